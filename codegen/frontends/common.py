@@ -1,0 +1,31 @@
+"""Helpers shared by the frontends."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def display_path(path: Path, root: Path | None) -> str:
+    """The path recorded in IR locations: relative to the schema root when under it (so output
+    does not depend on where a checkout lives), otherwise as given; always with '/' separators."""
+    if root is not None:
+        try:
+            return path.resolve().relative_to(root.resolve()).as_posix()
+        except ValueError:
+            pass
+    return path.as_posix()
+
+
+def read_text(path: Path, display: str) -> str:
+    """Read a schema file as UTF-8, turning I/O and decoding failures into SchemaError."""
+    from ..errors import SchemaError
+
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise SchemaError(display, 0, f"cannot read file: {exc.strerror or exc}") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise SchemaError(display, line, "expected UTF-8 text") from None

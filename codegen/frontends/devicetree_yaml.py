@@ -1,0 +1,75 @@
+"""YAML loading for the devicetree frontend: safe_load semantics, plus the line of every node.
+
+Mappings load as :class:`YMap` (a dict that knows its own line and the line of each key) and
+sequences as :class:`YList`, so errors and IR locations can point at the source line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Hashable
+from typing import Any
+
+import yaml
+
+from ..errors import SchemaError
+
+
+class YMap(dict[Any, Any]):
+    """A mapping with ``line`` (where it starts) and ``key_lines`` (where each key is)."""
+
+    line: int = 0
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.key_lines: dict[Any, int] = {}
+
+    def line_of(self, key: str) -> int:
+        return self.key_lines.get(key, self.line)
+
+
+class YList(list[Any]):
+    line: int = 0
+
+
+class _Loader(yaml.SafeLoader):
+    """SafeLoader whose maps and sequences remember lines and reject duplicate keys."""
+
+
+def _construct_map(loader: _Loader, node: yaml.MappingNode) -> YMap:
+    loader.flatten_mapping(node)
+    out = YMap()
+    out.line = node.start_mark.line + 1
+    for key_node, value_node in node.value:
+        key = loader.construct_object(key_node, deep=True)
+        if not isinstance(key, Hashable):
+            raise yaml.constructor.ConstructorError(None, None, "expected a scalar key", key_node.start_mark)
+        if key in out:
+            raise yaml.constructor.ConstructorError(None, None, f"duplicate key {key!r}", key_node.start_mark)
+        out[key] = loader.construct_object(value_node, deep=True)
+        out.key_lines[key] = key_node.start_mark.line + 1
+    return out
+
+
+def _construct_seq(loader: _Loader, node: yaml.SequenceNode) -> YList:
+    out = YList(loader.construct_object(child, deep=True) for child in node.value)
+    out.line = node.start_mark.line + 1
+    return out
+
+
+_Loader.add_constructor("tag:yaml.org,2002:map", _construct_map)
+_Loader.add_constructor("tag:yaml.org,2002:seq", _construct_seq)
+
+
+def load(text: str, display: str) -> Any:
+    """Parse one YAML document; YAML errors become SchemaError at the problem's line."""
+    try:
+        return yaml.load(text, Loader=_Loader)  # _Loader is a SafeLoader subclass
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else 1
+        what = exc.problem or exc.context or "malformed YAML"
+        raise SchemaError(display, line, f"expected well-formed YAML: {what}") from None
+    except yaml.YAMLError as exc:
+        raise SchemaError(display, 1, f"expected well-formed YAML: {exc}") from None
+    except RecursionError:
+        raise SchemaError(display, 1, "expected YAML without runaway nesting") from None

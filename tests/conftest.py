@@ -1,0 +1,36 @@
+"""Shared fixtures: the repository root and helpers to render a generated package into a temp dir."""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+from codegen.generate import generate
+from codegen.ir import Schema
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture
+def import_generated(tmp_path: Path) -> Iterator[object]:
+    """Generate a Schema into a fresh package under tmp_path and import one of its modules."""
+    added: list[str] = []
+
+    def _import(schema: Schema, module: str = "", package: str = "genpkg") -> ModuleType:
+        generate(schema, tmp_path / package)
+        if str(tmp_path) not in sys.path:
+            sys.path.insert(0, str(tmp_path))
+            added.append(str(tmp_path))
+        importlib.invalidate_caches()
+        return importlib.import_module(f"{package}.{module}" if module else package)
+
+    yield _import
+    for entry in added:
+        sys.path.remove(entry)
+    for name in [m for m in sys.modules if m == "genpkg" or m.startswith("genpkg.")]:
+        del sys.modules[name]
