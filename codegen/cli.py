@@ -4,12 +4,14 @@ malformed schema. Errors are one line on stderr, never a traceback."""
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from . import __version__, irjson
+from .commands import COMMAND_MODULES
 from .errors import BattgenError
 from .generate import generate
 from .ir import Schema
@@ -103,6 +105,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="write an importable package here (its import name is the folder's name)")
     p.add_argument("--check", action="store_true", help="write nothing; exit 1 naming stale files")
     p.set_defaults(func=cmd_generate)
+
+    for name in COMMAND_MODULES:
+        importlib.import_module(name).register(sub)
     return parser
 
 
