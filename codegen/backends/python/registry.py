@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from . import codec_dronecan, codec_mavlink, codec_uorb
+from . import codec_dronecan, codec_mavlink, codec_uorb, validators
 from .extensions import Extension
 
 EXTENSIONS: tuple[Extension, ...] = (
     codec_dronecan.EXTENSION,
     codec_uorb.EXTENSION,
     codec_mavlink.EXTENSION,
+    validators.EXTENSION,
 )
