@@ -16,6 +16,7 @@ class SourceFormat(str, enum.Enum):
     DRONECAN = "dronecan"
     DEVICETREE = "devicetree"
     MAVLINK = "mavlink"
+    PARAMS = "params"  # ArduPilot parameter metadata (apm.pdef.xml)
 
 
 @dataclass(frozen=True)
@@ -308,6 +309,15 @@ class DevicetreeInfo:
 
 
 @dataclass(frozen=True)
+class ParamsInfo:
+    """An ArduPilot parameter group: ``prefix`` joins group and parameter (``BATT_``); ``section``
+    is where apm.pdef.xml lists it (``libraries`` or ``vehicles``)."""
+
+    prefix: str
+    section: str
+
+
+@dataclass(frozen=True)
 class Message:
     """A message, service half, or devicetree node type.
 
@@ -328,12 +338,105 @@ class Message:
     dronecan: DronecanInfo | None = None
     mavlink: MavlinkInfo | None = None
     devicetree: DevicetreeInfo | None = None
+    params: ParamsInfo | None = None
 
     def field(self, name: str) -> Field:
         for f in self.fields:
             if f.name == name:
                 return f
         raise KeyError(name)
+
+
+# --------------------------------------------------------------------------------------------
+# Concepts and mappings (schemas/mappings/*.yaml): what converters between formats are made of
+
+# A rule parameter: scalars, or tuples of them (a YAML list), or tuples of Params (a YAML mapping)
+ParamValue = int | float | str | bool | None | tuple["ParamValue | Param", ...]
+
+
+@dataclass(frozen=True)
+class Param:
+    name: str
+    value: ParamValue
+
+
+@dataclass(frozen=True)
+class Concept:
+    """A shared battery quantity (pack voltage, state of charge...), in SI units.
+
+    ``kind`` is ``number``, ``integer``, ``bool``, ``text``, ``list`` (of numbers), ``choice``
+    (one of ``choices``) or ``flags`` (a set drawn from ``choices``); ``unit`` None when unitless.
+    """
+
+    name: str
+    kind: str
+    unit: Unit | None = None
+    doc: str = ""
+    choices: tuple[str, ...] = ()
+    location: Location | None = None
+
+
+@dataclass(frozen=True)
+class FieldRef:
+    """A field of a message (qualified name), or a concept (``message`` is ``"concepts"``)."""
+
+    message: str
+    field: str
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One step of a mapping: ``op`` computes ``targets`` from ``sources`` with ``params``."""
+
+    op: str
+    targets: tuple[FieldRef, ...]
+    sources: tuple[FieldRef, ...]
+    params: tuple[Param, ...] = ()
+    doc: str = ""
+    location: Location | None = None
+
+
+@dataclass(frozen=True)
+class Endpoint:
+    """What a converter reads or writes: one or more messages (the first required, the rest
+    optional companions such as DroneCAN's BatteryInfoAux), each known by a short alias."""
+
+    name: str
+    messages: tuple[str, ...]
+    aliases: tuple[str, ...]
+    doc: str = ""
+    location: Location | None = None
+
+
+CONCEPTS_ENDPOINT = "concepts"  # the shared battery state every format maps to and from
+
+
+@dataclass(frozen=True)
+class Mapping:
+    """How to turn the ``source`` endpoint into the ``target`` endpoint under ``policy``.
+
+    ``reversible`` mappings are also generated target -> source; ``policy`` is ``strict``,
+    ``px4`` or ``any``.
+    """
+
+    name: str
+    source: str
+    target: str
+    policy: str
+    rules: tuple[Rule, ...]
+    reversible: bool = False
+    doc: str = ""
+    location: Location | None = None
+
+
+@dataclass(frozen=True)
+class MappingSet:
+    """Everything one mapping file declares: concepts, endpoints and/or mappings."""
+
+    file: str
+    concepts: tuple[Concept, ...] = ()
+    endpoints: tuple[Endpoint, ...] = ()
+    mappings: tuple[Mapping, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -343,6 +446,7 @@ class Schema:
     messages: tuple[Message, ...] = ()
     enums: tuple[EnumDef, ...] = ()
     sources: tuple[str, ...] = field(default=())
+    mappings: tuple[MappingSet, ...] = ()
 
     def message(self, qualified_name: str) -> Message:
         for m in self.messages:
@@ -365,4 +469,5 @@ class Schema:
             messages=self.messages + other.messages,
             enums=self.enums + other.enums,
             sources=self.sources + other.sources,
+            mappings=self.mappings + other.mappings,
         )

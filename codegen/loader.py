@@ -16,7 +16,11 @@ FORMAT_FRONTENDS: dict[str, str] = {
     "dronecan": "codegen.frontends.dsdl",
     "devicetree": "codegen.frontends.devicetree",
     "mavlink": "codegen.frontends.mavlink",
+    "params": "codegen.frontends.params",
 }
+
+# converter mappings between the formats (schemas/mappings/*.yaml), parsed after the formats
+MAPPINGS_DIR = "mappings"
 
 EXTENSION_FORMATS: dict[str, str] = {
     ".msg": "uorb",
@@ -24,6 +28,7 @@ EXTENSION_FORMATS: dict[str, str] = {
     ".yaml": "devicetree",
     ".yml": "devicetree",
     ".xml": "mavlink",
+    ".pdef.xml": "params",  # ArduPilot parameter metadata; checked before the plain suffix
 }
 
 
@@ -32,7 +37,9 @@ def frontend(fmt: str) -> ModuleType:
 
 
 def format_of_file(path: Path) -> str:
-    fmt = EXTENSION_FORMATS.get(path.suffix.lower())
+    name = path.name.lower()
+    fmt = EXTENSION_FORMATS.get(".pdef.xml") if name.endswith(".pdef.xml") else None
+    fmt = fmt or EXTENSION_FORMATS.get(path.suffix.lower())
     if fmt is None:
         known = ", ".join(sorted(EXTENSION_FORMATS))
         raise BattgenError(f"{path}: cannot tell the schema format from the extension (expected one of {known})")
@@ -51,6 +58,11 @@ def load_schema_dir(root: Path) -> Schema:
         if sub.is_dir():
             part: Schema = frontend(fmt).parse_dir(sub)
             schema = schema.merged(part)
+    if (root / MAPPINGS_DIR).is_dir():
+        # after the formats, so every reference to a message or field can be checked
+        from .frontends import mappings
+
+        schema = schema.merged(mappings.parse_dir(root / MAPPINGS_DIR, schema=schema))
     return schema
 
 
@@ -90,4 +102,5 @@ def _deduplicated(schema: Schema) -> Schema:
         messages=tuple(sorted(messages, key=lambda m: m.qualified_name)),
         enums=tuple(sorted(enums.values(), key=lambda e: e.name)),
         sources=tuple(dict.fromkeys(schema.sources)),
+        mappings=schema.mappings,
     )

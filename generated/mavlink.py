@@ -8,10 +8,13 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import struct
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from . import _meta as _m
+from . import _mavlink as _mav
+from . import _validate as _v
 
 __all__ = ['BatteryStatus', 'MavBatteryChargeState', 'MavBatteryFault', 'MavBatteryFunction', 'MavBatteryMode', 'MavBatteryType']
 
@@ -84,6 +87,27 @@ class MavBatteryType(enum.IntEnum):
     LIFE = 2
     LION = 3
     NIMH = 4
+
+
+_MAV_BatteryStatus = struct.Struct('<iih10HhBBBbiB4HBI')
+_MAV_BatteryStatus_FIELDS: tuple[tuple[str, str, str, int], ...] = (('current_consumed', 'current_consumed', 'i', 0), ('energy_consumed', 'energy_consumed', 'i', 0), ('temperature', 'temperature', 'h', 0), ('voltages', 'voltages', 'H', 10), ('current_battery', 'current_battery', 'h', 0), ('id', 'id', 'B', 0), ('battery_function', 'battery_function', 'B', 0), ('type', 'type', 'B', 0), ('battery_remaining', 'battery_remaining', 'b', 0), ('time_remaining', 'time_remaining', 'i', 0), ('charge_state', 'charge_state', 'B', 0), ('voltages_ext', 'voltages_ext', 'H', 4), ('mode', 'mode', 'B', 0), ('fault_bitmask', 'fault_bitmask', 'I', 0),)
+_MAV_BatteryStatus_DTYPE: list[tuple[Any, ...]] = [('current_consumed', '<i4'), ('energy_consumed', '<i4'), ('temperature', '<i2'), ('voltages', '<u2', (10,)), ('current_battery', '<i2'), ('id', 'u1'), ('battery_function', 'u1'), ('type', 'u1'), ('battery_remaining', 'i1'), ('time_remaining', '<i4'), ('charge_state', 'u1'), ('voltages_ext', '<u2', (4,)), ('mode', 'u1'), ('fault_bitmask', '<u4')]
+
+
+_VS_BatteryStatus_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
+_VS_BatteryStatus_battery_function = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'MAV_BATTERY_FUNCTION_UNKNOWN', 1: 'MAV_BATTERY_FUNCTION_ALL', 2: 'MAV_BATTERY_FUNCTION_PROPULSION', 3: 'MAV_BATTERY_FUNCTION_AVIONICS', 4: 'MAV_BATTERY_FUNCTION_PAYLOAD'})
+_VS_BatteryStatus_type = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'MAV_BATTERY_TYPE_UNKNOWN', 1: 'MAV_BATTERY_TYPE_LIPO', 2: 'MAV_BATTERY_TYPE_LIFE', 3: 'MAV_BATTERY_TYPE_LION', 4: 'MAV_BATTERY_TYPE_NIMH'})
+_VS_BatteryStatus_temperature = _v.Number(type='int16', kind='int', low=-32768, high=32767, unit='cdegC', sentinel=32767, sentinel_text='INT16_MAX')
+_VS_BatteryStatus_voltages = _v.Array(_v.Number(type='uint16', kind='uint', low=0, high=65535, unit='mV', sentinel=65535, sentinel_text='[UINT16_MAX]'), 10, True)
+_VS_BatteryStatus_current_battery = _v.Number(type='int16', kind='int', low=-32768, high=32767, unit='cA', sentinel=-1, sentinel_text='-1')
+_VS_BatteryStatus_current_consumed = _v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='mAh', sentinel=-1, sentinel_text='-1')
+_VS_BatteryStatus_energy_consumed = _v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='hJ', sentinel=-1, sentinel_text='-1')
+_VS_BatteryStatus_battery_remaining = _v.Number(type='int8', kind='int', low=-128, high=127, unit='%', sentinel=-1, sentinel_text='-1')
+_VS_BatteryStatus_time_remaining = _v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='s')
+_VS_BatteryStatus_charge_state = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'MAV_BATTERY_CHARGE_STATE_UNDEFINED', 1: 'MAV_BATTERY_CHARGE_STATE_OK', 2: 'MAV_BATTERY_CHARGE_STATE_LOW', 3: 'MAV_BATTERY_CHARGE_STATE_CRITICAL', 4: 'MAV_BATTERY_CHARGE_STATE_EMERGENCY', 5: 'MAV_BATTERY_CHARGE_STATE_FAILED', 6: 'MAV_BATTERY_CHARGE_STATE_UNHEALTHY', 7: 'MAV_BATTERY_CHARGE_STATE_CHARGING'})
+_VS_BatteryStatus_voltages_ext = _v.Array(_v.Number(type='uint16', kind='uint', low=0, high=65535, unit='mV'), 4, True)
+_VS_BatteryStatus_mode = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'MAV_BATTERY_MODE_UNKNOWN', 1: 'MAV_BATTERY_MODE_AUTO_DISCHARGING', 2: 'MAV_BATTERY_MODE_HOT_SWAP'})
+_VS_BatteryStatus_fault_bitmask = _v.Number(type='uint32', kind='uint', low=0, high=4294967295, mask=0x1ff, bits={0x1: 'MAV_BATTERY_FAULT_DEEP_DISCHARGE', 0x2: 'MAV_BATTERY_FAULT_SPIKES', 0x4: 'MAV_BATTERY_FAULT_CELL_FAIL', 0x8: 'MAV_BATTERY_FAULT_OVER_CURRENT', 0x10: 'MAV_BATTERY_FAULT_OVER_TEMPERATURE', 0x20: 'MAV_BATTERY_FAULT_UNDER_TEMPERATURE', 0x40: 'MAV_BATTERY_FAULT_INCOMPATIBLE_VOLTAGE', 0x80: 'MAV_BATTERY_FAULT_INCOMPATIBLE_FIRMWARE', 0x100: 'BATTERY_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION'})
 
 
 @dataclasses.dataclass(slots=True)
@@ -163,3 +187,221 @@ class BatteryStatus:
         if 'fault_bitmask' in data:
             obj.fault_bitmask = _m.as_int(data['fault_bitmask'], 'fault_bitmask')
         return obj
+
+    MSG_ID: ClassVar[int] = 147
+    CRC_EXTRA: ClassVar[int] = 154
+    MAVLINK_BASE_LENGTH: ClassVar[int] = 36
+    MAVLINK_MAX_LENGTH: ClassVar[int] = 54
+
+    def encode(self, *, truncate: bool = True) -> bytes:
+        """The MAVLink 2 payload, 54 bytes in wire order; trailing zero bytes
+        are dropped (at least one byte is kept) unless ``truncate`` is False.
+        A value that does not fit its field raises EncodeError naming it."""
+        try:
+            data = _MAV_BatteryStatus.pack(self.current_consumed, self.energy_consumed, self.temperature, *self.voltages, self.current_battery, self.id, self.battery_function, self.type, self.battery_remaining, self.time_remaining, self.charge_state, *self.voltages_ext, self.mode, self.fault_bitmask)
+        except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+            raise _mav.explain('BATTERY_STATUS', self, _MAV_BatteryStatus_FIELDS) from exc
+        if len(self.voltages) != 10 or len(self.voltages_ext) != 4:
+            raise _mav.explain('BATTERY_STATUS', self, _MAV_BatteryStatus_FIELDS)
+        if truncate:
+            return data.rstrip(b"\x00") or b"\x00"
+        return data
+
+    @classmethod
+    def decode(cls, data: _mav.BytesLike) -> BatteryStatus:
+        """A MAVLink 2 payload; a short one is zero-filled, one over 54 bytes is a DecodeError."""
+        if len(data) != 54:
+            data = _mav.fill(data, 54, 'BATTERY_STATUS')
+        v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15, v16, v17, v18, v19, v20, v21, v22, v23, v24, v25 = _MAV_BatteryStatus.unpack(data)
+        obj = object.__new__(cls)
+        obj.current_consumed = v0
+        obj.energy_consumed = v1
+        obj.temperature = v2
+        obj.voltages = [v3, v4, v5, v6, v7, v8, v9, v10, v11, v12]
+        obj.current_battery = v13
+        obj.id = v14
+        obj.battery_function = v15
+        obj.type = v16
+        obj.battery_remaining = v17
+        obj.time_remaining = v18
+        obj.charge_state = v19
+        obj.voltages_ext = [v20, v21, v22, v23]
+        obj.mode = v24
+        obj.fault_bitmask = v25
+        return obj
+
+    def encode_frame(
+        self,
+        *,
+        seq: int = 0,
+        sysid: int = 1,
+        compid: int = 1,
+        mavlink1: bool = False,
+        incompat_flags: int = 0,
+        compat_flags: int = 0,
+        signature: bytes | None = None,
+    ) -> bytes:
+        """A whole frame: MAVLink 2 (0xFD, truncated payload, CRC with CRC_EXTRA; a 13-byte
+        ``signature`` is appended and flagged, not computed) or, with ``mavlink1``, MAVLink 1
+        (0xFE, the base payload without extensions; message ids below 256 only)."""
+        if mavlink1:
+            return _mav.frame_v1(self.encode(truncate=False)[:36], 147, b'\x9a', seq, sysid, compid, incompat_flags != 0 or compat_flags != 0 or signature is not None)
+        return _mav.frame_v2(self.encode(), 147, b'\x9a', seq, sysid, compid, incompat_flags, compat_flags, signature)
+
+    @classmethod
+    def decode_frame(cls, data: _mav.BytesLike) -> BatteryStatus:
+        """One whole MAVLink 1 or 2 frame of this message (CRC checked; a signature is skipped);
+        _mavlink.parse_frame gives the header fields."""
+        payload = _mav.frame_payload(data, 147, b'\x9a', 54, 'BATTERY_STATUS')
+        return cls.decode(payload)
+
+    @classmethod
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, Any]:
+        """Records of 54 bytes (zero-filled payloads) -> columns keyed by field name: numpy
+        arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
+        tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
+        arrays = _mav.numpy_columns(data, 54, _MAV_BatteryStatus_DTYPE, use_numpy, 'BATTERY_STATUS')
+        if arrays is not None:
+            return arrays
+        c = _mav.struct_columns(data, _MAV_BatteryStatus, 'BATTERY_STATUS')
+        return {
+            'current_consumed': c[0],
+            'energy_consumed': c[1],
+            'temperature': c[2],
+            'voltages': list(zip(*c[3:13], strict=True)),
+            'current_battery': c[13],
+            'id': c[14],
+            'battery_function': c[15],
+            'type': c[16],
+            'battery_remaining': c[17],
+            'time_remaining': c[18],
+            'charge_state': c[19],
+            'voltages_ext': list(zip(*c[20:24], strict=True)),
+            'mode': c[24],
+            'fault_bitmask': c[25],
+        }
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        a: Any
+        e: Any
+        sub: Any
+        r_battery_remaining: Any
+        try:
+            if (self.id & -256):
+                _v.diag(out, 'id', self.id, _VS_BatteryStatus_id)
+        except _v.SLOW:
+            _v.diag(out, 'id', self.id, _VS_BatteryStatus_id)
+        try:
+            if (self.battery_function not in {0, 1, 2, 3, 4}):
+                _v.diag(out, 'battery_function', self.battery_function, _VS_BatteryStatus_battery_function)
+        except _v.SLOW:
+            _v.diag(out, 'battery_function', self.battery_function, _VS_BatteryStatus_battery_function)
+        try:
+            if (self.type not in {0, 1, 2, 3, 4}):
+                _v.diag(out, 'type', self.type, _VS_BatteryStatus_type)
+        except _v.SLOW:
+            _v.diag(out, 'type', self.type, _VS_BatteryStatus_type)
+        try:
+            if ((self.temperature + 32768) & -65536):
+                _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatus_temperature)
+        except _v.SLOW:
+            _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatus_temperature)
+        try:
+            a = self.voltages
+            if len(a) != 10:
+                _v.diag(out, 'voltages', self.voltages, _VS_BatteryStatus_voltages)
+            else:
+                for e in a:
+                    if (e & -65536):
+                        _v.diag(out, 'voltages', self.voltages, _VS_BatteryStatus_voltages)
+                        break
+        except _v.SLOW:
+            _v.diag(out, 'voltages', self.voltages, _VS_BatteryStatus_voltages)
+        try:
+            if ((self.current_battery + 32768) & -65536):
+                _v.diag(out, 'current_battery', self.current_battery, _VS_BatteryStatus_current_battery)
+        except _v.SLOW:
+            _v.diag(out, 'current_battery', self.current_battery, _VS_BatteryStatus_current_battery)
+        try:
+            if ((self.current_consumed + 2147483648) & -4294967296):
+                _v.diag(out, 'current_consumed', self.current_consumed, _VS_BatteryStatus_current_consumed)
+        except _v.SLOW:
+            _v.diag(out, 'current_consumed', self.current_consumed, _VS_BatteryStatus_current_consumed)
+        try:
+            if ((self.energy_consumed + 2147483648) & -4294967296):
+                _v.diag(out, 'energy_consumed', self.energy_consumed, _VS_BatteryStatus_energy_consumed)
+        except _v.SLOW:
+            _v.diag(out, 'energy_consumed', self.energy_consumed, _VS_BatteryStatus_energy_consumed)
+        try:
+            if ((self.battery_remaining + 128) & -256):
+                _v.diag(out, 'battery_remaining', self.battery_remaining, _VS_BatteryStatus_battery_remaining)
+        except _v.SLOW:
+            _v.diag(out, 'battery_remaining', self.battery_remaining, _VS_BatteryStatus_battery_remaining)
+        try:
+            if ((self.time_remaining + 2147483648) & -4294967296):
+                _v.diag(out, 'time_remaining', self.time_remaining, _VS_BatteryStatus_time_remaining)
+        except _v.SLOW:
+            _v.diag(out, 'time_remaining', self.time_remaining, _VS_BatteryStatus_time_remaining)
+        try:
+            if (self.charge_state not in {0, 1, 2, 3, 4, 5, 6, 7}):
+                _v.diag(out, 'charge_state', self.charge_state, _VS_BatteryStatus_charge_state)
+        except _v.SLOW:
+            _v.diag(out, 'charge_state', self.charge_state, _VS_BatteryStatus_charge_state)
+        try:
+            a = self.voltages_ext
+            if len(a) != 4:
+                _v.diag(out, 'voltages_ext', self.voltages_ext, _VS_BatteryStatus_voltages_ext)
+            else:
+                for e in a:
+                    if (e & -65536):
+                        _v.diag(out, 'voltages_ext', self.voltages_ext, _VS_BatteryStatus_voltages_ext)
+                        break
+        except _v.SLOW:
+            _v.diag(out, 'voltages_ext', self.voltages_ext, _VS_BatteryStatus_voltages_ext)
+        try:
+            if (self.mode not in {0, 1, 2}):
+                _v.diag(out, 'mode', self.mode, _VS_BatteryStatus_mode)
+        except _v.SLOW:
+            _v.diag(out, 'mode', self.mode, _VS_BatteryStatus_mode)
+        try:
+            if (self.fault_bitmask & -512):
+                _v.diag(out, 'fault_bitmask', self.fault_bitmask, _VS_BatteryStatus_fault_bitmask)
+        except _v.SLOW:
+            _v.diag(out, 'fault_bitmask', self.fault_bitmask, _VS_BatteryStatus_fault_bitmask)
+        # rule battery-remaining-percent (mavlink-battery-status.yaml:4)
+        try:
+            r_battery_remaining = self.battery_remaining
+            if (r_battery_remaining != -1):
+                if not (0 <= r_battery_remaining <= 100):
+                    out.append(_v.rule('battery_remaining', 'battery-remaining-percent', r_battery_remaining, '0 <= battery_remaining <= 100', 'battery_remaining = ' + _v.fmt(r_battery_remaining) + ' % is outside 0..100 % (-1 means unknown)', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == 'error':
+                raise _v.ValidationError(found, 'mavlink.BATTERY_STATUS')
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == 'temperature':
+            return self.temperature != 32767
+        if field == 'voltages':
+            return any(e != 65535 for e in self.voltages)
+        if field == 'current_battery':
+            return self.current_battery != -1
+        if field == 'current_consumed':
+            return self.current_consumed != -1
+        if field == 'energy_consumed':
+            return self.energy_consumed != -1
+        if field == 'battery_remaining':
+            return self.battery_remaining != -1
+        if field in {'id', 'battery_function', 'type', 'time_remaining', 'charge_state', 'voltages_ext', 'mode', 'fault_bitmask'}:
+            return True
+        raise KeyError(f'{field!r} is not a field of ' + 'mavlink.BATTERY_STATUS')

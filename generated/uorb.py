@@ -9,10 +9,14 @@ from __future__ import annotations
 import dataclasses
 import enum
 import math
+import struct
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from . import _meta as _m
+from . import _ulog
+from . import _uorb
+from . import _validate as _v
 
 __all__ = ['BatteryStatus', 'BatteryStatusFault', 'BatteryStatusSource', 'BatteryStatusV0', 'BatteryStatusV0Fault', 'BatteryStatusV0Source', 'BatteryStatusV0State', 'BatteryStatusV0Warning', 'BatteryStatusWarning']
 
@@ -92,6 +96,118 @@ class BatteryStatusV0Fault(enum.IntEnum):
     INCOMPATIBLE_MODEL = 8
     HARDWARE_FAILURE = 9
     FAILED_TO_ARM = 10
+
+
+_S_BatteryStatus = struct.Struct('<Q33f9H?4B2?B2x')  # decode: nested messages inlined
+_SD_BatteryStatus = struct.Struct('<Q33f9H?4B2?B')  # without the trailing padding
+
+
+_COL_BatteryStatus = _uorb.Columns(
+    ('timestamp', 'voltage_v', 'current_a', 'current_average_a', 'discharged_mah', 'remaining', 'scale', 'time_remaining_s', 'temperature', 'voltage_cell_v[0]', 'voltage_cell_v[1]', 'voltage_cell_v[2]', 'voltage_cell_v[3]', 'voltage_cell_v[4]', 'voltage_cell_v[5]', 'voltage_cell_v[6]', 'voltage_cell_v[7]', 'voltage_cell_v[8]', 'voltage_cell_v[9]', 'voltage_cell_v[10]', 'voltage_cell_v[11]', 'voltage_cell_v[12]', 'voltage_cell_v[13]', 'max_cell_voltage_delta', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm', 'capacity', 'cycle_count', 'average_time_to_empty', 'manufacture_date', 'state_of_health', 'max_error', 'interface_error', 'faults', 'over_discharge_count', 'connected', 'cell_count', 'source', 'priority', 'id', 'is_powering_off', 'is_required', 'warning'),
+    '<Q33f9H?4B2?B',
+    168,
+    ('<u8', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '?', 'u1', 'u1', 'u1', 'u1', '?', '?', 'u1'),
+    (0, 8, 12, 16, 20, 24, 28, 32, 36, 40, 44, 48, 52, 56, 60, 64, 68, 72, 76, 80, 84, 88, 92, 96, 100, 104, 108, 112, 116, 120, 124, 128, 132, 136, 140, 142, 144, 146, 148, 150, 152, 154, 156, 158, 159, 160, 161, 162, 163, 164, 165),
+)
+
+
+_UC_BatteryStatus: tuple[tuple[str, str, str, int], ...] = (('timestamp', 'timestamp', 'Q', 0), ('voltage_v', 'voltage_v', 'f', 0), ('current_a', 'current_a', 'f', 0), ('current_average_a', 'current_average_a', 'f', 0), ('discharged_mah', 'discharged_mah', 'f', 0), ('remaining', 'remaining', 'f', 0), ('scale', 'scale', 'f', 0), ('time_remaining_s', 'time_remaining_s', 'f', 0), ('temperature', 'temperature', 'f', 0), ('voltage_cell_v', 'voltage_cell_v', 'f', 14), ('max_cell_voltage_delta', 'max_cell_voltage_delta', 'f', 0), ('full_charge_capacity_wh', 'full_charge_capacity_wh', 'f', 0), ('remaining_capacity_wh', 'remaining_capacity_wh', 'f', 0), ('nominal_voltage', 'nominal_voltage', 'f', 0), ('internal_resistance_estimate', 'internal_resistance_estimate', 'f', 0), ('ocv_estimate', 'ocv_estimate', 'f', 0), ('ocv_estimate_filtered', 'ocv_estimate_filtered', 'f', 0), ('volt_based_soc_estimate', 'volt_based_soc_estimate', 'f', 0), ('voltage_prediction', 'voltage_prediction', 'f', 0), ('prediction_error', 'prediction_error', 'f', 0), ('estimation_covariance_norm', 'estimation_covariance_norm', 'f', 0), ('capacity', 'capacity', 'H', 0), ('cycle_count', 'cycle_count', 'H', 0), ('average_time_to_empty', 'average_time_to_empty', 'H', 0), ('manufacture_date', 'manufacture_date', 'H', 0), ('state_of_health', 'state_of_health', 'H', 0), ('max_error', 'max_error', 'H', 0), ('interface_error', 'interface_error', 'H', 0), ('faults', 'faults', 'H', 0), ('over_discharge_count', 'over_discharge_count', 'H', 0), ('connected', 'connected', '?', 0), ('cell_count', 'cell_count', 'B', 0), ('source', 'source', 'B', 0), ('priority', 'priority', 'B', 0), ('id', 'id', 'B', 0), ('is_powering_off', 'is_powering_off', '?', 0), ('is_required', 'is_required', '?', 0), ('warning', 'warning', 'B', 0))
+
+
+_VS_BatteryStatus_timestamp = _v.Number(type='uint64', kind='uint', low=0, high=18446744073709551615, unit='us')
+_VS_BatteryStatus_connected = _v.Number(type='bool', kind='bool', low=0, high=1)
+_VS_BatteryStatus_voltage_v = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', sentinel=0.0, sentinel_text='0')
+_VS_BatteryStatus_current_a = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='A', sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatus_current_average_a = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='A', sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatus_discharged_mah = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='mAh', sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatus_remaining = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=0, maximum=1, sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatus_scale = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=1, sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatus_time_remaining_s = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='s', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryStatus_temperature = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='degC', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryStatus_cell_count = _v.Number(type='uint8', kind='uint', low=0, high=255, sentinel=0, sentinel_text='0')
+_VS_BatteryStatus_source = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'SOURCE_POWER_MODULE', 1: 'SOURCE_EXTERNAL', 2: 'SOURCE_ESCS'})
+_VS_BatteryStatus_priority = _v.Number(type='uint8', kind='uint', low=0, high=255)
+_VS_BatteryStatus_capacity = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='mAh')
+_VS_BatteryStatus_cycle_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_BatteryStatus_average_time_to_empty = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='min')
+_VS_BatteryStatus_manufacture_date = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_BatteryStatus_state_of_health = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='%', minimum=0, maximum=100)
+_VS_BatteryStatus_max_error = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='%', minimum=1, maximum=100)
+_VS_BatteryStatus_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
+_VS_BatteryStatus_interface_error = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_BatteryStatus_voltage_cell_v = _v.Array(_v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', sentinel=0.0, sentinel_text='0'), 14, True)
+_VS_BatteryStatus_max_cell_voltage_delta = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38)
+_VS_BatteryStatus_is_powering_off = _v.Number(type='bool', kind='bool', low=0, high=1)
+_VS_BatteryStatus_is_required = _v.Number(type='bool', kind='bool', low=0, high=1)
+_VS_BatteryStatus_warning = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'WARNING_NONE', 1: 'WARNING_LOW', 2: 'WARNING_CRITICAL', 3: 'WARNING_EMERGENCY', 4: 'WARNING_FAILED', 6: 'WARNING_UNHEALTHY', 7: 'WARNING_CHARGING'})
+_VS_BatteryStatus_faults = _v.Number(type='uint16', kind='uint', low=0, high=65535, mask=0x7ff, bits={0x1: 'FAULT_DEEP_DISCHARGE', 0x2: 'FAULT_SPIKES', 0x4: 'FAULT_CELL_FAIL', 0x8: 'FAULT_OVER_CURRENT', 0x10: 'FAULT_OVER_TEMPERATURE', 0x20: 'FAULT_UNDER_TEMPERATURE', 0x40: 'FAULT_INCOMPATIBLE_VOLTAGE', 0x80: 'FAULT_INCOMPATIBLE_FIRMWARE', 0x100: 'FAULT_INCOMPATIBLE_MODEL', 0x200: 'FAULT_HARDWARE_FAILURE', 0x400: 'FAULT_FAILED_TO_ARM'})
+_VS_BatteryStatus_full_charge_capacity_wh = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Wh')
+_VS_BatteryStatus_remaining_capacity_wh = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Wh')
+_VS_BatteryStatus_over_discharge_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_BatteryStatus_nominal_voltage = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatus_internal_resistance_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Ohm')
+_VS_BatteryStatus_ocv_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatus_ocv_estimate_filtered = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatus_volt_based_soc_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=0, maximum=1)
+_VS_BatteryStatus_voltage_prediction = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatus_prediction_error = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatus_estimation_covariance_norm = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38)
+
+
+_S_BatteryStatusV0 = struct.Struct('<Q33f10H?4B2?B')  # decode: nested messages inlined
+
+
+_COL_BatteryStatusV0 = _uorb.Columns(
+    ('timestamp', 'voltage_v', 'current_a', 'current_average_a', 'discharged_mah', 'remaining', 'scale', 'time_remaining_s', 'temperature', 'voltage_cell_v[0]', 'voltage_cell_v[1]', 'voltage_cell_v[2]', 'voltage_cell_v[3]', 'voltage_cell_v[4]', 'voltage_cell_v[5]', 'voltage_cell_v[6]', 'voltage_cell_v[7]', 'voltage_cell_v[8]', 'voltage_cell_v[9]', 'voltage_cell_v[10]', 'voltage_cell_v[11]', 'voltage_cell_v[12]', 'voltage_cell_v[13]', 'max_cell_voltage_delta', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm', 'capacity', 'cycle_count', 'average_time_to_empty', 'serial_number', 'manufacture_date', 'state_of_health', 'max_error', 'interface_error', 'faults', 'over_discharge_count', 'connected', 'cell_count', 'source', 'priority', 'id', 'is_powering_off', 'is_required', 'warning'),
+    '<Q33f10H?4B2?B',
+    168,
+    ('<u8', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '?', 'u1', 'u1', 'u1', 'u1', '?', '?', 'u1'),
+    (0, 8, 12, 16, 20, 24, 28, 32, 36, 40, 44, 48, 52, 56, 60, 64, 68, 72, 76, 80, 84, 88, 92, 96, 100, 104, 108, 112, 116, 120, 124, 128, 132, 136, 140, 142, 144, 146, 148, 150, 152, 154, 156, 158, 160, 161, 162, 163, 164, 165, 166, 167),
+)
+
+
+_UC_BatteryStatusV0: tuple[tuple[str, str, str, int], ...] = (('timestamp', 'timestamp', 'Q', 0), ('voltage_v', 'voltage_v', 'f', 0), ('current_a', 'current_a', 'f', 0), ('current_average_a', 'current_average_a', 'f', 0), ('discharged_mah', 'discharged_mah', 'f', 0), ('remaining', 'remaining', 'f', 0), ('scale', 'scale', 'f', 0), ('time_remaining_s', 'time_remaining_s', 'f', 0), ('temperature', 'temperature', 'f', 0), ('voltage_cell_v', 'voltage_cell_v', 'f', 14), ('max_cell_voltage_delta', 'max_cell_voltage_delta', 'f', 0), ('full_charge_capacity_wh', 'full_charge_capacity_wh', 'f', 0), ('remaining_capacity_wh', 'remaining_capacity_wh', 'f', 0), ('nominal_voltage', 'nominal_voltage', 'f', 0), ('internal_resistance_estimate', 'internal_resistance_estimate', 'f', 0), ('ocv_estimate', 'ocv_estimate', 'f', 0), ('ocv_estimate_filtered', 'ocv_estimate_filtered', 'f', 0), ('volt_based_soc_estimate', 'volt_based_soc_estimate', 'f', 0), ('voltage_prediction', 'voltage_prediction', 'f', 0), ('prediction_error', 'prediction_error', 'f', 0), ('estimation_covariance_norm', 'estimation_covariance_norm', 'f', 0), ('capacity', 'capacity', 'H', 0), ('cycle_count', 'cycle_count', 'H', 0), ('average_time_to_empty', 'average_time_to_empty', 'H', 0), ('serial_number', 'serial_number', 'H', 0), ('manufacture_date', 'manufacture_date', 'H', 0), ('state_of_health', 'state_of_health', 'H', 0), ('max_error', 'max_error', 'H', 0), ('interface_error', 'interface_error', 'H', 0), ('faults', 'faults', 'H', 0), ('over_discharge_count', 'over_discharge_count', 'H', 0), ('connected', 'connected', '?', 0), ('cell_count', 'cell_count', 'B', 0), ('source', 'source', 'B', 0), ('priority', 'priority', 'B', 0), ('id', 'id', 'B', 0), ('is_powering_off', 'is_powering_off', '?', 0), ('is_required', 'is_required', '?', 0), ('warning', 'warning', 'B', 0))
+
+
+_VS_BatteryStatusV0_timestamp = _v.Number(type='uint64', kind='uint', low=0, high=18446744073709551615, unit='us')
+_VS_BatteryStatusV0_connected = _v.Number(type='bool', kind='bool', low=0, high=1)
+_VS_BatteryStatusV0_voltage_v = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', sentinel=0.0, sentinel_text='0')
+_VS_BatteryStatusV0_current_a = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='A', sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatusV0_current_average_a = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='A', sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatusV0_discharged_mah = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='mAh', sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatusV0_remaining = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=0, maximum=1, sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatusV0_scale = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=1, sentinel=-1.0, sentinel_text='-1')
+_VS_BatteryStatusV0_time_remaining_s = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='s', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryStatusV0_temperature = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='degC', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryStatusV0_cell_count = _v.Number(type='uint8', kind='uint', low=0, high=255, sentinel=0, sentinel_text='0')
+_VS_BatteryStatusV0_source = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'SOURCE_POWER_MODULE', 1: 'SOURCE_EXTERNAL', 2: 'SOURCE_ESCS'})
+_VS_BatteryStatusV0_priority = _v.Number(type='uint8', kind='uint', low=0, high=255)
+_VS_BatteryStatusV0_capacity = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='mAh')
+_VS_BatteryStatusV0_cycle_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_BatteryStatusV0_average_time_to_empty = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='min')
+_VS_BatteryStatusV0_serial_number = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_BatteryStatusV0_manufacture_date = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_BatteryStatusV0_state_of_health = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='%', minimum=0, maximum=100)
+_VS_BatteryStatusV0_max_error = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='%', minimum=1, maximum=100)
+_VS_BatteryStatusV0_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
+_VS_BatteryStatusV0_interface_error = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_BatteryStatusV0_voltage_cell_v = _v.Array(_v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', sentinel=0.0, sentinel_text='0'), 14, True)
+_VS_BatteryStatusV0_max_cell_voltage_delta = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38)
+_VS_BatteryStatusV0_is_powering_off = _v.Number(type='bool', kind='bool', low=0, high=1)
+_VS_BatteryStatusV0_is_required = _v.Number(type='bool', kind='bool', low=0, high=1)
+_VS_BatteryStatusV0_warning = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'WARNING_NONE', 1: 'WARNING_LOW', 2: 'WARNING_CRITICAL', 3: 'WARNING_EMERGENCY', 4: 'WARNING_FAILED', 6: 'STATE_UNHEALTHY', 7: 'STATE_CHARGING'})
+_VS_BatteryStatusV0_faults = _v.Number(type='uint16', kind='uint', low=0, high=65535, mask=0x7ff, bits={0x1: 'FAULT_DEEP_DISCHARGE', 0x2: 'FAULT_SPIKES', 0x4: 'FAULT_CELL_FAIL', 0x8: 'FAULT_OVER_CURRENT', 0x10: 'FAULT_OVER_TEMPERATURE', 0x20: 'FAULT_UNDER_TEMPERATURE', 0x40: 'FAULT_INCOMPATIBLE_VOLTAGE', 0x80: 'FAULT_INCOMPATIBLE_FIRMWARE', 0x100: 'FAULT_INCOMPATIBLE_MODEL', 0x200: 'FAULT_HARDWARE_FAILURE', 0x400: 'FAULT_FAILED_TO_ARM'})
+_VS_BatteryStatusV0_full_charge_capacity_wh = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Wh')
+_VS_BatteryStatusV0_remaining_capacity_wh = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Wh')
+_VS_BatteryStatusV0_over_discharge_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_BatteryStatusV0_nominal_voltage = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatusV0_internal_resistance_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Ohm')
+_VS_BatteryStatusV0_ocv_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatusV0_ocv_estimate_filtered = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatusV0_volt_based_soc_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=0, maximum=1)
+_VS_BatteryStatusV0_voltage_prediction = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatusV0_prediction_error = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
+_VS_BatteryStatusV0_estimation_covariance_norm = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38)
 
 
 @dataclasses.dataclass(slots=True)
@@ -295,6 +411,457 @@ class BatteryStatus:
         if 'estimation_covariance_norm' in data:
             obj.estimation_covariance_norm = _m.as_float(data['estimation_covariance_norm'], 'estimation_covariance_norm')
         return obj
+
+    UORB_FORMAT: ClassVar[str] = '<Q33f9H?4B2?B2x'
+    UORB_SIZE: ClassVar[int] = 168
+    UORB_SIZE_NO_PADDING: ClassVar[int] = 166
+    UORB_TOPICS: ClassVar[tuple[str, ...]] = ('battery_status',)
+
+    def encode(self) -> bytes:
+        """PX4's C struct of this message: 168 bytes, little-endian, padding zeroed."""
+        try:
+            return _S_BatteryStatus.pack(
+                self.timestamp,
+                self.voltage_v,
+                self.current_a,
+                self.current_average_a,
+                self.discharged_mah,
+                self.remaining,
+                self.scale,
+                self.time_remaining_s,
+                self.temperature,
+                *self.voltage_cell_v,
+                self.max_cell_voltage_delta,
+                self.full_charge_capacity_wh,
+                self.remaining_capacity_wh,
+                self.nominal_voltage,
+                self.internal_resistance_estimate,
+                self.ocv_estimate,
+                self.ocv_estimate_filtered,
+                self.volt_based_soc_estimate,
+                self.voltage_prediction,
+                self.prediction_error,
+                self.estimation_covariance_norm,
+                self.capacity,
+                self.cycle_count,
+                self.average_time_to_empty,
+                self.manufacture_date,
+                self.state_of_health,
+                self.max_error,
+                self.interface_error,
+                self.faults,
+                self.over_discharge_count,
+                self.connected,
+                self.cell_count,
+                self.source,
+                self.priority,
+                self.id,
+                self.is_powering_off,
+                self.is_required,
+                self.warning,
+            )
+        except (struct.error, TypeError, OverflowError) as exc:
+            raise _uorb.encode_error('BatteryStatus', self, _UC_BatteryStatus, exc) from None
+
+    @classmethod
+    def decode(cls, data: bytes) -> BatteryStatus:
+        """From PX4's C struct: 168 bytes (or 166 without the trailing padding)."""
+        if len(data) != 168 and len(data) != 166:
+            raise _uorb.DecodeError('BatteryStatus: expected 168 bytes (or 166 without the trailing padding), got ' + str(len(data)))
+        v = _SD_BatteryStatus.unpack_from(data)
+        o = cls.__new__(cls)
+        o.timestamp = v[0]
+        o.voltage_v = v[1]
+        o.current_a = v[2]
+        o.current_average_a = v[3]
+        o.discharged_mah = v[4]
+        o.remaining = v[5]
+        o.scale = v[6]
+        o.time_remaining_s = v[7]
+        o.temperature = v[8]
+        o.voltage_cell_v = list(v[9:23])
+        o.max_cell_voltage_delta = v[23]
+        o.full_charge_capacity_wh = v[24]
+        o.remaining_capacity_wh = v[25]
+        o.nominal_voltage = v[26]
+        o.internal_resistance_estimate = v[27]
+        o.ocv_estimate = v[28]
+        o.ocv_estimate_filtered = v[29]
+        o.volt_based_soc_estimate = v[30]
+        o.voltage_prediction = v[31]
+        o.prediction_error = v[32]
+        o.estimation_covariance_norm = v[33]
+        o.capacity = v[34]
+        o.cycle_count = v[35]
+        o.average_time_to_empty = v[36]
+        o.manufacture_date = v[37]
+        o.state_of_health = v[38]
+        o.max_error = v[39]
+        o.interface_error = v[40]
+        o.faults = v[41]
+        o.over_discharge_count = v[42]
+        o.connected = v[43]
+        o.cell_count = v[44]
+        o.source = v[45]
+        o.priority = v[46]
+        o.id = v[47]
+        o.is_powering_off = v[48]
+        o.is_required = v[49]
+        o.warning = v[50]
+        return o
+
+    @classmethod
+    def decode_batch(
+        cls,
+        buffer: bytes,
+        *,
+        stride: int | None = None,
+        use_numpy: bool | None = None,
+        copy: bool = True,
+    ) -> dict[str, Any]:
+        """Columns of back-to-back records without an object per record, named as PX4 log
+        tools flatten them (``voltage_cell_v[3]``, ``nested.field``; char arrays as bytes).
+
+        ``stride``: bytes per record, default 168 (UORB_SIZE_NO_PADDING for ULog data).
+        numpy arrays when numpy is installed (``use_numpy`` None) or required (True; views
+        into ``buffer`` unless ``copy``), else lists from ``struct.iter_unpack``.
+        """
+        return _COL_BatteryStatus.decode(buffer, stride, use_numpy=use_numpy, copy=copy)
+
+    @classmethod
+    def ulog_format(cls) -> _ulog.Format:
+        """The ULog format PX4's logger writes for this struct (nested formats attached)."""
+        return _ulog.Format(
+            'battery_status',
+            (
+                _ulog.Member('uint64_t', 0, 'timestamp', 'timestamp', 'scalar'),
+                _ulog.Member('float', 0, 'voltage_v', 'voltage_v', 'scalar'),
+                _ulog.Member('float', 0, 'current_a', 'current_a', 'scalar'),
+                _ulog.Member('float', 0, 'current_average_a', 'current_average_a', 'scalar'),
+                _ulog.Member('float', 0, 'discharged_mah', 'discharged_mah', 'scalar'),
+                _ulog.Member('float', 0, 'remaining', 'remaining', 'scalar'),
+                _ulog.Member('float', 0, 'scale', 'scale', 'scalar'),
+                _ulog.Member('float', 0, 'time_remaining_s', 'time_remaining_s', 'scalar'),
+                _ulog.Member('float', 0, 'temperature', 'temperature', 'scalar'),
+                _ulog.Member('float', 14, 'voltage_cell_v', 'voltage_cell_v', 'array'),
+                _ulog.Member('float', 0, 'max_cell_voltage_delta', 'max_cell_voltage_delta', 'scalar'),
+                _ulog.Member('float', 0, 'full_charge_capacity_wh', 'full_charge_capacity_wh', 'scalar'),
+                _ulog.Member('float', 0, 'remaining_capacity_wh', 'remaining_capacity_wh', 'scalar'),
+                _ulog.Member('float', 0, 'nominal_voltage', 'nominal_voltage', 'scalar'),
+                _ulog.Member('float', 0, 'internal_resistance_estimate', 'internal_resistance_estimate', 'scalar'),
+                _ulog.Member('float', 0, 'ocv_estimate', 'ocv_estimate', 'scalar'),
+                _ulog.Member('float', 0, 'ocv_estimate_filtered', 'ocv_estimate_filtered', 'scalar'),
+                _ulog.Member('float', 0, 'volt_based_soc_estimate', 'volt_based_soc_estimate', 'scalar'),
+                _ulog.Member('float', 0, 'voltage_prediction', 'voltage_prediction', 'scalar'),
+                _ulog.Member('float', 0, 'prediction_error', 'prediction_error', 'scalar'),
+                _ulog.Member('float', 0, 'estimation_covariance_norm', 'estimation_covariance_norm', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'capacity', 'capacity', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'cycle_count', 'cycle_count', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'average_time_to_empty', 'average_time_to_empty', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'manufacture_date', 'manufacture_date', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'state_of_health', 'state_of_health', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'max_error', 'max_error', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'interface_error', 'interface_error', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'faults', 'faults', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'over_discharge_count', 'over_discharge_count', 'scalar'),
+                _ulog.Member('bool', 0, 'connected', 'connected', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'cell_count', 'cell_count', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'source', 'source', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'priority', 'priority', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'id', 'id', 'scalar'),
+                _ulog.Member('bool', 0, 'is_powering_off', 'is_powering_off', 'scalar'),
+                _ulog.Member('bool', 0, 'is_required', 'is_required', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'warning', 'warning', 'scalar'),
+                _ulog.Member('uint8_t', 2, '_padding0'),
+            ),
+            cls,
+            ('battery_status',),
+            1,
+        )
+
+    @classmethod
+    def from_ulog(
+        cls, source: _ulog.Source | _ulog.Log, *, topic: str | None = None, multi_id: int = 0
+    ) -> list[BatteryStatus]:
+        """Every record of this message in a ULog file (path, bytes, binary file or a read Log).
+
+        Topic defaults to the first of UORB_TOPICS. When the log's own format differs, the
+        fields matching by name and type are decoded and the rest keep their defaults
+        (see _ulog.Log.compare for the difference).
+        """
+        log = source if isinstance(source, _ulog.Log) else _ulog.read(source)
+        return log.messages(cls, topic=topic, multi_id=multi_id)
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        a: Any
+        e: Any
+        sub: Any
+        r_cell_count: Any
+        r_voltage_cell_v: Any
+        v_i: Any
+        try:
+            if (self.timestamp & -18446744073709551616):
+                _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryStatus_timestamp)
+        except _v.SLOW:
+            _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryStatus_timestamp)
+        try:
+            x = self.connected
+            if (x is not True and x is not False):
+                _v.diag(out, 'connected', self.connected, _VS_BatteryStatus_connected)
+        except _v.SLOW:
+            _v.diag(out, 'connected', self.connected, _VS_BatteryStatus_connected)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.voltage_v <= 3.4028234663852886e+38)):
+                _v.diag(out, 'voltage_v', self.voltage_v, _VS_BatteryStatus_voltage_v)
+        except _v.SLOW:
+            _v.diag(out, 'voltage_v', self.voltage_v, _VS_BatteryStatus_voltage_v)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.current_a <= 3.4028234663852886e+38)):
+                _v.diag(out, 'current_a', self.current_a, _VS_BatteryStatus_current_a)
+        except _v.SLOW:
+            _v.diag(out, 'current_a', self.current_a, _VS_BatteryStatus_current_a)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.current_average_a <= 3.4028234663852886e+38)):
+                _v.diag(out, 'current_average_a', self.current_average_a, _VS_BatteryStatus_current_average_a)
+        except _v.SLOW:
+            _v.diag(out, 'current_average_a', self.current_average_a, _VS_BatteryStatus_current_average_a)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.discharged_mah <= 3.4028234663852886e+38)):
+                _v.diag(out, 'discharged_mah', self.discharged_mah, _VS_BatteryStatus_discharged_mah)
+        except _v.SLOW:
+            _v.diag(out, 'discharged_mah', self.discharged_mah, _VS_BatteryStatus_discharged_mah)
+        try:
+            x = self.remaining
+            if (not (0.0 <= x <= 1.0) and x != -1.0):
+                _v.diag(out, 'remaining', self.remaining, _VS_BatteryStatus_remaining)
+        except _v.SLOW:
+            _v.diag(out, 'remaining', self.remaining, _VS_BatteryStatus_remaining)
+        try:
+            x = self.scale
+            if (not (1.0 <= x <= 3.4028234663852886e+38) and x != -1.0):
+                _v.diag(out, 'scale', self.scale, _VS_BatteryStatus_scale)
+        except _v.SLOW:
+            _v.diag(out, 'scale', self.scale, _VS_BatteryStatus_scale)
+        try:
+            x = self.time_remaining_s
+            if (not (-3.4028234663852886e+38 <= x <= 3.4028234663852886e+38) and x == x):
+                _v.diag(out, 'time_remaining_s', self.time_remaining_s, _VS_BatteryStatus_time_remaining_s)
+        except _v.SLOW:
+            _v.diag(out, 'time_remaining_s', self.time_remaining_s, _VS_BatteryStatus_time_remaining_s)
+        try:
+            x = self.temperature
+            if (not (-3.4028234663852886e+38 <= x <= 3.4028234663852886e+38) and x == x):
+                _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatus_temperature)
+        except _v.SLOW:
+            _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatus_temperature)
+        try:
+            if (self.cell_count & -256):
+                _v.diag(out, 'cell_count', self.cell_count, _VS_BatteryStatus_cell_count)
+        except _v.SLOW:
+            _v.diag(out, 'cell_count', self.cell_count, _VS_BatteryStatus_cell_count)
+        try:
+            if (self.source not in {0, 1, 2}):
+                _v.diag(out, 'source', self.source, _VS_BatteryStatus_source)
+        except _v.SLOW:
+            _v.diag(out, 'source', self.source, _VS_BatteryStatus_source)
+        try:
+            if (self.priority & -256):
+                _v.diag(out, 'priority', self.priority, _VS_BatteryStatus_priority)
+        except _v.SLOW:
+            _v.diag(out, 'priority', self.priority, _VS_BatteryStatus_priority)
+        try:
+            if (self.capacity & -65536):
+                _v.diag(out, 'capacity', self.capacity, _VS_BatteryStatus_capacity)
+        except _v.SLOW:
+            _v.diag(out, 'capacity', self.capacity, _VS_BatteryStatus_capacity)
+        try:
+            if (self.cycle_count & -65536):
+                _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryStatus_cycle_count)
+        except _v.SLOW:
+            _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryStatus_cycle_count)
+        try:
+            if (self.average_time_to_empty & -65536):
+                _v.diag(out, 'average_time_to_empty', self.average_time_to_empty, _VS_BatteryStatus_average_time_to_empty)
+        except _v.SLOW:
+            _v.diag(out, 'average_time_to_empty', self.average_time_to_empty, _VS_BatteryStatus_average_time_to_empty)
+        try:
+            if (self.manufacture_date & -65536):
+                _v.diag(out, 'manufacture_date', self.manufacture_date, _VS_BatteryStatus_manufacture_date)
+        except _v.SLOW:
+            _v.diag(out, 'manufacture_date', self.manufacture_date, _VS_BatteryStatus_manufacture_date)
+        try:
+            x = self.state_of_health
+            if (x & -65536 or not (0 <= x <= 100)):
+                _v.diag(out, 'state_of_health', self.state_of_health, _VS_BatteryStatus_state_of_health)
+        except _v.SLOW:
+            _v.diag(out, 'state_of_health', self.state_of_health, _VS_BatteryStatus_state_of_health)
+        try:
+            x = self.max_error
+            if (x & -65536 or not (1 <= x <= 100)):
+                _v.diag(out, 'max_error', self.max_error, _VS_BatteryStatus_max_error)
+        except _v.SLOW:
+            _v.diag(out, 'max_error', self.max_error, _VS_BatteryStatus_max_error)
+        try:
+            if (self.id & -256):
+                _v.diag(out, 'id', self.id, _VS_BatteryStatus_id)
+        except _v.SLOW:
+            _v.diag(out, 'id', self.id, _VS_BatteryStatus_id)
+        try:
+            if (self.interface_error & -65536):
+                _v.diag(out, 'interface_error', self.interface_error, _VS_BatteryStatus_interface_error)
+        except _v.SLOW:
+            _v.diag(out, 'interface_error', self.interface_error, _VS_BatteryStatus_interface_error)
+        try:
+            a = self.voltage_cell_v
+            if len(a) != 14:
+                _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
+            else:
+                for e in a:
+                    if (not (-3.4028234663852886e+38 <= e <= 3.4028234663852886e+38)):
+                        _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
+                        break
+        except _v.SLOW:
+            _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.max_cell_voltage_delta <= 3.4028234663852886e+38)):
+                _v.diag(out, 'max_cell_voltage_delta', self.max_cell_voltage_delta, _VS_BatteryStatus_max_cell_voltage_delta)
+        except _v.SLOW:
+            _v.diag(out, 'max_cell_voltage_delta', self.max_cell_voltage_delta, _VS_BatteryStatus_max_cell_voltage_delta)
+        try:
+            x = self.is_powering_off
+            if (x is not True and x is not False):
+                _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryStatus_is_powering_off)
+        except _v.SLOW:
+            _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryStatus_is_powering_off)
+        try:
+            x = self.is_required
+            if (x is not True and x is not False):
+                _v.diag(out, 'is_required', self.is_required, _VS_BatteryStatus_is_required)
+        except _v.SLOW:
+            _v.diag(out, 'is_required', self.is_required, _VS_BatteryStatus_is_required)
+        try:
+            if (self.warning not in {0, 1, 2, 3, 4, 6, 7}):
+                _v.diag(out, 'warning', self.warning, _VS_BatteryStatus_warning)
+        except _v.SLOW:
+            _v.diag(out, 'warning', self.warning, _VS_BatteryStatus_warning)
+        try:
+            if (self.faults & -2048):
+                _v.diag(out, 'faults', self.faults, _VS_BatteryStatus_faults)
+        except _v.SLOW:
+            _v.diag(out, 'faults', self.faults, _VS_BatteryStatus_faults)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.full_charge_capacity_wh <= 3.4028234663852886e+38)):
+                _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryStatus_full_charge_capacity_wh)
+        except _v.SLOW:
+            _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryStatus_full_charge_capacity_wh)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.remaining_capacity_wh <= 3.4028234663852886e+38)):
+                _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryStatus_remaining_capacity_wh)
+        except _v.SLOW:
+            _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryStatus_remaining_capacity_wh)
+        try:
+            if (self.over_discharge_count & -65536):
+                _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryStatus_over_discharge_count)
+        except _v.SLOW:
+            _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryStatus_over_discharge_count)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.nominal_voltage <= 3.4028234663852886e+38)):
+                _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryStatus_nominal_voltage)
+        except _v.SLOW:
+            _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryStatus_nominal_voltage)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.internal_resistance_estimate <= 3.4028234663852886e+38)):
+                _v.diag(out, 'internal_resistance_estimate', self.internal_resistance_estimate, _VS_BatteryStatus_internal_resistance_estimate)
+        except _v.SLOW:
+            _v.diag(out, 'internal_resistance_estimate', self.internal_resistance_estimate, _VS_BatteryStatus_internal_resistance_estimate)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.ocv_estimate <= 3.4028234663852886e+38)):
+                _v.diag(out, 'ocv_estimate', self.ocv_estimate, _VS_BatteryStatus_ocv_estimate)
+        except _v.SLOW:
+            _v.diag(out, 'ocv_estimate', self.ocv_estimate, _VS_BatteryStatus_ocv_estimate)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.ocv_estimate_filtered <= 3.4028234663852886e+38)):
+                _v.diag(out, 'ocv_estimate_filtered', self.ocv_estimate_filtered, _VS_BatteryStatus_ocv_estimate_filtered)
+        except _v.SLOW:
+            _v.diag(out, 'ocv_estimate_filtered', self.ocv_estimate_filtered, _VS_BatteryStatus_ocv_estimate_filtered)
+        try:
+            if (not (0.0 <= self.volt_based_soc_estimate <= 1.0)):
+                _v.diag(out, 'volt_based_soc_estimate', self.volt_based_soc_estimate, _VS_BatteryStatus_volt_based_soc_estimate)
+        except _v.SLOW:
+            _v.diag(out, 'volt_based_soc_estimate', self.volt_based_soc_estimate, _VS_BatteryStatus_volt_based_soc_estimate)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.voltage_prediction <= 3.4028234663852886e+38)):
+                _v.diag(out, 'voltage_prediction', self.voltage_prediction, _VS_BatteryStatus_voltage_prediction)
+        except _v.SLOW:
+            _v.diag(out, 'voltage_prediction', self.voltage_prediction, _VS_BatteryStatus_voltage_prediction)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.prediction_error <= 3.4028234663852886e+38)):
+                _v.diag(out, 'prediction_error', self.prediction_error, _VS_BatteryStatus_prediction_error)
+        except _v.SLOW:
+            _v.diag(out, 'prediction_error', self.prediction_error, _VS_BatteryStatus_prediction_error)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.estimation_covariance_norm <= 3.4028234663852886e+38)):
+                _v.diag(out, 'estimation_covariance_norm', self.estimation_covariance_norm, _VS_BatteryStatus_estimation_covariance_norm)
+        except _v.SLOW:
+            _v.diag(out, 'estimation_covariance_norm', self.estimation_covariance_norm, _VS_BatteryStatus_estimation_covariance_norm)
+        # rule cell-count-capacity (uorb-battery-status.yaml:5)
+        try:
+            r_cell_count = self.cell_count
+            r_voltage_cell_v = self.voltage_cell_v
+            if not (r_cell_count <= len(r_voltage_cell_v)):
+                out.append(_v.rule('cell_count', 'cell-count-capacity', r_cell_count, 'cell_count <= len(voltage_cell_v)', 'cell_count = ' + _v.fmt(r_cell_count) + ' is above the ' + _v.fmt(len(r_voltage_cell_v)) + ' cells voltage_cell_v can hold', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule cells-beyond-count-zero (uorb-battery-status.yaml:11)
+        try:
+            r_cell_count = self.cell_count
+            r_voltage_cell_v = self.voltage_cell_v
+            if (r_cell_count != 0):
+                for v_i in range(r_cell_count, len(r_voltage_cell_v)):
+                    try:
+                        if not (r_voltage_cell_v[v_i] == 0):
+                            out.append(_v.rule('voltage_cell_v' + '[' + str(v_i) + ']', 'cells-beyond-count-zero', r_voltage_cell_v[v_i], 'voltage_cell_v[i] == 0', 'voltage_cell_v[' + _v.fmt(v_i) + '] = ' + _v.fmt(r_voltage_cell_v[v_i]) + ' V but the battery has only ' + _v.fmt(r_cell_count) + ' cells; expected 0', 'error'))
+                    except _v.SLOW:
+                        pass
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == 'error':
+                raise _v.ValidationError(found, 'uorb.BatteryStatus')
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == 'voltage_v':
+            return self.voltage_v != 0.0
+        if field == 'current_a':
+            return self.current_a != -1.0
+        if field == 'current_average_a':
+            return self.current_average_a != -1.0
+        if field == 'discharged_mah':
+            return self.discharged_mah != -1.0
+        if field == 'remaining':
+            return self.remaining != -1.0
+        if field == 'scale':
+            return self.scale != -1.0
+        if field == 'time_remaining_s':
+            return self.time_remaining_s == self.time_remaining_s
+        if field == 'temperature':
+            return self.temperature == self.temperature
+        if field == 'cell_count':
+            return self.cell_count != 0
+        if field == 'voltage_cell_v':
+            return any(e != 0.0 for e in self.voltage_cell_v)
+        if field in {'timestamp', 'connected', 'source', 'priority', 'capacity', 'cycle_count', 'average_time_to_empty', 'manufacture_date', 'state_of_health', 'max_error', 'id', 'interface_error', 'max_cell_voltage_delta', 'is_powering_off', 'is_required', 'warning', 'faults', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'over_discharge_count', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm'}:
+            return True
+        raise KeyError(f'{field!r} is not a field of ' + 'uorb.BatteryStatus')
 
 
 @dataclasses.dataclass(slots=True)
@@ -502,3 +1069,461 @@ class BatteryStatusV0:
         if 'estimation_covariance_norm' in data:
             obj.estimation_covariance_norm = _m.as_float(data['estimation_covariance_norm'], 'estimation_covariance_norm')
         return obj
+
+    UORB_FORMAT: ClassVar[str] = '<Q33f10H?4B2?B'
+    UORB_SIZE: ClassVar[int] = 168
+    UORB_SIZE_NO_PADDING: ClassVar[int] = 168
+    UORB_TOPICS: ClassVar[tuple[str, ...]] = ('battery_status_v0',)
+
+    def encode(self) -> bytes:
+        """PX4's C struct of this message: 168 bytes, little-endian, padding zeroed."""
+        try:
+            return _S_BatteryStatusV0.pack(
+                self.timestamp,
+                self.voltage_v,
+                self.current_a,
+                self.current_average_a,
+                self.discharged_mah,
+                self.remaining,
+                self.scale,
+                self.time_remaining_s,
+                self.temperature,
+                *self.voltage_cell_v,
+                self.max_cell_voltage_delta,
+                self.full_charge_capacity_wh,
+                self.remaining_capacity_wh,
+                self.nominal_voltage,
+                self.internal_resistance_estimate,
+                self.ocv_estimate,
+                self.ocv_estimate_filtered,
+                self.volt_based_soc_estimate,
+                self.voltage_prediction,
+                self.prediction_error,
+                self.estimation_covariance_norm,
+                self.capacity,
+                self.cycle_count,
+                self.average_time_to_empty,
+                self.serial_number,
+                self.manufacture_date,
+                self.state_of_health,
+                self.max_error,
+                self.interface_error,
+                self.faults,
+                self.over_discharge_count,
+                self.connected,
+                self.cell_count,
+                self.source,
+                self.priority,
+                self.id,
+                self.is_powering_off,
+                self.is_required,
+                self.warning,
+            )
+        except (struct.error, TypeError, OverflowError) as exc:
+            raise _uorb.encode_error('BatteryStatusV0', self, _UC_BatteryStatusV0, exc) from None
+
+    @classmethod
+    def decode(cls, data: bytes) -> BatteryStatusV0:
+        """From PX4's C struct: 168 bytes."""
+        if len(data) != 168:
+            raise _uorb.DecodeError('BatteryStatusV0: expected 168 bytes, got ' + str(len(data)))
+        v = _S_BatteryStatusV0.unpack_from(data)
+        o = cls.__new__(cls)
+        o.timestamp = v[0]
+        o.voltage_v = v[1]
+        o.current_a = v[2]
+        o.current_average_a = v[3]
+        o.discharged_mah = v[4]
+        o.remaining = v[5]
+        o.scale = v[6]
+        o.time_remaining_s = v[7]
+        o.temperature = v[8]
+        o.voltage_cell_v = list(v[9:23])
+        o.max_cell_voltage_delta = v[23]
+        o.full_charge_capacity_wh = v[24]
+        o.remaining_capacity_wh = v[25]
+        o.nominal_voltage = v[26]
+        o.internal_resistance_estimate = v[27]
+        o.ocv_estimate = v[28]
+        o.ocv_estimate_filtered = v[29]
+        o.volt_based_soc_estimate = v[30]
+        o.voltage_prediction = v[31]
+        o.prediction_error = v[32]
+        o.estimation_covariance_norm = v[33]
+        o.capacity = v[34]
+        o.cycle_count = v[35]
+        o.average_time_to_empty = v[36]
+        o.serial_number = v[37]
+        o.manufacture_date = v[38]
+        o.state_of_health = v[39]
+        o.max_error = v[40]
+        o.interface_error = v[41]
+        o.faults = v[42]
+        o.over_discharge_count = v[43]
+        o.connected = v[44]
+        o.cell_count = v[45]
+        o.source = v[46]
+        o.priority = v[47]
+        o.id = v[48]
+        o.is_powering_off = v[49]
+        o.is_required = v[50]
+        o.warning = v[51]
+        return o
+
+    @classmethod
+    def decode_batch(
+        cls,
+        buffer: bytes,
+        *,
+        stride: int | None = None,
+        use_numpy: bool | None = None,
+        copy: bool = True,
+    ) -> dict[str, Any]:
+        """Columns of back-to-back records without an object per record, named as PX4 log
+        tools flatten them (``voltage_cell_v[3]``, ``nested.field``; char arrays as bytes).
+
+        ``stride``: bytes per record, default 168 (UORB_SIZE_NO_PADDING for ULog data).
+        numpy arrays when numpy is installed (``use_numpy`` None) or required (True; views
+        into ``buffer`` unless ``copy``), else lists from ``struct.iter_unpack``.
+        """
+        return _COL_BatteryStatusV0.decode(buffer, stride, use_numpy=use_numpy, copy=copy)
+
+    @classmethod
+    def ulog_format(cls) -> _ulog.Format:
+        """The ULog format PX4's logger writes for this struct (nested formats attached)."""
+        return _ulog.Format(
+            'battery_status_v0',
+            (
+                _ulog.Member('uint64_t', 0, 'timestamp', 'timestamp', 'scalar'),
+                _ulog.Member('float', 0, 'voltage_v', 'voltage_v', 'scalar'),
+                _ulog.Member('float', 0, 'current_a', 'current_a', 'scalar'),
+                _ulog.Member('float', 0, 'current_average_a', 'current_average_a', 'scalar'),
+                _ulog.Member('float', 0, 'discharged_mah', 'discharged_mah', 'scalar'),
+                _ulog.Member('float', 0, 'remaining', 'remaining', 'scalar'),
+                _ulog.Member('float', 0, 'scale', 'scale', 'scalar'),
+                _ulog.Member('float', 0, 'time_remaining_s', 'time_remaining_s', 'scalar'),
+                _ulog.Member('float', 0, 'temperature', 'temperature', 'scalar'),
+                _ulog.Member('float', 14, 'voltage_cell_v', 'voltage_cell_v', 'array'),
+                _ulog.Member('float', 0, 'max_cell_voltage_delta', 'max_cell_voltage_delta', 'scalar'),
+                _ulog.Member('float', 0, 'full_charge_capacity_wh', 'full_charge_capacity_wh', 'scalar'),
+                _ulog.Member('float', 0, 'remaining_capacity_wh', 'remaining_capacity_wh', 'scalar'),
+                _ulog.Member('float', 0, 'nominal_voltage', 'nominal_voltage', 'scalar'),
+                _ulog.Member('float', 0, 'internal_resistance_estimate', 'internal_resistance_estimate', 'scalar'),
+                _ulog.Member('float', 0, 'ocv_estimate', 'ocv_estimate', 'scalar'),
+                _ulog.Member('float', 0, 'ocv_estimate_filtered', 'ocv_estimate_filtered', 'scalar'),
+                _ulog.Member('float', 0, 'volt_based_soc_estimate', 'volt_based_soc_estimate', 'scalar'),
+                _ulog.Member('float', 0, 'voltage_prediction', 'voltage_prediction', 'scalar'),
+                _ulog.Member('float', 0, 'prediction_error', 'prediction_error', 'scalar'),
+                _ulog.Member('float', 0, 'estimation_covariance_norm', 'estimation_covariance_norm', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'capacity', 'capacity', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'cycle_count', 'cycle_count', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'average_time_to_empty', 'average_time_to_empty', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'serial_number', 'serial_number', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'manufacture_date', 'manufacture_date', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'state_of_health', 'state_of_health', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'max_error', 'max_error', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'interface_error', 'interface_error', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'faults', 'faults', 'scalar'),
+                _ulog.Member('uint16_t', 0, 'over_discharge_count', 'over_discharge_count', 'scalar'),
+                _ulog.Member('bool', 0, 'connected', 'connected', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'cell_count', 'cell_count', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'source', 'source', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'priority', 'priority', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'id', 'id', 'scalar'),
+                _ulog.Member('bool', 0, 'is_powering_off', 'is_powering_off', 'scalar'),
+                _ulog.Member('bool', 0, 'is_required', 'is_required', 'scalar'),
+                _ulog.Member('uint8_t', 0, 'warning', 'warning', 'scalar'),
+            ),
+            cls,
+            ('battery_status_v0',),
+            0,
+        )
+
+    @classmethod
+    def from_ulog(
+        cls, source: _ulog.Source | _ulog.Log, *, topic: str | None = None, multi_id: int = 0
+    ) -> list[BatteryStatusV0]:
+        """Every record of this message in a ULog file (path, bytes, binary file or a read Log).
+
+        Topic defaults to the first of UORB_TOPICS. When the log's own format differs, the
+        fields matching by name and type are decoded and the rest keep their defaults
+        (see _ulog.Log.compare for the difference).
+        """
+        log = source if isinstance(source, _ulog.Log) else _ulog.read(source)
+        return log.messages(cls, topic=topic, multi_id=multi_id)
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        a: Any
+        e: Any
+        sub: Any
+        r_cell_count: Any
+        r_voltage_cell_v: Any
+        v_i: Any
+        try:
+            if (self.timestamp & -18446744073709551616):
+                _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryStatusV0_timestamp)
+        except _v.SLOW:
+            _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryStatusV0_timestamp)
+        try:
+            x = self.connected
+            if (x is not True and x is not False):
+                _v.diag(out, 'connected', self.connected, _VS_BatteryStatusV0_connected)
+        except _v.SLOW:
+            _v.diag(out, 'connected', self.connected, _VS_BatteryStatusV0_connected)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.voltage_v <= 3.4028234663852886e+38)):
+                _v.diag(out, 'voltage_v', self.voltage_v, _VS_BatteryStatusV0_voltage_v)
+        except _v.SLOW:
+            _v.diag(out, 'voltage_v', self.voltage_v, _VS_BatteryStatusV0_voltage_v)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.current_a <= 3.4028234663852886e+38)):
+                _v.diag(out, 'current_a', self.current_a, _VS_BatteryStatusV0_current_a)
+        except _v.SLOW:
+            _v.diag(out, 'current_a', self.current_a, _VS_BatteryStatusV0_current_a)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.current_average_a <= 3.4028234663852886e+38)):
+                _v.diag(out, 'current_average_a', self.current_average_a, _VS_BatteryStatusV0_current_average_a)
+        except _v.SLOW:
+            _v.diag(out, 'current_average_a', self.current_average_a, _VS_BatteryStatusV0_current_average_a)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.discharged_mah <= 3.4028234663852886e+38)):
+                _v.diag(out, 'discharged_mah', self.discharged_mah, _VS_BatteryStatusV0_discharged_mah)
+        except _v.SLOW:
+            _v.diag(out, 'discharged_mah', self.discharged_mah, _VS_BatteryStatusV0_discharged_mah)
+        try:
+            x = self.remaining
+            if (not (0.0 <= x <= 1.0) and x != -1.0):
+                _v.diag(out, 'remaining', self.remaining, _VS_BatteryStatusV0_remaining)
+        except _v.SLOW:
+            _v.diag(out, 'remaining', self.remaining, _VS_BatteryStatusV0_remaining)
+        try:
+            x = self.scale
+            if (not (1.0 <= x <= 3.4028234663852886e+38) and x != -1.0):
+                _v.diag(out, 'scale', self.scale, _VS_BatteryStatusV0_scale)
+        except _v.SLOW:
+            _v.diag(out, 'scale', self.scale, _VS_BatteryStatusV0_scale)
+        try:
+            x = self.time_remaining_s
+            if (not (-3.4028234663852886e+38 <= x <= 3.4028234663852886e+38) and x == x):
+                _v.diag(out, 'time_remaining_s', self.time_remaining_s, _VS_BatteryStatusV0_time_remaining_s)
+        except _v.SLOW:
+            _v.diag(out, 'time_remaining_s', self.time_remaining_s, _VS_BatteryStatusV0_time_remaining_s)
+        try:
+            x = self.temperature
+            if (not (-3.4028234663852886e+38 <= x <= 3.4028234663852886e+38) and x == x):
+                _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatusV0_temperature)
+        except _v.SLOW:
+            _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatusV0_temperature)
+        try:
+            if (self.cell_count & -256):
+                _v.diag(out, 'cell_count', self.cell_count, _VS_BatteryStatusV0_cell_count)
+        except _v.SLOW:
+            _v.diag(out, 'cell_count', self.cell_count, _VS_BatteryStatusV0_cell_count)
+        try:
+            if (self.source not in {0, 1, 2}):
+                _v.diag(out, 'source', self.source, _VS_BatteryStatusV0_source)
+        except _v.SLOW:
+            _v.diag(out, 'source', self.source, _VS_BatteryStatusV0_source)
+        try:
+            if (self.priority & -256):
+                _v.diag(out, 'priority', self.priority, _VS_BatteryStatusV0_priority)
+        except _v.SLOW:
+            _v.diag(out, 'priority', self.priority, _VS_BatteryStatusV0_priority)
+        try:
+            if (self.capacity & -65536):
+                _v.diag(out, 'capacity', self.capacity, _VS_BatteryStatusV0_capacity)
+        except _v.SLOW:
+            _v.diag(out, 'capacity', self.capacity, _VS_BatteryStatusV0_capacity)
+        try:
+            if (self.cycle_count & -65536):
+                _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryStatusV0_cycle_count)
+        except _v.SLOW:
+            _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryStatusV0_cycle_count)
+        try:
+            if (self.average_time_to_empty & -65536):
+                _v.diag(out, 'average_time_to_empty', self.average_time_to_empty, _VS_BatteryStatusV0_average_time_to_empty)
+        except _v.SLOW:
+            _v.diag(out, 'average_time_to_empty', self.average_time_to_empty, _VS_BatteryStatusV0_average_time_to_empty)
+        try:
+            if (self.serial_number & -65536):
+                _v.diag(out, 'serial_number', self.serial_number, _VS_BatteryStatusV0_serial_number)
+        except _v.SLOW:
+            _v.diag(out, 'serial_number', self.serial_number, _VS_BatteryStatusV0_serial_number)
+        try:
+            if (self.manufacture_date & -65536):
+                _v.diag(out, 'manufacture_date', self.manufacture_date, _VS_BatteryStatusV0_manufacture_date)
+        except _v.SLOW:
+            _v.diag(out, 'manufacture_date', self.manufacture_date, _VS_BatteryStatusV0_manufacture_date)
+        try:
+            x = self.state_of_health
+            if (x & -65536 or not (0 <= x <= 100)):
+                _v.diag(out, 'state_of_health', self.state_of_health, _VS_BatteryStatusV0_state_of_health)
+        except _v.SLOW:
+            _v.diag(out, 'state_of_health', self.state_of_health, _VS_BatteryStatusV0_state_of_health)
+        try:
+            x = self.max_error
+            if (x & -65536 or not (1 <= x <= 100)):
+                _v.diag(out, 'max_error', self.max_error, _VS_BatteryStatusV0_max_error)
+        except _v.SLOW:
+            _v.diag(out, 'max_error', self.max_error, _VS_BatteryStatusV0_max_error)
+        try:
+            if (self.id & -256):
+                _v.diag(out, 'id', self.id, _VS_BatteryStatusV0_id)
+        except _v.SLOW:
+            _v.diag(out, 'id', self.id, _VS_BatteryStatusV0_id)
+        try:
+            if (self.interface_error & -65536):
+                _v.diag(out, 'interface_error', self.interface_error, _VS_BatteryStatusV0_interface_error)
+        except _v.SLOW:
+            _v.diag(out, 'interface_error', self.interface_error, _VS_BatteryStatusV0_interface_error)
+        try:
+            a = self.voltage_cell_v
+            if len(a) != 14:
+                _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
+            else:
+                for e in a:
+                    if (not (-3.4028234663852886e+38 <= e <= 3.4028234663852886e+38)):
+                        _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
+                        break
+        except _v.SLOW:
+            _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.max_cell_voltage_delta <= 3.4028234663852886e+38)):
+                _v.diag(out, 'max_cell_voltage_delta', self.max_cell_voltage_delta, _VS_BatteryStatusV0_max_cell_voltage_delta)
+        except _v.SLOW:
+            _v.diag(out, 'max_cell_voltage_delta', self.max_cell_voltage_delta, _VS_BatteryStatusV0_max_cell_voltage_delta)
+        try:
+            x = self.is_powering_off
+            if (x is not True and x is not False):
+                _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryStatusV0_is_powering_off)
+        except _v.SLOW:
+            _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryStatusV0_is_powering_off)
+        try:
+            x = self.is_required
+            if (x is not True and x is not False):
+                _v.diag(out, 'is_required', self.is_required, _VS_BatteryStatusV0_is_required)
+        except _v.SLOW:
+            _v.diag(out, 'is_required', self.is_required, _VS_BatteryStatusV0_is_required)
+        try:
+            if (self.warning not in {0, 1, 2, 3, 4, 6, 7}):
+                _v.diag(out, 'warning', self.warning, _VS_BatteryStatusV0_warning)
+        except _v.SLOW:
+            _v.diag(out, 'warning', self.warning, _VS_BatteryStatusV0_warning)
+        try:
+            if (self.faults & -2048):
+                _v.diag(out, 'faults', self.faults, _VS_BatteryStatusV0_faults)
+        except _v.SLOW:
+            _v.diag(out, 'faults', self.faults, _VS_BatteryStatusV0_faults)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.full_charge_capacity_wh <= 3.4028234663852886e+38)):
+                _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryStatusV0_full_charge_capacity_wh)
+        except _v.SLOW:
+            _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryStatusV0_full_charge_capacity_wh)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.remaining_capacity_wh <= 3.4028234663852886e+38)):
+                _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryStatusV0_remaining_capacity_wh)
+        except _v.SLOW:
+            _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryStatusV0_remaining_capacity_wh)
+        try:
+            if (self.over_discharge_count & -65536):
+                _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryStatusV0_over_discharge_count)
+        except _v.SLOW:
+            _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryStatusV0_over_discharge_count)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.nominal_voltage <= 3.4028234663852886e+38)):
+                _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryStatusV0_nominal_voltage)
+        except _v.SLOW:
+            _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryStatusV0_nominal_voltage)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.internal_resistance_estimate <= 3.4028234663852886e+38)):
+                _v.diag(out, 'internal_resistance_estimate', self.internal_resistance_estimate, _VS_BatteryStatusV0_internal_resistance_estimate)
+        except _v.SLOW:
+            _v.diag(out, 'internal_resistance_estimate', self.internal_resistance_estimate, _VS_BatteryStatusV0_internal_resistance_estimate)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.ocv_estimate <= 3.4028234663852886e+38)):
+                _v.diag(out, 'ocv_estimate', self.ocv_estimate, _VS_BatteryStatusV0_ocv_estimate)
+        except _v.SLOW:
+            _v.diag(out, 'ocv_estimate', self.ocv_estimate, _VS_BatteryStatusV0_ocv_estimate)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.ocv_estimate_filtered <= 3.4028234663852886e+38)):
+                _v.diag(out, 'ocv_estimate_filtered', self.ocv_estimate_filtered, _VS_BatteryStatusV0_ocv_estimate_filtered)
+        except _v.SLOW:
+            _v.diag(out, 'ocv_estimate_filtered', self.ocv_estimate_filtered, _VS_BatteryStatusV0_ocv_estimate_filtered)
+        try:
+            if (not (0.0 <= self.volt_based_soc_estimate <= 1.0)):
+                _v.diag(out, 'volt_based_soc_estimate', self.volt_based_soc_estimate, _VS_BatteryStatusV0_volt_based_soc_estimate)
+        except _v.SLOW:
+            _v.diag(out, 'volt_based_soc_estimate', self.volt_based_soc_estimate, _VS_BatteryStatusV0_volt_based_soc_estimate)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.voltage_prediction <= 3.4028234663852886e+38)):
+                _v.diag(out, 'voltage_prediction', self.voltage_prediction, _VS_BatteryStatusV0_voltage_prediction)
+        except _v.SLOW:
+            _v.diag(out, 'voltage_prediction', self.voltage_prediction, _VS_BatteryStatusV0_voltage_prediction)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.prediction_error <= 3.4028234663852886e+38)):
+                _v.diag(out, 'prediction_error', self.prediction_error, _VS_BatteryStatusV0_prediction_error)
+        except _v.SLOW:
+            _v.diag(out, 'prediction_error', self.prediction_error, _VS_BatteryStatusV0_prediction_error)
+        try:
+            if (not (-3.4028234663852886e+38 <= self.estimation_covariance_norm <= 3.4028234663852886e+38)):
+                _v.diag(out, 'estimation_covariance_norm', self.estimation_covariance_norm, _VS_BatteryStatusV0_estimation_covariance_norm)
+        except _v.SLOW:
+            _v.diag(out, 'estimation_covariance_norm', self.estimation_covariance_norm, _VS_BatteryStatusV0_estimation_covariance_norm)
+        # rule cell-count-capacity (uorb-battery-status.yaml:5)
+        try:
+            r_cell_count = self.cell_count
+            r_voltage_cell_v = self.voltage_cell_v
+            if not (r_cell_count <= len(r_voltage_cell_v)):
+                out.append(_v.rule('cell_count', 'cell-count-capacity', r_cell_count, 'cell_count <= len(voltage_cell_v)', 'cell_count = ' + _v.fmt(r_cell_count) + ' is above the ' + _v.fmt(len(r_voltage_cell_v)) + ' cells voltage_cell_v can hold', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule cells-beyond-count-zero (uorb-battery-status.yaml:11)
+        try:
+            r_cell_count = self.cell_count
+            r_voltage_cell_v = self.voltage_cell_v
+            if (r_cell_count != 0):
+                for v_i in range(r_cell_count, len(r_voltage_cell_v)):
+                    try:
+                        if not (r_voltage_cell_v[v_i] == 0):
+                            out.append(_v.rule('voltage_cell_v' + '[' + str(v_i) + ']', 'cells-beyond-count-zero', r_voltage_cell_v[v_i], 'voltage_cell_v[i] == 0', 'voltage_cell_v[' + _v.fmt(v_i) + '] = ' + _v.fmt(r_voltage_cell_v[v_i]) + ' V but the battery has only ' + _v.fmt(r_cell_count) + ' cells; expected 0', 'error'))
+                    except _v.SLOW:
+                        pass
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == 'error':
+                raise _v.ValidationError(found, 'uorb.BatteryStatusV0')
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == 'voltage_v':
+            return self.voltage_v != 0.0
+        if field == 'current_a':
+            return self.current_a != -1.0
+        if field == 'current_average_a':
+            return self.current_average_a != -1.0
+        if field == 'discharged_mah':
+            return self.discharged_mah != -1.0
+        if field == 'remaining':
+            return self.remaining != -1.0
+        if field == 'scale':
+            return self.scale != -1.0
+        if field == 'time_remaining_s':
+            return self.time_remaining_s == self.time_remaining_s
+        if field == 'temperature':
+            return self.temperature == self.temperature
+        if field == 'cell_count':
+            return self.cell_count != 0
+        if field == 'voltage_cell_v':
+            return any(e != 0.0 for e in self.voltage_cell_v)
+        if field in {'timestamp', 'connected', 'source', 'priority', 'capacity', 'cycle_count', 'average_time_to_empty', 'serial_number', 'manufacture_date', 'state_of_health', 'max_error', 'id', 'interface_error', 'max_cell_voltage_delta', 'is_powering_off', 'is_required', 'warning', 'faults', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'over_discharge_count', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm'}:
+            return True
+        raise KeyError(f'{field!r} is not a field of ' + 'uorb.BatteryStatusV0')

@@ -7,4 +7,8 @@ a command function takes the parsed arguments and returns the exit code.
 COMMAND_MODULES: tuple[str, ...] = (
     "codegen.commands.validate",
     "codegen.commands.docs",
+    "codegen.commands.schema",
+    "codegen.commands.convert",
+    "codegen.commands.params",
+    "codegen.commands.failsafe",
 )

@@ -23,6 +23,7 @@ _FORMAT_DOCS = {
     "mavlink": "MAVLink messages and enums.",
     "dronecan": "DroneCAN (UAVCAN v0) data types.",
     "devicetree": "Linux devicetree binding models.",
+    "params": "Autopilot parameter sets (ArduPilot apm.pdef.xml metadata).",
 }
 
 
@@ -36,7 +37,16 @@ def environment() -> jinja2.Environment:
     loader = jinja2.DictLoader(
         {
             name: resources.files(__package__).joinpath("templates", name).read_text(encoding="utf-8")
-            for name in ("module_head.py.j2", "module_body.py.j2", "_meta.py.j2", "package.py.j2")
+            for name in (
+                "module_head.py.j2",
+                "module_body.py.j2",
+                "_meta.py.j2",
+                "package.py.j2",
+                "_validate.py.j2",
+                "_mavlink.py.j2",
+                "_uorb.py.j2",
+                "_ulog.py.j2",
+            )
         }
     )
     env = jinja2.Environment(

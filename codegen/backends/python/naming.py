@@ -51,6 +51,8 @@ def module_path(msg: Message) -> str:
         return "mavlink"
     if msg.format is SourceFormat.UORB:
         return "uorb"
+    if msg.format is SourceFormat.PARAMS:
+        return "params"
     if msg.format is SourceFormat.DRONECAN and msg.dronecan is not None:
         namespace = msg.dronecan.full_name.rsplit(".", 1)[0]
         return "dronecan." + ".".join(identifier(p) for p in namespace.split("."))
@@ -68,6 +70,8 @@ def class_name(msg: Message) -> str:
         return base
     if msg.format is SourceFormat.DEVICETREE and msg.devicetree is not None and len(msg.devicetree.compatible) == 1:
         return camel(msg.devicetree.compatible[0])
+    if msg.format is SourceFormat.PARAMS:
+        return camel(msg.name) + "Params"  # params.BATT -> BattParams
     return camel(msg.name)
 
 

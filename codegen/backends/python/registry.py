@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from . import codec_dronecan, codec_mavlink, codec_uorb, validators
+from .converters import EXTENSION as CONVERTERS
 from .extensions import Extension
 
 EXTENSIONS: tuple[Extension, ...] = (
@@ -10,4 +11,5 @@ EXTENSIONS: tuple[Extension, ...] = (
     codec_uorb.EXTENSION,
     codec_mavlink.EXTENSION,
     validators.EXTENSION,
+    CONVERTERS,
 )

@@ -11,8 +11,37 @@ from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from ... import _meta as _m
+from ... import _validate as _v
 
 __all__ = ['SimpleBattery']
+
+
+_VS_SimpleBattery_compatible = _v.Optional(_v.Array(_v.Text(const='simple-battery'), None, False, min_length=1), required=True)
+_VS_SimpleBattery_device_chemistry = _v.Optional(_v.Text(choices=('nickel-cadmium', 'nickel-metal-hydride', 'lithium-ion', 'lithium-ion-polymer', 'lithium-ion-iron-phosphate', 'lithium-ion-manganese-oxide')), required=False)
+_VS_SimpleBattery_over_voltage_threshold_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
+_VS_SimpleBattery_re_charge_voltage_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
+_VS_SimpleBattery_voltage_min_design_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
+_VS_SimpleBattery_voltage_max_design_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
+_VS_SimpleBattery_energy_full_design_microwatt_hours = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uWh'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_charge_full_design_microamp_hours = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uAh'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_trickle_charge_current_microamp = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uA'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_tricklecharge_upper_limit_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
+_VS_SimpleBattery_precharge_current_microamp = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uA'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_precharge_upper_limit_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
+_VS_SimpleBattery_charge_term_current_microamp = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uA'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_constant_charge_current_max_microamp = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uA'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_constant_charge_voltage_max_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
+_VS_SimpleBattery_factory_internal_resistance_micro_ohms = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uOhm'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_resistance_temp_table = _v.Optional(_v.Array(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295), 2, True, min_length=2), None, False, min_length=1), required=False)
+_VS_SimpleBattery_ocv_capacity_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_operating_range_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2), required=False)
+_VS_SimpleBattery_ambient_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2), required=False)
+_VS_SimpleBattery_alert_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2), required=False)
+_VS_SimpleBattery_volt_drop_thresh_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV', maximum=48000000), 1, True, min_length=1), 1, True, min_length=1), required=False)
+_VS_SimpleBattery_volt_drop_soc_bp = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='bp'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_volt_drop_temperatures_millicelsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='mdegC'), None, False, min_length=1), required=False)
+_VS_SimpleBattery_ocv_capacity_table_n = _v.Pattern('^ocv-capacity-table-[0-9]+$', _v.Array(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295), 2, True, min_length=2), 100, False, min_length=1))
+_VS_SimpleBattery_volt_drop_n_microvolt = _v.Pattern('^volt-drop-[0-9]-microvolt', _v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1))
 
 
 @dataclasses.dataclass(slots=True)
@@ -179,3 +208,388 @@ class SimpleBattery:
             if _m._match('^volt-drop-[0-9]-microvolt', key):
                 obj.volt_drop_n_microvolt[key] = _m.as_list(value, key, None, False, lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)))
         return obj
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        a: Any
+        e: Any
+        sub: Any
+        i_1: Any
+        k_0: Any
+        r_constant_charge_voltage_max_microvolt: Any
+        r_ocv_capacity_celsius: Any
+        r_ocv_capacity_table_n: Any
+        r_over_voltage_threshold_microvolt: Any
+        r_voltage_max_design_microvolt: Any
+        r_voltage_min_design_microvolt: Any
+        v_i: Any
+        v_row: Any
+        v_table: Any
+        try:
+            if (x := self.compatible) is None or (len(x) < 1 or any((_x0 != 'simple-battery') for _x0 in x)):
+                _v.diag(out, 'compatible', self.compatible, _VS_SimpleBattery_compatible)
+        except _v.SLOW:
+            _v.diag(out, 'compatible', self.compatible, _VS_SimpleBattery_compatible)
+        try:
+            if (x := self.device_chemistry) is not None and (x not in {'nickel-cadmium', 'nickel-metal-hydride', 'lithium-ion', 'lithium-ion-polymer', 'lithium-ion-iron-phosphate', 'lithium-ion-manganese-oxide'}):
+                _v.diag(out, 'device-chemistry', self.device_chemistry, _VS_SimpleBattery_device_chemistry)
+        except _v.SLOW:
+            _v.diag(out, 'device-chemistry', self.device_chemistry, _VS_SimpleBattery_device_chemistry)
+        try:
+            if (x := self.over_voltage_threshold_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
+                _v.diag(out, 'over-voltage-threshold-microvolt', self.over_voltage_threshold_microvolt, _VS_SimpleBattery_over_voltage_threshold_microvolt)
+        except _v.SLOW:
+            _v.diag(out, 'over-voltage-threshold-microvolt', self.over_voltage_threshold_microvolt, _VS_SimpleBattery_over_voltage_threshold_microvolt)
+        try:
+            if (x := self.re_charge_voltage_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
+                _v.diag(out, 're-charge-voltage-microvolt', self.re_charge_voltage_microvolt, _VS_SimpleBattery_re_charge_voltage_microvolt)
+        except _v.SLOW:
+            _v.diag(out, 're-charge-voltage-microvolt', self.re_charge_voltage_microvolt, _VS_SimpleBattery_re_charge_voltage_microvolt)
+        try:
+            if (x := self.voltage_min_design_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
+                _v.diag(out, 'voltage-min-design-microvolt', self.voltage_min_design_microvolt, _VS_SimpleBattery_voltage_min_design_microvolt)
+        except _v.SLOW:
+            _v.diag(out, 'voltage-min-design-microvolt', self.voltage_min_design_microvolt, _VS_SimpleBattery_voltage_min_design_microvolt)
+        try:
+            if (x := self.voltage_max_design_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
+                _v.diag(out, 'voltage-max-design-microvolt', self.voltage_max_design_microvolt, _VS_SimpleBattery_voltage_max_design_microvolt)
+        except _v.SLOW:
+            _v.diag(out, 'voltage-max-design-microvolt', self.voltage_max_design_microvolt, _VS_SimpleBattery_voltage_max_design_microvolt)
+        try:
+            a = self.energy_full_design_microwatt_hours
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'energy-full-design-microwatt-hours', self.energy_full_design_microwatt_hours, _VS_SimpleBattery_energy_full_design_microwatt_hours)
+                else:
+                    for e in a:
+                        if (e & -4294967296):
+                            _v.diag(out, 'energy-full-design-microwatt-hours', self.energy_full_design_microwatt_hours, _VS_SimpleBattery_energy_full_design_microwatt_hours)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'energy-full-design-microwatt-hours', self.energy_full_design_microwatt_hours, _VS_SimpleBattery_energy_full_design_microwatt_hours)
+        try:
+            a = self.charge_full_design_microamp_hours
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'charge-full-design-microamp-hours', self.charge_full_design_microamp_hours, _VS_SimpleBattery_charge_full_design_microamp_hours)
+                else:
+                    for e in a:
+                        if (e & -4294967296):
+                            _v.diag(out, 'charge-full-design-microamp-hours', self.charge_full_design_microamp_hours, _VS_SimpleBattery_charge_full_design_microamp_hours)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'charge-full-design-microamp-hours', self.charge_full_design_microamp_hours, _VS_SimpleBattery_charge_full_design_microamp_hours)
+        try:
+            a = self.trickle_charge_current_microamp
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'trickle-charge-current-microamp', self.trickle_charge_current_microamp, _VS_SimpleBattery_trickle_charge_current_microamp)
+                else:
+                    for e in a:
+                        if (e & -4294967296):
+                            _v.diag(out, 'trickle-charge-current-microamp', self.trickle_charge_current_microamp, _VS_SimpleBattery_trickle_charge_current_microamp)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'trickle-charge-current-microamp', self.trickle_charge_current_microamp, _VS_SimpleBattery_trickle_charge_current_microamp)
+        try:
+            if (x := self.tricklecharge_upper_limit_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
+                _v.diag(out, 'tricklecharge-upper-limit-microvolt', self.tricklecharge_upper_limit_microvolt, _VS_SimpleBattery_tricklecharge_upper_limit_microvolt)
+        except _v.SLOW:
+            _v.diag(out, 'tricklecharge-upper-limit-microvolt', self.tricklecharge_upper_limit_microvolt, _VS_SimpleBattery_tricklecharge_upper_limit_microvolt)
+        try:
+            a = self.precharge_current_microamp
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'precharge-current-microamp', self.precharge_current_microamp, _VS_SimpleBattery_precharge_current_microamp)
+                else:
+                    for e in a:
+                        if (e & -4294967296):
+                            _v.diag(out, 'precharge-current-microamp', self.precharge_current_microamp, _VS_SimpleBattery_precharge_current_microamp)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'precharge-current-microamp', self.precharge_current_microamp, _VS_SimpleBattery_precharge_current_microamp)
+        try:
+            if (x := self.precharge_upper_limit_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
+                _v.diag(out, 'precharge-upper-limit-microvolt', self.precharge_upper_limit_microvolt, _VS_SimpleBattery_precharge_upper_limit_microvolt)
+        except _v.SLOW:
+            _v.diag(out, 'precharge-upper-limit-microvolt', self.precharge_upper_limit_microvolt, _VS_SimpleBattery_precharge_upper_limit_microvolt)
+        try:
+            a = self.charge_term_current_microamp
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'charge-term-current-microamp', self.charge_term_current_microamp, _VS_SimpleBattery_charge_term_current_microamp)
+                else:
+                    for e in a:
+                        if (e & -4294967296):
+                            _v.diag(out, 'charge-term-current-microamp', self.charge_term_current_microamp, _VS_SimpleBattery_charge_term_current_microamp)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'charge-term-current-microamp', self.charge_term_current_microamp, _VS_SimpleBattery_charge_term_current_microamp)
+        try:
+            a = self.constant_charge_current_max_microamp
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'constant-charge-current-max-microamp', self.constant_charge_current_max_microamp, _VS_SimpleBattery_constant_charge_current_max_microamp)
+                else:
+                    for e in a:
+                        if (e & -4294967296):
+                            _v.diag(out, 'constant-charge-current-max-microamp', self.constant_charge_current_max_microamp, _VS_SimpleBattery_constant_charge_current_max_microamp)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'constant-charge-current-max-microamp', self.constant_charge_current_max_microamp, _VS_SimpleBattery_constant_charge_current_max_microamp)
+        try:
+            if (x := self.constant_charge_voltage_max_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
+                _v.diag(out, 'constant-charge-voltage-max-microvolt', self.constant_charge_voltage_max_microvolt, _VS_SimpleBattery_constant_charge_voltage_max_microvolt)
+        except _v.SLOW:
+            _v.diag(out, 'constant-charge-voltage-max-microvolt', self.constant_charge_voltage_max_microvolt, _VS_SimpleBattery_constant_charge_voltage_max_microvolt)
+        try:
+            a = self.factory_internal_resistance_micro_ohms
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'factory-internal-resistance-micro-ohms', self.factory_internal_resistance_micro_ohms, _VS_SimpleBattery_factory_internal_resistance_micro_ohms)
+                else:
+                    for e in a:
+                        if (e & -4294967296):
+                            _v.diag(out, 'factory-internal-resistance-micro-ohms', self.factory_internal_resistance_micro_ohms, _VS_SimpleBattery_factory_internal_resistance_micro_ohms)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'factory-internal-resistance-micro-ohms', self.factory_internal_resistance_micro_ohms, _VS_SimpleBattery_factory_internal_resistance_micro_ohms)
+        try:
+            if (x := self.resistance_temp_table) is not None and (len(x) < 1 or any((len(_x0) != 2 or any((_x1 & -4294967296) for _x1 in _x0)) for _x0 in x)):
+                _v.diag(out, 'resistance-temp-table', self.resistance_temp_table, _VS_SimpleBattery_resistance_temp_table)
+        except _v.SLOW:
+            _v.diag(out, 'resistance-temp-table', self.resistance_temp_table, _VS_SimpleBattery_resistance_temp_table)
+        try:
+            a = self.ocv_capacity_celsius
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'ocv-capacity-celsius', self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius)
+                else:
+                    for e in a:
+                        if ((e + 2147483648) & -4294967296):
+                            _v.diag(out, 'ocv-capacity-celsius', self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'ocv-capacity-celsius', self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius)
+        try:
+            a = self.operating_range_celsius
+            if a is not None:
+                if len(a) != 2:
+                    _v.diag(out, 'operating-range-celsius', self.operating_range_celsius, _VS_SimpleBattery_operating_range_celsius)
+                else:
+                    for e in a:
+                        if ((e + 2147483648) & -4294967296):
+                            _v.diag(out, 'operating-range-celsius', self.operating_range_celsius, _VS_SimpleBattery_operating_range_celsius)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'operating-range-celsius', self.operating_range_celsius, _VS_SimpleBattery_operating_range_celsius)
+        try:
+            a = self.ambient_celsius
+            if a is not None:
+                if len(a) != 2:
+                    _v.diag(out, 'ambient-celsius', self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
+                else:
+                    for e in a:
+                        if ((e + 2147483648) & -4294967296):
+                            _v.diag(out, 'ambient-celsius', self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'ambient-celsius', self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
+        try:
+            a = self.alert_celsius
+            if a is not None:
+                if len(a) != 2:
+                    _v.diag(out, 'alert-celsius', self.alert_celsius, _VS_SimpleBattery_alert_celsius)
+                else:
+                    for e in a:
+                        if ((e + 2147483648) & -4294967296):
+                            _v.diag(out, 'alert-celsius', self.alert_celsius, _VS_SimpleBattery_alert_celsius)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'alert-celsius', self.alert_celsius, _VS_SimpleBattery_alert_celsius)
+        try:
+            if (x := self.volt_drop_thresh_microvolt) is not None and (len(x) != 1 or any((len(_x0) != 1 or any(((_x1 + 2147483648) & -4294967296 or not (-2147483648 <= _x1 <= 48000000)) for _x1 in _x0)) for _x0 in x)):
+                _v.diag(out, 'volt-drop-thresh-microvolt', self.volt_drop_thresh_microvolt, _VS_SimpleBattery_volt_drop_thresh_microvolt)
+        except _v.SLOW:
+            _v.diag(out, 'volt-drop-thresh-microvolt', self.volt_drop_thresh_microvolt, _VS_SimpleBattery_volt_drop_thresh_microvolt)
+        try:
+            a = self.volt_drop_soc_bp
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'volt-drop-soc-bp', self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
+                else:
+                    for e in a:
+                        if ((e + 2147483648) & -4294967296):
+                            _v.diag(out, 'volt-drop-soc-bp', self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'volt-drop-soc-bp', self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
+        try:
+            a = self.volt_drop_temperatures_millicelsius
+            if a is not None:
+                if len(a) < 1:
+                    _v.diag(out, 'volt-drop-temperatures-millicelsius', self.volt_drop_temperatures_millicelsius, _VS_SimpleBattery_volt_drop_temperatures_millicelsius)
+                else:
+                    for e in a:
+                        if ((e + 2147483648) & -4294967296):
+                            _v.diag(out, 'volt-drop-temperatures-millicelsius', self.volt_drop_temperatures_millicelsius, _VS_SimpleBattery_volt_drop_temperatures_millicelsius)
+                            break
+        except _v.SLOW:
+            _v.diag(out, 'volt-drop-temperatures-millicelsius', self.volt_drop_temperatures_millicelsius, _VS_SimpleBattery_volt_drop_temperatures_millicelsius)
+        try:
+            if any(not _v.search('^ocv-capacity-table-[0-9]+$', k) or (len(x) > 100 or len(x) < 1 or any((len(_x0) != 2 or any((_x1 & -4294967296) for _x1 in _x0)) for _x0 in x)) for k, x in self.ocv_capacity_table_n.items()):
+                _v.diag(out, '^ocv-capacity-table-[0-9]+$', self.ocv_capacity_table_n, _VS_SimpleBattery_ocv_capacity_table_n)
+        except _v.SLOW:
+            _v.diag(out, '^ocv-capacity-table-[0-9]+$', self.ocv_capacity_table_n, _VS_SimpleBattery_ocv_capacity_table_n)
+        try:
+            if any(not _v.search('^volt-drop-[0-9]-microvolt', k) or (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)) for k, x in self.volt_drop_n_microvolt.items()):
+                _v.diag(out, '^volt-drop-[0-9]-microvolt', self.volt_drop_n_microvolt, _VS_SimpleBattery_volt_drop_n_microvolt)
+        except _v.SLOW:
+            _v.diag(out, '^volt-drop-[0-9]-microvolt', self.volt_drop_n_microvolt, _VS_SimpleBattery_volt_drop_n_microvolt)
+        # rule voltage-design-order (devicetree-battery.yaml:7)
+        try:
+            r_voltage_min_design_microvolt = self.voltage_min_design_microvolt
+            r_voltage_max_design_microvolt = self.voltage_max_design_microvolt
+            if r_voltage_min_design_microvolt is not None and r_voltage_max_design_microvolt is not None:
+                if not (r_voltage_min_design_microvolt[0][0] < r_voltage_max_design_microvolt[0][0]):
+                    out.append(_v.rule('voltage-min-design-microvolt', 'voltage-design-order', r_voltage_min_design_microvolt, '`voltage-min-design-microvolt`[0][0] < `voltage-max-design-microvolt`[0][0]', 'voltage-min-design-microvolt = ' + _v.fmt(r_voltage_min_design_microvolt[0][0]) + ' uV must be below voltage-max-design-microvolt = ' + _v.fmt(r_voltage_max_design_microvolt[0][0]) + ' uV', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule charge-voltage-below-over-voltage (devicetree-battery.yaml:15)
+        try:
+            r_constant_charge_voltage_max_microvolt = self.constant_charge_voltage_max_microvolt
+            r_over_voltage_threshold_microvolt = self.over_voltage_threshold_microvolt
+            if r_constant_charge_voltage_max_microvolt is not None and r_over_voltage_threshold_microvolt is not None:
+                if not (r_constant_charge_voltage_max_microvolt[0][0] <= r_over_voltage_threshold_microvolt[0][0]):
+                    out.append(_v.rule('constant-charge-voltage-max-microvolt', 'charge-voltage-below-over-voltage', r_constant_charge_voltage_max_microvolt, '`constant-charge-voltage-max-microvolt`[0][0] <= `over-voltage-threshold-microvolt`[0][0]', 'constant-charge-voltage-max-microvolt = ' + _v.fmt(r_constant_charge_voltage_max_microvolt[0][0]) + ' uV is above over-voltage-threshold-microvolt = ' + _v.fmt(r_over_voltage_threshold_microvolt[0][0]) + ' uV', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule design-max-below-charge-voltage (devicetree-battery.yaml:23)
+        try:
+            r_voltage_max_design_microvolt = self.voltage_max_design_microvolt
+            r_constant_charge_voltage_max_microvolt = self.constant_charge_voltage_max_microvolt
+            if r_voltage_max_design_microvolt is not None and r_constant_charge_voltage_max_microvolt is not None:
+                if not (r_voltage_max_design_microvolt[0][0] >= r_constant_charge_voltage_max_microvolt[0][0]):
+                    out.append(_v.rule('voltage-max-design-microvolt', 'design-max-below-charge-voltage', r_voltage_max_design_microvolt, '`voltage-max-design-microvolt`[0][0] >= `constant-charge-voltage-max-microvolt`[0][0]', 'voltage-max-design-microvolt = ' + _v.fmt(r_voltage_max_design_microvolt[0][0]) + ' uV is below constant-charge-voltage-max-microvolt = ' + _v.fmt(r_constant_charge_voltage_max_microvolt[0][0]) + ' uV', 'warning'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule ocv-capacity-percent (devicetree-battery.yaml:34)
+        try:
+            r_ocv_capacity_table_n = self.ocv_capacity_table_n
+            for k_0, v_table in _v.entries(r_ocv_capacity_table_n):
+                for i_1, v_row in enumerate(v_table):
+                    try:
+                        if not (0 <= v_row[1] <= 100):
+                            out.append(_v.rule(k_0 + '[' + str(i_1) + ']' + '[' + str(1) + ']', 'ocv-capacity-percent', v_row[1], '0 <= row[1] <= 100', 'capacity ' + _v.fmt(v_row[1]) + ' % is outside 0..100 %', 'error'))
+                    except _v.SLOW:
+                        pass
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule ocv-table-descending (devicetree-battery.yaml:41)
+        try:
+            r_ocv_capacity_table_n = self.ocv_capacity_table_n
+            for k_0, v_table in _v.entries(r_ocv_capacity_table_n):
+                for v_i in range(1, len(v_table)):
+                    try:
+                        if not (v_table[(v_i - 1)][0] >= v_table[v_i][0]):
+                            out.append(_v.rule(k_0 + '[' + str(v_i) + ']', 'ocv-table-descending', v_table[v_i], 'table[i - 1][0] >= table[i][0]', 'OCV ' + _v.fmt(v_table[v_i][0]) + ' uV follows ' + _v.fmt(v_table[(v_i - 1)][0]) + ' uV; the table must be sorted by OCV, highest first', 'error'))
+                    except _v.SLOW:
+                        pass
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule ocv-table-count (devicetree-battery.yaml:50)
+        try:
+            r_ocv_capacity_table_n = self.ocv_capacity_table_n
+            r_ocv_capacity_celsius = self.ocv_capacity_celsius
+            if r_ocv_capacity_celsius is not None:
+                if not (len(r_ocv_capacity_table_n) == len(r_ocv_capacity_celsius)):
+                    out.append(_v.rule('ocv-capacity-celsius', 'ocv-table-count', r_ocv_capacity_celsius, 'len(`^ocv-capacity-table-[0-9]+$`) == len(`ocv-capacity-celsius`)', _v.fmt(len(r_ocv_capacity_celsius)) + ' ocv-capacity-celsius entries but ' + _v.fmt(len(r_ocv_capacity_table_n)) + ' ocv-capacity-table-N properties; expected one table per temperature', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule ocv-table-names (devicetree-battery.yaml:58)
+        try:
+            r_ocv_capacity_celsius = self.ocv_capacity_celsius
+            r_ocv_capacity_table_n = self.ocv_capacity_table_n
+            if r_ocv_capacity_celsius is not None:
+                for v_i in range(len(r_ocv_capacity_celsius)):
+                    try:
+                        if not (('ocv-capacity-table-' + str(v_i)) in r_ocv_capacity_table_n):
+                            out.append(_v.rule('ocv-capacity-celsius' + '[' + str(v_i) + ']', 'ocv-table-names', r_ocv_capacity_celsius[v_i], "'ocv-capacity-table-' + str(i) in `^ocv-capacity-table-[0-9]+$`", 'ocv-capacity-celsius[' + _v.fmt(v_i) + '] = ' + _v.fmt(r_ocv_capacity_celsius[v_i]) + ' degC has no ocv-capacity-table-' + _v.fmt(v_i), 'error'))
+                    except _v.SLOW:
+                        pass
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule ocv-temperature-count (devicetree-battery.yaml:65)
+        try:
+            r_ocv_capacity_celsius = self.ocv_capacity_celsius
+            if r_ocv_capacity_celsius is not None:
+                if not (len(r_ocv_capacity_celsius) <= 20):
+                    out.append(_v.rule('ocv-capacity-celsius', 'ocv-temperature-count', r_ocv_capacity_celsius, 'len(`ocv-capacity-celsius`) <= 20', 'ocv-capacity-celsius has ' + _v.fmt(len(r_ocv_capacity_celsius)) + ' entries; the kernel reads at most 20', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == 'error':
+                raise _v.ValidationError(found, 'devicetree.power.supply.battery')
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == 'compatible':
+            return self.compatible is not None
+        if field == 'device-chemistry':
+            return self.device_chemistry is not None
+        if field == 'over-voltage-threshold-microvolt':
+            return self.over_voltage_threshold_microvolt is not None
+        if field == 're-charge-voltage-microvolt':
+            return self.re_charge_voltage_microvolt is not None
+        if field == 'voltage-min-design-microvolt':
+            return self.voltage_min_design_microvolt is not None
+        if field == 'voltage-max-design-microvolt':
+            return self.voltage_max_design_microvolt is not None
+        if field == 'energy-full-design-microwatt-hours':
+            return self.energy_full_design_microwatt_hours is not None
+        if field == 'charge-full-design-microamp-hours':
+            return self.charge_full_design_microamp_hours is not None
+        if field == 'trickle-charge-current-microamp':
+            return self.trickle_charge_current_microamp is not None
+        if field == 'tricklecharge-upper-limit-microvolt':
+            return self.tricklecharge_upper_limit_microvolt is not None
+        if field == 'precharge-current-microamp':
+            return self.precharge_current_microamp is not None
+        if field == 'precharge-upper-limit-microvolt':
+            return self.precharge_upper_limit_microvolt is not None
+        if field == 'charge-term-current-microamp':
+            return self.charge_term_current_microamp is not None
+        if field == 'constant-charge-current-max-microamp':
+            return self.constant_charge_current_max_microamp is not None
+        if field == 'constant-charge-voltage-max-microvolt':
+            return self.constant_charge_voltage_max_microvolt is not None
+        if field == 'factory-internal-resistance-micro-ohms':
+            return self.factory_internal_resistance_micro_ohms is not None
+        if field == 'resistance-temp-table':
+            return self.resistance_temp_table is not None
+        if field == 'ocv-capacity-celsius':
+            return self.ocv_capacity_celsius is not None
+        if field == 'operating-range-celsius':
+            return self.operating_range_celsius is not None
+        if field == 'ambient-celsius':
+            return self.ambient_celsius is not None
+        if field == 'alert-celsius':
+            return self.alert_celsius is not None
+        if field == 'volt-drop-thresh-microvolt':
+            return self.volt_drop_thresh_microvolt is not None
+        if field == 'volt-drop-soc-bp':
+            return self.volt_drop_soc_bp is not None
+        if field == 'volt-drop-temperatures-millicelsius':
+            return self.volt_drop_temperatures_millicelsius is not None
+        if field == '^ocv-capacity-table-[0-9]+$':
+            return bool(self.ocv_capacity_table_n)
+        if field == '^volt-drop-[0-9]-microvolt':
+            return bool(self.volt_drop_n_microvolt)
+        raise KeyError(f'{field!r} is not a field of ' + 'devicetree.power.supply.battery')

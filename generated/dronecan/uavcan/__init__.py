@@ -7,12 +7,24 @@ Module: dronecan.uavcan.
 from __future__ import annotations
 
 import dataclasses
+import struct
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from ... import _meta as _m
+from ... import _dronecan as _dc
+from ... import _validate as _v
 
 __all__ = ['Timestamp']
+
+
+_DC_Timestamp_1 = struct.Struct('<IHB')
+
+
+_DC_Timestamp_2 = ((56, 'Timestamp.usec'),)
+
+
+_VS_Timestamp_usec = _v.Number(type='uint56', kind='uint', low=0, high=72057594037927935, unit='us', sentinel=0, sentinel_text='UNKNOWN')
 
 
 @dataclasses.dataclass(slots=True)
@@ -41,3 +53,67 @@ class Timestamp:
         if 'usec' in data:
             obj.usec = _m.as_int(data['usec'], 'usec')
         return obj
+
+    DATA_TYPE_ID: ClassVar[int | None] = None
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x05bd0b5c81087e0d
+
+    def encode(self, *, tao: bool = True) -> bytes:
+        """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        r1 = self.usec
+        p2 = (r1 & 0xffffffffffffff)
+        head = _DC_Timestamp_1.pack((p2 & 0xffffffff), ((p2 >> 32) & 0xffff), ((p2 >> 48) & 0xff))
+        return head
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> Timestamp:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        n = len(data)
+        if n < 7:
+            raise _dc.cut(_DC_Timestamp_2, n << 3)
+        u1, u2, u3 = _DC_Timestamp_1.unpack_from(data)
+        x4 = (u1 | (u2 << 32) | (u3 << 48))
+        if n > 7:
+            raise _dc.DecodeError('Timestamp: ' + str(n - 7) + ' byte(s) beyond the end of the message')
+        return cls(x4)
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        r1 = self.usec
+        p2 = (r1 & 0xffffffffffffff)
+        acc = (acc << 56) | int.from_bytes(_DC_Timestamp_1.pack((p2 & 0xffffffff), ((p2 >> 32) & 0xffff), ((p2 >> 48) & 0xff)), 'big')
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[Timestamp, int]:
+        if rem < 56:
+            raise _dc.cut(_DC_Timestamp_2, rem)
+        rem -= 56
+        u1, u2, u3 = _DC_Timestamp_1.unpack(((v >> rem) & 0xffffffffffffff).to_bytes(7, 'big'))
+        x4 = (u1 | (u2 << 32) | (u3 << 48))
+        return cls(x4), rem
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        a: Any
+        e: Any
+        sub: Any
+        try:
+            if (self.usec & -72057594037927936):
+                _v.diag(out, 'usec', self.usec, _VS_Timestamp_usec)
+        except _v.SLOW:
+            _v.diag(out, 'usec', self.usec, _VS_Timestamp_usec)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == 'error':
+                raise _v.ValidationError(found, 'dronecan.uavcan.Timestamp')
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == 'usec':
+            return self.usec != 0
+        raise KeyError(f'{field!r} is not a field of ' + 'dronecan.uavcan.Timestamp')

@@ -8,10 +8,13 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import struct
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from .... import _meta as _m
+from .... import _dronecan as _dc
+from .... import _validate as _v
 
 __all__ = ['BatteryInfo', 'BatteryInfoStatusFlag', 'CircuitStatus', 'CircuitStatusErrorFlag', 'PrimaryPowerSupplyStatus']
 
@@ -43,6 +46,80 @@ class CircuitStatusErrorFlag(enum.IntFlag):
     UNDERVOLTAGE = 2
     OVERCURRENT = 4
     UNDERCURRENT = 8
+
+
+_DC_BatteryInfo_1 = struct.Struct('<7f')
+
+
+_DC_BatteryInfo_2 = struct.Struct('<7I')
+
+
+_DC_BatteryInfo_3 = struct.Struct('<HHHHHHHIBI')
+
+
+_DC_BatteryInfo_4 = ((16, 'BatteryInfo.temperature'), (32, 'BatteryInfo.voltage'), (48, 'BatteryInfo.current'), (64, 'BatteryInfo.average_power_10sec'), (80, 'BatteryInfo.remaining_capacity_wh'), (96, 'BatteryInfo.full_charge_capacity_wh'), (112, 'BatteryInfo.hours_to_full_charge'), (123, 'BatteryInfo.status_flags'), (130, 'BatteryInfo.state_of_health_pct'), (137, 'BatteryInfo.state_of_charge_pct'), (144, 'BatteryInfo.state_of_charge_pct_stdev'), (152, 'BatteryInfo.battery_id'), (184, 'BatteryInfo.model_instance_id'))
+
+
+_DC_BatteryInfo_5 = struct.Struct('<eeeeeeeIBI')
+
+
+_VS_BatteryInfo_temperature = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='K')
+_VS_BatteryInfo_voltage = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='V')
+_VS_BatteryInfo_current = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='A')
+_VS_BatteryInfo_average_power_10sec = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='W')
+_VS_BatteryInfo_remaining_capacity_wh = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Wh')
+_VS_BatteryInfo_full_charge_capacity_wh = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Wh')
+_VS_BatteryInfo_hours_to_full_charge = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='h')
+_VS_BatteryInfo_status_flags = _v.Number(type='uint11', kind='uint', low=0, high=2047, mask=0x1ff, bits={0x1: 'STATUS_FLAG_IN_USE', 0x2: 'STATUS_FLAG_CHARGING', 0x4: 'STATUS_FLAG_CHARGED', 0x8: 'STATUS_FLAG_TEMP_HOT', 0x10: 'STATUS_FLAG_TEMP_COLD', 0x20: 'STATUS_FLAG_OVERLOAD', 0x40: 'STATUS_FLAG_BAD_BATTERY', 0x80: 'STATUS_FLAG_NEED_SERVICE', 0x100: 'STATUS_FLAG_BMS_ERROR', 0x200: 'STATUS_FLAG_RESERVED_A', 0x400: 'STATUS_FLAG_RESERVED_B'})
+_VS_BatteryInfo_state_of_health_pct = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%', sentinel=127, sentinel_text='STATE_OF_HEALTH_UNKNOWN')
+_VS_BatteryInfo_state_of_charge_pct = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%')
+_VS_BatteryInfo_state_of_charge_pct_stdev = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%')
+_VS_BatteryInfo_battery_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
+_VS_BatteryInfo_model_instance_id = _v.Number(type='uint32', kind='uint', low=0, high=4294967295)
+_VS_BatteryInfo_model_name = _v.Array(_v.Number(type='uint8', kind='uint', low=0, high=255), 31, False, byte=True)
+
+
+_DC_CircuitStatus_1 = struct.Struct('<2f')
+
+
+_DC_CircuitStatus_2 = struct.Struct('<2I')
+
+
+_DC_CircuitStatus_3 = struct.Struct('<HHHB')
+
+
+_DC_CircuitStatus_4 = ((16, 'CircuitStatus.circuit_id'), (32, 'CircuitStatus.voltage'), (48, 'CircuitStatus.current'), (56, 'CircuitStatus.error_flags'))
+
+
+_DC_CircuitStatus_5 = struct.Struct('<HeeB')
+
+
+_VS_CircuitStatus_circuit_id = _v.Number(type='uint16', kind='uint', low=0, high=65535)
+_VS_CircuitStatus_voltage = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='V')
+_VS_CircuitStatus_current = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='A')
+_VS_CircuitStatus_error_flags = _v.Number(type='uint8', kind='uint', low=0, high=255, mask=0xf, bits={0x1: 'ERROR_FLAG_OVERVOLTAGE', 0x2: 'ERROR_FLAG_UNDERVOLTAGE', 0x4: 'ERROR_FLAG_OVERCURRENT', 0x8: 'ERROR_FLAG_UNDERCURRENT'})
+
+
+_DC_PrimaryPowerSupplyStatus_1 = struct.Struct('<2f')
+
+
+_DC_PrimaryPowerSupplyStatus_2 = struct.Struct('<2I')
+
+
+_DC_PrimaryPowerSupplyStatus_3 = struct.Struct('<HHH')
+
+
+_DC_PrimaryPowerSupplyStatus_4 = ((16, 'PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power'), (32, 'PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power_variance'), (33, 'PrimaryPowerSupplyStatus.external_power_available'), (40, 'PrimaryPowerSupplyStatus.remaining_energy_pct'), (47, 'PrimaryPowerSupplyStatus.remaining_energy_pct_stdev'))
+
+
+_DC_PrimaryPowerSupplyStatus_5 = struct.Struct('<eeH')
+
+
+_VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='h')
+_VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Hours^2')
+_VS_PrimaryPowerSupplyStatus_external_power_available = _v.Number(type='bool', kind='bool', low=0, high=1)
+_VS_PrimaryPowerSupplyStatus_remaining_energy_pct = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%')
+_VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%')
 
 
 @dataclasses.dataclass(slots=True)
@@ -137,6 +214,355 @@ class BatteryInfo:
             obj.model_name = _m.as_bytes(data['model_name'], 'model_name', 31, False)
         return obj
 
+    DATA_TYPE_ID: ClassVar[int | None] = 1092
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x249c26548a711966
+
+    def encode(self, *, tao: bool = True) -> bytes:
+        """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        r1 = self.temperature
+        r2 = self.voltage
+        r3 = self.current
+        r4 = self.average_power_10sec
+        r5 = self.remaining_capacity_wh
+        r6 = self.full_charge_capacity_wh
+        r7 = self.hours_to_full_charge
+        g8, g9, g10, g11, g12, g13, g14 = _DC_BatteryInfo_2.unpack(_DC_BatteryInfo_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))), (r3 if -65504.0 <= r3 <= 65504.0 else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))), (r4 if -65504.0 <= r4 <= 65504.0 else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))), (r5 if -65504.0 <= r5 <= 65504.0 else (65504.0 if r5 > 65504.0 else (-65504.0 if r5 < -65504.0 else r5))), (r6 if -65504.0 <= r6 <= 65504.0 else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))), (r7 if -65504.0 <= r7 <= 65504.0 else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7)))))
+        h15 = (
+            ((g8 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g8 < 0x477FF000
+            else (((g8 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        )
+        h16 = (
+            ((g9 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g9 < 0x477FF000
+            else (((g9 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+        )
+        h17 = (
+            ((g10 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g10 < 0x477FF000
+            else (((g10 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
+        )
+        h18 = (
+            ((g11 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g11 < 0x477FF000
+            else (((g11 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        )
+        h19 = (
+            ((g12 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g12 < 0x477FF000
+            else (((g12 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        )
+        h20 = (
+            ((g13 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g13 < 0x477FF000
+            else (((g13 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        )
+        h21 = (
+            ((g14 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g14 < 0x477FF000
+            else (((g14 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        )
+        r22 = self.status_flags
+        p23 = (r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0))
+        r24 = self.state_of_health_pct
+        p25 = (r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0))
+        r26 = self.state_of_charge_pct
+        p27 = (r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0))
+        r28 = self.state_of_charge_pct_stdev
+        p29 = (r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0))
+        r30 = self.battery_id
+        r31 = self.model_instance_id
+        head = _DC_BatteryInfo_3.pack(h15, h16, h17, h18, h19, h20, h21, (p23 & 0xff) | (((p23 >> 8) & 0x7) << 13) | ((p25 & 0x3) << 22) | (((p25 >> 2) & 0x1f) << 8) | ((p27 & 0x1) << 31) | (((p27 >> 1) & 0x3f) << 16) | (p29 << 24), (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)), (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0)))
+        if tao:
+            x32 = self.model_name
+            if len(x32) > 31:
+                raise _dc.EncodeError('BatteryInfo.model_name: length ' + str(len(x32)) + ' exceeds capacity 31')
+            return head + bytes(x32)
+        acc = 0x10000000000000000000000000000000000000000000000 | int.from_bytes(head, 'big')
+        x33 = self.model_name
+        k34 = len(x33)
+        if k34 > 31:
+            raise _dc.EncodeError('BatteryInfo.model_name: length ' + str(k34) + ' exceeds capacity 31')
+        if not tao:
+            acc = (acc << 5) | k34
+        acc = (acc << (k34 << 3)) | int.from_bytes(x33, 'big')
+        return _dc.finish(acc)
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfo:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        f13: bytes
+        n = len(data)
+        if n < 23:
+            raise _dc.cut(_DC_BatteryInfo_4, n << 3)
+        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _DC_BatteryInfo_5.unpack_from(data)
+        x11 = ((u8 & 0xff) | (((u8 >> 13) & 0x7) << 8))
+        x12 = (((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1f) << 2))
+        x13 = ((u8 >> 31) | (((u8 >> 16) & 0x3f) << 1))
+        x14 = ((u8 >> 24) & 0x7f)
+        if tao:
+            f13 = bytes(data[23:])
+            k15 = len(f13)
+            if k15 > 31:
+                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k15) + ' exceeds capacity 31')
+            return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
+        v = int.from_bytes(data, 'big')
+        rem = (n << 3) - 184
+        if tao:
+            k16 = rem // 8
+            if rem - k16 * 8 >= 8:
+                raise _dc.DecodeError('BatteryInfo.model_name: input ends inside an element')
+            if k16 > 31:
+                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k16) + ' exceeds capacity 31')
+            n17 = k16 * 8
+            if rem < n17:
+                raise _dc.short('BatteryInfo.model_name', n17, rem)
+            rem -= n17
+            f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k16, 'big')
+        else:
+            if rem < 5:
+                raise _dc.short('BatteryInfo.model_name (length)', 5, rem)
+            rem -= 5
+            b18 = (v >> rem) & 0x1f
+            k16 = b18
+            if k16 > 31:
+                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k16) + ' exceeds capacity 31')
+            n19 = k16 * 8
+            if rem < n19:
+                raise _dc.short('BatteryInfo.model_name', n19, rem)
+            rem -= n19
+            f13 = ((v >> rem) & ((1 << n19) - 1)).to_bytes(k16, 'big')
+        if rem >= 8:
+            raise _dc.DecodeError('BatteryInfo: ' + str(rem >> 3) + ' byte(s) beyond the end of the message')
+        return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        r1 = self.temperature
+        r2 = self.voltage
+        r3 = self.current
+        r4 = self.average_power_10sec
+        r5 = self.remaining_capacity_wh
+        r6 = self.full_charge_capacity_wh
+        r7 = self.hours_to_full_charge
+        g8, g9, g10, g11, g12, g13, g14 = _DC_BatteryInfo_2.unpack(_DC_BatteryInfo_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))), (r3 if -65504.0 <= r3 <= 65504.0 else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))), (r4 if -65504.0 <= r4 <= 65504.0 else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))), (r5 if -65504.0 <= r5 <= 65504.0 else (65504.0 if r5 > 65504.0 else (-65504.0 if r5 < -65504.0 else r5))), (r6 if -65504.0 <= r6 <= 65504.0 else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))), (r7 if -65504.0 <= r7 <= 65504.0 else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7)))))
+        h15 = (
+            ((g8 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g8 < 0x477FF000
+            else (((g8 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        )
+        h16 = (
+            ((g9 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g9 < 0x477FF000
+            else (((g9 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+        )
+        h17 = (
+            ((g10 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g10 < 0x477FF000
+            else (((g10 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
+        )
+        h18 = (
+            ((g11 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g11 < 0x477FF000
+            else (((g11 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        )
+        h19 = (
+            ((g12 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g12 < 0x477FF000
+            else (((g12 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        )
+        h20 = (
+            ((g13 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g13 < 0x477FF000
+            else (((g13 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        )
+        h21 = (
+            ((g14 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g14 < 0x477FF000
+            else (((g14 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        )
+        r22 = self.status_flags
+        p23 = (r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0))
+        r24 = self.state_of_health_pct
+        p25 = (r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0))
+        r26 = self.state_of_charge_pct
+        p27 = (r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0))
+        r28 = self.state_of_charge_pct_stdev
+        p29 = (r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0))
+        r30 = self.battery_id
+        r31 = self.model_instance_id
+        acc = (acc << 184) | int.from_bytes(_DC_BatteryInfo_3.pack(h15, h16, h17, h18, h19, h20, h21, (p23 & 0xff) | (((p23 >> 8) & 0x7) << 13) | ((p25 & 0x3) << 22) | (((p25 >> 2) & 0x1f) << 8) | ((p27 & 0x1) << 31) | (((p27 >> 1) & 0x3f) << 16) | (p29 << 24), (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)), (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0))), 'big')
+        x32 = self.model_name
+        k33 = len(x32)
+        if k33 > 31:
+            raise _dc.EncodeError('BatteryInfo.model_name: length ' + str(k33) + ' exceeds capacity 31')
+        if not tao:
+            acc = (acc << 5) | k33
+        acc = (acc << (k33 << 3)) | int.from_bytes(x32, 'big')
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfo, int]:
+        f13: bytes
+        if rem < 184:
+            raise _dc.cut(_DC_BatteryInfo_4, rem)
+        rem -= 184
+        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _DC_BatteryInfo_5.unpack(((v >> rem) & 0xffffffffffffffffffffffffffffffffffffffffffffff).to_bytes(23, 'big'))
+        x11 = ((u8 & 0xff) | (((u8 >> 13) & 0x7) << 8))
+        x12 = (((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1f) << 2))
+        x13 = ((u8 >> 31) | (((u8 >> 16) & 0x3f) << 1))
+        x14 = ((u8 >> 24) & 0x7f)
+        if tao:
+            k15 = rem // 8
+            if rem - k15 * 8 >= 8:
+                raise _dc.DecodeError('BatteryInfo.model_name: input ends inside an element')
+            if k15 > 31:
+                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k15) + ' exceeds capacity 31')
+            n16 = k15 * 8
+            if rem < n16:
+                raise _dc.short('BatteryInfo.model_name', n16, rem)
+            rem -= n16
+            f13 = ((v >> rem) & ((1 << n16) - 1)).to_bytes(k15, 'big')
+        else:
+            if rem < 5:
+                raise _dc.short('BatteryInfo.model_name (length)', 5, rem)
+            rem -= 5
+            b17 = (v >> rem) & 0x1f
+            k15 = b17
+            if k15 > 31:
+                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k15) + ' exceeds capacity 31')
+            n18 = k15 * 8
+            if rem < n18:
+                raise _dc.short('BatteryInfo.model_name', n18, rem)
+            rem -= n18
+            f13 = ((v >> rem) & ((1 << n18) - 1)).to_bytes(k15, 'big')
+        return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13), rem
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        a: Any
+        e: Any
+        sub: Any
+        r_state_of_charge_pct: Any
+        r_state_of_health_pct: Any
+        try:
+            if (not (-65504.0 <= self.temperature <= 65504.0)):
+                _v.diag(out, 'temperature', self.temperature, _VS_BatteryInfo_temperature)
+        except _v.SLOW:
+            _v.diag(out, 'temperature', self.temperature, _VS_BatteryInfo_temperature)
+        try:
+            if (not (-65504.0 <= self.voltage <= 65504.0)):
+                _v.diag(out, 'voltage', self.voltage, _VS_BatteryInfo_voltage)
+        except _v.SLOW:
+            _v.diag(out, 'voltage', self.voltage, _VS_BatteryInfo_voltage)
+        try:
+            if (not (-65504.0 <= self.current <= 65504.0)):
+                _v.diag(out, 'current', self.current, _VS_BatteryInfo_current)
+        except _v.SLOW:
+            _v.diag(out, 'current', self.current, _VS_BatteryInfo_current)
+        try:
+            if (not (-65504.0 <= self.average_power_10sec <= 65504.0)):
+                _v.diag(out, 'average_power_10sec', self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
+        except _v.SLOW:
+            _v.diag(out, 'average_power_10sec', self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
+        try:
+            if (not (-65504.0 <= self.remaining_capacity_wh <= 65504.0)):
+                _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
+        except _v.SLOW:
+            _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
+        try:
+            if (not (-65504.0 <= self.full_charge_capacity_wh <= 65504.0)):
+                _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryInfo_full_charge_capacity_wh)
+        except _v.SLOW:
+            _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryInfo_full_charge_capacity_wh)
+        try:
+            if (not (-65504.0 <= self.hours_to_full_charge <= 65504.0)):
+                _v.diag(out, 'hours_to_full_charge', self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
+        except _v.SLOW:
+            _v.diag(out, 'hours_to_full_charge', self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
+        try:
+            if (self.status_flags & -512):
+                _v.diag(out, 'status_flags', self.status_flags, _VS_BatteryInfo_status_flags)
+        except _v.SLOW:
+            _v.diag(out, 'status_flags', self.status_flags, _VS_BatteryInfo_status_flags)
+        try:
+            if (self.state_of_health_pct & -128):
+                _v.diag(out, 'state_of_health_pct', self.state_of_health_pct, _VS_BatteryInfo_state_of_health_pct)
+        except _v.SLOW:
+            _v.diag(out, 'state_of_health_pct', self.state_of_health_pct, _VS_BatteryInfo_state_of_health_pct)
+        try:
+            if (self.state_of_charge_pct & -128):
+                _v.diag(out, 'state_of_charge_pct', self.state_of_charge_pct, _VS_BatteryInfo_state_of_charge_pct)
+        except _v.SLOW:
+            _v.diag(out, 'state_of_charge_pct', self.state_of_charge_pct, _VS_BatteryInfo_state_of_charge_pct)
+        try:
+            if (self.state_of_charge_pct_stdev & -128):
+                _v.diag(out, 'state_of_charge_pct_stdev', self.state_of_charge_pct_stdev, _VS_BatteryInfo_state_of_charge_pct_stdev)
+        except _v.SLOW:
+            _v.diag(out, 'state_of_charge_pct_stdev', self.state_of_charge_pct_stdev, _VS_BatteryInfo_state_of_charge_pct_stdev)
+        try:
+            if (self.battery_id & -256):
+                _v.diag(out, 'battery_id', self.battery_id, _VS_BatteryInfo_battery_id)
+        except _v.SLOW:
+            _v.diag(out, 'battery_id', self.battery_id, _VS_BatteryInfo_battery_id)
+        try:
+            if (self.model_instance_id & -4294967296):
+                _v.diag(out, 'model_instance_id', self.model_instance_id, _VS_BatteryInfo_model_instance_id)
+        except _v.SLOW:
+            _v.diag(out, 'model_instance_id', self.model_instance_id, _VS_BatteryInfo_model_instance_id)
+        try:
+            x = self.model_name
+            if (x.__class__ is not bytes or len(x) > 31):
+                _v.diag(out, 'model_name', self.model_name, _VS_BatteryInfo_model_name)
+        except _v.SLOW:
+            _v.diag(out, 'model_name', self.model_name, _VS_BatteryInfo_model_name)
+        # rule state-of-health-percent (dronecan-power.yaml:7)
+        try:
+            r_state_of_health_pct = self.state_of_health_pct
+            if (r_state_of_health_pct != 127):
+                if not (r_state_of_health_pct <= 100):
+                    out.append(_v.rule('state_of_health_pct', 'state-of-health-percent', r_state_of_health_pct, 'state_of_health_pct <= 100', 'state_of_health_pct = ' + _v.fmt(r_state_of_health_pct) + ' % is above 100 % (127 means unknown)', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        # rule state-of-charge-percent (dronecan-power.yaml:13)
+        try:
+            r_state_of_charge_pct = self.state_of_charge_pct
+            if not (r_state_of_charge_pct <= 100):
+                out.append(_v.rule('state_of_charge_pct', 'state-of-charge-percent', r_state_of_charge_pct, 'state_of_charge_pct <= 100', 'state_of_charge_pct = ' + _v.fmt(r_state_of_charge_pct) + ' % is above 100 %', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == 'error':
+                raise _v.ValidationError(found, 'dronecan.uavcan.equipment.power.BatteryInfo')
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == 'state_of_health_pct':
+            return self.state_of_health_pct != 127
+        if field in {'temperature', 'voltage', 'current', 'average_power_10sec', 'remaining_capacity_wh', 'full_charge_capacity_wh', 'hours_to_full_charge', 'status_flags', 'state_of_charge_pct', 'state_of_charge_pct_stdev', 'battery_id', 'model_instance_id', 'model_name'}:
+            return True
+        raise KeyError(f'{field!r} is not a field of ' + 'dronecan.uavcan.equipment.power.BatteryInfo')
+
 
 @dataclasses.dataclass(slots=True)
 class CircuitStatus:
@@ -180,6 +606,113 @@ class CircuitStatus:
             obj.error_flags = _m.as_int(data['error_flags'], 'error_flags')
         return obj
 
+    DATA_TYPE_ID: ClassVar[int | None] = 1091
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x8313d33d0ddda115
+
+    def encode(self, *, tao: bool = True) -> bytes:
+        """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        r1 = self.voltage
+        r2 = self.current
+        g3, g4 = _DC_CircuitStatus_2.unpack(_DC_CircuitStatus_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2)))))
+        h5 = (
+            ((g3 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g3 < 0x477FF000
+            else (((g3 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        )
+        h6 = (
+            ((g4 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g4 < 0x477FF000
+            else (((g4 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        )
+        r7 = self.circuit_id
+        r8 = self.error_flags
+        head = _DC_CircuitStatus_3.pack((r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)), h5, h6, (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0)))
+        return head
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> CircuitStatus:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        n = len(data)
+        if n < 7:
+            raise _dc.cut(_DC_CircuitStatus_4, n << 3)
+        u1, u2, u3, u4 = _DC_CircuitStatus_5.unpack_from(data)
+        if n > 7:
+            raise _dc.DecodeError('CircuitStatus: ' + str(n - 7) + ' byte(s) beyond the end of the message')
+        return cls(u1, u2, u3, u4)
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        r1 = self.voltage
+        r2 = self.current
+        g3, g4 = _DC_CircuitStatus_2.unpack(_DC_CircuitStatus_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2)))))
+        h5 = (
+            ((g3 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g3 < 0x477FF000
+            else (((g3 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        )
+        h6 = (
+            ((g4 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g4 < 0x477FF000
+            else (((g4 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        )
+        r7 = self.circuit_id
+        r8 = self.error_flags
+        acc = (acc << 56) | int.from_bytes(_DC_CircuitStatus_3.pack((r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)), h5, h6, (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0))), 'big')
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[CircuitStatus, int]:
+        if rem < 56:
+            raise _dc.cut(_DC_CircuitStatus_4, rem)
+        rem -= 56
+        u1, u2, u3, u4 = _DC_CircuitStatus_5.unpack(((v >> rem) & 0xffffffffffffff).to_bytes(7, 'big'))
+        return cls(u1, u2, u3, u4), rem
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        a: Any
+        e: Any
+        sub: Any
+        try:
+            if (self.circuit_id & -65536):
+                _v.diag(out, 'circuit_id', self.circuit_id, _VS_CircuitStatus_circuit_id)
+        except _v.SLOW:
+            _v.diag(out, 'circuit_id', self.circuit_id, _VS_CircuitStatus_circuit_id)
+        try:
+            if (not (-65504.0 <= self.voltage <= 65504.0)):
+                _v.diag(out, 'voltage', self.voltage, _VS_CircuitStatus_voltage)
+        except _v.SLOW:
+            _v.diag(out, 'voltage', self.voltage, _VS_CircuitStatus_voltage)
+        try:
+            if (not (-65504.0 <= self.current <= 65504.0)):
+                _v.diag(out, 'current', self.current, _VS_CircuitStatus_current)
+        except _v.SLOW:
+            _v.diag(out, 'current', self.current, _VS_CircuitStatus_current)
+        try:
+            if (self.error_flags & -16):
+                _v.diag(out, 'error_flags', self.error_flags, _VS_CircuitStatus_error_flags)
+        except _v.SLOW:
+            _v.diag(out, 'error_flags', self.error_flags, _VS_CircuitStatus_error_flags)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == 'error':
+                raise _v.ValidationError(found, 'dronecan.uavcan.equipment.power.CircuitStatus')
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field in {'circuit_id', 'voltage', 'current', 'error_flags'}:
+            return True
+        raise KeyError(f'{field!r} is not a field of ' + 'dronecan.uavcan.equipment.power.CircuitStatus')
+
 
 @dataclasses.dataclass(slots=True)
 class PrimaryPowerSupplyStatus:
@@ -222,3 +755,138 @@ class PrimaryPowerSupplyStatus:
         if 'remaining_energy_pct_stdev' in data:
             obj.remaining_energy_pct_stdev = _m.as_int(data['remaining_energy_pct_stdev'], 'remaining_energy_pct_stdev')
         return obj
+
+    DATA_TYPE_ID: ClassVar[int | None] = 1090
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0xbba05074ad757480
+
+    def encode(self, *, tao: bool = True) -> bytes:
+        """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        r1 = self.hours_to_empty_at_10sec_avg_power
+        r2 = self.hours_to_empty_at_10sec_avg_power_variance
+        g3, g4 = _DC_PrimaryPowerSupplyStatus_2.unpack(_DC_PrimaryPowerSupplyStatus_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2)))))
+        h5 = (
+            ((g3 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g3 < 0x477FF000
+            else (((g3 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        )
+        h6 = (
+            ((g4 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g4 < 0x477FF000
+            else (((g4 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        )
+        r7 = self.external_power_available
+        p8 = (1 if r7 else 0)
+        r9 = self.remaining_energy_pct
+        p10 = (r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0))
+        r11 = self.remaining_energy_pct_stdev
+        p12 = (r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0))
+        head = _DC_PrimaryPowerSupplyStatus_3.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9))
+        return head
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> PrimaryPowerSupplyStatus:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        n = len(data)
+        if n < 6:
+            raise _dc.cut(_DC_PrimaryPowerSupplyStatus_4, n << 3)
+        u1, u2, u3 = _DC_PrimaryPowerSupplyStatus_5.unpack_from(data)
+        x4 = (((u3 >> 7) & 0x1) != 0)
+        x5 = (u3 & 0x7f)
+        x6 = (u3 >> 9)
+        if n > 6:
+            raise _dc.DecodeError('PrimaryPowerSupplyStatus: ' + str(n - 6) + ' byte(s) beyond the end of the message')
+        return cls(u1, u2, x4, x5, x6)
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        r1 = self.hours_to_empty_at_10sec_avg_power
+        r2 = self.hours_to_empty_at_10sec_avg_power_variance
+        g3, g4 = _DC_PrimaryPowerSupplyStatus_2.unpack(_DC_PrimaryPowerSupplyStatus_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2)))))
+        h5 = (
+            ((g3 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g3 < 0x477FF000
+            else (((g3 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        )
+        h6 = (
+            ((g4 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g4 < 0x477FF000
+            else (((g4 - 0xB7FFF000) >> 13) | 0x8000
+                  if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        )
+        r7 = self.external_power_available
+        p8 = (1 if r7 else 0)
+        r9 = self.remaining_energy_pct
+        p10 = (r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0))
+        r11 = self.remaining_energy_pct_stdev
+        p12 = (r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0))
+        acc = (acc << 47) | (int.from_bytes(_DC_PrimaryPowerSupplyStatus_3.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9)), 'big') >> 1)
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[PrimaryPowerSupplyStatus, int]:
+        if rem < 47:
+            raise _dc.cut(_DC_PrimaryPowerSupplyStatus_4, rem)
+        rem -= 47
+        u1, u2, u3 = _DC_PrimaryPowerSupplyStatus_5.unpack((((v >> rem) & 0x7fffffffffff) << 1).to_bytes(6, 'big'))
+        x4 = (((u3 >> 7) & 0x1) != 0)
+        x5 = (u3 & 0x7f)
+        x6 = (u3 >> 9)
+        return cls(u1, u2, x4, x5, x6), rem
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        a: Any
+        e: Any
+        sub: Any
+        r_remaining_energy_pct: Any
+        try:
+            if (not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power <= 65504.0)):
+                _v.diag(out, 'hours_to_empty_at_10sec_avg_power', self.hours_to_empty_at_10sec_avg_power, _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power)
+        except _v.SLOW:
+            _v.diag(out, 'hours_to_empty_at_10sec_avg_power', self.hours_to_empty_at_10sec_avg_power, _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power)
+        try:
+            if (not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power_variance <= 65504.0)):
+                _v.diag(out, 'hours_to_empty_at_10sec_avg_power_variance', self.hours_to_empty_at_10sec_avg_power_variance, _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance)
+        except _v.SLOW:
+            _v.diag(out, 'hours_to_empty_at_10sec_avg_power_variance', self.hours_to_empty_at_10sec_avg_power_variance, _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance)
+        try:
+            x = self.external_power_available
+            if (x is not True and x is not False):
+                _v.diag(out, 'external_power_available', self.external_power_available, _VS_PrimaryPowerSupplyStatus_external_power_available)
+        except _v.SLOW:
+            _v.diag(out, 'external_power_available', self.external_power_available, _VS_PrimaryPowerSupplyStatus_external_power_available)
+        try:
+            if (self.remaining_energy_pct & -128):
+                _v.diag(out, 'remaining_energy_pct', self.remaining_energy_pct, _VS_PrimaryPowerSupplyStatus_remaining_energy_pct)
+        except _v.SLOW:
+            _v.diag(out, 'remaining_energy_pct', self.remaining_energy_pct, _VS_PrimaryPowerSupplyStatus_remaining_energy_pct)
+        try:
+            if (self.remaining_energy_pct_stdev & -128):
+                _v.diag(out, 'remaining_energy_pct_stdev', self.remaining_energy_pct_stdev, _VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev)
+        except _v.SLOW:
+            _v.diag(out, 'remaining_energy_pct_stdev', self.remaining_energy_pct_stdev, _VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev)
+        # rule remaining-energy-percent (dronecan-primary-power.yaml:4)
+        try:
+            r_remaining_energy_pct = self.remaining_energy_pct
+            if not (r_remaining_energy_pct <= 100):
+                out.append(_v.rule('remaining_energy_pct', 'remaining-energy-percent', r_remaining_energy_pct, 'remaining_energy_pct <= 100', 'remaining_energy_pct = ' + _v.fmt(r_remaining_energy_pct) + ' % is above 100 %', 'error'))
+        except _v.SLOW:
+            pass  # the field checks report the cause
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == 'error':
+                raise _v.ValidationError(found, 'dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus')
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field in {'hours_to_empty_at_10sec_avg_power', 'hours_to_empty_at_10sec_avg_power_variance', 'external_power_available', 'remaining_energy_pct', 'remaining_energy_pct_stdev'}:
+            return True
+        raise KeyError(f'{field!r} is not a field of ' + 'dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus')

@@ -1,0 +1,390 @@
+"""Cross-field rules: declarative YAML files in ``schemas/rules/`` that the validators compile into
+each generated ``validate()``.
+
+A rule file names the messages it applies to and lists rules; each rule has an ``assert``
+expression (the language is in :mod:`codegen.rules_expr`), optional ``where`` precondition and
+``for`` loops, a ``message`` template with ``{expr}`` placeholders and a severity (``warning`` for
+advice). Files are checked against ``codegen/rules.schema.json`` and every expression is parsed at
+load time; names are resolved against the message when the rules are compiled. Any problem is a
+:class:`~codegen.errors.SchemaError` naming the file and line.
+
+Semantics the compiled code keeps: a rule is skipped while a devicetree property it reads is
+absent; a rule whose evaluation fails (an index out of range, a value of the wrong type) is skipped
+too, since the field checks already report the cause.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import yaml
+
+from .errors import SchemaError
+from .frontends.common import display_path, read_text
+from .ir import Location, Message
+from .rules_expr import (
+    Binary,
+    BoolOp,
+    Call,
+    Compare,
+    Const,
+    Expr,
+    ExprError,
+    FieldRef,
+    Index,
+    ListLit,
+    Name,
+    Not,
+    Quant,
+    Unary,
+    VarRef,
+    parse,
+    parse_binding,
+    parse_template,
+)
+
+SEVERITIES = ("error", "warning")
+
+
+@dataclass(frozen=True)
+class Rule:
+    """A parsed rule; expressions hold unresolved names until :func:`bind`."""
+
+    id: str
+    severity: str
+    doc: str
+    where: Expr | None
+    bindings: tuple[tuple[str, Expr], ...]
+    check: Expr
+    path: Expr | None
+    message: tuple[str | Expr, ...]
+    text: str  # the assert as written: the violation's limit
+    location: Location
+    lines: tuple[tuple[str, int], ...]  # key -> line, for errors found when binding
+
+    def line_of(self, key: str) -> int:
+        return dict(self.lines).get(key, self.location.line)
+
+
+@dataclass(frozen=True)
+class RuleFile:
+    file: str
+    messages: tuple[str, ...]
+    rules: tuple[Rule, ...]
+
+
+# --------------------------------------------------------------------------------------------
+# Where rules come from
+
+
+def bundled_rules_dir() -> Path:
+    """``schemas/rules`` of this checkout."""
+    return Path(__file__).resolve().parent.parent / "schemas" / "rules"
+
+
+# (folder,) set by using(); None: the bundled rules
+_ACTIVE: contextvars.ContextVar[tuple[Path | None] | None] = contextvars.ContextVar("battgen_rules", default=None)
+
+
+@contextlib.contextmanager
+def using(rules_dir: Path | None) -> Iterator[None]:
+    """Generate with the rules below ``rules_dir`` (None: no rules at all) instead of the bundled ones."""
+    token = _ACTIVE.set((rules_dir,))
+    try:
+        yield
+    finally:
+        _ACTIVE.reset(token)
+
+
+def active_rules() -> tuple[RuleFile, ...]:
+    """The rule files in effect: those chosen with :func:`using`, else the bundled ones."""
+    chosen = _ACTIVE.get()
+    folder = bundled_rules_dir() if chosen is None else chosen[0]
+    return load_rules_dir(folder) if folder is not None and folder.is_dir() else ()
+
+
+def strict() -> bool:
+    """Whether a rule that does not fit its message is an error (rules chosen with :func:`using`)
+    or skipped (the bundled rules meeting another schema's message of the same name)."""
+    return _ACTIVE.get() is not None
+
+
+def bound_rules(files: tuple[RuleFile, ...], msg: Message) -> list[BoundRule]:
+    """The rules of ``msg`` bound to it; see :func:`strict` for rules naming what it lacks."""
+    out = []
+    for rule in rules_for(files, msg.qualified_name):
+        try:
+            out.append(bind(rule, msg))
+        except SchemaError:
+            if strict():
+                raise
+    return out
+
+
+def load_rules_dir(root: Path) -> tuple[RuleFile, ...]:
+    """Every ``*.yaml`` / ``*.yml`` file below ``root``, in sorted path order."""
+    paths = sorted(p for p in root.rglob("*") if p.suffix in (".yaml", ".yml") and p.is_file())
+    return tuple(load_rule_file(p, root=root) for p in paths)
+
+
+def rules_for(files: tuple[RuleFile, ...], qualified_name: str) -> tuple[Rule, ...]:
+    found: list[Rule] = []
+    seen: dict[str, Location] = {}
+    for f in files:
+        if qualified_name not in f.messages:
+            continue
+        for r in f.rules:
+            if r.id in seen:
+                raise SchemaError(
+                    r.location.file,
+                    r.location.line,
+                    f"rule id {r.id!r} of {qualified_name} is used twice "
+                    f"(first at {seen[r.id]}); expected unique ids per message",
+                )
+            seen[r.id] = r.location
+            found.append(r)
+    return tuple(found)
+
+
+# --------------------------------------------------------------------------------------------
+# Loading
+
+
+@cache
+def _schema() -> dict[str, Any]:
+    text = resources.files("codegen").joinpath("rules.schema.json").read_text(encoding="utf-8")
+    data: dict[str, Any] = json.loads(text)
+    return data
+
+
+def _plain(node: yaml.Node, path: tuple[object, ...], lines: dict[tuple[object, ...], int], file: str) -> object:
+    """YAML node -> plain data, recording the line of every value by its JSON path."""
+    lines[path] = node.start_mark.line + 1
+    if isinstance(node, yaml.MappingNode):
+        out: dict[str, object] = {}
+        for key_node, value_node in node.value:
+            key = yaml.SafeLoader("").construct_object(key_node) if isinstance(key_node, yaml.ScalarNode) else None
+            if not isinstance(key, str):
+                raise SchemaError(file, key_node.start_mark.line + 1, "expected a string key")
+            if key in out:
+                raise SchemaError(file, key_node.start_mark.line + 1, f"duplicate key {key!r}")
+            out[key] = _plain(value_node, (*path, key), lines, file)
+        return out
+    if isinstance(node, yaml.SequenceNode):
+        return [_plain(item, (*path, i), lines, file) for i, item in enumerate(node.value)]
+    loader = yaml.SafeLoader("")
+    try:
+        return loader.construct_object(node)
+    except yaml.YAMLError as exc:
+        raise SchemaError(file, node.start_mark.line + 1, f"unreadable value: {exc}") from None
+
+
+def load_rule_file(path: Path, *, root: Path | None = None) -> RuleFile:
+    display = display_path(path, root)
+    text = read_text(path, display)
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+        line = mark.line + 1 if mark is not None else 1
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise SchemaError(display, line, f"expected YAML: {problem}") from None
+    if node is None:
+        raise SchemaError(display, 1, "expected a rule file (a mapping with 'messages' and 'rules'), found nothing")
+    lines: dict[tuple[object, ...], int] = {}
+    data = _plain(node, (), lines, display)
+    errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(e.path))
+    if errors:
+        err = jsonschema.exceptions.best_match(errors)
+        where = tuple(err.absolute_path)
+        while where not in lines and where:
+            where = where[:-1]
+        at = "/".join(str(p) for p in err.absolute_path) or "the file"
+        raise SchemaError(display, lines.get(where, 1), f"{at}: {err.message} (see codegen/rules.schema.json)")
+    assert isinstance(data, dict)
+    rules = tuple(_rule(item, i, lines, display) for i, item in enumerate(data["rules"]))
+    return RuleFile(display, tuple(data["messages"]), rules)
+
+
+def _expr(text: str, key: tuple[object, ...], lines: dict[tuple[object, ...], int], file: str, what: str) -> Expr:
+    try:
+        return parse(text)
+    except ExprError as exc:
+        raise SchemaError(file, lines[key], f"{what} {text!r}: {exc.message} at column {exc.column}") from None
+
+
+def _rule(item: dict[str, Any], i: int, lines: dict[tuple[object, ...], int], file: str) -> Rule:
+    base: tuple[object, ...] = ("rules", i)
+    where = _expr(item["where"], (*base, "where"), lines, file, "in 'where'") if "where" in item else None
+    raw_for = item.get("for", [])
+    loops = [raw_for] if isinstance(raw_for, str) else list(raw_for)
+    bindings: list[tuple[str, Expr]] = []
+    for j, text in enumerate(loops):
+        key = (*base, "for") if isinstance(raw_for, str) else (*base, "for", j)
+        try:
+            bindings.append(parse_binding(text))
+        except ExprError as exc:
+            raise SchemaError(file, lines[key], f"in 'for' {text!r}: {exc.message} at column {exc.column}") from None
+    check = _expr(item["assert"], (*base, "assert"), lines, file, "in 'assert'")
+    path = _expr(item["path"], (*base, "path"), lines, file, "in 'path'") if "path" in item else None
+    try:
+        message = parse_template(item["message"])
+    except ExprError as exc:
+        raise SchemaError(
+            file, lines[(*base, "message")], f"in 'message': {exc.message} at column {exc.column}"
+        ) from None
+    keyed = tuple((k, lines[(*base, k)]) for k in item if (*base, k) in lines)
+    return Rule(
+        id=item["id"],
+        severity=item.get("severity", "error"),
+        doc=item.get("doc", ""),
+        where=where,
+        bindings=tuple(bindings),
+        check=check,
+        path=path,
+        message=message,
+        text=item["assert"],
+        location=Location(file, lines[base]),
+        lines=keyed,
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Binding names to a message
+
+
+@dataclass(frozen=True)
+class BoundRule:
+    rule: Rule
+    where: Expr | None
+    bindings: tuple[tuple[str, Expr], ...]
+    check: Expr
+    path: Expr | None
+    message: tuple[str | Expr, ...]
+
+
+def bind(rule: Rule, msg: Message) -> BoundRule:
+    """Resolve the rule's names against ``msg``: fields, loop variables, constants."""
+    fields = {f.name: f for f in msg.fields if not f.is_padding}
+    constants = {c.name: c.value for c in msg.constants if not isinstance(c.value, str)}
+
+    def resolve(expr: Expr, scope: frozenset[str], key: str) -> Expr:
+        def r(e: Expr) -> Expr:
+            return resolve(e, scope, key)
+
+        if isinstance(expr, Name):
+            if not expr.quoted and expr.text in scope:
+                return VarRef(expr.text)
+            if expr.text in fields:
+                return FieldRef(fields[expr.text])
+            if not expr.quoted and expr.text in constants:
+                value = constants[expr.text]
+                assert not isinstance(value, str)
+                return Const(value)
+            raise SchemaError(
+                rule.location.file,
+                rule.line_of(key),
+                f"rule {rule.id!r}: {expr.text!r} (column {expr.column} of '{key}') is not a field, constant or "
+                f"loop variable of {msg.qualified_name}",
+            )
+        if isinstance(expr, Unary):
+            return Unary(expr.op, r(expr.operand))
+        if isinstance(expr, Binary):
+            return Binary(expr.op, r(expr.left), r(expr.right))
+        if isinstance(expr, Compare):
+            return Compare(expr.ops, tuple(r(e) for e in expr.operands))
+        if isinstance(expr, BoolOp):
+            return BoolOp(expr.op, tuple(r(e) for e in expr.values))
+        if isinstance(expr, Not):
+            return Not(r(expr.operand))
+        if isinstance(expr, Index):
+            return Index(r(expr.target), r(expr.index))
+        if isinstance(expr, ListLit):
+            return ListLit(tuple(r(e) for e in expr.items))
+        if isinstance(expr, Quant):
+            return Quant(expr.func, resolve(expr.body, scope | {expr.var}, key), expr.var, r(expr.iterable))
+        if isinstance(expr, Call):
+            args = tuple(r(a) for a in expr.args)
+            if expr.func == "is_known" and not isinstance(args[0], FieldRef):
+                raise SchemaError(
+                    rule.location.file,
+                    rule.line_of(key),
+                    f"rule {rule.id!r}: is_known() takes a field name (column {expr.column} of '{key}')",
+                )
+            return Call(expr.func, args, expr.column)
+        return expr
+
+    scope: frozenset[str] = frozenset()
+    where = resolve(rule.where, scope, "where") if rule.where is not None else None
+    bindings: list[tuple[str, Expr]] = []
+    for var, iterable in rule.bindings:
+        if var in scope or var in fields:
+            raise SchemaError(
+                rule.location.file,
+                rule.line_of("for"),
+                f"rule {rule.id!r}: loop variable {var!r} hides a field or another loop variable; pick another name",
+            )
+        bindings.append((var, resolve(iterable, scope, "for")))
+        scope = scope | {var}
+    check = resolve(rule.check, scope, "assert")
+    path = resolve(rule.path, scope, "path") if rule.path is not None else None
+    if path is not None and not _is_place(path):
+        raise SchemaError(
+            rule.location.file,
+            rule.line_of("path"),
+            f"rule {rule.id!r}: expected 'path' to name a field or loop variable, optionally indexed",
+        )
+    message = tuple(p if isinstance(p, str) else resolve(p, scope, "message") for p in rule.message)
+    return BoundRule(rule, where, tuple(bindings), check, path, message)
+
+
+def _is_place(expr: Expr) -> bool:
+    while isinstance(expr, Index):
+        expr = expr.target
+    return isinstance(expr, FieldRef | VarRef)
+
+
+def referenced_fields(expr: Expr | None, *, skip_is_known: bool = True) -> list[str]:
+    """Schema names of the fields ``expr`` reads, in first-use order (is_known() arguments aside)."""
+    out: dict[str, None] = {}
+
+    def walk(e: Expr | None) -> None:
+        if e is None:
+            return
+        if isinstance(e, FieldRef):
+            out[e.field.name] = None
+        elif isinstance(e, Unary | Not):
+            walk(e.operand)
+        elif isinstance(e, Binary):
+            walk(e.left)
+            walk(e.right)
+        elif isinstance(e, Compare):
+            for x in e.operands:
+                walk(x)
+        elif isinstance(e, BoolOp):
+            for x in e.values:
+                walk(x)
+        elif isinstance(e, Index):
+            walk(e.target)
+            walk(e.index)
+        elif isinstance(e, ListLit):
+            for x in e.items:
+                walk(x)
+        elif isinstance(e, Quant):
+            walk(e.body)
+            walk(e.iterable)
+        elif isinstance(e, Call) and not (skip_is_known and e.func == "is_known"):
+            for x in e.args:
+                walk(x)
+
+    walk(expr)
+    return list(out)

@@ -1,0 +1,131 @@
+"""``battgen failsafe`` and ``battgen params`` end to end through the CLI."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from codegen.cli import main
+
+PARAMS = "BATT_LOW_VOLT,10.5\nBATT_CRT_VOLT,10.0\nBATT_FS_LOW_ACT,2\nBATT_FS_CRT_ACT,1\n"
+DTS = """/dts-v1/;
+/ {
+\tbattery: battery {
+\t\tcompatible = "simple-battery";
+\t\tdevice-chemistry = "lithium-ion-polymer";
+\t\tcharge-full-design-microamp-hours = <3300000>;
+\t\tvoltage-max-design-microvolt = <12600000>;
+\t\tocv-capacity-celsius = <20>;
+\t\tocv-capacity-table-0 = <4200000 100>, <3750000 20>, <3680000 10>, <3300000 0>;
+\t};
+};
+"""
+
+
+def sample(t: float, volts: float) -> dict[str, object]:
+    """Alternate the formats: uORB, MAVLink (mV in cell 0) and SI values."""
+    if t % 3 == 0:
+        return {"t": t, "armed": True, "message": "uorb.BatteryStatus", "data": {"voltage_v": volts}}
+    if t % 3 == 1:
+        cells = [round(volts * 1000)] + [65535] * 9
+        return {"t": t, "armed": True, "message": "BATTERY_STATUS", "data": {"voltages": cells}}
+    return {"t": t, "armed": True, "battery": {"voltage_v": volts}}
+
+
+def write_stream(path: Path, rows: list[dict[str, object]]) -> Path:
+    path.write_text("".join(json.dumps(r) + "\n" for r in rows), encoding="utf-8")
+    return path
+
+
+@pytest.fixture
+def files(tmp_path: Path) -> tuple[Path, Path]:
+    params = tmp_path / "fs.param"
+    params.write_text(PARAMS, encoding="utf-8")
+    rows = [sample(t, 11.5 if t < 5 else 10.4 if t < 25 else 9.8) for t in range(30)]
+    return params, write_stream(tmp_path / "s.jsonl", rows)
+
+
+def test_timeline_from_mixed_formats(files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    params, stream = files
+    assert main(["failsafe", "--params", str(params), str(stream)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 2
+    assert out[0].startswith("t=    15.000s  LOW ") and '"Battery LOW: 10.4V"' in out[0] and "-> rtl" in out[0]
+    assert "uorb.warning=1 mavlink.charge_state=2" in out[0]
+    assert '"Battery CRITICAL: 9.8V"' in out[1] and "-> hold" in out[1] and "(line 26)" in out[1]
+
+
+def test_json_events_carry_the_level_in_the_converted_message(
+    files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    params, stream = files
+    assert main(["failsafe", "--params", str(params), "--no-home", "--json", str(stream)]) == 0
+    low, crit = (json.loads(line) for line in capsys.readouterr().out.splitlines())
+    assert (low["t"], low["outcome"], low["message"], low["data"]["warning"]) == (15.0, "hold", "uorb.BatteryStatus", 1)
+    assert (crit["message"], crit["data"]["charge_state"]) == ("mavlink.BATTERY_STATUS", 3)
+
+
+@pytest.mark.parametrize(
+    ("line", "expected"),
+    [
+        ('{"t": 1, "armed": tru}', "s.jsonl:2: expected one JSON object per line"),
+        ('{"t": "x", "armed": true, "battery": {}}', 's.jsonl:2: expected "t": a number of seconds'),
+        ('{"t": 1, "armed": 1, "battery": {}}', 's.jsonl:2: expected "armed": true or false'),
+        ('{"t": 1, "armed": true, "data": {}}', 's.jsonl:2: expected "message"'),
+        ('{"t": 1, "armed": true, "message": "NoSuch", "data": {}}', "s.jsonl:2: no message called 'NoSuch'"),
+        ('{"t": 1, "armed": true, "message": "uorb.BatteryStatus", "data": {"voltage_v": "x"}}', "voltage_v"),
+        ('{"t": 0.5, "armed": true, "battery": {}}', "s.jsonl:2: expected sample times that never go back"),
+    ],
+)
+def test_unreadable_stream_exits_2(
+    tmp_path: Path, files: tuple[Path, Path], capsys: pytest.CaptureFixture[str], line: str, expected: str
+) -> None:
+    params, _ = files
+    stream = tmp_path / "s.jsonl"
+    stream.write_text('{"t": 1, "armed": true, "battery": {"voltage_v": 12}}\n' + line + "\n", encoding="utf-8")
+    assert main(["failsafe", "--params", str(params), str(stream)]) == 2
+    assert expected in capsys.readouterr().err
+
+
+def test_unreadable_params_exit_2(tmp_path: Path, files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    _, stream = files
+    bad = tmp_path / "bad.param"
+    bad.write_text("BATT_LOW_VOLT\n", encoding="utf-8")
+    assert main(["failsafe", "--params", str(bad), str(stream)]) == 2
+    assert "bad.param:1: expected 'NAME,VALUE' or 'NAME VALUE'" in capsys.readouterr().err
+
+
+def test_params_from_devicetree_writes_commented_param_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    dts = tmp_path / "bat.dts"
+    dts.write_text(DTS, encoding="utf-8")
+    out = tmp_path / "proposed.param"
+    assert main(["params", "--from-devicetree", str(dts), "--out", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert "BATT_CAPACITY,3300  # charge-full-design-microamp-hours = 3300000 uAh" in text
+    assert (
+        "BATT_LOW_VOLT,11.25  # OCV at 20 % SOC: 3.750 V per cell x 3 cells (ocv-capacity-table-0, bat.dts:9)" in text
+    )
+    assert "BATT_CRT_VOLT,11.04  # OCV at 10 % SOC" in text
+    assert "3 cells: voltage-max-design 12.6 V / 4.2 V per cell" in text
+    # the proposal is a valid parameter set: --check passes, and the evaluator reads it
+    assert main(["params", "--check", str(out)]) == 0
+    assert main(["params", "--from-devicetree", str(dts), "--cells", "4", "--low-soc", "15"]) == 0
+    assert "BATT_LOW_VOLT,14.86" in capsys.readouterr().out
+
+
+def test_params_check_reports_lines(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "v.param"
+    path.write_text("BATT_LOW_VOLT,10.5\nBATT_CRT_VOLT,11\nBATT_LOW_TIMER,200\nGPS_TYPE,1\n", encoding="utf-8")
+    assert main(["params", "--check", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert f"{path.as_posix()}:3: error: BATT_LOW_TIMER is 200: expected 0 to 120" in out
+    assert f"{path.as_posix()}:2: error: BATT_CRT_VOLT (11 V) must be below BATT_LOW_VOLT (10.5 V)" in out
+
+
+def test_params_from_devicetree_without_battery(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    dts = tmp_path / "empty.dts"
+    dts.write_text("/dts-v1/;\n/ {\n};\n", encoding="utf-8")
+    assert main(["params", "--from-devicetree", str(dts)]) == 2
+    assert 'expected a compatible = "simple-battery" node' in capsys.readouterr().err

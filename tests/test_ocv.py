@@ -1,0 +1,128 @@
+"""codegen.ocv against values worked out by hand from the kernel's integer arithmetic.
+
+Tables are the battery.yaml example's: -10 degC (4185000,100) (4113000,95) (4066000,90);
+0 degC (4200000,100) (4185000,95) (4113000,90); 10 degC (4250000,100) (4200000,95) (4185000,90).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from codegen.ocv import (
+    find_table_index,
+    linear_interpolate,
+    ocv_to_capacity,
+    ocv_to_capacity_in_table,
+    tables_from_properties,
+)
+
+COLD = [(4185000, 100), (4113000, 95), (4066000, 90)]
+ZERO = [(4200000, 100), (4185000, 95), (4113000, 90)]
+WARM = [(4250000, 100), (4200000, 95), (4185000, 90)]
+TEMPS = [-10, 0, 10]
+
+
+@pytest.mark.parametrize(
+    ("ocv", "expected", "why"),
+    [
+        (4300000, 100, "above the first entry: clamped to the first capacity"),
+        (4185001, 100, "just above the first entry"),
+        (4185000, 100, "exact first point: stops at i=1, x == x1 returns y1"),
+        (4150000, 97, "95 + 5*37000/72000 = 95 + 2 (2.57 truncated)"),
+        (4113000, 95, "exact middle point: i=2, x == x1"),
+        (4100000, 93, "90 + 5*34000/47000 = 90 + 3 (3.62 truncated)"),
+        (4070000, 90, "90 + 5*4000/47000 = 90 + 0"),
+        (4066000, 90, "exact last point: no entry below, i == len, clamped"),
+        (3000000, 90, "below the table: clamped to the last capacity"),
+        (-5, 90, "a negative OCV is just below the table"),
+    ],
+)
+def test_ocv_to_capacity_in_table(ocv: int, expected: int, why: str) -> None:
+    assert ocv_to_capacity_in_table(COLD, ocv) == expected, why
+
+
+def test_division_truncates_toward_zero() -> None:
+    # Capacity rising as OCV falls (a malformed but readable table): the product is negative.
+    # 20 + (10 - 20) * (3933 - 3900) / (4000 - 3900) = 20 + (-330 / 100) = 20 - 3 in C (floor: -4).
+    assert ocv_to_capacity_in_table([(4000, 10), (3900, 20)], 3933) == 17
+
+
+def test_int_overflow_wraps_like_the_kernel() -> None:
+    # (100000 - 0) * (500000 - 0) = 5e10 wraps to -1539607552 in a 32-bit int; / 1000000 -> -1539.
+    assert linear_interpolate(0, 0, 1000000, 100000, 500000) == -1539
+
+
+def test_interpolate_shortcuts() -> None:
+    assert linear_interpolate(1, 7, 5, 7, 3) == 7  # flat segment
+    assert linear_interpolate(1, 7, 1, 9, 1) == 7  # x == x0 first
+    assert linear_interpolate(1, 7, 1, 9, 4) == 9  # x1 == x0: y1
+    assert linear_interpolate(0, 0, 10, 100, 10) == 100
+
+
+def test_single_row_table() -> None:
+    assert ocv_to_capacity_in_table([(3700000, 40)], 4000000) == 40
+    assert ocv_to_capacity_in_table([(3700000, 40)], 3000000) == 40
+
+
+@pytest.mark.parametrize(
+    ("temp", "index"),
+    [
+        (-100, 0),
+        (-10, 0),
+        (-5, 0),  # tie between -10 and 0 (both 5 away): the first table wins
+        (-4, 1),
+        (4, 1),
+        (5, 1),  # tie between 0 and 10: the first of the two wins
+        (6, 2),
+        (100, 2),
+    ],
+)
+def test_find_table_index(temp: int, index: int) -> None:
+    assert find_table_index(TEMPS, temp) == index
+
+
+def test_duplicate_temperatures_pick_the_first() -> None:
+    assert find_table_index([20, 20, 25], 21) == 0
+
+
+def test_only_twenty_temperatures_count() -> None:
+    temps = [100] * 20 + [0]
+    assert find_table_index(temps, 0) == 0  # the 21st entry is beyond POWER_SUPPLY_OCV_TEMP_MAX
+
+
+def test_ocv_to_capacity_picks_then_interpolates() -> None:
+    tables = [COLD, ZERO, WARM]
+    # 5 degC ties 0 and 10: the 0 degC table; 90 + 5*37000/72000 = 92.
+    assert ocv_to_capacity(tables, TEMPS, 4150000, 5) == 92
+    # 8 degC: the 10 degC table; 4150000 is below it: clamped to 90.
+    assert ocv_to_capacity(tables, TEMPS, 4150000, 8) == 90
+    # -30 degC: the -10 degC table.
+    assert ocv_to_capacity(tables, TEMPS, 4150000, -30) == 97
+
+
+@pytest.mark.parametrize(
+    ("tables", "temps", "message"),
+    [
+        ([], [], "at least one"),
+        ([COLD], [0, 10], "one table each"),
+        ([COLD, []], [0, 10], "ocv-capacity-table-1 is empty"),
+        ([COLD] * 21, list(range(21)), "at most 20"),
+    ],
+)
+def test_errors(tables: list[list[tuple[int, int]]], temps: list[int], message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        ocv_to_capacity(tables, temps, 4000000, 0)
+
+
+def test_tables_from_properties_wraps_cells_to_int() -> None:
+    props = {
+        "ocv-capacity-celsius": [0xFFFFFFF6, 0],  # uint32 cells as a .dtb holds them: -10, 0
+        "ocv-capacity-table-0": [[4185000, 100], [4113000, 95]],
+        "ocv-capacity-table-1": [[4200000, 100], [4185000]],  # half row dropped as the kernel does
+    }
+    tables, temps = tables_from_properties(props)
+    assert temps == [-10, 0]
+    assert tables[1] == [(4200000, 100)]
+    assert ocv_to_capacity(tables, temps, 4150000, -8) == 97
+    with pytest.raises(ValueError, match="ocv-capacity-table-1 is missing"):
+        tables_from_properties({"ocv-capacity-celsius": [0, 1], "ocv-capacity-table-0": [[1, 2]]})
