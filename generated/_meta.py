@@ -86,13 +86,16 @@ def as_float(value: object, path: str) -> float:
         if isinstance(value, str) and value in ("NaN", "Infinity", "-Infinity", "nan", "inf", "-inf"):
             return float(value)
         raise DataError(path, "a number", value)
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:  # an integer beyond the largest double
+        raise DataError(path, "a number within the float range", value) from None
 
 
 def as_bool(value: object, path: str) -> bool:
     if isinstance(value, bool):
         return value
-    if isinstance(value, int) and value in (0, 1):
+    if isinstance(value, int | float) and value in (0, 1):  # JSON writers may emit 1.0 for true
         return bool(value)
     raise DataError(path, "true or false", value)
 

@@ -121,7 +121,7 @@ def _render_module(
         module_code=list(module_code),
     )
     std = ["import dataclasses"]
-    for name in ("enum", "math", "struct"):
+    for name in ("enum", "functools", "math", "struct"):
         if f"{name}." in body:
             std.append(f"import {name}")
     std.append("from collections.abc import Mapping")

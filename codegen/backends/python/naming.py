@@ -9,8 +9,24 @@ from ...ir import DronecanKind, Message, SourceFormat
 
 _NON_IDENT = re.compile(r"[^0-9A-Za-z_]+")
 _REGEX_TOKENS = re.compile(r"\[[^\]]*\][+*?]?|\\d[+*?]?|[+*?]")
-# names a generated class defines itself; a field must not shadow them
-_RESERVED = frozenset({"to_dict", "from_dict", "validate", "check", "encode", "decode", "is_known", "FIELDS"})
+# Every member a generated class gets from the backend and its extensions (codecs, validators):
+# a schema field or constant with one of these names is renamed (a trailing "_"), never shadowing it.
+RESERVED_MEMBERS = frozenset(
+    {
+        # models
+        "QUALIFIED_NAME", "to_dict", "from_dict",
+        # validators
+        "validate", "check", "is_known",
+        # codecs, all formats
+        "encode", "decode", "decode_batch",
+        # DroneCAN
+        "DATA_TYPE_ID", "DATA_TYPE_SIGNATURE", "union_field",
+        # uORB / ULog
+        "UORB_FORMAT", "UORB_SIZE", "UORB_SIZE_NO_PADDING", "UORB_TOPICS", "ulog_format", "from_ulog",
+        # MAVLink
+        "MSG_ID", "CRC_EXTRA", "MAVLINK_BASE_LENGTH", "MAVLINK_MAX_LENGTH", "encode_frame", "decode_frame",
+    }
+)  # fmt: skip
 
 
 def identifier(text: str) -> str:
@@ -18,7 +34,7 @@ def identifier(text: str) -> str:
     name = _NON_IDENT.sub("_", text).strip("_") or "field"
     if name[0].isdigit():
         name = "_" + name
-    if keyword.iskeyword(name) or keyword.issoftkeyword(name) or name in _RESERVED:
+    if keyword.iskeyword(name) or keyword.issoftkeyword(name) or name in RESERVED_MEMBERS:
         name += "_"
     return name
 

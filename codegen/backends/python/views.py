@@ -22,9 +22,6 @@ from ...ir import (
 from . import naming
 from .literals import docstring, py_literal
 
-_CLASS_ATTRS = frozenset({"QUALIFIED_NAME"})
-
-
 @dataclass(frozen=True)
 class ClassRef:
     module: str  # dotted, relative to the generated package root
@@ -124,7 +121,8 @@ class ModuleContext:
                 body = f"    return {ref.name}"
             else:
                 body = f"    from {self.relative(ref.module)} import {ref.name} as cls\n\n    return cls"
-            self.factories[fname] = f"def {fname}() -> type[{self.annotation_name(ref)}]:\n{body}"
+            # cached: the import statement runs once, not on every decode or from_dict
+            self.factories[fname] = f"@functools.cache\ndef {fname}() -> type[{self.annotation_name(ref)}]:\n{body}"
         return fname
 
     def annotation_name(self, ref: ClassRef) -> str:
@@ -322,7 +320,7 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
     cls = naming.class_name(msg)
     optional_props = msg.devicetree is not None
     fields: list[FieldView] = []
-    idents: set[str] = set(_CLASS_ATTRS)
+    idents: set[str] = set(naming.RESERVED_MEMBERS)
     patterns: list[str] = []
     keys: list[str] = []
     for f in msg.fields:

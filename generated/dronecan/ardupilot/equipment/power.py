@@ -7,6 +7,7 @@ Module: dronecan.ardupilot.equipment.power.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import struct
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -52,6 +53,7 @@ _VS_BatteryInfoAux_is_powering_off = _v.Number(type='bool', kind='bool', low=0, 
 _VS_BatteryInfoAux_battery_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
 
 
+@functools.cache
 def _cls_Timestamp() -> type[_dronecan_uavcan.Timestamp]:
     from ....dronecan.uavcan import Timestamp as cls
 
