@@ -22,6 +22,7 @@ from ...ir import (
 from . import naming
 from .literals import docstring, py_literal
 
+
 @dataclass(frozen=True)
 class ClassRef:
     module: str  # dotted, relative to the generated package root
