@@ -360,8 +360,24 @@ def test_ids_signatures_and_transfer_crc(sides: dict[str, Side]) -> None:
     side = sides["bundled"]
     cls = side.cls(side.by_name["dronecan.uavcan.equipment.power.BatteryInfo"])
     runtime = importlib.import_module("dc_bundled._dronecan")
+    # pydronecan defaults every field to zero; ours default to the sentinels (NaN, 127), so set them
+    unknown_as_zero = dict.fromkeys(
+        (
+            "temperature",
+            "average_power_10sec",
+            "remaining_capacity_wh",
+            "full_charge_capacity_wh",
+            "hours_to_full_charge",
+        ),
+        0.0,
+    )
     obj = cls(
-        voltage=16.8, current=-3.5, model_name=b"battgen test pack 4S", model_instance_id=7, state_of_health_pct=0
+        voltage=16.8,
+        current=-3.5,
+        model_name=b"battgen test pack 4S",
+        model_instance_id=7,
+        state_of_health_pct=0,
+        **unknown_as_zero,
     )
     payload = obj.encode()
     # pydronecan's own transfer: a multi-frame transfer starts with the CRC, seeded by the signature

@@ -73,6 +73,24 @@ def is_sentinel(value: object, invalid: float | None) -> bool:
     return bool(value == invalid)
 
 
+def _same(a: object, b: object) -> bool:
+    if a is b:
+        return True
+    if isinstance(a, float) and isinstance(b, float):
+        return a == b or (a != a and b != b)  # NaN: the same "unknown"
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+    return bool(a == b)
+
+
+def same_message(a: object, b: object) -> bool:
+    """Field-by-field equality of two messages of one class, NaN equal to NaN."""
+    names: tuple[str, ...] = getattr(type(a), "__slots__", ())
+    return all(_same(getattr(a, name), getattr(b, name)) for name in names)
+
+
 def as_int(value: object, path: str) -> int:
     if isinstance(value, bool) or not isinstance(value, int):
         if isinstance(value, float) and value.is_integer():

@@ -134,6 +134,12 @@ class BatteryStatus:
     mode: int = dataclasses.field(default=0, metadata=_m.meta(name='mode', type='uint8', enums=('mavlink.MAV_BATTERY_MODE',), extension=True, doc='Battery mode; 0 when not reported or in normal use.'))
     fault_bitmask: int = dataclasses.field(default=0, metadata=_m.meta(name='fault_bitmask', type='uint32', enums=('mavlink.MAV_BATTERY_FAULT',), extension=True, doc='Fault flags, valid when charge_state is FAILED or UNHEALTHY.'))
 
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}

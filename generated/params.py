@@ -94,6 +94,12 @@ class BattParams:
     BATT_ARM_VOLT: float = dataclasses.field(default=0.0, metadata=_m.meta(name='BATT_ARM_VOLT', type='float32', unit='V', quantity='voltage', minimum=0, maximum=30, doc='Arming is refused below this voltage. 0 disables the check.'))
     BATT_ARM_MAH: int = dataclasses.field(default=0, metadata=_m.meta(name='BATT_ARM_MAH', type='int32', unit='mAh', quantity='charge', scale=3.6, offset=0.0, doc='Arming is refused with less remaining charge than this. 0 disables the check.'))
 
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}

@@ -286,6 +286,12 @@ class BatteryStatus:
     prediction_error: float = dataclasses.field(default=0.0, metadata=_m.meta(name='prediction_error', type='float32', unit='V', quantity='voltage', doc='Prediction error'))
     estimation_covariance_norm: float = dataclasses.field(default=0.0, metadata=_m.meta(name='estimation_covariance_norm', type='float32', doc='Norm of the covariance matrix'))
 
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
@@ -940,6 +946,12 @@ class BatteryStatusV0:
     voltage_prediction: float = dataclasses.field(default=0.0, metadata=_m.meta(name='voltage_prediction', type='float32', unit='V', quantity='voltage', doc='Predicted voltage'))
     prediction_error: float = dataclasses.field(default=0.0, metadata=_m.meta(name='prediction_error', type='float32', unit='V', quantity='voltage', doc='Prediction error'))
     estimation_covariance_norm: float = dataclasses.field(default=0.0, metadata=_m.meta(name='estimation_covariance_norm', type='float32', doc='Norm of the covariance matrix'))
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""

@@ -398,3 +398,26 @@ def test_parse_dir_is_deterministic() -> None:
     assert first == second
     names = [m.qualified_name for m in first.messages]
     assert names == sorted(names) and len(names) == 5
+
+
+def test_invalid_tag_in_comments_gives_a_sentinel(tmp_path: Path) -> None:
+    ns = tmp_path / "ns"
+    ns.mkdir()
+    (ns / "T.uavcan").write_text(
+        "float16 a # [Volt] [@invalid NaN] pack voltage\nfloat32 b # [@invalid NaN]\nuint8 c # [@invalid 255]\n"
+    )
+    msg = dsdl.parse_file(ns / "T.uavcan", root=tmp_path).message("dronecan.ns.T")
+    a, b, c = msg.fields
+    assert a.invalid is not None and a.invalid.is_nan and a.unit is not None and a.unit.symbol == "V"
+    assert a.doc == "pack voltage"
+    assert b.invalid is not None and b.invalid.is_nan and b.unit is None
+    assert c.invalid is not None and c.invalid.value == 255
+
+
+def test_nan_sentinel_on_an_integer_is_an_error(tmp_path: Path) -> None:
+    ns = tmp_path / "ns"
+    ns.mkdir()
+    (ns / "T.uavcan").write_text("uint8 ok\nuint8 c # [@invalid NaN]\n")
+    with pytest.raises(SchemaError) as info:
+        dsdl.parse_file(ns / "T.uavcan", root=tmp_path)
+    assert info.value.line == 2 and "only on a float field" in info.value.message

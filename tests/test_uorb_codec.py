@@ -16,8 +16,6 @@ from conftest import ROOT
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from codegen.backends.python import render_package
-from codegen.errors import BattgenError
 from codegen.frontends import uorb
 from generated import _uorb
 from generated.uorb import BatteryStatus, BatteryStatusV0
@@ -245,10 +243,12 @@ def test_decode_batch_rejects_bad_buffers() -> None:
         BatteryStatus.decode_batch(bytes(200), stride=0)
 
 
-def test_a_field_named_like_a_codec_method_is_refused(tmp_path: Path) -> None:
+def test_a_field_named_like_a_codec_method_is_renamed(tmp_path: Path, import_generated: Any) -> None:
     (tmp_path / "Clash.msg").write_text("uint64 timestamp\nuint8 decode_batch\n", encoding="utf-8")
-    with pytest.raises(BattgenError, match=r"Clash\.msg:1: uorb\.Clash defines 'decode_batch'"):
-        render_package(uorb.parse_dir(tmp_path))
+    cls = import_generated(uorb.parse_dir(tmp_path), "uorb").Clash
+    value = cls(timestamp=5, decode_batch_=9)
+    assert cls.decode(value.encode()) == value and value.to_dict() == {"timestamp": 5, "decode_batch": 9}
+    assert callable(cls.decode_batch)
 
 
 def test_nested_package_is_mypy_clean(nested: ModuleType) -> None:

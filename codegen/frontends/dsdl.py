@@ -241,6 +241,10 @@ class _Loader:
         fields = []
         for f in section.fields:
             unit_text, value_range, rest = sem.split_tag(f.trailing)
+            is_float = isinstance(f.type, PrimT) and f.type.kind == "float"
+            tagged, problem, rest = sem.split_invalid(rest, is_float)
+            if problem:
+                raise SchemaError(td.file, f.line, problem)
             fields.append(
                 Field(
                     name=f.name if f.name and not isinstance(f.type, VoidT) else "",
@@ -250,7 +254,7 @@ class _Loader:
                     unit=sem.resolve_unit(unit_text) if unit_text else None,
                     unit_text=unit_text,
                     range=value_range,
-                    invalid=invalid.get(f.name or ""),
+                    invalid=invalid.get(f.name or "") or tagged,
                     enums=links.get(f.name or "", ()),
                 )
             )

@@ -16,6 +16,9 @@ Rules (generic, applied to every definition):
   values are distinct powers of two and such a field exists, else VALUE.
 * Sentinels: a constant ``<X>_UNKNOWN`` marks the "unknown" value of the only field whose
   upper-cased name starts with ``X``; a bare ``UNKNOWN`` does so for a structure's only field.
+  Where DSDL has no constant for it (float fields that are NaN when unknown), a trailing comment
+  may carry the uORB-style tag ``[@invalid NaN]`` (or a number); comments never change the wire
+  format or the signature, so this stays compatible with every other DSDL tool.
 """
 
 from __future__ import annotations
@@ -42,6 +45,8 @@ def split_tag(trailing: str) -> tuple[str | None, Range | None, str]:
     if not match:
         return None, None, trailing
     tag, rest = match.group(1).strip(), match.group(2).strip()
+    if tag.startswith("@"):  # an annotation such as [@invalid NaN], not a unit
+        return None, None, trailing
     numbers = _RANGE_RE.match(tag)
     if numbers:
         low, high = (_number(numbers.group(i)) for i in (1, 2))
@@ -49,6 +54,27 @@ def split_tag(trailing: str) -> tuple[str | None, Range | None, str]:
     if not tag:
         return None, None, trailing
     return tag, None, rest
+
+
+_INVALID_RE = re.compile(r"\[@invalid\s+([^\]]+)\]\s*")
+
+
+def split_invalid(comment: str, is_float: bool) -> tuple[Sentinel | None, str | None, str]:
+    """A ``[@invalid X]`` tag in a comment -> (sentinel, error text, the comment without it)."""
+    match = _INVALID_RE.search(comment)
+    if not match:
+        return None, None, comment
+    rest = (comment[: match.start()] + comment[match.end() :]).strip()
+    text = match.group(1).strip()
+    if text.lower() == "nan":
+        if not is_float:
+            return None, f"expected [@invalid NaN] only on a float field, got {text!r}", rest
+        return Sentinel(float("nan"), text), None, rest
+    try:
+        value = _number(text)
+    except ValueError:
+        return None, f"expected [@invalid NaN] or [@invalid <number>], got {text!r}", rest
+    return Sentinel(value, text), None, rest
 
 
 def _number(text: str) -> int | float:

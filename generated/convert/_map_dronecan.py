@@ -25,25 +25,25 @@ def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None 
     """dronecan -> concepts: returns the target objects as a tuple."""
     t = BatteryState()
     _v1 = s_info.voltage
-    if _v1 == _v1:
+    if _v1 == _v1 and _v1 == _v1:
         t.pack_voltage = float(_v1)
     _v2 = s_info.current
-    if _v2 == _v2:
+    if _v2 == _v2 and _v2 == _v2:
         t.current = float(_v2)
     _v3 = s_info.temperature
-    if _v3 == _v3 and _v3 > 0:
+    if _v3 == _v3 and _v3 == _v3 and _v3 > 0:
         t.temperature = float(_v3)
     _v4 = s_info.average_power_10sec
-    if _v4 == _v4:
+    if _v4 == _v4 and _v4 == _v4:
         t.average_power = float(_v4)
     _v5 = s_info.remaining_capacity_wh
-    if _v5 == _v5:
+    if _v5 == _v5 and _v5 == _v5:
         t.remaining_energy = float(_v5) * 3600.0
     _v6 = s_info.full_charge_capacity_wh
-    if _v6 == _v6:
+    if _v6 == _v6 and _v6 == _v6:
         t.full_energy = float(_v6) * 3600.0
     _v7 = s_info.hours_to_full_charge
-    if _v7 == _v7:
+    if _v7 == _v7 and _v7 == _v7:
         t.time_to_full = float(_v7) * 3600.0
     t.in_use = bool(s_info.status_flags & 1)
     t.charging = bool(s_info.status_flags & 2)

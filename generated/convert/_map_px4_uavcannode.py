@@ -25,6 +25,13 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     """uorb -> dronecan: returns the target objects as a tuple."""
     t_info = _C1()
     t_aux = _C2()
+    t_info.temperature = 0.0
+    t_info.voltage = 0.0
+    t_info.current = 0.0
+    t_info.average_power_10sec = 0.0
+    t_info.remaining_capacity_wh = 0.0
+    t_info.full_charge_capacity_wh = 0.0
+    t_info.hours_to_full_charge = 0.0
     t_info.state_of_health_pct = 0
     _n2 = s_status.cell_count
     if _n2 > 14 and rep is not None:
@@ -70,6 +77,16 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     if rep_u is not None:
         for _n in _K23_forward:
             rep_u.unknown(_n)
+    if rep_u is not None and _r.is_marker(t_info.temperature, math.nan):
+        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.temperature')
+    if rep_u is not None and _r.is_marker(t_info.voltage, math.nan):
+        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.voltage')
+    if rep_u is not None and _r.is_marker(t_info.current, math.nan):
+        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.current')
+    if rep_u is not None and _r.is_marker(t_info.remaining_capacity_wh, math.nan):
+        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh')
+    if rep_u is not None and _r.is_marker(t_info.full_charge_capacity_wh, math.nan):
+        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh')
     if rep_u is not None and _r.is_marker(t_info.state_of_health_pct, 127):
         rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct')
     if rep_u is not None:

@@ -95,6 +95,12 @@ class SimpleBattery:
     ocv_capacity_table_n: dict[str, list[list[int]]] = dataclasses.field(default_factory=dict, metadata=_m.meta(name='^ocv-capacity-table-[0-9]+$', type='uint32[2][<=100]', pattern='^ocv-capacity-table-[0-9]+$', doc='An array providing the open circuit voltage (OCV)\nof the battery and corresponding battery capacity percent, which is used\nto look up battery capacity according to current OCV value. And the open\ncircuit voltage unit is microvolt.\n[0] open circuit voltage (OCV) in microvolts\n[1] battery capacity percent'))
     volt_drop_n_microvolt: dict[str, list[list[int]]] = dataclasses.field(default_factory=dict, metadata=_m.meta(name='^volt-drop-[0-9]-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, pattern='^volt-drop-[0-9]-microvolt', doc="Table of the voltage drop rate (VDR) values. Each entry in the table should match a capacity value in the volt-drop-soc table. Furthermore, the values should be obtained for the temperature given in volt-drop-temperatures-millicelsius table at index matching the number in this table's name."))
 
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}

@@ -39,6 +39,12 @@ class Timestamp:
 
     usec: int = dataclasses.field(default=0, metadata=_m.meta(name='usec', type='uint56', unit='us', quantity='time', scale=1e-06, offset=0.0, invalid=0, invalid_text='UNKNOWN'))
 
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}

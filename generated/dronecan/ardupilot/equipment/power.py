@@ -80,6 +80,12 @@ class BatteryInfoAux:
     is_powering_off: bool = dataclasses.field(default=False, metadata=_m.meta(name='is_powering_off', type='bool', doc='About to switch off; false if unknown'))
     battery_id: int = dataclasses.field(default=0, metadata=_m.meta(name='battery_id', type='uint8', doc='Which battery of this vehicle (0 = main)'))
 
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import math
 import struct
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -63,13 +64,13 @@ _DC_BatteryInfo_4 = ((16, 'BatteryInfo.temperature'), (32, 'BatteryInfo.voltage'
 _DC_BatteryInfo_5 = struct.Struct('<eeeeeeeIBI')
 
 
-_VS_BatteryInfo_temperature = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='K')
-_VS_BatteryInfo_voltage = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='V')
-_VS_BatteryInfo_current = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='A')
-_VS_BatteryInfo_average_power_10sec = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='W')
-_VS_BatteryInfo_remaining_capacity_wh = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Wh')
-_VS_BatteryInfo_full_charge_capacity_wh = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Wh')
-_VS_BatteryInfo_hours_to_full_charge = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='h')
+_VS_BatteryInfo_temperature = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='K', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryInfo_voltage = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='V', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryInfo_current = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='A', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryInfo_average_power_10sec = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='W', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryInfo_remaining_capacity_wh = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Wh', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryInfo_full_charge_capacity_wh = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Wh', sentinel=math.nan, sentinel_text='NaN')
+_VS_BatteryInfo_hours_to_full_charge = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='h', sentinel=math.nan, sentinel_text='NaN')
 _VS_BatteryInfo_status_flags = _v.Number(type='uint11', kind='uint', low=0, high=2047, mask=0x1ff, bits={0x1: 'STATUS_FLAG_IN_USE', 0x2: 'STATUS_FLAG_CHARGING', 0x4: 'STATUS_FLAG_CHARGED', 0x8: 'STATUS_FLAG_TEMP_HOT', 0x10: 'STATUS_FLAG_TEMP_COLD', 0x20: 'STATUS_FLAG_OVERLOAD', 0x40: 'STATUS_FLAG_BAD_BATTERY', 0x80: 'STATUS_FLAG_NEED_SERVICE', 0x100: 'STATUS_FLAG_BMS_ERROR', 0x200: 'STATUS_FLAG_RESERVED_A', 0x400: 'STATUS_FLAG_RESERVED_B'})
 _VS_BatteryInfo_state_of_health_pct = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%', sentinel=127, sentinel_text='STATE_OF_HEALTH_UNKNOWN')
 _VS_BatteryInfo_state_of_charge_pct = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%')
@@ -145,13 +146,13 @@ class BatteryInfo:
     STATUS_FLAG_RESERVED_B: ClassVar[int] = 1024
     STATE_OF_HEALTH_UNKNOWN: ClassVar[int] = 127
 
-    temperature: float = dataclasses.field(default=0.0, metadata=_m.meta(name='temperature', type='float16', unit='K', quantity='temperature', doc='Measurements. Unknown values are NAN.'))
-    voltage: float = dataclasses.field(default=0.0, metadata=_m.meta(name='voltage', type='float16', unit='V', quantity='voltage'))
-    current: float = dataclasses.field(default=0.0, metadata=_m.meta(name='current', type='float16', unit='A', quantity='current'))
-    average_power_10sec: float = dataclasses.field(default=0.0, metadata=_m.meta(name='average_power_10sec', type='float16', unit='W', quantity='power', doc='Mean power over the last 10 s'))
-    remaining_capacity_wh: float = dataclasses.field(default=0.0, metadata=_m.meta(name='remaining_capacity_wh', type='float16', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, doc='Energy left; grows while charging'))
-    full_charge_capacity_wh: float = dataclasses.field(default=0.0, metadata=_m.meta(name='full_charge_capacity_wh', type='float16', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, doc='Energy when full; shrinks as the battery ages'))
-    hours_to_full_charge: float = dataclasses.field(default=0.0, metadata=_m.meta(name='hours_to_full_charge', type='float16', unit='h', quantity='time', scale=3600.0, offset=0.0, doc='Time until charged; zero when not charging'))
+    temperature: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='temperature', type='float16', unit='K', quantity='temperature', invalid=math.nan, invalid_text='NaN', doc='Measurements. Unknown values are NAN.'))
+    voltage: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='voltage', type='float16', unit='V', quantity='voltage', invalid=math.nan, invalid_text='NaN'))
+    current: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='current', type='float16', unit='A', quantity='current', invalid=math.nan, invalid_text='NaN'))
+    average_power_10sec: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='average_power_10sec', type='float16', unit='W', quantity='power', invalid=math.nan, invalid_text='NaN', doc='Mean power over the last 10 s'))
+    remaining_capacity_wh: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='remaining_capacity_wh', type='float16', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, invalid=math.nan, invalid_text='NaN', doc='Energy left; grows while charging'))
+    full_charge_capacity_wh: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='full_charge_capacity_wh', type='float16', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, invalid=math.nan, invalid_text='NaN', doc='Energy when full; shrinks as the battery ages'))
+    hours_to_full_charge: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='hours_to_full_charge', type='float16', unit='h', quantity='time', scale=3600.0, offset=0.0, invalid=math.nan, invalid_text='NaN', doc='Time until charged; zero when not charging'))
     status_flags: int = dataclasses.field(default=0, metadata=_m.meta(name='status_flags', type='uint11', enums=('dronecan.uavcan.equipment.power.BatteryInfo.STATUS_FLAG',)))
     state_of_health_pct: int = dataclasses.field(default=127, metadata=_m.meta(name='state_of_health_pct', type='uint7', unit='%', quantity='ratio', scale=0.01, offset=0.0, invalid=127, invalid_text='STATE_OF_HEALTH_UNKNOWN', doc='Optional'))
     state_of_charge_pct: int = dataclasses.field(default=0, metadata=_m.meta(name='state_of_charge_pct', type='uint7', unit='%', quantity='ratio', scale=0.01, offset=0.0, doc='State of charge.\nRequired'))
@@ -159,6 +160,12 @@ class BatteryInfo:
     battery_id: int = dataclasses.field(default=0, metadata=_m.meta(name='battery_id', type='uint8', doc='Identity.\nWhich battery of this vehicle (0 = main)'))
     model_instance_id: int = dataclasses.field(default=0, metadata=_m.meta(name='model_instance_id', type='uint32', doc='Serial number within the model; zero if none'))
     model_name: bytes = dataclasses.field(default=b'', metadata=_m.meta(name='model_name', type='uint8[<=31]', doc='Vendor, model and chemistry, as text'))
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
@@ -461,37 +468,44 @@ class BatteryInfo:
         r_state_of_charge_pct: Any
         r_state_of_health_pct: Any
         try:
-            if (not (-65504.0 <= self.temperature <= 65504.0)):
+            x = self.temperature
+            if (not (-65504.0 <= x <= 65504.0) and x == x):
                 _v.diag(out, 'temperature', self.temperature, _VS_BatteryInfo_temperature)
         except _v.SLOW:
             _v.diag(out, 'temperature', self.temperature, _VS_BatteryInfo_temperature)
         try:
-            if (not (-65504.0 <= self.voltage <= 65504.0)):
+            x = self.voltage
+            if (not (-65504.0 <= x <= 65504.0) and x == x):
                 _v.diag(out, 'voltage', self.voltage, _VS_BatteryInfo_voltage)
         except _v.SLOW:
             _v.diag(out, 'voltage', self.voltage, _VS_BatteryInfo_voltage)
         try:
-            if (not (-65504.0 <= self.current <= 65504.0)):
+            x = self.current
+            if (not (-65504.0 <= x <= 65504.0) and x == x):
                 _v.diag(out, 'current', self.current, _VS_BatteryInfo_current)
         except _v.SLOW:
             _v.diag(out, 'current', self.current, _VS_BatteryInfo_current)
         try:
-            if (not (-65504.0 <= self.average_power_10sec <= 65504.0)):
+            x = self.average_power_10sec
+            if (not (-65504.0 <= x <= 65504.0) and x == x):
                 _v.diag(out, 'average_power_10sec', self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
         except _v.SLOW:
             _v.diag(out, 'average_power_10sec', self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
         try:
-            if (not (-65504.0 <= self.remaining_capacity_wh <= 65504.0)):
+            x = self.remaining_capacity_wh
+            if (not (-65504.0 <= x <= 65504.0) and x == x):
                 _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
         except _v.SLOW:
             _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
         try:
-            if (not (-65504.0 <= self.full_charge_capacity_wh <= 65504.0)):
+            x = self.full_charge_capacity_wh
+            if (not (-65504.0 <= x <= 65504.0) and x == x):
                 _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryInfo_full_charge_capacity_wh)
         except _v.SLOW:
             _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryInfo_full_charge_capacity_wh)
         try:
-            if (not (-65504.0 <= self.hours_to_full_charge <= 65504.0)):
+            x = self.hours_to_full_charge
+            if (not (-65504.0 <= x <= 65504.0) and x == x):
                 _v.diag(out, 'hours_to_full_charge', self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
         except _v.SLOW:
             _v.diag(out, 'hours_to_full_charge', self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
@@ -557,9 +571,23 @@ class BatteryInfo:
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == 'temperature':
+            return self.temperature == self.temperature
+        if field == 'voltage':
+            return self.voltage == self.voltage
+        if field == 'current':
+            return self.current == self.current
+        if field == 'average_power_10sec':
+            return self.average_power_10sec == self.average_power_10sec
+        if field == 'remaining_capacity_wh':
+            return self.remaining_capacity_wh == self.remaining_capacity_wh
+        if field == 'full_charge_capacity_wh':
+            return self.full_charge_capacity_wh == self.full_charge_capacity_wh
+        if field == 'hours_to_full_charge':
+            return self.hours_to_full_charge == self.hours_to_full_charge
         if field == 'state_of_health_pct':
             return self.state_of_health_pct != 127
-        if field in {'temperature', 'voltage', 'current', 'average_power_10sec', 'remaining_capacity_wh', 'full_charge_capacity_wh', 'hours_to_full_charge', 'status_flags', 'state_of_charge_pct', 'state_of_charge_pct_stdev', 'battery_id', 'model_instance_id', 'model_name'}:
+        if field in {'status_flags', 'state_of_charge_pct', 'state_of_charge_pct_stdev', 'battery_id', 'model_instance_id', 'model_name'}:
             return True
         raise KeyError(f'{field!r} is not a field of ' + 'dronecan.uavcan.equipment.power.BatteryInfo')
 
@@ -581,6 +609,12 @@ class CircuitStatus:
     voltage: float = dataclasses.field(default=0.0, metadata=_m.meta(name='voltage', type='float16', unit='V', quantity='voltage'))
     current: float = dataclasses.field(default=0.0, metadata=_m.meta(name='current', type='float16', unit='A', quantity='current'))
     error_flags: int = dataclasses.field(default=0, metadata=_m.meta(name='error_flags', type='uint8', enums=('dronecan.uavcan.equipment.power.CircuitStatus.ERROR_FLAG',)))
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
@@ -728,6 +762,12 @@ class PrimaryPowerSupplyStatus:
     external_power_available: bool = dataclasses.field(default=False, metadata=_m.meta(name='external_power_available', type='bool', doc='An external source (e.g. a charger) is available.'))
     remaining_energy_pct: int = dataclasses.field(default=0, metadata=_m.meta(name='remaining_energy_pct', type='uint7', unit='%', quantity='ratio', scale=0.01, offset=0.0, doc='Remaining energy.\nRequired'))
     remaining_energy_pct_stdev: int = dataclasses.field(default=0, metadata=_m.meta(name='remaining_energy_pct_stdev', type='uint7', unit='%', quantity='ratio', scale=0.01, offset=0.0, doc='Standard deviation of the estimate'))
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
