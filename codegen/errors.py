@@ -7,11 +7,16 @@ class BattgenError(Exception):
     """Base of every error battgen reports to a user (the CLI prints it without a traceback)."""
 
 
-class SchemaError(BattgenError):
-    """A malformed schema: names the file, the 1-based line and what was expected."""
+class LocatedError(BattgenError):
+    """A problem at a place in an input file: names the file, the 1-based line (0: the whole file)
+    and what was expected."""
 
     def __init__(self, file: str, line: int, message: str) -> None:
         super().__init__(f"{file}:{line}: {message}")
         self.file = file
         self.line = line
         self.message = message
+
+
+class SchemaError(LocatedError):
+    """A malformed schema."""

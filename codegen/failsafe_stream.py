@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .errors import BattgenError
+from .errors import BattgenError, LocatedError
 from .failsafe import BatteryReading, reading_of
 from .ir import Schema
 
@@ -46,10 +46,8 @@ ROLES: dict[str, dict[str, str]] = {
 _OPTIONAL = {"distance_to_home_m": float, "travelled_m": float, "home_set": bool, "position_fix": bool}
 
 
-class StreamError(BattgenError):
-    def __init__(self, file: str, line: int, message: str) -> None:
-        super().__init__(f"{file}:{line}: {message}")
-        self.file, self.line, self.message = file, line, message
+class StreamError(LocatedError):
+    """A malformed input file, located by file and line."""
 
 
 @dataclass(frozen=True)

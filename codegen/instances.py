@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING, TextIO
 
 import yaml
 
-from .errors import BattgenError
+from .errors import BattgenError, LocatedError
+from .frontends.common import read_text
 from .ir import Message, SourceFormat
 
 JSON_SUFFIXES = frozenset({".json"})
@@ -39,14 +40,8 @@ _DECODER = json.JSONDecoder()
 _PATH_TOKEN = re.compile(r"\[\d+\]|[^.\[]+")
 
 
-class InstanceError(BattgenError):
+class InstanceError(LocatedError):
     """A data file that cannot be read at all: names the file, the 1-based line and what was expected."""
-
-    def __init__(self, file: str, line: int, message: str) -> None:
-        super().__init__(f"{file}:{line}: {message}")
-        self.file = file
-        self.line = line
-        self.message = message
 
 
 @dataclass(frozen=True)
@@ -154,14 +149,7 @@ def _open_text(path: Path, name: str) -> TextIO:
 
 
 def _read_text(path: Path, name: str) -> str:
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise InstanceError(name, data[: exc.start].count(b"\n") + 1, "expected UTF-8 text") from None
+    return read_text(path, name, InstanceError)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -15,7 +15,7 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from .errors import BattgenError
+from .errors import BattgenError, LocatedError
 
 Value = int | float
 
@@ -35,14 +35,8 @@ QGC_SUFFIXES = (".params",)
 ARDUPILOT_SUFFIXES = (".param", ".parm")
 
 
-class ParamFileError(BattgenError):
+class ParamFileError(LocatedError):
     """A malformed parameter file: names the file, the 1-based line and what was expected."""
-
-    def __init__(self, file: str, line: int, message: str) -> None:
-        super().__init__(f"{file}:{line}: {message}")
-        self.file = file
-        self.line = line
-        self.message = message
 
 
 @dataclass(frozen=True)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..errors import LocatedError, SchemaError
+
 
 def display_path(path: Path, root: Path | None) -> str:
     """The path recorded in IR locations: relative to the schema root when under it (so output
@@ -16,16 +18,14 @@ def display_path(path: Path, root: Path | None) -> str:
     return path.as_posix()
 
 
-def read_text(path: Path, display: str) -> str:
-    """Read a schema file as UTF-8, turning I/O and decoding failures into SchemaError."""
-    from ..errors import SchemaError
-
+def read_text(path: Path, display: str, error: type[LocatedError] = SchemaError) -> str:
+    """Read an input file as UTF-8, turning I/O and decoding failures into ``error`` (file and line)."""
     try:
         data = path.read_bytes()
     except OSError as exc:
-        raise SchemaError(display, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise error(display, 0, f"cannot read file: {exc.strerror or exc}") from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
-        raise SchemaError(display, line, "expected UTF-8 text") from None
+        raise error(display, line, "expected UTF-8 text") from None
