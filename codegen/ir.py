@@ -439,6 +439,32 @@ class MappingSet:
     mappings: tuple[Mapping, ...] = ()
 
 
+# --------------------------------------------------------------------------------------------
+# Cross-field rules (schemas/rules/*.yaml): what one message's fields must satisfy together
+
+
+@dataclass(frozen=True)
+class CrossFieldRule:
+    """A rule relating fields of a message that its schema cannot state.
+
+    Expressions are kept as written in the rule language (:mod:`codegen.rules_expr`); the frontend
+    has parsed every one and bound its names to each message in ``messages``. ``lines`` gives the
+    source line of each key (``assert``, ``where``, ``for``, ``path``, ``message``).
+    """
+
+    id: str
+    messages: tuple[str, ...]
+    severity: str  # "error" or "warning" (advice)
+    check: str  # the ``assert`` expression
+    location: Location
+    doc: str = ""
+    where: str | None = None
+    loops: tuple[str, ...] = ()  # ``for`` clauses, "name in expression"
+    path: str | None = None
+    message: str = ""
+    lines: tuple[tuple[str, int], ...] = ()
+
+
 @dataclass(frozen=True)
 class Schema:
     """Everything parsed from a set of sources: messages, and enums shared across messages."""
@@ -447,6 +473,7 @@ class Schema:
     enums: tuple[EnumDef, ...] = ()
     sources: tuple[str, ...] = field(default=())
     mappings: tuple[MappingSet, ...] = ()
+    rules: tuple[CrossFieldRule, ...] = ()
 
     def message(self, qualified_name: str) -> Message:
         for m in self.messages:
@@ -470,4 +497,5 @@ class Schema:
             enums=self.enums + other.enums,
             sources=self.sources + other.sources,
             mappings=self.mappings + other.mappings,
+            rules=self.rules + other.rules,
         )

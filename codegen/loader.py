@@ -7,6 +7,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from types import ModuleType
 
+from . import rules
 from .errors import BattgenError, SchemaError
 from .ir import EnumDef, Schema
 
@@ -21,6 +22,8 @@ FORMAT_FRONTENDS: dict[str, str] = {
 
 # converter mappings between the formats (schemas/mappings/*.yaml), parsed after the formats
 MAPPINGS_DIR = "mappings"
+# cross-field rules the validators compile (schemas/rules/*.yaml), also read after the formats
+RULES_DIR = "rules"
 
 EXTENSION_FORMATS: dict[str, str] = {
     ".msg": "uorb",
@@ -63,6 +66,9 @@ def load_schema_dir(root: Path) -> Schema:
         from .frontends import mappings
 
         schema = schema.merged(mappings.parse_dir(root / MAPPINGS_DIR, schema=schema))
+    if (root / RULES_DIR).is_dir():
+        schema = schema.merged(Schema(rules=rules.load_rules_dir(root / RULES_DIR)))
+        rules.check_rules(schema)  # after the formats: every rule must bind to the messages it names
     return schema
 
 
@@ -103,4 +109,5 @@ def _deduplicated(schema: Schema) -> Schema:
         enums=tuple(sorted(enums.values(), key=lambda e: e.name)),
         sources=tuple(dict.fromkeys(schema.sources)),
         mappings=schema.mappings,
+        rules=schema.rules,
     )

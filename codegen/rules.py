@@ -1,4 +1,5 @@
-"""Cross-field rules: declarative YAML files in ``schemas/rules/`` that the validators compile into
+"""Cross-field rules: declarative YAML files in ``schemas/rules/``, read into the IR
+(:class:`~codegen.ir.CrossFieldRule`, in ``Schema.rules``) and compiled by the validators into
 each generated ``validate()``.
 
 A rule file names the messages it applies to and lists rules; each rule has an ``assert``
@@ -15,10 +16,7 @@ too, since the field checks already report the cause.
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import json
-from collections.abc import Iterator
 from dataclasses import dataclass
 from functools import cache
 from importlib import resources
@@ -30,7 +28,7 @@ import yaml
 
 from .errors import SchemaError
 from .frontends.common import display_path, read_text
-from .ir import Location, Message
+from .ir import CrossFieldRule, Location, Message, Schema
 from .rules_expr import (
     Binary,
     BoolOp,
@@ -75,74 +73,45 @@ class Rule:
         return dict(self.lines).get(key, self.location.line)
 
 
-@dataclass(frozen=True)
-class RuleFile:
-    file: str
-    messages: tuple[str, ...]
-    rules: tuple[Rule, ...]
-
-
 # --------------------------------------------------------------------------------------------
-# Where rules come from
+# The rules of a schema
 
 
-def bundled_rules_dir() -> Path:
-    """``schemas/rules`` of this checkout."""
-    return Path(__file__).resolve().parent.parent / "schemas" / "rules"
+def bound_rules(schema: Schema, msg: Message) -> list[BoundRule]:
+    """The schema's rules for ``msg``, parsed and bound to its fields (names it lacks are errors)."""
+    return [bind(parsed(rule), msg) for rule in rules_for(schema.rules, msg.qualified_name)]
 
 
-# (folder,) set by using(); None: the bundled rules
-_ACTIVE: contextvars.ContextVar[tuple[Path | None] | None] = contextvars.ContextVar("battgen_rules", default=None)
+def check_rules(schema: Schema) -> None:
+    """Every rule names loaded messages and binds to each; a message of a format that is not
+    loaded at all is allowed (a rules folder may serve a subset of the schemas)."""
+    loaded = {m.qualified_name: m for m in schema.messages}
+    formats = {name.split(".", 1)[0] for name in loaded}
+    for rule in schema.rules:
+        for name in rule.messages:
+            if name in loaded:
+                bind(parsed(rule), loaded[name])
+            elif name.split(".", 1)[0] in formats:
+                raise SchemaError(
+                    rule.location.file,
+                    rule.location.line,
+                    f"rule {rule.id!r} names {name}, which is not defined; expected a loaded message",
+                )
+    for name in loaded:
+        rules_for(schema.rules, name)  # unique ids per message
 
 
-@contextlib.contextmanager
-def using(rules_dir: Path | None) -> Iterator[None]:
-    """Generate with the rules below ``rules_dir`` (None: no rules at all) instead of the bundled ones."""
-    token = _ACTIVE.set((rules_dir,))
-    try:
-        yield
-    finally:
-        _ACTIVE.reset(token)
-
-
-def active_rules() -> tuple[RuleFile, ...]:
-    """The rule files in effect: those chosen with :func:`using`, else the bundled ones."""
-    chosen = _ACTIVE.get()
-    folder = bundled_rules_dir() if chosen is None else chosen[0]
-    return load_rules_dir(folder) if folder is not None and folder.is_dir() else ()
-
-
-def strict() -> bool:
-    """Whether a rule that does not fit its message is an error (rules chosen with :func:`using`)
-    or skipped (the bundled rules meeting another schema's message of the same name)."""
-    return _ACTIVE.get() is not None
-
-
-def bound_rules(files: tuple[RuleFile, ...], msg: Message) -> list[BoundRule]:
-    """The rules of ``msg`` bound to it; see :func:`strict` for rules naming what it lacks."""
-    out = []
-    for rule in rules_for(files, msg.qualified_name):
-        try:
-            out.append(bind(rule, msg))
-        except SchemaError:
-            if strict():
-                raise
-    return out
-
-
-def load_rules_dir(root: Path) -> tuple[RuleFile, ...]:
+def load_rules_dir(root: Path) -> tuple[CrossFieldRule, ...]:
     """Every ``*.yaml`` / ``*.yml`` file below ``root``, in sorted path order."""
     paths = sorted(p for p in root.rglob("*") if p.suffix in (".yaml", ".yml") and p.is_file())
-    return tuple(load_rule_file(p, root=root) for p in paths)
+    return tuple(rule for p in paths for rule in load_rule_file(p, root=root))
 
 
-def rules_for(files: tuple[RuleFile, ...], qualified_name: str) -> tuple[Rule, ...]:
-    found: list[Rule] = []
+def rules_for(rules: tuple[CrossFieldRule, ...], qualified_name: str) -> tuple[CrossFieldRule, ...]:
+    found: list[CrossFieldRule] = []
     seen: dict[str, Location] = {}
-    for f in files:
-        if qualified_name not in f.messages:
-            continue
-        for r in f.rules:
+    for r in rules:
+        if qualified_name in r.messages:
             if r.id in seen:
                 raise SchemaError(
                     r.location.file,
@@ -188,7 +157,7 @@ def _plain(node: yaml.Node, path: tuple[object, ...], lines: dict[tuple[object, 
         raise SchemaError(file, node.start_mark.line + 1, f"unreadable value: {exc}") from None
 
 
-def load_rule_file(path: Path, *, root: Path | None = None) -> RuleFile:
+def load_rule_file(path: Path, *, root: Path | None = None) -> tuple[CrossFieldRule, ...]:
     display = display_path(path, root)
     text = read_text(path, display)
     try:
@@ -211,50 +180,77 @@ def load_rule_file(path: Path, *, root: Path | None = None) -> RuleFile:
         at = "/".join(str(p) for p in err.absolute_path) or "the file"
         raise SchemaError(display, lines.get(where, 1), f"{at}: {err.message} (see codegen/rules.schema.json)")
     assert isinstance(data, dict)
-    rules = tuple(_rule(item, i, lines, display) for i, item in enumerate(data["rules"]))
-    return RuleFile(display, tuple(data["messages"]), rules)
+    messages = tuple(data["messages"])
+    rules = tuple(_ir_rule(item, i, messages, lines, display) for i, item in enumerate(data["rules"]))
+    for rule in rules:
+        parsed(rule)  # every expression parses, or the error names its line now
+    return rules
 
 
-def _expr(text: str, key: tuple[object, ...], lines: dict[tuple[object, ...], int], file: str, what: str) -> Expr:
-    try:
-        return parse(text)
-    except ExprError as exc:
-        raise SchemaError(file, lines[key], f"{what} {text!r}: {exc.message} at column {exc.column}") from None
-
-
-def _rule(item: dict[str, Any], i: int, lines: dict[tuple[object, ...], int], file: str) -> Rule:
+def _ir_rule(
+    item: dict[str, Any], i: int, messages: tuple[str, ...], lines: dict[tuple[object, ...], int], file: str
+) -> CrossFieldRule:
     base: tuple[object, ...] = ("rules", i)
-    where = _expr(item["where"], (*base, "where"), lines, file, "in 'where'") if "where" in item else None
     raw_for = item.get("for", [])
-    loops = [raw_for] if isinstance(raw_for, str) else list(raw_for)
+    loops = (raw_for,) if isinstance(raw_for, str) else tuple(raw_for)
+    keyed = [(str(k), lines[(*base, k)]) for k in item if (*base, k) in lines]
+    if not isinstance(raw_for, str):
+        keyed += [(f"for[{j}]", lines[(*base, "for", j)]) for j in range(len(loops)) if (*base, "for", j) in lines]
+    return CrossFieldRule(
+        id=item["id"],
+        messages=messages,
+        severity=item.get("severity", "error"),
+        check=item["assert"],
+        location=Location(file, lines[base]),
+        doc=item.get("doc", ""),
+        where=item.get("where"),
+        loops=loops,
+        path=item.get("path"),
+        message=item["message"],
+        lines=tuple(keyed),
+    )
+
+
+@cache
+def parsed(rule: CrossFieldRule) -> Rule:
+    """The rule's expressions parsed (names still unresolved); errors name the key's line."""
+    lines = dict(rule.lines)
+    file = rule.location.file
+
+    def fail(key: str, what: str, text: str, exc: ExprError) -> SchemaError:
+        line = lines.get(key, lines.get(key.split("[")[0], rule.location.line))
+        return SchemaError(file, line, f"{what} {text!r}: {exc.message} at column {exc.column}")
+
+    def expr(text: str, key: str) -> Expr:
+        try:
+            return parse(text)
+        except ExprError as exc:
+            raise fail(key, f"in '{key}'", text, exc) from None
+
     bindings: list[tuple[str, Expr]] = []
-    for j, text in enumerate(loops):
-        key = (*base, "for") if isinstance(raw_for, str) else (*base, "for", j)
+    for j, text in enumerate(rule.loops):
         try:
             bindings.append(parse_binding(text))
         except ExprError as exc:
-            raise SchemaError(file, lines[key], f"in 'for' {text!r}: {exc.message} at column {exc.column}") from None
-    check = _expr(item["assert"], (*base, "assert"), lines, file, "in 'assert'")
-    path = _expr(item["path"], (*base, "path"), lines, file, "in 'path'") if "path" in item else None
+            raise fail(f"for[{j}]", "in 'for'", text, exc) from None
     try:
-        message = parse_template(item["message"])
+        message = parse_template(rule.message)
     except ExprError as exc:
         raise SchemaError(
-            file, lines[(*base, "message")], f"in 'message': {exc.message} at column {exc.column}"
+            file, lines.get("message", rule.location.line), f"in 'message': {exc.message} at column {exc.column}"
         ) from None
-    keyed = tuple((k, lines[(*base, k)]) for k in item if (*base, k) in lines)
     return Rule(
-        id=item["id"],
-        severity=item.get("severity", "error"),
-        doc=item.get("doc", ""),
-        where=where,
+        id=rule.id,
+        severity=rule.severity,
+        doc=rule.doc,
+        where=expr(rule.where, "where") if rule.where is not None else None,
         bindings=tuple(bindings),
-        check=check,
-        path=path,
+        check=expr(rule.check, "assert"),
+        path=expr(rule.path, "path") if rule.path is not None else None,
         message=message,
-        text=item["assert"],
-        location=Location(file, lines[base]),
-        lines=keyed,
+        text=rule.check,
+        location=rule.location,
+        lines=rule.lines,
     )
 
 

@@ -57,16 +57,15 @@ rules:
 
 
 def test_shipped_rules_load_and_bind() -> None:
-    files = rules.load_rules_dir(ROOT / "schemas" / "rules")
     schema = load([ROOT / "schemas"])
+    assert schema.rules, "the bundled schema folder's rules/ reaches the IR"
     names = {m.qualified_name for m in schema.messages}
     ids = []
-    for f in files:
-        assert set(f.messages) <= names, f.file
-        for qn in f.messages:
-            for r in rules.rules_for(files, qn):
-                rules.bind(r, schema.message(qn))
-                ids.append(r.id)
+    for rule in schema.rules:
+        assert set(rule.messages) <= names, rule.location
+        for qn in rule.messages:
+            rules.bind(rules.parsed(rule), schema.message(qn))
+        ids.append(rule.id)
     for expected in (
         "voltage-design-order",
         "ocv-capacity-percent",
@@ -78,7 +77,7 @@ def test_shipped_rules_load_and_bind() -> None:
         "cells-beyond-count-zero",
     ):
         assert expected in ids
-    advice = [r for f in files for r in f.rules if r.id == "design-max-below-charge-voltage"]
+    advice = [r for r in schema.rules if r.id == "design-max-below-charge-voltage"]
     assert advice[0].severity == "warning"
 
 
@@ -164,14 +163,14 @@ def _tiny(fields: tuple[Field, ...] = ()) -> Message:
     [
         (('"a < b"', '"a < zz"'), 4, "'zz' (column 5 of 'assert') is not a field, constant or loop variable of uorb.T"),
         (('"a < b"', '"is_known(a + 1)"'), 4, "is_known() takes a field name"),
-        (('    message:', '    path: "a + 1"\n    message:'), 5, "expected 'path' to name a field or loop variable"),
-        (('    message:', '    for: "a in range(3)"\n    message:'), 5, "loop variable 'a' hides a field"),
+        (("    message:", '    path: "a + 1"\n    message:'), 5, "expected 'path' to name a field or loop variable"),
+        (("    message:", '    for: "a in range(3)"\n    message:'), 5, "loop variable 'a' hides a field"),
     ],
 )
 def test_binding_errors_name_the_line(tmp_path: Path, change: tuple[str, str], line: int, expected: str) -> None:
     f = rules.load_rule_file(_write(tmp_path, GOOD.replace(*change)), root=tmp_path)
     with pytest.raises(SchemaError) as info:
-        rules.bind(f.rules[0], _tiny())
+        rules.bind(rules.parsed(f[0]), _tiny())
     assert info.value.file == "r.yaml" and info.value.line == line, str(info.value)
     assert expected in str(info.value)
 
@@ -179,9 +178,9 @@ def test_binding_errors_name_the_line(tmp_path: Path, change: tuple[str, str], l
 def test_duplicate_rule_ids_are_rejected(tmp_path: Path) -> None:
     _write(tmp_path, GOOD, "one.yaml")
     _write(tmp_path, GOOD, "two.yaml")
-    files = rules.load_rules_dir(tmp_path)
+    found = rules.load_rules_dir(tmp_path)
     with pytest.raises(SchemaError, match=r"rule id 'a-below-b' of uorb\.T is used twice") as info:
-        rules.rules_for(files, "uorb.T")
+        rules.rules_for(found, "uorb.T")
     assert info.value.file == "two.yaml" and info.value.line == 3
 
 
@@ -215,8 +214,7 @@ def _generated(tmp_path: Path, import_generated: Any, text: str = RULES) -> Any:
     folder = tmp_path / "rules"
     folder.mkdir()
     _write(folder, text)
-    with rules.using(folder):
-        module = import_generated(Schema(messages=(_tiny(),)), "uorb")
+    module = import_generated(Schema(messages=(_tiny(),), rules=rules.load_rules_dir(folder)), "uorb")
     return module.T
 
 
@@ -258,6 +256,28 @@ def test_a_rule_that_cannot_be_evaluated_is_skipped(tmp_path: Path, import_gener
 
 
 def test_no_rules(tmp_path: Path, import_generated: Any) -> None:
-    with rules.using(None):
-        module = import_generated(Schema(messages=(_tiny(),)), "uorb")
+    module = import_generated(Schema(messages=(_tiny(),)), "uorb")
     assert module.T(a=3.0, b=2.0).validate() == []
+
+
+def test_rules_naming_an_undefined_message_of_a_loaded_format_are_rejected(tmp_path: Path) -> None:
+    from codegen.loader import load as load_folder
+
+    (tmp_path / "uorb").mkdir()
+    (tmp_path / "uorb" / "T.msg").write_text("uint64 timestamp\nfloat32 a\nfloat32 b\n", encoding="utf-8")
+    (tmp_path / "rules").mkdir()
+    _write(tmp_path / "rules", GOOD.replace("uorb.T", "uorb.Missing"))
+    with pytest.raises(SchemaError, match=r"names uorb\.Missing, which is not defined") as info:
+        load_folder([tmp_path])
+    assert info.value.file == "r.yaml"
+
+
+def test_rules_travel_with_the_schema_folder(tmp_path: Path) -> None:
+    from codegen.loader import load as load_folder
+
+    (tmp_path / "uorb").mkdir()
+    (tmp_path / "uorb" / "T.msg").write_text("uint64 timestamp\nfloat32 a\nfloat32 b\n", encoding="utf-8")
+    assert load_folder([tmp_path]).rules == ()  # no rules/ folder: no rules, bundled or otherwise
+    (tmp_path / "rules").mkdir()
+    _write(tmp_path / "rules", GOOD)
+    assert [r.id for r in load_folder([tmp_path]).rules] == ["a-below-b"]

@@ -40,7 +40,7 @@ from ..ir import (
     Sentinel,
     StringType,
 )
-from ..rules import active_rules, bound_rules
+from ..rules import bound_rules
 
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
 NAN_STRINGS = ["NaN", "nan"]
@@ -64,7 +64,7 @@ def message_json_schema(schema: Schema, msg: Message) -> dict[str, Any]:
         "title": msg.qualified_name,
     }
     out.update(body)
-    rules = bound_rules(active_rules(), msg)
+    rules = bound_rules(schema, msg)
     if rules:
         out["$comment"] = "Cross-field rules checked by the generated validate() but not expressed here: " + "; ".join(
             f"{b.rule.id} ({b.rule.text})" for b in rules

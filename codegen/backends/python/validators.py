@@ -1,7 +1,7 @@
 """The validators extension: ``validate()``, ``check()`` and ``is_known()`` on every generated class.
 
 ``validate()`` is straight-line code specialised to the message: one cheap test per field (see
-:mod:`.validators_checks`), then the cross-field rules of ``schemas/rules/`` compiled by
+:mod:`.validators_checks`), then the schema's cross-field rules (``Schema.rules``, from ``schemas/rules/``) compiled by
 :mod:`.validators_rules`. Violation types and the careful diagnosis live in the generated runtime
 module ``_validate.py``.
 """
@@ -25,19 +25,13 @@ def _block(lines: list[str], depth: int) -> list[str]:
 
 
 class _Validators:
-    def __init__(self) -> None:
-        self._rules: tuple[rule_files.RuleFile, ...] | None = None
-
     def runtime_files(self, schema: Schema, header: str) -> dict[str, str]:
-        # rules are read once per package: render_package asks for runtime files before any class
-        self._rules = rule_files.active_rules()
         from . import environment
 
         text = environment().get_template("_validate.py.j2").render(header=header)
         return {"_validate.py": text}
 
     def contribute(self, msg: Message, ctx: ModuleContext, view: ClassView) -> Contribution:
-        files = self._rules if self._rules is not None else rule_files.active_rules()
         idents = {fv.source_name: fv.ident for fv in view.fields}
         specs: list[str] = []
         checks: list[str] = []
@@ -50,7 +44,7 @@ class _Validators:
             specs.append(f"{spec_name} = {code.spec_source}")
             checks += code.lines
         local_names: set[str] = set()
-        for bound in rule_files.bound_rules(files, msg):
+        for bound in rule_files.bound_rules(ctx.schema, msg):
             lines, names = rule_lines(bound, msg, idents)
             checks += lines
             local_names |= names
