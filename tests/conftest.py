@@ -3,17 +3,25 @@
 from __future__ import annotations
 
 import importlib
+import os
 import sys
 from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 from codegen.generate import generate
 from codegen.ir import Schema
 
 ROOT = Path(__file__).resolve().parent.parent
+
+# Property tests run on shared 2-core machines: no per-example deadline, and in CI the same
+# examples every run (a red CI must be reproducible); locally they stay random to find new cases.
+settings.register_profile("battgen", deadline=None, suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("battgen-ci", parent=settings.get_profile("battgen"), derandomize=True, database=None)
+settings.load_profile("battgen-ci" if os.environ.get("CI") else "battgen")
 
 
 @pytest.fixture
