@@ -1,4 +1,5 @@
-"""Reading data files into records for ``battgen validate``: JSON, YAML, JSON Lines, devicetree.
+"""Reading data files into records for ``battgen validate``: JSON, YAML, JSON Lines, devicetree,
+parameter files (.param/.parm/.params), PX4 ULog (.ulg) and MAVLink logs (.tlog, raw .mav streams).
 
 Each record keeps the line it starts on and, on demand, the line of any field path inside it,
 so a violation can be reported as ``file:line: message``. JSON Lines and YAML streams are read
@@ -6,6 +7,8 @@ one record at a time (constant memory); a JSON document is read whole, but its r
 found with ``raw_decode`` positions and field lines are only worked out for records that need them.
 NaN and infinities: JSON's bare ``NaN``/``Infinity``/``-Infinity`` tokens and the strings
 ``"NaN"``/``"Infinity"``/``"-Infinity"`` are both accepted (the generated ``from_dict`` reads the strings).
+The binary logs and parameter files are read by the ``instances_*`` modules; their records carry a
+decoded instance, a ``location`` (timestamp, multi_id, offset, ...) and the fields not to check.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ import re
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 import yaml
 
@@ -29,7 +32,27 @@ JSONL_SUFFIXES = frozenset({".jsonl", ".ndjson"})
 YAML_SUFFIXES = frozenset({".yaml", ".yml"})
 DTS_SUFFIXES = frozenset({".dts", ".dtsi"})
 DTB_SUFFIXES = frozenset({".dtb"})
+PARAM_SUFFIXES = frozenset({".param", ".parm", ".params"})
+ULOG_SUFFIXES = frozenset({".ulg"})
+TLOG_SUFFIXES = frozenset({".tlog"})
+MAVLINK_SUFFIXES = frozenset({".mav"})  # not .bin: that is ArduPilot's DataFlash log
 KNOWN_SUFFIXES = JSON_SUFFIXES | JSONL_SUFFIXES | YAML_SUFFIXES | DTS_SUFFIXES | DTB_SUFFIXES
+KNOWN_SUFFIXES |= PARAM_SUFFIXES | ULOG_SUFFIXES | TLOG_SUFFIXES | MAVLINK_SUFFIXES
+_KINDS = (
+    ("json", JSON_SUFFIXES),
+    ("jsonl", JSONL_SUFFIXES),
+    ("yaml", YAML_SUFFIXES),
+    ("dts", DTS_SUFFIXES),
+    ("dtb", DTB_SUFFIXES),
+    ("param", PARAM_SUFFIXES),
+    ("ulog", ULOG_SUFFIXES),
+    ("tlog", TLOG_SUFFIXES),
+    ("mavlink", MAVLINK_SUFFIXES),
+)
+KINDS = tuple(kind for kind, _ in _KINDS)
+# the source format a file kind implies (for a default --message); the text formats imply none
+KIND_FORMATS = {"dts": "devicetree", "dtb": "devicetree", "param": "params", "ulog": "uorb"}
+KIND_FORMATS |= {"tlog": "mavlink", "mavlink": "mavlink"}
 
 if TYPE_CHECKING:
     from . import dts
@@ -54,6 +77,9 @@ class Record:
     file: str  # the file to report (a devicetree node may come from an included file)
     where: str = ""  # extra location words, e.g. a devicetree node path
     locate: Callable[[str], int | None] | None = field(default=None, compare=False)
+    instance: Any = field(default=None, compare=False)  # already decoded (binary logs): no from_dict
+    skip: frozenset[str] = frozenset()  # fields the source lacks: their checks are not reported
+    location: Mapping[str, object] | None = None  # machine-readable where: timestamp, multi_id, offset...
 
     def line_of(self, path: str) -> int:
         """The line of a field path (``voltage_cell_v[3]``, ``timestamp.usec``), else the record's."""
@@ -73,29 +99,48 @@ class Unreadable:
     message: str
 
 
-Item = Record | Unreadable
+@dataclass(frozen=True)
+class Notice:
+    """Something to know about a whole input, not a violation of a record: how a log's format
+    differs from the schema, fields left unchecked, damage skipped in a stream. ``warning``
+    notices are printed; ``info`` ones only go into the JSON report."""
+
+    file: str
+    message: str
+    kind: str  # "format-diff", "unchecked", "stream", "damage", "empty"
+    severity: str = "warning"
+    data: Mapping[str, object] | None = None
+
+
+Item = Record | Unreadable | Notice
 
 
 def file_kind(path: Path) -> str:
-    """``json``, ``jsonl``, ``yaml``, ``dts`` or ``dtb`` from the file name's extension."""
+    """The data format (one of KINDS) from the file name's extension."""
     suffix = path.suffix.lower()
-    for kind, suffixes in (
-        ("json", JSON_SUFFIXES),
-        ("jsonl", JSONL_SUFFIXES),
-        ("yaml", YAML_SUFFIXES),
-        ("dts", DTS_SUFFIXES),
-        ("dtb", DTB_SUFFIXES),
-    ):
+    for kind, suffixes in _KINDS:
         if suffix in suffixes:
             return kind
     known = ", ".join(sorted(KNOWN_SUFFIXES))
-    raise InstanceError(path.as_posix(), 0, f"cannot tell the data format from the extension (expected one of {known})")
+    raise InstanceError(
+        path.as_posix(),
+        0,
+        f"cannot tell the data format from the extension (expected one of {known}, or give --input-format)",
+    )
 
 
-def read_records(path: Path, message: Message, display: str | None = None) -> Iterator[Item]:
-    """The records of one data file, in file order. Raises InstanceError when the file is unreadable."""
+def read_records(
+    path: Path, message: Message, display: str | None = None, *, model: Any = None, kind: str | None = None
+) -> Iterator[Item]:
+    """The records of one data file, in file order. Raises InstanceError (or another LocatedError)
+    when the file is unreadable. ``model`` is the generated class of ``message``: parameter files
+    and binary logs need it; ``kind`` overrides the format the extension implies."""
     name = display if display is not None else path.as_posix()
-    kind = file_kind(path)
+    kind = kind or file_kind(path)
+    if kind in ("param", "ulog", "tlog", "mavlink"):
+        if model is None:
+            raise InstanceError(name, 0, f"reading {kind} input needs the generated class of {message.qualified_name}")
+        return _read_binary_kind(path, name, message, model, kind)
     if kind in ("dts", "dtb"):
         if message.format is not SourceFormat.DEVICETREE:
             raise InstanceError(
@@ -110,6 +155,26 @@ def read_records(path: Path, message: Message, display: str | None = None) -> It
     if kind == "yaml":
         return _read_yaml(path, name)
     return _read_json(path, name)
+
+
+def _read_binary_kind(path: Path, name: str, message: Message, model: Any, kind: str) -> Iterator[Item]:
+    expected = {"param": SourceFormat.PARAMS, "ulog": SourceFormat.UORB}.get(kind, SourceFormat.MAVLINK)
+    if message.format is not expected:
+        what = {"param": "a parameter file holds parameters", "ulog": "a ULog file holds uORB topics"}.get(
+            kind, "a MAVLink log holds MAVLink messages"
+        )
+        raise InstanceError(name, 0, f"{what}, but {message.qualified_name} is a {message.format.value} message")
+    if kind == "param":
+        from .instances_params import read_params
+
+        return read_params(path, name, message, model)
+    if kind == "ulog":
+        from .instances_ulog import ulog_items
+
+        return ulog_items(path, name, message, model)
+    from .instances_mavlink import mavlink_items
+
+    return mavlink_items(path, name, message, model, timestamps=kind == "tlog")
 
 
 # ------------------------------------------------------------------------------------------------

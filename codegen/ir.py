@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 
@@ -108,12 +109,20 @@ class PrimitiveType:
 
 @dataclass(frozen=True)
 class ArrayType:
-    """A fixed (``dynamic=False``) or bounded-dynamic array; ``capacity`` None means unbounded."""
+    """A fixed (``dynamic=False``) or bounded-dynamic array; ``capacity`` None means unbounded.
+
+    ``columns[i]`` constrains element ``i`` only (JSON Schema's ``prefixItems``); elements past
+    the last column have only the field's constraints. A matrix whose rows are (OCV, percent)
+    puts its columns on the row type, the inner array. They live on the type rather than the
+    Field because a position is a property of one array level: the type says at which depth it
+    applies, and it travels with the type through every backend that walks element types.
+    """
 
     element: FieldType
     capacity: int | None
     dynamic: bool
     min_length: int = 0
+    columns: tuple[Column, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -145,6 +154,41 @@ class Range:
     maximum: int | float | None = None
     exclusive_minimum: bool = False
     exclusive_maximum: bool = False
+
+    def intersect(self, other: Range | None) -> Range:
+        """The values both ranges allow (the tighter bound on each side)."""
+        if other is None:
+            return self
+        lo, lo_x = _tighter(self.minimum, self.exclusive_minimum, other.minimum, other.exclusive_minimum, max)
+        hi, hi_x = _tighter(self.maximum, self.exclusive_maximum, other.maximum, other.exclusive_maximum, min)
+        return Range(lo, hi, lo_x, hi_x)
+
+
+def _tighter(
+    a: int | float | None, a_x: bool, b: int | float | None, b_x: bool, pick: Callable[..., int | float]
+) -> tuple[int | float | None, bool]:
+    if a is None:
+        return b, b_x
+    if b is None:
+        return a, a_x
+    if a == b:
+        return a, a_x or b_x
+    return (a, a_x) if pick(a, b) == a else (b, b_x)
+
+
+@dataclass(frozen=True)
+class Column:
+    """What one position of an array holds: element ``i`` of an ``ArrayType`` with ``columns``.
+
+    Its constraints add to the field's (both hold); ``range`` applies to every number element
+    ``i`` holds (the element itself, or each number of a row when the element is an array);
+    ``unit`` None means the field's unit.
+    """
+
+    doc: str = ""
+    unit: Unit | None = None
+    range: Range | None = None
+    location: Location | None = None
 
 
 @dataclass(frozen=True)

@@ -152,7 +152,10 @@ def test_stream_matches_a_float32_model_and_pymavlink_bytes(
     assert m.id == (battery_id - 1) % 256 and (m.battery_function, m.type, m.energy_consumed, m.mode) == (1, 1, -1, 0)
     assert m.current_consumed == (c_int(F32(discharged), np.int32) if connected else -1)
     assert m.current_battery == (c_int(F32(current) * F32(100.0), np.int16) if connected else -1)
-    assert m.battery_remaining == (c_int(np.round(F32(remaining) * F32(100.0)), np.int8) if connected else -1)
+    # PX4 uses C roundf (halves away from zero); numpy's round takes halves to even
+    percent = F32(remaining) * F32(100.0)
+    rounded = np.copysign(np.floor(np.abs(percent) + F32(0.5)), percent)
+    assert m.battery_remaining == (c_int(rounded, np.int8) if connected else -1)
     finite_t = connected and math.isfinite(time_remaining)
     assert m.time_remaining == (max(c_int(F32(time_remaining), np.int32), 1) if finite_t else 0)
     assert m.charge_state == {0: 1, 1: 2, 2: 3, 3: 4, 4: 5, 6: 6, 7: 7}.get(warning, 0)
@@ -233,3 +236,10 @@ def test_px4_chains_through_battery_status_like_a_vehicle() -> None:
     )
     m = MavBatteryStatus(voltages=[12600] + [65535] * 9, battery_remaining=50)
     assert mavlink_to_dronecan(m, policy="px4") == uorb_to_dronecan(mavlink_to_uorb(m, policy="px4"), policy="px4")
+
+
+@pytest.mark.parametrize(("remaining", "percent"), [(0.125, 13), (0.005, 1), (0.995, 100), (0.0, 0)])
+def test_remaining_rounds_halves_away_from_zero_as_roundf(remaining: float, percent: int) -> None:
+    # battery_remaining = roundf(remaining * 100.f): 12.5 -> 13, where round-half-even would give 12
+    status = BatteryStatus(connected=True, remaining=remaining)
+    assert uorb_to_mavlink(status, policy="px4").battery_remaining == percent

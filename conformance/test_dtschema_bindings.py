@@ -3,7 +3,9 @@
 (a) dtschema's meta-schema check accepts the battery binding we ship;
 (b) every binding shipped inside the dtschema package parses, and each property type we resolve
     is one dtschema's own type extraction (DTValidator.property_get_type) gives it;
-(c) each battery.yaml property has dtschema's type, and matrices have dtschema's dimensions.
+(c) each battery.yaml property has dtschema's type, and matrices have dtschema's dimensions;
+(d) per-position bounds (``items`` lists, the IR's ArrayType.columns) allow exactly the values
+    dtschema's processed schema allows at every position, in battery.yaml and the whole corpus.
 
 dtschema widens every string to string-array when it collects types, so "string" and
 "non-unique-string-array" compare as "string-array".
@@ -11,6 +13,7 @@ dtschema widens every string to string-array when it collects types, so "string"
 
 from __future__ import annotations
 
+import itertools
 import subprocess
 import sys
 from pathlib import Path
@@ -20,7 +23,7 @@ import pytest
 
 from codegen.frontends import devicetree as dt
 from codegen.frontends.devicetree_yaml import load
-from codegen.ir import ArrayType, Field, Schema
+from codegen.ir import ArrayType, Field, FieldType, Message, PrimitiveKind, PrimitiveType, Range, Schema
 
 dtschema = pytest.importorskip("dtschema")
 
@@ -151,3 +154,115 @@ def test_battery_matrix_dimensions_equal_dtschema(battery_validator: Any) -> Non
         assert _dims(f.type) == tuple(tuple(d) for d in theirs), f.name
         checked += 1
     assert checked == 3  # resistance-temp-table, volt-drop-thresh-microvolt, ^ocv-capacity-table-[0-9]+$
+
+
+# (d) ----------------------------------------------------------------------------------------
+
+
+def _positions(t: FieldType, limit: int = 3) -> list[tuple[int, ...]]:
+    """Index paths to the numbers of a value: up to ``limit`` per level, within the capacity."""
+    dims: list[range] = []
+    while isinstance(t, ArrayType):
+        dims.append(range(min(t.capacity, limit) if t.capacity is not None else limit))
+        t = t.element
+    return list(itertools.product(*dims)) if dims else []
+
+
+def _numeric(t: FieldType) -> bool:
+    while isinstance(t, ArrayType):
+        t = t.element
+    return isinstance(t, PrimitiveType) and t.kind in (PrimitiveKind.INT, PrimitiveKind.UINT)
+
+
+def _our_range(f: Field, path: tuple[int, ...]) -> Range | None:
+    t, rng = f.type, f.range
+    for i in path:
+        assert isinstance(t, ArrayType)
+        if i < len(t.columns) and t.columns[i].range is not None:
+            rng = t.columns[i].range.intersect(rng)
+        t = t.element
+    return rng
+
+
+def _their_leaf(node: Any, path: tuple[int, ...]) -> dict[str, Any]:
+    """The schema dtschema applies at ``path`` (items lists by position, an items mapping to all)."""
+    for i in path:
+        items = node.get("items") if isinstance(node, dict) else None
+        if isinstance(items, list):
+            node = items[i] if i < len(items) else {}
+        elif isinstance(items, dict):
+            node = items
+        else:
+            return {}
+    return node if isinstance(node, dict) else {}
+
+
+def _allows(leaf: dict[str, Any], v: float) -> bool:
+    """dtschema's numeric keywords at one position, applied to a number."""
+    checks = [
+        "minimum" not in leaf or v >= leaf["minimum"],
+        "maximum" not in leaf or v <= leaf["maximum"],
+        "exclusiveMinimum" not in leaf or v > leaf["exclusiveMinimum"],
+        "exclusiveMaximum" not in leaf or v < leaf["exclusiveMaximum"],
+        "const" not in leaf or v == leaf["const"],
+        "enum" not in leaf or v in leaf["enum"],
+    ]
+    return all(checks)
+
+
+def _in(r: Range | None, v: float) -> bool:
+    if r is None:
+        return True
+    low = r.minimum is None or (v > r.minimum if r.exclusive_minimum else v >= r.minimum)
+    return low and (r.maximum is None or (v < r.maximum if r.exclusive_maximum else v <= r.maximum))
+
+
+def _probes(leaf: dict[str, Any], r: Range | None) -> set[float]:
+    edges = [leaf.get(k) for k in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum", "const")]
+    edges += list(leaf.get("enum") or []) + ([r.minimum, r.maximum] if r is not None else [])
+    nums = [e for e in edges if isinstance(e, int | float) and not isinstance(e, bool)]
+    return {n + d for n in nums for d in (-1, 0, 1)} | {0}  # integer cells: integer probes
+
+
+def _position_mismatches(messages: tuple[Message, ...], validator: Any) -> tuple[int, list[Any]]:
+    """(bounded positions compared, disagreements) between our IR and dtschema's processed schemas."""
+    bounded, bad = 0, []
+    for m in messages:
+        info = m.devicetree
+        processed = validator.schemas.get(info.schema_id.rstrip("#")) if info is not None else None
+        if processed is None:
+            continue
+        for f in m.fields:
+            node = (processed.get("patternProperties" if f.pattern else "properties") or {}).get(f.name)
+            if not isinstance(node, dict) or not _numeric(f.type):
+                continue
+            for path in _positions(f.type):
+                leaf, ours = _their_leaf(node, path), _our_range(f, path)
+                enum = leaf.get("enum")
+                if isinstance(enum, list) and len(enum) != 1 + max(enum) - min(
+                    enum
+                ):  # not a Range: the IR keeps it as an annotation
+                    assert any(tag.endswith(".enum") for tag, _ in f.annotations), (m.qualified_name, f.name)
+                    continue
+                bounded += ours is not None
+                wrong = [v for v in sorted(_probes(leaf, ours)) if _allows(leaf, v) != _in(ours, v)]
+                if wrong:
+                    bad.append((m.qualified_name, f.name, path, ours, leaf, wrong))
+    return bounded, bad
+
+
+def test_battery_position_bounds_equal_dtschema(battery_validator: Any) -> None:
+    msg = dt.parse_file(BATTERY, root=SCHEMAS).message("devicetree.power.supply.battery")
+    bounded, bad = _position_mismatches((msg,), battery_validator)
+    assert bad == []
+    # the percent column of the OCV tables (3 rows probed) and volt-drop-thresh's one cell
+    assert bounded == 4
+    table = msg.field("^ocv-capacity-table-[0-9]+$").type
+    assert isinstance(table, ArrayType) and isinstance(table.element, ArrayType)
+    assert table.element.columns[1].range == Range(maximum=100)
+
+
+def test_corpus_position_bounds_equal_dtschema(corpus: Schema, core_validator: Any) -> None:
+    bounded, bad = _position_mismatches(corpus.messages, core_validator)
+    assert bad == []
+    assert bounded >= 12  # pci-device reg and interrupts cells, -us maxima...

@@ -2,6 +2,9 @@
 generated ``from_dict`` + ``validate()`` agree on random valid and invalid plain-JSON instances of
 every bundled message.
 
+Per-position constraints (ArrayType.columns, exported as prefixItems) are drawn on and beyond
+their bounds too, so the OCV tables' percent column is compared cell by cell.
+
 Out of the comparison, as documented in codegen/backends/jsonschema_export.py: cross-field rules
 (not exported) and warnings (never make an instance invalid). Instances are JSON data: NaN and the
 infinities appear as the strings the export documents; a bool is never written 1.0 and byte-array
@@ -12,6 +15,7 @@ from __future__ import annotations
 
 import importlib
 import math
+import re
 import string
 from pathlib import Path
 from typing import Any
@@ -21,10 +25,10 @@ import jsonschema
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from codegen.backends.jsonschema_export import FLOAT_MAX, export_all
+from codegen.backends.jsonschema_export import FLOAT_MAX, at_column, export_all
 from codegen.backends.python import naming
 from codegen.backends.python.validators_checks import enum_facts, folded
-from codegen.ir import CompositeType, Field, FieldType, Message, PrimitiveKind, PrimitiveType, Schema
+from codegen.ir import ArrayType, CompositeType, Field, FieldType, Message, PrimitiveKind, PrimitiveType, Schema
 from codegen.ir import StringType as StrT
 from codegen.loader import load
 
@@ -94,9 +98,41 @@ def _value(schema: Schema, f: Field, t: FieldType, depth: int = 0) -> st.SearchS
         sizes += [st.lists(fill, min_size=cap, max_size=cap), st.lists(fill, min_size=cap + 1, max_size=cap + 1)]
         if cap <= 16:
             sizes.append(st.lists(inner, min_size=max(cap - 1, 0), max_size=cap))
+    if t.columns:  # each position drawn around its own column's bounds, then maybe one more element
+        heads = _column_cells(schema, f, t, depth)
+        sizes += [heads, st.builds(lambda h, rest: [*h, *rest], heads, st.lists(inner, max_size=1))]
+    if isinstance(el, ArrayType) and el.columns:  # a table whose every row is drawn by its columns
+        sizes.append(st.lists(_column_cells(schema, f, el, depth + 1), min_size=1, max_size=3))
     if isinstance(el, PrimitiveType) and el.kind is PrimitiveKind.UINT and el.bits == 8:
         sizes.append(st.text(alphabet=string.printable, max_size=(cap or 8) + 2))
     return st.one_of(*sizes, JUNK)
+
+
+def _column_cells(schema: Schema, f: Field, t: ArrayType, depth: int) -> st.SearchStrategy[list[Any]]:
+    """One value per column, around that column's bounds; numbers only, so the row reaches validate()."""
+    cells = [_value(schema, at_column(f, c), t.element, depth + 1) for c in t.columns]
+    if isinstance(t.element, PrimitiveType):
+        cells = [c.filter(lambda v: isinstance(v, int | float) and not isinstance(v, bool)) for c in cells]
+    return st.tuples(*cells).map(list)
+
+
+SAMPLE_NAMES = ("ocv-capacity-table-0", "ocv-capacity-table-17", "volt-drop-3-microvolt")  # for pattern fields
+
+
+def _column_fields(schema: Schema, msg: Message) -> dict[str, st.SearchStrategy[Any]]:
+    """The fields with columns, each drawn position by position (tables row by row)."""
+    out: dict[str, st.SearchStrategy[Any]] = {}
+    for f in msg.fields:
+        t = f.type
+        if isinstance(t, ArrayType) and isinstance(t.element, ArrayType) and t.element.columns:
+            value = st.lists(_column_cells(schema, f, t.element, 1), min_size=1, max_size=3)
+        elif isinstance(t, ArrayType) and t.columns:
+            value = _column_cells(schema, f, t, 0)
+        else:
+            continue
+        for name in [n for n in SAMPLE_NAMES if _match(f.pattern, n)] if f.pattern else [f.name]:
+            out[name] = value
+    return out
 
 
 def _strategies(schema: Schema, msg: Message, depth: int) -> dict[str, st.SearchStrategy[Any]]:
@@ -105,7 +141,7 @@ def _strategies(schema: Schema, msg: Message, depth: int) -> dict[str, st.Search
         if f.is_padding:
             continue
         if f.pattern is not None:
-            for name in ("ocv-capacity-table-0", "ocv-capacity-table-17", "volt-drop-3-microvolt"):
+            for name in SAMPLE_NAMES:
                 if _match(f.pattern, name):
                     out[name] = _value(schema, f, f.type, depth)
             continue
@@ -114,8 +150,6 @@ def _strategies(schema: Schema, msg: Message, depth: int) -> dict[str, st.Search
 
 
 def _match(pattern: str, name: str) -> bool:
-    import re
-
     return re.search(pattern, name) is not None
 
 
@@ -153,9 +187,15 @@ def test_jsonschema_and_generated_validator_agree(name: str) -> None:
     base_data = {**model(msg)().to_dict(), **VALID_BASE.get(name, {})}
     assert validator.is_valid(base_data) and ours_valid(msg, base_data)[0]
 
+    columns = _column_paths(msg)
+    column_verdicts = 0  # instances both sides refused over a column's own bound
+
     def compare(data: dict[str, Any]) -> None:
+        nonlocal column_verdicts
         expected = validator.is_valid(data)
         got, detail = ours_valid(msg, data)
+        if not got and isinstance(detail, list) and any(_column_violation(v.path, columns) for v in detail):
+            column_verdicts += 1
         assert got == expected, (
             f"{name}: jsonschema says {'valid' if expected else 'invalid'}, the generated validator "
             f"says {'valid' if got else 'invalid'} for {data!r}: "
@@ -172,6 +212,56 @@ def test_jsonschema_and_generated_validator_agree(name: str) -> None:
     run()
     compare(base_data)
     assert outcomes[True] > 0 and outcomes[False] > 0, f"{name}: only one verdict drawn: {outcomes}"
+    if not columns:
+        return
+    fields = _column_fields(SCHEMA, msg)
+
+    @settings(max_examples=60, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
+    @given(st.fixed_dictionaries({}, optional=fields))
+    def around_columns(data: dict[str, Any]) -> None:
+        compare({**base_data, **data})
+
+    around_columns()
+    assert column_verdicts > 0, f"{name}: no instance broke a column bound ({columns})"
+
+
+def _column_paths(msg: Message) -> list[tuple[str, int]]:
+    """(field name or pattern, nesting depth) of every array level with a bounded column."""
+    out = []
+    for f in msg.fields:
+        t, depth = f.type, 0
+        while isinstance(t, ArrayType):
+            if any(c.range is not None for c in t.columns):
+                out.append((f.pattern or f.name, depth))
+            t, depth = t.element, depth + 1
+    return out
+
+
+def _column_violation(path: str, columns: list[tuple[str, int]]) -> bool:
+    """A range violation at a bounded column (``ocv-capacity-table-0[3][1]``)."""
+    name, _, rest = path.partition("[")
+    indexes = [int(i) for i in re.findall(r"\[(\d+)\]", "[" + rest)] if rest else []
+    return any(
+        (re.search(key, name) if key.startswith("^") else key == name) and len(indexes) == depth + 1
+        for key, depth in columns
+    )
+
+
+def test_column_bounds_agree() -> None:
+    """The OCV tables' percent column: 100 is fine, 101 is not, in both the export and validate()."""
+    battery = SCHEMA.message("devicetree.power.supply.battery")
+    v = jsonschema.Draft202012Validator(EXPORT[battery.qualified_name])
+    base = VALID_BASE[battery.qualified_name]
+    for cell, valid in ((100, True), (0, True), (101, False), (4294967295, False), (-1, False)):
+        data = {**base, "ocv-capacity-table-0": [[4200000, 100], [3700000, cell]]}
+        assert v.is_valid(data) is valid, cell
+        got, found = ours_valid(battery, data)
+        assert got is valid, (cell, found)
+        if not valid and cell == 101:
+            assert isinstance(found, list) and [x.path for x in found] == ["ocv-capacity-table-0[1][1]"]
+            assert found[0].message.endswith("battery capacity percent = 101 is above the maximum 100")
+    errors = list(v.iter_errors({**base, "ocv-capacity-table-3": [[4200000, 101]]}))
+    assert [list(e.absolute_path) for e in errors] == [["ocv-capacity-table-3", 0, 1]]
 
 
 def test_sentinels_and_nan_spelling_agree() -> None:

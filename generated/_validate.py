@@ -99,6 +99,7 @@ class Number:
     values: Mapping[int, str] | None = None  # value enum: allowed value -> member name
     mask: int | None = None  # bitmask: the bits that may be set
     bits: Mapping[int, str] | None = None  # bitmask: bit value -> member name (reserved ones too)
+    label: str = ""  # what the array position holds (a column's doc), named in messages
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -106,6 +107,7 @@ class Text:
     capacity: int | None = None  # in UTF-8 bytes
     choices: tuple[str, ...] = ()
     const: str | None = None
+    label: str = ""
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -115,6 +117,7 @@ class Array:
     fixed: bool
     min_length: int = 0
     byte: bool = False  # held as bytes
+    columns: tuple[Spec | None, ...] = ()  # element i's own spec (None: the element's)
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -178,8 +181,13 @@ def _names(members: Mapping[int, str], limit: int = 12) -> str:
     return ", ".join(items)
 
 
-def _type_violation(path: str, value: object, expected: str) -> Violation:
-    return Violation(path, "type", value, expected, f"{path} = {fmt(value)} is not {expected}")
+def _type_violation(path: str, value: object, expected: str, label: str = "") -> Violation:
+    return Violation(path, "type", value, expected, f"{_who(path, label)} = {fmt(value)} is not {expected}")
+
+
+def _who(path: str, label: str) -> str:
+    """How a message names the value: its path, and what its array position holds."""
+    return f"{path}: {label}" if label else path
 
 
 # ---------------------------------------------------------------------------------------------
@@ -224,58 +232,59 @@ def number(path: str, value: object, spec: Number) -> Violation | None:
     if is_sentinel(value, spec):
         return None
     unit = spec.unit
+    who = _who(path, spec.label)
     kind = spec.kind
     if kind == "bool":
         if isinstance(value, bool) or (isinstance(value, int) and value in (0, 1)):
             return None
         if isinstance(value, int | float):
-            return Violation(path, "type-bounds", value, (0, 1), f"{path} = {fmt(value)} is not a bool (0 or 1)")
-        return _type_violation(path, value, "a bool")
+            return Violation(path, "type-bounds", value, (0, 1), f"{who} = {fmt(value)} is not a bool (0 or 1)")
+        return _type_violation(path, value, "a bool", spec.label)
     if kind == "char":
         if isinstance(value, str) and len(value) <= 1 and (not value or ord(value) < 256):
             return None
-        return _type_violation(path, value, "a single 8-bit character")
+        return _type_violation(path, value, "a single 8-bit character", spec.label)
     if kind == "float":
         if not isinstance(value, int | float):
-            return _type_violation(path, value, f"a number ({spec.type})")
+            return _type_violation(path, value, f"a number ({spec.type})", spec.label)
         if isinstance(value, float) and math.isnan(value):
             return Violation(
                 path, "nan", value, spec.sentinel_text or None,
-                f"{path} is NaN, which is not allowed here"
+                f"{who} is NaN, which is not allowed here"
                 + (f" (its 'unknown' value is {spec.sentinel_text})" if spec.sentinel_text else ""),
             )
     elif isinstance(value, float):
         if not value.is_integer():
-            return _type_violation(path, value, f"an integer ({spec.type})")
+            return _type_violation(path, value, f"an integer ({spec.type})", spec.label)
     elif not isinstance(value, int):
-        return _type_violation(path, value, f"an integer ({spec.type})")
+        return _type_violation(path, value, f"an integer ({spec.type})", spec.label)
     assert isinstance(value, int | float)
     if not spec.low <= value <= spec.high:
         if kind == "float":
             if math.isinf(value):
-                text = f"{path} = {fmt(value)} is not a finite number"
+                text = f"{who} = {fmt(value)} is not a finite number"
             else:
                 text = (
-                    f"{path} = {_with_unit(value, unit)} is beyond the {spec.type} limit "
+                    f"{who} = {_with_unit(value, unit)} is beyond the {spec.type} limit "
                     f"±{_with_unit(spec.high, unit)} (it would saturate)"
                 )
         else:
             text = (
-                f"{path} = {_with_unit(value, unit)} does not fit {spec.type} "
+                f"{who} = {_with_unit(value, unit)} does not fit {spec.type} "
                 f"({fmt(spec.low)}..{fmt(spec.high)})"
             )
         return Violation(path, "type-bounds", value, (spec.low, spec.high), text)
     low, high = spec.minimum, spec.maximum
     if low is not None and (value <= low if spec.exclusive_minimum else value < low):
         word = "at or below the exclusive minimum" if spec.exclusive_minimum else "below the minimum"
-        return Violation(path, "range", value, low, f"{path} = {_with_unit(value, unit)} is {word} {_with_unit(low, unit)}")
+        return Violation(path, "range", value, low, f"{who} = {_with_unit(value, unit)} is {word} {_with_unit(low, unit)}")
     if high is not None and (value >= high if spec.exclusive_maximum else value > high):
         word = "at or above the exclusive maximum" if spec.exclusive_maximum else "above the maximum"
-        return Violation(path, "range", value, high, f"{path} = {_with_unit(value, unit)} is {word} {_with_unit(high, unit)}")
+        return Violation(path, "range", value, high, f"{who} = {_with_unit(value, unit)} is {word} {_with_unit(high, unit)}")
     if spec.values is not None and value not in spec.values:
         return Violation(
             path, "enum", value, tuple(sorted(spec.values)),
-            f"{path} = {fmt(value)} is not one of {_names(spec.values)}",
+            f"{who} = {fmt(value)} is not one of {_names(spec.values)}",
         )
     if spec.mask is not None:
         extra = int(value) & ~spec.mask
@@ -284,38 +293,39 @@ def number(path: str, value: object, spec: Number) -> Violation | None:
             what = f" ({', '.join(named)})" if named else ""
             return Violation(
                 path, "bitmask", value, spec.mask,
-                f"{path} = {int(value):#x} sets undefined or reserved bits {extra:#x}{what}; "
+                f"{who} = {int(value):#x} sets undefined or reserved bits {extra:#x}{what}; "
                 f"only {spec.mask:#x} may be set",
             )
     return None
 
 
 def text(path: str, value: object, spec: Text) -> Violation | None:
+    who = _who(path, spec.label)
     if not isinstance(value, str):
-        return _type_violation(path, value, "a string")
+        return _type_violation(path, value, "a string", spec.label)
     if spec.capacity is not None:
         try:
             size = len(value.encode("utf-8"))
         except UnicodeEncodeError:
-            return _type_violation(path, value, "valid UTF-8 text")
+            return _type_violation(path, value, "valid UTF-8 text", spec.label)
         if size > spec.capacity:
             return Violation(
                 path, "length", value, spec.capacity,
-                f"{path} is {size} bytes of UTF-8, more than its {spec.capacity}",
+                f"{who} is {size} bytes of UTF-8, more than its {spec.capacity}",
             )
     if spec.const is not None and value != spec.const:
-        return Violation(path, "enum", value, spec.const, f"{path} = {value!r} must be {spec.const!r}")
+        return Violation(path, "enum", value, spec.const, f"{who} = {value!r} must be {spec.const!r}")
     if spec.choices and value not in spec.choices:
         return Violation(
             path, "enum", value, spec.choices,
-            f"{path} = {value!r} is not one of " + ", ".join(repr(c) for c in spec.choices),
+            f"{who} = {value!r} is not one of " + ", ".join(repr(c) for c in spec.choices),
         )
     return None
 
 
 def _array(out: list[Violation], path: str, value: object, spec: Array) -> None:
     if spec.byte and isinstance(value, bytes | bytearray):
-        items: Sequence[object] = ()
+        items: Sequence[object] = value[: len(spec.columns)]  # any byte fits uint8: only columns may object
         n = len(value)
     elif isinstance(value, list | tuple):
         items = value
@@ -332,8 +342,10 @@ def _array(out: list[Violation], path: str, value: object, spec: Array) -> None:
         out.append(
             Violation(path, "length", n, spec.min_length, f"{path} has {n} items, fewer than {spec.min_length}")
         )
+    columns = spec.columns
     for i, item in enumerate(items):
-        diag(out, f"{path}[{i}]", item, spec.element)
+        column = columns[i] if i < len(columns) else None
+        diag(out, f"{path}[{i}]", item, spec.element if column is None else column)
 
 
 def _nested(out: list[Violation], path: str, value: object, spec: Nested) -> None:

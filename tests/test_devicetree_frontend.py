@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import textwrap
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -11,7 +12,17 @@ from codegen import units
 from codegen.errors import SchemaError
 from codegen.frontends import devicetree as dt
 from codegen.frontends.devicetree_data import PACKAGED, load_data
-from codegen.ir import ArrayType, CompositeType, Message, PrimitiveKind, PrimitiveType, Range, StringType
+from codegen.ir import (
+    ArrayType,
+    Column,
+    CompositeType,
+    Location,
+    Message,
+    PrimitiveKind,
+    PrimitiveType,
+    Range,
+    StringType,
+)
 
 SCHEMAS = Path(__file__).resolve().parent.parent / "schemas" / "devicetree"
 BATTERY = SCHEMAS / "power" / "supply" / "battery.yaml"
@@ -175,7 +186,12 @@ def test_battery_types(battery: Message) -> None:
     thresh = battery.field("volt-drop-thresh-microvolt")
     assert thresh.type == ArrayType(one, 1, False, 1) and thresh.range == Range(maximum=48000000)
     assert battery.field("precharge-current-microamp").type == ArrayType(u32, None, True, 1)
-    assert battery.field("alert-celsius").type == ArrayType(i32, 2, False, 2)
+    alert = battery.field("alert-celsius").type
+    assert isinstance(alert, ArrayType) and replace(alert, columns=()) == ArrayType(i32, 2, False, 2)
+    assert [c.doc for c in alert.columns] == [
+        "alert when battery temperature is lower than this value",
+        "alert when battery temperature is higher than this value",
+    ]
     chem = battery.field("device-chemistry")
     assert chem.type == StringType() and chem.choices[:2] == ("nickel-cadmium", "nickel-metal-hydride")
     assert len(chem.choices) == 6 and ("choice.lithium-ion" in dict(chem.annotations))
@@ -186,13 +202,104 @@ def test_battery_types(battery: Message) -> None:
 def test_battery_ocv_table_pattern_field(battery: Message) -> None:
     f = battery.field("^ocv-capacity-table-[0-9]+$")
     assert f.pattern == f.name and not f.required and f.location.line == 150
-    row = ArrayType(PrimitiveType(PrimitiveKind.UINT, 32), 2, dynamic=False, min_length=2)
-    assert f.type == ArrayType(row, 100, dynamic=True, min_length=1)
+    where = "power/supply/battery.yaml"
+    columns = (
+        Column("open circuit voltage (OCV) in microvolts", location=Location(where, 160)),
+        Column("battery capacity percent", range=Range(maximum=100), location=Location(where, 161)),
+    )
+    row = ArrayType(PrimitiveType(PrimitiveKind.UINT, 32), 2, dynamic=False, min_length=2, columns=columns)
+    assert f.type == ArrayType(row, 100, dynamic=True, min_length=1)  # the columns sit on the row type
     notes = dict(f.annotations)
-    assert notes["dt-type"] == "uint32-matrix" and notes["column[1].maximum"] == "100"
-    assert f.range is None  # only the percent column is bounded: kept as a column annotation
-    assert "[0] open circuit voltage (OCV) in microvolts" in f.doc
-    assert "[1] battery capacity percent" in f.doc
+    assert notes == {"dt-type": "uint32-matrix", "dt-type-source": "ref"}  # nothing left over
+    assert f.range is None  # only the percent column is bounded
+    assert "[1]" not in f.doc and f.doc.startswith("An array providing the open circuit voltage")
+
+
+def test_battery_columns_of_arrays(battery: Message) -> None:
+    t = battery.field("operating-range-celsius").type
+    assert isinstance(t, ArrayType) and [c.doc for c in t.columns] == [
+        "minimum temperature at which battery can operate",
+        "maximum temperature at which battery can operate",
+    ]
+    assert all(c.range is None and c.unit is None for c in t.columns)
+    table = battery.field("resistance-temp-table").type
+    assert isinstance(table, ArrayType) and isinstance(table.element, ArrayType) and table.columns == ()
+    assert [c.doc for c in table.element.columns] == [
+        "the temperature in degree Celsius",
+        "battery internal resistance percent",
+    ]
+
+
+def test_items_lists_become_columns_at_any_depth(tmp_path: Path) -> None:
+    msg = _parse(
+        tmp_path,
+        HEAD
+        + textwrap.dedent(
+            """        properties:
+          pair:
+            $ref: /schemas/types.yaml#/definitions/uint32-array
+            items:
+              - description: low
+                minimum: 2
+              - const: 7
+              - enum: [1, 2, 3]
+              - enum: [1, 5]
+              - {}
+          table:
+            $ref: /schemas/types.yaml#/definitions/int32-matrix
+            maxItems: 4
+            items:
+              items:
+                - description: a
+                  exclusiveMinimum: -5
+                  maximum: 5
+                - description: b
+          one-row:
+            $ref: /schemas/types.yaml#/definitions/uint32-matrix
+            items:
+              - description: the row
+                items:
+                  - minimum: 1
+                  - maximum: 9
+          two-rows:
+            $ref: /schemas/types.yaml#/definitions/uint32-matrix
+            items:
+              - items: [{maximum: 1}]
+              - items: [{maximum: 2}]
+          flat-microvolt:
+            items:
+              - description: min
+              - description: max
+                maximum: 5000000
+        """
+        ),
+    )
+    pair = msg.field("pair")
+    assert isinstance(pair.type, ArrayType)
+    assert [(c.doc, c.range) for c in pair.type.columns] == [
+        ("low", Range(minimum=2)),
+        ("", Range(7, 7)),
+        ("", Range(1, 3)),  # an enum without gaps is a range; one with gaps is not: kept as a note
+    ]  # the trailing positions say nothing the IR holds and are left out
+    assert pair.type.columns[0].location == Location("test/thing.yaml", 8)
+    assert dict(pair.annotations)["item[3].enum"] == "[1, 5]"
+    table = msg.field("table").type
+    assert isinstance(table, ArrayType) and isinstance(table.element, ArrayType)
+    assert [(c.doc, c.range) for c in table.element.columns] == [
+        ("a", Range(-5, 5, exclusive_minimum=True)),
+        ("b", None),
+    ]
+    one = msg.field("one-row").type
+    assert isinstance(one, ArrayType) and isinstance(one.element, ArrayType)
+    assert [c.doc for c in one.columns] == ["the row"] and (one.min_length, one.capacity) == (1, 1)
+    assert [c.range for c in one.element.columns] == [Range(minimum=1), Range(maximum=9)]
+    two = msg.field("two-rows")
+    assert isinstance(two.type, ArrayType) and isinstance(two.type.element, ArrayType)
+    assert two.type.element.columns == ()  # rows that differ cannot share one row type
+    assert dict(two.annotations)["row[1].column[0].maximum"] == "2"
+    flat = msg.field("flat-microvolt").type  # a -microvolt list written flat is one row
+    assert isinstance(flat, ArrayType) and isinstance(flat.element, ArrayType) and flat.columns == ()
+    assert [(c.doc, c.range) for c in flat.element.columns] == [("min", None), ("max", Range(maximum=5000000))]
 
 
 def test_battery_parse_is_deterministic(battery: Message) -> None:

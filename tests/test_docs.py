@@ -13,10 +13,23 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from codegen.backends.markdown_docs import INDEX, MARKER, cell, code, page_name, render_docs, render_message
+from codegen import units
+from codegen.backends.markdown_docs import (
+    INDEX,
+    MARKER,
+    cell,
+    code,
+    description,
+    page_name,
+    range_enum,
+    render_docs,
+    render_message,
+)
 from codegen.cli import main
 from codegen.frontends import uorb
 from codegen.ir import (
+    ArrayType,
+    Column,
     Constant,
     EnumDef,
     EnumEntry,
@@ -189,7 +202,23 @@ def test_devicetree_page_has_required_patterns_and_additional_properties(bundled
     rows = {r[0]: r for r in table(section(page, "## Fields"))}
     assert rows["compatible"][4].startswith("**Required.**")
     assert rows["voltage-min-design-microvolt"][1:3] == ["`int32-matrix`", "microvolt"]
-    assert rows["`^ocv-capacity-table-[0-9]+$`"][3] == "column[1]: [- : 100]"
+    ocv = rows["`^ocv-capacity-table-[0-9]+$`"]
+    assert ocv[3] == "[*][1]: [- : 100]"  # the percent column of every row, from the IR's columns
+    assert ocv[4].endswith(
+        "<br>`[*][0]`: open circuit voltage (OCV) in microvolts <br>`[*][1]`: battery capacity percent"
+    )
+    span = rows["operating-range-celsius"]
+    assert span[3] == "" and "<br>`[1]`: maximum temperature at which battery can operate" in span[4]
+
+
+def test_column_bounds_and_units_in_cells() -> None:
+    loc = Location("t.msg", 1)
+    mv = units.lookup("mV")
+    cols = (Column("lo | first", range=Range(0, 5, exclusive_minimum=True), unit=mv), Column(), Column("third"))
+    t = ArrayType(PrimitiveType(PrimitiveKind.UINT, 16), 4, False, columns=cols)
+    f = Field("v", t, loc, range=Range(maximum=9))
+    assert range_enum(f) == "[- : 9] [0]: (0 : 5] mV"  # each column on top of the field range
+    assert description(f) == "<br>`[0]`: lo \\| first <br>`[2]`: third"
 
 
 # -- escaping ---------------------------------------------------------------------------------------

@@ -18,6 +18,7 @@ from codegen.ir import (
     Message,
     PrimitiveKind,
     PrimitiveType,
+    Range,
     Schema,
     Sentinel,
     SourceFormat,
@@ -68,7 +69,6 @@ def test_shipped_rules_load_and_bind() -> None:
         ids.append(rule.id)
     for expected in (
         "voltage-design-order",
-        "ocv-capacity-percent",
         "ocv-table-descending",
         "ocv-table-count",
         "charge-voltage-below-over-voltage",
@@ -79,6 +79,11 @@ def test_shipped_rules_load_and_bind() -> None:
         assert expected in ids
     advice = [r for r in schema.rules if r.id == "design-max-below-charge-voltage"]
     assert advice[0].severity == "warning"
+    # the OCV percent limit is the binding's own (items: items: [.., {maximum: 100}]), so no rule restates it
+    assert "ocv-capacity-percent" not in ids
+    table = schema.message("devicetree.power.supply.battery").field("^ocv-capacity-table-[0-9]+$").type
+    assert isinstance(table, ArrayType) and isinstance(table.element, ArrayType)
+    assert table.element.columns[1].range == Range(maximum=100)
 
 
 # --------------------------------------------------------------------------------------------

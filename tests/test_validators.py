@@ -15,6 +15,7 @@ from hypothesis import given, settings
 
 from codegen.ir import (
     ArrayType,
+    Column,
     EnumDef,
     EnumEntry,
     EnumKind,
@@ -236,19 +237,47 @@ def test_devicetree_cross_field_rules() -> None:
     del data["ocv-capacity-table-2"]
     found = SimpleBattery.from_dict(data).validate()
     assert [(v.path, v.rule, v.severity) for v in found] == [
+        ("ocv-capacity-table-1[1][1]", "range", "error"),  # the binding's own column maximum, not a rule
         ("voltage-min-design-microvolt", "cross-field:voltage-design-order", "error"),
         ("constant-charge-voltage-max-microvolt", "cross-field:charge-voltage-below-over-voltage", "error"),
         ("voltage-max-design-microvolt", "cross-field:design-max-below-charge-voltage", "warning"),
-        ("ocv-capacity-table-1[1][1]", "cross-field:ocv-capacity-percent", "error"),
         ("ocv-capacity-table-1[1]", "cross-field:ocv-table-descending", "error"),
         ("ocv-capacity-celsius", "cross-field:ocv-table-count", "error"),
         ("ocv-capacity-celsius[2]", "cross-field:ocv-table-names", "error"),
     ]
-    assert found[0].message == (
+    assert found[1].message == (
         "voltage-min-design-microvolt = 4300000 uV must be below voltage-max-design-microvolt = 4200000 uV"
     )
     # advice alone does not fail check()
     SimpleBattery.from_dict({**EXAMPLE, "voltage-max-design-microvolt": [[4100000]]}).check()
+
+
+def test_devicetree_columns_name_what_the_position_holds() -> None:
+    table = [[4185000, 100], [4113000, 95], [4066000, 90], [4000000, 101]]
+    found = SimpleBattery.from_dict({**EXAMPLE, "ocv-capacity-table-0": table}).validate()
+    assert found == [
+        Violation(
+            "ocv-capacity-table-0[3][1]",
+            "range",
+            101,
+            100,
+            "ocv-capacity-table-0[3][1]: battery capacity percent = 101 is above the maximum 100",
+        )
+    ]
+    # the OCV column has no bound beyond uint32; a wrong type there is named by its column too
+    table[3] = [-1, 50]
+    node = SimpleBattery.from_dict(EXAMPLE)
+    node.ocv_capacity_table_n["ocv-capacity-table-0"] = table
+    (v,) = node.validate()
+    assert v.path == "ocv-capacity-table-0[3][0]" and v.rule == "type-bounds"
+    assert v.message.startswith(
+        "ocv-capacity-table-0[3][0]: open circuit voltage (OCV) in microvolts = -1 does not fit"
+    )
+    node = SimpleBattery.from_dict(EXAMPLE)
+    node.operating_range_celsius = [-30, 1 << 31]
+    (v,) = node.validate()
+    assert v.message.startswith("operating-range-celsius[1]: maximum temperature at which battery can operate = ")
+    assert SimpleBattery.from_dict({**EXAMPLE, "ocv-capacity-table-2": [[3000000, 100], [2900000, 0]]}).validate() == []
 
 
 # --------------------------------------------------------------------------------------------
@@ -284,16 +313,77 @@ def test_made_up_schema(import_generated: Any) -> None:
     assert _rules_of(X(m=[[1, 2, 3], [40000, 0]]).validate()) == [("m[0]", "length"), ("m[1][0]", "type-bounds")]
 
 
+def _with_columns() -> Schema:
+    u8 = PrimitiveType(PrimitiveKind.UINT, 8)
+    row = ArrayType(I16, 2, False, columns=(Column(), Column("pct", range=Range(maximum=100))))
+    pair = (Column("low", range=Range(-10, 10)), Column(), Column("third", range=Range(0, 5, True)))
+    cell = Sentinel(-99.0, "-99", per_element=True)
+    fields = (
+        # dynamic, nothing guarantees position 2 exists: the fast path guards it
+        Field("pair", ArrayType(I16, 4, True, columns=pair), LOC),
+        Field("head", ArrayType(u8, 4, False, columns=(Column("version", range=Range(1, 3)),)), LOC),
+        Field("rows", ArrayType(row, None, True), LOC),
+        # the column narrows the field's own range; the sentinel stays valid everywhere
+        Field(
+            "f",
+            ArrayType(F64, 3, False, columns=(Column("x", range=Range(0, 1)),)),
+            LOC,
+            range=Range(-5, 5),
+            invalid=cell,
+        ),
+    )
+    return Schema(messages=(Message("C", "uorb.C", SourceFormat.UORB, LOC, "", fields),))
+
+
+def test_columns_on_a_made_up_schema(import_generated: Any) -> None:
+    C = import_generated(_with_columns(), "uorb").C
+    ok = C(pair=[-10, 99, 5], head=b"\x03abc", rows=[[-5, 100], [7, 0]], f=[-99.0, -5.0, 5.0])
+    assert ok.validate() == []
+    found = C(pair=[11, 99, 0], head=b"\x00abc", rows=[[0, 0], [0, 101]], f=[1.5, 6.0, 0.0]).validate()
+    assert _rules_of(found) == [
+        ("pair[0]", "range"),
+        ("pair[2]", "range"),
+        ("head[0]", "range"),
+        ("rows[1][1]", "range"),
+        ("f[0]", "range"),
+        ("f[1]", "range"),
+    ]
+    assert found[1].message == "pair[2]: third = 0 is at or below the exclusive minimum 0"
+    assert found[2].message == "head[0]: version = 0 is below the minimum 1"
+    assert found[4].message == "f[0]: x = 1.5 is above the maximum 1"
+    assert found[5].message == "f[1] = 6 is above the maximum 5"
+    assert C(pair=[3], head=b"\x01abc", rows=[[]]).validate()[0].path == "rows[0]"  # length, not rows[0][1]
+    assert C(pair=[3], head=b"\x01abc").validate() == []  # a short dynamic array: its missing positions pass
+
+    module = importlib.import_module(C.__module__)
+    specs = {f.name: getattr(module, f"_VS_C_{f.name}") for f in dataclasses.fields(C)}
+    their_diag = module._v.diag  # the generated package's own runtime, not generated/_validate.py
+    cells = st.one_of(st.integers(-20, 120), st.sampled_from([0, 5, 6, 100, 101, -99.0, 1.5, 40000, "x", None]))
+
+    @settings(max_examples=300, deadline=None, database=None)
+    @given(
+        st.lists(cells, max_size=5),
+        st.binary(max_size=5) | st.lists(cells, max_size=5),
+        st.lists(st.lists(cells, max_size=3) | cells, max_size=3),
+        st.lists(cells | st.floats(-7, 7), max_size=4),
+    )
+    def run(pair: Any, head: Any, rows: Any, f: Any) -> None:
+        obj = C(pair=pair, head=head, rows=rows, f=f)
+        careful: list[Any] = []
+        for fl in dataclasses.fields(C):
+            their_diag(careful, fl.metadata["name"], getattr(obj, fl.name), specs[fl.name])
+        assert obj.validate() == careful
+
+    run()
+
+
 # --------------------------------------------------------------------------------------------
 # The fast path never passes what diag reports
 
 
 def _specs(cls: type) -> dict[str, Any]:
     module = importlib.import_module(cls.__module__)
-    return {
-        f.name: getattr(module, f"_VS_{cls.__name__}_{f.name}")
-        for f in dataclasses.fields(cls)
-    }
+    return {f.name: getattr(module, f"_VS_{cls.__name__}_{f.name}") for f in dataclasses.fields(cls)}
 
 
 VALUES = st.one_of(
@@ -326,5 +416,31 @@ def test_fast_path_agrees_with_diagnosis(cls: type) -> None:
             diag(careful, meta_name, getattr(obj, f.name), specs[f.name])
         fast = [v for v in obj.validate() if not v.rule.startswith("cross-field:")]
         assert fast == careful
+
+    run()
+
+
+def test_fast_path_agrees_on_devicetree_tables() -> None:
+    """OCV tables and two-cell ranges around their column bounds (the generic draw above leaves
+    devicetree lists unset)."""
+    specs = _specs(SimpleBattery)
+    cell = st.one_of(st.integers(-2, 102), st.sampled_from([4200000, 1 << 32, -(1 << 31) - 1, 100.0, 1.5, "x", None]))
+    row = st.lists(cell, min_size=1, max_size=3) | cell
+    tables = st.dictionaries(
+        st.sampled_from(["ocv-capacity-table-0", "ocv-capacity-table-12", "nope"]),
+        st.lists(row, max_size=4) | cell,
+        max_size=2,
+    )
+
+    @settings(max_examples=200, deadline=None, database=None)
+    @given(tables, st.none() | st.lists(cell, max_size=3), st.none() | st.lists(row, max_size=3))
+    def run(table: dict[str, Any], span: Any, resistance: Any) -> None:
+        obj = SimpleBattery.from_dict(EXAMPLE)
+        obj.ocv_capacity_table_n = table
+        obj.operating_range_celsius, obj.resistance_temp_table = span, resistance
+        careful: list[Violation] = []
+        for f in dataclasses.fields(SimpleBattery):
+            diag(careful, f.metadata["name"], getattr(obj, f.name), specs[f.name])
+        assert [v for v in obj.validate() if not v.rule.startswith("cross-field:")] == careful
 
     run()

@@ -19,16 +19,21 @@ Decisions (the conformance test ``conformance/test_jsonschema_agreement.py`` hol
   -- a byte array given as text is accepted only as ASCII (``maxLength`` counts characters); give
   other text as a list of byte values.
 - bool fields take ``true``/``false`` and the integers 0 and 1 (as the reader does).
+- Per-position constraints (``ArrayType.columns``: an OCV table row's percent column) are
+  ``prefixItems``, each entry the element's schema narrowed by its column (``items`` covers the
+  positions after them); a byte array with a bounded column is accepted only as a list.
 """
 
 from __future__ import annotations
 
 import math
 import sys
+from dataclasses import replace
 from typing import Any
 
 from ..ir import (
     ArrayType,
+    Column,
     CompositeType,
     EnumKind,
     Field,
@@ -145,6 +150,8 @@ def _type(schema: Schema, f: Field, t: FieldType, defs: dict[str, dict[str, Any]
         return {"$ref": f"#/$defs/{t.name}"}
     items = _type(schema, f, t.element, defs)
     node = {"type": "array", "items": items}
+    if t.columns:
+        node["prefixItems"] = [_column(schema, f, c, t.element, defs) for c in t.columns]
     if not t.dynamic and t.capacity is not None:
         node["minItems"] = node["maxItems"] = t.capacity
     else:
@@ -153,7 +160,8 @@ def _type(schema: Schema, f: Field, t: FieldType, defs: dict[str, dict[str, Any]
         if t.capacity is not None:
             node["maxItems"] = t.capacity
     el = t.element
-    if isinstance(el, PrimitiveType) and el.kind is PrimitiveKind.UINT and el.bits == 8:
+    bounded = any(c.range is not None for c in t.columns)
+    if isinstance(el, PrimitiveType) and el.kind is PrimitiveKind.UINT and el.bits == 8 and not bounded:
         text: dict[str, Any] = {"type": "string", "pattern": r"^[\x00-\x7f]*$"}
         if t.capacity is not None:
             text["maxLength"] = t.capacity
@@ -162,6 +170,20 @@ def _type(schema: Schema, f: Field, t: FieldType, defs: dict[str, dict[str, Any]
         elif t.min_length:
             text["minLength"] = t.min_length
         return {"anyOf": [node, text]}
+    return node
+
+
+def at_column(f: Field, c: Column) -> Field:
+    """The field as seen at one array position: its column's range on top of its own, its unit."""
+    return replace(f, range=c.range.intersect(f.range) if c.range is not None else f.range, unit=c.unit or f.unit)
+
+
+def _column(schema: Schema, f: Field, c: Column, element: FieldType, defs: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    node = _type(schema, at_column(f, c), element, defs)
+    if c.doc:
+        node = {"description": c.doc, **node} if "$ref" not in node else {"description": c.doc, "allOf": [node]}
+    if c.unit is not None:
+        node["x-unit"] = c.unit.symbol
     return node
 
 
@@ -289,7 +311,8 @@ def _default_ok(schema: Schema, f: Field, t: FieldType, *, top: bool = False) ->
         return t.min_length == 0
     if isinstance(t.element, PrimitiveType) and f.invalid is not None:
         return True  # filled with the sentinel
-    return _default_ok(schema, f, t.element)
+    columns = t.columns[: t.capacity]
+    return _default_ok(schema, f, t.element) and all(_default_ok(schema, at_column(f, c), t.element) for c in columns)
 
 
 def _leaf_ok(schema: Schema, f: Field, t: PrimitiveType, value: float) -> bool:

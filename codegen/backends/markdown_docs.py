@@ -4,7 +4,8 @@ A page holds the title ``# Name (FORMAT message)``, the message's doc, format fa
 DroneCAN data type id / signature / bit lengths, MAVLink id / CRC_EXTRA / extension fields,
 devicetree compatible / required / patternProperties / additionalProperties), a ``## Fields``
 table (Name | Type | Unit | Range/Enum | Description, the description ending in ``(Invalid: X)``
-for fields with an invalid sentinel), ``## Enums`` (a table per enum), ``## Constants`` (the
+for fields with an invalid sentinel; array columns show as ``[*][1]: [- : 100]`` in Range/Enum
+and ``[*][1]``: doc in Description), ``## Enums`` (a table per enum), ``## Constants`` (the
 constants that are not enum members) and ``## Source``. Output is a pure function of the IR.
 Every table cell goes through :func:`cell` or :func:`code`, so no schema text can break a table.
 """
@@ -18,6 +19,7 @@ from collections.abc import Sequence
 from ..ir import (
     ArrayType,
     CastMode,
+    Column,
     CompositeType,
     Constant,
     EnumDef,
@@ -164,15 +166,25 @@ def range_text(r: Range) -> str:
     return f"{'(' if r.exclusive_minimum else '['}{low} : {high}{')' if r.exclusive_maximum else ']'}"
 
 
+def columns(t: FieldType) -> list[tuple[str, Column]]:
+    """Every column of an array type with its position as an index path: ``[1]`` for element 1,
+    ``[*][1]`` for element 1 of every row of a matrix."""
+    out: list[tuple[str, Column]] = []
+    depth = 0
+    while isinstance(t, ArrayType):
+        out += [("[*]" * depth + f"[{i}]", c) for i, c in enumerate(t.columns)]
+        t, depth = t.element, depth + 1
+    return out
+
+
 def range_enum(f: Field) -> str:
     parts: list[str] = []
     if f.range is not None:
         parts.append(cell(range_text(f.range)))
-    for tag, text in f.annotations:  # element bounds of a table column (dt-schema items)
-        if tag.endswith(".minimum"):
-            parts.append(cell(f"{tag[: -len('.minimum')]}: [{text} : -]"))
-        elif tag.endswith(".maximum"):
-            parts.append(cell(f"{tag[: -len('.maximum')]}: [- : {text}]"))
+    for where, c in columns(f.type):  # per-position bounds (an OCV row's percent column)
+        if c.range is not None:
+            unit = f" {c.unit.symbol}" if c.unit is not None else ""
+            parts.append(cell(f"{where}: {range_text(c.range)}{unit}"))
     parts.append("".join(f"[{cell(name.rsplit('.', 1)[-1])}](#{anchor(name.rsplit('.', 1)[-1])})" for name in f.enums))
     if f.const is not None:
         parts.append("const " + code(str(f.const)))
@@ -194,6 +206,9 @@ def description(f: Field) -> str:
     choice_docs = [(tag[len("choice.") :], text) for tag, text in f.annotations if tag.startswith("choice.")]
     for choice, text in choice_docs:
         words.append(f"<br>{code(choice)}: {cell(text)}")
+    for where, c in columns(f.type):
+        if c.doc:
+            words.append(f"<br>{code(where)}: {cell(c.doc)}")
     if f.default is not None:
         words.append(f"(Default: {cell(number(f.default))})")
     if f.invalid is not None:

@@ -6,6 +6,13 @@ line, the payloads of a multi-message side separated by spaces; ``raw``: one pay
 decoded and encoded by the generated codecs. A record of a side with several messages
 (DroneCAN: BatteryInfo plus BatteryInfoAux) is keyed by alias (``{"info": {...}, "aux": {...}}``);
 a bare object is the first message. Errors name the input and record line; exit code 2.
+
+Logs convert every record they hold: PX4 flight logs (``ulog``, .ulg: every record of the source
+uORB message's topics, all multi_ids, in file order; a log format that differs from the schema is
+one warning on stderr, and fields the log lacks keep their defaults), MAVLink telemetry logs
+(``tlog``, .tlog) and raw MAVLink streams (``mavlink``, .mav): every frame of the source message,
+with bad CRCs and garbage skipped and summed up in one warning. ``--from``/``--to`` take a side
+name or a message name (``uorb.BatteryStatus``, ``mavlink.BATTERY_STATUS``).
 """
 
 from __future__ import annotations
@@ -23,8 +30,9 @@ from typing import IO, Any
 from ..errors import BattgenError
 
 FORMATS = ("json", "jsonl", "yaml", "hex", "raw")
+LOG_FORMATS = ("ulog", "tlog", "mavlink")  # input only
 _EXTENSIONS = {".json": "json", ".jsonl": "jsonl", ".ndjson": "jsonl", ".yaml": "yaml", ".yml": "yaml"}
-_EXTENSIONS |= {".hex": "hex", ".bin": "raw", ".raw": "raw"}
+_EXTENSIONS |= {".hex": "hex", ".bin": "raw", ".raw": "raw", ".ulg": "ulog", ".tlog": "tlog", ".mav": "mavlink"}
 
 
 def register(subparsers: Any) -> None:
@@ -35,9 +43,19 @@ def register(subparsers: Any) -> None:
     p.add_argument("--to", dest="target", required=True, help="target side, or 'concepts' for the shared state")
     p.add_argument("--policy", choices=("strict", "px4"), default="strict", help="strict (default) or px4")
     p.add_argument("--report", action="store_true", help="add each record's loss report (to stderr for binary output)")
+    p.add_argument(
+        "--report-summary",
+        action="store_true",
+        help="as --report, but the loss as a short text: one line per kind, fields grouped by message",
+    )
     p.add_argument("files", nargs="*", help="input files (default: standard input)")
     p.add_argument("-o", "--output", help="output file (default: standard output)")
-    p.add_argument("--in-format", choices=FORMATS, help="input format (default: from the extension, else jsonl)")
+    p.add_argument(
+        "--in-format",
+        "--input-format",
+        choices=FORMATS + LOG_FORMATS,
+        help="input format (default: from the extension, else jsonl; .ulg ulog, .tlog tlog, .mav mavlink)",
+    )
     p.add_argument("--out-format", choices=FORMATS, help="output format (default: the input's, text for binary)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="extra converter input (number)")
     p.add_argument("--package", default="generated", help="the generated package to use (default: generated)")
@@ -45,16 +63,55 @@ def register(subparsers: Any) -> None:
 
 
 class _Record:
-    __slots__ = ("data", "line", "where")
+    __slots__ = ("data", "line", "objs", "where")
 
-    def __init__(self, data: Any, where: str, line: int) -> None:
+    def __init__(self, data: Any, where: str, line: int, objs: list[Any] | None = None) -> None:
         self.data = data
         self.where = where
-        self.line = line
+        self.line = line  # 0: a log record, located by ``where``
+        self.objs = objs  # already decoded (logs)
 
 
 def _fail(where: str, line: int, message: str) -> BattgenError:
-    return BattgenError(f"{where}:{line}: {message}")
+    return BattgenError(f"{where}:{line}: {message}" if line > 0 else f"{where}: {message}")
+
+
+def _log_records(source: Path | IO[bytes], where: str, fmt: str, side: _Side) -> Iterator[_Record]:
+    """Every record of the side's first message in a .ulg, .tlog or raw MAVLink input."""
+    cls = side.items[0][1]
+    pad: list[Any] = [None] * (len(side.items) - 1)
+    if fmt == "ulog":
+        from ..instances import Unreadable
+        from ..instances_ulog import UlogReader
+
+        if not hasattr(cls, "ulog_format"):
+            raise BattgenError(f"{where}: a ULog file holds uORB messages; {side.name} is not a uORB side")
+        reader = UlogReader(source, where, cls)
+        try:
+            for notice in reader.notices:
+                text = notice.message
+                if notice.kind == "unchecked" and notice.data is not None:
+                    fields = ", ".join(map(str, notice.data.get("fields", ())))  # type: ignore[call-overload]
+                    text = f"{notice.data.get('topic')}: not in the log, converted from the schema's defaults: {fields}"
+                if notice.severity == "warning":
+                    print(f"{where}: warning: {text}", file=sys.stderr)
+            for rec in reader.records():
+                if isinstance(rec, Unreadable):
+                    raise BattgenError(f"{where}: {rec.message}")
+                yield _Record(None, f"{where} ({rec.where()})", 0, [rec.instance, *pad])
+        finally:
+            reader.close()
+        return
+    from ..instances_mavlink import StreamStats, read_frames
+
+    if not hasattr(cls, "MSG_ID"):
+        raise BattgenError(f"{where}: a MAVLink log holds MAVLink messages; {side.name} is not a MAVLink side")
+    stats = StreamStats()
+    name = getattr(cls, "QUALIFIED_NAME", cls.__name__).rpartition(".")[2]
+    for frame in read_frames(source, where, cls, stats, timestamps=fmt == "tlog"):
+        yield _Record(None, f"{where} ({frame.where(name)})", 0, [frame.instance, *pad])
+    if stats.damaged:
+        print(f"{where}: warning: {stats.summary(name)}", file=sys.stderr)
 
 
 def _read_records(stream: IO[bytes], where: str, fmt: str) -> Iterator[_Record]:
@@ -126,6 +183,8 @@ class _Side:
         self.items = items
 
     def build(self, rec: _Record) -> list[Any]:
+        if rec.objs is not None:
+            return rec.objs
         data = rec.data
         aliases = [a for a, _ in self.items]
         try:
@@ -213,8 +272,26 @@ def _inputs(settings: list[str]) -> dict[str, float]:
     return out
 
 
+def _side_name(pkg: ModuleType, name: str) -> str:
+    """A side given by its name, or by a message of it (qualified name or a dotted suffix)."""
+    if name in pkg.ENDPOINTS:
+        return name
+    found = set()
+    for side, items in pkg.ENDPOINTS.items():
+        for _, cls in items:
+            qualified = str(getattr(cls, "QUALIFIED_NAME", ""))
+            if name == qualified or qualified.endswith("." + name):
+                found.add(side)
+    if len(found) == 1:
+        return str(found.pop())
+    if found:
+        raise BattgenError(f"{name!r} is ambiguous: it names a message of the sides {', '.join(sorted(found))}")
+    return name  # unknown: reported with the known pairs
+
+
 def run(args: argparse.Namespace) -> int:
     pkg = _package(args.package)
+    args.source, args.target = _side_name(pkg, args.source), _side_name(pkg, args.target)
     key = (args.source, args.target)
     if key not in pkg.CONVERTERS:
         pairs = ", ".join(f"{s}->{t}" for s, t in sorted(pkg.CONVERTERS))
@@ -235,18 +312,32 @@ def run(args: argparse.Namespace) -> int:
     try:
         for path in args.files or ["-"]:
             fmt = args.in_format or _EXTENSIONS.get(Path(path).suffix.lower(), "jsonl")
-            out_fmt = args.out_format or ("jsonl" if fmt in ("hex", "raw") else fmt)
+            out_fmt = args.out_format or ("jsonl" if fmt in ("hex", "raw", *LOG_FORMATS) else fmt)
             where = "<stdin>" if path == "-" else path
+            if fmt in LOG_FORMATS and path != "-":  # read by path: memory-mapped
+                records = _log_records(Path(path), where, fmt, source)
+                _convert_stream(pkg, func, args, extra, source, target, records, where, fmt, out_fmt, out_stream)
+                continue
             try:
                 stream: IO[bytes] = sys.stdin.buffer if path == "-" else open(path, "rb")
             except OSError as exc:
                 raise BattgenError(f"{path}: cannot read: {exc.strerror or exc}") from None
             with stream:
-                _convert_stream(pkg, func, args, extra, source, target, stream, where, fmt, out_fmt, out_stream)
+                records = (
+                    _log_records(stream, where, fmt, source)
+                    if fmt in LOG_FORMATS
+                    else _read_records(stream, where, fmt)
+                )
+                _convert_stream(pkg, func, args, extra, source, target, records, where, fmt, out_fmt, out_stream)
     finally:
         if args.output:
             out_stream.close()
     return 0
+
+
+def _loss(report: Any, args: argparse.Namespace) -> Any:
+    """The record's loss report: every entry (--report), or its summary text (--report-summary)."""
+    return report.summary() if args.report_summary and not args.report else report.to_dict()
 
 
 def _convert_stream(
@@ -256,16 +347,16 @@ def _convert_stream(
     extra: dict[str, float],
     source: _Side,
     target: _Side,
-    stream: IO[bytes],
+    records: Iterator[_Record],
     where: str,
     fmt: str,
     out_fmt: str,
     out: IO[bytes],
 ) -> None:
     collected: list[Any] = []
-    for rec in _read_records(stream, where, fmt):
+    for rec in records:
         objs = source.build(rec)
-        report = pkg.LossReport() if args.report else None
+        report = pkg.LossReport() if args.report or args.report_summary else None
         try:
             result = func(*objs, policy=args.policy, report=report, **extra)
         except pkg.ConversionError as exc:
@@ -276,10 +367,10 @@ def _convert_stream(
             payloads = target.to_binary(result, rec)
             out.write(b" ".join(p.hex().encode() for p in payloads) + b"\n" if out_fmt == "hex" else b"".join(payloads))
             if report is not None:
-                sys.stderr.write(json.dumps({"line": rec.line, "loss": report.to_dict()}) + "\n")
+                sys.stderr.write(json.dumps({"line": rec.line, "loss": _loss(report, args)}) + "\n")
             continue
         plain = target.to_plain(result)
-        record = {"record": plain, "loss": report.to_dict()} if report is not None else plain
+        record = {"record": plain, "loss": _loss(report, args)} if report is not None else plain
         if out_fmt == "jsonl":
             out.write(json.dumps(record, allow_nan=False).encode() + b"\n")
             out.flush()

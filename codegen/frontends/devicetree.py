@@ -7,7 +7,8 @@ becomes a Field.  Sub-nodes described inline become messages of their own, named
 Type choices: a ``flag`` (present or absent, no value) is ``bool`` of 1 bit; a phandle is a
 ``uint32`` cell annotated ``("dt-phandle", ...)``; a property whose type nothing states is its raw
 bytes (``uint8[]``) annotated ``("dt-type", "unknown")``.  Every field carries ``("dt-type", name)``
-with the types.yaml name, and ``("dt-type-source", how)`` saying what decided it.
+with the types.yaml name, and ``("dt-type-source", how)`` saying what decided it.  An ``items``
+list (per-position schemas) becomes the array type's ``columns`` (see devicetree_columns).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from ..errors import SchemaError
 from ..ir import CompositeType, DevicetreeInfo, Field, Location, Message, Schema, SourceFormat
 from .common import display_path, read_text
 from .devicetree_data import DATA_FILES, DtData, load_data
-from .devicetree_shape import UNKNOWN_TYPE, as_text, ir_type, shape_of, values_of
+from .devicetree_shape import UNKNOWN_TYPE, as_text, ir_type, shape_of, values_of, with_columns
 from .devicetree_types import RefContext, Resolved, pointer, resolve
 from .devicetree_yaml import YList, YMap, load
 
@@ -159,12 +160,10 @@ def _field(f: _File, parent: str, name: str, schema: Any, line: int, *, is_patte
     else:
         td = data.types[found.dt_type]
         shape = shape_of(td, node, found.source == "unit-suffix")
-        ftype = ir_type(td, shape)
-        values = values_of(node, shape)
+        values = values_of(node, shape, f.display)
+        ftype = with_columns(ir_type(td, shape), values)
         rng = values.range
         notes += values.notes
-        if values.docs:
-            doc = "\n".join([doc, *values.docs]) if doc else "\n".join(values.docs)
         if td.value == "phandle":
             notes.append(("dt-phandle", "a 32-bit cell naming another node"))
     const, choices, choice_notes, consumed = _choices(node)

@@ -9,18 +9,18 @@ array (``dynamic=False``); an open upper bound is ``capacity=None``.
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
-from ..ir import ArrayType, FieldType, PrimitiveKind, PrimitiveType, Range, StringType
+from ..ir import ArrayType, Column, FieldType, PrimitiveKind, PrimitiveType, Range, StringType
+from .devicetree_columns import as_text, bounds_of, columns_of, verbatim
 from .devicetree_data import TypeDef
 from .devicetree_yaml import YMap
 
 Dim = tuple[int, int | None]  # (min items, max items or None when unbounded)
 
 _INT_KEYS = ("const", "enum", "minimum", "maximum")
-_RANGE_KEYS = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
+__all__ = ["UNKNOWN_TYPE", "Shape", "Values", "as_text", "ir_type", "shape_of", "values_of", "with_columns"]
 UNKNOWN_TYPE = ArrayType(PrimitiveType(PrimitiveKind.UINT, 8), None, dynamic=True)  # raw property bytes
 
 
@@ -117,57 +117,81 @@ def ir_type(td: TypeDef, shape: Shape) -> FieldType:
     return _array(_array(element, shape.inner), shape.outer)
 
 
-def range_of(schema: Any) -> Range | None:
-    if not isinstance(schema, YMap):
-        return None
-    values = {k: schema.get(k) for k in _RANGE_KEYS}
-    nums = {k: v for k, v in values.items() if isinstance(v, int | float) and not isinstance(v, bool)}
-    if not nums:
-        return None
-    lo = nums.get("exclusiveMinimum", nums.get("minimum"))
-    hi = nums.get("exclusiveMaximum", nums.get("maximum"))
-    return Range(lo, hi, "exclusiveMinimum" in nums, "exclusiveMaximum" in nums)
-
-
-def as_text(value: Any) -> str:
-    """A schema fragment as stable text for annotations."""
-    if isinstance(value, str):
-        return value
-    return json.dumps(value, sort_keys=True, default=str)
+range_of = bounds_of
 
 
 @dataclass(frozen=True)
 class Values:
-    """What a schema says about element values: a range, per-position notes, descriptions."""
+    """What a schema says about element values: one range for every element, the Columns of
+    the property's positions (``outer``) and of a matrix row's (``inner``), and notes for what
+    neither can hold."""
 
     range: Range | None
     notes: tuple[tuple[str, str], ...]
-    docs: tuple[str, ...]
+    outer: tuple[Column, ...] = ()
+    inner: tuple[Column, ...] = ()
+
+    def with_notes(self, notes: list[tuple[str, str]]) -> Values:
+        return replace(self, notes=self.notes + tuple(notes))
 
 
-def values_of(schema: Any, shape: Shape) -> Values:
+def _shared(own: Range | None, every: Range | None) -> Range | None:
+    """The property's own bounds narrowed by those its ``items`` mapping gives every element."""
+    return every if own is None else own.intersect(every)
+
+
+def values_of(schema: Any, shape: Shape, display: str) -> Values:
     """Constraints on the elements: the property's own min/max, then those in ``items``.
 
-    Per-position items (a row's columns, an array's entries) that differ cannot be one Range;
-    they become annotations ``column[i].maximum`` / ``item[i].maximum`` instead.
+    An ``items`` mapping bounds every element (the field's range); an ``items`` list gives each
+    position its own Column -- of the array itself, or of every row of a matrix.  A matrix
+    written as a list of row schemas gets one Column per row (its description), and its rows'
+    columns when every row lists the same ones and no row goes unlisted; otherwise those stay
+    annotations ``row[i].column[j].<key>``.
     """
     own = range_of(schema)
-    items = shape.row_schema.get("items") if isinstance(shape.row_schema, YMap) else None
-    label = "column" if shape.inner is not None else "item"
-    if isinstance(items, YMap):
-        return Values(own or range_of(items), (), ())
-    if not isinstance(items, list):
-        return Values(own, (), ())
+    if shape.outer is None or not isinstance(shape.row_schema, YMap):
+        return Values(own, ())
     notes: list[tuple[str, str]] = []
-    docs: list[str] = []
-    ranges = [range_of(i) for i in items]
-    for n, item in enumerate(items):
-        if not isinstance(item, YMap):
-            continue
-        if isinstance(item.get("description"), str):
-            docs.append(f"[{n}] {' '.join(item['description'].split())}")
-        for key, value in item.items():
-            if key != "description":
-                notes.append((f"{label}[{n}].{key}", as_text(value)))
-    shared = ranges[0] if ranges and all(r == ranges[0] for r in ranges) else None
-    return Values(own or shared, tuple(notes), tuple(docs))
+    if shape.inner is None:  # an array: row_schema is the property itself
+        items = shape.row_schema.get("items")
+        if isinstance(items, list):
+            return Values(own, (), columns_of(items, display, "item", notes)).with_notes(notes)
+        return Values(_shared(own, bounds_of(items)), ())
+    rows = schema.get("items") if isinstance(schema, YMap) and shape.row_schema is not schema else None
+    outer = columns_of(rows, display, "row", notes, bounds=False) if isinstance(rows, list) else ()
+    each = [_row(r, display, f"row[{n}].column") for n, r in enumerate(rows)] if isinstance(rows, list) else []
+    unlisted = isinstance(rows, list) and (shape.outer[1] is None or shape.outer[1] > len(rows))
+    if unlisted or any(_same(e) != _same(each[0]) for e in each):  # rows differ: their columns are notes
+        assert isinstance(rows, list)
+        kept = [
+            verbatim(r.get("items") if isinstance(r, YMap) else None, f"row[{n}].column") for n, r in enumerate(rows)
+        ]
+        return Values(own, (), outer).with_notes(notes + [n for k in kept for n in k])
+    shared, inner, inner_notes = _row(shape.row_schema, display, "column")
+    return Values(_shared(own, shared), (), outer, inner).with_notes(notes + inner_notes)
+
+
+def _row(row: Any, display: str, label: str) -> tuple[Range | None, tuple[Column, ...], list[tuple[str, str]]]:
+    """A row schema's bounds for every element, its columns, and the notes they leave."""
+    items = row.get("items") if isinstance(row, YMap) else None
+    notes: list[tuple[str, str]] = []
+    if isinstance(items, list):
+        return None, columns_of(items, display, label, notes), notes
+    return bounds_of(items), (), notes
+
+
+def _same(row: tuple[Range | None, tuple[Column, ...], list[tuple[str, str]]]) -> object:
+    """What two rows must share for one row type to hold both (source lines and labels aside)."""
+    bounds, columns, notes = row
+    return bounds, [replace(c, location=None) for c in columns], [(t.split("]", 1)[-1], v) for t, v in notes]
+
+
+def with_columns(t: FieldType, values: Values) -> FieldType:
+    """The IR type with the Columns attached at their depth."""
+    if not isinstance(t, ArrayType):
+        return t
+    element = t.element
+    if values.inner and isinstance(element, ArrayType):
+        element = replace(element, columns=values.inner)
+    return replace(t, element=element, columns=values.outer)

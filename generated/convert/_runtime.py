@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import struct
+from array import array
 from collections.abc import Iterator, Sequence
 from typing import Any
 
@@ -49,48 +50,68 @@ class LossEntry:
 
 
 class LossReport:
-    """What a conversion lost, in the order it happened (each entry once)."""
+    """What a conversion lost, in the order it happened (each entry once).
 
-    __slots__ = ("_seen", "entries")
+    Entries are kept as (kind, field, detail) keys of an insertion-ordered dict; the
+    :class:`LossEntry` objects are made when asked for, so a conversion only pays for a dict store."""
+
+    __slots__ = ("_keys",)
 
     def __init__(self) -> None:
-        self.entries: list[LossEntry] = []
-        self._seen: set[tuple[str, str, str]] = set()
+        self._keys: dict[tuple[str, str, str], None] = {}
+
+    @property
+    def entries(self) -> list[LossEntry]:
+        return [LossEntry(*key) for key in self._keys]
 
     def add(self, kind: str, field: str, detail: str = "") -> None:
-        key = (kind, field, detail)
-        if key not in self._seen:
-            self._seen.add(key)
-            self.entries.append(LossEntry(kind, field, detail))
+        self._keys[(kind, field, detail)] = None
 
     def unknown(self, field: str, detail: str = "") -> None:
-        self.add("unknown", field, detail)
+        self._keys[("unknown", field, detail)] = None
 
     def dropped(self, field: str, detail: str = "") -> None:
-        self.add("dropped", field, detail)
+        self._keys[("dropped", field, detail)] = None
 
     def clamped(self, field: str, detail: str = "") -> None:
-        self.add("clamped", field, detail)
+        self._keys[("clamped", field, detail)] = None
 
     def rounded(self, field: str, detail: str = "") -> None:
-        self.add("rounded", field, detail)
+        self._keys[("rounded", field, detail)] = None
 
     def discard(self, kind: str, field: str) -> None:
         """Withdraw entries (a later rule filled a field an earlier one left unknown)."""
-        self.entries = [e for e in self.entries if not (e.kind == kind and e.field == field)]
-        self._seen = {(e.kind, e.field, e.detail) for e in self.entries}
+        self._keys = {k: None for k in self._keys if not (k[0] == kind and k[1] == field)}
 
     def fields(self, kind: str) -> list[str]:
-        return [e.field for e in self.entries if e.kind == kind]
+        return [k[1] for k in self._keys if k[0] == kind]
 
     def to_dict(self) -> list[dict[str, str]]:
         return [e.to_dict() for e in self.entries]
+
+    def summary(self) -> str:
+        """A short text: one line per kind, fields grouped by message (``uorb.BatteryStatus: a, b``)."""
+        if not self._keys:
+            return "nothing lost"
+        lines = []
+        for kind in dict.fromkeys(k[0] for k in self._keys):
+            groups: dict[str, list[str]] = {}
+            for k, field, detail in self._keys:
+                if k == kind:
+                    owner, _, name = field.rpartition(".")
+                    groups.setdefault(owner, []).append(f"{name} ({detail})" if detail else name)
+            count = sum(len(v) for v in groups.values())
+            parts = "; ".join(
+                f"{owner}: {', '.join(names)}" if owner else ", ".join(names) for owner, names in groups.items()
+            )
+            lines.append(f"{kind} ({count}): {parts}")
+        return "\n".join(lines)
 
     def __iter__(self) -> Iterator[LossEntry]:
         return iter(self.entries)
 
     def __len__(self) -> int:
-        return len(self.entries)
+        return len(self._keys)
 
     def __repr__(self) -> str:
         return f"LossReport({self.entries!r})"
@@ -347,14 +368,16 @@ def px4_receiver_cells(
     voltages: Sequence[int], n_cells: int, marker: int, div: float
 ) -> tuple[list[float], int, float]:
     """PX4's receiver: cells while below ``marker`` (at most len(voltages)), v / div in float32, summed."""
-    cells = [0.0] * n_cells
-    total = 0.0
     n = 0
-    while n < len(voltages) and n < n_cells and voltages[n] < marker:
-        cells[n] = f32(float(voltages[n]) / div)
-        total = f32(total + cells[n])
+    limit = min(len(voltages), n_cells)
+    while n < limit and voltages[n] < marker:
         n += 1
-    return cells, n, total
+    # float32 rounding of every quotient at once (an array('f') store is the C cast f32 makes)
+    cells = array("f", [float(v) / div for v in voltages[:n]]).tolist() + [0.0] * (n_cells - n)
+    acc = array("f", b"\0\0\0\0")
+    for c in cells[:n]:
+        acc[0] = acc[0] + c  # the running sum is rounded at each step, as in C
+    return cells, n, acc[0]
 
 
 # -- devicetree -----------------------------------------------------------------------------

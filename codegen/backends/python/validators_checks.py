@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ...ir import (
     ArrayType,
@@ -117,16 +117,21 @@ def _num(value: float, t: PrimitiveType) -> str:
 
 
 class NumberCheck:
-    def __init__(self, t: PrimitiveType, f: Field, sentinel: Sentinel | None, facts: EnumFacts | None) -> None:
+    def __init__(
+        self, t: PrimitiveType, f: Field, sentinel: Sentinel | None, facts: EnumFacts | None, label: str = ""
+    ) -> None:
         self.t = t
         self.f = f
         self.sentinel = sentinel
         self.facts = facts
+        self.label = label  # the column's doc, named in messages
         self.bounds = folded(t, f.range) if t.kind not in (PrimitiveKind.CHAR, PrimitiveKind.VOID) else None
 
     def spec(self) -> str:
         t, f = self.t, self.f
         args = [f"type={py_literal(t.name)}", f"kind={py_literal(t.kind.value)}"]
+        if self.label:
+            args.append(f"label={py_literal(self.label)}")
         if t.kind is PrimitiveKind.CHAR:
             args += ["low=0", "high=255"]
         else:
@@ -205,12 +210,13 @@ class NumberCheck:
 
 
 class TextCheck:
-    def __init__(self, t: StringType, f: Field) -> None:
+    def __init__(self, t: StringType, f: Field, label: str = "") -> None:
         self.t = t
         self.f = f
+        self.label = label
 
     def spec(self) -> str:
-        args = []
+        args = [f"label={py_literal(self.label)}"] if self.label else []
         if self.t.capacity is not None:
             args.append(f"capacity={self.t.capacity}")
         strings = tuple(str(c) for c in self.f.choices)
@@ -234,12 +240,18 @@ class TextCheck:
 
 
 class ArrayCheck:
-    def __init__(self, t: ArrayType, inner: Check, depth: int) -> None:
+    """An array; ``columns[i]`` (None where the column says nothing) checks element i instead of
+    ``inner``. A column only narrows the element's checks, so the fast path tests every element
+    against ``inner`` and, on top, each position whose column has a range against that column."""
+
+    def __init__(self, t: ArrayType, inner: Check, depth: int, columns: list[Check | None]) -> None:
         self.t = t
         self.inner = inner
         self.depth = depth
+        self.columns = columns
         el = t.element
         self.byte = isinstance(el, PrimitiveType) and el.kind is PrimitiveKind.UINT and el.bits == 8
+        self.ranged = [i for i, c in enumerate(t.columns) if c.range is not None and columns[i] is not None]
 
     def spec(self) -> str:
         t = self.t
@@ -248,7 +260,22 @@ class ArrayCheck:
             args.append(f"min_length={t.min_length}")
         if self.byte:
             args.append("byte=True")
+        if any(c is not None for c in self.columns):
+            specs = [c.spec() if c is not None else "None" for c in self.columns]
+            args.append("columns=(" + ", ".join(specs) + ("," if len(specs) == 1 else "") + ")")
         return "_v.Array(" + ", ".join(args) + ")"
+
+    def column_bad(self) -> list[str]:
+        """Conditions on the positions whose column narrows the range; guarded by a length test
+        unless the length checks before them already guarantee the position exists."""
+        t, out = self.t, []
+        for i in self.ranged:
+            check = self.columns[i]
+            assert check is not None
+            cond = check.bad().replace(V, f"{V}[{i}]")
+            sure = (t.capacity is not None and t.capacity > i) if not t.dynamic else t.min_length > i
+            out.append(cond if sure else f"(len({V}) > {i} and {cond})")
+        return out
 
     def length_bad(self) -> list[str]:
         t = self.t
@@ -269,6 +296,7 @@ class ArrayCheck:
         else:
             item = f"_x{self.depth}"
             parts.append(f"any({self.inner.bad().replace(V, item)} for {item} in {V})")
+        parts += self.column_bad()
         return "(" + " or ".join(parts) + ")" if parts else "False"
 
 
@@ -286,14 +314,22 @@ class NestedCheck:
 Check = NumberCheck | TextCheck | ArrayCheck | NestedCheck
 
 
-def build(schema: Schema, f: Field, t: FieldType, depth: int = 0) -> Check:
+def build(schema: Schema, f: Field, t: FieldType, depth: int = 0, label: str = "") -> Check:
     if isinstance(t, PrimitiveType):
-        return NumberCheck(t, f, f.invalid, enum_facts(schema, f))
+        return NumberCheck(t, f, f.invalid, enum_facts(schema, f), label)
     if isinstance(t, StringType):
-        return TextCheck(t, f)
+        return TextCheck(t, f, label)
     if isinstance(t, CompositeType):
         return NestedCheck(t.name)
-    return ArrayCheck(t, build(schema, f, t.element, depth + 1), depth)
+    columns: list[Check | None] = []
+    for c in t.columns:
+        if not c.doc and c.range is None and c.unit is None:
+            columns.append(None)
+            continue
+        # the field as seen at this position: the column's range on top of the field's, its unit
+        at = replace(f, range=c.range.intersect(f.range) if c.range is not None else f.range, unit=c.unit or f.unit)
+        columns.append(build(schema, at, t.element, depth + 1, c.doc or label))
+    return ArrayCheck(t, build(schema, f, t.element, depth + 1, label), depth, columns)
 
 
 @dataclass(frozen=True)
@@ -331,7 +367,7 @@ def field_code(schema: Schema, msg: Message, f: Field, ident: str, spec_name: st
             f"if any(not _v.search({py_literal(f.pattern)}, k) or {cond} for k, x in {attr}.items()):",
             f"    {slow}",
         ]
-    elif isinstance(check, ArrayCheck) and not check.byte and isinstance(check.inner, NumberCheck):
+    elif isinstance(check, ArrayCheck) and not check.byte and not check.ranged and isinstance(check.inner, NumberCheck):
         # top-level array of numbers: a plain loop beats any() with a generator
         length = check.length_bad()
         item = check.inner.bad().replace(V, "e")

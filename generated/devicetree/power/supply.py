@@ -32,15 +32,15 @@ _VS_SimpleBattery_charge_term_current_microamp = _v.Optional(_v.Array(_v.Number(
 _VS_SimpleBattery_constant_charge_current_max_microamp = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uA'), None, False, min_length=1), required=False)
 _VS_SimpleBattery_constant_charge_voltage_max_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
 _VS_SimpleBattery_factory_internal_resistance_micro_ohms = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uOhm'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_resistance_temp_table = _v.Optional(_v.Array(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295), 2, True, min_length=2), None, False, min_length=1), required=False)
+_VS_SimpleBattery_resistance_temp_table = _v.Optional(_v.Array(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295), 2, True, min_length=2, columns=(_v.Number(type='uint32', kind='uint', label='the temperature in degree Celsius', low=0, high=4294967295), _v.Number(type='uint32', kind='uint', label='battery internal resistance percent', low=0, high=4294967295))), None, False, min_length=1), required=False)
 _VS_SimpleBattery_ocv_capacity_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_operating_range_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2), required=False)
-_VS_SimpleBattery_ambient_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2), required=False)
-_VS_SimpleBattery_alert_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2), required=False)
+_VS_SimpleBattery_operating_range_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2, columns=(_v.Number(type='int32', kind='int', label='minimum temperature at which battery can operate', low=-2147483648, high=2147483647, unit='degC'), _v.Number(type='int32', kind='int', label='maximum temperature at which battery can operate', low=-2147483648, high=2147483647, unit='degC'))), required=False)
+_VS_SimpleBattery_ambient_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2, columns=(_v.Number(type='int32', kind='int', label='alert when ambient temperature is lower than this value', low=-2147483648, high=2147483647, unit='degC'), _v.Number(type='int32', kind='int', label='alert when ambient temperature is higher than this value', low=-2147483648, high=2147483647, unit='degC'))), required=False)
+_VS_SimpleBattery_alert_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2, columns=(_v.Number(type='int32', kind='int', label='alert when battery temperature is lower than this value', low=-2147483648, high=2147483647, unit='degC'), _v.Number(type='int32', kind='int', label='alert when battery temperature is higher than this value', low=-2147483648, high=2147483647, unit='degC'))), required=False)
 _VS_SimpleBattery_volt_drop_thresh_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV', maximum=48000000), 1, True, min_length=1), 1, True, min_length=1), required=False)
 _VS_SimpleBattery_volt_drop_soc_bp = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='bp'), None, False, min_length=1), required=False)
 _VS_SimpleBattery_volt_drop_temperatures_millicelsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='mdegC'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_ocv_capacity_table_n = _v.Pattern('^ocv-capacity-table-[0-9]+$', _v.Array(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295), 2, True, min_length=2), 100, False, min_length=1))
+_VS_SimpleBattery_ocv_capacity_table_n = _v.Pattern('^ocv-capacity-table-[0-9]+$', _v.Array(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295), 2, True, min_length=2, columns=(_v.Number(type='uint32', kind='uint', label='open circuit voltage (OCV) in microvolts', low=0, high=4294967295), _v.Number(type='uint32', kind='uint', label='battery capacity percent', low=0, high=4294967295, maximum=100))), 100, False, min_length=1))
 _VS_SimpleBattery_volt_drop_n_microvolt = _v.Pattern('^volt-drop-[0-9]-microvolt', _v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1))
 
 
@@ -84,15 +84,15 @@ class SimpleBattery:
     constant_charge_current_max_microamp: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='constant-charge-current-max-microamp', type='uint32[]', unit='uA', quantity='current', scale=1e-06, offset=0.0, doc='maximum constant input current'))
     constant_charge_voltage_max_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='constant-charge-voltage-max-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, doc='maximum constant input voltage'))
     factory_internal_resistance_micro_ohms: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='factory-internal-resistance-micro-ohms', type='uint32[]', unit='uOhm', quantity='resistance', scale=1e-06, offset=0.0, doc='battery factory internal resistance'))
-    resistance_temp_table: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='resistance-temp-table', type='uint32[2][]', doc='A table providing the temperature in degree Celsius\nand corresponding battery internal resistance percent, which is used to\nlook up the resistance percent according to current temperature to get an\naccurate batterty internal resistance in different temperatures.\n[0] the temperature in degree Celsius\n[1] battery internal resistance percent'))
+    resistance_temp_table: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='resistance-temp-table', type='uint32[2][]', doc='A table providing the temperature in degree Celsius\nand corresponding battery internal resistance percent, which is used to\nlook up the resistance percent according to current temperature to get an\naccurate batterty internal resistance in different temperatures.'))
     ocv_capacity_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='ocv-capacity-celsius', type='int32[]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='An array containing the temperature in degree Celsius,\nfor each of the battery capacity lookup table.'))
-    operating_range_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='operating-range-celsius', type='int32[2]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='operating temperature range of a battery\n[0] minimum temperature at which battery can operate\n[1] maximum temperature at which battery can operate'))
-    ambient_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='ambient-celsius', type='int32[2]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='safe range of ambient temperature\n[0] alert when ambient temperature is lower than this value\n[1] alert when ambient temperature is higher than this value'))
-    alert_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='alert-celsius', type='int32[2]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='safe range of battery temperature\n[0] alert when battery temperature is lower than this value\n[1] alert when battery temperature is higher than this value'))
+    operating_range_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='operating-range-celsius', type='int32[2]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='operating temperature range of a battery'))
+    ambient_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='ambient-celsius', type='int32[2]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='safe range of ambient temperature'))
+    alert_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='alert-celsius', type='int32[2]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='safe range of battery temperature'))
     volt_drop_thresh_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='volt-drop-thresh-microvolt', type='int32[1][1]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, minimum=None, maximum=48000000, doc='Threshold for starting the VDR correction'))
     volt_drop_soc_bp: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='volt-drop-soc-bp', type='int32[]', unit='bp', quantity='ratio', scale=0.0001, offset=0.0, doc='Table of capacity values matching the values in VDR tables. The value should be given as basis points, 1/100 of a percent.'))
     volt_drop_temperatures_millicelsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='volt-drop-temperatures-millicelsius', type='int32[]', unit='mdegC', quantity='temperature', scale=0.001, offset=273.15, doc='An array containing the temperature in milli celsius, for each of the VDR lookup table.'))
-    ocv_capacity_table_n: dict[str, list[list[int]]] = dataclasses.field(default_factory=dict, metadata=_m.meta(name='^ocv-capacity-table-[0-9]+$', type='uint32[2][<=100]', pattern='^ocv-capacity-table-[0-9]+$', doc='An array providing the open circuit voltage (OCV)\nof the battery and corresponding battery capacity percent, which is used\nto look up battery capacity according to current OCV value. And the open\ncircuit voltage unit is microvolt.\n[0] open circuit voltage (OCV) in microvolts\n[1] battery capacity percent'))
+    ocv_capacity_table_n: dict[str, list[list[int]]] = dataclasses.field(default_factory=dict, metadata=_m.meta(name='^ocv-capacity-table-[0-9]+$', type='uint32[2][<=100]', pattern='^ocv-capacity-table-[0-9]+$', doc='An array providing the open circuit voltage (OCV)\nof the battery and corresponding battery capacity percent, which is used\nto look up battery capacity according to current OCV value. And the open\ncircuit voltage unit is microvolt.'))
     volt_drop_n_microvolt: dict[str, list[list[int]]] = dataclasses.field(default_factory=dict, metadata=_m.meta(name='^volt-drop-[0-9]-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, pattern='^volt-drop-[0-9]-microvolt', doc="Table of the voltage drop rate (VDR) values. Each entry in the table should match a capacity value in the volt-drop-soc table. Furthermore, the values should be obtained for the temperature given in volt-drop-temperatures-millicelsius table at index matching the number in this table's name."))
 
     def __eq__(self, other: object) -> bool:
@@ -222,7 +222,6 @@ class SimpleBattery:
         a: Any
         e: Any
         sub: Any
-        i_1: Any
         k_0: Any
         r_constant_charge_voltage_max_microvolt: Any
         r_ocv_capacity_celsius: Any
@@ -231,7 +230,6 @@ class SimpleBattery:
         r_voltage_max_design_microvolt: Any
         r_voltage_min_design_microvolt: Any
         v_i: Any
-        v_row: Any
         v_table: Any
         try:
             if (x := self.compatible) is None or (len(x) < 1 or any((_x0 != 'simple-battery') for _x0 in x)):
@@ -445,7 +443,7 @@ class SimpleBattery:
         except _v.SLOW:
             _v.diag(out, 'volt-drop-temperatures-millicelsius', self.volt_drop_temperatures_millicelsius, _VS_SimpleBattery_volt_drop_temperatures_millicelsius)
         try:
-            if any(not _v.search('^ocv-capacity-table-[0-9]+$', k) or (len(x) > 100 or len(x) < 1 or any((len(_x0) != 2 or any((_x1 & -4294967296) for _x1 in _x0)) for _x0 in x)) for k, x in self.ocv_capacity_table_n.items()):
+            if any(not _v.search('^ocv-capacity-table-[0-9]+$', k) or (len(x) > 100 or len(x) < 1 or any((len(_x0) != 2 or any((_x1 & -4294967296) for _x1 in _x0) or (_x0[1] & -4294967296 or not (0 <= _x0[1] <= 100))) for _x0 in x)) for k, x in self.ocv_capacity_table_n.items()):
                 _v.diag(out, '^ocv-capacity-table-[0-9]+$', self.ocv_capacity_table_n, _VS_SimpleBattery_ocv_capacity_table_n)
         except _v.SLOW:
             _v.diag(out, '^ocv-capacity-table-[0-9]+$', self.ocv_capacity_table_n, _VS_SimpleBattery_ocv_capacity_table_n)
@@ -454,7 +452,7 @@ class SimpleBattery:
                 _v.diag(out, '^volt-drop-[0-9]-microvolt', self.volt_drop_n_microvolt, _VS_SimpleBattery_volt_drop_n_microvolt)
         except _v.SLOW:
             _v.diag(out, '^volt-drop-[0-9]-microvolt', self.volt_drop_n_microvolt, _VS_SimpleBattery_volt_drop_n_microvolt)
-        # rule voltage-design-order (devicetree-battery.yaml:7)
+        # rule voltage-design-order (devicetree-battery.yaml:9)
         try:
             r_voltage_min_design_microvolt = self.voltage_min_design_microvolt
             r_voltage_max_design_microvolt = self.voltage_max_design_microvolt
@@ -463,7 +461,7 @@ class SimpleBattery:
                     out.append(_v.rule('voltage-min-design-microvolt', 'voltage-design-order', r_voltage_min_design_microvolt, '`voltage-min-design-microvolt`[0][0] < `voltage-max-design-microvolt`[0][0]', 'voltage-min-design-microvolt = ' + _v.fmt(r_voltage_min_design_microvolt[0][0]) + ' uV must be below voltage-max-design-microvolt = ' + _v.fmt(r_voltage_max_design_microvolt[0][0]) + ' uV', 'error'))
         except _v.SLOW:
             pass  # the field checks report the cause
-        # rule charge-voltage-below-over-voltage (devicetree-battery.yaml:15)
+        # rule charge-voltage-below-over-voltage (devicetree-battery.yaml:17)
         try:
             r_constant_charge_voltage_max_microvolt = self.constant_charge_voltage_max_microvolt
             r_over_voltage_threshold_microvolt = self.over_voltage_threshold_microvolt
@@ -472,7 +470,7 @@ class SimpleBattery:
                     out.append(_v.rule('constant-charge-voltage-max-microvolt', 'charge-voltage-below-over-voltage', r_constant_charge_voltage_max_microvolt, '`constant-charge-voltage-max-microvolt`[0][0] <= `over-voltage-threshold-microvolt`[0][0]', 'constant-charge-voltage-max-microvolt = ' + _v.fmt(r_constant_charge_voltage_max_microvolt[0][0]) + ' uV is above over-voltage-threshold-microvolt = ' + _v.fmt(r_over_voltage_threshold_microvolt[0][0]) + ' uV', 'error'))
         except _v.SLOW:
             pass  # the field checks report the cause
-        # rule design-max-below-charge-voltage (devicetree-battery.yaml:23)
+        # rule design-max-below-charge-voltage (devicetree-battery.yaml:25)
         try:
             r_voltage_max_design_microvolt = self.voltage_max_design_microvolt
             r_constant_charge_voltage_max_microvolt = self.constant_charge_voltage_max_microvolt
@@ -481,19 +479,7 @@ class SimpleBattery:
                     out.append(_v.rule('voltage-max-design-microvolt', 'design-max-below-charge-voltage', r_voltage_max_design_microvolt, '`voltage-max-design-microvolt`[0][0] >= `constant-charge-voltage-max-microvolt`[0][0]', 'voltage-max-design-microvolt = ' + _v.fmt(r_voltage_max_design_microvolt[0][0]) + ' uV is below constant-charge-voltage-max-microvolt = ' + _v.fmt(r_constant_charge_voltage_max_microvolt[0][0]) + ' uV', 'warning'))
         except _v.SLOW:
             pass  # the field checks report the cause
-        # rule ocv-capacity-percent (devicetree-battery.yaml:34)
-        try:
-            r_ocv_capacity_table_n = self.ocv_capacity_table_n
-            for k_0, v_table in _v.entries(r_ocv_capacity_table_n):
-                for i_1, v_row in enumerate(v_table):
-                    try:
-                        if not (0 <= v_row[1] <= 100):
-                            out.append(_v.rule(k_0 + '[' + str(i_1) + ']' + '[' + str(1) + ']', 'ocv-capacity-percent', v_row[1], '0 <= row[1] <= 100', 'capacity ' + _v.fmt(v_row[1]) + ' % is outside 0..100 %', 'error'))
-                    except _v.SLOW:
-                        pass
-        except _v.SLOW:
-            pass  # the field checks report the cause
-        # rule ocv-table-descending (devicetree-battery.yaml:41)
+        # rule ocv-table-descending (devicetree-battery.yaml:36)
         try:
             r_ocv_capacity_table_n = self.ocv_capacity_table_n
             for k_0, v_table in _v.entries(r_ocv_capacity_table_n):
@@ -505,7 +491,7 @@ class SimpleBattery:
                         pass
         except _v.SLOW:
             pass  # the field checks report the cause
-        # rule ocv-table-count (devicetree-battery.yaml:50)
+        # rule ocv-table-count (devicetree-battery.yaml:45)
         try:
             r_ocv_capacity_table_n = self.ocv_capacity_table_n
             r_ocv_capacity_celsius = self.ocv_capacity_celsius
@@ -514,7 +500,7 @@ class SimpleBattery:
                     out.append(_v.rule('ocv-capacity-celsius', 'ocv-table-count', r_ocv_capacity_celsius, 'len(`^ocv-capacity-table-[0-9]+$`) == len(`ocv-capacity-celsius`)', _v.fmt(len(r_ocv_capacity_celsius)) + ' ocv-capacity-celsius entries but ' + _v.fmt(len(r_ocv_capacity_table_n)) + ' ocv-capacity-table-N properties; expected one table per temperature', 'error'))
         except _v.SLOW:
             pass  # the field checks report the cause
-        # rule ocv-table-names (devicetree-battery.yaml:58)
+        # rule ocv-table-names (devicetree-battery.yaml:53)
         try:
             r_ocv_capacity_celsius = self.ocv_capacity_celsius
             r_ocv_capacity_table_n = self.ocv_capacity_table_n
@@ -527,7 +513,7 @@ class SimpleBattery:
                         pass
         except _v.SLOW:
             pass  # the field checks report the cause
-        # rule ocv-temperature-count (devicetree-battery.yaml:65)
+        # rule ocv-temperature-count (devicetree-battery.yaml:60)
         try:
             r_ocv_capacity_celsius = self.ocv_capacity_celsius
             if r_ocv_capacity_celsius is not None:
