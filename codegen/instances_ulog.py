@@ -1,25 +1,21 @@
 """PX4 ULog flight logs (.ulg) as records: every record of a uORB message's topics, all multi_ids.
 
-Records come in file order (multi_ids interleaved as logged), each decoded on its own, so memory
-does not grow with the number of records beyond the reader's index (one offset per record). A
-file given by path is memory-mapped rather than read into memory.
+Records come in file order (multi_ids interleaved as logged), each decoded on its own, through
+the generated reader's streaming API (``read(path, index=False)`` then ``Log.iter_records``): the
+file is memory-mapped and walked once, so memory does not grow with the number of records.
 
 Logs written before a message changed (PX4 logs predating message versioning) carry another
 format for the topic: the difference is one notice per topic, fields matching by name and type
 are decoded, and the checks of the fields the log lacks or types differently are not reported
 (their values would be the schema's defaults, not the log's data) -- with one notice naming them.
-
-The generated reader (``<package>._ulog``) hands out whole lists; walking one record at a time
-uses its index (``Log._streams``) and record filler (``_plan``/``_fill``) directly.
+Damage the reader recovered from and a log without the message's topics are told after the
+records, once the walk has seen the whole file.
 """
 
 from __future__ import annotations
 
-import heapq
 import importlib
-import mmap
 import struct
-import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,7 +26,6 @@ from .instances import InstanceError, Item, Notice, Record, Unreadable
 from .ir import Message
 
 MAX_DAMAGE_NOTICES = 10
-_D_HEADER = 5  # uint16 size, uint8 type 'D', uint16 msg_id: a record's data starts this far in
 
 
 @dataclass(frozen=True)
@@ -71,49 +66,41 @@ def _diff_line(diff: Any) -> str:
 
 
 class UlogReader:
-    """An opened log and the topics of one generated uORB class; close() releases the file."""
+    """An opened log and the topics of one generated uORB class; close() releases the file.
+
+    ``notices`` holds what the definitions tell (format differences, unchecked fields) when the
+    reader is made; ``trailing`` what only a whole walk can tell (damage, no records), once
+    records() is exhausted.
+    """
 
     def __init__(self, source: Path | IO[bytes], name: str, model: Any) -> None:
         self.name = name
         self.model = model
         self.ulog = runtime(model, "_ulog")
-        self._map: mmap.mmap | None = None
-        data: Any
         if isinstance(source, Path):
-            data = self._map = _map_file(source, name)
-        else:
-            data = source.read()
+            _check_file(source, name)
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", self.ulog.ULogWarning)  # listed in Log.warnings
-                self.log = self.ulog.Log(data)
-                self.log._parse()
+            self.log = self.ulog.read(source, index=False, warn=False)  # damage: listed in Log.warnings
+        except OSError as exc:
+            raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
         except (ValueError, struct.error, IndexError) as exc:  # ULogError is a ValueError
-            self.close()
             raise InstanceError(name, 0, f"expected a ULog file: {exc}") from None
+        self.topics = tuple(getattr(model, "UORB_TOPICS", ()) or (self.ulog.format_of(model).name,))
         self.notices: list[Notice] = []
-        self.plans: dict[str, tuple[Any, frozenset[str]]] = {}
+        self.trailing: list[Notice] = []  # filled once records() has walked the whole log
+        self.skips: dict[str, frozenset[str]] = {}  # decodable topics -> fields left unchecked
         self._prepare()
 
     def close(self) -> None:
-        if self._map is not None:
-            self._map.close()
-            self._map = None
+        self.log.close()
 
     def _prepare(self) -> None:
-        topics = tuple(getattr(self.model, "UORB_TOPICS", ()) or (self.ulog.format_of(self.model).name,))
-        present = {t for t, _ in self.log.topics()}
-        for text in self.log.warnings[:MAX_DAMAGE_NOTICES]:
-            self.notices.append(Notice(self.name, f"damaged log, recovered: {text}", "damage"))
-        if len(self.log.warnings) > MAX_DAMAGE_NOTICES:
-            more = len(self.log.warnings) - MAX_DAMAGE_NOTICES
-            self.notices.append(Notice(self.name, f"damaged log: {more} more problems recovered from", "damage"))
-        for topic in topics:
-            if topic not in present:
+        for topic in self.topics:
+            if topic not in self.log.formats:
                 continue
             try:
                 diff = self.log.compare(self.model, topic=topic)
-                lay = self.log.layout(topic)
+                self.log.layout(topic)
             except ValueError as exc:
                 self.notices.append(Notice(self.name, f"{topic}: cannot decode this topic: {exc}", "damage"))
                 continue
@@ -131,56 +118,51 @@ class UlogReader:
                         data={"topic": topic, "fields": sorted(skip)},
                     )
                 )
-            self.plans[topic] = (self._decoder(diff, lay, skip), skip)
-        if not self.plans:
-            logged = ", ".join(sorted(present)) or "none"
-            self.notices.append(
-                Notice(self.name, f"no {' or '.join(topics)} records in this log (topics logged: {logged})", "empty")
-            )
-
-    def _decoder(self, diff: Any, lay: Any, skip: frozenset[str]) -> Any:
-        data, size = self.log.data, lay.data_size
-        if diff.identical:
-            decode = self.model.decode
-            return lambda offset: decode(data[offset : offset + size])
-        unpack = lay.columns().record_struct(size).unpack_from
-        index = {n: i for i, n in enumerate(lay.names)}
-        plan = self.ulog._plan(self.ulog.format_of(self.model), index, "", "", set(skip))
-        fill, model = self.ulog._fill, self.model
-        return lambda offset: fill(model(), plan, unpack(data, offset))
+            self.skips[topic] = skip
 
     def records(self) -> Iterator[LogRecord | Unreadable]:
-        """Every record of the class's topics in file order (multi_ids interleaved)."""
-        streams = getattr(self.log, "_streams", {})
-        queues = [_stream(streams[key].offsets, *key) for key in self.log.topics() if key[0] in self.plans]
-        for offset, topic, multi_id in heapq.merge(*queues):
-            decode, skip = self.plans[topic]
-            try:
-                obj = decode(offset)
-            except (ValueError, struct.error, TypeError) as exc:
-                yield Unreadable(self.name, 0, f"{topic} multi_id {multi_id}, offset {offset}: cannot decode: {exc}")
-                continue
-            stamp = getattr(obj, "timestamp", None) if "timestamp" not in skip else None
-            yield LogRecord(topic, multi_id, offset - _D_HEADER, stamp if isinstance(stamp, int) else None, obj, skip)
+        """Every record of the class's topics in file order (multi_ids interleaved); at the end,
+        fills ``trailing``."""
+        skips = self.skips
+        try:
+            for rec in self.log.iter_records(self.model, topic=list(skips)):
+                skip = skips[rec.topic]
+                stamp = getattr(rec.instance, "timestamp", None) if "timestamp" not in skip else None
+                yield LogRecord(
+                    rec.topic, rec.multi_id, rec.offset, stamp if isinstance(stamp, int) else None, rec.instance, skip
+                )
+        except ValueError as exc:  # a record that cannot be decoded ends the walk
+            yield Unreadable(self.name, 0, str(exc))
+            return
+        self.trailing = self._after_walk()
+
+    def _after_walk(self) -> list[Notice]:
+        out: list[Notice] = []
+        problems = self.log.warnings
+        for text in problems[:MAX_DAMAGE_NOTICES]:
+            out.append(Notice(self.name, f"damaged log, recovered: {text}", "damage"))
+        if len(problems) > MAX_DAMAGE_NOTICES:
+            more = len(problems) - MAX_DAMAGE_NOTICES
+            out.append(Notice(self.name, f"damaged log: {more} more problems recovered from", "damage"))
+        present = sorted({t for t, _ in self.log.topics()})  # counted by the walk just finished
+        if not any(t in self.skips for t in present):
+            logged = ", ".join(present) or "none"
+            what = " or ".join(self.topics)
+            out.append(Notice(self.name, f"no {what} records in this log (topics logged: {logged})", "empty"))
+        return out
 
 
-def _stream(offsets: list[int], topic: str, multi_id: int) -> Iterator[tuple[int, str, int]]:
-    for offset in offsets:
-        yield offset, topic, multi_id
-
-
-def _map_file(path: Path, name: str) -> mmap.mmap:
+def _check_file(path: Path, name: str) -> None:
     try:
-        with path.open("rb") as f:
-            if f.seek(0, 2) == 0:
-                raise InstanceError(name, 0, "empty file: expected a ULog file")
-            return mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
+        if path.is_file() and path.stat().st_size == 0:
+            raise InstanceError(name, 0, "empty file: expected a ULog file")
     except OSError as exc:
         raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
 
 
 def ulog_items(path: Path, name: str, message: Message, model: Any) -> Iterator[Item]:
-    """validate's records of a .ulg file: notices first, then one record per logged message."""
+    """validate's records of a .ulg file: notices first, then one record per logged message, then
+    the notices of the whole walk (damage recovered from, no records of the message)."""
     reader = UlogReader(path, name, model)  # raises InstanceError before the first item
     return _items(reader)
 
@@ -204,5 +186,6 @@ def _items(reader: UlogReader) -> Iterator[Item]:
                 location=rec.location(),
             )
             index += 1
+        yield from reader.trailing
     finally:
         reader.close()

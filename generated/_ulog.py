@@ -9,18 +9,41 @@ flag bits ('B', first), formats ('F': ``name:type field;...``), info ('I', 'M') 
 msg_id then the struct without its trailing padding), log text ('L', 'C'), syncs and dropouts.
 
 Generated uORB classes describe themselves with ``ulog_format()``; this module writes them
-(:class:`Writer`), reads any log (:func:`read` -> :class:`Log`), and compares a log's own format
-with a class's (:class:`FormatDiff`), decoding the fields that match. Standard library only.
+(:class:`Writer`, :func:`write`), reads any log (:func:`read` -> :class:`Log`), and compares a
+log's own format with a class's (:class:`FormatDiff`), decoding the fields that match. Standard
+library only.
+
+Reading::
+
+    log = read(path)                        # a path is memory-mapped (mmap=False reads it whole);
+                                            # bytes and binary files are accepted too
+    log.topics(), log.count(topic, multi_id), log.info, log.parameters, log.logged, log.warnings
+    log.compare(BatteryStatus)              # FormatDiff: .missing / .retyped fields keep defaults
+    log.messages(BatteryStatus)             # one topic instance as a list
+    log.columns("battery_status")           # values as columns (numpy if installed)
+    for rec in log.iter_records(BatteryStatus):   # Record(offset, multi_id, topic, instance)
+        ...                                 # every topic and instance of the class, in file order
+
+``read(path, index=False)`` reads only the header and the definitions section; each
+``iter_records`` then walks the data section once, holding one window of offsets at a time, so a
+log of any length is streamed in constant memory. Queries that need every offset (``messages``,
+``columns``, ``records``) index such a log on first use; the attributes the data section fills
+(``subscriptions``, ``logged``, ``warnings``...) are complete once a walk has finished
+(``Log.walked``). ``Record.offset`` is where the record's 'D' header starts in the file.
 """
 
 from __future__ import annotations
 
+import copy
 import dataclasses
+import heapq
+import mmap
 import os
 import struct
 import warnings
-from collections.abc import Iterable, Mapping
-from typing import Any, BinaryIO, TypeVar
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from itertools import repeat
+from typing import Any, BinaryIO, Generic, NamedTuple, TypeVar
 
 from . import _uorb
 
@@ -33,6 +56,7 @@ INCOMPAT_DATA_APPENDED = 0x01  # bit 0 of incompat_flags[0]: data appended at ap
 COMPAT_DEFAULT_PARAMETERS = 0x01  # bit 0 of compat_flags[0]: the log holds 'Q' records
 
 Source = str | os.PathLike[str] | bytes | bytearray | memoryview | BinaryIO
+Buffer = bytes | mmap.mmap  # a log's data: the file's bytes or a read-only map of it
 
 # ULog C type -> (struct code, bytes, numpy type)
 TYPES: dict[str, tuple[str, int, str]] = {
@@ -546,22 +570,71 @@ class Subscription:
     topic: str
 
 
+class Record(NamedTuple, Generic[T]):
+    """One data record of :meth:`Log.iter_records`, decoded."""
+
+    offset: int  # where the 'D' record starts in the file (its size field)
+    multi_id: int
+    topic: str
+    instance: T
+
+
 class _Stream:
-    """The records of one (topic, multi_id): where each payload starts, and its layout."""
+    """The records of one (topic, multi_id): where their payloads start, and the topic's layout.
 
-    __slots__ = ("layout", "offsets", "topic")
+    Indexed, ``offsets`` holds every record; a walk without an index holds one window's records
+    there at a time and adds them to ``done`` when it moves on.
+    """
 
-    def __init__(self, topic: str, lay: Layout | None) -> None:
-        self.topic = topic
+    __slots__ = ("done", "key", "layout", "offsets")
+
+    def __init__(self, key: tuple[str, int], lay: Layout | None) -> None:
+        self.key = key
         self.layout = lay
         self.offsets: list[int] = []
+        self.done = 0
+
+    @property
+    def total(self) -> int:
+        return self.done + len(self.offsets)
+
+
+# The attributes records change; the definitions section's values are kept, and each walk of
+# the data section starts from a copy of them, so a walk can be repeated or abandoned.
+_WALK_STATE = (
+    "formats", "info", "info_multiple", "parameters", "changed_parameters", "default_parameters", "subscriptions",
+    "logged", "logged_tagged", "dropouts", "sync_count", "skipped_records", "unknown_types", "warnings",
+    "_streams", "_layouts", "_column_sets", "_by_id", "_bad_ids", "_in_data",
+)  # fmt: skip
+_DEFINITIONS = frozenset(b"FIMPQ")  # record types that may make up the definitions section
+_WINDOW = 1 << 18  # bytes of data section a walk without an index reads between handing out records
+_D_HEAD = 5  # uint16 size, uint8 'D', uint16 msg_id: a record's payload starts this far in
+
+
+def _copied(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _copied(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_copied(v) for v in value]
+    if isinstance(value, set):
+        return set(value)
+    return value
+
+
+def _first(pair: tuple[int, _Stream]) -> int:
+    return pair[0]
 
 
 class Log:
-    """A parsed ULog file. Data stays in the file's bytes until a topic is asked for."""
+    """A ULog file: its definitions read, its data section indexed (offsets of the records of
+    every topic instance) or, from ``read(..., index=False)``, walked when asked for.
 
-    def __init__(self, data: bytes) -> None:
+    ``data`` is the file: bytes, or a read-only memory map (close() or ``with`` releases it).
+    """
+
+    def __init__(self, data: Buffer, *, warn: bool = True) -> None:
         self.data = data
+        self.warn = warn  # issue a ULogWarning for each problem, besides listing it in ``warnings``
         self.version = 0
         self.timestamp = 0
         self.compat_flags = bytes(8)
@@ -587,16 +660,36 @@ class Log:
         self._by_id: dict[int, tuple[Any, int, int]] = {}  # msg_id -> (offsets.append, min, max record size)
         self._bad_ids: set[int] = set()  # ids warned about (once each)
         self._in_data = False
+        self._segments: list[tuple[int, int]] = []  # data section: (start, stop) up to each appended offset
+        self._definitions: dict[str, Any] = {}  # _WALK_STATE as the definitions section left it
+        self.walked = False  # a walk of the data section finished: the attributes above are complete
+        self.indexed = False  # ... and it kept every record's offset
+
+    def __enter__(self) -> Log:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Release a memory-mapped file (queries fail afterwards); nothing to do for bytes."""
+        if isinstance(self.data, mmap.mmap):
+            try:
+                self.data.close()
+            except BufferError:  # a view into the map is still alive: the map goes with the last one
+                pass
 
     # -- queries --------------------------------------------------------------------------------
 
     def topics(self) -> list[tuple[str, int]]:
         """(topic, multi_id) of every subscription with at least one record."""
-        return sorted(k for k, s in self._streams.items() if s.offsets)
+        self._count()
+        return sorted(k for k, s in self._streams.items() if s.total)
 
     def count(self, topic: str, multi_id: int = 0) -> int:
+        self._count()
         stream = self._streams.get((topic, multi_id))
-        return len(stream.offsets) if stream else 0
+        return stream.total if stream else 0
 
     def layout(self, topic: str) -> Layout:
         """The log's own layout of a topic."""
@@ -617,7 +710,7 @@ class Log:
     def records(self, topic: str, multi_id: int = 0) -> bytes:
         """Every record of a topic instance back to back, each ``layout(topic).data_size`` bytes."""
         size = self.layout(topic).data_size
-        stream = self._streams.get((topic, multi_id))
+        stream = self._index().get((topic, multi_id))
         if stream is None or not stream.offsets:
             return b""
         view = memoryview(self.data)
@@ -629,7 +722,7 @@ class Log:
         None) or required (True), else lists."""
         size = self.layout(topic).data_size
         np = _uorb.numpy_module(use_numpy)
-        stream = self._streams.get((topic, multi_id))
+        stream = self._index().get((topic, multi_id))
         if np is not None and stream is not None and stream.offsets:
             # Gather the records with one fancy-indexing step: a view of the file holding a
             # size-byte record at every byte offset, indexed by the records' offsets.
@@ -653,28 +746,117 @@ class Log:
         record goes through ``cls.decode``; otherwise fields matching by name and type are filled
         and the others keep their defaults (see :meth:`compare`)."""
         topic = topic or _default_topic(cls)
+        decode = self._decoder(cls, topic)
+        stream = self._index().get((topic, multi_id))
+        return [decode(o) for o in stream.offsets] if stream is not None else []
+
+    def iter_records(
+        self, cls: type[T], *, topic: str | Iterable[str] | None = None, multi_id: int | None = None
+    ) -> Iterator[Record[T]]:
+        """The records of ``cls``'s topics one at a time, in file order (instances interleaved as
+        logged), decoded as :meth:`messages` does: fields the log lacks or types otherwise keep
+        their defaults (:meth:`compare` names them).
+
+        ``topic``: one topic or several; None takes every topic of the class that the log has a
+        format for. ``multi_id``: one instance, or None for all. An indexed log hands out its
+        index; otherwise the data section is walked once, in constant memory. A topic without a
+        format in the log raises ULogError here, before the first record.
+        """
+        if topic is None:
+            fmt = format_of(cls)
+            names = [t for t in fmt.topics or (fmt.name,) if t in self.formats]
+        else:
+            names = [topic] if isinstance(topic, str) else list(topic)
+        decoders = {t: self._decoder(cls, t) for t in names}
+        return self._decode_all(decoders, multi_id)
+
+    def _decode_all(self, decoders: dict[str, Callable[[int], T]], multi_id: int | None) -> Iterator[Record[T]]:
+        def wanted(key: tuple[str, int]) -> bool:
+            return key[0] in decoders and (multi_id is None or key[1] == multi_id)
+
+        found: Iterable[tuple[int, _Stream]]
+        if self.indexed:
+            chosen = [zip(s.offsets, repeat(s)) for k, s in sorted(self._streams.items()) if wanted(k)]
+            found = chosen[0] if len(chosen) == 1 else heapq.merge(*chosen, key=_first)
+        else:
+            found = self._walk_unindexed(wanted)
+        for offset, stream in found:
+            topic, multi_id_ = stream.key
+            try:
+                obj = decoders[topic](offset)
+            except (ValueError, struct.error) as exc:
+                at = offset - _D_HEAD
+                raise ULogError(f"{topic} multi_id {multi_id_}, record at offset {at}: cannot decode: {exc}") from exc
+            yield Record(offset - _D_HEAD, multi_id_, topic, obj)
+
+    def _decoder(self, cls: type[T], topic: str) -> Callable[[int], T]:
+        """Decodes a record of ``topic`` as ``cls`` from the offset of its payload."""
         diff = self.compare(cls, topic=topic)
-        lay = self.layout(topic)
-        stream = self._streams.get((topic, multi_id))
-        if stream is None or not stream.offsets:
-            return []
-        data, size = self.data, lay.data_size
-        view = memoryview(data)
+        data, size = self.data, self.layout(topic).data_size
         if diff.identical:
-            decode: Any = getattr(cls, "decode")  # the generated classmethod (cls is a TypeVar)
-            return [decode(view[o : o + size]) for o in stream.offsets]
+            decode: Callable[[bytes], T] = getattr(cls, "decode")  # the generated classmethod
+            return lambda o: decode(data[o : o + size])
         unpack = self._columns(topic).record_struct(size).unpack_from
         skip = {name for name, _ in diff.missing} | {r.name for r in diff.retyped}
-        plan = _plan(format_of(cls), {n: i for i, n in enumerate(lay.names)}, "", "", skip)
-        return [_fill(cls(), plan, unpack(data, o)) for o in stream.offsets]
+        plan = _plan(format_of(cls), {n: i for i, n in enumerate(self.layout(topic).names)}, "", "", skip)
+        filled: Callable[[int], T] = lambda o: _fill(cls(), plan, unpack(data, o))  # noqa: E731
+        return filled
+
+    # -- walking the data section ---------------------------------------------------------------
+
+    def _index(self) -> dict[tuple[str, int], _Stream]:
+        """Every record's offset by (topic, multi_id), walking the data section if not done yet."""
+        if not self.indexed:
+            walk = self._fresh()
+            for _ in walk._windows(len(self.data) + 1):
+                pass
+            self._adopt(walk, indexed=True)
+        return self._streams
+
+    def _count(self) -> None:
+        if not self.walked:
+            for _ in self._walk_unindexed(lambda key: False):
+                pass
+
+    def _walk_unindexed(self, wanted: Callable[[tuple[str, int]], bool]) -> Iterator[tuple[int, _Stream]]:
+        """(payload offset, stream) of the wanted streams' records in file order, walking the data
+        section a window at a time (only a window's offsets are held). A walk that finishes makes
+        its results (subscriptions, counts, warnings...) this log's."""
+        walk = self._fresh()
+        for _ in walk._windows(_WINDOW):
+            streams = [s for s in walk._streams.values() if s.offsets]
+            chosen = [s for s in streams if wanted(s.key)]
+            if len(chosen) == 1:
+                yield from zip(chosen[0].offsets, repeat(chosen[0]))
+            elif chosen:
+                yield from sorted([(o, s) for s in chosen for o in s.offsets], key=_first)
+            for s in streams:
+                s.done += len(s.offsets)
+                s.offsets.clear()
+        self._adopt(walk, indexed=False)
+
+    def _fresh(self) -> Log:
+        """A copy of this log as its definitions section left it, to walk the data section with."""
+        walk = copy.copy(self)
+        for name, value in self._definitions.items():
+            setattr(walk, name, _copied(value))
+        return walk
+
+    def _adopt(self, walk: Log, *, indexed: bool) -> None:
+        for name in _WALK_STATE:
+            setattr(self, name, getattr(walk, name))
+        self.walked = True
+        self.indexed = indexed
 
     # -- parsing --------------------------------------------------------------------------------
 
     def _warn(self, text: str) -> None:
         self.warnings.append(text)
-        warnings.warn(text, ULogWarning, stacklevel=2)
+        if self.warn:
+            warnings.warn(text, ULogWarning, stacklevel=2)
 
-    def _parse(self) -> None:
+    def _load(self, index: bool) -> None:
+        """Read the header and the definitions section; with ``index``, index the data section."""
         data = self.data
         if len(data) < 16 or data[:7] != MAGIC:
             raise ULogError("not a ULog file: expected the magic bytes 'ULog' 01 12 35 and a 16-byte header")
@@ -692,9 +874,19 @@ class Log:
                     if len(good) != len(self.appended_offsets):
                         self._warn(f"ignored appended-data offsets outside the file: {self.appended_offsets}")
                     starts += good
-        for i, start in enumerate(starts):
-            stop = starts[i + 1] if i + 1 < len(starts) else end
-            self._walk(start, stop, stop == end)
+        self._segments = [(start, starts[i + 1] if i + 1 < len(starts) else end) for i, start in enumerate(starts)]
+        # The definitions section: formats, info and parameters up to the first record of another kind
+        # (damage included: the data section's walk reports it).
+        pos, stop = self._segments[0]
+        while pos + 3 <= stop:
+            size, kind = _HEAD.unpack_from(data, pos)
+            if kind not in _DEFINITIONS or pos + 3 + size > stop:
+                break
+            pos = self._step(pos, size, kind, stop, stop == end)
+        self._segments[0] = (pos, stop)
+        self._definitions = {name: _copied(getattr(self, name)) for name in _WALK_STATE}
+        if index:
+            self._index()
 
     def _flag_bits(self, body: bytes) -> None:
         if len(body) < 40:
@@ -706,11 +898,23 @@ class Log:
         if self.incompat_flags[0] & ~INCOMPAT_DATA_APPENDED or any(self.incompat_flags[1:]):
             raise ULogError(f"unknown incompatible flag bits {self.incompat_flags.hex()}: cannot read this log")
 
-    def _walk(self, pos: int, end: int, at_eof: bool) -> None:
+    def _windows(self, size: int) -> Iterator[None]:
+        """Walk the data section, pausing after the records that start in each ``size`` bytes."""
+        end = len(self.data)
+        for start, stop in self._segments:
+            pos = start
+            while pos <= stop:
+                pos = self._walk(pos, stop, stop == end, pos + size)
+                yield
+
+    def _walk(self, pos: int, end: int, at_eof: bool, limit: int) -> int:
+        """The records from ``pos`` that start before ``limit``: where the next one starts, or
+        ``end + 1`` once the segment ending at ``end`` is done."""
         data = self.data
         head = _HEAD_ID.unpack_from  # size, type and (for 'D') msg_id in one call
         by_id = self._by_id
-        while pos + 5 <= end:
+        stop = min(limit, end - 4)  # a 'D' header and msg_id are 5 bytes
+        while pos < stop:
             size, kind, msg_id = head(data, pos)
             nxt = pos + 3 + size
             if kind == 68 and nxt <= end:  # 'D', by far the most frequent: keep this path short
@@ -722,11 +926,14 @@ class Log:
                 pos = nxt
                 continue
             pos = self._step(pos, size, kind, end, at_eof)
+        if pos < end - 4:
+            return pos  # paused at the window's end
         while pos + 3 <= end:  # records of under 2 bytes at the very end
             size, kind = _HEAD.unpack_from(data, pos)
             pos = self._step(pos, size, kind, end, at_eof)
         if pos < end and at_eof:
             self._warn(f"truncated record header at offset {pos}: {end - pos} bytes at the end of the file")
+        return end + 1
 
     def _step(self, pos: int, size: int, kind: int, end: int, at_eof: bool) -> int:
         """Handle the record at ``pos`` (any type); the next position, or one past ``end`` to stop."""
@@ -780,7 +987,7 @@ class Log:
                     lay = self.layout(topic)
                 except ULogError as exc:
                     self._warn(f"subscription to {topic!r} (msg_id {msg_id}): {exc}")
-                stream = self._streams[(topic, multi_id)] = _Stream(topic, lay)
+                stream = self._streams[(topic, multi_id)] = _Stream((topic, multi_id), lay)
             lo, hi = (stream.layout.data_size, stream.layout.size) if stream.layout else (0, 0xFFFD)
             self._by_id[msg_id] = (stream.offsets.append, lo + 2, hi + 2)  # record sizes: msg_id included
             self._bad_ids.discard(msg_id)
@@ -854,18 +1061,37 @@ def _default_topic(cls: type[Any]) -> str:
     return fmt.topics[0] if fmt.topics else fmt.name
 
 
-def read(source: Source) -> Log:
-    """Parse a ULog file (path, bytes or binary file object). Damage is recovered from with a
-    :class:`ULogWarning` (also in ``Log.warnings``); a file that is not ULog raises ULogError."""
+def read(source: Source, *, mmap: bool = True, index: bool = True, warn: bool = True) -> Log:
+    """Read a ULog file: a path (memory-mapped unless ``mmap`` is False), bytes or a binary file.
+
+    With ``index`` (the default) the data section is walked at once and every record's offset
+    kept; without, only the header and definitions are read, and the data section is walked by
+    each :meth:`Log.iter_records` (or indexed on the first query that needs it). Damage is
+    recovered from and listed in ``Log.warnings``, each issued as a :class:`ULogWarning` too
+    unless ``warn`` is False; a file that is not ULog raises ULogError.
+    """
     if isinstance(source, bytes):
-        data = source
+        data: Buffer = source
     elif isinstance(source, bytearray | memoryview):
         data = bytes(source)
     elif isinstance(source, str | os.PathLike):
-        with open(source, "rb") as f:
-            data = f.read()
+        data = _open(source, mmap)
     else:
         data = source.read()
-    log = Log(data)
-    log._parse()
+    log = Log(data, warn=warn)
+    try:
+        log._load(index)
+    except BaseException:
+        log.close()
+        raise
     return log
+
+
+def _open(path: str | os.PathLike[str], use_map: bool) -> Buffer:
+    with open(path, "rb") as f:
+        if use_map:
+            try:
+                return mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
+            except (OSError, ValueError):  # empty, a pipe, or a file system that cannot map: read it
+                pass
+        return f.read()

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import io
+import mmap
 import struct
+import tracemalloc
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -265,3 +267,192 @@ def test_diff_text_and_data() -> None:
     assert str(_ulog.read(battery_log()).compare(BatteryStatus)) == (
         "battery_status: the log's format is the schema's (battery_status)"
     )
+
+
+# -- streaming: read(..., index=False), Log.iter_records ------------------------------------------
+
+
+def scan(raw: bytes) -> list[tuple[int, int, str]]:
+    """(offset, multi_id, topic) of every 'D' record, found by following the record sizes."""
+    subs: dict[int, tuple[int, str]] = {}
+    out, pos = [], 16
+    while pos < len(raw):
+        size, kind = struct.unpack_from("<HB", raw, pos)
+        body = raw[pos + 3 : pos + 3 + size]
+        if kind == ord("A"):
+            subs[struct.unpack_from("<H", body, 1)[0]] = (body[0], body[3:].decode())
+        elif kind == ord("D"):
+            out.append((pos, *subs[struct.unpack_from("<H", body)[0]]))
+        pos += 3 + size
+    return out
+
+
+def mixed_log(path: Path) -> list[tuple[BatteryStatus, int]]:
+    """Two battery instances in an irregular order, with another topic and log text in between."""
+    written = []
+    with _ulog.Writer(path, messages=[BatteryStatus, BatteryStatusV0]) as w:
+        for i in range(40):
+            multi_id = 1 if i % 3 == 1 or i % 7 == 0 else 0
+            msg = BatteryStatus(timestamp=i, voltage_v=10 + i / 8, id=multi_id)
+            w.write(msg, multi_id=multi_id)
+            written.append((msg, multi_id))
+            if i % 5 == 0:
+                w.write(BatteryStatusV0(timestamp=i))
+                w.log(f"step {i}")
+    return written
+
+
+def test_iter_records_are_the_records_a_scan_finds_in_file_order(tmp_path: Path) -> None:
+    path = tmp_path / "mixed.ulg"
+    written = mixed_log(path)
+    raw = path.read_bytes()
+    found = [(o, m) for o, m, t in scan(raw) if t == "battery_status"]
+    assert [m for _, m in found] == [m for _, m in written] and len(set(found)) == 40  # interleaved as logged
+    for log in (_ulog.read(path), _ulog.read(path, index=False)):
+        records = list(log.iter_records(BatteryStatus))
+        assert [(r.offset, r.multi_id) for r in records] == found
+        assert [r.instance for r in records] == [msg for msg, _ in written]
+        assert {r.topic for r in records} == {"battery_status"} and all(isinstance(r, _ulog.Record) for r in records)
+        assert [r.offset for r in log.iter_records(BatteryStatus, multi_id=1)] == [o for o, m in found if m == 1]
+        v0 = list(log.iter_records(BatteryStatusV0))
+        assert [(r.offset, r.multi_id, r.topic) for r in v0] == [x for x in scan(raw) if x[2] == "battery_status_v0"]
+        assert [r.instance.timestamp for r in v0] == list(range(0, 40, 5))
+
+
+def test_iter_records_keeps_defaults_for_what_the_log_lacks() -> None:
+    last = data(0, BatteryStatus(timestamp=9, voltage_v=3.0, faults=5).encode()[:166])
+    raw = battery_log(last).replace(b"uint16_t faults;", b"uint16_t faultz;")  # the 5 lands in faultz
+    log = _ulog.read(raw, index=False)
+    assert log.compare(BatteryStatus).missing == (("faults", "uint16_t"),)  # what was not decoded
+    with pytest.raises(_ulog.ULogError, match="no format for topic 'nope' in this log"):
+        log.iter_records(BatteryStatus, topic="nope")  # at the call, before any walk
+    assert not log.walked
+    *_, rec9 = log.iter_records(BatteryStatus)
+    assert (rec9.instance.timestamp, rec9.instance.voltage_v, rec9.instance.faults) == (9, 3.0, 0)
+    assert [r.topic for r in log.iter_records(BatteryStatusV0, topic=["battery_status"])] == ["battery_status"] * 4
+
+
+def test_mmap_bytes_and_file_inputs_give_the_same_records(tmp_path: Path) -> None:
+    path = tmp_path / "mixed.ulg"
+    mixed_log(path)
+    with path.open("rb") as f:
+        inputs = [
+            _ulog.read(path),
+            _ulog.read(path, mmap=False),
+            _ulog.read(path.read_bytes(), index=False),
+            _ulog.read(f),
+        ]
+    assert isinstance(inputs[0].data, mmap.mmap) and isinstance(inputs[1].data, bytes)
+    results = [list(log.iter_records(BatteryStatus)) for log in inputs]
+    assert all(r == results[0] for r in results) and len(results[0]) == 40
+    with _ulog.read(str(path)) as log:
+        assert log.count("battery_status", 1) == len([m for m in results[0] if m.multi_id == 1])
+    with pytest.raises(ValueError, match="closed"):
+        log.messages(BatteryStatus)  # the map was released
+    (tmp_path / "empty.ulg").write_bytes(b"")
+    with pytest.raises(_ulog.ULogError, match="not a ULog file"):
+        _ulog.read(tmp_path / "empty.ulg")  # nothing to map: read, and refused
+
+
+def test_a_lazy_log_is_complete_once_walked(tmp_path: Path) -> None:
+    path = tmp_path / "mixed.ulg"
+    mixed_log(path)
+    full, lazy = _ulog.read(path), _ulog.read(path, index=False)
+    assert full.walked and full.indexed and not lazy.walked and lazy.subscriptions == [] and lazy.formats
+    records = lazy.iter_records(BatteryStatus)
+    first = next(records)
+    del records  # abandoned: nothing of a half walk is kept
+    assert not lazy.walked and lazy.logged == []
+    again = list(lazy.iter_records(BatteryStatus))
+    assert again[0] == first and len(again) == 40
+    assert lazy.walked and not lazy.indexed and lazy.logged == full.logged and lazy.subscriptions == full.subscriptions
+    assert lazy.topics() == full.topics() and lazy.count("battery_status", 1) == full.count("battery_status", 1)
+    assert lazy.messages(BatteryStatus, multi_id=1) == full.messages(BatteryStatus, multi_id=1) and lazy.indexed
+    assert _ulog.read(path, index=False).topics() == full.topics()  # counted by a walk that decodes nothing
+
+
+def damaged_logs() -> dict[str, bytes]:
+    sync = rec("S", _ulog.SYNC)
+    body = rec("F", BATTERY_STATUS_FORMAT.encode()) + sub(0, 0, "battery_status")
+    body += data(0, BatteryStatus(timestamp=1).encode()[:166])
+    cut = data(0, BatteryStatus(timestamp=2).encode()[:166])[:50]
+    start = len(head()) + len(body) + len(cut)
+    appended = head(incompat=_ulog.INCOMPAT_DATA_APPENDED, offsets=(start,)) + body + cut
+    return {
+        "truncated": battery_log()[:-10],
+        "resync": battery_log(b"\0\0\0garbage", sync, data(0, BatteryStatus(timestamp=7).encode()[:166])),
+        "bad data": battery_log(data(9, b"x" * 8), data(0, bytes(100)), data(0, BatteryStatus(timestamp=5).encode())),
+        "appended": appended + data(0, BatteryStatus(timestamp=3).encode()[:166]),
+        "late format": battery_log(rec("F", b"late:uint8_t x;"), rec("I", b"\x0echar[1] late_1x")),
+    }
+
+
+STAMPS = {
+    "truncated": [0, 1],
+    "resync": [0, 1, 2, 7],
+    "bad data": [0, 1, 2, 5],
+    "appended": [1, 3],
+    "late format": [0, 1, 2],
+}
+
+
+@pytest.mark.parametrize("name", list(STAMPS))
+def test_walks_in_small_windows_agree_with_the_index(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    raw = damaged_logs()[name]
+    full = _ulog.read(raw, warn=False)
+    monkeypatch.setattr(_ulog, "_WINDOW", 7)  # a pause after nearly every record
+    lazy = _ulog.read(raw, index=False, warn=False)
+    records = list(lazy.iter_records(BatteryStatus))
+    assert records == list(full.iter_records(BatteryStatus))
+    assert [r.instance for r in records] == full.messages(BatteryStatus)
+    assert [r.instance.timestamp for r in records] == STAMPS[name]
+    assert all(raw[r.offset + 2] == ord("D") for r in records)
+    assert bool(full.warnings) == (name != "late format")
+    for attr in ("warnings", "skipped_records", "formats", "info", "subscriptions", "sync_count", "parameters"):
+        assert getattr(lazy, attr) == getattr(full, attr), attr
+    assert lazy.topics() == full.topics() and lazy.count("battery_status") == full.count("battery_status")
+
+
+REAL_LOGS = Path("/work/shared/data/ulog")
+
+
+@pytest.mark.parametrize("name", ["sample_log_small.ulg", "sample_px4_events.ulg"])
+def test_real_logs_walked_in_windows_read_as_indexed(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    path = REAL_LOGS / name
+    if not path.is_file():
+        pytest.skip("shared sample logs not present")
+    full = _ulog.read(path)
+    monkeypatch.setattr(_ulog, "_WINDOW", 4096)  # hundreds of windows, cutting between records of ~100 topics
+    lazy = _ulog.read(path, index=False)
+    records = list(lazy.iter_records(BatteryStatus))
+    assert len(records) > 20 and records == list(full.iter_records(BatteryStatus))
+    assert [r.instance for r in records if r.multi_id == 0] == full.messages(BatteryStatus)
+    assert [r.offset for r in records] == sorted(r.offset for r in records)
+    assert {r.multi_id for r in records} == {m for t, m in full.topics() if t == "battery_status"}
+    for attr in ("info", "info_multiple", "parameters", "changed_parameters", "logged", "dropouts", "subscriptions"):
+        assert getattr(lazy, attr) == getattr(full, attr), attr
+    counts = {key: lazy.count(*key) for key in lazy.topics()}
+    assert counts == {key: full.count(*key) for key in full.topics()} and len(counts) > 50
+
+
+def test_streaming_memory_does_not_grow_with_the_log(tmp_path: Path) -> None:
+    """A log 8x longer streams within the same memory: one window of offsets at a time."""
+    peaks = []
+    for n in (4_000, 32_000):
+        path = tmp_path / f"long{n}.ulg"
+        msg = BatteryStatus(voltage_v=12.0, remaining=0.5)
+        with _ulog.Writer(path, messages=[BatteryStatus]) as w:
+            for i in range(n):
+                msg.timestamp = i
+                w.write(msg, multi_id=i % 2)
+        tracemalloc.start()
+        try:
+            with _ulog.read(path, index=False) as log:
+                count = sum(1 for _ in log.iter_records(BatteryStatus))
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        assert count == n
+        peaks.append(peak)
+    # an index of 32,000 offsets alone takes over 1 MB; a list of instances ~30 MB
+    assert peaks[1] < 400_000 and peaks[1] < peaks[0] * 1.25 + 20_000, peaks

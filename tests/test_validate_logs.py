@@ -14,6 +14,7 @@ from conftest import ROOT
 
 from codegen.cli import main
 from codegen.commands.validate import check_file, make_checker
+from codegen.instances import read_records
 from generated import _ulog
 from generated.mavlink import BatteryStatus as MavBattery
 from generated.uorb import BatteryStatus
@@ -128,26 +129,50 @@ def test_log_without_the_topic_has_no_records(capsys: pytest.CaptureFixture[str]
     code, lines, err = run(capsys, "validate", "--message", "uorb.BatteryStatus", str(path))
     assert (code, lines) == (0, [])
     assert "warning: no battery_status records in this log (topics logged: battery_status_v0)" in err
+    # convert reports the same, after the (empty) output
+    code, lines, err = run(capsys, "convert", "--from", "uorb", "--to", "mavlink", str(path))
+    assert (code, lines) == (0, [])
+    assert "warning: no battery_status records in this log (topics logged: battery_status_v0)" in err
 
 
 def test_ulog_validation_memory_does_not_grow_with_records(tmp_path: Path) -> None:
-    """20,000 records (3.4 MB): the file is mapped, records are decoded one at a time; what grows is
-    the reader's offset index (about 40 bytes a record)."""
-    path = tmp_path / "long.ulg"
-    good = BatteryStatus(timestamp=1, voltage_v=12.0, remaining=0.5, max_error=1)
-    with _ulog.Writer(path, messages=[BatteryStatus]) as w:
-        for i in range(20_000):
-            good.timestamp = i
-            w.write(good)
+    """The file is mapped and walked once, records decoded one at a time: the peak stays flat from
+    3,000 to 15,000 records (an offset index would add ~40 bytes a record, a list of instances ~1 kB)."""
     message, checker = make_checker(SCHEMAS, "uorb.BatteryStatus")
-    tracemalloc.start()
-    try:
-        report = check_file(path, message, checker, echo=False)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
-    assert (report.records, report.errors) == (20_000, 0)
-    assert peak < 2_500_000, peak  # a list of 20,000 instances alone would take ~20 MB
+    good = BatteryStatus(timestamp=1, voltage_v=12.0, remaining=0.5, max_error=1)
+    peaks = []
+    for n in (3_000, 15_000):
+        path = tmp_path / f"long{n}.ulg"
+        with _ulog.Writer(path, messages=[BatteryStatus]) as w:
+            for i in range(n):
+                good.timestamp = i
+                w.write(good, multi_id=i % 3 % 2)
+        tracemalloc.start()
+        try:
+            report = check_file(path, message, checker, echo=False)
+            peaks.append(tracemalloc.get_traced_memory()[1])
+        finally:
+            tracemalloc.stop()
+        assert (report.records, report.errors, report.notices) == (n, 0, [])
+    assert peaks[1] < 600_000 and peaks[1] < peaks[0] * 1.25 + 20_000, peaks
+
+
+def test_damage_is_told_after_the_records(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    path = tmp_path / "cut.ulg"
+    _ulog.write(path, [BatteryStatus(timestamp=i, max_error=1) for i in range(3)])
+    stray = _record("D", struct.pack("<H", 7) + b"abc")  # msg_id 7 was never subscribed
+    path.write_bytes(path.read_bytes() + stray + _record("D", bytes(168))[:40])  # and a record cut short
+    code, doc = run_json(capsys, "--message", "uorb.BatteryStatus", str(path))
+    report = doc["files"][0]
+    assert (code, report["records"]) == (0, 3)
+    assert [n["kind"] for n in report["notices"]] == ["damage"] * 2
+    assert "data for msg_id 7 without a subscription" in report["notices"][0]["message"]
+    assert "truncated record 'D' at offset" in report["notices"][1]["message"]
+    code, _, err = run(capsys, "validate", "--message", "uorb.BatteryStatus", str(path))
+    assert code == 0 and err.count("warning: damaged log, recovered:") == 2
+    message, checker = make_checker(SCHEMAS, "uorb.BatteryStatus")
+    items = [getattr(item, "kind", "record") for item in read_records(path, message, model=checker.cls)]
+    assert items == ["record"] * 3 + ["damage"] * 2  # known once the walk has seen the whole file
 
 
 def test_convert_ulog_to_mavlink(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:

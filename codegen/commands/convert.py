@@ -99,6 +99,9 @@ def _log_records(source: Path | IO[bytes], where: str, fmt: str, side: _Side) ->
                 if isinstance(rec, Unreadable):
                     raise BattgenError(f"{where}: {rec.message}")
                 yield _Record(None, f"{where} ({rec.where()})", 0, [rec.instance, *pad])
+            for notice in reader.trailing:  # damage and "no records": known only after the whole walk
+                if notice.severity == "warning":
+                    print(f"{where}: warning: {notice.message}", file=sys.stderr)
         finally:
             reader.close()
         return
