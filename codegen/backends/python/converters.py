@@ -322,41 +322,42 @@ class _Generator:
 
     def pair_modules(self) -> list[tuple[str, str, str, str, list[str], tuple[str, ...]]]:
         """Writes the pair and endpoint modules; returns (source, target, module, function, policies, inputs)."""
-        registry = []
+        registry: list[tuple[str, str, str, str, list[str], tuple[str, ...]]] = []
         names = self.endpoint_names()
-        # format <-> concepts
-        for ep in names:
-            funcs, modules, imports = [], set(), set()
-            for fname, s, t in (("to_concepts", ep, CONCEPTS_ENDPOINT), ("from_concepts", CONCEPTS_ENDPOINT, ep)):
-                built = self.converter_function(fname, s, t)
-                if built is None:
-                    continue
-                text, mods, pols, inputs, imps = built
-                funcs.append(text)
-                modules |= mods
-                imports |= imps
-                registry.append((s, t, ep, fname, pols, inputs))
-            if funcs:
-                self.write_module(ep, f"Converters between {ep} and the shared concepts.", funcs, modules, imports)
+        for ep in names:  # format <-> concepts
+            directions = [("to_concepts", ep, CONCEPTS_ENDPOINT), ("from_concepts", CONCEPTS_ENDPOINT, ep)]
+            self.direction_module(ep, f"Converters between {ep} and the shared concepts.", directions, registry)
         for i, a in enumerate(names):
             for b in names[i + 1 :]:
                 module = f"{a}_{b}"
                 if module in self.endpoints:
                     raise BattgenError(f"converter module {module} would clash with the endpoint of that name")
-                funcs, modules, imports = [], set(), set()
-                for s, t in ((a, b), (b, a)):
-                    fname = f"{s}_to_{t}"
-                    built = self.converter_function(fname, s, t)
-                    if built is None:
-                        continue
-                    text, mods, pols, inputs, imps = built
-                    funcs.append(text)
-                    modules |= mods
-                    imports |= imps
-                    registry.append((s, t, module, fname, pols, inputs))
-                if funcs:
-                    self.write_module(module, f"Converters between {a} and {b}.", funcs, modules, imports)
+                directions = [(f"{s}_to_{t}", s, t) for s, t in ((a, b), (b, a))]
+                self.direction_module(module, f"Converters between {a} and {b}.", directions, registry)
         return registry
+
+    def direction_module(
+        self,
+        module: str,
+        doc: str,
+        directions: list[tuple[str, str, str]],
+        registry: list[tuple[str, str, str, str, list[str], tuple[str, ...]]],
+    ) -> None:
+        """Write ``module`` with a function per (name, source, target) that has a route; record them."""
+        funcs: list[str] = []
+        modules: set[str] = set()
+        imports: set[str] = set()
+        for fname, s, t in directions:
+            built = self.converter_function(fname, s, t)
+            if built is None:
+                continue
+            text, mods, pols, inputs, imps = built
+            funcs.append(text)
+            modules |= mods
+            imports |= imps
+            registry.append((s, t, module, fname, pols, inputs))
+        if funcs:
+            self.write_module(module, doc, funcs, modules, imports)
 
     def write_module(self, module: str, doc: str, funcs: list[str], modules: set[str], types: set[str]) -> None:
         imports = ["from . import _runtime as _r"] + [f"from . import {m}" for m in sorted(modules)] + sorted(types)
