@@ -120,6 +120,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BattgenError as exc:
         print(f"battgen: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    except ModuleNotFoundError as exc:  # a dependency missing from this environment, e.g. pymavlink
+        print(
+            f"battgen: needs the Python package {exc.name!r}: install battgen with pip (pip install -e .)",
+            file=sys.stderr,
+        )
+        return EXIT_USAGE
     except KeyboardInterrupt:
         return 130
     except BrokenPipeError:

@@ -117,3 +117,17 @@ def test_usage_errors_exit_2(args: list[str], needle: str) -> None:
     proc = run(args)
     assert proc.returncode == 2
     assert needle in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_missing_dependency_is_a_clean_error(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import codegen.cli as cli
+
+    def missing(_: object) -> int:
+        raise ModuleNotFoundError("No module named 'pymavlink'", name="pymavlink")
+
+    monkeypatch.setattr(cli, "cmd_list", missing)
+    assert cli.main(["list"]) == 2
+    err = capsys.readouterr().err
+    assert "needs the Python package 'pymavlink'" in err and "Traceback" not in err
