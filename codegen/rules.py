@@ -24,10 +24,11 @@ from pathlib import Path
 from typing import Any
 
 import jsonschema
-import yaml
 
 from .errors import SchemaError
 from .frontends.common import display_path, read_text
+from .frontends.yaml_lines import YList, YMap, line_at
+from .frontends.yaml_lines import load as load_yaml
 from .ir import CrossFieldRule, Location, Message, Schema
 from .rules_expr import (
     Binary,
@@ -135,73 +136,38 @@ def _schema() -> dict[str, Any]:
     return data
 
 
-def _plain(node: yaml.Node, path: tuple[object, ...], lines: dict[tuple[object, ...], int], file: str) -> object:
-    """YAML node -> plain data, recording the line of every value by its JSON path."""
-    lines[path] = node.start_mark.line + 1
-    if isinstance(node, yaml.MappingNode):
-        out: dict[str, object] = {}
-        for key_node, value_node in node.value:
-            key = yaml.SafeLoader("").construct_object(key_node) if isinstance(key_node, yaml.ScalarNode) else None
-            if not isinstance(key, str):
-                raise SchemaError(file, key_node.start_mark.line + 1, "expected a string key")
-            if key in out:
-                raise SchemaError(file, key_node.start_mark.line + 1, f"duplicate key {key!r}")
-            out[key] = _plain(value_node, (*path, key), lines, file)
-        return out
-    if isinstance(node, yaml.SequenceNode):
-        return [_plain(item, (*path, i), lines, file) for i, item in enumerate(node.value)]
-    loader = yaml.SafeLoader("")
-    try:
-        return loader.construct_object(node)
-    except yaml.YAMLError as exc:
-        raise SchemaError(file, node.start_mark.line + 1, f"unreadable value: {exc}") from None
-
-
 def load_rule_file(path: Path, *, root: Path | None = None) -> tuple[CrossFieldRule, ...]:
     display = display_path(path, root)
-    text = read_text(path, display)
-    try:
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
-        line = mark.line + 1 if mark is not None else 1
-        problem = getattr(exc, "problem", None) or str(exc)
-        raise SchemaError(display, line, f"expected YAML: {problem}") from None
-    if node is None:
+    data = load_yaml(read_text(path, display), display, expected="YAML")
+    if data is None:
         raise SchemaError(display, 1, "expected a rule file (a mapping with 'messages' and 'rules'), found nothing")
-    lines: dict[tuple[object, ...], int] = {}
-    data = _plain(node, (), lines, display)
     errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(e.path))
     if errors:
         err = jsonschema.exceptions.best_match(errors)
-        where = tuple(err.absolute_path)
-        while where not in lines and where:
-            where = where[:-1]
         at = "/".join(str(p) for p in err.absolute_path) or "the file"
-        raise SchemaError(display, lines.get(where, 1), f"{at}: {err.message} (see codegen/rules.schema.json)")
-    assert isinstance(data, dict)
+        raise SchemaError(
+            display, line_at(data, list(err.absolute_path)), f"{at}: {err.message} (see codegen/rules.schema.json)"
+        )
+    assert isinstance(data, YMap)
     messages = tuple(data["messages"])
-    rules = tuple(_ir_rule(item, i, messages, lines, display) for i, item in enumerate(data["rules"]))
+    rules = tuple(_ir_rule(item, messages, display) for item in data["rules"])
     for rule in rules:
         parsed(rule)  # every expression parses, or the error names its line now
     return rules
 
 
-def _ir_rule(
-    item: dict[str, Any], i: int, messages: tuple[str, ...], lines: dict[tuple[object, ...], int], file: str
-) -> CrossFieldRule:
-    base: tuple[object, ...] = ("rules", i)
+def _ir_rule(item: YMap, messages: tuple[str, ...], file: str) -> CrossFieldRule:
     raw_for = item.get("for", [])
     loops = (raw_for,) if isinstance(raw_for, str) else tuple(raw_for)
-    keyed = [(str(k), lines[(*base, k)]) for k in item if (*base, k) in lines]
-    if not isinstance(raw_for, str):
-        keyed += [(f"for[{j}]", lines[(*base, "for", j)]) for j in range(len(loops)) if (*base, "for", j) in lines]
+    keyed = [(str(k), item.line_of(k)) for k in item]
+    if isinstance(raw_for, YList):
+        keyed += [(f"for[{j}]", line) for j, line in enumerate(raw_for.item_lines)]
     return CrossFieldRule(
         id=item["id"],
         messages=messages,
         severity=item.get("severity", "error"),
         check=item["assert"],
-        location=Location(file, lines[base]),
+        location=Location(file, item.line),
         doc=item.get("doc", ""),
         where=item.get("where"),
         loops=loops,

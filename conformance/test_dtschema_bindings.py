@@ -22,7 +22,7 @@ from typing import Any
 import pytest
 
 from codegen.frontends import devicetree as dt
-from codegen.frontends.devicetree_yaml import load
+from codegen.frontends.yaml_lines import load
 from codegen.ir import ArrayType, Field, FieldType, Message, PrimitiveKind, PrimitiveType, Range, Schema
 
 dtschema = pytest.importorskip("dtschema")

@@ -25,7 +25,7 @@ from .common import display_path, read_text
 from .devicetree_data import DATA_FILES, DtData, load_data
 from .devicetree_shape import UNKNOWN_TYPE, as_text, ir_type, shape_of, values_of, with_columns
 from .devicetree_types import RefContext, Resolved, pointer, resolve
-from .devicetree_yaml import YList, YMap, load
+from .yaml_lines import YList, YMap, load
 
 PREFIX = "devicetree"
 # keys of a property schema the IR holds; the rest are kept verbatim in annotations

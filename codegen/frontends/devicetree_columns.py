@@ -13,7 +13,7 @@ import json
 from typing import Any
 
 from ..ir import Column, Location, Range
-from .devicetree_yaml import YMap
+from .yaml_lines import YMap
 
 _BOUNDS = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
 _SIZE_KEYS = frozenset({"items", "minItems", "maxItems"})  # a row's own shape: read by the caller

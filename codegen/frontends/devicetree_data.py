@@ -17,7 +17,7 @@ from .. import units
 from ..errors import SchemaError
 from ..ir import Unit
 from .common import display_path, read_text
-from .devicetree_yaml import YList, YMap, load
+from .yaml_lines import YList, YMap, load
 
 TYPES_FILE = "types.yaml"
 UNITS_FILE = "property-units.yaml"

@@ -15,7 +15,7 @@ from typing import Any
 from ..ir import ArrayType, Column, FieldType, PrimitiveKind, PrimitiveType, Range, StringType
 from .devicetree_columns import as_text, bounds_of, columns_of, verbatim
 from .devicetree_data import TypeDef
-from .devicetree_yaml import YMap
+from .yaml_lines import YMap
 
 Dim = tuple[int, int | None]  # (min items, max items or None when unbounded)
 

@@ -15,7 +15,7 @@ from urllib.parse import urljoin
 
 from ..errors import SchemaError
 from .devicetree_data import DtData
-from .devicetree_yaml import YList, YMap
+from .yaml_lines import YList, YMap
 
 # Core properties (devicetree specification / dt-schema's core schemas), for bindings that
 # list them without a type.

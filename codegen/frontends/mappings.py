@@ -32,7 +32,7 @@ from ..ir import (
     Schema,
 )
 from .common import display_path, read_text
-from .devicetree_yaml import YList, YMap, load
+from .yaml_lines import YMap, line_at, load
 
 # params naming constants of the message a rule reads or writes (checked when formats are known)
 _CONSTANT_PARAMS = {"mask", "map", "bits", "default", "equals"}
@@ -45,22 +45,6 @@ def mappings_json_schema() -> dict[str, Any]:
     return result
 
 
-def _line_at(doc: Any, path: list[Any]) -> int:
-    """The line of the deepest node along ``path`` that knows its line."""
-    line = getattr(doc, "line", 1) or 1
-    node = doc
-    for step in path:
-        if isinstance(node, YMap) and step in node:
-            line = node.line_of(step)
-            node = node[step]
-        elif isinstance(node, YList) and isinstance(step, int) and 0 <= step < len(node):
-            node = node[step]
-            line = getattr(node, "line", line) or line
-        else:
-            break
-    return line
-
-
 def _validate(doc: Any, display: str) -> None:
     import jsonschema
 
@@ -71,7 +55,7 @@ def _validate(doc: Any, display: str) -> None:
         best = jsonschema.exceptions.best_match(errors) or err
         path = list(best.absolute_path)
         where = "/".join(str(p) for p in path) or "the top level"
-        raise SchemaError(display, _line_at(doc, path), f"expected a valid mapping file at {where}: {best.message}")
+        raise SchemaError(display, line_at(doc, path), f"expected a valid mapping file at {where}: {best.message}")
 
 
 def _param_value(value: Any) -> ParamValue:
