@@ -58,7 +58,7 @@ def rate_with_report(fn: Callable[..., Any], items: list[tuple[Any, ...]], repea
 
 
 def cli_rate(n: int, repeat: int) -> float:
-    from codegen.cli import main
+    from codegen.cli.main import main
 
     line = json.dumps({"voltage": 12.6, "temperature": 298.15, "state_of_charge_pct": 55}) + "\n"
     data = (line * n).encode()

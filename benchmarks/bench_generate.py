@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from codegen.backends.python import render_package
-from codegen.loader import FORMAT_FRONTENDS, frontend, load
+from codegen.frontends.loader import FORMAT_FRONTENDS, frontend, load
 
 ROOT = Path(__file__).resolve().parent.parent
 SCHEMAS = ROOT / "schemas"

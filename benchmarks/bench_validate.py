@@ -24,8 +24,8 @@ from typing import Any
 import fastjsonschema
 import jsonschema
 
-from codegen.backends.jsonschema_export import message_json_schema
-from codegen.loader import load
+from codegen.backends.json_schema import message_json_schema
+from codegen.frontends.loader import load
 from generated.uorb import BatteryStatus
 
 ROOT = Path(__file__).resolve().parent.parent

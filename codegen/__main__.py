@@ -1,5 +1,5 @@
 """``python -m codegen`` runs the battgen command line."""
 
-from .cli import main
+from .cli.main import main
 
 raise SystemExit(main())

@@ -25,8 +25,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from codegen.backends.python import naming
+from codegen.backends.python.writer import generate
 from codegen.frontends import dsdl
-from codegen.generate import generate
 from codegen.ir import ArrayType, CompositeType, DronecanKind, FieldType, Message, PrimitiveKind, PrimitiveType, Schema
 
 dronecan = pytest.importorskip("dronecan")

@@ -24,7 +24,8 @@ from typing import Any
 import pytest
 import yaml
 
-from codegen.dts import (
+from codegen.frontends import devicetree as frontend
+from codegen.inputs.devicetree import (
     DevicetreeError,
     DtNode,
     find_compatible,
@@ -33,7 +34,6 @@ from codegen.dts import (
     read_dtb,
     read_dts,
 )
-from codegen.frontends import devicetree as frontend
 from codegen.ir import ArrayType, Message, Range
 from generated._meta import DataError
 from generated.devicetree.power.supply import SimpleBattery

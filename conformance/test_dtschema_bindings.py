@@ -22,8 +22,8 @@ from typing import Any
 import pytest
 
 from codegen.frontends import devicetree as dt
-from codegen.frontends.yaml_lines import load
 from codegen.ir import ArrayType, Field, FieldType, Message, PrimitiveKind, PrimitiveType, Range, Schema
+from codegen.text.yaml_lines import load
 
 dtschema = pytest.importorskip("dtschema")
 

@@ -25,12 +25,12 @@ import jsonschema
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from codegen.backends.jsonschema_export import FLOAT_MAX, at_column, export_all
+from codegen.backends.json_schema import FLOAT_MAX, at_column, export_all
 from codegen.backends.python import naming
-from codegen.backends.python.validators_checks import enum_facts, folded
+from codegen.backends.python.validators.checks import enum_facts, folded
+from codegen.frontends.loader import load
 from codegen.ir import ArrayType, CompositeType, Field, FieldType, Message, PrimitiveKind, PrimitiveType, Schema
 from codegen.ir import StringType as StrT
-from codegen.loader import load
 
 ROOT = Path(__file__).resolve().parent.parent
 SCHEMA = load([ROOT / "schemas"])

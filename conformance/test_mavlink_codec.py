@@ -22,8 +22,8 @@ from hypothesis import strategies as st
 from pymavlink.dialects.v10 import common as v10
 from pymavlink.dialects.v20 import common as v20
 
+from codegen.backends.python.writer import generate
 from codegen.frontends import mavlink as frontend
-from codegen.generate import generate
 from codegen.ir import ArrayType, Field, Message, PrimitiveKind, PrimitiveType, StringType
 from generated import _mavlink as runtime
 from generated.mavlink import BatteryStatus

@@ -1,6 +1,6 @@
 """Our MAVLink frontend against pymavlink: its parser (mavparse) and its generated dialect modules.
 
-Wire order, lengths and CRC_EXTRA are computed by codegen.frontends.mavlink_layout on its own,
+Wire order, lengths and CRC_EXTRA are computed by codegen.frontends.mavlink.layout on its own,
 so agreeing with pymavlink here is a real check, not a copy.
 """
 
@@ -20,7 +20,7 @@ import pytest
 from pymavlink.generator import mavparse
 
 from codegen.frontends import mavlink
-from codegen.frontends.mavlink_layout import c_type
+from codegen.frontends.mavlink.layout import c_type
 from codegen.ir import EnumKind, Message, Schema
 
 DIALECTS = Path(pymavlink.__file__).parent / "dialects" / "v20"

@@ -14,8 +14,8 @@ from pymavlink import mavutil
 from pymavlink.dialects.v10 import common as v10
 from pymavlink.dialects.v20 import common as v20
 
-from codegen.cli import main
-from codegen.instances_mavlink import StreamStats, read_frames
+from codegen.cli.main import main
+from codegen.inputs.tlog import StreamStats, read_frames
 from generated.mavlink import BatteryStatus
 
 T0 = 1_700_000_000_000_000  # microseconds since the Unix epoch

@@ -25,8 +25,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pyulog import ULog
 
+from codegen.backends.python.writer import generate
 from codegen.frontends import uorb
-from codegen.generate import generate
 from generated import _ulog
 from generated.uorb import BatteryStatus, BatteryStatusV0
 

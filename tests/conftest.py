@@ -12,7 +12,7 @@ from types import ModuleType
 import pytest
 from hypothesis import HealthCheck, settings
 
-from codegen.generate import generate
+from codegen.backends.python.writer import generate
 from codegen.ir import Schema
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -12,7 +12,6 @@ from typing import Any
 
 import pytest
 
-from codegen import units
 from codegen.backends.python import render_package
 from codegen.ir import (
     ArrayType,
@@ -34,6 +33,7 @@ from codegen.ir import (
     Sentinel,
     SourceFormat,
     StringType,
+    units,
 )
 
 L = Location("hostile.msg", 3)
@@ -151,7 +151,7 @@ def test_devicetree_model_and_pattern_properties(import_generated: Any) -> None:
 
 
 def test_generated_code_is_mypy_clean(tmp_path: Path) -> None:
-    from codegen.generate import generate
+    from codegen.backends.python.writer import generate
 
     generate(hostile_schema(), tmp_path / "genpkg")
     proc = subprocess.run(

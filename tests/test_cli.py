@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from codegen.cli import main
-from codegen.irjson import validate_ir_json
+from codegen.cli.main import main
+from codegen.ir.json_form import validate_ir_json
 
 SCHEMAS = ROOT / "schemas"
 
@@ -122,7 +122,7 @@ def test_usage_errors_exit_2(args: list[str], needle: str) -> None:
 def test_missing_dependency_is_a_clean_error(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import codegen.cli as cli
+    import codegen.cli.main as cli
 
     def missing(_: object) -> int:
         raise ModuleNotFoundError("No module named 'pymavlink'", name="pymavlink")

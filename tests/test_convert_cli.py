@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from codegen.cli import main
+from codegen.cli.main import main
 from generated.mavlink import BatteryStatus as MavBatteryStatus
 
 RECORD = {"temperature": 298.15, "voltage": 12.6, "current": 5, "state_of_charge_pct": 127, "battery_id": 0}

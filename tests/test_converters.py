@@ -14,8 +14,8 @@ from conftest import ROOT
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from codegen import ocv
-from codegen.loader import load
+from codegen.apps import ocv
+from codegen.frontends.loader import load
 from generated.convert import CONVERTERS, ENDPOINTS, POLICIES, BatteryState, ConversionError, LossReport, converter
 from generated.convert import _runtime as rt
 from generated.convert.dronecan import from_concepts as dronecan_from_concepts

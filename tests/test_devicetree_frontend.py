@@ -8,10 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from codegen import units
 from codegen.errors import SchemaError
 from codegen.frontends import devicetree as dt
-from codegen.frontends.devicetree_data import PACKAGED, load_data
+from codegen.frontends.devicetree.data import PACKAGED, load_data
 from codegen.ir import (
     ArrayType,
     Column,
@@ -22,6 +21,7 @@ from codegen.ir import (
     PrimitiveType,
     Range,
     StringType,
+    units,
 )
 
 SCHEMAS = Path(__file__).resolve().parent.parent / "schemas" / "devicetree"

@@ -13,8 +13,7 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from codegen import units
-from codegen.backends.markdown_docs import (
+from codegen.backends.markdown import (
     INDEX,
     MARKER,
     cell,
@@ -25,8 +24,9 @@ from codegen.backends.markdown_docs import (
     render_docs,
     render_message,
 )
-from codegen.cli import main
+from codegen.cli.main import main
 from codegen.frontends import uorb
+from codegen.frontends.loader import load
 from codegen.ir import (
     ArrayType,
     Column,
@@ -43,8 +43,8 @@ from codegen.ir import (
     Schema,
     Sentinel,
     SourceFormat,
+    units,
 )
-from codegen.loader import load
 
 SCHEMAS = ROOT / "schemas"
 PX4_PAGE = ROOT / "tests" / "data" / "docs" / "px4_BatteryStatusV0.md"

@@ -17,8 +17,8 @@ from typing import Any
 
 import pytest
 
+from codegen.backends.python.writer import generate
 from codegen.frontends import dsdl
-from codegen.generate import generate
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -6,11 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from codegen import units
 from codegen.errors import SchemaError
 from codegen.frontends import dsdl
-from codegen.frontends.dsdl_expr import ExpressionError, evaluate
-from codegen.frontends.dsdl_signature import crc64we
+from codegen.frontends.dsdl.expr import ExpressionError, evaluate
+from codegen.frontends.dsdl.signature import crc64we
 from codegen.ir import (
     ArrayType,
     CastMode,
@@ -22,6 +21,7 @@ from codegen.ir import (
     PrimitiveType,
     Range,
     Sentinel,
+    units,
 )
 
 BUNDLED = Path(__file__).resolve().parents[1] / "schemas" / "dronecan"

@@ -1,4 +1,4 @@
-"""The .dtb reader (codegen.dts.read_dtb) on blobs we build by hand, and its error paths.
+"""The .dtb reader (codegen.inputs.devicetree.read_dtb) on blobs we build by hand, and its error paths.
 
 Blobs are assembled here from the devicetree specification's layout so the tests need no dtc;
 conformance/test_dt_instances_dtschema.py reads what dtc itself writes.
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from codegen.dts import DevicetreeError, read_dtb, read_dtb_blob, read_dts, read_nodes
+from codegen.inputs.devicetree import DevicetreeError, read_dtb, read_dtb_blob, read_dts, read_nodes
 
 BEGIN, END_NODE, PROP, NOP, END = 1, 2, 3, 4, 9
 

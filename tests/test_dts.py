@@ -1,4 +1,4 @@
-"""The .dts/.dtsi parser (codegen.dts.read_dts) and the mapping onto the generated model.
+"""The .dts/.dtsi parser (codegen.inputs.devicetree.read_dts) and the mapping onto the generated model.
 
 Expected bytes follow dtc's output (checked against dtc itself in
 conformance/test_dt_instances_dtschema.py); here each feature and each error path on its own.
@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from codegen.dts import (
+from codegen.frontends import devicetree as frontend
+from codegen.inputs.devicetree import (
     DevicetreeError,
     DtNode,
     field_for,
@@ -24,7 +25,6 @@ from codegen.dts import (
     read_dts,
     read_nodes,
 )
-from codegen.frontends import devicetree as frontend
 from codegen.ir import Message
 from generated._meta import DataError
 from generated.devicetree.power.supply import SimpleBattery

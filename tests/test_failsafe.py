@@ -6,7 +6,7 @@ import dataclasses
 
 import pytest
 
-from codegen.failsafe import (
+from codegen.apps.failsafe.evaluator import (
     DEFAULTS,
     Action,
     BatteryFailsafe,
@@ -263,7 +263,7 @@ def test_time_must_not_go_back() -> None:
 def test_converters_and_ir_fallback_agree(qualified: str, module: str, cls: str, data: dict[str, object]) -> None:
     import importlib
 
-    from codegen.failsafe_stream import battery_state, battery_state_from_ir
+    from codegen.apps.failsafe.stream import battery_state, battery_state_from_ir
 
     model = getattr(importlib.import_module(f"generated.{module}"), cls).from_dict(data)
     ours, theirs = battery_state_from_ir(qualified, model), battery_state(qualified, model)

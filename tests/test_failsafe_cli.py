@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from codegen.cli import main
+from codegen.cli.main import main
 
 PARAMS = "BATT_LOW_VOLT,10.5\nBATT_CRT_VOLT,10.0\nBATT_FS_LOW_ACT,2\nBATT_FS_CRT_ACT,1\n"
 DTS = """/dts-v1/;

@@ -11,8 +11,8 @@ import time
 from conftest import ROOT
 
 from codegen.backends.python import render_package
-from codegen.generate import generate
-from codegen.loader import load
+from codegen.backends.python.writer import generate
+from codegen.frontends.loader import load
 
 
 def test_generated_is_fresh() -> None:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from codegen.cli import main
+from codegen.cli.main import main
 from generated.convert import LossReport
 from generated.convert.dronecan_uorb import dronecan_to_uorb
 from generated.dronecan.uavcan.equipment.power import BatteryInfo

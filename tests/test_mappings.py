@@ -9,11 +9,11 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from codegen import irjson
 from codegen.errors import SchemaError
 from codegen.frontends import mappings
+from codegen.frontends.loader import load
 from codegen.ir import CONCEPTS_ENDPOINT, FieldRef, Schema
-from codegen.loader import load
+from codegen.ir import json_form as irjson
 
 
 @cache

@@ -1,4 +1,4 @@
-"""codegen.ocv against values worked out by hand from the kernel's integer arithmetic.
+"""codegen.apps.ocv against values worked out by hand from the kernel's integer arithmetic.
 
 Tables are the battery.yaml example's: -10 degC (4185000,100) (4113000,95) (4066000,90);
 0 degC (4200000,100) (4185000,95) (4113000,90); 10 degC (4250000,100) (4200000,95) (4185000,90).
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pytest
 
-from codegen.ocv import (
+from codegen.apps.ocv import (
     find_table_index,
     linear_interpolate,
     ocv_to_capacity,

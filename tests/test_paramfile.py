@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from codegen import paramfile
+from codegen.apps.failsafe.checks import check_file, check_params
+from codegen.apps.param_proposal import propose, voltage_at
 from codegen.errors import BattgenError
-from codegen.failsafe_checks import check_file, check_params
-from codegen.param_proposal import propose, voltage_at
-from codegen.paramfile import ParamFileError
+from codegen.inputs import paramfile
+from codegen.inputs.paramfile import ParamFileError
 
 QGC = """# Onboard parameters for Vehicle 1
 #

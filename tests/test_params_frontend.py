@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from codegen import irjson
 from codegen.errors import SchemaError
-from codegen.frontends import params
+from codegen.frontends import pdef as params
+from codegen.frontends.loader import format_of_file, load
 from codegen.ir import EnumKind, PrimitiveKind, Range, SourceFormat
-from codegen.loader import format_of_file, load
+from codegen.ir import json_form as irjson
 
 ROOT = Path(__file__).resolve().parent.parent
 SHIPPED = ROOT / "schemas" / "params" / "battery_failsafe.pdef.xml"

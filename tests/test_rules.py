@@ -9,8 +9,9 @@ from typing import Any
 
 import pytest
 
-from codegen import rules
 from codegen.errors import SchemaError
+from codegen.frontends import rules
+from codegen.frontends.loader import load
 from codegen.ir import (
     ArrayType,
     Field,
@@ -23,8 +24,7 @@ from codegen.ir import (
     Sentinel,
     SourceFormat,
 )
-from codegen.loader import load
-from codegen.rules_expr import Compare, ExprError, Quant, parse, parse_template
+from codegen.ir.expr import Compare, ExprError, Quant, parse, parse_template
 
 ROOT = Path(__file__).resolve().parent.parent
 F32 = PrimitiveType(PrimitiveKind.FLOAT, 32)
@@ -266,7 +266,7 @@ def test_no_rules(tmp_path: Path, import_generated: Any) -> None:
 
 
 def test_rules_naming_an_undefined_message_of_a_loaded_format_are_rejected(tmp_path: Path) -> None:
-    from codegen.loader import load as load_folder
+    from codegen.frontends.loader import load as load_folder
 
     (tmp_path / "uorb").mkdir()
     (tmp_path / "uorb" / "T.msg").write_text("uint64 timestamp\nfloat32 a\nfloat32 b\n", encoding="utf-8")
@@ -278,7 +278,7 @@ def test_rules_naming_an_undefined_message_of_a_loaded_format_are_rejected(tmp_p
 
 
 def test_rules_travel_with_the_schema_folder(tmp_path: Path) -> None:
-    from codegen.loader import load as load_folder
+    from codegen.frontends.loader import load as load_folder
 
     (tmp_path / "uorb").mkdir()
     (tmp_path / "uorb" / "T.msg").write_text("uint64 timestamp\nfloat32 a\nfloat32 b\n", encoding="utf-8")

@@ -2,7 +2,7 @@ from __future__ import annotations
 
 import pytest
 
-from codegen import units
+from codegen.ir import units
 
 
 @pytest.mark.parametrize(

@@ -18,12 +18,12 @@ import pytest
 import yaml
 from conftest import ROOT
 
-from codegen.cli import build_parser, main
-from codegen.commands.validate import Checker, check_file, exit_code, make_checker
-from codegen.instances import Record, read_records
+from codegen.apps.models import resolve_message
+from codegen.cli.main import build_parser, main
+from codegen.cli.validate import Checker, check_file, exit_code, make_checker
+from codegen.frontends.loader import load
+from codegen.inputs.records import Record, read_records
 from codegen.ir import Location, Message, SourceFormat
-from codegen.loader import load
-from codegen.models import resolve_message
 
 DATA = ROOT / "tests" / "data" / "instances"
 SCHEMAS = ROOT / "schemas"

@@ -12,9 +12,9 @@ from typing import Any
 import pytest
 from conftest import ROOT
 
-from codegen.cli import main
-from codegen.commands.validate import check_file, make_checker
-from codegen.instances import read_records
+from codegen.cli.main import main
+from codegen.cli.validate import check_file, make_checker
+from codegen.inputs.records import read_records
 from generated import _ulog
 from generated.mavlink import BatteryStatus as MavBattery
 from generated.uorb import BatteryStatus

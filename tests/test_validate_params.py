@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from codegen.cli import main
+from codegen.cli.main import main
 
 
 def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, list[str], str]:

@@ -14,7 +14,6 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from .. import units
 from ..errors import SchemaError
 from ..ir import (
     CONCEPTS_ENDPOINT,
@@ -30,9 +29,10 @@ from ..ir import (
     ParamValue,
     Rule,
     Schema,
+    units,
 )
-from .common import display_path, read_text
-from .yaml_lines import YMap, line_at, load
+from ..text.files import display_path, read_text
+from ..text.yaml_lines import YMap, line_at, load
 
 # params naming constants of the message a rule reads or writes (checked when formats are known)
 _CONSTANT_PARAMS = {"mask", "map", "bits", "default", "equals"}
@@ -40,7 +40,7 @@ _CONSTANT_PARAMS = {"mask", "map", "bits", "default", "equals"}
 
 @cache
 def mappings_json_schema() -> dict[str, Any]:
-    text = resources.files("codegen").joinpath("mappings.schema.json").read_text(encoding="utf-8")
+    text = resources.files(__package__).joinpath("mappings.schema.json").read_text(encoding="utf-8")
     result: dict[str, Any] = json.loads(text)
     return result
 

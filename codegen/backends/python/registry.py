@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-from . import codec_dronecan, codec_mavlink, codec_uorb, validators
+from . import validators
+from .codecs import dronecan as codec_dronecan
+from .codecs import mavlink as codec_mavlink
+from .codecs import uorb as codec_uorb
 from .converters import EXTENSION as CONVERTERS
 from .extensions import Extension
 

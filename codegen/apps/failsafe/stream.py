@@ -1,0 +1,205 @@
+"""Battery samples for the failsafe evaluator: a JSON Lines stream, any supported message format.
+
+Each line is one sample::
+
+    {"t": 12.5, "armed": true, "message": "uorb.BatteryStatus", "data": {"voltage_v": 10.4, ...},
+     "distance_to_home_m": 120.0, "travelled_m": 800.0, "home_set": true, "position_fix": true}
+
+``t`` (seconds) and ``armed`` are required. The battery is either ``message`` + ``data`` (a message
+of any bundled format, by qualified or short name; ``message`` may be left to a stream-wide default)
+or ``battery``: the state in SI units directly (``voltage_v``, ``current_a``, ``consumed_mah``,
+``remaining_mah``, or the shared concept names ``pack_voltage``, ``current``, ``discharged`` [C]).
+The other keys are optional. Blank lines and lines starting with ``#`` are skipped.
+
+Message data becomes a battery state through the IR: the generated model reads it (defaults,
+sentinels), then the converters (generated/convert ``to_concepts``) give the canonical battery
+state in SI; without them a small IR-driven field table does (:func:`battery_state_from_ir`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import json
+import math
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ...errors import BattgenError, LocatedError
+from ...ir import Schema
+from .evaluator import BatteryReading, reading_of
+
+# which field carries what, per message (units come from the IR metadata)
+ROLES: dict[str, dict[str, str]] = {
+    "uorb.BatteryStatus": {"voltage": "voltage_v", "current": "current_a", "consumed": "discharged_mah"},
+    "uorb.BatteryStatusV0": {"voltage": "voltage_v", "current": "current_a", "consumed": "discharged_mah"},
+    "mavlink.BATTERY_STATUS": {
+        "cells": "voltages",
+        "cells_ext": "voltages_ext",
+        "current": "current_battery",
+        "consumed": "current_consumed",
+    },
+    "dronecan.uavcan.equipment.power.BatteryInfo": {"voltage": "voltage", "current": "current"},
+}
+_OPTIONAL = {"distance_to_home_m": float, "travelled_m": float, "home_set": bool, "position_fix": bool}
+
+
+class StreamError(LocatedError):
+    """A malformed input file, located by file and line."""
+
+
+@dataclass(frozen=True)
+class Sample:
+    line: int
+    t: float
+    armed: bool
+    battery: BatteryReading
+    message: str | None  # qualified name the battery came from (None: given in SI)
+    data: Mapping[str, Any] | None
+    extra: Mapping[str, Any]  # distance_to_home_m, travelled_m, home_set, position_fix
+
+
+def _si(meta: Mapping[str, Any], value: Any) -> float | None:
+    """A value in its field's unit -> the quantity's SI base; None for the invalid sentinel."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        return None
+    invalid = meta.get("invalid")
+    if invalid is not None and not meta.get("per_element") and value == invalid:
+        return None
+    return float(value) * float(meta.get("scale", 1.0)) + float(meta.get("offset", 0.0))
+
+
+# the converters' endpoint for each battery message (generated/convert: to the shared concepts)
+ENDPOINTS: dict[str, str] = {
+    "uorb.BatteryStatus": "uorb",
+    "uorb.BatteryStatusV0": "uorb_v0",
+    "mavlink.BATTERY_STATUS": "mavlink",
+    "dronecan.uavcan.equipment.power.BatteryInfo": "dronecan",
+}
+
+
+def battery_state(qualified_name: str, model: Any) -> BatteryReading:
+    """The failsafe's battery state from a generated model instance of a bundled battery message:
+    through the converters' ``to_concepts`` (canonical SI state) when the package has them."""
+    endpoint = ENDPOINTS.get(qualified_name)
+    if endpoint is not None:
+        try:  # imported by name: the generated converters are not for the type checker to follow
+            convert = importlib.import_module("generated.convert")
+        except ImportError:
+            pass
+        else:
+            return reading_of(convert.converter(endpoint, "concepts")(model))
+    return battery_state_from_ir(qualified_name, model)
+
+
+def battery_state_from_ir(qualified_name: str, model: Any) -> BatteryReading:
+    """Fallback without converters: the fields that carry voltage, current and drawn charge, with
+    their units' scales from the generated metadata."""
+    roles = ROLES.get(qualified_name)
+    if roles is None:
+        raise BattgenError(f"{qualified_name} carries no battery voltage or current (known: {', '.join(ROLES)})")
+    metas = {f.metadata["name"]: f.metadata for f in dataclasses.fields(model)}
+    by_name = {f.metadata["name"]: getattr(model, f.name) for f in dataclasses.fields(model)}
+
+    def get(role: str) -> float | None:
+        name = roles.get(role)
+        return None if name is None else _si(metas[name], by_name[name])
+
+    volts = get("voltage")
+    if "cells" in roles:  # MAVLink: cell voltages (cell 0 holds the pack when there is no per-cell data)
+        total = 0.0
+        for role, absent in (("cells", metas[roles["cells"]].get("invalid")), ("cells_ext", 0)):
+            meta = metas[roles[role]]
+            for v in by_name[roles[role]]:
+                if v != absent:
+                    total += v * float(meta.get("scale", 1.0))
+        volts = total or None
+    consumed = get("consumed")
+    return BatteryReading(
+        voltage_v=volts,
+        current_a=get("current"),
+        consumed_mah=None if consumed is None else consumed / 3.6,  # coulombs -> mAh
+    )
+
+
+class Reader:
+    """Reads a stream, resolving message names against a schema and its generated package."""
+
+    def __init__(self, schema: Schema, package: Any, default_message: str | None = None) -> None:
+        self.schema = schema
+        self.package = package
+        self.default_message = default_message
+        self._classes: dict[str, tuple[str, Any]] = {}
+
+    def model(self, name: str, file: str, line: int) -> tuple[str, Any]:
+        if name not in self._classes:
+            from ..models import model_class, resolve_message
+
+            try:
+                msg = resolve_message(self.schema, name)
+            except BattgenError as exc:
+                raise StreamError(file, line, str(exc)) from None
+            self._classes[name] = (msg.qualified_name, model_class(self.package, msg))
+        return self._classes[name]
+
+    def read(self, path: Path) -> Iterator[Sample]:
+        file = path.as_posix()
+        try:
+            stream = path.open(encoding="utf-8")
+        except OSError as exc:
+            raise StreamError(file, 0, f"cannot read file: {exc.strerror or exc}") from None
+        with stream:
+            try:
+                for number, text in enumerate(stream, start=1):
+                    if text.strip() and not text.lstrip().startswith("#"):
+                        yield self.sample(text, file, number)
+            except UnicodeDecodeError:
+                raise StreamError(file, 0, "expected UTF-8 text") from None
+
+    def sample(self, text: str, file: str, line: int) -> Sample:
+        def fail(message: str) -> StreamError:
+            return StreamError(file, line, message)
+
+        try:
+            obj = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise fail(f"expected one JSON object per line ({exc.msg} at column {exc.colno})") from None
+        if not isinstance(obj, dict):
+            raise fail("expected a JSON object per line")
+        t = obj.get("t")
+        if isinstance(t, bool) or not isinstance(t, int | float) or not math.isfinite(t):
+            raise fail(f'expected "t": a number of seconds, got {t!r}')
+        armed = obj.get("armed")
+        if not isinstance(armed, bool):
+            raise fail(f'expected "armed": true or false, got {armed!r}')
+        extra: dict[str, Any] = {}
+        for key, kind in _OPTIONAL.items():
+            if obj.get(key) is not None:
+                value = obj[key]
+                ok = (
+                    isinstance(value, bool)
+                    if kind is bool
+                    else isinstance(value, int | float) and not isinstance(value, bool)
+                )
+                if not ok:
+                    raise fail(f'expected "{key}": {"true or false" if kind is bool else "a number"}, got {value!r}')
+                extra[key] = value
+        if "battery" in obj:
+            if not isinstance(obj["battery"], dict):
+                raise fail('expected "battery": an object of SI values')
+            return Sample(line, float(t), armed, reading_of(obj["battery"]), None, None, extra)
+        name = obj.get("message", self.default_message)
+        if not isinstance(name, str):
+            raise fail('expected "message" (a message name) with "data", "battery", or --message')
+        data = obj.get("data")
+        if not isinstance(data, dict):
+            raise fail(f'expected "data": an object of {name} fields')
+        qualified, cls = self.model(name, file, line)
+        try:
+            model = cls.from_dict(data)
+            battery = battery_state(qualified, model)
+        except (ValueError, BattgenError) as exc:
+            raise fail(f"expected {qualified} data: {exc}") from None
+        return Sample(line, float(t), armed, battery, qualified, data, extra)

@@ -1,0 +1,105 @@
+"""The validators extension: ``validate()``, ``check()`` and ``is_known()`` on every generated class.
+
+``validate()`` is straight-line code specialised to the message: one cheap test per field (see
+:mod:`.validators_checks`), then the schema's cross-field rules (``Schema.rules``, from ``schemas/rules/``) compiled by
+:mod:`.validators_rules`. Violation types and the careful diagnosis live in the generated runtime
+module ``_validate.py``.
+"""
+
+from __future__ import annotations
+
+from ....frontends import rules as rule_files
+from ....ir import Message, Schema
+from ..extensions import Contribution
+from ..literals import py_literal
+from ..views import ClassView, ModuleContext
+from .checks import field_code
+from .rules import known_expr, rule_lines
+
+_INDENT = "    "
+
+
+def _block(lines: list[str], depth: int) -> list[str]:
+    pad = _INDENT * depth
+    return [pad + line if line else "" for line in lines]
+
+
+class _Validators:
+    def runtime_files(self, schema: Schema, header: str) -> dict[str, str]:
+        from .. import environment
+
+        text = environment().get_template("_validate.py.j2").render(header=header)
+        return {"_validate.py": text}
+
+    def contribute(self, msg: Message, ctx: ModuleContext, view: ClassView) -> Contribution:
+        idents = {fv.source_name: fv.ident for fv in view.fields}
+        specs: list[str] = []
+        checks: list[str] = []
+        for f in msg.fields:
+            if f.is_padding:
+                continue
+            ident = idents[f.name]
+            spec_name = f"_VS_{view.name}_{ident}"
+            code = field_code(ctx.schema, msg, f, ident, spec_name)
+            specs.append(f"{spec_name} = {code.spec_source}")
+            checks += code.lines
+        local_names: set[str] = set()
+        for bound in rule_files.bound_rules(ctx.schema, msg):
+            lines, names = rule_lines(bound, msg, idents)
+            checks += lines
+            local_names |= names
+        body = self._methods(msg, view, checks, sorted(local_names), idents)
+        return Contribution(
+            class_body="\n".join(_block(body, 1)) + "\n",
+            module_code=("\n".join(specs),) if specs else (),
+            imports=(f"from {ctx.root()} import _validate as _v",),
+        )
+
+    @staticmethod
+    def _methods(
+        msg: Message, view: ClassView, checks: list[str], local_names: list[str], idents: dict[str, str]
+    ) -> list[str]:
+        declared = ["x", "a", "e", "sub", *local_names]
+        out = [
+            "def validate(self) -> list[_v.Violation]:",
+            '    """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""',
+            "    out: list[_v.Violation] = []",
+            *[f"    {name}: Any" for name in declared],
+            *_block(checks, 1),
+            "    return out",
+            "",
+            "def check(self) -> None:",
+            '    """Raise ValidationError, carrying every violation, when validate() finds an error."""',
+            "    found = self.validate()",
+            "    for v in found:",
+            "        if v.severity == 'error':",
+            f"            raise _v.ValidationError(found, {view.qualified_name})",
+            "",
+            "def is_known(self, field: str) -> bool:",
+            '    """False when the field (schema name) holds its "unknown" sentinel or is absent."""',
+        ]
+        plain: list[str] = []
+        optional = msg.devicetree is not None
+        for f in msg.fields:
+            if f.is_padding:
+                continue
+            attr = f"self.{idents[f.name]}"
+            test = known_expr(f, attr, optional and f.pattern is None)
+            if test == "True":
+                plain.append(f.name)
+                continue
+            out += [f"    if field == {_lit(f.name)}:", f"        return {test}"]
+        if plain:
+            out += [
+                "    if field in {" + ", ".join(_lit(n) for n in plain) + "}:",
+                "        return True",
+            ]
+        out.append(f"    raise KeyError(f'{{field!r}} is not a field of ' + {view.qualified_name})")
+        return out
+
+
+def _lit(text: str) -> str:
+    return py_literal(text)
+
+
+EXTENSION = _Validators()

@@ -1,0 +1,137 @@
+"""The ``battgen`` command line. Exit codes: 0 ok, 1 check failed or invalid, 2 bad usage or
+malformed schema. Errors are one line on stderr, never a traceback."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from .. import __version__
+from ..backends.python.writer import generate
+from ..errors import BattgenError
+from ..frontends.loader import load
+from ..ir import Schema
+from ..ir import json_form as irjson
+from . import COMMAND_MODULES
+
+EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+
+
+def project_root() -> Path:
+    """The checkout holding schemas/ and generated/ (the current folder, else this package's parent)."""
+    cwd = Path.cwd()
+    if (cwd / "schemas").is_dir():
+        return cwd
+    return Path(__file__).resolve().parents[2]
+
+
+def _default_schemas() -> list[Path]:
+    return [project_root() / "schemas"]
+
+
+def _load(paths: Sequence[str]) -> Schema:
+    return load([Path(p) for p in paths] if paths else _default_schemas())
+
+
+def cmd_list(args: argparse.Namespace) -> int:
+    schema = _load(args.paths)
+    for msg in schema.messages:
+        print(msg.qualified_name)
+    return EXIT_OK
+
+
+def cmd_ir(args: argparse.Namespace) -> int:
+    schema = _load(args.paths)
+    sys.stdout.write(irjson.dumps(schema))
+    return EXIT_OK
+
+
+def cmd_generate(args: argparse.Namespace) -> int:
+    started = time.perf_counter()
+    schema = _load([args.schema_dir] if args.schema_dir else [])
+    out = Path(args.out) if args.out else project_root() / "generated"
+    if not out.name.isidentifier():
+        raise BattgenError(
+            f"{out}: the output folder's name is the package's import name, so it must be a Python identifier"
+        )
+    result = generate(schema, out, check=args.check)
+    elapsed = time.perf_counter() - started
+    if args.check:
+        if result.stale:
+            for rel in result.written:
+                print(f"stale: {out / rel}", file=sys.stderr)
+            for rel in result.removed:
+                print(f"not generated any more: {out / rel}", file=sys.stderr)
+            print(f"{out} is stale: run 'battgen generate'", file=sys.stderr)
+            return EXIT_FAILED
+        print(f"{out} is up to date ({len(result.unchanged)} files, {len(schema.messages)} messages)")
+        return EXIT_OK
+    for rel in result.written:
+        print(f"wrote {out / rel}")
+    for rel in result.removed:
+        print(f"removed {out / rel}")
+    print(
+        f"generated {len(schema.messages)} messages into {out}: {len(result.written)} written, "
+        f"{len(result.unchanged)} unchanged, {len(result.removed)} removed in {elapsed * 1000:.0f} ms"
+    )
+    return EXIT_OK
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        print(f"{self.prog}: error: {message}", file=sys.stderr)
+        raise SystemExit(EXIT_USAGE)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="battgen", description="Battery telemetry schemas: one IR, generated models.")
+    parser.add_argument("--version", action="version", version=f"battgen {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("list", help="print the qualified names of the messages in a schema folder or files")
+    p.add_argument("paths", nargs="*", help="schema folders or files (default: the bundled schemas/)")
+    p.set_defaults(func=cmd_list)
+
+    p = sub.add_parser("ir", help="print the IR as JSON")
+    p.add_argument("paths", nargs="*", help="schema folders (uorb/, dronecan/, devicetree/, mavlink/) or single files")
+    p.set_defaults(func=cmd_ir)
+
+    p = sub.add_parser("generate", help="generate the Python package (default: schemas/ into generated/)")
+    p.add_argument("schema_dir", nargs="?", help="schema folder (default: schemas/)")
+    p.add_argument("--out", help="write an importable package here (its import name is the folder's name)")
+    p.add_argument("--check", action="store_true", help="write nothing; exit 1 naming stale files")
+    p.set_defaults(func=cmd_generate)
+
+    for name in COMMAND_MODULES:
+        importlib.import_module(name).register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    func: Callable[[argparse.Namespace], int] = args.func
+    try:
+        return func(args)
+    except BattgenError as exc:
+        print(f"battgen: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except ModuleNotFoundError as exc:  # a dependency missing from this environment, e.g. pymavlink
+        print(
+            f"battgen: needs the Python package {exc.name!r}: install battgen with pip (pip install -e .)",
+            file=sys.stderr,
+        )
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:
+        return EXIT_OK
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

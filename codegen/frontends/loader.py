@@ -1,0 +1,113 @@
+"""Pick the frontend for each input and merge what they produce into one Schema."""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Iterable
+from pathlib import Path
+from types import ModuleType
+
+from ..errors import BattgenError, SchemaError
+from ..ir import EnumDef, Schema
+from . import rules
+
+# schema folder layout: one sub-folder per format, each handled by one frontend module
+FORMAT_FRONTENDS: dict[str, str] = {
+    "uorb": "codegen.frontends.uorb",
+    "dronecan": "codegen.frontends.dsdl",
+    "devicetree": "codegen.frontends.devicetree",
+    "mavlink": "codegen.frontends.mavlink",
+    "params": "codegen.frontends.pdef",
+}
+
+# converter mappings between the formats (schemas/mappings/*.yaml), parsed after the formats
+MAPPINGS_DIR = "mappings"
+# cross-field rules the validators compile (schemas/rules/*.yaml), also read after the formats
+RULES_DIR = "rules"
+
+EXTENSION_FORMATS: dict[str, str] = {
+    ".msg": "uorb",
+    ".uavcan": "dronecan",
+    ".yaml": "devicetree",
+    ".yml": "devicetree",
+    ".xml": "mavlink",
+    ".pdef.xml": "params",  # ArduPilot parameter metadata; checked before the plain suffix
+}
+
+
+def frontend(fmt: str) -> ModuleType:
+    return importlib.import_module(FORMAT_FRONTENDS[fmt])
+
+
+def format_of_file(path: Path) -> str:
+    name = path.name.lower()
+    fmt = EXTENSION_FORMATS.get(".pdef.xml") if name.endswith(".pdef.xml") else None
+    fmt = fmt or EXTENSION_FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        known = ", ".join(sorted(EXTENSION_FORMATS))
+        raise BattgenError(f"{path}: cannot tell the schema format from the extension (expected one of {known})")
+    return fmt
+
+
+def is_schema_dir(path: Path) -> bool:
+    return any((path / fmt).is_dir() for fmt in FORMAT_FRONTENDS)
+
+
+def load_schema_dir(root: Path) -> Schema:
+    """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset)."""
+    schema = Schema()
+    for fmt in FORMAT_FRONTENDS:
+        sub = root / fmt
+        if sub.is_dir():
+            part: Schema = frontend(fmt).parse_dir(sub)
+            schema = schema.merged(part)
+    if (root / MAPPINGS_DIR).is_dir():
+        # after the formats, so every reference to a message or field can be checked
+        from . import mappings
+
+        schema = schema.merged(mappings.parse_dir(root / MAPPINGS_DIR, schema=schema))
+    if (root / RULES_DIR).is_dir():
+        schema = schema.merged(Schema(rules=rules.load_rules_dir(root / RULES_DIR)))
+        rules.check_rules(schema)  # after the formats: every rule must bind to the messages it names
+    return schema
+
+
+def load(paths: Iterable[Path]) -> Schema:
+    """Parse schema folders and single files (format from the extension) into one Schema."""
+    schema = Schema()
+    for path in paths:
+        if path.is_dir():
+            if not is_schema_dir(path):
+                expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
+                raise BattgenError(f"{path}: not a schema folder (expected sub-folders {expected})")
+            part = load_schema_dir(path)
+        elif path.is_file():
+            part = frontend(format_of_file(path)).parse_file(path)
+        else:
+            raise BattgenError(f"{path}: no such file or folder")
+        schema = schema.merged(part)
+    return _deduplicated(schema)
+
+
+def _deduplicated(schema: Schema) -> Schema:
+    """Drop repeats of one definition (a referenced type parsed twice); reject clashing ones."""
+    seen: dict[str, object] = {}
+    messages = []
+    for msg in schema.messages:
+        prior = seen.get(msg.qualified_name)
+        if prior is None:
+            seen[msg.qualified_name] = msg
+            messages.append(msg)
+        elif prior != msg:
+            loc = msg.location
+            raise SchemaError(loc.file, loc.line, f"{msg.qualified_name} is defined twice with different contents")
+    enums: dict[str, EnumDef] = {}
+    for enum_def in schema.enums:
+        enums.setdefault(enum_def.name, enum_def)
+    return Schema(
+        messages=tuple(sorted(messages, key=lambda m: m.qualified_name)),
+        enums=tuple(sorted(enums.values(), key=lambda e: e.name)),
+        sources=tuple(dict.fromkeys(schema.sources)),
+        mappings=schema.mappings,
+        rules=schema.rules,
+    )

@@ -1,0 +1,212 @@
+"""Parameter files as users have them: ArduPilot / Mission Planner ``.param`` and QGroundControl ``.params``.
+
+``.param``: one ``NAME,VALUE`` or ``NAME VALUE`` a line; ``#`` starts a comment (also after a value).
+``.params`` (QGC): ``#`` comment lines, then tab-separated ``vehicle-id component-id NAME VALUE TYPE``
+with TYPE a MAV_PARAM_TYPE (9 = REAL32, 2 = INT8, ...). Values are read as int when written as an
+integer (or 0x hex, as pymavlink's mavparm reads them), else float; NaN and infinities are refused.
+Every error names file and line and says what was expected.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import BattgenError, LocatedError
+
+Value = int | float
+
+NAME = re.compile(r"[A-Za-z0-9_]{1,16}")  # MAVLink param_id: at most 16 characters
+_INT = re.compile(r"[+-]?[0-9]+")
+_HEX = re.compile(r"0[xX][0-9A-Fa-f]+")
+# MAV_PARAM_TYPE values a QGC file may carry, and which of them hold integers
+MAV_PARAM_TYPES: dict[int, str] = {
+    1: "UINT8", 2: "INT8", 3: "UINT16", 4: "INT16", 5: "UINT32",
+    6: "INT32", 7: "UINT64", 8: "INT64", 9: "REAL32", 10: "REAL64",
+}  # fmt: skip
+_FLOAT_TYPES = frozenset({9, 10})
+# our parameter types (codegen.frontends.pdef) as MAV_PARAM_TYPE
+TYPE_OF: dict[str, int] = {"int8": 2, "int16": 4, "int32": 6, "float32": 9}
+
+QGC_SUFFIXES = (".params",)
+ARDUPILOT_SUFFIXES = (".param", ".parm")
+
+
+class ParamFileError(LocatedError):
+    """A malformed parameter file: names the file, the 1-based line and what was expected."""
+
+
+@dataclass(frozen=True)
+class ParamEntry:
+    name: str
+    value: Value
+    line: int
+    mav_type: int | None = None  # QGC files state it
+    vehicle: int | None = None
+    component: int | None = None
+
+
+def is_param_file(path: Path) -> bool:
+    return path.suffix.lower() in QGC_SUFFIXES + ARDUPILOT_SUFFIXES
+
+
+def parse_text(text: str, display: str, *, qgc: bool | None = None) -> list[ParamEntry]:
+    """Entries in file order. ``qgc`` None: QGC when a data line has five tab-separated columns."""
+    lines = text.splitlines()
+    if qgc is None:
+        qgc = any(len(ln.split("\t")) == 5 for ln in lines if ln.strip() and not ln.lstrip().startswith("#"))
+    entries: list[ParamEntry] = []
+    seen: dict[tuple[int | None, int | None, str], int] = {}
+    for number, raw in enumerate(lines, start=1):
+        entry = _qgc_line(raw, display, number) if qgc else _ardupilot_line(raw, display, number)
+        if entry is None:
+            continue
+        key = (entry.vehicle, entry.component, entry.name)
+        if key in seen:
+            raise ParamFileError(
+                display, number, f"expected each parameter once: {entry.name} is also at line {seen[key]}"
+            )
+        seen[key] = number
+        entries.append(entry)
+    return entries
+
+
+def load(path: Path, display: str | None = None) -> list[ParamEntry]:
+    """Read a .param / .params file (format from the extension, else sniffed)."""
+    shown = display or path.as_posix()
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ParamFileError(shown, 0, f"cannot read file: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ParamFileError(shown, data[: exc.start].count(b"\n") + 1, "expected UTF-8 text") from None
+    suffix = path.suffix.lower()
+    qgc = True if suffix in QGC_SUFFIXES else False if suffix in ARDUPILOT_SUFFIXES else None
+    return parse_text(text, shown, qgc=qgc)
+
+
+def read_param_file(path: Path) -> Iterator[tuple[int, dict[str, Value]]]:
+    """One instance per parameter set: ``(line of its first parameter, {NAME: value})``.
+
+    A .param file is one set; a QGC .params file holds one set per (vehicle, component) pair,
+    yielded in order of first appearance. Feed a set to a generated model through :func:`select`
+    (e.g. ``BattParams.from_dict(select(values, BattParams))``)."""
+    groups: dict[tuple[int | None, int | None], tuple[int, dict[str, Value]]] = {}
+    for e in load(path):
+        groups.setdefault((e.vehicle, e.component), (e.line, {}))[1][e.name] = e.value
+    yield from groups.values()
+
+
+def select(values: Mapping[str, Value], model: type | Iterable[str]) -> dict[str, Value]:
+    """The parameters a model (a generated class, or field names) knows, dropping the rest of a full dump."""
+    if isinstance(model, type):
+        import dataclasses
+
+        names = {f.metadata.get("name", f.name) for f in dataclasses.fields(model)}
+    else:
+        names = set(model)
+    return {k: v for k, v in values.items() if k in names}
+
+
+def format_value(value: Value) -> str:
+    if isinstance(value, bool):
+        return str(int(value))
+    if isinstance(value, int):
+        return str(value)
+    return format(value, ".9g")
+
+
+def write_param(items: Sequence[tuple[str, Value, str]], *, header: Sequence[str] = ()) -> str:
+    """ArduPilot .param text: ``NAME,VALUE`` lines, each with its comment (``# ...``) when given."""
+    out = [f"# {h}" if h else "#" for h in header]
+    for name, value, comment in items:
+        _check_name(name)
+        line = f"{name},{format_value(value)}"
+        out.append(f"{line}  # {comment}" if comment else line)
+    return "\n".join(out) + "\n"
+
+
+def write_qgc(
+    items: Sequence[tuple[str, Value, int]], *, vehicle: int = 1, component: int = 1, header: Sequence[str] = ()
+) -> str:
+    """QGroundControl .params text; each item is (NAME, value, MAV_PARAM_TYPE)."""
+    out = [f"# {h}" if h else "#" for h in header]
+    out.append("# Vehicle-Id Component-Id Name Value Type")
+    for name, value, mav_type in items:
+        _check_name(name)
+        if mav_type not in MAV_PARAM_TYPES:
+            raise BattgenError(f"{name}: expected a MAV_PARAM_TYPE 1..10, got {mav_type}")
+        out.append(f"{vehicle}\t{component}\t{name}\t{format_value(value)}\t{mav_type}")
+    return "\n".join(out) + "\n"
+
+
+def _check_name(name: str) -> None:
+    if not NAME.fullmatch(name):
+        raise BattgenError(f"expected a parameter name of 1 to 16 letters, digits and _, got {name!r}")
+
+
+def _value(text: str, display: str, line: int, *, integer: bool = False) -> Value:
+    if _HEX.fullmatch(text):
+        return int(text, 16)
+    if _INT.fullmatch(text):
+        return int(text)
+    try:
+        number = float(text)
+    except ValueError:
+        raise ParamFileError(display, line, f"expected a number as the value, got {text!r}") from None
+    if not math.isfinite(number):
+        raise ParamFileError(display, line, f"expected a finite number as the value, got {text!r}")
+    if integer:
+        if not number.is_integer():
+            raise ParamFileError(
+                display, line, f"expected an integer value for an integer MAV_PARAM_TYPE, got {text!r}"
+            )
+        return int(number)
+    return number
+
+
+def _name(text: str, display: str, line: int) -> str:
+    if not NAME.fullmatch(text):
+        raise ParamFileError(display, line, f"expected a parameter name of 1 to 16 letters, digits and _, got {text!r}")
+    return text
+
+
+def _ardupilot_line(raw: str, display: str, line: int) -> ParamEntry | None:
+    body = raw.split("#", 1)[0].strip()
+    if not body:
+        return None
+    parts = [p for p in re.split(r"[,\s]+", body) if p]
+    if len(parts) != 2:
+        raise ParamFileError(display, line, f"expected 'NAME,VALUE' or 'NAME VALUE', got {body!r}")
+    return ParamEntry(_name(parts[0], display, line), _value(parts[1], display, line), line)
+
+
+def _qgc_line(raw: str, display: str, line: int) -> ParamEntry | None:
+    body = raw.strip()
+    if not body or body.startswith("#"):
+        return None
+    parts = body.split("\t") if "\t" in body else body.split()
+    parts = [p.strip() for p in parts]
+    if len(parts) != 5:
+        raise ParamFileError(
+            display,
+            line,
+            f"expected 5 tab-separated columns (vehicle id, component id, name, value, type), got {len(parts)}",
+        )
+    ids = []
+    for label, text in (("vehicle id", parts[0]), ("component id", parts[1]), ("type", parts[4])):
+        if not re.fullmatch(r"[0-9]{1,3}", text):
+            raise ParamFileError(display, line, f"expected a decimal {label}, got {text!r}")
+        ids.append(int(text))
+    vehicle, component, mav_type = ids
+    if mav_type not in MAV_PARAM_TYPES:
+        raise ParamFileError(display, line, f"expected a MAV_PARAM_TYPE from 1 to 10 as type, got {mav_type}")
+    value = _value(parts[3], display, line, integer=mav_type not in _FLOAT_TYPES)
+    if mav_type in _FLOAT_TYPES and isinstance(value, int):
+        value = float(value)
+    return ParamEntry(_name(parts[2], display, line), value, line, mav_type, vehicle, component)

@@ -1,0 +1,278 @@
+"""MAVLink logs as records: telemetry logs (.tlog) and raw MAVLink byte streams (.mav).
+
+A .tlog (MAVProxy, QGroundControl, Mission Planner) is a sequence of entries, each a big-endian
+uint64 time in microseconds (Unix epoch) followed by one MAVLink 1 or 2 frame. Entries are walked
+by their frames' lengths; frames of other messages are skipped without a checksum check (their
+CRC_EXTRA is not in the generated package), frames of the wanted message are checked with it. Bytes
+that do not start an entry are garbage: reading resumes at the next magic byte that starts a
+plausible entry (its frame ends where the next entry's frame begins, or at the end of the file).
+The file is memory-mapped, so memory stays flat whatever its size.
+
+A raw stream (``.mav`` or ``--input-format mavlink``; not ``.bin``, which is ArduPilot's DataFlash
+log) is fed in 64 KiB pieces to the generated :class:`StreamParser`, which resynchronises after
+garbage; its counters become the damage summary. Raw streams carry no times and the parser no
+offsets: such records are located by frame number, system/component id and sequence number.
+
+Damage (bad CRCs, garbage, a cut-off last frame) is one warning notice per file, never a failure;
+a non-empty file in which no frame at all is found is unreadable.
+"""
+
+from __future__ import annotations
+
+import mmap
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any
+
+from ..ir import Message
+from .records import InstanceError, Item, Notice, Record
+from .ulog import runtime
+
+CHUNK = 1 << 16
+MAGIC_V1, MAGIC_V2 = 0xFE, 0xFD
+SIGNED = 0x01
+_STAMP = 8
+
+
+@dataclass
+class StreamStats:
+    """What a MAVLink log held besides the wanted records."""
+
+    records: int = 0  # frames of the wanted message, decoded
+    other_frames: int = 0  # frames of other messages (tlog: exact; raw: as the parser counts them)
+    bad_crc: int = 0
+    garbage_bytes: int = 0
+    decode_errors: int = 0  # frames of the wanted message whose payload is too long
+    truncated_bytes: int = 0  # an entry or frame cut off at the end of the file
+    problems: list[str] = field(default_factory=list)
+
+    @property
+    def damaged(self) -> bool:
+        return bool(self.bad_crc or self.garbage_bytes or self.decode_errors or self.truncated_bytes)
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "records": self.records,
+            "other_frames": self.other_frames,
+            "bad_crc": self.bad_crc,
+            "garbage_bytes": self.garbage_bytes,
+            "decode_errors": self.decode_errors,
+            "truncated_bytes": self.truncated_bytes,
+        }
+
+    def summary(self, what: str) -> str:
+        parts = [f"{self.records} {what} records", f"{self.other_frames} frames of other messages skipped"]
+        if self.bad_crc:
+            parts.append(f"{self.bad_crc} {what} frames with a bad CRC skipped")
+        if self.decode_errors:
+            parts.append(f"{self.decode_errors} {what} frames too long to decode skipped")
+        if self.garbage_bytes:
+            parts.append(f"{self.garbage_bytes} bytes of garbage skipped")
+        if self.truncated_bytes:
+            parts.append(f"{self.truncated_bytes} bytes cut off at the end of the file")
+        return ", ".join(parts)
+
+
+@dataclass(frozen=True)
+class FrameRecord:
+    """One decoded frame of the wanted message and where it was."""
+
+    number: int  # 0-based among the wanted message's frames
+    offset: int | None  # of the tlog entry (its timestamp); None in a raw stream
+    timestamp: int | None  # tlog time, microseconds since the Unix epoch
+    frame: Any  # the generated runtime's Frame
+    instance: Any
+
+    def where(self, name: str) -> str:
+        f = self.frame
+        head = f"{name} #{self.number} from {f.sysid}/{f.compid} seq {f.seq}"
+        stamp = f" at {self.timestamp} us" if self.timestamp is not None else ""
+        place = f", offset {self.offset}" if self.offset is not None else ""
+        return head + stamp + place
+
+    def location(self) -> dict[str, object]:
+        f = self.frame
+        out: dict[str, object] = {"frame": self.number, "sysid": f.sysid, "compid": f.compid, "seq": f.seq}
+        if self.timestamp is not None:
+            out["timestamp_us"] = self.timestamp
+        if self.offset is not None:
+            out["offset"] = self.offset
+        return out
+
+
+def _frame_length(data: Any, start: int, end: int) -> tuple[int, int] | None:
+    """(total length, message id) of the frame whose header starts at ``start``, if it is whole."""
+    magic = data[start]
+    if magic == MAGIC_V2:
+        if end - start < 10:
+            return None
+        return 12 + data[start + 1] + (13 if data[start + 2] & SIGNED else 0), data[start + 7] | data[
+            start + 8
+        ] << 8 | data[start + 9] << 16
+    if end - start < 6:
+        return None
+    return 8 + data[start + 1], data[start + 5]
+
+
+def _is_magic(byte: int) -> bool:
+    return byte == MAGIC_V1 or byte == MAGIC_V2
+
+
+def tlog_frames(data: Any, model: Any, stats: StreamStats) -> Iterator[FrameRecord]:
+    """The frames of ``model``'s message in a .tlog held in ``data`` (bytes or an mmap)."""
+    rt = runtime(model, "_mavlink")
+    msgid: int = model.MSG_ID
+    end = len(data)
+    pos = 0
+    while pos < end:
+        start = pos + _STAMP
+        if start >= end:
+            stats.truncated_bytes += end - pos
+            return
+        if _is_magic(data[start]):
+            head = _frame_length(data, start, end)
+            if head is None or start + head[0] > end:
+                stats.truncated_bytes += end - pos
+                return
+            total, got = head
+            after = start + total
+            plausible = after == end or (after + _STAMP < end and _is_magic(data[after + _STAMP]))
+            if got == msgid:
+                try:
+                    frame = rt.parse_frame(data[start:after])
+                except ValueError as exc:  # FrameError: bad CRC, flags
+                    if plausible:
+                        stats.bad_crc += 1
+                        stats.problems.append(f"offset {pos}: {exc}")
+                        pos = after
+                        continue
+                else:
+                    record = _decode(frame, model, stats, pos, int.from_bytes(data[pos:start], "big"))
+                    if record is not None:
+                        yield record
+                    pos = after
+                    continue
+            elif plausible:
+                stats.other_frames += 1
+                pos = after
+                continue
+        pos = _resync(data, pos, end, stats)
+
+
+def _resync(data: Any, pos: int, end: int, stats: StreamStats) -> int:
+    """The next entry start after garbage at ``pos`` (``end`` when there is none)."""
+    cand = pos + 1
+    while cand + _STAMP < end:
+        if _is_magic(data[cand + _STAMP]):
+            stats.garbage_bytes += cand - pos
+            return cand
+        cand += 1
+    stats.garbage_bytes += end - pos
+    return end
+
+
+def _decode(frame: Any, model: Any, stats: StreamStats, offset: int | None, stamp: int | None) -> FrameRecord | None:
+    try:
+        obj = model.decode(frame.payload)
+    except ValueError as exc:  # DecodeError: a payload longer than the message
+        stats.decode_errors += 1
+        stats.problems.append(str(exc))
+        return None
+    stats.records += 1
+    return FrameRecord(stats.records - 1, offset, stamp, frame, obj)
+
+
+def raw_frames(stream: IO[bytes], model: Any, stats: StreamStats) -> Iterator[FrameRecord]:
+    """The frames of ``model``'s message in a raw MAVLink byte stream, read in CHUNK pieces."""
+    rt = runtime(model, "_mavlink")
+    msgid: int = model.MSG_ID
+    parser = rt.StreamParser()
+    seen = 0
+    while True:
+        chunk = stream.read(CHUNK)
+        if not chunk:
+            break
+        seen += len(chunk)
+        for frame in parser.feed(chunk):
+            if frame.msgid != msgid:
+                stats.other_frames += 1
+                continue
+            record = _decode(frame, model, stats, None, None)
+            if record is not None:
+                yield record
+    stats.bad_crc = parser.bad_crc
+    stats.other_frames += parser.unknown_msgid  # ids this package lacks (their checksums cannot be checked)
+    stats.garbage_bytes = parser.skipped_bytes
+    stats.truncated_bytes = parser.pending
+    if parser.last_error:
+        stats.problems.append(parser.last_error)
+    if seen and not (parser.frames or parser.unknown_msgid or parser.bad_crc):
+        raise InstanceError("", 0, f"expected a MAVLink byte stream: no frame in {seen} bytes")
+
+
+def _open_map(path: Path, name: str) -> mmap.mmap | bytes:
+    try:
+        with path.open("rb") as f:
+            if f.seek(0, 2) == 0:
+                return b""
+            return mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
+    except OSError as exc:
+        raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+
+
+def read_frames(
+    path: Path | IO[bytes], name: str, model: Any, stats: StreamStats, *, timestamps: bool
+) -> Iterator[FrameRecord]:
+    """The wanted frames of a .tlog (``timestamps``) or raw stream, from a path or a binary stream.
+    Raises InstanceError (naming ``name``) when nothing in a non-empty input is MAVLink."""
+    if not timestamps:
+        if isinstance(path, Path):
+            try:
+                stream: IO[bytes] = path.open("rb")
+            except OSError as exc:
+                raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+        else:
+            stream = path
+        try:
+            yield from raw_frames(stream, model, stats)
+        except InstanceError as exc:
+            raise InstanceError(name, 0, exc.message) from None
+        finally:
+            if isinstance(path, Path):
+                stream.close()
+        return
+    data = _open_map(path, name) if isinstance(path, Path) else path.read()
+    size = len(data)
+    try:
+        yield from tlog_frames(data, model, stats)
+    finally:
+        if isinstance(data, mmap.mmap):
+            data.close()
+    if size and not (stats.records or stats.other_frames or stats.bad_crc or stats.decode_errors):
+        raise InstanceError(
+            name, 0, "expected a MAVLink telemetry log: no 8-byte timestamp followed by a MAVLink frame found"
+        )
+
+
+def mavlink_items(path: Path, name: str, message: Message, model: Any, *, timestamps: bool) -> Iterator[Item]:
+    """validate's records of a .tlog or raw MAVLink file, then the damage summary."""
+    stats = StreamStats()
+    for rec in read_frames(path, name, model, stats, timestamps=timestamps):
+        yield Record(
+            rec.number,
+            0,
+            None,
+            name,
+            where=rec.where(message.name),
+            instance=rec.instance,
+            location=rec.location(),
+        )
+    yield stats_notice(name, message, stats)
+
+
+def stats_notice(name: str, message: Message, stats: StreamStats) -> Notice:
+    text = stats.summary(message.name)
+    if stats.problems:
+        text += f" (last problem: {stats.problems[-1]})"
+    return Notice(name, text, "stream", "warning" if stats.damaged else "info", stats.to_dict())

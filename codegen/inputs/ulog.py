@@ -1,0 +1,191 @@
+"""PX4 ULog flight logs (.ulg) as records: every record of a uORB message's topics, all multi_ids.
+
+Records come in file order (multi_ids interleaved as logged), each decoded on its own, through
+the generated reader's streaming API (``read(path, index=False)`` then ``Log.iter_records``): the
+file is memory-mapped and walked once, so memory does not grow with the number of records.
+
+Logs written before a message changed (PX4 logs predating message versioning) carry another
+format for the topic: the difference is one notice per topic, fields matching by name and type
+are decoded, and the checks of the fields the log lacks or types differently are not reported
+(their values would be the schema's defaults, not the log's data) -- with one notice naming them.
+Damage the reader recovered from and a log without the message's topics are told after the
+records, once the walk has seen the whole file.
+"""
+
+from __future__ import annotations
+
+import importlib
+import struct
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import IO, Any
+
+from ..ir import Message
+from .records import InstanceError, Item, Notice, Record, Unreadable
+
+MAX_DAMAGE_NOTICES = 10
+
+
+@dataclass(frozen=True)
+class LogRecord:
+    """One decoded record: topic, instance, file offset of its 'D' record, timestamp (us)."""
+
+    topic: str
+    multi_id: int
+    offset: int
+    timestamp: int | None
+    instance: Any
+    skip: frozenset[str]
+
+    def where(self) -> str:
+        stamp = f", timestamp {self.timestamp} us" if self.timestamp is not None else ""
+        return f"{self.topic} multi_id {self.multi_id}{stamp}, offset {self.offset}"
+
+    def location(self) -> dict[str, object]:
+        return {"topic": self.topic, "multi_id": self.multi_id, "timestamp_us": self.timestamp, "offset": self.offset}
+
+
+def runtime(model: Any, name: str) -> ModuleType:
+    """The generated package's runtime module ``name`` (``_ulog``, ``_mavlink``) of a model class."""
+    package = model.__module__.rpartition(".")[0]
+    return importlib.import_module(f"{package}.{name}")
+
+
+def _diff_line(diff: Any) -> str:
+    parts = []
+    if diff.missing:
+        parts.append("missing from the log: " + ", ".join(f"{n} {t}" for n, t in diff.missing))
+    if diff.extra:
+        parts.append("only in the log: " + ", ".join(f"{n} {t}" for n, t in diff.extra))
+    if diff.retyped:
+        parts.append("retyped: " + ", ".join(f"{r.name} (schema {r.schema}, log {r.log})" for r in diff.retyped))
+    body = "; ".join(parts) if parts else "same fields, other layout"
+    return f"{diff.topic}: the log's format differs from the schema's ({diff.message}): {body}"
+
+
+class UlogReader:
+    """An opened log and the topics of one generated uORB class; close() releases the file.
+
+    ``notices`` holds what the definitions tell (format differences, unchecked fields) when the
+    reader is made; ``trailing`` what only a whole walk can tell (damage, no records), once
+    records() is exhausted.
+    """
+
+    def __init__(self, source: Path | IO[bytes], name: str, model: Any) -> None:
+        self.name = name
+        self.model = model
+        self.ulog = runtime(model, "_ulog")
+        if isinstance(source, Path):
+            _check_file(source, name)
+        try:
+            self.log = self.ulog.read(source, index=False, warn=False)  # damage: listed in Log.warnings
+        except OSError as exc:
+            raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+        except (ValueError, struct.error, IndexError) as exc:  # ULogError is a ValueError
+            raise InstanceError(name, 0, f"expected a ULog file: {exc}") from None
+        self.topics = tuple(getattr(model, "UORB_TOPICS", ()) or (self.ulog.format_of(model).name,))
+        self.notices: list[Notice] = []
+        self.trailing: list[Notice] = []  # filled once records() has walked the whole log
+        self.skips: dict[str, frozenset[str]] = {}  # decodable topics -> fields left unchecked
+        self._prepare()
+
+    def close(self) -> None:
+        self.log.close()
+
+    def _prepare(self) -> None:
+        for topic in self.topics:
+            if topic not in self.log.formats:
+                continue
+            try:
+                diff = self.log.compare(self.model, topic=topic)
+                self.log.layout(topic)
+            except ValueError as exc:
+                self.notices.append(Notice(self.name, f"{topic}: cannot decode this topic: {exc}", "damage"))
+                continue
+            skip = frozenset({n for n, _ in diff.missing} | {r.name for r in diff.retyped})
+            if not diff.identical:
+                severity = "info" if diff.matches else "warning"
+                self.notices.append(Notice(self.name, _diff_line(diff), "format-diff", severity, diff.to_dict()))
+            if skip:
+                self.notices.append(
+                    Notice(
+                        self.name,
+                        f"{topic}: not checked, as the log lacks them or types them differently "
+                        f"(their values would be the schema's defaults): {', '.join(sorted(skip))}",
+                        "unchecked",
+                        data={"topic": topic, "fields": sorted(skip)},
+                    )
+                )
+            self.skips[topic] = skip
+
+    def records(self) -> Iterator[LogRecord | Unreadable]:
+        """Every record of the class's topics in file order (multi_ids interleaved); at the end,
+        fills ``trailing``."""
+        skips = self.skips
+        try:
+            for rec in self.log.iter_records(self.model, topic=list(skips)):
+                skip = skips[rec.topic]
+                stamp = getattr(rec.instance, "timestamp", None) if "timestamp" not in skip else None
+                yield LogRecord(
+                    rec.topic, rec.multi_id, rec.offset, stamp if isinstance(stamp, int) else None, rec.instance, skip
+                )
+        except ValueError as exc:  # a record that cannot be decoded ends the walk
+            yield Unreadable(self.name, 0, str(exc))
+            return
+        self.trailing = self._after_walk()
+
+    def _after_walk(self) -> list[Notice]:
+        out: list[Notice] = []
+        problems = self.log.warnings
+        for text in problems[:MAX_DAMAGE_NOTICES]:
+            out.append(Notice(self.name, f"damaged log, recovered: {text}", "damage"))
+        if len(problems) > MAX_DAMAGE_NOTICES:
+            more = len(problems) - MAX_DAMAGE_NOTICES
+            out.append(Notice(self.name, f"damaged log: {more} more problems recovered from", "damage"))
+        present = sorted({t for t, _ in self.log.topics()})  # counted by the walk just finished
+        if not any(t in self.skips for t in present):
+            logged = ", ".join(present) or "none"
+            what = " or ".join(self.topics)
+            out.append(Notice(self.name, f"no {what} records in this log (topics logged: {logged})", "empty"))
+        return out
+
+
+def _check_file(path: Path, name: str) -> None:
+    try:
+        if path.is_file() and path.stat().st_size == 0:
+            raise InstanceError(name, 0, "empty file: expected a ULog file")
+    except OSError as exc:
+        raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+
+
+def ulog_items(path: Path, name: str, message: Message, model: Any) -> Iterator[Item]:
+    """validate's records of a .ulg file: notices first, then one record per logged message, then
+    the notices of the whole walk (damage recovered from, no records of the message)."""
+    reader = UlogReader(path, name, model)  # raises InstanceError before the first item
+    return _items(reader)
+
+
+def _items(reader: UlogReader) -> Iterator[Item]:
+    try:
+        yield from reader.notices
+        index = 0
+        for rec in reader.records():
+            if isinstance(rec, Unreadable):
+                yield rec
+                continue
+            yield Record(
+                index,
+                0,
+                None,
+                reader.name,
+                where=rec.where(),
+                instance=rec.instance,
+                skip=rec.skip,
+                location=rec.location(),
+            )
+            index += 1
+        yield from reader.trailing
+    finally:
+        reader.close()
