@@ -1,0 +1,393 @@
+"""Prints a :mod:`.document` into text of a given line width.
+
+A group prints flat when its content, and what follows it up to the next line break, fits in the
+remaining width; otherwise its line breaks break. The queue of what is left to print and the
+stack of enclosing modes work as in ruff's printer (whose results this must reproduce): a fitting
+test reads ahead through the same queue without consuming it.
+"""
+
+from __future__ import annotations
+
+import enum
+import unicodedata
+from dataclasses import dataclass, replace
+
+from .document import (
+    BestFitting,
+    Condition,
+    Element,
+    End,
+    ExpandParent,
+    GroupMode,
+    Kind,
+    Line,
+    Measure,
+    Mode,
+    Start,
+    propagate_expand,
+)
+
+INDENT_WIDTH = 4
+
+
+@dataclass(frozen=True)
+class Args:
+    """How the content of the innermost open tag prints: indentation level, mode, measure."""
+
+    indent: int = 0
+    mode: Mode = Mode.EXPANDED
+    measure: Measure = Measure.FIRST_LINE
+
+
+class _Fits(enum.Enum):
+    YES = "yes"
+    NO = "no"
+    MAYBE = "maybe"
+
+
+def text_width(text: str) -> int:
+    return sum(2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in text)
+
+
+class Queue:
+    """What is left to print: a stack of (elements, next index) frames, the top one read first."""
+
+    def __init__(self, frames: list[list[object]] | None = None) -> None:
+        self.frames: list[list[object]] = frames if frames is not None else []
+
+    def copy(self) -> Queue:
+        return Queue([[items, index] for items, index in self.frames])
+
+    def pop(self) -> Element | None:
+        frames = self.frames
+        while frames:
+            frame = frames[-1]
+            items = frame[0]
+            index = frame[1]
+            assert isinstance(items, list) and isinstance(index, int)
+            if index < len(items):
+                frame[1] = index + 1
+                element: Element = items[index]
+                return element
+            frames.pop()
+        return None
+
+    def extend_back(self, elements: list[Element]) -> None:
+        if elements:
+            self.frames.append([elements, 0])
+
+    def pop_slice(self) -> None:
+        self.frames.pop()
+
+    def skip_content(self, kind: Kind) -> None:
+        depth = 1
+        while (element := self.pop()) is not None:
+            if isinstance(element, Start) and element.kind is kind:
+                depth += 1
+            elif isinstance(element, End) and element.kind is kind:
+                depth -= 1
+                if depth == 0:
+                    return
+
+
+Stack = list[tuple[Kind | None, Args]]
+
+
+class Printer:
+    def __init__(self, line_width: int) -> None:
+        self.line_width_limit = line_width
+        self.buffer: list[str] = []
+        self.line_has_text = False
+        self.line_width = 0
+        self.pending_indent = 0
+        self.measured_group_fits = False
+        self.group_modes: dict[int, Mode] = {}
+
+    def print(self, document: list[Element], indent: int) -> str:
+        propagate_expand(document)
+        self.pending_indent = indent
+        stack: Stack = [(None, Args(indent=indent))]
+        queue = Queue()
+        queue.extend_back(document)
+        while (element := queue.pop()) is not None:
+            self.print_element(stack, queue, element)
+        return "".join(self.buffer)
+
+    # -- printing ---------------------------------------------------------------------------------
+
+    def print_text(self, text: str) -> None:
+        if self.pending_indent:
+            self.buffer.append(" " * (INDENT_WIDTH * self.pending_indent))
+            self.line_width += INDENT_WIDTH * self.pending_indent
+            self.pending_indent = 0
+        self.buffer.append(text)
+        self.line_has_text = True
+        self.line_width += text_width(text)
+
+    def new_line(self) -> None:
+        self.buffer.append("\n")
+        self.line_width = 0
+        self.line_has_text = False
+        # fitting tests only looked up to the first line break: the next group measures again
+        self.measured_group_fits = False
+
+    def print_element(self, stack: Stack, queue: Queue, element: Element) -> None:
+        args = stack[-1][1]
+        if isinstance(element, str):
+            self.print_text(element)
+        elif isinstance(element, Line):
+            if args.mode is Mode.FLAT and element is not Line.HARD:
+                if element is Line.SOFT_OR_SPACE:
+                    self.print_text(" ")
+            else:
+                if self.line_has_text:
+                    self.new_line()
+                self.pending_indent = args.indent
+        elif isinstance(element, ExpandParent):
+            pass
+        elif isinstance(element, BestFitting):
+            self.print_best_fitting(element, queue, stack)
+        elif isinstance(element, Start):
+            self.print_start(element, args, queue, stack)
+        else:
+            self.print_end(element, args, queue, stack)
+
+    def print_start(self, tag: Start, args: Args, queue: Queue, stack: Stack) -> None:
+        kind = tag.kind
+        if kind is Kind.GROUP:
+            if tag.mode is GroupMode.FLAT:
+                mode = self.flat_group_print_mode(kind, tag.group_id, args, queue, stack)
+            else:
+                mode = Mode.EXPANDED
+            if tag.group_id is not None:
+                self.group_modes[tag.group_id] = mode
+            stack.append((kind, replace(args, mode=mode)))
+        elif kind is Kind.BEST_FIT_PARENTHESIZE:
+            self.print_best_fit_parenthesize(tag, args, queue, stack)
+        elif kind is Kind.CONDITIONAL_GROUP:
+            assert tag.condition is not None
+            if self.condition_mode(tag.condition, args) is tag.condition.mode:
+                if tag.mode is GroupMode.FLAT:
+                    mode = self.flat_group_print_mode(kind, None, args, queue, stack)
+                else:
+                    mode = Mode.EXPANDED
+                stack.append((kind, replace(args, mode=mode)))
+            else:
+                stack.append((kind, args))
+        elif kind is Kind.INDENT:
+            stack.append((kind, replace(args, indent=args.indent + 1)))
+        elif kind is Kind.CONDITIONAL_CONTENT:
+            assert tag.condition is not None
+            if self.condition_mode(tag.condition, args) is tag.condition.mode:
+                stack.append((kind, args))
+            else:
+                queue.skip_content(kind)
+        elif kind is Kind.INDENT_IF_GROUP_BREAKS:
+            assert tag.group_id is not None
+            expanded = self.group_modes[tag.group_id] is Mode.EXPANDED
+            stack.append((kind, replace(args, indent=args.indent + 1) if expanded else args))
+        elif kind is Kind.FITS_EXPANDED:
+            if tag.condition is None or self.condition_mode(tag.condition, args) is tag.condition.mode:
+                # the inner groups were measured expanded: they must measure again
+                self.measured_group_fits = False
+            stack.append((kind, args))
+        else:
+            stack.append((kind, args))
+
+    def print_end(self, tag: End, args: Args, queue: Queue, stack: Stack) -> None:
+        if tag.kind is Kind.BEST_FIT_PARENTHESIZE and args.mode is Mode.EXPANDED:
+            popped, _ = stack.pop()
+            assert popped is Kind.INDENT
+            queue.extend_back([Line.HARD, ")"])
+        popped, _ = stack.pop()
+        assert popped is tag.kind, (popped, tag.kind)
+
+    def condition_mode(self, condition: Condition, args: Args) -> Mode:
+        return args.mode if condition.group_id is None else self.group_modes[condition.group_id]
+
+    def flat_group_print_mode(self, kind: Kind, group_id: int | None, args: Args, queue: Queue, stack: Stack) -> Mode:
+        if args.mode is Mode.FLAT and self.measured_group_fits:
+            return Mode.FLAT  # an enclosing group already found that this one fits
+        self.measured_group_fits = True
+        if group_id is not None:
+            self.group_modes[group_id] = Mode.FLAT
+        stack.append((kind, replace(args, mode=Mode.FLAT)))
+        fits = self.fits(queue, stack)
+        stack.pop()
+        return Mode.FLAT if fits else Mode.EXPANDED
+
+    def print_best_fit_parenthesize(self, tag: Start, args: Args, queue: Queue, stack: Stack) -> None:
+        opening: list[Element] = ["(", Start(Kind.INDENT), Line.HARD]
+        if self.flat_group_print_mode(tag.kind, tag.group_id, args, queue, stack) is Mode.FLAT:
+            mode = Mode.FLAT
+        else:
+            # parenthesize only if the content then fits; else rather break it without parentheses
+            if tag.group_id is not None:
+                self.group_modes[tag.group_id] = Mode.EXPANDED
+            stack.append((tag.kind, replace(args, measure=Measure.ALL_LINES)))
+            queue.extend_back(opening)
+            fits_expanded = self.fits(queue, stack)
+            queue.pop_slice()
+            stack.pop()
+            mode = Mode.EXPANDED if fits_expanded else Mode.FLAT
+        if tag.group_id is not None:
+            self.group_modes[tag.group_id] = mode
+        if mode is Mode.EXPANDED:
+            queue.extend_back(opening)
+        stack.append((tag.kind, replace(args, mode=mode)))
+
+    def print_best_fitting(self, element: BestFitting, queue: Queue, stack: Stack) -> None:
+        args = stack[-1][1]
+        variants = element.variants
+        if args.mode is Mode.FLAT and self.measured_group_fits:
+            queue.extend_back(variants[0])
+            self.print_entry(queue, stack, args)
+            return
+        self.measured_group_fits = True
+        for variant in variants[:-1]:
+            content = variant[1:]  # the ENTRY start tag gets the measuring args below
+            queue.extend_back(content)
+            stack.append((Kind.ENTRY, replace(args, mode=Mode.FLAT, measure=element.measure)))
+            fits = self.fits(queue, stack)
+            stack.pop()
+            queue.pop_slice()
+            if fits:
+                queue.extend_back(variant)
+                self.print_entry(queue, stack, replace(args, mode=Mode.FLAT))
+                return
+        queue.extend_back(variants[-1])
+        self.print_entry(queue, stack, replace(args, mode=Mode.EXPANDED))
+
+    def print_entry(self, queue: Queue, stack: Stack, args: Args) -> None:
+        start = queue.pop()
+        assert isinstance(start, Start) and start.kind is Kind.ENTRY
+        stack.append((Kind.ENTRY, args))
+        depth = 1
+        while (element := queue.pop()) is not None:
+            if isinstance(element, Start) and element.kind is Kind.ENTRY:
+                depth += 1
+            elif isinstance(element, End) and element.kind is Kind.ENTRY:
+                depth -= 1
+                if depth == 0:
+                    stack.pop()
+                    return
+            self.print_element(stack, queue, element)
+        raise AssertionError("unterminated best-fitting entry")
+
+    def fits(self, queue: Queue, stack: Stack) -> bool:
+        return _FitsMeasurer(self, queue, stack).fits()
+
+
+class _FitsMeasurer:
+    """Reads ahead from the printer's position, in the modes the stack says, without printing."""
+
+    def __init__(self, printer: Printer, queue: Queue, stack: Stack) -> None:
+        self.printer = printer
+        self.queue = queue.copy()
+        self.stack: Stack = list(stack)
+        self.pending_indent = printer.pending_indent
+        self.line_width = printer.line_width
+        self.limit = printer.line_width_limit
+
+    def fits(self) -> bool:
+        while (element := self.queue.pop()) is not None:
+            result = self.fits_element(element)
+            if result is _Fits.YES:
+                return True
+            if result is _Fits.NO:
+                return False
+        return True
+
+    def fits_element(self, element: Element) -> _Fits:
+        args = self.stack[-1][1]
+        if isinstance(element, str):
+            return self.fits_text(element, args)
+        if isinstance(element, Line):
+            if args.mode is Mode.FLAT:
+                if element is Line.SOFT_OR_SPACE:
+                    return self.fits_text(" ", args)
+                if element is Line.HARD:
+                    return _Fits.YES
+            elif args.measure is Measure.FIRST_LINE:
+                return _Fits.YES
+            else:
+                self.line_width = 0
+                self.pending_indent = args.indent
+            return _Fits.MAYBE
+        if isinstance(element, ExpandParent):
+            return _Fits.MAYBE
+        if isinstance(element, BestFitting):
+            if args.mode is Mode.FLAT:
+                variant, entry_args = element.variants[0], replace(args, measure=element.measure)
+            else:
+                variant, entry_args = element.variants[-1], args
+            self.stack.append((Kind.ENTRY, entry_args))
+            self.queue.extend_back(variant[1:])
+            return _Fits.MAYBE
+        if isinstance(element, End):
+            return self.fits_end(element, args)
+        return self.fits_start(element, args)
+
+    def fits_start(self, tag: Start, args: Args) -> _Fits:
+        kind = tag.kind
+        modes = self.printer.group_modes
+        if kind is Kind.INDENT:
+            self.stack.append((kind, replace(args, indent=args.indent + 1)))
+        elif kind is Kind.GROUP:
+            return self.fits_group(kind, tag.mode, tag.group_id, args)
+        elif kind is Kind.BEST_FIT_PARENTHESIZE:
+            if tag.group_id is not None:
+                modes[tag.group_id] = args.mode
+            self.stack.append((kind, args))
+        elif kind is Kind.CONDITIONAL_GROUP:
+            assert tag.condition is not None
+            if self.printer.condition_mode(tag.condition, args) is tag.condition.mode:
+                return self.fits_group(kind, tag.mode, None, args)
+            self.stack.append((kind, args))
+        elif kind is Kind.CONDITIONAL_CONTENT:
+            assert tag.condition is not None
+            if self.printer.condition_mode(tag.condition, args) is tag.condition.mode:
+                self.stack.append((kind, args))
+            else:
+                self.queue.skip_content(kind)
+        elif kind is Kind.INDENT_IF_GROUP_BREAKS:
+            assert tag.group_id is not None
+            expanded = modes[tag.group_id] is Mode.EXPANDED
+            self.stack.append((kind, replace(args, indent=args.indent + 1) if expanded else args))
+        elif kind is Kind.FITS_EXPANDED:
+            met = tag.condition is None or self.printer.condition_mode(tag.condition, args) is tag.condition.mode
+            if args.mode is Mode.FLAT and met:
+                # measure the content fully expanded; only what comes before and after must fit
+                self.stack.append((kind, replace(args, measure=Measure.ALL_LINES_OVERFLOW, mode=Mode.EXPANDED)))
+            elif args.mode is Mode.FLAT and tag.propagate_expand:
+                return _Fits.NO
+            else:
+                self.stack.append((kind, args))
+        else:
+            self.stack.append((kind, args))
+        return _Fits.MAYBE
+
+    def fits_end(self, tag: End, args: Args) -> _Fits:
+        if tag.kind is Kind.BEST_FIT_PARENTHESIZE and args.mode is Mode.EXPANDED and self.stack[-1][0] is Kind.INDENT:
+            self.stack.pop()
+            _, unindented = self.stack.pop()
+            self.line_width = 0
+            self.pending_indent = unindented.indent
+            return self.fits_text(")", unindented)
+        self.stack.pop()
+        return _Fits.MAYBE
+
+    def fits_group(self, kind: Kind, group_mode: GroupMode, group_id: int | None, args: Args) -> _Fits:
+        mode = args.mode if group_mode is GroupMode.FLAT else Mode.EXPANDED
+        self.stack.append((kind, replace(args, mode=mode)))
+        if group_id is not None:
+            self.printer.group_modes[group_id] = mode
+        return _Fits.MAYBE
+
+    def fits_text(self, text: str, args: Args) -> _Fits:
+        self.line_width += INDENT_WIDTH * self.pending_indent
+        self.pending_indent = 0
+        self.line_width += text_width(text)
+        if self.line_width > self.limit and args.measure is not Measure.ALL_LINES_OVERFLOW:
+            return _Fits.NO
+        return _Fits.MAYBE
