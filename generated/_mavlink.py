@@ -35,9 +35,9 @@ MAX_PAYLOAD = 255
 
 # msgid -> (CRC_EXTRA, class name, MAVLINK_MAX_LENGTH, MAVLink name) of every generated message
 REGISTRY: dict[int, tuple[int, str, int, str]] = {
-    147: (154, 'BatteryStatus', 54, 'BATTERY_STATUS'),
+    147: (154, "BatteryStatus", 54, "BATTERY_STATUS"),
 }
-_MODULE = 'mavlink'
+_MODULE = "mavlink"
 _CLASSES: dict[int, type[MavlinkMessage]] = {}
 _FAST: dict[int, tuple[Any, bytes, int, str]] = {}  # msgid -> (decode, CRC_EXTRA byte, size, name)
 

@@ -12,11 +12,18 @@ import struct
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from . import _meta as _m
 from . import _mavlink as _mav
+from . import _meta as _m
 from . import _validate as _v
 
-__all__ = ['BatteryStatus', 'MavBatteryChargeState', 'MavBatteryFault', 'MavBatteryFunction', 'MavBatteryMode', 'MavBatteryType']
+__all__ = [
+    "BatteryStatus",
+    "MavBatteryChargeState",
+    "MavBatteryFault",
+    "MavBatteryFunction",
+    "MavBatteryMode",
+    "MavBatteryType",
+]
 
 
 class MavBatteryChargeState(enum.IntEnum):
@@ -89,25 +96,131 @@ class MavBatteryType(enum.IntEnum):
     NIMH = 4
 
 
-_MAV_BatteryStatus = struct.Struct('<iih10HhBBBbiB4HBI')
-_MAV_BatteryStatus_FIELDS: tuple[tuple[str, str, str, int], ...] = (('current_consumed', 'current_consumed', 'i', 0), ('energy_consumed', 'energy_consumed', 'i', 0), ('temperature', 'temperature', 'h', 0), ('voltages', 'voltages', 'H', 10), ('current_battery', 'current_battery', 'h', 0), ('id', 'id', 'B', 0), ('battery_function', 'battery_function', 'B', 0), ('type', 'type', 'B', 0), ('battery_remaining', 'battery_remaining', 'b', 0), ('time_remaining', 'time_remaining', 'i', 0), ('charge_state', 'charge_state', 'B', 0), ('voltages_ext', 'voltages_ext', 'H', 4), ('mode', 'mode', 'B', 0), ('fault_bitmask', 'fault_bitmask', 'I', 0),)
-_MAV_BatteryStatus_DTYPE: list[tuple[Any, ...]] = [('current_consumed', '<i4'), ('energy_consumed', '<i4'), ('temperature', '<i2'), ('voltages', '<u2', (10,)), ('current_battery', '<i2'), ('id', 'u1'), ('battery_function', 'u1'), ('type', 'u1'), ('battery_remaining', 'i1'), ('time_remaining', '<i4'), ('charge_state', 'u1'), ('voltages_ext', '<u2', (4,)), ('mode', 'u1'), ('fault_bitmask', '<u4')]
+_MAV_BatteryStatus = struct.Struct("<iih10HhBBBbiB4HBI")
+_MAV_BatteryStatus_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("current_consumed", "current_consumed", "i", 0),
+    ("energy_consumed", "energy_consumed", "i", 0),
+    ("temperature", "temperature", "h", 0),
+    ("voltages", "voltages", "H", 10),
+    ("current_battery", "current_battery", "h", 0),
+    ("id", "id", "B", 0),
+    ("battery_function", "battery_function", "B", 0),
+    ("type", "type", "B", 0),
+    ("battery_remaining", "battery_remaining", "b", 0),
+    ("time_remaining", "time_remaining", "i", 0),
+    ("charge_state", "charge_state", "B", 0),
+    ("voltages_ext", "voltages_ext", "H", 4),
+    ("mode", "mode", "B", 0),
+    ("fault_bitmask", "fault_bitmask", "I", 0),
+)
+_MAV_BatteryStatus_DTYPE: list[tuple[Any, ...]] = [
+    ("current_consumed", "<i4"),
+    ("energy_consumed", "<i4"),
+    ("temperature", "<i2"),
+    ("voltages", "<u2", (10,)),
+    ("current_battery", "<i2"),
+    ("id", "u1"),
+    ("battery_function", "u1"),
+    ("type", "u1"),
+    ("battery_remaining", "i1"),
+    ("time_remaining", "<i4"),
+    ("charge_state", "u1"),
+    ("voltages_ext", "<u2", (4,)),
+    ("mode", "u1"),
+    ("fault_bitmask", "<u4"),
+]
 
 
-_VS_BatteryStatus_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
-_VS_BatteryStatus_battery_function = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'MAV_BATTERY_FUNCTION_UNKNOWN', 1: 'MAV_BATTERY_FUNCTION_ALL', 2: 'MAV_BATTERY_FUNCTION_PROPULSION', 3: 'MAV_BATTERY_FUNCTION_AVIONICS', 4: 'MAV_BATTERY_FUNCTION_PAYLOAD'})
-_VS_BatteryStatus_type = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'MAV_BATTERY_TYPE_UNKNOWN', 1: 'MAV_BATTERY_TYPE_LIPO', 2: 'MAV_BATTERY_TYPE_LIFE', 3: 'MAV_BATTERY_TYPE_LION', 4: 'MAV_BATTERY_TYPE_NIMH'})
-_VS_BatteryStatus_temperature = _v.Number(type='int16', kind='int', low=-32768, high=32767, unit='cdegC', sentinel=32767, sentinel_text='INT16_MAX')
-_VS_BatteryStatus_voltages = _v.Array(_v.Number(type='uint16', kind='uint', low=0, high=65535, unit='mV', sentinel=65535, sentinel_text='[UINT16_MAX]'), 10, True)
-_VS_BatteryStatus_current_battery = _v.Number(type='int16', kind='int', low=-32768, high=32767, unit='cA', sentinel=-1, sentinel_text='-1')
-_VS_BatteryStatus_current_consumed = _v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='mAh', sentinel=-1, sentinel_text='-1')
-_VS_BatteryStatus_energy_consumed = _v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='hJ', sentinel=-1, sentinel_text='-1')
-_VS_BatteryStatus_battery_remaining = _v.Number(type='int8', kind='int', low=-128, high=127, unit='%', sentinel=-1, sentinel_text='-1')
-_VS_BatteryStatus_time_remaining = _v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='s')
-_VS_BatteryStatus_charge_state = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'MAV_BATTERY_CHARGE_STATE_UNDEFINED', 1: 'MAV_BATTERY_CHARGE_STATE_OK', 2: 'MAV_BATTERY_CHARGE_STATE_LOW', 3: 'MAV_BATTERY_CHARGE_STATE_CRITICAL', 4: 'MAV_BATTERY_CHARGE_STATE_EMERGENCY', 5: 'MAV_BATTERY_CHARGE_STATE_FAILED', 6: 'MAV_BATTERY_CHARGE_STATE_UNHEALTHY', 7: 'MAV_BATTERY_CHARGE_STATE_CHARGING'})
-_VS_BatteryStatus_voltages_ext = _v.Array(_v.Number(type='uint16', kind='uint', low=0, high=65535, unit='mV'), 4, True)
-_VS_BatteryStatus_mode = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'MAV_BATTERY_MODE_UNKNOWN', 1: 'MAV_BATTERY_MODE_AUTO_DISCHARGING', 2: 'MAV_BATTERY_MODE_HOT_SWAP'})
-_VS_BatteryStatus_fault_bitmask = _v.Number(type='uint32', kind='uint', low=0, high=4294967295, mask=0x1ff, bits={0x1: 'MAV_BATTERY_FAULT_DEEP_DISCHARGE', 0x2: 'MAV_BATTERY_FAULT_SPIKES', 0x4: 'MAV_BATTERY_FAULT_CELL_FAIL', 0x8: 'MAV_BATTERY_FAULT_OVER_CURRENT', 0x10: 'MAV_BATTERY_FAULT_OVER_TEMPERATURE', 0x20: 'MAV_BATTERY_FAULT_UNDER_TEMPERATURE', 0x40: 'MAV_BATTERY_FAULT_INCOMPATIBLE_VOLTAGE', 0x80: 'MAV_BATTERY_FAULT_INCOMPATIBLE_FIRMWARE', 0x100: 'BATTERY_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION'})
+_VS_BatteryStatus_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_VS_BatteryStatus_battery_function = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "MAV_BATTERY_FUNCTION_UNKNOWN",
+        1: "MAV_BATTERY_FUNCTION_ALL",
+        2: "MAV_BATTERY_FUNCTION_PROPULSION",
+        3: "MAV_BATTERY_FUNCTION_AVIONICS",
+        4: "MAV_BATTERY_FUNCTION_PAYLOAD",
+    },
+)
+_VS_BatteryStatus_type = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "MAV_BATTERY_TYPE_UNKNOWN",
+        1: "MAV_BATTERY_TYPE_LIPO",
+        2: "MAV_BATTERY_TYPE_LIFE",
+        3: "MAV_BATTERY_TYPE_LION",
+        4: "MAV_BATTERY_TYPE_NIMH",
+    },
+)
+_VS_BatteryStatus_temperature = _v.Number(
+    type="int16", kind="int", low=-32768, high=32767, unit="cdegC", sentinel=32767, sentinel_text="INT16_MAX"
+)
+_VS_BatteryStatus_voltages = _v.Array(
+    _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mV", sentinel=65535, sentinel_text="[UINT16_MAX]"),
+    10,
+    True,
+)
+_VS_BatteryStatus_current_battery = _v.Number(
+    type="int16", kind="int", low=-32768, high=32767, unit="cA", sentinel=-1, sentinel_text="-1"
+)
+_VS_BatteryStatus_current_consumed = _v.Number(
+    type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh", sentinel=-1, sentinel_text="-1"
+)
+_VS_BatteryStatus_energy_consumed = _v.Number(
+    type="int32", kind="int", low=-2147483648, high=2147483647, unit="hJ", sentinel=-1, sentinel_text="-1"
+)
+_VS_BatteryStatus_battery_remaining = _v.Number(
+    type="int8", kind="int", low=-128, high=127, unit="%", sentinel=-1, sentinel_text="-1"
+)
+_VS_BatteryStatus_time_remaining = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="s")
+_VS_BatteryStatus_charge_state = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "MAV_BATTERY_CHARGE_STATE_UNDEFINED",
+        1: "MAV_BATTERY_CHARGE_STATE_OK",
+        2: "MAV_BATTERY_CHARGE_STATE_LOW",
+        3: "MAV_BATTERY_CHARGE_STATE_CRITICAL",
+        4: "MAV_BATTERY_CHARGE_STATE_EMERGENCY",
+        5: "MAV_BATTERY_CHARGE_STATE_FAILED",
+        6: "MAV_BATTERY_CHARGE_STATE_UNHEALTHY",
+        7: "MAV_BATTERY_CHARGE_STATE_CHARGING",
+    },
+)
+_VS_BatteryStatus_voltages_ext = _v.Array(_v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mV"), 4, True)
+_VS_BatteryStatus_mode = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={0: "MAV_BATTERY_MODE_UNKNOWN", 1: "MAV_BATTERY_MODE_AUTO_DISCHARGING", 2: "MAV_BATTERY_MODE_HOT_SWAP"},
+)
+_VS_BatteryStatus_fault_bitmask = _v.Number(
+    type="uint32",
+    kind="uint",
+    low=0,
+    high=4294967295,
+    mask=0x1FF,
+    bits={
+        0x1: "MAV_BATTERY_FAULT_DEEP_DISCHARGE",
+        0x2: "MAV_BATTERY_FAULT_SPIKES",
+        0x4: "MAV_BATTERY_FAULT_CELL_FAIL",
+        0x8: "MAV_BATTERY_FAULT_OVER_CURRENT",
+        0x10: "MAV_BATTERY_FAULT_OVER_TEMPERATURE",
+        0x20: "MAV_BATTERY_FAULT_UNDER_TEMPERATURE",
+        0x40: "MAV_BATTERY_FAULT_INCOMPATIBLE_VOLTAGE",
+        0x80: "MAV_BATTERY_FAULT_INCOMPATIBLE_FIRMWARE",
+        0x100: "BATTERY_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION",
+    },
+)
 
 
 @dataclasses.dataclass(slots=True)
@@ -117,22 +230,163 @@ class BatteryStatus:
     Schema: mavlink.BATTERY_STATUS (mavlink, battery.xml:114).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'mavlink.BATTERY_STATUS'
+    QUALIFIED_NAME: ClassVar[str] = "mavlink.BATTERY_STATUS"
 
-    id: int = dataclasses.field(default=0, metadata=_m.meta(name='id', type='uint8', doc='Battery instance.'))
-    battery_function: int = dataclasses.field(default=0, metadata=_m.meta(name='battery_function', type='uint8', enums=('mavlink.MAV_BATTERY_FUNCTION',), doc='What the battery powers.'))
-    type: int = dataclasses.field(default=0, metadata=_m.meta(name='type', type='uint8', enums=('mavlink.MAV_BATTERY_TYPE',), doc='Battery chemistry.'))
-    temperature: int = dataclasses.field(default=32767, metadata=_m.meta(name='temperature', type='int16', unit='cdegC', quantity='temperature', scale=0.01, offset=273.15, invalid=32767, invalid_text='INT16_MAX', doc='Battery temperature; INT16_MAX when unknown.'))
-    voltages: list[int] = dataclasses.field(default_factory=lambda: [65535] * 10, metadata=_m.meta(name='voltages', type='uint16[10]', unit='mV', quantity='voltage', scale=0.001, offset=0.0, invalid=65535, invalid_text='[UINT16_MAX]', per_element=True, doc='Voltages of cells 1-10; UINT16_MAX in cells that do not exist. Without per-cell data, cell 0 holds the pack voltage; a pack above UINT16_MAX - 1 mV spills the rest into the following cells.'))
-    current_battery: int = dataclasses.field(default=-1, metadata=_m.meta(name='current_battery', type='int16', unit='cA', quantity='current', scale=0.01, offset=0.0, invalid=-1, invalid_text='-1', doc='Battery current; -1 when not measured.'))
-    current_consumed: int = dataclasses.field(default=-1, metadata=_m.meta(name='current_consumed', type='int32', unit='mAh', quantity='charge', scale=3.6, offset=0.0, invalid=-1, invalid_text='-1', doc='Charge drawn so far; -1 when not estimated.'))
-    energy_consumed: int = dataclasses.field(default=-1, metadata=_m.meta(name='energy_consumed', type='int32', unit='hJ', quantity='energy', scale=100.0, offset=0.0, invalid=-1, invalid_text='-1', doc='Energy drawn so far; -1 when not estimated.'))
-    battery_remaining: int = dataclasses.field(default=-1, metadata=_m.meta(name='battery_remaining', type='int8', unit='%', quantity='ratio', scale=0.01, offset=0.0, invalid=-1, invalid_text='-1', doc='Energy left, 0 to 100; -1 when not estimated.'))
-    time_remaining: int = dataclasses.field(default=0, metadata=_m.meta(name='time_remaining', type='int32', unit='s', quantity='time', extension=True, doc='Time left; 0 when not estimated.'))
-    charge_state: int = dataclasses.field(default=0, metadata=_m.meta(name='charge_state', type='uint8', enums=('mavlink.MAV_BATTERY_CHARGE_STATE',), extension=True, doc='Discharge level, for warnings and failsafes.'))
-    voltages_ext: list[int] = dataclasses.field(default_factory=lambda: [0] * 4, metadata=_m.meta(name='voltages_ext', type='uint16[4]', unit='mV', quantity='voltage', scale=0.001, offset=0.0, extension=True, doc='Voltages of cells 11-14; 0 in cells that do not exist (a measured 0 is sent as 1).'))
-    mode: int = dataclasses.field(default=0, metadata=_m.meta(name='mode', type='uint8', enums=('mavlink.MAV_BATTERY_MODE',), extension=True, doc='Battery mode; 0 when not reported or in normal use.'))
-    fault_bitmask: int = dataclasses.field(default=0, metadata=_m.meta(name='fault_bitmask', type='uint32', enums=('mavlink.MAV_BATTERY_FAULT',), extension=True, doc='Fault flags, valid when charge_state is FAILED or UNHEALTHY.'))
+    id: int = dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery instance."))
+    battery_function: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="battery_function",
+            type="uint8",
+            enums=("mavlink.MAV_BATTERY_FUNCTION",),
+            doc="What the battery powers.",
+        ),
+    )
+    type: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Battery chemistry."),
+    )
+    temperature: int = dataclasses.field(
+        default=32767,
+        metadata=_m.meta(
+            name="temperature",
+            type="int16",
+            unit="cdegC",
+            quantity="temperature",
+            scale=0.01,
+            offset=273.15,
+            invalid=32767,
+            invalid_text="INT16_MAX",
+            doc="Battery temperature; INT16_MAX when unknown.",
+        ),
+    )
+    voltages: list[int] = dataclasses.field(
+        default_factory=lambda: [65535] * 10,
+        metadata=_m.meta(
+            name="voltages",
+            type="uint16[10]",
+            unit="mV",
+            quantity="voltage",
+            scale=0.001,
+            offset=0.0,
+            invalid=65535,
+            invalid_text="[UINT16_MAX]",
+            per_element=True,
+            doc="Voltages of cells 1-10; UINT16_MAX in cells that do not exist. Without per-cell "
+            "data, cell 0 holds the pack voltage; a pack above UINT16_MAX - 1 mV spills the "
+            "rest into the following cells.",
+        ),
+    )
+    current_battery: int = dataclasses.field(
+        default=-1,
+        metadata=_m.meta(
+            name="current_battery",
+            type="int16",
+            unit="cA",
+            quantity="current",
+            scale=0.01,
+            offset=0.0,
+            invalid=-1,
+            invalid_text="-1",
+            doc="Battery current; -1 when not measured.",
+        ),
+    )
+    current_consumed: int = dataclasses.field(
+        default=-1,
+        metadata=_m.meta(
+            name="current_consumed",
+            type="int32",
+            unit="mAh",
+            quantity="charge",
+            scale=3.6,
+            offset=0.0,
+            invalid=-1,
+            invalid_text="-1",
+            doc="Charge drawn so far; -1 when not estimated.",
+        ),
+    )
+    energy_consumed: int = dataclasses.field(
+        default=-1,
+        metadata=_m.meta(
+            name="energy_consumed",
+            type="int32",
+            unit="hJ",
+            quantity="energy",
+            scale=100.0,
+            offset=0.0,
+            invalid=-1,
+            invalid_text="-1",
+            doc="Energy drawn so far; -1 when not estimated.",
+        ),
+    )
+    battery_remaining: int = dataclasses.field(
+        default=-1,
+        metadata=_m.meta(
+            name="battery_remaining",
+            type="int8",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            invalid=-1,
+            invalid_text="-1",
+            doc="Energy left, 0 to 100; -1 when not estimated.",
+        ),
+    )
+    time_remaining: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="time_remaining",
+            type="int32",
+            unit="s",
+            quantity="time",
+            extension=True,
+            doc="Time left; 0 when not estimated.",
+        ),
+    )
+    charge_state: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="charge_state",
+            type="uint8",
+            enums=("mavlink.MAV_BATTERY_CHARGE_STATE",),
+            extension=True,
+            doc="Discharge level, for warnings and failsafes.",
+        ),
+    )
+    voltages_ext: list[int] = dataclasses.field(
+        default_factory=lambda: [0] * 4,
+        metadata=_m.meta(
+            name="voltages_ext",
+            type="uint16[4]",
+            unit="mV",
+            quantity="voltage",
+            scale=0.001,
+            offset=0.0,
+            extension=True,
+            doc="Voltages of cells 11-14; 0 in cells that do not exist (a measured 0 is sent as 1).",
+        ),
+    )
+    mode: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="mode",
+            type="uint8",
+            enums=("mavlink.MAV_BATTERY_MODE",),
+            extension=True,
+            doc="Battery mode; 0 when not reported or in normal use.",
+        ),
+    )
+    fault_bitmask: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="fault_bitmask",
+            type="uint32",
+            enums=("mavlink.MAV_BATTERY_FAULT",),
+            extension=True,
+            doc="Fault flags, valid when charge_state is FAILED or UNHEALTHY.",
+        ),
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -143,55 +397,79 @@ class BatteryStatus:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['id'] = self.id
-        out['battery_function'] = self.battery_function
-        out['type'] = self.type
-        out['temperature'] = self.temperature
-        out['voltages'] = list(self.voltages)
-        out['current_battery'] = self.current_battery
-        out['current_consumed'] = self.current_consumed
-        out['energy_consumed'] = self.energy_consumed
-        out['battery_remaining'] = self.battery_remaining
-        out['time_remaining'] = self.time_remaining
-        out['charge_state'] = self.charge_state
-        out['voltages_ext'] = list(self.voltages_ext)
-        out['mode'] = self.mode
-        out['fault_bitmask'] = self.fault_bitmask
+        out["id"] = self.id
+        out["battery_function"] = self.battery_function
+        out["type"] = self.type
+        out["temperature"] = self.temperature
+        out["voltages"] = list(self.voltages)
+        out["current_battery"] = self.current_battery
+        out["current_consumed"] = self.current_consumed
+        out["energy_consumed"] = self.energy_consumed
+        out["battery_remaining"] = self.battery_remaining
+        out["time_remaining"] = self.time_remaining
+        out["charge_state"] = self.charge_state
+        out["voltages_ext"] = list(self.voltages_ext)
+        out["mode"] = self.mode
+        out["fault_bitmask"] = self.fault_bitmask
         return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'id', 'battery_function', 'type', 'temperature', 'voltages', 'current_battery', 'current_consumed', 'energy_consumed', 'battery_remaining', 'time_remaining', 'charge_state', 'voltages_ext', 'mode', 'fault_bitmask'}), (), 'BatteryStatus')
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "id",
+                    "battery_function",
+                    "type",
+                    "temperature",
+                    "voltages",
+                    "current_battery",
+                    "current_consumed",
+                    "energy_consumed",
+                    "battery_remaining",
+                    "time_remaining",
+                    "charge_state",
+                    "voltages_ext",
+                    "mode",
+                    "fault_bitmask",
+                }
+            ),
+            (),
+            "BatteryStatus",
+        )
         obj = cls()
-        if 'id' in data:
-            obj.id = _m.as_int(data['id'], 'id')
-        if 'battery_function' in data:
-            obj.battery_function = _m.as_int(data['battery_function'], 'battery_function')
-        if 'type' in data:
-            obj.type = _m.as_int(data['type'], 'type')
-        if 'temperature' in data:
-            obj.temperature = _m.as_int(data['temperature'], 'temperature')
-        if 'voltages' in data:
-            obj.voltages = _m.as_list(data['voltages'], 'voltages', 10, True, lambda item, p: _m.as_int(item, p))
-        if 'current_battery' in data:
-            obj.current_battery = _m.as_int(data['current_battery'], 'current_battery')
-        if 'current_consumed' in data:
-            obj.current_consumed = _m.as_int(data['current_consumed'], 'current_consumed')
-        if 'energy_consumed' in data:
-            obj.energy_consumed = _m.as_int(data['energy_consumed'], 'energy_consumed')
-        if 'battery_remaining' in data:
-            obj.battery_remaining = _m.as_int(data['battery_remaining'], 'battery_remaining')
-        if 'time_remaining' in data:
-            obj.time_remaining = _m.as_int(data['time_remaining'], 'time_remaining')
-        if 'charge_state' in data:
-            obj.charge_state = _m.as_int(data['charge_state'], 'charge_state')
-        if 'voltages_ext' in data:
-            obj.voltages_ext = _m.as_list(data['voltages_ext'], 'voltages_ext', 4, True, lambda item, p: _m.as_int(item, p))
-        if 'mode' in data:
-            obj.mode = _m.as_int(data['mode'], 'mode')
-        if 'fault_bitmask' in data:
-            obj.fault_bitmask = _m.as_int(data['fault_bitmask'], 'fault_bitmask')
+        if "id" in data:
+            obj.id = _m.as_int(data["id"], "id")
+        if "battery_function" in data:
+            obj.battery_function = _m.as_int(data["battery_function"], "battery_function")
+        if "type" in data:
+            obj.type = _m.as_int(data["type"], "type")
+        if "temperature" in data:
+            obj.temperature = _m.as_int(data["temperature"], "temperature")
+        if "voltages" in data:
+            obj.voltages = _m.as_list(data["voltages"], "voltages", 10, True, lambda item, p: _m.as_int(item, p))
+        if "current_battery" in data:
+            obj.current_battery = _m.as_int(data["current_battery"], "current_battery")
+        if "current_consumed" in data:
+            obj.current_consumed = _m.as_int(data["current_consumed"], "current_consumed")
+        if "energy_consumed" in data:
+            obj.energy_consumed = _m.as_int(data["energy_consumed"], "energy_consumed")
+        if "battery_remaining" in data:
+            obj.battery_remaining = _m.as_int(data["battery_remaining"], "battery_remaining")
+        if "time_remaining" in data:
+            obj.time_remaining = _m.as_int(data["time_remaining"], "time_remaining")
+        if "charge_state" in data:
+            obj.charge_state = _m.as_int(data["charge_state"], "charge_state")
+        if "voltages_ext" in data:
+            obj.voltages_ext = _m.as_list(
+                data["voltages_ext"], "voltages_ext", 4, True, lambda item, p: _m.as_int(item, p)
+            )
+        if "mode" in data:
+            obj.mode = _m.as_int(data["mode"], "mode")
+        if "fault_bitmask" in data:
+            obj.fault_bitmask = _m.as_int(data["fault_bitmask"], "fault_bitmask")
         return obj
 
     MSG_ID: ClassVar[int] = 147
@@ -204,11 +482,26 @@ class BatteryStatus:
         are dropped (at least one byte is kept) unless ``truncate`` is False.
         A value that does not fit its field raises EncodeError naming it."""
         try:
-            data = _MAV_BatteryStatus.pack(self.current_consumed, self.energy_consumed, self.temperature, *self.voltages, self.current_battery, self.id, self.battery_function, self.type, self.battery_remaining, self.time_remaining, self.charge_state, *self.voltages_ext, self.mode, self.fault_bitmask)
+            data = _MAV_BatteryStatus.pack(
+                self.current_consumed,
+                self.energy_consumed,
+                self.temperature,
+                *self.voltages,
+                self.current_battery,
+                self.id,
+                self.battery_function,
+                self.type,
+                self.battery_remaining,
+                self.time_remaining,
+                self.charge_state,
+                *self.voltages_ext,
+                self.mode,
+                self.fault_bitmask,
+            )
         except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
-            raise _mav.explain('BATTERY_STATUS', self, _MAV_BatteryStatus_FIELDS) from exc
+            raise _mav.explain("BATTERY_STATUS", self, _MAV_BatteryStatus_FIELDS) from exc
         if len(self.voltages) != 10 or len(self.voltages_ext) != 4:
-            raise _mav.explain('BATTERY_STATUS', self, _MAV_BatteryStatus_FIELDS)
+            raise _mav.explain("BATTERY_STATUS", self, _MAV_BatteryStatus_FIELDS)
         if truncate:
             return data.rstrip(b"\x00") or b"\x00"
         return data
@@ -217,8 +510,35 @@ class BatteryStatus:
     def decode(cls, data: _mav.BytesLike) -> BatteryStatus:
         """A MAVLink 2 payload; a short one is zero-filled, one over 54 bytes is a DecodeError."""
         if len(data) != 54:
-            data = _mav.fill(data, 54, 'BATTERY_STATUS')
-        v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15, v16, v17, v18, v19, v20, v21, v22, v23, v24, v25 = _MAV_BatteryStatus.unpack(data)
+            data = _mav.fill(data, 54, "BATTERY_STATUS")
+        (
+            v0,
+            v1,
+            v2,
+            v3,
+            v4,
+            v5,
+            v6,
+            v7,
+            v8,
+            v9,
+            v10,
+            v11,
+            v12,
+            v13,
+            v14,
+            v15,
+            v16,
+            v17,
+            v18,
+            v19,
+            v20,
+            v21,
+            v22,
+            v23,
+            v24,
+            v25,
+        ) = _MAV_BatteryStatus.unpack(data)
         obj = object.__new__(cls)
         obj.current_consumed = v0
         obj.energy_consumed = v1
@@ -251,14 +571,22 @@ class BatteryStatus:
         ``signature`` is appended and flagged, not computed) or, with ``mavlink1``, MAVLink 1
         (0xFE, the base payload without extensions; message ids below 256 only)."""
         if mavlink1:
-            return _mav.frame_v1(self.encode(truncate=False)[:36], 147, b'\x9a', seq, sysid, compid, incompat_flags != 0 or compat_flags != 0 or signature is not None)
-        return _mav.frame_v2(self.encode(), 147, b'\x9a', seq, sysid, compid, incompat_flags, compat_flags, signature)
+            return _mav.frame_v1(
+                self.encode(truncate=False)[:36],
+                147,
+                b"\x9a",
+                seq,
+                sysid,
+                compid,
+                incompat_flags != 0 or compat_flags != 0 or signature is not None,
+            )
+        return _mav.frame_v2(self.encode(), 147, b"\x9a", seq, sysid, compid, incompat_flags, compat_flags, signature)
 
     @classmethod
     def decode_frame(cls, data: _mav.BytesLike) -> BatteryStatus:
         """One whole MAVLink 1 or 2 frame of this message (CRC checked; a signature is skipped);
         _mavlink.parse_frame gives the header fields."""
-        payload = _mav.frame_payload(data, 147, b'\x9a', 54, 'BATTERY_STATUS')
+        payload = _mav.frame_payload(data, 147, b"\x9a", 54, "BATTERY_STATUS")
         return cls.decode(payload)
 
     @classmethod
@@ -266,25 +594,25 @@ class BatteryStatus:
         """Records of 54 bytes (zero-filled payloads) -> columns keyed by field name: numpy
         arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
         tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
-        arrays = _mav.numpy_columns(data, 54, _MAV_BatteryStatus_DTYPE, use_numpy, 'BATTERY_STATUS')
+        arrays = _mav.numpy_columns(data, 54, _MAV_BatteryStatus_DTYPE, use_numpy, "BATTERY_STATUS")
         if arrays is not None:
             return arrays
-        c = _mav.struct_columns(data, _MAV_BatteryStatus, 'BATTERY_STATUS')
+        c = _mav.struct_columns(data, _MAV_BatteryStatus, "BATTERY_STATUS")
         return {
-            'current_consumed': c[0],
-            'energy_consumed': c[1],
-            'temperature': c[2],
-            'voltages': list(zip(*c[3:13], strict=True)),
-            'current_battery': c[13],
-            'id': c[14],
-            'battery_function': c[15],
-            'type': c[16],
-            'battery_remaining': c[17],
-            'time_remaining': c[18],
-            'charge_state': c[19],
-            'voltages_ext': list(zip(*c[20:24], strict=True)),
-            'mode': c[24],
-            'fault_bitmask': c[25],
+            "current_consumed": c[0],
+            "energy_consumed": c[1],
+            "temperature": c[2],
+            "voltages": list(zip(*c[3:13], strict=True)),
+            "current_battery": c[13],
+            "id": c[14],
+            "battery_function": c[15],
+            "type": c[16],
+            "battery_remaining": c[17],
+            "time_remaining": c[18],
+            "charge_state": c[19],
+            "voltages_ext": list(zip(*c[20:24], strict=True)),
+            "mode": c[24],
+            "fault_bitmask": c[25],
         }
 
     def validate(self) -> list[_v.Violation]:
@@ -296,93 +624,104 @@ class BatteryStatus:
         sub: Any
         r_battery_remaining: Any
         try:
-            if (self.id & -256):
-                _v.diag(out, 'id', self.id, _VS_BatteryStatus_id)
+            if self.id & -256:
+                _v.diag(out, "id", self.id, _VS_BatteryStatus_id)
         except _v.SLOW:
-            _v.diag(out, 'id', self.id, _VS_BatteryStatus_id)
+            _v.diag(out, "id", self.id, _VS_BatteryStatus_id)
         try:
-            if (self.battery_function not in {0, 1, 2, 3, 4}):
-                _v.diag(out, 'battery_function', self.battery_function, _VS_BatteryStatus_battery_function)
+            if self.battery_function not in {0, 1, 2, 3, 4}:
+                _v.diag(out, "battery_function", self.battery_function, _VS_BatteryStatus_battery_function)
         except _v.SLOW:
-            _v.diag(out, 'battery_function', self.battery_function, _VS_BatteryStatus_battery_function)
+            _v.diag(out, "battery_function", self.battery_function, _VS_BatteryStatus_battery_function)
         try:
-            if (self.type not in {0, 1, 2, 3, 4}):
-                _v.diag(out, 'type', self.type, _VS_BatteryStatus_type)
+            if self.type not in {0, 1, 2, 3, 4}:
+                _v.diag(out, "type", self.type, _VS_BatteryStatus_type)
         except _v.SLOW:
-            _v.diag(out, 'type', self.type, _VS_BatteryStatus_type)
+            _v.diag(out, "type", self.type, _VS_BatteryStatus_type)
         try:
-            if ((self.temperature + 32768) & -65536):
-                _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatus_temperature)
+            if (self.temperature + 32768) & -65536:
+                _v.diag(out, "temperature", self.temperature, _VS_BatteryStatus_temperature)
         except _v.SLOW:
-            _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatus_temperature)
+            _v.diag(out, "temperature", self.temperature, _VS_BatteryStatus_temperature)
         try:
             a = self.voltages
             if len(a) != 10:
-                _v.diag(out, 'voltages', self.voltages, _VS_BatteryStatus_voltages)
+                _v.diag(out, "voltages", self.voltages, _VS_BatteryStatus_voltages)
             else:
                 for e in a:
-                    if (e & -65536):
-                        _v.diag(out, 'voltages', self.voltages, _VS_BatteryStatus_voltages)
+                    if e & -65536:
+                        _v.diag(out, "voltages", self.voltages, _VS_BatteryStatus_voltages)
                         break
         except _v.SLOW:
-            _v.diag(out, 'voltages', self.voltages, _VS_BatteryStatus_voltages)
+            _v.diag(out, "voltages", self.voltages, _VS_BatteryStatus_voltages)
         try:
-            if ((self.current_battery + 32768) & -65536):
-                _v.diag(out, 'current_battery', self.current_battery, _VS_BatteryStatus_current_battery)
+            if (self.current_battery + 32768) & -65536:
+                _v.diag(out, "current_battery", self.current_battery, _VS_BatteryStatus_current_battery)
         except _v.SLOW:
-            _v.diag(out, 'current_battery', self.current_battery, _VS_BatteryStatus_current_battery)
+            _v.diag(out, "current_battery", self.current_battery, _VS_BatteryStatus_current_battery)
         try:
-            if ((self.current_consumed + 2147483648) & -4294967296):
-                _v.diag(out, 'current_consumed', self.current_consumed, _VS_BatteryStatus_current_consumed)
+            if (self.current_consumed + 2147483648) & -4294967296:
+                _v.diag(out, "current_consumed", self.current_consumed, _VS_BatteryStatus_current_consumed)
         except _v.SLOW:
-            _v.diag(out, 'current_consumed', self.current_consumed, _VS_BatteryStatus_current_consumed)
+            _v.diag(out, "current_consumed", self.current_consumed, _VS_BatteryStatus_current_consumed)
         try:
-            if ((self.energy_consumed + 2147483648) & -4294967296):
-                _v.diag(out, 'energy_consumed', self.energy_consumed, _VS_BatteryStatus_energy_consumed)
+            if (self.energy_consumed + 2147483648) & -4294967296:
+                _v.diag(out, "energy_consumed", self.energy_consumed, _VS_BatteryStatus_energy_consumed)
         except _v.SLOW:
-            _v.diag(out, 'energy_consumed', self.energy_consumed, _VS_BatteryStatus_energy_consumed)
+            _v.diag(out, "energy_consumed", self.energy_consumed, _VS_BatteryStatus_energy_consumed)
         try:
-            if ((self.battery_remaining + 128) & -256):
-                _v.diag(out, 'battery_remaining', self.battery_remaining, _VS_BatteryStatus_battery_remaining)
+            if (self.battery_remaining + 128) & -256:
+                _v.diag(out, "battery_remaining", self.battery_remaining, _VS_BatteryStatus_battery_remaining)
         except _v.SLOW:
-            _v.diag(out, 'battery_remaining', self.battery_remaining, _VS_BatteryStatus_battery_remaining)
+            _v.diag(out, "battery_remaining", self.battery_remaining, _VS_BatteryStatus_battery_remaining)
         try:
-            if ((self.time_remaining + 2147483648) & -4294967296):
-                _v.diag(out, 'time_remaining', self.time_remaining, _VS_BatteryStatus_time_remaining)
+            if (self.time_remaining + 2147483648) & -4294967296:
+                _v.diag(out, "time_remaining", self.time_remaining, _VS_BatteryStatus_time_remaining)
         except _v.SLOW:
-            _v.diag(out, 'time_remaining', self.time_remaining, _VS_BatteryStatus_time_remaining)
+            _v.diag(out, "time_remaining", self.time_remaining, _VS_BatteryStatus_time_remaining)
         try:
-            if (self.charge_state not in {0, 1, 2, 3, 4, 5, 6, 7}):
-                _v.diag(out, 'charge_state', self.charge_state, _VS_BatteryStatus_charge_state)
+            if self.charge_state not in {0, 1, 2, 3, 4, 5, 6, 7}:
+                _v.diag(out, "charge_state", self.charge_state, _VS_BatteryStatus_charge_state)
         except _v.SLOW:
-            _v.diag(out, 'charge_state', self.charge_state, _VS_BatteryStatus_charge_state)
+            _v.diag(out, "charge_state", self.charge_state, _VS_BatteryStatus_charge_state)
         try:
             a = self.voltages_ext
             if len(a) != 4:
-                _v.diag(out, 'voltages_ext', self.voltages_ext, _VS_BatteryStatus_voltages_ext)
+                _v.diag(out, "voltages_ext", self.voltages_ext, _VS_BatteryStatus_voltages_ext)
             else:
                 for e in a:
-                    if (e & -65536):
-                        _v.diag(out, 'voltages_ext', self.voltages_ext, _VS_BatteryStatus_voltages_ext)
+                    if e & -65536:
+                        _v.diag(out, "voltages_ext", self.voltages_ext, _VS_BatteryStatus_voltages_ext)
                         break
         except _v.SLOW:
-            _v.diag(out, 'voltages_ext', self.voltages_ext, _VS_BatteryStatus_voltages_ext)
+            _v.diag(out, "voltages_ext", self.voltages_ext, _VS_BatteryStatus_voltages_ext)
         try:
-            if (self.mode not in {0, 1, 2}):
-                _v.diag(out, 'mode', self.mode, _VS_BatteryStatus_mode)
+            if self.mode not in {0, 1, 2}:
+                _v.diag(out, "mode", self.mode, _VS_BatteryStatus_mode)
         except _v.SLOW:
-            _v.diag(out, 'mode', self.mode, _VS_BatteryStatus_mode)
+            _v.diag(out, "mode", self.mode, _VS_BatteryStatus_mode)
         try:
-            if (self.fault_bitmask & -512):
-                _v.diag(out, 'fault_bitmask', self.fault_bitmask, _VS_BatteryStatus_fault_bitmask)
+            if self.fault_bitmask & -512:
+                _v.diag(out, "fault_bitmask", self.fault_bitmask, _VS_BatteryStatus_fault_bitmask)
         except _v.SLOW:
-            _v.diag(out, 'fault_bitmask', self.fault_bitmask, _VS_BatteryStatus_fault_bitmask)
+            _v.diag(out, "fault_bitmask", self.fault_bitmask, _VS_BatteryStatus_fault_bitmask)
         # rule battery-remaining-percent (mavlink-battery-status.yaml:4)
         try:
             r_battery_remaining = self.battery_remaining
-            if (r_battery_remaining != -1):
+            if r_battery_remaining != -1:
                 if not (0 <= r_battery_remaining <= 100):
-                    out.append(_v.rule('battery_remaining', 'battery-remaining-percent', r_battery_remaining, '0 <= battery_remaining <= 100', 'battery_remaining = ' + _v.fmt(r_battery_remaining) + ' % is outside 0..100 % (-1 means unknown)', 'error'))
+                    out.append(
+                        _v.rule(
+                            "battery_remaining",
+                            "battery-remaining-percent",
+                            r_battery_remaining,
+                            "0 <= battery_remaining <= 100",
+                            "battery_remaining = "
+                            + _v.fmt(r_battery_remaining)
+                            + " % is outside 0..100 % (-1 means unknown)",
+                            "error",
+                        )
+                    )
         except _v.SLOW:
             pass  # the field checks report the cause
         return out
@@ -391,23 +730,32 @@ class BatteryStatus:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'mavlink.BATTERY_STATUS')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "mavlink.BATTERY_STATUS")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field == 'temperature':
+        if field == "temperature":
             return self.temperature != 32767
-        if field == 'voltages':
+        if field == "voltages":
             return any(e != 65535 for e in self.voltages)
-        if field == 'current_battery':
+        if field == "current_battery":
             return self.current_battery != -1
-        if field == 'current_consumed':
+        if field == "current_consumed":
             return self.current_consumed != -1
-        if field == 'energy_consumed':
+        if field == "energy_consumed":
             return self.energy_consumed != -1
-        if field == 'battery_remaining':
+        if field == "battery_remaining":
             return self.battery_remaining != -1
-        if field in {'id', 'battery_function', 'type', 'time_remaining', 'charge_state', 'voltages_ext', 'mode', 'fault_bitmask'}:
+        if field in {
+            "id",
+            "battery_function",
+            "type",
+            "time_remaining",
+            "charge_state",
+            "voltages_ext",
+            "mode",
+            "fault_bitmask",
+        }:
             return True
-        raise KeyError(f'{field!r} is not a field of ' + 'mavlink.BATTERY_STATUS')
+        raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_STATUS")

@@ -14,7 +14,7 @@ from typing import Any, ClassVar
 from . import _meta as _m
 from . import _validate as _v
 
-__all__ = ['BattParams', 'BattParamsFsCrtAct', 'BattParamsFsLowAct', 'BattParamsFsVoltsrc']
+__all__ = ["BattParams", "BattParamsFsCrtAct", "BattParamsFsLowAct", "BattParamsFsVoltsrc"]
 
 
 class BattParamsFsVoltsrc(enum.IntEnum):
@@ -46,27 +46,88 @@ class BattParamsFsCrtAct(enum.IntEnum):
     TERMINATE = 5
 
 
-_VS_BattParams_BATT_CAPACITY = _v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='mAh')
-_VS_BattParams_BATT_LOW_VOLT = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', minimum=0, maximum=30)
-_VS_BattParams_BATT_LOW_TIMER = _v.Number(type='int8', kind='int', low=-128, high=127, unit='s', minimum=0, maximum=120)
-_VS_BattParams_BATT_FS_VOLTSRC = _v.Number(type='int8', kind='int', low=-128, high=127, values={0: 'FS_VOLTSRC_RAW_VOLTAGE', 1: 'FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE'})
-_VS_BattParams_BATT_LOW_MAH = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='mAh')
-_VS_BattParams_BATT_CRT_VOLT = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', minimum=0, maximum=30)
-_VS_BattParams_BATT_CRT_MAH = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='mAh')
-_VS_BattParams_BATT_FS_LOW_ACT = _v.Number(type='int8', kind='int', low=-128, high=127, values={0: 'FS_LOW_ACT_NONE', 1: 'FS_LOW_ACT_HOLD', 2: 'FS_LOW_ACT_RTL', 3: 'FS_LOW_ACT_SMARTRTL', 4: 'FS_LOW_ACT_SMARTRTL_OR_HOLD', 5: 'FS_LOW_ACT_TERMINATE'})
-_VS_BattParams_BATT_FS_CRT_ACT = _v.Number(type='int8', kind='int', low=-128, high=127, values={0: 'FS_CRT_ACT_NONE', 1: 'FS_CRT_ACT_HOLD', 2: 'FS_CRT_ACT_RTL', 3: 'FS_CRT_ACT_SMARTRTL', 4: 'FS_CRT_ACT_SMARTRTL_OR_HOLD', 5: 'FS_CRT_ACT_TERMINATE'})
-_VS_BattParams_BATT_ARM_VOLT = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', minimum=0, maximum=30)
-_VS_BattParams_BATT_ARM_MAH = _v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='mAh')
+_VS_BattParams_BATT_CAPACITY = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
+_VS_BattParams_BATT_LOW_VOLT = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    minimum=0,
+    maximum=30,
+)
+_VS_BattParams_BATT_LOW_TIMER = _v.Number(type="int8", kind="int", low=-128, high=127, unit="s", minimum=0, maximum=120)
+_VS_BattParams_BATT_FS_VOLTSRC = _v.Number(
+    type="int8",
+    kind="int",
+    low=-128,
+    high=127,
+    values={0: "FS_VOLTSRC_RAW_VOLTAGE", 1: "FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE"},
+)
+_VS_BattParams_BATT_LOW_MAH = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="mAh"
+)
+_VS_BattParams_BATT_CRT_VOLT = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    minimum=0,
+    maximum=30,
+)
+_VS_BattParams_BATT_CRT_MAH = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="mAh"
+)
+_VS_BattParams_BATT_FS_LOW_ACT = _v.Number(
+    type="int8",
+    kind="int",
+    low=-128,
+    high=127,
+    values={
+        0: "FS_LOW_ACT_NONE",
+        1: "FS_LOW_ACT_HOLD",
+        2: "FS_LOW_ACT_RTL",
+        3: "FS_LOW_ACT_SMARTRTL",
+        4: "FS_LOW_ACT_SMARTRTL_OR_HOLD",
+        5: "FS_LOW_ACT_TERMINATE",
+    },
+)
+_VS_BattParams_BATT_FS_CRT_ACT = _v.Number(
+    type="int8",
+    kind="int",
+    low=-128,
+    high=127,
+    values={
+        0: "FS_CRT_ACT_NONE",
+        1: "FS_CRT_ACT_HOLD",
+        2: "FS_CRT_ACT_RTL",
+        3: "FS_CRT_ACT_SMARTRTL",
+        4: "FS_CRT_ACT_SMARTRTL_OR_HOLD",
+        5: "FS_CRT_ACT_TERMINATE",
+    },
+)
+_VS_BattParams_BATT_ARM_VOLT = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    minimum=0,
+    maximum=30,
+)
+_VS_BattParams_BATT_ARM_MAH = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
 
 
 @dataclasses.dataclass(slots=True)
 class BattParams:
-    """Battery monitor: capacity, the two-stage (LOW, CRITICAL) failsafe thresholds and their actions, and arming limits. A threshold of 0 is disabled.
+    """Battery monitor: capacity, the two-stage (LOW, CRITICAL) failsafe thresholds and their actions, and arming
+    limits. A threshold of 0 is disabled.
 
     Schema: params.BATT (params, battery_failsafe.pdef.xml:8).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'params.BATT'
+    QUALIFIED_NAME: ClassVar[str] = "params.BATT"
     FS_VOLTSRC_RAW_VOLTAGE: ClassVar[int] = 0
     FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE: ClassVar[int] = 1
     FS_LOW_ACT_NONE: ClassVar[int] = 0
@@ -82,17 +143,132 @@ class BattParams:
     FS_CRT_ACT_SMARTRTL_OR_HOLD: ClassVar[int] = 4
     FS_CRT_ACT_TERMINATE: ClassVar[int] = 5
 
-    BATT_CAPACITY: int = dataclasses.field(default=3300, metadata=_m.meta(name='BATT_CAPACITY', type='int32', unit='mAh', quantity='charge', scale=3.6, offset=0.0, doc='Charge of the fully charged pack; the mAh thresholds are measured against it.'))
-    BATT_LOW_VOLT: float = dataclasses.field(default=0.0, metadata=_m.meta(name='BATT_LOW_VOLT', type='float32', unit='V', quantity='voltage', minimum=0, maximum=30, doc='LOW failsafe when the voltage stays below this for BATT_LOW_TIMER seconds. 0 disables it.'))
-    BATT_LOW_TIMER: int = dataclasses.field(default=10, metadata=_m.meta(name='BATT_LOW_TIMER', type='int8', unit='s', quantity='time', minimum=0, maximum=120, doc='How long the voltage must stay below BATT_LOW_VOLT before the LOW failsafe triggers; rides out sag under load.'))
-    BATT_FS_VOLTSRC: int = dataclasses.field(default=0, metadata=_m.meta(name='BATT_FS_VOLTSRC', type='int8', enums=('params.BATT.FS_VOLTSRC',), doc='Which voltage the failsafe compares with its thresholds.'))
-    BATT_LOW_MAH: float = dataclasses.field(default=0.0, metadata=_m.meta(name='BATT_LOW_MAH', type='float32', unit='mAh', quantity='charge', scale=3.6, offset=0.0, doc='LOW failsafe when the remaining charge drops below this. 0 disables it; needs a current sensor and BATT_CAPACITY.'))
-    BATT_CRT_VOLT: float = dataclasses.field(default=0.0, metadata=_m.meta(name='BATT_CRT_VOLT', type='float32', unit='V', quantity='voltage', minimum=0, maximum=30, doc='CRITICAL failsafe as soon as the voltage is below this. 0 disables it; must be below BATT_LOW_VOLT.'))
-    BATT_CRT_MAH: float = dataclasses.field(default=0.0, metadata=_m.meta(name='BATT_CRT_MAH', type='float32', unit='mAh', quantity='charge', scale=3.6, offset=0.0, doc='CRITICAL failsafe as soon as the remaining charge is below this. 0 disables it; must be below BATT_LOW_MAH.'))
-    BATT_FS_LOW_ACT: int = dataclasses.field(default=0, metadata=_m.meta(name='BATT_FS_LOW_ACT', type='int8', enums=('params.BATT.FS_LOW_ACT',), doc='What the vehicle does when the LOW failsafe triggers.'))
-    BATT_FS_CRT_ACT: int = dataclasses.field(default=0, metadata=_m.meta(name='BATT_FS_CRT_ACT', type='int8', enums=('params.BATT.FS_CRT_ACT',), doc='What the vehicle does when the CRITICAL failsafe triggers; overrides the LOW action.'))
-    BATT_ARM_VOLT: float = dataclasses.field(default=0.0, metadata=_m.meta(name='BATT_ARM_VOLT', type='float32', unit='V', quantity='voltage', minimum=0, maximum=30, doc='Arming is refused below this voltage. 0 disables the check.'))
-    BATT_ARM_MAH: int = dataclasses.field(default=0, metadata=_m.meta(name='BATT_ARM_MAH', type='int32', unit='mAh', quantity='charge', scale=3.6, offset=0.0, doc='Arming is refused with less remaining charge than this. 0 disables the check.'))
+    BATT_CAPACITY: int = dataclasses.field(
+        default=3300,
+        metadata=_m.meta(
+            name="BATT_CAPACITY",
+            type="int32",
+            unit="mAh",
+            quantity="charge",
+            scale=3.6,
+            offset=0.0,
+            doc="Charge of the fully charged pack; the mAh thresholds are measured against it.",
+        ),
+    )
+    BATT_LOW_VOLT: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="BATT_LOW_VOLT",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            minimum=0,
+            maximum=30,
+            doc="LOW failsafe when the voltage stays below this for BATT_LOW_TIMER seconds. 0 disables it.",
+        ),
+    )
+    BATT_LOW_TIMER: int = dataclasses.field(
+        default=10,
+        metadata=_m.meta(
+            name="BATT_LOW_TIMER",
+            type="int8",
+            unit="s",
+            quantity="time",
+            minimum=0,
+            maximum=120,
+            doc="How long the voltage must stay below BATT_LOW_VOLT before the LOW failsafe "
+            "triggers; rides out sag under load.",
+        ),
+    )
+    BATT_FS_VOLTSRC: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="BATT_FS_VOLTSRC",
+            type="int8",
+            enums=("params.BATT.FS_VOLTSRC",),
+            doc="Which voltage the failsafe compares with its thresholds.",
+        ),
+    )
+    BATT_LOW_MAH: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="BATT_LOW_MAH",
+            type="float32",
+            unit="mAh",
+            quantity="charge",
+            scale=3.6,
+            offset=0.0,
+            doc="LOW failsafe when the remaining charge drops below this. 0 disables it; needs a "
+            "current sensor and BATT_CAPACITY.",
+        ),
+    )
+    BATT_CRT_VOLT: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="BATT_CRT_VOLT",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            minimum=0,
+            maximum=30,
+            doc="CRITICAL failsafe as soon as the voltage is below this. 0 disables it; must be below BATT_LOW_VOLT.",
+        ),
+    )
+    BATT_CRT_MAH: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="BATT_CRT_MAH",
+            type="float32",
+            unit="mAh",
+            quantity="charge",
+            scale=3.6,
+            offset=0.0,
+            doc="CRITICAL failsafe as soon as the remaining charge is below this. 0 disables it; "
+            "must be below BATT_LOW_MAH.",
+        ),
+    )
+    BATT_FS_LOW_ACT: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="BATT_FS_LOW_ACT",
+            type="int8",
+            enums=("params.BATT.FS_LOW_ACT",),
+            doc="What the vehicle does when the LOW failsafe triggers.",
+        ),
+    )
+    BATT_FS_CRT_ACT: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="BATT_FS_CRT_ACT",
+            type="int8",
+            enums=("params.BATT.FS_CRT_ACT",),
+            doc="What the vehicle does when the CRITICAL failsafe triggers; overrides the LOW action.",
+        ),
+    )
+    BATT_ARM_VOLT: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="BATT_ARM_VOLT",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            minimum=0,
+            maximum=30,
+            doc="Arming is refused below this voltage. 0 disables the check.",
+        ),
+    )
+    BATT_ARM_MAH: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="BATT_ARM_MAH",
+            type="int32",
+            unit="mAh",
+            quantity="charge",
+            scale=3.6,
+            offset=0.0,
+            doc="Arming is refused with less remaining charge than this. 0 disables the check.",
+        ),
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -103,46 +279,65 @@ class BattParams:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['BATT_CAPACITY'] = self.BATT_CAPACITY
-        out['BATT_LOW_VOLT'] = self.BATT_LOW_VOLT
-        out['BATT_LOW_TIMER'] = self.BATT_LOW_TIMER
-        out['BATT_FS_VOLTSRC'] = self.BATT_FS_VOLTSRC
-        out['BATT_LOW_MAH'] = self.BATT_LOW_MAH
-        out['BATT_CRT_VOLT'] = self.BATT_CRT_VOLT
-        out['BATT_CRT_MAH'] = self.BATT_CRT_MAH
-        out['BATT_FS_LOW_ACT'] = self.BATT_FS_LOW_ACT
-        out['BATT_FS_CRT_ACT'] = self.BATT_FS_CRT_ACT
-        out['BATT_ARM_VOLT'] = self.BATT_ARM_VOLT
-        out['BATT_ARM_MAH'] = self.BATT_ARM_MAH
+        out["BATT_CAPACITY"] = self.BATT_CAPACITY
+        out["BATT_LOW_VOLT"] = self.BATT_LOW_VOLT
+        out["BATT_LOW_TIMER"] = self.BATT_LOW_TIMER
+        out["BATT_FS_VOLTSRC"] = self.BATT_FS_VOLTSRC
+        out["BATT_LOW_MAH"] = self.BATT_LOW_MAH
+        out["BATT_CRT_VOLT"] = self.BATT_CRT_VOLT
+        out["BATT_CRT_MAH"] = self.BATT_CRT_MAH
+        out["BATT_FS_LOW_ACT"] = self.BATT_FS_LOW_ACT
+        out["BATT_FS_CRT_ACT"] = self.BATT_FS_CRT_ACT
+        out["BATT_ARM_VOLT"] = self.BATT_ARM_VOLT
+        out["BATT_ARM_MAH"] = self.BATT_ARM_MAH
         return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> BattParams:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'BATT_CAPACITY', 'BATT_LOW_VOLT', 'BATT_LOW_TIMER', 'BATT_FS_VOLTSRC', 'BATT_LOW_MAH', 'BATT_CRT_VOLT', 'BATT_CRT_MAH', 'BATT_FS_LOW_ACT', 'BATT_FS_CRT_ACT', 'BATT_ARM_VOLT', 'BATT_ARM_MAH'}), (), 'BattParams')
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "BATT_CAPACITY",
+                    "BATT_LOW_VOLT",
+                    "BATT_LOW_TIMER",
+                    "BATT_FS_VOLTSRC",
+                    "BATT_LOW_MAH",
+                    "BATT_CRT_VOLT",
+                    "BATT_CRT_MAH",
+                    "BATT_FS_LOW_ACT",
+                    "BATT_FS_CRT_ACT",
+                    "BATT_ARM_VOLT",
+                    "BATT_ARM_MAH",
+                }
+            ),
+            (),
+            "BattParams",
+        )
         obj = cls()
-        if 'BATT_CAPACITY' in data:
-            obj.BATT_CAPACITY = _m.as_int(data['BATT_CAPACITY'], 'BATT_CAPACITY')
-        if 'BATT_LOW_VOLT' in data:
-            obj.BATT_LOW_VOLT = _m.as_float(data['BATT_LOW_VOLT'], 'BATT_LOW_VOLT')
-        if 'BATT_LOW_TIMER' in data:
-            obj.BATT_LOW_TIMER = _m.as_int(data['BATT_LOW_TIMER'], 'BATT_LOW_TIMER')
-        if 'BATT_FS_VOLTSRC' in data:
-            obj.BATT_FS_VOLTSRC = _m.as_int(data['BATT_FS_VOLTSRC'], 'BATT_FS_VOLTSRC')
-        if 'BATT_LOW_MAH' in data:
-            obj.BATT_LOW_MAH = _m.as_float(data['BATT_LOW_MAH'], 'BATT_LOW_MAH')
-        if 'BATT_CRT_VOLT' in data:
-            obj.BATT_CRT_VOLT = _m.as_float(data['BATT_CRT_VOLT'], 'BATT_CRT_VOLT')
-        if 'BATT_CRT_MAH' in data:
-            obj.BATT_CRT_MAH = _m.as_float(data['BATT_CRT_MAH'], 'BATT_CRT_MAH')
-        if 'BATT_FS_LOW_ACT' in data:
-            obj.BATT_FS_LOW_ACT = _m.as_int(data['BATT_FS_LOW_ACT'], 'BATT_FS_LOW_ACT')
-        if 'BATT_FS_CRT_ACT' in data:
-            obj.BATT_FS_CRT_ACT = _m.as_int(data['BATT_FS_CRT_ACT'], 'BATT_FS_CRT_ACT')
-        if 'BATT_ARM_VOLT' in data:
-            obj.BATT_ARM_VOLT = _m.as_float(data['BATT_ARM_VOLT'], 'BATT_ARM_VOLT')
-        if 'BATT_ARM_MAH' in data:
-            obj.BATT_ARM_MAH = _m.as_int(data['BATT_ARM_MAH'], 'BATT_ARM_MAH')
+        if "BATT_CAPACITY" in data:
+            obj.BATT_CAPACITY = _m.as_int(data["BATT_CAPACITY"], "BATT_CAPACITY")
+        if "BATT_LOW_VOLT" in data:
+            obj.BATT_LOW_VOLT = _m.as_float(data["BATT_LOW_VOLT"], "BATT_LOW_VOLT")
+        if "BATT_LOW_TIMER" in data:
+            obj.BATT_LOW_TIMER = _m.as_int(data["BATT_LOW_TIMER"], "BATT_LOW_TIMER")
+        if "BATT_FS_VOLTSRC" in data:
+            obj.BATT_FS_VOLTSRC = _m.as_int(data["BATT_FS_VOLTSRC"], "BATT_FS_VOLTSRC")
+        if "BATT_LOW_MAH" in data:
+            obj.BATT_LOW_MAH = _m.as_float(data["BATT_LOW_MAH"], "BATT_LOW_MAH")
+        if "BATT_CRT_VOLT" in data:
+            obj.BATT_CRT_VOLT = _m.as_float(data["BATT_CRT_VOLT"], "BATT_CRT_VOLT")
+        if "BATT_CRT_MAH" in data:
+            obj.BATT_CRT_MAH = _m.as_float(data["BATT_CRT_MAH"], "BATT_CRT_MAH")
+        if "BATT_FS_LOW_ACT" in data:
+            obj.BATT_FS_LOW_ACT = _m.as_int(data["BATT_FS_LOW_ACT"], "BATT_FS_LOW_ACT")
+        if "BATT_FS_CRT_ACT" in data:
+            obj.BATT_FS_CRT_ACT = _m.as_int(data["BATT_FS_CRT_ACT"], "BATT_FS_CRT_ACT")
+        if "BATT_ARM_VOLT" in data:
+            obj.BATT_ARM_VOLT = _m.as_float(data["BATT_ARM_VOLT"], "BATT_ARM_VOLT")
+        if "BATT_ARM_MAH" in data:
+            obj.BATT_ARM_MAH = _m.as_int(data["BATT_ARM_MAH"], "BATT_ARM_MAH")
         return obj
 
     def validate(self) -> list[_v.Violation]:
@@ -153,72 +348,84 @@ class BattParams:
         e: Any
         sub: Any
         try:
-            if ((self.BATT_CAPACITY + 2147483648) & -4294967296):
-                _v.diag(out, 'BATT_CAPACITY', self.BATT_CAPACITY, _VS_BattParams_BATT_CAPACITY)
+            if (self.BATT_CAPACITY + 2147483648) & -4294967296:
+                _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _VS_BattParams_BATT_CAPACITY)
         except _v.SLOW:
-            _v.diag(out, 'BATT_CAPACITY', self.BATT_CAPACITY, _VS_BattParams_BATT_CAPACITY)
+            _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _VS_BattParams_BATT_CAPACITY)
         try:
-            if (not (0.0 <= self.BATT_LOW_VOLT <= 30.0)):
-                _v.diag(out, 'BATT_LOW_VOLT', self.BATT_LOW_VOLT, _VS_BattParams_BATT_LOW_VOLT)
+            if not (0.0 <= self.BATT_LOW_VOLT <= 30.0):
+                _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _VS_BattParams_BATT_LOW_VOLT)
         except _v.SLOW:
-            _v.diag(out, 'BATT_LOW_VOLT', self.BATT_LOW_VOLT, _VS_BattParams_BATT_LOW_VOLT)
+            _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _VS_BattParams_BATT_LOW_VOLT)
         try:
             x = self.BATT_LOW_TIMER
-            if ((x + 128) & -256 or not (0 <= x <= 120)):
-                _v.diag(out, 'BATT_LOW_TIMER', self.BATT_LOW_TIMER, _VS_BattParams_BATT_LOW_TIMER)
+            if (x + 128) & -256 or not (0 <= x <= 120):
+                _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _VS_BattParams_BATT_LOW_TIMER)
         except _v.SLOW:
-            _v.diag(out, 'BATT_LOW_TIMER', self.BATT_LOW_TIMER, _VS_BattParams_BATT_LOW_TIMER)
+            _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _VS_BattParams_BATT_LOW_TIMER)
         try:
-            if (self.BATT_FS_VOLTSRC not in {0, 1}):
-                _v.diag(out, 'BATT_FS_VOLTSRC', self.BATT_FS_VOLTSRC, _VS_BattParams_BATT_FS_VOLTSRC)
+            if self.BATT_FS_VOLTSRC not in {0, 1}:
+                _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _VS_BattParams_BATT_FS_VOLTSRC)
         except _v.SLOW:
-            _v.diag(out, 'BATT_FS_VOLTSRC', self.BATT_FS_VOLTSRC, _VS_BattParams_BATT_FS_VOLTSRC)
+            _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _VS_BattParams_BATT_FS_VOLTSRC)
         try:
-            if (not (-3.4028234663852886e+38 <= self.BATT_LOW_MAH <= 3.4028234663852886e+38)):
-                _v.diag(out, 'BATT_LOW_MAH', self.BATT_LOW_MAH, _VS_BattParams_BATT_LOW_MAH)
+            if not (-3.4028234663852886e38 <= self.BATT_LOW_MAH <= 3.4028234663852886e38):
+                _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _VS_BattParams_BATT_LOW_MAH)
         except _v.SLOW:
-            _v.diag(out, 'BATT_LOW_MAH', self.BATT_LOW_MAH, _VS_BattParams_BATT_LOW_MAH)
+            _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _VS_BattParams_BATT_LOW_MAH)
         try:
-            if (not (0.0 <= self.BATT_CRT_VOLT <= 30.0)):
-                _v.diag(out, 'BATT_CRT_VOLT', self.BATT_CRT_VOLT, _VS_BattParams_BATT_CRT_VOLT)
+            if not (0.0 <= self.BATT_CRT_VOLT <= 30.0):
+                _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _VS_BattParams_BATT_CRT_VOLT)
         except _v.SLOW:
-            _v.diag(out, 'BATT_CRT_VOLT', self.BATT_CRT_VOLT, _VS_BattParams_BATT_CRT_VOLT)
+            _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _VS_BattParams_BATT_CRT_VOLT)
         try:
-            if (not (-3.4028234663852886e+38 <= self.BATT_CRT_MAH <= 3.4028234663852886e+38)):
-                _v.diag(out, 'BATT_CRT_MAH', self.BATT_CRT_MAH, _VS_BattParams_BATT_CRT_MAH)
+            if not (-3.4028234663852886e38 <= self.BATT_CRT_MAH <= 3.4028234663852886e38):
+                _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _VS_BattParams_BATT_CRT_MAH)
         except _v.SLOW:
-            _v.diag(out, 'BATT_CRT_MAH', self.BATT_CRT_MAH, _VS_BattParams_BATT_CRT_MAH)
+            _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _VS_BattParams_BATT_CRT_MAH)
         try:
-            if (self.BATT_FS_LOW_ACT not in {0, 1, 2, 3, 4, 5}):
-                _v.diag(out, 'BATT_FS_LOW_ACT', self.BATT_FS_LOW_ACT, _VS_BattParams_BATT_FS_LOW_ACT)
+            if self.BATT_FS_LOW_ACT not in {0, 1, 2, 3, 4, 5}:
+                _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _VS_BattParams_BATT_FS_LOW_ACT)
         except _v.SLOW:
-            _v.diag(out, 'BATT_FS_LOW_ACT', self.BATT_FS_LOW_ACT, _VS_BattParams_BATT_FS_LOW_ACT)
+            _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _VS_BattParams_BATT_FS_LOW_ACT)
         try:
-            if (self.BATT_FS_CRT_ACT not in {0, 1, 2, 3, 4, 5}):
-                _v.diag(out, 'BATT_FS_CRT_ACT', self.BATT_FS_CRT_ACT, _VS_BattParams_BATT_FS_CRT_ACT)
+            if self.BATT_FS_CRT_ACT not in {0, 1, 2, 3, 4, 5}:
+                _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _VS_BattParams_BATT_FS_CRT_ACT)
         except _v.SLOW:
-            _v.diag(out, 'BATT_FS_CRT_ACT', self.BATT_FS_CRT_ACT, _VS_BattParams_BATT_FS_CRT_ACT)
+            _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _VS_BattParams_BATT_FS_CRT_ACT)
         try:
-            if (not (0.0 <= self.BATT_ARM_VOLT <= 30.0)):
-                _v.diag(out, 'BATT_ARM_VOLT', self.BATT_ARM_VOLT, _VS_BattParams_BATT_ARM_VOLT)
+            if not (0.0 <= self.BATT_ARM_VOLT <= 30.0):
+                _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _VS_BattParams_BATT_ARM_VOLT)
         except _v.SLOW:
-            _v.diag(out, 'BATT_ARM_VOLT', self.BATT_ARM_VOLT, _VS_BattParams_BATT_ARM_VOLT)
+            _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _VS_BattParams_BATT_ARM_VOLT)
         try:
-            if ((self.BATT_ARM_MAH + 2147483648) & -4294967296):
-                _v.diag(out, 'BATT_ARM_MAH', self.BATT_ARM_MAH, _VS_BattParams_BATT_ARM_MAH)
+            if (self.BATT_ARM_MAH + 2147483648) & -4294967296:
+                _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _VS_BattParams_BATT_ARM_MAH)
         except _v.SLOW:
-            _v.diag(out, 'BATT_ARM_MAH', self.BATT_ARM_MAH, _VS_BattParams_BATT_ARM_MAH)
+            _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _VS_BattParams_BATT_ARM_MAH)
         return out
 
     def check(self) -> None:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'params.BATT')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "params.BATT")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field in {'BATT_CAPACITY', 'BATT_LOW_VOLT', 'BATT_LOW_TIMER', 'BATT_FS_VOLTSRC', 'BATT_LOW_MAH', 'BATT_CRT_VOLT', 'BATT_CRT_MAH', 'BATT_FS_LOW_ACT', 'BATT_FS_CRT_ACT', 'BATT_ARM_VOLT', 'BATT_ARM_MAH'}:
+        if field in {
+            "BATT_CAPACITY",
+            "BATT_LOW_VOLT",
+            "BATT_LOW_TIMER",
+            "BATT_FS_VOLTSRC",
+            "BATT_LOW_MAH",
+            "BATT_CRT_VOLT",
+            "BATT_CRT_MAH",
+            "BATT_FS_LOW_ACT",
+            "BATT_FS_CRT_ACT",
+            "BATT_ARM_VOLT",
+            "BATT_ARM_MAH",
+        }:
             return True
-        raise KeyError(f'{field!r} is not a field of ' + 'params.BATT')
+        raise KeyError(f"{field!r} is not a field of " + "params.BATT")

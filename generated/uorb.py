@@ -14,11 +14,20 @@ from collections.abc import Mapping
 from typing import Any, ClassVar
 
 from . import _meta as _m
-from . import _ulog
-from . import _uorb
+from . import _ulog, _uorb
 from . import _validate as _v
 
-__all__ = ['BatteryStatus', 'BatteryStatusFault', 'BatteryStatusSource', 'BatteryStatusV0', 'BatteryStatusV0Fault', 'BatteryStatusV0Source', 'BatteryStatusV0State', 'BatteryStatusV0Warning', 'BatteryStatusWarning']
+__all__ = [
+    "BatteryStatus",
+    "BatteryStatusFault",
+    "BatteryStatusSource",
+    "BatteryStatusV0",
+    "BatteryStatusV0Fault",
+    "BatteryStatusV0Source",
+    "BatteryStatusV0State",
+    "BatteryStatusV0Warning",
+    "BatteryStatusWarning",
+]
 
 
 class BatteryStatusSource(enum.IntEnum):
@@ -98,116 +107,797 @@ class BatteryStatusV0Fault(enum.IntEnum):
     FAILED_TO_ARM = 10
 
 
-_S_BatteryStatus = struct.Struct('<Q33f9H?4B2?B2x')  # decode: nested messages inlined
-_SD_BatteryStatus = struct.Struct('<Q33f9H?4B2?B')  # without the trailing padding
+# the C struct, nested messages inlined (decoding reads them in place)
+_BATTERY_STATUS_STRUCT = struct.Struct("<Q33f9H?4B2?B2x")
+# without the trailing padding, which ULog records leave out
+_BATTERY_STATUS_UNPADDED = struct.Struct("<Q33f9H?4B2?B")
 
 
-_COL_BatteryStatus = _uorb.Columns(
-    ('timestamp', 'voltage_v', 'current_a', 'current_average_a', 'discharged_mah', 'remaining', 'scale', 'time_remaining_s', 'temperature', 'voltage_cell_v[0]', 'voltage_cell_v[1]', 'voltage_cell_v[2]', 'voltage_cell_v[3]', 'voltage_cell_v[4]', 'voltage_cell_v[5]', 'voltage_cell_v[6]', 'voltage_cell_v[7]', 'voltage_cell_v[8]', 'voltage_cell_v[9]', 'voltage_cell_v[10]', 'voltage_cell_v[11]', 'voltage_cell_v[12]', 'voltage_cell_v[13]', 'max_cell_voltage_delta', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm', 'capacity', 'cycle_count', 'average_time_to_empty', 'manufacture_date', 'state_of_health', 'max_error', 'interface_error', 'faults', 'over_discharge_count', 'connected', 'cell_count', 'source', 'priority', 'id', 'is_powering_off', 'is_required', 'warning'),
-    '<Q33f9H?4B2?B',
+_BATTERY_STATUS_COLUMNS = _uorb.Columns(
+    (
+        "timestamp",
+        "voltage_v",
+        "current_a",
+        "current_average_a",
+        "discharged_mah",
+        "remaining",
+        "scale",
+        "time_remaining_s",
+        "temperature",
+        "voltage_cell_v[0]",
+        "voltage_cell_v[1]",
+        "voltage_cell_v[2]",
+        "voltage_cell_v[3]",
+        "voltage_cell_v[4]",
+        "voltage_cell_v[5]",
+        "voltage_cell_v[6]",
+        "voltage_cell_v[7]",
+        "voltage_cell_v[8]",
+        "voltage_cell_v[9]",
+        "voltage_cell_v[10]",
+        "voltage_cell_v[11]",
+        "voltage_cell_v[12]",
+        "voltage_cell_v[13]",
+        "max_cell_voltage_delta",
+        "full_charge_capacity_wh",
+        "remaining_capacity_wh",
+        "nominal_voltage",
+        "internal_resistance_estimate",
+        "ocv_estimate",
+        "ocv_estimate_filtered",
+        "volt_based_soc_estimate",
+        "voltage_prediction",
+        "prediction_error",
+        "estimation_covariance_norm",
+        "capacity",
+        "cycle_count",
+        "average_time_to_empty",
+        "manufacture_date",
+        "state_of_health",
+        "max_error",
+        "interface_error",
+        "faults",
+        "over_discharge_count",
+        "connected",
+        "cell_count",
+        "source",
+        "priority",
+        "id",
+        "is_powering_off",
+        "is_required",
+        "warning",
+    ),
+    "<Q33f9H?4B2?B",
     168,
-    ('<u8', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '?', 'u1', 'u1', 'u1', 'u1', '?', '?', 'u1'),
-    (0, 8, 12, 16, 20, 24, 28, 32, 36, 40, 44, 48, 52, 56, 60, 64, 68, 72, 76, 80, 84, 88, 92, 96, 100, 104, 108, 112, 116, 120, 124, 128, 132, 136, 140, 142, 144, 146, 148, 150, 152, 154, 156, 158, 159, 160, 161, 162, 163, 164, 165),
+    (
+        "<u8",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "?",
+        "u1",
+        "u1",
+        "u1",
+        "u1",
+        "?",
+        "?",
+        "u1",
+    ),
+    (
+        0,
+        8,
+        12,
+        16,
+        20,
+        24,
+        28,
+        32,
+        36,
+        40,
+        44,
+        48,
+        52,
+        56,
+        60,
+        64,
+        68,
+        72,
+        76,
+        80,
+        84,
+        88,
+        92,
+        96,
+        100,
+        104,
+        108,
+        112,
+        116,
+        120,
+        124,
+        128,
+        132,
+        136,
+        140,
+        142,
+        144,
+        146,
+        148,
+        150,
+        152,
+        154,
+        156,
+        158,
+        159,
+        160,
+        161,
+        162,
+        163,
+        164,
+        165,
+    ),
 )
 
 
-_UC_BatteryStatus: tuple[tuple[str, str, str, int], ...] = (('timestamp', 'timestamp', 'Q', 0), ('voltage_v', 'voltage_v', 'f', 0), ('current_a', 'current_a', 'f', 0), ('current_average_a', 'current_average_a', 'f', 0), ('discharged_mah', 'discharged_mah', 'f', 0), ('remaining', 'remaining', 'f', 0), ('scale', 'scale', 'f', 0), ('time_remaining_s', 'time_remaining_s', 'f', 0), ('temperature', 'temperature', 'f', 0), ('voltage_cell_v', 'voltage_cell_v', 'f', 14), ('max_cell_voltage_delta', 'max_cell_voltage_delta', 'f', 0), ('full_charge_capacity_wh', 'full_charge_capacity_wh', 'f', 0), ('remaining_capacity_wh', 'remaining_capacity_wh', 'f', 0), ('nominal_voltage', 'nominal_voltage', 'f', 0), ('internal_resistance_estimate', 'internal_resistance_estimate', 'f', 0), ('ocv_estimate', 'ocv_estimate', 'f', 0), ('ocv_estimate_filtered', 'ocv_estimate_filtered', 'f', 0), ('volt_based_soc_estimate', 'volt_based_soc_estimate', 'f', 0), ('voltage_prediction', 'voltage_prediction', 'f', 0), ('prediction_error', 'prediction_error', 'f', 0), ('estimation_covariance_norm', 'estimation_covariance_norm', 'f', 0), ('capacity', 'capacity', 'H', 0), ('cycle_count', 'cycle_count', 'H', 0), ('average_time_to_empty', 'average_time_to_empty', 'H', 0), ('manufacture_date', 'manufacture_date', 'H', 0), ('state_of_health', 'state_of_health', 'H', 0), ('max_error', 'max_error', 'H', 0), ('interface_error', 'interface_error', 'H', 0), ('faults', 'faults', 'H', 0), ('over_discharge_count', 'over_discharge_count', 'H', 0), ('connected', 'connected', '?', 0), ('cell_count', 'cell_count', 'B', 0), ('source', 'source', 'B', 0), ('priority', 'priority', 'B', 0), ('id', 'id', 'B', 0), ('is_powering_off', 'is_powering_off', '?', 0), ('is_required', 'is_required', '?', 0), ('warning', 'warning', 'B', 0))
-
-
-_VS_BatteryStatus_timestamp = _v.Number(type='uint64', kind='uint', low=0, high=18446744073709551615, unit='us')
-_VS_BatteryStatus_connected = _v.Number(type='bool', kind='bool', low=0, high=1)
-_VS_BatteryStatus_voltage_v = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', sentinel=0.0, sentinel_text='0')
-_VS_BatteryStatus_current_a = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='A', sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatus_current_average_a = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='A', sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatus_discharged_mah = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='mAh', sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatus_remaining = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=0, maximum=1, sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatus_scale = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=1, sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatus_time_remaining_s = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='s', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryStatus_temperature = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='degC', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryStatus_cell_count = _v.Number(type='uint8', kind='uint', low=0, high=255, sentinel=0, sentinel_text='0')
-_VS_BatteryStatus_source = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'SOURCE_POWER_MODULE', 1: 'SOURCE_EXTERNAL', 2: 'SOURCE_ESCS'})
-_VS_BatteryStatus_priority = _v.Number(type='uint8', kind='uint', low=0, high=255)
-_VS_BatteryStatus_capacity = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='mAh')
-_VS_BatteryStatus_cycle_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryStatus_average_time_to_empty = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='min')
-_VS_BatteryStatus_manufacture_date = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryStatus_state_of_health = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='%', minimum=0, maximum=100)
-_VS_BatteryStatus_max_error = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='%', minimum=1, maximum=100)
-_VS_BatteryStatus_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
-_VS_BatteryStatus_interface_error = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryStatus_voltage_cell_v = _v.Array(_v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', sentinel=0.0, sentinel_text='0'), 14, True)
-_VS_BatteryStatus_max_cell_voltage_delta = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38)
-_VS_BatteryStatus_is_powering_off = _v.Number(type='bool', kind='bool', low=0, high=1)
-_VS_BatteryStatus_is_required = _v.Number(type='bool', kind='bool', low=0, high=1)
-_VS_BatteryStatus_warning = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'WARNING_NONE', 1: 'WARNING_LOW', 2: 'WARNING_CRITICAL', 3: 'WARNING_EMERGENCY', 4: 'WARNING_FAILED', 6: 'WARNING_UNHEALTHY', 7: 'WARNING_CHARGING'})
-_VS_BatteryStatus_faults = _v.Number(type='uint16', kind='uint', low=0, high=65535, mask=0x7ff, bits={0x1: 'FAULT_DEEP_DISCHARGE', 0x2: 'FAULT_SPIKES', 0x4: 'FAULT_CELL_FAIL', 0x8: 'FAULT_OVER_CURRENT', 0x10: 'FAULT_OVER_TEMPERATURE', 0x20: 'FAULT_UNDER_TEMPERATURE', 0x40: 'FAULT_INCOMPATIBLE_VOLTAGE', 0x80: 'FAULT_INCOMPATIBLE_FIRMWARE', 0x100: 'FAULT_INCOMPATIBLE_MODEL', 0x200: 'FAULT_HARDWARE_FAILURE', 0x400: 'FAULT_FAILED_TO_ARM'})
-_VS_BatteryStatus_full_charge_capacity_wh = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Wh')
-_VS_BatteryStatus_remaining_capacity_wh = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Wh')
-_VS_BatteryStatus_over_discharge_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryStatus_nominal_voltage = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatus_internal_resistance_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Ohm')
-_VS_BatteryStatus_ocv_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatus_ocv_estimate_filtered = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatus_volt_based_soc_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=0, maximum=1)
-_VS_BatteryStatus_voltage_prediction = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatus_prediction_error = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatus_estimation_covariance_norm = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38)
-
-
-_S_BatteryStatusV0 = struct.Struct('<Q33f10H?4B2?B')  # decode: nested messages inlined
-
-
-_COL_BatteryStatusV0 = _uorb.Columns(
-    ('timestamp', 'voltage_v', 'current_a', 'current_average_a', 'discharged_mah', 'remaining', 'scale', 'time_remaining_s', 'temperature', 'voltage_cell_v[0]', 'voltage_cell_v[1]', 'voltage_cell_v[2]', 'voltage_cell_v[3]', 'voltage_cell_v[4]', 'voltage_cell_v[5]', 'voltage_cell_v[6]', 'voltage_cell_v[7]', 'voltage_cell_v[8]', 'voltage_cell_v[9]', 'voltage_cell_v[10]', 'voltage_cell_v[11]', 'voltage_cell_v[12]', 'voltage_cell_v[13]', 'max_cell_voltage_delta', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm', 'capacity', 'cycle_count', 'average_time_to_empty', 'serial_number', 'manufacture_date', 'state_of_health', 'max_error', 'interface_error', 'faults', 'over_discharge_count', 'connected', 'cell_count', 'source', 'priority', 'id', 'is_powering_off', 'is_required', 'warning'),
-    '<Q33f10H?4B2?B',
-    168,
-    ('<u8', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<f4', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '<u2', '?', 'u1', 'u1', 'u1', 'u1', '?', '?', 'u1'),
-    (0, 8, 12, 16, 20, 24, 28, 32, 36, 40, 44, 48, 52, 56, 60, 64, 68, 72, 76, 80, 84, 88, 92, 96, 100, 104, 108, 112, 116, 120, 124, 128, 132, 136, 140, 142, 144, 146, 148, 150, 152, 154, 156, 158, 160, 161, 162, 163, 164, 165, 166, 167),
+# (attribute, field, struct code, count) of the plain fields, to name a value that does not fit
+_BATTERY_STATUS_PACKED_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("timestamp", "timestamp", "Q", 0),
+    ("voltage_v", "voltage_v", "f", 0),
+    ("current_a", "current_a", "f", 0),
+    ("current_average_a", "current_average_a", "f", 0),
+    ("discharged_mah", "discharged_mah", "f", 0),
+    ("remaining", "remaining", "f", 0),
+    ("scale", "scale", "f", 0),
+    ("time_remaining_s", "time_remaining_s", "f", 0),
+    ("temperature", "temperature", "f", 0),
+    ("voltage_cell_v", "voltage_cell_v", "f", 14),
+    ("max_cell_voltage_delta", "max_cell_voltage_delta", "f", 0),
+    ("full_charge_capacity_wh", "full_charge_capacity_wh", "f", 0),
+    ("remaining_capacity_wh", "remaining_capacity_wh", "f", 0),
+    ("nominal_voltage", "nominal_voltage", "f", 0),
+    ("internal_resistance_estimate", "internal_resistance_estimate", "f", 0),
+    ("ocv_estimate", "ocv_estimate", "f", 0),
+    ("ocv_estimate_filtered", "ocv_estimate_filtered", "f", 0),
+    ("volt_based_soc_estimate", "volt_based_soc_estimate", "f", 0),
+    ("voltage_prediction", "voltage_prediction", "f", 0),
+    ("prediction_error", "prediction_error", "f", 0),
+    ("estimation_covariance_norm", "estimation_covariance_norm", "f", 0),
+    ("capacity", "capacity", "H", 0),
+    ("cycle_count", "cycle_count", "H", 0),
+    ("average_time_to_empty", "average_time_to_empty", "H", 0),
+    ("manufacture_date", "manufacture_date", "H", 0),
+    ("state_of_health", "state_of_health", "H", 0),
+    ("max_error", "max_error", "H", 0),
+    ("interface_error", "interface_error", "H", 0),
+    ("faults", "faults", "H", 0),
+    ("over_discharge_count", "over_discharge_count", "H", 0),
+    ("connected", "connected", "?", 0),
+    ("cell_count", "cell_count", "B", 0),
+    ("source", "source", "B", 0),
+    ("priority", "priority", "B", 0),
+    ("id", "id", "B", 0),
+    ("is_powering_off", "is_powering_off", "?", 0),
+    ("is_required", "is_required", "?", 0),
+    ("warning", "warning", "B", 0),
 )
 
 
-_UC_BatteryStatusV0: tuple[tuple[str, str, str, int], ...] = (('timestamp', 'timestamp', 'Q', 0), ('voltage_v', 'voltage_v', 'f', 0), ('current_a', 'current_a', 'f', 0), ('current_average_a', 'current_average_a', 'f', 0), ('discharged_mah', 'discharged_mah', 'f', 0), ('remaining', 'remaining', 'f', 0), ('scale', 'scale', 'f', 0), ('time_remaining_s', 'time_remaining_s', 'f', 0), ('temperature', 'temperature', 'f', 0), ('voltage_cell_v', 'voltage_cell_v', 'f', 14), ('max_cell_voltage_delta', 'max_cell_voltage_delta', 'f', 0), ('full_charge_capacity_wh', 'full_charge_capacity_wh', 'f', 0), ('remaining_capacity_wh', 'remaining_capacity_wh', 'f', 0), ('nominal_voltage', 'nominal_voltage', 'f', 0), ('internal_resistance_estimate', 'internal_resistance_estimate', 'f', 0), ('ocv_estimate', 'ocv_estimate', 'f', 0), ('ocv_estimate_filtered', 'ocv_estimate_filtered', 'f', 0), ('volt_based_soc_estimate', 'volt_based_soc_estimate', 'f', 0), ('voltage_prediction', 'voltage_prediction', 'f', 0), ('prediction_error', 'prediction_error', 'f', 0), ('estimation_covariance_norm', 'estimation_covariance_norm', 'f', 0), ('capacity', 'capacity', 'H', 0), ('cycle_count', 'cycle_count', 'H', 0), ('average_time_to_empty', 'average_time_to_empty', 'H', 0), ('serial_number', 'serial_number', 'H', 0), ('manufacture_date', 'manufacture_date', 'H', 0), ('state_of_health', 'state_of_health', 'H', 0), ('max_error', 'max_error', 'H', 0), ('interface_error', 'interface_error', 'H', 0), ('faults', 'faults', 'H', 0), ('over_discharge_count', 'over_discharge_count', 'H', 0), ('connected', 'connected', '?', 0), ('cell_count', 'cell_count', 'B', 0), ('source', 'source', 'B', 0), ('priority', 'priority', 'B', 0), ('id', 'id', 'B', 0), ('is_powering_off', 'is_powering_off', '?', 0), ('is_required', 'is_required', '?', 0), ('warning', 'warning', 'B', 0))
+_VS_BatteryStatus_timestamp = _v.Number(type="uint64", kind="uint", low=0, high=18446744073709551615, unit="us")
+_VS_BatteryStatus_connected = _v.Number(type="bool", kind="bool", low=0, high=1)
+_VS_BatteryStatus_voltage_v = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_VS_BatteryStatus_current_a = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="A",
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatus_current_average_a = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="A",
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatus_discharged_mah = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="mAh",
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatus_remaining = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    minimum=0,
+    maximum=1,
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatus_scale = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    minimum=1,
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatus_time_remaining_s = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="s",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_VS_BatteryStatus_temperature = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="degC",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_VS_BatteryStatus_cell_count = _v.Number(type="uint8", kind="uint", low=0, high=255, sentinel=0, sentinel_text="0")
+_VS_BatteryStatus_source = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={0: "SOURCE_POWER_MODULE", 1: "SOURCE_EXTERNAL", 2: "SOURCE_ESCS"},
+)
+_VS_BatteryStatus_priority = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_VS_BatteryStatus_capacity = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mAh")
+_VS_BatteryStatus_cycle_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryStatus_average_time_to_empty = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="min")
+_VS_BatteryStatus_manufacture_date = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryStatus_state_of_health = _v.Number(
+    type="uint16", kind="uint", low=0, high=65535, unit="%", minimum=0, maximum=100
+)
+_VS_BatteryStatus_max_error = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="%", minimum=1, maximum=100)
+_VS_BatteryStatus_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_VS_BatteryStatus_interface_error = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryStatus_voltage_cell_v = _v.Array(
+    _v.Number(
+        type="float32",
+        kind="float",
+        low=-3.4028234663852886e38,
+        high=3.4028234663852886e38,
+        unit="V",
+        sentinel=0.0,
+        sentinel_text="0",
+    ),
+    14,
+    True,
+)
+_VS_BatteryStatus_max_cell_voltage_delta = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
+)
+_VS_BatteryStatus_is_powering_off = _v.Number(type="bool", kind="bool", low=0, high=1)
+_VS_BatteryStatus_is_required = _v.Number(type="bool", kind="bool", low=0, high=1)
+_VS_BatteryStatus_warning = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "WARNING_NONE",
+        1: "WARNING_LOW",
+        2: "WARNING_CRITICAL",
+        3: "WARNING_EMERGENCY",
+        4: "WARNING_FAILED",
+        6: "WARNING_UNHEALTHY",
+        7: "WARNING_CHARGING",
+    },
+)
+_VS_BatteryStatus_faults = _v.Number(
+    type="uint16",
+    kind="uint",
+    low=0,
+    high=65535,
+    mask=0x7FF,
+    bits={
+        0x1: "FAULT_DEEP_DISCHARGE",
+        0x2: "FAULT_SPIKES",
+        0x4: "FAULT_CELL_FAIL",
+        0x8: "FAULT_OVER_CURRENT",
+        0x10: "FAULT_OVER_TEMPERATURE",
+        0x20: "FAULT_UNDER_TEMPERATURE",
+        0x40: "FAULT_INCOMPATIBLE_VOLTAGE",
+        0x80: "FAULT_INCOMPATIBLE_FIRMWARE",
+        0x100: "FAULT_INCOMPATIBLE_MODEL",
+        0x200: "FAULT_HARDWARE_FAILURE",
+        0x400: "FAULT_FAILED_TO_ARM",
+    },
+)
+_VS_BatteryStatus_full_charge_capacity_wh = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
+)
+_VS_BatteryStatus_remaining_capacity_wh = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
+)
+_VS_BatteryStatus_over_discharge_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryStatus_nominal_voltage = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatus_internal_resistance_estimate = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Ohm"
+)
+_VS_BatteryStatus_ocv_estimate = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatus_ocv_estimate_filtered = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatus_volt_based_soc_estimate = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, minimum=0, maximum=1
+)
+_VS_BatteryStatus_voltage_prediction = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatus_prediction_error = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatus_estimation_covariance_norm = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
+)
 
 
-_VS_BatteryStatusV0_timestamp = _v.Number(type='uint64', kind='uint', low=0, high=18446744073709551615, unit='us')
-_VS_BatteryStatusV0_connected = _v.Number(type='bool', kind='bool', low=0, high=1)
-_VS_BatteryStatusV0_voltage_v = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', sentinel=0.0, sentinel_text='0')
-_VS_BatteryStatusV0_current_a = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='A', sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatusV0_current_average_a = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='A', sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatusV0_discharged_mah = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='mAh', sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatusV0_remaining = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=0, maximum=1, sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatusV0_scale = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=1, sentinel=-1.0, sentinel_text='-1')
-_VS_BatteryStatusV0_time_remaining_s = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='s', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryStatusV0_temperature = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='degC', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryStatusV0_cell_count = _v.Number(type='uint8', kind='uint', low=0, high=255, sentinel=0, sentinel_text='0')
-_VS_BatteryStatusV0_source = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'SOURCE_POWER_MODULE', 1: 'SOURCE_EXTERNAL', 2: 'SOURCE_ESCS'})
-_VS_BatteryStatusV0_priority = _v.Number(type='uint8', kind='uint', low=0, high=255)
-_VS_BatteryStatusV0_capacity = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='mAh')
-_VS_BatteryStatusV0_cycle_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryStatusV0_average_time_to_empty = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='min')
-_VS_BatteryStatusV0_serial_number = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryStatusV0_manufacture_date = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryStatusV0_state_of_health = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='%', minimum=0, maximum=100)
-_VS_BatteryStatusV0_max_error = _v.Number(type='uint16', kind='uint', low=0, high=65535, unit='%', minimum=1, maximum=100)
-_VS_BatteryStatusV0_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
-_VS_BatteryStatusV0_interface_error = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryStatusV0_voltage_cell_v = _v.Array(_v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V', sentinel=0.0, sentinel_text='0'), 14, True)
-_VS_BatteryStatusV0_max_cell_voltage_delta = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38)
-_VS_BatteryStatusV0_is_powering_off = _v.Number(type='bool', kind='bool', low=0, high=1)
-_VS_BatteryStatusV0_is_required = _v.Number(type='bool', kind='bool', low=0, high=1)
-_VS_BatteryStatusV0_warning = _v.Number(type='uint8', kind='uint', low=0, high=255, values={0: 'WARNING_NONE', 1: 'WARNING_LOW', 2: 'WARNING_CRITICAL', 3: 'WARNING_EMERGENCY', 4: 'WARNING_FAILED', 6: 'STATE_UNHEALTHY', 7: 'STATE_CHARGING'})
-_VS_BatteryStatusV0_faults = _v.Number(type='uint16', kind='uint', low=0, high=65535, mask=0x7ff, bits={0x1: 'FAULT_DEEP_DISCHARGE', 0x2: 'FAULT_SPIKES', 0x4: 'FAULT_CELL_FAIL', 0x8: 'FAULT_OVER_CURRENT', 0x10: 'FAULT_OVER_TEMPERATURE', 0x20: 'FAULT_UNDER_TEMPERATURE', 0x40: 'FAULT_INCOMPATIBLE_VOLTAGE', 0x80: 'FAULT_INCOMPATIBLE_FIRMWARE', 0x100: 'FAULT_INCOMPATIBLE_MODEL', 0x200: 'FAULT_HARDWARE_FAILURE', 0x400: 'FAULT_FAILED_TO_ARM'})
-_VS_BatteryStatusV0_full_charge_capacity_wh = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Wh')
-_VS_BatteryStatusV0_remaining_capacity_wh = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Wh')
-_VS_BatteryStatusV0_over_discharge_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryStatusV0_nominal_voltage = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatusV0_internal_resistance_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='Ohm')
-_VS_BatteryStatusV0_ocv_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatusV0_ocv_estimate_filtered = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatusV0_volt_based_soc_estimate = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, minimum=0, maximum=1)
-_VS_BatteryStatusV0_voltage_prediction = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatusV0_prediction_error = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38, unit='V')
-_VS_BatteryStatusV0_estimation_covariance_norm = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, high=3.4028234663852886e+38)
+# the C struct, nested messages inlined (decoding reads them in place)
+_BATTERY_STATUS_V0_STRUCT = struct.Struct("<Q33f10H?4B2?B")
+
+
+_BATTERY_STATUS_V0_COLUMNS = _uorb.Columns(
+    (
+        "timestamp",
+        "voltage_v",
+        "current_a",
+        "current_average_a",
+        "discharged_mah",
+        "remaining",
+        "scale",
+        "time_remaining_s",
+        "temperature",
+        "voltage_cell_v[0]",
+        "voltage_cell_v[1]",
+        "voltage_cell_v[2]",
+        "voltage_cell_v[3]",
+        "voltage_cell_v[4]",
+        "voltage_cell_v[5]",
+        "voltage_cell_v[6]",
+        "voltage_cell_v[7]",
+        "voltage_cell_v[8]",
+        "voltage_cell_v[9]",
+        "voltage_cell_v[10]",
+        "voltage_cell_v[11]",
+        "voltage_cell_v[12]",
+        "voltage_cell_v[13]",
+        "max_cell_voltage_delta",
+        "full_charge_capacity_wh",
+        "remaining_capacity_wh",
+        "nominal_voltage",
+        "internal_resistance_estimate",
+        "ocv_estimate",
+        "ocv_estimate_filtered",
+        "volt_based_soc_estimate",
+        "voltage_prediction",
+        "prediction_error",
+        "estimation_covariance_norm",
+        "capacity",
+        "cycle_count",
+        "average_time_to_empty",
+        "serial_number",
+        "manufacture_date",
+        "state_of_health",
+        "max_error",
+        "interface_error",
+        "faults",
+        "over_discharge_count",
+        "connected",
+        "cell_count",
+        "source",
+        "priority",
+        "id",
+        "is_powering_off",
+        "is_required",
+        "warning",
+    ),
+    "<Q33f10H?4B2?B",
+    168,
+    (
+        "<u8",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<f4",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "<u2",
+        "?",
+        "u1",
+        "u1",
+        "u1",
+        "u1",
+        "?",
+        "?",
+        "u1",
+    ),
+    (
+        0,
+        8,
+        12,
+        16,
+        20,
+        24,
+        28,
+        32,
+        36,
+        40,
+        44,
+        48,
+        52,
+        56,
+        60,
+        64,
+        68,
+        72,
+        76,
+        80,
+        84,
+        88,
+        92,
+        96,
+        100,
+        104,
+        108,
+        112,
+        116,
+        120,
+        124,
+        128,
+        132,
+        136,
+        140,
+        142,
+        144,
+        146,
+        148,
+        150,
+        152,
+        154,
+        156,
+        158,
+        160,
+        161,
+        162,
+        163,
+        164,
+        165,
+        166,
+        167,
+    ),
+)
+
+
+# (attribute, field, struct code, count) of the plain fields, to name a value that does not fit
+_BATTERY_STATUS_V0_PACKED_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("timestamp", "timestamp", "Q", 0),
+    ("voltage_v", "voltage_v", "f", 0),
+    ("current_a", "current_a", "f", 0),
+    ("current_average_a", "current_average_a", "f", 0),
+    ("discharged_mah", "discharged_mah", "f", 0),
+    ("remaining", "remaining", "f", 0),
+    ("scale", "scale", "f", 0),
+    ("time_remaining_s", "time_remaining_s", "f", 0),
+    ("temperature", "temperature", "f", 0),
+    ("voltage_cell_v", "voltage_cell_v", "f", 14),
+    ("max_cell_voltage_delta", "max_cell_voltage_delta", "f", 0),
+    ("full_charge_capacity_wh", "full_charge_capacity_wh", "f", 0),
+    ("remaining_capacity_wh", "remaining_capacity_wh", "f", 0),
+    ("nominal_voltage", "nominal_voltage", "f", 0),
+    ("internal_resistance_estimate", "internal_resistance_estimate", "f", 0),
+    ("ocv_estimate", "ocv_estimate", "f", 0),
+    ("ocv_estimate_filtered", "ocv_estimate_filtered", "f", 0),
+    ("volt_based_soc_estimate", "volt_based_soc_estimate", "f", 0),
+    ("voltage_prediction", "voltage_prediction", "f", 0),
+    ("prediction_error", "prediction_error", "f", 0),
+    ("estimation_covariance_norm", "estimation_covariance_norm", "f", 0),
+    ("capacity", "capacity", "H", 0),
+    ("cycle_count", "cycle_count", "H", 0),
+    ("average_time_to_empty", "average_time_to_empty", "H", 0),
+    ("serial_number", "serial_number", "H", 0),
+    ("manufacture_date", "manufacture_date", "H", 0),
+    ("state_of_health", "state_of_health", "H", 0),
+    ("max_error", "max_error", "H", 0),
+    ("interface_error", "interface_error", "H", 0),
+    ("faults", "faults", "H", 0),
+    ("over_discharge_count", "over_discharge_count", "H", 0),
+    ("connected", "connected", "?", 0),
+    ("cell_count", "cell_count", "B", 0),
+    ("source", "source", "B", 0),
+    ("priority", "priority", "B", 0),
+    ("id", "id", "B", 0),
+    ("is_powering_off", "is_powering_off", "?", 0),
+    ("is_required", "is_required", "?", 0),
+    ("warning", "warning", "B", 0),
+)
+
+
+_VS_BatteryStatusV0_timestamp = _v.Number(type="uint64", kind="uint", low=0, high=18446744073709551615, unit="us")
+_VS_BatteryStatusV0_connected = _v.Number(type="bool", kind="bool", low=0, high=1)
+_VS_BatteryStatusV0_voltage_v = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_VS_BatteryStatusV0_current_a = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="A",
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatusV0_current_average_a = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="A",
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatusV0_discharged_mah = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="mAh",
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatusV0_remaining = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    minimum=0,
+    maximum=1,
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatusV0_scale = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    minimum=1,
+    sentinel=-1.0,
+    sentinel_text="-1",
+)
+_VS_BatteryStatusV0_time_remaining_s = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="s",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_VS_BatteryStatusV0_temperature = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="degC",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_VS_BatteryStatusV0_cell_count = _v.Number(type="uint8", kind="uint", low=0, high=255, sentinel=0, sentinel_text="0")
+_VS_BatteryStatusV0_source = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={0: "SOURCE_POWER_MODULE", 1: "SOURCE_EXTERNAL", 2: "SOURCE_ESCS"},
+)
+_VS_BatteryStatusV0_priority = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_VS_BatteryStatusV0_capacity = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mAh")
+_VS_BatteryStatusV0_cycle_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryStatusV0_average_time_to_empty = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="min")
+_VS_BatteryStatusV0_serial_number = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryStatusV0_manufacture_date = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryStatusV0_state_of_health = _v.Number(
+    type="uint16", kind="uint", low=0, high=65535, unit="%", minimum=0, maximum=100
+)
+_VS_BatteryStatusV0_max_error = _v.Number(
+    type="uint16", kind="uint", low=0, high=65535, unit="%", minimum=1, maximum=100
+)
+_VS_BatteryStatusV0_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_VS_BatteryStatusV0_interface_error = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryStatusV0_voltage_cell_v = _v.Array(
+    _v.Number(
+        type="float32",
+        kind="float",
+        low=-3.4028234663852886e38,
+        high=3.4028234663852886e38,
+        unit="V",
+        sentinel=0.0,
+        sentinel_text="0",
+    ),
+    14,
+    True,
+)
+_VS_BatteryStatusV0_max_cell_voltage_delta = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
+)
+_VS_BatteryStatusV0_is_powering_off = _v.Number(type="bool", kind="bool", low=0, high=1)
+_VS_BatteryStatusV0_is_required = _v.Number(type="bool", kind="bool", low=0, high=1)
+_VS_BatteryStatusV0_warning = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "WARNING_NONE",
+        1: "WARNING_LOW",
+        2: "WARNING_CRITICAL",
+        3: "WARNING_EMERGENCY",
+        4: "WARNING_FAILED",
+        6: "STATE_UNHEALTHY",
+        7: "STATE_CHARGING",
+    },
+)
+_VS_BatteryStatusV0_faults = _v.Number(
+    type="uint16",
+    kind="uint",
+    low=0,
+    high=65535,
+    mask=0x7FF,
+    bits={
+        0x1: "FAULT_DEEP_DISCHARGE",
+        0x2: "FAULT_SPIKES",
+        0x4: "FAULT_CELL_FAIL",
+        0x8: "FAULT_OVER_CURRENT",
+        0x10: "FAULT_OVER_TEMPERATURE",
+        0x20: "FAULT_UNDER_TEMPERATURE",
+        0x40: "FAULT_INCOMPATIBLE_VOLTAGE",
+        0x80: "FAULT_INCOMPATIBLE_FIRMWARE",
+        0x100: "FAULT_INCOMPATIBLE_MODEL",
+        0x200: "FAULT_HARDWARE_FAILURE",
+        0x400: "FAULT_FAILED_TO_ARM",
+    },
+)
+_VS_BatteryStatusV0_full_charge_capacity_wh = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
+)
+_VS_BatteryStatusV0_remaining_capacity_wh = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
+)
+_VS_BatteryStatusV0_over_discharge_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryStatusV0_nominal_voltage = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatusV0_internal_resistance_estimate = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Ohm"
+)
+_VS_BatteryStatusV0_ocv_estimate = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatusV0_ocv_estimate_filtered = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatusV0_volt_based_soc_estimate = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, minimum=0, maximum=1
+)
+_VS_BatteryStatusV0_voltage_prediction = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatusV0_prediction_error = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_VS_BatteryStatusV0_estimation_covariance_norm = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
+)
 
 
 @dataclasses.dataclass(slots=True)
@@ -221,7 +911,7 @@ class BatteryStatus:
     Schema: uorb.BatteryStatus (uorb, BatteryStatus.msg:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'uorb.BatteryStatus'
+    QUALIFIED_NAME: ClassVar[str] = "uorb.BatteryStatus"
     MESSAGE_VERSION: ClassVar[int] = 1
     MAX_INSTANCES: ClassVar[int] = 3
     SOURCE_POWER_MODULE: ClassVar[int] = 0
@@ -247,44 +937,352 @@ class BatteryStatus:
     FAULT_FAILED_TO_ARM: ClassVar[int] = 10
     FAULT_COUNT: ClassVar[int] = 11
 
-    timestamp: int = dataclasses.field(default=0, metadata=_m.meta(name='timestamp', type='uint64', unit='us', quantity='time', scale=1e-06, offset=0.0, doc='Time since system start'))
-    connected: bool = dataclasses.field(default=False, metadata=_m.meta(name='connected', type='bool', doc='Whether or not a battery is connected. For power modules this is based on a voltage threshold.'))
-    voltage_v: float = dataclasses.field(default=0.0, metadata=_m.meta(name='voltage_v', type='float32', unit='V', quantity='voltage', invalid=0.0, invalid_text='0', doc='Battery voltage'))
-    current_a: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='current_a', type='float32', unit='A', quantity='current', invalid=-1.0, invalid_text='-1', doc='Battery current'))
-    current_average_a: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='current_average_a', type='float32', unit='A', quantity='current', invalid=-1.0, invalid_text='-1', doc='Battery current average (for FW average in level flight)'))
-    discharged_mah: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='discharged_mah', type='float32', unit='mAh', quantity='charge', scale=3.6, offset=0.0, invalid=-1.0, invalid_text='-1', doc='Discharged amount'))
-    remaining: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='remaining', type='float32', minimum=0, maximum=1, invalid=-1.0, invalid_text='-1', doc='Remaining capacity'))
-    scale: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='scale', type='float32', minimum=1, maximum=None, invalid=-1.0, invalid_text='-1', doc='Scaling factor to compensate for lower actuation power caused by voltage sag'))
-    time_remaining_s: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='time_remaining_s', type='float32', unit='s', quantity='time', invalid=math.nan, invalid_text='NaN', doc='Predicted time remaining until battery is empty under previous averaged load'))
-    temperature: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='temperature', type='float32', unit='degC', quantity='temperature', scale=1.0, offset=273.15, invalid=math.nan, invalid_text='NaN', doc='Temperature of the battery'))
-    cell_count: int = dataclasses.field(default=0, metadata=_m.meta(name='cell_count', type='uint8', invalid=0, invalid_text='0', doc='Number of cells'))
-    source: int = dataclasses.field(default=0, metadata=_m.meta(name='source', type='uint8', enums=('uorb.BatteryStatus.SOURCE',), doc='Battery source'))
-    priority: int = dataclasses.field(default=0, metadata=_m.meta(name='priority', type='uint8', doc='Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1'))
-    capacity: int = dataclasses.field(default=0, metadata=_m.meta(name='capacity', type='uint16', unit='mAh', quantity='charge', scale=3.6, offset=0.0, doc='Capacity of the battery when fully charged'))
-    cycle_count: int = dataclasses.field(default=0, metadata=_m.meta(name='cycle_count', type='uint16', doc='Number of discharge cycles the battery has experienced'))
-    average_time_to_empty: int = dataclasses.field(default=0, metadata=_m.meta(name='average_time_to_empty', type='uint16', unit='min', quantity='time', scale=60.0, offset=0.0, doc='Predicted remaining battery capacity based on the average rate of discharge'))
-    manufacture_date: int = dataclasses.field(default=0, metadata=_m.meta(name='manufacture_date', type='uint16', doc='Manufacture date, part of serial number of the battery pack. Formatted as: Day + Month×32 + (Year–1980)×512'))
-    state_of_health: int = dataclasses.field(default=0, metadata=_m.meta(name='state_of_health', type='uint16', unit='%', quantity='ratio', scale=0.01, offset=0.0, minimum=0, maximum=100, doc='State of health. FullChargeCapacity/DesignCapacity'))
-    max_error: int = dataclasses.field(default=0, metadata=_m.meta(name='max_error', type='uint16', unit='%', quantity='ratio', scale=0.01, offset=0.0, minimum=1, maximum=100, doc='Max error, expected margin of error in the state-of-charge calculation'))
-    id: int = dataclasses.field(default=0, metadata=_m.meta(name='id', type='uint8', doc='ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed'))
-    interface_error: int = dataclasses.field(default=0, metadata=_m.meta(name='interface_error', type='uint16', doc='Interface error counter'))
-    voltage_cell_v: list[float] = dataclasses.field(default_factory=lambda: [0.0] * 14, metadata=_m.meta(name='voltage_cell_v', type='float32[14]', unit='V', quantity='voltage', invalid=0.0, invalid_text='0', per_element=True, doc='Battery individual cell voltages'))
-    max_cell_voltage_delta: float = dataclasses.field(default=0.0, metadata=_m.meta(name='max_cell_voltage_delta', type='float32', doc='Max difference between individual cell voltages'))
-    is_powering_off: bool = dataclasses.field(default=False, metadata=_m.meta(name='is_powering_off', type='bool', doc='Power off event imminent indication, false if unknown'))
-    is_required: bool = dataclasses.field(default=False, metadata=_m.meta(name='is_required', type='bool', doc='Set if the battery is explicitly required before arming'))
-    warning: int = dataclasses.field(default=0, metadata=_m.meta(name='warning', type='uint8', enums=('uorb.BatteryStatus.WARNING',), doc='Current battery warning'))
-    faults: int = dataclasses.field(default=0, metadata=_m.meta(name='faults', type='uint16', enums=('uorb.BatteryStatus.FAULT',), doc='Smart battery supply status/fault flags (bitmask) for health indication'))
-    full_charge_capacity_wh: float = dataclasses.field(default=0.0, metadata=_m.meta(name='full_charge_capacity_wh', type='float32', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, doc='Compensated battery capacity'))
-    remaining_capacity_wh: float = dataclasses.field(default=0.0, metadata=_m.meta(name='remaining_capacity_wh', type='float32', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, doc='Compensated battery capacity remaining'))
-    over_discharge_count: int = dataclasses.field(default=0, metadata=_m.meta(name='over_discharge_count', type='uint16', doc='Number of battery overdischarge'))
-    nominal_voltage: float = dataclasses.field(default=0.0, metadata=_m.meta(name='nominal_voltage', type='float32', unit='V', quantity='voltage', doc='Nominal voltage of the battery pack'))
-    internal_resistance_estimate: float = dataclasses.field(default=0.0, metadata=_m.meta(name='internal_resistance_estimate', type='float32', unit='Ohm', quantity='resistance', doc='Internal resistance per cell estimate'))
-    ocv_estimate: float = dataclasses.field(default=0.0, metadata=_m.meta(name='ocv_estimate', type='float32', unit='V', quantity='voltage', doc='Open circuit voltage estimate'))
-    ocv_estimate_filtered: float = dataclasses.field(default=0.0, metadata=_m.meta(name='ocv_estimate_filtered', type='float32', unit='V', quantity='voltage', doc='Filtered open circuit voltage estimate'))
-    volt_based_soc_estimate: float = dataclasses.field(default=0.0, metadata=_m.meta(name='volt_based_soc_estimate', type='float32', minimum=0, maximum=1, doc='Normalized volt based state of charge estimate'))
-    voltage_prediction: float = dataclasses.field(default=0.0, metadata=_m.meta(name='voltage_prediction', type='float32', unit='V', quantity='voltage', doc='Predicted voltage'))
-    prediction_error: float = dataclasses.field(default=0.0, metadata=_m.meta(name='prediction_error', type='float32', unit='V', quantity='voltage', doc='Prediction error'))
-    estimation_covariance_norm: float = dataclasses.field(default=0.0, metadata=_m.meta(name='estimation_covariance_norm', type='float32', doc='Norm of the covariance matrix'))
+    timestamp: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="timestamp",
+            type="uint64",
+            unit="us",
+            quantity="time",
+            scale=1e-06,
+            offset=0.0,
+            doc="Time since system start",
+        ),
+    )
+    connected: bool = dataclasses.field(
+        default=False,
+        metadata=_m.meta(
+            name="connected",
+            type="bool",
+            doc="Whether or not a battery is connected. For power modules this is based on a voltage threshold.",
+        ),
+    )
+    voltage_v: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="voltage_v",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Battery voltage",
+        ),
+    )
+    current_a: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="current_a",
+            type="float32",
+            unit="A",
+            quantity="current",
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Battery current",
+        ),
+    )
+    current_average_a: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="current_average_a",
+            type="float32",
+            unit="A",
+            quantity="current",
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Battery current average (for FW average in level flight)",
+        ),
+    )
+    discharged_mah: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="discharged_mah",
+            type="float32",
+            unit="mAh",
+            quantity="charge",
+            scale=3.6,
+            offset=0.0,
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Discharged amount",
+        ),
+    )
+    remaining: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="remaining",
+            type="float32",
+            minimum=0,
+            maximum=1,
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Remaining capacity",
+        ),
+    )
+    scale: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="scale",
+            type="float32",
+            minimum=1,
+            maximum=None,
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Scaling factor to compensate for lower actuation power caused by voltage sag",
+        ),
+    )
+    time_remaining_s: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="time_remaining_s",
+            type="float32",
+            unit="s",
+            quantity="time",
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Predicted time remaining until battery is empty under previous averaged load",
+        ),
+    )
+    temperature: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="temperature",
+            type="float32",
+            unit="degC",
+            quantity="temperature",
+            scale=1.0,
+            offset=273.15,
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Temperature of the battery",
+        ),
+    )
+    cell_count: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="cell_count", type="uint8", invalid=0, invalid_text="0", doc="Number of cells")
+    )
+    source: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(name="source", type="uint8", enums=("uorb.BatteryStatus.SOURCE",), doc="Battery source"),
+    )
+    priority: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="priority",
+            type="uint8",
+            doc="Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1",
+        ),
+    )
+    capacity: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="capacity",
+            type="uint16",
+            unit="mAh",
+            quantity="charge",
+            scale=3.6,
+            offset=0.0,
+            doc="Capacity of the battery when fully charged",
+        ),
+    )
+    cycle_count: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="cycle_count", type="uint16", doc="Number of discharge cycles the battery has experienced"
+        ),
+    )
+    average_time_to_empty: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="average_time_to_empty",
+            type="uint16",
+            unit="min",
+            quantity="time",
+            scale=60.0,
+            offset=0.0,
+            doc="Predicted remaining battery capacity based on the average rate of discharge",
+        ),
+    )
+    manufacture_date: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="manufacture_date",
+            type="uint16",
+            doc="Manufacture date, part of serial number of the battery pack. Formatted as: Day "
+            "+ Month×32 + (Year–1980)×512",
+        ),
+    )
+    state_of_health: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="state_of_health",
+            type="uint16",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            minimum=0,
+            maximum=100,
+            doc="State of health. FullChargeCapacity/DesignCapacity",
+        ),
+    )
+    max_error: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="max_error",
+            type="uint16",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            minimum=1,
+            maximum=100,
+            doc="Max error, expected margin of error in the state-of-charge calculation",
+        ),
+    )
+    id: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="id",
+            type="uint8",
+            doc="ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed",
+        ),
+    )
+    interface_error: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="Interface error counter")
+    )
+    voltage_cell_v: list[float] = dataclasses.field(
+        default_factory=lambda: [0.0] * 14,
+        metadata=_m.meta(
+            name="voltage_cell_v",
+            type="float32[14]",
+            unit="V",
+            quantity="voltage",
+            invalid=0.0,
+            invalid_text="0",
+            per_element=True,
+            doc="Battery individual cell voltages",
+        ),
+    )
+    max_cell_voltage_delta: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="max_cell_voltage_delta", type="float32", doc="Max difference between individual cell voltages"
+        ),
+    )
+    is_powering_off: bool = dataclasses.field(
+        default=False,
+        metadata=_m.meta(
+            name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
+        ),
+    )
+    is_required: bool = dataclasses.field(
+        default=False,
+        metadata=_m.meta(
+            name="is_required", type="bool", doc="Set if the battery is explicitly required before arming"
+        ),
+    )
+    warning: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="warning", type="uint8", enums=("uorb.BatteryStatus.WARNING",), doc="Current battery warning"
+        ),
+    )
+    faults: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="faults",
+            type="uint16",
+            enums=("uorb.BatteryStatus.FAULT",),
+            doc="Smart battery supply status/fault flags (bitmask) for health indication",
+        ),
+    )
+    full_charge_capacity_wh: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="full_charge_capacity_wh",
+            type="float32",
+            unit="Wh",
+            quantity="energy",
+            scale=3600.0,
+            offset=0.0,
+            doc="Compensated battery capacity",
+        ),
+    )
+    remaining_capacity_wh: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="remaining_capacity_wh",
+            type="float32",
+            unit="Wh",
+            quantity="energy",
+            scale=3600.0,
+            offset=0.0,
+            doc="Compensated battery capacity remaining",
+        ),
+    )
+    over_discharge_count: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
+    )
+    nominal_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="nominal_voltage",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            doc="Nominal voltage of the battery pack",
+        ),
+    )
+    internal_resistance_estimate: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="internal_resistance_estimate",
+            type="float32",
+            unit="Ohm",
+            quantity="resistance",
+            doc="Internal resistance per cell estimate",
+        ),
+    )
+    ocv_estimate: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="ocv_estimate", type="float32", unit="V", quantity="voltage", doc="Open circuit voltage estimate"
+        ),
+    )
+    ocv_estimate_filtered: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="ocv_estimate_filtered",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            doc="Filtered open circuit voltage estimate",
+        ),
+    )
+    volt_based_soc_estimate: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="volt_based_soc_estimate",
+            type="float32",
+            minimum=0,
+            maximum=1,
+            doc="Normalized volt based state of charge estimate",
+        ),
+    )
+    voltage_prediction: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="voltage_prediction", type="float32", unit="V", quantity="voltage", doc="Predicted voltage"
+        ),
+    )
+    prediction_error: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Prediction error"),
+    )
+    estimation_covariance_norm: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(name="estimation_covariance_norm", type="float32", doc="Norm of the covariance matrix"),
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -295,138 +1293,190 @@ class BatteryStatus:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['timestamp'] = self.timestamp
-        out['connected'] = self.connected
-        out['voltage_v'] = self.voltage_v
-        out['current_a'] = self.current_a
-        out['current_average_a'] = self.current_average_a
-        out['discharged_mah'] = self.discharged_mah
-        out['remaining'] = self.remaining
-        out['scale'] = self.scale
-        out['time_remaining_s'] = self.time_remaining_s
-        out['temperature'] = self.temperature
-        out['cell_count'] = self.cell_count
-        out['source'] = self.source
-        out['priority'] = self.priority
-        out['capacity'] = self.capacity
-        out['cycle_count'] = self.cycle_count
-        out['average_time_to_empty'] = self.average_time_to_empty
-        out['manufacture_date'] = self.manufacture_date
-        out['state_of_health'] = self.state_of_health
-        out['max_error'] = self.max_error
-        out['id'] = self.id
-        out['interface_error'] = self.interface_error
-        out['voltage_cell_v'] = list(self.voltage_cell_v)
-        out['max_cell_voltage_delta'] = self.max_cell_voltage_delta
-        out['is_powering_off'] = self.is_powering_off
-        out['is_required'] = self.is_required
-        out['warning'] = self.warning
-        out['faults'] = self.faults
-        out['full_charge_capacity_wh'] = self.full_charge_capacity_wh
-        out['remaining_capacity_wh'] = self.remaining_capacity_wh
-        out['over_discharge_count'] = self.over_discharge_count
-        out['nominal_voltage'] = self.nominal_voltage
-        out['internal_resistance_estimate'] = self.internal_resistance_estimate
-        out['ocv_estimate'] = self.ocv_estimate
-        out['ocv_estimate_filtered'] = self.ocv_estimate_filtered
-        out['volt_based_soc_estimate'] = self.volt_based_soc_estimate
-        out['voltage_prediction'] = self.voltage_prediction
-        out['prediction_error'] = self.prediction_error
-        out['estimation_covariance_norm'] = self.estimation_covariance_norm
+        out["timestamp"] = self.timestamp
+        out["connected"] = self.connected
+        out["voltage_v"] = self.voltage_v
+        out["current_a"] = self.current_a
+        out["current_average_a"] = self.current_average_a
+        out["discharged_mah"] = self.discharged_mah
+        out["remaining"] = self.remaining
+        out["scale"] = self.scale
+        out["time_remaining_s"] = self.time_remaining_s
+        out["temperature"] = self.temperature
+        out["cell_count"] = self.cell_count
+        out["source"] = self.source
+        out["priority"] = self.priority
+        out["capacity"] = self.capacity
+        out["cycle_count"] = self.cycle_count
+        out["average_time_to_empty"] = self.average_time_to_empty
+        out["manufacture_date"] = self.manufacture_date
+        out["state_of_health"] = self.state_of_health
+        out["max_error"] = self.max_error
+        out["id"] = self.id
+        out["interface_error"] = self.interface_error
+        out["voltage_cell_v"] = list(self.voltage_cell_v)
+        out["max_cell_voltage_delta"] = self.max_cell_voltage_delta
+        out["is_powering_off"] = self.is_powering_off
+        out["is_required"] = self.is_required
+        out["warning"] = self.warning
+        out["faults"] = self.faults
+        out["full_charge_capacity_wh"] = self.full_charge_capacity_wh
+        out["remaining_capacity_wh"] = self.remaining_capacity_wh
+        out["over_discharge_count"] = self.over_discharge_count
+        out["nominal_voltage"] = self.nominal_voltage
+        out["internal_resistance_estimate"] = self.internal_resistance_estimate
+        out["ocv_estimate"] = self.ocv_estimate
+        out["ocv_estimate_filtered"] = self.ocv_estimate_filtered
+        out["volt_based_soc_estimate"] = self.volt_based_soc_estimate
+        out["voltage_prediction"] = self.voltage_prediction
+        out["prediction_error"] = self.prediction_error
+        out["estimation_covariance_norm"] = self.estimation_covariance_norm
         return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'timestamp', 'connected', 'voltage_v', 'current_a', 'current_average_a', 'discharged_mah', 'remaining', 'scale', 'time_remaining_s', 'temperature', 'cell_count', 'source', 'priority', 'capacity', 'cycle_count', 'average_time_to_empty', 'manufacture_date', 'state_of_health', 'max_error', 'id', 'interface_error', 'voltage_cell_v', 'max_cell_voltage_delta', 'is_powering_off', 'is_required', 'warning', 'faults', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'over_discharge_count', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm'}), (), 'BatteryStatus')
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "timestamp",
+                    "connected",
+                    "voltage_v",
+                    "current_a",
+                    "current_average_a",
+                    "discharged_mah",
+                    "remaining",
+                    "scale",
+                    "time_remaining_s",
+                    "temperature",
+                    "cell_count",
+                    "source",
+                    "priority",
+                    "capacity",
+                    "cycle_count",
+                    "average_time_to_empty",
+                    "manufacture_date",
+                    "state_of_health",
+                    "max_error",
+                    "id",
+                    "interface_error",
+                    "voltage_cell_v",
+                    "max_cell_voltage_delta",
+                    "is_powering_off",
+                    "is_required",
+                    "warning",
+                    "faults",
+                    "full_charge_capacity_wh",
+                    "remaining_capacity_wh",
+                    "over_discharge_count",
+                    "nominal_voltage",
+                    "internal_resistance_estimate",
+                    "ocv_estimate",
+                    "ocv_estimate_filtered",
+                    "volt_based_soc_estimate",
+                    "voltage_prediction",
+                    "prediction_error",
+                    "estimation_covariance_norm",
+                }
+            ),
+            (),
+            "BatteryStatus",
+        )
         obj = cls()
-        if 'timestamp' in data:
-            obj.timestamp = _m.as_int(data['timestamp'], 'timestamp')
-        if 'connected' in data:
-            obj.connected = _m.as_bool(data['connected'], 'connected')
-        if 'voltage_v' in data:
-            obj.voltage_v = _m.as_float(data['voltage_v'], 'voltage_v')
-        if 'current_a' in data:
-            obj.current_a = _m.as_float(data['current_a'], 'current_a')
-        if 'current_average_a' in data:
-            obj.current_average_a = _m.as_float(data['current_average_a'], 'current_average_a')
-        if 'discharged_mah' in data:
-            obj.discharged_mah = _m.as_float(data['discharged_mah'], 'discharged_mah')
-        if 'remaining' in data:
-            obj.remaining = _m.as_float(data['remaining'], 'remaining')
-        if 'scale' in data:
-            obj.scale = _m.as_float(data['scale'], 'scale')
-        if 'time_remaining_s' in data:
-            obj.time_remaining_s = _m.as_float(data['time_remaining_s'], 'time_remaining_s')
-        if 'temperature' in data:
-            obj.temperature = _m.as_float(data['temperature'], 'temperature')
-        if 'cell_count' in data:
-            obj.cell_count = _m.as_int(data['cell_count'], 'cell_count')
-        if 'source' in data:
-            obj.source = _m.as_int(data['source'], 'source')
-        if 'priority' in data:
-            obj.priority = _m.as_int(data['priority'], 'priority')
-        if 'capacity' in data:
-            obj.capacity = _m.as_int(data['capacity'], 'capacity')
-        if 'cycle_count' in data:
-            obj.cycle_count = _m.as_int(data['cycle_count'], 'cycle_count')
-        if 'average_time_to_empty' in data:
-            obj.average_time_to_empty = _m.as_int(data['average_time_to_empty'], 'average_time_to_empty')
-        if 'manufacture_date' in data:
-            obj.manufacture_date = _m.as_int(data['manufacture_date'], 'manufacture_date')
-        if 'state_of_health' in data:
-            obj.state_of_health = _m.as_int(data['state_of_health'], 'state_of_health')
-        if 'max_error' in data:
-            obj.max_error = _m.as_int(data['max_error'], 'max_error')
-        if 'id' in data:
-            obj.id = _m.as_int(data['id'], 'id')
-        if 'interface_error' in data:
-            obj.interface_error = _m.as_int(data['interface_error'], 'interface_error')
-        if 'voltage_cell_v' in data:
-            obj.voltage_cell_v = _m.as_list(data['voltage_cell_v'], 'voltage_cell_v', 14, True, lambda item, p: _m.as_float(item, p))
-        if 'max_cell_voltage_delta' in data:
-            obj.max_cell_voltage_delta = _m.as_float(data['max_cell_voltage_delta'], 'max_cell_voltage_delta')
-        if 'is_powering_off' in data:
-            obj.is_powering_off = _m.as_bool(data['is_powering_off'], 'is_powering_off')
-        if 'is_required' in data:
-            obj.is_required = _m.as_bool(data['is_required'], 'is_required')
-        if 'warning' in data:
-            obj.warning = _m.as_int(data['warning'], 'warning')
-        if 'faults' in data:
-            obj.faults = _m.as_int(data['faults'], 'faults')
-        if 'full_charge_capacity_wh' in data:
-            obj.full_charge_capacity_wh = _m.as_float(data['full_charge_capacity_wh'], 'full_charge_capacity_wh')
-        if 'remaining_capacity_wh' in data:
-            obj.remaining_capacity_wh = _m.as_float(data['remaining_capacity_wh'], 'remaining_capacity_wh')
-        if 'over_discharge_count' in data:
-            obj.over_discharge_count = _m.as_int(data['over_discharge_count'], 'over_discharge_count')
-        if 'nominal_voltage' in data:
-            obj.nominal_voltage = _m.as_float(data['nominal_voltage'], 'nominal_voltage')
-        if 'internal_resistance_estimate' in data:
-            obj.internal_resistance_estimate = _m.as_float(data['internal_resistance_estimate'], 'internal_resistance_estimate')
-        if 'ocv_estimate' in data:
-            obj.ocv_estimate = _m.as_float(data['ocv_estimate'], 'ocv_estimate')
-        if 'ocv_estimate_filtered' in data:
-            obj.ocv_estimate_filtered = _m.as_float(data['ocv_estimate_filtered'], 'ocv_estimate_filtered')
-        if 'volt_based_soc_estimate' in data:
-            obj.volt_based_soc_estimate = _m.as_float(data['volt_based_soc_estimate'], 'volt_based_soc_estimate')
-        if 'voltage_prediction' in data:
-            obj.voltage_prediction = _m.as_float(data['voltage_prediction'], 'voltage_prediction')
-        if 'prediction_error' in data:
-            obj.prediction_error = _m.as_float(data['prediction_error'], 'prediction_error')
-        if 'estimation_covariance_norm' in data:
-            obj.estimation_covariance_norm = _m.as_float(data['estimation_covariance_norm'], 'estimation_covariance_norm')
+        if "timestamp" in data:
+            obj.timestamp = _m.as_int(data["timestamp"], "timestamp")
+        if "connected" in data:
+            obj.connected = _m.as_bool(data["connected"], "connected")
+        if "voltage_v" in data:
+            obj.voltage_v = _m.as_float(data["voltage_v"], "voltage_v")
+        if "current_a" in data:
+            obj.current_a = _m.as_float(data["current_a"], "current_a")
+        if "current_average_a" in data:
+            obj.current_average_a = _m.as_float(data["current_average_a"], "current_average_a")
+        if "discharged_mah" in data:
+            obj.discharged_mah = _m.as_float(data["discharged_mah"], "discharged_mah")
+        if "remaining" in data:
+            obj.remaining = _m.as_float(data["remaining"], "remaining")
+        if "scale" in data:
+            obj.scale = _m.as_float(data["scale"], "scale")
+        if "time_remaining_s" in data:
+            obj.time_remaining_s = _m.as_float(data["time_remaining_s"], "time_remaining_s")
+        if "temperature" in data:
+            obj.temperature = _m.as_float(data["temperature"], "temperature")
+        if "cell_count" in data:
+            obj.cell_count = _m.as_int(data["cell_count"], "cell_count")
+        if "source" in data:
+            obj.source = _m.as_int(data["source"], "source")
+        if "priority" in data:
+            obj.priority = _m.as_int(data["priority"], "priority")
+        if "capacity" in data:
+            obj.capacity = _m.as_int(data["capacity"], "capacity")
+        if "cycle_count" in data:
+            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+        if "average_time_to_empty" in data:
+            obj.average_time_to_empty = _m.as_int(data["average_time_to_empty"], "average_time_to_empty")
+        if "manufacture_date" in data:
+            obj.manufacture_date = _m.as_int(data["manufacture_date"], "manufacture_date")
+        if "state_of_health" in data:
+            obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
+        if "max_error" in data:
+            obj.max_error = _m.as_int(data["max_error"], "max_error")
+        if "id" in data:
+            obj.id = _m.as_int(data["id"], "id")
+        if "interface_error" in data:
+            obj.interface_error = _m.as_int(data["interface_error"], "interface_error")
+        if "voltage_cell_v" in data:
+            obj.voltage_cell_v = _m.as_list(
+                data["voltage_cell_v"], "voltage_cell_v", 14, True, lambda item, p: _m.as_float(item, p)
+            )
+        if "max_cell_voltage_delta" in data:
+            obj.max_cell_voltage_delta = _m.as_float(data["max_cell_voltage_delta"], "max_cell_voltage_delta")
+        if "is_powering_off" in data:
+            obj.is_powering_off = _m.as_bool(data["is_powering_off"], "is_powering_off")
+        if "is_required" in data:
+            obj.is_required = _m.as_bool(data["is_required"], "is_required")
+        if "warning" in data:
+            obj.warning = _m.as_int(data["warning"], "warning")
+        if "faults" in data:
+            obj.faults = _m.as_int(data["faults"], "faults")
+        if "full_charge_capacity_wh" in data:
+            obj.full_charge_capacity_wh = _m.as_float(data["full_charge_capacity_wh"], "full_charge_capacity_wh")
+        if "remaining_capacity_wh" in data:
+            obj.remaining_capacity_wh = _m.as_float(data["remaining_capacity_wh"], "remaining_capacity_wh")
+        if "over_discharge_count" in data:
+            obj.over_discharge_count = _m.as_int(data["over_discharge_count"], "over_discharge_count")
+        if "nominal_voltage" in data:
+            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+        if "internal_resistance_estimate" in data:
+            obj.internal_resistance_estimate = _m.as_float(
+                data["internal_resistance_estimate"], "internal_resistance_estimate"
+            )
+        if "ocv_estimate" in data:
+            obj.ocv_estimate = _m.as_float(data["ocv_estimate"], "ocv_estimate")
+        if "ocv_estimate_filtered" in data:
+            obj.ocv_estimate_filtered = _m.as_float(data["ocv_estimate_filtered"], "ocv_estimate_filtered")
+        if "volt_based_soc_estimate" in data:
+            obj.volt_based_soc_estimate = _m.as_float(data["volt_based_soc_estimate"], "volt_based_soc_estimate")
+        if "voltage_prediction" in data:
+            obj.voltage_prediction = _m.as_float(data["voltage_prediction"], "voltage_prediction")
+        if "prediction_error" in data:
+            obj.prediction_error = _m.as_float(data["prediction_error"], "prediction_error")
+        if "estimation_covariance_norm" in data:
+            obj.estimation_covariance_norm = _m.as_float(
+                data["estimation_covariance_norm"], "estimation_covariance_norm"
+            )
         return obj
 
-    UORB_FORMAT: ClassVar[str] = '<Q33f9H?4B2?B2x'
+    UORB_FORMAT: ClassVar[str] = "<Q33f9H?4B2?B2x"
     UORB_SIZE: ClassVar[int] = 168
     UORB_SIZE_NO_PADDING: ClassVar[int] = 166
-    UORB_TOPICS: ClassVar[tuple[str, ...]] = ('battery_status',)
+    UORB_TOPICS: ClassVar[tuple[str, ...]] = ("battery_status",)
 
     def encode(self) -> bytes:
         """PX4's C struct of this message: 168 bytes, little-endian, padding zeroed."""
         try:
-            return _S_BatteryStatus.pack(
+            return _BATTERY_STATUS_STRUCT.pack(
                 self.timestamp,
                 self.voltage_v,
                 self.current_a,
@@ -467,14 +1517,16 @@ class BatteryStatus:
                 self.warning,
             )
         except (struct.error, TypeError, OverflowError) as exc:
-            raise _uorb.encode_error('BatteryStatus', self, _UC_BatteryStatus, exc) from None
+            raise _uorb.encode_error("BatteryStatus", self, _BATTERY_STATUS_PACKED_FIELDS, exc) from None
 
     @classmethod
     def decode(cls, data: bytes) -> BatteryStatus:
         """From PX4's C struct: 168 bytes (or 166 without the trailing padding)."""
         if len(data) != 168 and len(data) != 166:
-            raise _uorb.DecodeError('BatteryStatus: expected 168 bytes (or 166 without the trailing padding), got ' + str(len(data)))
-        v = _SD_BatteryStatus.unpack_from(data)
+            raise _uorb.DecodeError(
+                "BatteryStatus: expected 168 bytes (or 166 without the trailing padding), got " + str(len(data))
+            )
+        v = _BATTERY_STATUS_UNPADDED.unpack_from(data)
         o = cls.__new__(cls)
         o.timestamp = v[0]
         o.voltage_v = v[1]
@@ -532,56 +1584,56 @@ class BatteryStatus:
         numpy arrays when numpy is installed (``use_numpy`` None) or required (True; views
         into ``buffer`` unless ``copy``), else lists from ``struct.iter_unpack``.
         """
-        return _COL_BatteryStatus.decode(buffer, stride, use_numpy=use_numpy, copy=copy)
+        return _BATTERY_STATUS_COLUMNS.decode(buffer, stride, use_numpy=use_numpy, copy=copy)
 
     @classmethod
     def ulog_format(cls) -> _ulog.Format:
         """The ULog format PX4's logger writes for this struct (nested formats attached)."""
         return _ulog.Format(
-            'battery_status',
+            "battery_status",
             (
-                _ulog.Member('uint64_t', 0, 'timestamp', 'timestamp', 'scalar'),
-                _ulog.Member('float', 0, 'voltage_v', 'voltage_v', 'scalar'),
-                _ulog.Member('float', 0, 'current_a', 'current_a', 'scalar'),
-                _ulog.Member('float', 0, 'current_average_a', 'current_average_a', 'scalar'),
-                _ulog.Member('float', 0, 'discharged_mah', 'discharged_mah', 'scalar'),
-                _ulog.Member('float', 0, 'remaining', 'remaining', 'scalar'),
-                _ulog.Member('float', 0, 'scale', 'scale', 'scalar'),
-                _ulog.Member('float', 0, 'time_remaining_s', 'time_remaining_s', 'scalar'),
-                _ulog.Member('float', 0, 'temperature', 'temperature', 'scalar'),
-                _ulog.Member('float', 14, 'voltage_cell_v', 'voltage_cell_v', 'array'),
-                _ulog.Member('float', 0, 'max_cell_voltage_delta', 'max_cell_voltage_delta', 'scalar'),
-                _ulog.Member('float', 0, 'full_charge_capacity_wh', 'full_charge_capacity_wh', 'scalar'),
-                _ulog.Member('float', 0, 'remaining_capacity_wh', 'remaining_capacity_wh', 'scalar'),
-                _ulog.Member('float', 0, 'nominal_voltage', 'nominal_voltage', 'scalar'),
-                _ulog.Member('float', 0, 'internal_resistance_estimate', 'internal_resistance_estimate', 'scalar'),
-                _ulog.Member('float', 0, 'ocv_estimate', 'ocv_estimate', 'scalar'),
-                _ulog.Member('float', 0, 'ocv_estimate_filtered', 'ocv_estimate_filtered', 'scalar'),
-                _ulog.Member('float', 0, 'volt_based_soc_estimate', 'volt_based_soc_estimate', 'scalar'),
-                _ulog.Member('float', 0, 'voltage_prediction', 'voltage_prediction', 'scalar'),
-                _ulog.Member('float', 0, 'prediction_error', 'prediction_error', 'scalar'),
-                _ulog.Member('float', 0, 'estimation_covariance_norm', 'estimation_covariance_norm', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'capacity', 'capacity', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'cycle_count', 'cycle_count', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'average_time_to_empty', 'average_time_to_empty', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'manufacture_date', 'manufacture_date', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'state_of_health', 'state_of_health', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'max_error', 'max_error', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'interface_error', 'interface_error', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'faults', 'faults', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'over_discharge_count', 'over_discharge_count', 'scalar'),
-                _ulog.Member('bool', 0, 'connected', 'connected', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'cell_count', 'cell_count', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'source', 'source', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'priority', 'priority', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'id', 'id', 'scalar'),
-                _ulog.Member('bool', 0, 'is_powering_off', 'is_powering_off', 'scalar'),
-                _ulog.Member('bool', 0, 'is_required', 'is_required', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'warning', 'warning', 'scalar'),
-                _ulog.Member('uint8_t', 2, '_padding0'),
+                _ulog.Member("uint64_t", 0, "timestamp", "timestamp", "scalar"),
+                _ulog.Member("float", 0, "voltage_v", "voltage_v", "scalar"),
+                _ulog.Member("float", 0, "current_a", "current_a", "scalar"),
+                _ulog.Member("float", 0, "current_average_a", "current_average_a", "scalar"),
+                _ulog.Member("float", 0, "discharged_mah", "discharged_mah", "scalar"),
+                _ulog.Member("float", 0, "remaining", "remaining", "scalar"),
+                _ulog.Member("float", 0, "scale", "scale", "scalar"),
+                _ulog.Member("float", 0, "time_remaining_s", "time_remaining_s", "scalar"),
+                _ulog.Member("float", 0, "temperature", "temperature", "scalar"),
+                _ulog.Member("float", 14, "voltage_cell_v", "voltage_cell_v", "array"),
+                _ulog.Member("float", 0, "max_cell_voltage_delta", "max_cell_voltage_delta", "scalar"),
+                _ulog.Member("float", 0, "full_charge_capacity_wh", "full_charge_capacity_wh", "scalar"),
+                _ulog.Member("float", 0, "remaining_capacity_wh", "remaining_capacity_wh", "scalar"),
+                _ulog.Member("float", 0, "nominal_voltage", "nominal_voltage", "scalar"),
+                _ulog.Member("float", 0, "internal_resistance_estimate", "internal_resistance_estimate", "scalar"),
+                _ulog.Member("float", 0, "ocv_estimate", "ocv_estimate", "scalar"),
+                _ulog.Member("float", 0, "ocv_estimate_filtered", "ocv_estimate_filtered", "scalar"),
+                _ulog.Member("float", 0, "volt_based_soc_estimate", "volt_based_soc_estimate", "scalar"),
+                _ulog.Member("float", 0, "voltage_prediction", "voltage_prediction", "scalar"),
+                _ulog.Member("float", 0, "prediction_error", "prediction_error", "scalar"),
+                _ulog.Member("float", 0, "estimation_covariance_norm", "estimation_covariance_norm", "scalar"),
+                _ulog.Member("uint16_t", 0, "capacity", "capacity", "scalar"),
+                _ulog.Member("uint16_t", 0, "cycle_count", "cycle_count", "scalar"),
+                _ulog.Member("uint16_t", 0, "average_time_to_empty", "average_time_to_empty", "scalar"),
+                _ulog.Member("uint16_t", 0, "manufacture_date", "manufacture_date", "scalar"),
+                _ulog.Member("uint16_t", 0, "state_of_health", "state_of_health", "scalar"),
+                _ulog.Member("uint16_t", 0, "max_error", "max_error", "scalar"),
+                _ulog.Member("uint16_t", 0, "interface_error", "interface_error", "scalar"),
+                _ulog.Member("uint16_t", 0, "faults", "faults", "scalar"),
+                _ulog.Member("uint16_t", 0, "over_discharge_count", "over_discharge_count", "scalar"),
+                _ulog.Member("bool", 0, "connected", "connected", "scalar"),
+                _ulog.Member("uint8_t", 0, "cell_count", "cell_count", "scalar"),
+                _ulog.Member("uint8_t", 0, "source", "source", "scalar"),
+                _ulog.Member("uint8_t", 0, "priority", "priority", "scalar"),
+                _ulog.Member("uint8_t", 0, "id", "id", "scalar"),
+                _ulog.Member("bool", 0, "is_powering_off", "is_powering_off", "scalar"),
+                _ulog.Member("bool", 0, "is_required", "is_required", "scalar"),
+                _ulog.Member("uint8_t", 0, "warning", "warning", "scalar"),
+                _ulog.Member("uint8_t", 2, "_padding0"),
             ),
             cls,
-            ('battery_status',),
+            ("battery_status",),
             1,
         )
 
@@ -609,227 +1661,299 @@ class BatteryStatus:
         r_voltage_cell_v: Any
         v_i: Any
         try:
-            if (self.timestamp & -18446744073709551616):
-                _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryStatus_timestamp)
+            if self.timestamp & -18446744073709551616:
+                _v.diag(out, "timestamp", self.timestamp, _VS_BatteryStatus_timestamp)
         except _v.SLOW:
-            _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryStatus_timestamp)
+            _v.diag(out, "timestamp", self.timestamp, _VS_BatteryStatus_timestamp)
         try:
             x = self.connected
-            if (x is not True and x is not False):
-                _v.diag(out, 'connected', self.connected, _VS_BatteryStatus_connected)
+            if x is not True and x is not False:
+                _v.diag(out, "connected", self.connected, _VS_BatteryStatus_connected)
         except _v.SLOW:
-            _v.diag(out, 'connected', self.connected, _VS_BatteryStatus_connected)
+            _v.diag(out, "connected", self.connected, _VS_BatteryStatus_connected)
         try:
-            if (not (-3.4028234663852886e+38 <= self.voltage_v <= 3.4028234663852886e+38)):
-                _v.diag(out, 'voltage_v', self.voltage_v, _VS_BatteryStatus_voltage_v)
+            if not (-3.4028234663852886e38 <= self.voltage_v <= 3.4028234663852886e38):
+                _v.diag(out, "voltage_v", self.voltage_v, _VS_BatteryStatus_voltage_v)
         except _v.SLOW:
-            _v.diag(out, 'voltage_v', self.voltage_v, _VS_BatteryStatus_voltage_v)
+            _v.diag(out, "voltage_v", self.voltage_v, _VS_BatteryStatus_voltage_v)
         try:
-            if (not (-3.4028234663852886e+38 <= self.current_a <= 3.4028234663852886e+38)):
-                _v.diag(out, 'current_a', self.current_a, _VS_BatteryStatus_current_a)
+            if not (-3.4028234663852886e38 <= self.current_a <= 3.4028234663852886e38):
+                _v.diag(out, "current_a", self.current_a, _VS_BatteryStatus_current_a)
         except _v.SLOW:
-            _v.diag(out, 'current_a', self.current_a, _VS_BatteryStatus_current_a)
+            _v.diag(out, "current_a", self.current_a, _VS_BatteryStatus_current_a)
         try:
-            if (not (-3.4028234663852886e+38 <= self.current_average_a <= 3.4028234663852886e+38)):
-                _v.diag(out, 'current_average_a', self.current_average_a, _VS_BatteryStatus_current_average_a)
+            if not (-3.4028234663852886e38 <= self.current_average_a <= 3.4028234663852886e38):
+                _v.diag(out, "current_average_a", self.current_average_a, _VS_BatteryStatus_current_average_a)
         except _v.SLOW:
-            _v.diag(out, 'current_average_a', self.current_average_a, _VS_BatteryStatus_current_average_a)
+            _v.diag(out, "current_average_a", self.current_average_a, _VS_BatteryStatus_current_average_a)
         try:
-            if (not (-3.4028234663852886e+38 <= self.discharged_mah <= 3.4028234663852886e+38)):
-                _v.diag(out, 'discharged_mah', self.discharged_mah, _VS_BatteryStatus_discharged_mah)
+            if not (-3.4028234663852886e38 <= self.discharged_mah <= 3.4028234663852886e38):
+                _v.diag(out, "discharged_mah", self.discharged_mah, _VS_BatteryStatus_discharged_mah)
         except _v.SLOW:
-            _v.diag(out, 'discharged_mah', self.discharged_mah, _VS_BatteryStatus_discharged_mah)
+            _v.diag(out, "discharged_mah", self.discharged_mah, _VS_BatteryStatus_discharged_mah)
         try:
             x = self.remaining
-            if (not (0.0 <= x <= 1.0) and x != -1.0):
-                _v.diag(out, 'remaining', self.remaining, _VS_BatteryStatus_remaining)
+            if not (0.0 <= x <= 1.0) and x != -1.0:
+                _v.diag(out, "remaining", self.remaining, _VS_BatteryStatus_remaining)
         except _v.SLOW:
-            _v.diag(out, 'remaining', self.remaining, _VS_BatteryStatus_remaining)
+            _v.diag(out, "remaining", self.remaining, _VS_BatteryStatus_remaining)
         try:
             x = self.scale
-            if (not (1.0 <= x <= 3.4028234663852886e+38) and x != -1.0):
-                _v.diag(out, 'scale', self.scale, _VS_BatteryStatus_scale)
+            if not (1.0 <= x <= 3.4028234663852886e38) and x != -1.0:
+                _v.diag(out, "scale", self.scale, _VS_BatteryStatus_scale)
         except _v.SLOW:
-            _v.diag(out, 'scale', self.scale, _VS_BatteryStatus_scale)
+            _v.diag(out, "scale", self.scale, _VS_BatteryStatus_scale)
         try:
             x = self.time_remaining_s
-            if (not (-3.4028234663852886e+38 <= x <= 3.4028234663852886e+38) and x == x):
-                _v.diag(out, 'time_remaining_s', self.time_remaining_s, _VS_BatteryStatus_time_remaining_s)
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "time_remaining_s", self.time_remaining_s, _VS_BatteryStatus_time_remaining_s)
         except _v.SLOW:
-            _v.diag(out, 'time_remaining_s', self.time_remaining_s, _VS_BatteryStatus_time_remaining_s)
+            _v.diag(out, "time_remaining_s", self.time_remaining_s, _VS_BatteryStatus_time_remaining_s)
         try:
             x = self.temperature
-            if (not (-3.4028234663852886e+38 <= x <= 3.4028234663852886e+38) and x == x):
-                _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatus_temperature)
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "temperature", self.temperature, _VS_BatteryStatus_temperature)
         except _v.SLOW:
-            _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatus_temperature)
+            _v.diag(out, "temperature", self.temperature, _VS_BatteryStatus_temperature)
         try:
-            if (self.cell_count & -256):
-                _v.diag(out, 'cell_count', self.cell_count, _VS_BatteryStatus_cell_count)
+            if self.cell_count & -256:
+                _v.diag(out, "cell_count", self.cell_count, _VS_BatteryStatus_cell_count)
         except _v.SLOW:
-            _v.diag(out, 'cell_count', self.cell_count, _VS_BatteryStatus_cell_count)
+            _v.diag(out, "cell_count", self.cell_count, _VS_BatteryStatus_cell_count)
         try:
-            if (self.source not in {0, 1, 2}):
-                _v.diag(out, 'source', self.source, _VS_BatteryStatus_source)
+            if self.source not in {0, 1, 2}:
+                _v.diag(out, "source", self.source, _VS_BatteryStatus_source)
         except _v.SLOW:
-            _v.diag(out, 'source', self.source, _VS_BatteryStatus_source)
+            _v.diag(out, "source", self.source, _VS_BatteryStatus_source)
         try:
-            if (self.priority & -256):
-                _v.diag(out, 'priority', self.priority, _VS_BatteryStatus_priority)
+            if self.priority & -256:
+                _v.diag(out, "priority", self.priority, _VS_BatteryStatus_priority)
         except _v.SLOW:
-            _v.diag(out, 'priority', self.priority, _VS_BatteryStatus_priority)
+            _v.diag(out, "priority", self.priority, _VS_BatteryStatus_priority)
         try:
-            if (self.capacity & -65536):
-                _v.diag(out, 'capacity', self.capacity, _VS_BatteryStatus_capacity)
+            if self.capacity & -65536:
+                _v.diag(out, "capacity", self.capacity, _VS_BatteryStatus_capacity)
         except _v.SLOW:
-            _v.diag(out, 'capacity', self.capacity, _VS_BatteryStatus_capacity)
+            _v.diag(out, "capacity", self.capacity, _VS_BatteryStatus_capacity)
         try:
-            if (self.cycle_count & -65536):
-                _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryStatus_cycle_count)
+            if self.cycle_count & -65536:
+                _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryStatus_cycle_count)
         except _v.SLOW:
-            _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryStatus_cycle_count)
+            _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryStatus_cycle_count)
         try:
-            if (self.average_time_to_empty & -65536):
-                _v.diag(out, 'average_time_to_empty', self.average_time_to_empty, _VS_BatteryStatus_average_time_to_empty)
+            if self.average_time_to_empty & -65536:
+                _v.diag(
+                    out, "average_time_to_empty", self.average_time_to_empty, _VS_BatteryStatus_average_time_to_empty
+                )
         except _v.SLOW:
-            _v.diag(out, 'average_time_to_empty', self.average_time_to_empty, _VS_BatteryStatus_average_time_to_empty)
+            _v.diag(out, "average_time_to_empty", self.average_time_to_empty, _VS_BatteryStatus_average_time_to_empty)
         try:
-            if (self.manufacture_date & -65536):
-                _v.diag(out, 'manufacture_date', self.manufacture_date, _VS_BatteryStatus_manufacture_date)
+            if self.manufacture_date & -65536:
+                _v.diag(out, "manufacture_date", self.manufacture_date, _VS_BatteryStatus_manufacture_date)
         except _v.SLOW:
-            _v.diag(out, 'manufacture_date', self.manufacture_date, _VS_BatteryStatus_manufacture_date)
+            _v.diag(out, "manufacture_date", self.manufacture_date, _VS_BatteryStatus_manufacture_date)
         try:
             x = self.state_of_health
-            if (x & -65536 or not (0 <= x <= 100)):
-                _v.diag(out, 'state_of_health', self.state_of_health, _VS_BatteryStatus_state_of_health)
+            if x & -65536 or not (0 <= x <= 100):
+                _v.diag(out, "state_of_health", self.state_of_health, _VS_BatteryStatus_state_of_health)
         except _v.SLOW:
-            _v.diag(out, 'state_of_health', self.state_of_health, _VS_BatteryStatus_state_of_health)
+            _v.diag(out, "state_of_health", self.state_of_health, _VS_BatteryStatus_state_of_health)
         try:
             x = self.max_error
-            if (x & -65536 or not (1 <= x <= 100)):
-                _v.diag(out, 'max_error', self.max_error, _VS_BatteryStatus_max_error)
+            if x & -65536 or not (1 <= x <= 100):
+                _v.diag(out, "max_error", self.max_error, _VS_BatteryStatus_max_error)
         except _v.SLOW:
-            _v.diag(out, 'max_error', self.max_error, _VS_BatteryStatus_max_error)
+            _v.diag(out, "max_error", self.max_error, _VS_BatteryStatus_max_error)
         try:
-            if (self.id & -256):
-                _v.diag(out, 'id', self.id, _VS_BatteryStatus_id)
+            if self.id & -256:
+                _v.diag(out, "id", self.id, _VS_BatteryStatus_id)
         except _v.SLOW:
-            _v.diag(out, 'id', self.id, _VS_BatteryStatus_id)
+            _v.diag(out, "id", self.id, _VS_BatteryStatus_id)
         try:
-            if (self.interface_error & -65536):
-                _v.diag(out, 'interface_error', self.interface_error, _VS_BatteryStatus_interface_error)
+            if self.interface_error & -65536:
+                _v.diag(out, "interface_error", self.interface_error, _VS_BatteryStatus_interface_error)
         except _v.SLOW:
-            _v.diag(out, 'interface_error', self.interface_error, _VS_BatteryStatus_interface_error)
+            _v.diag(out, "interface_error", self.interface_error, _VS_BatteryStatus_interface_error)
         try:
             a = self.voltage_cell_v
             if len(a) != 14:
-                _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
+                _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
             else:
                 for e in a:
-                    if (not (-3.4028234663852886e+38 <= e <= 3.4028234663852886e+38)):
-                        _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
+                    if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
+                        _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
                         break
         except _v.SLOW:
-            _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
+            _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
         try:
-            if (not (-3.4028234663852886e+38 <= self.max_cell_voltage_delta <= 3.4028234663852886e+38)):
-                _v.diag(out, 'max_cell_voltage_delta', self.max_cell_voltage_delta, _VS_BatteryStatus_max_cell_voltage_delta)
+            if not (-3.4028234663852886e38 <= self.max_cell_voltage_delta <= 3.4028234663852886e38):
+                _v.diag(
+                    out, "max_cell_voltage_delta", self.max_cell_voltage_delta, _VS_BatteryStatus_max_cell_voltage_delta
+                )
         except _v.SLOW:
-            _v.diag(out, 'max_cell_voltage_delta', self.max_cell_voltage_delta, _VS_BatteryStatus_max_cell_voltage_delta)
+            _v.diag(
+                out, "max_cell_voltage_delta", self.max_cell_voltage_delta, _VS_BatteryStatus_max_cell_voltage_delta
+            )
         try:
             x = self.is_powering_off
-            if (x is not True and x is not False):
-                _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryStatus_is_powering_off)
+            if x is not True and x is not False:
+                _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryStatus_is_powering_off)
         except _v.SLOW:
-            _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryStatus_is_powering_off)
+            _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryStatus_is_powering_off)
         try:
             x = self.is_required
-            if (x is not True and x is not False):
-                _v.diag(out, 'is_required', self.is_required, _VS_BatteryStatus_is_required)
+            if x is not True and x is not False:
+                _v.diag(out, "is_required", self.is_required, _VS_BatteryStatus_is_required)
         except _v.SLOW:
-            _v.diag(out, 'is_required', self.is_required, _VS_BatteryStatus_is_required)
+            _v.diag(out, "is_required", self.is_required, _VS_BatteryStatus_is_required)
         try:
-            if (self.warning not in {0, 1, 2, 3, 4, 6, 7}):
-                _v.diag(out, 'warning', self.warning, _VS_BatteryStatus_warning)
+            if self.warning not in {0, 1, 2, 3, 4, 6, 7}:
+                _v.diag(out, "warning", self.warning, _VS_BatteryStatus_warning)
         except _v.SLOW:
-            _v.diag(out, 'warning', self.warning, _VS_BatteryStatus_warning)
+            _v.diag(out, "warning", self.warning, _VS_BatteryStatus_warning)
         try:
-            if (self.faults & -2048):
-                _v.diag(out, 'faults', self.faults, _VS_BatteryStatus_faults)
+            if self.faults & -2048:
+                _v.diag(out, "faults", self.faults, _VS_BatteryStatus_faults)
         except _v.SLOW:
-            _v.diag(out, 'faults', self.faults, _VS_BatteryStatus_faults)
+            _v.diag(out, "faults", self.faults, _VS_BatteryStatus_faults)
         try:
-            if (not (-3.4028234663852886e+38 <= self.full_charge_capacity_wh <= 3.4028234663852886e+38)):
-                _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryStatus_full_charge_capacity_wh)
+            if not (-3.4028234663852886e38 <= self.full_charge_capacity_wh <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "full_charge_capacity_wh",
+                    self.full_charge_capacity_wh,
+                    _VS_BatteryStatus_full_charge_capacity_wh,
+                )
         except _v.SLOW:
-            _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryStatus_full_charge_capacity_wh)
+            _v.diag(
+                out, "full_charge_capacity_wh", self.full_charge_capacity_wh, _VS_BatteryStatus_full_charge_capacity_wh
+            )
         try:
-            if (not (-3.4028234663852886e+38 <= self.remaining_capacity_wh <= 3.4028234663852886e+38)):
-                _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryStatus_remaining_capacity_wh)
+            if not (-3.4028234663852886e38 <= self.remaining_capacity_wh <= 3.4028234663852886e38):
+                _v.diag(
+                    out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryStatus_remaining_capacity_wh
+                )
         except _v.SLOW:
-            _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryStatus_remaining_capacity_wh)
+            _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryStatus_remaining_capacity_wh)
         try:
-            if (self.over_discharge_count & -65536):
-                _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryStatus_over_discharge_count)
+            if self.over_discharge_count & -65536:
+                _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryStatus_over_discharge_count)
         except _v.SLOW:
-            _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryStatus_over_discharge_count)
+            _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryStatus_over_discharge_count)
         try:
-            if (not (-3.4028234663852886e+38 <= self.nominal_voltage <= 3.4028234663852886e+38)):
-                _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryStatus_nominal_voltage)
+            if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
+                _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryStatus_nominal_voltage)
         except _v.SLOW:
-            _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryStatus_nominal_voltage)
+            _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryStatus_nominal_voltage)
         try:
-            if (not (-3.4028234663852886e+38 <= self.internal_resistance_estimate <= 3.4028234663852886e+38)):
-                _v.diag(out, 'internal_resistance_estimate', self.internal_resistance_estimate, _VS_BatteryStatus_internal_resistance_estimate)
+            if not (-3.4028234663852886e38 <= self.internal_resistance_estimate <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "internal_resistance_estimate",
+                    self.internal_resistance_estimate,
+                    _VS_BatteryStatus_internal_resistance_estimate,
+                )
         except _v.SLOW:
-            _v.diag(out, 'internal_resistance_estimate', self.internal_resistance_estimate, _VS_BatteryStatus_internal_resistance_estimate)
+            _v.diag(
+                out,
+                "internal_resistance_estimate",
+                self.internal_resistance_estimate,
+                _VS_BatteryStatus_internal_resistance_estimate,
+            )
         try:
-            if (not (-3.4028234663852886e+38 <= self.ocv_estimate <= 3.4028234663852886e+38)):
-                _v.diag(out, 'ocv_estimate', self.ocv_estimate, _VS_BatteryStatus_ocv_estimate)
+            if not (-3.4028234663852886e38 <= self.ocv_estimate <= 3.4028234663852886e38):
+                _v.diag(out, "ocv_estimate", self.ocv_estimate, _VS_BatteryStatus_ocv_estimate)
         except _v.SLOW:
-            _v.diag(out, 'ocv_estimate', self.ocv_estimate, _VS_BatteryStatus_ocv_estimate)
+            _v.diag(out, "ocv_estimate", self.ocv_estimate, _VS_BatteryStatus_ocv_estimate)
         try:
-            if (not (-3.4028234663852886e+38 <= self.ocv_estimate_filtered <= 3.4028234663852886e+38)):
-                _v.diag(out, 'ocv_estimate_filtered', self.ocv_estimate_filtered, _VS_BatteryStatus_ocv_estimate_filtered)
+            if not (-3.4028234663852886e38 <= self.ocv_estimate_filtered <= 3.4028234663852886e38):
+                _v.diag(
+                    out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _VS_BatteryStatus_ocv_estimate_filtered
+                )
         except _v.SLOW:
-            _v.diag(out, 'ocv_estimate_filtered', self.ocv_estimate_filtered, _VS_BatteryStatus_ocv_estimate_filtered)
+            _v.diag(out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _VS_BatteryStatus_ocv_estimate_filtered)
         try:
-            if (not (0.0 <= self.volt_based_soc_estimate <= 1.0)):
-                _v.diag(out, 'volt_based_soc_estimate', self.volt_based_soc_estimate, _VS_BatteryStatus_volt_based_soc_estimate)
+            if not (0.0 <= self.volt_based_soc_estimate <= 1.0):
+                _v.diag(
+                    out,
+                    "volt_based_soc_estimate",
+                    self.volt_based_soc_estimate,
+                    _VS_BatteryStatus_volt_based_soc_estimate,
+                )
         except _v.SLOW:
-            _v.diag(out, 'volt_based_soc_estimate', self.volt_based_soc_estimate, _VS_BatteryStatus_volt_based_soc_estimate)
+            _v.diag(
+                out, "volt_based_soc_estimate", self.volt_based_soc_estimate, _VS_BatteryStatus_volt_based_soc_estimate
+            )
         try:
-            if (not (-3.4028234663852886e+38 <= self.voltage_prediction <= 3.4028234663852886e+38)):
-                _v.diag(out, 'voltage_prediction', self.voltage_prediction, _VS_BatteryStatus_voltage_prediction)
+            if not (-3.4028234663852886e38 <= self.voltage_prediction <= 3.4028234663852886e38):
+                _v.diag(out, "voltage_prediction", self.voltage_prediction, _VS_BatteryStatus_voltage_prediction)
         except _v.SLOW:
-            _v.diag(out, 'voltage_prediction', self.voltage_prediction, _VS_BatteryStatus_voltage_prediction)
+            _v.diag(out, "voltage_prediction", self.voltage_prediction, _VS_BatteryStatus_voltage_prediction)
         try:
-            if (not (-3.4028234663852886e+38 <= self.prediction_error <= 3.4028234663852886e+38)):
-                _v.diag(out, 'prediction_error', self.prediction_error, _VS_BatteryStatus_prediction_error)
+            if not (-3.4028234663852886e38 <= self.prediction_error <= 3.4028234663852886e38):
+                _v.diag(out, "prediction_error", self.prediction_error, _VS_BatteryStatus_prediction_error)
         except _v.SLOW:
-            _v.diag(out, 'prediction_error', self.prediction_error, _VS_BatteryStatus_prediction_error)
+            _v.diag(out, "prediction_error", self.prediction_error, _VS_BatteryStatus_prediction_error)
         try:
-            if (not (-3.4028234663852886e+38 <= self.estimation_covariance_norm <= 3.4028234663852886e+38)):
-                _v.diag(out, 'estimation_covariance_norm', self.estimation_covariance_norm, _VS_BatteryStatus_estimation_covariance_norm)
+            if not (-3.4028234663852886e38 <= self.estimation_covariance_norm <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "estimation_covariance_norm",
+                    self.estimation_covariance_norm,
+                    _VS_BatteryStatus_estimation_covariance_norm,
+                )
         except _v.SLOW:
-            _v.diag(out, 'estimation_covariance_norm', self.estimation_covariance_norm, _VS_BatteryStatus_estimation_covariance_norm)
+            _v.diag(
+                out,
+                "estimation_covariance_norm",
+                self.estimation_covariance_norm,
+                _VS_BatteryStatus_estimation_covariance_norm,
+            )
         # rule cell-count-capacity (uorb-battery-status.yaml:5)
         try:
             r_cell_count = self.cell_count
             r_voltage_cell_v = self.voltage_cell_v
             if not (r_cell_count <= len(r_voltage_cell_v)):
-                out.append(_v.rule('cell_count', 'cell-count-capacity', r_cell_count, 'cell_count <= len(voltage_cell_v)', 'cell_count = ' + _v.fmt(r_cell_count) + ' is above the ' + _v.fmt(len(r_voltage_cell_v)) + ' cells voltage_cell_v can hold', 'error'))
+                out.append(
+                    _v.rule(
+                        "cell_count",
+                        "cell-count-capacity",
+                        r_cell_count,
+                        "cell_count <= len(voltage_cell_v)",
+                        "cell_count = "
+                        + _v.fmt(r_cell_count)
+                        + " is above the "
+                        + _v.fmt(len(r_voltage_cell_v))
+                        + " cells voltage_cell_v can hold",
+                        "error",
+                    )
+                )
         except _v.SLOW:
             pass  # the field checks report the cause
         # rule cells-beyond-count-zero (uorb-battery-status.yaml:11)
         try:
             r_cell_count = self.cell_count
             r_voltage_cell_v = self.voltage_cell_v
-            if (r_cell_count != 0):
+            if r_cell_count != 0:
                 for v_i in range(r_cell_count, len(r_voltage_cell_v)):
                     try:
                         if not (r_voltage_cell_v[v_i] == 0):
-                            out.append(_v.rule('voltage_cell_v' + '[' + str(v_i) + ']', 'cells-beyond-count-zero', r_voltage_cell_v[v_i], 'voltage_cell_v[i] == 0', 'voltage_cell_v[' + _v.fmt(v_i) + '] = ' + _v.fmt(r_voltage_cell_v[v_i]) + ' V but the battery has only ' + _v.fmt(r_cell_count) + ' cells; expected 0', 'error'))
+                            out.append(
+                                _v.rule(
+                                    "voltage_cell_v" + "[" + str(v_i) + "]",
+                                    "cells-beyond-count-zero",
+                                    r_voltage_cell_v[v_i],
+                                    "voltage_cell_v[i] == 0",
+                                    "voltage_cell_v["
+                                    + _v.fmt(v_i)
+                                    + "] = "
+                                    + _v.fmt(r_voltage_cell_v[v_i])
+                                    + " V but the battery has only "
+                                    + _v.fmt(r_cell_count)
+                                    + " cells; expected 0",
+                                    "error",
+                                )
+                            )
                     except _v.SLOW:
                         pass
         except _v.SLOW:
@@ -840,34 +1964,63 @@ class BatteryStatus:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'uorb.BatteryStatus')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "uorb.BatteryStatus")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field == 'voltage_v':
+        if field == "voltage_v":
             return self.voltage_v != 0.0
-        if field == 'current_a':
+        if field == "current_a":
             return self.current_a != -1.0
-        if field == 'current_average_a':
+        if field == "current_average_a":
             return self.current_average_a != -1.0
-        if field == 'discharged_mah':
+        if field == "discharged_mah":
             return self.discharged_mah != -1.0
-        if field == 'remaining':
+        if field == "remaining":
             return self.remaining != -1.0
-        if field == 'scale':
+        if field == "scale":
             return self.scale != -1.0
-        if field == 'time_remaining_s':
+        if field == "time_remaining_s":
             return self.time_remaining_s == self.time_remaining_s
-        if field == 'temperature':
+        if field == "temperature":
             return self.temperature == self.temperature
-        if field == 'cell_count':
+        if field == "cell_count":
             return self.cell_count != 0
-        if field == 'voltage_cell_v':
+        if field == "voltage_cell_v":
             return any(e != 0.0 for e in self.voltage_cell_v)
-        if field in {'timestamp', 'connected', 'source', 'priority', 'capacity', 'cycle_count', 'average_time_to_empty', 'manufacture_date', 'state_of_health', 'max_error', 'id', 'interface_error', 'max_cell_voltage_delta', 'is_powering_off', 'is_required', 'warning', 'faults', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'over_discharge_count', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm'}:
+        if field in {
+            "timestamp",
+            "connected",
+            "source",
+            "priority",
+            "capacity",
+            "cycle_count",
+            "average_time_to_empty",
+            "manufacture_date",
+            "state_of_health",
+            "max_error",
+            "id",
+            "interface_error",
+            "max_cell_voltage_delta",
+            "is_powering_off",
+            "is_required",
+            "warning",
+            "faults",
+            "full_charge_capacity_wh",
+            "remaining_capacity_wh",
+            "over_discharge_count",
+            "nominal_voltage",
+            "internal_resistance_estimate",
+            "ocv_estimate",
+            "ocv_estimate_filtered",
+            "volt_based_soc_estimate",
+            "voltage_prediction",
+            "prediction_error",
+            "estimation_covariance_norm",
+        }:
             return True
-        raise KeyError(f'{field!r} is not a field of ' + 'uorb.BatteryStatus')
+        raise KeyError(f"{field!r} is not a field of " + "uorb.BatteryStatus")
 
 
 @dataclasses.dataclass(slots=True)
@@ -881,7 +2034,7 @@ class BatteryStatusV0:
     Schema: uorb.BatteryStatusV0 (uorb, BatteryStatusV0.msg:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'uorb.BatteryStatusV0'
+    QUALIFIED_NAME: ClassVar[str] = "uorb.BatteryStatusV0"
     MESSAGE_VERSION: ClassVar[int] = 0
     MAX_INSTANCES: ClassVar[int] = 4
     SOURCE_POWER_MODULE: ClassVar[int] = 0
@@ -907,45 +2060,358 @@ class BatteryStatusV0:
     FAULT_FAILED_TO_ARM: ClassVar[int] = 10
     FAULT_COUNT: ClassVar[int] = 11
 
-    timestamp: int = dataclasses.field(default=0, metadata=_m.meta(name='timestamp', type='uint64', unit='us', quantity='time', scale=1e-06, offset=0.0, doc='Time since system start'))
-    connected: bool = dataclasses.field(default=False, metadata=_m.meta(name='connected', type='bool', doc='Whether or not a battery is connected. For power modules this is based on a voltage threshold.'))
-    voltage_v: float = dataclasses.field(default=0.0, metadata=_m.meta(name='voltage_v', type='float32', unit='V', quantity='voltage', invalid=0.0, invalid_text='0', doc='Battery voltage'))
-    current_a: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='current_a', type='float32', unit='A', quantity='current', invalid=-1.0, invalid_text='-1', doc='Battery current'))
-    current_average_a: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='current_average_a', type='float32', unit='A', quantity='current', invalid=-1.0, invalid_text='-1', doc='Battery current average (for FW average in level flight)'))
-    discharged_mah: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='discharged_mah', type='float32', unit='mAh', quantity='charge', scale=3.6, offset=0.0, invalid=-1.0, invalid_text='-1', doc='Discharged amount'))
-    remaining: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='remaining', type='float32', minimum=0, maximum=1, invalid=-1.0, invalid_text='-1', doc='Remaining capacity'))
-    scale: float = dataclasses.field(default=-1.0, metadata=_m.meta(name='scale', type='float32', minimum=1, maximum=None, invalid=-1.0, invalid_text='-1', doc='Scaling factor to compensate for lower actuation power caused by voltage sag'))
-    time_remaining_s: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='time_remaining_s', type='float32', unit='s', quantity='time', invalid=math.nan, invalid_text='NaN', doc='Predicted time remaining until battery is empty under previous averaged load'))
-    temperature: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='temperature', type='float32', unit='degC', quantity='temperature', scale=1.0, offset=273.15, invalid=math.nan, invalid_text='NaN', doc='Temperature of the battery'))
-    cell_count: int = dataclasses.field(default=0, metadata=_m.meta(name='cell_count', type='uint8', invalid=0, invalid_text='0', doc='Number of cells'))
-    source: int = dataclasses.field(default=0, metadata=_m.meta(name='source', type='uint8', enums=('uorb.BatteryStatusV0.SOURCE',), doc='Battery source'))
-    priority: int = dataclasses.field(default=0, metadata=_m.meta(name='priority', type='uint8', doc='Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1'))
-    capacity: int = dataclasses.field(default=0, metadata=_m.meta(name='capacity', type='uint16', unit='mAh', quantity='charge', scale=3.6, offset=0.0, doc='Capacity of the battery when fully charged'))
-    cycle_count: int = dataclasses.field(default=0, metadata=_m.meta(name='cycle_count', type='uint16', doc='Number of discharge cycles the battery has experienced'))
-    average_time_to_empty: int = dataclasses.field(default=0, metadata=_m.meta(name='average_time_to_empty', type='uint16', unit='min', quantity='time', scale=60.0, offset=0.0, doc='Predicted remaining battery capacity based on the average rate of discharge'))
-    serial_number: int = dataclasses.field(default=0, metadata=_m.meta(name='serial_number', type='uint16', doc='Serial number of the battery pack'))
-    manufacture_date: int = dataclasses.field(default=0, metadata=_m.meta(name='manufacture_date', type='uint16', doc='Manufacture date, part of serial number of the battery pack. Formatted as: Day + Month×32 + (Year–1980)×512'))
-    state_of_health: int = dataclasses.field(default=0, metadata=_m.meta(name='state_of_health', type='uint16', unit='%', quantity='ratio', scale=0.01, offset=0.0, minimum=0, maximum=100, doc='State of health. FullChargeCapacity/DesignCapacity'))
-    max_error: int = dataclasses.field(default=0, metadata=_m.meta(name='max_error', type='uint16', unit='%', quantity='ratio', scale=0.01, offset=0.0, minimum=1, maximum=100, doc='Max error, expected margin of error in the state-of-charge calculation'))
-    id: int = dataclasses.field(default=0, metadata=_m.meta(name='id', type='uint8', doc='ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed'))
-    interface_error: int = dataclasses.field(default=0, metadata=_m.meta(name='interface_error', type='uint16', doc='Interface error counter'))
-    voltage_cell_v: list[float] = dataclasses.field(default_factory=lambda: [0.0] * 14, metadata=_m.meta(name='voltage_cell_v', type='float32[14]', unit='V', quantity='voltage', invalid=0.0, invalid_text='0', per_element=True, doc='Battery individual cell voltages'))
-    max_cell_voltage_delta: float = dataclasses.field(default=0.0, metadata=_m.meta(name='max_cell_voltage_delta', type='float32', doc='Max difference between individual cell voltages'))
-    is_powering_off: bool = dataclasses.field(default=False, metadata=_m.meta(name='is_powering_off', type='bool', doc='Power off event imminent indication, false if unknown'))
-    is_required: bool = dataclasses.field(default=False, metadata=_m.meta(name='is_required', type='bool', doc='Set if the battery is explicitly required before arming'))
-    warning: int = dataclasses.field(default=0, metadata=_m.meta(name='warning', type='uint8', enums=('uorb.BatteryStatusV0.WARNING', 'uorb.BatteryStatusV0.STATE'), doc='Current battery warning'))
-    faults: int = dataclasses.field(default=0, metadata=_m.meta(name='faults', type='uint16', enums=('uorb.BatteryStatusV0.FAULT',), doc='Smart battery supply status/fault flags (bitmask) for health indication'))
-    full_charge_capacity_wh: float = dataclasses.field(default=0.0, metadata=_m.meta(name='full_charge_capacity_wh', type='float32', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, doc='Compensated battery capacity'))
-    remaining_capacity_wh: float = dataclasses.field(default=0.0, metadata=_m.meta(name='remaining_capacity_wh', type='float32', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, doc='Compensated battery capacity remaining'))
-    over_discharge_count: int = dataclasses.field(default=0, metadata=_m.meta(name='over_discharge_count', type='uint16', doc='Number of battery overdischarge'))
-    nominal_voltage: float = dataclasses.field(default=0.0, metadata=_m.meta(name='nominal_voltage', type='float32', unit='V', quantity='voltage', doc='Nominal voltage of the battery pack'))
-    internal_resistance_estimate: float = dataclasses.field(default=0.0, metadata=_m.meta(name='internal_resistance_estimate', type='float32', unit='Ohm', quantity='resistance', doc='Internal resistance per cell estimate'))
-    ocv_estimate: float = dataclasses.field(default=0.0, metadata=_m.meta(name='ocv_estimate', type='float32', unit='V', quantity='voltage', doc='Open circuit voltage estimate'))
-    ocv_estimate_filtered: float = dataclasses.field(default=0.0, metadata=_m.meta(name='ocv_estimate_filtered', type='float32', unit='V', quantity='voltage', doc='Filtered open circuit voltage estimate'))
-    volt_based_soc_estimate: float = dataclasses.field(default=0.0, metadata=_m.meta(name='volt_based_soc_estimate', type='float32', minimum=0, maximum=1, doc='Normalized volt based state of charge estimate'))
-    voltage_prediction: float = dataclasses.field(default=0.0, metadata=_m.meta(name='voltage_prediction', type='float32', unit='V', quantity='voltage', doc='Predicted voltage'))
-    prediction_error: float = dataclasses.field(default=0.0, metadata=_m.meta(name='prediction_error', type='float32', unit='V', quantity='voltage', doc='Prediction error'))
-    estimation_covariance_norm: float = dataclasses.field(default=0.0, metadata=_m.meta(name='estimation_covariance_norm', type='float32', doc='Norm of the covariance matrix'))
+    timestamp: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="timestamp",
+            type="uint64",
+            unit="us",
+            quantity="time",
+            scale=1e-06,
+            offset=0.0,
+            doc="Time since system start",
+        ),
+    )
+    connected: bool = dataclasses.field(
+        default=False,
+        metadata=_m.meta(
+            name="connected",
+            type="bool",
+            doc="Whether or not a battery is connected. For power modules this is based on a voltage threshold.",
+        ),
+    )
+    voltage_v: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="voltage_v",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Battery voltage",
+        ),
+    )
+    current_a: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="current_a",
+            type="float32",
+            unit="A",
+            quantity="current",
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Battery current",
+        ),
+    )
+    current_average_a: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="current_average_a",
+            type="float32",
+            unit="A",
+            quantity="current",
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Battery current average (for FW average in level flight)",
+        ),
+    )
+    discharged_mah: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="discharged_mah",
+            type="float32",
+            unit="mAh",
+            quantity="charge",
+            scale=3.6,
+            offset=0.0,
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Discharged amount",
+        ),
+    )
+    remaining: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="remaining",
+            type="float32",
+            minimum=0,
+            maximum=1,
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Remaining capacity",
+        ),
+    )
+    scale: float = dataclasses.field(
+        default=-1.0,
+        metadata=_m.meta(
+            name="scale",
+            type="float32",
+            minimum=1,
+            maximum=None,
+            invalid=-1.0,
+            invalid_text="-1",
+            doc="Scaling factor to compensate for lower actuation power caused by voltage sag",
+        ),
+    )
+    time_remaining_s: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="time_remaining_s",
+            type="float32",
+            unit="s",
+            quantity="time",
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Predicted time remaining until battery is empty under previous averaged load",
+        ),
+    )
+    temperature: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="temperature",
+            type="float32",
+            unit="degC",
+            quantity="temperature",
+            scale=1.0,
+            offset=273.15,
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Temperature of the battery",
+        ),
+    )
+    cell_count: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="cell_count", type="uint8", invalid=0, invalid_text="0", doc="Number of cells")
+    )
+    source: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(name="source", type="uint8", enums=("uorb.BatteryStatusV0.SOURCE",), doc="Battery source"),
+    )
+    priority: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="priority",
+            type="uint8",
+            doc="Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1",
+        ),
+    )
+    capacity: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="capacity",
+            type="uint16",
+            unit="mAh",
+            quantity="charge",
+            scale=3.6,
+            offset=0.0,
+            doc="Capacity of the battery when fully charged",
+        ),
+    )
+    cycle_count: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="cycle_count", type="uint16", doc="Number of discharge cycles the battery has experienced"
+        ),
+    )
+    average_time_to_empty: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="average_time_to_empty",
+            type="uint16",
+            unit="min",
+            quantity="time",
+            scale=60.0,
+            offset=0.0,
+            doc="Predicted remaining battery capacity based on the average rate of discharge",
+        ),
+    )
+    serial_number: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="Serial number of the battery pack")
+    )
+    manufacture_date: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="manufacture_date",
+            type="uint16",
+            doc="Manufacture date, part of serial number of the battery pack. Formatted as: Day "
+            "+ Month×32 + (Year–1980)×512",
+        ),
+    )
+    state_of_health: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="state_of_health",
+            type="uint16",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            minimum=0,
+            maximum=100,
+            doc="State of health. FullChargeCapacity/DesignCapacity",
+        ),
+    )
+    max_error: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="max_error",
+            type="uint16",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            minimum=1,
+            maximum=100,
+            doc="Max error, expected margin of error in the state-of-charge calculation",
+        ),
+    )
+    id: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="id",
+            type="uint8",
+            doc="ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed",
+        ),
+    )
+    interface_error: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="Interface error counter")
+    )
+    voltage_cell_v: list[float] = dataclasses.field(
+        default_factory=lambda: [0.0] * 14,
+        metadata=_m.meta(
+            name="voltage_cell_v",
+            type="float32[14]",
+            unit="V",
+            quantity="voltage",
+            invalid=0.0,
+            invalid_text="0",
+            per_element=True,
+            doc="Battery individual cell voltages",
+        ),
+    )
+    max_cell_voltage_delta: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="max_cell_voltage_delta", type="float32", doc="Max difference between individual cell voltages"
+        ),
+    )
+    is_powering_off: bool = dataclasses.field(
+        default=False,
+        metadata=_m.meta(
+            name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
+        ),
+    )
+    is_required: bool = dataclasses.field(
+        default=False,
+        metadata=_m.meta(
+            name="is_required", type="bool", doc="Set if the battery is explicitly required before arming"
+        ),
+    )
+    warning: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="warning",
+            type="uint8",
+            enums=("uorb.BatteryStatusV0.WARNING", "uorb.BatteryStatusV0.STATE"),
+            doc="Current battery warning",
+        ),
+    )
+    faults: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="faults",
+            type="uint16",
+            enums=("uorb.BatteryStatusV0.FAULT",),
+            doc="Smart battery supply status/fault flags (bitmask) for health indication",
+        ),
+    )
+    full_charge_capacity_wh: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="full_charge_capacity_wh",
+            type="float32",
+            unit="Wh",
+            quantity="energy",
+            scale=3600.0,
+            offset=0.0,
+            doc="Compensated battery capacity",
+        ),
+    )
+    remaining_capacity_wh: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="remaining_capacity_wh",
+            type="float32",
+            unit="Wh",
+            quantity="energy",
+            scale=3600.0,
+            offset=0.0,
+            doc="Compensated battery capacity remaining",
+        ),
+    )
+    over_discharge_count: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
+    )
+    nominal_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="nominal_voltage",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            doc="Nominal voltage of the battery pack",
+        ),
+    )
+    internal_resistance_estimate: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="internal_resistance_estimate",
+            type="float32",
+            unit="Ohm",
+            quantity="resistance",
+            doc="Internal resistance per cell estimate",
+        ),
+    )
+    ocv_estimate: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="ocv_estimate", type="float32", unit="V", quantity="voltage", doc="Open circuit voltage estimate"
+        ),
+    )
+    ocv_estimate_filtered: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="ocv_estimate_filtered",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            doc="Filtered open circuit voltage estimate",
+        ),
+    )
+    volt_based_soc_estimate: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="volt_based_soc_estimate",
+            type="float32",
+            minimum=0,
+            maximum=1,
+            doc="Normalized volt based state of charge estimate",
+        ),
+    )
+    voltage_prediction: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="voltage_prediction", type="float32", unit="V", quantity="voltage", doc="Predicted voltage"
+        ),
+    )
+    prediction_error: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Prediction error"),
+    )
+    estimation_covariance_norm: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(name="estimation_covariance_norm", type="float32", doc="Norm of the covariance matrix"),
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -956,141 +2422,194 @@ class BatteryStatusV0:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['timestamp'] = self.timestamp
-        out['connected'] = self.connected
-        out['voltage_v'] = self.voltage_v
-        out['current_a'] = self.current_a
-        out['current_average_a'] = self.current_average_a
-        out['discharged_mah'] = self.discharged_mah
-        out['remaining'] = self.remaining
-        out['scale'] = self.scale
-        out['time_remaining_s'] = self.time_remaining_s
-        out['temperature'] = self.temperature
-        out['cell_count'] = self.cell_count
-        out['source'] = self.source
-        out['priority'] = self.priority
-        out['capacity'] = self.capacity
-        out['cycle_count'] = self.cycle_count
-        out['average_time_to_empty'] = self.average_time_to_empty
-        out['serial_number'] = self.serial_number
-        out['manufacture_date'] = self.manufacture_date
-        out['state_of_health'] = self.state_of_health
-        out['max_error'] = self.max_error
-        out['id'] = self.id
-        out['interface_error'] = self.interface_error
-        out['voltage_cell_v'] = list(self.voltage_cell_v)
-        out['max_cell_voltage_delta'] = self.max_cell_voltage_delta
-        out['is_powering_off'] = self.is_powering_off
-        out['is_required'] = self.is_required
-        out['warning'] = self.warning
-        out['faults'] = self.faults
-        out['full_charge_capacity_wh'] = self.full_charge_capacity_wh
-        out['remaining_capacity_wh'] = self.remaining_capacity_wh
-        out['over_discharge_count'] = self.over_discharge_count
-        out['nominal_voltage'] = self.nominal_voltage
-        out['internal_resistance_estimate'] = self.internal_resistance_estimate
-        out['ocv_estimate'] = self.ocv_estimate
-        out['ocv_estimate_filtered'] = self.ocv_estimate_filtered
-        out['volt_based_soc_estimate'] = self.volt_based_soc_estimate
-        out['voltage_prediction'] = self.voltage_prediction
-        out['prediction_error'] = self.prediction_error
-        out['estimation_covariance_norm'] = self.estimation_covariance_norm
+        out["timestamp"] = self.timestamp
+        out["connected"] = self.connected
+        out["voltage_v"] = self.voltage_v
+        out["current_a"] = self.current_a
+        out["current_average_a"] = self.current_average_a
+        out["discharged_mah"] = self.discharged_mah
+        out["remaining"] = self.remaining
+        out["scale"] = self.scale
+        out["time_remaining_s"] = self.time_remaining_s
+        out["temperature"] = self.temperature
+        out["cell_count"] = self.cell_count
+        out["source"] = self.source
+        out["priority"] = self.priority
+        out["capacity"] = self.capacity
+        out["cycle_count"] = self.cycle_count
+        out["average_time_to_empty"] = self.average_time_to_empty
+        out["serial_number"] = self.serial_number
+        out["manufacture_date"] = self.manufacture_date
+        out["state_of_health"] = self.state_of_health
+        out["max_error"] = self.max_error
+        out["id"] = self.id
+        out["interface_error"] = self.interface_error
+        out["voltage_cell_v"] = list(self.voltage_cell_v)
+        out["max_cell_voltage_delta"] = self.max_cell_voltage_delta
+        out["is_powering_off"] = self.is_powering_off
+        out["is_required"] = self.is_required
+        out["warning"] = self.warning
+        out["faults"] = self.faults
+        out["full_charge_capacity_wh"] = self.full_charge_capacity_wh
+        out["remaining_capacity_wh"] = self.remaining_capacity_wh
+        out["over_discharge_count"] = self.over_discharge_count
+        out["nominal_voltage"] = self.nominal_voltage
+        out["internal_resistance_estimate"] = self.internal_resistance_estimate
+        out["ocv_estimate"] = self.ocv_estimate
+        out["ocv_estimate_filtered"] = self.ocv_estimate_filtered
+        out["volt_based_soc_estimate"] = self.volt_based_soc_estimate
+        out["voltage_prediction"] = self.voltage_prediction
+        out["prediction_error"] = self.prediction_error
+        out["estimation_covariance_norm"] = self.estimation_covariance_norm
         return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatusV0:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'timestamp', 'connected', 'voltage_v', 'current_a', 'current_average_a', 'discharged_mah', 'remaining', 'scale', 'time_remaining_s', 'temperature', 'cell_count', 'source', 'priority', 'capacity', 'cycle_count', 'average_time_to_empty', 'serial_number', 'manufacture_date', 'state_of_health', 'max_error', 'id', 'interface_error', 'voltage_cell_v', 'max_cell_voltage_delta', 'is_powering_off', 'is_required', 'warning', 'faults', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'over_discharge_count', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm'}), (), 'BatteryStatusV0')
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "timestamp",
+                    "connected",
+                    "voltage_v",
+                    "current_a",
+                    "current_average_a",
+                    "discharged_mah",
+                    "remaining",
+                    "scale",
+                    "time_remaining_s",
+                    "temperature",
+                    "cell_count",
+                    "source",
+                    "priority",
+                    "capacity",
+                    "cycle_count",
+                    "average_time_to_empty",
+                    "serial_number",
+                    "manufacture_date",
+                    "state_of_health",
+                    "max_error",
+                    "id",
+                    "interface_error",
+                    "voltage_cell_v",
+                    "max_cell_voltage_delta",
+                    "is_powering_off",
+                    "is_required",
+                    "warning",
+                    "faults",
+                    "full_charge_capacity_wh",
+                    "remaining_capacity_wh",
+                    "over_discharge_count",
+                    "nominal_voltage",
+                    "internal_resistance_estimate",
+                    "ocv_estimate",
+                    "ocv_estimate_filtered",
+                    "volt_based_soc_estimate",
+                    "voltage_prediction",
+                    "prediction_error",
+                    "estimation_covariance_norm",
+                }
+            ),
+            (),
+            "BatteryStatusV0",
+        )
         obj = cls()
-        if 'timestamp' in data:
-            obj.timestamp = _m.as_int(data['timestamp'], 'timestamp')
-        if 'connected' in data:
-            obj.connected = _m.as_bool(data['connected'], 'connected')
-        if 'voltage_v' in data:
-            obj.voltage_v = _m.as_float(data['voltage_v'], 'voltage_v')
-        if 'current_a' in data:
-            obj.current_a = _m.as_float(data['current_a'], 'current_a')
-        if 'current_average_a' in data:
-            obj.current_average_a = _m.as_float(data['current_average_a'], 'current_average_a')
-        if 'discharged_mah' in data:
-            obj.discharged_mah = _m.as_float(data['discharged_mah'], 'discharged_mah')
-        if 'remaining' in data:
-            obj.remaining = _m.as_float(data['remaining'], 'remaining')
-        if 'scale' in data:
-            obj.scale = _m.as_float(data['scale'], 'scale')
-        if 'time_remaining_s' in data:
-            obj.time_remaining_s = _m.as_float(data['time_remaining_s'], 'time_remaining_s')
-        if 'temperature' in data:
-            obj.temperature = _m.as_float(data['temperature'], 'temperature')
-        if 'cell_count' in data:
-            obj.cell_count = _m.as_int(data['cell_count'], 'cell_count')
-        if 'source' in data:
-            obj.source = _m.as_int(data['source'], 'source')
-        if 'priority' in data:
-            obj.priority = _m.as_int(data['priority'], 'priority')
-        if 'capacity' in data:
-            obj.capacity = _m.as_int(data['capacity'], 'capacity')
-        if 'cycle_count' in data:
-            obj.cycle_count = _m.as_int(data['cycle_count'], 'cycle_count')
-        if 'average_time_to_empty' in data:
-            obj.average_time_to_empty = _m.as_int(data['average_time_to_empty'], 'average_time_to_empty')
-        if 'serial_number' in data:
-            obj.serial_number = _m.as_int(data['serial_number'], 'serial_number')
-        if 'manufacture_date' in data:
-            obj.manufacture_date = _m.as_int(data['manufacture_date'], 'manufacture_date')
-        if 'state_of_health' in data:
-            obj.state_of_health = _m.as_int(data['state_of_health'], 'state_of_health')
-        if 'max_error' in data:
-            obj.max_error = _m.as_int(data['max_error'], 'max_error')
-        if 'id' in data:
-            obj.id = _m.as_int(data['id'], 'id')
-        if 'interface_error' in data:
-            obj.interface_error = _m.as_int(data['interface_error'], 'interface_error')
-        if 'voltage_cell_v' in data:
-            obj.voltage_cell_v = _m.as_list(data['voltage_cell_v'], 'voltage_cell_v', 14, True, lambda item, p: _m.as_float(item, p))
-        if 'max_cell_voltage_delta' in data:
-            obj.max_cell_voltage_delta = _m.as_float(data['max_cell_voltage_delta'], 'max_cell_voltage_delta')
-        if 'is_powering_off' in data:
-            obj.is_powering_off = _m.as_bool(data['is_powering_off'], 'is_powering_off')
-        if 'is_required' in data:
-            obj.is_required = _m.as_bool(data['is_required'], 'is_required')
-        if 'warning' in data:
-            obj.warning = _m.as_int(data['warning'], 'warning')
-        if 'faults' in data:
-            obj.faults = _m.as_int(data['faults'], 'faults')
-        if 'full_charge_capacity_wh' in data:
-            obj.full_charge_capacity_wh = _m.as_float(data['full_charge_capacity_wh'], 'full_charge_capacity_wh')
-        if 'remaining_capacity_wh' in data:
-            obj.remaining_capacity_wh = _m.as_float(data['remaining_capacity_wh'], 'remaining_capacity_wh')
-        if 'over_discharge_count' in data:
-            obj.over_discharge_count = _m.as_int(data['over_discharge_count'], 'over_discharge_count')
-        if 'nominal_voltage' in data:
-            obj.nominal_voltage = _m.as_float(data['nominal_voltage'], 'nominal_voltage')
-        if 'internal_resistance_estimate' in data:
-            obj.internal_resistance_estimate = _m.as_float(data['internal_resistance_estimate'], 'internal_resistance_estimate')
-        if 'ocv_estimate' in data:
-            obj.ocv_estimate = _m.as_float(data['ocv_estimate'], 'ocv_estimate')
-        if 'ocv_estimate_filtered' in data:
-            obj.ocv_estimate_filtered = _m.as_float(data['ocv_estimate_filtered'], 'ocv_estimate_filtered')
-        if 'volt_based_soc_estimate' in data:
-            obj.volt_based_soc_estimate = _m.as_float(data['volt_based_soc_estimate'], 'volt_based_soc_estimate')
-        if 'voltage_prediction' in data:
-            obj.voltage_prediction = _m.as_float(data['voltage_prediction'], 'voltage_prediction')
-        if 'prediction_error' in data:
-            obj.prediction_error = _m.as_float(data['prediction_error'], 'prediction_error')
-        if 'estimation_covariance_norm' in data:
-            obj.estimation_covariance_norm = _m.as_float(data['estimation_covariance_norm'], 'estimation_covariance_norm')
+        if "timestamp" in data:
+            obj.timestamp = _m.as_int(data["timestamp"], "timestamp")
+        if "connected" in data:
+            obj.connected = _m.as_bool(data["connected"], "connected")
+        if "voltage_v" in data:
+            obj.voltage_v = _m.as_float(data["voltage_v"], "voltage_v")
+        if "current_a" in data:
+            obj.current_a = _m.as_float(data["current_a"], "current_a")
+        if "current_average_a" in data:
+            obj.current_average_a = _m.as_float(data["current_average_a"], "current_average_a")
+        if "discharged_mah" in data:
+            obj.discharged_mah = _m.as_float(data["discharged_mah"], "discharged_mah")
+        if "remaining" in data:
+            obj.remaining = _m.as_float(data["remaining"], "remaining")
+        if "scale" in data:
+            obj.scale = _m.as_float(data["scale"], "scale")
+        if "time_remaining_s" in data:
+            obj.time_remaining_s = _m.as_float(data["time_remaining_s"], "time_remaining_s")
+        if "temperature" in data:
+            obj.temperature = _m.as_float(data["temperature"], "temperature")
+        if "cell_count" in data:
+            obj.cell_count = _m.as_int(data["cell_count"], "cell_count")
+        if "source" in data:
+            obj.source = _m.as_int(data["source"], "source")
+        if "priority" in data:
+            obj.priority = _m.as_int(data["priority"], "priority")
+        if "capacity" in data:
+            obj.capacity = _m.as_int(data["capacity"], "capacity")
+        if "cycle_count" in data:
+            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+        if "average_time_to_empty" in data:
+            obj.average_time_to_empty = _m.as_int(data["average_time_to_empty"], "average_time_to_empty")
+        if "serial_number" in data:
+            obj.serial_number = _m.as_int(data["serial_number"], "serial_number")
+        if "manufacture_date" in data:
+            obj.manufacture_date = _m.as_int(data["manufacture_date"], "manufacture_date")
+        if "state_of_health" in data:
+            obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
+        if "max_error" in data:
+            obj.max_error = _m.as_int(data["max_error"], "max_error")
+        if "id" in data:
+            obj.id = _m.as_int(data["id"], "id")
+        if "interface_error" in data:
+            obj.interface_error = _m.as_int(data["interface_error"], "interface_error")
+        if "voltage_cell_v" in data:
+            obj.voltage_cell_v = _m.as_list(
+                data["voltage_cell_v"], "voltage_cell_v", 14, True, lambda item, p: _m.as_float(item, p)
+            )
+        if "max_cell_voltage_delta" in data:
+            obj.max_cell_voltage_delta = _m.as_float(data["max_cell_voltage_delta"], "max_cell_voltage_delta")
+        if "is_powering_off" in data:
+            obj.is_powering_off = _m.as_bool(data["is_powering_off"], "is_powering_off")
+        if "is_required" in data:
+            obj.is_required = _m.as_bool(data["is_required"], "is_required")
+        if "warning" in data:
+            obj.warning = _m.as_int(data["warning"], "warning")
+        if "faults" in data:
+            obj.faults = _m.as_int(data["faults"], "faults")
+        if "full_charge_capacity_wh" in data:
+            obj.full_charge_capacity_wh = _m.as_float(data["full_charge_capacity_wh"], "full_charge_capacity_wh")
+        if "remaining_capacity_wh" in data:
+            obj.remaining_capacity_wh = _m.as_float(data["remaining_capacity_wh"], "remaining_capacity_wh")
+        if "over_discharge_count" in data:
+            obj.over_discharge_count = _m.as_int(data["over_discharge_count"], "over_discharge_count")
+        if "nominal_voltage" in data:
+            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+        if "internal_resistance_estimate" in data:
+            obj.internal_resistance_estimate = _m.as_float(
+                data["internal_resistance_estimate"], "internal_resistance_estimate"
+            )
+        if "ocv_estimate" in data:
+            obj.ocv_estimate = _m.as_float(data["ocv_estimate"], "ocv_estimate")
+        if "ocv_estimate_filtered" in data:
+            obj.ocv_estimate_filtered = _m.as_float(data["ocv_estimate_filtered"], "ocv_estimate_filtered")
+        if "volt_based_soc_estimate" in data:
+            obj.volt_based_soc_estimate = _m.as_float(data["volt_based_soc_estimate"], "volt_based_soc_estimate")
+        if "voltage_prediction" in data:
+            obj.voltage_prediction = _m.as_float(data["voltage_prediction"], "voltage_prediction")
+        if "prediction_error" in data:
+            obj.prediction_error = _m.as_float(data["prediction_error"], "prediction_error")
+        if "estimation_covariance_norm" in data:
+            obj.estimation_covariance_norm = _m.as_float(
+                data["estimation_covariance_norm"], "estimation_covariance_norm"
+            )
         return obj
 
-    UORB_FORMAT: ClassVar[str] = '<Q33f10H?4B2?B'
+    UORB_FORMAT: ClassVar[str] = "<Q33f10H?4B2?B"
     UORB_SIZE: ClassVar[int] = 168
     UORB_SIZE_NO_PADDING: ClassVar[int] = 168
-    UORB_TOPICS: ClassVar[tuple[str, ...]] = ('battery_status_v0',)
+    UORB_TOPICS: ClassVar[tuple[str, ...]] = ("battery_status_v0",)
 
     def encode(self) -> bytes:
         """PX4's C struct of this message: 168 bytes, little-endian, padding zeroed."""
         try:
-            return _S_BatteryStatusV0.pack(
+            return _BATTERY_STATUS_V0_STRUCT.pack(
                 self.timestamp,
                 self.voltage_v,
                 self.current_a,
@@ -1132,14 +2651,14 @@ class BatteryStatusV0:
                 self.warning,
             )
         except (struct.error, TypeError, OverflowError) as exc:
-            raise _uorb.encode_error('BatteryStatusV0', self, _UC_BatteryStatusV0, exc) from None
+            raise _uorb.encode_error("BatteryStatusV0", self, _BATTERY_STATUS_V0_PACKED_FIELDS, exc) from None
 
     @classmethod
     def decode(cls, data: bytes) -> BatteryStatusV0:
         """From PX4's C struct: 168 bytes."""
         if len(data) != 168:
-            raise _uorb.DecodeError('BatteryStatusV0: expected 168 bytes, got ' + str(len(data)))
-        v = _S_BatteryStatusV0.unpack_from(data)
+            raise _uorb.DecodeError("BatteryStatusV0: expected 168 bytes, got " + str(len(data)))
+        v = _BATTERY_STATUS_V0_STRUCT.unpack_from(data)
         o = cls.__new__(cls)
         o.timestamp = v[0]
         o.voltage_v = v[1]
@@ -1198,56 +2717,56 @@ class BatteryStatusV0:
         numpy arrays when numpy is installed (``use_numpy`` None) or required (True; views
         into ``buffer`` unless ``copy``), else lists from ``struct.iter_unpack``.
         """
-        return _COL_BatteryStatusV0.decode(buffer, stride, use_numpy=use_numpy, copy=copy)
+        return _BATTERY_STATUS_V0_COLUMNS.decode(buffer, stride, use_numpy=use_numpy, copy=copy)
 
     @classmethod
     def ulog_format(cls) -> _ulog.Format:
         """The ULog format PX4's logger writes for this struct (nested formats attached)."""
         return _ulog.Format(
-            'battery_status_v0',
+            "battery_status_v0",
             (
-                _ulog.Member('uint64_t', 0, 'timestamp', 'timestamp', 'scalar'),
-                _ulog.Member('float', 0, 'voltage_v', 'voltage_v', 'scalar'),
-                _ulog.Member('float', 0, 'current_a', 'current_a', 'scalar'),
-                _ulog.Member('float', 0, 'current_average_a', 'current_average_a', 'scalar'),
-                _ulog.Member('float', 0, 'discharged_mah', 'discharged_mah', 'scalar'),
-                _ulog.Member('float', 0, 'remaining', 'remaining', 'scalar'),
-                _ulog.Member('float', 0, 'scale', 'scale', 'scalar'),
-                _ulog.Member('float', 0, 'time_remaining_s', 'time_remaining_s', 'scalar'),
-                _ulog.Member('float', 0, 'temperature', 'temperature', 'scalar'),
-                _ulog.Member('float', 14, 'voltage_cell_v', 'voltage_cell_v', 'array'),
-                _ulog.Member('float', 0, 'max_cell_voltage_delta', 'max_cell_voltage_delta', 'scalar'),
-                _ulog.Member('float', 0, 'full_charge_capacity_wh', 'full_charge_capacity_wh', 'scalar'),
-                _ulog.Member('float', 0, 'remaining_capacity_wh', 'remaining_capacity_wh', 'scalar'),
-                _ulog.Member('float', 0, 'nominal_voltage', 'nominal_voltage', 'scalar'),
-                _ulog.Member('float', 0, 'internal_resistance_estimate', 'internal_resistance_estimate', 'scalar'),
-                _ulog.Member('float', 0, 'ocv_estimate', 'ocv_estimate', 'scalar'),
-                _ulog.Member('float', 0, 'ocv_estimate_filtered', 'ocv_estimate_filtered', 'scalar'),
-                _ulog.Member('float', 0, 'volt_based_soc_estimate', 'volt_based_soc_estimate', 'scalar'),
-                _ulog.Member('float', 0, 'voltage_prediction', 'voltage_prediction', 'scalar'),
-                _ulog.Member('float', 0, 'prediction_error', 'prediction_error', 'scalar'),
-                _ulog.Member('float', 0, 'estimation_covariance_norm', 'estimation_covariance_norm', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'capacity', 'capacity', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'cycle_count', 'cycle_count', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'average_time_to_empty', 'average_time_to_empty', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'serial_number', 'serial_number', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'manufacture_date', 'manufacture_date', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'state_of_health', 'state_of_health', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'max_error', 'max_error', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'interface_error', 'interface_error', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'faults', 'faults', 'scalar'),
-                _ulog.Member('uint16_t', 0, 'over_discharge_count', 'over_discharge_count', 'scalar'),
-                _ulog.Member('bool', 0, 'connected', 'connected', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'cell_count', 'cell_count', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'source', 'source', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'priority', 'priority', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'id', 'id', 'scalar'),
-                _ulog.Member('bool', 0, 'is_powering_off', 'is_powering_off', 'scalar'),
-                _ulog.Member('bool', 0, 'is_required', 'is_required', 'scalar'),
-                _ulog.Member('uint8_t', 0, 'warning', 'warning', 'scalar'),
+                _ulog.Member("uint64_t", 0, "timestamp", "timestamp", "scalar"),
+                _ulog.Member("float", 0, "voltage_v", "voltage_v", "scalar"),
+                _ulog.Member("float", 0, "current_a", "current_a", "scalar"),
+                _ulog.Member("float", 0, "current_average_a", "current_average_a", "scalar"),
+                _ulog.Member("float", 0, "discharged_mah", "discharged_mah", "scalar"),
+                _ulog.Member("float", 0, "remaining", "remaining", "scalar"),
+                _ulog.Member("float", 0, "scale", "scale", "scalar"),
+                _ulog.Member("float", 0, "time_remaining_s", "time_remaining_s", "scalar"),
+                _ulog.Member("float", 0, "temperature", "temperature", "scalar"),
+                _ulog.Member("float", 14, "voltage_cell_v", "voltage_cell_v", "array"),
+                _ulog.Member("float", 0, "max_cell_voltage_delta", "max_cell_voltage_delta", "scalar"),
+                _ulog.Member("float", 0, "full_charge_capacity_wh", "full_charge_capacity_wh", "scalar"),
+                _ulog.Member("float", 0, "remaining_capacity_wh", "remaining_capacity_wh", "scalar"),
+                _ulog.Member("float", 0, "nominal_voltage", "nominal_voltage", "scalar"),
+                _ulog.Member("float", 0, "internal_resistance_estimate", "internal_resistance_estimate", "scalar"),
+                _ulog.Member("float", 0, "ocv_estimate", "ocv_estimate", "scalar"),
+                _ulog.Member("float", 0, "ocv_estimate_filtered", "ocv_estimate_filtered", "scalar"),
+                _ulog.Member("float", 0, "volt_based_soc_estimate", "volt_based_soc_estimate", "scalar"),
+                _ulog.Member("float", 0, "voltage_prediction", "voltage_prediction", "scalar"),
+                _ulog.Member("float", 0, "prediction_error", "prediction_error", "scalar"),
+                _ulog.Member("float", 0, "estimation_covariance_norm", "estimation_covariance_norm", "scalar"),
+                _ulog.Member("uint16_t", 0, "capacity", "capacity", "scalar"),
+                _ulog.Member("uint16_t", 0, "cycle_count", "cycle_count", "scalar"),
+                _ulog.Member("uint16_t", 0, "average_time_to_empty", "average_time_to_empty", "scalar"),
+                _ulog.Member("uint16_t", 0, "serial_number", "serial_number", "scalar"),
+                _ulog.Member("uint16_t", 0, "manufacture_date", "manufacture_date", "scalar"),
+                _ulog.Member("uint16_t", 0, "state_of_health", "state_of_health", "scalar"),
+                _ulog.Member("uint16_t", 0, "max_error", "max_error", "scalar"),
+                _ulog.Member("uint16_t", 0, "interface_error", "interface_error", "scalar"),
+                _ulog.Member("uint16_t", 0, "faults", "faults", "scalar"),
+                _ulog.Member("uint16_t", 0, "over_discharge_count", "over_discharge_count", "scalar"),
+                _ulog.Member("bool", 0, "connected", "connected", "scalar"),
+                _ulog.Member("uint8_t", 0, "cell_count", "cell_count", "scalar"),
+                _ulog.Member("uint8_t", 0, "source", "source", "scalar"),
+                _ulog.Member("uint8_t", 0, "priority", "priority", "scalar"),
+                _ulog.Member("uint8_t", 0, "id", "id", "scalar"),
+                _ulog.Member("bool", 0, "is_powering_off", "is_powering_off", "scalar"),
+                _ulog.Member("bool", 0, "is_required", "is_required", "scalar"),
+                _ulog.Member("uint8_t", 0, "warning", "warning", "scalar"),
             ),
             cls,
-            ('battery_status_v0',),
+            ("battery_status_v0",),
             0,
         )
 
@@ -1275,232 +2794,315 @@ class BatteryStatusV0:
         r_voltage_cell_v: Any
         v_i: Any
         try:
-            if (self.timestamp & -18446744073709551616):
-                _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryStatusV0_timestamp)
+            if self.timestamp & -18446744073709551616:
+                _v.diag(out, "timestamp", self.timestamp, _VS_BatteryStatusV0_timestamp)
         except _v.SLOW:
-            _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryStatusV0_timestamp)
+            _v.diag(out, "timestamp", self.timestamp, _VS_BatteryStatusV0_timestamp)
         try:
             x = self.connected
-            if (x is not True and x is not False):
-                _v.diag(out, 'connected', self.connected, _VS_BatteryStatusV0_connected)
+            if x is not True and x is not False:
+                _v.diag(out, "connected", self.connected, _VS_BatteryStatusV0_connected)
         except _v.SLOW:
-            _v.diag(out, 'connected', self.connected, _VS_BatteryStatusV0_connected)
+            _v.diag(out, "connected", self.connected, _VS_BatteryStatusV0_connected)
         try:
-            if (not (-3.4028234663852886e+38 <= self.voltage_v <= 3.4028234663852886e+38)):
-                _v.diag(out, 'voltage_v', self.voltage_v, _VS_BatteryStatusV0_voltage_v)
+            if not (-3.4028234663852886e38 <= self.voltage_v <= 3.4028234663852886e38):
+                _v.diag(out, "voltage_v", self.voltage_v, _VS_BatteryStatusV0_voltage_v)
         except _v.SLOW:
-            _v.diag(out, 'voltage_v', self.voltage_v, _VS_BatteryStatusV0_voltage_v)
+            _v.diag(out, "voltage_v", self.voltage_v, _VS_BatteryStatusV0_voltage_v)
         try:
-            if (not (-3.4028234663852886e+38 <= self.current_a <= 3.4028234663852886e+38)):
-                _v.diag(out, 'current_a', self.current_a, _VS_BatteryStatusV0_current_a)
+            if not (-3.4028234663852886e38 <= self.current_a <= 3.4028234663852886e38):
+                _v.diag(out, "current_a", self.current_a, _VS_BatteryStatusV0_current_a)
         except _v.SLOW:
-            _v.diag(out, 'current_a', self.current_a, _VS_BatteryStatusV0_current_a)
+            _v.diag(out, "current_a", self.current_a, _VS_BatteryStatusV0_current_a)
         try:
-            if (not (-3.4028234663852886e+38 <= self.current_average_a <= 3.4028234663852886e+38)):
-                _v.diag(out, 'current_average_a', self.current_average_a, _VS_BatteryStatusV0_current_average_a)
+            if not (-3.4028234663852886e38 <= self.current_average_a <= 3.4028234663852886e38):
+                _v.diag(out, "current_average_a", self.current_average_a, _VS_BatteryStatusV0_current_average_a)
         except _v.SLOW:
-            _v.diag(out, 'current_average_a', self.current_average_a, _VS_BatteryStatusV0_current_average_a)
+            _v.diag(out, "current_average_a", self.current_average_a, _VS_BatteryStatusV0_current_average_a)
         try:
-            if (not (-3.4028234663852886e+38 <= self.discharged_mah <= 3.4028234663852886e+38)):
-                _v.diag(out, 'discharged_mah', self.discharged_mah, _VS_BatteryStatusV0_discharged_mah)
+            if not (-3.4028234663852886e38 <= self.discharged_mah <= 3.4028234663852886e38):
+                _v.diag(out, "discharged_mah", self.discharged_mah, _VS_BatteryStatusV0_discharged_mah)
         except _v.SLOW:
-            _v.diag(out, 'discharged_mah', self.discharged_mah, _VS_BatteryStatusV0_discharged_mah)
+            _v.diag(out, "discharged_mah", self.discharged_mah, _VS_BatteryStatusV0_discharged_mah)
         try:
             x = self.remaining
-            if (not (0.0 <= x <= 1.0) and x != -1.0):
-                _v.diag(out, 'remaining', self.remaining, _VS_BatteryStatusV0_remaining)
+            if not (0.0 <= x <= 1.0) and x != -1.0:
+                _v.diag(out, "remaining", self.remaining, _VS_BatteryStatusV0_remaining)
         except _v.SLOW:
-            _v.diag(out, 'remaining', self.remaining, _VS_BatteryStatusV0_remaining)
+            _v.diag(out, "remaining", self.remaining, _VS_BatteryStatusV0_remaining)
         try:
             x = self.scale
-            if (not (1.0 <= x <= 3.4028234663852886e+38) and x != -1.0):
-                _v.diag(out, 'scale', self.scale, _VS_BatteryStatusV0_scale)
+            if not (1.0 <= x <= 3.4028234663852886e38) and x != -1.0:
+                _v.diag(out, "scale", self.scale, _VS_BatteryStatusV0_scale)
         except _v.SLOW:
-            _v.diag(out, 'scale', self.scale, _VS_BatteryStatusV0_scale)
+            _v.diag(out, "scale", self.scale, _VS_BatteryStatusV0_scale)
         try:
             x = self.time_remaining_s
-            if (not (-3.4028234663852886e+38 <= x <= 3.4028234663852886e+38) and x == x):
-                _v.diag(out, 'time_remaining_s', self.time_remaining_s, _VS_BatteryStatusV0_time_remaining_s)
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "time_remaining_s", self.time_remaining_s, _VS_BatteryStatusV0_time_remaining_s)
         except _v.SLOW:
-            _v.diag(out, 'time_remaining_s', self.time_remaining_s, _VS_BatteryStatusV0_time_remaining_s)
+            _v.diag(out, "time_remaining_s", self.time_remaining_s, _VS_BatteryStatusV0_time_remaining_s)
         try:
             x = self.temperature
-            if (not (-3.4028234663852886e+38 <= x <= 3.4028234663852886e+38) and x == x):
-                _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatusV0_temperature)
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "temperature", self.temperature, _VS_BatteryStatusV0_temperature)
         except _v.SLOW:
-            _v.diag(out, 'temperature', self.temperature, _VS_BatteryStatusV0_temperature)
+            _v.diag(out, "temperature", self.temperature, _VS_BatteryStatusV0_temperature)
         try:
-            if (self.cell_count & -256):
-                _v.diag(out, 'cell_count', self.cell_count, _VS_BatteryStatusV0_cell_count)
+            if self.cell_count & -256:
+                _v.diag(out, "cell_count", self.cell_count, _VS_BatteryStatusV0_cell_count)
         except _v.SLOW:
-            _v.diag(out, 'cell_count', self.cell_count, _VS_BatteryStatusV0_cell_count)
+            _v.diag(out, "cell_count", self.cell_count, _VS_BatteryStatusV0_cell_count)
         try:
-            if (self.source not in {0, 1, 2}):
-                _v.diag(out, 'source', self.source, _VS_BatteryStatusV0_source)
+            if self.source not in {0, 1, 2}:
+                _v.diag(out, "source", self.source, _VS_BatteryStatusV0_source)
         except _v.SLOW:
-            _v.diag(out, 'source', self.source, _VS_BatteryStatusV0_source)
+            _v.diag(out, "source", self.source, _VS_BatteryStatusV0_source)
         try:
-            if (self.priority & -256):
-                _v.diag(out, 'priority', self.priority, _VS_BatteryStatusV0_priority)
+            if self.priority & -256:
+                _v.diag(out, "priority", self.priority, _VS_BatteryStatusV0_priority)
         except _v.SLOW:
-            _v.diag(out, 'priority', self.priority, _VS_BatteryStatusV0_priority)
+            _v.diag(out, "priority", self.priority, _VS_BatteryStatusV0_priority)
         try:
-            if (self.capacity & -65536):
-                _v.diag(out, 'capacity', self.capacity, _VS_BatteryStatusV0_capacity)
+            if self.capacity & -65536:
+                _v.diag(out, "capacity", self.capacity, _VS_BatteryStatusV0_capacity)
         except _v.SLOW:
-            _v.diag(out, 'capacity', self.capacity, _VS_BatteryStatusV0_capacity)
+            _v.diag(out, "capacity", self.capacity, _VS_BatteryStatusV0_capacity)
         try:
-            if (self.cycle_count & -65536):
-                _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryStatusV0_cycle_count)
+            if self.cycle_count & -65536:
+                _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryStatusV0_cycle_count)
         except _v.SLOW:
-            _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryStatusV0_cycle_count)
+            _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryStatusV0_cycle_count)
         try:
-            if (self.average_time_to_empty & -65536):
-                _v.diag(out, 'average_time_to_empty', self.average_time_to_empty, _VS_BatteryStatusV0_average_time_to_empty)
+            if self.average_time_to_empty & -65536:
+                _v.diag(
+                    out, "average_time_to_empty", self.average_time_to_empty, _VS_BatteryStatusV0_average_time_to_empty
+                )
         except _v.SLOW:
-            _v.diag(out, 'average_time_to_empty', self.average_time_to_empty, _VS_BatteryStatusV0_average_time_to_empty)
+            _v.diag(out, "average_time_to_empty", self.average_time_to_empty, _VS_BatteryStatusV0_average_time_to_empty)
         try:
-            if (self.serial_number & -65536):
-                _v.diag(out, 'serial_number', self.serial_number, _VS_BatteryStatusV0_serial_number)
+            if self.serial_number & -65536:
+                _v.diag(out, "serial_number", self.serial_number, _VS_BatteryStatusV0_serial_number)
         except _v.SLOW:
-            _v.diag(out, 'serial_number', self.serial_number, _VS_BatteryStatusV0_serial_number)
+            _v.diag(out, "serial_number", self.serial_number, _VS_BatteryStatusV0_serial_number)
         try:
-            if (self.manufacture_date & -65536):
-                _v.diag(out, 'manufacture_date', self.manufacture_date, _VS_BatteryStatusV0_manufacture_date)
+            if self.manufacture_date & -65536:
+                _v.diag(out, "manufacture_date", self.manufacture_date, _VS_BatteryStatusV0_manufacture_date)
         except _v.SLOW:
-            _v.diag(out, 'manufacture_date', self.manufacture_date, _VS_BatteryStatusV0_manufacture_date)
+            _v.diag(out, "manufacture_date", self.manufacture_date, _VS_BatteryStatusV0_manufacture_date)
         try:
             x = self.state_of_health
-            if (x & -65536 or not (0 <= x <= 100)):
-                _v.diag(out, 'state_of_health', self.state_of_health, _VS_BatteryStatusV0_state_of_health)
+            if x & -65536 or not (0 <= x <= 100):
+                _v.diag(out, "state_of_health", self.state_of_health, _VS_BatteryStatusV0_state_of_health)
         except _v.SLOW:
-            _v.diag(out, 'state_of_health', self.state_of_health, _VS_BatteryStatusV0_state_of_health)
+            _v.diag(out, "state_of_health", self.state_of_health, _VS_BatteryStatusV0_state_of_health)
         try:
             x = self.max_error
-            if (x & -65536 or not (1 <= x <= 100)):
-                _v.diag(out, 'max_error', self.max_error, _VS_BatteryStatusV0_max_error)
+            if x & -65536 or not (1 <= x <= 100):
+                _v.diag(out, "max_error", self.max_error, _VS_BatteryStatusV0_max_error)
         except _v.SLOW:
-            _v.diag(out, 'max_error', self.max_error, _VS_BatteryStatusV0_max_error)
+            _v.diag(out, "max_error", self.max_error, _VS_BatteryStatusV0_max_error)
         try:
-            if (self.id & -256):
-                _v.diag(out, 'id', self.id, _VS_BatteryStatusV0_id)
+            if self.id & -256:
+                _v.diag(out, "id", self.id, _VS_BatteryStatusV0_id)
         except _v.SLOW:
-            _v.diag(out, 'id', self.id, _VS_BatteryStatusV0_id)
+            _v.diag(out, "id", self.id, _VS_BatteryStatusV0_id)
         try:
-            if (self.interface_error & -65536):
-                _v.diag(out, 'interface_error', self.interface_error, _VS_BatteryStatusV0_interface_error)
+            if self.interface_error & -65536:
+                _v.diag(out, "interface_error", self.interface_error, _VS_BatteryStatusV0_interface_error)
         except _v.SLOW:
-            _v.diag(out, 'interface_error', self.interface_error, _VS_BatteryStatusV0_interface_error)
+            _v.diag(out, "interface_error", self.interface_error, _VS_BatteryStatusV0_interface_error)
         try:
             a = self.voltage_cell_v
             if len(a) != 14:
-                _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
+                _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
             else:
                 for e in a:
-                    if (not (-3.4028234663852886e+38 <= e <= 3.4028234663852886e+38)):
-                        _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
+                    if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
+                        _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
                         break
         except _v.SLOW:
-            _v.diag(out, 'voltage_cell_v', self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
+            _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
         try:
-            if (not (-3.4028234663852886e+38 <= self.max_cell_voltage_delta <= 3.4028234663852886e+38)):
-                _v.diag(out, 'max_cell_voltage_delta', self.max_cell_voltage_delta, _VS_BatteryStatusV0_max_cell_voltage_delta)
+            if not (-3.4028234663852886e38 <= self.max_cell_voltage_delta <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "max_cell_voltage_delta",
+                    self.max_cell_voltage_delta,
+                    _VS_BatteryStatusV0_max_cell_voltage_delta,
+                )
         except _v.SLOW:
-            _v.diag(out, 'max_cell_voltage_delta', self.max_cell_voltage_delta, _VS_BatteryStatusV0_max_cell_voltage_delta)
+            _v.diag(
+                out, "max_cell_voltage_delta", self.max_cell_voltage_delta, _VS_BatteryStatusV0_max_cell_voltage_delta
+            )
         try:
             x = self.is_powering_off
-            if (x is not True and x is not False):
-                _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryStatusV0_is_powering_off)
+            if x is not True and x is not False:
+                _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryStatusV0_is_powering_off)
         except _v.SLOW:
-            _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryStatusV0_is_powering_off)
+            _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryStatusV0_is_powering_off)
         try:
             x = self.is_required
-            if (x is not True and x is not False):
-                _v.diag(out, 'is_required', self.is_required, _VS_BatteryStatusV0_is_required)
+            if x is not True and x is not False:
+                _v.diag(out, "is_required", self.is_required, _VS_BatteryStatusV0_is_required)
         except _v.SLOW:
-            _v.diag(out, 'is_required', self.is_required, _VS_BatteryStatusV0_is_required)
+            _v.diag(out, "is_required", self.is_required, _VS_BatteryStatusV0_is_required)
         try:
-            if (self.warning not in {0, 1, 2, 3, 4, 6, 7}):
-                _v.diag(out, 'warning', self.warning, _VS_BatteryStatusV0_warning)
+            if self.warning not in {0, 1, 2, 3, 4, 6, 7}:
+                _v.diag(out, "warning", self.warning, _VS_BatteryStatusV0_warning)
         except _v.SLOW:
-            _v.diag(out, 'warning', self.warning, _VS_BatteryStatusV0_warning)
+            _v.diag(out, "warning", self.warning, _VS_BatteryStatusV0_warning)
         try:
-            if (self.faults & -2048):
-                _v.diag(out, 'faults', self.faults, _VS_BatteryStatusV0_faults)
+            if self.faults & -2048:
+                _v.diag(out, "faults", self.faults, _VS_BatteryStatusV0_faults)
         except _v.SLOW:
-            _v.diag(out, 'faults', self.faults, _VS_BatteryStatusV0_faults)
+            _v.diag(out, "faults", self.faults, _VS_BatteryStatusV0_faults)
         try:
-            if (not (-3.4028234663852886e+38 <= self.full_charge_capacity_wh <= 3.4028234663852886e+38)):
-                _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryStatusV0_full_charge_capacity_wh)
+            if not (-3.4028234663852886e38 <= self.full_charge_capacity_wh <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "full_charge_capacity_wh",
+                    self.full_charge_capacity_wh,
+                    _VS_BatteryStatusV0_full_charge_capacity_wh,
+                )
         except _v.SLOW:
-            _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryStatusV0_full_charge_capacity_wh)
+            _v.diag(
+                out,
+                "full_charge_capacity_wh",
+                self.full_charge_capacity_wh,
+                _VS_BatteryStatusV0_full_charge_capacity_wh,
+            )
         try:
-            if (not (-3.4028234663852886e+38 <= self.remaining_capacity_wh <= 3.4028234663852886e+38)):
-                _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryStatusV0_remaining_capacity_wh)
+            if not (-3.4028234663852886e38 <= self.remaining_capacity_wh <= 3.4028234663852886e38):
+                _v.diag(
+                    out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryStatusV0_remaining_capacity_wh
+                )
         except _v.SLOW:
-            _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryStatusV0_remaining_capacity_wh)
+            _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryStatusV0_remaining_capacity_wh)
         try:
-            if (self.over_discharge_count & -65536):
-                _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryStatusV0_over_discharge_count)
+            if self.over_discharge_count & -65536:
+                _v.diag(
+                    out, "over_discharge_count", self.over_discharge_count, _VS_BatteryStatusV0_over_discharge_count
+                )
         except _v.SLOW:
-            _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryStatusV0_over_discharge_count)
+            _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryStatusV0_over_discharge_count)
         try:
-            if (not (-3.4028234663852886e+38 <= self.nominal_voltage <= 3.4028234663852886e+38)):
-                _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryStatusV0_nominal_voltage)
+            if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
+                _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryStatusV0_nominal_voltage)
         except _v.SLOW:
-            _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryStatusV0_nominal_voltage)
+            _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryStatusV0_nominal_voltage)
         try:
-            if (not (-3.4028234663852886e+38 <= self.internal_resistance_estimate <= 3.4028234663852886e+38)):
-                _v.diag(out, 'internal_resistance_estimate', self.internal_resistance_estimate, _VS_BatteryStatusV0_internal_resistance_estimate)
+            if not (-3.4028234663852886e38 <= self.internal_resistance_estimate <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "internal_resistance_estimate",
+                    self.internal_resistance_estimate,
+                    _VS_BatteryStatusV0_internal_resistance_estimate,
+                )
         except _v.SLOW:
-            _v.diag(out, 'internal_resistance_estimate', self.internal_resistance_estimate, _VS_BatteryStatusV0_internal_resistance_estimate)
+            _v.diag(
+                out,
+                "internal_resistance_estimate",
+                self.internal_resistance_estimate,
+                _VS_BatteryStatusV0_internal_resistance_estimate,
+            )
         try:
-            if (not (-3.4028234663852886e+38 <= self.ocv_estimate <= 3.4028234663852886e+38)):
-                _v.diag(out, 'ocv_estimate', self.ocv_estimate, _VS_BatteryStatusV0_ocv_estimate)
+            if not (-3.4028234663852886e38 <= self.ocv_estimate <= 3.4028234663852886e38):
+                _v.diag(out, "ocv_estimate", self.ocv_estimate, _VS_BatteryStatusV0_ocv_estimate)
         except _v.SLOW:
-            _v.diag(out, 'ocv_estimate', self.ocv_estimate, _VS_BatteryStatusV0_ocv_estimate)
+            _v.diag(out, "ocv_estimate", self.ocv_estimate, _VS_BatteryStatusV0_ocv_estimate)
         try:
-            if (not (-3.4028234663852886e+38 <= self.ocv_estimate_filtered <= 3.4028234663852886e+38)):
-                _v.diag(out, 'ocv_estimate_filtered', self.ocv_estimate_filtered, _VS_BatteryStatusV0_ocv_estimate_filtered)
+            if not (-3.4028234663852886e38 <= self.ocv_estimate_filtered <= 3.4028234663852886e38):
+                _v.diag(
+                    out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _VS_BatteryStatusV0_ocv_estimate_filtered
+                )
         except _v.SLOW:
-            _v.diag(out, 'ocv_estimate_filtered', self.ocv_estimate_filtered, _VS_BatteryStatusV0_ocv_estimate_filtered)
+            _v.diag(out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _VS_BatteryStatusV0_ocv_estimate_filtered)
         try:
-            if (not (0.0 <= self.volt_based_soc_estimate <= 1.0)):
-                _v.diag(out, 'volt_based_soc_estimate', self.volt_based_soc_estimate, _VS_BatteryStatusV0_volt_based_soc_estimate)
+            if not (0.0 <= self.volt_based_soc_estimate <= 1.0):
+                _v.diag(
+                    out,
+                    "volt_based_soc_estimate",
+                    self.volt_based_soc_estimate,
+                    _VS_BatteryStatusV0_volt_based_soc_estimate,
+                )
         except _v.SLOW:
-            _v.diag(out, 'volt_based_soc_estimate', self.volt_based_soc_estimate, _VS_BatteryStatusV0_volt_based_soc_estimate)
+            _v.diag(
+                out,
+                "volt_based_soc_estimate",
+                self.volt_based_soc_estimate,
+                _VS_BatteryStatusV0_volt_based_soc_estimate,
+            )
         try:
-            if (not (-3.4028234663852886e+38 <= self.voltage_prediction <= 3.4028234663852886e+38)):
-                _v.diag(out, 'voltage_prediction', self.voltage_prediction, _VS_BatteryStatusV0_voltage_prediction)
+            if not (-3.4028234663852886e38 <= self.voltage_prediction <= 3.4028234663852886e38):
+                _v.diag(out, "voltage_prediction", self.voltage_prediction, _VS_BatteryStatusV0_voltage_prediction)
         except _v.SLOW:
-            _v.diag(out, 'voltage_prediction', self.voltage_prediction, _VS_BatteryStatusV0_voltage_prediction)
+            _v.diag(out, "voltage_prediction", self.voltage_prediction, _VS_BatteryStatusV0_voltage_prediction)
         try:
-            if (not (-3.4028234663852886e+38 <= self.prediction_error <= 3.4028234663852886e+38)):
-                _v.diag(out, 'prediction_error', self.prediction_error, _VS_BatteryStatusV0_prediction_error)
+            if not (-3.4028234663852886e38 <= self.prediction_error <= 3.4028234663852886e38):
+                _v.diag(out, "prediction_error", self.prediction_error, _VS_BatteryStatusV0_prediction_error)
         except _v.SLOW:
-            _v.diag(out, 'prediction_error', self.prediction_error, _VS_BatteryStatusV0_prediction_error)
+            _v.diag(out, "prediction_error", self.prediction_error, _VS_BatteryStatusV0_prediction_error)
         try:
-            if (not (-3.4028234663852886e+38 <= self.estimation_covariance_norm <= 3.4028234663852886e+38)):
-                _v.diag(out, 'estimation_covariance_norm', self.estimation_covariance_norm, _VS_BatteryStatusV0_estimation_covariance_norm)
+            if not (-3.4028234663852886e38 <= self.estimation_covariance_norm <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "estimation_covariance_norm",
+                    self.estimation_covariance_norm,
+                    _VS_BatteryStatusV0_estimation_covariance_norm,
+                )
         except _v.SLOW:
-            _v.diag(out, 'estimation_covariance_norm', self.estimation_covariance_norm, _VS_BatteryStatusV0_estimation_covariance_norm)
+            _v.diag(
+                out,
+                "estimation_covariance_norm",
+                self.estimation_covariance_norm,
+                _VS_BatteryStatusV0_estimation_covariance_norm,
+            )
         # rule cell-count-capacity (uorb-battery-status.yaml:5)
         try:
             r_cell_count = self.cell_count
             r_voltage_cell_v = self.voltage_cell_v
             if not (r_cell_count <= len(r_voltage_cell_v)):
-                out.append(_v.rule('cell_count', 'cell-count-capacity', r_cell_count, 'cell_count <= len(voltage_cell_v)', 'cell_count = ' + _v.fmt(r_cell_count) + ' is above the ' + _v.fmt(len(r_voltage_cell_v)) + ' cells voltage_cell_v can hold', 'error'))
+                out.append(
+                    _v.rule(
+                        "cell_count",
+                        "cell-count-capacity",
+                        r_cell_count,
+                        "cell_count <= len(voltage_cell_v)",
+                        "cell_count = "
+                        + _v.fmt(r_cell_count)
+                        + " is above the "
+                        + _v.fmt(len(r_voltage_cell_v))
+                        + " cells voltage_cell_v can hold",
+                        "error",
+                    )
+                )
         except _v.SLOW:
             pass  # the field checks report the cause
         # rule cells-beyond-count-zero (uorb-battery-status.yaml:11)
         try:
             r_cell_count = self.cell_count
             r_voltage_cell_v = self.voltage_cell_v
-            if (r_cell_count != 0):
+            if r_cell_count != 0:
                 for v_i in range(r_cell_count, len(r_voltage_cell_v)):
                     try:
                         if not (r_voltage_cell_v[v_i] == 0):
-                            out.append(_v.rule('voltage_cell_v' + '[' + str(v_i) + ']', 'cells-beyond-count-zero', r_voltage_cell_v[v_i], 'voltage_cell_v[i] == 0', 'voltage_cell_v[' + _v.fmt(v_i) + '] = ' + _v.fmt(r_voltage_cell_v[v_i]) + ' V but the battery has only ' + _v.fmt(r_cell_count) + ' cells; expected 0', 'error'))
+                            out.append(
+                                _v.rule(
+                                    "voltage_cell_v" + "[" + str(v_i) + "]",
+                                    "cells-beyond-count-zero",
+                                    r_voltage_cell_v[v_i],
+                                    "voltage_cell_v[i] == 0",
+                                    "voltage_cell_v["
+                                    + _v.fmt(v_i)
+                                    + "] = "
+                                    + _v.fmt(r_voltage_cell_v[v_i])
+                                    + " V but the battery has only "
+                                    + _v.fmt(r_cell_count)
+                                    + " cells; expected 0",
+                                    "error",
+                                )
+                            )
                     except _v.SLOW:
                         pass
         except _v.SLOW:
@@ -1511,31 +3113,61 @@ class BatteryStatusV0:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'uorb.BatteryStatusV0')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "uorb.BatteryStatusV0")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field == 'voltage_v':
+        if field == "voltage_v":
             return self.voltage_v != 0.0
-        if field == 'current_a':
+        if field == "current_a":
             return self.current_a != -1.0
-        if field == 'current_average_a':
+        if field == "current_average_a":
             return self.current_average_a != -1.0
-        if field == 'discharged_mah':
+        if field == "discharged_mah":
             return self.discharged_mah != -1.0
-        if field == 'remaining':
+        if field == "remaining":
             return self.remaining != -1.0
-        if field == 'scale':
+        if field == "scale":
             return self.scale != -1.0
-        if field == 'time_remaining_s':
+        if field == "time_remaining_s":
             return self.time_remaining_s == self.time_remaining_s
-        if field == 'temperature':
+        if field == "temperature":
             return self.temperature == self.temperature
-        if field == 'cell_count':
+        if field == "cell_count":
             return self.cell_count != 0
-        if field == 'voltage_cell_v':
+        if field == "voltage_cell_v":
             return any(e != 0.0 for e in self.voltage_cell_v)
-        if field in {'timestamp', 'connected', 'source', 'priority', 'capacity', 'cycle_count', 'average_time_to_empty', 'serial_number', 'manufacture_date', 'state_of_health', 'max_error', 'id', 'interface_error', 'max_cell_voltage_delta', 'is_powering_off', 'is_required', 'warning', 'faults', 'full_charge_capacity_wh', 'remaining_capacity_wh', 'over_discharge_count', 'nominal_voltage', 'internal_resistance_estimate', 'ocv_estimate', 'ocv_estimate_filtered', 'volt_based_soc_estimate', 'voltage_prediction', 'prediction_error', 'estimation_covariance_norm'}:
+        if field in {
+            "timestamp",
+            "connected",
+            "source",
+            "priority",
+            "capacity",
+            "cycle_count",
+            "average_time_to_empty",
+            "serial_number",
+            "manufacture_date",
+            "state_of_health",
+            "max_error",
+            "id",
+            "interface_error",
+            "max_cell_voltage_delta",
+            "is_powering_off",
+            "is_required",
+            "warning",
+            "faults",
+            "full_charge_capacity_wh",
+            "remaining_capacity_wh",
+            "over_discharge_count",
+            "nominal_voltage",
+            "internal_resistance_estimate",
+            "ocv_estimate",
+            "ocv_estimate_filtered",
+            "volt_based_soc_estimate",
+            "voltage_prediction",
+            "prediction_error",
+            "estimation_covariance_norm",
+        }:
             return True
-        raise KeyError(f'{field!r} is not a field of ' + 'uorb.BatteryStatusV0')
+        raise KeyError(f"{field!r} is not a field of " + "uorb.BatteryStatusV0")

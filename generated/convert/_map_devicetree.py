@@ -13,11 +13,11 @@ from ._concepts import BatteryState
 from ..devicetree.power.supply import SimpleBattery as _C0
 
 
-_K1_forward = dict((('lithium-ion', 'lion'), ('lithium-ion-polymer', 'lipo'), ('lithium-ion-iron-phosphate', 'life'), ('lithium-ion-manganese-oxide', 'limn'), ('nickel-metal-hydride', 'nimh'), ('nickel-cadmium', 'nicd'),))
-_K9_forward = dict((('lithium-ion', 4.2), ('lithium-ion-polymer', 4.2), ('lithium-ion-iron-phosphate', 3.65), ('lithium-ion-manganese-oxide', 4.2), ('nickel-metal-hydride', 1.5), ('nickel-cadmium', 1.5)))
-_K10_forward = dict((('lithium-ion', 3.0), ('lithium-ion-polymer', 3.0), ('lithium-ion-iron-phosphate', 2.5), ('lithium-ion-manganese-oxide', 3.0), ('nickel-metal-hydride', 1.0), ('nickel-cadmium', 1.0)))
-_K11_forward = dict((('lithium-ion', 3.6), ('lithium-ion-polymer', 3.7), ('lithium-ion-iron-phosphate', 3.2), ('lithium-ion-manganese-oxide', 3.7), ('nickel-metal-hydride', 1.2), ('nickel-cadmium', 1.2)))
-_K14_forward = (('compatible', 'compatible'), ('over_voltage_threshold_microvolt', 'over-voltage-threshold-microvolt'), ('re_charge_voltage_microvolt', 're-charge-voltage-microvolt'), ('trickle_charge_current_microamp', 'trickle-charge-current-microamp'), ('tricklecharge_upper_limit_microvolt', 'tricklecharge-upper-limit-microvolt'), ('precharge_current_microamp', 'precharge-current-microamp'), ('precharge_upper_limit_microvolt', 'precharge-upper-limit-microvolt'), ('charge_term_current_microamp', 'charge-term-current-microamp'), ('constant_charge_current_max_microamp', 'constant-charge-current-max-microamp'), ('constant_charge_voltage_max_microvolt', 'constant-charge-voltage-max-microvolt'), ('factory_internal_resistance_micro_ohms', 'factory-internal-resistance-micro-ohms'), ('resistance_temp_table', 'resistance-temp-table'), ('operating_range_celsius', 'operating-range-celsius'), ('ambient_celsius', 'ambient-celsius'), ('alert_celsius', 'alert-celsius'), ('volt_drop_thresh_microvolt', 'volt-drop-thresh-microvolt'), ('volt_drop_soc_bp', 'volt-drop-soc-bp'), ('volt_drop_temperatures_millicelsius', 'volt-drop-temperatures-millicelsius'), ('volt_drop_n_microvolt', '^volt-drop-[0-9]-microvolt'))
+_K1_forward = dict((("lithium-ion", "lion"), ("lithium-ion-polymer", "lipo"), ("lithium-ion-iron-phosphate", "life"), ("lithium-ion-manganese-oxide", "limn"), ("nickel-metal-hydride", "nimh"), ("nickel-cadmium", "nicd"),))
+_K9_forward = dict((("lithium-ion", 4.2), ("lithium-ion-polymer", 4.2), ("lithium-ion-iron-phosphate", 3.65), ("lithium-ion-manganese-oxide", 4.2), ("nickel-metal-hydride", 1.5), ("nickel-cadmium", 1.5)))
+_K10_forward = dict((("lithium-ion", 3.0), ("lithium-ion-polymer", 3.0), ("lithium-ion-iron-phosphate", 2.5), ("lithium-ion-manganese-oxide", 3.0), ("nickel-metal-hydride", 1.0), ("nickel-cadmium", 1.0)))
+_K11_forward = dict((("lithium-ion", 3.6), ("lithium-ion-polymer", 3.7), ("lithium-ion-iron-phosphate", 3.2), ("lithium-ion-manganese-oxide", 3.7), ("nickel-metal-hydride", 1.2), ("nickel-cadmium", 1.2)))
+_K14_forward = (("compatible", "compatible"), ("over_voltage_threshold_microvolt", "over-voltage-threshold-microvolt"), ("re_charge_voltage_microvolt", "re-charge-voltage-microvolt"), ("trickle_charge_current_microamp", "trickle-charge-current-microamp"), ("tricklecharge_upper_limit_microvolt", "tricklecharge-upper-limit-microvolt"), ("precharge_current_microamp", "precharge-current-microamp"), ("precharge_upper_limit_microvolt", "precharge-upper-limit-microvolt"), ("charge_term_current_microamp", "charge-term-current-microamp"), ("constant_charge_current_max_microamp", "constant-charge-current-max-microamp"), ("constant_charge_voltage_max_microvolt", "constant-charge-voltage-max-microvolt"), ("factory_internal_resistance_micro_ohms", "factory-internal-resistance-micro-ohms"), ("resistance_temp_table", "resistance-temp-table"), ("operating_range_celsius", "operating-range-celsius"), ("ambient_celsius", "ambient-celsius"), ("alert_celsius", "alert-celsius"), ("volt_drop_thresh_microvolt", "volt-drop-thresh-microvolt"), ("volt_drop_soc_bp", "volt-drop-soc-bp"), ("volt_drop_temperatures_millicelsius", "volt-drop-temperatures-millicelsius"), ("volt_drop_n_microvolt", "^volt-drop-[0-9]-microvolt"))
 _K15_forward = _C0()
 
 
@@ -27,7 +27,7 @@ def forward(s_node: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRepo
     _v2 = s_node.device_chemistry
     t.chemistry = None if _v2 is None else _K1_forward.get(_v2)
     if rep_d is not None and _v2 not in _K1_forward and _v2 not in (None, None,):
-        rep_d.dropped('devicetree.power.supply.battery.device-chemistry', '%r has no counterpart' % (_v2,))
+        rep_d.dropped("devicetree.power.supply.battery.device-chemistry", '%r has no counterpart' % (_v2,))
     _v3 = _r.dt_first(s_node.voltage_min_design_microvolt)
     if _v3 is not None:
         t.voltage_min_design = float(_v3) * 1e-06
@@ -60,7 +60,7 @@ def forward(s_node: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRepo
     _ts13 = s_node.ocv_capacity_celsius
     _tb13 = s_node.ocv_capacity_table_n
     if ocv_v is not None and _ts13:
-        _tabs13 = [_x13 for _x13 in (_tb13.get('ocv-capacity-table-' + str(_i13)) for _i13 in range(len(_ts13))) if _x13]
+        _tabs13 = [_x13 for _x13 in (_tb13.get("ocv-capacity-table-" + str(_i13)) for _i13 in range(len(_ts13))) if _x13]
         _t13 = temperature_c
         if _t13 is None and len(_ts13) == 1:
             _t13 = _ts13[0]
@@ -71,5 +71,5 @@ def forward(s_node: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRepo
     if rep_d is not None:
         for _a, _n in _K14_forward:
             if _r.differs(getattr(s_node, _a), getattr(_K15_forward, _a)):
-                rep_d.dropped('devicetree.power.supply.battery.' + _n)
+                rep_d.dropped("devicetree.power.supply.battery." + _n)
     return (t,)

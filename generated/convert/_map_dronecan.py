@@ -14,11 +14,11 @@ from ..dronecan.uavcan.equipment.power import BatteryInfo as _C0
 from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _C1
 
 
-_K26_forward = (('timestamp', 'timestamp'),)
+_K26_forward = (("timestamp", "timestamp"),)
 _K27_forward = _C1()
-_K11_backward = ('hardware_failure', 'over_current', 'over_temperature', 'under_temperature')
-_K26_backward = ('connected', 'average_current', 'design_energy', 'full_capacity', 'design_capacity', 'discharged', 'consumed_energy', 'time_remaining', 'cell_count', 'voltage_min_design', 'voltage_max_design', 'chemistry')
-_K27_backward = ('dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp',)
+_K11_backward = ("hardware_failure", "over_current", "over_temperature", "under_temperature")
+_K26_backward = ("connected", "average_current", "design_energy", "full_capacity", "design_capacity", "discharged", "consumed_energy", "time_remaining", "cell_count", "voltage_min_design", "voltage_max_design", "chemistry")
+_K27_backward = ("dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp",)
 
 
 def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[BatteryState]:
@@ -48,9 +48,9 @@ def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None 
     t.in_use = bool(s_info.status_flags & 1)
     t.charging = bool(s_info.status_flags & 2)
     if s_info.status_flags & 2:
-        t.warning = 'charging'
+        t.warning = "charging"
     _v11 = s_info.status_flags
-    t.faults = tuple(_n11 for _n11, _m11 in (('over_current', 32), ('over_temperature', 8), ('under_temperature', 16), ('hardware_failure', 64),) if _v11 & _m11)
+    t.faults = tuple(_n11 for _n11, _m11 in (("over_current", 32), ("over_temperature", 8), ("under_temperature", 16), ("hardware_failure", 64),) if _v11 & _m11)
     _v12 = s_info.state_of_health_pct
     if _v12 != 127 and _v12 <= 100:
         t.state_of_health = float(_v12) * 0.01
@@ -93,11 +93,11 @@ def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None 
         _v25 = s_aux.is_powering_off
         t.is_powering_off = bool(_v25)
     if rep_d is not None and s_info.status_flags & -124:
-        rep_d.dropped('dronecan.uavcan.equipment.power.BatteryInfo.status_flags', 'bits %#x have no counterpart' % (s_info.status_flags & -124))
+        rep_d.dropped("dronecan.uavcan.equipment.power.BatteryInfo.status_flags", 'bits %#x have no counterpart' % (s_info.status_flags & -124))
     if rep_d is not None and s_aux is not None:
         for _a, _n in _K26_forward:
             if _r.differs(getattr(s_aux, _a), getattr(_K27_forward, _a)):
-                rep_d.dropped('dronecan.ardupilot.equipment.power.BatteryInfoAux.' + _n)
+                rep_d.dropped("dronecan.ardupilot.equipment.power.BatteryInfoAux." + _n)
     return (t,)
 
 
@@ -109,170 +109,170 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     if _v1 is None or _v1 != _v1:
         t_info.voltage = math.nan
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.voltage')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.voltage")
     else:
-        t_info.voltage = _r.f16(_v1, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.voltage')
+        t_info.voltage = _r.f16(_v1, rep, "dronecan.uavcan.equipment.power.BatteryInfo.voltage")
     _v2 = s.current
     if _v2 is None or _v2 != _v2:
         t_info.current = math.nan
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.current')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.current")
     else:
-        t_info.current = _r.f16(_v2, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.current')
+        t_info.current = _r.f16(_v2, rep, "dronecan.uavcan.equipment.power.BatteryInfo.current")
     _v3 = s.temperature
     if _v3 is None or _v3 != _v3:
         t_info.temperature = math.nan
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.temperature')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.temperature")
     else:
-        t_info.temperature = _r.f16(_v3, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.temperature')
+        t_info.temperature = _r.f16(_v3, rep, "dronecan.uavcan.equipment.power.BatteryInfo.temperature")
     _v4 = s.average_power
     if _v4 is None or _v4 != _v4:
         t_info.average_power_10sec = math.nan
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec")
     else:
-        t_info.average_power_10sec = _r.f16(_v4, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec')
+        t_info.average_power_10sec = _r.f16(_v4, rep, "dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec")
     _v5 = s.remaining_energy
     if _v5 is None or _v5 != _v5:
         t_info.remaining_capacity_wh = math.nan
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
     else:
-        t_info.remaining_capacity_wh = _r.f16(_v5 * 0.0002777777777777778, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh')
+        t_info.remaining_capacity_wh = _r.f16(_v5 * 0.0002777777777777778, rep, "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
     _v6 = s.full_energy
     if _v6 is None or _v6 != _v6:
         t_info.full_charge_capacity_wh = math.nan
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
     else:
-        t_info.full_charge_capacity_wh = _r.f16(_v6 * 0.0002777777777777778, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh')
+        t_info.full_charge_capacity_wh = _r.f16(_v6 * 0.0002777777777777778, rep, "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
     _v7 = s.time_to_full
     if _v7 is None or _v7 != _v7:
         t_info.hours_to_full_charge = math.nan
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge")
     else:
-        t_info.hours_to_full_charge = _r.f16(_v7 * 0.0002777777777777778, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge')
+        t_info.hours_to_full_charge = _r.f16(_v7 * 0.0002777777777777778, rep, "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge")
     if s.in_use:
         t_info.status_flags |= 1
     if s.charging:
         t_info.status_flags |= 2
-    if s.warning == 'charging':
+    if s.warning == "charging":
         t_info.status_flags |= 2
     _v12 = s.faults
     if _v12 is None:
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.status_flags')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.status_flags")
     else:
         _b12 = t_info.status_flags
-        if 'over_current' in _v12:
+        if "over_current" in _v12:
             _b12 |= 32
-        if 'over_temperature' in _v12:
+        if "over_temperature" in _v12:
             _b12 |= 8
-        if 'under_temperature' in _v12:
+        if "under_temperature" in _v12:
             _b12 |= 16
-        if 'hardware_failure' in _v12:
+        if "hardware_failure" in _v12:
             _b12 |= 64
         t_info.status_flags = _b12
         if rep_d is not None:
             for _n12 in _v12:
                 if _n12 not in _K11_backward:
-                    rep_d.dropped('concepts.faults', _n12 + ' has no counterpart')
+                    rep_d.dropped("concepts.faults", _n12 + ' has no counterpart')
     _v13 = s.state_of_health
     if _v13 is None or _v13 != _v13:
         t_info.state_of_health_pct = 127
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct")
     else:
-        t_info.state_of_health_pct = _r.to_int(_v13 * 100.0, 0, 100, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct')
+        t_info.state_of_health_pct = _r.to_int(_v13 * 100.0, 0, 100, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct")
         if rep is not None and t_info.state_of_health_pct in (127,):
-            rep.clamped('dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct', 'a known value written as the unknown marker')
+            rep.clamped("dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct", 'a known value written as the unknown marker')
     _v14 = s.state_of_charge
     if _v14 is None or _v14 != _v14:
         t_info.state_of_charge_pct = 127
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct")
     else:
-        t_info.state_of_charge_pct = _r.to_int(_v14 * 100.0, 0, 127, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct')
+        t_info.state_of_charge_pct = _r.to_int(_v14 * 100.0, 0, 127, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct")
         if rep is not None and t_info.state_of_charge_pct in (127,):
-            rep.clamped('dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct', 'a known value written as the unknown marker')
+            rep.clamped("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct", 'a known value written as the unknown marker')
     _v15 = s.state_of_charge_stdev
     if _v15 is None or _v15 != _v15:
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev")
     else:
-        t_info.state_of_charge_pct_stdev = _r.to_int(_v15 * 100.0, 0, 127, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev')
+        t_info.state_of_charge_pct_stdev = _r.to_int(_v15 * 100.0, 0, 127, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev")
     _v16 = s.battery_index
     if _v16 is None:
         if rep_u is not None:
-            rep_u.unknown('dronecan.ardupilot.equipment.power.BatteryInfoAux.battery_id')
+            rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.battery_id")
     else:
-        t_aux.battery_id = _r.to_int(_v16, 0, 255, rep, 'dronecan.ardupilot.equipment.power.BatteryInfoAux.battery_id')
+        t_aux.battery_id = _r.to_int(_v16, 0, 255, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.battery_id")
     _v17 = s.battery_index
     if _v17 is None:
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.battery_id')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.battery_id")
     else:
-        t_info.battery_id = _r.to_int(_v17, 0, 255, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.battery_id')
+        t_info.battery_id = _r.to_int(_v17, 0, 255, rep, "dronecan.uavcan.equipment.power.BatteryInfo.battery_id")
     _v18 = s.serial_number
     if _v18 is None:
         t_info.model_instance_id = 0
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id")
     else:
-        t_info.model_instance_id = _r.to_int(_v18, 0, 4294967295, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id')
+        t_info.model_instance_id = _r.to_int(_v18, 0, 4294967295, rep, "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id")
         if rep is not None and t_info.model_instance_id in (0,):
-            rep.clamped('dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id', 'a known value written as the unknown marker')
+            rep.clamped("dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id", 'a known value written as the unknown marker')
     _v19 = s.model_name
     if _v19 is None:
         if rep_u is not None:
-            rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.model_name')
+            rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.model_name")
     else:
-        t_info.model_name = _r.bytes_out(_v19, 31, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.model_name')
+        t_info.model_name = _r.bytes_out(_v19, 31, rep, "dronecan.uavcan.equipment.power.BatteryInfo.model_name")
     _c20 = s.cell_voltages
     if _c20 is None:
         if rep_u is not None:
-            rep_u.unknown('dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell')
+            rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell")
     else:
         if len(_c20) > 255:
             if rep is not None:
-                rep.clamped('dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell', '%d cells, room for 255' % len(_c20))
+                rep.clamped("dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell", '%d cells, room for 255' % len(_c20))
             _c20 = _c20[:255]
-        _l20 = [_r.f16(_x20, rep, 'dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell') for _x20 in _c20]
+        _l20 = [_r.f16(_x20, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell") for _x20 in _c20]
         t_aux.voltage_cell = _l20
     _v21 = s.cycle_count
     if _v21 is None:
         if rep_u is not None:
-            rep_u.unknown('dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count')
+            rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count")
     else:
-        t_aux.cycle_count = _r.to_int(_v21, 0, 65535, rep, 'dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count')
+        t_aux.cycle_count = _r.to_int(_v21, 0, 65535, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count")
     _v22 = s.over_discharge_count
     if _v22 is None:
         if rep_u is not None:
-            rep_u.unknown('dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count')
+            rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count")
     else:
-        t_aux.over_discharge_count = _r.to_int(_v22, 0, 65535, rep, 'dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count')
+        t_aux.over_discharge_count = _r.to_int(_v22, 0, 65535, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count")
     _v23 = s.max_current
     if _v23 is None or _v23 != _v23:
         t_aux.max_current = math.nan
         if rep_u is not None:
-            rep_u.unknown('dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current')
+            rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current")
     else:
-        t_aux.max_current = _r.f16(_v23, rep, 'dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current')
+        t_aux.max_current = _r.f16(_v23, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current")
     _v24 = s.nominal_voltage
     if _v24 is None or _v24 != _v24:
         t_aux.nominal_voltage = 0.0
         if rep_u is not None:
-            rep_u.unknown('dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage')
+            rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage")
     else:
-        t_aux.nominal_voltage = _r.f16(_v24, rep, 'dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage')
+        t_aux.nominal_voltage = _r.f16(_v24, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage")
         if rep is not None and t_aux.nominal_voltage in (0,):
-            rep.clamped('dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage', 'a known value written as the unknown marker')
+            rep.clamped("dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage", 'a known value written as the unknown marker')
     _v25 = s.is_powering_off
     if _v25 is None:
         if rep_u is not None:
-            rep_u.unknown('dronecan.ardupilot.equipment.power.BatteryInfoAux.is_powering_off')
+            rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.is_powering_off")
     else:
         t_aux.is_powering_off = bool(_v25)
     if rep_d is not None:

@@ -13,15 +13,15 @@ from ._concepts import BatteryState
 from ..mavlink import BatteryStatus as _C0
 
 
-_K2_forward = dict(((1, 'lipo'), (2, 'life'), (3, 'lion'), (4, 'nimh'),))
-_K11_forward = dict(((1, 'none'), (2, 'low'), (3, 'critical'), (4, 'emergency'), (5, 'failed'), (6, 'unhealthy'), (7, 'charging'),))
-_K15_forward = (('battery_function', 'battery_function'), ('mode', 'mode'))
+_K2_forward = dict(((1, "lipo"), (2, "life"), (3, "lion"), (4, "nimh"),))
+_K11_forward = dict(((1, "none"), (2, "low"), (3, "critical"), (4, "emergency"), (5, "failed"), (6, "unhealthy"), (7, "charging"),))
+_K15_forward = (("battery_function", "battery_function"), ("mode", "mode"))
 _K16_forward = _C0()
-_K2_backward = dict((('lipo', 1), ('life', 2), ('lion', 3), ('nimh', 4),))
-_K11_backward = dict((('none', 1), ('low', 2), ('critical', 3), ('emergency', 4), ('failed', 5), ('unhealthy', 6), ('charging', 7),))
-_K13_backward = ('cell_fail', 'deep_discharge', 'incompatible_cells_configuration', 'incompatible_firmware', 'incompatible_voltage', 'over_current', 'over_temperature', 'spikes', 'under_temperature')
-_K15_backward = ('connected', 'in_use', 'charging', 'average_current', 'max_current', 'average_power', 'state_of_charge_stdev', 'state_of_health', 'remaining_energy', 'full_energy', 'design_energy', 'full_capacity', 'design_capacity', 'time_to_full', 'cell_count', 'cycle_count', 'over_discharge_count', 'nominal_voltage', 'voltage_min_design', 'voltage_max_design', 'serial_number', 'model_name', 'is_powering_off')
-_K16_backward = ('mavlink.BATTERY_STATUS.battery_function', 'mavlink.BATTERY_STATUS.mode')
+_K2_backward = dict((("lipo", 1), ("life", 2), ("lion", 3), ("nimh", 4),))
+_K11_backward = dict((("none", 1), ("low", 2), ("critical", 3), ("emergency", 4), ("failed", 5), ("unhealthy", 6), ("charging", 7),))
+_K13_backward = ("cell_fail", "deep_discharge", "incompatible_cells_configuration", "incompatible_firmware", "incompatible_voltage", "over_current", "over_temperature", "spikes", "under_temperature")
+_K15_backward = ("connected", "in_use", "charging", "average_current", "max_current", "average_power", "state_of_charge_stdev", "state_of_health", "remaining_energy", "full_energy", "design_energy", "full_capacity", "design_capacity", "time_to_full", "cell_count", "cycle_count", "over_discharge_count", "nominal_voltage", "voltage_min_design", "voltage_max_design", "serial_number", "model_name", "is_powering_off")
+_K16_backward = ("mavlink.BATTERY_STATUS.battery_function", "mavlink.BATTERY_STATUS.mode")
 
 
 def forward(s_msg: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[BatteryState]:
@@ -32,7 +32,7 @@ def forward(s_msg: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRepor
     _v3 = s_msg.type
     t.chemistry = None if _v3 is None else _K2_forward.get(_v3)
     if rep_d is not None and _v3 not in _K2_forward and _v3 not in (None, 0,):
-        rep_d.dropped('mavlink.BATTERY_STATUS.type', '%r has no counterpart' % (_v3,))
+        rep_d.dropped("mavlink.BATTERY_STATUS.type", '%r has no counterpart' % (_v3,))
     _v4 = s_msg.temperature
     if _v4 != 32767:
         t.temperature = float(_v4) * 0.01 + 273.15
@@ -59,16 +59,16 @@ def forward(s_msg: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRepor
     _v12 = s_msg.charge_state
     t.warning = None if _v12 is None else _K11_forward.get(_v12)
     if rep_d is not None and _v12 not in _K11_forward and _v12 not in (None, 0,):
-        rep_d.dropped('mavlink.BATTERY_STATUS.charge_state', '%r has no counterpart' % (_v12,))
+        rep_d.dropped("mavlink.BATTERY_STATUS.charge_state", '%r has no counterpart' % (_v12,))
     _v13 = s_msg.fault_bitmask
-    t.faults = tuple(_n13 for _n13, _m13 in (('deep_discharge', 1), ('spikes', 2), ('cell_fail', 4), ('over_current', 8), ('over_temperature', 16), ('under_temperature', 32), ('incompatible_voltage', 64), ('incompatible_firmware', 128), ('incompatible_cells_configuration', 256),) if _v13 & _m13)
+    t.faults = tuple(_n13 for _n13, _m13 in (("deep_discharge", 1), ("spikes", 2), ("cell_fail", 4), ("over_current", 8), ("over_temperature", 16), ("under_temperature", 32), ("incompatible_voltage", 64), ("incompatible_firmware", 128), ("incompatible_cells_configuration", 256),) if _v13 & _m13)
     t.connected = True
     if rep_d is not None and s_msg.fault_bitmask & -512:
-        rep_d.dropped('mavlink.BATTERY_STATUS.fault_bitmask', 'bits %#x have no counterpart' % (s_msg.fault_bitmask & -512))
+        rep_d.dropped("mavlink.BATTERY_STATUS.fault_bitmask", 'bits %#x have no counterpart' % (s_msg.fault_bitmask & -512))
     if rep_d is not None:
         for _a, _n in _K15_forward:
             if _r.differs(getattr(s_msg, _a), getattr(_K16_forward, _a)):
-                rep_d.dropped('mavlink.BATTERY_STATUS.' + _n)
+                rep_d.dropped("mavlink.BATTERY_STATUS." + _n)
     return (t,)
 
 
@@ -78,9 +78,9 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     _v1 = s.battery_index
     if _v1 is None:
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.id')
+            rep_u.unknown("mavlink.BATTERY_STATUS.id")
     else:
-        t_msg.id = _r.to_int(_v1, 0, 255, rep, 'mavlink.BATTERY_STATUS.id')
+        t_msg.id = _r.to_int(_v1, 0, 255, rep, "mavlink.BATTERY_STATUS.id")
     _v3 = s.chemistry
     _w3 = None if _v3 is None else _K2_backward.get(_v3)
     if _w3 is not None:
@@ -88,71 +88,71 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_msg.type = 0
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.type')
+            rep_u.unknown("mavlink.BATTERY_STATUS.type")
         if rep_d is not None and _v3 is not None:
-            rep_d.dropped('concepts.chemistry', '%r has no counterpart' % (_v3,))
+            rep_d.dropped("concepts.chemistry", '%r has no counterpart' % (_v3,))
     _v4 = s.temperature
     if _v4 is None or _v4 != _v4:
         t_msg.temperature = 32767
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.temperature')
+            rep_u.unknown("mavlink.BATTERY_STATUS.temperature")
     else:
-        t_msg.temperature = _r.to_int(_v4 * 100.0 + -27314.999999999996, -32768, 32767, rep, 'mavlink.BATTERY_STATUS.temperature')
+        t_msg.temperature = _r.to_int(_v4 * 100.0 + -27314.999999999996, -32768, 32767, rep, "mavlink.BATTERY_STATUS.temperature")
         if rep is not None and t_msg.temperature in (32767,):
-            rep.clamped('mavlink.BATTERY_STATUS.temperature', 'a known value written as the unknown marker')
+            rep.clamped("mavlink.BATTERY_STATUS.temperature", 'a known value written as the unknown marker')
     _c5 = s.cell_voltages
     _p5 = s.pack_voltage
     t_msg.voltages, t_msg.voltages_ext = _r.mavlink_cells_out(
         None if _c5 is None else [_x5 * 1000.0 for _x5 in _c5],
         None if _p5 is None else _p5 * 1000.0,
         10, 4, 65535, 0,
-        rep, 'mavlink.BATTERY_STATUS.voltages', 'mavlink.BATTERY_STATUS.voltages_ext',
+        rep, "mavlink.BATTERY_STATUS.voltages", "mavlink.BATTERY_STATUS.voltages_ext",
     )
     _v6 = s.current
     if _v6 is None or _v6 != _v6:
         t_msg.current_battery = -1
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.current_battery')
+            rep_u.unknown("mavlink.BATTERY_STATUS.current_battery")
     else:
-        t_msg.current_battery = _r.to_int(_v6 * 100.0, -32768, 32767, rep, 'mavlink.BATTERY_STATUS.current_battery')
+        t_msg.current_battery = _r.to_int(_v6 * 100.0, -32768, 32767, rep, "mavlink.BATTERY_STATUS.current_battery")
         if rep is not None and t_msg.current_battery in (-1,):
-            rep.clamped('mavlink.BATTERY_STATUS.current_battery', 'a known value written as the unknown marker')
+            rep.clamped("mavlink.BATTERY_STATUS.current_battery", 'a known value written as the unknown marker')
     _v7 = s.discharged
     if _v7 is None or _v7 != _v7:
         t_msg.current_consumed = -1
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.current_consumed')
+            rep_u.unknown("mavlink.BATTERY_STATUS.current_consumed")
     else:
-        t_msg.current_consumed = _r.to_int(_v7 * 0.2777777777777778, -2147483648, 2147483647, rep, 'mavlink.BATTERY_STATUS.current_consumed')
+        t_msg.current_consumed = _r.to_int(_v7 * 0.2777777777777778, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.current_consumed")
         if rep is not None and t_msg.current_consumed in (-1,):
-            rep.clamped('mavlink.BATTERY_STATUS.current_consumed', 'a known value written as the unknown marker')
+            rep.clamped("mavlink.BATTERY_STATUS.current_consumed", 'a known value written as the unknown marker')
     _v8 = s.consumed_energy
     if _v8 is None or _v8 != _v8:
         t_msg.energy_consumed = -1
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.energy_consumed')
+            rep_u.unknown("mavlink.BATTERY_STATUS.energy_consumed")
     else:
-        t_msg.energy_consumed = _r.to_int(_v8 * 0.01, -2147483648, 2147483647, rep, 'mavlink.BATTERY_STATUS.energy_consumed')
+        t_msg.energy_consumed = _r.to_int(_v8 * 0.01, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.energy_consumed")
         if rep is not None and t_msg.energy_consumed in (-1,):
-            rep.clamped('mavlink.BATTERY_STATUS.energy_consumed', 'a known value written as the unknown marker')
+            rep.clamped("mavlink.BATTERY_STATUS.energy_consumed", 'a known value written as the unknown marker')
     _v9 = s.state_of_charge
     if _v9 is None or _v9 != _v9:
         t_msg.battery_remaining = -1
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.battery_remaining')
+            rep_u.unknown("mavlink.BATTERY_STATUS.battery_remaining")
     else:
-        t_msg.battery_remaining = _r.to_int(_v9 * 100.0, -128, 100, rep, 'mavlink.BATTERY_STATUS.battery_remaining')
+        t_msg.battery_remaining = _r.to_int(_v9 * 100.0, -128, 100, rep, "mavlink.BATTERY_STATUS.battery_remaining")
         if rep is not None and t_msg.battery_remaining in (-1,):
-            rep.clamped('mavlink.BATTERY_STATUS.battery_remaining', 'a known value written as the unknown marker')
+            rep.clamped("mavlink.BATTERY_STATUS.battery_remaining", 'a known value written as the unknown marker')
     _v10 = s.time_remaining
     if _v10 is None or _v10 != _v10:
         t_msg.time_remaining = 0
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.time_remaining')
+            rep_u.unknown("mavlink.BATTERY_STATUS.time_remaining")
     else:
-        t_msg.time_remaining = _r.to_int(_v10, -2147483648, 2147483647, rep, 'mavlink.BATTERY_STATUS.time_remaining')
+        t_msg.time_remaining = _r.to_int(_v10, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.time_remaining")
         if rep is not None and t_msg.time_remaining in (0,):
-            rep.clamped('mavlink.BATTERY_STATUS.time_remaining', 'a known value written as the unknown marker')
+            rep.clamped("mavlink.BATTERY_STATUS.time_remaining", 'a known value written as the unknown marker')
     _v12 = s.warning
     _w12 = None if _v12 is None else _K11_backward.get(_v12)
     if _w12 is not None:
@@ -160,38 +160,38 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_msg.charge_state = 0
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.charge_state')
+            rep_u.unknown("mavlink.BATTERY_STATUS.charge_state")
         if rep_d is not None and _v12 is not None:
-            rep_d.dropped('concepts.warning', '%r has no counterpart' % (_v12,))
+            rep_d.dropped("concepts.warning", '%r has no counterpart' % (_v12,))
     _v14 = s.faults
     if _v14 is None:
         if rep_u is not None:
-            rep_u.unknown('mavlink.BATTERY_STATUS.fault_bitmask')
+            rep_u.unknown("mavlink.BATTERY_STATUS.fault_bitmask")
     else:
         _b14 = t_msg.fault_bitmask
-        if 'deep_discharge' in _v14:
+        if "deep_discharge" in _v14:
             _b14 |= 1
-        if 'spikes' in _v14:
+        if "spikes" in _v14:
             _b14 |= 2
-        if 'cell_fail' in _v14:
+        if "cell_fail" in _v14:
             _b14 |= 4
-        if 'over_current' in _v14:
+        if "over_current" in _v14:
             _b14 |= 8
-        if 'over_temperature' in _v14:
+        if "over_temperature" in _v14:
             _b14 |= 16
-        if 'under_temperature' in _v14:
+        if "under_temperature" in _v14:
             _b14 |= 32
-        if 'incompatible_voltage' in _v14:
+        if "incompatible_voltage" in _v14:
             _b14 |= 64
-        if 'incompatible_firmware' in _v14:
+        if "incompatible_firmware" in _v14:
             _b14 |= 128
-        if 'incompatible_cells_configuration' in _v14:
+        if "incompatible_cells_configuration" in _v14:
             _b14 |= 256
         t_msg.fault_bitmask = _b14
         if rep_d is not None:
             for _n14 in _v14:
                 if _n14 not in _K13_backward:
-                    rep_d.dropped('concepts.faults', _n14 + ' has no counterpart')
+                    rep_d.dropped("concepts.faults", _n14 + ' has no counterpart')
     if rep_d is not None:
         for _n in _K15_backward:
             if getattr(s, _n) is not None:

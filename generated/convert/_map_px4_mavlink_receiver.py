@@ -14,9 +14,9 @@ from ..mavlink import BatteryStatus as _C0
 from ..uorb import BatteryStatus as _C1
 
 
-_K9_forward = (('id', 'id'), ('battery_function', 'battery_function'), ('type', 'type'), ('energy_consumed', 'energy_consumed'), ('time_remaining', 'time_remaining'), ('charge_state', 'charge_state'), ('voltages_ext', 'voltages_ext'), ('mode', 'mode'), ('fault_bitmask', 'fault_bitmask'))
+_K9_forward = (("id", "id"), ("battery_function", "battery_function"), ("type", "type"), ("energy_consumed", "energy_consumed"), ("time_remaining", "time_remaining"), ("charge_state", "charge_state"), ("voltages_ext", "voltages_ext"), ("mode", "mode"), ("fault_bitmask", "fault_bitmask"))
 _K10_forward = _C0()
-_K11_forward = ('uorb.BatteryStatus.timestamp', 'uorb.BatteryStatus.current_average_a', 'uorb.BatteryStatus.scale', 'uorb.BatteryStatus.time_remaining_s', 'uorb.BatteryStatus.source', 'uorb.BatteryStatus.priority', 'uorb.BatteryStatus.capacity', 'uorb.BatteryStatus.cycle_count', 'uorb.BatteryStatus.average_time_to_empty', 'uorb.BatteryStatus.manufacture_date', 'uorb.BatteryStatus.state_of_health', 'uorb.BatteryStatus.max_error', 'uorb.BatteryStatus.id', 'uorb.BatteryStatus.interface_error', 'uorb.BatteryStatus.max_cell_voltage_delta', 'uorb.BatteryStatus.is_powering_off', 'uorb.BatteryStatus.is_required', 'uorb.BatteryStatus.faults', 'uorb.BatteryStatus.full_charge_capacity_wh', 'uorb.BatteryStatus.remaining_capacity_wh', 'uorb.BatteryStatus.over_discharge_count', 'uorb.BatteryStatus.nominal_voltage', 'uorb.BatteryStatus.internal_resistance_estimate', 'uorb.BatteryStatus.ocv_estimate', 'uorb.BatteryStatus.ocv_estimate_filtered', 'uorb.BatteryStatus.volt_based_soc_estimate', 'uorb.BatteryStatus.voltage_prediction', 'uorb.BatteryStatus.prediction_error', 'uorb.BatteryStatus.estimation_covariance_norm')
+_K11_forward = ("uorb.BatteryStatus.timestamp", "uorb.BatteryStatus.current_average_a", "uorb.BatteryStatus.scale", "uorb.BatteryStatus.time_remaining_s", "uorb.BatteryStatus.source", "uorb.BatteryStatus.priority", "uorb.BatteryStatus.capacity", "uorb.BatteryStatus.cycle_count", "uorb.BatteryStatus.average_time_to_empty", "uorb.BatteryStatus.manufacture_date", "uorb.BatteryStatus.state_of_health", "uorb.BatteryStatus.max_error", "uorb.BatteryStatus.id", "uorb.BatteryStatus.interface_error", "uorb.BatteryStatus.max_cell_voltage_delta", "uorb.BatteryStatus.is_powering_off", "uorb.BatteryStatus.is_required", "uorb.BatteryStatus.faults", "uorb.BatteryStatus.full_charge_capacity_wh", "uorb.BatteryStatus.remaining_capacity_wh", "uorb.BatteryStatus.over_discharge_count", "uorb.BatteryStatus.nominal_voltage", "uorb.BatteryStatus.internal_resistance_estimate", "uorb.BatteryStatus.ocv_estimate", "uorb.BatteryStatus.ocv_estimate_filtered", "uorb.BatteryStatus.volt_based_soc_estimate", "uorb.BatteryStatus.voltage_prediction", "uorb.BatteryStatus.prediction_error", "uorb.BatteryStatus.estimation_covariance_norm")
 
 
 def forward(s_msg: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C1]:
@@ -54,22 +54,22 @@ def forward(s_msg: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRepor
     if rep_d is not None:
         for _a, _n in _K9_forward:
             if _r.differs(getattr(s_msg, _a), getattr(_K10_forward, _a)):
-                rep_d.dropped('mavlink.BATTERY_STATUS.' + _n)
+                rep_d.dropped("mavlink.BATTERY_STATUS." + _n)
     if rep_u is not None:
         for _n in _K11_forward:
             rep_u.unknown(_n)
     if rep_u is not None and _r.is_marker(t_status.voltage_v, 0.0):
-        rep_u.unknown('uorb.BatteryStatus.voltage_v')
+        rep_u.unknown("uorb.BatteryStatus.voltage_v")
     if rep_u is not None and _r.is_marker(t_status.current_a, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.current_a')
+        rep_u.unknown("uorb.BatteryStatus.current_a")
     if rep_u is not None and _r.is_marker(t_status.discharged_mah, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.discharged_mah')
+        rep_u.unknown("uorb.BatteryStatus.discharged_mah")
     if rep_u is not None and _r.is_marker(t_status.remaining, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.remaining')
+        rep_u.unknown("uorb.BatteryStatus.remaining")
     if rep_u is not None and _r.is_marker(t_status.temperature, math.nan):
-        rep_u.unknown('uorb.BatteryStatus.temperature')
+        rep_u.unknown("uorb.BatteryStatus.temperature")
     if rep_u is not None and _r.is_marker(t_status.cell_count, 0):
-        rep_u.unknown('uorb.BatteryStatus.cell_count')
+        rep_u.unknown("uorb.BatteryStatus.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
-        rep_u.unknown('uorb.BatteryStatus.voltage_cell_v')
+        rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
     return (t_status,)

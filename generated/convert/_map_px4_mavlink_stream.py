@@ -15,7 +15,7 @@ from ..mavlink import BatteryStatus as _C1
 
 
 _K10_forward = dict(((0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (6, 6), (7, 7),))
-_K16_forward = (('timestamp', 'timestamp'), ('current_average_a', 'current_average_a'), ('scale', 'scale'), ('source', 'source'), ('priority', 'priority'), ('capacity', 'capacity'), ('cycle_count', 'cycle_count'), ('average_time_to_empty', 'average_time_to_empty'), ('manufacture_date', 'manufacture_date'), ('state_of_health', 'state_of_health'), ('max_error', 'max_error'), ('interface_error', 'interface_error'), ('max_cell_voltage_delta', 'max_cell_voltage_delta'), ('is_powering_off', 'is_powering_off'), ('is_required', 'is_required'), ('full_charge_capacity_wh', 'full_charge_capacity_wh'), ('remaining_capacity_wh', 'remaining_capacity_wh'), ('over_discharge_count', 'over_discharge_count'), ('nominal_voltage', 'nominal_voltage'), ('internal_resistance_estimate', 'internal_resistance_estimate'), ('ocv_estimate', 'ocv_estimate'), ('ocv_estimate_filtered', 'ocv_estimate_filtered'), ('volt_based_soc_estimate', 'volt_based_soc_estimate'), ('voltage_prediction', 'voltage_prediction'), ('prediction_error', 'prediction_error'), ('estimation_covariance_norm', 'estimation_covariance_norm'))
+_K16_forward = (("timestamp", "timestamp"), ("current_average_a", "current_average_a"), ("scale", "scale"), ("source", "source"), ("priority", "priority"), ("capacity", "capacity"), ("cycle_count", "cycle_count"), ("average_time_to_empty", "average_time_to_empty"), ("manufacture_date", "manufacture_date"), ("state_of_health", "state_of_health"), ("max_error", "max_error"), ("interface_error", "interface_error"), ("max_cell_voltage_delta", "max_cell_voltage_delta"), ("is_powering_off", "is_powering_off"), ("is_required", "is_required"), ("full_charge_capacity_wh", "full_charge_capacity_wh"), ("remaining_capacity_wh", "remaining_capacity_wh"), ("over_discharge_count", "over_discharge_count"), ("nominal_voltage", "nominal_voltage"), ("internal_resistance_estimate", "internal_resistance_estimate"), ("ocv_estimate", "ocv_estimate"), ("ocv_estimate_filtered", "ocv_estimate_filtered"), ("volt_based_soc_estimate", "volt_based_soc_estimate"), ("voltage_prediction", "voltage_prediction"), ("prediction_error", "prediction_error"), ("estimation_covariance_norm", "estimation_covariance_norm"))
 _K17_forward = _C0()
 
 
@@ -32,42 +32,42 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     t_msg.battery_function = 1
     t_msg.type = 1
     _x5 = _r.f32(float(s_status.discharged_mah))
-    t_msg.current_consumed = _r.c_float_to_int(_x5, 32, True, rep, 'mavlink.BATTERY_STATUS.current_consumed') if s_status.connected else -1
+    t_msg.current_consumed = _r.c_float_to_int(_x5, 32, True, rep, "mavlink.BATTERY_STATUS.current_consumed") if s_status.connected else -1
     t_msg.energy_consumed = -1
     _x7 = _r.f32(float(s_status.current_a))
     _x7 = _r.f32(_x7 * 100.0)
-    t_msg.current_battery = _r.c_float_to_int(_x7, 16, True, rep, 'mavlink.BATTERY_STATUS.current_battery') if s_status.connected else -1
+    t_msg.current_battery = _r.c_float_to_int(_x7, 16, True, rep, "mavlink.BATTERY_STATUS.current_battery") if s_status.connected else -1
     _x8 = _r.f32(float(s_status.remaining))
     _x8 = _r.f32(_x8 * 100.0)
     _x8 = _r.roundf(_x8)
-    t_msg.battery_remaining = _r.c_float_to_int(_x8, 8, True, rep, 'mavlink.BATTERY_STATUS.battery_remaining') if s_status.connected else -1
+    t_msg.battery_remaining = _r.c_float_to_int(_x8, 8, True, rep, "mavlink.BATTERY_STATUS.battery_remaining") if s_status.connected else -1
     _x9 = _r.f32(float(s_status.time_remaining_s))
-    t_msg.time_remaining = max(_r.c_float_to_int(_x9, 32, True, rep, 'mavlink.BATTERY_STATUS.time_remaining'), 1) if s_status.connected and math.isfinite(_x9) else 0
+    t_msg.time_remaining = max(_r.c_float_to_int(_x9, 32, True, rep, "mavlink.BATTERY_STATUS.time_remaining"), 1) if s_status.connected and math.isfinite(_x9) else 0
     t_msg.charge_state = _K10_forward.get(s_status.warning, 0)
     t_msg.mode = 0
     t_msg.fault_bitmask = _r.c_wrap(int(s_status.faults), 32, False)
     _x14 = _r.f32(float(s_status.temperature))
     _x14 = _r.f32(_x14 * 100.0)
-    t_msg.temperature = _r.c_float_to_int(_x14, 16, True, rep, 'mavlink.BATTERY_STATUS.temperature') if s_status.connected and math.isfinite(_x14) else 32767
+    t_msg.temperature = _r.c_float_to_int(_x14, 16, True, rep, "mavlink.BATTERY_STATUS.temperature") if s_status.connected and math.isfinite(_x14) else 32767
     t_msg.voltages, t_msg.voltages_ext = _r.px4_stream_cells(
         s_status.voltage_v, s_status.voltage_cell_v, s_status.cell_count, s_status.connected,
         1000.0, 9.999999747378752e-05, 10, 4, 65535, 0,
-        rep, 'mavlink.BATTERY_STATUS.voltages',
+        rep, "mavlink.BATTERY_STATUS.voltages",
     )
     if rep_d is not None:
         for _a, _n in _K16_forward:
             if _r.differs(getattr(s_status, _a), getattr(_K17_forward, _a)):
-                rep_d.dropped('uorb.BatteryStatus.' + _n)
+                rep_d.dropped("uorb.BatteryStatus." + _n)
     if rep_u is not None and _r.is_marker(t_msg.temperature, 32767):
-        rep_u.unknown('mavlink.BATTERY_STATUS.temperature')
+        rep_u.unknown("mavlink.BATTERY_STATUS.temperature")
     if rep_u is not None and all(_r.is_marker(_x, 65535) for _x in t_msg.voltages):
-        rep_u.unknown('mavlink.BATTERY_STATUS.voltages')
+        rep_u.unknown("mavlink.BATTERY_STATUS.voltages")
     if rep_u is not None and _r.is_marker(t_msg.current_battery, -1):
-        rep_u.unknown('mavlink.BATTERY_STATUS.current_battery')
+        rep_u.unknown("mavlink.BATTERY_STATUS.current_battery")
     if rep_u is not None and _r.is_marker(t_msg.current_consumed, -1):
-        rep_u.unknown('mavlink.BATTERY_STATUS.current_consumed')
+        rep_u.unknown("mavlink.BATTERY_STATUS.current_consumed")
     if rep_u is not None and _r.is_marker(t_msg.energy_consumed, -1):
-        rep_u.unknown('mavlink.BATTERY_STATUS.energy_consumed')
+        rep_u.unknown("mavlink.BATTERY_STATUS.energy_consumed")
     if rep_u is not None and _r.is_marker(t_msg.battery_remaining, -1):
-        rep_u.unknown('mavlink.BATTERY_STATUS.battery_remaining')
+        rep_u.unknown("mavlink.BATTERY_STATUS.battery_remaining")
     return (t_msg,)

@@ -15,11 +15,11 @@ from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _C1
 from ..uorb import BatteryStatus as _C2
 
 
-_K20_forward = (('average_power_10sec', 'average_power_10sec'), ('hours_to_full_charge', 'hours_to_full_charge'), ('state_of_health_pct', 'state_of_health_pct'), ('state_of_charge_pct_stdev', 'state_of_charge_pct_stdev'), ('model_instance_id', 'model_instance_id'), ('model_name', 'model_name'))
+_K20_forward = (("average_power_10sec", "average_power_10sec"), ("hours_to_full_charge", "hours_to_full_charge"), ("state_of_health_pct", "state_of_health_pct"), ("state_of_charge_pct_stdev", "state_of_charge_pct_stdev"), ("model_instance_id", "model_instance_id"), ("model_name", "model_name"))
 _K21_forward = _C0()
-_K22_forward = (('timestamp', 'timestamp'), ('max_current', 'max_current'), ('battery_id', 'battery_id'))
+_K22_forward = (("timestamp", "timestamp"), ("max_current", "max_current"), ("battery_id", "battery_id"))
 _K23_forward = _C1()
-_K24_forward = ('uorb.BatteryStatus.timestamp', 'uorb.BatteryStatus.current_average_a', 'uorb.BatteryStatus.discharged_mah', 'uorb.BatteryStatus.priority', 'uorb.BatteryStatus.average_time_to_empty', 'uorb.BatteryStatus.manufacture_date', 'uorb.BatteryStatus.state_of_health', 'uorb.BatteryStatus.max_error', 'uorb.BatteryStatus.interface_error', 'uorb.BatteryStatus.max_cell_voltage_delta', 'uorb.BatteryStatus.is_required', 'uorb.BatteryStatus.faults', 'uorb.BatteryStatus.internal_resistance_estimate', 'uorb.BatteryStatus.ocv_estimate', 'uorb.BatteryStatus.ocv_estimate_filtered', 'uorb.BatteryStatus.volt_based_soc_estimate', 'uorb.BatteryStatus.voltage_prediction', 'uorb.BatteryStatus.prediction_error', 'uorb.BatteryStatus.estimation_covariance_norm')
+_K24_forward = ("uorb.BatteryStatus.timestamp", "uorb.BatteryStatus.current_average_a", "uorb.BatteryStatus.discharged_mah", "uorb.BatteryStatus.priority", "uorb.BatteryStatus.average_time_to_empty", "uorb.BatteryStatus.manufacture_date", "uorb.BatteryStatus.state_of_health", "uorb.BatteryStatus.max_error", "uorb.BatteryStatus.interface_error", "uorb.BatteryStatus.max_cell_voltage_delta", "uorb.BatteryStatus.is_required", "uorb.BatteryStatus.faults", "uorb.BatteryStatus.internal_resistance_estimate", "uorb.BatteryStatus.ocv_estimate", "uorb.BatteryStatus.ocv_estimate_filtered", "uorb.BatteryStatus.volt_based_soc_estimate", "uorb.BatteryStatus.voltage_prediction", "uorb.BatteryStatus.prediction_error", "uorb.BatteryStatus.estimation_covariance_norm")
 
 
 def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C2]:
@@ -81,32 +81,32 @@ def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None 
     if s_aux is not None:
         _v19 = _r.f16(float(s_aux.nominal_voltage), None, '')
         if _v19 > 1.1920928955078125e-07:
-            t_status.capacity = _r.c_float_to_int(_r.f32(_r.f32(_r.f16(float(s_info.full_charge_capacity_wh), None, '') * 1000.0) / _v19), 16, False, rep, 'uorb.BatteryStatus.capacity')
+            t_status.capacity = _r.c_float_to_int(_r.f32(_r.f32(_r.f16(float(s_info.full_charge_capacity_wh), None, '') * 1000.0) / _v19), 16, False, rep, "uorb.BatteryStatus.capacity")
     if rep_d is not None:
         for _a, _n in _K20_forward:
             if _r.differs(getattr(s_info, _a), getattr(_K21_forward, _a)):
-                rep_d.dropped('dronecan.uavcan.equipment.power.BatteryInfo.' + _n)
+                rep_d.dropped("dronecan.uavcan.equipment.power.BatteryInfo." + _n)
     if rep_d is not None and s_aux is not None:
         for _a, _n in _K22_forward:
             if _r.differs(getattr(s_aux, _a), getattr(_K23_forward, _a)):
-                rep_d.dropped('dronecan.ardupilot.equipment.power.BatteryInfoAux.' + _n)
+                rep_d.dropped("dronecan.ardupilot.equipment.power.BatteryInfoAux." + _n)
     if rep_u is not None:
         for _n in _K24_forward:
             rep_u.unknown(_n)
     if rep_u is not None and _r.is_marker(t_status.voltage_v, 0.0):
-        rep_u.unknown('uorb.BatteryStatus.voltage_v')
+        rep_u.unknown("uorb.BatteryStatus.voltage_v")
     if rep_u is not None and _r.is_marker(t_status.current_a, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.current_a')
+        rep_u.unknown("uorb.BatteryStatus.current_a")
     if rep_u is not None and _r.is_marker(t_status.remaining, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.remaining')
+        rep_u.unknown("uorb.BatteryStatus.remaining")
     if rep_u is not None and _r.is_marker(t_status.scale, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.scale')
+        rep_u.unknown("uorb.BatteryStatus.scale")
     if rep_u is not None and _r.is_marker(t_status.time_remaining_s, math.nan):
-        rep_u.unknown('uorb.BatteryStatus.time_remaining_s')
+        rep_u.unknown("uorb.BatteryStatus.time_remaining_s")
     if rep_u is not None and _r.is_marker(t_status.temperature, math.nan):
-        rep_u.unknown('uorb.BatteryStatus.temperature')
+        rep_u.unknown("uorb.BatteryStatus.temperature")
     if rep_u is not None and _r.is_marker(t_status.cell_count, 0):
-        rep_u.unknown('uorb.BatteryStatus.cell_count')
+        rep_u.unknown("uorb.BatteryStatus.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
-        rep_u.unknown('uorb.BatteryStatus.voltage_cell_v')
+        rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
     return (t_status,)

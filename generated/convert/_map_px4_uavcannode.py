@@ -15,10 +15,10 @@ from ..dronecan.uavcan.equipment.power import BatteryInfo as _C1
 from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _C2
 
 
-_K21_forward = (('timestamp', 'timestamp'), ('current_average_a', 'current_average_a'), ('discharged_mah', 'discharged_mah'), ('scale', 'scale'), ('time_remaining_s', 'time_remaining_s'), ('source', 'source'), ('priority', 'priority'), ('capacity', 'capacity'), ('average_time_to_empty', 'average_time_to_empty'), ('manufacture_date', 'manufacture_date'), ('interface_error', 'interface_error'), ('max_cell_voltage_delta', 'max_cell_voltage_delta'), ('is_required', 'is_required'), ('faults', 'faults'), ('internal_resistance_estimate', 'internal_resistance_estimate'), ('ocv_estimate', 'ocv_estimate'), ('ocv_estimate_filtered', 'ocv_estimate_filtered'), ('volt_based_soc_estimate', 'volt_based_soc_estimate'), ('voltage_prediction', 'voltage_prediction'), ('prediction_error', 'prediction_error'), ('estimation_covariance_norm', 'estimation_covariance_norm'))
+_K21_forward = (("timestamp", "timestamp"), ("current_average_a", "current_average_a"), ("discharged_mah", "discharged_mah"), ("scale", "scale"), ("time_remaining_s", "time_remaining_s"), ("source", "source"), ("priority", "priority"), ("capacity", "capacity"), ("average_time_to_empty", "average_time_to_empty"), ("manufacture_date", "manufacture_date"), ("interface_error", "interface_error"), ("max_cell_voltage_delta", "max_cell_voltage_delta"), ("is_required", "is_required"), ("faults", "faults"), ("internal_resistance_estimate", "internal_resistance_estimate"), ("ocv_estimate", "ocv_estimate"), ("ocv_estimate_filtered", "ocv_estimate_filtered"), ("volt_based_soc_estimate", "volt_based_soc_estimate"), ("voltage_prediction", "voltage_prediction"), ("prediction_error", "prediction_error"), ("estimation_covariance_norm", "estimation_covariance_norm"))
 _K22_forward = _C0()
-_K23_forward = ('dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec', 'dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge')
-_K24_forward = ('dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp',)
+_K23_forward = ("dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec", "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge")
+_K24_forward = ("dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp",)
 
 
 def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C1, _C2]:
@@ -35,34 +35,34 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     t_info.state_of_health_pct = 0
     _n2 = s_status.cell_count
     if _n2 > 14 and rep is not None:
-        rep.clamped('dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell', '%d cells, %d in the array' % (_n2, 14))
-    t_aux.voltage_cell = [_r.f16(_r.f32(_x2), rep, 'dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell') for _x2 in s_status.voltage_cell_v[:min(_n2, 14)]]
+        rep.clamped("dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell", '%d cells, %d in the array' % (_n2, 14))
+    t_aux.voltage_cell = [_r.f16(_r.f32(_x2), rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell") for _x2 in s_status.voltage_cell_v[:min(_n2, 14)]]
     t_aux.cycle_count = _r.c_wrap(int(s_status.cycle_count), 16, False)
     t_aux.over_discharge_count = _r.c_wrap(int(s_status.over_discharge_count), 16, False)
     _x5 = _r.f32(float(s_status.current_a))
-    t_aux.max_current = _r.f16(_x5, rep, 'dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current')
+    t_aux.max_current = _r.f16(_x5, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current")
     _x6 = _r.f32(float(s_status.nominal_voltage))
-    t_aux.nominal_voltage = _r.f16(_x6, rep, 'dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage')
+    t_aux.nominal_voltage = _r.f16(_x6, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage")
     t_aux.is_powering_off = bool(int(s_status.is_powering_off))
     t_aux.battery_id = _r.c_wrap(int(s_status.id), 8, False)
     _x9 = _r.f32(float(s_status.voltage_v))
-    t_info.voltage = _r.f16(_x9, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.voltage')
+    t_info.voltage = _r.f16(_x9, rep, "dronecan.uavcan.equipment.power.BatteryInfo.voltage")
     _x10 = _r.f32(float(s_status.current_a))
-    t_info.current = _r.f16(_x10, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.current')
+    t_info.current = _r.f16(_x10, rep, "dronecan.uavcan.equipment.power.BatteryInfo.current")
     _x11 = _r.f32(float(s_status.temperature))
     _x11 = _r.f32(_x11 + 273.1499938964844)
-    t_info.temperature = _r.f16(_x11, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.temperature')
+    t_info.temperature = _r.f16(_x11, rep, "dronecan.uavcan.equipment.power.BatteryInfo.temperature")
     _x12 = _r.f32(float(s_status.full_charge_capacity_wh))
-    t_info.full_charge_capacity_wh = _r.f16(_x12, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh')
+    t_info.full_charge_capacity_wh = _r.f16(_x12, rep, "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
     _x13 = _r.f32(float(s_status.remaining_capacity_wh))
-    t_info.remaining_capacity_wh = _r.f16(_x13, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh')
+    t_info.remaining_capacity_wh = _r.f16(_x13, rep, "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
     _x14 = _r.f32(float(s_status.remaining))
     _x14 = _r.f32(_x14 * 100.0)
-    t_info.state_of_charge_pct = _r.saturate(_r.c_float_to_int(_x14, 8, False, rep, 'dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct'), 0, 127)
+    t_info.state_of_charge_pct = _r.saturate(_r.c_float_to_int(_x14, 8, False, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct"), 0, 127)
     t_info.state_of_charge_pct_stdev = _r.saturate(_r.c_wrap(int(s_status.max_error), 8, False), 0, 127)
     t_info.battery_id = _r.c_wrap(int(s_status.id), 8, False)
     t_info.model_instance_id = 0
-    t_info.model_name = b'PX4 CAN Battery'
+    t_info.model_name = b"PX4 CAN Battery"
     t_info.state_of_health_pct = _r.saturate(_r.c_wrap(int(s_status.state_of_health), 8, False), 0, 127)
     _b20 = 0
     if s_status.connected:
@@ -73,22 +73,22 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     if rep_d is not None:
         for _a, _n in _K21_forward:
             if _r.differs(getattr(s_status, _a), getattr(_K22_forward, _a)):
-                rep_d.dropped('uorb.BatteryStatus.' + _n)
+                rep_d.dropped("uorb.BatteryStatus." + _n)
     if rep_u is not None:
         for _n in _K23_forward:
             rep_u.unknown(_n)
     if rep_u is not None and _r.is_marker(t_info.temperature, math.nan):
-        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.temperature')
+        rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.temperature")
     if rep_u is not None and _r.is_marker(t_info.voltage, math.nan):
-        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.voltage')
+        rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.voltage")
     if rep_u is not None and _r.is_marker(t_info.current, math.nan):
-        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.current')
+        rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.current")
     if rep_u is not None and _r.is_marker(t_info.remaining_capacity_wh, math.nan):
-        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh')
+        rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
     if rep_u is not None and _r.is_marker(t_info.full_charge_capacity_wh, math.nan):
-        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh')
+        rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
     if rep_u is not None and _r.is_marker(t_info.state_of_health_pct, 127):
-        rep_u.unknown('dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct')
+        rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct")
     if rep_u is not None:
         for _n in _K24_forward:
             rep_u.unknown(_n)

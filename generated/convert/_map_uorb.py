@@ -13,13 +13,13 @@ from ._concepts import BatteryState
 from ..uorb import BatteryStatus as _C0
 
 
-_K16_forward = dict(((0, 'none'), (1, 'low'), (2, 'critical'), (3, 'emergency'), (4, 'failed'), (6, 'unhealthy'), (7, 'charging'),))
-_K23_forward = (('timestamp', 'timestamp'), ('scale', 'scale'), ('source', 'source'), ('priority', 'priority'), ('average_time_to_empty', 'average_time_to_empty'), ('manufacture_date', 'manufacture_date'), ('max_error', 'max_error'), ('interface_error', 'interface_error'), ('max_cell_voltage_delta', 'max_cell_voltage_delta'), ('is_required', 'is_required'), ('internal_resistance_estimate', 'internal_resistance_estimate'), ('ocv_estimate', 'ocv_estimate'), ('ocv_estimate_filtered', 'ocv_estimate_filtered'), ('volt_based_soc_estimate', 'volt_based_soc_estimate'), ('voltage_prediction', 'voltage_prediction'), ('prediction_error', 'prediction_error'), ('estimation_covariance_norm', 'estimation_covariance_norm'))
+_K16_forward = dict(((0, "none"), (1, "low"), (2, "critical"), (3, "emergency"), (4, "failed"), (6, "unhealthy"), (7, "charging"),))
+_K23_forward = (("timestamp", "timestamp"), ("scale", "scale"), ("source", "source"), ("priority", "priority"), ("average_time_to_empty", "average_time_to_empty"), ("manufacture_date", "manufacture_date"), ("max_error", "max_error"), ("interface_error", "interface_error"), ("max_cell_voltage_delta", "max_cell_voltage_delta"), ("is_required", "is_required"), ("internal_resistance_estimate", "internal_resistance_estimate"), ("ocv_estimate", "ocv_estimate"), ("ocv_estimate_filtered", "ocv_estimate_filtered"), ("volt_based_soc_estimate", "volt_based_soc_estimate"), ("voltage_prediction", "voltage_prediction"), ("prediction_error", "prediction_error"), ("estimation_covariance_norm", "estimation_covariance_norm"))
 _K24_forward = _C0()
-_K15_backward = ('cell_fail', 'deep_discharge', 'failed_to_arm', 'hardware_failure', 'incompatible_firmware', 'incompatible_model', 'incompatible_voltage', 'over_current', 'over_temperature', 'spikes', 'under_temperature')
-_K17_backward = dict((('none', 0), ('low', 1), ('critical', 2), ('emergency', 3), ('failed', 4), ('unhealthy', 6), ('charging', 7),))
-_K24_backward = ('in_use', 'charging', 'max_current', 'average_power', 'state_of_charge_stdev', 'design_energy', 'design_capacity', 'consumed_energy', 'time_to_full', 'voltage_min_design', 'voltage_max_design', 'serial_number', 'model_name', 'chemistry')
-_K25_backward = ('uorb.BatteryStatus.timestamp', 'uorb.BatteryStatus.scale', 'uorb.BatteryStatus.source', 'uorb.BatteryStatus.priority', 'uorb.BatteryStatus.average_time_to_empty', 'uorb.BatteryStatus.manufacture_date', 'uorb.BatteryStatus.max_error', 'uorb.BatteryStatus.interface_error', 'uorb.BatteryStatus.max_cell_voltage_delta', 'uorb.BatteryStatus.is_required', 'uorb.BatteryStatus.internal_resistance_estimate', 'uorb.BatteryStatus.ocv_estimate', 'uorb.BatteryStatus.ocv_estimate_filtered', 'uorb.BatteryStatus.volt_based_soc_estimate', 'uorb.BatteryStatus.voltage_prediction', 'uorb.BatteryStatus.prediction_error', 'uorb.BatteryStatus.estimation_covariance_norm')
+_K15_backward = ("cell_fail", "deep_discharge", "failed_to_arm", "hardware_failure", "incompatible_firmware", "incompatible_model", "incompatible_voltage", "over_current", "over_temperature", "spikes", "under_temperature")
+_K17_backward = dict((("none", 0), ("low", 1), ("critical", 2), ("emergency", 3), ("failed", 4), ("unhealthy", 6), ("charging", 7),))
+_K24_backward = ("in_use", "charging", "max_current", "average_power", "state_of_charge_stdev", "design_energy", "design_capacity", "consumed_energy", "time_to_full", "voltage_min_design", "voltage_max_design", "serial_number", "model_name", "chemistry")
+_K25_backward = ("uorb.BatteryStatus.timestamp", "uorb.BatteryStatus.scale", "uorb.BatteryStatus.source", "uorb.BatteryStatus.priority", "uorb.BatteryStatus.average_time_to_empty", "uorb.BatteryStatus.manufacture_date", "uorb.BatteryStatus.max_error", "uorb.BatteryStatus.interface_error", "uorb.BatteryStatus.max_cell_voltage_delta", "uorb.BatteryStatus.is_required", "uorb.BatteryStatus.internal_resistance_estimate", "uorb.BatteryStatus.ocv_estimate", "uorb.BatteryStatus.ocv_estimate_filtered", "uorb.BatteryStatus.volt_based_soc_estimate", "uorb.BatteryStatus.voltage_prediction", "uorb.BatteryStatus.prediction_error", "uorb.BatteryStatus.estimation_covariance_norm")
 
 
 def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[BatteryState]:
@@ -67,11 +67,11 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     if _v14 != 0:
         t.battery_index = _v14 + -1
     _v15 = s_status.faults
-    t.faults = tuple(_n15 for _n15, _m15 in (('deep_discharge', 1), ('spikes', 2), ('cell_fail', 4), ('over_current', 8), ('over_temperature', 16), ('under_temperature', 32), ('incompatible_voltage', 64), ('incompatible_firmware', 128), ('incompatible_model', 256), ('hardware_failure', 512), ('failed_to_arm', 1024),) if _v15 & _m15)
+    t.faults = tuple(_n15 for _n15, _m15 in (("deep_discharge", 1), ("spikes", 2), ("cell_fail", 4), ("over_current", 8), ("over_temperature", 16), ("under_temperature", 32), ("incompatible_voltage", 64), ("incompatible_firmware", 128), ("incompatible_model", 256), ("hardware_failure", 512), ("failed_to_arm", 1024),) if _v15 & _m15)
     _v17 = s_status.warning
     t.warning = None if _v17 is None else _K16_forward.get(_v17)
     if rep_d is not None and _v17 not in _K16_forward and _v17 not in (None, None,):
-        rep_d.dropped('uorb.BatteryStatus.warning', '%r has no counterpart' % (_v17,))
+        rep_d.dropped("uorb.BatteryStatus.warning", '%r has no counterpart' % (_v17,))
     _v18 = s_status.full_charge_capacity_wh
     if _v18 != 0:
         t.full_energy = float(_v18) * 3600.0
@@ -86,11 +86,11 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     _v22 = s_status.is_powering_off
     t.is_powering_off = bool(_v22)
     if rep_d is not None and s_status.faults & -2048:
-        rep_d.dropped('uorb.BatteryStatus.faults', 'bits %#x have no counterpart' % (s_status.faults & -2048))
+        rep_d.dropped("uorb.BatteryStatus.faults", 'bits %#x have no counterpart' % (s_status.faults & -2048))
     if rep_d is not None:
         for _a, _n in _K23_forward:
             if _r.differs(getattr(s_status, _a), getattr(_K24_forward, _a)):
-                rep_d.dropped('uorb.BatteryStatus.' + _n)
+                rep_d.dropped("uorb.BatteryStatus." + _n)
     return (t,)
 
 
@@ -100,85 +100,85 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     _v1 = s.connected
     if _v1 is None:
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.connected')
+            rep_u.unknown("uorb.BatteryStatus.connected")
     else:
         t_status.connected = bool(_v1)
     _v2 = s.pack_voltage
     if _v2 is None or _v2 != _v2:
         t_status.voltage_v = 0.0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.voltage_v')
+            rep_u.unknown("uorb.BatteryStatus.voltage_v")
     else:
         t_status.voltage_v = _r.f32(_v2)
         if rep is not None and t_status.voltage_v in (0.0,):
-            rep.clamped('uorb.BatteryStatus.voltage_v', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.voltage_v", 'a known value written as the unknown marker')
     _v3 = s.current
     if _v3 is None or _v3 != _v3:
         t_status.current_a = -1.0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.current_a')
+            rep_u.unknown("uorb.BatteryStatus.current_a")
     else:
         t_status.current_a = _r.f32(_v3)
         if rep is not None and t_status.current_a in (-1.0,):
-            rep.clamped('uorb.BatteryStatus.current_a', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.current_a", 'a known value written as the unknown marker')
     _v4 = s.average_current
     if _v4 is None or _v4 != _v4:
         t_status.current_average_a = -1.0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.current_average_a')
+            rep_u.unknown("uorb.BatteryStatus.current_average_a")
     else:
         t_status.current_average_a = _r.f32(_v4)
         if rep is not None and t_status.current_average_a in (-1.0,):
-            rep.clamped('uorb.BatteryStatus.current_average_a', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.current_average_a", 'a known value written as the unknown marker')
     _v5 = s.discharged
     if _v5 is None or _v5 != _v5:
         t_status.discharged_mah = -1.0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.discharged_mah')
+            rep_u.unknown("uorb.BatteryStatus.discharged_mah")
     else:
         t_status.discharged_mah = _r.f32(_v5 * 0.2777777777777778)
         if rep is not None and t_status.discharged_mah in (-1.0,):
-            rep.clamped('uorb.BatteryStatus.discharged_mah', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.discharged_mah", 'a known value written as the unknown marker')
     _v6 = s.state_of_charge
     if _v6 is None or _v6 != _v6:
         t_status.remaining = -1.0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.remaining')
+            rep_u.unknown("uorb.BatteryStatus.remaining")
     else:
         t_status.remaining = _r.f32(_v6)
         if rep is not None and t_status.remaining in (-1.0,):
-            rep.clamped('uorb.BatteryStatus.remaining', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.remaining", 'a known value written as the unknown marker')
     _v7 = s.time_remaining
     if _v7 is None or _v7 != _v7:
         t_status.time_remaining_s = math.nan
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.time_remaining_s')
+            rep_u.unknown("uorb.BatteryStatus.time_remaining_s")
     else:
         t_status.time_remaining_s = _r.f32(_v7)
     _v8 = s.temperature
     if _v8 is None or _v8 != _v8:
         t_status.temperature = math.nan
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.temperature')
+            rep_u.unknown("uorb.BatteryStatus.temperature")
     else:
         t_status.temperature = _r.f32(_v8 + -273.15)
     _v9 = s.cell_count
     if _v9 is None:
         t_status.cell_count = 0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.cell_count')
+            rep_u.unknown("uorb.BatteryStatus.cell_count")
     else:
-        t_status.cell_count = _r.to_int(_v9, 0, 255, rep, 'uorb.BatteryStatus.cell_count')
+        t_status.cell_count = _r.to_int(_v9, 0, 255, rep, "uorb.BatteryStatus.cell_count")
         if rep is not None and t_status.cell_count in (0,):
-            rep.clamped('uorb.BatteryStatus.cell_count', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.cell_count", 'a known value written as the unknown marker')
     _c10 = s.cell_voltages
     if _c10 is None:
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.voltage_cell_v')
+            rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
     else:
         if len(_c10) > 14:
             if rep is not None:
-                rep.clamped('uorb.BatteryStatus.voltage_cell_v', '%d cells, room for 14' % len(_c10))
+                rep.clamped("uorb.BatteryStatus.voltage_cell_v", '%d cells, room for 14' % len(_c10))
             _c10 = _c10[:14]
         _l10 = [0.0 if _x10 != _x10 else _r.f32(_x10) for _x10 in _c10]
         _l10 += [0.0] * (14 - len(_l10))
@@ -186,119 +186,119 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
         if not t_status.cell_count:
             t_status.cell_count = min(len(_c10), 14)
             if rep_u is not None:
-                rep_u.discard('unknown', 'uorb.BatteryStatus.cell_count')
+                rep_u.discard('unknown', "uorb.BatteryStatus.cell_count")
     _v11 = s.full_capacity
     if _v11 is None or _v11 != _v11:
         t_status.capacity = 0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.capacity')
+            rep_u.unknown("uorb.BatteryStatus.capacity")
     else:
-        t_status.capacity = _r.to_int(_v11 * 0.2777777777777778, 0, 65535, rep, 'uorb.BatteryStatus.capacity')
+        t_status.capacity = _r.to_int(_v11 * 0.2777777777777778, 0, 65535, rep, "uorb.BatteryStatus.capacity")
         if rep is not None and t_status.capacity in (0,):
-            rep.clamped('uorb.BatteryStatus.capacity', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.capacity", 'a known value written as the unknown marker')
     _v12 = s.cycle_count
     if _v12 is None:
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.cycle_count')
+            rep_u.unknown("uorb.BatteryStatus.cycle_count")
     else:
-        t_status.cycle_count = _r.to_int(_v12, 0, 65535, rep, 'uorb.BatteryStatus.cycle_count')
+        t_status.cycle_count = _r.to_int(_v12, 0, 65535, rep, "uorb.BatteryStatus.cycle_count")
     _v13 = s.state_of_health
     if _v13 is None or _v13 != _v13:
         t_status.state_of_health = 0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.state_of_health')
+            rep_u.unknown("uorb.BatteryStatus.state_of_health")
     else:
-        t_status.state_of_health = _r.to_int(_v13 * 100.0, 0, 65535, rep, 'uorb.BatteryStatus.state_of_health')
+        t_status.state_of_health = _r.to_int(_v13 * 100.0, 0, 65535, rep, "uorb.BatteryStatus.state_of_health")
         if rep is not None and t_status.state_of_health in (0,):
-            rep.clamped('uorb.BatteryStatus.state_of_health', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.state_of_health", 'a known value written as the unknown marker')
     _v14 = s.battery_index
     if _v14 is None:
         t_status.id = 0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.id')
+            rep_u.unknown("uorb.BatteryStatus.id")
     else:
-        t_status.id = _r.to_int(_v14 - -1, 0, 255, rep, 'uorb.BatteryStatus.id')
+        t_status.id = _r.to_int(_v14 - -1, 0, 255, rep, "uorb.BatteryStatus.id")
         if rep is not None and t_status.id in (0,):
-            rep.clamped('uorb.BatteryStatus.id', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.id", 'a known value written as the unknown marker')
     _v16 = s.faults
     if _v16 is None:
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.faults')
+            rep_u.unknown("uorb.BatteryStatus.faults")
     else:
         _b16 = t_status.faults
-        if 'deep_discharge' in _v16:
+        if "deep_discharge" in _v16:
             _b16 |= 1
-        if 'spikes' in _v16:
+        if "spikes" in _v16:
             _b16 |= 2
-        if 'cell_fail' in _v16:
+        if "cell_fail" in _v16:
             _b16 |= 4
-        if 'over_current' in _v16:
+        if "over_current" in _v16:
             _b16 |= 8
-        if 'over_temperature' in _v16:
+        if "over_temperature" in _v16:
             _b16 |= 16
-        if 'under_temperature' in _v16:
+        if "under_temperature" in _v16:
             _b16 |= 32
-        if 'incompatible_voltage' in _v16:
+        if "incompatible_voltage" in _v16:
             _b16 |= 64
-        if 'incompatible_firmware' in _v16:
+        if "incompatible_firmware" in _v16:
             _b16 |= 128
-        if 'incompatible_model' in _v16:
+        if "incompatible_model" in _v16:
             _b16 |= 256
-        if 'hardware_failure' in _v16:
+        if "hardware_failure" in _v16:
             _b16 |= 512
-        if 'failed_to_arm' in _v16:
+        if "failed_to_arm" in _v16:
             _b16 |= 1024
         t_status.faults = _b16
         if rep_d is not None:
             for _n16 in _v16:
                 if _n16 not in _K15_backward:
-                    rep_d.dropped('concepts.faults', _n16 + ' has no counterpart')
+                    rep_d.dropped("concepts.faults", _n16 + ' has no counterpart')
     _v18 = s.warning
     _w18 = None if _v18 is None else _K17_backward.get(_v18)
     if _w18 is not None:
         t_status.warning = _w18
     else:
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.warning')
+            rep_u.unknown("uorb.BatteryStatus.warning")
         if rep_d is not None and _v18 is not None:
-            rep_d.dropped('concepts.warning', '%r has no counterpart' % (_v18,))
+            rep_d.dropped("concepts.warning", '%r has no counterpart' % (_v18,))
     _v19 = s.full_energy
     if _v19 is None or _v19 != _v19:
         t_status.full_charge_capacity_wh = 0.0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.full_charge_capacity_wh')
+            rep_u.unknown("uorb.BatteryStatus.full_charge_capacity_wh")
     else:
         t_status.full_charge_capacity_wh = _r.f32(_v19 * 0.0002777777777777778)
         if rep is not None and t_status.full_charge_capacity_wh in (0,):
-            rep.clamped('uorb.BatteryStatus.full_charge_capacity_wh', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.full_charge_capacity_wh", 'a known value written as the unknown marker')
     _v20 = s.remaining_energy
     if _v20 is None or _v20 != _v20:
         t_status.remaining_capacity_wh = 0.0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.remaining_capacity_wh')
+            rep_u.unknown("uorb.BatteryStatus.remaining_capacity_wh")
     else:
         t_status.remaining_capacity_wh = _r.f32(_v20 * 0.0002777777777777778)
         if rep is not None and t_status.remaining_capacity_wh in (0,):
-            rep.clamped('uorb.BatteryStatus.remaining_capacity_wh', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.remaining_capacity_wh", 'a known value written as the unknown marker')
     _v21 = s.over_discharge_count
     if _v21 is None:
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.over_discharge_count')
+            rep_u.unknown("uorb.BatteryStatus.over_discharge_count")
     else:
-        t_status.over_discharge_count = _r.to_int(_v21, 0, 65535, rep, 'uorb.BatteryStatus.over_discharge_count')
+        t_status.over_discharge_count = _r.to_int(_v21, 0, 65535, rep, "uorb.BatteryStatus.over_discharge_count")
     _v22 = s.nominal_voltage
     if _v22 is None or _v22 != _v22:
         t_status.nominal_voltage = 0.0
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.nominal_voltage')
+            rep_u.unknown("uorb.BatteryStatus.nominal_voltage")
     else:
         t_status.nominal_voltage = _r.f32(_v22)
         if rep is not None and t_status.nominal_voltage in (0,):
-            rep.clamped('uorb.BatteryStatus.nominal_voltage', 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.nominal_voltage", 'a known value written as the unknown marker')
     _v23 = s.is_powering_off
     if _v23 is None:
         if rep_u is not None:
-            rep_u.unknown('uorb.BatteryStatus.is_powering_off')
+            rep_u.unknown("uorb.BatteryStatus.is_powering_off")
     else:
         t_status.is_powering_off = bool(_v23)
     if rep_d is not None:

@@ -14,7 +14,7 @@ from ..uorb import BatteryStatusV0 as _C0
 from ..uorb import BatteryStatus as _C1
 
 
-_K2_forward = (('serial_number', 'serial_number'),)
+_K2_forward = (("serial_number", "serial_number"),)
 _K3_forward = _C0()
 
 
@@ -62,25 +62,25 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     if rep_d is not None:
         for _a, _n in _K2_forward:
             if _r.differs(getattr(s_status, _a), getattr(_K3_forward, _a)):
-                rep_d.dropped('uorb.BatteryStatusV0.' + _n)
+                rep_d.dropped("uorb.BatteryStatusV0." + _n)
     if rep_u is not None and _r.is_marker(t_status.voltage_v, 0.0):
-        rep_u.unknown('uorb.BatteryStatus.voltage_v')
+        rep_u.unknown("uorb.BatteryStatus.voltage_v")
     if rep_u is not None and _r.is_marker(t_status.current_a, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.current_a')
+        rep_u.unknown("uorb.BatteryStatus.current_a")
     if rep_u is not None and _r.is_marker(t_status.current_average_a, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.current_average_a')
+        rep_u.unknown("uorb.BatteryStatus.current_average_a")
     if rep_u is not None and _r.is_marker(t_status.discharged_mah, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.discharged_mah')
+        rep_u.unknown("uorb.BatteryStatus.discharged_mah")
     if rep_u is not None and _r.is_marker(t_status.remaining, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.remaining')
+        rep_u.unknown("uorb.BatteryStatus.remaining")
     if rep_u is not None and _r.is_marker(t_status.scale, -1.0):
-        rep_u.unknown('uorb.BatteryStatus.scale')
+        rep_u.unknown("uorb.BatteryStatus.scale")
     if rep_u is not None and _r.is_marker(t_status.time_remaining_s, math.nan):
-        rep_u.unknown('uorb.BatteryStatus.time_remaining_s')
+        rep_u.unknown("uorb.BatteryStatus.time_remaining_s")
     if rep_u is not None and _r.is_marker(t_status.temperature, math.nan):
-        rep_u.unknown('uorb.BatteryStatus.temperature')
+        rep_u.unknown("uorb.BatteryStatus.temperature")
     if rep_u is not None and _r.is_marker(t_status.cell_count, 0):
-        rep_u.unknown('uorb.BatteryStatus.cell_count')
+        rep_u.unknown("uorb.BatteryStatus.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
-        rep_u.unknown('uorb.BatteryStatus.voltage_cell_v')
+        rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
     return (t_status,)

@@ -15,9 +15,9 @@ def to_concepts(node: _T_devicetree_power_supply_battery, *, policy: str = 'stri
     px4: not available
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_devicetree.forward(node, rep=report, rep_d=report, rep_u=report, ocv_v=ocv_v, temperature_c=temperature_c)
         return _strict1[0]
-    if policy == 'px4':
-        raise _r.ConversionError('no px4 behaviour converts devicetree to concepts; use another policy')
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    if policy == "px4":
+        raise _r.ConversionError("no px4 behaviour converts devicetree to concepts; use another policy")
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

@@ -16,12 +16,12 @@ def to_concepts(info: _T_dronecan_uavcan_equipment_power_BatteryInfo, aux: _T_dr
     px4: not available
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=report)
         return _strict1[0]
-    if policy == 'px4':
-        raise _r.ConversionError('no px4 behaviour converts dronecan to concepts; use another policy')
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    if policy == "px4":
+        raise _r.ConversionError("no px4 behaviour converts dronecan to concepts; use another policy")
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
 
 
 def from_concepts(state: BatteryState, *, policy: str = 'strict', report: _r.LossReport | None = None) -> tuple[_T_dronecan_uavcan_equipment_power_BatteryInfo, _T_dronecan_ardupilot_equipment_power_BatteryInfoAux]:
@@ -30,9 +30,9 @@ def from_concepts(state: BatteryState, *, policy: str = 'strict', report: _r.Los
     px4: not available
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_dronecan.backward(state, rep=report, rep_d=report, rep_u=report)
         return _strict1
-    if policy == 'px4':
-        raise _r.ConversionError('no px4 behaviour converts concepts to dronecan; use another policy')
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    if policy == "px4":
+        raise _r.ConversionError("no px4 behaviour converts concepts to dronecan; use another policy")
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

@@ -17,10 +17,10 @@ def devicetree_to_dronecan(node: _T_devicetree_power_supply_battery, *, policy: 
     px4: not available
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_devicetree.forward(node, rep=report, rep_d=report, rep_u=None, ocv_v=ocv_v, temperature_c=temperature_c)
         _strict2 = _map_dronecan.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
         return _strict2
-    if policy == 'px4':
-        raise _r.ConversionError('no px4 behaviour converts devicetree to dronecan; use another policy')
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    if policy == "px4":
+        raise _r.ConversionError("no px4 behaviour converts devicetree to dronecan; use another policy")
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

@@ -21,15 +21,15 @@ def dronecan_to_mavlink(info: _T_dronecan_uavcan_equipment_power_BatteryInfo, au
     px4: px4_uavcan_bridge (forward) -> px4_mavlink_stream (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_mavlink.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
         return _strict2[0]
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _px42 = _map_px4_mavlink_stream.forward(*_px41, rep=report, rep_d=None, rep_u=report)
         return _px42[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
 
 
 def mavlink_to_dronecan(msg: _T_mavlink_BATTERY_STATUS, *, policy: str = 'strict', report: _r.LossReport | None = None) -> tuple[_T_dronecan_uavcan_equipment_power_BatteryInfo, _T_dronecan_ardupilot_equipment_power_BatteryInfoAux]:
@@ -38,12 +38,12 @@ def mavlink_to_dronecan(msg: _T_mavlink_BATTERY_STATUS, *, policy: str = 'strict
     px4: px4_mavlink_receiver (forward) -> px4_uavcannode (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_dronecan.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
         return _strict2
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=None)
         _px42 = _map_px4_uavcannode.forward(*_px41, rep=report, rep_d=None, rep_u=report)
         return _px42
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

@@ -19,14 +19,14 @@ def dronecan_to_uorb(info: _T_dronecan_uavcan_equipment_power_BatteryInfo, aux: 
     px4: px4_uavcan_bridge (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_uorb.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
         return _strict2[0]
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=report)
         return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
 
 
 def uorb_to_dronecan(status: _T_uorb_BatteryStatus, *, policy: str = 'strict', report: _r.LossReport | None = None) -> tuple[_T_dronecan_uavcan_equipment_power_BatteryInfo, _T_dronecan_ardupilot_equipment_power_BatteryInfoAux]:
@@ -35,11 +35,11 @@ def uorb_to_dronecan(status: _T_uorb_BatteryStatus, *, policy: str = 'strict', r
     px4: px4_uavcannode (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_dronecan.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
         return _strict2
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_px4_uavcannode.forward(status, rep=report, rep_d=report, rep_u=report)
         return _px41
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

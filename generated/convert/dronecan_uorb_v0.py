@@ -21,16 +21,16 @@ def dronecan_to_uorb_v0(info: _T_dronecan_uavcan_equipment_power_BatteryInfo, au
     px4: px4_uavcan_bridge (forward) -> uorb_v0_down (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_uorb.backward(*_strict1, rep=report, rep_d=report, rep_u=None)
         _strict3 = _map_uorb_v0_down.forward(*_strict2, rep=report, rep_d=report, rep_u=report)
         return _strict3[0]
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _px42 = _map_uorb_v0_down.forward(*_px41, rep=report, rep_d=None, rep_u=report)
         return _px42[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
 
 
 def uorb_v0_to_dronecan(status: _T_uorb_BatteryStatusV0, *, policy: str = 'strict', report: _r.LossReport | None = None) -> tuple[_T_dronecan_uavcan_equipment_power_BatteryInfo, _T_dronecan_ardupilot_equipment_power_BatteryInfoAux]:
@@ -39,13 +39,13 @@ def uorb_v0_to_dronecan(status: _T_uorb_BatteryStatusV0, *, policy: str = 'stric
     px4: uorb_v0_up (forward) -> px4_uavcannode (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_uorb.forward(*_strict1, rep=report, rep_d=report, rep_u=None)
         _strict3 = _map_dronecan.backward(*_strict2, rep=report, rep_d=report, rep_u=report)
         return _strict3
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
         _px42 = _map_px4_uavcannode.forward(*_px41, rep=report, rep_d=report, rep_u=report)
         return _px42
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

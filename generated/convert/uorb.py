@@ -15,12 +15,12 @@ def to_concepts(status: _T_uorb_BatteryStatus, *, policy: str = 'strict', report
     px4: not available
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=report)
         return _strict1[0]
-    if policy == 'px4':
-        raise _r.ConversionError('no px4 behaviour converts uorb to concepts; use another policy')
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    if policy == "px4":
+        raise _r.ConversionError("no px4 behaviour converts uorb to concepts; use another policy")
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
 
 
 def from_concepts(state: BatteryState, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatus:
@@ -29,9 +29,9 @@ def from_concepts(state: BatteryState, *, policy: str = 'strict', report: _r.Los
     px4: not available
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb.backward(state, rep=report, rep_d=report, rep_u=report)
         return _strict1[0]
-    if policy == 'px4':
-        raise _r.ConversionError('no px4 behaviour converts concepts to uorb; use another policy')
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    if policy == "px4":
+        raise _r.ConversionError("no px4 behaviour converts concepts to uorb; use another policy")
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

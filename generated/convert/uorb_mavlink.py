@@ -18,14 +18,14 @@ def uorb_to_mavlink(status: _T_uorb_BatteryStatus, *, policy: str = 'strict', re
     px4: px4_mavlink_stream (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_mavlink.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
         return _strict2[0]
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_px4_mavlink_stream.forward(status, rep=report, rep_d=report, rep_u=report)
         return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
 
 
 def mavlink_to_uorb(msg: _T_mavlink_BATTERY_STATUS, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatus:
@@ -34,11 +34,11 @@ def mavlink_to_uorb(msg: _T_mavlink_BATTERY_STATUS, *, policy: str = 'strict', r
     px4: px4_mavlink_receiver (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_uorb.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
         return _strict2[0]
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=report)
         return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

@@ -16,13 +16,13 @@ def uorb_to_uorb_v0(status: _T_uorb_BatteryStatus, *, policy: str = 'strict', re
     px4: uorb_v0_down (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb_v0_down.forward(status, rep=report, rep_d=report, rep_u=report)
         return _strict1[0]
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_uorb_v0_down.forward(status, rep=report, rep_d=report, rep_u=report)
         return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
 
 
 def uorb_v0_to_uorb(status: _T_uorb_BatteryStatusV0, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatus:
@@ -31,10 +31,10 @@ def uorb_v0_to_uorb(status: _T_uorb_BatteryStatusV0, *, policy: str = 'strict', 
     px4: uorb_v0_up (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=report)
         return _strict1[0]
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=report)
         return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

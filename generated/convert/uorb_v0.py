@@ -17,13 +17,13 @@ def to_concepts(status: _T_uorb_BatteryStatusV0, *, policy: str = 'strict', repo
     px4: not available
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_uorb.forward(*_strict1, rep=report, rep_d=report, rep_u=report)
         return _strict2[0]
-    if policy == 'px4':
-        raise _r.ConversionError('no px4 behaviour converts uorb_v0 to concepts; use another policy')
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    if policy == "px4":
+        raise _r.ConversionError("no px4 behaviour converts uorb_v0 to concepts; use another policy")
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
 
 
 def from_concepts(state: BatteryState, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatusV0:
@@ -32,10 +32,10 @@ def from_concepts(state: BatteryState, *, policy: str = 'strict', report: _r.Los
     px4: not available
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb.backward(state, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_uorb_v0_down.forward(*_strict1, rep=report, rep_d=report, rep_u=report)
         return _strict2[0]
-    if policy == 'px4':
-        raise _r.ConversionError('no px4 behaviour converts concepts to uorb_v0; use another policy')
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    if policy == "px4":
+        raise _r.ConversionError("no px4 behaviour converts concepts to uorb_v0; use another policy")
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

@@ -20,16 +20,16 @@ def uorb_v0_to_mavlink(status: _T_uorb_BatteryStatusV0, *, policy: str = 'strict
     px4: uorb_v0_up (forward) -> px4_mavlink_stream (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_uorb.forward(*_strict1, rep=report, rep_d=report, rep_u=None)
         _strict3 = _map_mavlink.backward(*_strict2, rep=report, rep_d=report, rep_u=report)
         return _strict3[0]
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
         _px42 = _map_px4_mavlink_stream.forward(*_px41, rep=report, rep_d=report, rep_u=report)
         return _px42[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
 
 
 def mavlink_to_uorb_v0(msg: _T_mavlink_BATTERY_STATUS, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatusV0:
@@ -38,13 +38,13 @@ def mavlink_to_uorb_v0(msg: _T_mavlink_BATTERY_STATUS, *, policy: str = 'strict'
     px4: px4_mavlink_receiver (forward) -> uorb_v0_down (forward)
     Pass a LossReport as report to learn what did not survive.
     """
-    if policy == 'strict':
+    if policy == "strict":
         _strict1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
         _strict2 = _map_uorb.backward(*_strict1, rep=report, rep_d=report, rep_u=None)
         _strict3 = _map_uorb_v0_down.forward(*_strict2, rep=report, rep_d=report, rep_u=report)
         return _strict3[0]
-    if policy == 'px4':
+    if policy == "px4":
         _px41 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=None)
         _px42 = _map_uorb_v0_down.forward(*_px41, rep=report, rep_d=None, rep_u=report)
         return _px42[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, 'strict or px4'))
+    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))

@@ -6,4 +6,4 @@ Package: devicetree.
 
 from .power.supply import SimpleBattery
 
-__all__ = ['SimpleBattery']
+__all__ = ["SimpleBattery"]

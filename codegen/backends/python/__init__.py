@@ -12,6 +12,8 @@ import jinja2
 from ...ir import Message, Schema, SourceFormat
 from . import naming
 from .extensions import Contribution
+from .imports import from_imports
+from .layout import format_module
 from .literals import docstring, py_literal
 from .registry import EXTENSIONS
 from .views import ModuleContext, class_view, enum_views
@@ -80,10 +82,11 @@ def render_package(schema: Schema) -> dict[str, str]:
         files.update(extension.runtime_files(schema, HEADER))
 
     for module in sorted(modules):
-        files[module_file(module, packages)] = _render_module(env, schema, module, by_module[module], packages)
+        text = _render_module(env, schema, module, by_module[module], packages)
+        files[module_file(module, packages)] = format_module(text)
 
     for package in sorted(packages - modules):
-        files[module_file(package, packages)] = _render_package_init(env, schema, package, by_module)
+        files[module_file(package, packages)] = format_module(_render_package_init(env, schema, package, by_module))
     files["__init__.py"] = env.get_template("package.py.j2").render(
         header=HEADER,
         doc=docstring(
@@ -135,9 +138,8 @@ def _render_module(
         header=HEADER,
         module_doc=docstring(_FORMAT_DOCS.get(fmt, "Generated models.") + f"\n\nModule: {module}.", ""),
         std_imports=std,
-        root=ctx.root(),
-        extra_imports=sorted(extra_imports),
-        type_imports=type_imports,
+        local_imports=from_imports([f"from {ctx.root()} import _meta as _m", *extra_imports]),
+        type_imports=from_imports(type_imports),
         exports=sorted([c.name for c in classes] + [e.class_name for e in enums]),
     )
     return head.rstrip("\n") + "\n\n\n" + body.strip("\n") + "\n"

@@ -1,10 +1,21 @@
 """Python source literals for schema-supplied values: everything a schema says reaches generated
-code only through these functions, so no name, comment or value can break out of a literal."""
+code only through these functions, so no name, comment or value can break out of a literal.
+
+Literals are spelled as ruff writes them (double quotes unless the text holds more of them,
+upper-case hex digits), and long prose is cut into implicitly concatenated parts that the layout
+engine can put on lines of their own.
+"""
 
 from __future__ import annotations
 
 import math
+import textwrap
 import unicodedata
+
+from .layout import LINE_LENGTH
+from .layout.source import normalize_number, normalize_string
+
+PROSE_PART = 80  # characters of text per part of a long string literal
 
 
 def py_literal(value: object) -> str:
@@ -18,17 +29,39 @@ def py_literal(value: object) -> str:
             return "math.nan"
         if math.isinf(value):
             return "math.inf" if value > 0 else "-math.inf"
-        return repr(value)
-    if isinstance(value, str):
-        return repr(value)
-    if isinstance(value, bytes):
-        return repr(value)
+        return normalize_number(repr(value))
+    if isinstance(value, str | bytes):
+        return normalize_string(repr(value))
     if isinstance(value, tuple):
         inner = ", ".join(py_literal(v) for v in value)
         return f"({inner},)" if len(value) == 1 else f"({inner})"
     if isinstance(value, list):
         return "[" + ", ".join(py_literal(v) for v in value) + "]"
     raise TypeError(f"no literal for {type(value).__name__}")
+
+
+def hex_literal(value: int) -> str:
+    """``2047`` -> ``0x7FF`` (bit masks read better in hex)."""
+    return ("-" if value < 0 else "") + "0x" + format(abs(value), "X")
+
+
+def prose_literal(text: str) -> str:
+    """A string literal for documentation text: implicitly concatenated parts of at most
+    :data:`PROSE_PART` characters, cut after a space or newline, when the text is longer."""
+    if len(text) <= PROSE_PART:
+        return py_literal(text)
+    parts: list[str] = []
+    rest = text
+    while len(rest) > PROSE_PART:
+        window = rest[:PROSE_PART]
+        cut = window.rfind("\n") + 1 or window.rfind(" ") + 1
+        if cut <= 0:
+            cut = rest.find(" ", PROSE_PART) + 1 or len(rest)  # one long word: keep it whole
+        parts.append(rest[:cut])
+        rest = rest[cut:]
+    if rest:
+        parts.append(rest)
+    return " ".join(py_literal(p) for p in parts)
 
 
 def _clean(text: str) -> str:
@@ -39,13 +72,33 @@ def _clean(text: str) -> str:
     )
 
 
+def _wrapped(line: str, width: int) -> list[str]:
+    """A docstring line cut at spaces to fit ``width`` (a single long word stays whole)."""
+    if len(line) <= width:
+        return [line]
+    lead = line[: len(line) - len(line.lstrip(" "))]
+    return textwrap.wrap(
+        line,
+        width,
+        subsequent_indent=lead,
+        break_long_words=False,
+        break_on_hyphens=False,
+        drop_whitespace=True,
+    ) or [line]
+
+
 def docstring(text: str, indent: str) -> str:
-    """A triple-quoted docstring holding ``text`` verbatim, safe whatever the text contains."""
+    """A triple-quoted docstring holding ``text``, safe whatever the text contains; lines longer
+    than the line length allows are wrapped at spaces."""
     body = _clean(text.strip("\n")).replace("\\", "\\\\").replace('"""', '\\"\\"\\"')
-    body = "\n".join(line.rstrip() for line in body.splitlines())
+    width = LINE_LENGTH - len(indent)
+    lines: list[str] = []
+    for i, line in enumerate(body.splitlines()):
+        lines += _wrapped(line.rstrip(), width - (3 if i == 0 else 0))
+    body = "\n".join(lines)
     if body.endswith('"'):
         body += " "
-    if "\n" not in body:
+    if "\n" not in body and len(indent) + len(body) + 6 <= LINE_LENGTH:
         return f'{indent}"""{body}"""'
     lines = body.split("\n")
     out = [f'{indent}"""{lines[0]}']

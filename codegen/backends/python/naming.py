@@ -8,6 +8,7 @@ import re
 from ...ir import DronecanKind, Message, SourceFormat
 
 _NON_IDENT = re.compile(r"[^0-9A-Za-z_]+")
+_WORD_BOUNDARY = re.compile(r"(?<=[a-z0-9])(?=[A-Z])|(?<=[A-Z])(?=[A-Z][a-z])")
 _REGEX_TOKENS = re.compile(r"\[[^\]]*\][+*?]?|\\d[+*?]?|[+*?]")
 # Every member a generated class gets from the backend and its extensions (codecs, validators):
 # a schema field or constant with one of these names is renamed (a trailing "_"), never shadowing it.
@@ -59,6 +60,17 @@ def camel(text: str) -> str:
     else:
         result = "".join(w[:1].upper() + w[1:].lower() for w in words)
     return identifier(result)
+
+
+def upper_snake(name: str) -> str:
+    """``BatteryStatusV0`` / ``voltage_cell_v`` -> ``BATTERY_STATUS_V0`` / ``VOLTAGE_CELL_V``."""
+    spaced = _WORD_BOUNDARY.sub("_", name)
+    return re.sub(r"_+", "_", spaced).strip("_").upper() or "UNNAMED"
+
+
+def lower_snake(name: str) -> str:
+    """``BatteryStatusV0`` -> ``battery_status_v0``."""
+    return upper_snake(name).lower()
 
 
 def module_path(msg: Message) -> str:

@@ -20,7 +20,7 @@ from ...ir import (
     StringType,
 )
 from . import naming
-from .literals import docstring, py_literal
+from .literals import docstring, prose_literal, py_literal
 
 
 @dataclass(frozen=True)
@@ -104,8 +104,26 @@ class ModuleContext:
         self.classes = {
             m.qualified_name: ClassRef(naming.module_path(m), naming.class_name(m)) for m in schema.messages
         }
-        self.factories: dict[str, str] = {}  # class name -> factory function source
+        self.factories: dict[str, str] = {}  # factory function name -> its source
         self.referenced: set[str] = set()  # other modules named in annotations
+        self.names: dict[object, str] = {}  # what a module-level name holds -> the name
+        self.taken: set[str] = {ref.name for ref in self.classes.values() if ref.module == module}
+
+    def private_name(self, wanted: str, what: object) -> str:
+        """A module-level name for ``what`` (the same one on every request), ``wanted`` unless taken."""
+        name = self.names.get(what)
+        if name is None:
+            name, n = wanted, 1
+            while name in self.taken:
+                n += 1
+                name = f"{wanted}_{n}"
+            self.taken.add(name)
+            self.names[what] = name
+        return name
+
+    def constant(self, owner: str, role: str) -> str:
+        """The name of a module-level constant of class ``owner``: ``_BATTERY_STATUS_COLUMNS``."""
+        return self.private_name(f"_{naming.upper_snake(owner)}_{role}", ("constant", owner, role))
 
     def composite(self, t: CompositeType, where: Field) -> ClassRef:
         ref = self.classes.get(t.name)
@@ -116,7 +134,7 @@ class ModuleContext:
 
     def factory(self, ref: ClassRef) -> str:
         """Name of a function returning the class ``ref`` lazily (modules may refer to each other)."""
-        fname = f"_cls_{ref.name}"
+        fname = self.private_name(f"_{naming.lower_snake(ref.name)}_class", ("class", ref))
         if fname not in self.factories:
             if ref.module == self.module:
                 body = f"    return {ref.name}"
@@ -313,7 +331,7 @@ def _meta(f: Field) -> str:
     if f.pattern is not None:
         args.append(f"pattern={py_literal(f.pattern)}")
     if f.doc:
-        args.append(f"doc={py_literal(f.doc)}")
+        args.append(f"doc={prose_literal(f.doc)}")
     return "_m.meta(" + ", ".join(args) + ")"
 
 

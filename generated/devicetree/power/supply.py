@@ -13,35 +13,298 @@ from typing import Any, ClassVar
 from ... import _meta as _m
 from ... import _validate as _v
 
-__all__ = ['SimpleBattery']
+__all__ = ["SimpleBattery"]
 
 
-_VS_SimpleBattery_compatible = _v.Optional(_v.Array(_v.Text(const='simple-battery'), None, False, min_length=1), required=True)
-_VS_SimpleBattery_device_chemistry = _v.Optional(_v.Text(choices=('nickel-cadmium', 'nickel-metal-hydride', 'lithium-ion', 'lithium-ion-polymer', 'lithium-ion-iron-phosphate', 'lithium-ion-manganese-oxide')), required=False)
-_VS_SimpleBattery_over_voltage_threshold_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
-_VS_SimpleBattery_re_charge_voltage_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
-_VS_SimpleBattery_voltage_min_design_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
-_VS_SimpleBattery_voltage_max_design_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
-_VS_SimpleBattery_energy_full_design_microwatt_hours = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uWh'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_charge_full_design_microamp_hours = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uAh'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_trickle_charge_current_microamp = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uA'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_tricklecharge_upper_limit_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
-_VS_SimpleBattery_precharge_current_microamp = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uA'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_precharge_upper_limit_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
-_VS_SimpleBattery_charge_term_current_microamp = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uA'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_constant_charge_current_max_microamp = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uA'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_constant_charge_voltage_max_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1), required=False)
-_VS_SimpleBattery_factory_internal_resistance_micro_ohms = _v.Optional(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295, unit='uOhm'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_resistance_temp_table = _v.Optional(_v.Array(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295), 2, True, min_length=2, columns=(_v.Number(type='uint32', kind='uint', label='the temperature in degree Celsius', low=0, high=4294967295), _v.Number(type='uint32', kind='uint', label='battery internal resistance percent', low=0, high=4294967295))), None, False, min_length=1), required=False)
-_VS_SimpleBattery_ocv_capacity_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_operating_range_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2, columns=(_v.Number(type='int32', kind='int', label='minimum temperature at which battery can operate', low=-2147483648, high=2147483647, unit='degC'), _v.Number(type='int32', kind='int', label='maximum temperature at which battery can operate', low=-2147483648, high=2147483647, unit='degC'))), required=False)
-_VS_SimpleBattery_ambient_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2, columns=(_v.Number(type='int32', kind='int', label='alert when ambient temperature is lower than this value', low=-2147483648, high=2147483647, unit='degC'), _v.Number(type='int32', kind='int', label='alert when ambient temperature is higher than this value', low=-2147483648, high=2147483647, unit='degC'))), required=False)
-_VS_SimpleBattery_alert_celsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='degC'), 2, True, min_length=2, columns=(_v.Number(type='int32', kind='int', label='alert when battery temperature is lower than this value', low=-2147483648, high=2147483647, unit='degC'), _v.Number(type='int32', kind='int', label='alert when battery temperature is higher than this value', low=-2147483648, high=2147483647, unit='degC'))), required=False)
-_VS_SimpleBattery_volt_drop_thresh_microvolt = _v.Optional(_v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV', maximum=48000000), 1, True, min_length=1), 1, True, min_length=1), required=False)
-_VS_SimpleBattery_volt_drop_soc_bp = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='bp'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_volt_drop_temperatures_millicelsius = _v.Optional(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='mdegC'), None, False, min_length=1), required=False)
-_VS_SimpleBattery_ocv_capacity_table_n = _v.Pattern('^ocv-capacity-table-[0-9]+$', _v.Array(_v.Array(_v.Number(type='uint32', kind='uint', low=0, high=4294967295), 2, True, min_length=2, columns=(_v.Number(type='uint32', kind='uint', label='open circuit voltage (OCV) in microvolts', low=0, high=4294967295), _v.Number(type='uint32', kind='uint', label='battery capacity percent', low=0, high=4294967295, maximum=100))), 100, False, min_length=1))
-_VS_SimpleBattery_volt_drop_n_microvolt = _v.Pattern('^volt-drop-[0-9]-microvolt', _v.Array(_v.Array(_v.Number(type='int32', kind='int', low=-2147483648, high=2147483647, unit='uV'), None, False, min_length=1), None, False, min_length=1))
+_VS_SimpleBattery_compatible = _v.Optional(
+    _v.Array(_v.Text(const="simple-battery"), None, False, min_length=1), required=True
+)
+_VS_SimpleBattery_device_chemistry = _v.Optional(
+    _v.Text(
+        choices=(
+            "nickel-cadmium",
+            "nickel-metal-hydride",
+            "lithium-ion",
+            "lithium-ion-polymer",
+            "lithium-ion-iron-phosphate",
+            "lithium-ion-manganese-oxide",
+        )
+    ),
+    required=False,
+)
+_VS_SimpleBattery_over_voltage_threshold_microvolt = _v.Optional(
+    _v.Array(
+        _v.Array(
+            _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
+        ),
+        None,
+        False,
+        min_length=1,
+    ),
+    required=False,
+)
+_VS_SimpleBattery_re_charge_voltage_microvolt = _v.Optional(
+    _v.Array(
+        _v.Array(
+            _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
+        ),
+        None,
+        False,
+        min_length=1,
+    ),
+    required=False,
+)
+_VS_SimpleBattery_voltage_min_design_microvolt = _v.Optional(
+    _v.Array(
+        _v.Array(
+            _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
+        ),
+        None,
+        False,
+        min_length=1,
+    ),
+    required=False,
+)
+_VS_SimpleBattery_voltage_max_design_microvolt = _v.Optional(
+    _v.Array(
+        _v.Array(
+            _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
+        ),
+        None,
+        False,
+        min_length=1,
+    ),
+    required=False,
+)
+_VS_SimpleBattery_energy_full_design_microwatt_hours = _v.Optional(
+    _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uWh"), None, False, min_length=1),
+    required=False,
+)
+_VS_SimpleBattery_charge_full_design_microamp_hours = _v.Optional(
+    _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uAh"), None, False, min_length=1),
+    required=False,
+)
+_VS_SimpleBattery_trickle_charge_current_microamp = _v.Optional(
+    _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uA"), None, False, min_length=1),
+    required=False,
+)
+_VS_SimpleBattery_tricklecharge_upper_limit_microvolt = _v.Optional(
+    _v.Array(
+        _v.Array(
+            _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
+        ),
+        None,
+        False,
+        min_length=1,
+    ),
+    required=False,
+)
+_VS_SimpleBattery_precharge_current_microamp = _v.Optional(
+    _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uA"), None, False, min_length=1),
+    required=False,
+)
+_VS_SimpleBattery_precharge_upper_limit_microvolt = _v.Optional(
+    _v.Array(
+        _v.Array(
+            _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
+        ),
+        None,
+        False,
+        min_length=1,
+    ),
+    required=False,
+)
+_VS_SimpleBattery_charge_term_current_microamp = _v.Optional(
+    _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uA"), None, False, min_length=1),
+    required=False,
+)
+_VS_SimpleBattery_constant_charge_current_max_microamp = _v.Optional(
+    _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uA"), None, False, min_length=1),
+    required=False,
+)
+_VS_SimpleBattery_constant_charge_voltage_max_microvolt = _v.Optional(
+    _v.Array(
+        _v.Array(
+            _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
+        ),
+        None,
+        False,
+        min_length=1,
+    ),
+    required=False,
+)
+_VS_SimpleBattery_factory_internal_resistance_micro_ohms = _v.Optional(
+    _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uOhm"), None, False, min_length=1),
+    required=False,
+)
+_VS_SimpleBattery_resistance_temp_table = _v.Optional(
+    _v.Array(
+        _v.Array(
+            _v.Number(type="uint32", kind="uint", low=0, high=4294967295),
+            2,
+            True,
+            min_length=2,
+            columns=(
+                _v.Number(
+                    type="uint32", kind="uint", label="the temperature in degree Celsius", low=0, high=4294967295
+                ),
+                _v.Number(
+                    type="uint32", kind="uint", label="battery internal resistance percent", low=0, high=4294967295
+                ),
+            ),
+        ),
+        None,
+        False,
+        min_length=1,
+    ),
+    required=False,
+)
+_VS_SimpleBattery_ocv_capacity_celsius = _v.Optional(
+    _v.Array(
+        _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="degC"), None, False, min_length=1
+    ),
+    required=False,
+)
+_VS_SimpleBattery_operating_range_celsius = _v.Optional(
+    _v.Array(
+        _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="degC"),
+        2,
+        True,
+        min_length=2,
+        columns=(
+            _v.Number(
+                type="int32",
+                kind="int",
+                label="minimum temperature at which battery can operate",
+                low=-2147483648,
+                high=2147483647,
+                unit="degC",
+            ),
+            _v.Number(
+                type="int32",
+                kind="int",
+                label="maximum temperature at which battery can operate",
+                low=-2147483648,
+                high=2147483647,
+                unit="degC",
+            ),
+        ),
+    ),
+    required=False,
+)
+_VS_SimpleBattery_ambient_celsius = _v.Optional(
+    _v.Array(
+        _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="degC"),
+        2,
+        True,
+        min_length=2,
+        columns=(
+            _v.Number(
+                type="int32",
+                kind="int",
+                label="alert when ambient temperature is lower than this value",
+                low=-2147483648,
+                high=2147483647,
+                unit="degC",
+            ),
+            _v.Number(
+                type="int32",
+                kind="int",
+                label="alert when ambient temperature is higher than this value",
+                low=-2147483648,
+                high=2147483647,
+                unit="degC",
+            ),
+        ),
+    ),
+    required=False,
+)
+_VS_SimpleBattery_alert_celsius = _v.Optional(
+    _v.Array(
+        _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="degC"),
+        2,
+        True,
+        min_length=2,
+        columns=(
+            _v.Number(
+                type="int32",
+                kind="int",
+                label="alert when battery temperature is lower than this value",
+                low=-2147483648,
+                high=2147483647,
+                unit="degC",
+            ),
+            _v.Number(
+                type="int32",
+                kind="int",
+                label="alert when battery temperature is higher than this value",
+                low=-2147483648,
+                high=2147483647,
+                unit="degC",
+            ),
+        ),
+    ),
+    required=False,
+)
+_VS_SimpleBattery_volt_drop_thresh_microvolt = _v.Optional(
+    _v.Array(
+        _v.Array(
+            _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV", maximum=48000000),
+            1,
+            True,
+            min_length=1,
+        ),
+        1,
+        True,
+        min_length=1,
+    ),
+    required=False,
+)
+_VS_SimpleBattery_volt_drop_soc_bp = _v.Optional(
+    _v.Array(
+        _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="bp"), None, False, min_length=1
+    ),
+    required=False,
+)
+_VS_SimpleBattery_volt_drop_temperatures_millicelsius = _v.Optional(
+    _v.Array(
+        _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mdegC"), None, False, min_length=1
+    ),
+    required=False,
+)
+_VS_SimpleBattery_ocv_capacity_table_n = _v.Pattern(
+    "^ocv-capacity-table-[0-9]+$",
+    _v.Array(
+        _v.Array(
+            _v.Number(type="uint32", kind="uint", low=0, high=4294967295),
+            2,
+            True,
+            min_length=2,
+            columns=(
+                _v.Number(
+                    type="uint32", kind="uint", label="open circuit voltage (OCV) in microvolts", low=0, high=4294967295
+                ),
+                _v.Number(
+                    type="uint32", kind="uint", label="battery capacity percent", low=0, high=4294967295, maximum=100
+                ),
+            ),
+        ),
+        100,
+        False,
+        min_length=1,
+    ),
+)
+_VS_SimpleBattery_volt_drop_n_microvolt = _v.Pattern(
+    "^volt-drop-[0-9]-microvolt",
+    _v.Array(
+        _v.Array(
+            _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
+        ),
+        None,
+        False,
+        min_length=1,
+    ),
+)
 
 
 @dataclasses.dataclass(slots=True)
@@ -66,34 +329,317 @@ class SimpleBattery:
     Schema: devicetree.power.supply.battery (devicetree, power/supply/battery.yaml:4).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'devicetree.power.supply.battery'
+    QUALIFIED_NAME: ClassVar[str] = "devicetree.power.supply.battery"
 
-    compatible: list[str] = dataclasses.field(default_factory=list, metadata=_m.meta(name='compatible', type='string[]'))
-    device_chemistry: str | None = dataclasses.field(default=None, metadata=_m.meta(name='device-chemistry', type='string', doc='This describes the chemical technology of the battery.'))
-    over_voltage_threshold_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='over-voltage-threshold-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, doc='battery over-voltage limit'))
-    re_charge_voltage_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='re-charge-voltage-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, doc='limit to automatically start charging again'))
-    voltage_min_design_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='voltage-min-design-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, doc='drained battery voltage'))
-    voltage_max_design_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='voltage-max-design-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, doc='fully charged battery voltage'))
-    energy_full_design_microwatt_hours: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='energy-full-design-microwatt-hours', type='uint32[]', unit='uWh', quantity='energy', scale=0.0036, offset=0.0, doc='battery design energy'))
-    charge_full_design_microamp_hours: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='charge-full-design-microamp-hours', type='uint32[]', unit='uAh', quantity='charge', scale=0.0036, offset=0.0, doc='battery design capacity'))
-    trickle_charge_current_microamp: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='trickle-charge-current-microamp', type='uint32[]', unit='uA', quantity='current', scale=1e-06, offset=0.0, doc='current for trickle-charge phase. Please note that the trickle-charging here, refers "wake-up" or "pre-pre" -charging, for very empty batteries. Similar term is also used for "maintenance" or "top-off" -charging of batteries (like NiMh bq24400) - that is different and not controlled by this property.'))
-    tricklecharge_upper_limit_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='tricklecharge-upper-limit-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, doc='limit when to change to precharge from trickle charge Trickle-charging here refers "wake-up" or "pre-pre" -charging.'))
-    precharge_current_microamp: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='precharge-current-microamp', type='uint32[]', unit='uA', quantity='current', scale=1e-06, offset=0.0, doc='current for pre-charge phase'))
-    precharge_upper_limit_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='precharge-upper-limit-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, doc='limit when to change to constant charging'))
-    charge_term_current_microamp: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='charge-term-current-microamp', type='uint32[]', unit='uA', quantity='current', scale=1e-06, offset=0.0, doc='current for charge termination phase'))
-    constant_charge_current_max_microamp: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='constant-charge-current-max-microamp', type='uint32[]', unit='uA', quantity='current', scale=1e-06, offset=0.0, doc='maximum constant input current'))
-    constant_charge_voltage_max_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='constant-charge-voltage-max-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, doc='maximum constant input voltage'))
-    factory_internal_resistance_micro_ohms: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='factory-internal-resistance-micro-ohms', type='uint32[]', unit='uOhm', quantity='resistance', scale=1e-06, offset=0.0, doc='battery factory internal resistance'))
-    resistance_temp_table: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='resistance-temp-table', type='uint32[2][]', doc='A table providing the temperature in degree Celsius\nand corresponding battery internal resistance percent, which is used to\nlook up the resistance percent according to current temperature to get an\naccurate batterty internal resistance in different temperatures.'))
-    ocv_capacity_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='ocv-capacity-celsius', type='int32[]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='An array containing the temperature in degree Celsius,\nfor each of the battery capacity lookup table.'))
-    operating_range_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='operating-range-celsius', type='int32[2]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='operating temperature range of a battery'))
-    ambient_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='ambient-celsius', type='int32[2]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='safe range of ambient temperature'))
-    alert_celsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='alert-celsius', type='int32[2]', unit='degC', quantity='temperature', scale=1.0, offset=273.15, doc='safe range of battery temperature'))
-    volt_drop_thresh_microvolt: list[list[int]] | None = dataclasses.field(default=None, metadata=_m.meta(name='volt-drop-thresh-microvolt', type='int32[1][1]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, minimum=None, maximum=48000000, doc='Threshold for starting the VDR correction'))
-    volt_drop_soc_bp: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='volt-drop-soc-bp', type='int32[]', unit='bp', quantity='ratio', scale=0.0001, offset=0.0, doc='Table of capacity values matching the values in VDR tables. The value should be given as basis points, 1/100 of a percent.'))
-    volt_drop_temperatures_millicelsius: list[int] | None = dataclasses.field(default=None, metadata=_m.meta(name='volt-drop-temperatures-millicelsius', type='int32[]', unit='mdegC', quantity='temperature', scale=0.001, offset=273.15, doc='An array containing the temperature in milli celsius, for each of the VDR lookup table.'))
-    ocv_capacity_table_n: dict[str, list[list[int]]] = dataclasses.field(default_factory=dict, metadata=_m.meta(name='^ocv-capacity-table-[0-9]+$', type='uint32[2][<=100]', pattern='^ocv-capacity-table-[0-9]+$', doc='An array providing the open circuit voltage (OCV)\nof the battery and corresponding battery capacity percent, which is used\nto look up battery capacity according to current OCV value. And the open\ncircuit voltage unit is microvolt.'))
-    volt_drop_n_microvolt: dict[str, list[list[int]]] = dataclasses.field(default_factory=dict, metadata=_m.meta(name='^volt-drop-[0-9]-microvolt', type='int32[][]', unit='uV', quantity='voltage', scale=1e-06, offset=0.0, pattern='^volt-drop-[0-9]-microvolt', doc="Table of the voltage drop rate (VDR) values. Each entry in the table should match a capacity value in the volt-drop-soc table. Furthermore, the values should be obtained for the temperature given in volt-drop-temperatures-millicelsius table at index matching the number in this table's name."))
+    compatible: list[str] = dataclasses.field(
+        default_factory=list, metadata=_m.meta(name="compatible", type="string[]")
+    )
+    device_chemistry: str | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="device-chemistry", type="string", doc="This describes the chemical technology of the battery."
+        ),
+    )
+    over_voltage_threshold_microvolt: list[list[int]] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="over-voltage-threshold-microvolt",
+            type="int32[][]",
+            unit="uV",
+            quantity="voltage",
+            scale=1e-06,
+            offset=0.0,
+            doc="battery over-voltage limit",
+        ),
+    )
+    re_charge_voltage_microvolt: list[list[int]] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="re-charge-voltage-microvolt",
+            type="int32[][]",
+            unit="uV",
+            quantity="voltage",
+            scale=1e-06,
+            offset=0.0,
+            doc="limit to automatically start charging again",
+        ),
+    )
+    voltage_min_design_microvolt: list[list[int]] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="voltage-min-design-microvolt",
+            type="int32[][]",
+            unit="uV",
+            quantity="voltage",
+            scale=1e-06,
+            offset=0.0,
+            doc="drained battery voltage",
+        ),
+    )
+    voltage_max_design_microvolt: list[list[int]] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="voltage-max-design-microvolt",
+            type="int32[][]",
+            unit="uV",
+            quantity="voltage",
+            scale=1e-06,
+            offset=0.0,
+            doc="fully charged battery voltage",
+        ),
+    )
+    energy_full_design_microwatt_hours: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="energy-full-design-microwatt-hours",
+            type="uint32[]",
+            unit="uWh",
+            quantity="energy",
+            scale=0.0036,
+            offset=0.0,
+            doc="battery design energy",
+        ),
+    )
+    charge_full_design_microamp_hours: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="charge-full-design-microamp-hours",
+            type="uint32[]",
+            unit="uAh",
+            quantity="charge",
+            scale=0.0036,
+            offset=0.0,
+            doc="battery design capacity",
+        ),
+    )
+    trickle_charge_current_microamp: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="trickle-charge-current-microamp",
+            type="uint32[]",
+            unit="uA",
+            quantity="current",
+            scale=1e-06,
+            offset=0.0,
+            doc="current for trickle-charge phase. Please note that the trickle-charging here, "
+            'refers "wake-up" or "pre-pre" -charging, for very empty batteries. Similar term '
+            'is also used for "maintenance" or "top-off" -charging of batteries (like NiMh '
+            "bq24400) - that is different and not controlled by this property.",
+        ),
+    )
+    tricklecharge_upper_limit_microvolt: list[list[int]] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="tricklecharge-upper-limit-microvolt",
+            type="int32[][]",
+            unit="uV",
+            quantity="voltage",
+            scale=1e-06,
+            offset=0.0,
+            doc="limit when to change to precharge from trickle charge Trickle-charging here "
+            'refers "wake-up" or "pre-pre" -charging.',
+        ),
+    )
+    precharge_current_microamp: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="precharge-current-microamp",
+            type="uint32[]",
+            unit="uA",
+            quantity="current",
+            scale=1e-06,
+            offset=0.0,
+            doc="current for pre-charge phase",
+        ),
+    )
+    precharge_upper_limit_microvolt: list[list[int]] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="precharge-upper-limit-microvolt",
+            type="int32[][]",
+            unit="uV",
+            quantity="voltage",
+            scale=1e-06,
+            offset=0.0,
+            doc="limit when to change to constant charging",
+        ),
+    )
+    charge_term_current_microamp: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="charge-term-current-microamp",
+            type="uint32[]",
+            unit="uA",
+            quantity="current",
+            scale=1e-06,
+            offset=0.0,
+            doc="current for charge termination phase",
+        ),
+    )
+    constant_charge_current_max_microamp: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="constant-charge-current-max-microamp",
+            type="uint32[]",
+            unit="uA",
+            quantity="current",
+            scale=1e-06,
+            offset=0.0,
+            doc="maximum constant input current",
+        ),
+    )
+    constant_charge_voltage_max_microvolt: list[list[int]] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="constant-charge-voltage-max-microvolt",
+            type="int32[][]",
+            unit="uV",
+            quantity="voltage",
+            scale=1e-06,
+            offset=0.0,
+            doc="maximum constant input voltage",
+        ),
+    )
+    factory_internal_resistance_micro_ohms: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="factory-internal-resistance-micro-ohms",
+            type="uint32[]",
+            unit="uOhm",
+            quantity="resistance",
+            scale=1e-06,
+            offset=0.0,
+            doc="battery factory internal resistance",
+        ),
+    )
+    resistance_temp_table: list[list[int]] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="resistance-temp-table",
+            type="uint32[2][]",
+            doc="A table providing the temperature in degree Celsius\n"
+            "and corresponding battery internal resistance percent, which is used to\n"
+            "look up the resistance percent according to current temperature to get an\n"
+            "accurate batterty internal resistance in different temperatures.",
+        ),
+    )
+    ocv_capacity_celsius: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="ocv-capacity-celsius",
+            type="int32[]",
+            unit="degC",
+            quantity="temperature",
+            scale=1.0,
+            offset=273.15,
+            doc="An array containing the temperature in degree Celsius,\n"
+            "for each of the battery capacity lookup table.",
+        ),
+    )
+    operating_range_celsius: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="operating-range-celsius",
+            type="int32[2]",
+            unit="degC",
+            quantity="temperature",
+            scale=1.0,
+            offset=273.15,
+            doc="operating temperature range of a battery",
+        ),
+    )
+    ambient_celsius: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="ambient-celsius",
+            type="int32[2]",
+            unit="degC",
+            quantity="temperature",
+            scale=1.0,
+            offset=273.15,
+            doc="safe range of ambient temperature",
+        ),
+    )
+    alert_celsius: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="alert-celsius",
+            type="int32[2]",
+            unit="degC",
+            quantity="temperature",
+            scale=1.0,
+            offset=273.15,
+            doc="safe range of battery temperature",
+        ),
+    )
+    volt_drop_thresh_microvolt: list[list[int]] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="volt-drop-thresh-microvolt",
+            type="int32[1][1]",
+            unit="uV",
+            quantity="voltage",
+            scale=1e-06,
+            offset=0.0,
+            minimum=None,
+            maximum=48000000,
+            doc="Threshold for starting the VDR correction",
+        ),
+    )
+    volt_drop_soc_bp: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="volt-drop-soc-bp",
+            type="int32[]",
+            unit="bp",
+            quantity="ratio",
+            scale=0.0001,
+            offset=0.0,
+            doc="Table of capacity values matching the values in VDR tables. The value should be "
+            "given as basis points, 1/100 of a percent.",
+        ),
+    )
+    volt_drop_temperatures_millicelsius: list[int] | None = dataclasses.field(
+        default=None,
+        metadata=_m.meta(
+            name="volt-drop-temperatures-millicelsius",
+            type="int32[]",
+            unit="mdegC",
+            quantity="temperature",
+            scale=0.001,
+            offset=273.15,
+            doc="An array containing the temperature in milli celsius, for each of the VDR lookup table.",
+        ),
+    )
+    ocv_capacity_table_n: dict[str, list[list[int]]] = dataclasses.field(
+        default_factory=dict,
+        metadata=_m.meta(
+            name="^ocv-capacity-table-[0-9]+$",
+            type="uint32[2][<=100]",
+            pattern="^ocv-capacity-table-[0-9]+$",
+            doc="An array providing the open circuit voltage (OCV)\n"
+            "of the battery and corresponding battery capacity percent, which is used\n"
+            "to look up battery capacity according to current OCV value. And the open\n"
+            "circuit voltage unit is microvolt.",
+        ),
+    )
+    volt_drop_n_microvolt: dict[str, list[list[int]]] = dataclasses.field(
+        default_factory=dict,
+        metadata=_m.meta(
+            name="^volt-drop-[0-9]-microvolt",
+            type="int32[][]",
+            unit="uV",
+            quantity="voltage",
+            scale=1e-06,
+            offset=0.0,
+            pattern="^volt-drop-[0-9]-microvolt",
+            doc="Table of the voltage drop rate (VDR) values. Each entry in the table should "
+            "match a capacity value in the volt-drop-soc table. Furthermore, the values "
+            "should be obtained for the temperature given in "
+            "volt-drop-temperatures-millicelsius table at index matching the number in this "
+            "table's name.",
+        ),
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -104,53 +650,53 @@ class SimpleBattery:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['compatible'] = list(self.compatible)
+        out["compatible"] = list(self.compatible)
         if self.device_chemistry is not None:
-            out['device-chemistry'] = self.device_chemistry
+            out["device-chemistry"] = self.device_chemistry
         if self.over_voltage_threshold_microvolt is not None:
-            out['over-voltage-threshold-microvolt'] = [list(v) for v in self.over_voltage_threshold_microvolt]
+            out["over-voltage-threshold-microvolt"] = [list(v) for v in self.over_voltage_threshold_microvolt]
         if self.re_charge_voltage_microvolt is not None:
-            out['re-charge-voltage-microvolt'] = [list(v) for v in self.re_charge_voltage_microvolt]
+            out["re-charge-voltage-microvolt"] = [list(v) for v in self.re_charge_voltage_microvolt]
         if self.voltage_min_design_microvolt is not None:
-            out['voltage-min-design-microvolt'] = [list(v) for v in self.voltage_min_design_microvolt]
+            out["voltage-min-design-microvolt"] = [list(v) for v in self.voltage_min_design_microvolt]
         if self.voltage_max_design_microvolt is not None:
-            out['voltage-max-design-microvolt'] = [list(v) for v in self.voltage_max_design_microvolt]
+            out["voltage-max-design-microvolt"] = [list(v) for v in self.voltage_max_design_microvolt]
         if self.energy_full_design_microwatt_hours is not None:
-            out['energy-full-design-microwatt-hours'] = list(self.energy_full_design_microwatt_hours)
+            out["energy-full-design-microwatt-hours"] = list(self.energy_full_design_microwatt_hours)
         if self.charge_full_design_microamp_hours is not None:
-            out['charge-full-design-microamp-hours'] = list(self.charge_full_design_microamp_hours)
+            out["charge-full-design-microamp-hours"] = list(self.charge_full_design_microamp_hours)
         if self.trickle_charge_current_microamp is not None:
-            out['trickle-charge-current-microamp'] = list(self.trickle_charge_current_microamp)
+            out["trickle-charge-current-microamp"] = list(self.trickle_charge_current_microamp)
         if self.tricklecharge_upper_limit_microvolt is not None:
-            out['tricklecharge-upper-limit-microvolt'] = [list(v) for v in self.tricklecharge_upper_limit_microvolt]
+            out["tricklecharge-upper-limit-microvolt"] = [list(v) for v in self.tricklecharge_upper_limit_microvolt]
         if self.precharge_current_microamp is not None:
-            out['precharge-current-microamp'] = list(self.precharge_current_microamp)
+            out["precharge-current-microamp"] = list(self.precharge_current_microamp)
         if self.precharge_upper_limit_microvolt is not None:
-            out['precharge-upper-limit-microvolt'] = [list(v) for v in self.precharge_upper_limit_microvolt]
+            out["precharge-upper-limit-microvolt"] = [list(v) for v in self.precharge_upper_limit_microvolt]
         if self.charge_term_current_microamp is not None:
-            out['charge-term-current-microamp'] = list(self.charge_term_current_microamp)
+            out["charge-term-current-microamp"] = list(self.charge_term_current_microamp)
         if self.constant_charge_current_max_microamp is not None:
-            out['constant-charge-current-max-microamp'] = list(self.constant_charge_current_max_microamp)
+            out["constant-charge-current-max-microamp"] = list(self.constant_charge_current_max_microamp)
         if self.constant_charge_voltage_max_microvolt is not None:
-            out['constant-charge-voltage-max-microvolt'] = [list(v) for v in self.constant_charge_voltage_max_microvolt]
+            out["constant-charge-voltage-max-microvolt"] = [list(v) for v in self.constant_charge_voltage_max_microvolt]
         if self.factory_internal_resistance_micro_ohms is not None:
-            out['factory-internal-resistance-micro-ohms'] = list(self.factory_internal_resistance_micro_ohms)
+            out["factory-internal-resistance-micro-ohms"] = list(self.factory_internal_resistance_micro_ohms)
         if self.resistance_temp_table is not None:
-            out['resistance-temp-table'] = [list(v) for v in self.resistance_temp_table]
+            out["resistance-temp-table"] = [list(v) for v in self.resistance_temp_table]
         if self.ocv_capacity_celsius is not None:
-            out['ocv-capacity-celsius'] = list(self.ocv_capacity_celsius)
+            out["ocv-capacity-celsius"] = list(self.ocv_capacity_celsius)
         if self.operating_range_celsius is not None:
-            out['operating-range-celsius'] = list(self.operating_range_celsius)
+            out["operating-range-celsius"] = list(self.operating_range_celsius)
         if self.ambient_celsius is not None:
-            out['ambient-celsius'] = list(self.ambient_celsius)
+            out["ambient-celsius"] = list(self.ambient_celsius)
         if self.alert_celsius is not None:
-            out['alert-celsius'] = list(self.alert_celsius)
+            out["alert-celsius"] = list(self.alert_celsius)
         if self.volt_drop_thresh_microvolt is not None:
-            out['volt-drop-thresh-microvolt'] = [list(v) for v in self.volt_drop_thresh_microvolt]
+            out["volt-drop-thresh-microvolt"] = [list(v) for v in self.volt_drop_thresh_microvolt]
         if self.volt_drop_soc_bp is not None:
-            out['volt-drop-soc-bp'] = list(self.volt_drop_soc_bp)
+            out["volt-drop-soc-bp"] = list(self.volt_drop_soc_bp)
         if self.volt_drop_temperatures_millicelsius is not None:
-            out['volt-drop-temperatures-millicelsius'] = list(self.volt_drop_temperatures_millicelsius)
+            out["volt-drop-temperatures-millicelsius"] = list(self.volt_drop_temperatures_millicelsius)
         out.update({k: [list(v) for v in v] for k, v in self.ocv_capacity_table_n.items()})
         out.update({k: [list(v) for v in v] for k, v in self.volt_drop_n_microvolt.items()})
         return out
@@ -158,61 +704,222 @@ class SimpleBattery:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> SimpleBattery:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'compatible', 'device-chemistry', 'over-voltage-threshold-microvolt', 're-charge-voltage-microvolt', 'voltage-min-design-microvolt', 'voltage-max-design-microvolt', 'energy-full-design-microwatt-hours', 'charge-full-design-microamp-hours', 'trickle-charge-current-microamp', 'tricklecharge-upper-limit-microvolt', 'precharge-current-microamp', 'precharge-upper-limit-microvolt', 'charge-term-current-microamp', 'constant-charge-current-max-microamp', 'constant-charge-voltage-max-microvolt', 'factory-internal-resistance-micro-ohms', 'resistance-temp-table', 'ocv-capacity-celsius', 'operating-range-celsius', 'ambient-celsius', 'alert-celsius', 'volt-drop-thresh-microvolt', 'volt-drop-soc-bp', 'volt-drop-temperatures-millicelsius'}), (('^ocv-capacity-table-[0-9]+$', 'ocv_capacity_table_n'), ('^volt-drop-[0-9]-microvolt', 'volt_drop_n_microvolt'),), 'SimpleBattery')
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "compatible",
+                    "device-chemistry",
+                    "over-voltage-threshold-microvolt",
+                    "re-charge-voltage-microvolt",
+                    "voltage-min-design-microvolt",
+                    "voltage-max-design-microvolt",
+                    "energy-full-design-microwatt-hours",
+                    "charge-full-design-microamp-hours",
+                    "trickle-charge-current-microamp",
+                    "tricklecharge-upper-limit-microvolt",
+                    "precharge-current-microamp",
+                    "precharge-upper-limit-microvolt",
+                    "charge-term-current-microamp",
+                    "constant-charge-current-max-microamp",
+                    "constant-charge-voltage-max-microvolt",
+                    "factory-internal-resistance-micro-ohms",
+                    "resistance-temp-table",
+                    "ocv-capacity-celsius",
+                    "operating-range-celsius",
+                    "ambient-celsius",
+                    "alert-celsius",
+                    "volt-drop-thresh-microvolt",
+                    "volt-drop-soc-bp",
+                    "volt-drop-temperatures-millicelsius",
+                }
+            ),
+            (
+                ("^ocv-capacity-table-[0-9]+$", "ocv_capacity_table_n"),
+                ("^volt-drop-[0-9]-microvolt", "volt_drop_n_microvolt"),
+            ),
+            "SimpleBattery",
+        )
         obj = cls()
-        if 'compatible' in data:
-            obj.compatible = _m.as_list(data['compatible'], 'compatible', None, False, lambda item, p: _m.as_str(item, p))
-        if 'device-chemistry' in data:
-            obj.device_chemistry = _m.as_str(data['device-chemistry'], 'device-chemistry')
-        if 'over-voltage-threshold-microvolt' in data:
-            obj.over_voltage_threshold_microvolt = _m.as_list(data['over-voltage-threshold-microvolt'], 'over-voltage-threshold-microvolt', None, False, lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)))
-        if 're-charge-voltage-microvolt' in data:
-            obj.re_charge_voltage_microvolt = _m.as_list(data['re-charge-voltage-microvolt'], 're-charge-voltage-microvolt', None, False, lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)))
-        if 'voltage-min-design-microvolt' in data:
-            obj.voltage_min_design_microvolt = _m.as_list(data['voltage-min-design-microvolt'], 'voltage-min-design-microvolt', None, False, lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)))
-        if 'voltage-max-design-microvolt' in data:
-            obj.voltage_max_design_microvolt = _m.as_list(data['voltage-max-design-microvolt'], 'voltage-max-design-microvolt', None, False, lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)))
-        if 'energy-full-design-microwatt-hours' in data:
-            obj.energy_full_design_microwatt_hours = _m.as_list(data['energy-full-design-microwatt-hours'], 'energy-full-design-microwatt-hours', None, False, lambda item, p: _m.as_int(item, p))
-        if 'charge-full-design-microamp-hours' in data:
-            obj.charge_full_design_microamp_hours = _m.as_list(data['charge-full-design-microamp-hours'], 'charge-full-design-microamp-hours', None, False, lambda item, p: _m.as_int(item, p))
-        if 'trickle-charge-current-microamp' in data:
-            obj.trickle_charge_current_microamp = _m.as_list(data['trickle-charge-current-microamp'], 'trickle-charge-current-microamp', None, False, lambda item, p: _m.as_int(item, p))
-        if 'tricklecharge-upper-limit-microvolt' in data:
-            obj.tricklecharge_upper_limit_microvolt = _m.as_list(data['tricklecharge-upper-limit-microvolt'], 'tricklecharge-upper-limit-microvolt', None, False, lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)))
-        if 'precharge-current-microamp' in data:
-            obj.precharge_current_microamp = _m.as_list(data['precharge-current-microamp'], 'precharge-current-microamp', None, False, lambda item, p: _m.as_int(item, p))
-        if 'precharge-upper-limit-microvolt' in data:
-            obj.precharge_upper_limit_microvolt = _m.as_list(data['precharge-upper-limit-microvolt'], 'precharge-upper-limit-microvolt', None, False, lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)))
-        if 'charge-term-current-microamp' in data:
-            obj.charge_term_current_microamp = _m.as_list(data['charge-term-current-microamp'], 'charge-term-current-microamp', None, False, lambda item, p: _m.as_int(item, p))
-        if 'constant-charge-current-max-microamp' in data:
-            obj.constant_charge_current_max_microamp = _m.as_list(data['constant-charge-current-max-microamp'], 'constant-charge-current-max-microamp', None, False, lambda item, p: _m.as_int(item, p))
-        if 'constant-charge-voltage-max-microvolt' in data:
-            obj.constant_charge_voltage_max_microvolt = _m.as_list(data['constant-charge-voltage-max-microvolt'], 'constant-charge-voltage-max-microvolt', None, False, lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)))
-        if 'factory-internal-resistance-micro-ohms' in data:
-            obj.factory_internal_resistance_micro_ohms = _m.as_list(data['factory-internal-resistance-micro-ohms'], 'factory-internal-resistance-micro-ohms', None, False, lambda item, p: _m.as_int(item, p))
-        if 'resistance-temp-table' in data:
-            obj.resistance_temp_table = _m.as_list(data['resistance-temp-table'], 'resistance-temp-table', None, False, lambda item, p: _m.as_list(item, p, 2, True, lambda item, p: _m.as_int(item, p)))
-        if 'ocv-capacity-celsius' in data:
-            obj.ocv_capacity_celsius = _m.as_list(data['ocv-capacity-celsius'], 'ocv-capacity-celsius', None, False, lambda item, p: _m.as_int(item, p))
-        if 'operating-range-celsius' in data:
-            obj.operating_range_celsius = _m.as_list(data['operating-range-celsius'], 'operating-range-celsius', 2, True, lambda item, p: _m.as_int(item, p))
-        if 'ambient-celsius' in data:
-            obj.ambient_celsius = _m.as_list(data['ambient-celsius'], 'ambient-celsius', 2, True, lambda item, p: _m.as_int(item, p))
-        if 'alert-celsius' in data:
-            obj.alert_celsius = _m.as_list(data['alert-celsius'], 'alert-celsius', 2, True, lambda item, p: _m.as_int(item, p))
-        if 'volt-drop-thresh-microvolt' in data:
-            obj.volt_drop_thresh_microvolt = _m.as_list(data['volt-drop-thresh-microvolt'], 'volt-drop-thresh-microvolt', 1, True, lambda item, p: _m.as_list(item, p, 1, True, lambda item, p: _m.as_int(item, p)))
-        if 'volt-drop-soc-bp' in data:
-            obj.volt_drop_soc_bp = _m.as_list(data['volt-drop-soc-bp'], 'volt-drop-soc-bp', None, False, lambda item, p: _m.as_int(item, p))
-        if 'volt-drop-temperatures-millicelsius' in data:
-            obj.volt_drop_temperatures_millicelsius = _m.as_list(data['volt-drop-temperatures-millicelsius'], 'volt-drop-temperatures-millicelsius', None, False, lambda item, p: _m.as_int(item, p))
+        if "compatible" in data:
+            obj.compatible = _m.as_list(
+                data["compatible"], "compatible", None, False, lambda item, p: _m.as_str(item, p)
+            )
+        if "device-chemistry" in data:
+            obj.device_chemistry = _m.as_str(data["device-chemistry"], "device-chemistry")
+        if "over-voltage-threshold-microvolt" in data:
+            obj.over_voltage_threshold_microvolt = _m.as_list(
+                data["over-voltage-threshold-microvolt"],
+                "over-voltage-threshold-microvolt",
+                None,
+                False,
+                lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
+            )
+        if "re-charge-voltage-microvolt" in data:
+            obj.re_charge_voltage_microvolt = _m.as_list(
+                data["re-charge-voltage-microvolt"],
+                "re-charge-voltage-microvolt",
+                None,
+                False,
+                lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
+            )
+        if "voltage-min-design-microvolt" in data:
+            obj.voltage_min_design_microvolt = _m.as_list(
+                data["voltage-min-design-microvolt"],
+                "voltage-min-design-microvolt",
+                None,
+                False,
+                lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
+            )
+        if "voltage-max-design-microvolt" in data:
+            obj.voltage_max_design_microvolt = _m.as_list(
+                data["voltage-max-design-microvolt"],
+                "voltage-max-design-microvolt",
+                None,
+                False,
+                lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
+            )
+        if "energy-full-design-microwatt-hours" in data:
+            obj.energy_full_design_microwatt_hours = _m.as_list(
+                data["energy-full-design-microwatt-hours"],
+                "energy-full-design-microwatt-hours",
+                None,
+                False,
+                lambda item, p: _m.as_int(item, p),
+            )
+        if "charge-full-design-microamp-hours" in data:
+            obj.charge_full_design_microamp_hours = _m.as_list(
+                data["charge-full-design-microamp-hours"],
+                "charge-full-design-microamp-hours",
+                None,
+                False,
+                lambda item, p: _m.as_int(item, p),
+            )
+        if "trickle-charge-current-microamp" in data:
+            obj.trickle_charge_current_microamp = _m.as_list(
+                data["trickle-charge-current-microamp"],
+                "trickle-charge-current-microamp",
+                None,
+                False,
+                lambda item, p: _m.as_int(item, p),
+            )
+        if "tricklecharge-upper-limit-microvolt" in data:
+            obj.tricklecharge_upper_limit_microvolt = _m.as_list(
+                data["tricklecharge-upper-limit-microvolt"],
+                "tricklecharge-upper-limit-microvolt",
+                None,
+                False,
+                lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
+            )
+        if "precharge-current-microamp" in data:
+            obj.precharge_current_microamp = _m.as_list(
+                data["precharge-current-microamp"],
+                "precharge-current-microamp",
+                None,
+                False,
+                lambda item, p: _m.as_int(item, p),
+            )
+        if "precharge-upper-limit-microvolt" in data:
+            obj.precharge_upper_limit_microvolt = _m.as_list(
+                data["precharge-upper-limit-microvolt"],
+                "precharge-upper-limit-microvolt",
+                None,
+                False,
+                lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
+            )
+        if "charge-term-current-microamp" in data:
+            obj.charge_term_current_microamp = _m.as_list(
+                data["charge-term-current-microamp"],
+                "charge-term-current-microamp",
+                None,
+                False,
+                lambda item, p: _m.as_int(item, p),
+            )
+        if "constant-charge-current-max-microamp" in data:
+            obj.constant_charge_current_max_microamp = _m.as_list(
+                data["constant-charge-current-max-microamp"],
+                "constant-charge-current-max-microamp",
+                None,
+                False,
+                lambda item, p: _m.as_int(item, p),
+            )
+        if "constant-charge-voltage-max-microvolt" in data:
+            obj.constant_charge_voltage_max_microvolt = _m.as_list(
+                data["constant-charge-voltage-max-microvolt"],
+                "constant-charge-voltage-max-microvolt",
+                None,
+                False,
+                lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
+            )
+        if "factory-internal-resistance-micro-ohms" in data:
+            obj.factory_internal_resistance_micro_ohms = _m.as_list(
+                data["factory-internal-resistance-micro-ohms"],
+                "factory-internal-resistance-micro-ohms",
+                None,
+                False,
+                lambda item, p: _m.as_int(item, p),
+            )
+        if "resistance-temp-table" in data:
+            obj.resistance_temp_table = _m.as_list(
+                data["resistance-temp-table"],
+                "resistance-temp-table",
+                None,
+                False,
+                lambda item, p: _m.as_list(item, p, 2, True, lambda item, p: _m.as_int(item, p)),
+            )
+        if "ocv-capacity-celsius" in data:
+            obj.ocv_capacity_celsius = _m.as_list(
+                data["ocv-capacity-celsius"], "ocv-capacity-celsius", None, False, lambda item, p: _m.as_int(item, p)
+            )
+        if "operating-range-celsius" in data:
+            obj.operating_range_celsius = _m.as_list(
+                data["operating-range-celsius"], "operating-range-celsius", 2, True, lambda item, p: _m.as_int(item, p)
+            )
+        if "ambient-celsius" in data:
+            obj.ambient_celsius = _m.as_list(
+                data["ambient-celsius"], "ambient-celsius", 2, True, lambda item, p: _m.as_int(item, p)
+            )
+        if "alert-celsius" in data:
+            obj.alert_celsius = _m.as_list(
+                data["alert-celsius"], "alert-celsius", 2, True, lambda item, p: _m.as_int(item, p)
+            )
+        if "volt-drop-thresh-microvolt" in data:
+            obj.volt_drop_thresh_microvolt = _m.as_list(
+                data["volt-drop-thresh-microvolt"],
+                "volt-drop-thresh-microvolt",
+                1,
+                True,
+                lambda item, p: _m.as_list(item, p, 1, True, lambda item, p: _m.as_int(item, p)),
+            )
+        if "volt-drop-soc-bp" in data:
+            obj.volt_drop_soc_bp = _m.as_list(
+                data["volt-drop-soc-bp"], "volt-drop-soc-bp", None, False, lambda item, p: _m.as_int(item, p)
+            )
+        if "volt-drop-temperatures-millicelsius" in data:
+            obj.volt_drop_temperatures_millicelsius = _m.as_list(
+                data["volt-drop-temperatures-millicelsius"],
+                "volt-drop-temperatures-millicelsius",
+                None,
+                False,
+                lambda item, p: _m.as_int(item, p),
+            )
         for key, value in data.items():
-            if _m._match('^ocv-capacity-table-[0-9]+$', key):
-                obj.ocv_capacity_table_n[key] = _m.as_list(value, key, 100, False, lambda item, p: _m.as_list(item, p, 2, True, lambda item, p: _m.as_int(item, p)))
-            if _m._match('^volt-drop-[0-9]-microvolt', key):
-                obj.volt_drop_n_microvolt[key] = _m.as_list(value, key, None, False, lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)))
+            if _m._match("^ocv-capacity-table-[0-9]+$", key):
+                obj.ocv_capacity_table_n[key] = _m.as_list(
+                    value,
+                    key,
+                    100,
+                    False,
+                    lambda item, p: _m.as_list(item, p, 2, True, lambda item, p: _m.as_int(item, p)),
+                )
+            if _m._match("^volt-drop-[0-9]-microvolt", key):
+                obj.volt_drop_n_microvolt[key] = _m.as_list(
+                    value,
+                    key,
+                    None,
+                    False,
+                    lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
+                )
         return obj
 
     def validate(self) -> list[_v.Violation]:
@@ -232,233 +939,540 @@ class SimpleBattery:
         v_i: Any
         v_table: Any
         try:
-            if (x := self.compatible) is None or (len(x) < 1 or any((_x0 != 'simple-battery') for _x0 in x)):
-                _v.diag(out, 'compatible', self.compatible, _VS_SimpleBattery_compatible)
+            if (x := self.compatible) is None or (len(x) < 1 or any((_x0 != "simple-battery") for _x0 in x)):
+                _v.diag(out, "compatible", self.compatible, _VS_SimpleBattery_compatible)
         except _v.SLOW:
-            _v.diag(out, 'compatible', self.compatible, _VS_SimpleBattery_compatible)
+            _v.diag(out, "compatible", self.compatible, _VS_SimpleBattery_compatible)
         try:
-            if (x := self.device_chemistry) is not None and (x not in {'nickel-cadmium', 'nickel-metal-hydride', 'lithium-ion', 'lithium-ion-polymer', 'lithium-ion-iron-phosphate', 'lithium-ion-manganese-oxide'}):
-                _v.diag(out, 'device-chemistry', self.device_chemistry, _VS_SimpleBattery_device_chemistry)
+            if (x := self.device_chemistry) is not None and (
+                x
+                not in {
+                    "nickel-cadmium",
+                    "nickel-metal-hydride",
+                    "lithium-ion",
+                    "lithium-ion-polymer",
+                    "lithium-ion-iron-phosphate",
+                    "lithium-ion-manganese-oxide",
+                }
+            ):
+                _v.diag(out, "device-chemistry", self.device_chemistry, _VS_SimpleBattery_device_chemistry)
         except _v.SLOW:
-            _v.diag(out, 'device-chemistry', self.device_chemistry, _VS_SimpleBattery_device_chemistry)
+            _v.diag(out, "device-chemistry", self.device_chemistry, _VS_SimpleBattery_device_chemistry)
         try:
-            if (x := self.over_voltage_threshold_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
-                _v.diag(out, 'over-voltage-threshold-microvolt', self.over_voltage_threshold_microvolt, _VS_SimpleBattery_over_voltage_threshold_microvolt)
+            if (x := self.over_voltage_threshold_microvolt) is not None and (
+                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+            ):
+                _v.diag(
+                    out,
+                    "over-voltage-threshold-microvolt",
+                    self.over_voltage_threshold_microvolt,
+                    _VS_SimpleBattery_over_voltage_threshold_microvolt,
+                )
         except _v.SLOW:
-            _v.diag(out, 'over-voltage-threshold-microvolt', self.over_voltage_threshold_microvolt, _VS_SimpleBattery_over_voltage_threshold_microvolt)
+            _v.diag(
+                out,
+                "over-voltage-threshold-microvolt",
+                self.over_voltage_threshold_microvolt,
+                _VS_SimpleBattery_over_voltage_threshold_microvolt,
+            )
         try:
-            if (x := self.re_charge_voltage_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
-                _v.diag(out, 're-charge-voltage-microvolt', self.re_charge_voltage_microvolt, _VS_SimpleBattery_re_charge_voltage_microvolt)
+            if (x := self.re_charge_voltage_microvolt) is not None and (
+                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+            ):
+                _v.diag(
+                    out,
+                    "re-charge-voltage-microvolt",
+                    self.re_charge_voltage_microvolt,
+                    _VS_SimpleBattery_re_charge_voltage_microvolt,
+                )
         except _v.SLOW:
-            _v.diag(out, 're-charge-voltage-microvolt', self.re_charge_voltage_microvolt, _VS_SimpleBattery_re_charge_voltage_microvolt)
+            _v.diag(
+                out,
+                "re-charge-voltage-microvolt",
+                self.re_charge_voltage_microvolt,
+                _VS_SimpleBattery_re_charge_voltage_microvolt,
+            )
         try:
-            if (x := self.voltage_min_design_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
-                _v.diag(out, 'voltage-min-design-microvolt', self.voltage_min_design_microvolt, _VS_SimpleBattery_voltage_min_design_microvolt)
+            if (x := self.voltage_min_design_microvolt) is not None and (
+                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+            ):
+                _v.diag(
+                    out,
+                    "voltage-min-design-microvolt",
+                    self.voltage_min_design_microvolt,
+                    _VS_SimpleBattery_voltage_min_design_microvolt,
+                )
         except _v.SLOW:
-            _v.diag(out, 'voltage-min-design-microvolt', self.voltage_min_design_microvolt, _VS_SimpleBattery_voltage_min_design_microvolt)
+            _v.diag(
+                out,
+                "voltage-min-design-microvolt",
+                self.voltage_min_design_microvolt,
+                _VS_SimpleBattery_voltage_min_design_microvolt,
+            )
         try:
-            if (x := self.voltage_max_design_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
-                _v.diag(out, 'voltage-max-design-microvolt', self.voltage_max_design_microvolt, _VS_SimpleBattery_voltage_max_design_microvolt)
+            if (x := self.voltage_max_design_microvolt) is not None and (
+                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+            ):
+                _v.diag(
+                    out,
+                    "voltage-max-design-microvolt",
+                    self.voltage_max_design_microvolt,
+                    _VS_SimpleBattery_voltage_max_design_microvolt,
+                )
         except _v.SLOW:
-            _v.diag(out, 'voltage-max-design-microvolt', self.voltage_max_design_microvolt, _VS_SimpleBattery_voltage_max_design_microvolt)
+            _v.diag(
+                out,
+                "voltage-max-design-microvolt",
+                self.voltage_max_design_microvolt,
+                _VS_SimpleBattery_voltage_max_design_microvolt,
+            )
         try:
             a = self.energy_full_design_microwatt_hours
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'energy-full-design-microwatt-hours', self.energy_full_design_microwatt_hours, _VS_SimpleBattery_energy_full_design_microwatt_hours)
+                    _v.diag(
+                        out,
+                        "energy-full-design-microwatt-hours",
+                        self.energy_full_design_microwatt_hours,
+                        _VS_SimpleBattery_energy_full_design_microwatt_hours,
+                    )
                 else:
                     for e in a:
-                        if (e & -4294967296):
-                            _v.diag(out, 'energy-full-design-microwatt-hours', self.energy_full_design_microwatt_hours, _VS_SimpleBattery_energy_full_design_microwatt_hours)
+                        if e & -4294967296:
+                            _v.diag(
+                                out,
+                                "energy-full-design-microwatt-hours",
+                                self.energy_full_design_microwatt_hours,
+                                _VS_SimpleBattery_energy_full_design_microwatt_hours,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'energy-full-design-microwatt-hours', self.energy_full_design_microwatt_hours, _VS_SimpleBattery_energy_full_design_microwatt_hours)
+            _v.diag(
+                out,
+                "energy-full-design-microwatt-hours",
+                self.energy_full_design_microwatt_hours,
+                _VS_SimpleBattery_energy_full_design_microwatt_hours,
+            )
         try:
             a = self.charge_full_design_microamp_hours
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'charge-full-design-microamp-hours', self.charge_full_design_microamp_hours, _VS_SimpleBattery_charge_full_design_microamp_hours)
+                    _v.diag(
+                        out,
+                        "charge-full-design-microamp-hours",
+                        self.charge_full_design_microamp_hours,
+                        _VS_SimpleBattery_charge_full_design_microamp_hours,
+                    )
                 else:
                     for e in a:
-                        if (e & -4294967296):
-                            _v.diag(out, 'charge-full-design-microamp-hours', self.charge_full_design_microamp_hours, _VS_SimpleBattery_charge_full_design_microamp_hours)
+                        if e & -4294967296:
+                            _v.diag(
+                                out,
+                                "charge-full-design-microamp-hours",
+                                self.charge_full_design_microamp_hours,
+                                _VS_SimpleBattery_charge_full_design_microamp_hours,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'charge-full-design-microamp-hours', self.charge_full_design_microamp_hours, _VS_SimpleBattery_charge_full_design_microamp_hours)
+            _v.diag(
+                out,
+                "charge-full-design-microamp-hours",
+                self.charge_full_design_microamp_hours,
+                _VS_SimpleBattery_charge_full_design_microamp_hours,
+            )
         try:
             a = self.trickle_charge_current_microamp
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'trickle-charge-current-microamp', self.trickle_charge_current_microamp, _VS_SimpleBattery_trickle_charge_current_microamp)
+                    _v.diag(
+                        out,
+                        "trickle-charge-current-microamp",
+                        self.trickle_charge_current_microamp,
+                        _VS_SimpleBattery_trickle_charge_current_microamp,
+                    )
                 else:
                     for e in a:
-                        if (e & -4294967296):
-                            _v.diag(out, 'trickle-charge-current-microamp', self.trickle_charge_current_microamp, _VS_SimpleBattery_trickle_charge_current_microamp)
+                        if e & -4294967296:
+                            _v.diag(
+                                out,
+                                "trickle-charge-current-microamp",
+                                self.trickle_charge_current_microamp,
+                                _VS_SimpleBattery_trickle_charge_current_microamp,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'trickle-charge-current-microamp', self.trickle_charge_current_microamp, _VS_SimpleBattery_trickle_charge_current_microamp)
+            _v.diag(
+                out,
+                "trickle-charge-current-microamp",
+                self.trickle_charge_current_microamp,
+                _VS_SimpleBattery_trickle_charge_current_microamp,
+            )
         try:
-            if (x := self.tricklecharge_upper_limit_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
-                _v.diag(out, 'tricklecharge-upper-limit-microvolt', self.tricklecharge_upper_limit_microvolt, _VS_SimpleBattery_tricklecharge_upper_limit_microvolt)
+            if (x := self.tricklecharge_upper_limit_microvolt) is not None and (
+                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+            ):
+                _v.diag(
+                    out,
+                    "tricklecharge-upper-limit-microvolt",
+                    self.tricklecharge_upper_limit_microvolt,
+                    _VS_SimpleBattery_tricklecharge_upper_limit_microvolt,
+                )
         except _v.SLOW:
-            _v.diag(out, 'tricklecharge-upper-limit-microvolt', self.tricklecharge_upper_limit_microvolt, _VS_SimpleBattery_tricklecharge_upper_limit_microvolt)
+            _v.diag(
+                out,
+                "tricklecharge-upper-limit-microvolt",
+                self.tricklecharge_upper_limit_microvolt,
+                _VS_SimpleBattery_tricklecharge_upper_limit_microvolt,
+            )
         try:
             a = self.precharge_current_microamp
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'precharge-current-microamp', self.precharge_current_microamp, _VS_SimpleBattery_precharge_current_microamp)
+                    _v.diag(
+                        out,
+                        "precharge-current-microamp",
+                        self.precharge_current_microamp,
+                        _VS_SimpleBattery_precharge_current_microamp,
+                    )
                 else:
                     for e in a:
-                        if (e & -4294967296):
-                            _v.diag(out, 'precharge-current-microamp', self.precharge_current_microamp, _VS_SimpleBattery_precharge_current_microamp)
+                        if e & -4294967296:
+                            _v.diag(
+                                out,
+                                "precharge-current-microamp",
+                                self.precharge_current_microamp,
+                                _VS_SimpleBattery_precharge_current_microamp,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'precharge-current-microamp', self.precharge_current_microamp, _VS_SimpleBattery_precharge_current_microamp)
+            _v.diag(
+                out,
+                "precharge-current-microamp",
+                self.precharge_current_microamp,
+                _VS_SimpleBattery_precharge_current_microamp,
+            )
         try:
-            if (x := self.precharge_upper_limit_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
-                _v.diag(out, 'precharge-upper-limit-microvolt', self.precharge_upper_limit_microvolt, _VS_SimpleBattery_precharge_upper_limit_microvolt)
+            if (x := self.precharge_upper_limit_microvolt) is not None and (
+                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+            ):
+                _v.diag(
+                    out,
+                    "precharge-upper-limit-microvolt",
+                    self.precharge_upper_limit_microvolt,
+                    _VS_SimpleBattery_precharge_upper_limit_microvolt,
+                )
         except _v.SLOW:
-            _v.diag(out, 'precharge-upper-limit-microvolt', self.precharge_upper_limit_microvolt, _VS_SimpleBattery_precharge_upper_limit_microvolt)
+            _v.diag(
+                out,
+                "precharge-upper-limit-microvolt",
+                self.precharge_upper_limit_microvolt,
+                _VS_SimpleBattery_precharge_upper_limit_microvolt,
+            )
         try:
             a = self.charge_term_current_microamp
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'charge-term-current-microamp', self.charge_term_current_microamp, _VS_SimpleBattery_charge_term_current_microamp)
+                    _v.diag(
+                        out,
+                        "charge-term-current-microamp",
+                        self.charge_term_current_microamp,
+                        _VS_SimpleBattery_charge_term_current_microamp,
+                    )
                 else:
                     for e in a:
-                        if (e & -4294967296):
-                            _v.diag(out, 'charge-term-current-microamp', self.charge_term_current_microamp, _VS_SimpleBattery_charge_term_current_microamp)
+                        if e & -4294967296:
+                            _v.diag(
+                                out,
+                                "charge-term-current-microamp",
+                                self.charge_term_current_microamp,
+                                _VS_SimpleBattery_charge_term_current_microamp,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'charge-term-current-microamp', self.charge_term_current_microamp, _VS_SimpleBattery_charge_term_current_microamp)
+            _v.diag(
+                out,
+                "charge-term-current-microamp",
+                self.charge_term_current_microamp,
+                _VS_SimpleBattery_charge_term_current_microamp,
+            )
         try:
             a = self.constant_charge_current_max_microamp
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'constant-charge-current-max-microamp', self.constant_charge_current_max_microamp, _VS_SimpleBattery_constant_charge_current_max_microamp)
+                    _v.diag(
+                        out,
+                        "constant-charge-current-max-microamp",
+                        self.constant_charge_current_max_microamp,
+                        _VS_SimpleBattery_constant_charge_current_max_microamp,
+                    )
                 else:
                     for e in a:
-                        if (e & -4294967296):
-                            _v.diag(out, 'constant-charge-current-max-microamp', self.constant_charge_current_max_microamp, _VS_SimpleBattery_constant_charge_current_max_microamp)
+                        if e & -4294967296:
+                            _v.diag(
+                                out,
+                                "constant-charge-current-max-microamp",
+                                self.constant_charge_current_max_microamp,
+                                _VS_SimpleBattery_constant_charge_current_max_microamp,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'constant-charge-current-max-microamp', self.constant_charge_current_max_microamp, _VS_SimpleBattery_constant_charge_current_max_microamp)
+            _v.diag(
+                out,
+                "constant-charge-current-max-microamp",
+                self.constant_charge_current_max_microamp,
+                _VS_SimpleBattery_constant_charge_current_max_microamp,
+            )
         try:
-            if (x := self.constant_charge_voltage_max_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):
-                _v.diag(out, 'constant-charge-voltage-max-microvolt', self.constant_charge_voltage_max_microvolt, _VS_SimpleBattery_constant_charge_voltage_max_microvolt)
+            if (x := self.constant_charge_voltage_max_microvolt) is not None and (
+                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+            ):
+                _v.diag(
+                    out,
+                    "constant-charge-voltage-max-microvolt",
+                    self.constant_charge_voltage_max_microvolt,
+                    _VS_SimpleBattery_constant_charge_voltage_max_microvolt,
+                )
         except _v.SLOW:
-            _v.diag(out, 'constant-charge-voltage-max-microvolt', self.constant_charge_voltage_max_microvolt, _VS_SimpleBattery_constant_charge_voltage_max_microvolt)
+            _v.diag(
+                out,
+                "constant-charge-voltage-max-microvolt",
+                self.constant_charge_voltage_max_microvolt,
+                _VS_SimpleBattery_constant_charge_voltage_max_microvolt,
+            )
         try:
             a = self.factory_internal_resistance_micro_ohms
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'factory-internal-resistance-micro-ohms', self.factory_internal_resistance_micro_ohms, _VS_SimpleBattery_factory_internal_resistance_micro_ohms)
+                    _v.diag(
+                        out,
+                        "factory-internal-resistance-micro-ohms",
+                        self.factory_internal_resistance_micro_ohms,
+                        _VS_SimpleBattery_factory_internal_resistance_micro_ohms,
+                    )
                 else:
                     for e in a:
-                        if (e & -4294967296):
-                            _v.diag(out, 'factory-internal-resistance-micro-ohms', self.factory_internal_resistance_micro_ohms, _VS_SimpleBattery_factory_internal_resistance_micro_ohms)
+                        if e & -4294967296:
+                            _v.diag(
+                                out,
+                                "factory-internal-resistance-micro-ohms",
+                                self.factory_internal_resistance_micro_ohms,
+                                _VS_SimpleBattery_factory_internal_resistance_micro_ohms,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'factory-internal-resistance-micro-ohms', self.factory_internal_resistance_micro_ohms, _VS_SimpleBattery_factory_internal_resistance_micro_ohms)
+            _v.diag(
+                out,
+                "factory-internal-resistance-micro-ohms",
+                self.factory_internal_resistance_micro_ohms,
+                _VS_SimpleBattery_factory_internal_resistance_micro_ohms,
+            )
         try:
-            if (x := self.resistance_temp_table) is not None and (len(x) < 1 or any((len(_x0) != 2 or any((_x1 & -4294967296) for _x1 in _x0)) for _x0 in x)):
-                _v.diag(out, 'resistance-temp-table', self.resistance_temp_table, _VS_SimpleBattery_resistance_temp_table)
+            if (x := self.resistance_temp_table) is not None and (
+                len(x) < 1 or any((len(_x0) != 2 or any((_x1 & -4294967296) for _x1 in _x0)) for _x0 in x)
+            ):
+                _v.diag(
+                    out, "resistance-temp-table", self.resistance_temp_table, _VS_SimpleBattery_resistance_temp_table
+                )
         except _v.SLOW:
-            _v.diag(out, 'resistance-temp-table', self.resistance_temp_table, _VS_SimpleBattery_resistance_temp_table)
+            _v.diag(out, "resistance-temp-table", self.resistance_temp_table, _VS_SimpleBattery_resistance_temp_table)
         try:
             a = self.ocv_capacity_celsius
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'ocv-capacity-celsius', self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius)
+                    _v.diag(
+                        out, "ocv-capacity-celsius", self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius
+                    )
                 else:
                     for e in a:
-                        if ((e + 2147483648) & -4294967296):
-                            _v.diag(out, 'ocv-capacity-celsius', self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius)
+                        if (e + 2147483648) & -4294967296:
+                            _v.diag(
+                                out,
+                                "ocv-capacity-celsius",
+                                self.ocv_capacity_celsius,
+                                _VS_SimpleBattery_ocv_capacity_celsius,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'ocv-capacity-celsius', self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius)
+            _v.diag(out, "ocv-capacity-celsius", self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius)
         try:
             a = self.operating_range_celsius
             if a is not None:
                 if len(a) != 2:
-                    _v.diag(out, 'operating-range-celsius', self.operating_range_celsius, _VS_SimpleBattery_operating_range_celsius)
+                    _v.diag(
+                        out,
+                        "operating-range-celsius",
+                        self.operating_range_celsius,
+                        _VS_SimpleBattery_operating_range_celsius,
+                    )
                 else:
                     for e in a:
-                        if ((e + 2147483648) & -4294967296):
-                            _v.diag(out, 'operating-range-celsius', self.operating_range_celsius, _VS_SimpleBattery_operating_range_celsius)
+                        if (e + 2147483648) & -4294967296:
+                            _v.diag(
+                                out,
+                                "operating-range-celsius",
+                                self.operating_range_celsius,
+                                _VS_SimpleBattery_operating_range_celsius,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'operating-range-celsius', self.operating_range_celsius, _VS_SimpleBattery_operating_range_celsius)
+            _v.diag(
+                out, "operating-range-celsius", self.operating_range_celsius, _VS_SimpleBattery_operating_range_celsius
+            )
         try:
             a = self.ambient_celsius
             if a is not None:
                 if len(a) != 2:
-                    _v.diag(out, 'ambient-celsius', self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
+                    _v.diag(out, "ambient-celsius", self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
                 else:
                     for e in a:
-                        if ((e + 2147483648) & -4294967296):
-                            _v.diag(out, 'ambient-celsius', self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
+                        if (e + 2147483648) & -4294967296:
+                            _v.diag(out, "ambient-celsius", self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
                             break
         except _v.SLOW:
-            _v.diag(out, 'ambient-celsius', self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
+            _v.diag(out, "ambient-celsius", self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
         try:
             a = self.alert_celsius
             if a is not None:
                 if len(a) != 2:
-                    _v.diag(out, 'alert-celsius', self.alert_celsius, _VS_SimpleBattery_alert_celsius)
+                    _v.diag(out, "alert-celsius", self.alert_celsius, _VS_SimpleBattery_alert_celsius)
                 else:
                     for e in a:
-                        if ((e + 2147483648) & -4294967296):
-                            _v.diag(out, 'alert-celsius', self.alert_celsius, _VS_SimpleBattery_alert_celsius)
+                        if (e + 2147483648) & -4294967296:
+                            _v.diag(out, "alert-celsius", self.alert_celsius, _VS_SimpleBattery_alert_celsius)
                             break
         except _v.SLOW:
-            _v.diag(out, 'alert-celsius', self.alert_celsius, _VS_SimpleBattery_alert_celsius)
+            _v.diag(out, "alert-celsius", self.alert_celsius, _VS_SimpleBattery_alert_celsius)
         try:
-            if (x := self.volt_drop_thresh_microvolt) is not None and (len(x) != 1 or any((len(_x0) != 1 or any(((_x1 + 2147483648) & -4294967296 or not (-2147483648 <= _x1 <= 48000000)) for _x1 in _x0)) for _x0 in x)):
-                _v.diag(out, 'volt-drop-thresh-microvolt', self.volt_drop_thresh_microvolt, _VS_SimpleBattery_volt_drop_thresh_microvolt)
+            if (x := self.volt_drop_thresh_microvolt) is not None and (
+                len(x) != 1
+                or any(
+                    (
+                        len(_x0) != 1
+                        or any(
+                            ((_x1 + 2147483648) & -4294967296 or not (-2147483648 <= _x1 <= 48000000)) for _x1 in _x0
+                        )
+                    )
+                    for _x0 in x
+                )
+            ):
+                _v.diag(
+                    out,
+                    "volt-drop-thresh-microvolt",
+                    self.volt_drop_thresh_microvolt,
+                    _VS_SimpleBattery_volt_drop_thresh_microvolt,
+                )
         except _v.SLOW:
-            _v.diag(out, 'volt-drop-thresh-microvolt', self.volt_drop_thresh_microvolt, _VS_SimpleBattery_volt_drop_thresh_microvolt)
+            _v.diag(
+                out,
+                "volt-drop-thresh-microvolt",
+                self.volt_drop_thresh_microvolt,
+                _VS_SimpleBattery_volt_drop_thresh_microvolt,
+            )
         try:
             a = self.volt_drop_soc_bp
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'volt-drop-soc-bp', self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
+                    _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
                 else:
                     for e in a:
-                        if ((e + 2147483648) & -4294967296):
-                            _v.diag(out, 'volt-drop-soc-bp', self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
+                        if (e + 2147483648) & -4294967296:
+                            _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
                             break
         except _v.SLOW:
-            _v.diag(out, 'volt-drop-soc-bp', self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
+            _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
         try:
             a = self.volt_drop_temperatures_millicelsius
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, 'volt-drop-temperatures-millicelsius', self.volt_drop_temperatures_millicelsius, _VS_SimpleBattery_volt_drop_temperatures_millicelsius)
+                    _v.diag(
+                        out,
+                        "volt-drop-temperatures-millicelsius",
+                        self.volt_drop_temperatures_millicelsius,
+                        _VS_SimpleBattery_volt_drop_temperatures_millicelsius,
+                    )
                 else:
                     for e in a:
-                        if ((e + 2147483648) & -4294967296):
-                            _v.diag(out, 'volt-drop-temperatures-millicelsius', self.volt_drop_temperatures_millicelsius, _VS_SimpleBattery_volt_drop_temperatures_millicelsius)
+                        if (e + 2147483648) & -4294967296:
+                            _v.diag(
+                                out,
+                                "volt-drop-temperatures-millicelsius",
+                                self.volt_drop_temperatures_millicelsius,
+                                _VS_SimpleBattery_volt_drop_temperatures_millicelsius,
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, 'volt-drop-temperatures-millicelsius', self.volt_drop_temperatures_millicelsius, _VS_SimpleBattery_volt_drop_temperatures_millicelsius)
+            _v.diag(
+                out,
+                "volt-drop-temperatures-millicelsius",
+                self.volt_drop_temperatures_millicelsius,
+                _VS_SimpleBattery_volt_drop_temperatures_millicelsius,
+            )
         try:
-            if any(not _v.search('^ocv-capacity-table-[0-9]+$', k) or (len(x) > 100 or len(x) < 1 or any((len(_x0) != 2 or any((_x1 & -4294967296) for _x1 in _x0) or (_x0[1] & -4294967296 or not (0 <= _x0[1] <= 100))) for _x0 in x)) for k, x in self.ocv_capacity_table_n.items()):
-                _v.diag(out, '^ocv-capacity-table-[0-9]+$', self.ocv_capacity_table_n, _VS_SimpleBattery_ocv_capacity_table_n)
+            if any(
+                not _v.search("^ocv-capacity-table-[0-9]+$", k)
+                or (
+                    len(x) > 100
+                    or len(x) < 1
+                    or any(
+                        (
+                            len(_x0) != 2
+                            or any((_x1 & -4294967296) for _x1 in _x0)
+                            or (_x0[1] & -4294967296 or not (0 <= _x0[1] <= 100))
+                        )
+                        for _x0 in x
+                    )
+                )
+                for k, x in self.ocv_capacity_table_n.items()
+            ):
+                _v.diag(
+                    out,
+                    "^ocv-capacity-table-[0-9]+$",
+                    self.ocv_capacity_table_n,
+                    _VS_SimpleBattery_ocv_capacity_table_n,
+                )
         except _v.SLOW:
-            _v.diag(out, '^ocv-capacity-table-[0-9]+$', self.ocv_capacity_table_n, _VS_SimpleBattery_ocv_capacity_table_n)
+            _v.diag(
+                out, "^ocv-capacity-table-[0-9]+$", self.ocv_capacity_table_n, _VS_SimpleBattery_ocv_capacity_table_n
+            )
         try:
-            if any(not _v.search('^volt-drop-[0-9]-microvolt', k) or (len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)) for k, x in self.volt_drop_n_microvolt.items()):
-                _v.diag(out, '^volt-drop-[0-9]-microvolt', self.volt_drop_n_microvolt, _VS_SimpleBattery_volt_drop_n_microvolt)
+            if any(
+                not _v.search("^volt-drop-[0-9]-microvolt", k)
+                or (
+                    len(x) < 1
+                    or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+                )
+                for k, x in self.volt_drop_n_microvolt.items()
+            ):
+                _v.diag(
+                    out,
+                    "^volt-drop-[0-9]-microvolt",
+                    self.volt_drop_n_microvolt,
+                    _VS_SimpleBattery_volt_drop_n_microvolt,
+                )
         except _v.SLOW:
-            _v.diag(out, '^volt-drop-[0-9]-microvolt', self.volt_drop_n_microvolt, _VS_SimpleBattery_volt_drop_n_microvolt)
+            _v.diag(
+                out, "^volt-drop-[0-9]-microvolt", self.volt_drop_n_microvolt, _VS_SimpleBattery_volt_drop_n_microvolt
+            )
         # rule voltage-design-order (devicetree-battery.yaml:9)
         try:
             r_voltage_min_design_microvolt = self.voltage_min_design_microvolt
             r_voltage_max_design_microvolt = self.voltage_max_design_microvolt
             if r_voltage_min_design_microvolt is not None and r_voltage_max_design_microvolt is not None:
                 if not (r_voltage_min_design_microvolt[0][0] < r_voltage_max_design_microvolt[0][0]):
-                    out.append(_v.rule('voltage-min-design-microvolt', 'voltage-design-order', r_voltage_min_design_microvolt, '`voltage-min-design-microvolt`[0][0] < `voltage-max-design-microvolt`[0][0]', 'voltage-min-design-microvolt = ' + _v.fmt(r_voltage_min_design_microvolt[0][0]) + ' uV must be below voltage-max-design-microvolt = ' + _v.fmt(r_voltage_max_design_microvolt[0][0]) + ' uV', 'error'))
+                    out.append(
+                        _v.rule(
+                            "voltage-min-design-microvolt",
+                            "voltage-design-order",
+                            r_voltage_min_design_microvolt,
+                            "`voltage-min-design-microvolt`[0][0] < `voltage-max-design-microvolt`[0][0]",
+                            "voltage-min-design-microvolt = "
+                            + _v.fmt(r_voltage_min_design_microvolt[0][0])
+                            + " uV must be below voltage-max-design-microvolt = "
+                            + _v.fmt(r_voltage_max_design_microvolt[0][0])
+                            + " uV",
+                            "error",
+                        )
+                    )
         except _v.SLOW:
             pass  # the field checks report the cause
         # rule charge-voltage-below-over-voltage (devicetree-battery.yaml:17)
@@ -467,7 +1481,20 @@ class SimpleBattery:
             r_over_voltage_threshold_microvolt = self.over_voltage_threshold_microvolt
             if r_constant_charge_voltage_max_microvolt is not None and r_over_voltage_threshold_microvolt is not None:
                 if not (r_constant_charge_voltage_max_microvolt[0][0] <= r_over_voltage_threshold_microvolt[0][0]):
-                    out.append(_v.rule('constant-charge-voltage-max-microvolt', 'charge-voltage-below-over-voltage', r_constant_charge_voltage_max_microvolt, '`constant-charge-voltage-max-microvolt`[0][0] <= `over-voltage-threshold-microvolt`[0][0]', 'constant-charge-voltage-max-microvolt = ' + _v.fmt(r_constant_charge_voltage_max_microvolt[0][0]) + ' uV is above over-voltage-threshold-microvolt = ' + _v.fmt(r_over_voltage_threshold_microvolt[0][0]) + ' uV', 'error'))
+                    out.append(
+                        _v.rule(
+                            "constant-charge-voltage-max-microvolt",
+                            "charge-voltage-below-over-voltage",
+                            r_constant_charge_voltage_max_microvolt,
+                            "`constant-charge-voltage-max-microvolt`[0][0] <= `over-voltage-threshold-microvolt`[0][0]",
+                            "constant-charge-voltage-max-microvolt = "
+                            + _v.fmt(r_constant_charge_voltage_max_microvolt[0][0])
+                            + " uV is above over-voltage-threshold-microvolt = "
+                            + _v.fmt(r_over_voltage_threshold_microvolt[0][0])
+                            + " uV",
+                            "error",
+                        )
+                    )
         except _v.SLOW:
             pass  # the field checks report the cause
         # rule design-max-below-charge-voltage (devicetree-battery.yaml:25)
@@ -476,7 +1503,20 @@ class SimpleBattery:
             r_constant_charge_voltage_max_microvolt = self.constant_charge_voltage_max_microvolt
             if r_voltage_max_design_microvolt is not None and r_constant_charge_voltage_max_microvolt is not None:
                 if not (r_voltage_max_design_microvolt[0][0] >= r_constant_charge_voltage_max_microvolt[0][0]):
-                    out.append(_v.rule('voltage-max-design-microvolt', 'design-max-below-charge-voltage', r_voltage_max_design_microvolt, '`voltage-max-design-microvolt`[0][0] >= `constant-charge-voltage-max-microvolt`[0][0]', 'voltage-max-design-microvolt = ' + _v.fmt(r_voltage_max_design_microvolt[0][0]) + ' uV is below constant-charge-voltage-max-microvolt = ' + _v.fmt(r_constant_charge_voltage_max_microvolt[0][0]) + ' uV', 'warning'))
+                    out.append(
+                        _v.rule(
+                            "voltage-max-design-microvolt",
+                            "design-max-below-charge-voltage",
+                            r_voltage_max_design_microvolt,
+                            "`voltage-max-design-microvolt`[0][0] >= `constant-charge-voltage-max-microvolt`[0][0]",
+                            "voltage-max-design-microvolt = "
+                            + _v.fmt(r_voltage_max_design_microvolt[0][0])
+                            + " uV is below constant-charge-voltage-max-microvolt = "
+                            + _v.fmt(r_constant_charge_voltage_max_microvolt[0][0])
+                            + " uV",
+                            "warning",
+                        )
+                    )
         except _v.SLOW:
             pass  # the field checks report the cause
         # rule ocv-table-descending (devicetree-battery.yaml:36)
@@ -486,7 +1526,20 @@ class SimpleBattery:
                 for v_i in range(1, len(v_table)):
                     try:
                         if not (v_table[(v_i - 1)][0] >= v_table[v_i][0]):
-                            out.append(_v.rule(k_0 + '[' + str(v_i) + ']', 'ocv-table-descending', v_table[v_i], 'table[i - 1][0] >= table[i][0]', 'OCV ' + _v.fmt(v_table[v_i][0]) + ' uV follows ' + _v.fmt(v_table[(v_i - 1)][0]) + ' uV; the table must be sorted by OCV, highest first', 'error'))
+                            out.append(
+                                _v.rule(
+                                    k_0 + "[" + str(v_i) + "]",
+                                    "ocv-table-descending",
+                                    v_table[v_i],
+                                    "table[i - 1][0] >= table[i][0]",
+                                    "OCV "
+                                    + _v.fmt(v_table[v_i][0])
+                                    + " uV follows "
+                                    + _v.fmt(v_table[(v_i - 1)][0])
+                                    + " uV; the table must be sorted by OCV, highest first",
+                                    "error",
+                                )
+                            )
                     except _v.SLOW:
                         pass
         except _v.SLOW:
@@ -497,7 +1550,19 @@ class SimpleBattery:
             r_ocv_capacity_celsius = self.ocv_capacity_celsius
             if r_ocv_capacity_celsius is not None:
                 if not (len(r_ocv_capacity_table_n) == len(r_ocv_capacity_celsius)):
-                    out.append(_v.rule('ocv-capacity-celsius', 'ocv-table-count', r_ocv_capacity_celsius, 'len(`^ocv-capacity-table-[0-9]+$`) == len(`ocv-capacity-celsius`)', _v.fmt(len(r_ocv_capacity_celsius)) + ' ocv-capacity-celsius entries but ' + _v.fmt(len(r_ocv_capacity_table_n)) + ' ocv-capacity-table-N properties; expected one table per temperature', 'error'))
+                    out.append(
+                        _v.rule(
+                            "ocv-capacity-celsius",
+                            "ocv-table-count",
+                            r_ocv_capacity_celsius,
+                            "len(`^ocv-capacity-table-[0-9]+$`) == len(`ocv-capacity-celsius`)",
+                            _v.fmt(len(r_ocv_capacity_celsius))
+                            + " ocv-capacity-celsius entries but "
+                            + _v.fmt(len(r_ocv_capacity_table_n))
+                            + " ocv-capacity-table-N properties; expected one table per temperature",
+                            "error",
+                        )
+                    )
         except _v.SLOW:
             pass  # the field checks report the cause
         # rule ocv-table-names (devicetree-battery.yaml:53)
@@ -507,8 +1572,22 @@ class SimpleBattery:
             if r_ocv_capacity_celsius is not None:
                 for v_i in range(len(r_ocv_capacity_celsius)):
                     try:
-                        if not (('ocv-capacity-table-' + str(v_i)) in r_ocv_capacity_table_n):
-                            out.append(_v.rule('ocv-capacity-celsius' + '[' + str(v_i) + ']', 'ocv-table-names', r_ocv_capacity_celsius[v_i], "'ocv-capacity-table-' + str(i) in `^ocv-capacity-table-[0-9]+$`", 'ocv-capacity-celsius[' + _v.fmt(v_i) + '] = ' + _v.fmt(r_ocv_capacity_celsius[v_i]) + ' degC has no ocv-capacity-table-' + _v.fmt(v_i), 'error'))
+                        if not (("ocv-capacity-table-" + str(v_i)) in r_ocv_capacity_table_n):
+                            out.append(
+                                _v.rule(
+                                    "ocv-capacity-celsius" + "[" + str(v_i) + "]",
+                                    "ocv-table-names",
+                                    r_ocv_capacity_celsius[v_i],
+                                    "'ocv-capacity-table-' + str(i) in `^ocv-capacity-table-[0-9]+$`",
+                                    "ocv-capacity-celsius["
+                                    + _v.fmt(v_i)
+                                    + "] = "
+                                    + _v.fmt(r_ocv_capacity_celsius[v_i])
+                                    + " degC has no ocv-capacity-table-"
+                                    + _v.fmt(v_i),
+                                    "error",
+                                )
+                            )
                     except _v.SLOW:
                         pass
         except _v.SLOW:
@@ -518,7 +1597,18 @@ class SimpleBattery:
             r_ocv_capacity_celsius = self.ocv_capacity_celsius
             if r_ocv_capacity_celsius is not None:
                 if not (len(r_ocv_capacity_celsius) <= 20):
-                    out.append(_v.rule('ocv-capacity-celsius', 'ocv-temperature-count', r_ocv_capacity_celsius, 'len(`ocv-capacity-celsius`) <= 20', 'ocv-capacity-celsius has ' + _v.fmt(len(r_ocv_capacity_celsius)) + ' entries; the kernel reads at most 20', 'error'))
+                    out.append(
+                        _v.rule(
+                            "ocv-capacity-celsius",
+                            "ocv-temperature-count",
+                            r_ocv_capacity_celsius,
+                            "len(`ocv-capacity-celsius`) <= 20",
+                            "ocv-capacity-celsius has "
+                            + _v.fmt(len(r_ocv_capacity_celsius))
+                            + " entries; the kernel reads at most 20",
+                            "error",
+                        )
+                    )
         except _v.SLOW:
             pass  # the field checks report the cause
         return out
@@ -527,61 +1617,61 @@ class SimpleBattery:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'devicetree.power.supply.battery')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "devicetree.power.supply.battery")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field == 'compatible':
+        if field == "compatible":
             return self.compatible is not None
-        if field == 'device-chemistry':
+        if field == "device-chemistry":
             return self.device_chemistry is not None
-        if field == 'over-voltage-threshold-microvolt':
+        if field == "over-voltage-threshold-microvolt":
             return self.over_voltage_threshold_microvolt is not None
-        if field == 're-charge-voltage-microvolt':
+        if field == "re-charge-voltage-microvolt":
             return self.re_charge_voltage_microvolt is not None
-        if field == 'voltage-min-design-microvolt':
+        if field == "voltage-min-design-microvolt":
             return self.voltage_min_design_microvolt is not None
-        if field == 'voltage-max-design-microvolt':
+        if field == "voltage-max-design-microvolt":
             return self.voltage_max_design_microvolt is not None
-        if field == 'energy-full-design-microwatt-hours':
+        if field == "energy-full-design-microwatt-hours":
             return self.energy_full_design_microwatt_hours is not None
-        if field == 'charge-full-design-microamp-hours':
+        if field == "charge-full-design-microamp-hours":
             return self.charge_full_design_microamp_hours is not None
-        if field == 'trickle-charge-current-microamp':
+        if field == "trickle-charge-current-microamp":
             return self.trickle_charge_current_microamp is not None
-        if field == 'tricklecharge-upper-limit-microvolt':
+        if field == "tricklecharge-upper-limit-microvolt":
             return self.tricklecharge_upper_limit_microvolt is not None
-        if field == 'precharge-current-microamp':
+        if field == "precharge-current-microamp":
             return self.precharge_current_microamp is not None
-        if field == 'precharge-upper-limit-microvolt':
+        if field == "precharge-upper-limit-microvolt":
             return self.precharge_upper_limit_microvolt is not None
-        if field == 'charge-term-current-microamp':
+        if field == "charge-term-current-microamp":
             return self.charge_term_current_microamp is not None
-        if field == 'constant-charge-current-max-microamp':
+        if field == "constant-charge-current-max-microamp":
             return self.constant_charge_current_max_microamp is not None
-        if field == 'constant-charge-voltage-max-microvolt':
+        if field == "constant-charge-voltage-max-microvolt":
             return self.constant_charge_voltage_max_microvolt is not None
-        if field == 'factory-internal-resistance-micro-ohms':
+        if field == "factory-internal-resistance-micro-ohms":
             return self.factory_internal_resistance_micro_ohms is not None
-        if field == 'resistance-temp-table':
+        if field == "resistance-temp-table":
             return self.resistance_temp_table is not None
-        if field == 'ocv-capacity-celsius':
+        if field == "ocv-capacity-celsius":
             return self.ocv_capacity_celsius is not None
-        if field == 'operating-range-celsius':
+        if field == "operating-range-celsius":
             return self.operating_range_celsius is not None
-        if field == 'ambient-celsius':
+        if field == "ambient-celsius":
             return self.ambient_celsius is not None
-        if field == 'alert-celsius':
+        if field == "alert-celsius":
             return self.alert_celsius is not None
-        if field == 'volt-drop-thresh-microvolt':
+        if field == "volt-drop-thresh-microvolt":
             return self.volt_drop_thresh_microvolt is not None
-        if field == 'volt-drop-soc-bp':
+        if field == "volt-drop-soc-bp":
             return self.volt_drop_soc_bp is not None
-        if field == 'volt-drop-temperatures-millicelsius':
+        if field == "volt-drop-temperatures-millicelsius":
             return self.volt_drop_temperatures_millicelsius is not None
-        if field == '^ocv-capacity-table-[0-9]+$':
+        if field == "^ocv-capacity-table-[0-9]+$":
             return bool(self.ocv_capacity_table_n)
-        if field == '^volt-drop-[0-9]-microvolt':
+        if field == "^volt-drop-[0-9]-microvolt":
             return bool(self.volt_drop_n_microvolt)
-        raise KeyError(f'{field!r} is not a field of ' + 'devicetree.power.supply.battery')
+        raise KeyError(f"{field!r} is not a field of " + "devicetree.power.supply.battery")

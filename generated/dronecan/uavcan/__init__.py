@@ -11,20 +11,22 @@ import struct
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from ... import _meta as _m
 from ... import _dronecan as _dc
+from ... import _meta as _m
 from ... import _validate as _v
 
-__all__ = ['Timestamp']
+__all__ = ["Timestamp"]
 
 
-_DC_Timestamp_1 = struct.Struct('<IHB')
+_DC_Timestamp_1 = struct.Struct("<IHB")
 
 
-_DC_Timestamp_2 = ((56, 'Timestamp.usec'),)
+_DC_Timestamp_2 = ((56, "Timestamp.usec"),)
 
 
-_VS_Timestamp_usec = _v.Number(type='uint56', kind='uint', low=0, high=72057594037927935, unit='us', sentinel=0, sentinel_text='UNKNOWN')
+_VS_Timestamp_usec = _v.Number(
+    type="uint56", kind="uint", low=0, high=72057594037927935, unit="us", sentinel=0, sentinel_text="UNKNOWN"
+)
 
 
 @dataclasses.dataclass(slots=True)
@@ -34,10 +36,22 @@ class Timestamp:
     Schema: dronecan.uavcan.Timestamp (dronecan, uavcan/Timestamp.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'dronecan.uavcan.Timestamp'
+    QUALIFIED_NAME: ClassVar[str] = "dronecan.uavcan.Timestamp"
     UNKNOWN: ClassVar[int] = 0
 
-    usec: int = dataclasses.field(default=0, metadata=_m.meta(name='usec', type='uint56', unit='us', quantity='time', scale=1e-06, offset=0.0, invalid=0, invalid_text='UNKNOWN'))
+    usec: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="usec",
+            type="uint56",
+            unit="us",
+            quantity="time",
+            scale=1e-06,
+            offset=0.0,
+            invalid=0,
+            invalid_text="UNKNOWN",
+        ),
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -48,26 +62,26 @@ class Timestamp:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['usec'] = self.usec
+        out["usec"] = self.usec
         return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Timestamp:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'usec'}), (), 'Timestamp')
+        data = _m.check_keys(data, frozenset({"usec"}), (), "Timestamp")
         obj = cls()
-        if 'usec' in data:
-            obj.usec = _m.as_int(data['usec'], 'usec')
+        if "usec" in data:
+            obj.usec = _m.as_int(data["usec"], "usec")
         return obj
 
     DATA_TYPE_ID: ClassVar[int | None] = None
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x05bd0b5c81087e0d
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x05BD0B5C81087E0D
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
         r1 = self.usec
-        p2 = (r1 & 0xffffffffffffff)
-        head = _DC_Timestamp_1.pack((p2 & 0xffffffff), ((p2 >> 32) & 0xffff), ((p2 >> 48) & 0xff))
+        p2 = r1 & 0xFFFFFFFFFFFFFF
+        head = _DC_Timestamp_1.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
         return head
 
     @classmethod
@@ -77,15 +91,17 @@ class Timestamp:
         if n < 7:
             raise _dc.cut(_DC_Timestamp_2, n << 3)
         u1, u2, u3 = _DC_Timestamp_1.unpack_from(data)
-        x4 = (u1 | (u2 << 32) | (u3 << 48))
+        x4 = u1 | (u2 << 32) | (u3 << 48)
         if n > 7:
-            raise _dc.DecodeError('Timestamp: ' + str(n - 7) + ' byte(s) beyond the end of the message')
+            raise _dc.DecodeError("Timestamp: " + str(n - 7) + " byte(s) beyond the end of the message")
         return cls(x4)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         r1 = self.usec
-        p2 = (r1 & 0xffffffffffffff)
-        acc = (acc << 56) | int.from_bytes(_DC_Timestamp_1.pack((p2 & 0xffffffff), ((p2 >> 32) & 0xffff), ((p2 >> 48) & 0xff)), 'big')
+        p2 = r1 & 0xFFFFFFFFFFFFFF
+        acc = (acc << 56) | int.from_bytes(
+            _DC_Timestamp_1.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
+        )
         return acc
 
     @classmethod
@@ -93,8 +109,8 @@ class Timestamp:
         if rem < 56:
             raise _dc.cut(_DC_Timestamp_2, rem)
         rem -= 56
-        u1, u2, u3 = _DC_Timestamp_1.unpack(((v >> rem) & 0xffffffffffffff).to_bytes(7, 'big'))
-        x4 = (u1 | (u2 << 32) | (u3 << 48))
+        u1, u2, u3 = _DC_Timestamp_1.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        x4 = u1 | (u2 << 32) | (u3 << 48)
         return cls(x4), rem
 
     def validate(self) -> list[_v.Violation]:
@@ -105,21 +121,21 @@ class Timestamp:
         e: Any
         sub: Any
         try:
-            if (self.usec & -72057594037927936):
-                _v.diag(out, 'usec', self.usec, _VS_Timestamp_usec)
+            if self.usec & -72057594037927936:
+                _v.diag(out, "usec", self.usec, _VS_Timestamp_usec)
         except _v.SLOW:
-            _v.diag(out, 'usec', self.usec, _VS_Timestamp_usec)
+            _v.diag(out, "usec", self.usec, _VS_Timestamp_usec)
         return out
 
     def check(self) -> None:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'dronecan.uavcan.Timestamp')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "dronecan.uavcan.Timestamp")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field == 'usec':
+        if field == "usec":
             return self.usec != 0
-        raise KeyError(f'{field!r} is not a field of ' + 'dronecan.uavcan.Timestamp')
+        raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.Timestamp")

@@ -75,6 +75,9 @@ class _Generator:
         self.parts = parts(self.schema, msg)
         self.idents = {f.source_name: f.ident for f in view.fields}
         self.helpers: dict[str, None] = {}  # nested-message builders, in first-use order
+        self.struct = ctx.constant(self.cls, "STRUCT")  # the C struct, nested messages inlined
+        self.columns = ctx.constant(self.cls, "COLUMNS")
+        self.packed_fields = ctx.constant(self.cls, "PACKED_FIELDS")
 
     # -- names -------------------------------------------------------------------------------
 
@@ -119,28 +122,37 @@ class _Generator:
 
     def structs(self, full_fmt: str, has_trailing: bool) -> str:
         enc = "<" + compress_codes([_encode_code(p) for p in self.parts])
-        lines = [f"_S_{self.cls} = struct.Struct({py_literal(full_fmt)})  # decode: nested messages inlined"]
+        lines = [
+            "# the C struct, nested messages inlined (decoding reads them in place)",
+            f"{self.struct} = struct.Struct({py_literal(full_fmt)})",
+        ]
         if has_trailing:
             short = struct_format(self.schema, self.msg, trailing=False)
-            lines.append(f"_SD_{self.cls} = struct.Struct({py_literal(short)})  # without the trailing padding")
+            lines += [
+                "# without the trailing padding, which ULog records leave out",
+                f"{self.ctx.constant(self.cls, 'UNPADDED')} = struct.Struct({py_literal(short)})",
+            ]
         if enc != full_fmt:
-            lines.append(f"_SE_{self.cls} = struct.Struct({py_literal(enc)})  # encode: nested messages as bytes")
+            lines += [
+                "# nested messages as bytes: each encodes itself, so an error names its full path",
+                f"{self.ctx.constant(self.cls, 'ENCODE_STRUCT')} = struct.Struct({py_literal(enc)})",
+            ]
         return "\n".join(lines)
 
     def encode_method(self, size: int) -> str:
         enc = "<" + compress_codes([_encode_code(p) for p in self.parts])
-        struct_name = f"_SE_{self.cls}" if enc != struct_format(self.schema, self.msg) else f"_S_{self.cls}"
+        struct_name = self.struct
+        if enc != struct_format(self.schema, self.msg):
+            struct_name = self.ctx.constant(self.cls, "ENCODE_STRUCT")
         args = [a for p in self.parts if (a := self.encode_arg(p))]
         return "\n".join(
             [
                 "def encode(self) -> bytes:",
                 f'    """PX4\'s C struct of this message: {size} bytes, little-endian, padding zeroed."""',
                 "    try:",
-                f"        return {struct_name}.pack(",
-                *(f"            {a}," for a in args),
-                "        )",
+                f"        return {struct_name}.pack({', '.join(args)})",
                 f"    except {_ERRORS} as exc:",
-                f"        raise _uorb.encode_error({py_literal(self.cls)}, self, _UC_{self.cls}, exc) from None",
+                f"        raise _uorb.encode_error({py_literal(self.cls)}, self, {self.packed_fields}, exc) from None",
             ]
         )
 
@@ -169,7 +181,7 @@ class _Generator:
     def decode_method(self, size: int, no_pad: int) -> str:
         accepted = f"len(data) != {size}" + (f" and len(data) != {no_pad}" if no_pad != size else "")
         expected = f"{size} bytes" + (f" (or {no_pad} without the trailing padding)" if no_pad != size else "")
-        struct_name = f"_SD_{self.cls}" if no_pad != size else f"_S_{self.cls}"
+        struct_name = self.ctx.constant(self.cls, "UNPADDED") if no_pad != size else self.struct
         body = self.build_lines(self.msg, self.parts, "o", "cls", lambda i: str(i))
         return "\n".join(
             [
@@ -221,7 +233,7 @@ class _Generator:
     def nested_builder(self, nested: Message) -> str:
         """Name of a module-level function building ``nested`` from the parent's unpacked tuple."""
         cls_expr, annotation = self.class_expr(nested)
-        name = f"_ub_{naming.class_name(nested)}"
+        name = self.ctx.private_name(f"_{naming.lower_snake(naming.class_name(nested))}_from_values", nested)
         body = self.build_lines(nested, parts(self.schema, nested), "o", cls_expr, lambda i: f"i + {i}" if i else "i")
         code = "\n".join(
             [
@@ -236,15 +248,9 @@ class _Generator:
     def columns_constant(self, size: int) -> str:
         cols = list(columns(self.schema, self.msg))
         end = max((c.offset + c.size for c in cols), default=0)
-        return (
-            f"_COL_{self.cls} = _uorb.Columns(\n"
-            f"    {py_literal(tuple(c.name for c in cols))},\n"
-            f"    {py_literal(column_format(cols, end))},\n"
-            f"    {size},\n"
-            f"    {py_literal(tuple(c.np_type for c in cols))},\n"
-            f"    {py_literal(tuple(c.offset for c in cols))},\n"
-            ")"
-        )
+        names, fmt = py_literal(tuple(c.name for c in cols)), py_literal(column_format(cols, end))
+        np_types, offsets = py_literal(tuple(c.np_type for c in cols)), py_literal(tuple(c.offset for c in cols))
+        return f"{self.columns} = _uorb.Columns({names}, {fmt}, {size}, {np_types}, {offsets})"
 
     def check_table(self) -> str:
         """(attribute, field, struct code, count) of the plain fields, for naming a bad value."""
@@ -253,7 +259,12 @@ class _Generator:
             if p.kind in ("scalar", "array"):
                 code = p.code[-1]
                 rows.append((self.idents[p.name], p.name, code, p.count))
-        return f"_UC_{self.cls}: tuple[tuple[str, str, str, int], ...] = {py_literal(tuple(rows))}"
+        return "\n".join(
+            [
+                "# (attribute, field, struct code, count) of the plain fields, to name a value that does not fit",
+                f"{self.packed_fields}: tuple[tuple[str, str, str, int], ...] = {py_literal(tuple(rows))}",
+            ]
+        )
 
     def batch_method(self, size: int) -> str:
         return "\n".join(
@@ -274,7 +285,7 @@ class _Generator:
                 "    numpy arrays when numpy is installed (``use_numpy`` None) or required (True; views",
                 "    into ``buffer`` unless ``copy``), else lists from ``struct.iter_unpack``.",
                 '    """',
-                f"    return _COL_{self.cls}.decode(buffer, stride, use_numpy=use_numpy, copy=copy)",
+                f"    return {self.columns}.decode(buffer, stride, use_numpy=use_numpy, copy=copy)",
             ]
         )
 
@@ -287,15 +298,8 @@ class _Generator:
                 "@classmethod",
                 "def ulog_format(cls) -> _ulog.Format:",
                 '    """The ULog format PX4\'s logger writes for this struct (nested formats attached)."""',
-                "    return _ulog.Format(",
-                f"        {py_literal(snake(self.msg.name))},",
-                "        (",
-                *(f"            {m}," for m in members),
-                "        ),",
-                "        cls,",
-                f"        {py_literal(tuple(info.topics))},",
-                f"        {py_literal(info.message_version)},",
-                "    )",
+                f"    return _ulog.Format({py_literal(snake(self.msg.name))}, {_tuple(members)}, cls, "
+                f"{py_literal(tuple(info.topics))}, {py_literal(info.message_version)})",
                 "",
                 "@classmethod",
                 "def from_ulog(",
@@ -321,6 +325,10 @@ class _Generator:
             cls_expr, _ = self.class_expr(p.nested)
             args.append(f"{cls_expr}.ulog_format()")
         return f"_ulog.Member({', '.join(args)})"
+
+
+def _tuple(items: list[str]) -> str:
+    return "(" + ", ".join(items) + ("," if len(items) == 1 else "") + ")"
 
 
 def _encode_code(p: Part) -> str:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import enum
 import itertools
-from collections.abc import Iterable
 from dataclasses import dataclass
 
 
@@ -94,16 +93,19 @@ class BestFitting:
 
 
 Element = str | Line | ExpandParent | BestFitting | Start | End
-Content = Element | Iterable["Content"]
+Content = Element | list[Element]
 
 
 def flatten(*content: Content) -> list[Element]:
+    """The elements of ``content``: single elements, and lists of elements (which builders give)."""
     out: list[Element] = []
     for item in content:
-        if isinstance(item, str | Line | ExpandParent | BestFitting | Start | End):
+        if type(item) is list:
+            out += item
+        elif isinstance(item, str | Line | ExpandParent | BestFitting | Start | End):
             out.append(item)
         else:
-            out.extend(flatten(*item))
+            raise TypeError(f"not a document element: {item!r}")
     return out
 
 

@@ -1,4 +1,4 @@
-"""Lays out every one-line statement of a module: the entry point of the layout engine."""
+"""Lays out the statements of a module: the entry point of the layout engine."""
 
 from __future__ import annotations
 
@@ -6,8 +6,9 @@ import ast
 import io
 import tokenize
 
+from .document import Element
 from .printer import Printer
-from .source import Source
+from .source import Source, normalize_number, normalize_string, outside_fstrings
 from .statements import StatementLayout
 
 LINE_LENGTH = 120
@@ -25,7 +26,6 @@ def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
     comment or a triple-quoted string in it is kept as written.
     """
     lines = text.split("\n")
-    kept = _rows_with_comments_or_long_strings(text)
     replaced: dict[int, tuple[int, str]] = {}  # first row -> (last row, new text)
     for node in _statements(ast.parse(text).body):
         first = node.lineno - 1
@@ -38,22 +38,25 @@ def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
                 continue
         else:
             continue
-        if any(row in kept for row in range(first, last + 1)):
+        rows = lines[first : last + 1]
+        if any('"""' in row or "'''" in row for row in rows) or _has_comment(rows):
             continue
         line = lines[first]
-        stripped = line.lstrip(" ")
-        depth, rest = divmod(len(line) - len(stripped), _INDENT)
+        depth, rest = divmod(len(line) - len(line.lstrip(" ")), _INDENT)
         if rest:
             continue
-        joined = " ".join([stripped.strip(), *(lines[row].strip() for row in range(first + 1, last + 1))])
-        if isinstance(node, _HEADERS):
-            if not joined.endswith(":"):
-                continue
-            laid_out = _layout_header(joined, line_length, depth)
-        else:
-            laid_out = _layout_simple(joined, line_length, depth)
-        if laid_out is not None:
-            replaced[first] = (last, laid_out)
+        if first == last and len(line) <= line_length and _as_written(node, line):
+            continue
+        try:
+            if first == last:
+                document = _document(node, Source.of_line(line, *_roots(node)), line)
+            else:
+                joined = " ".join(lines[row].strip() for row in range(first, last + 1))
+                document = _joined_document(joined, isinstance(node, _HEADERS))
+        except NotImplementedError:
+            continue
+        if document is not None:
+            replaced[first] = (last, Printer(line_length).print(document, depth))
     out: list[str] = []
     row = 0
     while row < len(lines):
@@ -65,6 +68,98 @@ def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
             out.append(lines[row])
             row += 1
     return "\n".join(out)
+
+
+def _as_written(node: ast.stmt, line: str) -> bool:
+    """Whether a statement that fits on its line is already as ruff writes it: literals spelled
+    as ruff spells them (one part per string), no trailing comma that would keep brackets
+    broken, no parentheses ruff drops. (Spacing between tokens is the emitters' business: they
+    write it as ruff does, and the tests check generated/ with ruff.)"""
+    if not line.isascii():
+        return False  # AST offsets are in bytes: compare on ASCII lines only
+    for expression in _top_expressions(node):
+        if line[: expression.col_offset].rstrip().endswith("("):
+            return False  # parentheses around a whole expression: ruff may drop them
+    for sub in (n for root in _roots(node) for n in outside_fstrings(root)):
+        if isinstance(sub, ast.Constant):
+            text = line[sub.col_offset : sub.end_col_offset]
+            if isinstance(sub.value, str | bytes):
+                if normalize_string(text) != text:
+                    return False  # other quotes, or parts ruff would join
+            elif isinstance(sub.value, int | float | complex) and normalize_number(text) != text:
+                return False
+        elif isinstance(sub, ast.JoinedStr):
+            text = line[sub.col_offset : sub.end_col_offset]
+            if normalize_string(text) != text:
+                return False
+        elif isinstance(sub, ast.Call | ast.List | ast.Set | ast.Dict | ast.Tuple | ast.Subscript):
+            if isinstance(sub, ast.Tuple) and len(sub.elts) == 1:
+                continue
+            end = sub.end_col_offset or 0
+            if line[end - 1 : end] in (")", "]", "}") and line[: end - 1].rstrip().endswith(","):
+                return False  # a trailing comma keeps the brackets broken
+    return True
+
+
+def _top_expressions(node: ast.stmt) -> list[ast.expr]:
+    """The expressions a statement holds directly (where ruff drops redundant parentheses)."""
+    if isinstance(node, ast.For):
+        return [node.target, node.iter]
+    if isinstance(node, ast.If | ast.While):
+        return [node.test]
+    if isinstance(node, ast.Expr | ast.Return | ast.Assign | ast.AnnAssign | ast.AugAssign):
+        value = [node.value] if node.value is not None else []
+        if isinstance(node, ast.Assign):
+            return [*node.targets, *value]
+        if isinstance(node, ast.AnnAssign | ast.AugAssign):
+            return [node.target, *value]
+        return value
+    if isinstance(node, ast.Raise):
+        return [e for e in (node.exc, node.cause) if e is not None]
+    return []
+
+
+def _has_comment(rows: list[str]) -> bool:
+    if not any("#" in row for row in rows):
+        return False
+    text = "\n".join(row.strip() for row in rows)
+    try:
+        return any(tok.type == tokenize.COMMENT for tok in tokenize.generate_tokens(io.StringIO(text).readline))
+    except (tokenize.TokenError, SyntaxError):
+        return True
+
+
+def _roots(node: ast.stmt) -> list[ast.AST]:
+    """The parts of the statement laid out: all of it, or a header's expressions."""
+    if isinstance(node, ast.For):
+        return [node.target, node.iter]
+    if isinstance(node, ast.If | ast.While):
+        return [node.test]
+    return [node]
+
+
+def _document(node: ast.stmt, source: Source, line: str) -> list[Element] | None:
+    layout = StatementLayout(source)
+    if isinstance(node, _HEADERS):
+        if not line.rstrip().endswith(":"):
+            return None
+        keyword = line.split()[0]
+        return layout.header(keyword, node)
+    return layout.statement(node)
+
+
+def _joined_document(joined: str, header: bool) -> list[Element] | None:
+    if header:
+        if not joined.endswith(":"):
+            return None
+        keyword = joined.split(" ", 1)[0]
+        offset = 2 if keyword == "elif" else 0  # "elif x:" parses as "if x:"
+        text = joined[offset:] + " pass"
+        node = ast.parse(text).body[0]
+        assert isinstance(node, ast.If | ast.While | ast.For)
+        return StatementLayout(Source.of_line(text, *_roots(node))).header(keyword, node)
+    node = ast.parse(joined).body[0]
+    return StatementLayout(Source.of_line(joined, node)).statement(node)
 
 
 def _statements(body: list[ast.stmt]) -> list[ast.stmt]:
@@ -80,37 +175,5 @@ def _statements(body: list[ast.stmt]) -> list[ast.stmt]:
     return out
 
 
-def _rows_with_comments_or_long_strings(text: str) -> set[int]:
-    rows: set[int] = set()
-    for tok in tokenize.generate_tokens(io.StringIO(text).readline):
-        if tok.type == tokenize.COMMENT or (tok.type == tokenize.STRING and tok.start[0] != tok.end[0]):
-            rows.update(range(tok.start[0] - 1, tok.end[0]))
-    return rows
-
-
 def _is_docstring(node: ast.stmt) -> bool:
     return isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str)
-
-
-def _layout_simple(statement: str, line_length: int, depth: int) -> str | None:
-    tree = ast.parse(statement)
-    node = tree.body[0]
-    try:
-        document = StatementLayout(Source(statement, node)).statement(node)
-    except NotImplementedError:
-        return None
-    return Printer(line_length).print(document, depth)
-
-
-def _layout_header(header: str, line_length: int, depth: int) -> str | None:
-    keyword = header.split(" ", 1)[0]
-    # parse "elif x:" as "if x:"; the body is irrelevant to the header
-    offset = 2 if keyword == "elif" else 0
-    parsed = ast.parse(header[offset:] + " pass").body[0]
-    assert isinstance(parsed, ast.If | ast.While | ast.For)
-    source_text = header[offset:] + " pass"
-    try:
-        document = StatementLayout(Source(source_text, parsed)).header(keyword, parsed)
-    except NotImplementedError:
-        return None
-    return Printer(line_length).print(document, depth)

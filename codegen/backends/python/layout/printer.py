@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import enum
 import unicodedata
-from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 from .document import (
     BestFitting,
@@ -30,8 +30,7 @@ from .document import (
 INDENT_WIDTH = 4
 
 
-@dataclass(frozen=True)
-class Args:
+class Args(NamedTuple):
     """How the content of the innermost open tag prints: indentation level, mode, measure."""
 
     indent: int = 0
@@ -46,38 +45,41 @@ class _Fits(enum.Enum):
 
 
 def text_width(text: str) -> int:
+    if text.isascii():
+        return len(text)
     return sum(2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in text)
 
 
 class Queue:
-    """What is left to print: a stack of (elements, next index) frames, the top one read first."""
+    """What is left to print: a stack of element lists, each with the index of its next element."""
 
-    def __init__(self, frames: list[list[object]] | None = None) -> None:
-        self.frames: list[list[object]] = frames if frames is not None else []
+    def __init__(self, items: list[list[Element]] | None = None, indexes: list[int] | None = None) -> None:
+        self.items: list[list[Element]] = items if items is not None else []
+        self.indexes: list[int] = indexes if indexes is not None else []
 
     def copy(self) -> Queue:
-        return Queue([[items, index] for items, index in self.frames])
+        return Queue(list(self.items), list(self.indexes))
 
     def pop(self) -> Element | None:
-        frames = self.frames
-        while frames:
-            frame = frames[-1]
-            items = frame[0]
-            index = frame[1]
-            assert isinstance(items, list) and isinstance(index, int)
-            if index < len(items):
-                frame[1] = index + 1
-                element: Element = items[index]
-                return element
-            frames.pop()
+        items, indexes = self.items, self.indexes
+        while items:
+            top = items[-1]
+            index = indexes[-1]
+            if index < len(top):
+                indexes[-1] = index + 1
+                return top[index]
+            items.pop()
+            indexes.pop()
         return None
 
     def extend_back(self, elements: list[Element]) -> None:
         if elements:
-            self.frames.append([elements, 0])
+            self.items.append(elements)
+            self.indexes.append(0)
 
     def pop_slice(self) -> None:
-        self.frames.pop()
+        self.items.pop()
+        self.indexes.pop()
 
     def skip_content(self, kind: Kind) -> None:
         depth = 1
@@ -161,7 +163,7 @@ class Printer:
                 mode = Mode.EXPANDED
             if tag.group_id is not None:
                 self.group_modes[tag.group_id] = mode
-            stack.append((kind, replace(args, mode=mode)))
+            stack.append((kind, args._replace(mode=mode)))
         elif kind is Kind.BEST_FIT_PARENTHESIZE:
             self.print_best_fit_parenthesize(tag, args, queue, stack)
         elif kind is Kind.CONDITIONAL_GROUP:
@@ -171,11 +173,11 @@ class Printer:
                     mode = self.flat_group_print_mode(kind, None, args, queue, stack)
                 else:
                     mode = Mode.EXPANDED
-                stack.append((kind, replace(args, mode=mode)))
+                stack.append((kind, args._replace(mode=mode)))
             else:
                 stack.append((kind, args))
         elif kind is Kind.INDENT:
-            stack.append((kind, replace(args, indent=args.indent + 1)))
+            stack.append((kind, args._replace(indent=args.indent + 1)))
         elif kind is Kind.CONDITIONAL_CONTENT:
             assert tag.condition is not None
             if self.condition_mode(tag.condition, args) is tag.condition.mode:
@@ -185,7 +187,7 @@ class Printer:
         elif kind is Kind.INDENT_IF_GROUP_BREAKS:
             assert tag.group_id is not None
             expanded = self.group_modes[tag.group_id] is Mode.EXPANDED
-            stack.append((kind, replace(args, indent=args.indent + 1) if expanded else args))
+            stack.append((kind, args._replace(indent=args.indent + 1) if expanded else args))
         elif kind is Kind.FITS_EXPANDED:
             if tag.condition is None or self.condition_mode(tag.condition, args) is tag.condition.mode:
                 # the inner groups were measured expanded: they must measure again
@@ -211,7 +213,7 @@ class Printer:
         self.measured_group_fits = True
         if group_id is not None:
             self.group_modes[group_id] = Mode.FLAT
-        stack.append((kind, replace(args, mode=Mode.FLAT)))
+        stack.append((kind, args._replace(mode=Mode.FLAT)))
         fits = self.fits(queue, stack)
         stack.pop()
         return Mode.FLAT if fits else Mode.EXPANDED
@@ -224,7 +226,7 @@ class Printer:
             # parenthesize only if the content then fits; else rather break it without parentheses
             if tag.group_id is not None:
                 self.group_modes[tag.group_id] = Mode.EXPANDED
-            stack.append((tag.kind, replace(args, measure=Measure.ALL_LINES)))
+            stack.append((tag.kind, args._replace(measure=Measure.ALL_LINES)))
             queue.extend_back(opening)
             fits_expanded = self.fits(queue, stack)
             queue.pop_slice()
@@ -234,7 +236,7 @@ class Printer:
             self.group_modes[tag.group_id] = mode
         if mode is Mode.EXPANDED:
             queue.extend_back(opening)
-        stack.append((tag.kind, replace(args, mode=mode)))
+        stack.append((tag.kind, args._replace(mode=mode)))
 
     def print_best_fitting(self, element: BestFitting, queue: Queue, stack: Stack) -> None:
         args = stack[-1][1]
@@ -247,16 +249,16 @@ class Printer:
         for variant in variants[:-1]:
             content = variant[1:]  # the ENTRY start tag gets the measuring args below
             queue.extend_back(content)
-            stack.append((Kind.ENTRY, replace(args, mode=Mode.FLAT, measure=element.measure)))
+            stack.append((Kind.ENTRY, args._replace(mode=Mode.FLAT, measure=element.measure)))
             fits = self.fits(queue, stack)
             stack.pop()
             queue.pop_slice()
             if fits:
                 queue.extend_back(variant)
-                self.print_entry(queue, stack, replace(args, mode=Mode.FLAT))
+                self.print_entry(queue, stack, args._replace(mode=Mode.FLAT))
                 return
         queue.extend_back(variants[-1])
-        self.print_entry(queue, stack, replace(args, mode=Mode.EXPANDED))
+        self.print_entry(queue, stack, args._replace(mode=Mode.EXPANDED))
 
     def print_entry(self, queue: Queue, stack: Stack, args: Args) -> None:
         start = queue.pop()
@@ -318,7 +320,7 @@ class _FitsMeasurer:
             return _Fits.MAYBE
         if isinstance(element, BestFitting):
             if args.mode is Mode.FLAT:
-                variant, entry_args = element.variants[0], replace(args, measure=element.measure)
+                variant, entry_args = element.variants[0], args._replace(measure=element.measure)
             else:
                 variant, entry_args = element.variants[-1], args
             self.stack.append((Kind.ENTRY, entry_args))
@@ -332,7 +334,7 @@ class _FitsMeasurer:
         kind = tag.kind
         modes = self.printer.group_modes
         if kind is Kind.INDENT:
-            self.stack.append((kind, replace(args, indent=args.indent + 1)))
+            self.stack.append((kind, args._replace(indent=args.indent + 1)))
         elif kind is Kind.GROUP:
             return self.fits_group(kind, tag.mode, tag.group_id, args)
         elif kind is Kind.BEST_FIT_PARENTHESIZE:
@@ -353,12 +355,12 @@ class _FitsMeasurer:
         elif kind is Kind.INDENT_IF_GROUP_BREAKS:
             assert tag.group_id is not None
             expanded = modes[tag.group_id] is Mode.EXPANDED
-            self.stack.append((kind, replace(args, indent=args.indent + 1) if expanded else args))
+            self.stack.append((kind, args._replace(indent=args.indent + 1) if expanded else args))
         elif kind is Kind.FITS_EXPANDED:
             met = tag.condition is None or self.printer.condition_mode(tag.condition, args) is tag.condition.mode
             if args.mode is Mode.FLAT and met:
                 # measure the content fully expanded; only what comes before and after must fit
-                self.stack.append((kind, replace(args, measure=Measure.ALL_LINES_OVERFLOW, mode=Mode.EXPANDED)))
+                self.stack.append((kind, args._replace(measure=Measure.ALL_LINES_OVERFLOW, mode=Mode.EXPANDED)))
             elif args.mode is Mode.FLAT and tag.propagate_expand:
                 return _Fits.NO
             else:
@@ -379,7 +381,7 @@ class _FitsMeasurer:
 
     def fits_group(self, kind: Kind, group_mode: GroupMode, group_id: int | None, args: Args) -> _Fits:
         mode = args.mode if group_mode is GroupMode.FLAT else Mode.EXPANDED
-        self.stack.append((kind, replace(args, mode=mode)))
+        self.stack.append((kind, args._replace(mode=mode)))
         if group_id is not None:
             self.printer.group_modes[group_id] = mode
         return _Fits.MAYBE

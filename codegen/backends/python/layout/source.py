@@ -27,38 +27,39 @@ class Token:
     end: int
 
 
-def _tokens(text: str) -> list[Token]:
+def line_tokens(text: str) -> list[Token]:
+    """The tokens of a one-line statement that matter here (an f-string as one STRING token)."""
     out: list[Token] = []
-    fstring_start: tuple[int, int] | None = None  # (column, nesting) of an open f-string
+    fstring_start = 0  # column where the outermost open f-string starts
     depth = 0
     for tok in tokenize.generate_tokens(io.StringIO(text).readline):
         if tok.type in _SKIPPED or tok.type == token_types.COMMENT:
             continue
-        if tok.start[0] != 1:
-            raise ValueError("a statement on one line was expected")
+        if tok.start[0] != 1 or tok.end[0] != 1:
+            raise NotImplementedError("a statement on one line was expected")
         if tok.type == _FSTRING_START:
             if depth == 0:
-                fstring_start = (tok.start[1], 0)
+                fstring_start = tok.start[1]
             depth += 1
-            continue
-        if depth:
+        elif depth:
             if tok.type == _FSTRING_END:
                 depth -= 1
-                if depth == 0 and fstring_start is not None:
-                    begin = fstring_start[0]
-                    out.append(Token(token_types.STRING, text[begin : tok.end[1]], begin, tok.end[1]))
-            continue
-        out.append(Token(tok.type, tok.string, tok.start[1], tok.end[1]))
+                if depth == 0:
+                    end = tok.end[1]
+                    out.append(Token(token_types.STRING, text[fstring_start:end], fstring_start, end))
+        else:
+            out.append(Token(tok.type, tok.string, tok.start[1], tok.end[1]))
     return out
 
 
 class Source:
     """A one-line statement or expression: its tokens, and where each AST node sits among them."""
 
-    def __init__(self, text: str, tree: ast.AST) -> None:
+    def __init__(self, text: str, tokens: list[Token], *trees: ast.AST) -> None:
         self.text = text
+        self.ascii = text.isascii()
         self.encoded = text.encode("utf-8")
-        self.tokens = _tokens(text)
+        self.tokens = tokens
         self.by_start = {t.start: i for i, t in enumerate(self.tokens)}
         self.by_end = {t.end: i for i, t in enumerate(self.tokens)}
         self.match: dict[int, int] = {}
@@ -72,14 +73,21 @@ class Source:
                 self.match[j] = i
         # the parentheses of a call are its own, not parentheses around its (only) argument
         self.call_parens: set[int] = set()
-        for node in _outside_fstrings(tree):
+        for node in (n for tree in trees for n in outside_fstrings(tree)):
             if isinstance(node, ast.Call):
                 after = self.by_end[self.span(node.func)[1]] + 1
                 while self.tokens[after].text == ")":  # the function itself in parentheses
                     after += 1
                 self.call_parens.add(after)
 
+    @classmethod
+    def of_line(cls, text: str, *trees: ast.AST) -> Source:
+        """A statement alone on one line (``text``, parsed into ``trees``)."""
+        return cls(text, line_tokens(text), *trees)
+
     def char_offset(self, byte_offset: int) -> int:
+        if self.ascii:
+            return byte_offset
         return len(self.encoded[:byte_offset].decode("utf-8"))
 
     def span(self, node: ast.AST) -> tuple[int, int]:
@@ -123,7 +131,7 @@ class Source:
         return [t.text for t in self.tokens[first : last + 1] if t.kind == token_types.STRING]
 
 
-def _outside_fstrings(tree: ast.AST) -> list[ast.AST]:
+def outside_fstrings(tree: ast.AST) -> list[ast.AST]:
     """Every node but those inside f-strings (the tokens do not look inside an f-string)."""
     out: list[ast.AST] = []
     todo = [tree]

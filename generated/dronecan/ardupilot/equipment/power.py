@@ -12,49 +12,58 @@ import struct
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from .... import _meta as _m
 from .... import _dronecan as _dc
+from .... import _meta as _m
 from .... import _validate as _v
 
 if TYPE_CHECKING:
     from ....dronecan import uavcan as _dronecan_uavcan
 
-__all__ = ['BatteryInfoAux']
+__all__ = ["BatteryInfoAux"]
 
 
-_DC_BatteryInfoAux_1 = struct.Struct('<IHB')
+_DC_BatteryInfoAux_1 = struct.Struct("<IHB")
 
 
-_DC_BatteryInfoAux_2 = struct.Struct('<2f')
+_DC_BatteryInfoAux_2 = struct.Struct("<2f")
 
 
-_DC_BatteryInfoAux_3 = struct.Struct('<2I')
+_DC_BatteryInfoAux_3 = struct.Struct("<2I")
 
 
-_DC_BatteryInfoAux_4 = struct.Struct('<HHHHH')
+_DC_BatteryInfoAux_4 = struct.Struct("<HHHHH")
 
 
-_DC_BatteryInfoAux_5 = ((56, 'BatteryInfoAux.timestamp.usec'),)
+_DC_BatteryInfoAux_5 = ((56, "BatteryInfoAux.timestamp.usec"),)
 
 
-_DC_BatteryInfoAux_6 = ((16, 'BatteryInfoAux.cycle_count'), (32, 'BatteryInfoAux.over_discharge_count'), (48, 'BatteryInfoAux.max_current'), (64, 'BatteryInfoAux.nominal_voltage'), (65, 'BatteryInfoAux.is_powering_off'), (73, 'BatteryInfoAux.battery_id'))
+_DC_BatteryInfoAux_6 = (
+    (16, "BatteryInfoAux.cycle_count"),
+    (32, "BatteryInfoAux.over_discharge_count"),
+    (48, "BatteryInfoAux.max_current"),
+    (64, "BatteryInfoAux.nominal_voltage"),
+    (65, "BatteryInfoAux.is_powering_off"),
+    (73, "BatteryInfoAux.battery_id"),
+)
 
 
-_DC_BatteryInfoAux_7 = struct.Struct('<HHeeH')
+_DC_BatteryInfoAux_7 = struct.Struct("<HHeeH")
 
 
-_VS_BatteryInfoAux_timestamp = _v.Nested('dronecan.uavcan.Timestamp')
-_VS_BatteryInfoAux_voltage_cell = _v.Array(_v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='V'), 255, False)
-_VS_BatteryInfoAux_cycle_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryInfoAux_over_discharge_count = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_BatteryInfoAux_max_current = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='A')
-_VS_BatteryInfoAux_nominal_voltage = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='V')
-_VS_BatteryInfoAux_is_powering_off = _v.Number(type='bool', kind='bool', low=0, high=1)
-_VS_BatteryInfoAux_battery_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
+_VS_BatteryInfoAux_timestamp = _v.Nested("dronecan.uavcan.Timestamp")
+_VS_BatteryInfoAux_voltage_cell = _v.Array(
+    _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V"), 255, False
+)
+_VS_BatteryInfoAux_cycle_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryInfoAux_over_discharge_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_BatteryInfoAux_max_current = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="A")
+_VS_BatteryInfoAux_nominal_voltage = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V")
+_VS_BatteryInfoAux_is_powering_off = _v.Number(type="bool", kind="bool", low=0, high=1)
+_VS_BatteryInfoAux_battery_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
 
 
 @functools.cache
-def _cls_Timestamp() -> type[_dronecan_uavcan.Timestamp]:
+def _timestamp_class() -> type[_dronecan_uavcan.Timestamp]:
     from ....dronecan.uavcan import Timestamp as cls
 
     return cls
@@ -66,19 +75,63 @@ class BatteryInfoAux:
 
     Send it before the matching BatteryInfo.
 
-    Schema: dronecan.ardupilot.equipment.power.BatteryInfoAux (dronecan, ardupilot/equipment/power/20004.BatteryInfoAux.uavcan:1).
+    Schema: dronecan.ardupilot.equipment.power.BatteryInfoAux (dronecan,
+    ardupilot/equipment/power/20004.BatteryInfoAux.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'dronecan.ardupilot.equipment.power.BatteryInfoAux'
+    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryInfoAux"
 
-    timestamp: _dronecan_uavcan.Timestamp = dataclasses.field(default_factory=lambda: _cls_Timestamp()(), metadata=_m.meta(name='timestamp', type='dronecan.uavcan.Timestamp', doc='When the current was last measured.'))
-    voltage_cell: list[float] = dataclasses.field(default_factory=list, metadata=_m.meta(name='voltage_cell', type='float16[<=255]', unit='V', quantity='voltage', doc='Per-cell voltages; the length is the cell count.'))
-    cycle_count: int = dataclasses.field(default=0, metadata=_m.meta(name='cycle_count', type='uint16', doc='Full charge/discharge cycles (partial cycles add up).'))
-    over_discharge_count: int = dataclasses.field(default=0, metadata=_m.meta(name='over_discharge_count', type='uint16', doc='Discharges beyond the rated capacity.'))
-    max_current: float = dataclasses.field(default=0.0, metadata=_m.meta(name='max_current', type='float16', unit='A', quantity='current', doc='Peak current since the previous message.'))
-    nominal_voltage: float = dataclasses.field(default=0.0, metadata=_m.meta(name='nominal_voltage', type='float16', unit='V', quantity='voltage', doc='Nominal pack voltage, for Wh <-> Ah conversion; zero disables the conversion.'))
-    is_powering_off: bool = dataclasses.field(default=False, metadata=_m.meta(name='is_powering_off', type='bool', doc='About to switch off; false if unknown'))
-    battery_id: int = dataclasses.field(default=0, metadata=_m.meta(name='battery_id', type='uint8', doc='Which battery of this vehicle (0 = main)'))
+    timestamp: _dronecan_uavcan.Timestamp = dataclasses.field(
+        default_factory=lambda: _timestamp_class()(),
+        metadata=_m.meta(name="timestamp", type="dronecan.uavcan.Timestamp", doc="When the current was last measured."),
+    )
+    voltage_cell: list[float] = dataclasses.field(
+        default_factory=list,
+        metadata=_m.meta(
+            name="voltage_cell",
+            type="float16[<=255]",
+            unit="V",
+            quantity="voltage",
+            doc="Per-cell voltages; the length is the cell count.",
+        ),
+    )
+    cycle_count: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="cycle_count", type="uint16", doc="Full charge/discharge cycles (partial cycles add up)."
+        ),
+    )
+    over_discharge_count: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Discharges beyond the rated capacity."),
+    )
+    max_current: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="max_current",
+            type="float16",
+            unit="A",
+            quantity="current",
+            doc="Peak current since the previous message.",
+        ),
+    )
+    nominal_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="nominal_voltage",
+            type="float16",
+            unit="V",
+            quantity="voltage",
+            doc="Nominal pack voltage, for Wh <-> Ah conversion; zero disables the conversion.",
+        ),
+    )
+    is_powering_off: bool = dataclasses.field(
+        default=False,
+        metadata=_m.meta(name="is_powering_off", type="bool", doc="About to switch off; false if unknown"),
+    )
+    battery_id: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="battery_id", type="uint8", doc="Which battery of this vehicle (0 = main)")
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -89,76 +142,117 @@ class BatteryInfoAux:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['timestamp'] = self.timestamp.to_dict()
-        out['voltage_cell'] = list(self.voltage_cell)
-        out['cycle_count'] = self.cycle_count
-        out['over_discharge_count'] = self.over_discharge_count
-        out['max_current'] = self.max_current
-        out['nominal_voltage'] = self.nominal_voltage
-        out['is_powering_off'] = self.is_powering_off
-        out['battery_id'] = self.battery_id
+        out["timestamp"] = self.timestamp.to_dict()
+        out["voltage_cell"] = list(self.voltage_cell)
+        out["cycle_count"] = self.cycle_count
+        out["over_discharge_count"] = self.over_discharge_count
+        out["max_current"] = self.max_current
+        out["nominal_voltage"] = self.nominal_voltage
+        out["is_powering_off"] = self.is_powering_off
+        out["battery_id"] = self.battery_id
         return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> BatteryInfoAux:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'timestamp', 'voltage_cell', 'cycle_count', 'over_discharge_count', 'max_current', 'nominal_voltage', 'is_powering_off', 'battery_id'}), (), 'BatteryInfoAux')
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "timestamp",
+                    "voltage_cell",
+                    "cycle_count",
+                    "over_discharge_count",
+                    "max_current",
+                    "nominal_voltage",
+                    "is_powering_off",
+                    "battery_id",
+                }
+            ),
+            (),
+            "BatteryInfoAux",
+        )
         obj = cls()
-        if 'timestamp' in data:
-            obj.timestamp = _m.as_object(data['timestamp'], 'timestamp', _cls_Timestamp())
-        if 'voltage_cell' in data:
-            obj.voltage_cell = _m.as_list(data['voltage_cell'], 'voltage_cell', 255, False, lambda item, p: _m.as_float(item, p))
-        if 'cycle_count' in data:
-            obj.cycle_count = _m.as_int(data['cycle_count'], 'cycle_count')
-        if 'over_discharge_count' in data:
-            obj.over_discharge_count = _m.as_int(data['over_discharge_count'], 'over_discharge_count')
-        if 'max_current' in data:
-            obj.max_current = _m.as_float(data['max_current'], 'max_current')
-        if 'nominal_voltage' in data:
-            obj.nominal_voltage = _m.as_float(data['nominal_voltage'], 'nominal_voltage')
-        if 'is_powering_off' in data:
-            obj.is_powering_off = _m.as_bool(data['is_powering_off'], 'is_powering_off')
-        if 'battery_id' in data:
-            obj.battery_id = _m.as_int(data['battery_id'], 'battery_id')
+        if "timestamp" in data:
+            obj.timestamp = _m.as_object(data["timestamp"], "timestamp", _timestamp_class())
+        if "voltage_cell" in data:
+            obj.voltage_cell = _m.as_list(
+                data["voltage_cell"], "voltage_cell", 255, False, lambda item, p: _m.as_float(item, p)
+            )
+        if "cycle_count" in data:
+            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+        if "over_discharge_count" in data:
+            obj.over_discharge_count = _m.as_int(data["over_discharge_count"], "over_discharge_count")
+        if "max_current" in data:
+            obj.max_current = _m.as_float(data["max_current"], "max_current")
+        if "nominal_voltage" in data:
+            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+        if "is_powering_off" in data:
+            obj.is_powering_off = _m.as_bool(data["is_powering_off"], "is_powering_off")
+        if "battery_id" in data:
+            obj.battery_id = _m.as_int(data["battery_id"], "battery_id")
         return obj
 
     DATA_TYPE_ID: ClassVar[int | None] = 20004
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x7d7f49fc75484882
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x7D7F49FC75484882
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
         r1 = self.timestamp.usec
-        p2 = (r1 & 0xffffffffffffff)
-        head = _DC_BatteryInfoAux_1.pack((p2 & 0xffffffff), ((p2 >> 32) & 0xffff), ((p2 >> 48) & 0xff))
-        acc = 0x100000000000000 | int.from_bytes(head, 'big')
+        p2 = r1 & 0xFFFFFFFFFFFFFF
+        head = _DC_BatteryInfoAux_1.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
+        acc = 0x100000000000000 | int.from_bytes(head, "big")
         x3 = self.voltage_cell
         k4 = len(x3)
         if k4 > 255:
-            raise _dc.EncodeError('BatteryInfoAux.voltage_cell: length ' + str(k4) + ' exceeds capacity 255')
+            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
         acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f'<{k4}H', *[_dc.f16s(e5) for e5 in x3]), 'big')
+        acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
-        g8, g9 = _DC_BatteryInfoAux_3.unpack(_DC_BatteryInfoAux_2.pack((r6 if -65504.0 <= r6 <= 65504.0 else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))), (r7 if -65504.0 <= r7 <= 65504.0 else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7)))))
+        g8, g9 = _DC_BatteryInfoAux_3.unpack(
+            _DC_BatteryInfoAux_2.pack(
+                (
+                    r6
+                    if -65504.0 <= r6 <= 65504.0
+                    else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))
+                ),
+                (
+                    r7
+                    if -65504.0 <= r7 <= 65504.0
+                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                ),
+            )
+        )
         h10 = (
             ((g8 - 0x37FFF000) >> 13)
             if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
         )
         h11 = (
             ((g9 - 0x37FFF000) >> 13)
             if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
         )
         r12 = self.cycle_count
         r13 = self.over_discharge_count
         r14 = self.is_powering_off
-        p15 = (1 if r14 else 0)
+        p15 = 1 if r14 else 0
         r16 = self.battery_id
-        p17 = (r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0))
-        acc = (acc << 73) | (int.from_bytes(_DC_BatteryInfoAux_4.pack((r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)), (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)), h10, h11, (p15 << 7) | ((p17 & 0x1) << 15) | ((p17 >> 1) & 0x7f)), 'big') >> 7)
+        p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
+        acc = (acc << 73) | (
+            int.from_bytes(
+                _DC_BatteryInfoAux_4.pack(
+                    (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
+                    (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
+                    h10,
+                    h11,
+                    (p15 << 7) | ((p17 & 0x1) << 15) | ((p17 >> 1) & 0x7F),
+                ),
+                "big",
+            )
+            >> 7
+        )
         return _dc.finish(acc)
 
     @classmethod
@@ -169,63 +263,90 @@ class BatteryInfoAux:
         if n < 7:
             raise _dc.cut(_DC_BatteryInfoAux_5, n << 3)
         u1, u2, u3 = _DC_BatteryInfoAux_1.unpack_from(data)
-        x4 = (u1 | (u2 << 32) | (u3 << 48))
-        v = int.from_bytes(data, 'big')
+        x4 = u1 | (u2 << 32) | (u3 << 48)
+        v = int.from_bytes(data, "big")
         rem = (n << 3) - 56
         if rem < 8:
-            raise _dc.short('BatteryInfoAux.voltage_cell (length)', 8, rem)
+            raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
         rem -= 8
-        b6 = (v >> rem) & 0xff
+        b6 = (v >> rem) & 0xFF
         k5 = b6
         if k5 > 255:
-            raise _dc.DecodeError('BatteryInfoAux.voltage_cell: length ' + str(k5) + ' exceeds capacity 255')
+            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k5) + " exceeds capacity 255")
         n7 = k5 * 16
         if rem < n7:
-            raise _dc.short('BatteryInfoAux.voltage_cell', n7, rem)
+            raise _dc.short("BatteryInfoAux.voltage_cell", n7, rem)
         rem -= n7
-        f1 = list(struct.unpack(f'<{k5}e', ((v >> rem) & ((1 << n7) - 1)).to_bytes(n7 >> 3, 'big')))
+        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n7) - 1)).to_bytes(n7 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_DC_BatteryInfoAux_6, rem)
         rem -= 73
-        u8, u9, u10, u11, u12 = _DC_BatteryInfoAux_7.unpack((((v >> rem) & 0x1ffffffffffffffffff) << 7).to_bytes(10, 'big'))
-        x13 = (((u12 >> 7) & 0x1) != 0)
-        x14 = ((u12 >> 15) | ((u12 & 0x7f) << 1))
+        u8, u9, u10, u11, u12 = _DC_BatteryInfoAux_7.unpack(
+            (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
+        )
+        x13 = ((u12 >> 7) & 0x1) != 0
+        x14 = (u12 >> 15) | ((u12 & 0x7F) << 1)
         if rem >= 8:
-            raise _dc.DecodeError('BatteryInfoAux: ' + str(rem >> 3) + ' byte(s) beyond the end of the message')
-        return cls(_cls_Timestamp()(x4), f1, u8, u9, u10, u11, x13, x14)
+            raise _dc.DecodeError("BatteryInfoAux: " + str(rem >> 3) + " byte(s) beyond the end of the message")
+        return cls(_timestamp_class()(x4), f1, u8, u9, u10, u11, x13, x14)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         r1 = self.timestamp.usec
-        p2 = (r1 & 0xffffffffffffff)
-        acc = (acc << 56) | int.from_bytes(_DC_BatteryInfoAux_1.pack((p2 & 0xffffffff), ((p2 >> 32) & 0xffff), ((p2 >> 48) & 0xff)), 'big')
+        p2 = r1 & 0xFFFFFFFFFFFFFF
+        acc = (acc << 56) | int.from_bytes(
+            _DC_BatteryInfoAux_1.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
+        )
         x3 = self.voltage_cell
         k4 = len(x3)
         if k4 > 255:
-            raise _dc.EncodeError('BatteryInfoAux.voltage_cell: length ' + str(k4) + ' exceeds capacity 255')
+            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
         acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f'<{k4}H', *[_dc.f16s(e5) for e5 in x3]), 'big')
+        acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
-        g8, g9 = _DC_BatteryInfoAux_3.unpack(_DC_BatteryInfoAux_2.pack((r6 if -65504.0 <= r6 <= 65504.0 else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))), (r7 if -65504.0 <= r7 <= 65504.0 else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7)))))
+        g8, g9 = _DC_BatteryInfoAux_3.unpack(
+            _DC_BatteryInfoAux_2.pack(
+                (
+                    r6
+                    if -65504.0 <= r6 <= 65504.0
+                    else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))
+                ),
+                (
+                    r7
+                    if -65504.0 <= r7 <= 65504.0
+                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                ),
+            )
+        )
         h10 = (
             ((g8 - 0x37FFF000) >> 13)
             if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
         )
         h11 = (
             ((g9 - 0x37FFF000) >> 13)
             if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
         )
         r12 = self.cycle_count
         r13 = self.over_discharge_count
         r14 = self.is_powering_off
-        p15 = (1 if r14 else 0)
+        p15 = 1 if r14 else 0
         r16 = self.battery_id
-        p17 = (r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0))
-        acc = (acc << 73) | (int.from_bytes(_DC_BatteryInfoAux_4.pack((r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)), (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)), h10, h11, (p15 << 7) | ((p17 & 0x1) << 15) | ((p17 >> 1) & 0x7f)), 'big') >> 7)
+        p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
+        acc = (acc << 73) | (
+            int.from_bytes(
+                _DC_BatteryInfoAux_4.pack(
+                    (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
+                    (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
+                    h10,
+                    h11,
+                    (p15 << 7) | ((p17 & 0x1) << 15) | ((p17 >> 1) & 0x7F),
+                ),
+                "big",
+            )
+            >> 7
+        )
         return acc
 
     @classmethod
@@ -234,27 +355,29 @@ class BatteryInfoAux:
         if rem < 56:
             raise _dc.cut(_DC_BatteryInfoAux_5, rem)
         rem -= 56
-        u1, u2, u3 = _DC_BatteryInfoAux_1.unpack(((v >> rem) & 0xffffffffffffff).to_bytes(7, 'big'))
-        x4 = (u1 | (u2 << 32) | (u3 << 48))
+        u1, u2, u3 = _DC_BatteryInfoAux_1.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        x4 = u1 | (u2 << 32) | (u3 << 48)
         if rem < 8:
-            raise _dc.short('BatteryInfoAux.voltage_cell (length)', 8, rem)
+            raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
         rem -= 8
-        b6 = (v >> rem) & 0xff
+        b6 = (v >> rem) & 0xFF
         k5 = b6
         if k5 > 255:
-            raise _dc.DecodeError('BatteryInfoAux.voltage_cell: length ' + str(k5) + ' exceeds capacity 255')
+            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k5) + " exceeds capacity 255")
         n7 = k5 * 16
         if rem < n7:
-            raise _dc.short('BatteryInfoAux.voltage_cell', n7, rem)
+            raise _dc.short("BatteryInfoAux.voltage_cell", n7, rem)
         rem -= n7
-        f1 = list(struct.unpack(f'<{k5}e', ((v >> rem) & ((1 << n7) - 1)).to_bytes(n7 >> 3, 'big')))
+        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n7) - 1)).to_bytes(n7 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_DC_BatteryInfoAux_6, rem)
         rem -= 73
-        u8, u9, u10, u11, u12 = _DC_BatteryInfoAux_7.unpack((((v >> rem) & 0x1ffffffffffffffffff) << 7).to_bytes(10, 'big'))
-        x13 = (((u12 >> 7) & 0x1) != 0)
-        x14 = ((u12 >> 15) | ((u12 & 0x7f) << 1))
-        return cls(_cls_Timestamp()(x4), f1, u8, u9, u10, u11, x13, x14), rem
+        u8, u9, u10, u11, u12 = _DC_BatteryInfoAux_7.unpack(
+            (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
+        )
+        x13 = ((u12 >> 7) & 0x1) != 0
+        x14 = (u12 >> 15) | ((u12 & 0x7F) << 1)
+        return cls(_timestamp_class()(x4), f1, u8, u9, u10, u11, x13, x14), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -265,67 +388,76 @@ class BatteryInfoAux:
         sub: Any
         try:
             x = self.timestamp
-            if x.QUALIFIED_NAME != 'dronecan.uavcan.Timestamp':
-                _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryInfoAux_timestamp)
+            if x.QUALIFIED_NAME != "dronecan.uavcan.Timestamp":
+                _v.diag(out, "timestamp", self.timestamp, _VS_BatteryInfoAux_timestamp)
             else:
                 sub = x.validate()
                 if sub:
-                    out.extend(_v.prefixed('timestamp', sub))
+                    out.extend(_v.prefixed("timestamp", sub))
         except _v.SLOW:
-            _v.diag(out, 'timestamp', self.timestamp, _VS_BatteryInfoAux_timestamp)
+            _v.diag(out, "timestamp", self.timestamp, _VS_BatteryInfoAux_timestamp)
         try:
             a = self.voltage_cell
             if len(a) > 255:
-                _v.diag(out, 'voltage_cell', self.voltage_cell, _VS_BatteryInfoAux_voltage_cell)
+                _v.diag(out, "voltage_cell", self.voltage_cell, _VS_BatteryInfoAux_voltage_cell)
             else:
                 for e in a:
-                    if (not (-65504.0 <= e <= 65504.0)):
-                        _v.diag(out, 'voltage_cell', self.voltage_cell, _VS_BatteryInfoAux_voltage_cell)
+                    if not (-65504.0 <= e <= 65504.0):
+                        _v.diag(out, "voltage_cell", self.voltage_cell, _VS_BatteryInfoAux_voltage_cell)
                         break
         except _v.SLOW:
-            _v.diag(out, 'voltage_cell', self.voltage_cell, _VS_BatteryInfoAux_voltage_cell)
+            _v.diag(out, "voltage_cell", self.voltage_cell, _VS_BatteryInfoAux_voltage_cell)
         try:
-            if (self.cycle_count & -65536):
-                _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryInfoAux_cycle_count)
+            if self.cycle_count & -65536:
+                _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryInfoAux_cycle_count)
         except _v.SLOW:
-            _v.diag(out, 'cycle_count', self.cycle_count, _VS_BatteryInfoAux_cycle_count)
+            _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryInfoAux_cycle_count)
         try:
-            if (self.over_discharge_count & -65536):
-                _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryInfoAux_over_discharge_count)
+            if self.over_discharge_count & -65536:
+                _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryInfoAux_over_discharge_count)
         except _v.SLOW:
-            _v.diag(out, 'over_discharge_count', self.over_discharge_count, _VS_BatteryInfoAux_over_discharge_count)
+            _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryInfoAux_over_discharge_count)
         try:
-            if (not (-65504.0 <= self.max_current <= 65504.0)):
-                _v.diag(out, 'max_current', self.max_current, _VS_BatteryInfoAux_max_current)
+            if not (-65504.0 <= self.max_current <= 65504.0):
+                _v.diag(out, "max_current", self.max_current, _VS_BatteryInfoAux_max_current)
         except _v.SLOW:
-            _v.diag(out, 'max_current', self.max_current, _VS_BatteryInfoAux_max_current)
+            _v.diag(out, "max_current", self.max_current, _VS_BatteryInfoAux_max_current)
         try:
-            if (not (-65504.0 <= self.nominal_voltage <= 65504.0)):
-                _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryInfoAux_nominal_voltage)
+            if not (-65504.0 <= self.nominal_voltage <= 65504.0):
+                _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryInfoAux_nominal_voltage)
         except _v.SLOW:
-            _v.diag(out, 'nominal_voltage', self.nominal_voltage, _VS_BatteryInfoAux_nominal_voltage)
+            _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryInfoAux_nominal_voltage)
         try:
             x = self.is_powering_off
-            if (x is not True and x is not False):
-                _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryInfoAux_is_powering_off)
+            if x is not True and x is not False:
+                _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryInfoAux_is_powering_off)
         except _v.SLOW:
-            _v.diag(out, 'is_powering_off', self.is_powering_off, _VS_BatteryInfoAux_is_powering_off)
+            _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryInfoAux_is_powering_off)
         try:
-            if (self.battery_id & -256):
-                _v.diag(out, 'battery_id', self.battery_id, _VS_BatteryInfoAux_battery_id)
+            if self.battery_id & -256:
+                _v.diag(out, "battery_id", self.battery_id, _VS_BatteryInfoAux_battery_id)
         except _v.SLOW:
-            _v.diag(out, 'battery_id', self.battery_id, _VS_BatteryInfoAux_battery_id)
+            _v.diag(out, "battery_id", self.battery_id, _VS_BatteryInfoAux_battery_id)
         return out
 
     def check(self) -> None:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'dronecan.ardupilot.equipment.power.BatteryInfoAux')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "dronecan.ardupilot.equipment.power.BatteryInfoAux")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field in {'timestamp', 'voltage_cell', 'cycle_count', 'over_discharge_count', 'max_current', 'nominal_voltage', 'is_powering_off', 'battery_id'}:
+        if field in {
+            "timestamp",
+            "voltage_cell",
+            "cycle_count",
+            "over_discharge_count",
+            "max_current",
+            "nominal_voltage",
+            "is_powering_off",
+            "battery_id",
+        }:
             return True
-        raise KeyError(f'{field!r} is not a field of ' + 'dronecan.ardupilot.equipment.power.BatteryInfoAux')
+        raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryInfoAux")

@@ -13,11 +13,17 @@ import struct
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from .... import _meta as _m
 from .... import _dronecan as _dc
+from .... import _meta as _m
 from .... import _validate as _v
 
-__all__ = ['BatteryInfo', 'BatteryInfoStatusFlag', 'CircuitStatus', 'CircuitStatusErrorFlag', 'PrimaryPowerSupplyStatus']
+__all__ = [
+    "BatteryInfo",
+    "BatteryInfoStatusFlag",
+    "CircuitStatus",
+    "CircuitStatusErrorFlag",
+    "PrimaryPowerSupplyStatus",
+]
 
 
 class BatteryInfoStatusFlag(enum.IntFlag):
@@ -49,78 +55,156 @@ class CircuitStatusErrorFlag(enum.IntFlag):
     UNDERCURRENT = 8
 
 
-_DC_BatteryInfo_1 = struct.Struct('<7f')
+_DC_BatteryInfo_1 = struct.Struct("<7f")
 
 
-_DC_BatteryInfo_2 = struct.Struct('<7I')
+_DC_BatteryInfo_2 = struct.Struct("<7I")
 
 
-_DC_BatteryInfo_3 = struct.Struct('<HHHHHHHIBI')
+_DC_BatteryInfo_3 = struct.Struct("<HHHHHHHIBI")
 
 
-_DC_BatteryInfo_4 = ((16, 'BatteryInfo.temperature'), (32, 'BatteryInfo.voltage'), (48, 'BatteryInfo.current'), (64, 'BatteryInfo.average_power_10sec'), (80, 'BatteryInfo.remaining_capacity_wh'), (96, 'BatteryInfo.full_charge_capacity_wh'), (112, 'BatteryInfo.hours_to_full_charge'), (123, 'BatteryInfo.status_flags'), (130, 'BatteryInfo.state_of_health_pct'), (137, 'BatteryInfo.state_of_charge_pct'), (144, 'BatteryInfo.state_of_charge_pct_stdev'), (152, 'BatteryInfo.battery_id'), (184, 'BatteryInfo.model_instance_id'))
+_DC_BatteryInfo_4 = (
+    (16, "BatteryInfo.temperature"),
+    (32, "BatteryInfo.voltage"),
+    (48, "BatteryInfo.current"),
+    (64, "BatteryInfo.average_power_10sec"),
+    (80, "BatteryInfo.remaining_capacity_wh"),
+    (96, "BatteryInfo.full_charge_capacity_wh"),
+    (112, "BatteryInfo.hours_to_full_charge"),
+    (123, "BatteryInfo.status_flags"),
+    (130, "BatteryInfo.state_of_health_pct"),
+    (137, "BatteryInfo.state_of_charge_pct"),
+    (144, "BatteryInfo.state_of_charge_pct_stdev"),
+    (152, "BatteryInfo.battery_id"),
+    (184, "BatteryInfo.model_instance_id"),
+)
 
 
-_DC_BatteryInfo_5 = struct.Struct('<eeeeeeeIBI')
+_DC_BatteryInfo_5 = struct.Struct("<eeeeeeeIBI")
 
 
-_VS_BatteryInfo_temperature = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='K', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryInfo_voltage = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='V', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryInfo_current = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='A', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryInfo_average_power_10sec = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='W', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryInfo_remaining_capacity_wh = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Wh', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryInfo_full_charge_capacity_wh = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Wh', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryInfo_hours_to_full_charge = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='h', sentinel=math.nan, sentinel_text='NaN')
-_VS_BatteryInfo_status_flags = _v.Number(type='uint11', kind='uint', low=0, high=2047, mask=0x1ff, bits={0x1: 'STATUS_FLAG_IN_USE', 0x2: 'STATUS_FLAG_CHARGING', 0x4: 'STATUS_FLAG_CHARGED', 0x8: 'STATUS_FLAG_TEMP_HOT', 0x10: 'STATUS_FLAG_TEMP_COLD', 0x20: 'STATUS_FLAG_OVERLOAD', 0x40: 'STATUS_FLAG_BAD_BATTERY', 0x80: 'STATUS_FLAG_NEED_SERVICE', 0x100: 'STATUS_FLAG_BMS_ERROR', 0x200: 'STATUS_FLAG_RESERVED_A', 0x400: 'STATUS_FLAG_RESERVED_B'})
-_VS_BatteryInfo_state_of_health_pct = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%', sentinel=127, sentinel_text='STATE_OF_HEALTH_UNKNOWN')
-_VS_BatteryInfo_state_of_charge_pct = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%')
-_VS_BatteryInfo_state_of_charge_pct_stdev = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%')
-_VS_BatteryInfo_battery_id = _v.Number(type='uint8', kind='uint', low=0, high=255)
-_VS_BatteryInfo_model_instance_id = _v.Number(type='uint32', kind='uint', low=0, high=4294967295)
-_VS_BatteryInfo_model_name = _v.Array(_v.Number(type='uint8', kind='uint', low=0, high=255), 31, False, byte=True)
+_VS_BatteryInfo_temperature = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="K", sentinel=math.nan, sentinel_text="NaN"
+)
+_VS_BatteryInfo_voltage = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="V", sentinel=math.nan, sentinel_text="NaN"
+)
+_VS_BatteryInfo_current = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="A", sentinel=math.nan, sentinel_text="NaN"
+)
+_VS_BatteryInfo_average_power_10sec = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="W", sentinel=math.nan, sentinel_text="NaN"
+)
+_VS_BatteryInfo_remaining_capacity_wh = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="Wh", sentinel=math.nan, sentinel_text="NaN"
+)
+_VS_BatteryInfo_full_charge_capacity_wh = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="Wh", sentinel=math.nan, sentinel_text="NaN"
+)
+_VS_BatteryInfo_hours_to_full_charge = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="h", sentinel=math.nan, sentinel_text="NaN"
+)
+_VS_BatteryInfo_status_flags = _v.Number(
+    type="uint11",
+    kind="uint",
+    low=0,
+    high=2047,
+    mask=0x1FF,
+    bits={
+        0x1: "STATUS_FLAG_IN_USE",
+        0x2: "STATUS_FLAG_CHARGING",
+        0x4: "STATUS_FLAG_CHARGED",
+        0x8: "STATUS_FLAG_TEMP_HOT",
+        0x10: "STATUS_FLAG_TEMP_COLD",
+        0x20: "STATUS_FLAG_OVERLOAD",
+        0x40: "STATUS_FLAG_BAD_BATTERY",
+        0x80: "STATUS_FLAG_NEED_SERVICE",
+        0x100: "STATUS_FLAG_BMS_ERROR",
+        0x200: "STATUS_FLAG_RESERVED_A",
+        0x400: "STATUS_FLAG_RESERVED_B",
+    },
+)
+_VS_BatteryInfo_state_of_health_pct = _v.Number(
+    type="uint7", kind="uint", low=0, high=127, unit="%", sentinel=127, sentinel_text="STATE_OF_HEALTH_UNKNOWN"
+)
+_VS_BatteryInfo_state_of_charge_pct = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
+_VS_BatteryInfo_state_of_charge_pct_stdev = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
+_VS_BatteryInfo_battery_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_VS_BatteryInfo_model_instance_id = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+_VS_BatteryInfo_model_name = _v.Array(_v.Number(type="uint8", kind="uint", low=0, high=255), 31, False, byte=True)
 
 
-_DC_CircuitStatus_1 = struct.Struct('<2f')
+_DC_CircuitStatus_1 = struct.Struct("<2f")
 
 
-_DC_CircuitStatus_2 = struct.Struct('<2I')
+_DC_CircuitStatus_2 = struct.Struct("<2I")
 
 
-_DC_CircuitStatus_3 = struct.Struct('<HHHB')
+_DC_CircuitStatus_3 = struct.Struct("<HHHB")
 
 
-_DC_CircuitStatus_4 = ((16, 'CircuitStatus.circuit_id'), (32, 'CircuitStatus.voltage'), (48, 'CircuitStatus.current'), (56, 'CircuitStatus.error_flags'))
+_DC_CircuitStatus_4 = (
+    (16, "CircuitStatus.circuit_id"),
+    (32, "CircuitStatus.voltage"),
+    (48, "CircuitStatus.current"),
+    (56, "CircuitStatus.error_flags"),
+)
 
 
-_DC_CircuitStatus_5 = struct.Struct('<HeeB')
+_DC_CircuitStatus_5 = struct.Struct("<HeeB")
 
 
-_VS_CircuitStatus_circuit_id = _v.Number(type='uint16', kind='uint', low=0, high=65535)
-_VS_CircuitStatus_voltage = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='V')
-_VS_CircuitStatus_current = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='A')
-_VS_CircuitStatus_error_flags = _v.Number(type='uint8', kind='uint', low=0, high=255, mask=0xf, bits={0x1: 'ERROR_FLAG_OVERVOLTAGE', 0x2: 'ERROR_FLAG_UNDERVOLTAGE', 0x4: 'ERROR_FLAG_OVERCURRENT', 0x8: 'ERROR_FLAG_UNDERCURRENT'})
+_VS_CircuitStatus_circuit_id = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_VS_CircuitStatus_voltage = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V")
+_VS_CircuitStatus_current = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="A")
+_VS_CircuitStatus_error_flags = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    mask=0xF,
+    bits={
+        0x1: "ERROR_FLAG_OVERVOLTAGE",
+        0x2: "ERROR_FLAG_UNDERVOLTAGE",
+        0x4: "ERROR_FLAG_OVERCURRENT",
+        0x8: "ERROR_FLAG_UNDERCURRENT",
+    },
+)
 
 
-_DC_PrimaryPowerSupplyStatus_1 = struct.Struct('<2f')
+_DC_PrimaryPowerSupplyStatus_1 = struct.Struct("<2f")
 
 
-_DC_PrimaryPowerSupplyStatus_2 = struct.Struct('<2I')
+_DC_PrimaryPowerSupplyStatus_2 = struct.Struct("<2I")
 
 
-_DC_PrimaryPowerSupplyStatus_3 = struct.Struct('<HHH')
+_DC_PrimaryPowerSupplyStatus_3 = struct.Struct("<HHH")
 
 
-_DC_PrimaryPowerSupplyStatus_4 = ((16, 'PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power'), (32, 'PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power_variance'), (33, 'PrimaryPowerSupplyStatus.external_power_available'), (40, 'PrimaryPowerSupplyStatus.remaining_energy_pct'), (47, 'PrimaryPowerSupplyStatus.remaining_energy_pct_stdev'))
+_DC_PrimaryPowerSupplyStatus_4 = (
+    (16, "PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power"),
+    (32, "PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power_variance"),
+    (33, "PrimaryPowerSupplyStatus.external_power_available"),
+    (40, "PrimaryPowerSupplyStatus.remaining_energy_pct"),
+    (47, "PrimaryPowerSupplyStatus.remaining_energy_pct_stdev"),
+)
 
 
-_DC_PrimaryPowerSupplyStatus_5 = struct.Struct('<eeH')
+_DC_PrimaryPowerSupplyStatus_5 = struct.Struct("<eeH")
 
 
-_VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='h')
-_VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance = _v.Number(type='float16', kind='float', low=-65504.0, high=65504.0, unit='Hours^2')
-_VS_PrimaryPowerSupplyStatus_external_power_available = _v.Number(type='bool', kind='bool', low=0, high=1)
-_VS_PrimaryPowerSupplyStatus_remaining_energy_pct = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%')
-_VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev = _v.Number(type='uint7', kind='uint', low=0, high=127, unit='%')
+_VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="h"
+)
+_VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="Hours^2"
+)
+_VS_PrimaryPowerSupplyStatus_external_power_available = _v.Number(type="bool", kind="bool", low=0, high=1)
+_VS_PrimaryPowerSupplyStatus_remaining_energy_pct = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
+_VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev = _v.Number(
+    type="uint7", kind="uint", low=0, high=127, unit="%"
+)
 
 
 @dataclasses.dataclass(slots=True)
@@ -132,7 +216,7 @@ class BatteryInfo:
     Schema: dronecan.uavcan.equipment.power.BatteryInfo (dronecan, uavcan/equipment/power/1092.BatteryInfo.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'dronecan.uavcan.equipment.power.BatteryInfo'
+    QUALIFIED_NAME: ClassVar[str] = "dronecan.uavcan.equipment.power.BatteryInfo"
     STATUS_FLAG_IN_USE: ClassVar[int] = 1
     STATUS_FLAG_CHARGING: ClassVar[int] = 2
     STATUS_FLAG_CHARGED: ClassVar[int] = 4
@@ -146,20 +230,139 @@ class BatteryInfo:
     STATUS_FLAG_RESERVED_B: ClassVar[int] = 1024
     STATE_OF_HEALTH_UNKNOWN: ClassVar[int] = 127
 
-    temperature: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='temperature', type='float16', unit='K', quantity='temperature', invalid=math.nan, invalid_text='NaN', doc='Measurements. Unknown values are NAN.'))
-    voltage: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='voltage', type='float16', unit='V', quantity='voltage', invalid=math.nan, invalid_text='NaN'))
-    current: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='current', type='float16', unit='A', quantity='current', invalid=math.nan, invalid_text='NaN'))
-    average_power_10sec: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='average_power_10sec', type='float16', unit='W', quantity='power', invalid=math.nan, invalid_text='NaN', doc='Mean power over the last 10 s'))
-    remaining_capacity_wh: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='remaining_capacity_wh', type='float16', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, invalid=math.nan, invalid_text='NaN', doc='Energy left; grows while charging'))
-    full_charge_capacity_wh: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='full_charge_capacity_wh', type='float16', unit='Wh', quantity='energy', scale=3600.0, offset=0.0, invalid=math.nan, invalid_text='NaN', doc='Energy when full; shrinks as the battery ages'))
-    hours_to_full_charge: float = dataclasses.field(default=math.nan, metadata=_m.meta(name='hours_to_full_charge', type='float16', unit='h', quantity='time', scale=3600.0, offset=0.0, invalid=math.nan, invalid_text='NaN', doc='Time until charged; zero when not charging'))
-    status_flags: int = dataclasses.field(default=0, metadata=_m.meta(name='status_flags', type='uint11', enums=('dronecan.uavcan.equipment.power.BatteryInfo.STATUS_FLAG',)))
-    state_of_health_pct: int = dataclasses.field(default=127, metadata=_m.meta(name='state_of_health_pct', type='uint7', unit='%', quantity='ratio', scale=0.01, offset=0.0, invalid=127, invalid_text='STATE_OF_HEALTH_UNKNOWN', doc='Optional'))
-    state_of_charge_pct: int = dataclasses.field(default=0, metadata=_m.meta(name='state_of_charge_pct', type='uint7', unit='%', quantity='ratio', scale=0.01, offset=0.0, doc='State of charge.\nRequired'))
-    state_of_charge_pct_stdev: int = dataclasses.field(default=0, metadata=_m.meta(name='state_of_charge_pct_stdev', type='uint7', unit='%', quantity='ratio', scale=0.01, offset=0.0, doc='Standard deviation of the estimate'))
-    battery_id: int = dataclasses.field(default=0, metadata=_m.meta(name='battery_id', type='uint8', doc='Identity.\nWhich battery of this vehicle (0 = main)'))
-    model_instance_id: int = dataclasses.field(default=0, metadata=_m.meta(name='model_instance_id', type='uint32', doc='Serial number within the model; zero if none'))
-    model_name: bytes = dataclasses.field(default=b'', metadata=_m.meta(name='model_name', type='uint8[<=31]', doc='Vendor, model and chemistry, as text'))
+    temperature: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="temperature",
+            type="float16",
+            unit="K",
+            quantity="temperature",
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Measurements. Unknown values are NAN.",
+        ),
+    )
+    voltage: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="voltage", type="float16", unit="V", quantity="voltage", invalid=math.nan, invalid_text="NaN"
+        ),
+    )
+    current: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="current", type="float16", unit="A", quantity="current", invalid=math.nan, invalid_text="NaN"
+        ),
+    )
+    average_power_10sec: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="average_power_10sec",
+            type="float16",
+            unit="W",
+            quantity="power",
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Mean power over the last 10 s",
+        ),
+    )
+    remaining_capacity_wh: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="remaining_capacity_wh",
+            type="float16",
+            unit="Wh",
+            quantity="energy",
+            scale=3600.0,
+            offset=0.0,
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Energy left; grows while charging",
+        ),
+    )
+    full_charge_capacity_wh: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="full_charge_capacity_wh",
+            type="float16",
+            unit="Wh",
+            quantity="energy",
+            scale=3600.0,
+            offset=0.0,
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Energy when full; shrinks as the battery ages",
+        ),
+    )
+    hours_to_full_charge: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="hours_to_full_charge",
+            type="float16",
+            unit="h",
+            quantity="time",
+            scale=3600.0,
+            offset=0.0,
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Time until charged; zero when not charging",
+        ),
+    )
+    status_flags: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="status_flags", type="uint11", enums=("dronecan.uavcan.equipment.power.BatteryInfo.STATUS_FLAG",)
+        ),
+    )
+    state_of_health_pct: int = dataclasses.field(
+        default=127,
+        metadata=_m.meta(
+            name="state_of_health_pct",
+            type="uint7",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            invalid=127,
+            invalid_text="STATE_OF_HEALTH_UNKNOWN",
+            doc="Optional",
+        ),
+    )
+    state_of_charge_pct: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="state_of_charge_pct",
+            type="uint7",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            doc="State of charge.\nRequired",
+        ),
+    )
+    state_of_charge_pct_stdev: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="state_of_charge_pct_stdev",
+            type="uint7",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            doc="Standard deviation of the estimate",
+        ),
+    )
+    battery_id: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(name="battery_id", type="uint8", doc="Identity.\nWhich battery of this vehicle (0 = main)"),
+    )
+    model_instance_id: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(name="model_instance_id", type="uint32", doc="Serial number within the model; zero if none"),
+    )
+    model_name: bytes = dataclasses.field(
+        default=b"", metadata=_m.meta(name="model_name", type="uint8[<=31]", doc="Vendor, model and chemistry, as text")
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -170,59 +373,81 @@ class BatteryInfo:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['temperature'] = self.temperature
-        out['voltage'] = self.voltage
-        out['current'] = self.current
-        out['average_power_10sec'] = self.average_power_10sec
-        out['remaining_capacity_wh'] = self.remaining_capacity_wh
-        out['full_charge_capacity_wh'] = self.full_charge_capacity_wh
-        out['hours_to_full_charge'] = self.hours_to_full_charge
-        out['status_flags'] = self.status_flags
-        out['state_of_health_pct'] = self.state_of_health_pct
-        out['state_of_charge_pct'] = self.state_of_charge_pct
-        out['state_of_charge_pct_stdev'] = self.state_of_charge_pct_stdev
-        out['battery_id'] = self.battery_id
-        out['model_instance_id'] = self.model_instance_id
-        out['model_name'] = list(self.model_name)
+        out["temperature"] = self.temperature
+        out["voltage"] = self.voltage
+        out["current"] = self.current
+        out["average_power_10sec"] = self.average_power_10sec
+        out["remaining_capacity_wh"] = self.remaining_capacity_wh
+        out["full_charge_capacity_wh"] = self.full_charge_capacity_wh
+        out["hours_to_full_charge"] = self.hours_to_full_charge
+        out["status_flags"] = self.status_flags
+        out["state_of_health_pct"] = self.state_of_health_pct
+        out["state_of_charge_pct"] = self.state_of_charge_pct
+        out["state_of_charge_pct_stdev"] = self.state_of_charge_pct_stdev
+        out["battery_id"] = self.battery_id
+        out["model_instance_id"] = self.model_instance_id
+        out["model_name"] = list(self.model_name)
         return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> BatteryInfo:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'temperature', 'voltage', 'current', 'average_power_10sec', 'remaining_capacity_wh', 'full_charge_capacity_wh', 'hours_to_full_charge', 'status_flags', 'state_of_health_pct', 'state_of_charge_pct', 'state_of_charge_pct_stdev', 'battery_id', 'model_instance_id', 'model_name'}), (), 'BatteryInfo')
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "temperature",
+                    "voltage",
+                    "current",
+                    "average_power_10sec",
+                    "remaining_capacity_wh",
+                    "full_charge_capacity_wh",
+                    "hours_to_full_charge",
+                    "status_flags",
+                    "state_of_health_pct",
+                    "state_of_charge_pct",
+                    "state_of_charge_pct_stdev",
+                    "battery_id",
+                    "model_instance_id",
+                    "model_name",
+                }
+            ),
+            (),
+            "BatteryInfo",
+        )
         obj = cls()
-        if 'temperature' in data:
-            obj.temperature = _m.as_float(data['temperature'], 'temperature')
-        if 'voltage' in data:
-            obj.voltage = _m.as_float(data['voltage'], 'voltage')
-        if 'current' in data:
-            obj.current = _m.as_float(data['current'], 'current')
-        if 'average_power_10sec' in data:
-            obj.average_power_10sec = _m.as_float(data['average_power_10sec'], 'average_power_10sec')
-        if 'remaining_capacity_wh' in data:
-            obj.remaining_capacity_wh = _m.as_float(data['remaining_capacity_wh'], 'remaining_capacity_wh')
-        if 'full_charge_capacity_wh' in data:
-            obj.full_charge_capacity_wh = _m.as_float(data['full_charge_capacity_wh'], 'full_charge_capacity_wh')
-        if 'hours_to_full_charge' in data:
-            obj.hours_to_full_charge = _m.as_float(data['hours_to_full_charge'], 'hours_to_full_charge')
-        if 'status_flags' in data:
-            obj.status_flags = _m.as_int(data['status_flags'], 'status_flags')
-        if 'state_of_health_pct' in data:
-            obj.state_of_health_pct = _m.as_int(data['state_of_health_pct'], 'state_of_health_pct')
-        if 'state_of_charge_pct' in data:
-            obj.state_of_charge_pct = _m.as_int(data['state_of_charge_pct'], 'state_of_charge_pct')
-        if 'state_of_charge_pct_stdev' in data:
-            obj.state_of_charge_pct_stdev = _m.as_int(data['state_of_charge_pct_stdev'], 'state_of_charge_pct_stdev')
-        if 'battery_id' in data:
-            obj.battery_id = _m.as_int(data['battery_id'], 'battery_id')
-        if 'model_instance_id' in data:
-            obj.model_instance_id = _m.as_int(data['model_instance_id'], 'model_instance_id')
-        if 'model_name' in data:
-            obj.model_name = _m.as_bytes(data['model_name'], 'model_name', 31, False)
+        if "temperature" in data:
+            obj.temperature = _m.as_float(data["temperature"], "temperature")
+        if "voltage" in data:
+            obj.voltage = _m.as_float(data["voltage"], "voltage")
+        if "current" in data:
+            obj.current = _m.as_float(data["current"], "current")
+        if "average_power_10sec" in data:
+            obj.average_power_10sec = _m.as_float(data["average_power_10sec"], "average_power_10sec")
+        if "remaining_capacity_wh" in data:
+            obj.remaining_capacity_wh = _m.as_float(data["remaining_capacity_wh"], "remaining_capacity_wh")
+        if "full_charge_capacity_wh" in data:
+            obj.full_charge_capacity_wh = _m.as_float(data["full_charge_capacity_wh"], "full_charge_capacity_wh")
+        if "hours_to_full_charge" in data:
+            obj.hours_to_full_charge = _m.as_float(data["hours_to_full_charge"], "hours_to_full_charge")
+        if "status_flags" in data:
+            obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
+        if "state_of_health_pct" in data:
+            obj.state_of_health_pct = _m.as_int(data["state_of_health_pct"], "state_of_health_pct")
+        if "state_of_charge_pct" in data:
+            obj.state_of_charge_pct = _m.as_int(data["state_of_charge_pct"], "state_of_charge_pct")
+        if "state_of_charge_pct_stdev" in data:
+            obj.state_of_charge_pct_stdev = _m.as_int(data["state_of_charge_pct_stdev"], "state_of_charge_pct_stdev")
+        if "battery_id" in data:
+            obj.battery_id = _m.as_int(data["battery_id"], "battery_id")
+        if "model_instance_id" in data:
+            obj.model_instance_id = _m.as_int(data["model_instance_id"], "model_instance_id")
+        if "model_name" in data:
+            obj.model_name = _m.as_bytes(data["model_name"], "model_name", 31, False)
         return obj
 
     DATA_TYPE_ID: ClassVar[int | None] = 1092
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x249c26548a711966
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x249C26548A711966
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -233,73 +458,121 @@ class BatteryInfo:
         r5 = self.remaining_capacity_wh
         r6 = self.full_charge_capacity_wh
         r7 = self.hours_to_full_charge
-        g8, g9, g10, g11, g12, g13, g14 = _DC_BatteryInfo_2.unpack(_DC_BatteryInfo_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))), (r3 if -65504.0 <= r3 <= 65504.0 else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))), (r4 if -65504.0 <= r4 <= 65504.0 else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))), (r5 if -65504.0 <= r5 <= 65504.0 else (65504.0 if r5 > 65504.0 else (-65504.0 if r5 < -65504.0 else r5))), (r6 if -65504.0 <= r6 <= 65504.0 else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))), (r7 if -65504.0 <= r7 <= 65504.0 else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7)))))
+        g8, g9, g10, g11, g12, g13, g14 = _DC_BatteryInfo_2.unpack(
+            _DC_BatteryInfo_1.pack(
+                (
+                    r1
+                    if -65504.0 <= r1 <= 65504.0
+                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                ),
+                (
+                    r2
+                    if -65504.0 <= r2 <= 65504.0
+                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                ),
+                (
+                    r3
+                    if -65504.0 <= r3 <= 65504.0
+                    else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))
+                ),
+                (
+                    r4
+                    if -65504.0 <= r4 <= 65504.0
+                    else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))
+                ),
+                (
+                    r5
+                    if -65504.0 <= r5 <= 65504.0
+                    else (65504.0 if r5 > 65504.0 else (-65504.0 if r5 < -65504.0 else r5))
+                ),
+                (
+                    r6
+                    if -65504.0 <= r6 <= 65504.0
+                    else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))
+                ),
+                (
+                    r7
+                    if -65504.0 <= r7 <= 65504.0
+                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                ),
+            )
+        )
         h15 = (
             ((g8 - 0x37FFF000) >> 13)
             if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
         )
         h16 = (
             ((g9 - 0x37FFF000) >> 13)
             if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
         )
         h17 = (
             ((g10 - 0x37FFF000) >> 13)
             if 0x38800000 <= g10 < 0x477FF000
-            else (((g10 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
+            else (((g10 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
         )
         h18 = (
             ((g11 - 0x37FFF000) >> 13)
             if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
         )
         h19 = (
             ((g12 - 0x37FFF000) >> 13)
             if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
         )
         h20 = (
             ((g13 - 0x37FFF000) >> 13)
             if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
         )
         h21 = (
             ((g14 - 0x37FFF000) >> 13)
             if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
         )
         r22 = self.status_flags
-        p23 = (r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0))
+        p23 = r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0)
         r24 = self.state_of_health_pct
-        p25 = (r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0))
+        p25 = r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0)
         r26 = self.state_of_charge_pct
-        p27 = (r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0))
+        p27 = r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0)
         r28 = self.state_of_charge_pct_stdev
-        p29 = (r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0))
+        p29 = r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0)
         r30 = self.battery_id
         r31 = self.model_instance_id
-        head = _DC_BatteryInfo_3.pack(h15, h16, h17, h18, h19, h20, h21, (p23 & 0xff) | (((p23 >> 8) & 0x7) << 13) | ((p25 & 0x3) << 22) | (((p25 >> 2) & 0x1f) << 8) | ((p27 & 0x1) << 31) | (((p27 >> 1) & 0x3f) << 16) | (p29 << 24), (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)), (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0)))
+        head = _DC_BatteryInfo_3.pack(
+            h15,
+            h16,
+            h17,
+            h18,
+            h19,
+            h20,
+            h21,
+            (p23 & 0xFF)
+            | (((p23 >> 8) & 0x7) << 13)
+            | ((p25 & 0x3) << 22)
+            | (((p25 >> 2) & 0x1F) << 8)
+            | ((p27 & 0x1) << 31)
+            | (((p27 >> 1) & 0x3F) << 16)
+            | (p29 << 24),
+            (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)),
+            (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0)),
+        )
         if tao:
             x32 = self.model_name
             if len(x32) > 31:
-                raise _dc.EncodeError('BatteryInfo.model_name: length ' + str(len(x32)) + ' exceeds capacity 31')
+                raise _dc.EncodeError("BatteryInfo.model_name: length " + str(len(x32)) + " exceeds capacity 31")
             return head + bytes(x32)
-        acc = 0x10000000000000000000000000000000000000000000000 | int.from_bytes(head, 'big')
+        acc = 0x10000000000000000000000000000000000000000000000 | int.from_bytes(head, "big")
         x33 = self.model_name
         k34 = len(x33)
         if k34 > 31:
-            raise _dc.EncodeError('BatteryInfo.model_name: length ' + str(k34) + ' exceeds capacity 31')
+            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k34) + " exceeds capacity 31")
         if not tao:
             acc = (acc << 5) | k34
-        acc = (acc << (k34 << 3)) | int.from_bytes(x33, 'big')
+        acc = (acc << (k34 << 3)) | int.from_bytes(x33, "big")
         return _dc.finish(acc)
 
     @classmethod
@@ -310,44 +583,44 @@ class BatteryInfo:
         if n < 23:
             raise _dc.cut(_DC_BatteryInfo_4, n << 3)
         u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _DC_BatteryInfo_5.unpack_from(data)
-        x11 = ((u8 & 0xff) | (((u8 >> 13) & 0x7) << 8))
-        x12 = (((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1f) << 2))
-        x13 = ((u8 >> 31) | (((u8 >> 16) & 0x3f) << 1))
-        x14 = ((u8 >> 24) & 0x7f)
+        x11 = (u8 & 0xFF) | (((u8 >> 13) & 0x7) << 8)
+        x12 = ((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1F) << 2)
+        x13 = (u8 >> 31) | (((u8 >> 16) & 0x3F) << 1)
+        x14 = (u8 >> 24) & 0x7F
         if tao:
             f13 = bytes(data[23:])
             k15 = len(f13)
             if k15 > 31:
-                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k15) + ' exceeds capacity 31')
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
             return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
-        v = int.from_bytes(data, 'big')
+        v = int.from_bytes(data, "big")
         rem = (n << 3) - 184
         if tao:
             k16 = rem // 8
             if rem - k16 * 8 >= 8:
-                raise _dc.DecodeError('BatteryInfo.model_name: input ends inside an element')
+                raise _dc.DecodeError("BatteryInfo.model_name: input ends inside an element")
             if k16 > 31:
-                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k16) + ' exceeds capacity 31')
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k16) + " exceeds capacity 31")
             n17 = k16 * 8
             if rem < n17:
-                raise _dc.short('BatteryInfo.model_name', n17, rem)
+                raise _dc.short("BatteryInfo.model_name", n17, rem)
             rem -= n17
-            f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k16, 'big')
+            f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k16, "big")
         else:
             if rem < 5:
-                raise _dc.short('BatteryInfo.model_name (length)', 5, rem)
+                raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
             rem -= 5
-            b18 = (v >> rem) & 0x1f
+            b18 = (v >> rem) & 0x1F
             k16 = b18
             if k16 > 31:
-                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k16) + ' exceeds capacity 31')
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k16) + " exceeds capacity 31")
             n19 = k16 * 8
             if rem < n19:
-                raise _dc.short('BatteryInfo.model_name', n19, rem)
+                raise _dc.short("BatteryInfo.model_name", n19, rem)
             rem -= n19
-            f13 = ((v >> rem) & ((1 << n19) - 1)).to_bytes(k16, 'big')
+            f13 = ((v >> rem) & ((1 << n19) - 1)).to_bytes(k16, "big")
         if rem >= 8:
-            raise _dc.DecodeError('BatteryInfo: ' + str(rem >> 3) + ' byte(s) beyond the end of the message')
+            raise _dc.DecodeError("BatteryInfo: " + str(rem >> 3) + " byte(s) beyond the end of the message")
         return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
@@ -358,67 +631,118 @@ class BatteryInfo:
         r5 = self.remaining_capacity_wh
         r6 = self.full_charge_capacity_wh
         r7 = self.hours_to_full_charge
-        g8, g9, g10, g11, g12, g13, g14 = _DC_BatteryInfo_2.unpack(_DC_BatteryInfo_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))), (r3 if -65504.0 <= r3 <= 65504.0 else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))), (r4 if -65504.0 <= r4 <= 65504.0 else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))), (r5 if -65504.0 <= r5 <= 65504.0 else (65504.0 if r5 > 65504.0 else (-65504.0 if r5 < -65504.0 else r5))), (r6 if -65504.0 <= r6 <= 65504.0 else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))), (r7 if -65504.0 <= r7 <= 65504.0 else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7)))))
+        g8, g9, g10, g11, g12, g13, g14 = _DC_BatteryInfo_2.unpack(
+            _DC_BatteryInfo_1.pack(
+                (
+                    r1
+                    if -65504.0 <= r1 <= 65504.0
+                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                ),
+                (
+                    r2
+                    if -65504.0 <= r2 <= 65504.0
+                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                ),
+                (
+                    r3
+                    if -65504.0 <= r3 <= 65504.0
+                    else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))
+                ),
+                (
+                    r4
+                    if -65504.0 <= r4 <= 65504.0
+                    else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))
+                ),
+                (
+                    r5
+                    if -65504.0 <= r5 <= 65504.0
+                    else (65504.0 if r5 > 65504.0 else (-65504.0 if r5 < -65504.0 else r5))
+                ),
+                (
+                    r6
+                    if -65504.0 <= r6 <= 65504.0
+                    else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))
+                ),
+                (
+                    r7
+                    if -65504.0 <= r7 <= 65504.0
+                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                ),
+            )
+        )
         h15 = (
             ((g8 - 0x37FFF000) >> 13)
             if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
         )
         h16 = (
             ((g9 - 0x37FFF000) >> 13)
             if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
         )
         h17 = (
             ((g10 - 0x37FFF000) >> 13)
             if 0x38800000 <= g10 < 0x477FF000
-            else (((g10 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
+            else (((g10 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
         )
         h18 = (
             ((g11 - 0x37FFF000) >> 13)
             if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
         )
         h19 = (
             ((g12 - 0x37FFF000) >> 13)
             if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
         )
         h20 = (
             ((g13 - 0x37FFF000) >> 13)
             if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
         )
         h21 = (
             ((g14 - 0x37FFF000) >> 13)
             if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
         )
         r22 = self.status_flags
-        p23 = (r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0))
+        p23 = r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0)
         r24 = self.state_of_health_pct
-        p25 = (r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0))
+        p25 = r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0)
         r26 = self.state_of_charge_pct
-        p27 = (r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0))
+        p27 = r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0)
         r28 = self.state_of_charge_pct_stdev
-        p29 = (r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0))
+        p29 = r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0)
         r30 = self.battery_id
         r31 = self.model_instance_id
-        acc = (acc << 184) | int.from_bytes(_DC_BatteryInfo_3.pack(h15, h16, h17, h18, h19, h20, h21, (p23 & 0xff) | (((p23 >> 8) & 0x7) << 13) | ((p25 & 0x3) << 22) | (((p25 >> 2) & 0x1f) << 8) | ((p27 & 0x1) << 31) | (((p27 >> 1) & 0x3f) << 16) | (p29 << 24), (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)), (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0))), 'big')
+        acc = (acc << 184) | int.from_bytes(
+            _DC_BatteryInfo_3.pack(
+                h15,
+                h16,
+                h17,
+                h18,
+                h19,
+                h20,
+                h21,
+                (p23 & 0xFF)
+                | (((p23 >> 8) & 0x7) << 13)
+                | ((p25 & 0x3) << 22)
+                | (((p25 >> 2) & 0x1F) << 8)
+                | ((p27 & 0x1) << 31)
+                | (((p27 >> 1) & 0x3F) << 16)
+                | (p29 << 24),
+                (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)),
+                (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0)),
+            ),
+            "big",
+        )
         x32 = self.model_name
         k33 = len(x32)
         if k33 > 31:
-            raise _dc.EncodeError('BatteryInfo.model_name: length ' + str(k33) + ' exceeds capacity 31')
+            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k33) + " exceeds capacity 31")
         if not tao:
             acc = (acc << 5) | k33
-        acc = (acc << (k33 << 3)) | int.from_bytes(x32, 'big')
+        acc = (acc << (k33 << 3)) | int.from_bytes(x32, "big")
         return acc
 
     @classmethod
@@ -427,35 +751,37 @@ class BatteryInfo:
         if rem < 184:
             raise _dc.cut(_DC_BatteryInfo_4, rem)
         rem -= 184
-        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _DC_BatteryInfo_5.unpack(((v >> rem) & 0xffffffffffffffffffffffffffffffffffffffffffffff).to_bytes(23, 'big'))
-        x11 = ((u8 & 0xff) | (((u8 >> 13) & 0x7) << 8))
-        x12 = (((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1f) << 2))
-        x13 = ((u8 >> 31) | (((u8 >> 16) & 0x3f) << 1))
-        x14 = ((u8 >> 24) & 0x7f)
+        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _DC_BatteryInfo_5.unpack(
+            ((v >> rem) & 0xFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF).to_bytes(23, "big")
+        )
+        x11 = (u8 & 0xFF) | (((u8 >> 13) & 0x7) << 8)
+        x12 = ((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1F) << 2)
+        x13 = (u8 >> 31) | (((u8 >> 16) & 0x3F) << 1)
+        x14 = (u8 >> 24) & 0x7F
         if tao:
             k15 = rem // 8
             if rem - k15 * 8 >= 8:
-                raise _dc.DecodeError('BatteryInfo.model_name: input ends inside an element')
+                raise _dc.DecodeError("BatteryInfo.model_name: input ends inside an element")
             if k15 > 31:
-                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k15) + ' exceeds capacity 31')
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
             n16 = k15 * 8
             if rem < n16:
-                raise _dc.short('BatteryInfo.model_name', n16, rem)
+                raise _dc.short("BatteryInfo.model_name", n16, rem)
             rem -= n16
-            f13 = ((v >> rem) & ((1 << n16) - 1)).to_bytes(k15, 'big')
+            f13 = ((v >> rem) & ((1 << n16) - 1)).to_bytes(k15, "big")
         else:
             if rem < 5:
-                raise _dc.short('BatteryInfo.model_name (length)', 5, rem)
+                raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
             rem -= 5
-            b17 = (v >> rem) & 0x1f
+            b17 = (v >> rem) & 0x1F
             k15 = b17
             if k15 > 31:
-                raise _dc.DecodeError('BatteryInfo.model_name: length ' + str(k15) + ' exceeds capacity 31')
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
             n18 = k15 * 8
             if rem < n18:
-                raise _dc.short('BatteryInfo.model_name', n18, rem)
+                raise _dc.short("BatteryInfo.model_name", n18, rem)
             rem -= n18
-            f13 = ((v >> rem) & ((1 << n18) - 1)).to_bytes(k15, 'big')
+            f13 = ((v >> rem) & ((1 << n18) - 1)).to_bytes(k15, "big")
         return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13), rem
 
     def validate(self) -> list[_v.Violation]:
@@ -469,95 +795,132 @@ class BatteryInfo:
         r_state_of_health_pct: Any
         try:
             x = self.temperature
-            if (not (-65504.0 <= x <= 65504.0) and x == x):
-                _v.diag(out, 'temperature', self.temperature, _VS_BatteryInfo_temperature)
+            if not (-65504.0 <= x <= 65504.0) and x == x:
+                _v.diag(out, "temperature", self.temperature, _VS_BatteryInfo_temperature)
         except _v.SLOW:
-            _v.diag(out, 'temperature', self.temperature, _VS_BatteryInfo_temperature)
+            _v.diag(out, "temperature", self.temperature, _VS_BatteryInfo_temperature)
         try:
             x = self.voltage
-            if (not (-65504.0 <= x <= 65504.0) and x == x):
-                _v.diag(out, 'voltage', self.voltage, _VS_BatteryInfo_voltage)
+            if not (-65504.0 <= x <= 65504.0) and x == x:
+                _v.diag(out, "voltage", self.voltage, _VS_BatteryInfo_voltage)
         except _v.SLOW:
-            _v.diag(out, 'voltage', self.voltage, _VS_BatteryInfo_voltage)
+            _v.diag(out, "voltage", self.voltage, _VS_BatteryInfo_voltage)
         try:
             x = self.current
-            if (not (-65504.0 <= x <= 65504.0) and x == x):
-                _v.diag(out, 'current', self.current, _VS_BatteryInfo_current)
+            if not (-65504.0 <= x <= 65504.0) and x == x:
+                _v.diag(out, "current", self.current, _VS_BatteryInfo_current)
         except _v.SLOW:
-            _v.diag(out, 'current', self.current, _VS_BatteryInfo_current)
+            _v.diag(out, "current", self.current, _VS_BatteryInfo_current)
         try:
             x = self.average_power_10sec
-            if (not (-65504.0 <= x <= 65504.0) and x == x):
-                _v.diag(out, 'average_power_10sec', self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
+            if not (-65504.0 <= x <= 65504.0) and x == x:
+                _v.diag(out, "average_power_10sec", self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
         except _v.SLOW:
-            _v.diag(out, 'average_power_10sec', self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
+            _v.diag(out, "average_power_10sec", self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
         try:
             x = self.remaining_capacity_wh
-            if (not (-65504.0 <= x <= 65504.0) and x == x):
-                _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
+            if not (-65504.0 <= x <= 65504.0) and x == x:
+                _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
         except _v.SLOW:
-            _v.diag(out, 'remaining_capacity_wh', self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
+            _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
         try:
             x = self.full_charge_capacity_wh
-            if (not (-65504.0 <= x <= 65504.0) and x == x):
-                _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryInfo_full_charge_capacity_wh)
+            if not (-65504.0 <= x <= 65504.0) and x == x:
+                _v.diag(
+                    out,
+                    "full_charge_capacity_wh",
+                    self.full_charge_capacity_wh,
+                    _VS_BatteryInfo_full_charge_capacity_wh,
+                )
         except _v.SLOW:
-            _v.diag(out, 'full_charge_capacity_wh', self.full_charge_capacity_wh, _VS_BatteryInfo_full_charge_capacity_wh)
+            _v.diag(
+                out, "full_charge_capacity_wh", self.full_charge_capacity_wh, _VS_BatteryInfo_full_charge_capacity_wh
+            )
         try:
             x = self.hours_to_full_charge
-            if (not (-65504.0 <= x <= 65504.0) and x == x):
-                _v.diag(out, 'hours_to_full_charge', self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
+            if not (-65504.0 <= x <= 65504.0) and x == x:
+                _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
         except _v.SLOW:
-            _v.diag(out, 'hours_to_full_charge', self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
+            _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
         try:
-            if (self.status_flags & -512):
-                _v.diag(out, 'status_flags', self.status_flags, _VS_BatteryInfo_status_flags)
+            if self.status_flags & -512:
+                _v.diag(out, "status_flags", self.status_flags, _VS_BatteryInfo_status_flags)
         except _v.SLOW:
-            _v.diag(out, 'status_flags', self.status_flags, _VS_BatteryInfo_status_flags)
+            _v.diag(out, "status_flags", self.status_flags, _VS_BatteryInfo_status_flags)
         try:
-            if (self.state_of_health_pct & -128):
-                _v.diag(out, 'state_of_health_pct', self.state_of_health_pct, _VS_BatteryInfo_state_of_health_pct)
+            if self.state_of_health_pct & -128:
+                _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _VS_BatteryInfo_state_of_health_pct)
         except _v.SLOW:
-            _v.diag(out, 'state_of_health_pct', self.state_of_health_pct, _VS_BatteryInfo_state_of_health_pct)
+            _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _VS_BatteryInfo_state_of_health_pct)
         try:
-            if (self.state_of_charge_pct & -128):
-                _v.diag(out, 'state_of_charge_pct', self.state_of_charge_pct, _VS_BatteryInfo_state_of_charge_pct)
+            if self.state_of_charge_pct & -128:
+                _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _VS_BatteryInfo_state_of_charge_pct)
         except _v.SLOW:
-            _v.diag(out, 'state_of_charge_pct', self.state_of_charge_pct, _VS_BatteryInfo_state_of_charge_pct)
+            _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _VS_BatteryInfo_state_of_charge_pct)
         try:
-            if (self.state_of_charge_pct_stdev & -128):
-                _v.diag(out, 'state_of_charge_pct_stdev', self.state_of_charge_pct_stdev, _VS_BatteryInfo_state_of_charge_pct_stdev)
+            if self.state_of_charge_pct_stdev & -128:
+                _v.diag(
+                    out,
+                    "state_of_charge_pct_stdev",
+                    self.state_of_charge_pct_stdev,
+                    _VS_BatteryInfo_state_of_charge_pct_stdev,
+                )
         except _v.SLOW:
-            _v.diag(out, 'state_of_charge_pct_stdev', self.state_of_charge_pct_stdev, _VS_BatteryInfo_state_of_charge_pct_stdev)
+            _v.diag(
+                out,
+                "state_of_charge_pct_stdev",
+                self.state_of_charge_pct_stdev,
+                _VS_BatteryInfo_state_of_charge_pct_stdev,
+            )
         try:
-            if (self.battery_id & -256):
-                _v.diag(out, 'battery_id', self.battery_id, _VS_BatteryInfo_battery_id)
+            if self.battery_id & -256:
+                _v.diag(out, "battery_id", self.battery_id, _VS_BatteryInfo_battery_id)
         except _v.SLOW:
-            _v.diag(out, 'battery_id', self.battery_id, _VS_BatteryInfo_battery_id)
+            _v.diag(out, "battery_id", self.battery_id, _VS_BatteryInfo_battery_id)
         try:
-            if (self.model_instance_id & -4294967296):
-                _v.diag(out, 'model_instance_id', self.model_instance_id, _VS_BatteryInfo_model_instance_id)
+            if self.model_instance_id & -4294967296:
+                _v.diag(out, "model_instance_id", self.model_instance_id, _VS_BatteryInfo_model_instance_id)
         except _v.SLOW:
-            _v.diag(out, 'model_instance_id', self.model_instance_id, _VS_BatteryInfo_model_instance_id)
+            _v.diag(out, "model_instance_id", self.model_instance_id, _VS_BatteryInfo_model_instance_id)
         try:
             x = self.model_name
-            if (x.__class__ is not bytes or len(x) > 31):
-                _v.diag(out, 'model_name', self.model_name, _VS_BatteryInfo_model_name)
+            if x.__class__ is not bytes or len(x) > 31:
+                _v.diag(out, "model_name", self.model_name, _VS_BatteryInfo_model_name)
         except _v.SLOW:
-            _v.diag(out, 'model_name', self.model_name, _VS_BatteryInfo_model_name)
+            _v.diag(out, "model_name", self.model_name, _VS_BatteryInfo_model_name)
         # rule state-of-health-percent (dronecan-power.yaml:7)
         try:
             r_state_of_health_pct = self.state_of_health_pct
-            if (r_state_of_health_pct != 127):
+            if r_state_of_health_pct != 127:
                 if not (r_state_of_health_pct <= 100):
-                    out.append(_v.rule('state_of_health_pct', 'state-of-health-percent', r_state_of_health_pct, 'state_of_health_pct <= 100', 'state_of_health_pct = ' + _v.fmt(r_state_of_health_pct) + ' % is above 100 % (127 means unknown)', 'error'))
+                    out.append(
+                        _v.rule(
+                            "state_of_health_pct",
+                            "state-of-health-percent",
+                            r_state_of_health_pct,
+                            "state_of_health_pct <= 100",
+                            "state_of_health_pct = "
+                            + _v.fmt(r_state_of_health_pct)
+                            + " % is above 100 % (127 means unknown)",
+                            "error",
+                        )
+                    )
         except _v.SLOW:
             pass  # the field checks report the cause
         # rule state-of-charge-percent (dronecan-power.yaml:13)
         try:
             r_state_of_charge_pct = self.state_of_charge_pct
             if not (r_state_of_charge_pct <= 100):
-                out.append(_v.rule('state_of_charge_pct', 'state-of-charge-percent', r_state_of_charge_pct, 'state_of_charge_pct <= 100', 'state_of_charge_pct = ' + _v.fmt(r_state_of_charge_pct) + ' % is above 100 %', 'error'))
+                out.append(
+                    _v.rule(
+                        "state_of_charge_pct",
+                        "state-of-charge-percent",
+                        r_state_of_charge_pct,
+                        "state_of_charge_pct <= 100",
+                        "state_of_charge_pct = " + _v.fmt(r_state_of_charge_pct) + " % is above 100 %",
+                        "error",
+                    )
+                )
         except _v.SLOW:
             pass  # the field checks report the cause
         return out
@@ -566,49 +929,66 @@ class BatteryInfo:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'dronecan.uavcan.equipment.power.BatteryInfo')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "dronecan.uavcan.equipment.power.BatteryInfo")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field == 'temperature':
+        if field == "temperature":
             return self.temperature == self.temperature
-        if field == 'voltage':
+        if field == "voltage":
             return self.voltage == self.voltage
-        if field == 'current':
+        if field == "current":
             return self.current == self.current
-        if field == 'average_power_10sec':
+        if field == "average_power_10sec":
             return self.average_power_10sec == self.average_power_10sec
-        if field == 'remaining_capacity_wh':
+        if field == "remaining_capacity_wh":
             return self.remaining_capacity_wh == self.remaining_capacity_wh
-        if field == 'full_charge_capacity_wh':
+        if field == "full_charge_capacity_wh":
             return self.full_charge_capacity_wh == self.full_charge_capacity_wh
-        if field == 'hours_to_full_charge':
+        if field == "hours_to_full_charge":
             return self.hours_to_full_charge == self.hours_to_full_charge
-        if field == 'state_of_health_pct':
+        if field == "state_of_health_pct":
             return self.state_of_health_pct != 127
-        if field in {'status_flags', 'state_of_charge_pct', 'state_of_charge_pct_stdev', 'battery_id', 'model_instance_id', 'model_name'}:
+        if field in {
+            "status_flags",
+            "state_of_charge_pct",
+            "state_of_charge_pct_stdev",
+            "battery_id",
+            "model_instance_id",
+            "model_name",
+        }:
             return True
-        raise KeyError(f'{field!r} is not a field of ' + 'dronecan.uavcan.equipment.power.BatteryInfo')
+        raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.equipment.power.BatteryInfo")
 
 
 @dataclasses.dataclass(slots=True)
 class CircuitStatus:
     """Voltage, current and faults of one electrical circuit.
 
-    Schema: dronecan.uavcan.equipment.power.CircuitStatus (dronecan, uavcan/equipment/power/1091.CircuitStatus.uavcan:1).
+    Schema: dronecan.uavcan.equipment.power.CircuitStatus (dronecan,
+    uavcan/equipment/power/1091.CircuitStatus.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'dronecan.uavcan.equipment.power.CircuitStatus'
+    QUALIFIED_NAME: ClassVar[str] = "dronecan.uavcan.equipment.power.CircuitStatus"
     ERROR_FLAG_OVERVOLTAGE: ClassVar[int] = 1
     ERROR_FLAG_UNDERVOLTAGE: ClassVar[int] = 2
     ERROR_FLAG_OVERCURRENT: ClassVar[int] = 4
     ERROR_FLAG_UNDERCURRENT: ClassVar[int] = 8
 
-    circuit_id: int = dataclasses.field(default=0, metadata=_m.meta(name='circuit_id', type='uint16'))
-    voltage: float = dataclasses.field(default=0.0, metadata=_m.meta(name='voltage', type='float16', unit='V', quantity='voltage'))
-    current: float = dataclasses.field(default=0.0, metadata=_m.meta(name='current', type='float16', unit='A', quantity='current'))
-    error_flags: int = dataclasses.field(default=0, metadata=_m.meta(name='error_flags', type='uint8', enums=('dronecan.uavcan.equipment.power.CircuitStatus.ERROR_FLAG',)))
+    circuit_id: int = dataclasses.field(default=0, metadata=_m.meta(name="circuit_id", type="uint16"))
+    voltage: float = dataclasses.field(
+        default=0.0, metadata=_m.meta(name="voltage", type="float16", unit="V", quantity="voltage")
+    )
+    current: float = dataclasses.field(
+        default=0.0, metadata=_m.meta(name="current", type="float16", unit="A", quantity="current")
+    )
+    error_flags: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="error_flags", type="uint8", enums=("dronecan.uavcan.equipment.power.CircuitStatus.ERROR_FLAG",)
+        ),
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -619,50 +999,66 @@ class CircuitStatus:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['circuit_id'] = self.circuit_id
-        out['voltage'] = self.voltage
-        out['current'] = self.current
-        out['error_flags'] = self.error_flags
+        out["circuit_id"] = self.circuit_id
+        out["voltage"] = self.voltage
+        out["current"] = self.current
+        out["error_flags"] = self.error_flags
         return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> CircuitStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'circuit_id', 'voltage', 'current', 'error_flags'}), (), 'CircuitStatus')
+        data = _m.check_keys(data, frozenset({"circuit_id", "voltage", "current", "error_flags"}), (), "CircuitStatus")
         obj = cls()
-        if 'circuit_id' in data:
-            obj.circuit_id = _m.as_int(data['circuit_id'], 'circuit_id')
-        if 'voltage' in data:
-            obj.voltage = _m.as_float(data['voltage'], 'voltage')
-        if 'current' in data:
-            obj.current = _m.as_float(data['current'], 'current')
-        if 'error_flags' in data:
-            obj.error_flags = _m.as_int(data['error_flags'], 'error_flags')
+        if "circuit_id" in data:
+            obj.circuit_id = _m.as_int(data["circuit_id"], "circuit_id")
+        if "voltage" in data:
+            obj.voltage = _m.as_float(data["voltage"], "voltage")
+        if "current" in data:
+            obj.current = _m.as_float(data["current"], "current")
+        if "error_flags" in data:
+            obj.error_flags = _m.as_int(data["error_flags"], "error_flags")
         return obj
 
     DATA_TYPE_ID: ClassVar[int | None] = 1091
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x8313d33d0ddda115
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x8313D33D0DDDA115
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
         r1 = self.voltage
         r2 = self.current
-        g3, g4 = _DC_CircuitStatus_2.unpack(_DC_CircuitStatus_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2)))))
+        g3, g4 = _DC_CircuitStatus_2.unpack(
+            _DC_CircuitStatus_1.pack(
+                (
+                    r1
+                    if -65504.0 <= r1 <= 65504.0
+                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                ),
+                (
+                    r2
+                    if -65504.0 <= r2 <= 65504.0
+                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                ),
+            )
+        )
         h5 = (
             ((g3 - 0x37FFF000) >> 13)
             if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
         )
         h6 = (
             ((g4 - 0x37FFF000) >> 13)
             if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
         )
         r7 = self.circuit_id
         r8 = self.error_flags
-        head = _DC_CircuitStatus_3.pack((r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)), h5, h6, (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0)))
+        head = _DC_CircuitStatus_3.pack(
+            (r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)),
+            h5,
+            h6,
+            (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0)),
+        )
         return head
 
     @classmethod
@@ -673,28 +1069,47 @@ class CircuitStatus:
             raise _dc.cut(_DC_CircuitStatus_4, n << 3)
         u1, u2, u3, u4 = _DC_CircuitStatus_5.unpack_from(data)
         if n > 7:
-            raise _dc.DecodeError('CircuitStatus: ' + str(n - 7) + ' byte(s) beyond the end of the message')
+            raise _dc.DecodeError("CircuitStatus: " + str(n - 7) + " byte(s) beyond the end of the message")
         return cls(u1, u2, u3, u4)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         r1 = self.voltage
         r2 = self.current
-        g3, g4 = _DC_CircuitStatus_2.unpack(_DC_CircuitStatus_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2)))))
+        g3, g4 = _DC_CircuitStatus_2.unpack(
+            _DC_CircuitStatus_1.pack(
+                (
+                    r1
+                    if -65504.0 <= r1 <= 65504.0
+                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                ),
+                (
+                    r2
+                    if -65504.0 <= r2 <= 65504.0
+                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                ),
+            )
+        )
         h5 = (
             ((g3 - 0x37FFF000) >> 13)
             if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
         )
         h6 = (
             ((g4 - 0x37FFF000) >> 13)
             if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
         )
         r7 = self.circuit_id
         r8 = self.error_flags
-        acc = (acc << 56) | int.from_bytes(_DC_CircuitStatus_3.pack((r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)), h5, h6, (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0))), 'big')
+        acc = (acc << 56) | int.from_bytes(
+            _DC_CircuitStatus_3.pack(
+                (r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)),
+                h5,
+                h6,
+                (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0)),
+            ),
+            "big",
+        )
         return acc
 
     @classmethod
@@ -702,7 +1117,7 @@ class CircuitStatus:
         if rem < 56:
             raise _dc.cut(_DC_CircuitStatus_4, rem)
         rem -= 56
-        u1, u2, u3, u4 = _DC_CircuitStatus_5.unpack(((v >> rem) & 0xffffffffffffff).to_bytes(7, 'big'))
+        u1, u2, u3, u4 = _DC_CircuitStatus_5.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
         return cls(u1, u2, u3, u4), rem
 
     def validate(self) -> list[_v.Violation]:
@@ -713,55 +1128,102 @@ class CircuitStatus:
         e: Any
         sub: Any
         try:
-            if (self.circuit_id & -65536):
-                _v.diag(out, 'circuit_id', self.circuit_id, _VS_CircuitStatus_circuit_id)
+            if self.circuit_id & -65536:
+                _v.diag(out, "circuit_id", self.circuit_id, _VS_CircuitStatus_circuit_id)
         except _v.SLOW:
-            _v.diag(out, 'circuit_id', self.circuit_id, _VS_CircuitStatus_circuit_id)
+            _v.diag(out, "circuit_id", self.circuit_id, _VS_CircuitStatus_circuit_id)
         try:
-            if (not (-65504.0 <= self.voltage <= 65504.0)):
-                _v.diag(out, 'voltage', self.voltage, _VS_CircuitStatus_voltage)
+            if not (-65504.0 <= self.voltage <= 65504.0):
+                _v.diag(out, "voltage", self.voltage, _VS_CircuitStatus_voltage)
         except _v.SLOW:
-            _v.diag(out, 'voltage', self.voltage, _VS_CircuitStatus_voltage)
+            _v.diag(out, "voltage", self.voltage, _VS_CircuitStatus_voltage)
         try:
-            if (not (-65504.0 <= self.current <= 65504.0)):
-                _v.diag(out, 'current', self.current, _VS_CircuitStatus_current)
+            if not (-65504.0 <= self.current <= 65504.0):
+                _v.diag(out, "current", self.current, _VS_CircuitStatus_current)
         except _v.SLOW:
-            _v.diag(out, 'current', self.current, _VS_CircuitStatus_current)
+            _v.diag(out, "current", self.current, _VS_CircuitStatus_current)
         try:
-            if (self.error_flags & -16):
-                _v.diag(out, 'error_flags', self.error_flags, _VS_CircuitStatus_error_flags)
+            if self.error_flags & -16:
+                _v.diag(out, "error_flags", self.error_flags, _VS_CircuitStatus_error_flags)
         except _v.SLOW:
-            _v.diag(out, 'error_flags', self.error_flags, _VS_CircuitStatus_error_flags)
+            _v.diag(out, "error_flags", self.error_flags, _VS_CircuitStatus_error_flags)
         return out
 
     def check(self) -> None:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'dronecan.uavcan.equipment.power.CircuitStatus')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "dronecan.uavcan.equipment.power.CircuitStatus")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field in {'circuit_id', 'voltage', 'current', 'error_flags'}:
+        if field in {"circuit_id", "voltage", "current", "error_flags"}:
             return True
-        raise KeyError(f'{field!r} is not a field of ' + 'dronecan.uavcan.equipment.power.CircuitStatus')
+        raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.equipment.power.CircuitStatus")
 
 
 @dataclasses.dataclass(slots=True)
 class PrimaryPowerSupplyStatus:
     """Summary of the main power supply, sent at about 1 to 2 Hz.
 
-    Schema: dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus (dronecan, uavcan/equipment/power/1090.PrimaryPowerSupplyStatus.uavcan:1).
+    Schema: dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus (dronecan,
+    uavcan/equipment/power/1090.PrimaryPowerSupplyStatus.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = 'dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus'
+    QUALIFIED_NAME: ClassVar[str] = "dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus"
 
-    hours_to_empty_at_10sec_avg_power: float = dataclasses.field(default=0.0, metadata=_m.meta(name='hours_to_empty_at_10sec_avg_power', type='float16', unit='h', quantity='time', scale=3600.0, offset=0.0, doc='Time to full discharge at the mean load of the last 10 s.'))
-    hours_to_empty_at_10sec_avg_power_variance: float = dataclasses.field(default=0.0, metadata=_m.meta(name='hours_to_empty_at_10sec_avg_power_variance', type='float16', unit='Hours^2', quantity='unknown:Hours^2'))
-    external_power_available: bool = dataclasses.field(default=False, metadata=_m.meta(name='external_power_available', type='bool', doc='An external source (e.g. a charger) is available.'))
-    remaining_energy_pct: int = dataclasses.field(default=0, metadata=_m.meta(name='remaining_energy_pct', type='uint7', unit='%', quantity='ratio', scale=0.01, offset=0.0, doc='Remaining energy.\nRequired'))
-    remaining_energy_pct_stdev: int = dataclasses.field(default=0, metadata=_m.meta(name='remaining_energy_pct_stdev', type='uint7', unit='%', quantity='ratio', scale=0.01, offset=0.0, doc='Standard deviation of the estimate'))
+    hours_to_empty_at_10sec_avg_power: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="hours_to_empty_at_10sec_avg_power",
+            type="float16",
+            unit="h",
+            quantity="time",
+            scale=3600.0,
+            offset=0.0,
+            doc="Time to full discharge at the mean load of the last 10 s.",
+        ),
+    )
+    hours_to_empty_at_10sec_avg_power_variance: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="hours_to_empty_at_10sec_avg_power_variance",
+            type="float16",
+            unit="Hours^2",
+            quantity="unknown:Hours^2",
+        ),
+    )
+    external_power_available: bool = dataclasses.field(
+        default=False,
+        metadata=_m.meta(
+            name="external_power_available", type="bool", doc="An external source (e.g. a charger) is available."
+        ),
+    )
+    remaining_energy_pct: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="remaining_energy_pct",
+            type="uint7",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            doc="Remaining energy.\nRequired",
+        ),
+    )
+    remaining_energy_pct_stdev: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="remaining_energy_pct_stdev",
+            type="uint7",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            doc="Standard deviation of the estimate",
+        ),
+    )
 
     def __eq__(self, other: object) -> bool:
         """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
@@ -772,56 +1234,84 @@ class PrimaryPowerSupplyStatus:
     def to_dict(self) -> dict[str, Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
         out: dict[str, Any] = {}
-        out['hours_to_empty_at_10sec_avg_power'] = self.hours_to_empty_at_10sec_avg_power
-        out['hours_to_empty_at_10sec_avg_power_variance'] = self.hours_to_empty_at_10sec_avg_power_variance
-        out['external_power_available'] = self.external_power_available
-        out['remaining_energy_pct'] = self.remaining_energy_pct
-        out['remaining_energy_pct_stdev'] = self.remaining_energy_pct_stdev
+        out["hours_to_empty_at_10sec_avg_power"] = self.hours_to_empty_at_10sec_avg_power
+        out["hours_to_empty_at_10sec_avg_power_variance"] = self.hours_to_empty_at_10sec_avg_power_variance
+        out["external_power_available"] = self.external_power_available
+        out["remaining_energy_pct"] = self.remaining_energy_pct
+        out["remaining_energy_pct_stdev"] = self.remaining_energy_pct_stdev
         return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> PrimaryPowerSupplyStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({'hours_to_empty_at_10sec_avg_power', 'hours_to_empty_at_10sec_avg_power_variance', 'external_power_available', 'remaining_energy_pct', 'remaining_energy_pct_stdev'}), (), 'PrimaryPowerSupplyStatus')
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "hours_to_empty_at_10sec_avg_power",
+                    "hours_to_empty_at_10sec_avg_power_variance",
+                    "external_power_available",
+                    "remaining_energy_pct",
+                    "remaining_energy_pct_stdev",
+                }
+            ),
+            (),
+            "PrimaryPowerSupplyStatus",
+        )
         obj = cls()
-        if 'hours_to_empty_at_10sec_avg_power' in data:
-            obj.hours_to_empty_at_10sec_avg_power = _m.as_float(data['hours_to_empty_at_10sec_avg_power'], 'hours_to_empty_at_10sec_avg_power')
-        if 'hours_to_empty_at_10sec_avg_power_variance' in data:
-            obj.hours_to_empty_at_10sec_avg_power_variance = _m.as_float(data['hours_to_empty_at_10sec_avg_power_variance'], 'hours_to_empty_at_10sec_avg_power_variance')
-        if 'external_power_available' in data:
-            obj.external_power_available = _m.as_bool(data['external_power_available'], 'external_power_available')
-        if 'remaining_energy_pct' in data:
-            obj.remaining_energy_pct = _m.as_int(data['remaining_energy_pct'], 'remaining_energy_pct')
-        if 'remaining_energy_pct_stdev' in data:
-            obj.remaining_energy_pct_stdev = _m.as_int(data['remaining_energy_pct_stdev'], 'remaining_energy_pct_stdev')
+        if "hours_to_empty_at_10sec_avg_power" in data:
+            obj.hours_to_empty_at_10sec_avg_power = _m.as_float(
+                data["hours_to_empty_at_10sec_avg_power"], "hours_to_empty_at_10sec_avg_power"
+            )
+        if "hours_to_empty_at_10sec_avg_power_variance" in data:
+            obj.hours_to_empty_at_10sec_avg_power_variance = _m.as_float(
+                data["hours_to_empty_at_10sec_avg_power_variance"], "hours_to_empty_at_10sec_avg_power_variance"
+            )
+        if "external_power_available" in data:
+            obj.external_power_available = _m.as_bool(data["external_power_available"], "external_power_available")
+        if "remaining_energy_pct" in data:
+            obj.remaining_energy_pct = _m.as_int(data["remaining_energy_pct"], "remaining_energy_pct")
+        if "remaining_energy_pct_stdev" in data:
+            obj.remaining_energy_pct_stdev = _m.as_int(data["remaining_energy_pct_stdev"], "remaining_energy_pct_stdev")
         return obj
 
     DATA_TYPE_ID: ClassVar[int | None] = 1090
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0xbba05074ad757480
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0xBBA05074AD757480
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
         r1 = self.hours_to_empty_at_10sec_avg_power
         r2 = self.hours_to_empty_at_10sec_avg_power_variance
-        g3, g4 = _DC_PrimaryPowerSupplyStatus_2.unpack(_DC_PrimaryPowerSupplyStatus_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2)))))
+        g3, g4 = _DC_PrimaryPowerSupplyStatus_2.unpack(
+            _DC_PrimaryPowerSupplyStatus_1.pack(
+                (
+                    r1
+                    if -65504.0 <= r1 <= 65504.0
+                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                ),
+                (
+                    r2
+                    if -65504.0 <= r2 <= 65504.0
+                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                ),
+            )
+        )
         h5 = (
             ((g3 - 0x37FFF000) >> 13)
             if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
         )
         h6 = (
             ((g4 - 0x37FFF000) >> 13)
             if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
         )
         r7 = self.external_power_available
-        p8 = (1 if r7 else 0)
+        p8 = 1 if r7 else 0
         r9 = self.remaining_energy_pct
-        p10 = (r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0))
+        p10 = r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0)
         r11 = self.remaining_energy_pct_stdev
-        p12 = (r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0))
+        p12 = r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0)
         head = _DC_PrimaryPowerSupplyStatus_3.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9))
         return head
 
@@ -832,36 +1322,49 @@ class PrimaryPowerSupplyStatus:
         if n < 6:
             raise _dc.cut(_DC_PrimaryPowerSupplyStatus_4, n << 3)
         u1, u2, u3 = _DC_PrimaryPowerSupplyStatus_5.unpack_from(data)
-        x4 = (((u3 >> 7) & 0x1) != 0)
-        x5 = (u3 & 0x7f)
-        x6 = (u3 >> 9)
+        x4 = ((u3 >> 7) & 0x1) != 0
+        x5 = u3 & 0x7F
+        x6 = u3 >> 9
         if n > 6:
-            raise _dc.DecodeError('PrimaryPowerSupplyStatus: ' + str(n - 6) + ' byte(s) beyond the end of the message')
+            raise _dc.DecodeError("PrimaryPowerSupplyStatus: " + str(n - 6) + " byte(s) beyond the end of the message")
         return cls(u1, u2, x4, x5, x6)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         r1 = self.hours_to_empty_at_10sec_avg_power
         r2 = self.hours_to_empty_at_10sec_avg_power_variance
-        g3, g4 = _DC_PrimaryPowerSupplyStatus_2.unpack(_DC_PrimaryPowerSupplyStatus_1.pack((r1 if -65504.0 <= r1 <= 65504.0 else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))), (r2 if -65504.0 <= r2 <= 65504.0 else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2)))))
+        g3, g4 = _DC_PrimaryPowerSupplyStatus_2.unpack(
+            _DC_PrimaryPowerSupplyStatus_1.pack(
+                (
+                    r1
+                    if -65504.0 <= r1 <= 65504.0
+                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                ),
+                (
+                    r2
+                    if -65504.0 <= r2 <= 65504.0
+                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                ),
+            )
+        )
         h5 = (
             ((g3 - 0x37FFF000) >> 13)
             if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
         )
         h6 = (
             ((g4 - 0x37FFF000) >> 13)
             if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000
-                  if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
         )
         r7 = self.external_power_available
-        p8 = (1 if r7 else 0)
+        p8 = 1 if r7 else 0
         r9 = self.remaining_energy_pct
-        p10 = (r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0))
+        p10 = r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0)
         r11 = self.remaining_energy_pct_stdev
-        p12 = (r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0))
-        acc = (acc << 47) | (int.from_bytes(_DC_PrimaryPowerSupplyStatus_3.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9)), 'big') >> 1)
+        p12 = r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0)
+        acc = (acc << 47) | (
+            int.from_bytes(_DC_PrimaryPowerSupplyStatus_3.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9)), "big") >> 1
+        )
         return acc
 
     @classmethod
@@ -869,10 +1372,10 @@ class PrimaryPowerSupplyStatus:
         if rem < 47:
             raise _dc.cut(_DC_PrimaryPowerSupplyStatus_4, rem)
         rem -= 47
-        u1, u2, u3 = _DC_PrimaryPowerSupplyStatus_5.unpack((((v >> rem) & 0x7fffffffffff) << 1).to_bytes(6, 'big'))
-        x4 = (((u3 >> 7) & 0x1) != 0)
-        x5 = (u3 & 0x7f)
-        x6 = (u3 >> 9)
+        u1, u2, u3 = _DC_PrimaryPowerSupplyStatus_5.unpack((((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big"))
+        x4 = ((u3 >> 7) & 0x1) != 0
+        x5 = u3 & 0x7F
+        x6 = u3 >> 9
         return cls(u1, u2, x4, x5, x6), rem
 
     def validate(self) -> list[_v.Violation]:
@@ -884,36 +1387,95 @@ class PrimaryPowerSupplyStatus:
         sub: Any
         r_remaining_energy_pct: Any
         try:
-            if (not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power <= 65504.0)):
-                _v.diag(out, 'hours_to_empty_at_10sec_avg_power', self.hours_to_empty_at_10sec_avg_power, _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power)
+            if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power <= 65504.0):
+                _v.diag(
+                    out,
+                    "hours_to_empty_at_10sec_avg_power",
+                    self.hours_to_empty_at_10sec_avg_power,
+                    _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power,
+                )
         except _v.SLOW:
-            _v.diag(out, 'hours_to_empty_at_10sec_avg_power', self.hours_to_empty_at_10sec_avg_power, _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power)
+            _v.diag(
+                out,
+                "hours_to_empty_at_10sec_avg_power",
+                self.hours_to_empty_at_10sec_avg_power,
+                _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power,
+            )
         try:
-            if (not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power_variance <= 65504.0)):
-                _v.diag(out, 'hours_to_empty_at_10sec_avg_power_variance', self.hours_to_empty_at_10sec_avg_power_variance, _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance)
+            if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power_variance <= 65504.0):
+                _v.diag(
+                    out,
+                    "hours_to_empty_at_10sec_avg_power_variance",
+                    self.hours_to_empty_at_10sec_avg_power_variance,
+                    _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance,
+                )
         except _v.SLOW:
-            _v.diag(out, 'hours_to_empty_at_10sec_avg_power_variance', self.hours_to_empty_at_10sec_avg_power_variance, _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance)
+            _v.diag(
+                out,
+                "hours_to_empty_at_10sec_avg_power_variance",
+                self.hours_to_empty_at_10sec_avg_power_variance,
+                _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance,
+            )
         try:
             x = self.external_power_available
-            if (x is not True and x is not False):
-                _v.diag(out, 'external_power_available', self.external_power_available, _VS_PrimaryPowerSupplyStatus_external_power_available)
+            if x is not True and x is not False:
+                _v.diag(
+                    out,
+                    "external_power_available",
+                    self.external_power_available,
+                    _VS_PrimaryPowerSupplyStatus_external_power_available,
+                )
         except _v.SLOW:
-            _v.diag(out, 'external_power_available', self.external_power_available, _VS_PrimaryPowerSupplyStatus_external_power_available)
+            _v.diag(
+                out,
+                "external_power_available",
+                self.external_power_available,
+                _VS_PrimaryPowerSupplyStatus_external_power_available,
+            )
         try:
-            if (self.remaining_energy_pct & -128):
-                _v.diag(out, 'remaining_energy_pct', self.remaining_energy_pct, _VS_PrimaryPowerSupplyStatus_remaining_energy_pct)
+            if self.remaining_energy_pct & -128:
+                _v.diag(
+                    out,
+                    "remaining_energy_pct",
+                    self.remaining_energy_pct,
+                    _VS_PrimaryPowerSupplyStatus_remaining_energy_pct,
+                )
         except _v.SLOW:
-            _v.diag(out, 'remaining_energy_pct', self.remaining_energy_pct, _VS_PrimaryPowerSupplyStatus_remaining_energy_pct)
+            _v.diag(
+                out,
+                "remaining_energy_pct",
+                self.remaining_energy_pct,
+                _VS_PrimaryPowerSupplyStatus_remaining_energy_pct,
+            )
         try:
-            if (self.remaining_energy_pct_stdev & -128):
-                _v.diag(out, 'remaining_energy_pct_stdev', self.remaining_energy_pct_stdev, _VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev)
+            if self.remaining_energy_pct_stdev & -128:
+                _v.diag(
+                    out,
+                    "remaining_energy_pct_stdev",
+                    self.remaining_energy_pct_stdev,
+                    _VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev,
+                )
         except _v.SLOW:
-            _v.diag(out, 'remaining_energy_pct_stdev', self.remaining_energy_pct_stdev, _VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev)
+            _v.diag(
+                out,
+                "remaining_energy_pct_stdev",
+                self.remaining_energy_pct_stdev,
+                _VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev,
+            )
         # rule remaining-energy-percent (dronecan-primary-power.yaml:4)
         try:
             r_remaining_energy_pct = self.remaining_energy_pct
             if not (r_remaining_energy_pct <= 100):
-                out.append(_v.rule('remaining_energy_pct', 'remaining-energy-percent', r_remaining_energy_pct, 'remaining_energy_pct <= 100', 'remaining_energy_pct = ' + _v.fmt(r_remaining_energy_pct) + ' % is above 100 %', 'error'))
+                out.append(
+                    _v.rule(
+                        "remaining_energy_pct",
+                        "remaining-energy-percent",
+                        r_remaining_energy_pct,
+                        "remaining_energy_pct <= 100",
+                        "remaining_energy_pct = " + _v.fmt(r_remaining_energy_pct) + " % is above 100 %",
+                        "error",
+                    )
+                )
         except _v.SLOW:
             pass  # the field checks report the cause
         return out
@@ -922,11 +1484,17 @@ class PrimaryPowerSupplyStatus:
         """Raise ValidationError, carrying every violation, when validate() finds an error."""
         found = self.validate()
         for v in found:
-            if v.severity == 'error':
-                raise _v.ValidationError(found, 'dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus')
+            if v.severity == "error":
+                raise _v.ValidationError(found, "dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus")
 
     def is_known(self, field: str) -> bool:
         """False when the field (schema name) holds its "unknown" sentinel or is absent."""
-        if field in {'hours_to_empty_at_10sec_avg_power', 'hours_to_empty_at_10sec_avg_power_variance', 'external_power_available', 'remaining_energy_pct', 'remaining_energy_pct_stdev'}:
+        if field in {
+            "hours_to_empty_at_10sec_avg_power",
+            "hours_to_empty_at_10sec_avg_power_variance",
+            "external_power_available",
+            "remaining_energy_pct",
+            "remaining_energy_pct_stdev",
+        }:
             return True
-        raise KeyError(f'{field!r} is not a field of ' + 'dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus')
+        raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus")
