@@ -27,7 +27,7 @@ from hypothesis import HealthCheck, given, settings
 
 from codegen.backends.json_schema import FLOAT_MAX, at_column, export_all
 from codegen.backends.python import naming
-from codegen.backends.python.validators.checks import enum_facts, folded
+from codegen.backends.python.validators.bounds import enum_facts, folded
 from codegen.frontends.loader import load
 from codegen.ir import ArrayType, CompositeType, Field, FieldType, Message, PrimitiveKind, PrimitiveType, Schema
 from codegen.ir import StringType as StrT

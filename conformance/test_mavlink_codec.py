@@ -273,9 +273,15 @@ def _class_name(module: ModuleType, msg: Message) -> str:
     return naming.class_name(msg)
 
 
+def _payload_struct_name(module: ModuleType, msg: Message) -> str:
+    from codegen.backends.python import naming
+
+    return f"_{naming.upper_snake(_class_name(module, msg))}_PAYLOAD"
+
+
 def test_struct_format_matches_pymavlink_unpacker(common_pkg: tuple[ModuleType, dict[str, Message]]) -> None:
     module, messages = common_pkg
     for name, msg in messages.items():
-        layout = getattr(module, f"_MAV_{_class_name(module, msg)}")
+        layout = getattr(module, _payload_struct_name(module, msg))
         assert isinstance(layout, struct.Struct)
         assert layout.size == _pm_class(name).unpacker.size == msg.mavlink.max_length  # type: ignore[union-attr]

@@ -96,8 +96,9 @@ class MavBatteryType(enum.IntEnum):
     NIMH = 4
 
 
-_MAV_BatteryStatus = struct.Struct("<iih10HhBBBbiB4HBI")
-_MAV_BatteryStatus_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
+_BATTERY_STATUS_PAYLOAD = struct.Struct("<iih10HhBBBbiB4HBI")
+_BATTERY_STATUS_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("current_consumed", "current_consumed", "i", 0),
     ("energy_consumed", "energy_consumed", "i", 0),
     ("temperature", "temperature", "h", 0),
@@ -113,7 +114,7 @@ _MAV_BatteryStatus_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("mode", "mode", "B", 0),
     ("fault_bitmask", "fault_bitmask", "I", 0),
 )
-_MAV_BatteryStatus_DTYPE: list[tuple[Any, ...]] = [
+_BATTERY_STATUS_DTYPE: list[tuple[Any, ...]] = [
     ("current_consumed", "<i4"),
     ("energy_consumed", "<i4"),
     ("temperature", "<i2"),
@@ -131,8 +132,9 @@ _MAV_BatteryStatus_DTYPE: list[tuple[Any, ...]] = [
 ]
 
 
-_VS_BatteryStatus_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
-_VS_BatteryStatus_battery_function = _v.Number(
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_STATUS_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_STATUS_BATTERY_FUNCTION_SPEC = _v.Number(
     type="uint8",
     kind="uint",
     low=0,
@@ -145,7 +147,7 @@ _VS_BatteryStatus_battery_function = _v.Number(
         4: "MAV_BATTERY_FUNCTION_PAYLOAD",
     },
 )
-_VS_BatteryStatus_type = _v.Number(
+_BATTERY_STATUS_TYPE_SPEC = _v.Number(
     type="uint8",
     kind="uint",
     low=0,
@@ -158,28 +160,28 @@ _VS_BatteryStatus_type = _v.Number(
         4: "MAV_BATTERY_TYPE_NIMH",
     },
 )
-_VS_BatteryStatus_temperature = _v.Number(
+_BATTERY_STATUS_TEMPERATURE_SPEC = _v.Number(
     type="int16", kind="int", low=-32768, high=32767, unit="cdegC", sentinel=32767, sentinel_text="INT16_MAX"
 )
-_VS_BatteryStatus_voltages = _v.Array(
+_BATTERY_STATUS_VOLTAGES_SPEC = _v.Array(
     _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mV", sentinel=65535, sentinel_text="[UINT16_MAX]"),
     10,
     True,
 )
-_VS_BatteryStatus_current_battery = _v.Number(
+_BATTERY_STATUS_CURRENT_BATTERY_SPEC = _v.Number(
     type="int16", kind="int", low=-32768, high=32767, unit="cA", sentinel=-1, sentinel_text="-1"
 )
-_VS_BatteryStatus_current_consumed = _v.Number(
+_BATTERY_STATUS_CURRENT_CONSUMED_SPEC = _v.Number(
     type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh", sentinel=-1, sentinel_text="-1"
 )
-_VS_BatteryStatus_energy_consumed = _v.Number(
+_BATTERY_STATUS_ENERGY_CONSUMED_SPEC = _v.Number(
     type="int32", kind="int", low=-2147483648, high=2147483647, unit="hJ", sentinel=-1, sentinel_text="-1"
 )
-_VS_BatteryStatus_battery_remaining = _v.Number(
+_BATTERY_STATUS_BATTERY_REMAINING_SPEC = _v.Number(
     type="int8", kind="int", low=-128, high=127, unit="%", sentinel=-1, sentinel_text="-1"
 )
-_VS_BatteryStatus_time_remaining = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="s")
-_VS_BatteryStatus_charge_state = _v.Number(
+_BATTERY_STATUS_TIME_REMAINING_SPEC = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="s")
+_BATTERY_STATUS_CHARGE_STATE_SPEC = _v.Number(
     type="uint8",
     kind="uint",
     low=0,
@@ -195,15 +197,17 @@ _VS_BatteryStatus_charge_state = _v.Number(
         7: "MAV_BATTERY_CHARGE_STATE_CHARGING",
     },
 )
-_VS_BatteryStatus_voltages_ext = _v.Array(_v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mV"), 4, True)
-_VS_BatteryStatus_mode = _v.Number(
+_BATTERY_STATUS_VOLTAGES_EXT_SPEC = _v.Array(
+    _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mV"), 4, True
+)
+_BATTERY_STATUS_MODE_SPEC = _v.Number(
     type="uint8",
     kind="uint",
     low=0,
     high=255,
     values={0: "MAV_BATTERY_MODE_UNKNOWN", 1: "MAV_BATTERY_MODE_AUTO_DISCHARGING", 2: "MAV_BATTERY_MODE_HOT_SWAP"},
 )
-_VS_BatteryStatus_fault_bitmask = _v.Number(
+_BATTERY_STATUS_FAULT_BITMASK_SPEC = _v.Number(
     type="uint32",
     kind="uint",
     low=0,
@@ -482,7 +486,7 @@ class BatteryStatus:
         are dropped (at least one byte is kept) unless ``truncate`` is False.
         A value that does not fit its field raises EncodeError naming it."""
         try:
-            data = _MAV_BatteryStatus.pack(
+            data = _BATTERY_STATUS_PAYLOAD.pack(
                 self.current_consumed,
                 self.energy_consumed,
                 self.temperature,
@@ -499,9 +503,9 @@ class BatteryStatus:
                 self.fault_bitmask,
             )
         except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
-            raise _mav.explain("BATTERY_STATUS", self, _MAV_BatteryStatus_FIELDS) from exc
+            raise _mav.explain("BATTERY_STATUS", self, _BATTERY_STATUS_FIELDS) from exc
         if len(self.voltages) != 10 or len(self.voltages_ext) != 4:
-            raise _mav.explain("BATTERY_STATUS", self, _MAV_BatteryStatus_FIELDS)
+            raise _mav.explain("BATTERY_STATUS", self, _BATTERY_STATUS_FIELDS)
         if truncate:
             return data.rstrip(b"\x00") or b"\x00"
         return data
@@ -538,7 +542,7 @@ class BatteryStatus:
             v23,
             v24,
             v25,
-        ) = _MAV_BatteryStatus.unpack(data)
+        ) = _BATTERY_STATUS_PAYLOAD.unpack(data)
         obj = object.__new__(cls)
         obj.current_consumed = v0
         obj.energy_consumed = v1
@@ -594,10 +598,10 @@ class BatteryStatus:
         """Records of 54 bytes (zero-filled payloads) -> columns keyed by field name: numpy
         arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
         tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
-        arrays = _mav.numpy_columns(data, 54, _MAV_BatteryStatus_DTYPE, use_numpy, "BATTERY_STATUS")
+        arrays = _mav.numpy_columns(data, 54, _BATTERY_STATUS_DTYPE, use_numpy, "BATTERY_STATUS")
         if arrays is not None:
             return arrays
-        c = _mav.struct_columns(data, _MAV_BatteryStatus, "BATTERY_STATUS")
+        c = _mav.struct_columns(data, _BATTERY_STATUS_PAYLOAD, "BATTERY_STATUS")
         return {
             "current_consumed": c[0],
             "energy_consumed": c[1],
@@ -618,93 +622,91 @@ class BatteryStatus:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
         a: Any
         e: Any
-        sub: Any
         r_battery_remaining: Any
         try:
             if self.id & -256:
-                _v.diag(out, "id", self.id, _VS_BatteryStatus_id)
+                _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
         except _v.SLOW:
-            _v.diag(out, "id", self.id, _VS_BatteryStatus_id)
+            _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
         try:
             if self.battery_function not in {0, 1, 2, 3, 4}:
-                _v.diag(out, "battery_function", self.battery_function, _VS_BatteryStatus_battery_function)
+                _v.diag(out, "battery_function", self.battery_function, _BATTERY_STATUS_BATTERY_FUNCTION_SPEC)
         except _v.SLOW:
-            _v.diag(out, "battery_function", self.battery_function, _VS_BatteryStatus_battery_function)
+            _v.diag(out, "battery_function", self.battery_function, _BATTERY_STATUS_BATTERY_FUNCTION_SPEC)
         try:
             if self.type not in {0, 1, 2, 3, 4}:
-                _v.diag(out, "type", self.type, _VS_BatteryStatus_type)
+                _v.diag(out, "type", self.type, _BATTERY_STATUS_TYPE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "type", self.type, _VS_BatteryStatus_type)
+            _v.diag(out, "type", self.type, _BATTERY_STATUS_TYPE_SPEC)
         try:
             if (self.temperature + 32768) & -65536:
-                _v.diag(out, "temperature", self.temperature, _VS_BatteryStatus_temperature)
+                _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _VS_BatteryStatus_temperature)
+            _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
         try:
             a = self.voltages
             if len(a) != 10:
-                _v.diag(out, "voltages", self.voltages, _VS_BatteryStatus_voltages)
+                _v.diag(out, "voltages", self.voltages, _BATTERY_STATUS_VOLTAGES_SPEC)
             else:
                 for e in a:
                     if e & -65536:
-                        _v.diag(out, "voltages", self.voltages, _VS_BatteryStatus_voltages)
+                        _v.diag(out, "voltages", self.voltages, _BATTERY_STATUS_VOLTAGES_SPEC)
                         break
         except _v.SLOW:
-            _v.diag(out, "voltages", self.voltages, _VS_BatteryStatus_voltages)
+            _v.diag(out, "voltages", self.voltages, _BATTERY_STATUS_VOLTAGES_SPEC)
         try:
             if (self.current_battery + 32768) & -65536:
-                _v.diag(out, "current_battery", self.current_battery, _VS_BatteryStatus_current_battery)
+                _v.diag(out, "current_battery", self.current_battery, _BATTERY_STATUS_CURRENT_BATTERY_SPEC)
         except _v.SLOW:
-            _v.diag(out, "current_battery", self.current_battery, _VS_BatteryStatus_current_battery)
+            _v.diag(out, "current_battery", self.current_battery, _BATTERY_STATUS_CURRENT_BATTERY_SPEC)
         try:
             if (self.current_consumed + 2147483648) & -4294967296:
-                _v.diag(out, "current_consumed", self.current_consumed, _VS_BatteryStatus_current_consumed)
+                _v.diag(out, "current_consumed", self.current_consumed, _BATTERY_STATUS_CURRENT_CONSUMED_SPEC)
         except _v.SLOW:
-            _v.diag(out, "current_consumed", self.current_consumed, _VS_BatteryStatus_current_consumed)
+            _v.diag(out, "current_consumed", self.current_consumed, _BATTERY_STATUS_CURRENT_CONSUMED_SPEC)
         try:
             if (self.energy_consumed + 2147483648) & -4294967296:
-                _v.diag(out, "energy_consumed", self.energy_consumed, _VS_BatteryStatus_energy_consumed)
+                _v.diag(out, "energy_consumed", self.energy_consumed, _BATTERY_STATUS_ENERGY_CONSUMED_SPEC)
         except _v.SLOW:
-            _v.diag(out, "energy_consumed", self.energy_consumed, _VS_BatteryStatus_energy_consumed)
+            _v.diag(out, "energy_consumed", self.energy_consumed, _BATTERY_STATUS_ENERGY_CONSUMED_SPEC)
         try:
             if (self.battery_remaining + 128) & -256:
-                _v.diag(out, "battery_remaining", self.battery_remaining, _VS_BatteryStatus_battery_remaining)
+                _v.diag(out, "battery_remaining", self.battery_remaining, _BATTERY_STATUS_BATTERY_REMAINING_SPEC)
         except _v.SLOW:
-            _v.diag(out, "battery_remaining", self.battery_remaining, _VS_BatteryStatus_battery_remaining)
+            _v.diag(out, "battery_remaining", self.battery_remaining, _BATTERY_STATUS_BATTERY_REMAINING_SPEC)
         try:
             if (self.time_remaining + 2147483648) & -4294967296:
-                _v.diag(out, "time_remaining", self.time_remaining, _VS_BatteryStatus_time_remaining)
+                _v.diag(out, "time_remaining", self.time_remaining, _BATTERY_STATUS_TIME_REMAINING_SPEC)
         except _v.SLOW:
-            _v.diag(out, "time_remaining", self.time_remaining, _VS_BatteryStatus_time_remaining)
+            _v.diag(out, "time_remaining", self.time_remaining, _BATTERY_STATUS_TIME_REMAINING_SPEC)
         try:
             if self.charge_state not in {0, 1, 2, 3, 4, 5, 6, 7}:
-                _v.diag(out, "charge_state", self.charge_state, _VS_BatteryStatus_charge_state)
+                _v.diag(out, "charge_state", self.charge_state, _BATTERY_STATUS_CHARGE_STATE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "charge_state", self.charge_state, _VS_BatteryStatus_charge_state)
+            _v.diag(out, "charge_state", self.charge_state, _BATTERY_STATUS_CHARGE_STATE_SPEC)
         try:
             a = self.voltages_ext
             if len(a) != 4:
-                _v.diag(out, "voltages_ext", self.voltages_ext, _VS_BatteryStatus_voltages_ext)
+                _v.diag(out, "voltages_ext", self.voltages_ext, _BATTERY_STATUS_VOLTAGES_EXT_SPEC)
             else:
                 for e in a:
                     if e & -65536:
-                        _v.diag(out, "voltages_ext", self.voltages_ext, _VS_BatteryStatus_voltages_ext)
+                        _v.diag(out, "voltages_ext", self.voltages_ext, _BATTERY_STATUS_VOLTAGES_EXT_SPEC)
                         break
         except _v.SLOW:
-            _v.diag(out, "voltages_ext", self.voltages_ext, _VS_BatteryStatus_voltages_ext)
+            _v.diag(out, "voltages_ext", self.voltages_ext, _BATTERY_STATUS_VOLTAGES_EXT_SPEC)
         try:
             if self.mode not in {0, 1, 2}:
-                _v.diag(out, "mode", self.mode, _VS_BatteryStatus_mode)
+                _v.diag(out, "mode", self.mode, _BATTERY_STATUS_MODE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "mode", self.mode, _VS_BatteryStatus_mode)
+            _v.diag(out, "mode", self.mode, _BATTERY_STATUS_MODE_SPEC)
         try:
             if self.fault_bitmask & -512:
-                _v.diag(out, "fault_bitmask", self.fault_bitmask, _VS_BatteryStatus_fault_bitmask)
+                _v.diag(out, "fault_bitmask", self.fault_bitmask, _BATTERY_STATUS_FAULT_BITMASK_SPEC)
         except _v.SLOW:
-            _v.diag(out, "fault_bitmask", self.fault_bitmask, _VS_BatteryStatus_fault_bitmask)
+            _v.diag(out, "fault_bitmask", self.fault_bitmask, _BATTERY_STATUS_FAULT_BITMASK_SPEC)
         # rule battery-remaining-percent (mavlink-battery-status.yaml:4)
         try:
             r_battery_remaining = self.battery_remaining

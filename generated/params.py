@@ -46,8 +46,9 @@ class BattParamsFsCrtAct(enum.IntEnum):
     TERMINATE = 5
 
 
-_VS_BattParams_BATT_CAPACITY = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
-_VS_BattParams_BATT_LOW_VOLT = _v.Number(
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATT_PARAMS_BATT_CAPACITY_SPEC = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
+_BATT_PARAMS_BATT_LOW_VOLT_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -56,18 +57,20 @@ _VS_BattParams_BATT_LOW_VOLT = _v.Number(
     minimum=0,
     maximum=30,
 )
-_VS_BattParams_BATT_LOW_TIMER = _v.Number(type="int8", kind="int", low=-128, high=127, unit="s", minimum=0, maximum=120)
-_VS_BattParams_BATT_FS_VOLTSRC = _v.Number(
+_BATT_PARAMS_BATT_LOW_TIMER_SPEC = _v.Number(
+    type="int8", kind="int", low=-128, high=127, unit="s", minimum=0, maximum=120
+)
+_BATT_PARAMS_BATT_FS_VOLTSRC_SPEC = _v.Number(
     type="int8",
     kind="int",
     low=-128,
     high=127,
     values={0: "FS_VOLTSRC_RAW_VOLTAGE", 1: "FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE"},
 )
-_VS_BattParams_BATT_LOW_MAH = _v.Number(
+_BATT_PARAMS_BATT_LOW_MAH_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="mAh"
 )
-_VS_BattParams_BATT_CRT_VOLT = _v.Number(
+_BATT_PARAMS_BATT_CRT_VOLT_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -76,10 +79,10 @@ _VS_BattParams_BATT_CRT_VOLT = _v.Number(
     minimum=0,
     maximum=30,
 )
-_VS_BattParams_BATT_CRT_MAH = _v.Number(
+_BATT_PARAMS_BATT_CRT_MAH_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="mAh"
 )
-_VS_BattParams_BATT_FS_LOW_ACT = _v.Number(
+_BATT_PARAMS_BATT_FS_LOW_ACT_SPEC = _v.Number(
     type="int8",
     kind="int",
     low=-128,
@@ -93,7 +96,7 @@ _VS_BattParams_BATT_FS_LOW_ACT = _v.Number(
         5: "FS_LOW_ACT_TERMINATE",
     },
 )
-_VS_BattParams_BATT_FS_CRT_ACT = _v.Number(
+_BATT_PARAMS_BATT_FS_CRT_ACT_SPEC = _v.Number(
     type="int8",
     kind="int",
     low=-128,
@@ -107,7 +110,7 @@ _VS_BattParams_BATT_FS_CRT_ACT = _v.Number(
         5: "FS_CRT_ACT_TERMINATE",
     },
 )
-_VS_BattParams_BATT_ARM_VOLT = _v.Number(
+_BATT_PARAMS_BATT_ARM_VOLT_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -116,7 +119,7 @@ _VS_BattParams_BATT_ARM_VOLT = _v.Number(
     minimum=0,
     maximum=30,
 )
-_VS_BattParams_BATT_ARM_MAH = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
+_BATT_PARAMS_BATT_ARM_MAH_SPEC = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
 
 
 @dataclasses.dataclass(slots=True)
@@ -344,65 +347,62 @@ class BattParams:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         x: Any
-        a: Any
-        e: Any
-        sub: Any
         try:
             if (self.BATT_CAPACITY + 2147483648) & -4294967296:
-                _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _VS_BattParams_BATT_CAPACITY)
+                _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _VS_BattParams_BATT_CAPACITY)
+            _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)
         try:
             if not (0.0 <= self.BATT_LOW_VOLT <= 30.0):
-                _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _VS_BattParams_BATT_LOW_VOLT)
+                _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _BATT_PARAMS_BATT_LOW_VOLT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _VS_BattParams_BATT_LOW_VOLT)
+            _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _BATT_PARAMS_BATT_LOW_VOLT_SPEC)
         try:
             x = self.BATT_LOW_TIMER
             if (x + 128) & -256 or not (0 <= x <= 120):
-                _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _VS_BattParams_BATT_LOW_TIMER)
+                _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _BATT_PARAMS_BATT_LOW_TIMER_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _VS_BattParams_BATT_LOW_TIMER)
+            _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _BATT_PARAMS_BATT_LOW_TIMER_SPEC)
         try:
             if self.BATT_FS_VOLTSRC not in {0, 1}:
-                _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _VS_BattParams_BATT_FS_VOLTSRC)
+                _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _BATT_PARAMS_BATT_FS_VOLTSRC_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _VS_BattParams_BATT_FS_VOLTSRC)
+            _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _BATT_PARAMS_BATT_FS_VOLTSRC_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.BATT_LOW_MAH <= 3.4028234663852886e38):
-                _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _VS_BattParams_BATT_LOW_MAH)
+                _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _BATT_PARAMS_BATT_LOW_MAH_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _VS_BattParams_BATT_LOW_MAH)
+            _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _BATT_PARAMS_BATT_LOW_MAH_SPEC)
         try:
             if not (0.0 <= self.BATT_CRT_VOLT <= 30.0):
-                _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _VS_BattParams_BATT_CRT_VOLT)
+                _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _BATT_PARAMS_BATT_CRT_VOLT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _VS_BattParams_BATT_CRT_VOLT)
+            _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _BATT_PARAMS_BATT_CRT_VOLT_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.BATT_CRT_MAH <= 3.4028234663852886e38):
-                _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _VS_BattParams_BATT_CRT_MAH)
+                _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _BATT_PARAMS_BATT_CRT_MAH_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _VS_BattParams_BATT_CRT_MAH)
+            _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _BATT_PARAMS_BATT_CRT_MAH_SPEC)
         try:
             if self.BATT_FS_LOW_ACT not in {0, 1, 2, 3, 4, 5}:
-                _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _VS_BattParams_BATT_FS_LOW_ACT)
+                _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _VS_BattParams_BATT_FS_LOW_ACT)
+            _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC)
         try:
             if self.BATT_FS_CRT_ACT not in {0, 1, 2, 3, 4, 5}:
-                _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _VS_BattParams_BATT_FS_CRT_ACT)
+                _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _VS_BattParams_BATT_FS_CRT_ACT)
+            _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC)
         try:
             if not (0.0 <= self.BATT_ARM_VOLT <= 30.0):
-                _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _VS_BattParams_BATT_ARM_VOLT)
+                _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _BATT_PARAMS_BATT_ARM_VOLT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _VS_BattParams_BATT_ARM_VOLT)
+            _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _BATT_PARAMS_BATT_ARM_VOLT_SPEC)
         try:
             if (self.BATT_ARM_MAH + 2147483648) & -4294967296:
-                _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _VS_BattParams_BATT_ARM_MAH)
+                _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _BATT_PARAMS_BATT_ARM_MAH_SPEC)
         except _v.SLOW:
-            _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _VS_BattParams_BATT_ARM_MAH)
+            _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _BATT_PARAMS_BATT_ARM_MAH_SPEC)
         return out
 
     def check(self) -> None:

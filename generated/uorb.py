@@ -321,9 +321,10 @@ _BATTERY_STATUS_PACKED_FIELDS: tuple[tuple[str, str, str, int], ...] = (
 )
 
 
-_VS_BatteryStatus_timestamp = _v.Number(type="uint64", kind="uint", low=0, high=18446744073709551615, unit="us")
-_VS_BatteryStatus_connected = _v.Number(type="bool", kind="bool", low=0, high=1)
-_VS_BatteryStatus_voltage_v = _v.Number(
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_STATUS_TIMESTAMP_SPEC = _v.Number(type="uint64", kind="uint", low=0, high=18446744073709551615, unit="us")
+_BATTERY_STATUS_CONNECTED_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
+_BATTERY_STATUS_VOLTAGE_V_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -332,7 +333,7 @@ _VS_BatteryStatus_voltage_v = _v.Number(
     sentinel=0.0,
     sentinel_text="0",
 )
-_VS_BatteryStatus_current_a = _v.Number(
+_BATTERY_STATUS_CURRENT_A_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -341,7 +342,7 @@ _VS_BatteryStatus_current_a = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatus_current_average_a = _v.Number(
+_BATTERY_STATUS_CURRENT_AVERAGE_A_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -350,7 +351,7 @@ _VS_BatteryStatus_current_average_a = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatus_discharged_mah = _v.Number(
+_BATTERY_STATUS_DISCHARGED_MAH_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -359,7 +360,7 @@ _VS_BatteryStatus_discharged_mah = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatus_remaining = _v.Number(
+_BATTERY_STATUS_REMAINING_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -369,7 +370,7 @@ _VS_BatteryStatus_remaining = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatus_scale = _v.Number(
+_BATTERY_STATUS_SCALE_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -378,7 +379,7 @@ _VS_BatteryStatus_scale = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatus_time_remaining_s = _v.Number(
+_BATTERY_STATUS_TIME_REMAINING_S_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -387,7 +388,7 @@ _VS_BatteryStatus_time_remaining_s = _v.Number(
     sentinel=math.nan,
     sentinel_text="NaN",
 )
-_VS_BatteryStatus_temperature = _v.Number(
+_BATTERY_STATUS_TEMPERATURE_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -396,26 +397,28 @@ _VS_BatteryStatus_temperature = _v.Number(
     sentinel=math.nan,
     sentinel_text="NaN",
 )
-_VS_BatteryStatus_cell_count = _v.Number(type="uint8", kind="uint", low=0, high=255, sentinel=0, sentinel_text="0")
-_VS_BatteryStatus_source = _v.Number(
+_BATTERY_STATUS_CELL_COUNT_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255, sentinel=0, sentinel_text="0")
+_BATTERY_STATUS_SOURCE_SPEC = _v.Number(
     type="uint8",
     kind="uint",
     low=0,
     high=255,
     values={0: "SOURCE_POWER_MODULE", 1: "SOURCE_EXTERNAL", 2: "SOURCE_ESCS"},
 )
-_VS_BatteryStatus_priority = _v.Number(type="uint8", kind="uint", low=0, high=255)
-_VS_BatteryStatus_capacity = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mAh")
-_VS_BatteryStatus_cycle_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryStatus_average_time_to_empty = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="min")
-_VS_BatteryStatus_manufacture_date = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryStatus_state_of_health = _v.Number(
+_BATTERY_STATUS_PRIORITY_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_STATUS_CAPACITY_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mAh")
+_BATTERY_STATUS_CYCLE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_STATUS_AVERAGE_TIME_TO_EMPTY_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="min")
+_BATTERY_STATUS_MANUFACTURE_DATE_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_STATUS_STATE_OF_HEALTH_SPEC = _v.Number(
     type="uint16", kind="uint", low=0, high=65535, unit="%", minimum=0, maximum=100
 )
-_VS_BatteryStatus_max_error = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="%", minimum=1, maximum=100)
-_VS_BatteryStatus_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
-_VS_BatteryStatus_interface_error = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryStatus_voltage_cell_v = _v.Array(
+_BATTERY_STATUS_MAX_ERROR_SPEC = _v.Number(
+    type="uint16", kind="uint", low=0, high=65535, unit="%", minimum=1, maximum=100
+)
+_BATTERY_STATUS_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_STATUS_INTERFACE_ERROR_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_STATUS_VOLTAGE_CELL_V_SPEC = _v.Array(
     _v.Number(
         type="float32",
         kind="float",
@@ -428,12 +431,12 @@ _VS_BatteryStatus_voltage_cell_v = _v.Array(
     14,
     True,
 )
-_VS_BatteryStatus_max_cell_voltage_delta = _v.Number(
+_BATTERY_STATUS_MAX_CELL_VOLTAGE_DELTA_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
 )
-_VS_BatteryStatus_is_powering_off = _v.Number(type="bool", kind="bool", low=0, high=1)
-_VS_BatteryStatus_is_required = _v.Number(type="bool", kind="bool", low=0, high=1)
-_VS_BatteryStatus_warning = _v.Number(
+_BATTERY_STATUS_IS_POWERING_OFF_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
+_BATTERY_STATUS_IS_REQUIRED_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
+_BATTERY_STATUS_WARNING_SPEC = _v.Number(
     type="uint8",
     kind="uint",
     low=0,
@@ -448,7 +451,7 @@ _VS_BatteryStatus_warning = _v.Number(
         7: "WARNING_CHARGING",
     },
 )
-_VS_BatteryStatus_faults = _v.Number(
+_BATTERY_STATUS_FAULTS_SPEC = _v.Number(
     type="uint16",
     kind="uint",
     low=0,
@@ -468,35 +471,35 @@ _VS_BatteryStatus_faults = _v.Number(
         0x400: "FAULT_FAILED_TO_ARM",
     },
 )
-_VS_BatteryStatus_full_charge_capacity_wh = _v.Number(
+_BATTERY_STATUS_FULL_CHARGE_CAPACITY_WH_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
 )
-_VS_BatteryStatus_remaining_capacity_wh = _v.Number(
+_BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
 )
-_VS_BatteryStatus_over_discharge_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryStatus_nominal_voltage = _v.Number(
+_BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatus_internal_resistance_estimate = _v.Number(
+_BATTERY_STATUS_INTERNAL_RESISTANCE_ESTIMATE_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Ohm"
 )
-_VS_BatteryStatus_ocv_estimate = _v.Number(
+_BATTERY_STATUS_OCV_ESTIMATE_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatus_ocv_estimate_filtered = _v.Number(
+_BATTERY_STATUS_OCV_ESTIMATE_FILTERED_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatus_volt_based_soc_estimate = _v.Number(
+_BATTERY_STATUS_VOLT_BASED_SOC_ESTIMATE_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, minimum=0, maximum=1
 )
-_VS_BatteryStatus_voltage_prediction = _v.Number(
+_BATTERY_STATUS_VOLTAGE_PREDICTION_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatus_prediction_error = _v.Number(
+_BATTERY_STATUS_PREDICTION_ERROR_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatus_estimation_covariance_norm = _v.Number(
+_BATTERY_STATUS_ESTIMATION_COVARIANCE_NORM_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
 )
 
@@ -717,9 +720,10 @@ _BATTERY_STATUS_V0_PACKED_FIELDS: tuple[tuple[str, str, str, int], ...] = (
 )
 
 
-_VS_BatteryStatusV0_timestamp = _v.Number(type="uint64", kind="uint", low=0, high=18446744073709551615, unit="us")
-_VS_BatteryStatusV0_connected = _v.Number(type="bool", kind="bool", low=0, high=1)
-_VS_BatteryStatusV0_voltage_v = _v.Number(
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_STATUS_V0_TIMESTAMP_SPEC = _v.Number(type="uint64", kind="uint", low=0, high=18446744073709551615, unit="us")
+_BATTERY_STATUS_V0_CONNECTED_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
+_BATTERY_STATUS_V0_VOLTAGE_V_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -728,7 +732,7 @@ _VS_BatteryStatusV0_voltage_v = _v.Number(
     sentinel=0.0,
     sentinel_text="0",
 )
-_VS_BatteryStatusV0_current_a = _v.Number(
+_BATTERY_STATUS_V0_CURRENT_A_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -737,7 +741,7 @@ _VS_BatteryStatusV0_current_a = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatusV0_current_average_a = _v.Number(
+_BATTERY_STATUS_V0_CURRENT_AVERAGE_A_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -746,7 +750,7 @@ _VS_BatteryStatusV0_current_average_a = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatusV0_discharged_mah = _v.Number(
+_BATTERY_STATUS_V0_DISCHARGED_MAH_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -755,7 +759,7 @@ _VS_BatteryStatusV0_discharged_mah = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatusV0_remaining = _v.Number(
+_BATTERY_STATUS_V0_REMAINING_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -765,7 +769,7 @@ _VS_BatteryStatusV0_remaining = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatusV0_scale = _v.Number(
+_BATTERY_STATUS_V0_SCALE_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -774,7 +778,7 @@ _VS_BatteryStatusV0_scale = _v.Number(
     sentinel=-1.0,
     sentinel_text="-1",
 )
-_VS_BatteryStatusV0_time_remaining_s = _v.Number(
+_BATTERY_STATUS_V0_TIME_REMAINING_S_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -783,7 +787,7 @@ _VS_BatteryStatusV0_time_remaining_s = _v.Number(
     sentinel=math.nan,
     sentinel_text="NaN",
 )
-_VS_BatteryStatusV0_temperature = _v.Number(
+_BATTERY_STATUS_V0_TEMPERATURE_SPEC = _v.Number(
     type="float32",
     kind="float",
     low=-3.4028234663852886e38,
@@ -792,29 +796,31 @@ _VS_BatteryStatusV0_temperature = _v.Number(
     sentinel=math.nan,
     sentinel_text="NaN",
 )
-_VS_BatteryStatusV0_cell_count = _v.Number(type="uint8", kind="uint", low=0, high=255, sentinel=0, sentinel_text="0")
-_VS_BatteryStatusV0_source = _v.Number(
+_BATTERY_STATUS_V0_CELL_COUNT_SPEC = _v.Number(
+    type="uint8", kind="uint", low=0, high=255, sentinel=0, sentinel_text="0"
+)
+_BATTERY_STATUS_V0_SOURCE_SPEC = _v.Number(
     type="uint8",
     kind="uint",
     low=0,
     high=255,
     values={0: "SOURCE_POWER_MODULE", 1: "SOURCE_EXTERNAL", 2: "SOURCE_ESCS"},
 )
-_VS_BatteryStatusV0_priority = _v.Number(type="uint8", kind="uint", low=0, high=255)
-_VS_BatteryStatusV0_capacity = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mAh")
-_VS_BatteryStatusV0_cycle_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryStatusV0_average_time_to_empty = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="min")
-_VS_BatteryStatusV0_serial_number = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryStatusV0_manufacture_date = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryStatusV0_state_of_health = _v.Number(
+_BATTERY_STATUS_V0_PRIORITY_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_STATUS_V0_CAPACITY_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mAh")
+_BATTERY_STATUS_V0_CYCLE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_STATUS_V0_AVERAGE_TIME_TO_EMPTY_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="min")
+_BATTERY_STATUS_V0_SERIAL_NUMBER_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_STATUS_V0_MANUFACTURE_DATE_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_STATUS_V0_STATE_OF_HEALTH_SPEC = _v.Number(
     type="uint16", kind="uint", low=0, high=65535, unit="%", minimum=0, maximum=100
 )
-_VS_BatteryStatusV0_max_error = _v.Number(
+_BATTERY_STATUS_V0_MAX_ERROR_SPEC = _v.Number(
     type="uint16", kind="uint", low=0, high=65535, unit="%", minimum=1, maximum=100
 )
-_VS_BatteryStatusV0_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
-_VS_BatteryStatusV0_interface_error = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryStatusV0_voltage_cell_v = _v.Array(
+_BATTERY_STATUS_V0_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_STATUS_V0_INTERFACE_ERROR_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC = _v.Array(
     _v.Number(
         type="float32",
         kind="float",
@@ -827,12 +833,12 @@ _VS_BatteryStatusV0_voltage_cell_v = _v.Array(
     14,
     True,
 )
-_VS_BatteryStatusV0_max_cell_voltage_delta = _v.Number(
+_BATTERY_STATUS_V0_MAX_CELL_VOLTAGE_DELTA_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
 )
-_VS_BatteryStatusV0_is_powering_off = _v.Number(type="bool", kind="bool", low=0, high=1)
-_VS_BatteryStatusV0_is_required = _v.Number(type="bool", kind="bool", low=0, high=1)
-_VS_BatteryStatusV0_warning = _v.Number(
+_BATTERY_STATUS_V0_IS_POWERING_OFF_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
+_BATTERY_STATUS_V0_IS_REQUIRED_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
+_BATTERY_STATUS_V0_WARNING_SPEC = _v.Number(
     type="uint8",
     kind="uint",
     low=0,
@@ -847,7 +853,7 @@ _VS_BatteryStatusV0_warning = _v.Number(
         7: "STATE_CHARGING",
     },
 )
-_VS_BatteryStatusV0_faults = _v.Number(
+_BATTERY_STATUS_V0_FAULTS_SPEC = _v.Number(
     type="uint16",
     kind="uint",
     low=0,
@@ -867,35 +873,35 @@ _VS_BatteryStatusV0_faults = _v.Number(
         0x400: "FAULT_FAILED_TO_ARM",
     },
 )
-_VS_BatteryStatusV0_full_charge_capacity_wh = _v.Number(
+_BATTERY_STATUS_V0_FULL_CHARGE_CAPACITY_WH_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
 )
-_VS_BatteryStatusV0_remaining_capacity_wh = _v.Number(
+_BATTERY_STATUS_V0_REMAINING_CAPACITY_WH_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
 )
-_VS_BatteryStatusV0_over_discharge_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryStatusV0_nominal_voltage = _v.Number(
+_BATTERY_STATUS_V0_OVER_DISCHARGE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_STATUS_V0_NOMINAL_VOLTAGE_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatusV0_internal_resistance_estimate = _v.Number(
+_BATTERY_STATUS_V0_INTERNAL_RESISTANCE_ESTIMATE_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Ohm"
 )
-_VS_BatteryStatusV0_ocv_estimate = _v.Number(
+_BATTERY_STATUS_V0_OCV_ESTIMATE_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatusV0_ocv_estimate_filtered = _v.Number(
+_BATTERY_STATUS_V0_OCV_ESTIMATE_FILTERED_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatusV0_volt_based_soc_estimate = _v.Number(
+_BATTERY_STATUS_V0_VOLT_BASED_SOC_ESTIMATE_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, minimum=0, maximum=1
 )
-_VS_BatteryStatusV0_voltage_prediction = _v.Number(
+_BATTERY_STATUS_V0_VOLTAGE_PREDICTION_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatusV0_prediction_error = _v.Number(
+_BATTERY_STATUS_V0_PREDICTION_ERROR_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
-_VS_BatteryStatusV0_estimation_covariance_norm = _v.Number(
+_BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
 )
 
@@ -1656,258 +1662,274 @@ class BatteryStatus:
         x: Any
         a: Any
         e: Any
-        sub: Any
         r_cell_count: Any
         r_voltage_cell_v: Any
         v_i: Any
         try:
             if self.timestamp & -18446744073709551616:
-                _v.diag(out, "timestamp", self.timestamp, _VS_BatteryStatus_timestamp)
+                _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_TIMESTAMP_SPEC)
         except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _VS_BatteryStatus_timestamp)
+            _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_TIMESTAMP_SPEC)
         try:
             x = self.connected
             if x is not True and x is not False:
-                _v.diag(out, "connected", self.connected, _VS_BatteryStatus_connected)
+                _v.diag(out, "connected", self.connected, _BATTERY_STATUS_CONNECTED_SPEC)
         except _v.SLOW:
-            _v.diag(out, "connected", self.connected, _VS_BatteryStatus_connected)
+            _v.diag(out, "connected", self.connected, _BATTERY_STATUS_CONNECTED_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.voltage_v <= 3.4028234663852886e38):
-                _v.diag(out, "voltage_v", self.voltage_v, _VS_BatteryStatus_voltage_v)
+                _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_VOLTAGE_V_SPEC)
         except _v.SLOW:
-            _v.diag(out, "voltage_v", self.voltage_v, _VS_BatteryStatus_voltage_v)
+            _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_VOLTAGE_V_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.current_a <= 3.4028234663852886e38):
-                _v.diag(out, "current_a", self.current_a, _VS_BatteryStatus_current_a)
+                _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_CURRENT_A_SPEC)
         except _v.SLOW:
-            _v.diag(out, "current_a", self.current_a, _VS_BatteryStatus_current_a)
+            _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_CURRENT_A_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.current_average_a <= 3.4028234663852886e38):
-                _v.diag(out, "current_average_a", self.current_average_a, _VS_BatteryStatus_current_average_a)
+                _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_CURRENT_AVERAGE_A_SPEC)
         except _v.SLOW:
-            _v.diag(out, "current_average_a", self.current_average_a, _VS_BatteryStatus_current_average_a)
+            _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_CURRENT_AVERAGE_A_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.discharged_mah <= 3.4028234663852886e38):
-                _v.diag(out, "discharged_mah", self.discharged_mah, _VS_BatteryStatus_discharged_mah)
+                _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_DISCHARGED_MAH_SPEC)
         except _v.SLOW:
-            _v.diag(out, "discharged_mah", self.discharged_mah, _VS_BatteryStatus_discharged_mah)
+            _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_DISCHARGED_MAH_SPEC)
         try:
             x = self.remaining
             if not (0.0 <= x <= 1.0) and x != -1.0:
-                _v.diag(out, "remaining", self.remaining, _VS_BatteryStatus_remaining)
+                _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_REMAINING_SPEC)
         except _v.SLOW:
-            _v.diag(out, "remaining", self.remaining, _VS_BatteryStatus_remaining)
+            _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_REMAINING_SPEC)
         try:
             x = self.scale
             if not (1.0 <= x <= 3.4028234663852886e38) and x != -1.0:
-                _v.diag(out, "scale", self.scale, _VS_BatteryStatus_scale)
+                _v.diag(out, "scale", self.scale, _BATTERY_STATUS_SCALE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "scale", self.scale, _VS_BatteryStatus_scale)
+            _v.diag(out, "scale", self.scale, _BATTERY_STATUS_SCALE_SPEC)
         try:
             x = self.time_remaining_s
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
-                _v.diag(out, "time_remaining_s", self.time_remaining_s, _VS_BatteryStatus_time_remaining_s)
+                _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_TIME_REMAINING_S_SPEC)
         except _v.SLOW:
-            _v.diag(out, "time_remaining_s", self.time_remaining_s, _VS_BatteryStatus_time_remaining_s)
+            _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_TIME_REMAINING_S_SPEC)
         try:
             x = self.temperature
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
-                _v.diag(out, "temperature", self.temperature, _VS_BatteryStatus_temperature)
+                _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _VS_BatteryStatus_temperature)
+            _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
         try:
             if self.cell_count & -256:
-                _v.diag(out, "cell_count", self.cell_count, _VS_BatteryStatus_cell_count)
+                _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_CELL_COUNT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "cell_count", self.cell_count, _VS_BatteryStatus_cell_count)
+            _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_CELL_COUNT_SPEC)
         try:
             if self.source not in {0, 1, 2}:
-                _v.diag(out, "source", self.source, _VS_BatteryStatus_source)
+                _v.diag(out, "source", self.source, _BATTERY_STATUS_SOURCE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "source", self.source, _VS_BatteryStatus_source)
+            _v.diag(out, "source", self.source, _BATTERY_STATUS_SOURCE_SPEC)
         try:
             if self.priority & -256:
-                _v.diag(out, "priority", self.priority, _VS_BatteryStatus_priority)
+                _v.diag(out, "priority", self.priority, _BATTERY_STATUS_PRIORITY_SPEC)
         except _v.SLOW:
-            _v.diag(out, "priority", self.priority, _VS_BatteryStatus_priority)
+            _v.diag(out, "priority", self.priority, _BATTERY_STATUS_PRIORITY_SPEC)
         try:
             if self.capacity & -65536:
-                _v.diag(out, "capacity", self.capacity, _VS_BatteryStatus_capacity)
+                _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_CAPACITY_SPEC)
         except _v.SLOW:
-            _v.diag(out, "capacity", self.capacity, _VS_BatteryStatus_capacity)
+            _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_CAPACITY_SPEC)
         try:
             if self.cycle_count & -65536:
-                _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryStatus_cycle_count)
+                _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_CYCLE_COUNT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryStatus_cycle_count)
+            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_CYCLE_COUNT_SPEC)
         try:
             if self.average_time_to_empty & -65536:
                 _v.diag(
-                    out, "average_time_to_empty", self.average_time_to_empty, _VS_BatteryStatus_average_time_to_empty
-                )
-        except _v.SLOW:
-            _v.diag(out, "average_time_to_empty", self.average_time_to_empty, _VS_BatteryStatus_average_time_to_empty)
-        try:
-            if self.manufacture_date & -65536:
-                _v.diag(out, "manufacture_date", self.manufacture_date, _VS_BatteryStatus_manufacture_date)
-        except _v.SLOW:
-            _v.diag(out, "manufacture_date", self.manufacture_date, _VS_BatteryStatus_manufacture_date)
-        try:
-            x = self.state_of_health
-            if x & -65536 or not (0 <= x <= 100):
-                _v.diag(out, "state_of_health", self.state_of_health, _VS_BatteryStatus_state_of_health)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health", self.state_of_health, _VS_BatteryStatus_state_of_health)
-        try:
-            x = self.max_error
-            if x & -65536 or not (1 <= x <= 100):
-                _v.diag(out, "max_error", self.max_error, _VS_BatteryStatus_max_error)
-        except _v.SLOW:
-            _v.diag(out, "max_error", self.max_error, _VS_BatteryStatus_max_error)
-        try:
-            if self.id & -256:
-                _v.diag(out, "id", self.id, _VS_BatteryStatus_id)
-        except _v.SLOW:
-            _v.diag(out, "id", self.id, _VS_BatteryStatus_id)
-        try:
-            if self.interface_error & -65536:
-                _v.diag(out, "interface_error", self.interface_error, _VS_BatteryStatus_interface_error)
-        except _v.SLOW:
-            _v.diag(out, "interface_error", self.interface_error, _VS_BatteryStatus_interface_error)
-        try:
-            a = self.voltage_cell_v
-            if len(a) != 14:
-                _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
-            else:
-                for e in a:
-                    if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
-                        _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
-                        break
-        except _v.SLOW:
-            _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatus_voltage_cell_v)
-        try:
-            if not (-3.4028234663852886e38 <= self.max_cell_voltage_delta <= 3.4028234663852886e38):
-                _v.diag(
-                    out, "max_cell_voltage_delta", self.max_cell_voltage_delta, _VS_BatteryStatus_max_cell_voltage_delta
+                    out, "average_time_to_empty", self.average_time_to_empty, _BATTERY_STATUS_AVERAGE_TIME_TO_EMPTY_SPEC
                 )
         except _v.SLOW:
             _v.diag(
-                out, "max_cell_voltage_delta", self.max_cell_voltage_delta, _VS_BatteryStatus_max_cell_voltage_delta
+                out, "average_time_to_empty", self.average_time_to_empty, _BATTERY_STATUS_AVERAGE_TIME_TO_EMPTY_SPEC
+            )
+        try:
+            if self.manufacture_date & -65536:
+                _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_MANUFACTURE_DATE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_MANUFACTURE_DATE_SPEC)
+        try:
+            x = self.state_of_health
+            if x & -65536 or not (0 <= x <= 100):
+                _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_STATE_OF_HEALTH_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_STATE_OF_HEALTH_SPEC)
+        try:
+            x = self.max_error
+            if x & -65536 or not (1 <= x <= 100):
+                _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_MAX_ERROR_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_MAX_ERROR_SPEC)
+        try:
+            if self.id & -256:
+                _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
+        try:
+            if self.interface_error & -65536:
+                _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_INTERFACE_ERROR_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_INTERFACE_ERROR_SPEC)
+        try:
+            a = self.voltage_cell_v
+            if len(a) != 14:
+                _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC)
+            else:
+                for e in a:
+                    if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
+                        _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC)
+                        break
+        except _v.SLOW:
+            _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC)
+        try:
+            if not (-3.4028234663852886e38 <= self.max_cell_voltage_delta <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "max_cell_voltage_delta",
+                    self.max_cell_voltage_delta,
+                    _BATTERY_STATUS_MAX_CELL_VOLTAGE_DELTA_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out, "max_cell_voltage_delta", self.max_cell_voltage_delta, _BATTERY_STATUS_MAX_CELL_VOLTAGE_DELTA_SPEC
             )
         try:
             x = self.is_powering_off
             if x is not True and x is not False:
-                _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryStatus_is_powering_off)
+                _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_IS_POWERING_OFF_SPEC)
         except _v.SLOW:
-            _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryStatus_is_powering_off)
+            _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_IS_POWERING_OFF_SPEC)
         try:
             x = self.is_required
             if x is not True and x is not False:
-                _v.diag(out, "is_required", self.is_required, _VS_BatteryStatus_is_required)
+                _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_IS_REQUIRED_SPEC)
         except _v.SLOW:
-            _v.diag(out, "is_required", self.is_required, _VS_BatteryStatus_is_required)
+            _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_IS_REQUIRED_SPEC)
         try:
             if self.warning not in {0, 1, 2, 3, 4, 6, 7}:
-                _v.diag(out, "warning", self.warning, _VS_BatteryStatus_warning)
+                _v.diag(out, "warning", self.warning, _BATTERY_STATUS_WARNING_SPEC)
         except _v.SLOW:
-            _v.diag(out, "warning", self.warning, _VS_BatteryStatus_warning)
+            _v.diag(out, "warning", self.warning, _BATTERY_STATUS_WARNING_SPEC)
         try:
             if self.faults & -2048:
-                _v.diag(out, "faults", self.faults, _VS_BatteryStatus_faults)
+                _v.diag(out, "faults", self.faults, _BATTERY_STATUS_FAULTS_SPEC)
         except _v.SLOW:
-            _v.diag(out, "faults", self.faults, _VS_BatteryStatus_faults)
+            _v.diag(out, "faults", self.faults, _BATTERY_STATUS_FAULTS_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.full_charge_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
                     out,
                     "full_charge_capacity_wh",
                     self.full_charge_capacity_wh,
-                    _VS_BatteryStatus_full_charge_capacity_wh,
+                    _BATTERY_STATUS_FULL_CHARGE_CAPACITY_WH_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
-                out, "full_charge_capacity_wh", self.full_charge_capacity_wh, _VS_BatteryStatus_full_charge_capacity_wh
+                out,
+                "full_charge_capacity_wh",
+                self.full_charge_capacity_wh,
+                _BATTERY_STATUS_FULL_CHARGE_CAPACITY_WH_SPEC,
             )
         try:
             if not (-3.4028234663852886e38 <= self.remaining_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
-                    out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryStatus_remaining_capacity_wh
+                    out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC
                 )
         except _v.SLOW:
-            _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryStatus_remaining_capacity_wh)
+            _v.diag(
+                out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC
+            )
         try:
             if self.over_discharge_count & -65536:
-                _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryStatus_over_discharge_count)
+                _v.diag(
+                    out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC
+                )
         except _v.SLOW:
-            _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryStatus_over_discharge_count)
+            _v.diag(out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
-                _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryStatus_nominal_voltage)
+                _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryStatus_nominal_voltage)
+            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.internal_resistance_estimate <= 3.4028234663852886e38):
                 _v.diag(
                     out,
                     "internal_resistance_estimate",
                     self.internal_resistance_estimate,
-                    _VS_BatteryStatus_internal_resistance_estimate,
+                    _BATTERY_STATUS_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "internal_resistance_estimate",
                 self.internal_resistance_estimate,
-                _VS_BatteryStatus_internal_resistance_estimate,
+                _BATTERY_STATUS_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
             )
         try:
             if not (-3.4028234663852886e38 <= self.ocv_estimate <= 3.4028234663852886e38):
-                _v.diag(out, "ocv_estimate", self.ocv_estimate, _VS_BatteryStatus_ocv_estimate)
+                _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_OCV_ESTIMATE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "ocv_estimate", self.ocv_estimate, _VS_BatteryStatus_ocv_estimate)
+            _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_OCV_ESTIMATE_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.ocv_estimate_filtered <= 3.4028234663852886e38):
                 _v.diag(
-                    out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _VS_BatteryStatus_ocv_estimate_filtered
+                    out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _BATTERY_STATUS_OCV_ESTIMATE_FILTERED_SPEC
                 )
         except _v.SLOW:
-            _v.diag(out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _VS_BatteryStatus_ocv_estimate_filtered)
+            _v.diag(
+                out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _BATTERY_STATUS_OCV_ESTIMATE_FILTERED_SPEC
+            )
         try:
             if not (0.0 <= self.volt_based_soc_estimate <= 1.0):
                 _v.diag(
                     out,
                     "volt_based_soc_estimate",
                     self.volt_based_soc_estimate,
-                    _VS_BatteryStatus_volt_based_soc_estimate,
+                    _BATTERY_STATUS_VOLT_BASED_SOC_ESTIMATE_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
-                out, "volt_based_soc_estimate", self.volt_based_soc_estimate, _VS_BatteryStatus_volt_based_soc_estimate
+                out,
+                "volt_based_soc_estimate",
+                self.volt_based_soc_estimate,
+                _BATTERY_STATUS_VOLT_BASED_SOC_ESTIMATE_SPEC,
             )
         try:
             if not (-3.4028234663852886e38 <= self.voltage_prediction <= 3.4028234663852886e38):
-                _v.diag(out, "voltage_prediction", self.voltage_prediction, _VS_BatteryStatus_voltage_prediction)
+                _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_VOLTAGE_PREDICTION_SPEC)
         except _v.SLOW:
-            _v.diag(out, "voltage_prediction", self.voltage_prediction, _VS_BatteryStatus_voltage_prediction)
+            _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_VOLTAGE_PREDICTION_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.prediction_error <= 3.4028234663852886e38):
-                _v.diag(out, "prediction_error", self.prediction_error, _VS_BatteryStatus_prediction_error)
+                _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_PREDICTION_ERROR_SPEC)
         except _v.SLOW:
-            _v.diag(out, "prediction_error", self.prediction_error, _VS_BatteryStatus_prediction_error)
+            _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_PREDICTION_ERROR_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.estimation_covariance_norm <= 3.4028234663852886e38):
                 _v.diag(
                     out,
                     "estimation_covariance_norm",
                     self.estimation_covariance_norm,
-                    _VS_BatteryStatus_estimation_covariance_norm,
+                    _BATTERY_STATUS_ESTIMATION_COVARIANCE_NORM_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "estimation_covariance_norm",
                 self.estimation_covariance_norm,
-                _VS_BatteryStatus_estimation_covariance_norm,
+                _BATTERY_STATUS_ESTIMATION_COVARIANCE_NORM_SPEC,
             )
         # rule cell-count-capacity (uorb-battery-status.yaml:5)
         try:
@@ -2789,274 +2811,293 @@ class BatteryStatusV0:
         x: Any
         a: Any
         e: Any
-        sub: Any
         r_cell_count: Any
         r_voltage_cell_v: Any
         v_i: Any
         try:
             if self.timestamp & -18446744073709551616:
-                _v.diag(out, "timestamp", self.timestamp, _VS_BatteryStatusV0_timestamp)
+                _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_V0_TIMESTAMP_SPEC)
         except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _VS_BatteryStatusV0_timestamp)
+            _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_V0_TIMESTAMP_SPEC)
         try:
             x = self.connected
             if x is not True and x is not False:
-                _v.diag(out, "connected", self.connected, _VS_BatteryStatusV0_connected)
+                _v.diag(out, "connected", self.connected, _BATTERY_STATUS_V0_CONNECTED_SPEC)
         except _v.SLOW:
-            _v.diag(out, "connected", self.connected, _VS_BatteryStatusV0_connected)
+            _v.diag(out, "connected", self.connected, _BATTERY_STATUS_V0_CONNECTED_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.voltage_v <= 3.4028234663852886e38):
-                _v.diag(out, "voltage_v", self.voltage_v, _VS_BatteryStatusV0_voltage_v)
+                _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_V0_VOLTAGE_V_SPEC)
         except _v.SLOW:
-            _v.diag(out, "voltage_v", self.voltage_v, _VS_BatteryStatusV0_voltage_v)
+            _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_V0_VOLTAGE_V_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.current_a <= 3.4028234663852886e38):
-                _v.diag(out, "current_a", self.current_a, _VS_BatteryStatusV0_current_a)
+                _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_V0_CURRENT_A_SPEC)
         except _v.SLOW:
-            _v.diag(out, "current_a", self.current_a, _VS_BatteryStatusV0_current_a)
+            _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_V0_CURRENT_A_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.current_average_a <= 3.4028234663852886e38):
-                _v.diag(out, "current_average_a", self.current_average_a, _VS_BatteryStatusV0_current_average_a)
+                _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_V0_CURRENT_AVERAGE_A_SPEC)
         except _v.SLOW:
-            _v.diag(out, "current_average_a", self.current_average_a, _VS_BatteryStatusV0_current_average_a)
+            _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_V0_CURRENT_AVERAGE_A_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.discharged_mah <= 3.4028234663852886e38):
-                _v.diag(out, "discharged_mah", self.discharged_mah, _VS_BatteryStatusV0_discharged_mah)
+                _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_V0_DISCHARGED_MAH_SPEC)
         except _v.SLOW:
-            _v.diag(out, "discharged_mah", self.discharged_mah, _VS_BatteryStatusV0_discharged_mah)
+            _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_V0_DISCHARGED_MAH_SPEC)
         try:
             x = self.remaining
             if not (0.0 <= x <= 1.0) and x != -1.0:
-                _v.diag(out, "remaining", self.remaining, _VS_BatteryStatusV0_remaining)
+                _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_V0_REMAINING_SPEC)
         except _v.SLOW:
-            _v.diag(out, "remaining", self.remaining, _VS_BatteryStatusV0_remaining)
+            _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_V0_REMAINING_SPEC)
         try:
             x = self.scale
             if not (1.0 <= x <= 3.4028234663852886e38) and x != -1.0:
-                _v.diag(out, "scale", self.scale, _VS_BatteryStatusV0_scale)
+                _v.diag(out, "scale", self.scale, _BATTERY_STATUS_V0_SCALE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "scale", self.scale, _VS_BatteryStatusV0_scale)
+            _v.diag(out, "scale", self.scale, _BATTERY_STATUS_V0_SCALE_SPEC)
         try:
             x = self.time_remaining_s
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
-                _v.diag(out, "time_remaining_s", self.time_remaining_s, _VS_BatteryStatusV0_time_remaining_s)
+                _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_V0_TIME_REMAINING_S_SPEC)
         except _v.SLOW:
-            _v.diag(out, "time_remaining_s", self.time_remaining_s, _VS_BatteryStatusV0_time_remaining_s)
+            _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_V0_TIME_REMAINING_S_SPEC)
         try:
             x = self.temperature
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
-                _v.diag(out, "temperature", self.temperature, _VS_BatteryStatusV0_temperature)
+                _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V0_TEMPERATURE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _VS_BatteryStatusV0_temperature)
+            _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V0_TEMPERATURE_SPEC)
         try:
             if self.cell_count & -256:
-                _v.diag(out, "cell_count", self.cell_count, _VS_BatteryStatusV0_cell_count)
+                _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_V0_CELL_COUNT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "cell_count", self.cell_count, _VS_BatteryStatusV0_cell_count)
+            _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_V0_CELL_COUNT_SPEC)
         try:
             if self.source not in {0, 1, 2}:
-                _v.diag(out, "source", self.source, _VS_BatteryStatusV0_source)
+                _v.diag(out, "source", self.source, _BATTERY_STATUS_V0_SOURCE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "source", self.source, _VS_BatteryStatusV0_source)
+            _v.diag(out, "source", self.source, _BATTERY_STATUS_V0_SOURCE_SPEC)
         try:
             if self.priority & -256:
-                _v.diag(out, "priority", self.priority, _VS_BatteryStatusV0_priority)
+                _v.diag(out, "priority", self.priority, _BATTERY_STATUS_V0_PRIORITY_SPEC)
         except _v.SLOW:
-            _v.diag(out, "priority", self.priority, _VS_BatteryStatusV0_priority)
+            _v.diag(out, "priority", self.priority, _BATTERY_STATUS_V0_PRIORITY_SPEC)
         try:
             if self.capacity & -65536:
-                _v.diag(out, "capacity", self.capacity, _VS_BatteryStatusV0_capacity)
+                _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_V0_CAPACITY_SPEC)
         except _v.SLOW:
-            _v.diag(out, "capacity", self.capacity, _VS_BatteryStatusV0_capacity)
+            _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_V0_CAPACITY_SPEC)
         try:
             if self.cycle_count & -65536:
-                _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryStatusV0_cycle_count)
+                _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_V0_CYCLE_COUNT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryStatusV0_cycle_count)
+            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_V0_CYCLE_COUNT_SPEC)
         try:
             if self.average_time_to_empty & -65536:
                 _v.diag(
-                    out, "average_time_to_empty", self.average_time_to_empty, _VS_BatteryStatusV0_average_time_to_empty
+                    out,
+                    "average_time_to_empty",
+                    self.average_time_to_empty,
+                    _BATTERY_STATUS_V0_AVERAGE_TIME_TO_EMPTY_SPEC,
                 )
         except _v.SLOW:
-            _v.diag(out, "average_time_to_empty", self.average_time_to_empty, _VS_BatteryStatusV0_average_time_to_empty)
+            _v.diag(
+                out, "average_time_to_empty", self.average_time_to_empty, _BATTERY_STATUS_V0_AVERAGE_TIME_TO_EMPTY_SPEC
+            )
         try:
             if self.serial_number & -65536:
-                _v.diag(out, "serial_number", self.serial_number, _VS_BatteryStatusV0_serial_number)
+                _v.diag(out, "serial_number", self.serial_number, _BATTERY_STATUS_V0_SERIAL_NUMBER_SPEC)
         except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _VS_BatteryStatusV0_serial_number)
+            _v.diag(out, "serial_number", self.serial_number, _BATTERY_STATUS_V0_SERIAL_NUMBER_SPEC)
         try:
             if self.manufacture_date & -65536:
-                _v.diag(out, "manufacture_date", self.manufacture_date, _VS_BatteryStatusV0_manufacture_date)
+                _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_V0_MANUFACTURE_DATE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "manufacture_date", self.manufacture_date, _VS_BatteryStatusV0_manufacture_date)
+            _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_V0_MANUFACTURE_DATE_SPEC)
         try:
             x = self.state_of_health
             if x & -65536 or not (0 <= x <= 100):
-                _v.diag(out, "state_of_health", self.state_of_health, _VS_BatteryStatusV0_state_of_health)
+                _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_V0_STATE_OF_HEALTH_SPEC)
         except _v.SLOW:
-            _v.diag(out, "state_of_health", self.state_of_health, _VS_BatteryStatusV0_state_of_health)
+            _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_V0_STATE_OF_HEALTH_SPEC)
         try:
             x = self.max_error
             if x & -65536 or not (1 <= x <= 100):
-                _v.diag(out, "max_error", self.max_error, _VS_BatteryStatusV0_max_error)
+                _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_V0_MAX_ERROR_SPEC)
         except _v.SLOW:
-            _v.diag(out, "max_error", self.max_error, _VS_BatteryStatusV0_max_error)
+            _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_V0_MAX_ERROR_SPEC)
         try:
             if self.id & -256:
-                _v.diag(out, "id", self.id, _VS_BatteryStatusV0_id)
+                _v.diag(out, "id", self.id, _BATTERY_STATUS_V0_ID_SPEC)
         except _v.SLOW:
-            _v.diag(out, "id", self.id, _VS_BatteryStatusV0_id)
+            _v.diag(out, "id", self.id, _BATTERY_STATUS_V0_ID_SPEC)
         try:
             if self.interface_error & -65536:
-                _v.diag(out, "interface_error", self.interface_error, _VS_BatteryStatusV0_interface_error)
+                _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_V0_INTERFACE_ERROR_SPEC)
         except _v.SLOW:
-            _v.diag(out, "interface_error", self.interface_error, _VS_BatteryStatusV0_interface_error)
+            _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_V0_INTERFACE_ERROR_SPEC)
         try:
             a = self.voltage_cell_v
             if len(a) != 14:
-                _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
+                _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC)
             else:
                 for e in a:
                     if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
-                        _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
+                        _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC)
                         break
         except _v.SLOW:
-            _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _VS_BatteryStatusV0_voltage_cell_v)
+            _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.max_cell_voltage_delta <= 3.4028234663852886e38):
                 _v.diag(
                     out,
                     "max_cell_voltage_delta",
                     self.max_cell_voltage_delta,
-                    _VS_BatteryStatusV0_max_cell_voltage_delta,
+                    _BATTERY_STATUS_V0_MAX_CELL_VOLTAGE_DELTA_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
-                out, "max_cell_voltage_delta", self.max_cell_voltage_delta, _VS_BatteryStatusV0_max_cell_voltage_delta
+                out,
+                "max_cell_voltage_delta",
+                self.max_cell_voltage_delta,
+                _BATTERY_STATUS_V0_MAX_CELL_VOLTAGE_DELTA_SPEC,
             )
         try:
             x = self.is_powering_off
             if x is not True and x is not False:
-                _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryStatusV0_is_powering_off)
+                _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_V0_IS_POWERING_OFF_SPEC)
         except _v.SLOW:
-            _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryStatusV0_is_powering_off)
+            _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_V0_IS_POWERING_OFF_SPEC)
         try:
             x = self.is_required
             if x is not True and x is not False:
-                _v.diag(out, "is_required", self.is_required, _VS_BatteryStatusV0_is_required)
+                _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_V0_IS_REQUIRED_SPEC)
         except _v.SLOW:
-            _v.diag(out, "is_required", self.is_required, _VS_BatteryStatusV0_is_required)
+            _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_V0_IS_REQUIRED_SPEC)
         try:
             if self.warning not in {0, 1, 2, 3, 4, 6, 7}:
-                _v.diag(out, "warning", self.warning, _VS_BatteryStatusV0_warning)
+                _v.diag(out, "warning", self.warning, _BATTERY_STATUS_V0_WARNING_SPEC)
         except _v.SLOW:
-            _v.diag(out, "warning", self.warning, _VS_BatteryStatusV0_warning)
+            _v.diag(out, "warning", self.warning, _BATTERY_STATUS_V0_WARNING_SPEC)
         try:
             if self.faults & -2048:
-                _v.diag(out, "faults", self.faults, _VS_BatteryStatusV0_faults)
+                _v.diag(out, "faults", self.faults, _BATTERY_STATUS_V0_FAULTS_SPEC)
         except _v.SLOW:
-            _v.diag(out, "faults", self.faults, _VS_BatteryStatusV0_faults)
+            _v.diag(out, "faults", self.faults, _BATTERY_STATUS_V0_FAULTS_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.full_charge_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
                     out,
                     "full_charge_capacity_wh",
                     self.full_charge_capacity_wh,
-                    _VS_BatteryStatusV0_full_charge_capacity_wh,
+                    _BATTERY_STATUS_V0_FULL_CHARGE_CAPACITY_WH_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "full_charge_capacity_wh",
                 self.full_charge_capacity_wh,
-                _VS_BatteryStatusV0_full_charge_capacity_wh,
+                _BATTERY_STATUS_V0_FULL_CHARGE_CAPACITY_WH_SPEC,
             )
         try:
             if not (-3.4028234663852886e38 <= self.remaining_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
-                    out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryStatusV0_remaining_capacity_wh
+                    out,
+                    "remaining_capacity_wh",
+                    self.remaining_capacity_wh,
+                    _BATTERY_STATUS_V0_REMAINING_CAPACITY_WH_SPEC,
                 )
         except _v.SLOW:
-            _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryStatusV0_remaining_capacity_wh)
+            _v.diag(
+                out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_STATUS_V0_REMAINING_CAPACITY_WH_SPEC
+            )
         try:
             if self.over_discharge_count & -65536:
                 _v.diag(
-                    out, "over_discharge_count", self.over_discharge_count, _VS_BatteryStatusV0_over_discharge_count
+                    out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_V0_OVER_DISCHARGE_COUNT_SPEC
                 )
         except _v.SLOW:
-            _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryStatusV0_over_discharge_count)
+            _v.diag(
+                out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_V0_OVER_DISCHARGE_COUNT_SPEC
+            )
         try:
             if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
-                _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryStatusV0_nominal_voltage)
+                _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_V0_NOMINAL_VOLTAGE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryStatusV0_nominal_voltage)
+            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_V0_NOMINAL_VOLTAGE_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.internal_resistance_estimate <= 3.4028234663852886e38):
                 _v.diag(
                     out,
                     "internal_resistance_estimate",
                     self.internal_resistance_estimate,
-                    _VS_BatteryStatusV0_internal_resistance_estimate,
+                    _BATTERY_STATUS_V0_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "internal_resistance_estimate",
                 self.internal_resistance_estimate,
-                _VS_BatteryStatusV0_internal_resistance_estimate,
+                _BATTERY_STATUS_V0_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
             )
         try:
             if not (-3.4028234663852886e38 <= self.ocv_estimate <= 3.4028234663852886e38):
-                _v.diag(out, "ocv_estimate", self.ocv_estimate, _VS_BatteryStatusV0_ocv_estimate)
+                _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_V0_OCV_ESTIMATE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "ocv_estimate", self.ocv_estimate, _VS_BatteryStatusV0_ocv_estimate)
+            _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_V0_OCV_ESTIMATE_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.ocv_estimate_filtered <= 3.4028234663852886e38):
                 _v.diag(
-                    out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _VS_BatteryStatusV0_ocv_estimate_filtered
+                    out,
+                    "ocv_estimate_filtered",
+                    self.ocv_estimate_filtered,
+                    _BATTERY_STATUS_V0_OCV_ESTIMATE_FILTERED_SPEC,
                 )
         except _v.SLOW:
-            _v.diag(out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _VS_BatteryStatusV0_ocv_estimate_filtered)
+            _v.diag(
+                out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _BATTERY_STATUS_V0_OCV_ESTIMATE_FILTERED_SPEC
+            )
         try:
             if not (0.0 <= self.volt_based_soc_estimate <= 1.0):
                 _v.diag(
                     out,
                     "volt_based_soc_estimate",
                     self.volt_based_soc_estimate,
-                    _VS_BatteryStatusV0_volt_based_soc_estimate,
+                    _BATTERY_STATUS_V0_VOLT_BASED_SOC_ESTIMATE_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "volt_based_soc_estimate",
                 self.volt_based_soc_estimate,
-                _VS_BatteryStatusV0_volt_based_soc_estimate,
+                _BATTERY_STATUS_V0_VOLT_BASED_SOC_ESTIMATE_SPEC,
             )
         try:
             if not (-3.4028234663852886e38 <= self.voltage_prediction <= 3.4028234663852886e38):
-                _v.diag(out, "voltage_prediction", self.voltage_prediction, _VS_BatteryStatusV0_voltage_prediction)
+                _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_V0_VOLTAGE_PREDICTION_SPEC)
         except _v.SLOW:
-            _v.diag(out, "voltage_prediction", self.voltage_prediction, _VS_BatteryStatusV0_voltage_prediction)
+            _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_V0_VOLTAGE_PREDICTION_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.prediction_error <= 3.4028234663852886e38):
-                _v.diag(out, "prediction_error", self.prediction_error, _VS_BatteryStatusV0_prediction_error)
+                _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_V0_PREDICTION_ERROR_SPEC)
         except _v.SLOW:
-            _v.diag(out, "prediction_error", self.prediction_error, _VS_BatteryStatusV0_prediction_error)
+            _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_V0_PREDICTION_ERROR_SPEC)
         try:
             if not (-3.4028234663852886e38 <= self.estimation_covariance_norm <= 3.4028234663852886e38):
                 _v.diag(
                     out,
                     "estimation_covariance_norm",
                     self.estimation_covariance_norm,
-                    _VS_BatteryStatusV0_estimation_covariance_norm,
+                    _BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "estimation_covariance_norm",
                 self.estimation_covariance_norm,
-                _VS_BatteryStatusV0_estimation_covariance_norm,
+                _BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC,
             )
         # rule cell-count-capacity (uorb-battery-status.yaml:5)
         try:

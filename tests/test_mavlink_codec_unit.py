@@ -106,7 +106,7 @@ def test_invalid_utf8_text_decodes_losslessly(thing: ModuleType) -> None:
     # pymavlink decodes char[N] as ASCII with U+FFFD replacements; we never fail either, and keep the bytes
     cls = thing.Thing
     # wire order: the 8-byte fields, then the 1-byte ones in definition order, then the extension
-    assert thing.__dict__["_MAV_Thing"].format == "<Qd8s4s3b1sf"
+    assert thing.__dict__["_THING_PAYLOAD"].format == "<Qd8s4s3b1sf"
     payload = cls().encode(truncate=False)
     start = 16
     bad = payload[:start] + b"\xff\xfeok\xc3\x00zz" + payload[start + 8 :]

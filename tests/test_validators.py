@@ -13,6 +13,7 @@ import hypothesis.strategies as st
 import pytest
 from hypothesis import given, settings
 
+from codegen.backends.python.naming import upper_snake
 from codegen.ir import (
     ArrayType,
     Column,
@@ -356,7 +357,7 @@ def test_columns_on_a_made_up_schema(import_generated: Any) -> None:
     assert C(pair=[3], head=b"\x01abc").validate() == []  # a short dynamic array: its missing positions pass
 
     module = importlib.import_module(C.__module__)
-    specs = {f.name: getattr(module, f"_VS_C_{f.name}") for f in dataclasses.fields(C)}
+    specs = {f.name: getattr(module, f"_C_{upper_snake(f.name)}_SPEC") for f in dataclasses.fields(C)}
     their_diag = module._v.diag  # the generated package's own runtime, not generated/_validate.py
     cells = st.one_of(st.integers(-20, 120), st.sampled_from([0, 5, 6, 100, 101, -99.0, 1.5, 40000, "x", None]))
 
@@ -383,7 +384,8 @@ def test_columns_on_a_made_up_schema(import_generated: Any) -> None:
 
 def _specs(cls: type) -> dict[str, Any]:
     module = importlib.import_module(cls.__module__)
-    return {f.name: getattr(module, f"_VS_{cls.__name__}_{f.name}") for f in dataclasses.fields(cls)}
+    prefix = upper_snake(cls.__name__)
+    return {f.name: getattr(module, f"_{prefix}_{upper_snake(f.name)}_SPEC") for f in dataclasses.fields(cls)}
 
 
 VALUES = st.one_of(

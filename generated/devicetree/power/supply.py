@@ -16,10 +16,11 @@ from ... import _validate as _v
 __all__ = ["SimpleBattery"]
 
 
-_VS_SimpleBattery_compatible = _v.Optional(
+# what validate() reports against, field by field (read only when a fast test trips)
+_SIMPLE_BATTERY_COMPATIBLE_SPEC = _v.Optional(
     _v.Array(_v.Text(const="simple-battery"), None, False, min_length=1), required=True
 )
-_VS_SimpleBattery_device_chemistry = _v.Optional(
+_SIMPLE_BATTERY_DEVICE_CHEMISTRY_SPEC = _v.Optional(
     _v.Text(
         choices=(
             "nickel-cadmium",
@@ -32,7 +33,7 @@ _VS_SimpleBattery_device_chemistry = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_over_voltage_threshold_microvolt = _v.Optional(
+_SIMPLE_BATTERY_OVER_VOLTAGE_THRESHOLD_MICROVOLT_SPEC = _v.Optional(
     _v.Array(
         _v.Array(
             _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
@@ -43,7 +44,7 @@ _VS_SimpleBattery_over_voltage_threshold_microvolt = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_re_charge_voltage_microvolt = _v.Optional(
+_SIMPLE_BATTERY_RE_CHARGE_VOLTAGE_MICROVOLT_SPEC = _v.Optional(
     _v.Array(
         _v.Array(
             _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
@@ -54,7 +55,7 @@ _VS_SimpleBattery_re_charge_voltage_microvolt = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_voltage_min_design_microvolt = _v.Optional(
+_SIMPLE_BATTERY_VOLTAGE_MIN_DESIGN_MICROVOLT_SPEC = _v.Optional(
     _v.Array(
         _v.Array(
             _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
@@ -65,7 +66,7 @@ _VS_SimpleBattery_voltage_min_design_microvolt = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_voltage_max_design_microvolt = _v.Optional(
+_SIMPLE_BATTERY_VOLTAGE_MAX_DESIGN_MICROVOLT_SPEC = _v.Optional(
     _v.Array(
         _v.Array(
             _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
@@ -76,19 +77,19 @@ _VS_SimpleBattery_voltage_max_design_microvolt = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_energy_full_design_microwatt_hours = _v.Optional(
+_SIMPLE_BATTERY_ENERGY_FULL_DESIGN_MICROWATT_HOURS_SPEC = _v.Optional(
     _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uWh"), None, False, min_length=1),
     required=False,
 )
-_VS_SimpleBattery_charge_full_design_microamp_hours = _v.Optional(
+_SIMPLE_BATTERY_CHARGE_FULL_DESIGN_MICROAMP_HOURS_SPEC = _v.Optional(
     _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uAh"), None, False, min_length=1),
     required=False,
 )
-_VS_SimpleBattery_trickle_charge_current_microamp = _v.Optional(
+_SIMPLE_BATTERY_TRICKLE_CHARGE_CURRENT_MICROAMP_SPEC = _v.Optional(
     _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uA"), None, False, min_length=1),
     required=False,
 )
-_VS_SimpleBattery_tricklecharge_upper_limit_microvolt = _v.Optional(
+_SIMPLE_BATTERY_TRICKLECHARGE_UPPER_LIMIT_MICROVOLT_SPEC = _v.Optional(
     _v.Array(
         _v.Array(
             _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
@@ -99,11 +100,11 @@ _VS_SimpleBattery_tricklecharge_upper_limit_microvolt = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_precharge_current_microamp = _v.Optional(
+_SIMPLE_BATTERY_PRECHARGE_CURRENT_MICROAMP_SPEC = _v.Optional(
     _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uA"), None, False, min_length=1),
     required=False,
 )
-_VS_SimpleBattery_precharge_upper_limit_microvolt = _v.Optional(
+_SIMPLE_BATTERY_PRECHARGE_UPPER_LIMIT_MICROVOLT_SPEC = _v.Optional(
     _v.Array(
         _v.Array(
             _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
@@ -114,15 +115,15 @@ _VS_SimpleBattery_precharge_upper_limit_microvolt = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_charge_term_current_microamp = _v.Optional(
+_SIMPLE_BATTERY_CHARGE_TERM_CURRENT_MICROAMP_SPEC = _v.Optional(
     _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uA"), None, False, min_length=1),
     required=False,
 )
-_VS_SimpleBattery_constant_charge_current_max_microamp = _v.Optional(
+_SIMPLE_BATTERY_CONSTANT_CHARGE_CURRENT_MAX_MICROAMP_SPEC = _v.Optional(
     _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uA"), None, False, min_length=1),
     required=False,
 )
-_VS_SimpleBattery_constant_charge_voltage_max_microvolt = _v.Optional(
+_SIMPLE_BATTERY_CONSTANT_CHARGE_VOLTAGE_MAX_MICROVOLT_SPEC = _v.Optional(
     _v.Array(
         _v.Array(
             _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV"), None, False, min_length=1
@@ -133,11 +134,11 @@ _VS_SimpleBattery_constant_charge_voltage_max_microvolt = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_factory_internal_resistance_micro_ohms = _v.Optional(
+_SIMPLE_BATTERY_FACTORY_INTERNAL_RESISTANCE_MICRO_OHMS_SPEC = _v.Optional(
     _v.Array(_v.Number(type="uint32", kind="uint", low=0, high=4294967295, unit="uOhm"), None, False, min_length=1),
     required=False,
 )
-_VS_SimpleBattery_resistance_temp_table = _v.Optional(
+_SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC = _v.Optional(
     _v.Array(
         _v.Array(
             _v.Number(type="uint32", kind="uint", low=0, high=4294967295),
@@ -159,13 +160,13 @@ _VS_SimpleBattery_resistance_temp_table = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_ocv_capacity_celsius = _v.Optional(
+_SIMPLE_BATTERY_OCV_CAPACITY_CELSIUS_SPEC = _v.Optional(
     _v.Array(
         _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="degC"), None, False, min_length=1
     ),
     required=False,
 )
-_VS_SimpleBattery_operating_range_celsius = _v.Optional(
+_SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC = _v.Optional(
     _v.Array(
         _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="degC"),
         2,
@@ -192,7 +193,7 @@ _VS_SimpleBattery_operating_range_celsius = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_ambient_celsius = _v.Optional(
+_SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC = _v.Optional(
     _v.Array(
         _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="degC"),
         2,
@@ -219,7 +220,7 @@ _VS_SimpleBattery_ambient_celsius = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_alert_celsius = _v.Optional(
+_SIMPLE_BATTERY_ALERT_CELSIUS_SPEC = _v.Optional(
     _v.Array(
         _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="degC"),
         2,
@@ -246,7 +247,7 @@ _VS_SimpleBattery_alert_celsius = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_volt_drop_thresh_microvolt = _v.Optional(
+_SIMPLE_BATTERY_VOLT_DROP_THRESH_MICROVOLT_SPEC = _v.Optional(
     _v.Array(
         _v.Array(
             _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="uV", maximum=48000000),
@@ -260,19 +261,19 @@ _VS_SimpleBattery_volt_drop_thresh_microvolt = _v.Optional(
     ),
     required=False,
 )
-_VS_SimpleBattery_volt_drop_soc_bp = _v.Optional(
+_SIMPLE_BATTERY_VOLT_DROP_SOC_BP_SPEC = _v.Optional(
     _v.Array(
         _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="bp"), None, False, min_length=1
     ),
     required=False,
 )
-_VS_SimpleBattery_volt_drop_temperatures_millicelsius = _v.Optional(
+_SIMPLE_BATTERY_VOLT_DROP_TEMPERATURES_MILLICELSIUS_SPEC = _v.Optional(
     _v.Array(
         _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mdegC"), None, False, min_length=1
     ),
     required=False,
 )
-_VS_SimpleBattery_ocv_capacity_table_n = _v.Pattern(
+_SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC = _v.Pattern(
     "^ocv-capacity-table-[0-9]+$",
     _v.Array(
         _v.Array(
@@ -294,7 +295,7 @@ _VS_SimpleBattery_ocv_capacity_table_n = _v.Pattern(
         min_length=1,
     ),
 )
-_VS_SimpleBattery_volt_drop_n_microvolt = _v.Pattern(
+_SIMPLE_BATTERY_VOLT_DROP_N_MICROVOLT_SPEC = _v.Pattern(
     "^volt-drop-[0-9]-microvolt",
     _v.Array(
         _v.Array(
@@ -928,7 +929,6 @@ class SimpleBattery:
         x: Any
         a: Any
         e: Any
-        sub: Any
         k_0: Any
         r_constant_charge_voltage_max_microvolt: Any
         r_ocv_capacity_celsius: Any
@@ -940,9 +940,9 @@ class SimpleBattery:
         v_table: Any
         try:
             if (x := self.compatible) is None or (len(x) < 1 or any((_x0 != "simple-battery") for _x0 in x)):
-                _v.diag(out, "compatible", self.compatible, _VS_SimpleBattery_compatible)
+                _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "compatible", self.compatible, _VS_SimpleBattery_compatible)
+            _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)
         try:
             if (x := self.device_chemistry) is not None and (
                 x
@@ -955,9 +955,9 @@ class SimpleBattery:
                     "lithium-ion-manganese-oxide",
                 }
             ):
-                _v.diag(out, "device-chemistry", self.device_chemistry, _VS_SimpleBattery_device_chemistry)
+                _v.diag(out, "device-chemistry", self.device_chemistry, _SIMPLE_BATTERY_DEVICE_CHEMISTRY_SPEC)
         except _v.SLOW:
-            _v.diag(out, "device-chemistry", self.device_chemistry, _VS_SimpleBattery_device_chemistry)
+            _v.diag(out, "device-chemistry", self.device_chemistry, _SIMPLE_BATTERY_DEVICE_CHEMISTRY_SPEC)
         try:
             if (x := self.over_voltage_threshold_microvolt) is not None and (
                 len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
@@ -966,14 +966,14 @@ class SimpleBattery:
                     out,
                     "over-voltage-threshold-microvolt",
                     self.over_voltage_threshold_microvolt,
-                    _VS_SimpleBattery_over_voltage_threshold_microvolt,
+                    _SIMPLE_BATTERY_OVER_VOLTAGE_THRESHOLD_MICROVOLT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "over-voltage-threshold-microvolt",
                 self.over_voltage_threshold_microvolt,
-                _VS_SimpleBattery_over_voltage_threshold_microvolt,
+                _SIMPLE_BATTERY_OVER_VOLTAGE_THRESHOLD_MICROVOLT_SPEC,
             )
         try:
             if (x := self.re_charge_voltage_microvolt) is not None and (
@@ -983,14 +983,14 @@ class SimpleBattery:
                     out,
                     "re-charge-voltage-microvolt",
                     self.re_charge_voltage_microvolt,
-                    _VS_SimpleBattery_re_charge_voltage_microvolt,
+                    _SIMPLE_BATTERY_RE_CHARGE_VOLTAGE_MICROVOLT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "re-charge-voltage-microvolt",
                 self.re_charge_voltage_microvolt,
-                _VS_SimpleBattery_re_charge_voltage_microvolt,
+                _SIMPLE_BATTERY_RE_CHARGE_VOLTAGE_MICROVOLT_SPEC,
             )
         try:
             if (x := self.voltage_min_design_microvolt) is not None and (
@@ -1000,14 +1000,14 @@ class SimpleBattery:
                     out,
                     "voltage-min-design-microvolt",
                     self.voltage_min_design_microvolt,
-                    _VS_SimpleBattery_voltage_min_design_microvolt,
+                    _SIMPLE_BATTERY_VOLTAGE_MIN_DESIGN_MICROVOLT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "voltage-min-design-microvolt",
                 self.voltage_min_design_microvolt,
-                _VS_SimpleBattery_voltage_min_design_microvolt,
+                _SIMPLE_BATTERY_VOLTAGE_MIN_DESIGN_MICROVOLT_SPEC,
             )
         try:
             if (x := self.voltage_max_design_microvolt) is not None and (
@@ -1017,14 +1017,14 @@ class SimpleBattery:
                     out,
                     "voltage-max-design-microvolt",
                     self.voltage_max_design_microvolt,
-                    _VS_SimpleBattery_voltage_max_design_microvolt,
+                    _SIMPLE_BATTERY_VOLTAGE_MAX_DESIGN_MICROVOLT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "voltage-max-design-microvolt",
                 self.voltage_max_design_microvolt,
-                _VS_SimpleBattery_voltage_max_design_microvolt,
+                _SIMPLE_BATTERY_VOLTAGE_MAX_DESIGN_MICROVOLT_SPEC,
             )
         try:
             a = self.energy_full_design_microwatt_hours
@@ -1034,7 +1034,7 @@ class SimpleBattery:
                         out,
                         "energy-full-design-microwatt-hours",
                         self.energy_full_design_microwatt_hours,
-                        _VS_SimpleBattery_energy_full_design_microwatt_hours,
+                        _SIMPLE_BATTERY_ENERGY_FULL_DESIGN_MICROWATT_HOURS_SPEC,
                     )
                 else:
                     for e in a:
@@ -1043,7 +1043,7 @@ class SimpleBattery:
                                 out,
                                 "energy-full-design-microwatt-hours",
                                 self.energy_full_design_microwatt_hours,
-                                _VS_SimpleBattery_energy_full_design_microwatt_hours,
+                                _SIMPLE_BATTERY_ENERGY_FULL_DESIGN_MICROWATT_HOURS_SPEC,
                             )
                             break
         except _v.SLOW:
@@ -1051,7 +1051,7 @@ class SimpleBattery:
                 out,
                 "energy-full-design-microwatt-hours",
                 self.energy_full_design_microwatt_hours,
-                _VS_SimpleBattery_energy_full_design_microwatt_hours,
+                _SIMPLE_BATTERY_ENERGY_FULL_DESIGN_MICROWATT_HOURS_SPEC,
             )
         try:
             a = self.charge_full_design_microamp_hours
@@ -1061,7 +1061,7 @@ class SimpleBattery:
                         out,
                         "charge-full-design-microamp-hours",
                         self.charge_full_design_microamp_hours,
-                        _VS_SimpleBattery_charge_full_design_microamp_hours,
+                        _SIMPLE_BATTERY_CHARGE_FULL_DESIGN_MICROAMP_HOURS_SPEC,
                     )
                 else:
                     for e in a:
@@ -1070,7 +1070,7 @@ class SimpleBattery:
                                 out,
                                 "charge-full-design-microamp-hours",
                                 self.charge_full_design_microamp_hours,
-                                _VS_SimpleBattery_charge_full_design_microamp_hours,
+                                _SIMPLE_BATTERY_CHARGE_FULL_DESIGN_MICROAMP_HOURS_SPEC,
                             )
                             break
         except _v.SLOW:
@@ -1078,7 +1078,7 @@ class SimpleBattery:
                 out,
                 "charge-full-design-microamp-hours",
                 self.charge_full_design_microamp_hours,
-                _VS_SimpleBattery_charge_full_design_microamp_hours,
+                _SIMPLE_BATTERY_CHARGE_FULL_DESIGN_MICROAMP_HOURS_SPEC,
             )
         try:
             a = self.trickle_charge_current_microamp
@@ -1088,7 +1088,7 @@ class SimpleBattery:
                         out,
                         "trickle-charge-current-microamp",
                         self.trickle_charge_current_microamp,
-                        _VS_SimpleBattery_trickle_charge_current_microamp,
+                        _SIMPLE_BATTERY_TRICKLE_CHARGE_CURRENT_MICROAMP_SPEC,
                     )
                 else:
                     for e in a:
@@ -1097,7 +1097,7 @@ class SimpleBattery:
                                 out,
                                 "trickle-charge-current-microamp",
                                 self.trickle_charge_current_microamp,
-                                _VS_SimpleBattery_trickle_charge_current_microamp,
+                                _SIMPLE_BATTERY_TRICKLE_CHARGE_CURRENT_MICROAMP_SPEC,
                             )
                             break
         except _v.SLOW:
@@ -1105,7 +1105,7 @@ class SimpleBattery:
                 out,
                 "trickle-charge-current-microamp",
                 self.trickle_charge_current_microamp,
-                _VS_SimpleBattery_trickle_charge_current_microamp,
+                _SIMPLE_BATTERY_TRICKLE_CHARGE_CURRENT_MICROAMP_SPEC,
             )
         try:
             if (x := self.tricklecharge_upper_limit_microvolt) is not None and (
@@ -1115,14 +1115,14 @@ class SimpleBattery:
                     out,
                     "tricklecharge-upper-limit-microvolt",
                     self.tricklecharge_upper_limit_microvolt,
-                    _VS_SimpleBattery_tricklecharge_upper_limit_microvolt,
+                    _SIMPLE_BATTERY_TRICKLECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "tricklecharge-upper-limit-microvolt",
                 self.tricklecharge_upper_limit_microvolt,
-                _VS_SimpleBattery_tricklecharge_upper_limit_microvolt,
+                _SIMPLE_BATTERY_TRICKLECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
             )
         try:
             a = self.precharge_current_microamp
@@ -1132,7 +1132,7 @@ class SimpleBattery:
                         out,
                         "precharge-current-microamp",
                         self.precharge_current_microamp,
-                        _VS_SimpleBattery_precharge_current_microamp,
+                        _SIMPLE_BATTERY_PRECHARGE_CURRENT_MICROAMP_SPEC,
                     )
                 else:
                     for e in a:
@@ -1141,7 +1141,7 @@ class SimpleBattery:
                                 out,
                                 "precharge-current-microamp",
                                 self.precharge_current_microamp,
-                                _VS_SimpleBattery_precharge_current_microamp,
+                                _SIMPLE_BATTERY_PRECHARGE_CURRENT_MICROAMP_SPEC,
                             )
                             break
         except _v.SLOW:
@@ -1149,7 +1149,7 @@ class SimpleBattery:
                 out,
                 "precharge-current-microamp",
                 self.precharge_current_microamp,
-                _VS_SimpleBattery_precharge_current_microamp,
+                _SIMPLE_BATTERY_PRECHARGE_CURRENT_MICROAMP_SPEC,
             )
         try:
             if (x := self.precharge_upper_limit_microvolt) is not None and (
@@ -1159,14 +1159,14 @@ class SimpleBattery:
                     out,
                     "precharge-upper-limit-microvolt",
                     self.precharge_upper_limit_microvolt,
-                    _VS_SimpleBattery_precharge_upper_limit_microvolt,
+                    _SIMPLE_BATTERY_PRECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "precharge-upper-limit-microvolt",
                 self.precharge_upper_limit_microvolt,
-                _VS_SimpleBattery_precharge_upper_limit_microvolt,
+                _SIMPLE_BATTERY_PRECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
             )
         try:
             a = self.charge_term_current_microamp
@@ -1176,7 +1176,7 @@ class SimpleBattery:
                         out,
                         "charge-term-current-microamp",
                         self.charge_term_current_microamp,
-                        _VS_SimpleBattery_charge_term_current_microamp,
+                        _SIMPLE_BATTERY_CHARGE_TERM_CURRENT_MICROAMP_SPEC,
                     )
                 else:
                     for e in a:
@@ -1185,7 +1185,7 @@ class SimpleBattery:
                                 out,
                                 "charge-term-current-microamp",
                                 self.charge_term_current_microamp,
-                                _VS_SimpleBattery_charge_term_current_microamp,
+                                _SIMPLE_BATTERY_CHARGE_TERM_CURRENT_MICROAMP_SPEC,
                             )
                             break
         except _v.SLOW:
@@ -1193,7 +1193,7 @@ class SimpleBattery:
                 out,
                 "charge-term-current-microamp",
                 self.charge_term_current_microamp,
-                _VS_SimpleBattery_charge_term_current_microamp,
+                _SIMPLE_BATTERY_CHARGE_TERM_CURRENT_MICROAMP_SPEC,
             )
         try:
             a = self.constant_charge_current_max_microamp
@@ -1203,7 +1203,7 @@ class SimpleBattery:
                         out,
                         "constant-charge-current-max-microamp",
                         self.constant_charge_current_max_microamp,
-                        _VS_SimpleBattery_constant_charge_current_max_microamp,
+                        _SIMPLE_BATTERY_CONSTANT_CHARGE_CURRENT_MAX_MICROAMP_SPEC,
                     )
                 else:
                     for e in a:
@@ -1212,7 +1212,7 @@ class SimpleBattery:
                                 out,
                                 "constant-charge-current-max-microamp",
                                 self.constant_charge_current_max_microamp,
-                                _VS_SimpleBattery_constant_charge_current_max_microamp,
+                                _SIMPLE_BATTERY_CONSTANT_CHARGE_CURRENT_MAX_MICROAMP_SPEC,
                             )
                             break
         except _v.SLOW:
@@ -1220,7 +1220,7 @@ class SimpleBattery:
                 out,
                 "constant-charge-current-max-microamp",
                 self.constant_charge_current_max_microamp,
-                _VS_SimpleBattery_constant_charge_current_max_microamp,
+                _SIMPLE_BATTERY_CONSTANT_CHARGE_CURRENT_MAX_MICROAMP_SPEC,
             )
         try:
             if (x := self.constant_charge_voltage_max_microvolt) is not None and (
@@ -1230,14 +1230,14 @@ class SimpleBattery:
                     out,
                     "constant-charge-voltage-max-microvolt",
                     self.constant_charge_voltage_max_microvolt,
-                    _VS_SimpleBattery_constant_charge_voltage_max_microvolt,
+                    _SIMPLE_BATTERY_CONSTANT_CHARGE_VOLTAGE_MAX_MICROVOLT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "constant-charge-voltage-max-microvolt",
                 self.constant_charge_voltage_max_microvolt,
-                _VS_SimpleBattery_constant_charge_voltage_max_microvolt,
+                _SIMPLE_BATTERY_CONSTANT_CHARGE_VOLTAGE_MAX_MICROVOLT_SPEC,
             )
         try:
             a = self.factory_internal_resistance_micro_ohms
@@ -1247,7 +1247,7 @@ class SimpleBattery:
                         out,
                         "factory-internal-resistance-micro-ohms",
                         self.factory_internal_resistance_micro_ohms,
-                        _VS_SimpleBattery_factory_internal_resistance_micro_ohms,
+                        _SIMPLE_BATTERY_FACTORY_INTERNAL_RESISTANCE_MICRO_OHMS_SPEC,
                     )
                 else:
                     for e in a:
@@ -1256,7 +1256,7 @@ class SimpleBattery:
                                 out,
                                 "factory-internal-resistance-micro-ohms",
                                 self.factory_internal_resistance_micro_ohms,
-                                _VS_SimpleBattery_factory_internal_resistance_micro_ohms,
+                                _SIMPLE_BATTERY_FACTORY_INTERNAL_RESISTANCE_MICRO_OHMS_SPEC,
                             )
                             break
         except _v.SLOW:
@@ -1264,23 +1264,28 @@ class SimpleBattery:
                 out,
                 "factory-internal-resistance-micro-ohms",
                 self.factory_internal_resistance_micro_ohms,
-                _VS_SimpleBattery_factory_internal_resistance_micro_ohms,
+                _SIMPLE_BATTERY_FACTORY_INTERNAL_RESISTANCE_MICRO_OHMS_SPEC,
             )
         try:
             if (x := self.resistance_temp_table) is not None and (
                 len(x) < 1 or any((len(_x0) != 2 or any((_x1 & -4294967296) for _x1 in _x0)) for _x0 in x)
             ):
                 _v.diag(
-                    out, "resistance-temp-table", self.resistance_temp_table, _VS_SimpleBattery_resistance_temp_table
+                    out, "resistance-temp-table", self.resistance_temp_table, _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC
                 )
         except _v.SLOW:
-            _v.diag(out, "resistance-temp-table", self.resistance_temp_table, _VS_SimpleBattery_resistance_temp_table)
+            _v.diag(
+                out, "resistance-temp-table", self.resistance_temp_table, _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC
+            )
         try:
             a = self.ocv_capacity_celsius
             if a is not None:
                 if len(a) < 1:
                     _v.diag(
-                        out, "ocv-capacity-celsius", self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius
+                        out,
+                        "ocv-capacity-celsius",
+                        self.ocv_capacity_celsius,
+                        _SIMPLE_BATTERY_OCV_CAPACITY_CELSIUS_SPEC,
                     )
                 else:
                     for e in a:
@@ -1289,11 +1294,11 @@ class SimpleBattery:
                                 out,
                                 "ocv-capacity-celsius",
                                 self.ocv_capacity_celsius,
-                                _VS_SimpleBattery_ocv_capacity_celsius,
+                                _SIMPLE_BATTERY_OCV_CAPACITY_CELSIUS_SPEC,
                             )
                             break
         except _v.SLOW:
-            _v.diag(out, "ocv-capacity-celsius", self.ocv_capacity_celsius, _VS_SimpleBattery_ocv_capacity_celsius)
+            _v.diag(out, "ocv-capacity-celsius", self.ocv_capacity_celsius, _SIMPLE_BATTERY_OCV_CAPACITY_CELSIUS_SPEC)
         try:
             a = self.operating_range_celsius
             if a is not None:
@@ -1302,7 +1307,7 @@ class SimpleBattery:
                         out,
                         "operating-range-celsius",
                         self.operating_range_celsius,
-                        _VS_SimpleBattery_operating_range_celsius,
+                        _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC,
                     )
                 else:
                     for e in a:
@@ -1311,37 +1316,40 @@ class SimpleBattery:
                                 out,
                                 "operating-range-celsius",
                                 self.operating_range_celsius,
-                                _VS_SimpleBattery_operating_range_celsius,
+                                _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC,
                             )
                             break
         except _v.SLOW:
             _v.diag(
-                out, "operating-range-celsius", self.operating_range_celsius, _VS_SimpleBattery_operating_range_celsius
+                out,
+                "operating-range-celsius",
+                self.operating_range_celsius,
+                _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC,
             )
         try:
             a = self.ambient_celsius
             if a is not None:
                 if len(a) != 2:
-                    _v.diag(out, "ambient-celsius", self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
+                    _v.diag(out, "ambient-celsius", self.ambient_celsius, _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC)
                 else:
                     for e in a:
                         if (e + 2147483648) & -4294967296:
-                            _v.diag(out, "ambient-celsius", self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
+                            _v.diag(out, "ambient-celsius", self.ambient_celsius, _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC)
                             break
         except _v.SLOW:
-            _v.diag(out, "ambient-celsius", self.ambient_celsius, _VS_SimpleBattery_ambient_celsius)
+            _v.diag(out, "ambient-celsius", self.ambient_celsius, _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC)
         try:
             a = self.alert_celsius
             if a is not None:
                 if len(a) != 2:
-                    _v.diag(out, "alert-celsius", self.alert_celsius, _VS_SimpleBattery_alert_celsius)
+                    _v.diag(out, "alert-celsius", self.alert_celsius, _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC)
                 else:
                     for e in a:
                         if (e + 2147483648) & -4294967296:
-                            _v.diag(out, "alert-celsius", self.alert_celsius, _VS_SimpleBattery_alert_celsius)
+                            _v.diag(out, "alert-celsius", self.alert_celsius, _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC)
                             break
         except _v.SLOW:
-            _v.diag(out, "alert-celsius", self.alert_celsius, _VS_SimpleBattery_alert_celsius)
+            _v.diag(out, "alert-celsius", self.alert_celsius, _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC)
         try:
             if (x := self.volt_drop_thresh_microvolt) is not None and (
                 len(x) != 1
@@ -1359,27 +1367,29 @@ class SimpleBattery:
                     out,
                     "volt-drop-thresh-microvolt",
                     self.volt_drop_thresh_microvolt,
-                    _VS_SimpleBattery_volt_drop_thresh_microvolt,
+                    _SIMPLE_BATTERY_VOLT_DROP_THRESH_MICROVOLT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "volt-drop-thresh-microvolt",
                 self.volt_drop_thresh_microvolt,
-                _VS_SimpleBattery_volt_drop_thresh_microvolt,
+                _SIMPLE_BATTERY_VOLT_DROP_THRESH_MICROVOLT_SPEC,
             )
         try:
             a = self.volt_drop_soc_bp
             if a is not None:
                 if len(a) < 1:
-                    _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
+                    _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _SIMPLE_BATTERY_VOLT_DROP_SOC_BP_SPEC)
                 else:
                     for e in a:
                         if (e + 2147483648) & -4294967296:
-                            _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
+                            _v.diag(
+                                out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _SIMPLE_BATTERY_VOLT_DROP_SOC_BP_SPEC
+                            )
                             break
         except _v.SLOW:
-            _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _VS_SimpleBattery_volt_drop_soc_bp)
+            _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _SIMPLE_BATTERY_VOLT_DROP_SOC_BP_SPEC)
         try:
             a = self.volt_drop_temperatures_millicelsius
             if a is not None:
@@ -1388,7 +1398,7 @@ class SimpleBattery:
                         out,
                         "volt-drop-temperatures-millicelsius",
                         self.volt_drop_temperatures_millicelsius,
-                        _VS_SimpleBattery_volt_drop_temperatures_millicelsius,
+                        _SIMPLE_BATTERY_VOLT_DROP_TEMPERATURES_MILLICELSIUS_SPEC,
                     )
                 else:
                     for e in a:
@@ -1397,7 +1407,7 @@ class SimpleBattery:
                                 out,
                                 "volt-drop-temperatures-millicelsius",
                                 self.volt_drop_temperatures_millicelsius,
-                                _VS_SimpleBattery_volt_drop_temperatures_millicelsius,
+                                _SIMPLE_BATTERY_VOLT_DROP_TEMPERATURES_MILLICELSIUS_SPEC,
                             )
                             break
         except _v.SLOW:
@@ -1405,7 +1415,7 @@ class SimpleBattery:
                 out,
                 "volt-drop-temperatures-millicelsius",
                 self.volt_drop_temperatures_millicelsius,
-                _VS_SimpleBattery_volt_drop_temperatures_millicelsius,
+                _SIMPLE_BATTERY_VOLT_DROP_TEMPERATURES_MILLICELSIUS_SPEC,
             )
         try:
             if any(
@@ -1428,11 +1438,11 @@ class SimpleBattery:
                     out,
                     "^ocv-capacity-table-[0-9]+$",
                     self.ocv_capacity_table_n,
-                    _VS_SimpleBattery_ocv_capacity_table_n,
+                    _SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
-                out, "^ocv-capacity-table-[0-9]+$", self.ocv_capacity_table_n, _VS_SimpleBattery_ocv_capacity_table_n
+                out, "^ocv-capacity-table-[0-9]+$", self.ocv_capacity_table_n, _SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC
             )
         try:
             if any(
@@ -1447,11 +1457,14 @@ class SimpleBattery:
                     out,
                     "^volt-drop-[0-9]-microvolt",
                     self.volt_drop_n_microvolt,
-                    _VS_SimpleBattery_volt_drop_n_microvolt,
+                    _SIMPLE_BATTERY_VOLT_DROP_N_MICROVOLT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
-                out, "^volt-drop-[0-9]-microvolt", self.volt_drop_n_microvolt, _VS_SimpleBattery_volt_drop_n_microvolt
+                out,
+                "^volt-drop-[0-9]-microvolt",
+                self.volt_drop_n_microvolt,
+                _SIMPLE_BATTERY_VOLT_DROP_N_MICROVOLT_SPEC,
             )
         # rule voltage-design-order (devicetree-battery.yaml:9)
         try:

@@ -93,16 +93,16 @@ def _lines(*rows: str) -> str:
 class _Writer:
     """Source of one message's struct, field table and methods."""
 
-    def __init__(self, msg: Message, view: ClassView) -> None:
+    def __init__(self, msg: Message, view: ClassView, ctx: ModuleContext) -> None:
         assert msg.mavlink is not None
         self.info = msg.mavlink
         self.cls = view.name
         self.msg_name = msg.name
         self.name = py_literal(msg.name)
         self.slots = _slots(msg, view)
-        self.struct = f"_MAV_{self.cls}"
-        self.table = f"_MAV_{self.cls}_FIELDS"
-        self.dtype = f"_MAV_{self.cls}_DTYPE"
+        self.struct = ctx.constant(self.cls, "PAYLOAD")  # the whole payload, in wire order
+        self.table = ctx.constant(self.cls, "FIELDS")
+        self.dtype = ctx.constant(self.cls, "DTYPE")
         self.fmt = "<" + "".join(s.fmt for s in self.slots)
         self.positions: list[int] = []  # first struct item of each slot
         pos = 0
@@ -112,16 +112,17 @@ class _Writer:
         self.n_items = pos
 
     def module_code(self) -> str:
-        table = ", ".join(f"({py_literal(s.ident)}, {py_literal(s.source)}, {py_literal(s.code)}, {s.count})"
-                          for s in self.slots)  # fmt: skip
+        rows = [f"({py_literal(s.ident)}, {py_literal(s.source)}, {py_literal(s.code)}, {s.count})" for s in self.slots]
+        table = ", ".join(rows) + ("," if len(rows) == 1 else "")
         dtype = ", ".join(
             f"({py_literal(s.source)}, {py_literal(s.dtype)}"
             + (f", ({s.count},))" if s.count and not s.is_text else ")")
             for s in self.slots
         )
         return _lines(
+            "# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype",
             f"{self.struct} = struct.Struct({py_literal(self.fmt)})",
-            f"{self.table}: tuple[tuple[str, str, str, int], ...] = ({table},)",
+            f"{self.table}: tuple[tuple[str, str, str, int], ...] = ({table})",
             f"{self.dtype}: list[tuple[Any, ...]] = [{dtype}]",
         )
 
@@ -152,7 +153,7 @@ class _Writer:
             attr = f"self.{s.ident}"
             if s.is_text:
                 local = f"t_{s.ident}"
-                pre.append(f"            {local} = {attr}.encode('utf-8', 'surrogateescape')")
+                pre.append(f'            {local} = {attr}.encode("utf-8", "surrogateescape")')
                 args.append(local)
                 checks.append(f"len({local}) > {s.count}")
             elif s.is_bytes:
@@ -280,7 +281,7 @@ class _Codec:
     def contribute(self, msg: Message, ctx: ModuleContext, view: ClassView) -> Contribution:
         if msg.format is not SourceFormat.MAVLINK or msg.mavlink is None:
             return Contribution()
-        writer = _Writer(msg, view)
+        writer = _Writer(msg, view, ctx)
         return Contribution(
             class_body=writer.class_body(),
             module_code=(writer.module_code(),),

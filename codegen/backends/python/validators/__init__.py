@@ -1,9 +1,9 @@
 """The validators extension: ``validate()``, ``check()`` and ``is_known()`` on every generated class.
 
 ``validate()`` is straight-line code specialised to the message: one cheap test per field (see
-:mod:`.validators_checks`), then the schema's cross-field rules (``Schema.rules``, from ``schemas/rules/``) compiled by
-:mod:`.validators_rules`. Violation types and the careful diagnosis live in the generated runtime
-module ``_validate.py``.
+:mod:`.fields` and :mod:`.checks`), then the schema's cross-field rules (``Schema.rules``, from
+``schemas/rules/``) compiled by :mod:`.rules`. Violation types and the careful diagnosis live in
+the generated runtime module ``_validate.py``.
 """
 
 from __future__ import annotations
@@ -12,8 +12,9 @@ from ....frontends import rules as rule_files
 from ....ir import Message, Schema
 from ..extensions import Contribution
 from ..literals import py_literal
+from ..naming import upper_snake
 from ..views import ClassView, ModuleContext
-from .checks import field_code
+from .fields import field_code
 from .rules import known_expr, rule_lines
 
 _INDENT = "    "
@@ -35,23 +36,28 @@ class _Validators:
         idents = {fv.source_name: fv.ident for fv in view.fields}
         specs: list[str] = []
         checks: list[str] = []
+        field_names: set[str] = set()
         for f in msg.fields:
             if f.is_padding:
                 continue
             ident = idents[f.name]
-            spec_name = f"_VS_{view.name}_{ident}"
+            spec_name = ctx.constant(view.name, f"{upper_snake(ident)}_SPEC")
             code = field_code(ctx.schema, msg, f, ident, spec_name)
             specs.append(f"{spec_name} = {code.spec_source}")
             checks += code.lines
-        local_names: set[str] = set()
+            field_names |= code.names
+        rule_names: set[str] = set()
         for bound in rule_files.bound_rules(ctx.schema, msg):
             lines, names = rule_lines(bound, msg, idents)
             checks += lines
-            local_names |= names
-        body = self._methods(msg, view, checks, sorted(local_names), idents)
+            rule_names |= names
+        # the locals validate() assigns, declared once: each is reused for fields of different types
+        declared = [n for n in ("x", "a", "e", "sub") if n in field_names] + sorted(rule_names)
+        body = self._methods(msg, view, checks, declared, idents)
+        comment = "# what validate() reports against, field by field (read only when a fast test trips)"
         return Contribution(
             class_body="\n".join(_block(body, 1)) + "\n",
-            module_code=("\n".join(specs),) if specs else (),
+            module_code=("\n".join([comment, *specs]),) if specs else (),
             imports=(f"from {ctx.root()} import _validate as _v",),
         )
 
@@ -59,12 +65,11 @@ class _Validators:
     def _methods(
         msg: Message, view: ClassView, checks: list[str], local_names: list[str], idents: dict[str, str]
     ) -> list[str]:
-        declared = ["x", "a", "e", "sub", *local_names]
         out = [
             "def validate(self) -> list[_v.Violation]:",
             '    """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""',
             "    out: list[_v.Violation] = []",
-            *[f"    {name}: Any" for name in declared],
+            *[f"    {name}: Any" for name in local_names],
             *_block(checks, 1),
             "    return out",
             "",
@@ -72,7 +77,7 @@ class _Validators:
             '    """Raise ValidationError, carrying every violation, when validate() finds an error."""',
             "    found = self.validate()",
             "    for v in found:",
-            "        if v.severity == 'error':",
+            '        if v.severity == "error":',
             f"            raise _v.ValidationError(found, {view.qualified_name})",
             "",
             "def is_known(self, field: str) -> bool:",
@@ -94,7 +99,7 @@ class _Validators:
                 "    if field in {" + ", ".join(_lit(n) for n in plain) + "}:",
                 "        return True",
             ]
-        out.append(f"    raise KeyError(f'{{field!r}} is not a field of ' + {view.qualified_name})")
+        out.append(f'    raise KeyError(f"{{field!r}} is not a field of " + {view.qualified_name})')
         return out
 
 

@@ -8,112 +8,23 @@ sentinel into one chained comparison or one bit test wherever possible.
 
 from __future__ import annotations
 
-import math
-import sys
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from ....ir import (
     ArrayType,
     CompositeType,
-    EnumKind,
     Field,
     FieldType,
-    Message,
     PrimitiveKind,
     PrimitiveType,
-    Range,
     Schema,
     Sentinel,
     StringType,
 )
-from ..literals import py_literal
+from ..literals import hex_literal, prose_literal, py_literal
+from .bounds import EnumFacts, enum_facts, folded, inside, number, type_bounds
 
-FLOAT_MAX = {16: 65504.0, 32: 3.4028234663852886e38, 64: sys.float_info.max}
 V = "\x00V\x00"  # placeholder for the value expression in a condition
-
-
-@dataclass(frozen=True)
-class EnumFacts:
-    """What a field's enum groups allow."""
-
-    values: dict[int, str] | None  # value enums: value -> member name
-    mask: int | None  # bitmask / bit-index enums: bits that may be set
-    bits: dict[int, str]  # bit value -> member name (reserved members included)
-
-
-def enum_facts(schema: Schema, f: Field) -> EnumFacts | None:
-    if not f.enums:
-        return None
-    values: dict[int, str] = {}
-    mask: int | None = None
-    bits: dict[int, str] = {}
-    for name in f.enums:
-        e = schema.enum(name)
-        for entry in e.entries:
-            if e.kind is EnumKind.VALUE:
-                values.setdefault(entry.value, entry.name)
-                continue
-            bit = entry.value if e.kind is EnumKind.BITMASK else 1 << entry.value
-            bits.setdefault(bit, entry.name)
-            # members named *RESERVED* document bits that must stay zero
-            if "RESERVED" not in entry.name.upper():
-                mask = (mask or 0) | bit
-        if e.kind is not EnumKind.VALUE and mask is None:
-            mask = 0
-    if mask is not None:
-        return EnumFacts(None, mask, bits)
-    return EnumFacts(values, None, bits)
-
-
-def _leaf(t: FieldType) -> FieldType:
-    while isinstance(t, ArrayType):
-        t = t.element
-    return t
-
-
-@dataclass(frozen=True)
-class Bounds:
-    """The interval a primitive value must lie in (type width folded with the schema range)."""
-
-    low: float
-    high: float
-    low_strict: bool
-    high_strict: bool
-
-
-def type_bounds(t: PrimitiveType, rng: Range | None) -> tuple[float, float]:
-    if t.kind is PrimitiveKind.FLOAT:
-        top = FLOAT_MAX.get(t.bits, sys.float_info.max)
-        # ±inf is a violation unless the schema's range explicitly reaches it
-        high = math.inf if rng is not None and rng.maximum == math.inf else top
-        low = -math.inf if rng is not None and rng.minimum == -math.inf else -top
-        return low, high
-    vr = t.value_range
-    assert vr is not None
-    return vr
-
-
-def folded(t: PrimitiveType, rng: Range | None) -> Bounds:
-    low, high = type_bounds(t, rng)
-    lo_s = hi_s = False
-    if rng is not None:
-        if rng.minimum is not None and (rng.minimum > low or (rng.minimum == low and rng.exclusive_minimum)):
-            low, lo_s = rng.minimum, rng.exclusive_minimum
-        if rng.maximum is not None and (rng.maximum < high or (rng.maximum == high and rng.exclusive_maximum)):
-            high, hi_s = rng.maximum, rng.exclusive_maximum
-    return Bounds(low, high, lo_s, hi_s)
-
-
-def _inside(b: Bounds, value: float) -> bool:
-    above = value > b.low if b.low_strict else value >= b.low
-    below = value < b.high if b.high_strict else value <= b.high
-    return above and below
-
-
-def _num(value: float, t: PrimitiveType) -> str:
-    if t.kind is PrimitiveKind.FLOAT:
-        return py_literal(float(value))
-    return py_literal(int(value)) if float(value).is_integer() else py_literal(value)
 
 
 class NumberCheck:
@@ -131,12 +42,12 @@ class NumberCheck:
         t, f = self.t, self.f
         args = [f"type={py_literal(t.name)}", f"kind={py_literal(t.kind.value)}"]
         if self.label:
-            args.append(f"label={py_literal(self.label)}")
+            args.append(f"label={prose_literal(self.label)}")
         if t.kind is PrimitiveKind.CHAR:
             args += ["low=0", "high=255"]
         else:
             low, high = type_bounds(t, f.range)
-            args += [f"low={_num(low, t)}", f"high={_num(high, t)}"]
+            args += [f"low={number(low, t)}", f"high={number(high, t)}"]
         unit = f.unit.symbol if f.unit is not None else (f.unit_text or "")
         if unit:
             args.append(f"unit={py_literal(unit)}")
@@ -151,15 +62,15 @@ class NumberCheck:
             if r.exclusive_maximum:
                 args.append("exclusive_maximum=True")
         if self.sentinel is not None:
-            args.append(f"sentinel={_num(self.sentinel.value, t)}")
+            args.append(f"sentinel={number(self.sentinel.value, t)}")
             args.append(f"sentinel_text={py_literal(self.sentinel.text)}")
         facts = self.facts
         if facts is not None and facts.values is not None:
             items = ", ".join(f"{v}: {py_literal(n)}" for v, n in sorted(facts.values.items()))
             args.append("values={" + items + "}")
         if facts is not None and facts.mask is not None:
-            args.append(f"mask={facts.mask:#x}")
-            items = ", ".join(f"{b:#x}: {py_literal(n)}" for b, n in sorted(facts.bits.items()))
+            args.append(f"mask={hex_literal(facts.mask)}")
+            items = ", ".join(f"{hex_literal(b)}: {py_literal(n)}" for b, n in sorted(facts.bits.items()))
             args.append("bits={" + items + "}")
         return "_v.Number(" + ", ".join(args) + ")"
 
@@ -176,11 +87,11 @@ class NumberCheck:
         if t.kind is PrimitiveKind.FLOAT:
             lo = "<" if b.low_strict else "<="
             hi = "<" if b.high_strict else "<="
-            cond = f"not ({_num(b.low, t)} {lo} {V} {hi} {_num(b.high, t)})"  # false for NaN too
+            cond = f"not ({number(b.low, t)} {lo} {V} {hi} {number(b.high, t)})"  # false for NaN too
             if s is not None and s.is_nan:
                 cond += f" and {V} == {V}"
-            elif s is not None and not _inside(b, float(s.value)):
-                cond += f" and {V} != {_num(s.value, t)}"
+            elif s is not None and not inside(b, float(s.value)):
+                cond += f" and {V} != {number(s.value, t)}"
             return f"({cond})"
         # integers: a bit test rejects floats (TypeError) and values beyond the width at once
         tlow, thigh = type_bounds(t, None)
@@ -201,8 +112,8 @@ class NumberCheck:
             hi = "<" if b.high_strict else "<="
             parts.append(
                 (
-                    f"not ({_num(b.low, t)} {lo} {V} {hi} {_num(b.high, t)})",
-                    s is not None and not _inside(b, float(s.value)),
+                    f"not ({number(b.low, t)} {lo} {V} {hi} {number(b.high, t)})",
+                    s is not None and not inside(b, float(s.value)),
                 )
             )
         conds = [f"({c} and {V} != {int(s.value)})" if trips and s is not None else c for c, trips in parts]
@@ -216,7 +127,7 @@ class TextCheck:
         self.label = label
 
     def spec(self) -> str:
-        args = [f"label={py_literal(self.label)}"] if self.label else []
+        args = [f"label={prose_literal(self.label)}"] if self.label else []
         if self.t.capacity is not None:
             args.append(f"capacity={self.t.capacity}")
         strings = tuple(str(c) for c in self.f.choices)
@@ -330,76 +241,3 @@ def build(schema: Schema, f: Field, t: FieldType, depth: int = 0, label: str = "
         at = replace(f, range=c.range.intersect(f.range) if c.range is not None else f.range, unit=c.unit or f.unit)
         columns.append(build(schema, at, t.element, depth + 1, c.doc or label))
     return ArrayCheck(t, build(schema, f, t.element, depth + 1, label), depth, columns)
-
-
-@dataclass(frozen=True)
-class FieldCode:
-    spec_name: str
-    spec_source: str
-    lines: list[str]  # statements in validate(), unindented
-
-
-def field_code(schema: Schema, msg: Message, f: Field, ident: str, spec_name: str) -> FieldCode:
-    """Statements checking ``self.<ident>`` and appending violations to ``out``."""
-    check = build(schema, f, f.type)
-    optional = msg.devicetree is not None and f.pattern is None
-    spec = check.spec()
-    if f.pattern is not None:
-        spec = f"_v.Pattern({py_literal(f.pattern)}, {spec})"
-    elif optional:
-        spec = f"_v.Optional({spec}, required={py_literal(f.required)})"
-    path = py_literal(f.name)
-    attr = f"self.{ident}"
-    slow = f"_v.diag(out, {path}, {attr}, {spec_name})"
-    if isinstance(check, NestedCheck):
-        body = [
-            f"x = {attr}",
-            f"if x.QUALIFIED_NAME != {py_literal(check.qualified)}:",
-            f"    {slow}",
-            "else:",
-            "    sub = x.validate()",
-            "    if sub:",
-            f"        out.extend(_v.prefixed({path}, sub))",
-        ]
-    elif f.pattern is not None:
-        cond = check.bad().replace(V, "x")
-        body = [
-            f"if any(not _v.search({py_literal(f.pattern)}, k) or {cond} for k, x in {attr}.items()):",
-            f"    {slow}",
-        ]
-    elif isinstance(check, ArrayCheck) and not check.byte and not check.ranged and isinstance(check.inner, NumberCheck):
-        # top-level array of numbers: a plain loop beats any() with a generator
-        length = check.length_bad()
-        item = check.inner.bad().replace(V, "e")
-        if optional and f.required:
-            head, ind = [f"a = {attr}", "if a is None:", f"    {slow}", "else:"], "    "
-        elif optional:
-            head, ind = [f"a = {attr}", "if a is not None:"], "    "
-        else:
-            head, ind = [f"a = {attr}"], ""
-        loop = ["for e in a:", f"    if {item}:", f"        {slow}", "        break"]
-        if length:
-            cond = " or ".join(length).replace(V, "a")
-            inner = [f"if {cond}:", f"    {slow}", "else:", *["    " + x for x in loop]]
-        else:
-            inner = loop
-        body = head + [ind + x for x in inner]
-    else:
-        cond = check.bad()
-        if optional:
-            if f.required:
-                cond = f"(x := {attr}) is None or {cond.replace(V, 'x')}"
-            else:
-                cond = f"(x := {attr}) is not None and {cond.replace(V, 'x')}"
-        elif cond.count(V) == 1:
-            cond = cond.replace(V, attr)
-        else:
-            cond = f"{cond.replace(V, 'x', 1).replace(V, 'x')}"
-            body0 = f"x = {attr}"
-            return FieldCode(spec_name, spec, _wrap([body0, f"if {cond}:", f"    {slow}"], slow))
-        body = [f"if {cond}:", f"    {slow}"]
-    return FieldCode(spec_name, spec, _wrap(body, slow))
-
-
-def _wrap(body: list[str], slow: str) -> list[str]:
-    return ["try:", *["    " + line for line in body], "except _v.SLOW:", f"    {slow}"]

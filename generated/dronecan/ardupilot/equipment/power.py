@@ -50,16 +50,17 @@ _DC_BatteryInfoAux_6 = (
 _DC_BatteryInfoAux_7 = struct.Struct("<HHeeH")
 
 
-_VS_BatteryInfoAux_timestamp = _v.Nested("dronecan.uavcan.Timestamp")
-_VS_BatteryInfoAux_voltage_cell = _v.Array(
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_INFO_AUX_TIMESTAMP_SPEC = _v.Nested("dronecan.uavcan.Timestamp")
+_BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC = _v.Array(
     _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V"), 255, False
 )
-_VS_BatteryInfoAux_cycle_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryInfoAux_over_discharge_count = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_BatteryInfoAux_max_current = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="A")
-_VS_BatteryInfoAux_nominal_voltage = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V")
-_VS_BatteryInfoAux_is_powering_off = _v.Number(type="bool", kind="bool", low=0, high=1)
-_VS_BatteryInfoAux_battery_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_INFO_AUX_CYCLE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_INFO_AUX_MAX_CURRENT_SPEC = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="A")
+_BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V")
+_BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
+_BATTERY_INFO_AUX_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
 
 
 @functools.cache
@@ -389,55 +390,57 @@ class BatteryInfoAux:
         try:
             x = self.timestamp
             if x.QUALIFIED_NAME != "dronecan.uavcan.Timestamp":
-                _v.diag(out, "timestamp", self.timestamp, _VS_BatteryInfoAux_timestamp)
+                _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_AUX_TIMESTAMP_SPEC)
             else:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("timestamp", sub))
         except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _VS_BatteryInfoAux_timestamp)
+            _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_AUX_TIMESTAMP_SPEC)
         try:
             a = self.voltage_cell
             if len(a) > 255:
-                _v.diag(out, "voltage_cell", self.voltage_cell, _VS_BatteryInfoAux_voltage_cell)
+                _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
             else:
                 for e in a:
                     if not (-65504.0 <= e <= 65504.0):
-                        _v.diag(out, "voltage_cell", self.voltage_cell, _VS_BatteryInfoAux_voltage_cell)
+                        _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
                         break
         except _v.SLOW:
-            _v.diag(out, "voltage_cell", self.voltage_cell, _VS_BatteryInfoAux_voltage_cell)
+            _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
         try:
             if self.cycle_count & -65536:
-                _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryInfoAux_cycle_count)
+                _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _VS_BatteryInfoAux_cycle_count)
+            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC)
         try:
             if self.over_discharge_count & -65536:
-                _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryInfoAux_over_discharge_count)
+                _v.diag(
+                    out, "over_discharge_count", self.over_discharge_count, _BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC
+                )
         except _v.SLOW:
-            _v.diag(out, "over_discharge_count", self.over_discharge_count, _VS_BatteryInfoAux_over_discharge_count)
+            _v.diag(out, "over_discharge_count", self.over_discharge_count, _BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC)
         try:
             if not (-65504.0 <= self.max_current <= 65504.0):
-                _v.diag(out, "max_current", self.max_current, _VS_BatteryInfoAux_max_current)
+                _v.diag(out, "max_current", self.max_current, _BATTERY_INFO_AUX_MAX_CURRENT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "max_current", self.max_current, _VS_BatteryInfoAux_max_current)
+            _v.diag(out, "max_current", self.max_current, _BATTERY_INFO_AUX_MAX_CURRENT_SPEC)
         try:
             if not (-65504.0 <= self.nominal_voltage <= 65504.0):
-                _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryInfoAux_nominal_voltage)
+                _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _VS_BatteryInfoAux_nominal_voltage)
+            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC)
         try:
             x = self.is_powering_off
             if x is not True and x is not False:
-                _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryInfoAux_is_powering_off)
+                _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC)
         except _v.SLOW:
-            _v.diag(out, "is_powering_off", self.is_powering_off, _VS_BatteryInfoAux_is_powering_off)
+            _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC)
         try:
             if self.battery_id & -256:
-                _v.diag(out, "battery_id", self.battery_id, _VS_BatteryInfoAux_battery_id)
+                _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_AUX_BATTERY_ID_SPEC)
         except _v.SLOW:
-            _v.diag(out, "battery_id", self.battery_id, _VS_BatteryInfoAux_battery_id)
+            _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_AUX_BATTERY_ID_SPEC)
         return out
 
     def check(self) -> None:

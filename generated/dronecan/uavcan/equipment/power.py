@@ -84,28 +84,29 @@ _DC_BatteryInfo_4 = (
 _DC_BatteryInfo_5 = struct.Struct("<eeeeeeeIBI")
 
 
-_VS_BatteryInfo_temperature = _v.Number(
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_INFO_TEMPERATURE_SPEC = _v.Number(
     type="float16", kind="float", low=-65504.0, high=65504.0, unit="K", sentinel=math.nan, sentinel_text="NaN"
 )
-_VS_BatteryInfo_voltage = _v.Number(
+_BATTERY_INFO_VOLTAGE_SPEC = _v.Number(
     type="float16", kind="float", low=-65504.0, high=65504.0, unit="V", sentinel=math.nan, sentinel_text="NaN"
 )
-_VS_BatteryInfo_current = _v.Number(
+_BATTERY_INFO_CURRENT_SPEC = _v.Number(
     type="float16", kind="float", low=-65504.0, high=65504.0, unit="A", sentinel=math.nan, sentinel_text="NaN"
 )
-_VS_BatteryInfo_average_power_10sec = _v.Number(
+_BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC = _v.Number(
     type="float16", kind="float", low=-65504.0, high=65504.0, unit="W", sentinel=math.nan, sentinel_text="NaN"
 )
-_VS_BatteryInfo_remaining_capacity_wh = _v.Number(
+_BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC = _v.Number(
     type="float16", kind="float", low=-65504.0, high=65504.0, unit="Wh", sentinel=math.nan, sentinel_text="NaN"
 )
-_VS_BatteryInfo_full_charge_capacity_wh = _v.Number(
+_BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC = _v.Number(
     type="float16", kind="float", low=-65504.0, high=65504.0, unit="Wh", sentinel=math.nan, sentinel_text="NaN"
 )
-_VS_BatteryInfo_hours_to_full_charge = _v.Number(
+_BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC = _v.Number(
     type="float16", kind="float", low=-65504.0, high=65504.0, unit="h", sentinel=math.nan, sentinel_text="NaN"
 )
-_VS_BatteryInfo_status_flags = _v.Number(
+_BATTERY_INFO_STATUS_FLAGS_SPEC = _v.Number(
     type="uint11",
     kind="uint",
     low=0,
@@ -125,14 +126,14 @@ _VS_BatteryInfo_status_flags = _v.Number(
         0x400: "STATUS_FLAG_RESERVED_B",
     },
 )
-_VS_BatteryInfo_state_of_health_pct = _v.Number(
+_BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC = _v.Number(
     type="uint7", kind="uint", low=0, high=127, unit="%", sentinel=127, sentinel_text="STATE_OF_HEALTH_UNKNOWN"
 )
-_VS_BatteryInfo_state_of_charge_pct = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
-_VS_BatteryInfo_state_of_charge_pct_stdev = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
-_VS_BatteryInfo_battery_id = _v.Number(type="uint8", kind="uint", low=0, high=255)
-_VS_BatteryInfo_model_instance_id = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
-_VS_BatteryInfo_model_name = _v.Array(_v.Number(type="uint8", kind="uint", low=0, high=255), 31, False, byte=True)
+_BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
+_BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
+_BATTERY_INFO_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_INFO_MODEL_INSTANCE_ID_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+_BATTERY_INFO_MODEL_NAME_SPEC = _v.Array(_v.Number(type="uint8", kind="uint", low=0, high=255), 31, False, byte=True)
 
 
 _DC_CircuitStatus_1 = struct.Struct("<2f")
@@ -155,10 +156,11 @@ _DC_CircuitStatus_4 = (
 _DC_CircuitStatus_5 = struct.Struct("<HeeB")
 
 
-_VS_CircuitStatus_circuit_id = _v.Number(type="uint16", kind="uint", low=0, high=65535)
-_VS_CircuitStatus_voltage = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V")
-_VS_CircuitStatus_current = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="A")
-_VS_CircuitStatus_error_flags = _v.Number(
+# what validate() reports against, field by field (read only when a fast test trips)
+_CIRCUIT_STATUS_CIRCUIT_ID_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_CIRCUIT_STATUS_VOLTAGE_SPEC = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V")
+_CIRCUIT_STATUS_CURRENT_SPEC = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="A")
+_CIRCUIT_STATUS_ERROR_FLAGS_SPEC = _v.Number(
     type="uint8",
     kind="uint",
     low=0,
@@ -194,15 +196,16 @@ _DC_PrimaryPowerSupplyStatus_4 = (
 _DC_PrimaryPowerSupplyStatus_5 = struct.Struct("<eeH")
 
 
-_VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power = _v.Number(
+# what validate() reports against, field by field (read only when a fast test trips)
+_PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC = _v.Number(
     type="float16", kind="float", low=-65504.0, high=65504.0, unit="h"
 )
-_VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance = _v.Number(
+_PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC = _v.Number(
     type="float16", kind="float", low=-65504.0, high=65504.0, unit="Hours^2"
 )
-_VS_PrimaryPowerSupplyStatus_external_power_available = _v.Number(type="bool", kind="bool", low=0, high=1)
-_VS_PrimaryPowerSupplyStatus_remaining_energy_pct = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
-_VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev = _v.Number(
+_PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
+_PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
+_PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC = _v.Number(
     type="uint7", kind="uint", low=0, high=127, unit="%"
 )
 
@@ -788,41 +791,40 @@ class BatteryInfo:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         x: Any
-        a: Any
-        e: Any
-        sub: Any
         r_state_of_charge_pct: Any
         r_state_of_health_pct: Any
         try:
             x = self.temperature
             if not (-65504.0 <= x <= 65504.0) and x == x:
-                _v.diag(out, "temperature", self.temperature, _VS_BatteryInfo_temperature)
+                _v.diag(out, "temperature", self.temperature, _BATTERY_INFO_TEMPERATURE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _VS_BatteryInfo_temperature)
+            _v.diag(out, "temperature", self.temperature, _BATTERY_INFO_TEMPERATURE_SPEC)
         try:
             x = self.voltage
             if not (-65504.0 <= x <= 65504.0) and x == x:
-                _v.diag(out, "voltage", self.voltage, _VS_BatteryInfo_voltage)
+                _v.diag(out, "voltage", self.voltage, _BATTERY_INFO_VOLTAGE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _VS_BatteryInfo_voltage)
+            _v.diag(out, "voltage", self.voltage, _BATTERY_INFO_VOLTAGE_SPEC)
         try:
             x = self.current
             if not (-65504.0 <= x <= 65504.0) and x == x:
-                _v.diag(out, "current", self.current, _VS_BatteryInfo_current)
+                _v.diag(out, "current", self.current, _BATTERY_INFO_CURRENT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "current", self.current, _VS_BatteryInfo_current)
+            _v.diag(out, "current", self.current, _BATTERY_INFO_CURRENT_SPEC)
         try:
             x = self.average_power_10sec
             if not (-65504.0 <= x <= 65504.0) and x == x:
-                _v.diag(out, "average_power_10sec", self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
+                _v.diag(out, "average_power_10sec", self.average_power_10sec, _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC)
         except _v.SLOW:
-            _v.diag(out, "average_power_10sec", self.average_power_10sec, _VS_BatteryInfo_average_power_10sec)
+            _v.diag(out, "average_power_10sec", self.average_power_10sec, _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC)
         try:
             x = self.remaining_capacity_wh
             if not (-65504.0 <= x <= 65504.0) and x == x:
-                _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
+                _v.diag(
+                    out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC
+                )
         except _v.SLOW:
-            _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _VS_BatteryInfo_remaining_capacity_wh)
+            _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC)
         try:
             x = self.full_charge_capacity_wh
             if not (-65504.0 <= x <= 65504.0) and x == x:
@@ -830,64 +832,64 @@ class BatteryInfo:
                     out,
                     "full_charge_capacity_wh",
                     self.full_charge_capacity_wh,
-                    _VS_BatteryInfo_full_charge_capacity_wh,
+                    _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
-                out, "full_charge_capacity_wh", self.full_charge_capacity_wh, _VS_BatteryInfo_full_charge_capacity_wh
+                out, "full_charge_capacity_wh", self.full_charge_capacity_wh, _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC
             )
         try:
             x = self.hours_to_full_charge
             if not (-65504.0 <= x <= 65504.0) and x == x:
-                _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
+                _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _VS_BatteryInfo_hours_to_full_charge)
+            _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC)
         try:
             if self.status_flags & -512:
-                _v.diag(out, "status_flags", self.status_flags, _VS_BatteryInfo_status_flags)
+                _v.diag(out, "status_flags", self.status_flags, _BATTERY_INFO_STATUS_FLAGS_SPEC)
         except _v.SLOW:
-            _v.diag(out, "status_flags", self.status_flags, _VS_BatteryInfo_status_flags)
+            _v.diag(out, "status_flags", self.status_flags, _BATTERY_INFO_STATUS_FLAGS_SPEC)
         try:
             if self.state_of_health_pct & -128:
-                _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _VS_BatteryInfo_state_of_health_pct)
+                _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _VS_BatteryInfo_state_of_health_pct)
+            _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC)
         try:
             if self.state_of_charge_pct & -128:
-                _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _VS_BatteryInfo_state_of_charge_pct)
+                _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _VS_BatteryInfo_state_of_charge_pct)
+            _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC)
         try:
             if self.state_of_charge_pct_stdev & -128:
                 _v.diag(
                     out,
                     "state_of_charge_pct_stdev",
                     self.state_of_charge_pct_stdev,
-                    _VS_BatteryInfo_state_of_charge_pct_stdev,
+                    _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "state_of_charge_pct_stdev",
                 self.state_of_charge_pct_stdev,
-                _VS_BatteryInfo_state_of_charge_pct_stdev,
+                _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC,
             )
         try:
             if self.battery_id & -256:
-                _v.diag(out, "battery_id", self.battery_id, _VS_BatteryInfo_battery_id)
+                _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_BATTERY_ID_SPEC)
         except _v.SLOW:
-            _v.diag(out, "battery_id", self.battery_id, _VS_BatteryInfo_battery_id)
+            _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_BATTERY_ID_SPEC)
         try:
             if self.model_instance_id & -4294967296:
-                _v.diag(out, "model_instance_id", self.model_instance_id, _VS_BatteryInfo_model_instance_id)
+                _v.diag(out, "model_instance_id", self.model_instance_id, _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC)
         except _v.SLOW:
-            _v.diag(out, "model_instance_id", self.model_instance_id, _VS_BatteryInfo_model_instance_id)
+            _v.diag(out, "model_instance_id", self.model_instance_id, _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC)
         try:
             x = self.model_name
             if x.__class__ is not bytes or len(x) > 31:
-                _v.diag(out, "model_name", self.model_name, _VS_BatteryInfo_model_name)
+                _v.diag(out, "model_name", self.model_name, _BATTERY_INFO_MODEL_NAME_SPEC)
         except _v.SLOW:
-            _v.diag(out, "model_name", self.model_name, _VS_BatteryInfo_model_name)
+            _v.diag(out, "model_name", self.model_name, _BATTERY_INFO_MODEL_NAME_SPEC)
         # rule state-of-health-percent (dronecan-power.yaml:7)
         try:
             r_state_of_health_pct = self.state_of_health_pct
@@ -1123,30 +1125,26 @@ class CircuitStatus:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        a: Any
-        e: Any
-        sub: Any
         try:
             if self.circuit_id & -65536:
-                _v.diag(out, "circuit_id", self.circuit_id, _VS_CircuitStatus_circuit_id)
+                _v.diag(out, "circuit_id", self.circuit_id, _CIRCUIT_STATUS_CIRCUIT_ID_SPEC)
         except _v.SLOW:
-            _v.diag(out, "circuit_id", self.circuit_id, _VS_CircuitStatus_circuit_id)
+            _v.diag(out, "circuit_id", self.circuit_id, _CIRCUIT_STATUS_CIRCUIT_ID_SPEC)
         try:
             if not (-65504.0 <= self.voltage <= 65504.0):
-                _v.diag(out, "voltage", self.voltage, _VS_CircuitStatus_voltage)
+                _v.diag(out, "voltage", self.voltage, _CIRCUIT_STATUS_VOLTAGE_SPEC)
         except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _VS_CircuitStatus_voltage)
+            _v.diag(out, "voltage", self.voltage, _CIRCUIT_STATUS_VOLTAGE_SPEC)
         try:
             if not (-65504.0 <= self.current <= 65504.0):
-                _v.diag(out, "current", self.current, _VS_CircuitStatus_current)
+                _v.diag(out, "current", self.current, _CIRCUIT_STATUS_CURRENT_SPEC)
         except _v.SLOW:
-            _v.diag(out, "current", self.current, _VS_CircuitStatus_current)
+            _v.diag(out, "current", self.current, _CIRCUIT_STATUS_CURRENT_SPEC)
         try:
             if self.error_flags & -16:
-                _v.diag(out, "error_flags", self.error_flags, _VS_CircuitStatus_error_flags)
+                _v.diag(out, "error_flags", self.error_flags, _CIRCUIT_STATUS_ERROR_FLAGS_SPEC)
         except _v.SLOW:
-            _v.diag(out, "error_flags", self.error_flags, _VS_CircuitStatus_error_flags)
+            _v.diag(out, "error_flags", self.error_flags, _CIRCUIT_STATUS_ERROR_FLAGS_SPEC)
         return out
 
     def check(self) -> None:
@@ -1382,9 +1380,6 @@ class PrimaryPowerSupplyStatus:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         x: Any
-        a: Any
-        e: Any
-        sub: Any
         r_remaining_energy_pct: Any
         try:
             if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power <= 65504.0):
@@ -1392,14 +1387,14 @@ class PrimaryPowerSupplyStatus:
                     out,
                     "hours_to_empty_at_10sec_avg_power",
                     self.hours_to_empty_at_10sec_avg_power,
-                    _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power,
+                    _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "hours_to_empty_at_10sec_avg_power",
                 self.hours_to_empty_at_10sec_avg_power,
-                _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power,
+                _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC,
             )
         try:
             if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power_variance <= 65504.0):
@@ -1407,14 +1402,14 @@ class PrimaryPowerSupplyStatus:
                     out,
                     "hours_to_empty_at_10sec_avg_power_variance",
                     self.hours_to_empty_at_10sec_avg_power_variance,
-                    _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance,
+                    _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "hours_to_empty_at_10sec_avg_power_variance",
                 self.hours_to_empty_at_10sec_avg_power_variance,
-                _VS_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance,
+                _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC,
             )
         try:
             x = self.external_power_available
@@ -1423,14 +1418,14 @@ class PrimaryPowerSupplyStatus:
                     out,
                     "external_power_available",
                     self.external_power_available,
-                    _VS_PrimaryPowerSupplyStatus_external_power_available,
+                    _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "external_power_available",
                 self.external_power_available,
-                _VS_PrimaryPowerSupplyStatus_external_power_available,
+                _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC,
             )
         try:
             if self.remaining_energy_pct & -128:
@@ -1438,14 +1433,14 @@ class PrimaryPowerSupplyStatus:
                     out,
                     "remaining_energy_pct",
                     self.remaining_energy_pct,
-                    _VS_PrimaryPowerSupplyStatus_remaining_energy_pct,
+                    _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "remaining_energy_pct",
                 self.remaining_energy_pct,
-                _VS_PrimaryPowerSupplyStatus_remaining_energy_pct,
+                _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC,
             )
         try:
             if self.remaining_energy_pct_stdev & -128:
@@ -1453,14 +1448,14 @@ class PrimaryPowerSupplyStatus:
                     out,
                     "remaining_energy_pct_stdev",
                     self.remaining_energy_pct_stdev,
-                    _VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev,
+                    _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC,
                 )
         except _v.SLOW:
             _v.diag(
                 out,
                 "remaining_energy_pct_stdev",
                 self.remaining_energy_pct_stdev,
-                _VS_PrimaryPowerSupplyStatus_remaining_energy_pct_stdev,
+                _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC,
             )
         # rule remaining-energy-percent (dronecan-primary-power.yaml:4)
         try:
