@@ -18,10 +18,10 @@ from ... import _validate as _v
 __all__ = ["Timestamp"]
 
 
-_DC_Timestamp_1 = struct.Struct("<IHB")
-
-
-_DC_Timestamp_2 = ((56, "Timestamp.usec"),)
+# fixed fields as encoded (a float16 as its bit pattern)
+_TIMESTAMP_ENCODE_STRUCT = struct.Struct("<IHB")
+# (bit where each field ends, field): names the field a short payload cuts
+_TIMESTAMP_FIELD_ENDS = ((56, "Timestamp.usec"),)
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -82,7 +82,7 @@ class Timestamp:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
         r1 = self.usec
         p2 = r1 & 0xFFFFFFFFFFFFFF
-        head = _DC_Timestamp_1.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
+        head = _TIMESTAMP_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
         return head
 
     @classmethod
@@ -90,8 +90,8 @@ class Timestamp:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
         n = len(data)
         if n < 7:
-            raise _dc.cut(_DC_Timestamp_2, n << 3)
-        u1, u2, u3 = _DC_Timestamp_1.unpack_from(data)
+            raise _dc.cut(_TIMESTAMP_FIELD_ENDS, n << 3)
+        u1, u2, u3 = _TIMESTAMP_ENCODE_STRUCT.unpack_from(data)
         x4 = u1 | (u2 << 32) | (u3 << 48)
         if n > 7:
             raise _dc.DecodeError("Timestamp: " + str(n - 7) + " byte(s) beyond the end of the message")
@@ -101,16 +101,16 @@ class Timestamp:
         r1 = self.usec
         p2 = r1 & 0xFFFFFFFFFFFFFF
         acc = (acc << 56) | int.from_bytes(
-            _DC_Timestamp_1.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
+            _TIMESTAMP_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
         )
         return acc
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[Timestamp, int]:
         if rem < 56:
-            raise _dc.cut(_DC_Timestamp_2, rem)
+            raise _dc.cut(_TIMESTAMP_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3 = _DC_Timestamp_1.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        u1, u2, u3 = _TIMESTAMP_ENCODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
         x4 = u1 | (u2 << 32) | (u3 << 48)
         return cls(x4), rem
 

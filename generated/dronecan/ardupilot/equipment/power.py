@@ -22,22 +22,18 @@ if TYPE_CHECKING:
 __all__ = ["BatteryInfoAux"]
 
 
-_DC_BatteryInfoAux_1 = struct.Struct("<IHB")
-
-
-_DC_BatteryInfoAux_2 = struct.Struct("<2f")
-
-
-_DC_BatteryInfoAux_3 = struct.Struct("<2I")
-
-
-_DC_BatteryInfoAux_4 = struct.Struct("<HHHHH")
-
-
-_DC_BatteryInfoAux_5 = ((56, "BatteryInfoAux.timestamp.usec"),)
-
-
-_DC_BatteryInfoAux_6 = (
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_INFO_AUX_ENCODE_STRUCT = struct.Struct("<IHB")
+# float16 fields packed as float32 ...
+_BATTERY_INFO_AUX_FLOAT32_STRUCT = struct.Struct("<2f")
+# ... and read back as bits, from which each half is cut
+_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT = struct.Struct("<2I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_INFO_AUX_ENCODE_STRUCT_2 = struct.Struct("<HHHHH")
+# (bit where each field ends, field): names the field a short payload cuts
+_BATTERY_INFO_AUX_FIELD_ENDS = ((56, "BatteryInfoAux.timestamp.usec"),)
+# (bit where each field ends, field): names the field a short payload cuts
+_BATTERY_INFO_AUX_FIELD_ENDS_2 = (
     (16, "BatteryInfoAux.cycle_count"),
     (32, "BatteryInfoAux.over_discharge_count"),
     (48, "BatteryInfoAux.max_current"),
@@ -45,9 +41,8 @@ _DC_BatteryInfoAux_6 = (
     (65, "BatteryInfoAux.is_powering_off"),
     (73, "BatteryInfoAux.battery_id"),
 )
-
-
-_DC_BatteryInfoAux_7 = struct.Struct("<HHeeH")
+# fixed fields as decoded
+_BATTERY_INFO_AUX_DECODE_STRUCT = struct.Struct("<HHeeH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -201,7 +196,7 @@ class BatteryInfoAux:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
         r1 = self.timestamp.usec
         p2 = r1 & 0xFFFFFFFFFFFFFF
-        head = _DC_BatteryInfoAux_1.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
+        head = _BATTERY_INFO_AUX_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
         acc = 0x100000000000000 | int.from_bytes(head, "big")
         x3 = self.voltage_cell
         k4 = len(x3)
@@ -211,8 +206,8 @@ class BatteryInfoAux:
         acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
-        g8, g9 = _DC_BatteryInfoAux_3.unpack(
-            _DC_BatteryInfoAux_2.pack(
+        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT.unpack(
+            _BATTERY_INFO_AUX_FLOAT32_STRUCT.pack(
                 (
                     r6
                     if -65504.0 <= r6 <= 65504.0
@@ -243,7 +238,7 @@ class BatteryInfoAux:
         p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
         acc = (acc << 73) | (
             int.from_bytes(
-                _DC_BatteryInfoAux_4.pack(
+                _BATTERY_INFO_AUX_ENCODE_STRUCT_2.pack(
                     (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
                     (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
                     h10,
@@ -262,40 +257,39 @@ class BatteryInfoAux:
         f1: list[Any]
         n = len(data)
         if n < 7:
-            raise _dc.cut(_DC_BatteryInfoAux_5, n << 3)
-        u1, u2, u3 = _DC_BatteryInfoAux_1.unpack_from(data)
+            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, n << 3)
+        u1, u2, u3 = _BATTERY_INFO_AUX_ENCODE_STRUCT.unpack_from(data)
         x4 = u1 | (u2 << 32) | (u3 << 48)
         v = int.from_bytes(data, "big")
         rem = (n << 3) - 56
         if rem < 8:
             raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
         rem -= 8
-        b6 = (v >> rem) & 0xFF
-        k5 = b6
+        k5 = (v >> rem) & 0xFF
         if k5 > 255:
             raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k5) + " exceeds capacity 255")
-        n7 = k5 * 16
-        if rem < n7:
-            raise _dc.short("BatteryInfoAux.voltage_cell", n7, rem)
-        rem -= n7
-        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n7) - 1)).to_bytes(n7 >> 3, "big")))
+        n6 = k5 * 16
+        if rem < n6:
+            raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
+        rem -= n6
+        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
         if rem < 73:
-            raise _dc.cut(_DC_BatteryInfoAux_6, rem)
+            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_2, rem)
         rem -= 73
-        u8, u9, u10, u11, u12 = _DC_BatteryInfoAux_7.unpack(
+        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(
             (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
         )
-        x13 = ((u12 >> 7) & 0x1) != 0
-        x14 = (u12 >> 15) | ((u12 & 0x7F) << 1)
+        x12 = ((u11 >> 7) & 0x1) != 0
+        x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
         if rem >= 8:
             raise _dc.DecodeError("BatteryInfoAux: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(_timestamp_class()(x4), f1, u8, u9, u10, u11, x13, x14)
+        return cls(_timestamp_class()(x4), f1, u7, u8, u9, u10, x12, x13)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         r1 = self.timestamp.usec
         p2 = r1 & 0xFFFFFFFFFFFFFF
         acc = (acc << 56) | int.from_bytes(
-            _DC_BatteryInfoAux_1.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
+            _BATTERY_INFO_AUX_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
         )
         x3 = self.voltage_cell
         k4 = len(x3)
@@ -305,8 +299,8 @@ class BatteryInfoAux:
         acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
-        g8, g9 = _DC_BatteryInfoAux_3.unpack(
-            _DC_BatteryInfoAux_2.pack(
+        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT.unpack(
+            _BATTERY_INFO_AUX_FLOAT32_STRUCT.pack(
                 (
                     r6
                     if -65504.0 <= r6 <= 65504.0
@@ -337,7 +331,7 @@ class BatteryInfoAux:
         p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
         acc = (acc << 73) | (
             int.from_bytes(
-                _DC_BatteryInfoAux_4.pack(
+                _BATTERY_INFO_AUX_ENCODE_STRUCT_2.pack(
                     (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
                     (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
                     h10,
@@ -354,31 +348,30 @@ class BatteryInfoAux:
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfoAux, int]:
         f1: list[Any]
         if rem < 56:
-            raise _dc.cut(_DC_BatteryInfoAux_5, rem)
+            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3 = _DC_BatteryInfoAux_1.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        u1, u2, u3 = _BATTERY_INFO_AUX_ENCODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
         x4 = u1 | (u2 << 32) | (u3 << 48)
         if rem < 8:
             raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
         rem -= 8
-        b6 = (v >> rem) & 0xFF
-        k5 = b6
+        k5 = (v >> rem) & 0xFF
         if k5 > 255:
             raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k5) + " exceeds capacity 255")
-        n7 = k5 * 16
-        if rem < n7:
-            raise _dc.short("BatteryInfoAux.voltage_cell", n7, rem)
-        rem -= n7
-        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n7) - 1)).to_bytes(n7 >> 3, "big")))
+        n6 = k5 * 16
+        if rem < n6:
+            raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
+        rem -= n6
+        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
         if rem < 73:
-            raise _dc.cut(_DC_BatteryInfoAux_6, rem)
+            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_2, rem)
         rem -= 73
-        u8, u9, u10, u11, u12 = _DC_BatteryInfoAux_7.unpack(
+        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(
             (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
         )
-        x13 = ((u12 >> 7) & 0x1) != 0
-        x14 = (u12 >> 15) | ((u12 & 0x7F) << 1)
-        return cls(_timestamp_class()(x4), f1, u8, u9, u10, u11, x13, x14), rem
+        x12 = ((u11 >> 7) & 0x1) != 0
+        x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
+        return cls(_timestamp_class()(x4), f1, u7, u8, u9, u10, x12, x13), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""

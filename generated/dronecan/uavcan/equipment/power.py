@@ -55,16 +55,14 @@ class CircuitStatusErrorFlag(enum.IntFlag):
     UNDERCURRENT = 8
 
 
-_DC_BatteryInfo_1 = struct.Struct("<7f")
-
-
-_DC_BatteryInfo_2 = struct.Struct("<7I")
-
-
-_DC_BatteryInfo_3 = struct.Struct("<HHHHHHHIBI")
-
-
-_DC_BatteryInfo_4 = (
+# float16 fields packed as float32 ...
+_BATTERY_INFO_FLOAT32_STRUCT = struct.Struct("<7f")
+# ... and read back as bits, from which each half is cut
+_BATTERY_INFO_FLOAT32_BITS_STRUCT = struct.Struct("<7I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_INFO_ENCODE_STRUCT = struct.Struct("<HHHHHHHIBI")
+# (bit where each field ends, field): names the field a short payload cuts
+_BATTERY_INFO_FIELD_ENDS = (
     (16, "BatteryInfo.temperature"),
     (32, "BatteryInfo.voltage"),
     (48, "BatteryInfo.current"),
@@ -79,9 +77,8 @@ _DC_BatteryInfo_4 = (
     (152, "BatteryInfo.battery_id"),
     (184, "BatteryInfo.model_instance_id"),
 )
-
-
-_DC_BatteryInfo_5 = struct.Struct("<eeeeeeeIBI")
+# fixed fields as decoded
+_BATTERY_INFO_DECODE_STRUCT = struct.Struct("<eeeeeeeIBI")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -136,24 +133,21 @@ _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC = _v.Number(type="uint32", kind="uint", low
 _BATTERY_INFO_MODEL_NAME_SPEC = _v.Array(_v.Number(type="uint8", kind="uint", low=0, high=255), 31, False, byte=True)
 
 
-_DC_CircuitStatus_1 = struct.Struct("<2f")
-
-
-_DC_CircuitStatus_2 = struct.Struct("<2I")
-
-
-_DC_CircuitStatus_3 = struct.Struct("<HHHB")
-
-
-_DC_CircuitStatus_4 = (
+# float16 fields packed as float32 ...
+_CIRCUIT_STATUS_FLOAT32_STRUCT = struct.Struct("<2f")
+# ... and read back as bits, from which each half is cut
+_CIRCUIT_STATUS_FLOAT32_BITS_STRUCT = struct.Struct("<2I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_CIRCUIT_STATUS_ENCODE_STRUCT = struct.Struct("<HHHB")
+# (bit where each field ends, field): names the field a short payload cuts
+_CIRCUIT_STATUS_FIELD_ENDS = (
     (16, "CircuitStatus.circuit_id"),
     (32, "CircuitStatus.voltage"),
     (48, "CircuitStatus.current"),
     (56, "CircuitStatus.error_flags"),
 )
-
-
-_DC_CircuitStatus_5 = struct.Struct("<HeeB")
+# fixed fields as decoded
+_CIRCUIT_STATUS_DECODE_STRUCT = struct.Struct("<HeeB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -175,25 +169,22 @@ _CIRCUIT_STATUS_ERROR_FLAGS_SPEC = _v.Number(
 )
 
 
-_DC_PrimaryPowerSupplyStatus_1 = struct.Struct("<2f")
-
-
-_DC_PrimaryPowerSupplyStatus_2 = struct.Struct("<2I")
-
-
-_DC_PrimaryPowerSupplyStatus_3 = struct.Struct("<HHH")
-
-
-_DC_PrimaryPowerSupplyStatus_4 = (
+# float16 fields packed as float32 ...
+_PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT = struct.Struct("<2f")
+# ... and read back as bits, from which each half is cut
+_PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT = struct.Struct("<2I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT = struct.Struct("<HHH")
+# (bit where each field ends, field): names the field a short payload cuts
+_PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS = (
     (16, "PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power"),
     (32, "PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power_variance"),
     (33, "PrimaryPowerSupplyStatus.external_power_available"),
     (40, "PrimaryPowerSupplyStatus.remaining_energy_pct"),
     (47, "PrimaryPowerSupplyStatus.remaining_energy_pct_stdev"),
 )
-
-
-_DC_PrimaryPowerSupplyStatus_5 = struct.Struct("<eeH")
+# fixed fields as decoded
+_PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT = struct.Struct("<eeH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -461,8 +452,8 @@ class BatteryInfo:
         r5 = self.remaining_capacity_wh
         r6 = self.full_charge_capacity_wh
         r7 = self.hours_to_full_charge
-        g8, g9, g10, g11, g12, g13, g14 = _DC_BatteryInfo_2.unpack(
-            _DC_BatteryInfo_1.pack(
+        g8, g9, g10, g11, g12, g13, g14 = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
+            _BATTERY_INFO_FLOAT32_STRUCT.pack(
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
@@ -545,7 +536,7 @@ class BatteryInfo:
         p29 = r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0)
         r30 = self.battery_id
         r31 = self.model_instance_id
-        head = _DC_BatteryInfo_3.pack(
+        head = _BATTERY_INFO_ENCODE_STRUCT.pack(
             h15,
             h16,
             h17,
@@ -573,8 +564,7 @@ class BatteryInfo:
         k34 = len(x33)
         if k34 > 31:
             raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k34) + " exceeds capacity 31")
-        if not tao:
-            acc = (acc << 5) | k34
+        acc = (acc << 5) | k34
         acc = (acc << (k34 << 3)) | int.from_bytes(x33, "big")
         return _dc.finish(acc)
 
@@ -584,8 +574,8 @@ class BatteryInfo:
         f13: bytes
         n = len(data)
         if n < 23:
-            raise _dc.cut(_DC_BatteryInfo_4, n << 3)
-        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _DC_BatteryInfo_5.unpack_from(data)
+            raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, n << 3)
+        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _BATTERY_INFO_DECODE_STRUCT.unpack_from(data)
         x11 = (u8 & 0xFF) | (((u8 >> 13) & 0x7) << 8)
         x12 = ((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1F) << 2)
         x13 = (u8 >> 31) | (((u8 >> 16) & 0x3F) << 1)
@@ -598,30 +588,17 @@ class BatteryInfo:
             return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
         v = int.from_bytes(data, "big")
         rem = (n << 3) - 184
-        if tao:
-            k16 = rem // 8
-            if rem - k16 * 8 >= 8:
-                raise _dc.DecodeError("BatteryInfo.model_name: input ends inside an element")
-            if k16 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k16) + " exceeds capacity 31")
-            n17 = k16 * 8
-            if rem < n17:
-                raise _dc.short("BatteryInfo.model_name", n17, rem)
-            rem -= n17
-            f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k16, "big")
-        else:
-            if rem < 5:
-                raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
-            rem -= 5
-            b18 = (v >> rem) & 0x1F
-            k16 = b18
-            if k16 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k16) + " exceeds capacity 31")
-            n19 = k16 * 8
-            if rem < n19:
-                raise _dc.short("BatteryInfo.model_name", n19, rem)
-            rem -= n19
-            f13 = ((v >> rem) & ((1 << n19) - 1)).to_bytes(k16, "big")
+        if rem < 5:
+            raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
+        rem -= 5
+        k16 = (v >> rem) & 0x1F
+        if k16 > 31:
+            raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k16) + " exceeds capacity 31")
+        n17 = k16 * 8
+        if rem < n17:
+            raise _dc.short("BatteryInfo.model_name", n17, rem)
+        rem -= n17
+        f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k16, "big")
         if rem >= 8:
             raise _dc.DecodeError("BatteryInfo: " + str(rem >> 3) + " byte(s) beyond the end of the message")
         return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
@@ -634,8 +611,8 @@ class BatteryInfo:
         r5 = self.remaining_capacity_wh
         r6 = self.full_charge_capacity_wh
         r7 = self.hours_to_full_charge
-        g8, g9, g10, g11, g12, g13, g14 = _DC_BatteryInfo_2.unpack(
-            _DC_BatteryInfo_1.pack(
+        g8, g9, g10, g11, g12, g13, g14 = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
+            _BATTERY_INFO_FLOAT32_STRUCT.pack(
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
@@ -719,7 +696,7 @@ class BatteryInfo:
         r30 = self.battery_id
         r31 = self.model_instance_id
         acc = (acc << 184) | int.from_bytes(
-            _DC_BatteryInfo_3.pack(
+            _BATTERY_INFO_ENCODE_STRUCT.pack(
                 h15,
                 h16,
                 h17,
@@ -752,9 +729,9 @@ class BatteryInfo:
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfo, int]:
         f13: bytes
         if rem < 184:
-            raise _dc.cut(_DC_BatteryInfo_4, rem)
+            raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, rem)
         rem -= 184
-        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _DC_BatteryInfo_5.unpack(
+        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _BATTERY_INFO_DECODE_STRUCT.unpack(
             ((v >> rem) & 0xFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF).to_bytes(23, "big")
         )
         x11 = (u8 & 0xFF) | (((u8 >> 13) & 0x7) << 8)
@@ -776,15 +753,14 @@ class BatteryInfo:
             if rem < 5:
                 raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
             rem -= 5
-            b17 = (v >> rem) & 0x1F
-            k15 = b17
+            k15 = (v >> rem) & 0x1F
             if k15 > 31:
                 raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
-            n18 = k15 * 8
-            if rem < n18:
-                raise _dc.short("BatteryInfo.model_name", n18, rem)
-            rem -= n18
-            f13 = ((v >> rem) & ((1 << n18) - 1)).to_bytes(k15, "big")
+            n17 = k15 * 8
+            if rem < n17:
+                raise _dc.short("BatteryInfo.model_name", n17, rem)
+            rem -= n17
+            f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k15, "big")
         return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13), rem
 
     def validate(self) -> list[_v.Violation]:
@@ -1029,8 +1005,8 @@ class CircuitStatus:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
         r1 = self.voltage
         r2 = self.current
-        g3, g4 = _DC_CircuitStatus_2.unpack(
-            _DC_CircuitStatus_1.pack(
+        g3, g4 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
+            _CIRCUIT_STATUS_FLOAT32_STRUCT.pack(
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
@@ -1055,7 +1031,7 @@ class CircuitStatus:
         )
         r7 = self.circuit_id
         r8 = self.error_flags
-        head = _DC_CircuitStatus_3.pack(
+        head = _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
             (r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)),
             h5,
             h6,
@@ -1068,8 +1044,8 @@ class CircuitStatus:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
         n = len(data)
         if n < 7:
-            raise _dc.cut(_DC_CircuitStatus_4, n << 3)
-        u1, u2, u3, u4 = _DC_CircuitStatus_5.unpack_from(data)
+            raise _dc.cut(_CIRCUIT_STATUS_FIELD_ENDS, n << 3)
+        u1, u2, u3, u4 = _CIRCUIT_STATUS_DECODE_STRUCT.unpack_from(data)
         if n > 7:
             raise _dc.DecodeError("CircuitStatus: " + str(n - 7) + " byte(s) beyond the end of the message")
         return cls(u1, u2, u3, u4)
@@ -1077,8 +1053,8 @@ class CircuitStatus:
     def _dc_put(self, acc: int, tao: bool) -> int:
         r1 = self.voltage
         r2 = self.current
-        g3, g4 = _DC_CircuitStatus_2.unpack(
-            _DC_CircuitStatus_1.pack(
+        g3, g4 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
+            _CIRCUIT_STATUS_FLOAT32_STRUCT.pack(
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
@@ -1104,7 +1080,7 @@ class CircuitStatus:
         r7 = self.circuit_id
         r8 = self.error_flags
         acc = (acc << 56) | int.from_bytes(
-            _DC_CircuitStatus_3.pack(
+            _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
                 (r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)),
                 h5,
                 h6,
@@ -1117,9 +1093,9 @@ class CircuitStatus:
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[CircuitStatus, int]:
         if rem < 56:
-            raise _dc.cut(_DC_CircuitStatus_4, rem)
+            raise _dc.cut(_CIRCUIT_STATUS_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3, u4 = _DC_CircuitStatus_5.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        u1, u2, u3, u4 = _CIRCUIT_STATUS_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
         return cls(u1, u2, u3, u4), rem
 
     def validate(self) -> list[_v.Violation]:
@@ -1280,8 +1256,8 @@ class PrimaryPowerSupplyStatus:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
         r1 = self.hours_to_empty_at_10sec_avg_power
         r2 = self.hours_to_empty_at_10sec_avg_power_variance
-        g3, g4 = _DC_PrimaryPowerSupplyStatus_2.unpack(
-            _DC_PrimaryPowerSupplyStatus_1.pack(
+        g3, g4 = _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
+            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
@@ -1310,7 +1286,7 @@ class PrimaryPowerSupplyStatus:
         p10 = r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0)
         r11 = self.remaining_energy_pct_stdev
         p12 = r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0)
-        head = _DC_PrimaryPowerSupplyStatus_3.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9))
+        head = _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9))
         return head
 
     @classmethod
@@ -1318,8 +1294,8 @@ class PrimaryPowerSupplyStatus:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
         n = len(data)
         if n < 6:
-            raise _dc.cut(_DC_PrimaryPowerSupplyStatus_4, n << 3)
-        u1, u2, u3 = _DC_PrimaryPowerSupplyStatus_5.unpack_from(data)
+            raise _dc.cut(_PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS, n << 3)
+        u1, u2, u3 = _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack_from(data)
         x4 = ((u3 >> 7) & 0x1) != 0
         x5 = u3 & 0x7F
         x6 = u3 >> 9
@@ -1330,8 +1306,8 @@ class PrimaryPowerSupplyStatus:
     def _dc_put(self, acc: int, tao: bool) -> int:
         r1 = self.hours_to_empty_at_10sec_avg_power
         r2 = self.hours_to_empty_at_10sec_avg_power_variance
-        g3, g4 = _DC_PrimaryPowerSupplyStatus_2.unpack(
-            _DC_PrimaryPowerSupplyStatus_1.pack(
+        g3, g4 = _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
+            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
@@ -1361,16 +1337,19 @@ class PrimaryPowerSupplyStatus:
         r11 = self.remaining_energy_pct_stdev
         p12 = r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0)
         acc = (acc << 47) | (
-            int.from_bytes(_DC_PrimaryPowerSupplyStatus_3.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9)), "big") >> 1
+            int.from_bytes(_PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9)), "big")
+            >> 1
         )
         return acc
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[PrimaryPowerSupplyStatus, int]:
         if rem < 47:
-            raise _dc.cut(_DC_PrimaryPowerSupplyStatus_4, rem)
+            raise _dc.cut(_PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS, rem)
         rem -= 47
-        u1, u2, u3 = _DC_PrimaryPowerSupplyStatus_5.unpack((((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big"))
+        u1, u2, u3 = _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack(
+            (((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big")
+        )
         x4 = ((u3 >> 7) & 0x1) != 0
         x5 = u3 & 0x7F
         x6 = u3 >> 9

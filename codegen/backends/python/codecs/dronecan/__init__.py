@@ -4,7 +4,7 @@ Every DroneCAN class gets ``encode(*, tao=True) -> bytes``, ``decode(data, *, ta
 ``DATA_TYPE_ID`` / ``DATA_TYPE_SIGNATURE`` class attributes and, for a ``@union``, a
 ``union_field`` attribute naming the active field. The shared runtime (``_dronecan.py``) holds
 float16 rounding, the bit-stream finisher, ``DecodeError`` and ``transfer_crc``.
-Layout planning lives in codec_dronecan_plan, code emission in codec_dronecan_emit.
+Layout planning lives in :mod:`.plan`, code emission in :mod:`.emit`.
 """
 
 from __future__ import annotations
@@ -48,20 +48,20 @@ class _Codec:
         for f in msg.fields:  # fail early, with the field named, on a dangling reference
             if isinstance(f.type, CompositeType):
                 ctx.composite(f.type, f)
-        emitter = MessageEmitter(planner, msg, view.name, view.name, factories)
+        emitter = MessageEmitter(planner, msg, view.name, ctx, factories)
         taken = {f.ident for f in view.fields} | {c[0] for c in view.constants} | {"QUALIFIED_NAME"}
         id_name = _free_name("DATA_TYPE_ID", taken)
         sig_name = _free_name("DATA_TYPE_SIGNATURE", taken | {id_name})
         lines = [
             f"{id_name}: ClassVar[int | None] = {py_literal(info.data_type_id)}",
-            f"{sig_name}: ClassVar[int] = {info.signature:#018x}",
+            f"{sig_name}: ClassVar[int] = 0x{info.signature:016X}",
         ]
         if info.union:
             emitter.union_attr = _free_name("union_field", taken | {id_name, sig_name})
             first = emitter.idents[0]
             meta = (
-                f"_m.meta(name={py_literal(emitter.union_attr)}, type='union tag', "
-                "doc='Name of the field this union holds (the one encoded)')"
+                f'_m.meta(name={py_literal(emitter.union_attr)}, type="union tag", '
+                'doc="Name of the field this union holds (the one encoded)")'
             )
             lines.append(f"{emitter.union_attr}: str = dataclasses.field(default={py_literal(first)}, metadata={meta})")
         methods = [
@@ -74,7 +74,7 @@ class _Codec:
         class_body = "\n".join("    " + line if line else "" for line in body.split("\n"))
         return Contribution(
             class_body=class_body,
-            module_code=tuple(emitter.module_code),
+            module_code=("\n".join(emitter.module_code),) if emitter.module_code else (),
             imports=(f"from {ctx.root()} import _dronecan as _dc",),
         )
 

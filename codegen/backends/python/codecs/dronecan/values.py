@@ -4,7 +4,7 @@ float views on decode, the v0 byte order of a field wider than 8 bits; plus a li
 from __future__ import annotations
 
 from .....ir import CastMode, FieldType, PrimitiveKind, PrimitiveType
-from ...literals import py_literal
+from ...literals import hex_literal, py_literal
 from .plan import reorder_terms
 
 F32_MAX = "_dc.F32_MAX"
@@ -36,7 +36,7 @@ def error(kind: str, prefix: str, value: str = "", suffix: str = "") -> str:
 
 
 def mask(bits: int) -> str:
-    return hex((1 << bits) - 1)
+    return hex_literal((1 << bits) - 1)
 
 
 def stream(expr: str, width: int) -> str:
@@ -45,7 +45,7 @@ def stream(expr: str, width: int) -> str:
         return expr
     parts = []
     for vshift, mask, sshift in reorder_terms(width):
-        term = f"(({expr} >> {vshift}) & {hex(mask)})" if vshift else f"({expr} & {hex(mask)})"
+        term = f"(({expr} >> {vshift}) & {hex_literal(mask)})" if vshift else f"({expr} & {hex_literal(mask)})"
         parts.append(f"({term} << {sshift})" if sshift else term)
     return "(" + " | ".join(parts) + ")"
 
@@ -56,7 +56,7 @@ def unstream(expr: str, width: int) -> str:
         return expr
     parts = []
     for vshift, mask, sshift in reorder_terms(width):
-        term = f"(({expr} >> {sshift}) & {hex(mask)})" if sshift else f"({expr} & {hex(mask)})"
+        term = f"(({expr} >> {sshift}) & {hex_literal(mask)})" if sshift else f"({expr} & {hex_literal(mask)})"
         parts.append(f"({term} << {vshift})" if vshift else term)
     return "(" + " | ".join(parts) + ")"
 
@@ -116,7 +116,7 @@ def decode_pattern(t: PrimitiveType, b: str) -> str:
     if kind is PrimitiveKind.UINT:
         return b
     if kind is PrimitiveKind.INT:
-        sign = hex(1 << (bits - 1))
+        sign = hex_literal(1 << (bits - 1))
         return f"(({b} ^ {sign}) - {sign})"
     if kind is PrimitiveKind.FLOAT:
         return {16: "_dc.f16v", 32: "_dc.f32v", 64: "_dc.f64v"}[bits] + f"({b})"

@@ -1,0 +1,229 @@
+"""Encoding and decoding the fixed-size runs of a DroneCAN type (segments, see :mod:`.plan`):
+one ``struct`` call per segment, fields not on a byte boundary assembled from shifted pieces."""
+
+from __future__ import annotations
+
+from .....ir import CastMode, CompositeType, Message, PrimitiveKind
+from ...literals import py_literal
+from ...naming import upper_snake
+from ...views import ModuleContext
+from .plan import Node, Piece, Planner, Segment, Unit, plan_units
+from .values import Lines, clamp, decode_pattern, encode_value, error, mask, needs_name
+
+
+class SegmentEmitter:
+    def __init__(self, planner: Planner, msg: Message, cls: str, ctx: ModuleContext, factory: dict[str, str]) -> None:
+        self.p = planner
+        self.msg = msg
+        self.cls = cls
+        self.ctx = ctx  # names module-level constants
+        self.factory = factory
+        self.module_code: list[str] = []  # constants, each after a comment saying what it is
+        self.idents = planner.idents(msg)
+        self.union_attr = "union_field"
+
+    # -- module-level helpers ---------------------------------------------------------------
+
+    def module_value(self, source: str, role: str, comment: str) -> str:
+        """A module-level constant of this class holding ``source``, named for its ``role``
+        (``_BATTERY_INFO_ENCODE_STRUCT``); one constant per distinct source."""
+        what = ("dronecan", self.cls, source)
+        new = what not in self.ctx.names
+        name = self.ctx.private_name(f"_{upper_snake(self.cls)}_{role}", what)
+        if new:
+            self.module_code.append(f"# {comment}\n{name} = {source}")
+        return name
+
+    def struct_name(self, fmt: str, role: str, comment: str) -> str:
+        return self.module_value(f"struct.Struct({py_literal(fmt)})", role, comment)
+
+    def cut_table(self, seg: Segment) -> str:
+        rows = [(leaf.offset + leaf.bits, leaf.label) for leaf in seg.leaves]
+        comment = "(bit where each field ends, field): names the field a short payload cuts"
+        return self.module_value(py_literal(tuple(rows)), "FIELD_ENDS", comment)
+
+    def class_of(self, t: CompositeType) -> str:
+        return self.factory[t.name]
+
+    # -- segments: encoding ---------------------------------------------------------------
+
+    def seg_checks(self, seg: Segment, out: Lines) -> None:
+        for expr, n, label in seg.checks:
+            out.add(f"if len({expr}) != {n}:")
+            out.add("    raise " + error("EncodeError", f"{label}: expected {n} items, got ", f"str(len({expr}))"))
+
+    def seg_pack_args(self, seg: Segment, units: list[Unit], pieces: dict[int, list[Piece]], out: Lines) -> list[str]:
+        """Lines computing leaf values; returns the struct.pack arguments."""
+        self.seg_checks(seg, out)
+        values = self.float16_batch(seg, out)
+        for idx, leaf in enumerate(seg.leaves):
+            if leaf.type.kind is PrimitiveKind.VOID or idx in values:
+                continue
+            raw = leaf.enc
+            if leaf.nbytes:
+                values[idx] = raw
+                continue
+            group = not leaf.structable
+            if needs_name(leaf.type) or group:
+                name = out.fresh("r")
+                out.add(f"{name} = {raw}")
+                raw = name
+            value = encode_value(leaf.type, raw, pattern=group)
+            if group:
+                name = out.fresh("p")
+                out.add(f"{name} = {value}")
+                value = name
+            values[idx] = value
+        by_unit: dict[int, list[str]] = {}
+        for idx, runs in pieces.items():
+            leaf = seg.leaves[idx]
+            for pc in runs:
+                x = values[idx]
+                if pc.src == 0 and pc.size == leaf.bits:
+                    term = x
+                else:
+                    term = f"(({x} >> {pc.src}) & {mask(pc.size)})" if pc.src else f"({x} & {mask(pc.size)})"
+                by_unit.setdefault(pc.unit, []).append(f"({term} << {pc.dst})" if pc.dst else term)
+        args = []
+        for k, u in enumerate(units):
+            if u.group:
+                terms = by_unit.get(k, [])
+                args.append(" | ".join(terms) if terms else "0")
+            elif u.leaf is not None:
+                args.append(values[seg.leaves.index(u.leaf)])
+        return args
+
+    def float16_batch(self, seg: Segment, out: Lines) -> dict[int, str]:
+        """float16 bits of several fields at once: one struct round trip gives every float32
+        pattern, a normal half is then a subtraction and a shift (the rest go to the runtime)."""
+        halves = [
+            (idx, leaf)
+            for idx, leaf in enumerate(seg.leaves)
+            if leaf.type.kind is PrimitiveKind.FLOAT and leaf.type.bits == 16 and not leaf.nbytes
+        ]
+        if len(halves) < 2:
+            return {}
+        clamped = []
+        for _, leaf in halves:
+            raw = out.fresh("r")
+            out.add(f"{raw} = {leaf.enc}")
+            if leaf.type.cast is CastMode.SATURATED:
+                clamped.append(clamp(raw, "-65504.0", "65504.0"))
+            else:
+                clamped.append(clamp(raw, "-65504.0", "65504.0", "-_dc.INF", "_dc.INF"))
+        n = len(halves)
+        words = [out.fresh("g") for _ in halves]
+        floats = self.struct_name(f"<{n}f", "FLOAT32_STRUCT", "float16 fields packed as float32 ...")
+        ints = self.struct_name(
+            f"<{n}I", "FLOAT32_BITS_STRUCT", "... and read back as bits, from which each half is cut"
+        )
+        out.add(f"{', '.join(words)} = {ints}.unpack({floats}.pack({', '.join(clamped)}))")
+        values: dict[int, str] = {}
+        for (idx, _), g in zip(halves, words, strict=True):
+            h = out.fresh("h")
+            out.add(f"{h} = (")  # positive normal, negative normal, anything else
+            out.add(f"    (({g} - 0x37FFF000) >> 13)")
+            out.add(f"    if 0x38800000 <= {g} < 0x477FF000")
+            out.add(f"    else ((({g} - 0xB7FFF000) >> 13) | 0x8000")
+            out.add(f"          if 0xB8800000 <= {g} < 0xC77FF000 else _dc.f16bits({g}))")
+            out.add(")")
+            values[idx] = h
+        return values
+
+    def seg_bytes(self, seg: Segment, out: Lines) -> str:
+        """Lines packing a segment; returns the expression of its bytes (zero padded)."""
+        units, pieces = plan_units(seg)
+        args = self.seg_pack_args(seg, units, pieces, out)
+        fmt = "<" + "".join(u.pack for u in units)
+        name = self.struct_name(fmt, "ENCODE_STRUCT", "fixed fields as encoded (a float16 as its bit pattern)")
+        return f"{name}.pack({', '.join(args)})"
+
+    def seg_put(self, seg: Segment, out: Lines) -> None:
+        """Append a segment to ``acc``."""
+        if seg.bits == 0:
+            self.seg_checks(seg, out)
+            return
+        live = [leaf for leaf in seg.leaves if leaf.type.kind is not PrimitiveKind.VOID]
+        if not live:
+            out.add(f"acc <<= {seg.bits}")
+            return
+        if len(seg.leaves) == 1 and seg.bits <= 8 and not live[0].nbytes:
+            leaf = live[0]
+            raw = leaf.enc
+            if needs_name(leaf.type):
+                raw = out.fresh("r")
+                out.add(f"{raw} = {leaf.enc}")
+            out.add(f"acc = (acc << {seg.bits}) | {encode_value(leaf.type, raw, pattern=True)}")
+            return
+        data = self.seg_bytes(seg, out)
+        pad = -seg.bits % 8
+        shifted = f'(int.from_bytes({data}, "big") >> {pad})' if pad else f'int.from_bytes({data}, "big")'
+        out.add(f"acc = (acc << {seg.bits}) | {shifted}")
+
+    # -- segments: decoding ---------------------------------------------------------------
+
+    def seg_unpack(self, seg: Segment, out: Lines, source: str) -> None:
+        """Lines unpacking a segment from ``source`` (bytes expression or 'from:<data>'); sets leaf vars."""
+        units, pieces = plan_units(seg)
+        fmt = "<" + "".join(u.unpack for u in units)
+        unit_vars: dict[int, str] = {}
+        names = []
+        for k, u in enumerate(units):
+            if u.pack.endswith("x"):
+                continue
+            var = out.fresh("u")
+            unit_vars[k] = var
+            names.append(var)
+            if u.leaf is not None:
+                u.leaf.var = var
+        if names:
+            st = self.struct_name(fmt, "DECODE_STRUCT", "fixed fields as decoded")
+            call = f"{st}.unpack_from({source[5:]})" if source.startswith("from:") else f"{st}.unpack({source})"
+            target = ", ".join(names) + ("," if len(names) == 1 else "")
+            out.add(f"{target} = {call}")
+        for idx, runs in pieces.items():
+            leaf = seg.leaves[idx]
+            parts = []
+            for pc in runs:
+                u_var = unit_vars[pc.unit]
+                ubits = units[pc.unit].size * 8
+                term = f"({u_var} >> {pc.dst})" if pc.dst else u_var
+                if pc.dst + pc.size < ubits:
+                    term = f"({term} & {mask(pc.size)})"
+                parts.append(f"({term} << {pc.src})" if pc.src else term)
+            bits = parts[0] if len(parts) == 1 else "(" + " | ".join(parts) + ")"
+            var = out.fresh("x")
+            out.add(f"{var} = {decode_pattern(leaf.type, bits)}")
+            leaf.var = var
+
+    def seg_get(self, seg: Segment, out: Lines) -> None:
+        """Read a segment from ``v`` with ``rem`` bits left."""
+        if seg.bits == 0:
+            return
+        out.add(f"if rem < {seg.bits}:")
+        out.add(f"    raise _dc.cut({self.cut_table(seg)}, rem)")
+        out.add(f"rem -= {seg.bits}")
+        live = [leaf for leaf in seg.leaves if leaf.type.kind is not PrimitiveKind.VOID]
+        if not live:
+            return
+        if len(seg.leaves) == 1 and seg.bits <= 8 and not live[0].nbytes:
+            var = out.fresh("x")
+            out.add(f"{var} = {decode_pattern(live[0].type, f'((v >> rem) & {mask(seg.bits)})')}")
+            live[0].var = var
+            return
+        nb = (seg.bits + 7) // 8
+        pad = -seg.bits % 8
+        chunk = f"((v >> rem) & {mask(seg.bits)})"
+        if pad:
+            chunk = f"({chunk} << {pad})"
+        self.seg_unpack(seg, out, f'{chunk}.to_bytes({nb}, "big")')
+
+    def node_expr(self, node: Node) -> str:
+        if node.leaf is not None:
+            return node.leaf.var
+        inner = ", ".join(self.node_expr(n) for n in node.items)
+        if node.factory:
+            return f"{node.factory}({inner})"
+        if node.as_bytes:
+            return f"bytes(({inner}{',' if len(node.items) == 1 else ''}))"
+        return f"[{inner}]"
