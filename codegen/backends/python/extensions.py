@@ -11,7 +11,8 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from ...ir import Message, Schema
-from .views import ClassView, ModuleContext
+from .module_context import ModuleContext
+from .views import ClassView
 
 
 @dataclass(frozen=True)

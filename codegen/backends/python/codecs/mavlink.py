@@ -16,7 +16,8 @@ from ....ir import ArrayType, Field, Message, PrimitiveKind, PrimitiveType, Sche
 from .. import naming
 from ..extensions import Contribution
 from ..literals import py_literal
-from ..views import ClassView, FieldView, ModuleContext
+from ..module_context import ModuleContext
+from ..views import ClassView, FieldView
 
 RUNTIME = "_mavlink.py"
 # names the codec adds to a class; a field with one of them would break it

@@ -21,7 +21,8 @@ from ....ir import Message, Schema, SourceFormat
 from .. import naming
 from ..extensions import Contribution
 from ..literals import py_literal
-from ..views import ClassRef, ClassView, ModuleContext, class_view
+from ..module_context import ClassRef, ModuleContext
+from ..views import ClassView, class_view
 from .uorb_layout import Part, column_format, columns, parts, snake, struct_format, trailing_padding
 from .uorb_layout import compress as compress_codes
 

@@ -12,8 +12,9 @@ from ....frontends import rules as rule_files
 from ....ir import Message, Schema
 from ..extensions import Contribution
 from ..literals import py_literal
+from ..module_context import ModuleContext
 from ..naming import upper_snake
-from ..views import ClassView, ModuleContext
+from ..views import ClassView
 from .fields import field_code
 from .rules import known_expr, rule_lines
 

@@ -12,7 +12,8 @@ from __future__ import annotations
 from .....ir import CompositeType, Message, Schema, SourceFormat
 from ...extensions import Contribution
 from ...literals import py_literal
-from ...views import ClassView, ModuleContext
+from ...module_context import ModuleContext
+from ...views import ClassView
 from .emit import MessageEmitter
 from .plan import Planner
 from .runtime_text import RUNTIME

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from .....ir import CastMode, CompositeType, Message, PrimitiveKind
 from ...literals import py_literal
+from ...module_context import ModuleContext
 from ...naming import upper_snake
-from ...views import ModuleContext
 from .plan import Node, Piece, Planner, Segment, Unit, plan_units
 from .values import Lines, clamp, decode_pattern, encode_value, error, mask, needs_name
 
