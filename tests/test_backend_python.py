@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from conftest import ROOT
 
 from codegen.backends.python import render_package
 from codegen.ir import (
@@ -157,6 +158,75 @@ def test_generated_code_is_mypy_clean(tmp_path: Path) -> None:
     proc = subprocess.run(
         [sys.executable, "-m", "mypy", "--strict", "--no-incremental", "genpkg"],
         cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+# Statements the layout engine breaks or normalises, each one line as an emitter writes it; the
+# engine must lay them out exactly as ruff does (ruff only checks here, generation never runs it).
+LAYOUT_CASES = (
+    "_SPEC = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, "
+    "high=3.4028234663852886e+38, unit='V', mask=0x7ff)",
+    "_TABLE: tuple[tuple[str, str, str, int], ...] = (('timestamp', 'timestamp', 'Q', 0), ('voltage_v', "
+    "'voltage_v', 'f', 0), ('current_a', 'current_a', 'f', 0))",
+    "x = (first_operand_with_a_long_name & 0xff) | (((second_operand_with_a_long_name >> 8) & 0x7) << "
+    "13) | (third_operand << 22)",
+    "y = value_with_a_long_name if -65504.0 <= value_with_a_long_name <= 65504.0 else (65504.0 if "
+    "value_with_a_long_name > 0 else -65504.0)",
+    "out.append(_v.rule('voltage_cell_v' + '[' + str(v_i) + ']', 'cells-beyond-count-zero', "
+    "r_voltage_cell_v[v_i], 'voltage_cell_v[i] == 0'))",
+    "if (x := self.over_voltage_threshold_microvolt) is not None and (len(x) < 1 or any((len(_x0) < 1 or "
+    "any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)):\n    pass",
+    "while some_condition_with_a_long_name and another_condition_with_a_long_name or "
+    "yet_another_condition_with_a_long_name_here:\n    pass",
+    "for key, value in sorted(some_mapping_with_a_long_name.items(), key=lambda item: (item[1], "
+    "item[0]), reverse=True)[:limit_with_a_long_name]:\n    pass",
+    "default: list[float] = dataclasses.field(default_factory=lambda: [0.0] * 14, "
+    "metadata=_m.meta(name='voltage_cell_v', type='float32[14]', doc='Battery individual cell voltages, "
+    "' 'one per cell, ' 'zero where unknown'))",
+    "g1, g2, g3 = _FLOAT32_BITS.unpack(_FLOAT32.pack((r1 if -65504.0 <= r1 <= 65504.0 else 65504.0), (r2 "
+    "if -65504.0 <= r2 <= 65504.0 else 65504.0)))",
+    "raise _uorb.DecodeError('BatteryStatus: expected 168 bytes (or 166 without the trailing padding), "
+    "got ' + str(len(data)))",
+    "return {'current_consumed': c[0], 'energy_consumed': c[1], 'temperature': c[2], 'voltages': "
+    "list(zip(*c[3:13], strict=True))}",
+    "value = {key_with_a_long_name: [item.to_dict() for item in values_with_a_long_name] for "
+    "key_with_a_long_name, values_with_a_long_name in data.items()}",
+    "short = ('a', 'b',)",
+    "parenthesized = (a + b)",
+    "text = 'it\\'s \"quoted\"'",
+    "nested = outer_function(inner_function(argument_one, argument_two, argument_three), "
+    "other_inner(argument_four, argument_five))",
+)
+
+
+def test_layout_engine_agrees_with_ruff(tmp_path: Path) -> None:
+    from codegen.backends.python.layout import format_module
+
+    path = tmp_path / "cases.py"
+    body = "\n".join(LAYOUT_CASES).replace("\n", "\n    ")
+    path.write_text(f"def f():\n    {body}\n")
+    path.write_text(format_module(path.read_text()))
+    proc = subprocess.run(
+        [sys.executable, "-m", "ruff", "format", "--diff", "--config", str(ROOT / "pyproject.toml"), str(path)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_generated_models_of_hostile_schemas_are_formatted(tmp_path: Path) -> None:
+    from codegen.backends.python.writer import generate
+
+    generate(hostile_schema(), tmp_path / "genpkg")
+    # the models, not the runtime modules copied into the package (files named _*.py)
+    models = [str(p) for p in (tmp_path / "genpkg").rglob("*.py") if not p.stem.startswith("_") or p.stem == "__init__"]
+    proc = subprocess.run(
+        [sys.executable, "-m", "ruff", "format", "--check", "--config", str(ROOT / "pyproject.toml"), *models],
         capture_output=True,
         text=True,
         check=False,

@@ -22,6 +22,8 @@ __all__ = ["Timestamp"]
 _TIMESTAMP_ENCODE_STRUCT = struct.Struct("<IHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _TIMESTAMP_FIELD_ENDS = ((56, "Timestamp.usec"),)
+# fixed fields as decoded
+_TIMESTAMP_DECODE_STRUCT = struct.Struct("<IHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -91,7 +93,7 @@ class Timestamp:
         n = len(data)
         if n < 7:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, n << 3)
-        u1, u2, u3 = _TIMESTAMP_ENCODE_STRUCT.unpack_from(data)
+        u1, u2, u3 = _TIMESTAMP_DECODE_STRUCT.unpack_from(data)
         x4 = u1 | (u2 << 32) | (u3 << 48)
         if n > 7:
             raise _dc.DecodeError("Timestamp: " + str(n - 7) + " byte(s) beyond the end of the message")
@@ -110,7 +112,7 @@ class Timestamp:
         if rem < 56:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3 = _TIMESTAMP_ENCODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        u1, u2, u3 = _TIMESTAMP_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
         x4 = u1 | (u2 << 32) | (u3 << 48)
         return cls(x4), rem
 

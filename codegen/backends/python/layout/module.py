@@ -39,7 +39,7 @@ def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
         else:
             continue
         rows = lines[first : last + 1]
-        if any('"""' in row or "'''" in row for row in rows) or _has_comment(rows):
+        if _kept_as_written(rows):
             continue
         line = lines[first]
         depth, rest = divmod(len(line) - len(line.lstrip(" ")), _INDENT)
@@ -94,6 +94,8 @@ def _as_written(node: ast.stmt, line: str) -> bool:
                 return False
         elif isinstance(sub, ast.Call | ast.List | ast.Set | ast.Dict | ast.Tuple | ast.Subscript):
             if isinstance(sub, ast.Tuple) and len(sub.elts) == 1:
+                if line[sub.col_offset : sub.col_offset + 1] != "(":
+                    return False  # ruff writes a one-element tuple in parentheses
                 continue
             end = sub.end_col_offset or 0
             if line[end - 1 : end] in (")", "]", "}") and line[: end - 1].rstrip().endswith(","):
@@ -119,14 +121,18 @@ def _top_expressions(node: ast.stmt) -> list[ast.expr]:
     return []
 
 
-def _has_comment(rows: list[str]) -> bool:
-    if not any("#" in row for row in rows):
+def _kept_as_written(rows: list[str]) -> bool:
+    """Whether the rows of a statement hold a comment or a string written over several lines."""
+    if not any("#" in row or '"""' in row or "'''" in row for row in rows):
         return False
-    text = "\n".join(row.strip() for row in rows)
+    text = "\n".join([rows[0].lstrip(" "), *rows[1:]])
     try:
-        return any(tok.type == tokenize.COMMENT for tok in tokenize.generate_tokens(io.StringIO(text).readline))
+        for tok in tokenize.generate_tokens(io.StringIO(text).readline):
+            if tok.type == tokenize.COMMENT or (tok.type == tokenize.STRING and tok.start[0] != tok.end[0]):
+                return True
     except (tokenize.TokenError, SyntaxError):
         return True
+    return False
 
 
 def _roots(node: ast.stmt) -> list[ast.AST]:

@@ -25,15 +25,17 @@ __all__ = ["BatteryInfoAux"]
 # fixed fields as encoded (a float16 as its bit pattern)
 _BATTERY_INFO_AUX_ENCODE_STRUCT = struct.Struct("<IHB")
 # float16 fields packed as float32 ...
-_BATTERY_INFO_AUX_FLOAT32_STRUCT = struct.Struct("<2f")
+_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<2f")
 # ... and read back as bits, from which each half is cut
-_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT = struct.Struct("<2I")
+_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<2I")
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_INFO_AUX_ENCODE_STRUCT_2 = struct.Struct("<HHHHH")
+_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<HHHHH")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_AUX_FIELD_ENDS = ((56, "BatteryInfoAux.timestamp.usec"),)
+# fixed fields as decoded
+_BATTERY_INFO_AUX_DECODE_STRUCT = struct.Struct("<IHB")
 # (bit where each field ends, field): names the field a short payload cuts
-_BATTERY_INFO_AUX_FIELD_ENDS_2 = (
+_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT = (
     (16, "BatteryInfoAux.cycle_count"),
     (32, "BatteryInfoAux.over_discharge_count"),
     (48, "BatteryInfoAux.max_current"),
@@ -42,7 +44,7 @@ _BATTERY_INFO_AUX_FIELD_ENDS_2 = (
     (73, "BatteryInfoAux.battery_id"),
 )
 # fixed fields as decoded
-_BATTERY_INFO_AUX_DECODE_STRUCT = struct.Struct("<HHeeH")
+_BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<HHeeH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -206,8 +208,8 @@ class BatteryInfoAux:
         acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
-        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT.unpack(
-            _BATTERY_INFO_AUX_FLOAT32_STRUCT.pack(
+        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
+            _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
                 (
                     r6
                     if -65504.0 <= r6 <= 65504.0
@@ -238,7 +240,7 @@ class BatteryInfoAux:
         p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
         acc = (acc << 73) | (
             int.from_bytes(
-                _BATTERY_INFO_AUX_ENCODE_STRUCT_2.pack(
+                _BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT.pack(
                     (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
                     (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
                     h10,
@@ -258,7 +260,7 @@ class BatteryInfoAux:
         n = len(data)
         if n < 7:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, n << 3)
-        u1, u2, u3 = _BATTERY_INFO_AUX_ENCODE_STRUCT.unpack_from(data)
+        u1, u2, u3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack_from(data)
         x4 = u1 | (u2 << 32) | (u3 << 48)
         v = int.from_bytes(data, "big")
         rem = (n << 3) - 56
@@ -274,9 +276,9 @@ class BatteryInfoAux:
         rem -= n6
         f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
         if rem < 73:
-            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_2, rem)
+            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
-        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(
+        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
             (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
         )
         x12 = ((u11 >> 7) & 0x1) != 0
@@ -299,8 +301,8 @@ class BatteryInfoAux:
         acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
-        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT.unpack(
-            _BATTERY_INFO_AUX_FLOAT32_STRUCT.pack(
+        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
+            _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
                 (
                     r6
                     if -65504.0 <= r6 <= 65504.0
@@ -331,7 +333,7 @@ class BatteryInfoAux:
         p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
         acc = (acc << 73) | (
             int.from_bytes(
-                _BATTERY_INFO_AUX_ENCODE_STRUCT_2.pack(
+                _BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT.pack(
                     (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
                     (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
                     h10,
@@ -350,7 +352,7 @@ class BatteryInfoAux:
         if rem < 56:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3 = _BATTERY_INFO_AUX_ENCODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        u1, u2, u3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
         x4 = u1 | (u2 << 32) | (u3 << 48)
         if rem < 8:
             raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
@@ -364,9 +366,9 @@ class BatteryInfoAux:
         rem -= n6
         f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
         if rem < 73:
-            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_2, rem)
+            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
-        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(
+        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
             (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
         )
         x12 = ((u11 >> 7) & 0x1) != 0

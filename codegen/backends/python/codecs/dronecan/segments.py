@@ -6,7 +6,7 @@ from __future__ import annotations
 from .....ir import CastMode, CompositeType, Message, PrimitiveKind
 from ...literals import py_literal
 from ...module_context import ModuleContext
-from ...naming import upper_snake
+from ...naming import identifier, upper_snake
 from .plan import Node, Piece, Planner, Segment, Unit, plan_units
 from .values import Lines, clamp, decode_pattern, encode_value, error, mask, needs_name
 
@@ -27,7 +27,7 @@ class SegmentEmitter:
     def module_value(self, source: str, role: str, comment: str) -> str:
         """A module-level constant of this class holding ``source``, named for its ``role``
         (``_BATTERY_INFO_ENCODE_STRUCT``); one constant per distinct source."""
-        what = ("dronecan", self.cls, source)
+        what = ("dronecan", self.cls, role, source)
         new = what not in self.ctx.names
         name = self.ctx.private_name(f"_{upper_snake(self.cls)}_{role}", what)
         if new:
@@ -37,10 +37,19 @@ class SegmentEmitter:
     def struct_name(self, fmt: str, role: str, comment: str) -> str:
         return self.module_value(f"struct.Struct({py_literal(fmt)})", role, comment)
 
+    def segment_role(self, seg: Segment, role: str) -> str:
+        """``role``, or ``role_FROM_<FIELD>`` for a segment that does not start the message."""
+        first = seg.leaves[0].label.split(".", 1)[1] if seg.leaves else ""
+        first = first.split(".")[0].split("[")[0]
+        starts = self.msg.fields[0] if self.msg.fields else None
+        if starts is None or first == ("<void>" if starts.is_padding else starts.name):
+            return role
+        return f"{role}_FROM_{upper_snake(identifier(first))}"
+
     def cut_table(self, seg: Segment) -> str:
         rows = [(leaf.offset + leaf.bits, leaf.label) for leaf in seg.leaves]
         comment = "(bit where each field ends, field): names the field a short payload cuts"
-        return self.module_value(py_literal(tuple(rows)), "FIELD_ENDS", comment)
+        return self.module_value(py_literal(tuple(rows)), self.segment_role(seg, "FIELD_ENDS"), comment)
 
     def class_of(self, t: CompositeType) -> str:
         return self.factory[t.name]
@@ -113,9 +122,13 @@ class SegmentEmitter:
                 clamped.append(clamp(raw, "-65504.0", "65504.0", "-_dc.INF", "_dc.INF"))
         n = len(halves)
         words = [out.fresh("g") for _ in halves]
-        floats = self.struct_name(f"<{n}f", "FLOAT32_STRUCT", "float16 fields packed as float32 ...")
+        floats = self.struct_name(
+            f"<{n}f", self.segment_role(seg, "FLOAT32_STRUCT"), "float16 fields packed as float32 ..."
+        )
         ints = self.struct_name(
-            f"<{n}I", "FLOAT32_BITS_STRUCT", "... and read back as bits, from which each half is cut"
+            f"<{n}I",
+            self.segment_role(seg, "FLOAT32_BITS_STRUCT"),
+            "... and read back as bits, from which each half is cut",
         )
         out.add(f"{', '.join(words)} = {ints}.unpack({floats}.pack({', '.join(clamped)}))")
         values: dict[int, str] = {}
@@ -135,7 +148,8 @@ class SegmentEmitter:
         units, pieces = plan_units(seg)
         args = self.seg_pack_args(seg, units, pieces, out)
         fmt = "<" + "".join(u.pack for u in units)
-        name = self.struct_name(fmt, "ENCODE_STRUCT", "fixed fields as encoded (a float16 as its bit pattern)")
+        comment = "fixed fields as encoded (a float16 as its bit pattern)"
+        name = self.struct_name(fmt, self.segment_role(seg, "ENCODE_STRUCT"), comment)
         return f"{name}.pack({', '.join(args)})"
 
     def seg_put(self, seg: Segment, out: Lines) -> None:
@@ -177,7 +191,7 @@ class SegmentEmitter:
             if u.leaf is not None:
                 u.leaf.var = var
         if names:
-            st = self.struct_name(fmt, "DECODE_STRUCT", "fixed fields as decoded")
+            st = self.struct_name(fmt, self.segment_role(seg, "DECODE_STRUCT"), "fixed fields as decoded")
             call = f"{st}.unpack_from({source[5:]})" if source.startswith("from:") else f"{st}.unpack({source})"
             target = ", ".join(names) + ("," if len(names) == 1 else "")
             out.add(f"{target} = {call}")
