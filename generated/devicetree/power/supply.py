@@ -939,7 +939,7 @@ class SimpleBattery:
         v_i: Any
         v_table: Any
         try:
-            if (x := self.compatible) is None or (len(x) < 1 or any((_x0 != "simple-battery") for _x0 in x)):
+            if (x := self.compatible) is None or (len(x) < 1 or any(_x0 != "simple-battery" for _x0 in x)):
                 _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)
         except _v.SLOW:
             _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)
@@ -960,7 +960,7 @@ class SimpleBattery:
             _v.diag(out, "device-chemistry", self.device_chemistry, _SIMPLE_BATTERY_DEVICE_CHEMISTRY_SPEC)
         try:
             if (x := self.over_voltage_threshold_microvolt) is not None and (
-                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+                len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out,
@@ -977,7 +977,7 @@ class SimpleBattery:
             )
         try:
             if (x := self.re_charge_voltage_microvolt) is not None and (
-                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+                len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out,
@@ -994,7 +994,7 @@ class SimpleBattery:
             )
         try:
             if (x := self.voltage_min_design_microvolt) is not None and (
-                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+                len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out,
@@ -1011,7 +1011,7 @@ class SimpleBattery:
             )
         try:
             if (x := self.voltage_max_design_microvolt) is not None and (
-                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+                len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out,
@@ -1109,7 +1109,7 @@ class SimpleBattery:
             )
         try:
             if (x := self.tricklecharge_upper_limit_microvolt) is not None and (
-                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+                len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out,
@@ -1153,7 +1153,7 @@ class SimpleBattery:
             )
         try:
             if (x := self.precharge_upper_limit_microvolt) is not None and (
-                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+                len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out,
@@ -1224,7 +1224,7 @@ class SimpleBattery:
             )
         try:
             if (x := self.constant_charge_voltage_max_microvolt) is not None and (
-                len(x) < 1 or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+                len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out,
@@ -1268,7 +1268,7 @@ class SimpleBattery:
             )
         try:
             if (x := self.resistance_temp_table) is not None and (
-                len(x) < 1 or any((len(_x0) != 2 or any((_x1 & -4294967296) for _x1 in _x0)) for _x0 in x)
+                len(x) < 1 or any(len(_x0) != 2 or any(_x1 & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out, "resistance-temp-table", self.resistance_temp_table, _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC
@@ -1354,12 +1354,8 @@ class SimpleBattery:
             if (x := self.volt_drop_thresh_microvolt) is not None and (
                 len(x) != 1
                 or any(
-                    (
-                        len(_x0) != 1
-                        or any(
-                            ((_x1 + 2147483648) & -4294967296 or not (-2147483648 <= _x1 <= 48000000)) for _x1 in _x0
-                        )
-                    )
+                    len(_x0) != 1
+                    or any((_x1 + 2147483648) & -4294967296 or not (-2147483648 <= _x1 <= 48000000) for _x1 in _x0)
                     for _x0 in x
                 )
             ):
@@ -1424,11 +1420,9 @@ class SimpleBattery:
                     len(x) > 100
                     or len(x) < 1
                     or any(
-                        (
-                            len(_x0) != 2
-                            or any((_x1 & -4294967296) for _x1 in _x0)
-                            or (_x0[1] & -4294967296 or not (0 <= _x0[1] <= 100))
-                        )
+                        len(_x0) != 2
+                        or any(_x1 & -4294967296 for _x1 in _x0)
+                        or (_x0[1] & -4294967296 or not (0 <= _x0[1] <= 100))
                         for _x0 in x
                     )
                 )
@@ -1448,8 +1442,7 @@ class SimpleBattery:
             if any(
                 not _v.search("^volt-drop-[0-9]-microvolt", k)
                 or (
-                    len(x) < 1
-                    or any((len(_x0) < 1 or any(((_x1 + 2147483648) & -4294967296) for _x1 in _x0)) for _x0 in x)
+                    len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
                 )
                 for k, x in self.volt_drop_n_microvolt.items()
             ):
