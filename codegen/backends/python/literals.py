@@ -40,6 +40,21 @@ def py_literal(value: object) -> str:
     raise TypeError(f"no literal for {type(value).__name__}")
 
 
+def unparenthesized(source: str) -> str:
+    """An expression's source without the parentheses around all of it, where it stands alone (a
+    statement's value, a generator's element). Emitters build conditions wrapped in one pair; a
+    bracket inside a string literal at worst keeps that pair."""
+    if not source.startswith("("):
+        return source
+    depth = 0
+    for i, ch in enumerate(source):
+        depth += ch == "("
+        depth -= ch == ")"
+        if depth == 0:
+            return source[1:-1] if i == len(source) - 1 else source
+    return source
+
+
 def hex_literal(value: int) -> str:
     """``2047`` -> ``0x7FF`` (bit masks read better in hex)."""
     return ("-" if value < 0 else "") + "0x" + format(abs(value), "X")

@@ -127,14 +127,14 @@ class LayoutContext:
             group_id=group_id,
         )
 
-    def comma_separated(self, items: list[list[Element]], closing: int | None) -> list[Element]:
+    def comma_separated(self, items: list[list[Element]], bracketed: ast.AST | None) -> list[Element]:
         """Items joined by commas that break; a trailing comma when broken (and a magic one kept)."""
         out: list[Element] = []
         for i, item in enumerate(items):
             if i:
                 out += [",", Line.SOFT_OR_SPACE]
             out += item
-        magic = closing is not None and self.source.magic_trailing_comma(closing)
+        magic = bracketed is not None and self.source.magic_trailing_comma(bracketed)
         if items and (magic or len(items) > 1):
             out += d.if_group_breaks(",")
         if items and magic:

@@ -74,7 +74,6 @@ class ExpressionLayout(OperatorLayout):
 
     def fmt_Call(self, node: ast.Call) -> list[Element]:
         func = self.expr(node.func, Parens.ALWAYS if self.source.is_parenthesized(node.func) else Parens.NEVER)
-        closing = self.source.last_token(node)
         if not node.args and not node.keywords:
             return [*func, "()"]
 
@@ -92,7 +91,7 @@ class ExpressionLayout(OperatorLayout):
                     self.keyword(e) if isinstance(e, ast.keyword) else self.expr(e)
                     for _, e in sorted(entries, key=lambda e: e[0])
                 ]
-            return d.group(self.comma_separated(items, closing))
+            return d.group(self.comma_separated(items, node))
 
         return [*func, *self.parenthesized("(", arguments, ")")]
 
@@ -122,10 +121,9 @@ class ExpressionLayout(OperatorLayout):
         if len(node.elts) == 1:
             single = node.elts[0]
             return self.parenthesized("(", lambda: [*self.expr(single), ","], ")")
-        closing = self.source.last_token(node)
 
         def sequence() -> list[Element]:
-            return self.comma_separated([self.expr(e) for e in node.elts], closing if own else None)
+            return self.comma_separated([self.expr(e) for e in node.elts], node if own else None)
 
         if own:
             return self.parenthesized("(", sequence, ")")
@@ -145,8 +143,7 @@ class ExpressionLayout(OperatorLayout):
     def bracketed(self, left: str, items: list[ast.expr], node: ast.expr, right: str) -> list[Element]:
         if not items:
             return [left + right]
-        closing = self.source.last_token(node)
-        return self.parenthesized(left, lambda: self.comma_separated([self.expr(e) for e in items], closing), right)
+        return self.parenthesized(left, lambda: self.comma_separated([self.expr(e) for e in items], node), right)
 
     def fmt_List(self, node: ast.List) -> list[Element]:
         return self.bracketed("[", node.elts, node, "]")
@@ -157,7 +154,6 @@ class ExpressionLayout(OperatorLayout):
     def fmt_Dict(self, node: ast.Dict) -> list[Element]:
         if not node.keys:
             return ["{}"]
-        closing = self.source.last_token(node)
 
         def pairs() -> list[Element]:
             items: list[list[Element]] = []
@@ -166,7 +162,7 @@ class ExpressionLayout(OperatorLayout):
                     items.append(d.group("**", self.expr(value)))
                 else:
                     items.append(d.group(self.expr(key), ":", " ", self.expr(value)))
-            return self.comma_separated(items, closing)
+            return self.comma_separated(items, node)
 
         return self.parenthesized("{", pairs, "}")
 

@@ -7,7 +7,7 @@ import io
 import tokenize
 
 from .document import Element
-from .printer import Printer
+from .printer import Printer, flat_text, text_width
 from .source import Source, normalize_number, normalize_string, outside_fstrings
 from .statements import StatementLayout
 
@@ -49,14 +49,18 @@ def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
             continue
         try:
             if first == last:
-                document = _document(node, Source.of_line(line, *_roots(node)), line)
+                document = _document(node, Source(line, *_roots(node)), line)
             else:
                 joined = " ".join(lines[row].strip() for row in range(first, last + 1))
                 document = _joined_document(joined, isinstance(node, _HEADERS))
         except NotImplementedError:
             continue
         if document is not None:
-            replaced[first] = (last, Printer(line_length).print(document, depth))
+            flat = flat_text(document)
+            if flat is not None and _INDENT * depth + text_width(flat) <= line_length:
+                replaced[first] = (last, " " * (_INDENT * depth) + flat)
+            else:
+                replaced[first] = (last, Printer(line_length).print(document, depth))
     out: list[str] = []
     row = 0
     while row < len(lines):
@@ -86,7 +90,7 @@ def _as_written(node: ast.stmt, line: str) -> bool:
             if isinstance(sub.value, str | bytes):
                 if normalize_string(text) != text:
                     return False  # other quotes, or parts ruff would join
-            elif isinstance(sub.value, int | float | complex) and normalize_number(text) != text:
+            elif type(sub.value) in (int, float, complex) and normalize_number(text) != text:
                 return False
         elif isinstance(sub, ast.JoinedStr):
             text = line[sub.col_offset : sub.end_col_offset]
@@ -163,9 +167,9 @@ def _joined_document(joined: str, header: bool) -> list[Element] | None:
         text = joined[offset:] + " pass"
         node = ast.parse(text).body[0]
         assert isinstance(node, ast.If | ast.While | ast.For)
-        return StatementLayout(Source.of_line(text, *_roots(node))).header(keyword, node)
+        return StatementLayout(Source(text, *_roots(node))).header(keyword, node)
     node = ast.parse(joined).body[0]
-    return StatementLayout(Source.of_line(joined, node)).statement(node)
+    return StatementLayout(Source(joined, node)).statement(node)
 
 
 def _statements(body: list[ast.stmt]) -> list[ast.stmt]:

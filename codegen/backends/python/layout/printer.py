@@ -292,7 +292,16 @@ class _FitsMeasurer:
         self.limit = printer.line_width_limit
 
     def fits(self) -> bool:
-        while (element := self.queue.pop()) is not None:
+        pop, stack, limit = self.queue.pop, self.stack, self.limit
+        while (element := pop()) is not None:
+            if type(element) is str:  # most elements are text: measured here, not in fits_element
+                if self.pending_indent:
+                    self.line_width += INDENT_WIDTH * self.pending_indent
+                    self.pending_indent = 0
+                self.line_width += len(element) if element.isascii() else text_width(element)
+                if self.line_width > limit and stack[-1][1].measure is not Measure.ALL_LINES_OVERFLOW:
+                    return False
+                continue
             result = self.fits_element(element)
             if result is _Fits.YES:
                 return True
@@ -393,3 +402,36 @@ class _FitsMeasurer:
         if self.line_width > self.limit and args.measure is not Measure.ALL_LINES_OVERFLOW:
             return _Fits.NO
         return _Fits.MAYBE
+
+
+def flat_text(document: list[Element]) -> str | None:
+    """The document printed on one line, or None when something in it forces a line break.
+
+    When the result fits the line width this is what :class:`Printer` prints too (every group
+    then fits flat), so a statement short enough needs no fitting tests at all."""
+    out: list[str] = []
+    skipping = 0  # depth inside content shown only when a group breaks
+    for element in document:
+        if skipping:
+            if isinstance(element, Start) and element.kind is Kind.CONDITIONAL_CONTENT:
+                skipping += 1
+            elif isinstance(element, End) and element.kind is Kind.CONDITIONAL_CONTENT:
+                skipping -= 1
+        elif type(element) is str:
+            out.append(element)
+        elif element is Line.SOFT_OR_SPACE:
+            out.append(" ")
+        elif element is Line.HARD or isinstance(element, ExpandParent):
+            return None
+        elif isinstance(element, BestFitting):
+            inner = flat_text(element.variants[0][1:-1])
+            if inner is None:
+                return None
+            out.append(inner)
+        elif isinstance(element, Start):
+            if element.kind is Kind.GROUP and element.mode is not GroupMode.FLAT:
+                return None
+            condition = element.condition
+            if element.kind is Kind.CONDITIONAL_CONTENT and condition is not None and condition.mode is Mode.EXPANDED:
+                skipping = 1
+    return "".join(out)

@@ -1,7 +1,7 @@
 """The source text of one statement (or one expression) next to its AST: what the AST forgets.
 
-Parentheses written around an expression, the tokens of an implicitly concatenated string, a
-trailing comma before a closing bracket and the spelling of literals come from the tokens; the
+Parentheses written around an expression, the parts of an implicitly concatenated string, a
+trailing comma before a closing bracket and the spelling of literals come from the text; the
 literal spellings are normalised here the way ruff normalises them (double quotes unless that
 needs more escapes, upper-case hex digits, lower-case exponent).
 """
@@ -9,81 +9,58 @@ needs more escapes, upper-case hex digits, lower-case exponent).
 from __future__ import annotations
 
 import ast
-import io
-import token as token_types
-import tokenize
-from dataclasses import dataclass
-
-_SKIPPED = {token_types.NEWLINE, token_types.NL, token_types.ENDMARKER, token_types.INDENT, token_types.DEDENT}
-_FSTRING_START = getattr(token_types, "FSTRING_START", -1)  # Python 3.12+ splits f-strings
-_FSTRING_END = getattr(token_types, "FSTRING_END", -1)
 
 
-@dataclass(frozen=True)
-class Token:
-    kind: int
-    text: str
-    start: int  # character offsets in the statement's single line
-    end: int
-
-
-def line_tokens(text: str) -> list[Token]:
-    """The tokens of a one-line statement that matter here (an f-string as one STRING token)."""
-    out: list[Token] = []
-    fstring_start = 0  # column where the outermost open f-string starts
-    depth = 0
-    for tok in tokenize.generate_tokens(io.StringIO(text).readline):
-        if tok.type in _SKIPPED or tok.type == token_types.COMMENT:
-            continue
-        if tok.start[0] != 1 or tok.end[0] != 1:
-            raise NotImplementedError("a statement on one line was expected")
-        if tok.type == _FSTRING_START:
-            if depth == 0:
-                fstring_start = tok.start[1]
-            depth += 1
-        elif depth:
-            if tok.type == _FSTRING_END:
-                depth -= 1
-                if depth == 0:
-                    end = tok.end[1]
-                    out.append(Token(token_types.STRING, text[fstring_start:end], fstring_start, end))
-        else:
-            out.append(Token(tok.type, tok.string, tok.start[1], tok.end[1]))
+def outside_fstrings(tree: ast.AST) -> list[ast.AST]:
+    """Every node but those inside f-strings (their positions are not the source's in every Python)."""
+    out: list[ast.AST] = []
+    todo = [tree]
+    while todo:
+        node = todo.pop()
+        out.append(node)
+        if not isinstance(node, ast.JoinedStr):
+            todo.extend(ast.iter_child_nodes(node))
     return out
 
 
 class Source:
-    """A one-line statement or expression: its tokens, and where each AST node sits among them."""
+    """A statement or expression on one line: where each AST node sits in the text, which brackets
+    match, which parentheses are a call's own. String literals are known from the AST, so the
+    brackets are found by one scan of the text around them."""
 
-    def __init__(self, text: str, tokens: list[Token], *trees: ast.AST) -> None:
+    def __init__(self, text: str, *trees: ast.AST) -> None:
         self.text = text
         self.ascii = text.isascii()
         self.encoded = text.encode("utf-8")
-        self.tokens = tokens
-        self.by_start = {t.start: i for i, t in enumerate(self.tokens)}
-        self.by_end = {t.end: i for i, t in enumerate(self.tokens)}
+        nodes = [n for tree in trees for n in outside_fstrings(tree)]
+        strings = sorted(
+            self.span(n)
+            for n in nodes
+            if isinstance(n, ast.JoinedStr) or (isinstance(n, ast.Constant) and isinstance(n.value, str | bytes))
+        )
         self.match: dict[int, int] = {}
         opened: list[int] = []
-        for i, t in enumerate(self.tokens):
-            if t.text in ("(", "[", "{"):
+        i, n, k = 0, len(text), 0
+        while i < n:
+            if k < len(strings) and i == strings[k][0]:
+                i = strings[k][1]
+                k += 1
+                continue
+            ch = text[i]
+            if ch in "([{":
                 opened.append(i)
-            elif t.text in (")", "]", "}"):
+            elif ch in ")]}":
                 j = opened.pop()
-                self.match[i] = j
-                self.match[j] = i
+                self.match[i], self.match[j] = j, i
+            i += 1
         # the parentheses of a call are its own, not parentheses around its (only) argument
         self.call_parens: set[int] = set()
-        for node in (n for tree in trees for n in outside_fstrings(tree)):
+        for node in nodes:
             if isinstance(node, ast.Call):
-                after = self.by_end[self.span(node.func)[1]] + 1
-                while self.tokens[after].text == ")":  # the function itself in parentheses
-                    after += 1
-                self.call_parens.add(after)
-
-    @classmethod
-    def of_line(cls, text: str, *trees: ast.AST) -> Source:
-        """A statement alone on one line (``text``, parsed into ``trees``)."""
-        return cls(text, line_tokens(text), *trees)
+                at = self.span(node.func)[1]
+                while text[at] in " )":  # the function itself may be in parentheses
+                    at += 1
+                self.call_parens.add(at)
 
     def char_offset(self, byte_offset: int) -> int:
         if self.ascii:
@@ -95,52 +72,59 @@ class Source:
         end = self.char_offset(getattr(node, "end_col_offset"))  # noqa: B009
         return start, end
 
-    def first_token(self, node: ast.AST) -> int:
-        return self.by_start[self.span(node)[0]]
-
-    def last_token(self, node: ast.AST) -> int:
-        return self.by_end[self.span(node)[1]]
-
     def segment(self, node: ast.AST) -> str:
         start, end = self.span(node)
         return self.text[start:end]
 
+    def _before(self, at: int) -> int:
+        at -= 1
+        while at >= 0 and self.text[at] == " ":
+            at -= 1
+        return at
+
+    def _after(self, at: int) -> int:
+        while at < len(self.text) and self.text[at] == " ":
+            at += 1
+        return at
+
     def is_parenthesized(self, node: ast.AST) -> bool:
         """Whether the source writes parentheses around the expression (its own ones excluded)."""
-        before, after = self.first_token(node) - 1, self.last_token(node) + 1
-        tokens = self.tokens
+        start, end = self.span(node)
+        before, after = self._before(start), self._after(end)
         return (
             before >= 0
-            and after < len(tokens)
-            and tokens[before].text == "("
-            and tokens[after].text == ")"
+            and self.text[before] == "("
             and self.match.get(before) == after
             and before not in self.call_parens
         )
 
     def own_parentheses(self, node: ast.Tuple | ast.GeneratorExp) -> bool:
         """A tuple or generator written with parentheses of its own (not a call's)."""
-        first, last = self.first_token(node), self.last_token(node)
-        return self.tokens[first].text == "(" and self.match.get(first) == last and first not in self.call_parens
+        start, end = self.span(node)
+        return self.text[start] == "(" and self.match.get(start) == end - 1 and start not in self.call_parens
 
-    def magic_trailing_comma(self, closing: int) -> bool:
-        return closing > 0 and self.tokens[closing - 1].text == ","
+    def magic_trailing_comma(self, node: ast.AST) -> bool:
+        """Whether a comma precedes the bracket that closes ``node``."""
+        closing = self.span(node)[1] - 1
+        before = self._before(closing)
+        return before >= 0 and self.text[before] == ","
 
     def string_parts(self, node: ast.AST) -> list[str]:
-        first, last = self.first_token(node), self.last_token(node)
-        return [t.text for t in self.tokens[first : last + 1] if t.kind == token_types.STRING]
-
-
-def outside_fstrings(tree: ast.AST) -> list[ast.AST]:
-    """Every node but those inside f-strings (the tokens do not look inside an f-string)."""
-    out: list[ast.AST] = []
-    todo = [tree]
-    while todo:
-        node = todo.pop()
-        out.append(node)
-        if not isinstance(node, ast.JoinedStr):
-            todo.extend(ast.iter_child_nodes(node))
-    return out
+        """The string literals an (implicitly concatenated) string expression is written as."""
+        text, (at, end) = self.text, self.span(node)
+        parts: list[str] = []
+        while at < end:
+            start = at
+            while text[at] not in "'\"":
+                at += 1
+            quote = text[at : at + 3] if text[at : at + 3] in ('"""', "'''") else text[at]
+            at += len(quote)
+            while text[at : at + len(quote)] != quote:
+                at += 2 if text[at] == "\\" else 1
+            at += len(quote)
+            parts.append(text[start:at])
+            at = self._after(at)
+        return parts
 
 
 # -- literal spellings ---------------------------------------------------------------------------

@@ -21,7 +21,7 @@ from ....ir import (
     Sentinel,
     StringType,
 )
-from ..literals import hex_literal, prose_literal, py_literal
+from ..literals import hex_literal, prose_literal, py_literal, unparenthesized
 from .bounds import EnumFacts, enum_facts, folded, inside, number, type_bounds
 
 V = "\x00V\x00"  # placeholder for the value expression in a condition
@@ -206,22 +206,9 @@ class ArrayCheck:
             parts.insert(0, f"{V}.__class__ is not bytes")
         else:
             item = f"_x{self.depth}"
-            parts.append(f"any({_bare(self.inner.bad()).replace(V, item)} for {item} in {V})")
+            parts.append(f"any({unparenthesized(self.inner.bad()).replace(V, item)} for {item} in {V})")
         parts += self.column_bad()
         return "(" + " or ".join(parts) + ")" if parts else "False"
-
-
-def _bare(cond: str) -> str:
-    """A condition without the parentheses around all of it (a generator's element needs none)."""
-    if not cond.startswith("("):
-        return cond
-    depth = 0
-    for i, ch in enumerate(cond):
-        depth += ch == "("
-        depth -= ch == ")"
-        if depth == 0:
-            return cond[1:-1] if i == len(cond) - 1 else cond
-    return cond
 
 
 class NestedCheck:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ....ir import Field, Message, Schema
-from ..literals import py_literal
+from ..literals import py_literal, unparenthesized
 from .checks import ArrayCheck, NestedCheck, NumberCheck, V, build
 
 
@@ -59,7 +59,7 @@ def field_code(schema: Schema, msg: Message, f: Field, ident: str, spec_name: st
             head, ind = [f"a = {attr}", "if a is not None:"], "    "
         else:
             head, ind = [f"a = {attr}"], ""
-        loop = ["for e in a:", f"    if {item}:", f"        {slow}", "        break"]
+        loop = ["for e in a:", f"    if {unparenthesized(item)}:", f"        {slow}", "        break"]
         if length:
             cond = " or ".join(length).replace(V, "a")
             inner = [f"if {cond}:", f"    {slow}", "else:", *["    " + x for x in loop]]
@@ -76,10 +76,10 @@ def field_code(schema: Schema, msg: Message, f: Field, ident: str, spec_name: st
                 cond = f"(x := {attr}) is not None and {cond.replace(V, 'x')}"
             body = [f"if {cond}:", f"    {slow}"]
         elif cond.count(V) == 1:
-            body = [f"if {cond.replace(V, attr)}:", f"    {slow}"]
+            body = [f"if {unparenthesized(cond).replace(V, attr)}:", f"    {slow}"]
         else:  # the value is tested more than once: read the attribute once
             names.add("x")
-            body = [f"x = {attr}", f"if {cond.replace(V, 'x')}:", f"    {slow}"]
+            body = [f"x = {attr}", f"if {unparenthesized(cond).replace(V, 'x')}:", f"    {slow}"]
     return FieldCode(spec_name, spec, _wrap(body, slow), frozenset(names))
 
 

@@ -4,7 +4,7 @@ one ``struct`` call per segment, fields not on a byte boundary assembled from sh
 from __future__ import annotations
 
 from .....ir import CastMode, CompositeType, Message, PrimitiveKind
-from ...literals import py_literal
+from ...literals import py_literal, unparenthesized
 from ...module_context import ModuleContext
 from ...naming import identifier, upper_snake
 from .plan import Node, Piece, Planner, Segment, Unit, plan_units
@@ -80,7 +80,7 @@ class SegmentEmitter:
             value = encode_value(leaf.type, raw, pattern=group)
             if group:
                 name = out.fresh("p")
-                out.add(f"{name} = {value}")
+                out.add(f"{name} = {unparenthesized(value)}")
                 value = name
             values[idx] = value
         by_unit: dict[int, list[str]] = {}
@@ -207,7 +207,7 @@ class SegmentEmitter:
                 parts.append(f"({term} << {pc.src})" if pc.src else term)
             bits = parts[0] if len(parts) == 1 else "(" + " | ".join(parts) + ")"
             var = out.fresh("x")
-            out.add(f"{var} = {decode_pattern(leaf.type, bits)}")
+            out.add(f"{var} = {unparenthesized(decode_pattern(leaf.type, bits))}")
             leaf.var = var
 
     def seg_get(self, seg: Segment, out: Lines) -> None:
@@ -222,7 +222,8 @@ class SegmentEmitter:
             return
         if len(seg.leaves) == 1 and seg.bits <= 8 and not live[0].nbytes:
             var = out.fresh("x")
-            out.add(f"{var} = {decode_pattern(live[0].type, f'((v >> rem) & {mask(seg.bits)})')}")
+            pattern = decode_pattern(live[0].type, f"((v >> rem) & {mask(seg.bits)})")
+            out.add(f"{var} = {unparenthesized(pattern)}")
             live[0].var = var
             return
         nb = (seg.bits + 7) // 8

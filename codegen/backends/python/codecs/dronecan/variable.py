@@ -4,7 +4,7 @@ prefix, or the tail array optimisation), large static arrays and nested variable
 from __future__ import annotations
 
 from .....ir import ArrayType, CompositeType, FieldType, PrimitiveType
-from ...literals import py_literal
+from ...literals import py_literal, unparenthesized
 from .plan import Segment, VarField, is_u8, struct_code
 from .segments import SegmentEmitter
 from .values import Lines, decode_pattern, encode_value, error, mask, stream, structable_element, unstream
@@ -148,7 +148,7 @@ class VariableFieldEmitter(SegmentEmitter):
         else:
             b = out.fresh("b")
             out.add(f"{b} = (v >> rem) & {mask(width)}")
-            out.add(f"{k} = {unstream(b, width)}")
+            out.add(f"{k} = {unparenthesized(unstream(b, width))}")
         out.add(f"if {k} > {cap}:")
         out.add(f"    raise {too_long}")
         self.elements_get(t.element, k, target, label, elem_tao, out)
