@@ -1,5 +1,9 @@
 """The Python backend: a package of typed dataclasses (and, through extensions, codecs and
-validators) generated from the IR. Output is a pure function of the IR: same IR, same bytes."""
+validators) generated from the IR. Output is a pure function of the IR: same IR, same bytes.
+
+Templates and extensions write each statement on one line; every module is then laid out by
+:mod:`.layout` as ``ruff format`` would write it, so generated code reads like reviewed code.
+"""
 
 from __future__ import annotations
 
@@ -88,14 +92,11 @@ def render_package(schema: Schema) -> dict[str, str]:
 
     for package in sorted(packages - modules):
         files[module_file(package, packages)] = format_module(_render_package_init(env, schema, package, by_module))
-    files["__init__.py"] = env.get_template("package.py.j2").render(
-        header=HEADER,
-        doc=docstring(
-            "battgen generated models.\n\nFormats: " + ", ".join(sorted({m.split(".")[0] for m in modules})) + ".", ""
-        ),
-        imports=[],
-        exports=[],
+    formats = ", ".join(sorted({m.split(".")[0] for m in modules}))
+    root = env.get_template("package.py.j2").render(
+        header=HEADER, doc=docstring(f"battgen generated models.\n\nFormats: {formats}.", ""), imports=[], exports=[]
     )
+    files["__init__.py"] = format_module(root)
     return files
 
 

@@ -61,13 +61,13 @@ class FieldBuilder:
     def zero(self, t: FieldType) -> str:
         """Source for a fresh default value of type ``t``."""
         if isinstance(t, PrimitiveType):
-            return {"bool": "False", "float": "0.0", "str": "''", "int": "0"}[python_scalar(t)]
+            return {"bool": "False", "float": "0.0", "str": '""', "int": "0"}[python_scalar(t)]
         if isinstance(t, StringType):
-            return "''"
+            return '""'
         if isinstance(t, CompositeType):
             return self.ctx.factory(self.ctx.composite(t, self.f)) + "()()"
         if is_byte_array(t):
-            return f"bytes({t.capacity})" if not t.dynamic and t.capacity else "b''"
+            return f"bytes({t.capacity})" if not t.dynamic and t.capacity else 'b""'
         if t.dynamic or not t.capacity:
             return "[]"
         element = self.zero(t.element)
@@ -97,7 +97,7 @@ class FieldBuilder:
         zero = self.zero(t)
         if isinstance(t, PrimitiveType | StringType):
             return f"default={zero}"
-        if zero == "b''":
+        if zero == 'b""':
             return f"default={zero}"
         if zero == "[]":
             return "default_factory=list"
