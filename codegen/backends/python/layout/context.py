@@ -208,7 +208,14 @@ class LayoutContext:
         if isinstance(node, ast.Attribute | ast.Subscript):
             if self.source.is_parenthesized(node.value):
                 return Needs.NEVER
-            return self.needs_parentheses(node.value, node)
+            needs = self.needs_parentheses(node.value, node)
+            functions = ast.FunctionDef | ast.AsyncFunctionDef
+            if isinstance(node, ast.Subscript) and isinstance(parent, functions) and parent.returns is node:
+                if needs is Needs.BEST_FIT:  # a return annotation breaks in its brackets, after the parameters
+                    p = parent.args
+                    empty = not (p.posonlyargs or p.args or p.vararg or p.kwonlyargs or p.kwarg)
+                    return Needs.MULTILINE if empty else Needs.NEVER
+            return needs
         if isinstance(node, ast.UnaryOp):
             if self.source.is_parenthesized(node.operand):
                 return Needs.NEVER

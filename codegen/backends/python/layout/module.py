@@ -13,8 +13,9 @@ from .statements import StatementLayout
 
 LINE_LENGTH = 120
 _INDENT = 4
-_SIMPLE = ast.Expr | ast.Assign | ast.AnnAssign | ast.AugAssign | ast.Return | ast.Raise
+_SIMPLE = ast.Expr | ast.Assign | ast.AnnAssign | ast.AugAssign | ast.Return | ast.Raise | ast.ImportFrom
 _HEADERS = ast.If | ast.While | ast.For
+_DEFS = ast.FunctionDef | ast.AsyncFunctionDef
 
 
 def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
@@ -36,6 +37,10 @@ def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
             last = (tested.end_lineno or tested.lineno) - 1
             if node.body[0].lineno - 1 <= last:
                 continue
+        elif isinstance(node, _DEFS):
+            last = node.body[0].lineno - 2  # the header ends on the row before the body
+            if last < first:
+                continue
         else:
             continue
         rows = lines[first : last + 1]
@@ -45,14 +50,15 @@ def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
         depth, rest = divmod(len(line) - len(line.lstrip(" ")), _INDENT)
         if rest:
             continue
-        if first == last and len(line) <= line_length and _as_written(node, line):
+        simple_enough = not isinstance(node, _DEFS) and not (isinstance(node, ast.ImportFrom) and "(" in line)
+        if first == last and len(line) <= line_length and simple_enough and _as_written(node, line):
             continue
         try:
             if first == last:
                 document = _document(node, Source(line, *_roots(node)), line)
             else:
                 joined = " ".join(lines[row].strip() for row in range(first, last + 1))
-                document = _joined_document(joined, isinstance(node, _HEADERS))
+                document = _joined_document(joined, node)
         except NotImplementedError:
             continue
         if document is not None:
@@ -141,6 +147,8 @@ def _kept_as_written(rows: list[str]) -> bool:
 
 def _roots(node: ast.stmt) -> list[ast.AST]:
     """The parts of the statement laid out: all of it, or a header's expressions."""
+    if isinstance(node, _DEFS):
+        return [node.args] + ([node.returns] if node.returns is not None else [])
     if isinstance(node, ast.For):
         return [node.target, node.iter]
     if isinstance(node, ast.If | ast.While):
@@ -150,6 +158,8 @@ def _roots(node: ast.stmt) -> list[ast.AST]:
 
 def _document(node: ast.stmt, source: Source, line: str) -> list[Element] | None:
     layout = StatementLayout(source)
+    if isinstance(node, _DEFS):
+        return layout.function_header(node) if line.rstrip().endswith(":") else None
     if isinstance(node, _HEADERS):
         if not line.rstrip().endswith(":"):
             return None
@@ -158,16 +168,20 @@ def _document(node: ast.stmt, source: Source, line: str) -> list[Element] | None
     return layout.statement(node)
 
 
-def _joined_document(joined: str, header: bool) -> list[Element] | None:
-    if header:
+def _joined_document(joined: str, original: ast.stmt) -> list[Element] | None:
+    """The document of a statement written over several lines, joined into ``joined``."""
+    if isinstance(original, _HEADERS | _DEFS):
         if not joined.endswith(":"):
             return None
         keyword = joined.split(" ", 1)[0]
         offset = 2 if keyword == "elif" else 0  # "elif x:" parses as "if x:"
         text = joined[offset:] + " pass"
         node = ast.parse(text).body[0]
+        layout = StatementLayout(Source(text, *_roots(node)))
+        if isinstance(node, _DEFS):
+            return layout.function_header(node)
         assert isinstance(node, ast.If | ast.While | ast.For)
-        return StatementLayout(Source(text, *_roots(node))).header(keyword, node)
+        return layout.header(keyword, node)
     node = ast.parse(joined).body[0]
     return StatementLayout(Source(joined, node)).statement(node)
 

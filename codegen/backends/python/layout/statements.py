@@ -11,10 +11,23 @@ import ast
 
 from . import document as d
 from .context import Level, Needs, Parens, Parenthesize
-from .document import Element
+from .document import Element, Line
 from .expressions import ExpressionLayout, TupleParens
 from .operators import BINARY
 from .source import joined_strings
+
+
+def _all_parameters(params: ast.arguments) -> list[ast.AST]:
+    """Every parameter and default, in source order (the last one decides a trailing comma)."""
+    nodes: list[ast.AST] = [*params.posonlyargs, *params.args]
+    if params.vararg is not None:
+        nodes.append(params.vararg)
+    nodes += params.kwonlyargs
+    if params.kwarg is not None:
+        nodes.append(params.kwarg)
+    nodes += [e for e in (*params.defaults, *params.kw_defaults) if e is not None]
+    return sorted(nodes, key=lambda n: (getattr(n, "lineno", 0), getattr(n, "col_offset", 0)))
+
 
 _ARITHMETIC = (ast.BitOr, ast.BitXor, ast.LShift, ast.RShift, ast.Add, ast.Sub)
 
@@ -41,6 +54,8 @@ class StatementLayout(ExpressionLayout):
             if isinstance(node.value, ast.Tuple):
                 return ["return", " ", *self.tuple(node.value, TupleParens.OPTIONAL)]
             return ["return", " ", *self.left_to_right(node.value, node)]
+        if isinstance(node, ast.ImportFrom):
+            return self.import_from(node)
         if isinstance(node, ast.Raise):
             out: list[Element] = ["raise"]
             if node.exc is not None:
@@ -49,6 +64,85 @@ class StatementLayout(ExpressionLayout):
                 out += [" ", "from", " ", *self.maybe_parenthesize(node.cause, node, Parenthesize.OPTIONAL)]
             return out
         raise NotImplementedError(type(node).__name__)
+
+    def import_from(self, node: ast.ImportFrom) -> list[Element]:
+        """``from module import a, b``: in parentheses, one name per line, when too long."""
+        head: list[Element] = ["from", " ", "." * node.level + (node.module or ""), " ", "import", " "]
+        if len(node.names) == 1 and node.names[0].name == "*":
+            return [*head, "*"]
+
+        def names() -> list[Element]:
+            out: list[Element] = []
+            for i, alias in enumerate(node.names):
+                if i:
+                    out += [",", Line.SOFT_OR_SPACE]
+                out += [alias.name] if alias.asname is None else [alias.name, " ", "as", " ", alias.asname]
+            out += d.if_group_breaks(",")
+            text = self.source.text.rstrip()
+            if text.endswith(")") and text[:-1].rstrip().endswith(","):
+                out.append(d.EXPAND_PARENT)  # a trailing comma keeps the names one per line
+            return out
+
+        return [*head, *self.parenthesize_if_expands(names)]
+
+    def function_header(self, node: ast.FunctionDef | ast.AsyncFunctionDef) -> list[Element]:
+        """``def name(parameters) -> annotation:``: parameters break first, one per line if need be."""
+        out: list[Element] = ["async", " "] if isinstance(node, ast.AsyncFunctionDef) else []
+        out += ["def", " ", node.name]
+        if getattr(node, "type_params", None):
+            raise NotImplementedError("type parameters")
+        inner = self.parameters(node.args)
+        returns = node.returns
+        if returns is not None:
+            inner += [" ", "->", " "]
+            if isinstance(returns, ast.Tuple):
+                inner += self.expr(returns, Parens.NEVER)
+            else:
+                empty = not _all_parameters(node.args)
+                how = Parenthesize.IF_BREAKS_PARENTHESIZED if empty else Parenthesize.IF_BREAKS
+                inner += self.maybe_parenthesize(returns, node, how)
+        return [*out, *d.group(inner), ":"]
+
+    def parameters(self, params: ast.arguments) -> list[Element]:
+        every = _all_parameters(params)
+        if not every:
+            return ["()"]
+        with self.at(Level("parenthesized")):
+            entries: list[list[Element]] = []
+            defaults = [None] * (len(params.posonlyargs) + len(params.args) - len(params.defaults))
+            positional = [*params.posonlyargs, *params.args]
+            for i, (arg, default) in enumerate(zip(positional, [*defaults, *params.defaults], strict=True)):
+                entries.append(self.parameter(arg, default))
+                if params.posonlyargs and i == len(params.posonlyargs) - 1:
+                    entries.append(["/"])
+            if params.vararg is not None:
+                entries.append(["*", *self.parameter(params.vararg, None)])
+            elif params.kwonlyargs:
+                entries.append(["*"])
+            for arg, kw_default in zip(params.kwonlyargs, params.kw_defaults, strict=True):
+                entries.append(self.parameter(arg, kw_default))
+            if params.kwarg is not None:
+                entries.append(["**", *self.parameter(params.kwarg, None)])
+            inner: list[Element] = []
+            for i, entry in enumerate(entries):
+                if i:
+                    inner += [",", Line.SOFT_OR_SPACE]
+                inner += entry
+            inner += d.if_group_breaks(",")
+            last = every[-1]
+            after = self.source.span(last)[1]
+            if self.source.text[after:].lstrip(" ").startswith(","):
+                inner.append(Line.HARD)  # a trailing comma keeps the parameters one per line
+        single = len(every) == 1 and not params.posonlyargs and not params.kwonlyargs
+        return ["(", *d.soft_block_indent(inner if single else d.group(inner)), ")"]
+
+    def parameter(self, arg: ast.arg, default: ast.expr | None) -> list[Element]:
+        out: list[Element] = [arg.arg]
+        if arg.annotation is not None:
+            out += [":", " ", *self.expr(arg.annotation)]
+        if default is not None:
+            out += [" = " if arg.annotation is not None else "=", *self.expr(default)]
+        return out
 
     def header(self, keyword: str, node: ast.If | ast.While | ast.For) -> list[Element]:
         if isinstance(node, ast.For):
