@@ -196,6 +196,12 @@ LAYOUT_CASES = (
     "value = {key_with_a_long_name: [item.to_dict() for item in values_with_a_long_name] for "
     "key_with_a_long_name, values_with_a_long_name in data.items()}",
     "short = ('a', 'b',)",
+    "def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None = None, "
+    "rep_d: _r.LossReport | None = None) -> tuple[BatteryState]:\n    pass",
+    "def from_ulog(cls, source: _ulog.Source | _ulog.Log, *, topic: str | None = None, multi_id: int = 0) "
+    "-> list[BatteryStatus]:\n    pass",
+    "from . import devicetree, dronecan, dronecan_devicetree, dronecan_mavlink, dronecan_uorb, "
+    "dronecan_uorb_v0, mavlink, mavlink_devicetree, uorb",
     "parenthesized = (a + b)",
     "text = 'it\\'s \"quoted\"'",
     "nested = outer_function(inner_function(argument_one, argument_two, argument_three), "
@@ -207,7 +213,7 @@ def test_layout_engine_agrees_with_ruff(tmp_path: Path) -> None:
     from codegen.backends.python.layout import format_module
 
     path = tmp_path / "cases.py"
-    body = "\n".join(LAYOUT_CASES).replace("\n", "\n    ")
+    body = "\n\n".join(LAYOUT_CASES).replace("\n", "\n    ").replace("\n    \n", "\n\n")
     path.write_text(f"def f():\n    {body}\n")
     path.write_text(format_module(path.read_text()))
     proc = subprocess.run(
