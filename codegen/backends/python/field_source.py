@@ -4,7 +4,7 @@ the statements that turn it into plain data and back (``to_dict`` / ``from_dict`
 from __future__ import annotations
 
 from ...ir import ArrayType, CompositeType, Field, FieldType, PrimitiveKind, PrimitiveType, StringType
-from .literals import prose_literal, py_literal
+from .literals import py_literal, text_literal
 from .module_context import ModuleContext
 
 
@@ -171,5 +171,5 @@ def meta(f: Field) -> str:
     if f.pattern is not None:
         args.append(f"pattern={py_literal(f.pattern)}")
     if f.doc:
-        args.append(f"doc={prose_literal(f.doc)}")
+        args.append(f"doc={text_literal(f.doc)}")
     return "_m.meta(" + ", ".join(args) + ")"

@@ -2,7 +2,7 @@
 code only through these functions, so no name, comment or value can break out of a literal.
 
 Literals are spelled as ruff writes them (double quotes unless the text holds more of them,
-upper-case hex digits), and long prose is cut into implicitly concatenated parts that the layout
+upper-case hex digits), and long text is cut into implicitly concatenated parts that the layout
 engine can put on lines of their own.
 """
 
@@ -15,7 +15,7 @@ import unicodedata
 from .layout import LINE_LENGTH
 from .layout.source import normalize_number, normalize_string
 
-PROSE_PART = 80  # characters of text per part of a long string literal
+TEXT_PART = 80  # characters of text per part of a long string literal
 
 
 def py_literal(value: object) -> str:
@@ -60,18 +60,17 @@ def hex_literal(value: int) -> str:
     return ("-" if value < 0 else "") + "0x" + format(abs(value), "X")
 
 
-def prose_literal(text: str) -> str:
-    """A string literal for documentation text: implicitly concatenated parts of at most
-    :data:`PROSE_PART` characters, cut after a space or newline, when the text is longer."""
-    if len(text) <= PROSE_PART:
+def text_literal(text: str) -> str:
+    """A string literal for text that may be long (documentation, a struct format): implicitly
+    concatenated parts of at most :data:`TEXT_PART` characters, each cut after a space or a
+    newline where there is one, so that the layout can put the parts on lines of their own."""
+    if len(text) <= TEXT_PART:
         return py_literal(text)
     parts: list[str] = []
     rest = text
-    while len(rest) > PROSE_PART:
-        window = rest[:PROSE_PART]
-        cut = window.rfind("\n") + 1 or window.rfind(" ") + 1
-        if cut <= 0:
-            cut = rest.find(" ", PROSE_PART) + 1 or len(rest)  # one long word: keep it whole
+    while len(rest) > TEXT_PART:
+        window = rest[:TEXT_PART]
+        cut = window.rfind("\n") + 1 or window.rfind(" ") + 1 or TEXT_PART
         parts.append(rest[:cut])
         rest = rest[cut:]
     if rest:

@@ -15,7 +15,7 @@ from ....errors import BattgenError
 from ....ir import ArrayType, Field, Message, PrimitiveKind, PrimitiveType, Schema, SourceFormat, StringType
 from .. import naming
 from ..extensions import Contribution
-from ..literals import py_literal
+from ..literals import py_literal, text_literal
 from ..module_context import ModuleContext
 from ..views import ClassView, FieldView
 
@@ -122,7 +122,7 @@ class _Writer:
         )
         return _lines(
             "# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype",
-            f"{self.struct} = struct.Struct({py_literal(self.fmt)})",
+            f"{self.struct} = struct.Struct({text_literal(self.fmt)})",
             f"{self.table}: tuple[tuple[str, str, str, int], ...] = ({table})",
             f"{self.dtype}: list[tuple[Any, ...]] = [{dtype}]",
         )

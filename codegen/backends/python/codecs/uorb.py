@@ -20,7 +20,7 @@ from ....errors import BattgenError
 from ....ir import Message, Schema, SourceFormat
 from .. import naming
 from ..extensions import Contribution
-from ..literals import py_literal
+from ..literals import py_literal, text_literal
 from ..module_context import ClassRef, ModuleContext
 from ..views import ClassView, class_view
 from .uorb_layout import Part, column_format, columns, parts, snake, struct_format, trailing_padding
@@ -101,7 +101,7 @@ class _Generator:
         no_pad = size - trailing_padding(self.schema, self.msg)
         full_fmt = struct_format(self.schema, self.msg)
         attrs = [
-            f"UORB_FORMAT: ClassVar[str] = {py_literal(full_fmt)}",
+            f"UORB_FORMAT: ClassVar[str] = {text_literal(full_fmt)}",
             f"UORB_SIZE: ClassVar[int] = {size}",
             f"UORB_SIZE_NO_PADDING: ClassVar[int] = {no_pad}",
             f"UORB_TOPICS: ClassVar[tuple[str, ...]] = {py_literal(tuple(info.topics))}",
@@ -125,18 +125,18 @@ class _Generator:
         enc = "<" + compress_codes([_encode_code(p) for p in self.parts])
         lines = [
             "# the C struct, nested messages inlined (decoding reads them in place)",
-            f"{self.struct} = struct.Struct({py_literal(full_fmt)})",
+            f"{self.struct} = struct.Struct({text_literal(full_fmt)})",
         ]
         if has_trailing:
             short = struct_format(self.schema, self.msg, trailing=False)
             lines += [
                 "# without the trailing padding, which ULog records leave out",
-                f"{self.ctx.constant(self.cls, 'UNPADDED')} = struct.Struct({py_literal(short)})",
+                f"{self.ctx.constant(self.cls, 'UNPADDED')} = struct.Struct({text_literal(short)})",
             ]
         if enc != full_fmt:
             lines += [
                 "# nested messages as bytes: each encodes itself, so an error names its full path",
-                f"{self.ctx.constant(self.cls, 'ENCODE_STRUCT')} = struct.Struct({py_literal(enc)})",
+                f"{self.ctx.constant(self.cls, 'ENCODE_STRUCT')} = struct.Struct({text_literal(enc)})",
             ]
         return "\n".join(lines)
 
@@ -249,7 +249,7 @@ class _Generator:
     def columns_constant(self, size: int) -> str:
         cols = list(columns(self.schema, self.msg))
         end = max((c.offset + c.size for c in cols), default=0)
-        names, fmt = py_literal(tuple(c.name for c in cols)), py_literal(column_format(cols, end))
+        names, fmt = py_literal(tuple(c.name for c in cols)), text_literal(column_format(cols, end))
         np_types, offsets = py_literal(tuple(c.np_type for c in cols)), py_literal(tuple(c.offset for c in cols))
         return f"{self.columns} = _uorb.Columns({names}, {fmt}, {size}, {np_types}, {offsets})"
 

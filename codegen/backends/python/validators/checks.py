@@ -21,7 +21,7 @@ from ....ir import (
     Sentinel,
     StringType,
 )
-from ..literals import hex_literal, prose_literal, py_literal, unparenthesized
+from ..literals import hex_literal, py_literal, text_literal, unparenthesized
 from .bounds import EnumFacts, enum_facts, folded, inside, number, type_bounds
 
 V = "\x00V\x00"  # placeholder for the value expression in a condition
@@ -42,7 +42,7 @@ class NumberCheck:
         t, f = self.t, self.f
         args = [f"type={py_literal(t.name)}", f"kind={py_literal(t.kind.value)}"]
         if self.label:
-            args.append(f"label={prose_literal(self.label)}")
+            args.append(f"label={text_literal(self.label)}")
         if t.kind is PrimitiveKind.CHAR:
             args += ["low=0", "high=255"]
         else:
@@ -127,7 +127,7 @@ class TextCheck:
         self.label = label
 
     def spec(self) -> str:
-        args = [f"label={prose_literal(self.label)}"] if self.label else []
+        args = [f"label={text_literal(self.label)}"] if self.label else []
         if self.t.capacity is not None:
             args.append(f"capacity={self.t.capacity}")
         strings = tuple(str(c) for c in self.f.choices)

@@ -4,7 +4,7 @@ one ``struct`` call per segment, fields not on a byte boundary assembled from sh
 from __future__ import annotations
 
 from .....ir import CastMode, CompositeType, Message, PrimitiveKind
-from ...literals import py_literal, unparenthesized
+from ...literals import py_literal, text_literal, unparenthesized
 from ...module_context import ModuleContext
 from ...naming import identifier, upper_snake
 from .plan import Node, Piece, Planner, Segment, Unit, plan_units
@@ -35,7 +35,7 @@ class SegmentEmitter:
         return name
 
     def struct_name(self, fmt: str, role: str, comment: str) -> str:
-        return self.module_value(f"struct.Struct({py_literal(fmt)})", role, comment)
+        return self.module_value(f"struct.Struct({text_literal(fmt)})", role, comment)
 
     def segment_role(self, seg: Segment, role: str) -> str:
         """``role``, or ``role_FROM_<FIELD>`` for a segment that does not start the message."""
