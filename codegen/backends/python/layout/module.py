@@ -7,8 +7,9 @@ import io
 import tokenize
 
 from .document import Element
-from .printer import Printer, flat_text, text_width
+from .printer import Printer, flat_text
 from .source import Source, normalize_number, normalize_string, outside_fstrings
+from .state import text_width
 from .statements import StatementLayout
 
 LINE_LENGTH = 120

@@ -3,14 +3,10 @@
 A group prints flat when its content, and what follows it up to the next line break, fits in the
 remaining width; otherwise its line breaks break. The queue of what is left to print and the
 stack of enclosing modes work as in ruff's printer (whose results this must reproduce): a fitting
-test reads ahead through the same queue without consuming it.
+test (:mod:`.fits`) reads ahead through the same queue without consuming it (:mod:`.state`).
 """
 
 from __future__ import annotations
-
-import enum
-import unicodedata
-from typing import NamedTuple
 
 from .document import (
     BestFitting,
@@ -26,73 +22,8 @@ from .document import (
     Start,
     propagate_expand,
 )
-
-INDENT_WIDTH = 4
-
-
-class Args(NamedTuple):
-    """How the content of the innermost open tag prints: indentation level, mode, measure."""
-
-    indent: int = 0
-    mode: Mode = Mode.EXPANDED
-    measure: Measure = Measure.FIRST_LINE
-
-
-class _Fits(enum.Enum):
-    YES = "yes"
-    NO = "no"
-    MAYBE = "maybe"
-
-
-def text_width(text: str) -> int:
-    if text.isascii():
-        return len(text)
-    return sum(2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in text)
-
-
-class Queue:
-    """What is left to print: a stack of element lists, each with the index of its next element."""
-
-    def __init__(self, items: list[list[Element]] | None = None, indexes: list[int] | None = None) -> None:
-        self.items: list[list[Element]] = items if items is not None else []
-        self.indexes: list[int] = indexes if indexes is not None else []
-
-    def copy(self) -> Queue:
-        return Queue(list(self.items), list(self.indexes))
-
-    def pop(self) -> Element | None:
-        items, indexes = self.items, self.indexes
-        while items:
-            top = items[-1]
-            index = indexes[-1]
-            if index < len(top):
-                indexes[-1] = index + 1
-                return top[index]
-            items.pop()
-            indexes.pop()
-        return None
-
-    def extend_back(self, elements: list[Element]) -> None:
-        if elements:
-            self.items.append(elements)
-            self.indexes.append(0)
-
-    def pop_slice(self) -> None:
-        self.items.pop()
-        self.indexes.pop()
-
-    def skip_content(self, kind: Kind) -> None:
-        depth = 1
-        while (element := self.pop()) is not None:
-            if isinstance(element, Start) and element.kind is kind:
-                depth += 1
-            elif isinstance(element, End) and element.kind is kind:
-                depth -= 1
-                if depth == 0:
-                    return
-
-
-Stack = list[tuple[Kind | None, Args]]
+from .fits import FitsMeasurer
+from .state import INDENT_WIDTH, Args, Queue, Stack, condition_mode, text_width
 
 
 class Printer:
@@ -205,7 +136,7 @@ class Printer:
         assert popped is tag.kind, (popped, tag.kind)
 
     def condition_mode(self, condition: Condition, args: Args) -> Mode:
-        return args.mode if condition.group_id is None else self.group_modes[condition.group_id]
+        return condition_mode(condition, args, self.group_modes)
 
     def flat_group_print_mode(self, kind: Kind, group_id: int | None, args: Args, queue: Queue, stack: Stack) -> Mode:
         if args.mode is Mode.FLAT and self.measured_group_fits:
@@ -277,131 +208,10 @@ class Printer:
         raise AssertionError("unterminated best-fitting entry")
 
     def fits(self, queue: Queue, stack: Stack) -> bool:
-        return _FitsMeasurer(self, queue, stack).fits()
-
-
-class _FitsMeasurer:
-    """Reads ahead from the printer's position, in the modes the stack says, without printing."""
-
-    def __init__(self, printer: Printer, queue: Queue, stack: Stack) -> None:
-        self.printer = printer
-        self.queue = queue.copy()
-        self.stack: Stack = list(stack)
-        self.pending_indent = printer.pending_indent
-        self.line_width = printer.line_width
-        self.limit = printer.line_width_limit
-
-    def fits(self) -> bool:
-        pop, stack, limit = self.queue.pop, self.stack, self.limit
-        while (element := pop()) is not None:
-            if type(element) is str:  # most elements are text: measured here, not in fits_element
-                if self.pending_indent:
-                    self.line_width += INDENT_WIDTH * self.pending_indent
-                    self.pending_indent = 0
-                self.line_width += len(element) if element.isascii() else text_width(element)
-                if self.line_width > limit and stack[-1][1].measure is not Measure.ALL_LINES_OVERFLOW:
-                    return False
-                continue
-            result = self.fits_element(element)
-            if result is _Fits.YES:
-                return True
-            if result is _Fits.NO:
-                return False
-        return True
-
-    def fits_element(self, element: Element) -> _Fits:
-        args = self.stack[-1][1]
-        if isinstance(element, str):
-            return self.fits_text(element, args)
-        if isinstance(element, Line):
-            if args.mode is Mode.FLAT:
-                if element is Line.SOFT_OR_SPACE:
-                    return self.fits_text(" ", args)
-                if element is Line.HARD:
-                    return _Fits.YES
-            elif args.measure is Measure.FIRST_LINE:
-                return _Fits.YES
-            else:
-                self.line_width = 0
-                self.pending_indent = args.indent
-            return _Fits.MAYBE
-        if isinstance(element, ExpandParent):
-            return _Fits.MAYBE
-        if isinstance(element, BestFitting):
-            if args.mode is Mode.FLAT:
-                variant, entry_args = element.variants[0], args._replace(measure=element.measure)
-            else:
-                variant, entry_args = element.variants[-1], args
-            self.stack.append((Kind.ENTRY, entry_args))
-            self.queue.extend_back(variant[1:])
-            return _Fits.MAYBE
-        if isinstance(element, End):
-            return self.fits_end(element, args)
-        return self.fits_start(element, args)
-
-    def fits_start(self, tag: Start, args: Args) -> _Fits:
-        kind = tag.kind
-        modes = self.printer.group_modes
-        if kind is Kind.INDENT:
-            self.stack.append((kind, args._replace(indent=args.indent + 1)))
-        elif kind is Kind.GROUP:
-            return self.fits_group(kind, tag.mode, tag.group_id, args)
-        elif kind is Kind.BEST_FIT_PARENTHESIZE:
-            if tag.group_id is not None:
-                modes[tag.group_id] = args.mode
-            self.stack.append((kind, args))
-        elif kind is Kind.CONDITIONAL_GROUP:
-            assert tag.condition is not None
-            if self.printer.condition_mode(tag.condition, args) is tag.condition.mode:
-                return self.fits_group(kind, tag.mode, None, args)
-            self.stack.append((kind, args))
-        elif kind is Kind.CONDITIONAL_CONTENT:
-            assert tag.condition is not None
-            if self.printer.condition_mode(tag.condition, args) is tag.condition.mode:
-                self.stack.append((kind, args))
-            else:
-                self.queue.skip_content(kind)
-        elif kind is Kind.INDENT_IF_GROUP_BREAKS:
-            assert tag.group_id is not None
-            expanded = modes[tag.group_id] is Mode.EXPANDED
-            self.stack.append((kind, args._replace(indent=args.indent + 1) if expanded else args))
-        elif kind is Kind.FITS_EXPANDED:
-            met = tag.condition is None or self.printer.condition_mode(tag.condition, args) is tag.condition.mode
-            if args.mode is Mode.FLAT and met:
-                # measure the content fully expanded; only what comes before and after must fit
-                self.stack.append((kind, args._replace(measure=Measure.ALL_LINES_OVERFLOW, mode=Mode.EXPANDED)))
-            elif args.mode is Mode.FLAT and tag.propagate_expand:
-                return _Fits.NO
-            else:
-                self.stack.append((kind, args))
-        else:
-            self.stack.append((kind, args))
-        return _Fits.MAYBE
-
-    def fits_end(self, tag: End, args: Args) -> _Fits:
-        if tag.kind is Kind.BEST_FIT_PARENTHESIZE and args.mode is Mode.EXPANDED and self.stack[-1][0] is Kind.INDENT:
-            self.stack.pop()
-            _, unindented = self.stack.pop()
-            self.line_width = 0
-            self.pending_indent = unindented.indent
-            return self.fits_text(")", unindented)
-        self.stack.pop()
-        return _Fits.MAYBE
-
-    def fits_group(self, kind: Kind, group_mode: GroupMode, group_id: int | None, args: Args) -> _Fits:
-        mode = args.mode if group_mode is GroupMode.FLAT else Mode.EXPANDED
-        self.stack.append((kind, args._replace(mode=mode)))
-        if group_id is not None:
-            self.printer.group_modes[group_id] = mode
-        return _Fits.MAYBE
-
-    def fits_text(self, text: str, args: Args) -> _Fits:
-        self.line_width += INDENT_WIDTH * self.pending_indent
-        self.pending_indent = 0
-        self.line_width += text_width(text)
-        if self.line_width > self.limit and args.measure is not Measure.ALL_LINES_OVERFLOW:
-            return _Fits.NO
-        return _Fits.MAYBE
+        measurer = FitsMeasurer(
+            queue, stack, self.group_modes, self.line_width, self.pending_indent, self.line_width_limit
+        )
+        return measurer.fits()
 
 
 def flat_text(document: list[Element]) -> str | None:
