@@ -7,10 +7,10 @@ Emitters write each statement on one line; :func:`format_module` breaks the ones
 ``if``/``elif``, ``while`` and ``for``; a statement with a comment or a string over several lines
 in it, and the rest of the module (blank lines, docstrings, other headers), stay as written.
 
-Modules: :mod:`.document` (what to print), :mod:`.printer` (how it fits the line width),
-:mod:`.source` (what the AST forgets: parentheses, string parts, spellings), :mod:`.context`,
-:mod:`.operators`, :mod:`.expressions` and :mod:`.statements` (Python constructs as documents),
-:mod:`.module` (the entry point).
+Modules: :mod:`.document` (what to print), :mod:`.printer`, :mod:`.fits` and :mod:`.state` (how
+it is fitted to the line width), :mod:`.source` (what the AST forgets: parentheses, string parts,
+spellings), :mod:`.context`, :mod:`.operators`, :mod:`.expressions` and :mod:`.statements`
+(Python constructs as documents), :mod:`.module` (the entry point).
 """
 
 from __future__ import annotations
