@@ -2,7 +2,7 @@
 
 Layout of the generated package:
 
-- ``convert/_runtime.py``  the loss report and numeric helpers (copied from converters_runtime.py)
+- ``convert/_runtime.py``  the loss report and numeric helpers (copied from ``runtime/convert/_runtime.py``)
 - ``convert/_concepts.py`` ``BatteryState``: the shared concepts as a dataclass (SI units, None = unknown)
 - ``convert/_map_<mapping>.py`` one function per direction of each mapping (``forward``/``backward``)
 - ``convert/<endpoint>.py``  ``to_concepts`` / ``from_concepts`` for each format with a concept mapping
@@ -16,13 +16,13 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Mapping as _Map
 from dataclasses import dataclass
-from pathlib import Path
 
 from ....errors import BattgenError
 from ....ir import CONCEPTS_ENDPOINT, Concept, Endpoint, Mapping, Message, Schema
 from .. import naming
 from ..extensions import Contribution
 from ..literals import docstring, py_literal
+from ..runtime import copied
 from ..views import ClassView, ModuleContext
 from .emit import FunctionBuilder, Side
 
@@ -433,8 +433,7 @@ class _Generator:
         self.files[f"{PACKAGE}/__init__.py"] = _tidy("\n".join(lines) + "\n")
 
     def render(self) -> dict[str, str]:
-        runtime = (Path(__file__).parent.parent / "runtime" / "convert_runtime.py").read_text(encoding="utf-8")
-        self.files[f"{PACKAGE}/_runtime.py"] = self.header + "\n" + runtime
+        self.files.update(copied(f"{PACKAGE}/_runtime.py"))
         self.concepts_module()
         for mapping in _mappings(self.schema):
             self.mapping_module(mapping)

@@ -12,6 +12,7 @@ from ....frontends import rules as rule_files
 from ....ir import Message, Schema
 from ..extensions import Contribution
 from ..literals import py_literal
+from ..runtime import copied
 from ..views import ClassView, ModuleContext
 from .checks import field_code
 from .rules import known_expr, rule_lines
@@ -26,10 +27,7 @@ def _block(lines: list[str], depth: int) -> list[str]:
 
 class _Validators:
     def runtime_files(self, schema: Schema, header: str) -> dict[str, str]:
-        from .. import environment
-
-        text = environment().get_template("_validate.py.j2").render(header=header)
-        return {"_validate.py": text}
+        return copied("_validate.py")
 
     def contribute(self, msg: Message, ctx: ModuleContext, view: ClassView) -> Contribution:
         idents = {fv.source_name: fv.ident for fv in view.fields}

@@ -12,10 +12,10 @@ from __future__ import annotations
 from .....ir import CompositeType, Message, Schema, SourceFormat
 from ...extensions import Contribution
 from ...literals import py_literal
+from ...runtime import copied
 from ...views import ClassView, ModuleContext
 from .emit import MessageEmitter
 from .plan import Planner
-from .runtime_text import RUNTIME
 
 
 class _Factories(dict[str, str]):
@@ -81,7 +81,7 @@ class _Codec:
     def runtime_files(self, schema: Schema, header: str) -> dict[str, str]:
         if not any(m.format is SourceFormat.DRONECAN for m in schema.messages):
             return {}
-        return {"_dronecan.py": header + "\n" + RUNTIME.lstrip("\n")}
+        return copied("_dronecan.py")
 
 
 EXTENSION = _Codec()

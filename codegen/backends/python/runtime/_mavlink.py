@@ -1,4 +1,3 @@
-{{ header }}
 """MAVLink run-time support for the generated message classes: checksum, frames, stream parsing.
 
 Standard library only. Every generated MAVLink class carries ``MSG_ID``, ``CRC_EXTRA``,
@@ -16,6 +15,9 @@ frame -> an instance of whichever generated class its id names), :class:`StreamP
 out of a byte stream with garbage, with counters) and :func:`message_class` (the id registry).
 Text (``char[N]``) is UTF-8; bytes that are not valid UTF-8 decode through ``surrogateescape``,
 so decoding never fails and encoding the text again gives back the same bytes.
+
+The helpers the generated payload code calls live in ``_mavlink_payload``, the ids of this
+package's messages in the generated ``_mavlink_registry``; both are importable from here.
 """
 
 from __future__ import annotations
@@ -23,9 +25,47 @@ from __future__ import annotations
 import binascii
 import importlib
 import struct
-from typing import Any, ClassVar, NamedTuple, Protocol, TypeAlias
+from typing import Any, ClassVar, NamedTuple, Protocol
 
-BytesLike: TypeAlias = bytes | bytearray | memoryview
+from . import _mavlink_registry
+from ._mavlink_payload import (
+    BytesLike,
+    DecodeError,
+    EncodeError,
+    explain,
+    fill,
+    numpy_columns,
+    struct_columns,
+    text,
+)
+
+__all__ = [
+    "IFLAG_SIGNED",
+    "MAGIC_V1",
+    "MAGIC_V2",
+    "MAX_PAYLOAD",
+    "REGISTRY",
+    "SIGNATURE_LENGTH",
+    "BytesLike",
+    "DecodeError",
+    "EncodeError",
+    "Frame",
+    "FrameError",
+    "MavlinkMessage",
+    "StreamParser",
+    "crc16",
+    "decode_message",
+    "explain",
+    "fill",
+    "frame_payload",
+    "frame_v1",
+    "frame_v2",
+    "message_class",
+    "numpy_columns",
+    "parse_frame",
+    "struct_columns",
+    "text",
+]
 
 MAGIC_V1 = 0xFE
 MAGIC_V2 = 0xFD
@@ -34,12 +74,8 @@ SIGNATURE_LENGTH = 13
 MAX_PAYLOAD = 255
 
 # msgid -> (CRC_EXTRA, class name, MAVLINK_MAX_LENGTH, MAVLink name) of every generated message
-REGISTRY: dict[int, tuple[int, str, int, str]] = {
-{% for msgid, extra, name, size, mavname in registry %}
-    {{ msgid }}: ({{ extra }}, {{ name | pystr }}, {{ size }}, {{ mavname | pystr }}),
-{% endfor %}
-}
-_MODULE = {{ module | pystr }}
+REGISTRY: dict[int, tuple[int, str, int, str]] = _mavlink_registry.REGISTRY
+_MODULE = _mavlink_registry.MODULE  # the generated module holding the classes, relative to this package
 _CLASSES: dict[int, type[MavlinkMessage]] = {}
 _FAST: dict[int, tuple[Any, bytes, int, str]] = {}  # msgid -> (decode, CRC_EXTRA byte, size, name)
 
@@ -53,16 +89,8 @@ _hqx = binascii.crc_hqx
 _ZEROS = [bytes(i) for i in range(MAX_PAYLOAD + 1)]
 
 
-class DecodeError(ValueError):
-    """Bytes that do not hold a valid message or frame; the message names what and where."""
-
-
 class FrameError(DecodeError):
     """A malformed frame: bad magic, length, flags or checksum, or an unknown message id."""
-
-
-class EncodeError(ValueError):
-    """A value that does not fit its wire field, named as MESSAGE.field."""
 
 
 class MavlinkMessage(Protocol):
@@ -123,14 +151,7 @@ class Frame(NamedTuple):
         cls = message_class(self.msgid)
         if cls is None:
             raise FrameError(f"message id {self.msgid}: not a message of this package")
-        return getattr(cls, "decode")(self.payload)
-
-
-def fill(data: BytesLike, size: int, name: str) -> bytes:
-    """A payload zero-filled to ``size`` bytes (MAVLink 2 drops trailing zeros on send)."""
-    if len(data) > size:
-        raise DecodeError(f"{name}: payload of {len(data)} bytes exceeds the maximum length {size}")
-    return bytes(data) + bytes(size - len(data))
+        return getattr(cls, "decode")(self.payload)  # noqa: B009 (MavlinkMessage does not declare decode)
 
 
 def frame_v2(
@@ -226,7 +247,9 @@ def _split(data: BytesLike, start: int = 0) -> tuple[Frame, int]:
     (crc,) = _CRC.unpack_from(data, end)
     expected = crc16(data[start + 1 : end], entry[0])
     if crc != expected:
-        raise FrameError(f"frame: bad CRC for message id {msgid} ({entry[3]}): got 0x{crc:04x}, expected 0x{expected:04x}")
+        raise FrameError(
+            f"frame: bad CRC for message id {msgid} ({entry[3]}): got 0x{crc:04x}, expected 0x{expected:04x}"
+        )
     signature = bytes(data[end + 2 : start + total]) if iflags else None
     return Frame(version, msgid, seq, sysid, compid, payload, iflags, cflags, crc, signature), total
 
@@ -262,7 +285,11 @@ def frame_payload(data: BytesLike, msgid: int, crc_extra: bytes, size: int, name
     if got != msgid:
         raise FrameError(f"{name}: frame holds message id {got}, expected {msgid}")
     # the checksum run on through the received CRC bytes leaves 0 when they match
-    if iflags & ~IFLAG_SIGNED or n != end + 2 + tail or _hqx((data[1:end] + crc_extra + data[end : end + 2]).translate(_MIRROR), 0xFFFF):
+    if (
+        iflags & ~IFLAG_SIGNED
+        or n != end + 2 + tail
+        or _hqx((data[1:end] + crc_extra + data[end : end + 2]).translate(_MIRROR), 0xFFFF)
+    ):
         parse_frame(data)  # raises the precise error
     if end - start > size:
         raise DecodeError(f"{name}: payload of {end - start} bytes exceeds the maximum length {size}")
@@ -284,7 +311,7 @@ def decode_message(data: BytesLike) -> Any:
         if cls is None:
             return parse_frame(data).message()  # raises: unknown id
         entry = REGISTRY[msgid]
-        fast = _FAST[msgid] = (getattr(cls, "decode"), bytes((entry[0],)), entry[2], entry[3])
+        fast = _FAST[msgid] = (getattr(cls, "decode"), bytes((entry[0],)), entry[2], entry[3])  # noqa: B009
     decode, extra, size, name = fast
     return decode(frame_payload(data, msgid, extra, size, name))
 
@@ -388,81 +415,3 @@ def _next_magic(buf: bytearray, start: int) -> int:
     if v2 < 0:
         return v1
     return v2 if v1 < 0 else min(v1, v2)
-
-
-def text(raw: bytes) -> str:
-    """A NUL-padded char[N] field as text (up to the first NUL)."""
-    return raw.split(b"\x00", 1)[0].decode("utf-8", "surrogateescape")
-
-
-def explain(name: str, obj: object, fields: tuple[tuple[str, str, str, int], ...]) -> EncodeError:
-    """The first field of ``obj`` that does not fit the wire, as an EncodeError (the slow path)."""
-    for ident, source, fmt, count in fields:
-        value = getattr(obj, ident, None)
-        where = f"{name}.{source}"
-        if fmt == "s":
-            if not isinstance(value, str):
-                return EncodeError(f"{where}: expected text, got {value!r}")
-            try:
-                size = len(value.encode("utf-8", "surrogateescape"))
-            except UnicodeError:
-                return EncodeError(f"{where}: {value!r} cannot be encoded as UTF-8")
-            if size > count:
-                return EncodeError(f"{where}: {size} bytes exceed the capacity {count}")
-        elif fmt == "B*":
-            if not isinstance(value, bytes | bytearray) or len(value) != count:
-                return EncodeError(f"{where}: expected {count} bytes, got {value!r}")
-        elif count:
-            if not isinstance(value, list | tuple) or len(value) != count:
-                return EncodeError(f"{where}: expected a list of {count} values, got {value!r}")
-            for i, item in enumerate(value):
-                problem = _scalar_problem(fmt, item)
-                if problem:
-                    return EncodeError(f"{where}[{i}]: {problem}")
-        else:
-            problem = _scalar_problem(fmt, value)
-            if problem:
-                return EncodeError(f"{where}: {problem}")
-    return EncodeError(f"{name}: cannot be encoded")
-
-
-def _scalar_problem(fmt: str, value: object) -> str:
-    if fmt in "fd":
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            return f"expected a number, got {value!r}"
-    elif isinstance(value, bool) or not isinstance(value, int):
-        return f"expected an integer, got {value!r}"
-    try:
-        struct.pack("<" + fmt, value)
-    except (struct.error, OverflowError):
-        bits = struct.calcsize(fmt) * 8
-        kind = "a float" if fmt in "fd" else ("a signed" if fmt.islower() else "an unsigned") + f" {bits}-bit integer"
-        return f"{value!r} does not fit {kind}"
-    return ""
-
-
-def struct_columns(data: BytesLike, layout: struct.Struct, name: str) -> list[tuple[Any, ...]]:
-    """Fixed-size records -> one tuple per struct item (iter_unpack, no object per record)."""
-    if len(data) % layout.size:
-        raise DecodeError(f"{name}: {len(data)} bytes are not a whole number of {layout.size}-byte records")
-    if not data:
-        return [()] * len(layout.unpack(bytes(layout.size)))
-    return list(zip(*layout.iter_unpack(data), strict=True))
-
-
-def numpy_columns(
-    data: BytesLike, size: int, dtype: list[tuple[Any, ...]], use_numpy: bool | None, name: str
-) -> dict[str, Any] | None:
-    """Fixed-size records -> numpy columns, or None when numpy is not wanted or not installed."""
-    if use_numpy is False:
-        return None
-    try:
-        np: Any = importlib.import_module("numpy")
-    except ImportError:
-        if use_numpy:
-            raise
-        return None
-    if len(data) % size:
-        raise DecodeError(f"{name}: {len(data)} bytes are not a whole number of {size}-byte records")
-    records = np.frombuffer(data, dtype=np.dtype(dtype))
-    return {field[0]: records[field[0]].copy() for field in dtype}

@@ -1,5 +1,3 @@
-{{ header }}
-{% raw %}
 """Run-time support of the generated uORB codecs: errors, C strings, batch decoding into columns.
 
 Standard library only; numpy is used when a caller asks for it and it is installed.
@@ -63,7 +61,9 @@ def nested(value: Any, cls: type[Any], path: str) -> bytes:
     except EncodeError as exc:
         inner = str(exc)
         prefix = cls.__name__ + "."
-        raise EncodeError(path + inner[len(cls.__name__) :] if inner.startswith(prefix) else f"{path}: {inner}") from None
+        raise EncodeError(
+            path + inner[len(cls.__name__) :] if inner.startswith(prefix) else f"{path}: {inner}"
+        ) from None
     return data
 
 
@@ -73,9 +73,7 @@ def nested_array(value: Any, count: int, cls: type[Any], path: str) -> bytes:
     return b"".join([nested(item, cls, f"{path}[{i}]") for i, item in enumerate(value)])
 
 
-def encode_error(
-    name: str, obj: object, table: Sequence[tuple[str, str, str, int]], exc: Exception
-) -> EncodeError:
+def encode_error(name: str, obj: object, table: Sequence[tuple[str, str, str, int]], exc: Exception) -> EncodeError:
     """The error for a failed pack: finds the plain field at fault (only runs on the error path)."""
     for attr, field, code, count in table:
         value = getattr(obj, attr, None)
@@ -197,5 +195,4 @@ class Columns:
         s = self.record_struct(stride)
         if not n:
             return {name: [] for name in self.names}
-        return dict(zip(self.names, map(list, zip(*s.iter_unpack(buffer))), strict=True))
-{% endraw %}
+        return dict(zip(self.names, map(list, zip(*s.iter_unpack(buffer), strict=False)), strict=True))

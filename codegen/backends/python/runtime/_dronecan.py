@@ -1,13 +1,3 @@
-"""Source of ``_dronecan.py``, the run-time module the generated DroneCAN codecs share.
-
-Only what cannot be specialised per type lives there: float16 conversion with the rounding the
-reference stack uses (libuavcan's algorithm: round the float32 half away from zero, NaN -> 0x7FFF),
-float bit views for fields that are not byte aligned, the bit-stream finisher, the transfer CRC.
-"""
-
-from __future__ import annotations
-
-RUNTIME = '''
 """Run-time support of the generated DroneCAN (UAVCAN v0) codecs. Standard library only.
 
 The generated code writes a message as one Python int, most significant bit first, behind a
@@ -154,4 +144,3 @@ def transfer_crc(signature: int, payload: bytes) -> int:
     """The CRC of a multi-frame transfer: CRC-16-CCITT over the data type signature
     (8 bytes, little-endian) followed by the payload."""
     return crc16(payload, crc16(signature.to_bytes(8, "little")))
-'''

@@ -1,4 +1,3 @@
-{{ header }}
 """Run-time support shared by the generated modules: field metadata and reading plain data.
 
 Standard library only, so the generated package can be vendored as it is.
@@ -150,9 +149,7 @@ def as_bytes(value: object, path: str, capacity: int | None, fixed: bool) -> byt
     return data
 
 
-def as_list(
-    value: object, path: str, capacity: int | None, fixed: bool, item: Callable[[object, str], T]
-) -> list[T]:
+def as_list(value: object, path: str, capacity: int | None, fixed: bool, item: Callable[[object, str], T]) -> list[T]:
     if not isinstance(value, list | tuple):
         raise DataError(path, "a list", value)
     _check_length(len(value), path, capacity, fixed, value)
@@ -169,7 +166,9 @@ def as_object(value: object, path: str, cls: Any) -> Any:
     return result
 
 
-def check_keys(data: object, known: frozenset[str], patterns: tuple[tuple[str, str], ...], cls: str) -> Mapping[str, Any]:
+def check_keys(
+    data: object, known: frozenset[str], patterns: tuple[tuple[str, str], ...], cls: str
+) -> Mapping[str, Any]:
     """The data as a mapping, after checking it names only fields of ``cls``."""
     if not isinstance(data, Mapping):
         raise DataError(cls, "an object", data)

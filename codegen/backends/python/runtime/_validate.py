@@ -1,4 +1,3 @@
-{{ header }}
 """Run-time support of the generated validators: violations, the error carrying them, and the
 careful diagnosis of a value the generated fast path flagged.
 
@@ -249,7 +248,10 @@ def number(path: str, value: object, spec: Number) -> Violation | None:
             return _type_violation(path, value, f"a number ({spec.type})", spec.label)
         if isinstance(value, float) and math.isnan(value):
             return Violation(
-                path, "nan", value, spec.sentinel_text or None,
+                path,
+                "nan",
+                value,
+                spec.sentinel_text or None,
                 f"{who} is NaN, which is not allowed here"
                 + (f" (its 'unknown' value is {spec.sentinel_text})" if spec.sentinel_text else ""),
             )
@@ -269,21 +271,25 @@ def number(path: str, value: object, spec: Number) -> Violation | None:
                     f"±{_with_unit(spec.high, unit)} (it would saturate)"
                 )
         else:
-            text = (
-                f"{who} = {_with_unit(value, unit)} does not fit {spec.type} "
-                f"({fmt(spec.low)}..{fmt(spec.high)})"
-            )
+            text = f"{who} = {_with_unit(value, unit)} does not fit {spec.type} ({fmt(spec.low)}..{fmt(spec.high)})"
         return Violation(path, "type-bounds", value, (spec.low, spec.high), text)
     low, high = spec.minimum, spec.maximum
     if low is not None and (value <= low if spec.exclusive_minimum else value < low):
         word = "at or below the exclusive minimum" if spec.exclusive_minimum else "below the minimum"
-        return Violation(path, "range", value, low, f"{who} = {_with_unit(value, unit)} is {word} {_with_unit(low, unit)}")
+        return Violation(
+            path, "range", value, low, f"{who} = {_with_unit(value, unit)} is {word} {_with_unit(low, unit)}"
+        )
     if high is not None and (value >= high if spec.exclusive_maximum else value > high):
         word = "at or above the exclusive maximum" if spec.exclusive_maximum else "above the maximum"
-        return Violation(path, "range", value, high, f"{who} = {_with_unit(value, unit)} is {word} {_with_unit(high, unit)}")
+        return Violation(
+            path, "range", value, high, f"{who} = {_with_unit(value, unit)} is {word} {_with_unit(high, unit)}"
+        )
     if spec.values is not None and value not in spec.values:
         return Violation(
-            path, "enum", value, tuple(sorted(spec.values)),
+            path,
+            "enum",
+            value,
+            tuple(sorted(spec.values)),
             f"{who} = {fmt(value)} is not one of {_names(spec.values)}",
         )
     if spec.mask is not None:
@@ -292,7 +298,10 @@ def number(path: str, value: object, spec: Number) -> Violation | None:
             named = [name for bit, name in sorted((spec.bits or {}).items()) if bit & extra]
             what = f" ({', '.join(named)})" if named else ""
             return Violation(
-                path, "bitmask", value, spec.mask,
+                path,
+                "bitmask",
+                value,
+                spec.mask,
                 f"{who} = {int(value):#x} sets undefined or reserved bits {extra:#x}{what}; "
                 f"only {spec.mask:#x} may be set",
             )
@@ -310,14 +319,20 @@ def text(path: str, value: object, spec: Text) -> Violation | None:
             return _type_violation(path, value, "valid UTF-8 text", spec.label)
         if size > spec.capacity:
             return Violation(
-                path, "length", value, spec.capacity,
+                path,
+                "length",
+                value,
+                spec.capacity,
                 f"{who} is {size} bytes of UTF-8, more than its {spec.capacity}",
             )
     if spec.const is not None and value != spec.const:
         return Violation(path, "enum", value, spec.const, f"{who} = {value!r} must be {spec.const!r}")
     if spec.choices and value not in spec.choices:
         return Violation(
-            path, "enum", value, spec.choices,
+            path,
+            "enum",
+            value,
+            spec.choices,
             f"{who} = {value!r} is not one of " + ", ".join(repr(c) for c in spec.choices),
         )
     return None
@@ -339,9 +354,7 @@ def _array(out: list[Violation], path: str, value: object, spec: Array) -> None:
     elif cap is not None and n > cap:
         out.append(Violation(path, "length", n, cap, f"{path} has {n} items, more than its capacity {cap}"))
     elif n < spec.min_length:
-        out.append(
-            Violation(path, "length", n, spec.min_length, f"{path} has {n} items, fewer than {spec.min_length}")
-        )
+        out.append(Violation(path, "length", n, spec.min_length, f"{path} has {n} items, fewer than {spec.min_length}"))
     columns = spec.columns
     for i, item in enumerate(items):
         column = columns[i] if i < len(columns) else None
@@ -368,7 +381,10 @@ def _pattern(out: list[Violation], path: str, value: object, spec: Pattern) -> N
         if not isinstance(key, str) or re.search(spec.pattern, key) is None:
             out.append(
                 Violation(
-                    str(key), "pattern", key, spec.pattern,
+                    str(key),
+                    "pattern",
+                    key,
+                    spec.pattern,
                     f"property name {key!r} does not match {spec.pattern}",
                 )
             )
