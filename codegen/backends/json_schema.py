@@ -31,7 +31,6 @@ import sys
 from dataclasses import replace
 from typing import Any
 
-from ..frontends.rules import bound_rules
 from ..ir import (
     ArrayType,
     Column,
@@ -46,6 +45,7 @@ from ..ir import (
     Sentinel,
     StringType,
 )
+from ..ir.rules import rules_for
 
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
 NAN_STRINGS = ["NaN", "nan"]
@@ -69,10 +69,10 @@ def message_json_schema(schema: Schema, msg: Message) -> dict[str, Any]:
         "title": msg.qualified_name,
     }
     out.update(body)
-    rules = bound_rules(schema, msg)
+    rules = rules_for(schema, msg)
     if rules:
         out["$comment"] = "Cross-field rules checked by the generated validate() but not expressed here: " + "; ".join(
-            f"{b.rule.id} ({b.rule.text})" for b in rules
+            f"{r.id} ({r.check})" for r in rules
         )
     if defs:
         out["$defs"] = dict(sorted(defs.items()))

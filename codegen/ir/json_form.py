@@ -49,7 +49,8 @@ def to_jsonable(obj: object) -> Any:
         if tag is not None:
             out["form"] = tag
         for f in dataclasses.fields(obj):
-            out[f.name] = to_jsonable(getattr(obj, f.name))
+            if f.metadata.get("json_form", True):  # parsed forms (rule expressions) show as their text
+                out[f.name] = to_jsonable(getattr(obj, f.name))
         if isinstance(obj, ir.PrimitiveType):
             out["name"] = obj.name
         return out

@@ -11,6 +11,8 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from .expr import RuleExpressions
+
 
 class SourceFormat(str, enum.Enum):
     UORB = "uorb"
@@ -491,9 +493,11 @@ class MappingSet:
 class CrossFieldRule:
     """A rule relating fields of a message that its schema cannot state.
 
-    Expressions are kept as written in the rule language (:mod:`codegen.ir.expr`); the frontend
-    has parsed every one and bound its names to each message in ``messages``. ``lines`` gives the
-    source line of each key (``assert``, ``where``, ``for``, ``path``, ``message``).
+    ``exprs`` holds the expressions parsed (:mod:`codegen.ir.expr`), with loop variables resolved;
+    the frontend has checked that the other names bind to each message in ``messages`` (see
+    :func:`codegen.ir.rules.bind`). The text fields keep the expressions as written: the JSON form
+    shows them, and a violation quotes the ``assert``. ``lines`` gives the source line of each key
+    (``assert``, ``where``, ``for``, ``for[i]``, ``path``, ``message``).
     """
 
     id: str
@@ -501,6 +505,7 @@ class CrossFieldRule:
     severity: str  # "error" or "warning" (advice)
     check: str  # the ``assert`` expression
     location: Location
+    exprs: RuleExpressions = field(metadata={"json_form": False})  # the text fields, parsed
     doc: str = ""
     where: str | None = None
     loops: tuple[str, ...] = ()  # ``for`` clauses, "name in expression"

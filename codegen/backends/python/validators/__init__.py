@@ -8,8 +8,8 @@ module ``_validate.py``.
 
 from __future__ import annotations
 
-from ....frontends import rules as rule_files
 from ....ir import Message, Schema
+from ....ir.rules import bound_rules
 from ..extensions import Contribution
 from ..literals import py_literal
 from ..runtime import copied
@@ -42,7 +42,7 @@ class _Validators:
             specs.append(f"{spec_name} = {code.spec_source}")
             checks += code.lines
         local_names: set[str] = set()
-        for bound in rule_files.bound_rules(ctx.schema, msg):
+        for bound in bound_rules(ctx.schema, msg):
             lines, names = rule_lines(bound, msg, idents)
             checks += lines
             local_names |= names
