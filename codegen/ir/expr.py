@@ -13,7 +13,6 @@ or :class:`Const` for each message the rule applies to.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -192,17 +191,6 @@ def rebuild(expr: Expr, kids: tuple[Expr, ...]) -> Expr:
     if isinstance(expr, Call):
         return Call(expr.func, kids, expr.column)
     return expr
-
-
-def nodes(expr: Expr | None) -> Iterator[Expr]:
-    """Every node of ``expr`` (none for ``None``), parents before their children, in source order."""
-    if expr is None:
-        return
-    stack = [expr]
-    while stack:
-        e = stack.pop()
-        yield e
-        stack.extend(reversed(children(e)))
 
 
 def referenced_fields(expr: Expr | None, *, skip_is_known: bool = True) -> list[str]:
