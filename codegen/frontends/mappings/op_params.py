@@ -12,7 +12,7 @@ from __future__ import annotations
 import enum
 import math
 import types
-from dataclasses import MISSING, Field, fields
+from dataclasses import MISSING, dataclass, fields
 from typing import Any, Union, get_args, get_origin, get_type_hints
 
 from ...errors import SchemaError
@@ -66,23 +66,30 @@ def _kind(tp: Any) -> str:
     raise TypeError(f"no parameter kind for {tp!r}")  # a new kind of op parameter: add it here
 
 
-_HINTS: dict[type, dict[str, Any]] = {}
+@dataclass(frozen=True)
+class _Param:
+    """One parameter of an op (or one field of an entry), read from its dataclass field."""
+
+    name: str
+    type: Any  # the annotation without None
+    required: bool  # no default: a rule must write it
+    null: bool  # a required parameter that may be null (None is a value of its own, not "left out")
 
 
-def _hints(cls: type) -> dict[str, Any]:
-    """The resolved annotations of a dataclass (ops.py defers them as text)."""
-    if cls not in _HINTS:
-        _HINTS[cls] = get_type_hints(cls)
-    return _HINTS[cls]
+_PARAMS: dict[type, tuple[_Param, ...]] = {}
 
 
-def _params(cls: type) -> list[tuple[Field[Any], Any, bool]]:
-    """(field, annotation without None, whether the field must be written) of an op or entry."""
-    out = []
-    for f in fields(cls):
-        core, _ = _split_optional(_hints(cls)[f.name])
-        out.append((f, core, f.default is MISSING and f.default_factory is MISSING))
-    return out
+def _params(cls: type) -> tuple[_Param, ...]:
+    """The parameters of an op, or the fields of an entry, in order."""
+    if cls not in _PARAMS:
+        hints = get_type_hints(cls)  # ops.py defers its annotations as text
+        out = []
+        for f in fields(cls):
+            core, optional = _split_optional(hints[f.name])
+            required = f.default is MISSING and f.default_factory is MISSING
+            out.append(_Param(f.name, core, required, required and optional))
+        _PARAMS[cls] = tuple(out)
+    return _PARAMS[cls]
 
 
 # -- JSON Schema ------------------------------------------------------------------------------
@@ -101,40 +108,30 @@ _SCHEMAS: dict[str, dict[str, Any]] = {
 }
 
 
-def _schema(tp: Any, nullable: bool) -> dict[str, Any]:
-    kind = _kind(tp)
-    if kind == "entries":
-        (entry,) = get_args(tp)[:1]
-        _, *rest = _params(entry)
+def _schema(param: _Param) -> dict[str, Any]:
+    kind = _kind(param.type)
+    if kind == "entries":  # a YAML mapping: key -> the entry's one other field, or a mapping of its fields
+        _, *rest = _params(get_args(param.type)[0])
         if len(rest) == 1:
-            value = _value_schema(entry, rest[0])
+            value = _schema(rest[0])
         else:
             value = {
                 "type": "object",
                 "additionalProperties": False,
-                "required": [f.name for f, _, required in rest if required],
-                "properties": {f.name: _value_schema(entry, (f, core, r)) for f, core, r in rest},
+                "required": [p.name for p in rest if p.required],
+                "properties": {p.name: _schema(p) for p in rest},
             }
         return {"type": "object", "additionalProperties": value}
-    schema: dict[str, Any] = _SCHEMAS[kind] if kind in _SCHEMAS else {"enum": [m.value for m in tp]}
-    if nullable:
-        schema = {"anyOf": [schema, {"type": "null"}]}
-    return schema
-
-
-def _value_schema(owner: type, param: tuple[Field[Any], Any, bool]) -> dict[str, Any]:
-    f, core, required = param
-    # None is written as null only where it is a value of its own, not "left out"
-    return _schema(core, required and _split_optional(_hints(owner)[f.name])[1])
+    schema = _SCHEMAS[kind] if kind in _SCHEMAS else {"enum": [m.value for m in param.type]}
+    return {"anyOf": [schema, {"type": "null"}]} if param.null else schema
 
 
 def params_schema(cls: type[MappingOp]) -> dict[str, Any]:
     """The JSON Schema of a rule of op ``cls``: its parameters, and the keys every rule has."""
     props: dict[str, Any] = {key: True for key in RULE_KEYS}
-    for param in _params(cls):
-        props[param[0].name] = _value_schema(cls, param)
+    props.update({p.name: _schema(p) for p in _params(cls)})
     return {
-        "required": [f.name for f, _, required in _params(cls) if required],
+        "required": [p.name for p in _params(cls) if p.required],
         "properties": props,
         "additionalProperties": False,
     }
@@ -143,11 +140,13 @@ def params_schema(cls: type[MappingOp]) -> dict[str, Any]:
 # -- YAML -> typed op --------------------------------------------------------------------------
 
 
+@dataclass(frozen=True)
 class _Place:
     """Where a parameter is, for errors."""
 
-    def __init__(self, display: str, line: int, key: str) -> None:
-        self.display, self.line, self.key = display, line, key
+    display: str
+    line: int
+    key: str
 
     def error(self, expected: str, got: object) -> SchemaError:
         return SchemaError(self.display, self.line, f"expected {expected} for {self.key!r}, got {got!r}")
@@ -175,9 +174,10 @@ def _value(value: Any, at: _Place) -> int | float | bool | str | ConstantRef:
     return _number(value, at)
 
 
-def _convert(tp: Any, nullable: bool, value: Any, at: _Place) -> Any:
-    if value is None and nullable:
+def _convert(param: _Param, value: Any, at: _Place) -> Any:
+    if value is None and param.null:
         return None
+    tp = param.type
     kind = _kind(tp)
     if kind == "number":
         return _number(value, at)
@@ -202,36 +202,33 @@ def _convert(tp: Any, nullable: bool, value: Any, at: _Place) -> Any:
         if not isinstance(value, list):
             raise at.error("a list of numbers", value)
         return tuple(_marker(v, at) for v in value)
-    (entry,) = get_args(tp)[:1]
     if not isinstance(value, dict):
         raise at.error("a mapping", value)
-    return tuple(_entry(entry, str(key), item, at) for key, item in value.items())
+    return tuple(_entry(get_args(tp)[0], str(key), item, at) for key, item in value.items())
 
 
 def _entry(cls: type[Entry], key: str, value: Any, at: _Place) -> Entry:
-    (key_field, key_type, _), *rest = _params(cls)
-    args = {key_field.name: _convert(key_type, False, key, at)}
+    key_param, *rest = _params(cls)
+    args = {key_param.name: _convert(key_param, key, at)}
     if len(rest) == 1:
-        f, core, required = rest[0]
-        args[f.name] = _convert(core, required, value, at)
+        args[rest[0].name] = _convert(rest[0], value, at)
     else:
         if not isinstance(value, dict):
             raise at.error("a mapping", value)
-        for f, core, required in rest:
-            if f.name in value:
-                args[f.name] = _convert(core, required, value[f.name], at)
-            elif required:
-                raise at.error(f"a mapping with {f.name!r}", value)
+        for p in rest:
+            if p.name in value:
+                args[p.name] = _convert(p, value[p.name], at)
+            elif p.required:
+                raise at.error(f"a mapping with {p.name!r}", value)
     return cls(**args)
 
 
 def build_op(cls: type[MappingOp], body: YMap, display: str) -> MappingOp:
     """The typed op of a rule (``body`` already checked against the JSON Schema)."""
     args: dict[str, Any] = {}
-    for f, core, required in _params(cls):
-        if f.name in body:
-            nullable = required and _split_optional(_hints(cls)[f.name])[1]
-            args[f.name] = _convert(core, nullable, body[f.name], _Place(display, body.line_of(f.name), f.name))
-        elif required:
-            raise SchemaError(display, body.line, f"expected {f.name!r} for op {cls.NAME!r}")
+    for p in _params(cls):
+        if p.name in body:
+            args[p.name] = _convert(p, body[p.name], _Place(display, body.line_of(p.name), p.name))
+        elif p.required:
+            raise SchemaError(display, body.line, f"expected {p.name!r} for op {cls.NAME!r}")
     return cls(**args)
