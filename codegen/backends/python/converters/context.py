@@ -41,6 +41,9 @@ from .source import INDENT, WIDTH, Call, call, literal, number, value_lines
 FLT_EPS = 1.1920928955078125e-07
 
 TEMPORARIES = re.compile(r"\b_(?:v|w|c|p|x|n|m|b|e|f|s|a|l|t|ts|tb|tabs|cap|uv|hi|lo|ch|i)\b")
+# f-strings (whose fields may name temporaries), other string literals (schema text: left as it is)
+_QUOTED = r""""(?:[^"\\]|\\.)*"|'(?:[^'\\]|\\.)*'"""
+_TOKENS = re.compile(rf"(\b[fF](?:{_QUOTED}))|({_QUOTED})|{TEMPORARIES.pattern}")
 
 
 def f32(x: float) -> float:
@@ -134,7 +137,16 @@ class RuleContext:
     def _numbered(self, text: str) -> str:
         if not self.rule_number:  # the epilogue's temporaries keep their names
             return text
-        return TEMPORARIES.sub(lambda m: f"{m.group(0)}{self.rule_number}", text)
+
+        def number(m: re.Match[str]) -> str:
+            return f"{m.group(0)}{self.rule_number}"
+
+        def token(m: re.Match[str]) -> str:
+            if m.group(1):  # an f-string: its fields are code
+                return TEMPORARIES.sub(number, m.group(1))
+            return m.group(2) or number(m)
+
+        return _TOKENS.sub(token, text)
 
     def emit(self, *lines: str) -> None:
         """Body lines, indented relative to the rule's block."""
