@@ -37,7 +37,7 @@ class FunctionBuilder(
 ):
     def build(self) -> list[str]:
         """The function's body lines, after the lines making the target objects."""
-        for number_, rule in enumerate(self.mapping.rules, 1):
+        for index, rule in enumerate(self.mapping.rules, 1):
             if rule.only is not None and (rule.only is Direction.BACKWARD) != self.backward:
                 continue
             reads = rule.targets if self.backward else rule.sources
@@ -48,7 +48,7 @@ class FunctionBuilder(
                     if r.message != CONCEPTS_ENDPOINT and self.src.optional(r.message)
                 }
             )
-            self.rule_number = number_
+            self.rule_number = index
             self.lines += ["", *self.rule_comment(rule)]
             if optional and not rule.op.HANDLES_MISSING:
                 self.lines.append(f"{INDENT}if {' and '.join(f'{v} is not None' for v in optional)}:")
