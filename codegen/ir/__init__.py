@@ -14,6 +14,7 @@ from .model import (
     Constant,
     CrossFieldRule,
     DevicetreeInfo,
+    Direction,
     DronecanInfo,
     DronecanKind,
     Endpoint,
@@ -28,9 +29,7 @@ from .model import (
     MappingSet,
     MavlinkInfo,
     Message,
-    Param,
     ParamsInfo,
-    ParamValue,
     PrimitiveKind,
     PrimitiveType,
     Range,
@@ -43,6 +42,7 @@ from .model import (
     Unit,
     UorbInfo,
 )
+from .ops import MappingOp
 
 __all__ = [
     "CONCEPTS_ENDPOINT",
@@ -54,6 +54,7 @@ __all__ = [
     "Constant",
     "CrossFieldRule",
     "DevicetreeInfo",
+    "Direction",
     "DronecanInfo",
     "DronecanKind",
     "Endpoint",
@@ -65,11 +66,10 @@ __all__ = [
     "FieldType",
     "Location",
     "Mapping",
+    "MappingOp",
     "MappingSet",
     "MavlinkInfo",
     "Message",
-    "Param",
-    "ParamValue",
     "ParamsInfo",
     "PrimitiveKind",
     "PrimitiveType",

@@ -15,6 +15,7 @@ from importlib import resources
 from typing import Any
 
 from . import model as ir
+from .mapping_json import rule_json
 
 # The members of the FieldType union carry a "form" tag so the JSON form is self-describing.
 _TYPE_TAGS: dict[type, str] = {
@@ -43,6 +44,8 @@ def to_jsonable(obj: object) -> Any:
         return _number(obj)
     if isinstance(obj, tuple | list):
         return [to_jsonable(item) for item in obj]
+    if isinstance(obj, ir.Rule):  # a typed op, written as its mapping file spelled it
+        return rule_json(obj, to_jsonable)
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         out: dict[str, Any] = {}
         tag = _TYPE_TAGS.get(type(obj))

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from .expr import RuleExpressions
+from .ops import MappingOp
 
 
 class SourceFormat(str, enum.Enum):
@@ -396,15 +397,6 @@ class Message:
 # --------------------------------------------------------------------------------------------
 # Concepts and mappings (schemas/mappings/*.yaml): what converters between formats are made of
 
-# A rule parameter: scalars, or tuples of them (a YAML list), or tuples of Params (a YAML mapping)
-ParamValue = int | float | str | bool | None | tuple["ParamValue | Param", ...]
-
-
-@dataclass(frozen=True)
-class Param:
-    name: str
-    value: ParamValue
-
 
 @dataclass(frozen=True)
 class Concept:
@@ -430,16 +422,24 @@ class FieldRef:
     field: str
 
 
+class Direction(str, enum.Enum):
+    """A direction of a reversible mapping: source -> target (forward) or back."""
+
+    FORWARD = "forward"
+    BACKWARD = "backward"
+
+
 @dataclass(frozen=True)
 class Rule:
-    """One step of a mapping: ``op`` computes ``targets`` from ``sources`` with ``params``."""
+    """One step of a mapping: ``op`` (a typed op of :mod:`codegen.ir.ops`, holding its parameters)
+    computes ``targets`` from ``sources``; ``only`` limits it to one direction of a reversible mapping."""
 
-    op: str
+    op: MappingOp
     targets: tuple[FieldRef, ...]
     sources: tuple[FieldRef, ...]
-    params: tuple[Param, ...] = ()
     doc: str = ""
     location: Location | None = None
+    only: Direction | None = None
 
 
 @dataclass(frozen=True)

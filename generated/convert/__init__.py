@@ -11,93 +11,116 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from . import devicetree, dronecan, dronecan_devicetree, dronecan_mavlink, dronecan_uorb, dronecan_uorb_v0, mavlink, mavlink_devicetree, uorb, uorb_devicetree, uorb_mavlink, uorb_uorb_v0, uorb_v0, uorb_v0_devicetree, uorb_v0_mavlink
+from ..devicetree.power.supply import SimpleBattery
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
+from ..mavlink import BatteryStatus as MavlinkBatteryStatus
+from ..uorb import BatteryStatus as UorbBatteryStatus
+from ..uorb import BatteryStatusV0
+from . import (
+    devicetree,
+    dronecan,
+    dronecan_devicetree,
+    dronecan_mavlink,
+    dronecan_uorb,
+    dronecan_uorb_v0,
+    mavlink,
+    mavlink_devicetree,
+    uorb,
+    uorb_devicetree,
+    uorb_mavlink,
+    uorb_uorb_v0,
+    uorb_v0,
+    uorb_v0_devicetree,
+    uorb_v0_mavlink,
+)
 from ._concepts import BatteryState
 from ._runtime import ConversionError, LossEntry, LossReport
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _E0
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _E1
-from ..uorb import BatteryStatus as _E2
-from ..uorb import BatteryStatusV0 as _E3
-from ..mavlink import BatteryStatus as _E4
-from ..devicetree.power.supply import SimpleBattery as _E5
 
 __all__ = [
-    'CONVERTERS', 'ENDPOINTS', 'INPUTS', 'POLICIES',
-    'BatteryState', 'ConversionError', 'LossEntry', 'LossReport', 'converter',
+    "CONVERTERS",
+    "ENDPOINTS",
+    "INPUTS",
+    "POLICIES",
+    "BatteryState",
+    "ConversionError",
+    "LossEntry",
+    "LossReport",
+    "converter",
 ]
 
 # each endpoint's objects in order: the first required, the rest optional companions
 ENDPOINTS: dict[str, tuple[tuple[str, type[Any]], ...]] = {
-    'dronecan': (('info', _E0), ('aux', _E1),),
-    'uorb': (('status', _E2),),
-    'uorb_v0': (('status', _E3),),
-    'mavlink': (('msg', _E4),),
-    'devicetree': (('node', _E5),),
-    'concepts': (('state', BatteryState),),
+    "dronecan": (("info", BatteryInfo), ("aux", BatteryInfoAux)),
+    "uorb": (("status", UorbBatteryStatus),),
+    "uorb_v0": (("status", BatteryStatusV0),),
+    "mavlink": (("msg", MavlinkBatteryStatus),),
+    "devicetree": (("node", SimpleBattery),),
+    "concepts": (("state", BatteryState),),
 }
 
 CONVERTERS: dict[tuple[str, str], Callable[..., Any]] = {
-    ('dronecan', 'concepts'): dronecan.to_concepts,
-    ('concepts', 'dronecan'): dronecan.from_concepts,
-    ('uorb', 'concepts'): uorb.to_concepts,
-    ('concepts', 'uorb'): uorb.from_concepts,
-    ('uorb_v0', 'concepts'): uorb_v0.to_concepts,
-    ('concepts', 'uorb_v0'): uorb_v0.from_concepts,
-    ('mavlink', 'concepts'): mavlink.to_concepts,
-    ('concepts', 'mavlink'): mavlink.from_concepts,
-    ('devicetree', 'concepts'): devicetree.to_concepts,
-    ('dronecan', 'uorb'): dronecan_uorb.dronecan_to_uorb,
-    ('uorb', 'dronecan'): dronecan_uorb.uorb_to_dronecan,
-    ('dronecan', 'uorb_v0'): dronecan_uorb_v0.dronecan_to_uorb_v0,
-    ('uorb_v0', 'dronecan'): dronecan_uorb_v0.uorb_v0_to_dronecan,
-    ('dronecan', 'mavlink'): dronecan_mavlink.dronecan_to_mavlink,
-    ('mavlink', 'dronecan'): dronecan_mavlink.mavlink_to_dronecan,
-    ('devicetree', 'dronecan'): dronecan_devicetree.devicetree_to_dronecan,
-    ('uorb', 'uorb_v0'): uorb_uorb_v0.uorb_to_uorb_v0,
-    ('uorb_v0', 'uorb'): uorb_uorb_v0.uorb_v0_to_uorb,
-    ('uorb', 'mavlink'): uorb_mavlink.uorb_to_mavlink,
-    ('mavlink', 'uorb'): uorb_mavlink.mavlink_to_uorb,
-    ('devicetree', 'uorb'): uorb_devicetree.devicetree_to_uorb,
-    ('uorb_v0', 'mavlink'): uorb_v0_mavlink.uorb_v0_to_mavlink,
-    ('mavlink', 'uorb_v0'): uorb_v0_mavlink.mavlink_to_uorb_v0,
-    ('devicetree', 'uorb_v0'): uorb_v0_devicetree.devicetree_to_uorb_v0,
-    ('devicetree', 'mavlink'): mavlink_devicetree.devicetree_to_mavlink,
+    ("dronecan", "concepts"): dronecan.to_concepts,
+    ("concepts", "dronecan"): dronecan.from_concepts,
+    ("uorb", "concepts"): uorb.to_concepts,
+    ("concepts", "uorb"): uorb.from_concepts,
+    ("uorb_v0", "concepts"): uorb_v0.to_concepts,
+    ("concepts", "uorb_v0"): uorb_v0.from_concepts,
+    ("mavlink", "concepts"): mavlink.to_concepts,
+    ("concepts", "mavlink"): mavlink.from_concepts,
+    ("devicetree", "concepts"): devicetree.to_concepts,
+    ("dronecan", "uorb"): dronecan_uorb.dronecan_to_uorb,
+    ("uorb", "dronecan"): dronecan_uorb.uorb_to_dronecan,
+    ("dronecan", "uorb_v0"): dronecan_uorb_v0.dronecan_to_uorb_v0,
+    ("uorb_v0", "dronecan"): dronecan_uorb_v0.uorb_v0_to_dronecan,
+    ("dronecan", "mavlink"): dronecan_mavlink.dronecan_to_mavlink,
+    ("mavlink", "dronecan"): dronecan_mavlink.mavlink_to_dronecan,
+    ("devicetree", "dronecan"): dronecan_devicetree.devicetree_to_dronecan,
+    ("uorb", "uorb_v0"): uorb_uorb_v0.uorb_to_uorb_v0,
+    ("uorb_v0", "uorb"): uorb_uorb_v0.uorb_v0_to_uorb,
+    ("uorb", "mavlink"): uorb_mavlink.uorb_to_mavlink,
+    ("mavlink", "uorb"): uorb_mavlink.mavlink_to_uorb,
+    ("devicetree", "uorb"): uorb_devicetree.devicetree_to_uorb,
+    ("uorb_v0", "mavlink"): uorb_v0_mavlink.uorb_v0_to_mavlink,
+    ("mavlink", "uorb_v0"): uorb_v0_mavlink.mavlink_to_uorb_v0,
+    ("devicetree", "uorb_v0"): uorb_v0_devicetree.devicetree_to_uorb_v0,
+    ("devicetree", "mavlink"): mavlink_devicetree.devicetree_to_mavlink,
 }
 
 # the policies each converter supports, and the extra keyword inputs it accepts
 POLICIES: dict[tuple[str, str], tuple[str, ...]] = {
-    ('dronecan', 'concepts'): ('strict',),
-    ('concepts', 'dronecan'): ('strict',),
-    ('uorb', 'concepts'): ('strict',),
-    ('concepts', 'uorb'): ('strict',),
-    ('uorb_v0', 'concepts'): ('strict',),
-    ('concepts', 'uorb_v0'): ('strict',),
-    ('mavlink', 'concepts'): ('strict',),
-    ('concepts', 'mavlink'): ('strict',),
-    ('devicetree', 'concepts'): ('strict',),
-    ('dronecan', 'uorb'): ('strict', 'px4'),
-    ('uorb', 'dronecan'): ('strict', 'px4'),
-    ('dronecan', 'uorb_v0'): ('strict', 'px4'),
-    ('uorb_v0', 'dronecan'): ('strict', 'px4'),
-    ('dronecan', 'mavlink'): ('strict', 'px4'),
-    ('mavlink', 'dronecan'): ('strict', 'px4'),
-    ('devicetree', 'dronecan'): ('strict',),
-    ('uorb', 'uorb_v0'): ('strict', 'px4'),
-    ('uorb_v0', 'uorb'): ('strict', 'px4'),
-    ('uorb', 'mavlink'): ('strict', 'px4'),
-    ('mavlink', 'uorb'): ('strict', 'px4'),
-    ('devicetree', 'uorb'): ('strict',),
-    ('uorb_v0', 'mavlink'): ('strict', 'px4'),
-    ('mavlink', 'uorb_v0'): ('strict', 'px4'),
-    ('devicetree', 'uorb_v0'): ('strict',),
-    ('devicetree', 'mavlink'): ('strict',),
+    ("dronecan", "concepts"): ("strict",),
+    ("concepts", "dronecan"): ("strict",),
+    ("uorb", "concepts"): ("strict",),
+    ("concepts", "uorb"): ("strict",),
+    ("uorb_v0", "concepts"): ("strict",),
+    ("concepts", "uorb_v0"): ("strict",),
+    ("mavlink", "concepts"): ("strict",),
+    ("concepts", "mavlink"): ("strict",),
+    ("devicetree", "concepts"): ("strict",),
+    ("dronecan", "uorb"): ("strict", "px4"),
+    ("uorb", "dronecan"): ("strict", "px4"),
+    ("dronecan", "uorb_v0"): ("strict", "px4"),
+    ("uorb_v0", "dronecan"): ("strict", "px4"),
+    ("dronecan", "mavlink"): ("strict", "px4"),
+    ("mavlink", "dronecan"): ("strict", "px4"),
+    ("devicetree", "dronecan"): ("strict",),
+    ("uorb", "uorb_v0"): ("strict", "px4"),
+    ("uorb_v0", "uorb"): ("strict", "px4"),
+    ("uorb", "mavlink"): ("strict", "px4"),
+    ("mavlink", "uorb"): ("strict", "px4"),
+    ("devicetree", "uorb"): ("strict",),
+    ("uorb_v0", "mavlink"): ("strict", "px4"),
+    ("mavlink", "uorb_v0"): ("strict", "px4"),
+    ("devicetree", "uorb_v0"): ("strict",),
+    ("devicetree", "mavlink"): ("strict",),
 }
 INPUTS: dict[tuple[str, str], tuple[str, ...]] = {
-    ('devicetree', 'concepts'): ('ocv_v', 'temperature_c'),
-    ('devicetree', 'dronecan'): ('ocv_v', 'temperature_c'),
-    ('devicetree', 'uorb'): ('ocv_v', 'temperature_c'),
-    ('devicetree', 'uorb_v0'): ('ocv_v', 'temperature_c'),
-    ('devicetree', 'mavlink'): ('ocv_v', 'temperature_c'),
+    ("devicetree", "concepts"): ("ocv_v", "temperature_c"),
+    ("devicetree", "dronecan"): ("ocv_v", "temperature_c"),
+    ("devicetree", "uorb"): ("ocv_v", "temperature_c"),
+    ("devicetree", "uorb_v0"): ("ocv_v", "temperature_c"),
+    ("devicetree", "mavlink"): ("ocv_v", "temperature_c"),
 }
 
 
@@ -105,6 +128,6 @@ def converter(source: str, target: str) -> Callable[..., Any]:
     """The converter from ``source`` to ``target`` (endpoint names), or ConversionError."""
     found = CONVERTERS.get((source, target))
     if found is None:
-        pairs = ', '.join(f'{s}->{t}' for s, t in sorted(CONVERTERS))
-        raise ConversionError(f'no converter from {source!r} to {target!r} (known: {pairs})')
+        pairs = ", ".join(f"{s}->{t}" for s, t in sorted(CONVERTERS))
+        raise ConversionError(f"no converter from {source!r} to {target!r} (known: {pairs})")
     return found
