@@ -12,10 +12,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..apps.package import bundled_schemas
 from ..backends.markdown import MARKER, render_docs
 from ..errors import BattgenError
 from ..frontends.loader import load
-from .main import project_root
 
 EXIT_OK, EXIT_STALE = 0, 1
 
@@ -57,7 +57,7 @@ def write_docs(pages: dict[str, str], out: Path, *, check: bool) -> tuple[list[s
 
 
 def run(args: argparse.Namespace) -> int:
-    schema = load([Path(args.schema_dir)] if args.schema_dir else [project_root() / "schemas"])
+    schema = load([Path(args.schema_dir)] if args.schema_dir else [bundled_schemas()])
     out = Path(args.out) if args.out else Path("docs") / "messages"
     pages = render_docs(schema)
     written, removed, unchanged = write_docs(pages, out, check=args.check)
