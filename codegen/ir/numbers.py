@@ -48,18 +48,23 @@ def to_json_data(value: object) -> object:
     """``value`` as strict JSON data (what ``json.dumps(..., allow_nan=False)`` takes): non-finite
     floats spelled, bytes as lists of byte values, tuples and sets as lists (sets sorted), mapping
     keys as strings, and any other object as its ``str``."""
-    if value is None or isinstance(value, bool | str):
-        return value
-    if isinstance(value, int):
-        return int(value)  # an IntEnum member as its plain value
+    # the common cases first: this runs once per value of every converted record
     if isinstance(value, float):
-        return to_json_number(value)
-    if isinstance(value, bytes | bytearray):
-        return list(value)
-    if isinstance(value, dict):
-        return {str(k): to_json_data(v) for k, v in value.items()}
-    if isinstance(value, set | frozenset):
-        return sorted((to_json_data(v) for v in value), key=repr)
+        return value if math.isfinite(value) else to_json_number(value)
+    if value is None or isinstance(value, bool | str) or type(value) is int:
+        return value
     if isinstance(value, list | tuple):
         return [to_json_data(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): to_json_data(v) for k, v in value.items()}
+    return _other_json_data(value)
+
+
+def _other_json_data(value: object) -> object:
+    if isinstance(value, int):
+        return int(value)  # an IntEnum member as its plain value
+    if isinstance(value, bytes | bytearray):
+        return list(value)
+    if isinstance(value, set | frozenset):
+        return sorted((to_json_data(v) for v in value), key=repr)
     return str(value)
