@@ -19,7 +19,7 @@ from ..frontends import devicetree as devicetree_schemas
 from ..inputs import devicetree, paramfile
 from ..inputs.model import MessageClass, field_names
 from ..ir import Message
-from .failsafe.checks import check_params
+from .failsafe.checks import Finding, check_params
 from .package import bundled_package, bundled_schemas, data_error, package_module
 from .param_proposal import Result, propose
 
@@ -72,6 +72,12 @@ def propose_from_devicetree(
         mah_thresholds=mah_thresholds,
     )
     return result, f"{Path(file).name}:{battery.line} ({battery.path}, {BATTERY_COMPATIBLE})"
+
+
+def check_proposals(result: Result) -> list[Finding]:
+    """The failsafe's cross-field findings about the proposed parameters (with the cell count and
+    chemistry the proposal assumed)."""
+    return check_params({p.name: p.value for p in result.proposals}, cells=result.cells, chemistry=result.chemistry)
 
 
 def render(result: Result, source: str, fmt: str) -> str:

@@ -18,8 +18,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..apps.failsafe.checks import CELL_RANGES, check_params
-from ..apps.param_files import check_param_file, propose_from_devicetree, render
+from ..apps.failsafe.checks import CELL_RANGES
+from ..apps.param_files import check_param_file, check_proposals, propose_from_devicetree, render
 from ..errors import BattgenError
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
@@ -60,9 +60,7 @@ def run(args: argparse.Namespace) -> int:
         mah_thresholds=args.mah_thresholds,
     )
     text = render(result, source, args.format)
-    for finding in check_params(
-        {p.name: p.value for p in result.proposals}, cells=result.cells, chemistry=result.chemistry
-    ):
+    for finding in check_proposals(result):
         print(f"battgen: {finding.severity}: {finding.message}", file=sys.stderr)
     if args.out:
         try:

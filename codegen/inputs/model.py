@@ -15,6 +15,7 @@ here too, as far as the log readers use them.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from typing import Any, Protocol, cast, runtime_checkable
@@ -108,7 +109,12 @@ def package_name(cls: MessageClass) -> str:
     """The import name of the generated package a class belongs to: the nearest package above the
     class's module that holds the generated ``_meta`` module (messages may sit in subpackages,
     ``dronecan.uavcan.equipment.power``)."""
-    parts = cls.__module__.split(".")
+    return _package_of_module(cls.__module__)
+
+
+@functools.cache
+def _package_of_module(module: str) -> str:
+    parts = module.split(".")
     for end in range(len(parts) - 1, 0, -1):
         name = ".".join(parts[:end])
         try:
