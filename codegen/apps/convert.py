@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Protocol, cast
+from typing import IO, Literal, Protocol, cast
 
 from ..errors import BattgenError
 from ..inputs.documents import read_json, read_jsonl, read_yaml
@@ -205,7 +205,7 @@ class Conversion:
         fmt: str,
         *,
         binary: bool = False,
-        loss: str | None = None,
+        loss: Literal["entries", "summary"] | None = None,
         inputs: Mapping[str, float] | None = None,
     ) -> Iterator[Converted | Notice]:
         """Convert every record of one input (``where`` names it) read as ``fmt``. ``binary``:

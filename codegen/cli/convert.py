@@ -22,7 +22,7 @@ import json
 import sys
 from collections.abc import Iterable
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, Literal
 
 import yaml
 
@@ -80,7 +80,9 @@ def run(args: argparse.Namespace) -> int:
                 f"--set {name}: not an input of {conversion.source_name} -> {conversion.target_name} "
                 f"({', '.join(conversion.inputs_taken) or 'none'})"
             )
-    loss = "entries" if args.report else "summary" if args.report_summary else None
+    loss: Literal["entries", "summary"] | None = (
+        "entries" if args.report else "summary" if args.report_summary else None
+    )
     out_stream: IO[bytes] = open(args.output, "wb") if args.output else sys.stdout.buffer
     try:
         for path in args.files or ["-"]:
