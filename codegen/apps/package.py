@@ -1,7 +1,9 @@
-"""Finding a message by name and the generated class that models it.
+"""Locating the generated package, its modules and the class that models a message.
 
-The bundled schemas use the committed ``generated`` package; any other schema folder is
-generated into a temporary package once per process and imported from there.
+The one place that knows where generated code comes from: the checkout (:func:`project_root`)
+holds ``schemas/`` and the committed ``generated/``; the bundled schemas use that package; any
+other schema folder is generated into a temporary package once per process and imported from
+there; ``battgen convert --package NAME`` imports a package by name from the current folder.
 """
 
 from __future__ import annotations
@@ -15,43 +17,31 @@ import sys
 import tempfile
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import cast
 
 from ..backends.python import naming
 from ..backends.python.writer import generate
 from ..errors import BattgenError
+from ..inputs.model import MessageClass
 from ..ir import Message, Schema
 
 _PACKAGES: dict[str, ModuleType] = {}
 
 
-def message_aliases(msg: Message) -> set[str]:
-    """The names a user may give for ``msg``: its qualified name, every dotted suffix of it, the
-    source name, the generated class name, and for devicetree bindings the compatible strings."""
-    parts = msg.qualified_name.split(".")
-    names = {".".join(parts[i:]) for i in range(len(parts))}
-    names.update((msg.name, naming.class_name(msg)))
-    if msg.devicetree is not None:
-        names.update(msg.devicetree.compatible)
-    return names
+_INSTALLED_ROOT = Path(__file__).resolve().parents[2]  # the checkout (or site-packages) holding codegen/
 
 
-def resolve_message(schema: Schema, name: str) -> Message:
-    """The message called ``name``: exact qualified name first, else an unambiguous short form."""
-    for msg in schema.messages:
-        if msg.qualified_name == name:
-            return msg
-    matches = [m for m in schema.messages if name in message_aliases(m)]
-    if not matches:
-        folded = name.casefold()
-        matches = [m for m in schema.messages if folded in {a.casefold() for a in message_aliases(m)}]
-    if len(matches) == 1:
-        return matches[0]
-    if matches:
-        candidates = ", ".join(m.qualified_name for m in matches)
-        raise BattgenError(f"message name {name!r} is ambiguous: it could be {candidates}")
-    known = ", ".join(m.qualified_name for m in schema.messages)
-    raise BattgenError(f"no message called {name!r} (known: {known})")
+def project_root() -> Path:
+    """The checkout holding schemas/ and generated/ (the current folder, else this package's parent)."""
+    cwd = Path.cwd()
+    if (cwd / "schemas").is_dir():
+        return cwd
+    return _INSTALLED_ROOT
+
+
+def bundled_schemas() -> Path:
+    """The schema folder used when none is given."""
+    return project_root() / "schemas"
 
 
 def _is_committed(schema_dir: Path, root: Path) -> bool:
@@ -94,8 +84,9 @@ def _temporary_package(schema: Schema, key: str) -> ModuleType:
     return _import_from(tmp / name, name)
 
 
-def model_package(schema: Schema, schema_dir: Path, root: Path) -> ModuleType:
+def model_package(schema: Schema, schema_dir: Path, root: Path | None = None) -> ModuleType:
     """The generated package for ``schema`` (read from ``schema_dir``), imported once per process."""
+    root = root if root is not None else project_root()
     key = str(schema_dir.resolve())
     pkg = _PACKAGES.get(key)
     if pkg is None:
@@ -107,12 +98,44 @@ def model_package(schema: Schema, schema_dir: Path, root: Path) -> ModuleType:
     return pkg
 
 
-def model_class(package: ModuleType, msg: Message) -> Any:
+def bundled_package() -> ModuleType:
+    """The committed package of the bundled schemas, without reading the schemas: the project's
+    ``generated/``, else the one installed with battgen."""
+    folder = project_root() / "generated"
+    if not (folder / "__init__.py").is_file():
+        folder = _INSTALLED_ROOT / "generated"
+    key = f"committed:{folder}"
+    pkg = _PACKAGES.get(key)
+    if pkg is None:
+        pkg = _PACKAGES[key] = _committed_package(folder)
+    return pkg
+
+
+def named_package(name: str) -> ModuleType:
+    """A generated package by its import name, looked for in the current folder first."""
+    root = str(Path.cwd())
+    if root not in sys.path:
+        sys.path.insert(0, root)
+    return importlib.import_module(name)
+
+
+def package_module(package: ModuleType, name: str) -> ModuleType:
+    """A module of a generated package: ``convert``, ``params``, ``_meta``..."""
+    return importlib.import_module(f"{package.__name__}.{name}")
+
+
+def data_error(package: ModuleType) -> type[Exception]:
+    """The error a generated ``from_dict`` raises on data that does not fit (``_meta.DataError``)."""
+    error = getattr(package_module(package, "_meta"), "DataError", ValueError)
+    return cast(type[Exception], error)
+
+
+def model_class(package: ModuleType, msg: Message) -> MessageClass:
     """The generated class of ``msg`` inside ``package``."""
-    module = importlib.import_module(f"{package.__name__}.{naming.module_path(msg)}")
+    module = package_module(package, naming.module_path(msg))
     cls = getattr(module, naming.class_name(msg), None)
     if cls is None or getattr(cls, "QUALIFIED_NAME", None) != msg.qualified_name:
         raise BattgenError(
             f"the generated package {package.__name__} has no class for {msg.qualified_name}: run 'battgen generate'"
         )
-    return cls
+    return cast(MessageClass, cls)
