@@ -16,12 +16,13 @@ from pathlib import Path
 
 from ..errors import BattgenError, LocatedError
 from ..frontends.loader import load
-from ..frontends.rules import bound_rules, referenced_fields
 from ..inputs.dispatch import KIND_FORMATS, file_kind, read_records
 from ..inputs.model import GeneratedMessage, MessageClass, Violation
 from ..inputs.records import Notice, Record, Unreadable
 from ..ir import Message, Schema, SourceFormat
+from ..ir.expr import referenced_fields
 from ..ir.numbers import to_json_data
+from ..ir.rules import bound_rules
 from .failsafe.checks import NONNEGATIVE, check_params
 from .messages import resolve_message
 from .package import data_error, model_class, model_package

@@ -45,12 +45,13 @@ from ..ir import (
     Sentinel,
     StringType,
 )
+from ..ir.numbers import INFINITY_SPELLINGS, NAN_SPELLINGS, NEG_INFINITY_SPELLINGS
 from ..ir.rules import rules_for
 
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
-NAN_STRINGS = ["NaN", "nan"]
-INF_STRINGS = ["Infinity", "inf"]
-NEG_INF_STRINGS = ["-Infinity", "-inf"]
+NAN_STRINGS = list(NAN_SPELLINGS)
+INF_STRINGS = list(INFINITY_SPELLINGS)
+NEG_INF_STRINGS = list(NEG_INFINITY_SPELLINGS)
 FLOAT_MAX = {16: 65504.0, 32: 3.4028234663852886e38, 64: sys.float_info.max}
 _MAX_MASK_ENUM = 4096
 

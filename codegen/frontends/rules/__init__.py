@@ -21,8 +21,6 @@ from pathlib import Path
 
 from ...errors import SchemaError
 from ...ir import CrossFieldRule, Location, Schema
-from ...ir.expr import referenced_fields
-from ...ir.rules import bound_rules
 from .binding import check_binding
 from .files import load_rule_file
 
@@ -67,13 +65,10 @@ def check_unique_ids(rules: tuple[CrossFieldRule, ...], qualified_name: str) -> 
             seen[r.id] = r.location
 
 
-# bound_rules and referenced_fields live in the IR; re-exported for callers that still import them from here
 __all__ = [
-    "bound_rules",
     "check_binding",
     "check_rules",
     "check_unique_ids",
     "load_rule_file",
     "load_rules_dir",
-    "referenced_fields",
 ]
