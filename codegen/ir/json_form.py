@@ -13,7 +13,7 @@ from functools import cache
 from importlib import resources
 from typing import Any
 
-from . import model as ir
+from .. import ir
 from .mapping_json import rule_json
 from .numbers import to_json_number
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from .mapping_values import ConstantRef, Entry
-from .model import Rule
+from .mappings import Rule
 from .ops import MappingOp
 
 WrittenValue = int | float | bool | str | None | tuple["WrittenValue | WrittenParam", ...]

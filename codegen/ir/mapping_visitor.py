@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import Protocol, TypeVar, assert_never
 
 from . import ops
-from .model import Rule
+from .mappings import Rule
 
 T_co = TypeVar("T_co", covariant=True)
 

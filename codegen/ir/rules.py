@@ -11,7 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .expr import Const, Expr, FieldRef, Loop, Name, Template, children, rebuild
-from .model import CrossFieldRule, Message, Schema
+from .messages import Message
+from .schema import CrossFieldRule, Schema
 
 
 class UnboundName(LookupError):
