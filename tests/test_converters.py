@@ -6,7 +6,10 @@ The px4-policy rules are pinned in conformance/test_converters_px4.py.
 from __future__ import annotations
 
 import math
+import re
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -15,6 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from codegen.apps import ocv
+from codegen.frontends import mappings
 from codegen.frontends.loader import load
 from generated.convert import CONVERTERS, ENDPOINTS, POLICIES, BatteryState, ConversionError, LossReport, converter
 from generated.convert import _runtime as rt
@@ -402,3 +406,32 @@ def test_generated_converters_are_valid_and_inert_with_hostile_names(tmp_path: P
     back = pkg.CONVERTERS[("concepts", "odd")](state)
     assert (back.lambda_, back.class_) == (3.5, 4)
     assert ROOT.is_dir()
+
+
+# -- the generated text is reviewable -------------------------------------------------------------
+
+
+def test_generated_converters_are_formatted_and_lint_clean() -> None:
+    convert = ROOT / "generated" / "convert"
+    for args in (["format", "--check"], ["check"]):
+        proc = subprocess.run(
+            [sys.executable, "-m", "ruff", *args, "--no-force-exclude", str(convert)],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+        assert proc.returncode == 0, proc.stdout + proc.stderr
+    lines = [
+        (p.name, n, line) for p in sorted(convert.glob("*.py")) for n, line in enumerate(p.read_text().splitlines())
+    ]
+    assert [(name, n) for name, n, line in lines if len(line) > 120] == []
+    assert [(name, n) for name, n, line in lines if re.search(r"\b_[KCET]\d+", line)] == []  # constants have names
+
+
+def test_every_rule_is_preceded_by_its_mapping_file_and_line() -> None:
+    schema = load([ROOT / "schemas"])
+    for mapping in mappings.all_mappings(schema):
+        text = (ROOT / "generated" / "convert" / f"_map_{mapping.name}.py").read_text()
+        for rule in mapping.rules:
+            assert f"    # {rule.location}: {rule.op.NAME} " in text, rule.location

@@ -16,9 +16,9 @@ from codegen.apps.failsafe.evaluator import (
     FailsafeParams,
     Level,
     Outcome,
-    apply_level,
     resolve_action,
 )
+from codegen.apps.failsafe.levels import apply_level
 
 # a 3S LiPo as in the seed: LOW 10.5 V (3.5 V/cell), CRITICAL 10.0 V; LOW -> RTL, CRITICAL -> Hold
 PARAMS = FailsafeParams(low_volt=10.5, crt_volt=10.0, low_action=Action.RTL, crt_action=Action.HOLD)

@@ -3,17 +3,23 @@ of malformed mapping file is a SchemaError naming the file, the line and what wa
 
 from __future__ import annotations
 
+import json
+import math
 from functools import cache
 from pathlib import Path
 
 import pytest
 from conftest import ROOT
 
+from codegen.backends.python.converters.function import FunctionBuilder
 from codegen.errors import SchemaError
 from codegen.frontends import mappings
 from codegen.frontends.loader import load
-from codegen.ir import CONCEPTS_ENDPOINT, FieldRef, Schema
+from codegen.ir import CONCEPTS_ENDPOINT, Direction, FieldRef, Schema
 from codegen.ir import json_form as irjson
+from codegen.ir.mapping_values import ConstantRef, ValuePair
+from codegen.ir.mapping_visitor import OpVisitor
+from codegen.ir.ops import OPS, Const, EnumMap, PX4Conversion, PX4Convert, PX4Int, Scale
 
 
 @cache
@@ -44,7 +50,7 @@ def test_every_px4_rule_is_documented() -> None:
     for m in mappings.all_mappings(bundled()):
         if m.policy == "px4":
             undocumented = [
-                r.location for r in m.rules if not r.doc and r.op not in ("px4_int", "px4_convert", "const")
+                r.location for r in m.rules if not r.doc and not isinstance(r.op, PX4Int | PX4Convert | Const)
             ]
             assert undocumented == [], m.name
 
@@ -166,3 +172,90 @@ def test_cells_needs_an_array(tmp_path: Path) -> None:
 def test_top_level_must_be_a_mapping(tmp_path: Path) -> None:
     err = _error(tmp_path, "- just\n- a list\n")
     assert (err.file, err.line) == ("m.yaml", 1) and "expected a mapping file" in err.message
+
+
+# -- typed ops ------------------------------------------------------------------------------------
+
+
+def test_rules_hold_typed_ops_with_typed_parameters() -> None:
+    rules = {
+        (r.location.file, r.location.line): r for m in mappings.all_mappings(bundled()) for r in m.rules if r.location
+    }
+    scale = rules["dronecan.yaml", 12].op
+    assert isinstance(scale, Scale) and len(scale.unknown) == 1 and math.isnan(scale.unknown[0])
+    stream = rules["px4_mavlink_stream.yaml", 40].op
+    assert stream == PX4Convert(PX4Conversion.RAW, guard="connected", finite=True, at_least=1, otherwise=0)
+    charge = rules["px4_mavlink_stream.yaml", 49].op
+    assert isinstance(charge, EnumMap) and charge.default == ConstantRef("MAV_BATTERY_CHARGE_STATE_UNDEFINED")
+    assert charge.map[0] == ValuePair(ConstantRef("WARNING_NONE"), ConstantRef("MAV_BATTERY_CHARGE_STATE_OK"))
+    assert rules["dronecan.yaml", 46].only is Direction.FORWARD
+    assert hash(charge) == hash(rules["px4_mavlink_stream.yaml", 49].op)  # the IR stays hashable
+
+
+def test_the_op_list_is_written_once() -> None:
+    schema = mappings.mappings_json_schema()
+    rule = schema["$defs"]["rule"]
+    assert rule["properties"]["op"]["enum"] == list(OPS)
+    assert [c["if"]["properties"]["op"]["const"] for c in rule["allOf"]] == list(OPS)
+    on_file = json.loads((Path(mappings.__file__).parent / "mappings.schema.json").read_text())["$defs"]["rule"]
+    assert on_file["properties"]["op"] == {"type": "string"} and "allOf" not in on_file
+    assert set(OPS) == {name.removeprefix("visit_") for name in dir(OpVisitor) if name.startswith("visit_")}
+    assert all(hasattr(FunctionBuilder, f"visit_{name}") for name in OPS)
+
+
+def test_op_parameters_come_from_the_op_classes() -> None:
+    then = {
+        c["if"]["properties"]["op"]["const"]: c["then"]
+        for c in mappings.mappings_json_schema()["$defs"]["rule"]["allOf"]
+    }
+    assert then["flag"]["required"] == ["mask"]
+    assert then["px4_convert"]["properties"]["convert"] == {"enum": ["raw", "units"]}
+    assert then["scale"]["properties"]["valid_max"] == {"type": "number"}
+    assert then["const"]["properties"]["value"]["anyOf"][1] == {"type": "null"}
+    assert then["bits_from"]["properties"]["bits"]["additionalProperties"]["required"] == ["field"]
+
+
+def test_unknown_parameter_is_rejected(tmp_path: Path) -> None:
+    err = _error(tmp_path, _mapping("{op: scale, from: voltage_v, to: pack_voltage, mask: FAULT_SPIKES}"))
+    assert (err.file, err.line) == ("m.yaml", 6) and "expected a valid mapping file" in err.message
+    assert "mask" in err.message
+
+
+def test_ill_typed_parameter_is_named(tmp_path: Path) -> None:
+    err = _error(tmp_path, _mapping("{op: scale, from: voltage_v, to: pack_voltage, valid_max: high}"))
+    assert (err.file, err.line) == ("m.yaml", 6) and "expected a valid mapping file" in err.message
+    assert "valid_max" in err.message and "high" in err.message
+
+
+def test_missing_parameter_is_named(tmp_path: Path) -> None:
+    err = _error(tmp_path, _mapping("{op: flag, from: faults, to: pack_voltage}"))
+    assert (err.file, err.line) == ("m.yaml", 6) and "'mask' is a required property" in err.message
+
+
+def test_reference_count_is_checked(tmp_path: Path) -> None:
+    err = _error(tmp_path, _mapping("{op: soc_hybrid, from: voltage_v, to: pack_voltage}"))
+    assert (err.file, err.line) == ("m.yaml", 6)
+    assert "expected 3 reference(s) in 'from' for op 'soc_hybrid', got 1" in err.message
+
+
+def test_unknown_unit_parameter_is_named(tmp_path: Path) -> None:
+    rule = "{op: px4_convert, from: voltage_v, to: pack_voltage, convert: units, source_unit: furlongs}"
+    err = _error(tmp_path, _mapping(rule))
+    assert (err.file, err.line) == ("m.yaml", 6) and "expected a known unit for 'source_unit'" in err.message
+
+
+def test_constants_in_any_parameter_are_checked(tmp_path: Path) -> None:
+    err = _error(tmp_path, _mapping("{op: const, to: pack_voltage, value: WARNING_ON_FIRE}"))
+    assert (err.file, err.line) == ("m.yaml", 6) and "expected a constant" in err.message
+    assert "WARNING_ON_FIRE" in err.message
+
+
+def test_ir_json_writes_parameters_as_the_file_does(tmp_path: Path) -> None:
+    rule = "{op: copy, from: id, to: pack_voltage, add: -1, unknown: [0, NaN], only: backward}"
+    (m,) = mappings.all_mappings(_parse(tmp_path, _mapping(rule)))
+    params = irjson.to_jsonable(m.rules[0])["params"]
+    assert params == [
+        {"name": "add", "value": -1},
+        {"name": "unknown", "value": [0, "NaN"]},
+        {"name": "only", "value": "backward"},
+    ]

@@ -102,6 +102,13 @@ def test_doctype_and_entities_are_refused(tmp_path: Path, doctype: str) -> None:
     assert "expected no DOCTYPE" in err.message
 
 
+def test_text_must_be_utf8(tmp_path: Path) -> None:
+    path = tmp_path / "latin.xml"
+    path.write_bytes(b'<?xml version="1.0"?>\n<mavlink>\n<!-- caf\xe9 -->\n</mavlink>\n')
+    err = fails(path, tmp_path)
+    assert (err.file, err.line, err.message) == ("latin.xml", 3, "expected UTF-8 text")
+
+
 # ------------------------------------------------------------------------------------------
 # Malformed documents and attributes
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from codegen.errors import SchemaError
-from codegen.frontends import pdef as params
+from codegen.frontends import pdef
 from codegen.frontends.loader import format_of_file, load
 from codegen.ir import EnumKind, PrimitiveKind, Range, SourceFormat
 from codegen.ir import json_form as irjson
@@ -28,13 +28,13 @@ def group(params_xml: str, name: str = "BATT_") -> str:
 
 def error(tmp_path: Path, body: str) -> SchemaError:
     with pytest.raises(SchemaError) as info:
-        params.parse_file(write(tmp_path, body), root=tmp_path)
+        pdef.parse_file(write(tmp_path, body), root=tmp_path)
     assert info.value.file == "x.pdef.xml"
     return info.value
 
 
 def test_shipped_schema_facts() -> None:
-    schema = params.parse_dir(ROOT / "schemas" / "params")
+    schema = pdef.parse_dir(ROOT / "schemas" / "params")
     msg = schema.message("params.BATT")
     assert (msg.name, msg.format, msg.params and msg.params.prefix) == ("BATT", SourceFormat.PARAMS, "BATT_")
     names = [f.name for f in msg.fields]
@@ -99,7 +99,7 @@ def test_real_pdef_forms_values_bitmask_inference_vehicle(tmp_path: Path) -> Non
     </parameters>
   </libraries>
 </paramfile>"""
-    schema = params.parse_file(write(tmp_path, body), root=tmp_path)
+    schema = pdef.parse_file(write(tmp_path, body), root=tmp_path)
     assert [m.qualified_name for m in schema.messages] == ["params.ArduCopter", "params.BATT"]
     copter = schema.message("params.ArduCopter")
     assert copter.fields[0].name == "FRAME_CLASS" and copter.params is not None and copter.params.section == "vehicles"
@@ -166,12 +166,30 @@ def test_errors_name_file_line_and_expectation(tmp_path: Path, body: str, line: 
     assert expected in exc.message
 
 
+@pytest.mark.parametrize(
+    "doctype",
+    ['<!DOCTYPE paramfile SYSTEM "file:///etc/passwd">', "<!DOCTYPE paramfile>"],
+)
+def test_any_doctype_is_refused(tmp_path: Path, doctype: str) -> None:
+    exc = error(tmp_path, f"{doctype}\n<paramfile/>")
+    assert exc.line == 2
+    assert exc.message == "expected no DOCTYPE (apm.pdef.xml needs no DTD)"
+
+
+def test_text_must_be_utf8(tmp_path: Path) -> None:
+    path = tmp_path / "x.pdef.xml"
+    path.write_bytes(b'<?xml version="1.0"?>\n<paramfile>\n<!-- caf\xe9 -->\n</paramfile>\n')
+    with pytest.raises(SchemaError) as info:
+        pdef.parse_file(path, root=tmp_path)
+    assert (info.value.file, info.value.line, info.value.message) == ("x.pdef.xml", 3, "expected UTF-8 text")
+
+
 def test_unreadable_and_duplicate_groups(tmp_path: Path) -> None:
     with pytest.raises(SchemaError, match="cannot read file"):
-        params.parse_file(tmp_path / "missing.pdef.xml")
+        pdef.parse_file(tmp_path / "missing.pdef.xml")
     (tmp_path / "a.pdef.xml").write_text(group('<param name="BATT_A"/>'), encoding="utf-8")
     (tmp_path / "b.pdef.xml").write_text(group('<param name="BATT_B"/>'), encoding="utf-8")
     with pytest.raises(SchemaError) as info:
-        params.parse_dir(tmp_path)
+        pdef.parse_dir(tmp_path)
     assert (info.value.file, info.value.line) == ("b.pdef.xml", 1)
     assert "expected one definition of params.BATT" in info.value.message

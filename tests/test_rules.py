@@ -12,6 +12,7 @@ import pytest
 from codegen.errors import SchemaError
 from codegen.frontends import rules
 from codegen.frontends.loader import load
+from codegen.frontends.rules.parse import ExprError, parse, parse_template
 from codegen.ir import (
     ArrayType,
     Field,
@@ -24,7 +25,7 @@ from codegen.ir import (
     Sentinel,
     SourceFormat,
 )
-from codegen.ir.expr import Compare, ExprError, Quant, parse, parse_template
+from codegen.ir.expr import Compare, Quant
 
 ROOT = Path(__file__).resolve().parent.parent
 F32 = PrimitiveType(PrimitiveKind.FLOAT, 32)
@@ -65,7 +66,7 @@ def test_shipped_rules_load_and_bind() -> None:
     for rule in schema.rules:
         assert set(rule.messages) <= names, rule.location
         for qn in rule.messages:
-            rules.bind(rules.parsed(rule), schema.message(qn))
+            rules.check_binding(rule, schema.message(qn))
         ids.append(rule.id)
     for expected in (
         "voltage-design-order",
@@ -175,7 +176,7 @@ def _tiny(fields: tuple[Field, ...] = ()) -> Message:
 def test_binding_errors_name_the_line(tmp_path: Path, change: tuple[str, str], line: int, expected: str) -> None:
     f = rules.load_rule_file(_write(tmp_path, GOOD.replace(*change)), root=tmp_path)
     with pytest.raises(SchemaError) as info:
-        rules.bind(rules.parsed(f[0]), _tiny())
+        rules.check_binding(f[0], _tiny())
     assert info.value.file == "r.yaml" and info.value.line == line, str(info.value)
     assert expected in str(info.value)
 
@@ -185,7 +186,7 @@ def test_duplicate_rule_ids_are_rejected(tmp_path: Path) -> None:
     _write(tmp_path, GOOD, "two.yaml")
     found = rules.load_rules_dir(tmp_path)
     with pytest.raises(SchemaError, match=r"rule id 'a-below-b' of uorb\.T is used twice") as info:
-        rules.rules_for(found, "uorb.T")
+        rules.check_unique_ids(found, "uorb.T")
     assert info.value.file == "two.yaml" and info.value.line == 3
 
 

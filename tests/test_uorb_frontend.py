@@ -9,6 +9,7 @@ import pytest
 
 from codegen.errors import SchemaError
 from codegen.frontends import uorb
+from codegen.frontends.uorb.build import snake_case
 from codegen.ir import (
     ArrayType,
     CompositeType,
@@ -219,8 +220,8 @@ def test_topics(tmp_path: Path) -> None:
     assert m.doc == "Doc line"
     d = parse(tmp_path, HEAD, name="SensorGps")
     assert d.uorb is not None and d.uorb.topics == ("sensor_gps",) and d.uorb.message_version is None
-    assert uorb.snake_case("Ekf2Timestamps") == "ekf2_timestamps"
-    assert uorb.snake_case("BatteryStatusV0") == "battery_status_v0"
+    assert snake_case("Ekf2Timestamps") == "ekf2_timestamps"
+    assert snake_case("BatteryStatusV0") == "battery_status_v0"
 
 
 def test_nested_messages_and_layout(tmp_path: Path) -> None:

@@ -18,11 +18,13 @@ import pytest
 import yaml
 from conftest import ROOT
 
-from codegen.apps.models import resolve_message
+from codegen.apps.messages import resolve_message
+from codegen.apps.validate import Checker, exit_code, make_checker
 from codegen.cli.main import build_parser, main
-from codegen.cli.validate import Checker, check_file, exit_code, make_checker
+from codegen.cli.validate import check_file
 from codegen.frontends.loader import load
-from codegen.inputs.records import Record, read_records
+from codegen.inputs.dispatch import read_records
+from codegen.inputs.records import Record
 from codegen.ir import Location, Message, SourceFormat
 
 DATA = ROOT / "tests" / "data" / "instances"

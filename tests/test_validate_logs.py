@@ -12,9 +12,10 @@ from typing import Any
 import pytest
 from conftest import ROOT
 
+from codegen.apps.validate import make_checker
 from codegen.cli.main import main
-from codegen.cli.validate import check_file, make_checker
-from codegen.inputs.records import read_records
+from codegen.cli.validate import check_file
+from codegen.inputs.dispatch import read_records
 from generated import _ulog
 from generated.mavlink import BatteryStatus as MavBattery
 from generated.uorb import BatteryStatus

@@ -31,7 +31,6 @@ import sys
 from dataclasses import replace
 from typing import Any
 
-from ..frontends.rules import bound_rules
 from ..ir import (
     ArrayType,
     Column,
@@ -46,11 +45,13 @@ from ..ir import (
     Sentinel,
     StringType,
 )
+from ..ir.numbers import INFINITY_SPELLINGS, NAN_SPELLINGS, NEG_INFINITY_SPELLINGS
+from ..ir.rules import rules_for
 
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
-NAN_STRINGS = ["NaN", "nan"]
-INF_STRINGS = ["Infinity", "inf"]
-NEG_INF_STRINGS = ["-Infinity", "-inf"]
+NAN_STRINGS = list(NAN_SPELLINGS)
+INF_STRINGS = list(INFINITY_SPELLINGS)
+NEG_INF_STRINGS = list(NEG_INFINITY_SPELLINGS)
 FLOAT_MAX = {16: 65504.0, 32: 3.4028234663852886e38, 64: sys.float_info.max}
 _MAX_MASK_ENUM = 4096
 
@@ -69,10 +70,10 @@ def message_json_schema(schema: Schema, msg: Message) -> dict[str, Any]:
         "title": msg.qualified_name,
     }
     out.update(body)
-    rules = bound_rules(schema, msg)
+    rules = rules_for(schema, msg)
     if rules:
         out["$comment"] = "Cross-field rules checked by the generated validate() but not expressed here: " + "; ".join(
-            f"{b.rule.id} ({b.rule.text})" for b in rules
+            f"{r.id} ({r.check})" for r in rules
         )
     if defs:
         out["$defs"] = dict(sorted(defs.items()))

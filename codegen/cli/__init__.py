@@ -1,14 +1,7 @@
-"""Sub-commands of the battgen CLI beyond list / ir / generate, one module each.
+"""The ``battgen`` command line: argparse and printing only, one module per command.
 
-Each module exposes ``register(subparsers)`` adding its parser with ``set_defaults(func=...)``;
-a command function takes the parsed arguments and returns the exit code.
+:mod:`.main` holds the parser and the list / ir / generate commands; every other command is a
+module here exposing ``register(subparsers)``, which adds its parser with ``set_defaults(func=...)``.
+A command function takes the parsed arguments, drives an engine of :mod:`codegen.apps` and prints
+what it hands back; it returns the exit code.
 """
-
-COMMAND_MODULES: tuple[str, ...] = (
-    "codegen.cli.validate",
-    "codegen.cli.docs",
-    "codegen.cli.schema",
-    "codegen.cli.convert",
-    "codegen.cli.params",
-    "codegen.cli.failsafe",
-)

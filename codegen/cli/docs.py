@@ -12,52 +12,16 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..backends.markdown import MARKER, render_docs
-from ..errors import BattgenError
+from ..apps.docs import write_docs
+from ..apps.package import bundled_schemas
+from ..backends.markdown import render_docs
 from ..frontends.loader import load
-from .main import project_root
 
 EXIT_OK, EXIT_STALE = 0, 1
 
 
-def _ours(path: Path) -> bool:
-    """Whether a Markdown file was written by this command (only those are ever removed)."""
-    try:
-        with path.open(encoding="utf-8") as stream:
-            return stream.readline().rstrip("\n") == MARKER
-    except (OSError, UnicodeDecodeError):
-        return False
-
-
-def write_docs(pages: dict[str, str], out: Path, *, check: bool) -> tuple[list[str], list[str], list[str]]:
-    """(written, removed, unchanged) page names; with ``check`` nothing is written or removed."""
-    written, unchanged = [], []
-    for name, text in pages.items():
-        target = out / name
-        data = text.encode("utf-8")
-        try:
-            same = target.is_file() and target.read_bytes() == data
-        except OSError:
-            same = False
-        if same:
-            unchanged.append(name)
-            continue
-        written.append(name)
-        if not check:
-            try:
-                out.mkdir(parents=True, exist_ok=True)
-                target.write_bytes(data)
-            except OSError as exc:
-                raise BattgenError(f"{target}: cannot write: {exc.strerror or exc}") from None
-    removed = sorted(p.name for p in out.glob("*.md") if p.name not in pages and _ours(p)) if out.is_dir() else []
-    if not check:
-        for name in removed:
-            (out / name).unlink()
-    return written, removed, unchanged
-
-
 def run(args: argparse.Namespace) -> int:
-    schema = load([Path(args.schema_dir)] if args.schema_dir else [project_root() / "schemas"])
+    schema = load([Path(args.schema_dir)] if args.schema_dir else [bundled_schemas()])
     out = Path(args.out) if args.out else Path("docs") / "messages"
     pages = render_docs(schema)
     written, removed, unchanged = write_docs(pages, out, check=args.check)

@@ -27,10 +27,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..apps.failsafe.evaluator import BatteryFailsafe, Event, FailsafeParams, Level, apply_level
-from ..apps.failsafe.stream import Reader, Sample
+from ..apps.failsafe.evaluator import BatteryFailsafe, Event
+from ..apps.failsafe.levels import Level, apply_level
+from ..apps.failsafe.stream import Replay, Sample, open_reader, read_failsafe_params
 from ..errors import BattgenError
-from ..inputs import paramfile
 
 EXIT_OK, EXIT_UNREADABLE = 0, 2
 
@@ -55,31 +55,10 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _params(path: Path) -> FailsafeParams:
-    values: dict[str, float] = {}
-    for _, group in paramfile.read_param_file(path):
-        values.update(group)
-    try:
-        return FailsafeParams.from_values(values)
-    except ValueError as exc:
-        raise BattgenError(f"{path}: {exc}") from None
-
-
-def _reader(args: argparse.Namespace) -> Reader:
-    from ..apps.models import model_package
-    from ..frontends.loader import load
-    from .main import project_root
-
-    root = project_root()
-    schema_dir = Path(args.schemas) if args.schemas else root / "schemas"
-    schema = load([schema_dir])
-    return Reader(schema, model_package(schema, schema_dir, root), args.message)
-
-
 def run(args: argparse.Namespace) -> int:
     try:
-        params = _params(Path(args.params))
-        reader = _reader(args)
+        params = read_failsafe_params(Path(args.params))
+        reader = open_reader(Path(args.schemas) if args.schemas else None, args.message)
         fs = BatteryFailsafe(
             params,
             home_set=not args.no_home,
@@ -88,20 +67,14 @@ def run(args: argparse.Namespace) -> int:
             margin=args.margin,
             consumption_mah_per_m=args.rate,
         )
-        count = 0
-        for sample in reader.read(Path(args.stream)):
-            count += 1
-            try:
-                events = fs.update(sample.t, sample.battery, armed=sample.armed, **sample.extra)
-            except ValueError as exc:
-                raise BattgenError(f"{args.stream}:{sample.line}: {exc}") from None
-            for event in events:
-                print(_json(event, sample) if args.json else _line(event, sample))
+        replay = Replay(fs, reader)
+        for event, sample in replay.run(Path(args.stream), args.stream):
+            print(_json(event, sample) if args.json else _line(event, sample))
     except BattgenError as exc:
         print(f"battgen: {exc}", file=sys.stderr)
         return EXIT_UNREADABLE
     if not args.json:
-        print(f"{count} samples, {len(fs.events)} events, final level {fs.level.name}", file=sys.stderr)
+        print(f"{replay.samples} samples, {len(fs.events)} events, final level {fs.level.name}", file=sys.stderr)
     return EXIT_OK
 
 

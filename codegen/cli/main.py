@@ -4,37 +4,26 @@ malformed schema. Errors are one line on stderr, never a traceback."""
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from .. import __version__
+from ..apps.package import bundled_schemas, project_root
 from ..backends.python.writer import generate
 from ..errors import BattgenError
 from ..frontends.loader import load
 from ..ir import Schema
 from ..ir import json_form as irjson
-from . import COMMAND_MODULES
+from . import convert, docs, failsafe, params, schema, validate
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
-
-
-def project_root() -> Path:
-    """The checkout holding schemas/ and generated/ (the current folder, else this package's parent)."""
-    cwd = Path.cwd()
-    if (cwd / "schemas").is_dir():
-        return cwd
-    return Path(__file__).resolve().parents[2]
-
-
-def _default_schemas() -> list[Path]:
-    return [project_root() / "schemas"]
+COMMAND_MODULES = (validate, docs, schema, convert, params, failsafe)  # in the order of the help text
 
 
 def _load(paths: Sequence[str]) -> Schema:
-    return load([Path(p) for p in paths] if paths else _default_schemas())
+    return load([Path(p) for p in paths] if paths else [bundled_schemas()])
 
 
 def cmd_list(args: argparse.Namespace) -> int:
@@ -107,8 +96,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--check", action="store_true", help="write nothing; exit 1 naming stale files")
     p.set_defaults(func=cmd_generate)
 
-    for name in COMMAND_MODULES:
-        importlib.import_module(name).register(sub)
+    for module in COMMAND_MODULES:
+        module.register(sub)
     return parser
 
 

@@ -14,18 +14,15 @@ Exit codes: 0 ok (warnings allowed), 1 the check found errors, 2 unreadable inpu
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
 from pathlib import Path
 from typing import Any
 
-from ..apps.failsafe.checks import CELL_RANGES, check_params
-from ..apps.param_proposal import Result, propose
+from ..apps.failsafe.checks import CELL_RANGES
+from ..apps.param_files import check_param_file, check_proposals, propose_from_devicetree, render
 from ..errors import BattgenError
-from ..inputs import paramfile
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
-BATTERY_COMPATIBLE = "simple-battery"
 
 
 def register(subparsers: Any) -> None:
@@ -53,11 +50,17 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.check:
         return _check(Path(args.check), args.cells, args.chemistry)
-    result, source = from_devicetree(Path(args.from_devicetree), args)
+    result, source = propose_from_devicetree(
+        Path(args.from_devicetree),
+        node=args.node,
+        cells=args.cells,
+        low_soc=args.low_soc,
+        critical_soc=args.critical_soc,
+        table=args.ocv_table,
+        mah_thresholds=args.mah_thresholds,
+    )
     text = render(result, source, args.format)
-    for finding in check_params(
-        {p.name: p.value for p in result.proposals}, cells=result.cells, chemistry=result.chemistry
-    ):
+    for finding in check_proposals(result):
         print(f"battgen: {finding.severity}: {finding.message}", file=sys.stderr)
     if args.out:
         try:
@@ -69,78 +72,12 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _battery_message() -> Any:
-    from ..frontends import devicetree
-    from .main import project_root
-
-    schema = devicetree.parse_dir(project_root() / "schemas" / "devicetree")
-    return schema.message("devicetree.power.supply.battery")
-
-
-def from_devicetree(path: Path, args: argparse.Namespace) -> tuple[Result, str]:
-    from ..inputs import devicetree as dts
-
-    nodes = dts.read_nodes(path)
-    batteries = dts.find_compatible(nodes, BATTERY_COMPATIBLE)
-    if args.node:
-        batteries = [n for n in batteries if n.path == args.node or args.node in n.labels]
-    if not batteries:
-        wanted = f" at {args.node}" if args.node else ""
-        raise BattgenError(f'{path}: expected a compatible = "{BATTERY_COMPATIBLE}" node{wanted}')
-    node = batteries[0]
-    props = dts.node_to_model_dict(node, _battery_message())
-    file = node.file or path.as_posix()
-    lines = {name: f"{Path(v.file or file).name}:{v.line}" for name, v in node.properties.items() if v.line}
-    where = f"{file}:{node.line} ({node.path})"
-    result = propose(
-        props,
-        where=where,
-        lines=lines,
-        cells=args.cells,
-        low_soc=args.low_soc,
-        critical_soc=args.critical_soc,
-        table=args.ocv_table,
-        mah_thresholds=args.mah_thresholds,
-    )
-    return result, f"{Path(file).name}:{node.line} ({node.path}, {BATTERY_COMPATIBLE})"
-
-
-def render(result: Result, source: str, fmt: str) -> str:
-    header = [f"Battery failsafe parameters proposed by battgen from {source}", *result.notes]
-    if fmt == "qgc":
-        from generated.params import BattParams
-
-        types = {f.name: f.metadata["type"] for f in dataclasses.fields(BattParams)}
-        items = [(p.name, p.value, paramfile.TYPE_OF.get(types.get(p.name, "float32"), 9)) for p in result.proposals]
-        header += [f"{p.name}: {p.comment}" for p in result.proposals]
-        return paramfile.write_qgc(items, header=header)
-    return paramfile.write_param([(p.name, p.value, p.comment) for p in result.proposals], header=header)
-
-
 def _check(path: Path, cells: int | None, chemistry: str) -> int:
-    from generated._meta import DataError
-    from generated.params import BattParams
-
     display = path.as_posix()
-    entries = paramfile.load(path, display)
-    lines = {e.name: e.line for e in entries}
-    errors = warnings = 0
-    for first, values in paramfile.read_param_file(path):
-        batt = paramfile.select(values, BattParams)
-        try:
-            model = BattParams.from_dict(batt)
-        except DataError as exc:
-            print(f"{display}:{lines.get(exc.path, first)}: error: {exc}")
-            errors += 1
-            continue
-        for f in dataclasses.fields(BattParams):
-            value, lo, hi = getattr(model, f.name), f.metadata["minimum"], f.metadata["maximum"]
-            if (lo is not None and value < lo) or (hi is not None and value > hi):
-                print(f"{display}:{lines.get(f.name, first)}: error: {f.name} is {value:g}: expected {lo:g} to {hi:g}")
-                errors += 1
-        for finding in check_params(model.to_dict(), cells=cells, chemistry=chemistry):
-            print(f"{display}:{lines.get(finding.param, first)}: {finding.severity}: {finding.message}")
-            errors += finding.severity == "error"
-            warnings += finding.severity == "warning"
+    findings = check_param_file(path, cells=cells, chemistry=chemistry)
+    for f in findings:
+        print(f"{display}:{f.line}: {f.severity}: {f.message}")
+    errors = sum(f.severity == "error" for f in findings)
+    warnings = sum(f.severity == "warning" for f in findings)
     print(f"{display}: {errors} errors, {warnings} warnings", file=sys.stderr)
     return EXIT_ERRORS if errors else EXIT_OK

@@ -13,11 +13,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..apps.models import resolve_message
+from ..apps.messages import resolve_message
+from ..apps.package import bundled_schemas
 from ..backends.json_schema import export_all, message_json_schema
 from ..errors import BattgenError
 from ..frontends.loader import load
-from .main import project_root
 
 
 def _dumps(doc: Any) -> str:
@@ -25,7 +25,7 @@ def _dumps(doc: Any) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    schema = load([Path(args.schemas)] if args.schemas else [project_root() / "schemas"])
+    schema = load([Path(args.schemas)] if args.schemas else [bundled_schemas()])
     if args.message:
         sys.stdout.write(_dumps(message_json_schema(schema, resolve_message(schema, args.message))))
         return 0

@@ -2,22 +2,30 @@
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Iterable
 from pathlib import Path
-from types import ModuleType
+from typing import Protocol
 
 from ..errors import BattgenError, SchemaError
 from ..ir import EnumDef, Schema
-from . import rules
+from . import devicetree, dsdl, mavlink, pdef, rules, uorb
 
-# schema folder layout: one sub-folder per format, each handled by one frontend module
-FORMAT_FRONTENDS: dict[str, str] = {
-    "uorb": "codegen.frontends.uorb",
-    "dronecan": "codegen.frontends.dsdl",
-    "devicetree": "codegen.frontends.devicetree",
-    "mavlink": "codegen.frontends.mavlink",
-    "params": "codegen.frontends.pdef",
+
+class Frontend(Protocol):
+    """What a format's frontend package offers: a folder of its files, or one file, parsed into IR."""
+
+    def parse_dir(self, root: Path, /) -> Schema: ...
+
+    def parse_file(self, path: Path, /, *, root: Path | None = None) -> Schema: ...
+
+
+# schema folder layout: one sub-folder per format, each handled by one frontend package
+FORMAT_FRONTENDS: dict[str, Frontend] = {
+    "uorb": uorb,
+    "dronecan": dsdl,
+    "devicetree": devicetree,
+    "mavlink": mavlink,
+    "params": pdef,  # ArduPilot parameter metadata (apm.pdef.xml)
 }
 
 # converter mappings between the formats (schemas/mappings/*.yaml), parsed after the formats
@@ -35,8 +43,8 @@ EXTENSION_FORMATS: dict[str, str] = {
 }
 
 
-def frontend(fmt: str) -> ModuleType:
-    return importlib.import_module(FORMAT_FRONTENDS[fmt])
+def frontend(fmt: str) -> Frontend:
+    return FORMAT_FRONTENDS[fmt]
 
 
 def format_of_file(path: Path) -> str:

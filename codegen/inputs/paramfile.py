@@ -9,6 +9,7 @@ Every error names file and line and says what was expected.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
@@ -90,23 +91,29 @@ def load(path: Path, display: str | None = None) -> list[ParamEntry]:
     return parse_text(text, shown, qgc=qgc)
 
 
-def read_param_file(path: Path) -> Iterator[tuple[int, dict[str, Value]]]:
-    """One instance per parameter set: ``(line of its first parameter, {NAME: value})``.
+def sets(entries: Iterable[ParamEntry]) -> dict[tuple[int | None, int | None], list[ParamEntry]]:
+    """The entries by parameter set: a .param file is one set (key ``(None, None)``); a QGC
+    .params file holds one per (vehicle, component) pair, in order of first appearance."""
+    groups: dict[tuple[int | None, int | None], list[ParamEntry]] = {}
+    for entry in entries:
+        groups.setdefault((entry.vehicle, entry.component), []).append(entry)
+    return groups
 
-    A .param file is one set; a QGC .params file holds one set per (vehicle, component) pair,
-    yielded in order of first appearance. Feed a set to a generated model through :func:`select`
-    (e.g. ``BattParams.from_dict(select(values, BattParams))``)."""
-    groups: dict[tuple[int | None, int | None], tuple[int, dict[str, Value]]] = {}
-    for e in load(path):
-        groups.setdefault((e.vehicle, e.component), (e.line, {}))[1][e.name] = e.value
-    yield from groups.values()
+
+def value_sets(entries: Iterable[ParamEntry]) -> list[tuple[int, dict[str, Value]]]:
+    """One item per parameter set (see :func:`sets`): ``(line of its first parameter, {NAME: value})``."""
+    return [(group[0].line, {e.name: e.value for e in group}) for group in sets(entries).values()]
+
+
+def read_param_file(path: Path) -> Iterator[tuple[int, dict[str, Value]]]:
+    """One instance per parameter set of a file, as :func:`value_sets`. Feed a set to a generated
+    model through :func:`select` (e.g. ``BattParams.from_dict(select(values, BattParams))``)."""
+    yield from value_sets(load(path))
 
 
 def select(values: Mapping[str, Value], model: type | Iterable[str]) -> dict[str, Value]:
     """The parameters a model (a generated class, or field names) knows, dropping the rest of a full dump."""
     if isinstance(model, type):
-        import dataclasses
-
         names = {f.metadata.get("name", f.name) for f in dataclasses.fields(model)}
     else:
         names = set(model)

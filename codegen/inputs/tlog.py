@@ -23,11 +23,12 @@ import mmap
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO
 
-from ..ir import Message
-from .records import InstanceError, Item, Notice, Record
-from .ulog import runtime
+from .model import Frame, GeneratedMessage, MavlinkClass, mavlink_runtime
+from .records import InputError, Item, Notice, Record
+
+Buffer = bytes | mmap.mmap  # a whole .tlog: the file mapped, or the bytes of a stream
 
 CHUNK = 1 << 16
 MAGIC_V1, MAGIC_V2 = 0xFE, 0xFD
@@ -81,8 +82,8 @@ class FrameRecord:
     number: int  # 0-based among the wanted message's frames
     offset: int | None  # of the tlog entry (its timestamp); None in a raw stream
     timestamp: int | None  # tlog time, microseconds since the Unix epoch
-    frame: Any  # the generated runtime's Frame
-    instance: Any
+    frame: Frame
+    instance: GeneratedMessage
 
     def where(self, name: str) -> str:
         f = self.frame
@@ -101,7 +102,7 @@ class FrameRecord:
         return out
 
 
-def _frame_length(data: Any, start: int, end: int) -> tuple[int, int] | None:
+def _frame_length(data: Buffer, start: int, end: int) -> tuple[int, int] | None:
     """(total length, message id) of the frame whose header starts at ``start``, if it is whole."""
     magic = data[start]
     if magic == MAGIC_V2:
@@ -119,10 +120,10 @@ def _is_magic(byte: int) -> bool:
     return byte == MAGIC_V1 or byte == MAGIC_V2
 
 
-def tlog_frames(data: Any, model: Any, stats: StreamStats) -> Iterator[FrameRecord]:
+def tlog_frames(data: Buffer, model: MavlinkClass, stats: StreamStats) -> Iterator[FrameRecord]:
     """The frames of ``model``'s message in a .tlog held in ``data`` (bytes or an mmap)."""
-    rt = runtime(model, "_mavlink")
-    msgid: int = model.MSG_ID
+    rt = mavlink_runtime(model)
+    msgid = model.MSG_ID
     end = len(data)
     pos = 0
     while pos < end:
@@ -160,7 +161,7 @@ def tlog_frames(data: Any, model: Any, stats: StreamStats) -> Iterator[FrameReco
         pos = _resync(data, pos, end, stats)
 
 
-def _resync(data: Any, pos: int, end: int, stats: StreamStats) -> int:
+def _resync(data: Buffer, pos: int, end: int, stats: StreamStats) -> int:
     """The next entry start after garbage at ``pos`` (``end`` when there is none)."""
     cand = pos + 1
     while cand + _STAMP < end:
@@ -172,7 +173,9 @@ def _resync(data: Any, pos: int, end: int, stats: StreamStats) -> int:
     return end
 
 
-def _decode(frame: Any, model: Any, stats: StreamStats, offset: int | None, stamp: int | None) -> FrameRecord | None:
+def _decode(
+    frame: Frame, model: MavlinkClass, stats: StreamStats, offset: int | None, stamp: int | None
+) -> FrameRecord | None:
     try:
         obj = model.decode(frame.payload)
     except ValueError as exc:  # DecodeError: a payload longer than the message
@@ -183,10 +186,10 @@ def _decode(frame: Any, model: Any, stats: StreamStats, offset: int | None, stam
     return FrameRecord(stats.records - 1, offset, stamp, frame, obj)
 
 
-def raw_frames(stream: IO[bytes], model: Any, stats: StreamStats) -> Iterator[FrameRecord]:
+def raw_frames(stream: IO[bytes], model: MavlinkClass, stats: StreamStats) -> Iterator[FrameRecord]:
     """The frames of ``model``'s message in a raw MAVLink byte stream, read in CHUNK pieces."""
-    rt = runtime(model, "_mavlink")
-    msgid: int = model.MSG_ID
+    rt = mavlink_runtime(model)
+    msgid = model.MSG_ID
     parser = rt.StreamParser()
     seen = 0
     while True:
@@ -208,7 +211,7 @@ def raw_frames(stream: IO[bytes], model: Any, stats: StreamStats) -> Iterator[Fr
     if parser.last_error:
         stats.problems.append(parser.last_error)
     if seen and not (parser.frames or parser.unknown_msgid or parser.bad_crc):
-        raise InstanceError("", 0, f"expected a MAVLink byte stream: no frame in {seen} bytes")
+        raise InputError("", 0, f"expected a MAVLink byte stream: no frame in {seen} bytes")
 
 
 def _open_map(path: Path, name: str) -> mmap.mmap | bytes:
@@ -218,26 +221,26 @@ def _open_map(path: Path, name: str) -> mmap.mmap | bytes:
                 return b""
             return mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
     except OSError as exc:
-        raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
 
 
 def read_frames(
-    path: Path | IO[bytes], name: str, model: Any, stats: StreamStats, *, timestamps: bool
+    path: Path | IO[bytes], name: str, model: MavlinkClass, stats: StreamStats, *, timestamps: bool
 ) -> Iterator[FrameRecord]:
     """The wanted frames of a .tlog (``timestamps``) or raw stream, from a path or a binary stream.
-    Raises InstanceError (naming ``name``) when nothing in a non-empty input is MAVLink."""
+    Raises InputError (naming ``name``) when nothing in a non-empty input is MAVLink."""
     if not timestamps:
         if isinstance(path, Path):
             try:
                 stream: IO[bytes] = path.open("rb")
             except OSError as exc:
-                raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+                raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
         else:
             stream = path
         try:
             yield from raw_frames(stream, model, stats)
-        except InstanceError as exc:
-            raise InstanceError(name, 0, exc.message) from None
+        except InputError as exc:
+            raise InputError(name, 0, exc.message) from None
         finally:
             if isinstance(path, Path):
                 stream.close()
@@ -250,29 +253,31 @@ def read_frames(
         if isinstance(data, mmap.mmap):
             data.close()
     if size and not (stats.records or stats.other_frames or stats.bad_crc or stats.decode_errors):
-        raise InstanceError(
+        raise InputError(
             name, 0, "expected a MAVLink telemetry log: no 8-byte timestamp followed by a MAVLink frame found"
         )
 
 
-def mavlink_items(path: Path, name: str, message: Message, model: Any, *, timestamps: bool) -> Iterator[Item]:
-    """validate's records of a .tlog or raw MAVLink file, then the damage summary."""
-    stats = StreamStats()
-    for rec in read_frames(path, name, model, stats, timestamps=timestamps):
-        yield Record(
-            rec.number,
-            0,
-            None,
-            name,
-            where=rec.where(message.name),
-            instance=rec.instance,
-            location=rec.location(),
-        )
-    yield stats_notice(name, message, stats)
+def message_name(model: MavlinkClass) -> str:
+    """The MAVLink name of a generated class's message (``BATTERY_STATUS``)."""
+    return model.QUALIFIED_NAME.rpartition(".")[2]
 
 
-def stats_notice(name: str, message: Message, stats: StreamStats) -> Notice:
-    text = stats.summary(message.name)
+def mavlink_items(
+    source: Path | IO[bytes], name: str, model: MavlinkClass, *, timestamps: bool, stats: StreamStats | None = None
+) -> Iterator[Item]:
+    """The records of a .tlog (``timestamps``) or raw MAVLink input, then the damage summary as a
+    notice (``stats``, when given, holds the counts for the caller as well)."""
+    stats = stats if stats is not None else StreamStats()
+    what = message_name(model)
+    for rec in read_frames(source, name, model, stats, timestamps=timestamps):
+        yield Record(rec.number, 0, None, name, where=rec.where(what), instance=rec.instance, location=rec.location())
+    yield stats_notice(name, what, stats)
+
+
+def stats_notice(name: str, what: str, stats: StreamStats) -> Notice:
+    """The summary of a MAVLink input: a warning when it was damaged, else for the JSON report only."""
+    text = stats.summary(what)
     if stats.problems:
         text += f" (last problem: {stats.problems[-1]})"
     return Notice(name, text, "stream", "warning" if stats.damaged else "info", stats.to_dict())

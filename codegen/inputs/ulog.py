@@ -14,16 +14,14 @@ records, once the walk has seen the whole file.
 
 from __future__ import annotations
 
-import importlib
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from types import ModuleType
-from typing import IO, Any
+from typing import IO
 
-from ..ir import Message
-from .records import InstanceError, Item, Notice, Record, Unreadable
+from .model import FormatDiff, GeneratedMessage, MessageClass, UorbClass, ulog_runtime
+from .records import InputError, Item, Notice, Record, Unreadable
 
 MAX_DAMAGE_NOTICES = 10
 
@@ -36,7 +34,7 @@ class LogRecord:
     multi_id: int
     offset: int
     timestamp: int | None
-    instance: Any
+    instance: GeneratedMessage
     skip: frozenset[str]
 
     def where(self) -> str:
@@ -47,13 +45,7 @@ class LogRecord:
         return {"topic": self.topic, "multi_id": self.multi_id, "timestamp_us": self.timestamp, "offset": self.offset}
 
 
-def runtime(model: Any, name: str) -> ModuleType:
-    """The generated package's runtime module ``name`` (``_ulog``, ``_mavlink``) of a model class."""
-    package = model.__module__.rpartition(".")[0]
-    return importlib.import_module(f"{package}.{name}")
-
-
-def _diff_line(diff: Any) -> str:
+def _diff_line(diff: FormatDiff) -> str:
     parts = []
     if diff.missing:
         parts.append("missing from the log: " + ", ".join(f"{n} {t}" for n, t in diff.missing))
@@ -73,19 +65,20 @@ class UlogReader:
     records() is exhausted.
     """
 
-    def __init__(self, source: Path | IO[bytes], name: str, model: Any) -> None:
+    def __init__(self, source: Path | IO[bytes], name: str, model: MessageClass) -> None:
         self.name = name
         self.model = model
-        self.ulog = runtime(model, "_ulog")
+        self.ulog = ulog_runtime(model)
         if isinstance(source, Path):
             _check_file(source, name)
         try:
             self.log = self.ulog.read(source, index=False, warn=False)  # damage: listed in Log.warnings
         except OSError as exc:
-            raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+            raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
         except (ValueError, struct.error, IndexError) as exc:  # ULogError is a ValueError
-            raise InstanceError(name, 0, f"expected a ULog file: {exc}") from None
-        self.topics = tuple(getattr(model, "UORB_TOPICS", ()) or (self.ulog.format_of(model).name,))
+            raise InputError(name, 0, f"expected a ULog file: {exc}") from None
+        topics = model.UORB_TOPICS if isinstance(model, UorbClass) else ()
+        self.topics = tuple(topics or (self.ulog.format_of(model).name,))
         self.notices: list[Notice] = []
         self.trailing: list[Notice] = []  # filled once records() has walked the whole log
         self.skips: dict[str, frozenset[str]] = {}  # decodable topics -> fields left unchecked
@@ -127,7 +120,9 @@ class UlogReader:
         try:
             for rec in self.log.iter_records(self.model, topic=list(skips)):
                 skip = skips[rec.topic]
-                stamp = getattr(rec.instance, "timestamp", None) if "timestamp" not in skip else None
+                stamp = (
+                    getattr(rec.instance, "timestamp", None) if "timestamp" not in skip else None
+                )  # not every topic has one
                 yield LogRecord(
                     rec.topic, rec.multi_id, rec.offset, stamp if isinstance(stamp, int) else None, rec.instance, skip
                 )
@@ -155,15 +150,15 @@ class UlogReader:
 def _check_file(path: Path, name: str) -> None:
     try:
         if path.is_file() and path.stat().st_size == 0:
-            raise InstanceError(name, 0, "empty file: expected a ULog file")
+            raise InputError(name, 0, "empty file: expected a ULog file")
     except OSError as exc:
-        raise InstanceError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
 
 
-def ulog_items(path: Path, name: str, message: Message, model: Any) -> Iterator[Item]:
-    """validate's records of a .ulg file: notices first, then one record per logged message, then
-    the notices of the whole walk (damage recovered from, no records of the message)."""
-    reader = UlogReader(path, name, model)  # raises InstanceError before the first item
+def ulog_items(source: Path | IO[bytes], name: str, model: MessageClass) -> Iterator[Item]:
+    """The records of a .ulg file: notices first, then one record per logged message, then the
+    notices of the whole walk (damage recovered from, no records of the message)."""
+    reader = UlogReader(source, name, model)  # raises InputError before the first item
     return _items(reader)
 
 

@@ -1,47 +1,58 @@
 """The intermediate representation (IR): frontends produce it, backends consume it.
 
-The model lives in :mod:`.model`; this package face re-exports it so that users write
-``from codegen.ir import Message``.
+The model is split by concern (``basics``, ``fieldtypes``, ``fields``, ``messages``, ``mappings`` with
+``ops``, ``schema`` with ``expr``); this package face re-exports it so that users write
+``from codegen.ir import Message``. ``json_form`` is the IR as JSON (``battgen ir``), ``units`` the one unit registry.
 """
 
-from .model import (
-    CONCEPTS_ENDPOINT,
-    ArrayType,
-    CastMode,
-    Column,
-    CompositeType,
-    Concept,
+from .basics import (
+    Location,
+    SourceFormat,
+    Unit,
+)
+from .fields import (
     Constant,
-    CrossFieldRule,
-    DevicetreeInfo,
-    DronecanInfo,
-    DronecanKind,
-    Endpoint,
     EnumDef,
     EnumEntry,
     EnumKind,
     Field,
-    FieldRef,
+    Sentinel,
+)
+from .fieldtypes import (
+    ArrayType,
+    CastMode,
+    Column,
+    CompositeType,
     FieldType,
-    Location,
-    Mapping,
-    MappingSet,
-    MavlinkInfo,
-    Message,
-    Param,
-    ParamsInfo,
-    ParamValue,
     PrimitiveKind,
     PrimitiveType,
     Range,
-    Rule,
-    Schema,
-    Sentinel,
-    SourceFormat,
     StringType,
+)
+from .mappings import (
+    CONCEPTS_ENDPOINT,
+    Concept,
+    Direction,
+    Endpoint,
+    FieldRef,
+    Mapping,
+    MappingSet,
+    Rule,
+)
+from .messages import (
+    DevicetreeInfo,
+    DronecanInfo,
+    DronecanKind,
+    MavlinkInfo,
+    Message,
+    ParamsInfo,
     StructSlot,
-    Unit,
     UorbInfo,
+)
+from .ops import MappingOp
+from .schema import (
+    CrossFieldRule,
+    Schema,
 )
 
 __all__ = [
@@ -54,6 +65,7 @@ __all__ = [
     "Constant",
     "CrossFieldRule",
     "DevicetreeInfo",
+    "Direction",
     "DronecanInfo",
     "DronecanKind",
     "Endpoint",
@@ -65,11 +77,10 @@ __all__ = [
     "FieldType",
     "Location",
     "Mapping",
+    "MappingOp",
     "MappingSet",
     "MavlinkInfo",
     "Message",
-    "Param",
-    "ParamValue",
     "ParamsInfo",
     "PrimitiveKind",
     "PrimitiveType",

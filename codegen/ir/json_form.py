@@ -9,12 +9,13 @@ from __future__ import annotations
 import dataclasses
 import enum
 import json
-import math
 from functools import cache
 from importlib import resources
 from typing import Any
 
-from . import model as ir
+from .. import ir
+from .mapping_json import rule_json
+from .numbers import to_json_number
 
 # The members of the FieldType union carry a "form" tag so the JSON form is self-describing.
 _TYPE_TAGS: dict[type, str] = {
@@ -25,14 +26,6 @@ _TYPE_TAGS: dict[type, str] = {
 }
 
 
-def _number(value: float) -> float | str:
-    if math.isnan(value):
-        return "NaN"
-    if math.isinf(value):
-        return "Infinity" if value > 0 else "-Infinity"
-    return value
-
-
 def to_jsonable(obj: object) -> Any:
     """Turn an IR object (or tuple of them) into plain JSON data."""
     if isinstance(obj, enum.Enum):
@@ -40,16 +33,19 @@ def to_jsonable(obj: object) -> Any:
     if isinstance(obj, bool) or obj is None or isinstance(obj, (int, str)):
         return obj
     if isinstance(obj, float):
-        return _number(obj)
+        return to_json_number(obj)
     if isinstance(obj, tuple | list):
         return [to_jsonable(item) for item in obj]
+    if isinstance(obj, ir.Rule):  # a typed op, written as its mapping file spelled it
+        return rule_json(obj, to_jsonable)
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         out: dict[str, Any] = {}
         tag = _TYPE_TAGS.get(type(obj))
         if tag is not None:
             out["form"] = tag
         for f in dataclasses.fields(obj):
-            out[f.name] = to_jsonable(getattr(obj, f.name))
+            if f.metadata.get("json_form", True):  # parsed forms (rule expressions) show as their text
+                out[f.name] = to_jsonable(getattr(obj, f.name))
         if isinstance(obj, ir.PrimitiveType):
             out["name"] = obj.name
         return out

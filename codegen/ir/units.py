@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 
-from .model import Unit
+from .basics import Unit
 
 _C_PER_AH = 3600.0  # coulombs in one ampere-hour
 _J_PER_WH = 3600.0

@@ -1,4 +1,4 @@
-"""Helpers shared by the frontends."""
+"""Reading a text file as UTF-8 with errors at a file and line, and the path that names it in IR locations."""
 
 from __future__ import annotations
 

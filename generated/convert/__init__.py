@@ -11,29 +11,52 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from . import devicetree, dronecan, dronecan_devicetree, dronecan_mavlink, dronecan_uorb, dronecan_uorb_v0, mavlink, mavlink_devicetree, uorb, uorb_devicetree, uorb_mavlink, uorb_uorb_v0, uorb_v0, uorb_v0_devicetree, uorb_v0_mavlink
+from ..devicetree.power.supply import SimpleBattery
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
+from ..mavlink import BatteryStatus as MavlinkBatteryStatus
+from ..uorb import BatteryStatus as UorbBatteryStatus
+from ..uorb import BatteryStatusV0
+from . import (
+    devicetree,
+    dronecan,
+    dronecan_devicetree,
+    dronecan_mavlink,
+    dronecan_uorb,
+    dronecan_uorb_v0,
+    mavlink,
+    mavlink_devicetree,
+    uorb,
+    uorb_devicetree,
+    uorb_mavlink,
+    uorb_uorb_v0,
+    uorb_v0,
+    uorb_v0_devicetree,
+    uorb_v0_mavlink,
+)
 from ._concepts import BatteryState
 from ._runtime import ConversionError, LossEntry, LossReport
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _E0
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _E1
-from ..uorb import BatteryStatus as _E2
-from ..uorb import BatteryStatusV0 as _E3
-from ..mavlink import BatteryStatus as _E4
-from ..devicetree.power.supply import SimpleBattery as _E5
 
 __all__ = [
-    'CONVERTERS', 'ENDPOINTS', 'INPUTS', 'POLICIES',
-    'BatteryState', 'ConversionError', 'LossEntry', 'LossReport', 'converter',
+    "CONVERTERS",
+    "ENDPOINTS",
+    "INPUTS",
+    "POLICIES",
+    "BatteryState",
+    "ConversionError",
+    "LossEntry",
+    "LossReport",
+    "converter",
 ]
 
 # each endpoint's objects in order: the first required, the rest optional companions
 ENDPOINTS: dict[str, tuple[tuple[str, type[Any]], ...]] = {
-    "dronecan": (("info", _E0), ("aux", _E1),),
-    "uorb": (("status", _E2),),
-    "uorb_v0": (("status", _E3),),
-    "mavlink": (("msg", _E4),),
-    "devicetree": (("node", _E5),),
-    "concepts": (('state', BatteryState),),
+    "dronecan": (("info", BatteryInfo), ("aux", BatteryInfoAux)),
+    "uorb": (("status", UorbBatteryStatus),),
+    "uorb_v0": (("status", BatteryStatusV0),),
+    "mavlink": (("msg", MavlinkBatteryStatus),),
+    "devicetree": (("node", SimpleBattery),),
+    "concepts": (("state", BatteryState),),
 }
 
 CONVERTERS: dict[tuple[str, str], Callable[..., Any]] = {
@@ -105,6 +128,6 @@ def converter(source: str, target: str) -> Callable[..., Any]:
     """The converter from ``source`` to ``target`` (endpoint names), or ConversionError."""
     found = CONVERTERS.get((source, target))
     if found is None:
-        pairs = ', '.join(f'{s}->{t}' for s, t in sorted(CONVERTERS))
-        raise ConversionError(f'no converter from {source!r} to {target!r} (known: {pairs})')
+        pairs = ", ".join(f"{s}->{t}" for s, t in sorted(CONVERTERS))
+        raise ConversionError(f"no converter from {source!r} to {target!r} (known: {pairs})")
     return found

@@ -18,9 +18,98 @@ from . import _runtime as _r
 class BatteryState:
     """One battery's state in the shared concepts (see schemas/mappings/concepts.yaml)."""
 
-    UNITS: ClassVar[dict[str, str | None]] = {"connected": None, "in_use": None, "charging": None, "pack_voltage": "V", "current": "A", "average_current": "A", "max_current": "A", "average_power": "W", "temperature": "K", "state_of_charge": "1", "state_of_charge_stdev": "1", "state_of_health": "1", "remaining_energy": "J", "full_energy": "J", "design_energy": "J", "full_capacity": "C", "design_capacity": "C", "discharged": "C", "consumed_energy": "J", "time_remaining": "s", "time_to_full": "s", "cell_voltages": "V", "cell_count": None, "cycle_count": None, "over_discharge_count": None, "nominal_voltage": "V", "voltage_min_design": "V", "voltage_max_design": "V", "battery_index": None, "serial_number": None, "model_name": None, "is_powering_off": None, "chemistry": None, "warning": None, "faults": None}
-    KINDS: ClassVar[dict[str, str]] = {"connected": "bool", "in_use": "bool", "charging": "bool", "pack_voltage": "number", "current": "number", "average_current": "number", "max_current": "number", "average_power": "number", "temperature": "number", "state_of_charge": "number", "state_of_charge_stdev": "number", "state_of_health": "number", "remaining_energy": "number", "full_energy": "number", "design_energy": "number", "full_capacity": "number", "design_capacity": "number", "discharged": "number", "consumed_energy": "number", "time_remaining": "number", "time_to_full": "number", "cell_voltages": "list", "cell_count": "integer", "cycle_count": "integer", "over_discharge_count": "integer", "nominal_voltage": "number", "voltage_min_design": "number", "voltage_max_design": "number", "battery_index": "integer", "serial_number": "integer", "model_name": "text", "is_powering_off": "bool", "chemistry": "choice", "warning": "choice", "faults": "flags"}
-    CHOICES: ClassVar[dict[str, tuple[str, ...]]] = {"chemistry": ("lipo", "lion", "life", "nimh", "nicd", "limn"), "warning": ("none", "low", "critical", "emergency", "failed", "unhealthy", "charging"), "faults": ("deep_discharge", "spikes", "cell_fail", "over_current", "over_temperature", "under_temperature", "incompatible_voltage", "incompatible_firmware", "incompatible_model", "hardware_failure", "failed_to_arm", "incompatible_cells_configuration")}
+    UNITS: ClassVar[dict[str, str | None]] = {
+        "connected": None,
+        "in_use": None,
+        "charging": None,
+        "pack_voltage": "V",
+        "current": "A",
+        "average_current": "A",
+        "max_current": "A",
+        "average_power": "W",
+        "temperature": "K",
+        "state_of_charge": "1",
+        "state_of_charge_stdev": "1",
+        "state_of_health": "1",
+        "remaining_energy": "J",
+        "full_energy": "J",
+        "design_energy": "J",
+        "full_capacity": "C",
+        "design_capacity": "C",
+        "discharged": "C",
+        "consumed_energy": "J",
+        "time_remaining": "s",
+        "time_to_full": "s",
+        "cell_voltages": "V",
+        "cell_count": None,
+        "cycle_count": None,
+        "over_discharge_count": None,
+        "nominal_voltage": "V",
+        "voltage_min_design": "V",
+        "voltage_max_design": "V",
+        "battery_index": None,
+        "serial_number": None,
+        "model_name": None,
+        "is_powering_off": None,
+        "chemistry": None,
+        "warning": None,
+        "faults": None,
+    }
+    KINDS: ClassVar[dict[str, str]] = {
+        "connected": "bool",
+        "in_use": "bool",
+        "charging": "bool",
+        "pack_voltage": "number",
+        "current": "number",
+        "average_current": "number",
+        "max_current": "number",
+        "average_power": "number",
+        "temperature": "number",
+        "state_of_charge": "number",
+        "state_of_charge_stdev": "number",
+        "state_of_health": "number",
+        "remaining_energy": "number",
+        "full_energy": "number",
+        "design_energy": "number",
+        "full_capacity": "number",
+        "design_capacity": "number",
+        "discharged": "number",
+        "consumed_energy": "number",
+        "time_remaining": "number",
+        "time_to_full": "number",
+        "cell_voltages": "list",
+        "cell_count": "integer",
+        "cycle_count": "integer",
+        "over_discharge_count": "integer",
+        "nominal_voltage": "number",
+        "voltage_min_design": "number",
+        "voltage_max_design": "number",
+        "battery_index": "integer",
+        "serial_number": "integer",
+        "model_name": "text",
+        "is_powering_off": "bool",
+        "chemistry": "choice",
+        "warning": "choice",
+        "faults": "flags",
+    }
+    CHOICES: ClassVar[dict[str, tuple[str, ...]]] = {
+        "chemistry": ("lipo", "lion", "life", "nimh", "nicd", "limn"),
+        "warning": ("none", "low", "critical", "emergency", "failed", "unhealthy", "charging"),
+        "faults": (
+            "deep_discharge",
+            "spikes",
+            "cell_fail",
+            "over_current",
+            "over_temperature",
+            "under_temperature",
+            "incompatible_voltage",
+            "incompatible_firmware",
+            "incompatible_model",
+            "hardware_failure",
+            "failed_to_arm",
+            "incompatible_cells_configuration",
+        ),
+    }
 
     connected: bool | None = None
     """A battery is attached and reporting."""
@@ -108,27 +197,27 @@ class BatteryState:
         for name, value in data.items():
             kind = cls.KINDS.get(name)
             if kind is None:
-                raise _r.ConversionError(f'{name}: not a battery concept')
+                raise _r.ConversionError(f"{name}: not a battery concept")
             choices = cls.CHOICES.get(name, ())
             setattr(obj, name, None if value is None else _coerce(name, kind, value, choices))
         return obj
 
 
 def _coerce(name: str, kind: str, value: Any, choices: tuple[str, ...]) -> Any:
-    if kind == 'number' and isinstance(value, int | float) and not isinstance(value, bool):
+    if kind == "number" and isinstance(value, int | float) and not isinstance(value, bool):
         return float(value)
-    if kind == 'number' and value in ('NaN', 'nan'):
+    if kind == "number" and value in ("NaN", "nan"):
         return math.nan
-    if kind == 'integer' and isinstance(value, int) and not isinstance(value, bool):
+    if kind == "integer" and isinstance(value, int) and not isinstance(value, bool):
         return value
-    if kind == 'bool' and isinstance(value, bool):
+    if kind == "bool" and isinstance(value, bool):
         return value
-    if kind == 'text' and isinstance(value, str):
+    if kind == "text" and isinstance(value, str):
         return value
-    if kind == 'choice' and value in choices:
+    if kind == "choice" and value in choices:
         return value
-    if kind == 'list' and isinstance(value, list | tuple):
-        return tuple(_coerce(name, 'number', v, ()) for v in value)
-    if kind == 'flags' and isinstance(value, list | tuple) and all(v in choices for v in value):
+    if kind == "list" and isinstance(value, list | tuple):
+        return tuple(_coerce(name, "number", v, ()) for v in value)
+    if kind == "flags" and isinstance(value, list | tuple) and all(v in choices for v in value):
         return tuple(c for c in choices if c in value)
-    raise _r.ConversionError(f'{name}: expected a {kind} value, got {value!r}')
+    raise _r.ConversionError(f"{name}: expected a {kind} value, got {value!r}")

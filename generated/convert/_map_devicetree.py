@@ -6,70 +6,153 @@ A simple-battery node describes a new pack, so its design figures are also its f
 
 from __future__ import annotations
 
-import math
-
+from ..devicetree.power.supply import SimpleBattery
 from . import _runtime as _r
 from ._concepts import BatteryState
-from ..devicetree.power.supply import SimpleBattery as _C0
+
+_CHEMISTRY_BY_DEVICE_CHEMISTRY = {
+    "lithium-ion": "lion",
+    "lithium-ion-polymer": "lipo",
+    "lithium-ion-iron-phosphate": "life",
+    "lithium-ion-manganese-oxide": "limn",
+    "nickel-metal-hydride": "nimh",
+    "nickel-cadmium": "nicd",
+}
+_CELL_CHARGED_V = {
+    "lithium-ion": 4.2,
+    "lithium-ion-polymer": 4.2,
+    "lithium-ion-iron-phosphate": 3.65,
+    "lithium-ion-manganese-oxide": 4.2,
+    "nickel-metal-hydride": 1.5,
+    "nickel-cadmium": 1.5,
+}
+_CELL_EMPTY_V = {
+    "lithium-ion": 3.0,
+    "lithium-ion-polymer": 3.0,
+    "lithium-ion-iron-phosphate": 2.5,
+    "lithium-ion-manganese-oxide": 3.0,
+    "nickel-metal-hydride": 1.0,
+    "nickel-cadmium": 1.0,
+}
+_CELL_NOMINAL_V = {
+    "lithium-ion": 3.6,
+    "lithium-ion-polymer": 3.7,
+    "lithium-ion-iron-phosphate": 3.2,
+    "lithium-ion-manganese-oxide": 3.7,
+    "nickel-metal-hydride": 1.2,
+    "nickel-cadmium": 1.2,
+}
+_UNREAD_NODE_FIELDS = (
+    ("compatible", "compatible"),
+    ("over_voltage_threshold_microvolt", "over-voltage-threshold-microvolt"),
+    ("re_charge_voltage_microvolt", "re-charge-voltage-microvolt"),
+    ("trickle_charge_current_microamp", "trickle-charge-current-microamp"),
+    ("tricklecharge_upper_limit_microvolt", "tricklecharge-upper-limit-microvolt"),
+    ("precharge_current_microamp", "precharge-current-microamp"),
+    ("precharge_upper_limit_microvolt", "precharge-upper-limit-microvolt"),
+    ("charge_term_current_microamp", "charge-term-current-microamp"),
+    ("constant_charge_current_max_microamp", "constant-charge-current-max-microamp"),
+    ("constant_charge_voltage_max_microvolt", "constant-charge-voltage-max-microvolt"),
+    ("factory_internal_resistance_micro_ohms", "factory-internal-resistance-micro-ohms"),
+    ("resistance_temp_table", "resistance-temp-table"),
+    ("operating_range_celsius", "operating-range-celsius"),
+    ("ambient_celsius", "ambient-celsius"),
+    ("alert_celsius", "alert-celsius"),
+    ("volt_drop_thresh_microvolt", "volt-drop-thresh-microvolt"),
+    ("volt_drop_soc_bp", "volt-drop-soc-bp"),
+    ("volt_drop_temperatures_millicelsius", "volt-drop-temperatures-millicelsius"),
+    ("volt_drop_n_microvolt", "^volt-drop-[0-9]-microvolt"),
+)
+_NODE_DEFAULTS = SimpleBattery()
 
 
-_K1_forward = dict((("lithium-ion", "lion"), ("lithium-ion-polymer", "lipo"), ("lithium-ion-iron-phosphate", "life"), ("lithium-ion-manganese-oxide", "limn"), ("nickel-metal-hydride", "nimh"), ("nickel-cadmium", "nicd"),))
-_K9_forward = dict((("lithium-ion", 4.2), ("lithium-ion-polymer", 4.2), ("lithium-ion-iron-phosphate", 3.65), ("lithium-ion-manganese-oxide", 4.2), ("nickel-metal-hydride", 1.5), ("nickel-cadmium", 1.5)))
-_K10_forward = dict((("lithium-ion", 3.0), ("lithium-ion-polymer", 3.0), ("lithium-ion-iron-phosphate", 2.5), ("lithium-ion-manganese-oxide", 3.0), ("nickel-metal-hydride", 1.0), ("nickel-cadmium", 1.0)))
-_K11_forward = dict((("lithium-ion", 3.6), ("lithium-ion-polymer", 3.7), ("lithium-ion-iron-phosphate", 3.2), ("lithium-ion-manganese-oxide", 3.7), ("nickel-metal-hydride", 1.2), ("nickel-cadmium", 1.2)))
-_K14_forward = (("compatible", "compatible"), ("over_voltage_threshold_microvolt", "over-voltage-threshold-microvolt"), ("re_charge_voltage_microvolt", "re-charge-voltage-microvolt"), ("trickle_charge_current_microamp", "trickle-charge-current-microamp"), ("tricklecharge_upper_limit_microvolt", "tricklecharge-upper-limit-microvolt"), ("precharge_current_microamp", "precharge-current-microamp"), ("precharge_upper_limit_microvolt", "precharge-upper-limit-microvolt"), ("charge_term_current_microamp", "charge-term-current-microamp"), ("constant_charge_current_max_microamp", "constant-charge-current-max-microamp"), ("constant_charge_voltage_max_microvolt", "constant-charge-voltage-max-microvolt"), ("factory_internal_resistance_micro_ohms", "factory-internal-resistance-micro-ohms"), ("resistance_temp_table", "resistance-temp-table"), ("operating_range_celsius", "operating-range-celsius"), ("ambient_celsius", "ambient-celsius"), ("alert_celsius", "alert-celsius"), ("volt_drop_thresh_microvolt", "volt-drop-thresh-microvolt"), ("volt_drop_soc_bp", "volt-drop-soc-bp"), ("volt_drop_temperatures_millicelsius", "volt-drop-temperatures-millicelsius"), ("volt_drop_n_microvolt", "^volt-drop-[0-9]-microvolt"))
-_K15_forward = _C0()
-
-
-def forward(s_node: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None, ocv_v: float | None = None, temperature_c: float | None = None) -> tuple[BatteryState]:
+def forward(
+    s_node: SimpleBattery,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+    ocv_v: float | None = None,
+    temperature_c: float | None = None,
+) -> tuple[BatteryState]:
     """devicetree -> concepts: returns the target objects as a tuple."""
     t = BatteryState()
-    _v2 = s_node.device_chemistry
-    t.chemistry = None if _v2 is None else _K1_forward.get(_v2)
-    if rep_d is not None and _v2 not in _K1_forward and _v2 not in (None, None,):
-        rep_d.dropped("devicetree.power.supply.battery.device-chemistry", '%r has no counterpart' % (_v2,))
-    _v3 = _r.dt_first(s_node.voltage_min_design_microvolt)
+
+    # devicetree.yaml:11: choice device-chemistry -> chemistry
+    _v1 = s_node.device_chemistry
+    t.chemistry = None if _v1 is None else _CHEMISTRY_BY_DEVICE_CHEMISTRY.get(_v1)
+    if rep_d is not None and _v1 not in _CHEMISTRY_BY_DEVICE_CHEMISTRY and _v1 not in (None, None):
+        rep_d.dropped("devicetree.power.supply.battery.device-chemistry", f"{_v1!r} has no counterpart")
+
+    # devicetree.yaml:21: scale voltage-min-design-microvolt -> voltage_min_design
+    _v2 = _r.dt_first(s_node.voltage_min_design_microvolt)
+    if _v2 is not None:
+        t.voltage_min_design = float(_v2) * 1e-06
+
+    # devicetree.yaml:22: scale voltage-max-design-microvolt -> voltage_max_design
+    _v3 = _r.dt_first(s_node.voltage_max_design_microvolt)
     if _v3 is not None:
-        t.voltage_min_design = float(_v3) * 1e-06
-    _v4 = _r.dt_first(s_node.voltage_max_design_microvolt)
+        t.voltage_max_design = float(_v3) * 1e-06
+
+    # devicetree.yaml:23: scale energy-full-design-microwatt-hours -> design_energy
+    _v4 = _r.dt_first(s_node.energy_full_design_microwatt_hours)
     if _v4 is not None:
-        t.voltage_max_design = float(_v4) * 1e-06
+        t.design_energy = float(_v4) * 0.0036
+
+    # devicetree.yaml:24: scale energy-full-design-microwatt-hours -> full_energy
     _v5 = _r.dt_first(s_node.energy_full_design_microwatt_hours)
     if _v5 is not None:
-        t.design_energy = float(_v5) * 0.0036
-    _v6 = _r.dt_first(s_node.energy_full_design_microwatt_hours)
+        t.full_energy = float(_v5) * 0.0036
+
+    # devicetree.yaml:25: scale charge-full-design-microamp-hours -> design_capacity
+    _v6 = _r.dt_first(s_node.charge_full_design_microamp_hours)
     if _v6 is not None:
-        t.full_energy = float(_v6) * 0.0036
+        t.design_capacity = float(_v6) * 0.0036
+
+    # devicetree.yaml:26: scale charge-full-design-microamp-hours -> full_capacity
     _v7 = _r.dt_first(s_node.charge_full_design_microamp_hours)
     if _v7 is not None:
-        t.design_capacity = float(_v7) * 0.0036
-    _v8 = _r.dt_first(s_node.charge_full_design_microamp_hours)
-    if _v8 is not None:
-        t.full_capacity = float(_v8) * 0.0036
-    _hi12 = _r.dt_first(s_node.voltage_max_design_microvolt)
-    _lo12 = _r.dt_first(s_node.voltage_min_design_microvolt)
-    _ch12 = s_node.device_chemistry
-    _n12 = _r.cells_from_design(
-        None if _hi12 is None else _hi12 * 1e-06, None if _lo12 is None else _lo12 * 1e-06,
-        _ch12, _K9_forward, _K10_forward,
+        t.full_capacity = float(_v7) * 0.0036
+
+    # devicetree.yaml:27: dt_pack voltage-max-design-microvolt, voltage-min-design-microvolt, device-chemistry ->
+    # cell_count, nominal_voltage
+    # Cells = design voltage / the chemistry's cell voltage (charged for the maximum, else empty for the minimum), to
+    # the nearest whole cell; nominal = cells x the chemistry's nominal cell voltage.
+    _hi8 = _r.dt_first(s_node.voltage_max_design_microvolt)
+    _lo8 = _r.dt_first(s_node.voltage_min_design_microvolt)
+    _ch8 = s_node.device_chemistry
+    _n8 = _r.cells_from_design(
+        None if _hi8 is None else _hi8 * 1e-06,
+        None if _lo8 is None else _lo8 * 1e-06,
+        _ch8,
+        _CELL_CHARGED_V,
+        _CELL_EMPTY_V,
     )
-    if _n12 is not None:
-        t.cell_count = _n12
-        if _ch12 is not None and _ch12 in _K11_forward:
-            t.nominal_voltage = _n12 * _K11_forward[_ch12]
-    _ts13 = s_node.ocv_capacity_celsius
-    _tb13 = s_node.ocv_capacity_table_n
-    if ocv_v is not None and _ts13:
-        _tabs13 = [_x13 for _x13 in (_tb13.get("ocv-capacity-table-" + str(_i13)) for _i13 in range(len(_ts13))) if _x13]
-        _t13 = temperature_c
-        if _t13 is None and len(_ts13) == 1:
-            _t13 = _ts13[0]
-        if _t13 is not None and len(_tabs13) == len(_ts13):
-            _uv13 = int(round(ocv_v * 1000000.0))
-            _cap13 = _r.ocv_to_capacity(_tabs13, _ts13, _uv13, int(round(_t13)))
-            t.state_of_charge = _cap13 * 0.01
+    if _n8 is not None:
+        t.cell_count = _n8
+        if _ch8 is not None and _ch8 in _CELL_NOMINAL_V:
+            t.nominal_voltage = _n8 * _CELL_NOMINAL_V[_ch8]
+
+    # devicetree.yaml:39: ocv_soc ocv-capacity-celsius, ^ocv-capacity-table-[0-9]+$ -> state_of_charge
+    # Given a measured open-circuit voltage (the scale of the tables) and temperature, the capacity the Linux
+    # power-supply core reports: the table of the nearest temperature, linear integer interpolation between its points,
+    # clamped at the ends.
+    _ts9 = s_node.ocv_capacity_celsius
+    _tb9 = s_node.ocv_capacity_table_n
+    if ocv_v is not None and _ts9:
+        _tabs9 = [_x9 for _x9 in (_tb9.get("ocv-capacity-table-" + str(_i9)) for _i9 in range(len(_ts9))) if _x9]
+        _t9 = temperature_c
+        if _t9 is None and len(_ts9) == 1:
+            _t9 = _ts9[0]
+        if _t9 is not None and len(_tabs9) == len(_ts9):
+            _uv9 = round(ocv_v * 1000000.0)
+            _cap9 = _r.ocv_to_capacity(_tabs9, _ts9, _uv9, round(_t9))
+            t.state_of_charge = _cap9 * 0.01
+
+    # what did not survive the conversion
     if rep_d is not None:
-        for _a, _n in _K14_forward:
-            if _r.differs(getattr(s_node, _a), getattr(_K15_forward, _a)):
+        for _a, _n in _UNREAD_NODE_FIELDS:
+            if _r.differs(getattr(s_node, _a), getattr(_NODE_DEFAULTS, _a)):
                 rep_d.dropped("devicetree.power.supply.battery." + _n)
+
     return (t,)

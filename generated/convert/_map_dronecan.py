@@ -8,103 +8,198 @@ from __future__ import annotations
 
 import math
 
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
 from . import _runtime as _r
 from ._concepts import BatteryState
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _C0
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _C1
+
+_FAULTS_BITS = (("over_current", 32), ("over_temperature", 8), ("under_temperature", 16), ("hardware_failure", 64))
+_UNREAD_AUX_FIELDS = (("timestamp", "timestamp"),)
+_AUX_DEFAULTS = BatteryInfoAux()
+_FAULTS_WITH_BITS = ("hardware_failure", "over_current", "over_temperature", "under_temperature")
+_UNREAD_CONCEPTS = (
+    "connected",
+    "average_current",
+    "design_energy",
+    "full_capacity",
+    "design_capacity",
+    "discharged",
+    "consumed_energy",
+    "time_remaining",
+    "cell_count",
+    "voltage_min_design",
+    "voltage_max_design",
+    "chemistry",
+)
+_UNWRITTEN_AUX_FIELDS = ("dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp",)
 
 
-_K26_forward = (("timestamp", "timestamp"),)
-_K27_forward = _C1()
-_K11_backward = ("hardware_failure", "over_current", "over_temperature", "under_temperature")
-_K26_backward = ("connected", "average_current", "design_energy", "full_capacity", "design_capacity", "discharged", "consumed_energy", "time_remaining", "cell_count", "voltage_min_design", "voltage_max_design", "chemistry")
-_K27_backward = ("dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp",)
-
-
-def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[BatteryState]:
+def forward(
+    s_info: BatteryInfo,
+    s_aux: BatteryInfoAux | None = None,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryState]:
     """dronecan -> concepts: returns the target objects as a tuple."""
     t = BatteryState()
+
+    # dronecan.yaml:12: scale info.voltage -> pack_voltage
     _v1 = s_info.voltage
-    if _v1 == _v1 and _v1 == _v1:
+    if _v1 == _v1:
         t.pack_voltage = float(_v1)
+
+    # dronecan.yaml:13: scale info.current -> current
     _v2 = s_info.current
-    if _v2 == _v2 and _v2 == _v2:
+    if _v2 == _v2:
         t.current = float(_v2)
+
+    # dronecan.yaml:14: scale info.temperature -> temperature
+    # Kelvin; zero or below is not a physical reading and counts as unknown.
     _v3 = s_info.temperature
-    if _v3 == _v3 and _v3 == _v3 and _v3 > 0:
+    if _v3 == _v3 and _v3 > 0:
         t.temperature = float(_v3)
+
+    # dronecan.yaml:20: scale info.average_power_10sec -> average_power
     _v4 = s_info.average_power_10sec
-    if _v4 == _v4 and _v4 == _v4:
+    if _v4 == _v4:
         t.average_power = float(_v4)
+
+    # dronecan.yaml:21: scale info.remaining_capacity_wh -> remaining_energy
     _v5 = s_info.remaining_capacity_wh
-    if _v5 == _v5 and _v5 == _v5:
+    if _v5 == _v5:
         t.remaining_energy = float(_v5) * 3600.0
+
+    # dronecan.yaml:22: scale info.full_charge_capacity_wh -> full_energy
     _v6 = s_info.full_charge_capacity_wh
-    if _v6 == _v6 and _v6 == _v6:
+    if _v6 == _v6:
         t.full_energy = float(_v6) * 3600.0
+
+    # dronecan.yaml:23: scale info.hours_to_full_charge -> time_to_full
     _v7 = s_info.hours_to_full_charge
-    if _v7 == _v7 and _v7 == _v7:
+    if _v7 == _v7:
         t.time_to_full = float(_v7) * 3600.0
+
+    # dronecan.yaml:24: flag info.status_flags -> in_use
     t.in_use = bool(s_info.status_flags & 1)
+
+    # dronecan.yaml:25: flag info.status_flags -> charging
     t.charging = bool(s_info.status_flags & 2)
+
+    # dronecan.yaml:26: flag_choice info.status_flags -> warning
+    # Charging is a battery state of its own (uORB WARNING_CHARGING, MAVLink CHARGE_STATE_CHARGING).
     if s_info.status_flags & 2:
         t.warning = "charging"
+
+    # dronecan.yaml:32: flags info.status_flags -> faults
+    # Status bits with a fault meaning; CHARGED, NEED_SERVICE and BMS_ERROR have none and are reported dropped.
     _v11 = s_info.status_flags
-    t.faults = tuple(_n11 for _n11, _m11 in (("over_current", 32), ("over_temperature", 8), ("under_temperature", 16), ("hardware_failure", 64),) if _v11 & _m11)
+    t.faults = tuple(_n11 for _n11, _m11 in _FAULTS_BITS if _v11 & _m11)
+
+    # dronecan.yaml:41: scale info.state_of_health_pct -> state_of_health
+    # 127 (STATE_OF_HEALTH_UNKNOWN) and anything above 100 % mean unknown.
     _v12 = s_info.state_of_health_pct
     if _v12 != 127 and _v12 <= 100:
         t.state_of_health = float(_v12) * 0.01
-    _e13, _f13, _p13 = s_info.remaining_capacity_wh, s_info.full_charge_capacity_wh, s_info.state_of_charge_pct
+
+    # dronecan.yaml:46: soc_hybrid info.remaining_capacity_wh, info.full_charge_capacity_wh, info.state_of_charge_pct ->
+    # state_of_charge
+    # Remaining over full energy when both are known and positive (finer than whole percent), else the percentage (127
+    # or above 100 = unknown), else unknown.
+    _e13 = s_info.remaining_capacity_wh
+    _f13 = s_info.full_charge_capacity_wh
+    _p13 = s_info.state_of_charge_pct
     if _e13 == _e13 and _f13 == _f13 and _e13 > 0 and _f13 > 0:
         t.state_of_charge = min(_e13 / _f13, 1.0)
     elif _p13 != 127 and _p13 <= 100:
         t.state_of_charge = float(_p13) * 0.01
-    _v14 = s_info.state_of_charge_pct_stdev
-    t.state_of_charge_stdev = float(_v14) * 0.01
+
+    # dronecan.yaml:56: scale info.state_of_charge_pct_stdev -> state_of_charge_stdev
+    _v15 = s_info.state_of_charge_pct_stdev
+    t.state_of_charge_stdev = float(_v15) * 0.01
+
+    # dronecan.yaml:57: copy aux.battery_id -> battery_index
+    # Same as BatteryInfo's; the BatteryInfo rule below wins.
     if s_aux is not None:
-        _v15 = s_aux.battery_id
-        t.battery_index = _v15
-    _v16 = s_info.battery_id
-    t.battery_index = _v16
-    _v17 = s_info.model_instance_id
-    if _v17 != 0:
-        t.serial_number = _v17
-    _v18 = s_info.model_name
-    t.model_name = _r.text_in(_v18)
+        _v16 = s_aux.battery_id
+        t.battery_index = _v16
+
+    # dronecan.yaml:58: copy info.battery_id -> battery_index
+    # 0-based (0 = main battery).
+    _v17 = s_info.battery_id
+    t.battery_index = _v17
+
+    # dronecan.yaml:59: copy info.model_instance_id -> serial_number
+    _v18 = s_info.model_instance_id
+    if _v18 != 0:
+        t.serial_number = _v18
+
+    # dronecan.yaml:60: copy info.model_name -> model_name
+    _v19 = s_info.model_name
+    t.model_name = _r.text_in(_v19)
+
+    # dronecan.yaml:61: const True -> connected
+    # Only an attached battery sends BatteryInfo.
     t.connected = True
+
+    # dronecan.yaml:62: cells aux.voltage_cell -> cell_voltages
     if s_aux is not None:
-        _c20 = list(s_aux.voltage_cell)
-        t.cell_voltages = tuple(float(_x20) for _x20 in _c20) or None
+        _c21 = list(s_aux.voltage_cell)
+        t.cell_voltages = tuple(float(_x21) for _x21 in _c21) or None
+
+    # dronecan.yaml:63: copy aux.cycle_count -> cycle_count
     if s_aux is not None:
-        _v21 = s_aux.cycle_count
-        t.cycle_count = _v21
+        _v22 = s_aux.cycle_count
+        t.cycle_count = _v22
+
+    # dronecan.yaml:64: copy aux.over_discharge_count -> over_discharge_count
     if s_aux is not None:
-        _v22 = s_aux.over_discharge_count
-        t.over_discharge_count = _v22
+        _v23 = s_aux.over_discharge_count
+        t.over_discharge_count = _v23
+
+    # dronecan.yaml:65: scale aux.max_current -> max_current
     if s_aux is not None:
-        _v23 = s_aux.max_current
-        if _v23 == _v23:
-            t.max_current = float(_v23)
+        _v24 = s_aux.max_current
+        if _v24 == _v24:
+            t.max_current = float(_v24)
+
+    # dronecan.yaml:66: scale aux.nominal_voltage -> nominal_voltage
+    # Zero disables it.
     if s_aux is not None:
-        _v24 = s_aux.nominal_voltage
-        if _v24 != 0 and _v24 == _v24:
-            t.nominal_voltage = float(_v24)
+        _v25 = s_aux.nominal_voltage
+        if _v25 != 0 and _v25 == _v25:
+            t.nominal_voltage = float(_v25)
+
+    # dronecan.yaml:67: copy aux.is_powering_off -> is_powering_off
     if s_aux is not None:
-        _v25 = s_aux.is_powering_off
-        t.is_powering_off = bool(_v25)
+        _v26 = s_aux.is_powering_off
+        t.is_powering_off = bool(_v26)
+
+    # what did not survive the conversion
     if rep_d is not None and s_info.status_flags & -124:
-        rep_d.dropped("dronecan.uavcan.equipment.power.BatteryInfo.status_flags", 'bits %#x have no counterpart' % (s_info.status_flags & -124))
+        _b = s_info.status_flags & -124
+        rep_d.dropped("dronecan.uavcan.equipment.power.BatteryInfo.status_flags", f"bits {_b:#x} have no counterpart")
     if rep_d is not None and s_aux is not None:
-        for _a, _n in _K26_forward:
-            if _r.differs(getattr(s_aux, _a), getattr(_K27_forward, _a)):
+        for _a, _n in _UNREAD_AUX_FIELDS:
+            if _r.differs(getattr(s_aux, _a), getattr(_AUX_DEFAULTS, _a)):
                 rep_d.dropped("dronecan.ardupilot.equipment.power.BatteryInfoAux." + _n)
+
     return (t,)
 
 
-def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C0, _C1]:
+def backward(
+    s: BatteryState,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryInfo, BatteryInfoAux]:
     """concepts -> dronecan: returns the target objects as a tuple."""
-    t_info = _C0()
-    t_aux = _C1()
+    t_info = BatteryInfo()
+    t_aux = BatteryInfoAux()
+
+    # dronecan.yaml:12: scale info.voltage -> pack_voltage
     _v1 = s.pack_voltage
     if _v1 is None or _v1 != _v1:
         t_info.voltage = math.nan
@@ -112,6 +207,8 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.voltage")
     else:
         t_info.voltage = _r.f16(_v1, rep, "dronecan.uavcan.equipment.power.BatteryInfo.voltage")
+
+    # dronecan.yaml:13: scale info.current -> current
     _v2 = s.current
     if _v2 is None or _v2 != _v2:
         t_info.current = math.nan
@@ -119,6 +216,9 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.current")
     else:
         t_info.current = _r.f16(_v2, rep, "dronecan.uavcan.equipment.power.BatteryInfo.current")
+
+    # dronecan.yaml:14: scale info.temperature -> temperature
+    # Kelvin; zero or below is not a physical reading and counts as unknown.
     _v3 = s.temperature
     if _v3 is None or _v3 != _v3:
         t_info.temperature = math.nan
@@ -126,6 +226,8 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.temperature")
     else:
         t_info.temperature = _r.f16(_v3, rep, "dronecan.uavcan.equipment.power.BatteryInfo.temperature")
+
+    # dronecan.yaml:20: scale info.average_power_10sec -> average_power
     _v4 = s.average_power
     if _v4 is None or _v4 != _v4:
         t_info.average_power_10sec = math.nan
@@ -133,153 +235,265 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec")
     else:
         t_info.average_power_10sec = _r.f16(_v4, rep, "dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec")
+
+    # dronecan.yaml:21: scale info.remaining_capacity_wh -> remaining_energy
     _v5 = s.remaining_energy
     if _v5 is None or _v5 != _v5:
         t_info.remaining_capacity_wh = math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
     else:
-        t_info.remaining_capacity_wh = _r.f16(_v5 * 0.0002777777777777778, rep, "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
+        t_info.remaining_capacity_wh = _r.f16(
+            _v5 * 0.0002777777777777778,
+            rep,
+            "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh",
+        )
+
+    # dronecan.yaml:22: scale info.full_charge_capacity_wh -> full_energy
     _v6 = s.full_energy
     if _v6 is None or _v6 != _v6:
         t_info.full_charge_capacity_wh = math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
     else:
-        t_info.full_charge_capacity_wh = _r.f16(_v6 * 0.0002777777777777778, rep, "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
+        t_info.full_charge_capacity_wh = _r.f16(
+            _v6 * 0.0002777777777777778,
+            rep,
+            "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh",
+        )
+
+    # dronecan.yaml:23: scale info.hours_to_full_charge -> time_to_full
     _v7 = s.time_to_full
     if _v7 is None or _v7 != _v7:
         t_info.hours_to_full_charge = math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge")
     else:
-        t_info.hours_to_full_charge = _r.f16(_v7 * 0.0002777777777777778, rep, "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge")
+        t_info.hours_to_full_charge = _r.f16(
+            _v7 * 0.0002777777777777778,
+            rep,
+            "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge",
+        )
+
+    # dronecan.yaml:24: flag info.status_flags -> in_use
     if s.in_use:
         t_info.status_flags |= 1
+
+    # dronecan.yaml:25: flag info.status_flags -> charging
     if s.charging:
         t_info.status_flags |= 2
+
+    # dronecan.yaml:26: flag_choice info.status_flags -> warning
+    # Charging is a battery state of its own (uORB WARNING_CHARGING, MAVLink CHARGE_STATE_CHARGING).
     if s.warning == "charging":
         t_info.status_flags |= 2
-    _v12 = s.faults
-    if _v12 is None:
+
+    # dronecan.yaml:32: flags info.status_flags -> faults
+    # Status bits with a fault meaning; CHARGED, NEED_SERVICE and BMS_ERROR have none and are reported dropped.
+    _v11 = s.faults
+    if _v11 is None:
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.status_flags")
     else:
-        _b12 = t_info.status_flags
-        if "over_current" in _v12:
-            _b12 |= 32
-        if "over_temperature" in _v12:
-            _b12 |= 8
-        if "under_temperature" in _v12:
-            _b12 |= 16
-        if "hardware_failure" in _v12:
-            _b12 |= 64
-        t_info.status_flags = _b12
+        _b11 = t_info.status_flags
+        if "over_current" in _v11:
+            _b11 |= 32
+        if "over_temperature" in _v11:
+            _b11 |= 8
+        if "under_temperature" in _v11:
+            _b11 |= 16
+        if "hardware_failure" in _v11:
+            _b11 |= 64
+        t_info.status_flags = _b11
         if rep_d is not None:
-            for _n12 in _v12:
-                if _n12 not in _K11_backward:
-                    rep_d.dropped("concepts.faults", _n12 + ' has no counterpart')
-    _v13 = s.state_of_health
-    if _v13 is None or _v13 != _v13:
+            for _n11 in _v11:
+                if _n11 not in _FAULTS_WITH_BITS:
+                    rep_d.dropped("concepts.faults", _n11 + " has no counterpart")
+
+    # dronecan.yaml:41: scale info.state_of_health_pct -> state_of_health
+    # 127 (STATE_OF_HEALTH_UNKNOWN) and anything above 100 % mean unknown.
+    _v12 = s.state_of_health
+    if _v12 is None or _v12 != _v12:
         t_info.state_of_health_pct = 127
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct")
     else:
-        t_info.state_of_health_pct = _r.to_int(_v13 * 100.0, 0, 100, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct")
+        t_info.state_of_health_pct = _r.to_int(
+            _v12 * 100.0,
+            0,
+            100,
+            rep,
+            "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct",
+        )
         if rep is not None and t_info.state_of_health_pct in (127,):
-            rep.clamped("dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct", 'a known value written as the unknown marker')
+            rep.clamped(
+                "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct",
+                "a known value written as the unknown marker",
+            )
+
+    # dronecan.yaml:55: scale info.state_of_charge_pct -> state_of_charge
     _v14 = s.state_of_charge
     if _v14 is None or _v14 != _v14:
         t_info.state_of_charge_pct = 127
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct")
     else:
-        t_info.state_of_charge_pct = _r.to_int(_v14 * 100.0, 0, 127, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct")
+        t_info.state_of_charge_pct = _r.to_int(
+            _v14 * 100.0,
+            0,
+            127,
+            rep,
+            "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct",
+        )
         if rep is not None and t_info.state_of_charge_pct in (127,):
-            rep.clamped("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct", 'a known value written as the unknown marker')
+            rep.clamped(
+                "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct",
+                "a known value written as the unknown marker",
+            )
+
+    # dronecan.yaml:56: scale info.state_of_charge_pct_stdev -> state_of_charge_stdev
     _v15 = s.state_of_charge_stdev
     if _v15 is None or _v15 != _v15:
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev")
     else:
-        t_info.state_of_charge_pct_stdev = _r.to_int(_v15 * 100.0, 0, 127, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev")
+        t_info.state_of_charge_pct_stdev = _r.to_int(
+            _v15 * 100.0,
+            0,
+            127,
+            rep,
+            "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev",
+        )
+
+    # dronecan.yaml:57: copy aux.battery_id -> battery_index
+    # Same as BatteryInfo's; the BatteryInfo rule below wins.
     _v16 = s.battery_index
     if _v16 is None:
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.battery_id")
     else:
         t_aux.battery_id = _r.to_int(_v16, 0, 255, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.battery_id")
+
+    # dronecan.yaml:58: copy info.battery_id -> battery_index
+    # 0-based (0 = main battery).
     _v17 = s.battery_index
     if _v17 is None:
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.battery_id")
     else:
         t_info.battery_id = _r.to_int(_v17, 0, 255, rep, "dronecan.uavcan.equipment.power.BatteryInfo.battery_id")
+
+    # dronecan.yaml:59: copy info.model_instance_id -> serial_number
     _v18 = s.serial_number
     if _v18 is None:
         t_info.model_instance_id = 0
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id")
     else:
-        t_info.model_instance_id = _r.to_int(_v18, 0, 4294967295, rep, "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id")
+        t_info.model_instance_id = _r.to_int(
+            _v18,
+            0,
+            4294967295,
+            rep,
+            "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id",
+        )
         if rep is not None and t_info.model_instance_id in (0,):
-            rep.clamped("dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id", 'a known value written as the unknown marker')
+            rep.clamped(
+                "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id",
+                "a known value written as the unknown marker",
+            )
+
+    # dronecan.yaml:60: copy info.model_name -> model_name
     _v19 = s.model_name
     if _v19 is None:
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.model_name")
     else:
         t_info.model_name = _r.bytes_out(_v19, 31, rep, "dronecan.uavcan.equipment.power.BatteryInfo.model_name")
-    _c20 = s.cell_voltages
-    if _c20 is None:
+
+    # dronecan.yaml:62: cells aux.voltage_cell -> cell_voltages
+    _c21 = s.cell_voltages
+    if _c21 is None:
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell")
     else:
-        if len(_c20) > 255:
+        if len(_c21) > 255:
             if rep is not None:
-                rep.clamped("dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell", '%d cells, room for 255' % len(_c20))
-            _c20 = _c20[:255]
-        _l20 = [_r.f16(_x20, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell") for _x20 in _c20]
-        t_aux.voltage_cell = _l20
-    _v21 = s.cycle_count
-    if _v21 is None:
+                rep.clamped(
+                    "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell",
+                    f"{len(_c21)} cells, room for 255",
+                )
+            _c21 = _c21[:255]
+        _l21 = [_r.f16(_x21, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell") for _x21 in _c21]
+        t_aux.voltage_cell = _l21
+
+    # dronecan.yaml:63: copy aux.cycle_count -> cycle_count
+    _v22 = s.cycle_count
+    if _v22 is None:
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count")
     else:
-        t_aux.cycle_count = _r.to_int(_v21, 0, 65535, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count")
-    _v22 = s.over_discharge_count
-    if _v22 is None:
+        t_aux.cycle_count = _r.to_int(
+            _v22,
+            0,
+            65535,
+            rep,
+            "dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count",
+        )
+
+    # dronecan.yaml:64: copy aux.over_discharge_count -> over_discharge_count
+    _v23 = s.over_discharge_count
+    if _v23 is None:
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count")
     else:
-        t_aux.over_discharge_count = _r.to_int(_v22, 0, 65535, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count")
-    _v23 = s.max_current
-    if _v23 is None or _v23 != _v23:
+        t_aux.over_discharge_count = _r.to_int(
+            _v23,
+            0,
+            65535,
+            rep,
+            "dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count",
+        )
+
+    # dronecan.yaml:65: scale aux.max_current -> max_current
+    _v24 = s.max_current
+    if _v24 is None or _v24 != _v24:
         t_aux.max_current = math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current")
     else:
-        t_aux.max_current = _r.f16(_v23, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current")
-    _v24 = s.nominal_voltage
-    if _v24 is None or _v24 != _v24:
+        t_aux.max_current = _r.f16(_v24, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current")
+
+    # dronecan.yaml:66: scale aux.nominal_voltage -> nominal_voltage
+    # Zero disables it.
+    _v25 = s.nominal_voltage
+    if _v25 is None or _v25 != _v25:
         t_aux.nominal_voltage = 0.0
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage")
     else:
-        t_aux.nominal_voltage = _r.f16(_v24, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage")
+        t_aux.nominal_voltage = _r.f16(_v25, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage")
         if rep is not None and t_aux.nominal_voltage in (0,):
-            rep.clamped("dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage", 'a known value written as the unknown marker')
-    _v25 = s.is_powering_off
-    if _v25 is None:
+            rep.clamped(
+                "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage",
+                "a known value written as the unknown marker",
+            )
+
+    # dronecan.yaml:67: copy aux.is_powering_off -> is_powering_off
+    _v26 = s.is_powering_off
+    if _v26 is None:
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.is_powering_off")
     else:
-        t_aux.is_powering_off = bool(_v25)
+        t_aux.is_powering_off = bool(_v26)
+
+    # what did not survive the conversion
     if rep_d is not None:
-        for _n in _K26_backward:
+        for _n in _UNREAD_CONCEPTS:
             if getattr(s, _n) is not None:
-                rep_d.dropped('concepts.' + _n)
+                rep_d.dropped("concepts." + _n)
     if rep_u is not None:
-        for _n in _K27_backward:
+        for _n in _UNWRITTEN_AUX_FIELDS:
             rep_u.unknown(_n)
-    return (t_info, t_aux,)
+
+    return (t_info, t_aux)

@@ -6,197 +6,352 @@ The MAVLink BATTERY_STATUS message.
 
 from __future__ import annotations
 
-import math
-
+from ..mavlink import BatteryStatus
 from . import _runtime as _r
 from ._concepts import BatteryState
-from ..mavlink import BatteryStatus as _C0
+
+_CHEMISTRY_BY_TYPE = {1: "lipo", 2: "life", 3: "lion", 4: "nimh"}
+_WARNING_BY_CHARGE_STATE = {
+    1: "none",
+    2: "low",
+    3: "critical",
+    4: "emergency",
+    5: "failed",
+    6: "unhealthy",
+    7: "charging",
+}
+_FAULTS_BITS = (
+    ("deep_discharge", 1),
+    ("spikes", 2),
+    ("cell_fail", 4),
+    ("over_current", 8),
+    ("over_temperature", 16),
+    ("under_temperature", 32),
+    ("incompatible_voltage", 64),
+    ("incompatible_firmware", 128),
+    ("incompatible_cells_configuration", 256),
+)
+_UNREAD_MSG_FIELDS = (("battery_function", "battery_function"), ("mode", "mode"))
+_MSG_DEFAULTS = BatteryStatus()
+_TYPE_BY_CHEMISTRY = {"lipo": 1, "life": 2, "lion": 3, "nimh": 4}
+_CHARGE_STATE_BY_WARNING = {
+    "none": 1,
+    "low": 2,
+    "critical": 3,
+    "emergency": 4,
+    "failed": 5,
+    "unhealthy": 6,
+    "charging": 7,
+}
+_FAULTS_WITH_BITS = (
+    "cell_fail",
+    "deep_discharge",
+    "incompatible_cells_configuration",
+    "incompatible_firmware",
+    "incompatible_voltage",
+    "over_current",
+    "over_temperature",
+    "spikes",
+    "under_temperature",
+)
+_UNREAD_CONCEPTS = (
+    "connected",
+    "in_use",
+    "charging",
+    "average_current",
+    "max_current",
+    "average_power",
+    "state_of_charge_stdev",
+    "state_of_health",
+    "remaining_energy",
+    "full_energy",
+    "design_energy",
+    "full_capacity",
+    "design_capacity",
+    "time_to_full",
+    "cell_count",
+    "cycle_count",
+    "over_discharge_count",
+    "nominal_voltage",
+    "voltage_min_design",
+    "voltage_max_design",
+    "serial_number",
+    "model_name",
+    "is_powering_off",
+)
+_UNWRITTEN_MSG_FIELDS = ("mavlink.BATTERY_STATUS.battery_function", "mavlink.BATTERY_STATUS.mode")
 
 
-_K2_forward = dict(((1, "lipo"), (2, "life"), (3, "lion"), (4, "nimh"),))
-_K11_forward = dict(((1, "none"), (2, "low"), (3, "critical"), (4, "emergency"), (5, "failed"), (6, "unhealthy"), (7, "charging"),))
-_K15_forward = (("battery_function", "battery_function"), ("mode", "mode"))
-_K16_forward = _C0()
-_K2_backward = dict((("lipo", 1), ("life", 2), ("lion", 3), ("nimh", 4),))
-_K11_backward = dict((("none", 1), ("low", 2), ("critical", 3), ("emergency", 4), ("failed", 5), ("unhealthy", 6), ("charging", 7),))
-_K13_backward = ("cell_fail", "deep_discharge", "incompatible_cells_configuration", "incompatible_firmware", "incompatible_voltage", "over_current", "over_temperature", "spikes", "under_temperature")
-_K15_backward = ("connected", "in_use", "charging", "average_current", "max_current", "average_power", "state_of_charge_stdev", "state_of_health", "remaining_energy", "full_energy", "design_energy", "full_capacity", "design_capacity", "time_to_full", "cell_count", "cycle_count", "over_discharge_count", "nominal_voltage", "voltage_min_design", "voltage_max_design", "serial_number", "model_name", "is_powering_off")
-_K16_backward = ("mavlink.BATTERY_STATUS.battery_function", "mavlink.BATTERY_STATUS.mode")
-
-
-def forward(s_msg: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[BatteryState]:
+def forward(
+    s_msg: BatteryStatus,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryState]:
     """mavlink -> concepts: returns the target objects as a tuple."""
     t = BatteryState()
+
+    # mavlink.yaml:10: copy id -> battery_index
     _v1 = s_msg.id
     t.battery_index = _v1
-    _v3 = s_msg.type
-    t.chemistry = None if _v3 is None else _K2_forward.get(_v3)
-    if rep_d is not None and _v3 not in _K2_forward and _v3 not in (None, 0,):
-        rep_d.dropped("mavlink.BATTERY_STATUS.type", '%r has no counterpart' % (_v3,))
-    _v4 = s_msg.temperature
-    if _v4 != 32767:
-        t.temperature = float(_v4) * 0.01 + 273.15
-    _c5, _p5 = _r.mavlink_cells_in(s_msg.voltages, s_msg.voltages_ext, 65535, 0, 65534)
-    if _p5 is not None:
-        t.pack_voltage = float(_p5) * 0.001
-    if _c5 is not None:
-        t.cell_voltages = tuple(float(_x5) * 0.001 for _x5 in _c5)
-    _v6 = s_msg.current_battery
+
+    # mavlink.yaml:11: choice type -> chemistry
+    _v2 = s_msg.type
+    t.chemistry = None if _v2 is None else _CHEMISTRY_BY_TYPE.get(_v2)
+    if rep_d is not None and _v2 not in _CHEMISTRY_BY_TYPE and _v2 not in (None, 0):
+        rep_d.dropped("mavlink.BATTERY_STATUS.type", f"{_v2!r} has no counterpart")
+
+    # mavlink.yaml:16: scale temperature -> temperature
+    _v3 = s_msg.temperature
+    if _v3 != 32767:
+        t.temperature = float(_v3) * 0.01 + 273.15
+
+    # mavlink.yaml:17: mavlink_voltages voltages, voltages_ext -> pack_voltage, cell_voltages
+    # Cells 1-10 (UINT16_MAX = none) then 11-14 (0 = none, a measured 0 sent as 1). Without per-cell data cell 1 holds
+    # the pack voltage, spilling UINT16_MAX - 1 mV chunks into the next cells; a lone entry or a spill is read as the
+    # pack voltage, cells unknown.
+    _c4, _p4 = _r.mavlink_cells_in(s_msg.voltages, s_msg.voltages_ext, 65535, 0, 65534)
+    if _p4 is not None:
+        t.pack_voltage = float(_p4) * 0.001
+    if _c4 is not None:
+        t.cell_voltages = tuple(float(_x4) * 0.001 for _x4 in _c4)
+
+    # mavlink.yaml:24: scale current_battery -> current
+    _v5 = s_msg.current_battery
+    if _v5 != -1:
+        t.current = float(_v5) * 0.01
+
+    # mavlink.yaml:25: scale current_consumed -> discharged
+    _v6 = s_msg.current_consumed
     if _v6 != -1:
-        t.current = float(_v6) * 0.01
-    _v7 = s_msg.current_consumed
+        t.discharged = float(_v6) * 3.6
+
+    # mavlink.yaml:26: scale energy_consumed -> consumed_energy
+    _v7 = s_msg.energy_consumed
     if _v7 != -1:
-        t.discharged = float(_v7) * 3.6
-    _v8 = s_msg.energy_consumed
-    if _v8 != -1:
-        t.consumed_energy = float(_v8) * 100.0
-    _v9 = s_msg.battery_remaining
-    if _v9 != -1 and _v9 <= 100:
-        t.state_of_charge = float(_v9) * 0.01
-    _v10 = s_msg.time_remaining
-    if _v10 != 0:
-        t.time_remaining = float(_v10)
-    _v12 = s_msg.charge_state
-    t.warning = None if _v12 is None else _K11_forward.get(_v12)
-    if rep_d is not None and _v12 not in _K11_forward and _v12 not in (None, 0,):
-        rep_d.dropped("mavlink.BATTERY_STATUS.charge_state", '%r has no counterpart' % (_v12,))
-    _v13 = s_msg.fault_bitmask
-    t.faults = tuple(_n13 for _n13, _m13 in (("deep_discharge", 1), ("spikes", 2), ("cell_fail", 4), ("over_current", 8), ("over_temperature", 16), ("under_temperature", 32), ("incompatible_voltage", 64), ("incompatible_firmware", 128), ("incompatible_cells_configuration", 256),) if _v13 & _m13)
+        t.consumed_energy = float(_v7) * 100.0
+
+    # mavlink.yaml:27: scale battery_remaining -> state_of_charge
+    _v8 = s_msg.battery_remaining
+    if _v8 != -1 and _v8 <= 100:
+        t.state_of_charge = float(_v8) * 0.01
+
+    # mavlink.yaml:28: scale time_remaining -> time_remaining
+    # 0 means not estimated.
+    _v9 = s_msg.time_remaining
+    if _v9 != 0:
+        t.time_remaining = float(_v9)
+
+    # mavlink.yaml:29: choice charge_state -> warning
+    _v10 = s_msg.charge_state
+    t.warning = None if _v10 is None else _WARNING_BY_CHARGE_STATE.get(_v10)
+    if rep_d is not None and _v10 not in _WARNING_BY_CHARGE_STATE and _v10 not in (None, 0):
+        rep_d.dropped("mavlink.BATTERY_STATUS.charge_state", f"{_v10!r} has no counterpart")
+
+    # mavlink.yaml:41: flags fault_bitmask -> faults
+    _v11 = s_msg.fault_bitmask
+    t.faults = tuple(_n11 for _n11, _m11 in _FAULTS_BITS if _v11 & _m11)
+
+    # mavlink.yaml:54: const True -> connected
+    # Only an attached battery is reported.
     t.connected = True
+
+    # what did not survive the conversion
     if rep_d is not None and s_msg.fault_bitmask & -512:
-        rep_d.dropped("mavlink.BATTERY_STATUS.fault_bitmask", 'bits %#x have no counterpart' % (s_msg.fault_bitmask & -512))
+        _b = s_msg.fault_bitmask & -512
+        rep_d.dropped("mavlink.BATTERY_STATUS.fault_bitmask", f"bits {_b:#x} have no counterpart")
     if rep_d is not None:
-        for _a, _n in _K15_forward:
-            if _r.differs(getattr(s_msg, _a), getattr(_K16_forward, _a)):
+        for _a, _n in _UNREAD_MSG_FIELDS:
+            if _r.differs(getattr(s_msg, _a), getattr(_MSG_DEFAULTS, _a)):
                 rep_d.dropped("mavlink.BATTERY_STATUS." + _n)
+
     return (t,)
 
 
-def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C0]:
+def backward(
+    s: BatteryState,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryStatus]:
     """concepts -> mavlink: returns the target objects as a tuple."""
-    t_msg = _C0()
+    t_msg = BatteryStatus()
+
+    # mavlink.yaml:10: copy id -> battery_index
     _v1 = s.battery_index
     if _v1 is None:
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.id")
     else:
         t_msg.id = _r.to_int(_v1, 0, 255, rep, "mavlink.BATTERY_STATUS.id")
-    _v3 = s.chemistry
-    _w3 = None if _v3 is None else _K2_backward.get(_v3)
-    if _w3 is not None:
-        t_msg.type = _w3
+
+    # mavlink.yaml:11: choice type -> chemistry
+    _v2 = s.chemistry
+    _w2 = None if _v2 is None else _TYPE_BY_CHEMISTRY.get(_v2)
+    if _w2 is not None:
+        t_msg.type = _w2
     else:
         t_msg.type = 0
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.type")
-        if rep_d is not None and _v3 is not None:
-            rep_d.dropped("concepts.chemistry", '%r has no counterpart' % (_v3,))
-    _v4 = s.temperature
-    if _v4 is None or _v4 != _v4:
+        if rep_d is not None and _v2 is not None:
+            rep_d.dropped("concepts.chemistry", f"{_v2!r} has no counterpart")
+
+    # mavlink.yaml:16: scale temperature -> temperature
+    _v3 = s.temperature
+    if _v3 is None or _v3 != _v3:
         t_msg.temperature = 32767
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.temperature")
     else:
-        t_msg.temperature = _r.to_int(_v4 * 100.0 + -27314.999999999996, -32768, 32767, rep, "mavlink.BATTERY_STATUS.temperature")
+        t_msg.temperature = _r.to_int(
+            _v3 * 100.0 + -27314.999999999996,
+            -32768,
+            32767,
+            rep,
+            "mavlink.BATTERY_STATUS.temperature",
+        )
         if rep is not None and t_msg.temperature in (32767,):
-            rep.clamped("mavlink.BATTERY_STATUS.temperature", 'a known value written as the unknown marker')
-    _c5 = s.cell_voltages
-    _p5 = s.pack_voltage
+            rep.clamped("mavlink.BATTERY_STATUS.temperature", "a known value written as the unknown marker")
+
+    # mavlink.yaml:17: mavlink_voltages voltages, voltages_ext -> pack_voltage, cell_voltages
+    # Cells 1-10 (UINT16_MAX = none) then 11-14 (0 = none, a measured 0 sent as 1). Without per-cell data cell 1 holds
+    # the pack voltage, spilling UINT16_MAX - 1 mV chunks into the next cells; a lone entry or a spill is read as the
+    # pack voltage, cells unknown.
+    _c4 = s.cell_voltages
+    _p4 = s.pack_voltage
     t_msg.voltages, t_msg.voltages_ext = _r.mavlink_cells_out(
-        None if _c5 is None else [_x5 * 1000.0 for _x5 in _c5],
-        None if _p5 is None else _p5 * 1000.0,
-        10, 4, 65535, 0,
-        rep, "mavlink.BATTERY_STATUS.voltages", "mavlink.BATTERY_STATUS.voltages_ext",
+        None if _c4 is None else [_x4 * 1000.0 for _x4 in _c4],
+        None if _p4 is None else _p4 * 1000.0,
+        10,
+        4,
+        65535,
+        0,
+        rep,
+        "mavlink.BATTERY_STATUS.voltages",
+        "mavlink.BATTERY_STATUS.voltages_ext",
     )
-    _v6 = s.current
-    if _v6 is None or _v6 != _v6:
+
+    # mavlink.yaml:24: scale current_battery -> current
+    _v5 = s.current
+    if _v5 is None or _v5 != _v5:
         t_msg.current_battery = -1
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.current_battery")
     else:
-        t_msg.current_battery = _r.to_int(_v6 * 100.0, -32768, 32767, rep, "mavlink.BATTERY_STATUS.current_battery")
+        t_msg.current_battery = _r.to_int(_v5 * 100.0, -32768, 32767, rep, "mavlink.BATTERY_STATUS.current_battery")
         if rep is not None and t_msg.current_battery in (-1,):
-            rep.clamped("mavlink.BATTERY_STATUS.current_battery", 'a known value written as the unknown marker')
-    _v7 = s.discharged
-    if _v7 is None or _v7 != _v7:
+            rep.clamped("mavlink.BATTERY_STATUS.current_battery", "a known value written as the unknown marker")
+
+    # mavlink.yaml:25: scale current_consumed -> discharged
+    _v6 = s.discharged
+    if _v6 is None or _v6 != _v6:
         t_msg.current_consumed = -1
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.current_consumed")
     else:
-        t_msg.current_consumed = _r.to_int(_v7 * 0.2777777777777778, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.current_consumed")
+        t_msg.current_consumed = _r.to_int(
+            _v6 * 0.2777777777777778,
+            -2147483648,
+            2147483647,
+            rep,
+            "mavlink.BATTERY_STATUS.current_consumed",
+        )
         if rep is not None and t_msg.current_consumed in (-1,):
-            rep.clamped("mavlink.BATTERY_STATUS.current_consumed", 'a known value written as the unknown marker')
-    _v8 = s.consumed_energy
-    if _v8 is None or _v8 != _v8:
+            rep.clamped("mavlink.BATTERY_STATUS.current_consumed", "a known value written as the unknown marker")
+
+    # mavlink.yaml:26: scale energy_consumed -> consumed_energy
+    _v7 = s.consumed_energy
+    if _v7 is None or _v7 != _v7:
         t_msg.energy_consumed = -1
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.energy_consumed")
     else:
-        t_msg.energy_consumed = _r.to_int(_v8 * 0.01, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.energy_consumed")
+        t_msg.energy_consumed = _r.to_int(
+            _v7 * 0.01,
+            -2147483648,
+            2147483647,
+            rep,
+            "mavlink.BATTERY_STATUS.energy_consumed",
+        )
         if rep is not None and t_msg.energy_consumed in (-1,):
-            rep.clamped("mavlink.BATTERY_STATUS.energy_consumed", 'a known value written as the unknown marker')
-    _v9 = s.state_of_charge
-    if _v9 is None or _v9 != _v9:
+            rep.clamped("mavlink.BATTERY_STATUS.energy_consumed", "a known value written as the unknown marker")
+
+    # mavlink.yaml:27: scale battery_remaining -> state_of_charge
+    _v8 = s.state_of_charge
+    if _v8 is None or _v8 != _v8:
         t_msg.battery_remaining = -1
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.battery_remaining")
     else:
-        t_msg.battery_remaining = _r.to_int(_v9 * 100.0, -128, 100, rep, "mavlink.BATTERY_STATUS.battery_remaining")
+        t_msg.battery_remaining = _r.to_int(_v8 * 100.0, -128, 100, rep, "mavlink.BATTERY_STATUS.battery_remaining")
         if rep is not None and t_msg.battery_remaining in (-1,):
-            rep.clamped("mavlink.BATTERY_STATUS.battery_remaining", 'a known value written as the unknown marker')
-    _v10 = s.time_remaining
-    if _v10 is None or _v10 != _v10:
+            rep.clamped("mavlink.BATTERY_STATUS.battery_remaining", "a known value written as the unknown marker")
+
+    # mavlink.yaml:28: scale time_remaining -> time_remaining
+    # 0 means not estimated.
+    _v9 = s.time_remaining
+    if _v9 is None or _v9 != _v9:
         t_msg.time_remaining = 0
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.time_remaining")
     else:
-        t_msg.time_remaining = _r.to_int(_v10, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.time_remaining")
+        t_msg.time_remaining = _r.to_int(_v9, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.time_remaining")
         if rep is not None and t_msg.time_remaining in (0,):
-            rep.clamped("mavlink.BATTERY_STATUS.time_remaining", 'a known value written as the unknown marker')
-    _v12 = s.warning
-    _w12 = None if _v12 is None else _K11_backward.get(_v12)
-    if _w12 is not None:
-        t_msg.charge_state = _w12
+            rep.clamped("mavlink.BATTERY_STATUS.time_remaining", "a known value written as the unknown marker")
+
+    # mavlink.yaml:29: choice charge_state -> warning
+    _v10 = s.warning
+    _w10 = None if _v10 is None else _CHARGE_STATE_BY_WARNING.get(_v10)
+    if _w10 is not None:
+        t_msg.charge_state = _w10
     else:
         t_msg.charge_state = 0
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.charge_state")
-        if rep_d is not None and _v12 is not None:
-            rep_d.dropped("concepts.warning", '%r has no counterpart' % (_v12,))
-    _v14 = s.faults
-    if _v14 is None:
+        if rep_d is not None and _v10 is not None:
+            rep_d.dropped("concepts.warning", f"{_v10!r} has no counterpart")
+
+    # mavlink.yaml:41: flags fault_bitmask -> faults
+    _v11 = s.faults
+    if _v11 is None:
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.fault_bitmask")
     else:
-        _b14 = t_msg.fault_bitmask
-        if "deep_discharge" in _v14:
-            _b14 |= 1
-        if "spikes" in _v14:
-            _b14 |= 2
-        if "cell_fail" in _v14:
-            _b14 |= 4
-        if "over_current" in _v14:
-            _b14 |= 8
-        if "over_temperature" in _v14:
-            _b14 |= 16
-        if "under_temperature" in _v14:
-            _b14 |= 32
-        if "incompatible_voltage" in _v14:
-            _b14 |= 64
-        if "incompatible_firmware" in _v14:
-            _b14 |= 128
-        if "incompatible_cells_configuration" in _v14:
-            _b14 |= 256
-        t_msg.fault_bitmask = _b14
+        _b11 = t_msg.fault_bitmask
+        if "deep_discharge" in _v11:
+            _b11 |= 1
+        if "spikes" in _v11:
+            _b11 |= 2
+        if "cell_fail" in _v11:
+            _b11 |= 4
+        if "over_current" in _v11:
+            _b11 |= 8
+        if "over_temperature" in _v11:
+            _b11 |= 16
+        if "under_temperature" in _v11:
+            _b11 |= 32
+        if "incompatible_voltage" in _v11:
+            _b11 |= 64
+        if "incompatible_firmware" in _v11:
+            _b11 |= 128
+        if "incompatible_cells_configuration" in _v11:
+            _b11 |= 256
+        t_msg.fault_bitmask = _b11
         if rep_d is not None:
-            for _n14 in _v14:
-                if _n14 not in _K13_backward:
-                    rep_d.dropped("concepts.faults", _n14 + ' has no counterpart')
+            for _n11 in _v11:
+                if _n11 not in _FAULTS_WITH_BITS:
+                    rep_d.dropped("concepts.faults", _n11 + " has no counterpart")
+
+    # what did not survive the conversion
     if rep_d is not None:
-        for _n in _K15_backward:
+        for _n in _UNREAD_CONCEPTS:
             if getattr(s, _n) is not None:
-                rep_d.dropped('concepts.' + _n)
+                rep_d.dropped("concepts." + _n)
     if rep_u is not None:
-        for _n in _K16_backward:
+        for _n in _UNWRITTEN_MSG_FIELDS:
             rep_u.unknown(_n)
+
     return (t_msg,)

@@ -8,20 +8,67 @@ from __future__ import annotations
 
 import math
 
+from ..mavlink import BatteryStatus as MavlinkBatteryStatus
+from ..uorb import BatteryStatus as UorbBatteryStatus
 from . import _runtime as _r
-from ._concepts import BatteryState
-from ..mavlink import BatteryStatus as _C0
-from ..uorb import BatteryStatus as _C1
+
+_UNREAD_MSG_FIELDS = (
+    ("id", "id"),
+    ("battery_function", "battery_function"),
+    ("type", "type"),
+    ("energy_consumed", "energy_consumed"),
+    ("time_remaining", "time_remaining"),
+    ("charge_state", "charge_state"),
+    ("voltages_ext", "voltages_ext"),
+    ("mode", "mode"),
+    ("fault_bitmask", "fault_bitmask"),
+)
+_MSG_DEFAULTS = MavlinkBatteryStatus()
+_UNWRITTEN_STATUS_FIELDS = (
+    "uorb.BatteryStatus.timestamp",
+    "uorb.BatteryStatus.current_average_a",
+    "uorb.BatteryStatus.scale",
+    "uorb.BatteryStatus.time_remaining_s",
+    "uorb.BatteryStatus.source",
+    "uorb.BatteryStatus.priority",
+    "uorb.BatteryStatus.capacity",
+    "uorb.BatteryStatus.cycle_count",
+    "uorb.BatteryStatus.average_time_to_empty",
+    "uorb.BatteryStatus.manufacture_date",
+    "uorb.BatteryStatus.state_of_health",
+    "uorb.BatteryStatus.max_error",
+    "uorb.BatteryStatus.id",
+    "uorb.BatteryStatus.interface_error",
+    "uorb.BatteryStatus.max_cell_voltage_delta",
+    "uorb.BatteryStatus.is_powering_off",
+    "uorb.BatteryStatus.is_required",
+    "uorb.BatteryStatus.faults",
+    "uorb.BatteryStatus.full_charge_capacity_wh",
+    "uorb.BatteryStatus.remaining_capacity_wh",
+    "uorb.BatteryStatus.over_discharge_count",
+    "uorb.BatteryStatus.nominal_voltage",
+    "uorb.BatteryStatus.internal_resistance_estimate",
+    "uorb.BatteryStatus.ocv_estimate",
+    "uorb.BatteryStatus.ocv_estimate_filtered",
+    "uorb.BatteryStatus.volt_based_soc_estimate",
+    "uorb.BatteryStatus.voltage_prediction",
+    "uorb.BatteryStatus.prediction_error",
+    "uorb.BatteryStatus.estimation_covariance_norm",
+)
 
 
-_K9_forward = (("id", "id"), ("battery_function", "battery_function"), ("type", "type"), ("energy_consumed", "energy_consumed"), ("time_remaining", "time_remaining"), ("charge_state", "charge_state"), ("voltages_ext", "voltages_ext"), ("mode", "mode"), ("fault_bitmask", "fault_bitmask"))
-_K10_forward = _C0()
-_K11_forward = ("uorb.BatteryStatus.timestamp", "uorb.BatteryStatus.current_average_a", "uorb.BatteryStatus.scale", "uorb.BatteryStatus.time_remaining_s", "uorb.BatteryStatus.source", "uorb.BatteryStatus.priority", "uorb.BatteryStatus.capacity", "uorb.BatteryStatus.cycle_count", "uorb.BatteryStatus.average_time_to_empty", "uorb.BatteryStatus.manufacture_date", "uorb.BatteryStatus.state_of_health", "uorb.BatteryStatus.max_error", "uorb.BatteryStatus.id", "uorb.BatteryStatus.interface_error", "uorb.BatteryStatus.max_cell_voltage_delta", "uorb.BatteryStatus.is_powering_off", "uorb.BatteryStatus.is_required", "uorb.BatteryStatus.faults", "uorb.BatteryStatus.full_charge_capacity_wh", "uorb.BatteryStatus.remaining_capacity_wh", "uorb.BatteryStatus.over_discharge_count", "uorb.BatteryStatus.nominal_voltage", "uorb.BatteryStatus.internal_resistance_estimate", "uorb.BatteryStatus.ocv_estimate", "uorb.BatteryStatus.ocv_estimate_filtered", "uorb.BatteryStatus.volt_based_soc_estimate", "uorb.BatteryStatus.voltage_prediction", "uorb.BatteryStatus.prediction_error", "uorb.BatteryStatus.estimation_covariance_norm")
-
-
-def forward(s_msg: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C1]:
+def forward(
+    s_msg: MavlinkBatteryStatus,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[UorbBatteryStatus]:
     """mavlink -> uorb: returns the target objects as a tuple."""
-    t_status = _C1()
+    t_status = UorbBatteryStatus()
+
+    # px4_mavlink_receiver.yaml:11: zero_all -> status
+    # battery_status_s battery_status{}
     t_status.voltage_v = 0.0
     t_status.current_a = 0.0
     t_status.current_average_a = 0.0
@@ -32,31 +79,59 @@ def forward(s_msg: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRepor
     t_status.temperature = 0.0
     t_status.cell_count = 0
     t_status.voltage_cell_v = [0.0] * 14
+
+    # px4_mavlink_receiver.yaml:12: px4_receiver_cells voltages -> voltage_cell_v, cell_count, voltage_v
+    # Cells while below UINT16_MAX (at most 10): voltage_cell_v[i] = v / 1000.0f, summed in float32 into voltage_v;
+    # voltages_ext is not read.
     _c2, _n2, _t2 = _r.px4_receiver_cells(s_msg.voltages, 14, 65535, 1000.0)
     t_status.voltage_cell_v = _c2
     t_status.cell_count = _n2
     t_status.voltage_v = _t2
+
+    # px4_mavlink_receiver.yaml:18: px4_convert current_battery -> current_a
+    # current_a = current_battery / 100.0f
     _x3 = _r.f32(float(s_msg.current_battery))
     _x3 = _r.f32(_x3 / 100.0)
     t_status.current_a = _x3
+
+    # px4_mavlink_receiver.yaml:19: px4_convert battery_remaining -> remaining
+    # remaining = battery_remaining / 100.0f (-1 gives -0.01)
     _x4 = _r.f32(float(s_msg.battery_remaining))
     _x4 = _r.f32(_x4 / 100.0)
     t_status.remaining = _x4
+
+    # px4_mavlink_receiver.yaml:26: px4_convert current_consumed -> discharged_mah
+    # discharged_mah = current_consumed
     _x5 = _r.f32(float(s_msg.current_consumed))
     t_status.discharged_mah = _x5
+
+    # px4_mavlink_receiver.yaml:27: px4_convert temperature -> temperature
+    # temperature = (float)temperature -- PX4 copies the cdegC number unscaled into degC
     _x6 = _r.f32(float(s_msg.temperature))
     t_status.temperature = _x6
+
+    # px4_mavlink_receiver.yaml:32: const True -> connected
     t_status.connected = True
+
+    # px4_mavlink_receiver.yaml:33: px4_warning -> warning
+    # The receiver's own threshold chain (BAT_EMERGEN_THR, BAT_CRIT_THR, BAT_LOW_THR), NONE otherwise.
     _s8 = t_status.remaining
-    t_status.warning = (
-        3 if _s8 < 0.05000000074505806 else 2 if _s8 < 0.07000000029802322 else 1 if _s8 < 0.15000000596046448 else 0
-    )
+    if _s8 < 0.05000000074505806:
+        t_status.warning = 3
+    elif _s8 < 0.07000000029802322:
+        t_status.warning = 2
+    elif _s8 < 0.15000000596046448:
+        t_status.warning = 1
+    else:
+        t_status.warning = 0
+
+    # what did not survive the conversion
     if rep_d is not None:
-        for _a, _n in _K9_forward:
-            if _r.differs(getattr(s_msg, _a), getattr(_K10_forward, _a)):
+        for _a, _n in _UNREAD_MSG_FIELDS:
+            if _r.differs(getattr(s_msg, _a), getattr(_MSG_DEFAULTS, _a)):
                 rep_d.dropped("mavlink.BATTERY_STATUS." + _n)
     if rep_u is not None:
-        for _n in _K11_forward:
+        for _n in _UNWRITTEN_STATUS_FIELDS:
             rep_u.unknown(_n)
     if rep_u is not None and _r.is_marker(t_status.voltage_v, 0.0):
         rep_u.unknown("uorb.BatteryStatus.voltage_v")
@@ -72,4 +147,5 @@ def forward(s_msg: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRepor
         rep_u.unknown("uorb.BatteryStatus.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
         rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
+
     return (t_status,)

@@ -8,55 +8,154 @@ from __future__ import annotations
 
 import math
 
+from ..mavlink import BatteryStatus as MavlinkBatteryStatus
+from ..uorb import BatteryStatus as UorbBatteryStatus
 from . import _runtime as _r
-from ._concepts import BatteryState
-from ..uorb import BatteryStatus as _C0
-from ..mavlink import BatteryStatus as _C1
+
+_CHARGE_STATE_BY_WARNING = {0: 1, 1: 2, 2: 3, 3: 4, 4: 5, 6: 6, 7: 7}
+_UNREAD_STATUS_FIELDS = (
+    ("timestamp", "timestamp"),
+    ("current_average_a", "current_average_a"),
+    ("scale", "scale"),
+    ("source", "source"),
+    ("priority", "priority"),
+    ("capacity", "capacity"),
+    ("cycle_count", "cycle_count"),
+    ("average_time_to_empty", "average_time_to_empty"),
+    ("manufacture_date", "manufacture_date"),
+    ("state_of_health", "state_of_health"),
+    ("max_error", "max_error"),
+    ("interface_error", "interface_error"),
+    ("max_cell_voltage_delta", "max_cell_voltage_delta"),
+    ("is_powering_off", "is_powering_off"),
+    ("is_required", "is_required"),
+    ("full_charge_capacity_wh", "full_charge_capacity_wh"),
+    ("remaining_capacity_wh", "remaining_capacity_wh"),
+    ("over_discharge_count", "over_discharge_count"),
+    ("nominal_voltage", "nominal_voltage"),
+    ("internal_resistance_estimate", "internal_resistance_estimate"),
+    ("ocv_estimate", "ocv_estimate"),
+    ("ocv_estimate_filtered", "ocv_estimate_filtered"),
+    ("volt_based_soc_estimate", "volt_based_soc_estimate"),
+    ("voltage_prediction", "voltage_prediction"),
+    ("prediction_error", "prediction_error"),
+    ("estimation_covariance_norm", "estimation_covariance_norm"),
+)
+_STATUS_DEFAULTS = UorbBatteryStatus()
 
 
-_K10_forward = dict(((0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (6, 6), (7, 7),))
-_K16_forward = (("timestamp", "timestamp"), ("current_average_a", "current_average_a"), ("scale", "scale"), ("source", "source"), ("priority", "priority"), ("capacity", "capacity"), ("cycle_count", "cycle_count"), ("average_time_to_empty", "average_time_to_empty"), ("manufacture_date", "manufacture_date"), ("state_of_health", "state_of_health"), ("max_error", "max_error"), ("interface_error", "interface_error"), ("max_cell_voltage_delta", "max_cell_voltage_delta"), ("is_powering_off", "is_powering_off"), ("is_required", "is_required"), ("full_charge_capacity_wh", "full_charge_capacity_wh"), ("remaining_capacity_wh", "remaining_capacity_wh"), ("over_discharge_count", "over_discharge_count"), ("nominal_voltage", "nominal_voltage"), ("internal_resistance_estimate", "internal_resistance_estimate"), ("ocv_estimate", "ocv_estimate"), ("ocv_estimate_filtered", "ocv_estimate_filtered"), ("volt_based_soc_estimate", "volt_based_soc_estimate"), ("voltage_prediction", "voltage_prediction"), ("prediction_error", "prediction_error"), ("estimation_covariance_norm", "estimation_covariance_norm"))
-_K17_forward = _C0()
-
-
-def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C1]:
+def forward(
+    s_status: UorbBatteryStatus,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[MavlinkBatteryStatus]:
     """uorb -> mavlink: returns the target objects as a tuple."""
-    t_msg = _C1()
+    t_msg = MavlinkBatteryStatus()
+
+    # px4_mavlink_stream.yaml:12: zero_all -> msg
+    # mavlink_battery_status_t bat_msg{}
     t_msg.temperature = 0
     t_msg.voltages = [0] * 10
     t_msg.current_battery = 0
     t_msg.current_consumed = 0
     t_msg.energy_consumed = 0
     t_msg.battery_remaining = 0
-    t_msg.id = _r.c_wrap(int(s_status.id) + -1, 8, False)
+
+    # px4_mavlink_stream.yaml:13: px4_int id -> id
+    # id = battery_status.id - 1 (uint8: 0 becomes 255)
+    t_msg.id = _r.c_wrap(int(s_status.id) - 1, 8, False)
+
+    # px4_mavlink_stream.yaml:14: const MAV_BATTERY_FUNCTION_ALL -> battery_function
     t_msg.battery_function = 1
+
+    # px4_mavlink_stream.yaml:15: const MAV_BATTERY_TYPE_LIPO -> type
     t_msg.type = 1
+
+    # px4_mavlink_stream.yaml:16: px4_convert discharged_mah -> current_consumed
+    # current_consumed = connected ? discharged_mah : -1
     _x5 = _r.f32(float(s_status.discharged_mah))
-    t_msg.current_consumed = _r.c_float_to_int(_x5, 32, True, rep, "mavlink.BATTERY_STATUS.current_consumed") if s_status.connected else -1
+    if s_status.connected:
+        t_msg.current_consumed = _r.c_float_to_int(_x5, 32, True, rep, "mavlink.BATTERY_STATUS.current_consumed")
+    else:
+        t_msg.current_consumed = -1
+
+    # px4_mavlink_stream.yaml:23: const -1 -> energy_consumed
     t_msg.energy_consumed = -1
+
+    # px4_mavlink_stream.yaml:24: px4_convert current_a -> current_battery
+    # current_battery = connected ? current_a * 100 : -1 (int16: above 327.67 A it wraps)
     _x7 = _r.f32(float(s_status.current_a))
     _x7 = _r.f32(_x7 * 100.0)
-    t_msg.current_battery = _r.c_float_to_int(_x7, 16, True, rep, "mavlink.BATTERY_STATUS.current_battery") if s_status.connected else -1
+    if s_status.connected:
+        t_msg.current_battery = _r.c_float_to_int(_x7, 16, True, rep, "mavlink.BATTERY_STATUS.current_battery")
+    else:
+        t_msg.current_battery = -1
+
+    # px4_mavlink_stream.yaml:31: px4_convert remaining -> battery_remaining
+    # battery_remaining = connected ? roundf(remaining * 100.f) : -1
     _x8 = _r.f32(float(s_status.remaining))
     _x8 = _r.f32(_x8 * 100.0)
     _x8 = _r.roundf(_x8)
-    t_msg.battery_remaining = _r.c_float_to_int(_x8, 8, True, rep, "mavlink.BATTERY_STATUS.battery_remaining") if s_status.connected else -1
+    if s_status.connected:
+        t_msg.battery_remaining = _r.c_float_to_int(_x8, 8, True, rep, "mavlink.BATTERY_STATUS.battery_remaining")
+    else:
+        t_msg.battery_remaining = -1
+
+    # px4_mavlink_stream.yaml:40: px4_convert time_remaining_s -> time_remaining
+    # time_remaining = connected && isfinite(time_remaining_s) ? max((int)time_remaining_s, 1) : 0
     _x9 = _r.f32(float(s_status.time_remaining_s))
-    t_msg.time_remaining = max(_r.c_float_to_int(_x9, 32, True, rep, "mavlink.BATTERY_STATUS.time_remaining"), 1) if s_status.connected and math.isfinite(_x9) else 0
-    t_msg.charge_state = _K10_forward.get(s_status.warning, 0)
+    if s_status.connected and math.isfinite(_x9):
+        t_msg.time_remaining = max(_r.c_float_to_int(_x9, 32, True, rep, "mavlink.BATTERY_STATUS.time_remaining"), 1)
+    else:
+        t_msg.time_remaining = 0
+
+    # px4_mavlink_stream.yaml:49: enum_map warning -> charge_state
+    # The switch on battery_status.warning.
+    t_msg.charge_state = _CHARGE_STATE_BY_WARNING.get(s_status.warning, 0)
+
+    # px4_mavlink_stream.yaml:62: const MAV_BATTERY_MODE_UNKNOWN -> mode
+    # This battery_status version has no mode field: the switch's default.
     t_msg.mode = 0
+
+    # px4_mavlink_stream.yaml:63: px4_int faults -> fault_bitmask
+    # fault_bitmask = faults (bit i of FAULT_* as it is)
     t_msg.fault_bitmask = _r.c_wrap(int(s_status.faults), 32, False)
-    _x14 = _r.f32(float(s_status.temperature))
-    _x14 = _r.f32(_x14 * 100.0)
-    t_msg.temperature = _r.c_float_to_int(_x14, 16, True, rep, "mavlink.BATTERY_STATUS.temperature") if s_status.connected and math.isfinite(_x14) else 32767
+
+    # px4_mavlink_stream.yaml:64: px4_convert temperature -> temperature
+    # temperature = connected && isfinite(temperature) ? temperature * 100.f : INT16_MAX
+    _x13 = _r.f32(float(s_status.temperature))
+    _x13 = _r.f32(_x13 * 100.0)
+    if s_status.connected and math.isfinite(_x13):
+        t_msg.temperature = _r.c_float_to_int(_x13, 16, True, rep, "mavlink.BATTERY_STATUS.temperature")
+    else:
+        t_msg.temperature = 32767
+
+    # px4_mavlink_stream.yaml:72: px4_stream_cells voltage_v, voltage_cell_v, cell_count, connected -> voltages,
+    # voltages_ext
+    # voltages all UINT16_MAX, voltages_ext all 0; if connected: with cell_count 0 or cell 0 below 0.0001 V the pack
+    # voltage in mV goes into cell 1, split into UINT16_MAX - 1 chunks when it does not fit (left unknown beyond 10
+    # fields), else min(cell_count, 14) cells x 1000.f.
     t_msg.voltages, t_msg.voltages_ext = _r.px4_stream_cells(
-        s_status.voltage_v, s_status.voltage_cell_v, s_status.cell_count, s_status.connected,
-        1000.0, 9.999999747378752e-05, 10, 4, 65535, 0,
-        rep, "mavlink.BATTERY_STATUS.voltages",
+        s_status.voltage_v,
+        s_status.voltage_cell_v,
+        s_status.cell_count,
+        s_status.connected,
+        1000.0,
+        9.999999747378752e-05,
+        10,
+        4,
+        65535,
+        0,
+        rep,
+        "mavlink.BATTERY_STATUS.voltages",
     )
+
+    # what did not survive the conversion
     if rep_d is not None:
-        for _a, _n in _K16_forward:
-            if _r.differs(getattr(s_status, _a), getattr(_K17_forward, _a)):
+        for _a, _n in _UNREAD_STATUS_FIELDS:
+            if _r.differs(getattr(s_status, _a), getattr(_STATUS_DEFAULTS, _a)):
                 rep_d.dropped("uorb.BatteryStatus." + _n)
     if rep_u is not None and _r.is_marker(t_msg.temperature, 32767):
         rep_u.unknown("mavlink.BATTERY_STATUS.temperature")
@@ -70,4 +169,5 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
         rep_u.unknown("mavlink.BATTERY_STATUS.energy_consumed")
     if rep_u is not None and _r.is_marker(t_msg.battery_remaining, -1):
         rep_u.unknown("mavlink.BATTERY_STATUS.battery_remaining")
+
     return (t_msg,)

@@ -8,23 +8,58 @@ from __future__ import annotations
 
 import math
 
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
+from ..uorb import BatteryStatus
 from . import _runtime as _r
-from ._concepts import BatteryState
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _C0
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _C1
-from ..uorb import BatteryStatus as _C2
+
+_UNREAD_INFO_FIELDS = (
+    ("average_power_10sec", "average_power_10sec"),
+    ("hours_to_full_charge", "hours_to_full_charge"),
+    ("state_of_health_pct", "state_of_health_pct"),
+    ("state_of_charge_pct_stdev", "state_of_charge_pct_stdev"),
+    ("model_instance_id", "model_instance_id"),
+    ("model_name", "model_name"),
+)
+_INFO_DEFAULTS = BatteryInfo()
+_UNREAD_AUX_FIELDS = (("timestamp", "timestamp"), ("max_current", "max_current"), ("battery_id", "battery_id"))
+_AUX_DEFAULTS = BatteryInfoAux()
+_UNWRITTEN_STATUS_FIELDS = (
+    "uorb.BatteryStatus.timestamp",
+    "uorb.BatteryStatus.current_average_a",
+    "uorb.BatteryStatus.discharged_mah",
+    "uorb.BatteryStatus.priority",
+    "uorb.BatteryStatus.average_time_to_empty",
+    "uorb.BatteryStatus.manufacture_date",
+    "uorb.BatteryStatus.state_of_health",
+    "uorb.BatteryStatus.max_error",
+    "uorb.BatteryStatus.interface_error",
+    "uorb.BatteryStatus.max_cell_voltage_delta",
+    "uorb.BatteryStatus.is_required",
+    "uorb.BatteryStatus.faults",
+    "uorb.BatteryStatus.internal_resistance_estimate",
+    "uorb.BatteryStatus.ocv_estimate",
+    "uorb.BatteryStatus.ocv_estimate_filtered",
+    "uorb.BatteryStatus.volt_based_soc_estimate",
+    "uorb.BatteryStatus.voltage_prediction",
+    "uorb.BatteryStatus.prediction_error",
+    "uorb.BatteryStatus.estimation_covariance_norm",
+)
 
 
-_K20_forward = (("average_power_10sec", "average_power_10sec"), ("hours_to_full_charge", "hours_to_full_charge"), ("state_of_health_pct", "state_of_health_pct"), ("state_of_charge_pct_stdev", "state_of_charge_pct_stdev"), ("model_instance_id", "model_instance_id"), ("model_name", "model_name"))
-_K21_forward = _C0()
-_K22_forward = (("timestamp", "timestamp"), ("max_current", "max_current"), ("battery_id", "battery_id"))
-_K23_forward = _C1()
-_K24_forward = ("uorb.BatteryStatus.timestamp", "uorb.BatteryStatus.current_average_a", "uorb.BatteryStatus.discharged_mah", "uorb.BatteryStatus.priority", "uorb.BatteryStatus.average_time_to_empty", "uorb.BatteryStatus.manufacture_date", "uorb.BatteryStatus.state_of_health", "uorb.BatteryStatus.max_error", "uorb.BatteryStatus.interface_error", "uorb.BatteryStatus.max_cell_voltage_delta", "uorb.BatteryStatus.is_required", "uorb.BatteryStatus.faults", "uorb.BatteryStatus.internal_resistance_estimate", "uorb.BatteryStatus.ocv_estimate", "uorb.BatteryStatus.ocv_estimate_filtered", "uorb.BatteryStatus.volt_based_soc_estimate", "uorb.BatteryStatus.voltage_prediction", "uorb.BatteryStatus.prediction_error", "uorb.BatteryStatus.estimation_covariance_norm")
-
-
-def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C2]:
+def forward(
+    s_info: BatteryInfo,
+    s_aux: BatteryInfoAux | None = None,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryStatus]:
     """dronecan -> uorb: returns the target objects as a tuple."""
-    t_status = _C2()
+    t_status = BatteryStatus()
+
+    # px4_uavcan_bridge.yaml:16: zero_all -> status
+    # The bridge's battery_status array is zero-initialised.
     t_status.voltage_v = 0.0
     t_status.current_a = 0.0
     t_status.current_average_a = 0.0
@@ -35,63 +70,130 @@ def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None 
     t_status.temperature = 0.0
     t_status.cell_count = 0
     t_status.voltage_cell_v = [0.0] * 14
-    _x2 = _r.f16(float(s_info.voltage), None, '')
+
+    # px4_uavcan_bridge.yaml:17: px4_convert info.voltage -> voltage_v
+    # voltage_v = msg.voltage
+    _x2 = _r.f16(float(s_info.voltage), None, "")
     t_status.voltage_v = _x2
-    _x3 = _r.f16(float(s_info.current), None, '')
+
+    # px4_uavcan_bridge.yaml:18: px4_convert info.current -> current_a
+    # current_a = msg.current
+    _x3 = _r.f16(float(s_info.current), None, "")
     t_status.current_a = _x3
+
+    # px4_uavcan_bridge.yaml:19: px4_convert info.state_of_charge_pct -> remaining
+    # remaining = msg.state_of_charge_pct / 100.0f -- no check for 127, so 127 gives 1.27
     _x4 = _r.f32(float(s_info.state_of_charge_pct))
     _x4 = _r.f32(_x4 / 100.0)
     t_status.remaining = _x4
+
+    # px4_uavcan_bridge.yaml:26: const -1.0 -> scale
+    # scale = -1.f
     t_status.scale = -1.0
-    _x6 = _r.f16(float(s_info.temperature), None, '')
+
+    # px4_uavcan_bridge.yaml:27: px4_convert info.temperature -> temperature
+    # temperature = msg.temperature + atmosphere::kAbsoluteNullCelsius (-273.15f); NaN stays NaN
+    _x6 = _r.f16(float(s_info.temperature), None, "")
     _x6 = _r.f32(_x6 + -273.1499938964844)
     t_status.temperature = _x6
+
+    # px4_uavcan_bridge.yaml:32: const True -> connected
+    # connected = true
     t_status.connected = True
+
+    # px4_uavcan_bridge.yaml:33: px4_int info.status_flags -> source
+    # source = msg.status_flags & STATUS_FLAG_IN_USE (so 1, EXTERNAL, while in use, else 0)
     t_status.source = _r.c_wrap((int(s_info.status_flags) & 1), 8, False)
-    _x9 = _r.f16(float(s_info.full_charge_capacity_wh), None, '')
+
+    # px4_uavcan_bridge.yaml:38: px4_convert info.full_charge_capacity_wh -> full_charge_capacity_wh
+    _x9 = _r.f16(float(s_info.full_charge_capacity_wh), None, "")
     t_status.full_charge_capacity_wh = _x9
-    _x10 = _r.f16(float(s_info.remaining_capacity_wh), None, '')
+
+    # px4_uavcan_bridge.yaml:39: px4_convert info.remaining_capacity_wh -> remaining_capacity_wh
+    _x10 = _r.f16(float(s_info.remaining_capacity_wh), None, "")
     t_status.remaining_capacity_wh = _x10
+
+    # px4_uavcan_bridge.yaml:40: px4_int info.battery_id -> id
+    # id = msg.battery_id (0-based, copied as it is)
     t_status.id = _r.c_wrap(int(s_info.battery_id), 8, False)
+
+    # px4_uavcan_bridge.yaml:41: const math.nan -> time_remaining_s
+    # time_remaining_s = NAN (raw mode)
     t_status.time_remaining_s = math.nan
+
+    # px4_uavcan_bridge.yaml:42: px4_bridge_cells info.voltage, aux.voltage_cell -> voltage_cell_v, cell_count
+    # Without BatteryInfoAux: voltage_cell_v[0] = msg.voltage, cell_count = 1. With it: cell_count = min(cells, 14) and
+    # those cells copied.
     _c13 = [0.0] * 14
-    _c13[0] = _r.f16(float(s_info.voltage), None, '')
+    _c13[0] = _r.f16(float(s_info.voltage), None, "")
     if s_aux is None:
         t_status.cell_count = 1
     else:
         _a13 = s_aux.voltage_cell
         _n13 = min(len(_a13) & 0xFF, 14)
         for _i13 in range(_n13):
-            _c13[_i13] = _r.f16(float(_a13[_i13]), None, '')
+            _c13[_i13] = _r.f16(float(_a13[_i13]), None, "")
         t_status.cell_count = _n13
     t_status.voltage_cell_v = _c13
+
+    # px4_uavcan_bridge.yaml:48: px4_warning -> warning
+    # Battery::determineWarning(remaining) with the default BAT_EMERGEN_THR, BAT_CRIT_THR and BAT_LOW_THR: EMERGENCY
+    # below 0.05, CRITICAL below 0.07, LOW below 0.15, else NONE (float32 compares).
     _s14 = t_status.remaining
-    t_status.warning = (
-        3 if _s14 < 0.05000000074505806 else 2 if _s14 < 0.07000000029802322 else 1 if _s14 < 0.15000000596046448 else 0
-    )
+    if _s14 < 0.05000000074505806:
+        t_status.warning = 3
+    elif _s14 < 0.07000000029802322:
+        t_status.warning = 2
+    elif _s14 < 0.15000000596046448:
+        t_status.warning = 1
+    else:
+        t_status.warning = 0
+
+    # px4_uavcan_bridge.yaml:57: px4_int aux.cycle_count -> cycle_count
     if s_aux is not None:
         t_status.cycle_count = _r.c_wrap(int(s_aux.cycle_count), 16, False)
+
+    # px4_uavcan_bridge.yaml:58: px4_int aux.over_discharge_count -> over_discharge_count
     if s_aux is not None:
         t_status.over_discharge_count = _r.c_wrap(int(s_aux.over_discharge_count), 16, False)
+
+    # px4_uavcan_bridge.yaml:59: px4_convert aux.nominal_voltage -> nominal_voltage
+    # nominal_voltage = msg.nominal_voltage > FLT_EPSILON ? msg.nominal_voltage : NAN
     if s_aux is not None:
-        _x17 = _r.f16(float(s_aux.nominal_voltage), None, '')
-        t_status.nominal_voltage = _x17 if _x17 > 1.1920928955078125e-07 else math.nan
+        _x17 = _r.f16(float(s_aux.nominal_voltage), None, "")
+        if _x17 > 1.1920928955078125e-07:
+            t_status.nominal_voltage = _x17
+        else:
+            t_status.nominal_voltage = math.nan
+
+    # px4_uavcan_bridge.yaml:66: px4_int aux.is_powering_off -> is_powering_off
     if s_aux is not None:
         t_status.is_powering_off = bool(int(s_aux.is_powering_off))
+
+    # px4_uavcan_bridge.yaml:67: px4_aux_capacity info.full_charge_capacity_wh, aux.nominal_voltage -> capacity
+    # if nominal_voltage > FLT_EPSILON: capacity = full_charge_capacity_wh * 1000.f / nominal_voltage (Wh / V in mAh)
     if s_aux is not None:
-        _v19 = _r.f16(float(s_aux.nominal_voltage), None, '')
+        _v19 = _r.f16(float(s_aux.nominal_voltage), None, "")
         if _v19 > 1.1920928955078125e-07:
-            t_status.capacity = _r.c_float_to_int(_r.f32(_r.f32(_r.f16(float(s_info.full_charge_capacity_wh), None, '') * 1000.0) / _v19), 16, False, rep, "uorb.BatteryStatus.capacity")
+            t_status.capacity = _r.c_float_to_int(
+                _r.f32(_r.f32(_r.f16(float(s_info.full_charge_capacity_wh), None, "") * 1000.0) / _v19),
+                16,
+                False,
+                rep,
+                "uorb.BatteryStatus.capacity",
+            )
+
+    # what did not survive the conversion
     if rep_d is not None:
-        for _a, _n in _K20_forward:
-            if _r.differs(getattr(s_info, _a), getattr(_K21_forward, _a)):
+        for _a, _n in _UNREAD_INFO_FIELDS:
+            if _r.differs(getattr(s_info, _a), getattr(_INFO_DEFAULTS, _a)):
                 rep_d.dropped("dronecan.uavcan.equipment.power.BatteryInfo." + _n)
     if rep_d is not None and s_aux is not None:
-        for _a, _n in _K22_forward:
-            if _r.differs(getattr(s_aux, _a), getattr(_K23_forward, _a)):
+        for _a, _n in _UNREAD_AUX_FIELDS:
+            if _r.differs(getattr(s_aux, _a), getattr(_AUX_DEFAULTS, _a)):
                 rep_d.dropped("dronecan.ardupilot.equipment.power.BatteryInfoAux." + _n)
     if rep_u is not None:
-        for _n in _K24_forward:
+        for _n in _UNWRITTEN_STATUS_FIELDS:
             rep_u.unknown(_n)
     if rep_u is not None and _r.is_marker(t_status.voltage_v, 0.0):
         rep_u.unknown("uorb.BatteryStatus.voltage_v")
@@ -109,4 +211,5 @@ def forward(s_info: _C0, s_aux: _C1 | None = None, *, rep: _r.LossReport | None 
         rep_u.unknown("uorb.BatteryStatus.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
         rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
+
     return (t_status,)

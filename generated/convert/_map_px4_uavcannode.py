@@ -8,23 +8,55 @@ from __future__ import annotations
 
 import math
 
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
+from ..uorb import BatteryStatus
 from . import _runtime as _r
-from ._concepts import BatteryState
-from ..uorb import BatteryStatus as _C0
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _C1
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _C2
+
+_UNREAD_STATUS_FIELDS = (
+    ("timestamp", "timestamp"),
+    ("current_average_a", "current_average_a"),
+    ("discharged_mah", "discharged_mah"),
+    ("scale", "scale"),
+    ("time_remaining_s", "time_remaining_s"),
+    ("source", "source"),
+    ("priority", "priority"),
+    ("capacity", "capacity"),
+    ("average_time_to_empty", "average_time_to_empty"),
+    ("manufacture_date", "manufacture_date"),
+    ("interface_error", "interface_error"),
+    ("max_cell_voltage_delta", "max_cell_voltage_delta"),
+    ("is_required", "is_required"),
+    ("faults", "faults"),
+    ("internal_resistance_estimate", "internal_resistance_estimate"),
+    ("ocv_estimate", "ocv_estimate"),
+    ("ocv_estimate_filtered", "ocv_estimate_filtered"),
+    ("volt_based_soc_estimate", "volt_based_soc_estimate"),
+    ("voltage_prediction", "voltage_prediction"),
+    ("prediction_error", "prediction_error"),
+    ("estimation_covariance_norm", "estimation_covariance_norm"),
+)
+_STATUS_DEFAULTS = BatteryStatus()
+_UNWRITTEN_INFO_FIELDS = (
+    "dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec",
+    "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge",
+)
+_UNWRITTEN_AUX_FIELDS = ("dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp",)
 
 
-_K21_forward = (("timestamp", "timestamp"), ("current_average_a", "current_average_a"), ("discharged_mah", "discharged_mah"), ("scale", "scale"), ("time_remaining_s", "time_remaining_s"), ("source", "source"), ("priority", "priority"), ("capacity", "capacity"), ("average_time_to_empty", "average_time_to_empty"), ("manufacture_date", "manufacture_date"), ("interface_error", "interface_error"), ("max_cell_voltage_delta", "max_cell_voltage_delta"), ("is_required", "is_required"), ("faults", "faults"), ("internal_resistance_estimate", "internal_resistance_estimate"), ("ocv_estimate", "ocv_estimate"), ("ocv_estimate_filtered", "ocv_estimate_filtered"), ("volt_based_soc_estimate", "volt_based_soc_estimate"), ("voltage_prediction", "voltage_prediction"), ("prediction_error", "prediction_error"), ("estimation_covariance_norm", "estimation_covariance_norm"))
-_K22_forward = _C0()
-_K23_forward = ("dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec", "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge")
-_K24_forward = ("dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp",)
-
-
-def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C1, _C2]:
+def forward(
+    s_status: BatteryStatus,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryInfo, BatteryInfoAux]:
     """uorb -> dronecan: returns the target objects as a tuple."""
-    t_info = _C1()
-    t_aux = _C2()
+    t_info = BatteryInfo()
+    t_aux = BatteryInfoAux()
+
+    # px4_uavcannode.yaml:12: zero_all -> info, aux
+    # BatteryInfo battery_info{} and BatteryInfoAux battery_info_aux{}
     t_info.temperature = 0.0
     t_info.voltage = 0.0
     t_info.current = 0.0
@@ -33,49 +65,112 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     t_info.full_charge_capacity_wh = 0.0
     t_info.hours_to_full_charge = 0.0
     t_info.state_of_health_pct = 0
+
+    # px4_uavcannode.yaml:13: px4_cell_list voltage_cell_v, cell_count -> aux.voltage_cell
+    # voltage_cell = voltage_cell_v[0 .. cell_count)
     _n2 = s_status.cell_count
     if _n2 > 14 and rep is not None:
-        rep.clamped("dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell", '%d cells, %d in the array' % (_n2, 14))
-    t_aux.voltage_cell = [_r.f16(_r.f32(_x2), rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell") for _x2 in s_status.voltage_cell_v[:min(_n2, 14)]]
+        rep.clamped(
+            "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell",
+            f"{int(_n2)} cells, 14 in the array",
+        )
+    _m2 = min(_n2, 14)
+    _s2 = "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell"
+    t_aux.voltage_cell = [_r.f16(_r.f32(_x2), rep, _s2) for _x2 in s_status.voltage_cell_v[:_m2]]
+
+    # px4_uavcannode.yaml:14: px4_int cycle_count -> aux.cycle_count
     t_aux.cycle_count = _r.c_wrap(int(s_status.cycle_count), 16, False)
+
+    # px4_uavcannode.yaml:15: px4_int over_discharge_count -> aux.over_discharge_count
     t_aux.over_discharge_count = _r.c_wrap(int(s_status.over_discharge_count), 16, False)
+
+    # px4_uavcannode.yaml:16: px4_convert current_a -> aux.max_current
+    # max_current = current_a
     _x5 = _r.f32(float(s_status.current_a))
     t_aux.max_current = _r.f16(_x5, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current")
+
+    # px4_uavcannode.yaml:17: px4_convert nominal_voltage -> aux.nominal_voltage
     _x6 = _r.f32(float(s_status.nominal_voltage))
     t_aux.nominal_voltage = _r.f16(_x6, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage")
+
+    # px4_uavcannode.yaml:18: px4_int is_powering_off -> aux.is_powering_off
     t_aux.is_powering_off = bool(int(s_status.is_powering_off))
+
+    # px4_uavcannode.yaml:19: px4_int id -> aux.battery_id
     t_aux.battery_id = _r.c_wrap(int(s_status.id), 8, False)
+
+    # px4_uavcannode.yaml:20: px4_convert voltage_v -> info.voltage
     _x9 = _r.f32(float(s_status.voltage_v))
     t_info.voltage = _r.f16(_x9, rep, "dronecan.uavcan.equipment.power.BatteryInfo.voltage")
+
+    # px4_uavcannode.yaml:21: px4_convert current_a -> info.current
     _x10 = _r.f32(float(s_status.current_a))
     t_info.current = _r.f16(_x10, rep, "dronecan.uavcan.equipment.power.BatteryInfo.current")
+
+    # px4_uavcannode.yaml:22: px4_convert temperature -> info.temperature
+    # temperature = temperature - atmosphere::kAbsoluteNullCelsius (C to K)
     _x11 = _r.f32(float(s_status.temperature))
     _x11 = _r.f32(_x11 + 273.1499938964844)
     t_info.temperature = _r.f16(_x11, rep, "dronecan.uavcan.equipment.power.BatteryInfo.temperature")
+
+    # px4_uavcannode.yaml:27: px4_convert full_charge_capacity_wh -> info.full_charge_capacity_wh
     _x12 = _r.f32(float(s_status.full_charge_capacity_wh))
-    t_info.full_charge_capacity_wh = _r.f16(_x12, rep, "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
+    t_info.full_charge_capacity_wh = _r.f16(
+        _x12,
+        rep,
+        "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh",
+    )
+
+    # px4_uavcannode.yaml:28: px4_convert remaining_capacity_wh -> info.remaining_capacity_wh
     _x13 = _r.f32(float(s_status.remaining_capacity_wh))
-    t_info.remaining_capacity_wh = _r.f16(_x13, rep, "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
+    t_info.remaining_capacity_wh = _r.f16(
+        _x13,
+        rep,
+        "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh",
+    )
+
+    # px4_uavcannode.yaml:29: px4_convert remaining -> info.state_of_charge_pct
+    # state_of_charge_pct = remaining * 100.0f (uint8 store, then uint7 saturation)
     _x14 = _r.f32(float(s_status.remaining))
     _x14 = _r.f32(_x14 * 100.0)
-    t_info.state_of_charge_pct = _r.saturate(_r.c_float_to_int(_x14, 8, False, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct"), 0, 127)
+    t_info.state_of_charge_pct = _r.saturate(
+        _r.c_float_to_int(_x14, 8, False, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct"),
+        0,
+        127,
+    )
+
+    # px4_uavcannode.yaml:35: px4_int max_error -> info.state_of_charge_pct_stdev
+    # state_of_charge_pct_stdev = max_error
     t_info.state_of_charge_pct_stdev = _r.saturate(_r.c_wrap(int(s_status.max_error), 8, False), 0, 127)
+
+    # px4_uavcannode.yaml:36: px4_int id -> info.battery_id
     t_info.battery_id = _r.c_wrap(int(s_status.id), 8, False)
+
+    # px4_uavcannode.yaml:37: const 0 -> info.model_instance_id
     t_info.model_instance_id = 0
+
+    # px4_uavcannode.yaml:38: const "PX4 CAN Battery" -> info.model_name
     t_info.model_name = b"PX4 CAN Battery"
+
+    # px4_uavcannode.yaml:39: px4_int state_of_health -> info.state_of_health_pct
     t_info.state_of_health_pct = _r.saturate(_r.c_wrap(int(s_status.state_of_health), 8, False), 0, 127)
+
+    # px4_uavcannode.yaml:40: bits_from connected, warning -> info.status_flags
+    # IN_USE while connected, CHARGING when warning is STATE_CHARGING
     _b20 = 0
     if s_status.connected:
         _b20 |= 1
     if s_status.warning == 7:
         _b20 |= 2
     t_info.status_flags = _b20
+
+    # what did not survive the conversion
     if rep_d is not None:
-        for _a, _n in _K21_forward:
-            if _r.differs(getattr(s_status, _a), getattr(_K22_forward, _a)):
+        for _a, _n in _UNREAD_STATUS_FIELDS:
+            if _r.differs(getattr(s_status, _a), getattr(_STATUS_DEFAULTS, _a)):
                 rep_d.dropped("uorb.BatteryStatus." + _n)
     if rep_u is not None:
-        for _n in _K23_forward:
+        for _n in _UNWRITTEN_INFO_FIELDS:
             rep_u.unknown(_n)
     if rep_u is not None and _r.is_marker(t_info.temperature, math.nan):
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.temperature")
@@ -90,6 +185,7 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     if rep_u is not None and _r.is_marker(t_info.state_of_health_pct, 127):
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct")
     if rep_u is not None:
-        for _n in _K24_forward:
+        for _n in _UNWRITTEN_AUX_FIELDS:
             rep_u.unknown(_n)
-    return (t_info, t_aux,)
+
+    return (t_info, t_aux)

@@ -8,101 +8,247 @@ from __future__ import annotations
 
 import math
 
+from ..uorb import BatteryStatus
 from . import _runtime as _r
 from ._concepts import BatteryState
-from ..uorb import BatteryStatus as _C0
+
+_FAULTS_BITS = (
+    ("deep_discharge", 1),
+    ("spikes", 2),
+    ("cell_fail", 4),
+    ("over_current", 8),
+    ("over_temperature", 16),
+    ("under_temperature", 32),
+    ("incompatible_voltage", 64),
+    ("incompatible_firmware", 128),
+    ("incompatible_model", 256),
+    ("hardware_failure", 512),
+    ("failed_to_arm", 1024),
+)
+_WARNING_BY_WARNING = {0: "none", 1: "low", 2: "critical", 3: "emergency", 4: "failed", 6: "unhealthy", 7: "charging"}
+_UNREAD_STATUS_FIELDS = (
+    ("timestamp", "timestamp"),
+    ("scale", "scale"),
+    ("source", "source"),
+    ("priority", "priority"),
+    ("average_time_to_empty", "average_time_to_empty"),
+    ("manufacture_date", "manufacture_date"),
+    ("max_error", "max_error"),
+    ("interface_error", "interface_error"),
+    ("max_cell_voltage_delta", "max_cell_voltage_delta"),
+    ("is_required", "is_required"),
+    ("internal_resistance_estimate", "internal_resistance_estimate"),
+    ("ocv_estimate", "ocv_estimate"),
+    ("ocv_estimate_filtered", "ocv_estimate_filtered"),
+    ("volt_based_soc_estimate", "volt_based_soc_estimate"),
+    ("voltage_prediction", "voltage_prediction"),
+    ("prediction_error", "prediction_error"),
+    ("estimation_covariance_norm", "estimation_covariance_norm"),
+)
+_STATUS_DEFAULTS = BatteryStatus()
+_FAULTS_WITH_BITS = (
+    "cell_fail",
+    "deep_discharge",
+    "failed_to_arm",
+    "hardware_failure",
+    "incompatible_firmware",
+    "incompatible_model",
+    "incompatible_voltage",
+    "over_current",
+    "over_temperature",
+    "spikes",
+    "under_temperature",
+)
+_WARNING_BY_WARNING_BACKWARD = {
+    "none": 0,
+    "low": 1,
+    "critical": 2,
+    "emergency": 3,
+    "failed": 4,
+    "unhealthy": 6,
+    "charging": 7,
+}
+_UNREAD_CONCEPTS = (
+    "in_use",
+    "charging",
+    "max_current",
+    "average_power",
+    "state_of_charge_stdev",
+    "design_energy",
+    "design_capacity",
+    "consumed_energy",
+    "time_to_full",
+    "voltage_min_design",
+    "voltage_max_design",
+    "serial_number",
+    "model_name",
+    "chemistry",
+)
+_UNWRITTEN_STATUS_FIELDS = (
+    "uorb.BatteryStatus.timestamp",
+    "uorb.BatteryStatus.scale",
+    "uorb.BatteryStatus.source",
+    "uorb.BatteryStatus.priority",
+    "uorb.BatteryStatus.average_time_to_empty",
+    "uorb.BatteryStatus.manufacture_date",
+    "uorb.BatteryStatus.max_error",
+    "uorb.BatteryStatus.interface_error",
+    "uorb.BatteryStatus.max_cell_voltage_delta",
+    "uorb.BatteryStatus.is_required",
+    "uorb.BatteryStatus.internal_resistance_estimate",
+    "uorb.BatteryStatus.ocv_estimate",
+    "uorb.BatteryStatus.ocv_estimate_filtered",
+    "uorb.BatteryStatus.volt_based_soc_estimate",
+    "uorb.BatteryStatus.voltage_prediction",
+    "uorb.BatteryStatus.prediction_error",
+    "uorb.BatteryStatus.estimation_covariance_norm",
+)
 
 
-_K16_forward = dict(((0, "none"), (1, "low"), (2, "critical"), (3, "emergency"), (4, "failed"), (6, "unhealthy"), (7, "charging"),))
-_K23_forward = (("timestamp", "timestamp"), ("scale", "scale"), ("source", "source"), ("priority", "priority"), ("average_time_to_empty", "average_time_to_empty"), ("manufacture_date", "manufacture_date"), ("max_error", "max_error"), ("interface_error", "interface_error"), ("max_cell_voltage_delta", "max_cell_voltage_delta"), ("is_required", "is_required"), ("internal_resistance_estimate", "internal_resistance_estimate"), ("ocv_estimate", "ocv_estimate"), ("ocv_estimate_filtered", "ocv_estimate_filtered"), ("volt_based_soc_estimate", "volt_based_soc_estimate"), ("voltage_prediction", "voltage_prediction"), ("prediction_error", "prediction_error"), ("estimation_covariance_norm", "estimation_covariance_norm"))
-_K24_forward = _C0()
-_K15_backward = ("cell_fail", "deep_discharge", "failed_to_arm", "hardware_failure", "incompatible_firmware", "incompatible_model", "incompatible_voltage", "over_current", "over_temperature", "spikes", "under_temperature")
-_K17_backward = dict((("none", 0), ("low", 1), ("critical", 2), ("emergency", 3), ("failed", 4), ("unhealthy", 6), ("charging", 7),))
-_K24_backward = ("in_use", "charging", "max_current", "average_power", "state_of_charge_stdev", "design_energy", "design_capacity", "consumed_energy", "time_to_full", "voltage_min_design", "voltage_max_design", "serial_number", "model_name", "chemistry")
-_K25_backward = ("uorb.BatteryStatus.timestamp", "uorb.BatteryStatus.scale", "uorb.BatteryStatus.source", "uorb.BatteryStatus.priority", "uorb.BatteryStatus.average_time_to_empty", "uorb.BatteryStatus.manufacture_date", "uorb.BatteryStatus.max_error", "uorb.BatteryStatus.interface_error", "uorb.BatteryStatus.max_cell_voltage_delta", "uorb.BatteryStatus.is_required", "uorb.BatteryStatus.internal_resistance_estimate", "uorb.BatteryStatus.ocv_estimate", "uorb.BatteryStatus.ocv_estimate_filtered", "uorb.BatteryStatus.volt_based_soc_estimate", "uorb.BatteryStatus.voltage_prediction", "uorb.BatteryStatus.prediction_error", "uorb.BatteryStatus.estimation_covariance_norm")
-
-
-def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[BatteryState]:
+def forward(
+    s_status: BatteryStatus,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryState]:
     """uorb -> concepts: returns the target objects as a tuple."""
     t = BatteryState()
+
+    # uorb.yaml:11: copy connected -> connected
     _v1 = s_status.connected
     t.connected = bool(_v1)
+
+    # uorb.yaml:12: scale voltage_v -> pack_voltage
     _v2 = s_status.voltage_v
     if _v2 != 0.0:
         t.pack_voltage = float(_v2)
+
+    # uorb.yaml:13: scale current_a -> current
     _v3 = s_status.current_a
     if _v3 != -1.0:
         t.current = float(_v3)
+
+    # uorb.yaml:14: scale current_average_a -> average_current
     _v4 = s_status.current_average_a
     if _v4 != -1.0:
         t.average_current = float(_v4)
+
+    # uorb.yaml:15: scale discharged_mah -> discharged
     _v5 = s_status.discharged_mah
     if _v5 != -1.0:
         t.discharged = float(_v5) * 3.6
+
+    # uorb.yaml:16: scale remaining -> state_of_charge
     _v6 = s_status.remaining
     if _v6 != -1.0:
         t.state_of_charge = float(_v6)
+
+    # uorb.yaml:17: scale time_remaining_s -> time_remaining
     _v7 = s_status.time_remaining_s
     if _v7 == _v7:
         t.time_remaining = float(_v7)
+
+    # uorb.yaml:18: scale temperature -> temperature
     _v8 = s_status.temperature
     if _v8 == _v8:
         t.temperature = float(_v8) + 273.15
+
+    # uorb.yaml:19: copy cell_count -> cell_count
     _v9 = s_status.cell_count
     if _v9 != 0:
         t.cell_count = _v9
+
+    # uorb.yaml:20: cells voltage_cell_v -> cell_voltages
     _c10 = list(s_status.voltage_cell_v)
     _n10 = s_status.cell_count
     _c10 = _c10[:_n10] if _n10 else _r.leading(_c10, 0.0)
     t.cell_voltages = tuple(math.nan if _r.is_marker(_x10, 0.0) else float(_x10) for _x10 in _c10) or None
+
+    # uorb.yaml:21: scale capacity -> full_capacity
     _v11 = s_status.capacity
     if _v11 != 0:
         t.full_capacity = float(_v11) * 3.6
+
+    # uorb.yaml:22: copy cycle_count -> cycle_count
     _v12 = s_status.cycle_count
     t.cycle_count = _v12
+
+    # uorb.yaml:23: scale state_of_health -> state_of_health
     _v13 = s_status.state_of_health
     if _v13 != 0:
         t.state_of_health = float(_v13) * 0.01
+
+    # uorb.yaml:24: copy id -> battery_index
+    # 1-based; 0 means not assigned.
     _v14 = s_status.id
     if _v14 != 0:
         t.battery_index = _v14 + -1
+
+    # uorb.yaml:25: flags faults -> faults
     _v15 = s_status.faults
-    t.faults = tuple(_n15 for _n15, _m15 in (("deep_discharge", 1), ("spikes", 2), ("cell_fail", 4), ("over_current", 8), ("over_temperature", 16), ("under_temperature", 32), ("incompatible_voltage", 64), ("incompatible_firmware", 128), ("incompatible_model", 256), ("hardware_failure", 512), ("failed_to_arm", 1024),) if _v15 & _m15)
-    _v17 = s_status.warning
-    t.warning = None if _v17 is None else _K16_forward.get(_v17)
-    if rep_d is not None and _v17 not in _K16_forward and _v17 not in (None, None,):
-        rep_d.dropped("uorb.BatteryStatus.warning", '%r has no counterpart' % (_v17,))
-    _v18 = s_status.full_charge_capacity_wh
+    t.faults = tuple(_n15 for _n15, _m15 in _FAULTS_BITS if _v15 & _m15)
+
+    # uorb.yaml:40: choice warning -> warning
+    _v16 = s_status.warning
+    t.warning = None if _v16 is None else _WARNING_BY_WARNING.get(_v16)
+    if rep_d is not None and _v16 not in _WARNING_BY_WARNING and _v16 not in (None, None):
+        rep_d.dropped("uorb.BatteryStatus.warning", f"{_v16!r} has no counterpart")
+
+    # uorb.yaml:51: scale full_charge_capacity_wh -> full_energy
+    _v17 = s_status.full_charge_capacity_wh
+    if _v17 != 0:
+        t.full_energy = float(_v17) * 3600.0
+
+    # uorb.yaml:52: scale remaining_capacity_wh -> remaining_energy
+    _v18 = s_status.remaining_capacity_wh
     if _v18 != 0:
-        t.full_energy = float(_v18) * 3600.0
-    _v19 = s_status.remaining_capacity_wh
-    if _v19 != 0:
-        t.remaining_energy = float(_v19) * 3600.0
-    _v20 = s_status.over_discharge_count
-    t.over_discharge_count = _v20
-    _v21 = s_status.nominal_voltage
-    if _v21 != 0 and _v21 == _v21:
-        t.nominal_voltage = float(_v21)
-    _v22 = s_status.is_powering_off
-    t.is_powering_off = bool(_v22)
+        t.remaining_energy = float(_v18) * 3600.0
+
+    # uorb.yaml:53: copy over_discharge_count -> over_discharge_count
+    _v19 = s_status.over_discharge_count
+    t.over_discharge_count = _v19
+
+    # uorb.yaml:54: scale nominal_voltage -> nominal_voltage
+    _v20 = s_status.nominal_voltage
+    if _v20 != 0 and _v20 == _v20:
+        t.nominal_voltage = float(_v20)
+
+    # uorb.yaml:55: copy is_powering_off -> is_powering_off
+    _v21 = s_status.is_powering_off
+    t.is_powering_off = bool(_v21)
+
+    # what did not survive the conversion
     if rep_d is not None and s_status.faults & -2048:
-        rep_d.dropped("uorb.BatteryStatus.faults", 'bits %#x have no counterpart' % (s_status.faults & -2048))
+        _b = s_status.faults & -2048
+        rep_d.dropped("uorb.BatteryStatus.faults", f"bits {_b:#x} have no counterpart")
     if rep_d is not None:
-        for _a, _n in _K23_forward:
-            if _r.differs(getattr(s_status, _a), getattr(_K24_forward, _a)):
+        for _a, _n in _UNREAD_STATUS_FIELDS:
+            if _r.differs(getattr(s_status, _a), getattr(_STATUS_DEFAULTS, _a)):
                 rep_d.dropped("uorb.BatteryStatus." + _n)
+
     return (t,)
 
 
-def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C0]:
+def backward(
+    s: BatteryState,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryStatus]:
     """concepts -> uorb: returns the target objects as a tuple."""
-    t_status = _C0()
+    t_status = BatteryStatus()
+
+    # uorb.yaml:11: copy connected -> connected
     _v1 = s.connected
     if _v1 is None:
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.connected")
     else:
         t_status.connected = bool(_v1)
+
+    # uorb.yaml:12: scale voltage_v -> pack_voltage
     _v2 = s.pack_voltage
     if _v2 is None or _v2 != _v2:
         t_status.voltage_v = 0.0
@@ -111,7 +257,9 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_status.voltage_v = _r.f32(_v2)
         if rep is not None and t_status.voltage_v in (0.0,):
-            rep.clamped("uorb.BatteryStatus.voltage_v", 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.voltage_v", "a known value written as the unknown marker")
+
+    # uorb.yaml:13: scale current_a -> current
     _v3 = s.current
     if _v3 is None or _v3 != _v3:
         t_status.current_a = -1.0
@@ -120,7 +268,9 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_status.current_a = _r.f32(_v3)
         if rep is not None and t_status.current_a in (-1.0,):
-            rep.clamped("uorb.BatteryStatus.current_a", 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.current_a", "a known value written as the unknown marker")
+
+    # uorb.yaml:14: scale current_average_a -> average_current
     _v4 = s.average_current
     if _v4 is None or _v4 != _v4:
         t_status.current_average_a = -1.0
@@ -129,7 +279,9 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_status.current_average_a = _r.f32(_v4)
         if rep is not None and t_status.current_average_a in (-1.0,):
-            rep.clamped("uorb.BatteryStatus.current_average_a", 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.current_average_a", "a known value written as the unknown marker")
+
+    # uorb.yaml:15: scale discharged_mah -> discharged
     _v5 = s.discharged
     if _v5 is None or _v5 != _v5:
         t_status.discharged_mah = -1.0
@@ -138,7 +290,9 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_status.discharged_mah = _r.f32(_v5 * 0.2777777777777778)
         if rep is not None and t_status.discharged_mah in (-1.0,):
-            rep.clamped("uorb.BatteryStatus.discharged_mah", 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.discharged_mah", "a known value written as the unknown marker")
+
+    # uorb.yaml:16: scale remaining -> state_of_charge
     _v6 = s.state_of_charge
     if _v6 is None or _v6 != _v6:
         t_status.remaining = -1.0
@@ -147,7 +301,9 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_status.remaining = _r.f32(_v6)
         if rep is not None and t_status.remaining in (-1.0,):
-            rep.clamped("uorb.BatteryStatus.remaining", 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.remaining", "a known value written as the unknown marker")
+
+    # uorb.yaml:17: scale time_remaining_s -> time_remaining
     _v7 = s.time_remaining
     if _v7 is None or _v7 != _v7:
         t_status.time_remaining_s = math.nan
@@ -155,6 +311,8 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
             rep_u.unknown("uorb.BatteryStatus.time_remaining_s")
     else:
         t_status.time_remaining_s = _r.f32(_v7)
+
+    # uorb.yaml:18: scale temperature -> temperature
     _v8 = s.temperature
     if _v8 is None or _v8 != _v8:
         t_status.temperature = math.nan
@@ -162,6 +320,8 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
             rep_u.unknown("uorb.BatteryStatus.temperature")
     else:
         t_status.temperature = _r.f32(_v8 + -273.15)
+
+    # uorb.yaml:19: copy cell_count -> cell_count
     _v9 = s.cell_count
     if _v9 is None:
         t_status.cell_count = 0
@@ -170,7 +330,9 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_status.cell_count = _r.to_int(_v9, 0, 255, rep, "uorb.BatteryStatus.cell_count")
         if rep is not None and t_status.cell_count in (0,):
-            rep.clamped("uorb.BatteryStatus.cell_count", 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.cell_count", "a known value written as the unknown marker")
+
+    # uorb.yaml:20: cells voltage_cell_v -> cell_voltages
     _c10 = s.cell_voltages
     if _c10 is None:
         if rep_u is not None:
@@ -178,7 +340,7 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         if len(_c10) > 14:
             if rep is not None:
-                rep.clamped("uorb.BatteryStatus.voltage_cell_v", '%d cells, room for 14' % len(_c10))
+                rep.clamped("uorb.BatteryStatus.voltage_cell_v", f"{len(_c10)} cells, room for 14")
             _c10 = _c10[:14]
         _l10 = [0.0 if _x10 != _x10 else _r.f32(_x10) for _x10 in _c10]
         _l10 += [0.0] * (14 - len(_l10))
@@ -186,7 +348,9 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
         if not t_status.cell_count:
             t_status.cell_count = min(len(_c10), 14)
             if rep_u is not None:
-                rep_u.discard('unknown', "uorb.BatteryStatus.cell_count")
+                rep_u.discard("unknown", "uorb.BatteryStatus.cell_count")
+
+    # uorb.yaml:21: scale capacity -> full_capacity
     _v11 = s.full_capacity
     if _v11 is None or _v11 != _v11:
         t_status.capacity = 0
@@ -195,13 +359,17 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_status.capacity = _r.to_int(_v11 * 0.2777777777777778, 0, 65535, rep, "uorb.BatteryStatus.capacity")
         if rep is not None and t_status.capacity in (0,):
-            rep.clamped("uorb.BatteryStatus.capacity", 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.capacity", "a known value written as the unknown marker")
+
+    # uorb.yaml:22: copy cycle_count -> cycle_count
     _v12 = s.cycle_count
     if _v12 is None:
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.cycle_count")
     else:
         t_status.cycle_count = _r.to_int(_v12, 0, 65535, rep, "uorb.BatteryStatus.cycle_count")
+
+    # uorb.yaml:23: scale state_of_health -> state_of_health
     _v13 = s.state_of_health
     if _v13 is None or _v13 != _v13:
         t_status.state_of_health = 0
@@ -210,7 +378,10 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_status.state_of_health = _r.to_int(_v13 * 100.0, 0, 65535, rep, "uorb.BatteryStatus.state_of_health")
         if rep is not None and t_status.state_of_health in (0,):
-            rep.clamped("uorb.BatteryStatus.state_of_health", 'a known value written as the unknown marker')
+            rep.clamped("uorb.BatteryStatus.state_of_health", "a known value written as the unknown marker")
+
+    # uorb.yaml:24: copy id -> battery_index
+    # 1-based; 0 means not assigned.
     _v14 = s.battery_index
     if _v14 is None:
         t_status.id = 0
@@ -219,93 +390,110 @@ def backward(s: BatteryState, *, rep: _r.LossReport | None = None, rep_d: _r.Los
     else:
         t_status.id = _r.to_int(_v14 - -1, 0, 255, rep, "uorb.BatteryStatus.id")
         if rep is not None and t_status.id in (0,):
-            rep.clamped("uorb.BatteryStatus.id", 'a known value written as the unknown marker')
-    _v16 = s.faults
-    if _v16 is None:
+            rep.clamped("uorb.BatteryStatus.id", "a known value written as the unknown marker")
+
+    # uorb.yaml:25: flags faults -> faults
+    _v15 = s.faults
+    if _v15 is None:
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.faults")
     else:
-        _b16 = t_status.faults
-        if "deep_discharge" in _v16:
-            _b16 |= 1
-        if "spikes" in _v16:
-            _b16 |= 2
-        if "cell_fail" in _v16:
-            _b16 |= 4
-        if "over_current" in _v16:
-            _b16 |= 8
-        if "over_temperature" in _v16:
-            _b16 |= 16
-        if "under_temperature" in _v16:
-            _b16 |= 32
-        if "incompatible_voltage" in _v16:
-            _b16 |= 64
-        if "incompatible_firmware" in _v16:
-            _b16 |= 128
-        if "incompatible_model" in _v16:
-            _b16 |= 256
-        if "hardware_failure" in _v16:
-            _b16 |= 512
-        if "failed_to_arm" in _v16:
-            _b16 |= 1024
-        t_status.faults = _b16
+        _b15 = t_status.faults
+        if "deep_discharge" in _v15:
+            _b15 |= 1
+        if "spikes" in _v15:
+            _b15 |= 2
+        if "cell_fail" in _v15:
+            _b15 |= 4
+        if "over_current" in _v15:
+            _b15 |= 8
+        if "over_temperature" in _v15:
+            _b15 |= 16
+        if "under_temperature" in _v15:
+            _b15 |= 32
+        if "incompatible_voltage" in _v15:
+            _b15 |= 64
+        if "incompatible_firmware" in _v15:
+            _b15 |= 128
+        if "incompatible_model" in _v15:
+            _b15 |= 256
+        if "hardware_failure" in _v15:
+            _b15 |= 512
+        if "failed_to_arm" in _v15:
+            _b15 |= 1024
+        t_status.faults = _b15
         if rep_d is not None:
-            for _n16 in _v16:
-                if _n16 not in _K15_backward:
-                    rep_d.dropped("concepts.faults", _n16 + ' has no counterpart')
-    _v18 = s.warning
-    _w18 = None if _v18 is None else _K17_backward.get(_v18)
-    if _w18 is not None:
-        t_status.warning = _w18
+            for _n15 in _v15:
+                if _n15 not in _FAULTS_WITH_BITS:
+                    rep_d.dropped("concepts.faults", _n15 + " has no counterpart")
+
+    # uorb.yaml:40: choice warning -> warning
+    _v16 = s.warning
+    _w16 = None if _v16 is None else _WARNING_BY_WARNING_BACKWARD.get(_v16)
+    if _w16 is not None:
+        t_status.warning = _w16
     else:
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.warning")
-        if rep_d is not None and _v18 is not None:
-            rep_d.dropped("concepts.warning", '%r has no counterpart' % (_v18,))
-    _v19 = s.full_energy
-    if _v19 is None or _v19 != _v19:
+        if rep_d is not None and _v16 is not None:
+            rep_d.dropped("concepts.warning", f"{_v16!r} has no counterpart")
+
+    # uorb.yaml:51: scale full_charge_capacity_wh -> full_energy
+    _v17 = s.full_energy
+    if _v17 is None or _v17 != _v17:
         t_status.full_charge_capacity_wh = 0.0
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.full_charge_capacity_wh")
     else:
-        t_status.full_charge_capacity_wh = _r.f32(_v19 * 0.0002777777777777778)
+        t_status.full_charge_capacity_wh = _r.f32(_v17 * 0.0002777777777777778)
         if rep is not None and t_status.full_charge_capacity_wh in (0,):
-            rep.clamped("uorb.BatteryStatus.full_charge_capacity_wh", 'a known value written as the unknown marker')
-    _v20 = s.remaining_energy
-    if _v20 is None or _v20 != _v20:
+            rep.clamped("uorb.BatteryStatus.full_charge_capacity_wh", "a known value written as the unknown marker")
+
+    # uorb.yaml:52: scale remaining_capacity_wh -> remaining_energy
+    _v18 = s.remaining_energy
+    if _v18 is None or _v18 != _v18:
         t_status.remaining_capacity_wh = 0.0
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.remaining_capacity_wh")
     else:
-        t_status.remaining_capacity_wh = _r.f32(_v20 * 0.0002777777777777778)
+        t_status.remaining_capacity_wh = _r.f32(_v18 * 0.0002777777777777778)
         if rep is not None and t_status.remaining_capacity_wh in (0,):
-            rep.clamped("uorb.BatteryStatus.remaining_capacity_wh", 'a known value written as the unknown marker')
-    _v21 = s.over_discharge_count
-    if _v21 is None:
+            rep.clamped("uorb.BatteryStatus.remaining_capacity_wh", "a known value written as the unknown marker")
+
+    # uorb.yaml:53: copy over_discharge_count -> over_discharge_count
+    _v19 = s.over_discharge_count
+    if _v19 is None:
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.over_discharge_count")
     else:
-        t_status.over_discharge_count = _r.to_int(_v21, 0, 65535, rep, "uorb.BatteryStatus.over_discharge_count")
-    _v22 = s.nominal_voltage
-    if _v22 is None or _v22 != _v22:
+        t_status.over_discharge_count = _r.to_int(_v19, 0, 65535, rep, "uorb.BatteryStatus.over_discharge_count")
+
+    # uorb.yaml:54: scale nominal_voltage -> nominal_voltage
+    _v20 = s.nominal_voltage
+    if _v20 is None or _v20 != _v20:
         t_status.nominal_voltage = 0.0
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.nominal_voltage")
     else:
-        t_status.nominal_voltage = _r.f32(_v22)
+        t_status.nominal_voltage = _r.f32(_v20)
         if rep is not None and t_status.nominal_voltage in (0,):
-            rep.clamped("uorb.BatteryStatus.nominal_voltage", 'a known value written as the unknown marker')
-    _v23 = s.is_powering_off
-    if _v23 is None:
+            rep.clamped("uorb.BatteryStatus.nominal_voltage", "a known value written as the unknown marker")
+
+    # uorb.yaml:55: copy is_powering_off -> is_powering_off
+    _v21 = s.is_powering_off
+    if _v21 is None:
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.is_powering_off")
     else:
-        t_status.is_powering_off = bool(_v23)
+        t_status.is_powering_off = bool(_v21)
+
+    # what did not survive the conversion
     if rep_d is not None:
-        for _n in _K24_backward:
+        for _n in _UNREAD_CONCEPTS:
             if getattr(s, _n) is not None:
-                rep_d.dropped('concepts.' + _n)
+                rep_d.dropped("concepts." + _n)
     if rep_u is not None:
-        for _n in _K25_backward:
+        for _n in _UNWRITTEN_STATUS_FIELDS:
             rep_u.unknown(_n)
+
     return (t_status,)

@@ -8,15 +8,21 @@ from __future__ import annotations
 
 import math
 
+from ..uorb import BatteryStatus, BatteryStatusV0
 from . import _runtime as _r
-from ._concepts import BatteryState
-from ..uorb import BatteryStatus as _C0
-from ..uorb import BatteryStatusV0 as _C1
 
 
-def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C1]:
+def forward(
+    s_status: BatteryStatus,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryStatusV0]:
     """uorb -> uorb_v0: returns the target objects as a tuple."""
-    t_status = _C1()
+    t_status = BatteryStatusV0()
+
+    # uorb_versions.yaml:21: same_names status -> status
     t_status.timestamp = s_status.timestamp
     t_status.connected = s_status.connected
     t_status.voltage_v = s_status.voltage_v
@@ -55,7 +61,12 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     t_status.voltage_prediction = s_status.voltage_prediction
     t_status.prediction_error = s_status.prediction_error
     t_status.estimation_covariance_norm = s_status.estimation_covariance_norm
+
+    # uorb_versions.yaml:22: const 0 -> serial_number
+    # PX4 writes 0.
     t_status.serial_number = 0
+
+    # what did not survive the conversion
     if rep_u is not None and _r.is_marker(t_status.voltage_v, 0.0):
         rep_u.unknown("uorb.BatteryStatusV0.voltage_v")
     if rep_u is not None and _r.is_marker(t_status.current_a, -1.0):
@@ -76,4 +87,5 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
         rep_u.unknown("uorb.BatteryStatusV0.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
         rep_u.unknown("uorb.BatteryStatusV0.voltage_cell_v")
+
     return (t_status,)

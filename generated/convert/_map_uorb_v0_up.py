@@ -8,19 +8,24 @@ from __future__ import annotations
 
 import math
 
+from ..uorb import BatteryStatus, BatteryStatusV0
 from . import _runtime as _r
-from ._concepts import BatteryState
-from ..uorb import BatteryStatusV0 as _C0
-from ..uorb import BatteryStatus as _C1
+
+_UNREAD_STATUS_FIELDS = (("serial_number", "serial_number"),)
+_STATUS_DEFAULTS = BatteryStatusV0()
 
 
-_K2_forward = (("serial_number", "serial_number"),)
-_K3_forward = _C0()
-
-
-def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossReport | None = None, rep_u: _r.LossReport | None = None) -> tuple[_C1]:
+def forward(
+    s_status: BatteryStatusV0,
+    *,
+    rep: _r.LossReport | None = None,
+    rep_d: _r.LossReport | None = None,
+    rep_u: _r.LossReport | None = None,
+) -> tuple[BatteryStatus]:
     """uorb_v0 -> uorb: returns the target objects as a tuple."""
-    t_status = _C1()
+    t_status = BatteryStatus()
+
+    # uorb_versions.yaml:13: same_names status -> status
     t_status.timestamp = s_status.timestamp
     t_status.connected = s_status.connected
     t_status.voltage_v = s_status.voltage_v
@@ -59,9 +64,11 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
     t_status.voltage_prediction = s_status.voltage_prediction
     t_status.prediction_error = s_status.prediction_error
     t_status.estimation_covariance_norm = s_status.estimation_covariance_norm
+
+    # what did not survive the conversion
     if rep_d is not None:
-        for _a, _n in _K2_forward:
-            if _r.differs(getattr(s_status, _a), getattr(_K3_forward, _a)):
+        for _a, _n in _UNREAD_STATUS_FIELDS:
+            if _r.differs(getattr(s_status, _a), getattr(_STATUS_DEFAULTS, _a)):
                 rep_d.dropped("uorb.BatteryStatusV0." + _n)
     if rep_u is not None and _r.is_marker(t_status.voltage_v, 0.0):
         rep_u.unknown("uorb.BatteryStatus.voltage_v")
@@ -83,4 +90,5 @@ def forward(s_status: _C0, *, rep: _r.LossReport | None = None, rep_d: _r.LossRe
         rep_u.unknown("uorb.BatteryStatus.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
         rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
+
     return (t_status,)

@@ -3,21 +3,37 @@
 
 from __future__ import annotations
 
-from . import _runtime as _r
+from ..devicetree.power.supply import SimpleBattery
 from . import _map_devicetree
-from ..devicetree.power.supply import SimpleBattery as _T_devicetree_power_supply_battery
+from . import _runtime as _r
 from ._concepts import BatteryState
 
 
-def to_concepts(node: _T_devicetree_power_supply_battery, *, policy: str = 'strict', report: _r.LossReport | None = None, ocv_v: float | None = None, temperature_c: float | None = None) -> BatteryState:
+def to_concepts(
+    node: SimpleBattery,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+    ocv_v: float | None = None,
+    temperature_c: float | None = None,
+) -> BatteryState:
     """Convert devicetree to concepts.
+
     strict: devicetree (forward)
     px4: not available
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_devicetree.forward(node, rep=report, rep_d=report, rep_u=report, ocv_v=ocv_v, temperature_c=temperature_c)
-        return _strict1[0]
+        _strict_1 = _map_devicetree.forward(
+            node,
+            rep=report,
+            rep_d=report,
+            rep_u=report,
+            ocv_v=ocv_v,
+            temperature_c=temperature_c,
+        )
+        return _strict_1[0]
     if policy == "px4":
         raise _r.ConversionError("no px4 behaviour converts devicetree to concepts; use another policy")
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

@@ -3,36 +3,51 @@
 
 from __future__ import annotations
 
-from . import _runtime as _r
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
 from . import _map_dronecan
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _T_dronecan_ardupilot_equipment_power_BatteryInfoAux
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _T_dronecan_uavcan_equipment_power_BatteryInfo
+from . import _runtime as _r
 from ._concepts import BatteryState
 
 
-def to_concepts(info: _T_dronecan_uavcan_equipment_power_BatteryInfo, aux: _T_dronecan_ardupilot_equipment_power_BatteryInfoAux | None = None, *, policy: str = 'strict', report: _r.LossReport | None = None) -> BatteryState:
+def to_concepts(
+    info: BatteryInfo,
+    aux: BatteryInfoAux | None = None,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryState:
     """Convert dronecan to concepts.
+
     strict: dronecan (forward)
     px4: not available
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=report)
-        return _strict1[0]
+        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=report)
+        return _strict_1[0]
     if policy == "px4":
         raise _r.ConversionError("no px4 behaviour converts dronecan to concepts; use another policy")
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 
-def from_concepts(state: BatteryState, *, policy: str = 'strict', report: _r.LossReport | None = None) -> tuple[_T_dronecan_uavcan_equipment_power_BatteryInfo, _T_dronecan_ardupilot_equipment_power_BatteryInfoAux]:
+def from_concepts(
+    state: BatteryState,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> tuple[BatteryInfo, BatteryInfoAux]:
     """Convert concepts to dronecan.
+
     strict: dronecan (backward)
     px4: not available
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_dronecan.backward(state, rep=report, rep_d=report, rep_u=report)
-        return _strict1
+        _strict_1 = _map_dronecan.backward(state, rep=report, rep_d=report, rep_u=report)
+        return _strict_1
     if policy == "px4":
         raise _r.ConversionError("no px4 behaviour converts concepts to dronecan; use another policy")
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

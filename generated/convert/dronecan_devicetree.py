@@ -3,24 +3,39 @@
 
 from __future__ import annotations
 
+from ..devicetree.power.supply import SimpleBattery
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
+from . import _map_devicetree, _map_dronecan
 from . import _runtime as _r
-from . import _map_devicetree
-from . import _map_dronecan
-from ..devicetree.power.supply import SimpleBattery as _T_devicetree_power_supply_battery
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _T_dronecan_ardupilot_equipment_power_BatteryInfoAux
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _T_dronecan_uavcan_equipment_power_BatteryInfo
 
 
-def devicetree_to_dronecan(node: _T_devicetree_power_supply_battery, *, policy: str = 'strict', report: _r.LossReport | None = None, ocv_v: float | None = None, temperature_c: float | None = None) -> tuple[_T_dronecan_uavcan_equipment_power_BatteryInfo, _T_dronecan_ardupilot_equipment_power_BatteryInfoAux]:
+def devicetree_to_dronecan(
+    node: SimpleBattery,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+    ocv_v: float | None = None,
+    temperature_c: float | None = None,
+) -> tuple[BatteryInfo, BatteryInfoAux]:
     """Convert devicetree to dronecan.
+
     strict: devicetree (forward) -> dronecan (backward)
     px4: not available
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_devicetree.forward(node, rep=report, rep_d=report, rep_u=None, ocv_v=ocv_v, temperature_c=temperature_c)
-        _strict2 = _map_dronecan.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2
+        _strict_1 = _map_devicetree.forward(
+            node,
+            rep=report,
+            rep_d=report,
+            rep_u=None,
+            ocv_v=ocv_v,
+            temperature_c=temperature_c,
+        )
+        _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2
     if policy == "px4":
         raise _r.ConversionError("no px4 behaviour converts devicetree to dronecan; use another policy")
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

@@ -3,47 +3,64 @@
 
 from __future__ import annotations
 
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
+from ..mavlink import BatteryStatus
+from . import (
+    _map_dronecan,
+    _map_mavlink,
+    _map_px4_mavlink_receiver,
+    _map_px4_mavlink_stream,
+    _map_px4_uavcan_bridge,
+    _map_px4_uavcannode,
+)
 from . import _runtime as _r
-from . import _map_dronecan
-from . import _map_mavlink
-from . import _map_px4_mavlink_receiver
-from . import _map_px4_mavlink_stream
-from . import _map_px4_uavcan_bridge
-from . import _map_px4_uavcannode
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _T_dronecan_ardupilot_equipment_power_BatteryInfoAux
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _T_dronecan_uavcan_equipment_power_BatteryInfo
-from ..mavlink import BatteryStatus as _T_mavlink_BATTERY_STATUS
 
 
-def dronecan_to_mavlink(info: _T_dronecan_uavcan_equipment_power_BatteryInfo, aux: _T_dronecan_ardupilot_equipment_power_BatteryInfoAux | None = None, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_mavlink_BATTERY_STATUS:
+def dronecan_to_mavlink(
+    info: BatteryInfo,
+    aux: BatteryInfoAux | None = None,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryStatus:
     """Convert dronecan to mavlink.
+
     strict: dronecan (forward) -> mavlink (backward)
     px4: px4_uavcan_bridge (forward) -> px4_mavlink_stream (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_mavlink.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2[0]
+        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2[0]
     if policy == "px4":
-        _px41 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=None)
-        _px42 = _map_px4_mavlink_stream.forward(*_px41, rep=report, rep_d=None, rep_u=report)
-        return _px42[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=None)
+        _px4_2 = _map_px4_mavlink_stream.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        return _px4_2[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 
-def mavlink_to_dronecan(msg: _T_mavlink_BATTERY_STATUS, *, policy: str = 'strict', report: _r.LossReport | None = None) -> tuple[_T_dronecan_uavcan_equipment_power_BatteryInfo, _T_dronecan_ardupilot_equipment_power_BatteryInfoAux]:
+def mavlink_to_dronecan(
+    msg: BatteryStatus,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> tuple[BatteryInfo, BatteryInfoAux]:
     """Convert mavlink to dronecan.
+
     strict: mavlink (forward) -> dronecan (backward)
     px4: px4_mavlink_receiver (forward) -> px4_uavcannode (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_dronecan.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2
+        _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2
     if policy == "px4":
-        _px41 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=None)
-        _px42 = _map_px4_uavcannode.forward(*_px41, rep=report, rep_d=None, rep_u=report)
-        return _px42
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=None)
+        _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        return _px4_2
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

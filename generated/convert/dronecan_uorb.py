@@ -3,43 +3,55 @@
 
 from __future__ import annotations
 
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
+from ..uorb import BatteryStatus
+from . import _map_dronecan, _map_px4_uavcan_bridge, _map_px4_uavcannode, _map_uorb
 from . import _runtime as _r
-from . import _map_dronecan
-from . import _map_px4_uavcan_bridge
-from . import _map_px4_uavcannode
-from . import _map_uorb
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _T_dronecan_ardupilot_equipment_power_BatteryInfoAux
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _T_dronecan_uavcan_equipment_power_BatteryInfo
-from ..uorb import BatteryStatus as _T_uorb_BatteryStatus
 
 
-def dronecan_to_uorb(info: _T_dronecan_uavcan_equipment_power_BatteryInfo, aux: _T_dronecan_ardupilot_equipment_power_BatteryInfoAux | None = None, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatus:
+def dronecan_to_uorb(
+    info: BatteryInfo,
+    aux: BatteryInfoAux | None = None,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryStatus:
     """Convert dronecan to uorb.
+
     strict: dronecan (forward) -> uorb (backward)
     px4: px4_uavcan_bridge (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_uorb.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2[0]
+        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2[0]
     if policy == "px4":
-        _px41 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=report)
-        return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=report)
+        return _px4_1[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 
-def uorb_to_dronecan(status: _T_uorb_BatteryStatus, *, policy: str = 'strict', report: _r.LossReport | None = None) -> tuple[_T_dronecan_uavcan_equipment_power_BatteryInfo, _T_dronecan_ardupilot_equipment_power_BatteryInfoAux]:
+def uorb_to_dronecan(
+    status: BatteryStatus,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> tuple[BatteryInfo, BatteryInfoAux]:
     """Convert uorb to dronecan.
+
     strict: uorb (forward) -> dronecan (backward)
     px4: px4_uavcannode (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_dronecan.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2
+        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2
     if policy == "px4":
-        _px41 = _map_px4_uavcannode.forward(status, rep=report, rep_d=report, rep_u=report)
-        return _px41
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_px4_uavcannode.forward(status, rep=report, rep_d=report, rep_u=report)
+        return _px4_1
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

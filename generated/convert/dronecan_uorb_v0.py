@@ -3,49 +3,59 @@
 
 from __future__ import annotations
 
+from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
+from ..dronecan.uavcan.equipment.power import BatteryInfo
+from ..uorb import BatteryStatusV0
+from . import _map_dronecan, _map_px4_uavcan_bridge, _map_px4_uavcannode, _map_uorb, _map_uorb_v0_down, _map_uorb_v0_up
 from . import _runtime as _r
-from . import _map_dronecan
-from . import _map_px4_uavcan_bridge
-from . import _map_px4_uavcannode
-from . import _map_uorb
-from . import _map_uorb_v0_down
-from . import _map_uorb_v0_up
-from ..dronecan.ardupilot.equipment.power import BatteryInfoAux as _T_dronecan_ardupilot_equipment_power_BatteryInfoAux
-from ..dronecan.uavcan.equipment.power import BatteryInfo as _T_dronecan_uavcan_equipment_power_BatteryInfo
-from ..uorb import BatteryStatusV0 as _T_uorb_BatteryStatusV0
 
 
-def dronecan_to_uorb_v0(info: _T_dronecan_uavcan_equipment_power_BatteryInfo, aux: _T_dronecan_ardupilot_equipment_power_BatteryInfoAux | None = None, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatusV0:
+def dronecan_to_uorb_v0(
+    info: BatteryInfo,
+    aux: BatteryInfoAux | None = None,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryStatusV0:
     """Convert dronecan to uorb_v0.
+
     strict: dronecan (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: px4_uavcan_bridge (forward) -> uorb_v0_down (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_uorb.backward(*_strict1, rep=report, rep_d=report, rep_u=None)
-        _strict3 = _map_uorb_v0_down.forward(*_strict2, rep=report, rep_d=report, rep_u=report)
-        return _strict3[0]
+        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
+        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        return _strict_3[0]
     if policy == "px4":
-        _px41 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=None)
-        _px42 = _map_uorb_v0_down.forward(*_px41, rep=report, rep_d=None, rep_u=report)
-        return _px42[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=None)
+        _px4_2 = _map_uorb_v0_down.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        return _px4_2[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 
-def uorb_v0_to_dronecan(status: _T_uorb_BatteryStatusV0, *, policy: str = 'strict', report: _r.LossReport | None = None) -> tuple[_T_dronecan_uavcan_equipment_power_BatteryInfo, _T_dronecan_ardupilot_equipment_power_BatteryInfoAux]:
+def uorb_v0_to_dronecan(
+    status: BatteryStatusV0,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> tuple[BatteryInfo, BatteryInfoAux]:
     """Convert uorb_v0 to dronecan.
+
     strict: uorb_v0_up (forward) -> uorb (forward) -> dronecan (backward)
     px4: uorb_v0_up (forward) -> px4_uavcannode (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_uorb.forward(*_strict1, rep=report, rep_d=report, rep_u=None)
-        _strict3 = _map_dronecan.backward(*_strict2, rep=report, rep_d=report, rep_u=report)
-        return _strict3
+        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
+        _strict_3 = _map_dronecan.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        return _strict_3
     if policy == "px4":
-        _px41 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _px42 = _map_px4_uavcannode.forward(*_px41, rep=report, rep_d=report, rep_u=report)
-        return _px42
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
+        _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=report, rep_u=report)
+        return _px4_2
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

@@ -3,35 +3,39 @@
 
 from __future__ import annotations
 
-from . import _runtime as _r
+from ..uorb import BatteryStatus
 from . import _map_uorb
-from ..uorb import BatteryStatus as _T_uorb_BatteryStatus
+from . import _runtime as _r
 from ._concepts import BatteryState
 
 
-def to_concepts(status: _T_uorb_BatteryStatus, *, policy: str = 'strict', report: _r.LossReport | None = None) -> BatteryState:
+def to_concepts(status: BatteryStatus, *, policy: str = "strict", report: _r.LossReport | None = None) -> BatteryState:
     """Convert uorb to concepts.
+
     strict: uorb (forward)
     px4: not available
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=report)
-        return _strict1[0]
+        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=report)
+        return _strict_1[0]
     if policy == "px4":
         raise _r.ConversionError("no px4 behaviour converts uorb to concepts; use another policy")
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 
-def from_concepts(state: BatteryState, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatus:
+def from_concepts(state: BatteryState, *, policy: str = "strict", report: _r.LossReport | None = None) -> BatteryStatus:
     """Convert concepts to uorb.
+
     strict: uorb (backward)
     px4: not available
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb.backward(state, rep=report, rep_d=report, rep_u=report)
-        return _strict1[0]
+        _strict_1 = _map_uorb.backward(state, rep=report, rep_d=report, rep_u=report)
+        return _strict_1[0]
     if policy == "px4":
         raise _r.ConversionError("no px4 behaviour converts concepts to uorb; use another policy")
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

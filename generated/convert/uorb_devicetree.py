@@ -3,23 +3,38 @@
 
 from __future__ import annotations
 
+from ..devicetree.power.supply import SimpleBattery
+from ..uorb import BatteryStatus
+from . import _map_devicetree, _map_uorb
 from . import _runtime as _r
-from . import _map_devicetree
-from . import _map_uorb
-from ..devicetree.power.supply import SimpleBattery as _T_devicetree_power_supply_battery
-from ..uorb import BatteryStatus as _T_uorb_BatteryStatus
 
 
-def devicetree_to_uorb(node: _T_devicetree_power_supply_battery, *, policy: str = 'strict', report: _r.LossReport | None = None, ocv_v: float | None = None, temperature_c: float | None = None) -> _T_uorb_BatteryStatus:
+def devicetree_to_uorb(
+    node: SimpleBattery,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+    ocv_v: float | None = None,
+    temperature_c: float | None = None,
+) -> BatteryStatus:
     """Convert devicetree to uorb.
+
     strict: devicetree (forward) -> uorb (backward)
     px4: not available
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_devicetree.forward(node, rep=report, rep_d=report, rep_u=None, ocv_v=ocv_v, temperature_c=temperature_c)
-        _strict2 = _map_uorb.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2[0]
+        _strict_1 = _map_devicetree.forward(
+            node,
+            rep=report,
+            rep_d=report,
+            rep_u=None,
+            ocv_v=ocv_v,
+            temperature_c=temperature_c,
+        )
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2[0]
     if policy == "px4":
         raise _r.ConversionError("no px4 behaviour converts devicetree to uorb; use another policy")
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

@@ -3,42 +3,53 @@
 
 from __future__ import annotations
 
+from ..mavlink import BatteryStatus as MavlinkBatteryStatus
+from ..uorb import BatteryStatus as UorbBatteryStatus
+from . import _map_mavlink, _map_px4_mavlink_receiver, _map_px4_mavlink_stream, _map_uorb
 from . import _runtime as _r
-from . import _map_mavlink
-from . import _map_px4_mavlink_receiver
-from . import _map_px4_mavlink_stream
-from . import _map_uorb
-from ..mavlink import BatteryStatus as _T_mavlink_BATTERY_STATUS
-from ..uorb import BatteryStatus as _T_uorb_BatteryStatus
 
 
-def uorb_to_mavlink(status: _T_uorb_BatteryStatus, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_mavlink_BATTERY_STATUS:
+def uorb_to_mavlink(
+    status: UorbBatteryStatus,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> MavlinkBatteryStatus:
     """Convert uorb to mavlink.
+
     strict: uorb (forward) -> mavlink (backward)
     px4: px4_mavlink_stream (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_mavlink.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2[0]
+        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2[0]
     if policy == "px4":
-        _px41 = _map_px4_mavlink_stream.forward(status, rep=report, rep_d=report, rep_u=report)
-        return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_px4_mavlink_stream.forward(status, rep=report, rep_d=report, rep_u=report)
+        return _px4_1[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 
-def mavlink_to_uorb(msg: _T_mavlink_BATTERY_STATUS, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatus:
+def mavlink_to_uorb(
+    msg: MavlinkBatteryStatus,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> UorbBatteryStatus:
     """Convert mavlink to uorb.
+
     strict: mavlink (forward) -> uorb (backward)
     px4: px4_mavlink_receiver (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_uorb.backward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2[0]
+        _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2[0]
     if policy == "px4":
-        _px41 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=report)
-        return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=report)
+        return _px4_1[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

@@ -3,38 +3,50 @@
 
 from __future__ import annotations
 
+from ..uorb import BatteryStatus, BatteryStatusV0
+from . import _map_uorb_v0_down, _map_uorb_v0_up
 from . import _runtime as _r
-from . import _map_uorb_v0_down
-from . import _map_uorb_v0_up
-from ..uorb import BatteryStatus as _T_uorb_BatteryStatus
-from ..uorb import BatteryStatusV0 as _T_uorb_BatteryStatusV0
 
 
-def uorb_to_uorb_v0(status: _T_uorb_BatteryStatus, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatusV0:
+def uorb_to_uorb_v0(
+    status: BatteryStatus,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryStatusV0:
     """Convert uorb to uorb_v0.
+
     strict: uorb_v0_down (forward)
     px4: uorb_v0_down (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb_v0_down.forward(status, rep=report, rep_d=report, rep_u=report)
-        return _strict1[0]
+        _strict_1 = _map_uorb_v0_down.forward(status, rep=report, rep_d=report, rep_u=report)
+        return _strict_1[0]
     if policy == "px4":
-        _px41 = _map_uorb_v0_down.forward(status, rep=report, rep_d=report, rep_u=report)
-        return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_uorb_v0_down.forward(status, rep=report, rep_d=report, rep_u=report)
+        return _px4_1[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 
-def uorb_v0_to_uorb(status: _T_uorb_BatteryStatusV0, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatus:
+def uorb_v0_to_uorb(
+    status: BatteryStatusV0,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryStatus:
     """Convert uorb_v0 to uorb.
+
     strict: uorb_v0_up (forward)
     px4: uorb_v0_up (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=report)
-        return _strict1[0]
+        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=report)
+        return _strict_1[0]
     if policy == "px4":
-        _px41 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=report)
-        return _px41[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=report)
+        return _px4_1[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

@@ -3,39 +3,51 @@
 
 from __future__ import annotations
 
+from ..uorb import BatteryStatusV0
+from . import _map_uorb, _map_uorb_v0_down, _map_uorb_v0_up
 from . import _runtime as _r
-from . import _map_uorb
-from . import _map_uorb_v0_down
-from . import _map_uorb_v0_up
-from ..uorb import BatteryStatusV0 as _T_uorb_BatteryStatusV0
 from ._concepts import BatteryState
 
 
-def to_concepts(status: _T_uorb_BatteryStatusV0, *, policy: str = 'strict', report: _r.LossReport | None = None) -> BatteryState:
+def to_concepts(
+    status: BatteryStatusV0,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryState:
     """Convert uorb_v0 to concepts.
+
     strict: uorb_v0_up (forward) -> uorb (forward)
     px4: not available
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_uorb.forward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2[0]
+        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2[0]
     if policy == "px4":
         raise _r.ConversionError("no px4 behaviour converts uorb_v0 to concepts; use another policy")
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 
-def from_concepts(state: BatteryState, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatusV0:
+def from_concepts(
+    state: BatteryState,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryStatusV0:
     """Convert concepts to uorb_v0.
+
     strict: uorb (backward) -> uorb_v0_down (forward)
     px4: not available
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb.backward(state, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_uorb_v0_down.forward(*_strict1, rep=report, rep_d=report, rep_u=report)
-        return _strict2[0]
+        _strict_1 = _map_uorb.backward(state, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_uorb_v0_down.forward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        return _strict_2[0]
     if policy == "px4":
         raise _r.ConversionError("no px4 behaviour converts concepts to uorb_v0; use another policy")
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

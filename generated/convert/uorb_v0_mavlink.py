@@ -3,48 +3,64 @@
 
 from __future__ import annotations
 
+from ..mavlink import BatteryStatus
+from ..uorb import BatteryStatusV0
+from . import (
+    _map_mavlink,
+    _map_px4_mavlink_receiver,
+    _map_px4_mavlink_stream,
+    _map_uorb,
+    _map_uorb_v0_down,
+    _map_uorb_v0_up,
+)
 from . import _runtime as _r
-from . import _map_mavlink
-from . import _map_px4_mavlink_receiver
-from . import _map_px4_mavlink_stream
-from . import _map_uorb
-from . import _map_uorb_v0_down
-from . import _map_uorb_v0_up
-from ..mavlink import BatteryStatus as _T_mavlink_BATTERY_STATUS
-from ..uorb import BatteryStatusV0 as _T_uorb_BatteryStatusV0
 
 
-def uorb_v0_to_mavlink(status: _T_uorb_BatteryStatusV0, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_mavlink_BATTERY_STATUS:
+def uorb_v0_to_mavlink(
+    status: BatteryStatusV0,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryStatus:
     """Convert uorb_v0 to mavlink.
+
     strict: uorb_v0_up (forward) -> uorb (forward) -> mavlink (backward)
     px4: uorb_v0_up (forward) -> px4_mavlink_stream (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_uorb.forward(*_strict1, rep=report, rep_d=report, rep_u=None)
-        _strict3 = _map_mavlink.backward(*_strict2, rep=report, rep_d=report, rep_u=report)
-        return _strict3[0]
+        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
+        _strict_3 = _map_mavlink.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        return _strict_3[0]
     if policy == "px4":
-        _px41 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _px42 = _map_px4_mavlink_stream.forward(*_px41, rep=report, rep_d=report, rep_u=report)
-        return _px42[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
+        _px4_2 = _map_px4_mavlink_stream.forward(*_px4_1, rep=report, rep_d=report, rep_u=report)
+        return _px4_2[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 
-def mavlink_to_uorb_v0(msg: _T_mavlink_BATTERY_STATUS, *, policy: str = 'strict', report: _r.LossReport | None = None) -> _T_uorb_BatteryStatusV0:
+def mavlink_to_uorb_v0(
+    msg: BatteryStatus,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+) -> BatteryStatusV0:
     """Convert mavlink to uorb_v0.
+
     strict: mavlink (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: px4_mavlink_receiver (forward) -> uorb_v0_down (forward)
+
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
-        _strict1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
-        _strict2 = _map_uorb.backward(*_strict1, rep=report, rep_d=report, rep_u=None)
-        _strict3 = _map_uorb_v0_down.forward(*_strict2, rep=report, rep_d=report, rep_u=report)
-        return _strict3[0]
+        _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
+        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        return _strict_3[0]
     if policy == "px4":
-        _px41 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=None)
-        _px42 = _map_uorb_v0_down.forward(*_px41, rep=report, rep_d=None, rep_u=report)
-        return _px42[0]
-    raise _r.ConversionError('unknown policy %r (expected %s)' % (policy, "strict or px4"))
+        _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=None)
+        _px4_2 = _map_uorb_v0_down.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        return _px4_2[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

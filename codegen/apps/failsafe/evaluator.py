@@ -27,13 +27,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from .levels import Level, mavlink_charge_state, uorb_warning
+
 MAH_PER_AS = 1000.0 / 3600.0  # one ampere for one second, in mAh
-
-
-class Level(enum.IntEnum):
-    NONE = 0
-    LOW = 1
-    CRITICAL = 2
 
 
 class Action(enum.IntEnum):
@@ -159,31 +155,6 @@ def resolve_action(action: Action, *, home_set: bool, position_fix: bool, smart_
     if action in (Action.SMART_RTL, Action.RTL) and can_rtl:
         return Outcome.RTL
     return Outcome.HOLD
-
-
-def uorb_warning(level: Level) -> int:
-    """The level as uORB battery_status.warning (generated enum BatteryStatusWarning)."""
-    from generated.uorb import BatteryStatusWarning as W
-
-    return int({Level.NONE: W.NONE, Level.LOW: W.LOW, Level.CRITICAL: W.CRITICAL}[level])
-
-
-def mavlink_charge_state(level: Level) -> int:
-    """The level as MAVLink BATTERY_STATUS.charge_state (generated enum MavBatteryChargeState)."""
-    from generated.mavlink import MavBatteryChargeState as C
-
-    return int({Level.NONE: C.OK, Level.LOW: C.LOW, Level.CRITICAL: C.CRITICAL}[level])
-
-
-def apply_level(qualified_name: str, data: Mapping[str, Any], level: Level) -> dict[str, Any]:
-    """A copy of converted message data with the failsafe level written in (uORB ``warning``,
-    MAVLink ``charge_state``); other messages come back unchanged."""
-    out = dict(data)
-    if qualified_name.startswith("uorb.BatteryStatus"):
-        out["warning"] = uorb_warning(level)
-    elif qualified_name == "mavlink.BATTERY_STATUS":
-        out["charge_state"] = mavlink_charge_state(level)
-    return out
 
 
 def _known(value: Any) -> float | None:

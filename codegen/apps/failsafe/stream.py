@@ -9,27 +9,37 @@ Each line is one sample::
 of any bundled format, by qualified or short name; ``message`` may be left to a stream-wide default)
 or ``battery``: the state in SI units directly (``voltage_v``, ``current_a``, ``consumed_mah``,
 ``remaining_mah``, or the shared concept names ``pack_voltage``, ``current``, ``discharged`` [C]).
-The other keys are optional. Blank lines and lines starting with ``#`` are skipped.
+The other keys are optional. Blank lines and lines starting with ``#`` are skipped (the lines
+are read by the shared JSON Lines reader, :func:`codegen.inputs.documents.read_jsonl`).
 
 Message data becomes a battery state through the IR: the generated model reads it (defaults,
-sentinels), then the converters (generated/convert ``to_concepts``) give the canonical battery
-state in SI; without them a small IR-driven field table does (:func:`battery_state_from_ir`).
+sentinels), then the converters (the generated package's ``convert``, to the shared concepts)
+give the canonical battery state in SI; without them a small IR-driven field table does
+(:func:`battery_state_from_ir`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import importlib
-import json
 import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from types import ModuleType
+from typing import Any, cast
 
 from ...errors import BattgenError, LocatedError
+from ...frontends.loader import load
+from ...inputs import paramfile
+from ...inputs.documents import read_jsonl
+from ...inputs.model import GeneratedMessage, MessageClass, package_name
+from ...inputs.records import Record, Unreadable
 from ...ir import Schema
-from .evaluator import BatteryReading, reading_of
+from ..convert import ConvertModule
+from ..messages import resolve_message
+from ..package import bundled_schemas, model_class, model_package
+from .evaluator import BatteryFailsafe, BatteryReading, Event, FailsafeParams, reading_of
 
 # which field carries what, per message (units come from the IR metadata)
 ROLES: dict[str, dict[str, str]] = {
@@ -80,28 +90,35 @@ ENDPOINTS: dict[str, str] = {
 }
 
 
-def battery_state(qualified_name: str, model: Any) -> BatteryReading:
+def _converters(model: GeneratedMessage) -> ConvertModule | None:
+    """The converters of the generated package ``model``'s class belongs to, if it has them."""
+    try:
+        module: ModuleType = importlib.import_module(package_name(cast(MessageClass, type(model))) + ".convert")
+    except ImportError:
+        return None
+    return cast(ConvertModule, module)
+
+
+def battery_state(qualified_name: str, model: GeneratedMessage) -> BatteryReading:
     """The failsafe's battery state from a generated model instance of a bundled battery message:
-    through the converters' ``to_concepts`` (canonical SI state) when the package has them."""
+    through the converters to the shared concepts (canonical SI state) when the package has them."""
     endpoint = ENDPOINTS.get(qualified_name)
     if endpoint is not None:
-        try:  # imported by name: the generated converters are not for the type checker to follow
-            convert = importlib.import_module("generated.convert")
-        except ImportError:
-            pass
-        else:
+        convert = _converters(model)
+        if convert is not None:
             return reading_of(convert.converter(endpoint, "concepts")(model))
     return battery_state_from_ir(qualified_name, model)
 
 
-def battery_state_from_ir(qualified_name: str, model: Any) -> BatteryReading:
+def battery_state_from_ir(qualified_name: str, model: GeneratedMessage) -> BatteryReading:
     """Fallback without converters: the fields that carry voltage, current and drawn charge, with
     their units' scales from the generated metadata."""
     roles = ROLES.get(qualified_name)
     if roles is None:
         raise BattgenError(f"{qualified_name} carries no battery voltage or current (known: {', '.join(ROLES)})")
-    metas = {f.metadata["name"]: f.metadata for f in dataclasses.fields(model)}
-    by_name = {f.metadata["name"]: getattr(model, f.name) for f in dataclasses.fields(model)}
+    fields = dataclasses.fields(cast(Any, model))  # a generated message is a dataclass
+    metas = {f.metadata["name"]: f.metadata for f in fields}
+    by_name = {f.metadata["name"]: getattr(model, f.name) for f in fields}
 
     def get(role: str) -> float | None:
         name = roles.get(role)
@@ -127,16 +144,14 @@ def battery_state_from_ir(qualified_name: str, model: Any) -> BatteryReading:
 class Reader:
     """Reads a stream, resolving message names against a schema and its generated package."""
 
-    def __init__(self, schema: Schema, package: Any, default_message: str | None = None) -> None:
+    def __init__(self, schema: Schema, package: ModuleType, default_message: str | None = None) -> None:
         self.schema = schema
         self.package = package
         self.default_message = default_message
-        self._classes: dict[str, tuple[str, Any]] = {}
+        self._classes: dict[str, tuple[str, MessageClass]] = {}
 
-    def model(self, name: str, file: str, line: int) -> tuple[str, Any]:
+    def model(self, name: str, file: str, line: int) -> tuple[str, MessageClass]:
         if name not in self._classes:
-            from ..models import model_class, resolve_message
-
             try:
                 msg = resolve_message(self.schema, name)
             except BattgenError as exc:
@@ -146,28 +161,24 @@ class Reader:
 
     def read(self, path: Path) -> Iterator[Sample]:
         file = path.as_posix()
-        try:
-            stream = path.open(encoding="utf-8")
-        except OSError as exc:
-            raise StreamError(file, 0, f"cannot read file: {exc.strerror or exc}") from None
-        with stream:
-            try:
-                for number, text in enumerate(stream, start=1):
-                    if text.strip() and not text.lstrip().startswith("#"):
-                        yield self.sample(text, file, number)
-            except UnicodeDecodeError:
-                raise StreamError(file, 0, "expected UTF-8 text") from None
+        for item in read_jsonl(path, file, comments=True):  # InputError when the file cannot be opened
+            if isinstance(item, Unreadable):
+                if item.reason:
+                    message = f"expected one JSON object per line ({item.reason} at column {item.column})"
+                    raise StreamError(file, item.line, message)
+                raise StreamError(file, item.line, item.message)
+            if not isinstance(item, Record):
+                continue  # JSON Lines readers tell no notices
+            if not isinstance(item.data, dict):
+                raise StreamError(file, item.line, "expected a JSON object per line")
+            yield self.sample(item.data, file, item.line)
 
-    def sample(self, text: str, file: str, line: int) -> Sample:
+    def sample(self, obj: Mapping[str, Any], file: str, line: int) -> Sample:
+        """One sample from a line's JSON object."""
+
         def fail(message: str) -> StreamError:
             return StreamError(file, line, message)
 
-        try:
-            obj = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise fail(f"expected one JSON object per line ({exc.msg} at column {exc.colno})") from None
-        if not isinstance(obj, dict):
-            raise fail("expected a JSON object per line")
         t = obj.get("t")
         if isinstance(t, bool) or not isinstance(t, int | float) or not math.isfinite(t):
             raise fail(f'expected "t": a number of seconds, got {t!r}')
@@ -203,3 +214,41 @@ class Reader:
         except (ValueError, BattgenError) as exc:
             raise fail(f"expected {qualified} data: {exc}") from None
         return Sample(line, float(t), armed, battery, qualified, data, extra)
+
+
+def open_reader(schema_dir: Path | None, default_message: str | None = None) -> Reader:
+    """A reader of samples whose messages come from ``schema_dir`` (default: the bundled schemas)."""
+    schema_dir = schema_dir or bundled_schemas()
+    schema = load([schema_dir])
+    return Reader(schema, model_package(schema, schema_dir), default_message)
+
+
+def read_failsafe_params(path: Path) -> FailsafeParams:
+    """The BATT_* parameters of a .param / .params file (others ignored; every set of a QGC file
+    merged, later sets winning)."""
+    values: dict[str, float] = {}
+    for _, group in paramfile.read_param_file(path):
+        values.update(group)
+    try:
+        return FailsafeParams.from_values(values)
+    except ValueError as exc:
+        raise BattgenError(f"{path}: {exc}") from None
+
+
+class Replay:
+    """Feeds a stream's samples to an evaluator; ``samples`` counts those read so far."""
+
+    def __init__(self, failsafe: BatteryFailsafe, reader: Reader) -> None:
+        self.failsafe = failsafe
+        self.reader = reader
+        self.samples = 0
+
+    def run(self, path: Path, name: str) -> Iterator[tuple[Event, Sample]]:
+        """Every transition with the sample that caused it; errors name the stream as ``name``."""
+        for sample in self.reader.read(path):
+            self.samples += 1
+            try:
+                events = self.failsafe.update(sample.t, sample.battery, armed=sample.armed, **sample.extra)
+            except ValueError as exc:
+                raise BattgenError(f"{name}:{sample.line}: {exc}") from None
+            yield from ((event, sample) for event in events)

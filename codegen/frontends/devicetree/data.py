@@ -1,8 +1,8 @@
 """The two data files the devicetree frontend reads: types.yaml and property-units.yaml.
 
-They sit at the schema root (schemas/devicetree/); a copy ships in codegen/data/devicetree/ for
-roots that lack them -- or hold dt-schema's own files of the same names, which have another layout
-(ours carry a ``format:`` marker).
+They sit at the schema root (schemas/devicetree/); a copy ships in ``packaged/`` beside this
+module for roots that lack them -- or hold dt-schema's own files of the same names, which have
+another layout (ours carry a ``format:`` marker).
 """
 
 from __future__ import annotations

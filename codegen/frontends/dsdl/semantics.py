@@ -26,7 +26,7 @@ from __future__ import annotations
 import re
 
 from ...ir import EnumDef, EnumEntry, EnumKind, Location, Range, Sentinel, Unit, units
-from .syntax import ArrayT, ConstDef, FieldDef
+from .definitions import ArrayT, ConstDef, FieldDef
 
 _TAG_RE = re.compile(r"\[([^\]]*)\]\s*:?\s*(.*)\Z", re.DOTALL)
 _NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from .syntax import ArrayT, AttrT, FieldDef, PrimT, RefT, Section, TypeDef, VoidT
+from .definitions import ArrayT, AttrT, FieldDef, PrimT, RefT, Section, TypeDef, VoidT
 
 MASK64 = (1 << 64) - 1
 POLY = 0x42F0E1EBA9EA3693

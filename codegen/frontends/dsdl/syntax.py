@@ -1,7 +1,8 @@
-"""DSDL v0 (DroneCAN / UAVCAN v0) source syntax: file names, type expressions, attribute lines.
+"""DSDL v0 (DroneCAN / UAVCAN v0) source syntax: type expressions, attribute lines, directives.
 
-This module turns one ``.uavcan`` file into a :class:`TypeDef` without touching other files:
-composite references are resolved lexically to full names here and located by the loader.
+This module turns the text of one ``.uavcan`` file into a :class:`~.definitions.TypeDef` without
+touching other files: composite references are resolved lexically to full names here and located
+by :mod:`.namespaces` (file and namespace names are checked in :mod:`.names`).
 The rules follow the DSDL v0 specification as the reference tools apply it, e.g. comments
 run from ``#`` to the end of the line, whitespace inside a constant initialiser is ignored,
 ``[<N]`` means at most N-1 elements, ``uint1`` is spelled ``bool``.
@@ -10,183 +11,21 @@ run from ``#`` to the end of the line, whitespace inside a constant initialiser 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 from ...errors import SchemaError
+from .definitions import ArrayT, AttrT, ConstDef, FieldDef, PrimT, RefT, Section, TypeDef, VoidT
 from .expr import ExpressionError, evaluate
+from .names import valid_namespace_component, valid_type_name
 
-MAX_FULL_NAME_LEN = 80
 MAX_MESSAGE_ID = 65535
 MAX_SERVICE_ID = 255
 
-_NAMESPACE_RE = re.compile(r"[a-z][a-z0-9_]*\Z")
-_TYPE_NAME_RE = re.compile(r"[A-Z][A-Za-z0-9_]*\Z")
 _ATTR_NAME_RE = re.compile(r"[a-zA-Z][a-zA-Z0-9_]*\Z")
 _VOID_RE = re.compile(r"void(\d+)\Z")
 _ARRAY_RE = re.compile(r"(.+?)\[([^\]]*)\]\Z")
 _PRIMITIVE_RE = re.compile(r"(bool)\Z|([a-z]+)(\d+)\Z")
 
-_FLOAT_MAX = {16: 65504.0, 32: 3.4028234663852886e38, 64: 1.7976931348623157e308}
 _CAST_MODES = ("saturated", "truncated")
-
-
-# --------------------------------------------------------------------------------------------
-# Types as written in a definition
-
-
-@dataclass(frozen=True)
-class PrimT:
-    kind: str  # "bool" | "uint" | "int" | "float"
-    bits: int
-    cast: str  # "saturated" | "truncated"
-
-    @property
-    def normalized(self) -> str:
-        return f"{self.cast} {'bool' if self.kind == 'bool' else f'{self.kind}{self.bits}'}"
-
-    @property
-    def value_range(self) -> tuple[int | float, int | float]:
-        if self.kind == "float":
-            return -_FLOAT_MAX[self.bits], _FLOAT_MAX[self.bits]
-        if self.kind == "int":
-            return -(1 << (self.bits - 1)), (1 << (self.bits - 1)) - 1
-        return 0, (1 << self.bits) - 1
-
-
-@dataclass(frozen=True)
-class VoidT:
-    bits: int
-
-    @property
-    def normalized(self) -> str:
-        return f"void{self.bits}"
-
-
-@dataclass(frozen=True)
-class RefT:
-    """A composite type, by full name (already resolved against the referencing namespace)."""
-
-    full_name: str
-
-    @property
-    def normalized(self) -> str:
-        return self.full_name
-
-
-@dataclass(frozen=True)
-class ArrayT:
-    element: PrimT | RefT
-    size: int  # maximum (dynamic) or exact (static) element count, after normalising [<N]
-    dynamic: bool
-
-    @property
-    def normalized(self) -> str:
-        return f"{self.element.normalized}[{'<=' if self.dynamic else ''}{self.size}]"
-
-
-AttrT = PrimT | VoidT | RefT | ArrayT
-
-
-# --------------------------------------------------------------------------------------------
-# Definitions
-
-
-@dataclass(frozen=True)
-class FieldDef:
-    name: str | None  # None for padding
-    type: AttrT
-    line: int
-    above: str = ""  # the comment block directly above the line
-    trailing: str = ""  # the comment at the end of the line
-
-    @property
-    def normalized(self) -> str:
-        if isinstance(self.type, VoidT):
-            return self.type.normalized
-        return f"{self.type.normalized} {self.name}"
-
-
-@dataclass(frozen=True)
-class ConstDef:
-    name: str
-    type: PrimT
-    value: int | float | bool
-    line: int
-    above: str = ""
-    trailing: str = ""
-
-
-@dataclass(frozen=True)
-class Section:
-    """A message body, or one half of a service."""
-
-    fields: tuple[FieldDef, ...]
-    constants: tuple[ConstDef, ...]
-    union: bool
-    line: int  # where the section starts: 1, or the line of '---'
-
-
-@dataclass(frozen=True)
-class TypeDef:
-    full_name: str
-    file: str  # display path
-    default_id: int | None
-    version: tuple[int, int] | None
-    request: Section  # the message body for a message
-    response: Section | None  # set for a service
-    override_signature: int | None
-    doc: str
-
-    @property
-    def is_service(self) -> bool:
-        return self.response is not None
-
-    @property
-    def sections(self) -> tuple[Section, ...]:
-        return (self.request,) if self.response is None else (self.request, self.response)
-
-    @property
-    def short_name(self) -> str:
-        return self.full_name.rsplit(".", 1)[-1]
-
-
-# --------------------------------------------------------------------------------------------
-# Names
-
-
-def valid_namespace_component(name: str) -> bool:
-    return bool(_NAMESPACE_RE.match(name))
-
-
-def split_file_name(basename: str) -> tuple[int | None, str, tuple[int, int] | None] | None:
-    """``[<id>.]<Name>[.<major>.<minor>].uavcan`` -> (id, name, version); None if not that shape."""
-    items = basename.split(".")
-    if len(items) not in (2, 3, 4, 5) or items[-1] != "uavcan":
-        return None
-    has_id = len(items) in (3, 5)
-    dtid_text, name = (items[0], items[1]) if has_id else (None, items[0])
-    version_items = items[-3:-1] if len(items) >= 4 else None
-    if dtid_text is not None and not dtid_text.isdigit():
-        return None
-    if version_items is not None and not all(v.isdigit() for v in version_items):
-        return None
-    version = (int(version_items[0]), int(version_items[1])) if version_items else None
-    return (int(dtid_text) if dtid_text is not None else None), name, version
-
-
-def check_full_name(full_name: str, file: str, line: int) -> None:
-    namespace, _, short = full_name.rpartition(".")
-    if not namespace:
-        raise SchemaError(file, line, f"expected a type inside a namespace, got {full_name!r}")
-    for component in namespace.split("."):
-        if not valid_namespace_component(component):
-            raise SchemaError(
-                file, line, f"expected namespace components of lowercase letters, digits and '_', got {component!r}"
-            )
-    if not _TYPE_NAME_RE.match(short):
-        raise SchemaError(file, line, f"expected a CamelCase type name, got {short!r}")
-    if len(full_name) > MAX_FULL_NAME_LEN:
-        raise SchemaError(file, line, f"expected a full type name of at most {MAX_FULL_NAME_LEN} characters")
 
 
 # --------------------------------------------------------------------------------------------
@@ -221,7 +60,7 @@ def parse_type(text: str, cast: str | None, namespace: str) -> AttrT:
     full_name = text if "." in text else f"{namespace}.{text}"
     short = full_name.rpartition(".")[2]
     components = full_name.split(".")[:-1]
-    if not (_TYPE_NAME_RE.match(short) and all(valid_namespace_component(c) for c in components)):
+    if not (valid_type_name(short) and all(valid_namespace_component(c) for c in components)):
         raise _LineError(
             f"unknown type {text!r}: expected bool, uintN, intN, floatN, voidN, an array of one, "
             "or a composite type name (CamelCase, optionally namespace-qualified)"

@@ -37,8 +37,7 @@ from ...ir import (
     StringType,
     units,
 )
-from . import layout as mavlink_layout
-from . import values as mavlink_values
+from . import layout, values
 from .scan import MAVLINK_VERSION_TYPE, ScannedField, ScannedFile
 
 PREFIX = "mavlink."
@@ -156,15 +155,13 @@ def _element(ftype: FieldType) -> PrimitiveType:
 
 def _sentinel(text: str, ftype: FieldType, enum: _EnumParts | None, where: Location) -> Sentinel:
     names = {e.name: e.value for e in enum.entries} if enum is not None else {}
-    found = mavlink_values.sentinel(text, names)
+    found = values.sentinel(text, names)
     if found is None:
-        raise SchemaError(
-            where.file, where.line, f"expected invalid= to be {mavlink_values.SENTINEL_FORMS}, got {text!r}"
-        )
+        raise SchemaError(where.file, where.line, f"expected invalid= to be {values.SENTINEL_FORMS}, got {text!r}")
     element = _element(ftype)
     if found.per_element and isinstance(ftype, PrimitiveType):
         raise SchemaError(where.file, where.line, f"expected a bracketed invalid={text!r} only on an array field")
-    if not mavlink_values.fits(found.value, element):
+    if not values.fits(found.value, element):
         raise SchemaError(where.file, where.line, f"expected an invalid value that fits {element.name}, got {text!r}")
     if element.kind is not PrimitiveKind.FLOAT and isinstance(found.value, float):
         found = Sentinel(int(found.value), found.text, found.per_element)
@@ -172,7 +169,7 @@ def _sentinel(text: str, ftype: FieldType, enum: _EnumParts | None, where: Locat
 
 
 def _number(text: str, attr: str, where: Location, *, nan: bool) -> int | float:
-    value = mavlink_values.number(text)
+    value = values.number(text)
     if value is None or (not nan and isinstance(value, float) and math.isnan(value)):
         raise SchemaError(where.file, where.line, f"expected a number as {attr}=, got {text!r}")
     return value
@@ -229,16 +226,16 @@ def _message(lf: LoadedFile, ours: Any, theirs: Any, enums: dict[str, _EnumParts
         if any(f.name == sf.name for f in fields):
             raise SchemaError(lf.display, sf.line, f"expected unique field names in {ours.name}; {sf.name} repeats")
         fields.append(_field(lf, sf, mf, enums))
-    base_length, max_length = mavlink_layout.lengths(fields)
+    base_length, max_length = layout.lengths(fields)
     if max_length > MAX_PAYLOAD:
         raise SchemaError(
             lf.display, ours.line, f"expected at most {MAX_PAYLOAD} payload bytes in {ours.name}, got {max_length}"
         )
     info = MavlinkInfo(
         msg_id=ours.msg_id,
-        crc_extra=mavlink_layout.crc_extra(ours.name, fields),
+        crc_extra=layout.crc_extra(ours.name, fields),
         dialect=lf.path.stem,
-        wire_order=tuple(f.name for f in mavlink_layout.wire_order(fields)),
+        wire_order=tuple(f.name for f in layout.wire_order(fields)),
         base_length=base_length,
         max_length=max_length,
     )
@@ -256,8 +253,8 @@ def _message(lf: LoadedFile, ours: Any, theirs: Any, enums: dict[str, _EnumParts
 def _enum_kind(parts: _EnumParts, name: str, bitmask_refs: set[str]) -> EnumKind:
     if parts.bitmask:
         return EnumKind.BITMASK
-    values = [e.value for e in parts.entries]
-    powers = bool(values) and all(v > 0 and v & (v - 1) == 0 for v in values) and len(set(values)) == len(values)
+    codes = [e.value for e in parts.entries]
+    powers = bool(codes) and all(v > 0 and v & (v - 1) == 0 for v in codes) and len(set(codes)) == len(codes)
     return EnumKind.BITMASK if powers and name in bitmask_refs else EnumKind.VALUE
 
 

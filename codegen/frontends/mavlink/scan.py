@@ -1,19 +1,19 @@
 """A safety pre-scan of MAVLink XML, run before pymavlink's parser sees a file.
 
 pymavlink's mavparse eval()s enum entry values, reports few line numbers and may crash on
-malformed attributes. This scan walks the same element paths with expat, rejects DTDs
-(entity tricks) and every attribute form mavparse would choke on or eval unsafely, and keeps
-what mavparse drops: line numbers, include lines, minValue/maxValue/default, <superseded>.
+malformed attributes. This scan walks the same element paths with the shared hardened expat
+set-up (codegen.text.xml: no DTDs, no entities), rejects every attribute form mavparse would
+choke on or eval unsafely, and keeps what mavparse drops: line numbers, include lines,
+minValue/maxValue/default, <superseded>.
 """
 
 from __future__ import annotations
 
 import re
-import xml.parsers.expat
 from dataclasses import dataclass, field
 
-from ...errors import SchemaError
-from . import values as mavlink_values
+from ...text.xml import XmlReader
+from .values import ENTRY_VALUE_FORMS, entry_value
 
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 FIELD_TYPE = re.compile(r"(?P<base>float|double|char|u?int(?:8|16|32|64)_t)(?:\[(?P<len>[0-9]{1,3})\])?")
@@ -69,29 +69,15 @@ class ScannedFile:
     enums: list[ScannedEnum] = field(default_factory=list)
 
 
-class _Scanner:
+class _Scanner(XmlReader):
+    """Walks the elements in document order, checking each one as it opens (and includes and
+    versions as they close, when their text is known)."""
+
     def __init__(self, display: str) -> None:
-        self.display = display
+        super().__init__(display, no_dtd_because="MAVLink XML needs no DTD; entity declarations are refused")
         self.out = ScannedFile()
         self.stack: list[str] = []
-        self.text: list[str] = []
-        self.parser = xml.parsers.expat.ParserCreate()
-        p = self.parser
-        p.SetParamEntityParsing(xml.parsers.expat.XML_PARAM_ENTITY_PARSING_NEVER)
-        p.StartDoctypeDeclHandler = self._doctype
-        p.EntityDeclHandler = self._entity
-        p.StartElementHandler = self._start
-        p.EndElementHandler = self._end
-        p.CharacterDataHandler = self._chars
-
-    def error(self, message: str) -> SchemaError:
-        return SchemaError(self.display, self.parser.CurrentLineNumber, message)
-
-    def _doctype(self, *_: object) -> None:
-        raise self.error("expected no DOCTYPE (MAVLink XML needs no DTD; entity declarations are refused)")
-
-    def _entity(self, *_: object) -> None:
-        raise self.error("expected no ENTITY declarations")
+        self.chars: list[str] = []
 
     def _require(self, attrs: dict[str, str], names: tuple[str, ...], where: str) -> None:
         for name in names:
@@ -111,9 +97,9 @@ class _Scanner:
             raise self.error(f'expected {name}="true" or "false" on <{where}>, got {value!r}')
         return value == "true"
 
-    def _start(self, tag: str, attrs: dict[str, str]) -> None:
+    def start(self, tag: str, attrs: dict[str, str]) -> None:
         self.stack.append(tag)
-        self.text = []
+        self.chars = []
         path = ".".join(self.stack)
         if len(self.stack) == 1 and tag != "mavlink":
             raise self.error(f"expected <mavlink> as the root element, got <{tag}>")
@@ -127,7 +113,7 @@ class _Scanner:
         text = attrs["id"]
         if not re.fullmatch(r"[0-9]{1,8}", text) or int(text) > MAX_MSG_ID:
             raise self.error(f"expected a decimal message id from 0 to {MAX_MSG_ID}, got {text!r}")
-        self.out.messages.append(ScannedMessage(name, int(text), self.parser.CurrentLineNumber))
+        self.out.messages.append(ScannedMessage(name, int(text), self.line))
 
     def _extensions(self, attrs: dict[str, str]) -> None:
         message = self.out.messages[-1]
@@ -150,7 +136,7 @@ class _Scanner:
             raise self.error(f"expected at most {MAX_FIELDS} fields in message {message.name}")
         self._flag(attrs, "instance", "field")
         kept = {k: v for k, v in attrs.items() if k in _FIELD_ATTRS}
-        line = self.parser.CurrentLineNumber
+        line = self.line
         message.fields.append(ScannedField(name, type_text, line, message.has_extensions, kept))
 
     def _deprecated(self, attrs: dict[str, str]) -> None:
@@ -172,35 +158,34 @@ class _Scanner:
     def _enum(self, attrs: dict[str, str]) -> None:
         name = self._name(attrs, "enum")
         bitmask = self._flag(attrs, "bitmask", "enum")
-        self.out.enums.append(ScannedEnum(name, self.parser.CurrentLineNumber, bitmask))
+        self.out.enums.append(ScannedEnum(name, self.line, bitmask))
 
     def _entry(self, attrs: dict[str, str]) -> None:
         enum = self.out.enums[-1]
         name = self._name(attrs, "entry")
         if "value" in attrs:
-            value = mavlink_values.entry_value(attrs["value"])
+            value = entry_value(attrs["value"])
             if value is None:
-                raise self.error(
-                    f"expected {mavlink_values.ENTRY_VALUE_FORMS} as value of {name}, got {attrs['value']!r}"
-                )
+                raise self.error(f"expected {ENTRY_VALUE_FORMS} as value of {name}, got {attrs['value']!r}")
         else:
             value = enum.highest + 1
         enum.highest = max(enum.highest, value)
         self._flag(attrs, "hasLocation", "entry")
-        enum.entries.append(ScannedEntry(name, value, self.parser.CurrentLineNumber))
+        enum.entries.append(ScannedEntry(name, value, self.line))
 
-    def _param(self, attrs: dict[str, str]) -> None:
+    def _command_param(self, attrs: dict[str, str]) -> None:
+        # a MAV_CMD entry's <param index="N">: the command's N-th argument
         self._require(attrs, ("index",), "param")
         if not re.fullmatch(r"[1-9][0-9]{0,2}", attrs["index"]):
             raise self.error(f"expected a positive decimal param index, got {attrs['index']!r}")
 
-    def _chars(self, data: str) -> None:
-        self.text.append(data)
+    def text(self, data: str) -> None:
+        self.chars.append(data)
 
-    def _end(self, tag: str) -> None:
+    def end(self, tag: str) -> None:
         path = ".".join(self.stack)
-        text = "".join(self.text).strip()
-        line = self.parser.CurrentLineNumber
+        text = "".join(self.chars).strip()
+        line = self.line
         if path == "mavlink.include":
             if not text:
                 raise self.error("expected a file name inside <include>")
@@ -208,7 +193,7 @@ class _Scanner:
         elif path == "mavlink.version" and not re.fullmatch(r"[0-9]{1,3}", text):
             raise self.error(f"expected a decimal number inside <version>, got {text!r}")
         self.stack.pop()
-        self.text = []
+        self.chars = []
 
 
 _HANDLERS = {
@@ -223,16 +208,12 @@ _HANDLERS = {
     "mavlink.enums.enum.entry": _Scanner._entry,
     "mavlink.enums.enum.entry.deprecated": _Scanner._deprecated,
     "mavlink.enums.enum.entry.superseded": _Scanner._entry_superseded,
-    "mavlink.enums.enum.entry.param": _Scanner._param,
+    "mavlink.enums.enum.entry.param": _Scanner._command_param,
 }
 
 
 def scan(data: bytes, display: str) -> ScannedFile:
     """Check one MAVLink XML document; SchemaError (file, line, expected form) on anything unsafe."""
     scanner = _Scanner(display)
-    try:
-        scanner.parser.Parse(data, True)
-    except xml.parsers.expat.ExpatError as exc:
-        message = xml.parsers.expat.errors.messages.get(exc.code, str(exc))
-        raise SchemaError(display, exc.lineno, f"expected well-formed XML ({message})") from None
+    scanner.read(data)
     return scanner.out

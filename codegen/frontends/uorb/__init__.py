@@ -2,45 +2,29 @@
 
 A message is named by its file (``BatteryStatus.msg`` -> ``uorb.BatteryStatus``); a field type
 that is not builtin names another ``.msg`` in the same directory. Each message carries its PX4
-C-struct layout (see ``uorb_layout``), which needs the sizes of nested messages, so parsing a
-file also parses the files it nests; the returned Schema includes them.
+C-struct layout (:mod:`.layout`), which needs the sizes of nested messages, so parsing a file also
+parses the files it nests; the returned Schema includes them.
+
+The work is done in: :mod:`.syntax` (the lines of a file), :mod:`.values` (literals),
+:mod:`.annotations` (field comment metadata), :mod:`.enums` (constants grouped into enums),
+:mod:`.layout` (struct layout) and :mod:`.build` (files -> IR messages).
 """
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 from ...errors import SchemaError
-from ...ir import (
-    ArrayType,
-    CompositeType,
-    Constant,
-    Field,
-    FieldType,
-    Location,
-    Message,
-    PrimitiveKind,
-    PrimitiveType,
-    Schema,
-    SourceFormat,
-    StringType,
-    UorbInfo,
-    units,
-)
-from ...text.files import display_path, read_text
-from .annotations import parse_comment, sentinel
-from .enums import build_enums
-from .layout import Member, px4_layout
-from .syntax import BUILTINS, ConstantLine, FieldLine, MsgText, parse_text
+from ...ir import Schema
+from ...text.files import display_path
+from .build import Loader
 
-PREFIX = "uorb."
-_MESSAGE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+__all__ = ["parse_dir", "parse_file"]
 
 
 def parse_file(path: Path, *, root: Path | None = None) -> Schema:
     """One .msg file, plus the messages it nests (their sizes shape its layout)."""
-    loader = _Loader(root)
+    loader = Loader(root)
     loader.load(path)
     return loader.schema()
 
@@ -49,155 +33,8 @@ def parse_dir(root: Path) -> Schema:
     """Every .msg file below ``root``, in sorted path order."""
     if not root.is_dir():
         raise SchemaError(display_path(root, None), 0, "expected a directory of .msg files")
-    loader = _Loader(root)
+    loader = Loader(root)
     for path in sorted(root.rglob("*.msg")):
         if path.is_file():
             loader.load(path)
     return loader.schema()
-
-
-def snake_case(name: str) -> str:
-    """PX4's default topic name for a message file: ``BatteryStatusV0`` -> ``battery_status_v0``."""
-    spaced = re.sub(r"(.)([A-Z][a-z]+)", r"\1_\2", name)
-    return re.sub(r"([a-z0-9])([A-Z])", r"\1_\2", spaced).lower()
-
-
-class _Loader:
-    """Parses files once each, following nested types, and refuses nesting cycles."""
-
-    def __init__(self, root: Path | None) -> None:
-        self.root = root
-        self.done: dict[Path, Message] = {}
-        self.names: dict[str, str] = {}  # qualified name -> file it came from
-        self.active: list[Path] = []
-
-    def schema(self) -> Schema:
-        messages = sorted(self.done.values(), key=lambda m: m.qualified_name)
-        return Schema(messages=tuple(messages), sources=tuple(sorted(m.location.file for m in messages)))
-
-    def load(self, path: Path) -> Message:
-        key = path.resolve()
-        if key in self.done:
-            return self.done[key]
-        display = display_path(path, self.root)
-        if not _MESSAGE_NAME.match(path.stem):
-            raise SchemaError(
-                display, 1, f"expected a file named after its message (letters, digits, '_'), got '{path.name}'"
-            )
-        qualified = PREFIX + path.stem
-        if qualified in self.names:
-            raise SchemaError(
-                display, 1, f"expected a unique message name: {qualified} is also defined in {self.names[qualified]}"
-            )
-        self.active.append(key)
-        try:
-            message = self._build(path, display, parse_text(read_text(path, display), display))
-        finally:
-            self.active.pop()
-        self.done[key] = message
-        self.names[qualified] = display
-        return message
-
-    def _build(self, path: Path, display: str, text: MsgText) -> Message:
-        qualified = PREFIX + path.stem
-        constants = tuple(_constant(c, display) for c in text.items if isinstance(c, ConstantLine))
-        values = {c.name: c.value for c in constants if not isinstance(c.value, str)}
-        fields: list[Field] = []
-        members: list[Member] = []
-        for item in text.items:
-            if isinstance(item, FieldLine):
-                fields.append(_field(item, qualified, values, display))
-                members.append(self._member(path, item, display))
-        _check_timestamp(fields, display)
-        size, layout = px4_layout(members)
-        version = _message_version(text, display)
-        return Message(
-            name=path.stem,
-            qualified_name=qualified,
-            format=SourceFormat.UORB,
-            location=Location(display, 1),
-            doc=text.doc,
-            fields=tuple(fields),
-            constants=constants,
-            enums=build_enums(qualified, fields, constants, display),
-            uorb=UorbInfo(
-                message_version=version,
-                topics=text.topics or (snake_case(path.stem),),
-                struct_size=size,
-                layout=layout,
-            ),
-        )
-
-    def _member(self, path: Path, item: FieldLine, display: str) -> Member:
-        count = item.array_len or 1
-        if item.base in BUILTINS:
-            return Member(item.name, BUILTINS[item.base].bits // 8, count)
-        nested = path.parent / f"{item.base}.msg"
-        if not nested.is_file():
-            raise SchemaError(
-                display, item.line, f"expected a builtin type or a message defined in {item.base}.msg next to this file"
-            )
-        if nested.resolve() in self.active:
-            raise SchemaError(display, item.line, f"expected no nesting cycle: {item.base} contains this message")
-        child = self.load(nested)
-        assert child.uorb is not None  # every uORB message carries its layout
-        return Member(item.name, 0, count, child.uorb.struct_size)
-
-
-def _constant(item: ConstantLine, file: str) -> Constant:
-    return Constant(item.name, item.type, item.value, item.comment, Location(file, item.line))
-
-
-def _field(item: FieldLine, qualified: str, constants: dict[str, int | float | bool], file: str) -> Field:
-    notes = parse_comment(item.comment, file, item.line)
-    element = BUILTINS.get(item.base)
-    ftype = _field_type(item, element)
-    invalid = None
-    if notes.invalid is not None:
-        numeric = element if element is not None and element.kind is not PrimitiveKind.CHAR else None
-        invalid = sentinel(notes.invalid[0], numeric, item.array_len is not None, constants, file, item.line)
-    if notes.enums and (element is None or element.kind not in (PrimitiveKind.INT, PrimitiveKind.UINT)):
-        raise SchemaError(file, item.line, "expected '@enum' only on integer fields")
-    unit = None
-    if notes.unit_text is not None:
-        unit = units.lookup(notes.unit_text) or units.opaque(notes.unit_text)
-    return Field(
-        name=item.name,
-        type=ftype,
-        location=Location(file, item.line),
-        doc=notes.doc,
-        unit=unit,
-        unit_text=notes.unit_text,
-        range=notes.range,
-        invalid=invalid,
-        enums=tuple(f"{qualified}.{prefix}" for prefix in notes.enums),
-        annotations=notes.annotations,
-    )
-
-
-def _field_type(item: FieldLine, element: PrimitiveType | None) -> FieldType:
-    scalar: PrimitiveType | CompositeType = element if element is not None else CompositeType(PREFIX + item.base)
-    if item.array_len is None:
-        return scalar
-    if element is not None and element.kind is PrimitiveKind.CHAR:
-        return StringType(capacity=item.array_len)  # char[N]: a NUL-padded string
-    return ArrayType(element=scalar, capacity=item.array_len, dynamic=False)
-
-
-def _check_timestamp(fields: list[Field], file: str) -> None:
-    """PX4's generator refuses a message without a uint64 ``timestamp``."""
-    for f in fields:
-        if f.name == "timestamp":
-            if f.type != BUILTINS["uint64"]:
-                raise SchemaError(file, f.location.line, "expected 'timestamp' to be a uint64 (PX4 requires it)")
-            return
-    raise SchemaError(file, 1, "expected a 'uint64 timestamp' field (PX4 requires one in every message)")
-
-
-def _message_version(text: MsgText, file: str) -> int | None:
-    for item in text.items:
-        if isinstance(item, ConstantLine) and item.name == "MESSAGE_VERSION":
-            if item.type.kind not in (PrimitiveKind.INT, PrimitiveKind.UINT) or int(item.value) < 0:
-                raise SchemaError(file, item.line, "expected MESSAGE_VERSION to be a non-negative integer constant")
-            return int(item.value)
-    return None

@@ -1,6 +1,6 @@
 """Line syntax of a PX4 uORB .msg file: header doc, ``# TOPICS`` lines, fields and constants.
 
-This layer only splits and checks lines; meaning (units, enums, layout) is added in ``uorb``.
+This layer only splits and checks lines; meaning (units, enums, layout) is added in :mod:`.build`.
 """
 
 from __future__ import annotations

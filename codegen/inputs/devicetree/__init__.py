@@ -11,10 +11,7 @@ is read here); errors name the file and line and say what was expected.
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from ...text.files import display_path
-from .dtb import Blob, parse_dtb
+from .dtb import Blob
 from .mapping import (
     GENERIC_PROPERTIES,
     by_phandle,
@@ -26,8 +23,7 @@ from .mapping import (
     nodes_for_message,
 )
 from .model import DevicetreeError, DtNode, DtPart, DtValue
-from .parse import Parser
-from .tree import finish
+from .reading import read_dtb, read_dtb_blob, read_dts, read_nodes
 
 __all__ = [
     "GENERIC_PROPERTIES",
@@ -48,39 +44,3 @@ __all__ = [
     "read_dts",
     "read_nodes",
 ]
-
-
-def read_dts(path: Path, *, root: Path | None = None) -> list[DtNode]:
-    """Every node of a .dts (or a self-contained .dtsi), root first, in document order."""
-    display = display_path(path, root)
-    parser = Parser(path, display, root)
-    tree = parser.parse(require_header=path.suffix != ".dtsi")
-    return finish(tree)
-
-
-def read_dtb_blob(path: Path, *, root: Path | None = None) -> Blob:
-    display = display_path(path, root)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise DevicetreeError(display, 0, f"cannot read file: {exc.strerror or exc}") from None
-    return parse_dtb(data, display)
-
-
-def read_dtb(path: Path, *, root: Path | None = None) -> list[DtNode]:
-    """Every node of a flattened devicetree blob, root first, in blob order."""
-    return read_dtb_blob(path, root=root).nodes
-
-
-def read_nodes(path: Path, *, root: Path | None = None) -> list[DtNode]:
-    """read_dtb for .dtb/.dtbo files and blobs with the FDT magic, read_dts otherwise."""
-    if path.suffix in (".dtb", ".dtbo"):
-        return read_dtb(path, root=root)
-    try:
-        with path.open("rb") as fh:
-            head = fh.read(4)
-    except OSError:
-        head = b""
-    if head == b"\xd0\x0d\xfe\xed":
-        return read_dtb(path, root=root)
-    return read_dts(path, root=root)

@@ -2,14 +2,13 @@
 
 Per message this emits one precompiled ``struct.Struct`` (the whole payload in wire order, as
 ``MavlinkInfo.wire_order`` says) and straight-line methods; frame handling, the checksum and the
-id registry live in the runtime module ``_mavlink.py`` (template ``_mavlink.py.j2``).
+id registry live in the runtime module ``_mavlink.py`` (copied from ``runtime/``), which imports the
+registry of this package's messages from the generated ``_mavlink_registry.py``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-
-import jinja2
 
 from ....errors import BattgenError
 from ....ir import ArrayType, Field, Message, PrimitiveKind, PrimitiveType, Schema, SourceFormat, StringType
@@ -17,9 +16,12 @@ from .. import naming
 from ..extensions import Contribution
 from ..literals import py_literal, text_literal
 from ..module_context import ModuleContext
+from ..runtime import copied
 from ..views import ClassView, FieldView
 
 RUNTIME = "_mavlink.py"
+RUNTIME_FILES = (RUNTIME, "_mavlink_payload.py")  # copied from runtime/
+REGISTRY = "_mavlink_registry.py"  # generated: the messages by id, imported by _mavlink.py
 # names the codec adds to a class; a field with one of them would break it
 _OWN_NAMES = frozenset(
     {"MSG_ID", "CRC_EXTRA", "MAVLINK_BASE_LENGTH", "MAVLINK_MAX_LENGTH", "encode_frame", "decode_frame", "decode_batch"}
@@ -301,17 +303,23 @@ class _Codec:
                 m.mavlink.msg_id,
                 (m.mavlink.msg_id, m.mavlink.crc_extra, naming.class_name(m), m.mavlink.max_length, m.name),
             )
-        template = _environment().get_template("_mavlink.py.j2")
-        text = template.render(
-            header=header, registry=[registry[k] for k in sorted(registry)], module=naming.module_path(messages[0])
-        )
-        return {RUNTIME: text}
+        entries = [registry[k] for k in sorted(registry)]
+        return {**copied(*RUNTIME_FILES), REGISTRY: _registry_module(header, entries, naming.module_path(messages[0]))}
 
 
-def _environment() -> jinja2.Environment:
-    from .. import environment
-
-    return environment()
+def _registry_module(header: str, entries: list[tuple[int, int, str, int, str]], module: str) -> str:
+    """The per-package part of the MAVLink runtime: the message registry the copied ``_mavlink.py`` imports."""
+    lines = [
+        header,
+        '"""The MAVLink messages of this package by id, for the runtime module ``_mavlink``."""',
+        "",
+        "# msgid -> (CRC_EXTRA, class name, MAVLINK_MAX_LENGTH, MAVLink name) of every generated message",
+        "REGISTRY: dict[int, tuple[int, str, int, str]] = {",
+        *(f"    {i}: ({crc}, {py_literal(name)}, {size}, {py_literal(mav)})," for i, crc, name, size, mav in entries),
+        "}",
+        f"MODULE = {py_literal(module)}  # the generated module holding the classes, relative to this package",
+    ]
+    return "\n".join(lines) + "\n"
 
 
 EXTENSION = _Codec()

@@ -8,8 +8,9 @@ value names its full path). Split of responsibilities:
 
 - here (toolchain): everything that depends on the IR -- formats, offsets, column names, code;
 - ``_uorb.py`` (runtime): errors, C strings, the batch column decoder (``struct``, numpy optional);
-- ``_ulog.py`` (runtime): the ULog file format, writer, reader and schema-vs-log comparison, driven
-  by each class's ``ulog_format()``; standard library only, so a vendored package reads logs.
+- ``_ulog.py`` (runtime, with its parts ``_ulog_*.py``): the ULog file format, writer, reader and
+  schema-vs-log comparison, driven by each class's ``ulog_format()``; standard library only, so a
+  vendored package reads logs.
 """
 
 from __future__ import annotations
@@ -22,11 +23,12 @@ from .. import naming
 from ..extensions import Contribution
 from ..literals import py_literal, text_literal
 from ..module_context import ClassRef, ModuleContext
+from ..runtime import copied
 from ..views import ClassView, class_view
 from .uorb_layout import Part, column_format, columns, parts, snake, struct_format, trailing_padding
 from .uorb_layout import compress as compress_codes
 
-RUNTIME_TEMPLATES = ("_uorb.py.j2", "_ulog.py.j2")
+RUNTIME_FILES = ("_uorb.py", "_ulog.py", "_ulog_compare.py", "_ulog_format.py", "_ulog_parse.py", "_ulog_writer.py")
 _ADDED = ("UORB_FORMAT", "UORB_SIZE", "UORB_SIZE_NO_PADDING", "UORB_TOPICS")
 _METHODS = ("encode", "decode", "decode_batch", "ulog_format", "from_ulog")
 _ERRORS = "(struct.error, TypeError, OverflowError)"
@@ -47,10 +49,7 @@ class _Codec:
     def runtime_files(self, schema: Schema, header: str) -> dict[str, str]:
         if not any(m.format is SourceFormat.UORB for m in schema.messages):
             return {}
-        from .. import environment
-
-        env = environment()
-        return {name[: -len(".j2")]: env.get_template(name).render(header=header) for name in RUNTIME_TEMPLATES}
+        return copied(*RUNTIME_FILES)
 
 
 EXTENSION = _Codec()

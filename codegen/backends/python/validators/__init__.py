@@ -8,12 +8,13 @@ the generated runtime module ``_validate.py``.
 
 from __future__ import annotations
 
-from ....frontends import rules as rule_files
 from ....ir import Message, Schema
+from ....ir.rules import bound_rules
 from ..extensions import Contribution
 from ..literals import py_literal
 from ..module_context import ModuleContext
 from ..naming import upper_snake
+from ..runtime import copied
 from ..views import ClassView
 from .fields import field_code
 from .rules import known_expr, rule_lines
@@ -28,10 +29,7 @@ def _block(lines: list[str], depth: int) -> list[str]:
 
 class _Validators:
     def runtime_files(self, schema: Schema, header: str) -> dict[str, str]:
-        from .. import environment
-
-        text = environment().get_template("_validate.py.j2").render(header=header)
-        return {"_validate.py": text}
+        return copied("_validate.py")
 
     def contribute(self, msg: Message, ctx: ModuleContext, view: ClassView) -> Contribution:
         idents = {fv.source_name: fv.ident for fv in view.fields}
@@ -48,7 +46,7 @@ class _Validators:
             checks += code.lines
             field_names |= code.names
         rule_names: set[str] = set()
-        for bound in rule_files.bound_rules(ctx.schema, msg):
+        for bound in bound_rules(ctx.schema, msg):
             lines, names = rule_lines(bound, msg, idents)
             checks += lines
             rule_names |= names

@@ -1,4 +1,5 @@
-"""Cross-field rules (codegen/rules.py) compiled into statements of the generated ``validate()``.
+"""Cross-field rules (``Schema.rules``, bound to a message by :mod:`codegen.ir.rules`) compiled into
+statements of the generated ``validate()``.
 
 Expressions become plain Python over locals: fields are read once into ``r_<name>``, loop
 variables are ``v_<name>``, constants are literals. Nothing of a rule file reaches the output but
@@ -7,7 +8,6 @@ through these node types and :func:`~.literals.py_literal`, so a rule cannot inj
 
 from __future__ import annotations
 
-from ....frontends.rules import BoundRule, referenced_fields
 from ....ir import ArrayType, Field, Message
 from ....ir.expr import (
     Binary,
@@ -24,7 +24,9 @@ from ....ir.expr import (
     Quant,
     Unary,
     VarRef,
+    referenced_fields,
 )
+from ....ir.rules import BoundRule
 from ..literals import py_literal
 
 
@@ -47,16 +49,17 @@ class _Emitter:
     def __init__(self, msg: Message, idents: dict[str, str]) -> None:
         self.msg = msg
         self.idents = idents  # schema name -> attribute
+        self.fields = {f.name: f for f in msg.fields}
         self.optional = msg.devicetree is not None
 
-    def local(self, f: Field) -> str:
-        return "r_" + self.idents[f.name]
+    def local(self, name: str) -> str:
+        return "r_" + self.idents[name]
 
     def expr(self, e: Expr) -> str:
         if isinstance(e, Const):
             return py_literal(e.value)
         if isinstance(e, FieldRef):
-            return self.local(e.field)
+            return self.local(e.name)
         if isinstance(e, VarRef):
             return "v_" + e.name
         if isinstance(e, Unary):
@@ -88,8 +91,8 @@ class _Emitter:
         if e.func == "is_known":
             target = e.args[0]
             assert isinstance(target, FieldRef)
-            f = target.field
-            return "(" + known_expr(f, self.local(f), self.optional and f.pattern is None) + ")"
+            f = self.fields[target.name]
+            return "(" + known_expr(f, self.local(f.name), self.optional and f.pattern is None) + ")"
         if e.func == "reversed":
             return f"list(reversed({args[0]}))"
         if e.func == "keys":
@@ -103,7 +106,7 @@ def _place_path(e: Expr, em: _Emitter, paths: dict[str, str | None]) -> str | No
         indexes.insert(0, e.index)
         e = e.target
     if isinstance(e, FieldRef):
-        base: str | None = py_literal(e.field.name)
+        base: str | None = py_literal(e.name)
     elif isinstance(e, VarRef):
         base = paths.get(e.name)
     else:
@@ -145,7 +148,7 @@ def rule_lines(bound: BoundRule, msg: Message, idents: dict[str, str]) -> tuple[
         names.add("v_" + var)
         it = em.expr(iterable)
         parent = _place_path(iterable, em, paths)
-        if isinstance(iterable, FieldRef) and iterable.field.pattern is not None:
+        if isinstance(iterable, FieldRef) and every[iterable.name].pattern is not None:
             names.add(f"k_{n}")
             body.append(f"{ind}for k_{n}, v_{var} in _v.entries({it}):")
             paths[var] = f"k_{n}"
@@ -169,7 +172,7 @@ def rule_lines(bound: BoundRule, msg: Message, idents: dict[str, str]) -> tuple[
         value_code = f"r_{idents[first[0]]}" if first else "None"
     message = " + ".join(py_literal(p) if isinstance(p, str) else f"_v.fmt({em.expr(p)})" for p in bound.message)
     report = (
-        f"out.append(_v.rule({path_code}, {py_literal(rule.id)}, {value_code}, {py_literal(rule.text)}, "
+        f"out.append(_v.rule({path_code}, {py_literal(rule.id)}, {value_code}, {py_literal(rule.check)}, "
         f"{message or py_literal(rule.id)}, {py_literal(rule.severity)}))"
     )
     if bound.bindings:

@@ -13,10 +13,10 @@ from .....ir import CompositeType, Message, Schema, SourceFormat
 from ...extensions import Contribution
 from ...literals import py_literal
 from ...module_context import ModuleContext
+from ...runtime import copied
 from ...views import ClassView
 from .emit import MessageEmitter
 from .plan import Planner
-from .runtime_text import RUNTIME
 
 
 class _Factories(dict[str, str]):
@@ -82,7 +82,7 @@ class _Codec:
     def runtime_files(self, schema: Schema, header: str) -> dict[str, str]:
         if not any(m.format is SourceFormat.DRONECAN for m in schema.messages):
             return {}
-        return {"_dronecan.py": header + "\n" + RUNTIME.lstrip("\n")}
+        return copied("_dronecan.py")
 
 
 EXTENSION = _Codec()

@@ -1,0 +1,310 @@
+"""The engine of ``battgen convert``: records of one format through a generated converter to another.
+
+A :class:`Conversion` is one converter of a generated package's ``convert`` module, picked by its
+sides (a side name, or a message of the side by qualified name or a dotted suffix of it), with a
+policy and the extra inputs it takes. :meth:`Conversion.run` reads an input with the shared
+readers (JSON, JSON Lines, YAML, hex or raw payloads, ULog, tlog, raw MAVLink) and hands out one
+:class:`Converted` per record -- the plain data or the payloads of the target side, with the loss
+report when asked -- and the notices a log reader has (format differences, damage skipped).
+Errors name the input and the record's line (or a log record's location) and stop the run.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Literal, Protocol, cast
+
+from ..errors import BattgenError
+from ..inputs.documents import read_json, read_jsonl, read_yaml
+from ..inputs.model import DecodingClass, Encodable, MavlinkClass, MessageClass, PlainClass, PlainData, UorbClass
+from ..inputs.payloads import read_hex, read_raw
+from ..inputs.records import InputError, Item, Notice, Record, Unreadable
+from ..inputs.tlog import StreamStats, mavlink_items, message_name
+from ..inputs.ulog import ulog_items
+from ..ir.numbers import to_json_data
+from .package import named_package, package_module
+
+FORMATS = ("json", "jsonl", "yaml", "hex", "raw")
+BINARY_FORMATS = ("hex", "raw")
+LOG_FORMATS = ("ulog", "tlog", "mavlink")  # input only
+_EXTENSIONS = {".json": "json", ".jsonl": "jsonl", ".ndjson": "jsonl", ".yaml": "yaml", ".yml": "yaml"}
+_EXTENSIONS |= {".hex": "hex", ".bin": "raw", ".raw": "raw", ".ulg": "ulog", ".tlog": "tlog", ".mav": "mavlink"}
+
+# (alias, class) of each message of a side, the first required; the concept state is a side too
+Side = tuple[tuple[str, PlainClass], ...]
+
+
+class LossReport(Protocol):
+    """The generated converters' record of what a conversion lost."""
+
+    def to_dict(self) -> list[dict[str, str]]: ...
+    def summary(self) -> str: ...
+
+
+class ConvertModule(Protocol):
+    """A generated package's ``convert`` module."""
+
+    ENDPOINTS: Mapping[str, Side]
+    CONVERTERS: Mapping[tuple[str, str], Callable[..., object]]
+    POLICIES: Mapping[tuple[str, str], tuple[str, ...]]
+    INPUTS: Mapping[tuple[str, str], tuple[str, ...]]
+    ConversionError: type[Exception]
+
+    def LossReport(self) -> LossReport: ...  # the class, called to make one
+    def converter(self, source: str, target: str) -> Callable[..., object]: ...
+
+
+def input_format(path: str, given: str | None) -> str:
+    """The format of an input: given, else from the extension, else JSON Lines."""
+    return given or _EXTENSIONS.get(Path(path).suffix.lower(), "jsonl")
+
+
+def output_format(in_format: str, given: str | None) -> str:
+    """The output format: given, else the input's (JSON Lines for binary input and logs)."""
+    return given or ("jsonl" if in_format in (*BINARY_FORMATS, *LOG_FORMATS) else in_format)
+
+
+def fail(where: str, line: int, message: str) -> BattgenError:
+    return BattgenError(f"{where}:{line}: {message}" if line > 0 else f"{where}: {message}")
+
+
+def converters(package: str) -> ConvertModule:
+    """The ``convert`` module of a generated package, by the package's import name."""
+    try:
+        return cast(ConvertModule, package_module(named_package(package), "convert"))
+    except ImportError as exc:
+        raise BattgenError(f"cannot import {package}.convert ({exc}); run 'battgen generate' first") from None
+
+
+def side_name(module: ConvertModule, name: str) -> str:
+    """A side given by its name, or by a message of it (qualified name or a dotted suffix)."""
+    if name in module.ENDPOINTS:
+        return name
+    found = set()
+    for side, items in module.ENDPOINTS.items():
+        for _, cls in items:
+            if not isinstance(cls, MessageClass):
+                continue  # the concept state has no message name
+            if name == cls.QUALIFIED_NAME or cls.QUALIFIED_NAME.endswith("." + name):
+                found.add(side)
+    if len(found) == 1:
+        return found.pop()
+    if found:
+        raise BattgenError(f"{name!r} is ambiguous: it names a message of the sides {', '.join(sorted(found))}")
+    return name  # unknown: reported with the known pairs
+
+
+@dataclass(frozen=True)
+class Converted:
+    """One record converted: the target's plain data, or its payloads (binary output)."""
+
+    line: int  # of the input record (0: a log record)
+    plain: object = None
+    payloads: tuple[bytes, ...] = ()
+    loss: object = None  # the loss report's entries or summary, when asked for
+
+
+class Endpoint:
+    """How to build and write one side's objects (a tuple of messages, or the concept state)."""
+
+    def __init__(self, name: str, items: Side) -> None:
+        self.name = name
+        self.items = items
+        # the classes with a binary codec, looked up once (not per record)
+        self.codecs = [cls if isinstance(cls, DecodingClass) else None for _, cls in items]
+
+    def build(self, rec: Record) -> list[PlainData | None]:
+        if rec.instance is not None:  # decoded already (a log record)
+            return [rec.instance, *([None] * (len(self.items) - 1))]
+        data = rec.data
+        aliases = [a for a, _ in self.items]
+        try:
+            if isinstance(data, list) and data and all(isinstance(x, bytes) for x in data):
+                return self._decode(data, rec)
+            if not isinstance(data, dict):
+                raise fail(rec.file, rec.line, f"expected a {self.name} record (an object), got {type(data).__name__}")
+            parts = (
+                [data.get(a) for a in aliases]
+                if len(aliases) > 1 and set(data) <= set(aliases)
+                else [data, *([None] * (len(aliases) - 1))]
+            )
+            out: list[PlainData | None] = []
+            for (alias, cls), part in zip(self.items, parts, strict=True):
+                if part is None:
+                    if alias == aliases[0]:
+                        raise fail(rec.file, rec.line, f"expected the {alias} message of {self.name}")
+                    out.append(None)
+                elif not isinstance(part, dict):
+                    raise fail(rec.file, rec.line, f"expected {alias} to be an object")
+                else:
+                    out.append(cls.from_dict(part))
+            return out
+        except BattgenError:
+            raise
+        except (ValueError, TypeError, KeyError) as exc:  # DataError / ConversionError are ValueErrors
+            raise fail(rec.file, rec.line, f"invalid {self.name} record: {exc}") from None
+
+    def _decode(self, payloads: list[bytes], rec: Record) -> list[PlainData | None]:
+        out: list[PlainData | None] = []
+        for i, ((alias, _), cls) in enumerate(zip(self.items, self.codecs, strict=True)):
+            if i >= len(payloads):
+                out.append(None)
+                continue
+            if cls is None:
+                raise fail(rec.file, rec.line, f"{self.name} {alias} has no binary codec yet")
+            out.append(cls.decode(payloads[i]))
+        return out
+
+    def to_plain(self, objs: object) -> object:
+        seq = cast(tuple[PlainData | None, ...], objs if isinstance(objs, tuple) else (objs,))
+        if len(self.items) == 1:
+            return to_json_data(cast(PlainData, seq[0]).to_dict())
+        return {a: to_json_data(o.to_dict()) for (a, _), o in zip(self.items, seq, strict=True) if o is not None}
+
+    def to_binary(self, objs: object, file: str, line: int) -> tuple[bytes, ...]:
+        seq = cast(tuple[object, ...], objs if isinstance(objs, tuple) else (objs,))
+        out = []
+        for (alias, _), o in zip(self.items, seq, strict=True):
+            if o is None:
+                continue
+            if not isinstance(o, Encodable):
+                raise fail(file, line, f"{self.name} {alias} has no binary codec yet")
+            try:
+                out.append(o.encode())
+            except (ValueError, TypeError, OverflowError) as exc:
+                raise fail(file, line, f"cannot encode {alias}: {exc}") from None
+        return tuple(out)
+
+
+class Conversion:
+    """One converter of a generated package, checked: the pair exists, has the policy."""
+
+    def __init__(self, package: str, source: str, target: str, policy: str) -> None:
+        self.module = converters(package)
+        self.source_name, self.target_name = side_name(self.module, source), side_name(self.module, target)
+        key = (self.source_name, self.target_name)
+        if key not in self.module.CONVERTERS:
+            pairs = ", ".join(f"{s}->{t}" for s, t in sorted(self.module.CONVERTERS))
+            raise BattgenError(f"no converter from {self.source_name!r} to {self.target_name!r} (known pairs: {pairs})")
+        if policy not in self.module.POLICIES[key]:
+            raise BattgenError(
+                f"{self.source_name} -> {self.target_name} has no {policy} policy (PX4 has no such code path)"
+            )
+        self.policy = policy
+        self.func = self.module.CONVERTERS[key]
+        self.inputs_taken: tuple[str, ...] = self.module.INPUTS.get(key, ())
+        self.source = Endpoint(self.source_name, self.module.ENDPOINTS[self.source_name])
+        self.target = Endpoint(self.target_name, self.module.ENDPOINTS[self.target_name])
+
+    def run(
+        self,
+        source: Path | IO[bytes],
+        where: str,
+        fmt: str,
+        *,
+        binary: bool = False,
+        loss: Literal["entries", "summary"] | None = None,
+        inputs: Mapping[str, float] | None = None,
+    ) -> Iterator[Converted | Notice]:
+        """Convert every record of one input (``where`` names it) read as ``fmt``. ``binary``:
+        hand out the target's payloads instead of its plain data; ``loss``: ``"entries"`` or
+        ``"summary"`` of each record's loss report."""
+        extra = dict(inputs or {})
+        for item in self._items(source, where, fmt):
+            if isinstance(item, Notice):
+                yield item
+                continue
+            if isinstance(item, Unreadable):
+                raise fail(where, item.line, _reworded(item.message, item.reason, fmt))
+            objs = self.source.build(item)
+            report = self.module.LossReport() if loss is not None else None
+            try:
+                result = self.func(*objs, policy=self.policy, report=report, **extra)
+            except self.module.ConversionError as exc:
+                raise fail(where, item.line, f"cannot convert: {exc}") from None
+            except (ValueError, TypeError, AttributeError) as exc:
+                text = f"cannot convert (a value the input lacks or does not fit): {exc}"
+                raise fail(where, item.line, text) from None
+            lost = None if report is None else report.summary() if loss == "summary" else report.to_dict()
+            if binary:
+                yield Converted(item.line, payloads=self.target.to_binary(result, item.file, item.line), loss=lost)
+            else:
+                yield Converted(item.line, plain=self.target.to_plain(result), loss=lost)
+
+    def _items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
+        if fmt in LOG_FORMATS:
+            yield from self._log_items(source, where, fmt)
+            return
+        if not isinstance(source, Path):
+            yield from _stream_items(source, where, fmt)
+            return
+        try:
+            stream = source.open("rb")
+        except OSError as exc:
+            raise BattgenError(f"{where}: cannot read: {exc.strerror or exc}") from None
+        with stream:
+            yield from _stream_items(stream, where, fmt)
+
+    def _log_items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
+        """Every record of the source side's first message in a .ulg, .tlog or raw MAVLink input."""
+        cls = self.source.items[0][1]
+        if fmt == "ulog":
+            if not isinstance(cls, UorbClass):
+                raise BattgenError(f"{where}: a ULog file holds uORB messages; {self.source_name} is not a uORB side")
+            for item in ulog_items(source, where, cls):
+                if isinstance(item, Record):
+                    yield _located(item, where)
+                elif isinstance(item, Notice) and item.kind == "unchecked" and item.data is not None:
+                    fields = ", ".join(map(str, cast(list[str], item.data.get("fields", ()))))
+                    text = f"{item.data.get('topic')}: not in the log, converted from the schema's defaults: {fields}"
+                    yield Notice(item.file, text, item.kind, item.severity, item.data)
+                elif isinstance(item, Unreadable):
+                    raise BattgenError(f"{where}: {item.message}")
+                else:
+                    yield item
+            return
+        if not isinstance(cls, MavlinkClass):
+            what = f"{self.source_name} is not a MAVLink side"
+            raise BattgenError(f"{where}: a MAVLink log holds MAVLink messages; {what}")
+        stats = StreamStats()
+        for item in mavlink_items(source, where, cls, timestamps=fmt == "tlog", stats=stats):
+            if isinstance(item, Record):
+                yield _located(item, where)
+        if stats.damaged:  # the summary without the last problem: a converted log is not a report
+            yield Notice(where, stats.summary(message_name(cls)), "stream")
+
+
+def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item]:
+    try:
+        if fmt == "raw":
+            yield from read_raw(stream, where)
+        elif fmt == "hex":
+            yield from read_hex(stream, where)
+        elif fmt == "jsonl":
+            yield from read_jsonl(stream, where)
+        elif fmt == "json":
+            yield from read_json(stream, where)
+        else:
+            yield from read_yaml(stream, where)
+    except InputError as exc:
+        if not exc.reason:
+            raise
+        raise fail(where, exc.line, _reworded(exc.message, exc.reason, fmt)) from None
+
+
+def _located(record: Record, where: str) -> Record:
+    """A log record whose errors name the input and the record: ``file (topic multi_id 0, ...)``."""
+    return Record(record.index, 0, None, f"{where} ({record.where})", instance=record.instance)
+
+
+def _reworded(message: str, reason: str, fmt: str) -> str:
+    """A reader's syntax error in convert's words (they name what a record is in each format)."""
+    if not reason:
+        return message
+    if fmt == "jsonl":
+        return f"expected one JSON record per line: {reason}"
+    if fmt == "json":
+        return f"expected JSON: {reason}"
+    return f"expected YAML: {reason}"

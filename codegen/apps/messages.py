@@ -1,0 +1,36 @@
+"""Finding a message of a schema by the names a user gives it."""
+
+from __future__ import annotations
+
+from ..backends.python import naming
+from ..errors import BattgenError
+from ..ir import Message, Schema
+
+
+def message_aliases(msg: Message) -> set[str]:
+    """The names a user may give for ``msg``: its qualified name, every dotted suffix of it, the
+    source name, the generated class name, and for devicetree bindings the compatible strings."""
+    parts = msg.qualified_name.split(".")
+    names = {".".join(parts[i:]) for i in range(len(parts))}
+    names.update((msg.name, naming.class_name(msg)))
+    if msg.devicetree is not None:
+        names.update(msg.devicetree.compatible)
+    return names
+
+
+def resolve_message(schema: Schema, name: str) -> Message:
+    """The message called ``name``: exact qualified name first, else an unambiguous short form."""
+    for msg in schema.messages:
+        if msg.qualified_name == name:
+            return msg
+    matches = [m for m in schema.messages if name in message_aliases(m)]
+    if not matches:
+        folded = name.casefold()
+        matches = [m for m in schema.messages if folded in {a.casefold() for a in message_aliases(m)}]
+    if len(matches) == 1:
+        return matches[0]
+    if matches:
+        candidates = ", ".join(m.qualified_name for m in matches)
+        raise BattgenError(f"message name {name!r} is ambiguous: it could be {candidates}")
+    known = ", ".join(m.qualified_name for m in schema.messages)
+    raise BattgenError(f"no message called {name!r} (known: {known})")

@@ -1,0 +1,141 @@
+"""Locating the generated package, its modules and the class that models a message.
+
+The one place that knows where generated code comes from: the checkout (:func:`project_root`)
+holds ``schemas/`` and the committed ``generated/``; the bundled schemas use that package; any
+other schema folder is generated into a temporary package once per process and imported from
+there; ``battgen convert --package NAME`` imports a package by name from the current folder.
+"""
+
+from __future__ import annotations
+
+import atexit
+import hashlib
+import importlib
+import importlib.util
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+from types import ModuleType
+from typing import cast
+
+from ..backends.python import naming
+from ..backends.python.writer import generate
+from ..errors import BattgenError
+from ..inputs.model import MessageClass
+from ..ir import Message, Schema
+
+_PACKAGES: dict[str, ModuleType] = {}
+
+
+_INSTALLED_ROOT = Path(__file__).resolve().parents[2]  # the checkout (or site-packages) holding codegen/
+
+
+def project_root() -> Path:
+    """The checkout holding schemas/ and generated/ (the current folder, else this package's parent)."""
+    cwd = Path.cwd()
+    if (cwd / "schemas").is_dir():
+        return cwd
+    return _INSTALLED_ROOT
+
+
+def bundled_schemas() -> Path:
+    """The schema folder used when none is given."""
+    return project_root() / "schemas"
+
+
+def _is_committed(schema_dir: Path, root: Path) -> bool:
+    try:
+        same = schema_dir.resolve() == (root / "schemas").resolve()
+    except OSError:
+        return False
+    return same and (root / "generated" / "__init__.py").is_file()
+
+
+def _import_from(folder: Path, name: str) -> ModuleType:
+    spec = importlib.util.spec_from_file_location(
+        name, folder / "__init__.py", submodule_search_locations=[str(folder)]
+    )
+    if spec is None or spec.loader is None:
+        raise BattgenError(f"{folder}: cannot import the generated package")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def _committed_package(folder: Path) -> ModuleType:
+    try:
+        pkg = importlib.import_module("generated")
+        if any(Path(p).resolve() == folder.resolve() for p in getattr(pkg, "__path__", ())):
+            return pkg
+    except ImportError:
+        pass
+    digest = hashlib.sha256(str(folder.resolve()).encode()).hexdigest()[:12]
+    return _import_from(folder, f"_battgen_generated_{digest}")
+
+
+def _temporary_package(schema: Schema, key: str) -> ModuleType:
+    digest = hashlib.sha256(key.encode()).hexdigest()[:12]
+    name = f"_battgen_models_{digest}"
+    tmp = Path(tempfile.mkdtemp(prefix="battgen-models-"))
+    atexit.register(shutil.rmtree, tmp, True)
+    generate(schema, tmp / name)
+    return _import_from(tmp / name, name)
+
+
+def model_package(schema: Schema, schema_dir: Path, root: Path | None = None) -> ModuleType:
+    """The generated package for ``schema`` (read from ``schema_dir``), imported once per process."""
+    root = root if root is not None else project_root()
+    key = str(schema_dir.resolve())
+    pkg = _PACKAGES.get(key)
+    if pkg is None:
+        if _is_committed(schema_dir, root):
+            pkg = _committed_package(root / "generated")
+        else:
+            pkg = _temporary_package(schema, key)
+        _PACKAGES[key] = pkg
+    return pkg
+
+
+def bundled_package() -> ModuleType:
+    """The committed package of the bundled schemas, without reading the schemas: the project's
+    ``generated/``, else the one installed with battgen."""
+    folder = project_root() / "generated"
+    if not (folder / "__init__.py").is_file():
+        folder = _INSTALLED_ROOT / "generated"
+    key = f"committed:{folder}"
+    pkg = _PACKAGES.get(key)
+    if pkg is None:
+        pkg = _PACKAGES[key] = _committed_package(folder)
+    return pkg
+
+
+def named_package(name: str) -> ModuleType:
+    """A generated package by its import name, looked for in the current folder first."""
+    root = str(Path.cwd())
+    if root not in sys.path:
+        sys.path.insert(0, root)
+    return importlib.import_module(name)
+
+
+def package_module(package: ModuleType, name: str) -> ModuleType:
+    """A module of a generated package: ``convert``, ``params``, ``_meta``..."""
+    return importlib.import_module(f"{package.__name__}.{name}")
+
+
+def data_error(package: ModuleType) -> type[Exception]:
+    """The error a generated ``from_dict`` raises on data that does not fit (``_meta.DataError``)."""
+    error = getattr(package_module(package, "_meta"), "DataError", ValueError)
+    return cast(type[Exception], error)
+
+
+def model_class(package: ModuleType, msg: Message) -> MessageClass:
+    """The generated class of ``msg`` inside ``package``."""
+    module = package_module(package, naming.module_path(msg))
+    cls = getattr(module, naming.class_name(msg), None)
+    if cls is None or getattr(cls, "QUALIFIED_NAME", None) != msg.qualified_name:
+        raise BattgenError(
+            f"the generated package {package.__name__} has no class for {msg.qualified_name}: run 'battgen generate'"
+        )
+    return cast(MessageClass, cls)

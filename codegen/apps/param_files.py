@@ -1,0 +1,123 @@
+"""The engine of ``battgen params``: battery failsafe parameter files, proposed and checked.
+
+:func:`propose_from_devicetree` reads a devicetree battery (a ``simple-battery`` node) and proposes
+the BATT_* parameters (:mod:`.param_proposal`); :func:`render` writes them as an ArduPilot .param
+or a QGroundControl .params file. :func:`check_param_file` reads a parameter file and checks each
+parameter set against the generated parameter model (types, ranges) and the failsafe's
+cross-field rules (:mod:`.failsafe.checks`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, cast
+
+from ..errors import BattgenError
+from ..frontends import devicetree as devicetree_schemas
+from ..inputs import devicetree, paramfile
+from ..inputs.model import MessageClass, field_names
+from ..ir import Message
+from .failsafe.checks import Finding, check_params
+from .package import bundled_package, bundled_schemas, data_error, package_module
+from .param_proposal import Result, propose
+
+BATTERY_COMPATIBLE = "simple-battery"
+BATTERY_MESSAGE = "devicetree.power.supply.battery"
+
+
+def _battery_message() -> Message:
+    schema = devicetree_schemas.parse_dir(bundled_schemas() / "devicetree")
+    return schema.message(BATTERY_MESSAGE)
+
+
+def _batt_params() -> MessageClass:
+    """The bundled package's class of the BATT_* parameters (params.BATT)."""
+    return cast(MessageClass, package_module(bundled_package(), "params").BattParams)
+
+
+def propose_from_devicetree(
+    path: Path,
+    *,
+    node: str | None = None,
+    cells: int | None = None,
+    low_soc: float = 20.0,
+    critical_soc: float = 10.0,
+    table: int | None = None,
+    mah_thresholds: bool = False,
+) -> tuple[Result, str]:
+    """The proposals from the first simple-battery node of a .dts/.dtb (or the one at ``node``,
+    a path or a label), and the words naming where they came from."""
+    nodes = devicetree.read_nodes(path)
+    batteries = devicetree.find_compatible(nodes, BATTERY_COMPATIBLE)
+    if node:
+        batteries = [n for n in batteries if n.path == node or node in n.labels]
+    if not batteries:
+        wanted = f" at {node}" if node else ""
+        raise BattgenError(f'{path}: expected a compatible = "{BATTERY_COMPATIBLE}" node{wanted}')
+    battery = batteries[0]
+    props = devicetree.node_to_model_dict(battery, _battery_message())
+    file = battery.file or path.as_posix()
+    lines = {name: f"{Path(v.file or file).name}:{v.line}" for name, v in battery.properties.items() if v.line}
+    where = f"{file}:{battery.line} ({battery.path})"
+    result = propose(
+        props,
+        where=where,
+        lines=lines,
+        cells=cells,
+        low_soc=low_soc,
+        critical_soc=critical_soc,
+        table=table,
+        mah_thresholds=mah_thresholds,
+    )
+    return result, f"{Path(file).name}:{battery.line} ({battery.path}, {BATTERY_COMPATIBLE})"
+
+
+def check_proposals(result: Result) -> list[Finding]:
+    """The failsafe's cross-field findings about the proposed parameters (with the cell count and
+    chemistry the proposal assumed)."""
+    return check_params({p.name: p.value for p in result.proposals}, cells=result.cells, chemistry=result.chemistry)
+
+
+def render(result: Result, source: str, fmt: str) -> str:
+    """The proposals as a parameter file: ``param`` (ArduPilot) or ``qgc`` (QGroundControl)."""
+    header = [f"Battery failsafe parameters proposed by battgen from {source}", *result.notes]
+    if fmt == "qgc":
+        types = {f.name: f.metadata["type"] for f in dataclasses.fields(cast(Any, _batt_params()))}
+        items = [(p.name, p.value, paramfile.TYPE_OF.get(types.get(p.name, "float32"), 9)) for p in result.proposals]
+        header += [f"{p.name}: {p.comment}" for p in result.proposals]
+        return paramfile.write_qgc(items, header=header)
+    return paramfile.write_param([(p.name, p.value, p.comment) for p in result.proposals], header=header)
+
+
+@dataclass(frozen=True)
+class ParamFinding:
+    line: int
+    severity: str  # "error" or "warning"
+    message: str
+
+
+def check_param_file(path: Path, *, cells: int | None = None, chemistry: str = "lipo") -> list[ParamFinding]:
+    """Every problem of each parameter set of a .param / .params file, in file order per set:
+    data the model cannot read, values outside their ranges, then the cross-field findings.
+    Absent parameters take the model's defaults."""
+    model = _batt_params()
+    error = data_error(bundled_package())
+    entries = paramfile.load(path, path.as_posix())
+    lines = {e.name: e.line for e in entries}
+    out: list[ParamFinding] = []
+    for first, values in paramfile.value_sets(entries):
+        try:
+            instance = model.from_dict(paramfile.select(values, field_names(model)))
+        except error as exc:
+            out.append(ParamFinding(lines.get(str(getattr(exc, "path", "")), first), "error", str(exc)))
+            continue
+        for f in dataclasses.fields(cast(Any, model)):
+            value, lo, hi = getattr(instance, f.name), f.metadata["minimum"], f.metadata["maximum"]
+            if (lo is not None and value < lo) or (hi is not None and value > hi):
+                text = f"{f.name} is {value:g}: expected {lo:g} to {hi:g}"
+                out.append(ParamFinding(lines.get(f.name, first), "error", text))
+        for finding in check_params(instance.to_dict(), cells=cells, chemistry=chemistry):
+            out.append(ParamFinding(lines.get(finding.param, first), finding.severity, finding.message))
+    return out

@@ -1,0 +1,336 @@
+"""The engine of ``battgen validate``: check the records of data files against a message's generated validator.
+
+:func:`make_checker` loads the schemas and finds the message and its generated class;
+:func:`check_file` reads one file's records (:mod:`codegen.inputs.dispatch`), builds each with the
+generated ``from_dict`` (or takes the instance a binary log decoded), runs ``validate()`` and
+the checks a message gets beyond it (the failsafe cross-field checks of a parameter set), and
+collects the findings, notices and unreadable parts into a :class:`FileReport` -- handing each to
+a callback as it is found, so that a caller can print them while a long file is still being read.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import BattgenError, LocatedError
+from ..frontends.loader import load
+from ..inputs.dispatch import KIND_FORMATS, file_kind, read_records
+from ..inputs.model import GeneratedMessage, MessageClass, Violation
+from ..inputs.records import Notice, Record, Unreadable
+from ..ir import Message, Schema, SourceFormat
+from ..ir.expr import referenced_fields
+from ..ir.numbers import to_json_data
+from ..ir.rules import bound_rules
+from .failsafe.checks import NONNEGATIVE, check_params
+from .messages import resolve_message
+from .package import data_error, model_class, model_package
+
+EXIT_OK, EXIT_INVALID, EXIT_UNREADABLE = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class Finding:
+    """A violation of one record, placed in its file."""
+
+    file: str
+    line: int  # 0: a .dtb or a log, which have no lines
+    record: int
+    where: str
+    path: str
+    rule: str
+    value: object
+    limit: object
+    message: str
+    severity: str
+    location: Mapping[str, object] | None = None
+
+
+Event = Finding | Notice | Unreadable
+
+
+@dataclass
+class FileReport:
+    """What checking one file found. ``findings`` stays empty when the caller took them as they came."""
+
+    file: str
+    records: int = 0
+    findings: list[Finding] = field(default_factory=list)
+    unreadable: list[Unreadable] = field(default_factory=list)
+    notices: list[Notice] = field(default_factory=list)
+    errors: int = 0
+    warnings: int = 0
+
+
+# A check beyond the generated validate(): (instance, its violations) -> findings as
+# (severity, path, rule, value, message)
+ExtraFinding = tuple[str, str, str, object, str]
+ExtraCheck = Callable[[GeneratedMessage, Sequence[Violation]], list[ExtraFinding]]
+
+
+def failsafe_check(instance: GeneratedMessage, violations: Sequence[Violation]) -> list[ExtraFinding]:
+    """codegen.apps.failsafe.checks over a BATT_* parameter set (absent parameters at their defaults,
+    as ``battgen params --check`` does). A negative threshold the schema's range already reported
+    is not reported twice: for a negative value that is the only finding check_params makes."""
+    values = instance.to_dict()
+    flagged = {str(v.path) for v in violations}
+    out = []
+    for f in check_params(values):
+        value = values.get(f.param)
+        if isinstance(value, int | float) and value < 0 and f.param in flagged:
+            continue
+        out.append((f.severity, f.param, "cross-field:failsafe", value, f.message))
+    return out
+
+
+def extra_check(message: Message) -> ExtraCheck | None:
+    """The checks a message gets beyond its generated validate()."""
+    names = {f.name for f in message.fields}
+    if message.format is SourceFormat.PARAMS and set(NONNEGATIVE) <= names:
+        return failsafe_check
+    return None
+
+
+def rule_fields(schema: Schema, message: Message) -> dict[str, frozenset[str]]:
+    """Cross-field rule id -> the fields it reads (is_known() arguments included)."""
+    out: dict[str, frozenset[str]] = {}
+    for bound in bound_rules(schema, message):
+        exprs = [bound.where, bound.check, bound.path, *(e for _, e in bound.bindings)]
+        exprs += [p for p in bound.message if not isinstance(p, str)]
+        names = {n for e in exprs for n in referenced_fields(e, skip_is_known=False)}
+        out[bound.rule.id] = frozenset(names)
+    return out
+
+
+def _covers(skip: frozenset[str], path: str) -> bool:
+    """True when ``path`` (``a``, ``a[3]``, ``a.b``) lies in a skipped field."""
+    return any(path == s or path.startswith((s + ".", s + "[")) for s in skip)
+
+
+def _short(value: object, width: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+class Checker:
+    """Builds each record with the generated ``from_dict`` (or takes the instance a binary log
+    decoded) and collects ``validate()``'s violations, minus those of fields the source lacks."""
+
+    def __init__(
+        self,
+        cls: MessageClass,
+        message: Message,
+        data_error: type[BaseException],
+        rules: Mapping[str, frozenset[str]] | None = None,
+        extra: ExtraCheck | None = None,
+    ) -> None:
+        self.cls = cls
+        self.message = message
+        self.data_error = data_error
+        self.rules = rules or {}
+        self.extra = extra
+
+    def check(self, record: Record) -> list[Finding]:
+        instance = record.instance
+        if instance is None:
+            try:
+                instance = self.cls.from_dict(record.data)
+            except self.data_error as exc:
+                return [self._type_finding(record, exc)]
+            except Exception as exc:  # a generated from_dict should raise DataError only; never a traceback
+                return [self._finding(record, "", "type", record.data, None, f"cannot read the record: {exc}", "error")]
+        try:
+            violations = instance.validate()
+            extra = self.extra(instance, violations) if self.extra is not None else []
+        except Exception as exc:
+            return [self._finding(record, "", "internal", None, None, f"the validator failed: {exc!r}", "error")]
+        if record.skip:
+            violations = [v for v in violations if not self._skipped(v, record.skip)]
+        findings = [
+            self._finding(
+                record,
+                str(v.path),
+                str(v.rule),
+                v.value,
+                v.limit,
+                str(v.message),
+                "warning" if v.severity == "warning" else "error",
+            )
+            for v in violations
+        ]
+        findings += [self._finding(record, p, rule, value, None, text, sev) for sev, p, rule, value, text in extra]
+        return sorted(findings, key=lambda f: f.line)  # stable: the validator's order within a line
+
+    def _skipped(self, v: Violation, skip: frozenset[str]) -> bool:
+        rule = str(v.rule)
+        if rule.startswith("cross-field:") and self.rules.get(rule[len("cross-field:") :], frozenset()) & skip:
+            return True
+        return _covers(skip, str(v.path))
+
+    def _type_finding(self, record: Record, exc: BaseException) -> Finding:
+        # the generated DataError names the field path, what was expected and the value found
+        path = str(getattr(exc, "path", ""))
+        expected = str(getattr(exc, "expected", ""))
+        value = getattr(exc, "value", None)
+        prefix = f"{self.cls.__name__}"
+        if path == prefix:
+            path = ""
+        elif path.startswith(prefix + "."):
+            path = path[len(prefix) + 1 :]
+        if expected.startswith("a field of "):
+            text = f"{path} is not a field of {self.message.qualified_name}"
+        else:
+            text = f"{path or 'the record'}: expected {expected}, got {_short(value)}"
+        return self._finding(record, path, "type", value, expected, text, "error")
+
+    @staticmethod
+    def _finding(
+        record: Record, path: str, rule: str, value: object, limit: object, message: str, severity: str
+    ) -> Finding:
+        if path and path not in message:
+            message = f"{path}: {message}"
+        return Finding(
+            record.file,
+            record.line_of(path),
+            record.index,
+            record.where,
+            path,
+            rule,
+            value,
+            limit,
+            message,
+            severity,
+            record.location,
+        )
+
+
+def check_file(
+    path: Path,
+    message: Message,
+    checker: Checker,
+    *,
+    kind: str | None = None,
+    keep_findings: bool = True,
+    on_event: Callable[[Event], None] | None = None,
+) -> FileReport:
+    """Check every record of one file. Each finding, notice and unreadable part goes to
+    ``on_event`` as soon as it is found; findings are kept in the report only with
+    ``keep_findings`` (so a caller printing them streams a file of any size in constant memory)."""
+    report = FileReport(path.as_posix())
+
+    def tell(event: Event) -> None:
+        if on_event is not None:
+            on_event(event)
+
+    try:
+        for item in read_records(path, message, report.file, model=checker.cls, kind=kind):
+            if isinstance(item, Notice):
+                report.notices.append(item)
+                tell(item)
+                continue
+            if isinstance(item, Unreadable):
+                report.unreadable.append(item)
+                tell(item)
+                continue
+            report.records += 1
+            for finding in checker.check(item):
+                if finding.severity == "warning":
+                    report.warnings += 1
+                else:
+                    report.errors += 1
+                if keep_findings:
+                    report.findings.append(finding)
+                tell(finding)
+    except LocatedError as exc:  # input, parameter-file and devicetree errors name file and line
+        problem = Unreadable(exc.file, exc.line, exc.message)
+    except BattgenError as exc:
+        problem = Unreadable(report.file, 0, str(exc))
+    except Exception as exc:  # a reader's bug must still end in one line, never a traceback
+        problem = Unreadable(report.file, 0, f"cannot read: {exc!r}")
+    else:
+        return report
+    report.unreadable.append(problem)
+    tell(problem)
+    return report
+
+
+def exit_code(reports: Iterable[FileReport]) -> int:
+    """0 when every record is valid, 1 when one has an error, 2 when an input was unreadable."""
+    code = EXIT_OK
+    for report in reports:
+        if report.unreadable:
+            return EXIT_UNREADABLE
+        if report.errors:
+            code = EXIT_INVALID
+    return code
+
+
+def json_document(message: Message, reports: list[FileReport]) -> dict[str, object]:
+    """The reports as one JSON document (``validate --format json``)."""
+    return {
+        "message": message.qualified_name,
+        "valid": exit_code(reports) == EXIT_OK,
+        "exit_code": exit_code(reports),
+        "files": [
+            {
+                "file": r.file,
+                "records": r.records,
+                "errors": r.errors,
+                "warnings": r.warnings,
+                "unreadable": [{"file": u.file, "line": u.line, "message": u.message} for u in r.unreadable],
+                "notices": [
+                    {"kind": n.kind, "severity": n.severity, "message": n.message, "data": to_json_data(n.data)}
+                    for n in r.notices
+                ],
+                "violations": [
+                    {
+                        "file": f.file,
+                        "line": f.line if f.line > 0 else None,
+                        "record": f.record,
+                        "node": f.where or None,
+                        "location": to_json_data(f.location),
+                        "path": f.path,
+                        "rule": f.rule,
+                        "value": to_json_data(f.value),
+                        "limit": to_json_data(f.limit),
+                        "message": f.message,
+                        "severity": f.severity,
+                    }
+                    for f in r.findings
+                ],
+            }
+            for r in reports
+        ],
+    }
+
+
+def default_message(schema: Schema, files: list[str], kind: str | None) -> str:
+    """The message to check when --message is omitted: the only one of the inputs' format."""
+    formats: set[SourceFormat | None] = set()
+    for name in files:
+        try:
+            formats.add(KIND_FORMATS.get(kind or file_kind(Path(name))))
+        except LocatedError:
+            formats.add(None)
+    candidates = [m.qualified_name for m in schema.messages if m.format in formats]
+    if len(formats) == 1 and None not in formats and len(candidates) == 1:
+        return candidates[0]
+    if len(formats) == 1 and None not in formats and candidates:
+        raise BattgenError(
+            f"--message is required: the schemas hold {len(candidates)} such messages ({', '.join(candidates)})"
+        )
+    raise BattgenError("--message is required for these inputs (it may be omitted for parameter files)")
+
+
+def make_checker(
+    schema_dir: Path, message_name: str | None, files: list[str] | None = None, kind: str | None = None
+) -> tuple[Message, Checker]:
+    """Load the schemas, resolve the message (or the inputs' default one) and its generated class."""
+    schema = load([schema_dir])
+    if message_name is None:
+        message_name = default_message(schema, files or [], kind)
+    message = resolve_message(schema, message_name)
+    package = model_package(schema, schema_dir)
+    cls = model_class(package, message)
+    return message, Checker(cls, message, data_error(package), rule_fields(schema, message), extra_check(message))

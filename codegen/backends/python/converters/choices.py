@@ -1,0 +1,84 @@
+"""Emitters of the ops between enumerated values and concepts: flag, flag_choice, flags, choice.
+
+Bits read into bool, choice or flags concepts are noted, so the function's epilogue reports the
+bits of the field nothing reads as dropped; choices with no counterpart are reported too.
+"""
+
+from __future__ import annotations
+
+from ....ir import Rule
+from ....ir.ops import Choice, Flag, FlagChoice, Flags
+from .context import RuleContext, constant_name
+from .source import literal
+
+_NO_COUNTERPART = 'f"{_v!r} has no counterpart"'
+
+
+class ChoiceEmitters(RuleContext):
+    def note_bits(self, message: str, field: str, mask: int) -> None:
+        """Bits of a source field some rule reads (the rest are reported dropped)."""
+        self.bit_masks[message, field] = self.bit_masks.get((message, field), 0) | mask
+
+    def visit_flag(self, rule: Rule, op: Flag) -> None:
+        fmt, con = self.format_and_concept(rule)
+        mask = self.mask(op.mask, [fmt])
+        if not self.backward:
+            self.note_bits(fmt.message, fmt.field, mask)
+            self.emit(f"{self.t(con)} = bool({self.s(fmt)} & {literal(mask)})")
+        else:
+            target = self.t(fmt)
+            self.emit(f"if {self.s(con)}:", f"    {target} |= {literal(mask)}")
+
+    def visit_flag_choice(self, rule: Rule, op: FlagChoice) -> None:
+        """A bit that stands for one value of a choice concept (CHARGING -> warning 'charging')."""
+        fmt, con = self.format_and_concept(rule)
+        mask = self.mask(op.mask, [fmt])
+        value = literal(op.value)
+        if not self.backward:
+            self.note_bits(fmt.message, fmt.field, mask)
+            self.emit(f"if {self.s(fmt)} & {literal(mask)}:", f"    {self.t(con)} = {value}")
+        else:
+            self.emit(f"if {self.s(con)} == {value}:", f"    {self.t(fmt)} |= {literal(mask)}")
+
+    def visit_flags(self, rule: Rule, op: Flags) -> None:
+        fmt, con = self.format_and_concept(rule)
+        concept = self.concepts[con.field]
+        table = {bit.choice: self.mask(bit.mask, [fmt]) for bit in op.map}
+        ordered = tuple((c, table[c]) for c in concept.choices if c in table)
+        if not self.backward:
+            self.note_bits(fmt.message, fmt.field, sum(table.values()))
+            bits = self.const(constant_name(con.field, "bits"), ordered)
+            self.emit(f"_v = {self.s(fmt)}", f"{self.t(con)} = tuple(_n for _n, _m in {bits} if _v & _m)")
+            return
+        target, label = self.t(fmt), self.label(fmt)
+        known = self.const(constant_name(con.field, "with", "bits"), tuple(sorted(table)))
+        self.emit(f"_v = {self.s(con)}", "if _v is None:", "    if rep_u is not None:")
+        self.emit_call("rep_u.unknown", [label], 2)
+        self.emit("else:", f"    _b = {target}")
+        for name, mask in ordered:
+            self.emit(f"    if {literal(name)} in _v:", f"        _b |= {literal(mask)}")
+        self.emit(f"    {target} = _b", "    if rep_d is not None:", "        for _n in _v:")
+        self.emit(f"            if _n not in {known}:")
+        self.emit_call("rep_d.dropped", [literal(f"concepts.{con.field}"), '_n + " has no counterpart"'], 4)
+
+    def visit_choice(self, rule: Rule, op: Choice) -> None:
+        fmt, con = self.format_and_concept(rule)
+        table = [(entry.choice, self.value_of(entry.value, [fmt])) for entry in op.map]
+        unknown = self.value_of(op.unknown, [fmt]) if op.unknown is not None else None
+        if not self.backward:
+            by_value = self.const(constant_name(con.field, "by", fmt.field), {v: k for k, v in table})
+            self.emit(f"_v = {self.s(fmt)}", f"{self.t(con)} = None if _v is None else {by_value}.get(_v)")
+            skip = f"({literal(None)}, {literal(unknown)})"
+            self.emit(f"if rep_d is not None and _v not in {by_value} and _v not in {skip}:")
+            self.emit_call("rep_d.dropped", [self.label(fmt), _NO_COUNTERPART], 1)
+            return
+        by_choice = self.const(constant_name(fmt.field, "by", con.field), dict(table))
+        target, label = self.t(fmt), self.label(fmt)
+        self.emit(f"_v = {self.s(con)}", f"_w = None if _v is None else {by_choice}.get(_v)")
+        self.emit("if _w is not None:", f"    {target} = _w", "else:")
+        if unknown is not None:
+            self.emit(f"    {target} = {literal(unknown)}")
+        self.emit("    if rep_u is not None:")
+        self.emit_call("rep_u.unknown", [label], 2)
+        self.emit("    if rep_d is not None and _v is not None:")
+        self.emit_call("rep_d.dropped", [literal(f"concepts.{con.field}"), _NO_COUNTERPART], 2)

@@ -1,0 +1,146 @@
+"""Run-time support of the generated DroneCAN (UAVCAN v0) codecs. Standard library only.
+
+The generated code writes a message as one Python int, most significant bit first, behind a
+sentinel 1 bit (so the bit count is ``acc.bit_length() - 1``); it reads from one int of the
+whole payload, counting the bits that remain after the read position.
+"""
+
+from __future__ import annotations
+
+import struct
+
+_F32 = struct.Struct("<f")
+_U32 = struct.Struct("<I")
+_F64 = struct.Struct("<d")
+_U64 = struct.Struct("<Q")
+_E16 = struct.Struct("<e")
+_U16 = struct.Struct("<H")
+
+F16_MAX = 65504.0
+F32_MAX = 3.4028234663852886e38
+F64_MAX = 1.7976931348623157e308
+INF = float("inf")
+
+
+class DecodeError(ValueError):
+    """Bytes that are not a valid encoding: names the field and what was wrong."""
+
+
+class EncodeError(ValueError):
+    """A value that cannot be encoded (an array longer than its capacity, an unknown union field)."""
+
+
+def f16bits(u: int) -> int:
+    """float16 bits of the float32 with bits ``u``, rounded as the reference does."""
+    sign = (u >> 16) & 0x8000
+    a = u & 0x7FFFFFFF
+    if a >= 0x7F800000:  # inf or NaN; every NaN becomes 0x7FFF
+        return sign | (0x7FFF if a > 0x7F800000 else 0x7C00)
+    if a >= 0x38800000:  # normal half (or overflow): drop 13 bits, a set bit 12 rounds up
+        h = (a - 0x37FFF000) >> 13
+        return sign | (h if h < 0x7C00 else 0x7C00)
+    # subnormal half: the reference scales the float32 (low 12 bits cleared) by 2**-112,
+    # which rounds to nearest even into a float32 subnormal, then rounds that half up.
+    a &= 0xFFFFF000
+    e = a >> 23
+    if e == 0:
+        return sign
+    sig = 0x800000 | (a & 0x7FFFFF)
+    shift = 113 - e
+    if shift > 24:
+        return sign
+    m = sig >> shift
+    rest = sig & ((1 << shift) - 1)
+    half = 1 << (shift - 1)
+    if rest > half or (rest == half and m & 1):
+        m += 1
+    return sign | ((m + 0x1000) >> 13)
+
+
+def f16s(x: float) -> int:
+    """Bits of a saturated float16: out of range (and infinity) clamps to +-65504."""
+    if x > F16_MAX:
+        x = F16_MAX
+    elif x < -F16_MAX:
+        x = -F16_MAX
+    u: int = _U32.unpack(_F32.pack(x))[0]
+    a = u & 0x7FFFFFFF
+    if 0x38800000 <= a < 0x477FF000:
+        return ((u >> 16) & 0x8000) | ((a - 0x37FFF000) >> 13)
+    return f16bits(u)
+
+
+def f16t(x: float) -> int:
+    """Bits of a truncated float16: out of range becomes infinity."""
+    if x > F16_MAX:
+        x = INF
+    elif x < -F16_MAX:
+        x = -INF
+    return f16bits(_U32.unpack(_F32.pack(x))[0])
+
+
+def f16v(bits: int) -> float:
+    """Value of float16 bits (exact, as the reference converts them)."""
+    return float(_E16.unpack(_U16.pack(bits))[0])
+
+
+def f32bits(x: float) -> int:
+    return int(_U32.unpack(_F32.pack(x))[0])
+
+
+def f32v(bits: int) -> float:
+    return float(_F32.unpack(_U32.pack(bits))[0])
+
+
+def f64bits(x: float) -> int:
+    return int(_U64.unpack(_F64.pack(x))[0])
+
+
+def f64v(bits: int) -> float:
+    return float(_F64.unpack(_U64.pack(bits))[0])
+
+
+def finish(acc: int) -> bytes:
+    """The bytes of a sentinel-led bit accumulator, zero padded to a whole byte."""
+    n = acc.bit_length() - 1
+    pad = -n & 7
+    return ((acc ^ (1 << n)) << pad).to_bytes((n + pad) >> 3, "big")
+
+
+def cut(table: tuple[tuple[int, str], ...], have: int) -> DecodeError:
+    """The error for a fixed run of fields cut short: names the first field that does not fit."""
+    for end, label in table:
+        if end > have:
+            return DecodeError(f"{label}: input ends inside this field ({have} bits left, {end} needed)")
+    return DecodeError(f"{table[-1][1]}: input ends inside this field")
+
+
+def short(label: str, need: int, have: int) -> DecodeError:
+    return DecodeError(f"{label}: input ends inside this field ({have} bits left, {need} needed)")
+
+
+def _crc_table() -> tuple[int, ...]:
+    out = []
+    for i in range(256):
+        crc = i << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
+        out.append(crc)
+    return tuple(out)
+
+
+_CRC = _crc_table()
+
+
+def crc16(data: bytes, crc: int = 0xFFFF) -> int:
+    """CRC-16-CCITT (polynomial 0x1021, no reflection), continuing from ``crc``."""
+    table = _CRC
+    for byte in data:
+        crc = ((crc << 8) & 0xFF00) ^ table[(crc >> 8) ^ byte]
+    return crc
+
+
+def transfer_crc(signature: int, payload: bytes) -> int:
+    """The CRC of a multi-frame transfer: CRC-16-CCITT over the data type signature
+    (8 bytes, little-endian) followed by the payload."""
+    return crc16(payload, crc16(signature.to_bytes(8, "little")))

@@ -1,0 +1,95 @@
+"""Name resolution for mapping files: concepts, endpoints, messages, fields and constants.
+
+Given the formats' Schema, every reference a rule makes is checked, so a typo is a SchemaError
+naming the file and line rather than a broken converter. Without one (a mapping file read on
+its own), only concepts and endpoints are checked.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterator
+
+from ...errors import SchemaError
+from ...ir import CONCEPTS_ENDPOINT, ArrayType, Concept, Endpoint, FieldRef, Message, Rule, Schema
+from ...ir.mapping_values import ConstantRef
+from ...ir.ops import Cells
+
+
+class Resolver:
+    """Resolves names across all files of a folder: concepts, endpoints and (optionally) formats."""
+
+    def __init__(self, schema: Schema | None) -> None:
+        self.schema = schema
+        self.concepts: dict[str, Concept] = {}
+        self.endpoints: dict[str, Endpoint] = {}
+
+    def message(self, name: str, display: str, line: int) -> Message | None:
+        if self.schema is None:
+            return None
+        try:
+            return self.schema.message(name)
+        except KeyError:
+            raise SchemaError(display, line, f"expected a known message, got {name!r}") from None
+
+    def endpoint(self, name: str, display: str, line: int) -> Endpoint | None:
+        if name == CONCEPTS_ENDPOINT:
+            return None
+        found = self.endpoints.get(name)
+        if found is None:
+            known = ", ".join([*sorted(self.endpoints), CONCEPTS_ENDPOINT])
+            raise SchemaError(display, line, f"expected a declared endpoint ({known}), got {name!r}")
+        return found
+
+    def ref(self, text: str, endpoint: Endpoint | None, display: str, line: int) -> FieldRef:
+        if endpoint is None:
+            if text not in self.concepts:
+                raise SchemaError(display, line, f"expected a declared concept, got {text!r}")
+            return FieldRef(CONCEPTS_ENDPOINT, text)
+        aliases = dict(zip(endpoint.aliases, endpoint.messages, strict=True))
+        if text in aliases:
+            return FieldRef(aliases[text], "")
+        alias, dot, field = text.partition(".")
+        if dot and alias in aliases:
+            qualified = aliases[alias]
+        elif len(aliases) == 1:
+            qualified, field = endpoint.messages[0], text
+        else:
+            known = ", ".join(endpoint.aliases)
+            raise SchemaError(display, line, f"expected ALIAS.FIELD with ALIAS one of {known}, got {text!r}")
+        msg = self.message(qualified, display, line)
+        if msg is not None and not any(f.name == field for f in msg.fields):
+            raise SchemaError(display, line, f"expected a field of {qualified}, got {field!r}")
+        return FieldRef(qualified, field)
+
+    def check_rule(self, rule: Rule, display: str, line: int) -> None:
+        """What only the formats can tell: named constants exist, ``cells`` relates arrays."""
+        if self.schema is None:
+            return
+        names: set[str] = set()
+        for ref in rule.targets + rule.sources:
+            if ref.message != CONCEPTS_ENDPOINT:
+                names.update(c.name for c in self.schema.message(ref.message).constants)
+        for e in self.schema.enums:
+            names.update(x.name for x in e.entries)
+        for const in _constants(rule.op):
+            if const.name not in names:
+                raise SchemaError(display, line, f"expected a constant of the messages used, got {const.name!r}")
+        if isinstance(rule.op, Cells):
+            for ref in rule.targets + rule.sources:
+                if ref.message != CONCEPTS_ENDPOINT and not isinstance(
+                    self.schema.message(ref.message).field(ref.field).type, ArrayType
+                ):
+                    raise SchemaError(display, line, f"expected an array field for op 'cells', got {ref.field!r}")
+
+
+def _constants(value: object) -> Iterator[ConstantRef]:
+    """Every constant an op's parameters name, in order."""
+    if isinstance(value, ConstantRef):
+        yield value
+    elif isinstance(value, tuple):
+        for item in value:
+            yield from _constants(item)
+    elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+        for f in dataclasses.fields(value):
+            yield from _constants(getattr(value, f.name))

@@ -1,0 +1,308 @@
+"""Text documents as records: JSON (an object or an array of them), JSON Lines and YAML streams.
+
+JSON Lines and YAML are read one record at a time (constant memory): a line, or a YAML document
+composed on its own. A JSON document is read whole, but its records are found with
+``raw_decode`` positions, and field lines are only worked out for records that ask for them.
+YAML goes through PyYAML's safe loader; an alias is walked once when field lines are worked out,
+so a document of nested aliases (an "alias bomb") costs no more than its text.
+
+NaN and infinities: JSON's bare ``NaN``/``Infinity``/``-Infinity`` tokens are read as floats; the
+strings (:mod:`codegen.ir.numbers`) stay strings, which the generated ``from_dict`` accepts.
+A source is a path or an open binary stream (standard input); a byte order mark is skipped.
+"""
+
+from __future__ import annotations
+
+import bisect
+import io
+import json
+import re
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import IO
+
+import yaml
+
+from ..text.files import read_text
+from .records import TOO_DEEP, InputError, Item, Record, Unreadable, join_path, nearest_line
+
+Source = Path | IO[bytes]
+
+_WS = re.compile(r"[ \t\n\r]*")
+_DECODER = json.JSONDecoder()
+_BOM = "\ufeff"  # a byte order mark some editors write
+
+
+@contextmanager
+def _text_stream(source: Source, name: str) -> Iterator[IO[str]]:
+    """``source`` as UTF-8 text, newlines kept as they are; a stream given is left open."""
+    if isinstance(source, Path):
+        try:
+            stream = source.open(encoding="utf-8", newline="")
+        except OSError as exc:
+            raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+        with stream:
+            yield stream
+        return
+    wrapper = io.TextIOWrapper(source, encoding="utf-8", newline="")
+    try:
+        yield wrapper
+    finally:
+        wrapper.detach()  # closing the wrapper would close the caller's stream
+
+
+def _whole_text(source: Source, name: str) -> str:
+    if isinstance(source, Path):
+        return read_text(source, name, InputError)
+    data = source.read()
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(name, data[: exc.start].count(b"\n") + 1, "expected UTF-8 text") from None
+
+
+# ------------------------------------------------------------------------------------------------
+# JSON Lines: one record per non-blank line, read lazily
+
+
+def read_jsonl(source: Source, name: str, *, comments: bool = False) -> Iterator[Item]:
+    """One record per non-blank line (with ``comments``, lines starting with ``#`` are skipped
+    too); a malformed line is an Unreadable item and reading goes on."""
+    with _text_stream(source, name) as stream:
+        index = 0
+        lineno = 0
+        while True:
+            try:
+                line = stream.readline()
+            except UnicodeDecodeError:
+                yield Unreadable(name, lineno + 1, "expected UTF-8 text")
+                return
+            if not line:
+                return
+            lineno += 1
+            if lineno == 1 and line.startswith(_BOM):
+                line = line[1:]
+            text = line.strip()
+            if not text or (comments and text.startswith("#")):
+                continue
+            try:
+                data = json.loads(line)
+            except json.JSONDecodeError as exc:
+                message = f"expected one JSON value per line: {exc.msg} (column {exc.colno})"
+                yield Unreadable(name, lineno, message, exc.msg, exc.colno)
+                continue
+            except RecursionError:
+                yield Unreadable(name, lineno, TOO_DEEP)
+                continue
+            yield Record(index, lineno, data, name)
+            index += 1
+
+
+# ------------------------------------------------------------------------------------------------
+# JSON: one object or an array of objects
+
+
+class _LineIndex:
+    """Offset -> 1-based line over a text, by binary search of its newline offsets."""
+
+    def __init__(self, text: str, start: int, end: int, first_line: int) -> None:
+        self.start = start
+        self.first_line = first_line
+        self.newlines = [m.start() for m in re.finditer("\n", text[start:end])]
+
+    def line(self, offset: int) -> int:
+        return self.first_line + bisect.bisect_right(self.newlines, offset - self.start - 1)
+
+
+def read_json(source: Source, name: str) -> Iterator[Item]:
+    """The records of a JSON document: each element of a top-level array, else the one value.
+    The whole document is checked before the first record (InputError when it is malformed)."""
+    text = _whole_text(source, name)
+    try:
+        return _json_records(text, name)
+    except json.JSONDecodeError as exc:
+        message = f"malformed JSON: {exc.msg} (column {exc.colno})"
+        raise InputError(name, exc.lineno, message, reason=exc.msg, column=exc.colno) from None
+    except RecursionError:
+        raise InputError(name, 1, TOO_DEEP) from None
+
+
+def _skip(text: str, pos: int) -> int:
+    """The offset after the whitespace at ``pos``."""
+    return _WS.match(text, pos).end()  # type: ignore[union-attr]  # the pattern matches the empty string
+
+
+def _json_records(text: str, name: str) -> Iterator[Item]:
+    pos = _skip(text, 1 if text.startswith(_BOM) else 0)
+    records: list[tuple[int, int, object]] = []  # start offset, end offset, value
+    if text.startswith("[", pos):
+        pos = _skip(text, pos + 1)
+        if text.startswith("]", pos):
+            pos += 1
+        else:
+            while True:
+                value, end = _DECODER.raw_decode(text, pos)
+                records.append((pos, end, value))
+                pos = _skip(text, end)
+                if text.startswith(",", pos):
+                    pos = _skip(text, pos + 1)
+                    continue
+                if text.startswith("]", pos):
+                    pos += 1
+                    break
+                raise json.JSONDecodeError("expected ',' or ']' after an array element", text, pos)
+    else:
+        value, end = _DECODER.raw_decode(text, pos)
+        records.append((pos, end, value))
+        pos = end
+    pos = _skip(text, pos)
+    if pos != len(text):
+        raise json.JSONDecodeError("expected the end of the file after the JSON document", text, pos)
+    return _json_items(text, name, records)
+
+
+def _json_items(text: str, name: str, records: list[tuple[int, int, object]]) -> Iterator[Item]:
+    line, counted = 1, 0
+    for index, (start, end, value) in enumerate(records):
+        line += text.count("\n", counted, start)
+        counted = start
+        yield Record(index, line, value, name, locate=_json_locator(text, start, end, line))
+
+
+def _json_locator(text: str, start: int, end: int, line: int) -> Callable[[str], int | None]:
+    cache: dict[str, int] = {}
+
+    def locate(path: str) -> int | None:
+        if not cache:
+            index = _LineIndex(text, start, end, line)
+            try:
+                _scan_json(text, start, "", cache, index)
+            except (json.JSONDecodeError, IndexError, RecursionError):
+                cache[""] = line  # already decoded once, so this does not happen; stay quiet if it does
+        return nearest_line(cache, path)
+
+    return locate
+
+
+def _scan_json(text: str, pos: int, path: str, out: dict[str, int], index: _LineIndex) -> int:
+    """Walk one JSON value from ``pos`` recording the line of every path; returns its end offset."""
+    out[path] = index.line(pos)
+    char = text[pos]
+    if char == "{":
+        pos = _skip(text, pos + 1)
+        if text[pos] == "}":
+            return pos + 1
+        while True:
+            key, pos = _DECODER.raw_decode(text, pos)
+            pos = _skip(text, _skip(text, pos) + 1)  # past the ':'
+            pos = _scan_json(text, pos, join_path(path, str(key)), out, index)
+            pos = _skip(text, pos)
+            if text[pos] == "}":
+                return pos + 1
+            pos = _skip(text, pos + 1)  # past the ','
+    if char == "[":
+        pos = _skip(text, pos + 1)
+        if text[pos] == "]":
+            return pos + 1
+        item = 0
+        while True:
+            pos = _scan_json(text, pos, f"{path}[{item}]", out, index)
+            item += 1
+            pos = _skip(text, pos)
+            if text[pos] == "]":
+                return pos + 1
+            pos = _skip(text, pos + 1)
+    _, end = _DECODER.raw_decode(text, pos)
+    return int(end)
+
+
+# ------------------------------------------------------------------------------------------------
+# YAML: a stream of documents, each a record or a list of records; composed one document at a time
+
+
+class _LineLoader(yaml.SafeLoader):
+    """SafeLoader that also hands back the composed node, so each value's line is known."""
+
+    def next_document(self) -> tuple[object, yaml.Node] | None:
+        if not self.check_node():
+            return None
+        node = self.get_node()
+        if node is None:
+            return None
+        return self.construct_document(node), node
+
+
+def _node_lines(node: yaml.Node, path: str, out: dict[str, int], seen: set[int]) -> None:
+    out.setdefault(path, node.start_mark.line + 1)
+    if id(node) in seen:
+        return  # an alias: its lines are those of the anchored node, walked once (no alias bombs)
+    seen.add(id(node))
+    if isinstance(node, yaml.MappingNode):
+        for key_node, value_node in node.value:
+            if isinstance(key_node, yaml.ScalarNode):
+                key = join_path(path, str(key_node.value))
+                out.setdefault(key, key_node.start_mark.line + 1)
+                _node_lines(value_node, key, out, seen)
+    elif isinstance(node, yaml.SequenceNode):
+        for i, item in enumerate(node.value):
+            _node_lines(item, f"{path}[{i}]", out, seen)
+
+
+def _yaml_locator(node: yaml.Node) -> Callable[[str], int | None]:
+    cache: dict[str, int] = {}
+
+    def locate(path: str) -> int | None:
+        if not cache:
+            try:
+                _node_lines(node, "", cache, set())
+            except RecursionError:
+                cache.setdefault("", node.start_mark.line + 1)
+        return nearest_line(cache, path)
+
+    return locate
+
+
+def _yaml_error(name: str, exc: Exception) -> InputError:
+    if isinstance(exc, yaml.MarkedYAMLError):
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else 0
+        what = " ".join(p for p in (exc.context, exc.problem) if p)
+        column = mark.column + 1 if mark is not None else 0
+        return InputError(name, line, f"malformed YAML: {what}", reason=what, column=column)
+    if isinstance(exc, yaml.YAMLError):
+        return InputError(name, 0, f"malformed YAML: {exc}", reason=str(exc))
+    return InputError(name, 0, "expected UTF-8 text")
+
+
+def read_yaml(source: Source, name: str) -> Iterator[Item]:
+    """One record per document, or per item of a document that is a list; empty documents are
+    skipped. A malformed document raises InputError when reading reaches it."""
+    with _text_stream(source, name) as stream:
+        try:
+            loader = _LineLoader(stream)
+        except (yaml.YAMLError, UnicodeDecodeError) as exc:
+            raise _yaml_error(name, exc) from None
+        try:
+            index = 0
+            while True:
+                try:
+                    document = loader.next_document()
+                except (yaml.YAMLError, UnicodeDecodeError) as exc:
+                    raise _yaml_error(name, exc) from None
+                except RecursionError:
+                    raise InputError(name, loader.line + 1, TOO_DEEP) from None
+                if document is None:
+                    return
+                data, node = document
+                if data is None:
+                    continue  # an empty document
+                if isinstance(node, yaml.SequenceNode) and isinstance(data, list):
+                    for item, item_data in zip(node.value, data, strict=True):
+                        yield Record(index, item.start_mark.line + 1, item_data, name, locate=_yaml_locator(item))
+                        index += 1
+                else:
+                    yield Record(index, node.start_mark.line + 1, data, name, locate=_yaml_locator(node))
+                    index += 1
+        finally:
+            loader.dispose()

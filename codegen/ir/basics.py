@@ -1,0 +1,52 @@
+"""The IR's roots: which format a definition came from, where it stands, and units of measure."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+
+class SourceFormat(str, enum.Enum):
+    UORB = "uorb"
+    DRONECAN = "dronecan"
+    DEVICETREE = "devicetree"
+    MAVLINK = "mavlink"
+    PARAMS = "params"  # ArduPilot parameter metadata (apm.pdef.xml)
+
+
+@dataclass(frozen=True)
+class Location:
+    """Where a definition came from: the file as given to the frontend and a 1-based line."""
+
+    file: str
+    line: int
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}"
+
+
+# --------------------------------------------------------------------------------------------
+# Units
+
+
+@dataclass(frozen=True)
+class Unit:
+    """A unit of measure, related to its quantity's base unit by ``base = value * scale + offset``.
+
+    ``symbol`` is canonical (``mV``, ``degC``); two units of one ``quantity`` convert into each
+    other through their ``scale`` and ``offset`` alone, so converters derive factors from the IR.
+    """
+
+    symbol: str
+    quantity: str
+    base: str
+    scale: float = 1.0
+    offset: float = 0.0
+
+    def factor_to(self, other: Unit) -> tuple[float, float]:
+        """(multiplier, addend) turning a value in this unit into ``other``."""
+        if self.quantity != other.quantity:
+            raise ValueError(f"cannot convert {self.symbol} ({self.quantity}) to {other.symbol} ({other.quantity})")
+        mul = self.scale / other.scale
+        add = (self.offset - other.offset) / other.scale
+        return mul, add

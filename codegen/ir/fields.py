@@ -1,0 +1,109 @@
+"""What a field means beyond its type: range, per-position columns, invalid sentinel, enums, constants."""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+
+from .basics import Location, Unit
+from .fieldtypes import FieldType, PrimitiveKind, PrimitiveType, Range, StringType
+
+
+@dataclass(frozen=True)
+class Sentinel:
+    """The value that means "unknown / invalid".
+
+    ``text`` keeps the spelling of the source (``INT16_MAX``, ``NaN``); ``value`` is the number
+    (``float('nan')`` for NaN). ``per_element`` marks an array whose elements each carry it.
+    """
+
+    value: int | float
+    text: str
+    per_element: bool = False
+
+    @property
+    def is_nan(self) -> bool:
+        return isinstance(self.value, float) and math.isnan(self.value)
+
+    def matches(self, value: object) -> bool:
+        if self.is_nan:
+            return isinstance(value, float) and math.isnan(value)
+        return bool(value == self.value)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Sentinel):
+            return NotImplemented
+        same = (self.is_nan and other.is_nan) or self.value == other.value
+        return same and self.text == other.text and self.per_element == other.per_element
+
+    def __hash__(self) -> int:
+        return hash(("nan" if self.is_nan else self.value, self.text, self.per_element))
+
+
+class EnumKind(str, enum.Enum):
+    VALUE = "value"  # the field holds one of the entries
+    BITMASK = "bitmask"  # entries are masks (1, 2, 4, ...) OR-ed together
+    BIT_INDEX = "bit_index"  # entries are bit positions (0, 1, 2, ...) in a bitmask field
+
+
+@dataclass(frozen=True)
+class EnumEntry:
+    name: str
+    value: int
+    doc: str = ""
+    location: Location | None = None
+
+
+@dataclass(frozen=True)
+class EnumDef:
+    """A named group of values. ``name`` is qualified (``uorb.BatteryStatus.WARNING``)."""
+
+    name: str
+    kind: EnumKind
+    entries: tuple[EnumEntry, ...]
+    doc: str = ""
+    location: Location | None = None
+
+    @property
+    def short_name(self) -> str:
+        return self.name.rsplit(".", 1)[-1]
+
+
+@dataclass(frozen=True)
+class Constant:
+    name: str
+    type: PrimitiveType | StringType
+    value: int | float | bool | str
+    doc: str = ""
+    location: Location | None = None
+
+
+@dataclass(frozen=True)
+class Field:
+    """One field of a message (or property of a devicetree node).
+
+    ``name`` is the source spelling (``voltage-min-design-microvolt``); backends pick identifiers.
+    ``enums`` names the enum groups (qualified) the value draws on, in the order the schema lists.
+    """
+
+    name: str
+    type: FieldType
+    location: Location
+    doc: str = ""
+    unit: Unit | None = None
+    unit_text: str | None = None
+    range: Range | None = None
+    invalid: Sentinel | None = None
+    enums: tuple[str, ...] = ()
+    extension: bool = False  # MAVLink 2 extension field
+    pattern: str | None = None  # devicetree patternProperties: the name is a regular expression
+    required: bool = False
+    const: str | int | None = None
+    choices: tuple[str | int, ...] = ()
+    default: int | float | bool | str | None = None
+    annotations: tuple[tuple[str, str], ...] = ()  # source annotations kept verbatim (tag, text)
+
+    @property
+    def is_padding(self) -> bool:
+        return isinstance(self.type, PrimitiveType) and self.type.kind is PrimitiveKind.VOID

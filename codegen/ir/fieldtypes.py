@@ -1,0 +1,136 @@
+"""Field types with their exact width (primitives, arrays, strings, references to composites), and the
+bounds an array may set per position (``Range``, ``Column``)."""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from .basics import Location, Unit
+
+
+@dataclass(frozen=True)
+class Range:
+    """Inclusive bounds unless marked exclusive; either side may be open (None)."""
+
+    minimum: int | float | None = None
+    maximum: int | float | None = None
+    exclusive_minimum: bool = False
+    exclusive_maximum: bool = False
+
+    def intersect(self, other: Range | None) -> Range:
+        """The values both ranges allow (the tighter bound on each side)."""
+        if other is None:
+            return self
+        lo, lo_x = _tighter(self.minimum, self.exclusive_minimum, other.minimum, other.exclusive_minimum, max)
+        hi, hi_x = _tighter(self.maximum, self.exclusive_maximum, other.maximum, other.exclusive_maximum, min)
+        return Range(lo, hi, lo_x, hi_x)
+
+
+def _tighter(
+    a: int | float | None, a_x: bool, b: int | float | None, b_x: bool, pick: Callable[..., int | float]
+) -> tuple[int | float | None, bool]:
+    if a is None:
+        return b, b_x
+    if b is None:
+        return a, a_x
+    if a == b:
+        return a, a_x or b_x
+    return (a, a_x) if pick(a, b) == a else (b, b_x)
+
+
+@dataclass(frozen=True)
+class Column:
+    """What one position of an array holds: element ``i`` of an ``ArrayType`` with ``columns``.
+
+    Its constraints add to the field's (both hold); ``range`` applies to every number element
+    ``i`` holds (the element itself, or each number of a row when the element is an array);
+    ``unit`` None means the field's unit.
+    """
+
+    doc: str = ""
+    unit: Unit | None = None
+    range: Range | None = None
+    location: Location | None = None
+
+
+class PrimitiveKind(str, enum.Enum):
+    BOOL = "bool"
+    UINT = "uint"
+    INT = "int"
+    FLOAT = "float"
+    CHAR = "char"  # MAVLink / uORB char: a byte of a fixed-size string
+    VOID = "void"  # DSDL padding bits; fields of this kind have no name
+
+
+class CastMode(str, enum.Enum):
+    SATURATED = "saturated"
+    TRUNCATED = "truncated"
+
+
+@dataclass(frozen=True)
+class PrimitiveType:
+    kind: PrimitiveKind
+    bits: int
+    cast: CastMode = CastMode.SATURATED
+
+    @property
+    def name(self) -> str:
+        """The type as a schema would spell it: ``uint11``, ``float16``, ``bool``, ``void5``."""
+        if self.kind is PrimitiveKind.BOOL:
+            return "bool"
+        if self.kind is PrimitiveKind.CHAR:
+            return "char"
+        return f"{self.kind.value}{self.bits}"
+
+    @property
+    def value_range(self) -> tuple[float, float] | None:
+        """The representable range of an integer or float type (None for void/char)."""
+        if self.kind is PrimitiveKind.BOOL:
+            return (0, 1)
+        if self.kind is PrimitiveKind.UINT:
+            return (0, (1 << self.bits) - 1)
+        if self.kind is PrimitiveKind.INT:
+            return (-(1 << (self.bits - 1)), (1 << (self.bits - 1)) - 1)
+        if self.kind is PrimitiveKind.FLOAT:
+            return {16: (-65504.0, 65504.0), 32: (-3.4028234663852886e38, 3.4028234663852886e38)}.get(
+                self.bits, (-math.inf, math.inf)
+            )
+        return None
+
+
+@dataclass(frozen=True)
+class ArrayType:
+    """A fixed (``dynamic=False``) or bounded-dynamic array; ``capacity`` None means unbounded.
+
+    ``columns[i]`` constrains element ``i`` only (JSON Schema's ``prefixItems``); elements past
+    the last column have only the field's constraints. A matrix whose rows are (OCV, percent)
+    puts its columns on the row type, the inner array. They live on the type rather than the
+    Field because a position is a property of one array level: the type says at which depth it
+    applies, and it travels with the type through every backend that walks element types.
+    """
+
+    element: FieldType
+    capacity: int | None
+    dynamic: bool
+    min_length: int = 0
+    columns: tuple[Column, ...] = ()
+
+
+@dataclass(frozen=True)
+class StringType:
+    """A text value: a devicetree string, or a NUL-padded char array of ``capacity`` bytes."""
+
+    capacity: int | None = None
+
+
+@dataclass(frozen=True)
+class CompositeType:
+    """A reference to another message by its qualified name."""
+
+    name: str
+
+
+FieldType = PrimitiveType | ArrayType | StringType | CompositeType

@@ -1,0 +1,72 @@
+"""Cross-field rules and the Schema that holds everything one load produced."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .basics import Location
+from .expr import RuleExpressions
+from .fields import EnumDef
+from .mappings import MappingSet
+from .messages import Message
+
+
+@dataclass(frozen=True)
+class CrossFieldRule:
+    """A rule relating fields of a message that its schema cannot state.
+
+    ``exprs`` holds the expressions parsed (:mod:`codegen.ir.expr`), with loop variables resolved;
+    the frontend has checked that the other names bind to each message in ``messages`` (see
+    :func:`codegen.ir.rules.bind`). The text fields keep the expressions as written: the JSON form
+    shows them, and a violation quotes the ``assert``. ``lines`` gives the source line of each key
+    (``assert``, ``where``, ``for``, ``for[i]``, ``path``, ``message``).
+    """
+
+    id: str
+    messages: tuple[str, ...]
+    severity: str  # "error" or "warning" (advice)
+    check: str  # the ``assert`` expression
+    location: Location
+    exprs: RuleExpressions = field(metadata={"json_form": False})  # the text fields, parsed
+    doc: str = ""
+    where: str | None = None
+    loops: tuple[str, ...] = ()  # ``for`` clauses, "name in expression"
+    path: str | None = None
+    message: str = ""
+    lines: tuple[tuple[str, int], ...] = ()
+
+
+@dataclass(frozen=True)
+class Schema:
+    """Everything parsed from a set of sources: messages, and enums shared across messages."""
+
+    messages: tuple[Message, ...] = ()
+    enums: tuple[EnumDef, ...] = ()
+    sources: tuple[str, ...] = field(default=())
+    mappings: tuple[MappingSet, ...] = ()
+    rules: tuple[CrossFieldRule, ...] = ()
+
+    def message(self, qualified_name: str) -> Message:
+        for m in self.messages:
+            if m.qualified_name == qualified_name:
+                return m
+        raise KeyError(qualified_name)
+
+    def enum(self, name: str) -> EnumDef:
+        for e in self.enums:
+            if e.name == name:
+                return e
+        for m in self.messages:
+            for e in m.enums:
+                if e.name == name:
+                    return e
+        raise KeyError(name)
+
+    def merged(self, other: Schema) -> Schema:
+        return Schema(
+            messages=self.messages + other.messages,
+            enums=self.enums + other.enums,
+            sources=self.sources + other.sources,
+            mappings=self.mappings + other.mappings,
+            rules=self.rules + other.rules,
+        )
