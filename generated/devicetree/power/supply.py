@@ -1578,7 +1578,7 @@ class SimpleBattery:
             if r_ocv_capacity_celsius is not None:
                 for v_i in range(len(r_ocv_capacity_celsius)):
                     try:
-                        if not (("ocv-capacity-table-" + str(v_i)) in r_ocv_capacity_table_n):
+                        if ("ocv-capacity-table-" + str(v_i)) not in r_ocv_capacity_table_n:
                             out.append(
                                 _v.rule(
                                     "ocv-capacity-celsius" + "[" + str(v_i) + "]",

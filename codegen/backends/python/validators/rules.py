@@ -45,6 +45,9 @@ def known_expr(f: Field, value: str, optional: bool) -> str:
     return " and ".join(parts) if parts else "True"
 
 
+_NEGATED_MEMBERSHIP = {"in": "not in", "not in": "in"}
+
+
 class _Emitter:
     def __init__(self, msg: Message, idents: dict[str, str]) -> None:
         self.msg = msg
@@ -85,6 +88,14 @@ class _Emitter:
             return self.call(e)
         assert not isinstance(e, Name), "names are resolved before emission"
         raise AssertionError(e)
+
+    def failed(self, e: Expr) -> str:
+        """The condition under which check ``e`` fails: ``not (check)``, spelled ``a not in b`` for a
+        single membership test as Python style asks (the same test, E713)."""
+        if isinstance(e, Compare) and len(e.ops) == 1 and e.ops[0] in _NEGATED_MEMBERSHIP:
+            left, right = (self.expr(o) for o in e.operands)
+            return f"({left} {_NEGATED_MEMBERSHIP[e.ops[0]]} {right})"
+        return f"not {self.expr(e)}"
 
     def call(self, e: Call) -> str:
         args = [self.expr(a) for a in e.args]
@@ -178,12 +189,12 @@ def rule_lines(bound: BoundRule, msg: Message, idents: dict[str, str]) -> tuple[
     if bound.bindings:
         body += [
             f"{ind}try:",
-            f"{ind}    if not {em.expr(bound.check)}:",
+            f"{ind}    if {em.failed(bound.check)}:",
             f"{ind}        {report}",
             f"{ind}except _v.SLOW:",
             f"{ind}    pass",
         ]
     else:
-        body += [f"{ind}if not {em.expr(bound.check)}:", f"{ind}    {report}"]
+        body += [f"{ind}if {em.failed(bound.check)}:", f"{ind}    {report}"]
     lines += ["try:", *["    " + b for b in body], "except _v.SLOW:", "    pass  # the field checks report the cause"]
     return lines, names
