@@ -13,7 +13,7 @@ from codegen.apps.failsafe.evaluator import (
     BatteryReading,
     Cause,
     Event,
-    FailsafeParams,
+    FailsafeSettings,
     Level,
     Outcome,
     resolve_action,
@@ -21,7 +21,7 @@ from codegen.apps.failsafe.evaluator import (
 from codegen.apps.failsafe.levels import apply_level
 
 # a 3S LiPo as in the seed: LOW 10.5 V (3.5 V/cell), CRITICAL 10.0 V; LOW -> RTL, CRITICAL -> Hold
-PARAMS = FailsafeParams(low_volt=10.5, crt_volt=10.0, low_action=Action.RTL, crt_action=Action.HOLD)
+PARAMS = FailsafeSettings(low_volt=10.5, crt_volt=10.0, low_action=Action.RTL, crt_action=Action.HOLD)
 
 
 def run(fs: BatteryFailsafe, volts: list[tuple[float, float]], **kw: object) -> list[Event]:
@@ -109,7 +109,7 @@ def test_disarm_clears_and_nothing_triggers_while_disarmed() -> None:
 def test_zero_voltage_is_unknown_and_zero_threshold_is_disabled() -> None:
     fs = BatteryFailsafe(PARAMS)
     assert run(fs, series(0, 60, 0.0)) == []
-    fs = BatteryFailsafe(FailsafeParams(low_volt=0, crt_volt=0))
+    fs = BatteryFailsafe(FailsafeSettings(low_volt=0, crt_volt=0))
     assert run(fs, series(0, 60, 1.0)) == []
     fs = BatteryFailsafe(PARAMS)
     # a dropout (0 V) in the middle of a sag restarts the timer
@@ -118,7 +118,7 @@ def test_zero_voltage_is_unknown_and_zero_threshold_is_disabled() -> None:
 
 
 def test_capacity_thresholds_use_capacity_minus_consumed() -> None:
-    params = FailsafeParams(capacity_mah=3300, low_mah=660, crt_mah=330, low_action=Action.RTL)
+    params = FailsafeSettings(capacity_mah=3300, low_mah=660, crt_mah=330, low_action=Action.RTL)
     fs = BatteryFailsafe(params)
     events: list[Event] = []
     for t, consumed in [(0, 100.0), (1, 2600.0), (2, 2700.0), (3, 2900.0), (4, 3000.0)]:
@@ -131,7 +131,7 @@ def test_capacity_thresholds_use_capacity_minus_consumed() -> None:
 
 
 def test_capacity_from_integrated_current() -> None:
-    params = FailsafeParams(capacity_mah=1000, low_mah=500)
+    params = FailsafeSettings(capacity_mah=1000, low_mah=500)
     fs = BatteryFailsafe(params)
     events: list[Event] = []
     for t in range(0, 1000):  # 3.6 A = 1 mAh per second
@@ -168,7 +168,7 @@ def test_fallback_chain(action: Action, home: bool, fix: bool, smart: bool, expe
 
 
 def test_terminate_disarms_until_the_stream_rearms() -> None:
-    fs = BatteryFailsafe(FailsafeParams(crt_volt=10.0, crt_action=Action.TERMINATE))
+    fs = BatteryFailsafe(FailsafeSettings(crt_volt=10.0, crt_action=Action.TERMINATE))
     events = run(fs, [(0, 9.0)])
     assert [e.outcome for e in events] == [Outcome.DISARM]
     assert run(fs, series(1, 10, 9.0)) == []  # disarmed by the failsafe: silent
@@ -187,7 +187,7 @@ def drive_out(fs: BatteryFailsafe, *, speed: float = 2.0, amps: float = 2.0) -> 
 
 
 def test_distance_rule_triggers_before_the_point_of_no_return() -> None:
-    params = FailsafeParams(capacity_mah=3300, low_action=Action.RTL)
+    params = FailsafeSettings(capacity_mah=3300, low_action=Action.RTL)
     fs = BatteryFailsafe(params)
     fired = drive_out(fs)
     assert len(fired) == 1
@@ -205,10 +205,10 @@ def test_distance_rule_triggers_before_the_point_of_no_return() -> None:
 
 
 def test_distance_rule_margin_and_no_current_sensor() -> None:
-    early = drive_out(BatteryFailsafe(FailsafeParams(capacity_mah=3300), margin=2.0))
-    late = drive_out(BatteryFailsafe(FailsafeParams(capacity_mah=3300), margin=1.0))
+    early = drive_out(BatteryFailsafe(FailsafeSettings(capacity_mah=3300), margin=2.0))
+    late = drive_out(BatteryFailsafe(FailsafeSettings(capacity_mah=3300), margin=1.0))
     assert early[0][0] < late[0][0]
-    fs = BatteryFailsafe(FailsafeParams(capacity_mah=3300))
+    fs = BatteryFailsafe(FailsafeSettings(capacity_mah=3300))
     for t in range(0, 4000):  # voltage only: nothing to learn a rate from, no remaining charge
         assert fs.update(float(t), BatteryReading(voltage_v=11.5), armed=True, distance_to_home_m=2.0 * t) == []
 
@@ -232,12 +232,12 @@ def test_params_from_values_and_schema_defaults() -> None:
 
     defaults = BattParams().to_dict()
     assert {k: defaults[k] for k in DEFAULTS} == DEFAULTS
-    p = FailsafeParams.from_values({"BATT_LOW_VOLT": 10.5, "BATT_FS_LOW_ACT": 3, "OTHER": 1})
+    p = FailsafeSettings.from_values({"BATT_LOW_VOLT": 10.5, "BATT_FS_LOW_ACT": 3, "OTHER": 1})
     assert (p.low_volt, p.low_action, p.low_timer_s, p.capacity_mah) == (10.5, Action.SMART_RTL, 10.0, 3300.0)
     with pytest.raises(ValueError, match=r"BATT_FS_CRT_ACT: expected an action 0\.\.5"):
-        FailsafeParams.from_values({"BATT_FS_CRT_ACT": 9})
+        FailsafeSettings.from_values({"BATT_FS_CRT_ACT": 9})
     with pytest.raises(ValueError, match="BATT_LOW_VOLT: expected a finite number"):
-        FailsafeParams.from_values({"BATT_LOW_VOLT": "x"})
+        FailsafeSettings.from_values({"BATT_LOW_VOLT": "x"})
 
 
 def test_time_must_not_go_back() -> None:

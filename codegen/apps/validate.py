@@ -23,7 +23,7 @@ from ..ir import Message, Schema, SourceFormat
 from ..ir.expr import referenced_fields
 from ..ir.numbers import to_json_data
 from ..ir.rules import bound_rules
-from .failsafe.checks import NONNEGATIVE, check_params
+from .failsafe.checks import NONNEGATIVE, check_settings
 from .messages import resolve_message
 from .package import data_error, model_class, model_package
 
@@ -72,11 +72,11 @@ ExtraCheck = Callable[[GeneratedMessage, Sequence[Violation]], list[ExtraFinding
 def failsafe_check(instance: GeneratedMessage, violations: Sequence[Violation]) -> list[ExtraFinding]:
     """codegen.apps.failsafe.checks over a BATT_* parameter set (absent parameters at their defaults,
     as ``battgen params --check`` does). A negative threshold the schema's range already reported
-    is not reported twice: for a negative value that is the only finding check_params makes."""
+    is not reported twice: for a negative value that is the only finding check_settings makes."""
     values = instance.to_dict()
     flagged = {str(v.path) for v in violations}
     out = []
-    for f in check_params(values):
+    for f in check_settings(values):
         value = values.get(f.param)
         if isinstance(value, int | float) and value < 0 and f.param in flagged:
             continue
@@ -87,7 +87,7 @@ def failsafe_check(instance: GeneratedMessage, violations: Sequence[Violation]) 
 def extra_check(message: Message) -> ExtraCheck | None:
     """The checks a message gets beyond its generated validate()."""
     names = {f.name for f in message.fields}
-    if message.format is SourceFormat.PARAMS and set(NONNEGATIVE) <= names:
+    if message.format is SourceFormat.PDEF and set(NONNEGATIVE) <= names:
         return failsafe_check
     return None
 

@@ -43,7 +43,7 @@ FORMAT_TITLES = {
     SourceFormat.DRONECAN: "DroneCAN (UAVCAN v0)",
     SourceFormat.MAVLINK: "MAVLink",
     SourceFormat.DEVICETREE: "Linux devicetree bindings",
-    SourceFormat.PARAMS: "ArduPilot parameters",
+    SourceFormat.PDEF: "ArduPilot parameters",
 }
 
 

@@ -18,8 +18,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..apps.batt_parameters import check_parameter_file, check_proposals, propose_from_devicetree, render
 from ..apps.failsafe.checks import CELL_RANGES
-from ..apps.param_files import check_param_file, check_proposals, propose_from_devicetree, render
 from ..errors import BattgenError
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
@@ -74,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _check(path: Path, cells: int | None, chemistry: str) -> int:
     display = path.as_posix()
-    findings = check_param_file(path, cells=cells, chemistry=chemistry)
+    findings = check_parameter_file(path, cells=cells, chemistry=chemistry)
     for f in findings:
         print(f"{display}:{f.line}: {f.severity}: {f.message}")
     errors = sum(f.severity == "error" for f in findings)

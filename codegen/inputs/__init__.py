@@ -4,7 +4,7 @@
 - :mod:`.dispatch`: the kind of a file (from its extension) and its reader;
 - :mod:`.documents`: JSON, JSON Lines, YAML; :mod:`.payloads`: hex and raw binary payloads;
 - :mod:`.ulog`: PX4 flight logs; :mod:`.tlog`: MAVLink telemetry logs and raw MAVLink streams;
-- :mod:`.paramfile` (parse and write) and :mod:`.param_records`: .param / .params files;
+- :mod:`.parameter_files` (parse and write) and :mod:`.parameter_records`: .param / .params files;
 - :mod:`.devicetree`: .dts/.dtsi source and .dtb blobs;
 - :mod:`.model`: what readers and applications use of a generated package, as Protocols.
 

@@ -16,7 +16,7 @@ from ..ir import Message, SourceFormat
 from .devicetree.records import read_devicetree
 from .documents import read_json, read_jsonl, read_yaml
 from .model import MavlinkClass, MessageClass
-from .param_records import read_params
+from .parameter_records import read_parameter_records
 from .records import InputError, Item
 from .tlog import mavlink_items
 from .ulog import ulog_items
@@ -48,7 +48,7 @@ KINDS = tuple(kind for kind, _ in _KINDS)
 KIND_FORMATS: dict[str, SourceFormat] = {
     "dts": SourceFormat.DEVICETREE,
     "dtb": SourceFormat.DEVICETREE,
-    "param": SourceFormat.PARAMS,
+    "param": SourceFormat.PDEF,
     "ulog": SourceFormat.UORB,
     "tlog": SourceFormat.MAVLINK,
     "mavlink": SourceFormat.MAVLINK,
@@ -106,7 +106,7 @@ def read_records(
     if kind in ("dts", "dtb"):
         return read_devicetree(path, name, message, binary=kind == "dtb")
     if model is not None and kind == "param":
-        return read_params(path, name, model)
+        return read_parameter_records(path, name, model)
     if model is not None and kind == "ulog":
         return ulog_items(path, name, model)
     if model is not None and kind in ("tlog", "mavlink"):

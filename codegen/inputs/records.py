@@ -1,6 +1,6 @@
 """What the data readers hand out: records, the parts that could not be read, and notices.
 
-Every reader (:mod:`.documents`, :mod:`.ulog`, :mod:`.tlog`, :mod:`.param_records`,
+Every reader (:mod:`.documents`, :mod:`.ulog`, :mod:`.tlog`, :mod:`.parameter_records`,
 :mod:`.devicetree.records`) yields :data:`Item`\\ s in file order, and raises :class:`InputError`
 (or another LocatedError naming file and line) when a file cannot be read at all. A record keeps
 the line it starts on and, on demand, the line of any field path inside it, so that a violation

@@ -45,7 +45,7 @@ from .messages import (
     DronecanKind,
     MavlinkInfo,
     Message,
-    ParamsInfo,
+    PdefInfo,
     StructSlot,
     UorbInfo,
 )
@@ -81,7 +81,7 @@ __all__ = [
     "MappingSet",
     "MavlinkInfo",
     "Message",
-    "ParamsInfo",
+    "PdefInfo",
     "PrimitiveKind",
     "PrimitiveType",
     "Range",

@@ -11,7 +11,7 @@ class SourceFormat(str, enum.Enum):
     DRONECAN = "dronecan"
     DEVICETREE = "devicetree"
     MAVLINK = "mavlink"
-    PARAMS = "params"  # ArduPilot parameter metadata (apm.pdef.xml)
+    PDEF = "params"  # ArduPilot parameter metadata (apm.pdef.xml); the value names the schema folder and prefix
 
 
 @dataclass(frozen=True)

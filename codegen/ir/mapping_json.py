@@ -16,11 +16,11 @@ from .mapping_values import ConstantRef, Entry
 from .mappings import Rule
 from .ops import MappingOp
 
-WrittenValue = int | float | bool | str | None | tuple["WrittenValue | WrittenParam", ...]
+WrittenValue = int | float | bool | str | None | tuple["WrittenValue | WrittenArgument", ...]
 
 
 @dataclass(frozen=True)
-class WrittenParam:
+class WrittenArgument:
     """One parameter as a mapping file writes it: a key and its value, mappings as tuples of these."""
 
     name: str
@@ -35,22 +35,24 @@ def _written(value: object) -> WrittenValue:
     if isinstance(value, Entry):
         return _written_entry(value)
     if isinstance(value, tuple):
-        return tuple(_entry_param(v) if isinstance(v, Entry) else _written(v) for v in value)
+        return tuple(_entry_argument(v) if isinstance(v, Entry) else _written(v) for v in value)
     if value is None or isinstance(value, int | float | str):
         return value
     raise TypeError(f"not a mapping op parameter: {type(value).__name__}")
 
 
-def _entry_param(entry: Entry) -> WrittenParam:
+def _entry_argument(entry: Entry) -> WrittenArgument:
     key = fields(entry)[0]
-    return WrittenParam(str(_written(getattr(entry, key.name))), _written_entry(entry))
+    return WrittenArgument(str(_written(getattr(entry, key.name))), _written_entry(entry))
 
 
 def _written_entry(entry: Entry) -> WrittenValue:
     rest = fields(entry)[1:]
     if len(rest) == 1:
         return _written(getattr(entry, rest[0].name))
-    return tuple(WrittenParam(f.name, _written(getattr(entry, f.name))) for f in rest if _given(getattr(entry, f.name)))
+    return tuple(
+        WrittenArgument(f.name, _written(getattr(entry, f.name))) for f in rest if _given(getattr(entry, f.name))
+    )
 
 
 def _given(value: object) -> bool:
@@ -58,9 +60,11 @@ def _given(value: object) -> bool:
     return value is not None and value is not False and value != ()
 
 
-def written_params(op: MappingOp) -> tuple[WrittenParam, ...]:
+def written_arguments(op: MappingOp) -> tuple[WrittenArgument, ...]:
     """The op's parameters as its mapping file wrote them, in field order, left-out ones omitted."""
-    return tuple(WrittenParam(f.name, _written(getattr(op, f.name))) for f in fields(op) if _given(getattr(op, f.name)))
+    return tuple(
+        WrittenArgument(f.name, _written(getattr(op, f.name))) for f in fields(op) if _given(getattr(op, f.name))
+    )
 
 
 def rule_json(rule: Rule, jsonable: Callable[[object], Any]) -> dict[str, Any]:
@@ -70,7 +74,7 @@ def rule_json(rule: Rule, jsonable: Callable[[object], Any]) -> dict[str, Any]:
         "op": rule.op.NAME,
         "targets": jsonable(rule.targets),
         "sources": jsonable(rule.sources),
-        "params": jsonable(written_params(rule.op)) + only,
+        "params": jsonable(written_arguments(rule.op)) + only,
         "doc": rule.doc,
         "location": jsonable(rule.location),
     }

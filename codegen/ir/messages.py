@@ -68,7 +68,7 @@ class DevicetreeInfo:
 
 
 @dataclass(frozen=True)
-class ParamsInfo:
+class PdefInfo:
     """An ArduPilot parameter group: ``prefix`` joins group and parameter (``BATT_``); ``section``
     is where apm.pdef.xml lists it (``libraries`` or ``vehicles``)."""
 
@@ -97,7 +97,7 @@ class Message:
     dronecan: DronecanInfo | None = None
     mavlink: MavlinkInfo | None = None
     devicetree: DevicetreeInfo | None = None
-    params: ParamsInfo | None = None
+    params: PdefInfo | None = None
 
     def field(self, name: str) -> Field:
         for f in self.fields:

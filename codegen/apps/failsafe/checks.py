@@ -18,7 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from ...inputs import paramfile
+from ...inputs import parameter_files
 
 # plausible per-cell voltage under load, empty to full, by chemistry
 CELL_RANGES: dict[str, tuple[float, float]] = {
@@ -48,7 +48,7 @@ def _num(values: Mapping[str, object], name: str) -> float:
     return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else 0.0
 
 
-def check_params(values: Mapping[str, object], *, cells: int | None = None, chemistry: str = "lipo") -> list[Finding]:
+def check_settings(values: Mapping[str, object], *, cells: int | None = None, chemistry: str = "lipo") -> list[Finding]:
     """Every cross-field problem of a BATT_* parameter set (absent parameters count as 0)."""
     if chemistry not in CELL_RANGES:
         raise ValueError(f"expected a chemistry among {', '.join(CELL_RANGES)}, got {chemistry!r}")
@@ -131,10 +131,10 @@ def _per_cell(v: Mapping[str, float], cells: int | None, chemistry: str) -> list
 def check_file(path: Path, *, cells: int | None = None, chemistry: str = "lipo") -> list[tuple[str, int, Finding]]:
     """The findings of a .param / .params file as (file, line of the parameter, finding)."""
     display = path.as_posix()
-    entries = paramfile.load(path, display)
+    entries = parameter_files.load(path, display)
     lines = {e.name: e.line for e in entries}
     out: list[tuple[str, int, Finding]] = []
-    for first, values in paramfile.read_param_file(path):
-        for finding in check_params(values, cells=cells, chemistry=chemistry):
+    for first, values in parameter_files.read_parameter_file(path):
+        for finding in check_settings(values, cells=cells, chemistry=chemistry):
             out.append((display, lines.get(finding.param, first), finding))
     return out

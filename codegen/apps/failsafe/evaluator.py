@@ -74,7 +74,7 @@ DEFAULTS: dict[str, float] = {
 
 
 @dataclass(frozen=True)
-class FailsafeParams:
+class FailsafeSettings:
     capacity_mah: float = DEFAULTS["BATT_CAPACITY"]
     low_volt: float = DEFAULTS["BATT_LOW_VOLT"]
     low_timer_s: float = DEFAULTS["BATT_LOW_TIMER"]
@@ -85,7 +85,7 @@ class FailsafeParams:
     crt_action: Action = Action.NONE
 
     @classmethod
-    def from_values(cls, values: Mapping[str, Any]) -> FailsafeParams:
+    def from_values(cls, values: Mapping[str, Any]) -> FailsafeSettings:
         """From BATT_* names (a parameter file, or a generated ``BattParams.to_dict()``); others ignored."""
 
         def get(name: str) -> float:
@@ -211,7 +211,7 @@ class BatteryFailsafe:
     it), ``learn_after_m`` (travel needed before the learned rate is trusted).
     """
 
-    params: FailsafeParams
+    params: FailsafeSettings
     home_set: bool = True
     position_fix: bool = True
     smart_rtl_ready: bool = True

@@ -31,7 +31,7 @@ from typing import Any, cast
 
 from ...errors import BattgenError, LocatedError
 from ...frontends.loader import load
-from ...inputs import paramfile
+from ...inputs import parameter_files
 from ...inputs.documents import read_jsonl
 from ...inputs.model import GeneratedMessage, MessageClass, package_name
 from ...inputs.records import Record, Unreadable
@@ -39,7 +39,7 @@ from ...ir import Schema
 from ..convert import ConvertModule
 from ..messages import resolve_message
 from ..package import bundled_schemas, model_class, model_package
-from .evaluator import BatteryFailsafe, BatteryReading, Event, FailsafeParams, reading_of
+from .evaluator import BatteryFailsafe, BatteryReading, Event, FailsafeSettings, reading_of
 
 # which field carries what, per message (units come from the IR metadata)
 ROLES: dict[str, dict[str, str]] = {
@@ -223,14 +223,14 @@ def open_reader(schema_dir: Path | None, default_message: str | None = None) -> 
     return Reader(schema, model_package(schema, schema_dir), default_message)
 
 
-def read_failsafe_params(path: Path) -> FailsafeParams:
+def read_failsafe_params(path: Path) -> FailsafeSettings:
     """The BATT_* parameters of a .param / .params file (others ignored; every set of a QGC file
     merged, later sets winning)."""
     values: dict[str, float] = {}
-    for _, group in paramfile.read_param_file(path):
+    for _, group in parameter_files.read_parameter_file(path):
         values.update(group)
     try:
-        return FailsafeParams.from_values(values)
+        return FailsafeSettings.from_values(values)
     except ValueError as exc:
         raise BattgenError(f"{path}: {exc}") from None
 

@@ -79,7 +79,7 @@ def module_path(msg: Message) -> str:
         return "mavlink"
     if msg.format is SourceFormat.UORB:
         return "uorb"
-    if msg.format is SourceFormat.PARAMS:
+    if msg.format is SourceFormat.PDEF:
         return "params"
     if msg.format is SourceFormat.DRONECAN and msg.dronecan is not None:
         namespace = msg.dronecan.full_name.rsplit(".", 1)[0]
@@ -98,7 +98,7 @@ def class_name(msg: Message) -> str:
         return base
     if msg.format is SourceFormat.DEVICETREE and msg.devicetree is not None and len(msg.devicetree.compatible) == 1:
         return camel(msg.devicetree.compatible[0])
-    if msg.format is SourceFormat.PARAMS:
+    if msg.format is SourceFormat.PDEF:
         return camel(msg.name) + "Params"  # params.BATT -> BattParams
     return camel(msg.name)
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import re
 
-from ...ir import Constant, EnumDef, Field, Message, ParamsInfo, SourceFormat
+from ...ir import Constant, EnumDef, Field, Message, PdefInfo, SourceFormat
 from .parameter import parameter
 from .tree import Element
 
@@ -64,11 +64,11 @@ def _group(node: Element, section: str) -> Message:
     return Message(
         name=name,
         qualified_name=qualified,
-        format=SourceFormat.PARAMS,
+        format=SourceFormat.PDEF,
         location=node.location(),
         doc=node.attrs.get("documentation", "").strip(),
         fields=tuple(fields),
         constants=tuple(constants),
         enums=tuple(enums),
-        params=ParamsInfo(prefix=prefix, section=section),
+        params=PdefInfo(prefix=prefix, section=section),
     )

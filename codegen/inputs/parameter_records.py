@@ -2,7 +2,7 @@
 
 One record per parameter set: the whole of an ArduPilot .param file, one per (vehicle, component)
 of a QGroundControl .params file. A record holds the parameters the message models (a full dump's
-other parameters are dropped, see :func:`codegen.inputs.paramfile.select`); sets holding none of them are
+other parameters are dropped, see :func:`codegen.inputs.parameter_files.select`); sets holding none of them are
 skipped, with one notice when the whole file holds none. A violation points at its parameter's line.
 """
 
@@ -11,20 +11,20 @@ from __future__ import annotations
 from collections.abc import Iterator
 from pathlib import Path
 
-from . import paramfile
+from . import parameter_files
 from .model import MessageClass, field_names
 from .records import Item, Notice, Record, first_field_locator
 
 
-def read_params(path: Path, name: str, model: MessageClass) -> Iterator[Item]:
-    """The parameter sets of one file (ParamFileError names file and line when it is malformed)."""
-    entries = paramfile.load(path, name)  # read eagerly: a malformed file fails before any record
+def read_parameter_records(path: Path, name: str, model: MessageClass) -> Iterator[Item]:
+    """The parameter sets of one file (ParameterFileError names file and line when it is malformed)."""
+    entries = parameter_files.load(path, name)  # read eagerly: a malformed file fails before any record
     return _records(entries, name, model.QUALIFIED_NAME, field_names(model))
 
 
-def _records(entries: list[paramfile.ParamEntry], name: str, qualified: str, names: set[str]) -> Iterator[Item]:
+def _records(entries: list[parameter_files.ParamEntry], name: str, qualified: str, names: set[str]) -> Iterator[Item]:
     index = 0
-    for (vehicle, component), group in paramfile.sets(entries).items():
+    for (vehicle, component), group in parameter_files.sets(entries).items():
         chosen = [e for e in group if e.name in names]
         if not chosen:
             continue  # e.g. a gimbal's parameters in a QGC file: nothing of this message

@@ -36,7 +36,7 @@ def error(tmp_path: Path, body: str) -> SchemaError:
 def test_shipped_schema_facts() -> None:
     schema = pdef.parse_dir(ROOT / "schemas" / "params")
     msg = schema.message("params.BATT")
-    assert (msg.name, msg.format, msg.params and msg.params.prefix) == ("BATT", SourceFormat.PARAMS, "BATT_")
+    assert (msg.name, msg.format, msg.params and msg.params.prefix) == ("BATT", SourceFormat.PDEF, "BATT_")
     names = [f.name for f in msg.fields]
     for expected in ("BATT_LOW_VOLT", "BATT_CRT_VOLT", "BATT_LOW_MAH", "BATT_CRT_MAH", "BATT_FS_LOW_ACT"):
         assert expected in names

@@ -36,7 +36,7 @@ QGC_SUFFIXES = (".params",)
 ARDUPILOT_SUFFIXES = (".param", ".parm")
 
 
-class ParamFileError(LocatedError):
+class ParameterFileError(LocatedError):
     """A malformed parameter file: names the file, the 1-based line and what was expected."""
 
 
@@ -50,7 +50,7 @@ class ParamEntry:
     component: int | None = None
 
 
-def is_param_file(path: Path) -> bool:
+def is_parameter_file(path: Path) -> bool:
     return path.suffix.lower() in QGC_SUFFIXES + ARDUPILOT_SUFFIXES
 
 
@@ -67,7 +67,7 @@ def parse_text(text: str, display: str, *, qgc: bool | None = None) -> list[Para
             continue
         key = (entry.vehicle, entry.component, entry.name)
         if key in seen:
-            raise ParamFileError(
+            raise ParameterFileError(
                 display, number, f"expected each parameter once: {entry.name} is also at line {seen[key]}"
             )
         seen[key] = number
@@ -81,11 +81,11 @@ def load(path: Path, display: str | None = None) -> list[ParamEntry]:
     try:
         data = path.read_bytes()
     except OSError as exc:
-        raise ParamFileError(shown, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise ParameterFileError(shown, 0, f"cannot read file: {exc.strerror or exc}") from None
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise ParamFileError(shown, data[: exc.start].count(b"\n") + 1, "expected UTF-8 text") from None
+        raise ParameterFileError(shown, data[: exc.start].count(b"\n") + 1, "expected UTF-8 text") from None
     suffix = path.suffix.lower()
     qgc = True if suffix in QGC_SUFFIXES else False if suffix in ARDUPILOT_SUFFIXES else None
     return parse_text(text, shown, qgc=qgc)
@@ -105,7 +105,7 @@ def value_sets(entries: Iterable[ParamEntry]) -> list[tuple[int, dict[str, Value
     return [(group[0].line, {e.name: e.value for e in group}) for group in sets(entries).values()]
 
 
-def read_param_file(path: Path) -> Iterator[tuple[int, dict[str, Value]]]:
+def read_parameter_file(path: Path) -> Iterator[tuple[int, dict[str, Value]]]:
     """One instance per parameter set of a file, as :func:`value_sets`. Feed a set to a generated
     model through :func:`select` (e.g. ``BattParams.from_dict(select(values, BattParams))``)."""
     yield from value_sets(load(path))
@@ -165,12 +165,12 @@ def _value(text: str, display: str, line: int, *, integer: bool = False) -> Valu
     try:
         number = float(text)
     except ValueError:
-        raise ParamFileError(display, line, f"expected a number as the value, got {text!r}") from None
+        raise ParameterFileError(display, line, f"expected a number as the value, got {text!r}") from None
     if not math.isfinite(number):
-        raise ParamFileError(display, line, f"expected a finite number as the value, got {text!r}")
+        raise ParameterFileError(display, line, f"expected a finite number as the value, got {text!r}")
     if integer:
         if not number.is_integer():
-            raise ParamFileError(
+            raise ParameterFileError(
                 display, line, f"expected an integer value for an integer MAV_PARAM_TYPE, got {text!r}"
             )
         return int(number)
@@ -179,7 +179,9 @@ def _value(text: str, display: str, line: int, *, integer: bool = False) -> Valu
 
 def _name(text: str, display: str, line: int) -> str:
     if not NAME.fullmatch(text):
-        raise ParamFileError(display, line, f"expected a parameter name of 1 to 16 letters, digits and _, got {text!r}")
+        raise ParameterFileError(
+            display, line, f"expected a parameter name of 1 to 16 letters, digits and _, got {text!r}"
+        )
     return text
 
 
@@ -189,7 +191,7 @@ def _ardupilot_line(raw: str, display: str, line: int) -> ParamEntry | None:
         return None
     parts = [p for p in re.split(r"[,\s]+", body) if p]
     if len(parts) != 2:
-        raise ParamFileError(display, line, f"expected 'NAME,VALUE' or 'NAME VALUE', got {body!r}")
+        raise ParameterFileError(display, line, f"expected 'NAME,VALUE' or 'NAME VALUE', got {body!r}")
     return ParamEntry(_name(parts[0], display, line), _value(parts[1], display, line), line)
 
 
@@ -200,7 +202,7 @@ def _qgc_line(raw: str, display: str, line: int) -> ParamEntry | None:
     parts = body.split("\t") if "\t" in body else body.split()
     parts = [p.strip() for p in parts]
     if len(parts) != 5:
-        raise ParamFileError(
+        raise ParameterFileError(
             display,
             line,
             f"expected 5 tab-separated columns (vehicle id, component id, name, value, type), got {len(parts)}",
@@ -208,11 +210,11 @@ def _qgc_line(raw: str, display: str, line: int) -> ParamEntry | None:
     ids = []
     for label, text in (("vehicle id", parts[0]), ("component id", parts[1]), ("type", parts[4])):
         if not re.fullmatch(r"[0-9]{1,3}", text):
-            raise ParamFileError(display, line, f"expected a decimal {label}, got {text!r}")
+            raise ParameterFileError(display, line, f"expected a decimal {label}, got {text!r}")
         ids.append(int(text))
     vehicle, component, mav_type = ids
     if mav_type not in MAV_PARAM_TYPES:
-        raise ParamFileError(display, line, f"expected a MAV_PARAM_TYPE from 1 to 10 as type, got {mav_type}")
+        raise ParameterFileError(display, line, f"expected a MAV_PARAM_TYPE from 1 to 10 as type, got {mav_type}")
     value = _value(parts[3], display, line, integer=mav_type not in _FLOAT_TYPES)
     if mav_type in _FLOAT_TYPES and isinstance(value, int):
         value = float(value)

@@ -1,8 +1,8 @@
 """The engine of ``battgen params``: battery failsafe parameter files, proposed and checked.
 
 :func:`propose_from_devicetree` reads a devicetree battery (a ``simple-battery`` node) and proposes
-the BATT_* parameters (:mod:`.param_proposal`); :func:`render` writes them as an ArduPilot .param
-or a QGroundControl .params file. :func:`check_param_file` reads a parameter file and checks each
+the BATT_* parameters (:mod:`.batt_proposal`); :func:`render` writes them as an ArduPilot .param
+or a QGroundControl .params file. :func:`check_parameter_file` reads a parameter file and checks each
 parameter set against the generated parameter model (types, ranges) and the failsafe's
 cross-field rules (:mod:`.failsafe.checks`).
 """
@@ -16,12 +16,12 @@ from typing import Any, cast
 
 from ..errors import BattgenError
 from ..frontends import devicetree as devicetree_schemas
-from ..inputs import devicetree, paramfile
+from ..inputs import devicetree, parameter_files
 from ..inputs.model import MessageClass, field_names
 from ..ir import Message
-from .failsafe.checks import Finding, check_params
+from .batt_proposal import Result, propose
+from .failsafe.checks import Finding, check_settings
 from .package import bundled_package, bundled_schemas, data_error, package_module
-from .param_proposal import Result, propose
 
 BATTERY_COMPATIBLE = "simple-battery"
 BATTERY_MESSAGE = "devicetree.power.supply.battery"
@@ -77,7 +77,7 @@ def propose_from_devicetree(
 def check_proposals(result: Result) -> list[Finding]:
     """The failsafe's cross-field findings about the proposed parameters (with the cell count and
     chemistry the proposal assumed)."""
-    return check_params({p.name: p.value for p in result.proposals}, cells=result.cells, chemistry=result.chemistry)
+    return check_settings({p.name: p.value for p in result.proposals}, cells=result.cells, chemistry=result.chemistry)
 
 
 def render(result: Result, source: str, fmt: str) -> str:
@@ -85,39 +85,41 @@ def render(result: Result, source: str, fmt: str) -> str:
     header = [f"Battery failsafe parameters proposed by battgen from {source}", *result.notes]
     if fmt == "qgc":
         types = {f.name: f.metadata["type"] for f in dataclasses.fields(cast(Any, _batt_params()))}
-        items = [(p.name, p.value, paramfile.TYPE_OF.get(types.get(p.name, "float32"), 9)) for p in result.proposals]
+        items = [
+            (p.name, p.value, parameter_files.TYPE_OF.get(types.get(p.name, "float32"), 9)) for p in result.proposals
+        ]
         header += [f"{p.name}: {p.comment}" for p in result.proposals]
-        return paramfile.write_qgc(items, header=header)
-    return paramfile.write_param([(p.name, p.value, p.comment) for p in result.proposals], header=header)
+        return parameter_files.write_qgc(items, header=header)
+    return parameter_files.write_param([(p.name, p.value, p.comment) for p in result.proposals], header=header)
 
 
 @dataclass(frozen=True)
-class ParamFinding:
+class ParameterFinding:
     line: int
     severity: str  # "error" or "warning"
     message: str
 
 
-def check_param_file(path: Path, *, cells: int | None = None, chemistry: str = "lipo") -> list[ParamFinding]:
+def check_parameter_file(path: Path, *, cells: int | None = None, chemistry: str = "lipo") -> list[ParameterFinding]:
     """Every problem of each parameter set of a .param / .params file, in file order per set:
     data the model cannot read, values outside their ranges, then the cross-field findings.
     Absent parameters take the model's defaults."""
     model = _batt_params()
     error = data_error(bundled_package())
-    entries = paramfile.load(path, path.as_posix())
+    entries = parameter_files.load(path, path.as_posix())
     lines = {e.name: e.line for e in entries}
-    out: list[ParamFinding] = []
-    for first, values in paramfile.value_sets(entries):
+    out: list[ParameterFinding] = []
+    for first, values in parameter_files.value_sets(entries):
         try:
-            instance = model.from_dict(paramfile.select(values, field_names(model)))
+            instance = model.from_dict(parameter_files.select(values, field_names(model)))
         except error as exc:
-            out.append(ParamFinding(lines.get(str(getattr(exc, "path", "")), first), "error", str(exc)))
+            out.append(ParameterFinding(lines.get(str(getattr(exc, "path", "")), first), "error", str(exc)))
             continue
         for f in dataclasses.fields(cast(Any, model)):
             value, lo, hi = getattr(instance, f.name), f.metadata["minimum"], f.metadata["maximum"]
             if (lo is not None and value < lo) or (hi is not None and value > hi):
                 text = f"{f.name} is {value:g}: expected {lo:g} to {hi:g}"
-                out.append(ParamFinding(lines.get(f.name, first), "error", text))
-        for finding in check_params(instance.to_dict(), cells=cells, chemistry=chemistry):
-            out.append(ParamFinding(lines.get(finding.param, first), finding.severity, finding.message))
+                out.append(ParameterFinding(lines.get(f.name, first), "error", text))
+        for finding in check_settings(instance.to_dict(), cells=cells, chemistry=chemistry):
+            out.append(ParameterFinding(lines.get(finding.param, first), finding.severity, finding.message))
     return out

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from codegen.apps.failsafe.checks import check_file, check_params
-from codegen.apps.param_proposal import propose, voltage_at
+from codegen.apps.batt_proposal import propose, voltage_at
+from codegen.apps.failsafe.checks import check_file, check_settings
 from codegen.errors import BattgenError
-from codegen.inputs import paramfile
-from codegen.inputs.paramfile import ParamFileError
+from codegen.inputs import parameter_files
+from codegen.inputs.parameter_files import ParameterFileError
 
 QGC = """# Onboard parameters for Vehicle 1
 #
@@ -26,13 +26,13 @@ def test_ardupilot_forms_and_comments(tmp_path: Path) -> None:
     path.write_text(
         "# saved\nBATT_LOW_VOLT,10.5\nBATT_CRT_VOLT 10  # trailing\n\nBATT_OPTIONS\t0x3\n", encoding="utf-8"
     )
-    entries = paramfile.load(path)
+    entries = parameter_files.load(path)
     assert [(e.name, e.value, e.line) for e in entries] == [
         ("BATT_LOW_VOLT", 10.5, 2),
         ("BATT_CRT_VOLT", 10, 3),
         ("BATT_OPTIONS", 3, 5),
     ]
-    assert list(paramfile.read_param_file(path)) == [
+    assert list(parameter_files.read_parameter_file(path)) == [
         (2, {"BATT_LOW_VOLT": 10.5, "BATT_CRT_VOLT": 10, "BATT_OPTIONS": 3})
     ]
 
@@ -40,22 +40,22 @@ def test_ardupilot_forms_and_comments(tmp_path: Path) -> None:
 def test_qgc_one_set_per_component(tmp_path: Path) -> None:
     path = tmp_path / "v.params"
     path.write_text(QGC, encoding="utf-8")
-    sets = list(paramfile.read_param_file(path))
+    sets = list(parameter_files.read_parameter_file(path))
     assert sets == [(4, {"BATT_CAPACITY": 3300, "BATT_LOW_VOLT": 10.5}), (6, {"MNT_TYPE": 1})]
-    assert paramfile.load(path)[1].mav_type == 9
+    assert parameter_files.load(path)[1].mav_type == 9
 
 
 def test_round_trip_and_select(tmp_path: Path) -> None:
     from generated.params import BattParams
 
-    text = paramfile.write_param([("BATT_LOW_VOLT", 10.5, "from the OCV table"), ("BATT_CAPACITY", 3300, "")])
+    text = parameter_files.write_param([("BATT_LOW_VOLT", 10.5, "from the OCV table"), ("BATT_CAPACITY", 3300, "")])
     assert text == "BATT_LOW_VOLT,10.5  # from the OCV table\nBATT_CAPACITY,3300\n"
-    qgc = paramfile.write_qgc([("BATT_LOW_VOLT", 10.5, 9), ("BATT_CAPACITY", 3300, 6)])
+    qgc = parameter_files.write_qgc([("BATT_LOW_VOLT", 10.5, 9), ("BATT_CAPACITY", 3300, 6)])
     for name, body in (("r.param", text), ("r.params", qgc)):
         (tmp_path / name).write_text(body, encoding="utf-8")
-        [(_, values)] = list(paramfile.read_param_file(tmp_path / name))
+        [(_, values)] = list(parameter_files.read_parameter_file(tmp_path / name))
         assert values == {"BATT_LOW_VOLT": 10.5, "BATT_CAPACITY": 3300}
-    model = BattParams.from_dict(paramfile.select({**values, "GPS_TYPE": 1}, BattParams))
+    model = BattParams.from_dict(parameter_files.select({**values, "GPS_TYPE": 1}, BattParams))
     assert model.BATT_LOW_VOLT == 10.5
 
 
@@ -76,22 +76,22 @@ def test_round_trip_and_select(tmp_path: Path) -> None:
 def test_errors_name_file_line_and_expectation(tmp_path: Path, name: str, body: str, line: int, expected: str) -> None:
     path = tmp_path / name
     path.write_text(body, encoding="utf-8")
-    with pytest.raises(ParamFileError) as info:
-        paramfile.load(path)
+    with pytest.raises(ParameterFileError) as info:
+        parameter_files.load(path)
     assert (info.value.file, info.value.line) == (path.as_posix(), line)
     assert expected in info.value.message
 
 
 def test_unreadable(tmp_path: Path) -> None:
-    with pytest.raises(ParamFileError, match="cannot read file"):
-        paramfile.load(tmp_path / "nope.param")
+    with pytest.raises(ParameterFileError, match="cannot read file"):
+        parameter_files.load(tmp_path / "nope.param")
     (tmp_path / "b.param").write_bytes(b"BATT_A,1\n\xff\n")
-    with pytest.raises(ParamFileError, match=r"b\.param:2: expected UTF-8"):
-        paramfile.load(tmp_path / "b.param")
+    with pytest.raises(ParameterFileError, match=r"b\.param:2: expected UTF-8"):
+        parameter_files.load(tmp_path / "b.param")
 
 
 def findings(values: dict[str, float], **kw: object) -> list[tuple[str, str]]:
-    return [(f.severity, f.param) for f in check_params(values, **kw)]  # type: ignore[arg-type]
+    return [(f.severity, f.param) for f in check_settings(values, **kw)]  # type: ignore[arg-type]
 
 
 def test_cross_field_rules() -> None:
@@ -110,7 +110,7 @@ def test_cross_field_rules() -> None:
     assert findings({"BATT_LOW_VOLT": 5.0, "BATT_CRT_VOLT": 4.5}) == [("warning", "BATT_LOW_VOLT")]
     assert findings({**ok, "BATT_ARM_VOLT": 10.4}) == [("warning", "BATT_ARM_VOLT")]
     with pytest.raises(ValueError, match="expected a chemistry"):
-        check_params(ok, chemistry="coal")
+        check_settings(ok, chemistry="coal")
 
 
 def test_check_file_reports_parameter_lines(tmp_path: Path) -> None:
