@@ -5,7 +5,7 @@ every bundled message.
 Per-position constraints (ArrayType.columns, exported as prefixItems) are drawn on and beyond
 their bounds too, so the OCV tables' percent column is compared cell by cell.
 
-Out of the comparison, as documented in codegen/backends/jsonschema_export.py: cross-field rules
+Out of the comparison, as documented in codegen/backends/json_schema.py: cross-field rules
 (not exported) and warnings (never make an instance invalid). Instances are JSON data: NaN and the
 infinities appear as the strings the export documents; a bool is never written 1.0 and byte-array
 text is ASCII (the two places where the JSON data model cannot tell what the reader tells).

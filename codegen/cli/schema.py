@@ -2,7 +2,7 @@
 
 ``--message NAME`` prints one message's schema; ``--out DIR`` writes ``<qualified name>.schema.json``
 for every message; with neither, one JSON object maps each qualified name to its schema.
-NaN and the infinities are the strings "NaN", "Infinity", "-Infinity" (see jsonschema_export).
+NaN and the infinities are the strings "NaN", "Infinity", "-Infinity" (see codegen.ir.numbers).
 """
 
 from __future__ import annotations

@@ -3,16 +3,14 @@
 from __future__ import annotations
 
 from . import validators
-from .codecs import dronecan as codec_dronecan
-from .codecs import mavlink as codec_mavlink
-from .codecs import uorb as codec_uorb
+from .codecs import dronecan, mavlink, uorb
 from .converters import EXTENSION as CONVERTERS
 from .extensions import Extension
 
 EXTENSIONS: tuple[Extension, ...] = (
-    codec_dronecan.EXTENSION,
-    codec_uorb.EXTENSION,
-    codec_mavlink.EXTENSION,
+    dronecan.EXTENSION,
+    uorb.EXTENSION,
+    mavlink.EXTENSION,
     validators.EXTENSION,
     CONVERTERS,
 )

@@ -1,4 +1,4 @@
-"""The grammar of devicetree source (.dts/.dtsi, dtc's /dts-v1/ language) into a dts_tree.Node.
+"""The grammar of devicetree source (.dts/.dtsi, dtc's /dts-v1/ language) into a tree.Node.
 
 Integer expressions are evaluated here with dtc's semantics: unsigned 64-bit arithmetic, then
 the value must fit the cell width (a negative number fits as its two's complement).

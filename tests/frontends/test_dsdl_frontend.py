@@ -24,7 +24,7 @@ from codegen.ir import (
     units,
 )
 
-BUNDLED = Path(__file__).resolve().parents[1] / "schemas" / "dronecan"
+BUNDLED = Path(__file__).resolve().parents[2] / "schemas" / "dronecan"
 BATTERY_INFO = BUNDLED / "uavcan" / "equipment" / "power" / "1092.BatteryInfo.uavcan"
 BATTERY_AUX = BUNDLED / "ardupilot" / "equipment" / "power" / "20004.BatteryInfoAux.uavcan"
 

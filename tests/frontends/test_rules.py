@@ -27,7 +27,7 @@ from codegen.ir import (
 )
 from codegen.ir.expr import Compare, Quant
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 F32 = PrimitiveType(PrimitiveKind.FLOAT, 32)
 U8 = PrimitiveType(PrimitiveKind.UINT, 8)
 LOC = Location("t.msg", 1)

@@ -12,7 +12,7 @@ from codegen.frontends.loader import format_of_file, load
 from codegen.ir import EnumKind, PrimitiveKind, Range, SourceFormat
 from codegen.ir import json_form as irjson
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = ROOT / "schemas" / "params" / "battery_failsafe.pdef.xml"
 
 

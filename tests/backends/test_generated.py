@@ -42,17 +42,6 @@ def test_models_default_to_sentinels() -> None:
     assert meta["warning"]["enums"] == ("uorb.BatteryStatus.WARNING",)
 
 
-def test_generated_package_is_mypy_clean() -> None:
-    proc = subprocess.run(
-        [sys.executable, "-m", "mypy", "--strict", "--no-incremental", "-p", "generated"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-
-
 def _ruff(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [sys.executable, "-m", "ruff", *args, "generated"], cwd=ROOT, capture_output=True, text=True, check=False

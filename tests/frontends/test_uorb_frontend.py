@@ -22,7 +22,7 @@ from codegen.ir import (
     StringType,
 )
 
-SCHEMAS = Path(__file__).resolve().parents[1] / "schemas" / "uorb"
+SCHEMAS = Path(__file__).resolve().parents[2] / "schemas" / "uorb"
 HEAD = "uint64 timestamp # [us] Time since system start\n"
 
 

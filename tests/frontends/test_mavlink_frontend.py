@@ -12,7 +12,7 @@ from codegen.errors import SchemaError
 from codegen.frontends import mavlink
 from codegen.ir import ArrayType, EnumKind, PrimitiveKind, PrimitiveType, Range, Schema, Sentinel, StringType
 
-SCHEMAS = Path(__file__).resolve().parent.parent / "schemas" / "mavlink"
+SCHEMAS = Path(__file__).resolve().parents[2] / "schemas" / "mavlink"
 
 HEAD = '<?xml version="1.0"?>\n<mavlink>\n'
 

@@ -29,7 +29,7 @@ from codegen.ir import Message
 from generated._meta import DataError
 from generated.devicetree.power.supply import SimpleBattery
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data" / "devicetree"
 
 

@@ -24,7 +24,7 @@ from codegen.ir import (
     units,
 )
 
-SCHEMAS = Path(__file__).resolve().parent.parent / "schemas" / "devicetree"
+SCHEMAS = Path(__file__).resolve().parents[2] / "schemas" / "devicetree"
 BATTERY = SCHEMAS / "power" / "supply" / "battery.yaml"
 
 HEAD = """\

@@ -20,7 +20,7 @@ import pytest
 from codegen.backends.python.writer import generate
 from codegen.frontends import dsdl
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 DEFINITIONS = {
     "Fixed.uavcan": "uint4 a\nvoid4\nint16 b\n",

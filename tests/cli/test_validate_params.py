@@ -44,7 +44,7 @@ def test_param_file_violations_point_at_parameter_lines(capsys: pytest.CaptureFi
     by_line = {int(line.split(":")[1]): line for line in lines}
     assert set(by_line) == {5, 6, 7}, lines
     assert "BATT_CRT_VOLT" in by_line[5] and "minimum 0" in by_line[5]
-    assert "not below BATT_CAPACITY" in by_line[6]  # a cross-field finding of failsafe_checks
+    assert "not below BATT_CAPACITY" in by_line[6]  # a cross-field finding of apps/failsafe/checks.py
     assert "BATT_FS_LOW_ACT" in by_line[7]
     assert len(lines) == 3  # BATT_CRT_VOLT = -1 once: the range covers check_settings' "negative" rule
     assert "params.BATT: 1 record in 1 file, 3 errors" in err

@@ -38,7 +38,7 @@ from generated.dronecan.uavcan.equipment.power import BatteryInfo
 from generated.mavlink import BatteryStatus as MavBatteryStatus
 from generated.uorb import BatteryStatus
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _rules_of(found: list[Violation]) -> list[tuple[str, str]]:

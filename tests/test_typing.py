@@ -1,0 +1,71 @@
+"""Everything we write or generate type-checks under mypy --strict: the toolchain, the committed
+package, and packages generated from the hand-built schemas of tests/samples.py (hostile names,
+every MAVLink field kind, nested uORB messages). One mypy run checks them all; each target is a
+case of its own, so a failure names what broke."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import ROOT
+from samples import NESTED, hostile_schema, mavlink_thing_xml
+
+from codegen.backends.python.writer import generate
+from codegen.frontends import mavlink, uorb
+
+# target -> the folder whose files mypy reports on
+TARGETS = ("codegen", "generated", "hostile", "mavlink_thing", "uorb_nested")
+
+
+def _generate_samples(root: Path) -> None:
+    generate(hostile_schema(), root / "hostile")
+    work = root / "sources"
+    work.mkdir()
+    generate(mavlink.parse_file(mavlink_thing_xml(work), root=work), root / "mavlink_thing")
+    msgs = work / "msg"
+    msgs.mkdir()
+    for name, text in NESTED.items():
+        (msgs / name).write_text(text, encoding="utf-8")
+    generate(uorb.parse_dir(msgs), root / "uorb_nested")
+
+
+@pytest.fixture(scope="module")
+def mypy_report(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[str]]:
+    """Run mypy once over every target; its error lines, by target."""
+    samples = tmp_path_factory.mktemp("typed")
+    _generate_samples(samples)
+    # the project's configuration (strict, and the reference stacks without stubs) for all targets
+    command = [sys.executable, "-m", "mypy", "--no-incremental", "--config-file", str(ROOT / "pyproject.toml")]
+    for target in TARGETS:
+        command += ["-p", target]
+    proc = subprocess.run(
+        command,
+        cwd=ROOT,
+        env={**os.environ, "MYPYPATH": str(samples)},  # where the sample packages are found
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode in (0, 1), proc.stdout + proc.stderr  # 2: mypy itself failed
+    report: dict[str, list[str]] = {t: [] for t in TARGETS}
+    places = {"codegen": ROOT / "codegen", "generated": ROOT / "generated"}
+    places |= {t: samples / t for t in TARGETS[2:]}
+    for line in proc.stdout.splitlines():
+        match = re.match(r"(.+?):\d+: (error|note)", line)
+        if match is None:
+            continue
+        path = (ROOT / match.group(1)).resolve()
+        owner = next((t for t, folder in places.items() if path.is_relative_to(folder.resolve())), None)
+        report.setdefault(owner or "elsewhere", []).append(line)
+    report["summary"] = [proc.stdout.strip().splitlines()[-1]] if proc.stdout.strip() else []
+    return report
+
+
+@pytest.mark.parametrize("target", [*TARGETS, "elsewhere"])
+def test_mypy_strict(mypy_report: dict[str, list[str]], target: str) -> None:
+    assert mypy_report.get(target, []) == [], "\n".join(mypy_report[target] + mypy_report["summary"])
