@@ -244,9 +244,7 @@ def backward(
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
     else:
         t_info.remaining_capacity_wh = _r.f16(
-            _v5 * 0.0002777777777777778,
-            rep,
-            "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh",
+            _v5 * 0.0002777777777777778, rep, "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh"
         )
 
     # dronecan.yaml:22: scale info.full_charge_capacity_wh -> full_energy
@@ -257,9 +255,7 @@ def backward(
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
     else:
         t_info.full_charge_capacity_wh = _r.f16(
-            _v6 * 0.0002777777777777778,
-            rep,
-            "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh",
+            _v6 * 0.0002777777777777778, rep, "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh"
         )
 
     # dronecan.yaml:23: scale info.hours_to_full_charge -> time_to_full
@@ -270,9 +266,7 @@ def backward(
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge")
     else:
         t_info.hours_to_full_charge = _r.f16(
-            _v7 * 0.0002777777777777778,
-            rep,
-            "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge",
+            _v7 * 0.0002777777777777778, rep, "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge"
         )
 
     # dronecan.yaml:24: flag info.status_flags -> in_use
@@ -319,11 +313,7 @@ def backward(
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct")
     else:
         t_info.state_of_health_pct = _r.to_int(
-            _v12 * 100.0,
-            0,
-            100,
-            rep,
-            "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct",
+            _v12 * 100.0, 0, 100, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct"
         )
         if rep is not None and t_info.state_of_health_pct in (127,):
             rep.clamped(
@@ -339,11 +329,7 @@ def backward(
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct")
     else:
         t_info.state_of_charge_pct = _r.to_int(
-            _v14 * 100.0,
-            0,
-            127,
-            rep,
-            "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct",
+            _v14 * 100.0, 0, 127, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct"
         )
         if rep is not None and t_info.state_of_charge_pct in (127,):
             rep.clamped(
@@ -358,11 +344,7 @@ def backward(
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev")
     else:
         t_info.state_of_charge_pct_stdev = _r.to_int(
-            _v15 * 100.0,
-            0,
-            127,
-            rep,
-            "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev",
+            _v15 * 100.0, 0, 127, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev"
         )
 
     # dronecan.yaml:57: copy aux.battery_id -> battery_index
@@ -391,11 +373,7 @@ def backward(
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id")
     else:
         t_info.model_instance_id = _r.to_int(
-            _v18,
-            0,
-            4294967295,
-            rep,
-            "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id",
+            _v18, 0, 4294967295, rep, "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id"
         )
         if rep is not None and t_info.model_instance_id in (0,):
             rep.clamped(
@@ -420,8 +398,7 @@ def backward(
         if len(_c21) > 255:
             if rep is not None:
                 rep.clamped(
-                    "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell",
-                    f"{len(_c21)} cells, room for 255",
+                    "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell", f"{len(_c21)} cells, room for 255"
                 )
             _c21 = _c21[:255]
         _l21 = [_r.f16(_x21, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell") for _x21 in _c21]
@@ -434,11 +411,7 @@ def backward(
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count")
     else:
         t_aux.cycle_count = _r.to_int(
-            _v22,
-            0,
-            65535,
-            rep,
-            "dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count",
+            _v22, 0, 65535, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count"
         )
 
     # dronecan.yaml:64: copy aux.over_discharge_count -> over_discharge_count
@@ -448,11 +421,7 @@ def backward(
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count")
     else:
         t_aux.over_discharge_count = _r.to_int(
-            _v23,
-            0,
-            65535,
-            rep,
-            "dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count",
+            _v23, 0, 65535, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count"
         )
 
     # dronecan.yaml:65: scale aux.max_current -> max_current

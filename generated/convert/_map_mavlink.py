@@ -207,11 +207,7 @@ def backward(
             rep_u.unknown("mavlink.BATTERY_STATUS.temperature")
     else:
         t_msg.temperature = _r.to_int(
-            _v3 * 100.0 + -27314.999999999996,
-            -32768,
-            32767,
-            rep,
-            "mavlink.BATTERY_STATUS.temperature",
+            _v3 * 100.0 + -27314.999999999996, -32768, 32767, rep, "mavlink.BATTERY_STATUS.temperature"
         )
         if rep is not None and t_msg.temperature in (32767,):
             rep.clamped("mavlink.BATTERY_STATUS.temperature", "a known value written as the unknown marker")
@@ -253,11 +249,7 @@ def backward(
             rep_u.unknown("mavlink.BATTERY_STATUS.current_consumed")
     else:
         t_msg.current_consumed = _r.to_int(
-            _v6 * 0.2777777777777778,
-            -2147483648,
-            2147483647,
-            rep,
-            "mavlink.BATTERY_STATUS.current_consumed",
+            _v6 * 0.2777777777777778, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.current_consumed"
         )
         if rep is not None and t_msg.current_consumed in (-1,):
             rep.clamped("mavlink.BATTERY_STATUS.current_consumed", "a known value written as the unknown marker")
@@ -270,11 +262,7 @@ def backward(
             rep_u.unknown("mavlink.BATTERY_STATUS.energy_consumed")
     else:
         t_msg.energy_consumed = _r.to_int(
-            _v7 * 0.01,
-            -2147483648,
-            2147483647,
-            rep,
-            "mavlink.BATTERY_STATUS.energy_consumed",
+            _v7 * 0.01, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.energy_consumed"
         )
         if rep is not None and t_msg.energy_consumed in (-1,):
             rep.clamped("mavlink.BATTERY_STATUS.energy_consumed", "a known value written as the unknown marker")

@@ -71,8 +71,7 @@ def forward(
     _n2 = s_status.cell_count
     if _n2 > 14 and rep is not None:
         rep.clamped(
-            "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell",
-            f"{int(_n2)} cells, 14 in the array",
+            "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell", f"{int(_n2)} cells, 14 in the array"
         )
     _m2 = min(_n2, 14)
     _s2 = "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell"
@@ -116,17 +115,13 @@ def forward(
     # px4_uavcannode.yaml:27: px4_convert full_charge_capacity_wh -> info.full_charge_capacity_wh
     _x12 = _r.f32(float(s_status.full_charge_capacity_wh))
     t_info.full_charge_capacity_wh = _r.f16(
-        _x12,
-        rep,
-        "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh",
+        _x12, rep, "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh"
     )
 
     # px4_uavcannode.yaml:28: px4_convert remaining_capacity_wh -> info.remaining_capacity_wh
     _x13 = _r.f32(float(s_status.remaining_capacity_wh))
     t_info.remaining_capacity_wh = _r.f16(
-        _x13,
-        rep,
-        "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh",
+        _x13, rep, "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh"
     )
 
     # px4_uavcannode.yaml:29: px4_convert remaining -> info.state_of_charge_pct

@@ -26,12 +26,7 @@ def to_concepts(
     """
     if policy == "strict":
         _strict_1 = _map_devicetree.forward(
-            node,
-            rep=report,
-            rep_d=report,
-            rep_u=report,
-            ocv_v=ocv_v,
-            temperature_c=temperature_c,
+            node, rep=report, rep_d=report, rep_u=report, ocv_v=ocv_v, temperature_c=temperature_c
         )
         return _strict_1[0]
     if policy == "px4":

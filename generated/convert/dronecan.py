@@ -11,11 +11,7 @@ from ._concepts import BatteryState
 
 
 def to_concepts(
-    info: BatteryInfo,
-    aux: BatteryInfoAux | None = None,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    info: BatteryInfo, aux: BatteryInfoAux | None = None, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryState:
     """Convert dronecan to concepts.
 
@@ -33,10 +29,7 @@ def to_concepts(
 
 
 def from_concepts(
-    state: BatteryState,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    state: BatteryState, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> tuple[BatteryInfo, BatteryInfoAux]:
     """Convert concepts to dronecan.
 

@@ -27,12 +27,7 @@ def devicetree_to_dronecan(
     """
     if policy == "strict":
         _strict_1 = _map_devicetree.forward(
-            node,
-            rep=report,
-            rep_d=report,
-            rep_u=None,
-            ocv_v=ocv_v,
-            temperature_c=temperature_c,
+            node, rep=report, rep_d=report, rep_u=None, ocv_v=ocv_v, temperature_c=temperature_c
         )
         _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2

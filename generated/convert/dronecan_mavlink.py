@@ -18,11 +18,7 @@ from . import _runtime as _r
 
 
 def dronecan_to_mavlink(
-    info: BatteryInfo,
-    aux: BatteryInfoAux | None = None,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    info: BatteryInfo, aux: BatteryInfoAux | None = None, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryStatus:
     """Convert dronecan to mavlink.
 
@@ -43,10 +39,7 @@ def dronecan_to_mavlink(
 
 
 def mavlink_to_dronecan(
-    msg: BatteryStatus,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    msg: BatteryStatus, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> tuple[BatteryInfo, BatteryInfoAux]:
     """Convert mavlink to dronecan.
 

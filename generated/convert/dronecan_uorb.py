@@ -11,11 +11,7 @@ from . import _runtime as _r
 
 
 def dronecan_to_uorb(
-    info: BatteryInfo,
-    aux: BatteryInfoAux | None = None,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    info: BatteryInfo, aux: BatteryInfoAux | None = None, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryStatus:
     """Convert dronecan to uorb.
 
@@ -35,10 +31,7 @@ def dronecan_to_uorb(
 
 
 def uorb_to_dronecan(
-    status: BatteryStatus,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    status: BatteryStatus, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> tuple[BatteryInfo, BatteryInfoAux]:
     """Convert uorb to dronecan.
 

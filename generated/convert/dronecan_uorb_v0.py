@@ -11,11 +11,7 @@ from . import _runtime as _r
 
 
 def dronecan_to_uorb_v0(
-    info: BatteryInfo,
-    aux: BatteryInfoAux | None = None,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    info: BatteryInfo, aux: BatteryInfoAux | None = None, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryStatusV0:
     """Convert dronecan to uorb_v0.
 
@@ -37,10 +33,7 @@ def dronecan_to_uorb_v0(
 
 
 def uorb_v0_to_dronecan(
-    status: BatteryStatusV0,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    status: BatteryStatusV0, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> tuple[BatteryInfo, BatteryInfoAux]:
     """Convert uorb_v0 to dronecan.
 

@@ -10,10 +10,7 @@ from . import _runtime as _r
 
 
 def uorb_to_mavlink(
-    status: UorbBatteryStatus,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    status: UorbBatteryStatus, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> MavlinkBatteryStatus:
     """Convert uorb to mavlink.
 
@@ -33,10 +30,7 @@ def uorb_to_mavlink(
 
 
 def mavlink_to_uorb(
-    msg: MavlinkBatteryStatus,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    msg: MavlinkBatteryStatus, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> UorbBatteryStatus:
     """Convert mavlink to uorb.
 

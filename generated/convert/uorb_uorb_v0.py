@@ -9,10 +9,7 @@ from . import _runtime as _r
 
 
 def uorb_to_uorb_v0(
-    status: BatteryStatus,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    status: BatteryStatus, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryStatusV0:
     """Convert uorb to uorb_v0.
 
@@ -31,10 +28,7 @@ def uorb_to_uorb_v0(
 
 
 def uorb_v0_to_uorb(
-    status: BatteryStatusV0,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    status: BatteryStatusV0, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryStatus:
     """Convert uorb_v0 to uorb.
 

@@ -10,10 +10,7 @@ from ._concepts import BatteryState
 
 
 def to_concepts(
-    status: BatteryStatusV0,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    status: BatteryStatusV0, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryState:
     """Convert uorb_v0 to concepts.
 
@@ -32,10 +29,7 @@ def to_concepts(
 
 
 def from_concepts(
-    state: BatteryState,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    state: BatteryState, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryStatusV0:
     """Convert concepts to uorb_v0.
 

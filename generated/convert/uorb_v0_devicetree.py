@@ -26,12 +26,7 @@ def devicetree_to_uorb_v0(
     """
     if policy == "strict":
         _strict_1 = _map_devicetree.forward(
-            node,
-            rep=report,
-            rep_d=report,
-            rep_u=None,
-            ocv_v=ocv_v,
-            temperature_c=temperature_c,
+            node, rep=report, rep_d=report, rep_u=None, ocv_v=ocv_v, temperature_c=temperature_c
         )
         _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)

@@ -17,10 +17,7 @@ from . import _runtime as _r
 
 
 def uorb_v0_to_mavlink(
-    status: BatteryStatusV0,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    status: BatteryStatusV0, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryStatus:
     """Convert uorb_v0 to mavlink.
 
@@ -42,10 +39,7 @@ def uorb_v0_to_mavlink(
 
 
 def mavlink_to_uorb_v0(
-    msg: BatteryStatus,
-    *,
-    policy: str = "strict",
-    report: _r.LossReport | None = None,
+    msg: BatteryStatus, *, policy: str = "strict", report: _r.LossReport | None = None
 ) -> BatteryStatusV0:
     """Convert mavlink to uorb_v0.
 

@@ -19,7 +19,7 @@ TEXT_PART = 80  # characters of text per part of a long string literal
 
 
 def py_literal(value: object) -> str:
-    """Deterministic Python source for a scalar, tuple or list value."""
+    """Deterministic Python source for a scalar (bytes too), or a tuple, list or dict of them."""
     if value is None or isinstance(value, bool):
         return repr(value)
     if isinstance(value, int):
@@ -37,7 +37,14 @@ def py_literal(value: object) -> str:
         return f"({inner},)" if len(value) == 1 else f"({inner})"
     if isinstance(value, list):
         return "[" + ", ".join(py_literal(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{py_literal(k)}: {py_literal(v)}" for k, v in value.items()) + "}"
     raise TypeError(f"no literal for {type(value).__name__}")
+
+
+def float_literal(value: float | int) -> str:
+    """A number as a float literal, whatever type it came as (``math.nan`` for NaN)."""
+    return py_literal(float(value))
 
 
 def unparenthesized(source: str) -> str:
@@ -76,6 +83,15 @@ def text_literal(text: str) -> str:
     if rest:
         parts.append(rest)
     return " ".join(py_literal(p) for p in parts)
+
+
+def comment(text: str, indent: str) -> list[str]:
+    """``text`` as ``#`` comment lines after ``indent``, wrapped at spaces to the line length (a
+    word longer than a line stays whole). Line breaks and control characters become spaces, so
+    the text cannot leave the comment."""
+    words = " ".join("".join(" " if unicodedata.category(ch)[0] == "C" else ch for ch in text).split())
+    width = LINE_LENGTH - len(indent) - 2
+    return [f"{indent}# {line}" for line in textwrap.wrap(words, width, break_long_words=False, break_on_hyphens=False)]
 
 
 def _clean(text: str) -> str:

@@ -14,8 +14,9 @@ Modules of this package: :mod:`.mapping_module` writes a mapping's functions, ru
 :class:`~.function.FunctionBuilder` (the backend's implementation of the op contract,
 :class:`~codegen.ir.mapping_visitor.OpVisitor`, from the emitter mixins :mod:`.numeric`,
 :mod:`.choices`, :mod:`.cells`, :mod:`.devicetree`, :mod:`.messages`, :mod:`.px4`, :mod:`.px4_cells`);
-:mod:`.routes` chains them into converters; :mod:`.concepts_module` writes ``BatteryState``;
-:mod:`.source` lays the text out as ``ruff format`` would.
+:mod:`.routes` chains them into converters; :mod:`.concepts_module` writes ``BatteryState``.
+Emitters write one statement a line, with literals from :mod:`..literals`; every module is then
+laid out by :mod:`..layout`, as the model modules are.
 """
 
 from __future__ import annotations

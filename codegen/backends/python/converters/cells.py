@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from ....ir import FieldRef, Rule
 from ....ir.ops import Cells, MavlinkVoltages
+from ..literals import py_literal
 from .context import RuleContext, affine, array_type, factor
-from .source import Call, literal
 
 
 class CellEmitters(RuleContext):
@@ -21,12 +21,12 @@ class CellEmitters(RuleContext):
             mul, add = factor(f_unit, c_unit)
             self.emit(f"_c = list({self.s(fmt)})")
             if count_ref is not None:
-                self.emit(f"_n = {self.s(count_ref)}", f"_c = _c[:_n] if _n else _r.leading(_c, {literal(mark)})")
+                self.emit(f"_n = {self.s(count_ref)}", f"_c = _c[:_n] if _n else _r.leading(_c, {py_literal(mark)})")
             elif mark is not None:
-                self.emit(f"_c = _r.leading(_c, {literal(mark)})")
+                self.emit(f"_c = _r.leading(_c, {py_literal(mark)})")
             conv = affine("float(_x)", mul, add)
             if mark is not None:
-                conv = f"math.nan if _r.is_marker(_x, {literal(mark)}) else {conv}"
+                conv = f"math.nan if _r.is_marker(_x, {py_literal(mark)}) else {conv}"
             self.emit(f"{self.t(con)} = tuple({conv} for _x in _c) or None")
             return
         mul, add = factor(c_unit, f_unit)
@@ -54,7 +54,7 @@ class CellEmitters(RuleContext):
         if count_ref is not None:
             count = self.t(count_ref)
             self.emit(f"    if not {count}:", f"        {count} = min(len(_c), {cap})", "        if rep_u is not None:")
-            self.emit_call("rep_u.discard", [literal("unknown"), self.label(count_ref)], 3)
+            self.emit_call("rep_u.discard", [py_literal("unknown"), self.label(count_ref)], 3)
 
     def visit_mavlink_voltages(self, rule: Rule, op: MavlinkVoltages) -> None:
         main_ref, ext_ref = rule.sources
@@ -77,7 +77,7 @@ class CellEmitters(RuleContext):
             return
         mul, add = factor(v_unit, main_f.unit)
         self.emit(f"_c = {self.s(cells)}", f"_p = {self.s(pack)}")
-        args: list[str | Call] = [
+        args: list[str] = [
             f"None if _c is None else [{affine('_x', mul, add)} for _x in _c]",
             f"None if _p is None else {affine('_p', mul, add)}",
             *(str(x) for x in (main_cap, ext_cap, main_mark, ext_mark)),

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from ....ir import Rule
 from ....ir.ops import Choice, Flag, FlagChoice, Flags
+from ..literals import py_literal
 from .context import RuleContext, constant_name
-from .source import literal
 
 _NO_COUNTERPART = 'f"{_v!r} has no counterpart"'
 
@@ -24,21 +24,21 @@ class ChoiceEmitters(RuleContext):
         mask = self.mask(op.mask, [fmt])
         if not self.backward:
             self.note_bits(fmt.message, fmt.field, mask)
-            self.emit(f"{self.t(con)} = bool({self.s(fmt)} & {literal(mask)})")
+            self.emit(f"{self.t(con)} = bool({self.s(fmt)} & {py_literal(mask)})")
         else:
             target = self.t(fmt)
-            self.emit(f"if {self.s(con)}:", f"    {target} |= {literal(mask)}")
+            self.emit(f"if {self.s(con)}:", f"    {target} |= {py_literal(mask)}")
 
     def visit_flag_choice(self, rule: Rule, op: FlagChoice) -> None:
         """A bit that stands for one value of a choice concept (CHARGING -> warning 'charging')."""
         fmt, con = self.format_and_concept(rule)
         mask = self.mask(op.mask, [fmt])
-        value = literal(op.value)
+        value = py_literal(op.value)
         if not self.backward:
             self.note_bits(fmt.message, fmt.field, mask)
-            self.emit(f"if {self.s(fmt)} & {literal(mask)}:", f"    {self.t(con)} = {value}")
+            self.emit(f"if {self.s(fmt)} & {py_literal(mask)}:", f"    {self.t(con)} = {value}")
         else:
-            self.emit(f"if {self.s(con)} == {value}:", f"    {self.t(fmt)} |= {literal(mask)}")
+            self.emit(f"if {self.s(con)} == {value}:", f"    {self.t(fmt)} |= {py_literal(mask)}")
 
     def visit_flags(self, rule: Rule, op: Flags) -> None:
         fmt, con = self.format_and_concept(rule)
@@ -56,10 +56,10 @@ class ChoiceEmitters(RuleContext):
         self.emit_call("rep_u.unknown", [label], 2)
         self.emit("else:", f"    _b = {target}")
         for name, mask in ordered:
-            self.emit(f"    if {literal(name)} in _v:", f"        _b |= {literal(mask)}")
+            self.emit(f"    if {py_literal(name)} in _v:", f"        _b |= {py_literal(mask)}")
         self.emit(f"    {target} = _b", "    if rep_d is not None:", "        for _n in _v:")
         self.emit(f"            if _n not in {known}:")
-        self.emit_call("rep_d.dropped", [literal(f"concepts.{con.field}"), '_n + " has no counterpart"'], 4)
+        self.emit_call("rep_d.dropped", [py_literal(f"concepts.{con.field}"), '_n + " has no counterpart"'], 4)
 
     def visit_choice(self, rule: Rule, op: Choice) -> None:
         fmt, con = self.format_and_concept(rule)
@@ -68,7 +68,7 @@ class ChoiceEmitters(RuleContext):
         if not self.backward:
             by_value = self.const(constant_name(con.field, "by", fmt.field), {v: k for k, v in table})
             self.emit(f"_v = {self.s(fmt)}", f"{self.t(con)} = None if _v is None else {by_value}.get(_v)")
-            skip = f"({literal(None)}, {literal(unknown)})"
+            skip = f"({py_literal(None)}, {py_literal(unknown)})"
             self.emit(f"if rep_d is not None and _v not in {by_value} and _v not in {skip}:")
             self.emit_call("rep_d.dropped", [self.label(fmt), _NO_COUNTERPART], 1)
             return
@@ -77,8 +77,8 @@ class ChoiceEmitters(RuleContext):
         self.emit(f"_v = {self.s(con)}", f"_w = None if _v is None else {by_choice}.get(_v)")
         self.emit("if _w is not None:", f"    {target} = _w", "else:")
         if unknown is not None:
-            self.emit(f"    {target} = {literal(unknown)}")
+            self.emit(f"    {target} = {py_literal(unknown)}")
         self.emit("    if rep_u is not None:")
         self.emit_call("rep_u.unknown", [label], 2)
         self.emit("    if rep_d is not None and _v is not None:")
-        self.emit_call("rep_d.dropped", [literal(f"concepts.{con.field}"), _NO_COUNTERPART], 2)
+        self.emit_call("rep_d.dropped", [py_literal(f"concepts.{con.field}"), _NO_COUNTERPART], 2)

@@ -6,8 +6,15 @@ from collections.abc import Iterable
 
 from ....ir import Schema
 from .. import naming
+from ..imports import from_imports
 
-Import = tuple[str, str, str | None]  # (relative module, name, alias or None), see source.imports
+Import = tuple[str, str, str | None]  # (relative module, name, alias or None)
+
+
+def import_lines(names: Iterable[Import]) -> list[str]:
+    """The ``from`` imports binding ``names``, in isort order (one statement a line: the layout
+    engine breaks the long ones)."""
+    return from_imports(f"from {m} import {name}" + (f" as {alias}" if alias else "") for m, name, alias in names)
 
 
 def class_names(

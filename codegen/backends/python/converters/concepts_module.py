@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from ....ir import Concept
 from .. import naming
-from .source import INDENT, docstring, tidy, value_lines
+from ..layout import format_module
+from ..literals import docstring, py_literal
+from .context import INDENT
 
 _KIND_TYPES = {
     "number": "float | None",
@@ -86,13 +88,13 @@ def concepts_module(concepts: dict[str, Concept], header: str) -> str:
         "class BatteryState:",
         docstring("One battery's state in the shared concepts (see schemas/mappings/concepts.yaml).", INDENT),
         "",
-        *value_lines("UNITS: ClassVar[dict[str, str | None]] = ", units, INDENT),
-        *value_lines("KINDS: ClassVar[dict[str, str]] = ", kinds, INDENT),
-        *value_lines("CHOICES: ClassVar[dict[str, tuple[str, ...]]] = ", choices, INDENT),
+        f"{INDENT}UNITS: ClassVar[dict[str, str | None]] = {py_literal(units)}",
+        f"{INDENT}KINDS: ClassVar[dict[str, str]] = {py_literal(kinds)}",
+        f"{INDENT}CHOICES: ClassVar[dict[str, tuple[str, ...]]] = {py_literal(choices)}",
         "",
     ]
     for c in concepts.values():
         unit = f" [{c.unit.symbol}]" if c.unit else ""
         lines.append(f"{INDENT}{naming.identifier(c.name)}: {_KIND_TYPES[c.kind]} = None")
         lines.append(docstring(f"{c.doc}{unit}", INDENT))
-    return tidy("\n".join(lines) + "\n" + _METHODS)
+    return format_module("\n".join(lines) + "\n" + _METHODS)

@@ -5,9 +5,10 @@ source endpoint's objects, read; the target's, written), the body lines so far, 
 constants shared by both directions (:class:`ModuleConstants`). The emitter mixins of this
 package (numeric, choices, cells, devicetree, messages, px4, px4_cells) build on it.
 
-Temporaries an emitter writes (``_v``, ``_c``, ...; see :data:`TEMPORARIES`) get the rule's
-number as a suffix when emitted, so each has one type across the function (mypy) and a reader
-can tell which rule made it.
+Emitters write each statement on one line (a call as :func:`call` spells it); the module is
+laid out afterwards by the layout engine. Temporaries an emitter writes (``_v``, ``_c``, ...;
+see :data:`TEMPORARIES`) get the rule's number as a suffix when emitted, so each has one type
+across the function (mypy) and a reader can tell which rule made it.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from __future__ import annotations
 import math
 import re
 import struct
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from ....errors import BattgenError
@@ -36,9 +37,11 @@ from ....ir import (
 )
 from ....ir.mapping_values import ConstantRef, Number, Value
 from .. import naming
-from .source import INDENT, WIDTH, Call, call, literal, number, value_lines
+from ..layout import LINE_LENGTH
+from ..literals import float_literal, py_literal
 
 FLT_EPS = 1.1920928955078125e-07
+INDENT = "    "
 
 TEMPORARIES = re.compile(r"\b_(?:v|w|c|p|x|n|m|b|e|f|s|a|l|t|ts|tb|tabs|cap|uv|hi|lo|ch|i)\b")
 # f-strings (whose fields may name temporaries), other string literals (schema text: left as it is)
@@ -83,14 +86,13 @@ class ModuleConstants:
     """
 
     def __init__(self) -> None:
-        self.lines: dict[str, list[str]] = {}
+        self.lines: dict[str, str] = {}  # name -> its assignment statement
 
     def add(self, name: str, value: object, direction: str, *, expression: str | None = None) -> str:
         """The constant ``name`` holding ``value`` (a literal) or ``expression`` (source text)."""
         candidates = [name, f"{name}_{direction.upper()}", *(f"{name}_{i}" for i in range(2, 100))]
         for candidate in candidates:
-            head = f"{candidate} = "
-            text = [head + expression] if expression is not None else value_lines(head, value)
+            text = f"{candidate} = {py_literal(value) if expression is None else expression}"
             if self.lines.setdefault(candidate, text) == text:
                 return candidate
         raise BattgenError(f"too many constants named {name}")
@@ -138,13 +140,13 @@ class RuleContext:
         if not self.rule_number:  # the epilogue's temporaries keep their names
             return text
 
-        def number(m: re.Match[str]) -> str:
+        def suffixed(m: re.Match[str]) -> str:
             return f"{m.group(0)}{self.rule_number}"
 
         def token(m: re.Match[str]) -> str:
             if m.group(1):  # an f-string: its fields are code
-                return TEMPORARIES.sub(number, m.group(1))
-            return m.group(2) or number(m)
+                return TEMPORARIES.sub(suffixed, m.group(1))
+            return m.group(2) or suffixed(m)
 
         return _TOKENS.sub(token, text)
 
@@ -152,19 +154,14 @@ class RuleContext:
         """Body lines, indented relative to the rule's block."""
         self.lines.extend(self.pad + self._numbered(line) if line else "" for line in lines)
 
-    def emit_call(self, head: str, args: Sequence[str | Call], nest: int = 0) -> None:
-        """A call statement ``head(args)``, one argument per line when it does not fit."""
-        self.lines.extend(call(self._numbered(head), [self._renumbered(a) for a in args], self.pad + INDENT * nest))
-
-    def _renumbered(self, arg: str | Call) -> str | Call:
-        if isinstance(arg, Call):
-            return Call(self._numbered(arg.func), [self._renumbered(a) for a in arg.args])
-        return self._numbered(arg)
+    def emit_call(self, head: str, args: list[str], nest: int = 0) -> None:
+        """A call statement ``head(args)``, ``nest`` blocks into the rule's block."""
+        self.emit(INDENT * nest + call(head, args))
 
     def emit_with_label(self, line: Callable[[str], str], label: str) -> None:
         """The line ``line(label)``; when that does not fit, the label goes into a variable (``_s``) first."""
         text = line(label)
-        if len(self.pad) + len(self._numbered(text)) <= WIDTH:
+        if len(self.pad) + len(self._numbered(text)) <= LINE_LENGTH:
             self.emit(text)
             return
         nest = text[: len(text) - len(text.lstrip())]
@@ -199,7 +196,7 @@ class RuleContext:
 
     def label(self, ref: FieldRef) -> str:
         """The loss report's name of a field: ``qualified.message.field``."""
-        return literal(f"{ref.message}.{ref.field}")
+        return py_literal(f"{ref.message}.{ref.field}")
 
     def constant_value(self, name: str, refs: Iterable[FieldRef]) -> int | float | bool | str:
         """A constant by name, looked up in the messages a rule uses, then in dialect enums."""
@@ -241,7 +238,7 @@ class RuleContext:
 
     def known_test(self, var: str, marks: list[float | int]) -> list[str]:
         """Conditions that ``var`` is none of ``marks`` (NaN by ``var == var``)."""
-        return [f"{var} == {var}" if _nan(m) else f"{var} != {literal(m)}" for m in marks]
+        return [f"{var} == {var}" if _nan(m) else f"{var} != {py_literal(m)}" for m in marks]
 
     def unit_of(self, ref: FieldRef) -> Unit | None:
         if ref.message == CONCEPTS_ENDPOINT:
@@ -269,18 +266,18 @@ class RuleContext:
         return p is not None and p.kind is PrimitiveKind.FLOAT
 
     def marker_literal(self, f: Field, mark: float | int) -> str:
-        return number(mark) if self.is_float(f) else literal(int(mark))
+        return float_literal(mark) if self.is_float(f) else py_literal(int(mark))
 
-    def store(self, f: Field, expr: str, label: str, hi: Number | None = None) -> Call | str:
+    def store(self, f: Field, expr: str, label: str, hi: Number | None = None) -> str:
         """``expr`` (a float) as the field holds it: float16/float32, bool, or a rounded, clamped integer."""
         p = self.prim(f)
         if p is None:
             return expr
         if p.kind is PrimitiveKind.FLOAT:
             if p.bits == 16:
-                return Call("_r.f16", [expr, "rep", label])
+                return call("_r.f16", [expr, "rep", label])
             if p.bits == 32:
-                return Call("_r.f32", [expr])
+                return call("_r.f32", [expr])
             return expr
         if p.kind is PrimitiveKind.BOOL:
             return f"bool({expr})"
@@ -288,23 +285,23 @@ class RuleContext:
         if rng is None:
             return expr
         top = int(rng[1]) if hi is None else min(int(rng[1]), int(hi))
-        return Call("_r.to_int", [expr, literal(int(rng[0])), literal(top), "rep", label])
+        return call("_r.to_int", [expr, py_literal(int(rng[0])), py_literal(top), "rep", label])
 
-    def store_c(self, f: Field, expr: str, label: str) -> Call | str:
+    def store_c(self, f: Field, expr: str, label: str) -> str:
         """A C assignment of a float32 value to the field's type, then DroneCAN saturation."""
         p = self.prim(f)
         if p is None:
             raise BattgenError(f"{self.mapping.name}: {f.name} is not a number")
         if p.kind is PrimitiveKind.FLOAT:
-            return Call("_r.f16", [expr, "rep", label]) if p.bits == 16 else expr
+            return call("_r.f16", [expr, "rep", label]) if p.bits == 16 else expr
         if p.kind is PrimitiveKind.BOOL:
             return f"bool({expr})"
         signed = p.kind is PrimitiveKind.INT
         storage = next(b for b in (8, 16, 32, 64) if b >= p.bits)
-        out = Call("_r.c_float_to_int", [expr, str(storage), str(signed), "rep", label])
+        out = call("_r.c_float_to_int", [expr, str(storage), str(signed), "rep", label])
         if storage != p.bits:
             lo, hi = p.value_range or (0, 0)
-            return Call("_r.saturate", [out, str(int(lo)), str(int(hi))])
+            return call("_r.saturate", [out, str(int(lo)), str(int(hi))])
         return out
 
     def px4_read(self, ref: FieldRef, expr: str | None = None) -> str:
@@ -315,12 +312,14 @@ class RuleContext:
             return f'_r.f16(float({value}), None, "")'
         return f"_r.f32(float({value}))"
 
-    def emit_assign(self, target: str, value: Call | str, nest: int = 0) -> None:
-        """``target = value``, a call wrapped one argument per line when it does not fit."""
-        if isinstance(value, Call):
-            self.emit_call(f"{target} = {value.func}", value.args, nest)
-        else:
-            self.emit(f"{INDENT * nest}{target} = {value}")
+    def emit_assign(self, target: str, value: str, nest: int = 0) -> None:
+        """``target = value``, ``nest`` blocks into the rule's block."""
+        self.emit(f"{INDENT * nest}{target} = {value}")
+
+
+def call(func: str, args: list[str]) -> str:
+    """The call expression ``func(args)``."""
+    return f"{func}({', '.join(args)})"
 
 
 def factor(frm: Unit | None, to: Unit | None) -> tuple[float, float]:
@@ -333,9 +332,9 @@ def factor(frm: Unit | None, to: Unit | None) -> tuple[float, float]:
 def affine(expr: str, mul: float, add: float) -> str:
     out = expr
     if mul != 1.0:
-        out = f"{out} * {number(mul)}"
+        out = f"{out} * {float_literal(mul)}"
     if add != 0.0:
-        out = f"{out} + {number(add)}"
+        out = f"{out} + {float_literal(add)}"
     return out
 
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 from ....ir import Rule, units
 from ....ir.ops import DtPack, OcvSoc
 from .. import naming
+from ..literals import float_literal, py_literal
 from .context import RuleContext, constant_name, factor
-from .source import literal, number
 
 
 class DevicetreeEmitters(RuleContext):
@@ -29,8 +29,8 @@ class DevicetreeEmitters(RuleContext):
             f"_ch = {self.s(chem)}",
         )
         args = [
-            f"None if _hi is None else _hi * {number(mul_max)}",
-            f"None if _lo is None else _lo * {number(mul_min)}",
+            f"None if _hi is None else _hi * {float_literal(mul_max)}",
+            f"None if _lo is None else _lo * {float_literal(mul_min)}",
             "_ch",
             charged,
             empty,
@@ -57,12 +57,12 @@ class DevicetreeEmitters(RuleContext):
             f"_ts = {self.s(temps)}",
             f"_tb = {self.s(tables)}",
             f"if {voltage} is not None and _ts:",
-            f"    _tabs = [_x for _x in (_tb.get({literal(stem)} + str(_i)) for _i in range(len(_ts))) if _x]",
+            f"    _tabs = [_x for _x in (_tb.get({py_literal(stem)} + str(_i)) for _i in range(len(_ts))) if _x]",
             f"    _t = {temperature}",
             "    if _t is None and len(_ts) == 1:",
             "        _t = _ts[0]",
             "    if _t is not None and len(_tabs) == len(_ts):",
-            f"        _uv = round({voltage} * {number(to_uv)})",
+            f"        _uv = round({voltage} * {float_literal(to_uv)})",
             "        _cap = _r.ocv_to_capacity(_tabs, _ts, _uv, round(_t))",
-            f"        {self.t(rule.targets[0])} = _cap * {number(pct)}",
+            f"        {self.t(rule.targets[0])} = _cap * {float_literal(pct)}",
         )

@@ -14,15 +14,15 @@ from ....ir.mapping_values import ConstantRef
 from ....ir.mapping_visitor import OpVisitor, visit
 from ....ir.ops import Const
 from .. import naming
+from ..literals import comment, py_literal
 from .cells import CellEmitters
 from .choices import ChoiceEmitters
-from .context import Side, constant_name
+from .context import INDENT, Side, constant_name
 from .devicetree import DevicetreeEmitters
 from .messages import MessageEmitters
 from .numeric import NumericEmitters
 from .px4 import PX4Emitters
 from .px4_cells import PX4CellEmitters
-from .source import INDENT, comment, literal, number
 
 
 class FunctionBuilder(
@@ -76,7 +76,7 @@ class FunctionBuilder(
         sources = f" {spelled(rule.sources, file_sources)}" if rule.sources else ""
         if isinstance(rule.op, Const):  # the value is what a reader wants to see
             value = rule.op.value
-            sources = f" {value.name if isinstance(value, ConstantRef) else literal(value)}"
+            sources = f" {value.name if isinstance(value, ConstantRef) else py_literal(value)}"
         head = f"{where}{rule.op.NAME}{sources} -> {spelled(rule.targets, file_targets)}"
         return comment(head, INDENT) + (comment(rule.doc, INDENT) if rule.doc else [])
 
@@ -95,10 +95,10 @@ class FunctionBuilder(
         for (qualified, fname), mask in sorted(self.bit_masks.items()):
             ref = FieldRef(qualified, fname)
             var = f"{self.src.var(qualified)}.{self.attr(ref)}"
-            guard = f"rep_d is not None and {var} & {literal(~mask)}"
+            guard = f"rep_d is not None and {var} & {py_literal(~mask)}"
             if self.src.optional(qualified):
                 guard = f"{self.src.var(qualified)} is not None and {guard}"
-            self.emit(f"if {guard}:", f"    _b = {var} & {literal(~mask)}")
+            self.emit(f"if {guard}:", f"    _b = {var} & {py_literal(~mask)}")
             self.emit_call("rep_d.dropped", [self.label(ref), 'f"bits {_b:#x} have no counterpart"'], 1)
         if self.src.endpoint is None:
             unread = tuple(c for c in self.concepts if (CONCEPTS_ENDPOINT, c) not in self.read)
@@ -127,7 +127,7 @@ class FunctionBuilder(
                     f"    for _a, _n in {names}:",
                     f"        if _r.differs(getattr({var}, _a), getattr({default}, _a)):",
                 )
-                self.emit_call("rep_d.dropped", [f"{literal(qualified + '.')} + _n"], 3)
+                self.emit_call("rep_d.dropped", [f"{py_literal(qualified + '.')} + _n"], 3)
 
     def report_unknown(self) -> None:
         """Target fields no rule wrote, and between formats those left at their marker."""
@@ -150,11 +150,11 @@ class FunctionBuilder(
                 if f.invalid is None or (qualified, f.name) not in self.written:
                     continue
                 attr = f"{var}.{naming.field_identifier(f.name, f.pattern)}"
-                mark = number(f.invalid.value) if isinstance(f.invalid.value, float) else literal(f.invalid.value)
+                mark = py_literal(f.invalid.value)
                 test = (
                     f"all(_r.is_marker(_x, {mark}) for _x in {attr})"
                     if f.invalid.per_element
                     else f"_r.is_marker({attr}, {mark})"
                 )
                 self.emit(f"if rep_u is not None and {test}:")
-                self.emit_call("rep_u.unknown", [literal(f"{qualified}.{f.name}")], 1)
+                self.emit_call("rep_u.unknown", [py_literal(f"{qualified}.{f.name}")], 1)

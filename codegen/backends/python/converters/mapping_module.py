@@ -6,10 +6,11 @@ from dataclasses import dataclass
 
 from ....ir import CONCEPTS_ENDPOINT, Concept, Endpoint, Mapping, Schema
 from .. import naming
-from .classes import class_names
-from .context import ModuleConstants, Side
+from ..layout import format_module
+from ..literals import docstring
+from .classes import class_names, import_lines
+from .context import INDENT, ModuleConstants, Side
 from .function import FunctionBuilder
-from .source import INDENT, docstring, imports, signature, tidy
 
 # names a mapping module binds besides its message classes
 _TAKEN = ("BatteryState", "forward", "backward", "math")
@@ -67,18 +68,18 @@ def mapping_module(
         made.append(Edge(src_name, dst_name, module, fname, mapping, tuple(builder.inputs)))
     where = f" ({mapping.location})" if mapping.location else ""
     doc = docstring(f"Mapping {mapping.name}{where}, policy {mapping.policy}.\n\n{mapping.doc}", "")
-    code = [line for lines in functions for line in lines] + [line for c in constants.lines.values() for line in c]
+    consts = list(constants.lines.values())
+    code = [line for lines in functions for line in lines] + consts
     names = set(class_imports) | {(".", "_runtime", "_r")}
     if CONCEPTS_ENDPOINT in (mapping.source, mapping.target):
         names.add(("._concepts", "BatteryState", None))
     head = [header, doc, "", "from __future__ import annotations", ""]
     if any("math." in line for line in code if not line.lstrip().startswith("#")):
         head += ["import math", ""]
-    head += imports(names)
-    consts = [line for lines in constants.lines.values() for line in lines]
+    head += import_lines(names)
     text = "\n".join([*head, *(["", *consts] if consts else [])]) + "\n\n\n"
     text += "\n\n\n".join("\n".join(f) for f in functions)
-    return module, tidy(text), made
+    return module, format_module(text + "\n"), made
 
 
 def _function(b: FunctionBuilder, src: str, dst: str, body: list[str]) -> list[str]:
@@ -93,7 +94,7 @@ def _function(b: FunctionBuilder, src: str, dst: str, body: list[str]) -> list[s
     report = "_r.LossReport | None = None"
     params += ["*", f"rep: {report}", f"rep_d: {report}", f"rep_u: {report}"]
     params += [f"{name}: float | None = None" for name in b.inputs]
-    lines = signature(b.direction, params, f"tuple[{', '.join(dst_t)}]")
+    lines = [f"def {b.direction}({', '.join(params)}) -> tuple[{', '.join(dst_t)}]:"]
     lines.append(docstring(f"{src} -> {dst}: returns the target objects as a tuple.", INDENT))
     if b.dst.endpoint is None:
         lines.append(f"{INDENT}{b.dst.names[0]} = BatteryState()")

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from ....ir import CONCEPTS_ENDPOINT, ArrayType, PrimitiveKind, Rule, StringType
 from ....ir.ops import Const, Copy, Scale, SocHybrid
-from .context import RuleContext, affine, factor
-from .source import Call, literal, number
+from ..literals import py_literal
+from .context import RuleContext, affine, call, factor
 
-_WRITTEN_AS_MARKER = literal("a known value written as the unknown marker")
+_WRITTEN_AS_MARKER = py_literal("a known value written as the unknown marker")
 
 
 class NumericEmitters(RuleContext):
@@ -30,9 +30,9 @@ class NumericEmitters(RuleContext):
             tests = ["_v is not None"] if is_list else []
             tests += self.known_test("_v", marks)
             if op.valid_above is not None:
-                tests.append(f"_v > {literal(op.valid_above)}")
+                tests.append(f"_v > {py_literal(op.valid_above)}")
             if op.valid_max is not None:
-                tests.append(f"_v <= {literal(op.valid_max)}")
+                tests.append(f"_v <= {py_literal(op.valid_max)}")
             value = affine("float(_v)", mul, add)
             if tests:
                 self.emit(f"if {' and '.join(tests)}:", f"    {self.t(con)} = {value}")
@@ -56,7 +56,7 @@ class NumericEmitters(RuleContext):
             self.emit_assign(target, stored, 1)
         int_marks = [m for m in marks if m == m]
         if int_marks and not is_list:
-            self.emit(f"    if rep is not None and {target} in {literal(tuple(int_marks))}:")
+            self.emit(f"    if rep is not None and {target} in {py_literal(tuple(int_marks))}:")
             self.emit_call("rep.clamped", [label, _WRITTEN_AS_MARKER], 2)
 
     def visit_copy(self, rule: Rule, op: Copy) -> None:
@@ -70,7 +70,7 @@ class NumericEmitters(RuleContext):
             if kind == "text":
                 self.emit(f"{self.t(con)} = _r.text_in(_v)")
                 return
-            value = "bool(_v)" if kind == "bool" else f"_v + {literal(add)}" if add else "_v"
+            value = "bool(_v)" if kind == "bool" else f"_v + {py_literal(add)}" if add else "_v"
             tests = self.known_test("_v", marks)
             if tests:
                 self.emit(f"if {' and '.join(tests)}:", f"    {self.t(con)} = {value}")
@@ -90,12 +90,12 @@ class NumericEmitters(RuleContext):
                 self.emit(f"    {target} = _v")
             else:
                 cap = f.type.capacity if isinstance(f.type, ArrayType) else None
-                self.emit_assign(target, Call("_r.bytes_out", ["_v", literal(cap), "rep", label]), 1)
+                self.emit_assign(target, call("_r.bytes_out", ["_v", py_literal(cap), "rep", label]), 1)
             return
-        value = f"_v - {literal(add)}" if add else "_v"
+        value = f"_v - {py_literal(add)}" if add else "_v"
         self.emit_assign(target, self.store(f, value, label), 1)
         if marks and kind != "bool":
-            self.emit(f"    if rep is not None and {target} in {literal(tuple(marks))}:")
+            self.emit(f"    if rep is not None and {target} in {py_literal(tuple(marks))}:")
             self.emit_call("rep.clamped", [label, _WRITTEN_AS_MARKER], 2)
 
     def visit_const(self, rule: Rule, op: Const) -> None:
@@ -107,7 +107,7 @@ class NumericEmitters(RuleContext):
                     value = float(value)
                 if isinstance(value, str) and p is not None and p.kind is PrimitiveKind.UINT:
                     value = value.encode("utf-8")
-            self.emit(f"{self.t(ref)} = {number(value) if isinstance(value, float) else literal(value)}")
+            self.emit(f"{self.t(ref)} = {py_literal(value)}")
 
     def visit_soc_hybrid(self, rule: Rule, op: SocHybrid) -> None:
         remaining, full, percent = rule.sources
@@ -115,7 +115,7 @@ class NumericEmitters(RuleContext):
         mul, add = factor(f.unit, self.concepts[rule.targets[0].field].unit)
         tests = self.known_test("_p", self.markers(f, op.unknown))
         if op.valid_max is not None:
-            tests.append(f"_p <= {literal(op.valid_max)}")
+            tests.append(f"_p <= {py_literal(op.valid_max)}")
         target = self.t(rule.targets[0])
         self.emit(
             f"_e = {self.s(remaining)}",

@@ -10,8 +10,8 @@ from __future__ import annotations
 from ....errors import BattgenError
 from ....ir import FieldRef, PrimitiveKind, Rule, Unit, units
 from ....ir.ops import BitsFrom, EnumMap, PX4AuxCapacity, PX4Conversion, PX4Convert, PX4Form, PX4Int, PX4Warning
-from .context import FLT_EPS, RuleContext, constant_name, f32, factor
-from .source import Call, literal, number
+from ..literals import float_literal, py_literal
+from .context import FLT_EPS, RuleContext, call, constant_name, f32, factor
 
 
 class PX4Emitters(RuleContext):
@@ -36,23 +36,23 @@ class PX4Emitters(RuleContext):
             mul, add = su.factor_to(tu)
             if mul != 1.0:
                 if op.form is PX4Form.DIVIDE:
-                    self.emit(f"_x = _r.f32(_x / {number(f32(1.0 / mul))})")
+                    self.emit(f"_x = _r.f32(_x / {float_literal(f32(1.0 / mul))})")
                 else:
-                    self.emit(f"_x = _r.f32(_x * {number(f32(mul))})")
+                    self.emit(f"_x = _r.f32(_x * {float_literal(f32(mul))})")
             if add != 0.0:
-                self.emit(f"_x = _r.f32(_x + {number(f32(add))})")
+                self.emit(f"_x = _r.f32(_x + {float_literal(f32(add))})")
         if op.round:
             self.emit("_x = _r.roundf(_x)")
         value = self.store_c(f_dst, "_x", label)
         if op.at_least is not None:
-            value = Call("max", [value, literal(op.at_least)])
+            value = call("max", [value, py_literal(op.at_least)])
         tests = []
         if op.guard is not None:
             tests.append(self.s(FieldRef(src.message, op.guard)))
         if op.finite:
             tests.append("math.isfinite(_x)")
         if op.above is not None:
-            tests.append(f"_x > {number(f32(float(op.above)))}")
+            tests.append(f"_x > {float_literal(f32(float(op.above)))}")
         target = self.t(dst)
         if not tests:
             self.emit_assign(target, value)
@@ -60,17 +60,15 @@ class PX4Emitters(RuleContext):
         otherwise = self.value_of(op.otherwise if op.otherwise is not None else 0, [dst])
         self.emit(f"if {' and '.join(tests)}:")
         self.emit_assign(target, value, 1)
-        self.emit(
-            "else:", f"    {target} = {number(otherwise) if isinstance(otherwise, float) else literal(otherwise)}"
-        )
+        self.emit("else:", f"    {target} = {py_literal(otherwise)}")
 
     def visit_px4_int(self, rule: Rule, op: PX4Int) -> None:
         src, dst = rule.sources[0], rule.targets[0]
         expr = f"int({self.s(src)})"
         if op.mask is not None:
-            expr = f"({expr} & {literal(self.mask(op.mask, [src]))})"
+            expr = f"({expr} & {py_literal(self.mask(op.mask, [src]))})"
         if op.add:
-            expr = f"{expr} - {literal(-op.add)}" if op.add < 0 else f"{expr} + {literal(op.add)}"
+            expr = f"{expr} - {py_literal(-op.add)}" if op.add < 0 else f"{expr} + {py_literal(op.add)}"
         prim = self.prim(self.fld(dst))
         if prim is None:
             raise BattgenError(f"{self.mapping.name}: {dst.field} is not a number")
@@ -78,10 +76,10 @@ class PX4Emitters(RuleContext):
             self.emit(f"{self.t(dst)} = bool({expr})")
             return
         storage = next(b for b in (8, 16, 32, 64) if b >= prim.bits)
-        value = Call("_r.c_wrap", [expr, str(storage), str(prim.kind is PrimitiveKind.INT)])
+        value = call("_r.c_wrap", [expr, str(storage), str(prim.kind is PrimitiveKind.INT)])
         if storage != prim.bits:
             lo, hi = prim.value_range or (0, 0)
-            value = Call("_r.saturate", [value, str(int(lo)), str(int(hi))])
+            value = call("_r.saturate", [value, str(int(lo)), str(int(hi))])
         self.emit_assign(self.t(dst), value)
 
     def visit_px4_warning(self, rule: Rule, op: PX4Warning) -> None:
@@ -92,15 +90,15 @@ class PX4Emitters(RuleContext):
         chain = (("if", "emergency", op.emergency), ("elif", "critical", op.critical), ("elif", "low", op.low))
         for keyword, name, threshold in chain:
             value = self.constant_value(f"WARNING_{name.upper()}", [dst])
-            self.emit(f"{keyword} _s < {number(f32(float(threshold)))}:", f"    {target} = {literal(value)}")
-        self.emit("else:", f"    {target} = {literal(self.constant_value('WARNING_NONE', [dst]))}")
+            self.emit(f"{keyword} _s < {float_literal(f32(float(threshold)))}:", f"    {target} = {py_literal(value)}")
+        self.emit("else:", f"    {target} = {py_literal(self.constant_value('WARNING_NONE', [dst]))}")
 
     def visit_enum_map(self, rule: Rule, op: EnumMap) -> None:
         src, dst = rule.sources[0], rule.targets[0]
         table = {self.value_of(pair.source, [src]): self.value_of(pair.target, [dst]) for pair in op.map}
         default = self.value_of(op.default if op.default is not None else 0, [dst])
         by_value = self.const(constant_name(dst.field, "by", src.field), table)
-        self.emit(f"{self.t(dst)} = {by_value}.get({self.s(src)}, {literal(default)})")
+        self.emit(f"{self.t(dst)} = {by_value}.get({self.s(src)}, {py_literal(default)})")
 
     def visit_bits_from(self, rule: Rule, op: BitsFrom) -> None:
         dst = rule.targets[0]
@@ -109,8 +107,8 @@ class PX4Emitters(RuleContext):
             src = FieldRef(rule.sources[0].message, bit.field)
             cond = self.s(src)
             if bit.equals is not None:
-                cond = f"{cond} == {literal(self.value_of(bit.equals, [src]))}"
-            self.emit(f"if {cond}:", f"    _b |= {literal(self.mask(bit.mask, [dst]))}")
+                cond = f"{cond} == {py_literal(self.value_of(bit.equals, [src]))}"
+            self.emit(f"if {cond}:", f"    _b |= {py_literal(self.mask(bit.mask, [dst]))}")
         self.emit(f"{self.t(dst)} = _b")
 
     def visit_px4_aux_capacity(self, rule: Rule, op: PX4AuxCapacity) -> None:
@@ -120,6 +118,6 @@ class PX4Emitters(RuleContext):
         # Wh / V is Ah; the factor to the target's unit (mAh) comes from the unit registry
         mul, _ = factor(units.lookup("Ah"), f_dst.unit)
         eps = f32(float(op.above if op.above is not None else FLT_EPS))
-        value = f"_r.f32(_r.f32({self.px4_read(energy)} * {number(f32(mul))}) / _v)"
-        self.emit(f"_v = {self.px4_read(voltage)}", f"if _v > {number(eps)}:")
+        value = f"_r.f32(_r.f32({self.px4_read(energy)} * {float_literal(f32(mul))}) / _v)"
+        self.emit(f"_v = {self.px4_read(voltage)}", f"if _v > {float_literal(eps)}:")
         self.emit_assign(self.t(dst), self.store_c(f_dst, value, self.label(dst)), 1)

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from ....ir import Rule
 from ....ir.ops import PX4BridgeCells, PX4CellList, PX4ReceiverCells, PX4StreamCells
+from ..literals import float_literal
 from .context import RuleContext, array_type, f32, factor
-from .source import number
 
 
 class PX4CellEmitters(RuleContext):
@@ -17,7 +17,8 @@ class PX4CellEmitters(RuleContext):
         mul, _ = factor(self.fld(cells).unit, mf.unit)
         fill = int(mf.invalid.value) if mf.invalid is not None else 0xFFFF
         threshold = f32(float(op.cell_threshold if op.cell_threshold is not None else 0.0001))
-        args = [self.s(volt), self.s(cells), self.s(count), self.s(connected), number(f32(mul)), number(threshold)]
+        numbers = [float_literal(f32(mul)), float_literal(threshold)]
+        args = [self.s(volt), self.s(cells), self.s(count), self.s(connected), *numbers]
         sizes = [str(array_type(mf).capacity), str(array_type(ef).capacity), str(fill), "0"]
         self.emit_call(f"{self.t(main)}, {self.t(ext)} = _r.px4_stream_cells", [*args, *sizes, "rep", self.label(main)])
 
@@ -27,7 +28,7 @@ class PX4CellEmitters(RuleContext):
         vf, cf = self.fld(volts), self.fld(cells)
         mul, _ = factor(vf.unit, cf.unit)
         mark = int(vf.invalid.value) if vf.invalid is not None else 0xFFFF
-        args = [self.s(volts), str(array_type(cf).capacity), str(mark), number(f32(1.0 / mul))]
+        args = [self.s(volts), str(array_type(cf).capacity), str(mark), float_literal(f32(1.0 / mul))]
         self.emit_call("_c, _n, _t = _r.px4_receiver_cells", args)
         self.emit(f"{self.t(cells)} = _c", f"{self.t(count)} = _n", f"{self.t(total)} = _t")
 

@@ -14,9 +14,11 @@ from dataclasses import dataclass
 from ....errors import BattgenError
 from ....ir import CONCEPTS_ENDPOINT, Endpoint, Schema
 from .. import naming
-from .classes import Import, class_names
+from ..layout import format_module
+from ..literals import docstring, py_literal
+from .classes import Import, class_names, import_lines
+from .context import INDENT, call
 from .mapping_module import Edge
-from .source import INDENT, bracketed, call, docstring, imports, literal, signature, tidy, value_lines
 
 PACKAGE = "convert"
 POLICIES = ("strict", "px4")
@@ -105,8 +107,9 @@ class Routes:
             self.converters.append(Converter(s, t, module, fname, policies, inputs))
         if not functions:
             return
-        head = [self.header, docstring(doc, ""), "", "from __future__ import annotations", "", *imports(used)]
-        self.files[f"{PACKAGE}/{module}.py"] = tidy("\n".join([*head, "", "", ""]) + "\n\n\n".join(functions))
+        head = [self.header, docstring(doc, ""), "", "from __future__ import annotations", "", *import_lines(used)]
+        text = "\n".join([*head, "", "", ""]) + "\n\n\n".join(functions) + "\n"
+        self.files[f"{PACKAGE}/{module}.py"] = format_module(text)
 
     def function(
         self, fname: str, source: str, target: str, routes: dict[str, list[Edge] | None], classes: dict[str, str]
@@ -133,13 +136,12 @@ class Routes:
             how = " -> ".join(f"{e.mapping.name} ({e.function})" for e in r) if r else "not available"
             docs.append(f"{p}: {how}")
         docs += ["", "Pass a LossReport as report to learn what did not survive."]
-        lines = [*signature(fname, params, returns), docstring("\n".join(docs), INDENT)]
+        lines = [f"def {fname}({', '.join(params)}) -> {returns}:", docstring("\n".join(docs), INDENT)]
         for p, r in routes.items():
-            lines.append(f"{INDENT}if policy == {literal(p)}:")
+            lines.append(f"{INDENT}if policy == {py_literal(p)}:")
             if r is None:
-                lines += call(
-                    "raise _r.ConversionError", [literal(_NO_ROUTE.format(p=p, s=source, t=target))], INDENT * 2
-                )
+                no_route = py_literal(_NO_ROUTE.format(p=p, s=source, t=target))
+                lines.append(f"{INDENT * 2}raise _r.ConversionError({no_route})")
             else:
                 lines += self.calls(r, args, inputs, single, p)
         expected = " or ".join(POLICIES)
@@ -159,7 +161,7 @@ class Routes:
             given += ["rep=report", f"rep_d={rep_d}", f"rep_u={rep_u}"]
             given += [f"{n}={n}" for n in e.inputs if n in inputs] if first else []
             result = f"_{naming.identifier(policy)}_{i + 1}"
-            out += call(f"{result} = {e.module}.{e.function}", given, INDENT * 2)
+            out.append(f"{INDENT * 2}{result} = {call(f'{e.module}.{e.function}', given)}")
             after_px4 = after_px4 or e.mapping.policy == "px4"
         out.append(f"{INDENT * 2}return {result}[0]" if single else f"{INDENT * 2}return {result}")
         return out
@@ -177,12 +179,13 @@ class Routes:
             return f"({pairs[0]},)" if len(pairs) == 1 else f"({', '.join(pairs)})"
 
         endpoint_items = [
-            f"{literal(name)}: "
-            + objects([f"({literal(a)}, {classes[q]})" for a, q in zip(ep.aliases, ep.messages, strict=True)])
+            f"{py_literal(name)}: "
+            + objects([f"({py_literal(a)}, {classes[q]})" for a, q in zip(ep.aliases, ep.messages, strict=True)])
             for name, ep in self.endpoints.items()
         ]
-        endpoint_items.append(f"{literal(CONCEPTS_ENDPOINT)}: {objects(['(' + literal('state') + ', BatteryState)'])}")
-        pairs = [(literal((c.source, c.target)), c) for c in self.converters]
+        state = f"({py_literal('state')}, BatteryState)"
+        endpoint_items.append(f"{py_literal(CONCEPTS_ENDPOINT)}: {objects([state])}")
+        pairs = [(py_literal((c.source, c.target)), c) for c in self.converters]
         exported = ["CONVERTERS", "ENDPOINTS", "INPUTS", "POLICIES", "BatteryState", "ConversionError"]
         exported += ["LossEntry", "LossReport", "converter"]
         lines = [
@@ -200,33 +203,24 @@ class Routes:
             "from collections.abc import Callable",
             "from typing import Any",
             "",
-            *imports(used),
+            *import_lines(used),
             "",
-            *value_lines("__all__ = ", exported),
+            f"__all__ = {py_literal(exported)}",
             "",
             "# each endpoint's objects in order: the first required, the rest optional companions",
-            *bracketed("ENDPOINTS: dict[str, tuple[tuple[str, type[Any]], ...]] = {", endpoint_items, "}", ""),
+            "ENDPOINTS: dict[str, tuple[tuple[str, type[Any]], ...]] = {" + ", ".join(endpoint_items) + "}",
             "",
-            *bracketed(
-                "CONVERTERS: dict[tuple[str, str], Callable[..., Any]] = {",
-                [f"{k}: {c.module}.{c.function}" for k, c in pairs],
-                "}",
-                "",
-            ),
+            "CONVERTERS: dict[tuple[str, str], Callable[..., Any]] = {"
+            + ", ".join(f"{k}: {c.module}.{c.function}" for k, c in pairs)
+            + "}",
             "",
             "# the policies each converter supports, and the extra keyword inputs it accepts",
-            *bracketed(
-                "POLICIES: dict[tuple[str, str], tuple[str, ...]] = {",
-                [f"{k}: {literal(c.policies)}" for k, c in pairs],
-                "}",
-                "",
-            ),
-            *bracketed(
-                "INPUTS: dict[tuple[str, str], tuple[str, ...]] = {",
-                [f"{k}: {literal(c.inputs)}" for k, c in pairs if c.inputs],
-                "}",
-                "",
-            ),
+            "POLICIES: dict[tuple[str, str], tuple[str, ...]] = {"
+            + ", ".join(f"{k}: {py_literal(c.policies)}" for k, c in pairs)
+            + "}",
+            "INPUTS: dict[tuple[str, str], tuple[str, ...]] = {"
+            + ", ".join(f"{k}: {py_literal(c.inputs)}" for k, c in pairs if c.inputs)
+            + "}",
             "",
             "",
             "def converter(source: str, target: str) -> Callable[..., Any]:",
@@ -237,4 +231,4 @@ class Routes:
             '        raise ConversionError(f"no converter from {source!r} to {target!r} (known: {pairs})")',
             "    return found",
         ]
-        return tidy("\n".join(lines) + "\n")
+        return format_module("\n".join(lines) + "\n")

@@ -107,25 +107,12 @@ class LayoutContext:
         group_id = d.new_group_id()
         with self.at(Level("expression", group_id)):
             inner = content()
-        return d.group(
-            d.if_group_breaks("("),
-            d.indent_if_group_breaks(Line.SOFT, inner, group_id=group_id),
-            Line.SOFT,
-            d.if_group_breaks(")"),
-            group_id=group_id,
-        )
+        return _parentheses_if_breaks(inner, group_id)
 
     def parenthesize_if_expands(self, content: Callable[[], list[Element]]) -> list[Element]:
         with self.at(PARENTHESIZED):
             inner = content()
-        group_id = d.new_group_id()
-        return d.group(
-            d.if_group_breaks("("),
-            d.indent_if_group_breaks(Line.SOFT, inner, group_id=group_id),
-            Line.SOFT,
-            d.if_group_breaks(")"),
-            group_id=group_id,
-        )
+        return _parentheses_if_breaks(inner, d.new_group_id())
 
     def comma_separated(self, items: list[list[Element]], bracketed: ast.AST | None) -> list[Element]:
         """Items joined by commas that break; a trailing comma when broken (and a magic one kept)."""
@@ -228,3 +215,14 @@ class LayoutContext:
         if isinstance(node, ast.GeneratorExp):
             return Needs.NEVER
         return Needs.MULTILINE
+
+
+def _parentheses_if_breaks(inner: list[Element], group_id: int) -> list[Element]:
+    """``inner`` in a group (``group_id``) that shows parentheses, and indents, only when it breaks."""
+    return d.group(
+        d.if_group_breaks("("),
+        d.indent_if_group_breaks(Line.SOFT, inner, group_id=group_id),
+        Line.SOFT,
+        d.if_group_breaks(")"),
+        group_id=group_id,
+    )

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import ast
 import io
+import keyword
+import re
 import tokenize
 
 from .document import Element
@@ -17,6 +19,11 @@ _INDENT = 4
 _SIMPLE = ast.Expr | ast.Assign | ast.AnnAssign | ast.AugAssign | ast.Return | ast.Raise | ast.ImportFrom
 _HEADERS = ast.If | ast.While | ast.For
 _DEFS = ast.FunctionDef | ast.AsyncFunctionDef
+# what may need normalising on a line that fits: a string, a number, a comma that ends a
+# collection (before a closing bracket, or after the one element of a tuple: a comma followed by
+# anything that cannot start an expression)
+_MAYBE_UNNORMALISED = re.compile(r"""['"]|(?<![\w.])\.?\d|,\s*(?:$|[^\s\w(\[{\-+~*.]|(?:in|if|else|for)\b)""")
+_OPENING = re.compile(r"(\w*)\(")
 
 
 def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
@@ -52,8 +59,9 @@ def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
         if rest:
             continue
         simple_enough = not isinstance(node, _DEFS) and not (isinstance(node, ast.ImportFrom) and "(" in line)
-        if first == last and len(line) <= line_length and simple_enough and _as_written(node, line):
-            continue
+        if first == last and len(line) <= line_length and simple_enough:
+            if _plainly_written(line) or _as_written(node, line):
+                continue
         try:
             if first == last:
                 document = _document(node, Source(line, *_roots(node)), line)
@@ -79,6 +87,22 @@ def format_module(text: str, line_length: int = LINE_LENGTH) -> str:
             out.append(lines[row])
             row += 1
     return "\n".join(out)
+
+
+def _plainly_written(line: str) -> bool:
+    """A quick test, on the text alone, that a line needs nothing :func:`_as_written` looks for: no
+    literal to respell, no trailing comma, only call parentheses (after a name that is not a
+    keyword, or after a closing bracket). Most lines pass it and need no walk over their AST."""
+    if not line.isascii() or _MAYBE_UNNORMALISED.search(line):
+        return False
+    for match in _OPENING.finditer(line):
+        name, at = match.group(1), match.start()
+        if name:
+            if keyword.iskeyword(name) or keyword.issoftkeyword(name):
+                return False
+        elif at == 0 or line[at - 1] not in ")]":
+            return False
+    return True
 
 
 def _as_written(node: ast.stmt, line: str) -> bool:
