@@ -7,15 +7,14 @@ The battery failsafe evaluates battery data from any format through it.
 from __future__ import annotations
 
 import dataclasses
-import math
-from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import ClassVar
 
-from . import _runtime as _r
+from ._state import ConceptState
 
 
+# to_dict() and from_dict() come from ConceptState (runtime/convert/_state.py), over KINDS and CHOICES
 @dataclasses.dataclass(slots=True)
-class BatteryState:
+class BatteryState(ConceptState):
     """One battery's state in the shared concepts (see schemas/mappings/concepts.yaml)."""
 
     UNITS: ClassVar[dict[str, str | None]] = {
@@ -181,43 +180,3 @@ class BatteryState:
     """Discharge level, for warnings and failsafes."""
     faults: tuple[str, ...] | None = None
     """Fault conditions currently reported."""
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain data keyed by concept name (lists for cells and flags, None for unknown)."""
-        out: dict[str, Any] = {}
-        for name in self.KINDS:
-            value = getattr(self, name)
-            out[name] = list(value) if isinstance(value, tuple) else value
-        return out
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryState:
-        """Build from plain data; unknown keys and ill-typed values raise ConversionError."""
-        obj = cls()
-        for name, value in data.items():
-            kind = cls.KINDS.get(name)
-            if kind is None:
-                raise _r.ConversionError(f"{name}: not a battery concept")
-            choices = cls.CHOICES.get(name, ())
-            setattr(obj, name, None if value is None else _coerce(name, kind, value, choices))
-        return obj
-
-
-def _coerce(name: str, kind: str, value: Any, choices: tuple[str, ...]) -> Any:
-    if kind == "number" and isinstance(value, int | float) and not isinstance(value, bool):
-        return float(value)
-    if kind == "number" and value in ("NaN", "nan"):
-        return math.nan
-    if kind == "integer" and isinstance(value, int) and not isinstance(value, bool):
-        return value
-    if kind == "bool" and isinstance(value, bool):
-        return value
-    if kind == "text" and isinstance(value, str):
-        return value
-    if kind == "choice" and value in choices:
-        return value
-    if kind == "list" and isinstance(value, list | tuple):
-        return tuple(_coerce(name, "number", v, ()) for v in value)
-    if kind == "flags" and isinstance(value, list | tuple) and all(v in choices for v in value):
-        return tuple(c for c in choices if c in value)
-    raise _r.ConversionError(f"{name}: expected a {kind} value, got {value!r}")

@@ -3,6 +3,7 @@
 Layout of the generated package:
 
 - ``convert/_runtime.py``  the loss report and numeric helpers (copied from ``runtime/convert/_runtime.py``)
+- ``convert/_state.py``    ``BatteryState``'s base: plain data in and out (copied from ``runtime/convert/_state.py``)
 - ``convert/_concepts.py`` ``BatteryState``: the shared concepts as a dataclass (SI units, None = unknown)
 - ``convert/_map_<mapping>.py`` one function per direction of each mapping (``forward``/``backward``)
 - ``convert/<endpoint>.py``  ``to_concepts`` / ``from_concepts`` for each format with a concept mapping
@@ -60,7 +61,7 @@ class _Generator:
         self.files[f"{PACKAGE}/__init__.py"] = registry.init_module()
 
     def render(self) -> dict[str, str]:
-        self.files.update(copied(f"{PACKAGE}/_runtime.py"))
+        self.files.update(copied(f"{PACKAGE}/_runtime.py", f"{PACKAGE}/_state.py"))
         self.concepts_module()
         for mapping in _mappings(self.schema):
             self.mapping_module(mapping)
