@@ -7,6 +7,7 @@ A simple-battery node describes a new pack, so its design figures are also its f
 from __future__ import annotations
 
 from ..devicetree.power.supply import SimpleBattery
+from . import _cells
 from . import _runtime as _r
 from ._concepts import BatteryState
 
@@ -85,32 +86,32 @@ def forward(
         rep_d.dropped("devicetree.power.supply.battery.device-chemistry", f"{_v1!r} has no counterpart")
 
     # devicetree.yaml:21: scale voltage-min-design-microvolt -> voltage_min_design
-    _v2 = _r.dt_first(s_node.voltage_min_design_microvolt)
+    _v2 = _cells.dt_first(s_node.voltage_min_design_microvolt)
     if _v2 is not None:
         t.voltage_min_design = float(_v2) * 1e-06
 
     # devicetree.yaml:22: scale voltage-max-design-microvolt -> voltage_max_design
-    _v3 = _r.dt_first(s_node.voltage_max_design_microvolt)
+    _v3 = _cells.dt_first(s_node.voltage_max_design_microvolt)
     if _v3 is not None:
         t.voltage_max_design = float(_v3) * 1e-06
 
     # devicetree.yaml:23: scale energy-full-design-microwatt-hours -> design_energy
-    _v4 = _r.dt_first(s_node.energy_full_design_microwatt_hours)
+    _v4 = _cells.dt_first(s_node.energy_full_design_microwatt_hours)
     if _v4 is not None:
         t.design_energy = float(_v4) * 0.0036
 
     # devicetree.yaml:24: scale energy-full-design-microwatt-hours -> full_energy
-    _v5 = _r.dt_first(s_node.energy_full_design_microwatt_hours)
+    _v5 = _cells.dt_first(s_node.energy_full_design_microwatt_hours)
     if _v5 is not None:
         t.full_energy = float(_v5) * 0.0036
 
     # devicetree.yaml:25: scale charge-full-design-microamp-hours -> design_capacity
-    _v6 = _r.dt_first(s_node.charge_full_design_microamp_hours)
+    _v6 = _cells.dt_first(s_node.charge_full_design_microamp_hours)
     if _v6 is not None:
         t.design_capacity = float(_v6) * 0.0036
 
     # devicetree.yaml:26: scale charge-full-design-microamp-hours -> full_capacity
-    _v7 = _r.dt_first(s_node.charge_full_design_microamp_hours)
+    _v7 = _cells.dt_first(s_node.charge_full_design_microamp_hours)
     if _v7 is not None:
         t.full_capacity = float(_v7) * 0.0036
 
@@ -118,10 +119,10 @@ def forward(
     # cell_count, nominal_voltage
     # Cells = design voltage / the chemistry's cell voltage (charged for the maximum, else empty for the minimum), to
     # the nearest whole cell; nominal = cells x the chemistry's nominal cell voltage.
-    _hi8 = _r.dt_first(s_node.voltage_max_design_microvolt)
-    _lo8 = _r.dt_first(s_node.voltage_min_design_microvolt)
+    _hi8 = _cells.dt_first(s_node.voltage_max_design_microvolt)
+    _lo8 = _cells.dt_first(s_node.voltage_min_design_microvolt)
     _ch8 = s_node.device_chemistry
-    _n8 = _r.cells_from_design(
+    _n8 = _cells.cells_from_design(
         None if _hi8 is None else _hi8 * 1e-06,
         None if _lo8 is None else _lo8 * 1e-06,
         _ch8,
@@ -146,7 +147,7 @@ def forward(
             _t9 = _ts9[0]
         if _t9 is not None and len(_tabs9) == len(_ts9):
             _uv9 = round(ocv_v * 1000000.0)
-            _cap9 = _r.ocv_to_capacity(_tabs9, _ts9, _uv9, round(_t9))
+            _cap9 = _cells.ocv_to_capacity(_tabs9, _ts9, _uv9, round(_t9))
             t.state_of_charge = _cap9 * 0.01
 
     # what did not survive the conversion

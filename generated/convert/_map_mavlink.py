@@ -7,6 +7,7 @@ The MAVLink BATTERY_STATUS message.
 from __future__ import annotations
 
 from ..mavlink import BatteryStatus
+from . import _cells
 from . import _runtime as _r
 from ._concepts import BatteryState
 
@@ -111,7 +112,7 @@ def forward(
     # Cells 1-10 (UINT16_MAX = none) then 11-14 (0 = none, a measured 0 sent as 1). Without per-cell data cell 1 holds
     # the pack voltage, spilling UINT16_MAX - 1 mV chunks into the next cells; a lone entry or a spill is read as the
     # pack voltage, cells unknown.
-    _c4, _p4 = _r.mavlink_cells_in(s_msg.voltages, s_msg.voltages_ext, 65535, 0, 65534)
+    _c4, _p4 = _cells.mavlink_cells_in(s_msg.voltages, s_msg.voltages_ext, 65535, 0, 65534)
     if _p4 is not None:
         t.pack_voltage = float(_p4) * 0.001
     if _c4 is not None:
@@ -218,7 +219,7 @@ def backward(
     # pack voltage, cells unknown.
     _c4 = s.cell_voltages
     _p4 = s.pack_voltage
-    t_msg.voltages, t_msg.voltages_ext = _r.mavlink_cells_out(
+    t_msg.voltages, t_msg.voltages_ext = _cells.mavlink_cells_out(
         None if _c4 is None else [_x4 * 1000.0 for _x4 in _c4],
         None if _p4 is None else _p4 * 1000.0,
         10,

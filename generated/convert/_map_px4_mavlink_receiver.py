@@ -10,6 +10,7 @@ import math
 
 from ..mavlink import BatteryStatus as MavlinkBatteryStatus
 from ..uorb import BatteryStatus as UorbBatteryStatus
+from . import _cells
 from . import _runtime as _r
 
 _UNREAD_MSG_FIELDS = (
@@ -83,7 +84,7 @@ def forward(
     # px4_mavlink_receiver.yaml:12: px4_receiver_cells voltages -> voltage_cell_v, cell_count, voltage_v
     # Cells while below UINT16_MAX (at most 10): voltage_cell_v[i] = v / 1000.0f, summed in float32 into voltage_v;
     # voltages_ext is not read.
-    _c2, _n2, _t2 = _r.px4_receiver_cells(s_msg.voltages, 14, 65535, 1000.0)
+    _c2, _n2, _t2 = _cells.px4_receiver_cells(s_msg.voltages, 14, 65535, 1000.0)
     t_status.voltage_cell_v = _c2
     t_status.cell_count = _n2
     t_status.voltage_v = _t2

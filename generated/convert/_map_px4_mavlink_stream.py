@@ -10,6 +10,7 @@ import math
 
 from ..mavlink import BatteryStatus as MavlinkBatteryStatus
 from ..uorb import BatteryStatus as UorbBatteryStatus
+from . import _cells
 from . import _runtime as _r
 
 _CHARGE_STATE_BY_WARNING = {0: 1, 1: 2, 2: 3, 3: 4, 4: 5, 6: 6, 7: 7}
@@ -137,7 +138,7 @@ def forward(
     # voltages all UINT16_MAX, voltages_ext all 0; if connected: with cell_count 0 or cell 0 below 0.0001 V the pack
     # voltage in mV goes into cell 1, split into UINT16_MAX - 1 chunks when it does not fit (left unknown beyond 10
     # fields), else min(cell_count, 14) cells x 1000.f.
-    t_msg.voltages, t_msg.voltages_ext = _r.px4_stream_cells(
+    t_msg.voltages, t_msg.voltages_ext = _cells.px4_stream_cells(
         s_status.voltage_v,
         s_status.voltage_cell_v,
         s_status.cell_count,

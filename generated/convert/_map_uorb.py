@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 from ..uorb import BatteryStatus
+from . import _cells
 from . import _runtime as _r
 from ._concepts import BatteryState
 
@@ -162,7 +163,7 @@ def forward(
     # uorb.yaml:20: cells voltage_cell_v -> cell_voltages
     _c10 = list(s_status.voltage_cell_v)
     _n10 = s_status.cell_count
-    _c10 = _c10[:_n10] if _n10 else _r.leading(_c10, 0.0)
+    _c10 = _c10[:_n10] if _n10 else _cells.leading(_c10, 0.0)
     t.cell_voltages = tuple(math.nan if _r.is_marker(_x10, 0.0) else float(_x10) for _x10 in _c10) or None
 
     # uorb.yaml:21: scale capacity -> full_capacity

@@ -20,7 +20,16 @@ from hypothesis import strategies as st
 from codegen.apps import ocv
 from codegen.frontends import mappings
 from codegen.frontends.loader import load
-from generated.convert import CONVERTERS, ENDPOINTS, POLICIES, BatteryState, ConversionError, LossReport, converter
+from generated.convert import (
+    CONVERTERS,
+    ENDPOINTS,
+    POLICIES,
+    BatteryState,
+    ConversionError,
+    LossReport,
+    _cells,
+    converter,
+)
 from generated.convert import _runtime as rt
 from generated.convert.dronecan import from_concepts as dronecan_from_concepts
 from generated.convert.dronecan import to_concepts as dronecan_to_concepts
@@ -239,7 +248,7 @@ def test_ocv_state_of_charge_agrees_with_the_kernel_model(ocv_uv: int, temp: int
     expected = ocv.ocv_to_capacity(*ocv.tables_from_properties(NODE), ocv_uv, temp)
     out = devicetree_to_uorb(node, ocv_v=ocv_uv / 1e6, temperature_c=temp)
     assert round(out.remaining * 100) == expected
-    assert rt.ocv_to_capacity(*ocv.tables_from_properties(NODE), ocv_uv, temp) == expected
+    assert _cells.ocv_to_capacity(*ocv.tables_from_properties(NODE), ocv_uv, temp) == expected
 
 
 # -- round trips -----------------------------------------------------------------------------

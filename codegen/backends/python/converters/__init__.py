@@ -3,6 +3,7 @@
 Layout of the generated package:
 
 - ``convert/_runtime.py``  the loss report and numeric helpers (copied from ``runtime/convert/_runtime.py``)
+- ``convert/_cells.py``    the array algorithms the mappings name (copied from ``runtime/convert/_cells.py``)
 - ``convert/_state.py``    ``BatteryState``'s base: plain data in and out (copied from ``runtime/convert/_state.py``)
 - ``convert/_concepts.py`` ``BatteryState``: the shared concepts as a dataclass (SI units, None = unknown)
 - ``convert/_map_<mapping>.py`` one function per direction of each mapping (``forward``/``backward``)
@@ -61,7 +62,7 @@ class _Generator:
         self.files[f"{PACKAGE}/__init__.py"] = registry.init_module()
 
     def render(self) -> dict[str, str]:
-        self.files.update(copied(f"{PACKAGE}/_runtime.py", f"{PACKAGE}/_state.py"))
+        self.files.update(copied(f"{PACKAGE}/_runtime.py", f"{PACKAGE}/_cells.py", f"{PACKAGE}/_state.py"))
         self.concepts_module()
         for mapping in _mappings(self.schema):
             self.mapping_module(mapping)

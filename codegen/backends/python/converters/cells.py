@@ -21,9 +21,11 @@ class CellEmitters(RuleContext):
             mul, add = factor(f_unit, c_unit)
             self.emit(f"_c = list({self.s(fmt)})")
             if count_ref is not None:
-                self.emit(f"_n = {self.s(count_ref)}", f"_c = _c[:_n] if _n else _r.leading(_c, {py_literal(mark)})")
+                self.emit(
+                    f"_n = {self.s(count_ref)}", f"_c = _c[:_n] if _n else _cells.leading(_c, {py_literal(mark)})"
+                )
             elif mark is not None:
-                self.emit(f"_c = _r.leading(_c, {py_literal(mark)})")
+                self.emit(f"_c = _cells.leading(_c, {py_literal(mark)})")
             conv = affine("float(_x)", mul, add)
             if mark is not None:
                 conv = f"math.nan if _r.is_marker(_x, {py_literal(mark)}) else {conv}"
@@ -67,7 +69,7 @@ class CellEmitters(RuleContext):
         if not self.backward:
             mul, add = factor(main_f.unit, v_unit)
             marks = [str(main_mark), str(ext_mark), str(main_mark - 1)]
-            self.emit_call("_c, _p = _r.mavlink_cells_in", [self.s(main_ref), self.s(ext_ref), *marks])
+            self.emit_call("_c, _p = _cells.mavlink_cells_in", [self.s(main_ref), self.s(ext_ref), *marks])
             self.emit(
                 "if _p is not None:",
                 f"    {self.t(pack)} = {affine('float(_p)', mul, add)}",
@@ -85,4 +87,4 @@ class CellEmitters(RuleContext):
             self.label(main_ref),
             self.label(ext_ref),
         ]
-        self.emit_call(f"{self.t(main_ref)}, {self.t(ext_ref)} = _r.mavlink_cells_out", args)
+        self.emit_call(f"{self.t(main_ref)}, {self.t(ext_ref)} = _cells.mavlink_cells_out", args)

@@ -24,8 +24,8 @@ class DevicetreeEmitters(RuleContext):
         mul_max, _ = factor(self.fld(vmax).unit, units.lookup("V"))
         mul_min, _ = factor(self.fld(vmin).unit, units.lookup("V"))
         self.emit(
-            f"_hi = _r.dt_first({self.s(vmax)})",
-            f"_lo = _r.dt_first({self.s(vmin)})",
+            f"_hi = _cells.dt_first({self.s(vmax)})",
+            f"_lo = _cells.dt_first({self.s(vmin)})",
             f"_ch = {self.s(chem)}",
         )
         args = [
@@ -35,7 +35,7 @@ class DevicetreeEmitters(RuleContext):
             charged,
             empty,
         ]
-        self.emit_call("_n = _r.cells_from_design", list(args))
+        self.emit_call("_n = _cells.cells_from_design", list(args))
         self.emit(
             "if _n is not None:",
             f"    {self.t(count)} = _n",
@@ -63,6 +63,6 @@ class DevicetreeEmitters(RuleContext):
             "        _t = _ts[0]",
             "    if _t is not None and len(_tabs) == len(_ts):",
             f"        _uv = round({voltage} * {float_literal(to_uv)})",
-            "        _cap = _r.ocv_to_capacity(_tabs, _ts, _uv, round(_t))",
+            "        _cap = _cells.ocv_to_capacity(_tabs, _ts, _uv, round(_t))",
             f"        {self.t(rule.targets[0])} = _cap * {float_literal(pct)}",
         )

@@ -71,6 +71,8 @@ def mapping_module(
     consts = list(constants.lines.values())
     code = [line for lines in functions for line in lines] + consts
     names = set(class_imports) | {(".", "_runtime", "_r")}
+    if any("_cells." in line for line in code if not line.lstrip().startswith("#")):
+        names.add((".", "_cells", None))  # the array algorithms (runtime/convert/_cells.py)
     if CONCEPTS_ENDPOINT in (mapping.source, mapping.target):
         names.add(("._concepts", "BatteryState", None))
     head = [header, doc, "", "from __future__ import annotations", ""]

@@ -26,7 +26,7 @@ class NumericEmitters(RuleContext):
         if not self.backward:
             mul, add = factor(f_unit, c_unit)
             src = self.s(fmt)
-            self.emit(f"_v = _r.dt_first({src})" if is_list else f"_v = {src}")
+            self.emit(f"_v = _cells.dt_first({src})" if is_list else f"_v = {src}")
             tests = ["_v is not None"] if is_list else []
             tests += self.known_test("_v", marks)
             if op.valid_above is not None:

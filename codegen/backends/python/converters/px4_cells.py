@@ -20,7 +20,9 @@ class PX4CellEmitters(RuleContext):
         numbers = [float_literal(f32(mul)), float_literal(threshold)]
         args = [self.s(volt), self.s(cells), self.s(count), self.s(connected), *numbers]
         sizes = [str(array_type(mf).capacity), str(array_type(ef).capacity), str(fill), "0"]
-        self.emit_call(f"{self.t(main)}, {self.t(ext)} = _r.px4_stream_cells", [*args, *sizes, "rep", self.label(main)])
+        self.emit_call(
+            f"{self.t(main)}, {self.t(ext)} = _cells.px4_stream_cells", [*args, *sizes, "rep", self.label(main)]
+        )
 
     def visit_px4_receiver_cells(self, rule: Rule, op: PX4ReceiverCells) -> None:
         (volts,) = rule.sources
@@ -29,7 +31,7 @@ class PX4CellEmitters(RuleContext):
         mul, _ = factor(vf.unit, cf.unit)
         mark = int(vf.invalid.value) if vf.invalid is not None else 0xFFFF
         args = [self.s(volts), str(array_type(cf).capacity), str(mark), float_literal(f32(1.0 / mul))]
-        self.emit_call("_c, _n, _t = _r.px4_receiver_cells", args)
+        self.emit_call("_c, _n, _t = _cells.px4_receiver_cells", args)
         self.emit(f"{self.t(cells)} = _c", f"{self.t(count)} = _n", f"{self.t(total)} = _t")
 
     def visit_px4_bridge_cells(self, rule: Rule, op: PX4BridgeCells) -> None:
