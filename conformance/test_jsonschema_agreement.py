@@ -25,11 +25,21 @@ import jsonschema
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from codegen.backends.json_schema import FLOAT_MAX, at_column, export_all
+from codegen.backends.json_schema import at_column, export_all
 from codegen.backends.python import naming
 from codegen.backends.python.validators.bounds import enum_facts, folded
 from codegen.frontends.loader import load
-from codegen.ir import ArrayType, CompositeType, Field, FieldType, Message, PrimitiveKind, PrimitiveType, Schema
+from codegen.ir import (
+    FLOAT_MAX,
+    ArrayType,
+    CompositeType,
+    Field,
+    FieldType,
+    Message,
+    PrimitiveKind,
+    PrimitiveType,
+    Schema,
+)
 from codegen.ir import StringType as StrT
 
 ROOT = Path(__file__).resolve().parent.parent

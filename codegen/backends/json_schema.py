@@ -27,7 +27,6 @@ Decisions (the conformance test ``conformance/test_jsonschema_agreement.py`` hol
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import replace
 from typing import Any
 
@@ -45,6 +44,7 @@ from ..ir import (
     Sentinel,
     StringType,
 )
+from ..ir.fieldtypes import allowed_range
 from ..ir.numbers import INFINITY_SPELLINGS, NAN_SPELLINGS, NEG_INFINITY_SPELLINGS
 from ..ir.rules import rules_for
 
@@ -52,7 +52,6 @@ DRAFT = "https://json-schema.org/draft/2020-12/schema"
 NAN_STRINGS = list(NAN_SPELLINGS)
 INF_STRINGS = list(INFINITY_SPELLINGS)
 NEG_INF_STRINGS = list(NEG_INFINITY_SPELLINGS)
-FLOAT_MAX = {16: 65504.0, 32: 3.4028234663852886e38, 64: sys.float_info.max}
 _MAX_MASK_ENUM = 4096
 
 
@@ -190,22 +189,9 @@ def _column(schema: Schema, f: Field, c: Column, element: FieldType, defs: dict[
 
 def _bounds(t: PrimitiveType, f: Field) -> tuple[float, float, bool, bool]:
     """Folded type width and schema range: (low, high, low exclusive, high exclusive)."""
-    rng = f.range
-    if t.kind is PrimitiveKind.FLOAT:
-        top = FLOAT_MAX.get(t.bits, sys.float_info.max)
-        low: float = -math.inf if rng is not None and rng.minimum == -math.inf else -top
-        high: float = math.inf if rng is not None and rng.maximum == math.inf else top
-    else:
-        vr = t.value_range
-        assert vr is not None
-        low, high = vr
-    lo_x = hi_x = False
-    if rng is not None:
-        if rng.minimum is not None and (rng.minimum > low or (rng.minimum == low and rng.exclusive_minimum)):
-            low, lo_x = rng.minimum, rng.exclusive_minimum
-        if rng.maximum is not None and (rng.maximum < high or (rng.maximum == high and rng.exclusive_maximum)):
-            high, hi_x = rng.maximum, rng.exclusive_maximum
-    return low, high, lo_x, hi_x
+    r = allowed_range(t, f.range)
+    assert r.minimum is not None and r.maximum is not None
+    return r.minimum, r.maximum, r.exclusive_minimum, r.exclusive_maximum
 
 
 def _enum_facts(schema: Schema, f: Field) -> tuple[list[int] | None, int | None]:

@@ -19,6 +19,7 @@ from .fields import (
     Sentinel,
 )
 from .fieldtypes import (
+    FLOAT_MAX,
     ArrayType,
     CastMode,
     Column,
@@ -28,6 +29,8 @@ from .fieldtypes import (
     PrimitiveType,
     Range,
     StringType,
+    allowed_range,
+    type_bounds,
 )
 from .mappings import (
     CONCEPTS_ENDPOINT,
@@ -57,6 +60,7 @@ from .schema import (
 
 __all__ = [
     "CONCEPTS_ENDPOINT",
+    "FLOAT_MAX",
     "ArrayType",
     "CastMode",
     "Column",
@@ -93,4 +97,6 @@ __all__ = [
     "StructSlot",
     "Unit",
     "UorbInfo",
+    "allowed_range",
+    "type_bounds",
 ]

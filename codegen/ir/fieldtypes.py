@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import enum
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -134,3 +135,26 @@ class CompositeType:
 
 
 FieldType = PrimitiveType | ArrayType | StringType | CompositeType
+
+
+# The largest finite value of each float width (IEEE 754 binary16/32/64)
+FLOAT_MAX: dict[int, float] = {16: 65504.0, 32: 3.4028234663852886e38, 64: sys.float_info.max}
+
+
+def type_bounds(t: PrimitiveType, rng: Range | None) -> tuple[float, float]:
+    """The values type ``t`` holds: an integer's width, a float's finite range; a float may be
+    -inf/+inf only where the schema's range explicitly reaches it."""
+    if t.kind is PrimitiveKind.FLOAT:
+        top = FLOAT_MAX.get(t.bits, sys.float_info.max)
+        low = -math.inf if rng is not None and rng.minimum == -math.inf else -top
+        high = math.inf if rng is not None and rng.maximum == math.inf else top
+        return low, high
+    bounds = t.value_range
+    assert bounds is not None, f"{t.name} has no numeric range"
+    return bounds
+
+
+def allowed_range(t: PrimitiveType, rng: Range | None) -> Range:
+    """The interval a value of type ``t`` must lie in: the type's bounds folded with the schema's range."""
+    low, high = type_bounds(t, rng)
+    return Range(low, high).intersect(rng)

@@ -9,8 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-_FLOAT_MAX = {16: 65504.0, 32: 3.4028234663852886e38, 64: 1.7976931348623157e308}
-
+from ...ir import FLOAT_MAX
 
 # --------------------------------------------------------------------------------------------
 # Types as written in a definition
@@ -29,7 +28,7 @@ class PrimT:
     @property
     def value_range(self) -> tuple[int | float, int | float]:
         if self.kind == "float":
-            return -_FLOAT_MAX[self.bits], _FLOAT_MAX[self.bits]
+            return -FLOAT_MAX[self.bits], FLOAT_MAX[self.bits]
         if self.kind == "int":
             return -(1 << (self.bits - 1)), (1 << (self.bits - 1)) - 1
         return 0, (1 << self.bits) - 1

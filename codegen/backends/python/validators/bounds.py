@@ -3,14 +3,10 @@ checks and their specs are built from (also what the JSON Schema conformance tes
 
 from __future__ import annotations
 
-import math
-import sys
 from dataclasses import dataclass
 
-from ....ir import EnumKind, Field, PrimitiveKind, PrimitiveType, Range, Schema
+from ....ir import EnumKind, Field, PrimitiveKind, PrimitiveType, Range, Schema, allowed_range
 from ..literals import py_literal
-
-FLOAT_MAX = {16: 65504.0, 32: 3.4028234663852886e38, 64: sys.float_info.max}
 
 
 @dataclass(frozen=True)
@@ -56,27 +52,10 @@ class Bounds:
     high_strict: bool
 
 
-def type_bounds(t: PrimitiveType, rng: Range | None) -> tuple[float, float]:
-    if t.kind is PrimitiveKind.FLOAT:
-        top = FLOAT_MAX.get(t.bits, sys.float_info.max)
-        # ±inf is a violation unless the schema's range explicitly reaches it
-        high = math.inf if rng is not None and rng.maximum == math.inf else top
-        low = -math.inf if rng is not None and rng.minimum == -math.inf else -top
-        return low, high
-    vr = t.value_range
-    assert vr is not None
-    return vr
-
-
 def folded(t: PrimitiveType, rng: Range | None) -> Bounds:
-    low, high = type_bounds(t, rng)
-    lo_s = hi_s = False
-    if rng is not None:
-        if rng.minimum is not None and (rng.minimum > low or (rng.minimum == low and rng.exclusive_minimum)):
-            low, lo_s = rng.minimum, rng.exclusive_minimum
-        if rng.maximum is not None and (rng.maximum < high or (rng.maximum == high and rng.exclusive_maximum)):
-            high, hi_s = rng.maximum, rng.exclusive_maximum
-    return Bounds(low, high, lo_s, hi_s)
+    r = allowed_range(t, rng)
+    assert r.minimum is not None and r.maximum is not None
+    return Bounds(r.minimum, r.maximum, r.exclusive_minimum, r.exclusive_maximum)
 
 
 def inside(b: Bounds, value: float) -> bool:

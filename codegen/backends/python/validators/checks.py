@@ -20,9 +20,10 @@ from ....ir import (
     Schema,
     Sentinel,
     StringType,
+    type_bounds,
 )
 from ..literals import hex_literal, py_literal, text_literal, unparenthesized
-from .bounds import EnumFacts, enum_facts, folded, inside, number, type_bounds
+from .bounds import EnumFacts, enum_facts, folded, inside, number
 
 V = "\x00V\x00"  # placeholder for the value expression in a condition
 
