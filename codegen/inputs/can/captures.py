@@ -1,10 +1,11 @@
 """CAN frames from where users have them: capture files, ArduPilot DataFlash logs, live buses.
 
-Capture files are read with python-can's log readers (candump ``.log``, Vector ``.asc`` and ``.blf``, PEAK ``.trc``,
-each also gzip-compressed, and python-can's own ``.csv`` when the format is given); ArduPilot DataFlash logs (``.bin``) carry the frames of a
-logged bus as CANF (classic) and CAFD (CAN FD) records, read with pymavlink's DataFlash reader; a live bus is any
-python-can interface, named ``interface:channel`` (``socketcan:can0``, ``slcan:/dev/ttyACM0``, ``virtual:bus0``).
-python-can is an optional dependency (``pip install 'battgen[can]'``); without it the readers say so.
+Capture files are read with python-can's log readers: candump ``.log``, Vector ``.asc`` and ``.blf``, PEAK ``.trc``
+(each also gzip-compressed), and python-can's own ``.csv`` when the format is given. ArduPilot DataFlash logs
+(``.bin``) carry the frames of a logged bus as CANF (classic) and CAFD (CAN FD) records, read with pymavlink's
+DataFlash reader. A live bus is any python-can interface, named ``interface:channel`` (``socketcan:can0``,
+``slcan:/dev/ttyACM0``, ``virtual:bus0``). python-can is an optional dependency (``pip install 'battgen[can]'``);
+without it the readers say so.
 
 Every source yields :class:`~.reassembly.Frame`\\ s in capture order, with ``t`` in seconds since the first frame;
 error and remote frames are skipped. A reader's own failure on a damaged file is an :class:`InputError` naming the

@@ -14,10 +14,10 @@ import functools
 import importlib
 import pkgutil
 from collections import Counter
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
-from ..model import DronecanClass, MessageClass, package_name
+from ..model import DronecanClass, GeneratedMessage, MessageClass, package_name
 from ..records import InputError, Item, Notice, Record, Unreadable
 from .captures import DATAFLASH_SUFFIXES, read_capture, read_dataflash_frames
 from .ordering import AuxOrder
@@ -86,29 +86,42 @@ class _Notices:
 
 def capture_items(path: Path, name: str, model: MessageClass) -> Iterator[Item]:
     """The records of ``model``'s message in a CAN capture, with transport notices and a closing summary."""
-    if not isinstance(model, DronecanClass) or model.DATA_TYPE_ID is None:
-        raise InputError(
-            name, 0, f"a CAN capture holds DroneCAN messages with a data type id; {model.QUALIFIED_NAME} has none"
-        )
-    return _items(frames_of(path, name), name, model)
+    return capture_side(path, name, [model])
+
+
+def capture_side(path: Path, name: str, models: Sequence[MessageClass]) -> Iterator[Item]:
+    """The records of ``models[0]``'s message in a CAN capture, each with the same node's latest message of each
+    other model as its ``companions`` (None until the node sent one): BatteryInfo with its node's BatteryInfoAux,
+    paired the way PX4's bridge pairs them."""
+    classes = []
+    for model in models:
+        if not isinstance(model, DronecanClass) or model.DATA_TYPE_ID is None:
+            raise InputError(
+                name, 0, f"a CAN capture holds DroneCAN messages with a data type id; {model.QUALIFIED_NAME} has none"
+            )
+        classes.append(model)
+    return _items(frames_of(path, name), name, classes)
 
 
 def transfer_items(frames: Iterable[Frame], name: str, model: DronecanClass) -> Iterator[Item]:
     """As :func:`capture_items`, for frames from anywhere (a live bus)."""
-    return _items(iter(frames), name, model)
+    return _items(iter(frames), name, [model])
 
 
-def _items(frames: Iterator[Frame], name: str, model: DronecanClass) -> Iterator[Item]:
+def _items(frames: Iterator[Frame], name: str, classes: Sequence[DronecanClass]) -> Iterator[Item]:
+    model = classes[0]
     known = registry(package_name(model))
     signatures = {key: cls.DATA_TYPE_SIGNATURE for key, cls in known.items()}
-    signatures.setdefault((type_kind(model), model.DATA_TYPE_ID or 0), model.DATA_TYPE_SIGNATURE)
+    for cls in classes:
+        signatures.setdefault((type_kind(cls), cls.DATA_TYPE_ID or 0), cls.DATA_TYPE_SIGNATURE)
+    wanted = {cls.DATA_TYPE_ID: i for i, cls in reversed(list(enumerate(classes))) if type_kind(cls) == "message"}
     reassembler = Reassembler(signatures)
     order = AuxOrder(known)
     notices = _Notices(name)
+    latest: dict[tuple[int, int], GeneratedMessage] = {}  # (node, position in classes) -> its last message
     per_node: Counter[int] = Counter()
     index = 0
     last = Frame(0, 0.0, 0, b"")
-    want = (type_kind(model), model.DATA_TYPE_ID)
     for frame in frames:
         last = frame
         for event in reassembler.feed(frame):
@@ -121,12 +134,17 @@ def _items(frames: Iterator[Frame], name: str, model: DronecanClass) -> Iterator
                 note = notices.notice(diag)
                 if note is not None:
                     yield note
-            if event.id.service or ("message", event.id.data_type_id) != want:
+            position = None if event.id.service else wanted.get(event.id.data_type_id)
+            if position is None:
                 continue
+            cls = classes[position]
             try:
-                instance = model.decode(event.payload, tao=not event.fd)
+                instance = cls.decode(event.payload, tao=not event.fd)
             except ValueError as exc:  # the generated DecodeError: bytes that are not this message
-                yield Unreadable(name, 0, f"{_where(event)}: cannot decode {model.QUALIFIED_NAME}: {exc}")
+                yield Unreadable(name, 0, f"{_where(event)}: cannot decode {cls.QUALIFIED_NAME}: {exc}")
+                continue
+            if position:
+                latest[(event.node, position)] = instance
                 continue
             per_node[event.node] += 1
             yield Record(
@@ -137,6 +155,7 @@ def _items(frames: Iterator[Frame], name: str, model: DronecanClass) -> Iterator
                 where=_where(event),
                 instance=instance,
                 location={"t": event.t, "frame": event.frame, "node": event.node, "transfer_id": event.transfer_id},
+                companions=tuple(latest.get((event.node, i)) for i in range(1, len(classes))),
             )
             index += 1
     for diag in reassembler.finish(last.t, last.index):
