@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 from ..inputs.can.ordering import AuxOrder
 from ..inputs.can.reassembly import Diagnostic, Frame, Reassembler, Transfer
-from ..inputs.can.records import Registry, type_kind
+from ..inputs.can.records import Registry, decode_transfer, signatures
 from ..inputs.model import GeneratedMessage
 
 KEEP_PER_CODE = 20  # problems listed per code; the rest are counted
@@ -89,8 +89,7 @@ def scan(
     on_message: Callable[[Transfer, GeneratedMessage], None] | None = None,
 ) -> CaptureReport:
     """Account for every frame; ``on_message`` is called with each decoded transfer of a known type."""
-    signatures = {key: cls.DATA_TYPE_SIGNATURE for key, cls in known.items()}
-    reassembler = Reassembler(signatures)
+    reassembler = Reassembler(signatures(known))
     order = AuxOrder(known)
     report = CaptureReport(source)
     last: Frame | None = None
@@ -127,11 +126,7 @@ def _count(
     on_message: Callable[[Transfer, GeneratedMessage], None] | None,
 ) -> None:
     kind = transfer.id.kind
-    cls = known.get(("service" if transfer.id.service else "message", transfer.id.data_type_id))
-    if cls is not None and transfer.id.service and type_kind(cls) == "service":
-        # a service's two halves share one id: pick the half by the frame's request bit
-        sibling = cls.QUALIFIED_NAME.rsplit(".", 1)[0] + (".Request" if transfer.id.request else ".Response")
-        cls = next((c for c in known.values() if c.QUALIFIED_NAME == sibling), None)
+    cls = known.get((kind, transfer.id.data_type_id))
     key = (transfer.node, kind, transfer.id.data_type_id)
     stream = report.streams.get(key)
     if stream is None:
@@ -142,7 +137,7 @@ def _count(
     if cls is None:
         return
     try:
-        message = cls.decode(transfer.payload, tao=not transfer.fd)
+        message = decode_transfer(cls, transfer)
     except ValueError as exc:  # the generated DecodeError
         stream.undecodable += 1
         note(

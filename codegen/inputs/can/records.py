@@ -28,13 +28,26 @@ Registry = dict[tuple[str, int], DronecanClass]
 
 
 def type_kind(cls: DronecanClass) -> str:
-    """``service`` for a half of a service (generated as ``<Name>.Request`` / ``.Response``), else ``message``."""
-    return "service" if cls.QUALIFIED_NAME.endswith((".Request", ".Response")) else "message"
+    """``request`` / ``response`` for the halves of a service (generated as ``<Name>.Request`` / ``.Response``),
+    else ``message``: the same words as :attr:`~.wire.CanId.kind`."""
+    for half in ("Request", "Response"):
+        if cls.QUALIFIED_NAME.endswith("." + half):
+            return half.lower()
+    return "message"
+
+
+def signatures(known: Registry) -> dict[tuple[str, int], int]:
+    """The transfer CRC seeds the reassembler needs, by (``message`` | ``service``, id)."""
+    return {
+        ("message" if kind == "message" else "service", type_id): cls.DATA_TYPE_SIGNATURE
+        for (kind, type_id), cls in known.items()
+    }
 
 
 @functools.cache
 def registry(package: str) -> Registry:
-    """Every DroneCAN class with a data type id in a generated package, by (kind, id)."""
+    """Every DroneCAN class with a data type id in a generated package, by (kind, id): ``message``, or
+    ``request`` / ``response`` for the two halves of a service, which share the service's id."""
     found: Registry = {}
     try:
         root = importlib.import_module(package + ".dronecan")
@@ -49,6 +62,28 @@ def registry(package: str) -> Registry:
                 if value.__module__ == module.__name__:
                     found.setdefault((type_kind(value), value.DATA_TYPE_ID), value)
     return found
+
+
+FD_MAX_PADDING = 15  # bytes: the largest gap between two CAN FD data lengths (48 -> 64) less one
+
+
+def decode_transfer(cls: DronecanClass, transfer: Transfer) -> GeneratedMessage:
+    """A transfer's message. Classic CAN payloads use tail-array optimisation; a CAN FD transfer does not, and
+    its last frame is padded with zero bytes up to a valid data length, which the message does not say: the
+    padding is cut back until the payload decodes (the content is the same whichever length succeeds)."""
+    if not transfer.fd:
+        return cls.decode(transfer.payload, tao=True)
+    payload = transfer.payload
+    error: ValueError | None = None
+    for cut in range(min(FD_MAX_PADDING, len(payload)) + 1):
+        if cut and payload[-cut] != 0:
+            break
+        try:
+            return cls.decode(payload[: len(payload) - cut], tao=False)
+        except ValueError as exc:  # the generated DecodeError
+            error = exc
+    assert error is not None
+    raise error
 
 
 def frames_of(path: Path, name: str) -> Iterator[Frame]:
@@ -111,11 +146,11 @@ def transfer_items(frames: Iterable[Frame], name: str, model: DronecanClass) -> 
 def _items(frames: Iterator[Frame], name: str, classes: Sequence[DronecanClass]) -> Iterator[Item]:
     model = classes[0]
     known = registry(package_name(model))
-    signatures = {key: cls.DATA_TYPE_SIGNATURE for key, cls in known.items()}
+    seeds = signatures(known)
     for cls in classes:
-        signatures.setdefault((type_kind(cls), cls.DATA_TYPE_ID or 0), cls.DATA_TYPE_SIGNATURE)
+        seeds.setdefault(("message", cls.DATA_TYPE_ID or 0), cls.DATA_TYPE_SIGNATURE)
     wanted = {cls.DATA_TYPE_ID: i for i, cls in reversed(list(enumerate(classes))) if type_kind(cls) == "message"}
-    reassembler = Reassembler(signatures)
+    reassembler = Reassembler(seeds)
     order = AuxOrder(known)
     notices = _Notices(name)
     latest: dict[tuple[int, int], GeneratedMessage] = {}  # (node, position in classes) -> its last message
@@ -139,7 +174,7 @@ def _items(frames: Iterator[Frame], name: str, classes: Sequence[DronecanClass])
                 continue
             cls = classes[position]
             try:
-                instance = cls.decode(event.payload, tao=not event.fd)
+                instance = decode_transfer(cls, event)
             except ValueError as exc:  # the generated DecodeError: bytes that are not this message
                 yield Unreadable(name, 0, f"{_where(event)}: cannot decode {cls.QUALIFIED_NAME}: {exc}")
                 continue
