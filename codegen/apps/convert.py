@@ -261,7 +261,8 @@ class Conversion:
         if fmt in ("can", "dataflash"):
             if not isinstance(source, Path):
                 raise BattgenError(f"{where}: a CAN capture is read from a file, not from standard input")
-            for item in capture_side(source, where, [c for _, c in self.source.items]):
+            models = [c for _, c in self.source.items if isinstance(c, MessageClass)]
+            for item in capture_side(source, where, models):
                 if isinstance(item, Record):
                     yield Record(
                         item.index,

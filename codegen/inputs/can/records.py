@@ -199,7 +199,7 @@ def _items(frames: Iterator[Frame], name: str, classes: Sequence[DronecanClass])
             yield note
     yield from notices.overflow()
     if reassembler.frames == 0:
-        yield Notice(name, "no CAN frames in this capture", "empty")
+        yield Notice(name, "no CAN frames in this capture", "empty", "error")  # empty input is not success
         return
     nodes = ", ".join(f"node {n}: {c}" for n, c in sorted(per_node.items())) or "none"
     summary = (
