@@ -9,7 +9,7 @@ bounded in number and length, so its memory stays flat however long the capture.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 from . import wire
@@ -89,6 +89,8 @@ class _Pending:
 
 
 Event = Transfer | Diagnostic
+_NOTHING: tuple[Event, ...] = ()
+_KEY_MASK = wire.ID_MASK >> 5  # the identifier less its 5 priority bits: one transfer in progress per key
 Signatures = Mapping[tuple[str, int], int]  # ("message" | "service", data type id) -> signature
 
 
@@ -105,6 +107,7 @@ class Reassembler:
 
     def __init__(self, signatures: Signatures, *, timeout: float = TIMEOUT) -> None:
         self._signatures = signatures
+        self._seeds: dict[int, int] = {}  # signature -> its CRC seed, computed once
         self._timeout = timeout
         self._pending: dict[int, _Pending] = {}
         self._last_tid: dict[tuple[int, bool, int], int] = {}
@@ -113,122 +116,103 @@ class Reassembler:
         self.frames = 0
         self.transfers = 0
 
-    def feed(self, frame: Frame) -> list[Event]:
-        """The transfers completed and the problems found by one more frame."""
+    def feed(self, frame: Frame) -> Sequence[Event]:
+        """The transfers completed and the problems found by one more frame (usually none: an empty tuple)."""
         self.frames += 1
         out: list[Event] = []
-        if self._pending and len(self._pending) % 64 == 0:
+        if not self.frames & 63 and self._pending:  # now and then, transfers whose sender went quiet
             out.extend(self._expire(frame.t, frame.index))
-        if not frame.extended:
-            self._standard += 1
-            if self._standard == 1:
-                out.append(
-                    Diagnostic(
-                        "can-standard-id",
-                        "an 11-bit frame: not DroneCAN, skipped (counted once)",
-                        frame.t,
-                        frame.index,
-                        severity="info",
-                    )
-                )
+        data = frame.data
+        if not frame.extended or not data:
+            out.extend(self._not_dronecan(frame))
             return out
-        if not frame.data:
-            out.append(Diagnostic("can-empty-frame", "a frame without data: no tail byte", frame.t, frame.index))
-            return out
-        id_ = wire.parse_id(frame.can_id)
-        key = frame.can_id & (wire.ID_MASK >> 5)  # the identifier less its priority
-        tail = frame.data[-1]
-        tid = tail & wire.TRANSFER_ID_MASK
-        start, end, toggle = bool(tail & wire.TAIL_START), bool(tail & wire.TAIL_END), tail & wire.TAIL_TOGGLE
+        tail = data[-1]
+        key = frame.can_id & _KEY_MASK
         pending = self._pending.get(key)
         if pending is not None and frame.t - pending.last_t > self._timeout:
             out.append(self._lost(pending, "timed out", frame))
             del self._pending[key]
             pending = None
-        if start:
+        if tail & wire.TAIL_START:
             if pending is not None:
                 out.append(self._lost(pending, "restarted by a new start frame", frame))
                 del self._pending[key]
-            if toggle:
-                out.append(
-                    Diagnostic(
-                        "can-toggle",
-                        f"{_where(id_)}: toggle bit set on the start frame of transfer "
-                        f"{tid} (expected clear); transfer dropped",
-                        frame.t,
-                        frame.index,
-                        id_.source,
-                        id_.data_type_id,
-                    )
-                )
+            pending = self._start(key, frame, tail, out)
+            if pending is None:
                 return out
-            pending = _Pending(frame, id_, tid, frame.t, fd=frame.fd)
+        elif pending is None or (tail & wire.TRANSFER_ID_MASK) != pending.transfer_id:
+            out.append(self._stray(frame, tail, pending))
+            if pending is not None:
+                del self._pending[key]
+            return out
+        elif tail & wire.TAIL_TOGGLE != pending.toggle:
+            out.append(self._bad_toggle(frame, tail, pending))
+            del self._pending[key]
+            return out
+        else:
+            pending.chunks.append(data[:-1])
+            pending.size += len(data) - 1
+            pending.count += 1
+            pending.toggle ^= wire.TAIL_TOGGLE
+            pending.last_t = frame.t
+            pending.fd = pending.fd or frame.fd
+            if pending.size > MAX_PAYLOAD:
+                out.append(self._too_long(frame, pending))
+                del self._pending[key]
+                return out
+        if tail & wire.TAIL_END:
+            self._pending.pop(key, None)
+            out.extend(self._complete(pending, frame))
+        return out if out else _NOTHING
+
+    def _start(self, key: int, frame: Frame, tail: int, out: list[Event]) -> _Pending | None:
+        """A transfer's first frame: its state (kept in progress unless it also ends here), or None if refused."""
+        id_ = wire.parse_id(frame.can_id)
+        tid = tail & wire.TRANSFER_ID_MASK
+        if tail & wire.TAIL_TOGGLE:
+            text = f"{_where(id_)}: toggle bit set on the start frame of transfer {tid} (expected clear); dropped"
+            out.append(Diagnostic("can-toggle", text, frame.t, frame.index, id_.source, id_.data_type_id))
+            return None
+        pending = _Pending(
+            frame, id_, tid, frame.t, wire.TAIL_TOGGLE, 1, frame.fd, [frame.data[:-1]], len(frame.data) - 1
+        )
+        if not tail & wire.TAIL_END:
             if len(self._pending) >= MAX_PENDING:
                 oldest = min(self._pending, key=lambda k: self._pending[k].last_t)
                 out.append(self._lost(self._pending.pop(oldest), "dropped: too many transfers in progress", frame))
             self._pending[key] = pending
-        elif pending is None:
-            out.append(
-                Diagnostic(
-                    "can-missing-start",
-                    f"{_where(id_)}: a frame of transfer {tid} without its start frame",
-                    frame.t,
-                    frame.index,
-                    id_.source,
-                    id_.data_type_id,
-                )
-            )
-            return out
-        elif tid != pending.transfer_id:
-            out.append(
-                Diagnostic(
-                    "can-transfer-id",
-                    f"{_where(id_)}: transfer id {tid} inside transfer {pending.transfer_id}; both dropped",
-                    frame.t,
-                    frame.index,
-                    id_.source,
-                    id_.data_type_id,
-                )
-            )
-            del self._pending[key]
-            return out
-        if toggle != pending.toggle:
-            out.append(
-                Diagnostic(
-                    "can-toggle",
-                    f"{_where(id_)}: toggle bit {toggle >> 5} on frame {pending.count + 1}"
-                    f" of transfer {tid} (expected {pending.toggle >> 5}); transfer dropped",
-                    frame.t,
-                    frame.index,
-                    id_.source,
-                    id_.data_type_id,
-                )
-            )
-            del self._pending[key]
-            return out
-        pending.chunks.append(frame.data[:-1])
-        pending.size += len(frame.data) - 1
-        pending.count += 1
-        pending.toggle ^= wire.TAIL_TOGGLE
-        pending.last_t = frame.t
-        pending.fd = pending.fd or frame.fd
-        if pending.size > MAX_PAYLOAD:
-            out.append(
-                Diagnostic(
-                    "can-too-long",
-                    f"{_where(id_)}: transfer {tid} longer than {MAX_PAYLOAD} bytes; dropped",
-                    frame.t,
-                    frame.index,
-                    id_.source,
-                    id_.data_type_id,
-                )
-            )
-            del self._pending[key]
-            return out
-        if end:
-            del self._pending[key]
-            out.extend(self._complete(pending, frame))
-        return out
+        return pending
+
+    def _not_dronecan(self, frame: Frame) -> list[Diagnostic]:
+        if frame.data:
+            self._standard += 1
+            if self._standard > 1:
+                return []
+            text = "an 11-bit frame: not DroneCAN, skipped (counted once)"
+            return [Diagnostic("can-standard-id", text, frame.t, frame.index, severity="info")]
+        return [Diagnostic("can-empty-frame", "a frame without data: no tail byte", frame.t, frame.index)]
+
+    def _stray(self, frame: Frame, tail: int, pending: _Pending | None) -> Diagnostic:
+        id_ = wire.parse_id(frame.can_id)
+        tid = tail & wire.TRANSFER_ID_MASK
+        if pending is None:
+            text = f"{_where(id_)}: a frame of transfer {tid} without its start frame"
+            return Diagnostic("can-missing-start", text, frame.t, frame.index, id_.source, id_.data_type_id)
+        text = f"{_where(id_)}: transfer id {tid} inside transfer {pending.transfer_id}; both dropped"
+        return Diagnostic("can-transfer-id", text, frame.t, frame.index, id_.source, id_.data_type_id)
+
+    def _bad_toggle(self, frame: Frame, tail: int, pending: _Pending) -> Diagnostic:
+        id_ = pending.id
+        text = (
+            f"{_where(id_)}: toggle bit {(tail & wire.TAIL_TOGGLE) >> 5} on frame {pending.count + 1} of transfer "
+            f"{pending.transfer_id} (expected {pending.toggle >> 5}); transfer dropped"
+        )
+        return Diagnostic("can-toggle", text, frame.t, frame.index, id_.source, id_.data_type_id)
+
+    def _too_long(self, frame: Frame, pending: _Pending) -> Diagnostic:
+        id_ = pending.id
+        text = f"{_where(id_)}: transfer {pending.transfer_id} longer than {MAX_PAYLOAD} bytes; dropped"
+        return Diagnostic("can-too-long", text, frame.t, frame.index, id_.source, id_.data_type_id)
 
     def finish(self, t: float, index: int) -> list[Diagnostic]:
         """The transfers still in progress at the end of the capture, as ``can-missing-end`` problems."""
@@ -253,7 +237,7 @@ class Reassembler:
 
     def _complete(self, p: _Pending, last: Frame) -> list[Event]:
         out: list[Event] = []
-        body = b"".join(p.chunks)
+        body = p.chunks[0] if p.count == 1 else b"".join(p.chunks)
         checked = True
         if p.count > 1:
             kind = "service" if p.id.service else "message"
@@ -288,7 +272,10 @@ class Reassembler:
                         )
                     )
             else:
-                computed = wire.transfer_crc(body, signature)
+                seed = self._seeds.get(signature)
+                if seed is None:
+                    seed = self._seeds[signature] = wire.signature_crc(signature)
+                computed = wire.crc16(body, seed)
                 if computed != carried:
                     out.append(
                         Diagnostic(
