@@ -20,6 +20,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+from ..dataflash import open_log
 from ..records import InputError
 from .reassembly import Frame
 
@@ -96,39 +97,37 @@ def read_capture(path: Path, name: str) -> Iterator[Frame]:
 
 
 def read_dataflash_frames(path: Path, name: str) -> Iterator[Frame]:
-    """The CAN frames an ArduPilot DataFlash log recorded (CANF and CAFD records; see CAN_Dn_UC_OPTION's
-    logging bit), read with pymavlink's DataFlash reader."""
-    try:
-        dfreader = importlib.import_module("pymavlink.DFReader")
-    except ImportError as exc:
-        raise InputError(name, 0, "reading DataFlash logs needs pymavlink: pip install pymavlink") from exc
-    try:
-        log = dfreader.DFReader_binary(str(path), zero_time_base=True)
-    except (ValueError, OSError, IndexError, KeyError, TypeError) as exc:
-        raise InputError(name, 0, f"cannot read the DataFlash log: {exc}") from exc
+    """The CAN frames an ArduPilot DataFlash log recorded: its CANF (classic) and CAFD (CAN FD) records, laid out
+    as ``libraries/AP_CANManager/LogStructure.h`` declares them (``Id`` with AP_HAL's flag bits on top; CAFD's
+    ``DLC`` a data length code and its data in eight 64-bit words)."""
     index = 0
-    t0: float | None = None
-    while True:
+    t0: int | None = None
+    for record in open_log(path, name).messages(("CANF", "CAFD")):
+        values = record.fields
         try:
-            record = log.recv_match(type=["CANF", "CAFD"])
-        except (ValueError, IndexError, KeyError, TypeError, AttributeError) as exc:
-            raise InputError(name, 0, f"cannot read the DataFlash log after CAN frame {index}: {exc}") from exc
-        if record is None:
-            return
-        raw_id = int(record.Id)
-        if raw_id & (_RTR_FLAG | _ERR_FLAG):
-            continue
-        fd = record.get_type() == "CAFD"
-        if fd:
-            words = b"".join(int(getattr(record, f"D{i}")).to_bytes(8, "little") for i in range(8))
-            length = _FD_LENGTHS[int(record.DLC) & 0xF]
-            data = words[:length]
-        else:
-            data = bytes(int(getattr(record, f"B{i}")) & 0xFF for i in range(8))[: min(int(record.DLC), 8)]
-        stamp = int(record.TimeUS) / 1e6
+            raw_id = int(values["Id"])
+            if raw_id & (_RTR_FLAG | _ERR_FLAG):
+                continue
+            if record.type == "CAFD":
+                words = b"".join((int(values[f"D{i}"]) & (2**64 - 1)).to_bytes(8, "little") for i in range(8))
+                data = words[: _FD_LENGTHS[int(values["DLC"]) & 0xF]]
+            else:
+                data = bytes(int(values[f"B{i}"]) & 0xFF for i in range(8))[: max(0, min(int(values["DLC"]), 8))]
+            bus = int(values.get("Bus", 0))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(name, 0, f"{record.type} record {record.index}: expected CAN frame fields: {exc}") from exc
+        stamp = record.time_us or 0
         if t0 is None:
             t0 = stamp
-        yield Frame(index, stamp - t0, raw_id & 0x1FFFFFFF, data, bool(raw_id & _EXTENDED_FLAG), fd, f"bus{record.Bus}")
+        yield Frame(
+            index,
+            (stamp - t0) / 1e6,
+            raw_id & 0x1FFFFFFF,
+            data,
+            bool(raw_id & _EXTENDED_FLAG),
+            record.type == "CAFD",
+            f"bus{bus}",
+        )
         index += 1
 
 
