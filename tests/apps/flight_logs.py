@@ -62,3 +62,57 @@ def write_flight(path: Path, seconds: float = 600.0, hz: float = 10.0, packs: in
             )
     _ulog_writer.write(path, records)
     return path
+
+
+def write_capture_flight(
+    path: Path,
+    *,
+    seconds: float = 60.0,
+    hz: float = 5.0,
+    node: int = 20,
+    serial: int = 777,
+    health: int = 95,
+    cycles: int = 10,
+    resistance: float = 0.03,
+) -> Path:
+    """A candump capture of one DroneCAN battery node: BatteryInfo at ``hz`` through a load profile, its pack
+    identified by ``model_instance_id`` (the serial the report follows across flights)."""
+    import can  # python-can writes the capture as candump does
+
+    from codegen.inputs.can import wire
+    from generated.dronecan.uavcan.equipment.power import BatteryInfo
+
+    writer = can.Logger(str(path))
+    try:
+        n = int(seconds * hz)
+        for k in range(n):
+            t = k / hz
+            current = (15.0, 35.0)[int(t // 10) % 2]
+            soc = 1.0 - 0.8 * k / max(1, n - 1)
+            volts = CELLS * _ocv_per_cell(soc) - current * resistance
+            info = BatteryInfo(
+                voltage=volts,
+                current=current,
+                temperature=300.0,
+                state_of_charge_pct=int(soc * 100),
+                state_of_health_pct=health,
+                battery_id=0,
+                model_instance_id=serial,
+                model_name=b"6S pack",
+                remaining_capacity_wh=soc * 200,
+                full_charge_capacity_wh=200,
+            )
+            payload = info.encode()
+            signature = BatteryInfo.DATA_TYPE_SIGNATURE
+            for data in wire.split_transfer(payload, signature, k % 32):
+                writer.on_message_received(
+                    can.Message(
+                        timestamp=1_700_000_000 + t,
+                        arbitration_id=wire.message_id(1092, node),
+                        is_extended_id=True,
+                        data=data,
+                    )
+                )
+    finally:
+        writer.stop()
+    return path

@@ -4,9 +4,10 @@ Charge used comes from the battery's own discharged counter where it reports one
 autopilot's integrator), else from integrating the current (trapezoids); energy from integrating V·I. The
 internal resistance is estimated from load steps: consecutive samples at most 2 s apart whose current changes by
 at least 20 % of the flight's peak current (and 1 A) give R = -ΔV/ΔI; the median of those steps is reported, as
-a single step is easily spoiled by a voltage reading lagging the current. The voltage sag per amp is the slope of
-the least-squares line of voltage against current over the whole flight (a steady pack sags linearly with
-load; the slope also includes wiring resistance, which is why the load-step estimate is given separately).
+a single step is easily spoiled by a voltage reading lagging the current. The voltage sag per amp is the least-squares
+slope of the voltage's sample-to-sample changes against the current's, over the whole flight: it uses every
+change of load, small ones too, so it is the figure to compare between flights of one pack, while the load-step
+median is the better estimate of the pack's resistance when a log is noisy.
 """
 
 from __future__ import annotations
@@ -113,16 +114,18 @@ def _steps(s: BatterySeries, peak: float) -> list[float]:
     return out
 
 
-def _slope(s: BatterySeries) -> float | None:
-    pairs = [(i, v) for i, v in zip(s.current, s.pack_voltage, strict=True) if i is not None and v is not None]
-    if len(pairs) < 3:
-        return None
-    mean_i = statistics.fmean(i for i, _ in pairs)
-    mean_v = statistics.fmean(v for _, v in pairs)
-    var = sum((i - mean_i) ** 2 for i, _ in pairs)
-    if var < 1e-9:
-        return None
-    return -sum((i - mean_i) * (v - mean_v) for i, v in pairs) / var
+def _sag(s: BatterySeries) -> float | None:
+    """-dV/dI as the least-squares slope through the origin of the sample-to-sample changes (ΔV on ΔI, samples
+    at most STEP_MAX_DT apart): every change of load counts, small ones too, and the slow decline of the discharge
+    adds little to ΔV between neighbours and nothing correlated with ΔI."""
+    num = den = 0.0
+    for k in range(1, len(s.t)):
+        v0, v1, i0, i1 = s.pack_voltage[k - 1], s.pack_voltage[k], s.current[k - 1], s.current[k]
+        if v0 is None or v1 is None or i0 is None or i1 is None or s.t[k] - s.t[k - 1] > STEP_MAX_DT:
+            continue
+        num += (i1 - i0) * (v1 - v0)
+        den += (i1 - i0) ** 2
+    return -num / den if den > 1e-9 else None
 
 
 def _time_below(s: BatterySeries, threshold: float) -> float:
@@ -159,7 +162,7 @@ def compute(s: BatterySeries, thresholds: dict[str, float] | None = None) -> Fig
         min_cell_voltage_v=min(cells) if cells else None,
         max_cell_imbalance_v=max(imbalance) if imbalance else None,
         max_temperature_c=max(temps) if temps else None,
-        sag_per_amp_v_per_a=_slope(s),
+        sag_per_amp_v_per_a=_sag(s),
         internal_resistance_ohm=statistics.median(steps) if steps else None,
         load_steps=len(steps),
         time_below_s={name: _time_below(s, v) for name, v in (thresholds or {}).items() if v > 0},

@@ -2,7 +2,7 @@
 
 Flights are ordered as the inputs were given (sort the file names by date to get a time axis); a pack is
 followed across flights by its serial number, where the battery reports one. The trends plotted per pack: charge
-used, internal resistance (load steps), minimum cell voltage and state of health where the pack reports it.
+used and internal resistance (load steps), and the state of health and cycle count where the pack reports them.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from typing import Any
 from .figures import Figures, compute
 from .series import InputSeries
 
+_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf")
 HEADER = [
     "flight",
     "battery",
@@ -59,41 +60,62 @@ def _row(source: str, label: str, serial: str, f: Figures) -> list[str]:
 
 def fleet_view(inputs: Sequence[InputSeries]) -> FleetView:
     rows: list[list[str]] = []
-    by_serial: dict[str, list[tuple[int, Figures]]] = {}
+    by_serial: dict[str, list[tuple[int, Figures, float | None, int | None]]] = {}
     for flight, item in enumerate(inputs):
         for s in item.batteries:
             f = compute(s)
             rows.append(_row(PurePath(item.source).name, s.label, s.serial, f))
             if s.serial:
-                by_serial.setdefault(s.serial, []).append((flight + 1, f))
+                by_serial.setdefault(s.serial, []).append((flight + 1, f, s.state_of_health, s.cycle_count))
+    quantities = (
+        ("charge used [mAh]", lambda p: p[1].charge_used_mah),
+        (
+            "internal resistance [mΩ]",
+            lambda p: None if p[1].internal_resistance_ohm is None else p[1].internal_resistance_ohm * 1000,
+        ),
+        ("state of health [%]", lambda p: p[2]),
+        ("cycles", lambda p: None if p[3] is None else float(p[3])),
+    )
+    series = {serial: points for serial, points in sorted(by_serial.items()) if len(points) >= 2}
+    shown = [
+        (name, get) for name, get in quantities if any(get(p) is not None for points in series.values() for p in points)
+    ]
     data: list[dict[str, Any]] = []
-    for serial, points in sorted(by_serial.items()):
-        if len(points) < 2:
-            continue
-        xs = [p for p, _ in points]
-        for axis, name, values in (
-            ("y", "charge used [mAh]", [f.charge_used_mah for _, f in points]),
-            (
-                "y2",
-                "IR [mΩ]",
-                [None if f.internal_resistance_ohm is None else f.internal_resistance_ohm * 1000 for _, f in points],
-            ),
-        ):
+    layout: dict[str, Any] = {
+        "height": 150 * max(1, len(shown)) + 70,
+        "margin": {"l": 70, "r": 20, "t": 20, "b": 40},
+        "showlegend": True,
+        "legend": {"orientation": "h", "y": -0.12},
+    }
+    height = 1.0 / max(1, len(shown))
+    for r, (name, get) in enumerate(shown):
+        axis = "" if r == 0 else str(r + 1)
+        layout[f"xaxis{axis}"] = {
+            "anchor": f"y{axis}",
+            "dtick": 1,
+            "showticklabels": r == len(shown) - 1,
+            **({"matches": "x"} if r else {}),
+            **({"title": {"text": "flight (input order)"}} if r == len(shown) - 1 else {}),
+        }
+        layout[f"yaxis{axis}"] = {
+            "title": {"text": name, "font": {"size": 11}},
+            "anchor": f"x{axis}",
+            "domain": [1.0 - (r + 1) * height + 0.04, 1.0 - r * height],
+        }
+        for k, (serial, points) in enumerate(series.items()):
             data.append(
                 {
                     "type": "scatter",
                     "mode": "lines+markers",
-                    "name": f"{serial} {name}",
-                    "x": xs,
-                    "y": values,
-                    "yaxis": axis,
+                    "name": f"pack {serial}",
+                    "legendgroup": serial,
+                    "showlegend": r == 0,
+                    "x": [p[0] for p in points],
+                    "y": [get(p) for p in points],
+                    "xaxis": f"x{axis}",
+                    "yaxis": f"y{axis}",
+                    "line": {"color": _COLOURS[k % len(_COLOURS)]},
+                    "meta": {"serial": serial, "quantity": name},
                 }
             )
-    layout = {
-        "height": 320,
-        "margin": {"l": 70, "r": 70, "t": 20, "b": 40},
-        "xaxis": {"title": {"text": "flight (input order)"}, "dtick": 1},
-        "yaxis": {"title": {"text": "charge used [mAh]"}},
-        "yaxis2": {"title": {"text": "internal resistance [mΩ]"}, "overlaying": "y", "side": "right"},
-    }
     return FleetView(HEADER, rows, {"data": data, "layout": layout})

@@ -54,10 +54,14 @@ class BatterySeries:
     remaining_energy: list[float | None] = field(default_factory=list)  # Wh
     cells: list[list[float]] = field(default_factory=list)  # known cell voltages of each sample
     serial: str = ""
+    cycle_count: int | None = None  # the last the battery reported
+    state_of_health: float | None = None  # percent, the last the battery reported
     armed: list[tuple[float, bool]] = field(default_factory=list)  # arming changes, where the input tells
 
     @property
     def label(self) -> str:
+        if self.instance_word == "node":  # a DroneCAN battery is known by its node id
+            return f"node {self.battery}"
         return f"battery {self.battery + 1} ({self.instance_word} {self.battery})"
 
     @property
@@ -196,8 +200,16 @@ def _append(series: BatterySeries, t: float, state: Mapping[str, Any]) -> None:
     series.remaining_energy.append(None if energy is None else energy / 3600.0)
     cells = state.get("cell_voltages") or []
     series.cells.append([v for v in (_number(c) for c in cells) if v is not None and v > 0.0])
+    health = _number(state.get("state_of_health"))
+    if health is not None and health > 0:
+        series.state_of_health = health * 100.0
+    cycles = state.get("cycle_count")
+    if isinstance(cycles, int) and not isinstance(cycles, bool) and cycles > 0:
+        series.cycle_count = cycles
     serial = state.get("serial_number")
-    if isinstance(serial, str) and serial and not series.serial:
+    if isinstance(serial, int) and not isinstance(serial, bool) and serial > 0:
+        serial = str(serial)  # the concept is an integer (DroneCAN model_instance_id, PX4's uint16)
+    if isinstance(serial, str) and serial.strip("\x00 0") and not series.serial:
         series.serial = serial
 
 
