@@ -35,9 +35,13 @@ def decimate(
         part = known[int(b * size) : int((b + 1) * size)]
         if not part:
             continue
-        low = min(range(len(part)), key=lambda i: part[i][1])
-        high = max(range(len(part)), key=lambda i: part[i][1])
-        for i in sorted({low, high}) if low != high else (low, low):
-            xs.append(part[i][0])
-            ys.append(part[i][1])
+        low = min(part, key=_value)
+        high = max(part, key=_value)
+        first, second = (low, high) if low[0] <= high[0] else (high, low)
+        xs += (first[0], second[0])
+        ys += (first[1], second[1])
     return xs, ys
+
+
+def _value(point: tuple[float, float]) -> float:
+    return point[1]

@@ -17,11 +17,11 @@ import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, cast
+from typing import Any
 
 from ...errors import BattgenError
 from ...inputs.dispatch import KIND_FORMATS, file_kind, read_records
-from ...inputs.model import PlainData, package_name
+from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
 from ...ir import SourceFormat
 from ..convert import Conversion
@@ -177,13 +177,29 @@ def _package_of(checker: Checker) -> str:
     return package_name(checker.cls)
 
 
+_CONCEPTS = (
+    "pack_voltage",
+    "current",
+    "state_of_charge",
+    "temperature",
+    "discharged",
+    "remaining_energy",
+    "cell_voltages",
+    "state_of_health",
+    "cycle_count",
+    "serial_number",
+    "battery_index",
+)
+
+
 def _state(conversion: Conversion, record: Record) -> Mapping[str, Any] | None:
+    """The concepts the report draws, read off the converter's state (not its whole ``to_dict``)."""
     try:
         objs = conversion.source.build(record)
         state = conversion.func(*objs, policy="strict", report=conversion.module.LossReport())
     except (BattgenError, ValueError, TypeError, AttributeError):  # ConversionError is a ValueError
         return None
-    return cast(PlainData, state).to_dict()  # the concept state (generated BatteryState)
+    return {name: getattr(state, name, None) for name in _CONCEPTS}
 
 
 def _append(series: BatterySeries, t: float, state: Mapping[str, Any]) -> None:
