@@ -115,7 +115,8 @@ def register(subparsers: Any) -> None:
         "--message",
         metavar="NAME",
         help="qualified message name (uorb.BatteryStatus, mavlink.BATTERY_STATUS, params.BATT, ...) or an "
-        "unambiguous short form; optional when the inputs' format has one message (parameter files: params.BATT)",
+        "unambiguous short form; optional when the inputs' format has one message (parameter files: params.BATT; "
+        "MAVLink logs: mavlink.BATTERY_STATUS)",
     )
     p.add_argument("--schemas", metavar="DIR", help="schema folder (default: the bundled schemas/)")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output format (default: text)")
