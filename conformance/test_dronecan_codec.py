@@ -415,6 +415,28 @@ def test_every_union_branch_matches_pydronecan(
     check_roundtrip(side, msg, {"_branch": branch, branch: value}, exact=exact)
 
 
+def _resolve(package: str, qualified: str) -> Any:
+    """The object a qualified name (as ``battgen list`` prints it) names in the generated package."""
+    parts = qualified.split(".")
+    for cut in range(len(parts) - 1, 0, -1):
+        try:
+            obj = importlib.import_module(".".join([package, *parts[:cut]]))
+        except ModuleNotFoundError:
+            continue
+        for attr in parts[cut:]:
+            obj = getattr(obj, attr)
+        return obj
+    raise AssertionError(qualified)
+
+
+def test_every_listed_name_is_importable_as_written(sides: dict[str, Side]) -> None:
+    """DSDL names are kept exactly (CBAT, PUSHCAN), and a service's halves are GetSet.Request / .Response."""
+    side = sides["specs"]
+    for msg in side.schema.messages:
+        assert _resolve(side.package, msg.qualified_name) is side.cls(msg), msg.qualified_name
+    assert side.cls(side.by_name["dronecan.cuav.equipment.power.CBAT"]).__name__ == "CBAT"
+
+
 def test_ids_signatures_and_transfer_crc(sides: dict[str, Side]) -> None:
     for side in sides.values():
         for msg in side.schema.messages:
