@@ -69,13 +69,17 @@ class Scale(Op):
     Reading, the field's sentinel or any of ``unknown`` means unknown, and so does a value not
     above ``valid_above`` or above ``valid_max``; a devicetree list gives its first element.
     Writing, unknown becomes the first marker and a value is stored as the field holds it
-    (float16, rounded and clamped integers, at most ``valid_max``).
+    (float16, rounded and clamped integers, at most ``valid_max``). ``unit`` is the field's unit
+    where its schema names none (a DSDL comment in prose); ``negate`` when the field counts the
+    other way from the concept (CBAT reports a discharge as a negative current).
     """
 
     NAME: ClassVar[str] = "scale"
     unknown: tuple[Number, ...] = ()
     valid_above: Number | None = None
     valid_max: Number | None = None
+    unit: UnitSymbol | None = None
+    negate: bool = False
 
 
 @dataclass(frozen=True)

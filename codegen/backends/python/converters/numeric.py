@@ -21,10 +21,12 @@ class NumericEmitters(RuleContext):
         f = self.fld(fmt)
         marks = self.markers(f, op.unknown)
         c_unit = self.concepts[con.field].unit
-        f_unit = f.unit or c_unit
+        f_unit = f.unit or self.unit_param(op.unit, c_unit)
         is_list = isinstance(f.type, ArrayType)
         if not self.backward:
             mul, add = factor(f_unit, c_unit)
+            if op.negate:
+                mul, add = -mul, -add
             src = self.s(fmt)
             self.emit(f"_v = _cells.dt_first({src})" if is_list else f"_v = {src}")
             tests = ["_v is not None"] if is_list else []
@@ -40,6 +42,8 @@ class NumericEmitters(RuleContext):
                 self.emit(f"{self.t(con)} = {value}")
             return
         mul, add = factor(c_unit, f_unit)
+        if op.negate:
+            mul = -mul
         label = self.label(fmt)
         target = self.t(fmt)
         self.emit(f"_v = {self.s(con)}", "if _v is None or _v != _v:")

@@ -8,21 +8,13 @@ the bytes PX4 would send.
 from __future__ import annotations
 
 from ....errors import BattgenError
-from ....ir import FieldRef, PrimitiveKind, Rule, Unit, units
+from ....ir import FieldRef, PrimitiveKind, Rule, units
 from ....ir.ops import BitsFrom, EnumMap, PX4AuxCapacity, PX4Conversion, PX4Convert, PX4Form, PX4Int, PX4Warning
 from ..literals import float_literal, py_literal
 from .context import FLT_EPS, RuleContext, call, constant_name, f32, factor
 
 
 class PX4Emitters(RuleContext):
-    def unit_param(self, symbol: str | None, fallback: Unit | None) -> Unit | None:
-        if symbol is None:
-            return fallback
-        unit = units.lookup(symbol)
-        if unit is None:
-            raise BattgenError(f"{self.mapping.name}: unknown unit {symbol!r}")
-        return unit
-
     def visit_px4_convert(self, rule: Rule, op: PX4Convert) -> None:
         src, dst = rule.sources[0], rule.targets[0]
         f_dst = self.fld(dst)
