@@ -333,6 +333,31 @@ class PX4AuxCapacity(Op):
     above: Number | None = None
 
 
+@dataclass(frozen=True)
+class PX4BridgeEstimates(Op):
+    """PX4's uavcan bridge with its Battery object: ``from: [current, a field of the companion message]``
+    -> ``to: [discharged charge, time remaining, average current]``, reading the target's fields
+    ``soc_of`` (state of charge, 0-1) and ``capacity_of`` (mAh).
+
+    Without the companion message (raw mode) the discharged charge grows by |current| over the
+    converter input ``dt_input`` (seconds since the previous message, at most 2) from the input
+    ``discharged_input`` (the total so far, 0 if not given), and the time remaining is NaN. With it
+    (BatteryInfoAux) the discharged charge stays as given, the average current is the Battery
+    object's filter, which a disarmed vehicle holds at ``average_current`` (BAT_AVRG_CURRENT), and
+    the time remaining is state of charge times capacity over that current, NaN without a capacity.
+    """
+
+    NAME: ClassVar[str] = "px4_bridge_estimates"
+    SOURCES: ClassVar[Arity] = (2, 2)
+    TARGETS: ClassVar[Arity] = (3, 3)
+    HANDLES_MISSING: ClassVar[bool] = True
+    soc_of: str
+    capacity_of: str
+    average_current: Number
+    dt_input: str
+    discharged_input: str
+
+
 MappingOp = (
     Scale
     | Copy
@@ -358,6 +383,7 @@ MappingOp = (
     | PX4BridgeCells
     | PX4CellList
     | PX4AuxCapacity
+    | PX4BridgeEstimates
 )
 
 # every op by the name mapping files give it, in the order above

@@ -192,6 +192,9 @@ POLICIES: dict[tuple[str, str], tuple[str, ...]] = {
 }
 INPUTS: dict[tuple[str, str], tuple[str, ...]] = {
     ("devicetree", "concepts"): ("ocv_v", "temperature_c"),
+    ("dronecan", "uorb"): ("discharged_mah_before", "dt_s"),
+    ("dronecan", "uorb_v0"): ("discharged_mah_before", "dt_s"),
+    ("dronecan", "mavlink"): ("discharged_mah_before", "dt_s"),
     ("devicetree", "dronecan"): ("ocv_v", "temperature_c"),
     ("devicetree", "ardupilot_battery"): ("ocv_v", "temperature_c"),
     ("devicetree", "cbat"): ("ocv_v", "temperature_c"),

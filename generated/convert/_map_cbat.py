@@ -67,11 +67,11 @@ def forward(
     # cbat.yaml:14: scale current -> current
     # CBAT reports a discharge as negative.
     _v2 = s_cbat.current
-    t.current = float(_v2) * -1.0
+    t.current = float(_v2) * -1.0 + 0.0
 
     # cbat.yaml:15: scale average_current -> average_current
     _v3 = s_cbat.average_current
-    t.average_current = float(_v3) * -1.0
+    t.average_current = float(_v3) * -1.0 + 0.0
 
     # cbat.yaml:16: scale temperature -> temperature
     # Kelvin; 0 or below is no reading.
@@ -196,7 +196,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("dronecan.cuav.equipment.power.CBAT.current")
     else:
-        t_cbat.current = _r.f32(_v2 * -1.0)
+        t_cbat.current = _r.f32(_v2 * -1.0 + 0.0)
 
     # cbat.yaml:15: scale average_current -> average_current
     _v3 = s.average_current
@@ -204,7 +204,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("dronecan.cuav.equipment.power.CBAT.average_current")
     else:
-        t_cbat.average_current = _r.f32(_v3 * -1.0)
+        t_cbat.average_current = _r.f32(_v3 * -1.0 + 0.0)
 
     # cbat.yaml:16: scale temperature -> temperature
     # Kelvin; 0 or below is no reading.

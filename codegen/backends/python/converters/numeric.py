@@ -35,7 +35,7 @@ class NumericEmitters(RuleContext):
                 tests.append(f"_v > {py_literal(op.valid_above)}")
             if op.valid_max is not None:
                 tests.append(f"_v <= {py_literal(op.valid_max)}")
-            value = affine("float(_v)", mul, add)
+            value = _signed(affine("float(_v)", mul, add), op.negate and add == 0.0)
             if tests:
                 self.emit(f"if {' and '.join(tests)}:", f"    {self.t(con)} = {value}")
             else:
@@ -52,7 +52,7 @@ class NumericEmitters(RuleContext):
         self.emit("    if rep_u is not None:")
         self.emit_call("rep_u.unknown", [label], 2)
         self.emit("else:")
-        stored = self.store(f, affine("_v", mul, add), label, op.valid_max)
+        stored = self.store(f, _signed(affine("_v", mul, add), op.negate and add == 0.0), label, op.valid_max)
         if is_list:  # a devicetree list of one
             self.emit_assign("_w", stored, 1)
             self.emit(f"    {target} = [[_w]]")
@@ -130,3 +130,8 @@ class NumericEmitters(RuleContext):
             f"elif {' and '.join(tests) or 'True'}:",
             f"    {target} = {affine('float(_p)', mul, add)}",
         )
+
+
+def _signed(value: str, negated: bool) -> str:
+    """A negated value plus 0.0, so that a zero reads 0.0 rather than -0.0."""
+    return f"{value} + 0.0" if negated else value
