@@ -338,7 +338,7 @@ class BatteryCells:
         acc = (acc << (k2 * 16)) | int.from_bytes(struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
         r4 = self.index
         acc = (acc << 16) | int.from_bytes(
-            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack((r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0))),
+            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
             "big",
         )
         return _dc.finish(acc)
@@ -378,7 +378,7 @@ class BatteryCells:
         acc = (acc << (k2 * 16)) | int.from_bytes(struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
         r4 = self.index
         acc = (acc << 16) | int.from_bytes(
-            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack((r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0))),
+            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
             "big",
         )
         return acc
@@ -808,7 +808,7 @@ class BatteryContinuous:
             raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, rem)
         rem -= 200
         u1, u2, u3, u4, u5, u6, u7, u8, u9 = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack(
-            ((v >> rem) & 0xFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF).to_bytes(25, "big")
+            ((v >> rem) & ((1 << 200) - 1)).to_bytes(25, "big")
         )
         return cls(u1, u2, u3, u4, u5, u6, u7, u8, u9), rem
 
@@ -1098,7 +1098,7 @@ class BatteryInfoAux:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
         u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
-            (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
+            (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
         )
         x12 = ((u11 >> 7) & 0x1) != 0
         x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
@@ -1188,7 +1188,7 @@ class BatteryInfoAux:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
         u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
-            (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
+            (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
         )
         x12 = ((u11 >> 7) & 0x1) != 0
         x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
@@ -1686,7 +1686,7 @@ class BatteryPeriodic:
         rem -= 256
         u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18 = (
             _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-                ((v >> rem) & 0xFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF).to_bytes(32, "big")
+                ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
             )
         )
         if rem >= 8:
@@ -1850,7 +1850,7 @@ class BatteryPeriodic:
         rem -= 256
         u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18 = (
             _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-                ((v >> rem) & 0xFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF).to_bytes(32, "big")
+                ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
             )
         )
         return cls(f0, f1, f2, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18), rem
@@ -2196,9 +2196,7 @@ class BatteryTag:
         if rem < 192:
             raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, rem)
         rem -= 192
-        u1, u2, u3, u4, u5, u6 = _BATTERY_TAG_DECODE_STRUCT.unpack(
-            ((v >> rem) & 0xFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF).to_bytes(24, "big")
-        )
+        u1, u2, u3, u4, u5, u6 = _BATTERY_TAG_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 192) - 1)).to_bytes(24, "big"))
         return cls(u1, u2, u3, u4, u5, u6), rem
 
     def validate(self) -> list[_v.Violation]:

@@ -469,19 +469,15 @@ class CBAT:
         p29 = r28 if 0 <= r28 <= 65535 else (65535 if r28 > 65535 else 0)
         r30 = self.passed_charge
         p31 = _dc.f32bits(
-            (
-                r30
-                if -_dc.F32_MAX <= r30 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r30 > _dc.F32_MAX else (-_dc.F32_MAX if r30 < -_dc.F32_MAX else r30))
-            )
+            r30
+            if -_dc.F32_MAX <= r30 <= _dc.F32_MAX
+            else (_dc.F32_MAX if r30 > _dc.F32_MAX else (-_dc.F32_MAX if r30 < -_dc.F32_MAX else r30))
         )
         r32 = self.nominal_voltage
         p33 = _dc.f32bits(
-            (
-                r32
-                if -_dc.F32_MAX <= r32 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r32 > _dc.F32_MAX else (-_dc.F32_MAX if r32 < -_dc.F32_MAX else r32))
-            )
+            r32
+            if -_dc.F32_MAX <= r32 <= _dc.F32_MAX
+            else (_dc.F32_MAX if r32 > _dc.F32_MAX else (-_dc.F32_MAX if r32 < -_dc.F32_MAX else r32))
         )
         r34 = self.is_powering_off
         p35 = 1 if r34 else 0
@@ -605,15 +601,7 @@ class CBAT:
             raise _dc.cut(_CBAT_FIELD_ENDS_FROM_CELL_COUNT, rem)
         rem -= 441
         u5, u6, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18, u19 = (
-            _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack(
-                (
-                    (
-                        (v >> rem)
-                        & 0x1FFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF
-                    )
-                    << 7
-                ).to_bytes(56, "big")
-            )
+            _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
         )
         x20 = (u15 >> 1) & 0x7F
         x21 = ((u15 >> 10) & 0x3F) | ((u15 & 0x1) << 6)
@@ -633,28 +621,24 @@ class CBAT:
         x25 = (u15 >> 59) | (((u15 >> 48) & 0x7) << 5) | (((u16 >> 3) & 0x1F) << 8) | (((u15 >> 56) & 0x7) << 13)
         x26 = ((u16 >> 11) & 0x1F) | ((u16 & 0x7) << 5) | (((u16 >> 19) & 0x1F) << 8) | (((u16 >> 8) & 0x7) << 13)
         x27 = _dc.f32v(
-            (
-                ((u16 >> 27) & 0x1F)
-                | (((u16 >> 16) & 0x7) << 5)
-                | (((u16 >> 35) & 0x1F) << 8)
-                | (((u16 >> 24) & 0x7) << 13)
-                | (((u16 >> 43) & 0x1F) << 16)
-                | (((u16 >> 32) & 0x7) << 21)
-                | (((u16 >> 51) & 0x1F) << 24)
-                | (((u16 >> 40) & 0x7) << 29)
-            )
+            ((u16 >> 27) & 0x1F)
+            | (((u16 >> 16) & 0x7) << 5)
+            | (((u16 >> 35) & 0x1F) << 8)
+            | (((u16 >> 24) & 0x7) << 13)
+            | (((u16 >> 43) & 0x1F) << 16)
+            | (((u16 >> 32) & 0x7) << 21)
+            | (((u16 >> 51) & 0x1F) << 24)
+            | (((u16 >> 40) & 0x7) << 29)
         )
         x28 = _dc.f32v(
-            (
-                (u16 >> 59)
-                | (((u16 >> 48) & 0x7) << 5)
-                | (((u17 >> 3) & 0x1F) << 8)
-                | (((u16 >> 56) & 0x7) << 13)
-                | (((u17 >> 11) & 0x1F) << 16)
-                | ((u17 & 0x7) << 21)
-                | (((u17 >> 19) & 0x1F) << 24)
-                | (((u17 >> 8) & 0x7) << 29)
-            )
+            (u16 >> 59)
+            | (((u16 >> 48) & 0x7) << 5)
+            | (((u17 >> 3) & 0x1F) << 8)
+            | (((u16 >> 56) & 0x7) << 13)
+            | (((u17 >> 11) & 0x1F) << 16)
+            | ((u17 & 0x7) << 21)
+            | (((u17 >> 19) & 0x1F) << 24)
+            | (((u17 >> 8) & 0x7) << 29)
         )
         x29 = ((u17 >> 18) & 0x1) != 0
         x30 = (u17 >> 26) | (((u17 >> 16) & 0x3) << 6) | (((u18 >> 2) & 0x3F) << 8) | (((u17 >> 24) & 0x3) << 14)
@@ -752,19 +736,15 @@ class CBAT:
         p29 = r28 if 0 <= r28 <= 65535 else (65535 if r28 > 65535 else 0)
         r30 = self.passed_charge
         p31 = _dc.f32bits(
-            (
-                r30
-                if -_dc.F32_MAX <= r30 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r30 > _dc.F32_MAX else (-_dc.F32_MAX if r30 < -_dc.F32_MAX else r30))
-            )
+            r30
+            if -_dc.F32_MAX <= r30 <= _dc.F32_MAX
+            else (_dc.F32_MAX if r30 > _dc.F32_MAX else (-_dc.F32_MAX if r30 < -_dc.F32_MAX else r30))
         )
         r32 = self.nominal_voltage
         p33 = _dc.f32bits(
-            (
-                r32
-                if -_dc.F32_MAX <= r32 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r32 > _dc.F32_MAX else (-_dc.F32_MAX if r32 < -_dc.F32_MAX else r32))
-            )
+            r32
+            if -_dc.F32_MAX <= r32 <= _dc.F32_MAX
+            else (_dc.F32_MAX if r32 > _dc.F32_MAX else (-_dc.F32_MAX if r32 < -_dc.F32_MAX else r32))
         )
         r34 = self.is_powering_off
         p35 = 1 if r34 else 0
@@ -885,15 +865,7 @@ class CBAT:
             raise _dc.cut(_CBAT_FIELD_ENDS_FROM_CELL_COUNT, rem)
         rem -= 441
         u5, u6, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18, u19 = (
-            _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack(
-                (
-                    (
-                        (v >> rem)
-                        & 0x1FFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF
-                    )
-                    << 7
-                ).to_bytes(56, "big")
-            )
+            _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
         )
         x20 = (u15 >> 1) & 0x7F
         x21 = ((u15 >> 10) & 0x3F) | ((u15 & 0x1) << 6)
@@ -913,28 +885,24 @@ class CBAT:
         x25 = (u15 >> 59) | (((u15 >> 48) & 0x7) << 5) | (((u16 >> 3) & 0x1F) << 8) | (((u15 >> 56) & 0x7) << 13)
         x26 = ((u16 >> 11) & 0x1F) | ((u16 & 0x7) << 5) | (((u16 >> 19) & 0x1F) << 8) | (((u16 >> 8) & 0x7) << 13)
         x27 = _dc.f32v(
-            (
-                ((u16 >> 27) & 0x1F)
-                | (((u16 >> 16) & 0x7) << 5)
-                | (((u16 >> 35) & 0x1F) << 8)
-                | (((u16 >> 24) & 0x7) << 13)
-                | (((u16 >> 43) & 0x1F) << 16)
-                | (((u16 >> 32) & 0x7) << 21)
-                | (((u16 >> 51) & 0x1F) << 24)
-                | (((u16 >> 40) & 0x7) << 29)
-            )
+            ((u16 >> 27) & 0x1F)
+            | (((u16 >> 16) & 0x7) << 5)
+            | (((u16 >> 35) & 0x1F) << 8)
+            | (((u16 >> 24) & 0x7) << 13)
+            | (((u16 >> 43) & 0x1F) << 16)
+            | (((u16 >> 32) & 0x7) << 21)
+            | (((u16 >> 51) & 0x1F) << 24)
+            | (((u16 >> 40) & 0x7) << 29)
         )
         x28 = _dc.f32v(
-            (
-                (u16 >> 59)
-                | (((u16 >> 48) & 0x7) << 5)
-                | (((u17 >> 3) & 0x1F) << 8)
-                | (((u16 >> 56) & 0x7) << 13)
-                | (((u17 >> 11) & 0x1F) << 16)
-                | ((u17 & 0x7) << 21)
-                | (((u17 >> 19) & 0x1F) << 24)
-                | (((u17 >> 8) & 0x7) << 29)
-            )
+            (u16 >> 59)
+            | (((u16 >> 48) & 0x7) << 5)
+            | (((u17 >> 3) & 0x1F) << 8)
+            | (((u16 >> 56) & 0x7) << 13)
+            | (((u17 >> 11) & 0x1F) << 16)
+            | ((u17 & 0x7) << 21)
+            | (((u17 >> 19) & 0x1F) << 24)
+            | (((u17 >> 8) & 0x7) << 29)
         )
         x29 = ((u17 >> 18) & 0x1) != 0
         x30 = (u17 >> 26) | (((u17 >> 16) & 0x3) << 6) | (((u18 >> 2) & 0x3F) << 8) | (((u17 >> 24) & 0x3) << 14)
