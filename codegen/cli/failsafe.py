@@ -45,6 +45,7 @@ from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
 from ..errors import BattgenError
+from ..inputs import parameter_files
 
 EXIT_OK, EXIT_UNREADABLE = 0, 2
 
@@ -80,6 +81,8 @@ def run(args: argparse.Namespace) -> int:
         if args.params:
             values: dict[str, float] = read_parameter_values(Path(args.params))
             where = args.params
+            for repeat in parameter_files.repeats(parameter_files.load(Path(args.params))):
+                print(f"battgen: warning: {args.params}:{repeat.lines[-1]}: {repeat.message()}", file=sys.stderr)
         elif kind == "bin":
             values, where = bin_parameters(stream), f"{args.stream} (PARM records)"
         else:

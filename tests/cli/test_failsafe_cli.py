@@ -149,3 +149,15 @@ def test_params_from_devicetree_without_battery(tmp_path: Path, capsys: pytest.C
     dts.write_text("/dts-v1/;\n/ {\n};\n", encoding="utf-8")
     assert main(["params", "--from-devicetree", str(dts)]) == 2
     assert 'expected a compatible = "simple-battery" node' in capsys.readouterr().err
+
+
+def test_repeated_parameter_warns_and_the_last_value_counts(
+    tmp_path: Path, files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, stream = files
+    params = tmp_path / "twice.param"
+    params.write_text("BATT_LOW_VOLT,9\r\nBATT_FS_LOW_ACT,2\r\nBATT_LOW_VOLT,10.5\r\n", encoding="utf-8")
+    assert main(["failsafe", "--params", str(params), str(stream)]) == 0
+    captured = capsys.readouterr()
+    assert "twice.param:3: BATT_LOW_VOLT is set 2 times (lines 1, 3): the last value, 10.5" in captured.err
+    assert captured.out.startswith("t=    16.000s  battery 1 LOW ")  # 10.5 V, not 9 V
