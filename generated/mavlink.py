@@ -6,11 +6,12 @@ Module: mavlink.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
-import struct
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+import enum as _enum
+import struct as _struct
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from . import _mavlink as _mav
 from . import _meta as _m
@@ -26,7 +27,7 @@ __all__ = [
 ]
 
 
-class MavBatteryChargeState(enum.IntEnum):
+class MavBatteryChargeState(_enum.IntEnum):
     """How far the battery is discharged, for warnings and failsafes.
 
     mavlink.MAV_BATTERY_CHARGE_STATE: values.
@@ -42,7 +43,7 @@ class MavBatteryChargeState(enum.IntEnum):
     CHARGING = 7
 
 
-class MavBatteryFault(enum.IntFlag):
+class MavBatteryFault(_enum.IntFlag):
     """Fault flags; set together with charge state FAILED or UNHEALTHY.
 
     mavlink.MAV_BATTERY_FAULT: bit masks, combined with |.
@@ -59,7 +60,7 @@ class MavBatteryFault(enum.IntFlag):
     BATTERY_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION = 256
 
 
-class MavBatteryFunction(enum.IntEnum):
+class MavBatteryFunction(_enum.IntEnum):
     """What the battery powers.
 
     mavlink.MAV_BATTERY_FUNCTION: values.
@@ -72,7 +73,7 @@ class MavBatteryFunction(enum.IntEnum):
     PAYLOAD = 4
 
 
-class MavBatteryMode(enum.IntEnum):
+class MavBatteryMode(_enum.IntEnum):
     """Operating mode reported by a smart battery.
 
     mavlink.MAV_BATTERY_MODE: values.
@@ -83,7 +84,7 @@ class MavBatteryMode(enum.IntEnum):
     HOT_SWAP = 2
 
 
-class MavBatteryType(enum.IntEnum):
+class MavBatteryType(_enum.IntEnum):
     """Battery chemistry.
 
     mavlink.MAV_BATTERY_TYPE: values.
@@ -97,7 +98,7 @@ class MavBatteryType(enum.IntEnum):
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
-_BATTERY_STATUS_PAYLOAD = struct.Struct("<iih10HhBBBbiB4HBI")
+_BATTERY_STATUS_PAYLOAD = _struct.Struct("<iih10HhBBBbiB4HBI")
 _BATTERY_STATUS_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("current_consumed", "current_consumed", "i", 0),
     ("energy_consumed", "energy_consumed", "i", 0),
@@ -114,7 +115,7 @@ _BATTERY_STATUS_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("mode", "mode", "B", 0),
     ("fault_bitmask", "fault_bitmask", "I", 0),
 )
-_BATTERY_STATUS_DTYPE: list[tuple[Any, ...]] = [
+_BATTERY_STATUS_DTYPE: list[tuple[_Any, ...]] = [
     ("current_consumed", "<i4"),
     ("energy_consumed", "<i4"),
     ("temperature", "<i2"),
@@ -227,17 +228,17 @@ _BATTERY_STATUS_FAULT_BITMASK_SPEC = _v.Number(
 )
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryStatus:
     """State of one battery.
 
     Schema: mavlink.BATTERY_STATUS (mavlink, battery.xml:114).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "mavlink.BATTERY_STATUS"
+    QUALIFIED_NAME: _ClassVar[str] = "mavlink.BATTERY_STATUS"
 
-    id: int = dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery instance."))
-    battery_function: int = dataclasses.field(
+    id: int = _dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery instance."))
+    battery_function: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="battery_function",
@@ -246,11 +247,11 @@ class BatteryStatus:
             doc="What the battery powers.",
         ),
     )
-    type: int = dataclasses.field(
+    type: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Battery chemistry."),
     )
-    temperature: int = dataclasses.field(
+    temperature: int = _dataclasses.field(
         default=32767,
         metadata=_m.meta(
             name="temperature",
@@ -264,7 +265,7 @@ class BatteryStatus:
             doc="Battery temperature; INT16_MAX when unknown.",
         ),
     )
-    voltages: list[int] = dataclasses.field(
+    voltages: list[int] = _dataclasses.field(
         default_factory=lambda: [65535] * 10,
         metadata=_m.meta(
             name="voltages",
@@ -281,7 +282,7 @@ class BatteryStatus:
             "rest into the following cells.",
         ),
     )
-    current_battery: int = dataclasses.field(
+    current_battery: int = _dataclasses.field(
         default=-1,
         metadata=_m.meta(
             name="current_battery",
@@ -295,7 +296,7 @@ class BatteryStatus:
             doc="Battery current; -1 when not measured.",
         ),
     )
-    current_consumed: int = dataclasses.field(
+    current_consumed: int = _dataclasses.field(
         default=-1,
         metadata=_m.meta(
             name="current_consumed",
@@ -309,7 +310,7 @@ class BatteryStatus:
             doc="Charge drawn so far; -1 when not estimated.",
         ),
     )
-    energy_consumed: int = dataclasses.field(
+    energy_consumed: int = _dataclasses.field(
         default=-1,
         metadata=_m.meta(
             name="energy_consumed",
@@ -323,7 +324,7 @@ class BatteryStatus:
             doc="Energy drawn so far; -1 when not estimated.",
         ),
     )
-    battery_remaining: int = dataclasses.field(
+    battery_remaining: int = _dataclasses.field(
         default=-1,
         metadata=_m.meta(
             name="battery_remaining",
@@ -337,7 +338,7 @@ class BatteryStatus:
             doc="Energy left, 0 to 100; -1 when not estimated.",
         ),
     )
-    time_remaining: int = dataclasses.field(
+    time_remaining: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="time_remaining",
@@ -348,7 +349,7 @@ class BatteryStatus:
             doc="Time left; 0 when not estimated.",
         ),
     )
-    charge_state: int = dataclasses.field(
+    charge_state: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="charge_state",
@@ -358,7 +359,7 @@ class BatteryStatus:
             doc="Discharge level, for warnings and failsafes.",
         ),
     )
-    voltages_ext: list[int] = dataclasses.field(
+    voltages_ext: list[int] = _dataclasses.field(
         default_factory=lambda: [0] * 4,
         metadata=_m.meta(
             name="voltages_ext",
@@ -371,7 +372,7 @@ class BatteryStatus:
             doc="Voltages of cells 11-14; 0 in cells that do not exist (a measured 0 is sent as 1).",
         ),
     )
-    mode: int = dataclasses.field(
+    mode: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="mode",
@@ -381,7 +382,7 @@ class BatteryStatus:
             doc="Battery mode; 0 when not reported or in normal use.",
         ),
     )
-    fault_bitmask: int = dataclasses.field(
+    fault_bitmask: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="fault_bitmask",
@@ -398,9 +399,9 @@ class BatteryStatus:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["id"] = self.id
         out["battery_function"] = self.battery_function
         out["type"] = self.type
@@ -418,7 +419,7 @@ class BatteryStatus:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatus:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -476,10 +477,10 @@ class BatteryStatus:
             obj.fault_bitmask = _m.as_int(data["fault_bitmask"], "fault_bitmask")
         return obj
 
-    MSG_ID: ClassVar[int] = 147
-    CRC_EXTRA: ClassVar[int] = 154
-    MAVLINK_BASE_LENGTH: ClassVar[int] = 36
-    MAVLINK_MAX_LENGTH: ClassVar[int] = 54
+    MSG_ID: _ClassVar[int] = 147
+    CRC_EXTRA: _ClassVar[int] = 154
+    MAVLINK_BASE_LENGTH: _ClassVar[int] = 36
+    MAVLINK_MAX_LENGTH: _ClassVar[int] = 54
 
     def encode(self, *, truncate: bool = True) -> bytes:
         """The MAVLink 2 payload, 54 bytes in wire order; trailing zero bytes
@@ -502,7 +503,7 @@ class BatteryStatus:
                 self.mode,
                 self.fault_bitmask,
             )
-        except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+        except (_struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
             raise _mav.explain("BATTERY_STATUS", self, _BATTERY_STATUS_FIELDS) from exc
         if len(self.voltages) != 10 or len(self.voltages_ext) != 4:
             raise _mav.explain("BATTERY_STATUS", self, _BATTERY_STATUS_FIELDS)
@@ -594,7 +595,7 @@ class BatteryStatus:
         return cls.decode(payload)
 
     @classmethod
-    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, Any]:
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, _Any]:
         """Records of 54 bytes (zero-filled payloads) -> columns keyed by field name: numpy
         arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
         tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
@@ -622,9 +623,9 @@ class BatteryStatus:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        a: Any
-        e: Any
-        r_battery_remaining: Any
+        a: _Any
+        e: _Any
+        r_battery_remaining: _Any
         try:
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)

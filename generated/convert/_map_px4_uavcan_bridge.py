@@ -6,7 +6,7 @@ PX4's uavcan battery bridge.
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
 from ..dronecan.uavcan.equipment.power import BatteryInfo
@@ -117,9 +117,9 @@ def forward(
     # id = msg.battery_id (0-based, copied as it is)
     t_status.id = _r.c_wrap(int(s_info.battery_id), 8, False)
 
-    # px4_uavcan_bridge.yaml:41: const math.nan -> time_remaining_s
+    # px4_uavcan_bridge.yaml:41: const _math.nan -> time_remaining_s
     # time_remaining_s = NAN (raw mode)
-    t_status.time_remaining_s = math.nan
+    t_status.time_remaining_s = _math.nan
 
     # px4_uavcan_bridge.yaml:42: px4_bridge_cells info.voltage, aux.voltage_cell -> voltage_cell_v, cell_count
     # Without BatteryInfoAux: voltage_cell_v[0] = msg.voltage, cell_count = 1. With it: cell_count = min(cells, 14) and
@@ -164,7 +164,7 @@ def forward(
         if _x17 > 1.1920928955078125e-07:
             t_status.nominal_voltage = _x17
         else:
-            t_status.nominal_voltage = math.nan
+            t_status.nominal_voltage = _math.nan
 
     # px4_uavcan_bridge.yaml:66: px4_int aux.is_powering_off -> is_powering_off
     if s_aux is not None:
@@ -203,9 +203,9 @@ def forward(
         rep_u.unknown("uorb.BatteryStatus.remaining")
     if rep_u is not None and _r.is_marker(t_status.scale, -1.0):
         rep_u.unknown("uorb.BatteryStatus.scale")
-    if rep_u is not None and _r.is_marker(t_status.time_remaining_s, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.time_remaining_s, _math.nan):
         rep_u.unknown("uorb.BatteryStatus.time_remaining_s")
-    if rep_u is not None and _r.is_marker(t_status.temperature, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.temperature, _math.nan):
         rep_u.unknown("uorb.BatteryStatus.temperature")
     if rep_u is not None and _r.is_marker(t_status.cell_count, 0):
         rep_u.unknown("uorb.BatteryStatus.cell_count")

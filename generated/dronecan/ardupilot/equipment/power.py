@@ -6,11 +6,13 @@ Module: dronecan.ardupilot.equipment.power.
 
 from __future__ import annotations
 
-import dataclasses
-import functools
-import struct
-from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any, ClassVar
+import dataclasses as _dataclasses
+import functools as _functools
+import struct as _struct
+from collections.abc import Mapping as _Mapping
+from typing import TYPE_CHECKING
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from .... import _dronecan as _dc
 from .... import _meta as _m
@@ -23,17 +25,17 @@ __all__ = ["BatteryInfoAux"]
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_INFO_AUX_ENCODE_STRUCT = struct.Struct("<IHB")
+_BATTERY_INFO_AUX_ENCODE_STRUCT = _struct.Struct("<IHB")
 # float16 fields packed as float32 ...
-_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<2f")
+_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2f")
 # ... and read back as bits, from which each half is cut
-_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<2I")
+_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2I")
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<HHHHH")
+_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHHHH")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_AUX_FIELD_ENDS = ((56, "BatteryInfoAux.timestamp.usec"),)
 # fixed fields as decoded
-_BATTERY_INFO_AUX_DECODE_STRUCT = struct.Struct("<IHB")
+_BATTERY_INFO_AUX_DECODE_STRUCT = _struct.Struct("<IHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT = (
     (16, "BatteryInfoAux.cycle_count"),
@@ -44,7 +46,7 @@ _BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT = (
     (73, "BatteryInfoAux.battery_id"),
 )
 # fixed fields as decoded
-_BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<HHeeH")
+_BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHeeH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -60,14 +62,14 @@ _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC = _v.Number(type="bool", kind="bool", low
 _BATTERY_INFO_AUX_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
 
 
-@functools.cache
+@_functools.cache
 def _timestamp_class() -> type[_dronecan_uavcan.Timestamp]:
     from ....dronecan.uavcan import Timestamp as cls
 
     return cls
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryInfoAux:
     """Extra battery data that complements uavcan.equipment.power.BatteryInfo.
 
@@ -77,13 +79,13 @@ class BatteryInfoAux:
     ardupilot/equipment/power/20004.BatteryInfoAux.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryInfoAux"
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryInfoAux"
 
-    timestamp: _dronecan_uavcan.Timestamp = dataclasses.field(
+    timestamp: _dronecan_uavcan.Timestamp = _dataclasses.field(
         default_factory=lambda: _timestamp_class()(),
         metadata=_m.meta(name="timestamp", type="dronecan.uavcan.Timestamp", doc="When the current was last measured."),
     )
-    voltage_cell: list[float] = dataclasses.field(
+    voltage_cell: list[float] = _dataclasses.field(
         default_factory=list,
         metadata=_m.meta(
             name="voltage_cell",
@@ -93,17 +95,17 @@ class BatteryInfoAux:
             doc="Per-cell voltages; the length is the cell count.",
         ),
     )
-    cycle_count: int = dataclasses.field(
+    cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cycle_count", type="uint16", doc="Full charge/discharge cycles (partial cycles add up)."
         ),
     )
-    over_discharge_count: int = dataclasses.field(
+    over_discharge_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Discharges beyond the rated capacity."),
     )
-    max_current: float = dataclasses.field(
+    max_current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="max_current",
@@ -113,7 +115,7 @@ class BatteryInfoAux:
             doc="Peak current since the previous message.",
         ),
     )
-    nominal_voltage: float = dataclasses.field(
+    nominal_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="nominal_voltage",
@@ -123,11 +125,11 @@ class BatteryInfoAux:
             doc="Nominal pack voltage, for Wh <-> Ah conversion; zero disables the conversion.",
         ),
     )
-    is_powering_off: bool = dataclasses.field(
+    is_powering_off: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(name="is_powering_off", type="bool", doc="About to switch off; false if unknown"),
     )
-    battery_id: int = dataclasses.field(
+    battery_id: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="battery_id", type="uint8", doc="Which battery of this vehicle (0 = main)")
     )
 
@@ -137,9 +139,9 @@ class BatteryInfoAux:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["timestamp"] = self.timestamp.to_dict()
         out["voltage_cell"] = list(self.voltage_cell)
         out["cycle_count"] = self.cycle_count
@@ -151,7 +153,7 @@ class BatteryInfoAux:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryInfoAux:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfoAux:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -191,8 +193,8 @@ class BatteryInfoAux:
             obj.battery_id = _m.as_int(data["battery_id"], "battery_id")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 20004
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x7D7F49FC75484882
+    DATA_TYPE_ID: _ClassVar[int | None] = 20004
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x7D7F49FC75484882
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -205,7 +207,7 @@ class BatteryInfoAux:
         if k4 > 255:
             raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
         acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
+        acc = (acc << (k4 * 16)) | int.from_bytes(_struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
         g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
@@ -256,7 +258,7 @@ class BatteryInfoAux:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfoAux:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f1: list[Any]
+        f1: list[_Any]
         n = len(data)
         if n < 7:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, n << 3)
@@ -274,7 +276,7 @@ class BatteryInfoAux:
         if rem < n6:
             raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
         rem -= n6
-        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
+        f1 = list(_struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
@@ -298,7 +300,7 @@ class BatteryInfoAux:
         if k4 > 255:
             raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
         acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
+        acc = (acc << (k4 * 16)) | int.from_bytes(_struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
         g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
@@ -348,7 +350,7 @@ class BatteryInfoAux:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfoAux, int]:
-        f1: list[Any]
+        f1: list[_Any]
         if rem < 56:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, rem)
         rem -= 56
@@ -364,7 +366,7 @@ class BatteryInfoAux:
         if rem < n6:
             raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
         rem -= n6
-        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
+        f1 = list(_struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
@@ -378,10 +380,10 @@ class BatteryInfoAux:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        a: Any
-        e: Any
-        sub: Any
+        x: _Any
+        a: _Any
+        e: _Any
+        sub: _Any
         try:
             x = self.timestamp
             if x.QUALIFIED_NAME != "dronecan.uavcan.Timestamp":

@@ -54,8 +54,8 @@ class _Codec:
         id_name = _free_name("DATA_TYPE_ID", taken)
         sig_name = _free_name("DATA_TYPE_SIGNATURE", taken | {id_name})
         lines = [
-            f"{id_name}: ClassVar[int | None] = {py_literal(info.data_type_id)}",
-            f"{sig_name}: ClassVar[int] = 0x{info.signature:016X}",
+            f"{id_name}: _ClassVar[int | None] = {py_literal(info.data_type_id)}",
+            f"{sig_name}: _ClassVar[int] = 0x{info.signature:016X}",
         ]
         if info.union:
             emitter.union_attr = _free_name("union_field", taken | {id_name, sig_name})
@@ -64,7 +64,8 @@ class _Codec:
                 f'_m.meta(name={py_literal(emitter.union_attr)}, type="union tag", '
                 'doc="Name of the field this union holds (the one encoded)")'
             )
-            lines.append(f"{emitter.union_attr}: str = dataclasses.field(default={py_literal(first)}, metadata={meta})")
+            default = py_literal(first)
+            lines.append(f"{emitter.union_attr}: str = _dataclasses.field(default={default}, metadata={meta})")
         methods = [
             emitter.method_encode(),
             emitter.method_decode(),
