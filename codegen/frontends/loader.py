@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Protocol
 
@@ -61,13 +61,18 @@ def is_schema_dir(path: Path) -> bool:
     return any((path / fmt).is_dir() for fmt in FORMAT_FRONTENDS)
 
 
-def load_schema_dir(root: Path) -> Schema:
-    """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset)."""
+def load_schema_dir(root: Path, *, include_paths: Sequence[Path] = ()) -> Schema:
+    """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset); MAVLink includes
+    may also come from ``include_paths`` (README Limits)."""
     schema = Schema()
     for fmt in FORMAT_FRONTENDS:
         sub = root / fmt
         if sub.is_dir():
-            part: Schema = frontend(fmt).parse_dir(sub)
+            part: Schema = (
+                mavlink.parse_dir(sub, include_paths=include_paths)
+                if fmt == "mavlink"
+                else frontend(fmt).parse_dir(sub)
+            )
             schema = schema.merged(part)
     if (root / MAPPINGS_DIR).is_dir():
         # after the formats, so every reference to a message or field can be checked
@@ -80,17 +85,23 @@ def load_schema_dir(root: Path) -> Schema:
     return schema
 
 
-def load(paths: Iterable[Path]) -> Schema:
-    """Parse schema folders and single files (format from the extension) into one Schema."""
+def load(paths: Iterable[Path], *, include_paths: Sequence[Path] = ()) -> Schema:
+    """Parse schema folders and single files (format from the extension) into one Schema;
+    ``include_paths``: folders MAVLink <include>s may read besides the schema folder."""
     schema = Schema()
     for path in paths:
         if path.is_dir():
             if not is_schema_dir(path):
                 expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
                 raise BattgenError(f"{path}: not a schema folder (expected sub-folders {expected})")
-            part = load_schema_dir(path)
+            part = load_schema_dir(path, include_paths=include_paths)
         elif path.is_file():
-            part = frontend(format_of_file(path)).parse_file(path)
+            fmt = format_of_file(path)
+            part = (
+                mavlink.parse_file(path, include_paths=include_paths)
+                if fmt == "mavlink"
+                else frontend(fmt).parse_file(path)
+            )
         else:
             raise BattgenError(f"{path}: no such file or folder")
         schema = schema.merged(part)
