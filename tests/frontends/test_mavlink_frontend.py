@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import pytest
 from pymavlink.generator import mavparse
@@ -145,6 +146,11 @@ def test_unknown_field_type(tmp_path: Path, type_text: str) -> None:
         ('<field type="int16_t" name="f" invalid="-1.5">x</field>', "fits int16"),
         ('<field type="uint16_t" name="f" invalid="[UINT16_MAX]">x</field>', "only on an array field"),
         ('<field type="uint8_t" name="f" invalid="[1">x</field>', "expected invalid= to be"),
+        ('<field type="uint8_t[2]" name="f" invalid="[1,2,3,]">x</field>', "at most 2 positions"),
+        ('<field type="uint8_t[2]" name="f" invalid="[,,]">x</field>', "expected invalid= to be"),
+        ('<field type="uint8_t[2]" name="f" invalid="[1,x,]">x</field>', "expected invalid= to be"),
+        ('<field type="uint8_t[2]" name="f" invalid="[1,256,]">x</field>', "fits uint8"),
+        ('<field type="uint8_t" name="f" invalid="[0,]">x</field>', "only on an array field"),
         ('<field type="uint8_t" name="f" minValue="low">x</field>', "expected a number as minValue="),
         ('<field type="uint8_t" name="f" default="x">x</field>', "expected a number as default="),
         ('<field type="uint8_t" name="f" instance="yes">x</field>', 'expected instance="true" or "false"'),
@@ -360,7 +366,7 @@ def test_battery_status_message(battery_schema: Schema) -> None:
     assert battery_schema.sources == ("battery.xml",)
     assert (msg.name, msg.location.file) == ("BATTERY_STATUS", "battery.xml")
     assert msg.location.line == line_of(SCHEMAS / "battery.xml", '<message id="147"')
-    assert msg.doc == "State of one battery."
+    assert msg.doc.startswith("Battery information. Updates GCS with flight controller battery status.")
     info = msg.mavlink
     assert info is not None
     assert (info.msg_id, info.crc_extra, info.dialect, info.base_length, info.max_length) == (
@@ -395,7 +401,8 @@ def test_battery_status_units_and_sentinels(battery_schema: Schema) -> None:
     assert voltages.invalid == Sentinel(65535, "[UINT16_MAX]", per_element=True)
     for name in ("current_battery", "current_consumed", "energy_consumed", "battery_remaining"):
         assert msg.field(name).invalid == Sentinel(-1, "-1"), name
-    assert msg.field("voltages_ext").invalid is None
+    assert msg.field("time_remaining").invalid == Sentinel(0, "0")  # upstream's markers since 2021
+    assert msg.field("voltages_ext").invalid == Sentinel(0, "[0]", per_element=True)
 
 
 def test_battery_status_enums(battery_schema: Schema) -> None:
@@ -408,7 +415,8 @@ def test_battery_status_enums(battery_schema: Schema) -> None:
         "mode": ("mavlink.MAV_BATTERY_MODE",),
         "fault_bitmask": ("mavlink.MAV_BATTERY_FAULT",),
     }
-    assert [e.name for e in battery_schema.enums] == sorted(n for (n,) in refs.values())
+    others = ("mavlink.MAV_BATTERY_STATUS_FLAGS",)  # BATTERY_STATUS_V2's
+    assert [e.name for e in battery_schema.enums] == sorted([n for (n,) in refs.values()] + list(others))
     fault = battery_schema.enum("mavlink.MAV_BATTERY_FAULT")
     assert fault.kind is EnumKind.BITMASK
     assert [e.value for e in fault.entries] == [1 << i for i in range(9)]
@@ -419,3 +427,33 @@ def test_battery_status_enums(battery_schema: Schema) -> None:
     assert all(
         e.doc and e.location and e.location.file == "battery.xml" for en in battery_schema.enums for e in en.entries
     )
+
+
+@pytest.mark.parametrize(
+    ("attr", "value", "elements"),
+    [
+        # the array forms of the MAVLink guide's invalid attribute; [0,] is development.xml's CONTROL_STATUS
+        ("[0,]", 0, (0,)),
+        ("[7,,UINT8_MAX,]", 7, (7, None, 255)),
+        ("[,5]", 5, (None, 5)),
+        ("[3]", 3, ()),
+        ("[3:]", 3, ()),
+    ],
+)
+def test_array_invalid_forms(tmp_path: Path, attr: str, value: int, elements: tuple[int | None, ...]) -> None:
+    path = write(tmp_path, "a.xml", message(fld("uint8_t[4]", "a", f' invalid="{attr}"')))
+    s = mavlink.parse_file(path, root=tmp_path).message("mavlink.M").field("a").invalid
+    assert s == Sentinel(value, attr, per_element=True, elements=elements)
+    expected = list(elements) + [None] * (4 - len(elements)) if elements else [value] * 4
+    assert s is not None and [s.marker_at(i) for i in range(4)] == expected
+
+
+def test_positional_invalid_in_generated_code(tmp_path: Path, import_generated: Any) -> None:
+    """Marked positions default to their marker; an element without a marker is always known."""
+    fields = fld("int16_t[3]", "a", ' invalid="[-5,,7,]"') + fld("int16_t[2]", "b", ' invalid="[-5,7,]"')
+    path = write(tmp_path, "p.xml", message(fields))
+    m = import_generated(mavlink.parse_file(path, root=tmp_path), "mavlink").M()
+    assert (m.a, m.b) == ([-5, 0, 7], [-5, 7])
+    assert m.is_known("a") and not m.is_known("b")
+    m.b = [-5, 8]
+    assert m.is_known("b")
