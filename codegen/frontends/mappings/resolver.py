@@ -11,7 +11,19 @@ import dataclasses
 from collections.abc import Iterator
 
 from ...errors import SchemaError
-from ...ir import CONCEPTS_ENDPOINT, ArrayType, Concept, Endpoint, FieldRef, Message, Rule, Schema, units
+from ...ir import (
+    CONCEPTS_ENDPOINT,
+    ArrayType,
+    Concept,
+    Endpoint,
+    FieldRef,
+    Message,
+    PrimitiveKind,
+    PrimitiveType,
+    Rule,
+    Schema,
+    units,
+)
 from ...ir.basics import Unit
 from ...ir.mapping_values import ConstantRef
 from ...ir.ops import Cells, PX4Conversion, PX4Convert, Scale
@@ -83,6 +95,30 @@ class Resolver:
                 ):
                     raise SchemaError(display, line, f"expected an array field for op 'cells', got {ref.field!r}")
         self._check_units(rule, display, line)
+        self._check_written_marker(rule, display, line)
+
+    def _check_written_marker(self, rule: Rule, display: str, line: int) -> None:
+        """The first ``unknown`` marker is what a converter writes for unknown: an integer field needs
+        an integer one (NaN and fractions are for float fields)."""
+        markers = getattr(rule.op, "unknown", None)
+        if not isinstance(markers, tuple) or not markers or self.schema is None:
+            return
+        first = markers[0]
+        if not isinstance(first, float) or first.is_integer():
+            return
+        for ref in rule.sources + rule.targets:
+            if ref.message == CONCEPTS_ENDPOINT or not ref.field:
+                continue
+            t = self.schema.message(ref.message).field(ref.field).type
+            while isinstance(t, ArrayType):
+                t = t.element
+            if isinstance(t, PrimitiveType) and t.kind is not PrimitiveKind.FLOAT:
+                raise SchemaError(
+                    display,
+                    line,
+                    f"expected an integer as the first 'unknown' marker (written for unknown): {ref.field} holds "
+                    f"{t.kind.value}{t.bits} values, got {first}",
+                )
 
     def _unit(self, ref: FieldRef) -> Unit | None:
         if ref.message == CONCEPTS_ENDPOINT:
