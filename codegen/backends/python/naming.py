@@ -12,7 +12,7 @@ from ...ir import DronecanKind, Message, Schema, SourceFormat
 _NON_IDENT = re.compile(r"[^0-9A-Za-z_]+")
 _WORD_BOUNDARY = re.compile(r"(?<=[a-z0-9])(?=[A-Z])|(?<=[A-Z])(?=[A-Z][a-z])")
 _REGEX_TOKENS = re.compile(r"\[[^\]]*\][+*?]?|\\d[+*?]?|[+*?]")
-# The one clash rule (README "Names in the generated code"): a schema name that would clash with a
+# The one clash rule (README "Names", under "Generated package"): a schema name that would clash with a
 # name the generated code needs gets a trailing "_" (repeated while it still clashes). The generated
 # modules import what they use under private aliases (``_struct``, ``_ClassVar``), which no schema
 # name can spell (identifier() strips leading underscores), so what is left to avoid is below.
@@ -35,7 +35,7 @@ RESERVED_MEMBERS = frozenset(
     }
 )  # fmt: skip
 # Builtins a generated class body names unqualified (annotations, decorators): a member of that
-# name would be what the rest of the class body sees (tests/backends/test_hostile_names.py keeps
+# name would be what the rest of the class body sees (tests/backends/test_clashing_names.py keeps
 # this list in step with the templates).
 CLASS_SCOPE_NAMES = frozenset(
     {"bool", "bytearray", "bytes", "classmethod", "dict", "float", "int", "list", "object", "staticmethod", "str"}
@@ -122,7 +122,7 @@ def module_path(msg: Message) -> str:
 
 def class_name(msg: Message) -> str:
     if msg.format is SourceFormat.DRONECAN and msg.dronecan is not None:
-        base = camel(msg.dronecan.full_name.rsplit(".", 1)[-1])
+        base = identifier(msg.dronecan.full_name.rsplit(".", 1)[-1])  # the DSDL name exactly: CBAT stays CBAT
         if msg.dronecan.kind is DronecanKind.REQUEST:
             return base + "Request"
         if msg.dronecan.kind is DronecanKind.RESPONSE:
