@@ -218,7 +218,9 @@ def _save(name: str, target: Target, text: str, exc: BaseException) -> None:
     folder = CRASHERS / f"schema-{name}"
     folder.mkdir(parents=True, exist_ok=True)
     stem = hashlib.sha1(site.encode()).hexdigest()[:12]
-    path = folder / f"{stem}{Path(target.victim).suffix}"
+    suffix = Path(target.victim).suffix
+    # a .uavcan file below tests/ would make the folder look like a DSDL root to `battgen list tests`
+    path = folder / f"{stem}{suffix}{'.txt' if suffix == '.uavcan' else ''}"
     if not path.exists() or len(path.read_bytes()) > len(text.encode("utf-8", "surrogatepass")):
         path.write_text(text, encoding="utf-8", errors="surrogatepass")
 
