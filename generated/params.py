@@ -6,10 +6,11 @@ Module: params.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+import enum as _enum
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from . import _meta as _m
 from . import _validate as _v
@@ -17,7 +18,7 @@ from . import _validate as _v
 __all__ = ["BattParams", "BattParamsFsVoltsrc"]
 
 
-class BattParamsFsVoltsrc(enum.IntEnum):
+class BattParamsFsVoltsrc(_enum.IntEnum):
     """params.BATT.FS_VOLTSRC: values."""
 
     RAW_VOLTAGE = 0
@@ -56,7 +57,7 @@ _BATT_PARAMS_BATT_ARM_VOLT_SPEC = _v.Number(
 _BATT_PARAMS_BATT_ARM_MAH_SPEC = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BattParams:
     """Battery monitor: capacity, the two-stage (LOW, CRITICAL) failsafe thresholds and their actions, and arming
     limits. A threshold of 0 is disabled.
@@ -64,11 +65,11 @@ class BattParams:
     Schema: params.BATT (params, battery_failsafe.pdef.xml:11).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "params.BATT"
-    FS_VOLTSRC_RAW_VOLTAGE: ClassVar[int] = 0
-    FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE: ClassVar[int] = 1
+    QUALIFIED_NAME: _ClassVar[str] = "params.BATT"
+    FS_VOLTSRC_RAW_VOLTAGE: _ClassVar[int] = 0
+    FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE: _ClassVar[int] = 1
 
-    BATT_CAPACITY: int = dataclasses.field(
+    BATT_CAPACITY: int = _dataclasses.field(
         default=3300,
         metadata=_m.meta(
             name="BATT_CAPACITY",
@@ -80,7 +81,7 @@ class BattParams:
             doc="Charge of the fully charged pack; the mAh thresholds are measured against it.",
         ),
     )
-    BATT_LOW_VOLT: float = dataclasses.field(
+    BATT_LOW_VOLT: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_LOW_VOLT",
@@ -92,7 +93,7 @@ class BattParams:
             "vehicles.",
         ),
     )
-    BATT_LOW_TIMER: int = dataclasses.field(
+    BATT_LOW_TIMER: int = _dataclasses.field(
         default=10,
         metadata=_m.meta(
             name="BATT_LOW_TIMER",
@@ -106,7 +107,7 @@ class BattParams:
             "0 disables the voltage failsafes.",
         ),
     )
-    BATT_FS_VOLTSRC: int = dataclasses.field(
+    BATT_FS_VOLTSRC: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="BATT_FS_VOLTSRC",
@@ -115,7 +116,7 @@ class BattParams:
             doc="Which voltage the failsafe compares with its thresholds.",
         ),
     )
-    BATT_LOW_MAH: float = dataclasses.field(
+    BATT_LOW_MAH: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_LOW_MAH",
@@ -128,7 +129,7 @@ class BattParams:
             "drops below this. 0 disables it; checked only when the monitor measures current.",
         ),
     )
-    BATT_CRT_VOLT: float = dataclasses.field(
+    BATT_CRT_VOLT: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_CRT_VOLT",
@@ -139,7 +140,7 @@ class BattParams:
             "BATT_LOW_TIMER seconds. 0 disables it; should be below BATT_LOW_VOLT.",
         ),
     )
-    BATT_CRT_MAH: float = dataclasses.field(
+    BATT_CRT_MAH: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_CRT_MAH",
@@ -152,7 +153,7 @@ class BattParams:
             "checked only when the monitor measures current; should be below BATT_LOW_MAH.",
         ),
     )
-    BATT_FS_LOW_ACT: int = dataclasses.field(
+    BATT_FS_LOW_ACT: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="BATT_FS_LOW_ACT",
@@ -164,7 +165,7 @@ class BattParams:
             "Sub: 0 None, 2 Disarm, 3 Enter surface mode.",
         ),
     )
-    BATT_FS_CRT_ACT: int = dataclasses.field(
+    BATT_FS_CRT_ACT: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="BATT_FS_CRT_ACT",
@@ -174,7 +175,7 @@ class BattParams:
             "vehicle's list is at least that of any battery failsafe action already run.",
         ),
     )
-    BATT_ARM_VOLT: float = dataclasses.field(
+    BATT_ARM_VOLT: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_ARM_VOLT",
@@ -184,7 +185,7 @@ class BattParams:
             doc="Arming is refused below this voltage. 0 disables the check.",
         ),
     )
-    BATT_ARM_MAH: int = dataclasses.field(
+    BATT_ARM_MAH: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="BATT_ARM_MAH",
@@ -203,9 +204,9 @@ class BattParams:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["BATT_CAPACITY"] = self.BATT_CAPACITY
         out["BATT_LOW_VOLT"] = self.BATT_LOW_VOLT
         out["BATT_LOW_TIMER"] = self.BATT_LOW_TIMER
@@ -220,7 +221,7 @@ class BattParams:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BattParams:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BattParams:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -270,7 +271,7 @@ class BattParams:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
+        x: _Any
         try:
             if (self.BATT_CAPACITY + 2147483648) & -4294967296:
                 _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)
