@@ -7,6 +7,7 @@ logs. The screenshots are kept as test artefacts (see ``report_browser.py``); th
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -90,3 +91,40 @@ def test_fleet_page(tmp_path: Path) -> None:
     }
     assert {t["name"] for t in trends["traces"]} == {"pack 777"}
     assert all(t["points"] == 3 for t in trends["traces"])
+
+
+PARAMS = """# a copter with two 6S packs: LOW at 3.5 V/cell -> RTL, CRITICAL at 3.3 V/cell -> Land
+BATT_MONITOR,4
+BATT_CAPACITY,10000
+BATT_LOW_VOLT,21.0
+BATT_CRT_VOLT,19.8
+BATT_FS_LOW_ACT,2
+BATT_FS_CRT_ACT,1
+BATT2_MONITOR,4
+BATT2_CAPACITY,10000
+BATT2_LOW_VOLT,21.0
+BATT2_CRT_VOLT,19.8
+BATT2_FS_LOW_ACT,2
+BATT2_FS_CRT_ACT,1
+"""
+
+
+def test_failsafe_markers_sit_at_the_replayed_times(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The page's marker lines are ``battgen failsafe``'s events on the same log and parameters."""
+    require_browser()
+    log = write_flight(tmp_path / "failsafe.ulg", seconds=600, hz=10, packs=2, armed=(5, 590))
+    params = tmp_path / "copter.param"
+    params.write_text(PARAMS)
+    capsys.readouterr()
+    assert main(["failsafe", "--params", str(params), "--vehicle", "copter", "--json", str(log)]) == 0
+    events = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert {e["level"] for e in events} == {"LOW", "CRITICAL"}
+    out = _report(tmp_path, "failsafe", log, extra=("--params", str(params), "--vehicle", "copter"))
+    page = open_page(out, "report-failsafe")
+    _check(page, out.resolve().as_uri())
+    plots = [p for p in page.plots if p["id"].startswith("plot-")]
+    for battery, plot in enumerate(plots, start=1):
+        expected = [(e["level"], e["t"]) for e in events if e["battery"] == battery]
+        got = [(m["level"], m["t"]) for m in plot["markers"]]
+        assert [level for level, _ in got] == [level for level, _ in expected]
+        assert [t for _, t in got] == pytest.approx([t for _, t in expected], abs=1e-6)

@@ -31,7 +31,7 @@ def collect(
 ) -> Report:
     """Every input read and replayed (a BattgenError for an input that cannot be read)."""
     inputs = [read_input(p, schema_dir, message=message) for p in paths]
-    return Report(inputs, {i.source: replay(i, params, vehicle) for i in inputs})
+    return Report(inputs, {i.source: replay(i, p, params, vehicle) for i, p in zip(inputs, paths, strict=True)})
 
 
 def html(report: Report, *, title: str = "") -> str:
@@ -51,6 +51,6 @@ def pngs(report: Report, folder: Path) -> list[Path]:
         for s in item.batteries:
             path = folder / f"{_slug(item.source)}-battery{s.battery + 1}.png"
             markers = [Marker(e.t, e.level, e.text) for e in rep.events if e.battery == s.battery]
-            write_png(s, path, markers, rep.thresholds)
+            write_png(s, path, markers, rep.thresholds.get(s.battery, {}))
             written.append(path)
     return written

@@ -48,7 +48,8 @@ class Replay:
 
     events: list[FailsafeEvent] = field(default_factory=list)
     note: str = ""
-    thresholds: dict[str, float] = field(default_factory=dict)  # name -> volts, drawn on the voltage plot
+    # battery (0-based, as the series number them) -> {parameter name: volts}, drawn on the voltage plot
+    thresholds: dict[int, dict[str, float]] = field(default_factory=dict)
 
 
 def plotly_js() -> str:
@@ -85,12 +86,12 @@ def _section(
         "plot_id": plot_id,
         "label": s.label,
         "serial": s.serial,
-        "figures": compute(s, replay.thresholds).rows(),
+        "figures": compute(s, replay.thresholds.get(s.battery, {})).rows(),
         "events": [{"t": e.t, "level": e.level, "text": e.text, "css": _CSS.get(e.level, "")} for e in events],
         "failsafe_note": replay.note,
         "findings": _grouped(findings, s.battery),
     }
-    return context, figure(s, markers, replay.thresholds)
+    return context, figure(s, markers, replay.thresholds.get(s.battery, {}))
 
 
 def render(

@@ -58,7 +58,7 @@ def figure(
     data: list[dict[str, Any]] = []
     layout: dict[str, Any] = {
         "height": max(1, len(rows)) * ROW_HEIGHT + 60,
-        "margin": {"l": 70, "r": 20, "t": 30, "b": 40},
+        "margin": {"l": 70, "r": 20, "t": 44, "b": 40},
         "showlegend": False,
         "hovermode": "x unified",
         "shapes": [],
