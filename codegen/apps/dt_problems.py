@@ -91,7 +91,9 @@ def read_node(
                 unit_text = f"{name}: value is not an array of cells, as its unit suffix requires"
                 problems.append(Problem(name, UNIT_RULE, value, "an array", unit_text))
             del remaining[name]
-    for _ in range(len(remaining) + 1):  # each round drops one property
+    stand_ins: set[str] = set()
+    rounds = len(remaining) + sum(len(v) for v in remaining.values() if isinstance(v, list)) + 1
+    for _ in range(rounds):  # each round drops a property or stands in for one of its items
         try:
             instance: GeneratedMessage = cls.from_dict(remaining)
         except data_error as exc:
@@ -100,11 +102,35 @@ def read_node(
             name = top_property(problem.path, remaining)
             if name not in remaining:
                 return None, problems
-            del remaining[name]
+            if not _stand_in(remaining, name, problem.path, stand_ins):
+                del remaining[name]
             continue
         problems += _const_lengths(message, remaining)
         return instance, problems
     return None, problems
+
+
+def _stand_in(data: dict[str, Any], name: str, path: str, done: set[str]) -> bool:
+    """dt-validate checks every item of a list on its own: an item that does not read is replaced by
+    another item of the same list (its findings are then dropped, see ``stood_in``), so the other
+    items are still checked. False when there is no item to stand in."""
+    m = re.match(re.escape(name) + r"\[(\d+)\]", path)
+    value = data[name]
+    if m is None or not isinstance(value, list):
+        return False
+    bad = int(m.group(1))
+    item_path = f"{name}[{bad}]"
+    spare = [i for i in range(len(value)) if i != bad and f"{name}[{i}]" not in done]
+    if item_path in done or not spare or bad >= len(value):
+        return False
+    done.add(item_path)
+    data[name] = [*value[:bad], value[spare[0]], *value[bad + 1 :]]
+    return True
+
+
+def stood_in(path: str, problems: list[Problem]) -> bool:
+    """Whether a ``validate()`` finding lies in an item ``read_node`` replaced (already reported)."""
+    return any(p.rule == "type" and (path == p.path or path.startswith((p.path + "[", p.path + "."))) for p in problems)
 
 
 def left_out_fields(message: Message, data: Mapping[str, Any], problems: list[Problem]) -> frozenset[str]:
@@ -148,7 +174,8 @@ def order_key(message: Message, data: Mapping[str, Any], path: str, rule: str) -
         return (4, name)  # required
     if f is None:
         return (7,)
+    items = tuple(int(i) for i in re.findall(r"\[(\d+)\]", path[len(name) :]))  # in item order, as dt-validate
     if f.pattern is not None:
         patterns = sorted(g.pattern for g in message.fields if g.pattern is not None)
-        return (1, patterns.index(f.pattern), position)
-    return (2, name, 1 if rule == LENGTH_RULE else 0)  # items[0] comes before maxItems
+        return (1, patterns.index(f.pattern), position, items)
+    return (2, name, 1 if rule == LENGTH_RULE else 0, items)  # items[0] comes before maxItems

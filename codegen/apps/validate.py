@@ -183,6 +183,7 @@ class Checker:
             # a cross-field rule reading a property left out (it did not read) would judge its absence
             left_out = dt_problems.left_out_fields(self.message, data, early)
             violations = [v for v in violations if not self._skipped(v, left_out)]
+            violations = [v for v in violations if not dt_problems.stood_in(str(v.path), early)]
             findings += [
                 self._finding(
                     record, str(v.path), str(v.rule), v.value, v.limit, str(v.message),
