@@ -104,6 +104,7 @@ class Converted:
     plain: object = None
     payloads: tuple[bytes, ...] = ()
     loss: object = None  # the loss report's entries or summary, when asked for
+    source: Mapping[str, object] | None = None  # a log record's location (topic, multi_id, timestamp, offset)
 
 
 class Endpoint:
@@ -228,10 +229,12 @@ class Conversion:
                 text = f"cannot convert (a value the input lacks or does not fit): {exc}"
                 raise fail(where, item.line, text) from None
             lost = None if report is None else report.summary() if loss == "summary" else report.to_dict()
+            at = item.location
             if binary:
-                yield Converted(item.line, payloads=self.target.to_binary(result, item.file, item.line), loss=lost)
+                payloads = self.target.to_binary(result, item.file, item.line)
+                yield Converted(item.line, payloads=payloads, loss=lost, source=at)
             else:
-                yield Converted(item.line, plain=self.target.to_plain(result), loss=lost)
+                yield Converted(item.line, plain=self.target.to_plain(result), loss=lost, source=at)
 
     def _items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
         if fmt in LOG_FORMATS:
@@ -296,7 +299,9 @@ def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item]:
 
 def _located(record: Record, where: str) -> Record:
     """A log record whose errors name the input and the record: ``file (topic multi_id 0, ...)``."""
-    return Record(record.index, 0, None, f"{where} ({record.where})", instance=record.instance)
+    return Record(
+        record.index, 0, None, f"{where} ({record.where})", instance=record.instance, location=record.location
+    )
 
 
 def _reworded(message: str, reason: str, fmt: str) -> str:

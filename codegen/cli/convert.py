@@ -111,9 +111,14 @@ def _write(events: Iterable[Converted | Notice], where: str, fmt: str, out_fmt: 
             payloads = event.payloads
             out.write(b" ".join(p.hex().encode() for p in payloads) + b"\n" if out_fmt == "hex" else b"".join(payloads))
             if event.loss is not None:
-                sys.stderr.write(json.dumps({"line": event.line, "loss": event.loss}) + "\n")
+                where_from = {"source": dict(event.source)} if event.source is not None else {"line": event.line}
+                sys.stderr.write(json.dumps({**where_from, "loss": event.loss}) + "\n")
             continue
-        record = {"record": event.plain, "loss": event.loss} if event.loss is not None else event.plain
+        record: Any = event.plain
+        if event.loss is not None:
+            record = {"record": event.plain, "loss": event.loss}
+            if event.source is not None:  # a log record: which topic instance, when, where in the file
+                record["source"] = dict(event.source)
         if out_fmt == "jsonl":
             out.write(json.dumps(record, allow_nan=False).encode() + b"\n")
             out.flush()

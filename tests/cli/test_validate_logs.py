@@ -81,8 +81,10 @@ def test_real_px4_logs_predating_message_versions(capsys: pytest.CaptureFixture[
     kinds = [n["kind"] for n in report["notices"]]
     assert kinds == ["format-diff", "unchecked"]
     diff = report["notices"][0]["data"]
-    assert ["voltage_cell_v", "float[14]", "float[10]"] in diff["retyped"]
-    assert "cell_count" in report["notices"][1]["data"]["fields"]
+    assert ["voltage_cell_v", "float[14]", "float[10]"] in diff["converted"] and diff["retyped"] == []
+    assert diff["renamed"] == [["average_current_a", "current_average_a"]]
+    unchecked = report["notices"][1]["data"]["fields"]
+    assert "time_remaining_s" in unchecked and not {"cell_count", "voltage_cell_v"} & set(unchecked)
     multi_ids = [v["location"]["multi_id"] for v in report["violations"]]
     assert set(multi_ids) == {0, 1} and multi_ids[:2] == [0, 1]  # file order: batteries interleaved
     stamps = [v["location"]["timestamp_us"] for v in report["violations"] if v["location"]["multi_id"] == 0]
