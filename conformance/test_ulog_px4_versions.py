@@ -5,7 +5,8 @@ from float[10] to float[14], narrowed ``cell_count`` from int32 to uint8, droppe
 ``voltage_filtered_v``, ``run_time_to_empty``, ``serial_number``...). Logs are written here from
 PX4's own old definitions (conformance/corpus/px4_battery_status_history/, see its SOURCE.md),
 through a package our generator makes from each, and read back with the bundled
-``BatteryStatus.from_ulog``; pyulog, the reference reader, reads the same file. Every value pyulog
+``BatteryStatus.from_ulog`` (releases 1.14 to 1.18 and main from conformance/corpus/px4_msgs/ too);
+pyulog, the reference reader, reads the same file. Every value pyulog
 sees must be in the record: in the instance under its (renamed) field, or in the record's extras
 -- the two real shared logs included, every battery instance of them.
 """
@@ -42,6 +43,12 @@ VERSIONS = {
     "px4_log_v1_11": CORPUS / "battery_status.log_v1_11.msg",
     "px4_0a799f45": CORPUS / "BatteryStatus.0a799f45.msg",
     "px4_v0": ROOT / "schemas" / "uorb" / "BatteryStatusV0.msg",
+}
+# the releases h11px4's corpus holds (px4_msgs mirror of PX4's msg/, see its SOURCE.md)
+PX4_MSGS = ROOT / "conformance" / "corpus" / "px4_msgs"
+VERSIONS |= {
+    f"px4_{v.replace('.', '_')}": PX4_MSGS / v / "BatteryStatus.msg"
+    for v in ("1.14", "1.15", "1.16", "1.17", "1.18", "main")
 }
 FIELDS = {f.name: f for f in dataclasses.fields(BatteryStatus)}
 RENAMED = _ulog.RENAMED["battery_status"]
