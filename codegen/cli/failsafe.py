@@ -15,8 +15,9 @@ The parameters come from a .param / .params file (BATT_* names; others ignored).
 Prints one line per transition: time, level, cause, value, threshold, action and outcome, the
 operator text, and the uORB ``warning`` / MAVLink ``charge_state`` values for the level.
 ``--json`` prints JSON Lines instead, each event with the converted message (when the sample was a
-uORB battery_status or MAVLink BATTERY_STATUS) carrying the level. Exit 0 always, 2 when the
-parameter file or the stream cannot be read.
+uORB battery_status or MAVLink BATTERY_STATUS) carrying the level. Exit 0 when the stream was replayed, 1 when the
+parameter file holds no BATT_* parameter or the stream no sample (``--allow-empty`` accepts
+either), 2 when the parameter file or the stream cannot be read.
 """
 
 from __future__ import annotations
@@ -29,10 +30,10 @@ from typing import Any
 
 from ..apps.failsafe.evaluator import BatteryFailsafe, Event
 from ..apps.failsafe.levels import Level, apply_level
-from ..apps.failsafe.stream import Replay, Sample, open_reader, read_failsafe_params
+from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_failsafe_params
 from ..errors import BattgenError
 
-EXIT_OK, EXIT_UNREADABLE = 0, 2
+EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE = 0, 1, 2
 
 
 def register(subparsers: Any) -> None:
@@ -44,6 +45,11 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("stream", help="JSON Lines file of battery samples")
     p.add_argument("--params", required=True, help="a .param / .params file with the BATT_* parameters")
+    p.add_argument(
+        "--allow-empty",
+        action="store_true",
+        help="a parameter file without BATT_* parameters, or a stream without samples, is not an error",
+    )
     p.add_argument("--message", help="message of samples that name none (e.g. uorb.BatteryStatus)")
     p.add_argument("--schemas", help="schema folder the messages come from (default: the bundled schemas/)")
     p.add_argument("--no-home", action="store_true", help="no home position is set (RTL falls back to Hold)")
@@ -57,6 +63,14 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
+        batt, total = batt_parameter_count(Path(args.params))
+        if not batt and not args.allow_empty:
+            print(
+                f"{args.params}: no BATT_* parameter in this file ({total} parameters read): the failsafe would run "
+                "on defaults alone (--allow-empty accepts that)",
+                file=sys.stderr,
+            )
+            return EXIT_EMPTY
         params = read_failsafe_params(Path(args.params))
         reader = open_reader(Path(args.schemas) if args.schemas else None, args.message)
         fs = BatteryFailsafe(
@@ -75,6 +89,9 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_UNREADABLE
     if not args.json:
         print(f"{replay.samples} samples, {len(fs.events)} events, final level {fs.level.name}", file=sys.stderr)
+    if not replay.samples and not args.allow_empty:
+        print(f"{args.stream}: no battery samples in this stream (--allow-empty accepts that)", file=sys.stderr)
+        return EXIT_EMPTY
     return EXIT_OK
 
 

@@ -47,7 +47,12 @@ def cmd_generate(args: argparse.Namespace) -> int:
         raise BattgenError(
             f"{out}: the output folder's name is the package's import name, so it must be a Python identifier"
         )
-    result = generate(schema, out, check=args.check)
+    if out.exists() and not out.is_dir():
+        raise BattgenError(f"--out {out}: is a file; expected a folder for the package")
+    try:
+        result = generate(schema, out, check=args.check)
+    except OSError as exc:
+        raise BattgenError(f"--out {out}: cannot write: {exc.strerror or exc}") from None
     elapsed = time.perf_counter() - started
     if args.check:
         if result.stale:

@@ -8,7 +8,8 @@
 file proposing BATT_CAPACITY and BATT_LOW_VOLT / BATT_CRT_VOLT, each with a comment saying where
 the value came from. ``--check`` reads a .param / .params file and reports the BATT_* values
 that break their ranges or the cross-field rules (codegen.apps.failsafe.checks).
-Exit codes: 0 ok (warnings allowed), 1 the check found errors, 2 unreadable input or bad usage.
+Exit codes: 0 ok (warnings allowed), 1 the check found errors or the file holds no BATT_* parameter
+(``--allow-empty`` accepts that), 2 unreadable input or bad usage.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from typing import Any
 
 from ..apps.batt_parameters import check_parameter_file, check_proposals, propose_from_devicetree, render
 from ..apps.failsafe.checks import CELL_RANGES
+from ..apps.failsafe.stream import batt_parameter_count
 from ..errors import BattgenError
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
@@ -44,12 +46,13 @@ def register(subparsers: Any) -> None:
     p.add_argument("--format", choices=("param", "qgc"), default="param", help="output file format (param)")
     p.add_argument("--out", "-o", help="write here instead of standard output")
     p.add_argument("--chemistry", choices=sorted(CELL_RANGES), default="lipo", help="for --check (lipo)")
+    p.add_argument("--allow-empty", action="store_true", help="for --check: a file without BATT_* is not an error")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     if args.check:
-        return _check(Path(args.check), args.cells, args.chemistry)
+        return _check(Path(args.check), args.cells, args.chemistry, args.allow_empty)
     result, source = propose_from_devicetree(
         Path(args.from_devicetree),
         node=args.node,
@@ -72,9 +75,17 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _check(path: Path, cells: int | None, chemistry: str) -> int:
+def _check(path: Path, cells: int | None, chemistry: str, allow_empty: bool) -> int:
     display = path.as_posix()
     findings = check_parameter_file(path, cells=cells, chemistry=chemistry)
+    batt, total = batt_parameter_count(path)
+    if not batt and not allow_empty:
+        print(
+            f"{display}: no BATT_* parameter in this file ({total} parameters read): nothing to check "
+            "(--allow-empty accepts that)",
+            file=sys.stderr,
+        )
+        return EXIT_ERRORS
     for f in findings:
         print(f"{display}:{f.line}: {f.severity}: {f.message}")
     errors = sum(f.severity == "error" for f in findings)

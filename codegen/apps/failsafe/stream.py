@@ -235,6 +235,15 @@ def read_failsafe_params(path: Path) -> FailsafeSettings:
         raise BattgenError(f"{path}: {exc}") from None
 
 
+def batt_parameter_count(path: Path) -> tuple[int, int]:
+    """(BATT_* parameters, all parameters) of a .param / .params file: a file without BATT_* would
+    run the failsafe, or pass a check, on defaults alone."""
+    names: set[str] = set()
+    for _, group in parameter_files.read_parameter_file(path):
+        names.update(group)
+    return sum(1 for n in names if n.startswith("BATT_")), len(names)
+
+
 class Replay:
     """Feeds a stream's samples to an evaluator; ``samples`` counts those read so far."""
 
