@@ -47,6 +47,8 @@ class Record:
     skip: frozenset[str] = frozenset()  # fields the source lacks: their checks are not reported
     location: Mapping[str, object] | None = None  # machine-readable where: timestamp, multi_id, offset...
     extras: Mapping[str, object] | None = None  # a log's values the instance has no field for (older PX4)
+    # decoded with the instance: the other messages of a multi-message side (a CAN node's BatteryInfoAux)
+    companions: tuple[GeneratedMessage | None, ...] = field(default=(), compare=False)
 
     def line_of(self, path: str) -> int:
         """The line of a field path (``voltage_cell_v[3]``, ``timestamp.usec``), else the record's."""
