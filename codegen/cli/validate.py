@@ -48,6 +48,7 @@ from pathlib import Path
 from typing import Any
 
 from ..apps import validate as engine
+from ..apps.failsafe.vehicles import VEHICLES
 from ..apps.gate import Gate, Settings, describe, profile_names, settings
 from ..apps.package import bundled_schemas
 from ..apps.validate import Checker, Event, FileReport, Finding, exit_code, is_empty, json_document, make_checker
@@ -137,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
     schema_dir = Path(args.schemas) if args.schemas else bundled_schemas()
     kind = args.input_format
     chosen = settings(_selectors(args.select), _selectors(args.ignore), args.profile, Path.cwd())
-    message, checker = make_checker(schema_dir, args.message, args.files, kind)
+    message, checker = make_checker(schema_dir, args.message, args.files, kind, vehicle=args.vehicle)
     fmt = args.format
     text_like = fmt in ("text", "github")
     reports, all_groups, problems = [], [], []
@@ -254,6 +255,11 @@ def register(subparsers: Any) -> None:
         "--input-format",
         choices=KINDS,
         help="read every FILE as this format (default: from each extension; 'mavlink' is a raw MAVLink stream)",
+    )
+    p.add_argument(
+        "--vehicle",
+        choices=sorted(VEHICLES),
+        help="ArduPilot vehicle of parameter files: what the BATT*_FS_*_ACT codes mean (default: detected, else rover)",
     )
     p.add_argument(
         "files",

@@ -47,6 +47,7 @@ class Record:
     skip: frozenset[str] = frozenset()  # fields the source lacks: their checks are not reported
     location: Mapping[str, object] | None = None  # machine-readable where: timestamp, multi_id, offset...
     extras: Mapping[str, object] | None = None  # a log's values the instance has no field for (older PX4)
+    context: Mapping[str, object] | None = field(default=None, compare=False)  # a parameter set's other values
     # decoded with the instance: the other messages of a multi-message side (a CAN node's BatteryInfoAux)
     companions: tuple[GeneratedMessage | None, ...] = field(default=(), compare=False)
 
