@@ -90,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
             values, where = bin_parameters(stream), f"{args.stream} (PARM records)"
         else:
             raise BattgenError("expected --params FILE (only a DataFlash .bin log carries its own parameters)")
-        if not batt_parameter_count(values) and not args.allow_empty:
+        if args.params and not batt_parameter_count(values) and not args.allow_empty:
             print(
                 f"{where}: no BATT*_ parameter ({len(values)} parameters read): the failsafe would run on "
                 "defaults alone (--allow-empty accepts that)",
