@@ -110,7 +110,7 @@ class UlogColumns:
             raise InputError(self.name, 0, f"{topic} multi_id {multi_id}: cannot decode: {exc}") from None
         skip = frozenset({n for n, _ in diff.missing} | {r.name for r in diff.retyped})
         n = len(next(iter(raw.values()))) if raw else 0
-        defaults = self.model()
+        defaults = cast(Any, self.model)()
         out: dict[str, NDArray] = {}
         for f in dataclasses.fields(cast(Any, self.model)):
             name = f.metadata.get("name", f.name)

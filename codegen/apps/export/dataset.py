@@ -55,7 +55,11 @@ def _raw_type(ftype: object) -> Any:
             return pa.bool_()
         if ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT):
             bits = next(b for b in (8, 16, 32, 64) if b >= ftype.bits)
-            return pa.int64() if bits == 64 else getattr(pa, f"{'u' if ftype.kind is PrimitiveKind.UINT else ''}int{bits}")()
+            return (
+                pa.int64()
+                if bits == 64
+                else getattr(pa, f"{'u' if ftype.kind is PrimitiveKind.UINT else ''}int{bits}")()
+            )
         if ftype.kind is PrimitiveKind.CHAR:
             return pa.string()
     return pa.string()
@@ -82,7 +86,9 @@ def raw_table(message: Message, batch: Batch, log: str) -> Any:
                 width = values.shape[1] if values.ndim == 2 else 0
                 arr = pa.FixedSizeListArray.from_arrays(flat, width).cast(typ)
         elif pa.types.is_string(typ):
-            arr = pa.array([v.split(b"\0", 1)[0].decode("utf-8", "replace") if isinstance(v, bytes) else v for v in values], typ)
+            arr = pa.array(
+                [v.split(b"\0", 1)[0].decode("utf-8", "replace") if isinstance(v, bytes) else v for v in values], typ
+            )
         else:
             arr = pa.array(values, type=typ, from_pandas=False)
         meta = {"unit": f.unit.symbol} if f.unit is not None else {}
@@ -90,12 +96,12 @@ def raw_table(message: Message, batch: Batch, log: str) -> Any:
             meta["invalid"] = f.invalid.text
         fields.append(pa.field(f.name, typ, metadata=meta or None))
         arrays.append(arr)
-    return pa.Table.from_arrays(arrays, schema=pa.schema(fields, metadata={"battgen": json.dumps({"message": message.qualified_name})}))
+    return pa.Table.from_arrays(
+        arrays, schema=pa.schema(fields, metadata={"battgen": json.dumps({"message": message.qualified_name})})
+    )
 
 
-def write_log(
-    out: Path, log: str, battery: Any, raws: Sequence[tuple[str, Any]], manifest: dict[str, object]
-) -> None:
+def write_log(out: Path, log: str, battery: Any, raws: Sequence[tuple[str, Any]], manifest: dict[str, object]) -> None:
     """Write one log's partitions and then its marker (see the module docstring)."""
     out.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".tmp-{log}-", dir=out))

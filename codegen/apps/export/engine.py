@@ -21,6 +21,7 @@ from .columnar import convert_columns
 from .dataset import is_exported, raw_table, write_log
 from .sources import content_id, read_batches
 from .table import battery_schema, battery_table
+from .views import write_views
 
 
 @dataclass(frozen=True)
@@ -120,3 +121,9 @@ def _run(paths: list[str], options: ExportOptions, jobs: int) -> Iterator[LogRes
 
 def count(results: Iterable[LogResult], status: str) -> int:
     return sum(1 for r in results if r.status == status)
+
+
+def finish(out: Path) -> None:
+    """After a run: the views file in the dataset folder."""
+    out.mkdir(parents=True, exist_ok=True)
+    write_views(out)

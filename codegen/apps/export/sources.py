@@ -215,5 +215,7 @@ def guess_message(catalog: Catalog, record: Record, name: str) -> str:
         if qualified is not None and keys <= {f.name for f in catalog.schema.message(qualified).fields}:
             return qualified
     raise InputError(
-        name, record.line, f"cannot tell which battery message the records are ({', '.join(sorted(keys)[:6])}...): give --message"
+        name,
+        record.line,
+        f"cannot tell which battery message the records are ({', '.join(sorted(keys)[:6])}...): give --message",
     )

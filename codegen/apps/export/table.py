@@ -80,7 +80,7 @@ def concept_array(col: ConceptColumn) -> Any:
     if kind == "flags":
         bits = ((col.values[:, None] >> np.arange(len(col.concept.choices))) & 1).astype(bool)
         bits &= col.valid[:, None]
-        return _lists(bits, pa.DictionaryArray.from_arrays(np.nonzero(bits)[1].astype(np.int32), choices), invalid)
+        return _lists(bits, pa.DictionaryArray.from_arrays(np.asarray(np.nonzero(bits)[1], np.int32), choices), invalid)
     assert col.lengths is not None
     used = (np.arange(col.values.shape[1]) < col.lengths[:, None]) & col.valid[:, None]
     flat = col.values[used]
@@ -95,11 +95,13 @@ def _lists(used: NDArray, values: Any, invalid: NDArray) -> Any:
     return pa.ListArray.from_arrays(pa.array(offsets), values, mask=pa.array(invalid))
 
 
-def battery_table(catalog: Catalog, schema: Any, columns: Mapping[str, ConceptColumn], batch: Batch, log: str, source: str) -> Any:
+def battery_table(
+    catalog: Catalog, schema: Any, columns: Mapping[str, ConceptColumn], batch: Batch, log: str, source: str
+) -> Any:
     """The battery table of one batch of records of the log ``log`` (its content id), file ``source``."""
     n = batch.n
     index = columns["battery_index"]
-    battery = np.where(index.valid, index.values, batch.instance).astype(np.int32)
+    battery = np.asarray(np.where(index.valid, index.values, batch.instance), np.int32)
     timestamp = pa.timestamp("us", tz="UTC")
     arrays: list[Any] = [
         pa.array(np.full(n, log, object), type=pa.string()),
