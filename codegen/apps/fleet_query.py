@@ -53,9 +53,10 @@ def query_to_parquet(dataset: Path, sql: str, out: Path) -> int:
 
     con = connect(dataset)
     try:
-        rel = con.sql(sql)
-        rel.write_parquet(out.as_posix())
-        return int(con.sql(f"SELECT count(*) FROM read_parquet('{out.as_posix()}')").fetchone()[0])
+        target = out.as_posix().replace("'", "''")
+        con.execute(f"COPY ({sql}) TO '{target}' (FORMAT parquet)")
+        row = con.execute(f"SELECT count(*) FROM read_parquet('{target}')").fetchall()[0]
+        return int(row[0])
     except duckdb.Error as exc:
         raise BattgenError(f"query failed: {exc}") from None
     finally:

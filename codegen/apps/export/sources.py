@@ -125,6 +125,8 @@ def _dtype(ftype: object) -> Any:
             return np.float64
         if ftype.kind is PrimitiveKind.BOOL:
             return np.bool_
+        if ftype.kind is PrimitiveKind.UINT and ftype.bits > 63:
+            return np.uint64
         if ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT):
             return np.int64
     return object
@@ -139,14 +141,15 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
         attr = naming.field_identifier(f.name, f.pattern)
         values = [getattr(x, attr) for x in instances]
         dtype = _dtype(f.type)
-        if isinstance(f.type, ArrayType) and not isinstance(f.type.element, StringType) and dtype is not object:
+        texts = any(isinstance(v, bytes | str) for v in values)
+        if isinstance(f.type, ArrayType) and not isinstance(f.type.element, StringType) and not texts:
             width = f.type.capacity or max((len(v) for v in values), default=0)
             matrix = np.zeros((len(values), width), dtype)
             for i, v in enumerate(values):
                 matrix[i, : len(v)] = v
             out[f.name] = matrix
         else:
-            column = np.empty(len(values), dtype)
+            column = np.empty(len(values), object if texts else dtype)
             column[:] = values
             out[f.name] = column
     return out
