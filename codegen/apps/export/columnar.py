@@ -235,10 +235,11 @@ class ColumnConverter(OpVisitor[None]):
         if op.count_field is not None:
             count = self.columns[op.count_field].astype(np.int64)
             lengths = np.where(count != 0, np.minimum(count, m.shape[1]), lengths)
-        values = _affine(m, *_factor(f.unit or con.concept.unit, con.concept.unit))
+        values = np.array(_affine(m, *_factor(f.unit or con.concept.unit, con.concept.unit)), dtype=np.float64)
+        unknown = np.arange(m.shape[1]) >= lengths[:, None]
         if mark is not None:
-            values = np.where(_not_marker(m, mark), values, np.nan)
-        values = np.where(np.arange(m.shape[1]) < lengths[:, None], values, np.nan)
+            unknown |= ~_not_marker(m, mark)
+        values[unknown] = np.nan
         con.set_list(values, lengths, lengths > 0)
 
     def visit_mavlink_voltages(self, rule: Rule, op: o.MavlinkVoltages) -> None:

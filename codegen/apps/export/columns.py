@@ -61,6 +61,11 @@ class ConceptColumn:
 
     def set_list(self, values: NDArray, lengths: NDArray, where: NDArray) -> None:
         """Write the rows of a list concept where ``where`` holds (widening the matrix if needed)."""
+        if not self.valid.any():  # nothing written yet: take the rows as they are
+            self.values = np.where(where[:, None], values, np.nan) if not where.all() else values
+            self.lengths = np.where(where, lengths, 0)
+            self.valid = where.copy()
+            return
         width = max(self.values.shape[1], values.shape[1])
         if width > self.values.shape[1]:
             wider = np.full((self.values.shape[0], width), np.nan)

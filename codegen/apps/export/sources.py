@@ -45,7 +45,7 @@ class Batch:
     t: NDArray  # seconds since the log's start (NaN: unknown)
     instance: NDArray  # the log's instance of each record (ULog multi_id, else 0)
     time_us: NDArray | None = None  # microseconds since the Unix epoch
-    vehicle: NDArray | None = None  # object array of str / None
+    vehicle: NDArray | str | None = None  # one for the batch, or an object array of str / None
     armed: NDArray | None = None  # float 1.0 / 0.0 / NaN (unknown)
     notes: list[str] = field(default_factory=list)
 
@@ -99,7 +99,7 @@ def _ulog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
             if stamps is not None and offset is not None:
                 batch.time_us = stamps.astype(np.int64) + offset
             if log.vehicle is not None:
-                batch.vehicle = np.full(inst.n, log.vehicle, object)
+                batch.vehicle = log.vehicle
             if stamps is not None and armed is not None:
                 batch.armed = _as_of(armed[0], armed[1], stamps)
             out.append(batch)

@@ -104,16 +104,20 @@ def battery_table(
     battery = np.asarray(np.where(index.valid, index.values, batch.instance), np.int32)
     timestamp = pa.timestamp("us", tz="UTC")
     arrays: list[Any] = [
-        pa.array(np.full(n, log, object), type=pa.string()),
-        pa.array(np.full(n, source, object), type=pa.string()),
-        pa.nulls(n, pa.string()) if batch.vehicle is None else pa.array(batch.vehicle, type=pa.string()),
+        pa.repeat(pa.scalar(log, pa.string()), n),
+        pa.repeat(pa.scalar(source, pa.string()), n),
+        pa.nulls(n, pa.string())
+        if batch.vehicle is None
+        else pa.repeat(pa.scalar(batch.vehicle, pa.string()), n)
+        if isinstance(batch.vehicle, str)
+        else pa.array(batch.vehicle, type=pa.string()),
         pa.array(battery, type=pa.int32()),
         pa.array(batch.t, type=pa.float64(), mask=np.isnan(batch.t)),
         pa.nulls(n, timestamp) if batch.time_us is None else pa.array(batch.time_us, type=pa.int64()).cast(timestamp),
         pa.nulls(n, pa.bool_())
         if batch.armed is None
         else pa.array(batch.armed == 1.0, type=pa.bool_(), mask=np.isnan(batch.armed)),
-        pa.array(np.full(n, batch.message, object), type=pa.string()),
+        pa.repeat(pa.scalar(batch.message, pa.string()), n),
     ]
     arrays.extend(concept_array(columns[c.name]) for c in catalog.concepts)
     return pa.Table.from_arrays(arrays, schema=schema)
