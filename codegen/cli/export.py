@@ -1,6 +1,7 @@
 """``battgen export LOG... -o DIR``: battery records of many logs into one Parquet dataset.
 
-Inputs: PX4 ULog (.ulg), MAVLink telemetry logs (.tlog) and JSON Lines (.jsonl/.ndjson) of any
+Inputs: PX4 ULog (.ulg), MAVLink telemetry logs (.tlog), ArduPilot DataFlash logs (.bin: BAT
+readings) and JSON Lines (.jsonl/.ndjson) of any
 bundled battery message (``--message``, else told from the first record's keys); a folder stands
 for the logs under it. Every record becomes a row of one table in SI units, unknown values null,
 partitioned by log (``DIR/battery/log=<id>/``); ``--raw`` also writes each message's own table.
@@ -24,7 +25,7 @@ from typing import Any
 from ..errors import BattgenError
 
 EXIT_OK, EXIT_FAILED, EXIT_UNREADABLE = 0, 1, 2
-_SUFFIXES = (".ulg", ".tlog", ".jsonl", ".ndjson")
+_SUFFIXES = (".ulg", ".tlog", ".bin", ".jsonl", ".ndjson")
 
 
 def register(subparsers: Any) -> None:
@@ -34,7 +35,7 @@ def register(subparsers: Any) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("logs", nargs="+", metavar="LOG", help="log files (.ulg, .tlog, .jsonl) or folders of them")
+    p.add_argument("logs", nargs="+", metavar="LOG", help="log files (.ulg, .tlog, .bin, .jsonl) or folders of them")
     p.add_argument("-o", "--out", required=True, metavar="DIR", help="the dataset folder (created if needed)")
     p.add_argument("--raw", action="store_true", help="also write each message's table, fields as decoded")
     p.add_argument("--message", help="the message of JSON Lines inputs (default: told from their keys)")
@@ -83,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_UNREADABLE
     logs = _inputs(args.logs)
     if not logs:
-        print("battgen: no logs to export (expected .ulg, .tlog or .jsonl files)", file=sys.stderr)
+        print("battgen: no logs to export (expected .ulg, .tlog, .bin or .jsonl files)", file=sys.stderr)
         return EXIT_UNREADABLE
     if args.jobs < 1:
         print("battgen: --jobs must be at least 1", file=sys.stderr)

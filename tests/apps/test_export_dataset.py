@@ -4,14 +4,17 @@ unknown; tlog and JSON Lines inputs; incremental runs; bad logs reported, never 
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 from pathlib import Path
+from typing import Any
 
 import duckdb
 import pyarrow.parquet as pq
 import pytest
 import pyulog
+from conftest import ROOT
 from fleet_samples import DOCUMENTED, LOGS, jsonl, needs_logs, tlog
 
 from codegen.apps.export.engine import ExportOptions, export_logs, finish
@@ -114,3 +117,30 @@ def test_jobs_two_gives_the_same_dataset(tmp_path: Path) -> None:
         b = pq.read_table(tmp_path / "two" / "battery" / f"log={r.log}")
         assert a.equals(b)
     assert not math.isnan(0.0)
+
+
+def _dataflash_writer() -> Any:
+    spec = importlib.util.spec_from_file_location("dataflash_writer", ROOT / "tests" / "inputs" / "dataflash_writer.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_dataflash_bat_records(tmp_path: Path) -> None:
+    rows = [(1.0, 0, 12.6, 5.0, 100.0), (2.0, 0, 12.4, 25.0, 110.0), (2.0, 1, 16.1, 3.0, 50.0)]
+    path = _dataflash_writer().battery_log(tmp_path / "f.bin", {"BATT_LOW_VOLT": 10.5}, rows, [(1.5, True)])
+    out = tmp_path / "ds"
+    results = export_logs([path.as_posix()], ExportOptions(out, raw=True))
+    assert [(r.status, r.rows) for r in results] == [("exported", 3)]
+    got = run_query(
+        out, "SELECT message, battery, t, armed, pack_voltage, current, discharged FROM battery ORDER BY battery, t"
+    ).rows
+    assert [g[:4] for g in got] == [
+        ("dataflash.BAT", 0, 1.0, None),
+        ("dataflash.BAT", 0, 2.0, True),
+        ("dataflash.BAT", 1, 2.0, True),
+    ]
+    assert [g[4:] for g in got] == [pytest.approx((v, a, mah * 3.6)) for _, _, v, a, mah in rows]
+    flights = run_query(out, "SELECT battery, internal_resistance FROM flights ORDER BY battery").rows
+    assert flights[0][1] == pytest.approx(0.2 / 20.0) and flights[1][1] is None

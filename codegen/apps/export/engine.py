@@ -19,7 +19,8 @@ from ...errors import BattgenError
 from .catalog import bundled_catalog
 from .columnar import convert_columns
 from .dataset import is_exported, raw_table, write_log
-from .sources import content_id, read_batches
+from .readers import read_log
+from .sources import content_id
 from .table import battery_schema, battery_table
 from .views import write_views
 
@@ -66,14 +67,16 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
 def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResult:
     catalog = bundled_catalog()
     schema = battery_schema(catalog)
-    batches = read_batches(file, name, catalog, options.message)
+    batches = read_log(file, name, catalog, options.message)
     tables = []
     raws: dict[str, list[object]] = {}
     notes: list[str] = []
     for batch in batches:
-        columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)
+        columns = batch.concepts
+        if columns is None:
+            columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)
         tables.append(battery_table(catalog, schema, columns, batch, log, file.name))
-        if options.raw:
+        if options.raw and batch.message in catalog.sources:
             raws.setdefault(batch.message, []).append(raw_table(catalog.schema.message(batch.message), batch, log))
         notes.extend(batch.notes)
     table = pa.concat_tables(tables) if tables else schema.empty_table()

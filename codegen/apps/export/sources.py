@@ -29,9 +29,10 @@ from ...inputs.ulog_columns import UlogColumns
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
-from .columns import NDArray
+from .columns import ConceptColumn, NDArray
 
-EXPORT_KINDS = ("ulog", "tlog", "jsonl")
+EXPORT_KINDS = ("ulog", "tlog", "jsonl", "dataflash")
+DATAFLASH_SUFFIXES = frozenset({".bin"})
 ID_DIGITS = 16
 
 
@@ -47,6 +48,7 @@ class Batch:
     time_us: NDArray | None = None  # microseconds since the Unix epoch
     vehicle: NDArray | str | None = None  # one for the batch, or an object array of str / None
     armed: NDArray | None = None  # float 1.0 / 0.0 / NaN (unknown)
+    concepts: dict[str, ConceptColumn] | None = None  # filled by the reader (a format without IR mapping)
     notes: list[str] = field(default_factory=list)
 
 
@@ -60,9 +62,10 @@ def content_id(path: Path) -> str:
 
 
 def export_kind(path: Path) -> str:
-    kind = kind_of_suffix(path)
+    kind = "dataflash" if path.suffix.lower() in DATAFLASH_SUFFIXES else kind_of_suffix(path)
     if kind not in EXPORT_KINDS:
-        raise InputError(path.as_posix(), 0, "expected a PX4 ULog (.ulg), MAVLink tlog (.tlog) or JSON Lines file")
+        expected = "a PX4 ULog (.ulg), MAVLink tlog (.tlog), ArduPilot DataFlash (.bin) or JSON Lines file"
+        raise InputError(path.as_posix(), 0, f"expected {expected}")
     return kind
 
 
@@ -77,6 +80,8 @@ def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = 
         return _ulog_batches(path, name, catalog)
     if kind == "tlog":
         return _tlog_batches(path, name, catalog)
+    if kind == "dataflash":
+        raise InputError(name, 0, "DataFlash logs are read by codegen.apps.export.dataflash_batches")
     return _jsonl_batches(path, name, catalog, message)
 
 
@@ -101,12 +106,12 @@ def _ulog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
             if log.vehicle is not None:
                 batch.vehicle = log.vehicle
             if stamps is not None and armed is not None:
-                batch.armed = _as_of(armed[0], armed[1], stamps)
+                batch.armed = as_of(armed[0], armed[1], stamps)
             out.append(batch)
     return out
 
 
-def _as_of(times: NDArray, values: NDArray, at: NDArray) -> NDArray:
+def as_of(times: NDArray, values: NDArray, at: NDArray) -> NDArray:
     """The latest of ``values`` at or before each of ``at`` (NaN before the first)."""
     order = np.argsort(times, kind="stable")
     times, values = times[order], values[order].astype(np.float64)
