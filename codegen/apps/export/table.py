@@ -66,6 +66,8 @@ def battery_schema(catalog: Catalog) -> Any:
 def concept_array(col: ConceptColumn) -> Any:
     """One concept column as an Arrow array: unknown (and NaN) as null."""
     kind = col.concept.kind
+    if not col.valid.any():  # a concept the source never gives: no arrays to build
+        return pa.nulls(len(col.valid), _ARROW_TYPES[kind])
     invalid = ~col.valid
     if kind == "number":
         return pa.array(col.values, type=pa.float64(), mask=invalid | np.isnan(col.values))
