@@ -50,6 +50,7 @@ class ClassView:
     keys_literal: str  # frozenset of accepted source names
     pattern_literal: str  # tuple of (regex, ident) for pattern fields
     extensions: list[str] = field(default_factory=list)  # extra, already indented class-body code
+    union_table: str = ""  # a DroneCAN union's module-level _dc.Union (from_dict lets it pick the branch)
 
 
 def enum_views(enums: tuple[EnumDef, ...], owner: str) -> list[EnumView]:
@@ -72,7 +73,7 @@ def enum_views(enums: tuple[EnumDef, ...], owner: str) -> list[EnumView]:
         text = (e.doc + "\n\n" if e.doc else "") + f"{e.name}: {kind_doc}."
         views.append(
             EnumView(
-                class_name=owner + naming.camel(group),
+                class_name=naming.class_identifier(owner + naming.camel(group)),
                 base="IntFlag" if e.kind is EnumKind.BITMASK else "IntEnum",
                 doc=docstring(text, "    "),
                 members=members,
@@ -84,18 +85,17 @@ def enum_views(enums: tuple[EnumDef, ...], owner: str) -> list[EnumView]:
 def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
     cls = naming.class_name(msg)
     optional_props = msg.devicetree is not None
+    # a DroneCAN union: every branch is None but the one held (see runtime/_dronecan.Union)
+    union = msg.dronecan is not None and msg.dronecan.union
     fields: list[FieldView] = []
-    idents: set[str] = set(naming.RESERVED_MEMBERS)
+    names = naming.member_names(msg, ctx.module_classes)
     patterns: list[str] = []
     keys: list[str] = []
     for f in msg.fields:
         if f.is_padding:
             continue
-        ident = naming.field_identifier(f.name, f.pattern)
-        while ident in idents:
-            ident += "_"
-        idents.add(ident)
-        optional = optional_props and not f.required and f.pattern is None
+        ident = names[("field", f.name)]
+        optional = (optional_props and not f.required and f.pattern is None) or union
         b = FieldBuilder(ctx, f, optional)
         annotation = b.annotation(f.type)
         key = py_literal(f.name)
@@ -123,10 +123,7 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
 
     constants: list[tuple[str, str, str]] = []
     for c in msg.constants:
-        name = naming.identifier(c.name)
-        while name in idents:
-            name += "_"
-        idents.add(name)
+        name = names[("constant", c.name)]
         if isinstance(c.type, PrimitiveType):
             literal = py_literal(typed(c.value, c.type) if isinstance(c.value, int | float) else c.value)
             annotation = python_scalar(c.type)
@@ -134,6 +131,8 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
             literal, annotation = py_literal(str(c.value)), "str"
         constants.append((name, annotation, literal))
 
+    if union:
+        keys.append("union_field")
     src = msg.location
     doc_text = msg.doc.strip() or msg.qualified_name
     doc_text += f"\n\nSchema: {msg.qualified_name} ({msg.format.value}, {src.file}:{src.line})."
@@ -146,4 +145,5 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
         source=f"{src.file}",
         keys_literal="frozenset({" + ", ".join(py_literal(k) for k in keys) + "})" if keys else "frozenset()",
         pattern_literal="(" + ", ".join(patterns) + ",)" if patterns else "()",
+        union_table=ctx.constant(cls, "UNION") if union else "",
     )

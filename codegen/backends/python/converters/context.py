@@ -34,6 +34,7 @@ from ....ir import (
     Rule,
     Schema,
     Unit,
+    units,
 )
 from ....ir.mapping_values import ConstantRef, Number, Value
 from .. import naming
@@ -106,6 +107,15 @@ def constant_name(*words: str) -> str:
 class RuleContext:
     """One direction of one mapping being written; see the module docstring."""
 
+    def unit_param(self, symbol: str | None, fallback: Unit | None) -> Unit | None:
+        """The unit a rule names (``unit``, ``source_unit``, ...), else ``fallback``."""
+        if symbol is None:
+            return fallback
+        unit = units.lookup(symbol)
+        if unit is None:
+            raise BattgenError(f"{self.mapping.name}: unknown unit {symbol!r}")
+        return unit
+
     def __init__(
         self,
         schema: Schema,
@@ -126,6 +136,7 @@ class RuleContext:
         self.backward = direction == "backward"
         self.classes = classes  # qualified message name -> the class's name in the module
         self.constants = constants
+        self.member_cache: dict[str, dict[tuple[str, str], str]] = {}
         self.lines: list[str] = []
         self.inputs: list[str] = []  # extra keyword inputs (ocv_soc)
         self.read: set[tuple[str, str]] = set()
@@ -181,8 +192,16 @@ class RuleContext:
     def attr(self, ref: FieldRef) -> str:
         if ref.message == CONCEPTS_ENDPOINT:
             return naming.identifier(ref.field)
-        f = self.fld(ref)
-        return naming.field_identifier(f.name, f.pattern)
+        return self.member(ref.message, ref.field)
+
+    def member(self, message: str, field: str) -> str:
+        """The attribute of a message's field, by the backend's one naming rule."""
+        names = self.member_cache.get(message)
+        if names is None:
+            msg = self.msg(message)
+            names = naming.member_names(msg, naming.module_classes(self.schema, naming.module_path(msg)))
+            self.member_cache[message] = names
+        return names[("field", field)]
 
     def s(self, ref: FieldRef) -> str:
         """A source value (and note that it is read)."""

@@ -22,7 +22,7 @@ from .variable import VariableFieldEmitter
 class MessageEmitter(VariableFieldEmitter):
     def annotation(self, t: FieldType) -> str | None:
         if isinstance(t, ArrayType):
-            return "bytes" if is_u8(t.element) else "list[Any]"
+            return "bytes" if is_u8(t.element) else "list[_Any]"
         return None
 
     def items(self, base: str) -> list[Item]:
@@ -100,12 +100,16 @@ class MessageEmitter(VariableFieldEmitter):
         bits = self.tag_bits()
         out.add(f"u = self.{self.union_attr}")
         for n, (i, ident) in enumerate(self.union_fields()):
-            out.add(f"{'if' if n == 0 else 'elif'} u == {py_literal(ident)}:")
-            out.level += 1
-            out.add(f"acc = (acc << {bits}) | {n}" if n else f"acc <<= {bits}")
             f = self.msg.fields[i]
+            out.add(f"{'if' if n == 0 else 'elif'} u == {py_literal(f.name)}:")
+            out.level += 1
+            held = out.fresh("x")
+            out.add(f"{held} = self.{ident}")
+            out.add(f"if {held} is None:")
+            out.add("    raise " + error("EncodeError", f"{self.cls}.{f.name}: the selected branch holds None"))
+            out.add(f"acc = (acc << {bits}) | {n}" if n else f"acc <<= {bits}")
             item = VarField(i, f.name, ident, f.type, True)
-            self.branch_put(item, out)
+            self.branch_put(item, held, out)
             out.level -= 1
         out.add("else:")
         out.add(
@@ -113,9 +117,8 @@ class MessageEmitter(VariableFieldEmitter):
             + error("EncodeError", f"{self.cls}.{self.union_attr}: ", "repr(u)", f" is not a field of {self.cls}")
         )
 
-    def branch_put(self, item: VarField, out: Lines) -> None:
+    def branch_put(self, item: VarField, expr: str, out: Lines) -> None:
         label = f"{self.cls}.{item.field_name}"
-        expr = f"self.{item.ident}"
         if self.p.fixed(item.type):
             seg = Segment([], [], [])
             self.p.flatten(seg, item.type, expr, label)
@@ -145,7 +148,7 @@ class MessageEmitter(VariableFieldEmitter):
                 if ann is not None:
                     out.add(f"{target}: {ann}")
                 self.var_get(VarField(i, f.name, ident, f.type, True), target, label, "tao", out)
-            out.add(f"return cls({ident}={target}, {self.union_attr}={py_literal(ident)}), rem")
+            out.add(f"return cls({ident}={target}), rem")
             out.level -= 1
         count = len(self.msg.fields)
         out.add("raise " + error("DecodeError", f"{self.cls}: union tag ", "str(t)", f" is not one of 0..{count - 1}"))
@@ -217,7 +220,7 @@ class MessageEmitter(VariableFieldEmitter):
             e = out.fresh("e")
             value = encode_value(word, e, pattern=False)
             code = struct_code(word, pack=True)
-            out.add(f'return {head} + struct.pack(f"<{{len({x})}}{code}", *[{value} for {e} in {x}])')
+            out.add(f'return {head} + _struct.pack(f"<{{len({x})}}{code}", *[{value} for {e} in {x}])')
         out.level -= 1
 
     def method_decode(self) -> str:
@@ -286,7 +289,7 @@ class MessageEmitter(VariableFieldEmitter):
             out.add(f"if {k} > {t.capacity}:")
             out.add(f"    raise {too_long}")
             code = struct_code(word, pack=False)
-            out.add(f'{target} = list(struct.unpack_from(f"<{{{k}}}{code}", data, {start}))')
+            out.add(f'{target} = list(_struct.unpack_from(f"<{{{k}}}{code}", data, {start}))')
         out.level -= 1
 
     def wrap_decode(self, out: Lines) -> str:

@@ -35,7 +35,7 @@ class SegmentEmitter:
         return name
 
     def struct_name(self, fmt: str, role: str, comment: str) -> str:
-        return self.module_value(f"struct.Struct({text_literal(fmt)})", role, comment)
+        return self.module_value(f"_struct.Struct({text_literal(fmt)})", role, comment)
 
     def segment_role(self, seg: Segment, role: str) -> str:
         """``role``, or ``role_FROM_<FIELD>`` for a segment that does not start the message."""
@@ -150,7 +150,7 @@ class SegmentEmitter:
         fmt = "<" + "".join(u.pack for u in units)
         comment = "fixed fields as encoded (a float16 as its bit pattern)"
         name = self.struct_name(fmt, self.segment_role(seg, "ENCODE_STRUCT"), comment)
-        return f"{name}.pack({', '.join(args)})"
+        return f"{name}.pack({', '.join(args) if len(args) > 1 else unparenthesized(args[0])})"
 
     def seg_put(self, seg: Segment, out: Lines) -> None:
         """Append a segment to ``acc``."""
