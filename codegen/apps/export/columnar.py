@@ -18,7 +18,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ...errors import BattgenError
-from ...ir import CONCEPTS_ENDPOINT, Field, FieldRef, Rule, Unit
+from ...ir import CONCEPTS_ENDPOINT, Field, FieldRef, Rule, Unit, units
 from ...ir import ops as o
 from ...ir.mapping_values import ConstantRef, Number, Value
 from ...ir.mapping_visitor import OpVisitor, visit
@@ -147,7 +147,13 @@ class ColumnConverter(OpVisitor[None]):
             ok &= x > op.valid_above
         if op.valid_max is not None:
             ok &= x <= op.valid_max
-        con.set(_affine(x, *_factor(f.unit or con.concept.unit, con.concept.unit)), ok)
+        named = units.lookup(op.unit) if op.unit is not None else None
+        mul, add = _factor(f.unit or named or con.concept.unit, con.concept.unit)
+        if op.negate:  # the field counts the other way; + 0.0 keeps a zero from reading -0.0
+            value = _affine(x, -mul, -add)
+            con.set(value + 0.0 if add == 0.0 else value, ok)
+        else:
+            con.set(_affine(x, mul, add), ok)
 
     def visit_copy(self, rule: Rule, op: o.Copy) -> None:
         fmt, con = self.pair(rule)
@@ -308,6 +314,9 @@ class ColumnConverter(OpVisitor[None]):
         self._not_columnar(rule)
 
     def visit_px4_aux_capacity(self, rule: Rule, op: o.PX4AuxCapacity) -> None:
+        self._not_columnar(rule)
+
+    def visit_px4_bridge_estimates(self, rule: Rule, op: o.PX4BridgeEstimates) -> None:
         self._not_columnar(rule)
 
 
