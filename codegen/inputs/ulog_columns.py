@@ -43,6 +43,7 @@ class ColumnLog(Protocol):
     def compare(self, cls: Any, *, topic: str | None = None) -> FormatDiff: ...
     def layout(self, topic: str) -> _Layout: ...
     def columns(self, topic: str, multi_id: int = 0, *, use_numpy: bool | None = None) -> dict[str, Any]: ...
+    def iter_records(self, cls: Any, *, topic: str | None = None, multi_id: int | None = None) -> Iterator[Any]: ...
     def close(self) -> None: ...
 
 
@@ -109,6 +110,8 @@ class UlogColumns:
         except (ValueError, struct.error) as exc:
             raise InputError(self.name, 0, f"{topic} multi_id {multi_id}: cannot decode: {exc}") from None
         skip = frozenset({n for n, _ in diff.missing} | {r.name for r in diff.retyped})
+        if not diff.identical:  # an older layout: the generated reader maps it record by record
+            return self._decoded(topic, multi_id, skip)
         n = len(next(iter(raw.values()))) if raw else 0
         defaults = cast(Any, self.model)()
         out: dict[str, NDArray] = {}
@@ -127,6 +130,30 @@ class UlogColumns:
                 out[name] = np.full(n, default)
         stamps = raw.get("timestamp") if "timestamp" not in skip else None
         return TopicColumns(topic, multi_id, n, stamps, out, skip)
+
+    def _decoded(self, topic: str, multi_id: int, skip: frozenset[str]) -> TopicColumns:
+        """The columns of a topic instance whose format differs from the class: every record
+        decoded by the generated reader (fields matched by name, renames and compatible types
+        converted), gathered into columns -- the same values a per-record reader sees."""
+        import numpy as np
+
+        try:
+            records = [r.instance for r in self.log.iter_records(self.model, topic=topic, multi_id=multi_id)]
+        except (ValueError, struct.error) as exc:
+            raise InputError(self.name, 0, f"{topic} multi_id {multi_id}: cannot decode: {exc}") from None
+        out: dict[str, NDArray] = {}
+        for f in dataclasses.fields(cast(Any, self.model)):
+            values = [getattr(r, f.name) for r in records]
+            if values and isinstance(values[0], list):
+                width = max(len(v) for v in values)
+                matrix = np.zeros((len(values), width), np.asarray(values[0]).dtype if width else np.float64)
+                for i, v in enumerate(values):
+                    matrix[i, : len(v)] = v
+                out[f.metadata.get("name", f.name)] = matrix
+            else:
+                out[f.metadata.get("name", f.name)] = np.array(values)
+        stamps = out.get("timestamp") if "timestamp" not in skip else None
+        return TopicColumns(topic, multi_id, len(records), stamps, out, skip)
 
     def utc_offset_us(self) -> int | None:
         """UTC minus the log's clock, from the first GPS record that carries UTC time, if any."""
