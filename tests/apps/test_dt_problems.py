@@ -5,6 +5,7 @@ these run without dtc or dtschema and pin the wording, lines and exit code."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -28,22 +29,23 @@ NODE = """/dts-v1/;
 def test_every_problem_of_a_node_in_dt_validates_order(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     board = tmp_path / "board.dts"
     board.write_text(NODE)
-    code = main(["validate", "--message", "simple-battery", str(board)])
-    out = [line for line in capsys.readouterr().out.splitlines() if ": /battery: " in line]
-    lines = [int(line.split(":")[1]) for line in out]
-    problems = [line.split(": /battery: ", 1)[1] for line in out]
+    code = main(["validate", "--message", "simple-battery", "--format", "json", str(board)])
+    (report,) = json.loads(capsys.readouterr().out)["files"]
+    found = [v for v in report["violations"] if v["node"] == "/battery"]
+    problems = [v["message"] for v in found]
     assert code == 1
     assert problems[0] == (
         "acme,secret-sauce, other-sauce-microvolt are not defined by devicetree.power.supply.battery "
         "(additionalProperties: false)"
     )
+    assert found[0]["value"] == ["acme,secret-sauce", "other-sauce-microvolt"]
     # the pattern properties item by item, as dt-validate cuts the cells (5 cells: rows of 2, then [103]);
     # the short row is reported and the rows around it are still checked
-    assert [p.split(":", 1)[0] for p in problems[1:5]] == [
+    assert [v["path"] for v in found[1:5]] == [
         "ocv-capacity-table-0[0][1]",
         "ocv-capacity-table-1[0][1]",
         "ocv-capacity-table-1[1][1]",
         "ocv-capacity-table-1[2]",
     ]
     assert problems[5] == "acme,secret-sauce: no schema gives this property a type, so its value stays raw bytes"
-    assert len(problems) == 6 and lines == [5, 8, 9, 9, 9, 5]  # each at its property's line
+    assert len(problems) == 6 and [v["line"] for v in found] == [5, 8, 9, 9, 9, 5]  # each at its property's line
