@@ -161,14 +161,18 @@ def test_non_object_records_and_unknown_fields_are_type_violations(
     assert lines[1] == f"{path.as_posix()}:3: volts is not a field of uorb.BatteryStatus"
 
 
-def test_empty_inputs_are_valid(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+def test_empty_inputs_are_not_success(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     (tmp_path / "a.json").write_text("[]")
     (tmp_path / "b.jsonl").write_text("\n\n")
     (tmp_path / "c.yaml").write_text("# nothing\n")
     files = [str(tmp_path / n) for n in ("a.json", "b.jsonl", "c.yaml")]
     code, lines, err = validate(capsys, "--message", "uorb.BatteryStatus", *files)
-    assert (code, lines) == (0, [])
-    assert "0 records in 3 files" in err
+    assert (code, lines) == (1, [])
+    for f in files:
+        assert f"{Path(f).as_posix()}: no uorb.BatteryStatus records in this file (--allow-empty accepts that)" in err
+    assert "0 records in 3 files, 0 errors, 0 warnings, 3 without records" in err
+    code, lines, err = validate(capsys, "--message", "uorb.BatteryStatus", "--allow-empty", *files)
+    assert (code, lines) == (0, []) and "no uorb" not in err
 
 
 # -- message names ---------------------------------------------------------------------------------
@@ -216,9 +220,10 @@ def test_dts_nodes_are_checked_with_node_paths_and_property_lines(capsys: pytest
     code, lines, err = validate(capsys, "--message", "simple-battery", str(path))
     assert code == 1
     assert "2 records" in err  # the charger is not a simple-battery node
-    assert lines[0].startswith(f"{path.as_posix()}:20: /battery-spare: voltage-min-design-microvolt = 4200000 uV")
-    assert lines[1].startswith(f"{path.as_posix()}:23: /battery-spare: ocv-capacity-table-0[0][1]")
-    assert "120" in lines[1] and len(lines) == 2
+    # dt-validate's order: the binding's own checks first, battgen's cross-field rules after them
+    assert lines[0].startswith(f"{path.as_posix()}:23: /battery-spare: ocv-capacity-table-0[0][1]")
+    assert lines[1].startswith(f"{path.as_posix()}:20: /battery-spare: voltage-min-design-microvolt = 4200000 uV")
+    assert "120" in lines[0] and len(lines) == 2
 
 
 def test_advice_rules_warn_without_failing(capsys: pytest.CaptureFixture[str]) -> None:
