@@ -195,36 +195,47 @@ def test_unreadable_or_empty_capture_is_one_clear_line(
 
 
 def test_live_virtual_bus_with_a_pydronecan_node(capsys: pytest.CaptureFixture[str]) -> None:
-    """A pydronecan node publishes BatteryInfoAux + BatteryInfo on python-can's in-process virtual bus."""
+    """A pydronecan node publishes BatteryInfoAux + BatteryInfo on python-can's in-process virtual bus while
+    ``battgen can --bus`` listens. The node keeps publishing until the command has returned, so a loaded machine
+    (a late start of either side) changes how many transfers are seen, never whether they are right; the reader
+    may join in the middle of a transfer and stop in the middle of one, the only transport problems allowed."""
     virtual = pytest.importorskip("can.interfaces.virtual")
     # pydronecan's python-can driver flushes after every send; the virtual bus has nothing to flush
     original = virtual.VirtualBus.flush_tx_buffer
     virtual.VirtualBus.flush_tx_buffer = lambda self: None  # type: ignore[method-assign]
     channel = f"battgen-{time.monotonic_ns()}"
+    stop = threading.Event()
 
     def publish() -> None:
-        time.sleep(0.4)  # the reader's bus is open by then
         node = dronecan.make_node(channel, node_id=42, bustype="virtual", bitrate=1_000_000)
         try:
-            for _ in range(8):
+            deadline = time.monotonic() + 60  # bounded even if the reader never returns
+            while not stop.is_set() and time.monotonic() < deadline:
                 node.broadcast(dronecan.ardupilot.equipment.power.BatteryInfoAux(voltage_cell=[3.8] * 4, battery_id=1))
                 node.broadcast(dronecan.uavcan.equipment.power.BatteryInfo(voltage=15.2, battery_id=1))
-                time.sleep(0.03)
+                time.sleep(0.02)
         finally:
             node.close()
 
     thread = threading.Thread(target=publish, daemon=True)
     thread.start()
     try:
-        code = main(["can", "--bus", f"virtual:{channel}", "--duration", "1.5", "--records", "--format", "json"])
+        code = main(["can", "--bus", f"virtual:{channel}", "--duration", "2.5", "--records", "--format", "json"])
     finally:
+        stop.set()
         thread.join(timeout=10)
         virtual.VirtualBus.flush_tx_buffer = original  # type: ignore[method-assign]
     out = capsys.readouterr().out
-    records = [json.loads(x) for x in out.splitlines() if x.startswith('{"t"')]
-    assert code == 0
+    lines = out.splitlines()
+    records = [json.loads(x) for x in lines if x.startswith('{"t"')]
+    report = json.loads("\n".join(x for x in lines if not x.startswith('{"t"')))["captures"][0]
     infos = [r for r in records if r["type"] == "BatteryInfo"]
-    assert len(infos) == 8 and all(r["node"] == 42 and abs(r["message"]["voltage"] - 15.2) < 0.01 for r in infos)
+    assert len(infos) >= 3
+    assert all(r["node"] == 42 and abs(r["message"]["voltage"] - 15.2) < 0.01 for r in infos)
+    # joining mid-transfer, and stopping mid-transfer: each at most once per message type
+    counts = report["problem_counts"]
+    assert set(counts) <= {"can-missing-start", "can-missing-end"} and all(n <= 2 for n in counts.values())
+    assert code == (1 if report["problem_counts"] else 0)
 
 
 def test_gzip_capture_is_looked_through(tmp_path: Path) -> None:
