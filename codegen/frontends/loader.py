@@ -1,4 +1,11 @@
-"""Pick the frontend for each input and merge what they produce into one Schema."""
+"""Pick the frontend for each input and merge what they produce into one Schema.
+
+Like a compiler, a load reports every error in one run: each format folder and each path given is
+parsed even when an earlier one failed, and the errors of all of them are raised together as one
+:class:`~codegen.errors.ErrorList` (the frontends collect theirs per file and line the same way).
+Mappings and rules are checked only when the formats they refer to parsed cleanly, since a
+message missing because its file is broken would otherwise be reported again from every mapping.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +13,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Protocol
 
-from ..errors import BattgenError, SchemaError
+from ..errors import BattgenError, ErrorList, SchemaError
 from ..ir import EnumDef, Schema
 from . import devicetree, dsdl, mavlink, pdef, rules, uorb
 
@@ -64,11 +71,17 @@ def is_schema_dir(path: Path) -> bool:
 def load_schema_dir(root: Path) -> Schema:
     """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset)."""
     schema = Schema()
+    errors: list[BattgenError] = []
     for fmt in FORMAT_FRONTENDS:
         sub = root / fmt
         if sub.is_dir():
-            part: Schema = frontend(fmt).parse_dir(sub)
+            try:
+                part: Schema = frontend(fmt).parse_dir(sub)
+            except BattgenError as error:
+                errors.append(error)
+                continue
             schema = schema.merged(part)
+    ErrorList.raise_if_any(errors)
     if (root / MAPPINGS_DIR).is_dir():
         # after the formats, so every reference to a message or field can be checked
         from . import mappings
@@ -81,20 +94,34 @@ def load_schema_dir(root: Path) -> Schema:
 
 
 def load(paths: Iterable[Path]) -> Schema:
-    """Parse schema folders and single files (format from the extension) into one Schema."""
+    """Parse schema folders and single files (format from the extension) into one Schema; the
+    errors of every path are raised together."""
     schema = Schema()
+    errors: list[BattgenError] = []
     for path in paths:
-        if path.is_dir():
-            if not is_schema_dir(path):
-                expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
-                raise BattgenError(f"{path}: not a schema folder (expected sub-folders {expected})")
-            part = load_schema_dir(path)
-        elif path.is_file():
-            part = frontend(format_of_file(path)).parse_file(path)
-        else:
-            raise BattgenError(f"{path}: no such file or folder")
+        try:
+            part = _load_path(path)
+        except BattgenError as error:
+            errors.append(error)
+            continue
         schema = schema.merged(part)
+    ErrorList.raise_if_any(errors)
     return _deduplicated(schema)
+
+
+def _load_path(path: Path) -> Schema:
+    if path.is_dir():
+        if not is_schema_dir(path) and any(p.is_file() for p in path.glob("*.msg")):
+            return frontend("uorb").parse_dir(path)  # a folder of .msg files, as PX4's own msg/
+        if not is_schema_dir(path):
+            expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
+            raise BattgenError(
+                f"{path}: not a schema folder (expected sub-folders {expected}, or a folder of .msg files)"
+            )
+        return load_schema_dir(path)
+    if path.is_file():
+        return frontend(format_of_file(path)).parse_file(path)
+    raise BattgenError(f"{path}: no such file or folder")
 
 
 def _deduplicated(schema: Schema) -> Schema:
@@ -118,4 +145,5 @@ def _deduplicated(schema: Schema) -> Schema:
         sources=tuple(dict.fromkeys(schema.sources)),
         mappings=schema.mappings,
         rules=schema.rules,
+        warnings=tuple(dict.fromkeys(schema.warnings)),
     )

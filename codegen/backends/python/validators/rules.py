@@ -8,7 +8,7 @@ through these node types and :func:`~.literals.py_literal`, so a rule cannot inj
 
 from __future__ import annotations
 
-from ....ir import ArrayType, Field, Message
+from ....ir import ArrayType, Field, Message, StringType
 from ....ir.expr import (
     Binary,
     BoolOp,
@@ -37,7 +37,9 @@ def known_expr(f: Field, value: str, optional: bool) -> str:
     s = f.invalid
     parts = [f"{value} is not None"] if optional else []
     if s is not None:
-        if isinstance(f.type, ArrayType):
+        if isinstance(f.type, StringType):  # a text's sentinel is 0 in every byte: the empty string
+            parts.append(f'{value} != ""')
+        elif isinstance(f.type, ArrayType):
             test = "e == e" if s.is_nan else f"e != {py_literal(s.value)}"
             parts.append(f"any({test} for e in {value})")
         else:
