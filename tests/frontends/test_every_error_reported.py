@@ -70,7 +70,7 @@ def test_several_paths_are_all_read(broken_uorb: Path, tmp_path: Path) -> None:
     with pytest.raises(ErrorList) as info:
         load([broken_uorb / "Beta.msg", tmp_path / "missing", broken_uorb / "Delta.msg"])
     assert [str(e) for e in info.value.errors] == [
-        "Beta.msg:2: expected a value in 0..255 for uint8, got 300",
+        f"{broken_uorb / 'Beta.msg'}:2: expected a value in 0..255 for uint8, got 300",
         f"{tmp_path / 'missing'}: no such file or folder",
     ]
 
