@@ -102,12 +102,19 @@ def test_v1_differs_from_v0_as_specified(battery: tuple[Message, Message]) -> No
     consts1 = {c.name: c.value for c in v1.constants}
     consts0 = {c.name: c.value for c in v0.constants}
     assert (consts1["MAX_INSTANCES"], consts0["MAX_INSTANCES"]) == (3, 4)
-    assert (consts1["WARNING_UNHEALTHY"], consts1["WARNING_CHARGING"]) == (6, 7)
-    assert (consts0["STATE_UNHEALTHY"], consts0["STATE_CHARGING"]) == (6, 7) and "STATE_UNHEALTHY" not in consts1
+    # PX4 main names 6 and 7 as V0 does, under [@enum WARNING STATE]
+    assert (consts1["STATE_UNHEALTHY"], consts1["STATE_CHARGING"]) == (6, 7) and "WARNING_UNHEALTHY" not in consts1
+    assert (consts0["STATE_UNHEALTHY"], consts0["STATE_CHARGING"]) == (6, 7)
     t1, t0 = v1.field("temperature"), v0.field("temperature")
     assert (t1.unit_text, t0.unit_text) == ("degC", "°C")
     assert t1.unit == t0.unit and t1.unit is not None and t1.unit.symbol == "degC"
-    assert v1.field("warning").enums == ("uorb.BatteryStatus.WARNING",)
+    assert v1.field("warning").enums == ("uorb.BatteryStatus.WARNING", "uorb.BatteryStatus.STATE")
+    assert (v1.field("remaining_capacity_wh").invalid, v0.field("remaining_capacity_wh").invalid) == (
+        Sentinel(math.nan, "NaN"),
+        None,
+    )
+    assert v1.field("nominal_voltage").invalid == Sentinel(math.nan, "NaN")
+    assert (v1.field("scale").unit_text, v0.field("scale").unit_text) == ("-", None)
     assert v0.field("warning").enums == ("uorb.BatteryStatusV0.WARNING", "uorb.BatteryStatusV0.STATE")
 
 
@@ -141,7 +148,9 @@ def test_battery_enums(battery: tuple[Message, Message]) -> None:
     assert any(c.name == "FAULT_COUNT" and c.value == 11 for c in v0.constants)  # kept as a constant
     assert fault.entries[2].name == "FAULT_CELL_FAIL"  # written "FAULT_CELL_FAIL= 2"
     assert fault.entries[0].doc == "Battery has deep discharged" and fault.entries[0].location is not None
-    assert [e.value for e in v1.enums[1].entries] == [0, 1, 2, 3, 4, 6, 7]
+    assert [e.name for e in v1.enums] == [e.name.replace("StatusV0", "Status") for e in v0.enums]
+    assert [e.value for e in v1.enums[1].entries] == [0, 1, 2, 3, 4]
+    assert [e.value for e in v1.enums[2].entries] == [6, 7]
     assert len(v0.constants) == 2 + 3 + 7 + 12  # every constant stays, enum members included
 
 
