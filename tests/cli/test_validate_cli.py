@@ -181,6 +181,8 @@ def test_empty_inputs_are_valid(capsys: pytest.CaptureFixture[str], tmp_path: Pa
         ("BatteryStatusV0", "uorb.BatteryStatusV0"),
         ("mavlink.BATTERY_STATUS", "mavlink.BATTERY_STATUS"),
         ("BATTERY_STATUS", "mavlink.BATTERY_STATUS"),
+        ("BATTERY_INFO", "mavlink.BATTERY_INFO"),
+        ("BatteryStatusV2", "mavlink.BATTERY_STATUS_V2"),
         ("power.BatteryInfo", "dronecan.uavcan.equipment.power.BatteryInfo"),
         ("uorb.BatteryInfo", "uorb.BatteryInfo"),
         ("uavcan.equipment.power.BatteryInfo", "dronecan.uavcan.equipment.power.BatteryInfo"),

@@ -37,8 +37,8 @@ def known_expr(f: Field, value: str, optional: bool) -> str:
     s = f.invalid
     parts = [f"{value} is not None"] if optional else []
     if s is not None:
-        if isinstance(f.type, StringType):  # a text's sentinel is 0 in every byte: the empty string
-            parts.append(f'{value} != ""')
+        if isinstance(f.type, StringType):  # a char array marked [0]: the empty text is unknown
+            parts.append(f"{value} != {py_literal(chr(int(s.value)) * (f.type.capacity or 1) if s.value else '')}")
         elif isinstance(f.type, ArrayType) and s.elements:
             parts.append(_known_by_position(f.type, s, value))
         elif isinstance(f.type, ArrayType):
