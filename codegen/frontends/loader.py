@@ -93,9 +93,50 @@ def load_schema_dir(root: Path) -> Schema:
     return schema
 
 
+_OWN_FOLDERS = frozenset(FORMAT_FRONTENDS) | {MAPPINGS_DIR, RULES_DIR}
+_SEARCH_LIMIT = 10_000  # directory entries looked at while telling a DSDL tree from a schema folder
+
+
+def _first_dsdl(folder: Path) -> Path | None:
+    """Some ``*.uavcan`` file below ``folder`` (a bounded walk: never a whole disk)."""
+    for seen, path in enumerate(folder.rglob("*")):
+        if seen >= _SEARCH_LIMIT:
+            return None
+        if path.suffix == ".uavcan" and path.is_file():
+            return path
+    return None
+
+
+def dsdl_definition(path: Path) -> Path | None:
+    """A definition that makes ``path`` a DSDL tree rather than a schema folder, if it is one: a
+    ``*.uavcan`` file in it or below a namespace folder (``uavcan/``, ``ardupilot/``, ...), with none
+    of a schema folder's other format folders. A ``dronecan/`` folder alone keeps its schema-folder meaning."""
+    if any((path / name).is_dir() for name in _OWN_FOLDERS - {"dronecan"}):
+        return None
+    direct = next((p for p in sorted(path.glob("*.uavcan")) if p.is_file()), None)
+    if direct is not None:
+        return direct
+    for sub in sorted(path.iterdir()):
+        if sub.is_dir() and sub.name != "dronecan":
+            found = _first_dsdl(sub)
+            if found is not None:
+                return found
+    return None
+
+
+def _load_dsdl_tree(path: Path, definition: Path) -> Schema:
+    """A DSDL root; a folder inside one (a namespace) is refused with the root to pass instead."""
+    root = dsdl.find_root(definition)
+    if definition.parent.resolve() == path.resolve() or root.resolve() in path.resolve().parents:
+        raise BattgenError(
+            f"{path}: a DSDL namespace folder, not a DSDL root: pass the folder holding its top namespace, {root}"
+        )
+    return dsdl.parse_dir(path)
+
+
 def load(paths: Iterable[Path]) -> Schema:
-    """Parse schema folders and single files (format from the extension) into one Schema; the
-    errors of every path are raised together."""
+    """Parse schema folders, DSDL roots, folders of .msg files and single files (format from the
+    extension) into one Schema; the errors of every path are raised together."""
     schema = Schema()
     errors: list[BattgenError] = []
     for path in paths:
@@ -111,14 +152,18 @@ def load(paths: Iterable[Path]) -> Schema:
 
 def _load_path(path: Path) -> Schema:
     if path.is_dir():
-        if not is_schema_dir(path) and any(p.is_file() for p in path.glob("*.msg")):
+        definition = dsdl_definition(path)
+        if definition is not None:
+            return _load_dsdl_tree(path, definition)
+        if is_schema_dir(path):
+            return load_schema_dir(path)
+        if any(p.is_file() for p in path.glob("*.msg")):
             return frontend("uorb").parse_dir(path)  # a folder of .msg files, as PX4's own msg/
-        if not is_schema_dir(path):
-            expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
-            raise BattgenError(
-                f"{path}: not a schema folder (expected sub-folders {expected}, or a folder of .msg files)"
-            )
-        return load_schema_dir(path)
+        expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
+        raise BattgenError(
+            f"{path}: not a schema folder (expected sub-folders {expected}) nor a DSDL root "
+            "(namespace folders such as uavcan/ holding .uavcan files) nor a folder of .msg files"
+        )
     if path.is_file():
         return frontend(format_of_file(path)).parse_file(path)
     raise BattgenError(f"{path}: no such file or folder")
