@@ -250,6 +250,10 @@ def _number(schema: Schema, f: Field, t: PrimitiveType) -> dict[str, Any]:
             core["maximum"] = min(core.get("maximum", mask), mask)
         elif bin(mask).count("1") <= _MAX_MASK_ENUM.bit_length() - 1:
             core["enum"] = _mask_values(mask)
+        else:  # many bits: a run of low bits under a few high ones is a union of ranges
+            run = (mask ^ (mask + 1)) >> 1  # the trailing ones of the mask
+            if bin(mask & ~run).count("1") <= _MAX_MASK_ENUM.bit_length() - 1:
+                core["anyOf"] = [{"minimum": h, "maximum": h + run} for h in _mask_values(mask & ~run)]
     alternatives = [core]
     if is_float and high == math.inf:
         alternatives.append({"enum": INF_STRINGS})
@@ -287,6 +291,8 @@ def _core_accepts(core: dict[str, Any], value: float) -> bool:
     if "exclusiveMinimum" in core and value <= core["exclusiveMinimum"]:
         return False
     if "exclusiveMaximum" in core and value >= core["exclusiveMaximum"]:
+        return False
+    if "anyOf" in core and not any(r["minimum"] <= value <= r["maximum"] for r in core["anyOf"]):
         return False
     return "enum" not in core or value in core["enum"]
 
