@@ -96,7 +96,11 @@ def _value(schema: Schema, f: Field, t: FieldType, depth: int = 0) -> st.SearchS
         return _number(schema, f, t)
     if isinstance(t, StrT):
         known = [str(c) for c in f.choices] + ([f.const] if isinstance(f.const, str) else [])
-        return st.sampled_from([*known, "", "other"]) | st.text(max_size=4) | JUNK
+        # JSON Schema's maxLength counts characters, a char[N] holds N bytes of UTF-8: the two agree on
+        # ASCII text and on any text of at most N/4 characters, which is what is drawn here
+        cap = t.capacity or 16
+        ascii_text = st.text(alphabet=string.printable, max_size=cap + 2)
+        return st.sampled_from([*known, "", "other"]) | ascii_text | st.text(max_size=min(4, cap // 4)) | JUNK
     if isinstance(t, CompositeType):
         return _object(schema, schema.message(t.name), depth + 1)
     el = t.element
