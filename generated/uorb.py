@@ -6,12 +6,13 @@ Module: uorb.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
-import math
-import struct
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+import enum as _enum
+import math as _math
+import struct as _struct
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from . import _meta as _m
 from . import _ulog, _uorb
@@ -32,7 +33,7 @@ __all__ = [
 ]
 
 
-class BatteryStatusSource(enum.IntEnum):
+class BatteryStatusSource(_enum.IntEnum):
     """uorb.BatteryStatus.SOURCE: values."""
 
     POWER_MODULE = 0
@@ -40,7 +41,7 @@ class BatteryStatusSource(enum.IntEnum):
     ESCS = 2
 
 
-class BatteryStatusWarning(enum.IntEnum):
+class BatteryStatusWarning(_enum.IntEnum):
     """uorb.BatteryStatus.WARNING: values."""
 
     NONE = 0
@@ -50,14 +51,14 @@ class BatteryStatusWarning(enum.IntEnum):
     FAILED = 4
 
 
-class BatteryStatusState(enum.IntEnum):
+class BatteryStatusState(_enum.IntEnum):
     """uorb.BatteryStatus.STATE: values."""
 
     UNHEALTHY = 6
     CHARGING = 7
 
 
-class BatteryStatusFault(enum.IntEnum):
+class BatteryStatusFault(_enum.IntEnum):
     """uorb.BatteryStatus.FAULT: bit positions in a bitmask field."""
 
     DEEP_DISCHARGE = 0
@@ -73,7 +74,7 @@ class BatteryStatusFault(enum.IntEnum):
     FAILED_TO_ARM = 10
 
 
-class BatteryStatusV0Source(enum.IntEnum):
+class BatteryStatusV0Source(_enum.IntEnum):
     """uorb.BatteryStatusV0.SOURCE: values."""
 
     POWER_MODULE = 0
@@ -81,7 +82,7 @@ class BatteryStatusV0Source(enum.IntEnum):
     ESCS = 2
 
 
-class BatteryStatusV0Warning(enum.IntEnum):
+class BatteryStatusV0Warning(_enum.IntEnum):
     """uorb.BatteryStatusV0.WARNING: values."""
 
     NONE = 0
@@ -91,14 +92,14 @@ class BatteryStatusV0Warning(enum.IntEnum):
     FAILED = 4
 
 
-class BatteryStatusV0State(enum.IntEnum):
+class BatteryStatusV0State(_enum.IntEnum):
     """uorb.BatteryStatusV0.STATE: values."""
 
     UNHEALTHY = 6
     CHARGING = 7
 
 
-class BatteryStatusV0Fault(enum.IntEnum):
+class BatteryStatusV0Fault(_enum.IntEnum):
     """uorb.BatteryStatusV0.FAULT: bit positions in a bitmask field."""
 
     DEEP_DISCHARGE = 0
@@ -115,9 +116,9 @@ class BatteryStatusV0Fault(enum.IntEnum):
 
 
 # the C struct, nested messages inlined (decoding reads them in place)
-_BATTERY_INFO_STRUCT = struct.Struct("<QB32s7x")
+_BATTERY_INFO_STRUCT = _struct.Struct("<QB32s7x")
 # without the trailing padding, which ULog records leave out
-_BATTERY_INFO_UNPADDED = struct.Struct("<QB32s")
+_BATTERY_INFO_UNPADDED = _struct.Struct("<QB32s")
 
 
 _BATTERY_INFO_COLUMNS = _uorb.Columns(
@@ -139,9 +140,9 @@ _BATTERY_INFO_SERIAL_NUMBER_SPEC = _v.Text(capacity=32)
 
 
 # the C struct, nested messages inlined (decoding reads them in place)
-_BATTERY_STATUS_STRUCT = struct.Struct("<Q33f9H?4B2?B2x")
+_BATTERY_STATUS_STRUCT = _struct.Struct("<Q33f9H?4B2?B2x")
 # without the trailing padding, which ULog records leave out
-_BATTERY_STATUS_UNPADDED = struct.Struct("<Q33f9H?4B2?B")
+_BATTERY_STATUS_UNPADDED = _struct.Struct("<Q33f9H?4B2?B")
 
 
 _BATTERY_STATUS_COLUMNS = _uorb.Columns(
@@ -416,7 +417,7 @@ _BATTERY_STATUS_TIME_REMAINING_S_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="s",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_TEMPERATURE_SPEC = _v.Number(
@@ -425,7 +426,7 @@ _BATTERY_STATUS_TEMPERATURE_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="degC",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_CELL_COUNT_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255, sentinel=0, sentinel_text="0")
@@ -511,7 +512,7 @@ _BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="Wh",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
@@ -521,7 +522,7 @@ _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="V",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_INTERNAL_RESISTANCE_ESTIMATE_SPEC = _v.Number(
@@ -548,7 +549,7 @@ _BATTERY_STATUS_ESTIMATION_COVARIANCE_NORM_SPEC = _v.Number(
 
 
 # the C struct, nested messages inlined (decoding reads them in place)
-_BATTERY_STATUS_V0_STRUCT = struct.Struct("<Q33f10H?4B2?B")
+_BATTERY_STATUS_V0_STRUCT = _struct.Struct("<Q33f10H?4B2?B")
 
 
 _BATTERY_STATUS_V0_COLUMNS = _uorb.Columns(
@@ -827,7 +828,7 @@ _BATTERY_STATUS_V0_TIME_REMAINING_S_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="s",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_V0_TEMPERATURE_SPEC = _v.Number(
@@ -836,7 +837,7 @@ _BATTERY_STATUS_V0_TEMPERATURE_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="degC",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_V0_CELL_COUNT_SPEC = _v.Number(
@@ -949,7 +950,7 @@ _BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC = _v.Number(
 )
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryInfo:
     """Battery information
 
@@ -959,9 +960,9 @@ class BatteryInfo:
     Schema: uorb.BatteryInfo (uorb, BatteryInfo.msg:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "uorb.BatteryInfo"
+    QUALIFIED_NAME: _ClassVar[str] = "uorb.BatteryInfo"
 
-    timestamp: int = dataclasses.field(
+    timestamp: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="timestamp",
@@ -973,13 +974,13 @@ class BatteryInfo:
             doc="Time since system start",
         ),
     )
-    id: int = dataclasses.field(
+    id: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="id", type="uint8", doc="Must match the id in the battery_status message for the same battery"
         ),
     )
-    serial_number: str = dataclasses.field(
+    serial_number: str = _dataclasses.field(
         default="",
         metadata=_m.meta(
             name="serial_number",
@@ -997,16 +998,16 @@ class BatteryInfo:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["timestamp"] = self.timestamp
         out["id"] = self.id
         out["serial_number"] = self.serial_number
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryInfo:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfo:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(data, frozenset({"timestamp", "id", "serial_number"}), (), "BatteryInfo")
         obj = cls()
@@ -1018,11 +1019,11 @@ class BatteryInfo:
             obj.serial_number = _m.as_str(data["serial_number"], "serial_number")
         return obj
 
-    UORB_FORMAT: ClassVar[str] = "<QB32s7x"
-    UORB_SIZE: ClassVar[int] = 48
-    UORB_SIZE_NO_PADDING: ClassVar[int] = 41
-    UORB_TOPICS: ClassVar[tuple[str, ...]] = ("battery_info",)
-    MESSAGE_VERSION: ClassVar[int | None] = None
+    UORB_FORMAT: _ClassVar[str] = "<QB32s7x"
+    UORB_SIZE: _ClassVar[int] = 48
+    UORB_SIZE_NO_PADDING: _ClassVar[int] = 41
+    UORB_TOPICS: _ClassVar[tuple[str, ...]] = ("battery_info",)
+    MESSAGE_VERSION: _ClassVar[int | None] = None
 
     def encode(self) -> bytes:
         """PX4's C struct of this message: 48 bytes, little-endian, padding zeroed."""
@@ -1030,7 +1031,7 @@ class BatteryInfo:
             return _BATTERY_INFO_STRUCT.pack(
                 self.timestamp, self.id, _uorb.cstr_encode(self.serial_number, 32, "BatteryInfo.serial_number")
             )
-        except (struct.error, TypeError, OverflowError) as exc:
+        except (_struct.error, TypeError, OverflowError) as exc:
             raise _uorb.encode_error("BatteryInfo", self, _BATTERY_INFO_PACKED_FIELDS, exc) from None
 
     @classmethod
@@ -1055,7 +1056,7 @@ class BatteryInfo:
         stride: int | None = None,
         use_numpy: bool | None = None,
         copy: bool = True,
-    ) -> dict[str, Any]:
+    ) -> dict[str, _Any]:
         """Columns of back-to-back records without an object per record, named as PX4 log
         tools flatten them (``voltage_cell_v[3]``, ``nested.field``; char arrays as bytes).
 
@@ -1097,7 +1098,7 @@ class BatteryInfo:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
+        x: _Any
         try:
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_TIMESTAMP_SPEC)
@@ -1132,7 +1133,7 @@ class BatteryInfo:
         raise KeyError(f"{field!r} is not a field of " + "uorb.BatteryInfo")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryStatus:
     """Battery status
 
@@ -1143,33 +1144,33 @@ class BatteryStatus:
     Schema: uorb.BatteryStatus (uorb, BatteryStatus.msg:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "uorb.BatteryStatus"
-    MESSAGE_VERSION: ClassVar[int] = 1
-    MAX_INSTANCES: ClassVar[int] = 3
-    SOURCE_POWER_MODULE: ClassVar[int] = 0
-    SOURCE_EXTERNAL: ClassVar[int] = 1
-    SOURCE_ESCS: ClassVar[int] = 2
-    WARNING_NONE: ClassVar[int] = 0
-    WARNING_LOW: ClassVar[int] = 1
-    WARNING_CRITICAL: ClassVar[int] = 2
-    WARNING_EMERGENCY: ClassVar[int] = 3
-    WARNING_FAILED: ClassVar[int] = 4
-    STATE_UNHEALTHY: ClassVar[int] = 6
-    STATE_CHARGING: ClassVar[int] = 7
-    FAULT_DEEP_DISCHARGE: ClassVar[int] = 0
-    FAULT_SPIKES: ClassVar[int] = 1
-    FAULT_CELL_FAIL: ClassVar[int] = 2
-    FAULT_OVER_CURRENT: ClassVar[int] = 3
-    FAULT_OVER_TEMPERATURE: ClassVar[int] = 4
-    FAULT_UNDER_TEMPERATURE: ClassVar[int] = 5
-    FAULT_INCOMPATIBLE_VOLTAGE: ClassVar[int] = 6
-    FAULT_INCOMPATIBLE_FIRMWARE: ClassVar[int] = 7
-    FAULT_INCOMPATIBLE_MODEL: ClassVar[int] = 8
-    FAULT_HARDWARE_FAILURE: ClassVar[int] = 9
-    FAULT_FAILED_TO_ARM: ClassVar[int] = 10
-    FAULT_COUNT: ClassVar[int] = 11
+    QUALIFIED_NAME: _ClassVar[str] = "uorb.BatteryStatus"
+    MESSAGE_VERSION: _ClassVar[int] = 1
+    MAX_INSTANCES: _ClassVar[int] = 3
+    SOURCE_POWER_MODULE: _ClassVar[int] = 0
+    SOURCE_EXTERNAL: _ClassVar[int] = 1
+    SOURCE_ESCS: _ClassVar[int] = 2
+    WARNING_NONE: _ClassVar[int] = 0
+    WARNING_LOW: _ClassVar[int] = 1
+    WARNING_CRITICAL: _ClassVar[int] = 2
+    WARNING_EMERGENCY: _ClassVar[int] = 3
+    WARNING_FAILED: _ClassVar[int] = 4
+    STATE_UNHEALTHY: _ClassVar[int] = 6
+    STATE_CHARGING: _ClassVar[int] = 7
+    FAULT_DEEP_DISCHARGE: _ClassVar[int] = 0
+    FAULT_SPIKES: _ClassVar[int] = 1
+    FAULT_CELL_FAIL: _ClassVar[int] = 2
+    FAULT_OVER_CURRENT: _ClassVar[int] = 3
+    FAULT_OVER_TEMPERATURE: _ClassVar[int] = 4
+    FAULT_UNDER_TEMPERATURE: _ClassVar[int] = 5
+    FAULT_INCOMPATIBLE_VOLTAGE: _ClassVar[int] = 6
+    FAULT_INCOMPATIBLE_FIRMWARE: _ClassVar[int] = 7
+    FAULT_INCOMPATIBLE_MODEL: _ClassVar[int] = 8
+    FAULT_HARDWARE_FAILURE: _ClassVar[int] = 9
+    FAULT_FAILED_TO_ARM: _ClassVar[int] = 10
+    FAULT_COUNT: _ClassVar[int] = 11
 
-    timestamp: int = dataclasses.field(
+    timestamp: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="timestamp",
@@ -1181,7 +1182,7 @@ class BatteryStatus:
             doc="Time since system start",
         ),
     )
-    connected: bool = dataclasses.field(
+    connected: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="connected",
@@ -1189,7 +1190,7 @@ class BatteryStatus:
             doc="Whether or not a battery is connected. For power modules this is based on a voltage threshold.",
         ),
     )
-    voltage_v: float = dataclasses.field(
+    voltage_v: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="voltage_v",
@@ -1201,7 +1202,7 @@ class BatteryStatus:
             doc="Battery voltage",
         ),
     )
-    current_a: float = dataclasses.field(
+    current_a: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="current_a",
@@ -1213,7 +1214,7 @@ class BatteryStatus:
             doc="Battery current",
         ),
     )
-    current_average_a: float = dataclasses.field(
+    current_average_a: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="current_average_a",
@@ -1225,7 +1226,7 @@ class BatteryStatus:
             doc="Battery current average (for FW average in level flight)",
         ),
     )
-    discharged_mah: float = dataclasses.field(
+    discharged_mah: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="discharged_mah",
@@ -1239,7 +1240,7 @@ class BatteryStatus:
             doc="Discharged amount",
         ),
     )
-    remaining: float = dataclasses.field(
+    remaining: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="remaining",
@@ -1251,7 +1252,7 @@ class BatteryStatus:
             doc="Remaining capacity",
         ),
     )
-    scale: float = dataclasses.field(
+    scale: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="scale",
@@ -1265,20 +1266,20 @@ class BatteryStatus:
             doc="Scaling factor to compensate for lower actuation power caused by voltage sag",
         ),
     )
-    time_remaining_s: float = dataclasses.field(
-        default=math.nan,
+    time_remaining_s: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="time_remaining_s",
             type="float32",
             unit="s",
             quantity="time",
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Predicted time remaining until battery is empty under previous averaged load",
         ),
     )
-    temperature: float = dataclasses.field(
-        default=math.nan,
+    temperature: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="temperature",
             type="float32",
@@ -1286,12 +1287,12 @@ class BatteryStatus:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Temperature of the battery",
         ),
     )
-    cell_count: int = dataclasses.field(
+    cell_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cell_count",
@@ -1303,11 +1304,11 @@ class BatteryStatus:
             doc="Number of cells",
         ),
     )
-    source: int = dataclasses.field(
+    source: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="source", type="uint8", enums=("uorb.BatteryStatus.SOURCE",), doc="Battery source"),
     )
-    priority: int = dataclasses.field(
+    priority: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="priority",
@@ -1317,7 +1318,7 @@ class BatteryStatus:
             doc="Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1",
         ),
     )
-    capacity: int = dataclasses.field(
+    capacity: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="capacity",
@@ -1329,7 +1330,7 @@ class BatteryStatus:
             doc="Capacity of the battery when fully charged",
         ),
     )
-    cycle_count: int = dataclasses.field(
+    cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cycle_count",
@@ -1339,7 +1340,7 @@ class BatteryStatus:
             doc="Number of discharge cycles the battery has experienced",
         ),
     )
-    average_time_to_empty: int = dataclasses.field(
+    average_time_to_empty: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="average_time_to_empty",
@@ -1351,7 +1352,7 @@ class BatteryStatus:
             doc="Predicted remaining battery capacity based on the average rate of discharge",
         ),
     )
-    manufacture_date: int = dataclasses.field(
+    manufacture_date: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="manufacture_date",
@@ -1362,7 +1363,7 @@ class BatteryStatus:
             "+ Month×32 + (Year–1980)×512",
         ),
     )
-    state_of_health: int = dataclasses.field(
+    state_of_health: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="state_of_health",
@@ -1376,7 +1377,7 @@ class BatteryStatus:
             doc="State of health. FullChargeCapacity/DesignCapacity",
         ),
     )
-    max_error: int = dataclasses.field(
+    max_error: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="max_error",
@@ -1390,7 +1391,7 @@ class BatteryStatus:
             doc="Max error, expected margin of error in the state-of-charge calculation",
         ),
     )
-    id: int = dataclasses.field(
+    id: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="id",
@@ -1400,13 +1401,13 @@ class BatteryStatus:
             doc="ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed",
         ),
     )
-    interface_error: int = dataclasses.field(
+    interface_error: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="interface_error", type="uint16", unit="1", quantity="ratio", doc="Interface error counter"
         ),
     )
-    voltage_cell_v: list[float] = dataclasses.field(
+    voltage_cell_v: list[float] = _dataclasses.field(
         default_factory=lambda: [0.0] * 14,
         metadata=_m.meta(
             name="voltage_cell_v",
@@ -1419,7 +1420,7 @@ class BatteryStatus:
             doc="Battery individual cell voltages",
         ),
     )
-    max_cell_voltage_delta: float = dataclasses.field(
+    max_cell_voltage_delta: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="max_cell_voltage_delta",
@@ -1429,19 +1430,19 @@ class BatteryStatus:
             doc="Max difference between individual cell voltages",
         ),
     )
-    is_powering_off: bool = dataclasses.field(
+    is_powering_off: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
         ),
     )
-    is_required: bool = dataclasses.field(
+    is_required: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="is_required", type="bool", doc="Set if the battery is explicitly required before arming"
         ),
     )
-    warning: int = dataclasses.field(
+    warning: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="warning",
@@ -1450,7 +1451,7 @@ class BatteryStatus:
             doc="Current battery warning",
         ),
     )
-    faults: int = dataclasses.field(
+    faults: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="faults",
@@ -1459,7 +1460,7 @@ class BatteryStatus:
             doc="Smart battery supply status/fault flags (bitmask) for health indication",
         ),
     )
-    full_charge_capacity_wh: float = dataclasses.field(
+    full_charge_capacity_wh: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="full_charge_capacity_wh",
@@ -1471,8 +1472,8 @@ class BatteryStatus:
             doc="Compensated battery capacity",
         ),
     )
-    remaining_capacity_wh: float = dataclasses.field(
-        default=math.nan,
+    remaining_capacity_wh: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="remaining_capacity_wh",
             type="float32",
@@ -1480,12 +1481,12 @@ class BatteryStatus:
             quantity="energy",
             scale=3600.0,
             offset=0.0,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Compensated battery capacity remaining",
         ),
     )
-    over_discharge_count: int = dataclasses.field(
+    over_discharge_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="over_discharge_count",
@@ -1495,19 +1496,19 @@ class BatteryStatus:
             doc="Number of battery overdischarge",
         ),
     )
-    nominal_voltage: float = dataclasses.field(
-        default=math.nan,
+    nominal_voltage: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="nominal_voltage",
             type="float32",
             unit="V",
             quantity="voltage",
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Nominal voltage of the battery pack",
         ),
     )
-    internal_resistance_estimate: float = dataclasses.field(
+    internal_resistance_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="internal_resistance_estimate",
@@ -1517,13 +1518,13 @@ class BatteryStatus:
             doc="Internal resistance per cell estimate",
         ),
     )
-    ocv_estimate: float = dataclasses.field(
+    ocv_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="ocv_estimate", type="float32", unit="V", quantity="voltage", doc="Open circuit voltage estimate"
         ),
     )
-    ocv_estimate_filtered: float = dataclasses.field(
+    ocv_estimate_filtered: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="ocv_estimate_filtered",
@@ -1533,7 +1534,7 @@ class BatteryStatus:
             doc="Filtered open circuit voltage estimate",
         ),
     )
-    volt_based_soc_estimate: float = dataclasses.field(
+    volt_based_soc_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="volt_based_soc_estimate",
@@ -1545,17 +1546,17 @@ class BatteryStatus:
             doc="Normalized volt based state of charge estimate",
         ),
     )
-    voltage_prediction: float = dataclasses.field(
+    voltage_prediction: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="voltage_prediction", type="float32", unit="V", quantity="voltage", doc="Predicted voltage"
         ),
     )
-    prediction_error: float = dataclasses.field(
+    prediction_error: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Prediction error"),
     )
-    estimation_covariance_norm: float = dataclasses.field(
+    estimation_covariance_norm: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="estimation_covariance_norm",
@@ -1572,9 +1573,9 @@ class BatteryStatus:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["timestamp"] = self.timestamp
         out["connected"] = self.connected
         out["voltage_v"] = self.voltage_v
@@ -1616,7 +1617,7 @@ class BatteryStatus:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatus:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -1750,10 +1751,10 @@ class BatteryStatus:
             )
         return obj
 
-    UORB_FORMAT: ClassVar[str] = "<Q33f9H?4B2?B2x"
-    UORB_SIZE: ClassVar[int] = 168
-    UORB_SIZE_NO_PADDING: ClassVar[int] = 166
-    UORB_TOPICS: ClassVar[tuple[str, ...]] = ("battery_status",)
+    UORB_FORMAT: _ClassVar[str] = "<Q33f9H?4B2?B2x"
+    UORB_SIZE: _ClassVar[int] = 168
+    UORB_SIZE_NO_PADDING: _ClassVar[int] = 166
+    UORB_TOPICS: _ClassVar[tuple[str, ...]] = ("battery_status",)
 
     def encode(self) -> bytes:
         """PX4's C struct of this message: 168 bytes, little-endian, padding zeroed."""
@@ -1798,7 +1799,7 @@ class BatteryStatus:
                 self.is_required,
                 self.warning,
             )
-        except (struct.error, TypeError, OverflowError) as exc:
+        except (_struct.error, TypeError, OverflowError) as exc:
             raise _uorb.encode_error("BatteryStatus", self, _BATTERY_STATUS_PACKED_FIELDS, exc) from None
 
     @classmethod
@@ -1858,7 +1859,7 @@ class BatteryStatus:
         stride: int | None = None,
         use_numpy: bool | None = None,
         copy: bool = True,
-    ) -> dict[str, Any]:
+    ) -> dict[str, _Any]:
         """Columns of back-to-back records without an object per record, named as PX4 log
         tools flatten them (``voltage_cell_v[3]``, ``nested.field``; char arrays as bytes).
 
@@ -1935,12 +1936,12 @@ class BatteryStatus:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        a: Any
-        e: Any
-        r_cell_count: Any
-        r_voltage_cell_v: Any
-        v_i: Any
+        x: _Any
+        a: _Any
+        e: _Any
+        r_cell_count: _Any
+        r_voltage_cell_v: _Any
+        v_i: _Any
         try:
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_TIMESTAMP_SPEC)
@@ -2325,7 +2326,7 @@ class BatteryStatus:
         raise KeyError(f"{field!r} is not a field of " + "uorb.BatteryStatus")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryStatusV0:
     """Battery status
 
@@ -2336,33 +2337,33 @@ class BatteryStatusV0:
     Schema: uorb.BatteryStatusV0 (uorb, BatteryStatusV0.msg:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "uorb.BatteryStatusV0"
-    MESSAGE_VERSION: ClassVar[int] = 0
-    MAX_INSTANCES: ClassVar[int] = 4
-    SOURCE_POWER_MODULE: ClassVar[int] = 0
-    SOURCE_EXTERNAL: ClassVar[int] = 1
-    SOURCE_ESCS: ClassVar[int] = 2
-    WARNING_NONE: ClassVar[int] = 0
-    WARNING_LOW: ClassVar[int] = 1
-    WARNING_CRITICAL: ClassVar[int] = 2
-    WARNING_EMERGENCY: ClassVar[int] = 3
-    WARNING_FAILED: ClassVar[int] = 4
-    STATE_UNHEALTHY: ClassVar[int] = 6
-    STATE_CHARGING: ClassVar[int] = 7
-    FAULT_DEEP_DISCHARGE: ClassVar[int] = 0
-    FAULT_SPIKES: ClassVar[int] = 1
-    FAULT_CELL_FAIL: ClassVar[int] = 2
-    FAULT_OVER_CURRENT: ClassVar[int] = 3
-    FAULT_OVER_TEMPERATURE: ClassVar[int] = 4
-    FAULT_UNDER_TEMPERATURE: ClassVar[int] = 5
-    FAULT_INCOMPATIBLE_VOLTAGE: ClassVar[int] = 6
-    FAULT_INCOMPATIBLE_FIRMWARE: ClassVar[int] = 7
-    FAULT_INCOMPATIBLE_MODEL: ClassVar[int] = 8
-    FAULT_HARDWARE_FAILURE: ClassVar[int] = 9
-    FAULT_FAILED_TO_ARM: ClassVar[int] = 10
-    FAULT_COUNT: ClassVar[int] = 11
+    QUALIFIED_NAME: _ClassVar[str] = "uorb.BatteryStatusV0"
+    MESSAGE_VERSION: _ClassVar[int] = 0
+    MAX_INSTANCES: _ClassVar[int] = 4
+    SOURCE_POWER_MODULE: _ClassVar[int] = 0
+    SOURCE_EXTERNAL: _ClassVar[int] = 1
+    SOURCE_ESCS: _ClassVar[int] = 2
+    WARNING_NONE: _ClassVar[int] = 0
+    WARNING_LOW: _ClassVar[int] = 1
+    WARNING_CRITICAL: _ClassVar[int] = 2
+    WARNING_EMERGENCY: _ClassVar[int] = 3
+    WARNING_FAILED: _ClassVar[int] = 4
+    STATE_UNHEALTHY: _ClassVar[int] = 6
+    STATE_CHARGING: _ClassVar[int] = 7
+    FAULT_DEEP_DISCHARGE: _ClassVar[int] = 0
+    FAULT_SPIKES: _ClassVar[int] = 1
+    FAULT_CELL_FAIL: _ClassVar[int] = 2
+    FAULT_OVER_CURRENT: _ClassVar[int] = 3
+    FAULT_OVER_TEMPERATURE: _ClassVar[int] = 4
+    FAULT_UNDER_TEMPERATURE: _ClassVar[int] = 5
+    FAULT_INCOMPATIBLE_VOLTAGE: _ClassVar[int] = 6
+    FAULT_INCOMPATIBLE_FIRMWARE: _ClassVar[int] = 7
+    FAULT_INCOMPATIBLE_MODEL: _ClassVar[int] = 8
+    FAULT_HARDWARE_FAILURE: _ClassVar[int] = 9
+    FAULT_FAILED_TO_ARM: _ClassVar[int] = 10
+    FAULT_COUNT: _ClassVar[int] = 11
 
-    timestamp: int = dataclasses.field(
+    timestamp: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="timestamp",
@@ -2374,7 +2375,7 @@ class BatteryStatusV0:
             doc="Time since system start",
         ),
     )
-    connected: bool = dataclasses.field(
+    connected: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="connected",
@@ -2382,7 +2383,7 @@ class BatteryStatusV0:
             doc="Whether or not a battery is connected. For power modules this is based on a voltage threshold.",
         ),
     )
-    voltage_v: float = dataclasses.field(
+    voltage_v: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="voltage_v",
@@ -2394,7 +2395,7 @@ class BatteryStatusV0:
             doc="Battery voltage",
         ),
     )
-    current_a: float = dataclasses.field(
+    current_a: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="current_a",
@@ -2406,7 +2407,7 @@ class BatteryStatusV0:
             doc="Battery current",
         ),
     )
-    current_average_a: float = dataclasses.field(
+    current_average_a: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="current_average_a",
@@ -2418,7 +2419,7 @@ class BatteryStatusV0:
             doc="Battery current average (for FW average in level flight)",
         ),
     )
-    discharged_mah: float = dataclasses.field(
+    discharged_mah: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="discharged_mah",
@@ -2432,7 +2433,7 @@ class BatteryStatusV0:
             doc="Discharged amount",
         ),
     )
-    remaining: float = dataclasses.field(
+    remaining: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="remaining",
@@ -2444,7 +2445,7 @@ class BatteryStatusV0:
             doc="Remaining capacity",
         ),
     )
-    scale: float = dataclasses.field(
+    scale: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="scale",
@@ -2456,20 +2457,20 @@ class BatteryStatusV0:
             doc="Scaling factor to compensate for lower actuation power caused by voltage sag",
         ),
     )
-    time_remaining_s: float = dataclasses.field(
-        default=math.nan,
+    time_remaining_s: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="time_remaining_s",
             type="float32",
             unit="s",
             quantity="time",
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Predicted time remaining until battery is empty under previous averaged load",
         ),
     )
-    temperature: float = dataclasses.field(
-        default=math.nan,
+    temperature: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="temperature",
             type="float32",
@@ -2477,19 +2478,19 @@ class BatteryStatusV0:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Temperature of the battery",
         ),
     )
-    cell_count: int = dataclasses.field(
+    cell_count: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="cell_count", type="uint8", invalid=0, invalid_text="0", doc="Number of cells")
     )
-    source: int = dataclasses.field(
+    source: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="source", type="uint8", enums=("uorb.BatteryStatusV0.SOURCE",), doc="Battery source"),
     )
-    priority: int = dataclasses.field(
+    priority: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="priority",
@@ -2497,7 +2498,7 @@ class BatteryStatusV0:
             doc="Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1",
         ),
     )
-    capacity: int = dataclasses.field(
+    capacity: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="capacity",
@@ -2509,13 +2510,13 @@ class BatteryStatusV0:
             doc="Capacity of the battery when fully charged",
         ),
     )
-    cycle_count: int = dataclasses.field(
+    cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cycle_count", type="uint16", doc="Number of discharge cycles the battery has experienced"
         ),
     )
-    average_time_to_empty: int = dataclasses.field(
+    average_time_to_empty: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="average_time_to_empty",
@@ -2527,10 +2528,10 @@ class BatteryStatusV0:
             doc="Predicted remaining battery capacity based on the average rate of discharge",
         ),
     )
-    serial_number: int = dataclasses.field(
+    serial_number: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="Serial number of the battery pack")
     )
-    manufacture_date: int = dataclasses.field(
+    manufacture_date: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="manufacture_date",
@@ -2539,7 +2540,7 @@ class BatteryStatusV0:
             "+ Month×32 + (Year–1980)×512",
         ),
     )
-    state_of_health: int = dataclasses.field(
+    state_of_health: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="state_of_health",
@@ -2553,7 +2554,7 @@ class BatteryStatusV0:
             doc="State of health. FullChargeCapacity/DesignCapacity",
         ),
     )
-    max_error: int = dataclasses.field(
+    max_error: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="max_error",
@@ -2567,7 +2568,7 @@ class BatteryStatusV0:
             doc="Max error, expected margin of error in the state-of-charge calculation",
         ),
     )
-    id: int = dataclasses.field(
+    id: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="id",
@@ -2575,10 +2576,10 @@ class BatteryStatusV0:
             doc="ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed",
         ),
     )
-    interface_error: int = dataclasses.field(
+    interface_error: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="Interface error counter")
     )
-    voltage_cell_v: list[float] = dataclasses.field(
+    voltage_cell_v: list[float] = _dataclasses.field(
         default_factory=lambda: [0.0] * 14,
         metadata=_m.meta(
             name="voltage_cell_v",
@@ -2591,25 +2592,25 @@ class BatteryStatusV0:
             doc="Battery individual cell voltages",
         ),
     )
-    max_cell_voltage_delta: float = dataclasses.field(
+    max_cell_voltage_delta: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="max_cell_voltage_delta", type="float32", doc="Max difference between individual cell voltages"
         ),
     )
-    is_powering_off: bool = dataclasses.field(
+    is_powering_off: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
         ),
     )
-    is_required: bool = dataclasses.field(
+    is_required: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="is_required", type="bool", doc="Set if the battery is explicitly required before arming"
         ),
     )
-    warning: int = dataclasses.field(
+    warning: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="warning",
@@ -2618,7 +2619,7 @@ class BatteryStatusV0:
             doc="Current battery warning",
         ),
     )
-    faults: int = dataclasses.field(
+    faults: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="faults",
@@ -2627,7 +2628,7 @@ class BatteryStatusV0:
             doc="Smart battery supply status/fault flags (bitmask) for health indication",
         ),
     )
-    full_charge_capacity_wh: float = dataclasses.field(
+    full_charge_capacity_wh: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="full_charge_capacity_wh",
@@ -2639,7 +2640,7 @@ class BatteryStatusV0:
             doc="Compensated battery capacity",
         ),
     )
-    remaining_capacity_wh: float = dataclasses.field(
+    remaining_capacity_wh: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="remaining_capacity_wh",
@@ -2651,10 +2652,10 @@ class BatteryStatusV0:
             doc="Compensated battery capacity remaining",
         ),
     )
-    over_discharge_count: int = dataclasses.field(
+    over_discharge_count: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
     )
-    nominal_voltage: float = dataclasses.field(
+    nominal_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="nominal_voltage",
@@ -2664,7 +2665,7 @@ class BatteryStatusV0:
             doc="Nominal voltage of the battery pack",
         ),
     )
-    internal_resistance_estimate: float = dataclasses.field(
+    internal_resistance_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="internal_resistance_estimate",
@@ -2674,13 +2675,13 @@ class BatteryStatusV0:
             doc="Internal resistance per cell estimate",
         ),
     )
-    ocv_estimate: float = dataclasses.field(
+    ocv_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="ocv_estimate", type="float32", unit="V", quantity="voltage", doc="Open circuit voltage estimate"
         ),
     )
-    ocv_estimate_filtered: float = dataclasses.field(
+    ocv_estimate_filtered: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="ocv_estimate_filtered",
@@ -2690,7 +2691,7 @@ class BatteryStatusV0:
             doc="Filtered open circuit voltage estimate",
         ),
     )
-    volt_based_soc_estimate: float = dataclasses.field(
+    volt_based_soc_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="volt_based_soc_estimate",
@@ -2700,17 +2701,17 @@ class BatteryStatusV0:
             doc="Normalized volt based state of charge estimate",
         ),
     )
-    voltage_prediction: float = dataclasses.field(
+    voltage_prediction: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="voltage_prediction", type="float32", unit="V", quantity="voltage", doc="Predicted voltage"
         ),
     )
-    prediction_error: float = dataclasses.field(
+    prediction_error: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Prediction error"),
     )
-    estimation_covariance_norm: float = dataclasses.field(
+    estimation_covariance_norm: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="estimation_covariance_norm", type="float32", doc="Norm of the covariance matrix"),
     )
@@ -2721,9 +2722,9 @@ class BatteryStatusV0:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["timestamp"] = self.timestamp
         out["connected"] = self.connected
         out["voltage_v"] = self.voltage_v
@@ -2766,7 +2767,7 @@ class BatteryStatusV0:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatusV0:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatusV0:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -2903,10 +2904,10 @@ class BatteryStatusV0:
             )
         return obj
 
-    UORB_FORMAT: ClassVar[str] = "<Q33f10H?4B2?B"
-    UORB_SIZE: ClassVar[int] = 168
-    UORB_SIZE_NO_PADDING: ClassVar[int] = 168
-    UORB_TOPICS: ClassVar[tuple[str, ...]] = ("battery_status_v0",)
+    UORB_FORMAT: _ClassVar[str] = "<Q33f10H?4B2?B"
+    UORB_SIZE: _ClassVar[int] = 168
+    UORB_SIZE_NO_PADDING: _ClassVar[int] = 168
+    UORB_TOPICS: _ClassVar[tuple[str, ...]] = ("battery_status_v0",)
 
     def encode(self) -> bytes:
         """PX4's C struct of this message: 168 bytes, little-endian, padding zeroed."""
@@ -2952,7 +2953,7 @@ class BatteryStatusV0:
                 self.is_required,
                 self.warning,
             )
-        except (struct.error, TypeError, OverflowError) as exc:
+        except (_struct.error, TypeError, OverflowError) as exc:
             raise _uorb.encode_error("BatteryStatusV0", self, _BATTERY_STATUS_V0_PACKED_FIELDS, exc) from None
 
     @classmethod
@@ -3011,7 +3012,7 @@ class BatteryStatusV0:
         stride: int | None = None,
         use_numpy: bool | None = None,
         copy: bool = True,
-    ) -> dict[str, Any]:
+    ) -> dict[str, _Any]:
         """Columns of back-to-back records without an object per record, named as PX4 log
         tools flatten them (``voltage_cell_v[3]``, ``nested.field``; char arrays as bytes).
 
@@ -3088,12 +3089,12 @@ class BatteryStatusV0:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        a: Any
-        e: Any
-        r_cell_count: Any
-        r_voltage_cell_v: Any
-        v_i: Any
+        x: _Any
+        a: _Any
+        e: _Any
+        r_cell_count: _Any
+        r_voltage_cell_v: _Any
+        v_i: _Any
         try:
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_V0_TIMESTAMP_SPEC)

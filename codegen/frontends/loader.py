@@ -9,7 +9,7 @@ message missing because its file is broken would otherwise be reported again fro
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Protocol
 
@@ -68,15 +68,20 @@ def is_schema_dir(path: Path) -> bool:
     return any((path / fmt).is_dir() for fmt in FORMAT_FRONTENDS)
 
 
-def load_schema_dir(root: Path) -> Schema:
-    """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset)."""
+def load_schema_dir(root: Path, *, include_paths: Sequence[Path] = ()) -> Schema:
+    """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset); MAVLink includes
+    may also come from ``include_paths`` (README Limits)."""
     schema = Schema()
     errors: list[BattgenError] = []
     for fmt in FORMAT_FRONTENDS:
         sub = root / fmt
         if sub.is_dir():
             try:
-                part: Schema = frontend(fmt).parse_dir(sub)
+                part: Schema = (
+                    mavlink.parse_dir(sub, include_paths=include_paths)
+                    if fmt == "mavlink"
+                    else frontend(fmt).parse_dir(sub)
+                )
             except BattgenError as error:
                 errors.append(error)
                 continue
@@ -134,14 +139,15 @@ def _load_dsdl_tree(path: Path, definition: Path) -> Schema:
     return dsdl.parse_dir(path)
 
 
-def load(paths: Iterable[Path]) -> Schema:
+def load(paths: Iterable[Path], *, include_paths: Sequence[Path] = ()) -> Schema:
     """Parse schema folders, DSDL roots, folders of .msg files and single files (format from the
-    extension) into one Schema; the errors of every path are raised together."""
+    extension) into one Schema; the errors of every path are raised together. ``include_paths``:
+    folders MAVLink <include>s may read besides the schema folder."""
     schema = Schema()
     errors: list[BattgenError] = []
     for path in paths:
         try:
-            part = _load_path(path)
+            part = _load_path(path, include_paths)
         except BattgenError as error:
             errors.append(error)
             continue
@@ -150,13 +156,13 @@ def load(paths: Iterable[Path]) -> Schema:
     return _deduplicated(schema)
 
 
-def _load_path(path: Path) -> Schema:
+def _load_path(path: Path, include_paths: Sequence[Path]) -> Schema:
     if path.is_dir():
         definition = dsdl_definition(path)
         if definition is not None:
             return _load_dsdl_tree(path, definition)
         if is_schema_dir(path):
-            return load_schema_dir(path)
+            return load_schema_dir(path, include_paths=include_paths)
         if any(p.is_file() for p in path.glob("*.msg")):
             return frontend("uorb").parse_dir(path)  # a folder of .msg files, as PX4's own msg/
         expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
@@ -165,7 +171,10 @@ def _load_path(path: Path) -> Schema:
             "(namespace folders such as uavcan/ holding .uavcan files) nor a folder of .msg files"
         )
     if path.is_file():
-        return frontend(format_of_file(path)).parse_file(path)
+        fmt = format_of_file(path)
+        if fmt == "mavlink":
+            return mavlink.parse_file(path, include_paths=include_paths)
+        return frontend(fmt).parse_file(path)
     raise BattgenError(f"{path}: no such file or folder")
 
 

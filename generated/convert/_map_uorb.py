@@ -6,7 +6,7 @@ PX4's battery_status topic.
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..uorb import BatteryStatus
 from . import _cells
@@ -176,7 +176,7 @@ def forward(
     _c10 = list(s_status.voltage_cell_v)
     _n10 = s_status.cell_count
     _c10 = _c10[:_n10] if _n10 else _cells.leading(_c10, 0.0)
-    t.cell_voltages = tuple(math.nan if _r.is_marker(_x10, 0.0) else float(_x10) for _x10 in _c10) or None
+    t.cell_voltages = tuple(_math.nan if _r.is_marker(_x10, 0.0) else float(_x10) for _x10 in _c10) or None
 
     # uorb.yaml:21: scale capacity -> full_capacity
     _v11 = s_status.capacity
@@ -319,7 +319,7 @@ def backward(
     # uorb.yaml:17: scale time_remaining_s -> time_remaining
     _v7 = s.time_remaining
     if _v7 is None or _v7 != _v7:
-        t_status.time_remaining_s = math.nan
+        t_status.time_remaining_s = _math.nan
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.time_remaining_s")
     else:
@@ -328,7 +328,7 @@ def backward(
     # uorb.yaml:18: scale temperature -> temperature
     _v8 = s.temperature
     if _v8 is None or _v8 != _v8:
-        t_status.temperature = math.nan
+        t_status.temperature = _math.nan
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.temperature")
     else:
@@ -465,7 +465,7 @@ def backward(
     # uorb.yaml:52: scale remaining_capacity_wh -> remaining_energy
     _v18 = s.remaining_energy
     if _v18 is None or _v18 != _v18:
-        t_status.remaining_capacity_wh = math.nan
+        t_status.remaining_capacity_wh = _math.nan
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.remaining_capacity_wh")
     else:
@@ -484,7 +484,7 @@ def backward(
     # uorb.yaml:54: scale nominal_voltage -> nominal_voltage
     _v20 = s.nominal_voltage
     if _v20 is None or _v20 != _v20:
-        t_status.nominal_voltage = math.nan
+        t_status.nominal_voltage = _math.nan
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.nominal_voltage")
     else:

@@ -6,7 +6,7 @@ BatteryStatusV0 -> BatteryStatus (fromOlder).
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..uorb import BatteryStatus, BatteryStatusV0
 from . import _runtime as _r
@@ -82,17 +82,17 @@ def forward(
         rep_u.unknown("uorb.BatteryStatus.remaining")
     if rep_u is not None and _r.is_marker(t_status.scale, -1.0):
         rep_u.unknown("uorb.BatteryStatus.scale")
-    if rep_u is not None and _r.is_marker(t_status.time_remaining_s, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.time_remaining_s, _math.nan):
         rep_u.unknown("uorb.BatteryStatus.time_remaining_s")
-    if rep_u is not None and _r.is_marker(t_status.temperature, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.temperature, _math.nan):
         rep_u.unknown("uorb.BatteryStatus.temperature")
     if rep_u is not None and _r.is_marker(t_status.cell_count, 0):
         rep_u.unknown("uorb.BatteryStatus.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
         rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
-    if rep_u is not None and _r.is_marker(t_status.remaining_capacity_wh, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.remaining_capacity_wh, _math.nan):
         rep_u.unknown("uorb.BatteryStatus.remaining_capacity_wh")
-    if rep_u is not None and _r.is_marker(t_status.nominal_voltage, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.nominal_voltage, _math.nan):
         rep_u.unknown("uorb.BatteryStatus.nominal_voltage")
 
     return (t_status,)

@@ -32,7 +32,8 @@ from ...ir import (
     UorbInfo,
     units,
 )
-from ...text.files import display_path, read_text
+from ...text.files import display_path
+from ...text.limits import read_schema_text
 from .annotations import parse_comment, sentinel, text_sentinel
 from .enums import build_enums
 from .layout import Member, px4_layout
@@ -110,7 +111,7 @@ class Loader:
                 display, 1, f"expected a unique message name: {qualified} is also defined in {self.names[qualified]}"
             )
         errors: list[SchemaError] = []
-        text = parse_text(read_text(path, display), display, errors)
+        text = parse_text(read_schema_text(path, display), display, errors)
         return self._build(path, display, text, list(errors))
 
     def _build(self, path: Path, display: str, text: MsgText, errors: list[BattgenError]) -> Message:
