@@ -23,6 +23,7 @@ from ..ir import Message, Schema, SourceFormat
 from ..ir.expr import referenced_fields
 from ..ir.numbers import to_json_data
 from ..ir.rules import bound_rules
+from ..text.brief import brief, reportable
 from .failsafe.checks import NONNEGATIVE, check_settings
 from .messages import resolve_message
 from .package import data_error, model_class, model_package
@@ -108,11 +109,6 @@ def _covers(skip: frozenset[str], path: str) -> bool:
     return any(path == s or path.startswith((s + ".", s + "[")) for s in skip)
 
 
-def _short(value: object, width: int = 60) -> str:
-    text = repr(value)
-    return text if len(text) <= width else text[: width - 3] + "..."
-
-
 class Checker:
     """Builds each record with the generated ``from_dict`` (or takes the instance a binary log
     decoded) and collects ``validate()``'s violations, minus those of fields the source lacks."""
@@ -181,7 +177,7 @@ class Checker:
         if expected.startswith("a field of "):
             text = f"{path} is not a field of {self.message.qualified_name}"
         else:
-            text = f"{path or 'the record'}: expected {expected}, got {_short(value)}"
+            text = f"{path or 'the record'}: expected {expected}, got {brief(value)}"
         return self._finding(record, path, "type", value, expected, text, "error")
 
     @staticmethod
@@ -197,8 +193,8 @@ class Checker:
             record.where,
             path,
             rule,
-            value,
-            limit,
+            reportable(value),  # the report may be JSON: a hostile value is carried by its brief text
+            reportable(limit),
             message,
             severity,
             record.location,

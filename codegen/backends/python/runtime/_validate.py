@@ -17,8 +17,9 @@ import dataclasses
 import enum
 import math
 import re
-import reprlib
 from collections.abc import Mapping, Sequence
+
+from ._meta import brief
 
 __all__ = ["Severity", "ValidationError", "Violation"]
 
@@ -147,10 +148,6 @@ Spec = Number | Text | Array | Nested | Optional | Pattern
 # ---------------------------------------------------------------------------------------------
 # Wording
 
-_SHORT = reprlib.Repr()  # a repr bounded in depth and length, for values of unexpected types
-_SHORT.maxlevel = 2
-_SHORT.maxstring = _SHORT.maxother = _SHORT.maxlong = 40
-
 
 def fmt(value: object, depth: int = 0) -> str:
     """A value as a firmware engineer would write it (1.5, 4.19999981, NaN, inf, 0x600), never longer
@@ -176,7 +173,7 @@ def fmt(value: object, depth: int = 0) -> str:
             text = "[" + ", ".join(fmt(v, depth + 1) for v in value) + "]"
             return text if len(text) <= 120 else text[:116] + "...]"
         return f"[... {len(value)} items]"
-    text = repr(value if len(value) <= 200 else value[:200]) if isinstance(value, str) else _SHORT.repr(value)
+    text = repr(value if len(value) <= 200 else value[:200]) if isinstance(value, str) else brief(value)
     return text if len(text) <= 60 else text[:57] + "..."
 
 
