@@ -115,6 +115,8 @@ def _description(f: Field) -> str:
     s = f.invalid
     if s is not None:
         each = " (per element)" if s.per_element or isinstance(f.type, ArrayType) else ""
+        if s.elements:
+            each = " (by position)"
         value = "NaN" if s.is_nan else repr(s.value)
         named = "" if s.text.strip("[]") in (value, "NaN") else f" ({s.text.strip('[]')})"
         parts.append(f"Unknown{each}: {value}{named}, accepted as a valid value.")

@@ -16,29 +16,48 @@ class Sentinel:
 
     ``text`` keeps the spelling of the source (``INT16_MAX``, ``NaN``); ``value`` is the number
     (``float('nan')`` for NaN). ``per_element`` marks an array whose elements each carry it.
+    ``elements`` is for a marker given per position (MAVLink's ``[v1,,v3,]``, ``[0,]``): the marker
+    of each leading element, None where the list leaves one out; elements past the list have no
+    marker. It is empty for the other forms; when set, ``value`` is its first marker.
     """
 
     value: int | float
     text: str
     per_element: bool = False
+    elements: tuple[int | float | None, ...] = ()
 
     @property
     def is_nan(self) -> bool:
-        return isinstance(self.value, float) and math.isnan(self.value)
+        return _is_nan(self.value)
 
     def matches(self, value: object) -> bool:
         if self.is_nan:
             return isinstance(value, float) and math.isnan(value)
         return bool(value == self.value)
 
+    def marker_at(self, index: int) -> int | float | None:
+        """The marker of array element ``index`` (None when that element has none)."""
+        if not self.elements:
+            return self.value
+        return self.elements[index] if 0 <= index < len(self.elements) else None
+
+    def _key(self) -> tuple[object, ...]:
+        def norm(v: int | float | None) -> object:
+            return "nan" if v is not None and _is_nan(v) else v
+
+        return (norm(self.value), self.text, self.per_element, tuple(norm(v) for v in self.elements))
+
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Sentinel):
             return NotImplemented
-        same = (self.is_nan and other.is_nan) or self.value == other.value
-        return same and self.text == other.text and self.per_element == other.per_element
+        return self._key() == other._key()
 
     def __hash__(self) -> int:
-        return hash(("nan" if self.is_nan else self.value, self.text, self.per_element))
+        return hash(self._key())
+
+
+def _is_nan(value: int | float) -> bool:
+    return isinstance(value, float) and math.isnan(value)
 
 
 class EnumKind(str, enum.Enum):

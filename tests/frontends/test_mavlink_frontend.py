@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import pytest
 from pymavlink.generator import mavparse
@@ -145,6 +146,11 @@ def test_unknown_field_type(tmp_path: Path, type_text: str) -> None:
         ('<field type="int16_t" name="f" invalid="-1.5">x</field>', "fits int16"),
         ('<field type="uint16_t" name="f" invalid="[UINT16_MAX]">x</field>', "only on an array field"),
         ('<field type="uint8_t" name="f" invalid="[1">x</field>', "expected invalid= to be"),
+        ('<field type="uint8_t[2]" name="f" invalid="[1,2,3,]">x</field>', "at most 2 positions"),
+        ('<field type="uint8_t[2]" name="f" invalid="[,,]">x</field>', "expected invalid= to be"),
+        ('<field type="uint8_t[2]" name="f" invalid="[1,x,]">x</field>', "expected invalid= to be"),
+        ('<field type="uint8_t[2]" name="f" invalid="[1,256,]">x</field>', "fits uint8"),
+        ('<field type="uint8_t" name="f" invalid="[0,]">x</field>', "only on an array field"),
         ('<field type="uint8_t" name="f" minValue="low">x</field>', "expected a number as minValue="),
         ('<field type="uint8_t" name="f" default="x">x</field>', "expected a number as default="),
         ('<field type="uint8_t" name="f" instance="yes">x</field>', 'expected instance="true" or "false"'),
@@ -419,3 +425,33 @@ def test_battery_status_enums(battery_schema: Schema) -> None:
     assert all(
         e.doc and e.location and e.location.file == "battery.xml" for en in battery_schema.enums for e in en.entries
     )
+
+
+@pytest.mark.parametrize(
+    ("attr", "value", "elements"),
+    [
+        # the array forms of the MAVLink guide's invalid attribute; [0,] is development.xml's CONTROL_STATUS
+        ("[0,]", 0, (0,)),
+        ("[7,,UINT8_MAX,]", 7, (7, None, 255)),
+        ("[,5]", 5, (None, 5)),
+        ("[3]", 3, ()),
+        ("[3:]", 3, ()),
+    ],
+)
+def test_array_invalid_forms(tmp_path: Path, attr: str, value: int, elements: tuple[int | None, ...]) -> None:
+    path = write(tmp_path, "a.xml", message(fld("uint8_t[4]", "a", f' invalid="{attr}"')))
+    s = mavlink.parse_file(path, root=tmp_path).message("mavlink.M").field("a").invalid
+    assert s == Sentinel(value, attr, per_element=True, elements=elements)
+    expected = list(elements) + [None] * (4 - len(elements)) if elements else [value] * 4
+    assert s is not None and [s.marker_at(i) for i in range(4)] == expected
+
+
+def test_positional_invalid_in_generated_code(tmp_path: Path, import_generated: Any) -> None:
+    """Marked positions default to their marker; an element without a marker is always known."""
+    fields = fld("int16_t[3]", "a", ' invalid="[-5,,7,]"') + fld("int16_t[2]", "b", ' invalid="[-5,7,]"')
+    path = write(tmp_path, "p.xml", message(fields))
+    m = import_generated(mavlink.parse_file(path, root=tmp_path), "mavlink").M()
+    assert (m.a, m.b) == ([-5, 0, 7], [-5, 7])
+    assert m.is_known("a") and not m.is_known("b")
+    m.b = [-5, 8]
+    assert m.is_known("b")

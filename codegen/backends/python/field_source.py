@@ -85,6 +85,12 @@ class FieldBuilder:
         if sentinel is not None and isinstance(t, PrimitiveType) and not sentinel.per_element:
             return f"default={py_literal(typed(sentinel.value, t))}"
         if sentinel is not None and isinstance(t, ArrayType) and isinstance(t.element, PrimitiveType):
+            if not t.dynamic and t.capacity and sentinel.elements:  # marked positions hold their marker
+                element = t.element
+                fill = [typed(sentinel.marker_at(i) or 0, element) for i in range(t.capacity)]
+                if is_byte_array(t):
+                    return f"default_factory=lambda: bytes({py_literal(fill)})"
+                return f"default_factory=lambda: {py_literal(fill)}"
             if not t.dynamic and t.capacity:
                 value = py_literal(typed(sentinel.value, t.element))
                 if is_byte_array(t):

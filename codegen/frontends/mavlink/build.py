@@ -161,10 +161,17 @@ def _sentinel(text: str, ftype: FieldType, enum: _EnumParts | None, where: Locat
     element = _element(ftype)
     if found.per_element and isinstance(ftype, PrimitiveType):
         raise SchemaError(where.file, where.line, f"expected a bracketed invalid={text!r} only on an array field")
-    if not values.fits(found.value, element):
+    markers = [m for m in found.elements if m is not None] or [found.value]
+    if not all(values.fits(m, element) for m in markers):
         raise SchemaError(where.file, where.line, f"expected an invalid value that fits {element.name}, got {text!r}")
-    if element.kind is not PrimitiveKind.FLOAT and isinstance(found.value, float):
-        found = Sentinel(int(found.value), found.text, found.per_element)
+    length = ftype.capacity if isinstance(ftype, ArrayType | StringType) else 1
+    if length is not None and len(found.elements) > length:
+        raise SchemaError(
+            where.file, where.line, f"expected at most {length} positions in invalid={text!r}, one per array element"
+        )
+    if element.kind is not PrimitiveKind.FLOAT:  # 1.0 written for an integer field is the integer 1
+        positions = [None if m is None else int(m) for m in found.elements]
+        found = Sentinel(int(found.value), found.text, found.per_element, tuple(positions))
     return found
 
 

@@ -24,10 +24,12 @@ _INTEGER = re.compile(r"-?(?:0|[1-9][0-9]*)|-?0[xX][0-9a-fA-F]+")
 _FLOAT = re.compile(r"-?(?:[0-9]+\.[0-9]*|\.[0-9]+|[0-9]+)(?:[eE][-+]?[0-9]+)?")
 _LIMIT = re.compile(r"(U?)INT(8|16|32|64)_(MAX|MIN)")
 _NAN = frozenset({"NaN", "NAN", "nan"})
+_MAX_POSITIONS = 255  # no array in a 255-byte payload has more elements
 
 SENTINEL_FORMS = (
     "a number, NaN, INTn_MAX/INTn_MIN/UINTn_MAX/UINTn_MIN, an entry of the field's enum, "
-    "or one of those in brackets ([X] per element, [X:] for the first element)"
+    "or for an array one of those in brackets ([X] per element, [X:] when the first element is X, "
+    "[X1,,X3,] per position)"
 )
 
 
@@ -71,27 +73,42 @@ def _limit(text: str) -> int | None:
     return (1 << (bits - 1)) - 1 if m[3] == "MAX" else -(1 << (bits - 1))
 
 
+def _scalar(text: str, enum_values: Mapping[str, int]) -> int | float | None:
+    value: int | float | None = number(text)
+    if value is None:
+        value = _limit(text)
+    if value is None:
+        value = enum_values.get(text)
+    return value
+
+
 def sentinel(text: str, enum_values: Mapping[str, int]) -> Sentinel | None:
     """The Sentinel an ``invalid`` attribute spells, or None when the form is not understood.
 
-    ``[X]`` marks every array element; ``[X:]`` (first element X means the whole array is
-    unknown) is kept as per-element too, its spelling preserved in ``text``.
+    The forms are those of the MAVLink guide's field ``invalid`` attribute: ``X``; ``[X]`` marks
+    every array element; ``[X:]`` (the whole array is unknown when its first element is X) is kept
+    as per-element too, its spelling preserved in ``text``; ``[X1,,X3,]`` marks elements by
+    position (``[0,]``: only the first), an empty position having no marker.
     """
-    inner = text
-    per_element = False
-    if text.startswith("[") and text.endswith("]"):
-        inner = text[1:-1]
-        if inner.endswith(":"):
-            inner = inner[:-1]
-        per_element = True
-    value: int | float | None = number(inner)
-    if value is None:
-        value = _limit(inner)
-    if value is None:
-        value = enum_values.get(inner)
-    if value is None:
-        return None
-    return Sentinel(value=value, text=text, per_element=per_element)
+    if not (text.startswith("[") and text.endswith("]")):
+        value = _scalar(text, enum_values)
+        return None if value is None else Sentinel(value=value, text=text)
+    inner = text[1:-1]
+    if "," in inner:
+        items = inner.split(",")
+        if items[-1] == "":
+            items.pop()  # the list's closing comma
+        if len(items) > _MAX_POSITIONS:
+            return None
+        markers = tuple(None if item == "" else _scalar(item, enum_values) for item in items)
+        given = [m for m in markers if m is not None]
+        if len(given) != sum(1 for item in items if item != "") or not given:
+            return None  # an item not understood, or no marker at all
+        return Sentinel(value=given[0], text=text, per_element=True, elements=markers)
+    if inner.endswith(":"):
+        inner = inner[:-1]
+    value = _scalar(inner, enum_values)
+    return None if value is None else Sentinel(value=value, text=text, per_element=True)
 
 
 def fits(value: int | float, element: PrimitiveType) -> bool:

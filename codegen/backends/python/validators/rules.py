@@ -8,7 +8,7 @@ through these node types and :func:`~.literals.py_literal`, so a rule cannot inj
 
 from __future__ import annotations
 
-from ....ir import ArrayType, Field, FieldType, Message
+from ....ir import ArrayType, Field, FieldType, Message, Sentinel
 from ....ir.expr import (
     Binary,
     BoolOp,
@@ -37,12 +37,26 @@ def known_expr(f: Field, value: str, optional: bool) -> str:
     s = f.invalid
     parts = [f"{value} is not None"] if optional else []
     if s is not None:
-        if isinstance(f.type, ArrayType):
+        if isinstance(f.type, ArrayType) and s.elements:
+            parts.append(_known_by_position(f.type, s, value))
+        elif isinstance(f.type, ArrayType):
             test = "e == e" if s.is_nan else f"e != {py_literal(s.value)}"
             parts.append(f"any({test} for e in {value})")
         else:
             parts.append(f"{value} == {value}" if s.is_nan else f"{value} != {py_literal(s.value)}")
     return " and ".join(parts) if parts else "True"
+
+
+def _known_by_position(t: ArrayType, s: Sentinel, value: str) -> str:
+    """Known unless every element carries its position's marker (an element without one is always known)."""
+    markers = s.elements
+    if None in markers or (not t.dynamic and t.capacity is not None and len(markers) < t.capacity):
+        return "True"
+    tests = [
+        f"{value}[{i}] == {value}[{i}]" if isinstance(m, float) and m != m else f"{value}[{i}] != {py_literal(m)}"
+        for i, m in enumerate(markers)
+    ]
+    return f"(len({value}) != {len(markers)} or " + " or ".join(tests) + ")"
 
 
 _NEGATED_MEMBERSHIP = {"in": "not in", "not in": "in"}

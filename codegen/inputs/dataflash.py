@@ -1,0 +1,256 @@
+"""ArduPilot DataFlash logs (``.bin``), read through pymavlink's DataFlash reader (``DFReader_binary``).
+
+A DataFlash log is a sequence of messages, each ``0xA3 0x95 <type>`` and a payload laid out by the
+log's own ``FMT`` records (the FMT record of type 128 describes FMT itself). pymavlink's reader
+parses them; this module asks it for the messages a caller wants and hands them out as plain
+:class:`DataflashMessage` records (type, index, byte offset, ``TimeUS``, fields), plus three views
+the battery tools need:
+
+- :func:`log_parameters`: the log's ``PARM`` records (``Name``, ``Value``); a parameter logged
+  more than once (set in flight) takes its last value, as the vehicle ended up with it.
+- :func:`battery_records`: ``BAT`` records (``Inst`` 0-based, ``Volt``, ``Curr``, ``CurrTot`` mAh,
+  ``RemPct``), and the older layouts (``BAT`` without ``Inst``, ``BAT2`` for the second monitor,
+  ``CURR``/``CURR2`` before ArduPilot 3.6).
+- :func:`arming_records`: the arming state from ``ARM`` records (``ArmState``) and the ``EV``
+  events 10 (ARMED) and 11 (DISARMED) older logs carry.
+
+pymavlink prints what it skips (garbage, unknown types) on stdout/stderr; that text is captured and
+counted instead (:attr:`DataflashLog.skipped_notes`). A file that is not a DataFlash log, or holds
+no message, is an :class:`~.records.InputError` naming the file. The reader maps the file, so
+memory stays flat; every loop ends at the end of the file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import struct
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .records import InputError
+
+HEAD = b"\xa3\x95"
+FMT_TYPE = 0x80
+BATTERY_TYPES = frozenset({"BAT", "BATT", "BAT2", "CURR", "CURR2"})
+ARMING_TYPES = frozenset({"ARM", "EV"})
+EV_ARMED, EV_DISARMED = 10, 11  # AP_Logger LogEvent ids
+
+
+@dataclass(frozen=True)
+class DataflashMessage:
+    """One message of the log: its type name, 0-based index among the messages read, the byte
+    offset of its header, ``TimeUS`` (or ``TimeMS`` * 1000) when it has one, and its fields."""
+
+    type: str
+    index: int
+    offset: int
+    time_us: int | None
+    fields: Mapping[str, Any]
+
+    @property
+    def time_s(self) -> float | None:
+        return None if self.time_us is None else self.time_us / 1e6
+
+
+@dataclass(frozen=True)
+class BatteryRecord:
+    """One battery monitor reading. ``instance`` is 0-based (ArduPilot prints it 1-based)."""
+
+    time_s: float
+    instance: int
+    voltage_v: float | None
+    current_a: float | None
+    consumed_mah: float | None
+    remaining_pct: float | None
+    offset: int
+
+
+@dataclass(frozen=True)
+class ArmingRecord:
+    time_s: float
+    armed: bool
+    offset: int
+
+
+@dataclass
+class DataflashLog:
+    """An open log; :meth:`messages` may be walked more than once."""
+
+    path: Path
+    display: str
+    skipped_notes: list[str] = field(default_factory=list)
+
+    def messages(self, types: Iterable[str] | None = None) -> Iterator[DataflashMessage]:
+        """The messages (of ``types`` when given), in file order."""
+        wanted = None if types is None else set(types)
+        reader = _open(self.path, self.display, self.skipped_notes)
+        index = 0
+        try:
+            while True:
+                with _captured(self.skipped_notes):
+                    try:
+                        msg = reader.recv_match(type=sorted(wanted)) if wanted else reader.recv_msg()
+                    except Exception as exc:  # pymavlink raises bare Exceptions on a corrupt FMT
+                        raise InputError(self.display, 0, f"expected a DataFlash log: {exc}") from None
+                if msg is None:
+                    return
+                name = msg.get_type()
+                if name == "BAD_DATA":
+                    continue
+                length = int(getattr(getattr(msg, "fmt", None), "len", 0) or 0)
+                values = msg.to_dict()
+                values.pop("mavpackettype", None)
+                yield DataflashMessage(name, index, max(0, int(reader.offset) - length), _time_us(values), values)
+                index += 1
+        finally:
+            with contextlib.suppress(Exception):
+                reader.close()
+
+
+def is_dataflash(path: Path) -> bool:
+    """True when the file starts like a DataFlash log (a FMT message)."""
+    try:
+        with path.open("rb") as f:
+            return f.read(3) == HEAD + bytes([FMT_TYPE])
+    except OSError:
+        return False
+
+
+def open_log(path: Path, display: str | None = None) -> DataflashLog:
+    """A DataFlash log, checked to start like one; InputError when it cannot be read."""
+    shown = display or path.as_posix()
+    try:
+        with path.open("rb") as f:
+            head = f.read(3)
+    except OSError as exc:
+        raise InputError(shown, 0, f"cannot read file: {exc.strerror or exc}") from None
+    if not head:
+        raise InputError(shown, 0, "expected a DataFlash log, got an empty file")
+    if head != HEAD + bytes([FMT_TYPE]):
+        raise InputError(shown, 0, "expected a DataFlash log (starting with a FMT message, bytes A3 95 80)")
+    return DataflashLog(path, shown)
+
+
+def _open(path: Path, display: str, notes: list[str]) -> Any:
+    from pymavlink import DFReader
+
+    with _captured(notes):
+        try:
+            return DFReader.DFReader_binary(str(path), zero_time_base=True)
+        except (OSError, ValueError) as exc:
+            raise InputError(display, 0, f"cannot read DataFlash log: {exc}") from None
+        except Exception as exc:  # a corrupt FMT record: pymavlink raises a bare Exception
+            raise InputError(display, 0, f"expected a DataFlash log: {exc}") from None
+
+
+@contextlib.contextmanager
+def _captured(notes: list[str]) -> Iterator[None]:
+    """pymavlink's prints (skipped bytes, unknown formats) as notes instead of output."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        yield
+    for text in (out.getvalue(), err.getvalue()):
+        notes.extend(line for line in text.splitlines() if line.strip())
+
+
+def _time_us(values: Mapping[str, Any]) -> int | None:
+    for name, scale in (("TimeUS", 1), ("TimeMS", 1000)):
+        value = values.get(name)
+        if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
+            return int(value) * scale
+    return None
+
+
+def shortest_float32(value: float) -> float:
+    """The shortest decimal that is the same float32 (``10.600000381469727`` -> ``10.6``): DataFlash
+    floats are float32, and ArduPilot compares them as float32, so a logged 10.6 V must equal a
+    10.6 V parameter here too."""
+    if not math.isfinite(value) or value == 0:
+        return value
+    try:
+        bits = struct.pack("<f", value)
+    except OverflowError:
+        return value
+    for digits in range(6, 10):
+        candidate = float(f"{value:.{digits}g}")
+        if struct.pack("<f", candidate) == bits:
+            return candidate
+    return value
+
+
+def _number(values: Mapping[str, Any], *names: str) -> float | None:
+    for name in names:
+        value = values.get(name)
+        if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
+            return shortest_float32(float(value)) if isinstance(value, float) else float(value)
+    return None
+
+
+def log_parameters(log: DataflashLog) -> dict[str, float]:
+    """The PARM records as {name: value}; a name logged again takes its later value."""
+    out: dict[str, float] = {}
+    for msg in log.messages({"PARM"}):
+        name, value = msg.fields.get("Name"), _number(msg.fields, "Value")
+        if isinstance(name, bytes):
+            name = name.decode("ascii", "replace")
+        if isinstance(name, str) and name and value is not None:
+            out[name.rstrip("\x00")] = value
+    return out
+
+
+def _battery(msg: DataflashMessage) -> BatteryRecord | None:
+    if msg.time_s is None:
+        return None
+    f = msg.fields
+    if msg.type in ("BAT2", "CURR2"):
+        instance = 1
+    else:
+        inst = _number(f, "Inst", "Instance")
+        instance = int(inst) if inst is not None else 0
+    return BatteryRecord(
+        time_s=msg.time_s,
+        instance=instance,
+        voltage_v=_number(f, "Volt"),
+        current_a=_number(f, "Curr"),
+        consumed_mah=_number(f, "CurrTot"),
+        remaining_pct=_number(f, "RemPct"),
+        offset=msg.offset,
+    )
+
+
+def _arming(msg: DataflashMessage) -> ArmingRecord | None:
+    if msg.time_s is None:
+        return None
+    if msg.type == "ARM":
+        state = _number(msg.fields, "ArmState")
+        return None if state is None else ArmingRecord(msg.time_s, bool(state), msg.offset)
+    ev = _number(msg.fields, "Id")
+    return ArmingRecord(msg.time_s, ev == EV_ARMED, msg.offset) if ev in (EV_ARMED, EV_DISARMED) else None
+
+
+def flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord]:
+    """Battery readings (every instance) and arming changes, in file order (one pass)."""
+    for msg in log.messages(BATTERY_TYPES | ARMING_TYPES):
+        item = _arming(msg) if msg.type in ARMING_TYPES else _battery(msg)
+        if item is not None:
+            yield item
+
+
+def battery_records(log: DataflashLog) -> Iterator[BatteryRecord]:
+    """Every battery reading of the log (all instances), in file order."""
+    for msg in log.messages(BATTERY_TYPES):
+        item = _battery(msg)
+        if item is not None:
+            yield item
+
+
+def arming_records(log: DataflashLog) -> Iterator[ArmingRecord]:
+    """Arming state changes: ARM.ArmState, else EV ids 10 (armed) / 11 (disarmed)."""
+    for msg in log.messages(ARMING_TYPES):
+        item = _arming(msg)
+        if item is not None:
+            yield item
