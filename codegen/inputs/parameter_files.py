@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import BattgenError, LocatedError
+from ..text.brief import brief
 
 Value = int | float
 
@@ -157,7 +158,18 @@ def _check_name(name: str) -> None:
         raise BattgenError(f"expected a parameter name of 1 to 16 letters, digits and _, got {name!r}")
 
 
+# A MAVLink parameter is a float32 or an integer of at most 32 bits on the wire: a value of more digits
+# than any of those holds is refused here, before int() (which refuses over 4,300 digits) or a message quotes it.
+MAX_DIGITS = 40
+
+
 def _value(text: str, display: str, line: int, *, integer: bool = False) -> Value:
+    if len(text) > MAX_DIGITS and (_HEX.fullmatch(text) or _INT.fullmatch(text)):
+        raise ParameterFileError(
+            display,
+            line,
+            f"expected a parameter value (float32 or a 32-bit integer), got a number of {len(text)} digits",
+        )
     if _HEX.fullmatch(text):
         return int(text, 16)
     if _INT.fullmatch(text):
@@ -165,13 +177,13 @@ def _value(text: str, display: str, line: int, *, integer: bool = False) -> Valu
     try:
         number = float(text)
     except ValueError:
-        raise ParameterFileError(display, line, f"expected a number as the value, got {text!r}") from None
+        raise ParameterFileError(display, line, f"expected a number as the value, got {brief(text)}") from None
     if not math.isfinite(number):
-        raise ParameterFileError(display, line, f"expected a finite number as the value, got {text!r}")
+        raise ParameterFileError(display, line, f"expected a finite number as the value, got {brief(text)}")
     if integer:
         if not number.is_integer():
             raise ParameterFileError(
-                display, line, f"expected an integer value for an integer MAV_PARAM_TYPE, got {text!r}"
+                display, line, f"expected an integer value for an integer MAV_PARAM_TYPE, got {brief(text)}"
             )
         return int(number)
     return number
@@ -180,7 +192,7 @@ def _value(text: str, display: str, line: int, *, integer: bool = False) -> Valu
 def _name(text: str, display: str, line: int) -> str:
     if not NAME.fullmatch(text):
         raise ParameterFileError(
-            display, line, f"expected a parameter name of 1 to 16 letters, digits and _, got {text!r}"
+            display, line, f"expected a parameter name of 1 to 16 letters, digits and _, got {brief(text)}"
         )
     return text
 
@@ -210,7 +222,7 @@ def _qgc_line(raw: str, display: str, line: int) -> ParamEntry | None:
     ids = []
     for label, text in (("vehicle id", parts[0]), ("component id", parts[1]), ("type", parts[4])):
         if not re.fullmatch(r"[0-9]{1,3}", text):
-            raise ParameterFileError(display, line, f"expected a decimal {label}, got {text!r}")
+            raise ParameterFileError(display, line, f"expected a decimal {label}, got {brief(text)}")
         ids.append(int(text))
     vehicle, component, mav_type = ids
     if mav_type not in MAV_PARAM_TYPES:
