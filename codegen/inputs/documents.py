@@ -65,6 +65,25 @@ def _whole_text(source: Source, name: str) -> str:
 # ------------------------------------------------------------------------------------------------
 # JSON Lines: one record per non-blank line, read lazily
 
+# The longest line read as one record: a battery record is a few kilobytes, and a line is held in memory
+# (and decoded) whole, so a 200 MB line would cost gigabytes. Longer lines are skipped without being kept.
+MAX_LINE = 1 << 20
+
+
+def _skip_line(stream: IO[str]) -> int:
+    """Read on to the end of an over-long line in pieces; how many characters were skipped."""
+    skipped = 0
+    while True:
+        piece = stream.readline(MAX_LINE)
+        skipped += len(piece)
+        if not piece or piece.endswith("\n"):
+            return skipped
+
+
+def _too_long(length: int) -> str:
+    return f"a line of {length} characters, longer than the {MAX_LINE} a JSON Lines record may have (skipped)"
+
+
 
 def read_jsonl(source: Source, name: str, *, comments: bool = False) -> Iterator[Item]:
     """One record per non-blank line (with ``comments``, lines starting with ``#`` are skipped
@@ -74,7 +93,12 @@ def read_jsonl(source: Source, name: str, *, comments: bool = False) -> Iterator
         lineno = 0
         while True:
             try:
-                line = stream.readline()
+                line = stream.readline(MAX_LINE + 1)
+                if len(line) > MAX_LINE and not line.endswith("\n"):
+                    lineno += 1
+                    length = len(line) + _skip_line(stream)
+                    yield Unreadable(name, lineno, _too_long(length))
+                    continue
             except UnicodeDecodeError:
                 yield Unreadable(name, lineno + 1, "expected UTF-8 text")
                 return

@@ -155,7 +155,7 @@ def write_qgc(
 
 def _check_name(name: str) -> None:
     if not NAME.fullmatch(name):
-        raise BattgenError(f"expected a parameter name of 1 to 16 letters, digits and _, got {name!r}")
+        raise BattgenError(f"expected a parameter name of 1 to 16 letters, digits and _, got {brief(name)}")
 
 
 # A MAVLink parameter is a float32 or an integer of at most 32 bits on the wire: a value of more digits
@@ -203,7 +203,7 @@ def _ardupilot_line(raw: str, display: str, line: int) -> ParamEntry | None:
         return None
     parts = [p for p in re.split(r"[,\s]+", body) if p]
     if len(parts) != 2:
-        raise ParameterFileError(display, line, f"expected 'NAME,VALUE' or 'NAME VALUE', got {body!r}")
+        raise ParameterFileError(display, line, f"expected 'NAME,VALUE' or 'NAME VALUE', got {brief(body)}")
     return ParamEntry(_name(parts[0], display, line), _value(parts[1], display, line), line)
 
 

@@ -197,7 +197,8 @@ def check_keys(
         raise DataError(cls, "an object", data)
     for key in data:
         if key not in known and not any(_match(p, key) for p, _ in patterns):
-            raise DataError(f"{cls}.{key}", "a field of " + cls, data[key])
+            name = key if isinstance(key, str) and len(key) <= 80 else brief(key)  # a name, not a novel
+            raise DataError(f"{cls}.{name}", "a field of " + cls, data[key])
     return data
 
 
