@@ -4,5 +4,7 @@
 # msgid -> (CRC_EXTRA, class name, MAVLINK_MAX_LENGTH, MAVLink name) of every generated message
 REGISTRY: dict[int, tuple[int, str, int, str]] = {
     147: (154, "BatteryStatus", 54, "BATTERY_STATUS"),
+    369: (145, "BatteryStatusV2", 27, "BATTERY_STATUS_V2"),
+    372: (26, "BatteryInfo", 140, "BATTERY_INFO"),
 }
 MODULE = "mavlink"  # the generated module holding the classes, relative to this package

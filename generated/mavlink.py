@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import math
 import struct
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -17,17 +18,20 @@ from . import _meta as _m
 from . import _validate as _v
 
 __all__ = [
+    "BatteryInfo",
     "BatteryStatus",
+    "BatteryStatusV2",
     "MavBatteryChargeState",
     "MavBatteryFault",
     "MavBatteryFunction",
     "MavBatteryMode",
+    "MavBatteryStatusFlags",
     "MavBatteryType",
 ]
 
 
 class MavBatteryChargeState(enum.IntEnum):
-    """How far the battery is discharged, for warnings and failsafes.
+    """Enumeration for battery charge states.
 
     mavlink.MAV_BATTERY_CHARGE_STATE: values.
     """
@@ -43,7 +47,8 @@ class MavBatteryChargeState(enum.IntEnum):
 
 
 class MavBatteryFault(enum.IntFlag):
-    """Fault flags; set together with charge state FAILED or UNHEALTHY.
+    """Smart battery supply status/fault flags (bitmask) for health indication. The battery must also report either
+    MAV_BATTERY_CHARGE_STATE_FAILED or MAV_BATTERY_CHARGE_STATE_UNHEALTHY if any of these are set.
 
     mavlink.MAV_BATTERY_FAULT: bit masks, combined with |.
     """
@@ -60,7 +65,7 @@ class MavBatteryFault(enum.IntFlag):
 
 
 class MavBatteryFunction(enum.IntEnum):
-    """What the battery powers.
+    """Enumeration of battery functions
 
     mavlink.MAV_BATTERY_FUNCTION: values.
     """
@@ -73,7 +78,8 @@ class MavBatteryFunction(enum.IntEnum):
 
 
 class MavBatteryMode(enum.IntEnum):
-    """Operating mode reported by a smart battery.
+    """Battery mode. Note, the normal operation mode (i.e. when flying) should be reported as MAV_BATTERY_MODE_UNKNOWN
+    to allow message trimming in normal flight.
 
     mavlink.MAV_BATTERY_MODE: values.
     """
@@ -83,8 +89,36 @@ class MavBatteryMode(enum.IntEnum):
     HOT_SWAP = 2
 
 
+class MavBatteryStatusFlags(enum.IntFlag):
+    """Battery status flags for fault, health and state indication.
+
+    mavlink.MAV_BATTERY_STATUS_FLAGS: bit masks, combined with |.
+    """
+
+    NOT_READY_TO_USE = 1
+    CHARGING = 2
+    CELL_BALANCING = 4
+    FAULT_CELL_IMBALANCE = 8
+    AUTO_DISCHARGING = 16
+    REQUIRES_SERVICE = 32
+    BAD_BATTERY = 64
+    PROTECTIONS_ENABLED = 128
+    FAULT_PROTECTION_SYSTEM = 256
+    FAULT_OVER_VOLT = 512
+    FAULT_UNDER_VOLT = 1024
+    FAULT_OVER_TEMPERATURE = 2048
+    FAULT_UNDER_TEMPERATURE = 4096
+    FAULT_OVER_CURRENT = 8192
+    FAULT_SHORT_CIRCUIT = 16384
+    FAULT_INCOMPATIBLE_VOLTAGE = 32768
+    FAULT_INCOMPATIBLE_FIRMWARE = 65536
+    FAULT_INCOMPATIBLE_CELLS_CONFIGURATION = 131072
+    CAPACITY_RELATIVE_TO_FULL = 262144
+    EXTENDED = 2147483648
+
+
 class MavBatteryType(enum.IntEnum):
-    """Battery chemistry.
+    """Enumeration of battery types
 
     mavlink.MAV_BATTERY_TYPE: values.
     """
@@ -94,6 +128,189 @@ class MavBatteryType(enum.IntEnum):
     LIFE = 2
     LION = 3
     NIMH = 4
+
+
+# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
+_BATTERY_INFO_PAYLOAD = struct.Struct("<ffffffffffHHBBBBB9s32s50s")
+_BATTERY_INFO_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("discharge_minimum_voltage", "discharge_minimum_voltage", "f", 0),
+    ("charging_minimum_voltage", "charging_minimum_voltage", "f", 0),
+    ("resting_minimum_voltage", "resting_minimum_voltage", "f", 0),
+    ("charging_maximum_voltage", "charging_maximum_voltage", "f", 0),
+    ("charging_maximum_current", "charging_maximum_current", "f", 0),
+    ("nominal_voltage", "nominal_voltage", "f", 0),
+    ("discharge_maximum_current", "discharge_maximum_current", "f", 0),
+    ("discharge_maximum_burst_current", "discharge_maximum_burst_current", "f", 0),
+    ("design_capacity", "design_capacity", "f", 0),
+    ("full_charge_capacity", "full_charge_capacity", "f", 0),
+    ("cycle_count", "cycle_count", "H", 0),
+    ("weight", "weight", "H", 0),
+    ("id", "id", "B", 0),
+    ("battery_function", "battery_function", "B", 0),
+    ("type", "type", "B", 0),
+    ("state_of_health", "state_of_health", "B", 0),
+    ("cells_in_series", "cells_in_series", "B", 0),
+    ("manufacture_date", "manufacture_date", "s", 9),
+    ("serial_number", "serial_number", "s", 32),
+    ("name", "name", "s", 50),
+)
+_BATTERY_INFO_DTYPE: list[tuple[Any, ...]] = [
+    ("discharge_minimum_voltage", "<f4"),
+    ("charging_minimum_voltage", "<f4"),
+    ("resting_minimum_voltage", "<f4"),
+    ("charging_maximum_voltage", "<f4"),
+    ("charging_maximum_current", "<f4"),
+    ("nominal_voltage", "<f4"),
+    ("discharge_maximum_current", "<f4"),
+    ("discharge_maximum_burst_current", "<f4"),
+    ("design_capacity", "<f4"),
+    ("full_charge_capacity", "<f4"),
+    ("cycle_count", "<u2"),
+    ("weight", "<u2"),
+    ("id", "u1"),
+    ("battery_function", "u1"),
+    ("type", "u1"),
+    ("state_of_health", "u1"),
+    ("cells_in_series", "u1"),
+    ("manufacture_date", "S9"),
+    ("serial_number", "S32"),
+    ("name", "S50"),
+]
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_INFO_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_INFO_BATTERY_FUNCTION_SPEC = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "MAV_BATTERY_FUNCTION_UNKNOWN",
+        1: "MAV_BATTERY_FUNCTION_ALL",
+        2: "MAV_BATTERY_FUNCTION_PROPULSION",
+        3: "MAV_BATTERY_FUNCTION_AVIONICS",
+        4: "MAV_BATTERY_FUNCTION_PAYLOAD",
+    },
+)
+_BATTERY_INFO_TYPE_SPEC = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "MAV_BATTERY_TYPE_UNKNOWN",
+        1: "MAV_BATTERY_TYPE_LIPO",
+        2: "MAV_BATTERY_TYPE_LIFE",
+        3: "MAV_BATTERY_TYPE_LION",
+        4: "MAV_BATTERY_TYPE_NIMH",
+    },
+)
+_BATTERY_INFO_STATE_OF_HEALTH_SPEC = _v.Number(
+    type="uint8", kind="uint", low=0, high=255, unit="%", sentinel=255, sentinel_text="UINT8_MAX"
+)
+_BATTERY_INFO_CELLS_IN_SERIES_SPEC = _v.Number(
+    type="uint8", kind="uint", low=0, high=255, sentinel=0, sentinel_text="0"
+)
+_BATTERY_INFO_CYCLE_COUNT_SPEC = _v.Number(
+    type="uint16", kind="uint", low=0, high=65535, sentinel=65535, sentinel_text="UINT16_MAX"
+)
+_BATTERY_INFO_WEIGHT_SPEC = _v.Number(
+    type="uint16", kind="uint", low=0, high=65535, unit="g", sentinel=0, sentinel_text="0"
+)
+_BATTERY_INFO_DISCHARGE_MINIMUM_VOLTAGE_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_BATTERY_INFO_CHARGING_MINIMUM_VOLTAGE_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_BATTERY_INFO_RESTING_MINIMUM_VOLTAGE_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_BATTERY_INFO_CHARGING_MAXIMUM_VOLTAGE_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_BATTERY_INFO_CHARGING_MAXIMUM_CURRENT_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="A",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_BATTERY_INFO_NOMINAL_VOLTAGE_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_BATTERY_INFO_DISCHARGE_MAXIMUM_CURRENT_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="A",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_BATTERY_INFO_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="A",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_BATTERY_INFO_DESIGN_CAPACITY_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="Ah",
+    sentinel=0.0,
+    sentinel_text="0",
+)
+_BATTERY_INFO_FULL_CHARGE_CAPACITY_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="Ah",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_BATTERY_INFO_MANUFACTURE_DATE_SPEC = _v.Text(capacity=9)
+_BATTERY_INFO_SERIAL_NUMBER_SPEC = _v.Text(capacity=32)
+_BATTERY_INFO_NAME_SPEC = _v.Text(capacity=50)
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
@@ -180,7 +397,9 @@ _BATTERY_STATUS_ENERGY_CONSUMED_SPEC = _v.Number(
 _BATTERY_STATUS_BATTERY_REMAINING_SPEC = _v.Number(
     type="int8", kind="int", low=-128, high=127, unit="%", sentinel=-1, sentinel_text="-1"
 )
-_BATTERY_STATUS_TIME_REMAINING_SPEC = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="s")
+_BATTERY_STATUS_TIME_REMAINING_SPEC = _v.Number(
+    type="int32", kind="int", low=-2147483648, high=2147483647, unit="s", sentinel=0, sentinel_text="0"
+)
 _BATTERY_STATUS_CHARGE_STATE_SPEC = _v.Number(
     type="uint8",
     kind="uint",
@@ -198,7 +417,7 @@ _BATTERY_STATUS_CHARGE_STATE_SPEC = _v.Number(
     },
 )
 _BATTERY_STATUS_VOLTAGES_EXT_SPEC = _v.Array(
-    _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mV"), 4, True
+    _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="mV", sentinel=0, sentinel_text="[0]"), 4, True
 )
 _BATTERY_STATUS_MODE_SPEC = _v.Number(
     type="uint8",
@@ -227,28 +446,838 @@ _BATTERY_STATUS_FAULT_BITMASK_SPEC = _v.Number(
 )
 
 
-@dataclasses.dataclass(slots=True)
-class BatteryStatus:
-    """State of one battery.
+# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
+_BATTERY_STATUS_V2_PAYLOAD = struct.Struct("<fffffIhB")
+_BATTERY_STATUS_V2_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("voltage", "voltage", "f", 0),
+    ("current", "current", "f", 0),
+    ("capacity_consumed", "capacity_consumed", "f", 0),
+    ("capacity_remaining", "capacity_remaining", "f", 0),
+    ("state_of_charge", "state_of_charge", "f", 0),
+    ("status_flags", "status_flags", "I", 0),
+    ("temperature", "temperature", "h", 0),
+    ("id", "id", "B", 0),
+)
+_BATTERY_STATUS_V2_DTYPE: list[tuple[Any, ...]] = [
+    ("voltage", "<f4"),
+    ("current", "<f4"),
+    ("capacity_consumed", "<f4"),
+    ("capacity_remaining", "<f4"),
+    ("state_of_charge", "<f4"),
+    ("status_flags", "<u4"),
+    ("temperature", "<i2"),
+    ("id", "u1"),
+]
 
-    Schema: mavlink.BATTERY_STATUS (mavlink, battery.xml:114).
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_STATUS_V2_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_STATUS_V2_TEMPERATURE_SPEC = _v.Number(
+    type="int16", kind="int", low=-32768, high=32767, unit="cdegC", sentinel=32767, sentinel_text="INT16_MAX"
+)
+_BATTERY_STATUS_V2_VOLTAGE_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_BATTERY_STATUS_V2_CURRENT_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="A",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_BATTERY_STATUS_V2_CAPACITY_CONSUMED_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="Ah",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_BATTERY_STATUS_V2_CAPACITY_REMAINING_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="Ah",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_BATTERY_STATUS_V2_STATE_OF_CHARGE_SPEC = _v.Number(
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="%",
+    sentinel=math.nan,
+    sentinel_text="NaN",
+)
+_BATTERY_STATUS_V2_STATUS_FLAGS_SPEC = _v.Number(
+    type="uint32",
+    kind="uint",
+    low=0,
+    high=4294967295,
+    mask=0x8007FFFF,
+    bits={
+        0x1: "MAV_BATTERY_STATUS_FLAGS_NOT_READY_TO_USE",
+        0x2: "MAV_BATTERY_STATUS_FLAGS_CHARGING",
+        0x4: "MAV_BATTERY_STATUS_FLAGS_CELL_BALANCING",
+        0x8: "MAV_BATTERY_STATUS_FLAGS_FAULT_CELL_IMBALANCE",
+        0x10: "MAV_BATTERY_STATUS_FLAGS_AUTO_DISCHARGING",
+        0x20: "MAV_BATTERY_STATUS_FLAGS_REQUIRES_SERVICE",
+        0x40: "MAV_BATTERY_STATUS_FLAGS_BAD_BATTERY",
+        0x80: "MAV_BATTERY_STATUS_FLAGS_PROTECTIONS_ENABLED",
+        0x100: "MAV_BATTERY_STATUS_FLAGS_FAULT_PROTECTION_SYSTEM",
+        0x200: "MAV_BATTERY_STATUS_FLAGS_FAULT_OVER_VOLT",
+        0x400: "MAV_BATTERY_STATUS_FLAGS_FAULT_UNDER_VOLT",
+        0x800: "MAV_BATTERY_STATUS_FLAGS_FAULT_OVER_TEMPERATURE",
+        0x1000: "MAV_BATTERY_STATUS_FLAGS_FAULT_UNDER_TEMPERATURE",
+        0x2000: "MAV_BATTERY_STATUS_FLAGS_FAULT_OVER_CURRENT",
+        0x4000: "MAV_BATTERY_STATUS_FLAGS_FAULT_SHORT_CIRCUIT",
+        0x8000: "MAV_BATTERY_STATUS_FLAGS_FAULT_INCOMPATIBLE_VOLTAGE",
+        0x10000: "MAV_BATTERY_STATUS_FLAGS_FAULT_INCOMPATIBLE_FIRMWARE",
+        0x20000: "MAV_BATTERY_STATUS_FLAGS_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION",
+        0x40000: "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL",
+        0x80000000: "MAV_BATTERY_STATUS_FLAGS_EXTENDED",
+    },
+)
+
+
+@dataclasses.dataclass(slots=True)
+class BatteryInfo:
+    """Battery information that is static, or requires infrequent update. This message should requested using
+    MAV_CMD_REQUEST_MESSAGE and/or streamed at very low rate. BATTERY_STATUS_V2 is used for higher-rate battery
+    status information. [work in progress]
+
+    Schema: mavlink.BATTERY_INFO (mavlink, battery.xml:259).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "mavlink.BATTERY_STATUS"
+    QUALIFIED_NAME: ClassVar[str] = "mavlink.BATTERY_INFO"
 
-    id: int = dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery instance."))
+    id: int = dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
     battery_function: int = dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="battery_function",
             type="uint8",
             enums=("mavlink.MAV_BATTERY_FUNCTION",),
-            doc="What the battery powers.",
+            doc="Function of the battery.",
         ),
     )
     type: int = dataclasses.field(
         default=0,
-        metadata=_m.meta(name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Battery chemistry."),
+        metadata=_m.meta(
+            name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Type (chemistry) of the battery."
+        ),
+    )
+    state_of_health: int = dataclasses.field(
+        default=255,
+        metadata=_m.meta(
+            name="state_of_health",
+            type="uint8",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            invalid=255,
+            invalid_text="UINT8_MAX",
+            doc="State of Health (SOH) estimate. Typically 100% at the time of manufacture and "
+            "will decrease over time and use. -1: field not provided.",
+        ),
+    )
+    cells_in_series: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="cells_in_series",
+            type="uint8",
+            invalid=0,
+            invalid_text="0",
+            doc="Number of battery cells in series. 0: field not provided.",
+        ),
+    )
+    cycle_count: int = dataclasses.field(
+        default=65535,
+        metadata=_m.meta(
+            name="cycle_count",
+            type="uint16",
+            invalid=65535,
+            invalid_text="UINT16_MAX",
+            doc="Lifetime count of the number of charge/discharge cycles "
+            "(https://en.wikipedia.org/wiki/Charge_cycle). UINT16_MAX: field not provided.",
+        ),
+    )
+    weight: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="weight",
+            type="uint16",
+            unit="g",
+            quantity="mass",
+            scale=0.001,
+            offset=0.0,
+            invalid=0,
+            invalid_text="0",
+            doc="Battery weight. 0: field not provided.",
+        ),
+    )
+    discharge_minimum_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="discharge_minimum_voltage",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Minimum per-cell voltage when discharging. 0: field not provided.",
+        ),
+    )
+    charging_minimum_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="charging_minimum_voltage",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Minimum per-cell voltage when charging. 0: field not provided.",
+        ),
+    )
+    resting_minimum_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="resting_minimum_voltage",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Minimum per-cell voltage when resting. 0: field not provided.",
+        ),
+    )
+    charging_maximum_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="charging_maximum_voltage",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Maximum per-cell voltage when charged. 0: field not provided.",
+        ),
+    )
+    charging_maximum_current: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="charging_maximum_current",
+            type="float32",
+            unit="A",
+            quantity="current",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Maximum pack continuous charge current. 0: field not provided.",
+        ),
+    )
+    nominal_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="nominal_voltage",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Battery nominal voltage. Used for conversion between Wh and Ah. 0: field not provided.",
+        ),
+    )
+    discharge_maximum_current: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="discharge_maximum_current",
+            type="float32",
+            unit="A",
+            quantity="current",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Maximum pack discharge current. 0: field not provided.",
+        ),
+    )
+    discharge_maximum_burst_current: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="discharge_maximum_burst_current",
+            type="float32",
+            unit="A",
+            quantity="current",
+            invalid=0.0,
+            invalid_text="0",
+            doc="Maximum pack discharge burst current. 0: field not provided.",
+        ),
+    )
+    design_capacity: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="design_capacity",
+            type="float32",
+            unit="Ah",
+            quantity="charge",
+            scale=3600.0,
+            offset=0.0,
+            invalid=0.0,
+            invalid_text="0",
+            doc="Fully charged design capacity. 0: field not provided.",
+        ),
+    )
+    full_charge_capacity: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="full_charge_capacity",
+            type="float32",
+            unit="Ah",
+            quantity="charge",
+            scale=3600.0,
+            offset=0.0,
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Predicted battery capacity when fully charged (accounting for battery "
+            "degradation). NAN: field not provided.",
+        ),
+    )
+    manufacture_date: str = dataclasses.field(
+        default="",
+        metadata=_m.meta(
+            name="manufacture_date",
+            type="char[9]",
+            invalid=0,
+            invalid_text="[0]",
+            per_element=True,
+            doc="Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated. All 0: field not provided.",
+        ),
+    )
+    serial_number: str = dataclasses.field(
+        default="",
+        metadata=_m.meta(
+            name="serial_number",
+            type="char[32]",
+            invalid=0,
+            invalid_text="[0]",
+            per_element=True,
+            doc="Serial number in ASCII characters, 0 terminated. All 0: field not provided.",
+        ),
+    )
+    name: str = dataclasses.field(
+        default="",
+        metadata=_m.meta(
+            name="name",
+            type="char[50]",
+            invalid=0,
+            invalid_text="[0]",
+            per_element=True,
+            doc="Battery device name. Formatted as manufacturer name then product name, "
+            "separated with an underscore (in ASCII characters), 0 terminated. All 0: field "
+            "not provided.",
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, Any] = {}
+        out["id"] = self.id
+        out["battery_function"] = self.battery_function
+        out["type"] = self.type
+        out["state_of_health"] = self.state_of_health
+        out["cells_in_series"] = self.cells_in_series
+        out["cycle_count"] = self.cycle_count
+        out["weight"] = self.weight
+        out["discharge_minimum_voltage"] = self.discharge_minimum_voltage
+        out["charging_minimum_voltage"] = self.charging_minimum_voltage
+        out["resting_minimum_voltage"] = self.resting_minimum_voltage
+        out["charging_maximum_voltage"] = self.charging_maximum_voltage
+        out["charging_maximum_current"] = self.charging_maximum_current
+        out["nominal_voltage"] = self.nominal_voltage
+        out["discharge_maximum_current"] = self.discharge_maximum_current
+        out["discharge_maximum_burst_current"] = self.discharge_maximum_burst_current
+        out["design_capacity"] = self.design_capacity
+        out["full_charge_capacity"] = self.full_charge_capacity
+        out["manufacture_date"] = self.manufacture_date
+        out["serial_number"] = self.serial_number
+        out["name"] = self.name
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> BatteryInfo:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "id",
+                    "battery_function",
+                    "type",
+                    "state_of_health",
+                    "cells_in_series",
+                    "cycle_count",
+                    "weight",
+                    "discharge_minimum_voltage",
+                    "charging_minimum_voltage",
+                    "resting_minimum_voltage",
+                    "charging_maximum_voltage",
+                    "charging_maximum_current",
+                    "nominal_voltage",
+                    "discharge_maximum_current",
+                    "discharge_maximum_burst_current",
+                    "design_capacity",
+                    "full_charge_capacity",
+                    "manufacture_date",
+                    "serial_number",
+                    "name",
+                }
+            ),
+            (),
+            "BatteryInfo",
+        )
+        obj = cls()
+        if "id" in data:
+            obj.id = _m.as_int(data["id"], "id")
+        if "battery_function" in data:
+            obj.battery_function = _m.as_int(data["battery_function"], "battery_function")
+        if "type" in data:
+            obj.type = _m.as_int(data["type"], "type")
+        if "state_of_health" in data:
+            obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
+        if "cells_in_series" in data:
+            obj.cells_in_series = _m.as_int(data["cells_in_series"], "cells_in_series")
+        if "cycle_count" in data:
+            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+        if "weight" in data:
+            obj.weight = _m.as_int(data["weight"], "weight")
+        if "discharge_minimum_voltage" in data:
+            obj.discharge_minimum_voltage = _m.as_float(data["discharge_minimum_voltage"], "discharge_minimum_voltage")
+        if "charging_minimum_voltage" in data:
+            obj.charging_minimum_voltage = _m.as_float(data["charging_minimum_voltage"], "charging_minimum_voltage")
+        if "resting_minimum_voltage" in data:
+            obj.resting_minimum_voltage = _m.as_float(data["resting_minimum_voltage"], "resting_minimum_voltage")
+        if "charging_maximum_voltage" in data:
+            obj.charging_maximum_voltage = _m.as_float(data["charging_maximum_voltage"], "charging_maximum_voltage")
+        if "charging_maximum_current" in data:
+            obj.charging_maximum_current = _m.as_float(data["charging_maximum_current"], "charging_maximum_current")
+        if "nominal_voltage" in data:
+            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+        if "discharge_maximum_current" in data:
+            obj.discharge_maximum_current = _m.as_float(data["discharge_maximum_current"], "discharge_maximum_current")
+        if "discharge_maximum_burst_current" in data:
+            obj.discharge_maximum_burst_current = _m.as_float(
+                data["discharge_maximum_burst_current"], "discharge_maximum_burst_current"
+            )
+        if "design_capacity" in data:
+            obj.design_capacity = _m.as_float(data["design_capacity"], "design_capacity")
+        if "full_charge_capacity" in data:
+            obj.full_charge_capacity = _m.as_float(data["full_charge_capacity"], "full_charge_capacity")
+        if "manufacture_date" in data:
+            obj.manufacture_date = _m.as_str(data["manufacture_date"], "manufacture_date")
+        if "serial_number" in data:
+            obj.serial_number = _m.as_str(data["serial_number"], "serial_number")
+        if "name" in data:
+            obj.name = _m.as_str(data["name"], "name")
+        return obj
+
+    MSG_ID: ClassVar[int] = 372
+    CRC_EXTRA: ClassVar[int] = 26
+    MAVLINK_BASE_LENGTH: ClassVar[int] = 140
+    MAVLINK_MAX_LENGTH: ClassVar[int] = 140
+
+    def encode(self, *, truncate: bool = True) -> bytes:
+        """The MAVLink 2 payload, 140 bytes in wire order; trailing zero bytes
+        are dropped (at least one byte is kept) unless ``truncate`` is False.
+        A value that does not fit its field raises EncodeError naming it."""
+        try:
+            t_manufacture_date = self.manufacture_date.encode("utf-8", "surrogateescape")
+            t_serial_number = self.serial_number.encode("utf-8", "surrogateescape")
+            t_name = self.name.encode("utf-8", "surrogateescape")
+            data = _BATTERY_INFO_PAYLOAD.pack(
+                self.discharge_minimum_voltage,
+                self.charging_minimum_voltage,
+                self.resting_minimum_voltage,
+                self.charging_maximum_voltage,
+                self.charging_maximum_current,
+                self.nominal_voltage,
+                self.discharge_maximum_current,
+                self.discharge_maximum_burst_current,
+                self.design_capacity,
+                self.full_charge_capacity,
+                self.cycle_count,
+                self.weight,
+                self.id,
+                self.battery_function,
+                self.type,
+                self.state_of_health,
+                self.cells_in_series,
+                t_manufacture_date,
+                t_serial_number,
+                t_name,
+            )
+        except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+            raise _mav.explain("BATTERY_INFO", self, _BATTERY_INFO_FIELDS) from exc
+        if len(t_manufacture_date) > 9 or len(t_serial_number) > 32 or len(t_name) > 50:
+            raise _mav.explain("BATTERY_INFO", self, _BATTERY_INFO_FIELDS)
+        if truncate:
+            return data.rstrip(b"\x00") or b"\x00"
+        return data
+
+    @classmethod
+    def decode(cls, data: _mav.BytesLike) -> BatteryInfo:
+        """A MAVLink 2 payload; a short one is zero-filled, one over 140 bytes is a DecodeError."""
+        if len(data) != 140:
+            data = _mav.fill(data, 140, "BATTERY_INFO")
+        v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15, v16, v17, v18, v19 = (
+            _BATTERY_INFO_PAYLOAD.unpack(data)
+        )
+        obj = object.__new__(cls)
+        obj.discharge_minimum_voltage = v0
+        obj.charging_minimum_voltage = v1
+        obj.resting_minimum_voltage = v2
+        obj.charging_maximum_voltage = v3
+        obj.charging_maximum_current = v4
+        obj.nominal_voltage = v5
+        obj.discharge_maximum_current = v6
+        obj.discharge_maximum_burst_current = v7
+        obj.design_capacity = v8
+        obj.full_charge_capacity = v9
+        obj.cycle_count = v10
+        obj.weight = v11
+        obj.id = v12
+        obj.battery_function = v13
+        obj.type = v14
+        obj.state_of_health = v15
+        obj.cells_in_series = v16
+        obj.manufacture_date = _mav.text(v17)
+        obj.serial_number = _mav.text(v18)
+        obj.name = _mav.text(v19)
+        return obj
+
+    def encode_frame(
+        self,
+        *,
+        seq: int = 0,
+        sysid: int = 1,
+        compid: int = 1,
+        mavlink1: bool = False,
+        incompat_flags: int = 0,
+        compat_flags: int = 0,
+        signature: bytes | None = None,
+    ) -> bytes:
+        """A whole frame: MAVLink 2 (0xFD, truncated payload, CRC with CRC_EXTRA; a 13-byte
+        ``signature`` is appended and flagged, not computed) or, with ``mavlink1``, MAVLink 1
+        (0xFE, the base payload without extensions; message ids below 256 only)."""
+        if mavlink1:
+            raise _mav.EncodeError("BATTERY_INFO: message id 372 does not fit a MAVLink 1 frame")
+        return _mav.frame_v2(self.encode(), 372, b"\x1a", seq, sysid, compid, incompat_flags, compat_flags, signature)
+
+    @classmethod
+    def decode_frame(cls, data: _mav.BytesLike) -> BatteryInfo:
+        """One whole MAVLink 1 or 2 frame of this message (CRC checked; a signature is skipped);
+        _mavlink.parse_frame gives the header fields."""
+        payload = _mav.frame_payload(data, 372, b"\x1a", 140, "BATTERY_INFO")
+        return cls.decode(payload)
+
+    @classmethod
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, Any]:
+        """Records of 140 bytes (zero-filled payloads) -> columns keyed by field name: numpy
+        arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
+        tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
+        arrays = _mav.numpy_columns(data, 140, _BATTERY_INFO_DTYPE, use_numpy, "BATTERY_INFO")
+        if arrays is not None:
+            return arrays
+        c = _mav.struct_columns(data, _BATTERY_INFO_PAYLOAD, "BATTERY_INFO")
+        return {
+            "discharge_minimum_voltage": c[0],
+            "charging_minimum_voltage": c[1],
+            "resting_minimum_voltage": c[2],
+            "charging_maximum_voltage": c[3],
+            "charging_maximum_current": c[4],
+            "nominal_voltage": c[5],
+            "discharge_maximum_current": c[6],
+            "discharge_maximum_burst_current": c[7],
+            "design_capacity": c[8],
+            "full_charge_capacity": c[9],
+            "cycle_count": c[10],
+            "weight": c[11],
+            "id": c[12],
+            "battery_function": c[13],
+            "type": c[14],
+            "state_of_health": c[15],
+            "cells_in_series": c[16],
+            "manufacture_date": [_mav.text(b) for b in c[17]],
+            "serial_number": [_mav.text(b) for b in c[18]],
+            "name": [_mav.text(b) for b in c[19]],
+        }
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        try:
+            if self.id & -256:
+                _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
+        try:
+            if self.battery_function not in {0, 1, 2, 3, 4}:
+                _v.diag(out, "battery_function", self.battery_function, _BATTERY_INFO_BATTERY_FUNCTION_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "battery_function", self.battery_function, _BATTERY_INFO_BATTERY_FUNCTION_SPEC)
+        try:
+            if self.type not in {0, 1, 2, 3, 4}:
+                _v.diag(out, "type", self.type, _BATTERY_INFO_TYPE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "type", self.type, _BATTERY_INFO_TYPE_SPEC)
+        try:
+            if self.state_of_health & -256:
+                _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_INFO_STATE_OF_HEALTH_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_INFO_STATE_OF_HEALTH_SPEC)
+        try:
+            if self.cells_in_series & -256:
+                _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_INFO_CELLS_IN_SERIES_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_INFO_CELLS_IN_SERIES_SPEC)
+        try:
+            if self.cycle_count & -65536:
+                _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_CYCLE_COUNT_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_CYCLE_COUNT_SPEC)
+        try:
+            if self.weight & -65536:
+                _v.diag(out, "weight", self.weight, _BATTERY_INFO_WEIGHT_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "weight", self.weight, _BATTERY_INFO_WEIGHT_SPEC)
+        try:
+            if not (-3.4028234663852886e38 <= self.discharge_minimum_voltage <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "discharge_minimum_voltage",
+                    self.discharge_minimum_voltage,
+                    _BATTERY_INFO_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "discharge_minimum_voltage",
+                self.discharge_minimum_voltage,
+                _BATTERY_INFO_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.charging_minimum_voltage <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "charging_minimum_voltage",
+                    self.charging_minimum_voltage,
+                    _BATTERY_INFO_CHARGING_MINIMUM_VOLTAGE_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "charging_minimum_voltage",
+                self.charging_minimum_voltage,
+                _BATTERY_INFO_CHARGING_MINIMUM_VOLTAGE_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.resting_minimum_voltage <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "resting_minimum_voltage",
+                    self.resting_minimum_voltage,
+                    _BATTERY_INFO_RESTING_MINIMUM_VOLTAGE_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out, "resting_minimum_voltage", self.resting_minimum_voltage, _BATTERY_INFO_RESTING_MINIMUM_VOLTAGE_SPEC
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.charging_maximum_voltage <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "charging_maximum_voltage",
+                    self.charging_maximum_voltage,
+                    _BATTERY_INFO_CHARGING_MAXIMUM_VOLTAGE_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "charging_maximum_voltage",
+                self.charging_maximum_voltage,
+                _BATTERY_INFO_CHARGING_MAXIMUM_VOLTAGE_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.charging_maximum_current <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "charging_maximum_current",
+                    self.charging_maximum_current,
+                    _BATTERY_INFO_CHARGING_MAXIMUM_CURRENT_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "charging_maximum_current",
+                self.charging_maximum_current,
+                _BATTERY_INFO_CHARGING_MAXIMUM_CURRENT_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
+                _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_NOMINAL_VOLTAGE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_NOMINAL_VOLTAGE_SPEC)
+        try:
+            if not (-3.4028234663852886e38 <= self.discharge_maximum_current <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "discharge_maximum_current",
+                    self.discharge_maximum_current,
+                    _BATTERY_INFO_DISCHARGE_MAXIMUM_CURRENT_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "discharge_maximum_current",
+                self.discharge_maximum_current,
+                _BATTERY_INFO_DISCHARGE_MAXIMUM_CURRENT_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.discharge_maximum_burst_current <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "discharge_maximum_burst_current",
+                    self.discharge_maximum_burst_current,
+                    _BATTERY_INFO_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "discharge_maximum_burst_current",
+                self.discharge_maximum_burst_current,
+                _BATTERY_INFO_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
+                _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_INFO_DESIGN_CAPACITY_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_INFO_DESIGN_CAPACITY_SPEC)
+        try:
+            x = self.full_charge_capacity
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_INFO_FULL_CHARGE_CAPACITY_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_INFO_FULL_CHARGE_CAPACITY_SPEC)
+        try:
+            x = self.manufacture_date
+            if x.__class__ is not str or len(x.encode()) > 9:
+                _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_INFO_MANUFACTURE_DATE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_INFO_MANUFACTURE_DATE_SPEC)
+        try:
+            x = self.serial_number
+            if x.__class__ is not str or len(x.encode()) > 32:
+                _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
+        try:
+            x = self.name
+            if x.__class__ is not str or len(x.encode()) > 50:
+                _v.diag(out, "name", self.name, _BATTERY_INFO_NAME_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "name", self.name, _BATTERY_INFO_NAME_SPEC)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "mavlink.BATTERY_INFO")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == "state_of_health":
+            return self.state_of_health != 255
+        if field == "cells_in_series":
+            return self.cells_in_series != 0
+        if field == "cycle_count":
+            return self.cycle_count != 65535
+        if field == "weight":
+            return self.weight != 0
+        if field == "discharge_minimum_voltage":
+            return self.discharge_minimum_voltage != 0
+        if field == "charging_minimum_voltage":
+            return self.charging_minimum_voltage != 0
+        if field == "resting_minimum_voltage":
+            return self.resting_minimum_voltage != 0
+        if field == "charging_maximum_voltage":
+            return self.charging_maximum_voltage != 0
+        if field == "charging_maximum_current":
+            return self.charging_maximum_current != 0
+        if field == "nominal_voltage":
+            return self.nominal_voltage != 0
+        if field == "discharge_maximum_current":
+            return self.discharge_maximum_current != 0
+        if field == "discharge_maximum_burst_current":
+            return self.discharge_maximum_burst_current != 0
+        if field == "design_capacity":
+            return self.design_capacity != 0
+        if field == "full_charge_capacity":
+            return self.full_charge_capacity == self.full_charge_capacity
+        if field == "manufacture_date":
+            return self.manufacture_date != ""
+        if field == "serial_number":
+            return self.serial_number != ""
+        if field == "name":
+            return self.name != ""
+        if field in {"id", "battery_function", "type"}:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_INFO")
+
+
+@dataclasses.dataclass(slots=True)
+class BatteryStatus:
+    """Battery information. Updates GCS with flight controller battery status. Smart batteries also use this message,
+    but may additionally send BATTERY_INFO.
+
+    Schema: mavlink.BATTERY_STATUS (mavlink, battery.xml:225).
+    """
+
+    QUALIFIED_NAME: ClassVar[str] = "mavlink.BATTERY_STATUS"
+
+    id: int = dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
+    battery_function: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="battery_function",
+            type="uint8",
+            enums=("mavlink.MAV_BATTERY_FUNCTION",),
+            doc="Function of the battery",
+        ),
+    )
+    type: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Type (chemistry) of the battery"
+        ),
     )
     temperature: int = dataclasses.field(
         default=32767,
@@ -261,7 +1290,7 @@ class BatteryStatus:
             offset=273.15,
             invalid=32767,
             invalid_text="INT16_MAX",
-            doc="Battery temperature; INT16_MAX when unknown.",
+            doc="Temperature of the battery. INT16_MAX for unknown temperature.",
         ),
     )
     voltages: list[int] = dataclasses.field(
@@ -276,9 +1305,14 @@ class BatteryStatus:
             invalid=65535,
             invalid_text="[UINT16_MAX]",
             per_element=True,
-            doc="Voltages of cells 1-10; UINT16_MAX in cells that do not exist. Without per-cell "
-            "data, cell 0 holds the pack voltage; a pack above UINT16_MAX - 1 mV spills the "
-            "rest into the following cells.",
+            doc="Battery voltage of cells 1 to 10 (see voltages_ext for cells 11-14). Cells in "
+            "this field above the valid cell count for this battery should have the "
+            "UINT16_MAX value. If individual cell voltages are unknown or not measured for "
+            "this battery, then the overall battery voltage should be filled in cell 0, with "
+            "all others set to UINT16_MAX. If the voltage of the battery is greater than "
+            "(UINT16_MAX - 1), then cell 0 should be set to (UINT16_MAX - 1), and cell 1 to "
+            "the remaining voltage. This can be extended to multiple cells if the total "
+            "voltage is greater than 2 * (UINT16_MAX - 1).",
         ),
     )
     current_battery: int = dataclasses.field(
@@ -292,7 +1326,8 @@ class BatteryStatus:
             offset=0.0,
             invalid=-1,
             invalid_text="-1",
-            doc="Battery current; -1 when not measured.",
+            doc="Battery current, -1: autopilot does not measure the current. Value may "
+            "overflow/rollover for very high currents (> 327.67A)",
         ),
     )
     current_consumed: int = dataclasses.field(
@@ -306,7 +1341,7 @@ class BatteryStatus:
             offset=0.0,
             invalid=-1,
             invalid_text="-1",
-            doc="Charge drawn so far; -1 when not estimated.",
+            doc="Consumed charge, -1: autopilot does not provide consumption estimate",
         ),
     )
     energy_consumed: int = dataclasses.field(
@@ -320,7 +1355,7 @@ class BatteryStatus:
             offset=0.0,
             invalid=-1,
             invalid_text="-1",
-            doc="Energy drawn so far; -1 when not estimated.",
+            doc="Consumed energy, -1: autopilot does not provide energy consumption estimate",
         ),
     )
     battery_remaining: int = dataclasses.field(
@@ -334,7 +1369,7 @@ class BatteryStatus:
             offset=0.0,
             invalid=-1,
             invalid_text="-1",
-            doc="Energy left, 0 to 100; -1 when not estimated.",
+            doc="Remaining battery energy. Values: [0-100], -1: autopilot does not estimate the remaining battery.",
         ),
     )
     time_remaining: int = dataclasses.field(
@@ -344,8 +1379,10 @@ class BatteryStatus:
             type="int32",
             unit="s",
             quantity="time",
+            invalid=0,
+            invalid_text="0",
             extension=True,
-            doc="Time left; 0 when not estimated.",
+            doc="Remaining battery time, 0: autopilot does not provide remaining battery time estimate",
         ),
     )
     charge_state: int = dataclasses.field(
@@ -355,7 +1392,7 @@ class BatteryStatus:
             type="uint8",
             enums=("mavlink.MAV_BATTERY_CHARGE_STATE",),
             extension=True,
-            doc="Discharge level, for warnings and failsafes.",
+            doc="State for extent of discharge, provided by autopilot for warning or external reactions",
         ),
     )
     voltages_ext: list[int] = dataclasses.field(
@@ -367,8 +1404,14 @@ class BatteryStatus:
             quantity="voltage",
             scale=0.001,
             offset=0.0,
+            invalid=0,
+            invalid_text="[0]",
+            per_element=True,
             extension=True,
-            doc="Voltages of cells 11-14; 0 in cells that do not exist (a measured 0 is sent as 1).",
+            doc="Battery voltages for cells 11 to 14. Cells above the valid cell count for this "
+            "battery should have a value of 0, where zero indicates not supported (note, "
+            "this is different than for the voltages field and allows empty byte "
+            "truncation). If the measured value is 0 then 1 should be sent instead.",
         ),
     )
     mode: int = dataclasses.field(
@@ -378,7 +1421,8 @@ class BatteryStatus:
             type="uint8",
             enums=("mavlink.MAV_BATTERY_MODE",),
             extension=True,
-            doc="Battery mode; 0 when not reported or in normal use.",
+            doc="Battery mode. Default (0) is that battery mode reporting is not supported or "
+            "battery is in normal-use mode.",
         ),
     )
     fault_bitmask: int = dataclasses.field(
@@ -388,7 +1432,9 @@ class BatteryStatus:
             type="uint32",
             enums=("mavlink.MAV_BATTERY_FAULT",),
             extension=True,
-            doc="Fault flags, valid when charge_state is FAILED or UNHEALTHY.",
+            doc="Fault/health indications. These should be set when charge_state is "
+            "MAV_BATTERY_CHARGE_STATE_FAILED or MAV_BATTERY_CHARGE_STATE_UNHEALTHY (if not, "
+            "fault reporting is not supported).",
         ),
     )
 
@@ -749,15 +1795,345 @@ class BatteryStatus:
             return self.energy_consumed != -1
         if field == "battery_remaining":
             return self.battery_remaining != -1
-        if field in {
-            "id",
-            "battery_function",
-            "type",
-            "time_remaining",
-            "charge_state",
-            "voltages_ext",
-            "mode",
-            "fault_bitmask",
-        }:
+        if field == "time_remaining":
+            return self.time_remaining != 0
+        if field == "voltages_ext":
+            return any(e != 0 for e in self.voltages_ext)
+        if field in {"id", "battery_function", "type", "charge_state", "mode", "fault_bitmask"}:
             return True
         raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_STATUS")
+
+
+@dataclasses.dataclass(slots=True)
+class BatteryStatusV2:
+    """Battery dynamic information. This should be streamed (nominally at 1Hz). Static/invariant battery information is
+    sent in BATTERY_INFO. Note that smart batteries should set the MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL
+    bit to indicate that supplied capacity values are relative to a battery that is known to be full. Power monitors
+    would not set this bit, indicating that capacity_consumed is relative to drone power-on, and that other values
+    are estimated based on the assumption that the battery was full on power-on.
+
+    Schema: mavlink.BATTERY_STATUS_V2 (mavlink, battery.xml:243).
+    """
+
+    QUALIFIED_NAME: ClassVar[str] = "mavlink.BATTERY_STATUS_V2"
+
+    id: int = dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
+    temperature: int = dataclasses.field(
+        default=32767,
+        metadata=_m.meta(
+            name="temperature",
+            type="int16",
+            unit="cdegC",
+            quantity="temperature",
+            scale=0.01,
+            offset=273.15,
+            invalid=32767,
+            invalid_text="INT16_MAX",
+            doc="Temperature of the whole battery pack (not internal electronics). INT16_MAX field not provided.",
+        ),
+    )
+    voltage: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="voltage",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Battery voltage (total). NaN: field not provided.",
+        ),
+    )
+    current: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="current",
+            type="float32",
+            unit="A",
+            quantity="current",
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Battery current (through all cells/loads). Positive value when discharging and "
+            "negative if charging. NaN: field not provided.",
+        ),
+    )
+    capacity_consumed: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="capacity_consumed",
+            type="float32",
+            unit="Ah",
+            quantity="charge",
+            scale=3600.0,
+            offset=0.0,
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Consumed charge. NaN: field not provided. This is either the consumption since "
+            "power-on or since the battery was full, depending on the value of "
+            "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL.",
+        ),
+    )
+    capacity_remaining: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="capacity_remaining",
+            type="float32",
+            unit="Ah",
+            quantity="charge",
+            scale=3600.0,
+            offset=0.0,
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="Remaining charge (until empty). NaN: field not provided. Note: If "
+            "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL is unset, this value is "
+            "based on the assumption the battery was full when the system was powered.",
+        ),
+    )
+    state_of_charge: float = dataclasses.field(
+        default=math.nan,
+        metadata=_m.meta(
+            name="state_of_charge",
+            type="float32",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            invalid=math.nan,
+            invalid_text="NaN",
+            doc="State of Charge (SoC). Remaining capacity relative to current fully-charged "
+            "capacity as a percentage. Values: [0-100], NaN: field not provided. Note that "
+            "the value may be calculated from design_capacity if current "
+            "full_charge_capacity is not known (see BATTERY_INFO).",
+        ),
+    )
+    status_flags: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="status_flags",
+            type="uint32",
+            enums=("mavlink.MAV_BATTERY_STATUS_FLAGS",),
+            doc="Fault, health, readiness, and other status indications.",
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, Any] = {}
+        out["id"] = self.id
+        out["temperature"] = self.temperature
+        out["voltage"] = self.voltage
+        out["current"] = self.current
+        out["capacity_consumed"] = self.capacity_consumed
+        out["capacity_remaining"] = self.capacity_remaining
+        out["state_of_charge"] = self.state_of_charge
+        out["status_flags"] = self.status_flags
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatusV2:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "id",
+                    "temperature",
+                    "voltage",
+                    "current",
+                    "capacity_consumed",
+                    "capacity_remaining",
+                    "state_of_charge",
+                    "status_flags",
+                }
+            ),
+            (),
+            "BatteryStatusV2",
+        )
+        obj = cls()
+        if "id" in data:
+            obj.id = _m.as_int(data["id"], "id")
+        if "temperature" in data:
+            obj.temperature = _m.as_int(data["temperature"], "temperature")
+        if "voltage" in data:
+            obj.voltage = _m.as_float(data["voltage"], "voltage")
+        if "current" in data:
+            obj.current = _m.as_float(data["current"], "current")
+        if "capacity_consumed" in data:
+            obj.capacity_consumed = _m.as_float(data["capacity_consumed"], "capacity_consumed")
+        if "capacity_remaining" in data:
+            obj.capacity_remaining = _m.as_float(data["capacity_remaining"], "capacity_remaining")
+        if "state_of_charge" in data:
+            obj.state_of_charge = _m.as_float(data["state_of_charge"], "state_of_charge")
+        if "status_flags" in data:
+            obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
+        return obj
+
+    MSG_ID: ClassVar[int] = 369
+    CRC_EXTRA: ClassVar[int] = 145
+    MAVLINK_BASE_LENGTH: ClassVar[int] = 27
+    MAVLINK_MAX_LENGTH: ClassVar[int] = 27
+
+    def encode(self, *, truncate: bool = True) -> bytes:
+        """The MAVLink 2 payload, 27 bytes in wire order; trailing zero bytes
+        are dropped (at least one byte is kept) unless ``truncate`` is False.
+        A value that does not fit its field raises EncodeError naming it."""
+        try:
+            data = _BATTERY_STATUS_V2_PAYLOAD.pack(
+                self.voltage,
+                self.current,
+                self.capacity_consumed,
+                self.capacity_remaining,
+                self.state_of_charge,
+                self.status_flags,
+                self.temperature,
+                self.id,
+            )
+        except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+            raise _mav.explain("BATTERY_STATUS_V2", self, _BATTERY_STATUS_V2_FIELDS) from exc
+        if truncate:
+            return data.rstrip(b"\x00") or b"\x00"
+        return data
+
+    @classmethod
+    def decode(cls, data: _mav.BytesLike) -> BatteryStatusV2:
+        """A MAVLink 2 payload; a short one is zero-filled, one over 27 bytes is a DecodeError."""
+        if len(data) != 27:
+            data = _mav.fill(data, 27, "BATTERY_STATUS_V2")
+        v0, v1, v2, v3, v4, v5, v6, v7 = _BATTERY_STATUS_V2_PAYLOAD.unpack(data)
+        obj = object.__new__(cls)
+        obj.voltage = v0
+        obj.current = v1
+        obj.capacity_consumed = v2
+        obj.capacity_remaining = v3
+        obj.state_of_charge = v4
+        obj.status_flags = v5
+        obj.temperature = v6
+        obj.id = v7
+        return obj
+
+    def encode_frame(
+        self,
+        *,
+        seq: int = 0,
+        sysid: int = 1,
+        compid: int = 1,
+        mavlink1: bool = False,
+        incompat_flags: int = 0,
+        compat_flags: int = 0,
+        signature: bytes | None = None,
+    ) -> bytes:
+        """A whole frame: MAVLink 2 (0xFD, truncated payload, CRC with CRC_EXTRA; a 13-byte
+        ``signature`` is appended and flagged, not computed) or, with ``mavlink1``, MAVLink 1
+        (0xFE, the base payload without extensions; message ids below 256 only)."""
+        if mavlink1:
+            raise _mav.EncodeError("BATTERY_STATUS_V2: message id 369 does not fit a MAVLink 1 frame")
+        return _mav.frame_v2(self.encode(), 369, b"\x91", seq, sysid, compid, incompat_flags, compat_flags, signature)
+
+    @classmethod
+    def decode_frame(cls, data: _mav.BytesLike) -> BatteryStatusV2:
+        """One whole MAVLink 1 or 2 frame of this message (CRC checked; a signature is skipped);
+        _mavlink.parse_frame gives the header fields."""
+        payload = _mav.frame_payload(data, 369, b"\x91", 27, "BATTERY_STATUS_V2")
+        return cls.decode(payload)
+
+    @classmethod
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, Any]:
+        """Records of 27 bytes (zero-filled payloads) -> columns keyed by field name: numpy
+        arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
+        tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
+        arrays = _mav.numpy_columns(data, 27, _BATTERY_STATUS_V2_DTYPE, use_numpy, "BATTERY_STATUS_V2")
+        if arrays is not None:
+            return arrays
+        c = _mav.struct_columns(data, _BATTERY_STATUS_V2_PAYLOAD, "BATTERY_STATUS_V2")
+        return {
+            "voltage": c[0],
+            "current": c[1],
+            "capacity_consumed": c[2],
+            "capacity_remaining": c[3],
+            "state_of_charge": c[4],
+            "status_flags": c[5],
+            "temperature": c[6],
+            "id": c[7],
+        }
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        try:
+            if self.id & -256:
+                _v.diag(out, "id", self.id, _BATTERY_STATUS_V2_ID_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "id", self.id, _BATTERY_STATUS_V2_ID_SPEC)
+        try:
+            if (self.temperature + 32768) & -65536:
+                _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V2_TEMPERATURE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V2_TEMPERATURE_SPEC)
+        try:
+            x = self.voltage
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "voltage", self.voltage, _BATTERY_STATUS_V2_VOLTAGE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "voltage", self.voltage, _BATTERY_STATUS_V2_VOLTAGE_SPEC)
+        try:
+            x = self.current
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "current", self.current, _BATTERY_STATUS_V2_CURRENT_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "current", self.current, _BATTERY_STATUS_V2_CURRENT_SPEC)
+        try:
+            x = self.capacity_consumed
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_STATUS_V2_CAPACITY_CONSUMED_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_STATUS_V2_CAPACITY_CONSUMED_SPEC)
+        try:
+            x = self.capacity_remaining
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "capacity_remaining", self.capacity_remaining, _BATTERY_STATUS_V2_CAPACITY_REMAINING_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "capacity_remaining", self.capacity_remaining, _BATTERY_STATUS_V2_CAPACITY_REMAINING_SPEC)
+        try:
+            x = self.state_of_charge
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
+                _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_STATUS_V2_STATE_OF_CHARGE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_STATUS_V2_STATE_OF_CHARGE_SPEC)
+        try:
+            if self.status_flags & -2148007936:
+                _v.diag(out, "status_flags", self.status_flags, _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "status_flags", self.status_flags, _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "mavlink.BATTERY_STATUS_V2")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == "temperature":
+            return self.temperature != 32767
+        if field == "voltage":
+            return self.voltage == self.voltage
+        if field == "current":
+            return self.current == self.current
+        if field == "capacity_consumed":
+            return self.capacity_consumed == self.capacity_consumed
+        if field == "capacity_remaining":
+            return self.capacity_remaining == self.capacity_remaining
+        if field == "state_of_charge":
+            return self.state_of_charge == self.state_of_charge
+        if field in {"id", "status_flags"}:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_STATUS_V2")

@@ -17,6 +17,8 @@ from pathlib import Path
 from typing import IO, Literal, Protocol, cast
 
 from ..errors import BattgenError
+from ..inputs.can.captures import is_capture
+from ..inputs.can.records import capture_side
 from ..inputs.documents import read_json, read_jsonl, read_yaml
 from ..inputs.model import DecodingClass, Encodable, MavlinkClass, MessageClass, PlainClass, PlainData, UorbClass
 from ..inputs.payloads import read_hex, read_raw
@@ -28,9 +30,10 @@ from .package import named_package, package_module
 
 FORMATS = ("json", "jsonl", "yaml", "hex", "raw")
 BINARY_FORMATS = ("hex", "raw")
-LOG_FORMATS = ("ulog", "tlog", "mavlink")  # input only
+LOG_FORMATS = ("ulog", "tlog", "mavlink", "can", "dataflash")  # input only
 _EXTENSIONS = {".json": "json", ".jsonl": "jsonl", ".ndjson": "jsonl", ".yaml": "yaml", ".yml": "yaml"}
 _EXTENSIONS |= {".hex": "hex", ".bin": "raw", ".raw": "raw", ".ulg": "ulog", ".tlog": "tlog", ".mav": "mavlink"}
+_EXTENSIONS |= {".log": "can", ".asc": "can", ".blf": "can", ".trc": "can"}
 
 # (alias, class) of each message of a side, the first required; the concept state is a side too
 Side = tuple[tuple[str, PlainClass], ...]
@@ -58,7 +61,11 @@ class ConvertModule(Protocol):
 
 def input_format(path: str, given: str | None) -> str:
     """The format of an input: given, else from the extension, else JSON Lines."""
-    return given or _EXTENSIONS.get(Path(path).suffix.lower(), "jsonl")
+    if given:
+        return given
+    if is_capture(Path(path)):  # looks through .gz
+        return "can"
+    return _EXTENSIONS.get(Path(path).suffix.lower(), "jsonl")
 
 
 def output_format(in_format: str, given: str | None) -> str:
@@ -116,8 +123,9 @@ class Endpoint:
         self.codecs = [cls if isinstance(cls, DecodingClass) else None for _, cls in items]
 
     def build(self, rec: Record) -> list[PlainData | None]:
-        if rec.instance is not None:  # decoded already (a log record)
-            return [rec.instance, *([None] * (len(self.items) - 1))]
+        if rec.instance is not None:  # decoded already (a log record; a CAN node's other messages beside it)
+            rest = list(rec.companions[: len(self.items) - 1])
+            return [rec.instance, *rest, *([None] * (len(self.items) - 1 - len(rest)))]
         data = rec.data
         aliases = [a for a, _ in self.items]
         try:
@@ -248,8 +256,27 @@ class Conversion:
             yield from _stream_items(stream, where, fmt)
 
     def _log_items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
-        """Every record of the source side's first message in a .ulg, .tlog or raw MAVLink input."""
+        """Every record of the source side's first message in a .ulg, .tlog, raw MAVLink or CAN capture input."""
         cls = self.source.items[0][1]
+        if fmt in ("can", "dataflash"):
+            if not isinstance(source, Path):
+                raise BattgenError(f"{where}: a CAN capture is read from a file, not from standard input")
+            models = [c for _, c in self.source.items if isinstance(c, MessageClass)]
+            for item in capture_side(source, where, models):
+                if isinstance(item, Record):
+                    yield Record(
+                        item.index,
+                        0,
+                        None,
+                        f"{where} ({item.where})",
+                        instance=item.instance,
+                        companions=item.companions,
+                    )
+                elif isinstance(item, Unreadable):
+                    raise BattgenError(f"{where}: {item.message}")
+                elif item.severity != "info":
+                    yield item
+            return
         if fmt == "ulog":
             if not isinstance(cls, UorbClass):
                 raise BattgenError(f"{where}: a ULog file holds uORB messages; {self.source_name} is not a uORB side")

@@ -223,6 +223,8 @@ def check_file(
         for item in read_records(path, message, report.file, model=checker.cls, kind=kind):
             if isinstance(item, Notice):
                 report.notices.append(item)
+                if item.severity == "error":  # damage a reader found (a CAN transfer's bad CRC): a finding too
+                    report.errors += 1
                 tell(item)
                 continue
             if isinstance(item, Unreadable):
@@ -301,8 +303,13 @@ def json_document(message: Message, reports: list[FileReport]) -> dict[str, obje
     }
 
 
+MAVLINK_DEFAULT = "mavlink.BATTERY_STATUS"
+CAPTURE_DEFAULT = "dronecan.uavcan.equipment.power.BatteryInfo"
+
+
 def default_message(schema: Schema, files: list[str], kind: str | None) -> str:
-    """The message to check when --message is omitted: the only one of the inputs' format."""
+    """The message to check when --message is omitted: the only one of the inputs' format, and
+    for MAVLink inputs BATTERY_STATUS (the battery message every autopilot sends)."""
     formats: set[SourceFormat | None] = set()
     for name in files:
         try:
@@ -310,8 +317,12 @@ def default_message(schema: Schema, files: list[str], kind: str | None) -> str:
         except LocatedError:
             formats.add(None)
     candidates = [m.qualified_name for m in schema.messages if m.format in formats]
+    if formats == {SourceFormat.DRONECAN} and CAPTURE_DEFAULT in candidates:
+        return CAPTURE_DEFAULT  # a CAN capture: the battery's own message, the one every battery node sends
     if len(formats) == 1 and None not in formats and len(candidates) == 1:
         return candidates[0]
+    if formats == {SourceFormat.MAVLINK} and MAVLINK_DEFAULT in candidates:
+        return MAVLINK_DEFAULT  # BATTERY_INFO and BATTERY_STATUS_V2 are asked for by name
     if len(formats) == 1 and None not in formats and candidates:
         raise BattgenError(
             f"--message is required: the schemas hold {len(candidates)} such messages ({', '.join(candidates)})"

@@ -16,10 +16,10 @@ from ..errors import BattgenError
 from ..frontends.loader import load
 from ..ir import Schema
 from ..ir import json_form as irjson
-from . import convert, docs, failsafe, params, schema, validate
+from . import can, convert, docs, failsafe, params, schema, validate
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
-COMMAND_MODULES = (validate, docs, schema, convert, params, failsafe)  # in the order of the help text
+COMMAND_MODULES = (validate, docs, schema, convert, params, failsafe, can)  # in the order of the help text
 
 
 def _load(paths: Sequence[str]) -> Schema:

@@ -2,7 +2,8 @@
 
 Inputs, by extension (or ``--input-format``): JSON (.json), JSON Lines (.jsonl/.ndjson), YAML
 (.yaml/.yml), devicetree (.dts/.dtsi/.dtb), parameter files (ArduPilot .param/.parm, QGroundControl
-.params), PX4 flight logs (.ulg), MAVLink telemetry logs (.tlog) and raw MAVLink streams (.mav).
+.params), PX4 flight logs (.ulg), MAVLink telemetry logs (.tlog), raw MAVLink streams (.mav), and CAN
+bus captures (candump .log, .asc, .blf, .trc; ArduPilot DataFlash .bin with CANF/CAFD records).
 
 - Parameter files: one record per parameter set (per vehicle/component in a .params file) holding
   the message's parameters; a violation names its parameter's line. For params.BATT the failsafe
@@ -16,7 +17,9 @@ Inputs, by extension (or ``--input-format``): JSON (.json), JSON Lines (.jsonl/.
   sequence number and (tlog) time and offset; bad CRCs and garbage are one warning summary.
 
 ``--message`` may be omitted when the inputs imply a format with only one message in the schemas
-(parameter files: params.BATT; MAVLink logs with the bundled schemas: mavlink.BATTERY_STATUS).
+(parameter files: params.BATT; MAVLink logs with the bundled schemas: mavlink.BATTERY_STATUS; CAN
+captures: DroneCAN BatteryInfo, every battery node's records located by time, frame and node, with the
+transport diagnostics -- toggle, CRC, missing start or end, transfer-id gaps, BatteryInfoAux order).
 
 Prints one line per violation, ``file:line: message`` (``file: location: message`` for logs;
 warnings marked, and not failing), notices about whole inputs and a summary on stderr; or with
@@ -56,12 +59,15 @@ def finding_line(f: Finding) -> str:
 
 
 def print_event(event: Event) -> None:
-    """Findings on stdout; warning notices and unreadable parts on stderr (info notices: JSON only)."""
+    """Findings on stdout; warning and error notices, the stream summary of a log or capture and unreadable
+    parts on stderr (other info notices: JSON only)."""
     if isinstance(event, Finding):
         print(finding_line(event))
     elif isinstance(event, Notice):
-        if event.severity == "warning":
-            print(f"{event.file}: warning: {event.message}", file=sys.stderr)
+        if event.severity in ("warning", "error"):
+            print(f"{event.file}: {event.severity}: {event.message}", file=sys.stderr)
+        elif event.kind == "stream":  # what a log or capture held (frames, nodes): one line, worth seeing
+            print(f"{event.file}: note: {event.message}", file=sys.stderr)
     else:
         print(f"{_place(event.file, event.line)}: {event.message}", file=sys.stderr)
 
@@ -109,7 +115,8 @@ def register(subparsers: Any) -> None:
         "--message",
         metavar="NAME",
         help="qualified message name (uorb.BatteryStatus, mavlink.BATTERY_STATUS, params.BATT, ...) or an "
-        "unambiguous short form; optional when the inputs' format has one message (parameter files: params.BATT)",
+        "unambiguous short form; optional when the inputs' format has one message (parameter files: params.BATT; "
+        "MAVLink logs: mavlink.BATTERY_STATUS)",
     )
     p.add_argument("--schemas", metavar="DIR", help="schema folder (default: the bundled schemas/)")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output format (default: text)")

@@ -2,7 +2,8 @@
 
 Kinds: JSON (.json), JSON Lines (.jsonl/.ndjson), YAML (.yaml/.yml), devicetree source
 (.dts/.dtsi) and blobs (.dtb), parameter files (.param/.parm/.params), PX4 ULog (.ulg), MAVLink
-telemetry logs (.tlog) and raw MAVLink streams (.mav; not .bin, which is ArduPilot's DataFlash log).
+telemetry logs (.tlog), raw MAVLink streams (.mav), CAN bus captures (candump .log, .asc, .blf, .trc, also
+gzip-compressed) and the CAN frames of ArduPilot DataFlash logs (.bin) for DroneCAN messages.
 The text kinds hold plain data for any message; the others hold one source format's messages, and
 the binary ones are decoded by the message's generated class.
 """
@@ -13,6 +14,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ..ir import Message, SourceFormat
+from .can.captures import CAPTURE_SUFFIXES, DATAFLASH_SUFFIXES, is_capture
+from .can.records import capture_items
 from .devicetree.records import read_devicetree
 from .documents import read_json, read_jsonl, read_yaml
 from .model import MavlinkClass, MessageClass
@@ -31,7 +34,9 @@ ULOG_SUFFIXES = frozenset({".ulg"})
 TLOG_SUFFIXES = frozenset({".tlog"})
 MAVLINK_SUFFIXES = frozenset({".mav"})  # not .bin: that is ArduPilot's DataFlash log
 KNOWN_SUFFIXES = JSON_SUFFIXES | JSONL_SUFFIXES | YAML_SUFFIXES | DTS_SUFFIXES | DTB_SUFFIXES
-KNOWN_SUFFIXES |= PARAM_SUFFIXES | ULOG_SUFFIXES | TLOG_SUFFIXES | MAVLINK_SUFFIXES
+KNOWN_SUFFIXES |= (
+    PARAM_SUFFIXES | ULOG_SUFFIXES | TLOG_SUFFIXES | MAVLINK_SUFFIXES | CAPTURE_SUFFIXES | DATAFLASH_SUFFIXES
+)
 _KINDS = (
     ("json", JSON_SUFFIXES),
     ("jsonl", JSONL_SUFFIXES),
@@ -42,6 +47,8 @@ _KINDS = (
     ("ulog", ULOG_SUFFIXES),
     ("tlog", TLOG_SUFFIXES),
     ("mavlink", MAVLINK_SUFFIXES),
+    ("can", CAPTURE_SUFFIXES),
+    ("dataflash", DATAFLASH_SUFFIXES),
 )
 KINDS = tuple(kind for kind, _ in _KINDS)
 # the source format a file kind holds; the text kinds hold any
@@ -52,6 +59,7 @@ KIND_FORMATS: dict[str, SourceFormat] = {
     "ulog": SourceFormat.UORB,
     "tlog": SourceFormat.MAVLINK,
     "mavlink": SourceFormat.MAVLINK,
+    "can": SourceFormat.DRONECAN,
 }
 _HOLDS = {
     "dts": "a devicetree file holds devicetree nodes",
@@ -60,11 +68,14 @@ _HOLDS = {
     "ulog": "a ULog file holds uORB topics",
     "tlog": "a MAVLink log holds MAVLink messages",
     "mavlink": "a MAVLink log holds MAVLink messages",
+    "can": "a CAN capture holds DroneCAN messages",
 }
 
 
 def kind_of_suffix(path: Path) -> str | None:
     """The data kind (one of KINDS) a file name's extension says, if any."""
+    if is_capture(path):  # looks through .gz
+        return "can"
     suffix = path.suffix.lower()
     for kind, suffixes in _KINDS:
         if suffix in suffixes:
@@ -98,11 +109,22 @@ def read_records(
     parameter files and binary logs need it; ``kind`` overrides the kind the extension says."""
     name = display if display is not None else path.as_posix()
     kind = kind or file_kind(path)
-    if kind in ("param", "ulog", "tlog", "mavlink") and model is None:
+    if kind == "dataflash" and message.format is SourceFormat.DRONECAN:
+        kind = "can"  # a DataFlash log's CANF/CAFD records: the frames of a logged CAN bus
+    if kind in ("param", "ulog", "tlog", "mavlink", "can") and model is None:
         raise InputError(name, 0, f"reading {kind} input needs the generated class of {message.qualified_name}")
     expected = KIND_FORMATS.get(kind)
     if expected is not None and message.format is not expected:
         raise InputError(name, 0, f"{_HOLDS[kind]}, but {message.qualified_name} is a {message.format.value} message")
+    if model is not None and kind == "can":
+        return capture_items(path, name, model)
+    if kind == "dataflash":
+        raise InputError(
+            name,
+            0,
+            f"a DataFlash log is read here for the DroneCAN messages of its CAN frames; "
+            f"{message.qualified_name} is a {message.format.value} message",
+        )
     if kind in ("dts", "dtb"):
         return read_devicetree(path, name, message, binary=kind == "dtb")
     if model is not None and kind == "param":

@@ -226,3 +226,13 @@ def ulog_runtime(cls: MessageClass) -> UlogRuntime:
 def mavlink_runtime(cls: MessageClass) -> MavlinkRuntime:
     """The ``_mavlink`` module of the generated package a MAVLink class belongs to."""
     return cast(MavlinkRuntime, importlib.import_module(package_name(cls) + "._mavlink"))
+
+
+@runtime_checkable
+class DronecanClass(MessageClass, Protocol):
+    """A generated DroneCAN class: its data type id (None for a type without a default id) and signature."""
+
+    DATA_TYPE_ID: int | None
+    DATA_TYPE_SIGNATURE: int
+
+    def decode(self, data: bytes, /, *, tao: bool = True) -> GeneratedMessage: ...

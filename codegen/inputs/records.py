@@ -46,6 +46,8 @@ class Record:
     instance: GeneratedMessage | None = field(default=None, compare=False)  # decoded already: no from_dict
     skip: frozenset[str] = frozenset()  # fields the source lacks: their checks are not reported
     location: Mapping[str, object] | None = None  # machine-readable where: timestamp, multi_id, offset...
+    # decoded with the instance: the other messages of a multi-message side (a CAN node's BatteryInfoAux)
+    companions: tuple[GeneratedMessage | None, ...] = field(default=(), compare=False)
 
     def line_of(self, path: str) -> int:
         """The line of a field path (``voltage_cell_v[3]``, ``timestamp.usec``), else the record's."""

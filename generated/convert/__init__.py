@@ -13,8 +13,10 @@ from typing import Any
 
 from ..devicetree.power.supply import SimpleBattery
 from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
-from ..dronecan.uavcan.equipment.power import BatteryInfo
+from ..dronecan.uavcan.equipment.power import BatteryInfo as DronecanBatteryInfo
+from ..mavlink import BatteryInfo as MavlinkBatteryInfo
 from ..mavlink import BatteryStatus as MavlinkBatteryStatus
+from ..mavlink import BatteryStatusV2
 from ..uorb import BatteryStatus as UorbBatteryStatus
 from ..uorb import BatteryStatusV0
 from . import (
@@ -22,17 +24,30 @@ from . import (
     dronecan,
     dronecan_devicetree,
     dronecan_mavlink,
+    dronecan_mavlink_info,
+    dronecan_mavlink_v2,
     dronecan_uorb,
     dronecan_uorb_v0,
     mavlink,
     mavlink_devicetree,
+    mavlink_info,
+    mavlink_info_devicetree,
+    mavlink_info_mavlink_v2,
+    mavlink_mavlink_info,
+    mavlink_mavlink_v2,
+    mavlink_v2,
+    mavlink_v2_devicetree,
     uorb,
     uorb_devicetree,
     uorb_mavlink,
+    uorb_mavlink_info,
+    uorb_mavlink_v2,
     uorb_uorb_v0,
     uorb_v0,
     uorb_v0_devicetree,
     uorb_v0_mavlink,
+    uorb_v0_mavlink_info,
+    uorb_v0_mavlink_v2,
 )
 from ._concepts import BatteryState
 from ._runtime import ConversionError, LossEntry, LossReport
@@ -51,10 +66,12 @@ __all__ = [
 
 # each endpoint's objects in order: the first required, the rest optional companions
 ENDPOINTS: dict[str, tuple[tuple[str, type[Any]], ...]] = {
-    "dronecan": (("info", BatteryInfo), ("aux", BatteryInfoAux)),
+    "dronecan": (("info", DronecanBatteryInfo), ("aux", BatteryInfoAux)),
     "uorb": (("status", UorbBatteryStatus),),
     "uorb_v0": (("status", BatteryStatusV0),),
     "mavlink": (("msg", MavlinkBatteryStatus),),
+    "mavlink_info": (("info", MavlinkBatteryInfo),),
+    "mavlink_v2": (("status", BatteryStatusV2),),
     "devicetree": (("node", SimpleBattery),),
     "concepts": (("state", BatteryState),),
 }
@@ -68,6 +85,10 @@ CONVERTERS: dict[tuple[str, str], Callable[..., Any]] = {
     ("concepts", "uorb_v0"): uorb_v0.from_concepts,
     ("mavlink", "concepts"): mavlink.to_concepts,
     ("concepts", "mavlink"): mavlink.from_concepts,
+    ("mavlink_info", "concepts"): mavlink_info.to_concepts,
+    ("concepts", "mavlink_info"): mavlink_info.from_concepts,
+    ("mavlink_v2", "concepts"): mavlink_v2.to_concepts,
+    ("concepts", "mavlink_v2"): mavlink_v2.from_concepts,
     ("devicetree", "concepts"): devicetree.to_concepts,
     ("dronecan", "uorb"): dronecan_uorb.dronecan_to_uorb,
     ("uorb", "dronecan"): dronecan_uorb.uorb_to_dronecan,
@@ -75,16 +96,36 @@ CONVERTERS: dict[tuple[str, str], Callable[..., Any]] = {
     ("uorb_v0", "dronecan"): dronecan_uorb_v0.uorb_v0_to_dronecan,
     ("dronecan", "mavlink"): dronecan_mavlink.dronecan_to_mavlink,
     ("mavlink", "dronecan"): dronecan_mavlink.mavlink_to_dronecan,
+    ("dronecan", "mavlink_info"): dronecan_mavlink_info.dronecan_to_mavlink_info,
+    ("mavlink_info", "dronecan"): dronecan_mavlink_info.mavlink_info_to_dronecan,
+    ("dronecan", "mavlink_v2"): dronecan_mavlink_v2.dronecan_to_mavlink_v2,
+    ("mavlink_v2", "dronecan"): dronecan_mavlink_v2.mavlink_v2_to_dronecan,
     ("devicetree", "dronecan"): dronecan_devicetree.devicetree_to_dronecan,
     ("uorb", "uorb_v0"): uorb_uorb_v0.uorb_to_uorb_v0,
     ("uorb_v0", "uorb"): uorb_uorb_v0.uorb_v0_to_uorb,
     ("uorb", "mavlink"): uorb_mavlink.uorb_to_mavlink,
     ("mavlink", "uorb"): uorb_mavlink.mavlink_to_uorb,
+    ("uorb", "mavlink_info"): uorb_mavlink_info.uorb_to_mavlink_info,
+    ("mavlink_info", "uorb"): uorb_mavlink_info.mavlink_info_to_uorb,
+    ("uorb", "mavlink_v2"): uorb_mavlink_v2.uorb_to_mavlink_v2,
+    ("mavlink_v2", "uorb"): uorb_mavlink_v2.mavlink_v2_to_uorb,
     ("devicetree", "uorb"): uorb_devicetree.devicetree_to_uorb,
     ("uorb_v0", "mavlink"): uorb_v0_mavlink.uorb_v0_to_mavlink,
     ("mavlink", "uorb_v0"): uorb_v0_mavlink.mavlink_to_uorb_v0,
+    ("uorb_v0", "mavlink_info"): uorb_v0_mavlink_info.uorb_v0_to_mavlink_info,
+    ("mavlink_info", "uorb_v0"): uorb_v0_mavlink_info.mavlink_info_to_uorb_v0,
+    ("uorb_v0", "mavlink_v2"): uorb_v0_mavlink_v2.uorb_v0_to_mavlink_v2,
+    ("mavlink_v2", "uorb_v0"): uorb_v0_mavlink_v2.mavlink_v2_to_uorb_v0,
     ("devicetree", "uorb_v0"): uorb_v0_devicetree.devicetree_to_uorb_v0,
+    ("mavlink", "mavlink_info"): mavlink_mavlink_info.mavlink_to_mavlink_info,
+    ("mavlink_info", "mavlink"): mavlink_mavlink_info.mavlink_info_to_mavlink,
+    ("mavlink", "mavlink_v2"): mavlink_mavlink_v2.mavlink_to_mavlink_v2,
+    ("mavlink_v2", "mavlink"): mavlink_mavlink_v2.mavlink_v2_to_mavlink,
     ("devicetree", "mavlink"): mavlink_devicetree.devicetree_to_mavlink,
+    ("mavlink_info", "mavlink_v2"): mavlink_info_mavlink_v2.mavlink_info_to_mavlink_v2,
+    ("mavlink_v2", "mavlink_info"): mavlink_info_mavlink_v2.mavlink_v2_to_mavlink_info,
+    ("devicetree", "mavlink_info"): mavlink_info_devicetree.devicetree_to_mavlink_info,
+    ("devicetree", "mavlink_v2"): mavlink_v2_devicetree.devicetree_to_mavlink_v2,
 }
 
 # the policies each converter supports, and the extra keyword inputs it accepts
@@ -97,6 +138,10 @@ POLICIES: dict[tuple[str, str], tuple[str, ...]] = {
     ("concepts", "uorb_v0"): ("strict",),
     ("mavlink", "concepts"): ("strict",),
     ("concepts", "mavlink"): ("strict",),
+    ("mavlink_info", "concepts"): ("strict",),
+    ("concepts", "mavlink_info"): ("strict",),
+    ("mavlink_v2", "concepts"): ("strict",),
+    ("concepts", "mavlink_v2"): ("strict",),
     ("devicetree", "concepts"): ("strict",),
     ("dronecan", "uorb"): ("strict", "px4"),
     ("uorb", "dronecan"): ("strict", "px4"),
@@ -104,16 +149,36 @@ POLICIES: dict[tuple[str, str], tuple[str, ...]] = {
     ("uorb_v0", "dronecan"): ("strict", "px4"),
     ("dronecan", "mavlink"): ("strict", "px4"),
     ("mavlink", "dronecan"): ("strict", "px4"),
+    ("dronecan", "mavlink_info"): ("strict",),
+    ("mavlink_info", "dronecan"): ("strict",),
+    ("dronecan", "mavlink_v2"): ("strict",),
+    ("mavlink_v2", "dronecan"): ("strict",),
     ("devicetree", "dronecan"): ("strict",),
     ("uorb", "uorb_v0"): ("strict", "px4"),
     ("uorb_v0", "uorb"): ("strict", "px4"),
     ("uorb", "mavlink"): ("strict", "px4"),
     ("mavlink", "uorb"): ("strict", "px4"),
+    ("uorb", "mavlink_info"): ("strict",),
+    ("mavlink_info", "uorb"): ("strict",),
+    ("uorb", "mavlink_v2"): ("strict",),
+    ("mavlink_v2", "uorb"): ("strict",),
     ("devicetree", "uorb"): ("strict",),
     ("uorb_v0", "mavlink"): ("strict", "px4"),
     ("mavlink", "uorb_v0"): ("strict", "px4"),
+    ("uorb_v0", "mavlink_info"): ("strict",),
+    ("mavlink_info", "uorb_v0"): ("strict",),
+    ("uorb_v0", "mavlink_v2"): ("strict",),
+    ("mavlink_v2", "uorb_v0"): ("strict",),
     ("devicetree", "uorb_v0"): ("strict",),
+    ("mavlink", "mavlink_info"): ("strict",),
+    ("mavlink_info", "mavlink"): ("strict",),
+    ("mavlink", "mavlink_v2"): ("strict",),
+    ("mavlink_v2", "mavlink"): ("strict",),
     ("devicetree", "mavlink"): ("strict",),
+    ("mavlink_info", "mavlink_v2"): ("strict",),
+    ("mavlink_v2", "mavlink_info"): ("strict",),
+    ("devicetree", "mavlink_info"): ("strict",),
+    ("devicetree", "mavlink_v2"): ("strict",),
 }
 INPUTS: dict[tuple[str, str], tuple[str, ...]] = {
     ("devicetree", "concepts"): ("ocv_v", "temperature_c"),
@@ -121,6 +186,8 @@ INPUTS: dict[tuple[str, str], tuple[str, ...]] = {
     ("devicetree", "uorb"): ("ocv_v", "temperature_c"),
     ("devicetree", "uorb_v0"): ("ocv_v", "temperature_c"),
     ("devicetree", "mavlink"): ("ocv_v", "temperature_c"),
+    ("devicetree", "mavlink_info"): ("ocv_v", "temperature_c"),
+    ("devicetree", "mavlink_v2"): ("ocv_v", "temperature_c"),
 }
 
 

@@ -50,6 +50,18 @@ class BatteryState(ConceptState):
         "serial_number": None,
         "model_name": None,
         "is_powering_off": None,
+        "remaining_capacity": "C",
+        "serial_number_text": None,
+        "manufacture_date": None,
+        "weight": "kg",
+        "cell_discharge_min_voltage": "V",
+        "cell_charge_min_voltage": "V",
+        "cell_rest_min_voltage": "V",
+        "cell_charge_max_voltage": "V",
+        "max_charge_current": "A",
+        "max_discharge_current": "A",
+        "max_burst_current": "A",
+        "battery_function": None,
         "chemistry": None,
         "warning": None,
         "faults": None,
@@ -87,11 +99,24 @@ class BatteryState(ConceptState):
         "serial_number": "integer",
         "model_name": "text",
         "is_powering_off": "bool",
+        "remaining_capacity": "number",
+        "serial_number_text": "text",
+        "manufacture_date": "text",
+        "weight": "number",
+        "cell_discharge_min_voltage": "number",
+        "cell_charge_min_voltage": "number",
+        "cell_rest_min_voltage": "number",
+        "cell_charge_max_voltage": "number",
+        "max_charge_current": "number",
+        "max_discharge_current": "number",
+        "max_burst_current": "number",
+        "battery_function": "choice",
         "chemistry": "choice",
         "warning": "choice",
         "faults": "flags",
     }
     CHOICES: ClassVar[dict[str, tuple[str, ...]]] = {
+        "battery_function": ("all", "propulsion", "avionics", "payload"),
         "chemistry": ("lipo", "lion", "life", "nimh", "nicd", "limn"),
         "warning": ("none", "low", "critical", "emergency", "failed", "unhealthy", "charging"),
         "faults": (
@@ -174,6 +199,30 @@ class BatteryState(ConceptState):
     """Vendor, model and chemistry as text."""
     is_powering_off: bool | None = None
     """The pack is about to switch itself off."""
+    remaining_capacity: float | None = None
+    """Charge left until empty. [C]"""
+    serial_number_text: str | None = None
+    """Serial number of the pack as text."""
+    manufacture_date: str | None = None
+    """Manufacture date as the pack gives it (MAVLink: DDMMYYYY)."""
+    weight: float | None = None
+    """Mass of the pack. [kg]"""
+    cell_discharge_min_voltage: float | None = None
+    """Lowest cell voltage allowed while discharging. [V]"""
+    cell_charge_min_voltage: float | None = None
+    """Lowest cell voltage allowed while charging. [V]"""
+    cell_rest_min_voltage: float | None = None
+    """Lowest cell voltage allowed at rest. [V]"""
+    cell_charge_max_voltage: float | None = None
+    """Cell voltage when fully charged. [V]"""
+    max_charge_current: float | None = None
+    """Highest continuous charge current allowed. [A]"""
+    max_discharge_current: float | None = None
+    """Highest continuous discharge current allowed. [A]"""
+    max_burst_current: float | None = None
+    """Highest burst discharge current allowed. [A]"""
+    battery_function: str | None = None
+    """What the battery powers."""
     chemistry: str | None = None
     """Cell chemistry."""
     warning: str | None = None

@@ -29,6 +29,18 @@ _UNREAD_CONCEPTS = (
     "cell_count",
     "voltage_min_design",
     "voltage_max_design",
+    "remaining_capacity",
+    "serial_number_text",
+    "manufacture_date",
+    "weight",
+    "cell_discharge_min_voltage",
+    "cell_charge_min_voltage",
+    "cell_rest_min_voltage",
+    "cell_charge_max_voltage",
+    "max_charge_current",
+    "max_discharge_current",
+    "max_burst_current",
+    "battery_function",
     "chemistry",
 )
 _UNWRITTEN_AUX_FIELDS = ("dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp",)

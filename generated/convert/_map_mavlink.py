@@ -11,6 +11,7 @@ from . import _cells
 from . import _runtime as _r
 from ._concepts import BatteryState
 
+_BATTERY_FUNCTION_BY_BATTERY_FUNCTION = {1: "all", 2: "propulsion", 3: "avionics", 4: "payload"}
 _CHEMISTRY_BY_TYPE = {1: "lipo", 2: "life", 3: "lion", 4: "nimh"}
 _WARNING_BY_CHARGE_STATE = {
     1: "none",
@@ -32,8 +33,9 @@ _FAULTS_BITS = (
     ("incompatible_firmware", 128),
     ("incompatible_cells_configuration", 256),
 )
-_UNREAD_MSG_FIELDS = (("battery_function", "battery_function"), ("mode", "mode"))
+_UNREAD_MSG_FIELDS = (("mode", "mode"),)
 _MSG_DEFAULTS = BatteryStatus()
+_BATTERY_FUNCTION_BY_BATTERY_FUNCTION_BACKWARD = {"all": 1, "propulsion": 2, "avionics": 3, "payload": 4}
 _TYPE_BY_CHEMISTRY = {"lipo": 1, "life": 2, "lion": 3, "nimh": 4}
 _CHARGE_STATE_BY_WARNING = {
     "none": 1,
@@ -79,8 +81,19 @@ _UNREAD_CONCEPTS = (
     "serial_number",
     "model_name",
     "is_powering_off",
+    "remaining_capacity",
+    "serial_number_text",
+    "manufacture_date",
+    "weight",
+    "cell_discharge_min_voltage",
+    "cell_charge_min_voltage",
+    "cell_rest_min_voltage",
+    "cell_charge_max_voltage",
+    "max_charge_current",
+    "max_discharge_current",
+    "max_burst_current",
 )
-_UNWRITTEN_MSG_FIELDS = ("mavlink.BATTERY_STATUS.battery_function", "mavlink.BATTERY_STATUS.mode")
+_UNWRITTEN_MSG_FIELDS = ("mavlink.BATTERY_STATUS.mode",)
 
 
 def forward(
@@ -97,64 +110,70 @@ def forward(
     _v1 = s_msg.id
     t.battery_index = _v1
 
-    # mavlink.yaml:11: choice type -> chemistry
-    _v2 = s_msg.type
-    t.chemistry = None if _v2 is None else _CHEMISTRY_BY_TYPE.get(_v2)
-    if rep_d is not None and _v2 not in _CHEMISTRY_BY_TYPE and _v2 not in (None, 0):
-        rep_d.dropped("mavlink.BATTERY_STATUS.type", f"{_v2!r} has no counterpart")
+    # mavlink.yaml:11: choice battery_function -> battery_function
+    _v2 = s_msg.battery_function
+    t.battery_function = None if _v2 is None else _BATTERY_FUNCTION_BY_BATTERY_FUNCTION.get(_v2)
+    if rep_d is not None and _v2 not in _BATTERY_FUNCTION_BY_BATTERY_FUNCTION and _v2 not in (None, 0):
+        rep_d.dropped("mavlink.BATTERY_STATUS.battery_function", f"{_v2!r} has no counterpart")
 
-    # mavlink.yaml:16: scale temperature -> temperature
-    _v3 = s_msg.temperature
-    if _v3 != 32767:
-        t.temperature = float(_v3) * 0.01 + 273.15
+    # mavlink.yaml:20: choice type -> chemistry
+    _v3 = s_msg.type
+    t.chemistry = None if _v3 is None else _CHEMISTRY_BY_TYPE.get(_v3)
+    if rep_d is not None and _v3 not in _CHEMISTRY_BY_TYPE and _v3 not in (None, 0):
+        rep_d.dropped("mavlink.BATTERY_STATUS.type", f"{_v3!r} has no counterpart")
 
-    # mavlink.yaml:17: mavlink_voltages voltages, voltages_ext -> pack_voltage, cell_voltages
+    # mavlink.yaml:25: scale temperature -> temperature
+    _v4 = s_msg.temperature
+    if _v4 != 32767:
+        t.temperature = float(_v4) * 0.01 + 273.15
+
+    # mavlink.yaml:26: mavlink_voltages voltages, voltages_ext -> pack_voltage, cell_voltages
     # Cells 1-10 (UINT16_MAX = none) then 11-14 (0 = none, a measured 0 sent as 1). Without per-cell data cell 1 holds
     # the pack voltage, spilling UINT16_MAX - 1 mV chunks into the next cells; a lone entry or a spill is read as the
     # pack voltage, cells unknown.
-    _c4, _p4 = _cells.mavlink_cells_in(s_msg.voltages, s_msg.voltages_ext, 65535, 0, 65534)
-    if _p4 is not None:
-        t.pack_voltage = float(_p4) * 0.001
-    if _c4 is not None:
-        t.cell_voltages = tuple(float(_x4) * 0.001 for _x4 in _c4)
+    _c5, _p5 = _cells.mavlink_cells_in(s_msg.voltages, s_msg.voltages_ext, 65535, 0, 65534)
+    if _p5 is not None:
+        t.pack_voltage = float(_p5) * 0.001
+    if _c5 is not None:
+        t.cell_voltages = tuple(float(_x5) * 0.001 for _x5 in _c5)
 
-    # mavlink.yaml:24: scale current_battery -> current
-    _v5 = s_msg.current_battery
-    if _v5 != -1:
-        t.current = float(_v5) * 0.01
-
-    # mavlink.yaml:25: scale current_consumed -> discharged
-    _v6 = s_msg.current_consumed
+    # mavlink.yaml:33: scale current_battery -> current
+    _v6 = s_msg.current_battery
     if _v6 != -1:
-        t.discharged = float(_v6) * 3.6
+        t.current = float(_v6) * 0.01
 
-    # mavlink.yaml:26: scale energy_consumed -> consumed_energy
-    _v7 = s_msg.energy_consumed
+    # mavlink.yaml:34: scale current_consumed -> discharged
+    _v7 = s_msg.current_consumed
     if _v7 != -1:
-        t.consumed_energy = float(_v7) * 100.0
+        t.discharged = float(_v7) * 3.6
 
-    # mavlink.yaml:27: scale battery_remaining -> state_of_charge
-    _v8 = s_msg.battery_remaining
-    if _v8 != -1 and _v8 <= 100:
-        t.state_of_charge = float(_v8) * 0.01
+    # mavlink.yaml:35: scale energy_consumed -> consumed_energy
+    _v8 = s_msg.energy_consumed
+    if _v8 != -1:
+        t.consumed_energy = float(_v8) * 100.0
 
-    # mavlink.yaml:28: scale time_remaining -> time_remaining
+    # mavlink.yaml:36: scale battery_remaining -> state_of_charge
+    _v9 = s_msg.battery_remaining
+    if _v9 != -1 and _v9 <= 100:
+        t.state_of_charge = float(_v9) * 0.01
+
+    # mavlink.yaml:37: scale time_remaining -> time_remaining
     # 0 means not estimated.
-    _v9 = s_msg.time_remaining
-    if _v9 != 0:
-        t.time_remaining = float(_v9)
+    _v10 = s_msg.time_remaining
+    if _v10 != 0:
+        t.time_remaining = float(_v10)
 
-    # mavlink.yaml:29: choice charge_state -> warning
-    _v10 = s_msg.charge_state
-    t.warning = None if _v10 is None else _WARNING_BY_CHARGE_STATE.get(_v10)
-    if rep_d is not None and _v10 not in _WARNING_BY_CHARGE_STATE and _v10 not in (None, 0):
-        rep_d.dropped("mavlink.BATTERY_STATUS.charge_state", f"{_v10!r} has no counterpart")
+    # mavlink.yaml:38: choice charge_state -> warning
+    _v11 = s_msg.charge_state
+    t.warning = None if _v11 is None else _WARNING_BY_CHARGE_STATE.get(_v11)
+    if rep_d is not None and _v11 not in _WARNING_BY_CHARGE_STATE and _v11 not in (None, 0):
+        rep_d.dropped("mavlink.BATTERY_STATUS.charge_state", f"{_v11!r} has no counterpart")
 
-    # mavlink.yaml:41: flags fault_bitmask -> faults
-    _v11 = s_msg.fault_bitmask
-    t.faults = tuple(_n11 for _n11, _m11 in _FAULTS_BITS if _v11 & _m11)
+    # mavlink.yaml:50: flags fault_bitmask -> faults
+    _v12 = s_msg.fault_bitmask
+    t.faults = tuple(_n12 for _n12, _m12 in _FAULTS_BITS if _v12 & _m12)
 
-    # mavlink.yaml:54: const True -> connected
+    # mavlink.yaml:63: const True -> connected
     # Only an attached battery is reported.
     t.connected = True
 
@@ -188,40 +207,52 @@ def backward(
     else:
         t_msg.id = _r.to_int(_v1, 0, 255, rep, "mavlink.BATTERY_STATUS.id")
 
-    # mavlink.yaml:11: choice type -> chemistry
-    _v2 = s.chemistry
-    _w2 = None if _v2 is None else _TYPE_BY_CHEMISTRY.get(_v2)
+    # mavlink.yaml:11: choice battery_function -> battery_function
+    _v2 = s.battery_function
+    _w2 = None if _v2 is None else _BATTERY_FUNCTION_BY_BATTERY_FUNCTION_BACKWARD.get(_v2)
     if _w2 is not None:
-        t_msg.type = _w2
+        t_msg.battery_function = _w2
+    else:
+        t_msg.battery_function = 0
+        if rep_u is not None:
+            rep_u.unknown("mavlink.BATTERY_STATUS.battery_function")
+        if rep_d is not None and _v2 is not None:
+            rep_d.dropped("concepts.battery_function", f"{_v2!r} has no counterpart")
+
+    # mavlink.yaml:20: choice type -> chemistry
+    _v3 = s.chemistry
+    _w3 = None if _v3 is None else _TYPE_BY_CHEMISTRY.get(_v3)
+    if _w3 is not None:
+        t_msg.type = _w3
     else:
         t_msg.type = 0
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.type")
-        if rep_d is not None and _v2 is not None:
-            rep_d.dropped("concepts.chemistry", f"{_v2!r} has no counterpart")
+        if rep_d is not None and _v3 is not None:
+            rep_d.dropped("concepts.chemistry", f"{_v3!r} has no counterpart")
 
-    # mavlink.yaml:16: scale temperature -> temperature
-    _v3 = s.temperature
-    if _v3 is None or _v3 != _v3:
+    # mavlink.yaml:25: scale temperature -> temperature
+    _v4 = s.temperature
+    if _v4 is None or _v4 != _v4:
         t_msg.temperature = 32767
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.temperature")
     else:
         t_msg.temperature = _r.to_int(
-            _v3 * 100.0 + -27314.999999999996, -32768, 32767, rep, "mavlink.BATTERY_STATUS.temperature"
+            _v4 * 100.0 + -27314.999999999996, -32768, 32767, rep, "mavlink.BATTERY_STATUS.temperature"
         )
         if rep is not None and t_msg.temperature in (32767,):
             rep.clamped("mavlink.BATTERY_STATUS.temperature", "a known value written as the unknown marker")
 
-    # mavlink.yaml:17: mavlink_voltages voltages, voltages_ext -> pack_voltage, cell_voltages
+    # mavlink.yaml:26: mavlink_voltages voltages, voltages_ext -> pack_voltage, cell_voltages
     # Cells 1-10 (UINT16_MAX = none) then 11-14 (0 = none, a measured 0 sent as 1). Without per-cell data cell 1 holds
     # the pack voltage, spilling UINT16_MAX - 1 mV chunks into the next cells; a lone entry or a spill is read as the
     # pack voltage, cells unknown.
-    _c4 = s.cell_voltages
-    _p4 = s.pack_voltage
+    _c5 = s.cell_voltages
+    _p5 = s.pack_voltage
     t_msg.voltages, t_msg.voltages_ext = _cells.mavlink_cells_out(
-        None if _c4 is None else [_x4 * 1000.0 for _x4 in _c4],
-        None if _p4 is None else _p4 * 1000.0,
+        None if _c5 is None else [_x5 * 1000.0 for _x5 in _c5],
+        None if _p5 is None else _p5 * 1000.0,
         10,
         4,
         65535,
@@ -231,108 +262,108 @@ def backward(
         "mavlink.BATTERY_STATUS.voltages_ext",
     )
 
-    # mavlink.yaml:24: scale current_battery -> current
-    _v5 = s.current
-    if _v5 is None or _v5 != _v5:
+    # mavlink.yaml:33: scale current_battery -> current
+    _v6 = s.current
+    if _v6 is None or _v6 != _v6:
         t_msg.current_battery = -1
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.current_battery")
     else:
-        t_msg.current_battery = _r.to_int(_v5 * 100.0, -32768, 32767, rep, "mavlink.BATTERY_STATUS.current_battery")
+        t_msg.current_battery = _r.to_int(_v6 * 100.0, -32768, 32767, rep, "mavlink.BATTERY_STATUS.current_battery")
         if rep is not None and t_msg.current_battery in (-1,):
             rep.clamped("mavlink.BATTERY_STATUS.current_battery", "a known value written as the unknown marker")
 
-    # mavlink.yaml:25: scale current_consumed -> discharged
-    _v6 = s.discharged
-    if _v6 is None or _v6 != _v6:
+    # mavlink.yaml:34: scale current_consumed -> discharged
+    _v7 = s.discharged
+    if _v7 is None or _v7 != _v7:
         t_msg.current_consumed = -1
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.current_consumed")
     else:
         t_msg.current_consumed = _r.to_int(
-            _v6 * 0.2777777777777778, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.current_consumed"
+            _v7 * 0.2777777777777778, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.current_consumed"
         )
         if rep is not None and t_msg.current_consumed in (-1,):
             rep.clamped("mavlink.BATTERY_STATUS.current_consumed", "a known value written as the unknown marker")
 
-    # mavlink.yaml:26: scale energy_consumed -> consumed_energy
-    _v7 = s.consumed_energy
-    if _v7 is None or _v7 != _v7:
+    # mavlink.yaml:35: scale energy_consumed -> consumed_energy
+    _v8 = s.consumed_energy
+    if _v8 is None or _v8 != _v8:
         t_msg.energy_consumed = -1
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.energy_consumed")
     else:
         t_msg.energy_consumed = _r.to_int(
-            _v7 * 0.01, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.energy_consumed"
+            _v8 * 0.01, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.energy_consumed"
         )
         if rep is not None and t_msg.energy_consumed in (-1,):
             rep.clamped("mavlink.BATTERY_STATUS.energy_consumed", "a known value written as the unknown marker")
 
-    # mavlink.yaml:27: scale battery_remaining -> state_of_charge
-    _v8 = s.state_of_charge
-    if _v8 is None or _v8 != _v8:
+    # mavlink.yaml:36: scale battery_remaining -> state_of_charge
+    _v9 = s.state_of_charge
+    if _v9 is None or _v9 != _v9:
         t_msg.battery_remaining = -1
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.battery_remaining")
     else:
-        t_msg.battery_remaining = _r.to_int(_v8 * 100.0, -128, 100, rep, "mavlink.BATTERY_STATUS.battery_remaining")
+        t_msg.battery_remaining = _r.to_int(_v9 * 100.0, -128, 100, rep, "mavlink.BATTERY_STATUS.battery_remaining")
         if rep is not None and t_msg.battery_remaining in (-1,):
             rep.clamped("mavlink.BATTERY_STATUS.battery_remaining", "a known value written as the unknown marker")
 
-    # mavlink.yaml:28: scale time_remaining -> time_remaining
+    # mavlink.yaml:37: scale time_remaining -> time_remaining
     # 0 means not estimated.
-    _v9 = s.time_remaining
-    if _v9 is None or _v9 != _v9:
+    _v10 = s.time_remaining
+    if _v10 is None or _v10 != _v10:
         t_msg.time_remaining = 0
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.time_remaining")
     else:
-        t_msg.time_remaining = _r.to_int(_v9, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.time_remaining")
+        t_msg.time_remaining = _r.to_int(_v10, -2147483648, 2147483647, rep, "mavlink.BATTERY_STATUS.time_remaining")
         if rep is not None and t_msg.time_remaining in (0,):
             rep.clamped("mavlink.BATTERY_STATUS.time_remaining", "a known value written as the unknown marker")
 
-    # mavlink.yaml:29: choice charge_state -> warning
-    _v10 = s.warning
-    _w10 = None if _v10 is None else _CHARGE_STATE_BY_WARNING.get(_v10)
-    if _w10 is not None:
-        t_msg.charge_state = _w10
+    # mavlink.yaml:38: choice charge_state -> warning
+    _v11 = s.warning
+    _w11 = None if _v11 is None else _CHARGE_STATE_BY_WARNING.get(_v11)
+    if _w11 is not None:
+        t_msg.charge_state = _w11
     else:
         t_msg.charge_state = 0
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.charge_state")
-        if rep_d is not None and _v10 is not None:
-            rep_d.dropped("concepts.warning", f"{_v10!r} has no counterpart")
+        if rep_d is not None and _v11 is not None:
+            rep_d.dropped("concepts.warning", f"{_v11!r} has no counterpart")
 
-    # mavlink.yaml:41: flags fault_bitmask -> faults
-    _v11 = s.faults
-    if _v11 is None:
+    # mavlink.yaml:50: flags fault_bitmask -> faults
+    _v12 = s.faults
+    if _v12 is None:
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.fault_bitmask")
     else:
-        _b11 = t_msg.fault_bitmask
-        if "deep_discharge" in _v11:
-            _b11 |= 1
-        if "spikes" in _v11:
-            _b11 |= 2
-        if "cell_fail" in _v11:
-            _b11 |= 4
-        if "over_current" in _v11:
-            _b11 |= 8
-        if "over_temperature" in _v11:
-            _b11 |= 16
-        if "under_temperature" in _v11:
-            _b11 |= 32
-        if "incompatible_voltage" in _v11:
-            _b11 |= 64
-        if "incompatible_firmware" in _v11:
-            _b11 |= 128
-        if "incompatible_cells_configuration" in _v11:
-            _b11 |= 256
-        t_msg.fault_bitmask = _b11
+        _b12 = t_msg.fault_bitmask
+        if "deep_discharge" in _v12:
+            _b12 |= 1
+        if "spikes" in _v12:
+            _b12 |= 2
+        if "cell_fail" in _v12:
+            _b12 |= 4
+        if "over_current" in _v12:
+            _b12 |= 8
+        if "over_temperature" in _v12:
+            _b12 |= 16
+        if "under_temperature" in _v12:
+            _b12 |= 32
+        if "incompatible_voltage" in _v12:
+            _b12 |= 64
+        if "incompatible_firmware" in _v12:
+            _b12 |= 128
+        if "incompatible_cells_configuration" in _v12:
+            _b12 |= 256
+        t_msg.fault_bitmask = _b12
         if rep_d is not None:
-            for _n11 in _v11:
-                if _n11 not in _FAULTS_WITH_BITS:
-                    rep_d.dropped("concepts.faults", _n11 + " has no counterpart")
+            for _n12 in _v12:
+                if _n12 not in _FAULTS_WITH_BITS:
+                    rep_d.dropped("concepts.faults", _n12 + " has no counterpart")
 
     # what did not survive the conversion
     if rep_d is not None:

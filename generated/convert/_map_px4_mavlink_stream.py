@@ -63,6 +63,8 @@ def forward(
     t_msg.current_consumed = 0
     t_msg.energy_consumed = 0
     t_msg.battery_remaining = 0
+    t_msg.time_remaining = 0
+    t_msg.voltages_ext = [0] * 4
 
     # px4_mavlink_stream.yaml:13: px4_int id -> id
     # id = battery_status.id - 1 (uint8: 0 becomes 255)
@@ -170,5 +172,9 @@ def forward(
         rep_u.unknown("mavlink.BATTERY_STATUS.energy_consumed")
     if rep_u is not None and _r.is_marker(t_msg.battery_remaining, -1):
         rep_u.unknown("mavlink.BATTERY_STATUS.battery_remaining")
+    if rep_u is not None and _r.is_marker(t_msg.time_remaining, 0):
+        rep_u.unknown("mavlink.BATTERY_STATUS.time_remaining")
+    if rep_u is not None and all(_r.is_marker(_x, 0) for _x in t_msg.voltages_ext):
+        rep_u.unknown("mavlink.BATTERY_STATUS.voltages_ext")
 
     return (t_msg,)

@@ -366,7 +366,7 @@ def test_battery_status_message(battery_schema: Schema) -> None:
     assert battery_schema.sources == ("battery.xml",)
     assert (msg.name, msg.location.file) == ("BATTERY_STATUS", "battery.xml")
     assert msg.location.line == line_of(SCHEMAS / "battery.xml", '<message id="147"')
-    assert msg.doc == "State of one battery."
+    assert msg.doc.startswith("Battery information. Updates GCS with flight controller battery status.")
     info = msg.mavlink
     assert info is not None
     assert (info.msg_id, info.crc_extra, info.dialect, info.base_length, info.max_length) == (
@@ -401,7 +401,8 @@ def test_battery_status_units_and_sentinels(battery_schema: Schema) -> None:
     assert voltages.invalid == Sentinel(65535, "[UINT16_MAX]", per_element=True)
     for name in ("current_battery", "current_consumed", "energy_consumed", "battery_remaining"):
         assert msg.field(name).invalid == Sentinel(-1, "-1"), name
-    assert msg.field("voltages_ext").invalid is None
+    assert msg.field("time_remaining").invalid == Sentinel(0, "0")  # upstream's markers since 2021
+    assert msg.field("voltages_ext").invalid == Sentinel(0, "[0]", per_element=True)
 
 
 def test_battery_status_enums(battery_schema: Schema) -> None:
@@ -414,7 +415,8 @@ def test_battery_status_enums(battery_schema: Schema) -> None:
         "mode": ("mavlink.MAV_BATTERY_MODE",),
         "fault_bitmask": ("mavlink.MAV_BATTERY_FAULT",),
     }
-    assert [e.name for e in battery_schema.enums] == sorted(n for (n,) in refs.values())
+    others = ("mavlink.MAV_BATTERY_STATUS_FLAGS",)  # BATTERY_STATUS_V2's
+    assert [e.name for e in battery_schema.enums] == sorted([n for (n,) in refs.values()] + list(others))
     fault = battery_schema.enum("mavlink.MAV_BATTERY_FAULT")
     assert fault.kind is EnumKind.BITMASK
     assert [e.value for e in fault.entries] == [1 << i for i in range(9)]

@@ -80,7 +80,11 @@ class NumericEmitters(RuleContext):
         label = self.label(fmt)
         target = self.t(fmt)
         self.emit(f"_v = {self.s(con)}", "if _v is None:")
-        if marks:
+        if kind == "text" and f.invalid is not None:  # a text's marker (MAVLink "[0]") is the empty text
+            cap = f.type.capacity if isinstance(f.type, ArrayType) else None
+            empty = '""' if isinstance(f.type, StringType) else f"bytes({py_literal(cap or 0)})"
+            self.emit(f"    {target} = {empty}")
+        elif marks:
             self.emit(f"    {target} = {self.marker_literal(f, marks[0])}")
         self.emit("    if rep_u is not None:")
         self.emit_call("rep_u.unknown", [label], 2)

@@ -8,7 +8,7 @@ through these node types and :func:`~.literals.py_literal`, so a rule cannot inj
 
 from __future__ import annotations
 
-from ....ir import ArrayType, Field, FieldType, Message, Sentinel
+from ....ir import ArrayType, Field, FieldType, Message, Sentinel, StringType
 from ....ir.expr import (
     Binary,
     BoolOp,
@@ -37,7 +37,9 @@ def known_expr(f: Field, value: str, optional: bool) -> str:
     s = f.invalid
     parts = [f"{value} is not None"] if optional else []
     if s is not None:
-        if isinstance(f.type, ArrayType) and s.elements:
+        if isinstance(f.type, StringType):  # a char array marked [0]: the empty text is unknown
+            parts.append(f"{value} != {py_literal(chr(int(s.value)) * (f.type.capacity or 1) if s.value else '')}")
+        elif isinstance(f.type, ArrayType) and s.elements:
             parts.append(_known_by_position(f.type, s, value))
         elif isinstance(f.type, ArrayType):
             test = "e == e" if s.is_nan else f"e != {py_literal(s.value)}"

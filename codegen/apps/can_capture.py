@@ -1,0 +1,155 @@
+"""What a CAN capture (or a live bus) holds: nodes, data types and their rates, transport problems.
+
+The engine behind ``battgen can``: every frame is reassembled (:mod:`codegen.inputs.can.reassembly`), each transfer
+is counted per (node, data type) and, when it is a type the generated package knows, decoded (a decode failure is
+a problem too); transport diagnostics and the BatteryInfoAux order check are collected per code. The report keeps
+counts and the first few problems of each kind, so its memory is flat in the capture's length.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+from ..inputs.can.ordering import AuxOrder
+from ..inputs.can.reassembly import Diagnostic, Frame, Reassembler, Transfer
+from ..inputs.can.records import Registry, decode_transfer, signatures
+from ..inputs.model import GeneratedMessage
+
+KEEP_PER_CODE = 20  # problems listed per code; the rest are counted
+
+
+@dataclass
+class Stream:
+    """The transfers of one (node, kind, data type) seen in a capture."""
+
+    node: int
+    kind: str
+    data_type_id: int
+    name: str  # the DSDL name where the generated package knows the type, else ""
+    count: int = 0
+    first_t: float = 0.0
+    last_t: float = 0.0
+    undecodable: int = 0
+
+    @property
+    def rate(self) -> float:
+        """Transfers per second between the first and last one (0 for a single transfer)."""
+        span = self.last_t - self.first_t
+        return (self.count - 1) / span if self.count > 1 and span > 0 else 0.0
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "node": self.node,
+            "kind": self.kind,
+            "data_type_id": self.data_type_id,
+            "name": self.name,
+            "count": self.count,
+            "rate_hz": round(self.rate, 3),
+            "undecodable": self.undecodable,
+        }
+
+
+@dataclass
+class CaptureReport:
+    """The whole account of one capture."""
+
+    source: str
+    frames: int = 0
+    transfers: int = 0
+    duration: float = 0.0
+    streams: dict[tuple[int, str, int], Stream] = field(default_factory=dict)
+    counts: Counter[str] = field(default_factory=Counter)  # problems per code
+    problems: list[Diagnostic] = field(default_factory=list)  # the first KEEP_PER_CODE of each code
+    severities: dict[str, str] = field(default_factory=dict)  # code -> severity
+
+    @property
+    def errors(self) -> int:
+        """Transport damage found (warnings such as skipped transfer ids and info notes not counted)."""
+        return sum(n for code, n in self.counts.items() if self.severities.get(code) == "error")
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "source": self.source,
+            "frames": self.frames,
+            "transfers": self.transfers,
+            "duration_s": round(self.duration, 6),
+            "streams": [s.to_dict() for _, s in sorted(self.streams.items())],
+            "problem_counts": dict(sorted(self.counts.items())),
+            "problems": [d.to_dict() for d in self.problems],
+        }
+
+
+def scan(
+    frames: Iterable[Frame],
+    source: str,
+    known: Registry,
+    *,
+    on_message: Callable[[Transfer, GeneratedMessage], None] | None = None,
+) -> CaptureReport:
+    """Account for every frame; ``on_message`` is called with each decoded transfer of a known type."""
+    reassembler = Reassembler(signatures(known))
+    order = AuxOrder(known)
+    report = CaptureReport(source)
+    last: Frame | None = None
+
+    def note(diag: Diagnostic) -> None:
+        report.counts[diag.code] += 1
+        report.severities[diag.code] = diag.severity
+        if report.counts[diag.code] <= KEEP_PER_CODE:
+            report.problems.append(diag)
+
+    for frame in frames:
+        last = frame
+        for event in reassembler.feed(frame):
+            if isinstance(event, Diagnostic):
+                note(event)
+                continue
+            for diag in order.see(event):
+                note(diag)
+            _count(report, event, known, note, on_message)
+    if last is not None:
+        for diag in reassembler.finish(last.t, last.index):
+            note(diag)
+        report.duration = last.t
+    report.frames = reassembler.frames
+    report.transfers = reassembler.transfers
+    return report
+
+
+def _count(
+    report: CaptureReport,
+    transfer: Transfer,
+    known: Registry,
+    note: Callable[[Diagnostic], None],
+    on_message: Callable[[Transfer, GeneratedMessage], None] | None,
+) -> None:
+    kind = transfer.id.kind
+    cls = known.get((kind, transfer.id.data_type_id))
+    key = (transfer.node, kind, transfer.id.data_type_id)
+    stream = report.streams.get(key)
+    if stream is None:
+        name = cls.QUALIFIED_NAME.removeprefix("dronecan.") if cls is not None else ""
+        stream = report.streams[key] = Stream(transfer.node, kind, transfer.id.data_type_id, name, 0, transfer.t)
+    stream.count += 1
+    stream.last_t = transfer.t
+    if cls is None:
+        return
+    try:
+        message = decode_transfer(cls, transfer)
+    except ValueError as exc:  # the generated DecodeError
+        stream.undecodable += 1
+        note(
+            Diagnostic(
+                "can-decode",
+                f"node {transfer.node}: {stream.name} transfer {transfer.transfer_id} does not decode: {exc}",
+                transfer.t,
+                transfer.frame,
+                transfer.node,
+                transfer.id.data_type_id,
+            )
+        )
+        return
+    if on_message is not None:
+        on_message(transfer, message)

@@ -1,0 +1,160 @@
+"""CAN frames from where users have them: capture files, ArduPilot DataFlash logs, live buses.
+
+Capture files are read with python-can's log readers: candump ``.log``, Vector ``.asc`` and ``.blf``, PEAK ``.trc``
+(each also gzip-compressed), and python-can's own ``.csv`` when the format is given. ArduPilot DataFlash logs
+(``.bin``) carry the frames of a logged bus as CANF (classic) and CAFD (CAN FD) records, read with pymavlink's
+DataFlash reader. A live bus is any python-can interface, named ``interface:channel`` (``socketcan:can0``,
+``slcan:/dev/ttyACM0``, ``virtual:bus0``). python-can is an optional dependency (``pip install 'battgen[can]'``);
+without it the readers say so.
+
+Every source yields :class:`~.reassembly.Frame`\\ s in capture order, with ``t`` in seconds since the first frame;
+error and remote frames are skipped. A reader's own failure on a damaged file is an :class:`InputError` naming the
+file and the frame it stopped at, never a traceback.
+"""
+
+from __future__ import annotations
+
+import importlib
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+from ..dataflash import open_log
+from ..records import InputError
+from .reassembly import Frame
+
+# python-can's .csv is read only when asked for (--input-format can): a .csv is more often a table of values
+CAPTURE_SUFFIXES = frozenset({".log", ".asc", ".blf", ".trc"})
+DATAFLASH_SUFFIXES = frozenset({".bin"})
+_FD_LENGTHS = (0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64)
+_EXTENDED_FLAG = 1 << 31  # ArduPilot's CANFrame: FlagEFF, FlagRTR, FlagERR in the top bits of the id
+_RTR_FLAG = 1 << 30
+_ERR_FLAG = 1 << 29
+NEEDS_CAN = "reading CAN captures needs python-can: pip install 'battgen[can]'"
+
+
+def capture_suffix(path: Path) -> str:
+    """The capture suffix of a file name, looking through a ``.gz`` (``bus.asc.gz`` -> ``.asc``)."""
+    suffixes = [s.lower() for s in path.suffixes]
+    if suffixes and suffixes[-1] == ".gz":
+        suffixes.pop()
+    return suffixes[-1] if suffixes else ""
+
+
+def is_capture(path: Path) -> bool:
+    return capture_suffix(path) in CAPTURE_SUFFIXES
+
+
+def _python_can(name: str) -> Any:
+    try:
+        return importlib.import_module("can")
+    except ImportError as exc:
+        raise InputError(name, 0, NEEDS_CAN) from exc
+
+
+def _frames_of(messages: Iterator[Any], name: str, what: str) -> Iterator[Frame]:
+    index = 0
+    t0: float | None = None
+    while True:
+        try:
+            message = next(messages)
+        except StopIteration:
+            return
+        except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError) as exc:
+            # a damaged capture: the third-party reader's own complaint, located at the frame it reached
+            raise InputError(name, 0, f"cannot read {what} after frame {index}: {exc}") from exc
+        if message.is_error_frame or message.is_remote_frame:
+            continue
+        stamp = float(message.timestamp or 0.0)
+        if t0 is None:
+            t0 = stamp
+        yield Frame(
+            index,
+            stamp - t0,
+            int(message.arbitration_id),
+            bytes(message.data),
+            bool(message.is_extended_id),
+            bool(message.is_fd),
+            str(message.channel or ""),
+        )
+        index += 1
+
+
+def read_capture(path: Path, name: str) -> Iterator[Frame]:
+    """The frames of a capture file read with python-can's log reader for its suffix."""
+    can = _python_can(name)
+    try:
+        reader = can.LogReader(str(path))
+    except (ValueError, OSError) as exc:
+        raise InputError(name, 0, f"cannot open the CAN capture: {exc}") from exc
+    try:
+        yield from _frames_of(iter(reader), name, "the CAN capture")
+    finally:
+        stop = getattr(reader, "stop", None)
+        if callable(stop):
+            stop()
+
+
+def read_dataflash_frames(path: Path, name: str) -> Iterator[Frame]:
+    """The CAN frames an ArduPilot DataFlash log recorded: its CANF (classic) and CAFD (CAN FD) records, laid out
+    as ``libraries/AP_CANManager/LogStructure.h`` declares them (``Id`` with AP_HAL's flag bits on top; CAFD's
+    ``DLC`` a data length code and its data in eight 64-bit words)."""
+    index = 0
+    t0: int | None = None
+    for record in open_log(path, name).messages(("CANF", "CAFD")):
+        values = record.fields
+        try:
+            raw_id = int(values["Id"])
+            if raw_id & (_RTR_FLAG | _ERR_FLAG):
+                continue
+            if record.type == "CAFD":
+                words = b"".join((int(values[f"D{i}"]) & (2**64 - 1)).to_bytes(8, "little") for i in range(8))
+                data = words[: _FD_LENGTHS[int(values["DLC"]) & 0xF]]
+            else:
+                data = bytes(int(values[f"B{i}"]) & 0xFF for i in range(8))[: max(0, min(int(values["DLC"]), 8))]
+            bus = int(values.get("Bus", 0))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(name, 0, f"{record.type} record {record.index}: expected CAN frame fields: {exc}") from exc
+        stamp = record.time_us or 0
+        if t0 is None:
+            t0 = stamp
+        yield Frame(
+            index,
+            (stamp - t0) / 1e6,
+            raw_id & 0x1FFFFFFF,
+            data,
+            bool(raw_id & _EXTENDED_FLAG),
+            record.type == "CAFD",
+            f"bus{bus}",
+        )
+        index += 1
+
+
+def read_bus(
+    spec: str, *, duration: float | None = None, clock: Callable[[], float] = time.monotonic
+) -> Iterator[Frame]:
+    """Frames from a live python-can bus named ``interface:channel`` until ``duration`` seconds have passed
+    (forever when None; the caller stops on Ctrl-C). The bus is shut down however the iteration ends."""
+    interface, sep, channel = spec.partition(":")
+    if not sep or not interface or not channel:
+        raise InputError(spec, 0, "expected a bus as interface:channel, e.g. socketcan:can0 or slcan:/dev/ttyACM0")
+    can = _python_can(spec)
+    try:
+        options = {"fd": True} if interface == "socketcan" else {}  # CAN FD frames too, where the driver can
+        bus = can.Bus(interface=interface, channel=channel, **options)
+    except Exception as exc:  # python-can raises many kinds (CanInterfaceNotImplementedError, OSError, ...)
+        raise InputError(spec, 0, f"cannot open the CAN bus: {exc}") from exc
+    try:
+        yield from _frames_of(_receive(bus, duration, clock), spec, "the CAN bus")
+    finally:
+        bus.shutdown()
+
+
+def _receive(bus: Any, duration: float | None, clock: Callable[[], float]) -> Iterator[Any]:
+    """Messages from ``bus`` until ``duration`` seconds have passed; polls in 0.1 s steps so the end is timely."""
+    start = clock()
+    while duration is None or clock() - start < duration:
+        message = bus.recv(timeout=0.1)
+        if message is not None:
+            yield message

@@ -1,0 +1,317 @@
+"""Reassembling DroneCAN transfers from a stream of CAN frames, with transport diagnostics.
+
+A :class:`Reassembler` is fed frames in capture order and hands out completed :class:`Transfer`\\ s and
+:class:`Diagnostic`\\ s: the transport errors a bus debugger looks for (a wrong toggle bit, a transfer CRC that
+does not match the data type's signature, a continuation frame without its start, a transfer that never ends or
+is restarted, skipped transfer ids). It keeps one transfer in progress per identifier (less the priority bits),
+bounded in number and length, so its memory stays flat however long the capture.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+from . import wire
+
+TIMEOUT = 2.0  # seconds a transfer may take between frames (libcanard's and pydronecan's receive timeout)
+MAX_PAYLOAD = 4096  # bytes: far above any DroneCAN v0 data type; a longer transfer is damage
+MAX_PENDING = 1024  # transfers in progress at once; the oldest is dropped past this
+
+
+@dataclass(frozen=True, slots=True)
+class Frame:
+    """One CAN frame of a capture: where it is (0-based ``index``, ``t`` in seconds), its identifier and data."""
+
+    index: int
+    t: float
+    can_id: int
+    data: bytes
+    extended: bool = True
+    fd: bool = False
+    channel: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class Transfer:
+    """A completed transfer: its identifier, transfer id, payload (the CRC removed) and where it was."""
+
+    t: float  # time of its first frame
+    frame: int  # index of its first frame
+    last_frame: int
+    id: wire.CanId
+    transfer_id: int
+    payload: bytes
+    frames: int
+    fd: bool = False
+    crc_checked: bool = True  # False: a multi-frame transfer of a data type whose signature is unknown
+
+    @property
+    def node(self) -> int:
+        return self.id.source
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    """A transport problem (or, with severity ``info``, a fact) found at one frame of a capture."""
+
+    code: str  # a stable name: can-toggle, can-crc, can-missing-start, ...
+    message: str
+    t: float
+    frame: int
+    node: int | None = None
+    data_type_id: int | None = None
+    severity: str = "error"
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "code": self.code,
+            "severity": self.severity,
+            "t": self.t,
+            "frame": self.frame,
+            "node": self.node,
+            "data_type_id": self.data_type_id,
+            "message": self.message,
+        }
+
+
+@dataclass(slots=True)
+class _Pending:
+    first: Frame
+    id: wire.CanId
+    transfer_id: int
+    last_t: float
+    toggle: int = 0
+    count: int = 0
+    fd: bool = False
+    chunks: list[bytes] = field(default_factory=list)
+    size: int = 0
+
+
+Event = Transfer | Diagnostic
+_NOTHING: tuple[Event, ...] = ()
+_KEY_MASK = wire.ID_MASK >> 5  # the identifier less its 5 priority bits: one transfer in progress per key
+Signatures = Mapping[tuple[str, int], int]  # ("message" | "service", data type id) -> signature
+
+
+def _where(id_: wire.CanId) -> str:
+    kind = "service" if id_.service else "message"
+    node = f"node {id_.source}" if id_.source else "an anonymous node"
+    return f"{kind} type {id_.data_type_id} from {node}"
+
+
+class Reassembler:
+    """Frames in, transfers and diagnostics out. ``signatures`` gives the data type signature of each known
+    (``"message"``/``"service"``, id) for the transfer CRC; a multi-frame transfer of another type is handed
+    out with ``crc_checked=False`` and one ``can-unknown-type`` notice per type."""
+
+    def __init__(self, signatures: Signatures, *, timeout: float = TIMEOUT) -> None:
+        self._signatures = signatures
+        self._seeds: dict[int, int] = {}  # signature -> its CRC seed, computed once
+        self._timeout = timeout
+        self._pending: dict[int, _Pending] = {}
+        self._last_tid: dict[tuple[int, bool, int], int] = {}
+        self._unknown: set[tuple[bool, int]] = set()
+        self._standard = 0
+        self.frames = 0
+        self.transfers = 0
+
+    def feed(self, frame: Frame) -> Sequence[Event]:
+        """The transfers completed and the problems found by one more frame (usually none: an empty tuple)."""
+        self.frames += 1
+        out: list[Event] = []
+        if not self.frames & 63 and self._pending:  # now and then, transfers whose sender went quiet
+            out.extend(self._expire(frame.t, frame.index))
+        data = frame.data
+        if not frame.extended or not data:
+            out.extend(self._not_dronecan(frame))
+            return out
+        tail = data[-1]
+        key = frame.can_id & _KEY_MASK
+        pending = self._pending.get(key)
+        if pending is not None and frame.t - pending.last_t > self._timeout:
+            out.append(self._lost(pending, "timed out", frame))
+            del self._pending[key]
+            pending = None
+        if tail & wire.TAIL_START:
+            if pending is not None:
+                out.append(self._lost(pending, "restarted by a new start frame", frame))
+                del self._pending[key]
+            pending = self._start(key, frame, tail, out)
+            if pending is None:
+                return out
+        elif pending is None or (tail & wire.TRANSFER_ID_MASK) != pending.transfer_id:
+            out.append(self._stray(frame, tail, pending))
+            if pending is not None:
+                del self._pending[key]
+            return out
+        elif tail & wire.TAIL_TOGGLE != pending.toggle:
+            out.append(self._bad_toggle(frame, tail, pending))
+            del self._pending[key]
+            return out
+        else:
+            pending.chunks.append(data[:-1])
+            pending.size += len(data) - 1
+            pending.count += 1
+            pending.toggle ^= wire.TAIL_TOGGLE
+            pending.last_t = frame.t
+            pending.fd = pending.fd or frame.fd
+            if pending.size > MAX_PAYLOAD:
+                out.append(self._too_long(frame, pending))
+                del self._pending[key]
+                return out
+        if tail & wire.TAIL_END:
+            self._pending.pop(key, None)
+            out.extend(self._complete(pending, frame))
+        return out if out else _NOTHING
+
+    def _start(self, key: int, frame: Frame, tail: int, out: list[Event]) -> _Pending | None:
+        """A transfer's first frame: its state (kept in progress unless it also ends here), or None if refused."""
+        id_ = wire.parse_id(frame.can_id)
+        tid = tail & wire.TRANSFER_ID_MASK
+        if tail & wire.TAIL_TOGGLE:
+            text = f"{_where(id_)}: toggle bit set on the start frame of transfer {tid} (expected clear); dropped"
+            out.append(Diagnostic("can-toggle", text, frame.t, frame.index, id_.source, id_.data_type_id))
+            return None
+        pending = _Pending(
+            frame, id_, tid, frame.t, wire.TAIL_TOGGLE, 1, frame.fd, [frame.data[:-1]], len(frame.data) - 1
+        )
+        if not tail & wire.TAIL_END:
+            if len(self._pending) >= MAX_PENDING:
+                oldest = min(self._pending, key=lambda k: self._pending[k].last_t)
+                out.append(self._lost(self._pending.pop(oldest), "dropped: too many transfers in progress", frame))
+            self._pending[key] = pending
+        return pending
+
+    def _not_dronecan(self, frame: Frame) -> list[Diagnostic]:
+        if frame.data:
+            self._standard += 1
+            if self._standard > 1:
+                return []
+            text = "an 11-bit frame: not DroneCAN, skipped (counted once)"
+            return [Diagnostic("can-standard-id", text, frame.t, frame.index, severity="info")]
+        return [Diagnostic("can-empty-frame", "a frame without data: no tail byte", frame.t, frame.index)]
+
+    def _stray(self, frame: Frame, tail: int, pending: _Pending | None) -> Diagnostic:
+        id_ = wire.parse_id(frame.can_id)
+        tid = tail & wire.TRANSFER_ID_MASK
+        if pending is None:
+            text = f"{_where(id_)}: a frame of transfer {tid} without its start frame"
+            return Diagnostic("can-missing-start", text, frame.t, frame.index, id_.source, id_.data_type_id)
+        text = f"{_where(id_)}: transfer id {tid} inside transfer {pending.transfer_id}; both dropped"
+        return Diagnostic("can-transfer-id", text, frame.t, frame.index, id_.source, id_.data_type_id)
+
+    def _bad_toggle(self, frame: Frame, tail: int, pending: _Pending) -> Diagnostic:
+        id_ = pending.id
+        text = (
+            f"{_where(id_)}: toggle bit {(tail & wire.TAIL_TOGGLE) >> 5} on frame {pending.count + 1} of transfer "
+            f"{pending.transfer_id} (expected {pending.toggle >> 5}); transfer dropped"
+        )
+        return Diagnostic("can-toggle", text, frame.t, frame.index, id_.source, id_.data_type_id)
+
+    def _too_long(self, frame: Frame, pending: _Pending) -> Diagnostic:
+        id_ = pending.id
+        text = f"{_where(id_)}: transfer {pending.transfer_id} longer than {MAX_PAYLOAD} bytes; dropped"
+        return Diagnostic("can-too-long", text, frame.t, frame.index, id_.source, id_.data_type_id)
+
+    def finish(self, t: float, index: int) -> list[Diagnostic]:
+        """The transfers still in progress at the end of the capture, as ``can-missing-end`` problems."""
+        lost = [self._lost(p, "not finished when the capture ended", None, t, index) for p in self._pending.values()]
+        self._pending.clear()
+        return lost
+
+    def _expire(self, t: float, index: int) -> list[Diagnostic]:
+        stale = [k for k, p in self._pending.items() if t - p.last_t > self._timeout]
+        return [self._lost(self._pending.pop(k), "timed out", None, t, index) for k in stale]
+
+    def _lost(self, p: _Pending, why: str, frame: Frame | None, t: float = 0.0, index: int = 0) -> Diagnostic:
+        at_t, at = (frame.t, frame.index) if frame is not None else (t, index)
+        return Diagnostic(
+            "can-missing-end",
+            f"{_where(p.id)}: transfer {p.transfer_id} (started at frame {p.first.index}, {p.count} frame(s)) {why}",
+            at_t,
+            at,
+            p.id.source,
+            p.id.data_type_id,
+        )
+
+    def _complete(self, p: _Pending, last: Frame) -> list[Event]:
+        out: list[Event] = []
+        body = p.chunks[0] if p.count == 1 else b"".join(p.chunks)
+        checked = True
+        if p.count > 1:
+            kind = "service" if p.id.service else "message"
+            signature = self._signatures.get((kind, p.id.data_type_id))
+            if len(body) < 2:
+                out.append(
+                    Diagnostic(
+                        "can-crc",
+                        f"{_where(p.id)}: transfer {p.transfer_id} too short for its CRC",
+                        p.first.t,
+                        p.first.index,
+                        p.id.source,
+                        p.id.data_type_id,
+                    )
+                )
+                return out
+            carried, body = body[0] | (body[1] << 8), body[2:]
+            if signature is None:
+                checked = False
+                if (p.id.service, p.id.data_type_id) not in self._unknown:
+                    self._unknown.add((p.id.service, p.id.data_type_id))
+                    out.append(
+                        Diagnostic(
+                            "can-unknown-type",
+                            f"{_where(p.id)}: data type not known, so its transfer "
+                            "CRC is not checked (reported once per type)",
+                            p.first.t,
+                            p.first.index,
+                            p.id.source,
+                            p.id.data_type_id,
+                            severity="info",
+                        )
+                    )
+            else:
+                seed = self._seeds.get(signature)
+                if seed is None:
+                    seed = self._seeds[signature] = wire.signature_crc(signature)
+                computed = wire.crc16(body, seed)
+                if computed != carried:
+                    out.append(
+                        Diagnostic(
+                            "can-crc",
+                            f"{_where(p.id)}: transfer {p.transfer_id} CRC 0x{carried:04X}, "
+                            f"expected 0x{computed:04X} for signature 0x{signature:016X}; dropped",
+                            p.first.t,
+                            p.first.index,
+                            p.id.source,
+                            p.id.data_type_id,
+                        )
+                    )
+                    return out
+        if not p.id.service and not p.id.anonymous:
+            out.extend(self._gap(p))
+        self.transfers += 1
+        out.append(Transfer(p.first.t, p.first.index, last.index, p.id, p.transfer_id, body, p.count, p.fd, checked))
+        return out
+
+    def _gap(self, p: _Pending) -> list[Diagnostic]:
+        key = (p.id.source, p.id.service, p.id.data_type_id)
+        last = self._last_tid.get(key)
+        self._last_tid[key] = p.transfer_id
+        if last is None:
+            return []
+        missed = (p.transfer_id - last - 1) % wire.TRANSFER_IDS
+        if missed == 0 or missed == wire.TRANSFER_IDS - 1:  # the next one, or a repeat (redundant interfaces)
+            return []
+        return [
+            Diagnostic(
+                "can-tid-gap",
+                f"{_where(p.id)}: transfer id {p.transfer_id} after {last}: {missed} transfer(s) missing",
+                p.first.t,
+                p.first.index,
+                p.id.source,
+                p.id.data_type_id,
+                severity="warning",
+            )
+        ]
