@@ -84,7 +84,6 @@ def _too_long(length: int) -> str:
     return f"a line of {length} characters, longer than the {MAX_LINE} a JSON Lines record may have (skipped)"
 
 
-
 def read_jsonl(source: Source, name: str, *, comments: bool = False) -> Iterator[Item]:
     """One record per non-blank line (with ``comments``, lines starting with ``#`` are skipped
     too); a malformed line is an Unreadable item and reading goes on."""
