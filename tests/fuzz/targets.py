@@ -211,6 +211,7 @@ def _commands(name: str, path: str) -> list[list[str]]:
         ["validate", "--message", "uorb.BatteryStatus", p],
         ["validate", "--format", "json", "--message", "devicetree.power.supply.battery", p],
         ["convert", "--from", "uorb", "--to", "dronecan", "--report", p],
+        ["failsafe", "--params", str(SEEDS / "vehicle.param"), p],
     ]
 
 

@@ -1,6 +1,6 @@
 """Fuzzing the commands a user runs on data files: ``battgen validate`` (text and JSON reports),
-``convert`` and ``params`` on mutated and random files of every kind, in-process through ``main(argv)``
-with the output captured.
+``convert``, ``params`` and ``failsafe`` (on the text kinds) on mutated and random files of every kind,
+in-process through ``main(argv)`` with the output captured.
 
 Every run ends with exit status 0, 1 or 2 (2 with a message), no traceback, no defect hidden by a
 catch-all and no message line longer than a screen (tests/fuzz/targets.py ``command``).
