@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import json
 import math
 import os
+import struct
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -27,7 +29,17 @@ from hypothesis import strategies as st
 from codegen.backends.python import naming
 from codegen.backends.python.writer import generate
 from codegen.frontends import dsdl
-from codegen.ir import ArrayType, CompositeType, DronecanKind, FieldType, Message, PrimitiveKind, PrimitiveType, Schema
+from codegen.ir import (
+    ArrayType,
+    CastMode,
+    CompositeType,
+    DronecanKind,
+    FieldType,
+    Message,
+    PrimitiveKind,
+    PrimitiveType,
+    Schema,
+)
 
 dronecan = pytest.importorskip("dronecan")
 from dronecan import dsdl as pydsdl  # noqa: E402
@@ -78,6 +90,7 @@ class Side:
         self.reference = {t.full_name: t for t in pydsdl.parse_namespaces(dirs)}
         self.by_name = {m.qualified_name: m for m in self.schema.messages}
         self.draw = Draw(self)
+        self.exact = Draw(self, canonical=True)  # values the types hold exactly: decode(encode(x)) == x
 
     def cls(self, msg: Message) -> Any:
         module = importlib.import_module(f"{self.package}.{naming.module_path(msg)}")
@@ -99,6 +112,7 @@ def sides(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Side]]
     sys.path.insert(0, str(out))
     try:
         yield {"bundled": Side(BUNDLED, out, "dc_bundled"), "specs": Side(SPECS, out, "dc_specs")}
+        print(f"\nDroneCAN checks: {COUNTS}")
     finally:
         sys.path.remove(str(out))
         for name in [n for n in sys.modules if n.split(".")[0] in ("dc_bundled", "dc_specs")]:
@@ -113,17 +127,26 @@ def _names(root: Path) -> list[str]:
 # Plain values: drawn from the IR type, poured into both objects, read back from both
 
 
-def _prim_strategy(t: PrimitiveType, in_bytes: bool) -> st.SearchStrategy[Any]:
+def _prim_strategy(t: PrimitiveType, in_bytes: bool, canonical: bool = False) -> st.SearchStrategy[Any]:
+    """Values for a primitive; ``canonical`` ones are those the type holds exactly (decode gives them back)."""
     if t.kind is PrimitiveKind.BOOL:
         return st.booleans()
     if t.kind is PrimitiveKind.UINT:
         top = (1 << t.bits) - 1
-        if in_bytes:
+        if in_bytes or canonical:
             return st.integers(0, top)
         return st.one_of(st.integers(0, top), st.sampled_from([0, top]), st.integers(-(1 << t.bits), 1 << (t.bits + 1)))
     if t.kind is PrimitiveKind.INT:
         lo, hi = -(1 << (t.bits - 1)), (1 << (t.bits - 1)) - 1
+        if canonical:
+            return st.one_of(st.integers(lo, hi), st.sampled_from([lo, hi, -1]))
         return st.one_of(st.integers(lo, hi), st.sampled_from([lo, hi, -1]), st.integers(2 * lo, 2 * hi + 2))
+    if canonical:  # saturated floats clamp infinity to the largest finite value, so they hold no infinity
+        finite = t.cast is CastMode.SATURATED
+        if t.bits == 16:
+            halves = st.integers(0, 0xFFFF).map(lambda b: struct.unpack("<e", struct.pack("<H", b))[0])
+            return halves.filter(lambda x: not (finite and math.isinf(x)))
+        return st.floats(width=t.bits, allow_infinity=not finite)  # type: ignore[arg-type]
     if t.bits == 16:
         return st.one_of(st.sampled_from(F16_EDGES), st.floats(width=32), st.floats(-70000.0, 70000.0))
     if t.bits == 32:
@@ -132,8 +155,9 @@ def _prim_strategy(t: PrimitiveType, in_bytes: bool) -> st.SearchStrategy[Any]:
 
 
 class Draw:
-    def __init__(self, side: Side) -> None:
+    def __init__(self, side: Side, canonical: bool = False) -> None:
         self.side = side
+        self.canonical = canonical
         self.cache: dict[str, st.SearchStrategy[Any]] = {}
 
     def message(self, msg: Message) -> st.SearchStrategy[Any]:
@@ -155,13 +179,16 @@ class Draw:
 
     def field(self, t: FieldType) -> st.SearchStrategy[Any]:
         if isinstance(t, PrimitiveType):
-            return _prim_strategy(t, False)
+            return _prim_strategy(t, False, self.canonical)
         if isinstance(t, CompositeType):
             return st.deferred(lambda: self.message(self.side.by_name[t.name]))
         assert isinstance(t, ArrayType) and t.capacity is not None
         cap = t.capacity
         u8 = isinstance(t.element, PrimitiveType) and t.element.kind is PrimitiveKind.UINT and t.element.bits == 8
-        elem = _prim_strategy(t.element, True) if isinstance(t.element, PrimitiveType) else self.field(t.element)
+        if isinstance(t.element, PrimitiveType):
+            elem = _prim_strategy(t.element, True, self.canonical)
+        else:
+            elem = self.field(t.element)
         if not t.dynamic:
             return st.lists(elem, min_size=cap, max_size=cap)
         if u8:
@@ -204,15 +231,18 @@ def _attrs(cls: Any) -> dict[str, str]:
 
 
 def build_ours(side: Side, msg: Message, plain: dict[str, Any]) -> Any:
+    """Our object for plain values; a union is constructed by its one branch, as a user would."""
     cls = side.cls(msg)
     attrs = _attrs(cls)
+    if "_branch" in plain:
+        branch = plain["_branch"]
+        obj = cls(**{attrs[branch]: _ours_value(side, msg.field(branch).type, plain[branch])})
+        assert obj.union_field == branch
+        return obj
     obj = cls()
-    names = [plain["_branch"]] if "_branch" in plain else [f.name for f in msg.fields if not f.is_padding]
-    for name in names:
+    for name in [f.name for f in msg.fields if not f.is_padding]:
         f = msg.field(name)
         setattr(obj, attrs[name], _ours_value(side, f.type, plain[name]))
-    if "_branch" in plain:
-        obj.union_field = attrs[plain["_branch"]]
     return obj
 
 
@@ -255,7 +285,7 @@ def plain_ours(side: Side, obj: Any, msg: Message) -> Any:
     attrs = _attrs(type(obj))
     names = [f.name for f in msg.fields if not f.is_padding]
     if msg.dronecan.union:
-        names = [n for n in names if attrs[n] == obj.union_field]
+        names = [n for n in names if n == obj.union_field]
     out = {}
     for name in names:
         out[name] = _plain_ours_value(side, msg.field(name).type, getattr(obj, attrs[name]))
@@ -280,10 +310,17 @@ def _norm(value: Any) -> Any:
     return value
 
 
-def check_roundtrip(side: Side, msg: Message, plain: dict[str, Any]) -> None:
+def check_roundtrip(side: Side, msg: Message, plain: dict[str, Any], exact: bool = False) -> None:
+    """Our bytes equal pydronecan's for the same values, both decoders agree, and plain data round-trips;
+    for ``exact`` values (those the type holds exactly) also ``decode(encode(x)) == x``."""
     ref = side.ref_new(msg)
     fill_ref(side, ref, msg, plain)
     ours = build_ours(side, msg, plain)
+    cls = side.cls(msg)
+    data = ours.to_dict()
+    assert cls.from_dict(data) == ours, msg.qualified_name
+    assert cls.from_dict(json.loads(json.dumps(data))) == ours, msg.qualified_name
+    COUNTS["to_dict"] += 1
     for tao in (True, False):
         expected = bytes(transport.bytes_from_bits(ref._pack(tao)))
         got = ours.encode(tao=tao)
@@ -293,10 +330,27 @@ def check_roundtrip(side: Side, msg: Message, plain: dict[str, Any]) -> None:
         back._unpack(transport.bits_from_bytes(got), tao)
         assert plain_ours(side, decoded, msg) == plain_ref(side, back, msg), f"{msg.qualified_name} tao={tao}"
         assert decoded.encode(tao=tao) == expected
+        COUNTS["encode"] += 1
+        if exact:
+            assert decoded == ours, f"{msg.qualified_name} tao={tao}: decode(encode(x)) != x for {plain!r}"
+            COUNTS["decode"] += 1
+
+
+# the fuzzing budget's switch (tests/fuzz/budget.py): BATTGEN_FUZZ=long tries far more values per type
+LONG = os.environ.get("BATTGEN_FUZZ", "") == "long"
+
+
+def _examples(ci: int) -> int:
+    override = os.environ.get("BATTGEN_FUZZ_EXAMPLES")
+    return int(override) if override else ci * 40 if LONG else ci
+
+
+# checks made in this session, printed when the module's packages are torn down (pytest -s)
+COUNTS = {"to_dict": 0, "encode": 0, "decode": 0}
 
 
 SWEEP = settings(
-    max_examples=12,
+    max_examples=_examples(10),
     deadline=None,
     derandomize=True,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much],
@@ -312,8 +366,17 @@ def test_specs_type_matches_pydronecan(sides: dict[str, Side], name: str, data: 
     check_roundtrip(side, msg, data.draw(side.draw.message(msg)))
 
 
+@pytest.mark.parametrize("name", _names(SPECS))
+@settings(SWEEP, max_examples=_examples(6))
+@given(data=st.data())
+def test_specs_type_round_trips_exactly(sides: dict[str, Side], name: str, data: st.DataObject) -> None:
+    side = sides["specs"]
+    msg = side.by_name[name]
+    check_roundtrip(side, msg, data.draw(side.exact.message(msg)), exact=True)
+
+
 @pytest.mark.parametrize("name", _names(BUNDLED))
-@settings(SWEEP, max_examples=60)
+@settings(SWEEP, max_examples=_examples(60))
 @given(data=st.data())
 def test_bundled_type_matches_pydronecan(sides: dict[str, Side], name: str, data: st.DataObject) -> None:
     side = sides["bundled"]
@@ -321,7 +384,7 @@ def test_bundled_type_matches_pydronecan(sides: dict[str, Side], name: str, data
     check_roundtrip(side, msg, data.draw(side.draw.message(msg)))
 
 
-@settings(SWEEP, max_examples=250)
+@settings(SWEEP, max_examples=_examples(250))
 @given(data=st.data())
 def test_battery_info_matches_pydronecan(sides: dict[str, Side], data: st.DataObject) -> None:
     side = sides["bundled"]
@@ -339,15 +402,39 @@ def _branches(root: Path) -> list[tuple[str, str]]:
 
 
 @pytest.mark.parametrize(("name", "branch"), _branches(SPECS))
-@settings(SWEEP, max_examples=6)
+@settings(SWEEP, max_examples=_examples(6))
 @given(data=st.data())
 def test_every_union_branch_matches_pydronecan(
     sides: dict[str, Side], name: str, branch: str, data: st.DataObject
 ) -> None:
+    """Constructed by one field (``Value(integer_value=42)``), a union encodes that branch as pydronecan does."""
     side = sides["specs"]
     msg = side.by_name[name]
-    value = data.draw(side.draw.field(msg.field(branch).type))
-    check_roundtrip(side, msg, {"_branch": branch, branch: value})
+    exact = data.draw(st.booleans())
+    value = data.draw((side.exact if exact else side.draw).field(msg.field(branch).type))
+    check_roundtrip(side, msg, {"_branch": branch, branch: value}, exact=exact)
+
+
+def _resolve(package: str, qualified: str) -> Any:
+    """The object a qualified name (as ``battgen list`` prints it) names in the generated package."""
+    parts = qualified.split(".")
+    for cut in range(len(parts) - 1, 0, -1):
+        try:
+            obj = importlib.import_module(".".join([package, *parts[:cut]]))
+        except ModuleNotFoundError:
+            continue
+        for attr in parts[cut:]:
+            obj = getattr(obj, attr)
+        return obj
+    raise AssertionError(qualified)
+
+
+def test_every_listed_name_is_importable_as_written(sides: dict[str, Side]) -> None:
+    """DSDL names are kept exactly (CBAT, PUSHCAN), and a service's halves are GetSet.Request / .Response."""
+    side = sides["specs"]
+    for msg in side.schema.messages:
+        assert _resolve(side.package, msg.qualified_name) is side.cls(msg), msg.qualified_name
+    assert side.cls(side.by_name["dronecan.cuav.equipment.power.CBAT"]).__name__ == "CBAT"
 
 
 def test_ids_signatures_and_transfer_crc(sides: dict[str, Side]) -> None:

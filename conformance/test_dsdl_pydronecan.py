@@ -205,6 +205,11 @@ BUNDLED_TYPES = [
     "uavcan.equipment.power.CircuitStatus",
     "uavcan.equipment.power.PrimaryPowerSupplyStatus",
     "ardupilot.equipment.power.BatteryInfoAux",
+    "ardupilot.equipment.power.BatteryContinuous",
+    "ardupilot.equipment.power.BatteryPeriodic",
+    "ardupilot.equipment.power.BatteryCells",
+    "ardupilot.equipment.power.BatteryTag",
+    "cuav.equipment.power.CBAT",
 ]
 
 

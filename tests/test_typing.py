@@ -16,10 +16,10 @@ from conftest import ROOT
 from samples import NESTED, hostile_schema, mavlink_thing_xml
 
 from codegen.backends.python.writer import generate
-from codegen.frontends import mavlink, uorb
+from codegen.frontends import dsdl, mavlink, uorb
 
 # target -> the folder whose files mypy reports on
-TARGETS = ("codegen", "generated", "hostile", "mavlink_thing", "uorb_nested")
+TARGETS = ("codegen", "generated", "hostile", "mavlink_thing", "uorb_nested", "dronecan_unions")
 
 
 def _generate_samples(root: Path) -> None:
@@ -32,6 +32,12 @@ def _generate_samples(root: Path) -> None:
     for name, text in NESTED.items():
         (msgs / name).write_text(text, encoding="utf-8")
     generate(uorb.parse_dir(msgs), root / "uorb_nested")
+    # DroneCAN unions (param.Value inside GetSet, NumericValue): the types pydronecan ships
+    specs = Path(pytest.importorskip("dronecan").__file__).parent / "dsdl_specs"
+    generate(
+        dsdl.parse_file(specs / "uavcan" / "protocol" / "param" / "11.GetSet.uavcan", root=specs),
+        root / "dronecan_unions",
+    )
 
 
 @pytest.fixture(scope="module")

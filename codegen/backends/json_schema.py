@@ -102,7 +102,24 @@ def _object(schema: Schema, msg: Message, defs: dict[str, dict[str, Any]]) -> di
     out["additionalProperties"] = False
     if required:
         out["required"] = required
+    if msg.dronecan is not None and msg.dronecan.union:
+        _union(out, list(props))
     return out
+
+
+def _union(out: dict[str, Any], branches: list[str]) -> None:
+    """A DroneCAN union's plain data holds one branch: its key alone, or with ``union_field`` naming it."""
+    out["properties"]["union_field"] = {"description": "The branch this union holds.", "enum": branches}
+    out.pop("required", None)  # no branch is required: the empty object holds the first at its default
+    named = [
+        {
+            "required": ["union_field"],
+            "properties": {"union_field": {"const": b}},
+            "propertyNames": {"enum": ["union_field", b]},
+        }
+        for b in branches
+    ]
+    out["anyOf"] = [*named, {"not": {"required": ["union_field"]}, "maxProperties": 1}]
 
 
 def _description(f: Field) -> str:

@@ -80,15 +80,63 @@ def load_schema_dir(root: Path) -> Schema:
     return schema
 
 
+_OWN_FOLDERS = frozenset(FORMAT_FRONTENDS) | {MAPPINGS_DIR, RULES_DIR}
+_SEARCH_LIMIT = 10_000  # directory entries looked at while telling a DSDL tree from a schema folder
+
+
+def _first_dsdl(folder: Path) -> Path | None:
+    """Some ``*.uavcan`` file below ``folder`` (a bounded walk: never a whole disk)."""
+    for seen, path in enumerate(folder.rglob("*")):
+        if seen >= _SEARCH_LIMIT:
+            return None
+        if path.suffix == ".uavcan" and path.is_file():
+            return path
+    return None
+
+
+def dsdl_definition(path: Path) -> Path | None:
+    """A definition that makes ``path`` a DSDL tree rather than a schema folder, if it is one: a
+    ``*.uavcan`` file in it or below a namespace folder (``uavcan/``, ``ardupilot/``, ...), with none
+    of a schema folder's other format folders. A ``dronecan/`` folder alone keeps its schema-folder meaning."""
+    if any((path / name).is_dir() for name in _OWN_FOLDERS - {"dronecan"}):
+        return None
+    direct = next((p for p in sorted(path.glob("*.uavcan")) if p.is_file()), None)
+    if direct is not None:
+        return direct
+    for sub in sorted(path.iterdir()):
+        if sub.is_dir() and sub.name != "dronecan":
+            found = _first_dsdl(sub)
+            if found is not None:
+                return found
+    return None
+
+
+def _load_dsdl_tree(path: Path, definition: Path) -> Schema:
+    """A DSDL root; a folder inside one (a namespace) is refused with the root to pass instead."""
+    root = dsdl.find_root(definition)
+    if definition.parent.resolve() == path.resolve() or root.resolve() in path.resolve().parents:
+        raise BattgenError(
+            f"{path}: a DSDL namespace folder, not a DSDL root: pass the folder holding its top namespace, {root}"
+        )
+    return dsdl.parse_dir(path)
+
+
 def load(paths: Iterable[Path]) -> Schema:
-    """Parse schema folders and single files (format from the extension) into one Schema."""
+    """Parse schema folders, DSDL roots and single files (format from the extension) into one Schema."""
     schema = Schema()
     for path in paths:
         if path.is_dir():
-            if not is_schema_dir(path):
+            definition = dsdl_definition(path)
+            if definition is not None:
+                part = _load_dsdl_tree(path, definition)
+            elif is_schema_dir(path):
+                part = load_schema_dir(path)
+            else:
                 expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
-                raise BattgenError(f"{path}: not a schema folder (expected sub-folders {expected})")
-            part = load_schema_dir(path)
+                raise BattgenError(
+                    f"{path}: not a schema folder (expected sub-folders {expected}) nor a DSDL root "
+                    "(namespace folders such as uavcan/ holding .uavcan files)"
+                )
         elif path.is_file():
             part = frontend(format_of_file(path)).parse_file(path)
         else:

@@ -69,13 +69,17 @@ class Scale(Op):
     Reading, the field's sentinel or any of ``unknown`` means unknown, and so does a value not
     above ``valid_above`` or above ``valid_max``; a devicetree list gives its first element.
     Writing, unknown becomes the first marker and a value is stored as the field holds it
-    (float16, rounded and clamped integers, at most ``valid_max``).
+    (float16, rounded and clamped integers, at most ``valid_max``). ``unit`` is the field's unit
+    where its schema names none (a DSDL comment in prose); ``negate`` when the field counts the
+    other way from the concept (CBAT reports a discharge as a negative current).
     """
 
     NAME: ClassVar[str] = "scale"
     unknown: tuple[Number, ...] = ()
     valid_above: Number | None = None
     valid_max: Number | None = None
+    unit: UnitSymbol | None = None
+    negate: bool = False
 
 
 @dataclass(frozen=True)
@@ -329,6 +333,31 @@ class PX4AuxCapacity(Op):
     above: Number | None = None
 
 
+@dataclass(frozen=True)
+class PX4BridgeEstimates(Op):
+    """PX4's uavcan bridge with its Battery object: ``from: [current, a field of the companion message]``
+    -> ``to: [discharged charge, time remaining, average current]``, reading the target's fields
+    ``soc_of`` (state of charge, 0-1) and ``capacity_of`` (mAh).
+
+    Without the companion message (raw mode) the discharged charge grows by |current| over the
+    converter input ``dt_input`` (seconds since the previous message, at most 2) from the input
+    ``discharged_input`` (the total so far, 0 if not given), and the time remaining is NaN. With it
+    (BatteryInfoAux) the discharged charge stays as given, the average current is the Battery
+    object's filter, which a disarmed vehicle holds at ``average_current`` (BAT_AVRG_CURRENT), and
+    the time remaining is state of charge times capacity over that current, NaN without a capacity.
+    """
+
+    NAME: ClassVar[str] = "px4_bridge_estimates"
+    SOURCES: ClassVar[Arity] = (2, 2)
+    TARGETS: ClassVar[Arity] = (3, 3)
+    HANDLES_MISSING: ClassVar[bool] = True
+    soc_of: str
+    capacity_of: str
+    average_current: Number
+    dt_input: str
+    discharged_input: str
+
+
 MappingOp = (
     Scale
     | Copy
@@ -354,6 +383,7 @@ MappingOp = (
     | PX4BridgeCells
     | PX4CellList
     | PX4AuxCapacity
+    | PX4BridgeEstimates
 )
 
 # every op by the name mapping files give it, in the order above

@@ -26,8 +26,6 @@ _UNREAD_AUX_FIELDS = (("timestamp", "timestamp"), ("max_current", "max_current")
 _AUX_DEFAULTS = BatteryInfoAux()
 _UNWRITTEN_STATUS_FIELDS = (
     "uorb.BatteryStatus.timestamp",
-    "uorb.BatteryStatus.current_average_a",
-    "uorb.BatteryStatus.discharged_mah",
     "uorb.BatteryStatus.priority",
     "uorb.BatteryStatus.average_time_to_empty",
     "uorb.BatteryStatus.manufacture_date",
@@ -54,6 +52,8 @@ def forward(
     rep: _r.LossReport | None = None,
     rep_d: _r.LossReport | None = None,
     rep_u: _r.LossReport | None = None,
+    dt_s: float | None = None,
+    discharged_mah_before: float | None = None,
 ) -> tuple[BatteryStatus]:
     """dronecan -> uorb: returns the target objects as a tuple."""
     t_status = BatteryStatus()
@@ -117,71 +117,95 @@ def forward(
     # id = msg.battery_id (0-based, copied as it is)
     t_status.id = _r.c_wrap(int(s_info.battery_id), 8, False)
 
-    # px4_uavcan_bridge.yaml:41: const math.nan -> time_remaining_s
-    # time_remaining_s = NAN (raw mode)
-    t_status.time_remaining_s = math.nan
-
-    # px4_uavcan_bridge.yaml:42: px4_bridge_cells info.voltage, aux.voltage_cell -> voltage_cell_v, cell_count
+    # px4_uavcan_bridge.yaml:41: px4_bridge_cells info.voltage, aux.voltage_cell -> voltage_cell_v, cell_count
     # Without BatteryInfoAux: voltage_cell_v[0] = msg.voltage, cell_count = 1. With it: cell_count = min(cells, 14) and
     # those cells copied.
-    _c13 = [0.0] * 14
-    _c13[0] = _r.f16(float(s_info.voltage), None, "")
+    _c12 = [0.0] * 14
+    _c12[0] = _r.f16(float(s_info.voltage), None, "")
     if s_aux is None:
         t_status.cell_count = 1
     else:
-        _a13 = s_aux.voltage_cell
-        _n13 = min(len(_a13) & 0xFF, 14)
-        for _i13 in range(_n13):
-            _c13[_i13] = _r.f16(float(_a13[_i13]), None, "")
-        t_status.cell_count = _n13
-    t_status.voltage_cell_v = _c13
+        _a12 = s_aux.voltage_cell
+        _n12 = min(len(_a12) & 0xFF, 14)
+        for _i12 in range(_n12):
+            _c12[_i12] = _r.f16(float(_a12[_i12]), None, "")
+        t_status.cell_count = _n12
+    t_status.voltage_cell_v = _c12
 
-    # px4_uavcan_bridge.yaml:48: px4_warning -> warning
+    # px4_uavcan_bridge.yaml:47: px4_warning -> warning
     # Battery::determineWarning(remaining) with the default BAT_EMERGEN_THR, BAT_CRIT_THR and BAT_LOW_THR: EMERGENCY
     # below 0.05, CRITICAL below 0.07, LOW below 0.15, else NONE (float32 compares).
-    _s14 = t_status.remaining
-    if _s14 < 0.05000000074505806:
+    _s13 = t_status.remaining
+    if _s13 < 0.05000000074505806:
         t_status.warning = 3
-    elif _s14 < 0.07000000029802322:
+    elif _s13 < 0.07000000029802322:
         t_status.warning = 2
-    elif _s14 < 0.15000000596046448:
+    elif _s13 < 0.15000000596046448:
         t_status.warning = 1
     else:
         t_status.warning = 0
 
-    # px4_uavcan_bridge.yaml:57: px4_int aux.cycle_count -> cycle_count
+    # px4_uavcan_bridge.yaml:56: px4_int aux.cycle_count -> cycle_count
     if s_aux is not None:
         t_status.cycle_count = _r.c_wrap(int(s_aux.cycle_count), 16, False)
 
-    # px4_uavcan_bridge.yaml:58: px4_int aux.over_discharge_count -> over_discharge_count
+    # px4_uavcan_bridge.yaml:57: px4_int aux.over_discharge_count -> over_discharge_count
     if s_aux is not None:
         t_status.over_discharge_count = _r.c_wrap(int(s_aux.over_discharge_count), 16, False)
 
-    # px4_uavcan_bridge.yaml:59: px4_convert aux.nominal_voltage -> nominal_voltage
+    # px4_uavcan_bridge.yaml:58: px4_convert aux.nominal_voltage -> nominal_voltage
     # nominal_voltage = msg.nominal_voltage > FLT_EPSILON ? msg.nominal_voltage : NAN
     if s_aux is not None:
-        _x17 = _r.f16(float(s_aux.nominal_voltage), None, "")
-        if _x17 > 1.1920928955078125e-07:
-            t_status.nominal_voltage = _x17
+        _x16 = _r.f16(float(s_aux.nominal_voltage), None, "")
+        if _x16 > 1.1920928955078125e-07:
+            t_status.nominal_voltage = _x16
         else:
             t_status.nominal_voltage = math.nan
 
-    # px4_uavcan_bridge.yaml:66: px4_int aux.is_powering_off -> is_powering_off
+    # px4_uavcan_bridge.yaml:65: px4_int aux.is_powering_off -> is_powering_off
     if s_aux is not None:
         t_status.is_powering_off = bool(int(s_aux.is_powering_off))
 
-    # px4_uavcan_bridge.yaml:67: px4_aux_capacity info.full_charge_capacity_wh, aux.nominal_voltage -> capacity
+    # px4_uavcan_bridge.yaml:66: px4_aux_capacity info.full_charge_capacity_wh, aux.nominal_voltage -> capacity
     # if nominal_voltage > FLT_EPSILON: capacity = full_charge_capacity_wh * 1000.f / nominal_voltage (Wh / V in mAh)
     if s_aux is not None:
-        _v19 = _r.f16(float(s_aux.nominal_voltage), None, "")
-        if _v19 > 1.1920928955078125e-07:
+        _v18 = _r.f16(float(s_aux.nominal_voltage), None, "")
+        if _v18 > 1.1920928955078125e-07:
             t_status.capacity = _r.c_float_to_int(
-                _r.f32(_r.f32(_r.f16(float(s_info.full_charge_capacity_wh), None, "") * 1000.0) / _v19),
+                _r.f32(_r.f32(_r.f16(float(s_info.full_charge_capacity_wh), None, "") * 1000.0) / _v18),
                 16,
                 False,
                 rep,
                 "uorb.BatteryStatus.capacity",
             )
+
+    # px4_uavcan_bridge.yaml:71: px4_bridge_estimates info.current, aux.voltage_cell -> discharged_mah,
+    # time_remaining_s, current_average_a
+    # Raw mode (BatteryInfo alone, battery_sub_cb): discharged_mah = Battery::sumDischarged(fabsf(msg.current)) over the
+    # seconds since the previous BatteryInfo (Battery::updateDt, at most 2 s; give dt_s and the total so far as
+    # discharged_mah_before), time_remaining_s = NAN. With BatteryInfoAux (battery_aux_sub_cb): time_remaining_s =
+    # Battery::computeRemainingTime(fabsf(current_a)) and current_average_a = Battery::getCurrentAverage(); a converter
+    # sees no vehicle_status, so the vehicle counts as disarmed and the average stays at BAT_AVRG_CURRENT (15 A by
+    # default).
+    _v19 = 0.0 if discharged_mah_before is None else _r.f32(discharged_mah_before)
+    if s_aux is None:
+        # Battery::updateDt (at most 2 s) and Battery::sumDischarged(fabsf(msg.current))
+        _x19 = abs(_r.f16(float(s_info.current), None, ""))
+        _t19 = 0.0 if dt_s is None else _r.f32(min(_r.f32(dt_s), 2.0))
+        if _t19 > 1.1920928955078125e-07:
+            _v19 = _r.f32(_v19 + _r.f32(_r.f32(_x19 * 1000.0) * _r.f32(_t19 / 3600.0)))
+        t_status.time_remaining_s = math.nan
+    else:
+        # Battery::computeRemainingTime while disarmed: the average filter reset to BAT_AVRG_CURRENT
+        _m19 = 15.0
+        t_status.current_average_a = _m19
+        _cap19 = _r.f32(t_status.capacity)
+        _s19 = t_status.remaining
+        t_status.time_remaining_s = math.nan
+        if _cap19 > 0:
+            _x19 = _r.f32(_r.f32(_s19 * _cap19) / max(_r.f32(_m19 * 1000.0), 1.1920928955078125e-07))
+            t_status.time_remaining_s = _r.f32(_x19 * 3600.0)
+    t_status.discharged_mah = _v19
 
     # what did not survive the conversion
     if rep_d is not None:
@@ -199,6 +223,10 @@ def forward(
         rep_u.unknown("uorb.BatteryStatus.voltage_v")
     if rep_u is not None and _r.is_marker(t_status.current_a, -1.0):
         rep_u.unknown("uorb.BatteryStatus.current_a")
+    if rep_u is not None and _r.is_marker(t_status.current_average_a, -1.0):
+        rep_u.unknown("uorb.BatteryStatus.current_average_a")
+    if rep_u is not None and _r.is_marker(t_status.discharged_mah, -1.0):
+        rep_u.unknown("uorb.BatteryStatus.discharged_mah")
     if rep_u is not None and _r.is_marker(t_status.remaining, -1.0):
         rep_u.unknown("uorb.BatteryStatus.remaining")
     if rep_u is not None and _r.is_marker(t_status.scale, -1.0):

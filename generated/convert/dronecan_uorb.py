@@ -11,7 +11,13 @@ from . import _runtime as _r
 
 
 def dronecan_to_uorb(
-    info: BatteryInfo, aux: BatteryInfoAux | None = None, *, policy: str = "strict", report: _r.LossReport | None = None
+    info: BatteryInfo,
+    aux: BatteryInfoAux | None = None,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+    discharged_mah_before: float | None = None,
+    dt_s: float | None = None,
 ) -> BatteryStatus:
     """Convert dronecan to uorb.
 
@@ -25,7 +31,9 @@ def dronecan_to_uorb(
         _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
     if policy == "px4":
-        _px4_1 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=report)
+        _px4_1 = _map_px4_uavcan_bridge.forward(
+            info, aux, rep=report, rep_d=report, rep_u=report, dt_s=dt_s, discharged_mah_before=discharged_mah_before
+        )
         return _px4_1[0]
     raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 

@@ -11,7 +11,13 @@ from . import _runtime as _r
 
 
 def dronecan_to_uorb_v0(
-    info: BatteryInfo, aux: BatteryInfoAux | None = None, *, policy: str = "strict", report: _r.LossReport | None = None
+    info: BatteryInfo,
+    aux: BatteryInfoAux | None = None,
+    *,
+    policy: str = "strict",
+    report: _r.LossReport | None = None,
+    discharged_mah_before: float | None = None,
+    dt_s: float | None = None,
 ) -> BatteryStatusV0:
     """Convert dronecan to uorb_v0.
 
@@ -26,7 +32,9 @@ def dronecan_to_uorb_v0(
         _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
     if policy == "px4":
-        _px4_1 = _map_px4_uavcan_bridge.forward(info, aux, rep=report, rep_d=report, rep_u=None)
+        _px4_1 = _map_px4_uavcan_bridge.forward(
+            info, aux, rep=report, rep_d=report, rep_u=None, dt_s=dt_s, discharged_mah_before=discharged_mah_before
+        )
         _px4_2 = _map_uorb_v0_down.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
         return _px4_2[0]
     raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

@@ -13,7 +13,7 @@ from importlib import resources
 
 import jinja2
 
-from ...ir import Message, Schema, SourceFormat
+from ...ir import DronecanKind, Message, Schema, SourceFormat
 from . import naming
 from .extensions import Contribution
 from .imports import from_imports
@@ -111,9 +111,11 @@ def _render_module(
     if module == "mavlink":
         referenced = {e for m in messages for f in m.fields for e in f.enums}
         enums.extend(enum_views(tuple(e for e in schema.enums if e.name in referenced), ""))
+    services = _services(messages, {c.name for c in classes} | {e.class_name for e in enums})
     body = env.get_template("module_body.py.j2").render(
         enums=enums,
         classes=classes,
+        services=services,
         factories=[ctx.factories[k] for k in sorted(ctx.factories)],
         module_code=list(module_code),
     )
@@ -134,9 +136,33 @@ def _render_module(
         std_imports=std,
         local_imports=from_imports([f"from {ctx.root()} import _meta as _m", *extra_imports]),
         type_imports=from_imports(type_imports),
-        exports=sorted([c.name for c in classes] + [e.class_name for e in enums]),
+        exports=sorted([c.name for c in classes] + [e.class_name for e in enums] + [v["name"] for v in services]),
     )
     return head.rstrip("\n") + "\n\n\n" + body.strip("\n") + "\n"
+
+
+def _services(messages: list[Message], taken: set[str]) -> list[dict[str, str]]:
+    """A DroneCAN service's name as a class holding its two halves, so ``GetSet.Request`` (the name
+    ``battgen list`` prints, and pydronecan's) works beside ``GetSetRequest``."""
+    halves: dict[str, dict[DronecanKind, str]] = defaultdict(dict)
+    for m in messages:
+        if m.dronecan is not None and m.dronecan.kind is not DronecanKind.MESSAGE:
+            halves[m.dronecan.full_name][m.dronecan.kind] = naming.class_name(m)
+    out = []
+    for full_name, pair in sorted(halves.items()):
+        name = naming.identifier(full_name.rsplit(".", 1)[-1])
+        if name in taken or len(pair) != 2:
+            continue
+        doc = f"The DroneCAN service {full_name}: its request and response types."
+        out.append(
+            {
+                "name": name,
+                "doc": docstring(doc, "    "),
+                "request": pair[DronecanKind.REQUEST],
+                "response": pair[DronecanKind.RESPONSE],
+            }
+        )
+    return out
 
 
 def _render_package_init(

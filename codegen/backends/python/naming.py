@@ -90,7 +90,7 @@ def module_path(msg: Message) -> str:
 
 def class_name(msg: Message) -> str:
     if msg.format is SourceFormat.DRONECAN and msg.dronecan is not None:
-        base = camel(msg.dronecan.full_name.rsplit(".", 1)[-1])
+        base = identifier(msg.dronecan.full_name.rsplit(".", 1)[-1])  # the DSDL name exactly: CBAT stays CBAT
         if msg.dronecan.kind is DronecanKind.REQUEST:
             return base + "Request"
         if msg.dronecan.kind is DronecanKind.RESPONSE:

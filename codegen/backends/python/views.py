@@ -50,6 +50,7 @@ class ClassView:
     keys_literal: str  # frozenset of accepted source names
     pattern_literal: str  # tuple of (regex, ident) for pattern fields
     extensions: list[str] = field(default_factory=list)  # extra, already indented class-body code
+    union_table: str = ""  # a DroneCAN union's module-level _dc.Union (from_dict lets it pick the branch)
 
 
 def enum_views(enums: tuple[EnumDef, ...], owner: str) -> list[EnumView]:
@@ -84,6 +85,8 @@ def enum_views(enums: tuple[EnumDef, ...], owner: str) -> list[EnumView]:
 def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
     cls = naming.class_name(msg)
     optional_props = msg.devicetree is not None
+    # a DroneCAN union: every branch is None but the one held (see runtime/_dronecan.Union)
+    union = msg.dronecan is not None and msg.dronecan.union
     fields: list[FieldView] = []
     idents: set[str] = set(naming.RESERVED_MEMBERS)
     patterns: list[str] = []
@@ -95,7 +98,7 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
         while ident in idents:
             ident += "_"
         idents.add(ident)
-        optional = optional_props and not f.required and f.pattern is None
+        optional = (optional_props and not f.required and f.pattern is None) or union
         b = FieldBuilder(ctx, f, optional)
         annotation = b.annotation(f.type)
         key = py_literal(f.name)
@@ -134,6 +137,8 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
             literal, annotation = py_literal(str(c.value)), "str"
         constants.append((name, annotation, literal))
 
+    if union:
+        keys.append("union_field")
     src = msg.location
     doc_text = msg.doc.strip() or msg.qualified_name
     doc_text += f"\n\nSchema: {msg.qualified_name} ({msg.format.value}, {src.file}:{src.line})."
@@ -146,4 +151,5 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
         source=f"{src.file}",
         keys_literal="frozenset({" + ", ".join(py_literal(k) for k in keys) + "})" if keys else "frozenset()",
         pattern_literal="(" + ", ".join(patterns) + ",)" if patterns else "()",
+        union_table=ctx.constant(cls, "UNION") if union else "",
     )

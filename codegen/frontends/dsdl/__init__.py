@@ -30,7 +30,7 @@ from ...ir import Schema
 from .build import build
 from .namespaces import Namespaces, find_root
 
-__all__ = ["parse_dir", "parse_file"]
+__all__ = ["find_root", "parse_dir", "parse_file"]
 
 
 def parse_file(path: Path, *, root: Path | None = None) -> Schema:

@@ -34,6 +34,7 @@ from ....ir import (
     Rule,
     Schema,
     Unit,
+    units,
 )
 from ....ir.mapping_values import ConstantRef, Number, Value
 from .. import naming
@@ -105,6 +106,15 @@ def constant_name(*words: str) -> str:
 
 class RuleContext:
     """One direction of one mapping being written; see the module docstring."""
+
+    def unit_param(self, symbol: str | None, fallback: Unit | None) -> Unit | None:
+        """The unit a rule names (``unit``, ``source_unit``, ...), else ``fallback``."""
+        if symbol is None:
+            return fallback
+        unit = units.lookup(symbol)
+        if unit is None:
+            raise BattgenError(f"{self.mapping.name}: unknown unit {symbol!r}")
+        return unit
 
     def __init__(
         self,

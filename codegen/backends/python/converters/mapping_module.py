@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 from ....ir import CONCEPTS_ENDPOINT, Concept, Endpoint, Mapping, Schema
@@ -11,6 +12,9 @@ from ..literals import docstring
 from .classes import class_names, import_lines
 from .context import INDENT, ModuleConstants, Side
 from .function import FunctionBuilder
+
+# a call into the array algorithms module, not an endpoint alias ending in "cells" (s_cells.voltages)
+_USES_CELLS = re.compile(r"(?<![\w.])_cells\.")
 
 # names a mapping module binds besides its message classes
 _TAKEN = ("BatteryState", "forward", "backward", "math")
@@ -71,7 +75,7 @@ def mapping_module(
     consts = list(constants.lines.values())
     code = [line for lines in functions for line in lines] + consts
     names = set(class_imports) | {(".", "_runtime", "_r")}
-    if any("_cells." in line for line in code if not line.lstrip().startswith("#")):
+    if any(_USES_CELLS.search(line) for line in code if not line.lstrip().startswith("#")):
         names.add((".", "_cells", None))  # the array algorithms (runtime/convert/_cells.py)
     if CONCEPTS_ENDPOINT in (mapping.source, mapping.target):
         names.add(("._concepts", "BatteryState", None))

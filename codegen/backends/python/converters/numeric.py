@@ -21,10 +21,12 @@ class NumericEmitters(RuleContext):
         f = self.fld(fmt)
         marks = self.markers(f, op.unknown)
         c_unit = self.concepts[con.field].unit
-        f_unit = f.unit or c_unit
+        f_unit = f.unit or self.unit_param(op.unit, c_unit)
         is_list = isinstance(f.type, ArrayType)
         if not self.backward:
             mul, add = factor(f_unit, c_unit)
+            if op.negate:
+                mul, add = -mul, -add
             src = self.s(fmt)
             self.emit(f"_v = _cells.dt_first({src})" if is_list else f"_v = {src}")
             tests = ["_v is not None"] if is_list else []
@@ -33,13 +35,15 @@ class NumericEmitters(RuleContext):
                 tests.append(f"_v > {py_literal(op.valid_above)}")
             if op.valid_max is not None:
                 tests.append(f"_v <= {py_literal(op.valid_max)}")
-            value = affine("float(_v)", mul, add)
+            value = _signed(affine("float(_v)", mul, add), op.negate and add == 0.0)
             if tests:
                 self.emit(f"if {' and '.join(tests)}:", f"    {self.t(con)} = {value}")
             else:
                 self.emit(f"{self.t(con)} = {value}")
             return
         mul, add = factor(c_unit, f_unit)
+        if op.negate:
+            mul = -mul
         label = self.label(fmt)
         target = self.t(fmt)
         self.emit(f"_v = {self.s(con)}", "if _v is None or _v != _v:")
@@ -48,7 +52,7 @@ class NumericEmitters(RuleContext):
         self.emit("    if rep_u is not None:")
         self.emit_call("rep_u.unknown", [label], 2)
         self.emit("else:")
-        stored = self.store(f, affine("_v", mul, add), label, op.valid_max)
+        stored = self.store(f, _signed(affine("_v", mul, add), op.negate and add == 0.0), label, op.valid_max)
         if is_list:  # a devicetree list of one
             self.emit_assign("_w", stored, 1)
             self.emit(f"    {target} = [[_w]]")
@@ -130,3 +134,8 @@ class NumericEmitters(RuleContext):
             f"elif {' and '.join(tests) or 'True'}:",
             f"    {target} = {affine('float(_p)', mul, add)}",
         )
+
+
+def _signed(value: str, negated: bool) -> str:
+    """A negated value plus 0.0, so that a zero reads 0.0 rather than -0.0."""
+    return f"{value} + 0.0" if negated else value

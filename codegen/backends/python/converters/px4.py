@@ -7,22 +7,27 @@ the bytes PX4 would send.
 
 from __future__ import annotations
 
+import math
+
 from ....errors import BattgenError
-from ....ir import FieldRef, PrimitiveKind, Rule, Unit, units
-from ....ir.ops import BitsFrom, EnumMap, PX4AuxCapacity, PX4Conversion, PX4Convert, PX4Form, PX4Int, PX4Warning
+from ....ir import FieldRef, PrimitiveKind, Rule, units
+from ....ir.ops import (
+    BitsFrom,
+    EnumMap,
+    PX4AuxCapacity,
+    PX4BridgeEstimates,
+    PX4Conversion,
+    PX4Convert,
+    PX4Form,
+    PX4Int,
+    PX4Warning,
+)
+from .. import naming
 from ..literals import float_literal, py_literal
 from .context import FLT_EPS, RuleContext, call, constant_name, f32, factor
 
 
 class PX4Emitters(RuleContext):
-    def unit_param(self, symbol: str | None, fallback: Unit | None) -> Unit | None:
-        if symbol is None:
-            return fallback
-        unit = units.lookup(symbol)
-        if unit is None:
-            raise BattgenError(f"{self.mapping.name}: unknown unit {symbol!r}")
-        return unit
-
     def visit_px4_convert(self, rule: Rule, op: PX4Convert) -> None:
         src, dst = rule.sources[0], rule.targets[0]
         f_dst = self.fld(dst)
@@ -121,3 +126,36 @@ class PX4Emitters(RuleContext):
         value = f"_r.f32(_r.f32({self.px4_read(energy)} * {float_literal(f32(mul))}) / _v)"
         self.emit(f"_v = {self.px4_read(voltage)}", f"if _v > {float_literal(eps)}:")
         self.emit_assign(self.t(dst), self.store_c(f_dst, value, self.label(dst)), 1)
+
+    def visit_px4_bridge_estimates(self, rule: Rule, op: PX4BridgeEstimates) -> None:
+        """Runs without the companion message too (``HANDLES_MISSING``): PX4's raw mode."""
+        current, aux = rule.sources
+        discharged, remaining_time, average = rule.targets
+        dt, total = naming.identifier(op.dt_input), naming.identifier(op.discharged_input)
+        for name in (dt, total):
+            if name not in self.inputs:
+                self.inputs.append(name)
+        soc = self.t(FieldRef(discharged.message, op.soc_of))
+        capacity = self.t(FieldRef(discharged.message, op.capacity_of))
+        eps = float_literal(FLT_EPS)
+        self.emit(
+            f"_v = 0.0 if {total} is None else _r.f32({total})",
+            f"if {self.src.var(aux.message)} is None:",
+            "    # Battery::updateDt (at most 2 s) and Battery::sumDischarged(fabsf(msg.current))",
+            f"    _x = abs({self.px4_read(current)})",
+            f"    _t = 0.0 if {dt} is None else _r.f32(min(_r.f32({dt}), 2.0))",
+            f"    if _t > {eps}:",
+            "        _v = _r.f32(_v + _r.f32(_r.f32(_x * 1000.0) * _r.f32(_t / 3600.0)))",
+            f"    {self.t(remaining_time)} = {float_literal(math.nan)}",
+            "else:",
+            "    # Battery::computeRemainingTime while disarmed: the average filter reset to BAT_AVRG_CURRENT",
+            f"    _m = {float_literal(f32(float(op.average_current)))}",
+            f"    {self.t(average)} = _m",
+            f"    _cap = _r.f32({capacity})",
+            f"    _s = {soc}",
+            f"    {self.t(remaining_time)} = {float_literal(math.nan)}",
+            "    if _cap > 0:",
+            f"        _x = _r.f32(_r.f32(_s * _cap) / max(_r.f32(_m * 1000.0), {eps}))",
+            f"        {self.t(remaining_time)} = _r.f32(_x * 3600.0)",
+            f"{self.t(discharged)} = _v",
+        )

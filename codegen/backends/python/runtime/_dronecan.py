@@ -8,6 +8,10 @@ whole payload, counting the bits that remain after the read position.
 from __future__ import annotations
 
 import struct
+from collections.abc import Mapping
+from typing import Any
+
+from ._meta import DataError
 
 _F32 = struct.Struct("<f")
 _U32 = struct.Struct("<I")
@@ -28,6 +32,90 @@ class DecodeError(ValueError):
 
 class EncodeError(ValueError):
     """A value that cannot be encoded (an array longer than its capacity, an unknown union field)."""
+
+
+UNION_ATTR = "union_field"
+
+
+class Union:
+    """The branches of one generated union class, and the rules that keep exactly one of them held.
+
+    A union object holds its value in the attribute of the selected branch; every other branch
+    attribute is None, and ``union_field`` names the selected branch by its DSDL name (as
+    pydronecan's ``get_active_union_field``). Assigning a value to a branch selects it; assigning
+    a branch's name to ``union_field`` switches to that branch with a fresh default value (from the
+    class's ``_dc_zero(name)``).
+    """
+
+    __slots__ = ("attrs", "names", "owner")
+
+    def __init__(self, owner: str, branches: tuple[tuple[str, str], ...]) -> None:
+        self.owner = owner
+        self.names: dict[str, str] = dict(branches)  # DSDL name -> attribute
+        self.attrs: dict[str, str] = {attr: name for name, attr in branches}  # attribute -> DSDL name
+
+    @staticmethod
+    def _zero(obj: Any, name: str) -> Any:
+        return obj._dc_zero(name)
+
+    def settle(self, obj: object) -> None:
+        """``__post_init__``: the one branch given to the constructor, or the first at its default."""
+        held = [name for name, attr in self.names.items() if getattr(obj, attr) is not None]
+        if len(held) > 1:
+            raise TypeError(f"{self.owner}: a union holds one field, got {', '.join(held)}")
+        if held:
+            name = held[0]
+        else:
+            name = next(iter(self.names))
+            object.__setattr__(obj, self.names[name], self._zero(obj, name))
+        object.__setattr__(obj, UNION_ATTR, name)
+
+    def assign(self, obj: object, attr: str, value: object) -> None:
+        """``__setattr__``: a value given to a branch selects it and drops the others."""
+        if attr == UNION_ATTR:
+            self.switch(obj, value)
+            return
+        object.__setattr__(obj, attr, value)
+        name = self.attrs.get(attr)
+        if name is None or value is None:
+            return
+        try:
+            current = getattr(obj, UNION_ATTR)
+        except AttributeError:  # still inside __init__: settle() checks that one branch was given
+            return
+        if current != name:
+            self._drop_others(obj, name)
+            object.__setattr__(obj, UNION_ATTR, name)
+
+    def switch(self, obj: object, name: object) -> None:
+        """``union_field = name``: select that branch, at its default unless it already holds a value.
+
+        A name that is no branch is stored as it is; ``validate()`` reports it and ``encode()`` refuses it."""
+        if isinstance(name, str) and name in self.names:
+            attr = self.names[name]
+            if getattr(obj, attr, None) is None:
+                object.__setattr__(obj, attr, self._zero(obj, name))
+            self._drop_others(obj, name)
+        object.__setattr__(obj, UNION_ATTR, name)
+
+    def _drop_others(self, obj: object, name: str) -> None:
+        for other, attr in self.names.items():
+            if other != name:
+                object.__setattr__(obj, attr, None)
+
+    def choose(self, obj: object, data: Mapping[str, Any]) -> None:
+        """``from_dict``: the branch the plain data names (``union_field``, or its one branch key)."""
+        given = [name for name in self.names if name in data]
+        tag = data.get(UNION_ATTR)
+        choices = ", ".join(self.names)
+        if UNION_ATTR in data:
+            if not isinstance(tag, str) or tag not in self.names:
+                raise DataError(f"{self.owner}.{UNION_ATTR}", f"one of {choices}", tag)
+            if given and given != [tag]:
+                raise DataError(f"{self.owner}.{UNION_ATTR}", f"the branch the data gives ({given[0]})", tag)
+            self.switch(obj, tag)
+        elif len(given) > 1:
+            raise DataError(self.owner, f"one field of the union ({choices})", given)
 
 
 def f16bits(u: int) -> int:

@@ -7,7 +7,8 @@ exactly what is wrong from the field's spec and words it for a firmware engineer
 only, so the generated package can be vendored as it is.
 
 Rule ids: ``type`` (wrong kind of value), ``type-bounds`` (beyond the bit width or float format),
-``nan``, ``range``, ``enum``, ``bitmask``, ``length``, ``required``, ``pattern``,
+``nan``, ``range``, ``enum``, ``bitmask``, ``length``, ``required``, ``pattern``, ``union`` (a DroneCAN
+union whose ``union_field`` names no branch, or a branch that holds no value),
 ``cross-field:<rule id>`` (rules from schemas/rules/).
 """
 
@@ -400,6 +401,21 @@ def _pattern(out: list[Violation], path: str, value: object, spec: Pattern) -> N
             )
             continue
         diag(out, key, item, spec.inner)
+
+
+def union(out: list[Violation], held: object, values: Mapping[str, object]) -> None:
+    """A DroneCAN union: ``union_field`` names one of its branches, and that branch alone holds a value."""
+    names = ", ".join(values)
+    if not isinstance(held, str) or held not in values:
+        message = f"union_field = {fmt(held)} is not a field of this union (one of {names})"
+        out.append(Violation("union_field", "union", held, tuple(values), message))
+        return
+    if values[held] is None:
+        out.append(Violation(held, "union", None, held, f"{held} is the selected branch of the union but holds None"))
+    others = [name for name, value in values.items() if name != held and value is not None]
+    if others:
+        message = f"union_field = {held}, yet {', '.join(others)} also hold a value (a union encodes one field)"
+        out.append(Violation("union_field", "union", held, tuple(others), message))
 
 
 def prefixed(path: str, found: Sequence[Violation]) -> list[Violation]:

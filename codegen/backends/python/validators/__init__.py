@@ -16,7 +16,7 @@ from ..module_context import ModuleContext
 from ..naming import upper_snake
 from ..runtime import copied
 from ..views import ClassView
-from .fields import field_code
+from .fields import field_code, is_optional
 from .rules import known_expr, rule_lines
 
 _INDENT = "    "
@@ -45,6 +45,9 @@ class _Validators:
             specs.append(f"{spec_name} = {code.spec_source}")
             checks += code.lines
             field_names |= code.names
+        if msg.dronecan is not None and msg.dronecan.union:
+            held = ", ".join(f"{py_literal(name)}: self.{ident}" for name, ident in idents.items())
+            checks.append(f"_v.union(out, self.union_field, {{{held}}})")
         rule_names: set[str] = set()
         for bound in bound_rules(ctx.schema, msg):
             lines, names = rule_lines(bound, msg, idents)
@@ -83,12 +86,11 @@ class _Validators:
             '    """False when the field (schema name) holds its "unknown" sentinel or is absent."""',
         ]
         plain: list[str] = []
-        optional = msg.devicetree is not None
         for f in msg.fields:
             if f.is_padding:
                 continue
             attr = f"self.{idents[f.name]}"
-            test = known_expr(f, attr, optional and f.pattern is None)
+            test = known_expr(f, attr, is_optional(msg, f))
             if test == "True":
                 plain.append(f.name)
                 continue

@@ -21,7 +21,7 @@ class FieldCode:
 def field_code(schema: Schema, msg: Message, f: Field, ident: str, spec_name: str) -> FieldCode:
     """Statements checking ``self.<ident>`` and appending violations to ``out``."""
     check = build(schema, f, f.type)
-    optional = msg.devicetree is not None and f.pattern is None
+    optional = is_optional(msg, f)
     spec = check.spec()
     if f.pattern is not None:
         spec = f"_v.Pattern({py_literal(f.pattern)}, {spec})"
@@ -33,9 +33,13 @@ def field_code(schema: Schema, msg: Message, f: Field, ident: str, spec_name: st
     names: set[str] = set()
     if isinstance(check, NestedCheck):
         names |= {"x", "sub"}
+        absent = []
+        if optional:  # an absent branch of a union (or optional property) is checked by the union's own test
+            absent = ["if x is None:", f"    {slow}" if f.required else "    pass"]
         body = [
             f"x = {attr}",
-            f"if x.QUALIFIED_NAME != {py_literal(check.qualified)}:",
+            *absent,
+            f"{'elif' if absent else 'if'} x.QUALIFIED_NAME != {py_literal(check.qualified)}:",
             f"    {slow}",
             "else:",
             "    sub = x.validate()",
@@ -81,6 +85,13 @@ def field_code(schema: Schema, msg: Message, f: Field, ident: str, spec_name: st
             names.add("x")
             body = [f"x = {attr}", f"if {unparenthesized(cond).replace(V, 'x')}:", f"    {slow}"]
     return FieldCode(spec_name, spec, _wrap(body, slow), frozenset(names))
+
+
+def is_optional(msg: Message, f: Field) -> bool:
+    """Whether the field's value may be None: a devicetree property, or a branch of a DroneCAN union."""
+    if f.pattern is not None:
+        return False
+    return msg.devicetree is not None or (msg.dronecan is not None and msg.dronecan.union)
 
 
 def _wrap(body: list[str], slow: str) -> list[str]:

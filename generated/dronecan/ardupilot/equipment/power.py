@@ -7,6 +7,7 @@ Module: dronecan.ardupilot.equipment.power.
 from __future__ import annotations
 
 import dataclasses
+import enum
 import functools
 import struct
 from collections.abc import Mapping
@@ -19,7 +20,126 @@ from .... import _validate as _v
 if TYPE_CHECKING:
     from ....dronecan import uavcan as _dronecan_uavcan
 
-__all__ = ["BatteryInfoAux"]
+__all__ = [
+    "BatteryCells",
+    "BatteryContinuous",
+    "BatteryContinuousStatusFlag",
+    "BatteryInfoAux",
+    "BatteryPeriodic",
+    "BatteryTag",
+]
+
+
+class BatteryContinuousStatusFlag(enum.IntFlag):
+    """dronecan.ardupilot.equipment.power.BatteryContinuous.STATUS_FLAG: bit masks, combined with |."""
+
+    READY_TO_USE = 1
+    CHARGING = 2
+    CELL_BALANCING = 4
+    FAULT_CELL_IMBALANCE = 8
+    AUTO_DISCHARGING = 16
+    REQUIRES_SERVICE = 32
+    BAD_BATTERY = 64
+    PROTECTIONS_ENABLED = 128
+    FAULT_PROTECTION_SYSTEM = 256
+    FAULT_OVER_VOLT = 512
+    FAULT_UNDER_VOLT = 1024
+    FAULT_OVER_TEMP = 2048
+    FAULT_UNDER_TEMP = 4096
+    FAULT_OVER_CURRENT = 8192
+    FAULT_SHORT_CIRCUIT = 16384
+    FAULT_INCOMPATIBLE_VOLTAGE = 32768
+    FAULT_INCOMPATIBLE_FIRMWARE = 65536
+    FAULT_INCOMPATIBLE_CELLS_CONFIGURATION = 131072
+    CAPACITY_RELATIVE_TO_FULL = 262144
+
+
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX = struct.Struct("<H")
+# (bit where each field ends, field): names the field a short payload cuts
+_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX = ((16, "BatteryCells.index"),)
+# fixed fields as decoded
+_BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX = struct.Struct("<H")
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_CELLS_VOLTAGES_SPEC = _v.Array(
+    _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V"), 24, False
+)
+_BATTERY_CELLS_INDEX_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+
+
+# float16 fields packed as float32 ...
+_BATTERY_CONTINUOUS_FLOAT32_STRUCT = struct.Struct("<4f")
+# ... and read back as bits, from which each half is cut
+_BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT = struct.Struct("<4I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_CONTINUOUS_ENCODE_STRUCT = struct.Struct("<HHHffHBfI")
+# (bit where each field ends, field): names the field a short payload cuts
+_BATTERY_CONTINUOUS_FIELD_ENDS = (
+    (16, "BatteryContinuous.temperature_cells"),
+    (32, "BatteryContinuous.temperature_pcb"),
+    (48, "BatteryContinuous.temperature_other"),
+    (80, "BatteryContinuous.current"),
+    (112, "BatteryContinuous.voltage"),
+    (128, "BatteryContinuous.state_of_charge"),
+    (136, "BatteryContinuous.slot_id"),
+    (168, "BatteryContinuous.capacity_consumed"),
+    (200, "BatteryContinuous.status_flags"),
+)
+# fixed fields as decoded
+_BATTERY_CONTINUOUS_DECODE_STRUCT = struct.Struct("<eeeffeBfI")
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="degC"
+)
+_BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="degC"
+)
+_BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="degC"
+)
+_BATTERY_CONTINUOUS_CURRENT_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="A"
+)
+_BATTERY_CONTINUOUS_VOLTAGE_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+)
+_BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="%")
+_BATTERY_CONTINUOUS_SLOT_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Ah"
+)
+_BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC = _v.Number(
+    type="uint32",
+    kind="uint",
+    low=0,
+    high=4294967295,
+    mask=0x7FFFF,
+    bits={
+        0x1: "STATUS_FLAG_READY_TO_USE",
+        0x2: "STATUS_FLAG_CHARGING",
+        0x4: "STATUS_FLAG_CELL_BALANCING",
+        0x8: "STATUS_FLAG_FAULT_CELL_IMBALANCE",
+        0x10: "STATUS_FLAG_AUTO_DISCHARGING",
+        0x20: "STATUS_FLAG_REQUIRES_SERVICE",
+        0x40: "STATUS_FLAG_BAD_BATTERY",
+        0x80: "STATUS_FLAG_PROTECTIONS_ENABLED",
+        0x100: "STATUS_FLAG_FAULT_PROTECTION_SYSTEM",
+        0x200: "STATUS_FLAG_FAULT_OVER_VOLT",
+        0x400: "STATUS_FLAG_FAULT_UNDER_VOLT",
+        0x800: "STATUS_FLAG_FAULT_OVER_TEMP",
+        0x1000: "STATUS_FLAG_FAULT_UNDER_TEMP",
+        0x2000: "STATUS_FLAG_FAULT_OVER_CURRENT",
+        0x4000: "STATUS_FLAG_FAULT_SHORT_CIRCUIT",
+        0x8000: "STATUS_FLAG_FAULT_INCOMPATIBLE_VOLTAGE",
+        0x10000: "STATUS_FLAG_FAULT_INCOMPATIBLE_FIRMWARE",
+        0x20000: "STATUS_FLAG_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION",
+        0x40000: "STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL",
+    },
+)
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
@@ -60,11 +180,710 @@ _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC = _v.Number(type="bool", kind="bool", low
 _BATTERY_INFO_AUX_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
 
 
+# float16 fields packed as float32 ...
+_BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY = struct.Struct("<4f")
+# ... and read back as bits, from which each half is cut
+_BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY = struct.Struct("<4I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY = struct.Struct("<fBHHHHffffHB")
+# (bit where each field ends, field): names the field a short payload cuts
+_BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY = (
+    (32, "BatteryPeriodic.design_capacity"),
+    (40, "BatteryPeriodic.cells_in_series"),
+    (56, "BatteryPeriodic.nominal_voltage"),
+    (72, "BatteryPeriodic.discharge_minimum_voltage"),
+    (88, "BatteryPeriodic.charging_minimum_voltage"),
+    (104, "BatteryPeriodic.charging_maximum_voltage"),
+    (136, "BatteryPeriodic.charging_maximum_current"),
+    (168, "BatteryPeriodic.discharge_maximum_current"),
+    (200, "BatteryPeriodic.discharge_maximum_burst_current"),
+    (232, "BatteryPeriodic.full_charge_capacity"),
+    (248, "BatteryPeriodic.cycle_count"),
+    (256, "BatteryPeriodic.state_of_health"),
+)
+# fixed fields as decoded
+_BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY = struct.Struct("<fBeeeeffffHB")
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_PERIODIC_NAME_SPEC = _v.Array(_v.Number(type="uint8", kind="uint", low=0, high=255), 50, False, byte=True)
+_BATTERY_PERIODIC_SERIAL_NUMBER_SPEC = _v.Array(
+    _v.Number(type="uint8", kind="uint", low=0, high=255), 32, False, byte=True
+)
+_BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC = _v.Array(
+    _v.Number(type="uint8", kind="uint", low=0, high=255), 9, False, byte=True
+)
+_BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Ah"
+)
+_BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V")
+_BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="V"
+)
+_BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="V"
+)
+_BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC = _v.Number(
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="V"
+)
+_BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="A"
+)
+_BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="A"
+)
+_BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="A"
+)
+_BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Ah"
+)
+_BATTERY_PERIODIC_CYCLE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255, unit="%")
+
+
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_TAG_ENCODE_STRUCT = struct.Struct("<IIfIII")
+# (bit where each field ends, field): names the field a short payload cuts
+_BATTERY_TAG_FIELD_ENDS = (
+    (32, "BatteryTag.serial_number"),
+    (64, "BatteryTag.num_cycles"),
+    (96, "BatteryTag.armed_hours"),
+    (128, "BatteryTag.battery_capacity_mAh"),
+    (160, "BatteryTag.first_use_mins"),
+    (192, "BatteryTag.last_arm_time_mins"),
+)
+# fixed fields as decoded
+_BATTERY_TAG_DECODE_STRUCT = struct.Struct("<IIfIII")
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_TAG_SERIAL_NUMBER_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+_BATTERY_TAG_NUM_CYCLES_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+_BATTERY_TAG_ARMED_HOURS_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
+)
+_BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+_BATTERY_TAG_FIRST_USE_MINS_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+_BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+
+
 @functools.cache
 def _timestamp_class() -> type[_dronecan_uavcan.Timestamp]:
     from ....dronecan.uavcan import Timestamp as cls
 
     return cls
+
+
+@dataclasses.dataclass(slots=True)
+class BatteryCells:
+    """Battery cell voltages
+    Rate: set by parameter on smart battery (default off)
+
+    Schema: dronecan.ardupilot.equipment.power.BatteryCells (dronecan,
+    ardupilot/equipment/power/20012.BatteryCells.uavcan:1).
+    """
+
+    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryCells"
+
+    voltages: list[float] = dataclasses.field(
+        default_factory=list, metadata=_m.meta(name="voltages", type="float16[<=24]", unit="V", quantity="voltage")
+    )
+    index: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="index",
+            type="uint16",
+            doc="Index of the first cell in the array, index 0 is cells at array indices 0 - 23, "
+            "index 24 is cells at array indices 24 - 47, etc.",
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, Any] = {}
+        out["voltages"] = list(self.voltages)
+        out["index"] = self.index
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> BatteryCells:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(data, frozenset({"voltages", "index"}), (), "BatteryCells")
+        obj = cls()
+        if "voltages" in data:
+            obj.voltages = _m.as_list(data["voltages"], "voltages", 24, False, lambda item, p: _m.as_float(item, p))
+        if "index" in data:
+            obj.index = _m.as_int(data["index"], "index")
+        return obj
+
+    DATA_TYPE_ID: ClassVar[int | None] = 20012
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x5C8B1ABD15890EA4
+
+    def encode(self, *, tao: bool = True) -> bytes:
+        """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        acc = 1
+        x1 = self.voltages
+        k2 = len(x1)
+        if k2 > 24:
+            raise _dc.EncodeError("BatteryCells.voltages: length " + str(k2) + " exceeds capacity 24")
+        acc = (acc << 5) | k2
+        acc = (acc << (k2 * 16)) | int.from_bytes(struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
+        r4 = self.index
+        acc = (acc << 16) | int.from_bytes(
+            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
+            "big",
+        )
+        return _dc.finish(acc)
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> BatteryCells:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        f0: list[Any]
+        n = len(data)
+        v = int.from_bytes(data, "big")
+        rem = n << 3
+        if rem < 5:
+            raise _dc.short("BatteryCells.voltages (length)", 5, rem)
+        rem -= 5
+        k1 = (v >> rem) & 0x1F
+        if k1 > 24:
+            raise _dc.DecodeError("BatteryCells.voltages: length " + str(k1) + " exceeds capacity 24")
+        n2 = k1 * 16
+        if rem < n2:
+            raise _dc.short("BatteryCells.voltages", n2, rem)
+        rem -= n2
+        f0 = list(struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
+        if rem < 16:
+            raise _dc.cut(_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX, rem)
+        rem -= 16
+        (u3,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
+        if rem >= 8:
+            raise _dc.DecodeError("BatteryCells: " + str(rem >> 3) + " byte(s) beyond the end of the message")
+        return cls(f0, u3)
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        x1 = self.voltages
+        k2 = len(x1)
+        if k2 > 24:
+            raise _dc.EncodeError("BatteryCells.voltages: length " + str(k2) + " exceeds capacity 24")
+        acc = (acc << 5) | k2
+        acc = (acc << (k2 * 16)) | int.from_bytes(struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
+        r4 = self.index
+        acc = (acc << 16) | int.from_bytes(
+            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
+            "big",
+        )
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryCells, int]:
+        f0: list[Any]
+        if rem < 5:
+            raise _dc.short("BatteryCells.voltages (length)", 5, rem)
+        rem -= 5
+        k1 = (v >> rem) & 0x1F
+        if k1 > 24:
+            raise _dc.DecodeError("BatteryCells.voltages: length " + str(k1) + " exceeds capacity 24")
+        n2 = k1 * 16
+        if rem < n2:
+            raise _dc.short("BatteryCells.voltages", n2, rem)
+        rem -= n2
+        f0 = list(struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
+        if rem < 16:
+            raise _dc.cut(_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX, rem)
+        rem -= 16
+        (u3,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
+        return cls(f0, u3), rem
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        a: Any
+        e: Any
+        try:
+            a = self.voltages
+            if len(a) > 24:
+                _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
+            else:
+                for e in a:
+                    if not (-65504.0 <= e <= 65504.0):
+                        _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
+                        break
+        except _v.SLOW:
+            _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
+        try:
+            if self.index & -65536:
+                _v.diag(out, "index", self.index, _BATTERY_CELLS_INDEX_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "index", self.index, _BATTERY_CELLS_INDEX_SPEC)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "dronecan.ardupilot.equipment.power.BatteryCells")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field in {"voltages", "index"}:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryCells")
+
+
+@dataclasses.dataclass(slots=True)
+class BatteryContinuous:
+    """Battery data to be sent continuously
+
+    Schema: dronecan.ardupilot.equipment.power.BatteryContinuous (dronecan,
+    ardupilot/equipment/power/20010.BatteryContinuous.uavcan:1).
+    """
+
+    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryContinuous"
+    STATUS_FLAG_READY_TO_USE: ClassVar[int] = 1
+    STATUS_FLAG_CHARGING: ClassVar[int] = 2
+    STATUS_FLAG_CELL_BALANCING: ClassVar[int] = 4
+    STATUS_FLAG_FAULT_CELL_IMBALANCE: ClassVar[int] = 8
+    STATUS_FLAG_AUTO_DISCHARGING: ClassVar[int] = 16
+    STATUS_FLAG_REQUIRES_SERVICE: ClassVar[int] = 32
+    STATUS_FLAG_BAD_BATTERY: ClassVar[int] = 64
+    STATUS_FLAG_PROTECTIONS_ENABLED: ClassVar[int] = 128
+    STATUS_FLAG_FAULT_PROTECTION_SYSTEM: ClassVar[int] = 256
+    STATUS_FLAG_FAULT_OVER_VOLT: ClassVar[int] = 512
+    STATUS_FLAG_FAULT_UNDER_VOLT: ClassVar[int] = 1024
+    STATUS_FLAG_FAULT_OVER_TEMP: ClassVar[int] = 2048
+    STATUS_FLAG_FAULT_UNDER_TEMP: ClassVar[int] = 4096
+    STATUS_FLAG_FAULT_OVER_CURRENT: ClassVar[int] = 8192
+    STATUS_FLAG_FAULT_SHORT_CIRCUIT: ClassVar[int] = 16384
+    STATUS_FLAG_FAULT_INCOMPATIBLE_VOLTAGE: ClassVar[int] = 32768
+    STATUS_FLAG_FAULT_INCOMPATIBLE_FIRMWARE: ClassVar[int] = 65536
+    STATUS_FLAG_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION: ClassVar[int] = 131072
+    STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL: ClassVar[int] = 262144
+
+    temperature_cells: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="temperature_cells",
+            type="float16",
+            unit="degC",
+            quantity="temperature",
+            scale=1.0,
+            offset=273.15,
+            doc="Pack mounted thermistor (preferably installed between cells), NAN: field not provided",
+        ),
+    )
+    temperature_pcb: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="temperature_pcb",
+            type="float16",
+            unit="degC",
+            quantity="temperature",
+            scale=1.0,
+            offset=273.15,
+            doc="Battery PCB temperature (likely output FET(s) or current sense resistor), NAN: field not provided",
+        ),
+    )
+    temperature_other: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="temperature_other",
+            type="float16",
+            unit="degC",
+            quantity="temperature",
+            scale=1.0,
+            offset=273.15,
+            doc="Application dependent, NAN: field not provided",
+        ),
+    )
+    current: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="current",
+            type="float32",
+            unit="A",
+            quantity="current",
+            doc="Positive: defined as a discharge current. Negative: defined as a charging "
+            "current, NAN: field not provided",
+        ),
+    )
+    voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(name="voltage", type="float32", unit="V", quantity="voltage", doc="Battery voltage"),
+    )
+    state_of_charge: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="state_of_charge",
+            type="float16",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            doc="The estimated state of charge, in percent remaining (0 - 100).",
+        ),
+    )
+    slot_id: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="slot_id",
+            type="uint8",
+            doc=": The physical location of the battery on the aircraft. 0: field not provided",
+        ),
+    )
+    capacity_consumed: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="capacity_consumed",
+            type="float32",
+            unit="Ah",
+            quantity="charge",
+            scale=3600.0,
+            offset=0.0,
+            doc="This is either the consumption since power-on or since the battery was full, "
+            "depending on the value of STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL, NAN: field not "
+            "provided",
+        ),
+    )
+    status_flags: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="status_flags",
+            type="uint32",
+            enums=("dronecan.ardupilot.equipment.power.BatteryContinuous.STATUS_FLAG",),
+            doc=": Fault, health, readiness, and other status indications",
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, Any] = {}
+        out["temperature_cells"] = self.temperature_cells
+        out["temperature_pcb"] = self.temperature_pcb
+        out["temperature_other"] = self.temperature_other
+        out["current"] = self.current
+        out["voltage"] = self.voltage
+        out["state_of_charge"] = self.state_of_charge
+        out["slot_id"] = self.slot_id
+        out["capacity_consumed"] = self.capacity_consumed
+        out["status_flags"] = self.status_flags
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> BatteryContinuous:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "temperature_cells",
+                    "temperature_pcb",
+                    "temperature_other",
+                    "current",
+                    "voltage",
+                    "state_of_charge",
+                    "slot_id",
+                    "capacity_consumed",
+                    "status_flags",
+                }
+            ),
+            (),
+            "BatteryContinuous",
+        )
+        obj = cls()
+        if "temperature_cells" in data:
+            obj.temperature_cells = _m.as_float(data["temperature_cells"], "temperature_cells")
+        if "temperature_pcb" in data:
+            obj.temperature_pcb = _m.as_float(data["temperature_pcb"], "temperature_pcb")
+        if "temperature_other" in data:
+            obj.temperature_other = _m.as_float(data["temperature_other"], "temperature_other")
+        if "current" in data:
+            obj.current = _m.as_float(data["current"], "current")
+        if "voltage" in data:
+            obj.voltage = _m.as_float(data["voltage"], "voltage")
+        if "state_of_charge" in data:
+            obj.state_of_charge = _m.as_float(data["state_of_charge"], "state_of_charge")
+        if "slot_id" in data:
+            obj.slot_id = _m.as_int(data["slot_id"], "slot_id")
+        if "capacity_consumed" in data:
+            obj.capacity_consumed = _m.as_float(data["capacity_consumed"], "capacity_consumed")
+        if "status_flags" in data:
+            obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
+        return obj
+
+    DATA_TYPE_ID: ClassVar[int | None] = 20010
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x756B561340D5E4AE
+
+    def encode(self, *, tao: bool = True) -> bytes:
+        """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        r1 = self.temperature_cells
+        r2 = self.temperature_pcb
+        r3 = self.temperature_other
+        r4 = self.state_of_charge
+        g5, g6, g7, g8 = _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
+            _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
+                (
+                    r1
+                    if -65504.0 <= r1 <= 65504.0
+                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                ),
+                (
+                    r2
+                    if -65504.0 <= r2 <= 65504.0
+                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                ),
+                (
+                    r3
+                    if -65504.0 <= r3 <= 65504.0
+                    else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))
+                ),
+                (
+                    r4
+                    if -65504.0 <= r4 <= 65504.0
+                    else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))
+                ),
+            )
+        )
+        h9 = (
+            ((g5 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g5 < 0x477FF000
+            else (((g5 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g5 < 0xC77FF000 else _dc.f16bits(g5))
+        )
+        h10 = (
+            ((g6 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g6 < 0x477FF000
+            else (((g6 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g6 < 0xC77FF000 else _dc.f16bits(g6))
+        )
+        h11 = (
+            ((g7 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g7 < 0x477FF000
+            else (((g7 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g7 < 0xC77FF000 else _dc.f16bits(g7))
+        )
+        h12 = (
+            ((g8 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g8 < 0x477FF000
+            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        )
+        r13 = self.current
+        r14 = self.voltage
+        r15 = self.slot_id
+        r16 = self.capacity_consumed
+        r17 = self.status_flags
+        head = _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
+            h9,
+            h10,
+            h11,
+            (
+                r13
+                if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
+                else (_dc.F32_MAX if r13 > _dc.F32_MAX else (-_dc.F32_MAX if r13 < -_dc.F32_MAX else r13))
+            ),
+            (
+                r14
+                if -_dc.F32_MAX <= r14 <= _dc.F32_MAX
+                else (_dc.F32_MAX if r14 > _dc.F32_MAX else (-_dc.F32_MAX if r14 < -_dc.F32_MAX else r14))
+            ),
+            h12,
+            (r15 if 0 <= r15 <= 255 else (255 if r15 > 255 else 0)),
+            (
+                r16
+                if -_dc.F32_MAX <= r16 <= _dc.F32_MAX
+                else (_dc.F32_MAX if r16 > _dc.F32_MAX else (-_dc.F32_MAX if r16 < -_dc.F32_MAX else r16))
+            ),
+            (r17 if 0 <= r17 <= 4294967295 else (4294967295 if r17 > 4294967295 else 0)),
+        )
+        return head
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> BatteryContinuous:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        n = len(data)
+        if n < 25:
+            raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, n << 3)
+        u1, u2, u3, u4, u5, u6, u7, u8, u9 = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack_from(data)
+        if n > 25:
+            raise _dc.DecodeError("BatteryContinuous: " + str(n - 25) + " byte(s) beyond the end of the message")
+        return cls(u1, u2, u3, u4, u5, u6, u7, u8, u9)
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        r1 = self.temperature_cells
+        r2 = self.temperature_pcb
+        r3 = self.temperature_other
+        r4 = self.state_of_charge
+        g5, g6, g7, g8 = _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
+            _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
+                (
+                    r1
+                    if -65504.0 <= r1 <= 65504.0
+                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                ),
+                (
+                    r2
+                    if -65504.0 <= r2 <= 65504.0
+                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                ),
+                (
+                    r3
+                    if -65504.0 <= r3 <= 65504.0
+                    else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))
+                ),
+                (
+                    r4
+                    if -65504.0 <= r4 <= 65504.0
+                    else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))
+                ),
+            )
+        )
+        h9 = (
+            ((g5 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g5 < 0x477FF000
+            else (((g5 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g5 < 0xC77FF000 else _dc.f16bits(g5))
+        )
+        h10 = (
+            ((g6 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g6 < 0x477FF000
+            else (((g6 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g6 < 0xC77FF000 else _dc.f16bits(g6))
+        )
+        h11 = (
+            ((g7 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g7 < 0x477FF000
+            else (((g7 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g7 < 0xC77FF000 else _dc.f16bits(g7))
+        )
+        h12 = (
+            ((g8 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g8 < 0x477FF000
+            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        )
+        r13 = self.current
+        r14 = self.voltage
+        r15 = self.slot_id
+        r16 = self.capacity_consumed
+        r17 = self.status_flags
+        acc = (acc << 200) | int.from_bytes(
+            _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
+                h9,
+                h10,
+                h11,
+                (
+                    r13
+                    if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r13 > _dc.F32_MAX else (-_dc.F32_MAX if r13 < -_dc.F32_MAX else r13))
+                ),
+                (
+                    r14
+                    if -_dc.F32_MAX <= r14 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r14 > _dc.F32_MAX else (-_dc.F32_MAX if r14 < -_dc.F32_MAX else r14))
+                ),
+                h12,
+                (r15 if 0 <= r15 <= 255 else (255 if r15 > 255 else 0)),
+                (
+                    r16
+                    if -_dc.F32_MAX <= r16 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r16 > _dc.F32_MAX else (-_dc.F32_MAX if r16 < -_dc.F32_MAX else r16))
+                ),
+                (r17 if 0 <= r17 <= 4294967295 else (4294967295 if r17 > 4294967295 else 0)),
+            ),
+            "big",
+        )
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryContinuous, int]:
+        if rem < 200:
+            raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, rem)
+        rem -= 200
+        u1, u2, u3, u4, u5, u6, u7, u8, u9 = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack(
+            ((v >> rem) & ((1 << 200) - 1)).to_bytes(25, "big")
+        )
+        return cls(u1, u2, u3, u4, u5, u6, u7, u8, u9), rem
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        try:
+            if not (-65504.0 <= self.temperature_cells <= 65504.0):
+                _v.diag(out, "temperature_cells", self.temperature_cells, _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "temperature_cells", self.temperature_cells, _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC)
+        try:
+            if not (-65504.0 <= self.temperature_pcb <= 65504.0):
+                _v.diag(out, "temperature_pcb", self.temperature_pcb, _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "temperature_pcb", self.temperature_pcb, _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC)
+        try:
+            if not (-65504.0 <= self.temperature_other <= 65504.0):
+                _v.diag(out, "temperature_other", self.temperature_other, _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "temperature_other", self.temperature_other, _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC)
+        try:
+            if not (-3.4028234663852886e38 <= self.current <= 3.4028234663852886e38):
+                _v.diag(out, "current", self.current, _BATTERY_CONTINUOUS_CURRENT_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "current", self.current, _BATTERY_CONTINUOUS_CURRENT_SPEC)
+        try:
+            if not (-3.4028234663852886e38 <= self.voltage <= 3.4028234663852886e38):
+                _v.diag(out, "voltage", self.voltage, _BATTERY_CONTINUOUS_VOLTAGE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "voltage", self.voltage, _BATTERY_CONTINUOUS_VOLTAGE_SPEC)
+        try:
+            if not (-65504.0 <= self.state_of_charge <= 65504.0):
+                _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC)
+        try:
+            if self.slot_id & -256:
+                _v.diag(out, "slot_id", self.slot_id, _BATTERY_CONTINUOUS_SLOT_ID_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "slot_id", self.slot_id, _BATTERY_CONTINUOUS_SLOT_ID_SPEC)
+        try:
+            if not (-3.4028234663852886e38 <= self.capacity_consumed <= 3.4028234663852886e38):
+                _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC)
+        try:
+            if self.status_flags & -524288:
+                _v.diag(out, "status_flags", self.status_flags, _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "status_flags", self.status_flags, _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "dronecan.ardupilot.equipment.power.BatteryContinuous")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field in {
+            "temperature_cells",
+            "temperature_pcb",
+            "temperature_other",
+            "current",
+            "voltage",
+            "state_of_charge",
+            "slot_id",
+            "capacity_consumed",
+            "status_flags",
+        }:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryContinuous")
 
 
 @dataclasses.dataclass(slots=True)
@@ -279,7 +1098,7 @@ class BatteryInfoAux:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
         u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
-            (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
+            (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
         )
         x12 = ((u11 >> 7) & 0x1) != 0
         x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
@@ -369,7 +1188,7 @@ class BatteryInfoAux:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
         u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
-            (((v >> rem) & 0x1FFFFFFFFFFFFFFFFFF) << 7).to_bytes(10, "big")
+            (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
         )
         x12 = ((u11 >> 7) & 0x1) != 0
         x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
@@ -459,3 +1278,978 @@ class BatteryInfoAux:
         }:
             return True
         raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryInfoAux")
+
+
+@dataclasses.dataclass(slots=True)
+class BatteryPeriodic:
+    """Battery data to be sent statically upon request or periodically at a low rate
+     Recommend that this message is sent at a maximum of 1Hz and nominally 0.2 Hz (IE: once every 5 seconds.)
+
+    Schema: dronecan.ardupilot.equipment.power.BatteryPeriodic (dronecan,
+    ardupilot/equipment/power/20011.BatteryPeriodic.uavcan:1).
+    """
+
+    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryPeriodic"
+
+    name: bytes = dataclasses.field(
+        default=b"",
+        metadata=_m.meta(name="name", type="uint8[<=50]", doc=": Formatted as manufacturer_product, 0 terminated"),
+    )
+    serial_number: bytes = dataclasses.field(
+        default=b"",
+        metadata=_m.meta(
+            name="serial_number", type="uint8[<=32]", doc=": Serial number in ASCII characters, 0 terminated"
+        ),
+    )
+    manufacture_date: bytes = dataclasses.field(
+        default=b"",
+        metadata=_m.meta(
+            name="manufacture_date",
+            type="uint8[<=9]",
+            doc=": Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated",
+        ),
+    )
+    design_capacity: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="design_capacity",
+            type="float32",
+            unit="Ah",
+            quantity="charge",
+            scale=3600.0,
+            offset=0.0,
+            doc="Fully charged design capacity. 0: field not provided.",
+        ),
+    )
+    cells_in_series: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="cells_in_series", type="uint8", doc=": Number of battery cells in series. 0: field not provided."
+        ),
+    )
+    nominal_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="nominal_voltage",
+            type="float16",
+            unit="V",
+            quantity="voltage",
+            doc="Battery nominal voltage. Used for conversion between Wh and Ah. 0: field not provided.",
+        ),
+    )
+    discharge_minimum_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="discharge_minimum_voltage",
+            type="float16",
+            unit="V",
+            quantity="voltage",
+            doc="Minimum per-cell voltage when discharging. 0: field not provided.",
+        ),
+    )
+    charging_minimum_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="charging_minimum_voltage",
+            type="float16",
+            unit="V",
+            quantity="voltage",
+            doc="Minimum per-cell voltage when charging. 0: field not provided.",
+        ),
+    )
+    charging_maximum_voltage: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="charging_maximum_voltage",
+            type="float16",
+            unit="V",
+            quantity="voltage",
+            doc="Maximum per-cell voltage when charged. 0: field not provided.",
+        ),
+    )
+    charging_maximum_current: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="charging_maximum_current",
+            type="float32",
+            unit="A",
+            quantity="current",
+            doc="Maximum pack continuous charge current. 0: field not provided.",
+        ),
+    )
+    discharge_maximum_current: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="discharge_maximum_current",
+            type="float32",
+            unit="A",
+            quantity="current",
+            doc="Maximum pack continuous discharge current. 0: field not provided.",
+        ),
+    )
+    discharge_maximum_burst_current: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="discharge_maximum_burst_current",
+            type="float32",
+            unit="A",
+            quantity="current",
+            doc="Maximum pack discharge burst current for 30 seconds. 0: field not provided",
+        ),
+    )
+    full_charge_capacity: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="full_charge_capacity",
+            type="float32",
+            unit="Ah",
+            quantity="charge",
+            scale=3600.0,
+            offset=0.0,
+            doc="Predicted battery capacity when fully charged (accounting for battery "
+            "degradation), NAN: field not provided",
+        ),
+    )
+    cycle_count: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="cycle_count",
+            type="uint16",
+            doc=": Lifetime count of the number of charge/discharge cycles "
+            "(https://en.wikipedia.org/wiki/Charge_cycle). UINT16_MAX: field not provided.",
+        ),
+    )
+    state_of_health: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="state_of_health",
+            type="uint8",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            doc="State of Health (SOH) estimate, in percent (0 - 100). UINT8_MAX: field not provided.",
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, Any] = {}
+        out["name"] = list(self.name)
+        out["serial_number"] = list(self.serial_number)
+        out["manufacture_date"] = list(self.manufacture_date)
+        out["design_capacity"] = self.design_capacity
+        out["cells_in_series"] = self.cells_in_series
+        out["nominal_voltage"] = self.nominal_voltage
+        out["discharge_minimum_voltage"] = self.discharge_minimum_voltage
+        out["charging_minimum_voltage"] = self.charging_minimum_voltage
+        out["charging_maximum_voltage"] = self.charging_maximum_voltage
+        out["charging_maximum_current"] = self.charging_maximum_current
+        out["discharge_maximum_current"] = self.discharge_maximum_current
+        out["discharge_maximum_burst_current"] = self.discharge_maximum_burst_current
+        out["full_charge_capacity"] = self.full_charge_capacity
+        out["cycle_count"] = self.cycle_count
+        out["state_of_health"] = self.state_of_health
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> BatteryPeriodic:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "name",
+                    "serial_number",
+                    "manufacture_date",
+                    "design_capacity",
+                    "cells_in_series",
+                    "nominal_voltage",
+                    "discharge_minimum_voltage",
+                    "charging_minimum_voltage",
+                    "charging_maximum_voltage",
+                    "charging_maximum_current",
+                    "discharge_maximum_current",
+                    "discharge_maximum_burst_current",
+                    "full_charge_capacity",
+                    "cycle_count",
+                    "state_of_health",
+                }
+            ),
+            (),
+            "BatteryPeriodic",
+        )
+        obj = cls()
+        if "name" in data:
+            obj.name = _m.as_bytes(data["name"], "name", 50, False)
+        if "serial_number" in data:
+            obj.serial_number = _m.as_bytes(data["serial_number"], "serial_number", 32, False)
+        if "manufacture_date" in data:
+            obj.manufacture_date = _m.as_bytes(data["manufacture_date"], "manufacture_date", 9, False)
+        if "design_capacity" in data:
+            obj.design_capacity = _m.as_float(data["design_capacity"], "design_capacity")
+        if "cells_in_series" in data:
+            obj.cells_in_series = _m.as_int(data["cells_in_series"], "cells_in_series")
+        if "nominal_voltage" in data:
+            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+        if "discharge_minimum_voltage" in data:
+            obj.discharge_minimum_voltage = _m.as_float(data["discharge_minimum_voltage"], "discharge_minimum_voltage")
+        if "charging_minimum_voltage" in data:
+            obj.charging_minimum_voltage = _m.as_float(data["charging_minimum_voltage"], "charging_minimum_voltage")
+        if "charging_maximum_voltage" in data:
+            obj.charging_maximum_voltage = _m.as_float(data["charging_maximum_voltage"], "charging_maximum_voltage")
+        if "charging_maximum_current" in data:
+            obj.charging_maximum_current = _m.as_float(data["charging_maximum_current"], "charging_maximum_current")
+        if "discharge_maximum_current" in data:
+            obj.discharge_maximum_current = _m.as_float(data["discharge_maximum_current"], "discharge_maximum_current")
+        if "discharge_maximum_burst_current" in data:
+            obj.discharge_maximum_burst_current = _m.as_float(
+                data["discharge_maximum_burst_current"], "discharge_maximum_burst_current"
+            )
+        if "full_charge_capacity" in data:
+            obj.full_charge_capacity = _m.as_float(data["full_charge_capacity"], "full_charge_capacity")
+        if "cycle_count" in data:
+            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+        if "state_of_health" in data:
+            obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
+        return obj
+
+    DATA_TYPE_ID: ClassVar[int | None] = 20011
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x0F012494E97358D2
+
+    def encode(self, *, tao: bool = True) -> bytes:
+        """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        acc = 1
+        x1 = self.name
+        k2 = len(x1)
+        if k2 > 50:
+            raise _dc.EncodeError("BatteryPeriodic.name: length " + str(k2) + " exceeds capacity 50")
+        acc = (acc << 6) | k2
+        acc = (acc << (k2 << 3)) | int.from_bytes(x1, "big")
+        x3 = self.serial_number
+        k4 = len(x3)
+        if k4 > 32:
+            raise _dc.EncodeError("BatteryPeriodic.serial_number: length " + str(k4) + " exceeds capacity 32")
+        acc = (acc << 6) | k4
+        acc = (acc << (k4 << 3)) | int.from_bytes(x3, "big")
+        x5 = self.manufacture_date
+        k6 = len(x5)
+        if k6 > 9:
+            raise _dc.EncodeError("BatteryPeriodic.manufacture_date: length " + str(k6) + " exceeds capacity 9")
+        acc = (acc << 4) | k6
+        acc = (acc << (k6 << 3)) | int.from_bytes(x5, "big")
+        r7 = self.nominal_voltage
+        r8 = self.discharge_minimum_voltage
+        r9 = self.charging_minimum_voltage
+        r10 = self.charging_maximum_voltage
+        g11, g12, g13, g14 = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+            _BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY.pack(
+                (
+                    r7
+                    if -65504.0 <= r7 <= 65504.0
+                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                ),
+                (
+                    r8
+                    if -65504.0 <= r8 <= 65504.0
+                    else (65504.0 if r8 > 65504.0 else (-65504.0 if r8 < -65504.0 else r8))
+                ),
+                (
+                    r9
+                    if -65504.0 <= r9 <= 65504.0
+                    else (65504.0 if r9 > 65504.0 else (-65504.0 if r9 < -65504.0 else r9))
+                ),
+                (
+                    r10
+                    if -65504.0 <= r10 <= 65504.0
+                    else (65504.0 if r10 > 65504.0 else (-65504.0 if r10 < -65504.0 else r10))
+                ),
+            )
+        )
+        h15 = (
+            ((g11 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g11 < 0x477FF000
+            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        )
+        h16 = (
+            ((g12 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g12 < 0x477FF000
+            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        )
+        h17 = (
+            ((g13 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g13 < 0x477FF000
+            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        )
+        h18 = (
+            ((g14 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g14 < 0x477FF000
+            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        )
+        r19 = self.design_capacity
+        r20 = self.cells_in_series
+        r21 = self.charging_maximum_current
+        r22 = self.discharge_maximum_current
+        r23 = self.discharge_maximum_burst_current
+        r24 = self.full_charge_capacity
+        r25 = self.cycle_count
+        r26 = self.state_of_health
+        acc = (acc << 256) | int.from_bytes(
+            _BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY.pack(
+                (
+                    r19
+                    if -_dc.F32_MAX <= r19 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r19 > _dc.F32_MAX else (-_dc.F32_MAX if r19 < -_dc.F32_MAX else r19))
+                ),
+                (r20 if 0 <= r20 <= 255 else (255 if r20 > 255 else 0)),
+                h15,
+                h16,
+                h17,
+                h18,
+                (
+                    r21
+                    if -_dc.F32_MAX <= r21 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r21 > _dc.F32_MAX else (-_dc.F32_MAX if r21 < -_dc.F32_MAX else r21))
+                ),
+                (
+                    r22
+                    if -_dc.F32_MAX <= r22 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r22 > _dc.F32_MAX else (-_dc.F32_MAX if r22 < -_dc.F32_MAX else r22))
+                ),
+                (
+                    r23
+                    if -_dc.F32_MAX <= r23 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r23 > _dc.F32_MAX else (-_dc.F32_MAX if r23 < -_dc.F32_MAX else r23))
+                ),
+                (
+                    r24
+                    if -_dc.F32_MAX <= r24 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r24 > _dc.F32_MAX else (-_dc.F32_MAX if r24 < -_dc.F32_MAX else r24))
+                ),
+                (r25 if 0 <= r25 <= 65535 else (65535 if r25 > 65535 else 0)),
+                (r26 if 0 <= r26 <= 255 else (255 if r26 > 255 else 0)),
+            ),
+            "big",
+        )
+        return _dc.finish(acc)
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> BatteryPeriodic:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        f0: bytes
+        f1: bytes
+        f2: bytes
+        n = len(data)
+        v = int.from_bytes(data, "big")
+        rem = n << 3
+        if rem < 6:
+            raise _dc.short("BatteryPeriodic.name (length)", 6, rem)
+        rem -= 6
+        k1 = (v >> rem) & 0x3F
+        if k1 > 50:
+            raise _dc.DecodeError("BatteryPeriodic.name: length " + str(k1) + " exceeds capacity 50")
+        n2 = k1 * 8
+        if rem < n2:
+            raise _dc.short("BatteryPeriodic.name", n2, rem)
+        rem -= n2
+        f0 = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
+        if rem < 6:
+            raise _dc.short("BatteryPeriodic.serial_number (length)", 6, rem)
+        rem -= 6
+        k3 = (v >> rem) & 0x3F
+        if k3 > 32:
+            raise _dc.DecodeError("BatteryPeriodic.serial_number: length " + str(k3) + " exceeds capacity 32")
+        n4 = k3 * 8
+        if rem < n4:
+            raise _dc.short("BatteryPeriodic.serial_number", n4, rem)
+        rem -= n4
+        f1 = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
+        if rem < 4:
+            raise _dc.short("BatteryPeriodic.manufacture_date (length)", 4, rem)
+        rem -= 4
+        k5 = (v >> rem) & 0xF
+        if k5 > 9:
+            raise _dc.DecodeError("BatteryPeriodic.manufacture_date: length " + str(k5) + " exceeds capacity 9")
+        n6 = k5 * 8
+        if rem < n6:
+            raise _dc.short("BatteryPeriodic.manufacture_date", n6, rem)
+        rem -= n6
+        f2 = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
+        if rem < 256:
+            raise _dc.cut(_BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY, rem)
+        rem -= 256
+        u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18 = (
+            _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+                ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
+            )
+        )
+        if rem >= 8:
+            raise _dc.DecodeError("BatteryPeriodic: " + str(rem >> 3) + " byte(s) beyond the end of the message")
+        return cls(f0, f1, f2, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18)
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        x1 = self.name
+        k2 = len(x1)
+        if k2 > 50:
+            raise _dc.EncodeError("BatteryPeriodic.name: length " + str(k2) + " exceeds capacity 50")
+        acc = (acc << 6) | k2
+        acc = (acc << (k2 << 3)) | int.from_bytes(x1, "big")
+        x3 = self.serial_number
+        k4 = len(x3)
+        if k4 > 32:
+            raise _dc.EncodeError("BatteryPeriodic.serial_number: length " + str(k4) + " exceeds capacity 32")
+        acc = (acc << 6) | k4
+        acc = (acc << (k4 << 3)) | int.from_bytes(x3, "big")
+        x5 = self.manufacture_date
+        k6 = len(x5)
+        if k6 > 9:
+            raise _dc.EncodeError("BatteryPeriodic.manufacture_date: length " + str(k6) + " exceeds capacity 9")
+        acc = (acc << 4) | k6
+        acc = (acc << (k6 << 3)) | int.from_bytes(x5, "big")
+        r7 = self.nominal_voltage
+        r8 = self.discharge_minimum_voltage
+        r9 = self.charging_minimum_voltage
+        r10 = self.charging_maximum_voltage
+        g11, g12, g13, g14 = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+            _BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY.pack(
+                (
+                    r7
+                    if -65504.0 <= r7 <= 65504.0
+                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                ),
+                (
+                    r8
+                    if -65504.0 <= r8 <= 65504.0
+                    else (65504.0 if r8 > 65504.0 else (-65504.0 if r8 < -65504.0 else r8))
+                ),
+                (
+                    r9
+                    if -65504.0 <= r9 <= 65504.0
+                    else (65504.0 if r9 > 65504.0 else (-65504.0 if r9 < -65504.0 else r9))
+                ),
+                (
+                    r10
+                    if -65504.0 <= r10 <= 65504.0
+                    else (65504.0 if r10 > 65504.0 else (-65504.0 if r10 < -65504.0 else r10))
+                ),
+            )
+        )
+        h15 = (
+            ((g11 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g11 < 0x477FF000
+            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        )
+        h16 = (
+            ((g12 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g12 < 0x477FF000
+            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        )
+        h17 = (
+            ((g13 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g13 < 0x477FF000
+            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        )
+        h18 = (
+            ((g14 - 0x37FFF000) >> 13)
+            if 0x38800000 <= g14 < 0x477FF000
+            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        )
+        r19 = self.design_capacity
+        r20 = self.cells_in_series
+        r21 = self.charging_maximum_current
+        r22 = self.discharge_maximum_current
+        r23 = self.discharge_maximum_burst_current
+        r24 = self.full_charge_capacity
+        r25 = self.cycle_count
+        r26 = self.state_of_health
+        acc = (acc << 256) | int.from_bytes(
+            _BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY.pack(
+                (
+                    r19
+                    if -_dc.F32_MAX <= r19 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r19 > _dc.F32_MAX else (-_dc.F32_MAX if r19 < -_dc.F32_MAX else r19))
+                ),
+                (r20 if 0 <= r20 <= 255 else (255 if r20 > 255 else 0)),
+                h15,
+                h16,
+                h17,
+                h18,
+                (
+                    r21
+                    if -_dc.F32_MAX <= r21 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r21 > _dc.F32_MAX else (-_dc.F32_MAX if r21 < -_dc.F32_MAX else r21))
+                ),
+                (
+                    r22
+                    if -_dc.F32_MAX <= r22 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r22 > _dc.F32_MAX else (-_dc.F32_MAX if r22 < -_dc.F32_MAX else r22))
+                ),
+                (
+                    r23
+                    if -_dc.F32_MAX <= r23 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r23 > _dc.F32_MAX else (-_dc.F32_MAX if r23 < -_dc.F32_MAX else r23))
+                ),
+                (
+                    r24
+                    if -_dc.F32_MAX <= r24 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r24 > _dc.F32_MAX else (-_dc.F32_MAX if r24 < -_dc.F32_MAX else r24))
+                ),
+                (r25 if 0 <= r25 <= 65535 else (65535 if r25 > 65535 else 0)),
+                (r26 if 0 <= r26 <= 255 else (255 if r26 > 255 else 0)),
+            ),
+            "big",
+        )
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryPeriodic, int]:
+        f0: bytes
+        f1: bytes
+        f2: bytes
+        if rem < 6:
+            raise _dc.short("BatteryPeriodic.name (length)", 6, rem)
+        rem -= 6
+        k1 = (v >> rem) & 0x3F
+        if k1 > 50:
+            raise _dc.DecodeError("BatteryPeriodic.name: length " + str(k1) + " exceeds capacity 50")
+        n2 = k1 * 8
+        if rem < n2:
+            raise _dc.short("BatteryPeriodic.name", n2, rem)
+        rem -= n2
+        f0 = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
+        if rem < 6:
+            raise _dc.short("BatteryPeriodic.serial_number (length)", 6, rem)
+        rem -= 6
+        k3 = (v >> rem) & 0x3F
+        if k3 > 32:
+            raise _dc.DecodeError("BatteryPeriodic.serial_number: length " + str(k3) + " exceeds capacity 32")
+        n4 = k3 * 8
+        if rem < n4:
+            raise _dc.short("BatteryPeriodic.serial_number", n4, rem)
+        rem -= n4
+        f1 = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
+        if rem < 4:
+            raise _dc.short("BatteryPeriodic.manufacture_date (length)", 4, rem)
+        rem -= 4
+        k5 = (v >> rem) & 0xF
+        if k5 > 9:
+            raise _dc.DecodeError("BatteryPeriodic.manufacture_date: length " + str(k5) + " exceeds capacity 9")
+        n6 = k5 * 8
+        if rem < n6:
+            raise _dc.short("BatteryPeriodic.manufacture_date", n6, rem)
+        rem -= n6
+        f2 = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
+        if rem < 256:
+            raise _dc.cut(_BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY, rem)
+        rem -= 256
+        u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18 = (
+            _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+                ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
+            )
+        )
+        return cls(f0, f1, f2, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18), rem
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: Any
+        try:
+            x = self.name
+            if x.__class__ is not bytes or len(x) > 50:
+                _v.diag(out, "name", self.name, _BATTERY_PERIODIC_NAME_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "name", self.name, _BATTERY_PERIODIC_NAME_SPEC)
+        try:
+            x = self.serial_number
+            if x.__class__ is not bytes or len(x) > 32:
+                _v.diag(out, "serial_number", self.serial_number, _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "serial_number", self.serial_number, _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC)
+        try:
+            x = self.manufacture_date
+            if x.__class__ is not bytes or len(x) > 9:
+                _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC)
+        try:
+            if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
+                _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC)
+        try:
+            if self.cells_in_series & -256:
+                _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC)
+        try:
+            if not (-65504.0 <= self.nominal_voltage <= 65504.0):
+                _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC)
+        try:
+            if not (-65504.0 <= self.discharge_minimum_voltage <= 65504.0):
+                _v.diag(
+                    out,
+                    "discharge_minimum_voltage",
+                    self.discharge_minimum_voltage,
+                    _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "discharge_minimum_voltage",
+                self.discharge_minimum_voltage,
+                _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
+            )
+        try:
+            if not (-65504.0 <= self.charging_minimum_voltage <= 65504.0):
+                _v.diag(
+                    out,
+                    "charging_minimum_voltage",
+                    self.charging_minimum_voltage,
+                    _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "charging_minimum_voltage",
+                self.charging_minimum_voltage,
+                _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC,
+            )
+        try:
+            if not (-65504.0 <= self.charging_maximum_voltage <= 65504.0):
+                _v.diag(
+                    out,
+                    "charging_maximum_voltage",
+                    self.charging_maximum_voltage,
+                    _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "charging_maximum_voltage",
+                self.charging_maximum_voltage,
+                _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.charging_maximum_current <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "charging_maximum_current",
+                    self.charging_maximum_current,
+                    _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "charging_maximum_current",
+                self.charging_maximum_current,
+                _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.discharge_maximum_current <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "discharge_maximum_current",
+                    self.discharge_maximum_current,
+                    _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "discharge_maximum_current",
+                self.discharge_maximum_current,
+                _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.discharge_maximum_burst_current <= 3.4028234663852886e38):
+                _v.diag(
+                    out,
+                    "discharge_maximum_burst_current",
+                    self.discharge_maximum_burst_current,
+                    _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "discharge_maximum_burst_current",
+                self.discharge_maximum_burst_current,
+                _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
+            )
+        try:
+            if not (-3.4028234663852886e38 <= self.full_charge_capacity <= 3.4028234663852886e38):
+                _v.diag(
+                    out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC
+                )
+        except _v.SLOW:
+            _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC)
+        try:
+            if self.cycle_count & -65536:
+                _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_PERIODIC_CYCLE_COUNT_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_PERIODIC_CYCLE_COUNT_SPEC)
+        try:
+            if self.state_of_health & -256:
+                _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "dronecan.ardupilot.equipment.power.BatteryPeriodic")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field in {
+            "name",
+            "serial_number",
+            "manufacture_date",
+            "design_capacity",
+            "cells_in_series",
+            "nominal_voltage",
+            "discharge_minimum_voltage",
+            "charging_minimum_voltage",
+            "charging_maximum_voltage",
+            "charging_maximum_current",
+            "discharge_maximum_current",
+            "discharge_maximum_burst_current",
+            "full_charge_capacity",
+            "cycle_count",
+            "state_of_health",
+        }:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryPeriodic")
+
+
+@dataclasses.dataclass(slots=True)
+class BatteryTag:
+    """Battery tag information. This is broadcast by a battery tag device
+    permanently attached to a battery to record the lifecycle of the battery
+
+    Schema: dronecan.ardupilot.equipment.power.BatteryTag (dronecan,
+    ardupilot/equipment/power/20500.BatteryTag.uavcan:1).
+    """
+
+    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryTag"
+
+    serial_number: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="serial_number", type="uint32", doc="vendor supplied serial number")
+    )
+    num_cycles: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="num_cycles",
+            type="uint32",
+            doc="number of cycles this battery has been through. Criteria for\ndefining a cycle is vendor specific",
+        ),
+    )
+    armed_hours: float = dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="armed_hours",
+            type="float32",
+            doc="number of hours that this battery has been running when\nvehicle is in an armed state",
+        ),
+    )
+    battery_capacity_mAh: int = dataclasses.field(
+        default=0, metadata=_m.meta(name="battery_capacity_mAh", type="uint32", doc="battery capacity in milliAmpHours")
+    )
+    first_use_mins: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="first_use_mins",
+            type="uint32",
+            doc="time of first use of battery with vehicle armed, in minutes since 1/1/1970",
+        ),
+    )
+    last_arm_time_mins: int = dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="last_arm_time_mins",
+            type="uint32",
+            doc="time of most recent change to armed state, in minutes since 1/1/1970",
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, Any] = {}
+        out["serial_number"] = self.serial_number
+        out["num_cycles"] = self.num_cycles
+        out["armed_hours"] = self.armed_hours
+        out["battery_capacity_mAh"] = self.battery_capacity_mAh
+        out["first_use_mins"] = self.first_use_mins
+        out["last_arm_time_mins"] = self.last_arm_time_mins
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> BatteryTag:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "serial_number",
+                    "num_cycles",
+                    "armed_hours",
+                    "battery_capacity_mAh",
+                    "first_use_mins",
+                    "last_arm_time_mins",
+                }
+            ),
+            (),
+            "BatteryTag",
+        )
+        obj = cls()
+        if "serial_number" in data:
+            obj.serial_number = _m.as_int(data["serial_number"], "serial_number")
+        if "num_cycles" in data:
+            obj.num_cycles = _m.as_int(data["num_cycles"], "num_cycles")
+        if "armed_hours" in data:
+            obj.armed_hours = _m.as_float(data["armed_hours"], "armed_hours")
+        if "battery_capacity_mAh" in data:
+            obj.battery_capacity_mAh = _m.as_int(data["battery_capacity_mAh"], "battery_capacity_mAh")
+        if "first_use_mins" in data:
+            obj.first_use_mins = _m.as_int(data["first_use_mins"], "first_use_mins")
+        if "last_arm_time_mins" in data:
+            obj.last_arm_time_mins = _m.as_int(data["last_arm_time_mins"], "last_arm_time_mins")
+        return obj
+
+    DATA_TYPE_ID: ClassVar[int | None] = 20500
+    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x4A5A9B42099F73E1
+
+    def encode(self, *, tao: bool = True) -> bytes:
+        """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        r1 = self.serial_number
+        r2 = self.num_cycles
+        r3 = self.armed_hours
+        r4 = self.battery_capacity_mAh
+        r5 = self.first_use_mins
+        r6 = self.last_arm_time_mins
+        head = _BATTERY_TAG_ENCODE_STRUCT.pack(
+            (r1 if 0 <= r1 <= 4294967295 else (4294967295 if r1 > 4294967295 else 0)),
+            (r2 if 0 <= r2 <= 4294967295 else (4294967295 if r2 > 4294967295 else 0)),
+            (
+                r3
+                if -_dc.F32_MAX <= r3 <= _dc.F32_MAX
+                else (_dc.F32_MAX if r3 > _dc.F32_MAX else (-_dc.F32_MAX if r3 < -_dc.F32_MAX else r3))
+            ),
+            (r4 if 0 <= r4 <= 4294967295 else (4294967295 if r4 > 4294967295 else 0)),
+            (r5 if 0 <= r5 <= 4294967295 else (4294967295 if r5 > 4294967295 else 0)),
+            (r6 if 0 <= r6 <= 4294967295 else (4294967295 if r6 > 4294967295 else 0)),
+        )
+        return head
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> BatteryTag:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        n = len(data)
+        if n < 24:
+            raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, n << 3)
+        u1, u2, u3, u4, u5, u6 = _BATTERY_TAG_DECODE_STRUCT.unpack_from(data)
+        if n > 24:
+            raise _dc.DecodeError("BatteryTag: " + str(n - 24) + " byte(s) beyond the end of the message")
+        return cls(u1, u2, u3, u4, u5, u6)
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        r1 = self.serial_number
+        r2 = self.num_cycles
+        r3 = self.armed_hours
+        r4 = self.battery_capacity_mAh
+        r5 = self.first_use_mins
+        r6 = self.last_arm_time_mins
+        acc = (acc << 192) | int.from_bytes(
+            _BATTERY_TAG_ENCODE_STRUCT.pack(
+                (r1 if 0 <= r1 <= 4294967295 else (4294967295 if r1 > 4294967295 else 0)),
+                (r2 if 0 <= r2 <= 4294967295 else (4294967295 if r2 > 4294967295 else 0)),
+                (
+                    r3
+                    if -_dc.F32_MAX <= r3 <= _dc.F32_MAX
+                    else (_dc.F32_MAX if r3 > _dc.F32_MAX else (-_dc.F32_MAX if r3 < -_dc.F32_MAX else r3))
+                ),
+                (r4 if 0 <= r4 <= 4294967295 else (4294967295 if r4 > 4294967295 else 0)),
+                (r5 if 0 <= r5 <= 4294967295 else (4294967295 if r5 > 4294967295 else 0)),
+                (r6 if 0 <= r6 <= 4294967295 else (4294967295 if r6 > 4294967295 else 0)),
+            ),
+            "big",
+        )
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryTag, int]:
+        if rem < 192:
+            raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, rem)
+        rem -= 192
+        u1, u2, u3, u4, u5, u6 = _BATTERY_TAG_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 192) - 1)).to_bytes(24, "big"))
+        return cls(u1, u2, u3, u4, u5, u6), rem
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        try:
+            if self.serial_number & -4294967296:
+                _v.diag(out, "serial_number", self.serial_number, _BATTERY_TAG_SERIAL_NUMBER_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "serial_number", self.serial_number, _BATTERY_TAG_SERIAL_NUMBER_SPEC)
+        try:
+            if self.num_cycles & -4294967296:
+                _v.diag(out, "num_cycles", self.num_cycles, _BATTERY_TAG_NUM_CYCLES_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "num_cycles", self.num_cycles, _BATTERY_TAG_NUM_CYCLES_SPEC)
+        try:
+            if not (-3.4028234663852886e38 <= self.armed_hours <= 3.4028234663852886e38):
+                _v.diag(out, "armed_hours", self.armed_hours, _BATTERY_TAG_ARMED_HOURS_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "armed_hours", self.armed_hours, _BATTERY_TAG_ARMED_HOURS_SPEC)
+        try:
+            if self.battery_capacity_mAh & -4294967296:
+                _v.diag(out, "battery_capacity_mAh", self.battery_capacity_mAh, _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "battery_capacity_mAh", self.battery_capacity_mAh, _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC)
+        try:
+            if self.first_use_mins & -4294967296:
+                _v.diag(out, "first_use_mins", self.first_use_mins, _BATTERY_TAG_FIRST_USE_MINS_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "first_use_mins", self.first_use_mins, _BATTERY_TAG_FIRST_USE_MINS_SPEC)
+        try:
+            if self.last_arm_time_mins & -4294967296:
+                _v.diag(out, "last_arm_time_mins", self.last_arm_time_mins, _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "last_arm_time_mins", self.last_arm_time_mins, _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "dronecan.ardupilot.equipment.power.BatteryTag")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field in {
+            "serial_number",
+            "num_cycles",
+            "armed_hours",
+            "battery_capacity_mAh",
+            "first_use_mins",
+            "last_arm_time_mins",
+        }:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryTag")

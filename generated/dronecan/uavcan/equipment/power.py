@@ -732,7 +732,7 @@ class BatteryInfo:
             raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, rem)
         rem -= 184
         u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _BATTERY_INFO_DECODE_STRUCT.unpack(
-            ((v >> rem) & 0xFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF).to_bytes(23, "big")
+            ((v >> rem) & ((1 << 184) - 1)).to_bytes(23, "big")
         )
         x11 = (u8 & 0xFF) | (((u8 >> 13) & 0x7) << 8)
         x12 = ((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1F) << 2)

@@ -2,8 +2,10 @@
 
 Every DroneCAN class gets ``encode(*, tao=True) -> bytes``, ``decode(data, *, tao=True)``,
 ``DATA_TYPE_ID`` / ``DATA_TYPE_SIGNATURE`` class attributes and, for a ``@union``, a
-``union_field`` attribute naming the active field. The shared runtime (``_dronecan.py``) holds
-float16 rounding, the bit-stream finisher, ``DecodeError`` and ``transfer_crc``.
+``union_field`` attribute naming the held branch, kept by the runtime's ``Union`` (branch
+attributes are None except the held one; assigning a branch selects it, as in pydronecan).
+The shared runtime (``_dronecan.py``) holds float16 rounding, the bit-stream finisher,
+``DecodeError`` and ``transfer_crc``.
 Layout planning lives in :mod:`.plan`, code emission in :mod:`.emit`.
 """
 
@@ -11,6 +13,7 @@ from __future__ import annotations
 
 from .....ir import CompositeType, Message, Schema, SourceFormat
 from ...extensions import Contribution
+from ...field_source import FieldBuilder
 from ...literals import py_literal
 from ...module_context import ModuleContext
 from ...runtime import copied
@@ -58,13 +61,7 @@ class _Codec:
             f"{sig_name}: ClassVar[int] = 0x{info.signature:016X}",
         ]
         if info.union:
-            emitter.union_attr = _free_name("union_field", taken | {id_name, sig_name})
-            first = emitter.idents[0]
-            meta = (
-                f'_m.meta(name={py_literal(emitter.union_attr)}, type="union tag", '
-                'doc="Name of the field this union holds (the one encoded)")'
-            )
-            lines.append(f"{emitter.union_attr}: str = dataclasses.field(default={py_literal(first)}, metadata={meta})")
+            self._union(msg, ctx, view, emitter, lines)
         methods = [
             emitter.method_encode(),
             emitter.method_decode(),
@@ -78,6 +75,40 @@ class _Codec:
             module_code=("\n".join(emitter.module_code),) if emitter.module_code else (),
             imports=(f"from {ctx.root()} import _dronecan as _dc",),
         )
+
+    @staticmethod
+    def _union(msg: Message, ctx: ModuleContext, view: ClassView, emitter: MessageEmitter, lines: list[str]) -> None:
+        """The branch table, ``union_field`` and the hooks that keep one branch held (``_dc.Union``)."""
+        branches = []
+        zeros = ["@staticmethod", "def _dc_zero(name: str) -> Any:"]
+        zeros.append('    """A fresh default value of branch ``name``."""')
+        for f, fv in zip([f for f in msg.fields if not f.is_padding], view.fields, strict=True):
+            branches.append(f"({py_literal(f.name)}, {py_literal(fv.ident)})")
+            zero = FieldBuilder(ctx, f, optional=False).zero(f.type)
+            zeros += [f"    if name == {py_literal(f.name)}:", f"        return {zero}"]
+        zeros.append(f"    raise KeyError(name + {py_literal(' is not a field of ' + view.name)})")
+        table = ctx.constant(view.name, "UNION")
+        emitter.module_code.append(
+            f"# the branches of {view.name}: (DSDL name, attribute)\n"
+            f"{table} = _dc.Union({py_literal(view.name)}, ({', '.join(branches)},))"
+        )
+        meta = (
+            '_m.meta(name="union_field", type="union tag", '
+            'doc="DSDL name of the field this union holds (the one encoded)")'
+        )
+        lines += [
+            f"union_field: str = dataclasses.field(init=False, metadata={meta})",
+            "",
+            "def __post_init__(self) -> None:",
+            '    """Select the one branch given (or the first, at its default); two given raise TypeError."""',
+            f"    {table}.settle(self)",
+            "",
+            "def __setattr__(self, name: str, value: Any) -> None:",
+            '    """A value assigned to a branch selects it; assigning a branch name to union_field switches to it."""',
+            f"    {table}.assign(self, name, value)",
+            "",
+            *zeros,
+        ]
 
     def runtime_files(self, schema: Schema, header: str) -> dict[str, str]:
         if not any(m.format is SourceFormat.DRONECAN for m in schema.messages):

@@ -100,12 +100,16 @@ class MessageEmitter(VariableFieldEmitter):
         bits = self.tag_bits()
         out.add(f"u = self.{self.union_attr}")
         for n, (i, ident) in enumerate(self.union_fields()):
-            out.add(f"{'if' if n == 0 else 'elif'} u == {py_literal(ident)}:")
-            out.level += 1
-            out.add(f"acc = (acc << {bits}) | {n}" if n else f"acc <<= {bits}")
             f = self.msg.fields[i]
+            out.add(f"{'if' if n == 0 else 'elif'} u == {py_literal(f.name)}:")
+            out.level += 1
+            held = out.fresh("x")
+            out.add(f"{held} = self.{ident}")
+            out.add(f"if {held} is None:")
+            out.add("    raise " + error("EncodeError", f"{self.cls}.{f.name}: the selected branch holds None"))
+            out.add(f"acc = (acc << {bits}) | {n}" if n else f"acc <<= {bits}")
             item = VarField(i, f.name, ident, f.type, True)
-            self.branch_put(item, out)
+            self.branch_put(item, held, out)
             out.level -= 1
         out.add("else:")
         out.add(
@@ -113,9 +117,8 @@ class MessageEmitter(VariableFieldEmitter):
             + error("EncodeError", f"{self.cls}.{self.union_attr}: ", "repr(u)", f" is not a field of {self.cls}")
         )
 
-    def branch_put(self, item: VarField, out: Lines) -> None:
+    def branch_put(self, item: VarField, expr: str, out: Lines) -> None:
         label = f"{self.cls}.{item.field_name}"
-        expr = f"self.{item.ident}"
         if self.p.fixed(item.type):
             seg = Segment([], [], [])
             self.p.flatten(seg, item.type, expr, label)
@@ -145,7 +148,7 @@ class MessageEmitter(VariableFieldEmitter):
                 if ann is not None:
                     out.add(f"{target}: {ann}")
                 self.var_get(VarField(i, f.name, ident, f.type, True), target, label, "tao", out)
-            out.add(f"return cls({ident}={target}, {self.union_attr}={py_literal(ident)}), rem")
+            out.add(f"return cls({ident}={target}), rem")
             out.level -= 1
         count = len(self.msg.fields)
         out.add("raise " + error("DecodeError", f"{self.cls}: union tag ", "str(t)", f" is not one of 0..{count - 1}"))

@@ -150,7 +150,7 @@ class SegmentEmitter:
         fmt = "<" + "".join(u.pack for u in units)
         comment = "fixed fields as encoded (a float16 as its bit pattern)"
         name = self.struct_name(fmt, self.segment_role(seg, "ENCODE_STRUCT"), comment)
-        return f"{name}.pack({', '.join(args)})"
+        return f"{name}.pack({', '.join(args) if len(args) > 1 else unparenthesized(args[0])})"
 
     def seg_put(self, seg: Segment, out: Lines) -> None:
         """Append a segment to ``acc``."""

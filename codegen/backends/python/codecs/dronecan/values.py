@@ -4,7 +4,7 @@ float views on decode, the v0 byte order of a field wider than 8 bits; plus a li
 from __future__ import annotations
 
 from .....ir import CastMode, FieldType, PrimitiveKind, PrimitiveType
-from ...literals import hex_literal, py_literal
+from ...literals import hex_literal, py_literal, unparenthesized
 from .plan import reorder_terms
 
 F32_MAX = "_dc.F32_MAX"
@@ -36,7 +36,8 @@ def error(kind: str, prefix: str, value: str = "", suffix: str = "") -> str:
 
 
 def mask(bits: int) -> str:
-    return hex_literal((1 << bits) - 1)
+    """The literal of ``bits`` one bits; past 64 bits, as a shift (a hex literal would outgrow a line)."""
+    return hex_literal((1 << bits) - 1) if bits <= 64 else f"((1 << {bits}) - 1)"
 
 
 def stream(expr: str, width: int) -> str:
@@ -96,7 +97,8 @@ def encode_value(t: PrimitiveType, raw: str, *, pattern: bool) -> str:
         else:
             value = raw
         if pattern:
-            return f"_dc.f32bits({value})" if bits == 32 else f"_dc.f64bits({value})"
+            inner = unparenthesized(value)
+            return f"_dc.f32bits({inner})" if bits == 32 else f"_dc.f64bits({inner})"
         return value
     raise ValueError(f"cannot encode {t.name}")
 
@@ -119,7 +121,7 @@ def decode_pattern(t: PrimitiveType, b: str) -> str:
         sign = hex_literal(1 << (bits - 1))
         return f"(({b} ^ {sign}) - {sign})"
     if kind is PrimitiveKind.FLOAT:
-        return {16: "_dc.f16v", 32: "_dc.f32v", 64: "_dc.f64v"}[bits] + f"({b})"
+        return {16: "_dc.f16v", 32: "_dc.f32v", 64: "_dc.f64v"}[bits] + f"({unparenthesized(b)})"
     raise ValueError(f"cannot decode {t.name}")
 
 
