@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import importlib
 import io
+import pkgutil
 import re
 import tempfile
 from collections.abc import Callable, Iterator
@@ -30,8 +32,6 @@ from codegen.inputs.dispatch import read_records
 from codegen.inputs.records import Notice, Record, Unreadable
 from codegen.ir import Message
 from generated import _mavlink
-from generated.dronecan.ardupilot.equipment.power import BatteryInfoAux
-from generated.dronecan.uavcan.equipment.power import BatteryInfo, CircuitStatus, PrimaryPowerSupplyStatus
 from generated.mavlink import BatteryStatus as MavBatteryStatus
 from generated.uorb import BatteryStatus, BatteryStatusV0
 
@@ -44,7 +44,20 @@ MASKED = re.compile(r"cannot read: [A-Za-z]*(Error|Exception)\(|the validator fa
 
 # -- decoders -----------------------------------------------------------------------------------------------
 
-DRONECAN = (BatteryInfo, CircuitStatus, PrimaryPowerSupplyStatus, BatteryInfoAux)
+
+def _classes(package: str) -> tuple[Any, ...]:
+    """Every generated message class under a package of ``generated`` (unions and nested types too)."""
+    root = importlib.import_module(package)
+    found: dict[str, Any] = {}
+    for info in pkgutil.walk_packages(root.__path__, package + "."):
+        module = importlib.import_module(info.name)
+        for value in vars(module).values():
+            if isinstance(value, type) and hasattr(value, "QUALIFIED_NAME") and hasattr(value, "decode"):
+                found[value.QUALIFIED_NAME] = value
+    return tuple(found[name] for name in sorted(found))
+
+
+DRONECAN = _classes("generated.dronecan")
 UORB = (BatteryStatus, BatteryStatusV0)
 
 
