@@ -6,12 +6,13 @@ Module: mavlink.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
-import math
-import struct
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+import enum as _enum
+import math as _math
+import struct as _struct
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from . import _mavlink as _mav
 from . import _meta as _m
@@ -30,7 +31,7 @@ __all__ = [
 ]
 
 
-class MavBatteryChargeState(enum.IntEnum):
+class MavBatteryChargeState(_enum.IntEnum):
     """Enumeration for battery charge states.
 
     mavlink.MAV_BATTERY_CHARGE_STATE: values.
@@ -46,7 +47,7 @@ class MavBatteryChargeState(enum.IntEnum):
     CHARGING = 7
 
 
-class MavBatteryFault(enum.IntFlag):
+class MavBatteryFault(_enum.IntFlag):
     """Smart battery supply status/fault flags (bitmask) for health indication. The battery must also report either
     MAV_BATTERY_CHARGE_STATE_FAILED or MAV_BATTERY_CHARGE_STATE_UNHEALTHY if any of these are set.
 
@@ -64,7 +65,7 @@ class MavBatteryFault(enum.IntFlag):
     BATTERY_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION = 256
 
 
-class MavBatteryFunction(enum.IntEnum):
+class MavBatteryFunction(_enum.IntEnum):
     """Enumeration of battery functions
 
     mavlink.MAV_BATTERY_FUNCTION: values.
@@ -77,7 +78,7 @@ class MavBatteryFunction(enum.IntEnum):
     PAYLOAD = 4
 
 
-class MavBatteryMode(enum.IntEnum):
+class MavBatteryMode(_enum.IntEnum):
     """Battery mode. Note, the normal operation mode (i.e. when flying) should be reported as MAV_BATTERY_MODE_UNKNOWN
     to allow message trimming in normal flight.
 
@@ -89,7 +90,7 @@ class MavBatteryMode(enum.IntEnum):
     HOT_SWAP = 2
 
 
-class MavBatteryStatusFlags(enum.IntFlag):
+class MavBatteryStatusFlags(_enum.IntFlag):
     """Battery status flags for fault, health and state indication.
 
     mavlink.MAV_BATTERY_STATUS_FLAGS: bit masks, combined with |.
@@ -117,7 +118,7 @@ class MavBatteryStatusFlags(enum.IntFlag):
     EXTENDED = 2147483648
 
 
-class MavBatteryType(enum.IntEnum):
+class MavBatteryType(_enum.IntEnum):
     """Enumeration of battery types
 
     mavlink.MAV_BATTERY_TYPE: values.
@@ -131,7 +132,7 @@ class MavBatteryType(enum.IntEnum):
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
-_BATTERY_INFO_PAYLOAD = struct.Struct("<ffffffffffHHBBBBB9s32s50s")
+_BATTERY_INFO_PAYLOAD = _struct.Struct("<ffffffffffHHBBBBB9s32s50s")
 _BATTERY_INFO_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("discharge_minimum_voltage", "discharge_minimum_voltage", "f", 0),
     ("charging_minimum_voltage", "charging_minimum_voltage", "f", 0),
@@ -154,7 +155,7 @@ _BATTERY_INFO_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("serial_number", "serial_number", "s", 32),
     ("name", "name", "s", 50),
 )
-_BATTERY_INFO_DTYPE: list[tuple[Any, ...]] = [
+_BATTERY_INFO_DTYPE: list[tuple[_Any, ...]] = [
     ("discharge_minimum_voltage", "<f4"),
     ("charging_minimum_voltage", "<f4"),
     ("resting_minimum_voltage", "<f4"),
@@ -305,7 +306,7 @@ _BATTERY_INFO_FULL_CHARGE_CAPACITY_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="Ah",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_INFO_MANUFACTURE_DATE_SPEC = _v.Text(capacity=9)
@@ -314,7 +315,7 @@ _BATTERY_INFO_NAME_SPEC = _v.Text(capacity=50)
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
-_BATTERY_STATUS_PAYLOAD = struct.Struct("<iih10HhBBBbiB4HBI")
+_BATTERY_STATUS_PAYLOAD = _struct.Struct("<iih10HhBBBbiB4HBI")
 _BATTERY_STATUS_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("current_consumed", "current_consumed", "i", 0),
     ("energy_consumed", "energy_consumed", "i", 0),
@@ -331,7 +332,7 @@ _BATTERY_STATUS_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("mode", "mode", "B", 0),
     ("fault_bitmask", "fault_bitmask", "I", 0),
 )
-_BATTERY_STATUS_DTYPE: list[tuple[Any, ...]] = [
+_BATTERY_STATUS_DTYPE: list[tuple[_Any, ...]] = [
     ("current_consumed", "<i4"),
     ("energy_consumed", "<i4"),
     ("temperature", "<i2"),
@@ -447,7 +448,7 @@ _BATTERY_STATUS_FAULT_BITMASK_SPEC = _v.Number(
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
-_BATTERY_STATUS_V2_PAYLOAD = struct.Struct("<fffffIhB")
+_BATTERY_STATUS_V2_PAYLOAD = _struct.Struct("<fffffIhB")
 _BATTERY_STATUS_V2_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("voltage", "voltage", "f", 0),
     ("current", "current", "f", 0),
@@ -458,7 +459,7 @@ _BATTERY_STATUS_V2_FIELDS: tuple[tuple[str, str, str, int], ...] = (
     ("temperature", "temperature", "h", 0),
     ("id", "id", "B", 0),
 )
-_BATTERY_STATUS_V2_DTYPE: list[tuple[Any, ...]] = [
+_BATTERY_STATUS_V2_DTYPE: list[tuple[_Any, ...]] = [
     ("voltage", "<f4"),
     ("current", "<f4"),
     ("capacity_consumed", "<f4"),
@@ -481,7 +482,7 @@ _BATTERY_STATUS_V2_VOLTAGE_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="V",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_V2_CURRENT_SPEC = _v.Number(
@@ -490,7 +491,7 @@ _BATTERY_STATUS_V2_CURRENT_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="A",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_V2_CAPACITY_CONSUMED_SPEC = _v.Number(
@@ -499,7 +500,7 @@ _BATTERY_STATUS_V2_CAPACITY_CONSUMED_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="Ah",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_V2_CAPACITY_REMAINING_SPEC = _v.Number(
@@ -508,7 +509,7 @@ _BATTERY_STATUS_V2_CAPACITY_REMAINING_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="Ah",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_V2_STATE_OF_CHARGE_SPEC = _v.Number(
@@ -517,7 +518,7 @@ _BATTERY_STATUS_V2_STATE_OF_CHARGE_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="%",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC = _v.Number(
@@ -551,7 +552,7 @@ _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC = _v.Number(
 )
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryInfo:
     """Battery information that is static, or requires infrequent update. This message should requested using
     MAV_CMD_REQUEST_MESSAGE and/or streamed at very low rate. BATTERY_STATUS_V2 is used for higher-rate battery
@@ -560,10 +561,10 @@ class BatteryInfo:
     Schema: mavlink.BATTERY_INFO (mavlink, battery.xml:259).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "mavlink.BATTERY_INFO"
+    QUALIFIED_NAME: _ClassVar[str] = "mavlink.BATTERY_INFO"
 
-    id: int = dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
-    battery_function: int = dataclasses.field(
+    id: int = _dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
+    battery_function: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="battery_function",
@@ -572,13 +573,13 @@ class BatteryInfo:
             doc="Function of the battery.",
         ),
     )
-    type: int = dataclasses.field(
+    type: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Type (chemistry) of the battery."
         ),
     )
-    state_of_health: int = dataclasses.field(
+    state_of_health: int = _dataclasses.field(
         default=255,
         metadata=_m.meta(
             name="state_of_health",
@@ -593,7 +594,7 @@ class BatteryInfo:
             "will decrease over time and use. -1: field not provided.",
         ),
     )
-    cells_in_series: int = dataclasses.field(
+    cells_in_series: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cells_in_series",
@@ -603,7 +604,7 @@ class BatteryInfo:
             doc="Number of battery cells in series. 0: field not provided.",
         ),
     )
-    cycle_count: int = dataclasses.field(
+    cycle_count: int = _dataclasses.field(
         default=65535,
         metadata=_m.meta(
             name="cycle_count",
@@ -614,7 +615,7 @@ class BatteryInfo:
             "(https://en.wikipedia.org/wiki/Charge_cycle). UINT16_MAX: field not provided.",
         ),
     )
-    weight: int = dataclasses.field(
+    weight: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="weight",
@@ -628,7 +629,7 @@ class BatteryInfo:
             doc="Battery weight. 0: field not provided.",
         ),
     )
-    discharge_minimum_voltage: float = dataclasses.field(
+    discharge_minimum_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="discharge_minimum_voltage",
@@ -640,7 +641,7 @@ class BatteryInfo:
             doc="Minimum per-cell voltage when discharging. 0: field not provided.",
         ),
     )
-    charging_minimum_voltage: float = dataclasses.field(
+    charging_minimum_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="charging_minimum_voltage",
@@ -652,7 +653,7 @@ class BatteryInfo:
             doc="Minimum per-cell voltage when charging. 0: field not provided.",
         ),
     )
-    resting_minimum_voltage: float = dataclasses.field(
+    resting_minimum_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="resting_minimum_voltage",
@@ -664,7 +665,7 @@ class BatteryInfo:
             doc="Minimum per-cell voltage when resting. 0: field not provided.",
         ),
     )
-    charging_maximum_voltage: float = dataclasses.field(
+    charging_maximum_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="charging_maximum_voltage",
@@ -676,7 +677,7 @@ class BatteryInfo:
             doc="Maximum per-cell voltage when charged. 0: field not provided.",
         ),
     )
-    charging_maximum_current: float = dataclasses.field(
+    charging_maximum_current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="charging_maximum_current",
@@ -688,7 +689,7 @@ class BatteryInfo:
             doc="Maximum pack continuous charge current. 0: field not provided.",
         ),
     )
-    nominal_voltage: float = dataclasses.field(
+    nominal_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="nominal_voltage",
@@ -700,7 +701,7 @@ class BatteryInfo:
             doc="Battery nominal voltage. Used for conversion between Wh and Ah. 0: field not provided.",
         ),
     )
-    discharge_maximum_current: float = dataclasses.field(
+    discharge_maximum_current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="discharge_maximum_current",
@@ -712,7 +713,7 @@ class BatteryInfo:
             doc="Maximum pack discharge current. 0: field not provided.",
         ),
     )
-    discharge_maximum_burst_current: float = dataclasses.field(
+    discharge_maximum_burst_current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="discharge_maximum_burst_current",
@@ -724,7 +725,7 @@ class BatteryInfo:
             doc="Maximum pack discharge burst current. 0: field not provided.",
         ),
     )
-    design_capacity: float = dataclasses.field(
+    design_capacity: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="design_capacity",
@@ -738,8 +739,8 @@ class BatteryInfo:
             doc="Fully charged design capacity. 0: field not provided.",
         ),
     )
-    full_charge_capacity: float = dataclasses.field(
-        default=math.nan,
+    full_charge_capacity: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="full_charge_capacity",
             type="float32",
@@ -747,13 +748,13 @@ class BatteryInfo:
             quantity="charge",
             scale=3600.0,
             offset=0.0,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Predicted battery capacity when fully charged (accounting for battery "
             "degradation). NAN: field not provided.",
         ),
     )
-    manufacture_date: str = dataclasses.field(
+    manufacture_date: str = _dataclasses.field(
         default="",
         metadata=_m.meta(
             name="manufacture_date",
@@ -764,7 +765,7 @@ class BatteryInfo:
             doc="Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated. All 0: field not provided.",
         ),
     )
-    serial_number: str = dataclasses.field(
+    serial_number: str = _dataclasses.field(
         default="",
         metadata=_m.meta(
             name="serial_number",
@@ -775,7 +776,7 @@ class BatteryInfo:
             doc="Serial number in ASCII characters, 0 terminated. All 0: field not provided.",
         ),
     )
-    name: str = dataclasses.field(
+    name: str = _dataclasses.field(
         default="",
         metadata=_m.meta(
             name="name",
@@ -795,9 +796,9 @@ class BatteryInfo:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["id"] = self.id
         out["battery_function"] = self.battery_function
         out["type"] = self.type
@@ -821,7 +822,7 @@ class BatteryInfo:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryInfo:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfo:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -897,10 +898,10 @@ class BatteryInfo:
             obj.name = _m.as_str(data["name"], "name")
         return obj
 
-    MSG_ID: ClassVar[int] = 372
-    CRC_EXTRA: ClassVar[int] = 26
-    MAVLINK_BASE_LENGTH: ClassVar[int] = 140
-    MAVLINK_MAX_LENGTH: ClassVar[int] = 140
+    MSG_ID: _ClassVar[int] = 372
+    CRC_EXTRA: _ClassVar[int] = 26
+    MAVLINK_BASE_LENGTH: _ClassVar[int] = 140
+    MAVLINK_MAX_LENGTH: _ClassVar[int] = 140
 
     def encode(self, *, truncate: bool = True) -> bytes:
         """The MAVLink 2 payload, 140 bytes in wire order; trailing zero bytes
@@ -932,7 +933,7 @@ class BatteryInfo:
                 t_serial_number,
                 t_name,
             )
-        except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+        except (_struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
             raise _mav.explain("BATTERY_INFO", self, _BATTERY_INFO_FIELDS) from exc
         if len(t_manufacture_date) > 9 or len(t_serial_number) > 32 or len(t_name) > 50:
             raise _mav.explain("BATTERY_INFO", self, _BATTERY_INFO_FIELDS)
@@ -997,7 +998,7 @@ class BatteryInfo:
         return cls.decode(payload)
 
     @classmethod
-    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, Any]:
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, _Any]:
         """Records of 140 bytes (zero-filled payloads) -> columns keyed by field name: numpy
         arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
         tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
@@ -1031,7 +1032,7 @@ class BatteryInfo:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
+        x: _Any
         try:
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
@@ -1253,7 +1254,7 @@ class BatteryInfo:
         raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_INFO")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryStatus:
     """Battery information. Updates GCS with flight controller battery status. Smart batteries also use this message,
     but may additionally send BATTERY_INFO.
@@ -1261,10 +1262,10 @@ class BatteryStatus:
     Schema: mavlink.BATTERY_STATUS (mavlink, battery.xml:225).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "mavlink.BATTERY_STATUS"
+    QUALIFIED_NAME: _ClassVar[str] = "mavlink.BATTERY_STATUS"
 
-    id: int = dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
-    battery_function: int = dataclasses.field(
+    id: int = _dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
+    battery_function: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="battery_function",
@@ -1273,13 +1274,13 @@ class BatteryStatus:
             doc="Function of the battery",
         ),
     )
-    type: int = dataclasses.field(
+    type: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Type (chemistry) of the battery"
         ),
     )
-    temperature: int = dataclasses.field(
+    temperature: int = _dataclasses.field(
         default=32767,
         metadata=_m.meta(
             name="temperature",
@@ -1293,7 +1294,7 @@ class BatteryStatus:
             doc="Temperature of the battery. INT16_MAX for unknown temperature.",
         ),
     )
-    voltages: list[int] = dataclasses.field(
+    voltages: list[int] = _dataclasses.field(
         default_factory=lambda: [65535] * 10,
         metadata=_m.meta(
             name="voltages",
@@ -1315,7 +1316,7 @@ class BatteryStatus:
             "voltage is greater than 2 * (UINT16_MAX - 1).",
         ),
     )
-    current_battery: int = dataclasses.field(
+    current_battery: int = _dataclasses.field(
         default=-1,
         metadata=_m.meta(
             name="current_battery",
@@ -1330,7 +1331,7 @@ class BatteryStatus:
             "overflow/rollover for very high currents (> 327.67A)",
         ),
     )
-    current_consumed: int = dataclasses.field(
+    current_consumed: int = _dataclasses.field(
         default=-1,
         metadata=_m.meta(
             name="current_consumed",
@@ -1344,7 +1345,7 @@ class BatteryStatus:
             doc="Consumed charge, -1: autopilot does not provide consumption estimate",
         ),
     )
-    energy_consumed: int = dataclasses.field(
+    energy_consumed: int = _dataclasses.field(
         default=-1,
         metadata=_m.meta(
             name="energy_consumed",
@@ -1358,7 +1359,7 @@ class BatteryStatus:
             doc="Consumed energy, -1: autopilot does not provide energy consumption estimate",
         ),
     )
-    battery_remaining: int = dataclasses.field(
+    battery_remaining: int = _dataclasses.field(
         default=-1,
         metadata=_m.meta(
             name="battery_remaining",
@@ -1372,7 +1373,7 @@ class BatteryStatus:
             doc="Remaining battery energy. Values: [0-100], -1: autopilot does not estimate the remaining battery.",
         ),
     )
-    time_remaining: int = dataclasses.field(
+    time_remaining: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="time_remaining",
@@ -1385,7 +1386,7 @@ class BatteryStatus:
             doc="Remaining battery time, 0: autopilot does not provide remaining battery time estimate",
         ),
     )
-    charge_state: int = dataclasses.field(
+    charge_state: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="charge_state",
@@ -1395,7 +1396,7 @@ class BatteryStatus:
             doc="State for extent of discharge, provided by autopilot for warning or external reactions",
         ),
     )
-    voltages_ext: list[int] = dataclasses.field(
+    voltages_ext: list[int] = _dataclasses.field(
         default_factory=lambda: [0] * 4,
         metadata=_m.meta(
             name="voltages_ext",
@@ -1414,7 +1415,7 @@ class BatteryStatus:
             "truncation). If the measured value is 0 then 1 should be sent instead.",
         ),
     )
-    mode: int = dataclasses.field(
+    mode: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="mode",
@@ -1425,7 +1426,7 @@ class BatteryStatus:
             "battery is in normal-use mode.",
         ),
     )
-    fault_bitmask: int = dataclasses.field(
+    fault_bitmask: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="fault_bitmask",
@@ -1444,9 +1445,9 @@ class BatteryStatus:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["id"] = self.id
         out["battery_function"] = self.battery_function
         out["type"] = self.type
@@ -1464,7 +1465,7 @@ class BatteryStatus:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatus:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -1522,10 +1523,10 @@ class BatteryStatus:
             obj.fault_bitmask = _m.as_int(data["fault_bitmask"], "fault_bitmask")
         return obj
 
-    MSG_ID: ClassVar[int] = 147
-    CRC_EXTRA: ClassVar[int] = 154
-    MAVLINK_BASE_LENGTH: ClassVar[int] = 36
-    MAVLINK_MAX_LENGTH: ClassVar[int] = 54
+    MSG_ID: _ClassVar[int] = 147
+    CRC_EXTRA: _ClassVar[int] = 154
+    MAVLINK_BASE_LENGTH: _ClassVar[int] = 36
+    MAVLINK_MAX_LENGTH: _ClassVar[int] = 54
 
     def encode(self, *, truncate: bool = True) -> bytes:
         """The MAVLink 2 payload, 54 bytes in wire order; trailing zero bytes
@@ -1548,7 +1549,7 @@ class BatteryStatus:
                 self.mode,
                 self.fault_bitmask,
             )
-        except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+        except (_struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
             raise _mav.explain("BATTERY_STATUS", self, _BATTERY_STATUS_FIELDS) from exc
         if len(self.voltages) != 10 or len(self.voltages_ext) != 4:
             raise _mav.explain("BATTERY_STATUS", self, _BATTERY_STATUS_FIELDS)
@@ -1640,7 +1641,7 @@ class BatteryStatus:
         return cls.decode(payload)
 
     @classmethod
-    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, Any]:
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, _Any]:
         """Records of 54 bytes (zero-filled payloads) -> columns keyed by field name: numpy
         arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
         tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
@@ -1668,9 +1669,9 @@ class BatteryStatus:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        a: Any
-        e: Any
-        r_battery_remaining: Any
+        a: _Any
+        e: _Any
+        r_battery_remaining: _Any
         try:
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
@@ -1804,7 +1805,7 @@ class BatteryStatus:
         raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_STATUS")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryStatusV2:
     """Battery dynamic information. This should be streamed (nominally at 1Hz). Static/invariant battery information is
     sent in BATTERY_INFO. Note that smart batteries should set the MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL
@@ -1815,10 +1816,10 @@ class BatteryStatusV2:
     Schema: mavlink.BATTERY_STATUS_V2 (mavlink, battery.xml:243).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "mavlink.BATTERY_STATUS_V2"
+    QUALIFIED_NAME: _ClassVar[str] = "mavlink.BATTERY_STATUS_V2"
 
-    id: int = dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
-    temperature: int = dataclasses.field(
+    id: int = _dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
+    temperature: int = _dataclasses.field(
         default=32767,
         metadata=_m.meta(
             name="temperature",
@@ -1832,33 +1833,33 @@ class BatteryStatusV2:
             doc="Temperature of the whole battery pack (not internal electronics). INT16_MAX field not provided.",
         ),
     )
-    voltage: float = dataclasses.field(
-        default=math.nan,
+    voltage: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="voltage",
             type="float32",
             unit="V",
             quantity="voltage",
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Battery voltage (total). NaN: field not provided.",
         ),
     )
-    current: float = dataclasses.field(
-        default=math.nan,
+    current: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="current",
             type="float32",
             unit="A",
             quantity="current",
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Battery current (through all cells/loads). Positive value when discharging and "
             "negative if charging. NaN: field not provided.",
         ),
     )
-    capacity_consumed: float = dataclasses.field(
-        default=math.nan,
+    capacity_consumed: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="capacity_consumed",
             type="float32",
@@ -1866,15 +1867,15 @@ class BatteryStatusV2:
             quantity="charge",
             scale=3600.0,
             offset=0.0,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Consumed charge. NaN: field not provided. This is either the consumption since "
             "power-on or since the battery was full, depending on the value of "
             "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL.",
         ),
     )
-    capacity_remaining: float = dataclasses.field(
-        default=math.nan,
+    capacity_remaining: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="capacity_remaining",
             type="float32",
@@ -1882,15 +1883,15 @@ class BatteryStatusV2:
             quantity="charge",
             scale=3600.0,
             offset=0.0,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Remaining charge (until empty). NaN: field not provided. Note: If "
             "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL is unset, this value is "
             "based on the assumption the battery was full when the system was powered.",
         ),
     )
-    state_of_charge: float = dataclasses.field(
-        default=math.nan,
+    state_of_charge: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="state_of_charge",
             type="float32",
@@ -1898,7 +1899,7 @@ class BatteryStatusV2:
             quantity="ratio",
             scale=0.01,
             offset=0.0,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="State of Charge (SoC). Remaining capacity relative to current fully-charged "
             "capacity as a percentage. Values: [0-100], NaN: field not provided. Note that "
@@ -1906,7 +1907,7 @@ class BatteryStatusV2:
             "full_charge_capacity is not known (see BATTERY_INFO).",
         ),
     )
-    status_flags: int = dataclasses.field(
+    status_flags: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="status_flags",
@@ -1922,9 +1923,9 @@ class BatteryStatusV2:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["id"] = self.id
         out["temperature"] = self.temperature
         out["voltage"] = self.voltage
@@ -1936,7 +1937,7 @@ class BatteryStatusV2:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatusV2:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatusV2:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -1974,10 +1975,10 @@ class BatteryStatusV2:
             obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
         return obj
 
-    MSG_ID: ClassVar[int] = 369
-    CRC_EXTRA: ClassVar[int] = 145
-    MAVLINK_BASE_LENGTH: ClassVar[int] = 27
-    MAVLINK_MAX_LENGTH: ClassVar[int] = 27
+    MSG_ID: _ClassVar[int] = 369
+    CRC_EXTRA: _ClassVar[int] = 145
+    MAVLINK_BASE_LENGTH: _ClassVar[int] = 27
+    MAVLINK_MAX_LENGTH: _ClassVar[int] = 27
 
     def encode(self, *, truncate: bool = True) -> bytes:
         """The MAVLink 2 payload, 27 bytes in wire order; trailing zero bytes
@@ -1994,7 +1995,7 @@ class BatteryStatusV2:
                 self.temperature,
                 self.id,
             )
-        except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+        except (_struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
             raise _mav.explain("BATTERY_STATUS_V2", self, _BATTERY_STATUS_V2_FIELDS) from exc
         if truncate:
             return data.rstrip(b"\x00") or b"\x00"
@@ -2043,7 +2044,7 @@ class BatteryStatusV2:
         return cls.decode(payload)
 
     @classmethod
-    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, Any]:
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, _Any]:
         """Records of 27 bytes (zero-filled payloads) -> columns keyed by field name: numpy
         arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
         tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
@@ -2065,7 +2066,7 @@ class BatteryStatusV2:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
+        x: _Any
         try:
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_V2_ID_SPEC)

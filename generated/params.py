@@ -6,10 +6,11 @@ Module: params.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+import enum as _enum
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from . import _meta as _m
 from . import _validate as _v
@@ -17,14 +18,14 @@ from . import _validate as _v
 __all__ = ["BattParams", "BattParamsFsCrtAct", "BattParamsFsLowAct", "BattParamsFsVoltsrc"]
 
 
-class BattParamsFsVoltsrc(enum.IntEnum):
+class BattParamsFsVoltsrc(_enum.IntEnum):
     """params.BATT.FS_VOLTSRC: values."""
 
     RAW_VOLTAGE = 0
     SAG_COMPENSATED_VOLTAGE = 1
 
 
-class BattParamsFsLowAct(enum.IntEnum):
+class BattParamsFsLowAct(_enum.IntEnum):
     """params.BATT.FS_LOW_ACT: values."""
 
     NONE = 0
@@ -35,7 +36,7 @@ class BattParamsFsLowAct(enum.IntEnum):
     TERMINATE = 5
 
 
-class BattParamsFsCrtAct(enum.IntEnum):
+class BattParamsFsCrtAct(_enum.IntEnum):
     """params.BATT.FS_CRT_ACT: values."""
 
     NONE = 0
@@ -122,7 +123,7 @@ _BATT_PARAMS_BATT_ARM_VOLT_SPEC = _v.Number(
 _BATT_PARAMS_BATT_ARM_MAH_SPEC = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BattParams:
     """Battery monitor: capacity, the two-stage (LOW, CRITICAL) failsafe thresholds and their actions, and arming
     limits. A threshold of 0 is disabled.
@@ -130,23 +131,23 @@ class BattParams:
     Schema: params.BATT (params, battery_failsafe.pdef.xml:8).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "params.BATT"
-    FS_VOLTSRC_RAW_VOLTAGE: ClassVar[int] = 0
-    FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE: ClassVar[int] = 1
-    FS_LOW_ACT_NONE: ClassVar[int] = 0
-    FS_LOW_ACT_HOLD: ClassVar[int] = 1
-    FS_LOW_ACT_RTL: ClassVar[int] = 2
-    FS_LOW_ACT_SMARTRTL: ClassVar[int] = 3
-    FS_LOW_ACT_SMARTRTL_OR_HOLD: ClassVar[int] = 4
-    FS_LOW_ACT_TERMINATE: ClassVar[int] = 5
-    FS_CRT_ACT_NONE: ClassVar[int] = 0
-    FS_CRT_ACT_HOLD: ClassVar[int] = 1
-    FS_CRT_ACT_RTL: ClassVar[int] = 2
-    FS_CRT_ACT_SMARTRTL: ClassVar[int] = 3
-    FS_CRT_ACT_SMARTRTL_OR_HOLD: ClassVar[int] = 4
-    FS_CRT_ACT_TERMINATE: ClassVar[int] = 5
+    QUALIFIED_NAME: _ClassVar[str] = "params.BATT"
+    FS_VOLTSRC_RAW_VOLTAGE: _ClassVar[int] = 0
+    FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE: _ClassVar[int] = 1
+    FS_LOW_ACT_NONE: _ClassVar[int] = 0
+    FS_LOW_ACT_HOLD: _ClassVar[int] = 1
+    FS_LOW_ACT_RTL: _ClassVar[int] = 2
+    FS_LOW_ACT_SMARTRTL: _ClassVar[int] = 3
+    FS_LOW_ACT_SMARTRTL_OR_HOLD: _ClassVar[int] = 4
+    FS_LOW_ACT_TERMINATE: _ClassVar[int] = 5
+    FS_CRT_ACT_NONE: _ClassVar[int] = 0
+    FS_CRT_ACT_HOLD: _ClassVar[int] = 1
+    FS_CRT_ACT_RTL: _ClassVar[int] = 2
+    FS_CRT_ACT_SMARTRTL: _ClassVar[int] = 3
+    FS_CRT_ACT_SMARTRTL_OR_HOLD: _ClassVar[int] = 4
+    FS_CRT_ACT_TERMINATE: _ClassVar[int] = 5
 
-    BATT_CAPACITY: int = dataclasses.field(
+    BATT_CAPACITY: int = _dataclasses.field(
         default=3300,
         metadata=_m.meta(
             name="BATT_CAPACITY",
@@ -158,7 +159,7 @@ class BattParams:
             doc="Charge of the fully charged pack; the mAh thresholds are measured against it.",
         ),
     )
-    BATT_LOW_VOLT: float = dataclasses.field(
+    BATT_LOW_VOLT: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_LOW_VOLT",
@@ -170,7 +171,7 @@ class BattParams:
             doc="LOW failsafe when the voltage stays below this for BATT_LOW_TIMER seconds. 0 disables it.",
         ),
     )
-    BATT_LOW_TIMER: int = dataclasses.field(
+    BATT_LOW_TIMER: int = _dataclasses.field(
         default=10,
         metadata=_m.meta(
             name="BATT_LOW_TIMER",
@@ -183,7 +184,7 @@ class BattParams:
             "triggers; rides out sag under load.",
         ),
     )
-    BATT_FS_VOLTSRC: int = dataclasses.field(
+    BATT_FS_VOLTSRC: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="BATT_FS_VOLTSRC",
@@ -192,7 +193,7 @@ class BattParams:
             doc="Which voltage the failsafe compares with its thresholds.",
         ),
     )
-    BATT_LOW_MAH: float = dataclasses.field(
+    BATT_LOW_MAH: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_LOW_MAH",
@@ -205,7 +206,7 @@ class BattParams:
             "current sensor and BATT_CAPACITY.",
         ),
     )
-    BATT_CRT_VOLT: float = dataclasses.field(
+    BATT_CRT_VOLT: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_CRT_VOLT",
@@ -217,7 +218,7 @@ class BattParams:
             doc="CRITICAL failsafe as soon as the voltage is below this. 0 disables it; must be below BATT_LOW_VOLT.",
         ),
     )
-    BATT_CRT_MAH: float = dataclasses.field(
+    BATT_CRT_MAH: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_CRT_MAH",
@@ -230,7 +231,7 @@ class BattParams:
             "must be below BATT_LOW_MAH.",
         ),
     )
-    BATT_FS_LOW_ACT: int = dataclasses.field(
+    BATT_FS_LOW_ACT: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="BATT_FS_LOW_ACT",
@@ -239,7 +240,7 @@ class BattParams:
             doc="What the vehicle does when the LOW failsafe triggers.",
         ),
     )
-    BATT_FS_CRT_ACT: int = dataclasses.field(
+    BATT_FS_CRT_ACT: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="BATT_FS_CRT_ACT",
@@ -248,7 +249,7 @@ class BattParams:
             doc="What the vehicle does when the CRITICAL failsafe triggers; overrides the LOW action.",
         ),
     )
-    BATT_ARM_VOLT: float = dataclasses.field(
+    BATT_ARM_VOLT: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="BATT_ARM_VOLT",
@@ -260,7 +261,7 @@ class BattParams:
             doc="Arming is refused below this voltage. 0 disables the check.",
         ),
     )
-    BATT_ARM_MAH: int = dataclasses.field(
+    BATT_ARM_MAH: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="BATT_ARM_MAH",
@@ -279,9 +280,9 @@ class BattParams:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["BATT_CAPACITY"] = self.BATT_CAPACITY
         out["BATT_LOW_VOLT"] = self.BATT_LOW_VOLT
         out["BATT_LOW_TIMER"] = self.BATT_LOW_TIMER
@@ -296,7 +297,7 @@ class BattParams:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BattParams:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BattParams:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -346,7 +347,7 @@ class BattParams:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
+        x: _Any
         try:
             if (self.BATT_CAPACITY + 2147483648) & -4294967296:
                 _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)

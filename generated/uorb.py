@@ -6,12 +6,13 @@ Module: uorb.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
-import math
-import struct
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+import enum as _enum
+import math as _math
+import struct as _struct
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from . import _meta as _m
 from . import _ulog, _uorb
@@ -30,7 +31,7 @@ __all__ = [
 ]
 
 
-class BatteryStatusSource(enum.IntEnum):
+class BatteryStatusSource(_enum.IntEnum):
     """uorb.BatteryStatus.SOURCE: values."""
 
     POWER_MODULE = 0
@@ -38,7 +39,7 @@ class BatteryStatusSource(enum.IntEnum):
     ESCS = 2
 
 
-class BatteryStatusWarning(enum.IntEnum):
+class BatteryStatusWarning(_enum.IntEnum):
     """uorb.BatteryStatus.WARNING: values."""
 
     NONE = 0
@@ -50,7 +51,7 @@ class BatteryStatusWarning(enum.IntEnum):
     CHARGING = 7
 
 
-class BatteryStatusFault(enum.IntEnum):
+class BatteryStatusFault(_enum.IntEnum):
     """uorb.BatteryStatus.FAULT: bit positions in a bitmask field."""
 
     DEEP_DISCHARGE = 0
@@ -66,7 +67,7 @@ class BatteryStatusFault(enum.IntEnum):
     FAILED_TO_ARM = 10
 
 
-class BatteryStatusV0Source(enum.IntEnum):
+class BatteryStatusV0Source(_enum.IntEnum):
     """uorb.BatteryStatusV0.SOURCE: values."""
 
     POWER_MODULE = 0
@@ -74,7 +75,7 @@ class BatteryStatusV0Source(enum.IntEnum):
     ESCS = 2
 
 
-class BatteryStatusV0Warning(enum.IntEnum):
+class BatteryStatusV0Warning(_enum.IntEnum):
     """uorb.BatteryStatusV0.WARNING: values."""
 
     NONE = 0
@@ -84,14 +85,14 @@ class BatteryStatusV0Warning(enum.IntEnum):
     FAILED = 4
 
 
-class BatteryStatusV0State(enum.IntEnum):
+class BatteryStatusV0State(_enum.IntEnum):
     """uorb.BatteryStatusV0.STATE: values."""
 
     UNHEALTHY = 6
     CHARGING = 7
 
 
-class BatteryStatusV0Fault(enum.IntEnum):
+class BatteryStatusV0Fault(_enum.IntEnum):
     """uorb.BatteryStatusV0.FAULT: bit positions in a bitmask field."""
 
     DEEP_DISCHARGE = 0
@@ -108,9 +109,9 @@ class BatteryStatusV0Fault(enum.IntEnum):
 
 
 # the C struct, nested messages inlined (decoding reads them in place)
-_BATTERY_STATUS_STRUCT = struct.Struct("<Q33f9H?4B2?B2x")
+_BATTERY_STATUS_STRUCT = _struct.Struct("<Q33f9H?4B2?B2x")
 # without the trailing padding, which ULog records leave out
-_BATTERY_STATUS_UNPADDED = struct.Struct("<Q33f9H?4B2?B")
+_BATTERY_STATUS_UNPADDED = _struct.Struct("<Q33f9H?4B2?B")
 
 
 _BATTERY_STATUS_COLUMNS = _uorb.Columns(
@@ -385,7 +386,7 @@ _BATTERY_STATUS_TIME_REMAINING_S_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="s",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_TEMPERATURE_SPEC = _v.Number(
@@ -394,7 +395,7 @@ _BATTERY_STATUS_TEMPERATURE_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="degC",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_CELL_COUNT_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255, sentinel=0, sentinel_text="0")
@@ -505,7 +506,7 @@ _BATTERY_STATUS_ESTIMATION_COVARIANCE_NORM_SPEC = _v.Number(
 
 
 # the C struct, nested messages inlined (decoding reads them in place)
-_BATTERY_STATUS_V0_STRUCT = struct.Struct("<Q33f10H?4B2?B")
+_BATTERY_STATUS_V0_STRUCT = _struct.Struct("<Q33f10H?4B2?B")
 
 
 _BATTERY_STATUS_V0_COLUMNS = _uorb.Columns(
@@ -784,7 +785,7 @@ _BATTERY_STATUS_V0_TIME_REMAINING_S_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="s",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_V0_TEMPERATURE_SPEC = _v.Number(
@@ -793,7 +794,7 @@ _BATTERY_STATUS_V0_TEMPERATURE_SPEC = _v.Number(
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
     unit="degC",
-    sentinel=math.nan,
+    sentinel=_math.nan,
     sentinel_text="NaN",
 )
 _BATTERY_STATUS_V0_CELL_COUNT_SPEC = _v.Number(
@@ -906,7 +907,7 @@ _BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC = _v.Number(
 )
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryStatus:
     """Battery status
 
@@ -917,33 +918,33 @@ class BatteryStatus:
     Schema: uorb.BatteryStatus (uorb, BatteryStatus.msg:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "uorb.BatteryStatus"
-    MESSAGE_VERSION: ClassVar[int] = 1
-    MAX_INSTANCES: ClassVar[int] = 3
-    SOURCE_POWER_MODULE: ClassVar[int] = 0
-    SOURCE_EXTERNAL: ClassVar[int] = 1
-    SOURCE_ESCS: ClassVar[int] = 2
-    WARNING_NONE: ClassVar[int] = 0
-    WARNING_LOW: ClassVar[int] = 1
-    WARNING_CRITICAL: ClassVar[int] = 2
-    WARNING_EMERGENCY: ClassVar[int] = 3
-    WARNING_FAILED: ClassVar[int] = 4
-    WARNING_UNHEALTHY: ClassVar[int] = 6
-    WARNING_CHARGING: ClassVar[int] = 7
-    FAULT_DEEP_DISCHARGE: ClassVar[int] = 0
-    FAULT_SPIKES: ClassVar[int] = 1
-    FAULT_CELL_FAIL: ClassVar[int] = 2
-    FAULT_OVER_CURRENT: ClassVar[int] = 3
-    FAULT_OVER_TEMPERATURE: ClassVar[int] = 4
-    FAULT_UNDER_TEMPERATURE: ClassVar[int] = 5
-    FAULT_INCOMPATIBLE_VOLTAGE: ClassVar[int] = 6
-    FAULT_INCOMPATIBLE_FIRMWARE: ClassVar[int] = 7
-    FAULT_INCOMPATIBLE_MODEL: ClassVar[int] = 8
-    FAULT_HARDWARE_FAILURE: ClassVar[int] = 9
-    FAULT_FAILED_TO_ARM: ClassVar[int] = 10
-    FAULT_COUNT: ClassVar[int] = 11
+    QUALIFIED_NAME: _ClassVar[str] = "uorb.BatteryStatus"
+    MESSAGE_VERSION: _ClassVar[int] = 1
+    MAX_INSTANCES: _ClassVar[int] = 3
+    SOURCE_POWER_MODULE: _ClassVar[int] = 0
+    SOURCE_EXTERNAL: _ClassVar[int] = 1
+    SOURCE_ESCS: _ClassVar[int] = 2
+    WARNING_NONE: _ClassVar[int] = 0
+    WARNING_LOW: _ClassVar[int] = 1
+    WARNING_CRITICAL: _ClassVar[int] = 2
+    WARNING_EMERGENCY: _ClassVar[int] = 3
+    WARNING_FAILED: _ClassVar[int] = 4
+    WARNING_UNHEALTHY: _ClassVar[int] = 6
+    WARNING_CHARGING: _ClassVar[int] = 7
+    FAULT_DEEP_DISCHARGE: _ClassVar[int] = 0
+    FAULT_SPIKES: _ClassVar[int] = 1
+    FAULT_CELL_FAIL: _ClassVar[int] = 2
+    FAULT_OVER_CURRENT: _ClassVar[int] = 3
+    FAULT_OVER_TEMPERATURE: _ClassVar[int] = 4
+    FAULT_UNDER_TEMPERATURE: _ClassVar[int] = 5
+    FAULT_INCOMPATIBLE_VOLTAGE: _ClassVar[int] = 6
+    FAULT_INCOMPATIBLE_FIRMWARE: _ClassVar[int] = 7
+    FAULT_INCOMPATIBLE_MODEL: _ClassVar[int] = 8
+    FAULT_HARDWARE_FAILURE: _ClassVar[int] = 9
+    FAULT_FAILED_TO_ARM: _ClassVar[int] = 10
+    FAULT_COUNT: _ClassVar[int] = 11
 
-    timestamp: int = dataclasses.field(
+    timestamp: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="timestamp",
@@ -955,7 +956,7 @@ class BatteryStatus:
             doc="Time since system start",
         ),
     )
-    connected: bool = dataclasses.field(
+    connected: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="connected",
@@ -963,7 +964,7 @@ class BatteryStatus:
             doc="Whether or not a battery is connected. For power modules this is based on a voltage threshold.",
         ),
     )
-    voltage_v: float = dataclasses.field(
+    voltage_v: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="voltage_v",
@@ -975,7 +976,7 @@ class BatteryStatus:
             doc="Battery voltage",
         ),
     )
-    current_a: float = dataclasses.field(
+    current_a: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="current_a",
@@ -987,7 +988,7 @@ class BatteryStatus:
             doc="Battery current",
         ),
     )
-    current_average_a: float = dataclasses.field(
+    current_average_a: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="current_average_a",
@@ -999,7 +1000,7 @@ class BatteryStatus:
             doc="Battery current average (for FW average in level flight)",
         ),
     )
-    discharged_mah: float = dataclasses.field(
+    discharged_mah: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="discharged_mah",
@@ -1013,7 +1014,7 @@ class BatteryStatus:
             doc="Discharged amount",
         ),
     )
-    remaining: float = dataclasses.field(
+    remaining: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="remaining",
@@ -1025,7 +1026,7 @@ class BatteryStatus:
             doc="Remaining capacity",
         ),
     )
-    scale: float = dataclasses.field(
+    scale: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="scale",
@@ -1037,20 +1038,20 @@ class BatteryStatus:
             doc="Scaling factor to compensate for lower actuation power caused by voltage sag",
         ),
     )
-    time_remaining_s: float = dataclasses.field(
-        default=math.nan,
+    time_remaining_s: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="time_remaining_s",
             type="float32",
             unit="s",
             quantity="time",
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Predicted time remaining until battery is empty under previous averaged load",
         ),
     )
-    temperature: float = dataclasses.field(
-        default=math.nan,
+    temperature: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="temperature",
             type="float32",
@@ -1058,19 +1059,19 @@ class BatteryStatus:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Temperature of the battery",
         ),
     )
-    cell_count: int = dataclasses.field(
+    cell_count: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="cell_count", type="uint8", invalid=0, invalid_text="0", doc="Number of cells")
     )
-    source: int = dataclasses.field(
+    source: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="source", type="uint8", enums=("uorb.BatteryStatus.SOURCE",), doc="Battery source"),
     )
-    priority: int = dataclasses.field(
+    priority: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="priority",
@@ -1078,7 +1079,7 @@ class BatteryStatus:
             doc="Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1",
         ),
     )
-    capacity: int = dataclasses.field(
+    capacity: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="capacity",
@@ -1090,13 +1091,13 @@ class BatteryStatus:
             doc="Capacity of the battery when fully charged",
         ),
     )
-    cycle_count: int = dataclasses.field(
+    cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cycle_count", type="uint16", doc="Number of discharge cycles the battery has experienced"
         ),
     )
-    average_time_to_empty: int = dataclasses.field(
+    average_time_to_empty: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="average_time_to_empty",
@@ -1108,7 +1109,7 @@ class BatteryStatus:
             doc="Predicted remaining battery capacity based on the average rate of discharge",
         ),
     )
-    manufacture_date: int = dataclasses.field(
+    manufacture_date: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="manufacture_date",
@@ -1117,7 +1118,7 @@ class BatteryStatus:
             "+ Month×32 + (Year–1980)×512",
         ),
     )
-    state_of_health: int = dataclasses.field(
+    state_of_health: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="state_of_health",
@@ -1131,7 +1132,7 @@ class BatteryStatus:
             doc="State of health. FullChargeCapacity/DesignCapacity",
         ),
     )
-    max_error: int = dataclasses.field(
+    max_error: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="max_error",
@@ -1145,7 +1146,7 @@ class BatteryStatus:
             doc="Max error, expected margin of error in the state-of-charge calculation",
         ),
     )
-    id: int = dataclasses.field(
+    id: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="id",
@@ -1153,10 +1154,10 @@ class BatteryStatus:
             doc="ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed",
         ),
     )
-    interface_error: int = dataclasses.field(
+    interface_error: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="Interface error counter")
     )
-    voltage_cell_v: list[float] = dataclasses.field(
+    voltage_cell_v: list[float] = _dataclasses.field(
         default_factory=lambda: [0.0] * 14,
         metadata=_m.meta(
             name="voltage_cell_v",
@@ -1169,31 +1170,31 @@ class BatteryStatus:
             doc="Battery individual cell voltages",
         ),
     )
-    max_cell_voltage_delta: float = dataclasses.field(
+    max_cell_voltage_delta: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="max_cell_voltage_delta", type="float32", doc="Max difference between individual cell voltages"
         ),
     )
-    is_powering_off: bool = dataclasses.field(
+    is_powering_off: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
         ),
     )
-    is_required: bool = dataclasses.field(
+    is_required: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="is_required", type="bool", doc="Set if the battery is explicitly required before arming"
         ),
     )
-    warning: int = dataclasses.field(
+    warning: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="warning", type="uint8", enums=("uorb.BatteryStatus.WARNING",), doc="Current battery warning"
         ),
     )
-    faults: int = dataclasses.field(
+    faults: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="faults",
@@ -1202,7 +1203,7 @@ class BatteryStatus:
             doc="Smart battery supply status/fault flags (bitmask) for health indication",
         ),
     )
-    full_charge_capacity_wh: float = dataclasses.field(
+    full_charge_capacity_wh: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="full_charge_capacity_wh",
@@ -1214,7 +1215,7 @@ class BatteryStatus:
             doc="Compensated battery capacity",
         ),
     )
-    remaining_capacity_wh: float = dataclasses.field(
+    remaining_capacity_wh: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="remaining_capacity_wh",
@@ -1226,10 +1227,10 @@ class BatteryStatus:
             doc="Compensated battery capacity remaining",
         ),
     )
-    over_discharge_count: int = dataclasses.field(
+    over_discharge_count: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
     )
-    nominal_voltage: float = dataclasses.field(
+    nominal_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="nominal_voltage",
@@ -1239,7 +1240,7 @@ class BatteryStatus:
             doc="Nominal voltage of the battery pack",
         ),
     )
-    internal_resistance_estimate: float = dataclasses.field(
+    internal_resistance_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="internal_resistance_estimate",
@@ -1249,13 +1250,13 @@ class BatteryStatus:
             doc="Internal resistance per cell estimate",
         ),
     )
-    ocv_estimate: float = dataclasses.field(
+    ocv_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="ocv_estimate", type="float32", unit="V", quantity="voltage", doc="Open circuit voltage estimate"
         ),
     )
-    ocv_estimate_filtered: float = dataclasses.field(
+    ocv_estimate_filtered: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="ocv_estimate_filtered",
@@ -1265,7 +1266,7 @@ class BatteryStatus:
             doc="Filtered open circuit voltage estimate",
         ),
     )
-    volt_based_soc_estimate: float = dataclasses.field(
+    volt_based_soc_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="volt_based_soc_estimate",
@@ -1275,17 +1276,17 @@ class BatteryStatus:
             doc="Normalized volt based state of charge estimate",
         ),
     )
-    voltage_prediction: float = dataclasses.field(
+    voltage_prediction: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="voltage_prediction", type="float32", unit="V", quantity="voltage", doc="Predicted voltage"
         ),
     )
-    prediction_error: float = dataclasses.field(
+    prediction_error: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Prediction error"),
     )
-    estimation_covariance_norm: float = dataclasses.field(
+    estimation_covariance_norm: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="estimation_covariance_norm", type="float32", doc="Norm of the covariance matrix"),
     )
@@ -1296,9 +1297,9 @@ class BatteryStatus:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["timestamp"] = self.timestamp
         out["connected"] = self.connected
         out["voltage_v"] = self.voltage_v
@@ -1340,7 +1341,7 @@ class BatteryStatus:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatus:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -1474,10 +1475,10 @@ class BatteryStatus:
             )
         return obj
 
-    UORB_FORMAT: ClassVar[str] = "<Q33f9H?4B2?B2x"
-    UORB_SIZE: ClassVar[int] = 168
-    UORB_SIZE_NO_PADDING: ClassVar[int] = 166
-    UORB_TOPICS: ClassVar[tuple[str, ...]] = ("battery_status",)
+    UORB_FORMAT: _ClassVar[str] = "<Q33f9H?4B2?B2x"
+    UORB_SIZE: _ClassVar[int] = 168
+    UORB_SIZE_NO_PADDING: _ClassVar[int] = 166
+    UORB_TOPICS: _ClassVar[tuple[str, ...]] = ("battery_status",)
 
     def encode(self) -> bytes:
         """PX4's C struct of this message: 168 bytes, little-endian, padding zeroed."""
@@ -1522,7 +1523,7 @@ class BatteryStatus:
                 self.is_required,
                 self.warning,
             )
-        except (struct.error, TypeError, OverflowError) as exc:
+        except (_struct.error, TypeError, OverflowError) as exc:
             raise _uorb.encode_error("BatteryStatus", self, _BATTERY_STATUS_PACKED_FIELDS, exc) from None
 
     @classmethod
@@ -1582,7 +1583,7 @@ class BatteryStatus:
         stride: int | None = None,
         use_numpy: bool | None = None,
         copy: bool = True,
-    ) -> dict[str, Any]:
+    ) -> dict[str, _Any]:
         """Columns of back-to-back records without an object per record, named as PX4 log
         tools flatten them (``voltage_cell_v[3]``, ``nested.field``; char arrays as bytes).
 
@@ -1659,12 +1660,12 @@ class BatteryStatus:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        a: Any
-        e: Any
-        r_cell_count: Any
-        r_voltage_cell_v: Any
-        v_i: Any
+        x: _Any
+        a: _Any
+        e: _Any
+        r_cell_count: _Any
+        r_voltage_cell_v: _Any
+        v_i: _Any
         try:
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_TIMESTAMP_SPEC)
@@ -2045,7 +2046,7 @@ class BatteryStatus:
         raise KeyError(f"{field!r} is not a field of " + "uorb.BatteryStatus")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryStatusV0:
     """Battery status
 
@@ -2056,33 +2057,33 @@ class BatteryStatusV0:
     Schema: uorb.BatteryStatusV0 (uorb, BatteryStatusV0.msg:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "uorb.BatteryStatusV0"
-    MESSAGE_VERSION: ClassVar[int] = 0
-    MAX_INSTANCES: ClassVar[int] = 4
-    SOURCE_POWER_MODULE: ClassVar[int] = 0
-    SOURCE_EXTERNAL: ClassVar[int] = 1
-    SOURCE_ESCS: ClassVar[int] = 2
-    WARNING_NONE: ClassVar[int] = 0
-    WARNING_LOW: ClassVar[int] = 1
-    WARNING_CRITICAL: ClassVar[int] = 2
-    WARNING_EMERGENCY: ClassVar[int] = 3
-    WARNING_FAILED: ClassVar[int] = 4
-    STATE_UNHEALTHY: ClassVar[int] = 6
-    STATE_CHARGING: ClassVar[int] = 7
-    FAULT_DEEP_DISCHARGE: ClassVar[int] = 0
-    FAULT_SPIKES: ClassVar[int] = 1
-    FAULT_CELL_FAIL: ClassVar[int] = 2
-    FAULT_OVER_CURRENT: ClassVar[int] = 3
-    FAULT_OVER_TEMPERATURE: ClassVar[int] = 4
-    FAULT_UNDER_TEMPERATURE: ClassVar[int] = 5
-    FAULT_INCOMPATIBLE_VOLTAGE: ClassVar[int] = 6
-    FAULT_INCOMPATIBLE_FIRMWARE: ClassVar[int] = 7
-    FAULT_INCOMPATIBLE_MODEL: ClassVar[int] = 8
-    FAULT_HARDWARE_FAILURE: ClassVar[int] = 9
-    FAULT_FAILED_TO_ARM: ClassVar[int] = 10
-    FAULT_COUNT: ClassVar[int] = 11
+    QUALIFIED_NAME: _ClassVar[str] = "uorb.BatteryStatusV0"
+    MESSAGE_VERSION: _ClassVar[int] = 0
+    MAX_INSTANCES: _ClassVar[int] = 4
+    SOURCE_POWER_MODULE: _ClassVar[int] = 0
+    SOURCE_EXTERNAL: _ClassVar[int] = 1
+    SOURCE_ESCS: _ClassVar[int] = 2
+    WARNING_NONE: _ClassVar[int] = 0
+    WARNING_LOW: _ClassVar[int] = 1
+    WARNING_CRITICAL: _ClassVar[int] = 2
+    WARNING_EMERGENCY: _ClassVar[int] = 3
+    WARNING_FAILED: _ClassVar[int] = 4
+    STATE_UNHEALTHY: _ClassVar[int] = 6
+    STATE_CHARGING: _ClassVar[int] = 7
+    FAULT_DEEP_DISCHARGE: _ClassVar[int] = 0
+    FAULT_SPIKES: _ClassVar[int] = 1
+    FAULT_CELL_FAIL: _ClassVar[int] = 2
+    FAULT_OVER_CURRENT: _ClassVar[int] = 3
+    FAULT_OVER_TEMPERATURE: _ClassVar[int] = 4
+    FAULT_UNDER_TEMPERATURE: _ClassVar[int] = 5
+    FAULT_INCOMPATIBLE_VOLTAGE: _ClassVar[int] = 6
+    FAULT_INCOMPATIBLE_FIRMWARE: _ClassVar[int] = 7
+    FAULT_INCOMPATIBLE_MODEL: _ClassVar[int] = 8
+    FAULT_HARDWARE_FAILURE: _ClassVar[int] = 9
+    FAULT_FAILED_TO_ARM: _ClassVar[int] = 10
+    FAULT_COUNT: _ClassVar[int] = 11
 
-    timestamp: int = dataclasses.field(
+    timestamp: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="timestamp",
@@ -2094,7 +2095,7 @@ class BatteryStatusV0:
             doc="Time since system start",
         ),
     )
-    connected: bool = dataclasses.field(
+    connected: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="connected",
@@ -2102,7 +2103,7 @@ class BatteryStatusV0:
             doc="Whether or not a battery is connected. For power modules this is based on a voltage threshold.",
         ),
     )
-    voltage_v: float = dataclasses.field(
+    voltage_v: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="voltage_v",
@@ -2114,7 +2115,7 @@ class BatteryStatusV0:
             doc="Battery voltage",
         ),
     )
-    current_a: float = dataclasses.field(
+    current_a: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="current_a",
@@ -2126,7 +2127,7 @@ class BatteryStatusV0:
             doc="Battery current",
         ),
     )
-    current_average_a: float = dataclasses.field(
+    current_average_a: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="current_average_a",
@@ -2138,7 +2139,7 @@ class BatteryStatusV0:
             doc="Battery current average (for FW average in level flight)",
         ),
     )
-    discharged_mah: float = dataclasses.field(
+    discharged_mah: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="discharged_mah",
@@ -2152,7 +2153,7 @@ class BatteryStatusV0:
             doc="Discharged amount",
         ),
     )
-    remaining: float = dataclasses.field(
+    remaining: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="remaining",
@@ -2164,7 +2165,7 @@ class BatteryStatusV0:
             doc="Remaining capacity",
         ),
     )
-    scale: float = dataclasses.field(
+    scale: float = _dataclasses.field(
         default=-1.0,
         metadata=_m.meta(
             name="scale",
@@ -2176,20 +2177,20 @@ class BatteryStatusV0:
             doc="Scaling factor to compensate for lower actuation power caused by voltage sag",
         ),
     )
-    time_remaining_s: float = dataclasses.field(
-        default=math.nan,
+    time_remaining_s: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="time_remaining_s",
             type="float32",
             unit="s",
             quantity="time",
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Predicted time remaining until battery is empty under previous averaged load",
         ),
     )
-    temperature: float = dataclasses.field(
-        default=math.nan,
+    temperature: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="temperature",
             type="float32",
@@ -2197,19 +2198,19 @@ class BatteryStatusV0:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Temperature of the battery",
         ),
     )
-    cell_count: int = dataclasses.field(
+    cell_count: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="cell_count", type="uint8", invalid=0, invalid_text="0", doc="Number of cells")
     )
-    source: int = dataclasses.field(
+    source: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="source", type="uint8", enums=("uorb.BatteryStatusV0.SOURCE",), doc="Battery source"),
     )
-    priority: int = dataclasses.field(
+    priority: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="priority",
@@ -2217,7 +2218,7 @@ class BatteryStatusV0:
             doc="Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1",
         ),
     )
-    capacity: int = dataclasses.field(
+    capacity: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="capacity",
@@ -2229,13 +2230,13 @@ class BatteryStatusV0:
             doc="Capacity of the battery when fully charged",
         ),
     )
-    cycle_count: int = dataclasses.field(
+    cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cycle_count", type="uint16", doc="Number of discharge cycles the battery has experienced"
         ),
     )
-    average_time_to_empty: int = dataclasses.field(
+    average_time_to_empty: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="average_time_to_empty",
@@ -2247,10 +2248,10 @@ class BatteryStatusV0:
             doc="Predicted remaining battery capacity based on the average rate of discharge",
         ),
     )
-    serial_number: int = dataclasses.field(
+    serial_number: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="Serial number of the battery pack")
     )
-    manufacture_date: int = dataclasses.field(
+    manufacture_date: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="manufacture_date",
@@ -2259,7 +2260,7 @@ class BatteryStatusV0:
             "+ Month×32 + (Year–1980)×512",
         ),
     )
-    state_of_health: int = dataclasses.field(
+    state_of_health: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="state_of_health",
@@ -2273,7 +2274,7 @@ class BatteryStatusV0:
             doc="State of health. FullChargeCapacity/DesignCapacity",
         ),
     )
-    max_error: int = dataclasses.field(
+    max_error: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="max_error",
@@ -2287,7 +2288,7 @@ class BatteryStatusV0:
             doc="Max error, expected margin of error in the state-of-charge calculation",
         ),
     )
-    id: int = dataclasses.field(
+    id: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="id",
@@ -2295,10 +2296,10 @@ class BatteryStatusV0:
             doc="ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed",
         ),
     )
-    interface_error: int = dataclasses.field(
+    interface_error: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="Interface error counter")
     )
-    voltage_cell_v: list[float] = dataclasses.field(
+    voltage_cell_v: list[float] = _dataclasses.field(
         default_factory=lambda: [0.0] * 14,
         metadata=_m.meta(
             name="voltage_cell_v",
@@ -2311,25 +2312,25 @@ class BatteryStatusV0:
             doc="Battery individual cell voltages",
         ),
     )
-    max_cell_voltage_delta: float = dataclasses.field(
+    max_cell_voltage_delta: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="max_cell_voltage_delta", type="float32", doc="Max difference between individual cell voltages"
         ),
     )
-    is_powering_off: bool = dataclasses.field(
+    is_powering_off: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
         ),
     )
-    is_required: bool = dataclasses.field(
+    is_required: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="is_required", type="bool", doc="Set if the battery is explicitly required before arming"
         ),
     )
-    warning: int = dataclasses.field(
+    warning: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="warning",
@@ -2338,7 +2339,7 @@ class BatteryStatusV0:
             doc="Current battery warning",
         ),
     )
-    faults: int = dataclasses.field(
+    faults: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="faults",
@@ -2347,7 +2348,7 @@ class BatteryStatusV0:
             doc="Smart battery supply status/fault flags (bitmask) for health indication",
         ),
     )
-    full_charge_capacity_wh: float = dataclasses.field(
+    full_charge_capacity_wh: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="full_charge_capacity_wh",
@@ -2359,7 +2360,7 @@ class BatteryStatusV0:
             doc="Compensated battery capacity",
         ),
     )
-    remaining_capacity_wh: float = dataclasses.field(
+    remaining_capacity_wh: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="remaining_capacity_wh",
@@ -2371,10 +2372,10 @@ class BatteryStatusV0:
             doc="Compensated battery capacity remaining",
         ),
     )
-    over_discharge_count: int = dataclasses.field(
+    over_discharge_count: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
     )
-    nominal_voltage: float = dataclasses.field(
+    nominal_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="nominal_voltage",
@@ -2384,7 +2385,7 @@ class BatteryStatusV0:
             doc="Nominal voltage of the battery pack",
         ),
     )
-    internal_resistance_estimate: float = dataclasses.field(
+    internal_resistance_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="internal_resistance_estimate",
@@ -2394,13 +2395,13 @@ class BatteryStatusV0:
             doc="Internal resistance per cell estimate",
         ),
     )
-    ocv_estimate: float = dataclasses.field(
+    ocv_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="ocv_estimate", type="float32", unit="V", quantity="voltage", doc="Open circuit voltage estimate"
         ),
     )
-    ocv_estimate_filtered: float = dataclasses.field(
+    ocv_estimate_filtered: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="ocv_estimate_filtered",
@@ -2410,7 +2411,7 @@ class BatteryStatusV0:
             doc="Filtered open circuit voltage estimate",
         ),
     )
-    volt_based_soc_estimate: float = dataclasses.field(
+    volt_based_soc_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="volt_based_soc_estimate",
@@ -2420,17 +2421,17 @@ class BatteryStatusV0:
             doc="Normalized volt based state of charge estimate",
         ),
     )
-    voltage_prediction: float = dataclasses.field(
+    voltage_prediction: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="voltage_prediction", type="float32", unit="V", quantity="voltage", doc="Predicted voltage"
         ),
     )
-    prediction_error: float = dataclasses.field(
+    prediction_error: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Prediction error"),
     )
-    estimation_covariance_norm: float = dataclasses.field(
+    estimation_covariance_norm: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="estimation_covariance_norm", type="float32", doc="Norm of the covariance matrix"),
     )
@@ -2441,9 +2442,9 @@ class BatteryStatusV0:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["timestamp"] = self.timestamp
         out["connected"] = self.connected
         out["voltage_v"] = self.voltage_v
@@ -2486,7 +2487,7 @@ class BatteryStatusV0:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryStatusV0:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatusV0:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -2623,10 +2624,10 @@ class BatteryStatusV0:
             )
         return obj
 
-    UORB_FORMAT: ClassVar[str] = "<Q33f10H?4B2?B"
-    UORB_SIZE: ClassVar[int] = 168
-    UORB_SIZE_NO_PADDING: ClassVar[int] = 168
-    UORB_TOPICS: ClassVar[tuple[str, ...]] = ("battery_status_v0",)
+    UORB_FORMAT: _ClassVar[str] = "<Q33f10H?4B2?B"
+    UORB_SIZE: _ClassVar[int] = 168
+    UORB_SIZE_NO_PADDING: _ClassVar[int] = 168
+    UORB_TOPICS: _ClassVar[tuple[str, ...]] = ("battery_status_v0",)
 
     def encode(self) -> bytes:
         """PX4's C struct of this message: 168 bytes, little-endian, padding zeroed."""
@@ -2672,7 +2673,7 @@ class BatteryStatusV0:
                 self.is_required,
                 self.warning,
             )
-        except (struct.error, TypeError, OverflowError) as exc:
+        except (_struct.error, TypeError, OverflowError) as exc:
             raise _uorb.encode_error("BatteryStatusV0", self, _BATTERY_STATUS_V0_PACKED_FIELDS, exc) from None
 
     @classmethod
@@ -2731,7 +2732,7 @@ class BatteryStatusV0:
         stride: int | None = None,
         use_numpy: bool | None = None,
         copy: bool = True,
-    ) -> dict[str, Any]:
+    ) -> dict[str, _Any]:
         """Columns of back-to-back records without an object per record, named as PX4 log
         tools flatten them (``voltage_cell_v[3]``, ``nested.field``; char arrays as bytes).
 
@@ -2808,12 +2809,12 @@ class BatteryStatusV0:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        a: Any
-        e: Any
-        r_cell_count: Any
-        r_voltage_cell_v: Any
-        v_i: Any
+        x: _Any
+        a: _Any
+        e: _Any
+        r_cell_count: _Any
+        r_voltage_cell_v: _Any
+        v_i: _Any
         try:
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_V0_TIMESTAMP_SPEC)

@@ -99,6 +99,47 @@ def hostile_schema() -> Schema:
     return Schema((outer, inner, weird, dt))
 
 
+def clashing_schema() -> Schema:
+    """Names that clash with what generated code uses (issue 10): types named like the typing names and
+    builtins it needs, members named like its modules, builtins and classes, an enum entry ``mro``."""
+    fields = tuple(
+        Field(n, U8, L) for n in ("dataclasses", "struct", "math", "enum", "int", "float", "str", "bool", "Any")
+    )
+    kinds = EnumDef("uorb.ClassVar.KIND", EnumKind.VALUE, tuple(EnumEntry(f"KIND_{n}", i) for i, n in enumerate(
+        ("mro", "name", "value", "real", "to_bytes")
+    )))  # fmt: skip
+    classvar = Message(
+        "ClassVar",
+        "uorb.ClassVar",
+        SourceFormat.UORB,
+        L,
+        "",
+        (*fields, Field("kind", U8, L, enums=("uorb.ClassVar.KIND",))),
+        constants=(Constant("dataclasses", U8, 1), Constant("QUALIFIED_NAME", U8, 2), Constant("ClassVar", U8, 3)),
+        enums=(kinds,),
+    )
+    seven = Constant("K", U8, 7)
+    later = [
+        Message(n, f"uorb.{n}", SourceFormat.UORB, L, "", (Field("x", U8, L), Field(n, U8, L)), constants=(seven,))
+        for n in ("Any", "Mapping", "ValueError", "Struct")
+    ]
+    inner = Message(
+        "Inner",
+        "dronecan.ns.Inner",
+        SourceFormat.DRONECAN,
+        L,
+        "",
+        (Field("Outer", U8, L),),
+        dronecan=_dronecan("ns.Inner"),
+    )
+    outer = Message(
+        "Outer", "dronecan.ns.Outer", SourceFormat.DRONECAN, L, "",
+        (Field("Inner", CompositeType("dronecan.ns.Inner"), L), Field("Outer", F32, L), Field("float", F32, L)),
+        dronecan=_dronecan("ns.Outer"),
+    )  # fmt: skip
+    return Schema((classvar, *later, inner, outer))
+
+
 FIELDS = """
 <field type="uint64_t" name="time_usec">t</field>
 <field type="char[8]" name="label">l</field>

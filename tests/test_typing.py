@@ -13,17 +13,18 @@ from pathlib import Path
 
 import pytest
 from conftest import ROOT
-from samples import NESTED, hostile_schema, mavlink_thing_xml
+from samples import NESTED, clashing_schema, hostile_schema, mavlink_thing_xml
 
 from codegen.backends.python.writer import generate
 from codegen.frontends import dsdl, mavlink, uorb
 
 # target -> the folder whose files mypy reports on
-TARGETS = ("codegen", "generated", "hostile", "mavlink_thing", "uorb_nested", "dronecan_unions")
+TARGETS = ("codegen", "generated", "hostile", "clashing", "mavlink_thing", "uorb_nested", "dronecan_unions")
 
 
 def _generate_samples(root: Path) -> None:
     generate(hostile_schema(), root / "hostile")
+    generate(clashing_schema(), root / "clashing")
     work = root / "sources"
     work.mkdir()
     generate(mavlink.parse_file(mavlink_thing_xml(work), root=work), root / "mavlink_thing")

@@ -186,6 +186,18 @@ class Endpoint:
         return tuple(out)
 
 
+CARRIED = "_before"  # the suffix of a converter input fed from the previous record's result
+
+
+def _carried(result: object, field: str) -> float | None:
+    """The value of ``field`` in a converter's result (one object or a tuple of them), None if absent."""
+    for obj in result if isinstance(result, tuple) else (result,):
+        value = getattr(obj, field, None)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return float(value)
+    return None
+
+
 class Conversion:
     """One converter of a generated package, checked: the pair exists, has the policy."""
 
@@ -219,7 +231,10 @@ class Conversion:
         """Convert every record of one input (``where`` names it) read as ``fmt``. ``binary``:
         hand out the target's payloads instead of its plain data; ``loss``: ``"entries"`` or
         ``"summary"`` of each record's loss report."""
-        extra = dict(inputs or {})
+        extra: dict[str, float | None] = dict(inputs or {})
+        # an input named <field>_before is state the converter carries from record to record (PX4's
+        # discharged-charge integral): unless given, each record gets the previous result's <field>
+        carried = [name for name in self.inputs_taken if name.endswith(CARRIED) and name not in extra]
         for item in self._items(source, where, fmt):
             if isinstance(item, Notice):
                 yield item
@@ -235,6 +250,8 @@ class Conversion:
             except (ValueError, TypeError, AttributeError) as exc:
                 text = f"cannot convert (a value the input lacks or does not fit): {exc}"
                 raise fail(where, item.line, text) from None
+            for name in carried:
+                extra[name] = _carried(result, name.removesuffix(CARRIED))
             lost = None if report is None else report.summary() if loss == "summary" else report.to_dict()
             if binary:
                 yield Converted(item.line, payloads=self.target.to_binary(result, item.file, item.line), loss=lost)

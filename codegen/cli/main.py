@@ -22,26 +22,36 @@ EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 COMMAND_MODULES = (validate, docs, schema, convert, params, failsafe, can)  # in the order of the help text
 
 
-def _load(paths: Sequence[str]) -> Schema:
-    return load([Path(p) for p in paths] if paths else [bundled_schemas()])
+def _load(paths: Sequence[str], args: argparse.Namespace) -> Schema:
+    include_paths = [Path(p) for p in args.include_path or ()]
+    return load([Path(p) for p in paths] if paths else [bundled_schemas()], include_paths=include_paths)
+
+
+def _include_path_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--include-path",
+        action="append",
+        metavar="DIR",
+        help="a folder MAVLink <include>s may read from besides the schema folder (repeatable)",
+    )
 
 
 def cmd_list(args: argparse.Namespace) -> int:
-    schema = _load(args.paths)
+    schema = _load(args.paths, args)
     for msg in schema.messages:
         print(msg.qualified_name)
     return EXIT_OK
 
 
 def cmd_ir(args: argparse.Namespace) -> int:
-    schema = _load(args.paths)
+    schema = _load(args.paths, args)
     sys.stdout.write(irjson.dumps(schema))
     return EXIT_OK
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
     started = time.perf_counter()
-    schema = _load([args.schema_dir] if args.schema_dir else [])
+    schema = _load([args.schema_dir] if args.schema_dir else [], args)
     out = Path(args.out) if args.out else project_root() / "generated"
     if not out.name.isidentifier():
         raise BattgenError(
@@ -84,16 +94,19 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("list", help="print the qualified names of the messages in a schema folder or files")
     p.add_argument("paths", nargs="*", help="schema folders or files (default: the bundled schemas/)")
+    _include_path_option(p)
     p.set_defaults(func=cmd_list)
 
     p = sub.add_parser("ir", help="print the IR as JSON")
     p.add_argument("paths", nargs="*", help="schema folders (uorb/, dronecan/, devicetree/, mavlink/) or single files")
+    _include_path_option(p)
     p.set_defaults(func=cmd_ir)
 
     p = sub.add_parser("generate", help="generate the Python package (default: schemas/ into generated/)")
     p.add_argument("schema_dir", nargs="?", help="schema folder (default: schemas/)")
     p.add_argument("--out", help="write an importable package here (its import name is the folder's name)")
     p.add_argument("--check", action="store_true", help="write nothing; exit 1 naming stale files")
+    _include_path_option(p)
     p.set_defaults(func=cmd_generate)
 
     for module in COMMAND_MODULES:

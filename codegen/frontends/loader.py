@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Protocol
 
@@ -61,13 +61,18 @@ def is_schema_dir(path: Path) -> bool:
     return any((path / fmt).is_dir() for fmt in FORMAT_FRONTENDS)
 
 
-def load_schema_dir(root: Path) -> Schema:
-    """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset)."""
+def load_schema_dir(root: Path, *, include_paths: Sequence[Path] = ()) -> Schema:
+    """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset); MAVLink includes
+    may also come from ``include_paths`` (README Limits)."""
     schema = Schema()
     for fmt in FORMAT_FRONTENDS:
         sub = root / fmt
         if sub.is_dir():
-            part: Schema = frontend(fmt).parse_dir(sub)
+            part: Schema = (
+                mavlink.parse_dir(sub, include_paths=include_paths)
+                if fmt == "mavlink"
+                else frontend(fmt).parse_dir(sub)
+            )
             schema = schema.merged(part)
     if (root / MAPPINGS_DIR).is_dir():
         # after the formats, so every reference to a message or field can be checked
@@ -121,8 +126,9 @@ def _load_dsdl_tree(path: Path, definition: Path) -> Schema:
     return dsdl.parse_dir(path)
 
 
-def load(paths: Iterable[Path]) -> Schema:
-    """Parse schema folders, DSDL roots and single files (format from the extension) into one Schema."""
+def load(paths: Iterable[Path], *, include_paths: Sequence[Path] = ()) -> Schema:
+    """Parse schema folders, DSDL roots and single files (format from the extension) into one Schema;
+    ``include_paths``: folders MAVLink <include>s may read besides the schema folder."""
     schema = Schema()
     for path in paths:
         if path.is_dir():
@@ -130,7 +136,7 @@ def load(paths: Iterable[Path]) -> Schema:
             if definition is not None:
                 part = _load_dsdl_tree(path, definition)
             elif is_schema_dir(path):
-                part = load_schema_dir(path)
+                part = load_schema_dir(path, include_paths=include_paths)
             else:
                 expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
                 raise BattgenError(
@@ -138,7 +144,12 @@ def load(paths: Iterable[Path]) -> Schema:
                     "(namespace folders such as uavcan/ holding .uavcan files)"
                 )
         elif path.is_file():
-            part = frontend(format_of_file(path)).parse_file(path)
+            fmt = format_of_file(path)
+            part = (
+                mavlink.parse_file(path, include_paths=include_paths)
+                if fmt == "mavlink"
+                else frontend(fmt).parse_file(path)
+            )
         else:
             raise BattgenError(f"{path}: no such file or folder")
         schema = schema.merged(part)

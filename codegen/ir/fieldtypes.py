@@ -102,6 +102,12 @@ class PrimitiveType:
         return None
 
 
+# The largest array capacity a frontend accepts (README "Limits"): four times the largest upstream one
+# (PX4 512, DroneCAN 300, dtschema maxItems 1024, MAVLink 255). The generated codecs, column lists and
+# the data readers' loops are sized by capacities, so an absurd one must not reach them.
+MAX_ARRAY_CAPACITY = 4096
+
+
 @dataclass(frozen=True)
 class ArrayType:
     """A fixed (``dynamic=False``) or bounded-dynamic array; ``capacity`` None means unbounded.

@@ -10,6 +10,10 @@ Every XML file battgen reads goes through :class:`XmlReader`, an expat parser wi
 - Errors are :class:`~codegen.errors.SchemaError` at a file and line: ``expected well-formed XML
   (<expat's message>)`` for malformed documents, and whatever a format's handlers raise.
 
+- The limits of :mod:`.limits`, checked while expat streams (before any later parser sees the
+  bytes): the file's size and number lengths, an encoding declared as UTF-8 if declared at all, the
+  nesting depth and the length of one element's text.
+
 Expat streams the document, so a format reads it in document order by overriding
 :meth:`XmlReader.start`, :meth:`XmlReader.end` and :meth:`XmlReader.text`; :attr:`XmlReader.line` is
 the line being read and :meth:`XmlReader.error` makes a SchemaError there. Each format keeps its own
@@ -18,16 +22,29 @@ limits (field counts, id ranges...), which belong to the format rather than to X
 
 from __future__ import annotations
 
+import re
 import xml.parsers.expat
 from pathlib import Path
 
 from ..errors import SchemaError
-from .files import read_text
+from .limits import MAX_XML_DEPTH, MAX_XML_TEXT, read_schema_text
+
+# the encoding named by an XML declaration; expat (and pymavlink after it) would look any name up
+_DECLARED_ENCODING = re.compile(r"""\ufeff?<\?xml[^>]*?\bencoding\s*=\s*["']([^"']*)["']""")
 
 
 def read_xml(path: Path, display: str) -> bytes:
-    """The bytes of an XML file, once they are known to be UTF-8 text (SchemaError otherwise)."""
-    return read_text(path, display).encode("utf-8")
+    """The bytes of an XML file, once they are known to be UTF-8 text within the schema limits and
+    declare no other encoding (SchemaError otherwise)."""
+    text = read_schema_text(path, display)
+    match = _DECLARED_ENCODING.match(text)
+    if match is not None and match.group(1).lower().replace("_", "-") not in ("utf-8", "utf8"):
+        raise SchemaError(
+            display,
+            1,
+            f'expected encoding="UTF-8" in the XML declaration (schema files are UTF-8), got {match.group(1)[:40]!r}',
+        )
+    return text.encode("utf-8")
 
 
 class XmlReader:
@@ -44,9 +61,11 @@ class XmlReader:
         p.SetParamEntityParsing(xml.parsers.expat.XML_PARAM_ENTITY_PARSING_NEVER)
         p.StartDoctypeDeclHandler = self._doctype
         p.EntityDeclHandler = self._entity
-        p.StartElementHandler = self.start
-        p.EndElementHandler = self.end
-        p.CharacterDataHandler = self.text
+        p.StartElementHandler = self._start
+        p.EndElementHandler = self._end
+        p.CharacterDataHandler = self._text
+        self._depth = 0
+        self._text_length = 0  # characters of text since the last tag
 
     @property
     def line(self) -> int:
@@ -72,6 +91,24 @@ class XmlReader:
         except xml.parsers.expat.ExpatError as exc:
             message = xml.parsers.expat.errors.messages.get(exc.code, str(exc))
             raise SchemaError(self.display, exc.lineno, f"expected well-formed XML ({message})") from None
+
+    def _start(self, tag: str, attrs: dict[str, str]) -> None:
+        self._depth += 1
+        self._text_length = 0
+        if self._depth > MAX_XML_DEPTH:
+            raise self.error(f"expected elements nested at most {MAX_XML_DEPTH} deep (README Limits)")
+        self.start(tag, attrs)
+
+    def _end(self, tag: str) -> None:
+        self._depth -= 1
+        self._text_length = 0
+        self.end(tag)
+
+    def _text(self, data: str) -> None:
+        self._text_length += len(data)
+        if self._text_length > MAX_XML_TEXT:
+            raise self.error(f"expected at most {MAX_XML_TEXT} characters of text in one element (README Limits)")
+        self.text(data)
 
     def _doctype(self, *_: object) -> None:
         raise self.error(f"expected no DOCTYPE ({self._no_dtd_because})")

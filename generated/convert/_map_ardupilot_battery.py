@@ -6,7 +6,7 @@ ArduPilot's DroneCAN battery messages, read and written with the meaning their D
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..dronecan.ardupilot.equipment.power import BatteryCells, BatteryContinuous, BatteryPeriodic, BatteryTag
 from . import _runtime as _r
@@ -269,7 +269,7 @@ def backward(
     # ardupilot_battery.yaml:15: scale continuous.voltage -> pack_voltage
     _v1 = s.pack_voltage
     if _v1 is None or _v1 != _v1:
-        t_continuous.voltage = math.nan
+        t_continuous.voltage = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryContinuous.voltage")
     else:
@@ -279,7 +279,7 @@ def backward(
     # Positive while discharging, as the concept.
     _v2 = s.current
     if _v2 is None or _v2 != _v2:
-        t_continuous.current = math.nan
+        t_continuous.current = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryContinuous.current")
     else:
@@ -289,7 +289,7 @@ def backward(
     # The cell thermistor (degrees Celsius); the PCB and other temperatures have no concept.
     _v3 = s.temperature
     if _v3 is None or _v3 != _v3:
-        t_continuous.temperature_cells = math.nan
+        t_continuous.temperature_cells = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryContinuous.temperature_cells")
     else:
@@ -300,7 +300,7 @@ def backward(
     # ardupilot_battery.yaml:22: scale continuous.state_of_charge -> state_of_charge
     _v4 = s.state_of_charge
     if _v4 is None or _v4 != _v4:
-        t_continuous.state_of_charge = math.nan
+        t_continuous.state_of_charge = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryContinuous.state_of_charge")
     else:
@@ -312,7 +312,7 @@ def backward(
     # Ah drawn so far.
     _v5 = s.discharged
     if _v5 is None or _v5 != _v5:
-        t_continuous.capacity_consumed = math.nan
+        t_continuous.capacity_consumed = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryContinuous.capacity_consumed")
     else:
@@ -399,7 +399,7 @@ def backward(
     # ardupilot_battery.yaml:48: scale periodic.full_charge_capacity -> full_capacity
     _v13 = s.full_capacity
     if _v13 is None or _v13 != _v13:
-        t_periodic.full_charge_capacity = math.nan
+        t_periodic.full_charge_capacity = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryPeriodic.full_charge_capacity")
     else:

@@ -6,7 +6,7 @@ DroneCAN smart battery data, read and written with the meaning the DSDL comments
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
 from ..dronecan.uavcan.equipment.power import BatteryInfo
@@ -214,7 +214,7 @@ def backward(
     # dronecan.yaml:12: scale info.voltage -> pack_voltage
     _v1 = s.pack_voltage
     if _v1 is None or _v1 != _v1:
-        t_info.voltage = math.nan
+        t_info.voltage = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.voltage")
     else:
@@ -223,7 +223,7 @@ def backward(
     # dronecan.yaml:13: scale info.current -> current
     _v2 = s.current
     if _v2 is None or _v2 != _v2:
-        t_info.current = math.nan
+        t_info.current = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.current")
     else:
@@ -233,7 +233,7 @@ def backward(
     # Kelvin; zero or below is not a physical reading and counts as unknown.
     _v3 = s.temperature
     if _v3 is None or _v3 != _v3:
-        t_info.temperature = math.nan
+        t_info.temperature = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.temperature")
     else:
@@ -242,7 +242,7 @@ def backward(
     # dronecan.yaml:20: scale info.average_power_10sec -> average_power
     _v4 = s.average_power
     if _v4 is None or _v4 != _v4:
-        t_info.average_power_10sec = math.nan
+        t_info.average_power_10sec = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec")
     else:
@@ -251,7 +251,7 @@ def backward(
     # dronecan.yaml:21: scale info.remaining_capacity_wh -> remaining_energy
     _v5 = s.remaining_energy
     if _v5 is None or _v5 != _v5:
-        t_info.remaining_capacity_wh = math.nan
+        t_info.remaining_capacity_wh = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
     else:
@@ -262,7 +262,7 @@ def backward(
     # dronecan.yaml:22: scale info.full_charge_capacity_wh -> full_energy
     _v6 = s.full_energy
     if _v6 is None or _v6 != _v6:
-        t_info.full_charge_capacity_wh = math.nan
+        t_info.full_charge_capacity_wh = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
     else:
@@ -273,7 +273,7 @@ def backward(
     # dronecan.yaml:23: scale info.hours_to_full_charge -> time_to_full
     _v7 = s.time_to_full
     if _v7 is None or _v7 != _v7:
-        t_info.hours_to_full_charge = math.nan
+        t_info.hours_to_full_charge = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge")
     else:
@@ -439,7 +439,7 @@ def backward(
     # dronecan.yaml:65: scale aux.max_current -> max_current
     _v24 = s.max_current
     if _v24 is None or _v24 != _v24:
-        t_aux.max_current = math.nan
+        t_aux.max_current = _math.nan
         if rep_u is not None:
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current")
     else:

@@ -6,7 +6,7 @@ The MAVLink BATTERY_INFO message, static or rarely changing facts of a pack.
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..mavlink import BatteryInfo
 from . import _runtime as _r
@@ -353,7 +353,7 @@ def backward(
     # mavlink_info.yaml:39: scale full_charge_capacity -> full_capacity
     _v17 = s.full_capacity
     if _v17 is None or _v17 != _v17:
-        t_info.full_charge_capacity = math.nan
+        t_info.full_charge_capacity = _math.nan
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_INFO.full_charge_capacity")
     else:

@@ -6,7 +6,7 @@ The MAVLink BATTERY_STATUS_V2 message, a battery's dynamic state.
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..mavlink import BatteryStatusV2
 from . import _runtime as _r
@@ -181,7 +181,7 @@ def backward(
     # mavlink_v2.yaml:13: scale voltage -> pack_voltage
     _v3 = s.pack_voltage
     if _v3 is None or _v3 != _v3:
-        t_status.voltage = math.nan
+        t_status.voltage = _math.nan
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS_V2.voltage")
     else:
@@ -191,7 +191,7 @@ def backward(
     # Positive while discharging, as the concept.
     _v4 = s.current
     if _v4 is None or _v4 != _v4:
-        t_status.current = math.nan
+        t_status.current = _math.nan
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS_V2.current")
     else:
@@ -202,7 +202,7 @@ def backward(
     # assumption that the battery was full then).
     _v5 = s.discharged
     if _v5 is None or _v5 != _v5:
-        t_status.capacity_consumed = math.nan
+        t_status.capacity_consumed = _math.nan
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS_V2.capacity_consumed")
     else:
@@ -211,7 +211,7 @@ def backward(
     # mavlink_v2.yaml:21: scale capacity_remaining -> remaining_capacity
     _v6 = s.remaining_capacity
     if _v6 is None or _v6 != _v6:
-        t_status.capacity_remaining = math.nan
+        t_status.capacity_remaining = _math.nan
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS_V2.capacity_remaining")
     else:
@@ -220,7 +220,7 @@ def backward(
     # mavlink_v2.yaml:22: scale state_of_charge -> state_of_charge
     _v7 = s.state_of_charge
     if _v7 is None or _v7 != _v7:
-        t_status.state_of_charge = math.nan
+        t_status.state_of_charge = _math.nan
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS_V2.state_of_charge")
     else:

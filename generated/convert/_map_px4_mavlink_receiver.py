@@ -6,7 +6,7 @@ PX4's MAVLink receiver.
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..mavlink import BatteryStatus as MavlinkBatteryStatus
 from ..uorb import BatteryStatus as UorbBatteryStatus
@@ -142,7 +142,7 @@ def forward(
         rep_u.unknown("uorb.BatteryStatus.discharged_mah")
     if rep_u is not None and _r.is_marker(t_status.remaining, -1.0):
         rep_u.unknown("uorb.BatteryStatus.remaining")
-    if rep_u is not None and _r.is_marker(t_status.temperature, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.temperature, _math.nan):
         rep_u.unknown("uorb.BatteryStatus.temperature")
     if rep_u is not None and _r.is_marker(t_status.cell_count, 0):
         rep_u.unknown("uorb.BatteryStatus.cell_count")

@@ -6,7 +6,7 @@ PX4's BATTERY_STATUS stream.
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..mavlink import BatteryStatus as MavlinkBatteryStatus
 from ..uorb import BatteryStatus as UorbBatteryStatus
@@ -109,7 +109,7 @@ def forward(
     # px4_mavlink_stream.yaml:40: px4_convert time_remaining_s -> time_remaining
     # time_remaining = connected && isfinite(time_remaining_s) ? max((int)time_remaining_s, 1) : 0
     _x9 = _r.f32(float(s_status.time_remaining_s))
-    if s_status.connected and math.isfinite(_x9):
+    if s_status.connected and _math.isfinite(_x9):
         t_msg.time_remaining = max(_r.c_float_to_int(_x9, 32, True, rep, "mavlink.BATTERY_STATUS.time_remaining"), 1)
     else:
         t_msg.time_remaining = 0
@@ -130,7 +130,7 @@ def forward(
     # temperature = connected && isfinite(temperature) ? temperature * 100.f : INT16_MAX
     _x13 = _r.f32(float(s_status.temperature))
     _x13 = _r.f32(_x13 * 100.0)
-    if s_status.connected and math.isfinite(_x13):
+    if s_status.connected and _math.isfinite(_x13):
         t_msg.temperature = _r.c_float_to_int(_x13, 16, True, rep, "mavlink.BATTERY_STATUS.temperature")
     else:
         t_msg.temperature = 32767

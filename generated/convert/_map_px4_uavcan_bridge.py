@@ -6,7 +6,7 @@ PX4's uavcan battery bridge.
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
 from ..dronecan.uavcan.equipment.power import BatteryInfo
@@ -160,7 +160,7 @@ def forward(
         if _x16 > 1.1920928955078125e-07:
             t_status.nominal_voltage = _x16
         else:
-            t_status.nominal_voltage = math.nan
+            t_status.nominal_voltage = _math.nan
 
     # px4_uavcan_bridge.yaml:65: px4_int aux.is_powering_off -> is_powering_off
     if s_aux is not None:
@@ -194,14 +194,14 @@ def forward(
         _t19 = 0.0 if dt_s is None else _r.f32(min(_r.f32(dt_s), 2.0))
         if _t19 > 1.1920928955078125e-07:
             _v19 = _r.f32(_v19 + _r.f32(_r.f32(_x19 * 1000.0) * _r.f32(_t19 / 3600.0)))
-        t_status.time_remaining_s = math.nan
+        t_status.time_remaining_s = _math.nan
     else:
         # Battery::computeRemainingTime while disarmed: the average filter reset to BAT_AVRG_CURRENT
         _m19 = 15.0
         t_status.current_average_a = _m19
         _cap19 = _r.f32(t_status.capacity)
         _s19 = t_status.remaining
-        t_status.time_remaining_s = math.nan
+        t_status.time_remaining_s = _math.nan
         if _cap19 > 0:
             _x19 = _r.f32(_r.f32(_s19 * _cap19) / max(_r.f32(_m19 * 1000.0), 1.1920928955078125e-07))
             t_status.time_remaining_s = _r.f32(_x19 * 3600.0)
@@ -231,9 +231,9 @@ def forward(
         rep_u.unknown("uorb.BatteryStatus.remaining")
     if rep_u is not None and _r.is_marker(t_status.scale, -1.0):
         rep_u.unknown("uorb.BatteryStatus.scale")
-    if rep_u is not None and _r.is_marker(t_status.time_remaining_s, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.time_remaining_s, _math.nan):
         rep_u.unknown("uorb.BatteryStatus.time_remaining_s")
-    if rep_u is not None and _r.is_marker(t_status.temperature, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.temperature, _math.nan):
         rep_u.unknown("uorb.BatteryStatus.temperature")
     if rep_u is not None and _r.is_marker(t_status.cell_count, 0):
         rep_u.unknown("uorb.BatteryStatus.cell_count")

@@ -6,7 +6,7 @@ PX4 as a DroneCAN battery node.
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
 from ..dronecan.uavcan.equipment.power import BatteryInfo
@@ -167,15 +167,15 @@ def forward(
     if rep_u is not None:
         for _n in _UNWRITTEN_INFO_FIELDS:
             rep_u.unknown(_n)
-    if rep_u is not None and _r.is_marker(t_info.temperature, math.nan):
+    if rep_u is not None and _r.is_marker(t_info.temperature, _math.nan):
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.temperature")
-    if rep_u is not None and _r.is_marker(t_info.voltage, math.nan):
+    if rep_u is not None and _r.is_marker(t_info.voltage, _math.nan):
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.voltage")
-    if rep_u is not None and _r.is_marker(t_info.current, math.nan):
+    if rep_u is not None and _r.is_marker(t_info.current, _math.nan):
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.current")
-    if rep_u is not None and _r.is_marker(t_info.remaining_capacity_wh, math.nan):
+    if rep_u is not None and _r.is_marker(t_info.remaining_capacity_wh, _math.nan):
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh")
-    if rep_u is not None and _r.is_marker(t_info.full_charge_capacity_wh, math.nan):
+    if rep_u is not None and _r.is_marker(t_info.full_charge_capacity_wh, _math.nan):
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
     if rep_u is not None and _r.is_marker(t_info.state_of_health_pct, 127):
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct")

@@ -6,7 +6,7 @@ PX4's battery_status topic.
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..uorb import BatteryStatus
 from . import _cells
@@ -176,7 +176,7 @@ def forward(
     _c10 = list(s_status.voltage_cell_v)
     _n10 = s_status.cell_count
     _c10 = _c10[:_n10] if _n10 else _cells.leading(_c10, 0.0)
-    t.cell_voltages = tuple(math.nan if _r.is_marker(_x10, 0.0) else float(_x10) for _x10 in _c10) or None
+    t.cell_voltages = tuple(_math.nan if _r.is_marker(_x10, 0.0) else float(_x10) for _x10 in _c10) or None
 
     # uorb.yaml:21: scale capacity -> full_capacity
     _v11 = s_status.capacity
@@ -319,7 +319,7 @@ def backward(
     # uorb.yaml:17: scale time_remaining_s -> time_remaining
     _v7 = s.time_remaining
     if _v7 is None or _v7 != _v7:
-        t_status.time_remaining_s = math.nan
+        t_status.time_remaining_s = _math.nan
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.time_remaining_s")
     else:
@@ -328,7 +328,7 @@ def backward(
     # uorb.yaml:18: scale temperature -> temperature
     _v8 = s.temperature
     if _v8 is None or _v8 != _v8:
-        t_status.temperature = math.nan
+        t_status.temperature = _math.nan
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.temperature")
     else:

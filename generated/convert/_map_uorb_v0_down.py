@@ -6,7 +6,7 @@ BatteryStatus -> BatteryStatusV0 (toOlder).
 
 from __future__ import annotations
 
-import math
+import math as _math
 
 from ..uorb import BatteryStatus, BatteryStatusV0
 from . import _runtime as _r
@@ -79,9 +79,9 @@ def forward(
         rep_u.unknown("uorb.BatteryStatusV0.remaining")
     if rep_u is not None and _r.is_marker(t_status.scale, -1.0):
         rep_u.unknown("uorb.BatteryStatusV0.scale")
-    if rep_u is not None and _r.is_marker(t_status.time_remaining_s, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.time_remaining_s, _math.nan):
         rep_u.unknown("uorb.BatteryStatusV0.time_remaining_s")
-    if rep_u is not None and _r.is_marker(t_status.temperature, math.nan):
+    if rep_u is not None and _r.is_marker(t_status.temperature, _math.nan):
         rep_u.unknown("uorb.BatteryStatusV0.temperature")
     if rep_u is not None and _r.is_marker(t_status.cell_count, 0):
         rep_u.unknown("uorb.BatteryStatusV0.cell_count")

@@ -119,16 +119,16 @@ def _render_module(
         factories=[ctx.factories[k] for k in sorted(ctx.factories)],
         module_code=list(module_code),
     )
-    std = ["import dataclasses"]
+    # every module under a private alias: no schema name (identifier() strips leading "_") can hide it
+    std = ["import dataclasses as _dataclasses"]
     for name in ("enum", "functools", "math", "struct"):
-        if f"{name}." in body:
-            std.append(f"import {name}")
-    std.append("from collections.abc import Mapping")
-    typing_names = ["Any", "ClassVar"]
+        if f"_{name}." in body:
+            std.append(f"import {name} as _{name}")
     type_imports = ctx.type_imports()
+    std.append("from collections.abc import Mapping as _Mapping")
     if type_imports:
-        typing_names.insert(0, "TYPE_CHECKING")
-    std.append("from typing import " + ", ".join(typing_names))
+        std.append("from typing import TYPE_CHECKING")  # isort's order: a constant before the classes
+    std += ["from typing import Any as _Any", "from typing import ClassVar as _ClassVar"]
     fmt = module.split(".")[0]
     head = env.get_template("module_head.py.j2").render(
         header=HEADER,

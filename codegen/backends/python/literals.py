@@ -26,9 +26,9 @@ def py_literal(value: object) -> str:
         return repr(value)
     if isinstance(value, float):
         if math.isnan(value):
-            return "math.nan"
+            return "_math.nan"
         if math.isinf(value):
-            return "math.inf" if value > 0 else "-math.inf"
+            return "_math.inf" if value > 0 else "-_math.inf"
         return normalize_number(repr(value))
     if isinstance(value, str | bytes):
         return normalize_string(repr(value))
@@ -43,7 +43,7 @@ def py_literal(value: object) -> str:
 
 
 def float_literal(value: float | int) -> str:
-    """A number as a float literal, whatever type it came as (``math.nan`` for NaN)."""
+    """A number as a float literal, whatever type it came as (``_math.nan`` for NaN)."""
     return py_literal(float(value))
 
 

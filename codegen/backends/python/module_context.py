@@ -28,7 +28,8 @@ class ModuleContext:
         self.factories: dict[str, str] = {}  # factory function name -> its source
         self.referenced: set[str] = set()  # other modules named in annotations
         self.names: dict[object, str] = {}  # what a module-level name holds -> the name
-        self.taken: set[str] = {ref.name for ref in self.classes.values() if ref.module == module}
+        self.module_classes = frozenset(ref.name for ref in self.classes.values() if ref.module == module)
+        self.taken: set[str] = set(self.module_classes)
 
     def private_name(self, wanted: str, what: object) -> str:
         """A module-level name for ``what`` (the same one on every request), ``wanted`` unless taken."""
@@ -62,7 +63,7 @@ class ModuleContext:
             else:
                 body = f"    from {self.relative(ref.module)} import {ref.name} as cls\n\n    return cls"
             # cached: the import statement runs once, not on every decode or from_dict
-            self.factories[fname] = f"@functools.cache\ndef {fname}() -> type[{self.annotation_name(ref)}]:\n{body}"
+            self.factories[fname] = f"@_functools.cache\ndef {fname}() -> type[{self.annotation_name(ref)}]:\n{body}"
         return fname
 
     def annotation_name(self, ref: ClassRef) -> str:

@@ -2,16 +2,22 @@
 
 from __future__ import annotations
 
+import builtins
+import enum
 import keyword
 import re
 
-from ...ir import DronecanKind, Message, SourceFormat
+from ...ir import DronecanKind, Message, Schema, SourceFormat
 
 _NON_IDENT = re.compile(r"[^0-9A-Za-z_]+")
 _WORD_BOUNDARY = re.compile(r"(?<=[a-z0-9])(?=[A-Z])|(?<=[A-Z])(?=[A-Z][a-z])")
 _REGEX_TOKENS = re.compile(r"\[[^\]]*\][+*?]?|\\d[+*?]?|[+*?]")
+# The one clash rule (README "Names", under "Generated package"): a schema name that would clash with a
+# name the generated code needs gets a trailing "_" (repeated while it still clashes). The generated
+# modules import what they use under private aliases (``_struct``, ``_ClassVar``), which no schema
+# name can spell (identifier() strips leading underscores), so what is left to avoid is below.
+#
 # Every member a generated class gets from the backend and its extensions (codecs, validators):
-# a schema field or constant with one of these names is renamed (a trailing "_"), never shadowing it.
 RESERVED_MEMBERS = frozenset(
     {
         # models
@@ -28,6 +34,27 @@ RESERVED_MEMBERS = frozenset(
         "MSG_ID", "CRC_EXTRA", "MAVLINK_BASE_LENGTH", "MAVLINK_MAX_LENGTH", "encode_frame", "decode_frame",
     }
 )  # fmt: skip
+# Builtins a generated class body names unqualified (annotations, decorators): a member of that
+# name would be what the rest of the class body sees (tests/backends/test_clashing_names.py keeps
+# this list in step with the templates).
+CLASS_SCOPE_NAMES = frozenset(
+    {"bool", "bytearray", "bytes", "classmethod", "dict", "float", "int", "list", "object", "staticmethod", "str"}
+    | {"tuple"}
+)
+# What an enum member may not be called: the attributes IntEnum and IntFlag have (``mro`` is refused
+# by enum itself; ``real`` or ``to_bytes`` would hide int's).
+ENUM_MEMBERS = frozenset(
+    {"mro", "name", "value"} | {n for base in (enum.IntEnum, enum.IntFlag) for n in dir(base) if not n.startswith("_")}
+)
+# A class is a module-level name: one spelled like a builtin (``ValueError``) would hide it from the
+# generated methods that raise or call it.
+_BUILTINS = frozenset(dir(builtins))
+
+
+def _unclash(name: str, taken: frozenset[str] | set[str]) -> str:
+    while name in taken:
+        name += "_"
+    return name
 
 
 def identifier(text: str) -> str:
@@ -35,9 +62,14 @@ def identifier(text: str) -> str:
     name = _NON_IDENT.sub("_", text).strip("_") or "field"
     if name[0].isdigit():
         name = "_" + name
-    if keyword.iskeyword(name) or keyword.issoftkeyword(name) or name in RESERVED_MEMBERS:
+    if keyword.iskeyword(name) or keyword.issoftkeyword(name):
         name += "_"
-    return name
+    return _unclash(name, RESERVED_MEMBERS | CLASS_SCOPE_NAMES)
+
+
+def class_identifier(name: str) -> str:
+    """A generated class's name, clear of the builtins its module's code uses."""
+    return _unclash(name, _BUILTINS)
 
 
 def field_identifier(name: str, pattern: str | None = None) -> str:
@@ -95,12 +127,12 @@ def class_name(msg: Message) -> str:
             return base + "Request"
         if msg.dronecan.kind is DronecanKind.RESPONSE:
             return base + "Response"
-        return base
+        return class_identifier(base)
     if msg.format is SourceFormat.DEVICETREE and msg.devicetree is not None and len(msg.devicetree.compatible) == 1:
-        return camel(msg.devicetree.compatible[0])
+        return class_identifier(camel(msg.devicetree.compatible[0]))
     if msg.format is SourceFormat.PDEF:
-        return camel(msg.name) + "Params"  # params.BATT -> BattParams
-    return camel(msg.name)
+        return class_identifier(camel(msg.name) + "Params")  # params.BATT -> BattParams
+    return class_identifier(camel(msg.name))
 
 
 def enum_member(entry_name: str, group: str) -> str:
@@ -108,6 +140,33 @@ def enum_member(entry_name: str, group: str) -> str:
     prefix = group + "_"
     short = entry_name[len(prefix) :] if entry_name.startswith(prefix) and len(entry_name) > len(prefix) else entry_name
     name = identifier(short)
-    if name.startswith("_") or name in ("name", "value"):
+    if name.startswith("_"):  # a digit first (``CELLS_2S`` in CELLS): the whole name reads better than ``_2S``
         name = identifier(entry_name)
-    return name
+    return _unclash(name, ENUM_MEMBERS)
+
+
+def module_classes(schema: Schema, module: str) -> frozenset[str]:
+    """The names of the message classes of one generated module."""
+    return frozenset(class_name(m) for m in schema.messages if module_path(m) == module)
+
+
+def member_names(msg: Message, classes: frozenset[str]) -> dict[tuple[str, str], str]:
+    """The attribute of each field and constant of ``msg``, keyed ``("field" | "constant", schema name)``.
+
+    The one clash rule: a name that is taken (a reserved member, a builtin of the class body, a class
+    of the same module that the class body may name, or an earlier member) gets a trailing ``_``
+    until it is free. Every part of the backend names members through this function.
+    """
+    taken: set[str] = set(classes)
+    out: dict[tuple[str, str], str] = {}
+    for f in msg.fields:
+        if f.is_padding:
+            continue
+        name = _unclash(field_identifier(f.name, f.pattern), taken)
+        taken.add(name)
+        out[("field", f.name)] = name
+    for c in msg.constants:
+        name = _unclash(identifier(c.name), taken)
+        taken.add(name)
+        out[("constant", c.name)] = name
+    return out

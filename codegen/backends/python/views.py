@@ -73,7 +73,7 @@ def enum_views(enums: tuple[EnumDef, ...], owner: str) -> list[EnumView]:
         text = (e.doc + "\n\n" if e.doc else "") + f"{e.name}: {kind_doc}."
         views.append(
             EnumView(
-                class_name=owner + naming.camel(group),
+                class_name=naming.class_identifier(owner + naming.camel(group)),
                 base="IntFlag" if e.kind is EnumKind.BITMASK else "IntEnum",
                 doc=docstring(text, "    "),
                 members=members,
@@ -88,16 +88,13 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
     # a DroneCAN union: every branch is None but the one held (see runtime/_dronecan.Union)
     union = msg.dronecan is not None and msg.dronecan.union
     fields: list[FieldView] = []
-    idents: set[str] = set(naming.RESERVED_MEMBERS)
+    names = naming.member_names(msg, ctx.module_classes)
     patterns: list[str] = []
     keys: list[str] = []
     for f in msg.fields:
         if f.is_padding:
             continue
-        ident = naming.field_identifier(f.name, f.pattern)
-        while ident in idents:
-            ident += "_"
-        idents.add(ident)
+        ident = names[("field", f.name)]
         optional = (optional_props and not f.required and f.pattern is None) or union
         b = FieldBuilder(ctx, f, optional)
         annotation = b.annotation(f.type)
@@ -126,10 +123,7 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
 
     constants: list[tuple[str, str, str]] = []
     for c in msg.constants:
-        name = naming.identifier(c.name)
-        while name in idents:
-            name += "_"
-        idents.add(name)
+        name = names[("constant", c.name)]
         if isinstance(c.type, PrimitiveType):
             literal = py_literal(typed(c.value, c.type) if isinstance(c.value, int | float) else c.value)
             annotation = python_scalar(c.type)

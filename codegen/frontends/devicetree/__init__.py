@@ -22,7 +22,8 @@ from typing import Any
 
 from ...errors import SchemaError
 from ...ir import Message, Schema
-from ...text.files import display_path, read_text
+from ...text.files import display_path
+from ...text.limits import read_schema_text
 from ...text.yaml_lines import load
 from .binding import binding_messages, is_binding
 from .data import DATA_FILES, load_data
@@ -32,7 +33,7 @@ __all__ = ["is_binding", "parse_dir", "parse_file"]
 
 def _load(path: Path, root: Path | None) -> tuple[Any, str]:
     display = display_path(path, root)
-    return load(read_text(path, display), display), display
+    return load(read_schema_text(path, display), display), display
 
 
 def parse_file(path: Path, *, root: Path | None = None) -> Schema:

@@ -152,7 +152,11 @@ def _field(f: _File, parent: str, name: str, schema: Any, line: int, *, is_patte
     elif found.dt_type is None:
         ftype = UNKNOWN_TYPE
     else:
-        td = data.types[found.dt_type]
+        td = data.types.get(found.dt_type)
+        if td is None:  # a types.yaml of the schema folder that leaves out a type the frontend names
+            raise SchemaError(
+                f.display, line, f"expected types.yaml to define {found.dt_type!r}, the type of property {name!r}"
+            )
         shape = shape_of(td, node, found.source == "unit-suffix")
         values = values_of(node, shape, f.display)
         ftype = with_columns(ir_type(td, shape), values)

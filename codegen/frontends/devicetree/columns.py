@@ -24,7 +24,16 @@ def as_text(value: Any) -> str:
     """A schema fragment as stable text for annotations."""
     if isinstance(value, str):
         return value
-    return json.dumps(value, sort_keys=True, default=str)
+    return json.dumps(_string_keys(value), sort_keys=True, default=str)
+
+
+def _string_keys(value: Any) -> Any:
+    """YAML allows keys of any type (``3: lithium-ion``); JSON text, and sorting, need strings."""
+    if isinstance(value, dict):
+        return {str(k): _string_keys(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_string_keys(v) for v in value]
+    return value
 
 
 def _number(value: Any) -> bool:

@@ -15,7 +15,8 @@ from typing import Any
 
 from ...errors import SchemaError
 from ...ir import Unit, units
-from ...text.files import display_path, read_text
+from ...text.files import display_path
+from ...text.limits import read_schema_text
 from ...text.yaml_lines import YList, YMap, load
 
 TYPES_FILE = "types.yaml"
@@ -101,7 +102,7 @@ def _mapping(value: Any, display: str, line: int, what: str) -> YMap:
 
 
 def _load_types(path: Path, display: str) -> dict[str, TypeDef]:
-    doc = _mapping(load(read_text(path, display), display), display, 1, "the file")
+    doc = _mapping(load(read_schema_text(path, display), display), display, 1, "the file")
     defs = _mapping(doc.get("definitions"), display, doc.line_of("definitions"), "'definitions'")
     out: dict[str, TypeDef] = {}
     for name, spec in defs.items():
@@ -143,7 +144,7 @@ def _rule(entry: Any, key: str, display: str, line: int, types: dict[str, TypeDe
 def _load_units(
     path: Path, display: str, types: dict[str, TypeDef]
 ) -> tuple[tuple[UnitRule, ...], dict[str, UnitRule]]:
-    doc = _mapping(load(read_text(path, display), display), display, 1, "the file")
+    doc = _mapping(load(read_schema_text(path, display), display), display, 1, "the file")
     suffixes, names = doc.get("suffixes"), doc.get("names", YList())
     if not isinstance(suffixes, YList) or not isinstance(names, YList):
         raise SchemaError(display, doc.line_of("suffixes"), "expected 'suffixes' and 'names' to be lists")

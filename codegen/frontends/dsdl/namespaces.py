@@ -10,7 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...errors import SchemaError
-from ...text.files import display_path, read_text
+from ...text.files import display_path
+from ...text.limits import read_schema_text
 from .definitions import ArrayT, RefT, TypeDef
 from .names import check_full_name, split_file_name, valid_namespace_component
 from .signature import dsdl_signature
@@ -67,7 +68,7 @@ class Namespaces:
         if full_name in self._loading:
             chain = " -> ".join([*self._loading, full_name])
             raise SchemaError(display, 0, f"expected no recursive type references: {chain}")
-        text = read_text(path, display)
+        text = read_schema_text(path, display)
         td = parse_source(text, file=display, full_name=full_name, default_id=default_id, version=version)
         self._loading.append(full_name)
         try:

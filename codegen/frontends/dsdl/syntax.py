@@ -13,6 +13,7 @@ from __future__ import annotations
 import re
 
 from ...errors import SchemaError
+from ...ir.fieldtypes import MAX_ARRAY_CAPACITY
 from .definitions import ArrayT, AttrT, ConstDef, FieldDef, PrimT, RefT, Section, TypeDef, VoidT
 from .expr import ExpressionError, evaluate
 from .names import valid_namespace_component, valid_type_name
@@ -80,6 +81,8 @@ def _array_bound(spec: str) -> tuple[int, bool]:
         raise _LineError(f"expected an array bound [N], [<N] or [<=N] with an integer N, got [{spec}]") from None
     if size <= 0:
         raise _LineError(f"expected an array capacity of at least 1, got [{spec}]")
+    if size > MAX_ARRAY_CAPACITY:
+        raise _LineError(f"expected an array capacity of at most {MAX_ARRAY_CAPACITY} (README Limits), got [{spec}]")
     return size, dynamic
 
 

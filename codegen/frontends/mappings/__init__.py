@@ -16,7 +16,8 @@ from typing import Any
 from ...errors import SchemaError
 from ...ir import CONCEPTS_ENDPOINT, Concept, Direction, Endpoint, Location, Mapping, MappingSet, Rule, Schema, units
 from ...ir.ops import OPS, Arity
-from ...text.files import display_path, read_text
+from ...text.files import display_path
+from ...text.limits import read_schema_text
 from ...text.yaml_lines import YMap, line_at, load
 from .json_schema import mappings_json_schema
 from .op_params import build_op
@@ -127,7 +128,7 @@ def _mappings(doc: YMap, display: str, resolver: Resolver) -> list[Mapping]:
 
 def _load(path: Path, root: Path | None) -> tuple[str, YMap]:
     display = display_path(path, root)
-    doc = load(read_text(path, display), display)
+    doc = load(read_schema_text(path, display), display)
     if not isinstance(doc, YMap):
         raise SchemaError(display, getattr(doc, "line", 1) or 1, "expected a mapping file (a YAML mapping)")
     _validate(doc, display)

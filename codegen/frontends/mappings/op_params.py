@@ -121,7 +121,7 @@ def _schema(param: _Param) -> dict[str, Any]:
                 "required": [p.name for p in rest if p.required],
                 "properties": {p.name: _schema(p) for p in rest},
             }
-        return {"type": "object", "additionalProperties": value}
+        return {"type": "object", "additionalProperties": value, "minProperties": 1}
     schema = _SCHEMAS[kind] if kind in _SCHEMAS else {"enum": [m.value for m in param.type]}
     return {"anyOf": [schema, {"type": "null"}]} if param.null else schema
 
@@ -152,16 +152,20 @@ class _Place:
         return SchemaError(self.display, self.line, f"expected {expected} for {self.key!r}, got {got!r}")
 
 
-def _number(value: Any, at: _Place) -> int | float:
+def _number(value: Any, at: _Place, *, finite: bool = True) -> int | float:
+    """A number; a bound, an offset or a threshold must be finite (YAML's .inf and .nan are floats
+    too, and would reach the emitters as a bound no integer field can hold)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise at.error("a number", value)
+    if finite and isinstance(value, float) and not math.isfinite(value):
+        raise at.error("a finite number", value)
     return math.nan if math.isnan(value) else value  # one NaN object, so equal ops compare equal
 
 
 def _marker(value: Any, at: _Place) -> int | float:
     if isinstance(value, str) and value.lower() in _NON_FINITE:
         return _NON_FINITE[value.lower()]
-    return _number(value, at)
+    return _number(value, at, finite=False)  # an unknown marker may be NaN or an infinity
 
 
 def _value(value: Any, at: _Place) -> int | float | bool | str | ConstantRef:
@@ -171,6 +175,8 @@ def _value(value: Any, at: _Place) -> int | float | bool | str | ConstantRef:
         return math.nan if value.lower() == "nan" else value
     if isinstance(value, bool):
         return value
+    if isinstance(value, float) and math.isnan(value):
+        return math.nan  # a value written as NaN (a float field's unknown)
     return _number(value, at)
 
 
@@ -202,8 +208,8 @@ def _convert(param: _Param, value: Any, at: _Place) -> Any:
         if not isinstance(value, list):
             raise at.error("a list of numbers", value)
         return tuple(_marker(v, at) for v in value)
-    if not isinstance(value, dict):
-        raise at.error("a mapping", value)
+    if not isinstance(value, dict) or not value:
+        raise at.error("a mapping of at least one entry", value)
     return tuple(_entry(get_args(tp)[0], str(key), item, at) for key, item in value.items())
 
 

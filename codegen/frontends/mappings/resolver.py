@@ -11,9 +11,22 @@ import dataclasses
 from collections.abc import Iterator
 
 from ...errors import SchemaError
-from ...ir import CONCEPTS_ENDPOINT, ArrayType, Concept, Endpoint, FieldRef, Message, Rule, Schema
+from ...ir import (
+    CONCEPTS_ENDPOINT,
+    ArrayType,
+    Concept,
+    Endpoint,
+    FieldRef,
+    Message,
+    PrimitiveKind,
+    PrimitiveType,
+    Rule,
+    Schema,
+    units,
+)
+from ...ir.basics import Unit
 from ...ir.mapping_values import ConstantRef
-from ...ir.ops import Cells
+from ...ir.ops import Cells, PX4Conversion, PX4Convert, Scale
 
 
 class Resolver:
@@ -81,6 +94,61 @@ class Resolver:
                     self.schema.message(ref.message).field(ref.field).type, ArrayType
                 ):
                     raise SchemaError(display, line, f"expected an array field for op 'cells', got {ref.field!r}")
+        self._check_units(rule, display, line)
+        self._check_written_marker(rule, display, line)
+
+    def _check_written_marker(self, rule: Rule, display: str, line: int) -> None:
+        """The first ``unknown`` marker is what a converter writes for unknown: an integer field needs
+        an integer one (NaN and fractions are for float fields)."""
+        markers = getattr(rule.op, "unknown", None)
+        if not isinstance(markers, tuple) or not markers or self.schema is None:
+            return
+        first = markers[0]
+        if not isinstance(first, float) or first.is_integer():
+            return
+        for ref in rule.sources + rule.targets:
+            if ref.message == CONCEPTS_ENDPOINT or not ref.field:
+                continue
+            t = self.schema.message(ref.message).field(ref.field).type
+            while isinstance(t, ArrayType):
+                t = t.element
+            if isinstance(t, PrimitiveType) and t.kind is not PrimitiveKind.FLOAT:
+                raise SchemaError(
+                    display,
+                    line,
+                    f"expected an integer as the first 'unknown' marker (written for unknown): {ref.field} holds "
+                    f"{t.kind.value}{t.bits} values, got {first}",
+                )
+
+    def _unit(self, ref: FieldRef) -> Unit | None:
+        if ref.message == CONCEPTS_ENDPOINT:
+            concept = self.concepts.get(ref.field)
+            return concept.unit if concept is not None else None
+        if self.schema is None or not ref.field:
+            return None
+        return self.schema.message(ref.message).field(ref.field).unit
+
+    def _check_units(self, rule: Rule, display: str, line: int) -> None:
+        """Ops that convert between units need units of one quantity (volts to millivolts, not to amperes)."""
+        op = rule.op
+        if isinstance(op, Scale | Cells):
+            pairs = [(self._unit(s), self._unit(t)) for s in rule.sources for t in rule.targets]
+        elif isinstance(op, PX4Convert) and op.convert is PX4Conversion.UNITS:
+            su = units.lookup(op.source_unit) if op.source_unit else self._unit(rule.sources[0])
+            tu = units.lookup(op.target_unit) if op.target_unit else self._unit(rule.targets[0])
+            if su is None or tu is None:
+                raise SchemaError(display, line, "expected units on both sides of px4_convert with convert: units")
+            pairs = [(su, tu)]
+        else:
+            return
+        for su, tu in pairs:
+            if su is not None and tu is not None and su.quantity != tu.quantity:
+                raise SchemaError(
+                    display,
+                    line,
+                    f"expected units of one quantity for op {op.NAME!r}, got {su.symbol} ({su.quantity}) "
+                    f"and {tu.symbol} ({tu.quantity})",
+                )
 
 
 def _constants(value: object) -> Iterator[ConstantRef]:

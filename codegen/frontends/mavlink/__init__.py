@@ -8,6 +8,7 @@ what it includes, :mod:`.scan` pre-checks it for safety (before pymavlink's pars
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 from ...ir import Schema
@@ -17,11 +18,11 @@ from .includes import read_dialects
 __all__ = ["parse_dir", "parse_file"]
 
 
-def parse_file(path: Path, *, root: Path | None = None) -> Schema:
-    """One dialect file and everything it includes."""
-    return build(read_dialects([path], root))
+def parse_file(path: Path, *, root: Path | None = None, include_paths: Sequence[Path] = ()) -> Schema:
+    """One dialect file and everything it includes (from its folder, or root, and include_paths)."""
+    return build(read_dialects([path], root, include_paths))
 
 
-def parse_dir(root: Path) -> Schema:
-    """Every *.xml below root (sorted); shared includes are read once."""
-    return build(read_dialects(sorted(p for p in root.rglob("*.xml") if p.is_file()), root))
+def parse_dir(root: Path, *, include_paths: Sequence[Path] = ()) -> Schema:
+    """Every *.xml below root (sorted); shared includes are read once (from root and include_paths)."""
+    return build(read_dialects(sorted(p for p in root.rglob("*.xml") if p.is_file()), root, include_paths))

@@ -3,8 +3,10 @@
 Each file is read as UTF-8, pre-scanned (:mod:`.scan`: no DTDs, only literal enum values, since
 pymavlink eval()s them), then parsed by pymavlink's own mavparse.MAVXML from a private copy of
 exactly the bytes we checked, with its stdout captured and its exceptions and exits turned into
-SchemaError. Includes resolve relative to the including file; cycles and missing files are errors
-at the <include> line.
+SchemaError. Includes resolve relative to the including file, then in each folder of the user's
+search path (``--include-path``); a file outside the schema folder and the search path is refused
+(an include may not read /etc/passwd or wander up with ``../``). Cycles and missing or refused files
+are errors at the <include> line.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import io
 import os
 import re
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 from ...errors import SchemaError
@@ -23,11 +26,20 @@ from .build import LoadedFile
 from .scan import scan
 
 
-def read_dialects(paths: list[Path], root: Path | None) -> list[LoadedFile]:
-    """The files named and every file they include, included files before their includer."""
+def read_dialects(paths: list[Path], root: Path | None, include_paths: Sequence[Path] = ()) -> list[LoadedFile]:
+    """The files named and every file they include, included files before their includer.
+
+    Includes must stay inside ``root`` (for single files without a root: the folder of each file
+    named) or one of ``include_paths``, which are also searched for includes not found beside the
+    including file.
+    """
     with tempfile.TemporaryDirectory(prefix="battgen-mavlink-") as tmp:
-        reader = _Reader(root, Path(tmp))
+        reader = _Reader(root, Path(tmp), tuple(include_paths))
         for path in paths:
+            reader.allowed = (
+                (root if root is not None else path.parent).resolve(),
+                *(p.resolve() for p in include_paths),
+            )
             reader.load(path)
     return list(reader.files.values())
 
@@ -53,9 +65,11 @@ def _mavparse(data: bytes, name: str, display: str, workdir: Path) -> object:
 
 
 class _Reader:
-    def __init__(self, root: Path | None, workdir: Path) -> None:
+    def __init__(self, root: Path | None, workdir: Path, include_paths: tuple[Path, ...]) -> None:
         self.root = root
         self.workdir = workdir
+        self.include_paths = include_paths
+        self.allowed: tuple[Path, ...] = ()  # the folders includes may read from
         self.files: dict[Path, LoadedFile] = {}  # included files before their includer
 
     def load(self, path: Path, chain: tuple[Path, ...] = ()) -> None:
@@ -67,17 +81,38 @@ class _Reader:
         scanned = scan(data, display)
         chain += (key,)
         for text, line in scanned.includes:
-            included = Path(os.path.normpath(path.parent / text))
+            included = self._resolve(path, text, display, line)
             if included.resolve() in chain:
                 raise SchemaError(
                     display, line, f"expected an include that does not lead back here; {text} closes an include cycle"
                 )
-            if not included.is_file():
-                raise SchemaError(
-                    display,
-                    line,
-                    f"expected {text} to exist relative to this file ({display_path(included, self.root)})",
-                )
             self.load(included, chain)
         mavxml = _mavparse(data, path.name, display, self.workdir)
         self.files[key] = LoadedFile(path, display, scanned, mavxml)
+
+    def _resolve(self, path: Path, text: str, display: str, line: int) -> Path:
+        """The file an <include> names: beside the including file, else in the search path; inside
+        the schema folder or the search path in either case."""
+        candidates = [Path(os.path.normpath(path.parent / text))]
+        candidates += [Path(os.path.normpath(folder / text)) for folder in self.include_paths]
+        # containment first (symbolic links followed): nothing outside is even looked at
+        found = next((c for c in candidates if self._inside(c) and c.is_file()), None)
+        if found is not None:
+            return found
+        if not self._inside(candidates[0]):
+            raise SchemaError(
+                display,
+                line,
+                f"expected an include inside the schema folder ({self.allowed[0]}); {text} is outside it "
+                "(allow its folder with --include-path)",
+            )
+        raise SchemaError(
+            display,
+            line,
+            f"expected {text} to exist relative to this file ({display_path(candidates[0], self.root)})"
+            + (" or in the --include-path folders" if self.include_paths else ""),
+        )
+
+    def _inside(self, candidate: Path) -> bool:
+        real = candidate.resolve()
+        return any(real.is_relative_to(folder) for folder in self.allowed)

@@ -120,6 +120,6 @@ def fits(value: int | float, element: PrimitiveType) -> bool:
     bounds = element.value_range
     if bounds is None:
         return False
-    if element.kind is not PrimitiveKind.FLOAT and value != int(value):
-        return False
+    if element.kind is not PrimitiveKind.FLOAT and isinstance(value, float) and not value.is_integer():
+        return False  # a fraction, or an infinity (1e999), in an integer field
     return bounds[0] <= value <= bounds[1]

@@ -34,6 +34,7 @@ class _TreeBuilder(XmlReader):
     def __init__(self, display: str) -> None:
         super().__init__(display, no_dtd_because="apm.pdef.xml needs no DTD")
         self.stack: list[Element] = []
+        self.chunks: list[list[str]] = []  # the text pieces of each open element, joined once it closes
         self.root: Element | None = None
 
     def start(self, tag: str, attrs: dict[str, str]) -> None:
@@ -43,14 +44,15 @@ class _TreeBuilder(XmlReader):
         else:
             self.root = node
         self.stack.append(node)
+        self.chunks.append([])
 
     def end(self, tag: str) -> None:
         node = self.stack.pop()
-        node.text = node.text.strip()
+        node.text = "".join(self.chunks.pop()).strip()  # one join: appending piece by piece is quadratic
 
     def text(self, data: str) -> None:
-        if self.stack:
-            self.stack[-1].text += data
+        if self.chunks:
+            self.chunks[-1].append(data)
 
 
 def read_tree(path: Path, display: str) -> Element:

@@ -17,7 +17,8 @@ import jsonschema
 from ...errors import SchemaError
 from ...ir import CrossFieldRule, Location
 from ...ir.expr import Expr, Loop, RuleExpressions
-from ...text.files import display_path, read_text
+from ...text.files import display_path
+from ...text.limits import read_schema_text
 from ...text.yaml_lines import YList, YMap, line_at
 from ...text.yaml_lines import load as load_yaml
 from .binding import scoped
@@ -36,7 +37,7 @@ def _schema() -> dict[str, Any]:
 def load_rule_file(path: Path, *, root: Path | None = None) -> tuple[CrossFieldRule, ...]:
     """The rules of one file; ``root`` shortens the file name in errors and locations."""
     display = display_path(path, root)
-    data = load_yaml(read_text(path, display), display, expected="YAML")
+    data = load_yaml(read_schema_text(path, display), display, expected="YAML")
     if data is None:
         raise SchemaError(display, 1, "expected a rule file (a mapping with 'messages' and 'rules'), found nothing")
     errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(e.path))

@@ -26,7 +26,8 @@ from ...ir import (
     UorbInfo,
     units,
 )
-from ...text.files import display_path, read_text
+from ...text.files import display_path
+from ...text.limits import read_schema_text
 from .annotations import parse_comment, sentinel
 from .enums import build_enums
 from .layout import Member, px4_layout
@@ -71,7 +72,7 @@ class Loader:
             )
         self.active.append(key)
         try:
-            message = self._build(path, display, parse_text(read_text(path, display), display))
+            message = self._build(path, display, parse_text(read_schema_text(path, display), display))
         finally:
             self.active.pop()
         self.done[key] = message

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 from ...errors import SchemaError
 from ...ir import PrimitiveKind, PrimitiveType
+from ...ir.fieldtypes import MAX_ARRAY_CAPACITY
 from .values import describe_range, fits, parse_int, parse_number
 
 BUILTINS: dict[str, PrimitiveType] = {
@@ -129,6 +130,10 @@ def _type(token: str, file: str, line: int) -> tuple[str, int | None]:
         )
     if count < 1:
         raise SchemaError(file, line, f"expected an array size of at least 1, got {count}")
+    if count > MAX_ARRAY_CAPACITY:
+        raise SchemaError(
+            file, line, f"expected an array size of at most {MAX_ARRAY_CAPACITY} (README Limits), got {count}"
+        )
     return base, count
 
 

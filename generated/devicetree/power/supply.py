@@ -6,9 +6,10 @@ Module: devicetree.power.supply.
 
 from __future__ import annotations
 
-import dataclasses
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from ... import _meta as _m
 from ... import _validate as _v
@@ -308,7 +309,7 @@ _SIMPLE_BATTERY_VOLT_DROP_N_MICROVOLT_SPEC = _v.Pattern(
 )
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class SimpleBattery:
     """The devicetree battery node provides static battery characteristics.
     In smart batteries, these are typically stored in non-volatile memory
@@ -330,18 +331,18 @@ class SimpleBattery:
     Schema: devicetree.power.supply.battery (devicetree, power/supply/battery.yaml:4).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "devicetree.power.supply.battery"
+    QUALIFIED_NAME: _ClassVar[str] = "devicetree.power.supply.battery"
 
-    compatible: list[str] = dataclasses.field(
+    compatible: list[str] = _dataclasses.field(
         default_factory=list, metadata=_m.meta(name="compatible", type="string[]")
     )
-    device_chemistry: str | None = dataclasses.field(
+    device_chemistry: str | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="device-chemistry", type="string", doc="This describes the chemical technology of the battery."
         ),
     )
-    over_voltage_threshold_microvolt: list[list[int]] | None = dataclasses.field(
+    over_voltage_threshold_microvolt: list[list[int]] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="over-voltage-threshold-microvolt",
@@ -353,7 +354,7 @@ class SimpleBattery:
             doc="battery over-voltage limit",
         ),
     )
-    re_charge_voltage_microvolt: list[list[int]] | None = dataclasses.field(
+    re_charge_voltage_microvolt: list[list[int]] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="re-charge-voltage-microvolt",
@@ -365,7 +366,7 @@ class SimpleBattery:
             doc="limit to automatically start charging again",
         ),
     )
-    voltage_min_design_microvolt: list[list[int]] | None = dataclasses.field(
+    voltage_min_design_microvolt: list[list[int]] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="voltage-min-design-microvolt",
@@ -377,7 +378,7 @@ class SimpleBattery:
             doc="drained battery voltage",
         ),
     )
-    voltage_max_design_microvolt: list[list[int]] | None = dataclasses.field(
+    voltage_max_design_microvolt: list[list[int]] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="voltage-max-design-microvolt",
@@ -389,7 +390,7 @@ class SimpleBattery:
             doc="fully charged battery voltage",
         ),
     )
-    energy_full_design_microwatt_hours: list[int] | None = dataclasses.field(
+    energy_full_design_microwatt_hours: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="energy-full-design-microwatt-hours",
@@ -401,7 +402,7 @@ class SimpleBattery:
             doc="battery design energy",
         ),
     )
-    charge_full_design_microamp_hours: list[int] | None = dataclasses.field(
+    charge_full_design_microamp_hours: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="charge-full-design-microamp-hours",
@@ -413,7 +414,7 @@ class SimpleBattery:
             doc="battery design capacity",
         ),
     )
-    trickle_charge_current_microamp: list[int] | None = dataclasses.field(
+    trickle_charge_current_microamp: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="trickle-charge-current-microamp",
@@ -428,7 +429,7 @@ class SimpleBattery:
             "bq24400) - that is different and not controlled by this property.",
         ),
     )
-    tricklecharge_upper_limit_microvolt: list[list[int]] | None = dataclasses.field(
+    tricklecharge_upper_limit_microvolt: list[list[int]] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="tricklecharge-upper-limit-microvolt",
@@ -441,7 +442,7 @@ class SimpleBattery:
             'refers "wake-up" or "pre-pre" -charging.',
         ),
     )
-    precharge_current_microamp: list[int] | None = dataclasses.field(
+    precharge_current_microamp: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="precharge-current-microamp",
@@ -453,7 +454,7 @@ class SimpleBattery:
             doc="current for pre-charge phase",
         ),
     )
-    precharge_upper_limit_microvolt: list[list[int]] | None = dataclasses.field(
+    precharge_upper_limit_microvolt: list[list[int]] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="precharge-upper-limit-microvolt",
@@ -465,7 +466,7 @@ class SimpleBattery:
             doc="limit when to change to constant charging",
         ),
     )
-    charge_term_current_microamp: list[int] | None = dataclasses.field(
+    charge_term_current_microamp: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="charge-term-current-microamp",
@@ -477,7 +478,7 @@ class SimpleBattery:
             doc="current for charge termination phase",
         ),
     )
-    constant_charge_current_max_microamp: list[int] | None = dataclasses.field(
+    constant_charge_current_max_microamp: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="constant-charge-current-max-microamp",
@@ -489,7 +490,7 @@ class SimpleBattery:
             doc="maximum constant input current",
         ),
     )
-    constant_charge_voltage_max_microvolt: list[list[int]] | None = dataclasses.field(
+    constant_charge_voltage_max_microvolt: list[list[int]] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="constant-charge-voltage-max-microvolt",
@@ -501,7 +502,7 @@ class SimpleBattery:
             doc="maximum constant input voltage",
         ),
     )
-    factory_internal_resistance_micro_ohms: list[int] | None = dataclasses.field(
+    factory_internal_resistance_micro_ohms: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="factory-internal-resistance-micro-ohms",
@@ -513,7 +514,7 @@ class SimpleBattery:
             doc="battery factory internal resistance",
         ),
     )
-    resistance_temp_table: list[list[int]] | None = dataclasses.field(
+    resistance_temp_table: list[list[int]] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="resistance-temp-table",
@@ -524,7 +525,7 @@ class SimpleBattery:
             "accurate batterty internal resistance in different temperatures.",
         ),
     )
-    ocv_capacity_celsius: list[int] | None = dataclasses.field(
+    ocv_capacity_celsius: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="ocv-capacity-celsius",
@@ -537,7 +538,7 @@ class SimpleBattery:
             "for each of the battery capacity lookup table.",
         ),
     )
-    operating_range_celsius: list[int] | None = dataclasses.field(
+    operating_range_celsius: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="operating-range-celsius",
@@ -549,7 +550,7 @@ class SimpleBattery:
             doc="operating temperature range of a battery",
         ),
     )
-    ambient_celsius: list[int] | None = dataclasses.field(
+    ambient_celsius: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="ambient-celsius",
@@ -561,7 +562,7 @@ class SimpleBattery:
             doc="safe range of ambient temperature",
         ),
     )
-    alert_celsius: list[int] | None = dataclasses.field(
+    alert_celsius: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="alert-celsius",
@@ -573,7 +574,7 @@ class SimpleBattery:
             doc="safe range of battery temperature",
         ),
     )
-    volt_drop_thresh_microvolt: list[list[int]] | None = dataclasses.field(
+    volt_drop_thresh_microvolt: list[list[int]] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="volt-drop-thresh-microvolt",
@@ -587,7 +588,7 @@ class SimpleBattery:
             doc="Threshold for starting the VDR correction",
         ),
     )
-    volt_drop_soc_bp: list[int] | None = dataclasses.field(
+    volt_drop_soc_bp: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="volt-drop-soc-bp",
@@ -600,7 +601,7 @@ class SimpleBattery:
             "given as basis points, 1/100 of a percent.",
         ),
     )
-    volt_drop_temperatures_millicelsius: list[int] | None = dataclasses.field(
+    volt_drop_temperatures_millicelsius: list[int] | None = _dataclasses.field(
         default=None,
         metadata=_m.meta(
             name="volt-drop-temperatures-millicelsius",
@@ -612,7 +613,7 @@ class SimpleBattery:
             doc="An array containing the temperature in milli celsius, for each of the VDR lookup table.",
         ),
     )
-    ocv_capacity_table_n: dict[str, list[list[int]]] = dataclasses.field(
+    ocv_capacity_table_n: dict[str, list[list[int]]] = _dataclasses.field(
         default_factory=dict,
         metadata=_m.meta(
             name="^ocv-capacity-table-[0-9]+$",
@@ -624,7 +625,7 @@ class SimpleBattery:
             "circuit voltage unit is microvolt.",
         ),
     )
-    volt_drop_n_microvolt: dict[str, list[list[int]]] = dataclasses.field(
+    volt_drop_n_microvolt: dict[str, list[list[int]]] = _dataclasses.field(
         default_factory=dict,
         metadata=_m.meta(
             name="^volt-drop-[0-9]-microvolt",
@@ -648,9 +649,9 @@ class SimpleBattery:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["compatible"] = list(self.compatible)
         if self.device_chemistry is not None:
             out["device-chemistry"] = self.device_chemistry
@@ -703,7 +704,7 @@ class SimpleBattery:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> SimpleBattery:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> SimpleBattery:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -926,18 +927,18 @@ class SimpleBattery:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        a: Any
-        e: Any
-        k_0: Any
-        r_constant_charge_voltage_max_microvolt: Any
-        r_ocv_capacity_celsius: Any
-        r_ocv_capacity_table_n: Any
-        r_over_voltage_threshold_microvolt: Any
-        r_voltage_max_design_microvolt: Any
-        r_voltage_min_design_microvolt: Any
-        v_i: Any
-        v_table: Any
+        x: _Any
+        a: _Any
+        e: _Any
+        k_0: _Any
+        r_constant_charge_voltage_max_microvolt: _Any
+        r_ocv_capacity_celsius: _Any
+        r_ocv_capacity_table_n: _Any
+        r_over_voltage_threshold_microvolt: _Any
+        r_voltage_max_design_microvolt: _Any
+        r_voltage_min_design_microvolt: _Any
+        v_i: _Any
+        v_table: _Any
         try:
             if (x := self.compatible) is None or (len(x) < 1 or any(_x0 != "simple-battery" for _x0 in x)):
                 _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)

@@ -6,10 +6,11 @@ Module: dronecan.uavcan.
 
 from __future__ import annotations
 
-import dataclasses
-import struct
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+import struct as _struct
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from ... import _dronecan as _dc
 from ... import _meta as _m
@@ -19,11 +20,11 @@ __all__ = ["Timestamp"]
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
-_TIMESTAMP_ENCODE_STRUCT = struct.Struct("<IHB")
+_TIMESTAMP_ENCODE_STRUCT = _struct.Struct("<IHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _TIMESTAMP_FIELD_ENDS = ((56, "Timestamp.usec"),)
 # fixed fields as decoded
-_TIMESTAMP_DECODE_STRUCT = struct.Struct("<IHB")
+_TIMESTAMP_DECODE_STRUCT = _struct.Struct("<IHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -32,17 +33,17 @@ _TIMESTAMP_USEC_SPEC = _v.Number(
 )
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class Timestamp:
     """Time since an arbitrary epoch, in microseconds (7 bytes on the wire).
 
     Schema: dronecan.uavcan.Timestamp (dronecan, uavcan/Timestamp.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.uavcan.Timestamp"
-    UNKNOWN: ClassVar[int] = 0
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.uavcan.Timestamp"
+    UNKNOWN: _ClassVar[int] = 0
 
-    usec: int = dataclasses.field(
+    usec: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="usec",
@@ -62,14 +63,14 @@ class Timestamp:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["usec"] = self.usec
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Timestamp:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> Timestamp:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(data, frozenset({"usec"}), (), "Timestamp")
         obj = cls()
@@ -77,8 +78,8 @@ class Timestamp:
             obj.usec = _m.as_int(data["usec"], "usec")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = None
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x05BD0B5C81087E0D
+    DATA_TYPE_ID: _ClassVar[int | None] = None
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x05BD0B5C81087E0D
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""

@@ -124,19 +124,19 @@ class _Writer:
         )
         return _lines(
             "# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype",
-            f"{self.struct} = struct.Struct({text_literal(self.fmt)})",
+            f"{self.struct} = _struct.Struct({text_literal(self.fmt)})",
             f"{self.table}: tuple[tuple[str, str, str, int], ...] = ({table})",
-            f"{self.dtype}: list[tuple[Any, ...]] = [{dtype}]",
+            f"{self.dtype}: list[tuple[_Any, ...]] = [{dtype}]",
         )
 
     def class_body(self) -> str:
         info = self.info
         return "\n".join(
             [
-                f"    MSG_ID: ClassVar[int] = {info.msg_id}",
-                f"    CRC_EXTRA: ClassVar[int] = {info.crc_extra}",
-                f"    MAVLINK_BASE_LENGTH: ClassVar[int] = {info.base_length}",
-                f"    MAVLINK_MAX_LENGTH: ClassVar[int] = {info.max_length}",
+                f"    MSG_ID: _ClassVar[int] = {info.msg_id}",
+                f"    CRC_EXTRA: _ClassVar[int] = {info.crc_extra}",
+                f"    MAVLINK_BASE_LENGTH: _ClassVar[int] = {info.base_length}",
+                f"    MAVLINK_MAX_LENGTH: _ClassVar[int] = {info.max_length}",
                 "",
                 self._encode(),
                 "",
@@ -175,7 +175,7 @@ class _Writer:
             "        try:",
             *pre,
             f"            data = {self.struct}.pack({', '.join(args)})",
-            "        except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:",
+            "        except (_struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:",
             f"            raise _mav.explain({self.name}, self, {self.table}) from exc",
         ]
         if checks:
@@ -266,7 +266,7 @@ class _Writer:
             entries.append(f"            {py_literal(s.source)}: {value},")
         return _lines(
             "    @classmethod",
-            "    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, Any]:",
+            "    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, _Any]:",
             f'        """Records of {size} bytes (zero-filled payloads) -> columns keyed by field name: numpy',
             "        arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else",
             '        tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""',

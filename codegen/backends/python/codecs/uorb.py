@@ -31,7 +31,7 @@ from .uorb_layout import compress as compress_codes
 RUNTIME_FILES = ("_uorb.py", "_ulog.py", "_ulog_compare.py", "_ulog_format.py", "_ulog_parse.py", "_ulog_writer.py")
 _ADDED = ("UORB_FORMAT", "UORB_SIZE", "UORB_SIZE_NO_PADDING", "UORB_TOPICS")
 _METHODS = ("encode", "decode", "decode_batch", "ulog_format", "from_ulog")
-_ERRORS = "(struct.error, TypeError, OverflowError)"
+_ERRORS = "(_struct.error, TypeError, OverflowError)"
 
 
 class _Codec:
@@ -100,13 +100,13 @@ class _Generator:
         no_pad = size - trailing_padding(self.schema, self.msg)
         full_fmt = struct_format(self.schema, self.msg)
         attrs = [
-            f"UORB_FORMAT: ClassVar[str] = {text_literal(full_fmt)}",
-            f"UORB_SIZE: ClassVar[int] = {size}",
-            f"UORB_SIZE_NO_PADDING: ClassVar[int] = {no_pad}",
-            f"UORB_TOPICS: ClassVar[tuple[str, ...]] = {py_literal(tuple(info.topics))}",
+            f"UORB_FORMAT: _ClassVar[str] = {text_literal(full_fmt)}",
+            f"UORB_SIZE: _ClassVar[int] = {size}",
+            f"UORB_SIZE_NO_PADDING: _ClassVar[int] = {no_pad}",
+            f"UORB_TOPICS: _ClassVar[tuple[str, ...]] = {py_literal(tuple(info.topics))}",
         ]
         if not any(c.name == "MESSAGE_VERSION" for c in self.msg.constants):
-            attrs.append(f"MESSAGE_VERSION: ClassVar[int | None] = {py_literal(info.message_version)}")
+            attrs.append(f"MESSAGE_VERSION: _ClassVar[int | None] = {py_literal(info.message_version)}")
         blocks = [
             "\n".join(attrs),
             self.encode_method(size),
@@ -124,18 +124,18 @@ class _Generator:
         enc = "<" + compress_codes([_encode_code(p) for p in self.parts])
         lines = [
             "# the C struct, nested messages inlined (decoding reads them in place)",
-            f"{self.struct} = struct.Struct({text_literal(full_fmt)})",
+            f"{self.struct} = _struct.Struct({text_literal(full_fmt)})",
         ]
         if has_trailing:
             short = struct_format(self.schema, self.msg, trailing=False)
             lines += [
                 "# without the trailing padding, which ULog records leave out",
-                f"{self.ctx.constant(self.cls, 'UNPADDED')} = struct.Struct({text_literal(short)})",
+                f"{self.ctx.constant(self.cls, 'UNPADDED')} = _struct.Struct({text_literal(short)})",
             ]
         if enc != full_fmt:
             lines += [
                 "# nested messages as bytes: each encodes itself, so an error names its full path",
-                f"{self.ctx.constant(self.cls, 'ENCODE_STRUCT')} = struct.Struct({text_literal(enc)})",
+                f"{self.ctx.constant(self.cls, 'ENCODE_STRUCT')} = _struct.Struct({text_literal(enc)})",
             ]
         return "\n".join(lines)
 
@@ -237,7 +237,7 @@ class _Generator:
         body = self.build_lines(nested, parts(self.schema, nested), "o", cls_expr, lambda i: f"i + {i}" if i else "i")
         code = "\n".join(
             [
-                f"def {name}(v: tuple[Any, ...], i: int) -> {annotation}:",
+                f"def {name}(v: tuple[_Any, ...], i: int) -> {annotation}:",
                 *("    " + line for line in body),
                 "    return o",
             ]
@@ -277,7 +277,7 @@ class _Generator:
                 "    stride: int | None = None,",
                 "    use_numpy: bool | None = None,",
                 "    copy: bool = True,",
-                ") -> dict[str, Any]:",
+                ") -> dict[str, _Any]:",
                 '    """Columns of back-to-back records without an object per record, named as PX4 log',
                 "    tools flatten them (``voltage_cell_v[3]``, ``nested.field``; char arrays as bytes).",
                 "",

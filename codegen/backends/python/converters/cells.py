@@ -28,7 +28,7 @@ class CellEmitters(RuleContext):
                 self.emit(f"_c = _cells.leading(_c, {py_literal(mark)})")
             conv = affine("float(_x)", mul, add)
             if mark is not None:
-                conv = f"math.nan if _r.is_marker(_x, {py_literal(mark)}) else {conv}"
+                conv = f"_math.nan if _r.is_marker(_x, {py_literal(mark)}) else {conv}"
             self.emit(f"{self.t(con)} = tuple({conv} for _x in _c) or None")
             return
         mul, add = factor(c_unit, f_unit)

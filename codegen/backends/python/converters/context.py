@@ -136,6 +136,7 @@ class RuleContext:
         self.backward = direction == "backward"
         self.classes = classes  # qualified message name -> the class's name in the module
         self.constants = constants
+        self.member_cache: dict[str, dict[tuple[str, str], str]] = {}
         self.lines: list[str] = []
         self.inputs: list[str] = []  # extra keyword inputs (ocv_soc)
         self.read: set[tuple[str, str]] = set()
@@ -191,8 +192,16 @@ class RuleContext:
     def attr(self, ref: FieldRef) -> str:
         if ref.message == CONCEPTS_ENDPOINT:
             return naming.identifier(ref.field)
-        f = self.fld(ref)
-        return naming.field_identifier(f.name, f.pattern)
+        return self.member(ref.message, ref.field)
+
+    def member(self, message: str, field: str) -> str:
+        """The attribute of a message's field, by the backend's one naming rule."""
+        names = self.member_cache.get(message)
+        if names is None:
+            msg = self.msg(message)
+            names = naming.member_names(msg, naming.module_classes(self.schema, naming.module_path(msg)))
+            self.member_cache[message] = names
+        return names[("field", field)]
 
     def s(self, ref: FieldRef) -> str:
         """A source value (and note that it is read)."""

@@ -13,7 +13,6 @@ from ....ir import CONCEPTS_ENDPOINT, Direction, FieldRef, Rule
 from ....ir.mapping_values import ConstantRef
 from ....ir.mapping_visitor import OpVisitor, visit
 from ....ir.ops import Const
-from .. import naming
 from ..literals import comment, py_literal
 from .cells import CellEmitters
 from .choices import ChoiceEmitters
@@ -113,7 +112,7 @@ class FunctionBuilder(
         else:
             for qualified, var, alias in zip(self.src.endpoint.messages, self.src.names, self.src.aliases, strict=True):
                 attrs = tuple(
-                    (naming.field_identifier(f.name, f.pattern), f.name)
+                    (self.member(qualified, f.name), f.name)
                     for f in self.msg(qualified).fields
                     if not f.is_padding and (qualified, f.name) not in self.read
                 )
@@ -149,7 +148,7 @@ class FunctionBuilder(
             for f in m.fields:
                 if f.invalid is None or (qualified, f.name) not in self.written:
                     continue
-                attr = f"{var}.{naming.field_identifier(f.name, f.pattern)}"
+                attr = f"{var}.{self.member(qualified, f.name)}"
                 mark = py_literal(f.invalid.value)
                 test = (
                     f"all(_r.is_marker(_x, {mark}) for _x in {attr})"

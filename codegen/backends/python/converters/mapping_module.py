@@ -17,7 +17,8 @@ from .function import FunctionBuilder
 _USES_CELLS = re.compile(r"(?<![\w.])_cells\.")
 
 # names a mapping module binds besides its message classes
-_TAKEN = ("BatteryState", "forward", "backward", "math")
+_TAKEN = ("BatteryState", "forward", "backward", "_math")
+_USES_MATH = re.compile(r"(?<![\w.])_math\.")
 
 
 @dataclass(frozen=True)
@@ -80,8 +81,8 @@ def mapping_module(
     if CONCEPTS_ENDPOINT in (mapping.source, mapping.target):
         names.add(("._concepts", "BatteryState", None))
     head = [header, doc, "", "from __future__ import annotations", ""]
-    if any("math." in line for line in code if not line.lstrip().startswith("#")):
-        head += ["import math", ""]
+    if any(_USES_MATH.search(line) for line in code if not line.lstrip().startswith("#")):
+        head += ["import math as _math", ""]  # private, like every module the generated code uses
     head += import_lines(names)
     text = "\n".join([*head, *(["", *consts] if consts else [])]) + "\n\n\n"
     text += "\n\n\n".join("\n".join(f) for f in functions)

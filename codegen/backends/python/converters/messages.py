@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from ....ir import ArrayType, FieldRef, Rule
 from ....ir.ops import SameNames, ZeroAll
-from .. import naming
 from .context import RuleContext
 
 
@@ -32,4 +31,4 @@ class MessageEmitters(RuleContext):
                 zero = "0.0" if self.is_float(f) else "0"
                 if isinstance(f.type, ArrayType) and f.type.capacity is not None and not f.type.dynamic:
                     zero = f"[{zero}] * {f.type.capacity}"
-                self.emit(f"{var}.{naming.field_identifier(f.name, f.pattern)} = {zero}")
+                self.emit(f"{var}.{self.member(ref.message, f.name)} = {zero}")

@@ -55,7 +55,7 @@ class PX4Emitters(RuleContext):
         if op.guard is not None:
             tests.append(self.s(FieldRef(src.message, op.guard)))
         if op.finite:
-            tests.append("math.isfinite(_x)")
+            tests.append("_math.isfinite(_x)")
         if op.above is not None:
             tests.append(f"_x > {float_literal(f32(float(op.above)))}")
         target = self.t(dst)

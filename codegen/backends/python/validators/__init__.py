@@ -71,7 +71,7 @@ class _Validators:
             "def validate(self) -> list[_v.Violation]:",
             '    """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""',
             "    out: list[_v.Violation] = []",
-            *[f"    {name}: Any" for name in local_names],
+            *[f"    {name}: _Any" for name in local_names],
             *_block(checks, 1),
             "    return out",
             "",

@@ -6,12 +6,14 @@ Module: dronecan.ardupilot.equipment.power.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
-import functools
-import struct
-from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any, ClassVar
+import dataclasses as _dataclasses
+import enum as _enum
+import functools as _functools
+import struct as _struct
+from collections.abc import Mapping as _Mapping
+from typing import TYPE_CHECKING
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from .... import _dronecan as _dc
 from .... import _meta as _m
@@ -30,7 +32,7 @@ __all__ = [
 ]
 
 
-class BatteryContinuousStatusFlag(enum.IntFlag):
+class BatteryContinuousStatusFlag(_enum.IntFlag):
     """dronecan.ardupilot.equipment.power.BatteryContinuous.STATUS_FLAG: bit masks, combined with |."""
 
     READY_TO_USE = 1
@@ -55,11 +57,11 @@ class BatteryContinuousStatusFlag(enum.IntFlag):
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX = struct.Struct("<H")
+_BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_CELLS_FIELD_ENDS_FROM_INDEX = ((16, "BatteryCells.index"),)
 # fixed fields as decoded
-_BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX = struct.Struct("<H")
+_BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -70,11 +72,11 @@ _BATTERY_CELLS_INDEX_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65
 
 
 # float16 fields packed as float32 ...
-_BATTERY_CONTINUOUS_FLOAT32_STRUCT = struct.Struct("<4f")
+_BATTERY_CONTINUOUS_FLOAT32_STRUCT = _struct.Struct("<4f")
 # ... and read back as bits, from which each half is cut
-_BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT = struct.Struct("<4I")
+_BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT = _struct.Struct("<4I")
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_CONTINUOUS_ENCODE_STRUCT = struct.Struct("<HHHffHBfI")
+_BATTERY_CONTINUOUS_ENCODE_STRUCT = _struct.Struct("<HHHffHBfI")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_CONTINUOUS_FIELD_ENDS = (
     (16, "BatteryContinuous.temperature_cells"),
@@ -88,7 +90,7 @@ _BATTERY_CONTINUOUS_FIELD_ENDS = (
     (200, "BatteryContinuous.status_flags"),
 )
 # fixed fields as decoded
-_BATTERY_CONTINUOUS_DECODE_STRUCT = struct.Struct("<eeeffeBfI")
+_BATTERY_CONTINUOUS_DECODE_STRUCT = _struct.Struct("<eeeffeBfI")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -143,17 +145,17 @@ _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC = _v.Number(
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_INFO_AUX_ENCODE_STRUCT = struct.Struct("<IHB")
+_BATTERY_INFO_AUX_ENCODE_STRUCT = _struct.Struct("<IHB")
 # float16 fields packed as float32 ...
-_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<2f")
+_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2f")
 # ... and read back as bits, from which each half is cut
-_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<2I")
+_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2I")
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<HHHHH")
+_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHHHH")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_AUX_FIELD_ENDS = ((56, "BatteryInfoAux.timestamp.usec"),)
 # fixed fields as decoded
-_BATTERY_INFO_AUX_DECODE_STRUCT = struct.Struct("<IHB")
+_BATTERY_INFO_AUX_DECODE_STRUCT = _struct.Struct("<IHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT = (
     (16, "BatteryInfoAux.cycle_count"),
@@ -164,7 +166,7 @@ _BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT = (
     (73, "BatteryInfoAux.battery_id"),
 )
 # fixed fields as decoded
-_BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT = struct.Struct("<HHeeH")
+_BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHeeH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -181,11 +183,11 @@ _BATTERY_INFO_AUX_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, 
 
 
 # float16 fields packed as float32 ...
-_BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY = struct.Struct("<4f")
+_BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4f")
 # ... and read back as bits, from which each half is cut
-_BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY = struct.Struct("<4I")
+_BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4I")
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY = struct.Struct("<fBHHHHffffHB")
+_BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBHHHHffffHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY = (
     (32, "BatteryPeriodic.design_capacity"),
@@ -202,7 +204,7 @@ _BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY = (
     (256, "BatteryPeriodic.state_of_health"),
 )
 # fixed fields as decoded
-_BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY = struct.Struct("<fBeeeeffffHB")
+_BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBeeeeffffHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -244,7 +246,7 @@ _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC = _v.Number(type="uint8", kind="uint", lo
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_TAG_ENCODE_STRUCT = struct.Struct("<IIfIII")
+_BATTERY_TAG_ENCODE_STRUCT = _struct.Struct("<IIfIII")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_TAG_FIELD_ENDS = (
     (32, "BatteryTag.serial_number"),
@@ -255,7 +257,7 @@ _BATTERY_TAG_FIELD_ENDS = (
     (192, "BatteryTag.last_arm_time_mins"),
 )
 # fixed fields as decoded
-_BATTERY_TAG_DECODE_STRUCT = struct.Struct("<IIfIII")
+_BATTERY_TAG_DECODE_STRUCT = _struct.Struct("<IIfIII")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -269,14 +271,14 @@ _BATTERY_TAG_FIRST_USE_MINS_SPEC = _v.Number(type="uint32", kind="uint", low=0, 
 _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
 
 
-@functools.cache
+@_functools.cache
 def _timestamp_class() -> type[_dronecan_uavcan.Timestamp]:
     from ....dronecan.uavcan import Timestamp as cls
 
     return cls
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryCells:
     """Battery cell voltages
     Rate: set by parameter on smart battery (default off)
@@ -285,12 +287,12 @@ class BatteryCells:
     ardupilot/equipment/power/20012.BatteryCells.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryCells"
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryCells"
 
-    voltages: list[float] = dataclasses.field(
+    voltages: list[float] = _dataclasses.field(
         default_factory=list, metadata=_m.meta(name="voltages", type="float16[<=24]", unit="V", quantity="voltage")
     )
-    index: int = dataclasses.field(
+    index: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="index",
@@ -306,15 +308,15 @@ class BatteryCells:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["voltages"] = list(self.voltages)
         out["index"] = self.index
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryCells:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryCells:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(data, frozenset({"voltages", "index"}), (), "BatteryCells")
         obj = cls()
@@ -324,8 +326,8 @@ class BatteryCells:
             obj.index = _m.as_int(data["index"], "index")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 20012
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x5C8B1ABD15890EA4
+    DATA_TYPE_ID: _ClassVar[int | None] = 20012
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x5C8B1ABD15890EA4
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -335,7 +337,7 @@ class BatteryCells:
         if k2 > 24:
             raise _dc.EncodeError("BatteryCells.voltages: length " + str(k2) + " exceeds capacity 24")
         acc = (acc << 5) | k2
-        acc = (acc << (k2 * 16)) | int.from_bytes(struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
+        acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
         r4 = self.index
         acc = (acc << 16) | int.from_bytes(
             _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
@@ -346,7 +348,7 @@ class BatteryCells:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryCells:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f0: list[Any]
+        f0: list[_Any]
         n = len(data)
         v = int.from_bytes(data, "big")
         rem = n << 3
@@ -360,7 +362,7 @@ class BatteryCells:
         if rem < n2:
             raise _dc.short("BatteryCells.voltages", n2, rem)
         rem -= n2
-        f0 = list(struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
+        f0 = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
         if rem < 16:
             raise _dc.cut(_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX, rem)
         rem -= 16
@@ -375,7 +377,7 @@ class BatteryCells:
         if k2 > 24:
             raise _dc.EncodeError("BatteryCells.voltages: length " + str(k2) + " exceeds capacity 24")
         acc = (acc << 5) | k2
-        acc = (acc << (k2 * 16)) | int.from_bytes(struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
+        acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
         r4 = self.index
         acc = (acc << 16) | int.from_bytes(
             _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
@@ -385,7 +387,7 @@ class BatteryCells:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryCells, int]:
-        f0: list[Any]
+        f0: list[_Any]
         if rem < 5:
             raise _dc.short("BatteryCells.voltages (length)", 5, rem)
         rem -= 5
@@ -396,7 +398,7 @@ class BatteryCells:
         if rem < n2:
             raise _dc.short("BatteryCells.voltages", n2, rem)
         rem -= n2
-        f0 = list(struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
+        f0 = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
         if rem < 16:
             raise _dc.cut(_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX, rem)
         rem -= 16
@@ -406,8 +408,8 @@ class BatteryCells:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        a: Any
-        e: Any
+        a: _Any
+        e: _Any
         try:
             a = self.voltages
             if len(a) > 24:
@@ -440,7 +442,7 @@ class BatteryCells:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryCells")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryContinuous:
     """Battery data to be sent continuously
 
@@ -448,28 +450,28 @@ class BatteryContinuous:
     ardupilot/equipment/power/20010.BatteryContinuous.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryContinuous"
-    STATUS_FLAG_READY_TO_USE: ClassVar[int] = 1
-    STATUS_FLAG_CHARGING: ClassVar[int] = 2
-    STATUS_FLAG_CELL_BALANCING: ClassVar[int] = 4
-    STATUS_FLAG_FAULT_CELL_IMBALANCE: ClassVar[int] = 8
-    STATUS_FLAG_AUTO_DISCHARGING: ClassVar[int] = 16
-    STATUS_FLAG_REQUIRES_SERVICE: ClassVar[int] = 32
-    STATUS_FLAG_BAD_BATTERY: ClassVar[int] = 64
-    STATUS_FLAG_PROTECTIONS_ENABLED: ClassVar[int] = 128
-    STATUS_FLAG_FAULT_PROTECTION_SYSTEM: ClassVar[int] = 256
-    STATUS_FLAG_FAULT_OVER_VOLT: ClassVar[int] = 512
-    STATUS_FLAG_FAULT_UNDER_VOLT: ClassVar[int] = 1024
-    STATUS_FLAG_FAULT_OVER_TEMP: ClassVar[int] = 2048
-    STATUS_FLAG_FAULT_UNDER_TEMP: ClassVar[int] = 4096
-    STATUS_FLAG_FAULT_OVER_CURRENT: ClassVar[int] = 8192
-    STATUS_FLAG_FAULT_SHORT_CIRCUIT: ClassVar[int] = 16384
-    STATUS_FLAG_FAULT_INCOMPATIBLE_VOLTAGE: ClassVar[int] = 32768
-    STATUS_FLAG_FAULT_INCOMPATIBLE_FIRMWARE: ClassVar[int] = 65536
-    STATUS_FLAG_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION: ClassVar[int] = 131072
-    STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL: ClassVar[int] = 262144
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryContinuous"
+    STATUS_FLAG_READY_TO_USE: _ClassVar[int] = 1
+    STATUS_FLAG_CHARGING: _ClassVar[int] = 2
+    STATUS_FLAG_CELL_BALANCING: _ClassVar[int] = 4
+    STATUS_FLAG_FAULT_CELL_IMBALANCE: _ClassVar[int] = 8
+    STATUS_FLAG_AUTO_DISCHARGING: _ClassVar[int] = 16
+    STATUS_FLAG_REQUIRES_SERVICE: _ClassVar[int] = 32
+    STATUS_FLAG_BAD_BATTERY: _ClassVar[int] = 64
+    STATUS_FLAG_PROTECTIONS_ENABLED: _ClassVar[int] = 128
+    STATUS_FLAG_FAULT_PROTECTION_SYSTEM: _ClassVar[int] = 256
+    STATUS_FLAG_FAULT_OVER_VOLT: _ClassVar[int] = 512
+    STATUS_FLAG_FAULT_UNDER_VOLT: _ClassVar[int] = 1024
+    STATUS_FLAG_FAULT_OVER_TEMP: _ClassVar[int] = 2048
+    STATUS_FLAG_FAULT_UNDER_TEMP: _ClassVar[int] = 4096
+    STATUS_FLAG_FAULT_OVER_CURRENT: _ClassVar[int] = 8192
+    STATUS_FLAG_FAULT_SHORT_CIRCUIT: _ClassVar[int] = 16384
+    STATUS_FLAG_FAULT_INCOMPATIBLE_VOLTAGE: _ClassVar[int] = 32768
+    STATUS_FLAG_FAULT_INCOMPATIBLE_FIRMWARE: _ClassVar[int] = 65536
+    STATUS_FLAG_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION: _ClassVar[int] = 131072
+    STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL: _ClassVar[int] = 262144
 
-    temperature_cells: float = dataclasses.field(
+    temperature_cells: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="temperature_cells",
@@ -481,7 +483,7 @@ class BatteryContinuous:
             doc="Pack mounted thermistor (preferably installed between cells), NAN: field not provided",
         ),
     )
-    temperature_pcb: float = dataclasses.field(
+    temperature_pcb: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="temperature_pcb",
@@ -493,7 +495,7 @@ class BatteryContinuous:
             doc="Battery PCB temperature (likely output FET(s) or current sense resistor), NAN: field not provided",
         ),
     )
-    temperature_other: float = dataclasses.field(
+    temperature_other: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="temperature_other",
@@ -505,7 +507,7 @@ class BatteryContinuous:
             doc="Application dependent, NAN: field not provided",
         ),
     )
-    current: float = dataclasses.field(
+    current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="current",
@@ -516,11 +518,11 @@ class BatteryContinuous:
             "current, NAN: field not provided",
         ),
     )
-    voltage: float = dataclasses.field(
+    voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="voltage", type="float32", unit="V", quantity="voltage", doc="Battery voltage"),
     )
-    state_of_charge: float = dataclasses.field(
+    state_of_charge: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="state_of_charge",
@@ -532,7 +534,7 @@ class BatteryContinuous:
             doc="The estimated state of charge, in percent remaining (0 - 100).",
         ),
     )
-    slot_id: int = dataclasses.field(
+    slot_id: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="slot_id",
@@ -540,7 +542,7 @@ class BatteryContinuous:
             doc=": The physical location of the battery on the aircraft. 0: field not provided",
         ),
     )
-    capacity_consumed: float = dataclasses.field(
+    capacity_consumed: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="capacity_consumed",
@@ -554,7 +556,7 @@ class BatteryContinuous:
             "provided",
         ),
     )
-    status_flags: int = dataclasses.field(
+    status_flags: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="status_flags",
@@ -570,9 +572,9 @@ class BatteryContinuous:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["temperature_cells"] = self.temperature_cells
         out["temperature_pcb"] = self.temperature_pcb
         out["temperature_other"] = self.temperature_other
@@ -585,7 +587,7 @@ class BatteryContinuous:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryContinuous:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryContinuous:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -626,8 +628,8 @@ class BatteryContinuous:
             obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 20010
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x756B561340D5E4AE
+    DATA_TYPE_ID: _ClassVar[int | None] = 20010
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x756B561340D5E4AE
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -886,7 +888,7 @@ class BatteryContinuous:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryContinuous")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryInfoAux:
     """Extra battery data that complements uavcan.equipment.power.BatteryInfo.
 
@@ -896,13 +898,13 @@ class BatteryInfoAux:
     ardupilot/equipment/power/20004.BatteryInfoAux.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryInfoAux"
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryInfoAux"
 
-    timestamp: _dronecan_uavcan.Timestamp = dataclasses.field(
+    timestamp: _dronecan_uavcan.Timestamp = _dataclasses.field(
         default_factory=lambda: _timestamp_class()(),
         metadata=_m.meta(name="timestamp", type="dronecan.uavcan.Timestamp", doc="When the current was last measured."),
     )
-    voltage_cell: list[float] = dataclasses.field(
+    voltage_cell: list[float] = _dataclasses.field(
         default_factory=list,
         metadata=_m.meta(
             name="voltage_cell",
@@ -912,17 +914,17 @@ class BatteryInfoAux:
             doc="Per-cell voltages; the length is the cell count.",
         ),
     )
-    cycle_count: int = dataclasses.field(
+    cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cycle_count", type="uint16", doc="Full charge/discharge cycles (partial cycles add up)."
         ),
     )
-    over_discharge_count: int = dataclasses.field(
+    over_discharge_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Discharges beyond the rated capacity."),
     )
-    max_current: float = dataclasses.field(
+    max_current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="max_current",
@@ -932,7 +934,7 @@ class BatteryInfoAux:
             doc="Peak current since the previous message.",
         ),
     )
-    nominal_voltage: float = dataclasses.field(
+    nominal_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="nominal_voltage",
@@ -942,11 +944,11 @@ class BatteryInfoAux:
             doc="Nominal pack voltage, for Wh <-> Ah conversion; zero disables the conversion.",
         ),
     )
-    is_powering_off: bool = dataclasses.field(
+    is_powering_off: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(name="is_powering_off", type="bool", doc="About to switch off; false if unknown"),
     )
-    battery_id: int = dataclasses.field(
+    battery_id: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="battery_id", type="uint8", doc="Which battery of this vehicle (0 = main)")
     )
 
@@ -956,9 +958,9 @@ class BatteryInfoAux:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["timestamp"] = self.timestamp.to_dict()
         out["voltage_cell"] = list(self.voltage_cell)
         out["cycle_count"] = self.cycle_count
@@ -970,7 +972,7 @@ class BatteryInfoAux:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryInfoAux:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfoAux:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -1010,8 +1012,8 @@ class BatteryInfoAux:
             obj.battery_id = _m.as_int(data["battery_id"], "battery_id")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 20004
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x7D7F49FC75484882
+    DATA_TYPE_ID: _ClassVar[int | None] = 20004
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x7D7F49FC75484882
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -1024,7 +1026,7 @@ class BatteryInfoAux:
         if k4 > 255:
             raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
         acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
+        acc = (acc << (k4 * 16)) | int.from_bytes(_struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
         g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
@@ -1075,7 +1077,7 @@ class BatteryInfoAux:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfoAux:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f1: list[Any]
+        f1: list[_Any]
         n = len(data)
         if n < 7:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, n << 3)
@@ -1093,7 +1095,7 @@ class BatteryInfoAux:
         if rem < n6:
             raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
         rem -= n6
-        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
+        f1 = list(_struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
@@ -1117,7 +1119,7 @@ class BatteryInfoAux:
         if k4 > 255:
             raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
         acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
+        acc = (acc << (k4 * 16)) | int.from_bytes(_struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
         r6 = self.max_current
         r7 = self.nominal_voltage
         g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
@@ -1167,7 +1169,7 @@ class BatteryInfoAux:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfoAux, int]:
-        f1: list[Any]
+        f1: list[_Any]
         if rem < 56:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, rem)
         rem -= 56
@@ -1183,7 +1185,7 @@ class BatteryInfoAux:
         if rem < n6:
             raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
         rem -= n6
-        f1 = list(struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
+        f1 = list(_struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
@@ -1197,10 +1199,10 @@ class BatteryInfoAux:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        a: Any
-        e: Any
-        sub: Any
+        x: _Any
+        a: _Any
+        e: _Any
+        sub: _Any
         try:
             x = self.timestamp
             if x.QUALIFIED_NAME != "dronecan.uavcan.Timestamp":
@@ -1280,7 +1282,7 @@ class BatteryInfoAux:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryInfoAux")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryPeriodic:
     """Battery data to be sent statically upon request or periodically at a low rate
      Recommend that this message is sent at a maximum of 1Hz and nominally 0.2 Hz (IE: once every 5 seconds.)
@@ -1289,19 +1291,19 @@ class BatteryPeriodic:
     ardupilot/equipment/power/20011.BatteryPeriodic.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryPeriodic"
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryPeriodic"
 
-    name: bytes = dataclasses.field(
+    name: bytes = _dataclasses.field(
         default=b"",
         metadata=_m.meta(name="name", type="uint8[<=50]", doc=": Formatted as manufacturer_product, 0 terminated"),
     )
-    serial_number: bytes = dataclasses.field(
+    serial_number: bytes = _dataclasses.field(
         default=b"",
         metadata=_m.meta(
             name="serial_number", type="uint8[<=32]", doc=": Serial number in ASCII characters, 0 terminated"
         ),
     )
-    manufacture_date: bytes = dataclasses.field(
+    manufacture_date: bytes = _dataclasses.field(
         default=b"",
         metadata=_m.meta(
             name="manufacture_date",
@@ -1309,7 +1311,7 @@ class BatteryPeriodic:
             doc=": Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated",
         ),
     )
-    design_capacity: float = dataclasses.field(
+    design_capacity: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="design_capacity",
@@ -1321,13 +1323,13 @@ class BatteryPeriodic:
             doc="Fully charged design capacity. 0: field not provided.",
         ),
     )
-    cells_in_series: int = dataclasses.field(
+    cells_in_series: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cells_in_series", type="uint8", doc=": Number of battery cells in series. 0: field not provided."
         ),
     )
-    nominal_voltage: float = dataclasses.field(
+    nominal_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="nominal_voltage",
@@ -1337,7 +1339,7 @@ class BatteryPeriodic:
             doc="Battery nominal voltage. Used for conversion between Wh and Ah. 0: field not provided.",
         ),
     )
-    discharge_minimum_voltage: float = dataclasses.field(
+    discharge_minimum_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="discharge_minimum_voltage",
@@ -1347,7 +1349,7 @@ class BatteryPeriodic:
             doc="Minimum per-cell voltage when discharging. 0: field not provided.",
         ),
     )
-    charging_minimum_voltage: float = dataclasses.field(
+    charging_minimum_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="charging_minimum_voltage",
@@ -1357,7 +1359,7 @@ class BatteryPeriodic:
             doc="Minimum per-cell voltage when charging. 0: field not provided.",
         ),
     )
-    charging_maximum_voltage: float = dataclasses.field(
+    charging_maximum_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="charging_maximum_voltage",
@@ -1367,7 +1369,7 @@ class BatteryPeriodic:
             doc="Maximum per-cell voltage when charged. 0: field not provided.",
         ),
     )
-    charging_maximum_current: float = dataclasses.field(
+    charging_maximum_current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="charging_maximum_current",
@@ -1377,7 +1379,7 @@ class BatteryPeriodic:
             doc="Maximum pack continuous charge current. 0: field not provided.",
         ),
     )
-    discharge_maximum_current: float = dataclasses.field(
+    discharge_maximum_current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="discharge_maximum_current",
@@ -1387,7 +1389,7 @@ class BatteryPeriodic:
             doc="Maximum pack continuous discharge current. 0: field not provided.",
         ),
     )
-    discharge_maximum_burst_current: float = dataclasses.field(
+    discharge_maximum_burst_current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="discharge_maximum_burst_current",
@@ -1397,7 +1399,7 @@ class BatteryPeriodic:
             doc="Maximum pack discharge burst current for 30 seconds. 0: field not provided",
         ),
     )
-    full_charge_capacity: float = dataclasses.field(
+    full_charge_capacity: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="full_charge_capacity",
@@ -1410,7 +1412,7 @@ class BatteryPeriodic:
             "degradation), NAN: field not provided",
         ),
     )
-    cycle_count: int = dataclasses.field(
+    cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cycle_count",
@@ -1419,7 +1421,7 @@ class BatteryPeriodic:
             "(https://en.wikipedia.org/wiki/Charge_cycle). UINT16_MAX: field not provided.",
         ),
     )
-    state_of_health: int = dataclasses.field(
+    state_of_health: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="state_of_health",
@@ -1438,9 +1440,9 @@ class BatteryPeriodic:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["name"] = list(self.name)
         out["serial_number"] = list(self.serial_number)
         out["manufacture_date"] = list(self.manufacture_date)
@@ -1459,7 +1461,7 @@ class BatteryPeriodic:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryPeriodic:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryPeriodic:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -1520,8 +1522,8 @@ class BatteryPeriodic:
             obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 20011
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x0F012494E97358D2
+    DATA_TYPE_ID: _ClassVar[int | None] = 20011
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x0F012494E97358D2
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -1858,7 +1860,7 @@ class BatteryPeriodic:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
+        x: _Any
         try:
             x = self.name
             if x.__class__ is not bytes or len(x) > 50:
@@ -2031,7 +2033,7 @@ class BatteryPeriodic:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryPeriodic")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryTag:
     """Battery tag information. This is broadcast by a battery tag device
     permanently attached to a battery to record the lifecycle of the battery
@@ -2040,12 +2042,12 @@ class BatteryTag:
     ardupilot/equipment/power/20500.BatteryTag.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryTag"
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryTag"
 
-    serial_number: int = dataclasses.field(
+    serial_number: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="serial_number", type="uint32", doc="vendor supplied serial number")
     )
-    num_cycles: int = dataclasses.field(
+    num_cycles: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="num_cycles",
@@ -2053,7 +2055,7 @@ class BatteryTag:
             doc="number of cycles this battery has been through. Criteria for\ndefining a cycle is vendor specific",
         ),
     )
-    armed_hours: float = dataclasses.field(
+    armed_hours: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="armed_hours",
@@ -2061,10 +2063,10 @@ class BatteryTag:
             doc="number of hours that this battery has been running when\nvehicle is in an armed state",
         ),
     )
-    battery_capacity_mAh: int = dataclasses.field(
+    battery_capacity_mAh: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="battery_capacity_mAh", type="uint32", doc="battery capacity in milliAmpHours")
     )
-    first_use_mins: int = dataclasses.field(
+    first_use_mins: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="first_use_mins",
@@ -2072,7 +2074,7 @@ class BatteryTag:
             doc="time of first use of battery with vehicle armed, in minutes since 1/1/1970",
         ),
     )
-    last_arm_time_mins: int = dataclasses.field(
+    last_arm_time_mins: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="last_arm_time_mins",
@@ -2087,9 +2089,9 @@ class BatteryTag:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["serial_number"] = self.serial_number
         out["num_cycles"] = self.num_cycles
         out["armed_hours"] = self.armed_hours
@@ -2099,7 +2101,7 @@ class BatteryTag:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryTag:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryTag:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -2131,8 +2133,8 @@ class BatteryTag:
             obj.last_arm_time_mins = _m.as_int(data["last_arm_time_mins"], "last_arm_time_mins")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 20500
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x4A5A9B42099F73E1
+    DATA_TYPE_ID: _ClassVar[int | None] = 20500
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x4A5A9B42099F73E1
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""

@@ -6,11 +6,12 @@ Module: dronecan.cuav.equipment.power.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
-import struct
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+import enum as _enum
+import struct as _struct
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from .... import _dronecan as _dc
 from .... import _meta as _m
@@ -19,7 +20,7 @@ from .... import _validate as _v
 __all__ = ["CBAT", "CBATStatusFlag"]
 
 
-class CBATStatusFlag(enum.IntFlag):
+class CBATStatusFlag(_enum.IntFlag):
     """dronecan.cuav.equipment.power.CBAT.STATUS_FLAG: bit masks, combined with |."""
 
     IN_USE = 1
@@ -36,13 +37,13 @@ class CBATStatusFlag(enum.IntFlag):
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
-_CBAT_ENCODE_STRUCT = struct.Struct("<ff")
+_CBAT_ENCODE_STRUCT = _struct.Struct("<ff")
 # fixed fields as encoded (a float16 as its bit pattern)
-_CBAT_ENCODE_STRUCT_FROM_CELL_COUNT = struct.Struct("<BfffffffHHQQIHB")
+_CBAT_ENCODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _CBAT_FIELD_ENDS = ((32, "CBAT.temperature"), (64, "CBAT.voltage"))
 # fixed fields as decoded
-_CBAT_DECODE_STRUCT = struct.Struct("<ff")
+_CBAT_DECODE_STRUCT = _struct.Struct("<ff")
 # (bit where each field ends, field): names the field a short payload cuts
 _CBAT_FIELD_ENDS_FROM_CELL_COUNT = (
     (8, "CBAT.cell_count"),
@@ -69,7 +70,7 @@ _CBAT_FIELD_ENDS_FROM_CELL_COUNT = (
     (441, "CBAT.status_flags"),
 )
 # fixed fields as decoded
-_CBAT_DECODE_STRUCT_FROM_CELL_COUNT = struct.Struct("<BfffffffHHQQIHB")
+_CBAT_DECODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -137,64 +138,64 @@ _CBAT_STATUS_FLAGS_SPEC = _v.Number(
 )
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class CBAT:
     """support for CUAV Smart Battery on UAVCAN
 
     Schema: dronecan.cuav.equipment.power.CBAT (dronecan, cuav/equipment/power/20300.CBAT.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.cuav.equipment.power.CBAT"
-    STATUS_FLAG_IN_USE: ClassVar[int] = 1
-    STATUS_FLAG_CHARGING: ClassVar[int] = 2
-    STATUS_FLAG_CHARGED: ClassVar[int] = 4
-    STATUS_FLAG_TEMP_HOT: ClassVar[int] = 8
-    STATUS_FLAG_TEMP_COLD: ClassVar[int] = 16
-    STATUS_FLAG_OVERLOAD: ClassVar[int] = 32
-    STATUS_FLAG_BAD_BATTERY: ClassVar[int] = 64
-    STATUS_FLAG_NEED_SERVICE: ClassVar[int] = 128
-    STATUS_FLAG_BMS_ERROR: ClassVar[int] = 256
-    STATUS_FLAG_RESERVED_A: ClassVar[int] = 512
-    STATUS_FLAG_RESERVED_B: ClassVar[int] = 1024
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.cuav.equipment.power.CBAT"
+    STATUS_FLAG_IN_USE: _ClassVar[int] = 1
+    STATUS_FLAG_CHARGING: _ClassVar[int] = 2
+    STATUS_FLAG_CHARGED: _ClassVar[int] = 4
+    STATUS_FLAG_TEMP_HOT: _ClassVar[int] = 8
+    STATUS_FLAG_TEMP_COLD: _ClassVar[int] = 16
+    STATUS_FLAG_OVERLOAD: _ClassVar[int] = 32
+    STATUS_FLAG_BAD_BATTERY: _ClassVar[int] = 64
+    STATUS_FLAG_NEED_SERVICE: _ClassVar[int] = 128
+    STATUS_FLAG_BMS_ERROR: _ClassVar[int] = 256
+    STATUS_FLAG_RESERVED_A: _ClassVar[int] = 512
+    STATUS_FLAG_RESERVED_B: _ClassVar[int] = 1024
 
-    temperature: float = dataclasses.field(
+    temperature: float = _dataclasses.field(
         default=0.0, metadata=_m.meta(name="temperature", type="float32", doc="The surface temperature of the battery")
     )
-    voltage: float = dataclasses.field(
+    voltage: float = _dataclasses.field(
         default=0.0, metadata=_m.meta(name="voltage", type="float32", doc="The total voltage of the battery")
     )
-    voltage_cell: list[float] = dataclasses.field(
+    voltage_cell: list[float] = _dataclasses.field(
         default_factory=list,
         metadata=_m.meta(name="voltage_cell", type="float32[<=15]", doc="Battery individual cell voltages"),
     )
-    cell_count: int = dataclasses.field(
+    cell_count: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="cell_count", type="uint8", doc="Number of cells")
     )
-    current: float = dataclasses.field(
+    current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="current", type="float32", doc="The current flowing through the sense resistor"),
     )
-    average_current: float = dataclasses.field(
+    average_current: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="average_current", type="float32", doc="The average current flowing through the sense resistor"
         ),
     )
-    average_power: float = dataclasses.field(
+    average_power: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="average_power", type="float32", doc="The average power of the current discharge"),
     )
-    available_energy: float = dataclasses.field(
+    available_energy: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="available_energy", type="float32", doc="The predicted charge or energy remaining in the battery"
         ),
     )
-    remaining_capacity: float = dataclasses.field(
+    remaining_capacity: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(name="remaining_capacity", type="float32", doc="The compensated battery capacity remaining"),
     )
-    full_charge_capacity: float = dataclasses.field(
+    full_charge_capacity: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="full_charge_capacity",
@@ -202,10 +203,10 @@ class CBAT:
             doc="The compensated capacity of the battery when fully charged",
         ),
     )
-    design_capacity: float = dataclasses.field(
+    design_capacity: float = _dataclasses.field(
         default=0.0, metadata=_m.meta(name="design_capacity", type="float32", doc="The design capacity of the battery")
     )
-    average_time_to_empty: int = dataclasses.field(
+    average_time_to_empty: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="average_time_to_empty",
@@ -213,7 +214,7 @@ class CBAT:
             doc="The predicted remaining battery life at the present rate of discharge, in minutes",
         ),
     )
-    average_time_to_full: int = dataclasses.field(
+    average_time_to_full: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="average_time_to_full",
@@ -221,13 +222,13 @@ class CBAT:
             doc="The predicted remaining time until the battery reaches full charge, in minutes",
         ),
     )
-    state_of_health: int = dataclasses.field(
+    state_of_health: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="state_of_health", type="uint7", doc="Health of the battery")
     )
-    state_of_charge: int = dataclasses.field(
+    state_of_charge: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="state_of_charge", type="uint7", doc="Percent of the full charge [0, 100]")
     )
-    max_error: int = dataclasses.field(
+    max_error: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="max_error",
@@ -235,43 +236,43 @@ class CBAT:
             doc="max error, expected margin of error in % in the state-of-charge calculation with a range of 1 to 100%",
         ),
     )
-    serial_number: int = dataclasses.field(
+    serial_number: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="serial number of the battery pack")
     )
-    manufacture_date: int = dataclasses.field(
+    manufacture_date: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="manufacture_date", type="uint16", doc="manufacture date, part of serial number of the battery pack"
         ),
     )
-    cycle_count: int = dataclasses.field(
+    cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="cycle_count", type="uint16", doc="number of discharge cycles the battery has experienced"
         ),
     )
-    over_discharge_count: int = dataclasses.field(
+    over_discharge_count: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
     )
-    passed_charge: float = dataclasses.field(
+    passed_charge: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="passed_charge", type="float32", doc="The amount of charge passing through the sense resistor"
         ),
     )
-    nominal_voltage: float = dataclasses.field(
+    nominal_voltage: float = _dataclasses.field(
         default=0.0, metadata=_m.meta(name="nominal_voltage", type="float32", doc="Nominal voltage of the battery pack")
     )
-    is_powering_off: bool = dataclasses.field(
+    is_powering_off: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
         ),
     )
-    interface_error: int = dataclasses.field(
+    interface_error: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="interface error counter")
     )
-    status_flags: int = dataclasses.field(
+    status_flags: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="status_flags", type="uint11", enums=("dronecan.cuav.equipment.power.CBAT.STATUS_FLAG",)),
     )
@@ -282,9 +283,9 @@ class CBAT:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["temperature"] = self.temperature
         out["voltage"] = self.voltage
         out["voltage_cell"] = list(self.voltage_cell)
@@ -313,7 +314,7 @@ class CBAT:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> CBAT:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> CBAT:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -404,8 +405,8 @@ class CBAT:
             obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 20300
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0xB4DACE3A38E09A74
+    DATA_TYPE_ID: _ClassVar[int | None] = 20300
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0xB4DACE3A38E09A74
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -430,7 +431,7 @@ class CBAT:
             raise _dc.EncodeError("CBAT.voltage_cell: length " + str(k4) + " exceeds capacity 15")
         acc = (acc << 4) | k4
         acc = (acc << (k4 * 32)) | int.from_bytes(
-            struct.pack(
+            _struct.pack(
                 f"<{k4}f",
                 *[
                     (
@@ -579,7 +580,7 @@ class CBAT:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> CBAT:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f2: list[Any]
+        f2: list[_Any]
         n = len(data)
         if n < 8:
             raise _dc.cut(_CBAT_FIELD_ENDS, n << 3)
@@ -596,7 +597,7 @@ class CBAT:
         if rem < n4:
             raise _dc.short("CBAT.voltage_cell", n4, rem)
         rem -= n4
-        f2 = list(struct.unpack(f"<{k3}f", ((v >> rem) & ((1 << n4) - 1)).to_bytes(n4 >> 3, "big")))
+        f2 = list(_struct.unpack(f"<{k3}f", ((v >> rem) & ((1 << n4) - 1)).to_bytes(n4 >> 3, "big")))
         if rem < 441:
             raise _dc.cut(_CBAT_FIELD_ENDS_FROM_CELL_COUNT, rem)
         rem -= 441
@@ -697,7 +698,7 @@ class CBAT:
             raise _dc.EncodeError("CBAT.voltage_cell: length " + str(k4) + " exceeds capacity 15")
         acc = (acc << 4) | k4
         acc = (acc << (k4 * 32)) | int.from_bytes(
-            struct.pack(
+            _struct.pack(
                 f"<{k4}f",
                 *[
                     (
@@ -845,7 +846,7 @@ class CBAT:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[CBAT, int]:
-        f2: list[Any]
+        f2: list[_Any]
         if rem < 64:
             raise _dc.cut(_CBAT_FIELD_ENDS, rem)
         rem -= 64
@@ -860,7 +861,7 @@ class CBAT:
         if rem < n4:
             raise _dc.short("CBAT.voltage_cell", n4, rem)
         rem -= n4
-        f2 = list(struct.unpack(f"<{k3}f", ((v >> rem) & ((1 << n4) - 1)).to_bytes(n4 >> 3, "big")))
+        f2 = list(_struct.unpack(f"<{k3}f", ((v >> rem) & ((1 << n4) - 1)).to_bytes(n4 >> 3, "big")))
         if rem < 441:
             raise _dc.cut(_CBAT_FIELD_ENDS_FROM_CELL_COUNT, rem)
         rem -= 441
@@ -938,9 +939,9 @@ class CBAT:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        a: Any
-        e: Any
+        x: _Any
+        a: _Any
+        e: _Any
         try:
             if not (-3.4028234663852886e38 <= self.temperature <= 3.4028234663852886e38):
                 _v.diag(out, "temperature", self.temperature, _CBAT_TEMPERATURE_SPEC)

@@ -6,12 +6,13 @@ Module: dronecan.uavcan.equipment.power.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
-import math
-import struct
-from collections.abc import Mapping
-from typing import Any, ClassVar
+import dataclasses as _dataclasses
+import enum as _enum
+import math as _math
+import struct as _struct
+from collections.abc import Mapping as _Mapping
+from typing import Any as _Any
+from typing import ClassVar as _ClassVar
 
 from .... import _dronecan as _dc
 from .... import _meta as _m
@@ -26,7 +27,7 @@ __all__ = [
 ]
 
 
-class BatteryInfoStatusFlag(enum.IntFlag):
+class BatteryInfoStatusFlag(_enum.IntFlag):
     """Status bits, OR-ed into status_flags.
     CHARGING stays set while a charger is attached, CHARGED clears when it is removed.
 
@@ -46,7 +47,7 @@ class BatteryInfoStatusFlag(enum.IntFlag):
     RESERVED_B = 1024
 
 
-class CircuitStatusErrorFlag(enum.IntFlag):
+class CircuitStatusErrorFlag(_enum.IntFlag):
     """dronecan.uavcan.equipment.power.CircuitStatus.ERROR_FLAG: bit masks, combined with |."""
 
     OVERVOLTAGE = 1
@@ -56,11 +57,11 @@ class CircuitStatusErrorFlag(enum.IntFlag):
 
 
 # float16 fields packed as float32 ...
-_BATTERY_INFO_FLOAT32_STRUCT = struct.Struct("<7f")
+_BATTERY_INFO_FLOAT32_STRUCT = _struct.Struct("<7f")
 # ... and read back as bits, from which each half is cut
-_BATTERY_INFO_FLOAT32_BITS_STRUCT = struct.Struct("<7I")
+_BATTERY_INFO_FLOAT32_BITS_STRUCT = _struct.Struct("<7I")
 # fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_INFO_ENCODE_STRUCT = struct.Struct("<HHHHHHHIBI")
+_BATTERY_INFO_ENCODE_STRUCT = _struct.Struct("<HHHHHHHIBI")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_FIELD_ENDS = (
     (16, "BatteryInfo.temperature"),
@@ -78,30 +79,30 @@ _BATTERY_INFO_FIELD_ENDS = (
     (184, "BatteryInfo.model_instance_id"),
 )
 # fixed fields as decoded
-_BATTERY_INFO_DECODE_STRUCT = struct.Struct("<eeeeeeeIBI")
+_BATTERY_INFO_DECODE_STRUCT = _struct.Struct("<eeeeeeeIBI")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
 _BATTERY_INFO_TEMPERATURE_SPEC = _v.Number(
-    type="float16", kind="float", low=-65504.0, high=65504.0, unit="K", sentinel=math.nan, sentinel_text="NaN"
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="K", sentinel=_math.nan, sentinel_text="NaN"
 )
 _BATTERY_INFO_VOLTAGE_SPEC = _v.Number(
-    type="float16", kind="float", low=-65504.0, high=65504.0, unit="V", sentinel=math.nan, sentinel_text="NaN"
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="V", sentinel=_math.nan, sentinel_text="NaN"
 )
 _BATTERY_INFO_CURRENT_SPEC = _v.Number(
-    type="float16", kind="float", low=-65504.0, high=65504.0, unit="A", sentinel=math.nan, sentinel_text="NaN"
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="A", sentinel=_math.nan, sentinel_text="NaN"
 )
 _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC = _v.Number(
-    type="float16", kind="float", low=-65504.0, high=65504.0, unit="W", sentinel=math.nan, sentinel_text="NaN"
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="W", sentinel=_math.nan, sentinel_text="NaN"
 )
 _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC = _v.Number(
-    type="float16", kind="float", low=-65504.0, high=65504.0, unit="Wh", sentinel=math.nan, sentinel_text="NaN"
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="Wh", sentinel=_math.nan, sentinel_text="NaN"
 )
 _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC = _v.Number(
-    type="float16", kind="float", low=-65504.0, high=65504.0, unit="Wh", sentinel=math.nan, sentinel_text="NaN"
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="Wh", sentinel=_math.nan, sentinel_text="NaN"
 )
 _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC = _v.Number(
-    type="float16", kind="float", low=-65504.0, high=65504.0, unit="h", sentinel=math.nan, sentinel_text="NaN"
+    type="float16", kind="float", low=-65504.0, high=65504.0, unit="h", sentinel=_math.nan, sentinel_text="NaN"
 )
 _BATTERY_INFO_STATUS_FLAGS_SPEC = _v.Number(
     type="uint11",
@@ -134,11 +135,11 @@ _BATTERY_INFO_MODEL_NAME_SPEC = _v.Array(_v.Number(type="uint8", kind="uint", lo
 
 
 # float16 fields packed as float32 ...
-_CIRCUIT_STATUS_FLOAT32_STRUCT = struct.Struct("<2f")
+_CIRCUIT_STATUS_FLOAT32_STRUCT = _struct.Struct("<2f")
 # ... and read back as bits, from which each half is cut
-_CIRCUIT_STATUS_FLOAT32_BITS_STRUCT = struct.Struct("<2I")
+_CIRCUIT_STATUS_FLOAT32_BITS_STRUCT = _struct.Struct("<2I")
 # fixed fields as encoded (a float16 as its bit pattern)
-_CIRCUIT_STATUS_ENCODE_STRUCT = struct.Struct("<HHHB")
+_CIRCUIT_STATUS_ENCODE_STRUCT = _struct.Struct("<HHHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _CIRCUIT_STATUS_FIELD_ENDS = (
     (16, "CircuitStatus.circuit_id"),
@@ -147,7 +148,7 @@ _CIRCUIT_STATUS_FIELD_ENDS = (
     (56, "CircuitStatus.error_flags"),
 )
 # fixed fields as decoded
-_CIRCUIT_STATUS_DECODE_STRUCT = struct.Struct("<HeeB")
+_CIRCUIT_STATUS_DECODE_STRUCT = _struct.Struct("<HeeB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -170,11 +171,11 @@ _CIRCUIT_STATUS_ERROR_FLAGS_SPEC = _v.Number(
 
 
 # float16 fields packed as float32 ...
-_PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT = struct.Struct("<2f")
+_PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT = _struct.Struct("<2f")
 # ... and read back as bits, from which each half is cut
-_PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT = struct.Struct("<2I")
+_PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT = _struct.Struct("<2I")
 # fixed fields as encoded (a float16 as its bit pattern)
-_PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT = struct.Struct("<HHH")
+_PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT = _struct.Struct("<HHH")
 # (bit where each field ends, field): names the field a short payload cuts
 _PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS = (
     (16, "PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power"),
@@ -184,7 +185,7 @@ _PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS = (
     (47, "PrimaryPowerSupplyStatus.remaining_energy_pct_stdev"),
 )
 # fixed fields as decoded
-_PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT = struct.Struct("<eeH")
+_PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT = _struct.Struct("<eeH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -201,7 +202,7 @@ _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC = _v.Number(
 )
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class BatteryInfo:
     """State of one battery.
 
@@ -210,58 +211,58 @@ class BatteryInfo:
     Schema: dronecan.uavcan.equipment.power.BatteryInfo (dronecan, uavcan/equipment/power/1092.BatteryInfo.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.uavcan.equipment.power.BatteryInfo"
-    STATUS_FLAG_IN_USE: ClassVar[int] = 1
-    STATUS_FLAG_CHARGING: ClassVar[int] = 2
-    STATUS_FLAG_CHARGED: ClassVar[int] = 4
-    STATUS_FLAG_TEMP_HOT: ClassVar[int] = 8
-    STATUS_FLAG_TEMP_COLD: ClassVar[int] = 16
-    STATUS_FLAG_OVERLOAD: ClassVar[int] = 32
-    STATUS_FLAG_BAD_BATTERY: ClassVar[int] = 64
-    STATUS_FLAG_NEED_SERVICE: ClassVar[int] = 128
-    STATUS_FLAG_BMS_ERROR: ClassVar[int] = 256
-    STATUS_FLAG_RESERVED_A: ClassVar[int] = 512
-    STATUS_FLAG_RESERVED_B: ClassVar[int] = 1024
-    STATE_OF_HEALTH_UNKNOWN: ClassVar[int] = 127
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.uavcan.equipment.power.BatteryInfo"
+    STATUS_FLAG_IN_USE: _ClassVar[int] = 1
+    STATUS_FLAG_CHARGING: _ClassVar[int] = 2
+    STATUS_FLAG_CHARGED: _ClassVar[int] = 4
+    STATUS_FLAG_TEMP_HOT: _ClassVar[int] = 8
+    STATUS_FLAG_TEMP_COLD: _ClassVar[int] = 16
+    STATUS_FLAG_OVERLOAD: _ClassVar[int] = 32
+    STATUS_FLAG_BAD_BATTERY: _ClassVar[int] = 64
+    STATUS_FLAG_NEED_SERVICE: _ClassVar[int] = 128
+    STATUS_FLAG_BMS_ERROR: _ClassVar[int] = 256
+    STATUS_FLAG_RESERVED_A: _ClassVar[int] = 512
+    STATUS_FLAG_RESERVED_B: _ClassVar[int] = 1024
+    STATE_OF_HEALTH_UNKNOWN: _ClassVar[int] = 127
 
-    temperature: float = dataclasses.field(
-        default=math.nan,
+    temperature: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="temperature",
             type="float16",
             unit="K",
             quantity="temperature",
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Measurements. Unknown values are NAN.",
         ),
     )
-    voltage: float = dataclasses.field(
-        default=math.nan,
+    voltage: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
-            name="voltage", type="float16", unit="V", quantity="voltage", invalid=math.nan, invalid_text="NaN"
+            name="voltage", type="float16", unit="V", quantity="voltage", invalid=_math.nan, invalid_text="NaN"
         ),
     )
-    current: float = dataclasses.field(
-        default=math.nan,
+    current: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
-            name="current", type="float16", unit="A", quantity="current", invalid=math.nan, invalid_text="NaN"
+            name="current", type="float16", unit="A", quantity="current", invalid=_math.nan, invalid_text="NaN"
         ),
     )
-    average_power_10sec: float = dataclasses.field(
-        default=math.nan,
+    average_power_10sec: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="average_power_10sec",
             type="float16",
             unit="W",
             quantity="power",
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Mean power over the last 10 s",
         ),
     )
-    remaining_capacity_wh: float = dataclasses.field(
-        default=math.nan,
+    remaining_capacity_wh: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="remaining_capacity_wh",
             type="float16",
@@ -269,13 +270,13 @@ class BatteryInfo:
             quantity="energy",
             scale=3600.0,
             offset=0.0,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Energy left; grows while charging",
         ),
     )
-    full_charge_capacity_wh: float = dataclasses.field(
-        default=math.nan,
+    full_charge_capacity_wh: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="full_charge_capacity_wh",
             type="float16",
@@ -283,13 +284,13 @@ class BatteryInfo:
             quantity="energy",
             scale=3600.0,
             offset=0.0,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Energy when full; shrinks as the battery ages",
         ),
     )
-    hours_to_full_charge: float = dataclasses.field(
-        default=math.nan,
+    hours_to_full_charge: float = _dataclasses.field(
+        default=_math.nan,
         metadata=_m.meta(
             name="hours_to_full_charge",
             type="float16",
@@ -297,18 +298,18 @@ class BatteryInfo:
             quantity="time",
             scale=3600.0,
             offset=0.0,
-            invalid=math.nan,
+            invalid=_math.nan,
             invalid_text="NaN",
             doc="Time until charged; zero when not charging",
         ),
     )
-    status_flags: int = dataclasses.field(
+    status_flags: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="status_flags", type="uint11", enums=("dronecan.uavcan.equipment.power.BatteryInfo.STATUS_FLAG",)
         ),
     )
-    state_of_health_pct: int = dataclasses.field(
+    state_of_health_pct: int = _dataclasses.field(
         default=127,
         metadata=_m.meta(
             name="state_of_health_pct",
@@ -322,7 +323,7 @@ class BatteryInfo:
             doc="Optional",
         ),
     )
-    state_of_charge_pct: int = dataclasses.field(
+    state_of_charge_pct: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="state_of_charge_pct",
@@ -334,7 +335,7 @@ class BatteryInfo:
             doc="State of charge.\nRequired",
         ),
     )
-    state_of_charge_pct_stdev: int = dataclasses.field(
+    state_of_charge_pct_stdev: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="state_of_charge_pct_stdev",
@@ -346,15 +347,15 @@ class BatteryInfo:
             doc="Standard deviation of the estimate",
         ),
     )
-    battery_id: int = dataclasses.field(
+    battery_id: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="battery_id", type="uint8", doc="Identity.\nWhich battery of this vehicle (0 = main)"),
     )
-    model_instance_id: int = dataclasses.field(
+    model_instance_id: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(name="model_instance_id", type="uint32", doc="Serial number within the model; zero if none"),
     )
-    model_name: bytes = dataclasses.field(
+    model_name: bytes = _dataclasses.field(
         default=b"", metadata=_m.meta(name="model_name", type="uint8[<=31]", doc="Vendor, model and chemistry, as text")
     )
 
@@ -364,9 +365,9 @@ class BatteryInfo:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["temperature"] = self.temperature
         out["voltage"] = self.voltage
         out["current"] = self.current
@@ -384,7 +385,7 @@ class BatteryInfo:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BatteryInfo:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfo:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -440,8 +441,8 @@ class BatteryInfo:
             obj.model_name = _m.as_bytes(data["model_name"], "model_name", 31, False)
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 1092
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x249C26548A711966
+    DATA_TYPE_ID: _ClassVar[int | None] = 1092
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x249C26548A711966
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -766,9 +767,9 @@ class BatteryInfo:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        r_state_of_charge_pct: Any
-        r_state_of_health_pct: Any
+        x: _Any
+        r_state_of_charge_pct: _Any
+        r_state_of_health_pct: _Any
         try:
             x = self.temperature
             if not (-65504.0 <= x <= 65504.0) and x == x:
@@ -940,7 +941,7 @@ class BatteryInfo:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.equipment.power.BatteryInfo")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class CircuitStatus:
     """Voltage, current and faults of one electrical circuit.
 
@@ -948,20 +949,20 @@ class CircuitStatus:
     uavcan/equipment/power/1091.CircuitStatus.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.uavcan.equipment.power.CircuitStatus"
-    ERROR_FLAG_OVERVOLTAGE: ClassVar[int] = 1
-    ERROR_FLAG_UNDERVOLTAGE: ClassVar[int] = 2
-    ERROR_FLAG_OVERCURRENT: ClassVar[int] = 4
-    ERROR_FLAG_UNDERCURRENT: ClassVar[int] = 8
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.uavcan.equipment.power.CircuitStatus"
+    ERROR_FLAG_OVERVOLTAGE: _ClassVar[int] = 1
+    ERROR_FLAG_UNDERVOLTAGE: _ClassVar[int] = 2
+    ERROR_FLAG_OVERCURRENT: _ClassVar[int] = 4
+    ERROR_FLAG_UNDERCURRENT: _ClassVar[int] = 8
 
-    circuit_id: int = dataclasses.field(default=0, metadata=_m.meta(name="circuit_id", type="uint16"))
-    voltage: float = dataclasses.field(
+    circuit_id: int = _dataclasses.field(default=0, metadata=_m.meta(name="circuit_id", type="uint16"))
+    voltage: float = _dataclasses.field(
         default=0.0, metadata=_m.meta(name="voltage", type="float16", unit="V", quantity="voltage")
     )
-    current: float = dataclasses.field(
+    current: float = _dataclasses.field(
         default=0.0, metadata=_m.meta(name="current", type="float16", unit="A", quantity="current")
     )
-    error_flags: int = dataclasses.field(
+    error_flags: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="error_flags", type="uint8", enums=("dronecan.uavcan.equipment.power.CircuitStatus.ERROR_FLAG",)
@@ -974,9 +975,9 @@ class CircuitStatus:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["circuit_id"] = self.circuit_id
         out["voltage"] = self.voltage
         out["current"] = self.current
@@ -984,7 +985,7 @@ class CircuitStatus:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> CircuitStatus:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> CircuitStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(data, frozenset({"circuit_id", "voltage", "current", "error_flags"}), (), "CircuitStatus")
         obj = cls()
@@ -998,8 +999,8 @@ class CircuitStatus:
             obj.error_flags = _m.as_int(data["error_flags"], "error_flags")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 1091
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0x8313D33D0DDDA115
+    DATA_TYPE_ID: _ClassVar[int | None] = 1091
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x8313D33D0DDDA115
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -1137,7 +1138,7 @@ class CircuitStatus:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.equipment.power.CircuitStatus")
 
 
-@dataclasses.dataclass(slots=True)
+@_dataclasses.dataclass(slots=True)
 class PrimaryPowerSupplyStatus:
     """Summary of the main power supply, sent at about 1 to 2 Hz.
 
@@ -1145,9 +1146,9 @@ class PrimaryPowerSupplyStatus:
     uavcan/equipment/power/1090.PrimaryPowerSupplyStatus.uavcan:1).
     """
 
-    QUALIFIED_NAME: ClassVar[str] = "dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus"
+    QUALIFIED_NAME: _ClassVar[str] = "dronecan.uavcan.equipment.power.PrimaryPowerSupplyStatus"
 
-    hours_to_empty_at_10sec_avg_power: float = dataclasses.field(
+    hours_to_empty_at_10sec_avg_power: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="hours_to_empty_at_10sec_avg_power",
@@ -1159,7 +1160,7 @@ class PrimaryPowerSupplyStatus:
             doc="Time to full discharge at the mean load of the last 10 s.",
         ),
     )
-    hours_to_empty_at_10sec_avg_power_variance: float = dataclasses.field(
+    hours_to_empty_at_10sec_avg_power_variance: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
             name="hours_to_empty_at_10sec_avg_power_variance",
@@ -1168,13 +1169,13 @@ class PrimaryPowerSupplyStatus:
             quantity="unknown:Hours^2",
         ),
     )
-    external_power_available: bool = dataclasses.field(
+    external_power_available: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
             name="external_power_available", type="bool", doc="An external source (e.g. a charger) is available."
         ),
     )
-    remaining_energy_pct: int = dataclasses.field(
+    remaining_energy_pct: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="remaining_energy_pct",
@@ -1186,7 +1187,7 @@ class PrimaryPowerSupplyStatus:
             doc="Remaining energy.\nRequired",
         ),
     )
-    remaining_energy_pct_stdev: int = dataclasses.field(
+    remaining_energy_pct_stdev: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="remaining_energy_pct_stdev",
@@ -1205,9 +1206,9 @@ class PrimaryPowerSupplyStatus:
             return NotImplemented
         return _m.same_message(self, other)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, _Any]:
         """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
-        out: dict[str, Any] = {}
+        out: dict[str, _Any] = {}
         out["hours_to_empty_at_10sec_avg_power"] = self.hours_to_empty_at_10sec_avg_power
         out["hours_to_empty_at_10sec_avg_power_variance"] = self.hours_to_empty_at_10sec_avg_power_variance
         out["external_power_available"] = self.external_power_available
@@ -1216,7 +1217,7 @@ class PrimaryPowerSupplyStatus:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> PrimaryPowerSupplyStatus:
+    def from_dict(cls, data: _Mapping[str, _Any]) -> PrimaryPowerSupplyStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(
             data,
@@ -1249,8 +1250,8 @@ class PrimaryPowerSupplyStatus:
             obj.remaining_energy_pct_stdev = _m.as_int(data["remaining_energy_pct_stdev"], "remaining_energy_pct_stdev")
         return obj
 
-    DATA_TYPE_ID: ClassVar[int | None] = 1090
-    DATA_TYPE_SIGNATURE: ClassVar[int] = 0xBBA05074AD757480
+    DATA_TYPE_ID: _ClassVar[int | None] = 1090
+    DATA_TYPE_SIGNATURE: _ClassVar[int] = 0xBBA05074AD757480
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
@@ -1358,8 +1359,8 @@ class PrimaryPowerSupplyStatus:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        x: Any
-        r_remaining_energy_pct: Any
+        x: _Any
+        r_remaining_energy_pct: _Any
         try:
             if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power <= 65504.0):
                 _v.diag(

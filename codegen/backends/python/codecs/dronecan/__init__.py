@@ -57,8 +57,8 @@ class _Codec:
         id_name = _free_name("DATA_TYPE_ID", taken)
         sig_name = _free_name("DATA_TYPE_SIGNATURE", taken | {id_name})
         lines = [
-            f"{id_name}: ClassVar[int | None] = {py_literal(info.data_type_id)}",
-            f"{sig_name}: ClassVar[int] = 0x{info.signature:016X}",
+            f"{id_name}: _ClassVar[int | None] = {py_literal(info.data_type_id)}",
+            f"{sig_name}: _ClassVar[int] = 0x{info.signature:016X}",
         ]
         if info.union:
             self._union(msg, ctx, view, emitter, lines)
@@ -80,7 +80,7 @@ class _Codec:
     def _union(msg: Message, ctx: ModuleContext, view: ClassView, emitter: MessageEmitter, lines: list[str]) -> None:
         """The branch table, ``union_field`` and the hooks that keep one branch held (``_dc.Union``)."""
         branches = []
-        zeros = ["@staticmethod", "def _dc_zero(name: str) -> Any:"]
+        zeros = ["@staticmethod", "def _dc_zero(name: str) -> _Any:"]
         zeros.append('    """A fresh default value of branch ``name``."""')
         for f, fv in zip([f for f in msg.fields if not f.is_padding], view.fields, strict=True):
             branches.append(f"({py_literal(f.name)}, {py_literal(fv.ident)})")
@@ -97,13 +97,13 @@ class _Codec:
             'doc="DSDL name of the field this union holds (the one encoded)")'
         )
         lines += [
-            f"union_field: str = dataclasses.field(init=False, metadata={meta})",
+            f"union_field: str = _dataclasses.field(init=False, metadata={meta})",
             "",
             "def __post_init__(self) -> None:",
             '    """Select the one branch given (or the first, at its default); two given raise TypeError."""',
             f"    {table}.settle(self)",
             "",
-            "def __setattr__(self, name: str, value: Any) -> None:",
+            "def __setattr__(self, name: str, value: _Any) -> None:",
             '    """A value assigned to a branch selects it; assigning a branch name to union_field switches to it."""',
             f"    {table}.assign(self, name, value)",
             "",

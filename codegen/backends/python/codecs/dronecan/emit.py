@@ -22,7 +22,7 @@ from .variable import VariableFieldEmitter
 class MessageEmitter(VariableFieldEmitter):
     def annotation(self, t: FieldType) -> str | None:
         if isinstance(t, ArrayType):
-            return "bytes" if is_u8(t.element) else "list[Any]"
+            return "bytes" if is_u8(t.element) else "list[_Any]"
         return None
 
     def items(self, base: str) -> list[Item]:
@@ -220,7 +220,7 @@ class MessageEmitter(VariableFieldEmitter):
             e = out.fresh("e")
             value = encode_value(word, e, pattern=False)
             code = struct_code(word, pack=True)
-            out.add(f'return {head} + struct.pack(f"<{{len({x})}}{code}", *[{value} for {e} in {x}])')
+            out.add(f'return {head} + _struct.pack(f"<{{len({x})}}{code}", *[{value} for {e} in {x}])')
         out.level -= 1
 
     def method_decode(self) -> str:
@@ -289,7 +289,7 @@ class MessageEmitter(VariableFieldEmitter):
             out.add(f"if {k} > {t.capacity}:")
             out.add(f"    raise {too_long}")
             code = struct_code(word, pack=False)
-            out.add(f'{target} = list(struct.unpack_from(f"<{{{k}}}{code}", data, {start}))')
+            out.add(f'{target} = list(_struct.unpack_from(f"<{{{k}}}{code}", data, {start}))')
         out.level -= 1
 
     def wrap_decode(self, out: Lines) -> str:

@@ -112,6 +112,7 @@ class Planner:
     def __init__(self, schema: Schema, factory: dict[str, str]) -> None:
         self.schema = schema
         self.messages = {m.qualified_name: m for m in schema.messages}
+        self.member_idents: dict[str, list[str]] = {}
         self.factory = factory  # qualified name -> expression giving the class
 
     # -- sizes ----------------------------------------------------------------------------
@@ -234,20 +235,14 @@ class Planner:
         return self.idents(m)[[f.name for f in m.fields].index(name)]
 
     def idents(self, m: Message) -> list[str]:
-        from ...naming import field_identifier
+        from ...naming import member_names, module_classes, module_path
 
-        out: list[str] = []
-        used: set[str] = {"QUALIFIED_NAME"}
-        for f in m.fields:
-            if f.is_padding:
-                out.append("")
-                continue
-            ident = field_identifier(f.name)
-            while ident in used:
-                ident += "_"
-            used.add(ident)
-            out.append(ident)
-        return out
+        cached = self.member_idents.get(m.qualified_name)
+        if cached is None:
+            names = member_names(m, module_classes(self.schema, module_path(m)))
+            cached = ["" if f.is_padding else names[("field", f.name)] for f in m.fields]
+            self.member_idents[m.qualified_name] = cached
+        return cached
 
 
 def is_u8(t: FieldType) -> bool:

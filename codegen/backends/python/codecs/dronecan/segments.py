@@ -35,7 +35,7 @@ class SegmentEmitter:
         return name
 
     def struct_name(self, fmt: str, role: str, comment: str) -> str:
-        return self.module_value(f"struct.Struct({text_literal(fmt)})", role, comment)
+        return self.module_value(f"_struct.Struct({text_literal(fmt)})", role, comment)
 
     def segment_role(self, seg: Segment, role: str) -> str:
         """``role``, or ``role_FROM_<FIELD>`` for a segment that does not start the message."""

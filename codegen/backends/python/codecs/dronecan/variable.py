@@ -24,7 +24,7 @@ class VariableFieldEmitter(SegmentEmitter):
             if word is not None:
                 value = encode_value(word, e, pattern=False)
                 code = struct_code(word, pack=True)
-                packed = f'struct.pack(f"<{{{k}}}{code}", *[{value} for {e} in {x}])'
+                packed = f'_struct.pack(f"<{{{k}}}{code}", *[{value} for {e} in {x}])'
                 out.add(f'acc = (acc << ({k} * {elem.bits})) | int.from_bytes({packed}, "big")')
                 return
             out.add(f"for {e} in {x}:")
@@ -91,7 +91,7 @@ class VariableFieldEmitter(SegmentEmitter):
             if word is not None:
                 code = struct_code(word, pack=False)
                 data = f'((v >> rem) & ((1 << {need}) - 1)).to_bytes({need} >> 3, "big")'
-                out.add(f'{target} = list(struct.unpack(f"<{{{k}}}{code}", {data}))')
+                out.add(f'{target} = list(_struct.unpack(f"<{{{k}}}{code}", {data}))')
                 return
             pos, b = out.fresh("q"), out.fresh("b")
             out.add(f"{pos} = rem + {need}")
