@@ -25,6 +25,7 @@ from ..ir.numbers import to_json_data
 from ..ir.rules import bound_rules
 from ..text.brief import brief, reportable
 from .failsafe.checks import NONNEGATIVE, check_settings
+from .failsafe.vehicles import detect_vehicle
 from .messages import resolve_message
 from .package import data_error, model_class, model_package
 
@@ -64,24 +65,35 @@ class FileReport:
     warnings: int = 0
 
 
-# A check beyond the generated validate(): (instance, its violations) -> findings as
-# (severity, path, rule, value, message)
+# A check beyond the generated validate(): (instance, its violations, the record's context, the
+# vehicle asked for) -> findings as (severity, path, rule, value, message)
 ExtraFinding = tuple[str, str, str, object, str]
-ExtraCheck = Callable[[GeneratedMessage, Sequence[Violation]], list[ExtraFinding]]
+ExtraCheck = Callable[
+    [GeneratedMessage, Sequence[Violation], Mapping[str, object] | None, str | None], list[ExtraFinding]
+]
 
 
-def failsafe_check(instance: GeneratedMessage, violations: Sequence[Violation]) -> list[ExtraFinding]:
-    """codegen.apps.failsafe.checks over a BATT_* parameter set (absent parameters at their defaults,
-    as ``battgen params --check`` does). A negative threshold the schema's range already reported
-    is not reported twice: for a negative value that is the only finding check_settings makes."""
-    values = instance.to_dict()
+def failsafe_check(
+    instance: GeneratedMessage,
+    violations: Sequence[Violation],
+    context: Mapping[str, object] | None = None,
+    vehicle: str | None = None,
+    *,
+    cells: int | None = None,
+    chemistry: str = "lipo",
+) -> list[ExtraFinding]:
+    """codegen.apps.failsafe.checks over a parameter set: every battery's BATT*_ group (the whole set
+    from the record's context; battery 1's absent parameters at the model's defaults), with the
+    action codes of the vehicle given, else detected from the set (as ``battgen params --check`` and
+    ``battgen failsafe`` do). Findings the schema's own checks made are not repeated."""
+    values: Mapping[str, object] = context if context is not None else instance.to_dict()
     flagged = {str(v.path) for v in violations}
+    detection = detect_vehicle(values, vehicle)
     out = []
-    for f in check_settings(values):
-        value = values.get(f.param)
-        if isinstance(value, int | float) and value < 0 and f.param in flagged:
+    for f in check_settings(values, vehicle=detection.vehicle, cells=cells, chemistry=chemistry):
+        if f.param in flagged and f.severity == "error":
             continue
-        out.append((f.severity, f.param, "cross-field:failsafe", value, f.message))
+        out.append((f.severity, f.param, "cross-field:failsafe", values.get(f.param), f.message))
     return out
 
 
@@ -120,12 +132,14 @@ class Checker:
         data_error: type[BaseException],
         rules: Mapping[str, frozenset[str]] | None = None,
         extra: ExtraCheck | None = None,
+        vehicle: str | None = None,
     ) -> None:
         self.cls = cls
         self.message = message
         self.data_error = data_error
         self.rules = rules or {}
         self.extra = extra
+        self.vehicle = vehicle  # the ArduPilot vehicle a parameter set is for (None: detect it)
 
     def check(self, record: Record) -> list[Finding]:
         instance = record.instance
@@ -138,7 +152,7 @@ class Checker:
                 return [self._finding(record, "", "type", record.data, None, f"cannot read the record: {exc}", "error")]
         try:
             violations = instance.validate()
-            extra = self.extra(instance, violations) if self.extra is not None else []
+            extra = self.extra(instance, violations, record.context, self.vehicle) if self.extra is not None else []
         except Exception as exc:
             return [self._finding(record, "", "internal", None, None, f"the validator failed: {exc!r}", "error")]
         if record.skip:
@@ -331,7 +345,11 @@ def default_message(schema: Schema, files: list[str], kind: str | None) -> str:
 
 
 def make_checker(
-    schema_dir: Path, message_name: str | None, files: list[str] | None = None, kind: str | None = None
+    schema_dir: Path,
+    message_name: str | None,
+    files: list[str] | None = None,
+    kind: str | None = None,
+    vehicle: str | None = None,
 ) -> tuple[Message, Checker]:
     """Load the schemas, resolve the message (or the inputs' default one) and its generated class."""
     schema = load([schema_dir])
@@ -340,4 +358,5 @@ def make_checker(
     message = resolve_message(schema, message_name)
     package = model_package(schema, schema_dir)
     cls = model_class(package, message)
-    return message, Checker(cls, message, data_error(package), rule_fields(schema, message), extra_check(message))
+    extra = extra_check(message)
+    return message, Checker(cls, message, data_error(package), rule_fields(schema, message), extra, vehicle)

@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from ..apps import validate as engine
+from ..apps.failsafe.vehicles import VEHICLES
 from ..apps.package import bundled_schemas
 from ..apps.validate import Checker, Event, FileReport, Finding, exit_code, json_document, make_checker
 from ..inputs.dispatch import KINDS
@@ -82,7 +83,7 @@ def check_file(path: Path, message: Message, checker: Checker, *, echo: bool, ki
 def run(args: argparse.Namespace) -> int:
     schema_dir = Path(args.schemas) if args.schemas else bundled_schemas()
     kind = args.input_format
-    message, checker = make_checker(schema_dir, args.message, args.files, kind)
+    message, checker = make_checker(schema_dir, args.message, args.files, kind, vehicle=args.vehicle)
     as_json = args.format == "json"
     reports = [check_file(Path(f), message, checker, echo=not as_json, kind=kind) for f in args.files]
     code = exit_code(reports)
@@ -124,6 +125,11 @@ def register(subparsers: Any) -> None:
         "--input-format",
         choices=KINDS,
         help="read every FILE as this format (default: from each extension; 'mavlink' is a raw MAVLink stream)",
+    )
+    p.add_argument(
+        "--vehicle",
+        choices=sorted(VEHICLES),
+        help="ArduPilot vehicle of parameter files: what the BATT*_FS_*_ACT codes mean (default: detected, else rover)",
     )
     p.add_argument(
         "files",

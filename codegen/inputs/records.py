@@ -46,6 +46,7 @@ class Record:
     instance: GeneratedMessage | None = field(default=None, compare=False)  # decoded already: no from_dict
     skip: frozenset[str] = frozenset()  # fields the source lacks: their checks are not reported
     location: Mapping[str, object] | None = None  # machine-readable where: timestamp, multi_id, offset...
+    context: Mapping[str, object] | None = field(default=None, compare=False)  # a parameter set's other values
     # decoded with the instance: the other messages of a multi-message side (a CAN node's BatteryInfoAux)
     companions: tuple[GeneratedMessage | None, ...] = field(default=(), compare=False)
 
