@@ -15,7 +15,7 @@ from typing import ClassVar as _ClassVar
 from . import _meta as _m
 from . import _validate as _v
 
-__all__ = ["BattParams", "BattParamsFsCrtAct", "BattParamsFsLowAct", "BattParamsFsVoltsrc"]
+__all__ = ["BattParams", "BattParamsFsVoltsrc"]
 
 
 class BattParamsFsVoltsrc(_enum.IntEnum):
@@ -25,38 +25,10 @@ class BattParamsFsVoltsrc(_enum.IntEnum):
     SAG_COMPENSATED_VOLTAGE = 1
 
 
-class BattParamsFsLowAct(_enum.IntEnum):
-    """params.BATT.FS_LOW_ACT: values."""
-
-    NONE = 0
-    HOLD = 1
-    RTL = 2
-    SMARTRTL = 3
-    SMARTRTL_OR_HOLD = 4
-    TERMINATE = 5
-
-
-class BattParamsFsCrtAct(_enum.IntEnum):
-    """params.BATT.FS_CRT_ACT: values."""
-
-    NONE = 0
-    HOLD = 1
-    RTL = 2
-    SMARTRTL = 3
-    SMARTRTL_OR_HOLD = 4
-    TERMINATE = 5
-
-
 # what validate() reports against, field by field (read only when a fast test trips)
 _BATT_PARAMS_BATT_CAPACITY_SPEC = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
 _BATT_PARAMS_BATT_LOW_VOLT_SPEC = _v.Number(
-    type="float32",
-    kind="float",
-    low=-3.4028234663852886e38,
-    high=3.4028234663852886e38,
-    unit="V",
-    minimum=0,
-    maximum=30,
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
 _BATT_PARAMS_BATT_LOW_TIMER_SPEC = _v.Number(
     type="int8", kind="int", low=-128, high=127, unit="s", minimum=0, maximum=120
@@ -72,53 +44,15 @@ _BATT_PARAMS_BATT_LOW_MAH_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="mAh"
 )
 _BATT_PARAMS_BATT_CRT_VOLT_SPEC = _v.Number(
-    type="float32",
-    kind="float",
-    low=-3.4028234663852886e38,
-    high=3.4028234663852886e38,
-    unit="V",
-    minimum=0,
-    maximum=30,
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
 _BATT_PARAMS_BATT_CRT_MAH_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="mAh"
 )
-_BATT_PARAMS_BATT_FS_LOW_ACT_SPEC = _v.Number(
-    type="int8",
-    kind="int",
-    low=-128,
-    high=127,
-    values={
-        0: "FS_LOW_ACT_NONE",
-        1: "FS_LOW_ACT_HOLD",
-        2: "FS_LOW_ACT_RTL",
-        3: "FS_LOW_ACT_SMARTRTL",
-        4: "FS_LOW_ACT_SMARTRTL_OR_HOLD",
-        5: "FS_LOW_ACT_TERMINATE",
-    },
-)
-_BATT_PARAMS_BATT_FS_CRT_ACT_SPEC = _v.Number(
-    type="int8",
-    kind="int",
-    low=-128,
-    high=127,
-    values={
-        0: "FS_CRT_ACT_NONE",
-        1: "FS_CRT_ACT_HOLD",
-        2: "FS_CRT_ACT_RTL",
-        3: "FS_CRT_ACT_SMARTRTL",
-        4: "FS_CRT_ACT_SMARTRTL_OR_HOLD",
-        5: "FS_CRT_ACT_TERMINATE",
-    },
-)
+_BATT_PARAMS_BATT_FS_LOW_ACT_SPEC = _v.Number(type="int8", kind="int", low=-128, high=127)
+_BATT_PARAMS_BATT_FS_CRT_ACT_SPEC = _v.Number(type="int8", kind="int", low=-128, high=127)
 _BATT_PARAMS_BATT_ARM_VOLT_SPEC = _v.Number(
-    type="float32",
-    kind="float",
-    low=-3.4028234663852886e38,
-    high=3.4028234663852886e38,
-    unit="V",
-    minimum=0,
-    maximum=30,
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
 _BATT_PARAMS_BATT_ARM_MAH_SPEC = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
 
@@ -128,24 +62,12 @@ class BattParams:
     """Battery monitor: capacity, the two-stage (LOW, CRITICAL) failsafe thresholds and their actions, and arming
     limits. A threshold of 0 is disabled.
 
-    Schema: params.BATT (params, battery_failsafe.pdef.xml:8).
+    Schema: params.BATT (params, battery_failsafe.pdef.xml:11).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "params.BATT"
     FS_VOLTSRC_RAW_VOLTAGE: _ClassVar[int] = 0
     FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE: _ClassVar[int] = 1
-    FS_LOW_ACT_NONE: _ClassVar[int] = 0
-    FS_LOW_ACT_HOLD: _ClassVar[int] = 1
-    FS_LOW_ACT_RTL: _ClassVar[int] = 2
-    FS_LOW_ACT_SMARTRTL: _ClassVar[int] = 3
-    FS_LOW_ACT_SMARTRTL_OR_HOLD: _ClassVar[int] = 4
-    FS_LOW_ACT_TERMINATE: _ClassVar[int] = 5
-    FS_CRT_ACT_NONE: _ClassVar[int] = 0
-    FS_CRT_ACT_HOLD: _ClassVar[int] = 1
-    FS_CRT_ACT_RTL: _ClassVar[int] = 2
-    FS_CRT_ACT_SMARTRTL: _ClassVar[int] = 3
-    FS_CRT_ACT_SMARTRTL_OR_HOLD: _ClassVar[int] = 4
-    FS_CRT_ACT_TERMINATE: _ClassVar[int] = 5
 
     BATT_CAPACITY: int = _dataclasses.field(
         default=3300,
@@ -166,9 +88,9 @@ class BattParams:
             type="float32",
             unit="V",
             quantity="voltage",
-            minimum=0,
-            maximum=30,
-            doc="LOW failsafe when the voltage stays below this for BATT_LOW_TIMER seconds. 0 disables it.",
+            doc="LOW failsafe when the voltage stays below this for more than BATT_LOW_TIMER "
+            "seconds. 0 disables it. ArduPilot's default is 10.5 V on Copter, 0 on the other "
+            "vehicles.",
         ),
     )
     BATT_LOW_TIMER: int = _dataclasses.field(
@@ -180,8 +102,9 @@ class BattParams:
             quantity="time",
             minimum=0,
             maximum=120,
-            doc="How long the voltage must stay below BATT_LOW_VOLT before the LOW failsafe "
-            "triggers; rides out sag under load.",
+            doc="How long the voltage must stay below BATT_LOW_VOLT or BATT_CRT_VOLT before the "
+            "LOW or CRITICAL failsafe triggers (strictly longer); rides out sag under load. "
+            "0 disables the voltage failsafes.",
         ),
     )
     BATT_FS_VOLTSRC: int = _dataclasses.field(
@@ -202,8 +125,8 @@ class BattParams:
             quantity="charge",
             scale=3.6,
             offset=0.0,
-            doc="LOW failsafe when the remaining charge drops below this. 0 disables it; needs a "
-            "current sensor and BATT_CAPACITY.",
+            doc="LOW failsafe when the remaining charge (BATT_CAPACITY minus the charge used) "
+            "drops below this. 0 disables it; checked only when the monitor measures current.",
         ),
     )
     BATT_CRT_VOLT: float = _dataclasses.field(
@@ -213,9 +136,8 @@ class BattParams:
             type="float32",
             unit="V",
             quantity="voltage",
-            minimum=0,
-            maximum=30,
-            doc="CRITICAL failsafe as soon as the voltage is below this. 0 disables it; must be below BATT_LOW_VOLT.",
+            doc="CRITICAL failsafe when the voltage stays below this for more than "
+            "BATT_LOW_TIMER seconds. 0 disables it; should be below BATT_LOW_VOLT.",
         ),
     )
     BATT_CRT_MAH: float = _dataclasses.field(
@@ -228,7 +150,7 @@ class BattParams:
             scale=3.6,
             offset=0.0,
             doc="CRITICAL failsafe as soon as the remaining charge is below this. 0 disables it; "
-            "must be below BATT_LOW_MAH.",
+            "checked only when the monitor measures current; should be below BATT_LOW_MAH.",
         ),
     )
     BATT_FS_LOW_ACT: int = _dataclasses.field(
@@ -236,8 +158,11 @@ class BattParams:
         metadata=_m.meta(
             name="BATT_FS_LOW_ACT",
             type="int8",
-            enums=("params.BATT.FS_LOW_ACT",),
-            doc="What the vehicle does when the LOW failsafe triggers.",
+            doc="What the vehicle does when the LOW failsafe triggers. Rover: 0 None, 1 RTL, 2 "
+            "Hold, 3 SmartRTL, 4 SmartRTL or Hold, 5 Terminate; Copter: 0 None, 1 Land, 2 "
+            "RTL, 3 SmartRTL or RTL, 4 SmartRTL or Land, 5 Terminate, 6 Auto DO_LAND_START "
+            "or RTL; Plane: 0 None, 1 RTL, 2 Land, 3 Terminate, 4 QLand, 6 Loiter to QLand; "
+            "Sub: 0 None, 2 Disarm, 3 Enter surface mode.",
         ),
     )
     BATT_FS_CRT_ACT: int = _dataclasses.field(
@@ -245,8 +170,9 @@ class BattParams:
         metadata=_m.meta(
             name="BATT_FS_CRT_ACT",
             type="int8",
-            enums=("params.BATT.FS_CRT_ACT",),
-            doc="What the vehicle does when the CRITICAL failsafe triggers; overrides the LOW action.",
+            doc="What the vehicle does when the CRITICAL failsafe triggers: the LOW action's "
+            "codes per vehicle, Plane also 5 Parachute. It runs only if its priority on the "
+            "vehicle's list is at least that of any battery failsafe action already run.",
         ),
     )
     BATT_ARM_VOLT: float = _dataclasses.field(
@@ -256,8 +182,6 @@ class BattParams:
             type="float32",
             unit="V",
             quantity="voltage",
-            minimum=0,
-            maximum=30,
             doc="Arming is refused below this voltage. 0 disables the check.",
         ),
     )
@@ -354,7 +278,7 @@ class BattParams:
         except _v.SLOW:
             _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)
         try:
-            if not (0.0 <= self.BATT_LOW_VOLT <= 30.0):
+            if not (-3.4028234663852886e38 <= self.BATT_LOW_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _BATT_PARAMS_BATT_LOW_VOLT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _BATT_PARAMS_BATT_LOW_VOLT_SPEC)
@@ -375,7 +299,7 @@ class BattParams:
         except _v.SLOW:
             _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _BATT_PARAMS_BATT_LOW_MAH_SPEC)
         try:
-            if not (0.0 <= self.BATT_CRT_VOLT <= 30.0):
+            if not (-3.4028234663852886e38 <= self.BATT_CRT_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _BATT_PARAMS_BATT_CRT_VOLT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _BATT_PARAMS_BATT_CRT_VOLT_SPEC)
@@ -385,17 +309,17 @@ class BattParams:
         except _v.SLOW:
             _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _BATT_PARAMS_BATT_CRT_MAH_SPEC)
         try:
-            if self.BATT_FS_LOW_ACT not in {0, 1, 2, 3, 4, 5}:
+            if (self.BATT_FS_LOW_ACT + 128) & -256:
                 _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC)
         try:
-            if self.BATT_FS_CRT_ACT not in {0, 1, 2, 3, 4, 5}:
+            if (self.BATT_FS_CRT_ACT + 128) & -256:
                 _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC)
         try:
-            if not (0.0 <= self.BATT_ARM_VOLT <= 30.0):
+            if not (-3.4028234663852886e38 <= self.BATT_ARM_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _BATT_PARAMS_BATT_ARM_VOLT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _BATT_PARAMS_BATT_ARM_VOLT_SPEC)

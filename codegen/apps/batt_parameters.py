@@ -11,20 +11,24 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any, cast
 
 from ..errors import BattgenError
 from ..frontends import devicetree as devicetree_schemas
 from ..inputs import devicetree, parameter_files
-from ..inputs.model import MessageClass, field_names
+from ..inputs.model import MessageClass
 from ..ir import Message
 from .batt_proposal import Result, propose
 from .failsafe.checks import Finding, check_settings
-from .package import bundled_package, bundled_schemas, data_error, package_module
+from .failsafe.vehicles import detect_vehicle
+from .package import bundled_package, bundled_schemas, package_module
+from .validate import check_file, failsafe_check, make_checker
 
 BATTERY_COMPATIBLE = "simple-battery"
 BATTERY_MESSAGE = "devicetree.power.supply.battery"
+BATT_MESSAGE_NAME = "params.BATT"
 
 
 def _battery_message() -> Message:
@@ -100,26 +104,31 @@ class ParameterFinding:
     message: str
 
 
-def check_parameter_file(path: Path, *, cells: int | None = None, chemistry: str = "lipo") -> list[ParameterFinding]:
-    """Every problem of each parameter set of a .param / .params file, in file order per set:
-    data the model cannot read, values outside their ranges, then the cross-field findings.
-    Absent parameters take the model's defaults."""
-    model = _batt_params()
-    error = data_error(bundled_package())
-    entries = parameter_files.load(path, path.as_posix())
-    lines = {e.name: e.line for e in entries}
-    out: list[ParameterFinding] = []
-    for first, values in parameter_files.value_sets(entries):
-        try:
-            instance = model.from_dict(parameter_files.select(values, field_names(model)))
-        except error as exc:
-            out.append(ParameterFinding(lines.get(str(getattr(exc, "path", "")), first), "error", str(exc)))
-            continue
-        for f in dataclasses.fields(cast(Any, model)):
-            value, lo, hi = getattr(instance, f.name), f.metadata["minimum"], f.metadata["maximum"]
-            if (lo is not None and value < lo) or (hi is not None and value > hi):
-                text = f"{f.name} is {value:g}: expected {lo:g} to {hi:g}"
-                out.append(ParameterFinding(lines.get(f.name, first), "error", text))
-        for finding in check_settings(instance.to_dict(), cells=cells, chemistry=chemistry):
-            out.append(ParameterFinding(lines.get(finding.param, first), finding.severity, finding.message))
-    return out
+@dataclass(frozen=True)
+class ParameterReport:
+    findings: list[ParameterFinding]
+    notes: list[str]  # what to know about the whole file: repeated parameters, the vehicle
+    unreadable: str | None  # why the file could not be read (then no findings)
+
+
+def check_parameter_file(
+    path: Path, *, cells: int | None = None, chemistry: str = "lipo", vehicle: str | None = None
+) -> ParameterReport:
+    """Every problem of each parameter set of a parameter file, found by the very engine ``battgen
+    validate`` runs (the generated model's types and ranges, then the failsafe checks of every
+    battery with the vehicle's action codes), so the two commands agree on every file."""
+    _, checker = make_checker(bundled_schemas(), BATT_MESSAGE_NAME, vehicle=vehicle)
+    checker.extra = partial(failsafe_check, cells=cells, chemistry=chemistry)
+    report = check_file(path, checker.message, checker, kind="param")
+    notes = [n.message for n in report.notices]
+    try:
+        values: dict[str, object] = {}
+        for _, group in parameter_files.read_parameter_file(path):
+            values.update(group)
+        notes.append(f"vehicle {detect_vehicle(values, vehicle).how}")
+    except BattgenError:
+        pass
+    findings = [ParameterFinding(f.line, f.severity, f.message) for f in report.findings]
+    first = report.unreadable[0] if report.unreadable else None
+    unreadable = None if first is None else f"{first.file}:{first.line}: {first.message}"
+    return ParameterReport(findings, notes, unreadable)

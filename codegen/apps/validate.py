@@ -10,6 +10,7 @@ a callback as it is found, so that a caller can print them while a long file is 
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,6 +25,8 @@ from ..ir.expr import referenced_fields
 from ..ir.numbers import to_json_data
 from ..ir.rules import bound_rules
 from .failsafe.checks import NONNEGATIVE, check_settings
+from .failsafe.vehicles import detect_vehicle
+from .gate import Gate
 from .messages import resolve_message
 from .package import data_error, model_class, model_package
 
@@ -45,6 +48,7 @@ class Finding:
     message: str
     severity: str
     location: Mapping[str, object] | None = None
+    waived: str = ""  # why it is left out of the verdict (--ignore, a profile's waiver); "" when reported
 
 
 Event = Finding | Notice | Unreadable
@@ -61,26 +65,38 @@ class FileReport:
     notices: list[Notice] = field(default_factory=list)
     errors: int = 0
     warnings: int = 0
+    waived: int = 0  # findings left out by the rule selection or a profile (counted, not failing)
 
 
-# A check beyond the generated validate(): (instance, its violations) -> findings as
-# (severity, path, rule, value, message)
+# A check beyond the generated validate(): (instance, its violations, the record's context, the
+# vehicle asked for) -> findings as (severity, path, rule, value, message)
 ExtraFinding = tuple[str, str, str, object, str]
-ExtraCheck = Callable[[GeneratedMessage, Sequence[Violation]], list[ExtraFinding]]
+ExtraCheck = Callable[
+    [GeneratedMessage, Sequence[Violation], Mapping[str, object] | None, str | None], list[ExtraFinding]
+]
 
 
-def failsafe_check(instance: GeneratedMessage, violations: Sequence[Violation]) -> list[ExtraFinding]:
-    """codegen.apps.failsafe.checks over a BATT_* parameter set (absent parameters at their defaults,
-    as ``battgen params --check`` does). A negative threshold the schema's range already reported
-    is not reported twice: for a negative value that is the only finding check_settings makes."""
-    values = instance.to_dict()
+def failsafe_check(
+    instance: GeneratedMessage,
+    violations: Sequence[Violation],
+    context: Mapping[str, object] | None = None,
+    vehicle: str | None = None,
+    *,
+    cells: int | None = None,
+    chemistry: str = "lipo",
+) -> list[ExtraFinding]:
+    """codegen.apps.failsafe.checks over a parameter set: every battery's BATT*_ group (the whole set
+    from the record's context; battery 1's absent parameters at the model's defaults), with the
+    action codes of the vehicle given, else detected from the set (as ``battgen params --check`` and
+    ``battgen failsafe`` do). Findings the schema's own checks made are not repeated."""
+    values: Mapping[str, object] = context if context is not None else instance.to_dict()
     flagged = {str(v.path) for v in violations}
+    detection = detect_vehicle(values, vehicle)
     out = []
-    for f in check_settings(values):
-        value = values.get(f.param)
-        if isinstance(value, int | float) and value < 0 and f.param in flagged:
+    for f in check_settings(values, vehicle=detection.vehicle, cells=cells, chemistry=chemistry):
+        if f.param in flagged and f.severity == "error":
             continue
-        out.append((f.severity, f.param, "cross-field:failsafe", value, f.message))
+        out.append((f.severity, f.param, "cross-field:failsafe", values.get(f.param), f.message))
     return out
 
 
@@ -124,12 +140,14 @@ class Checker:
         data_error: type[BaseException],
         rules: Mapping[str, frozenset[str]] | None = None,
         extra: ExtraCheck | None = None,
+        vehicle: str | None = None,
     ) -> None:
         self.cls = cls
         self.message = message
         self.data_error = data_error
         self.rules = rules or {}
         self.extra = extra
+        self.vehicle = vehicle  # the ArduPilot vehicle a parameter set is for (None: detect it)
 
     def check(self, record: Record) -> list[Finding]:
         instance = record.instance
@@ -142,7 +160,7 @@ class Checker:
                 return [self._finding(record, "", "type", record.data, None, f"cannot read the record: {exc}", "error")]
         try:
             violations = instance.validate()
-            extra = self.extra(instance, violations) if self.extra is not None else []
+            extra = self.extra(instance, violations, record.context, self.vehicle) if self.extra is not None else []
         except Exception as exc:
             return [self._finding(record, "", "internal", None, None, f"the validator failed: {exc!r}", "error")]
         if record.skip:
@@ -213,10 +231,13 @@ def check_file(
     kind: str | None = None,
     keep_findings: bool = True,
     on_event: Callable[[Event], None] | None = None,
+    gate: Gate | None = None,
 ) -> FileReport:
     """Check every record of one file. Each finding, notice and unreadable part goes to
     ``on_event`` as soon as it is found; findings are kept in the report only with
-    ``keep_findings`` (so a caller printing them streams a file of any size in constant memory)."""
+    ``keep_findings`` (so a caller printing them streams a file of any size in constant memory).
+    ``gate`` leaves findings out by rule selection or a profile: they are marked ``waived`` and
+    counted, never errors."""
     report = FileReport(path.as_posix())
 
     def tell(event: Event) -> None:
@@ -237,7 +258,11 @@ def check_file(
                 continue
             report.records += 1
             for finding in checker.check(item):
-                if finding.severity == "warning":
+                reason = gate.why_not(finding.rule, finding.path) if gate is not None else None
+                if reason is not None:
+                    finding = dataclasses.replace(finding, waived=reason)
+                    report.waived += 1
+                elif finding.severity == "warning":
                     report.warnings += 1
                 else:
                     report.errors += 1
@@ -257,29 +282,39 @@ def check_file(
     return report
 
 
-def exit_code(reports: Iterable[FileReport]) -> int:
-    """0 when every record is valid, 1 when one has an error, 2 when an input was unreadable."""
+def is_empty(report: FileReport) -> bool:
+    """A file that was read but held no record of the message."""
+    return report.records == 0 and not report.unreadable
+
+
+def exit_code(reports: Iterable[FileReport], *, allow_empty: bool = True) -> int:
+    """0 when every record is valid, 1 when one has an error (or, unless ``allow_empty``, a file
+    held no record at all), 2 when an input was unreadable."""
     code = EXIT_OK
     for report in reports:
         if report.unreadable:
             return EXIT_UNREADABLE
-        if report.errors:
+        if report.errors or (is_empty(report) and not allow_empty):
             code = EXIT_INVALID
     return code
 
 
-def json_document(message: Message, reports: list[FileReport]) -> dict[str, object]:
-    """The reports as one JSON document (``validate --format json``)."""
+def json_document(message: Message, reports: list[FileReport], *, allow_empty: bool = True) -> dict[str, object]:
+    """The reports as one JSON document (``validate --format json``); waived findings are listed
+    with their ``waived`` reason and not counted as errors or warnings."""
+    code = exit_code(reports, allow_empty=allow_empty)
     return {
         "message": message.qualified_name,
-        "valid": exit_code(reports) == EXIT_OK,
-        "exit_code": exit_code(reports),
+        "valid": code == EXIT_OK,
+        "exit_code": code,
         "files": [
             {
                 "file": r.file,
                 "records": r.records,
+                "empty": is_empty(r),
                 "errors": r.errors,
                 "warnings": r.warnings,
+                "waived": r.waived,
                 "unreadable": [{"file": u.file, "line": u.line, "message": u.message} for u in r.unreadable],
                 "notices": [
                     {"kind": n.kind, "severity": n.severity, "message": n.message, "data": to_json_data(n.data)}
@@ -298,6 +333,7 @@ def json_document(message: Message, reports: list[FileReport]) -> dict[str, obje
                         "limit": to_json_data(f.limit),
                         "message": f.message,
                         "severity": f.severity,
+                        "waived": f.waived or None,
                     }
                     for f in r.findings
                 ],
@@ -335,7 +371,11 @@ def default_message(schema: Schema, files: list[str], kind: str | None) -> str:
 
 
 def make_checker(
-    schema_dir: Path, message_name: str | None, files: list[str] | None = None, kind: str | None = None
+    schema_dir: Path,
+    message_name: str | None,
+    files: list[str] | None = None,
+    kind: str | None = None,
+    vehicle: str | None = None,
 ) -> tuple[Message, Checker]:
     """Load the schemas, resolve the message (or the inputs' default one) and its generated class."""
     schema = load([schema_dir])
@@ -344,4 +384,5 @@ def make_checker(
     message = resolve_message(schema, message_name)
     package = model_package(schema, schema_dir)
     cls = model_class(package, message)
-    return message, Checker(cls, message, data_error(package), rule_fields(schema, message), extra_check(message))
+    extra = extra_check(message)
+    return message, Checker(cls, message, data_error(package), rule_fields(schema, message), extra, vehicle)

@@ -1,22 +1,32 @@
-"""``battgen failsafe --params FILE STREAM``: replay battery samples through the failsafe evaluator.
+"""``battgen failsafe [--params FILE] [--vehicle NAME] STREAM``: replay batteries through ArduPilot's failsafe.
 
-STREAM is JSON Lines, one sample a line (``-`` is not accepted: a file is read)::
+STREAM is a flight log or a JSON Lines file of samples, told apart by content (then extension):
+
+- PX4 ULog (``.ulg``): battery_status (every multi_id) and vehicle_status.arming_state;
+- MAVLink telemetry log (``.tlog``): BATTERY_STATUS (or SYS_STATUS) and the autopilot's HEARTBEAT
+  armed flag;
+- ArduPilot DataFlash log (``.bin``): BAT records, ARM/EV arming, and the log's own PARM records as
+  the parameters when ``--params`` is not given;
+- JSON Lines, one sample a line::
 
     {"t": 0.0, "armed": true, "message": "uorb.BatteryStatus", "data": {"voltage_v": 11.9, "current_a": 2.1}}
-    {"t": 1.0, "armed": true, "message": "BATTERY_STATUS", "data": {"voltages": [10400, 65535, ...]}}
-    {"t": 2.0, "armed": true, "battery": {"voltage_v": 10.4, "current_a": 2.0}, "distance_to_home_m": 350}
+    {"t": 1.0, "armed": true, "instance": 2, "battery": {"voltage_v": 10.4, "current_a": 2.0}}
 
-``t`` seconds (never going back) and ``armed`` are required. The battery is a message of any
-bundled format (``message`` by qualified or short name, or ``--message`` for the whole stream,
-with its ``data``) or ``battery``: SI values (voltage_v, current_a, consumed_mah, remaining_mah).
-Optional: ``distance_to_home_m``, ``travelled_m`` (odometer), ``home_set``, ``position_fix``.
-The parameters come from a .param / .params file (BATT_* names; others ignored).
+  ``t`` seconds (never going back) and ``armed`` are required; ``instance`` is the battery (1-based,
+  default: the message's id, else 1). The battery is a message of any bundled format (``message``, or
+  ``--message`` for the whole stream, with its ``data``) or ``battery``: SI values (voltage_v,
+  current_a, consumed_mah, remaining_mah). Optional: ``distance_to_home_m``, ``travelled_m``,
+  ``home_set``, ``position_fix``.
 
-Prints one line per transition: time, level, cause, value, threshold, action and outcome, the
-operator text, and the uORB ``warning`` / MAVLink ``charge_state`` values for the level.
-``--json`` prints JSON Lines instead, each event with the converted message (when the sample was a
-uORB battery_status or MAVLink BATTERY_STATUS) carrying the level. Exit 0 always, 2 when the
-parameter file or the stream cannot be read.
+The parameters (``--params``: ArduPilot .param/.parm/.params, QGroundControl .params) give every
+battery's BATT_, BATT2_ .. BATT9_, BATTA_ .. BATTG_ settings. The vehicle (``--vehicle``) decides
+what an action code means, its priority and its fallbacks; without it, it is detected from
+parameters only one vehicle has, else rover is assumed (said on stderr either way).
+
+Semantics are ArduPilot's AP_BattMonitor (see the README's failsafe section); ``--variant
+seed-critical`` and ``--variant distance`` turn on the seed's own choices. Prints one line per
+transition (``--json``: one JSON object per line). Exit 0; 1 when the parameters hold no BATT*_
+one (``--allow-empty`` accepts that); 2 when an input cannot be read or holds no battery reading.
 """
 
 from __future__ import annotations
@@ -27,90 +37,136 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..apps.failsafe.evaluator import BatteryFailsafe, Event
-from ..apps.failsafe.levels import Level, apply_level
-from ..apps.failsafe.stream import Replay, Sample, open_reader, read_failsafe_params
+from ..apps.failsafe.distance import DistanceRule
+from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
+from ..apps.failsafe.levels import apply_level
+from ..apps.failsafe.logs import bin_parameters, log_kind, read_log
+from ..apps.failsafe.settings import battery_settings
+from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
+from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
 from ..errors import BattgenError
+from ..inputs import parameter_files
 
-EXIT_OK, EXIT_UNREADABLE = 0, 2
+EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE = 0, 1, 2
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "failsafe",
-        help="replay a JSON Lines stream of battery samples through the battery failsafe",
+        help="replay a flight log (.ulg, .tlog, .bin) or JSON Lines samples through ArduPilot's battery failsafe",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("stream", help="JSON Lines file of battery samples")
-    p.add_argument("--params", required=True, help="a .param / .params file with the BATT_* parameters")
+    p.add_argument("stream", help=".ulg, .tlog, .bin or a JSON Lines file of battery samples")
+    p.add_argument("--params", help="parameter file with the BATT*_ parameters (a .bin's own PARM records otherwise)")
+    p.add_argument("--vehicle", choices=sorted(VEHICLES), help="ArduPilot vehicle (default: detected, else rover)")
+    p.add_argument("--variant", action="append", choices=sorted(VARIANTS), default=[], help="a seed variant (opt-in)")
+    p.add_argument(
+        "--allow-empty", action="store_true", help="parameters without any BATT*_ one are not an error (exit 1)"
+    )
     p.add_argument("--message", help="message of samples that name none (e.g. uorb.BatteryStatus)")
     p.add_argument("--schemas", help="schema folder the messages come from (default: the bundled schemas/)")
-    p.add_argument("--no-home", action="store_true", help="no home position is set (RTL falls back to Hold)")
-    p.add_argument("--no-fix", action="store_true", help="no position fix (RTL falls back to Hold)")
+    p.add_argument("--no-home", action="store_true", help="no home position is set (RTL falls back)")
+    p.add_argument("--no-fix", action="store_true", help="no position fix (RTL falls back)")
     p.add_argument("--no-smartrtl", action="store_true", help="no SmartRTL path recorded")
-    p.add_argument("--margin", type=float, default=1.3, help="safety margin of the distance rule (1.3)")
-    p.add_argument("--rate", type=float, help="consumption in mAh per metre until one is learned")
+    p.add_argument("--quadplane", choices=("yes", "no"), help="plane: a QuadPlane is available (default: Q_ENABLE)")
+    p.add_argument("--landing-sequence", action="store_true", help="the mission holds a DO_LAND_START sequence")
+    p.add_argument("--margin", type=float, default=1.3, help="distance variant: safety margin (1.3)")
+    p.add_argument("--rate", type=float, help="distance variant: consumption in mAh per metre until one is learned")
     p.add_argument("--json", action="store_true", help="print events as JSON Lines")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    stream = Path(args.stream)
     try:
-        params = read_failsafe_params(Path(args.params))
-        reader = open_reader(Path(args.schemas) if args.schemas else None, args.message)
-        fs = BatteryFailsafe(
-            params,
+        kind = log_kind(stream) if stream.suffix.lower() not in (".jsonl", ".ndjson", ".json") else None
+        if args.params:
+            values: dict[str, float] = read_parameter_values(Path(args.params))
+            where = args.params
+            for repeat in parameter_files.repeats(parameter_files.load(Path(args.params))):
+                print(f"battgen: warning: {args.params}:{repeat.lines[-1]}: {repeat.message()}", file=sys.stderr)
+        elif kind == "bin":
+            values, where = bin_parameters(stream), f"{args.stream} (PARM records)"
+        else:
+            raise BattgenError("expected --params FILE (only a DataFlash .bin log carries its own parameters)")
+        if args.params and not batt_parameter_count(values) and not args.allow_empty:
+            print(
+                f"{where}: no BATT*_ parameter ({len(values)} parameters read): the failsafe would run on "
+                "defaults alone (--allow-empty accepts that)",
+                file=sys.stderr,
+            )
+            return EXIT_EMPTY
+        detection = detect_vehicle(values, args.vehicle)
+        vehicle = detection.vehicle
+        settings = battery_settings(values, vehicle)
+        quadplane = args.quadplane == "yes" if args.quadplane else values.get("Q_ENABLE", 0) == 1
+        situation = Situation(
             home_set=not args.no_home,
             position_fix=not args.no_fix,
             smart_rtl_ready=not args.no_smartrtl,
-            margin=args.margin,
-            consumption_mah_per_m=args.rate,
+            quadplane=quadplane,
+            landing_sequence=args.landing_sequence,
         )
+        fs = make_failsafe(
+            settings,
+            vehicle,
+            situation=situation,
+            variants=args.variant,
+            distance_rule=DistanceRule(margin=args.margin, consumption_mah_per_m=args.rate),
+        )
+        print(f"battgen: vehicle {detection.how}; parameters from {where}", file=sys.stderr)
+        for variant in args.variant:
+            print(f"battgen: variant {variant}: {VARIANTS[variant]}", file=sys.stderr)
+        reader = open_reader(Path(args.schemas) if args.schemas else None, args.message)
         replay = Replay(fs, reader)
-        for event, sample in replay.run(Path(args.stream), args.stream):
-            print(_json(event, sample) if args.json else _line(event, sample))
-    except BattgenError as exc:
+        samples = read_log(stream, kind) if kind else None
+        for event, sample in replay.run(stream, args.stream, samples):
+            print(_json(event, sample, vehicle.name) if args.json else _line(event, sample))
+        if replay.samples == 0:
+            raise BattgenError(f"{args.stream}: expected battery readings, found none")
+    except (BattgenError, ValueError) as exc:
         print(f"battgen: {exc}", file=sys.stderr)
         return EXIT_UNREADABLE
-    if not args.json:
-        print(f"{replay.samples} samples, {len(fs.events)} events, final level {fs.level.name}", file=sys.stderr)
+    print(f"{replay.samples} samples, {len(fs.events)} events, final level {fs.level.name}", file=sys.stderr)
     return EXIT_OK
 
 
-def _num(value: float | None, unit: str) -> str:
-    if value is None:
-        return "-"
+def _num(value: float, unit: str) -> str:
     return f"{value:.0f}{unit}" if unit == "mAh" else f"{value:.2f}{unit}"
 
 
 def _line(e: Event, s: Sample) -> str:
-    unit = "V" if e.cause.value == "voltage" else "mAh"
-    detail = (
-        f"{e.level.name:<8} {e.cause.value:<9} value={_num(e.value, unit)} threshold={_num(e.threshold, unit)} "
-        f"action={e.action.name} -> {e.outcome.value}"
-    )
-    if e.level is Level.NONE:
-        detail = f"{e.level.name:<8} {e.cause.value:<9}"
+    unit = "V" if e.cause == "voltage" else "mAh"
+    run_ = f"-> {e.outcome}" if e.executed else f"not run (priority {e.priority} is below one already run)"
     return (
-        f't={e.time:10.3f}s  {detail}  "{e.text}"  uorb.warning={e.uorb_warning} '
-        f"mavlink.charge_state={e.mavlink_charge_state}  (line {s.line})"
+        f"t={e.time:10.3f}s  battery {e.battery} {e.level.name:<8} {e.cause:<8} value={_num(e.value, unit)} "
+        f"threshold={_num(e.threshold, unit)} action={e.action} ({e.action_code}) {run_}  "
+        f'"{e.ardupilot_text}"  seed: "{e.text}"  uorb.warning={e.uorb_warning} '
+        f"mavlink.charge_state={e.mavlink_charge_state}  ({s.place})"
     )
 
 
-def _json(e: Event, s: Sample) -> str:
+def _json(e: Event, s: Sample, vehicle: str) -> str:
     out: dict[str, Any] = {
         "t": e.time,
-        "line": s.line,
+        "battery": e.battery,
         "level": e.level.name,
-        "cause": e.cause.value,
+        "cause": e.cause,
         "value": e.value,
         "threshold": e.threshold,
-        "action": e.action.name,
-        "outcome": e.outcome.value,
-        "text": e.text,
+        "action": e.action,
+        "action_code": e.action_code,
+        "executed": e.executed,
+        "outcome": e.outcome,
+        "priority": e.priority,
+        "vehicle": vehicle,
+        "voltage_source": e.voltage_source,
+        "seed_text": e.text,
+        "ardupilot_text": e.ardupilot_text,
         "uorb_warning": e.uorb_warning,
         "mavlink_charge_state": e.mavlink_charge_state,
+        "where": s.place,
     }
     if s.message is not None and s.data is not None:
         out["message"] = s.message

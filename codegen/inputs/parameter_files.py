@@ -1,10 +1,16 @@
-"""Parameter files as users have them: ArduPilot / Mission Planner ``.param`` and QGroundControl ``.params``.
+"""Parameter files as users have them, told apart by their content (never the extension alone).
 
-``.param``: one ``NAME,VALUE`` or ``NAME VALUE`` a line; ``#`` starts a comment (also after a value).
-``.params`` (QGC): ``#`` comment lines, then tab-separated ``vehicle-id component-id NAME VALUE TYPE``
-with TYPE a MAV_PARAM_TYPE (9 = REAL32, 2 = INT8, ...). Values are read as int when written as an
-integer (or 0x hex, as pymavlink's mavparm reads them), else float; NaN and infinities are refused.
-Every error names file and line and says what was expected.
+- ArduPilot layout: one ``NAME,VALUE`` (Mission Planner ``.param``, ArduPilot's own
+  ``Tools/Frame_params/*.param`` and comma-separated ``.params``) or ``NAME VALUE`` (MAVProxy
+  ``.parm``, spaces or tabs) a line; ``#`` starts a comment (also after a value).
+- QGroundControl layout: ``#`` comment lines, then tab-separated ``vehicle-id component-id NAME VALUE
+  TYPE`` with TYPE a MAV_PARAM_TYPE (9 = REAL32, 2 = INT8, ...).
+
+The layout is the QGC one when the first data line starts with two decimal ids, else ArduPilot's.
+CRLF line ends and a UTF-8 byte-order mark are fine. A parameter written twice keeps its last
+value, as loading the file into a vehicle would (:func:`repeats` lists them, for a warning). Values
+are read as int when written as an integer (or 0x hex, as pymavlink's mavparm reads them), else
+float; NaN and infinities are refused. Every error names file and line and says what was expected.
 """
 
 from __future__ import annotations
@@ -54,29 +60,64 @@ def is_parameter_file(path: Path) -> bool:
     return path.suffix.lower() in QGC_SUFFIXES + ARDUPILOT_SUFFIXES
 
 
+_QGC_START = re.compile(r"\s*[0-9]+\s+[0-9]+\s")
+
+
+def is_qgc_text(lines: Sequence[str]) -> bool:
+    """The QGroundControl layout: the first data line starts with vehicle and component ids."""
+    for line in lines:
+        body = line.strip()
+        if body and not body.startswith("#"):
+            return bool(_QGC_START.match(line))
+    return False
+
+
 def parse_text(text: str, display: str, *, qgc: bool | None = None) -> list[ParamEntry]:
-    """Entries in file order. ``qgc`` None: QGC when a data line has five tab-separated columns."""
+    """Entries in file order, a repeated parameter at each of its lines (the last one counts).
+    ``qgc`` None: the layout from the content (:func:`is_qgc_text`)."""
     lines = text.splitlines()
     if qgc is None:
-        qgc = any(len(ln.split("\t")) == 5 for ln in lines if ln.strip() and not ln.lstrip().startswith("#"))
+        qgc = is_qgc_text(lines)
     entries: list[ParamEntry] = []
-    seen: dict[tuple[int | None, int | None, str], int] = {}
     for number, raw in enumerate(lines, start=1):
         entry = _qgc_line(raw, display, number) if qgc else _ardupilot_line(raw, display, number)
-        if entry is None:
-            continue
-        key = (entry.vehicle, entry.component, entry.name)
-        if key in seen:
-            raise ParameterFileError(
-                display, number, f"expected each parameter once: {entry.name} is also at line {seen[key]}"
-            )
-        seen[key] = number
-        entries.append(entry)
+        if entry is not None:
+            entries.append(entry)
     return entries
 
 
+@dataclass(frozen=True)
+class Repeat:
+    """A parameter written more than once in one set: the value at its last line is loaded."""
+
+    name: str
+    lines: tuple[int, ...]
+    values: tuple[Value, ...]
+    vehicle: int | None = None
+    component: int | None = None
+
+    def message(self) -> str:
+        at = ", ".join(str(n) for n in self.lines)
+        return (
+            f"{self.name} is set {len(self.lines)} times (lines {at}): the last value, "
+            f"{format_value(self.values[-1])}, is the one a vehicle loads"
+        )
+
+
+def repeats(entries: Iterable[ParamEntry]) -> list[Repeat]:
+    """The parameters written more than once in a set, in order of their first line."""
+    seen: dict[tuple[int | None, int | None, str], list[ParamEntry]] = {}
+    for e in entries:
+        seen.setdefault((e.vehicle, e.component, e.name), []).append(e)
+    return [
+        Repeat(name, tuple(e.line for e in group), tuple(e.value for e in group), vehicle, component)
+        for (vehicle, component, name), group in seen.items()
+        if len(group) > 1
+    ]
+
+
 def load(path: Path, display: str | None = None) -> list[ParamEntry]:
-    """Read a .param / .params file (format from the extension, else sniffed)."""
+    """Read a parameter file of either layout (told from the content)."""
     shown = display or path.as_posix()
     try:
         data = path.read_bytes()
@@ -86,9 +127,7 @@ def load(path: Path, display: str | None = None) -> list[ParamEntry]:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise ParameterFileError(shown, data[: exc.start].count(b"\n") + 1, "expected UTF-8 text") from None
-    suffix = path.suffix.lower()
-    qgc = True if suffix in QGC_SUFFIXES else False if suffix in ARDUPILOT_SUFFIXES else None
-    return parse_text(text, shown, qgc=qgc)
+    return parse_text(text, shown)
 
 
 def sets(entries: Iterable[ParamEntry]) -> dict[tuple[int | None, int | None], list[ParamEntry]]:
@@ -101,7 +140,8 @@ def sets(entries: Iterable[ParamEntry]) -> dict[tuple[int | None, int | None], l
 
 
 def value_sets(entries: Iterable[ParamEntry]) -> list[tuple[int, dict[str, Value]]]:
-    """One item per parameter set (see :func:`sets`): ``(line of its first parameter, {NAME: value})``."""
+    """One item per parameter set (see :func:`sets`): ``(line of its first parameter, {NAME: value})``;
+    a repeated parameter has its last value."""
     return [(group[0].line, {e.name: e.value for e in group}) for group in sets(entries).values()]
 
 

@@ -9,7 +9,8 @@ import pytest
 
 from codegen.cli.main import main
 
-PARAMS = "BATT_LOW_VOLT,10.5\nBATT_CRT_VOLT,10.0\nBATT_FS_LOW_ACT,2\nBATT_FS_CRT_ACT,1\n"
+# a Rover's 3S pack: LOW 10.5 V -> 1 (RTL on Rover), CRITICAL 10.0 V -> 2 (Hold on Rover)
+PARAMS = "BATT_LOW_VOLT,10.5\nBATT_CRT_VOLT,10.0\nBATT_FS_LOW_ACT,1\nBATT_FS_CRT_ACT,2\n"
 DTS = """/dts-v1/;
 / {
 \tbattery: battery {
@@ -43,18 +44,24 @@ def write_stream(path: Path, rows: list[dict[str, object]]) -> Path:
 def files(tmp_path: Path) -> tuple[Path, Path]:
     params = tmp_path / "fs.param"
     params.write_text(PARAMS, encoding="utf-8")
-    rows = [sample(t, 11.5 if t < 5 else 10.4 if t < 25 else 9.8) for t in range(30)]
+    rows = [sample(t, 11.5 if t < 5 else 10.4 if t < 25 else 9.8) for t in range(40)]
     return params, write_stream(tmp_path / "s.jsonl", rows)
 
 
 def test_timeline_from_mixed_formats(files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
     params, stream = files
     assert main(["failsafe", "--params", str(params), str(stream)]) == 0
-    out = capsys.readouterr().out.splitlines()
+    captured = capsys.readouterr()
+    out = captured.out.splitlines()
     assert len(out) == 2
-    assert out[0].startswith("t=    15.000s  LOW ") and '"Battery LOW: 10.4V"' in out[0] and "-> rtl" in out[0]
+    # below 10.5 V from t = 5: LOW once more than BATT_LOW_TIMER (10 s) has passed, at t = 16
+    assert out[0].startswith("t=    16.000s  battery 1 LOW ") and "action=RTL (1) -> rtl" in out[0]
+    assert '"Battery 1 is low 10.40V used 0 mAh"' in out[0] and 'seed: "Battery LOW: 10.4V"' in out[0]
     assert "uorb.warning=1 mavlink.charge_state=2" in out[0]
-    assert '"Battery CRITICAL: 9.8V"' in out[1] and "-> hold" in out[1] and "(line 26)" in out[1]
+    # below 10.0 V from t = 25: CRITICAL timed too, at t = 36; Hold outranks RTL, so it runs
+    assert out[1].startswith("t=    36.000s  battery 1 CRITICAL") and "action=Hold (2) -> hold" in out[1]
+    assert '"Battery 1 is critical 9.80V used 0 mAh"' in out[1] and "(line 37)" in out[1]
+    assert "vehicle rover (assumed: no parameter only one vehicle has; give --vehicle)" in captured.err
 
 
 def test_json_events_carry_the_level_in_the_converted_message(
@@ -63,8 +70,15 @@ def test_json_events_carry_the_level_in_the_converted_message(
     params, stream = files
     assert main(["failsafe", "--params", str(params), "--no-home", "--json", str(stream)]) == 0
     low, crit = (json.loads(line) for line in capsys.readouterr().out.splitlines())
-    assert (low["t"], low["outcome"], low["message"], low["data"]["warning"]) == (15.0, "hold", "uorb.BatteryStatus", 1)
-    assert (crit["message"], crit["data"]["charge_state"]) == ("mavlink.BATTERY_STATUS", 3)
+    assert {k: low[k] for k in ("t", "battery", "level", "cause", "value", "threshold")} == {
+        "t": 16.0, "battery": 1, "level": "LOW", "cause": "voltage", "value": 10.4, "threshold": 10.5
+    }  # fmt: skip
+    assert (low["action"], low["action_code"], low["executed"], low["outcome"]) == ("RTL", 1, True, "hold")
+    assert (low["seed_text"], low["ardupilot_text"]) == ("Battery LOW: 10.4V", "Battery 1 is low 10.40V used 0 mAh")
+    # t = 16 was a MAVLink BATTERY_STATUS, t = 36 a uORB battery_status: each comes back with the level
+    assert (low["message"], low["data"]["charge_state"]) == ("mavlink.BATTERY_STATUS", low["mavlink_charge_state"])
+    assert (crit["t"], crit["message"], crit["data"]["warning"]) == (36.0, "uorb.BatteryStatus", crit["uorb_warning"])
+    assert crit["mavlink_charge_state"] == 3 and crit["executed"] and crit["outcome"] == "hold"
 
 
 @pytest.mark.parametrize(
@@ -76,7 +90,8 @@ def test_json_events_carry_the_level_in_the_converted_message(
         ('{"t": 1, "armed": true, "data": {}}', 's.jsonl:2: expected "message"'),
         ('{"t": 1, "armed": true, "message": "NoSuch", "data": {}}', "s.jsonl:2: no message called 'NoSuch'"),
         ('{"t": 1, "armed": true, "message": "uorb.BatteryStatus", "data": {"voltage_v": "x"}}', "voltage_v"),
-        ('{"t": 0.5, "armed": true, "battery": {}}', "s.jsonl:2: expected sample times that never go back"),
+        ('{"t": 0.5, "armed": true, "battery": {}}', "s.jsonl: line 2: expected sample times that never go back"),
+        ('{"t": 2, "armed": true, "instance": 17, "battery": {}}', 's.jsonl:2: expected "instance": a battery number'),
     ],
 )
 def test_unreadable_stream_exits_2(
@@ -117,11 +132,16 @@ def test_params_from_devicetree_writes_commented_param_file(tmp_path: Path, caps
 
 def test_params_check_reports_lines(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "v.param"
-    path.write_text("BATT_LOW_VOLT,10.5\nBATT_CRT_VOLT,11\nBATT_LOW_TIMER,200\nGPS_TYPE,1\n", encoding="utf-8")
+    path.write_text(
+        "BATT_LOW_VOLT,10.5\nBATT_CRT_VOLT,11\nBATT_LOW_TIMER,200\nGPS_TYPE,1\nBATT2_FS_LOW_ACT,6\n", encoding="utf-8"
+    )
     assert main(["params", "--check", str(path)]) == 1
     out = capsys.readouterr().out
-    assert f"{path.as_posix()}:3: error: BATT_LOW_TIMER is 200: expected 0 to 120" in out
-    assert f"{path.as_posix()}:2: error: BATT_CRT_VOLT (11 V) must be below BATT_LOW_VOLT (10.5 V)" in out
+    assert f"{path.as_posix()}:3: error: BATT_LOW_TIMER = 200 s does not fit int8" in out  # AP_Int8
+    assert f"{path.as_posix()}:2: warning: BATT_CRT_VOLT (11 V) is not below BATT_LOW_VOLT (10.5 V)" in out
+    assert f"{path.as_posix()}:5: error: BATT2_FS_LOW_ACT = 6 is no rover action" in out
+    assert main(["params", "--check", str(path), "--vehicle", "copter"]) == 1  # 6 is Copter's; the timer is not
+    assert "BATT2_FS_LOW_ACT" not in capsys.readouterr().out
 
 
 def test_params_from_devicetree_without_battery(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -129,3 +149,15 @@ def test_params_from_devicetree_without_battery(tmp_path: Path, capsys: pytest.C
     dts.write_text("/dts-v1/;\n/ {\n};\n", encoding="utf-8")
     assert main(["params", "--from-devicetree", str(dts)]) == 2
     assert 'expected a compatible = "simple-battery" node' in capsys.readouterr().err
+
+
+def test_repeated_parameter_warns_and_the_last_value_counts(
+    tmp_path: Path, files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, stream = files
+    params = tmp_path / "twice.param"
+    params.write_text("BATT_LOW_VOLT,9\r\nBATT_FS_LOW_ACT,2\r\nBATT_LOW_VOLT,10.5\r\n", encoding="utf-8")
+    assert main(["failsafe", "--params", str(params), str(stream)]) == 0
+    captured = capsys.readouterr()
+    assert "twice.param:3: BATT_LOW_VOLT is set 2 times (lines 1, 3): the last value, 10.5" in captured.err
+    assert captured.out.startswith("t=    16.000s  battery 1 LOW ")  # 10.5 V, not 9 V

@@ -43,11 +43,13 @@ def test_param_file_violations_point_at_parameter_lines(capsys: pytest.CaptureFi
     assert code == 1
     by_line = {int(line.split(":")[1]): line for line in lines}
     assert set(by_line) == {5, 6, 7}, lines
-    assert "BATT_CRT_VOLT" in by_line[5] and "minimum 0" in by_line[5]
-    assert "not below BATT_CAPACITY" in by_line[6]  # a cross-field finding of apps/failsafe/checks.py
-    assert "BATT_FS_LOW_ACT" in by_line[7]
-    assert len(lines) == 3  # BATT_CRT_VOLT = -1 once: the range covers check_settings' "negative" rule
-    assert "params.BATT: 1 record in 1 file, 3 errors" in err
+    # ArduPilot treats a negative threshold as off, and flies with a LOW_MAH above the capacity:
+    # warnings; 9 is no Rover action: an error
+    assert "warning: BATT_CRT_VOLT is -1: ArduPilot treats a negative value as 0 (off)" in by_line[5]
+    assert "warning: BATT_LOW_MAH (4000 mAh) is not below BATT_CAPACITY" in by_line[6]
+    assert "BATT_FS_LOW_ACT = 9 is no rover action" in by_line[7] and "warning" not in by_line[7]
+    assert len(lines) == 3
+    assert "params.BATT: 1 record in 1 file, 1 error, 2 warnings" in err
 
 
 def test_negative_threshold_without_a_schema_range_comes_from_check_params(
@@ -56,9 +58,10 @@ def test_negative_threshold_without_a_schema_range_comes_from_check_params(
     path = tmp_path / "neg.param"
     path.write_text("BATT_CAPACITY 3300\nBATT_CRT_MAH -5\n", encoding="utf-8")
     code, doc = run_json(capsys, "--message", "params.BATT", str(path))
-    assert code == 1
+    assert code == 0  # a warning
     [violation] = doc["files"][0]["violations"]
     assert (violation["line"], violation["path"], violation["rule"]) == (2, "BATT_CRT_MAH", "cross-field:failsafe")
+    assert violation["severity"] == "warning"
 
 
 def test_mavproxy_style_float_values_fit_integer_parameters(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
@@ -89,9 +92,9 @@ def test_file_without_the_message_parameters_is_a_notice(capsys: pytest.CaptureF
     path = tmp_path / "other.param"
     path.write_text("ARMING_CHECK,1\nSERIAL0_BAUD,115\n", encoding="utf-8")
     code, lines, err = run(capsys, str(path))
-    assert (code, lines) == (0, [])
+    assert (code, lines) == (1, [])  # a parameter file without the parameters asked for is not a pass
     assert "warning: no parameter of params.BATT in this file (2 parameters read)" in err
-    assert "0 records" in err
+    assert "0 records" in err and "no params.BATT records in this file" in err
 
 
 def test_malformed_param_file_exits_2_naming_file_and_line(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
@@ -125,4 +128,16 @@ def test_json_params_records_get_the_cross_field_checks_too(capsys: pytest.Captu
     path = tmp_path / "p.json"
     path.write_text(json.dumps({"BATT_LOW_VOLT": 10.0, "BATT_CRT_VOLT": 10.5}), encoding="utf-8")
     code, lines, _ = run(capsys, "--message", "params.BATT", str(path))
-    assert code == 1 and len(lines) == 1 and "must be below BATT_LOW_VOLT" in lines[0]
+    assert code == 0 and len(lines) == 1 and "warning: BATT_CRT_VOLT (10.5 V) is not below BATT_LOW_VOLT" in lines[0]
+
+
+def test_vehicle_decides_the_action_codes(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    path = tmp_path / "copter.param"
+    path.write_text("BATT_FS_LOW_ACT,6\nBATT2_FS_CRT_ACT,6\nBATT2_LOW_VOLT,10.5\n", encoding="utf-8")
+    code, lines, _ = run(capsys, str(path))  # rover assumed: 6 is none of its actions
+    assert code == 1 and [line.split(":")[1] for line in lines] == ["1", "2"]
+    assert "BATT2_FS_CRT_ACT = 6 is no rover action" in lines[1]
+    assert run(capsys, "--vehicle", "copter", str(path))[0] == 0  # Auto DO_LAND_START or RTL
+    path.write_text("RTL_ALT,1500\nBATT_FS_LOW_ACT,6\n", encoding="utf-8")  # RTL_ALT: only Copter has it
+    assert run(capsys, str(path))[0] == 0
+    assert run(capsys, "--vehicle", "sub", str(path))[0] == 1

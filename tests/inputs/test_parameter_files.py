@@ -66,9 +66,8 @@ def test_round_trip_and_select(tmp_path: Path) -> None:
         ("a.param", "BATT_LOW_VOLT,ten\n", 1, "expected a number as the value"),
         ("a.param", "\nBATT_LOW_VOLT,nan\n", 2, "expected a finite number"),
         ("a.param", "BATT-LOW,1\n", 1, "expected a parameter name"),
-        ("a.param", "BATT_A,1\nBATT_A,2\n", 2, "expected each parameter once: BATT_A is also at line 1"),
         ("v.params", "# x\n1\t1\tBATT_A\t1\n", 2, "expected 5 tab-separated columns"),
-        ("v.params", "1\tx\tBATT_A\t1\t9\n", 1, "expected a decimal component id"),
+        ("v.params", "1\t1\tBATT_A\t1\t9\n1\tx\tBATT_B\t1\t9\n", 2, "expected a decimal component id"),
         ("v.params", "1\t1\tBATT_A\t1\t11\n", 1, "expected a MAV_PARAM_TYPE from 1 to 10"),
         ("v.params", "1\t1\tBATT_A\t1.5\t6\n", 1, "expected an integer value"),
     ],
@@ -98,17 +97,26 @@ def test_cross_field_rules() -> None:
     ok = {"BATT_CAPACITY": 3300, "BATT_LOW_VOLT": 10.5, "BATT_CRT_VOLT": 10.0, "BATT_LOW_MAH": 660, "BATT_CRT_MAH": 330}
     assert findings(ok) == [] and findings(ok, cells=3) == []
     assert findings({}) == []  # everything 0: disabled, nothing to say
-    assert findings({**ok, "BATT_CRT_VOLT": 10.5}) == [("error", "BATT_CRT_VOLT")]
-    assert findings({**ok, "BATT_CRT_MAH": 700}) == [("error", "BATT_CRT_MAH")]
-    assert findings({**ok, "BATT_CAPACITY": 0}) == [("error", "BATT_LOW_MAH"), ("error", "BATT_CRT_MAH")]
-    assert findings({**ok, "BATT_LOW_MAH": 4000, "BATT_CRT_MAH": 0}) == [("error", "BATT_LOW_MAH")]
-    assert findings({**ok, "BATT_LOW_MAH": -1, "BATT_CRT_MAH": 0}) == [("error", "BATT_LOW_MAH")]
+    # plausibility is a warning: ArduPilot flies with it (only its arming check objects to LOW < CRT)
+    assert findings({**ok, "BATT_CRT_VOLT": 10.5}) == [("warning", "BATT_CRT_VOLT")]
+    assert findings({**ok, "BATT_CRT_MAH": 700}) == [("warning", "BATT_CRT_MAH")]
+    assert findings({**ok, "BATT_CAPACITY": 0}) == [("warning", "BATT_LOW_MAH"), ("warning", "BATT_CRT_MAH")]
+    assert findings({**ok, "BATT_LOW_MAH": 4000, "BATT_CRT_MAH": 0}) == [("warning", "BATT_LOW_MAH")]
+    assert findings({**ok, "BATT_LOW_MAH": -1, "BATT_CRT_MAH": 0}) == [("warning", "BATT_LOW_MAH")]
+    assert findings({**ok, "BATT_LOW_TIMER": 0}) == [("warning", "BATT_LOW_TIMER")]  # disables the voltage checks
     # a 3S threshold on a 4S pack: 2.63 V per cell
     assert findings(ok, cells=4) == [("warning", "BATT_LOW_VOLT"), ("warning", "BATT_CRT_VOLT")]
     assert findings({"BATT_LOW_VOLT": 12.0}, cells=3, chemistry="life") == [("warning", "BATT_LOW_VOLT")]
     # no cell count puts 5 V and 4.5 V within 3.0..4.35 V per cell at once
     assert findings({"BATT_LOW_VOLT": 5.0, "BATT_CRT_VOLT": 4.5}) == [("warning", "BATT_LOW_VOLT")]
     assert findings({**ok, "BATT_ARM_VOLT": 10.4}) == [("warning", "BATT_ARM_VOLT")]
+    # errors: what ArduPilot cannot act on, for every battery
+    assert findings({"BATT2_FS_LOW_ACT": 7, "BATT3_FS_VOLTSRC": 2, "BATTG_LOW_TIMER": 200}) == [
+        ("error", "BATT2_FS_LOW_ACT"),
+        ("error", "BATT3_FS_VOLTSRC"),
+        ("error", "BATTG_LOW_TIMER"),
+    ]
+    assert findings({"BATT5_LOW_VOLT": 10.0, "BATT5_CRT_VOLT": 10.2}) == [("warning", "BATT5_CRT_VOLT")]
     with pytest.raises(ValueError, match="expected a chemistry"):
         check_settings(ok, chemistry="coal")
 
@@ -118,7 +126,28 @@ def test_check_file_reports_parameter_lines(tmp_path: Path) -> None:
     path.write_text("BATT_LOW_VOLT,10.5\n# note\nBATT_CRT_VOLT,11\n", encoding="utf-8")
     [(file, line, finding)] = check_file(path)
     assert (file, line, finding.param) == (path.as_posix(), 3, "BATT_CRT_VOLT")
-    assert "must be below BATT_LOW_VOLT" in finding.message
+    assert "is not below BATT_LOW_VOLT" in finding.message
+
+
+def test_repeated_parameter_keeps_its_last_value(tmp_path: Path) -> None:
+    path = tmp_path / "r.param"
+    path.write_text("BATT_A,1\nBATT_B,5\r\nBATT_A,2\n", encoding="utf-8")
+    assert list(parameter_files.read_parameter_file(path)) == [(1, {"BATT_A": 2, "BATT_B": 5})]
+    [repeat] = parameter_files.repeats(parameter_files.load(path))
+    assert (repeat.name, repeat.lines, repeat.values) == ("BATT_A", (1, 3), (1, 2))
+    assert repeat.message() == "BATT_A is set 2 times (lines 1, 3): the last value, 2, is the one a vehicle loads"
+
+
+def test_layout_from_content_not_extension(tmp_path: Path) -> None:
+    comma = tmp_path / "ardupilot.params"  # ArduPilot's own .params files are comma-separated
+    comma.write_text("BATT_LOW_VOLT,10.5\nBATT_CAPACITY,3300\n", encoding="utf-8")
+    qgc = tmp_path / "qgc.param"
+    qgc.write_text(QGC, encoding="utf-8")
+    assert list(parameter_files.read_parameter_file(comma)) == [(1, {"BATT_LOW_VOLT": 10.5, "BATT_CAPACITY": 3300})]
+    assert next(values for _, values in parameter_files.read_parameter_file(qgc)) == {
+        "BATT_CAPACITY": 3300,
+        "BATT_LOW_VOLT": 10.5,
+    }
 
 
 TABLE = [[4200000, 100], [3750000, 20], [3680000, 10], [3300000, 0]]

@@ -23,7 +23,8 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import math
-from collections.abc import Iterator, Mapping
+import re
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -39,7 +40,8 @@ from ...ir import Schema
 from ..convert import ConvertModule
 from ..messages import resolve_message
 from ..package import bundled_schemas, model_class, model_package
-from .evaluator import BatteryFailsafe, BatteryReading, Event, FailsafeSettings, reading_of
+from .evaluator import BatteryFailsafe, Event
+from .reading import BatteryReading, reading_of
 
 # which field carries what, per message (units come from the IR metadata)
 ROLES: dict[str, dict[str, str]] = {
@@ -69,6 +71,12 @@ class Sample:
     message: str | None  # qualified name the battery came from (None: given in SI)
     data: Mapping[str, Any] | None
     extra: Mapping[str, Any]  # distance_to_home_m, travelled_m, home_set, position_fix
+    instance: int = 1  # the battery, 1-based as ArduPilot prints it
+    where: str = ""  # how to find it again: "line 12", "offset 4711"
+
+    @property
+    def place(self) -> str:
+        return self.where or f"line {self.line}"
 
 
 def _si(meta: Mapping[str, Any], value: Any) -> float | None:
@@ -197,10 +205,15 @@ class Reader:
                 if not ok:
                     raise fail(f'expected "{key}": {"true or false" if kind is bool else "a number"}, got {value!r}')
                 extra[key] = value
+        instance = obj.get("instance")
+        if instance is not None and (
+            isinstance(instance, bool) or not isinstance(instance, int) or not 1 <= instance <= 16
+        ):
+            raise fail(f'expected "instance": a battery number from 1 to 16, got {instance!r}')
         if "battery" in obj:
             if not isinstance(obj["battery"], dict):
                 raise fail('expected "battery": an object of SI values')
-            return Sample(line, float(t), armed, reading_of(obj["battery"]), None, None, extra)
+            return Sample(line, float(t), armed, reading_of(obj["battery"]), None, None, extra, instance or 1)
         name = obj.get("message", self.default_message)
         if not isinstance(name, str):
             raise fail('expected "message" (a message name) with "data", "battery", or --message')
@@ -213,7 +226,7 @@ class Reader:
             battery = battery_state(qualified, model)
         except (ValueError, BattgenError) as exc:
             raise fail(f"expected {qualified} data: {exc}") from None
-        return Sample(line, float(t), armed, battery, qualified, data, extra)
+        return Sample(line, float(t), armed, battery, qualified, data, extra, instance or _instance_of(qualified, data))
 
 
 def open_reader(schema_dir: Path | None, default_message: str | None = None) -> Reader:
@@ -223,16 +236,34 @@ def open_reader(schema_dir: Path | None, default_message: str | None = None) -> 
     return Reader(schema, model_package(schema, schema_dir), default_message)
 
 
-def read_failsafe_params(path: Path) -> FailsafeSettings:
-    """The BATT_* parameters of a .param / .params file (others ignored; every set of a QGC file
-    merged, later sets winning)."""
+def _instance_of(qualified: str, data: Mapping[str, Any]) -> int:
+    """The battery a message is about: uORB battery_status.id is 1-based, MAVLink BATTERY_STATUS.id
+    0-based; else battery 1."""
+    ident = data.get("id")
+    if isinstance(ident, int) and not isinstance(ident, bool):
+        if qualified.startswith("uorb.") and 1 <= ident <= 16:
+            return ident
+        if qualified == "mavlink.BATTERY_STATUS" and 0 <= ident < 16:
+            return ident + 1
+    return 1
+
+
+def read_parameter_values(path: Path) -> dict[str, float]:
+    """Every parameter of a .param / .params file (every set of a QGC file merged, later sets
+    winning); the failsafe takes the BATT*_ ones and the vehicle's own."""
     values: dict[str, float] = {}
     for _, group in parameter_files.read_parameter_file(path):
         values.update(group)
-    try:
-        return FailsafeSettings.from_values(values)
-    except ValueError as exc:
-        raise BattgenError(f"{path}: {exc}") from None
+    return values
+
+
+_BATT = re.compile(r"BATT[1-9A-G]?_")
+
+
+def batt_parameter_count(values: Mapping[str, float]) -> int:
+    """How many of ``values`` are battery monitor parameters (BATT_, BATT2_ .. BATT9_, BATTA_ ..
+    BATTG_): without any, the failsafe would run, or a check pass, on defaults alone."""
+    return sum(1 for name in values if _BATT.match(name))
 
 
 class Replay:
@@ -243,12 +274,15 @@ class Replay:
         self.reader = reader
         self.samples = 0
 
-    def run(self, path: Path, name: str) -> Iterator[tuple[Event, Sample]]:
-        """Every transition with the sample that caused it; errors name the stream as ``name``."""
-        for sample in self.reader.read(path):
+    def run(self, path: Path, name: str, samples: Iterable[Sample] | None = None) -> Iterator[tuple[Event, Sample]]:
+        """Every transition with the sample that caused it; errors name the stream as ``name``.
+        ``samples`` replaces the JSON Lines reader (a flight log's samples)."""
+        for sample in self.reader.read(path) if samples is None else samples:
             self.samples += 1
             try:
-                events = self.failsafe.update(sample.t, sample.battery, armed=sample.armed, **sample.extra)
+                events = self.failsafe.update(
+                    sample.t, sample.battery, armed=sample.armed, instance=sample.instance, **sample.extra
+                )
             except ValueError as exc:
-                raise BattgenError(f"{name}:{sample.line}: {exc}") from None
+                raise BattgenError(f"{name}: {sample.place}: {exc}") from None
             yield from ((event, sample) for event in events)
