@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import io
+import json
 import math
 import sys
 from collections.abc import Iterator
@@ -204,3 +205,20 @@ def test_real_logs_every_instance_every_field(name: str) -> None:
         first = {r.multi_id: r.instance for r in reversed(records)}
         assert first[0].cell_count == 6 and first[0].voltage_cell_v[5] == pytest.approx(3.9016, abs=1e-4)
         assert first[1].cell_count == 12 and first[1].voltage_cell_v[9] == pytest.approx(4.1576, abs=1e-4)
+
+
+def test_validate_names_a_value_that_does_not_fit(
+    old_packages: dict[str, ModuleType], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from codegen.cli.main import main
+
+    module = old_packages["px4_log_v1_11"]
+    path = tmp_path / "old.ulg"
+    path.write_bytes(_write(module, [(module.BatteryStatus(cell_count=6, max_error=1, scale=1.0), 0),
+                                     (module.BatteryStatus(cell_count=-3, max_error=1, scale=1.0), 1)]))  # fmt: skip
+    code = main(["validate", "--message", "uorb.BatteryStatus", "--format", "json", str(path)])
+    doc = json.loads(capsys.readouterr().out)
+    (unfit,) = [n for n in doc["files"][0]["notices"] if n["kind"] == "unfit"]
+    assert unfit["data"]["multi_id"] == 1 and unfit["data"]["fields"] == {"cell_count": -3}
+    assert "does not fit the schema's type, left at its default: cell_count = -3" in unfit["message"]
+    assert code == 0 and doc["files"][0]["records"] == 2
