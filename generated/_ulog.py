@@ -40,12 +40,23 @@ import heapq
 import mmap
 import os
 import struct
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from itertools import repeat
 from typing import Any, BinaryIO, Generic, NamedTuple, TypeVar
 
 from . import _uorb
-from ._ulog_compare import FormatDiff, Retyped, compare, fill, fill_plan
+from ._ulog_compare import (
+    EMPTY,
+    RENAMED,
+    FormatDiff,
+    Retyped,
+    compare,
+    convert,
+    convert_plan,
+    extra_indexes,
+    fill,
+    fill_plan,
+)
 from ._ulog_format import (
     COMPAT_DEFAULT_PARAMETERS,
     INCOMPAT_DATA_APPENDED,
@@ -69,6 +80,7 @@ __all__ = [
     "COMPAT_DEFAULT_PARAMETERS",
     "INCOMPAT_DATA_APPENDED",
     "MAGIC",
+    "RENAMED",
     "SYNC",
     "TYPES",
     "VERSION",
@@ -99,14 +111,21 @@ Source = str | os.PathLike[str] | bytes | bytearray | memoryview | BinaryIO
 
 
 class Record(NamedTuple, Generic[T]):
-    """One data record of :meth:`Log.iter_records`, decoded."""
+    """One data record of :meth:`Log.iter_records`, decoded.
+
+    ``extras``: the log's values the instance does not hold, by the log's flattened name (fields
+    the class lacks, array elements beyond its length, values out of its type's range); ``unfit``
+    names those of them that did not fit the class's type (the field keeps its default)."""
 
     offset: int  # where the 'D' record starts in the file (its size field)
     multi_id: int
     topic: str
     instance: T
+    extras: Mapping[str, Any] = EMPTY
+    unfit: tuple[str, ...] = ()
 
 
+_Decoder = Callable[[int], tuple[T, Mapping[str, Any], tuple[str, ...]]]
 _WINDOW = 1 << 18  # bytes of data section a walk without an index reads between handing out records
 _D_HEAD = 5  # uint16 size, uint8 'D', uint16 msg_id: a record's payload starts this far in
 
@@ -189,7 +208,7 @@ class Log(LogParser):
         topic = topic or _default_topic(cls)
         decode = self._decoder(cls, topic)
         stream = self._index().get((topic, multi_id))
-        return [decode(o) for o in stream.offsets] if stream is not None else []
+        return [decode(o)[0] for o in stream.offsets] if stream is not None else []
 
     def iter_records(
         self, cls: type[T], *, topic: str | Iterable[str] | None = None, multi_id: int | None = None
@@ -211,7 +230,7 @@ class Log(LogParser):
         decoders = {t: self._decoder(cls, t) for t in names}
         return self._decode_all(decoders, multi_id)
 
-    def _decode_all(self, decoders: dict[str, Callable[[int], T]], multi_id: int | None) -> Iterator[Record[T]]:
+    def _decode_all(self, decoders: dict[str, _Decoder[T]], multi_id: int | None) -> Iterator[Record[T]]:
         def wanted(key: tuple[str, int]) -> bool:
             return key[0] in decoders and (multi_id is None or key[1] == multi_id)
 
@@ -224,24 +243,37 @@ class Log(LogParser):
         for offset, stream in found:
             topic, multi_id_ = stream.key
             try:
-                obj = decoders[topic](offset)
+                obj, extras, unfit = decoders[topic](offset)
             except (ValueError, struct.error) as exc:
                 at = offset - _D_HEAD
                 raise ULogError(f"{topic} multi_id {multi_id_}, record at offset {at}: cannot decode: {exc}") from exc
-            yield Record(offset - _D_HEAD, multi_id_, topic, obj)
+            yield Record(offset - _D_HEAD, multi_id_, topic, obj, extras, unfit)
 
-    def _decoder(self, cls: type[T], topic: str) -> Callable[[int], T]:
-        """Decodes a record of ``topic`` as ``cls`` from the offset of its payload."""
+    def _decoder(self, cls: type[T], topic: str) -> _Decoder[T]:
+        """Decodes a record of ``topic`` as ``cls`` from the offset of its payload: the instance,
+        the log's values it does not hold, and which of them did not fit (see :class:`Record`)."""
         diff = self.compare(cls, topic=topic)
         data, size = self.data, self.layout(topic).data_size
         if diff.identical:
             decode: Callable[[bytes], T] = getattr(cls, "decode")  # noqa: B009 (the generated classmethod, unknown to T)
-            return lambda o: decode(data[o : o + size])
+            return lambda o: (decode(data[o : o + size]), EMPTY, ())
         unpack = self._columns(topic).record_struct(size).unpack_from
-        skip = {name for name, _ in diff.missing} | {r.name for r in diff.retyped}
-        plan = fill_plan(format_of(cls), {n: i for i, n in enumerate(self.layout(topic).names)}, "", "", skip)
-        filled: Callable[[int], T] = lambda o: fill(cls(), plan, unpack(data, o))  # noqa: E731
-        return filled
+        names = self.layout(topic).names
+        skip = {name for name, _ in diff.missing} | {r.name for r in diff.retyped} | {r.name for r in diff.converted}
+        alias = {new: old for old, new in diff.renamed}
+        ours = format_of(cls)
+        plan = fill_plan(ours, {n: i for i, n in enumerate(names)}, "", "", skip, alias)
+        conversions = convert_plan(ours, diff.converted, alias, names)
+        extra_at = extra_indexes(diff.extra, names)
+
+        def decode_other(o: int) -> tuple[T, Mapping[str, Any], tuple[str, ...]]:
+            values = unpack(data, o)
+            obj = fill(cls(), plan, values)
+            extras = {name: values[i] for i, name in extra_at}
+            unfit = convert(obj, conversions, values, extras)
+            return obj, extras or EMPTY, tuple(unfit)
+
+        return decode_other
 
     # -- walking the data section ---------------------------------------------------------------
 

@@ -1646,16 +1646,18 @@ class BatteryStatus:
 
     @classmethod
     def from_ulog(
-        cls, source: _ulog.Source | _ulog.Log, *, topic: str | None = None, multi_id: int = 0
-    ) -> list[BatteryStatus]:
-        """Every record of this message in a ULog file (path, bytes, binary file or a read Log).
+        cls, source: _ulog.Source | _ulog.Log, *, topic: str | None = None, multi_id: int | None = None
+    ) -> list[_ulog.Record[BatteryStatus]]:
+        """Every record of this message in a ULog file (path, bytes, binary file or a read Log),
+        in file order: each a _ulog.Record saying its instance (multi_id), topic and offset.
 
-        Topic defaults to the first of UORB_TOPICS. When the log's own format differs, the
-        fields matching by name and type are decoded and the rest keep their defaults
-        (see _ulog.Log.compare for the difference).
+        Every instance unless ``multi_id`` names one; every topic of UORB_TOPICS unless ``topic``
+        names one. When the log's own format differs (an older PX4), fields are matched by name
+        (through PX4's renames), compatible types converted with range checks, and the log's
+        values the instance cannot hold kept in the record's ``extras`` (see _ulog.Log.compare).
         """
         log = source if isinstance(source, _ulog.Log) else _ulog.read(source)
-        return log.messages(cls, topic=topic, multi_id=multi_id)
+        return list(log.iter_records(cls, topic=topic, multi_id=multi_id))
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -2795,16 +2797,18 @@ class BatteryStatusV0:
 
     @classmethod
     def from_ulog(
-        cls, source: _ulog.Source | _ulog.Log, *, topic: str | None = None, multi_id: int = 0
-    ) -> list[BatteryStatusV0]:
-        """Every record of this message in a ULog file (path, bytes, binary file or a read Log).
+        cls, source: _ulog.Source | _ulog.Log, *, topic: str | None = None, multi_id: int | None = None
+    ) -> list[_ulog.Record[BatteryStatusV0]]:
+        """Every record of this message in a ULog file (path, bytes, binary file or a read Log),
+        in file order: each a _ulog.Record saying its instance (multi_id), topic and offset.
 
-        Topic defaults to the first of UORB_TOPICS. When the log's own format differs, the
-        fields matching by name and type are decoded and the rest keep their defaults
-        (see _ulog.Log.compare for the difference).
+        Every instance unless ``multi_id`` names one; every topic of UORB_TOPICS unless ``topic``
+        names one. When the log's own format differs (an older PX4), fields are matched by name
+        (through PX4's renames), compatible types converted with range checks, and the log's
+        values the instance cannot hold kept in the record's ``extras`` (see _ulog.Log.compare).
         """
         log = source if isinstance(source, _ulog.Log) else _ulog.read(source)
-        return log.messages(cls, topic=topic, multi_id=multi_id)
+        return list(log.iter_records(cls, topic=topic, multi_id=multi_id))
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""

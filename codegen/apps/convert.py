@@ -111,6 +111,9 @@ class Converted:
     plain: object = None
     payloads: tuple[bytes, ...] = ()
     loss: object = None  # the loss report's entries or summary, when asked for
+    source: Mapping[str, object] | None = None  # where the record came from: file, record, line or log location
+    # (field, detail) of each value the target could not hold, written as its "unknown" instead
+    unrepresentable: tuple[tuple[str, str], ...] = ()
 
 
 class Endpoint:
@@ -242,21 +245,28 @@ class Conversion:
             if isinstance(item, Unreadable):
                 raise fail(where, item.line, _reworded(item.message, item.reason, fmt))
             objs = self.source.build(item)
-            report = self.module.LossReport() if loss is not None else None
+            # always kept: what the target could not hold is told even without --report
+            report = self.module.LossReport()
             try:
                 result = self.func(*objs, policy=self.policy, report=report, **extra)
             except self.module.ConversionError as exc:
-                raise fail(where, item.line, f"cannot convert: {exc}") from None
+                raise fail(item.file, item.line, f"record {item.index + 1}: cannot convert: {exc}") from None
             except (ValueError, TypeError, AttributeError) as exc:
-                text = f"cannot convert (a value the input lacks or does not fit): {exc}"
-                raise fail(where, item.line, text) from None
+                text = f"record {item.index + 1}: cannot convert (a value the input lacks or does not fit): {exc}"
+                raise fail(item.file, item.line, text) from None
             for name in carried:
                 extra[name] = _carried(result, name.removesuffix(CARRIED))
-            lost = None if report is None else report.summary() if loss == "summary" else report.to_dict()
+            lost = None if loss is None else report.summary() if loss == "summary" else report.to_dict()
+            unheld = tuple(
+                (str(e["field"]), str(e.get("detail", ""))) for e in report.to_dict() if e["kind"] == "unrepresentable"
+            )
+            at = _source(item, where)
             if binary:
-                yield Converted(item.line, payloads=self.target.to_binary(result, item.file, item.line), loss=lost)
+                payloads = self.target.to_binary(result, item.file, item.line)
+                yield Converted(item.line, payloads=payloads, loss=lost, source=at, unrepresentable=unheld)
             else:
-                yield Converted(item.line, plain=self.target.to_plain(result), loss=lost)
+                plain = self.target.to_plain(result)
+                yield Converted(item.line, plain=plain, loss=lost, source=at, unrepresentable=unheld)
 
     def _items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
         if fmt in LOG_FORMATS:
@@ -338,9 +348,22 @@ def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item]:
         raise fail(where, exc.line, _reworded(exc.message, exc.reason, fmt)) from None
 
 
+def _source(item: Record, where: str) -> dict[str, object]:
+    """Where a record came from, for the loss report: the input, the record's number (1-based),
+    and its line or, for a log record, its location (topic, multi_id, timestamp, offset)."""
+    out: dict[str, object] = {"file": where, "record": item.index + 1}
+    if item.location is not None:
+        out.update(item.location)
+    elif item.line > 0:
+        out["line"] = item.line
+    return out
+
+
 def _located(record: Record, where: str) -> Record:
     """A log record whose errors name the input and the record: ``file (topic multi_id 0, ...)``."""
-    return Record(record.index, 0, None, f"{where} ({record.where})", instance=record.instance)
+    return Record(
+        record.index, 0, None, f"{where} ({record.where})", instance=record.instance, location=record.location
+    )
 
 
 def _reworded(message: str, reason: str, fmt: str) -> str:

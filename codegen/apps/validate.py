@@ -10,6 +10,7 @@ a callback as it is found, so that a caller can print them while a long file is 
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,6 +26,7 @@ from ..ir.numbers import to_json_data
 from ..ir.rules import bound_rules
 from .failsafe.checks import NONNEGATIVE, check_settings
 from .failsafe.vehicles import detect_vehicle
+from .gate import Gate
 from .messages import resolve_message
 from .package import data_error, model_class, model_package
 
@@ -46,6 +48,7 @@ class Finding:
     message: str
     severity: str
     location: Mapping[str, object] | None = None
+    waived: str = ""  # why it is left out of the verdict (--ignore, a profile's waiver); "" when reported
 
 
 Event = Finding | Notice | Unreadable
@@ -62,6 +65,7 @@ class FileReport:
     notices: list[Notice] = field(default_factory=list)
     errors: int = 0
     warnings: int = 0
+    waived: int = 0  # findings left out by the rule selection or a profile (counted, not failing)
 
 
 # A check beyond the generated validate(): (instance, its violations, the record's context, the
@@ -227,10 +231,13 @@ def check_file(
     kind: str | None = None,
     keep_findings: bool = True,
     on_event: Callable[[Event], None] | None = None,
+    gate: Gate | None = None,
 ) -> FileReport:
     """Check every record of one file. Each finding, notice and unreadable part goes to
     ``on_event`` as soon as it is found; findings are kept in the report only with
-    ``keep_findings`` (so a caller printing them streams a file of any size in constant memory)."""
+    ``keep_findings`` (so a caller printing them streams a file of any size in constant memory).
+    ``gate`` leaves findings out by rule selection or a profile: they are marked ``waived`` and
+    counted, never errors."""
     report = FileReport(path.as_posix())
 
     def tell(event: Event) -> None:
@@ -251,7 +258,11 @@ def check_file(
                 continue
             report.records += 1
             for finding in checker.check(item):
-                if finding.severity == "warning":
+                reason = gate.why_not(finding.rule, finding.path) if gate is not None else None
+                if reason is not None:
+                    finding = dataclasses.replace(finding, waived=reason)
+                    report.waived += 1
+                elif finding.severity == "warning":
                     report.warnings += 1
                 else:
                     report.errors += 1
@@ -271,29 +282,39 @@ def check_file(
     return report
 
 
-def exit_code(reports: Iterable[FileReport]) -> int:
-    """0 when every record is valid, 1 when one has an error, 2 when an input was unreadable."""
+def is_empty(report: FileReport) -> bool:
+    """A file that was read but held no record of the message."""
+    return report.records == 0 and not report.unreadable
+
+
+def exit_code(reports: Iterable[FileReport], *, allow_empty: bool = True) -> int:
+    """0 when every record is valid, 1 when one has an error (or, unless ``allow_empty``, a file
+    held no record at all), 2 when an input was unreadable."""
     code = EXIT_OK
     for report in reports:
         if report.unreadable:
             return EXIT_UNREADABLE
-        if report.errors:
+        if report.errors or (is_empty(report) and not allow_empty):
             code = EXIT_INVALID
     return code
 
 
-def json_document(message: Message, reports: list[FileReport]) -> dict[str, object]:
-    """The reports as one JSON document (``validate --format json``)."""
+def json_document(message: Message, reports: list[FileReport], *, allow_empty: bool = True) -> dict[str, object]:
+    """The reports as one JSON document (``validate --format json``); waived findings are listed
+    with their ``waived`` reason and not counted as errors or warnings."""
+    code = exit_code(reports, allow_empty=allow_empty)
     return {
         "message": message.qualified_name,
-        "valid": exit_code(reports) == EXIT_OK,
-        "exit_code": exit_code(reports),
+        "valid": code == EXIT_OK,
+        "exit_code": code,
         "files": [
             {
                 "file": r.file,
                 "records": r.records,
+                "empty": is_empty(r),
                 "errors": r.errors,
                 "warnings": r.warnings,
+                "waived": r.waived,
                 "unreadable": [{"file": u.file, "line": u.line, "message": u.message} for u in r.unreadable],
                 "notices": [
                     {"kind": n.kind, "severity": n.severity, "message": n.message, "data": to_json_data(n.data)}
@@ -312,6 +333,7 @@ def json_document(message: Message, reports: list[FileReport]) -> dict[str, obje
                         "limit": to_json_data(f.limit),
                         "message": f.message,
                         "severity": f.severity,
+                        "waived": f.waived or None,
                     }
                     for f in r.findings
                 ],

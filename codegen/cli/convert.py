@@ -13,6 +13,11 @@ one warning on stderr, and fields the log lacks keep their defaults), MAVLink te
 (``tlog``, .tlog) and raw MAVLink streams (``mavlink``, .mav): every frame of the source message,
 with bad CRCs and garbage skipped and summed up in one warning. ``--from``/``--to`` take a side
 name or a message name (``uorb.BatteryStatus``, ``mavlink.BATTERY_STATUS``).
+
+No real record is refused: a value the target cannot hold (a NaN cell among known ones in
+MAVLink's integer cells) is written as the target's "unknown" with an ``unrepresentable``
+loss entry; each such kind is one line on stderr naming file, record and field, with a count,
+and the exit code is 1. An input without records is exit 1 too (``--allow-empty`` accepts it).
 """
 
 from __future__ import annotations
@@ -20,9 +25,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import IO, Any, Literal
+from typing import IO, Any, Literal, cast
 
 import yaml
 
@@ -55,6 +60,9 @@ def register(subparsers: Any) -> None:
     p.add_argument("--out-format", choices=FORMATS, help="output format (default: the input's, text for binary)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="extra converter input (number)")
     p.add_argument("--package", default="generated", help="the generated package to use (default: generated)")
+    p.add_argument(
+        "--allow-empty", action="store_true", help="an input without records is not an error (default: exit 1)"
+    )
     p.set_defaults(func=run)
 
 
@@ -83,7 +91,8 @@ def run(args: argparse.Namespace) -> int:
     loss: Literal["entries", "summary"] | None = (
         "entries" if args.report else "summary" if args.report_summary else None
     )
-    out_stream: IO[bytes] = open(args.output, "wb") if args.output else sys.stdout.buffer
+    out_stream: IO[bytes] = open_output(args.output) if args.output else sys.stdout.buffer
+    tally = Tally()
     try:
         for path in args.files or ["-"]:
             fmt = input_format(path, args.in_format)
@@ -91,11 +100,79 @@ def run(args: argparse.Namespace) -> int:
             source = sys.stdin.buffer if path == "-" else Path(path)
             where = "<stdin>" if path == "-" else path
             events = conversion.run(source, where, fmt, binary=out_fmt in ("hex", "raw"), loss=loss, inputs=extra)
-            _write(events, where, fmt, out_fmt, out_stream)
+            before = tally.records
+            _write(tally.count(events, where), where, fmt, out_fmt, out_stream)
+            if tally.records == before:
+                tally.empty.append(where)
     finally:
         if args.output:
             out_stream.close()
-    return 0
+    return tally.finish(conversion.target_name, allow_empty=args.allow_empty)
+
+
+def open_output(name: str) -> IO[bytes]:
+    """The -o file, opened for writing; a clear one-line error for a missing folder or a folder."""
+    path = Path(name)
+    if path.is_dir():
+        raise BattgenError(f"-o {name}: is a folder; expected a file name")
+    if not path.parent.is_dir():
+        raise BattgenError(f"-o {name}: the folder {path.parent.as_posix()} does not exist")
+    try:
+        return path.open("wb")
+    except OSError as exc:
+        raise BattgenError(f"-o {name}: cannot write: {exc.strerror or exc}") from None
+
+
+class Tally:
+    """What a run converted: records, inputs without any, and the values the target could not
+    hold (grouped by field and detail, with the count and the first record)."""
+
+    def __init__(self) -> None:
+        self.records = 0
+        self.empty: list[str] = []
+        self.unheld: dict[tuple[str, str], list[object]] = {}  # (field, detail) -> [count, first source]
+
+    def count(self, events: Iterable[Converted | Notice], where: str) -> Iterable[Converted | Notice]:
+        for event in events:
+            if isinstance(event, Converted):
+                self.records += 1
+                for key in event.unrepresentable:
+                    seen = self.unheld.setdefault(key, [0, event.source or {"file": where}])
+                    seen[0] = cast(int, seen[0]) + 1
+            yield event
+
+    def finish(self, target: str, *, allow_empty: bool) -> int:
+        """Print the closing lines on stderr; the exit code: 1 for an input without records
+        (unless allowed) or values the target could not hold, else 0."""
+        code = 0
+        for where in self.empty:
+            if not allow_empty:
+                print(f"{where}: no records to convert (--allow-empty accepts that)", file=sys.stderr)
+                code = 1
+        for (field, detail), (n, first) in self.unheld.items():
+            at = _where(cast(Mapping[str, object], first))
+            times = f" ({n} records, the first shown)" if cast(int, n) > 1 else ""
+            print(f"{at}: {field}: {detail}{times}", file=sys.stderr)
+        if self.unheld:
+            records = sum(cast(int, v[0]) for v in self.unheld.values())
+            print(
+                f"convert: {self.records} records to {target}; {len(self.unheld)} kinds of value the target cannot "
+                f"hold, written as its 'unknown' ({records} times; --report lists each record's losses)",
+                file=sys.stderr,
+            )
+            code = 1
+        return code
+
+
+def _where(source: Mapping[str, object]) -> str:
+    """``file: record N (topic multi_id M, timestamp T us, offset O)`` or ``file:line: record N``."""
+    file = str(source.get("file", ""))
+    head = f"{file}:{source['line']}" if "line" in source else file
+    text = f"{head}: record {source['record']}" if "record" in source else head
+    if "topic" in source:
+        stamp = f", timestamp {source['timestamp_us']} us" if source.get("timestamp_us") is not None else ""
+        text += f" ({source['topic']} multi_id {source['multi_id']}{stamp}, offset {source['offset']})"
+    return text
 
 
 def _write(events: Iterable[Converted | Notice], where: str, fmt: str, out_fmt: str, out: IO[bytes]) -> None:
@@ -111,9 +188,14 @@ def _write(events: Iterable[Converted | Notice], where: str, fmt: str, out_fmt: 
             payloads = event.payloads
             out.write(b" ".join(p.hex().encode() for p in payloads) + b"\n" if out_fmt == "hex" else b"".join(payloads))
             if event.loss is not None:
-                sys.stderr.write(json.dumps({"line": event.line, "loss": event.loss}) + "\n")
+                where_from = {"source": dict(event.source)} if event.source is not None else {"line": event.line}
+                sys.stderr.write(json.dumps({**where_from, "loss": event.loss}) + "\n")
             continue
-        record = {"record": event.plain, "loss": event.loss} if event.loss is not None else event.plain
+        record: Any = event.plain
+        if event.loss is not None:
+            record = {"record": event.plain, "loss": event.loss}
+            if event.source is not None:  # the file, the record, and a log record's topic instance
+                record["source"] = dict(event.source)
         if out_fmt == "jsonl":
             out.write(json.dumps(record, allow_nan=False).encode() + b"\n")
             out.flush()

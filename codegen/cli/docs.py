@@ -15,6 +15,7 @@ from typing import Any
 from ..apps.docs import write_docs
 from ..apps.package import bundled_schemas
 from ..backends.markdown import render_docs
+from ..errors import BattgenError
 from ..frontends.loader import load
 
 EXIT_OK, EXIT_STALE = 0, 1
@@ -23,6 +24,8 @@ EXIT_OK, EXIT_STALE = 0, 1
 def run(args: argparse.Namespace) -> int:
     schema = load([Path(args.schema_dir)] if args.schema_dir else [bundled_schemas()])
     out = Path(args.out) if args.out else Path("docs") / "messages"
+    if out.exists() and not out.is_dir():
+        raise BattgenError(f"--out {out}: is a file; expected a folder for the pages")
     pages = render_docs(schema)
     written, removed, unchanged = write_docs(pages, out, check=args.check)
     if args.check:

@@ -25,8 +25,8 @@ parameters only one vehicle has, else rover is assumed (said on stderr either wa
 
 Semantics are ArduPilot's AP_BattMonitor (see the README's failsafe section); ``--variant
 seed-critical`` and ``--variant distance`` turn on the seed's own choices. Prints one line per
-transition (``--json``: one JSON object per line). Exit 0, 2 when an input cannot be read or holds
-no battery reading.
+transition (``--json``: one JSON object per line). Exit 0; 1 when the parameters hold no BATT*_
+one (``--allow-empty`` accepts that); 2 when an input cannot be read or holds no battery reading.
 """
 
 from __future__ import annotations
@@ -42,12 +42,12 @@ from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
 from ..apps.failsafe.levels import apply_level
 from ..apps.failsafe.logs import bin_parameters, log_kind, read_log
 from ..apps.failsafe.settings import battery_settings
-from ..apps.failsafe.stream import Replay, Sample, open_reader, read_parameter_values
+from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
 from ..errors import BattgenError
 from ..inputs import parameter_files
 
-EXIT_OK, EXIT_UNREADABLE = 0, 2
+EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE = 0, 1, 2
 
 
 def register(subparsers: Any) -> None:
@@ -61,6 +61,9 @@ def register(subparsers: Any) -> None:
     p.add_argument("--params", help="parameter file with the BATT*_ parameters (a .bin's own PARM records otherwise)")
     p.add_argument("--vehicle", choices=sorted(VEHICLES), help="ArduPilot vehicle (default: detected, else rover)")
     p.add_argument("--variant", action="append", choices=sorted(VARIANTS), default=[], help="a seed variant (opt-in)")
+    p.add_argument(
+        "--allow-empty", action="store_true", help="parameters without any BATT*_ one are not an error (exit 1)"
+    )
     p.add_argument("--message", help="message of samples that name none (e.g. uorb.BatteryStatus)")
     p.add_argument("--schemas", help="schema folder the messages come from (default: the bundled schemas/)")
     p.add_argument("--no-home", action="store_true", help="no home position is set (RTL falls back)")
@@ -87,6 +90,13 @@ def run(args: argparse.Namespace) -> int:
             values, where = bin_parameters(stream), f"{args.stream} (PARM records)"
         else:
             raise BattgenError("expected --params FILE (only a DataFlash .bin log carries its own parameters)")
+        if args.params and not batt_parameter_count(values) and not args.allow_empty:
+            print(
+                f"{where}: no BATT*_ parameter ({len(values)} parameters read): the failsafe would run on "
+                "defaults alone (--allow-empty accepts that)",
+                file=sys.stderr,
+            )
+            return EXIT_EMPTY
         detection = detect_vehicle(values, args.vehicle)
         vehicle = detection.vehicle
         settings = battery_settings(values, vehicle)

@@ -16,10 +16,11 @@ from ..errors import BattgenError
 from ..frontends.loader import load
 from ..ir import Schema
 from ..ir import json_form as irjson
-from . import can, convert, docs, failsafe, params, schema, validate
+from . import can, convert, docs, export, failsafe, params, query, schema, validate, vectors
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
-COMMAND_MODULES = (validate, docs, schema, convert, params, failsafe, can)  # in the order of the help text
+# in the order of the help text
+COMMAND_MODULES = (validate, docs, schema, convert, vectors, params, failsafe, can, export, query)
 
 
 def _load(paths: Sequence[str], args: argparse.Namespace) -> Schema:
@@ -57,7 +58,12 @@ def cmd_generate(args: argparse.Namespace) -> int:
         raise BattgenError(
             f"{out}: the output folder's name is the package's import name, so it must be a Python identifier"
         )
-    result = generate(schema, out, check=args.check)
+    if out.exists() and not out.is_dir():
+        raise BattgenError(f"--out {out}: is a file; expected a folder for the package")
+    try:
+        result = generate(schema, out, check=args.check)
+    except OSError as exc:
+        raise BattgenError(f"--out {out}: cannot write: {exc.strerror or exc}") from None
     elapsed = time.perf_counter() - started
     if args.check:
         if result.stale:

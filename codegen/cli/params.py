@@ -10,7 +10,8 @@ the value came from. ``--check`` reads a parameter file (any layout ArduPilot, M
 QGroundControl writes) and reports what ``battgen validate`` reports on it: the BATT_* values that
 break their types and ranges, every battery's action codes for the vehicle (given, else detected,
 else rover), and the plausibility warnings (codegen.apps.failsafe.checks).
-Exit codes: 0 ok (warnings allowed), 1 the check found errors, 2 unreadable input or bad usage.
+Exit codes: 0 ok (warnings allowed), 1 the check found errors or the file holds no BATT*_ parameter
+(``--allow-empty`` accepts that), 2 unreadable input or bad usage.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from typing import Any
 
 from ..apps.batt_parameters import check_parameter_file, check_proposals, propose_from_devicetree, render
 from ..apps.failsafe.checks import CELL_RANGES
+from ..apps.failsafe.stream import batt_parameter_count, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES
 from ..errors import BattgenError
 
@@ -50,12 +52,13 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--vehicle", choices=sorted(VEHICLES), help="for --check: ArduPilot vehicle (default: detected, else rover)"
     )
+    p.add_argument("--allow-empty", action="store_true", help="for --check: a file without BATT*_ is not an error")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     if args.check:
-        return _check(Path(args.check), args.cells, args.chemistry, args.vehicle)
+        return _check(Path(args.check), args.cells, args.chemistry, args.vehicle, args.allow_empty)
     result, source = propose_from_devicetree(
         Path(args.from_devicetree),
         node=args.node,
@@ -78,12 +81,20 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _check(path: Path, cells: int | None, chemistry: str, vehicle: str | None) -> int:
+def _check(path: Path, cells: int | None, chemistry: str, vehicle: str | None, allow_empty: bool) -> int:
     display = path.as_posix()
     report = check_parameter_file(path, cells=cells, chemistry=chemistry, vehicle=vehicle)
     if report.unreadable is not None:
         print(f"battgen: {report.unreadable}", file=sys.stderr)
         return EXIT_USAGE
+    values = read_parameter_values(path)
+    if not batt_parameter_count(values) and not allow_empty:
+        print(
+            f"{display}: no BATT*_ parameter in this file ({len(values)} parameters read): nothing to check "
+            "(--allow-empty accepts that)",
+            file=sys.stderr,
+        )
+        return EXIT_ERRORS
     for note in report.notes:
         print(f"{display}: {note}", file=sys.stderr)
     for f in report.findings:

@@ -21,15 +21,27 @@ bus captures (candump .log, .asc, .blf, .trc; ArduPilot DataFlash .bin with CANF
 captures: DroneCAN BatteryInfo, every battery node's records located by time, frame and node, with the
 transport diagnostics -- toggle, CRC, missing start or end, transfer-id gaps, BatteryInfoAux order).
 
-Prints one line per violation, ``file:line: message`` (``file: location: message`` for logs;
-warnings marked, and not failing), notices about whole inputs and a summary on stderr; or with
-``--format json`` one JSON document (each violation with its ``location``, each file with its
-``notices``). Exit 0 valid, 1 violations, 2 unreadable input or unknown message.
+Findings are grouped: one line per file, severity, rule and field (array indexes aside), the first
+finding's ``file:line: message`` (``file: location: message`` for logs; warnings marked, and not
+failing) and how many more records repeat it; notices about whole inputs and a summary on stderr.
+``--format json`` gives one JSON document (every violation with its ``location``, each file with
+its ``notices``), ``--format github`` GitHub Actions annotations (``::error file=...::``), and
+``--format sarif`` a SARIF 2.1.0 log for code scanning.
+
+A CI gate: ``--select`` / ``--ignore`` take selectors (``range/max_error``, ``range``, ``max_error``,
+``cells-beyond-count-zero``, wildcards allowed), and ``--profile px4`` waives PX4's documented
+deviations from its own .msg (each with its evidence, in codegen/apps/profiles/px4.yaml); the
+same settings may live under ``[tool.battgen]`` (``select``, ``ignore``, ``profile``) in the
+nearest pyproject.toml. What is left out is counted in the summary (SARIF: suppressed results).
+A file without records of the message is exit 1 (``--allow-empty`` accepts it).
+
+Exit 0 valid, 1 violations or a file without records, 2 unreadable input or unknown message.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.metadata
 import json
 import sys
 from pathlib import Path
@@ -37,10 +49,12 @@ from typing import Any
 
 from ..apps import validate as engine
 from ..apps.failsafe.vehicles import VEHICLES
+from ..apps.gate import Gate, Settings, describe, profile_names, settings
 from ..apps.package import bundled_schemas
-from ..apps.validate import Checker, Event, FileReport, Finding, exit_code, json_document, make_checker
+from ..apps.validate import Checker, Event, FileReport, Finding, exit_code, is_empty, json_document, make_checker
+from ..apps.validate_formats import Group, Grouper, github_line, github_notice, sarif_document
 from ..inputs.dispatch import KINDS
-from ..inputs.records import Notice
+from ..inputs.records import Notice, Unreadable
 from ..ir import Message
 
 
@@ -60,49 +74,141 @@ def finding_line(f: Finding) -> str:
 
 
 def print_event(event: Event) -> None:
-    """Findings on stdout; warning and error notices, the stream summary of a log or capture and unreadable
-    parts on stderr (other info notices: JSON only)."""
-    if isinstance(event, Finding):
-        print(finding_line(event))
-    elif isinstance(event, Notice):
+    """Warning and error notices, the stream summary of a log or capture and unreadable parts on
+    stderr (other info notices: JSON only); findings are grouped and printed once their file is
+    done (see :func:`print_groups`)."""
+    if isinstance(event, Notice):
         if event.severity in ("warning", "error"):
             print(f"{event.file}: {event.severity}: {event.message}", file=sys.stderr)
         elif event.kind == "stream":  # what a log or capture held (frames, nodes): one line, worth seeing
             print(f"{event.file}: note: {event.message}", file=sys.stderr)
-    else:
+    elif isinstance(event, Unreadable):
         print(f"{_place(event.file, event.line)}: {event.message}", file=sys.stderr)
 
 
-def check_file(path: Path, message: Message, checker: Checker, *, echo: bool, kind: str | None = None) -> FileReport:
-    """Check every record of one file; with ``echo`` print each finding as it is found (streaming)."""
+def print_groups(grouper: Grouper, github: bool) -> None:
+    """Each group of reported findings once: its first finding, with how often it repeats."""
+    for group in grouper.groups():
+        print(github_line(group) if github else finding_line(group.first) + group.repeats())
+    if grouper.overflow:
+        print(f"... and {grouper.overflow} findings of further kinds (use --format json)")
+
+
+def check_file(
+    path: Path,
+    message: Message,
+    checker: Checker,
+    grouper: Grouper | None = None,
+    *,
+    echo: bool,
+    keep: bool | None = None,
+    kind: str | None = None,
+    gate: Gate | None = None,
+    github: bool = False,
+) -> FileReport:
+    """Check every record of one file, grouping its findings as they come (memory bounded by the
+    kinds of finding, not the records). With ``echo``, print notices as they come and the groups
+    once the file is done (``github``: as workflow commands). ``keep`` (default: not ``echo``)
+    keeps every finding in the report too (``--format json``)."""
+    groups = grouper if grouper is not None else Grouper()
+
+    def on_event(event: Event) -> None:
+        if isinstance(event, Finding):
+            groups.add(event)
+        elif echo:
+            print_event(event)
+
+    keep_findings = not echo if keep is None else keep
+    report = engine.check_file(
+        path, message, checker, kind=kind, keep_findings=keep_findings, on_event=on_event, gate=gate
+    )
     if echo:
-        return engine.check_file(path, message, checker, kind=kind, keep_findings=False, on_event=print_event)
-    return engine.check_file(path, message, checker, kind=kind)
+        print_groups(groups, github)
+    return report
+
+
+def _selectors(values: list[str] | None) -> list[str] | None:
+    """--select/--ignore values: repeatable, each comma-separated; None when not given."""
+    if values is None:
+        return None
+    return [s.strip() for v in values for s in v.split(",") if s.strip()]
 
 
 def run(args: argparse.Namespace) -> int:
     schema_dir = Path(args.schemas) if args.schemas else bundled_schemas()
     kind = args.input_format
+    chosen = settings(_selectors(args.select), _selectors(args.ignore), args.profile, Path.cwd())
     message, checker = make_checker(schema_dir, args.message, args.files, kind, vehicle=args.vehicle)
-    as_json = args.format == "json"
-    reports = [check_file(Path(f), message, checker, echo=not as_json, kind=kind) for f in args.files]
-    code = exit_code(reports)
-    if as_json:
-        json.dump(json_document(message, reports), sys.stdout, indent=2, allow_nan=False)
+    fmt = args.format
+    text_like = fmt in ("text", "github")
+    reports, all_groups, problems = [], [], []
+    github = fmt == "github"
+    for f in args.files:
+        gate = Gate(chosen, message.qualified_name)
+        grouper = Grouper()
+        report = check_file(
+            Path(f), message, checker, grouper, echo=text_like, keep=fmt == "json", kind=kind, gate=gate, github=github
+        )
+        reports.append(report)
+        all_groups += grouper.groups() + grouper.groups(waived=True)
+        problems += [(u.file, f"{_place(u.file, u.line)}: {u.message}") for u in report.unreadable]
+        if is_empty(report) and not args.allow_empty:
+            text = f"no {message.qualified_name} records in this file (--allow-empty accepts that)"
+            problems.append((report.file, f"{report.file}: {text}"))
+            if github:
+                print(github_notice(report.file, text))
+            elif text_like:
+                print(f"{report.file}: {text}", file=sys.stderr)
+        if github:
+            for u in report.unreadable:
+                print(github_notice(u.file, u.message))
+    code = exit_code(reports, allow_empty=args.allow_empty)
+    if fmt == "json":
+        json.dump(json_document(message, reports, allow_empty=args.allow_empty), sys.stdout, indent=2, allow_nan=False)
+        sys.stdout.write("\n")
+    elif fmt == "sarif":
+        doc = sarif_document(message.qualified_name, all_groups, problems, chosen, code, version())
+        json.dump(doc, sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
     else:
-        records = sum(r.records for r in reports)
-        errors = sum(r.errors for r in reports)
-        warnings = sum(r.warnings for r in reports)
-        unreadable = sum(len(r.unreadable) for r in reports)
-        summary = (
-            f"{message.qualified_name}: {_count(records, 'record')} in {_count(len(reports), 'file')}, "
-            f"{_count(errors, 'error')}, {_count(warnings, 'warning')}"
-        )
-        if unreadable:
-            summary += f", {unreadable} unreadable"
-        print(summary, file=sys.stderr)
+        print(summary(message, reports, all_groups, chosen), file=sys.stderr)
     return code
+
+
+def version() -> str:
+    try:
+        return importlib.metadata.version("battgen")
+    except importlib.metadata.PackageNotFoundError:
+        return "0"
+
+
+def summary(message: Message, reports: list[FileReport], groups: list[Group], chosen: Settings) -> str:
+    """The closing line: records, files, errors and warnings (with the lines that showed them),
+    and what the selection left out."""
+    records = sum(r.records for r in reports)
+    errors = sum(r.errors for r in reports)
+    warnings = sum(r.warnings for r in reports)
+    waived = sum(r.waived for r in reports)
+    shown = [g for g in groups if not g.first.waived]
+    text = (
+        f"{message.qualified_name}: {_count(records, 'record')} in {_count(len(reports), 'file')}, "
+        f"{_count(errors, 'error')}, {_count(warnings, 'warning')}"
+    )
+    if errors or warnings:
+        text += f" (shown as {_count(len(shown), 'line')})"
+    unreadable = sum(len(r.unreadable) for r in reports)
+    if unreadable:
+        text += f", {unreadable} unreadable"
+    empty = sum(1 for r in reports if is_empty(r))
+    if empty:
+        text += f", {empty} without records"
+    if waived:
+        left_out = sorted({": ".join(g.first.waived.split(": ")[:2]) for g in groups if g.first.waived})
+        text += f"; {_count(waived, 'finding')} left out: " + "; ".join(left_out)
+    used = list(describe(chosen))
+    if used:
+        text += f" [{', '.join(used)}{' from ' + chosen.origin if chosen.origin else ''}]"
+    return text
 
 
 def register(subparsers: Any) -> None:
@@ -120,7 +226,31 @@ def register(subparsers: Any) -> None:
         "MAVLink logs: mavlink.BATTERY_STATUS)",
     )
     p.add_argument("--schemas", metavar="DIR", help="schema folder (default: the bundled schemas/)")
-    p.add_argument("--format", choices=("text", "json"), default="text", help="output format (default: text)")
+    p.add_argument(
+        "--format",
+        choices=("text", "json", "github", "sarif"),
+        default="text",
+        help="text (default), json, github (workflow-command annotations) or sarif (SARIF 2.1.0, code scanning)",
+    )
+    p.add_argument(
+        "--select",
+        action="append",
+        metavar="SELECTORS",
+        help="report only these findings: RULE/FIELD, RULE or FIELD, wildcards allowed, comma-separated "
+        "(replaces [tool.battgen] select)",
+    )
+    p.add_argument(
+        "--ignore",
+        action="append",
+        metavar="SELECTORS",
+        help="leave these findings out (counted in the summary; replaces [tool.battgen] ignore)",
+    )
+    p.add_argument(
+        "--profile",
+        metavar="NAME",
+        help=f"waive a bundled profile's known firmware deviations ({', '.join(profile_names())}); '' for none",
+    )
+    p.add_argument("--allow-empty", action="store_true", help="a file without records is not an error")
     p.add_argument(
         "--input-format",
         choices=KINDS,

@@ -146,6 +146,8 @@ class FormatDiff(Protocol):
     extra: tuple[tuple[str, str], ...]
     retyped: tuple[FormatChange, ...]
     identical: bool
+    renamed: tuple[tuple[str, str], ...]
+    converted: tuple[FormatChange, ...]
 
     @property
     def matches(self) -> bool: ...
@@ -159,6 +161,8 @@ class LogRecord(Protocol):
     multi_id: int
     topic: str
     instance: GeneratedMessage
+    extras: Mapping[str, Any]
+    unfit: tuple[str, ...]
 
 
 class UlogLog(Protocol):

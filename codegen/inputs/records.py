@@ -46,6 +46,7 @@ class Record:
     instance: GeneratedMessage | None = field(default=None, compare=False)  # decoded already: no from_dict
     skip: frozenset[str] = frozenset()  # fields the source lacks: their checks are not reported
     location: Mapping[str, object] | None = None  # machine-readable where: timestamp, multi_id, offset...
+    extras: Mapping[str, object] | None = None  # a log's values the instance has no field for (older PX4)
     context: Mapping[str, object] | None = field(default=None, compare=False)  # a parameter set's other values
     # decoded with the instance: the other messages of a multi-message side (a CAN node's BatteryInfoAux)
     companions: tuple[GeneratedMessage | None, ...] = field(default=(), compare=False)
@@ -80,7 +81,7 @@ class Notice:
 
     file: str
     message: str
-    kind: str  # "format-diff", "unchecked", "stream", "damage", "empty"
+    kind: str  # "format-diff", "unchecked", "unfit", "stream", "damage", "empty"
     severity: str = "warning"
     data: Mapping[str, object] | None = None
 

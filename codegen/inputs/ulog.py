@@ -4,10 +4,15 @@ Records come in file order (multi_ids interleaved as logged), each decoded on it
 the generated reader's streaming API (``read(path, index=False)`` then ``Log.iter_records``): the
 file is memory-mapped and walked once, so memory does not grow with the number of records.
 
-Logs written before a message changed (PX4 logs predating message versioning) carry another
-format for the topic: the difference is one notice per topic, fields matching by name and type
-are decoded, and the checks of the fields the log lacks or types differently are not reported
-(their values would be the schema's defaults, not the log's data) -- with one notice naming them.
+Logs written before a message changed (PX4 logs of older releases) carry another format for the
+topic, read through the log's own definitions: the difference is one notice per topic; fields are
+matched by name (through PX4's renames, ``average_current_a`` -> ``current_average_a``), values of
+another but compatible type are converted with a range check (``int32 cell_count`` -> uint8,
+``float[10] voltage_cell_v`` -> float[14]), and the log's values the schema has no field for
+(``voltage_filtered_v``, ``run_time_to_empty``...) travel with each record as its ``extras``. The
+checks of the fields the log lacks or types incompatibly are not reported (their values would be
+the schema's defaults, not the log's data) -- with one notice naming them; a value that does not
+fit its converted field is one notice per record.
 Damage the reader recovered from and a log without the message's topics are told after the
 records, once the walk has seen the whole file.
 """
@@ -15,7 +20,7 @@ records, once the walk has seen the whole file.
 from __future__ import annotations
 
 import struct
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
@@ -36,6 +41,8 @@ class LogRecord:
     timestamp: int | None
     instance: GeneratedMessage
     skip: frozenset[str]
+    extras: Mapping[str, object]
+    unfit: tuple[str, ...]
 
     def where(self) -> str:
         stamp = f", timestamp {self.timestamp} us" if self.timestamp is not None else ""
@@ -51,6 +58,10 @@ def _diff_line(diff: FormatDiff) -> str:
         parts.append("missing from the log: " + ", ".join(f"{n} {t}" for n, t in diff.missing))
     if diff.extra:
         parts.append("only in the log: " + ", ".join(f"{n} {t}" for n, t in diff.extra))
+    if diff.renamed:
+        parts.append("renamed since: " + ", ".join(f"{a} -> {b}" for a, b in diff.renamed))
+    if diff.converted:
+        parts.append("converted: " + ", ".join(f"{r.name} (schema {r.schema}, log {r.log})" for r in diff.converted))
     if diff.retyped:
         parts.append("retyped: " + ", ".join(f"{r.name} (schema {r.schema}, log {r.log})" for r in diff.retyped))
     body = "; ".join(parts) if parts else "same fields, other layout"
@@ -124,7 +135,14 @@ class UlogReader:
                     getattr(rec.instance, "timestamp", None) if "timestamp" not in skip else None
                 )  # not every topic has one
                 yield LogRecord(
-                    rec.topic, rec.multi_id, rec.offset, stamp if isinstance(stamp, int) else None, rec.instance, skip
+                    rec.topic,
+                    rec.multi_id,
+                    rec.offset,
+                    stamp if isinstance(stamp, int) else None,
+                    rec.instance,
+                    skip,
+                    rec.extras,
+                    rec.unfit,
                 )
         except ValueError as exc:  # a record that cannot be decoded ends the walk
             yield Unreadable(self.name, 0, str(exc))
@@ -170,6 +188,14 @@ def _items(reader: UlogReader) -> Iterator[Item]:
             if isinstance(rec, Unreadable):
                 yield rec
                 continue
+            if rec.unfit:
+                values = ", ".join(f"{n} = {rec.extras[n]!r}" for n in rec.unfit)
+                yield Notice(
+                    reader.name,
+                    f"{rec.where()}: does not fit the schema's type, left at its default: {values}",
+                    "unfit",
+                    data={**rec.location(), "fields": {n: rec.extras[n] for n in rec.unfit}},
+                )
             yield Record(
                 index,
                 0,
@@ -179,6 +205,7 @@ def _items(reader: UlogReader) -> Iterator[Item]:
                 instance=rec.instance,
                 skip=rec.skip,
                 location=rec.location(),
+                extras=rec.extras,
             )
             index += 1
         yield from reader.trailing

@@ -125,7 +125,9 @@ def test_read_back_what_was_written(nested: ModuleType) -> None:
     assert log.topics() == [("outer", 0), ("outer", 2)] and log.count("outer", 2) == 1 and log.count("outer", 1) == 0
     assert log.info == {"ver_hw": "X", "time_ref_utc": 3600, "scale": 0.5} and log.logged == [(54, 9, "armed")]
     assert log.messages(nested.Outer) == [a] and log.messages(nested.Outer, multi_id=2) == [b]
-    assert nested.Outer.from_ulog(out.getvalue()) == [a]
+    records = nested.Outer.from_ulog(out.getvalue())  # every instance, each record saying which
+    assert [(r.multi_id, r.instance) for r in records] == [(0, a), (2, b)]
+    assert [r.instance for r in nested.Outer.from_ulog(out.getvalue(), multi_id=2)] == [b]
     cols = log.columns("outer", use_numpy=False)
     assert cols["one.tag"] == [b"hi\0\0\0"] and cols["many[1].v[2]"] == [3] and cols["n"] == [7]
     assert log.compare(nested.Outer).identical and not log.warnings
@@ -241,8 +243,10 @@ def test_format_differences_inside_nested_types(nested: ModuleType) -> None:
     assert [(r.name, r.schema, r.log) for r in diff.retyped] == [
         ("one.x", "float", "double"),
         ("many.x", "float", "double"),
-    ]
+    ]  # only top-level fields are converted (PX4 never retyped inside a nested type)
     assert not diff.identical and not diff.matches
+    (record,) = log.iter_records(nested.Outer)
+    assert dict(record.extras) == {"one.extra": 0, "many[0].extra": 0, "many[1].extra": 0}
     (msg,) = log.messages(nested.Outer)
     assert msg.n == 5 and msg.one.tag == "ab" and msg.one.x == 0.0 and msg.many[1].v == [0, 0, -4]
     assert isinstance(msg.many[0], nested.Inner) and str(diff).startswith("outer: the log's format differs")
@@ -257,12 +261,14 @@ def test_diff_text_and_data() -> None:
         "missing": [["faults", "uint16_t"]],
         "extra": [["faultz", "uint16_t"]],
         "retyped": [],
+        "renamed": [],
+        "converted": [],
         "identical": False,
     }
     assert str(diff) == (
         "battery_status: the log's format differs from the schema (battery_status)\n"
         "  missing from the log (left at defaults): faults uint16_t\n"
-        "  only in the log (not decoded): faultz uint16_t"
+        "  only in the log (kept as extras): faultz uint16_t"
     )
     assert str(_ulog.read(battery_log()).compare(BatteryStatus)) == (
         "battery_status: the log's format is the schema's (battery_status)"

@@ -135,7 +135,10 @@ def test_tlog_without_battery_status_uses_sys_status(tmp_path: Path, capsys: pyt
     path.write_bytes(bytes(out))
     params = tmp_path / "c.param"
     params.write_text("RTL_ALT,1500\n", encoding="utf-8")  # Copter: BATT_LOW_VOLT defaults to 10.5 V
-    found, err = events(capsys, "--params", str(params), str(path))
+    # no BATT*_ parameter at all: exit 1 unless asked for (defaults alone are then the point)
+    assert main(["failsafe", "--params", str(params), str(path)]) == 1
+    assert "no BATT*_ parameter (1 parameters read)" in capsys.readouterr().err
+    found, err = events(capsys, "--allow-empty", "--params", str(params), str(path))
     assert "vehicle copter (detected from RTL_ALT" in err
     assert [(e["t"], e["battery"], e["level"], e["action"]) for e in found] == [(16.0, 1, "LOW", "None")]
 

@@ -161,14 +161,18 @@ def test_non_object_records_and_unknown_fields_are_type_violations(
     assert lines[1] == f"{path.as_posix()}:3: volts is not a field of uorb.BatteryStatus"
 
 
-def test_empty_inputs_are_valid(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+def test_empty_inputs_are_not_success(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     (tmp_path / "a.json").write_text("[]")
     (tmp_path / "b.jsonl").write_text("\n\n")
     (tmp_path / "c.yaml").write_text("# nothing\n")
     files = [str(tmp_path / n) for n in ("a.json", "b.jsonl", "c.yaml")]
     code, lines, err = validate(capsys, "--message", "uorb.BatteryStatus", *files)
-    assert (code, lines) == (0, [])
-    assert "0 records in 3 files" in err
+    assert (code, lines) == (1, [])
+    for f in files:
+        assert f"{Path(f).as_posix()}: no uorb.BatteryStatus records in this file (--allow-empty accepts that)" in err
+    assert "0 records in 3 files, 0 errors, 0 warnings, 3 without records" in err
+    code, lines, err = validate(capsys, "--message", "uorb.BatteryStatus", "--allow-empty", *files)
+    assert (code, lines) == (0, []) and "no uorb" not in err
 
 
 # -- message names ---------------------------------------------------------------------------------

@@ -81,8 +81,10 @@ def test_real_px4_logs_predating_message_versions(capsys: pytest.CaptureFixture[
     kinds = [n["kind"] for n in report["notices"]]
     assert kinds == ["format-diff", "unchecked"]
     diff = report["notices"][0]["data"]
-    assert ["voltage_cell_v", "float[14]", "float[10]"] in diff["retyped"]
-    assert "cell_count" in report["notices"][1]["data"]["fields"]
+    assert ["voltage_cell_v", "float[14]", "float[10]"] in diff["converted"] and diff["retyped"] == []
+    assert diff["renamed"] == [["average_current_a", "current_average_a"]]
+    unchecked = report["notices"][1]["data"]["fields"]
+    assert "time_remaining_s" in unchecked and not {"cell_count", "voltage_cell_v"} & set(unchecked)
     multi_ids = [v["location"]["multi_id"] for v in report["violations"]]
     assert set(multi_ids) == {0, 1} and multi_ids[:2] == [0, 1]  # file order: batteries interleaved
     stamps = [v["location"]["timestamp_us"] for v in report["violations"] if v["location"]["multi_id"] == 0]
@@ -128,12 +130,16 @@ def test_log_without_the_topic_has_no_records(capsys: pytest.CaptureFixture[str]
 
     _ulog.write(path, [BatteryStatusV0()])
     code, lines, err = run(capsys, "validate", "--message", "uorb.BatteryStatus", str(path))
-    assert (code, lines) == (0, [])
+    assert (code, lines) == (1, [])  # nothing checked is not a pass
     assert "warning: no battery_status records in this log (topics logged: battery_status_v0)" in err
+    assert f"{path.as_posix()}: no uorb.BatteryStatus records in this file (--allow-empty accepts that)" in err
+    code, lines, err = run(capsys, "validate", "--message", "uorb.BatteryStatus", "--allow-empty", str(path))
+    assert (code, lines) == (0, [])
     # convert reports the same, after the (empty) output
     code, lines, err = run(capsys, "convert", "--from", "uorb", "--to", "mavlink", str(path))
-    assert (code, lines) == (0, [])
+    assert (code, lines) == (1, [])
     assert "warning: no battery_status records in this log (topics logged: battery_status_v0)" in err
+    assert f"{path}: no records to convert" in err
 
 
 def test_ulog_validation_memory_does_not_grow_with_records(tmp_path: Path) -> None:
@@ -260,4 +266,4 @@ def test_nothing_mavlink_is_unreadable(capsys: pytest.CaptureFixture[str], tmp_p
     empty = tmp_path / "empty.tlog"
     empty.write_bytes(b"")
     code, _, err = run(capsys, "validate", str(empty))
-    assert code == 0 and "0 records" in err
+    assert code == 1 and "0 records" in err and "no mavlink.BATTERY_STATUS records in this file" in err

@@ -92,9 +92,9 @@ def test_file_without_the_message_parameters_is_a_notice(capsys: pytest.CaptureF
     path = tmp_path / "other.param"
     path.write_text("ARMING_CHECK,1\nSERIAL0_BAUD,115\n", encoding="utf-8")
     code, lines, err = run(capsys, str(path))
-    assert (code, lines) == (0, [])
+    assert (code, lines) == (1, [])  # a parameter file without the parameters asked for is not a pass
     assert "warning: no parameter of params.BATT in this file (2 parameters read)" in err
-    assert "0 records" in err
+    assert "0 records" in err and "no params.BATT records in this file" in err
 
 
 def test_malformed_param_file_exits_2_naming_file_and_line(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:

@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import math
+import re
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -254,6 +255,15 @@ def read_parameter_values(path: Path) -> dict[str, float]:
     for _, group in parameter_files.read_parameter_file(path):
         values.update(group)
     return values
+
+
+_BATT = re.compile(r"BATT[1-9A-G]?_")
+
+
+def batt_parameter_count(values: Mapping[str, float]) -> int:
+    """How many of ``values`` are battery monitor parameters (BATT_, BATT2_ .. BATT9_, BATTA_ ..
+    BATTG_): without any, the failsafe would run, or a check pass, on defaults alone."""
+    return sum(1 for name in values if _BATT.match(name))
 
 
 class Replay:

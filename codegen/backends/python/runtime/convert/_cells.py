@@ -66,16 +66,27 @@ def mavlink_cells_out(
     main = [main_marker] * n_main
     ext = [ext_marker] * n_ext
     top = main_marker - 1
+    if cells and all(math.isnan(c) for c in cells):
+        cells = None  # a cell count without cell voltages: the pack voltage goes in, as MAVLink asks
     if cells:
         if len(cells) > n_main + n_ext:
             if rep is not None:
                 rep.clamped(label_ext, f"{len(cells)} cells, room for {n_main} + {n_ext}")
             cells = cells[: n_main + n_ext]
         for i, c in enumerate(cells):
-            if i < n_main:
-                main[i] = to_int(c, 0, top, rep, label_main)
+            label, marker = (label_main, main_marker) if i < n_main else (label_ext, ext_marker)
+            if math.isnan(c):  # one cell unknown among known ones: MAVLink has only "no cell" for it
+                value = marker
+                if rep is not None:
+                    rep.unrepresentable(label, f"cell {i + 1} unknown (NaN), sent as {marker} (no cell)")
+            elif i < n_main:
+                value = to_int(c, 0, top, rep, label)
             else:
-                ext[i - n_main] = max(to_int(c, 0, top, rep, label_ext), 1 if ext_marker == 0 else 0)
+                value = max(to_int(c, 0, top, rep, label), 1 if ext_marker == 0 else 0)
+            if i < n_main:
+                main[i] = value
+            else:
+                ext[i - n_main] = value
         return main, ext
     if pack is not None and not math.isnan(pack):
         mv = to_int(pack, 0, top * n_main, rep, label_main)

@@ -20,7 +20,9 @@ class ConversionError(ValueError):
 class LossEntry:
     """One thing that did not survive a conversion: ``kind`` is ``unknown`` (a target field left
     at its invalid value), ``dropped`` (source information with no place in the target),
-    ``clamped`` (a value forced into range) or ``rounded`` (a value quantised)."""
+    ``clamped`` (a value forced into range), ``rounded`` (a value quantised) or ``unrepresentable``
+    (a source value the target cannot hold, written as the target's "unknown" instead: a NaN cell
+    voltage becomes UINT16_MAX -- where a converter once refused the whole record)."""
 
     __slots__ = ("detail", "field", "kind")
 
@@ -76,6 +78,9 @@ class LossReport:
 
     def rounded(self, field: str, detail: str = "") -> None:
         self._keys[("rounded", field, detail)] = None
+
+    def unrepresentable(self, field: str, detail: str = "") -> None:
+        self._keys[("unrepresentable", field, detail)] = None
 
     def discard(self, kind: str, field: str) -> None:
         """Withdraw entries (a later rule filled a field an earlier one left unknown)."""

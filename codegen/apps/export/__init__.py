@@ -1,0 +1,8 @@
+"""The engine of ``battgen export``: battery records of many logs into one Parquet dataset.
+
+Needs the ``fleet`` extra (pyarrow, numpy; DuckDB for queries, dask.distributed for clusters).
+Modules: :mod:`.catalog` (the concepts and mappings, from the IR), :mod:`.sources` (a log into
+batches of columns), :mod:`.columnar` (the mappings over columns), :mod:`.per_record` (the
+generated converters, the reference), :mod:`.columns`, :mod:`.table` (Arrow), :mod:`.dataset`
+(the folder), :mod:`.engine` (runs), :mod:`.distributed` (Dask).
+"""

@@ -1,0 +1,93 @@
+"""What the fleet table is made of, read from the IR: the shared concepts and, per source message,
+the forward rules of its mapping to them (``schemas/mappings/``).
+
+The table's concept columns, their units and quantities, and which field of which message feeds
+each one all come from here, so the export has no unit, sentinel or field name of its own.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from pathlib import Path
+
+from ...errors import BattgenError
+from ...frontends.loader import load
+from ...ir import CONCEPTS_ENDPOINT, Concept, Direction, Endpoint, Message, Rule, Schema
+from ..package import bundled_schemas
+
+# endpoints whose messages are battery records in logs (devicetree nodes are static facts)
+RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan")
+
+
+@dataclass(frozen=True)
+class SourceMapping:
+    """How one source message becomes the concepts: its endpoint's forward rules that read it alone
+    (a companion message such as DroneCAN's BatteryInfoAux is not in a log's records)."""
+
+    endpoint: str
+    message: Message
+    rules: tuple[Rule, ...]
+
+    def sources_of(self, concept: str) -> tuple[str, ...]:
+        """The fields of the message a concept is read from."""
+        out: list[str] = []
+        for rule in self.rules:
+            if any(t.field == concept for t in rule.targets):
+                out.extend(s.field for s in rule.sources if s.field not in out)
+        return tuple(out)
+
+
+@dataclass(frozen=True)
+class Catalog:
+    """The concepts (in the order concepts.yaml lists them) and the record messages' mappings."""
+
+    schema: Schema
+    concepts: tuple[Concept, ...]
+    sources: dict[str, SourceMapping]  # by qualified message name
+
+    def concept(self, name: str) -> Concept:
+        for c in self.concepts:
+            if c.name == name:
+                return c
+        raise KeyError(name)
+
+    def source(self, qualified: str) -> SourceMapping:
+        found = self.sources.get(qualified)
+        if found is None:
+            known = ", ".join(sorted(self.sources))
+            raise BattgenError(f"{qualified} is not a battery record message (expected one of {known})")
+        return found
+
+
+def build_catalog(schema: Schema) -> Catalog:
+    """The catalog of an IR that holds the concepts and the record formats' mappings."""
+    concepts: list[Concept] = []
+    endpoints: dict[str, Endpoint] = {}
+    for mset in schema.mappings:
+        concepts.extend(mset.concepts)
+        endpoints.update({e.name: e for e in mset.endpoints})
+    sources: dict[str, SourceMapping] = {}
+    for mset in schema.mappings:
+        for mapping in mset.mappings:
+            if mapping.target != CONCEPTS_ENDPOINT or mapping.source not in RECORD_ENDPOINTS:
+                continue
+            endpoint = endpoints.get(mapping.source)
+            if endpoint is None:
+                continue
+            first = endpoint.messages[0]
+            rules = tuple(
+                r
+                for r in mapping.rules
+                if r.only in (None, Direction.FORWARD) and all(s.message == first for s in r.sources)
+            )
+            sources[first] = SourceMapping(mapping.source, schema.message(first), rules)
+    if not concepts or not sources:
+        raise BattgenError("the schemas hold no battery concepts or mappings to them (schemas/mappings/)")
+    return Catalog(schema, tuple(concepts), sources)
+
+
+@functools.cache
+def bundled_catalog(schema_dir: Path | None = None) -> Catalog:
+    """The catalog of the bundled schemas (read once per process)."""
+    return build_catalog(load([schema_dir or bundled_schemas()]))

@@ -1,0 +1,83 @@
+"""The concept columns a conversion fills: one :class:`ConceptColumn` per concept, numpy arrays.
+
+Both conversions write these -- the columnar one (:mod:`.columnar`, whole columns at a time) and
+the per-record one (:mod:`.per_record`, through the generated converters) -- so the two can be
+compared exactly, and :mod:`.table` turns them into Arrow columns in one place.
+
+Per kind: ``number`` float64, ``integer`` int64, ``bool`` bool, ``text`` object (str),
+``choice`` int16 codes into the concept's choices, ``flags`` int64 bit sets over the concept's
+choices (bit i = choices[i]), ``list`` a float64 matrix (NaN: an unknown element) and a length
+per row. ``valid`` is False where the concept is unknown.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ...ir import Concept
+
+NDArray = Any  # numpy arrays (numpy's own annotations would tie mypy to one numpy version)
+
+_DTYPES = {
+    "number": np.float64,
+    "integer": np.int64,
+    "bool": np.bool_,
+    "text": object,
+    "choice": np.int16,
+    "flags": np.int64,
+}
+
+
+@dataclass
+class ConceptColumn:
+    """One concept over ``n`` records (see the module docstring)."""
+
+    concept: Concept
+    values: NDArray
+    valid: NDArray
+    lengths: NDArray | None = None  # list concepts: the number of elements of each row
+
+    @classmethod
+    def empty(cls, concept: Concept, n: int, width: int = 0) -> ConceptColumn:
+        if concept.kind == "list":
+            return cls(concept, np.full((n, width), np.nan), np.zeros(n, bool), np.zeros(n, np.int64))
+        values = np.full(n, None, object) if concept.kind == "text" else np.zeros(n, _DTYPES[concept.kind])
+        return cls(concept, values, np.zeros(n, bool))
+
+    def set(self, values: NDArray, where: NDArray | None = None) -> None:
+        """Write ``values`` (an array or a scalar) where ``where`` holds (everywhere if None)."""
+        if where is None:
+            self.values[...] = values
+            self.valid[...] = True
+            return
+        if np.ndim(values) == 0:
+            self.values[where] = values
+        else:
+            self.values[where] = np.asarray(values)[where]
+        self.valid |= where
+
+    def set_list(self, values: NDArray, lengths: NDArray, where: NDArray) -> None:
+        """Write the rows of a list concept where ``where`` holds (widening the matrix if needed)."""
+        if not self.valid.any():  # nothing written yet: take the rows as they are
+            self.values = np.where(where[:, None], values, np.nan) if not where.all() else values
+            self.lengths = np.where(where, lengths, 0)
+            self.valid = where.copy()
+            return
+        width = max(self.values.shape[1], values.shape[1])
+        if width > self.values.shape[1]:
+            wider = np.full((self.values.shape[0], width), np.nan)
+            wider[:, : self.values.shape[1]] = self.values
+            self.values = wider
+        self.values[where, : values.shape[1]] = values[where]
+        self.values[where, values.shape[1] :] = np.nan
+        assert self.lengths is not None
+        self.lengths[where] = lengths[where]
+        self.valid |= where
+
+
+def empty_columns(concepts: tuple[Concept, ...], n: int) -> dict[str, ConceptColumn]:
+    """Every concept unknown for ``n`` records."""
+    return {c.name: ConceptColumn.empty(c, n) for c in concepts}

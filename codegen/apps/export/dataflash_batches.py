@@ -1,0 +1,70 @@
+"""ArduPilot DataFlash logs (.bin) for the export: the battery monitor readings (``BAT``, older
+``BAT2``/``CURR``/``CURR2``) of :mod:`codegen.inputs.dataflash`, one batch per instance.
+
+DataFlash has no message schema in the IR (its layout is in each log's own FMT records), so there is
+no mapping file to apply: the four values the reader gives -- ``Volt`` V, ``Curr`` A, ``CurrTot``
+mAh, ``RemPct`` % -- become concepts here, with the factors taken from the IR's unit registry.
+A value the log lacks is unknown. ``t`` is the log's ``TimeUS`` (time since boot, when the log
+starts); ``armed`` comes from ``ARM`` / ``EV`` records.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ...inputs.dataflash import ArmingRecord, BatteryRecord, flight_records, open_log
+from ...ir.units import unit
+from .catalog import Catalog
+from .columns import ConceptColumn, NDArray, empty_columns
+from .sources import Batch, as_of
+
+MESSAGE = "dataflash.BAT"
+# reader attribute -> (DataFlash field, unit, concept)
+FIELDS = (
+    ("voltage_v", "Volt", "V", "pack_voltage"),
+    ("current_a", "Curr", "A", "current"),
+    ("consumed_mah", "CurrTot", "mAh", "discharged"),
+    ("remaining_pct", "RemPct", "%", "state_of_charge"),
+)
+
+
+def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
+    """Every battery instance of a DataFlash log as a batch with its concepts filled."""
+    log = open_log(path, name)
+    readings: dict[int, list[BatteryRecord]] = {}
+    arming: list[ArmingRecord] = []
+    for item in flight_records(log):
+        if isinstance(item, ArmingRecord):
+            arming.append(item)
+        else:
+            readings.setdefault(item.instance, []).append(item)
+    arm_t = np.array([a.time_s for a in arming], np.float64)
+    arm_v = np.array([a.armed for a in arming], bool)
+    out: list[Batch] = []
+    for instance, rows in sorted(readings.items()):
+        n = len(rows)
+        columns: dict[str, NDArray] = {}
+        for attr, field, _, _ in FIELDS:
+            columns[field] = np.array([np.nan if getattr(r, attr) is None else getattr(r, attr) for r in rows])
+        t = np.array([r.time_s for r in rows], np.float64)
+        batch = Batch(MESSAGE, n, columns, t, np.full(n, instance))
+        batch.concepts = _concepts(catalog, columns, n)
+        if len(arming):
+            batch.armed = as_of(arm_t, arm_v, t)
+        if log.skipped_notes:
+            batch.notes.append(f"{len(log.skipped_notes)} notes from the DataFlash reader (skipped data)")
+        out.append(batch)
+    return out
+
+
+def _concepts(catalog: Catalog, columns: dict[str, NDArray], n: int) -> dict[str, ConceptColumn]:
+    out = empty_columns(catalog.concepts, n)
+    for _, field, symbol, concept in FIELDS:
+        target = out[concept]
+        assert target.concept.unit is not None
+        mul, add = unit(symbol).factor_to(target.concept.unit)
+        values = columns[field]
+        target.set(values * mul + add, ~np.isnan(values))
+    return out

@@ -1,0 +1,63 @@
+"""``battgen export --engine dask``: the per-log export (:func:`.engine.export_one`) as tasks on a
+Dask cluster (dask.distributed).
+
+Each task reads one log and writes its partition into the dataset folder, which every worker must
+reach under the same path (a shared file system); the results come back to the caller as they
+finish. Without a scheduler address a local cluster of ``workers`` processes is started for the run.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from .engine import ExportOptions, LogResult, export_one
+
+
+def export_dask(
+    paths: Sequence[str],
+    options: ExportOptions,
+    *,
+    scheduler: str | None = None,
+    workers: int = 2,
+    processes: bool = True,
+    progress: Callable[[LogResult], None] | None = None,
+) -> list[LogResult]:
+    """Export every log as a Dask task; results in input order."""
+    dist = _distributed()
+
+    unique = list(dict.fromkeys(paths))
+    cluster: Any = None
+    if scheduler is None:
+        cluster = dist.LocalCluster(
+            n_workers=max(1, workers), threads_per_worker=1, processes=processes, dashboard_address=None
+        )
+        client = dist.Client(cluster)
+    else:
+        client = dist.Client(scheduler)
+    try:
+        return run_on(client, unique, options, progress)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def run_on(
+    client: Any, paths: Sequence[str], options: ExportOptions, progress: Callable[[LogResult], None] | None = None
+) -> list[LogResult]:
+    """Export every log on an existing ``distributed.Client``; results in input order."""
+    futures = client.map(export_one, list(paths), options=options, pure=False)
+    results: dict[str, LogResult] = {}
+    for fut in _distributed().as_completed(futures):
+        res: LogResult = fut.result()
+        results[res.path] = res
+        if progress is not None:
+            progress(res)
+    return [results[p] for p in paths]
+
+
+def _distributed() -> Any:
+    """dask.distributed (imported when used: the fleet extra is optional; typed loosely on purpose)."""
+    return importlib.import_module("distributed")

@@ -1,0 +1,132 @@
+"""The per-log export and the runs over many logs: in this process, in ``jobs`` processes, or as
+tasks on a Dask cluster (:mod:`.distributed`), all through :func:`export_one`.
+
+A log is identified by its content (:func:`.sources.content_id`): one already in the dataset is
+skipped, so a nightly run over a growing fleet does only the new logs. A log that cannot be read
+is reported in its :class:`LogResult` and the run goes on.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pyarrow as pa
+
+from ...errors import BattgenError
+from .catalog import bundled_catalog
+from .columnar import convert_columns
+from .dataset import is_exported, raw_table, write_log
+from .readers import read_log
+from .sources import content_id
+from .table import battery_schema, battery_table
+from .views import write_views
+
+
+@dataclass(frozen=True)
+class ExportOptions:
+    """What every per-log export of a run shares (picklable: it travels to worker processes)."""
+
+    out: Path
+    raw: bool = False
+    message: str | None = None  # the message of JSON Lines inputs (None: told from their keys)
+
+
+@dataclass(frozen=True)
+class LogResult:
+    """What became of one input: ``exported``, ``skipped`` (already in the dataset, or the same
+    content as another input) or ``failed`` (``error`` says why)."""
+
+    path: str
+    status: str
+    log: str = ""
+    rows: int = 0
+    error: str = ""
+    notes: tuple[str, ...] = field(default=())
+
+
+def export_one(path: str, options: ExportOptions) -> LogResult:
+    """Export one log into the dataset at ``options.out``; never raises for a bad log."""
+    file = Path(path)
+    try:
+        log = content_id(file)
+    except OSError as exc:
+        return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
+    if is_exported(options.out, log):
+        return LogResult(path, "skipped", log, notes=("already in the dataset",))
+    try:
+        return _export(file, path, log, options)
+    except BattgenError as exc:
+        return LogResult(path, "failed", log, error=str(exc))
+    except (OSError, ValueError, MemoryError) as exc:  # a log the readers did not foresee
+        return LogResult(path, "failed", log, error=f"{path}: cannot export: {type(exc).__name__}: {exc}")
+
+
+def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResult:
+    catalog = bundled_catalog()
+    schema = battery_schema(catalog)
+    batches = read_log(file, name, catalog, options.message)
+    tables = []
+    raws: dict[str, list[object]] = {}
+    notes: list[str] = []
+    for batch in batches:
+        columns = batch.concepts
+        if columns is None:
+            columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)
+        tables.append(battery_table(catalog, schema, columns, batch, log, file.name))
+        if options.raw and batch.message in catalog.sources:
+            raws.setdefault(batch.message, []).append(raw_table(catalog.schema.message(batch.message), batch, log))
+        notes.extend(batch.notes)
+    table = pa.concat_tables(tables) if tables else schema.empty_table()
+    if not table.num_rows:
+        notes.append("no battery records")
+    raw_tables = [(m, pa.concat_tables(ts)) for m, ts in sorted(raws.items())]
+    manifest: dict[str, object] = {
+        "log": log,
+        "source": file.name,
+        "rows": table.num_rows,
+        "messages": sorted({b.message for b in batches}),
+        "notes": notes,
+    }
+    write_log(options.out, log, table, raw_tables, manifest)
+    return LogResult(name, "exported", log, table.num_rows, notes=tuple(notes))
+
+
+def export_logs(
+    paths: Sequence[str],
+    options: ExportOptions,
+    *,
+    jobs: int = 1,
+    progress: Callable[[LogResult], None] | None = None,
+) -> list[LogResult]:
+    """Export every log, in input order of the results; ``jobs`` > 1 runs them in processes."""
+    unique = list(dict.fromkeys(paths))
+    results: dict[str, LogResult] = {}
+    for res in _run(unique, options, jobs):
+        results[res.path] = res
+        if progress is not None:
+            progress(res)
+    return [results[p] for p in unique]
+
+
+def _run(paths: list[str], options: ExportOptions, jobs: int) -> Iterator[LogResult]:
+    if jobs <= 1 or len(paths) <= 1:
+        for p in paths:
+            yield export_one(p, options)
+        return
+    with concurrent.futures.ProcessPoolExecutor(max_workers=jobs) as pool:
+        futures = [pool.submit(export_one, p, options) for p in paths]
+        for fut in concurrent.futures.as_completed(futures):
+            yield fut.result()
+
+
+def count(results: Iterable[LogResult], status: str) -> int:
+    return sum(1 for r in results if r.status == status)
+
+
+def finish(out: Path) -> None:
+    """After a run: the views file in the dataset folder."""
+    out.mkdir(parents=True, exist_ok=True)
+    write_views(out)

@@ -1,0 +1,17 @@
+"""The batches of one log of any kind the export reads: DataFlash through
+:mod:`.dataflash_batches`, the others through :mod:`.sources`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .catalog import Catalog
+from .dataflash_batches import dataflash_batches
+from .sources import Batch, export_kind, read_batches
+
+
+def read_log(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
+    """Every battery batch of one log. Raises InputError (or another BattgenError) if unreadable."""
+    if export_kind(path) == "dataflash":
+        return dataflash_batches(path, name, catalog)
+    return read_batches(path, name, catalog, message)

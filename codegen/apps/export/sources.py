@@ -1,0 +1,229 @@
+"""Reading one log of any kind into batches of source columns for the export.
+
+A :class:`Batch` is the records of one source message in one log (one ULog topic instance, the
+BATTERY_STATUS frames of a tlog, the records of a JSON Lines file): the message's fields as
+columns, plus the context the table needs (time since the log's start, time of day, vehicle,
+instance, armed state). Kinds: PX4 ULog (.ulg) read as columns, MAVLink telemetry logs (.tlog)
+and JSON Lines (.jsonl/.ndjson) read record by record through the shared readers
+(:mod:`codegen.inputs`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, cast
+
+import numpy as np
+
+from ...backends.python import naming
+from ...errors import BattgenError
+from ...inputs.dispatch import kind_of_suffix
+from ...inputs.documents import read_jsonl
+from ...inputs.model import MavlinkClass, MessageClass, UorbClass
+from ...inputs.records import InputError, Record, Unreadable
+from ...inputs.tlog import StreamStats, read_frames
+from ...inputs.ulog_columns import UlogColumns
+from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
+from ..package import bundled_package, model_class
+from .catalog import RECORD_ENDPOINTS, Catalog
+from .columns import ConceptColumn, NDArray
+
+EXPORT_KINDS = ("ulog", "tlog", "jsonl", "dataflash")
+DATAFLASH_SUFFIXES = frozenset({".bin"})
+ID_DIGITS = 16
+
+
+@dataclass
+class Batch:
+    """The records of one source message in one log, as columns, and their context."""
+
+    message: str  # qualified name
+    n: int
+    columns: dict[str, NDArray]  # by schema field name; arrays as (n, capacity) matrices
+    t: NDArray  # seconds since the log's start (NaN: unknown)
+    instance: NDArray  # the log's instance of each record (ULog multi_id, else 0)
+    time_us: NDArray | None = None  # microseconds since the Unix epoch
+    vehicle: NDArray | str | None = None  # one for the batch, or an object array of str / None
+    armed: NDArray | None = None  # float 1.0 / 0.0 / NaN (unknown)
+    concepts: dict[str, ConceptColumn] | None = None  # filled by the reader (a format without IR mapping)
+    notes: list[str] = field(default_factory=list)
+
+
+def content_id(path: Path) -> str:
+    """The stable id of a file's content: the first hex digits of its SHA-256."""
+    digest = hashlib.sha256()
+    with path.open("rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()[:ID_DIGITS]
+
+
+def export_kind(path: Path) -> str:
+    kind = "dataflash" if path.suffix.lower() in DATAFLASH_SUFFIXES else kind_of_suffix(path)
+    if kind not in EXPORT_KINDS:
+        expected = "a PX4 ULog (.ulg), MAVLink tlog (.tlog), ArduPilot DataFlash (.bin) or JSON Lines file"
+        raise InputError(path.as_posix(), 0, f"expected {expected}")
+    return kind
+
+
+def _model(catalog: Catalog, qualified: str) -> MessageClass:
+    return model_class(bundled_package(), catalog.schema.message(qualified))
+
+
+def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
+    """Every battery batch of one log. Raises InputError (or another BattgenError) if unreadable."""
+    kind = export_kind(path)
+    if kind == "ulog":
+        return _ulog_batches(path, name, catalog)
+    if kind == "tlog":
+        return _tlog_batches(path, name, catalog)
+    if kind == "dataflash":
+        raise InputError(name, 0, "DataFlash logs are read by codegen.apps.export.dataflash_batches")
+    return _jsonl_batches(path, name, catalog, message)
+
+
+# -- ULog ------------------------------------------------------------------------------------------
+
+
+def _ulog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
+    model = _model(catalog, "uorb.BatteryStatus")
+    if not isinstance(model, UorbClass):
+        raise BattgenError("the generated uorb.BatteryStatus has no ULog support: run 'battgen generate'")
+    out: list[Batch] = []
+    with UlogColumns(path, name, model) as log:
+        start = log.start_us
+        offset = log.utc_offset_us()
+        armed = log.armed()
+        for inst in log.instances():
+            stamps = inst.timestamps
+            t = (stamps.astype(np.int64) - start) / 1e6 if stamps is not None else np.full(inst.n, np.nan)
+            batch = Batch(model.QUALIFIED_NAME, inst.n, inst.columns, t, np.full(inst.n, inst.multi_id))
+            if stamps is not None and offset is not None:
+                batch.time_us = stamps.astype(np.int64) + offset
+            if log.vehicle is not None:
+                batch.vehicle = log.vehicle
+            if stamps is not None and armed is not None:
+                batch.armed = as_of(armed[0], armed[1], stamps)
+            out.append(batch)
+    return out
+
+
+def as_of(times: NDArray, values: NDArray, at: NDArray) -> NDArray:
+    """The latest of ``values`` at or before each of ``at`` (NaN before the first)."""
+    order = np.argsort(times, kind="stable")
+    times, values = times[order], values[order].astype(np.float64)
+    idx = np.searchsorted(times, at, side="right") - 1
+    return np.where(idx >= 0, values[np.maximum(idx, 0)], np.nan)
+
+
+# -- records read one at a time --------------------------------------------------------------------
+
+
+def _dtype(ftype: object) -> Any:
+    while isinstance(ftype, ArrayType):
+        ftype = ftype.element
+    if isinstance(ftype, PrimitiveType):
+        if ftype.kind is PrimitiveKind.FLOAT:
+            return np.float64
+        if ftype.kind is PrimitiveKind.BOOL:
+            return np.bool_
+        if ftype.kind is PrimitiveKind.UINT and ftype.bits > 63:
+            return np.uint64
+        if ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT):
+            return np.int64
+    return object
+
+
+def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[str, NDArray]:
+    """Decoded records (generated instances) as columns by schema field name."""
+    out: dict[str, NDArray] = {}
+    for f in message.fields:
+        if f.is_padding:
+            continue
+        attr = naming.field_identifier(f.name, f.pattern)
+        values = [getattr(x, attr) for x in instances]
+        dtype = _dtype(f.type)
+        texts = any(isinstance(v, bytes | str) for v in values)
+        if isinstance(f.type, ArrayType) and not isinstance(f.type.element, StringType) and not texts:
+            width = f.type.capacity or max((len(v) for v in values), default=0)
+            matrix = np.zeros((len(values), width), dtype)
+            for i, v in enumerate(values):
+                matrix[i, : len(v)] = v
+            out[f.name] = matrix
+        else:
+            column = np.empty(len(values), object if texts else dtype)
+            column[:] = values
+            out[f.name] = column
+    return out
+
+
+def _tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
+    model = _model(catalog, "mavlink.BATTERY_STATUS")
+    if not isinstance(model, MavlinkClass):
+        raise BattgenError("the generated mavlink.BATTERY_STATUS has no MAVLink codec: run 'battgen generate'")
+    stats = StreamStats()
+    frames = list(read_frames(path, name, model, stats, timestamps=True))
+    if not frames:
+        return []
+    message = catalog.schema.message(model.QUALIFIED_NAME)
+    stamps = np.array([f.timestamp or 0 for f in frames], np.int64)
+    batch = Batch(
+        model.QUALIFIED_NAME,
+        len(frames),
+        instances_to_columns(message, [f.instance for f in frames]),
+        (stamps - stamps.min()) / 1e6,
+        np.zeros(len(frames), np.int64),
+        time_us=stamps,
+        vehicle=np.array([f"mavlink:{f.frame.sysid}" for f in frames], object),
+    )
+    if stats.damaged:
+        batch.notes.append(stats.summary("BATTERY_STATUS"))
+    return [batch]
+
+
+def _jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None) -> list[Batch]:
+    records: list[Record] = []
+    for item in read_jsonl(path, name):
+        if isinstance(item, Unreadable):
+            raise InputError(name, item.line, item.message)
+        if isinstance(item, Record):
+            records.append(item)
+    if not records:
+        return []
+    qualified = message or guess_message(catalog, records[0], name)
+    model = _model(catalog, qualified)
+    instances = []
+    for rec in records:
+        try:
+            instances.append(model.from_dict(rec.data))
+        except (ValueError, TypeError, KeyError) as exc:
+            raise InputError(name, rec.line, f"expected a {qualified} record: {exc}") from None
+    columns = instances_to_columns(catalog.schema.message(qualified), instances)
+    n = len(instances)
+    t = np.full(n, np.nan)
+    stamps = columns.get("timestamp")
+    if stamps is not None and stamps.ndim == 1 and stamps.dtype != object and n:
+        t = (stamps - stamps.min()) / 1e6
+    return [Batch(qualified, n, columns, t, np.zeros(n, np.int64))]
+
+
+def guess_message(catalog: Catalog, record: Record, name: str) -> str:
+    """The first record message (uorb, uorb_v0, mavlink, dronecan) whose fields hold every key of
+    the first record; the order settles a record that fits several (uORB versions share names)."""
+    data = record.data
+    if not isinstance(data, dict) or not data:
+        raise InputError(name, record.line, "expected a JSON object per line")
+    keys = set(cast(dict[str, Any], data))
+    by_endpoint = {s.endpoint: q for q, s in catalog.sources.items()}
+    for endpoint in RECORD_ENDPOINTS:
+        qualified = by_endpoint.get(endpoint)
+        if qualified is not None and keys <= {f.name for f in catalog.schema.message(qualified).fields}:
+            return qualified
+    raise InputError(
+        name,
+        record.line,
+        f"cannot tell which battery message the records are ({', '.join(sorted(keys)[:6])}...): give --message",
+    )

@@ -1,0 +1,63 @@
+"""The engine of ``battgen query``: DuckDB over an exported dataset, with the table ``battery``
+and the fleet views (:mod:`codegen.apps.export.views`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import BattgenError
+from .export.dataset import BATTERY
+from .export.views import views_sql
+
+
+@dataclass(frozen=True)
+class QueryResult:
+    columns: list[str]
+    rows: list[tuple[Any, ...]]
+
+
+def connect(dataset: Path) -> Any:
+    """A DuckDB connection with ``battery`` and the views over the dataset at ``dataset``."""
+    try:
+        import duckdb
+    except ImportError:
+        raise BattgenError("battgen query needs DuckDB: pip install 'battgen[fleet]'") from None
+    parts = dataset / BATTERY
+    if not any(parts.glob("*/*.parquet")):
+        raise BattgenError(f"{dataset}: no exported logs (expected {BATTERY}/log=*/*.parquet; run battgen export)")
+    con = duckdb.connect()
+    con.execute(views_sql((parts / "*" / "*.parquet").as_posix()))
+    return con
+
+
+def run_query(dataset: Path, sql: str) -> QueryResult:
+    """Run ``sql`` over the dataset; errors in the SQL are BattgenErrors."""
+    import duckdb
+
+    con = connect(dataset)
+    try:
+        cur = con.execute(sql)
+        columns = [d[0] for d in cur.description or []]
+        return QueryResult(columns, cur.fetchall() if columns else [])
+    except duckdb.Error as exc:
+        raise BattgenError(f"query failed: {exc}") from None
+    finally:
+        con.close()
+
+
+def query_to_parquet(dataset: Path, sql: str, out: Path) -> int:
+    """Write the result of ``sql`` to a Parquet file; the number of rows."""
+    import duckdb
+
+    con = connect(dataset)
+    try:
+        target = out.as_posix().replace("'", "''")
+        con.execute(f"COPY ({sql}) TO '{target}' (FORMAT parquet)")
+        row = con.execute(f"SELECT count(*) FROM read_parquet('{target}')").fetchall()[0]
+        return int(row[0])
+    except duckdb.Error as exc:
+        raise BattgenError(f"query failed: {exc}") from None
+    finally:
+        con.close()

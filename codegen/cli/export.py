@@ -1,0 +1,124 @@
+"""``battgen export LOG... -o DIR``: battery records of many logs into one Parquet dataset.
+
+Inputs: PX4 ULog (.ulg), MAVLink telemetry logs (.tlog), ArduPilot DataFlash logs (.bin: BAT
+readings) and JSON Lines (.jsonl/.ndjson) of any
+bundled battery message (``--message``, else told from the first record's keys); a folder stands
+for the logs under it. Every record becomes a row of one table in SI units, unknown values null,
+partitioned by log (``DIR/battery/log=<id>/``); ``--raw`` also writes each message's own table.
+A log already in the dataset (same content) is skipped; a log that cannot be read is reported at
+the end and the run goes on. Exit 0 when every log was exported or skipped, 1 when some failed,
+2 when there is nothing to read or the fleet extra is missing.
+
+``--engine dask`` runs the same per-log export as tasks on a Dask cluster (``--scheduler
+ADDRESS``, else a local one with ``--jobs`` workers); the output folder must be reachable by
+every worker under the same path.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from ..errors import BattgenError
+
+EXIT_OK, EXIT_FAILED, EXIT_UNREADABLE = 0, 1, 2
+_SUFFIXES = (".ulg", ".tlog", ".bin", ".jsonl", ".ndjson")
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "export",
+        help="export the battery records of many logs into a Parquet dataset (needs battgen[fleet])",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("logs", nargs="+", metavar="LOG", help="log files (.ulg, .tlog, .bin, .jsonl) or folders of them")
+    p.add_argument("-o", "--out", required=True, metavar="DIR", help="the dataset folder (created if needed)")
+    p.add_argument("--raw", action="store_true", help="also write each message's table, fields as decoded")
+    p.add_argument("--message", help="the message of JSON Lines inputs (default: told from their keys)")
+    p.add_argument("--jobs", type=int, default=1, metavar="N", help="logs exported in N processes (1)")
+    p.add_argument("--engine", choices=("local", "dask"), default="local", help="local processes or a Dask cluster")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="the Dask scheduler (default: a local cluster)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
+    p.set_defaults(func=run)
+
+
+def _inputs(names: list[str]) -> list[str]:
+    out: list[str] = []
+    for name in names:
+        path = Path(name)
+        if path.is_dir():
+            out.extend(sorted(p.as_posix() for p in path.rglob("*") if p.suffix.lower() in _SUFFIXES and p.is_file()))
+        else:
+            out.append(name)
+    return out
+
+
+def _progress(total: int, quiet: bool) -> tuple[Callable[[Any], None] | None, Callable[[], None]]:
+    """A tqdm bar on a terminal (stderr), else nothing."""
+    if quiet or total < 2 or not sys.stderr.isatty():
+        return None, lambda: None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return None, lambda: None
+    bar = tqdm(total=total, unit="log", file=sys.stderr)
+
+    def step(result: Any) -> None:
+        bar.update(1)
+
+    return step, bar.close
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        from ..apps.export import engine
+    except ImportError as exc:
+        print(
+            f"battgen: export needs the fleet extra ({exc.name} is missing): pip install 'battgen[fleet]'",
+            file=sys.stderr,
+        )
+        return EXIT_UNREADABLE
+    logs = _inputs(args.logs)
+    if not logs:
+        print("battgen: no logs to export (expected .ulg, .tlog, .bin or .jsonl files)", file=sys.stderr)
+        return EXIT_UNREADABLE
+    if args.jobs < 1:
+        print("battgen: --jobs must be at least 1", file=sys.stderr)
+        return EXIT_UNREADABLE
+    options = engine.ExportOptions(Path(args.out), raw=args.raw, message=args.message)
+    step, close = _progress(len(logs), args.quiet)
+    try:
+        if args.engine == "dask":
+            from ..apps.export import distributed
+
+            results = distributed.export_dask(logs, options, scheduler=args.scheduler, workers=args.jobs, progress=step)
+        else:
+            results = engine.export_logs(logs, options, jobs=args.jobs, progress=step)
+        engine.finish(options.out)
+    except ImportError as exc:
+        print(
+            f"battgen: the Dask engine needs dask.distributed ({exc.name} is missing): pip install 'battgen[fleet]'",
+            file=sys.stderr,
+        )
+        return EXIT_UNREADABLE
+    except BattgenError as exc:
+        print(f"battgen: {exc}", file=sys.stderr)
+        return EXIT_UNREADABLE
+    finally:
+        close()
+    failed = [r for r in results if r.status == "failed"]
+    for r in failed:
+        print(f"battgen: skipped {r.error}", file=sys.stderr)
+    if not args.quiet:
+        rows = sum(r.rows for r in results)
+        done, skipped = engine.count(results, "exported"), engine.count(results, "skipped")
+        print(
+            f"{len(results)} logs: {done} exported ({rows} rows), {skipped} already in the dataset, "
+            f"{len(failed)} unreadable -> {args.out}",
+            file=sys.stderr,
+        )
+    return EXIT_FAILED if failed else EXIT_OK
