@@ -7,8 +7,9 @@ their bounds too, so the OCV tables' percent column is compared cell by cell.
 
 Out of the comparison, as documented in codegen/backends/json_schema.py: cross-field rules
 (not exported) and warnings (never make an instance invalid). Instances are JSON data: NaN and the
-infinities appear as the strings the export documents; a bool is never written 1.0 and byte-array
-text is ASCII (the two places where the JSON data model cannot tell what the reader tells).
+infinities appear as the strings the export documents; a bool is never written 1.0, and byte-array
+text and text with a byte capacity (MAVLink char arrays) are ASCII (where the JSON data model cannot
+tell what the reader tells: maxLength counts characters, the capacity UTF-8 bytes).
 """
 
 from __future__ import annotations
@@ -96,6 +97,9 @@ def _value(schema: Schema, f: Field, t: FieldType, depth: int = 0) -> st.SearchS
         return _number(schema, f, t)
     if isinstance(t, StrT):
         known = [str(c) for c in f.choices] + ([f.const] if isinstance(f.const, str) else [])
+        if t.capacity is not None:  # a capacity counts UTF-8 bytes, JSON Schema's maxLength characters
+            text = st.text(alphabet=string.printable, max_size=t.capacity + 2)
+            return st.sampled_from([*known, "", "other"]) | text | JUNK
         return st.sampled_from([*known, "", "other"]) | st.text(max_size=4) | JUNK
     if isinstance(t, CompositeType):
         return _object(schema, schema.message(t.name), depth + 1)

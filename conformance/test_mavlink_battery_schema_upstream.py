@@ -175,3 +175,17 @@ def test_codec_equals_mavgen_from_corpus(mavdev: ModuleType, name: str, cls: Any
             assert _same(back.to_dict()[n], getattr(parsed[0], n)), n
 
     check()
+
+
+def test_status_flags_json_schema_agrees_with_the_generated_validator() -> None:
+    """MAV_BATTERY_STATUS_FLAGS is bits 0-18 plus EXTENDED (2**31): the gap between is refused by both."""
+    import jsonschema
+
+    from codegen.backends.json_schema import message_json_schema
+
+    exported = message_json_schema(SCHEMA, SCHEMA.message("mavlink.BATTERY_STATUS_V2"))
+    validator = jsonschema.Draft202012Validator(exported)
+    for flags, ok in ((0, True), (0x7FFFF, True), (0x80000, False), (0x80000000, True), (0x8007FFFF, True),
+                      (0x40000000, False)):  # fmt: skip
+        assert validator.is_valid({"status_flags": flags}) is ok, hex(flags)
+        assert (BatteryStatusV2(status_flags=flags).validate() == []) is ok, hex(flags)

@@ -14,6 +14,7 @@ import dataclasses
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from ..errors import BattgenError, LocatedError
 from ..frontends.loader import load
@@ -24,6 +25,7 @@ from ..ir import Message, Schema, SourceFormat
 from ..ir.expr import referenced_fields
 from ..ir.numbers import to_json_data
 from ..ir.rules import bound_rules
+from . import dt_problems
 from .failsafe.checks import NONNEGATIVE, check_settings
 from .failsafe.vehicles import detect_vehicle
 from .gate import Gate
@@ -151,6 +153,8 @@ class Checker:
 
     def check(self, record: Record) -> list[Finding]:
         instance = record.instance
+        if instance is None and self.message.devicetree is not None and isinstance(record.data, dict):
+            return self._check_node(record, record.data)
         if instance is None:
             try:
                 instance = self.cls.from_dict(record.data)
@@ -179,6 +183,33 @@ class Checker:
         ]
         findings += [self._finding(record, p, rule, value, None, text, sev) for sev, p, rule, value, text in extra]
         return sorted(findings, key=lambda f: f.line)  # stable: the validator's order within a line
+
+    def _check_node(self, record: Record, data: dict[str, Any]) -> list[Finding]:
+        """A devicetree node: every problem, in dt-validate's order (:mod:`.dt_problems`)."""
+
+        def problem(exc: BaseException) -> dt_problems.Problem:
+            f = self._type_finding(record, exc)
+            return dt_problems.Problem(f.path, f.rule, f.value, f.limit, f.message)
+
+        instance, early = dt_problems.read_node(self.cls, self.message, data, self.data_error, problem)
+        findings = [self._finding(record, p.path, p.rule, p.value, p.limit, p.text, "error") for p in early]
+        if instance is not None:
+            try:
+                violations = instance.validate()
+            except Exception as exc:
+                return [self._finding(record, "", "internal", None, None, f"the validator failed: {exc!r}", "error")]
+            # a cross-field rule reading a property left out (it did not read) would judge its absence
+            left_out = dt_problems.left_out_fields(self.message, data, early)
+            violations = [v for v in violations if not self._skipped(v, left_out)]
+            violations = [v for v in violations if not dt_problems.stood_in(str(v.path), early)]
+            findings += [
+                self._finding(
+                    record, str(v.path), str(v.rule), v.value, v.limit, str(v.message),
+                    "warning" if v.severity == "warning" else "error",
+                )
+                for v in violations
+            ]  # fmt: skip
+        return sorted(findings, key=lambda f: dt_problems.order_key(self.message, data, f.path, f.rule))
 
     def _skipped(self, v: Violation, skip: frozenset[str]) -> bool:
         rule = str(v.rule)

@@ -10,8 +10,9 @@ Decisions (the conformance test ``conformance/test_jsonschema_agreement.py`` hol
 - Sentinels validate: a field whose sentinel lies outside its range is ``anyOf [range, const]``.
 - Type widths become ``minimum``/``maximum`` (float16 at ±65504, float32 at ±3.4028235e38, finite);
   arrays get ``minItems``/``maxItems``; value enums are ``enum``; a bitmask whose allowed bits are the
-  low ones (all bundled ones: reserved bits lie above) is a ``maximum``, any other mask an ``enum`` of
-  its combinations (up to 4096), beyond that it is left to the generated validator.
+  low ones (reserved bits lie above) is a ``maximum``, low bits plus a few high ones an ``anyOf`` of
+  ranges (one per combination of the high bits), any other mask an ``enum`` of its combinations (up
+  to 4096); beyond that it is left to the generated validator.
 - Absent fields take their defaults in ``from_dict``; a field whose default is not valid (uORB
   ``max_error`` = 0 against its range 1..100) is therefore ``required``, as are devicetree
   ``required`` properties.
@@ -250,6 +251,10 @@ def _number(schema: Schema, f: Field, t: PrimitiveType) -> dict[str, Any]:
             core["maximum"] = min(core.get("maximum", mask), mask)
         elif bin(mask).count("1") <= _MAX_MASK_ENUM.bit_length() - 1:
             core["enum"] = _mask_values(mask)
+        elif bin(mask & (mask + 1)).count("1") <= _MAX_MASK_ENUM.bit_length() - 1:
+            # low bits plus a few high ones (MAVLink's ..._FLAGS_EXTENDED = 2**31): one range per high combination
+            low = mask ^ (mask & (mask + 1))
+            core["anyOf"] = [{"minimum": h, "maximum": h | low} for h in _mask_values(mask & (mask + 1))]
     alternatives = [core]
     if is_float and high == math.inf:
         alternatives.append({"enum": INF_STRINGS})
@@ -287,6 +292,8 @@ def _core_accepts(core: dict[str, Any], value: float) -> bool:
     if "exclusiveMinimum" in core and value <= core["exclusiveMinimum"]:
         return False
     if "exclusiveMaximum" in core and value >= core["exclusiveMaximum"]:
+        return False
+    if "anyOf" in core and not any(r["minimum"] <= value <= r["maximum"] for r in core["anyOf"]):
         return False
     return "enum" not in core or value in core["enum"]
 

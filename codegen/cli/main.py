@@ -16,11 +16,11 @@ from ..errors import BattgenError
 from ..frontends.loader import load
 from ..ir import Schema
 from ..ir import json_form as irjson
-from . import can, convert, docs, export, failsafe, params, query, schema, validate, vectors
+from . import can, convert, docs, export, failsafe, params, query, report, schema, validate, vectors
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 # in the order of the help text
-COMMAND_MODULES = (validate, docs, schema, convert, vectors, params, failsafe, can, export, query)
+COMMAND_MODULES = (validate, docs, schema, convert, vectors, params, failsafe, can, export, query, report)
 
 
 def _load(paths: Sequence[str], args: argparse.Namespace) -> Schema:

@@ -1,0 +1,153 @@
+"""The report page: one self-contained HTML file, plotly's JavaScript embedded, no network fetch.
+
+One section per battery of every input: the figures, the failsafe events, the validation findings grouped by
+rule (each with its count and a link to the time it first happened) and the time plots. With more than one
+input the page opens with the fleet view (:mod:`.fleet`). The figures' data sits in one JSON block that the
+page's script hands to plotly; links to a time zoom the battery's plots to ±10 s around it.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from importlib import resources
+from pathlib import PurePath
+from typing import Any
+
+import jinja2
+
+from ... import __version__
+from ...errors import BattgenError
+from ..validate import Finding
+from .downsample import POINT_BUDGET
+from .figures import compute
+from .fleet import FleetView
+from .plots import Marker, figure
+from .series import BatterySeries, InputSeries
+
+NEEDS_PLOTLY = "the HTML report embeds plotly's JavaScript: pip install 'battgen[report]'"
+_CSS = {"LOW": "warn", "CRITICAL": "bad", "error": "bad", "warning": "warn"}
+
+
+@dataclass(frozen=True)
+class FailsafeEvent:
+    """A failsafe transition to show: time, battery, level, and the operator text."""
+
+    t: float
+    battery: int
+    level: str
+    text: str
+
+
+@dataclass
+class Replay:
+    """The failsafe replay of one input: its events, and a note when there was none (no parameters...)."""
+
+    events: list[FailsafeEvent] = field(default_factory=list)
+    note: str = ""
+    # battery (0-based, as the series number them) -> {parameter name: volts}, drawn on the voltage plot
+    thresholds: dict[int, dict[str, float]] = field(default_factory=dict)
+
+
+def plotly_js() -> str:
+    """plotly.js, minified, from the plotly package (its JavaScript is what the page embeds)."""
+    try:
+        offline = importlib.import_module("plotly.offline")  # untyped: imported by name
+    except ImportError as exc:
+        raise BattgenError(NEEDS_PLOTLY) from exc
+    return str(offline.get_plotlyjs())
+
+
+def _grouped(findings: Sequence[tuple[float, int, Finding]], battery: int) -> list[dict[str, object]]:
+    groups: dict[tuple[str, str, str], dict[str, object]] = {}
+    for t, b, f in findings:
+        if b != battery:
+            continue
+        key = (f.rule, f.path, f.severity)
+        group = groups.get(key)
+        if group is None:
+            groups[key] = {"count": 1, "t": t, "text": f.message, "css": _CSS.get(f.severity, "")}
+        else:
+            group["count"] = int(str(group["count"])) + 1
+    return sorted(groups.values(), key=lambda g: (-int(str(g["count"])), str(g["text"])))
+
+
+def _section(
+    s: BatterySeries, findings: Sequence[tuple[float, int, Finding]], replay: Replay, index: int
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    plot_id = f"plot-{index}"
+    events = [e for e in replay.events if e.battery == s.battery]
+    markers = [Marker(e.t, e.level, e.text) for e in events]
+    context = {
+        "id": f"battery-{index}",
+        "plot_id": plot_id,
+        "label": s.label,
+        "serial": s.serial,
+        "figures": compute(s, replay.thresholds.get(s.battery, {})).rows(),
+        "events": [{"t": e.t, "level": e.level, "text": e.text, "css": _CSS.get(e.level, "")} for e in events],
+        "failsafe_note": replay.note,
+        "findings": _grouped(findings, s.battery),
+    }
+    return context, figure(s, markers, replay.thresholds.get(s.battery, {}))
+
+
+def render(
+    inputs: Sequence[InputSeries],
+    replays: Mapping[str, Replay],
+    *,
+    fleet: FleetView | None = None,
+    title: str = "",
+    now: datetime | None = None,
+) -> str:
+    """The page's HTML text."""
+    env = jinja2.Environment(loader=jinja2.FunctionLoader(_template), autoescape=True, undefined=jinja2.StrictUndefined)
+    figures: dict[str, Any] = {}
+    sections = []
+    index = 0
+    for item in inputs:
+        replay = replays.get(item.source, Replay())
+        batteries = []
+        for s in item.batteries:
+            context, fig = _section(s, item.findings, replay, index)
+            figures[context["plot_id"]] = fig
+            batteries.append(context)
+            index += 1
+        notices = [n.message for n in item.notices if n.severity != "info"]
+        notices += [u.message for u in item.unreadable]
+        name = PurePath(item.source).name or item.source
+        sections.append({"source": item.source, "name": name, "batteries": batteries, "notices": notices})
+    fleet_context = None
+    if fleet is not None:
+        fleet_context = {
+            "header": fleet.header,
+            "rows": fleet.rows,
+            "trends": bool(fleet.trends["data"]),
+            "trends_key": "trends",
+        }
+        if fleet.trends["data"]:
+            figures["trends"] = fleet.trends
+    stamp = (now or datetime.now(UTC)).strftime("%Y-%m-%d %H:%M UTC")
+    count = sum(len(i.batteries) for i in inputs)
+    first = PurePath(inputs[0].source).name if inputs else ""
+    page_title = title or (first if len(inputs) == 1 else f"{len(inputs)} flights") + " — battery report"
+    subtitle = (
+        f"{len(inputs)} input(s), {count} battery instance(s); made by battgen {__version__} on {stamp}; "
+        f"plots show at most {POINT_BUDGET} points per trace"
+    )
+    text = json.dumps(figures, allow_nan=False, separators=(",", ":")).replace("</", "<\\/")
+    return env.get_template("report.html.j2").render(
+        title=page_title,
+        subtitle=subtitle,
+        version=__version__,
+        plotly_js=plotly_js(),
+        inputs=sections,
+        fleet=fleet_context,
+        figures_json=text,
+    )
+
+
+def _template(name: str) -> str:
+    return resources.files(__package__).joinpath("templates", name).read_text(encoding="utf-8")

@@ -1,0 +1,161 @@
+"""The plotly figure of one battery: time plots sharing one time axis, failsafe events marked across them.
+
+Rows (each only when the battery reports it): pack voltage with the failsafe thresholds, current, power, state of
+charge, temperature, every cell, and the cell imbalance (max - min). Traces are decimated to the point budget of
+:mod:`.downsample`; every trace's ``meta`` holds its sample count before decimation, so a reader (or the browser
+test) can tell what was drawn from what was read.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from .downsample import POINT_BUDGET, decimate
+from .series import BatterySeries
+
+ROW_HEIGHT = 190
+LEVEL_COLOURS = {"LOW": "#d98200", "CRITICAL": "#c62828", "NONE": "#2e7d32"}
+
+
+@dataclass(frozen=True)
+class Marker:
+    """A failsafe event drawn on the time axis."""
+
+    t: float
+    level: str
+    text: str  # e.g. "LOW: RTL (voltage 10.4 V < 10.5 V)"
+
+
+def _rows(s: BatterySeries) -> list[tuple[str, str, list[tuple[str, Sequence[float | None]]]]]:
+    """(title, unit, traces) per row, leaving out rows the battery has no values for."""
+    rows: list[tuple[str, str, list[tuple[str, Sequence[float | None]]]]] = [
+        ("pack voltage", "V", [("pack voltage", s.pack_voltage)]),
+        ("current", "A", [("current", s.current)]),
+        ("power", "W", [("power", s.power)]),
+        ("state of charge", "%", [("state of charge", s.state_of_charge)]),
+        ("temperature", "°C", [("temperature", s.temperature)]),
+        ("cells", "V", [(f"cell {k + 1}", s.cell(k)) for k in range(s.cell_count)]),
+        ("cell imbalance", "mV", [("max - min", [None if v is None else v * 1000 for v in s.imbalance])]),
+    ]
+    return [
+        (title, unit, [(n, v) for n, v in traces if any(x is not None for x in v)])
+        for title, unit, traces in rows
+        if any(any(x is not None for x in v) for _, v in traces)
+    ]
+
+
+def figure(
+    s: BatterySeries,
+    markers: Sequence[Marker] = (),
+    thresholds: dict[str, float] | None = None,
+    budget: int = POINT_BUDGET,
+) -> dict[str, Any]:
+    """The figure as plotly JSON data (``{"data": [...], "layout": {...}}``), built without plotly's Python API
+    so that the page's JSON is exactly what this module says."""
+    rows = _rows(s)
+    data: list[dict[str, Any]] = []
+    layout: dict[str, Any] = {
+        "height": max(1, len(rows)) * ROW_HEIGHT + 60,
+        "margin": {"l": 70, "r": 20, "t": 44, "b": 40},
+        "showlegend": False,
+        "hovermode": "x unified",
+        "shapes": [],
+        "annotations": [],
+        "template": None,
+        "plot_bgcolor": "#fafafa",
+    }
+    gap = 0.04
+    height = (1.0 - gap * (len(rows) - 1)) / max(1, len(rows))
+    for r, (title, unit, traces) in enumerate(rows):
+        axis = "" if r == 0 else str(r + 1)
+        top = 1.0 - r * (height + gap)
+        layout[f"xaxis{axis}"] = {
+            "matches": "x" if r else None,
+            "showticklabels": r == len(rows) - 1,
+            "title": {"text": "time [s]"} if r == len(rows) - 1 else None,
+            "anchor": f"y{axis}",
+            "domain": [0, 1],
+        }
+        layout[f"yaxis{axis}"] = {
+            "title": {"text": f"{title} [{unit}]", "font": {"size": 11}},
+            "domain": [max(0.0, top - height), top],
+            "anchor": f"x{axis}",
+        }
+        for name, values in traces:
+            xs, ys = decimate(s.t, values, budget)
+            data.append(
+                {
+                    "type": "scattergl" if len(xs) > 5000 else "scatter",
+                    "mode": "lines",
+                    "name": name,
+                    "x": xs,
+                    "y": ys,
+                    "xaxis": f"x{axis}",
+                    "yaxis": f"y{axis}",
+                    "line": {"width": 1.2},
+                    "meta": {"row": title, "samples": sum(1 for v in values if v is not None)},
+                    "hovertemplate": f"%{{y:.3f}} {unit}<extra>{name}</extra>",
+                }
+            )
+        if title == "pack voltage":
+            for name, volts in (thresholds or {}).items():
+                if volts > 0:
+                    layout["shapes"].append(
+                        {
+                            "type": "line",
+                            "xref": "x domain",
+                            "x0": 0,
+                            "x1": 1,
+                            "yref": "y",
+                            "y0": volts,
+                            "y1": volts,
+                            "line": {"dash": "dash", "width": 1, "color": "#888"},
+                        }
+                    )
+                    layout["annotations"].append(
+                        {
+                            "xref": "x domain",
+                            "x": 1,
+                            "yref": "y",
+                            "y": volts,
+                            "text": name,
+                            "showarrow": False,
+                            "xanchor": "right",
+                            "yanchor": "bottom",
+                            "font": {"size": 10, "color": "#666"},
+                        }
+                    )
+    for m in markers:
+        colour = LEVEL_COLOURS.get(m.level, "#555")
+        layout["shapes"].append(
+            {
+                "type": "line",
+                "xref": "x",
+                "x0": m.t,
+                "x1": m.t,
+                "yref": "paper",
+                "y0": 0,
+                "y1": 1,
+                "line": {"color": colour, "width": 2},
+                "name": f"failsafe {m.level}",
+            }
+        )
+        layout["annotations"].append(
+            {
+                "xref": "x",
+                "x": m.t,
+                "yref": "paper",
+                "y": 1.0,
+                "text": m.level,
+                "showarrow": False,
+                "yanchor": "bottom",
+                "hovertext": m.text,
+                "font": {"color": colour, "size": 11},
+            }
+        )
+    for key in list(layout):
+        if key.startswith("xaxis") and layout[key].get("matches") is None:
+            layout[key].pop("matches", None)
+    return {"data": data, "layout": layout}

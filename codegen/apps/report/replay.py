@@ -1,0 +1,83 @@
+"""The failsafe replay shown in a report: the same evaluator as ``battgen failsafe``, on the same samples.
+
+Parameters come from ``--params`` (a .param/.params file), else from a DataFlash log's own PARM records; the
+vehicle from ``--vehicle``, else detected from the parameters (:func:`~..failsafe.vehicles.detect_vehicle`).
+Flight logs the failsafe reads itself (``.ulg`` with the arming state, ``.tlog``, ``.bin``) are replayed from its
+own samples, so the report's markers are exactly ``battgen failsafe``'s events; other inputs (CAN captures, JSON
+Lines) are replayed from the report's series, taken as armed throughout (said on the page). Event times are moved
+onto the report's time axis (seconds since the input's first battery record).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+from ...errors import BattgenError
+from ..failsafe.evaluator import BatteryFailsafe, Event, make_failsafe
+from ..failsafe.logs import LOG_KINDS, bin_parameters, log_kind, read_log
+from ..failsafe.reading import BatteryReading
+from ..failsafe.settings import battery_settings
+from ..failsafe.stream import Sample, read_parameter_values
+from ..failsafe.vehicles import detect_vehicle
+from .page import FailsafeEvent, Replay
+from .series import InputSeries
+
+NO_PARAMS = "no failsafe parameters: give --params FILE (BATT_* values) to replay the failsafe"
+
+
+def _series_samples(item: InputSeries) -> Iterator[Sample]:
+    """Samples from the report's series, in time order across batteries (armed throughout)."""
+    rows = []
+    for s in item.batteries:
+        for k, t in enumerate(s.t):
+            volts, amps, used = s.pack_voltage[k], s.current[k], s.discharged[k]
+            rows.append((t, s.battery + 1, BatteryReading(volts, amps if amps is None or amps >= 0 else None, used)))
+    rows.sort(key=lambda r: (r[0], r[1]))
+    for k, (t, instance, reading) in enumerate(rows):
+        yield Sample(k + 1, t, True, reading, None, None, {}, instance, f"sample {k + 1}")
+
+
+def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | None) -> Replay:
+    """The failsafe events of every battery of one input, on the report's time axis."""
+    kind = log_kind(path)
+    if params is not None:
+        values, where = read_parameter_values(params), str(params)
+    elif kind == "bin":
+        values, where = bin_parameters(path), "the log's PARM records"
+    else:
+        return Replay(note=NO_PARAMS)
+    try:
+        detection = detect_vehicle(values, vehicle)
+        failsafe = make_failsafe(battery_settings(values, detection.vehicle), detection.vehicle)
+    except ValueError as exc:
+        raise BattgenError(f"{where}: {exc}") from None
+    samples = read_log(path, kind) if kind in LOG_KINDS else _series_samples(item)
+    offset = _run(failsafe, samples)
+    note = f"replayed with {where}; vehicle {detection.how}"
+    if kind not in LOG_KINDS:
+        note += "; taken as armed throughout (this input has no arming state)"
+    thresholds = {
+        s.instance - 1: {"BATT_LOW_VOLT": s.low_volt, "BATT_CRT_VOLT": s.crt_volt} for s in failsafe.settings.values()
+    }
+    events = [FailsafeEvent(e.time - offset, e.battery - 1, e.level.name, _text(e)) for e in failsafe.events]
+    return Replay(events, note, thresholds)
+
+
+def _run(failsafe: BatteryFailsafe, samples: Iterator[Sample]) -> float:
+    """Feed every sample; the time of the first (the report's time 0)."""
+    offset: float | None = None
+    for sample in samples:
+        if offset is None:
+            offset = sample.t
+        try:
+            failsafe.update(sample.t, sample.battery, armed=sample.armed, instance=sample.instance, **sample.extra)
+        except ValueError as exc:
+            raise BattgenError(f"{sample.place}: {exc}") from None
+    return offset or 0.0
+
+
+def _text(e: Event) -> str:
+    """The action and what happened, then ArduPilot's own STATUSTEXT."""
+    ran = f"{e.action} -> {e.outcome}" if e.executed else f"{e.action}: not run (a higher-priority action already ran)"
+    return f"{e.cause} {ran}: \u201c{e.ardupilot_text}\u201d"

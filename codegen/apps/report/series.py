@@ -1,0 +1,234 @@
+"""Battery time series from any log, capture or data file battgen reads, one per battery instance.
+
+Every record is read by the data readers (:func:`codegen.inputs.dispatch.read_records`), checked by the
+message's generated validator (the findings go into the report) and turned into the shared battery concepts by
+the generated converters, so a PX4 ULog, a MAVLink tlog, a DroneCAN capture and a JSON Lines file all give the
+same SI columns. Unknown values (every sentinel) are ``None``, which the plots draw as gaps.
+
+Which battery a record belongs to: the ULog ``multi_id``, the CAN node, else the message's own battery index
+(MAVLink ``id``). Time: seconds since the first record of the file, from the log's timestamps (ULog, tlog, CAN)
+or the record's ``timestamp`` field (microseconds, as uORB and the JSON forms of it carry); without either, the
+record's position (one per second) -- said in the series' ``time_source``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ...errors import BattgenError
+from ...inputs.dispatch import KIND_FORMATS, file_kind, read_records
+from ...inputs.model import package_name
+from ...inputs.records import Notice, Record, Unreadable
+from ...ir import SourceFormat
+from ..convert import Conversion
+from ..validate import Checker, Finding, make_checker
+
+DEFAULT_MESSAGES = {
+    SourceFormat.UORB: "uorb.BatteryStatus",
+    SourceFormat.MAVLINK: "mavlink.BATTERY_STATUS",
+    SourceFormat.DRONECAN: "dronecan.uavcan.equipment.power.BatteryInfo",
+}
+KELVIN = 273.15
+COULOMB_PER_MAH = 3.6
+
+
+@dataclass
+class BatterySeries:
+    """One battery of one input: its samples in SI (temperature in °C, charge in mAh, energy in Wh)."""
+
+    source: str
+    battery: int
+    instance_word: str  # how the input names its instances: "multi_id", "node", "id"
+    message: str
+    time_source: str = "log"
+    t: list[float] = field(default_factory=list)
+    pack_voltage: list[float | None] = field(default_factory=list)
+    current: list[float | None] = field(default_factory=list)
+    state_of_charge: list[float | None] = field(default_factory=list)  # percent
+    temperature: list[float | None] = field(default_factory=list)  # °C
+    discharged: list[float | None] = field(default_factory=list)  # mAh
+    remaining_energy: list[float | None] = field(default_factory=list)  # Wh
+    cells: list[list[float]] = field(default_factory=list)  # known cell voltages of each sample
+    serial: str = ""
+    cycle_count: int | None = None  # the last the battery reported
+    state_of_health: float | None = None  # percent, the last the battery reported
+    armed: list[tuple[float, bool]] = field(default_factory=list)  # arming changes, where the input tells
+
+    @property
+    def label(self) -> str:
+        if self.instance_word == "node":  # a DroneCAN battery is known by its node id
+            return f"node {self.battery}"
+        return f"battery {self.battery + 1} ({self.instance_word} {self.battery})"
+
+    @property
+    def power(self) -> list[float | None]:
+        return [
+            v * i if v is not None and i is not None else None
+            for v, i in zip(self.pack_voltage, self.current, strict=True)
+        ]
+
+    @property
+    def cell_count(self) -> int:
+        return max((len(c) for c in self.cells), default=0)
+
+    def cell(self, k: int) -> list[float | None]:
+        return [c[k] if k < len(c) else None for c in self.cells]
+
+    @property
+    def imbalance(self) -> list[float | None]:
+        """max - min cell voltage of each sample with at least two known cells."""
+        return [max(c) - min(c) if len(c) >= 2 else None for c in self.cells]
+
+
+@dataclass
+class InputSeries:
+    """What one input gave: its batteries, its validation findings and notices, what could not be read."""
+
+    source: str
+    message: str
+    batteries: list[BatterySeries]
+    findings: list[tuple[float, int, Finding]]  # (t, battery, finding)
+    notices: list[Notice]
+    unreadable: list[Unreadable]
+    records: int
+    not_converted: int = 0
+
+
+def _number(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    return float(value) if math.isfinite(value) else None
+
+
+def _time(record: Record, index: int) -> tuple[float | None, str]:
+    loc: Mapping[str, object] = record.location or {}
+    t = loc.get("t")
+    if isinstance(t, int | float):
+        return float(t), "log"
+    stamp = loc.get("timestamp_us")
+    if isinstance(stamp, int):
+        return stamp / 1e6, "log"
+    data = record.instance.to_dict() if record.instance is not None else record.data
+    if isinstance(data, Mapping):
+        value = data.get("timestamp")
+        if isinstance(value, int) and not isinstance(value, bool) and value > 0:
+            return value / 1e6, "field"
+    return float(index), "position"
+
+
+def _battery(record: Record, state: Mapping[str, Any]) -> tuple[int, str]:
+    loc: Mapping[str, object] = record.location or {}
+    for key, word in (("multi_id", "multi_id"), ("node", "node")):
+        value = loc.get(key)
+        if isinstance(value, int):
+            return value, word
+    index = state.get("battery_index")
+    return (index if isinstance(index, int) else 0), "id"
+
+
+def default_message(path: Path, kind: str | None) -> str:
+    fmt = KIND_FORMATS.get(kind or file_kind(path))
+    if fmt is None or fmt not in DEFAULT_MESSAGES:
+        raise BattgenError(f"{path}: give --message for this input (e.g. uorb.BatteryStatus)")
+    return DEFAULT_MESSAGES[fmt]
+
+
+def read_input(
+    path: Path, schema_dir: Path, *, message: str | None = None, kind: str | None = None, display: str | None = None
+) -> InputSeries:
+    """Every battery of one input as series, with the validator's findings. Raises a BattgenError (a
+    LocatedError naming file and line for a damaged input) when the input cannot be read at all."""
+    name = display or path.as_posix()
+    msg, checker = make_checker(schema_dir, message or default_message(path, kind), [str(path)], kind)
+    conversion = Conversion(_package_of(checker), msg.qualified_name, "concepts", "strict")
+    batteries: dict[int, BatterySeries] = {}
+    out = InputSeries(name, msg.qualified_name, [], [], [], [], 0)
+    t0: float | None = None
+    for item in read_records(path, msg, name, model=checker.cls, kind=kind):
+        if isinstance(item, Notice):
+            out.notices.append(item)
+            continue
+        if isinstance(item, Unreadable):
+            out.unreadable.append(item)
+            continue
+        out.records += 1
+        t, source = _time(item, out.records - 1)
+        t0 = t if t0 is None else t0
+        state = _state(conversion, item)
+        if state is None:
+            out.not_converted += 1
+            continue
+        number, word = _battery(item, state)
+        series = batteries.get(number)
+        if series is None:
+            series = batteries[number] = BatterySeries(name, number, word, msg.qualified_name, source)
+        _append(series, (t or 0.0) - (t0 or 0.0), state)
+        for finding in checker.check(item):
+            out.findings.append(((t or 0.0) - (t0 or 0.0), number, finding))
+    out.batteries = [batteries[k] for k in sorted(batteries)]
+    return out
+
+
+def _package_of(checker: Checker) -> str:
+    return package_name(checker.cls)
+
+
+_CONCEPTS = (
+    "pack_voltage",
+    "current",
+    "state_of_charge",
+    "temperature",
+    "discharged",
+    "remaining_energy",
+    "cell_voltages",
+    "state_of_health",
+    "cycle_count",
+    "serial_number",
+    "battery_index",
+)
+
+
+def _state(conversion: Conversion, record: Record) -> Mapping[str, Any] | None:
+    """The concepts the report draws, read off the converter's state (not its whole ``to_dict``)."""
+    try:
+        objs = conversion.source.build(record)
+        state = conversion.func(*objs, policy="strict", report=conversion.module.LossReport())
+    except (BattgenError, ValueError, TypeError, AttributeError):  # ConversionError is a ValueError
+        return None
+    return {name: getattr(state, name, None) for name in _CONCEPTS}
+
+
+def _append(series: BatterySeries, t: float, state: Mapping[str, Any]) -> None:
+    series.t.append(t)
+    series.pack_voltage.append(_number(state.get("pack_voltage")))
+    series.current.append(_number(state.get("current")))
+    soc = _number(state.get("state_of_charge"))
+    series.state_of_charge.append(None if soc is None else soc * 100.0)
+    kelvin = _number(state.get("temperature"))
+    series.temperature.append(None if kelvin is None else kelvin - KELVIN)
+    charge = _number(state.get("discharged"))
+    series.discharged.append(None if charge is None else charge / COULOMB_PER_MAH)
+    energy = _number(state.get("remaining_energy"))
+    series.remaining_energy.append(None if energy is None else energy / 3600.0)
+    cells = state.get("cell_voltages") or []
+    series.cells.append([v for v in (_number(c) for c in cells) if v is not None and v > 0.0])
+    health = _number(state.get("state_of_health"))
+    if health is not None and health > 0:
+        series.state_of_health = health * 100.0
+    cycles = state.get("cycle_count")
+    if isinstance(cycles, int) and not isinstance(cycles, bool) and cycles > 0:
+        series.cycle_count = cycles
+    serial = state.get("serial_number")
+    if isinstance(serial, int) and not isinstance(serial, bool) and serial > 0:
+        serial = str(serial)  # the concept is an integer (DroneCAN model_instance_id, PX4's uint16)
+    if isinstance(serial, str) and serial.strip("\x00 0") and not series.serial:
+        series.serial = serial
+
+
+def read_inputs(paths: list[Path], schema_dir: Path, *, message: str | None = None) -> Iterator[InputSeries]:
+    for path in paths:
+        yield read_input(path, schema_dir, message=message)

@@ -1,0 +1,80 @@
+"""``battgen report LOG... [-o report.html] [--format html|png]``: a flight's battery at a glance.
+
+Reads any log or capture battgen reads (PX4 ``.ulg``, MAVLink ``.tlog``, CAN captures, JSON Lines of a bundled
+message with ``--message``) and writes one self-contained HTML page (plotly embedded, opens offline): per battery
+instance the time plots of pack voltage, current, power, state of charge, temperature and every cell with the
+imbalance, the failsafe replay marked on the time axis (``--params`` with the BATT_* values, ``--vehicle``), the
+validation findings grouped by rule with links to their time, and the figures (charge and energy used, average
+and peak power, minimum pack and cell voltage, time under each threshold, voltage sag per amp and an internal
+resistance estimate from load steps). Several inputs give a fleet page: a row per flight and battery, and trends
+per pack serial. ``--format png`` writes one static image per battery into the ``-o`` folder instead.
+Exit 0 when written, 2 when an input cannot be read or the output cannot be written.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from ..apps.package import bundled_schemas
+from ..apps.report.build import collect, html, pngs
+from ..errors import BattgenError
+
+EXIT_OK = 0
+
+
+def run(args: argparse.Namespace) -> int:
+    schema_dir = Path(args.schemas) if args.schemas else bundled_schemas()
+    paths = [Path(p) for p in args.logs]
+    for p in paths:
+        if not p.is_file():
+            raise BattgenError(f"{p}: cannot read file: no such file")
+    report = collect(
+        paths, schema_dir, message=args.message, params=Path(args.params) if args.params else None, vehicle=args.vehicle
+    )
+    if not any(i.batteries for i in report.inputs):
+        raise BattgenError("no battery records in the input(s): nothing to report")
+    if args.format == "png":
+        folder = Path(args.output or "report")
+        if folder.exists() and not folder.is_dir():
+            raise BattgenError(f"{folder}: --format png writes a folder of images, and this is a file")
+        for path in pngs(report, folder):
+            print(f"wrote {path}")
+        return EXIT_OK
+    out = Path(args.output or "report.html")
+    if out.is_dir():
+        raise BattgenError(f"{out}: is a folder; give the report's file name (-o report.html)")
+    if not out.parent.is_dir():
+        raise BattgenError(f"{out.parent}: no such folder for the report")
+    text = html(report, title=args.title or "")
+    try:
+        out.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise BattgenError(f"{out}: cannot write: {exc.strerror or exc}") from None
+    batteries = sum(len(i.batteries) for i in report.inputs)
+    print(f"wrote {out} ({len(report.inputs)} input(s), {batteries} battery instance(s), {len(text) // 1024} KiB)")
+    return EXIT_OK
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "report",
+        help="an HTML report (or PNG images) of a flight's battery: plots, failsafe replay, findings, figures",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("logs", nargs="+", metavar="LOG", help=".ulg, .tlog, CAN captures, or data files with --message")
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="PATH",
+        help="the HTML file (default report.html), or with --format png the folder of images (default report/)",
+    )
+    p.add_argument("--format", choices=("html", "png"), default="html", help="output (default: html)")
+    p.add_argument("--message", metavar="NAME", help="the message of data-file inputs (default by log kind)")
+    p.add_argument("--schemas", metavar="DIR", help="schema folder (default: the bundled schemas/)")
+    p.add_argument("--params", metavar="FILE", help="BATT_* parameter file to replay the failsafe with")
+    p.add_argument("--vehicle", metavar="NAME", help="vehicle profile of the failsafe (rover, copter, plane, sub)")
+    p.add_argument("--title", metavar="TEXT", help="the page's title")
+    p.set_defaults(func=run)

@@ -1,0 +1,120 @@
+"""``battgen report`` without a browser: the figures against the physics of a known flight, the decimation, the
+page's self-containment, PNG output, and clear errors.
+
+The synthetic flights (``flight_logs.py``) are built from a pack model with a known internal resistance and a
+known current profile, so the figures are checked against those quantities, not against our own output.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+from flight_logs import CELLS, RESISTANCE, write_capture_flight, write_flight
+
+from codegen.apps.package import bundled_schemas
+from codegen.apps.report.downsample import POINT_BUDGET, decimate, planned_length
+from codegen.apps.report.figures import compute, integrate
+from codegen.apps.report.series import read_input
+from codegen.cli.main import main
+
+pytest.importorskip("plotly")
+
+
+@pytest.fixture(scope="module")
+def flight(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_flight(tmp_path_factory.mktemp("report") / "flight.ulg", seconds=300, hz=10, packs=2)
+
+
+def test_every_battery_instance_is_read(flight: Path) -> None:
+    item = read_input(flight, bundled_schemas())
+    assert [(b.battery, len(b.t)) for b in item.batteries] == [(0, 3000), (1, 3000)]
+    assert all(b.cell_count == CELLS for b in item.batteries)
+    assert item.findings == []  # the synthetic records are valid
+
+
+def test_internal_resistance_from_load_steps_is_the_packs(flight: Path) -> None:
+    item = read_input(flight, bundled_schemas())
+    for battery, ohms in zip(item.batteries, RESISTANCE, strict=True):
+        f = compute(battery)
+        assert f.internal_resistance_ohm == pytest.approx(ohms, rel=0.03)
+        assert f.sag_per_amp_v_per_a == pytest.approx(ohms, rel=0.03)
+        # a step every 30 s for 300 s: 9, less the three cruise-to-hover steps (7 A) under 20 % of the 42 A peak
+        assert f.load_steps == 6
+
+
+def test_charge_and_energy_used(flight: Path) -> None:
+    item = read_input(flight, bundled_schemas())
+    b = item.batteries[0]
+    f = compute(b)
+    # the counter the log carries, and the integral of the current it logged, agree
+    amp_hours = integrate(b.t, b.current)
+    assert amp_hours is not None
+    assert f.charge_used_mah == pytest.approx(amp_hours / 3.6, rel=0.01)
+    assert f.energy_used_wh is not None and f.average_power_w is not None
+    assert f.energy_used_wh == pytest.approx(f.average_power_w * f.duration_s / 3600, rel=1e-9)
+    assert f.peak_current_a == pytest.approx(42.0)
+    assert f.time_below_s == {}
+    below = compute(b, {"BATT_LOW_VOLT": 30.0})  # above the whole flight: all of it is below
+    assert below.time_below_s["BATT_LOW_VOLT"] == pytest.approx(f.duration_s, rel=1e-6)
+
+
+def test_decimation_keeps_every_peak() -> None:
+    t = [k * 0.1 for k in range(36000)]
+    v = [20.0 + (5.0 if k == 12345 else 0.0) - (3.0 if k == 30001 else 0.0) for k in range(36000)]
+    xs, ys = decimate(t, v)
+    assert len(xs) == planned_length(36000) == POINT_BUDGET
+    assert max(y for y in ys if y is not None) == 25.0 and min(y for y in ys if y is not None) == 17.0
+    assert xs == sorted(xs)
+    small_t, small_v = decimate(t[:50], v[:50])
+    assert small_t == t[:50] and small_v == v[:50]
+
+
+def test_page_is_self_contained(tmp_path: Path, flight: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "r.html"
+    assert main(["report", str(flight), "-o", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    # no script, style or image from anywhere else: the page opens offline
+    assert not re.search(r"<(script|link|img)[^>]+(src|href)=\"(https?:)?//", text)
+    data = json.loads(re.search(r'<script id="figures" type="application/json">(.*?)</script>', text, re.S)[1])
+    assert set(data) == {"plot-0", "plot-1"}
+    assert "wrote" in capsys.readouterr().out
+
+
+def test_capture_and_fleet(tmp_path: Path) -> None:
+    logs = [write_capture_flight(tmp_path / f"c{k}.log", seconds=20, health=90 - k) for k in range(2)]
+    out = tmp_path / "fleet.html"
+    assert main(["report", *map(str, logs), "-o", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert 'id="flights"' in text and "pack 777" in text
+
+
+def test_png_images(tmp_path: Path, flight: Path) -> None:
+    pytest.importorskip("matplotlib")
+    folder = tmp_path / "images"
+    assert main(["report", str(flight), "--format", "png", "-o", str(folder)]) == 0
+    images = sorted(folder.glob("*.png"))
+    assert [p.name for p in images] == ["flight.ulg-battery1.png", "flight.ulg-battery2.png"]
+    assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 20000 for p in images)
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["absent.ulg"], "absent.ulg: cannot read file"),
+        (["{flight}", "-o", "{tmp}"], "is a folder"),
+        (["{flight}", "-o", "{tmp}/missing/r.html"], "no such folder"),
+        (["{empty}", "--message", "uorb.BatteryStatus"], "no battery records"),
+    ],
+)
+def test_errors_are_one_line(
+    tmp_path: Path, flight: Path, capsys: pytest.CaptureFixture[str], args: list[str], expected: str
+) -> None:
+    empty = tmp_path / "empty.jsonl"
+    empty.write_text("")
+    argv = [a.format(flight=flight, tmp=tmp_path, empty=empty) for a in args]
+    code = main(["report", *argv])
+    err = capsys.readouterr().err
+    assert code == 2 and expected in err and "Traceback" not in err

@@ -1,0 +1,130 @@
+"""``battgen report`` pages opened in headless Chromium: they load offline without errors, every expected plot
+holds the points the data has (after the documented decimation), failsafe markers sit at the replayed times.
+
+Pages: each shared real PX4 log, a synthetic one-hour 10 Hz two-battery flight, and a fleet page over several
+logs. The screenshots are kept as test artefacts (see ``report_browser.py``); the load times are printed.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from flight_logs import write_capture_flight, write_flight
+from report_browser import Page, open_page, require_browser
+
+from codegen.apps.report.downsample import POINT_BUDGET, planned_length
+from codegen.cli.main import main
+
+pytest.importorskip("plotly")
+# shared/ lies beside the checkout (CI copies it there); a worktree elsewhere finds it in /work
+_SHARED = [Path(__file__).resolve().parents[3] / "shared", Path("/work/shared")]
+SHARED = next((p for p in _SHARED if p.is_dir()), _SHARED[0]) / "data" / "ulog"
+REAL_LOGS = sorted(SHARED.glob("*.ulg"))
+
+
+def _report(tmp_path: Path, name: str, *inputs: Path, extra: tuple[str, ...] = ()) -> Path:
+    out = tmp_path / f"{name}.html"
+    assert main(["report", *map(str, inputs), "-o", str(out), *extra]) == 0
+    return out
+
+
+def _check(page: Page, file_url: str) -> None:
+    severe = [e for e in page.console if e.get("level") == "SEVERE"]
+    assert severe == [], severe
+    assert page.requests <= {file_url}, page.requests - {file_url}
+    for plot in page.plots:
+        for trace in plot["traces"]:
+            if trace["samples"] is not None and trace["samples"] > POINT_BUDGET:
+                assert trace["points"] == planned_length(trace["samples"]), trace
+            else:
+                assert trace["points"] >= (trace["samples"] or 0), trace
+
+
+@pytest.mark.parametrize("log", REAL_LOGS, ids=[p.name for p in REAL_LOGS])
+def test_real_log_report_in_browser(tmp_path: Path, capsys: pytest.CaptureFixture[str], log: Path) -> None:
+    require_browser()
+    out = _report(tmp_path, log.stem, log)
+    page = open_page(out, f"report-{log.stem}")
+    _check(page, out.resolve().as_uri())
+    plots = [p for p in page.plots if p["id"].startswith("plot-")]
+    assert plots and all(any(t["row"] == "pack voltage" for t in p["traces"]) for p in plots)
+    print(f"{log.name}: rendered in {page.load_s:.2f} s")
+
+
+def test_one_hour_two_battery_flight(tmp_path: Path) -> None:
+    require_browser()
+    log = write_flight(tmp_path / "hour.ulg", seconds=3600, hz=10, packs=2)
+    out = _report(tmp_path, "hour", log)
+    page = open_page(out, "report-one-hour-two-batteries")
+    _check(page, out.resolve().as_uri())
+    plots = [p for p in page.plots if p["id"].startswith("plot-")]
+    assert len(plots) == 2
+    for plot in plots:
+        rows = {t["row"] for t in plot["traces"]}
+        assert rows == {"pack voltage", "current", "power", "state of charge", "temperature", "cells", "cell imbalance"}
+        voltage = next(t for t in plot["traces"] if t["row"] == "pack voltage")
+        assert voltage["samples"] == 36000 and voltage["points"] == POINT_BUDGET
+        assert sum(1 for t in plot["traces"] if t["row"] == "cells") == 6
+    print(f"one hour, 10 Hz, two batteries: rendered in {page.load_s:.2f} s")
+
+
+def test_fleet_page(tmp_path: Path) -> None:
+    """Three flights of one DroneCAN pack (serial 777, ageing) beside the real logs: a row per flight and battery,
+    and the pack's trends across its flights."""
+    require_browser()
+    captures = [
+        write_capture_flight(tmp_path / f"flight{k}.log", health=95 - 3 * k, resistance=0.030 + 0.005 * k)
+        for k in range(3)
+    ]
+    out = _report(tmp_path, "fleet", *captures, *REAL_LOGS)
+    page = open_page(out, "report-fleet")
+    _check(page, out.resolve().as_uri())
+    batteries = [p for p in page.plots if p["id"].startswith("plot-")]
+    assert len(batteries) == 3 + sum({"sample_log_small.ulg": 2}.get(p.name, 1) for p in REAL_LOGS)
+    trends = next(p for p in page.plots if p["id"] == "trends")
+    assert {t["row"] for t in trends["traces"]} == {
+        "charge used [mAh]",
+        "internal resistance [mΩ]",
+        "state of health [%]",
+    }
+    assert {t["name"] for t in trends["traces"]} == {"pack 777"}
+    assert all(t["points"] == 3 for t in trends["traces"])
+
+
+PARAMS = """# a copter with two 6S packs: LOW at 3.5 V/cell -> RTL, CRITICAL at 3.3 V/cell -> Land
+BATT_MONITOR,4
+BATT_CAPACITY,10000
+BATT_LOW_VOLT,21.0
+BATT_CRT_VOLT,19.8
+BATT_FS_LOW_ACT,2
+BATT_FS_CRT_ACT,1
+BATT2_MONITOR,4
+BATT2_CAPACITY,10000
+BATT2_LOW_VOLT,21.0
+BATT2_CRT_VOLT,19.8
+BATT2_FS_LOW_ACT,2
+BATT2_FS_CRT_ACT,1
+"""
+
+
+def test_failsafe_markers_sit_at_the_replayed_times(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The page's marker lines are ``battgen failsafe``'s events on the same log and parameters."""
+    require_browser()
+    log = write_flight(tmp_path / "failsafe.ulg", seconds=600, hz=10, packs=2, armed=(5, 590))
+    params = tmp_path / "copter.param"
+    params.write_text(PARAMS)
+    capsys.readouterr()
+    assert main(["failsafe", "--params", str(params), "--vehicle", "copter", "--json", str(log)]) == 0
+    events = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert {e["level"] for e in events} == {"LOW", "CRITICAL"}
+    out = _report(tmp_path, "failsafe", log, extra=("--params", str(params), "--vehicle", "copter"))
+    page = open_page(out, "report-failsafe")
+    _check(page, out.resolve().as_uri())
+    plots = [p for p in page.plots if p["id"].startswith("plot-")]
+    for battery, plot in enumerate(plots, start=1):
+        expected = [(e["level"], e["t"]) for e in events if e["battery"] == battery]
+        got = [(m["level"], m["t"]) for m in plot["markers"]]
+        assert [level for level, _ in got] == [level for level, _ in expected]
+        assert [t for _, t in got] == pytest.approx([t for _, t in expected], abs=1e-6)
