@@ -2240,7 +2240,7 @@ class BatteryStatus:
             r_cell_count = self.cell_count
             r_voltage_cell_v = self.voltage_cell_v
             if r_cell_count != 0:
-                for v_i in range(r_cell_count, len(r_voltage_cell_v)):
+                for v_i in _v.span(r_cell_count, len(r_voltage_cell_v), limit=14):
                     try:
                         if not (r_voltage_cell_v[v_i] == 0):
                             out.append(
@@ -3412,7 +3412,7 @@ class BatteryStatusV0:
             r_cell_count = self.cell_count
             r_voltage_cell_v = self.voltage_cell_v
             if r_cell_count != 0:
-                for v_i in range(r_cell_count, len(r_voltage_cell_v)):
+                for v_i in _v.span(r_cell_count, len(r_voltage_cell_v), limit=14):
                     try:
                         if not (r_voltage_cell_v[v_i] == 0):
                             out.append(

@@ -32,7 +32,7 @@ from ...ir import (
     UorbInfo,
     units,
 )
-from ...text.files import display_path
+from ...text.files import display_path, is_file
 from ...text.limits import read_schema_text
 from .annotations import parse_comment, sentinel, text_sentinel
 from .enums import build_enums
@@ -196,7 +196,7 @@ class Loader:
         if item.base in BUILTINS:
             return Member(item.name, BUILTINS[item.base].bits // 8, count)
         nested = path.parent / f"{item.base}.msg"
-        if not nested.is_file():
+        if not is_file(nested):
             raise SchemaError(
                 display, item.line, f"expected a builtin type or a message defined in {item.base}.msg next to this file"
             )
