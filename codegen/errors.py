@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+
 
 class BattgenError(Exception):
     """Base of every error battgen reports to a user (the CLI prints it without a traceback)."""
@@ -20,3 +23,50 @@ class LocatedError(BattgenError):
 
 class SchemaError(LocatedError):
     """A malformed schema."""
+
+
+class ErrorList(BattgenError):
+    """Every problem found in one run (several files, several lines of one file), like a compiler's
+    report: ``errors`` in the order found, one ``file:line: ...`` line each."""
+
+    def __init__(self, errors: Sequence[BattgenError]) -> None:
+        flat: dict[str, BattgenError] = {}  # one report per problem, though two paths may find it
+        for error in errors:
+            for one in error.errors if isinstance(error, ErrorList) else (error,):
+                flat.setdefault(str(one), one)
+        self.errors: tuple[BattgenError, ...] = tuple(flat.values())
+        count = len(self.errors)
+        summary = f"{count} error{'s' if count != 1 else ''}"
+        super().__init__("\n".join([*(str(e) for e in self.errors), summary]) if count != 1 else str(self.errors[0]))
+
+    @staticmethod
+    def raise_if_any(errors: Sequence[BattgenError]) -> None:
+        """Raise the one error as itself, several as an ErrorList; nothing when the list is empty."""
+        if len(errors) == 1 and not isinstance(errors[0], ErrorList):
+            raise errors[0]
+        if errors:
+            raise ErrorList(errors)
+
+
+class ErrorCollector:
+    """Collects the errors of independent steps (one per file, say) so that a run reports them all::
+
+    found = ErrorCollector()
+    for path in paths:
+        with found.step():
+            parse(path)
+    found.raise_if_any()
+    """
+
+    def __init__(self) -> None:
+        self.errors: list[BattgenError] = []
+
+    @contextmanager
+    def step(self) -> Iterator[None]:
+        try:
+            yield
+        except BattgenError as error:
+            self.errors.append(error)
+
+    def raise_if_any(self) -> None:
+        ErrorList.raise_if_any(self.errors)

@@ -215,7 +215,7 @@ def test_receiver_fields() -> None:
 
 def test_uavcannode_publisher_fields() -> None:
     s = BatteryStatus(connected=True, voltage_v=16.2, current_a=-3.0, temperature=25.1, remaining=0.876,
-                      max_error=300, state_of_health=95, id=2, warning=BatteryStatus.WARNING_CHARGING, cell_count=2,
+                      max_error=300, state_of_health=95, id=2, warning=BatteryStatus.STATE_CHARGING, cell_count=2,
                       voltage_cell_v=[4.05, 4.06] + [0.0] * 12, nominal_voltage=14.8, cycle_count=7)  # fmt: skip
     info, aux = uorb_to_dronecan(s, policy="px4")
     assert info.voltage == float(F16(F32(16.2))) and info.current == -3.0

@@ -7,6 +7,7 @@ Standard library only, so the generated package can be vendored as it is.
 from __future__ import annotations
 
 import math
+import reprlib
 import types
 from collections.abc import Callable, Mapping
 from typing import Any, TypeVar
@@ -14,11 +15,33 @@ from typing import Any, TypeVar
 T = TypeVar("T")
 
 
+class _Brief(reprlib.Repr):
+    """repr() kept to a line: a hostile value (a YAML alias bomb expands to billions of items, an integer
+    of 5,000 digits has no repr at all) is quoted by its start, never walked or printed whole."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.maxlevel = 2
+        self.maxstring = self.maxother = 60
+        self.maxlong = 40
+
+    def repr_int(self, x: int, level: int) -> str:
+        if x.bit_length() > 128:  # repr() refuses over 4,300 digits
+            return f"{'-' if x < 0 else ''}<an integer of {int(x.bit_length() * 0.30103) + 1} digits>"
+        return super().repr_int(x, level)
+
+    def repr_str(self, x: str, level: int) -> str:
+        return super().repr_str(x[:200], level) + ("..." if len(x) > 200 else "")
+
+
+brief = _Brief().repr
+
+
 class DataError(ValueError):
     """Input data that does not fit a message: names the field path, what was expected and the value."""
 
     def __init__(self, path: str, expected: str, value: object) -> None:
-        super().__init__(f"{path}: expected {expected}, got {value!r}")
+        super().__init__(f"{path}: expected {expected}, got {brief(value)}")
         self.path = path
         self.expected = expected
         self.value = value
@@ -175,7 +198,8 @@ def check_keys(
         raise DataError(cls, "an object", data)
     for key in data:
         if key not in known and not any(_match(p, key) for p, _ in patterns):
-            raise DataError(f"{cls}.{key}", "a field of " + cls, data[key])
+            name = key if isinstance(key, str) and len(key) <= 80 else brief(key)  # a name, not a novel
+            raise DataError(f"{cls}.{name}", "a field of " + cls, data[key])
     return data
 
 

@@ -21,6 +21,8 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 
+from ._meta import brief
+
 __all__ = ["Severity", "ValidationError", "Violation"]
 
 
@@ -149,8 +151,9 @@ Spec = Number | Text | Array | Nested | Optional | Pattern
 # Wording
 
 
-def fmt(value: object) -> str:
-    """A value as a firmware engineer would write it (1.5, 4.19999981, NaN, inf, 0x600)."""
+def fmt(value: object, depth: int = 0) -> str:
+    """A value as a firmware engineer would write it (1.5, 4.19999981, NaN, inf, 0x600), never longer
+    than a line: a message must not format a huge value in full (a YAML alias bomb expands to billions)."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
@@ -162,12 +165,17 @@ def fmt(value: object) -> str:
             return str(int(value))
         return format(value, ".9g")
     if isinstance(value, int):
+        if value.bit_length() > 128:  # str() refuses over 4,300 digits, and no field is that wide
+            return f"{'-' if value < 0 else ''}<an integer of {int(value.bit_length() * 0.30103) + 1} digits>"
         return str(value)
     if isinstance(value, bytes | bytearray):
-        return repr(bytes(value))
-    if isinstance(value, list | tuple) and len(value) <= 8:
-        return "[" + ", ".join(fmt(v) for v in value) + "]"
-    text = repr(value)
+        return repr(bytes(value)) if len(value) <= 40 else f"{bytes(value[:32])!r}... ({len(value)} bytes)"
+    if isinstance(value, list | tuple):
+        if len(value) <= 8 and depth < 2:  # a matrix row by row; deeper nesting is summarised
+            text = "[" + ", ".join(fmt(v, depth + 1) for v in value) + "]"
+            return text if len(text) <= 120 else text[:116] + "...]"
+        return f"[... {len(value)} items]"
+    text = repr(value if len(value) <= 200 else value[:200]) if isinstance(value, str) else brief(value)
     return text if len(text) <= 60 else text[:57] + "..."
 
 
@@ -357,6 +365,8 @@ def _array(out: list[Violation], path: str, value: object, spec: Array) -> None:
         out.append(Violation(path, "length", n, cap, f"{path} has {n} items, more than its capacity {cap}"))
     elif n < spec.min_length:
         out.append(Violation(path, "length", n, spec.min_length, f"{path} has {n} items, fewer than {spec.min_length}"))
+    if cap is not None:
+        items = items[:cap]  # an over-long array is reported once above; its excess is not walked
     columns = spec.columns
     for i, item in enumerate(items):
         column = columns[i] if i < len(columns) else None
@@ -428,6 +438,19 @@ def search(pattern: str, key: object) -> bool:
 def rule(path: str, rule_id: str, value: object, text: str, message: str, severity: str) -> Violation:
     """A broken cross-field rule (see schemas/rules/)."""
     return Violation(path, "cross-field:" + rule_id, value, text, message, severity)
+
+
+# How many indices a rule's range() covers at most when the message has an unbounded array (devicetree
+# tables); over fixed and bounded arrays the generated code passes the schema's largest capacity instead.
+SPAN_LIMIT = 1 << 16
+
+
+def span(start: int, stop: int | None = None, *, limit: int) -> range:
+    """A rule's ``range(start, stop)`` kept to the indices ``0..limit`` an array of the schema can have:
+    a corrupt count in a record (``cell_count = -10**8``) must not make validate() loop for minutes."""
+    if stop is None:
+        start, stop = 0, start
+    return range(max(start, 0), min(stop, limit))
 
 
 def entries(value: object) -> list[tuple[str, object]]:

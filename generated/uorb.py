@@ -19,9 +19,11 @@ from . import _ulog, _uorb
 from . import _validate as _v
 
 __all__ = [
+    "BatteryInfo",
     "BatteryStatus",
     "BatteryStatusFault",
     "BatteryStatusSource",
+    "BatteryStatusState",
     "BatteryStatusV0",
     "BatteryStatusV0Fault",
     "BatteryStatusV0Source",
@@ -47,6 +49,11 @@ class BatteryStatusWarning(_enum.IntEnum):
     CRITICAL = 2
     EMERGENCY = 3
     FAILED = 4
+
+
+class BatteryStatusState(_enum.IntEnum):
+    """uorb.BatteryStatus.STATE: values."""
+
     UNHEALTHY = 6
     CHARGING = 7
 
@@ -106,6 +113,30 @@ class BatteryStatusV0Fault(_enum.IntEnum):
     INCOMPATIBLE_MODEL = 8
     HARDWARE_FAILURE = 9
     FAILED_TO_ARM = 10
+
+
+# the C struct, nested messages inlined (decoding reads them in place)
+_BATTERY_INFO_STRUCT = _struct.Struct("<QB32s7x")
+# without the trailing padding, which ULog records leave out
+_BATTERY_INFO_UNPADDED = _struct.Struct("<QB32s")
+
+
+_BATTERY_INFO_COLUMNS = _uorb.Columns(
+    ("timestamp", "id", "serial_number"), "<QB32s", 48, ("<u8", "u1", "S32"), (0, 8, 9)
+)
+
+
+# (attribute, field, struct code, count) of the plain fields, to name a value that does not fit
+_BATTERY_INFO_PACKED_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("timestamp", "timestamp", "Q", 0),
+    ("id", "id", "B", 0),
+)
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_BATTERY_INFO_TIMESTAMP_SPEC = _v.Number(type="uint64", kind="uint", low=0, high=18446744073709551615, unit="us")
+_BATTERY_INFO_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+_BATTERY_INFO_SERIAL_NUMBER_SPEC = _v.Text(capacity=32)
 
 
 # the C struct, nested messages inlined (decoding reads them in place)
@@ -433,7 +464,7 @@ _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC = _v.Array(
     True,
 )
 _BATTERY_STATUS_MAX_CELL_VOLTAGE_DELTA_SPEC = _v.Number(
-    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
 _BATTERY_STATUS_IS_POWERING_OFF_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
 _BATTERY_STATUS_IS_REQUIRED_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
@@ -448,8 +479,8 @@ _BATTERY_STATUS_WARNING_SPEC = _v.Number(
         2: "WARNING_CRITICAL",
         3: "WARNING_EMERGENCY",
         4: "WARNING_FAILED",
-        6: "WARNING_UNHEALTHY",
-        7: "WARNING_CHARGING",
+        6: "STATE_UNHEALTHY",
+        7: "STATE_CHARGING",
     },
 )
 _BATTERY_STATUS_FAULTS_SPEC = _v.Number(
@@ -476,11 +507,23 @@ _BATTERY_STATUS_FULL_CHARGE_CAPACITY_WH_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
 )
 _BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC = _v.Number(
-    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Wh"
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="Wh",
+    sentinel=_math.nan,
+    sentinel_text="NaN",
 )
 _BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
 _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC = _v.Number(
-    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
+    type="float32",
+    kind="float",
+    low=-3.4028234663852886e38,
+    high=3.4028234663852886e38,
+    unit="V",
+    sentinel=_math.nan,
+    sentinel_text="NaN",
 )
 _BATTERY_STATUS_INTERNAL_RESISTANCE_ESTIMATE_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="Ohm"
@@ -908,6 +951,191 @@ _BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC = _v.Number(
 
 
 @_dataclasses.dataclass(slots=True)
+class BatteryInfo:
+    """Battery information
+
+    Static or near-invariant battery information.
+    Should be streamed at low rate.
+
+    Schema: uorb.BatteryInfo (uorb, BatteryInfo.msg:1).
+    """
+
+    QUALIFIED_NAME: _ClassVar[str] = "uorb.BatteryInfo"
+
+    timestamp: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="timestamp",
+            type="uint64",
+            unit="us",
+            quantity="time",
+            scale=1e-06,
+            offset=0.0,
+            doc="Time since system start",
+        ),
+    )
+    id: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="id", type="uint8", doc="Must match the id in the battery_status message for the same battery"
+        ),
+    )
+    serial_number: str = _dataclasses.field(
+        default="",
+        metadata=_m.meta(
+            name="serial_number",
+            type="char[32]",
+            invalid=0,
+            invalid_text="0",
+            per_element=True,
+            doc="Serial number of the battery pack in ASCII characters, 0 terminated",
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, _Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, _Any] = {}
+        out["timestamp"] = self.timestamp
+        out["id"] = self.id
+        out["serial_number"] = self.serial_number
+        return out
+
+    @classmethod
+    def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfo:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(data, frozenset({"timestamp", "id", "serial_number"}), (), "BatteryInfo")
+        obj = cls()
+        if "timestamp" in data:
+            obj.timestamp = _m.as_int(data["timestamp"], "timestamp")
+        if "id" in data:
+            obj.id = _m.as_int(data["id"], "id")
+        if "serial_number" in data:
+            obj.serial_number = _m.as_str(data["serial_number"], "serial_number")
+        return obj
+
+    UORB_FORMAT: _ClassVar[str] = "<QB32s7x"
+    UORB_SIZE: _ClassVar[int] = 48
+    UORB_SIZE_NO_PADDING: _ClassVar[int] = 41
+    UORB_TOPICS: _ClassVar[tuple[str, ...]] = ("battery_info",)
+    MESSAGE_VERSION: _ClassVar[int | None] = None
+
+    def encode(self) -> bytes:
+        """PX4's C struct of this message: 48 bytes, little-endian, padding zeroed."""
+        try:
+            return _BATTERY_INFO_STRUCT.pack(
+                self.timestamp, self.id, _uorb.cstr_encode(self.serial_number, 32, "BatteryInfo.serial_number")
+            )
+        except (_struct.error, TypeError, OverflowError) as exc:
+            raise _uorb.encode_error("BatteryInfo", self, _BATTERY_INFO_PACKED_FIELDS, exc) from None
+
+    @classmethod
+    def decode(cls, data: bytes) -> BatteryInfo:
+        """From PX4's C struct: 48 bytes (or 41 without the trailing padding)."""
+        if len(data) != 48 and len(data) != 41:
+            raise _uorb.DecodeError(
+                "BatteryInfo: expected 48 bytes (or 41 without the trailing padding), got " + str(len(data))
+            )
+        v = _BATTERY_INFO_UNPADDED.unpack_from(data)
+        o = cls.__new__(cls)
+        o.timestamp = v[0]
+        o.id = v[1]
+        o.serial_number = _uorb.cstr_decode(v[2])
+        return o
+
+    @classmethod
+    def decode_batch(
+        cls,
+        buffer: bytes,
+        *,
+        stride: int | None = None,
+        use_numpy: bool | None = None,
+        copy: bool = True,
+    ) -> dict[str, _Any]:
+        """Columns of back-to-back records without an object per record, named as PX4 log
+        tools flatten them (``voltage_cell_v[3]``, ``nested.field``; char arrays as bytes).
+
+        ``stride``: bytes per record, default 48 (UORB_SIZE_NO_PADDING for ULog data).
+        numpy arrays when numpy is installed (``use_numpy`` None) or required (True; views
+        into ``buffer`` unless ``copy``), else lists from ``struct.iter_unpack``.
+        """
+        return _BATTERY_INFO_COLUMNS.decode(buffer, stride, use_numpy=use_numpy, copy=copy)
+
+    @classmethod
+    def ulog_format(cls) -> _ulog.Format:
+        """The ULog format PX4's logger writes for this struct (nested formats attached)."""
+        return _ulog.Format(
+            "battery_info",
+            (
+                _ulog.Member("uint64_t", 0, "timestamp", "timestamp", "scalar"),
+                _ulog.Member("uint8_t", 0, "id", "id", "scalar"),
+                _ulog.Member("char", 32, "serial_number", "serial_number", "string"),
+                _ulog.Member("uint8_t", 7, "_padding0"),
+            ),
+            cls,
+            ("battery_info",),
+            None,
+        )
+
+    @classmethod
+    def from_ulog(
+        cls, source: _ulog.Source | _ulog.Log, *, topic: str | None = None, multi_id: int | None = None
+    ) -> list[_ulog.Record[BatteryInfo]]:
+        """Every record of this message in a ULog file (path, bytes, binary file or a read Log),
+        in file order: each a _ulog.Record saying its instance (multi_id), topic and offset.
+
+        Every instance unless ``multi_id`` names one; every topic of UORB_TOPICS unless ``topic``
+        names one. When the log's own format differs (an older PX4), fields are matched by name
+        (through PX4's renames), compatible types converted with range checks, and the log's
+        values the instance cannot hold kept in the record's ``extras`` (see _ulog.Log.compare).
+        """
+        log = source if isinstance(source, _ulog.Log) else _ulog.read(source)
+        return list(log.iter_records(cls, topic=topic, multi_id=multi_id))
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: _Any
+        try:
+            if self.timestamp & -18446744073709551616:
+                _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_TIMESTAMP_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_TIMESTAMP_SPEC)
+        try:
+            if self.id & -256:
+                _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
+        try:
+            x = self.serial_number
+            if x.__class__ is not str or len(x.encode()) > 32:
+                _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "uorb.BatteryInfo")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == "serial_number":
+            return self.serial_number != ""
+        if field in {"timestamp", "id"}:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "uorb.BatteryInfo")
+
+
+@_dataclasses.dataclass(slots=True)
 class BatteryStatus:
     """Battery status
 
@@ -929,8 +1157,8 @@ class BatteryStatus:
     WARNING_CRITICAL: _ClassVar[int] = 2
     WARNING_EMERGENCY: _ClassVar[int] = 3
     WARNING_FAILED: _ClassVar[int] = 4
-    WARNING_UNHEALTHY: _ClassVar[int] = 6
-    WARNING_CHARGING: _ClassVar[int] = 7
+    STATE_UNHEALTHY: _ClassVar[int] = 6
+    STATE_CHARGING: _ClassVar[int] = 7
     FAULT_DEEP_DISCHARGE: _ClassVar[int] = 0
     FAULT_SPIKES: _ClassVar[int] = 1
     FAULT_CELL_FAIL: _ClassVar[int] = 2
@@ -1031,6 +1259,8 @@ class BatteryStatus:
         metadata=_m.meta(
             name="scale",
             type="float32",
+            unit="1",
+            quantity="ratio",
             minimum=1,
             maximum=None,
             invalid=-1.0,
@@ -1065,7 +1295,16 @@ class BatteryStatus:
         ),
     )
     cell_count: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="cell_count", type="uint8", invalid=0, invalid_text="0", doc="Number of cells")
+        default=0,
+        metadata=_m.meta(
+            name="cell_count",
+            type="uint8",
+            unit="1",
+            quantity="ratio",
+            invalid=0,
+            invalid_text="0",
+            doc="Number of cells",
+        ),
     )
     source: int = _dataclasses.field(
         default=0,
@@ -1076,6 +1315,8 @@ class BatteryStatus:
         metadata=_m.meta(
             name="priority",
             type="uint8",
+            unit="1",
+            quantity="ratio",
             doc="Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1",
         ),
     )
@@ -1094,7 +1335,11 @@ class BatteryStatus:
     cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="cycle_count", type="uint16", doc="Number of discharge cycles the battery has experienced"
+            name="cycle_count",
+            type="uint16",
+            unit="1",
+            quantity="ratio",
+            doc="Number of discharge cycles the battery has experienced",
         ),
     )
     average_time_to_empty: int = _dataclasses.field(
@@ -1114,6 +1359,8 @@ class BatteryStatus:
         metadata=_m.meta(
             name="manufacture_date",
             type="uint16",
+            unit="1",
+            quantity="ratio",
             doc="Manufacture date, part of serial number of the battery pack. Formatted as: Day "
             "+ Month×32 + (Year–1980)×512",
         ),
@@ -1151,11 +1398,16 @@ class BatteryStatus:
         metadata=_m.meta(
             name="id",
             type="uint8",
+            unit="1",
+            quantity="ratio",
             doc="ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed",
         ),
     )
     interface_error: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="Interface error counter")
+        default=0,
+        metadata=_m.meta(
+            name="interface_error", type="uint16", unit="1", quantity="ratio", doc="Interface error counter"
+        ),
     )
     voltage_cell_v: list[float] = _dataclasses.field(
         default_factory=lambda: [0.0] * 14,
@@ -1173,7 +1425,11 @@ class BatteryStatus:
     max_cell_voltage_delta: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
-            name="max_cell_voltage_delta", type="float32", doc="Max difference between individual cell voltages"
+            name="max_cell_voltage_delta",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            doc="Max difference between individual cell voltages",
         ),
     )
     is_powering_off: bool = _dataclasses.field(
@@ -1191,7 +1447,10 @@ class BatteryStatus:
     warning: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="warning", type="uint8", enums=("uorb.BatteryStatus.WARNING",), doc="Current battery warning"
+            name="warning",
+            type="uint8",
+            enums=("uorb.BatteryStatus.WARNING", "uorb.BatteryStatus.STATE"),
+            doc="Current battery warning",
         ),
     )
     faults: int = _dataclasses.field(
@@ -1216,7 +1475,7 @@ class BatteryStatus:
         ),
     )
     remaining_capacity_wh: float = _dataclasses.field(
-        default=0.0,
+        default=_math.nan,
         metadata=_m.meta(
             name="remaining_capacity_wh",
             type="float32",
@@ -1224,19 +1483,30 @@ class BatteryStatus:
             quantity="energy",
             scale=3600.0,
             offset=0.0,
+            invalid=_math.nan,
+            invalid_text="NaN",
             doc="Compensated battery capacity remaining",
         ),
     )
     over_discharge_count: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
+        default=0,
+        metadata=_m.meta(
+            name="over_discharge_count",
+            type="uint16",
+            unit="1",
+            quantity="ratio",
+            doc="Number of battery overdischarge",
+        ),
     )
     nominal_voltage: float = _dataclasses.field(
-        default=0.0,
+        default=_math.nan,
         metadata=_m.meta(
             name="nominal_voltage",
             type="float32",
             unit="V",
             quantity="voltage",
+            invalid=_math.nan,
+            invalid_text="NaN",
             doc="Nominal voltage of the battery pack",
         ),
     )
@@ -1271,6 +1541,8 @@ class BatteryStatus:
         metadata=_m.meta(
             name="volt_based_soc_estimate",
             type="float32",
+            unit="1",
+            quantity="ratio",
             minimum=0,
             maximum=1,
             doc="Normalized volt based state of charge estimate",
@@ -1288,7 +1560,13 @@ class BatteryStatus:
     )
     estimation_covariance_norm: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(name="estimation_covariance_norm", type="float32", doc="Norm of the covariance matrix"),
+        metadata=_m.meta(
+            name="estimation_covariance_norm",
+            type="float32",
+            unit="1",
+            quantity="ratio",
+            doc="Norm of the covariance matrix",
+        ),
     )
 
     def __eq__(self, other: object) -> bool:
@@ -1845,7 +2123,8 @@ class BatteryStatus:
                 _BATTERY_STATUS_FULL_CHARGE_CAPACITY_WH_SPEC,
             )
         try:
-            if not (-3.4028234663852886e38 <= self.remaining_capacity_wh <= 3.4028234663852886e38):
+            x = self.remaining_capacity_wh
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(
                     out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC
                 )
@@ -1861,7 +2140,8 @@ class BatteryStatus:
         except _v.SLOW:
             _v.diag(out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC)
         try:
-            if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
+            x = self.nominal_voltage
+            if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC)
         except _v.SLOW:
             _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC)
@@ -1960,7 +2240,7 @@ class BatteryStatus:
             r_cell_count = self.cell_count
             r_voltage_cell_v = self.voltage_cell_v
             if r_cell_count != 0:
-                for v_i in range(r_cell_count, len(r_voltage_cell_v)):
+                for v_i in _v.span(r_cell_count, len(r_voltage_cell_v), limit=14):
                     try:
                         if not (r_voltage_cell_v[v_i] == 0):
                             out.append(
@@ -2014,6 +2294,10 @@ class BatteryStatus:
             return self.cell_count != 0
         if field == "voltage_cell_v":
             return any(e != 0.0 for e in self.voltage_cell_v)
+        if field == "remaining_capacity_wh":
+            return self.remaining_capacity_wh == self.remaining_capacity_wh
+        if field == "nominal_voltage":
+            return self.nominal_voltage == self.nominal_voltage
         if field in {
             "timestamp",
             "connected",
@@ -2033,9 +2317,7 @@ class BatteryStatus:
             "warning",
             "faults",
             "full_charge_capacity_wh",
-            "remaining_capacity_wh",
             "over_discharge_count",
-            "nominal_voltage",
             "internal_resistance_estimate",
             "ocv_estimate",
             "ocv_estimate_filtered",
@@ -3130,7 +3412,7 @@ class BatteryStatusV0:
             r_cell_count = self.cell_count
             r_voltage_cell_v = self.voltage_cell_v
             if r_cell_count != 0:
-                for v_i in range(r_cell_count, len(r_voltage_cell_v)):
+                for v_i in _v.span(r_cell_count, len(r_voltage_cell_v), limit=14):
                     try:
                         if not (r_voltage_cell_v[v_i] == 0):
                             out.append(

@@ -25,6 +25,7 @@ from ..ir import Message, Schema, SourceFormat
 from ..ir.expr import referenced_fields
 from ..ir.numbers import to_json_data
 from ..ir.rules import bound_rules
+from ..text.brief import brief, reportable
 from . import dt_problems
 from .failsafe.checks import NONNEGATIVE, check_settings
 from .failsafe.vehicles import detect_vehicle
@@ -126,11 +127,6 @@ def _covers(skip: frozenset[str], path: str) -> bool:
     return any(path == s or path.startswith((s + ".", s + "[")) for s in skip)
 
 
-def _short(value: object, width: int = 60) -> str:
-    text = repr(value)
-    return text if len(text) <= width else text[: width - 3] + "..."
-
-
 class Checker:
     """Builds each record with the generated ``from_dict`` (or takes the instance a binary log
     decoded) and collects ``validate()``'s violations, minus those of fields the source lacks."""
@@ -230,7 +226,7 @@ class Checker:
         if expected.startswith("a field of "):
             text = f"{path} is not a field of {self.message.qualified_name}"
         else:
-            text = f"{path or 'the record'}: expected {expected}, got {_short(value)}"
+            text = f"{path or 'the record'}: expected {expected}, got {brief(value)}"
         return self._finding(record, path, "type", value, expected, text, "error")
 
     @staticmethod
@@ -246,8 +242,8 @@ class Checker:
             record.where,
             path,
             rule,
-            value,
-            limit,
+            reportable(value),  # the report may be JSON: a hostile value is carried by its brief text
+            reportable(limit),
             message,
             severity,
             record.location,

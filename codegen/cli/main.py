@@ -12,7 +12,7 @@ from pathlib import Path
 from .. import __version__
 from ..apps.package import bundled_schemas, project_root
 from ..backends.python.writer import generate
-from ..errors import BattgenError
+from ..errors import BattgenError, ErrorList
 from ..frontends.loader import load
 from ..ir import Schema
 from ..ir import json_form as irjson
@@ -25,7 +25,10 @@ COMMAND_MODULES = (validate, docs, schema, convert, vectors, params, failsafe, c
 
 def _load(paths: Sequence[str], args: argparse.Namespace) -> Schema:
     include_paths = [Path(p) for p in args.include_path or ()]
-    return load([Path(p) for p in paths] if paths else [bundled_schemas()], include_paths=include_paths)
+    schema = load([Path(p) for p in paths] if paths else [bundled_schemas()], include_paths=include_paths)
+    for warning in schema.warnings:  # accepted, as upstream's tools accept it, but worth a look
+        print(f"battgen: {warning}", file=sys.stderr)
+    return schema
 
 
 def _include_path_option(p: argparse.ArgumentParser) -> None:
@@ -126,6 +129,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     func: Callable[[argparse.Namespace], int] = args.func
     try:
         return func(args)
+    except ErrorList as exc:  # every problem of the run, one line each, then the count
+        for error in exc.errors:
+            print(f"battgen: {error}", file=sys.stderr)
+        print(f"battgen: {len(exc.errors)} errors", file=sys.stderr)
+        return EXIT_USAGE
     except BattgenError as exc:
         print(f"battgen: {exc}", file=sys.stderr)
         return EXIT_USAGE

@@ -1,4 +1,11 @@
-"""Pick the frontend for each input and merge what they produce into one Schema."""
+"""Pick the frontend for each input and merge what they produce into one Schema.
+
+Like a compiler, a load reports every error in one run: each format folder and each path given is
+parsed even when an earlier one failed, and the errors of all of them are raised together as one
+:class:`~codegen.errors.ErrorList` (the frontends collect theirs per file and line the same way).
+Mappings and rules are checked only when the formats they refer to parsed cleanly, since a
+message missing because its file is broken would otherwise be reported again from every mapping.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +13,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Protocol
 
-from ..errors import BattgenError, SchemaError
+from ..errors import BattgenError, ErrorList, SchemaError
 from ..ir import EnumDef, Schema
 from . import devicetree, dsdl, mavlink, pdef, rules, uorb
 
@@ -65,15 +72,21 @@ def load_schema_dir(root: Path, *, include_paths: Sequence[Path] = ()) -> Schema
     """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset); MAVLink includes
     may also come from ``include_paths`` (README Limits)."""
     schema = Schema()
+    errors: list[BattgenError] = []
     for fmt in FORMAT_FRONTENDS:
         sub = root / fmt
         if sub.is_dir():
-            part: Schema = (
-                mavlink.parse_dir(sub, include_paths=include_paths)
-                if fmt == "mavlink"
-                else frontend(fmt).parse_dir(sub)
-            )
+            try:
+                part: Schema = (
+                    mavlink.parse_dir(sub, include_paths=include_paths)
+                    if fmt == "mavlink"
+                    else frontend(fmt).parse_dir(sub)
+                )
+            except BattgenError as error:
+                errors.append(error)
+                continue
             schema = schema.merged(part)
+    ErrorList.raise_if_any(errors)
     if (root / MAPPINGS_DIR).is_dir():
         # after the formats, so every reference to a message or field can be checked
         from . import mappings
@@ -127,33 +140,42 @@ def _load_dsdl_tree(path: Path, definition: Path) -> Schema:
 
 
 def load(paths: Iterable[Path], *, include_paths: Sequence[Path] = ()) -> Schema:
-    """Parse schema folders, DSDL roots and single files (format from the extension) into one Schema;
-    ``include_paths``: folders MAVLink <include>s may read besides the schema folder."""
+    """Parse schema folders, DSDL roots, folders of .msg files and single files (format from the
+    extension) into one Schema; the errors of every path are raised together. ``include_paths``:
+    folders MAVLink <include>s may read besides the schema folder."""
     schema = Schema()
+    errors: list[BattgenError] = []
     for path in paths:
-        if path.is_dir():
-            definition = dsdl_definition(path)
-            if definition is not None:
-                part = _load_dsdl_tree(path, definition)
-            elif is_schema_dir(path):
-                part = load_schema_dir(path, include_paths=include_paths)
-            else:
-                expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
-                raise BattgenError(
-                    f"{path}: not a schema folder (expected sub-folders {expected}) nor a DSDL root "
-                    "(namespace folders such as uavcan/ holding .uavcan files)"
-                )
-        elif path.is_file():
-            fmt = format_of_file(path)
-            part = (
-                mavlink.parse_file(path, include_paths=include_paths)
-                if fmt == "mavlink"
-                else frontend(fmt).parse_file(path)
-            )
-        else:
-            raise BattgenError(f"{path}: no such file or folder")
+        try:
+            part = _load_path(path, include_paths)
+        except BattgenError as error:
+            errors.append(error)
+            continue
         schema = schema.merged(part)
+    ErrorList.raise_if_any(errors)
     return _deduplicated(schema)
+
+
+def _load_path(path: Path, include_paths: Sequence[Path]) -> Schema:
+    if path.is_dir():
+        definition = dsdl_definition(path)
+        if definition is not None:
+            return _load_dsdl_tree(path, definition)
+        if is_schema_dir(path):
+            return load_schema_dir(path, include_paths=include_paths)
+        if any(p.is_file() for p in path.glob("*.msg")):
+            return frontend("uorb").parse_dir(path)  # a folder of .msg files, as PX4's own msg/
+        expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
+        raise BattgenError(
+            f"{path}: not a schema folder (expected sub-folders {expected}) nor a DSDL root "
+            "(namespace folders such as uavcan/ holding .uavcan files) nor a folder of .msg files"
+        )
+    if path.is_file():
+        fmt = format_of_file(path)
+        if fmt == "mavlink":
+            return mavlink.parse_file(path, include_paths=include_paths)
+        return frontend(fmt).parse_file(path)
+    raise BattgenError(f"{path}: no such file or folder")
 
 
 def _deduplicated(schema: Schema) -> Schema:
@@ -177,4 +199,5 @@ def _deduplicated(schema: Schema) -> Schema:
         sources=tuple(dict.fromkeys(schema.sources)),
         mappings=schema.mappings,
         rules=schema.rules,
+        warnings=tuple(dict.fromkeys(schema.warnings)),
     )

@@ -102,7 +102,13 @@ class DataflashLog:
                 if name == "BAD_DATA":
                     continue
                 length = int(getattr(getattr(msg, "fmt", None), "len", 0) or 0)
-                values = msg.to_dict()
+                try:  # a damaged FMT record can leave a message its columns do not describe
+                    values = msg.to_dict()
+                except Exception as exc:
+                    self.skipped_notes.append(
+                        f"{name} at offset {int(reader.offset) - length}: cannot decode ({exc!r})"
+                    )
+                    continue
                 values.pop("mavpackettype", None)
                 yield DataflashMessage(name, index, max(0, int(reader.offset) - length), _time_us(values), values)
                 index += 1

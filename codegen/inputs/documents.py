@@ -65,6 +65,24 @@ def _whole_text(source: Source, name: str) -> str:
 # ------------------------------------------------------------------------------------------------
 # JSON Lines: one record per non-blank line, read lazily
 
+# The longest line read as one record: a battery record is a few kilobytes, and a line is held in memory
+# (and decoded) whole, so a 200 MB line would cost gigabytes. Longer lines are skipped without being kept.
+MAX_LINE = 1 << 20
+
+
+def _skip_line(stream: IO[str]) -> int:
+    """Read on to the end of an over-long line in pieces; how many characters were skipped."""
+    skipped = 0
+    while True:
+        piece = stream.readline(MAX_LINE)
+        skipped += len(piece)
+        if not piece or piece.endswith("\n"):
+            return skipped
+
+
+def _too_long(length: int) -> str:
+    return f"a line of {length} characters, longer than the {MAX_LINE} a JSON Lines record may have (skipped)"
+
 
 def read_jsonl(source: Source, name: str, *, comments: bool = False) -> Iterator[Item]:
     """One record per non-blank line (with ``comments``, lines starting with ``#`` are skipped
@@ -74,7 +92,12 @@ def read_jsonl(source: Source, name: str, *, comments: bool = False) -> Iterator
         lineno = 0
         while True:
             try:
-                line = stream.readline()
+                line = stream.readline(MAX_LINE + 1)
+                if len(line) > MAX_LINE and not line.endswith("\n"):
+                    lineno += 1
+                    length = len(line) + _skip_line(stream)
+                    yield Unreadable(name, lineno, _too_long(length))
+                    continue
             except UnicodeDecodeError:
                 yield Unreadable(name, lineno + 1, "expected UTF-8 text")
                 return
@@ -94,6 +117,9 @@ def read_jsonl(source: Source, name: str, *, comments: bool = False) -> Iterator
                 continue
             except RecursionError:
                 yield Unreadable(name, lineno, TOO_DEEP)
+                continue
+            except ValueError:  # an integer of more digits than Python converts
+                yield Unreadable(name, lineno, _long_number(line))
                 continue
             yield Record(index, lineno, data, name)
             index += 1
@@ -126,6 +152,22 @@ def read_json(source: Source, name: str) -> Iterator[Item]:
         raise InputError(name, exc.lineno, message, reason=exc.msg, column=exc.colno) from None
     except RecursionError:
         raise InputError(name, 1, TOO_DEEP) from None
+    except ValueError:  # an integer of more digits than Python converts (4,300)
+        raise InputError(name, _long_number_line(text), _long_number(text)) from None
+
+
+_LONG_NUMBER = re.compile(r"[0-9]{4000,}")
+
+
+def _long_number_line(text: str) -> int:
+    m = _LONG_NUMBER.search(text)
+    return text.count("\n", 0, m.start()) + 1 if m else 0
+
+
+def _long_number(text: str) -> str:
+    m = _LONG_NUMBER.search(text)
+    digits = f"{m.end() - m.start()} digits" if m else "too many digits"
+    return f"expected a number a battery field can hold, got an integer of {digits} (more than 4,300 cannot be read)"
 
 
 def _skip(text: str, pos: int) -> int:
@@ -231,6 +273,18 @@ class _LineLoader(yaml.SafeLoader):
         if node is None:
             return None
         return self.construct_document(node), node
+
+    def construct_long_int(self, node: yaml.ScalarNode) -> object:
+        """PyYAML's int, but an integer of more digits than Python converts is an error at its line."""
+        try:
+            return self.construct_yaml_int(node)
+        except ValueError:
+            digits = sum(c.isdigit() for c in str(node.value))
+            problem = f"an integer of {digits} digits is more than a battery field holds (4,300 cannot be read)"
+            raise yaml.constructor.ConstructorError(None, None, problem, node.start_mark) from None
+
+
+_LineLoader.add_constructor("tag:yaml.org,2002:int", _LineLoader.construct_long_int)
 
 
 def _node_lines(node: yaml.Node, path: str, out: dict[str, int], seen: set[int]) -> None:

@@ -216,6 +216,8 @@ class StreamParser(Protocol):
 class MavlinkRuntime(Protocol):
     """The generated ``_mavlink`` module."""
 
+    REGISTRY: dict[int, tuple[int, str, int, str]]  # msgid -> (CRC_EXTRA, class name, max length, name)
+
     def parse_frame(self, data: bytes) -> Frame: ...
     def StreamParser(self) -> StreamParser: ...  # the class, called to make one
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import BattgenError, LocatedError
+from ..text.brief import brief
 
 Value = int | float
 
@@ -194,10 +195,21 @@ def write_qgc(
 
 def _check_name(name: str) -> None:
     if not NAME.fullmatch(name):
-        raise BattgenError(f"expected a parameter name of 1 to 16 letters, digits and _, got {name!r}")
+        raise BattgenError(f"expected a parameter name of 1 to 16 letters, digits and _, got {brief(name)}")
+
+
+# A MAVLink parameter is a float32 or an integer of at most 32 bits on the wire: a value of more digits
+# than any of those holds is refused here, before int() (which refuses over 4,300 digits) or a message quotes it.
+MAX_DIGITS = 40
 
 
 def _value(text: str, display: str, line: int, *, integer: bool = False) -> Value:
+    if len(text) > MAX_DIGITS and (_HEX.fullmatch(text) or _INT.fullmatch(text)):
+        raise ParameterFileError(
+            display,
+            line,
+            f"expected a parameter value (float32 or a 32-bit integer), got a number of {len(text)} digits",
+        )
     if _HEX.fullmatch(text):
         return int(text, 16)
     if _INT.fullmatch(text):
@@ -205,13 +217,13 @@ def _value(text: str, display: str, line: int, *, integer: bool = False) -> Valu
     try:
         number = float(text)
     except ValueError:
-        raise ParameterFileError(display, line, f"expected a number as the value, got {text!r}") from None
+        raise ParameterFileError(display, line, f"expected a number as the value, got {brief(text)}") from None
     if not math.isfinite(number):
-        raise ParameterFileError(display, line, f"expected a finite number as the value, got {text!r}")
+        raise ParameterFileError(display, line, f"expected a finite number as the value, got {brief(text)}")
     if integer:
         if not number.is_integer():
             raise ParameterFileError(
-                display, line, f"expected an integer value for an integer MAV_PARAM_TYPE, got {text!r}"
+                display, line, f"expected an integer value for an integer MAV_PARAM_TYPE, got {brief(text)}"
             )
         return int(number)
     return number
@@ -220,7 +232,7 @@ def _value(text: str, display: str, line: int, *, integer: bool = False) -> Valu
 def _name(text: str, display: str, line: int) -> str:
     if not NAME.fullmatch(text):
         raise ParameterFileError(
-            display, line, f"expected a parameter name of 1 to 16 letters, digits and _, got {text!r}"
+            display, line, f"expected a parameter name of 1 to 16 letters, digits and _, got {brief(text)}"
         )
     return text
 
@@ -231,7 +243,7 @@ def _ardupilot_line(raw: str, display: str, line: int) -> ParamEntry | None:
         return None
     parts = [p for p in re.split(r"[,\s]+", body) if p]
     if len(parts) != 2:
-        raise ParameterFileError(display, line, f"expected 'NAME,VALUE' or 'NAME VALUE', got {body!r}")
+        raise ParameterFileError(display, line, f"expected 'NAME,VALUE' or 'NAME VALUE', got {brief(body)}")
     return ParamEntry(_name(parts[0], display, line), _value(parts[1], display, line), line)
 
 
@@ -250,7 +262,7 @@ def _qgc_line(raw: str, display: str, line: int) -> ParamEntry | None:
     ids = []
     for label, text in (("vehicle id", parts[0]), ("component id", parts[1]), ("type", parts[4])):
         if not re.fullmatch(r"[0-9]{1,3}", text):
-            raise ParameterFileError(display, line, f"expected a decimal {label}, got {text!r}")
+            raise ParameterFileError(display, line, f"expected a decimal {label}, got {brief(text)}")
         ids.append(int(text))
     vehicle, component, mav_type = ids
     if mav_type not in MAV_PARAM_TYPES:

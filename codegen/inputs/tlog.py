@@ -2,10 +2,11 @@
 
 A .tlog (MAVProxy, QGroundControl, Mission Planner) is a sequence of entries, each a big-endian
 uint64 time in microseconds (Unix epoch) followed by one MAVLink 1 or 2 frame. Entries are walked
-by their frames' lengths; frames of other messages are skipped without a checksum check (their
-CRC_EXTRA is not in the generated package), frames of the wanted message are checked with it. Bytes
-that do not start an entry are garbage: reading resumes at the next magic byte that starts a
-plausible entry (its frame ends where the next entry's frame begins, or at the end of the file).
+by their frames' lengths. A frame of a message the generated package knows (the wanted one among them)
+counts only with a good checksum (its CRC_EXTRA); a frame of another message cannot be checked and is
+skipped when it is plausible (it ends where the next entry's frame begins, or at the end of the file)
+and no frame with a good checksum starts inside it, so a stray magic byte cannot swallow a real frame.
+Bytes that do not start an entry are garbage: reading resumes at the next magic byte that starts an entry.
 The file is memory-mapped, so memory stays flat whatever its size.
 
 A raw stream (``.mav`` or ``--input-format mavlink``; not ``.bin``, which is ArduPilot's DataFlash
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
-from .model import Frame, GeneratedMessage, MavlinkClass, mavlink_runtime
+from .model import Frame, GeneratedMessage, MavlinkClass, MavlinkRuntime, mavlink_runtime
 from .records import InputError, Item, Notice, Record
 
 Buffer = bytes | mmap.mmap  # a whole .tlog: the file mapped, or the bytes of a stream
@@ -134,31 +135,63 @@ def tlog_frames(data: Buffer, model: MavlinkClass, stats: StreamStats) -> Iterat
         if _is_magic(data[start]):
             head = _frame_length(data, start, end)
             if head is None or start + head[0] > end:
-                stats.truncated_bytes += end - pos
-                return
+                if head is None or _first_verified(data, rt, start + 1, end) < 0:
+                    stats.truncated_bytes += end - pos
+                    return
+                pos = _resync(data, pos, end, stats)  # a stray magic byte claiming more than is left
+                continue
             total, got = head
             after = start + total
             plausible = after == end or (after + _STAMP < end and _is_magic(data[after + _STAMP]))
-            if got == msgid:
+            if got in rt.REGISTRY:  # its CRC_EXTRA is known: only a frame with a good CRC counts
                 try:
                     frame = rt.parse_frame(data[start:after])
                 except ValueError as exc:  # FrameError: bad CRC, flags
-                    if plausible:
+                    # a damaged frame of the wanted message, unless a good frame starts inside it
+                    if got == msgid and plausible and _first_verified(data, rt, start + 1, after + _STAMP) < 0:
                         stats.bad_crc += 1
                         stats.problems.append(f"offset {pos}: {exc}")
                         pos = after
                         continue
                 else:
-                    record = _decode(frame, model, stats, pos, int.from_bytes(data[pos:start], "big"))
-                    if record is not None:
-                        yield record
+                    if got == msgid:
+                        record = _decode(frame, model, stats, pos, int.from_bytes(data[pos:start], "big"))
+                        if record is not None:
+                            yield record
+                    else:
+                        stats.other_frames += 1
                     pos = after
                     continue
-            elif plausible:
+            elif plausible and _first_verified(data, rt, start + 1, after + _STAMP) < 0:
+                # another message (no CRC_EXTRA to check it with), trusted as far as no frame with a
+                # good checksum starts inside it: a stray magic byte must not swallow a real frame
                 stats.other_frames += 1
                 pos = after
                 continue
         pos = _resync(data, pos, end, stats)
+
+
+def _first_verified(data: Buffer, rt: MavlinkRuntime, lo: int, hi: int) -> int:
+    """The first position in [lo, hi) where a frame of a message this package knows starts with a good
+    CRC (-1: none); only magic bytes followed by a known id are checked, so this stays cheap."""
+    end = len(data)
+    hi = min(hi, end)
+    while lo < hi:
+        v2 = data.find(b"\xfd", lo, hi)
+        v1 = data.find(b"\xfe", lo, hi)
+        m = v1 if v2 < 0 else v2 if v1 < 0 else min(v1, v2)
+        if m < 0:
+            return -1
+        head = _frame_length(data, m, end)
+        if head is not None and head[1] in rt.REGISTRY and m + head[0] <= end:
+            try:
+                rt.parse_frame(data[m : m + head[0]])
+            except ValueError:
+                pass
+            else:
+                return m
+        lo = m + 1
+    return -1
 
 
 def _resync(data: Buffer, pos: int, end: int, stats: StreamStats) -> int:

@@ -7,6 +7,7 @@ The model is split by concern (``basics``, ``fieldtypes``, ``fields``, ``message
 
 from .basics import (
     Location,
+    SchemaWarning,
     SourceFormat,
     Unit,
 )
@@ -91,6 +92,7 @@ __all__ = [
     "Range",
     "Rule",
     "Schema",
+    "SchemaWarning",
     "Sentinel",
     "SourceFormat",
     "StringType",

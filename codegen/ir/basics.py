@@ -25,6 +25,20 @@ class Location:
         return f"{self.file}:{self.line}"
 
 
+@dataclass(frozen=True)
+class SchemaWarning:
+    """Something a schema says that battgen accepts but that upstream's own tools flag (a linter
+    warning): printed as ``file:line: warning: ...`` and never a failure. ``kind`` names the class
+    of warning (for counting and filtering), ``message`` what is wrong and how it was read."""
+
+    location: Location
+    kind: str
+    message: str
+
+    def __str__(self) -> str:
+        return f"{self.location}: warning: {self.message}"
+
+
 # --------------------------------------------------------------------------------------------
 # Units
 

@@ -15,7 +15,9 @@ class Sentinel:
     """The value that means "unknown / invalid".
 
     ``text`` keeps the spelling of the source (``INT16_MAX``, ``NaN``); ``value`` is the number
-    (``float('nan')`` for NaN). ``per_element`` marks an array whose elements each carry it.
+    (``float('nan')`` for NaN). ``per_element`` marks an array whose elements each carry it; on a
+    text field (``char[N]``, a StringType) it is the byte value of every character, so ``0`` per
+    element is the empty string (PX4's ``[@invalid 0]`` "all bytes zero").
     ``elements`` is for a marker given per position (MAVLink's ``[v1,,v3,]``, ``[0,]``): the marker
     of each leading element, None where the list leaves one out; elements past the list have no
     marker. It is empty for the other forms; when set, ``value`` is its first marker.
@@ -122,6 +124,7 @@ class Field:
     choices: tuple[str | int, ...] = ()
     default: int | float | bool | str | None = None
     annotations: tuple[tuple[str, str], ...] = ()  # source annotations kept verbatim (tag, text)
+    frame: str | None = None  # coordinate frame the value is expressed in, as the source names it (NED, FRD, ...)
 
     @property
     def is_padding(self) -> bool:

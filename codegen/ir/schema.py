@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .basics import Location
+from .basics import Location, SchemaWarning
 from .expr import RuleExpressions
 from .fields import EnumDef
 from .mappings import MappingSet
@@ -45,6 +45,8 @@ class Schema:
     sources: tuple[str, ...] = field(default=())
     mappings: tuple[MappingSet, ...] = ()
     rules: tuple[CrossFieldRule, ...] = ()
+    # what the frontends accepted with a warning; printed on stderr, not part of the JSON form
+    warnings: tuple[SchemaWarning, ...] = field(default=(), metadata={"json_form": False}, compare=False)
 
     def message(self, qualified_name: str) -> Message:
         for m in self.messages:
@@ -69,4 +71,5 @@ class Schema:
             sources=self.sources + other.sources,
             mappings=self.mappings + other.mappings,
             rules=self.rules + other.rules,
+            warnings=self.warnings + other.warnings,
         )

@@ -29,3 +29,12 @@ def read_text(path: Path, display: str, error: type[LocatedError] = SchemaError)
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
         raise error(display, line, "expected UTF-8 text") from None
+
+
+def is_file(path: Path) -> bool:
+    """Whether ``path`` is a file, for a path built from schema text: a name too long for the file
+    system (or otherwise unusable) is simply not a file, where ``Path.is_file`` would raise."""
+    try:
+        return path.is_file()
+    except (OSError, ValueError):  # ENAMETOOLONG; ValueError for an embedded NUL
+        return False

@@ -100,7 +100,7 @@ def forward(
     t.charging = bool(s_info.status_flags & 2)
 
     # dronecan.yaml:26: flag_choice info.status_flags -> warning
-    # Charging is a battery state of its own (uORB WARNING_CHARGING, MAVLink CHARGE_STATE_CHARGING).
+    # Charging is a battery state of its own (uORB STATE_CHARGING, MAVLink CHARGE_STATE_CHARGING).
     if s_info.status_flags & 2:
         t.warning = "charging"
 
@@ -290,7 +290,7 @@ def backward(
         t_info.status_flags |= 2
 
     # dronecan.yaml:26: flag_choice info.status_flags -> warning
-    # Charging is a battery state of its own (uORB WARNING_CHARGING, MAVLink CHARGE_STATE_CHARGING).
+    # Charging is a battery state of its own (uORB STATE_CHARGING, MAVLink CHARGE_STATE_CHARGING).
     if s.warning == "charging":
         t_info.status_flags |= 2
 

@@ -80,6 +80,8 @@ def forward(
     t_status.temperature = 0.0
     t_status.cell_count = 0
     t_status.voltage_cell_v = [0.0] * 14
+    t_status.remaining_capacity_wh = 0.0
+    t_status.nominal_voltage = 0.0
 
     # px4_mavlink_receiver.yaml:12: px4_receiver_cells voltages -> voltage_cell_v, cell_count, voltage_v
     # Cells while below UINT16_MAX (at most 10): voltage_cell_v[i] = v / 1000.0f, summed in float32 into voltage_v;

@@ -70,6 +70,8 @@ def forward(
     t_status.temperature = 0.0
     t_status.cell_count = 0
     t_status.voltage_cell_v = [0.0] * 14
+    t_status.remaining_capacity_wh = 0.0
+    t_status.nominal_voltage = 0.0
 
     # px4_uavcan_bridge.yaml:17: px4_convert info.voltage -> voltage_v
     # voltage_v = msg.voltage
@@ -239,5 +241,9 @@ def forward(
         rep_u.unknown("uorb.BatteryStatus.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
         rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
+    if rep_u is not None and _r.is_marker(t_status.remaining_capacity_wh, _math.nan):
+        rep_u.unknown("uorb.BatteryStatus.remaining_capacity_wh")
+    if rep_u is not None and _r.is_marker(t_status.nominal_voltage, _math.nan):
+        rep_u.unknown("uorb.BatteryStatus.nominal_voltage")
 
     return (t_status,)

@@ -215,7 +215,7 @@ def forward(
 
     # uorb.yaml:52: scale remaining_capacity_wh -> remaining_energy
     _v18 = s_status.remaining_capacity_wh
-    if _v18 != 0:
+    if _v18 == _v18 and _v18 != 0:
         t.remaining_energy = float(_v18) * 3600.0
 
     # uorb.yaml:53: copy over_discharge_count -> over_discharge_count
@@ -224,7 +224,7 @@ def forward(
 
     # uorb.yaml:54: scale nominal_voltage -> nominal_voltage
     _v20 = s_status.nominal_voltage
-    if _v20 != 0 and _v20 == _v20:
+    if _v20 == _v20 and _v20 != 0:
         t.nominal_voltage = float(_v20)
 
     # uorb.yaml:55: copy is_powering_off -> is_powering_off
@@ -465,7 +465,7 @@ def backward(
     # uorb.yaml:52: scale remaining_capacity_wh -> remaining_energy
     _v18 = s.remaining_energy
     if _v18 is None or _v18 != _v18:
-        t_status.remaining_capacity_wh = 0.0
+        t_status.remaining_capacity_wh = _math.nan
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.remaining_capacity_wh")
     else:
@@ -484,7 +484,7 @@ def backward(
     # uorb.yaml:54: scale nominal_voltage -> nominal_voltage
     _v20 = s.nominal_voltage
     if _v20 is None or _v20 != _v20:
-        t_status.nominal_voltage = 0.0
+        t_status.nominal_voltage = _math.nan
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.nominal_voltage")
     else:

@@ -90,5 +90,9 @@ def forward(
         rep_u.unknown("uorb.BatteryStatus.cell_count")
     if rep_u is not None and all(_r.is_marker(_x, 0.0) for _x in t_status.voltage_cell_v):
         rep_u.unknown("uorb.BatteryStatus.voltage_cell_v")
+    if rep_u is not None and _r.is_marker(t_status.remaining_capacity_wh, _math.nan):
+        rep_u.unknown("uorb.BatteryStatus.remaining_capacity_wh")
+    if rep_u is not None and _r.is_marker(t_status.nominal_voltage, _math.nan):
+        rep_u.unknown("uorb.BatteryStatus.nominal_voltage")
 
     return (t_status,)

@@ -133,7 +133,7 @@ def test_strict_status_flags_to_faults_and_warning() -> None:
     cold = dronecan_to_uorb(BatteryInfo(status_flags=BatteryInfo.STATUS_FLAG_TEMP_COLD))
     assert cold.faults == 1 << BatteryStatus.FAULT_UNDER_TEMPERATURE
     charging = dronecan_to_uorb(BatteryInfo(status_flags=BatteryInfo.STATUS_FLAG_CHARGING))
-    assert charging.warning == BatteryStatus.WARNING_CHARGING
+    assert charging.warning == BatteryStatus.STATE_CHARGING
     assert mavlink_to_dronecan(MavBatteryStatus(charge_state=7))[0].status_flags & BatteryInfo.STATUS_FLAG_CHARGING
 
 

@@ -37,7 +37,8 @@ def test_models_default_to_sentinels() -> None:
     assert mav.temperature == 32767 and mav.voltages == [65535] * 10 and mav.current_battery == -1
     meta = {f.name: f.metadata for f in dataclasses.fields(BatteryStatus)}
     assert meta["voltage_v"]["unit"] == "V" and meta["remaining"]["minimum"] == 0
-    assert meta["warning"]["enums"] == ("uorb.BatteryStatus.WARNING",)
+    assert meta["warning"]["enums"] == ("uorb.BatteryStatus.WARNING", "uorb.BatteryStatus.STATE")
+    assert math.isnan(status.remaining_capacity_wh) and math.isnan(status.nominal_voltage)  # [@invalid NaN]
 
 
 def _ruff(*args: str) -> subprocess.CompletedProcess[str]:

@@ -188,6 +188,7 @@ def test_empty_inputs_are_not_success(capsys: pytest.CaptureFixture[str], tmp_pa
         ("BATTERY_INFO", "mavlink.BATTERY_INFO"),
         ("BatteryStatusV2", "mavlink.BATTERY_STATUS_V2"),
         ("power.BatteryInfo", "dronecan.uavcan.equipment.power.BatteryInfo"),
+        ("uorb.BatteryInfo", "uorb.BatteryInfo"),
         ("uavcan.equipment.power.BatteryInfo", "dronecan.uavcan.equipment.power.BatteryInfo"),
         ("devicetree.power.supply.battery", "devicetree.power.supply.battery"),
         ("simple-battery", "devicetree.power.supply.battery"),
@@ -201,6 +202,8 @@ def test_ambiguous_and_unknown_message_names_exit_2(capsys: pytest.CaptureFixtur
     code, _, err = validate(capsys, "--message", "BatteryStatus", str(DATA / "uorb_valid.json"))
     assert code == 2
     assert "ambiguous" in err and "mavlink.BATTERY_STATUS" in err and "uorb.BatteryStatus" in err
+    code, _, err = validate(capsys, "--message", "BatteryInfo", str(DATA / "uorb_valid.json"))
+    assert code == 2 and "uorb.BatteryInfo" in err and "dronecan.uavcan.equipment.power.BatteryInfo" in err
     code, _, err = validate(capsys, "--message", "BatteryStatu", str(DATA / "uorb_valid.json"))
     assert code == 2 and "no message called 'BatteryStatu'" in err and "uorb.BatteryStatusV0" in err
 

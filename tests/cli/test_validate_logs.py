@@ -63,7 +63,7 @@ def test_fields_the_log_lacks_are_not_blamed_on_it(capsys: pytest.CaptureFixture
         "maximum 1",
         f"{path.as_posix()}: battery_status multi_id 0, timestamp 3000 us, offset 229: warning = 9 is not one of "
         "WARNING_NONE (0), WARNING_LOW (1), WARNING_CRITICAL (2), WARNING_EMERGENCY (3), WARNING_FAILED (4), "
-        "WARNING_UNHEALTHY (6), WARNING_CHARGING (7)",
+        "STATE_UNHEALTHY (6), STATE_CHARGING (7)",
     ]
     assert err.count("the log's format differs") == 1 and err.count("not checked") == 1
     assert "max_error" in err.split("not checked")[1]

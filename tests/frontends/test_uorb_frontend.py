@@ -102,12 +102,19 @@ def test_v1_differs_from_v0_as_specified(battery: tuple[Message, Message]) -> No
     consts1 = {c.name: c.value for c in v1.constants}
     consts0 = {c.name: c.value for c in v0.constants}
     assert (consts1["MAX_INSTANCES"], consts0["MAX_INSTANCES"]) == (3, 4)
-    assert (consts1["WARNING_UNHEALTHY"], consts1["WARNING_CHARGING"]) == (6, 7)
-    assert (consts0["STATE_UNHEALTHY"], consts0["STATE_CHARGING"]) == (6, 7) and "STATE_UNHEALTHY" not in consts1
+    # PX4 main names 6 and 7 as V0 does, under [@enum WARNING STATE]
+    assert (consts1["STATE_UNHEALTHY"], consts1["STATE_CHARGING"]) == (6, 7) and "WARNING_UNHEALTHY" not in consts1
+    assert (consts0["STATE_UNHEALTHY"], consts0["STATE_CHARGING"]) == (6, 7)
     t1, t0 = v1.field("temperature"), v0.field("temperature")
     assert (t1.unit_text, t0.unit_text) == ("degC", "°C")
     assert t1.unit == t0.unit and t1.unit is not None and t1.unit.symbol == "degC"
-    assert v1.field("warning").enums == ("uorb.BatteryStatus.WARNING",)
+    assert v1.field("warning").enums == ("uorb.BatteryStatus.WARNING", "uorb.BatteryStatus.STATE")
+    assert (v1.field("remaining_capacity_wh").invalid, v0.field("remaining_capacity_wh").invalid) == (
+        Sentinel(math.nan, "NaN"),
+        None,
+    )
+    assert v1.field("nominal_voltage").invalid == Sentinel(math.nan, "NaN")
+    assert (v1.field("scale").unit_text, v0.field("scale").unit_text) == ("-", None)
     assert v0.field("warning").enums == ("uorb.BatteryStatusV0.WARNING", "uorb.BatteryStatusV0.STATE")
 
 
@@ -141,7 +148,9 @@ def test_battery_enums(battery: tuple[Message, Message]) -> None:
     assert any(c.name == "FAULT_COUNT" and c.value == 11 for c in v0.constants)  # kept as a constant
     assert fault.entries[2].name == "FAULT_CELL_FAIL"  # written "FAULT_CELL_FAIL= 2"
     assert fault.entries[0].doc == "Battery has deep discharged" and fault.entries[0].location is not None
-    assert [e.value for e in v1.enums[1].entries] == [0, 1, 2, 3, 4, 6, 7]
+    assert [e.name for e in v1.enums] == [e.name.replace("StatusV0", "Status") for e in v0.enums]
+    assert [e.value for e in v1.enums[1].entries] == [0, 1, 2, 3, 4]
+    assert [e.value for e in v1.enums[2].entries] == [6, 7]
     assert len(v0.constants) == 2 + 3 + 7 + 12  # every constant stays, enum members included
 
 
@@ -183,7 +192,7 @@ def test_annotation_tags(tmp_path: Path) -> None:
     x = m.field("x")
     assert x.range == Range(None, 3) and x.unit is not None and x.unit.symbol == "m"
     assert x.invalid is not None and x.invalid.is_nan and x.invalid.text == "NaN"
-    assert x.annotations == (("frame", "NED"), ("invalid", "NaN when no fix")) and x.doc == "North position"
+    assert x.annotations == (("invalid", "NaN when no fix"),) and x.doc == "North position" and x.frame == "NED"
     y = m.field("y")
     assert y.range == Range(-1.5, 2000.0) and y.annotations == (("future", "thing"),)
     assert y.unit is not None and y.unit.quantity == "unknown:dBm" and y.unit_text == "dBm"
@@ -283,7 +292,6 @@ def test_parse_dir_walks_subdirectories(tmp_path: Path) -> None:
         (HEAD + "float32 x # [m\n", 2, "expected ']' to close"),
         (HEAD + "float32 x # [m] [s]\n", 2, "expected one unit"),
         (HEAD + "float32 x # [] text\n", 2, "expected a unit inside '[]'"),
-        (HEAD + "uint8 x # [@enum MODE]\n", 2, "expected constants named MODE_* in this message"),
         (HEAD + "float32 x # [@enum MODE]\nuint8 MODE_A = 1\n", 2, "expected '@enum' only on integer fields"),
         (HEAD + "uint8 m # [@enum M]\nfloat32 M_A = 1.5\n", 3, "expected an integer constant in enum M"),
         (HEAD + "uint8 x\nuint16 x\n", 3, "expected a unique name: 'x' is already defined on line 2"),

@@ -45,7 +45,7 @@ HANG_SECONDS = 30  # per input, on a loaded 2-core machine; the slowest real sch
 RENDER_SECONDS = 300  # generating the whole package takes 2 s alone, far more under load
 COMPILE_EVERY = 1 if LONG else 4
 # CI examples per target: the whole-package targets (mappings, rules) cost a full load and render each
-CI_MUTANTS = {"mappings": 12, "rules": 20}
+CI_MUTANTS = {"mappings": 10, "rules": 15}
 
 
 @dataclass(frozen=True)
@@ -243,7 +243,7 @@ def workspace(tmp_path: Path) -> Iterator[Callable[[str], Workspace]]:
 def test_fuzz_schema_mutants(name: str, workspace: Callable[[str], Workspace]) -> None:
     ws = workspace(name)
 
-    @fuzz_settings(ci=CI_MUTANTS.get(name, 40))
+    @fuzz_settings(ci=CI_MUTANTS.get(name, 30))
     @given(st.data())
     def run(data: st.DataObject) -> None:
         ws.check(data.draw(mutants(ws.seed, ws.target.tokens)))
@@ -259,7 +259,7 @@ def test_fuzz_schema_mutants(name: str, workspace: Callable[[str], Workspace]) -
 def test_fuzz_schema_random_text(name: str, workspace: Callable[[str], Workspace]) -> None:
     ws = workspace(name)
 
-    @fuzz_settings(ci=15)
+    @fuzz_settings(ci=10)
     @given(random_text())
     def run(text: str) -> None:
         ws.check(text)

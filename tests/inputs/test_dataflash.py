@@ -70,6 +70,18 @@ def test_garbage_between_messages_is_skipped_and_noted(tmp_path: Path) -> None:
     assert log.skipped_notes and "Skipped" in log.skipped_notes[0]
 
 
+def test_a_message_its_damaged_format_does_not_describe_is_skipped(tmp_path: Path) -> None:
+    """Found by tests/fuzz/test_fuzz_failsafe_inputs.py: one byte inserted into a FMT record made
+    pymavlink's DFMessage.to_dict raise IndexError."""
+    good = battery_log(tmp_path / "g.bin", {"BATT_LOW_VOLT": 10.5}, [(1.0, 0, 12.0, 1.0, 5.0)], [(0.5, True)])
+    data = good.read_bytes()
+    bad = tmp_path / "bad.bin"
+    bad.write_bytes(data[:203] + b"," + data[203:])
+    log = dataflash.open_log(bad)
+    list(dataflash.flight_records(log))
+    assert any("cannot decode" in note for note in log.skipped_notes)
+
+
 @pytest.mark.parametrize(
     ("content", "expected"),
     [(b"", "empty file"), (b"PK\x03\x04 not a log", "A3 95 80"), (b"\xa3\x95\x80\x01", "")],

@@ -61,6 +61,8 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
     except BattgenError as exc:
         return LogResult(path, "failed", log, error=str(exc))
     except (OSError, ValueError, MemoryError) as exc:  # a log the readers did not foresee
+        if isinstance(exc, OSError) and is_exported(options.out, log):  # the same content, exported meanwhile
+            return LogResult(path, "skipped", log, notes=("the same content was exported by another task",))
         return LogResult(path, "failed", log, error=f"{path}: cannot export: {type(exc).__name__}: {exc}")
 
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ...errors import SchemaError
+from ...errors import ErrorCollector, SchemaError
 from ...ir import Message, Schema
 from ...text.files import display_path
 from ...text.limits import read_schema_text
@@ -48,14 +48,16 @@ def parse_dir(root: Path) -> Schema:
     data = load_data(root)
     messages: list[Message] = []
     sources: list[str] = []
+    found = ErrorCollector()  # every file's errors in one report
     for path in sorted(root.rglob("*.yaml")):
         if path.parent.resolve() == root.resolve() and path.name in DATA_FILES:
             continue
-        doc, display = _load(path, root)
-        if not is_binding(doc):
-            continue
-        messages += binding_messages(doc, display, data)
-        sources.append(display)
+        with found.step():
+            doc, display = _load(path, root)
+            if is_binding(doc):
+                messages += binding_messages(doc, display, data)
+                sources.append(display)
+    found.raise_if_any()
     seen: dict[str, str] = {}
     for m in messages:
         if m.qualified_name in seen:

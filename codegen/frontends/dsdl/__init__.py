@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...errors import SchemaError
+from ...errors import ErrorCollector, SchemaError
 from ...ir import Schema
 from .build import build
 from .namespaces import Namespaces, find_root
@@ -45,8 +45,11 @@ def parse_dir(root: Path) -> Schema:
     if not root.is_dir():
         raise SchemaError(root.as_posix(), 0, "expected a DSDL root directory")
     namespaces = Namespaces(root)
+    found = ErrorCollector()  # every file's errors in one report
     for path in sorted(root.rglob("*.uavcan")):
         if path.is_file():
-            namespaces.load_path(path)
+            with found.step():
+                namespaces.load_path(path)
+    found.raise_if_any()
     namespaces.check_unique_ids()
     return build(namespaces.defs)

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ...errors import SchemaError
-from ...text.files import display_path
+from ...text.files import display_path, is_file
 from ...text.xml import read_xml
 from .build import LoadedFile
 from .scan import scan
@@ -96,7 +96,7 @@ class _Reader:
         candidates = [Path(os.path.normpath(path.parent / text))]
         candidates += [Path(os.path.normpath(folder / text)) for folder in self.include_paths]
         # containment first (symbolic links followed): nothing outside is even looked at
-        found = next((c for c in candidates if self._inside(c) and c.is_file()), None)
+        found = next((c for c in candidates if self._inside(c) and is_file(c)), None)
         if found is not None:
             return found
         if not self._inside(candidates[0]):

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...errors import SchemaError
+from ...errors import ErrorCollector, SchemaError
 from ...ir import Message, Schema
 from ...text.files import display_path
 from .groups import group_messages
@@ -42,9 +42,12 @@ def parse_dir(root: Path) -> Schema:
     if not root.is_dir():
         raise SchemaError(display_path(root, None), 0, f"expected a directory of {SUFFIX} files")
     schema = Schema()
+    found = ErrorCollector()  # every file's errors in one report
     for path in sorted(root.rglob("*" + SUFFIX)):
         if path.is_file():
-            schema = schema.merged(parse_file(path, root=root))
+            with found.step():
+                schema = schema.merged(parse_file(path, root=root))
+    found.raise_if_any()
     seen: dict[str, Message] = {}
     for msg in schema.messages:
         if msg.qualified_name in seen:

@@ -17,7 +17,7 @@ from pathlib import Path
 from ...errors import SchemaError
 from ...ir import Schema
 from ...text.files import display_path
-from .build import Loader
+from .build import Loader, NestedFailure
 
 __all__ = ["parse_dir", "parse_file"]
 
@@ -25,16 +25,24 @@ __all__ = ["parse_dir", "parse_file"]
 def parse_file(path: Path, *, root: Path | None = None) -> Schema:
     """One .msg file, plus the messages it nests (their sizes shape its layout)."""
     loader = Loader(root)
-    loader.load(path)
+    try:
+        loader.load(path)
+    except NestedFailure:
+        pass  # its errors are in loader.errors
+    loader.raise_errors()
     return loader.schema()
 
 
 def parse_dir(root: Path) -> Schema:
-    """Every .msg file below ``root``, in sorted path order."""
+    """Every .msg file below ``root``, in sorted path order; errors of all files in one ErrorList."""
     if not root.is_dir():
         raise SchemaError(display_path(root, None), 0, "expected a directory of .msg files")
     loader = Loader(root)
     for path in sorted(root.rglob("*.msg")):
         if path.is_file():
-            loader.load(path)
+            try:
+                loader.load(path)
+            except NestedFailure:
+                continue  # reported in loader.errors (or, for a file nesting it, there already)
+    loader.raise_errors()
     return loader.schema()

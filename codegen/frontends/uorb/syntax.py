@@ -57,7 +57,9 @@ class MsgText:
     items: tuple[FieldLine | ConstantLine, ...]
 
 
-def parse_text(text: str, file: str) -> MsgText:
+def parse_text(text: str, file: str, errors: list[SchemaError] | None = None) -> MsgText:
+    """The lines of a file. With ``errors`` given, a bad line is appended there and skipped, so one
+    run reports every bad line; without, the first one is raised."""
     doc_lines: list[str] = []
     topics: list[str] = []
     items: list[FieldLine | ConstantLine] = []
@@ -66,24 +68,30 @@ def parse_text(text: str, file: str) -> MsgText:
     for number, raw in enumerate(text.split("\n"), start=1):
         line = raw.rstrip("\r").rstrip()
         stripped = line.strip()
-        topics_match = _TOPICS_LINE.match(line)
-        if topics_match:
-            topics.extend(_topics(topics_match.group(1) or "", topics, file, number))
+        try:
+            topics_match = _TOPICS_LINE.match(line)
+            if topics_match:
+                topics.extend(_topics(topics_match.group(1) or "", topics, file, number))
+                continue
+            if stripped.startswith("#"):
+                if in_header:
+                    body = stripped[1:]
+                    doc_lines.append(body[1:] if body.startswith(" ") else body)
+                continue  # later comment lines are internal comments
+            if not stripped:
+                in_header = in_header and not doc_lines
+                continue
+            in_header = False
+            item = _statement(line, file, number)
+            if item.name in seen:
+                raise SchemaError(
+                    file, number, f"expected a unique name: '{item.name}' is already defined on line {seen[item.name]}"
+                )
+        except SchemaError as error:
+            if errors is None:
+                raise
+            errors.append(error)
             continue
-        if stripped.startswith("#"):
-            if in_header:
-                body = stripped[1:]
-                doc_lines.append(body[1:] if body.startswith(" ") else body)
-            continue  # later comment lines are internal comments
-        if not stripped:
-            in_header = in_header and not doc_lines
-            continue
-        in_header = False
-        item = _statement(line, file, number)
-        if item.name in seen:
-            raise SchemaError(
-                file, number, f"expected a unique name: '{item.name}' is already defined on line {seen[item.name]}"
-            )
         seen[item.name] = number
         items.append(item)
     return MsgText(doc="\n".join(doc_lines).strip("\n"), topics=tuple(topics), items=tuple(items))

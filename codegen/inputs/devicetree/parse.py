@@ -21,6 +21,7 @@ _LITERAL = re.compile(r"(0[xX][0-9a-fA-F]+|[0-9]+)(?:ULL|LL|UL|U|L)?(?![A-Za-z0-
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _HEXBYTE = re.compile(r"[0-9a-fA-F]{2}")
 _MASK64 = (1 << 64) - 1
+MAX_INCBIN = 16 << 20  # bytes one /incbin/ may bring in (a board's firmware blob is far smaller)
 
 
 class Parser:
@@ -269,14 +270,26 @@ class Parser:
             length = self._expr()
         s.expect(")", "')' to close /incbin/(...)")
         base = s.src.path.parent if s.src.path else Path.cwd()
+        target = (base / name).resolve()
+        if not s.allowed(target):
+            raise s.error(f'/incbin/ "{name}": outside the folder of {s.stack[0].display} ({s.allowed_text()})', at)
         try:
-            data = (base / name).read_bytes()
+            if not target.is_file():  # /dev/zero, a FIFO: no end, or none to trust
+                raise s.error(f'/incbin/ "{name}": not a regular file', at)
+            size = target.stat().st_size
+            end = size if length < 0 else offset + length
+            if end > size:
+                raise s.error(f'/incbin/ "{name}": asks for bytes {offset}..{end} of a {size}-byte file', at)
+            if end - offset > MAX_INCBIN:
+                raise s.error(
+                    f'/incbin/ "{name}": {end - offset} bytes, more than the {MAX_INCBIN} a property may hold', at
+                )
+            with target.open("rb") as fh:  # only the slice asked for
+                fh.seek(offset)
+                data = fh.read(end - offset)
         except OSError as exc:
             raise s.error(f'/incbin/ "{name}": cannot read ({exc.strerror or exc})', at) from None
-        end = len(data) if length < 0 else offset + length
-        if end > len(data):
-            raise s.error(f'/incbin/ "{name}": asks for bytes {offset}..{end} of a {len(data)}-byte file', at)
-        return Draft("bytes", data[offset:end])
+        return Draft("bytes", data)
 
     # -- integer expressions (dtc: unsigned 64-bit, C precedence) ---------------------------
 

@@ -55,6 +55,17 @@ class Scanner:
     def __init__(self, path: Path, display: str, root: Path | None = None) -> None:
         self.stack = [Source(_read(path, display), display, path.resolve())]
         self.root = root
+        # /include/ and /incbin/ reach only below the top file's folder and the BATTGEN_DTS_PATH folders:
+        # a board file must not read /etc/passwd or /dev/zero into a property
+        extra = [Path(p).resolve() for p in os.environ.get("BATTGEN_DTS_PATH", "").split(os.pathsep) if p]
+        self.folders = [path.resolve().parent, *extra]
+
+    def allowed(self, target: Path) -> bool:
+        """Whether an /include/ or /incbin/ target (resolved) lies below an allowed folder."""
+        return any(target.is_relative_to(folder) for folder in self.folders)
+
+    def allowed_text(self) -> str:
+        return "add its folder to BATTGEN_DTS_PATH to allow it"
 
     @property
     def src(self) -> Source:
@@ -137,6 +148,10 @@ class Scanner:
         target = (base / name).resolve()
         display = os.path.normpath(os.path.join(os.path.dirname(self.src.display), name)).replace(os.sep, "/")
         chain = [s.path for s in self.stack]
+        if not self.allowed(target):
+            raise self.error(
+                f'/include/ "{name}": outside the folder of {self.stack[0].display} ({self.allowed_text()})', at
+            )
         if target in chain:
             cycle = " -> ".join([*(s.display for s in self.stack), display])
             raise self.error(f"/include/ cycle: {cycle}", at)

@@ -1530,7 +1530,7 @@ class SimpleBattery:
         try:
             r_ocv_capacity_table_n = self.ocv_capacity_table_n
             for k_0, v_table in _v.entries(r_ocv_capacity_table_n):
-                for v_i in range(1, len(v_table)):
+                for v_i in _v.span(1, len(v_table), limit=65536):
                     try:
                         if not (v_table[(v_i - 1)][0] >= v_table[v_i][0]):
                             out.append(
@@ -1577,7 +1577,7 @@ class SimpleBattery:
             r_ocv_capacity_celsius = self.ocv_capacity_celsius
             r_ocv_capacity_table_n = self.ocv_capacity_table_n
             if r_ocv_capacity_celsius is not None:
-                for v_i in range(len(r_ocv_capacity_celsius)):
+                for v_i in _v.span(len(r_ocv_capacity_celsius), limit=65536):
                     try:
                         if ("ocv-capacity-table-" + str(v_i)) not in r_ocv_capacity_table_n:
                             out.append(

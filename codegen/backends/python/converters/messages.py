@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ....ir import ArrayType, FieldRef, Rule
+from ....ir import ArrayType, FieldRef, Rule, StringType
 from ....ir.ops import SameNames, ZeroAll
 from .context import RuleContext
 
@@ -28,7 +28,7 @@ class MessageEmitters(RuleContext):
             for f in m.fields:
                 if f.invalid is None or f.is_padding:
                     continue
-                zero = "0.0" if self.is_float(f) else "0"
+                zero = "0.0" if self.is_float(f) else '""' if isinstance(f.type, StringType) else "0"
                 if isinstance(f.type, ArrayType) and f.type.capacity is not None and not f.type.dynamic:
                     zero = f"[{zero}] * {f.type.capacity}"
                 self.emit(f"{var}.{self.member(ref.message, f.name)} = {zero}")

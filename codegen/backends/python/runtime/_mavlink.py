@@ -325,12 +325,15 @@ class StreamParser:
     after garbage or a corrupted frame. Counters: ``frames``, ``bad_crc``, ``unknown_msgid``
     (frames whose id this package lacks: their checksum cannot be checked, so they are skipped
     like garbage), ``bad_flags``, ``skipped_bytes``, ``decode_errors``; ``last_error`` says
-    why the latest frame was rejected. With ``strict=True`` a rejected frame raises FrameError.
+    why the latest frame was rejected. With ``strict=True`` a rejected frame raises FrameError, once: the
+    parser has consumed it, so feeding on resumes after it and counts no frame twice.
     """
 
     def __init__(self, *, strict: bool = False) -> None:
         self.strict = strict
         self._buf = bytearray()
+        self._ready: list[Frame] = []  # strict mode: good frames found before a rejected one
+        self._ready_messages: list[Any] = []
         self.frames = 0
         self.bad_crc = 0
         self.unknown_msgid = 0
@@ -340,9 +343,11 @@ class StreamParser:
         self.last_error: str | None = None
 
     def feed(self, data: BytesLike) -> list[Frame]:
+        """The frames completed by ``data``. In strict mode a rejected frame raises FrameError once, after
+        its first byte is consumed; the good frames found before it in the same call come with the next call."""
         buf = self._buf
         buf += data
-        out: list[Frame] = []
+        out, self._ready = self._ready, []
         pos = 0
         n = len(buf)
         while pos < n:
@@ -362,9 +367,8 @@ class StreamParser:
                 iflags = 0
                 total = 8 + buf[pos + 1]
             if iflags & ~IFLAG_SIGNED:
-                self._reject(f"unknown incompatibility flags 0x{iflags:02x}")
                 self.bad_flags += 1
-                self.skipped_bytes += 1
+                self._reject(f"unknown incompatibility flags 0x{iflags:02x}", pos, out)
                 pos += 1
                 continue
             if n - pos < total:
@@ -377,8 +381,7 @@ class StreamParser:
                     self.bad_crc += 1
                 else:
                     self.unknown_msgid += 1
-                self._reject(str(exc))
-                self.skipped_bytes += 1
+                self._reject(str(exc), pos, out)
                 pos += 1
                 continue
             self.frames += 1
@@ -388,14 +391,20 @@ class StreamParser:
         return out
 
     def feed_messages(self, data: BytesLike) -> list[Any]:
-        """Like feed(), decoded; payloads longer than the message knows count as decode_errors."""
-        out = []
-        for frame in self.feed(data):
+        """Like feed(), decoded; payloads longer than the message knows count as decode_errors (strict
+        mode: raise FrameError once, the messages decoded before it coming with the next call)."""
+        out, self._ready_messages = self._ready_messages, []
+        frames = self.feed(data)
+        for i, frame in enumerate(frames):
             try:
                 out.append(frame.message())
             except DecodeError as exc:
                 self.decode_errors += 1
-                self._reject(str(exc))
+                self.last_error = str(exc)
+                if self.strict:
+                    self._ready = frames[i + 1 :] + self._ready
+                    self._ready_messages = out
+                    raise FrameError(str(exc)) from None
         return out
 
     @property
@@ -403,9 +412,14 @@ class StreamParser:
         """Bytes kept back, waiting for the rest of a frame."""
         return len(self._buf)
 
-    def _reject(self, why: str) -> None:
+    def _reject(self, why: str, pos: int, found: list[Frame]) -> None:
+        """Note why the frame at ``pos`` was rejected; in strict mode consume its first byte (and what
+        came before it) and raise, keeping the frames ``found`` so far for the next call."""
         self.last_error = why
+        self.skipped_bytes += 1
         if self.strict:
+            del self._buf[: pos + 1]
+            self._ready = found
             raise FrameError(why)
 
 

@@ -29,6 +29,9 @@ HEAD = struct.Struct("<HB")  # a record's header: uint16 size, uint8 type
 U16 = struct.Struct("<H")
 U64 = struct.Struct("<Q")
 MAX_DEPTH = 32  # nesting depth of formats, against cyclic definitions in a damaged log
+# A ULog record's size is a uint16: no format can describe more bytes (nor array more elements), so a
+# damaged or hostile format declaring more is refused before anything is laid out for it.
+MAX_MESSAGE = 65535
 
 
 class ULogError(ValueError):
@@ -110,8 +113,13 @@ def parse_format(text: str) -> Format:
         count = 0
         if "[" in ctype:
             ctype, _, rest = ctype.partition("[")
-            if not rest.endswith("]") or not rest[:-1].isdigit():
+            if not rest.endswith("]") or not (rest[:-1].isascii() and rest[:-1].isdigit()):
                 raise ULogError(f"format {name}: bad array type in {item!r}")
+            if len(rest) > 6 or int(rest[:-1]) > MAX_MESSAGE:
+                raise ULogError(
+                    f"format {name}: array {item.strip()[:60]!r} is longer than a ULog message holds "
+                    f"({MAX_MESSAGE} bytes)"
+                )
             count = int(rest[:-1])
         if not field or not ctype:
             raise ULogError(f"format {name}: expected 'type name', got {item!r}")
@@ -139,7 +147,7 @@ class Layout:
 def layout(fmt: Format, formats: Mapping[str, Format]) -> Layout:
     """Flatten ``fmt``, resolving nested types through ``formats`` (or the members' own)."""
     leaves: list[tuple[str, str, int, int, str]] = []
-    size = _flatten(fmt, formats, "", 0, leaves, 0)
+    size = _flatten(fmt, formats, "", 0, leaves, 0, [0])
     data_size = size
     for m in reversed(fmt.members):
         if not m.is_padding or m.ctype not in TYPES:
@@ -151,7 +159,7 @@ def layout(fmt: Format, formats: Mapping[str, Format]) -> Layout:
 
 def _flatten(
     fmt: Format, formats: Mapping[str, Format], prefix: str, base: int, out: list[tuple[str, str, int, int, str]],
-    depth: int,
+    depth: int, visits: list[int],
 ) -> int:  # fmt: skip
     if depth > MAX_DEPTH:
         raise ULogError(f"format {fmt.name}: nested deeper than {MAX_DEPTH} levels (a cycle?)")
@@ -161,6 +169,8 @@ def _flatten(
         known = TYPES.get(m.ctype)
         if known is not None:
             code, width, np_type = known
+            if at - base + width * n > MAX_MESSAGE:
+                raise ULogError(f"format {fmt.name}: larger than a ULog message holds ({MAX_MESSAGE} bytes)")
             if not m.is_padding:
                 if m.ctype == "char" and m.count:
                     out.append((prefix + m.name, f"{m.count}s", at, m.count, f"S{m.count}"))
@@ -175,7 +185,10 @@ def _flatten(
             raise ULogError(f"format {fmt.name}: field {m.name} has unknown type {m.ctype!r}")
         for i in range(n):
             inner = f"{prefix}{m.name}[{i}]." if m.count else f"{prefix}{m.name}."
-            at += _flatten(sub, formats, inner, at, out, depth + 1)
+            at += _flatten(sub, formats, inner, at, out, depth + 1, visits)
+            visits[0] += 1  # counted too: arrays of an empty nested type add no bytes
+            if at - base > MAX_MESSAGE or visits[0] + len(out) > MAX_MESSAGE:
+                raise ULogError(f"format {fmt.name}: larger than a ULog message holds ({MAX_MESSAGE} bytes)")
     return at - base
 
 

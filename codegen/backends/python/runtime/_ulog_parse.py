@@ -335,7 +335,8 @@ def _key_value(body: bytes) -> tuple[str, Any]:
     code, width, _ = known
     if not count:
         return key, struct.unpack("<" + code, raw[:width])[0] if len(raw) >= width else bytes(raw)
-    n_items = int(count.rstrip("]")) if count.rstrip("]").isdigit() else 0
+    digits = count.rstrip("]")
+    n_items = int(digits) if digits.isascii() and digits.isdigit() else 0
     if len(raw) < n_items * width:
         return key, bytes(raw)
     return key, list(struct.unpack_from(f"<{n_items}{code}", raw))

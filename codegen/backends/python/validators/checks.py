@@ -50,7 +50,7 @@ class NumberCheck:
             low, high = type_bounds(t, f.range)
             args += [f"low={number(low, t)}", f"high={number(high, t)}"]
         unit = f.unit.symbol if f.unit is not None else (f.unit_text or "")
-        if unit:
+        if unit and unit != "1":  # a dimensionless value ('[-]') reads as a bare number
             args.append(f"unit={py_literal(unit)}")
         if f.range is not None:
             r = f.range

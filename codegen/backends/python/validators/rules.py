@@ -8,7 +8,7 @@ through these node types and :func:`~.literals.py_literal`, so a rule cannot inj
 
 from __future__ import annotations
 
-from ....ir import ArrayType, Field, Message, Sentinel, StringType
+from ....ir import ArrayType, Field, FieldType, Message, Sentinel, StringType
 from ....ir.expr import (
     Binary,
     BoolOp,
@@ -63,6 +63,19 @@ def _known_by_position(t: ArrayType, s: Sentinel, value: str) -> str:
 
 _NEGATED_MEMBERSHIP = {"in": "not in", "not in": "in"}
 
+# The bound of a rule's range() over unbounded arrays; the same figure as the runtime's _validate.SPAN_LIMIT.
+SPAN_LIMIT = 1 << 16
+
+
+def _capacity(t: FieldType) -> int | None:
+    """The most elements any array level of ``t`` holds (None: unbounded)."""
+    if not isinstance(t, ArrayType):
+        return 0
+    inner = _capacity(t.element)
+    if t.capacity is None or inner is None:
+        return None
+    return max(t.capacity, inner)
+
 
 class _Emitter:
     def __init__(self, msg: Message, idents: dict[str, str]) -> None:
@@ -70,6 +83,13 @@ class _Emitter:
         self.idents = idents  # schema name -> attribute
         self.fields = {f.name: f for f in msg.fields}
         self.optional = msg.devicetree is not None
+
+    def span_limit(self) -> int:
+        """How many indices a rule's range() may cover: the largest array capacity of the message, or
+        the runtime's SPAN_LIMIT when an array of the message is unbounded (devicetree tables)."""
+        caps = [_capacity(f.type) for f in self.msg.fields if isinstance(f.type, ArrayType)]
+        known = [c for c in caps if c is not None]
+        return max(known) if known and len(known) == len(caps) else SPAN_LIMIT
 
     def local(self, name: str) -> str:
         return "r_" + self.idents[name]
@@ -124,6 +144,10 @@ class _Emitter:
             return f"list(reversed({args[0]}))"
         if e.func == "keys":
             return f"sorted({args[0]}.keys())"
+        if e.func == "range":
+            # a rule's range() indexes arrays: clamped to the schema's capacity, so a corrupt count in a
+            # record (cell_count = -10**8) cannot make validate() loop for minutes
+            return f"_v.span({', '.join(args)}, limit={self.span_limit()})"
         return f"{e.func}({', '.join(args)})"
 
 
