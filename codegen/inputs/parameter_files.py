@@ -76,7 +76,9 @@ def is_qgc_text(lines: Sequence[str]) -> bool:
 def parse_text(text: str, display: str, *, qgc: bool | None = None) -> list[ParamEntry]:
     """Entries in file order, a repeated parameter at each of its lines (the last one counts).
     ``qgc`` None: the layout from the content (:func:`is_qgc_text`)."""
-    lines = text.splitlines()
+    # lines as editors and file:line number them: \n, \r\n and \r break a line; str.splitlines would also
+    # break at \x85, \x0c, \u2028..., so a reported line number would not be the file's
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     if qgc is None:
         qgc = is_qgc_text(lines)
     entries: list[ParamEntry] = []
