@@ -4,7 +4,7 @@ counts per target (a nightly job, or before a release).
     python tests/fuzz/long_run.py --minutes 10            # all targets, the budget shared equally
     python tests/fuzz/long_run.py --minutes 2 read-yaml   # some targets
 
-Inputs come from the fuzzers' own strategies, in rounds of fresh random draws. Each input runs under a
+Inputs come from the fuzzers' own strategies, in rounds of 25 fresh random draws. Each input runs under a
 per-input alarm (a hang becomes a failure) and the process under an address-space cap (a memory blow-up
 becomes a MemoryError, a failure). A failing input is shrunk by hypothesis, saved to
 ``tests/fuzz/crashers/<target>/`` (replayed from then on by test_fuzz_crashers.py) and reported; the exit
@@ -79,7 +79,7 @@ def fuzz(target: str, seconds: float) -> tuple[int, list[str]]:
     found: list[str] = []
     deadline = time.monotonic() + seconds
     while time.monotonic() < deadline:
-        test = settings(max_examples=200, deadline=None, database=None, suppress_health_check=list(HealthCheck))(
+        test = settings(max_examples=25, deadline=None, database=None, suppress_health_check=list(HealthCheck))(
             given(strategy(target))(one)
         )
         try:

@@ -24,6 +24,15 @@ _MASK64 = (1 << 64) - 1
 MAX_INCBIN = 16 << 20  # bytes one /incbin/ may bring in (a board's firmware blob is far smaller)
 
 
+def _clip(name: str) -> str:
+    return name if len(name) <= 60 else name[:57] + "..."
+
+
+def _quoted(name: str) -> str:
+    """A node or property name in a message, cut to a line (hostile input can make one megabytes long)."""
+    return repr(name) if len(name) <= 60 else repr(name[:57]) + "..."
+
+
 class Parser:
     def __init__(self, path: Path, display: str, root: Path | None = None) -> None:
         self.s = Scanner(path, display, root)
@@ -118,12 +127,12 @@ class Parser:
 
     def _body(self, name: str, labels: list[str], at: tuple[str, int]) -> Node:
         s = self.s
-        s.expect("{", f"'{{' to open node {name or '/'}")
+        s.expect("{", f"'{{' to open node {_clip(name) if name else '/'}")
         node = Node(name, at[0], at[1], labels=list(labels))
         seen_child = False
         while not s.take("}"):
             if s.eof():
-                raise s.error(f"expected '}}' to close node {name or '/'} opened at {at[0]}:{at[1]}")
+                raise s.error(f"expected '}}' to close node {_clip(name) if name else '/'} opened at {at[0]}:{at[1]}")
             stmt_at = s.where()
             if s.take("/delete-property/"):
                 pname = self._name("a property name after /delete-property/")
@@ -152,11 +161,11 @@ class Parser:
             if omit:
                 raise s.error("/omit-if-no-ref/ applies to nodes: expected '{'")
             if seen_child:
-                raise s.error(f"property {item!r} after a child node: properties must come first", stmt_at)
+                raise s.error(f"property {_quoted(item)} after a child node: properties must come first", stmt_at)
             value = self._value() if s.take("=") else []
-            s.expect(";", f"';' after property {item!r}")
+            s.expect(";", f"';' after property {_quoted(item)}")
             node.props.append(self._prop(item, value, stmt_at))
-        s.expect(";", f"';' after the closing '}}' of node {name or '/'}")
+        s.expect(";", f"';' after the closing '}}' of node {_clip(name) if name else '/'}")
         return node
 
     def _prop(self, name: str, value: list[Draft], at: tuple[str, int], deleted: bool = False) -> Prop:

@@ -22,6 +22,7 @@ _CPP_DIRECTIVES = frozenset("include define undef if ifdef ifndef elif else endi
 _LINEMARKER = re.compile(r'#(?:line)?[ \t]+([0-9]+)[ \t]+"((?:[^"\\\n]|\\.)*)"[^\n]*')
 _DIRECTIVE = re.compile(r"#[ \t]*([a-z]+)(?=[\s<\"]|$)")
 _WS = " \t\r\n\f\v"
+_WORD = re.compile(r"[A-Za-z0-9_,.+*#?@-]+|\S")
 MAX_INCLUDE_DEPTH = 100
 
 
@@ -202,8 +203,11 @@ class Scanner:
         src = self.src
         if src.pos >= len(src.text):
             return "end of file"
-        word = re.match(r"[A-Za-z0-9_,.+*#?@-]+|\S", src.text[src.pos :])
-        return repr(word.group(0)) if word else "end of file"
+        word = _WORD.match(src.text, src.pos)
+        if not word:
+            return "end of file"
+        text = word.group(0)  # quoted briefly: a "word" of hostile input can be megabytes long
+        return repr(text) if len(text) <= 60 else repr(text[:57]) + "..."
 
     def match(self, pattern: re.Pattern[str]) -> str | None:
         m = pattern.match(self.src.text, self.src.pos)
