@@ -14,7 +14,7 @@ record's position (one per second) -- said in the series' ``time_source``.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -56,7 +56,6 @@ class BatterySeries:
     serial: str = ""
     cycle_count: int | None = None  # the last the battery reported
     state_of_health: float | None = None  # percent, the last the battery reported
-    armed: list[tuple[float, bool]] = field(default_factory=list)  # arming changes, where the input tells
 
     @property
     def label(self) -> str:
@@ -227,8 +226,3 @@ def _append(series: BatterySeries, t: float, state: Mapping[str, Any]) -> None:
         serial = str(serial)  # the concept is an integer (DroneCAN model_instance_id, PX4's uint16)
     if isinstance(serial, str) and serial.strip("\x00 0") and not series.serial:
         series.serial = serial
-
-
-def read_inputs(paths: list[Path], schema_dir: Path, *, message: str | None = None) -> Iterator[InputSeries]:
-    for path in paths:
-        yield read_input(path, schema_dir, message=message)
