@@ -9,18 +9,17 @@ is reported in its :class:`LogResult` and the run goes on.
 from __future__ import annotations
 
 import concurrent.futures
+import mmap
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import pyarrow as pa
-
 from ...errors import BattgenError
 from .catalog import bundled_catalog
 from .columnar import convert_columns
-from .dataset import is_exported, raw_table, write_log
+from .dataset import LogWriter, is_exported, raw_table
 from .readers import read_log
-from .sources import content_id
+from .sources import content_id, map_file
 from .table import battery_schema, battery_table
 from .views import write_views
 
@@ -50,50 +49,57 @@ class LogResult:
 def export_one(path: str, options: ExportOptions) -> LogResult:
     """Export one log into the dataset at ``options.out``; never raises for a bad log."""
     file = Path(path)
+    source = map_file(file)  # a ULog is hashed and read through one memory map
     try:
-        log = content_id(file)
-    except OSError as exc:
-        return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
-    if is_exported(options.out, log):
-        return LogResult(path, "skipped", log, notes=("already in the dataset",))
-    try:
-        return _export(file, path, log, options)
-    except BattgenError as exc:
-        return LogResult(path, "failed", log, error=str(exc))
-    except (OSError, ValueError, MemoryError) as exc:  # a log the readers did not foresee
-        if isinstance(exc, OSError) and is_exported(options.out, log):  # the same content, exported meanwhile
-            return LogResult(path, "skipped", log, notes=("the same content was exported by another task",))
-        return LogResult(path, "failed", log, error=f"{path}: cannot export: {type(exc).__name__}: {exc}")
+        try:
+            log = content_id(file, source)
+        except OSError as exc:
+            return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
+        if is_exported(options.out, log):
+            return LogResult(path, "skipped", log, notes=("already in the dataset",))
+        try:
+            return _export(file, path, log, options, source)
+        except BattgenError as exc:
+            return LogResult(path, "failed", log, error=str(exc))
+        except (OSError, ValueError, MemoryError) as exc:  # a log the readers did not foresee
+            if isinstance(exc, OSError) and is_exported(options.out, log):  # the same content, exported meanwhile
+                return LogResult(path, "skipped", log, notes=("the same content was exported by another task",))
+            return LogResult(path, "failed", log, error=f"{path}: cannot export: {type(exc).__name__}: {exc}")
+    finally:
+        if source is not None and not source.closed:
+            source.close()
 
 
-def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResult:
+def _export(file: Path, name: str, log: str, options: ExportOptions, source: mmap.mmap | None) -> LogResult:
     catalog = bundled_catalog()
     schema = battery_schema(catalog)
-    batches = read_log(file, name, catalog, options.message)
-    tables = []
-    raws: dict[str, list[object]] = {}
+    writer = LogWriter(options.out, log, schema)
     notes: list[str] = []
-    for batch in batches:
-        columns = batch.concepts
-        if columns is None:
-            columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)
-        tables.append(battery_table(catalog, schema, columns, batch, log, file.name))
-        if options.raw and batch.message in catalog.sources:
-            raws.setdefault(batch.message, []).append(raw_table(catalog.schema.message(batch.message), batch, log))
-        notes.extend(batch.notes)
-    table = pa.concat_tables(tables) if tables else schema.empty_table()
-    if not table.num_rows:
+    messages: set[str] = set()
+    try:
+        for batch in read_log(file, name, catalog, options.message, source):
+            columns = batch.concepts
+            if columns is None:
+                columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)
+            writer.add(battery_table(catalog, schema, columns, batch, log, file.name))
+            if options.raw and batch.message in catalog.sources:
+                writer.add_raw(batch.message, raw_table(catalog.schema.message(batch.message), batch, log))
+            messages.add(batch.message)
+            notes.extend(n for n in batch.notes if n not in notes)
+    except BaseException:
+        writer.abort()
+        raise
+    if not writer.rows:
         notes.append("no battery records")
-    raw_tables = [(m, pa.concat_tables(ts)) for m, ts in sorted(raws.items())]
     manifest: dict[str, object] = {
         "log": log,
         "source": file.name,
-        "rows": table.num_rows,
-        "messages": sorted({b.message for b in batches}),
+        "rows": writer.rows,
+        "messages": sorted(messages),
         "notes": notes,
     }
-    write_log(options.out, log, table, raw_tables, manifest)
-    return LogResult(name, "exported", log, table.num_rows, notes=tuple(notes))
+    writer.commit(manifest)
+    return LogResult(name, "exported", log, writer.rows, notes=tuple(notes))
 
 
 def export_logs(

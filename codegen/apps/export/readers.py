@@ -3,15 +3,21 @@
 
 from __future__ import annotations
 
+import mmap
+from collections.abc import Iterator
 from pathlib import Path
 
 from .catalog import Catalog
 from .dataflash_batches import dataflash_batches
-from .sources import Batch, export_kind, read_batches
+from .sources import Batch, export_kind, iter_batches
 
 
-def read_log(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
-    """Every battery batch of one log. Raises InputError (or another BattgenError) if unreadable."""
+def read_log(
+    path: Path, name: str, catalog: Catalog, message: str | None = None, source: mmap.mmap | None = None
+) -> Iterator[Batch]:
+    """The battery batches of one log, one at a time. Raises InputError (or another BattgenError)
+    if unreadable; ``source``: a memory map of the file the caller holds (see iter_batches)."""
     if export_kind(path) == "dataflash":
-        return dataflash_batches(path, name, catalog)
-    return read_batches(path, name, catalog, message)
+        yield from dataflash_batches(path, name, catalog)
+    else:
+        yield from iter_batches(path, name, catalog, message, source)
