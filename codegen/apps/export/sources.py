@@ -99,13 +99,19 @@ def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = 
 
 
 def iter_batches(
-    path: Path, name: str, catalog: Catalog, message: str | None = None, source: mmap.mmap | None = None
+    path: Path,
+    name: str,
+    catalog: Catalog,
+    message: str | None = None,
+    source: mmap.mmap | None = None,
+    all_fields: bool = True,
 ) -> Iterator[Batch]:
     """The battery batches of one log, one at a time (a ULog's in chunks: memory stays flat);
-    ``source`` is a memory map of a ULog file the caller holds (the log closes it)."""
+    ``source`` is a memory map of a ULog file the caller holds (the log closes it). Without
+    ``all_fields`` a ULog batch holds only the fields the mapping reads (and the timestamp)."""
     kind = export_kind(path)
     if kind == "ulog":
-        yield from _ulog_batches(path, name, catalog, source)
+        yield from _ulog_batches(path, name, catalog, source, all_fields)
     elif kind == "tlog":
         yield from _tlog_batches(path, name, catalog)
     elif kind == "dataflash":
@@ -117,15 +123,18 @@ def iter_batches(
 # -- ULog ------------------------------------------------------------------------------------------
 
 
-def _ulog_batches(path: Path, name: str, catalog: Catalog, source: mmap.mmap | None) -> Iterator[Batch]:
+def _ulog_batches(
+    path: Path, name: str, catalog: Catalog, source: mmap.mmap | None, all_fields: bool
+) -> Iterator[Batch]:
     model = _model(catalog, "uorb.BatteryStatus")
+    fields = None if all_fields else catalog.source(model.QUALIFIED_NAME).fields
     if not isinstance(model, UorbClass):
         raise BattgenError("the generated uorb.BatteryStatus has no ULog support: run 'battgen generate'")
     with UlogColumns(path, name, model, source) as log:
         start = log.start_us
         offset = log.utc_offset_us()
         armed = log.armed()
-        for inst in log.instances():
+        for inst in log.instances(fields=fields):
             stamps = inst.timestamps
             t = (stamps.astype(np.int64) - start) / 1e6 if stamps is not None else np.full(inst.n, np.nan)
             batch = Batch(model.QUALIFIED_NAME, inst.n, inst.columns, t, np.full(inst.n, inst.multi_id))
