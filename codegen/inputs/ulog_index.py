@@ -248,15 +248,18 @@ class _Bindings:
         """The binding of each data record (-1: none) from its msg_id and position."""
         import numpy as np
 
-        table = np.full(1 << 16, -1, np.int64)
+        ids = msg_ids.astype(np.int64)
+        size = max(
+            [int(ids.max()) + 1 if len(ids) else 0, *(m + 1 for m in self.initial), *(e[0] + 1 for e in self.events)]
+        )
+        table = np.full(size, -1, np.int64)  # by msg_id (a log's ids are small numbers)
         for msg_id, b in self.initial.items():
             table[msg_id] = b
-        ids = msg_ids.astype(np.int64)
         if not self.events:
             return table[ids]
         events = np.array(sorted(self.events), np.int64).reshape(-1, 3)
         if len(np.unique(events[:, 0])) == len(events):  # one change per msg_id (the usual): by table
-            since = np.full(1 << 16, np.iinfo(np.int64).max, np.int64)
+            since = np.full(size, np.iinfo(np.int64).max, np.int64)
             after = table.copy()
             since[events[:, 0]], after[events[:, 0]] = events[:, 1], events[:, 2]
             return np.where(starts > since[ids], after[ids], table[ids])

@@ -14,6 +14,7 @@ content again.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
@@ -102,6 +103,7 @@ def raw_table(message: Message, batch: Batch, log: str) -> Any:
     )
 
 
+@functools.lru_cache(maxsize=64)
 def _options(schema: Any) -> dict[str, Any]:
     """zstd; dictionary encoding for text and integers (counts, indices: few values; 4x faster to
     write than plain int64 under zstd), not for floats (tried: most of the write time, nothing

@@ -9,6 +9,7 @@ read from (JSON), so a reader of the Parquet files knows what each value means w
 
 from __future__ import annotations
 
+import functools
 import json
 from collections.abc import Mapping
 from typing import Any
@@ -47,8 +48,19 @@ CONTEXT: tuple[tuple[str, Any, str, str | None], ...] = (
 )
 
 
+_SCHEMAS: dict[int, tuple[Catalog, Any]] = {}  # by id(catalog), the catalog kept so the id stays its own
+
+
 def battery_schema(catalog: Catalog) -> Any:
-    """The Arrow schema of the battery table (the same for every log and format)."""
+    """The Arrow schema of the battery table (the same for every log and format; made once per
+    catalog, a few milliseconds that each log of a fleet would otherwise pay)."""
+    known = _SCHEMAS.get(id(catalog))
+    if known is None:
+        known = _SCHEMAS[id(catalog)] = (catalog, _battery_schema(catalog))
+    return known[1]
+
+
+def _battery_schema(catalog: Catalog) -> Any:
     fields = []
     for name, typ, doc, unit in CONTEXT:
         meta = {"doc": doc}
@@ -82,7 +94,7 @@ def concept_array(col: ConceptColumn) -> Any:
         return pa.array(col.values, type=_ARROW_TYPES[kind], mask=invalid)
     if kind == "text":
         return pa.array(col.values, type=pa.string(), mask=invalid)
-    choices = pa.array(list(col.concept.choices), type=pa.string())
+    choices = _words(tuple(col.concept.choices))
     if kind == "choice":
         return pa.DictionaryArray.from_arrays(pa.array(col.values.astype(np.int32), mask=invalid), choices)
     if kind == "flags":
@@ -116,9 +128,16 @@ def _flag_lists(bits: NDArray, valid: NDArray, choices: Any, invalid: NDArray | 
     return pa.ListArray.from_arrays(pa.array(offsets), items, mask=None if invalid is None else pa.array(invalid))
 
 
+@functools.lru_cache(maxsize=1024)
+def _words(words: tuple[str, ...]) -> Any:
+    """One Arrow array per set of words: every chunk's dictionary the same object, which the
+    Parquet writer takes as it is instead of merging dictionaries (measured: 15 % of the write)."""
+    return pa.array(list(words), type=pa.string())
+
+
 def label(text: str, n: int) -> Any:
     """``text`` ``n`` times, dictionary-encoded."""
-    return pa.DictionaryArray.from_arrays(pa.array(np.zeros(n, np.int32)), pa.array([text], pa.string()))
+    return pa.DictionaryArray.from_arrays(pa.array(np.zeros(n, np.int32)), _words((text,)))
 
 
 def battery_table(
