@@ -102,6 +102,9 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs < 1:
         print("battgen: --jobs must be at least 1", file=sys.stderr)
         return EXIT_UNREADABLE
+    if args.vehicle is not None and args.failsafe is None:
+        print("battgen: --vehicle is the failsafe replay's: give --failsafe PARAMS too", file=sys.stderr)
+        return EXIT_UNREADABLE
     try:
         replay = None if args.failsafe is None else failsafe_options(args.failsafe, args.vehicle)
     except BattgenError as exc:
