@@ -9,7 +9,8 @@ from typing import Any
 
 from ..errors import BattgenError
 from .export.dataset import BATTERY
-from .export.views import views_sql
+from .export.failsafe_tables import FAILSAFE
+from .export.views import has_failsafe, views_sql
 
 
 @dataclass(frozen=True)
@@ -28,7 +29,8 @@ def connect(dataset: Path) -> Any:
     if not any(parts.glob("*/*.parquet")):
         raise BattgenError(f"{dataset}: no exported logs (expected {BATTERY}/log=*/*.parquet; run battgen export)")
     con = duckdb.connect()
-    con.execute(views_sql((parts / "*" / "*.parquet").as_posix()))
+    failsafe = (dataset / FAILSAFE).as_posix() if has_failsafe(dataset) else None
+    con.execute(views_sql((parts / "*" / "*.parquet").as_posix(), failsafe))
     return con
 
 

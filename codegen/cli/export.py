@@ -9,6 +9,11 @@ A log already in the dataset (same content) is skipped; a log that cannot be rea
 the end and the run goes on. Exit 0 when every log was exported or skipped, 1 when some failed,
 2 when there is nothing to read or the fleet extra is missing.
 
+``--failsafe PARAMS`` also replays each flight log (.ulg, .tlog, .bin) through ArduPilot's battery
+failsafe as ``battgen failsafe`` does, with the parameter file PARAMS (``--failsafe log``: each
+DataFlash log's own PARM records), into ``DIR/failsafe/log=<id>/``; a log exported before without
+that replay is exported again.
+
 ``--engine dask`` runs the same per-log export as tasks on a Dask cluster (``--scheduler
 ADDRESS``, else a local one with ``--jobs`` workers); the output folder must be reachable by
 every worker under the same path.
@@ -39,6 +44,13 @@ def register(subparsers: Any) -> None:
     p.add_argument("-o", "--out", required=True, metavar="DIR", help="the dataset folder (created if needed)")
     p.add_argument("--raw", action="store_true", help="also write each message's table, fields as decoded")
     p.add_argument("--message", help="the message of JSON Lines inputs (default: told from their keys)")
+    p.add_argument(
+        "--failsafe",
+        metavar="PARAMS",
+        help="replay every log through ArduPilot's battery failsafe with this parameter file, or 'log' for each "
+        "DataFlash log's own PARM records (events in DIR/failsafe/, summed up in the flights view)",
+    )
+    p.add_argument("--vehicle", help="--failsafe: the ArduPilot vehicle (default: detected from the parameters)")
     p.add_argument("--jobs", type=int, default=1, metavar="N", help="logs exported in N processes (1)")
     p.add_argument("--engine", choices=("local", "dask"), default="local", help="local processes or a Dask cluster")
     p.add_argument("--scheduler", metavar="ADDRESS", help="the Dask scheduler (default: a local cluster)")
@@ -76,6 +88,7 @@ def _progress(total: int, quiet: bool) -> tuple[Callable[[Any], None] | None, Ca
 def run(args: argparse.Namespace) -> int:
     try:
         from ..apps.export import engine
+        from ..apps.export.failsafe_tables import failsafe_options
     except ImportError as exc:
         print(
             f"battgen: export needs the fleet extra ({exc.name} is missing): pip install 'battgen[fleet]'",
@@ -89,7 +102,15 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs < 1:
         print("battgen: --jobs must be at least 1", file=sys.stderr)
         return EXIT_UNREADABLE
-    options = engine.ExportOptions(Path(args.out), raw=args.raw, message=args.message)
+    if args.vehicle is not None and args.failsafe is None:
+        print("battgen: --vehicle is the failsafe replay's: give --failsafe PARAMS too", file=sys.stderr)
+        return EXIT_UNREADABLE
+    try:
+        replay = None if args.failsafe is None else failsafe_options(args.failsafe, args.vehicle)
+    except BattgenError as exc:
+        print(f"battgen: --failsafe: {exc}", file=sys.stderr)
+        return EXIT_UNREADABLE
+    options = engine.ExportOptions(Path(args.out), raw=args.raw, message=args.message, failsafe=replay)
     step, close = _progress(len(logs), args.quiet)
     try:
         if args.engine == "dask":

@@ -4,6 +4,7 @@ Layout under the output folder::
 
     battery/log=<id>/part-0.parquet        the normalised table (one file per log)
     raw/<message>/log=<id>/part-0.parquet  --raw: every field as decoded, sentinels kept
+    failsafe/log=<id>/events.parquet       --failsafe: the replay's events (and replays.parquet)
     logs/<id>.json                         what was exported from the log (its marker: present = done)
     views.sql                              the DuckDB views (see codegen.apps.fleet_query)
 
@@ -40,6 +41,15 @@ def marker(out: Path, log: str) -> Path:
 
 def is_exported(out: Path, log: str) -> bool:
     return marker(out, log).is_file()
+
+
+def exported_manifest(out: Path, log: str) -> dict[str, Any] | None:
+    """What the marker of an exported log records (None: not exported, or a marker unreadable)."""
+    try:
+        data = json.loads(marker(out, log).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
 
 
 def _raw_type(ftype: object) -> Any:
@@ -108,8 +118,16 @@ def _write(table: Any, path: Path) -> None:
     pq.write_table(table, path, compression="zstd", use_dictionary=text)
 
 
-def write_log(out: Path, log: str, battery: Any, raws: Sequence[tuple[str, Any]], manifest: dict[str, object]) -> None:
-    """Write one log's partitions and then its marker (see the module docstring)."""
+def write_log(
+    out: Path,
+    log: str,
+    battery: Any,
+    raws: Sequence[tuple[str, Any]],
+    manifest: dict[str, object],
+    tables: Sequence[tuple[str, dict[str, Any]]] = (),
+) -> None:
+    """Write one log's partitions and then its marker (see the module docstring). ``tables``: more
+    tables of the log, (table folder, {file name: table}) (the failsafe replay's)."""
     out.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".tmp-{log}-", dir=out))
     try:
@@ -123,6 +141,12 @@ def write_log(out: Path, log: str, battery: Any, raws: Sequence[tuple[str, Any]]
             rpart.mkdir()
             _write(table, rpart / "part-0.parquet")
             moves.append((rpart, out / RAW / message / f"log={log}"))
+        for i, (folder, files) in enumerate(tables):
+            tpart = tmp / f"table-{i}"
+            tpart.mkdir()
+            for file_name, table in files.items():
+                _write(table, tpart / file_name)
+            moves.append((tpart, out / folder / f"log={log}"))
         for src, dst in moves:
             dst.parent.mkdir(parents=True, exist_ok=True)
             if dst.exists():  # an earlier run stopped before its marker: its partition is replaced

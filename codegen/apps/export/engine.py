@@ -12,15 +12,17 @@ import concurrent.futures
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import pyarrow as pa
 
 from ...errors import BattgenError
 from .catalog import bundled_catalog
 from .columnar import convert_columns
-from .dataset import is_exported, raw_table, write_log
+from .dataset import exported_manifest, is_exported, raw_table, write_log
+from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, battery_numbers, replay_tables
 from .readers import read_log
-from .sources import content_id
+from .sources import content_id, export_kind
 from .table import battery_schema, battery_table
 from .views import write_views
 
@@ -32,6 +34,7 @@ class ExportOptions:
     out: Path
     raw: bool = False
     message: str | None = None  # the message of JSON Lines inputs (None: told from their keys)
+    failsafe: FailsafeOptions | None = None  # --failsafe: replay each log through the battery failsafe
 
 
 @dataclass(frozen=True)
@@ -54,7 +57,7 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
         log = content_id(file)
     except OSError as exc:
         return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
-    if is_exported(options.out, log):
+    if is_exported(options.out, log) and not _replay_missing(options, log):
         return LogResult(path, "skipped", log, notes=("already in the dataset",))
     try:
         return _export(file, path, log, options)
@@ -64,6 +67,14 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
         if isinstance(exc, OSError) and is_exported(options.out, log):  # the same content, exported meanwhile
             return LogResult(path, "skipped", log, notes=("the same content was exported by another task",))
         return LogResult(path, "failed", log, error=f"{path}: cannot export: {type(exc).__name__}: {exc}")
+
+
+def _replay_missing(options: ExportOptions, log: str) -> bool:
+    """A log exported before without this run's failsafe replay is exported again (with it)."""
+    if options.failsafe is None:
+        return False
+    manifest = exported_manifest(options.out, log)
+    return manifest is None or manifest.get("failsafe") != options.failsafe.key
 
 
 def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResult:
@@ -85,6 +96,19 @@ def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResul
     if not table.num_rows:
         notes.append("no battery records")
     raw_tables = [(m, pa.concat_tables(ts)) for m, ts in sorted(raws.items())]
+    extra: list[tuple[str, dict[str, Any]]] = []
+    if options.failsafe is not None:
+        numbers = battery_numbers(
+            export_kind(file), batches, [t["battery"][0].as_py() if t.num_rows else None for t in tables]
+        )
+        try:
+            replayed = replay_tables(file, name, export_kind(file), log, options.failsafe, batches, numbers)
+        except BattgenError as exc:
+            replayed = f"failsafe not replayed: {exc}"
+        if isinstance(replayed, str):
+            notes.append(replayed)
+        else:
+            extra.append((FAILSAFE, {EVENTS_FILE: replayed[0], REPLAYS_FILE: replayed[1]}))
     manifest: dict[str, object] = {
         "log": log,
         "source": file.name,
@@ -92,7 +116,9 @@ def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResul
         "messages": sorted({b.message for b in batches}),
         "notes": notes,
     }
-    write_log(options.out, log, table, raw_tables, manifest)
+    if options.failsafe is not None:
+        manifest["failsafe"] = options.failsafe.key
+    write_log(options.out, log, table, raw_tables, manifest, extra)
     return LogResult(name, "exported", log, table.num_rows, notes=tuple(notes))
 
 

@@ -49,6 +49,8 @@ class Batch:
     vehicle: NDArray | str | None = None  # one for the batch, or an object array of str / None
     armed: NDArray | None = None  # float 1.0 / 0.0 / NaN (unknown)
     concepts: dict[str, ConceptColumn] | None = None  # filled by the reader (a format without IR mapping)
+    origin_us: int = 0  # the log's clock at t = 0 (ULog/DataFlash: µs since boot; tlog: µs since the epoch)
+    utc_offset_us: int | None = None  # the log's clock + this = µs since the epoch (None: unknown)
     notes: list[str] = field(default_factory=list)
 
 
@@ -101,6 +103,7 @@ def _ulog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
             stamps = inst.timestamps
             t = (stamps.astype(np.int64) - start) / 1e6 if stamps is not None else np.full(inst.n, np.nan)
             batch = Batch(model.QUALIFIED_NAME, inst.n, inst.columns, t, np.full(inst.n, inst.multi_id))
+            batch.origin_us, batch.utc_offset_us = start, offset
             if stamps is not None and offset is not None:
                 batch.time_us = stamps.astype(np.int64) + offset
             if log.vehicle is not None:
@@ -179,6 +182,7 @@ def _tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
         time_us=stamps,
         vehicle=np.array([f"mavlink:{f.frame.sysid}" for f in frames], object),
     )
+    batch.origin_us, batch.utc_offset_us = int(stamps.min()), 0
     if stats.damaged:
         batch.notes.append(stats.summary("BATTERY_STATUS"))
     return [batch]

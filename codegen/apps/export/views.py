@@ -8,13 +8,20 @@ serial number where the pack reports one, else by vehicle and battery instance.
 Internal resistance is estimated at load steps: between consecutive records of a battery less than
 :data:`STEP_WINDOW_S` apart whose current changes by at least :data:`STEP_CURRENT_A`, R = -dV/dI;
 a flight's value is the median of its positive estimates.
+
+``failsafe_events`` and ``failsafe_replays`` are the tables ``battgen export --failsafe`` writes
+(:mod:`.failsafe_tables`); ``flights`` gives per flight the highest level reached, the number of
+events, when LOW and CRITICAL were first reached (``t``) and the last action run (null where the
+log was not replayed).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from .dataset import BATTERY
+from .failsafe_tables import EVENTS_FILE, EVENTS_SCHEMA, FAILSAFE, REPLAYS_FILE, REPLAYS_SCHEMA
 
 STEP_CURRENT_A = 2.0
 STEP_WINDOW_S = 1.0
@@ -35,7 +42,8 @@ WITH steps AS (
         lag(pack_voltage) OVER w AS prev_voltage
     FROM battery
     WINDOW w AS (PARTITION BY log, battery ORDER BY t)
-)
+),
+per_flight AS (
 SELECT
     log,
     battery,
@@ -65,7 +73,29 @@ SELECT
         END
     ) AS internal_resistance
 FROM steps
-GROUP BY log, battery;
+GROUP BY log, battery
+),
+failsafe AS (
+    SELECT
+        log,
+        battery,
+        count(*) AS events,
+        min(CASE WHEN level = 'LOW' THEN t END) AS first_low,
+        min(CASE WHEN level = 'CRITICAL' THEN t END) AS first_critical,
+        arg_max(outcome, replay_t) FILTER (WHERE executed) AS outcome
+    FROM failsafe_events
+    GROUP BY log, battery
+)
+SELECT
+    per_flight.*,
+    replay.level AS failsafe_level,
+    CASE WHEN replay.level IS NOT NULL THEN coalesce(failsafe.events, 0) END AS failsafe_events,
+    failsafe.first_low AS failsafe_first_low,
+    failsafe.first_critical AS failsafe_first_critical,
+    failsafe.outcome AS failsafe_outcome
+FROM per_flight
+LEFT JOIN failsafe_replays AS replay USING (log, battery)
+LEFT JOIN failsafe USING (log, battery);
 
 -- One row per pack: by serial number where the pack reports one, else by vehicle and battery instance.
 CREATE OR REPLACE VIEW packs AS
@@ -81,23 +111,58 @@ SELECT
     median(internal_resistance) AS internal_resistance,
     min(min_cell_voltage) AS min_cell_voltage,
     max(max_cell_imbalance) AS max_cell_imbalance,
-    max(max_temperature) AS max_temperature
+    max(max_temperature) AS max_temperature,
+    sum(failsafe_events) AS failsafe_events
 FROM flights
 GROUP BY pack;
 """
 
 
-def views_sql(glob: str) -> str:
-    """The views, reading the battery partitions at ``glob``."""
-    return _BATTERY_VIEW.format(glob=glob.replace("'", "''")) + "\n" + _FLIGHT_VIEWS
+_DUCKDB_TYPES = {"string": "VARCHAR", "int32": "INTEGER", "int64": "BIGINT", "double": "DOUBLE", "bool": "BOOLEAN"}
+
+
+def _table_view(name: str, glob: str | None, schema: Any) -> str:
+    """A view over Parquet files, or, where there are none yet, an empty one with the same columns
+    (DuckDB refuses a glob that matches nothing)."""
+    if glob is not None:
+        return f"""CREATE OR REPLACE VIEW {name} AS
+SELECT * FROM read_parquet('{_quote(glob)}', hive_partitioning = true, union_by_name = true);
+"""
+    columns = ", ".join(f"CAST(NULL AS {_DUCKDB_TYPES.get(str(f.type), 'TIMESTAMPTZ')}) AS {f.name}" for f in schema)
+    return f"CREATE OR REPLACE VIEW {name} AS SELECT {columns} WHERE false;\n"
+
+
+def _quote(text: str) -> str:
+    return text.replace("'", "''")
+
+
+def views_sql(glob: str, failsafe: str | None = None) -> str:
+    """The views, reading the battery partitions at ``glob`` and the failsafe replay's partitions
+    under ``failsafe`` (None: no log was replayed, the failsafe views are empty)."""
+    events = None if failsafe is None else f"{failsafe}/*/{EVENTS_FILE}"
+    replays = None if failsafe is None else f"{failsafe}/*/{REPLAYS_FILE}"
+    return "\n".join(
+        (
+            _BATTERY_VIEW.format(glob=_quote(glob)),
+            "-- The failsafe replay (battgen export --failsafe): its events, and the batteries replayed.",
+            _table_view("failsafe_events", events, EVENTS_SCHEMA),
+            _table_view("failsafe_replays", replays, REPLAYS_SCHEMA),
+            _FLIGHT_VIEWS,
+        )
+    )
+
+
+def has_failsafe(out: Path) -> bool:
+    """Whether any log of the dataset at ``out`` was replayed through the failsafe."""
+    return any((out / FAILSAFE).glob(f"*/{REPLAYS_FILE}"))
 
 
 def write_views(out: Path) -> Path:
-    """``views.sql`` in the dataset folder, with a path relative to it."""
+    """``views.sql`` in the dataset folder, with paths relative to it."""
     path = out / VIEWS_FILE
     text = (
         "-- battgen fleet views: run DuckDB in this folder (duckdb -init views.sql) or use battgen query.\n"
-        + views_sql(f"{BATTERY}/*/*.parquet")
+        + views_sql(f"{BATTERY}/*/*.parquet", FAILSAFE if has_failsafe(out) else None)
     )
     path.write_text(text, encoding="utf-8")
     return path
