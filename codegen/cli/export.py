@@ -56,6 +56,12 @@ def register(subparsers: Any) -> None:
         "DataFlash log's own PARM records (events in DIR/failsafe/, summed up in the flights view)",
     )
     p.add_argument("--vehicle", help="--failsafe: the ArduPilot vehicle (default: detected from the parameters)")
+    p.add_argument(
+        "--partition",
+        choices=("log", "day"),
+        default="log",
+        help="Hive partitions by log (default) or by UTC day then log (day=YYYY-MM-DD/log=<id>)",
+    )
     p.add_argument("--jobs", type=int, default=1, metavar="N", help="logs exported in N processes (1)")
     p.add_argument("--engine", choices=("local", "dask"), default="local", help="local processes or a Dask cluster")
     p.add_argument("--scheduler", metavar="ADDRESS", help="the Dask scheduler (default: a local cluster)")
@@ -134,7 +140,9 @@ def run(args: argparse.Namespace) -> int:
     except BattgenError as exc:
         print(f"battgen: --failsafe: {exc}", file=sys.stderr)
         return EXIT_UNREADABLE
-    options = engine.ExportOptions(Path(args.out), raw=args.raw, message=args.message, failsafe=replay)
+    options = engine.ExportOptions(
+        Path(args.out), raw=args.raw, message=args.message, failsafe=replay, partition=args.partition
+    )
     step, close = _progress(len(logs), args.quiet)
     try:
         if args.engine == "dask":

@@ -20,7 +20,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from .dataset import BATTERY
+from .dataset import BATTERY, table_glob
 from .failsafe_tables import EVENTS_FILE, EVENTS_SCHEMA, FAILSAFE, REPLAYS_FILE, REPLAYS_SCHEMA
 
 STEP_CURRENT_A = 2.0
@@ -136,11 +136,13 @@ def _quote(text: str) -> str:
     return text.replace("'", "''")
 
 
-def views_sql(glob: str, failsafe: str | None = None) -> str:
-    """The views, reading the battery partitions at ``glob`` and the failsafe replay's partitions
-    under ``failsafe`` (None: no log was replayed, the failsafe views are empty)."""
-    events = None if failsafe is None else f"{failsafe}/*/{EVENTS_FILE}"
-    replays = None if failsafe is None else f"{failsafe}/*/{REPLAYS_FILE}"
+def views_sql(out: Path, *, relative: bool = False) -> str:
+    """The views over the dataset at ``out`` in its layout (``relative``: paths relative to it);
+    the failsafe views are empty where no log was replayed."""
+    replayed = has_failsafe(out)
+    glob = table_glob(out, BATTERY, relative=relative)
+    events = table_glob(out, FAILSAFE, EVENTS_FILE, relative=relative) if replayed else None
+    replays = table_glob(out, FAILSAFE, REPLAYS_FILE, relative=relative) if replayed else None
     return "\n".join(
         (
             _BATTERY_VIEW.format(glob=_quote(glob)),
@@ -154,7 +156,7 @@ def views_sql(glob: str, failsafe: str | None = None) -> str:
 
 def has_failsafe(out: Path) -> bool:
     """Whether any log of the dataset at ``out`` was replayed through the failsafe."""
-    return any((out / FAILSAFE).glob(f"*/{REPLAYS_FILE}"))
+    return any((out / FAILSAFE).rglob(REPLAYS_FILE))
 
 
 def write_views(out: Path) -> Path:
@@ -162,7 +164,7 @@ def write_views(out: Path) -> Path:
     path = out / VIEWS_FILE
     text = (
         "-- battgen fleet views: run DuckDB in this folder (duckdb -init views.sql) or use battgen query.\n"
-        + views_sql(f"{BATTERY}/*/*.parquet", FAILSAFE if has_failsafe(out) else None)
+        + views_sql(out, relative=True)
     )
     path.write_text(text, encoding="utf-8")
     return path
