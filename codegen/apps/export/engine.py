@@ -20,6 +20,7 @@ import pyarrow.compute as pc
 from ...errors import BattgenError
 from .catalog import bundled_catalog
 from .columnar import convert_columns
+from .dataflash_batches import dataflash_raw_tables
 from .dataset import claim_layout, exported_manifest, is_exported, partition_of, raw_table, write_log
 from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, battery_numbers, replay_tables
 from .readers import read_log
@@ -98,6 +99,8 @@ def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResul
     if not table.num_rows:
         notes.append("no battery records")
     raw_tables = [(m, pa.concat_tables(ts)) for m, ts in sorted(raws.items())]
+    if options.raw and export_kind(file) == "dataflash":
+        raw_tables.extend(dataflash_raw_tables(file, name, log))
     extra: list[tuple[str, dict[str, Any]]] = []
     if options.failsafe is not None:
         numbers = battery_numbers(
