@@ -9,8 +9,7 @@ from typing import Any
 
 from ..errors import BattgenError
 from .export.dataset import BATTERY
-from .export.failsafe_tables import FAILSAFE
-from .export.views import has_failsafe, views_sql
+from .export.views import views_sql
 
 
 @dataclass(frozen=True)
@@ -25,12 +24,10 @@ def connect(dataset: Path) -> Any:
         import duckdb
     except ImportError:
         raise BattgenError("battgen query needs DuckDB: pip install 'battgen[fleet]'") from None
-    parts = dataset / BATTERY
-    if not any(parts.glob("*/*.parquet")):
+    if not any((dataset / BATTERY).rglob("*.parquet")):
         raise BattgenError(f"{dataset}: no exported logs (expected {BATTERY}/log=*/*.parquet; run battgen export)")
     con = duckdb.connect()
-    failsafe = (dataset / FAILSAFE).as_posix() if has_failsafe(dataset) else None
-    con.execute(views_sql((parts / "*" / "*.parquet").as_posix(), failsafe))
+    con.execute(views_sql(dataset))
     return con
 
 

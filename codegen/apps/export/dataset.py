@@ -7,6 +7,11 @@ Layout under the output folder::
     failsafe/log=<id>/events.parquet       --failsafe: the replay's events (and replays.parquet)
     logs/<id>.json                         what was exported from the log (its marker: present = done)
     views.sql                              the DuckDB views (see codegen.apps.fleet_query)
+    dataset.json                           the partitioning: {"partition": "log"} or "day"
+
+``--partition day`` puts a ``day=YYYY-MM-DD`` level (UTC, from the log's first record with a time
+of day; Hive's ``__HIVE_DEFAULT_PARTITION__``, read as null, where the log has none) above each
+``log=<id>`` folder.
 
 A log's files are written into a temporary folder beside them and moved into place, its marker
 last: a log whose marker exists is complete, and ``battgen export`` skips it when it meets the same
@@ -27,12 +32,54 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from ...errors import BattgenError
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from .sources import Batch
 
 BATTERY = "battery"
 RAW = "raw"
 LOGS = "logs"
+LAYOUT_FILE = "dataset.json"
+PARTITIONS = ("log", "day")
+UNKNOWN_DAY = "__HIVE_DEFAULT_PARTITION__"  # Hive's name for a null partition value; DuckDB and pyarrow read it so
+
+
+def layout(out: Path) -> str:
+    """How the dataset at ``out`` is partitioned: ``log`` (``<table>/log=<id>/``) or ``day``
+    (``<table>/day=YYYY-MM-DD/log=<id>/``); a dataset from before the choice existed is by log."""
+    try:
+        data = json.loads((out / LAYOUT_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return "log"
+    found = data.get("partition") if isinstance(data, dict) else None
+    return found if found in PARTITIONS else "log"
+
+
+def claim_layout(out: Path, partition: str) -> None:
+    """Record the partitioning of a new dataset; refuse another one for an existing dataset (the
+    two layouts in one folder would not read back as one table)."""
+    if partition not in PARTITIONS:
+        raise BattgenError(f"expected a partitioning among {', '.join(PARTITIONS)}, got {partition!r}")
+    has_logs = (out / LOGS).is_dir() and any((out / LOGS).glob("*.json"))
+    if has_logs and layout(out) != partition:
+        raise BattgenError(
+            f"{out}: the dataset is partitioned by {layout(out)}; give --partition {layout(out)} or a new folder"
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    (out / LAYOUT_FILE).write_text(json.dumps({"partition": partition}) + "\n", encoding="utf-8")
+
+
+def partition_of(partition: str, log: str, day: str | None) -> str:
+    """A log's partition folder under each table: ``log=<id>`` or ``day=<YYYY-MM-DD>/log=<id>``."""
+    if partition == "day":
+        return f"day={day or UNKNOWN_DAY}/log={log}"
+    return f"log={log}"
+
+
+def table_glob(out: Path, table: str, file_name: str = "*.parquet", *, relative: bool = False) -> str:
+    """The files of a table in the dataset's layout; ``relative``: a path relative to ``out``."""
+    depth = "*/*" if layout(out) == "day" else "*"
+    return f"{'' if relative else out.as_posix() + '/'}{table}/{depth}/{file_name}"
 
 
 def marker(out: Path, log: str) -> Path:
@@ -125,9 +172,12 @@ def write_log(
     raws: Sequence[tuple[str, Any]],
     manifest: dict[str, object],
     tables: Sequence[tuple[str, dict[str, Any]]] = (),
+    partition: str | None = None,
 ) -> None:
     """Write one log's partitions and then its marker (see the module docstring). ``tables``: more
-    tables of the log, (table folder, {file name: table}) (the failsafe replay's)."""
+    tables of the log, (table folder, {file name: table}) (the failsafe replay's); ``partition``: the
+    log's folder under each table (:func:`partition_of`; default ``log=<id>``)."""
+    where = partition or f"log={log}"
     out.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".tmp-{log}-", dir=out))
     try:
@@ -135,18 +185,18 @@ def write_log(
         part = tmp / BATTERY
         part.mkdir()
         _write(battery, part / "part-0.parquet")
-        moves.append((part, out / BATTERY / f"log={log}"))
+        moves.append((part, out / BATTERY / where))
         for i, (message, table) in enumerate(raws):
             rpart = tmp / f"{RAW}-{i}"
             rpart.mkdir()
             _write(table, rpart / "part-0.parquet")
-            moves.append((rpart, out / RAW / message / f"log={log}"))
+            moves.append((rpart, out / RAW / message / where))
         for i, (folder, files) in enumerate(tables):
             tpart = tmp / f"table-{i}"
             tpart.mkdir()
             for file_name, table in files.items():
                 _write(table, tpart / file_name)
-            moves.append((tpart, out / folder / f"log={log}"))
+            moves.append((tpart, out / folder / where))
         for src, dst in moves:
             dst.parent.mkdir(parents=True, exist_ok=True)
             if dst.exists():  # an earlier run stopped before its marker: its partition is replaced

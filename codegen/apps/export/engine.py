@@ -15,11 +15,13 @@ from pathlib import Path
 from typing import Any
 
 import pyarrow as pa
+import pyarrow.compute as pc
 
 from ...errors import BattgenError
 from .catalog import bundled_catalog
 from .columnar import convert_columns
-from .dataset import exported_manifest, is_exported, raw_table, write_log
+from .dataflash_batches import dataflash_raw_tables
+from .dataset import claim_layout, exported_manifest, is_exported, partition_of, raw_table, write_log
 from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, battery_numbers, replay_tables
 from .readers import read_log
 from .sources import content_id, export_kind
@@ -35,6 +37,7 @@ class ExportOptions:
     raw: bool = False
     message: str | None = None  # the message of JSON Lines inputs (None: told from their keys)
     failsafe: FailsafeOptions | None = None  # --failsafe: replay each log through the battery failsafe
+    partition: str = "log"  # "log" or "day" (see .dataset)
 
 
 @dataclass(frozen=True)
@@ -96,6 +99,8 @@ def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResul
     if not table.num_rows:
         notes.append("no battery records")
     raw_tables = [(m, pa.concat_tables(ts)) for m, ts in sorted(raws.items())]
+    if options.raw and export_kind(file) == "dataflash":
+        raw_tables.extend(dataflash_raw_tables(file, name, log))
     extra: list[tuple[str, dict[str, Any]]] = []
     if options.failsafe is not None:
         numbers = battery_numbers(
@@ -118,8 +123,16 @@ def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResul
     }
     if options.failsafe is not None:
         manifest["failsafe"] = options.failsafe.key
-    write_log(options.out, log, table, raw_tables, manifest, extra)
+    where = partition_of(options.partition, log, day_of(table))
+    manifest["partition"] = where
+    write_log(options.out, log, table, raw_tables, manifest, extra, where)
     return LogResult(name, "exported", log, table.num_rows, notes=tuple(notes))
+
+
+def day_of(table: Any) -> str | None:
+    """The UTC day (YYYY-MM-DD) of a log's first record with a time of day; None if none has one."""
+    first = pc.min(table["time"]).as_py() if table.num_rows else None
+    return None if first is None else str(first.date())
 
 
 def export_logs(
@@ -130,6 +143,7 @@ def export_logs(
     progress: Callable[[LogResult], None] | None = None,
 ) -> list[LogResult]:
     """Export every log, in input order of the results; ``jobs`` > 1 runs them in processes."""
+    claim_layout(options.out, options.partition)
     unique = list(dict.fromkeys(paths))
     results: dict[str, LogResult] = {}
     for res in _run(unique, options, jobs):

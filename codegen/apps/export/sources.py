@@ -29,9 +29,9 @@ from ...inputs.ulog_columns import UlogColumns
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
-from .columns import ConceptColumn, NDArray
+from .columns import ConceptColumn, NDArray, length_key
 
-EXPORT_KINDS = ("ulog", "tlog", "jsonl", "dataflash")
+EXPORT_KINDS = ("ulog", "tlog", "jsonl", "dataflash", "can")
 DATAFLASH_SUFFIXES = frozenset({".bin"})
 ID_DIGITS = 16
 
@@ -66,12 +66,15 @@ def content_id(path: Path) -> str:
 def export_kind(path: Path) -> str:
     kind = "dataflash" if path.suffix.lower() in DATAFLASH_SUFFIXES else kind_of_suffix(path)
     if kind not in EXPORT_KINDS:
-        expected = "a PX4 ULog (.ulg), MAVLink tlog (.tlog), ArduPilot DataFlash (.bin) or JSON Lines file"
+        expected = (
+            "a PX4 ULog (.ulg), MAVLink tlog (.tlog), ArduPilot DataFlash (.bin), CAN capture (.log, .asc, .blf, "
+            ".trc) or JSON Lines file"
+        )
         raise InputError(path.as_posix(), 0, f"expected {expected}")
     return kind
 
 
-def _model(catalog: Catalog, qualified: str) -> MessageClass:
+def model_of(catalog: Catalog, qualified: str) -> MessageClass:
     return model_class(bundled_package(), catalog.schema.message(qualified))
 
 
@@ -82,8 +85,8 @@ def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = 
         return _ulog_batches(path, name, catalog)
     if kind == "tlog":
         return _tlog_batches(path, name, catalog)
-    if kind == "dataflash":
-        raise InputError(name, 0, "DataFlash logs are read by codegen.apps.export.dataflash_batches")
+    if kind in ("dataflash", "can"):
+        raise InputError(name, 0, f"{kind} logs are read by codegen.apps.export.readers")
     return _jsonl_batches(path, name, catalog, message)
 
 
@@ -91,7 +94,7 @@ def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = 
 
 
 def _ulog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
-    model = _model(catalog, "uorb.BatteryStatus")
+    model = model_of(catalog, "uorb.BatteryStatus")
     if not isinstance(model, UorbClass):
         raise BattgenError("the generated uorb.BatteryStatus has no ULog support: run 'battgen generate'")
     out: list[Batch] = []
@@ -156,6 +159,8 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
             for i, v in enumerate(values):
                 matrix[i, : len(v)] = v
             out[f.name] = matrix
+            if f.type.dynamic:
+                out[length_key(f.name)] = np.array([len(v) for v in values], np.int64)
         else:
             column = np.empty(len(values), object if texts else dtype)
             column[:] = values
@@ -164,7 +169,7 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
 
 
 def _tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
-    model = _model(catalog, "mavlink.BATTERY_STATUS")
+    model = model_of(catalog, "mavlink.BATTERY_STATUS")
     if not isinstance(model, MavlinkClass):
         raise BattgenError("the generated mavlink.BATTERY_STATUS has no MAVLink codec: run 'battgen generate'")
     stats = StreamStats()
@@ -198,7 +203,7 @@ def _jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None)
     if not records:
         return []
     qualified = message or guess_message(catalog, records[0], name)
-    model = _model(catalog, qualified)
+    model = model_of(catalog, qualified)
     instances = []
     for rec in records:
         try:

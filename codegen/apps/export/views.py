@@ -5,9 +5,10 @@ views.sql``); ``battgen query`` (:mod:`codegen.apps.fleet_query`) runs them befo
 ``flights``: one row per flight (a log and a battery instance). ``packs``: one row per pack, by
 serial number where the pack reports one, else by vehicle and battery instance.
 
-Internal resistance is estimated at load steps: between consecutive records of a battery less than
-:data:`STEP_WINDOW_S` apart whose current changes by at least :data:`STEP_CURRENT_A`, R = -dV/dI;
-a flight's value is the median of its positive estimates.
+Internal resistance is estimated at load steps as ``battgen report`` does (one definition, in
+:mod:`codegen.apps.load_steps`): consecutive records of a battery at most 2 s apart whose current
+changes by at least 20 % of the flight's peak (and 1 A) give R = -dV/dI; a flight's value is the
+median of its positive estimates.
 
 ``failsafe_events`` and ``failsafe_replays`` are the tables ``battgen export --failsafe`` writes
 (:mod:`.failsafe_tables`); ``flights`` gives per flight the highest level reached, the number of
@@ -20,11 +21,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from .dataset import BATTERY
+from ..load_steps import resistance_sql
+from .dataset import BATTERY, table_glob
 from .failsafe_tables import EVENTS_FILE, EVENTS_SCHEMA, FAILSAFE, REPLAYS_FILE, REPLAYS_SCHEMA
 
-STEP_CURRENT_A = 2.0
-STEP_WINDOW_S = 1.0
+_STEP = resistance_sql("dt", "pack_voltage", "prev_voltage", "current", "prev_current", "peak_abs_current")
 VIEWS_FILE = "views.sql"
 
 _BATTERY_VIEW = """CREATE OR REPLACE VIEW battery AS
@@ -39,7 +40,8 @@ WITH steps AS (
         t - lag(t) OVER w AS dt,
         lag(armed) OVER w AS was_armed,
         lag(current) OVER w AS prev_current,
-        lag(pack_voltage) OVER w AS prev_voltage
+        lag(pack_voltage) OVER w AS prev_voltage,
+        max(abs(current)) OVER (PARTITION BY log, battery) AS peak_abs_current
     FROM battery
     WINDOW w AS (PARTITION BY log, battery ORDER BY t)
 ),
@@ -65,13 +67,7 @@ SELECT
     min(state_of_charge) AS end_state_of_charge,
     max(cycle_count) AS cycle_count,
     min(state_of_health) AS state_of_health,
-    median(
-        CASE
-            WHEN abs(current - prev_current) >= {STEP_CURRENT_A} AND dt <= {STEP_WINDOW_S}
-            AND -(pack_voltage - prev_voltage) / (current - prev_current) > 0
-            THEN -(pack_voltage - prev_voltage) / (current - prev_current)
-        END
-    ) AS internal_resistance
+    median({_STEP}) AS internal_resistance
 FROM steps
 GROUP BY log, battery
 ),
@@ -136,11 +132,13 @@ def _quote(text: str) -> str:
     return text.replace("'", "''")
 
 
-def views_sql(glob: str, failsafe: str | None = None) -> str:
-    """The views, reading the battery partitions at ``glob`` and the failsafe replay's partitions
-    under ``failsafe`` (None: no log was replayed, the failsafe views are empty)."""
-    events = None if failsafe is None else f"{failsafe}/*/{EVENTS_FILE}"
-    replays = None if failsafe is None else f"{failsafe}/*/{REPLAYS_FILE}"
+def views_sql(out: Path, *, relative: bool = False) -> str:
+    """The views over the dataset at ``out`` in its layout (``relative``: paths relative to it);
+    the failsafe views are empty where no log was replayed."""
+    replayed = has_failsafe(out)
+    glob = table_glob(out, BATTERY, relative=relative)
+    events = table_glob(out, FAILSAFE, EVENTS_FILE, relative=relative) if replayed else None
+    replays = table_glob(out, FAILSAFE, REPLAYS_FILE, relative=relative) if replayed else None
     return "\n".join(
         (
             _BATTERY_VIEW.format(glob=_quote(glob)),
@@ -154,7 +152,7 @@ def views_sql(glob: str, failsafe: str | None = None) -> str:
 
 def has_failsafe(out: Path) -> bool:
     """Whether any log of the dataset at ``out`` was replayed through the failsafe."""
-    return any((out / FAILSAFE).glob(f"*/{REPLAYS_FILE}"))
+    return any((out / FAILSAFE).rglob(REPLAYS_FILE))
 
 
 def write_views(out: Path) -> Path:
@@ -162,7 +160,7 @@ def write_views(out: Path) -> Path:
     path = out / VIEWS_FILE
     text = (
         "-- battgen fleet views: run DuckDB in this folder (duckdb -init views.sql) or use battgen query.\n"
-        + views_sql(f"{BATTERY}/*/*.parquet", FAILSAFE if has_failsafe(out) else None)
+        + views_sql(out, relative=True)
     )
     path.write_text(text, encoding="utf-8")
     return path

@@ -9,6 +9,7 @@ position fix, a SmartRTL path, no QuadPlane, no landing sequence), so the events
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,7 +19,7 @@ from .evaluator import Event, make_failsafe
 from .levels import Level
 from .logs import bin_parameters, read_log
 from .settings import battery_settings
-from .stream import Replay, Sample, open_reader
+from .stream import Reader, Replay, Sample, open_reader
 from .vehicles import detect_vehicle
 
 
@@ -32,6 +33,13 @@ class FlightReplay:
     vehicle_how: str
     samples: dict[int, int] = field(default_factory=dict)
     levels: dict[int, Level] = field(default_factory=dict)
+
+
+@functools.cache
+def _reader() -> Reader:
+    """The JSON Lines reader a Replay holds (a flight log's samples bypass it): the schemas loaded
+    once per process, not once per log."""
+    return open_reader(None)
 
 
 def replay_flight(
@@ -49,7 +57,7 @@ def replay_flight(
     except ValueError as exc:
         raise BattgenError(f"{name}: parameters: {exc}") from None
     fs = make_failsafe(settings, detection.vehicle)
-    replay = Replay(fs, open_reader(None))
+    replay = Replay(fs, _reader())
     out = FlightReplay([], detection.vehicle.name, detection.how)
 
     def samples_of() -> Iterator[Sample]:
