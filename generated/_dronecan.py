@@ -23,7 +23,6 @@ _U16 = struct.Struct("<H")
 
 F16_MAX = 65504.0
 F32_MAX = 3.4028234663852886e38
-F64_MAX = 1.7976931348623157e308
 INF = float("inf")
 
 
@@ -147,10 +146,12 @@ def f16bits(u: int) -> int:
 
 
 def f16s(x: float) -> int:
-    """Bits of a saturated float16: out of range (and infinity) clamps to +-65504."""
-    if x > F16_MAX:
+    """Bits of a saturated float16: a finite value out of range clamps to +-65504; infinity and NaN
+    are kept (the DSDL v0 rule, "infinity will be preserved", as libuavcan's FloatSpec::saturate and
+    pydronecan's re-encoding of decoded data; only pydronecan's value setter clamps infinity too)."""
+    if F16_MAX < x < INF:
         x = F16_MAX
-    elif x < -F16_MAX:
+    elif -INF < x < -F16_MAX:
         x = -F16_MAX
     u: int = _U32.unpack(_F32.pack(x))[0]
     a = u & 0x7FFFFFFF
@@ -160,7 +161,8 @@ def f16s(x: float) -> int:
 
 
 def f16t(x: float) -> int:
-    """Bits of a truncated float16: out of range becomes infinity."""
+    """Bits of a truncated float16: a value beyond +-65504 becomes infinity (before rounding, as the
+    reference casts); NaN is kept."""
     if x > F16_MAX:
         x = INF
     elif x < -F16_MAX:

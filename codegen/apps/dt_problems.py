@@ -29,11 +29,25 @@ from ..inputs.devicetree.mapping import field_for
 from ..inputs.model import GeneratedMessage, MessageClass
 from ..ir import ArrayType, Message
 from ..ir.units import devicetree_suffix_unit
+from ..text.brief import clip
 
 UNKNOWN_RULE = "additional-properties"
 RAW_RULE = "dt-core-type"
 UNIT_RULE = "unit-type"
 LENGTH_RULE = "length"
+NAMES_SHOWN = 8  # a message names this many unknown properties and counts the rest
+
+
+def quoted(name: str) -> str:
+    """A property name as a message shows it: the data's keys are unbounded, a message is not."""
+    return clip(name)
+
+
+def name_list(names: list[str]) -> str:
+    """Names for a message: the first NAMES_SHOWN, each clipped, and how many more there are."""
+    shown = ", ".join(quoted(n) for n in names[:NAMES_SHOWN])
+    more = len(names) - NAMES_SHOWN
+    return shown + (f" and {more} more" if more > 0 else "")
 
 
 @dataclass(frozen=True)
@@ -76,19 +90,19 @@ def read_node(
     if unknown and (info is None or not info.additional_properties):
         names = sorted(unknown)
         verb = "is" if len(names) == 1 else "are"
-        text = f"{', '.join(names)} {verb} not defined by {message.qualified_name} (additionalProperties: false)"
+        text = f"{name_list(names)} {verb} not defined by {message.qualified_name} (additionalProperties: false)"
         problems.append(Problem(names[0], UNKNOWN_RULE, names, "a property of the binding", text))
     for name in unknown:
         if data[name] is not True and not _typed_by_name(name):  # dt-validate keeps its raw bytes
-            text = f"{name}: no schema gives this property a type, so its value stays raw bytes"
+            text = f"{quoted(name)}: no schema gives this property a type, so its value stays raw bytes"
             problems.append(Problem(name, RAW_RULE, data[name], "a typed value", text))
     remaining = {k: v for k, v in data.items() if k not in unknown}
     for name, value in data.items():
         if name in remaining and isinstance(value, bytes):  # the cells do not decode as the type
-            raw_text = f"{name}: value does not decode as its type"
+            raw_text = f"{quoted(name)}: value does not decode as its type"
             problems.append(Problem(name, RAW_RULE, value, "a typed value", raw_text))
             if devicetree_suffix_unit(name) is not None:
-                unit_text = f"{name}: value is not an array of cells, as its unit suffix requires"
+                unit_text = f"{quoted(name)}: value is not an array of cells, as its unit suffix requires"
                 problems.append(Problem(name, UNIT_RULE, value, "an array", unit_text))
             del remaining[name]
     stand_ins: set[str] = set()
@@ -152,7 +166,7 @@ def _const_lengths(message: Message, data: Mapping[str, Any]) -> list[Problem]:
         f = field_for(message, name)
         if f is not None and f.const is not None and isinstance(f.type, ArrayType) and isinstance(value, list):
             if len(value) > 1:
-                text = f"{name} has {len(value)} items, more than 1"
+                text = f"{quoted(name)} has {len(value)} items, more than 1"
                 out.append(Problem(name, LENGTH_RULE, len(value), 1, text))
     return out
 

@@ -24,11 +24,10 @@ def connect(dataset: Path) -> Any:
         import duckdb
     except ImportError:
         raise BattgenError("battgen query needs DuckDB: pip install 'battgen[fleet]'") from None
-    parts = dataset / BATTERY
-    if not any(parts.glob("*/*.parquet")):
+    if not any((dataset / BATTERY).rglob("*.parquet")):
         raise BattgenError(f"{dataset}: no exported logs (expected {BATTERY}/log=*/*.parquet; run battgen export)")
     con = duckdb.connect()
-    con.execute(views_sql((parts / "*" / "*.parquet").as_posix()))
+    con.execute(views_sql(dataset))
     return con
 
 

@@ -25,7 +25,7 @@ from ..ir import Message, Schema, SourceFormat
 from ..ir.expr import referenced_fields
 from ..ir.numbers import to_json_data
 from ..ir.rules import bound_rules
-from ..text.brief import brief, reportable
+from ..text.brief import brief, clip, reportable
 from . import dt_problems
 from .failsafe.checks import NONNEGATIVE, check_settings
 from .failsafe.vehicles import detect_vehicle
@@ -233,8 +233,11 @@ class Checker:
     def _finding(
         record: Record, path: str, rule: str, value: object, limit: object, message: str, severity: str
     ) -> Finding:
-        if path and path not in message:
-            message = f"{path}: {message}"
+        shown = clip(path)
+        if path and path not in message and shown not in message:
+            message = f"{shown}: {message}"
+        if len(path) > len(shown):  # a key thousands of characters long: messages name it briefly
+            message = message.replace(path, shown)
         return Finding(
             record.file,
             record.line_of(path),

@@ -1,13 +1,19 @@
 """``battgen export LOG... -o DIR``: battery records of many logs into one Parquet dataset.
 
 Inputs: PX4 ULog (.ulg), MAVLink telemetry logs (.tlog), ArduPilot DataFlash logs (.bin: BAT
-readings) and JSON Lines (.jsonl/.ndjson) of any
+readings), CAN captures (candump .log, .asc, .blf, .trc, also .gz: DroneCAN BatteryInfo with
+BatteryInfoAux, and CUAV CBAT, per node) and JSON Lines (.jsonl/.ndjson) of any
 bundled battery message (``--message``, else told from the first record's keys); a folder stands
 for the logs under it. Every record becomes a row of one table in SI units, unknown values null,
 partitioned by log (``DIR/battery/log=<id>/``); ``--raw`` also writes each message's own table.
 A log already in the dataset (same content) is skipped; a log that cannot be read is reported at
 the end and the run goes on. Exit 0 when every log was exported or skipped, 1 when some failed,
 2 when there is nothing to read or the fleet extra is missing.
+
+``--failsafe PARAMS`` also replays each flight log (.ulg, .tlog, .bin) through ArduPilot's battery
+failsafe as ``battgen failsafe`` does, with the parameter file PARAMS (``--failsafe log``: each
+DataFlash log's own PARM records), into ``DIR/failsafe/log=<id>/``; a log exported before without
+that replay is exported again.
 
 ``--engine dask`` runs the same per-log export as tasks on a Dask cluster (``--scheduler
 ADDRESS``, else a local one with ``--jobs`` workers); the output folder must be reachable by
@@ -17,6 +23,8 @@ every worker under the same path.
 from __future__ import annotations
 
 import argparse
+import gzip
+import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -25,7 +33,7 @@ from typing import Any
 from ..errors import BattgenError
 
 EXIT_OK, EXIT_FAILED, EXIT_UNREADABLE = 0, 1, 2
-_SUFFIXES = (".ulg", ".tlog", ".bin", ".jsonl", ".ndjson")
+_SUFFIXES = (".ulg", ".tlog", ".bin", ".jsonl", ".ndjson", ".asc", ".blf", ".trc")
 
 
 def register(subparsers: Any) -> None:
@@ -35,10 +43,25 @@ def register(subparsers: Any) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("logs", nargs="+", metavar="LOG", help="log files (.ulg, .tlog, .bin, .jsonl) or folders of them")
+    p.add_argument(
+        "logs", nargs="+", metavar="LOG", help="log files (.ulg, .tlog, .bin, .jsonl, CAN captures) or folders of them"
+    )
     p.add_argument("-o", "--out", required=True, metavar="DIR", help="the dataset folder (created if needed)")
     p.add_argument("--raw", action="store_true", help="also write each message's table, fields as decoded")
     p.add_argument("--message", help="the message of JSON Lines inputs (default: told from their keys)")
+    p.add_argument(
+        "--failsafe",
+        metavar="PARAMS",
+        help="replay every log through ArduPilot's battery failsafe with this parameter file, or 'log' for each "
+        "DataFlash log's own PARM records (events in DIR/failsafe/, summed up in the flights view)",
+    )
+    p.add_argument("--vehicle", help="--failsafe: the ArduPilot vehicle (default: detected from the parameters)")
+    p.add_argument(
+        "--partition",
+        choices=("log", "day"),
+        default="log",
+        help="Hive partitions by log (default) or by UTC day then log (day=YYYY-MM-DD/log=<id>)",
+    )
     p.add_argument("--jobs", type=int, default=1, metavar="N", help="logs exported in N processes (1)")
     p.add_argument("--engine", choices=("local", "dask"), default="local", help="local processes or a Dask cluster")
     p.add_argument("--scheduler", metavar="ADDRESS", help="the Dask scheduler (default: a local cluster)")
@@ -51,10 +74,29 @@ def _inputs(names: list[str]) -> list[str]:
     for name in names:
         path = Path(name)
         if path.is_dir():
-            out.extend(sorted(p.as_posix() for p in path.rglob("*") if p.suffix.lower() in _SUFFIXES and p.is_file()))
+            out.extend(sorted(p.as_posix() for p in path.rglob("*") if _exportable(p)))
         else:
             out.append(name)
     return out
+
+
+def _exportable(path: Path) -> bool:
+    """A file of a folder to export: by its extension; a ``.log`` (``.log.gz``) only when it reads as a
+    candump capture, ``(seconds) interface id#data`` (a folder of logs holds other text logs too)."""
+    suffixes = [x.lower() for x in path.suffixes[-2:]]
+    if not path.is_file():
+        return False
+    if suffixes[-1:] == [".gz"]:
+        suffixes = suffixes[:-1]
+    if suffixes[-1:] != [".log"]:
+        return path.suffix.lower() in _SUFFIXES or bool(suffixes and suffixes[-1] in _SUFFIXES)
+    try:
+        opener = gzip.open if path.suffix.lower() == ".gz" else open
+        with opener(path, "rb") as f:
+            head = f.read(64)
+    except OSError:
+        return True  # let the export report it
+    return bool(re.match(rb"\(\d+(\.\d+)?\) \S+ [0-9A-Fa-f]+#", head))
 
 
 def _progress(total: int, quiet: bool) -> tuple[Callable[[Any], None] | None, Callable[[], None]]:
@@ -76,6 +118,7 @@ def _progress(total: int, quiet: bool) -> tuple[Callable[[Any], None] | None, Ca
 def run(args: argparse.Namespace) -> int:
     try:
         from ..apps.export import engine
+        from ..apps.export.failsafe_tables import failsafe_options
     except ImportError as exc:
         print(
             f"battgen: export needs the fleet extra ({exc.name} is missing): pip install 'battgen[fleet]'",
@@ -84,12 +127,22 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_UNREADABLE
     logs = _inputs(args.logs)
     if not logs:
-        print("battgen: no logs to export (expected .ulg, .tlog, .bin or .jsonl files)", file=sys.stderr)
+        print("battgen: no logs to export (expected .ulg, .tlog, .bin, .jsonl or CAN capture files)", file=sys.stderr)
         return EXIT_UNREADABLE
     if args.jobs < 1:
         print("battgen: --jobs must be at least 1", file=sys.stderr)
         return EXIT_UNREADABLE
-    options = engine.ExportOptions(Path(args.out), raw=args.raw, message=args.message)
+    if args.vehicle is not None and args.failsafe is None:
+        print("battgen: --vehicle is the failsafe replay's: give --failsafe PARAMS too", file=sys.stderr)
+        return EXIT_UNREADABLE
+    try:
+        replay = None if args.failsafe is None else failsafe_options(args.failsafe, args.vehicle)
+    except BattgenError as exc:
+        print(f"battgen: --failsafe: {exc}", file=sys.stderr)
+        return EXIT_UNREADABLE
+    options = engine.ExportOptions(
+        Path(args.out), raw=args.raw, message=args.message, failsafe=replay, partition=args.partition
+    )
     step, close = _progress(len(logs), args.quiet)
     try:
         if args.engine == "dask":

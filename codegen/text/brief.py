@@ -42,6 +42,18 @@ def brief(value: object, width: int = 60) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
 
 
+PATH_WIDTH = 160  # the generated runtime's _validate.PATH_WIDTH: both cut a path the same way
+
+
+def clip(path: str, width: int = PATH_WIDTH) -> str:
+    """A name or path from the data as a message shows it: whole up to ``width`` characters, else its
+    head and tail (a key can be thousands of characters; the tail keeps an item's index)."""
+    if len(path) <= width:
+        return path
+    tail = width // 3
+    return path[: width - tail - 3] + "..." + path[-tail:]
+
+
 def _scalar(v: object) -> bool:
     return (
         v is None

@@ -161,6 +161,32 @@ def test_generated_dronecan_records(data: st.DataObject) -> None:
     assert_same([info], qualified)
 
 
+@given(data=st.data())
+def test_generated_cbat_records(data: st.DataObject) -> None:
+    """CUAV CBAT: variable-length cells beside a cell count, negated current, percentages, sentinels."""
+    qualified = "dronecan.cuav.equipment.power.CBAT"
+    cls = _model(qualified)
+    batch = []
+    for _ in range(data.draw(st.integers(1, 4))):
+        cells = data.draw(st.lists(st.sampled_from((3.7, 0.0, math.nan, 4.2)), max_size=15))
+        batch.append(
+            cls.from_dict(
+                {
+                    "voltage": data.draw(st.sampled_from((math.nan, 0.0, 22.2))),
+                    "current": data.draw(st.sampled_from((math.nan, -12.5, 3.0))),
+                    "temperature": data.draw(st.sampled_from((0.0, 298.0, -5.0))),
+                    "voltage_cell": cells,
+                    "cell_count": data.draw(st.integers(0, 16)),
+                    "state_of_charge": data.draw(st.integers(0, 127)),
+                    "full_charge_capacity": data.draw(st.sampled_from((0.0, 16000.0))),
+                    "average_time_to_empty": data.draw(st.sampled_from((0, 65535, 30))),
+                    "status_flags": data.draw(st.integers(0, 2047)),
+                }
+            )
+        )
+    assert_same(batch, qualified)
+
+
 def test_ops_without_a_columnar_form_are_refused() -> None:
     rule = next(r for m in CATALOG.schema.mappings for mp in m.mappings for r in mp.rules if r.op.NAME == "px4_convert")
     from codegen.apps.export.columnar import ColumnConverter

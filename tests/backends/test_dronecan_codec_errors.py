@@ -131,7 +131,9 @@ def test_float16_rounding_and_special_values(pkg: dict[str, Any]) -> None:
     assert bits(1.00048828125) == (0x3C01, 0x3C01)  # a tie rounds away from zero (struct 'e' gives 0x3C00)
     assert bits(-1.00048828125) == (0xBC01, 0xBC01)
     assert bits(float("nan")) == (0x7FFF, 0x7FFF)
-    assert bits(float("inf")) == (0x7BFF, 0x7C00)  # saturated clamps to 65504, truncated keeps infinity
+    assert bits(float("inf")) == (0x7C00, 0x7C00)  # both keep infinity (DSDL v0: saturation preserves it)
+    assert bits(float("-inf")) == (0xFC00, 0xFC00)
+    assert bits(65520.0) == (0x7BFF, 0x7C00)  # finite beyond 65504: saturated clamps, truncated overflows
     assert bits(-1e9) == (0xFBFF, 0xFC00)
     assert bits(65519.0) == (0x7BFF, 0x7C00)
     assert bits(5.960464477539063e-08) == (0x0001, 0x0001)

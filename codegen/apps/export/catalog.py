@@ -17,7 +17,7 @@ from ...ir import CONCEPTS_ENDPOINT, Concept, Direction, Endpoint, Message, Rule
 from ..package import bundled_schemas
 
 # endpoints whose messages are battery records in logs (devicetree nodes are static facts)
-RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan")
+RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan", "cbat")
 
 
 @dataclass(frozen=True)
@@ -52,6 +52,8 @@ class Catalog:
     schema: Schema
     concepts: tuple[Concept, ...]
     sources: dict[str, SourceMapping]  # by qualified message name
+    # an endpoint's other messages (DroneCAN's BatteryInfoAux), with the rules that read them alone
+    companions: dict[str, SourceMapping]
 
     def concept(self, name: str) -> Concept:
         for c in self.concepts:
@@ -75,6 +77,7 @@ def build_catalog(schema: Schema) -> Catalog:
         concepts.extend(mset.concepts)
         endpoints.update({e.name: e for e in mset.endpoints})
     sources: dict[str, SourceMapping] = {}
+    companions: dict[str, SourceMapping] = {}
     for mset in schema.mappings:
         for mapping in mset.mappings:
             if mapping.target != CONCEPTS_ENDPOINT or mapping.source not in RECORD_ENDPOINTS:
@@ -89,9 +92,17 @@ def build_catalog(schema: Schema) -> Catalog:
                 if r.only in (None, Direction.FORWARD) and all(s.message == first for s in r.sources)
             )
             sources[first] = SourceMapping(mapping.source, schema.message(first), rules)
+            for other in endpoint.messages[1:]:
+                alone = tuple(
+                    r
+                    for r in mapping.rules
+                    if r.only in (None, Direction.FORWARD) and r.sources and all(s.message == other for s in r.sources)
+                )
+                if alone:
+                    companions[other] = SourceMapping(mapping.source, schema.message(other), alone)
     if not concepts or not sources:
         raise BattgenError("the schemas hold no battery concepts or mappings to them (schemas/mappings/)")
-    return Catalog(schema, tuple(concepts), sources)
+    return Catalog(schema, tuple(concepts), sources, companions)
 
 
 @functools.cache

@@ -23,7 +23,7 @@ from ...ir import ops as o
 from ...ir.mapping_values import ConstantRef, Number, Value
 from ...ir.mapping_visitor import OpVisitor, visit
 from .catalog import Catalog, SourceMapping
-from .columns import ConceptColumn, NDArray, empty_columns
+from .columns import ConceptColumn, NDArray, empty_columns, length_key
 
 
 class NotColumnar(BattgenError):
@@ -246,9 +246,13 @@ class ColumnConverter(OpVisitor[None]):
         m = self.col(fmt)
         mark = f.invalid.value if f.invalid is not None and f.invalid.per_element else None
         lengths = leading_lengths(m, mark)
+        given = self.columns.get(length_key(fmt.field))  # a variable-length array's own lengths
+        if given is not None:
+            lengths = np.minimum(lengths, given)
         if op.count_field is not None:
             count = self.columns[op.count_field].astype(np.int64)
-            lengths = np.where(count != 0, np.minimum(count, m.shape[1]), lengths)
+            room = m.shape[1] if given is None else given
+            lengths = np.where(count != 0, np.minimum(count, room), lengths)
         mul, add = _factor(f.unit or con.concept.unit, con.concept.unit)
         values = _affine(m, mul, add)
         if values is m:  # a float64 field as it is: the NaNs below must not write into the log's columns

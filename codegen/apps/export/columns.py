@@ -75,6 +75,12 @@ class ConceptColumn:
         self.valid |= where
 
 
+def length_key(field: str) -> str:
+    """The column holding each row's length of a variable-length array field (DroneCAN ``[<=N]``),
+    whose matrix is padded to its capacity."""
+    return f"{field}#length"
+
+
 def empty_columns(concepts: tuple[Concept, ...], n: int) -> dict[str, ConceptColumn]:
     """Every concept unknown for ``n`` records."""
     return {c.name: ConceptColumn.empty(c, n) for c in concepts}

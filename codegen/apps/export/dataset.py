@@ -4,8 +4,14 @@ Layout under the output folder::
 
     battery/log=<id>/part-0.parquet        the normalised table (one file per log)
     raw/<message>/log=<id>/part-0.parquet  --raw: every field as decoded, sentinels kept
+    failsafe/log=<id>/events.parquet       --failsafe: the replay's events (and replays.parquet)
     logs/<id>.json                         what was exported from the log (its marker: present = done)
     views.sql                              the DuckDB views (see codegen.apps.fleet_query)
+    dataset.json                           the partitioning: {"partition": "log"} or "day"
+
+``--partition day`` puts a ``day=YYYY-MM-DD`` level (UTC, from the log's first record with a time
+of day; Hive's ``__HIVE_DEFAULT_PARTITION__``, read as null, where the log has none) above each
+``log=<id>`` folder.
 
 A log's files are written into a temporary folder beside them and moved into place, its marker
 last: a log whose marker exists is complete, and ``battgen export`` skips it when it meets the same
@@ -27,6 +33,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from ...errors import BattgenError
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from .sources import Batch
 
@@ -34,6 +41,47 @@ BATTERY = "battery"
 RAW = "raw"
 LOGS = "logs"
 ROW_GROUP = 1 << 18  # rows per Parquet row group (fewer, larger groups write faster; engines split them)
+LAYOUT_FILE = "dataset.json"
+PARTITIONS = ("log", "day")
+UNKNOWN_DAY = "__HIVE_DEFAULT_PARTITION__"  # Hive's name for a null partition value; DuckDB and pyarrow read it so
+
+
+def layout(out: Path) -> str:
+    """How the dataset at ``out`` is partitioned: ``log`` (``<table>/log=<id>/``) or ``day``
+    (``<table>/day=YYYY-MM-DD/log=<id>/``); a dataset from before the choice existed is by log."""
+    try:
+        data = json.loads((out / LAYOUT_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return "log"
+    found = data.get("partition") if isinstance(data, dict) else None
+    return found if found in PARTITIONS else "log"
+
+
+def claim_layout(out: Path, partition: str) -> None:
+    """Record the partitioning of a new dataset; refuse another one for an existing dataset (the
+    two layouts in one folder would not read back as one table)."""
+    if partition not in PARTITIONS:
+        raise BattgenError(f"expected a partitioning among {', '.join(PARTITIONS)}, got {partition!r}")
+    has_logs = (out / LOGS).is_dir() and any((out / LOGS).glob("*.json"))
+    if has_logs and layout(out) != partition:
+        raise BattgenError(
+            f"{out}: the dataset is partitioned by {layout(out)}; give --partition {layout(out)} or a new folder"
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    (out / LAYOUT_FILE).write_text(json.dumps({"partition": partition}) + "\n", encoding="utf-8")
+
+
+def partition_of(partition: str, log: str, day: str | None) -> str:
+    """A log's partition folder under each table: ``log=<id>`` or ``day=<YYYY-MM-DD>/log=<id>``."""
+    if partition == "day":
+        return f"day={day or UNKNOWN_DAY}/log={log}"
+    return f"log={log}"
+
+
+def table_glob(out: Path, table: str, file_name: str = "*.parquet", *, relative: bool = False) -> str:
+    """The files of a table in the dataset's layout; ``relative``: a path relative to ``out``."""
+    depth = "*/*" if layout(out) == "day" else "*"
+    return f"{'' if relative else out.as_posix() + '/'}{table}/{depth}/{file_name}"
 
 
 def marker(out: Path, log: str) -> Path:
@@ -42,6 +90,15 @@ def marker(out: Path, log: str) -> Path:
 
 def is_exported(out: Path, log: str) -> bool:
     return marker(out, log).is_file()
+
+
+def exported_manifest(out: Path, log: str) -> dict[str, Any] | None:
+    """What the marker of an exported log records (None: not exported, or a marker unreadable)."""
+    try:
+        data = json.loads(marker(out, log).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
 
 
 def _raw_type(ftype: object) -> Any:
@@ -161,8 +218,16 @@ class LogWriter:
         if pending:
             self._writer(key, pending[0].schema).write_table(pa.concat_tables(pending), row_group_size=1 << 30)
 
-    def commit(self, manifest: dict[str, object]) -> None:
-        """Close the files and move them into place, the marker last."""
+    def commit(
+        self,
+        manifest: dict[str, object],
+        tables: Sequence[tuple[str, dict[str, Any]]] = (),
+        partition: str | None = None,
+    ) -> None:
+        """Close the files and move them into place, the marker last. ``tables``: more tables of
+        the log, (table folder, {file name: table}) (the failsafe replay's); ``partition``: the
+        log's folder under each table (:func:`partition_of`; default ``log=<id>``)."""
+        where = partition or f"log={self.log}"
         try:
             for key in list(self._pending):
                 self._flush(key)
@@ -171,8 +236,14 @@ class LogWriter:
             for writer in self._writers.values():
                 writer.close()
             self._writers.clear()
-            moves = [(folders.pop(""), self.out / BATTERY / f"log={self.log}")]
-            moves += [(f, self.out / RAW / message / f"log={self.log}") for message, f in sorted(folders.items())]
+            moves = [(folders.pop(""), self.out / BATTERY / where)]
+            moves += [(f, self.out / RAW / message / where) for message, f in sorted(folders.items())]
+            for i, (folder, files) in enumerate(tables):
+                part = self.tmp / f"table-{i}"
+                part.mkdir()
+                for file_name, table in files.items():
+                    pq.write_table(table, part / file_name, **_options(table.schema))
+                moves.append((part, self.out / folder / where))
             for src, dst in moves:
                 dst.parent.mkdir(parents=True, exist_ok=True)
                 if dst.exists():  # an earlier run stopped before its marker: its partition is replaced
@@ -194,8 +265,17 @@ class LogWriter:
         shutil.rmtree(self.tmp, ignore_errors=True)
 
 
-def write_log(out: Path, log: str, battery: Any, raws: Sequence[tuple[str, Any]], manifest: dict[str, object]) -> None:
-    """Write one log's partitions and then its marker (see the module docstring)."""
+def write_log(
+    out: Path,
+    log: str,
+    battery: Any,
+    raws: Sequence[tuple[str, Any]],
+    manifest: dict[str, object],
+    tables: Sequence[tuple[str, dict[str, Any]]] = (),
+    partition: str | None = None,
+) -> None:
+    """Write one log's partitions and then its marker (see the module docstring and
+    :meth:`LogWriter.commit`), all tables at once."""
     writer = LogWriter(out, log, battery.schema)
     try:
         writer.add(battery)
@@ -204,4 +284,4 @@ def write_log(out: Path, log: str, battery: Any, raws: Sequence[tuple[str, Any]]
     except BaseException:
         writer.abort()
         raise
-    writer.commit(manifest)
+    writer.commit(manifest, tables, partition)

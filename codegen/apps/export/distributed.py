@@ -12,6 +12,7 @@ import importlib
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from .dataset import claim_layout
 from .engine import ExportOptions, LogResult, export_one
 
 
@@ -48,6 +49,7 @@ def run_on(
     client: Any, paths: Sequence[str], options: ExportOptions, progress: Callable[[LogResult], None] | None = None
 ) -> list[LogResult]:
     """Export every log on an existing ``distributed.Client``; results in input order."""
+    claim_layout(options.out, options.partition)
     futures = client.map(export_one, list(paths), options=options, pure=False)
     results: dict[str, LogResult] = {}
     for fut in _distributed().as_completed(futures):

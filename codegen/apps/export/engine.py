@@ -13,13 +13,18 @@ import mmap
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
+
+import pyarrow.compute as pc
 
 from ...errors import BattgenError
 from .catalog import bundled_catalog
 from .columnar import convert_columns
-from .dataset import LogWriter, is_exported, raw_table
+from .dataflash_batches import dataflash_raw_tables
+from .dataset import LogWriter, claim_layout, exported_manifest, is_exported, partition_of, raw_table
+from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, battery_numbers, replay_tables
 from .readers import read_log
-from .sources import content_id, map_file
+from .sources import Batch, content_id, export_kind, map_file
 from .table import battery_schema, battery_table
 from .views import write_views
 
@@ -31,6 +36,8 @@ class ExportOptions:
     out: Path
     raw: bool = False
     message: str | None = None  # the message of JSON Lines inputs (None: told from their keys)
+    failsafe: FailsafeOptions | None = None  # --failsafe: replay each log through the battery failsafe
+    partition: str = "log"  # "log" or "day" (see .dataset)
 
 
 @dataclass(frozen=True)
@@ -55,7 +62,7 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
             log = content_id(file, source)
         except OSError as exc:
             return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
-        if is_exported(options.out, log):
+        if is_exported(options.out, log) and not _replay_missing(options, log):
             return LogResult(path, "skipped", log, notes=("already in the dataset",))
         try:
             return _export(file, path, log, options, source)
@@ -70,27 +77,61 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
             source.close()
 
 
+def _replay_missing(options: ExportOptions, log: str) -> bool:
+    """A log exported before without this run's failsafe replay is exported again (with it)."""
+    if options.failsafe is None:
+        return False
+    manifest = exported_manifest(options.out, log)
+    return manifest is None or manifest.get("failsafe") != options.failsafe.key
+
+
 def _export(file: Path, name: str, log: str, options: ExportOptions, source: mmap.mmap | None) -> LogResult:
+    """The batches stream through: each converted, its rows written, and let go (a log of any length
+    in flat memory); the failsafe replay keeps what it needs of each (its context, not its columns)."""
     catalog = bundled_catalog()
     schema = battery_schema(catalog)
     writer = LogWriter(options.out, log, schema)
     notes: list[str] = []
     messages: set[str] = set()
+    seen: list[Batch] = []  # each batch's context, for the replay
+    firsts: list[int | None] = []  # each batch's first battery number, for the replay
+    first_time: Any = None  # the log's first time of day (UTC), which names its day partition
     try:
         for batch in read_log(file, name, catalog, options.message, source, all_fields=options.raw):
             columns = batch.concepts
             if columns is None:
                 columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)
-            writer.add(battery_table(catalog, schema, columns, batch, log, file.name))
+            table = battery_table(catalog, schema, columns, batch, log, file.name)
+            writer.add(table)
             if options.raw and batch.message in catalog.sources:
                 writer.add_raw(batch.message, raw_table(catalog.schema.message(batch.message), batch, log))
             messages.add(batch.message)
             notes.extend(n for n in batch.notes if n not in notes)
+            first = pc.min(table["time"]).as_py() if table.num_rows else None
+            first_time = first if first_time is None or (first is not None and first < first_time) else first_time
+            if options.failsafe is not None:
+                firsts.append(table["battery"][0].as_py() if table.num_rows else None)
+                batch.columns, batch.concepts = {}, None
+                seen.append(batch)
+        if options.raw and export_kind(file) == "dataflash":
+            for message, raw in dataflash_raw_tables(file, name, log):
+                writer.add_raw(message, raw)
     except BaseException:
         writer.abort()
         raise
     if not writer.rows:
         notes.append("no battery records")
+    extra: list[tuple[str, dict[str, Any]]] = []
+    if options.failsafe is not None:
+        numbers = battery_numbers(export_kind(file), seen, firsts)
+        try:
+            replayed = replay_tables(file, name, export_kind(file), log, options.failsafe, seen, numbers)
+        except BattgenError as exc:
+            replayed = f"failsafe not replayed: {exc}"
+        if isinstance(replayed, str):
+            notes.append(replayed)
+        else:
+            extra.append((FAILSAFE, {EVENTS_FILE: replayed[0], REPLAYS_FILE: replayed[1]}))
     manifest: dict[str, object] = {
         "log": log,
         "source": file.name,
@@ -98,7 +139,11 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
         "messages": sorted(messages),
         "notes": notes,
     }
-    writer.commit(manifest)
+    if options.failsafe is not None:
+        manifest["failsafe"] = options.failsafe.key
+    where = partition_of(options.partition, log, None if first_time is None else str(first_time.date()))
+    manifest["partition"] = where
+    writer.commit(manifest, extra, where)
     return LogResult(name, "exported", log, writer.rows, notes=tuple(notes))
 
 
@@ -110,6 +155,7 @@ def export_logs(
     progress: Callable[[LogResult], None] | None = None,
 ) -> list[LogResult]:
     """Export every log, in input order of the results; ``jobs`` > 1 runs them in processes."""
+    claim_layout(options.out, options.partition)
     unique = list(dict.fromkeys(paths))
     results: dict[str, LogResult] = {}
     for res in _run(unique, options, jobs):

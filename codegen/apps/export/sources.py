@@ -30,9 +30,9 @@ from ...inputs.ulog_columns import UlogColumns
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
-from .columns import ConceptColumn, NDArray
+from .columns import ConceptColumn, NDArray, length_key
 
-EXPORT_KINDS = ("ulog", "tlog", "jsonl", "dataflash")
+EXPORT_KINDS = ("ulog", "tlog", "jsonl", "dataflash", "can")
 DATAFLASH_SUFFIXES = frozenset({".bin"})
 ID_DIGITS = 16
 
@@ -50,6 +50,8 @@ class Batch:
     vehicle: NDArray | str | None = None  # one for the batch, or an object array of str / None
     armed: NDArray | None = None  # float 1.0 / 0.0 / NaN (unknown)
     concepts: dict[str, ConceptColumn] | None = None  # filled by the reader (a format without IR mapping)
+    origin_us: int = 0  # the log's clock at t = 0 (ULog/DataFlash: µs since boot; tlog: µs since the epoch)
+    utc_offset_us: int | None = None  # the log's clock + this = µs since the epoch (None: unknown)
     notes: list[str] = field(default_factory=list)
 
 
@@ -84,12 +86,15 @@ def map_file(path: Path) -> mmap.mmap | None:
 def export_kind(path: Path) -> str:
     kind = "dataflash" if path.suffix.lower() in DATAFLASH_SUFFIXES else kind_of_suffix(path)
     if kind not in EXPORT_KINDS:
-        expected = "a PX4 ULog (.ulg), MAVLink tlog (.tlog), ArduPilot DataFlash (.bin) or JSON Lines file"
+        expected = (
+            "a PX4 ULog (.ulg), MAVLink tlog (.tlog), ArduPilot DataFlash (.bin), CAN capture (.log, .asc, .blf, "
+            ".trc) or JSON Lines file"
+        )
         raise InputError(path.as_posix(), 0, f"expected {expected}")
     return kind
 
 
-def _model(catalog: Catalog, qualified: str) -> MessageClass:
+def model_of(catalog: Catalog, qualified: str) -> MessageClass:
     return model_class(bundled_package(), catalog.schema.message(qualified))
 
 
@@ -114,8 +119,8 @@ def iter_batches(
         yield from _ulog_batches(path, name, catalog, source, all_fields)
     elif kind == "tlog":
         yield from _tlog_batches(path, name, catalog)
-    elif kind == "dataflash":
-        raise InputError(name, 0, "DataFlash logs are read by codegen.apps.export.dataflash_batches")
+    elif kind in ("dataflash", "can"):
+        raise InputError(name, 0, f"{kind} logs are read by codegen.apps.export.readers")
     else:
         yield from _jsonl_batches(path, name, catalog, message)
 
@@ -126,7 +131,7 @@ def iter_batches(
 def _ulog_batches(
     path: Path, name: str, catalog: Catalog, source: mmap.mmap | None, all_fields: bool
 ) -> Iterator[Batch]:
-    model = _model(catalog, "uorb.BatteryStatus")
+    model = model_of(catalog, "uorb.BatteryStatus")
     fields = None if all_fields else catalog.source(model.QUALIFIED_NAME).fields
     if not isinstance(model, UorbClass):
         raise BattgenError("the generated uorb.BatteryStatus has no ULog support: run 'battgen generate'")
@@ -138,6 +143,7 @@ def _ulog_batches(
             stamps = inst.timestamps
             t = (stamps.astype(np.int64) - start) / 1e6 if stamps is not None else np.full(inst.n, np.nan)
             batch = Batch(model.QUALIFIED_NAME, inst.n, inst.columns, t, np.full(inst.n, inst.multi_id))
+            batch.origin_us, batch.utc_offset_us = start, offset
             if stamps is not None and offset is not None:
                 batch.time_us = stamps.astype(np.int64) + offset
             if log.vehicle is not None:
@@ -189,6 +195,8 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
             for i, v in enumerate(values):
                 matrix[i, : len(v)] = v
             out[f.name] = matrix
+            if f.type.dynamic:
+                out[length_key(f.name)] = np.array([len(v) for v in values], np.int64)
         else:
             column = np.empty(len(values), object if texts else dtype)
             column[:] = values
@@ -197,7 +205,7 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
 
 
 def _tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
-    model = _model(catalog, "mavlink.BATTERY_STATUS")
+    model = model_of(catalog, "mavlink.BATTERY_STATUS")
     if not isinstance(model, MavlinkClass):
         raise BattgenError("the generated mavlink.BATTERY_STATUS has no MAVLink codec: run 'battgen generate'")
     stats = StreamStats()
@@ -215,6 +223,7 @@ def _tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
         time_us=stamps,
         vehicle=np.array([f"mavlink:{f.frame.sysid}" for f in frames], object),
     )
+    batch.origin_us, batch.utc_offset_us = int(stamps.min()), 0
     if stats.damaged:
         batch.notes.append(stats.summary("BATTERY_STATUS"))
     return [batch]
@@ -230,7 +239,7 @@ def _jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None)
     if not records:
         return []
     qualified = message or guess_message(catalog, records[0], name)
-    model = _model(catalog, qualified)
+    model = model_of(catalog, qualified)
     instances = []
     for rec in records:
         try:

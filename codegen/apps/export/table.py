@@ -37,7 +37,8 @@ _ARROW_TYPES: dict[str, Any] = {
 
 # the context of every record: (name, Arrow type, doc, unit)
 CONTEXT: tuple[tuple[str, Any, str, str | None], ...] = (
-    ("log", _LABEL, "stable id of the log's content (sha256 of the file, first 16 hex digits)", None),
+    # plain text: the Hive partition key too, which engines read from the path as text
+    ("log", pa.string(), "stable id of the log's content (sha256 of the file, first 16 hex digits)", None),
     ("source", _LABEL, "file name of the log", None),
     ("vehicle", _LABEL, "the vehicle, where the log says (ULog sys_uuid or hardware, MAVLink system id)", None),
     ("battery", pa.int32(), "battery instance (the concept battery_index where known, else the log's instance)", None),
@@ -149,7 +150,7 @@ def battery_table(
     battery = np.asarray(np.where(index.valid, index.values, batch.instance), np.int32)
     timestamp = pa.timestamp("us", tz="UTC")
     arrays: list[Any] = [
-        label(log, n),
+        pa.repeat(pa.scalar(log, pa.string()), n),
         label(source, n),
         pa.nulls(n, _LABEL)
         if batch.vehicle is None

@@ -5,19 +5,27 @@ views.sql``); ``battgen query`` (:mod:`codegen.apps.fleet_query`) runs them befo
 ``flights``: one row per flight (a log and a battery instance). ``packs``: one row per pack, by
 serial number where the pack reports one, else by vehicle and battery instance.
 
-Internal resistance is estimated at load steps: between consecutive records of a battery less than
-:data:`STEP_WINDOW_S` apart whose current changes by at least :data:`STEP_CURRENT_A`, R = -dV/dI;
-a flight's value is the median of its positive estimates.
+Internal resistance is estimated at load steps as ``battgen report`` does (one definition, in
+:mod:`codegen.apps.load_steps`): consecutive records of a battery at most 2 s apart whose current
+changes by at least 20 % of the flight's peak (and 1 A) give R = -dV/dI; a flight's value is the
+median of its positive estimates.
+
+``failsafe_events`` and ``failsafe_replays`` are the tables ``battgen export --failsafe`` writes
+(:mod:`.failsafe_tables`); ``flights`` gives per flight the highest level reached, the number of
+events, when LOW and CRITICAL were first reached (``t``) and the last action run (null where the
+log was not replayed).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
-from .dataset import BATTERY
+from ..load_steps import resistance_sql
+from .dataset import BATTERY, table_glob
+from .failsafe_tables import EVENTS_FILE, EVENTS_SCHEMA, FAILSAFE, REPLAYS_FILE, REPLAYS_SCHEMA
 
-STEP_CURRENT_A = 2.0
-STEP_WINDOW_S = 1.0
+_STEP = resistance_sql("dt", "pack_voltage", "prev_voltage", "current", "prev_current", "peak_abs_current")
 VIEWS_FILE = "views.sql"
 
 _BATTERY_VIEW = """CREATE OR REPLACE VIEW battery AS
@@ -32,10 +40,12 @@ WITH steps AS (
         t - lag(t) OVER w AS dt,
         lag(armed) OVER w AS was_armed,
         lag(current) OVER w AS prev_current,
-        lag(pack_voltage) OVER w AS prev_voltage
+        lag(pack_voltage) OVER w AS prev_voltage,
+        max(abs(current)) OVER (PARTITION BY log, battery) AS peak_abs_current
     FROM battery
     WINDOW w AS (PARTITION BY log, battery ORDER BY t)
-)
+),
+per_flight AS (
 SELECT
     log,
     battery,
@@ -57,15 +67,31 @@ SELECT
     min(state_of_charge) AS end_state_of_charge,
     max(cycle_count) AS cycle_count,
     min(state_of_health) AS state_of_health,
-    median(
-        CASE
-            WHEN abs(current - prev_current) >= {STEP_CURRENT_A} AND dt <= {STEP_WINDOW_S}
-            AND -(pack_voltage - prev_voltage) / (current - prev_current) > 0
-            THEN -(pack_voltage - prev_voltage) / (current - prev_current)
-        END
-    ) AS internal_resistance
+    median({_STEP}) AS internal_resistance
 FROM steps
-GROUP BY log, battery;
+GROUP BY log, battery
+),
+failsafe AS (
+    SELECT
+        log,
+        battery,
+        count(*) AS events,
+        min(CASE WHEN level = 'LOW' THEN t END) AS first_low,
+        min(CASE WHEN level = 'CRITICAL' THEN t END) AS first_critical,
+        arg_max(outcome, replay_t) FILTER (WHERE executed) AS outcome
+    FROM failsafe_events
+    GROUP BY log, battery
+)
+SELECT
+    per_flight.*,
+    replay.level AS failsafe_level,
+    CASE WHEN replay.level IS NOT NULL THEN coalesce(failsafe.events, 0) END AS failsafe_events,
+    failsafe.first_low AS failsafe_first_low,
+    failsafe.first_critical AS failsafe_first_critical,
+    failsafe.outcome AS failsafe_outcome
+FROM per_flight
+LEFT JOIN failsafe_replays AS replay USING (log, battery)
+LEFT JOIN failsafe USING (log, battery);
 
 -- One row per pack: by serial number where the pack reports one, else by vehicle and battery instance.
 CREATE OR REPLACE VIEW packs AS
@@ -81,23 +107,60 @@ SELECT
     median(internal_resistance) AS internal_resistance,
     min(min_cell_voltage) AS min_cell_voltage,
     max(max_cell_imbalance) AS max_cell_imbalance,
-    max(max_temperature) AS max_temperature
+    max(max_temperature) AS max_temperature,
+    sum(failsafe_events) AS failsafe_events
 FROM flights
 GROUP BY pack;
 """
 
 
-def views_sql(glob: str) -> str:
-    """The views, reading the battery partitions at ``glob``."""
-    return _BATTERY_VIEW.format(glob=glob.replace("'", "''")) + "\n" + _FLIGHT_VIEWS
+_DUCKDB_TYPES = {"string": "VARCHAR", "int32": "INTEGER", "int64": "BIGINT", "double": "DOUBLE", "bool": "BOOLEAN"}
+
+
+def _table_view(name: str, glob: str | None, schema: Any) -> str:
+    """A view over Parquet files, or, where there are none yet, an empty one with the same columns
+    (DuckDB refuses a glob that matches nothing)."""
+    if glob is not None:
+        return f"""CREATE OR REPLACE VIEW {name} AS
+SELECT * FROM read_parquet('{_quote(glob)}', hive_partitioning = true, union_by_name = true);
+"""
+    columns = ", ".join(f"CAST(NULL AS {_DUCKDB_TYPES.get(str(f.type), 'TIMESTAMPTZ')}) AS {f.name}" for f in schema)
+    return f"CREATE OR REPLACE VIEW {name} AS SELECT {columns} WHERE false;\n"
+
+
+def _quote(text: str) -> str:
+    return text.replace("'", "''")
+
+
+def views_sql(out: Path, *, relative: bool = False) -> str:
+    """The views over the dataset at ``out`` in its layout (``relative``: paths relative to it);
+    the failsafe views are empty where no log was replayed."""
+    replayed = has_failsafe(out)
+    glob = table_glob(out, BATTERY, relative=relative)
+    events = table_glob(out, FAILSAFE, EVENTS_FILE, relative=relative) if replayed else None
+    replays = table_glob(out, FAILSAFE, REPLAYS_FILE, relative=relative) if replayed else None
+    return "\n".join(
+        (
+            _BATTERY_VIEW.format(glob=_quote(glob)),
+            "-- The failsafe replay (battgen export --failsafe): its events, and the batteries replayed.",
+            _table_view("failsafe_events", events, EVENTS_SCHEMA),
+            _table_view("failsafe_replays", replays, REPLAYS_SCHEMA),
+            _FLIGHT_VIEWS,
+        )
+    )
+
+
+def has_failsafe(out: Path) -> bool:
+    """Whether any log of the dataset at ``out`` was replayed through the failsafe."""
+    return any((out / FAILSAFE).rglob(REPLAYS_FILE))
 
 
 def write_views(out: Path) -> Path:
-    """``views.sql`` in the dataset folder, with a path relative to it."""
+    """``views.sql`` in the dataset folder, with paths relative to it."""
     path = out / VIEWS_FILE
     text = (
         "-- battgen fleet views: run DuckDB in this folder (duckdb -init views.sql) or use battgen query.\n"
-        + views_sql(f"{BATTERY}/*/*.parquet")
+        + views_sql(out, relative=True)
     )
     path.write_text(text, encoding="utf-8")
     return path

@@ -79,7 +79,8 @@ def bin_samples(path: Path) -> Iterator[Sample]:
             armed = item.armed
             continue
         reading = BatteryReading(item.voltage_v, item.current_a, item.consumed_mah)
-        yield Sample(0, item.time_s, armed, reading, None, None, {}, item.instance + 1, f"offset {item.offset}")
+        where = f"offset {item.offset}"
+        yield Sample(0, item.time_s, armed, reading, None, None, {}, item.instance + 1, where, round(item.time_s * 1e6))
 
 
 def _number(value: Any) -> float | None:
@@ -129,7 +130,7 @@ def ulog_samples(path: Path) -> Iterator[Sample]:
                 used if used is not None and used >= 0 else None,
             )
             t = (ts - start) / 1e6
-            yield Sample(0, t, armed, reading, None, None, {}, mid + 1, f"battery_status multi_id {mid}")
+            yield Sample(0, t, armed, reading, None, None, {}, mid + 1, f"battery_status multi_id {mid}", ts)
 
 
 def _mavlink_reading(msg: Any) -> tuple[int, BatteryReading]:
@@ -182,6 +183,7 @@ def tlog_samples(path: Path) -> Iterator[Sample]:
                 continue
             instance, reading = _mavlink_reading(msg)
             t = round((stamp - start) * 1e6) / 1e6  # whole microseconds, as the log stores them
-            yield Sample(0, t, armed, reading, None, None, {}, instance, f"{name} message {index}")
+            where = f"{name} message {index}"
+            yield Sample(0, t, armed, reading, None, None, {}, instance, where, round(stamp * 1e6))
     finally:
         conn.close()

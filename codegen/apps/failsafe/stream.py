@@ -73,6 +73,7 @@ class Sample:
     extra: Mapping[str, Any]  # distance_to_home_m, travelled_m, home_set, position_fix
     instance: int = 1  # the battery, 1-based as ArduPilot prints it
     where: str = ""  # how to find it again: "line 12", "offset 4711"
+    stamp_us: int | None = None  # the log's own clock (ULog/DataFlash µs since boot, tlog µs since the epoch)
 
     @property
     def place(self) -> str:

@@ -2,9 +2,9 @@
 
 Charge used comes from the battery's own discharged counter where it reports one (the fuel gauge or the
 autopilot's integrator), else from integrating the current (trapezoids); energy from integrating V·I. The
-internal resistance is estimated from load steps: consecutive samples at most 2 s apart whose current changes by
-at least 20 % of the flight's peak current (and 1 A) give R = -ΔV/ΔI; the median of those steps is reported, as
-a single step is easily spoiled by a voltage reading lagging the current. The voltage sag per amp is the least-squares
+internal resistance is estimated from load steps (:mod:`codegen.apps.load_steps`, the definition the fleet views
+share): consecutive samples at most 2 s apart whose current changes by at least 20 % of the flight's peak current
+(and 1 A) give R = -ΔV/ΔI; the median of those steps is reported. The voltage sag per amp is the least-squares
 slope of the voltage's sample-to-sample changes against the current's, over the whole flight: it uses every
 change of load, small ones too, so it is the figure to compare between flights of one pack, while the load-step
 median is the better estimate of the pack's resistance when a log is noisy.
@@ -16,11 +16,10 @@ import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from ..load_steps import STEP_MAX_DT_S, step_resistances
 from .series import BatterySeries
 
-STEP_FRACTION = 0.2
-STEP_MIN_A = 1.0
-STEP_MAX_DT = 2.0
+STEP_MAX_DT = STEP_MAX_DT_S
 
 
 @dataclass(frozen=True)
@@ -99,19 +98,8 @@ def _charge_used(s: BatterySeries) -> float | None:
     return None if amp_seconds is None else amp_seconds / 3.6
 
 
-def _steps(s: BatterySeries, peak: float) -> list[float]:
-    threshold = max(STEP_MIN_A, STEP_FRACTION * peak)
-    out = []
-    for k in range(1, len(s.t)):
-        v0, v1, i0, i1 = s.pack_voltage[k - 1], s.pack_voltage[k], s.current[k - 1], s.current[k]
-        if None in (v0, v1, i0, i1) or s.t[k] - s.t[k - 1] > STEP_MAX_DT:
-            continue
-        assert v0 is not None and v1 is not None and i0 is not None and i1 is not None
-        if abs(i1 - i0) >= threshold:
-            r = -(v1 - v0) / (i1 - i0)
-            if r > 0:
-                out.append(r)
-    return out
+def _steps(s: BatterySeries) -> list[float]:
+    return step_resistances(s.t, s.pack_voltage, s.current)
 
 
 def _sag(s: BatterySeries) -> float | None:
@@ -141,8 +129,7 @@ def compute(s: BatterySeries, thresholds: dict[str, float] | None = None) -> Fig
     """The figures of one battery; ``thresholds`` (name -> volts, e.g. BATT_LOW_VOLT) for the time below each."""
     power = s.power
     currents = _known(s.current)
-    peak = max((abs(i) for i in currents), default=0.0)
-    steps = _steps(s, peak) if currents else []
+    steps = _steps(s)
     energy = integrate(s.t, power)
     duration = s.t[-1] - s.t[0] if len(s.t) > 1 else 0.0
     cells = [min(c) for c in s.cells if c]

@@ -35,12 +35,23 @@ class _Brief(reprlib.Repr):
 
 brief = _Brief().repr
 
+PATH_WIDTH = 160  # codegen.text.brief.PATH_WIDTH: the tool cuts a path the same way
+
+
+def clip(path: str) -> str:
+    """A path as a message shows it: whole up to PATH_WIDTH characters, else its head and tail (a data
+    key, such as a devicetree pattern property's name, can be thousands of characters)."""
+    if len(path) <= PATH_WIDTH:
+        return path
+    tail = PATH_WIDTH // 3
+    return path[: PATH_WIDTH - tail - 3] + "..." + path[-tail:]
+
 
 class DataError(ValueError):
     """Input data that does not fit a message: names the field path, what was expected and the value."""
 
     def __init__(self, path: str, expected: str, value: object) -> None:
-        super().__init__(f"{path}: expected {expected}, got {brief(value)}")
+        super().__init__(f"{clip(path)}: expected {expected}, got {brief(value)}")
         self.path = path
         self.expected = expected
         self.value = value
@@ -59,6 +70,7 @@ def meta(
     invalid: float | None = None,
     invalid_text: str | None = None,
     per_element: bool = False,
+    first_decides: bool = False,
     enums: tuple[str, ...] = (),
     extension: bool = False,
     pattern: str | None = None,
@@ -78,6 +90,7 @@ def meta(
             "invalid": invalid,
             "invalid_text": invalid_text,
             "per_element": per_element,
+            "first_decides": first_decides,  # MAVLink [X:]: the array is unknown when element 0 is the sentinel
             "enums": enums,
             "extension": extension,
             "pattern": pattern,

@@ -20,7 +20,7 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 
-from ._meta import brief
+from ._meta import brief, clip
 
 __all__ = ["Severity", "ValidationError", "Violation"]
 
@@ -120,6 +120,7 @@ class Array:
     min_length: int = 0
     byte: bool = False  # held as bytes
     columns: tuple[Spec | None, ...] = ()  # element i's own spec (None: the element's)
+    unknown_first: float | None = None  # MAVLink [X:]: element 0 holding X makes the whole array unknown
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -195,7 +196,7 @@ def _type_violation(path: str, value: object, expected: str, label: str = "") ->
 
 def _who(path: str, label: str) -> str:
     """How a message names the value: its path, and what its array position holds."""
-    return f"{path}: {label}" if label else path
+    return f"{clip(path)}: {label}" if label else clip(path)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -219,7 +220,7 @@ def diag(out: list[Violation], path: str, value: object, spec: Spec) -> None:
     elif isinstance(spec, Optional):
         if value is None:
             if spec.required:
-                out.append(Violation(path, "required", None, True, f"{path} is required but missing"))
+                out.append(Violation(path, "required", None, True, f"{clip(path)} is required but missing"))
         else:
             diag(out, path, value, spec.inner)
     else:
@@ -227,7 +228,10 @@ def diag(out: list[Violation], path: str, value: object, spec: Spec) -> None:
 
 
 def is_sentinel(value: object, spec: Number) -> bool:
-    s = spec.sentinel
+    return _is_marker(value, spec.sentinel)
+
+
+def _is_marker(value: object, s: float | None) -> bool:
     if s is None or isinstance(value, str):
         return False
     if isinstance(s, float) and math.isnan(s):
@@ -359,13 +363,17 @@ def _array(out: list[Violation], path: str, value: object, spec: Array) -> None:
         return
     cap = spec.capacity
     if spec.fixed and cap is not None and n != cap:
-        out.append(Violation(path, "length", n, cap, f"{path} has {n} items, it must have exactly {cap}"))
+        out.append(Violation(path, "length", n, cap, f"{clip(path)} has {n} items, it must have exactly {cap}"))
     elif cap is not None and n > cap:
-        out.append(Violation(path, "length", n, cap, f"{path} has {n} items, more than its capacity {cap}"))
+        out.append(Violation(path, "length", n, cap, f"{clip(path)} has {n} items, more than its capacity {cap}"))
     elif n < spec.min_length:
-        out.append(Violation(path, "length", n, spec.min_length, f"{path} has {n} items, fewer than {spec.min_length}"))
+        out.append(
+            Violation(path, "length", n, spec.min_length, f"{clip(path)} has {n} items, fewer than {spec.min_length}")
+        )
     if cap is not None:
         items = items[:cap]  # an over-long array is reported once above; its excess is not walked
+    if spec.unknown_first is not None and n and _is_marker(value[0], spec.unknown_first):
+        return  # the array is unknown: what its other elements hold means nothing
     columns = spec.columns
     for i, item in enumerate(items):
         column = columns[i] if i < len(columns) else None
@@ -396,7 +404,7 @@ def _pattern(out: list[Violation], path: str, value: object, spec: Pattern) -> N
                     "pattern",
                     key,
                     spec.pattern,
-                    f"property name {key!r} does not match {spec.pattern}",
+                    f"property name {brief(key)} does not match {spec.pattern}",
                 )
             )
             continue

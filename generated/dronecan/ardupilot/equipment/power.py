@@ -642,22 +642,22 @@ class BatteryContinuous:
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
                 ),
                 (
                     r2
                     if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
                 ),
                 (
                     r3
                     if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))
+                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
                 ),
                 (
                     r4
                     if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))
+                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
                 ),
             )
         )
@@ -693,19 +693,31 @@ class BatteryContinuous:
             (
                 r13
                 if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r13 > _dc.F32_MAX else (-_dc.F32_MAX if r13 < -_dc.F32_MAX else r13))
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < r13 < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
+                )
             ),
             (
                 r14
                 if -_dc.F32_MAX <= r14 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r14 > _dc.F32_MAX else (-_dc.F32_MAX if r14 < -_dc.F32_MAX else r14))
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < r14 < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < r14 < -_dc.F32_MAX else r14)
+                )
             ),
             h12,
             (r15 if 0 <= r15 <= 255 else (255 if r15 > 255 else 0)),
             (
                 r16
                 if -_dc.F32_MAX <= r16 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r16 > _dc.F32_MAX else (-_dc.F32_MAX if r16 < -_dc.F32_MAX else r16))
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < r16 < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < r16 < -_dc.F32_MAX else r16)
+                )
             ),
             (r17 if 0 <= r17 <= 4294967295 else (4294967295 if r17 > 4294967295 else 0)),
         )
@@ -732,22 +744,22 @@ class BatteryContinuous:
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
                 ),
                 (
                     r2
                     if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
                 ),
                 (
                     r3
                     if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))
+                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
                 ),
                 (
                     r4
                     if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))
+                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
                 ),
             )
         )
@@ -784,19 +796,31 @@ class BatteryContinuous:
                 (
                     r13
                     if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r13 > _dc.F32_MAX else (-_dc.F32_MAX if r13 < -_dc.F32_MAX else r13))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r13 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
+                    )
                 ),
                 (
                     r14
                     if -_dc.F32_MAX <= r14 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r14 > _dc.F32_MAX else (-_dc.F32_MAX if r14 < -_dc.F32_MAX else r14))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r14 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r14 < -_dc.F32_MAX else r14)
+                    )
                 ),
                 h12,
                 (r15 if 0 <= r15 <= 255 else (255 if r15 > 255 else 0)),
                 (
                     r16
                     if -_dc.F32_MAX <= r16 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r16 > _dc.F32_MAX else (-_dc.F32_MAX if r16 < -_dc.F32_MAX else r16))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r16 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r16 < -_dc.F32_MAX else r16)
+                    )
                 ),
                 (r17 if 0 <= r17 <= 4294967295 else (4294967295 if r17 > 4294967295 else 0)),
             ),
@@ -1034,12 +1058,12 @@ class BatteryInfoAux:
                 (
                     r6
                     if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))
+                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
                 ),
                 (
                     r7
                     if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
                 ),
             )
         )
@@ -1127,12 +1151,12 @@ class BatteryInfoAux:
                 (
                     r6
                     if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))
+                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
                 ),
                 (
                     r7
                     if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
                 ),
             )
         )
@@ -1555,22 +1579,22 @@ class BatteryPeriodic:
                 (
                     r7
                     if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
                 ),
                 (
                     r8
                     if -65504.0 <= r8 <= 65504.0
-                    else (65504.0 if r8 > 65504.0 else (-65504.0 if r8 < -65504.0 else r8))
+                    else (65504.0 if 65504.0 < r8 < _dc.INF else (-65504.0 if -_dc.INF < r8 < -65504.0 else r8))
                 ),
                 (
                     r9
                     if -65504.0 <= r9 <= 65504.0
-                    else (65504.0 if r9 > 65504.0 else (-65504.0 if r9 < -65504.0 else r9))
+                    else (65504.0 if 65504.0 < r9 < _dc.INF else (-65504.0 if -_dc.INF < r9 < -65504.0 else r9))
                 ),
                 (
                     r10
                     if -65504.0 <= r10 <= 65504.0
-                    else (65504.0 if r10 > 65504.0 else (-65504.0 if r10 < -65504.0 else r10))
+                    else (65504.0 if 65504.0 < r10 < _dc.INF else (-65504.0 if -_dc.INF < r10 < -65504.0 else r10))
                 ),
             )
         )
@@ -1607,7 +1631,11 @@ class BatteryPeriodic:
                 (
                     r19
                     if -_dc.F32_MAX <= r19 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r19 > _dc.F32_MAX else (-_dc.F32_MAX if r19 < -_dc.F32_MAX else r19))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r19 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r19 < -_dc.F32_MAX else r19)
+                    )
                 ),
                 (r20 if 0 <= r20 <= 255 else (255 if r20 > 255 else 0)),
                 h15,
@@ -1617,22 +1645,38 @@ class BatteryPeriodic:
                 (
                     r21
                     if -_dc.F32_MAX <= r21 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r21 > _dc.F32_MAX else (-_dc.F32_MAX if r21 < -_dc.F32_MAX else r21))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r21 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r21 < -_dc.F32_MAX else r21)
+                    )
                 ),
                 (
                     r22
                     if -_dc.F32_MAX <= r22 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r22 > _dc.F32_MAX else (-_dc.F32_MAX if r22 < -_dc.F32_MAX else r22))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r22 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r22 < -_dc.F32_MAX else r22)
+                    )
                 ),
                 (
                     r23
                     if -_dc.F32_MAX <= r23 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r23 > _dc.F32_MAX else (-_dc.F32_MAX if r23 < -_dc.F32_MAX else r23))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r23 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r23 < -_dc.F32_MAX else r23)
+                    )
                 ),
                 (
                     r24
                     if -_dc.F32_MAX <= r24 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r24 > _dc.F32_MAX else (-_dc.F32_MAX if r24 < -_dc.F32_MAX else r24))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r24 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r24 < -_dc.F32_MAX else r24)
+                    )
                 ),
                 (r25 if 0 <= r25 <= 65535 else (65535 if r25 > 65535 else 0)),
                 (r26 if 0 <= r26 <= 255 else (255 if r26 > 255 else 0)),
@@ -1723,22 +1767,22 @@ class BatteryPeriodic:
                 (
                     r7
                     if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
                 ),
                 (
                     r8
                     if -65504.0 <= r8 <= 65504.0
-                    else (65504.0 if r8 > 65504.0 else (-65504.0 if r8 < -65504.0 else r8))
+                    else (65504.0 if 65504.0 < r8 < _dc.INF else (-65504.0 if -_dc.INF < r8 < -65504.0 else r8))
                 ),
                 (
                     r9
                     if -65504.0 <= r9 <= 65504.0
-                    else (65504.0 if r9 > 65504.0 else (-65504.0 if r9 < -65504.0 else r9))
+                    else (65504.0 if 65504.0 < r9 < _dc.INF else (-65504.0 if -_dc.INF < r9 < -65504.0 else r9))
                 ),
                 (
                     r10
                     if -65504.0 <= r10 <= 65504.0
-                    else (65504.0 if r10 > 65504.0 else (-65504.0 if r10 < -65504.0 else r10))
+                    else (65504.0 if 65504.0 < r10 < _dc.INF else (-65504.0 if -_dc.INF < r10 < -65504.0 else r10))
                 ),
             )
         )
@@ -1775,7 +1819,11 @@ class BatteryPeriodic:
                 (
                     r19
                     if -_dc.F32_MAX <= r19 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r19 > _dc.F32_MAX else (-_dc.F32_MAX if r19 < -_dc.F32_MAX else r19))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r19 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r19 < -_dc.F32_MAX else r19)
+                    )
                 ),
                 (r20 if 0 <= r20 <= 255 else (255 if r20 > 255 else 0)),
                 h15,
@@ -1785,22 +1833,38 @@ class BatteryPeriodic:
                 (
                     r21
                     if -_dc.F32_MAX <= r21 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r21 > _dc.F32_MAX else (-_dc.F32_MAX if r21 < -_dc.F32_MAX else r21))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r21 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r21 < -_dc.F32_MAX else r21)
+                    )
                 ),
                 (
                     r22
                     if -_dc.F32_MAX <= r22 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r22 > _dc.F32_MAX else (-_dc.F32_MAX if r22 < -_dc.F32_MAX else r22))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r22 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r22 < -_dc.F32_MAX else r22)
+                    )
                 ),
                 (
                     r23
                     if -_dc.F32_MAX <= r23 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r23 > _dc.F32_MAX else (-_dc.F32_MAX if r23 < -_dc.F32_MAX else r23))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r23 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r23 < -_dc.F32_MAX else r23)
+                    )
                 ),
                 (
                     r24
                     if -_dc.F32_MAX <= r24 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r24 > _dc.F32_MAX else (-_dc.F32_MAX if r24 < -_dc.F32_MAX else r24))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r24 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r24 < -_dc.F32_MAX else r24)
+                    )
                 ),
                 (r25 if 0 <= r25 <= 65535 else (65535 if r25 > 65535 else 0)),
                 (r26 if 0 <= r26 <= 255 else (255 if r26 > 255 else 0)),
@@ -2150,7 +2214,11 @@ class BatteryTag:
             (
                 r3
                 if -_dc.F32_MAX <= r3 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r3 > _dc.F32_MAX else (-_dc.F32_MAX if r3 < -_dc.F32_MAX else r3))
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < r3 < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < r3 < -_dc.F32_MAX else r3)
+                )
             ),
             (r4 if 0 <= r4 <= 4294967295 else (4294967295 if r4 > 4294967295 else 0)),
             (r5 if 0 <= r5 <= 4294967295 else (4294967295 if r5 > 4294967295 else 0)),
@@ -2183,7 +2251,11 @@ class BatteryTag:
                 (
                     r3
                     if -_dc.F32_MAX <= r3 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r3 > _dc.F32_MAX else (-_dc.F32_MAX if r3 < -_dc.F32_MAX else r3))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r3 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r3 < -_dc.F32_MAX else r3)
+                    )
                 ),
                 (r4 if 0 <= r4 <= 4294967295 else (4294967295 if r4 > 4294967295 else 0)),
                 (r5 if 0 <= r5 <= 4294967295 else (4294967295 if r5 > 4294967295 else 0)),

@@ -416,12 +416,20 @@ class CBAT:
             (
                 r1
                 if -_dc.F32_MAX <= r1 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r1 > _dc.F32_MAX else (-_dc.F32_MAX if r1 < -_dc.F32_MAX else r1))
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < r1 < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < r1 < -_dc.F32_MAX else r1)
+                )
             ),
             (
                 r2
                 if -_dc.F32_MAX <= r2 <= _dc.F32_MAX
-                else (_dc.F32_MAX if r2 > _dc.F32_MAX else (-_dc.F32_MAX if r2 < -_dc.F32_MAX else r2))
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < r2 < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < r2 < -_dc.F32_MAX else r2)
+                )
             ),
         )
         acc = 0x10000000000000000 | int.from_bytes(head, "big")
@@ -437,7 +445,11 @@ class CBAT:
                     (
                         e5
                         if -_dc.F32_MAX <= e5 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if e5 > _dc.F32_MAX else (-_dc.F32_MAX if e5 < -_dc.F32_MAX else e5))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < e5 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < e5 < -_dc.F32_MAX else e5)
+                        )
                     )
                     for e5 in x3
                 ],
@@ -472,13 +484,17 @@ class CBAT:
         p31 = _dc.f32bits(
             r30
             if -_dc.F32_MAX <= r30 <= _dc.F32_MAX
-            else (_dc.F32_MAX if r30 > _dc.F32_MAX else (-_dc.F32_MAX if r30 < -_dc.F32_MAX else r30))
+            else (
+                _dc.F32_MAX if _dc.F32_MAX < r30 < _dc.INF else (-_dc.F32_MAX if -_dc.INF < r30 < -_dc.F32_MAX else r30)
+            )
         )
         r32 = self.nominal_voltage
         p33 = _dc.f32bits(
             r32
             if -_dc.F32_MAX <= r32 <= _dc.F32_MAX
-            else (_dc.F32_MAX if r32 > _dc.F32_MAX else (-_dc.F32_MAX if r32 < -_dc.F32_MAX else r32))
+            else (
+                _dc.F32_MAX if _dc.F32_MAX < r32 < _dc.INF else (-_dc.F32_MAX if -_dc.INF < r32 < -_dc.F32_MAX else r32)
+            )
         )
         r34 = self.is_powering_off
         p35 = 1 if r34 else 0
@@ -493,37 +509,65 @@ class CBAT:
                     (
                         r7
                         if -_dc.F32_MAX <= r7 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r7 > _dc.F32_MAX else (-_dc.F32_MAX if r7 < -_dc.F32_MAX else r7))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r7 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r7 < -_dc.F32_MAX else r7)
+                        )
                     ),
                     (
                         r8
                         if -_dc.F32_MAX <= r8 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r8 > _dc.F32_MAX else (-_dc.F32_MAX if r8 < -_dc.F32_MAX else r8))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r8 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r8 < -_dc.F32_MAX else r8)
+                        )
                     ),
                     (
                         r9
                         if -_dc.F32_MAX <= r9 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r9 > _dc.F32_MAX else (-_dc.F32_MAX if r9 < -_dc.F32_MAX else r9))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r9 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r9 < -_dc.F32_MAX else r9)
+                        )
                     ),
                     (
                         r10
                         if -_dc.F32_MAX <= r10 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r10 > _dc.F32_MAX else (-_dc.F32_MAX if r10 < -_dc.F32_MAX else r10))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r10 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r10 < -_dc.F32_MAX else r10)
+                        )
                     ),
                     (
                         r11
                         if -_dc.F32_MAX <= r11 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r11 > _dc.F32_MAX else (-_dc.F32_MAX if r11 < -_dc.F32_MAX else r11))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r11 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r11 < -_dc.F32_MAX else r11)
+                        )
                     ),
                     (
                         r12
                         if -_dc.F32_MAX <= r12 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r12 > _dc.F32_MAX else (-_dc.F32_MAX if r12 < -_dc.F32_MAX else r12))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r12 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r12 < -_dc.F32_MAX else r12)
+                        )
                     ),
                     (
                         r13
                         if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r13 > _dc.F32_MAX else (-_dc.F32_MAX if r13 < -_dc.F32_MAX else r13))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r13 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
+                        )
                     ),
                     (r14 if 0 <= r14 <= 65535 else (65535 if r14 > 65535 else 0)),
                     (r15 if 0 <= r15 <= 65535 else (65535 if r15 > 65535 else 0)),
@@ -682,12 +726,20 @@ class CBAT:
                 (
                     r1
                     if -_dc.F32_MAX <= r1 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r1 > _dc.F32_MAX else (-_dc.F32_MAX if r1 < -_dc.F32_MAX else r1))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r1 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r1 < -_dc.F32_MAX else r1)
+                    )
                 ),
                 (
                     r2
                     if -_dc.F32_MAX <= r2 <= _dc.F32_MAX
-                    else (_dc.F32_MAX if r2 > _dc.F32_MAX else (-_dc.F32_MAX if r2 < -_dc.F32_MAX else r2))
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < r2 < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < r2 < -_dc.F32_MAX else r2)
+                    )
                 ),
             ),
             "big",
@@ -704,7 +756,11 @@ class CBAT:
                     (
                         e5
                         if -_dc.F32_MAX <= e5 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if e5 > _dc.F32_MAX else (-_dc.F32_MAX if e5 < -_dc.F32_MAX else e5))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < e5 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < e5 < -_dc.F32_MAX else e5)
+                        )
                     )
                     for e5 in x3
                 ],
@@ -739,13 +795,17 @@ class CBAT:
         p31 = _dc.f32bits(
             r30
             if -_dc.F32_MAX <= r30 <= _dc.F32_MAX
-            else (_dc.F32_MAX if r30 > _dc.F32_MAX else (-_dc.F32_MAX if r30 < -_dc.F32_MAX else r30))
+            else (
+                _dc.F32_MAX if _dc.F32_MAX < r30 < _dc.INF else (-_dc.F32_MAX if -_dc.INF < r30 < -_dc.F32_MAX else r30)
+            )
         )
         r32 = self.nominal_voltage
         p33 = _dc.f32bits(
             r32
             if -_dc.F32_MAX <= r32 <= _dc.F32_MAX
-            else (_dc.F32_MAX if r32 > _dc.F32_MAX else (-_dc.F32_MAX if r32 < -_dc.F32_MAX else r32))
+            else (
+                _dc.F32_MAX if _dc.F32_MAX < r32 < _dc.INF else (-_dc.F32_MAX if -_dc.INF < r32 < -_dc.F32_MAX else r32)
+            )
         )
         r34 = self.is_powering_off
         p35 = 1 if r34 else 0
@@ -760,37 +820,65 @@ class CBAT:
                     (
                         r7
                         if -_dc.F32_MAX <= r7 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r7 > _dc.F32_MAX else (-_dc.F32_MAX if r7 < -_dc.F32_MAX else r7))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r7 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r7 < -_dc.F32_MAX else r7)
+                        )
                     ),
                     (
                         r8
                         if -_dc.F32_MAX <= r8 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r8 > _dc.F32_MAX else (-_dc.F32_MAX if r8 < -_dc.F32_MAX else r8))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r8 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r8 < -_dc.F32_MAX else r8)
+                        )
                     ),
                     (
                         r9
                         if -_dc.F32_MAX <= r9 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r9 > _dc.F32_MAX else (-_dc.F32_MAX if r9 < -_dc.F32_MAX else r9))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r9 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r9 < -_dc.F32_MAX else r9)
+                        )
                     ),
                     (
                         r10
                         if -_dc.F32_MAX <= r10 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r10 > _dc.F32_MAX else (-_dc.F32_MAX if r10 < -_dc.F32_MAX else r10))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r10 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r10 < -_dc.F32_MAX else r10)
+                        )
                     ),
                     (
                         r11
                         if -_dc.F32_MAX <= r11 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r11 > _dc.F32_MAX else (-_dc.F32_MAX if r11 < -_dc.F32_MAX else r11))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r11 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r11 < -_dc.F32_MAX else r11)
+                        )
                     ),
                     (
                         r12
                         if -_dc.F32_MAX <= r12 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r12 > _dc.F32_MAX else (-_dc.F32_MAX if r12 < -_dc.F32_MAX else r12))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r12 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r12 < -_dc.F32_MAX else r12)
+                        )
                     ),
                     (
                         r13
                         if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
-                        else (_dc.F32_MAX if r13 > _dc.F32_MAX else (-_dc.F32_MAX if r13 < -_dc.F32_MAX else r13))
+                        else (
+                            _dc.F32_MAX
+                            if _dc.F32_MAX < r13 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
+                        )
                     ),
                     (r14 if 0 <= r14 <= 65535 else (65535 if r14 > 65535 else 0)),
                     (r15 if 0 <= r15 <= 65535 else (65535 if r15 > 65535 else 0)),

@@ -458,37 +458,37 @@ class BatteryInfo:
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
                 ),
                 (
                     r2
                     if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
                 ),
                 (
                     r3
                     if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))
+                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
                 ),
                 (
                     r4
                     if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))
+                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
                 ),
                 (
                     r5
                     if -65504.0 <= r5 <= 65504.0
-                    else (65504.0 if r5 > 65504.0 else (-65504.0 if r5 < -65504.0 else r5))
+                    else (65504.0 if 65504.0 < r5 < _dc.INF else (-65504.0 if -_dc.INF < r5 < -65504.0 else r5))
                 ),
                 (
                     r6
                     if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))
+                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
                 ),
                 (
                     r7
                     if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
                 ),
             )
         )
@@ -617,37 +617,37 @@ class BatteryInfo:
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
                 ),
                 (
                     r2
                     if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
                 ),
                 (
                     r3
                     if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if r3 > 65504.0 else (-65504.0 if r3 < -65504.0 else r3))
+                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
                 ),
                 (
                     r4
                     if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if r4 > 65504.0 else (-65504.0 if r4 < -65504.0 else r4))
+                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
                 ),
                 (
                     r5
                     if -65504.0 <= r5 <= 65504.0
-                    else (65504.0 if r5 > 65504.0 else (-65504.0 if r5 < -65504.0 else r5))
+                    else (65504.0 if 65504.0 < r5 < _dc.INF else (-65504.0 if -_dc.INF < r5 < -65504.0 else r5))
                 ),
                 (
                     r6
                     if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if r6 > 65504.0 else (-65504.0 if r6 < -65504.0 else r6))
+                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
                 ),
                 (
                     r7
                     if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if r7 > 65504.0 else (-65504.0 if r7 < -65504.0 else r7))
+                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
                 ),
             )
         )
@@ -1011,12 +1011,12 @@ class CircuitStatus:
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
                 ),
                 (
                     r2
                     if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
                 ),
             )
         )
@@ -1059,12 +1059,12 @@ class CircuitStatus:
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
                 ),
                 (
                     r2
                     if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
                 ),
             )
         )
@@ -1262,12 +1262,12 @@ class PrimaryPowerSupplyStatus:
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
                 ),
                 (
                     r2
                     if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
                 ),
             )
         )
@@ -1312,12 +1312,12 @@ class PrimaryPowerSupplyStatus:
                 (
                     r1
                     if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if r1 > 65504.0 else (-65504.0 if r1 < -65504.0 else r1))
+                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
                 ),
                 (
                     r2
                     if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if r2 > 65504.0 else (-65504.0 if r2 < -65504.0 else r2))
+                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
                 ),
             )
         )

@@ -8,7 +8,7 @@ from ...literals import py_literal, text_literal, unparenthesized
 from ...module_context import ModuleContext
 from ...naming import identifier, upper_snake
 from .plan import Node, Piece, Planner, Segment, Unit, plan_units
-from .values import Lines, clamp, decode_pattern, encode_value, error, mask, needs_name
+from .values import Lines, clamp, decode_pattern, encode_value, error, mask, needs_name, saturate
 
 
 class SegmentEmitter:
@@ -117,7 +117,7 @@ class SegmentEmitter:
             raw = out.fresh("r")
             out.add(f"{raw} = {leaf.enc}")
             if leaf.type.cast is CastMode.SATURATED:
-                clamped.append(clamp(raw, "-65504.0", "65504.0"))
+                clamped.append(saturate(raw, "-65504.0", "65504.0"))
             else:
                 clamped.append(clamp(raw, "-65504.0", "65504.0", "-_dc.INF", "_dc.INF"))
         n = len(halves)

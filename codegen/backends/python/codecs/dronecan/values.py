@@ -8,7 +8,6 @@ from ...literals import hex_literal, py_literal, unparenthesized
 from .plan import reorder_terms
 
 F32_MAX = "_dc.F32_MAX"
-F64_MAX = "_dc.F64_MAX"
 
 
 class Lines:
@@ -68,6 +67,13 @@ def clamp(r: str, lo: str, hi: str, below: str | None = None, above: str | None 
     return f"({r} if {lo} <= {r} <= {hi} else ({above} if {r} > {hi} else ({below} if {r} < {lo} else {r})))"
 
 
+def saturate(r: str, lo: str, hi: str) -> str:
+    """A saturated float: finite values beyond the range clamp to it; infinity and NaN pass unchanged
+    (DSDL v0: "infinity will be preserved"; libuavcan's FloatSpec::saturate skips non-finite values)."""
+    inner = f"({lo} if -_dc.INF < {r} < {lo} else {r})"
+    return f"({r} if {lo} <= {r} <= {hi} else ({hi} if {hi} < {r} < _dc.INF else {inner}))"
+
+
 def encode_value(t: PrimitiveType, raw: str, *, pattern: bool) -> str:
     """What the encoder hands struct (``pattern``: the unsigned bit pattern) for value ``raw``.
 
@@ -89,13 +95,12 @@ def encode_value(t: PrimitiveType, raw: str, *, pattern: bool) -> str:
     if kind is PrimitiveKind.FLOAT:
         if bits == 16:
             return f"_dc.f16s({raw})" if sat else f"_dc.f16t({raw})"
-        top = F32_MAX if bits == 32 else F64_MAX
-        if sat:
-            value = clamp(raw, f"-{top}", top)
-        elif bits == 32:
-            value = clamp(raw, f"-{top}", top, "-_dc.INF", "_dc.INF")
-        else:
+        if bits == 64:  # a Python float is a float64: nothing is out of range, infinity is kept in both modes
             value = raw
+        elif sat:
+            value = saturate(raw, f"-{F32_MAX}", F32_MAX)
+        else:
+            value = clamp(raw, f"-{F32_MAX}", F32_MAX, "-_dc.INF", "_dc.INF")
         if pattern:
             inner = unparenthesized(value)
             return f"_dc.f32bits({inner})" if bits == 32 else f"_dc.f64bits({inner})"
@@ -107,7 +112,7 @@ def needs_name(t: PrimitiveType) -> bool:
     """Whether :func:`encode_value` uses its input more than once."""
     if t.kind is PrimitiveKind.INT or t.kind is PrimitiveKind.UINT:
         return t.cast is CastMode.SATURATED
-    return t.kind is PrimitiveKind.FLOAT and t.bits != 16 and not (t.bits == 64 and t.cast is CastMode.TRUNCATED)
+    return t.kind is PrimitiveKind.FLOAT and t.bits == 32
 
 
 def decode_pattern(t: PrimitiveType, b: str) -> str:

@@ -1,0 +1,180 @@
+"""``battgen export --failsafe``: each log replayed through ArduPilot's battery failsafe
+(:mod:`codegen.apps.failsafe.flight`, the engine of ``battgen failsafe``), its events as tables.
+
+Two tables per replayed log, in the log's partition of ``failsafe/``:
+
+- ``events.parquet``: one row per failsafe transition, the fields ``battgen failsafe --json``
+  prints (level, cause, value, threshold, action, outcome, the STATUSTEXT ArduPilot sends, ...),
+  with ``t`` on the battery table's clock (seconds since the log's start, so events line up with
+  the records) beside ``replay_t`` (the replay's own clock, seconds from the log's first reading,
+  as ``battgen failsafe`` prints it) and ``time`` (UTC) where the log has it;
+- ``replays.parquet``: one row per battery replayed (readings, the highest level reached, the
+  vehicle and the parameters used), so "replayed, no event" differs from "not replayed".
+
+``battery`` is the battery table's battery (0-based); ``instance`` is ArduPilot's number (1-based).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+
+from ...errors import BattgenError
+from ..failsafe.flight import replay_flight
+from ..failsafe.stream import batt_parameter_count, read_parameter_values
+from ..failsafe.vehicles import VEHICLES
+from .sources import Batch
+
+FAILSAFE = "failsafe"
+EVENTS_FILE = "events.parquet"
+REPLAYS_FILE = "replays.parquet"
+OWN_PARAMETERS = "log"  # --failsafe log: each DataFlash log's own PARM records
+_KINDS = {"ulog": "ulog", "tlog": "tlog", "dataflash": "bin"}
+
+
+@dataclass(frozen=True)
+class FailsafeOptions:
+    """The replay of a run (picklable): the parameters for every log, or None for each log's own."""
+
+    params: dict[str, float] | None
+    source: str  # what the parameters are, as the tables and the manifest record it
+    vehicle: str | None = None
+
+    @property
+    def key(self) -> str:
+        """Says whether a log's recorded replay was made with these options."""
+        return f"{self.source}|vehicle={self.vehicle or 'detected'}"
+
+
+def failsafe_options(given: str, vehicle: str | None = None) -> FailsafeOptions:
+    """The options of ``--failsafe GIVEN``: a parameter file, or ``log`` for each log's own."""
+    if vehicle is not None and vehicle not in VEHICLES:
+        raise BattgenError(f"expected a vehicle among {', '.join(sorted(VEHICLES))}, got {vehicle!r}")
+    if given == OWN_PARAMETERS:
+        return FailsafeOptions(None, "log parameters (PARM)", vehicle)
+    path = Path(given)
+    values = read_parameter_values(path)
+    if not batt_parameter_count(values):
+        raise BattgenError(f"{given}: no BATT*_ parameter ({len(values)} parameters read): expected battery settings")
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+    return FailsafeOptions(values, f"{path.name} ({digest})", vehicle)
+
+
+_TEXT, _INT, _FLOAT = pa.string(), pa.int32(), pa.float64()
+# (name, type, doc, unit)
+EVENT_COLUMNS: tuple[tuple[str, Any, str, str | None], ...] = (
+    ("log", _TEXT, "stable id of the log's content", None),
+    ("battery", _INT, "the battery table's battery (0-based)", None),
+    ("instance", _INT, "the battery as ArduPilot numbers it (1-based)", None),
+    ("t", _FLOAT, "seconds since the log's start, on the battery table's clock", "s"),
+    ("replay_t", _FLOAT, "seconds from the log's first reading, as battgen failsafe prints it", "s"),
+    ("time", pa.timestamp("us", tz="UTC"), "time of day (UTC), where the log has it", None),
+    ("level", _TEXT, "LOW or CRITICAL", None),
+    ("cause", _TEXT, "voltage or capacity", None),
+    ("value", _FLOAT, "the value that crossed: V (cause voltage) or remaining mAh (cause capacity)", None),
+    ("threshold", _FLOAT, "the parameter crossed: V or mAh, as value", None),
+    ("action", _TEXT, "the vehicle's name for the FS_LOW_ACT / FS_CRT_ACT action", None),
+    ("action_code", _INT, "the FS_LOW_ACT / FS_CRT_ACT value", None),
+    ("executed", pa.bool_(), "whether the priority rule let the action run", None),
+    ("outcome", _TEXT, "what the vehicle does after the handler's fallbacks", None),
+    ("priority", _INT, "the action's index in the vehicle's priority list", None),
+    ("statustext", _TEXT, "the STATUSTEXT AP_BattMonitor sends", None),
+    ("vehicle_type", _TEXT, "the ArduPilot vehicle whose semantics the replay used", None),
+    ("parameters", _TEXT, "the parameters the replay used", None),
+)
+REPLAY_COLUMNS: tuple[tuple[str, Any, str, str | None], ...] = (
+    ("log", _TEXT, "stable id of the log's content", None),
+    ("battery", _INT, "the battery table's battery (0-based)", None),
+    ("instance", _INT, "the battery as ArduPilot numbers it (1-based)", None),
+    ("readings", pa.int64(), "battery readings replayed", None),
+    ("level", _TEXT, "the highest level reached: NONE, LOW or CRITICAL", None),
+    ("vehicle_type", _TEXT, "the ArduPilot vehicle whose semantics the replay used", None),
+    ("parameters", _TEXT, "the parameters the replay used", None),
+)
+
+
+def table_schema(columns: Sequence[tuple[str, Any, str, str | None]], table: str) -> Any:
+    fields = []
+    for name, typ, doc, unit in columns:
+        meta = {"doc": doc} | ({"unit": unit, "quantity": "time"} if unit else {})
+        fields.append(pa.field(name, typ, nullable=name != "log", metadata=meta))
+    return pa.schema(fields, metadata={"battgen": json.dumps({"table": table, "version": 1})})
+
+
+EVENTS_SCHEMA = table_schema(EVENT_COLUMNS, "failsafe_events")
+REPLAYS_SCHEMA = table_schema(REPLAY_COLUMNS, "failsafe_replays")
+
+
+def battery_numbers(kind: str, batches: Sequence[Batch], batteries: Sequence[int | None]) -> dict[int, int]:
+    """ArduPilot's 1-based battery of a replay -> the battery table's battery. The replay numbers a
+    ULog multi_id or DataFlash instance + 1 (the batches' instance), a MAVLink id + 1 (the table's
+    battery is the id)."""
+    if kind == "tlog":
+        return {}
+    return {int(b.instance[0]) + 1: bat for b, bat in zip(batches, batteries, strict=True) if b.n and bat is not None}
+
+
+def replay_tables(
+    path: Path,
+    name: str,
+    kind: str,
+    log: str,
+    options: FailsafeOptions,
+    batches: Sequence[Batch],
+    numbers: dict[int, int],
+) -> tuple[Any, Any] | str:
+    """The events and replays tables of one log, or a note saying why it was not replayed."""
+    replay_kind = _KINDS.get(kind)
+    if replay_kind is None:
+        return "failsafe not replayed: a JSON Lines file is no flight log"
+    if options.params is None and replay_kind != "bin":
+        return "failsafe not replayed: only a DataFlash log carries its own parameters (give --failsafe PARAMS)"
+    replay = replay_flight(path, name, replay_kind, options.params, options.vehicle)
+    clock = next((b for b in batches if b.n), None)
+
+    def battery(instance: int) -> int:
+        return numbers.get(instance, instance - 1)
+
+    origin = None if clock is None else clock.origin_us
+    offset = None if clock is None else clock.utc_offset_us
+    rows: dict[str, list[Any]] = {c[0]: [] for c in EVENT_COLUMNS}
+    for event, sample in replay.events:
+        stamp = sample.stamp_us
+        rows["log"].append(log)
+        rows["battery"].append(battery(event.battery))
+        rows["instance"].append(event.battery)
+        rows["t"].append(None if stamp is None or origin is None else (stamp - origin) / 1e6)
+        rows["replay_t"].append(event.time)
+        rows["time"].append(None if stamp is None or offset is None else stamp + offset)
+        rows["level"].append(event.level.name)
+        for key in ("cause", "value", "threshold", "action", "action_code", "executed", "outcome", "priority"):
+            rows[key].append(getattr(event, key))
+        rows["statustext"].append(event.ardupilot_text)
+        rows["vehicle_type"].append(replay.vehicle)
+        rows["parameters"].append(options.source)
+    events = pa.Table.from_pydict(
+        {
+            k: v if k != "time" else pa.array(v, pa.int64()).cast(EVENTS_SCHEMA.field("time").type)
+            for k, v in rows.items()
+        },
+        schema=EVENTS_SCHEMA,
+    )
+    replays = pa.Table.from_pydict(
+        {
+            "log": [log] * len(replay.samples),
+            "battery": [battery(i) for i in sorted(replay.samples)],
+            "instance": sorted(replay.samples),
+            "readings": [replay.samples[i] for i in sorted(replay.samples)],
+            "level": [replay.levels[i].name if i in replay.levels else "NONE" for i in sorted(replay.samples)],
+            "vehicle_type": [replay.vehicle] * len(replay.samples),
+            "parameters": [options.source] * len(replay.samples),
+        },
+        schema=REPLAYS_SCHEMA,
+    )
+    return events, replays

@@ -1,0 +1,68 @@
+"""Internal resistance from load steps: the one definition ``battgen report`` (its figures) and the
+fleet views (``flights.internal_resistance``) both use.
+
+A load step is a pair of consecutive samples of one battery at most :data:`STEP_MAX_DT_S` apart
+whose current changes by at least :data:`STEP_FRACTION` of the flight's peak current (its largest
+absolute value), and by at least :data:`STEP_MIN_A`; each gives R = -ΔV/ΔI, kept when positive.
+The estimate is the median of them, as one step is easily spoiled by a voltage reading lagging the
+current. Relative to the peak, the threshold suits a 2 A hobby pack and a 200 A heavy lifter alike.
+
+:func:`step_resistances` computes it over Python lists; :func:`resistance_sql` writes the same as
+SQL over a table's columns (a window per battery), so the two cannot drift apart.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections.abc import Sequence
+
+STEP_FRACTION = 0.2
+STEP_MIN_A = 1.0
+STEP_MAX_DT_S = 2.0
+
+
+def step_threshold(peak_a: float) -> float:
+    """The smallest change of current that makes a load step in a flight whose peak is ``peak_a``."""
+    return max(STEP_MIN_A, STEP_FRACTION * peak_a)
+
+
+def step_resistances(
+    t: Sequence[float], voltage: Sequence[float | None], current: Sequence[float | None]
+) -> list[float]:
+    """Every load step's -ΔV/ΔI (Ω) of one battery's samples, in time order."""
+    known = [abs(i) for i in current if i is not None]
+    if not known:
+        return []
+    threshold = step_threshold(max(known))
+    out = []
+    for k in range(1, len(t)):
+        v0, v1, i0, i1 = voltage[k - 1], voltage[k], current[k - 1], current[k]
+        if v0 is None or v1 is None or i0 is None or i1 is None or t[k] - t[k - 1] > STEP_MAX_DT_S:
+            continue
+        if abs(i1 - i0) >= threshold:
+            r = -(v1 - v0) / (i1 - i0)
+            if r > 0:
+                out.append(r)
+    return out
+
+
+def internal_resistance(
+    t: Sequence[float], voltage: Sequence[float | None], current: Sequence[float | None]
+) -> float | None:
+    """The median of the load steps' resistances (None without any step)."""
+    steps = step_resistances(t, voltage, current)
+    return statistics.median(steps) if steps else None
+
+
+def resistance_sql(dt: str, voltage: str, prev_voltage: str, current: str, prev_current: str, peak: str) -> str:
+    """The SQL expression of one sample's load-step resistance (NULL where it is none), given the
+    column expressions of a window per battery: the sample's time step ``dt``, its and the previous
+    sample's voltage and current, and the battery's ``peak`` absolute current. Aggregate it with
+    ``median``."""
+    delta_i = f"({current} - {prev_current})"
+    resistance = f"-({voltage} - {prev_voltage}) / {delta_i}"
+    return (
+        f"CASE WHEN {dt} <= {STEP_MAX_DT_S} "
+        f"AND abs({delta_i}) >= greatest({STEP_MIN_A}, {STEP_FRACTION} * {peak}) "
+        f"AND {resistance} > 0 THEN {resistance} END"
+    )
