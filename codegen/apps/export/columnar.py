@@ -253,6 +253,8 @@ class ColumnConverter(OpVisitor[None]):
             count = self.columns[op.count_field].astype(np.int64)
             room = m.shape[1] if given is None else given
             lengths = np.where(count != 0, np.minimum(count, room), lengths)
+        if f.invalid is not None and f.invalid.first_decides and m.shape[1]:  # MAVLink [X:]: element 0 speaks
+            lengths = np.where(_not_marker(m[:, 0], f.invalid.value), lengths, 0)
         mul, add = _factor(f.unit or con.concept.unit, con.concept.unit)
         values = _affine(m, mul, add)
         if values is m:  # a float64 field as it is: the NaNs below must not write into the log's columns
