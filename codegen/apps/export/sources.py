@@ -73,12 +73,9 @@ def map_file(path: Path) -> mmap.mmap | None:
     other kinds, and where a file cannot be mapped: empty, a pipe...)."""
     if path.suffix.lower() != ".ulg":
         return None
-    # MAP_POPULATE (Linux): the whole file is mapped in one call rather than a page fault per 4 KiB
-    # (measured: 0.015 s against 0.15 s for 171 MB).
-    flags = mmap.MAP_SHARED | getattr(mmap, "MAP_POPULATE", 0)
     try:
         with path.open("rb") as f:
-            return mmap.mmap(f.fileno(), 0, flags=flags, prot=mmap.PROT_READ)
+            return mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
     except (OSError, ValueError):
         return None
 
