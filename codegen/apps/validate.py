@@ -187,8 +187,18 @@ class Checker:
             f = self._type_finding(record, exc)
             return dt_problems.Problem(f.path, f.rule, f.value, f.limit, f.message)
 
+        # YAML allows a key of any kind (`?` alone is a null key); a devicetree property is named by text
+        odd = [k for k in data if not isinstance(k, str)]
+        data = {k: v for k, v in data.items() if isinstance(k, str)}
         instance, early = dt_problems.read_node(self.cls, self.message, data, self.data_error, problem)
-        findings = [self._finding(record, p.path, p.rule, p.value, p.limit, p.text, "error") for p in early]
+        findings = [
+            self._finding(
+                record, "", dt_problems.UNKNOWN_RULE, None, None,
+                f"{clip(repr(key))} is not a property name: a devicetree property is named by text", "error",
+            )
+            for key in odd
+        ]  # fmt: skip
+        findings += [self._finding(record, p.path, p.rule, p.value, p.limit, p.text, "error") for p in early]
         if instance is not None:
             try:
                 violations = instance.validate()

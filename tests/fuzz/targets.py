@@ -238,13 +238,19 @@ def _commands(name: str, path: str) -> list[list[str]]:
     if name in ("dts", "dtb"):
         return [["validate", "--message", "simple-battery", p], ["params", "--from-devicetree", p],
                 ["convert", "--from", "devicetree", "--to", "uorb", p]]  # fmt: skip
+    fleet = ["export", "-q", "-o", str(Path(p).parent / "fleet"), p]  # the export's own readers (the C walk)
     if name in ("tlog", "mavlink"):
         return [
             ["validate", "--message", "mavlink.BATTERY_STATUS", p],
             ["convert", "--from", "mavlink", "--to", "uorb", p],
+            *([fleet] if name == "tlog" else []),
         ]
     if name == "ulog":
-        return [["validate", "--message", "uorb.BatteryStatus", p], ["convert", "--from", "uorb", "--to", "mavlink", p]]
+        return [
+            ["validate", "--message", "uorb.BatteryStatus", p],
+            ["convert", "--from", "uorb", "--to", "mavlink", p],
+            fleet,
+        ]
     return [
         ["validate", "--message", "uorb.BatteryStatus", p],
         ["validate", "--format", "json", "--message", "devicetree.power.supply.battery", p],

@@ -9,12 +9,14 @@ is reported in its :class:`LogResult` and the run goes on.
 from __future__ import annotations
 
 import concurrent.futures
+import datetime
 import mmap
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import pyarrow as pa
 import pyarrow.compute as pc
 
 from ...errors import BattgenError
@@ -95,7 +97,7 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
     messages: set[str] = set()
     seen: list[Batch] = []  # each batch's context, for the replay
     firsts: list[int | None] = []  # each batch's first battery number, for the replay
-    first_time: Any = None  # the log's first time of day (UTC), which names its day partition
+    first_us: int | None = None  # the log's first time of day (UTC µs), which names its day partition
     try:
         for batch in read_log(file, name, catalog, options.message, source, all_fields=options.raw):
             columns = batch.concepts
@@ -107,8 +109,8 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
                 writer.add_raw(batch.message, raw_table(catalog.schema.message(batch.message), batch, log))
             messages.add(batch.message)
             notes.extend(n for n in batch.notes if n not in notes)
-            first = pc.min(table["time"]).as_py() if table.num_rows else None
-            first_time = first if first_time is None or (first is not None and first < first_time) else first_time
+            first = pc.min(table["time"].cast(pa.int64())).as_py() if table.num_rows else None
+            first_us = first if first_us is None or (first is not None and first < first_us) else first_us
             if options.failsafe is not None:
                 firsts.append(table["battery"][0].as_py() if table.num_rows else None)
                 batch.columns, batch.concepts = {}, None
@@ -141,10 +143,21 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
     }
     if options.failsafe is not None:
         manifest["failsafe"] = options.failsafe.key
-    where = partition_of(options.partition, log, None if first_time is None else str(first_time.date()))
+    where = partition_of(options.partition, log, utc_day(first_us))
     manifest["partition"] = where
     writer.commit(manifest, extra, where)
     return LogResult(name, "exported", log, writer.rows, notes=tuple(notes))
+
+
+def utc_day(us: int | None) -> str | None:
+    """The UTC day (YYYY-MM-DD) of a time in µs since the epoch; None for none, or a time no
+    calendar holds (a damaged log's clock)."""
+    if us is None:
+        return None
+    try:
+        return (datetime.datetime(1970, 1, 1) + datetime.timedelta(microseconds=us)).date().isoformat()
+    except OverflowError:
+        return None
 
 
 def export_logs(
