@@ -127,7 +127,7 @@ def test_own_parameters_and_logs_without_any(tmp_path: Path, capsys: pytest.Capt
     assert notes["flight.tlog"] == [
         "failsafe not replayed: only a DataFlash log carries its own parameters (give --failsafe PARAMS)"
     ]
-    assert notes["b.jsonl"] == ["failsafe not replayed: a JSON Lines file is no flight log"]
+    assert notes["b.jsonl"] == ["failsafe not replayed: a JSON Lines file is no flight log battgen failsafe reads"]
 
 
 def test_incremental_runs_replay_again_only_for_new_parameters(
