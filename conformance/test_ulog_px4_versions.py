@@ -29,6 +29,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from pyulog import ULog
+from ulog_values import instances, scalar
 
 from codegen.backends.python.writer import generate
 from codegen.frontends import uorb
@@ -114,29 +115,12 @@ def old_packages(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str,
             del sys.modules[mod]
 
 
-def _scalar(type_text: str) -> st.SearchStrategy[Any]:
-    if type_text == "bool":
-        return st.booleans()
-    if type_text == "float32":
-        return st.floats(width=32)
-    bits = int(type_text.lstrip("uint"))
-    if type_text.startswith("uint"):
-        return st.integers(0, (1 << bits) - 1)
-    return st.integers(-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
-
-
 def _instances(cls: type[Any]) -> st.SearchStrategy[Any]:
-    fields: dict[str, st.SearchStrategy[Any]] = {}
-    for f in dataclasses.fields(cls):
-        base, _, count = f.metadata["type"].partition("[")
-        if count:
-            n = int(count[:-1])
-            fields[f.name] = st.lists(_scalar(base), min_size=n, max_size=n)
-        elif f.name == "cell_count" and base == "int32":  # mostly real cell counts, sometimes not
-            fields[f.name] = st.one_of(st.integers(0, 14), _scalar(base))
-        else:
-            fields[f.name] = _scalar(base)
-    return st.builds(cls, **fields)
+    """As ulog_values.instances, but an int32 cell_count (the oldest layouts) is mostly a real cell count."""
+    types = {f.name: f.metadata["type"] for f in dataclasses.fields(cls)}
+    if types.get("cell_count") != "int32":
+        return instances(cls)
+    return instances(cls, {"cell_count": st.one_of(st.integers(0, 14), scalar("int32"))})
 
 
 def _write(module: ModuleType, msgs: list[tuple[Any, int]]) -> bytes:

@@ -9,7 +9,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import importlib
 import io
 import struct
@@ -24,6 +23,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pyulog import ULog
+from ulog_values import instances
 
 from codegen.backends.python.writer import generate
 from codegen.frontends import uorb
@@ -32,30 +32,6 @@ from generated.uorb import BatteryStatus, BatteryStatusV0
 
 DATA = Path("/work/shared/data/ulog")
 LOGS = ("sample_log_small.ulg", "sample_px4_events.ulg")
-
-
-def _scalar(type_text: str) -> st.SearchStrategy[Any]:
-    if type_text == "bool":
-        return st.booleans()
-    if type_text == "float32":
-        return st.floats(width=32)
-    bits = int(type_text.lstrip("uint"))
-    if type_text.startswith("uint"):
-        return st.integers(0, (1 << bits) - 1)
-    return st.integers(-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
-
-
-def instances(cls: type[Any]) -> st.SearchStrategy[Any]:
-    """Random instances of a flat generated uORB class (scalars and builtin arrays)."""
-    fields: dict[str, st.SearchStrategy[Any]] = {}
-    for f in dataclasses.fields(cls):
-        base, _, count = f.metadata["type"].partition("[")
-        if count:
-            n = int(count[:-1])
-            fields[f.name] = st.lists(_scalar(base), min_size=n, max_size=n)
-        else:
-            fields[f.name] = _scalar(base)
-    return st.builds(cls, **fields)
 
 
 def expected_column(values: list[Any]) -> np.ndarray[Any, Any]:

@@ -121,6 +121,7 @@ class Array:
     min_length: int = 0
     byte: bool = False  # held as bytes
     columns: tuple[Spec | None, ...] = ()  # element i's own spec (None: the element's)
+    unknown_first: float | None = None  # MAVLink [X:]: element 0 holding X makes the whole array unknown
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -228,7 +229,10 @@ def diag(out: list[Violation], path: str, value: object, spec: Spec) -> None:
 
 
 def is_sentinel(value: object, spec: Number) -> bool:
-    s = spec.sentinel
+    return _is_marker(value, spec.sentinel)
+
+
+def _is_marker(value: object, s: float | None) -> bool:
     if s is None or isinstance(value, str):
         return False
     if isinstance(s, float) and math.isnan(s):
@@ -369,6 +373,8 @@ def _array(out: list[Violation], path: str, value: object, spec: Array) -> None:
         )
     if cap is not None:
         items = items[:cap]  # an over-long array is reported once above; its excess is not walked
+    if spec.unknown_first is not None and n and _is_marker(value[0], spec.unknown_first):
+        return  # the array is unknown: what its other elements hold means nothing
     columns = spec.columns
     for i, item in enumerate(items):
         column = columns[i] if i < len(columns) else None

@@ -135,6 +135,8 @@ def _description(f: Field) -> str:
         each = " (per element)" if s.per_element or isinstance(f.type, ArrayType) else ""
         if s.elements:
             each = " (by position)"
+        if s.first_decides:
+            each = " (the whole array, when its first element holds it)"
         value = "NaN" if s.is_nan else repr(s.value)
         named = "" if s.text.strip("[]") in (value, "NaN") else f" ({s.text.strip('[]')})"
         parts.append(f"Unknown{each}: {value}{named}, accepted as a valid value.")

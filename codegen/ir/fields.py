@@ -21,12 +21,15 @@ class Sentinel:
     ``elements`` is for a marker given per position (MAVLink's ``[v1,,v3,]``, ``[0,]``): the marker
     of each leading element, None where the list leaves one out; elements past the list have no
     marker. It is empty for the other forms; when set, ``value`` is its first marker.
+    ``first_decides`` is MAVLink's ``[X:]``: the whole array is unknown when its first element is
+    ``value`` (the other elements then mean nothing, whatever they hold); it is not per element.
     """
 
     value: int | float
     text: str
     per_element: bool = False
     elements: tuple[int | float | None, ...] = ()
+    first_decides: bool = False
 
     @property
     def is_nan(self) -> bool:
@@ -47,7 +50,8 @@ class Sentinel:
         def norm(v: int | float | None) -> object:
             return "nan" if v is not None and _is_nan(v) else v
 
-        return (norm(self.value), self.text, self.per_element, tuple(norm(v) for v in self.elements))
+        elements = tuple(norm(v) for v in self.elements)
+        return (norm(self.value), self.text, self.per_element, elements, self.first_decides)
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Sentinel):

@@ -321,7 +321,9 @@ def test_field_mapping_details(tmp_path: Path) -> None:
     assert ("type", "uint8_t_mavlink_version") in version.annotations
     q = m.field("q")
     assert q.type == ArrayType(PrimitiveType(PrimitiveKind.FLOAT, 32), 4, dynamic=False)
-    assert q.invalid is not None and q.invalid.is_nan and (q.invalid.text, q.invalid.per_element) == ("[NaN:]", True)
+    assert q.invalid is not None and q.invalid.is_nan
+    # [X:]: the first element decides for the whole array; it marks no element by itself
+    assert (q.invalid.text, q.invalid.per_element, q.invalid.first_decides) == ("[NaN:]", False, True)
     assert m.field("state").invalid == Sentinel(0, "E_UNKNOWN")
     assert m.field("flags").annotations == (("display", "bitmask"), ("print_format", "0x%04x"))
     cam = m.field("cam")
@@ -443,7 +445,8 @@ def test_battery_status_enums(battery_schema: Schema) -> None:
 def test_array_invalid_forms(tmp_path: Path, attr: str, value: int, elements: tuple[int | None, ...]) -> None:
     path = write(tmp_path, "a.xml", message(fld("uint8_t[4]", "a", f' invalid="{attr}"')))
     s = mavlink.parse_file(path, root=tmp_path).message("mavlink.M").field("a").invalid
-    assert s == Sentinel(value, attr, per_element=True, elements=elements)
+    first = attr.endswith(":]")  # [X:]: the first element decides for the whole array
+    assert s == Sentinel(value, attr, per_element=not first, elements=elements, first_decides=first)
     expected = list(elements) + [None] * (4 - len(elements)) if elements else [value] * 4
     assert s is not None and [s.marker_at(i) for i in range(4)] == expected
 

@@ -28,8 +28,9 @@ class DataflashWriter:
         body = struct.pack("<BB4s16s64s", type_id, length, name.encode(), fmt.encode(), columns.encode())
         self.out += HEAD + bytes([0x80]) + body
 
-    def define(self, name: str, fmt: str, columns: Sequence[str]) -> None:
-        self._fmt(0x40 + len(self.formats), name, fmt, ",".join(columns))
+    def define(self, name: str, fmt: str, columns: Sequence[str], type_id: int | None = None) -> None:
+        """Declare a message (an FMT record); its type id is the next free one unless given."""
+        self._fmt(0x40 + len(self.formats) if type_id is None else type_id, name, fmt, ",".join(columns))
 
     def write(self, name: str, *values: object) -> None:
         type_id, fmt = self.formats[name]

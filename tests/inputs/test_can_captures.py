@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import gzip
 import json
-import struct
 import threading
 import time
 from pathlib import Path
 from typing import Any
 
 import pytest
+from dataflash_writer import DataflashWriter
 
 from codegen.cli.main import main
 
@@ -103,25 +103,15 @@ def test_csv_capture_read_when_asked(tmp_path: Path, capsys: pytest.CaptureFixtu
 
 def _dataflash(path: Path, messages: list[Any]) -> Path:
     """An ArduPilot DataFlash log holding FMT and CANF records (layout of AP_CANManager/LogStructure.h)."""
-    head = b"\xa3\x95"
-    fmt_type, canf_type = 128, 200
-    canf = struct.Struct("<QBIB8B")
-
-    def fmt(type_: int, length: int, name: str, form: str, columns: str) -> bytes:
-        body = struct.pack("<BB4s16s64s", type_, length, name.encode(), form.encode(), columns.encode())
-        return head + bytes([fmt_type]) + body
-
-    out = fmt(fmt_type, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns")
-    out += fmt(canf_type, 3 + canf.size, "CANF", "QBIBBBBBBBBB", "TimeUS,Bus,Id,DLC,B0,B1,B2,B3,B4,B5,B6,B7")
+    log = DataflashWriter()
+    columns = ("TimeUS", "Bus", "Id", "DLC", "B0", "B1", "B2", "B3", "B4", "B5", "B6", "B7")
+    log.define("CANF", "QBIBBBBBBBBB", columns, type_id=200)
     t0 = messages[0].timestamp
     for m in messages:
         data = bytes(m.data) + bytes(8 - len(m.data))
         raw_id = m.arbitration_id | (1 << 31)  # AP_HAL::CANFrame::FlagEFF: an extended frame
-        out += (
-            head + bytes([canf_type]) + canf.pack(int((m.timestamp - t0) * 1e6) + 1000, 0, raw_id, len(m.data), *data)
-        )
-    path.write_bytes(out)
-    return path
+        log.write("CANF", int((m.timestamp - t0) * 1e6) + 1000, 0, raw_id, len(m.data), *data)
+    return log.save(path)
 
 
 def test_dataflash_canf_records(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -170,6 +170,8 @@ def meta(f: Field) -> str:
         args.append(f"invalid_text={py_literal(f.invalid.text)}")
         if f.invalid.per_element:
             args.append("per_element=True")
+        if f.invalid.first_decides:
+            args.append("first_decides=True")
     if f.enums:
         args.append(f"enums={py_literal(f.enums)}")
     if f.extension:

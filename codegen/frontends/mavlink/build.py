@@ -159,7 +159,7 @@ def _sentinel(text: str, ftype: FieldType, enum: _EnumParts | None, where: Locat
     if found is None:
         raise SchemaError(where.file, where.line, f"expected invalid= to be {values.SENTINEL_FORMS}, got {text!r}")
     element = _element(ftype)
-    if found.per_element and isinstance(ftype, PrimitiveType):
+    if (found.per_element or found.first_decides) and isinstance(ftype, PrimitiveType):
         raise SchemaError(where.file, where.line, f"expected a bracketed invalid={text!r} only on an array field")
     markers = [m for m in found.elements if m is not None] or [found.value]
     if not all(values.fits(m, element) for m in markers):
@@ -171,7 +171,7 @@ def _sentinel(text: str, ftype: FieldType, enum: _EnumParts | None, where: Locat
         )
     if element.kind is not PrimitiveKind.FLOAT:  # 1.0 written for an integer field is the integer 1
         positions = [None if m is None else int(m) for m in found.elements]
-        found = Sentinel(int(found.value), found.text, found.per_element, tuple(positions))
+        found = Sentinel(int(found.value), found.text, found.per_element, tuple(positions), found.first_decides)
     return found
 
 

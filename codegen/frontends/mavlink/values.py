@@ -85,10 +85,11 @@ def _scalar(text: str, enum_values: Mapping[str, int]) -> int | float | None:
 def sentinel(text: str, enum_values: Mapping[str, int]) -> Sentinel | None:
     """The Sentinel an ``invalid`` attribute spells, or None when the form is not understood.
 
-    The forms are those of the MAVLink guide's field ``invalid`` attribute: ``X``; ``[X]`` marks
-    every array element; ``[X:]`` (the whole array is unknown when its first element is X) is kept
-    as per-element too, its spelling preserved in ``text``; ``[X1,,X3,]`` marks elements by
-    position (``[0,]``: only the first), an empty position having no marker.
+    The forms are those of the MAVLink guide's field ``invalid`` attribute (mavlink-devguide,
+    en/guide/xml_schema.md): ``X``; ``[X]``: every array element that holds X is invalid;
+    ``[X:]``: all elements are invalid when the *first* holds X (``first_decides``; an X elsewhere
+    marks nothing); ``[X1,,X3,]`` marks elements by position (``[0,]``: only the first), an empty
+    position having no marker.
     """
     if not (text.startswith("[") and text.endswith("]")):
         value = _scalar(text, enum_values)
@@ -105,10 +106,11 @@ def sentinel(text: str, enum_values: Mapping[str, int]) -> Sentinel | None:
         if len(given) != sum(1 for item in items if item != "") or not given:
             return None  # an item not understood, or no marker at all
         return Sentinel(value=given[0], text=text, per_element=True, elements=markers)
-    if inner.endswith(":"):
-        inner = inner[:-1]
-    value = _scalar(inner, enum_values)
-    return None if value is None else Sentinel(value=value, text=text, per_element=True)
+    first = inner.endswith(":")
+    value = _scalar(inner[:-1] if first else inner, enum_values)
+    if value is None:
+        return None
+    return Sentinel(value=value, text=text, per_element=not first, first_decides=first)
 
 
 def fits(value: int | float, element: PrimitiveType) -> bool:

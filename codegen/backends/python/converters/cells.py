@@ -20,6 +20,8 @@ class CellEmitters(RuleContext):
         if not self.backward:
             mul, add = factor(f_unit, c_unit)
             self.emit(f"_c = list({self.s(fmt)})")
+            if f.invalid is not None and f.invalid.first_decides:  # [X:]: X first means no cell is known
+                self.emit(f"_c = [] if _c and _r.is_marker(_c[0], {py_literal(f.invalid.value)}) else _c")
             if count_ref is not None:
                 self.emit(
                     f"_n = {self.s(count_ref)}", f"_c = _c[:_n] if _n else _cells.leading(_c, {py_literal(mark)})"

@@ -150,10 +150,11 @@ class FunctionBuilder(
                     continue
                 attr = f"{var}.{self.member(qualified, f.name)}"
                 mark = py_literal(f.invalid.value)
-                test = (
-                    f"all(_r.is_marker(_x, {mark}) for _x in {attr})"
-                    if f.invalid.per_element
-                    else f"_r.is_marker({attr}, {mark})"
-                )
+                if f.invalid.first_decides:  # MAVLink [X:]: element 0 speaks for the array
+                    test = f"len({attr}) > 0 and _r.is_marker({attr}[0], {mark})"
+                elif f.invalid.per_element:
+                    test = f"all(_r.is_marker(_x, {mark}) for _x in {attr})"
+                else:
+                    test = f"_r.is_marker({attr}, {mark})"
                 self.emit(f"if rep_u is not None and {test}:")
                 self.emit_call("rep_u.unknown", [py_literal(f"{qualified}.{f.name}")], 1)

@@ -70,6 +70,7 @@ def meta(
     invalid: float | None = None,
     invalid_text: str | None = None,
     per_element: bool = False,
+    first_decides: bool = False,
     enums: tuple[str, ...] = (),
     extension: bool = False,
     pattern: str | None = None,
@@ -89,6 +90,7 @@ def meta(
             "invalid": invalid,
             "invalid_text": invalid_text,
             "per_element": per_element,
+            "first_decides": first_decides,  # MAVLink [X:]: the array is unknown when element 0 is the sentinel
             "enums": enums,
             "extension": extension,
             "pattern": pattern,

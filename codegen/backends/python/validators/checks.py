@@ -156,8 +156,11 @@ class ArrayCheck:
     ``inner``. A column only narrows the element's checks, so the fast path tests every element
     against ``inner`` and, on top, each position whose column has a range against that column."""
 
-    def __init__(self, t: ArrayType, inner: Check, depth: int, columns: list[Check | None]) -> None:
+    def __init__(
+        self, t: ArrayType, inner: Check, depth: int, columns: list[Check | None], first: Sentinel | None = None
+    ) -> None:
         self.t = t
+        self.first = first  # MAVLink's [X:]: when element 0 is X the array is unknown, its elements unchecked
         self.inner = inner
         self.depth = depth
         self.columns = columns
@@ -175,6 +178,9 @@ class ArrayCheck:
         if any(c is not None for c in self.columns):
             specs = [c.spec() if c is not None else "None" for c in self.columns]
             args.append("columns=(" + ", ".join(specs) + ("," if len(specs) == 1 else "") + ")")
+        if self.first is not None:
+            assert isinstance(self.inner, NumberCheck)
+            args.append(f"unknown_first={number(self.first.value, self.inner.t)}")
         return "_v.Array(" + ", ".join(args) + ")"
 
     def column_bad(self) -> list[str]:
@@ -205,10 +211,16 @@ class ArrayCheck:
         parts = self.length_bad()
         if self.byte:
             parts.insert(0, f"{V}.__class__ is not bytes")
+            elements = self.column_bad()
         else:
             item = f"_x{self.depth}"
-            parts.append(f"any({unparenthesized(self.inner.bad()).replace(V, item)} for {item} in {V})")
-        parts += self.column_bad()
+            elements = [f"any({unparenthesized(self.inner.bad()).replace(V, item)} for {item} in {V})"]
+            elements += self.column_bad()
+        if self.first is not None and elements:
+            s = self.first
+            unknown = f"{V}[0] != {V}[0]" if s.is_nan else f"{V}[0] == {py_literal(s.value)}"
+            elements = [f"(not (len({V}) > 0 and {unknown}) and ({' or '.join(elements)}))"]
+        parts += elements
         return "(" + " or ".join(parts) + ")" if parts else "False"
 
 
@@ -241,4 +253,6 @@ def build(schema: Schema, f: Field, t: FieldType, depth: int = 0, label: str = "
         # the field as seen at this position: the column's range on top of the field's, its unit
         at = replace(f, range=c.range.intersect(f.range) if c.range is not None else f.range, unit=c.unit or f.unit)
         columns.append(build(schema, at, t.element, depth + 1, c.doc or label))
-    return ArrayCheck(t, build(schema, f, t.element, depth + 1, label), depth, columns)
+    first = f.invalid if depth == 0 and f.invalid is not None and f.invalid.first_decides else None
+    inner = build(schema, f, t.element, depth + 1, label)
+    return ArrayCheck(t, inner, depth, columns, first if isinstance(inner, NumberCheck) else None)

@@ -41,6 +41,9 @@ def known_expr(f: Field, value: str, optional: bool) -> str:
             parts.append(f"{value} != {py_literal(chr(int(s.value)) * (f.type.capacity or 1) if s.value else '')}")
         elif isinstance(f.type, ArrayType) and s.elements:
             parts.append(_known_by_position(f.type, s, value))
+        elif isinstance(f.type, ArrayType) and s.first_decides:  # [X:]: the first element speaks for all
+            first = f"{value}[0] == {value}[0]" if s.is_nan else f"{value}[0] != {py_literal(s.value)}"
+            parts.append(f"(len({value}) > 0 and {first})")
         elif isinstance(f.type, ArrayType):
             test = "e == e" if s.is_nan else f"e != {py_literal(s.value)}"
             parts.append(f"any({test} for e in {value})")
