@@ -6,8 +6,9 @@ Prints:
 - battery records per CPU second from ULog to Parquet (one process): ``battgen export`` of one
   log (content id, index, columns, the IR's mappings over columns, Arrow, zstd Parquet) against what a
   user writes by hand on the same log (pyulog -> pandas DataFrame per instance -> ``to_parquet``,
-  raw fields, no units or sentinels); on the synthetic log (--records records, two instances) and on
-  the two real PX4 logs; the ratio. Targets (issue 14): >= 5x the hand path, >= 2 M records/s/core.
+  raw fields, no units or sentinels); on the synthetic log (--records records, two instances), on a
+  mixed one (--records / 20 battery records among 19x as many of another topic, as in a flight log)
+  and on the two real PX4 logs; the ratio. Targets (issue 14): >= 5x the hand path, >= 2 M records/s/core.
 - a synthetic fleet of --logs logs (--log-records records each, two instances) exported with --jobs 2
   and with a two-worker Dask LocalCluster (worker processes): wall time, records/s, the peak memory
   (max RSS) of the busiest worker, at a quarter of the fleet and at the whole fleet (flat in the
@@ -32,8 +33,9 @@ from pyulog import ULog
 
 from codegen.apps.export.engine import ExportOptions, export_logs, export_one, finish
 from codegen.apps.fleet_query import connect
+from codegen.inputs.ulog_index import compiled
 from generated import _ulog
-from generated.uorb import BatteryStatus
+from generated.uorb import BatteryInfo, BatteryStatus
 
 REAL_LOGS = Path("/work/shared/data/ulog")
 TOPIC = "battery_status"
@@ -48,15 +50,23 @@ def sample(i: int) -> BatteryStatus:
     return msg
 
 
-def write_log(path: Path, records: int, tag: str, flight: int = 0) -> None:
+def write_log(path: Path, records: int, tag: str, flight: int = 0, others: int = 0) -> None:
     """A log of ``records`` battery_status records (two instances) of the vehicle ``tag``; ``flight``
-    makes the content (and so the log's id) of each flight its own."""
+    makes the content (and so the log's id) of each flight its own; ``others`` records of another
+    topic (battery_info) after each battery record, as a real log's other topics outnumber it."""
     template = [sample(i) for i in range(min(records, 4096))]
-    with _ulog.Writer(str(path), timestamp=1_000_000 + flight, info={"sys_name": "bench", "sys_uuid": tag}) as w:
+    other = BatteryInfo(timestamp=0, id=1)
+    with _ulog.Writer(
+        str(path), timestamp=1_000_000 + flight, info={"sys_name": "bench", "sys_uuid": tag},
+        messages=(BatteryStatus, BatteryInfo),
+    ) as w:  # fmt: skip
         for i in range(records):
             msg = template[i % len(template)]
             msg.timestamp = 1_000_000 + 5_000 * i
             w.write(msg, multi_id=i & 1)
+            for j in range(others):
+                other.timestamp = msg.timestamp + j
+                w.write(other)
 
 
 def hand_path(path: str, out: Path) -> int:
@@ -162,13 +172,17 @@ def run(records: int, logs: int, per_log: int, dask: bool) -> dict[str, float]:
         synthetic = tmp / "synthetic.ulg"
         write_log(synthetic, records, "bench")
         single_log(synthetic, tmp, "synthetic", r)
+        mixed = tmp / "mixed.ulg"  # one battery record in twenty, as in a flight log's many topics
+        write_log(mixed, records // 20, "bench", others=19)
+        single_log(mixed, tmp, "mixed", r)
         for log in sorted(REAL_LOGS.glob("*.ulg")):
             single_log(log, tmp, log.stem, r)
     return r
 
 
 def report(r: dict[str, float]) -> None:
-    print("ULog -> Parquet, battery records per CPU second (one process, best of the repeats):")
+    walk = "compiled C walk" if compiled() else "generated Python walk (the C extension was not built)"
+    print(f"ULog -> Parquet, battery records per CPU second (one process, best of the repeats; {walk}):")
     for key in [k.removesuffix("_records") for k in r if k.endswith("_records") and not k.startswith("fleet")]:
         ours, hand = r[f"{key}_ours_rps"], r[f"{key}_hand_rps"]
         print(

@@ -19,7 +19,7 @@ def test_bench_fleet_runs(capsys: pytest.CaptureFixture[str]) -> None:
         results = module.main(["--records", "2000", "--logs", "4", "--log-records", "50", "--repeat", "1", "--no-dask"])
     finally:
         del sys.modules["bench_fleet"]
-    assert results["synthetic_records"] == 2000
+    assert results["synthetic_records"] == 2000 and results["mixed_records"] == 100
     assert results["jobs_rows"] == 4 * 50 == results["fleet_records"]
     assert results["duckdb_flights_rows"] == 8
     out = capsys.readouterr().out

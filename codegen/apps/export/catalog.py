@@ -29,6 +29,13 @@ class SourceMapping:
     message: Message
     rules: tuple[Rule, ...]
 
+    @functools.cached_property
+    def fields(self) -> frozenset[str]:
+        """Every field of the message a rule reads (sources, and a cells rule's count field)."""
+        out = {s.field for rule in self.rules for s in rule.sources if s.message == self.message.qualified_name}
+        out |= {f for rule in self.rules if (f := getattr(rule.op, "count_field", None)) is not None}
+        return frozenset(out)
+
     def sources_of(self, concept: str) -> tuple[str, ...]:
         """The fields of the message a concept is read from."""
         out: list[str] = []

@@ -63,8 +63,13 @@ def _is_nan(value: object) -> bool:
 
 def _not_marker(x: NDArray, mark: float | int) -> NDArray:
     if _is_nan(mark):
-        return np.asarray(x == x)
+        return ~np.isnan(x) if x.dtype.kind in "fc" else np.asarray(x == x)
     return np.asarray(x != mark)
+
+
+def _and(a: NDArray | None, b: NDArray) -> NDArray:
+    """``a & b`` where ``a`` None means everywhere."""
+    return b if a is None else a & b
 
 
 def leading_lengths(matrix: NDArray, mark: float | int | None) -> NDArray:
@@ -73,7 +78,8 @@ def leading_lengths(matrix: NDArray, mark: float | int | None) -> NDArray:
     if mark is None or width == 0:
         return np.full(matrix.shape[0], width, np.int64)
     hit = ~_not_marker(matrix, mark)
-    return np.where(hit.any(axis=1), hit.argmax(axis=1), width).astype(np.int64)
+    first = hit.argmax(axis=1)  # the first hit, or 0 where there is none
+    return np.where(hit[np.arange(len(first)), first], first, width).astype(np.int64)
 
 
 class ColumnConverter(OpVisitor[None]):
@@ -107,10 +113,12 @@ class ColumnConverter(OpVisitor[None]):
                 out.append(m)
         return out
 
-    def known(self, x: NDArray, marks: list[float | int]) -> NDArray:
-        ok = np.ones(self.n, bool)
+    def known(self, x: NDArray, marks: list[float | int]) -> NDArray | None:
+        """Where ``x`` is none of ``marks`` (None: everywhere)."""
+        ok: NDArray | None = None
         for m in marks:
-            ok &= _not_marker(x, m)
+            hit = _not_marker(x, m)
+            ok = hit if ok is None else ok & hit
         return ok
 
     def constant(self, value: Value | None, refs: tuple[FieldRef, ...]) -> object:
@@ -144,9 +152,9 @@ class ColumnConverter(OpVisitor[None]):
             raise NotColumnar(f"{rule.location}: scale of the list field {f.name} (devicetree) is not columnar")
         ok = self.known(x, self.markers(f, op.unknown))
         if op.valid_above is not None:
-            ok &= x > op.valid_above
+            ok = _and(ok, x > op.valid_above)
         if op.valid_max is not None:
-            ok &= x <= op.valid_max
+            ok = _and(ok, x <= op.valid_max)
         named = units.lookup(op.unit) if op.unit is not None else None
         mul, add = _factor(f.unit or named or con.concept.unit, con.concept.unit)
         if op.negate:  # the field counts the other way; + 0.0 keeps a zero from reading -0.0
@@ -192,10 +200,10 @@ class ColumnConverter(OpVisitor[None]):
         by_energy = (e == e) & (full_v == full_v) & (e > 0) & (full_v > 0)
         ok = self.known(p, self.markers(f, op.unknown))
         if op.valid_max is not None:
-            ok &= p <= op.valid_max
+            ok = _and(ok, p <= op.valid_max)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.minimum(e / np.where(by_energy, full_v, 1.0), 1.0)
-        con.set(_affine(p, *_factor(f.unit, con.concept.unit)), ok & ~by_energy)
+        con.set(_affine(p, *_factor(f.unit, con.concept.unit)), _and(ok, ~by_energy))
         con.set(ratio, by_energy)
 
     # -- bits and choices ----------------------------------------------------------------------
@@ -245,11 +253,16 @@ class ColumnConverter(OpVisitor[None]):
             count = self.columns[op.count_field].astype(np.int64)
             room = m.shape[1] if given is None else given
             lengths = np.where(count != 0, np.minimum(count, room), lengths)
-        values = np.array(_affine(m, *_factor(f.unit or con.concept.unit, con.concept.unit)), dtype=np.float64)
-        unknown = np.arange(m.shape[1]) >= lengths[:, None]
-        if mark is not None:
-            unknown |= ~_not_marker(m, mark)
-        values[unknown] = np.nan
+        mul, add = _factor(f.unit or con.concept.unit, con.concept.unit)
+        values = _affine(m, mul, add)
+        if values is m:  # a float64 field as it is: the NaNs below must not write into the log's columns
+            values = values.copy()
+        if len(lengths) and bool((lengths == lengths[0]).all()):  # every pack as long (the usual)
+            values[:, int(lengths[0]) :] = np.nan
+        else:
+            np.copyto(values, np.nan, where=np.arange(m.shape[1]) >= lengths[:, None])
+        if mark is not None and not _is_nan(mark):  # a NaN marker is NaN in the values already
+            np.copyto(values, np.nan, where=~_not_marker(m, mark))
         con.set_list(values, lengths, lengths > 0)
 
     def visit_mavlink_voltages(self, rule: Rule, op: o.MavlinkVoltages) -> None:

@@ -53,10 +53,7 @@ class ConceptColumn:
             self.values[...] = values
             self.valid[...] = True
             return
-        if np.ndim(values) == 0:
-            self.values[where] = values
-        else:
-            self.values[where] = np.asarray(values)[where]
+        np.copyto(self.values, values, where=where, casting="unsafe")
         self.valid |= where
 
     def set_list(self, values: NDArray, lengths: NDArray, where: NDArray) -> None:

@@ -9,22 +9,22 @@ is reported in its :class:`LogResult` and the run goes on.
 from __future__ import annotations
 
 import concurrent.futures
+import mmap
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import pyarrow as pa
 import pyarrow.compute as pc
 
 from ...errors import BattgenError
 from .catalog import bundled_catalog
 from .columnar import convert_columns
 from .dataflash_batches import dataflash_raw_tables
-from .dataset import claim_layout, exported_manifest, is_exported, partition_of, raw_table, write_log
+from .dataset import LogWriter, claim_layout, exported_manifest, is_exported, partition_of, raw_table
 from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, battery_numbers, replay_tables
 from .readers import read_log
-from .sources import content_id, export_kind
+from .sources import Batch, content_id, export_kind, map_file
 from .table import battery_schema, battery_table
 from .views import write_views
 
@@ -56,20 +56,25 @@ class LogResult:
 def export_one(path: str, options: ExportOptions) -> LogResult:
     """Export one log into the dataset at ``options.out``; never raises for a bad log."""
     file = Path(path)
+    source = map_file(file)  # a ULog is hashed and read through one memory map
     try:
-        log = content_id(file)
-    except OSError as exc:
-        return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
-    if is_exported(options.out, log) and not _replay_missing(options, log):
-        return LogResult(path, "skipped", log, notes=("already in the dataset",))
-    try:
-        return _export(file, path, log, options)
-    except BattgenError as exc:
-        return LogResult(path, "failed", log, error=str(exc))
-    except (OSError, ValueError, MemoryError) as exc:  # a log the readers did not foresee
-        if isinstance(exc, OSError) and is_exported(options.out, log):  # the same content, exported meanwhile
-            return LogResult(path, "skipped", log, notes=("the same content was exported by another task",))
-        return LogResult(path, "failed", log, error=f"{path}: cannot export: {type(exc).__name__}: {exc}")
+        try:
+            log = content_id(file, source)
+        except OSError as exc:
+            return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
+        if is_exported(options.out, log) and not _replay_missing(options, log):
+            return LogResult(path, "skipped", log, notes=("already in the dataset",))
+        try:
+            return _export(file, path, log, options, source)
+        except BattgenError as exc:
+            return LogResult(path, "failed", log, error=str(exc))
+        except (OSError, ValueError, MemoryError) as exc:  # a log the readers did not foresee
+            if isinstance(exc, OSError) and is_exported(options.out, log):  # the same content, exported meanwhile
+                return LogResult(path, "skipped", log, notes=("the same content was exported by another task",))
+            return LogResult(path, "failed", log, error=f"{path}: cannot export: {type(exc).__name__}: {exc}")
+    finally:
+        if source is not None and not source.closed:
+            source.close()
 
 
 def _replay_missing(options: ExportOptions, log: str) -> bool:
@@ -80,34 +85,47 @@ def _replay_missing(options: ExportOptions, log: str) -> bool:
     return manifest is None or manifest.get("failsafe") != options.failsafe.key
 
 
-def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResult:
+def _export(file: Path, name: str, log: str, options: ExportOptions, source: mmap.mmap | None) -> LogResult:
+    """The batches stream through: each converted, its rows written, and let go (a log of any length
+    in flat memory); the failsafe replay keeps what it needs of each (its context, not its columns)."""
     catalog = bundled_catalog()
     schema = battery_schema(catalog)
-    batches = read_log(file, name, catalog, options.message)
-    tables = []
-    raws: dict[str, list[object]] = {}
+    writer = LogWriter(options.out, log, schema)
     notes: list[str] = []
-    for batch in batches:
-        columns = batch.concepts
-        if columns is None:
-            columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)
-        tables.append(battery_table(catalog, schema, columns, batch, log, file.name))
-        if options.raw and batch.message in catalog.sources:
-            raws.setdefault(batch.message, []).append(raw_table(catalog.schema.message(batch.message), batch, log))
-        notes.extend(batch.notes)
-    table = pa.concat_tables(tables) if tables else schema.empty_table()
-    if not table.num_rows:
+    messages: set[str] = set()
+    seen: list[Batch] = []  # each batch's context, for the replay
+    firsts: list[int | None] = []  # each batch's first battery number, for the replay
+    first_time: Any = None  # the log's first time of day (UTC), which names its day partition
+    try:
+        for batch in read_log(file, name, catalog, options.message, source, all_fields=options.raw):
+            columns = batch.concepts
+            if columns is None:
+                columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)
+            table = battery_table(catalog, schema, columns, batch, log, file.name)
+            writer.add(table)
+            if options.raw and batch.message in catalog.sources:
+                writer.add_raw(batch.message, raw_table(catalog.schema.message(batch.message), batch, log))
+            messages.add(batch.message)
+            notes.extend(n for n in batch.notes if n not in notes)
+            first = pc.min(table["time"]).as_py() if table.num_rows else None
+            first_time = first if first_time is None or (first is not None and first < first_time) else first_time
+            if options.failsafe is not None:
+                firsts.append(table["battery"][0].as_py() if table.num_rows else None)
+                batch.columns, batch.concepts = {}, None
+                seen.append(batch)
+        if options.raw and export_kind(file) == "dataflash":
+            for message, raw in dataflash_raw_tables(file, name, log):
+                writer.add_raw(message, raw)
+    except BaseException:
+        writer.abort()
+        raise
+    if not writer.rows:
         notes.append("no battery records")
-    raw_tables = [(m, pa.concat_tables(ts)) for m, ts in sorted(raws.items())]
-    if options.raw and export_kind(file) == "dataflash":
-        raw_tables.extend(dataflash_raw_tables(file, name, log))
     extra: list[tuple[str, dict[str, Any]]] = []
     if options.failsafe is not None:
-        numbers = battery_numbers(
-            export_kind(file), batches, [t["battery"][0].as_py() if t.num_rows else None for t in tables]
-        )
+        numbers = battery_numbers(export_kind(file), seen, firsts)
         try:
-            replayed = replay_tables(file, name, export_kind(file), log, options.failsafe, batches, numbers)
+            replayed = replay_tables(file, name, export_kind(file), log, options.failsafe, seen, numbers)
         except BattgenError as exc:
             replayed = f"failsafe not replayed: {exc}"
         if isinstance(replayed, str):
@@ -117,22 +135,16 @@ def _export(file: Path, name: str, log: str, options: ExportOptions) -> LogResul
     manifest: dict[str, object] = {
         "log": log,
         "source": file.name,
-        "rows": table.num_rows,
-        "messages": sorted({b.message for b in batches}),
+        "rows": writer.rows,
+        "messages": sorted(messages),
         "notes": notes,
     }
     if options.failsafe is not None:
         manifest["failsafe"] = options.failsafe.key
-    where = partition_of(options.partition, log, day_of(table))
+    where = partition_of(options.partition, log, None if first_time is None else str(first_time.date()))
     manifest["partition"] = where
-    write_log(options.out, log, table, raw_tables, manifest, extra, where)
-    return LogResult(name, "exported", log, table.num_rows, notes=tuple(notes))
-
-
-def day_of(table: Any) -> str | None:
-    """The UTC day (YYYY-MM-DD) of a log's first record with a time of day; None if none has one."""
-    first = pc.min(table["time"]).as_py() if table.num_rows else None
-    return None if first is None else str(first.date())
+    writer.commit(manifest, extra, where)
+    return LogResult(name, "exported", log, writer.rows, notes=tuple(notes))
 
 
 def export_logs(

@@ -11,7 +11,8 @@ and JSON Lines (.jsonl/.ndjson) read record by record through the shared readers
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Sequence
+import mmap
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
@@ -54,13 +55,32 @@ class Batch:
     notes: list[str] = field(default_factory=list)
 
 
-def content_id(path: Path) -> str:
-    """The stable id of a file's content: the first hex digits of its SHA-256."""
+def content_id(path: Path, source: mmap.mmap | None = None) -> str:
+    """The stable id of a file's content: the first hex digits of its SHA-256 (``sha256sum``'s).
+    With ``source``, a memory map of the file, the hash reads the map: the pages the reader will
+    use are mapped once."""
+    if source is not None:
+        return hashlib.sha256(source).hexdigest()[:ID_DIGITS]
     digest = hashlib.sha256()
     with path.open("rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()[:ID_DIGITS]
+
+
+def map_file(path: Path) -> mmap.mmap | None:
+    """A read-only memory map of a ULog file, for hashing and reading it in one pass (None for
+    other kinds, and where a file cannot be mapped: empty, a pipe...)."""
+    if path.suffix.lower() != ".ulg":
+        return None
+    # MAP_POPULATE (Linux): the whole file is mapped in one call rather than a page fault per 4 KiB
+    # (measured: 0.015 s against 0.15 s for 171 MB).
+    flags = mmap.MAP_SHARED | getattr(mmap, "MAP_POPULATE", 0)
+    try:
+        with path.open("rb") as f:
+            return mmap.mmap(f.fileno(), 0, flags=flags, prot=mmap.PROT_READ)
+    except (OSError, ValueError):
+        return None
 
 
 def export_kind(path: Path) -> str:
@@ -80,29 +100,46 @@ def model_of(catalog: Catalog, qualified: str) -> MessageClass:
 
 def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
     """Every battery batch of one log. Raises InputError (or another BattgenError) if unreadable."""
+    return list(iter_batches(path, name, catalog, message))
+
+
+def iter_batches(
+    path: Path,
+    name: str,
+    catalog: Catalog,
+    message: str | None = None,
+    source: mmap.mmap | None = None,
+    all_fields: bool = True,
+) -> Iterator[Batch]:
+    """The battery batches of one log, one at a time (a ULog's in chunks: memory stays flat);
+    ``source`` is a memory map of a ULog file the caller holds (the log closes it). Without
+    ``all_fields`` a ULog batch holds only the fields the mapping reads (and the timestamp)."""
     kind = export_kind(path)
     if kind == "ulog":
-        return _ulog_batches(path, name, catalog)
-    if kind == "tlog":
-        return _tlog_batches(path, name, catalog)
-    if kind in ("dataflash", "can"):
+        yield from _ulog_batches(path, name, catalog, source, all_fields)
+    elif kind == "tlog":
+        yield from _tlog_batches(path, name, catalog)
+    elif kind in ("dataflash", "can"):
         raise InputError(name, 0, f"{kind} logs are read by codegen.apps.export.readers")
-    return _jsonl_batches(path, name, catalog, message)
+    else:
+        yield from _jsonl_batches(path, name, catalog, message)
 
 
 # -- ULog ------------------------------------------------------------------------------------------
 
 
-def _ulog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
+def _ulog_batches(
+    path: Path, name: str, catalog: Catalog, source: mmap.mmap | None, all_fields: bool
+) -> Iterator[Batch]:
     model = model_of(catalog, "uorb.BatteryStatus")
+    fields = None if all_fields else catalog.source(model.QUALIFIED_NAME).fields
     if not isinstance(model, UorbClass):
         raise BattgenError("the generated uorb.BatteryStatus has no ULog support: run 'battgen generate'")
-    out: list[Batch] = []
-    with UlogColumns(path, name, model) as log:
+    with UlogColumns(path, name, model, source) as log:
         start = log.start_us
         offset = log.utc_offset_us()
         armed = log.armed()
-        for inst in log.instances():
+        for inst in log.instances(fields=fields):
             stamps = inst.timestamps
             t = (stamps.astype(np.int64) - start) / 1e6 if stamps is not None else np.full(inst.n, np.nan)
             batch = Batch(model.QUALIFIED_NAME, inst.n, inst.columns, t, np.full(inst.n, inst.multi_id))
@@ -113,8 +150,7 @@ def _ulog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
                 batch.vehicle = log.vehicle
             if stamps is not None and armed is not None:
                 batch.armed = as_of(armed[0], armed[1], stamps)
-            out.append(batch)
-    return out
+            yield batch
 
 
 def as_of(times: NDArray, values: NDArray, at: NDArray) -> NDArray:

@@ -106,7 +106,8 @@ __all__ = [
 
 T = TypeVar("T")
 
-Source = str | os.PathLike[str] | bytes | bytearray | memoryview | BinaryIO
+Source = str | os.PathLike[str] | bytes | bytearray | memoryview | mmap.mmap | BinaryIO
+_MAP = mmap.mmap  # read() has a parameter named mmap
 
 
 class Record(NamedTuple, Generic[T]):
@@ -327,7 +328,8 @@ def _default_topic(cls: type[Any]) -> str:
 
 
 def read(source: Source, *, mmap: bool = True, index: bool = True, warn: bool = True) -> Log:
-    """Read a ULog file: a path (memory-mapped unless ``mmap`` is False), bytes or a binary file.
+    """Read a ULog file: a path (memory-mapped unless ``mmap`` is False), bytes, a memory map (used
+    as it is, and closed with the log) or a binary file.
 
     With ``index`` (the default) the data section is walked at once and every record's offset
     kept; without, only the header and definitions are read, and the data section is walked by
@@ -337,6 +339,8 @@ def read(source: Source, *, mmap: bool = True, index: bool = True, warn: bool = 
     """
     if isinstance(source, bytes):
         data: Buffer = source
+    elif isinstance(source, _MAP):  # shared with the caller (who hashed it, say): no copy
+        data = source
     elif isinstance(source, bytearray | memoryview):
         data = bytes(source)
     elif isinstance(source, str | os.PathLike):
