@@ -9,7 +9,8 @@ from typing import Any
 import pytest
 from pymavlink.generator import mavparse
 
-from codegen.errors import SchemaError
+from codegen.cli.main import main
+from codegen.errors import ErrorList, SchemaError
 from codegen.frontends import mavlink
 from codegen.ir import ArrayType, EnumKind, PrimitiveKind, PrimitiveType, Range, Schema, Sentinel, StringType
 
@@ -460,3 +461,38 @@ def test_positional_invalid_in_generated_code(tmp_path: Path, import_generated: 
     assert m.is_known("a") and not m.is_known("b")
     m.b = [-5, 8]
     assert m.is_known("b")
+
+
+# ------------------------------------------------------------------------------------------
+# A folder reports every bad file in one run
+
+
+def test_a_folder_reports_every_bad_file_at_once(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Bad files do not hide each other: a missing include, a file pymavlink rejects, a bad invalid=, a bad
+    message beside a good one (which still builds, and clashes with a later file) all come in one report;
+    a bad file read twice (c_uses_broken.xml includes it) is reported once."""
+    folder = tmp_path / "mavlink"  # a schema folder's MAVLink part, so the command line reads it too
+    folder.mkdir()
+    write(folder, "a_missing.xml", "<include>nowhere.xml</include>\n" + message(fld("uint8_t", "x"), msg_id=1))
+    write(folder, "b_broken.xml", message(fld("uint8_t", "x") + "<field>", name="B", msg_id=2))
+    write(folder, "c_uses_broken.xml", "<include>b_broken.xml</include>\n" + message(fld("uint8_t", "x"), name="C"))
+    write(folder, "d_invalid.xml", message(fld("uint8_t", "x", ' invalid="[300]"'), name="D", msg_id=4))
+    bad_first = message(fld("uint8_t", "x", ' invalid="UNKNOWN_NAME"'), name="E", msg_id=5)
+    write(folder, "e_two.xml", bad_first.replace("</messages>", "") + message(fld("uint8_t", "y"), name="F", msg_id=7)
+          .replace("<messages>\n", ""))  # fmt: skip
+    write(folder, "f_clash.xml", message(fld("uint8_t", "x"), name="F", msg_id=8))
+    with pytest.raises(ErrorList) as caught:
+        mavlink.parse_dir(folder)
+    lines = [str(e) for e in caught.value.errors]
+    files = [line.split(":", 1)[0] for line in lines]
+    assert files.count("b_broken.xml") == 1  # read once, though c_uses_broken.xml includes it
+    assert {"a_missing.xml", "b_broken.xml", "d_invalid.xml", "e_two.xml", "f_clash.xml"} == set(files), lines
+    assert any("nowhere.xml" in line for line in lines)
+    assert any(line.startswith("e_two.xml") and "UNKNOWN_NAME" in line for line in lines)
+    assert any(line.startswith("f_clash.xml") and "clashes with F at e_two.xml" in line for line in lines)
+    assert len(lines) == 5, lines
+    assert str(caught.value).endswith(f"{len(lines)} errors")
+    # the command line prints them all and exits 2
+    assert main(["list", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert all(line.split(": ", 1)[1][:50] in err for line in lines), err

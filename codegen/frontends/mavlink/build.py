@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ...errors import SchemaError
+from ...errors import ErrorCollector, SchemaError
 from ...ir import (
     ArrayType,
     EnumDef,
@@ -269,18 +269,24 @@ def build(files: Sequence[LoadedFile]) -> Schema:
     enums = _merge_enums(files)
     messages: dict[str, Message] = {}
     by_id: dict[int, Message] = {}
+    found = ErrorCollector()  # every bad message of every file in one report
     for lf in files:
-        for ours, theirs in _paired(lf.display, lf.scan.messages, lf.mavxml.message):
-            clash = messages.get(PREFIX + ours.name) or by_id.get(ours.msg_id)
-            if clash is not None:
-                raise SchemaError(
-                    lf.display,
-                    ours.line,
-                    f"expected unique message names and ids; {ours.name} "
-                    f"(id {ours.msg_id}) clashes with {clash.name} at {clash.location}",
-                )
-            message = _message(lf, ours, theirs, enums)
-            messages[message.qualified_name] = by_id[ours.msg_id] = message
+        pairs: list[tuple[Any, Any]] = []
+        with found.step():
+            pairs = list(_paired(lf.display, lf.scan.messages, lf.mavxml.message))
+        for ours, theirs in pairs:
+            with found.step():
+                clash = messages.get(PREFIX + ours.name) or by_id.get(ours.msg_id)
+                if clash is not None:
+                    raise SchemaError(
+                        lf.display,
+                        ours.line,
+                        f"expected unique message names and ids; {ours.name} "
+                        f"(id {ours.msg_id}) clashes with {clash.name} at {clash.location}",
+                    )
+                message = _message(lf, ours, theirs, enums)
+                messages[message.qualified_name] = by_id[ours.msg_id] = message
+    found.raise_if_any()
     bitmask_refs = {
         f.enums[0][len(PREFIX) :]
         for m in messages.values()

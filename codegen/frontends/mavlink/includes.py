@@ -7,6 +7,10 @@ SchemaError. Includes resolve relative to the including file, then in each folde
 search path (``--include-path``); a file outside the schema folder and the search path is refused
 (an include may not read /etc/passwd or wander up with ``../``). Cycles and missing or refused files
 are errors at the <include> line.
+
+A folder (or several files) is read whole even when files in it are bad: every file's errors come in
+one report (an ErrorList), a file that includes a bad file reporting its own errors too; a bad file
+included from several places is reported once.
 """
 
 from __future__ import annotations
@@ -19,20 +23,24 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from ...errors import SchemaError
+from ...errors import BattgenError, ErrorCollector, SchemaError
 from ...text.files import display_path, is_file
 from ...text.xml import read_xml
 from .build import LoadedFile
 from .scan import scan
 
 
-def read_dialects(paths: list[Path], root: Path | None, include_paths: Sequence[Path] = ()) -> list[LoadedFile]:
+def read_dialects(
+    paths: list[Path], root: Path | None, include_paths: Sequence[Path] = (), errors: ErrorCollector | None = None
+) -> list[LoadedFile]:
     """The files named and every file they include, included files before their includer.
 
     Includes must stay inside ``root`` (for single files without a root: the folder of each file
     named) or one of ``include_paths``, which are also searched for includes not found beside the
-    including file.
+    including file. The errors of every bad file are raised together, or with ``errors`` collected
+    there while the files that read are returned.
     """
+    found = errors if errors is not None else ErrorCollector()  # every bad file of the run, not the first
     with tempfile.TemporaryDirectory(prefix="battgen-mavlink-") as tmp:
         reader = _Reader(root, Path(tmp), tuple(include_paths))
         for path in paths:
@@ -40,7 +48,10 @@ def read_dialects(paths: list[Path], root: Path | None, include_paths: Sequence[
                 (root if root is not None else path.parent).resolve(),
                 *(p.resolve() for p in include_paths),
             )
-            reader.load(path)
+            with found.step():
+                reader.load(path)
+    if errors is None:
+        found.raise_if_any()
     return list(reader.files.values())
 
 
@@ -71,24 +82,40 @@ class _Reader:
         self.include_paths = include_paths
         self.allowed: tuple[Path, ...] = ()  # the folders includes may read from
         self.files: dict[Path, LoadedFile] = {}  # included files before their includer
+        self.failed: dict[Path, BattgenError] = {}  # bad files, each read (and reported) once
 
     def load(self, path: Path, chain: tuple[Path, ...] = ()) -> None:
         key = path.resolve()
         if key in self.files:
             return
+        if key in self.failed:
+            raise self.failed[key]
+        try:
+            self.files[key] = self._read(path, (*chain, key))
+        except BattgenError as exc:
+            self.failed[key] = exc
+            raise
+
+    def _read(self, path: Path, chain: tuple[Path, ...]) -> LoadedFile:
+        """One file, after everything it includes; its includes' errors and its own in one report."""
         display = display_path(path, self.root)
         data = read_xml(path, display)
         scanned = scan(data, display)
-        chain += (key,)
+        found = ErrorCollector()
         for text, line in scanned.includes:
-            included = self._resolve(path, text, display, line)
-            if included.resolve() in chain:
-                raise SchemaError(
-                    display, line, f"expected an include that does not lead back here; {text} closes an include cycle"
-                )
-            self.load(included, chain)
-        mavxml = _mavparse(data, path.name, display, self.workdir)
-        self.files[key] = LoadedFile(path, display, scanned, mavxml)
+            with found.step():
+                included = self._resolve(path, text, display, line)
+                if included.resolve() in chain:
+                    raise SchemaError(
+                        display,
+                        line,
+                        f"expected an include that does not lead back here; {text} closes an include cycle",
+                    )
+                self.load(included, chain)
+        with found.step():
+            mavxml = _mavparse(data, path.name, display, self.workdir)
+        found.raise_if_any()
+        return LoadedFile(path, display, scanned, mavxml)
 
     def _resolve(self, path: Path, text: str, display: str, line: int) -> Path:
         """The file an <include> names: beside the including file, else in the search path; inside
