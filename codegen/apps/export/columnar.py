@@ -23,7 +23,7 @@ from ...ir import ops as o
 from ...ir.mapping_values import ConstantRef, Number, Value
 from ...ir.mapping_visitor import OpVisitor, visit
 from .catalog import Catalog, SourceMapping
-from .columns import ConceptColumn, NDArray, empty_columns, length_key
+from .columns import ConceptColumn, LazyColumns, NDArray, length_key
 
 
 class NotColumnar(BattgenError):
@@ -38,7 +38,7 @@ def convert_columns(
     converter = ColumnConverter(catalog, source, columns, n)
     for rule in source.rules:
         visit(rule, converter)
-    return converter.out
+    return converter.out.done()
 
 
 def _factor(frm: Unit | None, to: Unit | None) -> tuple[float, float]:
@@ -90,7 +90,7 @@ class ColumnConverter(OpVisitor[None]):
         self.source = source
         self.columns = columns
         self.n = n
-        self.out = empty_columns(catalog.concepts, n)
+        self.out = LazyColumns(catalog.concepts, n)
 
     # -- facts ---------------------------------------------------------------------------------
 
