@@ -55,6 +55,7 @@ class WalkLog(Protocol):
     """The parts of the generated ``_ulog.Log`` a walk of its data section uses and updates."""
 
     data: Any
+    walked: bool
     indexed: bool
     _segments: list[tuple[int, int]]
     _streams: dict[StreamKey, _Stream]
@@ -82,14 +83,19 @@ def record_offsets(log: Any, *, use_compiled: bool | None = None) -> dict[Stream
     typed = cast(WalkLog, log)
     if _scan is None or use_compiled is False or typed.indexed:
         return {k: np.asarray(s.offsets, np.int64) for k, s in typed._index().items() if s.offsets}
-    walk = typed._fresh()
+    # A log not walked yet holds its definitions section's state: walk it in place (copying that
+    # state, parameters and all, cost a real log some milliseconds); else walk a fresh copy.
+    walk = typed if not typed.walked else typed._fresh()
     found: dict[StreamKey, list[NDArray]] = {}
     try:
         for start, stop in walk._segments:
             _walk_segment(walk, start, stop, found)
-    except _Fallback:  # a damaged log: the generated walker, whose warnings come in its order
+    except _Fallback:  # a damaged log: the generated walker (from the definitions), whose warnings come in its order
         return record_offsets(log, use_compiled=False)
-    typed._adopt(walk, indexed=False)
+    if walk is typed:
+        typed.walked = True
+    else:
+        typed._adopt(walk, indexed=False)
     return {k: parts[0] if len(parts) == 1 else np.concatenate(parts) for k, parts in found.items()}
 
 

@@ -67,6 +67,30 @@ def _round_trip(obj: Any, encode: Callable[[Any], bytes], decode: Callable[[byte
     assert again == obj, (obj, again)
 
 
+@functools.cache
+def _pydronecan_type(qualified: str) -> Any:
+    """pydronecan's type of the same DSDL name (None where the ``dronecan`` package has none)."""
+    try:
+        import dronecan
+    except ImportError:
+        return None
+    return dronecan.TYPENAMES.get(qualified.removeprefix("dronecan."))
+
+
+def _as_pydronecan_re_encodes(cls: Any, data: bytes, tao: bool, obj: Any) -> None:
+    """pydronecan reads what we decoded and writes it back; decoding that gives our values again (NaN
+    payloads aside: pydronecan keeps the bits it read, so bytes are compared through our decoder)."""
+    ref_type = _pydronecan_type(cls.QUALIFIED_NAME)
+    if ref_type is None:
+        return
+    from dronecan import transport
+
+    ref = transport.CompoundValue(ref_type, _mode=None)
+    ref._unpack(transport.bits_from_bytes(data), tao)
+    again = bytes(transport.bytes_from_bits(ref._pack(tao)))
+    assert cls.decode(again, tao=tao) == obj, (cls.QUALIFIED_NAME, tao, data.hex(), again.hex())
+
+
 def decode_dronecan(data: bytes) -> None:
     for cls in DRONECAN:
         for tao in (True, False):
@@ -75,6 +99,7 @@ def decode_dronecan(data: bytes) -> None:
             except ValueError:  # DecodeError
                 continue
             _round_trip(obj, lambda o, t=tao: o.encode(tao=t), lambda b, c=cls, t=tao: c.decode(b, tao=t))
+            _as_pydronecan_re_encodes(cls, data, tao, obj)
 
 
 def decode_uorb(data: bytes) -> None:

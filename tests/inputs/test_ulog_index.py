@@ -56,6 +56,9 @@ def _compare(data: bytes) -> None:
         assert got[key].tolist() == offsets, key
     assert _state(log) == _state(reference)
     assert log.topics() == reference.topics()
+    again = ulog_index.record_offsets(log)  # a log walked already: walked afresh, the same again
+    assert {k: v.tolist() for k, v in again.items()} == {k: v.tolist() for k, v in got.items()}
+    assert _state(log) == _state(reference)
 
 
 def _battery_log(records: int, extra_topic: bool = True) -> bytes:
