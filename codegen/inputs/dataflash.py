@@ -246,6 +246,41 @@ def flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord]:
             yield item
 
 
+def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord | GpsClock]:
+    """As :func:`flight_records`, with every GPS record that tells the time (:class:`GpsClock`), in
+    the same pass."""
+    for msg in log.messages(BATTERY_TYPES | ARMING_TYPES | {"GPS"}):
+        if msg.type == "GPS":
+            clock = _gps_clock(msg)
+            if clock is not None:
+                yield clock
+            continue
+        item = _arming(msg) if msg.type in ARMING_TYPES else _battery(msg)
+        if item is not None:
+            yield item
+
+
+GPS_EPOCH_S = 315_964_800  # 1980-01-06 00:00 UTC, the start of GPS week 0, in Unix time
+GPS_LEAP_S = 18  # GPS time runs ahead of UTC by the leap seconds since 1980 (18 since 2017, as pymavlink counts)
+
+
+@dataclass(frozen=True)
+class GpsClock:
+    """A GPS record's time (``GWk`` week, ``GMS`` ms of the week) against the log's ``TimeUS``:
+    ``utc_us - time_us`` turns the log's clock into µs since the Unix epoch (UTC)."""
+
+    time_us: int
+    utc_us: int
+
+
+def _gps_clock(msg: DataflashMessage) -> GpsClock | None:
+    """The clock of a GPS record that has a week (pymavlink's DFReader takes the first with ``GWk`` > 0)."""
+    week, ms = _number(msg.fields, "GWk"), _number(msg.fields, "GMS")
+    if msg.time_us is None or week is None or ms is None or week <= 0:
+        return None
+    return GpsClock(msg.time_us, (GPS_EPOCH_S + int(week) * 604_800 - GPS_LEAP_S) * 1_000_000 + int(ms) * 1000)
+
+
 def battery_records(log: DataflashLog) -> Iterator[BatteryRecord]:
     """Every battery reading of the log (all instances), in file order."""
     for msg in log.messages(BATTERY_TYPES):

@@ -146,6 +146,12 @@ def test_battery_info_with_aux_and_cbat_per_node(
         assert row["full_capacity"] == pytest.approx(16000 * 3.6)  # mAh -> C
     times = [r["t"] for r in _rows(out, "battery = 0")]  # seconds since the first frame, at a transfer's first
     assert times == pytest.approx([t for n, m, t in decoded if n == 10 and _type(m).endswith("BatteryInfo")], abs=2e-6)
+    stamps = [r["time"] for r in _rows(out, "battery = 0")]
+    if suffix != ".asc":  # absolute stamps: candump as logged, BLF and TRC from their header's start time
+        first = START + 0.001
+        assert [s.timestamp() for s in stamps] == pytest.approx([first + t for t in times], abs=2e-5)
+    else:  # python-can's ASC reader counts from the start
+        assert stamps == [None] * len(stamps)
     flights = run_query(out, "SELECT battery, records, pack FROM flights ORDER BY battery").rows
     assert flights == [(0, CYCLES, "1010"), (1, CYCLES, "1011"), (12, CYCLES, "4242")]
 

@@ -1,5 +1,6 @@
-"""battgen export --raw on DataFlash logs: the BAT and BCL records as tables of every field the log's
-FMT records declare, compared with pymavlink's own DataFlash reader on the same file."""
+"""battgen export on DataFlash logs, against pymavlink's own DataFlash reader on the same file: --raw
+writes the BAT and BCL records as tables of every field the log's FMT records declare; the time of
+day comes from the log's GPS week and time of week, as pymavlink's clock gives it."""
 
 from __future__ import annotations
 
@@ -18,8 +19,11 @@ from dataflash_writer import DataflashWriter
 CELLS = ("V1", "V2", "V3", "V4", "V5", "V6", "V7", "V8", "V9", "V10", "V11", "V12")
 
 
-def _log(path: Path) -> Path:
+def _log(path: Path, gps: bool = False) -> Path:
     w = DataflashWriter()
+    if gps:  # a fix 0.45 s into the log: GPS week 2290, Wednesday noon (GPS time)
+        w.define("GPS", "QBIH", ("TimeUS", "Status", "GMS", "GWk"))
+        w.write("GPS", 450_000, 3, 3 * 86_400_000 + 43_200_000, 2290)
     w.define("BAT", "QBfffffffBB", ("TimeUS", "Inst", "Volt", "VoltR", "Curr", "CurrTot", "EnrgTot", "Temp", "Res",
                                     "RemPct", "H"))  # fmt: skip
     w.define("BCL", "QBfHHHHHHHHHHHH", ("TimeUS", "Instance", "Volt", *CELLS))
@@ -67,3 +71,23 @@ def test_bat_and_bcl_records_every_field_as_pymavlink_reads_them(
     # and the normalised table is unchanged by --raw
     count = con.sql(f"SELECT count(*) FROM read_parquet('{out}/battery/*/*.parquet')").fetchall()
     assert count == [(40,)]
+
+
+def test_time_of_day_from_the_gps_clock(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    log = _log(tmp_path / "gps.bin", gps=True)
+    out = tmp_path / "ds"
+    assert main(["export", "-o", str(out), str(log), "--partition", "day"]) == 0, capsys.readouterr().err
+    from pymavlink import mavutil
+
+    conn = mavutil.mavlink_connection(str(log))
+    reference = []
+    while (msg := conn.recv_match(type="BAT")) is not None:
+        reference.append(msg._timestamp)
+    assert len(reference) == 40 and reference[0] > 1.7e9  # pymavlink found the GPS clock
+    con = duckdb.connect()
+    rows = con.sql(
+        f"SELECT epoch_us(time), day FROM read_parquet('{out}/battery/*/*/*.parquet', hive_partitioning = true) "
+        "ORDER BY t, battery"
+    ).fetchall()
+    assert [us / 1e6 for us, _ in rows] == pytest.approx(reference, abs=1e-6)
+    assert {str(day) for _, day in rows} == {"2023-11-29"}  # GPS week 2290 began on Sunday 2023-11-26

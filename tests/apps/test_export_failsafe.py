@@ -127,7 +127,7 @@ def test_own_parameters_and_logs_without_any(tmp_path: Path, capsys: pytest.Capt
     assert notes["flight.tlog"] == [
         "failsafe not replayed: only a DataFlash log carries its own parameters (give --failsafe PARAMS)"
     ]
-    assert notes["b.jsonl"] == ["failsafe not replayed: a JSON Lines file is no flight log"]
+    assert notes["b.jsonl"] == ["failsafe not replayed: a JSON Lines file is no flight log battgen failsafe reads"]
 
 
 def test_incremental_runs_replay_again_only_for_new_parameters(
@@ -192,3 +192,19 @@ def test_bad_failsafe_parameters_are_clear_errors(tmp_path: Path, capsys: pytest
     assert main(["export", "-o", str(tmp_path / "ds"), log, "--failsafe", "log", "--vehicle", "boat"]) == 2
     assert "expected a vehicle among" in capsys.readouterr().err
     assert not (tmp_path / "ds").exists()
+
+
+def test_options_travel_to_workers(tmp_path: Path) -> None:
+    """The replay's parameters are read once, on the caller's side, and go to worker processes and
+    Dask workers inside the (pickled) options: no worker needs the parameter file."""
+    import pickle
+
+    from codegen.apps.export.engine import ExportOptions
+    from codegen.apps.export.failsafe_tables import failsafe_options
+
+    replay = failsafe_options(str(_params(tmp_path, PARAMS)), "rover")
+    options = ExportOptions(tmp_path / "ds", failsafe=replay, partition="day")
+    (tmp_path / "rover.param").unlink()
+    back = pickle.loads(pickle.dumps(options))
+    assert back == options and back.failsafe is not None
+    assert back.failsafe.params == PARAMS and back.failsafe.key.endswith("|vehicle=rover")

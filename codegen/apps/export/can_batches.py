@@ -8,7 +8,8 @@ CUAV's ``CBAT``. Both go through the IR mappings with the columnar converter; th
 concepts (cell voltages, cycle count, ...) fill what BatteryInfo leaves unknown, as the mapping's
 rule order has it (BatteryInfo's ``battery_id`` wins over the aux one's).
 
-``t`` is the capture's time since its first frame; a capture says nothing of the vehicle. The
+``t`` is the capture's time since its first frame, ``time`` the time of day where the capture's
+stamps are absolute (candump, BLF, TRC); a capture says nothing of the vehicle. The
 battery is the message's ``battery_id``; where two nodes report the same id (common: many smart
 batteries ship with id 0), every battery of the capture is numbered by its node id instead, and the
 log's notes say so. Transport damage (bad CRCs, lost frames) is counted in the notes; a capture
@@ -23,6 +24,7 @@ from typing import cast
 
 import numpy as np
 
+from ...inputs.can.captures import capture_start
 from ...inputs.can.records import capture_side
 from ...inputs.model import MessageClass
 from ...inputs.records import InputError, Notice, Record, Unreadable
@@ -62,6 +64,12 @@ def can_batches(path: Path, name: str, catalog: Catalog, model_of: ModelOf) -> l
         for node, records in sorted(by_node.items()):
             out.append(_batch(catalog, qualified, node, records))
     _number_batteries(out, notes)
+    start = capture_start(path, name) if out else None
+    if start is not None:  # absolute stamps: the time of day of each record
+        origin = round(start * 1e6)
+        for b in out:
+            b.utc_offset_us = origin
+            b.time_us = np.round(b.t * 1e6).astype(np.int64) + origin
     if out:
         out[0].notes.extend(notes)
     return out

@@ -5,7 +5,9 @@ DataFlash has no message schema in the IR (its layout is in each log's own FMT r
 no mapping file to apply: the four values the reader gives -- ``Volt`` V, ``Curr`` A, ``CurrTot``
 mAh, ``RemPct`` % -- become concepts here, with the factors taken from the IR's unit registry.
 A value the log lacks is unknown. ``t`` is the log's ``TimeUS`` (time since boot, when the log
-starts); ``armed`` comes from ``ARM`` / ``EV`` records.
+starts); ``armed`` comes from ``ARM`` / ``EV`` records; ``time`` (UTC) from the first ``GPS``
+record with a week (``GWk``/``GMS`` against its ``TimeUS``, as pymavlink's DataFlash reader sets
+its clock), where the log has one.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from typing import Any
 import numpy as np
 import pyarrow as pa
 
-from ...inputs.dataflash import ArmingRecord, BatteryRecord, flight_records, open_log
+from ...inputs.dataflash import ArmingRecord, BatteryRecord, GpsClock, open_log, timed_flight_records
 from ...ir.units import unit
 from .catalog import Catalog
 from .columns import ConceptColumn, NDArray, empty_columns
@@ -38,9 +40,12 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
     log = open_log(path, name)
     readings: dict[int, list[BatteryRecord]] = {}
     arming: list[ArmingRecord] = []
-    for item in flight_records(log):
+    clock: GpsClock | None = None
+    for item in timed_flight_records(log):
         if isinstance(item, ArmingRecord):
             arming.append(item)
+        elif isinstance(item, GpsClock):
+            clock = clock or item
         else:
             readings.setdefault(item.instance, []).append(item)
     arm_t = np.array([a.time_s for a in arming], np.float64)
@@ -54,6 +59,9 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
         t = np.array([r.time_s for r in rows], np.float64)
         batch = Batch(MESSAGE, n, columns, t, np.full(n, instance))
         batch.concepts = _concepts(catalog, columns, n)
+        if clock is not None:  # the log's clock against UTC, from its first GPS record with a week
+            batch.utc_offset_us = clock.utc_us - clock.time_us
+            batch.time_us = np.round(t * 1e6).astype(np.int64) + batch.utc_offset_us
         if len(arming):
             batch.armed = as_of(arm_t, arm_v, t)
         if log.skipped_notes:

@@ -132,7 +132,8 @@ def replay_tables(
     """The events and replays tables of one log, or a note saying why it was not replayed."""
     replay_kind = _KINDS.get(kind)
     if replay_kind is None:
-        return "failsafe not replayed: a JSON Lines file is no flight log"
+        what = "a CAN capture" if kind == "can" else "a JSON Lines file"
+        return f"failsafe not replayed: {what} is no flight log battgen failsafe reads"
     if options.params is None and replay_kind != "bin":
         return "failsafe not replayed: only a DataFlash log carries its own parameters (give --failsafe PARAMS)"
     replay = replay_flight(path, name, replay_kind, options.params, options.vehicle)

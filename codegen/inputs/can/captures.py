@@ -96,6 +96,30 @@ def read_capture(path: Path, name: str) -> Iterator[Frame]:
             stop()
 
 
+ABSOLUTE_AFTER_S = 946_684_800.0  # 2000-01-01: a capture stamp past it is a time of day, not time since start
+
+
+def capture_start(path: Path, name: str) -> float | None:
+    """The Unix time (s) of a capture's first frame where its reader gives absolute stamps (candump
+    logs what the kernel stamped, BLF and TRC their header's start time); None where they count from the start
+    (python-can's ASC reader) or the capture is empty."""
+    can = _python_can(name)
+    try:
+        reader = can.LogReader(str(path))
+    except (ValueError, OSError) as exc:
+        raise InputError(name, 0, f"cannot open the CAN capture: {exc}") from exc
+    try:
+        first = next(iter(reader), None)
+    except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError):
+        return None  # the frame readers report the damage
+    finally:
+        stop = getattr(reader, "stop", None)
+        if callable(stop):
+            stop()
+    stamp = float(first.timestamp or 0.0) if first is not None else 0.0
+    return stamp if stamp >= ABSOLUTE_AFTER_S else None
+
+
 def read_dataflash_frames(path: Path, name: str) -> Iterator[Frame]:
     """The CAN frames an ArduPilot DataFlash log recorded: its CANF (classic) and CAFD (CAN FD) records, laid out
     as ``libraries/AP_CANManager/LogStructure.h`` declares them (``Id`` with AP_HAL's flag bits on top; CAFD's
