@@ -81,13 +81,18 @@ def _frames_of(messages: Iterator[Any], name: str, what: str) -> Iterator[Frame]
         index += 1
 
 
-def read_capture(path: Path, name: str) -> Iterator[Frame]:
-    """The frames of a capture file read with python-can's log reader for its suffix."""
+def _log_reader(path: Path, name: str) -> Any:
+    """python-can's log reader for the capture's suffix (InputError if it cannot open it)."""
     can = _python_can(name)
     try:
-        reader = can.LogReader(str(path))
+        return can.LogReader(str(path))
     except (ValueError, OSError) as exc:
         raise InputError(name, 0, f"cannot open the CAN capture: {exc}") from exc
+
+
+def read_capture(path: Path, name: str) -> Iterator[Frame]:
+    """The frames of a capture file read with python-can's log reader for its suffix."""
+    reader = _log_reader(path, name)
     try:
         yield from _frames_of(iter(reader), name, "the CAN capture")
     finally:
@@ -103,11 +108,7 @@ def capture_start(path: Path, name: str) -> float | None:
     """The Unix time (s) of a capture's first frame where its reader gives absolute stamps (candump
     logs what the kernel stamped, BLF and TRC their header's start time); None where they count from the start
     (python-can's ASC reader) or the capture is empty."""
-    can = _python_can(name)
-    try:
-        reader = can.LogReader(str(path))
-    except (ValueError, OSError) as exc:
-        raise InputError(name, 0, f"cannot open the CAN capture: {exc}") from exc
+    reader = _log_reader(path, name)
     try:
         first = next(iter(reader), None)
     except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError):
