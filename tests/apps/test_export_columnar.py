@@ -17,7 +17,8 @@ from hypothesis import strategies as st
 from codegen.apps.export.catalog import bundled_catalog
 from codegen.apps.export.columnar import NotColumnar, convert_columns
 from codegen.apps.export.per_record import concept_converter, states_to_columns
-from codegen.apps.export.sources import instances_to_columns, read_batches
+from codegen.apps.export.readers import read_batches
+from codegen.apps.export.sources import instances_to_columns
 from codegen.apps.export.table import concept_array
 from codegen.apps.package import bundled_package, model_class
 from codegen.inputs.model import UorbClass

@@ -10,7 +10,12 @@ from pathlib import Path
 from .can_batches import can_batches
 from .catalog import Catalog
 from .dataflash_batches import dataflash_batches
-from .sources import Batch, export_kind, iter_batches, model_of
+from .sources import Batch, export_kind, jsonl_batches, model_of, tlog_batches, ulog_batches
+
+
+def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
+    """Every battery batch of one log, every field of ULog records (see :func:`read_log`)."""
+    return list(read_log(path, name, catalog, message))
 
 
 def read_log(
@@ -21,12 +26,19 @@ def read_log(
     source: mmap.mmap | None = None,
     all_fields: bool = True,
 ) -> Iterator[Batch]:
-    """The battery batches of one log, one at a time. Raises InputError (or another BattgenError)
-    if unreadable; ``source`` and ``all_fields``: see iter_batches."""
+    """The battery batches of one log, one at a time (a ULog's in chunks: memory stays flat). Raises
+    InputError (or another BattgenError) if unreadable. ``source``: a memory map of a ULog file the
+    caller holds (the log closes it); without ``all_fields`` a ULog batch holds only the fields the
+    mapping reads (and the timestamp); ``message``: that of JSON Lines records (None: told from
+    their keys)."""
     kind = export_kind(path)
-    if kind == "dataflash":
+    if kind == "ulog":
+        yield from ulog_batches(path, name, catalog, source, all_fields)
+    elif kind == "tlog":
+        yield from tlog_batches(path, name, catalog)
+    elif kind == "dataflash":
         yield from dataflash_batches(path, name, catalog)
     elif kind == "can":
         yield from can_batches(path, name, catalog, model_of)
     else:
-        yield from iter_batches(path, name, catalog, message, source, all_fields)
+        yield from jsonl_batches(path, name, catalog, message)

@@ -95,37 +95,10 @@ def model_of(catalog: Catalog, qualified: str) -> MessageClass:
     return model_class(bundled_package(), catalog.schema.message(qualified))
 
 
-def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
-    """Every battery batch of one log. Raises InputError (or another BattgenError) if unreadable."""
-    return list(iter_batches(path, name, catalog, message))
-
-
-def iter_batches(
-    path: Path,
-    name: str,
-    catalog: Catalog,
-    message: str | None = None,
-    source: mmap.mmap | None = None,
-    all_fields: bool = True,
-) -> Iterator[Batch]:
-    """The battery batches of one log, one at a time (a ULog's in chunks: memory stays flat);
-    ``source`` is a memory map of a ULog file the caller holds (the log closes it). Without
-    ``all_fields`` a ULog batch holds only the fields the mapping reads (and the timestamp)."""
-    kind = export_kind(path)
-    if kind == "ulog":
-        yield from _ulog_batches(path, name, catalog, source, all_fields)
-    elif kind == "tlog":
-        yield from _tlog_batches(path, name, catalog)
-    elif kind in ("dataflash", "can"):
-        raise InputError(name, 0, f"{kind} logs are read by codegen.apps.export.readers")
-    else:
-        yield from _jsonl_batches(path, name, catalog, message)
-
-
 # -- ULog ------------------------------------------------------------------------------------------
 
 
-def _ulog_batches(
+def ulog_batches(
     path: Path, name: str, catalog: Catalog, source: mmap.mmap | None, all_fields: bool
 ) -> Iterator[Batch]:
     model = model_of(catalog, "uorb.BatteryStatus")
@@ -201,7 +174,7 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
     return out
 
 
-def _tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
+def tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
     model = model_of(catalog, "mavlink.BATTERY_STATUS")
     if not isinstance(model, MavlinkClass):
         raise BattgenError("the generated mavlink.BATTERY_STATUS has no MAVLink codec: run 'battgen generate'")
@@ -226,7 +199,7 @@ def _tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
     return [batch]
 
 
-def _jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None) -> list[Batch]:
+def jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None) -> list[Batch]:
     records: list[Record] = []
     for item in read_jsonl(path, name):
         if isinstance(item, Unreadable):
