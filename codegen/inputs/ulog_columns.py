@@ -3,8 +3,8 @@ each field a numpy array, for whole-log work such as ``battgen export``.
 
 The log is memory-mapped and indexed once (:mod:`.ulog_index`: the record walk at C speed, every
 decision the generated reader's); a topic instance's records are handed out in chunks of at most
-``chunk`` records, each gathered with one fancy-indexing step into a numpy structured array laid
-out as the log's format, whose fields are the columns (views, no further copy). Fields are named
+``chunk`` records, gathered a cache-sized block at a time into a numpy structured array laid out
+as the log's format, whose fields are copied out into contiguous columns. Fields are named
 and shaped as the generated class has them (arrays as ``(n, capacity)`` matrices) and filled as
 :meth:`Log.iter_records` fills a record: a field the log lacks or types otherwise keeps the
 class's default, so a column and a record of the same log agree
@@ -215,7 +215,7 @@ class UlogColumns:
         stamps = out.get("timestamp") if "timestamp" not in skip else None
         return TopicColumns(topic, multi_id, len(records), stamps, out, skip)
 
-    def _topic_columns(self, topic: str, fields: tuple[str, ...]) -> NDArray | None:
+    def _topic_records(self, topic: str, fields: tuple[str, ...]) -> NDArray | None:
         """The records of ``topic`` (instance 0) if the log has it with every one of ``fields``."""
         if topic not in self.log.formats:
             return None
@@ -230,7 +230,7 @@ class UlogColumns:
         """UTC minus the log's clock, from the first GPS record that carries UTC time, if any."""
         import numpy as np
 
-        recs = self._topic_columns("vehicle_gps_position", ("time_utc_usec", "timestamp"))
+        recs = self._topic_records("vehicle_gps_position", ("time_utc_usec", "timestamp"))
         if recs is None:
             return None
         utc, stamp = recs["time_utc_usec"], recs["timestamp"]
@@ -239,7 +239,7 @@ class UlogColumns:
 
     def armed(self) -> tuple[NDArray, NDArray] | None:
         """(timestamps, armed) of the ``actuator_armed`` records, if the log has them."""
-        recs = self._topic_columns("actuator_armed", ("timestamp", "armed"))
+        recs = self._topic_records("actuator_armed", ("timestamp", "armed"))
         if recs is None or not len(recs):
             return None
         return recs["timestamp"], _values(recs["armed"]).astype(bool)
@@ -270,7 +270,6 @@ def record_dtype(lay: _Layout) -> Any:
             names.append(base)
             formats.append((lay.np_types[i], (j - i,)))
         else:
-            j = i + 1
             names.append(lay.names[i])
             formats.append(lay.np_types[i])
         offsets.append(lay.offsets[i])

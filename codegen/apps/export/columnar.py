@@ -117,8 +117,7 @@ class ColumnConverter(OpVisitor[None]):
         """Where ``x`` is none of ``marks`` (None: everywhere)."""
         ok: NDArray | None = None
         for m in marks:
-            hit = _not_marker(x, m)
-            ok = hit if ok is None else ok & hit
+            ok = _and(ok, _not_marker(x, m))
         return ok
 
     def constant(self, value: Value | None, refs: tuple[FieldRef, ...]) -> object:

@@ -263,25 +263,3 @@ class LogWriter:
             writer.close()
         self._writers.clear()
         shutil.rmtree(self.tmp, ignore_errors=True)
-
-
-def write_log(
-    out: Path,
-    log: str,
-    battery: Any,
-    raws: Sequence[tuple[str, Any]],
-    manifest: dict[str, object],
-    tables: Sequence[tuple[str, dict[str, Any]]] = (),
-    partition: str | None = None,
-) -> None:
-    """Write one log's partitions and then its marker (see the module docstring and
-    :meth:`LogWriter.commit`), all tables at once."""
-    writer = LogWriter(out, log, battery.schema)
-    try:
-        writer.add(battery)
-        for message, table in raws:
-            writer.add_raw(message, table)
-    except BaseException:
-        writer.abort()
-        raise
-    writer.commit(manifest, tables, partition)

@@ -92,6 +92,7 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
     in flat memory); the failsafe replay keeps what it needs of each (its context, not its columns)."""
     catalog = bundled_catalog()
     schema = battery_schema(catalog)
+    kind = export_kind(file)
     writer = LogWriter(options.out, log, schema)
     notes: list[str] = []
     messages: set[str] = set()
@@ -110,12 +111,13 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
             messages.add(batch.message)
             notes.extend(n for n in batch.notes if n not in notes)
             first = pc.min(table["time"].cast(pa.int64())).as_py() if table.num_rows else None
-            first_us = first if first_us is None or (first is not None and first < first_us) else first_us
+            if first is not None:
+                first_us = first if first_us is None else min(first_us, first)
             if options.failsafe is not None:
                 firsts.append(table["battery"][0].as_py() if table.num_rows else None)
                 batch.columns, batch.concepts = {}, None
                 seen.append(batch)
-        if options.raw and export_kind(file) == "dataflash":
+        if options.raw and kind == "dataflash":
             for message, raw in dataflash_raw_tables(file, name, log):
                 writer.add_raw(message, raw)
     except BaseException:
@@ -125,9 +127,9 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
         notes.append("no battery records")
     extra: list[tuple[str, dict[str, Any]]] = []
     if options.failsafe is not None:
-        numbers = battery_numbers(export_kind(file), seen, firsts)
+        numbers = battery_numbers(kind, seen, firsts)
         try:
-            replayed = replay_tables(file, name, export_kind(file), log, options.failsafe, seen, numbers)
+            replayed = replay_tables(file, name, kind, log, options.failsafe, seen, numbers)
         except BattgenError as exc:
             replayed = f"failsafe not replayed: {exc}"
         if isinstance(replayed, str):
