@@ -8,6 +8,7 @@ finish. Without a scheduler address a local cluster of ``workers`` processes is 
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -57,7 +58,7 @@ def run_on(
     and a task's round trip through the scheduler costs about as much again (measured: 200 such
     logs in 4.1 s one per task on two workers, against 1.9 s by eight). Tasks stay many enough to
     keep every worker busy to the end and the progress moving."""
-    claim_layout(options.out, options.partition)
+    options = dataclasses.replace(options, content_id=claim_layout(options.out, options.partition, options.content_id))
     workers = max(1, sum(client.nthreads().values()))
     size = max(1, min(MAX_LOGS_PER_TASK, len(paths) // (TASKS_PER_WORKER * workers)))
     groups = [list(paths[i : i + size]) for i in range(0, len(paths), size)]

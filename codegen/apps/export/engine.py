@@ -9,6 +9,7 @@ is reported in its :class:`LogResult` and the run goes on.
 from __future__ import annotations
 
 import concurrent.futures
+import dataclasses
 import datetime
 import mmap
 from collections.abc import Callable, Iterable, Iterator, Sequence
@@ -23,7 +24,15 @@ from ...errors import BattgenError
 from .catalog import bundled_catalog
 from .columnar import convert_columns
 from .dataflash_batches import dataflash_raw_tables
-from .dataset import LogWriter, claim_layout, exported_manifest, is_exported, partition_of, raw_table
+from .dataset import (
+    LogWriter,
+    claim_layout,
+    content_scheme,
+    exported_manifest,
+    is_exported,
+    partition_of,
+    raw_table,
+)
 from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, battery_numbers, replay_tables
 from .readers import read_log
 from .sources import Batch, content_id, export_kind, map_file
@@ -40,6 +49,7 @@ class ExportOptions:
     message: str | None = None  # the message of JSON Lines inputs (None: told from their keys)
     failsafe: FailsafeOptions | None = None  # --failsafe: replay each log through the battery failsafe
     partition: str = "log"  # "log" or "day" (see .dataset)
+    content_id: str | None = None  # the hash naming logs (None: the dataset's, .dataset.content_scheme)
 
 
 @dataclass(frozen=True)
@@ -61,7 +71,7 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
     source = map_file(file)  # a ULog is hashed and read through one memory map
     try:
         try:
-            log = content_id(file, source)
+            log = content_id(file, source, options.content_id or content_scheme(options.out))
         except OSError as exc:
             return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
         if is_exported(options.out, log) and not _replay_missing(options, log):
@@ -170,7 +180,7 @@ def export_logs(
     progress: Callable[[LogResult], None] | None = None,
 ) -> list[LogResult]:
     """Export every log, in input order of the results; ``jobs`` > 1 runs them in processes."""
-    claim_layout(options.out, options.partition)
+    options = dataclasses.replace(options, content_id=claim_layout(options.out, options.partition, options.content_id))
     unique = list(dict.fromkeys(paths))
     results: dict[str, LogResult] = {}
     for res in _run(unique, options, jobs):

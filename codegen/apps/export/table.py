@@ -38,7 +38,12 @@ _ARROW_TYPES: dict[str, Any] = {
 # the context of every record: (name, Arrow type, doc, unit)
 CONTEXT: tuple[tuple[str, Any, str, str | None], ...] = (
     # plain text: the Hive partition key too, which engines read from the path as text
-    ("log", pa.string(), "stable id of the log's content (sha256 of the file, first 16 hex digits)", None),
+    (
+        "log",
+        pa.string(),
+        "stable id of the log's content (first 16 hex digits of its BLAKE3; older datasets: SHA-256)",
+        None,
+    ),
     ("source", _LABEL, "file name of the log", None),
     ("vehicle", _LABEL, "the vehicle, where the log says (ULog sys_uuid or hardware, MAVLink system id)", None),
     ("battery", pa.int32(), "battery instance (the concept battery_index where known, else the log's instance)", None),
@@ -86,7 +91,7 @@ def concept_array(col: ConceptColumn) -> Any:
     valid = col.valid
     everywhere = bool(valid.all())
     if not everywhere and not valid.any():  # a concept the source never gives: no arrays to build
-        return pa.nulls(len(valid), _ARROW_TYPES[kind])
+        return nulls(len(valid), _ARROW_TYPES[kind])
     invalid = None if everywhere else ~valid
     if kind == "number":  # NaN is null (from_pandas): one pass
         values = col.values if everywhere else np.where(valid, col.values, np.nan)
@@ -136,9 +141,23 @@ def _words(words: tuple[str, ...]) -> Any:
     return pa.array(list(words), type=pa.string())
 
 
+@functools.lru_cache(maxsize=64)
+def nulls(n: int, typ: Any) -> Any:
+    """``n`` nulls of ``typ``. Arrow arrays are immutable, so the chunks of a log (all of one
+    length but the last) share one: a format leaves most concepts unknown, and zeroed buffers for
+    each of them in every chunk were a tenth of the conversion's time."""
+    return pa.nulls(n, typ)
+
+
+@functools.lru_cache(maxsize=64)
 def label(text: str, n: int) -> Any:
-    """``text`` ``n`` times, dictionary-encoded."""
+    """``text`` ``n`` times, dictionary-encoded (shared as :func:`nulls` is)."""
     return pa.DictionaryArray.from_arrays(pa.array(np.zeros(n, np.int32)), _words((text,)))
+
+
+@functools.lru_cache(maxsize=64)
+def _repeat(text: str, n: int) -> Any:
+    return pa.repeat(pa.scalar(text, pa.string()), n)
 
 
 def battery_table(
@@ -150,17 +169,17 @@ def battery_table(
     battery = np.asarray(np.where(index.valid, index.values, batch.instance), np.int32)
     timestamp = pa.timestamp("us", tz="UTC")
     arrays: list[Any] = [
-        pa.repeat(pa.scalar(log, pa.string()), n),
+        _repeat(log, n),
         label(source, n),
-        pa.nulls(n, _LABEL)
+        nulls(n, _LABEL)
         if batch.vehicle is None
         else label(batch.vehicle, n)
         if isinstance(batch.vehicle, str)
         else pa.array(batch.vehicle, type=pa.string()).dictionary_encode(),
         pa.array(battery, type=pa.int32()),
         pa.array(batch.t, type=pa.float64(), mask=np.isnan(batch.t)),
-        pa.nulls(n, timestamp) if batch.time_us is None else pa.array(batch.time_us, type=pa.int64()).cast(timestamp),
-        pa.nulls(n, pa.bool_())
+        nulls(n, timestamp) if batch.time_us is None else pa.array(batch.time_us, type=pa.int64()).cast(timestamp),
+        nulls(n, pa.bool_())
         if batch.armed is None
         else pa.array(batch.armed == 1.0, type=pa.bool_(), mask=np.isnan(batch.armed)),
         label(batch.message, n),
