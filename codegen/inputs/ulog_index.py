@@ -39,10 +39,13 @@ _HEAD = struct.Struct("<HB")
 _HEADS = 1 << 15  # record heads per C walk call (512 KiB)
 
 _scan: Callable[[Any, int, int, bytes, Any], tuple[int, int]] | None
+# gather(buffer, offsets, record_size, [(offset, size, out)]): fields out of records (ulog_columns)
+gather: Callable[[Any, Any, int, Sequence[tuple[int, int, Any]]], None] | None
 try:
+    from ._ulog_scan import gather
     from ._ulog_scan import scan as _scan
-except ImportError:  # no C compiler at install time: the generated walker does the work
-    _scan = None
+except ImportError:  # no C compiler at install time: the generated walker does the work, numpy gathers
+    _scan = gather = None
 
 
 class _Stream(Protocol):

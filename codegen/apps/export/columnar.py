@@ -234,8 +234,7 @@ class ColumnConverter(OpVisitor[None]):
             value = self.constant(entry.value, (fmt,))
             codes[x == int(str(value))] = con.concept.choices.index(entry.choice)
         # the generated code assigns the lookup whatever it finds: no match is unknown again
-        con.values[...] = np.maximum(codes, 0)
-        con.valid[...] = codes >= 0
+        con.assign(np.maximum(codes, 0), codes >= 0)
 
     # -- cells ---------------------------------------------------------------------------------
 

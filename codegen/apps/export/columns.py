@@ -39,6 +39,7 @@ class ConceptColumn:
     values: NDArray
     valid: NDArray
     lengths: NDArray | None = None  # list concepts: the number of elements of each row
+    blank: bool = False  # never written: shared read-only arrays, unknown everywhere
 
     @classmethod
     def empty(cls, concept: Concept, n: int, width: int = 0) -> ConceptColumn:
@@ -49,12 +50,20 @@ class ConceptColumn:
 
     def _own(self) -> None:
         """Arrays of its own to write into (an unknown column's are shared and read-only)."""
+        self.blank = False
         if not self.valid.flags.writeable:
             self.values, self.valid = self.values.copy(), self.valid.copy()
             self.lengths = None if self.lengths is None else self.lengths.copy()
 
     def set(self, values: NDArray, where: NDArray | None = None) -> None:
         """Write ``values`` (an array or a scalar) where ``where`` holds (everywhere if None)."""
+        if self.blank and isinstance(values, np.ndarray) and values.shape == self.valid.shape:
+            # The first write of a whole column (the usual): a copy of it (``values`` may be a log's
+            # column, later rules write into ours), whatever it holds where it is unknown.
+            self.values = values.astype(self.values.dtype, casting="unsafe")
+            self.valid = np.ones(len(values), bool) if where is None else np.array(where, bool)
+            self.blank = False
+            return
         self._own()
         if where is None:
             self.values[...] = values
@@ -63,14 +72,22 @@ class ConceptColumn:
         np.copyto(self.values, values, where=where, casting="unsafe")
         self.valid |= where
 
+    def assign(self, values: NDArray, valid: NDArray) -> None:
+        """The whole column, what it held before forgotten (a lookup that finds nothing makes
+        the concept unknown again)."""
+        self.blank = False
+        self.values = values.astype(self.values.dtype, casting="unsafe")
+        self.valid = np.array(valid, bool)
+
     def set_list(self, values: NDArray, lengths: NDArray, where: NDArray) -> None:
         """Write the rows of a list concept where ``where`` holds (widening the matrix if needed)."""
-        self._own()
-        if not self.valid.any():  # nothing written yet: take the rows as they are
+        if self.blank or not self.valid.any():  # nothing written yet: take the rows as they are
+            self.blank = False
             self.values = np.where(where[:, None], values, np.nan) if not where.all() else values
             self.lengths = np.where(where, lengths, 0)
             self.valid = where.copy()
             return
+        self._own()
         width = max(self.values.shape[1], values.shape[1])
         if width > self.values.shape[1]:
             wider = np.full((self.values.shape[0], width), np.nan)
@@ -105,16 +122,26 @@ class LazyColumns(dict[str, ConceptColumn]):
         self.n = n
 
     def __missing__(self, name: str) -> ConceptColumn:
-        column = self[name] = ConceptColumn.empty(self.by_name[name], self.n)
+        column = self[name] = _blank(self.by_name[name], self.n)
         return column
 
     def done(self) -> dict[str, ConceptColumn]:
         """Every concept, those never written unknown (read-only arrays, no memory of their own)."""
-        never = np.broadcast_to(np.zeros(1, bool), (self.n,))
         for name, concept in self.by_name.items():
             if name not in self:
-                width = (self.n, 0) if concept.kind == "list" else (self.n,)
-                values: NDArray = np.broadcast_to(np.zeros(1, _DTYPES.get(concept.kind, np.float64)), width)
-                lengths = np.broadcast_to(np.zeros(1, np.int64), (self.n,)) if concept.kind == "list" else None
-                dict.__setitem__(self, name, ConceptColumn(concept, values, never, lengths))
+                dict.__setitem__(self, name, _blank(concept, self.n))
         return {name: self[name] for name in self.by_name}
+
+
+def _blank(concept: Concept, n: int) -> ConceptColumn:
+    """A concept unknown for ``n`` records, in shared read-only arrays: a text concept's values are
+    None, the others' zero; its first whole-column write replaces them, any other write copies them."""
+    never = np.broadcast_to(np.zeros(1, bool), (n,))
+    if concept.kind == "text":
+        values: NDArray = np.broadcast_to(np.full(1, None, object), (n,))
+    else:
+        values = np.broadcast_to(
+            np.zeros(1, _DTYPES.get(concept.kind, np.float64)), (n, 0) if concept.kind == "list" else (n,)
+        )
+    lengths = np.broadcast_to(np.zeros(1, np.int64), (n,)) if concept.kind == "list" else None
+    return ConceptColumn(concept, values, never, lengths, blank=True)
