@@ -253,6 +253,9 @@ class ColumnConverter(OpVisitor[None]):
             lengths = np.where(count != 0, np.minimum(count, room), lengths)
         if f.invalid is not None and f.invalid.first_decides and m.shape[1]:  # MAVLink [X:]: element 0 speaks
             lengths = np.where(_not_marker(m[:, 0], f.invalid.value), lengths, 0)
+        # elements past every row's length are dropped anyway: a pack of 4 cells in PX4's 14 slots
+        # converts 4 columns, not 14
+        m = m[:, : int(lengths.max()) if len(lengths) else 0]
         mul, add = _factor(f.unit or con.concept.unit, con.concept.unit)
         values = _affine(m, mul, add)
         if values is m:  # a float64 field as it is: the NaNs below must not write into the log's columns
