@@ -62,8 +62,8 @@ def _is_nan(value: object) -> bool:
 
 
 def _not_marker(x: NDArray, mark: float | int) -> NDArray:
-    if _is_nan(mark):
-        return ~np.isnan(x) if x.dtype.kind in "fc" else np.asarray(x == x)
+    if _is_nan(mark):  # x == x is "not NaN" in one pass (and True for integers)
+        return np.asarray(x == x)
     return np.asarray(x != mark)
 
 
@@ -156,11 +156,10 @@ class ColumnConverter(OpVisitor[None]):
             ok = _and(ok, x <= op.valid_max)
         named = units.lookup(op.unit) if op.unit is not None else None
         mul, add = _factor(f.unit or named or con.concept.unit, con.concept.unit)
-        if op.negate:  # the field counts the other way; + 0.0 keeps a zero from reading -0.0
-            value = _affine(x, -mul, -add)
-            con.set(value + 0.0 if add == 0.0 else value, ok)
-        else:
-            con.set(_affine(x, mul, add), ok)
+        value = _affine(x, -mul, -add) if op.negate else _affine(x, mul, add)
+        if op.negate and add == 0.0:  # the field counts the other way; + 0.0 keeps a zero from reading -0.0
+            value = value + 0.0
+        con.set(value, ok, take=value is not x)
 
     def visit_copy(self, rule: Rule, op: o.Copy) -> None:
         fmt, con = self.pair(rule)
@@ -220,10 +219,13 @@ class ColumnConverter(OpVisitor[None]):
         fmt, con = self.pair(rule)
         x = self.col(fmt).astype(np.int64)
         table = {bit.choice: self.mask(bit.mask) for bit in op.map}
-        bits = np.zeros(self.n, np.int64)
+        rows = np.flatnonzero(x)  # records with any bit set: few (a fault is rare)
+        some = np.zeros(len(rows), np.int64)
         for i, choice in enumerate(con.concept.choices):
-            if choice in table:
-                bits |= ((x & table[choice]) != 0).astype(np.int64) << i
+            if choice in table and len(rows):
+                some |= ((x[rows] & table[choice]) != 0).astype(np.int64) << i
+        bits = np.zeros(self.n, np.int64)
+        bits[rows] = some
         con.set(bits)
 
     def visit_choice(self, rule: Rule, op: o.Choice) -> None:
@@ -243,14 +245,17 @@ class ColumnConverter(OpVisitor[None]):
         f = self.fld(fmt)
         m = self.col(fmt)
         mark = f.invalid.value if f.invalid is not None and f.invalid.per_element else None
-        lengths = leading_lengths(m, mark)
         given = self.columns.get(length_key(fmt.field))  # a variable-length array's own lengths
-        if given is not None:
-            lengths = np.minimum(lengths, given)
-        if op.count_field is not None:
-            count = self.columns[op.count_field].astype(np.int64)
-            room = m.shape[1] if given is None else given
-            lengths = np.where(count != 0, np.minimum(count, room), lengths)
+        room = m.shape[1] if given is None else given
+        count = self.columns[op.count_field].astype(np.int64) if op.count_field is not None else None
+        if count is not None and count.all():  # every record gives its count (the usual): it alone decides
+            lengths = np.minimum(count, room)
+        else:
+            lengths = leading_lengths(m, mark)
+            if given is not None:
+                lengths = np.minimum(lengths, given)
+            if count is not None:
+                lengths = np.where(count != 0, np.minimum(count, room), lengths)
         if f.invalid is not None and f.invalid.first_decides and m.shape[1]:  # MAVLink [X:]: element 0 speaks
             lengths = np.where(_not_marker(m[:, 0], f.invalid.value), lengths, 0)
         # elements past every row's length are dropped anyway: a pack of 4 cells in PX4's 14 slots

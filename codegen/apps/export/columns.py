@@ -55,12 +55,14 @@ class ConceptColumn:
             self.values, self.valid = self.values.copy(), self.valid.copy()
             self.lengths = None if self.lengths is None else self.lengths.copy()
 
-    def set(self, values: NDArray, where: NDArray | None = None) -> None:
-        """Write ``values`` (an array or a scalar) where ``where`` holds (everywhere if None)."""
+    def set(self, values: NDArray, where: NDArray | None = None, *, take: bool = False) -> None:
+        """Write ``values`` (an array or a scalar) where ``where`` holds (everywhere if None);
+        ``take``: ``values`` is a new array nobody else holds, which the column may keep as it is."""
         if self.blank and isinstance(values, np.ndarray) and values.shape == self.valid.shape:
-            # The first write of a whole column (the usual): a copy of it (``values`` may be a log's
-            # column, later rules write into ours), whatever it holds where it is unknown.
-            self.values = values.astype(self.values.dtype, casting="unsafe")
+            # The first write of a whole column (the usual): the array itself if it is ours to take,
+            # else a copy (``values`` may be a log's column, and later rules write into ours);
+            # whatever it holds where it is unknown.
+            self.values = values.astype(self.values.dtype, casting="unsafe", copy=not take)
             self.valid = np.ones(len(values), bool) if where is None else np.array(where, bool)
             self.blank = False
             return

@@ -89,8 +89,10 @@ def concept_array(col: ConceptColumn) -> Any:
     """One concept column as an Arrow array: unknown (and NaN) as null."""
     kind = col.concept.kind
     valid = col.valid
+    if col.blank:  # a concept the source never gives (most of them): no arrays to look at or build
+        return nulls(len(valid), _ARROW_TYPES[kind])
     everywhere = bool(valid.all())
-    if not everywhere and not valid.any():  # a concept the source never gives: no arrays to build
+    if not everywhere and not valid.any():
         return nulls(len(valid), _ARROW_TYPES[kind])
     invalid = None if everywhere else ~valid
     if kind == "number":  # NaN is null (from_pandas): one pass
