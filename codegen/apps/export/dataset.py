@@ -7,7 +7,7 @@ Layout under the output folder::
     failsafe/log=<id>/events.parquet       --failsafe: the replay's events (and replays.parquet)
     logs/<id>.json                         what was exported from the log (its marker: present = done)
     views.sql                              the DuckDB views (see codegen.apps.fleet_query)
-    dataset.json                           {"partition": "log" or "day", "content_id": "blake3" or "sha256"}
+    dataset.json                           {"partition": "log" or "day", "content_id": "xxh128" or "sha256"}
 
 ``--partition day`` puts a ``day=YYYY-MM-DD`` level (UTC, from the log's first record with a time
 of day; Hive's ``__HIVE_DEFAULT_PARTITION__``, read as null, where the log has none) above each
@@ -43,7 +43,7 @@ LOGS = "logs"
 ROW_GROUP = 1 << 18  # rows per Parquet row group (fewer, larger groups write faster; engines split them)
 LAYOUT_FILE = "dataset.json"
 PARTITIONS = ("log", "day")
-CONTENT_IDS = ("blake3", "sha256")  # the hashes naming logs; the first for new datasets
+CONTENT_IDS = ("xxh128", "sha256")  # the hashes naming logs; the first for new datasets
 UNKNOWN_DAY = "__HIVE_DEFAULT_PARTITION__"  # Hive's name for a null partition value; DuckDB and pyarrow read it so
 
 
@@ -65,7 +65,7 @@ def layout(out: Path) -> str:
 def content_scheme(out: Path) -> str:
     """The hash naming the logs of the dataset at ``out`` (:func:`.sources.content_id`): the one
     its ``dataset.json`` records; SHA-256 for one whose logs were named before that record
-    existed (they keep their ids, so a nightly run still skips them); BLAKE3 for a new one."""
+    existed (they keep their ids, so a nightly run still skips them); XXH3-128 for a new one."""
     found = _settings(out).get("content_id")
     if found in CONTENT_IDS:
         return str(found)
@@ -79,7 +79,7 @@ def _has_logs(out: Path) -> bool:
 def claim_layout(out: Path, partition: str, scheme: str | None = None) -> str:
     """Record the partitioning and content id of a dataset; refuse another partitioning or hash for
     an existing dataset (two layouts in one folder would not read back as one table; two hashes would
-    name a log twice). ``scheme``: the hash for a new dataset (None: BLAKE3). Returns the dataset's
+    name a log twice). ``scheme``: the hash for a new dataset (None: XXH3-128). Returns the dataset's
     hash (:func:`content_scheme`)."""
     if partition not in PARTITIONS:
         raise BattgenError(f"expected a partitioning among {', '.join(PARTITIONS)}, got {partition!r}")

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
 
-import blake3
 import numpy as np
+import xxhash
 
 from ...backends.python import naming
 from ...errors import BattgenError
@@ -56,13 +56,17 @@ class Batch:
     notes: list[str] = field(default_factory=list)
 
 
-def content_id(path: Path, source: mmap.mmap | None = None, scheme: str = "blake3") -> str:
-    """The stable id of a file's content: the first hex digits of its BLAKE3 (``b3sum``'s), or of
-    its SHA-256 (``sha256sum``'s) in a dataset made before battgen chose BLAKE3 (see
-    :func:`.dataset.content_scheme`). Both are cryptographic; BLAKE3 hashes 2x faster here, a tenth of
-    a large log's export. With ``source``, a memory map of the file, the hash reads the map: the
-    pages the reader will use are mapped once."""
-    digest: Any = hashlib.sha256() if scheme == "sha256" else blake3.blake3()
+def content_id(path: Path, source: mmap.mmap | None = None, scheme: str = "xxh128") -> str:
+    """The stable id of a file's content: the first hex digits of its XXH3-128 (``xxh128sum``'s),
+    or of its SHA-256 (``sha256sum``'s) in a dataset made before battgen chose XXH3 (see
+    :func:`.dataset.content_scheme`).
+
+    Why not a cryptographic hash: an id of 16 hex digits (64 bits) has a 2^32 birthday bound
+    whatever hash it is cut from, so SHA-256 or BLAKE3 would buy no collision resistance here, and
+    they cost 10x and 5x XXH3's time: measured on a 171 MB log, SHA-256 0.10 s, BLAKE3 0.045 s,
+    XXH3-128 0.010 s, of an export of about half a second. With ``source``, a memory map of the
+    file, the hash reads the map: the pages the reader will use are mapped once."""
+    digest: Any = hashlib.sha256() if scheme == "sha256" else xxhash.xxh3_128()
     if source is not None:
         digest.update(source)
     else:

@@ -41,7 +41,7 @@ CONTEXT: tuple[tuple[str, Any, str, str | None], ...] = (
     (
         "log",
         pa.string(),
-        "stable id of the log's content (first 16 hex digits of its BLAKE3; older datasets: SHA-256)",
+        "stable id of the log's content (first 16 hex digits of its XXH3-128; older datasets: SHA-256)",
         None,
     ),
     ("source", _LABEL, "file name of the log", None),
