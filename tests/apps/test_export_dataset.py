@@ -92,6 +92,17 @@ def test_tlog_and_jsonl(tmp_path: Path) -> None:
     assert ir.rows[0][0] == pytest.approx((4.08 + 4.07 + 4.08 - (4.07 + 4.06 + 4.08)) / 20.0)  # one 20 A step
 
 
+def test_a_tlog_stamp_past_int64_is_an_unknown_time(tmp_path: Path) -> None:
+    good = tlog(tmp_path / "a.tlog").read_bytes()
+    bad = tmp_path / "b.tlog"  # the first frame's uint64 stamp all ones (a damaged log's; once an OverflowError)
+    bad.write_bytes(b"\xff" * 8 + good[8:])
+    [res] = export_logs([bad.as_posix()], ExportOptions(tmp_path / "ds"))
+    assert (res.status, res.rows) == ("exported", 6)
+    rows = run_query(tmp_path / "ds", "SELECT t, time FROM battery ORDER BY t NULLS FIRST").rows
+    assert rows[0] == (None, None)  # the frame is kept, its time unknown
+    assert rows[1][0] == 0.0 and all(t is not None and time is not None for t, time in rows[1:])
+
+
 def test_incremental_and_bad_logs(tmp_path: Path) -> None:
     out = tmp_path / "ds"
     good = jsonl(tmp_path / "a.jsonl")

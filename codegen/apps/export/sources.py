@@ -48,6 +48,7 @@ class Batch:
     t: NDArray  # seconds since the log's start (NaN: unknown)
     instance: NDArray  # the log's instance of each record (ULog multi_id, else 0)
     time_us: NDArray | None = None  # microseconds since the Unix epoch
+    time_known: NDArray | None = None  # where time_us holds a time (None: everywhere)
     vehicle: NDArray | str | None = None  # one for the batch, or an object array of str / None
     armed: NDArray | None = None  # float 1.0 / 0.0 / NaN (unknown)
     concepts: dict[str, ConceptColumn] | None = None  # filled by the reader (a format without IR mapping)
@@ -191,17 +192,21 @@ def tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
     if not frames:
         return []
     message = catalog.schema.message(model.QUALIFIED_NAME)
-    stamps = np.array([f.timestamp or 0 for f in frames], np.int64)
+    # a tlog's stamp is a uint64 of µs since the epoch; one past int64 (a damaged log's) is unknown
+    known = np.array([f.timestamp is not None and f.timestamp < 1 << 63 for f in frames], bool)
+    stamps = np.array([f.timestamp if ok else 0 for f, ok in zip(frames, known, strict=True)], np.int64)
+    origin = int(stamps[known].min()) if known.any() else 0
     batch = Batch(
         model.QUALIFIED_NAME,
         len(frames),
         instances_to_columns(message, [f.instance for f in frames]),
-        (stamps - stamps.min()) / 1e6,
+        np.where(known, (stamps - origin) / 1e6, np.nan),
         np.zeros(len(frames), np.int64),
         time_us=stamps,
+        time_known=None if known.all() else known,
         vehicle=np.array([f"mavlink:{f.frame.sysid}" for f in frames], object),
     )
-    batch.origin_us, batch.utc_offset_us = int(stamps.min()), 0
+    batch.origin_us, batch.utc_offset_us = origin, 0
     if stats.damaged:
         batch.notes.append(stats.summary("BATTERY_STATUS"))
     return [batch]

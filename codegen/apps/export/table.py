@@ -180,7 +180,11 @@ def battery_table(
         else pa.array(batch.vehicle, type=pa.string()).dictionary_encode(),
         pa.array(battery, type=pa.int32()),
         pa.array(batch.t, type=pa.float64(), mask=np.isnan(batch.t)),
-        nulls(n, timestamp) if batch.time_us is None else pa.array(batch.time_us, type=pa.int64()).cast(timestamp),
+        nulls(n, timestamp)
+        if batch.time_us is None
+        else pa.array(
+            batch.time_us, type=pa.int64(), mask=None if batch.time_known is None else ~batch.time_known
+        ).cast(timestamp),
         nulls(n, pa.bool_())
         if batch.armed is None
         else pa.array(batch.armed == 1.0, type=pa.bool_(), mask=np.isnan(batch.armed)),
