@@ -12,6 +12,7 @@ per row. ``valid`` is False where the concept is unknown.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -138,12 +139,16 @@ class LazyColumns(dict[str, ConceptColumn]):
 def _blank(concept: Concept, n: int) -> ConceptColumn:
     """A concept unknown for ``n`` records, in shared read-only arrays: a text concept's values are
     None, the others' zero; its first whole-column write replaces them, any other write copies them."""
-    never = np.broadcast_to(np.zeros(1, bool), (n,))
-    if concept.kind == "text":
-        values: NDArray = np.broadcast_to(np.full(1, None, object), (n,))
-    else:
-        values = np.broadcast_to(
-            np.zeros(1, _DTYPES.get(concept.kind, np.float64)), (n, 0) if concept.kind == "list" else (n,)
-        )
-    lengths = np.broadcast_to(np.zeros(1, np.int64), (n,)) if concept.kind == "list" else None
-    return ConceptColumn(concept, values, never, lengths, blank=True)
+    values = _unknown(concept.kind, n)
+    lengths = _unknown("lengths", n) if concept.kind == "list" else None
+    return ConceptColumn(concept, values, _unknown("valid", n), lengths, blank=True)
+
+
+@functools.lru_cache(maxsize=64)
+def _unknown(kind: str, n: int) -> NDArray:
+    """The read-only array of ``n`` unknown values of a kind (or ``valid`` flags, list ``lengths``),
+    one for all the concepts, chunks and logs that use it (a small log's fixed cost otherwise)."""
+    if kind == "text":
+        return np.broadcast_to(np.full(1, None, object), (n,))
+    dtype = {"valid": np.bool_, "lengths": np.int64}.get(kind) or _DTYPES.get(kind, np.float64)
+    return np.broadcast_to(np.zeros(1, dtype), (n, 0) if kind == "list" else (n,))
