@@ -37,6 +37,7 @@ NDArray = Any  # numpy arrays
 CHUNK = 1 << 17
 # records gathered at a time without the compiled gather: a block (some 100 KiB to 1 MiB) stays in the CPU's cache
 _BLOCK = 1 << 12
+_GATHER_FIELDS = 256  # fields per compiled gather call (it takes at most 512)
 _ELEMENT = re.compile(r"(.+)\[(\d+)\]")
 
 
@@ -146,7 +147,9 @@ class UlogColumns:
         offsets = self.offsets.get((topic, multi_id), np.zeros(0, np.int64))[begin:end]
         if gather is not None and lay.data_size and n:
             spec = [(cast(int, dtype.fields[name][1]), dtype[name].itemsize, out[name]) for name in names]
-            gather(self.log.data, np.ascontiguousarray(offsets, np.int64), lay.data_size, spec)
+            at_offsets = np.ascontiguousarray(offsets, np.int64)
+            for first in range(0, len(spec), _GATHER_FIELDS):
+                gather(self.log.data, at_offsets, lay.data_size, spec[first : first + _GATHER_FIELDS])
         else:
             for at in range(0, n, _BLOCK):
                 block = self.records(topic, multi_id, begin + at, begin + min(n, at + _BLOCK))

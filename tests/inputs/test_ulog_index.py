@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from codegen.inputs import ulog_index
+from codegen.inputs import ulog_columns, ulog_index
 from generated import _ulog
 from generated._ulog_parse import WALK_STATE
 from generated.uorb import BatteryInfo, BatteryStatus
@@ -134,3 +134,50 @@ def test_damaged_logs(cuts: list[tuple[int, bytes]], end: int) -> None:
 def test_inserted_garbage(at: int, garbage: bytes) -> None:
     """Bytes inserted: the chain is broken and resynchronised as the generated walker does."""
     _compare(_SMALL[:at] + garbage + _SMALL[at:])
+
+
+def _columns_both_ways(data: bytes, tmp: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every field of every battery_status chunk, by the compiled gather and by numpy: the same bytes."""
+    path = tmp / "log.ulg"
+    path.write_bytes(data)
+    gathered: list[bytes] = []
+    for compiled in (True, False):
+        if not compiled:
+            monkeypatch.setattr(ulog_columns, "gather", None)
+        with ulog_columns.UlogColumns(path, path.name, BatteryStatus) as log:
+            for chunk in log.instances(chunk=64):
+                gathered += [chunk.columns[name].tobytes() for name in sorted(chunk.columns)]
+    half = len(gathered) // 2
+    assert half and gathered[:half] == gathered[half:]
+
+
+@pytest.mark.parametrize("path", REAL_LOGS, ids=lambda p: p.name)
+def test_the_compiled_gather_reads_what_numpy_reads(
+    path: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    if ulog_columns.gather is None:
+        pytest.skip("the C extension is not built")
+    _columns_both_ways(path.read_bytes(), tmp_path, monkeypatch)
+
+
+def test_the_compiled_gather_on_a_written_log(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    if ulog_columns.gather is None:
+        pytest.skip("the C extension is not built")
+    _columns_both_ways(_battery_log(300), tmp_path, monkeypatch)
+
+
+def test_the_compiled_gather_refuses_to_read_outside() -> None:
+    gather = ulog_columns.gather
+    if gather is None:
+        pytest.skip("the C extension is not built")
+    data, out = bytes(range(64)), bytearray(8)
+    gather(data, np.array([0, 16], np.int64), 8, [(4, 4, out)])
+    assert bytes(out) == bytes([4, 5, 6, 7, 20, 21, 22, 23])
+    with pytest.raises(ValueError, match="outside the buffer"):
+        gather(data, np.array([0, 60], np.int64), 8, [(4, 4, out)])  # a record running past the end
+    with pytest.raises(ValueError, match="outside the buffer"):
+        gather(data, np.array([-1], np.int64), 8, [(0, 4, out)])
+    with pytest.raises(ValueError, match="outside the record"):
+        gather(data, np.array([0], np.int64), 8, [(6, 4, out)])  # a field past the record's end
+    with pytest.raises(ValueError, match="too small"):
+        gather(data, np.array([0, 8, 16], np.int64), 8, [(0, 4, out)])  # 3 records, room for 2
