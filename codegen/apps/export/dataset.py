@@ -36,6 +36,7 @@ import pyarrow.parquet as pq
 from ...errors import BattgenError
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from .sources import Batch
+from .table import floats
 
 BATTERY = "battery"
 RAW = "raw"
@@ -158,7 +159,7 @@ def raw_table(message: Message, batch: Batch, log: str) -> Any:
     arrays = [
         pa.array(np.full(batch.n, log, object), type=pa.string()),
         pa.array(np.asarray(batch.instance, np.int32), type=pa.int32()),
-        pa.array(batch.t, type=pa.float64(), mask=np.isnan(batch.t)),
+        floats(batch.t),
     ]
     fields = [pa.field("log", pa.string()), pa.field("instance", pa.int32()), pa.field("t", pa.float64())]
     for f in message.fields:

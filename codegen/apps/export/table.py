@@ -95,9 +95,8 @@ def concept_array(col: ConceptColumn) -> Any:
     if not everywhere and not valid.any():
         return nulls(len(valid), _ARROW_TYPES[kind])
     invalid = None if everywhere else ~valid
-    if kind == "number":  # NaN is null (from_pandas): one pass
-        values = col.values if everywhere else np.where(valid, col.values, np.nan)
-        return pa.array(values, type=pa.float64(), from_pandas=True)
+    if kind == "number":
+        return floats(col.values, invalid)
     if kind in ("integer", "bool"):
         return pa.array(col.values, type=_ARROW_TYPES[kind], mask=invalid)
     if kind == "text":
@@ -114,7 +113,19 @@ def concept_array(col: ConceptColumn) -> Any:
         flat = np.ascontiguousarray(col.values[:, :width]).reshape(-1)
     else:
         flat = col.values[np.arange(col.values.shape[1]) < lengths[:, None]]
-    return _lists(lengths, pa.array(flat, type=pa.float64(), from_pandas=True), invalid)
+    return _lists(lengths, floats(flat), invalid)
+
+
+def floats(values: NDArray, invalid: NDArray | None = None) -> Any:
+    """float64 values as Arrow, NaN (and where ``invalid``) null: with none of either (the usual),
+    the array as it is, no copy; else through a mask. (pyarrow's own NaN scan, ``from_pandas``, took
+    4x the mask's time and 15x numpy's ``isnan``.)"""
+    null = np.isnan(values)
+    if invalid is not None:
+        null |= invalid
+    if not null.any():
+        return pa.array(values, type=pa.float64())
+    return pa.array(values, type=pa.float64(), mask=null)
 
 
 def _flag_lists(bits: NDArray, valid: NDArray, choices: Any, invalid: NDArray | None) -> Any:
@@ -179,7 +190,7 @@ def battery_table(
         if isinstance(batch.vehicle, str)
         else pa.array(batch.vehicle, type=pa.string()).dictionary_encode(),
         pa.array(battery, type=pa.int32()),
-        pa.array(batch.t, type=pa.float64(), mask=np.isnan(batch.t)),
+        floats(batch.t),
         nulls(n, timestamp)
         if batch.time_us is None
         else pa.array(
