@@ -3,8 +3,8 @@ each field a numpy array, for whole-log work such as ``battgen export``.
 
 The log is memory-mapped and indexed once (:mod:`.ulog_index`: the record walk at C speed, every
 decision the generated reader's); a topic instance's records are handed out in chunks of at most
-``chunk`` records, gathered a cache-sized block at a time into a numpy structured array laid out
-as the log's format, whose fields are copied out into contiguous columns. Fields are named
+``chunk`` records, each wanted field copied out of every record into a contiguous column (by the
+compiled gather, else through a numpy structured dtype of the log's format). Fields are named
 and shaped as the generated class has them (arrays as ``(n, capacity)`` matrices) and filled as
 :meth:`Log.iter_records` fills a record: a field the log lacks or types otherwise keeps the
 class's default, so a column and a record of the same log agree

@@ -36,7 +36,7 @@ import pyarrow.parquet as pq
 from ...errors import BattgenError
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from .sources import Batch
-from .table import floats
+from .table import floats, repeated
 
 BATTERY = "battery"
 RAW = "raw"
@@ -157,7 +157,7 @@ def _raw_type(ftype: object) -> Any:
 def raw_table(message: Message, batch: Batch, log: str) -> Any:
     """One batch as its message's own table: every field as decoded (arrays as lists)."""
     arrays = [
-        pa.array(np.full(batch.n, log, object), type=pa.string()),
+        repeated(log, batch.n),
         pa.array(np.asarray(batch.instance, np.int32), type=pa.int32()),
         floats(batch.t),
     ]

@@ -108,7 +108,7 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
     messages: set[str] = set()
     seen: list[Batch] = []  # each batch's context, for the replay
     firsts: list[int | None] = []  # each batch's first battery number, for the replay
-    first_us: int | None = None  # the log's first time of day (UTC µs), which names its day partition
+    first_us: int | None = None  # the log's first time of day (UTC µs), which names its day partition (--partition day)
     try:
         for batch in read_log(file, name, catalog, options.message, source, all_fields=options.raw):
             columns = batch.concepts
@@ -120,9 +120,10 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
                 writer.add_raw(batch.message, raw_table(catalog.schema.message(batch.message), batch, log))
             messages.add(batch.message)
             notes.extend(n for n in batch.notes if n not in notes)
-            first = pc.min(table["time"].cast(pa.int64())).as_py() if table.num_rows else None
-            if first is not None:
-                first_us = first if first_us is None else min(first_us, first)
+            if options.partition == "day" and table.num_rows:  # only a day partition needs it
+                first = pc.min(table["time"].cast(pa.int64())).as_py()
+                if first is not None:
+                    first_us = first if first_us is None else min(first_us, first)
             if options.failsafe is not None:
                 firsts.append(table["battery"][0].as_py() if table.num_rows else None)
                 batch.columns, batch.concepts = {}, None

@@ -154,22 +154,32 @@ def _words(words: tuple[str, ...]) -> Any:
     return pa.array(list(words), type=pa.string())
 
 
-@functools.lru_cache(maxsize=64)
+# The caches below hold arrays of a chunk's length: every chunk of a log but its last has the same,
+# so they serve a log's chunks; they are small because entries of other lengths or logs are dead
+# weight (up to a megabyte each) in a worker that exports a fleet.
+
+
+@functools.lru_cache(maxsize=32)
 def nulls(n: int, typ: Any) -> Any:
-    """``n`` nulls of ``typ``. Arrow arrays are immutable, so the chunks of a log (all of one
-    length but the last) share one: a format leaves most concepts unknown, and zeroed buffers for
-    each of them in every chunk were a tenth of the conversion's time."""
+    """``n`` nulls of ``typ``. Arrow arrays are immutable, so the chunks of a log share one: a
+    format leaves most concepts unknown, and zeroed buffers for each of them in every chunk were a
+    tenth of the conversion's time."""
     return pa.nulls(n, typ)
 
 
-@functools.lru_cache(maxsize=64)
+@functools.lru_cache(maxsize=4)
+def _zeros(n: int) -> Any:
+    return pa.array(np.zeros(n, np.int32))
+
+
 def label(text: str, n: int) -> Any:
-    """``text`` ``n`` times, dictionary-encoded (shared as :func:`nulls` is)."""
-    return pa.DictionaryArray.from_arrays(pa.array(np.zeros(n, np.int32)), _words((text,)))
+    """``text`` ``n`` times, dictionary-encoded (its indices shared as :func:`nulls` are)."""
+    return pa.DictionaryArray.from_arrays(_zeros(n), _words((text,)))
 
 
-@functools.lru_cache(maxsize=64)
-def _repeat(text: str, n: int) -> Any:
+@functools.lru_cache(maxsize=4)
+def repeated(text: str, n: int) -> Any:
+    """``text`` ``n`` times as plain text (the log id, which is its Hive partition key too)."""
     return pa.repeat(pa.scalar(text, pa.string()), n)
 
 
@@ -182,7 +192,7 @@ def battery_table(
     battery = np.asarray(np.where(index.valid, index.values, batch.instance), np.int32)
     timestamp = pa.timestamp("us", tz="UTC")
     arrays: list[Any] = [
-        _repeat(log, n),
+        repeated(log, n),
         label(source, n),
         nulls(n, _LABEL)
         if batch.vehicle is None
