@@ -77,12 +77,14 @@ def fail(where: str, line: int, message: str) -> BattgenError:
     return BattgenError(f"{where}:{line}: {message}" if line > 0 else f"{where}: {message}")
 
 
-def converters(package: str) -> ConvertModule:
-    """The ``convert`` module of a generated package, by the package's import name."""
+def converters(package: str | None) -> ConvertModule:
+    """The ``convert`` module of a generated package, by the package's import name (None: the bundled one)."""
     try:
         return cast(ConvertModule, package_module(named_package(package), "convert"))
     except ImportError as exc:
-        raise BattgenError(f"cannot import {package}.convert ({exc}); run 'battgen generate' first") from None
+        raise BattgenError(
+            f"cannot import {package or 'generated'}.convert ({exc}); run 'battgen generate' first"
+        ) from None
 
 
 def side_name(module: ConvertModule, name: str) -> str:
@@ -204,7 +206,7 @@ def _carried(result: object, field: str) -> float | None:
 class Conversion:
     """One converter of a generated package, checked: the pair exists, has the policy."""
 
-    def __init__(self, package: str, source: str, target: str, policy: str) -> None:
+    def __init__(self, package: str | None, source: str, target: str, policy: str) -> None:
         self.module = converters(package)
         self.source_name, self.target_name = side_name(self.module, source), side_name(self.module, target)
         key = (self.source_name, self.target_name)

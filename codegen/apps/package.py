@@ -1,9 +1,11 @@
 """Locating the generated package, its modules and the class that models a message.
 
-The one place that knows where generated code comes from: the checkout (:func:`project_root`)
-holds ``schemas/`` and the committed ``generated/``; the bundled schemas use that package; any
-other schema folder is generated into a temporary package once per process and imported from
-there; ``battgen convert --package NAME`` imports a package by name from the current folder.
+The one place that knows where generated code comes from: the checkout battgen is installed from
+(:func:`project_root`, found from this package's location, never from the current folder, which
+holds a user's data and no code battgen may run) holds ``schemas/`` and the committed
+``generated/``; the bundled schemas use that package; any other schema folder (``--schemas``) is
+generated into a temporary package once per process and imported from there; only ``battgen
+convert --package NAME`` imports a package by name, as asked, from the current folder.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import importlib.util
 import shutil
 import sys
 import tempfile
+from collections.abc import Iterable
 from pathlib import Path
 from types import ModuleType
 from typing import cast
@@ -32,10 +35,7 @@ _INSTALLED_ROOT = Path(__file__).resolve().parents[2]  # the checkout (or site-p
 
 
 def project_root() -> Path:
-    """The checkout holding schemas/ and generated/ (the current folder, else this package's parent)."""
-    cwd = Path.cwd()
-    if (cwd / "schemas").is_dir():
-        return cwd
+    """The checkout battgen runs from, holding codegen/, schemas/ and generated/ (whatever the current folder)."""
     return _INSTALLED_ROOT
 
 
@@ -64,13 +64,23 @@ def _import_from(folder: Path, name: str) -> ModuleType:
     return module
 
 
+def _is_folder(locations: Iterable[str] | None, folder: Path) -> bool:
+    return any(Path(p).resolve() == folder.resolve() for p in locations or ())
+
+
 def _committed_package(folder: Path) -> ModuleType:
-    try:
-        pkg = importlib.import_module("generated")
-        if any(Path(p).resolve() == folder.resolve() for p in getattr(pkg, "__path__", ())):
-            return pkg
-    except ImportError:
-        pass
+    # The importable ``generated`` only if it is this folder: found first, without running it (the
+    # current folder, on sys.path under ``python -m``, may hold a stranger's ``generated/``).
+    pkg = sys.modules.get("generated")
+    if pkg is not None and _is_folder(getattr(pkg, "__path__", None), folder):
+        return pkg
+    if pkg is None:
+        try:
+            spec = importlib.util.find_spec("generated")
+        except (ImportError, ValueError):
+            spec = None
+        if spec is not None and _is_folder(spec.submodule_search_locations, folder):
+            return importlib.import_module("generated")
     digest = hashlib.sha256(str(folder.resolve()).encode()).hexdigest()[:12]
     return _import_from(folder, f"_battgen_generated_{digest}")
 
@@ -99,11 +109,8 @@ def model_package(schema: Schema, schema_dir: Path, root: Path | None = None) ->
 
 
 def bundled_package() -> ModuleType:
-    """The committed package of the bundled schemas, without reading the schemas: the project's
-    ``generated/``, else the one installed with battgen."""
-    folder = project_root() / "generated"
-    if not (folder / "__init__.py").is_file():
-        folder = _INSTALLED_ROOT / "generated"
+    """The committed package of the bundled schemas (the one installed with battgen), without reading the schemas."""
+    folder = _INSTALLED_ROOT / "generated"
     key = f"committed:{folder}"
     pkg = _PACKAGES.get(key)
     if pkg is None:
@@ -111,8 +118,11 @@ def bundled_package() -> ModuleType:
     return pkg
 
 
-def named_package(name: str) -> ModuleType:
-    """A generated package by its import name, looked for in the current folder first."""
+def named_package(name: str | None) -> ModuleType:
+    """A generated package by its import name, looked for in the current folder first (``convert
+    --package``, a user's choice); None: the bundled one."""
+    if name is None:
+        return bundled_package()
     root = str(Path.cwd())
     if root not in sys.path:
         sys.path.insert(0, root)

@@ -207,7 +207,7 @@ class VectorWriter:
     """Makes the vectors of one converter under one policy."""
 
     def __init__(self, source: str, target: str, policy: str) -> None:
-        self.conversion = Conversion("generated", source, target, policy)  # the bundled schemas' package
+        self.conversion = Conversion(None, source, target, policy)  # the bundled schemas' package
         if self.conversion.source_name not in SIDES:
             raise BattgenError(
                 f"vectors are made for message sides ({', '.join(SIDES)}); {self.conversion.source_name!r} is not one"

@@ -59,7 +59,9 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--out-format", choices=FORMATS, help="output format (default: the input's, text for binary)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="extra converter input (number)")
-    p.add_argument("--package", default="generated", help="the generated package to use (default: generated)")
+    p.add_argument(
+        "--package", help="a generated package to use, by import name (default: the one installed with battgen)"
+    )
     p.add_argument(
         "--allow-empty", action="store_true", help="an input without records is not an error (default: exit 1)"
     )
