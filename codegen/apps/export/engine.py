@@ -21,9 +21,12 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from ...errors import BattgenError
-from .catalog import bundled_catalog
-from .columnar import convert_columns
-from .dataflash_batches import dataflash_raw_tables
+from ..battery.catalog import bundled_catalog
+from ..battery.columnar import convert_columns
+from ..battery.readers import read_log
+from ..battery.sources import Batch, export_kind
+from .content import content_id, map_file
+from .dataflash_raw import dataflash_raw_tables
 from .dataset import (
     LogWriter,
     claim_layout,
@@ -34,8 +37,6 @@ from .dataset import (
     raw_table,
 )
 from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, battery_numbers, replay_tables
-from .readers import read_log
-from .sources import Batch, content_id, export_kind, map_file
 from .table import battery_schema, battery_table
 from .views import write_views
 

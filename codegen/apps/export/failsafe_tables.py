@@ -26,10 +26,10 @@ from typing import Any
 import pyarrow as pa
 
 from ...errors import BattgenError
+from ..battery.sources import Batch
 from ..failsafe.flight import replay_flight
 from ..failsafe.stream import batt_parameter_count, read_parameter_values
 from ..failsafe.vehicles import VEHICLES
-from .sources import Batch
 
 FAILSAFE = "failsafe"
 EVENTS_FILE = "events.parquet"

@@ -17,9 +17,9 @@ from typing import Any
 import numpy as np
 import pyarrow as pa
 
-from .catalog import Catalog
-from .columns import ConceptColumn, NDArray
-from .sources import Batch
+from ..battery.catalog import Catalog
+from ..battery.columns import ConceptColumn, NDArray
+from ..battery.sources import Batch
 
 # Text that repeats (the log, its file, a choice among a few) is dictionary-encoded in Arrow: Parquet
 # stores it so anyway, and building it so is a fraction of the cost. Engines read it as text.
