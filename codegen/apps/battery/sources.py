@@ -20,8 +20,8 @@ import numpy as np
 
 from ...backends.python import naming
 from ...errors import BattgenError
-from ...inputs.dispatch import kind_of_suffix
 from ...inputs.documents import read_jsonl
+from ...inputs.kinds import LOG_KINDS, detect
 from ...inputs.model import MavlinkClass, MessageClass, UorbClass
 from ...inputs.records import InputError, Record, Unreadable
 from ...inputs.tlog import StreamStats, read_frames
@@ -30,9 +30,6 @@ from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
 from .columns import ConceptColumn, NDArray, length_key
-
-EXPORT_KINDS = ("ulog", "tlog", "jsonl", "dataflash", "can")
-DATAFLASH_SUFFIXES = frozenset({".bin"})
 
 
 @dataclass
@@ -54,9 +51,11 @@ class Batch:
     notes: list[str] = field(default_factory=list)
 
 
-def export_kind(path: Path) -> str:
-    kind = "dataflash" if path.suffix.lower() in DATAFLASH_SUFFIXES else kind_of_suffix(path)
-    if kind not in EXPORT_KINDS:
+def log_kind(path: Path) -> str:
+    """The kind of a log or capture (:func:`codegen.inputs.kinds.detect`: content, then name); an InputError for
+    a file of another kind."""
+    kind = detect(path)
+    if kind not in LOG_KINDS:
         expected = (
             "a PX4 ULog (.ulg), MAVLink tlog (.tlog), ArduPilot DataFlash (.bin), CAN capture (.log, .asc, .blf, "
             ".trc) or JSON Lines file"

@@ -24,7 +24,7 @@ from ...errors import BattgenError
 from ..battery.catalog import bundled_catalog
 from ..battery.columnar import convert_columns
 from ..battery.readers import read_log
-from ..battery.sources import Batch, export_kind
+from ..battery.sources import Batch, log_kind
 from .content import content_id, map_file
 from .dataflash_raw import dataflash_raw_tables
 from .dataset import (
@@ -103,7 +103,7 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
     in flat memory); the failsafe replay keeps what it needs of each (its context, not its columns)."""
     catalog = bundled_catalog()
     schema = battery_schema(catalog)
-    kind = export_kind(file)
+    kind = log_kind(file)
     writer = LogWriter(options.out, log, schema)
     notes: list[str] = []
     messages: set[str] = set()

@@ -20,7 +20,8 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import BattgenError
-from ...inputs.dispatch import KIND_FORMATS, file_kind, read_records
+from ...inputs.dispatch import KIND_FORMATS, read_records
+from ...inputs.kinds import file_kind
 from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
 from ...ir import SourceFormat
