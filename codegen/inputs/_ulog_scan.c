@@ -17,11 +17,17 @@
  * size, type and msg_id, 5 bytes, in one step and leaves the last 4 bytes to its slower path).
  *
  * gather(buffer, offsets, record_size, fields) -> None
- *   offsets: int64 payload offsets of records of one format; every record must lie in buffer
+ *   offsets: a C-contiguous buffer of native int64 (a numpy int64 array): payload offsets of
+ *            records of one format; every record must lie in buffer
  *   fields:  a sequence of (offset in the record, size, out): out, a writable buffer of at least
  *            len(offsets) * size bytes, receives each record's field bytes back to back
  * One pass over the records copies every wanted field out of each while its cache lines are
  * loaded (ulog_columns.py reads the columns through numpy dtypes; this only moves bytes).
+ *
+ * Both are callable from Python with any arguments, so every bound is checked before a byte is
+ * touched, in unsigned 64-bit arithmetic written as differences of values already known to be in
+ * range (a - b with b <= a), never as sums that could wrap; a refusal is a ValueError or
+ * TypeError. Buffers are read and written with memcpy, so no alignment is assumed of them.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -36,7 +42,7 @@ struct head {
     uint16_t size;
     uint16_t msg_id; /* the two bytes after the type: a data record's msg_id */
     uint8_t type;
-    uint8_t pad[3]; /* never written: nobody reads it */
+    uint8_t pad[3]; /* zero: nobody reads it */
 };
 
 static PyObject *scan(PyObject *self, PyObject *args) {
@@ -53,22 +59,23 @@ static PyObject *scan(PyObject *self, PyObject *args) {
     }
     const unsigned char *d = (const unsigned char *)buf.buf;
     const unsigned char *k = (const unsigned char *)known.buf;
-    struct head *heads = (struct head *)out.buf;
+    char *heads = (char *)out.buf;
+    /* With 0 <= start <= stop <= len(buffer), p < stop - 4 keeps the 5 header bytes in bounds, and
+     * the record's end is compared as a difference (size + 3 against stop - p), not a sum. */
     Py_ssize_t cap = out.len / (Py_ssize_t)sizeof(struct head), n = 0, p = start, limit = stop - 4;
     Py_BEGIN_ALLOW_THREADS
     while (p < limit && n < cap) {
         unsigned size = (unsigned)d[p] | ((unsigned)d[p + 1] << 8);
         unsigned type = d[p + 2];
-        Py_ssize_t next = p + 3 + (Py_ssize_t)size;
-        if (next > stop || type == 0 || (!k[type] && (size == 0 || size > MAX_UNKNOWN_SIZE))) {
+        if ((size_t)size + 3 > (size_t)(stop - p) || type == 0 ||
+            (!k[type] && (size == 0 || size > MAX_UNKNOWN_SIZE))) {
             break; /* truncated or corrupt: the generated reader's rules decide */
         }
-        struct head *h = &heads[n++];
-        h->pos = (int64_t)p;
-        h->size = (uint16_t)size;
-        h->msg_id = (uint16_t)((unsigned)d[p + 3] | ((unsigned)d[p + 4] << 8));
-        h->type = (uint8_t)type;
-        p = next;
+        struct head h = {(int64_t)p, (uint16_t)size, (uint16_t)((unsigned)d[p + 3] | ((unsigned)d[p + 4] << 8)),
+                         (uint8_t)type, {0, 0, 0}};
+        memcpy(heads + (size_t)n * sizeof h, &h, sizeof h);
+        n++;
+        p += 3 + (Py_ssize_t)size;
     }
     Py_END_ALLOW_THREADS
     result = Py_BuildValue("(nn)", n, p);
@@ -97,44 +104,74 @@ static inline void copy_field(char *dst, const unsigned char *src, Py_ssize_t si
     }
 }
 
+/* Whether a buffer holds native int64 values: 8-byte items of format 'q' or 'l' (numpy's int64 on
+ * LP64 systems), in the machine's byte order. */
+static int is_native_int64(const Py_buffer *b) {
+    const char *f = b->format ? b->format : "B";
+    if (*f == '@' || *f == '=' || *f == (PY_LITTLE_ENDIAN ? '<' : '>')) {
+        f++;
+    }
+    return b->itemsize == 8 && (strcmp(f, "q") == 0 || strcmp(f, "l") == 0);
+}
+
 static PyObject *gather(PyObject *self, PyObject *args) {
     Py_buffer buf, offs;
     Py_ssize_t record_size;
-    PyObject *spec;
+    PyObject *offsets, *spec;
     (void)self;
-    if (!PyArg_ParseTuple(args, "y*y*nO", &buf, &offs, &record_size, &spec)) {
+    if (!PyArg_ParseTuple(args, "y*OnO", &buf, &offsets, &record_size, &spec)) {
         return NULL;
     }
-    PyObject *result = NULL, *seq = PySequence_Fast(spec, "gather: expected a sequence of (offset, size, out)");
+    if (PyObject_GetBuffer(offsets, &offs, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        PyBuffer_Release(&buf);
+        return NULL;
+    }
+    /* A tuple of the fields, ours alone: parsing an item can run Python code (an __index__), which
+     * must not be able to change or free the items under the loop. */
+    PyObject *result = NULL, *items = PySequence_Tuple(spec);
     Py_buffer outs[MAX_FIELDS];
     struct field fields[MAX_FIELDS];
-    Py_ssize_t nf = 0, count = offs.len / (Py_ssize_t)sizeof(int64_t);
-    if (seq == NULL) {
+    Py_ssize_t nf = 0, count = offs.len / 8;
+    if (items == NULL) {
         goto done;
     }
-    if (PySequence_Fast_GET_SIZE(seq) > MAX_FIELDS || record_size < 0) {
+    if (!is_native_int64(&offs) || offs.len % 8 != 0) {
+        PyErr_SetString(PyExc_TypeError, "gather: expected the offsets as native int64 values (a numpy int64 array)");
+        goto done;
+    }
+    if (PyTuple_GET_SIZE(items) > MAX_FIELDS || record_size < 0) {
         PyErr_SetString(PyExc_ValueError, "gather: too many fields, or a negative record size");
         goto done;
     }
-    for (Py_ssize_t j = 0; j < PySequence_Fast_GET_SIZE(seq); j++) {
+    for (Py_ssize_t j = 0; j < PyTuple_GET_SIZE(items); j++) {
+        PyObject *item = PyTuple_GET_ITEM(items, j);
         struct field *f = &fields[nf];
-        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(seq, j), "nnw*", &f->offset, &f->size, &outs[nf])) {
+        if (!PyTuple_Check(item)) {
+            PyErr_SetString(PyExc_TypeError, "gather: expected each field as a tuple (offset, size, out)");
+            goto done;
+        }
+        if (!PyArg_ParseTuple(item, "nnw*", &f->offset, &f->size, &outs[nf])) {
             goto done;
         }
         nf++;
-        if (f->offset < 0 || f->size < 0 || f->offset + f->size > record_size || outs[nf - 1].len / (f->size ? f->size : 1) < count) {
+        /* offset <= record_size, then size <= record_size - offset: no sum to overflow */
+        if (f->offset < 0 || f->size < 0 || f->offset > record_size || f->size > record_size - f->offset ||
+            outs[nf - 1].len / (f->size ? f->size : 1) < count) {
             PyErr_SetString(PyExc_ValueError, "gather: a field outside the record, or an output too small");
             goto done;
         }
         f->out = (char *)outs[nf - 1].buf;
     }
     const unsigned char *d = (const unsigned char *)buf.buf;
-    const int64_t *at = (const int64_t *)offs.buf;
+    const char *at = (const char *)offs.buf;
+    const uint64_t length = (uint64_t)buf.len, width = (uint64_t)record_size;
     int bad = 0;
     Py_BEGIN_ALLOW_THREADS
     for (Py_ssize_t i = 0; i < count; i++) {
-        int64_t o = at[i];
-        if (o < 0 || o > (int64_t)(buf.len - record_size)) {
+        int64_t o;
+        memcpy(&o, at + (size_t)i * 8, 8);
+        /* the record [o, o + width) inside [0, length): o <= length, then width <= length - o */
+        if (o < 0 || (uint64_t)o > length || width > length - (uint64_t)o) {
             bad = 1;
             break;
         }
@@ -152,7 +189,7 @@ done:
     for (Py_ssize_t j = 0; j < nf; j++) {
         PyBuffer_Release(&outs[j]);
     }
-    Py_XDECREF(seq);
+    Py_XDECREF(items);
     PyBuffer_Release(&buf);
     PyBuffer_Release(&offs);
     return result;

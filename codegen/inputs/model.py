@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import importlib
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from typing import Any, Protocol, cast, runtime_checkable
 
 
@@ -176,7 +176,50 @@ class UlogLog(Protocol):
     def iter_records(self, cls: Any, *, topic: str | Iterable[str] | None = None) -> Iterator[LogRecord]: ...
     def topics(self) -> list[tuple[str, int]]: ...
     def columns(self, topic: str, multi_id: int = 0, *, use_numpy: bool | None = None) -> dict[str, Any]: ...
+    def decoder(self, cls: Any, topic: str) -> Callable[[int], tuple[Any, Mapping[str, Any], tuple[str, ...]]]: ...
     def close(self) -> None: ...
+
+
+class UlogStream(Protocol):
+    """The records of one topic instance a walk found (``_ulog.Stream``): payload offsets listed
+    in ``offsets`` (a walk without an index moves them on, counting them in ``done``)."""
+
+    key: tuple[str, int]  # (topic, multi_id)
+    offsets: list[int]
+    done: int
+
+
+class UlogBinding(Protocol):
+    """Where a msg_id's data records go (``_ulog.Binding``): a stream, and the accepted record sizes."""
+
+    @property
+    def stream(self) -> UlogStream: ...
+    @property
+    def lo(self) -> int: ...
+    @property
+    def hi(self) -> int: ...
+
+
+class UlogWalk(Protocol):
+    """The walking API of ``_ulog.Log``: what a faster walker of the data section (the compiled
+    index, :mod:`.ulog_index`) uses to walk it with the generated reader's rules."""
+
+    KNOWN_TYPES: frozenset[int]  # record types the reader knows (others of size 0 or > 10000: corruption)
+    data: Any  # the file: bytes or a memory map
+    walked: bool
+    indexed: bool
+
+    @property
+    def segments(self) -> list[tuple[int, int]]: ...
+    @property
+    def streams(self) -> dict[tuple[str, int], UlogStream]: ...
+    def bindings(self) -> dict[int, UlogBinding]: ...
+    def binding(self, msg_id: int) -> UlogBinding | None: ...
+    def index(self) -> dict[tuple[str, int], UlogStream]: ...
+    def begin_walk(self) -> UlogWalk: ...
+    def end_walk(self, walk: Any, *, indexed: bool) -> None: ...
+    def step(self, pos: int, size: int, kind: int, end: int, at_eof: bool) -> int: ...
+    def walk(self, pos: int, end: int, at_eof: bool, limit: int) -> int: ...
 
 
 class UlogFormat(Protocol):

@@ -6,14 +6,16 @@ record starts -- is done by a small C function (``_ulog_scan.c``, built at insta
 is there), and what the records mean stays the generated reader's:
 
 - every record that is not data ('A' subscriptions, 'L' text, 'P' parameters...) goes through the
-  generated ``_step``, in file order, so subscriptions, info, warnings and counts come out as a
+  generated ``step``, in file order, so subscriptions, info, warnings and counts come out as a
   walk of the generated reader leaves them;
 - the data records ('D', nearly all of a log) are sorted into their streams with numpy: each
   takes the subscription its msg_id had when it was logged, and its size is checked as the
   generated walker checks it; a log with records it would skip (damage) is left to it whole,
   since its warnings about them interleave with the others;
 - where the generated walker would do something special (a record running past the end, a
-  corrupt header to resynchronise after), the C walk stops and the generated ``_step`` decides.
+  corrupt header to resynchronise after), the C walk stops and the generated ``step`` decides.
+
+It uses only the generated reader's public walking API (:class:`.model.UlogWalk`).
 
 Without the compiled walk, :func:`record_offsets` falls back on the generated index. Either way
 the result is the same: tests/inputs/test_ulog_index.py compares the two on real, synthetic and
@@ -22,11 +24,12 @@ damaged logs.
 
 from __future__ import annotations
 
-import importlib
 import itertools
 import struct
 from collections.abc import Callable, Sequence
-from typing import Any, Protocol, cast
+from typing import Any, cast
+
+from .model import UlogBinding, UlogWalk
 
 NDArray = Any  # numpy arrays
 StreamKey = tuple[str, int]
@@ -48,29 +51,6 @@ except ImportError:  # no C compiler at install time: the generated walker does 
     _scan = gather = None
 
 
-class _Stream(Protocol):
-    key: StreamKey
-    offsets: list[int]
-    done: int
-
-
-class WalkLog(Protocol):
-    """The parts of the generated ``_ulog.Log`` a walk of its data section uses and updates."""
-
-    data: Any
-    walked: bool
-    indexed: bool
-    _segments: list[tuple[int, int]]
-    _streams: dict[StreamKey, _Stream]
-    _by_id: dict[int, tuple[Callable[[int], None], int, int]]
-
-    def _fresh(self) -> WalkLog: ...
-    def _adopt(self, walk: Any, *, indexed: bool) -> None: ...
-    def _index(self) -> dict[StreamKey, _Stream]: ...
-    def _step(self, pos: int, size: int, kind: int, end: int, at_eof: bool) -> int: ...
-    def _walk(self, pos: int, end: int, at_eof: bool, limit: int) -> int: ...
-
-
 def compiled() -> bool:
     """Whether the C walk was built (else the generated walker indexes logs)."""
     return _scan is not None
@@ -83,22 +63,19 @@ def record_offsets(log: Any, *, use_compiled: bool | None = None) -> dict[Stream
     ``use_compiled`` False (or the extension missing) takes the generated index instead."""
     import numpy as np
 
-    typed = cast(WalkLog, log)
+    typed = cast(UlogWalk, log)
     if _scan is None or use_compiled is False or typed.indexed:
-        return {k: np.asarray(s.offsets, np.int64) for k, s in typed._index().items() if s.offsets}
-    # A log not walked yet holds its definitions section's state: walk it in place (copying that
-    # state, parameters and all, cost a real log some milliseconds); else walk a fresh copy.
-    walk = typed if not typed.walked else typed._fresh()
+        return {k: np.asarray(s.offsets, np.int64) for k, s in typed.index().items() if s.offsets}
+    # A log not walked yet is walked in place (copying its definitions' state, parameters and all,
+    # cost a real log some milliseconds); else a fresh copy.
+    walk = typed.begin_walk()
     found: dict[StreamKey, list[NDArray]] = {}
     try:
-        for start, stop in walk._segments:
+        for start, stop in walk.segments:
             _walk_segment(walk, start, stop, found)
     except _Fallback:  # a damaged log: the generated walker (from the definitions), whose warnings come in its order
         return record_offsets(log, use_compiled=False)
-    if walk is typed:
-        typed.walked = True
-    else:
-        typed._adopt(walk, indexed=False)
+    typed.end_walk(walk, indexed=False)
     return {k: parts[0] if len(parts) == 1 else np.concatenate(parts) for k, parts in found.items()}
 
 
@@ -106,25 +83,23 @@ class _Fallback(Exception):
     """Records the generated walker skips (with warnings whose order matters): let it walk."""
 
 
-def _known_types(walk: WalkLog) -> bytes:
+def _known_types(walk: UlogWalk) -> bytes:
     """The generated reader's known record types, as 256 flags for the C walk."""
-    module = importlib.import_module(type(walk)._step.__module__)
-    known = cast(frozenset[int], module._KNOWN)
-    return bytes(1 if t in known else 0 for t in range(256))
+    return bytes(1 if t in walk.KNOWN_TYPES else 0 for t in range(256))
 
 
-def _drain(walk: WalkLog, found: dict[StreamKey, list[NDArray]]) -> None:
+def _drain(walk: UlogWalk, found: dict[StreamKey, list[NDArray]]) -> None:
     """Move the offsets the generated walker listed (in its stream lists) into ``found``, in order."""
     import numpy as np
 
-    for key, stream in walk._streams.items():
+    for key, stream in walk.streams.items():
         if stream.offsets:
             found.setdefault(key, []).append(np.asarray(stream.offsets, np.int64))
             stream.done += len(stream.offsets)
             stream.offsets.clear()
 
 
-def _walk_segment(walk: WalkLog, start: int, stop: int, found: dict[StreamKey, list[NDArray]]) -> None:
+def _walk_segment(walk: UlogWalk, start: int, stop: int, found: dict[StreamKey, list[NDArray]]) -> None:
     """Walk the records in [start, stop) as the generated ``_windows`` does, the C walk first."""
     import numpy as np
 
@@ -143,10 +118,10 @@ def _walk_segment(walk: WalkLog, start: int, stop: int, found: dict[StreamKey, l
         if nxt >= stop - 4:
             break
         size, kind = _HEAD.unpack_from(data, nxt)  # truncated or corrupt: the generated rules decide
-        pos = walk._step(nxt, size, kind, stop, at_eof)
+        pos = walk.step(nxt, size, kind, stop, at_eof)
         _drain(walk, found)
     if pos <= stop:  # the last 4 bytes, and the warnings about a truncated end, as generated
-        walk._walk(pos, stop, at_eof, stop + 1)
+        walk.walk(pos, stop, at_eof, stop + 1)
         _drain(walk, found)
 
 
@@ -161,7 +136,7 @@ def _head_dtype() -> Any:
 
 
 def _sort_records(
-    walk: WalkLog,
+    walk: UlogWalk,
     bindings: _Bindings,
     heads: NDArray,
     stop: int,
@@ -180,7 +155,7 @@ def _sort_records(
     for pos, size, kind, msg_id in zip(  # subscriptions and the rest, in file order, through the generated reader
         others["pos"].tolist(), others["size"].tolist(), others["type"].tolist(), others["msg_id"].tolist(), strict=True
     ):
-        walk._step(pos, size, kind, stop, at_eof)
+        walk.step(pos, size, kind, stop, at_eof)
         if kind == _A and size >= 3:
             bindings.event(pos, _u16_at(walk.data, pos + 4))
         elif kind == _R and size >= 2:
@@ -203,7 +178,7 @@ def _sort_records(
         if end > begin:
             key = bindings.keys[int(streams[begin])]
             found.setdefault(key, []).append(payloads[begin:end])
-            walk._streams[key].done += end - begin
+            walk.streams[key].done += end - begin
 
 
 def _u16_at(data: Any, pos: int) -> int:
@@ -212,37 +187,31 @@ def _u16_at(data: Any, pos: int) -> int:
 
 class _Bindings:
     """Which stream each msg_id is bound to over a stretch of records: the binding before the
-    stretch, then each 'A' / 'R' record's change, as the generated reader's ``_by_id`` holds it."""
+    stretch, then each 'A' / 'R' record's change, as the generated reader's ``bindings()`` has it."""
 
-    def __init__(self, walk: WalkLog) -> None:
+    def __init__(self, walk: UlogWalk) -> None:
         self.walk = walk
         self.entries: list[tuple[int, int, int]] = []  # (stream, lo, hi) of each binding seen
         self.keys: list[StreamKey] = []
-        self._stream_index: dict[int, int] = {}  # id(stream.offsets) -> index into keys
+        self._stream_index: dict[StreamKey, int] = {}  # stream key -> index into keys
         self._entry_index: dict[tuple[int, int, int], int] = {}
         self.initial: dict[int, int] = {}
         self.events: list[tuple[int, int, int]] = []  # (msg_id, position, binding or -1)
 
     def restart(self) -> None:
         """A new stretch of records: the bindings the generated reader holds now, no changes yet."""
-        self.initial = {msg_id: self._binding(entry) for msg_id, entry in self.walk._by_id.items()}
+        self.initial = {msg_id: self._binding(b) for msg_id, b in self.walk.bindings().items()}
         self.events = []
 
-    def _binding(self, entry: tuple[Callable[[int], None], int, int] | None) -> int:
-        if entry is None:
+    def _binding(self, binding: UlogBinding | None) -> int:
+        if binding is None:
             return -1
-        append, lo, hi = entry
-        owner = id(getattr(append, "__self__", None))
-        stream = self._stream_index.get(owner)
+        key = binding.stream.key
+        stream = self._stream_index.get(key)
         if stream is None:
-            for key, s in self.walk._streams.items():
-                if id(s.offsets) == owner:
-                    stream = self._stream_index[owner] = len(self.keys)
-                    self.keys.append(key)
-                    break
-            else:
-                return -1
-        triple = (stream, lo, hi)
+            stream = self._stream_index[key] = len(self.keys)
+            self.keys.append(key)
+        triple = (stream, binding.lo, binding.hi)
         index = self._entry_index.get(triple)
         if index is None:
             index = self._entry_index[triple] = len(self.entries)
@@ -251,7 +220,7 @@ class _Bindings:
 
     def event(self, pos: int, msg_id: int) -> None:
         if msg_id >= 0:
-            self.events.append((msg_id, pos, self._binding(self.walk._by_id.get(msg_id))))
+            self.events.append((msg_id, pos, self._binding(self.walk.binding(msg_id))))
 
     def resolve(self, starts: NDArray, msg_ids: NDArray) -> NDArray:
         """The binding of each data record (-1: none) from its msg_id and position."""

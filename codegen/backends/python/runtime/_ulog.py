@@ -30,6 +30,11 @@ log of any length is streamed in constant memory. Queries that need every offset
 ``columns``, ``records``) index such a log on first use; the attributes the data section fills
 (``subscriptions``, ``logged``, ``warnings``...) are complete once a walk has finished
 (``Log.walked``). ``Record.offset`` is where the record's 'D' header starts in the file.
+
+Another walker of the data section (battgen's compiled index) works through the public walking
+API: ``Log.begin_walk`` / ``Log.end_walk`` around a walk that hands each record it cannot decide
+to ``Log.step`` (see ``_ulog_parse``); ``Log.index()`` and ``Log.decoder()`` are what the queries
+above use.
 """
 
 from __future__ import annotations
@@ -72,18 +77,32 @@ from ._ulog_format import (
     layout,
     parse_format,
 )
-from ._ulog_parse import WALK_STATE, Buffer, LogParser, Stream, Subscription, copy_state
+from ._ulog_parse import (
+    KNOWN_TYPES,
+    MAX_UNKNOWN_SIZE,
+    WALK_STATE,
+    Binding,
+    Buffer,
+    LogParser,
+    Stream,
+    Subscription,
+    copy_state,
+)
 from ._ulog_writer import Writer, write
 
 __all__ = [
     "COMPAT_DEFAULT_PARAMETERS",
     "INCOMPAT_DATA_APPENDED",
+    "KNOWN_TYPES",
     "MAGIC",
+    "MAX_UNKNOWN_SIZE",
     "RENAMED",
     "SYNC",
     "TYPES",
     "VERSION",
+    "Binding",
     "Buffer",
+    "Decoder",
     "Format",
     "FormatDiff",
     "Layout",
@@ -92,6 +111,7 @@ __all__ = [
     "Record",
     "Retyped",
     "Source",
+    "Stream",
     "Subscription",
     "ULogError",
     "ULogWarning",
@@ -125,7 +145,7 @@ class Record(NamedTuple, Generic[T]):
     unfit: tuple[str, ...] = ()
 
 
-_Decoder = Callable[[int], tuple[T, Mapping[str, Any], tuple[str, ...]]]
+Decoder = Callable[[int], tuple[T, Mapping[str, Any], tuple[str, ...]]]
 _WINDOW = 1 << 18  # bytes of data section a walk without an index reads between handing out records
 _D_HEAD = 5  # uint16 size, uint8 'D', uint16 msg_id: a record's payload starts this far in
 
@@ -170,7 +190,7 @@ class Log(LogParser):
     def records(self, topic: str, multi_id: int = 0) -> bytes:
         """Every record of a topic instance back to back, each ``layout(topic).data_size`` bytes."""
         size = self.layout(topic).data_size
-        stream = self._index().get((topic, multi_id))
+        stream = self.index().get((topic, multi_id))
         if stream is None or not stream.offsets:
             return b""
         view = memoryview(self.data)
@@ -182,7 +202,7 @@ class Log(LogParser):
         None) or required (True), else lists."""
         size = self.layout(topic).data_size
         np = _uorb.numpy_module(use_numpy)
-        stream = self._index().get((topic, multi_id))
+        stream = self.index().get((topic, multi_id))
         if np is not None and stream is not None and stream.offsets:
             # Gather the records with one fancy-indexing step: a view of the file holding a
             # size-byte record at every byte offset, indexed by the records' offsets.
@@ -206,8 +226,8 @@ class Log(LogParser):
         record goes through ``cls.decode``; otherwise fields matching by name and type are filled
         and the others keep their defaults (see :meth:`compare`)."""
         topic = topic or _default_topic(cls)
-        decode = self._decoder(cls, topic)
-        stream = self._index().get((topic, multi_id))
+        decode = self.decoder(cls, topic)
+        stream = self.index().get((topic, multi_id))
         return [decode(o)[0] for o in stream.offsets] if stream is not None else []
 
     def iter_records(
@@ -227,10 +247,10 @@ class Log(LogParser):
             names = [t for t in fmt.topics or (fmt.name,) if t in self.formats]
         else:
             names = [topic] if isinstance(topic, str) else list(topic)
-        decoders = {t: self._decoder(cls, t) for t in names}
+        decoders = {t: self.decoder(cls, t) for t in names}
         return self._decode_all(decoders, multi_id)
 
-    def _decode_all(self, decoders: dict[str, _Decoder[T]], multi_id: int | None) -> Iterator[Record[T]]:
+    def _decode_all(self, decoders: dict[str, Decoder[T]], multi_id: int | None) -> Iterator[Record[T]]:
         def wanted(key: tuple[str, int]) -> bool:
             return key[0] in decoders and (multi_id is None or key[1] == multi_id)
 
@@ -249,9 +269,10 @@ class Log(LogParser):
                 raise ULogError(f"{topic} multi_id {multi_id_}, record at offset {at}: cannot decode: {exc}") from exc
             yield Record(offset - _D_HEAD, multi_id_, topic, obj, extras, unfit)
 
-    def _decoder(self, cls: type[T], topic: str) -> _Decoder[T]:
-        """Decodes a record of ``topic`` as ``cls`` from the offset of its payload: the instance,
-        the log's values it does not hold, and which of them did not fit (see :class:`Record`)."""
+    def decoder(self, cls: type[T], topic: str) -> Decoder[T]:
+        """What :meth:`messages` and :meth:`iter_records` decode each record of ``topic`` with: from
+        the offset of a record's payload, the ``cls`` instance, the log's values it does not hold,
+        and which of them did not fit (see :class:`Record`)."""
         diff = self.compare(cls, topic=topic)
         data, size = self.data, self.layout(topic).data_size
         if diff.identical:
@@ -277,7 +298,7 @@ class Log(LogParser):
 
     # -- walking the data section ---------------------------------------------------------------
 
-    def _index(self) -> dict[tuple[str, int], Stream]:
+    def index(self) -> dict[tuple[str, int], Stream]:
         """Every record's offset by (topic, multi_id), walking the data section if not done yet."""
         if not self.indexed:
             walk = self._fresh()
@@ -308,6 +329,18 @@ class Log(LogParser):
                 s.offsets.clear()
         self._adopt(walk, indexed=False)
 
+    def begin_walk(self) -> Log:
+        """A log to walk the data section with (:meth:`step`, :meth:`walk`) from the state the
+        definitions section left: this log itself if its data section was never walked (nothing to
+        copy), else a fresh copy. :meth:`end_walk` makes a finished walk's results this log's; an
+        abandoned walk can be left as it is (each walk starts from the definitions' state)."""
+        return self if not self.walked else self._fresh()
+
+    def end_walk(self, walk: Log, *, indexed: bool) -> None:
+        """Make a finished walk from :meth:`begin_walk` this log's: its subscriptions, counts,
+        warnings...; ``indexed``: the walk kept every record's offset in its streams."""
+        self._adopt(walk, indexed=indexed)
+
     def _fresh(self) -> Log:
         """A copy of this log as its definitions section left it, to walk the data section with."""
         walk = copy.copy(self)
@@ -316,8 +349,9 @@ class Log(LogParser):
         return walk
 
     def _adopt(self, walk: Log, *, indexed: bool) -> None:
-        for name in WALK_STATE:
-            setattr(self, name, getattr(walk, name))
+        if walk is not self:
+            for name in WALK_STATE:
+                setattr(self, name, getattr(walk, name))
         self.walked = True
         self.indexed = indexed
 
@@ -351,7 +385,7 @@ def read(source: Source, *, mmap: bool = True, index: bool = True, warn: bool = 
     try:
         log._load()
         if index:
-            log._index()
+            log.index()
     except BaseException:
         log.close()
         raise

@@ -1,6 +1,13 @@
 """Reading a ULog file's records: the header, the definitions section and walks of the data
 section, each record filling the attributes of a log (:class:`LogParser`, the base of
 ``_ulog.Log``, which adds the queries). Part of the ULog runtime that ``_ulog`` re-exports.
+
+A faster walker of the data section (battgen's compiled one) drives a walk through the public
+walking API: :attr:`LogParser.segments` says where the data section's records are, and
+:meth:`LogParser.step` handles any one record (:meth:`LogParser.walk`, a run of them) by this
+reader's rules; :attr:`LogParser.streams` holds each topic instance's record offsets and
+:meth:`LogParser.bindings` which stream each msg_id's data records go to, with the record sizes
+accepted. ``Log.begin_walk`` and ``Log.end_walk`` start and finish such a walk.
 """
 
 from __future__ import annotations
@@ -10,7 +17,7 @@ import mmap
 import struct
 import warnings
 from collections.abc import Iterator
-from typing import Any
+from typing import Any, ClassVar, NamedTuple
 
 from . import _uorb
 from ._ulog_format import (
@@ -32,7 +39,10 @@ from ._ulog_format import (
 Buffer = bytes | mmap.mmap  # a log's data: the file's bytes or a read-only map of it
 
 _HEAD_ID = struct.Struct("<HBH")
-_KNOWN = frozenset(b"ABCDFILMOPQRS")
+# The record types this reader knows; a record of another type is skipped, unless its size is 0 or
+# over MAX_UNKNOWN_SIZE: then its header is taken for corruption and the walk resynchronises.
+KNOWN_TYPES = frozenset(b"ABCDFILMOPQRS")
+MAX_UNKNOWN_SIZE = 10000
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,6 +70,15 @@ class Stream:
     @property
     def total(self) -> int:
         return self.done + len(self.offsets)
+
+
+class Binding(NamedTuple):
+    """Where a msg_id's data records go (its latest subscription): the stream, and the record
+    sizes accepted (``lo <= size <= hi``, the size field of a 'D' record, msg_id included)."""
+
+    stream: Stream
+    lo: int
+    hi: int
 
 
 # The attributes records change; the definitions section's values are kept, and each walk of
@@ -113,13 +132,37 @@ class LogParser:
         self._streams: dict[tuple[str, int], Stream] = {}
         self._layouts: dict[str, Layout] = {}
         self._column_sets: dict[str, _uorb.Columns] = {}
-        self._by_id: dict[int, tuple[Any, int, int]] = {}  # msg_id -> (offsets.append, min, max record size)
+        # msg_id -> (stream.offsets.append, min and max record size, stream): the walk's hot path reads it
+        self._by_id: dict[int, tuple[Any, int, int, Stream]] = {}
         self._bad_ids: set[int] = set()  # ids warned about (once each)
         self._in_data = False
         self._segments: list[tuple[int, int]] = []  # data section: (start, stop) up to each appended offset
         self._definitions: dict[str, Any] = {}  # WALK_STATE as the definitions section left it
         self.walked = False  # a walk of the data section finished: the attributes above are complete
         self.indexed = False  # ... and it kept every record's offset
+
+    KNOWN_TYPES: ClassVar[frozenset[int]] = KNOWN_TYPES
+
+    # -- the walking API ---------------------------------------------------------------------
+
+    @property
+    def segments(self) -> list[tuple[int, int]]:
+        """The data section's records: (start, stop) byte ranges, one up to each appended-data offset."""
+        return list(self._segments)
+
+    @property
+    def streams(self) -> dict[tuple[str, int], Stream]:
+        """The record offsets of every topic instance, by (topic, multi_id), as walks fill them."""
+        return self._streams
+
+    def bindings(self) -> dict[int, Binding]:
+        """Which stream each msg_id's data records go to now (as the walk has got so far)."""
+        return {msg_id: Binding(e[3], e[1], e[2]) for msg_id, e in self._by_id.items()}
+
+    def binding(self, msg_id: int) -> Binding | None:
+        """Where data records of ``msg_id`` go now, or None (not subscribed: they are skipped)."""
+        e = self._by_id.get(msg_id)
+        return Binding(e[3], e[1], e[2]) if e is not None else None
 
     def layout(self, topic: str) -> Layout:
         """The log's own layout of a topic."""
@@ -169,7 +212,7 @@ class LogParser:
             size, kind = HEAD.unpack_from(data, pos)
             if kind not in _DEFINITIONS or pos + 3 + size > stop:
                 break
-            pos = self._step(pos, size, kind, stop, stop == end)
+            pos = self.step(pos, size, kind, stop, stop == end)
         self._segments[0] = (pos, stop)
         self._definitions = {name: copy_state(getattr(self, name)) for name in WALK_STATE}
 
@@ -189,12 +232,13 @@ class LogParser:
         for start, stop in self._segments:
             pos = start
             while pos <= stop:
-                pos = self._walk(pos, stop, stop == end, pos + size)
+                pos = self.walk(pos, stop, stop == end, pos + size)
                 yield
 
-    def _walk(self, pos: int, end: int, at_eof: bool, limit: int) -> int:
-        """The records from ``pos`` that start before ``limit``: where the next one starts, or
-        ``end + 1`` once the segment ending at ``end`` is done."""
+    def walk(self, pos: int, end: int, at_eof: bool, limit: int) -> int:
+        """Handle the records from ``pos`` that start before ``limit``, in the segment ending at
+        ``end`` (``at_eof``: the file's end, not an appended-data offset): where the next one
+        starts, or ``end + 1`` once the segment is done."""
         data = self.data
         head = _HEAD_ID.unpack_from  # size, type and (for 'D') msg_id in one call
         by_id = self._by_id
@@ -210,24 +254,25 @@ class LogParser:
                     self._bad_data(msg_id, size - 2, pos)
                 pos = nxt
                 continue
-            pos = self._step(pos, size, kind, end, at_eof)
+            pos = self.step(pos, size, kind, end, at_eof)
         if pos < end - 4:
             return pos  # paused at the window's end
         while pos + 3 <= end:  # records of under 2 bytes at the very end
             size, kind = HEAD.unpack_from(data, pos)
-            pos = self._step(pos, size, kind, end, at_eof)
+            pos = self.step(pos, size, kind, end, at_eof)
         if pos < end and at_eof:
             self._warn(f"truncated record header at offset {pos}: {end - pos} bytes at the end of the file")
         return end + 1
 
-    def _step(self, pos: int, size: int, kind: int, end: int, at_eof: bool) -> int:
-        """Handle the record at ``pos`` (any type); the next position, or one past ``end`` to stop."""
+    def step(self, pos: int, size: int, kind: int, end: int, at_eof: bool) -> int:
+        """Handle the record at ``pos`` (any type; ``size`` and ``kind`` read from its header) in
+        the segment ending at ``end``: the next record's position, or one past ``end`` to stop."""
         nxt = pos + 3 + size
         if nxt > end:
             where = "at the end of the file" if at_eof else "before an appended-data offset"
             self._warn(f"truncated record {chr(kind)!r} at offset {pos}: {end - pos - 3} of {size} bytes {where}")
             return end + 1
-        if kind == 0 or (kind not in _KNOWN and (size == 0 or size > 10000)):
+        if kind == 0 or (kind not in KNOWN_TYPES and (size == 0 or size > MAX_UNKNOWN_SIZE)):
             resync = self.data.find(SYNC, pos + 1, end)
             self._warn(f"corrupt record header at offset {pos}" + ("" if resync < 0 else f", resynced at {resync}"))
             return end + 1 if resync < 0 else resync + len(SYNC)
@@ -274,7 +319,7 @@ class LogParser:
                     self._warn(f"subscription to {topic!r} (msg_id {msg_id}): {exc}")
                 stream = self._streams[(topic, multi_id)] = Stream((topic, multi_id), lay)
             lo, hi = (stream.layout.data_size, stream.layout.size) if stream.layout else (0, 0xFFFD)
-            self._by_id[msg_id] = (stream.offsets.append, lo + 2, hi + 2)  # record sizes: msg_id included
+            self._by_id[msg_id] = (stream.offsets.append, lo + 2, hi + 2, stream)  # record sizes: msg_id included
             self._bad_ids.discard(msg_id)
         elif kind == 82:  # 'R' unsubscribe
             self._by_id.pop(U16.unpack_from(body)[0], None)
