@@ -17,9 +17,9 @@ from pathlib import Path
 from typing import IO, Literal, Protocol, cast
 
 from ..errors import BattgenError
-from ..inputs.can.captures import is_capture
 from ..inputs.can.records import capture_side
 from ..inputs.documents import read_json, read_jsonl, read_yaml
+from ..inputs.kinds import content_kind, kind_of_name
 from ..inputs.model import DecodingClass, Encodable, MavlinkClass, MessageClass, PlainClass, PlainData, UorbClass
 from ..inputs.payloads import read_hex, read_raw
 from ..inputs.records import InputError, Item, Notice, Record, Unreadable
@@ -60,10 +60,14 @@ class ConvertModule(Protocol):
 
 
 def input_format(path: str, given: str | None) -> str:
-    """The format of an input: given, else from the extension, else JSON Lines."""
+    """The format of an input: given, else a log's or capture's kind as its content says (:mod:`..inputs.kinds`),
+    else from the extension (``.bin`` and ``.hex``: one message's bytes), else JSON Lines."""
     if given:
         return given
-    if is_capture(Path(path)):  # looks through .gz
+    kind = content_kind(Path(path))
+    if kind in ("ulog", "tlog", "can"):
+        return kind
+    if kind_of_name(Path(path)) == "can":  # looks through .gz
         return "can"
     return _EXTENSIONS.get(Path(path).suffix.lower(), "jsonl")
 

@@ -103,7 +103,7 @@ def _object(schema: Schema, msg: Message, defs: dict[str, dict[str, Any]]) -> di
     out["additionalProperties"] = False
     if required:
         out["required"] = required
-    if msg.dronecan is not None and msg.dronecan.union:
+    if msg.is_union:
         _union(out, list(props))
     return out
 

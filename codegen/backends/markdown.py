@@ -44,6 +44,7 @@ FORMAT_TITLES = {
     SourceFormat.MAVLINK: "MAVLink",
     SourceFormat.DEVICETREE: "Linux devicetree bindings",
     SourceFormat.PDEF: "ArduPilot parameters",
+    SourceFormat.CYPHAL: "Cyphal (UAVCAN v1)",
 }
 
 
@@ -230,6 +231,8 @@ def _title(msg: Message) -> str:
     kind = "message"
     if msg.dronecan is not None and msg.dronecan.kind.value != "message":
         kind = f"service {msg.dronecan.kind.value}"
+    elif msg.cyphal is not None and msg.cyphal.kind.value != "message":
+        kind = f"service {msg.cyphal.kind.value}"
     elif msg.format is SourceFormat.DEVICETREE:
         kind = "binding"
     elif msg.params is not None:
@@ -251,6 +254,16 @@ def _facts(msg: Message) -> list[str]:
         facts.append(f"- **Kind:** {d.kind.value}{' (union)' if d.union else ''}")
         facts.append(f"- **Bit length:** {d.min_bitlen} to {d.max_bitlen}")
         facts.append(f"- **Bit length with tail array optimization:** {d.min_bitlen_tao} to {d.max_bitlen_tao}")
+    if msg.cyphal is not None:
+        c = msg.cyphal
+        facts.append(f"- **Full name:** {code(f'{c.full_name}.{c.major}.{c.minor}')}")
+        if c.alias_of is not None:
+            facts.append(f"- **Read as:** {code(c.alias_of)} (``reg.drone`` is UDRAL's former name)")
+        port = str(c.fixed_port_id) if c.fixed_port_id is not None else "none (set by the port registers)"
+        facts.append(f"- **Fixed port ID:** {port}")
+        sealing = "sealed" if c.sealed else f"delimited, extent {c.extent // 8} bytes"
+        facts.append(f"- **Kind:** {c.kind.value}{' (union)' if c.union else ''}, {sealing}")
+        facts.append(f"- **Bit length:** {c.min_bitlen} to {c.max_bitlen}")
     if msg.mavlink is not None:
         m = msg.mavlink
         facts.append(f"- **Message ID:** {m.msg_id}")

@@ -1,13 +1,10 @@
 """``battgen failsafe [--params FILE] [--vehicle NAME] STREAM``: replay batteries through ArduPilot's failsafe.
 
-STREAM is a flight log or a JSON Lines file of samples, told apart by content (then extension):
-
-- PX4 ULog (``.ulg``): battery_status (every multi_id) and vehicle_status.arming_state;
-- MAVLink telemetry log (``.tlog``): BATTERY_STATUS (or SYS_STATUS) and the autopilot's HEARTBEAT
-  armed flag;
-- ArduPilot DataFlash log (``.bin``): BAT records, ARM/EV arming, and the log's own PARM records as
-  the parameters when ``--params`` is not given;
-- JSON Lines, one sample a line::
+STREAM is a flight log or capture, or a JSON Lines file of samples, told apart by content (then extension).
+A log (PX4 ULog, MAVLink tlog, ArduPilot DataFlash binary or text, CAN capture) is read through the battery
+view ``export`` and ``report`` read too (``codegen.apps.battery``): the same records, clock (seconds since the
+log's start), battery numbers and arming state; a DataFlash log's own PARM records are the parameters when
+``--params`` is not given. A JSON Lines stream holds one sample a line::
 
     {"t": 0.0, "armed": true, "message": "uorb.BatteryStatus", "data": {"voltage_v": 11.9, "current_a": 2.1}}
     {"t": 1.0, "armed": true, "instance": 2, "battery": {"voltage_v": 10.4, "current_a": 2.0}}
@@ -40,14 +37,16 @@ from typing import Any
 from ..apps.failsafe.distance import DistanceRule
 from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
 from ..apps.failsafe.levels import apply_level
-from ..apps.failsafe.logs import bin_parameters, log_kind, read_log
+from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_parameters, log_samples
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
 from ..errors import BattgenError
 from ..inputs import parameter_files
+from ..inputs.kinds import detect
 
 EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE = 0, 1, 2
+FLIGHT_KINDS = ("ulog", "tlog", "dataflash", "can")
 
 
 def register(subparsers: Any) -> None:
@@ -80,16 +79,18 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     stream = Path(args.stream)
     try:
-        kind = log_kind(stream) if stream.suffix.lower() not in (".jsonl", ".ndjson", ".json") else None
+        # a flight log or capture is read through the battery view; JSON and JSON Lines are sample streams
+        table: SampleTable | None = log_samples(stream, args.stream) if detect(stream) in FLIGHT_KINDS else None
+        own = log_parameters(stream) if table is not None and not args.params else None
         if args.params:
             values: dict[str, float] = read_parameter_values(Path(args.params))
             where = args.params
             for repeat in parameter_files.repeats(parameter_files.load(Path(args.params))):
                 print(f"battgen: warning: {args.params}:{repeat.lines[-1]}: {repeat.message()}", file=sys.stderr)
-        elif kind == "bin":
-            values, where = bin_parameters(stream), f"{args.stream} (PARM records)"
+        elif own is not None:
+            values, where = own, f"{args.stream} (PARM records)"
         else:
-            raise BattgenError("expected --params FILE (only a DataFlash .bin log carries its own parameters)")
+            raise BattgenError("expected --params FILE (only a DataFlash log carries its own parameters)")
         if args.params and not batt_parameter_count(values) and not args.allow_empty:
             print(
                 f"{where}: no BATT*_ parameter ({len(values)} parameters read): the failsafe would run on "
@@ -120,7 +121,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"battgen: variant {variant}: {VARIANTS[variant]}", file=sys.stderr)
         reader = open_reader(Path(args.schemas) if args.schemas else None, args.message)
         replay = Replay(fs, reader)
-        samples = read_log(stream, kind) if kind else None
+        if table is not None and not table.has_arming:
+            print(f"battgen: {args.stream}: {NO_ARMING_NOTE}", file=sys.stderr)
+        samples = table.samples() if table is not None else None
         for event, sample in replay.run(stream, args.stream, samples):
             print(_json(event, sample, vehicle.name) if args.json else _line(event, sample))
         if replay.samples == 0:

@@ -53,7 +53,7 @@ from ..apps.gate import Gate, Settings, describe, profile_names, settings
 from ..apps.package import bundled_schemas
 from ..apps.validate import Checker, Event, FileReport, Finding, exit_code, is_empty, json_document, make_checker
 from ..apps.validate_formats import Group, Grouper, github_line, github_notice, sarif_document
-from ..inputs.dispatch import KINDS
+from ..inputs.kinds import KINDS
 from ..inputs.records import Notice, Unreadable
 from ..ir import Message
 

@@ -15,7 +15,7 @@ from typing import Protocol
 
 from ..errors import BattgenError, ErrorList, SchemaError
 from ..ir import EnumDef, Schema
-from . import devicetree, dsdl, mavlink, pdef, rules, uorb
+from . import cyphal, devicetree, dsdl, mavlink, pdef, rules, uorb
 
 
 class Frontend(Protocol):
@@ -33,6 +33,7 @@ FORMAT_FRONTENDS: dict[str, Frontend] = {
     "devicetree": devicetree,
     "mavlink": mavlink,
     "params": pdef,  # ArduPilot parameter metadata (apm.pdef.xml)
+    "cyphal": cyphal,  # Cyphal v1 DSDL root namespaces (uavcan/, reg/), read by pydsdl
 }
 
 # converter mappings between the formats (schemas/mappings/*.yaml), parsed after the formats
@@ -43,6 +44,7 @@ RULES_DIR = "rules"
 EXTENSION_FORMATS: dict[str, str] = {
     ".msg": "uorb",
     ".uavcan": "dronecan",
+    ".dsdl": "cyphal",
     ".yaml": "devicetree",
     ".yml": "devicetree",
     ".xml": "mavlink",
@@ -129,6 +131,14 @@ def dsdl_definition(path: Path) -> Path | None:
     return None
 
 
+def is_cyphal_root(path: Path) -> bool:
+    """A folder of Cyphal root namespaces (a copy of the public regulated data types, say): a sub-folder
+    holding ``*.dsdl`` definitions, and none of a schema folder's format folders."""
+    if any((path / name).is_dir() for name in _OWN_FOLDERS):
+        return False
+    return any(sub.is_dir() and cyphal.has_definitions(sub) for sub in sorted(path.iterdir()))
+
+
 def _load_dsdl_tree(path: Path, definition: Path) -> Schema:
     """A DSDL root; a folder inside one (a namespace) is refused with the root to pass instead."""
     root = dsdl.find_root(definition)
@@ -163,12 +173,14 @@ def _load_path(path: Path, include_paths: Sequence[Path]) -> Schema:
             return _load_dsdl_tree(path, definition)
         if is_schema_dir(path):
             return load_schema_dir(path, include_paths=include_paths)
+        if is_cyphal_root(path):
+            return cyphal.parse_dir(path)
         if any(p.is_file() for p in path.glob("*.msg")):
             return frontend("uorb").parse_dir(path)  # a folder of .msg files, as PX4's own msg/
         expected = ", ".join(f"{f}/" for f in FORMAT_FRONTENDS)
         raise BattgenError(
             f"{path}: not a schema folder (expected sub-folders {expected}) nor a DSDL root "
-            "(namespace folders such as uavcan/ holding .uavcan files) nor a folder of .msg files"
+            "(namespace folders such as uavcan/ holding .uavcan or Cyphal .dsdl files) nor a folder of .msg files"
         )
     if path.is_file():
         fmt = format_of_file(path)

@@ -44,6 +44,8 @@ from .mappings import (
     Rule,
 )
 from .messages import (
+    CyphalInfo,
+    CyphalKind,
     DevicetreeInfo,
     DronecanInfo,
     DronecanKind,
@@ -69,6 +71,8 @@ __all__ = [
     "Concept",
     "Constant",
     "CrossFieldRule",
+    "CyphalInfo",
+    "CyphalKind",
     "DevicetreeInfo",
     "Direction",
     "DronecanInfo",

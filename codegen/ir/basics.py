@@ -12,6 +12,7 @@ class SourceFormat(str, enum.Enum):
     DEVICETREE = "devicetree"
     MAVLINK = "mavlink"
     PDEF = "params"  # ArduPilot parameter metadata (apm.pdef.xml); the value names the schema folder and prefix
+    CYPHAL = "cyphal"  # Cyphal (UAVCAN v1) DSDL, read through pydsdl
 
 
 @dataclass(frozen=True)

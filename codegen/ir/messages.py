@@ -47,6 +47,35 @@ class DronecanInfo:
     normalized_definition: str
 
 
+class CyphalKind(str, enum.Enum):
+    MESSAGE = "message"
+    REQUEST = "request"
+    RESPONSE = "response"
+
+
+@dataclass(frozen=True)
+class CyphalInfo:
+    """A Cyphal v1 data type as pydsdl reads it. Bit lengths are the object's own (a delimited type's
+    32-bit delimiter header, written where it is nested in another type, is not counted); ``extent`` is
+    in bits and equals ``max_bitlen`` for a sealed type. ``full_name`` is the name as the source spells
+    it (``reg.drone.service.battery.Status`` for the older namespace); ``alias_of`` then names the
+    ``reg.udral`` type it is read as, whose name the message's qualified name carries."""
+
+    full_name: str
+    major: int
+    minor: int
+    kind: CyphalKind
+    union: bool
+    sealed: bool
+    extent: int
+    min_bitlen: int
+    max_bitlen: int
+    fixed_port_id: int | None = None
+    deprecated: bool = False
+    union_tag_bits: int = 0
+    alias_of: str | None = None
+
+
 @dataclass(frozen=True)
 class MavlinkInfo:
     msg_id: int
@@ -98,6 +127,12 @@ class Message:
     mavlink: MavlinkInfo | None = None
     devicetree: DevicetreeInfo | None = None
     params: PdefInfo | None = None
+    cyphal: CyphalInfo | None = None
+
+    @property
+    def is_union(self) -> bool:
+        """A DSDL union (DroneCAN ``@union``, Cyphal ``@union``): exactly one field is held at a time."""
+        return (self.dronecan is not None and self.dronecan.union) or (self.cyphal is not None and self.cyphal.union)
 
     def field(self, name: str) -> Field:
         for f in self.fields:

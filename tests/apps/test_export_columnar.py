@@ -14,11 +14,11 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from codegen.apps.export.catalog import bundled_catalog
-from codegen.apps.export.columnar import NotColumnar, convert_columns
-from codegen.apps.export.per_record import concept_converter, states_to_columns
-from codegen.apps.export.readers import read_batches
-from codegen.apps.export.sources import instances_to_columns
+from codegen.apps.battery.catalog import bundled_catalog
+from codegen.apps.battery.columnar import NotColumnar, convert_columns
+from codegen.apps.battery.per_record import concept_converter, states_to_columns
+from codegen.apps.battery.readers import read_batches
+from codegen.apps.battery.sources import instances_to_columns
 from codegen.apps.export.table import concept_array
 from codegen.apps.package import bundled_package, model_class
 from codegen.inputs.model import UorbClass
@@ -190,7 +190,7 @@ def test_generated_cbat_records(data: st.DataObject) -> None:
 
 def test_ops_without_a_columnar_form_are_refused() -> None:
     rule = next(r for m in CATALOG.schema.mappings for mp in m.mappings for r in mp.rules if r.op.NAME == "px4_convert")
-    from codegen.apps.export.columnar import ColumnConverter
+    from codegen.apps.battery.columnar import ColumnConverter
     from codegen.ir.mapping_visitor import visit
 
     converter = ColumnConverter(CATALOG, CATALOG.source("uorb.BatteryStatus"), {}, 0)

@@ -16,8 +16,8 @@ import pyulog
 from conftest import ROOT
 from fleet_samples import DOCUMENTED, LOGS, jsonl, needs_logs, tlog
 
+from codegen.apps.export.content import content_id
 from codegen.apps.export.engine import ExportOptions, export_logs, finish
-from codegen.apps.export.sources import content_id
 from codegen.apps.fleet_query import run_query
 from codegen.errors import BattgenError
 

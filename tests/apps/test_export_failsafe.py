@@ -165,8 +165,8 @@ def test_views_from_plain_duckdb_and_metadata(tmp_path: Path, capsys: pytest.Cap
 
 @needs_logs
 def test_real_ulog_events_on_the_battery_clock(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A real PX4 log: the replay's clock starts at its first reading, the table's at the log's
-    start; the event sits on the battery record that caused it, and the times differ by that gap."""
+    """A real PX4 log: the replay runs on the battery table's clock (seconds since the log's start), so the
+    event sits on the battery record that caused it, at the time ``battgen failsafe`` prints."""
     log = next(p for p in LOGS if p.name == "sample_px4_events.ulg")
     params = _params(tmp_path, {"BATT_LOW_VOLT": 16.1, "BATT_LOW_TIMER": 1, "BATT_FS_LOW_ACT": 2}, "px4.param")
     out = tmp_path / "ds"
@@ -179,7 +179,7 @@ def test_real_ulog_events_on_the_battery_clock(tmp_path: Path, capsys: pytest.Ca
         out, f"SELECT pack_voltage, t FROM battery WHERE battery = {ours[0]['battery']} AND t = {ours[0]['t']}"
     ).rows
     assert row[0][0] == pytest.approx(ours[0]["value"], rel=1e-6)
-    assert ours[0]["t"] < ours[0]["replay_t"]  # the log starts before its first battery or vehicle status
+    assert ours[0]["t"] == ours[0]["replay_t"] == row[0][1]  # one clock
 
 
 def test_bad_failsafe_parameters_are_clear_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -44,7 +44,7 @@ def test_ir_is_valid_json_against_the_ir_schema(capsys: pytest.CaptureFixture[st
     assert main(["ir", str(SCHEMAS)]) == 0
     data = json.loads(capsys.readouterr().out)
     assert validate_ir_json(data) == []
-    assert {m["format"] for m in data["messages"]} == {"uorb", "dronecan", "devicetree", "mavlink", "params"}
+    assert {m["format"] for m in data["messages"]} == {"uorb", "dronecan", "devicetree", "mavlink", "params", "cyphal"}
 
 
 @pytest.mark.parametrize(

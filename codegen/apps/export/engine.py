@@ -21,9 +21,12 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from ...errors import BattgenError
-from .catalog import bundled_catalog
-from .columnar import convert_columns
-from .dataflash_batches import dataflash_raw_tables
+from ..battery.catalog import bundled_catalog
+from ..battery.sources import Batch, log_kind
+from ..battery.view import read_view
+from ..failsafe.logs import SampleTable
+from .content import content_id, map_file
+from .dataflash_raw import dataflash_raw_tables
 from .dataset import (
     LogWriter,
     claim_layout,
@@ -33,9 +36,7 @@ from .dataset import (
     partition_of,
     raw_table,
 )
-from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, battery_numbers, replay_tables
-from .readers import read_log
-from .sources import Batch, content_id, export_kind, map_file
+from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, replay_tables
 from .table import battery_schema, battery_table
 from .views import write_views
 
@@ -102,18 +103,18 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
     in flat memory); the failsafe replay keeps what it needs of each (its context, not its columns)."""
     catalog = bundled_catalog()
     schema = battery_schema(catalog)
-    kind = export_kind(file)
+    kind = log_kind(file)
     writer = LogWriter(options.out, log, schema)
     notes: list[str] = []
     messages: set[str] = set()
-    seen: list[Batch] = []  # each batch's context, for the replay
-    firsts: list[int | None] = []  # each batch's first battery number, for the replay
+    replay = SampleTable()  # what the failsafe replay needs of each chunk (not its columns)
+    clock: Batch | None = None  # a batch of the log, for the replay's time of day
     first_us: int | None = None  # the log's first time of day (UTC µs), which names its day partition (--partition day)
     try:
-        for batch in read_log(file, name, catalog, options.message, source, all_fields=options.raw):
-            columns = batch.concepts
-            if columns is None:
-                columns = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)
+        for chunk in read_view(
+            file, name, catalog=catalog, message=options.message, source=source, all_fields=options.raw
+        ):
+            batch, columns = chunk.batch, chunk.concepts
             table = battery_table(catalog, schema, columns, batch, log, file.name)
             writer.add(table)
             if options.raw and batch.message in catalog.sources:
@@ -125,9 +126,8 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
                 if first is not None:
                     first_us = first if first_us is None else min(first_us, first)
             if options.failsafe is not None:
-                firsts.append(table["battery"][0].as_py() if table.num_rows else None)
-                batch.columns, batch.concepts = {}, None
-                seen.append(batch)
+                replay.add(chunk)
+                clock = clock or (batch if batch.n else None)
         if options.raw and kind == "dataflash":
             for message, raw in dataflash_raw_tables(file, name, log):
                 writer.add_raw(message, raw)
@@ -138,9 +138,8 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
         notes.append("no battery records")
     extra: list[tuple[str, dict[str, Any]]] = []
     if options.failsafe is not None:
-        numbers = battery_numbers(kind, seen, firsts)
         try:
-            replayed = replay_tables(file, name, kind, log, options.failsafe, seen, numbers)
+            replayed = replay_tables(file, name, kind, log, options.failsafe, replay, clock)
         except BattgenError as exc:
             replayed = f"failsafe not replayed: {exc}"
         if isinstance(replayed, str):

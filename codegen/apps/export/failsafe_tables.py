@@ -26,16 +26,16 @@ from typing import Any
 import pyarrow as pa
 
 from ...errors import BattgenError
+from ..battery.sources import Batch
 from ..failsafe.flight import replay_flight
+from ..failsafe.logs import SampleTable, log_parameters
 from ..failsafe.stream import batt_parameter_count, read_parameter_values
 from ..failsafe.vehicles import VEHICLES
-from .sources import Batch
 
 FAILSAFE = "failsafe"
 EVENTS_FILE = "events.parquet"
 REPLAYS_FILE = "replays.parquet"
 OWN_PARAMETERS = "log"  # --failsafe log: each DataFlash log's own PARM records
-_KINDS = {"ulog": "ulog", "tlog": "tlog", "dataflash": "bin"}
 
 
 @dataclass(frozen=True)
@@ -111,48 +111,39 @@ EVENTS_SCHEMA = table_schema(EVENT_COLUMNS, "failsafe_events")
 REPLAYS_SCHEMA = table_schema(REPLAY_COLUMNS, "failsafe_replays")
 
 
-def battery_numbers(kind: str, batches: Sequence[Batch], batteries: Sequence[int | None]) -> dict[int, int]:
-    """ArduPilot's 1-based battery of a replay -> the battery table's battery. The replay numbers a
-    ULog multi_id or DataFlash instance + 1 (the batches' instance), a MAVLink id + 1 (the table's
-    battery is the id)."""
-    if kind == "tlog":
-        return {}
-    return {int(b.instance[0]) + 1: bat for b, bat in zip(batches, batteries, strict=True) if b.n and bat is not None}
-
-
 def replay_tables(
     path: Path,
     name: str,
     kind: str,
     log: str,
     options: FailsafeOptions,
-    batches: Sequence[Batch],
-    numbers: dict[int, int],
+    table: SampleTable,
+    clock: Batch | None,
 ) -> tuple[Any, Any] | str:
-    """The events and replays tables of one log, or a note saying why it was not replayed."""
-    replay_kind = _KINDS.get(kind)
-    if replay_kind is None:
-        what = "a CAN capture" if kind == "can" else "a JSON Lines file"
-        return f"failsafe not replayed: {what} is no flight log battgen failsafe reads"
-    if options.params is None and replay_kind != "bin":
-        return "failsafe not replayed: only a DataFlash log carries its own parameters (give --failsafe PARAMS)"
-    replay = replay_flight(path, name, replay_kind, options.params, options.vehicle)
-    clock = next((b for b in batches if b.n), None)
+    """The events and replays tables of one log, replayed from the samples of the chunks the export read
+    (``table``), or a note saying why it was not replayed. ``clock``: a batch of the log, for the time of day."""
+    if kind == "jsonl":
+        return "failsafe not replayed: a JSON Lines file is no flight log battgen failsafe reads"
+    values = options.params
+    if values is None:
+        values = log_parameters(path)
+        if values is None:
+            return "failsafe not replayed: only a DataFlash log carries its own parameters (give --failsafe PARAMS)"
+    replay = replay_flight(table, name, values, options.vehicle)
 
     def battery(instance: int) -> int:
-        return numbers.get(instance, instance - 1)
+        return instance - 1
 
-    origin = None if clock is None else clock.origin_us
     offset = None if clock is None else clock.utc_offset_us
+    origin = 0 if clock is None else clock.origin_us
     rows: dict[str, list[Any]] = {c[0]: [] for c in EVENT_COLUMNS}
     for event, sample in replay.events:
-        stamp = sample.stamp_us
         rows["log"].append(log)
         rows["battery"].append(battery(event.battery))
         rows["instance"].append(event.battery)
-        rows["t"].append(None if stamp is None or origin is None else (stamp - origin) / 1e6)
+        rows["t"].append(sample.t)
         rows["replay_t"].append(event.time)
-        rows["time"].append(None if stamp is None or offset is None else stamp + offset)
+        rows["time"].append(None if offset is None else origin + round(sample.t * 1e6) + offset)
         rows["level"].append(event.level.name)
         for key in ("cause", "value", "threshold", "action", "action_code", "executed", "outcome", "priority"):
             rows[key].append(getattr(event, key))

@@ -17,9 +17,10 @@ from typing import Any
 import numpy as np
 import pyarrow as pa
 
-from .catalog import Catalog
-from .columns import ConceptColumn, NDArray
-from .sources import Batch
+from ..battery.catalog import Catalog
+from ..battery.columns import ConceptColumn, NDArray
+from ..battery.sources import Batch
+from ..battery.view import battery_of
 
 # Text that repeats (the log, its file, a choice among a few) is dictionary-encoded in Arrow: Parquet
 # stores it so anyway, and building it so is a fraction of the cost. Engines read it as text.
@@ -188,8 +189,7 @@ def battery_table(
 ) -> Any:
     """The battery table of one batch of records of the log ``log`` (its content id), file ``source``."""
     n = batch.n
-    index = columns["battery_index"]
-    battery = np.asarray(np.where(index.valid, index.values, batch.instance), np.int32)
+    battery = battery_of(columns, batch)
     timestamp = pa.timestamp("us", tz="UTC")
     arrays: list[Any] = [
         repeated(log, n),

@@ -17,7 +17,7 @@ from pathlib import Path
 from ...errors import BattgenError
 from .evaluator import Event, make_failsafe
 from .levels import Level
-from .logs import bin_parameters, read_log
+from .logs import SampleTable
 from .settings import battery_settings
 from .stream import Reader, Replay, Sample, open_reader
 from .vehicles import detect_vehicle
@@ -42,15 +42,9 @@ def _reader() -> Reader:
     return open_reader(None)
 
 
-def replay_flight(
-    path: Path, name: str, kind: str, values: dict[str, float] | None, vehicle: str | None
-) -> FlightReplay:
-    """Replay the log at ``path`` (``kind``: ulog, tlog or bin; errors name it ``name``) with the
-    parameter ``values`` (None: the log's own, which only a DataFlash log has)."""
-    if values is None:
-        if kind != "bin":
-            raise BattgenError(f"{name}: the log carries no parameters (only a DataFlash .bin has PARM records)")
-        values = bin_parameters(path)
+def replay_flight(table: SampleTable, name: str, values: dict[str, float], vehicle: str | None) -> FlightReplay:
+    """Replay a log's samples (:class:`.logs.SampleTable`; errors name the log ``name``) with the parameter
+    ``values``."""
     detection = detect_vehicle(values, vehicle)
     try:
         settings = battery_settings(values, detection.vehicle)
@@ -61,10 +55,10 @@ def replay_flight(
     out = FlightReplay([], detection.vehicle.name, detection.how)
 
     def samples_of() -> Iterator[Sample]:
-        for sample in read_log(path, kind):
+        for sample in table.samples():
             out.samples[sample.instance] = out.samples.get(sample.instance, 0) + 1
             yield sample
 
-    out.events.extend(replay.run(path, name, samples_of()))
+    out.events.extend(replay.run(Path(name), name, samples_of()))
     out.levels = {i: m.failsafe for i, m in sorted(fs.monitors.items())}
     return out

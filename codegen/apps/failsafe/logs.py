@@ -1,86 +1,116 @@
-"""Real flights as failsafe samples: PX4 ULog (.ulg), MAVLink telemetry logs (.tlog), DataFlash (.bin).
+"""Real flights as failsafe samples, from the battery view (:mod:`codegen.apps.battery.view`) that ``export`` and
+``report`` read too: the same records, the same clock, the same "armed" and the same concepts.
 
-Each reader yields :class:`~.stream.Sample`\\ s in time order (seconds from the log's first record),
-one per battery reading, every battery instance of the log (1-based, as ArduPilot prints it), with
-the arming state last logged before it (disarmed before the first). The files are read by the
-inputs layer: ``.ulg`` and ``.tlog`` by :mod:`codegen.inputs.flight_logs` (battery_status and
-vehicle_status; BATTERY_STATUS or SYS_STATUS and the autopilot's HEARTBEAT), ``.bin`` by
-:mod:`codegen.inputs.dataflash` (``BAT`` records, ``ARM``/``EV`` arming; the log's own ``PARM``
-records are its parameters, :func:`bin_parameters`).
+One sample per battery record of any log kind the view reads (PX4 ULog, MAVLink tlog, ArduPilot DataFlash, CAN
+captures), in time order across the log's batteries (a tie: the lower battery first), each with:
+
+- ``t``: the view's seconds since the log's start;
+- the battery: ArduPilot's 1-based number, the view's battery + 1;
+- the reading: the concepts ``pack_voltage`` (V), ``current`` (A) and ``discharged`` (C, as mAh), unknown where the
+  IR says so (a field's sentinel; a negative current stays, as a charging battery). A value that came from a
+  float32 field is taken as its shortest decimal, as a person reads the log (16.2 V, not 16.200000762939453), so
+  that it compares with a parameter as the firmware's float32 comparison does;
+- ``armed``: the view's arming state as of the record; before the log's first arming state the vehicle is
+  disarmed, and a log with no arming state at all (a CAN capture) is taken as armed throughout
+  (:data:`NO_ARMING_NOTE`).
+
+:class:`SampleTable` keeps what a replay needs of each chunk (six numbers a record) so that ``export --failsafe``
+replays a log from the chunks it has already read, without reading the file again.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 from pathlib import Path
-from typing import cast
 
-from ...inputs import dataflash, flight_logs
-from ...inputs.flight_logs import FlightArming, FlightReading
-from ...inputs.model import UlogRuntime
-from ..package import bundled_package, package_module
+import numpy as np
+
+from ...inputs import dataflash
+from ...inputs.kinds import detect
+from ..battery.columns import NDArray
+from ..battery.view import Chunk, read_view
 from .reading import BatteryReading
 from .stream import Sample
 
-LOG_KINDS = ("ulog", "tlog", "bin")
+COULOMB_PER_MAH = 3.6
+NO_ARMING_NOTE = "taken as armed throughout (this input has no arming state)"
 
 
-def log_kind(path: Path) -> str | None:
-    """``ulog`` / ``tlog`` / ``bin`` from the content where it tells (ULog and DataFlash magic
-    bytes), else from the extension; None for anything else (a JSON Lines stream)."""
-    try:
-        with path.open("rb") as f:
-            head = f.read(8)
-    except OSError:
+class SampleTable:
+    """The failsafe's view of a log's chunks, gathered as columns; :meth:`samples` gives them in time order."""
+
+    def __init__(self) -> None:
+        self._parts: list[tuple[NDArray, ...]] = []
+        self.has_arming = False
+        self.messages: list[str] = []
+
+    def add(self, chunk: Chunk) -> None:
+        if not chunk.n:
+            return
+        batch = chunk.batch
+        if batch.armed is not None:
+            self.has_arming = True
+        armed = np.full(chunk.n, np.nan) if batch.armed is None else np.asarray(batch.armed, np.float64)
+        self._parts.append(
+            (
+                np.asarray(batch.t, np.float64),
+                chunk.battery.astype(np.int64),
+                _as_logged(chunk.number("pack_voltage")),
+                _as_logged(chunk.number("current")),
+                _as_logged(chunk.number("discharged") / COULOMB_PER_MAH),
+                armed,
+                np.arange(chunk.n, dtype=np.int64),
+                np.full(chunk.n, len(self.messages), np.int64),
+            )
+        )
+        self.messages.append(batch.message)
+
+    def __len__(self) -> int:
+        return sum(len(p[0]) for p in self._parts)
+
+    def samples(self) -> Iterator[Sample]:
+        if not self._parts:
+            return
+        t, battery, volts, amps, mah, armed, row, part = (np.concatenate(c) for c in zip(*self._parts, strict=True))
+        order = np.lexsort((battery, t))  # by time, then battery; a record without a time sorts last
+        if self.has_arming:
+            armed = np.where(np.isnan(armed), 0.0, armed)  # disarmed before the log's first arming state
+        else:
+            armed = np.ones_like(armed)
+        columns = (t[order], battery[order], volts[order], amps[order], mah[order], armed[order])
+        where = (row[order], part[order])
+        for k, (tk, bk, vk, ik, mk, ak) in enumerate(zip(*(c.tolist() for c in columns), strict=True)):
+            if tk != tk:  # NaN: a record the log gives no time for cannot be replayed
+                continue
+            place = f"{self.messages[int(where[1][k])]} record {int(where[0][k])} of battery {bk}"
+            reading = BatteryReading(_opt(vk), _opt(ik), _opt(mk))
+            yield Sample(k + 1, tk, ak == 1.0, reading, None, None, {}, bk + 1, place)
+
+
+def _opt(value: float) -> float | None:
+    return None if value != value else value
+
+
+def _as_logged(values: NDArray) -> NDArray:
+    """Values that are exactly a float32 (read from a float32 field) as their shortest decimal."""
+    out = np.array(values, np.float64)
+    single = ~np.isnan(out) & (out.astype(np.float32).astype(np.float64) == out) & (out != np.round(out))
+    if single.any():
+        out[single] = [dataflash.shortest_float32(x) for x in out[single].tolist()]
+    return out
+
+
+def log_samples(path: Path, name: str | None = None) -> SampleTable:
+    """Every battery record of a log as samples (an InputError, or another BattgenError, if unreadable)."""
+    table = SampleTable()
+    for chunk in read_view(path, name):
+        table.add(chunk)
+    return table
+
+
+def log_parameters(path: Path) -> dict[str, float] | None:
+    """The parameters a log recorded, where its kind records ArduPilot's (a DataFlash log's PARM records; a value
+    set again in flight: its last); None for other kinds."""
+    if detect(path) != "dataflash":
         return None
-    if head.startswith(b"ULog\x01\x12\x35"):
-        return "ulog"
-    if head.startswith(dataflash.HEAD + bytes([dataflash.FMT_TYPE])):
-        return "bin"
-    suffix = path.suffix.lower()
-    return {".ulg": "ulog", ".tlog": "tlog", ".bin": "bin"}.get(suffix)
-
-
-def read_log(path: Path, kind: str) -> Iterator[Sample]:
-    if kind == "ulog":
-        return ulog_samples(path)
-    if kind == "tlog":
-        return tlog_samples(path)
-    return bin_samples(path)
-
-
-def bin_parameters(path: Path) -> dict[str, float]:
-    """The parameters a DataFlash log recorded (PARM; a value set again in flight: its last)."""
     return dataflash.log_parameters(dataflash.open_log(path))
-
-
-def bin_samples(path: Path) -> Iterator[Sample]:
-    log = dataflash.open_log(path)
-    armed = False
-    for item in dataflash.flight_records(log):
-        if isinstance(item, dataflash.ArmingRecord):
-            armed = item.armed
-            continue
-        reading = BatteryReading(item.voltage_v, item.current_a, item.consumed_mah)
-        where = f"offset {item.offset}"
-        yield Sample(0, item.time_s, armed, reading, None, None, {}, item.instance + 1, where, round(item.time_s * 1e6))
-
-
-def _samples(records: Iterator[FlightReading | FlightArming]) -> Iterator[Sample]:
-    """Samples of a log's readings, each with the arming state last logged before it."""
-    armed = False
-    for rec in records:
-        if isinstance(rec, FlightArming):
-            armed = rec.armed
-            continue
-        reading = BatteryReading(rec.voltage_v, rec.current_a, rec.consumed_mah)
-        yield Sample(0, rec.time_s, armed, reading, None, None, {}, rec.instance + 1, rec.where, rec.clock_us)
-
-
-def ulog_samples(path: Path) -> Iterator[Sample]:
-    runtime = cast(UlogRuntime, package_module(bundled_package(), "_ulog"))
-    return _samples(flight_logs.ulog_readings(path, runtime))
-
-
-def tlog_samples(path: Path) -> Iterator[Sample]:
-    return _samples(flight_logs.tlog_readings(path))

@@ -2,10 +2,10 @@
 
 Parameters come from ``--params`` (a .param/.params file), else from a DataFlash log's own PARM records; the
 vehicle from ``--vehicle``, else detected from the parameters (:func:`~..failsafe.vehicles.detect_vehicle`).
-Flight logs the failsafe reads itself (``.ulg`` with the arming state, ``.tlog``, ``.bin``) are replayed from its
-own samples, so the report's markers are exactly ``battgen failsafe``'s events; other inputs (CAN captures, JSON
-Lines) are replayed from the report's series, taken as armed throughout (said on the page). Event times are moved
-onto the report's time axis (seconds since the input's first battery record).
+A flight log or capture is replayed from the samples of the battery view the report's series come from (the same
+samples ``battgen failsafe`` replays, so the markers are exactly its events, on the same clock: seconds since the
+log's start); a log without an arming state is taken as armed throughout (said on the page). Other inputs (JSON
+Lines records) are replayed from the report's series, taken as armed throughout.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ...errors import BattgenError
 from ..failsafe.evaluator import BatteryFailsafe, Event, make_failsafe
-from ..failsafe.logs import LOG_KINDS, bin_parameters, log_kind, read_log
+from ..failsafe.logs import NO_ARMING_NOTE, log_parameters
 from ..failsafe.reading import BatteryReading
 from ..failsafe.settings import battery_settings
 from ..failsafe.stream import Sample, read_parameter_values
@@ -40,11 +40,11 @@ def _series_samples(item: InputSeries) -> Iterator[Sample]:
 
 def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | None) -> Replay:
     """The failsafe events of every battery of one input, on the report's time axis."""
-    kind = log_kind(path)
+    own = log_parameters(path) if params is None and item.samples is not None else None
     if params is not None:
         values, where = read_parameter_values(params), str(params)
-    elif kind == "bin":
-        values, where = bin_parameters(path), "the log's PARM records"
+    elif own is not None:
+        values, where = own, "the log's PARM records"
     else:
         return Replay(note=NO_PARAMS)
     try:
@@ -52,29 +52,25 @@ def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | No
         failsafe = make_failsafe(battery_settings(values, detection.vehicle), detection.vehicle)
     except ValueError as exc:
         raise BattgenError(f"{where}: {exc}") from None
-    samples = read_log(path, kind) if kind in LOG_KINDS else _series_samples(item)
-    offset = _run(failsafe, samples)
+    samples = item.samples.samples() if item.samples is not None else _series_samples(item)
+    _run(failsafe, samples)
     note = f"replayed with {where}; vehicle {detection.how}"
-    if kind not in LOG_KINDS:
-        note += "; taken as armed throughout (this input has no arming state)"
+    if item.samples is None or not item.samples.has_arming:
+        note += "; " + NO_ARMING_NOTE
     thresholds = {
         s.instance - 1: {"BATT_LOW_VOLT": s.low_volt, "BATT_CRT_VOLT": s.crt_volt} for s in failsafe.settings.values()
     }
-    events = [FailsafeEvent(e.time - offset, e.battery - 1, e.level.name, _text(e)) for e in failsafe.events]
+    events = [FailsafeEvent(e.time, e.battery - 1, e.level.name, _text(e)) for e in failsafe.events]
     return Replay(events, note, thresholds)
 
 
-def _run(failsafe: BatteryFailsafe, samples: Iterator[Sample]) -> float:
-    """Feed every sample; the time of the first (the report's time 0)."""
-    offset: float | None = None
+def _run(failsafe: BatteryFailsafe, samples: Iterator[Sample]) -> None:
+    """Feed every sample."""
     for sample in samples:
-        if offset is None:
-            offset = sample.t
         try:
             failsafe.update(sample.t, sample.battery, armed=sample.armed, instance=sample.instance, **sample.extra)
         except ValueError as exc:
             raise BattgenError(f"{sample.place}: {exc}") from None
-    return offset or 0.0
 
 
 def _text(e: Event) -> str:

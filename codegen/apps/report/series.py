@@ -19,12 +19,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ...errors import BattgenError
-from ...inputs.dispatch import KIND_FORMATS, file_kind, read_records
+from ...inputs.dispatch import KIND_FORMATS, read_records
+from ...inputs.kinds import file_kind
 from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
 from ...ir import SourceFormat
+from ..battery.columns import NDArray
+from ..battery.view import Chunk, read_view
 from ..convert import Conversion
+from ..failsafe.logs import SampleTable
 from ..validate import Checker, Finding, make_checker
 
 DEFAULT_MESSAGES = {
@@ -34,6 +40,8 @@ DEFAULT_MESSAGES = {
 }
 KELVIN = 273.15
 COULOMB_PER_MAH = 3.6
+VIEW_KINDS = ("ulog", "tlog", "dataflash", "can")  # read through the battery view (JSON Lines: record by record)
+INSTANCE_WORDS = {"ulog": "multi_id", "can": "node", "dataflash": "instance"}
 
 
 @dataclass
@@ -95,6 +103,7 @@ class InputSeries:
     unreadable: list[Unreadable]
     records: int
     not_converted: int = 0
+    samples: SampleTable | None = None  # the failsafe's samples of a log read through the battery view
 
 
 def _number(value: Any) -> float | None:
@@ -140,8 +149,97 @@ def read_input(
     path: Path, schema_dir: Path, *, message: str | None = None, kind: str | None = None, display: str | None = None
 ) -> InputSeries:
     """Every battery of one input as series, with the validator's findings. Raises a BattgenError (a
-    LocatedError naming file and line for a damaged input) when the input cannot be read at all."""
+    LocatedError naming file and line for a damaged input) when the input cannot be read at all.
+
+    A flight log or capture (every kind the battery view reads) gives its series from the view, the reading
+    ``export`` and ``failsafe`` share (:mod:`codegen.apps.battery.view`), with the samples for the failsafe
+    replay (:attr:`InputSeries.samples`); its records are also validated one by one where its kind has a message
+    schema (DataFlash has none). Other inputs (JSON, YAML) go record by record through the converters."""
     name = display or path.as_posix()
+    kind = kind or file_kind(path)
+    if kind in VIEW_KINDS and message is None:
+        return _view_input(path, name, schema_dir, kind)
+    return _record_input(path, schema_dir, name, message, kind)
+
+
+def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeries:
+    batteries: dict[int, BatterySeries] = {}
+    table = SampleTable()
+    messages: list[str] = []
+    records = 0
+    word = INSTANCE_WORDS.get(kind, "id")
+    for chunk in read_view(path, name):
+        table.add(chunk)
+        records += chunk.n
+        if chunk.batch.message not in messages:
+            messages.append(chunk.batch.message)
+        numbers = chunk.battery
+        for number in sorted(set(numbers.tolist())):
+            rows = np.nonzero(numbers == number)[0]
+            series = batteries.get(number)
+            if series is None:
+                series = batteries[number] = BatterySeries(name, number, word, chunk.batch.message)
+            _extend(series, chunk, rows)
+    for series in batteries.values():
+        _order(series)
+    out = InputSeries(
+        name, ", ".join(messages) or "none", [batteries[k] for k in sorted(batteries)], [], [], [], records
+    )
+    out.samples = table
+    if kind != "dataflash":  # validate the records against their message (a DataFlash log has no message schema)
+        checked = _record_input(path, schema_dir, name, None, kind)
+        out.findings, out.notices, out.unreadable = checked.findings, checked.notices, checked.unreadable
+    return out
+
+
+def _numbers(chunk: Chunk, concept: str, rows: NDArray, scale: float = 1.0, offset: float = 0.0) -> list[float | None]:
+    values = chunk.number(concept)[rows] * scale + offset
+    return [None if v != v else v for v in values.tolist()]
+
+
+def _extend(series: BatterySeries, chunk: Chunk, rows: NDArray) -> None:
+    """Append a chunk's rows of one battery, in the units the page shows."""
+    series.t.extend(np.asarray(chunk.batch.t, np.float64)[rows].tolist())
+    series.pack_voltage.extend(_numbers(chunk, "pack_voltage", rows))
+    series.current.extend(_numbers(chunk, "current", rows))
+    series.state_of_charge.extend(_numbers(chunk, "state_of_charge", rows, 100.0))
+    series.temperature.extend(_numbers(chunk, "temperature", rows, 1.0, -KELVIN))
+    series.discharged.extend(_numbers(chunk, "discharged", rows, 1 / COULOMB_PER_MAH))
+    series.remaining_energy.extend(_numbers(chunk, "remaining_energy", rows, 1 / 3600.0))
+    cells = chunk.concepts["cell_voltages"]
+    for k in rows.tolist():
+        width = int(cells.lengths[k]) if cells.valid[k] and cells.lengths is not None else 0
+        row = cells.values[k, :width].tolist() if width else []
+        series.cells.append([v for v in row if v == v and v > 0.0])
+    health = chunk.number("state_of_health")[rows]
+    if (health > 0).any():
+        series.state_of_health = float(health[health > 0][-1]) * 100.0
+    cycles = chunk.concepts["cycle_count"]
+    known_cycles = [int(v) for v, ok in zip(cycles.values[rows], cycles.valid[rows], strict=True) if ok and v > 0]
+    if known_cycles:
+        series.cycle_count = known_cycles[-1]
+    serial = chunk.concepts["serial_number"]
+    if not series.serial:
+        for v, ok in zip(serial.values[rows].tolist(), serial.valid[rows].tolist(), strict=True):
+            text = str(v) if ok and not isinstance(v, str) and v else v if ok and isinstance(v, str) else ""
+            if text.strip("\x00 0"):
+                series.serial = text
+                break
+
+
+def _order(series: BatterySeries) -> None:
+    """A battery's samples in time order (a ULog's batteries come instance by instance, chunks in order)."""
+    order = sorted(range(len(series.t)), key=lambda k: series.t[k])
+    if order == list(range(len(order))):
+        return
+    for name in ("t", "pack_voltage", "current", "state_of_charge", "temperature", "discharged"):
+        values = getattr(series, name)
+        setattr(series, name, [values[k] for k in order])
+    series.remaining_energy = [series.remaining_energy[k] for k in order]
+    series.cells = [series.cells[k] for k in order]
+
+
+def _record_input(path: Path, schema_dir: Path, name: str, message: str | None, kind: str | None) -> InputSeries:
     msg, checker = make_checker(schema_dir, message or default_message(path, kind), [str(path)], kind)
     conversion = Conversion(_package_of(checker), msg.qualified_name, "concepts", "strict")
     batteries: dict[int, BatterySeries] = {}

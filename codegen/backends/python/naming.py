@@ -39,7 +39,7 @@ RESERVED_MEMBERS = frozenset(
 # this list in step with the templates).
 CLASS_SCOPE_NAMES = frozenset(
     {"bool", "bytearray", "bytes", "classmethod", "dict", "float", "int", "list", "object", "staticmethod", "str"}
-    | {"tuple"}
+    | {"range", "tuple"}  # range: the default of a fixed array of structures (Cyphal)
 )
 # What an enum member may not be called: the attributes IntEnum and IntFlag have (``mro`` is refused
 # by enum itself; ``real`` or ``to_bytes`` would hide int's).
@@ -116,6 +116,9 @@ def module_path(msg: Message) -> str:
     if msg.format is SourceFormat.DRONECAN and msg.dronecan is not None:
         namespace = msg.dronecan.full_name.rsplit(".", 1)[0]
         return "dronecan." + ".".join(identifier(p) for p in namespace.split("."))
+    if msg.format is SourceFormat.CYPHAL and msg.cyphal is not None:
+        namespace = (msg.cyphal.alias_of or msg.cyphal.full_name).rsplit(".", 1)[0]
+        return "cyphal." + ".".join(identifier(p) for p in namespace.split("."))
     parts = msg.qualified_name.split(".")[:-1]
     return ".".join(identifier(p) for p in parts)
 
@@ -128,6 +131,8 @@ def class_name(msg: Message) -> str:
         if msg.dronecan.kind is DronecanKind.RESPONSE:
             return base + "Response"
         return class_identifier(base)
+    if msg.format is SourceFormat.CYPHAL:
+        return class_identifier(msg.name)  # nunavut's spelling: Status_0_2, ExecuteCommand_1_3_Request
     if msg.format is SourceFormat.DEVICETREE and msg.devicetree is not None and len(msg.devicetree.compatible) == 1:
         return class_identifier(camel(msg.devicetree.compatible[0]))
     if msg.format is SourceFormat.PDEF:

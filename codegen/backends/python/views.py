@@ -85,8 +85,8 @@ def enum_views(enums: tuple[EnumDef, ...], owner: str) -> list[EnumView]:
 def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
     cls = naming.class_name(msg)
     optional_props = msg.devicetree is not None
-    # a DroneCAN union: every branch is None but the one held (see runtime/_dronecan.Union)
-    union = msg.dronecan is not None and msg.dronecan.union
+    # a DSDL union: every branch is None but the one held (see runtime/_dronecan.Union)
+    union = msg.is_union
     fields: list[FieldView] = []
     names = naming.member_names(msg, ctx.module_classes)
     patterns: list[str] = []

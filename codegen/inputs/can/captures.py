@@ -22,28 +22,14 @@ from typing import Any
 
 from ..dataflash import open_log
 from ..records import InputError
+from .candump_screen import read_screen, screen_stamp
 from .reassembly import Frame
 
-# python-can's .csv is read only when asked for (--input-format can): a .csv is more often a table of values
-CAPTURE_SUFFIXES = frozenset({".log", ".asc", ".blf", ".trc"})
-DATAFLASH_SUFFIXES = frozenset({".bin"})
 _FD_LENGTHS = (0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64)
 _EXTENDED_FLAG = 1 << 31  # ArduPilot's CANFrame: FlagEFF, FlagRTR, FlagERR in the top bits of the id
 _RTR_FLAG = 1 << 30
 _ERR_FLAG = 1 << 29
 NEEDS_CAN = "reading CAN captures needs python-can: pip install 'battgen[can]'"
-
-
-def capture_suffix(path: Path) -> str:
-    """The capture suffix of a file name, looking through a ``.gz`` (``bus.asc.gz`` -> ``.asc``)."""
-    suffixes = [s.lower() for s in path.suffixes]
-    if suffixes and suffixes[-1] == ".gz":
-        suffixes.pop()
-    return suffixes[-1] if suffixes else ""
-
-
-def is_capture(path: Path) -> bool:
-    return capture_suffix(path) in CAPTURE_SUFFIXES
 
 
 def _python_can(name: str) -> Any:
@@ -90,8 +76,24 @@ def _log_reader(path: Path, name: str) -> Any:
         raise InputError(name, 0, f"cannot open the CAN capture: {exc}") from exc
 
 
+def _screen_capture(path: Path) -> float | bool | None:
+    """False unless the file is candump's screen output (``can0  123  [8]  ...``, which python-can does not
+    read); then the stamp of its first frame (None where candump printed none)."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(4096)
+    except OSError:
+        return False
+    first = next((line for line in head.decode("utf-8", "replace").splitlines() if line.strip()), "")
+    return screen_stamp(first)
+
+
 def read_capture(path: Path, name: str) -> Iterator[Frame]:
-    """The frames of a capture file read with python-can's log reader for its suffix."""
+    """The frames of a capture file read with python-can's log reader for its suffix (candump's screen output
+    with :mod:`.candump_screen`)."""
+    if _screen_capture(path) is not False:
+        yield from read_screen(path, name)
+        return
     reader = _log_reader(path, name)
     try:
         yield from _frames_of(iter(reader), name, "the CAN capture")
@@ -108,6 +110,9 @@ def capture_start(path: Path, name: str) -> float | None:
     """The Unix time (s) of a capture's first frame where its reader gives absolute stamps (candump
     logs what the kernel stamped, BLF and TRC their header's start time); None where they count from the start
     (python-can's ASC reader) or the capture is empty."""
+    screen = _screen_capture(path)
+    if screen is not False:
+        return screen if isinstance(screen, float) and screen >= ABSOLUTE_AFTER_S else None
     reader = _log_reader(path, name)
     try:
         first = next(iter(reader), None)

@@ -17,9 +17,10 @@ from collections import Counter
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
+from ..kinds import detect
 from ..model import DronecanClass, GeneratedMessage, MessageClass, package_name
 from ..records import InputError, Item, Notice, Record, Unreadable
-from .captures import DATAFLASH_SUFFIXES, read_capture, read_dataflash_frames
+from .captures import read_capture, read_dataflash_frames
 from .ordering import AuxOrder
 from .reassembly import Diagnostic, Frame, Reassembler, Transfer
 
@@ -88,7 +89,7 @@ def decode_transfer(cls: DronecanClass, transfer: Transfer) -> GeneratedMessage:
 
 def frames_of(path: Path, name: str) -> Iterator[Frame]:
     """The frames of a capture file or of a DataFlash log's CANF/CAFD records."""
-    if path.suffix.lower() in DATAFLASH_SUFFIXES:
+    if detect(path) == "dataflash":
         return read_dataflash_frames(path, name)
     return read_capture(path, name)
 

@@ -45,7 +45,7 @@ class _Validators:
             specs.append(f"{spec_name} = {code.spec_source}")
             checks += code.lines
             field_names |= code.names
-        if msg.dronecan is not None and msg.dronecan.union:
+        if msg.is_union:
             held = ", ".join(f"{py_literal(name)}: self.{ident}" for name, ident in idents.items())
             checks.append(f"_v.union(out, self.union_field, {{{held}}})")
         rule_names: set[str] = set()

@@ -88,10 +88,10 @@ def field_code(schema: Schema, msg: Message, f: Field, ident: str, spec_name: st
 
 
 def is_optional(msg: Message, f: Field) -> bool:
-    """Whether the field's value may be None: a devicetree property, or a branch of a DroneCAN union."""
+    """Whether the field's value may be None: a devicetree property, or a branch of a DSDL union."""
     if f.pattern is not None:
         return False
-    return msg.devicetree is not None or (msg.dronecan is not None and msg.dronecan.union)
+    return msg.devicetree is not None or msg.is_union
 
 
 def _wrap(body: list[str], slow: str) -> list[str]:

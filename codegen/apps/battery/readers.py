@@ -10,7 +10,7 @@ from pathlib import Path
 from .can_batches import can_batches
 from .catalog import Catalog
 from .dataflash_batches import dataflash_batches
-from .sources import Batch, export_kind, jsonl_batches, model_of, tlog_batches, ulog_batches
+from .sources import Batch, jsonl_batches, log_kind, model_of, tlog_batches, ulog_batches
 
 
 def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
@@ -31,7 +31,7 @@ def read_log(
     caller holds (the log closes it); without ``all_fields`` a ULog batch holds only the fields the
     mapping reads (and the timestamp); ``message``: that of JSON Lines records (None: told from
     their keys)."""
-    kind = export_kind(path)
+    kind = log_kind(path)
     if kind == "ulog":
         yield from ulog_batches(path, name, catalog, source, all_fields)
     elif kind == "tlog":

@@ -10,7 +10,6 @@ and JSON Lines (.jsonl/.ndjson) read record by record through the shared readers
 
 from __future__ import annotations
 
-import hashlib
 import mmap
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
@@ -18,12 +17,11 @@ from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
-import xxhash
 
 from ...backends.python import naming
 from ...errors import BattgenError
-from ...inputs.dispatch import kind_of_suffix
 from ...inputs.documents import read_jsonl
+from ...inputs.kinds import LOG_KINDS, detect
 from ...inputs.model import MavlinkClass, MessageClass, UorbClass
 from ...inputs.records import InputError, Record, Unreadable
 from ...inputs.tlog import StreamStats, read_frames
@@ -32,10 +30,6 @@ from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
 from .columns import ConceptColumn, NDArray, length_key
-
-EXPORT_KINDS = ("ulog", "tlog", "jsonl", "dataflash", "can")
-DATAFLASH_SUFFIXES = frozenset({".bin"})
-ID_DIGITS = 16
 
 
 @dataclass
@@ -57,41 +51,11 @@ class Batch:
     notes: list[str] = field(default_factory=list)
 
 
-def content_id(path: Path, source: mmap.mmap | None = None, scheme: str = "xxh128") -> str:
-    """The stable id of a file's content: the first hex digits of its XXH3-128 (``xxh128sum``'s),
-    or of its SHA-256 (``sha256sum``'s) in a dataset made before battgen chose XXH3 (see
-    :func:`.dataset.content_scheme`).
-
-    Why not a cryptographic hash: an id of 16 hex digits (64 bits) has a 2^32 birthday bound
-    whatever hash it is cut from, so SHA-256 or BLAKE3 would buy no collision resistance here, and
-    they cost 10x and 5x XXH3's time: measured on a 171 MB log, SHA-256 0.10 s, BLAKE3 0.045 s,
-    XXH3-128 0.010 s, of an export of about half a second. With ``source``, a memory map of the
-    file, the hash reads the map: the pages the reader will use are mapped once."""
-    digest: Any = hashlib.sha256() if scheme == "sha256" else xxhash.xxh3_128()
-    if source is not None:
-        digest.update(source)
-    else:
-        with path.open("rb") as f:
-            for block in iter(lambda: f.read(1 << 20), b""):
-                digest.update(block)
-    return str(digest.hexdigest())[:ID_DIGITS]
-
-
-def map_file(path: Path) -> mmap.mmap | None:
-    """A read-only memory map of a ULog file, for hashing and reading it in one pass (None for
-    other kinds, and where a file cannot be mapped: empty, a pipe...)."""
-    if path.suffix.lower() != ".ulg":
-        return None
-    try:
-        with path.open("rb") as f:
-            return mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
-    except (OSError, ValueError):
-        return None
-
-
-def export_kind(path: Path) -> str:
-    kind = "dataflash" if path.suffix.lower() in DATAFLASH_SUFFIXES else kind_of_suffix(path)
-    if kind not in EXPORT_KINDS:
+def log_kind(path: Path) -> str:
+    """The kind of a log or capture (:func:`codegen.inputs.kinds.detect`: content, then name); an InputError for
+    a file of another kind."""
+    kind = detect(path)
+    if kind not in LOG_KINDS:
         expected = (
             "a PX4 ULog (.ulg), MAVLink tlog (.tlog), ArduPilot DataFlash (.bin), CAN capture (.log, .asc, .blf, "
             ".trc) or JSON Lines file"
