@@ -16,6 +16,7 @@ instance (:func:`battery_of`).
 
 from __future__ import annotations
 
+import functools
 import mmap
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
@@ -41,8 +42,8 @@ class Chunk:
     def n(self) -> int:
         return self.batch.n
 
-    @property
-    def battery(self) -> NDArray:
+    @functools.cached_property
+    def battery(self) -> NDArray:  # the report and the failsafe's table both ask for it
         return battery_of(self.concepts, self.batch)
 
     def number(self, concept: str) -> NDArray:

@@ -65,9 +65,6 @@ class SampleTable:
         )
         self.messages.append(batch.message)
 
-    def __len__(self) -> int:
-        return sum(len(p[0]) for p in self._parts)
-
     def samples(self) -> Iterator[Sample]:
         if not self._parts:
             return
