@@ -27,7 +27,9 @@ from pyulog import ULog
 from generated import _ulog
 from generated.uorb import BatteryStatus
 
-REAL_LOGS = Path("/work/shared/data/ulog")
+# the shared real PX4 logs, beside the repository (as CI has them)
+REAL_LOGS = Path(__file__).resolve().parents[2] / "shared" / "data" / "ulog"
+
 TOPIC = "battery_status"
 
 

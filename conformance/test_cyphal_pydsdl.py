@@ -8,13 +8,14 @@ from pathlib import Path
 
 import pydsdl
 import pytest
+from shared_data import shared
 
 from codegen.frontends import cyphal
 from codegen.frontends.cyphal.build import type_name
 from codegen.ir import CyphalKind, Schema
 
 ROOT = Path(__file__).resolve().parents[1]
-CORPUS = ROOT.parent / "shared" / "corpus" / "cyphal"
+CORPUS = shared("corpus", "cyphal")
 OURS = ROOT / "schemas" / "cyphal"
 needs_corpus = pytest.mark.skipif(not (CORPUS / "reg").is_dir(), reason="the Cyphal corpus is not present")
 

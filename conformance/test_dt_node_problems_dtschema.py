@@ -1,6 +1,6 @@
 """Every problem of a devicetree battery node, as dt-validate reports it: same problems, same order.
 
-Cases: real kernel battery nodes (conformance/corpus/linux_batteries/, see its SOURCE.md), our
+Cases: real kernel battery nodes (../shared/corpus/upstream/linux_batteries/, see its SOURCE.md), our
 devicetree test files (tests/data/devicetree/) and nodes with several problems at once. Each side's
 report becomes a list of (kind, property): ``unknown`` for the one additionalProperties problem
 (with every name it lists), ``raw`` for dt-core's "not of type" on a value that stayed bytes,
@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from shared_data import UPSTREAM
 
 from codegen.apps.validate import Finding, check_file, make_checker
 from codegen.inputs.devicetree import find_compatible, read_dts
@@ -31,7 +32,7 @@ if DTC is None and os.environ.get("CI"):
 pytestmark = pytest.mark.skipif(DTC is None, reason="dtc not installed (apt-get install device-tree-compiler)")
 
 ROOT = Path(__file__).resolve().parent.parent
-CORPUS = ROOT / "conformance" / "corpus" / "linux_batteries"
+CORPUS = UPSTREAM / "linux_batteries"
 DATA = ROOT / "tests" / "data" / "devicetree"
 BIN = Path(sys.executable).parent
 BATTERY = "devicetree.power.supply.battery"

@@ -1,4 +1,4 @@
-"""ArduPilot's own frame parameter files (conformance/corpus/ardupilot_frame_params, GPL-3.0, see
+"""ArduPilot's own frame parameter files (../shared/corpus/upstream/ardupilot_frame_params, GPL-3.0, see
 SOURCE.md), every layout: read as pymavlink's mavparm reads them, the vehicle told from the
 parameters only it has, and ``battgen params --check`` agreeing with ``battgen validate``."""
 
@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from pymavlink import mavparm
+from shared_data import UPSTREAM
 
 from codegen.apps.batt_parameters import check_parameter_file
 from codegen.apps.failsafe.vehicles import detect_vehicle
@@ -15,7 +16,7 @@ from codegen.apps.package import bundled_schemas
 from codegen.apps.validate import check_file, make_checker
 from codegen.inputs import parameter_files
 
-CORPUS = Path(__file__).parent / "corpus" / "ardupilot_frame_params"
+CORPUS = UPSTREAM / "ardupilot_frame_params"
 FILES = {
     "SPARKKit-rover.param": ("rover", False, 56),
     "SkyWalkerX8.param": ("plane", False, 116),

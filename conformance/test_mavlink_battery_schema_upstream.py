@@ -1,5 +1,5 @@
 """The shipped schemas/mavlink/battery.xml against upstream's own definitions (the corpus of
-mavlink/mavlink's message_definitions, see conformance/corpus/mavlink/SOURCE.md).
+mavlink/mavlink's message_definitions, see ../shared/corpus/upstream/mavlink/SOURCE.md).
 
 - Every enum and message element of battery.xml equals the element of the same name in
   common.xml or development.xml: attributes, text and children, whitespace aside.
@@ -26,6 +26,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pymavlink.generator import mavgen, mavparse
+from shared_data import UPSTREAM
 
 from codegen.frontends import mavlink as frontend
 from codegen.ir import ArrayType, Field, Message, PrimitiveKind, PrimitiveType, StringType
@@ -33,7 +34,7 @@ from generated import _mavlink as runtime
 from generated.mavlink import BatteryInfo, BatteryStatus, BatteryStatusV2
 
 ROOT = Path(__file__).resolve().parent.parent
-CORPUS = ROOT / "conformance" / "corpus" / "mavlink"
+CORPUS = UPSTREAM / "mavlink"
 BATTERY_XML = ROOT / "schemas" / "mavlink" / "battery.xml"
 UPSTREAM = ("common.xml", "development.xml")
 FAST = settings(max_examples=40, derandomize=True, deadline=None, suppress_health_check=list(HealthCheck))

@@ -1,4 +1,4 @@
-"""Every dialect file of current mavlink/mavlink (conformance/corpus/mavlink/, see its SOURCE.md)
+"""Every dialect file of current mavlink/mavlink (../shared/corpus/upstream/mavlink/, see its SOURCE.md)
 read by our frontend and by pymavlink's parser (mavparse) on the same file.
 
 pymavlink's bundled dialects lag upstream (its BATTERY_STATUS has no invalid markers on the
@@ -17,12 +17,13 @@ from typing import Any
 
 import pytest
 from pymavlink.generator import mavparse
+from shared_data import UPSTREAM
 
 from codegen.frontends import mavlink
 from codegen.frontends.mavlink.layout import c_type
 from codegen.ir import Schema
 
-CORPUS = Path(__file__).resolve().parent / "corpus" / "mavlink"
+CORPUS = UPSTREAM / "mavlink"
 DIALECTS = sorted(p.name for p in CORPUS.glob("*.xml"))
 
 

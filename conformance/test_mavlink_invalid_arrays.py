@@ -4,7 +4,7 @@ The MAVLink guide (mavlink/mavlink-devguide, en/guide/xml_schema.md, field ``inv
 forms: ``[X]``: each element holding X is invalid; ``[X:]``: *all* elements are invalid when the *first*
 holds X; ``[X1,,X3,]``: by position. pymavlink's mavgen carries the attribute as text (its Ada generator
 only uses it for defaults), so the guide is the reference. Checked here on the corpus
-(conformance/corpus/mavlink, see its SOURCE.md): every ``[X:]`` field upstream (the covariance matrices
+(../shared/corpus/upstream/mavlink, see its SOURCE.md): every ``[X:]`` field upstream (the covariance matrices
 of common.xml and others) is read as first-decides, and its own description says the same; and on
 code generated from upstream's ATT_POS_MOCAP (``covariance``, ``[NaN:]``) and BATTERY_STATUS
 (``voltages``, ``[UINT16_MAX]``): ``is_known`` and ``validate`` follow each form.
@@ -17,17 +17,17 @@ import math
 import sys
 from collections.abc import Iterator
 from functools import cache
-from pathlib import Path
 from typing import Any
 
 import pytest
+from shared_data import UPSTREAM
 
 from codegen.backends.python import naming
 from codegen.backends.python.writer import generate
 from codegen.frontends import mavlink
 from codegen.ir import Field, Schema
 
-CORPUS = Path(__file__).resolve().parent / "corpus" / "mavlink"
+CORPUS = UPSTREAM / "mavlink"
 NAN = math.nan
 
 

@@ -1,4 +1,4 @@
-"""Every PX4 message definition of main and releases 1.14-1.18 (conformance/corpus/px4_msgs/) reads
+"""Every PX4 message definition of main and releases 1.14-1.18 (../shared/corpus/upstream/px4_msgs/) reads
 into the IR in one ``battgen ir`` run per folder, laid out as PX4 lays out its C structs.
 
 Two references for the layout: PX4's padding rule restated here from the facts of its generator
@@ -21,13 +21,14 @@ from typing import Any
 
 import pytest
 from pyulog import ULog
+from shared_data import REAL_LOGS, UPSTREAM, missing
 
 from codegen.cli.main import main
 from codegen.ir.json_form import validate_ir_json
 
-CORPUS = Path(__file__).resolve().parent / "corpus" / "px4_msgs"
+CORPUS = UPSTREAM / "px4_msgs"
 VERSIONS = ("main", "1.14", "1.15", "1.16", "1.17", "1.18")
-EVENTS_LOG = Path("/work/shared/data/ulog/sample_px4_events.ulg")  # PX4 v1.15.0 development build
+EVENTS_LOG = REAL_LOGS / "sample_px4_events.ulg"  # PX4 v1.15.0 development build
 
 # element sizes PX4's generator knows (msgtype_size_map); anything else is a nested message
 SIZES = {"int8": 1, "int16": 2, "int32": 4, "int64": 8, "uint8": 1, "uint16": 2, "uint32": 4, "uint64": 8,
@@ -147,7 +148,7 @@ def test_a_px4_1_15_log_has_our_layouts_of_the_1_15_definitions() -> None:
     """The field list PX4's logger wrote for a topic is its C struct; where the 1.15 definition has
     exactly those fields and types, our layout of it must be that list, padding included."""
     if not EVENTS_LOG.is_file():
-        pytest.skip("the PX4 1.15 test log is not available here")
+        missing("the PX4 1.15 test log")
     ulog = ULog(str(EVENTS_LOG), message_name_filter_list=[])
     assert ulog.msg_info_dict["ver_sw_release"] >> 16 == 0x010F  # v1.15
     code, data, err = run_ir(CORPUS / "1.15")

@@ -3,9 +3,9 @@
 PX4 changed battery_status many times (renamed ``average_current_a``, widened ``voltage_cell_v``
 from float[10] to float[14], narrowed ``cell_count`` from int32 to uint8, dropped
 ``voltage_filtered_v``, ``run_time_to_empty``, ``serial_number``...). Logs are written here from
-PX4's own old definitions (conformance/corpus/px4_battery_status_history/, see its SOURCE.md),
+PX4's own old definitions (../shared/corpus/upstream/px4_battery_status_history/, see its SOURCE.md),
 through a package our generator makes from each, and read back with the bundled
-``BatteryStatus.from_ulog`` (releases 1.14 to 1.18 and main from conformance/corpus/px4_msgs/ too);
+``BatteryStatus.from_ulog`` (releases 1.14 to 1.18 and main from ../shared/corpus/upstream/px4_msgs/ too);
 pyulog, the reference reader, reads the same file. Every value pyulog
 sees must be in the record: in the instance under its (renamed) field, or in the record's extras
 -- the two real shared logs included, every battery instance of them.
@@ -29,6 +29,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from pyulog import ULog
+from shared_data import REAL_LOGS, UPSTREAM, missing
 from ulog_values import instances, scalar
 
 from codegen.backends.python.writer import generate
@@ -37,8 +38,7 @@ from generated import _ulog
 from generated.uorb import BatteryStatus
 
 ROOT = Path(__file__).resolve().parent.parent
-CORPUS = ROOT / "conformance" / "corpus" / "px4_battery_status_history"
-REAL_LOGS = Path("/work/shared/data/ulog")
+CORPUS = UPSTREAM / "px4_battery_status_history"
 # (package name, definition file): oldest first; the first predates the generated timestamp line
 VERSIONS = {
     "px4_011d7193": CORPUS / "battery_status.011d7193.msg",
@@ -47,7 +47,7 @@ VERSIONS = {
     "px4_v0": ROOT / "schemas" / "uorb" / "BatteryStatusV0.msg",
 }
 # the releases h11px4's corpus holds (px4_msgs mirror of PX4's msg/, see its SOURCE.md)
-PX4_MSGS = ROOT / "conformance" / "corpus" / "px4_msgs"
+PX4_MSGS = UPSTREAM / "px4_msgs"
 VERSIONS |= {
     f"px4_{v.replace('.', '_')}": PX4_MSGS / v / "BatteryStatus.msg"
     for v in ("1.14", "1.15", "1.16", "1.17", "1.18", "main")
@@ -181,7 +181,7 @@ def test_a_value_that_does_not_fit_stays_in_the_extras(old_packages: dict[str, M
 def test_real_logs_every_instance_every_field(name: str) -> None:
     path = REAL_LOGS / name
     if not path.is_file():
-        pytest.skip("shared sample logs not present")
+        missing("the shared real PX4 logs")
     records = BatteryStatus.from_ulog(path)
     compared = assert_nothing_lost(ULog(str(path), ["battery_status"]), records, "battery_status")
     assert compared > 1000

@@ -23,6 +23,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pyulog import ULog
+from shared_data import REAL_LOGS, missing
 from ulog_values import instances
 
 from codegen.backends.python.writer import generate
@@ -30,7 +31,7 @@ from codegen.frontends import uorb
 from generated import _ulog
 from generated.uorb import BatteryStatus, BatteryStatusV0
 
-DATA = Path("/work/shared/data/ulog")
+DATA = REAL_LOGS
 LOGS = ("sample_log_small.ulg", "sample_px4_events.ulg")
 
 
@@ -144,7 +145,7 @@ def compare_columns(ours: dict[str, Any], theirs: dict[str, Any]) -> int:
 def real_log(request: pytest.FixtureRequest) -> tuple[str, ULog, _ulog.Log]:
     path = DATA / request.param
     if not path.is_file():
-        pytest.skip(f"test log {request.param} is not available here")
+        missing(f"test log {request.param}")
     return request.param, ULog(str(path)), _ulog.read(path)
 
 

@@ -14,11 +14,12 @@ from pathlib import Path
 
 import pytest
 from pyulog import ULog
+from shared_data import REAL_LOGS, missing
 
 from codegen.frontends import uorb
 from codegen.ir import ArrayType, CompositeType, PrimitiveKind, PrimitiveType, Schema, StringType
 
-DATA = Path("/work/shared/data/ulog")
+DATA = REAL_LOGS
 LOGS = ("sample_log_small.ulg", "sample_px4_events.ulg")
 SCHEMAS = Path(__file__).resolve().parents[1] / "schemas" / "uorb"
 
@@ -97,7 +98,7 @@ def our_fields(schema: Schema, fmt: str, names: dict[str, str]) -> list[LogField
 @pytest.fixture(scope="module", params=LOGS)
 def log_formats(request: pytest.FixtureRequest) -> tuple[str, dict[str, list[LogField]]]:
     if not (DATA / request.param).is_file():
-        pytest.skip(f"test log {request.param} is not available here")
+        missing(f"test log {request.param}")
     ulog = ULog(str(DATA / request.param), message_name_filter_list=[])  # formats only, no data
     return request.param, {name: list(fmt.fields) for name, fmt in ulog.message_formats.items()}
 

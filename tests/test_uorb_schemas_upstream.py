@@ -1,5 +1,5 @@
 """The shipped PX4 battery schemas are PX4's own files of today: ``schemas/uorb/BatteryStatus.msg``
-and ``BatteryInfo.msg`` equal the copies of PX4 main in conformance/corpus/px4_msgs/main/ byte for
+and ``BatteryInfo.msg`` equal the copies of PX4 main in ../shared/corpus/upstream/px4_msgs/main/ byte for
 byte, apart from the two ``# Upstream:`` lines that name where they come from."""
 
 from __future__ import annotations
@@ -8,10 +8,11 @@ import re
 from pathlib import Path
 
 import pytest
+from shared_data import UPSTREAM
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = ROOT / "schemas" / "uorb"
-CORPUS = ROOT / "conformance" / "corpus" / "px4_msgs"
+CORPUS = UPSTREAM / "px4_msgs"
 UPSTREAM = ("BatteryStatus", "BatteryInfo")
 
 

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from shared_data import real_logs
 
 from codegen.apps.battery.catalog import bundled_catalog
 from codegen.apps.battery.columnar import NotColumnar, convert_columns
@@ -26,9 +27,7 @@ from codegen.inputs.records import Record
 from codegen.inputs.ulog import ulog_items
 from codegen.ir import ArrayType, PrimitiveKind, PrimitiveType
 
-LOGS = sorted(Path("/work/shared/data/ulog").glob("*.ulg")) or sorted(
-    (Path(__file__).resolve().parents[2] / "conformance").rglob("*.ulg")
-)
+LOGS = real_logs()
 CATALOG = bundled_catalog()
 PACKAGE = bundled_package()
 

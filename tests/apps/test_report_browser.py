@@ -13,15 +13,13 @@ from pathlib import Path
 import pytest
 from flight_logs import write_capture_flight, write_flight
 from report_browser import Page, open_page, require_browser
+from shared_data import real_logs
 
 from codegen.apps.report.downsample import POINT_BUDGET, planned_length
 from codegen.cli.main import main
 
 pytest.importorskip("plotly")
-# shared/ lies beside the checkout (CI copies it there); a worktree elsewhere finds it in /work
-_SHARED = [Path(__file__).resolve().parents[3] / "shared", Path("/work/shared")]
-SHARED = next((p for p in _SHARED if p.is_dir()), _SHARED[0]) / "data" / "ulog"
-REAL_LOGS = sorted(SHARED.glob("*.ulg"))
+REAL_LOGS = real_logs()
 
 
 def _report(tmp_path: Path, name: str, *inputs: Path, extra: tuple[str, ...] = ()) -> Path:

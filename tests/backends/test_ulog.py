@@ -11,6 +11,7 @@ from types import ModuleType
 from typing import Any
 
 import pytest
+from shared_data import REAL_LOGS, missing
 
 from codegen.frontends import uorb
 from generated import _ulog
@@ -419,14 +420,11 @@ def test_walks_in_small_windows_agree_with_the_index(name: str, monkeypatch: pyt
     assert lazy.topics() == full.topics() and lazy.count("battery_status") == full.count("battery_status")
 
 
-REAL_LOGS = Path("/work/shared/data/ulog")
-
-
 @pytest.mark.parametrize("name", ["sample_log_small.ulg", "sample_px4_events.ulg"])
 def test_real_logs_walked_in_windows_read_as_indexed(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
     path = REAL_LOGS / name
     if not path.is_file():
-        pytest.skip("shared sample logs not present")
+        missing("the shared real PX4 logs")
     full = _ulog.read(path)
     monkeypatch.setattr(_ulog, "_WINDOW", 4096)  # hundreds of windows, cutting between records of ~100 topics
     lazy = _ulog.read(path, index=False)

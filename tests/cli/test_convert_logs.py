@@ -11,12 +11,11 @@ from pathlib import Path
 
 import pytest
 from pyulog import ULog
+from shared_data import REAL_LOGS, missing
 
 from codegen.cli.main import main
 from generated.convert import LossReport
 from generated.convert._cells import mavlink_cells_out
-
-REAL_LOGS = Path("/work/shared/data/ulog")
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -28,7 +27,7 @@ def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
 def real(name: str) -> Path:
     path = REAL_LOGS / name
     if not path.is_file():
-        pytest.skip("shared sample logs not present")
+        missing("the shared real PX4 logs")
     return path
 
 

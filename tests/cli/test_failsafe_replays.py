@@ -16,8 +16,8 @@ from codegen.cli.main import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "inputs"))
 from dataflash_writer import battery_log
+from shared_data import REAL_LOGS
 
-REAL_LOGS = Path("/work/shared/data/ulog")
 # a rover (CRUISE_SPEED is Rover's) with two packs: battery 1 by voltage, battery 2 by capacity
 PARAMS = {
     "CRUISE_SPEED": 2.0,

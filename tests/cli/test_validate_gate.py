@@ -9,6 +9,7 @@ from pathlib import Path
 
 import jsonschema
 import pytest
+from shared_data import REAL_LOGS, missing
 
 from codegen.apps.gate import finding_code, load_profile, matches, profile_names
 from codegen.cli.main import main
@@ -16,7 +17,6 @@ from codegen.frontends.loader import load
 
 ROOT = Path(__file__).resolve().parents[2]
 SARIF_SCHEMA = json.loads((ROOT / "tests" / "data" / "sarif" / "sarif-schema-2.1.0.json").read_text())
-REAL_LOGS = Path("/work/shared/data/ulog")
 LOGS = ("sample_log_small.ulg", "sample_px4_events.ulg")
 GOOD = '{"voltage_v": 12.0, "remaining": 0.5, "max_error": 1}'
 
@@ -30,7 +30,7 @@ def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, list[str],
 def logs() -> list[str]:
     paths = [REAL_LOGS / n for n in LOGS]
     if not all(p.is_file() for p in paths):
-        pytest.skip("shared sample logs not present")
+        missing("the shared real PX4 logs")
     return [str(p) for p in paths]
 
 

@@ -11,6 +11,7 @@ from typing import Any
 
 import pytest
 from conftest import ROOT
+from shared_data import REAL_LOGS, missing
 
 from codegen.apps.validate import make_checker
 from codegen.cli.main import main
@@ -20,7 +21,6 @@ from generated import _ulog
 from generated.mavlink import BatteryStatus as MavBattery
 from generated.uorb import BatteryStatus
 
-REAL_LOGS = Path("/work/shared/data/ulog")
 SCHEMAS = ROOT / "schemas"
 
 
@@ -74,7 +74,7 @@ def test_fields_the_log_lacks_are_not_blamed_on_it(capsys: pytest.CaptureFixture
 def test_real_px4_logs_predating_message_versions(capsys: pytest.CaptureFixture[str]) -> None:
     path = REAL_LOGS / "sample_log_small.ulg"
     if not path.is_file():
-        pytest.skip("shared sample logs not present")
+        missing("the shared real PX4 logs")
     code, doc = run_json(capsys, "--message", "uorb.BatteryStatus", str(path))
     report = doc["files"][0]
     assert code == 1 and report["records"] == 42  # 21 records of each of two batteries

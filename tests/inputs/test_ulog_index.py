@@ -13,15 +13,14 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from shared_data import real_logs
 
 from codegen.inputs import ulog_columns, ulog_index
 from generated import _ulog
 from generated._ulog_parse import WALK_STATE
 from generated.uorb import BatteryInfo, BatteryStatus
 
-REAL_LOGS = sorted(Path("/work/shared/data/ulog").glob("*.ulg")) or sorted(
-    Path(__file__).resolve().parents[2].joinpath("..", "shared", "data", "ulog").glob("*.ulg")
-)
+REAL_LOGS = real_logs()
 
 
 def _state(log: Any) -> dict[str, Any]:
