@@ -3,6 +3,8 @@
 
 # msgid -> (CRC_EXTRA, class name, MAVLINK_MAX_LENGTH, MAVLink name) of every generated message
 REGISTRY: dict[int, tuple[int, str, int, str]] = {
+    0: (50, "Heartbeat", 9, "HEARTBEAT"),
+    1: (124, "SysStatus", 43, "SYS_STATUS"),
     147: (154, "BatteryStatus", 54, "BATTERY_STATUS"),
     369: (145, "BatteryStatusV2", 27, "BATTERY_STATUS_V2"),
     372: (26, "BatteryInfo", 140, "BATTERY_INFO"),

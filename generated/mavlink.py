@@ -22,13 +22,50 @@ __all__ = [
     "BatteryInfo",
     "BatteryStatus",
     "BatteryStatusV2",
+    "Heartbeat",
+    "MavAutopilot",
     "MavBatteryChargeState",
     "MavBatteryFault",
     "MavBatteryFunction",
     "MavBatteryMode",
     "MavBatteryStatusFlags",
     "MavBatteryType",
+    "MavModeFlag",
+    "MavState",
+    "MavSysStatusSensor",
+    "MavSysStatusSensorExtended",
+    "MavType",
+    "SysStatus",
 ]
+
+
+class MavAutopilot(_enum.IntEnum):
+    """Which autopilot firmware family a flight controller runs.
+
+    mavlink.MAV_AUTOPILOT: values.
+    """
+
+    GENERIC = 0
+    RESERVED = 1
+    SLUGS = 2
+    ARDUPILOTMEGA = 3
+    OPENPILOT = 4
+    GENERIC_WAYPOINTS_ONLY = 5
+    GENERIC_WAYPOINTS_AND_SIMPLE_NAVIGATION_ONLY = 6
+    GENERIC_MISSION_FULL = 7
+    INVALID = 8
+    PPZ = 9
+    UDB = 10
+    FP = 11
+    PX4 = 12
+    SMACCMPILOT = 13
+    AUTOQUAD = 14
+    ARMAZILA = 15
+    AEROB = 16
+    ASLUAV = 17
+    SMARTAP = 18
+    AIRRAILS = 19
+    REFLEX = 20
 
 
 class MavBatteryChargeState(_enum.IntEnum):
@@ -129,6 +166,151 @@ class MavBatteryType(_enum.IntEnum):
     LIFE = 2
     LION = 3
     NIMH = 4
+
+
+class MavModeFlag(_enum.IntFlag):
+    """Bits of a heartbeat's base mode.
+
+    mavlink.MAV_MODE_FLAG: bit masks, combined with |.
+    """
+
+    CUSTOM_MODE_ENABLED = 1
+    TEST_ENABLED = 2
+    AUTO_ENABLED = 4
+    GUIDED_ENABLED = 8
+    STABILIZE_ENABLED = 16
+    HIL_ENABLED = 32
+    MANUAL_INPUT_ENABLED = 64
+    SAFETY_ARMED = 128
+
+
+class MavState(_enum.IntEnum):
+    """Overall state of a system, as its heartbeat reports it.
+
+    mavlink.MAV_STATE: values.
+    """
+
+    UNINIT = 0
+    BOOT = 1
+    CALIBRATING = 2
+    STANDBY = 3
+    ACTIVE = 4
+    CRITICAL = 5
+    EMERGENCY = 6
+    POWEROFF = 7
+    FLIGHT_TERMINATION = 8
+
+
+class MavSysStatusSensor(_enum.IntFlag):
+    """Bits naming the onboard sensors and controllers of SYS_STATUS's sensor bitmaps.
+
+    mavlink.MAV_SYS_STATUS_SENSOR: bit masks, combined with |.
+    """
+
+    MAV_SYS_STATUS_SENSOR_3D_GYRO = 1
+    MAV_SYS_STATUS_SENSOR_3D_ACCEL = 2
+    MAV_SYS_STATUS_SENSOR_3D_MAG = 4
+    ABSOLUTE_PRESSURE = 8
+    DIFFERENTIAL_PRESSURE = 16
+    GPS = 32
+    OPTICAL_FLOW = 64
+    VISION_POSITION = 128
+    LASER_POSITION = 256
+    EXTERNAL_GROUND_TRUTH = 512
+    ANGULAR_RATE_CONTROL = 1024
+    ATTITUDE_STABILIZATION = 2048
+    YAW_POSITION = 4096
+    Z_ALTITUDE_CONTROL = 8192
+    XY_POSITION_CONTROL = 16384
+    MOTOR_OUTPUTS = 32768
+    RC_RECEIVER = 65536
+    MAV_SYS_STATUS_SENSOR_3D_GYRO2 = 131072
+    MAV_SYS_STATUS_SENSOR_3D_ACCEL2 = 262144
+    MAV_SYS_STATUS_SENSOR_3D_MAG2 = 524288
+    MAV_SYS_STATUS_GEOFENCE = 1048576
+    MAV_SYS_STATUS_AHRS = 2097152
+    MAV_SYS_STATUS_TERRAIN = 4194304
+    MAV_SYS_STATUS_REVERSE_MOTOR = 8388608
+    MAV_SYS_STATUS_LOGGING = 16777216
+    BATTERY = 33554432
+    PROXIMITY = 67108864
+    SATCOM = 134217728
+    MAV_SYS_STATUS_PREARM_CHECK = 268435456
+    MAV_SYS_STATUS_OBSTACLE_AVOIDANCE = 536870912
+    PROPULSION = 1073741824
+    MAV_SYS_STATUS_EXTENSION_USED = 2147483648
+
+
+class MavSysStatusSensorExtended(_enum.IntFlag):
+    """Further sensor bits, for SYS_STATUS's extended bitmaps.
+
+    mavlink.MAV_SYS_STATUS_SENSOR_EXTENDED: bit masks, combined with |.
+    """
+
+    MAV_SYS_STATUS_RECOVERY_SYSTEM = 1
+    MAV_SYS_STATUS_SENSOR_LEAK = 2
+    MAV_SYS_STATUS_SENSOR_3D_GYRO3 = 4
+    MAV_SYS_STATUS_SENSOR_3D_ACCEL3 = 8
+    MAV_SYS_STATUS_SENSOR_3D_GYRO4 = 16
+    MAV_SYS_STATUS_SENSOR_3D_ACCEL4 = 32
+
+
+class MavType(_enum.IntEnum):
+    """What kind of vehicle or component a system is.
+
+    mavlink.MAV_TYPE: values.
+    """
+
+    GENERIC = 0
+    FIXED_WING = 1
+    QUADROTOR = 2
+    COAXIAL = 3
+    HELICOPTER = 4
+    ANTENNA_TRACKER = 5
+    GCS = 6
+    AIRSHIP = 7
+    FREE_BALLOON = 8
+    ROCKET = 9
+    GROUND_ROVER = 10
+    SURFACE_BOAT = 11
+    SUBMARINE = 12
+    HEXAROTOR = 13
+    OCTOROTOR = 14
+    TRICOPTER = 15
+    FLAPPING_WING = 16
+    KITE = 17
+    ONBOARD_CONTROLLER = 18
+    VTOL_TAILSITTER_DUOROTOR = 19
+    VTOL_TAILSITTER_QUADROTOR = 20
+    VTOL_TILTROTOR = 21
+    VTOL_FIXEDROTOR = 22
+    VTOL_TAILSITTER = 23
+    VTOL_TILTWING = 24
+    VTOL_RESERVED5 = 25
+    GIMBAL = 26
+    ADSB = 27
+    PARAFOIL = 28
+    DODECAROTOR = 29
+    CAMERA = 30
+    CHARGING_STATION = 31
+    FLARM = 32
+    SERVO = 33
+    ODID = 34
+    DECAROTOR = 35
+    BATTERY = 36
+    PARACHUTE = 37
+    LOG = 38
+    OSD = 39
+    IMU = 40
+    GPS = 41
+    WINCH = 42
+    GENERIC_MULTIROTOR = 43
+    ILLUMINATOR = 44
+    SPACECRAFT_ORBITER = 45
+    GROUND_QUADRUPED = 46
+    VTOL_GYRODYNE = 47
+    GRIPPER = 48
+    RADIO = 49
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
@@ -548,6 +730,379 @@ _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC = _v.Number(
         0x20000: "MAV_BATTERY_STATUS_FLAGS_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION",
         0x40000: "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL",
         0x80000000: "MAV_BATTERY_STATUS_FLAGS_EXTENDED",
+    },
+)
+
+
+# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
+_HEARTBEAT_PAYLOAD = _struct.Struct("<IBBBBB")
+_HEARTBEAT_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("custom_mode", "custom_mode", "I", 0),
+    ("type", "type", "B", 0),
+    ("autopilot", "autopilot", "B", 0),
+    ("base_mode", "base_mode", "B", 0),
+    ("system_status", "system_status", "B", 0),
+    ("mavlink_version", "mavlink_version", "B", 0),
+)
+_HEARTBEAT_DTYPE: list[tuple[_Any, ...]] = [
+    ("custom_mode", "<u4"),
+    ("type", "u1"),
+    ("autopilot", "u1"),
+    ("base_mode", "u1"),
+    ("system_status", "u1"),
+    ("mavlink_version", "u1"),
+]
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_HEARTBEAT_TYPE_SPEC = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "MAV_TYPE_GENERIC",
+        1: "MAV_TYPE_FIXED_WING",
+        2: "MAV_TYPE_QUADROTOR",
+        3: "MAV_TYPE_COAXIAL",
+        4: "MAV_TYPE_HELICOPTER",
+        5: "MAV_TYPE_ANTENNA_TRACKER",
+        6: "MAV_TYPE_GCS",
+        7: "MAV_TYPE_AIRSHIP",
+        8: "MAV_TYPE_FREE_BALLOON",
+        9: "MAV_TYPE_ROCKET",
+        10: "MAV_TYPE_GROUND_ROVER",
+        11: "MAV_TYPE_SURFACE_BOAT",
+        12: "MAV_TYPE_SUBMARINE",
+        13: "MAV_TYPE_HEXAROTOR",
+        14: "MAV_TYPE_OCTOROTOR",
+        15: "MAV_TYPE_TRICOPTER",
+        16: "MAV_TYPE_FLAPPING_WING",
+        17: "MAV_TYPE_KITE",
+        18: "MAV_TYPE_ONBOARD_CONTROLLER",
+        19: "MAV_TYPE_VTOL_TAILSITTER_DUOROTOR",
+        20: "MAV_TYPE_VTOL_TAILSITTER_QUADROTOR",
+        21: "MAV_TYPE_VTOL_TILTROTOR",
+        22: "MAV_TYPE_VTOL_FIXEDROTOR",
+        23: "MAV_TYPE_VTOL_TAILSITTER",
+        24: "MAV_TYPE_VTOL_TILTWING",
+        25: "MAV_TYPE_VTOL_RESERVED5",
+        26: "MAV_TYPE_GIMBAL",
+        27: "MAV_TYPE_ADSB",
+        28: "MAV_TYPE_PARAFOIL",
+        29: "MAV_TYPE_DODECAROTOR",
+        30: "MAV_TYPE_CAMERA",
+        31: "MAV_TYPE_CHARGING_STATION",
+        32: "MAV_TYPE_FLARM",
+        33: "MAV_TYPE_SERVO",
+        34: "MAV_TYPE_ODID",
+        35: "MAV_TYPE_DECAROTOR",
+        36: "MAV_TYPE_BATTERY",
+        37: "MAV_TYPE_PARACHUTE",
+        38: "MAV_TYPE_LOG",
+        39: "MAV_TYPE_OSD",
+        40: "MAV_TYPE_IMU",
+        41: "MAV_TYPE_GPS",
+        42: "MAV_TYPE_WINCH",
+        43: "MAV_TYPE_GENERIC_MULTIROTOR",
+        44: "MAV_TYPE_ILLUMINATOR",
+        45: "MAV_TYPE_SPACECRAFT_ORBITER",
+        46: "MAV_TYPE_GROUND_QUADRUPED",
+        47: "MAV_TYPE_VTOL_GYRODYNE",
+        48: "MAV_TYPE_GRIPPER",
+        49: "MAV_TYPE_RADIO",
+    },
+)
+_HEARTBEAT_AUTOPILOT_SPEC = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "MAV_AUTOPILOT_GENERIC",
+        1: "MAV_AUTOPILOT_RESERVED",
+        2: "MAV_AUTOPILOT_SLUGS",
+        3: "MAV_AUTOPILOT_ARDUPILOTMEGA",
+        4: "MAV_AUTOPILOT_OPENPILOT",
+        5: "MAV_AUTOPILOT_GENERIC_WAYPOINTS_ONLY",
+        6: "MAV_AUTOPILOT_GENERIC_WAYPOINTS_AND_SIMPLE_NAVIGATION_ONLY",
+        7: "MAV_AUTOPILOT_GENERIC_MISSION_FULL",
+        8: "MAV_AUTOPILOT_INVALID",
+        9: "MAV_AUTOPILOT_PPZ",
+        10: "MAV_AUTOPILOT_UDB",
+        11: "MAV_AUTOPILOT_FP",
+        12: "MAV_AUTOPILOT_PX4",
+        13: "MAV_AUTOPILOT_SMACCMPILOT",
+        14: "MAV_AUTOPILOT_AUTOQUAD",
+        15: "MAV_AUTOPILOT_ARMAZILA",
+        16: "MAV_AUTOPILOT_AEROB",
+        17: "MAV_AUTOPILOT_ASLUAV",
+        18: "MAV_AUTOPILOT_SMARTAP",
+        19: "MAV_AUTOPILOT_AIRRAILS",
+        20: "MAV_AUTOPILOT_REFLEX",
+    },
+)
+_HEARTBEAT_BASE_MODE_SPEC = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    mask=0xFF,
+    bits={
+        0x1: "MAV_MODE_FLAG_CUSTOM_MODE_ENABLED",
+        0x2: "MAV_MODE_FLAG_TEST_ENABLED",
+        0x4: "MAV_MODE_FLAG_AUTO_ENABLED",
+        0x8: "MAV_MODE_FLAG_GUIDED_ENABLED",
+        0x10: "MAV_MODE_FLAG_STABILIZE_ENABLED",
+        0x20: "MAV_MODE_FLAG_HIL_ENABLED",
+        0x40: "MAV_MODE_FLAG_MANUAL_INPUT_ENABLED",
+        0x80: "MAV_MODE_FLAG_SAFETY_ARMED",
+    },
+)
+_HEARTBEAT_CUSTOM_MODE_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+_HEARTBEAT_SYSTEM_STATUS_SPEC = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "MAV_STATE_UNINIT",
+        1: "MAV_STATE_BOOT",
+        2: "MAV_STATE_CALIBRATING",
+        3: "MAV_STATE_STANDBY",
+        4: "MAV_STATE_ACTIVE",
+        5: "MAV_STATE_CRITICAL",
+        6: "MAV_STATE_EMERGENCY",
+        7: "MAV_STATE_POWEROFF",
+        8: "MAV_STATE_FLIGHT_TERMINATION",
+    },
+)
+_HEARTBEAT_MAVLINK_VERSION_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+
+
+# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
+_SYS_STATUS_PAYLOAD = _struct.Struct("<IIIHHhHHHHHHbIII")
+_SYS_STATUS_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("onboard_control_sensors_present", "onboard_control_sensors_present", "I", 0),
+    ("onboard_control_sensors_enabled", "onboard_control_sensors_enabled", "I", 0),
+    ("onboard_control_sensors_health", "onboard_control_sensors_health", "I", 0),
+    ("load", "load", "H", 0),
+    ("voltage_battery", "voltage_battery", "H", 0),
+    ("current_battery", "current_battery", "h", 0),
+    ("drop_rate_comm", "drop_rate_comm", "H", 0),
+    ("errors_comm", "errors_comm", "H", 0),
+    ("errors_count1", "errors_count1", "H", 0),
+    ("errors_count2", "errors_count2", "H", 0),
+    ("errors_count3", "errors_count3", "H", 0),
+    ("errors_count4", "errors_count4", "H", 0),
+    ("battery_remaining", "battery_remaining", "b", 0),
+    ("onboard_control_sensors_present_extended", "onboard_control_sensors_present_extended", "I", 0),
+    ("onboard_control_sensors_enabled_extended", "onboard_control_sensors_enabled_extended", "I", 0),
+    ("onboard_control_sensors_health_extended", "onboard_control_sensors_health_extended", "I", 0),
+)
+_SYS_STATUS_DTYPE: list[tuple[_Any, ...]] = [
+    ("onboard_control_sensors_present", "<u4"),
+    ("onboard_control_sensors_enabled", "<u4"),
+    ("onboard_control_sensors_health", "<u4"),
+    ("load", "<u2"),
+    ("voltage_battery", "<u2"),
+    ("current_battery", "<i2"),
+    ("drop_rate_comm", "<u2"),
+    ("errors_comm", "<u2"),
+    ("errors_count1", "<u2"),
+    ("errors_count2", "<u2"),
+    ("errors_count3", "<u2"),
+    ("errors_count4", "<u2"),
+    ("battery_remaining", "i1"),
+    ("onboard_control_sensors_present_extended", "<u4"),
+    ("onboard_control_sensors_enabled_extended", "<u4"),
+    ("onboard_control_sensors_health_extended", "<u4"),
+]
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_SPEC = _v.Number(
+    type="uint32",
+    kind="uint",
+    low=0,
+    high=4294967295,
+    mask=0xFFFFFFFF,
+    bits={
+        0x1: "MAV_SYS_STATUS_SENSOR_3D_GYRO",
+        0x2: "MAV_SYS_STATUS_SENSOR_3D_ACCEL",
+        0x4: "MAV_SYS_STATUS_SENSOR_3D_MAG",
+        0x8: "MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE",
+        0x10: "MAV_SYS_STATUS_SENSOR_DIFFERENTIAL_PRESSURE",
+        0x20: "MAV_SYS_STATUS_SENSOR_GPS",
+        0x40: "MAV_SYS_STATUS_SENSOR_OPTICAL_FLOW",
+        0x80: "MAV_SYS_STATUS_SENSOR_VISION_POSITION",
+        0x100: "MAV_SYS_STATUS_SENSOR_LASER_POSITION",
+        0x200: "MAV_SYS_STATUS_SENSOR_EXTERNAL_GROUND_TRUTH",
+        0x400: "MAV_SYS_STATUS_SENSOR_ANGULAR_RATE_CONTROL",
+        0x800: "MAV_SYS_STATUS_SENSOR_ATTITUDE_STABILIZATION",
+        0x1000: "MAV_SYS_STATUS_SENSOR_YAW_POSITION",
+        0x2000: "MAV_SYS_STATUS_SENSOR_Z_ALTITUDE_CONTROL",
+        0x4000: "MAV_SYS_STATUS_SENSOR_XY_POSITION_CONTROL",
+        0x8000: "MAV_SYS_STATUS_SENSOR_MOTOR_OUTPUTS",
+        0x10000: "MAV_SYS_STATUS_SENSOR_RC_RECEIVER",
+        0x20000: "MAV_SYS_STATUS_SENSOR_3D_GYRO2",
+        0x40000: "MAV_SYS_STATUS_SENSOR_3D_ACCEL2",
+        0x80000: "MAV_SYS_STATUS_SENSOR_3D_MAG2",
+        0x100000: "MAV_SYS_STATUS_GEOFENCE",
+        0x200000: "MAV_SYS_STATUS_AHRS",
+        0x400000: "MAV_SYS_STATUS_TERRAIN",
+        0x800000: "MAV_SYS_STATUS_REVERSE_MOTOR",
+        0x1000000: "MAV_SYS_STATUS_LOGGING",
+        0x2000000: "MAV_SYS_STATUS_SENSOR_BATTERY",
+        0x4000000: "MAV_SYS_STATUS_SENSOR_PROXIMITY",
+        0x8000000: "MAV_SYS_STATUS_SENSOR_SATCOM",
+        0x10000000: "MAV_SYS_STATUS_PREARM_CHECK",
+        0x20000000: "MAV_SYS_STATUS_OBSTACLE_AVOIDANCE",
+        0x40000000: "MAV_SYS_STATUS_SENSOR_PROPULSION",
+        0x80000000: "MAV_SYS_STATUS_EXTENSION_USED",
+    },
+)
+_SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_SPEC = _v.Number(
+    type="uint32",
+    kind="uint",
+    low=0,
+    high=4294967295,
+    mask=0xFFFFFFFF,
+    bits={
+        0x1: "MAV_SYS_STATUS_SENSOR_3D_GYRO",
+        0x2: "MAV_SYS_STATUS_SENSOR_3D_ACCEL",
+        0x4: "MAV_SYS_STATUS_SENSOR_3D_MAG",
+        0x8: "MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE",
+        0x10: "MAV_SYS_STATUS_SENSOR_DIFFERENTIAL_PRESSURE",
+        0x20: "MAV_SYS_STATUS_SENSOR_GPS",
+        0x40: "MAV_SYS_STATUS_SENSOR_OPTICAL_FLOW",
+        0x80: "MAV_SYS_STATUS_SENSOR_VISION_POSITION",
+        0x100: "MAV_SYS_STATUS_SENSOR_LASER_POSITION",
+        0x200: "MAV_SYS_STATUS_SENSOR_EXTERNAL_GROUND_TRUTH",
+        0x400: "MAV_SYS_STATUS_SENSOR_ANGULAR_RATE_CONTROL",
+        0x800: "MAV_SYS_STATUS_SENSOR_ATTITUDE_STABILIZATION",
+        0x1000: "MAV_SYS_STATUS_SENSOR_YAW_POSITION",
+        0x2000: "MAV_SYS_STATUS_SENSOR_Z_ALTITUDE_CONTROL",
+        0x4000: "MAV_SYS_STATUS_SENSOR_XY_POSITION_CONTROL",
+        0x8000: "MAV_SYS_STATUS_SENSOR_MOTOR_OUTPUTS",
+        0x10000: "MAV_SYS_STATUS_SENSOR_RC_RECEIVER",
+        0x20000: "MAV_SYS_STATUS_SENSOR_3D_GYRO2",
+        0x40000: "MAV_SYS_STATUS_SENSOR_3D_ACCEL2",
+        0x80000: "MAV_SYS_STATUS_SENSOR_3D_MAG2",
+        0x100000: "MAV_SYS_STATUS_GEOFENCE",
+        0x200000: "MAV_SYS_STATUS_AHRS",
+        0x400000: "MAV_SYS_STATUS_TERRAIN",
+        0x800000: "MAV_SYS_STATUS_REVERSE_MOTOR",
+        0x1000000: "MAV_SYS_STATUS_LOGGING",
+        0x2000000: "MAV_SYS_STATUS_SENSOR_BATTERY",
+        0x4000000: "MAV_SYS_STATUS_SENSOR_PROXIMITY",
+        0x8000000: "MAV_SYS_STATUS_SENSOR_SATCOM",
+        0x10000000: "MAV_SYS_STATUS_PREARM_CHECK",
+        0x20000000: "MAV_SYS_STATUS_OBSTACLE_AVOIDANCE",
+        0x40000000: "MAV_SYS_STATUS_SENSOR_PROPULSION",
+        0x80000000: "MAV_SYS_STATUS_EXTENSION_USED",
+    },
+)
+_SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_SPEC = _v.Number(
+    type="uint32",
+    kind="uint",
+    low=0,
+    high=4294967295,
+    mask=0xFFFFFFFF,
+    bits={
+        0x1: "MAV_SYS_STATUS_SENSOR_3D_GYRO",
+        0x2: "MAV_SYS_STATUS_SENSOR_3D_ACCEL",
+        0x4: "MAV_SYS_STATUS_SENSOR_3D_MAG",
+        0x8: "MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE",
+        0x10: "MAV_SYS_STATUS_SENSOR_DIFFERENTIAL_PRESSURE",
+        0x20: "MAV_SYS_STATUS_SENSOR_GPS",
+        0x40: "MAV_SYS_STATUS_SENSOR_OPTICAL_FLOW",
+        0x80: "MAV_SYS_STATUS_SENSOR_VISION_POSITION",
+        0x100: "MAV_SYS_STATUS_SENSOR_LASER_POSITION",
+        0x200: "MAV_SYS_STATUS_SENSOR_EXTERNAL_GROUND_TRUTH",
+        0x400: "MAV_SYS_STATUS_SENSOR_ANGULAR_RATE_CONTROL",
+        0x800: "MAV_SYS_STATUS_SENSOR_ATTITUDE_STABILIZATION",
+        0x1000: "MAV_SYS_STATUS_SENSOR_YAW_POSITION",
+        0x2000: "MAV_SYS_STATUS_SENSOR_Z_ALTITUDE_CONTROL",
+        0x4000: "MAV_SYS_STATUS_SENSOR_XY_POSITION_CONTROL",
+        0x8000: "MAV_SYS_STATUS_SENSOR_MOTOR_OUTPUTS",
+        0x10000: "MAV_SYS_STATUS_SENSOR_RC_RECEIVER",
+        0x20000: "MAV_SYS_STATUS_SENSOR_3D_GYRO2",
+        0x40000: "MAV_SYS_STATUS_SENSOR_3D_ACCEL2",
+        0x80000: "MAV_SYS_STATUS_SENSOR_3D_MAG2",
+        0x100000: "MAV_SYS_STATUS_GEOFENCE",
+        0x200000: "MAV_SYS_STATUS_AHRS",
+        0x400000: "MAV_SYS_STATUS_TERRAIN",
+        0x800000: "MAV_SYS_STATUS_REVERSE_MOTOR",
+        0x1000000: "MAV_SYS_STATUS_LOGGING",
+        0x2000000: "MAV_SYS_STATUS_SENSOR_BATTERY",
+        0x4000000: "MAV_SYS_STATUS_SENSOR_PROXIMITY",
+        0x8000000: "MAV_SYS_STATUS_SENSOR_SATCOM",
+        0x10000000: "MAV_SYS_STATUS_PREARM_CHECK",
+        0x20000000: "MAV_SYS_STATUS_OBSTACLE_AVOIDANCE",
+        0x40000000: "MAV_SYS_STATUS_SENSOR_PROPULSION",
+        0x80000000: "MAV_SYS_STATUS_EXTENSION_USED",
+    },
+)
+_SYS_STATUS_LOAD_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="d%")
+_SYS_STATUS_VOLTAGE_BATTERY_SPEC = _v.Number(
+    type="uint16", kind="uint", low=0, high=65535, unit="mV", sentinel=65535, sentinel_text="UINT16_MAX"
+)
+_SYS_STATUS_CURRENT_BATTERY_SPEC = _v.Number(
+    type="int16", kind="int", low=-32768, high=32767, unit="cA", sentinel=-1, sentinel_text="-1"
+)
+_SYS_STATUS_BATTERY_REMAINING_SPEC = _v.Number(
+    type="int8", kind="int", low=-128, high=127, unit="%", sentinel=-1, sentinel_text="-1"
+)
+_SYS_STATUS_DROP_RATE_COMM_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535, unit="c%")
+_SYS_STATUS_ERRORS_COMM_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_SYS_STATUS_ERRORS_COUNT1_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_SYS_STATUS_ERRORS_COUNT2_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_SYS_STATUS_ERRORS_COUNT3_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_SYS_STATUS_ERRORS_COUNT4_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_EXTENDED_SPEC = _v.Number(
+    type="uint32",
+    kind="uint",
+    low=0,
+    high=4294967295,
+    mask=0x3F,
+    bits={
+        0x1: "MAV_SYS_STATUS_RECOVERY_SYSTEM",
+        0x2: "MAV_SYS_STATUS_SENSOR_LEAK",
+        0x4: "MAV_SYS_STATUS_SENSOR_3D_GYRO3",
+        0x8: "MAV_SYS_STATUS_SENSOR_3D_ACCEL3",
+        0x10: "MAV_SYS_STATUS_SENSOR_3D_GYRO4",
+        0x20: "MAV_SYS_STATUS_SENSOR_3D_ACCEL4",
+    },
+)
+_SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_EXTENDED_SPEC = _v.Number(
+    type="uint32",
+    kind="uint",
+    low=0,
+    high=4294967295,
+    mask=0x3F,
+    bits={
+        0x1: "MAV_SYS_STATUS_RECOVERY_SYSTEM",
+        0x2: "MAV_SYS_STATUS_SENSOR_LEAK",
+        0x4: "MAV_SYS_STATUS_SENSOR_3D_GYRO3",
+        0x8: "MAV_SYS_STATUS_SENSOR_3D_ACCEL3",
+        0x10: "MAV_SYS_STATUS_SENSOR_3D_GYRO4",
+        0x20: "MAV_SYS_STATUS_SENSOR_3D_ACCEL4",
+    },
+)
+_SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_EXTENDED_SPEC = _v.Number(
+    type="uint32",
+    kind="uint",
+    low=0,
+    high=4294967295,
+    mask=0x3F,
+    bits={
+        0x1: "MAV_SYS_STATUS_RECOVERY_SYSTEM",
+        0x2: "MAV_SYS_STATUS_SENSOR_LEAK",
+        0x4: "MAV_SYS_STATUS_SENSOR_3D_GYRO3",
+        0x8: "MAV_SYS_STATUS_SENSOR_3D_ACCEL3",
+        0x10: "MAV_SYS_STATUS_SENSOR_3D_GYRO4",
+        0x20: "MAV_SYS_STATUS_SENSOR_3D_ACCEL4",
     },
 )
 
@@ -2138,3 +2693,830 @@ class BatteryStatusV2:
         if field in {"id", "status_flags"}:
             return True
         raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_STATUS_V2")
+
+
+@_dataclasses.dataclass(slots=True)
+class Heartbeat:
+    """Sent about once a second by every system and component: what it is, which autopilot it runs, its mode and state.
+
+    Schema: mavlink.HEARTBEAT (mavlink, vehicle.xml:407).
+    """
+
+    QUALIFIED_NAME: _ClassVar[str] = "mavlink.HEARTBEAT"
+
+    type: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="type",
+            type="uint8",
+            enums=("mavlink.MAV_TYPE",),
+            doc="Vehicle type of a flight controller, else the component's type.",
+        ),
+    )
+    autopilot: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="autopilot",
+            type="uint8",
+            enums=("mavlink.MAV_AUTOPILOT",),
+            doc="Autopilot family; MAV_AUTOPILOT_INVALID for a component that is no flight controller.",
+        ),
+    )
+    base_mode: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="base_mode",
+            type="uint8",
+            enums=("mavlink.MAV_MODE_FLAG",),
+            doc="Mode bits; MAV_MODE_FLAG_SAFETY_ARMED set while the vehicle is armed.",
+        ),
+    )
+    custom_mode: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="custom_mode", type="uint32", doc="The autopilot's own mode number.")
+    )
+    system_status: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="system_status", type="uint8", enums=("mavlink.MAV_STATE",), doc="Overall state of the system."
+        ),
+    )
+    mavlink_version: int = _dataclasses.field(
+        default=2,
+        metadata=_m.meta(
+            name="mavlink_version", type="uint8", doc="Protocol version, filled in by the MAVLink library."
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, _Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, _Any] = {}
+        out["type"] = self.type
+        out["autopilot"] = self.autopilot
+        out["base_mode"] = self.base_mode
+        out["custom_mode"] = self.custom_mode
+        out["system_status"] = self.system_status
+        out["mavlink_version"] = self.mavlink_version
+        return out
+
+    @classmethod
+    def from_dict(cls, data: _Mapping[str, _Any]) -> Heartbeat:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(
+            data,
+            frozenset({"type", "autopilot", "base_mode", "custom_mode", "system_status", "mavlink_version"}),
+            (),
+            "Heartbeat",
+        )
+        obj = cls()
+        if "type" in data:
+            obj.type = _m.as_int(data["type"], "type")
+        if "autopilot" in data:
+            obj.autopilot = _m.as_int(data["autopilot"], "autopilot")
+        if "base_mode" in data:
+            obj.base_mode = _m.as_int(data["base_mode"], "base_mode")
+        if "custom_mode" in data:
+            obj.custom_mode = _m.as_int(data["custom_mode"], "custom_mode")
+        if "system_status" in data:
+            obj.system_status = _m.as_int(data["system_status"], "system_status")
+        if "mavlink_version" in data:
+            obj.mavlink_version = _m.as_int(data["mavlink_version"], "mavlink_version")
+        return obj
+
+    MSG_ID: _ClassVar[int] = 0
+    CRC_EXTRA: _ClassVar[int] = 50
+    MAVLINK_BASE_LENGTH: _ClassVar[int] = 9
+    MAVLINK_MAX_LENGTH: _ClassVar[int] = 9
+
+    def encode(self, *, truncate: bool = True) -> bytes:
+        """The MAVLink 2 payload, 9 bytes in wire order; trailing zero bytes
+        are dropped (at least one byte is kept) unless ``truncate`` is False.
+        A value that does not fit its field raises EncodeError naming it."""
+        try:
+            data = _HEARTBEAT_PAYLOAD.pack(
+                self.custom_mode, self.type, self.autopilot, self.base_mode, self.system_status, self.mavlink_version
+            )
+        except (_struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+            raise _mav.explain("HEARTBEAT", self, _HEARTBEAT_FIELDS) from exc
+        if truncate:
+            return data.rstrip(b"\x00") or b"\x00"
+        return data
+
+    @classmethod
+    def decode(cls, data: _mav.BytesLike) -> Heartbeat:
+        """A MAVLink 2 payload; a short one is zero-filled, one over 9 bytes is a DecodeError."""
+        if len(data) != 9:
+            data = _mav.fill(data, 9, "HEARTBEAT")
+        v0, v1, v2, v3, v4, v5 = _HEARTBEAT_PAYLOAD.unpack(data)
+        obj = object.__new__(cls)
+        obj.custom_mode = v0
+        obj.type = v1
+        obj.autopilot = v2
+        obj.base_mode = v3
+        obj.system_status = v4
+        obj.mavlink_version = v5
+        return obj
+
+    def encode_frame(
+        self,
+        *,
+        seq: int = 0,
+        sysid: int = 1,
+        compid: int = 1,
+        mavlink1: bool = False,
+        incompat_flags: int = 0,
+        compat_flags: int = 0,
+        signature: bytes | None = None,
+    ) -> bytes:
+        """A whole frame: MAVLink 2 (0xFD, truncated payload, CRC with CRC_EXTRA; a 13-byte
+        ``signature`` is appended and flagged, not computed) or, with ``mavlink1``, MAVLink 1
+        (0xFE, the base payload without extensions; message ids below 256 only)."""
+        if mavlink1:
+            return _mav.frame_v1(
+                self.encode(truncate=False)[:9],
+                0,
+                b"2",
+                seq,
+                sysid,
+                compid,
+                incompat_flags != 0 or compat_flags != 0 or signature is not None,
+            )
+        return _mav.frame_v2(self.encode(), 0, b"2", seq, sysid, compid, incompat_flags, compat_flags, signature)
+
+    @classmethod
+    def decode_frame(cls, data: _mav.BytesLike) -> Heartbeat:
+        """One whole MAVLink 1 or 2 frame of this message (CRC checked; a signature is skipped);
+        _mavlink.parse_frame gives the header fields."""
+        payload = _mav.frame_payload(data, 0, b"2", 9, "HEARTBEAT")
+        return cls.decode(payload)
+
+    @classmethod
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, _Any]:
+        """Records of 9 bytes (zero-filled payloads) -> columns keyed by field name: numpy
+        arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
+        tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
+        arrays = _mav.numpy_columns(data, 9, _HEARTBEAT_DTYPE, use_numpy, "HEARTBEAT")
+        if arrays is not None:
+            return arrays
+        c = _mav.struct_columns(data, _HEARTBEAT_PAYLOAD, "HEARTBEAT")
+        return {
+            "custom_mode": c[0],
+            "type": c[1],
+            "autopilot": c[2],
+            "base_mode": c[3],
+            "system_status": c[4],
+            "mavlink_version": c[5],
+        }
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        try:
+            if self.type not in {
+                0,
+                1,
+                2,
+                3,
+                4,
+                5,
+                6,
+                7,
+                8,
+                9,
+                10,
+                11,
+                12,
+                13,
+                14,
+                15,
+                16,
+                17,
+                18,
+                19,
+                20,
+                21,
+                22,
+                23,
+                24,
+                25,
+                26,
+                27,
+                28,
+                29,
+                30,
+                31,
+                32,
+                33,
+                34,
+                35,
+                36,
+                37,
+                38,
+                39,
+                40,
+                41,
+                42,
+                43,
+                44,
+                45,
+                46,
+                47,
+                48,
+                49,
+            }:
+                _v.diag(out, "type", self.type, _HEARTBEAT_TYPE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "type", self.type, _HEARTBEAT_TYPE_SPEC)
+        try:
+            if self.autopilot not in {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20}:
+                _v.diag(out, "autopilot", self.autopilot, _HEARTBEAT_AUTOPILOT_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "autopilot", self.autopilot, _HEARTBEAT_AUTOPILOT_SPEC)
+        try:
+            if self.base_mode & -256:
+                _v.diag(out, "base_mode", self.base_mode, _HEARTBEAT_BASE_MODE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "base_mode", self.base_mode, _HEARTBEAT_BASE_MODE_SPEC)
+        try:
+            if self.custom_mode & -4294967296:
+                _v.diag(out, "custom_mode", self.custom_mode, _HEARTBEAT_CUSTOM_MODE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "custom_mode", self.custom_mode, _HEARTBEAT_CUSTOM_MODE_SPEC)
+        try:
+            if self.system_status not in {0, 1, 2, 3, 4, 5, 6, 7, 8}:
+                _v.diag(out, "system_status", self.system_status, _HEARTBEAT_SYSTEM_STATUS_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "system_status", self.system_status, _HEARTBEAT_SYSTEM_STATUS_SPEC)
+        try:
+            if self.mavlink_version & -256:
+                _v.diag(out, "mavlink_version", self.mavlink_version, _HEARTBEAT_MAVLINK_VERSION_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "mavlink_version", self.mavlink_version, _HEARTBEAT_MAVLINK_VERSION_SPEC)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "mavlink.HEARTBEAT")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field in {"type", "autopilot", "base_mode", "custom_mode", "system_status", "mavlink_version"}:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "mavlink.HEARTBEAT")
+
+
+@_dataclasses.dataclass(slots=True)
+class SysStatus:
+    """General state of a system: its sensors, processor load, link errors and one battery reading.
+
+    Schema: mavlink.SYS_STATUS (mavlink, vehicle.xml:416).
+    """
+
+    QUALIFIED_NAME: _ClassVar[str] = "mavlink.SYS_STATUS"
+
+    onboard_control_sensors_present: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="onboard_control_sensors_present",
+            type="uint32",
+            enums=("mavlink.MAV_SYS_STATUS_SENSOR",),
+            doc="Sensors and controllers present (bit set: present).",
+        ),
+    )
+    onboard_control_sensors_enabled: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="onboard_control_sensors_enabled",
+            type="uint32",
+            enums=("mavlink.MAV_SYS_STATUS_SENSOR",),
+            doc="Sensors and controllers enabled (bit set: enabled).",
+        ),
+    )
+    onboard_control_sensors_health: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="onboard_control_sensors_health",
+            type="uint32",
+            enums=("mavlink.MAV_SYS_STATUS_SENSOR",),
+            doc="Sensors and controllers healthy (bit set: healthy, clear: in error).",
+        ),
+    )
+    load: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="load",
+            type="uint16",
+            unit="d%",
+            quantity="ratio",
+            scale=0.001,
+            offset=0.0,
+            doc="Main loop load, 0 to 1000.",
+        ),
+    )
+    voltage_battery: int = _dataclasses.field(
+        default=65535,
+        metadata=_m.meta(
+            name="voltage_battery",
+            type="uint16",
+            unit="mV",
+            quantity="voltage",
+            scale=0.001,
+            offset=0.0,
+            invalid=65535,
+            invalid_text="UINT16_MAX",
+            doc="Battery voltage; UINT16_MAX when the autopilot does not send it.",
+        ),
+    )
+    current_battery: int = _dataclasses.field(
+        default=-1,
+        metadata=_m.meta(
+            name="current_battery",
+            type="int16",
+            unit="cA",
+            quantity="current",
+            scale=0.01,
+            offset=0.0,
+            invalid=-1,
+            invalid_text="-1",
+            doc="Battery current; -1 when the autopilot does not send it.",
+        ),
+    )
+    battery_remaining: int = _dataclasses.field(
+        default=-1,
+        metadata=_m.meta(
+            name="battery_remaining",
+            type="int8",
+            unit="%",
+            quantity="ratio",
+            scale=0.01,
+            offset=0.0,
+            invalid=-1,
+            invalid_text="-1",
+            doc="Battery charge left, 0 to 100; -1 when the autopilot does not send it.",
+        ),
+    )
+    drop_rate_comm: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="drop_rate_comm",
+            type="uint16",
+            unit="c%",
+            quantity="ratio",
+            scale=0.0001,
+            offset=0.0,
+            doc="Share of packets dropped on all links.",
+        ),
+    )
+    errors_comm: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="errors_comm", type="uint16", doc="Packets dropped on all links.")
+    )
+    errors_count1: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="errors_count1", type="uint16", doc="An autopilot-specific error count.")
+    )
+    errors_count2: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="errors_count2", type="uint16", doc="An autopilot-specific error count.")
+    )
+    errors_count3: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="errors_count3", type="uint16", doc="An autopilot-specific error count.")
+    )
+    errors_count4: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="errors_count4", type="uint16", doc="An autopilot-specific error count.")
+    )
+    onboard_control_sensors_present_extended: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="onboard_control_sensors_present_extended",
+            type="uint32",
+            enums=("mavlink.MAV_SYS_STATUS_SENSOR_EXTENDED",),
+            extension=True,
+            doc="Further sensors present (bit set: present).",
+        ),
+    )
+    onboard_control_sensors_enabled_extended: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="onboard_control_sensors_enabled_extended",
+            type="uint32",
+            enums=("mavlink.MAV_SYS_STATUS_SENSOR_EXTENDED",),
+            extension=True,
+            doc="Further sensors enabled (bit set: enabled).",
+        ),
+    )
+    onboard_control_sensors_health_extended: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="onboard_control_sensors_health_extended",
+            type="uint32",
+            enums=("mavlink.MAV_SYS_STATUS_SENSOR_EXTENDED",),
+            extension=True,
+            doc="Further sensors healthy (bit set: healthy).",
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, _Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, _Any] = {}
+        out["onboard_control_sensors_present"] = self.onboard_control_sensors_present
+        out["onboard_control_sensors_enabled"] = self.onboard_control_sensors_enabled
+        out["onboard_control_sensors_health"] = self.onboard_control_sensors_health
+        out["load"] = self.load
+        out["voltage_battery"] = self.voltage_battery
+        out["current_battery"] = self.current_battery
+        out["battery_remaining"] = self.battery_remaining
+        out["drop_rate_comm"] = self.drop_rate_comm
+        out["errors_comm"] = self.errors_comm
+        out["errors_count1"] = self.errors_count1
+        out["errors_count2"] = self.errors_count2
+        out["errors_count3"] = self.errors_count3
+        out["errors_count4"] = self.errors_count4
+        out["onboard_control_sensors_present_extended"] = self.onboard_control_sensors_present_extended
+        out["onboard_control_sensors_enabled_extended"] = self.onboard_control_sensors_enabled_extended
+        out["onboard_control_sensors_health_extended"] = self.onboard_control_sensors_health_extended
+        return out
+
+    @classmethod
+    def from_dict(cls, data: _Mapping[str, _Any]) -> SysStatus:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(
+            data,
+            frozenset(
+                {
+                    "onboard_control_sensors_present",
+                    "onboard_control_sensors_enabled",
+                    "onboard_control_sensors_health",
+                    "load",
+                    "voltage_battery",
+                    "current_battery",
+                    "battery_remaining",
+                    "drop_rate_comm",
+                    "errors_comm",
+                    "errors_count1",
+                    "errors_count2",
+                    "errors_count3",
+                    "errors_count4",
+                    "onboard_control_sensors_present_extended",
+                    "onboard_control_sensors_enabled_extended",
+                    "onboard_control_sensors_health_extended",
+                }
+            ),
+            (),
+            "SysStatus",
+        )
+        obj = cls()
+        if "onboard_control_sensors_present" in data:
+            obj.onboard_control_sensors_present = _m.as_int(
+                data["onboard_control_sensors_present"], "onboard_control_sensors_present"
+            )
+        if "onboard_control_sensors_enabled" in data:
+            obj.onboard_control_sensors_enabled = _m.as_int(
+                data["onboard_control_sensors_enabled"], "onboard_control_sensors_enabled"
+            )
+        if "onboard_control_sensors_health" in data:
+            obj.onboard_control_sensors_health = _m.as_int(
+                data["onboard_control_sensors_health"], "onboard_control_sensors_health"
+            )
+        if "load" in data:
+            obj.load = _m.as_int(data["load"], "load")
+        if "voltage_battery" in data:
+            obj.voltage_battery = _m.as_int(data["voltage_battery"], "voltage_battery")
+        if "current_battery" in data:
+            obj.current_battery = _m.as_int(data["current_battery"], "current_battery")
+        if "battery_remaining" in data:
+            obj.battery_remaining = _m.as_int(data["battery_remaining"], "battery_remaining")
+        if "drop_rate_comm" in data:
+            obj.drop_rate_comm = _m.as_int(data["drop_rate_comm"], "drop_rate_comm")
+        if "errors_comm" in data:
+            obj.errors_comm = _m.as_int(data["errors_comm"], "errors_comm")
+        if "errors_count1" in data:
+            obj.errors_count1 = _m.as_int(data["errors_count1"], "errors_count1")
+        if "errors_count2" in data:
+            obj.errors_count2 = _m.as_int(data["errors_count2"], "errors_count2")
+        if "errors_count3" in data:
+            obj.errors_count3 = _m.as_int(data["errors_count3"], "errors_count3")
+        if "errors_count4" in data:
+            obj.errors_count4 = _m.as_int(data["errors_count4"], "errors_count4")
+        if "onboard_control_sensors_present_extended" in data:
+            obj.onboard_control_sensors_present_extended = _m.as_int(
+                data["onboard_control_sensors_present_extended"], "onboard_control_sensors_present_extended"
+            )
+        if "onboard_control_sensors_enabled_extended" in data:
+            obj.onboard_control_sensors_enabled_extended = _m.as_int(
+                data["onboard_control_sensors_enabled_extended"], "onboard_control_sensors_enabled_extended"
+            )
+        if "onboard_control_sensors_health_extended" in data:
+            obj.onboard_control_sensors_health_extended = _m.as_int(
+                data["onboard_control_sensors_health_extended"], "onboard_control_sensors_health_extended"
+            )
+        return obj
+
+    MSG_ID: _ClassVar[int] = 1
+    CRC_EXTRA: _ClassVar[int] = 124
+    MAVLINK_BASE_LENGTH: _ClassVar[int] = 31
+    MAVLINK_MAX_LENGTH: _ClassVar[int] = 43
+
+    def encode(self, *, truncate: bool = True) -> bytes:
+        """The MAVLink 2 payload, 43 bytes in wire order; trailing zero bytes
+        are dropped (at least one byte is kept) unless ``truncate`` is False.
+        A value that does not fit its field raises EncodeError naming it."""
+        try:
+            data = _SYS_STATUS_PAYLOAD.pack(
+                self.onboard_control_sensors_present,
+                self.onboard_control_sensors_enabled,
+                self.onboard_control_sensors_health,
+                self.load,
+                self.voltage_battery,
+                self.current_battery,
+                self.drop_rate_comm,
+                self.errors_comm,
+                self.errors_count1,
+                self.errors_count2,
+                self.errors_count3,
+                self.errors_count4,
+                self.battery_remaining,
+                self.onboard_control_sensors_present_extended,
+                self.onboard_control_sensors_enabled_extended,
+                self.onboard_control_sensors_health_extended,
+            )
+        except (_struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+            raise _mav.explain("SYS_STATUS", self, _SYS_STATUS_FIELDS) from exc
+        if truncate:
+            return data.rstrip(b"\x00") or b"\x00"
+        return data
+
+    @classmethod
+    def decode(cls, data: _mav.BytesLike) -> SysStatus:
+        """A MAVLink 2 payload; a short one is zero-filled, one over 43 bytes is a DecodeError."""
+        if len(data) != 43:
+            data = _mav.fill(data, 43, "SYS_STATUS")
+        v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15 = _SYS_STATUS_PAYLOAD.unpack(data)
+        obj = object.__new__(cls)
+        obj.onboard_control_sensors_present = v0
+        obj.onboard_control_sensors_enabled = v1
+        obj.onboard_control_sensors_health = v2
+        obj.load = v3
+        obj.voltage_battery = v4
+        obj.current_battery = v5
+        obj.drop_rate_comm = v6
+        obj.errors_comm = v7
+        obj.errors_count1 = v8
+        obj.errors_count2 = v9
+        obj.errors_count3 = v10
+        obj.errors_count4 = v11
+        obj.battery_remaining = v12
+        obj.onboard_control_sensors_present_extended = v13
+        obj.onboard_control_sensors_enabled_extended = v14
+        obj.onboard_control_sensors_health_extended = v15
+        return obj
+
+    def encode_frame(
+        self,
+        *,
+        seq: int = 0,
+        sysid: int = 1,
+        compid: int = 1,
+        mavlink1: bool = False,
+        incompat_flags: int = 0,
+        compat_flags: int = 0,
+        signature: bytes | None = None,
+    ) -> bytes:
+        """A whole frame: MAVLink 2 (0xFD, truncated payload, CRC with CRC_EXTRA; a 13-byte
+        ``signature`` is appended and flagged, not computed) or, with ``mavlink1``, MAVLink 1
+        (0xFE, the base payload without extensions; message ids below 256 only)."""
+        if mavlink1:
+            return _mav.frame_v1(
+                self.encode(truncate=False)[:31],
+                1,
+                b"|",
+                seq,
+                sysid,
+                compid,
+                incompat_flags != 0 or compat_flags != 0 or signature is not None,
+            )
+        return _mav.frame_v2(self.encode(), 1, b"|", seq, sysid, compid, incompat_flags, compat_flags, signature)
+
+    @classmethod
+    def decode_frame(cls, data: _mav.BytesLike) -> SysStatus:
+        """One whole MAVLink 1 or 2 frame of this message (CRC checked; a signature is skipped);
+        _mavlink.parse_frame gives the header fields."""
+        payload = _mav.frame_payload(data, 1, b"|", 43, "SYS_STATUS")
+        return cls.decode(payload)
+
+    @classmethod
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, _Any]:
+        """Records of 43 bytes (zero-filled payloads) -> columns keyed by field name: numpy
+        arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
+        tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
+        arrays = _mav.numpy_columns(data, 43, _SYS_STATUS_DTYPE, use_numpy, "SYS_STATUS")
+        if arrays is not None:
+            return arrays
+        c = _mav.struct_columns(data, _SYS_STATUS_PAYLOAD, "SYS_STATUS")
+        return {
+            "onboard_control_sensors_present": c[0],
+            "onboard_control_sensors_enabled": c[1],
+            "onboard_control_sensors_health": c[2],
+            "load": c[3],
+            "voltage_battery": c[4],
+            "current_battery": c[5],
+            "drop_rate_comm": c[6],
+            "errors_comm": c[7],
+            "errors_count1": c[8],
+            "errors_count2": c[9],
+            "errors_count3": c[10],
+            "errors_count4": c[11],
+            "battery_remaining": c[12],
+            "onboard_control_sensors_present_extended": c[13],
+            "onboard_control_sensors_enabled_extended": c[14],
+            "onboard_control_sensors_health_extended": c[15],
+        }
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        try:
+            if self.onboard_control_sensors_present & -4294967296:
+                _v.diag(
+                    out,
+                    "onboard_control_sensors_present",
+                    self.onboard_control_sensors_present,
+                    _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "onboard_control_sensors_present",
+                self.onboard_control_sensors_present,
+                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_SPEC,
+            )
+        try:
+            if self.onboard_control_sensors_enabled & -4294967296:
+                _v.diag(
+                    out,
+                    "onboard_control_sensors_enabled",
+                    self.onboard_control_sensors_enabled,
+                    _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "onboard_control_sensors_enabled",
+                self.onboard_control_sensors_enabled,
+                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_SPEC,
+            )
+        try:
+            if self.onboard_control_sensors_health & -4294967296:
+                _v.diag(
+                    out,
+                    "onboard_control_sensors_health",
+                    self.onboard_control_sensors_health,
+                    _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "onboard_control_sensors_health",
+                self.onboard_control_sensors_health,
+                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_SPEC,
+            )
+        try:
+            if self.load & -65536:
+                _v.diag(out, "load", self.load, _SYS_STATUS_LOAD_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "load", self.load, _SYS_STATUS_LOAD_SPEC)
+        try:
+            if self.voltage_battery & -65536:
+                _v.diag(out, "voltage_battery", self.voltage_battery, _SYS_STATUS_VOLTAGE_BATTERY_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "voltage_battery", self.voltage_battery, _SYS_STATUS_VOLTAGE_BATTERY_SPEC)
+        try:
+            if (self.current_battery + 32768) & -65536:
+                _v.diag(out, "current_battery", self.current_battery, _SYS_STATUS_CURRENT_BATTERY_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "current_battery", self.current_battery, _SYS_STATUS_CURRENT_BATTERY_SPEC)
+        try:
+            if (self.battery_remaining + 128) & -256:
+                _v.diag(out, "battery_remaining", self.battery_remaining, _SYS_STATUS_BATTERY_REMAINING_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "battery_remaining", self.battery_remaining, _SYS_STATUS_BATTERY_REMAINING_SPEC)
+        try:
+            if self.drop_rate_comm & -65536:
+                _v.diag(out, "drop_rate_comm", self.drop_rate_comm, _SYS_STATUS_DROP_RATE_COMM_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "drop_rate_comm", self.drop_rate_comm, _SYS_STATUS_DROP_RATE_COMM_SPEC)
+        try:
+            if self.errors_comm & -65536:
+                _v.diag(out, "errors_comm", self.errors_comm, _SYS_STATUS_ERRORS_COMM_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "errors_comm", self.errors_comm, _SYS_STATUS_ERRORS_COMM_SPEC)
+        try:
+            if self.errors_count1 & -65536:
+                _v.diag(out, "errors_count1", self.errors_count1, _SYS_STATUS_ERRORS_COUNT1_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "errors_count1", self.errors_count1, _SYS_STATUS_ERRORS_COUNT1_SPEC)
+        try:
+            if self.errors_count2 & -65536:
+                _v.diag(out, "errors_count2", self.errors_count2, _SYS_STATUS_ERRORS_COUNT2_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "errors_count2", self.errors_count2, _SYS_STATUS_ERRORS_COUNT2_SPEC)
+        try:
+            if self.errors_count3 & -65536:
+                _v.diag(out, "errors_count3", self.errors_count3, _SYS_STATUS_ERRORS_COUNT3_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "errors_count3", self.errors_count3, _SYS_STATUS_ERRORS_COUNT3_SPEC)
+        try:
+            if self.errors_count4 & -65536:
+                _v.diag(out, "errors_count4", self.errors_count4, _SYS_STATUS_ERRORS_COUNT4_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "errors_count4", self.errors_count4, _SYS_STATUS_ERRORS_COUNT4_SPEC)
+        try:
+            if self.onboard_control_sensors_present_extended & -64:
+                _v.diag(
+                    out,
+                    "onboard_control_sensors_present_extended",
+                    self.onboard_control_sensors_present_extended,
+                    _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_EXTENDED_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "onboard_control_sensors_present_extended",
+                self.onboard_control_sensors_present_extended,
+                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_EXTENDED_SPEC,
+            )
+        try:
+            if self.onboard_control_sensors_enabled_extended & -64:
+                _v.diag(
+                    out,
+                    "onboard_control_sensors_enabled_extended",
+                    self.onboard_control_sensors_enabled_extended,
+                    _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_EXTENDED_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "onboard_control_sensors_enabled_extended",
+                self.onboard_control_sensors_enabled_extended,
+                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_EXTENDED_SPEC,
+            )
+        try:
+            if self.onboard_control_sensors_health_extended & -64:
+                _v.diag(
+                    out,
+                    "onboard_control_sensors_health_extended",
+                    self.onboard_control_sensors_health_extended,
+                    _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_EXTENDED_SPEC,
+                )
+        except _v.SLOW:
+            _v.diag(
+                out,
+                "onboard_control_sensors_health_extended",
+                self.onboard_control_sensors_health_extended,
+                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_EXTENDED_SPEC,
+            )
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "mavlink.SYS_STATUS")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field == "voltage_battery":
+            return self.voltage_battery != 65535
+        if field == "current_battery":
+            return self.current_battery != -1
+        if field == "battery_remaining":
+            return self.battery_remaining != -1
+        if field in {
+            "onboard_control_sensors_present",
+            "onboard_control_sensors_enabled",
+            "onboard_control_sensors_health",
+            "load",
+            "drop_rate_comm",
+            "errors_comm",
+            "errors_count1",
+            "errors_count2",
+            "errors_count3",
+            "errors_count4",
+            "onboard_control_sensors_present_extended",
+            "onboard_control_sensors_enabled_extended",
+            "onboard_control_sensors_health_extended",
+        }:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "mavlink.SYS_STATUS")

@@ -21,7 +21,7 @@ a non-empty file in which no frame at all is found is unreadable.
 from __future__ import annotations
 
 import mmap
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
@@ -48,6 +48,12 @@ class StreamStats:
     decode_errors: int = 0  # frames of the wanted message whose payload is too long
     truncated_bytes: int = 0  # an entry or frame cut off at the end of the file
     problems: list[str] = field(default_factory=list)
+    first_stamp: int | None = None  # tlog: the stamp of the log's first frame (any message), µs since the epoch
+
+    def seen(self, stamp: int) -> None:
+        """A frame of any message with this tlog stamp was read (the first one is the log's start)."""
+        if self.first_stamp is None and stamp < 1 << 63:  # a stamp past int64 is a damaged one: unknown
+            self.first_stamp = stamp
 
     @property
     def damaged(self) -> bool:
@@ -123,8 +129,16 @@ def _is_magic(byte: int) -> bool:
 
 def tlog_frames(data: Buffer, model: MavlinkClass, stats: StreamStats) -> Iterator[FrameRecord]:
     """The frames of ``model``'s message in a .tlog held in ``data`` (bytes or an mmap)."""
-    rt = mavlink_runtime(model)
-    msgid = model.MSG_ID
+    return tlog_messages(data, {model.MSG_ID: model}, stats)
+
+
+def tlog_messages(data: Buffer, models: Mapping[int, MavlinkClass], stats: StreamStats) -> Iterator[FrameRecord]:
+    """The frames of every wanted message (``models`` by message id) in a .tlog held in ``data``, in file
+    order, in one walk; ``FrameRecord.number`` counts among the frames of the record's own message."""
+    if not models:
+        return
+    rt = mavlink_runtime(next(iter(models.values())))
+    numbers = dict.fromkeys(models, 0)
     end = len(data)
     pos = 0
     while pos < end:
@@ -147,16 +161,20 @@ def tlog_frames(data: Buffer, model: MavlinkClass, stats: StreamStats) -> Iterat
                 try:
                     frame = rt.parse_frame(data[start:after])
                 except ValueError as exc:  # FrameError: bad CRC, flags
-                    # a damaged frame of the wanted message, unless a good frame starts inside it
-                    if got == msgid and plausible and _first_verified(data, rt, start + 1, after + _STAMP) < 0:
+                    # a damaged frame of a wanted message, unless a good frame starts inside it
+                    if got in models and plausible and _first_verified(data, rt, start + 1, after + _STAMP) < 0:
                         stats.bad_crc += 1
                         stats.problems.append(f"offset {pos}: {exc}")
                         pos = after
                         continue
                 else:
-                    if got == msgid:
-                        record = _decode(frame, model, stats, pos, int.from_bytes(data[pos:start], "big"))
+                    stamp = int.from_bytes(data[pos:start], "big")
+                    stats.seen(stamp)
+                    model = models.get(got)
+                    if model is not None:
+                        record = _decode(frame, model, stats, pos, stamp, numbers[got])
                         if record is not None:
+                            numbers[got] += 1
                             yield record
                     else:
                         stats.other_frames += 1
@@ -165,6 +183,7 @@ def tlog_frames(data: Buffer, model: MavlinkClass, stats: StreamStats) -> Iterat
             elif plausible and _first_verified(data, rt, start + 1, after + _STAMP) < 0:
                 # another message (no CRC_EXTRA to check it with), trusted as far as no frame with a
                 # good checksum starts inside it: a stray magic byte must not swallow a real frame
+                stats.seen(int.from_bytes(data[pos:start], "big"))
                 stats.other_frames += 1
                 pos = after
                 continue
@@ -207,7 +226,7 @@ def _resync(data: Buffer, pos: int, end: int, stats: StreamStats) -> int:
 
 
 def _decode(
-    frame: Frame, model: MavlinkClass, stats: StreamStats, offset: int | None, stamp: int | None
+    frame: Frame, model: MavlinkClass, stats: StreamStats, offset: int | None, stamp: int | None, number: int = -1
 ) -> FrameRecord | None:
     try:
         obj = model.decode(frame.payload)
@@ -216,7 +235,7 @@ def _decode(
         stats.problems.append(str(exc))
         return None
     stats.records += 1
-    return FrameRecord(stats.records - 1, offset, stamp, frame, obj)
+    return FrameRecord(stats.records - 1 if number < 0 else number, offset, stamp, frame, obj)
 
 
 def raw_frames(stream: IO[bytes], model: MavlinkClass, stats: StreamStats) -> Iterator[FrameRecord]:
@@ -286,6 +305,24 @@ def read_frames(
         if isinstance(data, mmap.mmap):
             data.close()
     if size and not (stats.records or stats.other_frames or stats.bad_crc or stats.decode_errors):
+        raise InputError(
+            name, 0, "expected a MAVLink telemetry log: no 8-byte timestamp followed by a MAVLink frame found"
+        )
+
+
+def read_messages(
+    path: Path, name: str, models: Mapping[int, MavlinkClass], stats: StreamStats
+) -> Iterator[FrameRecord]:
+    """The frames of every wanted message of a .tlog file, in file order, from one CRC-checked walk (see the
+    module's docs); an InputError (naming ``name``) when nothing in a non-empty file is MAVLink."""
+    data = _open_map(path, name)
+    size = len(data)
+    try:
+        yield from tlog_messages(data, models, stats)
+    finally:
+        if isinstance(data, mmap.mmap):
+            data.close()
+    if size and stats.first_stamp is None and not (stats.records or stats.other_frames or stats.bad_crc):
         raise InputError(
             name, 0, "expected a MAVLink telemetry log: no 8-byte timestamp followed by a MAVLink frame found"
         )

@@ -122,9 +122,6 @@ def test_bin_tlog_and_jsonl_give_the_same_events(tmp_path: Path, capsys: pytest.
     assert tlog[0]["where"].startswith("mavlink.BATTERY_STATUS record ")
 
 
-@pytest.mark.xfail(
-    strict=True, reason="SYS_STATUS as a battery source of the tlog reader in codegen/apps/battery is not built yet"
-)
 def test_tlog_without_battery_status_uses_sys_status(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     from pymavlink.dialects.v20 import common
 

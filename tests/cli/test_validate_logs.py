@@ -202,9 +202,9 @@ def test_convert_ulog_to_mavlink(capsys: pytest.CaptureFixture[str], tmp_path: P
 
 
 def _other_frame(seq: int) -> bytes:
-    """A MAVLink 2 HEARTBEAT-shaped frame (id 0): a message this package does not know."""
+    """A MAVLink 2 frame of ATTITUDE (id 30): a message this package does not know (HEARTBEAT it does)."""
     payload = bytes(9)
-    return struct.pack("<BBBBBBBHB", 0xFD, len(payload), 0, 0, seq, 1, 1, 0, 0) + payload + b"\x12\x34"
+    return struct.pack("<BBBBBBBHB", 0xFD, len(payload), 0, 0, seq, 1, 1, 30, 0) + payload + b"\x12\x34"
 
 
 def mavlink_log(tlog: bool) -> tuple[bytes, int]:

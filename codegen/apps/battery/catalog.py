@@ -17,7 +17,7 @@ from ...ir import CONCEPTS_ENDPOINT, Concept, Direction, Endpoint, Message, Rule
 from ..package import bundled_schemas
 
 # endpoints whose messages are battery records in logs (devicetree nodes are static facts)
-RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan", "cbat")
+RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan", "cbat", "mavlink_sys_status")
 
 
 @dataclass(frozen=True)

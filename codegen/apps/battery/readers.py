@@ -1,5 +1,6 @@
 """The batches of one log of any kind the export reads: DataFlash through
-:mod:`.dataflash_batches`, CAN captures through :mod:`.can_batches`, the others through :mod:`.sources`."""
+:mod:`.dataflash_batches`, CAN captures through :mod:`.can_batches`, tlogs through :mod:`.tlog_batches`,
+the others through :mod:`.sources`."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ from pathlib import Path
 from .can_batches import can_batches
 from .catalog import Catalog
 from .dataflash_batches import dataflash_batches
-from .sources import Batch, jsonl_batches, log_kind, model_of, tlog_batches, ulog_batches
+from .sources import Batch, jsonl_batches, log_kind, model_of, ulog_batches
+from .tlog_batches import tlog_batches
 
 
 def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:

@@ -22,9 +22,8 @@ from ...backends.python import naming
 from ...errors import BattgenError
 from ...inputs.documents import read_jsonl
 from ...inputs.kinds import LOG_KINDS, detect
-from ...inputs.model import MavlinkClass, MessageClass, UorbClass
+from ...inputs.model import MessageClass, UorbClass
 from ...inputs.records import InputError, Record, Unreadable
-from ...inputs.tlog import StreamStats, read_frames
 from ...inputs.ulog_columns import UlogColumns
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
@@ -48,6 +47,7 @@ class Batch:
     concepts: dict[str, ConceptColumn] | None = None  # filled by the reader (a format without IR mapping)
     origin_us: int = 0  # the log's clock at t = 0 (ULog/DataFlash: µs since boot; tlog: µs since the epoch)
     utc_offset_us: int | None = None  # the log's clock + this = µs since the epoch (None: unknown)
+    vehicle_type: int | None = None  # MAVLink MAV_TYPE of the vehicle, where the log says (a tlog's HEARTBEAT)
     notes: list[str] = field(default_factory=list)
 
 
@@ -145,35 +145,6 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
             column[:] = values
             out[f.name] = column
     return out
-
-
-def tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
-    model = model_of(catalog, "mavlink.BATTERY_STATUS")
-    if not isinstance(model, MavlinkClass):
-        raise BattgenError("the generated mavlink.BATTERY_STATUS has no MAVLink codec: run 'battgen generate'")
-    stats = StreamStats()
-    frames = list(read_frames(path, name, model, stats, timestamps=True))
-    if not frames:
-        return []
-    message = catalog.schema.message(model.QUALIFIED_NAME)
-    # a tlog's stamp is a uint64 of µs since the epoch; one past int64 (a damaged log's) is unknown
-    known = np.array([f.timestamp is not None and f.timestamp < 1 << 63 for f in frames], bool)
-    stamps = np.array([f.timestamp if ok else 0 for f, ok in zip(frames, known, strict=True)], np.int64)
-    origin = int(stamps[known].min()) if known.any() else 0
-    batch = Batch(
-        model.QUALIFIED_NAME,
-        len(frames),
-        instances_to_columns(message, [f.instance for f in frames]),
-        np.where(known, (stamps - origin) / 1e6, np.nan),
-        np.zeros(len(frames), np.int64),
-        time_us=stamps,
-        time_known=None if known.all() else known,
-        vehicle=np.array([f"mavlink:{f.frame.sysid}" for f in frames], object),
-    )
-    batch.origin_us, batch.utc_offset_us = origin, 0
-    if stats.damaged:
-        batch.notes.append(stats.summary("BATTERY_STATUS"))
-    return [batch]
 
 
 def jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None) -> list[Batch]:

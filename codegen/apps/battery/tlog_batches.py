@@ -1,0 +1,116 @@
+"""MAVLink telemetry logs (.tlog) as battery batches, from one CRC-checked walk over the log
+(:func:`codegen.inputs.tlog.read_messages`) that reads BATTERY_STATUS, SYS_STATUS and HEARTBEAT together.
+
+- **Batteries**: a system's BATTERY_STATUS frames, one batch per battery ``id``; a system that sends no
+  BATTERY_STATUS at all is read from its SYS_STATUS frames as battery 0 (``schemas/mappings/mavlink_sys_status.yaml``).
+- **Clock**: ``t`` is seconds since the log's first frame of any message (its tlog stamp); ``time_us`` is the
+  record's own stamp, µs since the epoch, so ``origin_us`` is that first stamp and ``utc_offset_us`` 0. A stamp past
+  int64 (a damaged entry) is unknown.
+- **Armed**: as of each record in file order, ``base_mode & MAV_MODE_FLAG_SAFETY_ARMED`` of the latest vehicle
+  HEARTBEAT of the record's own system; NaN before it. A heartbeat is the vehicle's unless it comes from a ground
+  station (MAV_TYPE_GCS), a component that is no flight controller (MAV_AUTOPILOT_INVALID), a gimbal, ADS-B
+  receiver or onboard computer: pymavlink's ``probably_vehicle_heartbeat`` rule, which a GCS shows. A system with
+  no vehicle heartbeat in the log has no arming state (``armed`` None).
+- **Vehicle**: ``mavlink:<system id>``, and ``vehicle_type`` the MAV_TYPE of its last vehicle heartbeat.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import BattgenError
+from ...inputs.model import MavlinkClass
+from ...inputs.tlog import FrameRecord, StreamStats, read_messages
+from .catalog import Catalog
+from .sources import Batch, instances_to_columns, model_of
+
+BATTERY_STATUS, SYS_STATUS, HEARTBEAT = "mavlink.BATTERY_STATUS", "mavlink.SYS_STATUS", "mavlink.HEARTBEAT"
+SAFETY_ARMED = 128  # MAV_MODE_FLAG_SAFETY_ARMED
+NOT_VEHICLE_TYPES = frozenset({6, 18, 26, 27})  # MAV_TYPE_GCS, _ONBOARD_CONTROLLER, _GIMBAL, _ADSB
+AUTOPILOT_INVALID = 8  # MAV_AUTOPILOT_INVALID
+COMP_GIMBAL = 154  # MAV_COMP_ID_GIMBAL
+
+
+@dataclass
+class _System:
+    """What one system id sent: its battery frames and its vehicle heartbeats (offset, armed, type)."""
+
+    batteries: dict[int, list[FrameRecord]] = field(default_factory=dict)
+    sys_status: list[FrameRecord] = field(default_factory=list)
+    beats: list[tuple[int, bool, int]] = field(default_factory=list)
+
+
+def is_vehicle_heartbeat(compid: int, mav_type: int, autopilot: int) -> bool:
+    """Whether a HEARTBEAT speaks for the vehicle (see the module's docs)."""
+    return compid != COMP_GIMBAL and mav_type not in NOT_VEHICLE_TYPES and autopilot != AUTOPILOT_INVALID
+
+
+def _mavlink(catalog: Catalog, qualified: str) -> MavlinkClass:
+    model = model_of(catalog, qualified)
+    if not isinstance(model, MavlinkClass):
+        raise BattgenError(f"the generated {qualified} has no MAVLink codec: run 'battgen generate'")
+    return model
+
+
+def tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
+    """Every battery of a tlog as a batch (see the module's docs)."""
+    models = {m.MSG_ID: m for m in (_mavlink(catalog, q) for q in (BATTERY_STATUS, SYS_STATUS, HEARTBEAT))}
+    battery_id, status_id = _mavlink(catalog, BATTERY_STATUS).MSG_ID, _mavlink(catalog, SYS_STATUS).MSG_ID
+    stats = StreamStats()
+    systems: dict[int, _System] = {}
+    for rec in read_messages(path, name, models, stats):
+        system = systems.setdefault(rec.frame.sysid, _System())
+        msgid = rec.frame.msgid
+        if msgid == battery_id:
+            system.batteries.setdefault(int(getattr(rec.instance, "id")), []).append(rec)  # noqa: B009
+        elif msgid == status_id:
+            system.sys_status.append(rec)
+        else:
+            hb = rec.instance
+            mav_type, autopilot = int(getattr(hb, "type")), int(getattr(hb, "autopilot"))  # noqa: B009
+            if is_vehicle_heartbeat(rec.frame.compid, mav_type, autopilot):
+                armed = bool(int(getattr(hb, "base_mode")) & SAFETY_ARMED)  # noqa: B009
+                system.beats.append((rec.offset or 0, armed, mav_type))
+    origin = stats.first_stamp or 0
+    out: list[Batch] = []
+    for sysid, system in sorted(systems.items()):
+        groups = sorted(system.batteries.items())
+        if not groups and system.sys_status:
+            groups = [(0, system.sys_status)]
+        for instance, frames in groups:
+            qualified = BATTERY_STATUS if frames[0].frame.msgid == battery_id else SYS_STATUS
+            batch = _batch(catalog, qualified, frames, instance, origin, system, sysid)
+            if stats.damaged:
+                batch.notes.append(stats.summary("battery"))
+            out.append(batch)
+    return out
+
+
+def _batch(
+    catalog: Catalog, qualified: str, frames: list[FrameRecord], instance: int, origin: int, system: _System, sysid: int
+) -> Batch:
+    n = len(frames)
+    known = np.array([f.timestamp is not None and f.timestamp < 1 << 63 for f in frames], bool)
+    stamps = np.array([f.timestamp if ok else 0 for f, ok in zip(frames, known, strict=True)], np.int64)
+    batch = Batch(
+        qualified,
+        n,
+        instances_to_columns(catalog.schema.message(qualified), [f.instance for f in frames]),
+        np.where(known, (stamps - origin) / 1e6, np.nan),
+        np.full(n, instance, np.int64),
+        time_us=stamps,
+        time_known=None if known.all() else known,
+        vehicle=f"mavlink:{sysid}",
+    )
+    batch.origin_us, batch.utc_offset_us = origin, 0
+    if system.beats:
+        beat_at = np.array([b[0] for b in system.beats], np.int64)
+        beat_armed = np.array([b[1] for b in system.beats], np.float64)
+        at = np.array([f.offset or 0 for f in frames], np.int64)
+        idx = np.searchsorted(beat_at, at, side="right") - 1  # the latest heartbeat before the record in the file
+        batch.armed = np.where(idx >= 0, beat_armed[np.maximum(idx, 0)], np.nan)
+        batch.vehicle_type = system.beats[-1][2]
+    return batch
