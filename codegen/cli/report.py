@@ -7,17 +7,21 @@ imbalance, the failsafe replay marked on the time axis (``--params`` with the BA
 validation findings grouped by rule with links to their time, and the figures (charge and energy used, average
 and peak power, minimum pack and cell voltage, time under each threshold, voltage sag per amp and an internal
 resistance estimate from load steps). Several inputs give a fleet page: a row per flight and battery, and trends
-per pack serial. ``--format png`` writes one static image per battery into the ``-o`` folder instead.
+per pack serial. ``--format png`` writes one static image per battery into the ``-o`` folder instead;
+``--format json`` the figures, per input and battery (the page's and the flight's in SI), to ``-o`` or stdout.
 Exit 0 when written, 2 when an input cannot be read or the output cannot be written.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import sys
 from pathlib import Path
 from typing import Any
 
 from ..apps.package import bundled_schemas
+from ..apps.report.as_json import report_json
 from ..apps.report.build import collect, html, pngs
 from ..errors import BattgenError
 
@@ -42,19 +46,31 @@ def run(args: argparse.Namespace) -> int:
         for path in pngs(report, folder):
             print(f"wrote {path}")
         return EXIT_OK
+    if args.format == "json":
+        document = json.dumps(report_json(report), indent=2, ensure_ascii=True) + "\n"
+        if args.output is None or args.output == "-":
+            sys.stdout.write(document)
+            return EXIT_OK
+        _write(Path(args.output), document)
+        print(f"wrote {args.output}")
+        return EXIT_OK
     out = Path(args.output or "report.html")
+    text = html(report, title=args.title or "")
+    _write(out, text)
+    batteries = sum(len(i.batteries) for i in report.inputs)
+    print(f"wrote {out} ({len(report.inputs)} input(s), {batteries} battery instance(s), {len(text) // 1024} KiB)")
+    return EXIT_OK
+
+
+def _write(out: Path, text: str) -> None:
     if out.is_dir():
-        raise BattgenError(f"{out}: is a folder; give the report's file name (-o report.html)")
+        raise BattgenError(f"{out}: is a folder; give the output's file name")
     if not out.parent.is_dir():
         raise BattgenError(f"{out.parent}: no such folder for the report")
-    text = html(report, title=args.title or "")
     try:
         out.write_text(text, encoding="utf-8")
     except OSError as exc:
         raise BattgenError(f"{out}: cannot write: {exc.strerror or exc}") from None
-    batteries = sum(len(i.batteries) for i in report.inputs)
-    print(f"wrote {out} ({len(report.inputs)} input(s), {batteries} battery instance(s), {len(text) // 1024} KiB)")
-    return EXIT_OK
 
 
 def register(subparsers: Any) -> None:
@@ -69,9 +85,10 @@ def register(subparsers: Any) -> None:
         "-o",
         "--output",
         metavar="PATH",
-        help="the HTML file (default report.html), or with --format png the folder of images (default report/)",
+        help="the HTML file (default report.html); with --format png the folder of images (default report/); with "
+        "--format json the file (default: stdout)",
     )
-    p.add_argument("--format", choices=("html", "png"), default="html", help="output (default: html)")
+    p.add_argument("--format", choices=("html", "png", "json"), default="html", help="output (default: html)")
     p.add_argument("--message", metavar="NAME", help="the message of data-file inputs (default by log kind)")
     p.add_argument("--schemas", metavar="DIR", help="schema folder (default: the bundled schemas/)")
     p.add_argument("--params", metavar="FILE", help="BATT_* parameter file to replay the failsafe with")

@@ -11,12 +11,14 @@ import json
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from flight_logs import CELLS, RESISTANCE, write_capture_flight, write_flight
 
+from codegen.apps.battery.figures import trapezoid
 from codegen.apps.package import bundled_schemas
 from codegen.apps.report.downsample import POINT_BUDGET, decimate, planned_length
-from codegen.apps.report.figures import compute, integrate
+from codegen.apps.report.figures import compute
 from codegen.apps.report.series import read_input
 from codegen.cli.main import main
 
@@ -50,7 +52,7 @@ def test_charge_and_energy_used(flight: Path) -> None:
     b = item.batteries[0]
     f = compute(b)
     # the counter the log carries, and the integral of the current it logged, agree
-    amp_hours = integrate(b.t, b.current)
+    amp_hours = trapezoid(np.array(b.t), np.array([np.nan if i is None else i for i in b.current]))
     assert amp_hours is not None
     assert f.charge_used_mah == pytest.approx(amp_hours / 3.6, rel=0.01)
     assert f.energy_used_wh is not None and f.average_power_w is not None

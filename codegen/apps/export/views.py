@@ -3,7 +3,9 @@
 Written into the dataset as ``views.sql`` so any DuckDB can use them (``cd DIR; duckdb -init
 views.sql``); ``battgen query`` (:mod:`codegen.apps.fleet_query`) runs them before the user's SQL.
 ``flights``: one row per flight (a log and a battery instance). ``packs``: one row per pack, by
-serial number where the pack reports one, else by vehicle and battery instance.
+serial number where the pack reports one, else by vehicle and battery instance. A flight's records, times,
+voltages, current, armed time, charge and energy used are the figures of :mod:`codegen.apps.battery.figures`, the
+definition ``battgen report`` shows too.
 
 Internal resistance is estimated at load steps as ``battgen report`` does (one definition, in
 :mod:`codegen.apps.load_steps`): consecutive records of a battery at most 2 s apart whose current
@@ -21,6 +23,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from ..battery.figures import WINDOW_SQL, flight_sql
 from ..load_steps import resistance_sql
 from .dataset import BATTERY, table_glob
 from .failsafe_tables import EVENTS_FILE, EVENTS_SCHEMA, FAILSAFE, REPLAYS_FILE, REPLAYS_SCHEMA
@@ -37,10 +40,7 @@ CREATE OR REPLACE VIEW flights AS
 WITH steps AS (
     SELECT
         *,
-        t - lag(t) OVER w AS dt,
-        lag(armed) OVER w AS was_armed,
-        lag(current) OVER w AS prev_current,
-        lag(pack_voltage) OVER w AS prev_voltage,
+        {WINDOW_SQL},
         max(abs(current)) OVER (PARTITION BY log, battery) AS peak_abs_current
     FROM battery
     WINDOW w AS (PARTITION BY log, battery ORDER BY t)
@@ -53,14 +53,8 @@ SELECT
     any_value(vehicle) AS vehicle,
     coalesce(CAST(any_value(serial_number) AS VARCHAR), coalesce(any_value(vehicle), log) || '/' || battery) AS pack,
     min(time) AS start_time,
-    count(*) AS records,
-    max(t) - min(t) AS duration,
-    sum(CASE WHEN was_armed THEN dt END) AS duration_armed,
-    min(pack_voltage) AS min_voltage,
+{flight_sql()},
     min(list_min(cell_voltages)) AS min_cell_voltage,
-    max(current) AS peak_current,
-    coalesce(max(discharged) - min(discharged), sum(prev_current * dt)) AS charge_used,
-    coalesce(max(consumed_energy) - min(consumed_energy), sum(prev_voltage * prev_current * dt)) AS energy_used,
     max(list_max(cell_voltages) - list_min(cell_voltages)) AS max_cell_imbalance,
     max(temperature) AS max_temperature,
     max(state_of_charge) AS start_state_of_charge,

@@ -1,7 +1,9 @@
 """The figures people compute by hand from a flight's battery data.
 
-Charge used comes from the battery's own discharged counter where it reports one (the fuel gauge or the
-autopilot's integrator), else from integrating the current (trapezoids); energy from integrating V·I. The
+The flight's own figures -- records, its first and last time, armed time, minimum and maximum pack voltage, peak
+current, charge and energy used -- are :mod:`codegen.apps.battery.figures`, the one definition the fleet views
+share: charge and energy from the battery's own counter where it keeps one, else the trapezoid integral of the
+current and of V·I. The
 internal resistance is estimated from load steps (:mod:`codegen.apps.load_steps`, the definition the fleet views
 share): consecutive samples at most 2 s apart whose current changes by at least 20 % of the flight's peak current
 (and 1 A) give R = -ΔV/ΔI; the median of those steps is reported. The voltage sag per amp is the least-squares
@@ -16,6 +18,7 @@ import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from ..battery.figures import FlightFigures
 from ..load_steps import STEP_MAX_DT_S, step_resistances
 from .series import BatterySeries
 
@@ -39,6 +42,7 @@ class Figures:
     internal_resistance_ohm: float | None
     load_steps: int
     time_below_s: dict[str, float]  # threshold name -> seconds spent below it
+    flight: FlightFigures  # in SI, as the fleet views have them
 
     def rows(self) -> list[tuple[str, str]]:
         """The figures as (label, text) rows for the page."""
@@ -79,25 +83,6 @@ def _known(values: Sequence[float | None]) -> list[float]:
     return [v for v in values if v is not None]
 
 
-def integrate(t: Sequence[float], values: Sequence[float | None]) -> float | None:
-    """Trapezoid integral over the intervals whose two ends are known."""
-    total, used = 0.0, False
-    for k in range(1, len(t)):
-        a, b = values[k - 1], values[k]
-        if a is not None and b is not None:
-            total += (a + b) / 2 * (t[k] - t[k - 1])
-            used = True
-    return total if used else None
-
-
-def _charge_used(s: BatterySeries) -> float | None:
-    counter = _known(s.discharged)
-    if len(counter) >= 2 and max(counter) > 0:
-        return counter[-1] - counter[0]
-    amp_seconds = integrate(s.t, s.current)
-    return None if amp_seconds is None else amp_seconds / 3.6
-
-
 def _steps(s: BatterySeries) -> list[float]:
     return step_resistances(s.t, s.pack_voltage, s.current)
 
@@ -128,24 +113,23 @@ def _time_below(s: BatterySeries, threshold: float) -> float:
 def compute(s: BatterySeries, thresholds: dict[str, float] | None = None) -> Figures:
     """The figures of one battery; ``thresholds`` (name -> volts, e.g. BATT_LOW_VOLT) for the time below each."""
     power = s.power
-    currents = _known(s.current)
+    flight = s.flight()
     steps = _steps(s)
-    energy = integrate(s.t, power)
-    duration = s.t[-1] - s.t[0] if len(s.t) > 1 else 0.0
+    energy = flight.energy_used
+    duration = flight.duration_s
     cells = [min(c) for c in s.cells if c]
     imbalance = _known(s.imbalance)
     temps = _known(s.temperature)
-    volts = _known(s.pack_voltage)
     known_power = _known(power)
     return Figures(
         duration_s=duration,
         samples=len(s.t),
-        charge_used_mah=_charge_used(s),
+        charge_used_mah=None if flight.charge_used is None else flight.charge_used / 3.6,
         energy_used_wh=None if energy is None else energy / 3600.0,
         average_power_w=energy / duration if energy is not None and duration > 0 else None,
         peak_power_w=max(known_power) if known_power else None,
-        peak_current_a=max(currents) if currents else None,
-        min_pack_voltage_v=min(volts) if volts else None,
+        peak_current_a=flight.max_current,
+        min_pack_voltage_v=flight.min_voltage,
         min_cell_voltage_v=min(cells) if cells else None,
         max_cell_imbalance_v=max(imbalance) if imbalance else None,
         max_temperature_c=max(temps) if temps else None,
@@ -153,4 +137,5 @@ def compute(s: BatterySeries, thresholds: dict[str, float] | None = None) -> Fig
         internal_resistance_ohm=statistics.median(steps) if steps else None,
         load_steps=len(steps),
         time_below_s={name: _time_below(s, v) for name, v in (thresholds or {}).items() if v > 0},
+        flight=flight,
     )

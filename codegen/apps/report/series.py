@@ -28,6 +28,7 @@ from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
 from ...ir import SourceFormat
 from ..battery.columns import NDArray
+from ..battery.figures import FlightFigures, flight_figures
 from ..battery.view import Chunk, read_view
 from ..convert import Conversion
 from ..failsafe.logs import SampleTable
@@ -61,6 +62,11 @@ class BatterySeries:
     discharged: list[float | None] = field(default_factory=list)  # mAh
     remaining_energy: list[float | None] = field(default_factory=list)  # Wh
     cells: list[list[float]] = field(default_factory=list)  # known cell voltages of each sample
+    # in the concepts' SI units, NaN unknown, for the flight figures (codegen.apps.battery.figures)
+    charge_c: list[float] = field(default_factory=list)  # the discharged counter
+    energy_j: list[float] = field(default_factory=list)  # the consumed-energy counter
+    armed: list[float] = field(default_factory=list)  # 1.0 / 0.0 / NaN
+    knows_arming: bool = False  # whether the input carries an arming state at all
     serial: str = ""
     cycle_count: int | None = None  # the last the battery reported
     state_of_health: float | None = None  # percent, the last the battery reported
@@ -77,6 +83,21 @@ class BatterySeries:
             v * i if v is not None and i is not None else None
             for v, i in zip(self.pack_voltage, self.current, strict=True)
         ]
+
+    def flight(self) -> FlightFigures:
+        """The flight's figures, by the one definition the fleet views share."""
+
+        def array(values: list[float | None]) -> NDArray:
+            return np.array([np.nan if v is None else v for v in values], np.float64)
+
+        return flight_figures(
+            np.array(self.t, np.float64),
+            array(self.pack_voltage),
+            array(self.current),
+            np.array(self.charge_c, np.float64),
+            np.array(self.energy_j, np.float64),
+            np.array(self.armed, np.float64) if self.knows_arming else None,
+        )
 
     @property
     def cell_count(self) -> int:
@@ -206,6 +227,14 @@ def _extend(series: BatterySeries, chunk: Chunk, rows: NDArray) -> None:
     series.temperature.extend(_numbers(chunk, "temperature", rows, 1.0, -KELVIN))
     series.discharged.extend(_numbers(chunk, "discharged", rows, 1 / COULOMB_PER_MAH))
     series.remaining_energy.extend(_numbers(chunk, "remaining_energy", rows, 1 / 3600.0))
+    series.charge_c.extend(chunk.number("discharged")[rows].tolist())
+    series.energy_j.extend(chunk.number("consumed_energy")[rows].tolist())
+    armed = chunk.batch.armed
+    if armed is not None:
+        series.knows_arming = True
+        series.armed.extend(np.asarray(armed, np.float64)[rows].tolist())
+    else:
+        series.armed.extend([math.nan] * len(rows))
     cells = chunk.concepts["cell_voltages"]
     for k in rows.tolist():
         width = int(cells.lengths[k]) if cells.valid[k] and cells.lengths is not None else 0
@@ -232,7 +261,17 @@ def _order(series: BatterySeries) -> None:
     order = sorted(range(len(series.t)), key=lambda k: series.t[k])
     if order == list(range(len(order))):
         return
-    for name in ("t", "pack_voltage", "current", "state_of_charge", "temperature", "discharged"):
+    for name in (
+        "t",
+        "pack_voltage",
+        "current",
+        "state_of_charge",
+        "temperature",
+        "discharged",
+        "charge_c",
+        "energy_j",
+        "armed",
+    ):
         values = getattr(series, name)
         setattr(series, name, [values[k] for k in order])
     series.remaining_energy = [series.remaining_energy[k] for k in order]
@@ -280,6 +319,7 @@ _CONCEPTS = (
     "state_of_charge",
     "temperature",
     "discharged",
+    "consumed_energy",
     "remaining_energy",
     "cell_voltages",
     "state_of_health",
@@ -309,6 +349,10 @@ def _append(series: BatterySeries, t: float, state: Mapping[str, Any]) -> None:
     series.temperature.append(None if kelvin is None else kelvin - KELVIN)
     charge = _number(state.get("discharged"))
     series.discharged.append(None if charge is None else charge / COULOMB_PER_MAH)
+    series.charge_c.append(math.nan if charge is None else charge)
+    consumed = _number(state.get("consumed_energy"))
+    series.energy_j.append(math.nan if consumed is None else consumed)
+    series.armed.append(math.nan)  # a data file carries no arming state
     energy = _number(state.get("remaining_energy"))
     series.remaining_energy.append(None if energy is None else energy / 3600.0)
     cells = state.get("cell_voltages") or []
