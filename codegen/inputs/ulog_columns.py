@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol, cast
 
+from . import ulog_layouts
 from .model import FormatDiff, UorbClass, ulog_runtime
 from .records import InputError
 from .ulog_index import gather, record_offsets
@@ -185,21 +186,29 @@ class UlogColumns:
         except (ValueError, struct.error) as exc:
             raise InputError(self.name, 0, f"{topic} multi_id {multi_id}: cannot decode: {exc}") from None
         skip = frozenset({n for n, _ in diff.missing} | {r.name for r in diff.retyped})
-        if not diff.identical:  # an older layout: the generated reader maps it record by record
-            yield self._decoded(topic, multi_id, skip)
-            return
+        alias, converted = ulog_layouts.plan(diff)
         total = len(self.offsets.get((topic, multi_id), ()))
         defaults = cast(Any, self.model)()
         fields = [(f.metadata.get("name", f.name), getattr(defaults, f.name)) for f in dataclasses.fields(defaults)]
+        if not diff.identical and not _columnar(fields, converted):  # kinds only the generated reader maps
+            yield self._decoded(topic, multi_id, skip)
+            return
         if wanted is not None:
             fields = [(name, d) for name, d in fields if name in wanted or name == "timestamp"]
         names = set(dtype.names or ())
-        read = [name for name, _ in fields if name not in skip and name in names]
+        # schema name -> the log's field read as it is (same type; renamed ones under the log's name)
+        read = {name: alias.get(name, name) for name, _ in fields if name not in skip and name not in converted}
+        read = {name: log for name, log in read.items() if log in names}
+        conv = {name: converted[name] for name, _ in fields if name in converted and converted[name].log in names}
+        gathered = sorted(set(read.values()) | {c.log for c in conv.values()})
         for begin in range(0, total, chunk):
             n = min(chunk, total - begin)
-            out = self.columns(topic, multi_id, read, begin, begin + n)
+            got = self.columns(topic, multi_id, gathered, begin, begin + n)
+            out: dict[str, NDArray] = {name: got[log] for name, log in read.items()}
             for name, default in fields:
-                if name not in out:  # the class's default, as the per-record reader leaves it
+                if name in conv:
+                    out[name] = ulog_layouts.convert(conv[name], got[conv[name].log], default)
+                elif name not in out:  # the class's default, as the per-record reader leaves it
                     out[name] = np.tile(default, (n, 1)) if isinstance(default, list) else np.full(n, default)
             stamps = out.get("timestamp") if "timestamp" not in skip else None
             yield TopicColumns(topic, multi_id, n, stamps, out, skip)
@@ -295,6 +304,16 @@ def record_dtype(lay: _Layout) -> Any:
         offsets.append(lay.offsets[i])
         i = j
     return np.dtype({"names": names, "formats": formats, "offsets": offsets, "itemsize": lay.data_size})
+
+
+def _columnar(fields: list[tuple[str, Any]], converted: Mapping[str, ulog_layouts.Conversion]) -> bool:
+    """Whether every field of the class is a number or an array of numbers (what the column path
+    maps; strings and nested types stay with the generated decoder) and every conversion is of numbers."""
+    for _, default in fields:
+        values = default if isinstance(default, list) else [default]
+        if not all(isinstance(v, int | float) for v in values):
+            return False
+    return all(ulog_layouts.supported(c) for c in converted.values())
 
 
 def _values(field: NDArray) -> NDArray:

@@ -6,14 +6,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
-from shared_data import real_logs
+from shared_data import SHARED, real_logs
 
 from codegen.apps.battery.catalog import bundled_catalog
 from codegen.apps.battery.columnar import NotColumnar, convert_columns
@@ -25,9 +27,11 @@ from codegen.apps.package import bundled_package, model_class
 from codegen.inputs.model import UorbClass
 from codegen.inputs.records import Record
 from codegen.inputs.ulog import ulog_items
+from codegen.inputs.ulog_columns import UlogColumns
 from codegen.ir import ArrayType, PrimitiveKind, PrimitiveType
 
-LOGS = real_logs()
+# every real ULog of ../shared (real_logs(): a collection error under CI when there are none)
+LOGS = sorted(SHARED.rglob("*.ulg")) or real_logs()
 CATALOG = bundled_catalog()
 PACKAGE = bundled_package()
 
@@ -72,6 +76,36 @@ def test_real_logs_columnar_equals_per_record(log: Path) -> None:
             assert a.equals(b), f"{log.name} multi_id {batch.instance[0]}: {concept.name} differs"
         # the columns themselves are the records' fields (as the per-record decoder fills them)
         assert_same(records, batch.message)
+
+
+def _shared_logs() -> list[Path]:
+    if not LOGS:
+        if os.environ.get("CI"):
+            pytest.fail(f"no real ULog under {SHARED}")
+        pytest.skip(f"no real ULog under {SHARED}")
+    return LOGS
+
+
+def test_every_layout_is_read_as_columns_as_the_per_record_decoder_reads_it() -> None:
+    """On every real ULog of ../shared (PX4 1.8-1.16 layouts): the column path (chunks of 1000
+    records) gives, field by field, what the generated per-record decoder gives."""
+    model = _model("uorb.BatteryStatus")
+    checked = 0
+    for log_path in _shared_logs():
+        with UlogColumns(log_path, log_path.name, model) as log:
+            chunks = list(log.instances(chunk=1000))
+            for topic, multi_id in sorted({(c.topic, c.multi_id) for c in chunks}):
+                mine = [c for c in chunks if (c.topic, c.multi_id) == (topic, multi_id)]
+                oracle = log._decoded(topic, multi_id, mine[0].unfilled)
+                assert sum(c.n for c in mine) == oracle.n
+                for name, expected in oracle.columns.items():
+                    got = np.concatenate([c.columns[name] for c in mine])
+                    assert got.shape == expected.shape, f"{log_path.name} {name}"
+                    assert np.array_equal(got.astype(np.float64), expected.astype(np.float64), equal_nan=True), (
+                        f"{log_path.name} multi_id {multi_id}: {name} differs"
+                    )
+                    checked += 1
+    assert checked
 
 
 # -- generated records --------------------------------------------------------------------------------
@@ -196,3 +230,65 @@ def test_ops_without_a_columnar_form_are_refused() -> None:
     with pytest.raises(NotColumnar, match="px4_convert"):
         visit(rule, converter)
     assert np is not None
+
+
+# -- synthetic older layouts ------------------------------------------------------------------------
+
+_INT_TYPES = ("int8_t", "uint8_t", "int16_t", "uint16_t", "int32_t", "uint32_t", "int64_t", "uint64_t", "bool")
+_FLOAT_TYPES = ("float", "double")
+
+
+def _record(kind: bytes, body: bytes) -> bytes:
+    return len(body).to_bytes(2, "little") + kind + body
+
+
+@st.composite
+def older_layouts(draw: st.DrawFn) -> tuple[str, int]:
+    """A battery_status format text PX4 might have logged: some of the class's fields, in another
+    order, some under their old name or another compatible type, arrays of other lengths."""
+    cls = _model("uorb.BatteryStatus")
+    fields = [(f.metadata.get("name", f.name), getattr(cls(), f.name)) for f in dataclasses.fields(cls)]
+    chosen = draw(st.lists(st.sampled_from(fields[1:]), unique_by=lambda f: f[0], max_size=12))
+    members = ["uint64_t timestamp"]
+    for name, default in chosen:
+        value = default[0] if isinstance(default, list) else default
+        types = _FLOAT_TYPES if isinstance(value, float) else _INT_TYPES
+        ctype = draw(st.sampled_from(types))
+        size = f"[{draw(st.integers(1, 16))}]" if isinstance(default, list) else ""
+        if name == "current_average_a" and draw(st.booleans()):
+            name = "average_current_a"  # PX4 before v1.12
+        members.append(f"{ctype}{size} {name}")
+    sizes = {"int8_t": 1, "uint8_t": 1, "bool": 1, "int16_t": 2, "uint16_t": 2, "int32_t": 4, "uint32_t": 4,
+             "float": 4, "int64_t": 8, "uint64_t": 8, "double": 8}  # fmt: skip
+    size = sum(
+        sizes[m.split()[0].split("[")[0]] * int(m.split()[0].partition("[")[2].rstrip("]") or 1) for m in members
+    )
+    return "battery_status:" + ";".join(members) + ";", size
+
+
+def _older_log(fmt: str, payloads: list[bytes]) -> bytes:
+    head = b"ULog\x01\x12\x35" + b"\x01" + (1000).to_bytes(8, "little")
+    flags = _record(b"B", bytes(40))
+    out = head + flags + _record(b"F", fmt.encode()) + _record(b"A", b"\x00\x00\x00battery_status")
+    return out + b"".join(_record(b"D", b"\x00\x00" + p) for p in payloads)
+
+
+@settings(max_examples=40, deadline=None)
+@given(layout=older_layouts(), data=st.data())
+def test_synthetic_older_layouts_as_the_per_record_decoder(layout: tuple[str, int], data: st.DataObject) -> None:
+    fmt, size = layout
+    payloads = data.draw(st.lists(st.binary(min_size=size, max_size=size), min_size=1, max_size=6))
+    model = _model("uorb.BatteryStatus")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "older.ulg"
+        path.write_bytes(_older_log(fmt, payloads))
+        with UlogColumns(path, path.name, model) as log:
+            chunks = list(log.instances(chunk=4))
+            assert sum(c.n for c in chunks) == len(payloads)
+            oracle = log._decoded("battery_status", 0, chunks[0].unfilled)
+            for name, expected in oracle.columns.items():
+                got = np.concatenate([c.columns[name] for c in chunks])
+                assert got.shape == expected.shape, name
+                assert np.array_equal(got.astype(np.float64), expected.astype(np.float64), equal_nan=True), (
+                    f"{fmt}: {name}: columns {got.tolist()} != decoder {expected.tolist()}"
+                )
