@@ -31,11 +31,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .dataflash_units import field_scales
 from .records import InputError
 
 HEAD = b"\xa3\x95"
 FMT_TYPE = 0x80
-BATTERY_TYPES = frozenset({"BAT", "BATT", "BAT2", "CURR", "CURR2"})
+# BAT (Inst/Instance from 3.6 on), BAT2..BAT9 and CURR/CURR2/CUR2 of older firmware, one type per monitor
+NUMBERED_TYPES = {f"BAT{n}": n - 1 for n in range(2, 10)} | {"CURR2": 1, "CUR2": 1}
+BATTERY_TYPES = frozenset({"BAT", "BATT", "CURR"} | set(NUMBERED_TYPES))
 ARMING_TYPES = frozenset({"ARM", "EV"})
 EV_ARMED, EV_DISARMED = 10, 11  # AP_Logger LogEvent ids
 
@@ -50,6 +53,7 @@ class DataflashMessage:
     offset: int
     time_us: int | None
     fields: Mapping[str, Any]
+    scales: Mapping[str, float] = field(default_factory=dict)
 
     @property
     def time_s(self) -> float | None:
@@ -89,6 +93,7 @@ class DataflashLog:
         wanted = None if types is None else set(types)
         reader = _open(self.path, self.display, self.skipped_notes)
         index = 0
+        scales: dict[str, dict[str, float]] = {}
         try:
             while True:
                 with _captured(self.skipped_notes):
@@ -110,11 +115,21 @@ class DataflashLog:
                     )
                     continue
                 values.pop("mavpackettype", None)
-                yield DataflashMessage(name, index, max(0, int(reader.offset) - length), _time_us(values), values)
+                if name not in scales:
+                    scales[name] = _scales(name, getattr(msg, "fmt", None))
+                offset = max(0, int(reader.offset) - length)
+                yield DataflashMessage(name, index, offset, _time_us(values), values, scales[name])
                 index += 1
         finally:
             with contextlib.suppress(Exception):
                 reader.close()
+
+
+def _scales(name: str, fmt: Any) -> dict[str, float]:
+    if fmt is None:
+        return {}
+    units = getattr(fmt, "units", None)
+    return field_scales(name, str(fmt.format), list(fmt.columns), bool(units))
 
 
 def is_dataflash(path: Path) -> bool:
@@ -212,20 +227,26 @@ def _battery(msg: DataflashMessage) -> BatteryRecord | None:
     if msg.time_s is None:
         return None
     f = msg.fields
-    if msg.type in ("BAT2", "CURR2"):
-        instance = 1
+    if msg.type in NUMBERED_TYPES:
+        instance = NUMBERED_TYPES[msg.type]
     else:
         inst = _number(f, "Inst", "Instance")
         instance = int(inst) if inst is not None else 0
     return BatteryRecord(
         time_s=msg.time_s,
         instance=instance,
-        voltage_v=_number(f, "Volt"),
-        current_a=_number(f, "Curr"),
-        consumed_mah=_number(f, "CurrTot"),
-        remaining_pct=_number(f, "RemPct"),
+        voltage_v=_scaled(msg, "Volt"),
+        current_a=_scaled(msg, "Curr"),
+        consumed_mah=_scaled(msg, "CurrTot"),
+        remaining_pct=_scaled(msg, "RemPct"),
         offset=msg.offset,
     )
+
+
+def _scaled(msg: DataflashMessage, name: str) -> float | None:
+    value = _number(msg.fields, name)
+    scale = msg.scales.get(name, 1.0)
+    return value if value is None or scale == 1.0 else shortest_float32(value * scale)
 
 
 def _arming(msg: DataflashMessage) -> ArmingRecord | None:
