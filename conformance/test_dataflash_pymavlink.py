@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from codegen.inputs.dataflash import NUMBERED_TYPES, battery_records, open_log
+from codegen.inputs.dataflash_text import HEAD_BYTES, is_text_dataflash
 from codegen.inputs.dataflash_units import field_scales
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
@@ -20,7 +21,9 @@ CORPUS = SHARED / "corpus"
 def _logs() -> list[Path]:
     if not CORPUS.is_dir():
         return []
-    return sorted(p for p in CORPUS.rglob("*") if p.suffix.lower() == ".bin" and p.is_file())
+    binary = [p for p in CORPUS.rglob("*") if p.suffix.lower() == ".bin" and p.is_file()]
+    text = [p for p in CORPUS.rglob("*.log") if p.is_file() and is_text_dataflash(p.read_bytes()[:HEAD_BYTES])]
+    return sorted(binary + text)
 
 
 LOGS = _logs()
@@ -36,7 +39,8 @@ def test_corpus_present() -> None:
 def _reference(path: Path) -> dict[int, list[tuple[float, float, float, float]]]:
     from pymavlink import DFReader
 
-    reader = DFReader.DFReader_binary(str(path), zero_time_base=True)
+    text = path.suffix.lower() != ".bin"
+    reader = (DFReader.DFReader_text if text else DFReader.DFReader_binary)(str(path), zero_time_base=True)
     out: dict[int, list[tuple[float, float, float, float]]] = {}
     types = ["BAT", "BATT", "CURR", *NUMBERED_TYPES]
     while (msg := reader.recv_match(type=types)) is not None:
@@ -44,7 +48,7 @@ def _reference(path: Path) -> dict[int, list[tuple[float, float, float, float]]]
         fmt = msg.fmt
         scale = field_scales(msg.get_type(), fmt.format, fmt.columns, bool(getattr(fmt, "units", None)))
         inst = NUMBERED_TYPES.get(msg.get_type(), int(d.get("Inst", d.get("Instance", 0))))
-        t = d["TimeUS"] / 1e6 if "TimeUS" in d else d["TimeMS"] / 1e3
+        t = d["TimeUS"] / 1e6 if "TimeUS" in d else d["TimeMS"] / 1e3 if "TimeMS" in d else msg._timestamp
         row = (t, d["Volt"] * scale["Volt"], d["Curr"] * scale["Curr"], float(d["CurrTot"]))
         out.setdefault(inst, []).append(row)
     return out
@@ -78,6 +82,15 @@ def test_pre_36_curr_reads_volts_and_amps() -> None:
     # a 4S pack: ~16.8 V full, never the 1491 V the raw int16 hundredths would read
     assert 10 < min(volts) < max(volts) < 17.5
     assert 0 <= max(amps) < 100
+
+
+def test_text_log_read() -> None:
+    text = [p for p in LOGS if p.suffix.lower() == ".log"]
+    if not text:
+        pytest.skip("no text DataFlash log in the corpus")
+    for path in text:
+        rows = list(battery_records(open_log(path)))
+        assert rows and all(r.voltage_v is not None and 5 < r.voltage_v < 60 for r in rows)
 
 
 def test_legacy_scale_table() -> None:

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from .dataflash_arming import event_state
+from .dataflash_text import HEAD_BYTES, is_text_dataflash, open_text_reader
 from .dataflash_units import field_scales
 from .records import InputError
 
@@ -54,6 +55,13 @@ class DataflashMessage:
     time_us: int | None
     fields: Mapping[str, Any]
     scales: Mapping[str, float] = field(default_factory=dict)
+    clock_us: int | None = None  # pymavlink's clock: for records without TimeUS/TimeMS (pre-3.4 EV, 3.0 CURR)
+
+    @property
+    def when_s(self) -> float | None:
+        """``TimeUS`` where the record has it, else pymavlink's clock at the record."""
+        us = self.time_us if self.time_us is not None else self.clock_us
+        return None if us is None else us / 1e6
 
     @property
     def time_s(self) -> float | None:
@@ -86,12 +94,13 @@ class DataflashLog:
 
     path: Path
     display: str
+    text: bool = False
     skipped_notes: list[str] = field(default_factory=list)
 
     def messages(self, types: Iterable[str] | None = None) -> Iterator[DataflashMessage]:
         """The messages (of ``types`` when given), in file order."""
         wanted = None if types is None else set(types)
-        reader = _open(self.path, self.display, self.skipped_notes)
+        reader = _open(self.path, self.display, self.skipped_notes, self.text)
         index = 0
         scales: dict[str, dict[str, float]] = {}
         try:
@@ -118,7 +127,9 @@ class DataflashLog:
                 if name not in scales:
                     scales[name] = _scales(name, getattr(msg, "fmt", None))
                 offset = max(0, int(reader.offset) - length)
-                yield DataflashMessage(name, index, offset, _time_us(values), values, scales[name])
+                stamp = getattr(msg, "_timestamp", None)
+                clock = round(stamp * 1e6) if isinstance(stamp, float | int) and math.isfinite(stamp) else None
+                yield DataflashMessage(name, index, offset, _time_us(values), values, scales[name], clock)
                 index += 1
         finally:
             with contextlib.suppress(Exception):
@@ -146,21 +157,27 @@ def open_log(path: Path, display: str | None = None) -> DataflashLog:
     shown = display or path.as_posix()
     try:
         with path.open("rb") as f:
-            head = f.read(3)
+            head = f.read(HEAD_BYTES)
     except OSError as exc:
         raise InputError(shown, 0, f"cannot read file: {exc.strerror or exc}") from None
     if not head:
         raise InputError(shown, 0, "expected a DataFlash log, got an empty file")
-    if head != HEAD + bytes([FMT_TYPE]):
-        raise InputError(shown, 0, "expected a DataFlash log (starting with a FMT message, bytes A3 95 80)")
-    return DataflashLog(path, shown)
+    if head[:3] == HEAD + bytes([FMT_TYPE]):
+        return DataflashLog(path, shown)
+    if is_text_dataflash(head):
+        return DataflashLog(path, shown, text=True)
+    raise InputError(
+        shown, 0, "expected a DataFlash log (starting with a FMT message, bytes A3 95 80, or FMT, lines of text)"
+    )
 
 
-def _open(path: Path, display: str, notes: list[str]) -> Any:
+def _open(path: Path, display: str, notes: list[str], text: bool = False) -> Any:
     from pymavlink import DFReader
 
     with _captured(notes):
         try:
+            if text:
+                return open_text_reader(path)
             return DFReader.DFReader_binary(str(path), zero_time_base=True)
         except (OSError, ValueError) as exc:
             raise InputError(display, 0, f"cannot read DataFlash log: {exc}") from None
@@ -224,7 +241,8 @@ def log_parameters(log: DataflashLog) -> dict[str, float]:
 
 
 def _battery(msg: DataflashMessage) -> BatteryRecord | None:
-    if msg.time_s is None:
+    when = msg.when_s
+    if when is None:
         return None
     f = msg.fields
     if msg.type in NUMBERED_TYPES:
@@ -233,7 +251,7 @@ def _battery(msg: DataflashMessage) -> BatteryRecord | None:
         inst = _number(f, "Inst", "Instance")
         instance = int(inst) if inst is not None else 0
     return BatteryRecord(
-        time_s=msg.time_s,
+        time_s=when,
         instance=instance,
         voltage_v=_scaled(msg, "Volt"),
         current_a=_scaled(msg, "Curr"),
@@ -250,13 +268,14 @@ def _scaled(msg: DataflashMessage, name: str) -> float | None:
 
 
 def _arming(msg: DataflashMessage) -> ArmingRecord | None:
-    if msg.time_s is None:
+    when = msg.when_s
+    if when is None:
         return None
     if msg.type == "ARM":
         state = _number(msg.fields, "ArmState")
-        return None if state is None else ArmingRecord(msg.time_s, bool(state), msg.offset)
+        return None if state is None else ArmingRecord(when, bool(state), msg.offset)
     armed = event_state(_number(msg.fields, "Id"))
-    return None if armed is None else ArmingRecord(msg.time_s, armed, msg.offset)
+    return None if armed is None else ArmingRecord(when, armed, msg.offset)
 
 
 def flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord]:
@@ -335,6 +354,8 @@ def first_time_us(log: DataflashLog) -> int | None:
     for msg in log.messages():
         if msg.time_us is not None:
             return msg.time_us
+        if msg.type in BATTERY_TYPES and msg.clock_us is not None:  # a log without TimeUS/TimeMS at all
+            return msg.clock_us
     return None
 
 
