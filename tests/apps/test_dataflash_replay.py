@@ -75,3 +75,30 @@ def test_clock_and_arming(log: Path) -> None:
     assert batch.t[0] == pytest.approx(11.477 - 11.459)
     assert batch.armed is not None and batch.armed[0] == 0.0 and batch.armed[-1] == 1.0  # EV 10 at 72.6 s
     assert any("APM:Copter V3.3" in n for n in batch.notes)
+
+
+def _corpus_log(name: str) -> Path:
+    path = SHARED / "corpus" / "realworld3b" / "dataflash" / name
+    if not path.is_file():
+        path = SHARED / "corpus" / "realworld3" / "dataflash" / name
+    if not path.is_file():
+        if os.environ.get("CI"):
+            pytest.fail(f"missing {path}")
+        pytest.skip(f"missing {path}")
+    return path
+
+
+def test_log_disarmed_0_armed_from_the_first_record() -> None:
+    # LOG_DISARMED 0, one ARM record (ArmState 0 at the end): armed from the log's start until it
+    path = _corpus_log("wlichon_00000001.BIN")
+    assert log_parameters(path) is not None and (log_parameters(path) or {})["LOG_DISARMED"] == 0.0
+    batch = dataflash_batches(path, path.name, bundled_catalog())[0]
+    assert batch.armed is not None and batch.armed[0] == 1.0
+    assert set(batch.armed.tolist()) <= {0.0, 1.0}
+
+
+def test_log_disarmed_0_without_arm_records_is_armed_throughout() -> None:
+    path = _corpus_log("methodic_backend_log_80k.bin")
+    batch = dataflash_batches(path, path.name, bundled_catalog())[0]
+    assert batch.armed is not None and batch.n > 0 and (batch.armed == 1.0).all()
+    assert batch.t[0] >= 0.0 and batch.origin_us > 0
