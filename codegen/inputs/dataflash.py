@@ -1,4 +1,5 @@
-"""ArduPilot DataFlash logs (``.bin``), read through pymavlink's DataFlash reader (``DFReader_binary``).
+"""ArduPilot DataFlash logs (``.bin``, and text ``.log`` through :mod:`.dataflash_text`), read through
+pymavlink's DataFlash readers (``DFReader_binary``, ``DFReader_text``).
 
 A DataFlash log is a sequence of messages, each ``0xA3 0x95 <type>`` and a payload laid out by the
 log's own ``FMT`` records (the FMT record of type 128 describes FMT itself). pymavlink's reader
@@ -9,8 +10,8 @@ the battery tools need:
 - :func:`log_parameters`: the log's ``PARM`` records (``Name``, ``Value``); a parameter logged
   more than once (set in flight) takes its last value, as the vehicle ended up with it.
 - :func:`battery_records`: ``BAT`` records (``Inst`` 0-based, ``Volt``, ``Curr``, ``CurrTot`` mAh,
-  ``RemPct``), and the older layouts (``BAT`` without ``Inst``, ``BAT2`` for the second monitor,
-  ``CURR``/``CURR2`` before ArduPilot 3.6).
+  ``RemPct``), and the older layouts (``BAT`` without ``Inst``, ``BAT2``..``BAT9`` per monitor,
+  ``CURR``/``CURR2``/``CUR2`` before ArduPilot 3.6), in V / A / mAh (:mod:`.dataflash_units`).
 - :func:`arming_records`: the arming state from ``ARM`` records (``ArmState``) and the ``EV``
   events older logs carry (the rule, with ``LOG_DISARMED``, in :mod:`.dataflash_arming`).
 
