@@ -1,4 +1,5 @@
-"""ArduPilot DataFlash logs (``.bin``), read through pymavlink's DataFlash reader (``DFReader_binary``).
+"""ArduPilot DataFlash logs (``.bin``, and text ``.log`` through :mod:`.dataflash_text`), read through
+pymavlink's DataFlash readers (``DFReader_binary``, ``DFReader_text``).
 
 A DataFlash log is a sequence of messages, each ``0xA3 0x95 <type>`` and a payload laid out by the
 log's own ``FMT`` records (the FMT record of type 128 describes FMT itself). pymavlink's reader
@@ -9,10 +10,10 @@ the battery tools need:
 - :func:`log_parameters`: the log's ``PARM`` records (``Name``, ``Value``); a parameter logged
   more than once (set in flight) takes its last value, as the vehicle ended up with it.
 - :func:`battery_records`: ``BAT`` records (``Inst`` 0-based, ``Volt``, ``Curr``, ``CurrTot`` mAh,
-  ``RemPct``), and the older layouts (``BAT`` without ``Inst``, ``BAT2`` for the second monitor,
-  ``CURR``/``CURR2`` before ArduPilot 3.6).
+  ``RemPct``), and the older layouts (``BAT`` without ``Inst``, ``BAT2``..``BAT9`` per monitor,
+  ``CURR``/``CURR2``/``CUR2`` before ArduPilot 3.6), in V / A / mAh (:mod:`.dataflash_units`).
 - :func:`arming_records`: the arming state from ``ARM`` records (``ArmState``) and the ``EV``
-  events 10 (ARMED) and 11 (DISARMED) older logs carry.
+  events older logs carry (the rule, with ``LOG_DISARMED``, in :mod:`.dataflash_arming`).
 
 pymavlink prints what it skips (garbage, unknown types) on stdout/stderr; that text is captured and
 counted instead (:attr:`DataflashLog.skipped_notes`). A file that is not a DataFlash log, or holds
@@ -31,13 +32,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .dataflash_arming import event_state
+from .dataflash_text import HEAD_BYTES, is_text_dataflash, open_text_reader
+from .dataflash_units import field_scales
 from .records import InputError
 
 HEAD = b"\xa3\x95"
 FMT_TYPE = 0x80
-BATTERY_TYPES = frozenset({"BAT", "BATT", "BAT2", "CURR", "CURR2"})
+# BAT (Inst/Instance from 3.6 on), BAT2..BAT9 and CURR/CURR2/CUR2 of older firmware, one type per monitor
+NUMBERED_TYPES = {f"BAT{n}": n - 1 for n in range(2, 10)} | {"CURR2": 1, "CUR2": 1}
+BATTERY_TYPES = frozenset({"BAT", "BATT", "CURR"} | set(NUMBERED_TYPES))
 ARMING_TYPES = frozenset({"ARM", "EV"})
-EV_ARMED, EV_DISARMED = 10, 11  # AP_Logger LogEvent ids
 
 
 @dataclass(frozen=True)
@@ -50,6 +55,14 @@ class DataflashMessage:
     offset: int
     time_us: int | None
     fields: Mapping[str, Any]
+    scales: Mapping[str, float] = field(default_factory=dict)
+    clock_us: int | None = None  # pymavlink's clock: for records without TimeUS/TimeMS (pre-3.4 EV, 3.0 CURR)
+
+    @property
+    def when_s(self) -> float | None:
+        """``TimeUS`` where the record has it, else pymavlink's clock at the record."""
+        us = self.time_us if self.time_us is not None else self.clock_us
+        return None if us is None else us / 1e6
 
     @property
     def time_s(self) -> float | None:
@@ -82,13 +95,15 @@ class DataflashLog:
 
     path: Path
     display: str
+    text: bool = False
     skipped_notes: list[str] = field(default_factory=list)
 
     def messages(self, types: Iterable[str] | None = None) -> Iterator[DataflashMessage]:
         """The messages (of ``types`` when given), in file order."""
         wanted = None if types is None else set(types)
-        reader = _open(self.path, self.display, self.skipped_notes)
+        reader = _open(self.path, self.display, self.skipped_notes, self.text)
         index = 0
+        scales: dict[str, dict[str, float]] = {}
         try:
             while True:
                 with _captured(self.skipped_notes):
@@ -110,11 +125,23 @@ class DataflashLog:
                     )
                     continue
                 values.pop("mavpackettype", None)
-                yield DataflashMessage(name, index, max(0, int(reader.offset) - length), _time_us(values), values)
+                if name not in scales:
+                    scales[name] = _scales(name, getattr(msg, "fmt", None))
+                offset = max(0, int(reader.offset) - length)
+                stamp = getattr(msg, "_timestamp", None)
+                clock = round(stamp * 1e6) if isinstance(stamp, float | int) and math.isfinite(stamp) else None
+                yield DataflashMessage(name, index, offset, _time_us(values), values, scales[name], clock)
                 index += 1
         finally:
             with contextlib.suppress(Exception):
                 reader.close()
+
+
+def _scales(name: str, fmt: Any) -> dict[str, float]:
+    if fmt is None:
+        return {}
+    units = getattr(fmt, "units", None)
+    return field_scales(name, str(fmt.format), list(fmt.columns), bool(units))
 
 
 def is_dataflash(path: Path) -> bool:
@@ -131,21 +158,27 @@ def open_log(path: Path, display: str | None = None) -> DataflashLog:
     shown = display or path.as_posix()
     try:
         with path.open("rb") as f:
-            head = f.read(3)
+            head = f.read(HEAD_BYTES)
     except OSError as exc:
         raise InputError(shown, 0, f"cannot read file: {exc.strerror or exc}") from None
     if not head:
         raise InputError(shown, 0, "expected a DataFlash log, got an empty file")
-    if head != HEAD + bytes([FMT_TYPE]):
-        raise InputError(shown, 0, "expected a DataFlash log (starting with a FMT message, bytes A3 95 80)")
-    return DataflashLog(path, shown)
+    if head[:3] == HEAD + bytes([FMT_TYPE]):
+        return DataflashLog(path, shown)
+    if is_text_dataflash(head):
+        return DataflashLog(path, shown, text=True)
+    raise InputError(
+        shown, 0, "expected a DataFlash log (starting with a FMT message, bytes A3 95 80, or FMT, lines of text)"
+    )
 
 
-def _open(path: Path, display: str, notes: list[str]) -> Any:
+def _open(path: Path, display: str, notes: list[str], text: bool = False) -> Any:
     from pymavlink import DFReader
 
     with _captured(notes):
         try:
+            if text:
+                return open_text_reader(path)
             return DFReader.DFReader_binary(str(path), zero_time_base=True)
         except (OSError, ValueError) as exc:
             raise InputError(display, 0, f"cannot read DataFlash log: {exc}") from None
@@ -209,33 +242,41 @@ def log_parameters(log: DataflashLog) -> dict[str, float]:
 
 
 def _battery(msg: DataflashMessage) -> BatteryRecord | None:
-    if msg.time_s is None:
+    when = msg.when_s
+    if when is None:
         return None
     f = msg.fields
-    if msg.type in ("BAT2", "CURR2"):
-        instance = 1
+    if msg.type in NUMBERED_TYPES:
+        instance = NUMBERED_TYPES[msg.type]
     else:
         inst = _number(f, "Inst", "Instance")
         instance = int(inst) if inst is not None else 0
     return BatteryRecord(
-        time_s=msg.time_s,
+        time_s=when,
         instance=instance,
-        voltage_v=_number(f, "Volt"),
-        current_a=_number(f, "Curr"),
-        consumed_mah=_number(f, "CurrTot"),
-        remaining_pct=_number(f, "RemPct"),
+        voltage_v=_scaled(msg, "Volt"),
+        current_a=_scaled(msg, "Curr"),
+        consumed_mah=_scaled(msg, "CurrTot"),
+        remaining_pct=_scaled(msg, "RemPct"),
         offset=msg.offset,
     )
 
 
+def _scaled(msg: DataflashMessage, name: str) -> float | None:
+    value = _number(msg.fields, name)
+    scale = msg.scales.get(name, 1.0)
+    return value if value is None or scale == 1.0 else shortest_float32(value * scale)
+
+
 def _arming(msg: DataflashMessage) -> ArmingRecord | None:
-    if msg.time_s is None:
+    when = msg.when_s
+    if when is None:
         return None
     if msg.type == "ARM":
         state = _number(msg.fields, "ArmState")
-        return None if state is None else ArmingRecord(msg.time_s, bool(state), msg.offset)
-    ev = _number(msg.fields, "Id")
-    return ArmingRecord(msg.time_s, ev == EV_ARMED, msg.offset) if ev in (EV_ARMED, EV_DISARMED) else None
+        return None if state is None else ArmingRecord(when, bool(state), msg.offset)
+    armed = event_state(_number(msg.fields, "Id"))
+    return None if armed is None else ArmingRecord(when, armed, msg.offset)
 
 
 def flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord]:
@@ -246,18 +287,46 @@ def flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord]:
             yield item
 
 
-def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord | GpsClock]:
+@dataclass(frozen=True)
+class LogStart:
+    """The log's first record time (µs since boot), its ``LOG_DISARMED`` parameter (None: not
+    logged) and the firmware string of its first ``MSG`` (``APM:Copter V3.3-dev (ae3192b8)``)."""
+
+    time_us: int | None
+    log_disarmed: float | None
+    firmware: str | None
+
+
+def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord | GpsClock | LogStart]:
     """As :func:`flight_records`, with every GPS record that tells the time (:class:`GpsClock`), in
-    the same pass."""
-    for msg in log.messages(BATTERY_TYPES | ARMING_TYPES | {"GPS"}):
+    the same pass, and last a :class:`LogStart`."""
+    start = first_time_us(log)  # a short pass: the unfiltered walk is ~15x slower than a filtered one
+    log_disarmed: float | None = None
+    firmware: str | None = None
+    for msg in log.messages(BATTERY_TYPES | ARMING_TYPES | {"GPS", "PARM", "MSG"}):
         if msg.type == "GPS":
             clock = _gps_clock(msg)
             if clock is not None:
                 yield clock
-            continue
-        item = _arming(msg) if msg.type in ARMING_TYPES else _battery(msg)
-        if item is not None:
-            yield item
+        elif msg.type in ARMING_TYPES:
+            arm = _arming(msg)
+            if arm is not None:
+                yield arm
+        elif msg.type in BATTERY_TYPES:
+            bat = _battery(msg)
+            if bat is not None:
+                yield bat
+        elif (
+            msg.type == "PARM" and log_disarmed is None and msg.fields.get("Name") in ("LOG_DISARMED", b"LOG_DISARMED")
+        ):
+            log_disarmed = _number(msg.fields, "Value")
+        elif msg.type == "MSG" and firmware is None:
+            text = msg.fields.get("Message")
+            if isinstance(text, bytes):
+                text = text.decode("ascii", "replace")
+            if isinstance(text, str) and (" V" in text or text.startswith(("Ardu", "APM"))):
+                firmware = text.rstrip("\x00")
+    yield LogStart(start, log_disarmed, firmware)
 
 
 GPS_EPOCH_S = 315_964_800  # 1980-01-06 00:00 UTC, the start of GPS week 0, in Unix time
@@ -279,6 +348,16 @@ def _gps_clock(msg: DataflashMessage) -> GpsClock | None:
     if msg.time_us is None or week is None or ms is None or week <= 0:
         return None
     return GpsClock(msg.time_us, (GPS_EPOCH_S + int(week) * 604_800 - GPS_LEAP_S) * 1_000_000 + int(ms) * 1000)
+
+
+def first_time_us(log: DataflashLog) -> int | None:
+    """The log's start: the ``TimeUS`` (or ``TimeMS``) of its first record that has one."""
+    for msg in log.messages():
+        if msg.time_us is not None:
+            return msg.time_us
+        if msg.type in BATTERY_TYPES and msg.clock_us is not None:  # a log without TimeUS/TimeMS at all
+            return msg.clock_us
+    return None
 
 
 def battery_records(log: DataflashLog) -> Iterator[BatteryRecord]:

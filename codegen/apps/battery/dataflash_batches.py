@@ -4,10 +4,13 @@
 DataFlash has no message schema in the IR (its layout is in each log's own FMT records), so there is
 no mapping file to apply: the four values the reader gives -- ``Volt`` V, ``Curr`` A, ``CurrTot``
 mAh, ``RemPct`` % -- become concepts here, with the factors taken from the IR's unit registry.
-A value the log lacks is unknown. ``t`` is the log's ``TimeUS`` (time since boot, when the log
-starts); ``armed`` comes from ``ARM`` / ``EV`` records; ``time`` (UTC) from the first ``GPS``
-record with a week (``GWk``/``GMS`` against its ``TimeUS``, as pymavlink's DataFlash reader sets
-its clock), where the log has one.
+A value the log lacks is unknown; units come from the log (FMTU) or ArduPilot's logging code
+(:mod:`codegen.inputs.dataflash_units`). ``t`` is seconds since the log's first record, whose
+``TimeUS`` (µs since boot) is ``Batch.origin_us``; ``armed`` follows
+:mod:`codegen.inputs.dataflash_arming` (``ARM`` / ``EV`` records from the state ``LOG_DISARMED``
+implies at the first record); ``time`` (UTC) from the first ``GPS`` record with a week
+(``GWk``/``GMS`` against its ``TimeUS``, as pymavlink's DataFlash reader sets its clock), where
+the log has one.
 """
 
 from __future__ import annotations
@@ -16,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ...inputs.dataflash import ArmingRecord, BatteryRecord, GpsClock, open_log, timed_flight_records
+from ...inputs.dataflash import ArmingRecord, BatteryRecord, GpsClock, LogStart, open_log, timed_flight_records
+from ...inputs.dataflash_arming import armed_at_start
 from ...ir.units import unit
 from .catalog import Catalog
 from .columns import ConceptColumn, NDArray, empty_columns
@@ -38,29 +42,36 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
     readings: dict[int, list[BatteryRecord]] = {}
     arming: list[ArmingRecord] = []
     clock: GpsClock | None = None
+    start = LogStart(None, None, None)
     for item in timed_flight_records(log):
-        if isinstance(item, ArmingRecord):
+        if isinstance(item, LogStart):
+            start = item
+        elif isinstance(item, ArmingRecord):
             arming.append(item)
         elif isinstance(item, GpsClock):
             clock = clock or item
         else:
             readings.setdefault(item.instance, []).append(item)
-    arm_t = np.array([a.time_s for a in arming], np.float64)
-    arm_v = np.array([a.armed for a in arming], bool)
+    origin_us = start.time_us or 0
+    parameters = {} if start.log_disarmed is None else {"LOG_DISARMED": start.log_disarmed}
+    initially = armed_at_start(parameters, arming[0].armed if arming else None)
+    arm_t = np.array([-np.inf] + [a.time_s - origin_us / 1e6 for a in arming], np.float64)
+    arm_v = np.array([initially] + [a.armed for a in arming], bool)
     out: list[Batch] = []
     for instance, rows in sorted(readings.items()):
         n = len(rows)
         columns: dict[str, NDArray] = {}
         for attr, field, _, _ in FIELDS:
             columns[field] = np.array([np.nan if getattr(r, attr) is None else getattr(r, attr) for r in rows])
-        t = np.array([r.time_s for r in rows], np.float64)
-        batch = Batch(MESSAGE, n, columns, t, np.full(n, instance))
+        t = np.array([r.time_s for r in rows], np.float64) - origin_us / 1e6
+        batch = Batch(MESSAGE, n, columns, t, np.full(n, instance), origin_us=origin_us)
+        if start.firmware:
+            batch.notes.append(f"firmware: {start.firmware!r}")
         batch.concepts = _concepts(catalog, columns, n)
         if clock is not None:  # the log's clock against UTC, from its first GPS record with a week
             batch.utc_offset_us = clock.utc_us - clock.time_us
-            batch.time_us = np.round(t * 1e6).astype(np.int64) + batch.utc_offset_us
-        if len(arming):
-            batch.armed = as_of(arm_t, arm_v, t)
+            batch.time_us = np.round(t * 1e6).astype(np.int64) + origin_us + batch.utc_offset_us
+        batch.armed = as_of(arm_t, arm_v, t)
         if log.skipped_notes:
             batch.notes.append(f"{len(log.skipped_notes)} notes from the DataFlash reader (skipped data)")
         out.append(batch)

@@ -29,6 +29,7 @@ from ...inputs import dataflash
 from ...inputs.kinds import detect
 from ..battery.columns import NDArray
 from ..battery.view import Chunk, read_view
+from .legacy_parameters import with_current_names
 from .reading import BatteryReading
 from .stream import Sample
 
@@ -110,4 +111,4 @@ def log_parameters(path: Path) -> dict[str, float] | None:
     set again in flight: its last); None for other kinds."""
     if detect(path) != "dataflash":
         return None
-    return dataflash.log_parameters(dataflash.open_log(path))
+    return with_current_names(dataflash.log_parameters(dataflash.open_log(path)))
