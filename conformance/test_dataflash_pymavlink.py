@@ -9,12 +9,12 @@ import os
 from pathlib import Path
 
 import pytest
+from shared_data import SHARED
 
 from codegen.inputs.dataflash import NUMBERED_TYPES, battery_records, open_log
 from codegen.inputs.dataflash_text import HEAD_BYTES, is_text_dataflash
 from codegen.inputs.dataflash_units import field_scales
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 CORPUS = SHARED / "corpus"
 
 

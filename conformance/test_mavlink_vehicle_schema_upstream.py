@@ -15,12 +15,13 @@ from typing import Any
 import pytest
 from pymavlink.dialects.v20 import common as pm
 from pymavlink.generator import mavparse
+from shared_data import UPSTREAM as UPSTREAM_CORPUS
 
 from codegen.frontends import mavlink as frontend
 
 ROOT = Path(__file__).resolve().parent.parent
 VEHICLE_XML = ROOT / "schemas" / "mavlink" / "vehicle.xml"
-UPSTREAM = ROOT.parent / "shared" / "corpus" / "upstream" / "mavlink"
+UPSTREAM = UPSTREAM_CORPUS / "mavlink"
 MESSAGES = {"HEARTBEAT": (0, 50), "SYS_STATUS": (1, 124)}
 ENUMS = ("MAV_TYPE", "MAV_AUTOPILOT", "MAV_MODE_FLAG", "MAV_STATE", "MAV_SYS_STATUS_SENSOR",
          "MAV_SYS_STATUS_SENSOR_EXTENDED")  # fmt: skip

@@ -14,11 +14,10 @@ from typing import Any
 
 import numpy as np
 import pytest
+from shared_data import SHARED
 
 from codegen.apps.battery.view import read_view
 from codegen.inputs.kinds import detect
-
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
 
 def _tlogs() -> list[Path]:

@@ -7,6 +7,7 @@ import os
 from pathlib import Path
 
 import pytest
+from shared_data import SHARED
 
 from codegen.apps.battery.catalog import bundled_catalog
 from codegen.apps.battery.dataflash_batches import dataflash_batches
@@ -15,7 +16,6 @@ from codegen.apps.failsafe.logs import log_parameters
 from codegen.cli.main import main
 from codegen.inputs.dataflash import battery_records, open_log
 
-SHARED = Path(__file__).resolve().parents[2].parent / "shared"
 LOG = SHARED / "corpus" / "realworld3" / "dataflash" / "dronekit_log171.bin"
 
 
