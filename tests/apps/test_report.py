@@ -120,3 +120,27 @@ def test_errors_are_one_line(
     code = main(["report", *argv])
     err = capsys.readouterr().err
     assert code == 2 and expected in err and "Traceback" not in err
+
+
+def test_json_format_gives_the_page_figures_per_battery(
+    flight: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["report", "--format", "json", str(flight)]) == 0
+    text = capsys.readouterr().out
+    assert "NaN" not in text and "Infinity" not in text  # unknown is null: JSON has no NaN
+    doc = json.loads(text)
+    assert doc["format"] == "battgen-report" and doc["version"] == 1
+    [item] = doc["inputs"]
+    assert [b["battery"] for b in item["batteries"]] == [0, 1]
+    for battery, series in zip(item["batteries"], read_input(flight, bundled_schemas()).batteries, strict=True):
+        page = compute(series)
+        assert battery["figures"]["charge_used_mah"] == page.charge_used_mah
+        assert battery["figures"]["energy_used_wh"] == page.energy_used_wh
+        # the flight's figures in SI: the same numbers, in coulombs and joules
+        assert battery["flight"]["charge_used"] == pytest.approx(page.charge_used_mah * 3.6, rel=1e-12)
+        assert battery["flight"]["records"] == 3000 and battery["flight"]["duration_s"] == page.duration_s
+    out = tmp_path / "figures.json"
+    assert main(["report", "--format", "json", "-o", str(out), str(flight)]) == 0
+    assert json.loads(out.read_text()) == doc
+    assert main(["report", "--format", "json", "-o", str(tmp_path), str(flight)]) == 2
+    assert "is a folder" in capsys.readouterr().err
