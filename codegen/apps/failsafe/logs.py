@@ -93,7 +93,9 @@ def _as_logged(values: NDArray) -> NDArray:
     out = np.array(values, np.float64)
     single = ~np.isnan(out) & (out.astype(np.float32).astype(np.float64) == out) & (out != np.round(out))
     if single.any():
-        out[single] = [dataflash.shortest_float32(x) for x in out[single].tolist()]
+        # a log repeats its readings: each distinct value converted once, then spread back
+        distinct, back = np.unique(out[single], return_inverse=True)
+        out[single] = np.array([dataflash.shortest_float32(x) for x in distinct.tolist()], np.float64)[back]
     return out
 
 
