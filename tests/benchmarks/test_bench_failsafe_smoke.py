@@ -23,6 +23,6 @@ def test_bench_failsafe_smoke(capsys: pytest.CaptureFixture[str]) -> None:
     spec.loader.exec_module(bench)
     results = bench.run(records=500, real=False)
     (only,) = results.values()
-    assert set(only) == {"export", "export_failsafe", "report", "replay"}
+    assert set(only) == {"export", "export_failsafe", "report", "replay", "per_sample_replay"}
     assert all(v > 0 for v in only.values())
     assert "500 battery_status records" in capsys.readouterr().out
