@@ -178,6 +178,13 @@ class BatteryFailsafe:
         self.events.append(event)
         return [event]
 
+    def fire(self, t: float, mon: BatteryMonitor, trigger: Trigger) -> Event:
+        """An event of ``mon`` (its voltage and consumed charge as of ``t``) for ``trigger``, as :meth:`update`
+        fires it, without the stream's extra fields (the columnar replay of :mod:`.columnar`)."""
+        event = self._fire(t, mon, trigger, self.situation)
+        self.events.append(event)
+        return event
+
     def _fire(self, t: float, mon: BatteryMonitor, trigger: Trigger, situation: Situation) -> Event:
         s = mon.settings
         level = trigger.level

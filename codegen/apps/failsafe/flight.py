@@ -9,17 +9,15 @@ position fix, a SmartRTL path, no QuadPlane, no landing sequence), so the events
 
 from __future__ import annotations
 
-import functools
-from collections.abc import Iterator
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from ...errors import BattgenError
+from .columnar import replay_table
 from .evaluator import Event, make_failsafe
 from .levels import Level
 from .logs import SampleTable
 from .settings import battery_settings
-from .stream import Reader, Replay, Sample, open_reader
+from .stream import Sample
 from .vehicles import detect_vehicle
 
 
@@ -35,13 +33,6 @@ class FlightReplay:
     levels: dict[int, Level] = field(default_factory=dict)
 
 
-@functools.cache
-def _reader() -> Reader:
-    """The JSON Lines reader a Replay holds (a flight log's samples bypass it): the schemas loaded
-    once per process, not once per log."""
-    return open_reader(None)
-
-
 def replay_flight(table: SampleTable, name: str, values: dict[str, float], vehicle: str | None) -> FlightReplay:
     """Replay a log's samples (:class:`.logs.SampleTable`; errors name the log ``name``) with the parameter
     ``values``."""
@@ -51,14 +42,7 @@ def replay_flight(table: SampleTable, name: str, values: dict[str, float], vehic
     except ValueError as exc:
         raise BattgenError(f"{name}: parameters: {exc}") from None
     fs = make_failsafe(settings, detection.vehicle)
-    replay = Replay(fs, _reader())
-    out = FlightReplay([], detection.vehicle.name, detection.how)
-
-    def samples_of() -> Iterator[Sample]:
-        for sample in table.samples():
-            out.samples[sample.instance] = out.samples.get(sample.instance, 0) + 1
-            yield sample
-
-    out.events.extend(replay.run(Path(name), name, samples_of()))
+    events, counts = replay_table(fs, table, name)
+    out = FlightReplay(events, detection.vehicle.name, detection.how, counts)
     out.levels = {i: m.failsafe for i, m in sorted(fs.monitors.items())}
     return out

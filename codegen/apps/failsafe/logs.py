@@ -44,10 +44,12 @@ class SampleTable:
         self._parts: list[tuple[NDArray, ...]] = []
         self.has_arming = False
         self.messages: list[str] = []
+        self._order: tuple[NDArray, ...] | None = None  # the columns in time order, once asked for
 
     def add(self, chunk: Chunk) -> None:
         if not chunk.n:
             return
+        self._order = None
         batch = chunk.batch
         if batch.armed is not None:
             self.has_arming = True
@@ -66,17 +68,42 @@ class SampleTable:
         )
         self.messages.append(batch.message)
 
-    def samples(self) -> Iterator[Sample]:
-        if not self._parts:
-            return
+    def _sorted(self) -> tuple[NDArray, ...]:
         t, battery, volts, amps, mah, armed, row, part = (np.concatenate(c) for c in zip(*self._parts, strict=True))
         order = np.lexsort((battery, t))  # by time, then battery; a record without a time sorts last
         if self.has_arming:
             armed = np.where(np.isnan(armed), 0.0, armed)  # disarmed before the log's first arming state
         else:
             armed = np.ones_like(armed)
-        columns = (t[order], battery[order], volts[order], amps[order], mah[order], armed[order])
-        where = (row[order], part[order])
+        return t[order], battery[order], volts[order], amps[order], mah[order], armed[order], row[order], part[order]
+
+    def sorted_columns(self) -> tuple[NDArray, ...]:
+        """The samples as columns in time order: t, battery (0-based), V, A, mAh, armed (1.0 / 0.0) and each one's
+        position for :meth:`sample_at`; records without a time left out."""
+        if not self._parts:
+            empty = np.zeros(0)
+            return empty, empty.astype(np.int64), empty, empty, empty, empty, empty.astype(np.int64)
+        if self._order is None:
+            self._order = self._sorted()
+        t, battery, volts, amps, mah, armed = self._order[:6]
+        keep = np.flatnonzero(~np.isnan(t))
+        return t[keep], battery[keep], volts[keep], amps[keep], mah[keep], armed[keep], keep
+
+    def sample_at(self, k: int) -> Sample:
+        """The sample at position ``k`` of the time order, as :meth:`samples` gives it."""
+        if self._order is None:
+            self._order = self._sorted()
+        tk, bk, vk, ik, mk, ak, rk, pk = (c[k].item() for c in self._order)
+        place = f"{self.messages[int(pk)]} record {int(rk)} of battery {bk}"
+        reading = BatteryReading(_opt(vk), _opt(ik), _opt(mk))
+        return Sample(k + 1, tk, ak == 1.0, reading, None, None, {}, bk + 1, place)
+
+    def samples(self) -> Iterator[Sample]:
+        if not self._parts:
+            return
+        t, battery, volts, amps, mah, armed, row, part = self._sorted()
+        columns = (t, battery, volts, amps, mah, armed)
+        where = (row, part)
         for k, (tk, bk, vk, ik, mk, ak) in enumerate(zip(*(c.tolist() for c in columns), strict=True)):
             if tk != tk:  # NaN: a record the log gives no time for cannot be replayed
                 continue
@@ -94,7 +121,9 @@ def _as_logged(values: NDArray) -> NDArray:
     out = np.array(values, np.float64)
     single = ~np.isnan(out) & (out.astype(np.float32).astype(np.float64) == out) & (out != np.round(out))
     if single.any():
-        out[single] = [dataflash.shortest_float32(x) for x in out[single].tolist()]
+        # a log repeats its readings: each distinct value converted once, then spread back
+        distinct, back = np.unique(out[single], return_inverse=True)
+        out[single] = np.array([dataflash.shortest_float32(x) for x in distinct.tolist()], np.float64)[back]
     return out
 
 

@@ -14,6 +14,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ...errors import BattgenError
+from ..failsafe.columnar import replay_table
 from ..failsafe.evaluator import BatteryFailsafe, Event, make_failsafe
 from ..failsafe.logs import NO_ARMING_NOTE, log_parameters
 from ..failsafe.reading import BatteryReading
@@ -52,8 +53,7 @@ def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | No
         failsafe = make_failsafe(battery_settings(values, detection.vehicle), detection.vehicle)
     except ValueError as exc:
         raise BattgenError(f"{where}: {exc}") from None
-    samples = item.samples.samples() if item.samples is not None else _series_samples(item)
-    _run(failsafe, samples)
+    replay_table(failsafe, item.samples) if item.samples is not None else _run(failsafe, _series_samples(item))
     note = f"replayed with {where}; vehicle {detection.how}"
     if item.samples is None or not item.samples.has_arming:
         note += "; " + NO_ARMING_NOTE
