@@ -31,9 +31,11 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from ..apps.failsafe.columnar import replay_table
 from ..apps.failsafe.distance import DistanceRule
 from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
 from ..apps.failsafe.levels import apply_level
@@ -123,15 +125,22 @@ def run(args: argparse.Namespace) -> int:
         replay = Replay(fs, reader)
         if table is not None and not table.has_arming:
             print(f"battgen: {args.stream}: {NO_ARMING_NOTE}", file=sys.stderr)
-        samples = table.samples() if table is not None else None
-        for event, sample in replay.run(stream, args.stream, samples):
+        events: Iterable[tuple[Event, Sample]]
+        read = 0
+        if table is not None:  # a log: replayed over its columns (the same events as sample by sample)
+            events, counts = replay_table(fs, table, args.stream)
+            read = sum(counts.values())
+        else:
+            events = replay.run(stream, args.stream)
+        for event, sample in events:
             print(_json(event, sample, vehicle.name) if args.json else _line(event, sample))
-        if replay.samples == 0:
+        read = replay.samples if table is None else read
+        if read == 0:
             raise BattgenError(f"{args.stream}: expected battery readings, found none")
     except (BattgenError, ValueError) as exc:
         print(f"battgen: {exc}", file=sys.stderr)
         return EXIT_UNREADABLE
-    print(f"{replay.samples} samples, {len(fs.events)} events, final level {fs.level.name}", file=sys.stderr)
+    print(f"{read} samples, {len(fs.events)} events, final level {fs.level.name}", file=sys.stderr)
     return EXIT_OK
 
 
