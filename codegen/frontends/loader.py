@@ -70,9 +70,7 @@ def is_schema_dir(path: Path) -> bool:
     return any((path / fmt).is_dir() for fmt in FORMAT_FRONTENDS)
 
 
-def load_schema_dir(
-    root: Path, *, include_paths: Sequence[Path] = (), only: Collection[str] | None = None
-) -> Schema:
+def load_schema_dir(root: Path, *, include_paths: Sequence[Path] = (), only: Collection[str] | None = None) -> Schema:
     """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset); MAVLink includes
     may also come from ``include_paths`` (README Limits). ``only``: the sub-folders to read (format
     folders, ``mappings``, ``rules``), for a caller that needs just those; every one when None."""
@@ -152,9 +150,7 @@ def _load_dsdl_tree(path: Path, definition: Path) -> Schema:
     return dsdl.parse_dir(path)
 
 
-def load(
-    paths: Iterable[Path], *, include_paths: Sequence[Path] = (), only: Collection[str] | None = None
-) -> Schema:
+def load(paths: Iterable[Path], *, include_paths: Sequence[Path] = (), only: Collection[str] | None = None) -> Schema:
     """Parse schema folders, DSDL roots, folders of .msg files and single files (format from the
     extension) into one Schema; the errors of every path are raised together. ``include_paths``:
     folders MAVLink <include>s may read besides the schema folder; ``only``: the sub-folders of a

@@ -231,6 +231,7 @@ def test_the_bundled_catalog_is_the_catalog_of_the_whole_folder() -> None:
     assert ours.sources == whole.sources and ours.companions == whole.companions
     for name in [*ours.sources, *ours.companions]:
         assert ours.schema.message(name) == whole.schema.message(name)
+
     def first(schema_enums: Any, entry: str) -> Any:  # how a rule's constant is looked up (columnar.py)
         return next((e for e in schema_enums if any(x.name == entry for x in e.entries)), None)
 

@@ -92,7 +92,7 @@ class _Compiler:
             checks.append(self.keyword(key, arg, schema))
         return _all(checks) if checks else (lambda v: True)
 
-    def keyword(self, key: str, arg: Any, schema: dict[str, Any]) -> Check:  # noqa: C901 - one case per keyword
+    def keyword(self, key: str, arg: Any, schema: dict[str, Any]) -> Check:
         if key == "type":
             names = [arg] if isinstance(arg, str) else list(arg)
             tests = [_TYPES[n] for n in names]
@@ -113,8 +113,8 @@ class _Compiler:
         if key == "uniqueItems":
             if not arg:
                 return lambda v: True
-            return lambda v: not isinstance(v, list) or not any(
-                _equal(v[i], v[j]) for i in range(len(v)) for j in range(i)
+            return lambda v: (
+                not isinstance(v, list) or not any(_equal(v[i], v[j]) for i in range(len(v)) for j in range(i))
             )
         if key == "required":
             names = list(arg)
@@ -137,7 +137,7 @@ class _Compiler:
         if key == "$ref":
             return self.ref(arg)
         if key == "allOf":
-            return _all([self.compile(s) for s in arg])
+            return self.dispatch(arg) or _all([self.compile(s) for s in arg])
         if key == "anyOf":
             anyof = [self.compile(s) for s in arg]
             return lambda v: any(c(v) for c in anyof)
@@ -148,6 +148,36 @@ class _Compiler:
             cond, then = self.compile(arg), self.compile(schema.get("then", True))
             return lambda v: not cond(v) or then(v)
         raise TypeError(f"JSON Schema keyword {key!r} is not compiled")  # a new keyword: add it here
+
+    def dispatch(self, branches: list[Any]) -> Check | None:
+        """An ``allOf`` of ``if {KEY: const C} then S`` (a rule's op parameters) as one look-up of
+        ``KEY``: on an object at most one ``if`` holds, since the constants differ; the same
+        verdict as trying every branch, without trying them."""
+        keys: set[str] = set()
+        cases: dict[str, Check] = {}
+        for b in branches:
+            cond = b.get("if", {}) if isinstance(b, dict) and set(b) == {"if", "then"} else {}
+            props = cond.get("properties", {})
+            if set(cond) != {"required", "properties"} or len(props) != 1 or cond["required"] != list(props):
+                return None
+            [(key, want)] = props.items()
+            if set(want) != {"const"} or not isinstance(want["const"], str) or want["const"] in cases:
+                return None
+            keys.add(key)
+            cases[want["const"]] = self.compile(b["then"])
+        if len(keys) != 1:
+            return None
+        key = keys.pop()
+        every = _all(list(cases.values()))  # not an object: every "if" holds (its keywords ignore it)
+
+        def check(v: Any) -> bool:
+            if not isinstance(v, dict):
+                return every(v)
+            chosen = v.get(key)
+            then = cases.get(chosen) if isinstance(chosen, str) else None
+            return then is None or then(v)
+
+        return check
 
 
 @cache
