@@ -9,7 +9,7 @@ message missing because its file is broken would otherwise be reported again fro
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Collection, Iterable, Sequence
 from pathlib import Path
 from typing import Protocol
 
@@ -70,14 +70,15 @@ def is_schema_dir(path: Path) -> bool:
     return any((path / fmt).is_dir() for fmt in FORMAT_FRONTENDS)
 
 
-def load_schema_dir(root: Path, *, include_paths: Sequence[Path] = ()) -> Schema:
+def load_schema_dir(root: Path, *, include_paths: Sequence[Path] = (), only: Collection[str] | None = None) -> Schema:
     """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset); MAVLink includes
-    may also come from ``include_paths`` (README Limits)."""
+    may also come from ``include_paths`` (README Limits). ``only``: the sub-folders to read (format
+    folders, ``mappings``, ``rules``), for a caller that needs just those; every one when None."""
     schema = Schema()
     errors: list[BattgenError] = []
     for fmt in FORMAT_FRONTENDS:
         sub = root / fmt
-        if sub.is_dir():
+        if sub.is_dir() and (only is None or fmt in only):
             try:
                 part: Schema = (
                     mavlink.parse_dir(sub, include_paths=include_paths)
@@ -89,12 +90,12 @@ def load_schema_dir(root: Path, *, include_paths: Sequence[Path] = ()) -> Schema
                 continue
             schema = schema.merged(part)
     ErrorList.raise_if_any(errors)
-    if (root / MAPPINGS_DIR).is_dir():
+    if (root / MAPPINGS_DIR).is_dir() and (only is None or MAPPINGS_DIR in only):
         # after the formats, so every reference to a message or field can be checked
         from . import mappings
 
         schema = schema.merged(mappings.parse_dir(root / MAPPINGS_DIR, schema=schema))
-    if (root / RULES_DIR).is_dir():
+    if (root / RULES_DIR).is_dir() and (only is None or RULES_DIR in only):
         schema = schema.merged(Schema(rules=rules.load_rules_dir(root / RULES_DIR)))
         rules.check_rules(schema)  # after the formats: every rule must bind to the messages it names
     return schema
@@ -149,15 +150,16 @@ def _load_dsdl_tree(path: Path, definition: Path) -> Schema:
     return dsdl.parse_dir(path)
 
 
-def load(paths: Iterable[Path], *, include_paths: Sequence[Path] = ()) -> Schema:
+def load(paths: Iterable[Path], *, include_paths: Sequence[Path] = (), only: Collection[str] | None = None) -> Schema:
     """Parse schema folders, DSDL roots, folders of .msg files and single files (format from the
     extension) into one Schema; the errors of every path are raised together. ``include_paths``:
-    folders MAVLink <include>s may read besides the schema folder."""
+    folders MAVLink <include>s may read besides the schema folder; ``only``: the sub-folders of a
+    schema folder to read (:func:`load_schema_dir`)."""
     schema = Schema()
     errors: list[BattgenError] = []
     for path in paths:
         try:
-            part = _load_path(path, include_paths)
+            part = _load_path(path, include_paths, only)
         except BattgenError as error:
             errors.append(error)
             continue
@@ -166,13 +168,13 @@ def load(paths: Iterable[Path], *, include_paths: Sequence[Path] = ()) -> Schema
     return _deduplicated(schema)
 
 
-def _load_path(path: Path, include_paths: Sequence[Path]) -> Schema:
+def _load_path(path: Path, include_paths: Sequence[Path], only: Collection[str] | None = None) -> Schema:
     if path.is_dir():
         definition = dsdl_definition(path)
         if definition is not None:
             return _load_dsdl_tree(path, definition)
         if is_schema_dir(path):
-            return load_schema_dir(path, include_paths=include_paths)
+            return load_schema_dir(path, include_paths=include_paths, only=only)
         if is_cyphal_root(path):
             return cyphal.parse_dir(path)
         if any(p.is_file() for p in path.glob("*.msg")):

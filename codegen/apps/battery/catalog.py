@@ -12,7 +12,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ...errors import BattgenError
-from ...frontends.loader import load
+from ...frontends.loader import MAPPINGS_DIR, load
+from ...frontends.mappings import MAPPED_FORMATS
 from ...ir import CONCEPTS_ENDPOINT, Concept, Direction, Endpoint, Message, Rule, Schema
 from ..package import bundled_schemas
 
@@ -107,5 +108,12 @@ def build_catalog(schema: Schema) -> Catalog:
 
 @functools.cache
 def bundled_catalog(schema_dir: Path | None = None) -> Catalog:
-    """The catalog of the bundled schemas (read once per process)."""
-    return build_catalog(load([schema_dir or bundled_schemas()]))
+    """The catalog of the bundled schemas (read once per process).
+
+    Of the bundled folder only what the mappings can name is read (the formats their endpoints'
+    messages come from, and the mappings): every command starts here, and the Cyphal types (pydsdl),
+    the parameter metadata and the validator rules are no part of a battery reading. A folder
+    given is read whole, so every error in it is still reported."""
+    if schema_dir is None:
+        return build_catalog(load([bundled_schemas()], only=(*MAPPED_FORMATS, MAPPINGS_DIR)))
+    return build_catalog(load([schema_dir]))

@@ -10,6 +10,7 @@ converter.
 
 from __future__ import annotations
 
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -19,17 +20,42 @@ from ...ir.ops import OPS, Arity
 from ...text.files import display_path
 from ...text.limits import read_schema_text
 from ...text.yaml_lines import YMap, line_at, load
+from .fast_check import mapping_file_check
 from .json_schema import mappings_json_schema
 from .op_params import build_op
 from .resolver import Resolver
 
-__all__ = ["all_mappings", "concepts", "endpoints", "mappings_json_schema", "parse_dir", "parse_file"]
+__all__ = ["MAPPED_FORMATS", "all_mappings", "concepts", "endpoints", "mappings_json_schema", "parse_dir", "parse_file"]
+
+
+# the formats an endpoint's messages may come from (the pattern of mappings.schema.json's endpoint
+# messages): a catalog of the mappings needs these folders and no other
+MAPPED_FORMATS = ("uorb", "dronecan", "devicetree", "mavlink")
+
+# the mapping files shipped with battgen (the checkout's schemas/mappings/, as codegen.apps.package
+# finds it): they take the compiled check (.fast_check), every other file jsonschema itself
+_BUNDLED_DIR = Path(__file__).resolve().parents[3] / "schemas" / "mappings"
+
+
+def _is_bundled(path: Path) -> bool:
+    try:
+        return _BUNDLED_DIR in path.resolve().parents
+    except OSError:
+        return False
+
+
+@cache
+def _validator() -> Any:
+    """The jsonschema validator, built once per process (its schema and $ref registry are the same for every file)."""
+    import jsonschema  # here, not at the top: a command on the bundled schemas never needs it
+
+    return jsonschema.Draft202012Validator(mappings_json_schema())
 
 
 def _validate(doc: Any, display: str) -> None:
     import jsonschema
 
-    validator = jsonschema.Draft202012Validator(mappings_json_schema())
+    validator = _validator()
     errors = sorted(validator.iter_errors(doc), key=lambda e: (len(e.absolute_path), list(map(str, e.absolute_path))))
     if errors:
         err = errors[0]
@@ -131,7 +157,8 @@ def _load(path: Path, root: Path | None) -> tuple[str, YMap]:
     doc = load(read_schema_text(path, display), display)
     if not isinstance(doc, YMap):
         raise SchemaError(display, getattr(doc, "line", 1) or 1, "expected a mapping file (a YAML mapping)")
-    _validate(doc, display)
+    if not (_is_bundled(path) and mapping_file_check()(doc)):
+        _validate(doc, display)  # a user's file, or a bundled one the fast check refused: jsonschema's error
     return display, doc
 
 
