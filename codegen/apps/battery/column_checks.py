@@ -16,6 +16,7 @@ None and the caller reads the records a second time for that kind only.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +28,7 @@ from ...backends.python import naming
 from ...inputs.model import GeneratedMessage, MessageClass, UorbClass
 from ...inputs.records import Notice, Record, Unreadable
 from ...inputs.ulog import LogRecord, UlogReader
+from ...inputs.ulog_columns import record_dtype
 from ...inputs.ulog_index import record_offsets
 from ...ir import Field, Message, PrimitiveKind, PrimitiveType
 from ..validate import Checker, Finding
@@ -122,11 +124,11 @@ def _ulog_findings(path: Path, name: str, chunks: list[Chunk], checker: Checker)
         skip = reader.skips.get(topic)
         if skip is None:  # the topic is absent or undecodable: the per-record read says so
             return None
-        if reader.log.compare(model, topic=topic).converted:
-            return None  # values may not fit the schema's types: the per-record decoder's "unfit" notices
         offsets = record_offsets(reader.log)  # walks the log: its warnings and topics, as the record walk leaves them
         if reader.log.warnings:
             return None  # damage: the per-record walk's Unreadable parts and order
+        if not _all_fit(reader, topic, [v for k, v in offsets.items() if k[0] == topic]):
+            return None  # a value the schema's type cannot hold: the per-record decoder's "unfit" notice
         out = Checked(notices=list(reader.notices))
         rows = list(_located_rows(chunks, offsets, topic))
         if rows:
@@ -135,6 +137,56 @@ def _ulog_findings(path: Path, name: str, chunks: list[Chunk], checker: Checker)
         return out
     finally:
         reader.close()
+
+
+def _all_fit(reader: UlogReader, topic: str, offsets: list[NDArray]) -> bool:
+    """Whether every value of a field the log types otherwise than the schema (an older PX4's ``int32``
+    ``cell_count``) fits the schema's type, as the generated decoder's conversion judges (else it leaves the
+    default and tells an "unfit" notice the columns do not carry). Read from the raw records, no decoding."""
+    diff = reader.log.compare(reader.model, topic=topic)
+    if not diff.converted:
+        return True
+    if not offsets:
+        return True
+    lay = reader.log.layout(topic)
+    dtype = record_dtype(lay)
+    data = reader.log.data
+    at_every_byte = np.ndarray(
+        buffer=data, dtype=np.dtype((np.void, lay.data_size)), shape=(len(data) - lay.data_size + 1,), strides=(1,)
+    )
+    records = at_every_byte[np.concatenate(offsets)].view(dtype)
+    log_names = {new: old for old, new in diff.renamed}
+    for r in diff.converted:
+        name = log_names.get(r.name, r.name)
+        base, _, count = r.schema.partition("[")
+        if name not in (dtype.names or ()):
+            return False
+        values = np.asarray(records[name])
+        if values.ndim == 2:
+            values = values[:, : int(count.rstrip("]") or 0)]
+        fits = _fits(base, values)
+        if fits is None or not fits.all():
+            return False
+    return True
+
+
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+def _fits(ctype: str, values: NDArray) -> NDArray | None:
+    """Where values fit a C type (NaN and infinities fit a float); None for a type not judged here."""
+    if ctype == "double":
+        return np.ones(values.shape, bool)
+    if ctype == "float":
+        return np.asarray(~np.isfinite(values) | (np.abs(values) <= _FLOAT32_MAX), bool)
+    match = re.fullmatch(r"(u?)int(8|16|32|64)_t", ctype)
+    if match is None:
+        return None
+    bits = int(match.group(2))
+    lo, hi = (0, (1 << bits) - 1) if match.group(1) else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+    if values.dtype.kind in "iu":
+        return np.asarray((values >= lo) & (values <= hi), bool)
+    return np.asarray((values >= lo) & (values <= hi), bool) if values.dtype.kind == "f" else None
 
 
 def _after_walk(reader: UlogReader) -> list[Notice]:
@@ -153,13 +205,17 @@ def _located_rows(chunks: list[Chunk], offsets: Mapping[tuple[str, int], NDArray
         multi_id = int(chunk.batch.instance[0]) if chunk.n else 0
         begin = begun.get(multi_id, 0)
         begun[multi_id] = begin + chunk.n
-        yield _Rows(k, offsets[(topic, multi_id)][begin : begin + chunk.n])
+        yield _Rows(k, offsets.get((topic, multi_id), np.zeros(0, np.int64))[begin : begin + chunk.n])
 
 
 def _checked_rows(
     name: str, rows: list[_Rows], chunks: list[Chunk], checker: Checker, topic: str, skip: frozenset[str]
 ) -> list[tuple[float, int, Finding]]:
     every = np.concatenate([r.offsets for r in rows])
+    if len(every) != sum(chunks[r.chunk].n for r in rows):
+        raise ValueError("the view's rows and the log's index disagree")  # a bug, never a quiet misplacement
+    if not len(every):
+        return []
     order = np.argsort(every, kind="stable")
     index = np.empty(len(every), np.int64)
     index[order] = np.arange(len(every))  # the record's position in file order (ulog_items' index)
