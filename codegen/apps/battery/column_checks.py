@@ -16,6 +16,7 @@ None and the caller reads the records a second time for that kind only.
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
@@ -91,21 +92,33 @@ def _int_range(ftype: PrimitiveType) -> tuple[int, int]:
 
 def row_instance(cls: MessageClass, message: Message, columns: Mapping[str, NDArray], row: int) -> GeneratedMessage:
     """One row of the columns as the generated class (the values the per-record decoder gives)."""
-    kwargs: dict[str, Any] = {}
+    return row_instances(cls, message, columns, np.array([row]))[0]
+
+
+def row_instances(
+    cls: MessageClass, message: Message, columns: Mapping[str, NDArray], rows: NDArray
+) -> list[GeneratedMessage]:
+    """Rows of the columns as the generated class: each column's rows turned into Python values at once (a
+    numpy ``tolist``), then one constructor call a row."""
+    names: list[str] = []
+    values: list[list[Any]] = []
     for f in message.fields:
         if f.is_padding or f.name not in columns:
             continue
-        column = columns[f.name]
-        value: Any
-        if column.ndim == 2:
-            width = columns.get(length_key(f.name))
-            cells = column[row, : int(width[row])] if width is not None else column[row]
-            value = cells.tolist()
+        column = columns[f.name][rows]
+        width = columns.get(length_key(f.name))
+        if column.ndim == 2 and width is not None:
+            cells = column.tolist()
+            values.append([c[: int(w)] for c, w in zip(cells, width[rows].tolist(), strict=True)])
         else:
-            value = column[row]
-            value = value.tolist() if isinstance(value, np.generic) else value
-        kwargs[naming.field_identifier(f.name, f.pattern)] = value
-    return cls(**kwargs)  # type: ignore[call-arg]
+            values.append(column.tolist())  # an object column's values stay as they are
+        names.append(naming.field_identifier(f.name, f.pattern))
+    make: Any = cls
+    if not names:
+        return []
+    if tuple(names) == tuple(f.name for f in dataclasses.fields(make)):  # the constructor's order: positional
+        return [make(*row) for row in zip(*values, strict=True)]
+    return [make(**dict(zip(names, row, strict=True))) for row in zip(*values, strict=True)]
 
 
 def column_findings(path: Path, name: str, kind: str, chunks: Iterable[Chunk], checker: Checker) -> Checked | None:
@@ -228,12 +241,13 @@ def _checked_rows(
         chunk = chunks[r.chunk]
         columns = chunk.batch.columns
         multi_id = int(chunk.batch.instance[0])
-        mask = flaggable(checker, columns, chunk.n)
-        for row in np.nonzero(mask)[0].tolist():
+        picked = np.nonzero(flaggable(checker, columns, chunk.n))[0]
+        instances = row_instances(checker.cls, checker.message, columns, picked)
+        offsets = (r.offsets[picked] - _D_HEAD).tolist()
+        for row, instance, offset in zip(picked.tolist(), instances, offsets, strict=True):
             at = start + row
             stamp = int(stamps_all[at]) if stamps_all[at] >= 0 else None
-            instance = row_instance(checker.cls, checker.message, columns, row)
-            rec = LogRecord(topic, multi_id, int(r.offsets[row]) - _D_HEAD, stamp, instance, skip, {}, ())
+            rec = LogRecord(topic, multi_id, offset, stamp, instance, skip, {}, ())
             record = Record(
                 int(index[at]), 0, None, name, where=rec.where(), instance=instance, skip=skip,
                 location=rec.location(),
