@@ -1,5 +1,6 @@
-"""The report's reading of a log (``read_input``): before (the battery view, then every record read a second time
-for the validator's findings) and after (the findings from the view's columns, :mod:`codegen.apps.battery.column_checks`).
+"""The report's reading of a log (``read_input``): before (the battery view, then every record read a second
+time for the validator's findings) and after (the findings from the view's columns,
+:mod:`codegen.apps.battery.column_checks`).
 
 "Before" is the same ``_view_input`` with the view read for the mapping's fields only and the column findings
 switched off, which is what the report did before; both give the same findings (checked here, as in
