@@ -88,6 +88,7 @@ def test_tlog_report_findings_equal_the_record_read(path: Path) -> None:
 # -- synthetic columns ---------------------------------------------------------------------------
 
 _MESSAGE, _CHECKER = make_checker(SCHEMAS, "uorb.BatteryStatus", [], "ulog")
+_CLASS: Any = _CHECKER.cls
 _FLOATS = st.one_of(
     st.sampled_from([0.0, -1.0, math.nan, math.inf, -math.inf, 1e39, -3.5, 0.5, 1.0, 2.0, 255.0]),
     st.floats(allow_nan=True, allow_infinity=True, width=32),
@@ -96,7 +97,7 @@ _FLOATS = st.one_of(
 
 def _columns(rows: list[dict[str, Any]]) -> dict[str, NDArray]:
     """The columns the view gives a ULog of the bundled layout: every field, defaults where not drawn."""
-    default = _CHECKER.cls()
+    default = _CLASS()
     out: dict[str, NDArray] = {}
     for f in _MESSAGE.fields:
         if f.is_padding:
@@ -141,7 +142,7 @@ def test_rows_outside_the_mask_have_no_findings_and_rows_inside_are_the_oracles(
         rows = [_as_floats32(row) for row in rows]
     mask = flaggable(_CHECKER, columns, len(rows))
     for k, row in enumerate(rows):
-        expected = _CHECKER.check(Record(k, 0, None, "x", instance=_CHECKER.cls(**row)))
+        expected = _CHECKER.check(Record(k, 0, None, "x", instance=_CLASS(**row)))
         built = row_instance(_CHECKER.cls, _MESSAGE, columns, k)
         got = _CHECKER.check(Record(k, 0, None, "x", instance=built))
         assert repr(got) == repr(expected)  # repr: a NaN value is not equal to itself

@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -32,9 +32,22 @@ from ...inputs.ulog import LogRecord, UlogReader
 from ...inputs.ulog_columns import record_dtype
 from ...inputs.ulog_index import record_offsets
 from ...ir import Field, Message, PrimitiveKind, PrimitiveType
-from ..validate import Checker, Finding
 from .columns import NDArray, length_key
 from .view import Chunk
+
+
+class Checker(Protocol):
+    """The per-record validator (:class:`codegen.apps.validate.Checker`; not imported: the validator's app
+    imports the battery view)."""
+
+    cls: MessageClass
+    message: Message
+    rules: Mapping[str, frozenset[str]]
+
+    def check(self, record: Record) -> Sequence[Finding]: ...
+
+
+Finding = Any  # a :class:`codegen.apps.validate.Finding`, as the checker makes it
 
 _D_HEAD = 5  # a ULog data record's payload starts this far after the record (uint16 size, 'D', uint16 msg_id)
 
@@ -161,9 +174,10 @@ def _all_fit(reader: UlogReader, topic: str, offsets: list[NDArray]) -> bool:
         return True
     if not offsets:
         return True
-    lay = reader.log.layout(topic)
+    log: Any = reader.log  # the generated Log: its memory map and layouts
+    lay = log.layout(topic)
     dtype = record_dtype(lay)
-    data = reader.log.data
+    data = log.data
     at_every_byte = np.ndarray(
         buffer=data, dtype=np.dtype((np.void, lay.data_size)), shape=(len(data) - lay.data_size + 1,), strides=(1,)
     )
