@@ -95,6 +95,10 @@ _FLOATS = st.one_of(
 )
 
 
+# a record the validator passes where nothing is drawn (the class's default max_error, 0, is below its minimum)
+_VALID = {"max_error": 1}
+
+
 def _columns(rows: list[dict[str, Any]]) -> dict[str, NDArray]:
     """The columns the view gives a ULog of the bundled layout: every field, defaults where not drawn."""
     default = _CLASS()
@@ -103,7 +107,7 @@ def _columns(rows: list[dict[str, Any]]) -> dict[str, NDArray]:
         if f.is_padding:
             continue
         base = getattr(default, f.name)
-        values = [row.get(f.name, base) for row in rows]
+        values = [row.get(f.name, _VALID.get(f.name, base)) for row in rows]
         if isinstance(base, list):
             out[f.name] = np.array(values, np.float32 if base and isinstance(base[0], float) else np.int64)
         elif isinstance(base, bool):
@@ -111,7 +115,7 @@ def _columns(rows: list[dict[str, Any]]) -> dict[str, NDArray]:
         elif isinstance(base, float):
             out[f.name] = np.array(values, np.float32)
         else:
-            out[f.name] = np.array(values, np.int64)
+            out[f.name] = np.array(values, np.uint64 if f.name == "timestamp" else np.int64)
     return out
 
 
@@ -126,8 +130,10 @@ def _columns(rows: list[dict[str, Any]]) -> dict[str, NDArray]:
                 "remaining": _FLOATS,
                 "scale": _FLOATS,
                 "temperature": _FLOATS,
-                "max_error": st.integers(0, 65535),
-                "cell_count": st.integers(0, 255),
+                "max_error": st.one_of(st.sampled_from([0, 1, 50, 100, 101]), st.integers(0, 65535)),
+                "cell_count": st.one_of(st.sampled_from([0, 4, 6, 14, 15]), st.integers(0, 255)),
+                "remaining_capacity_wh": _FLOATS,
+                "timestamp": st.integers(0, 2**64 - 1),
                 "warning": st.integers(0, 255),
                 "voltage_cell_v": st.lists(_FLOATS, min_size=14, max_size=14),
             },
@@ -142,12 +148,14 @@ def test_rows_outside_the_mask_have_no_findings_and_rows_inside_are_the_oracles(
         rows = [_as_floats32(row) for row in rows]
     mask = flaggable(_CHECKER, columns, len(rows))
     for k, row in enumerate(rows):
-        expected = _CHECKER.check(Record(k, 0, None, "x", instance=_CLASS(**row)))
+        expected = _CHECKER.check(Record(k, 0, None, "x", instance=_CLASS(**{**_VALID, **row})))
         built = row_instance(_CHECKER.cls, _MESSAGE, columns, k)
         got = _CHECKER.check(Record(k, 0, None, "x", instance=built))
         assert repr(got) == repr(expected)  # repr: a NaN value is not equal to itself
         if not mask[k]:
             assert expected == []
+    valid = _columns([{}] * 3)
+    assert not flaggable(_CHECKER, valid, 3).any()  # a valid record is not judged one by one
 
 
 def _as_floats32(row: dict[str, Any]) -> dict[str, Any]:

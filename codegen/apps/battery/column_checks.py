@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
@@ -31,7 +31,7 @@ from ...inputs.records import Notice, Record, Unreadable
 from ...inputs.ulog import LogRecord, UlogReader
 from ...inputs.ulog_columns import record_dtype
 from ...inputs.ulog_index import record_offsets
-from ...ir import Field, Message, PrimitiveKind, PrimitiveType
+from ...ir import ArrayType, Field, Message, PrimitiveKind, PrimitiveType
 from .columns import NDArray, length_key
 from .view import Chunk
 
@@ -63,44 +63,151 @@ class Checked:
 
 
 def flaggable(checker: Checker, columns: Mapping[str, NDArray], n: int) -> NDArray:
-    """The rows some check of ``validate()`` may flag (a superset: a row outside it has no finding).
+    """The rows some check of ``validate()`` may flag: a superset (a row outside it has no finding).
 
-    A message with cross-field rules (:func:`codegen.ir.rules.bound_rules`) has every row flaggable: a rule's
-    expression reads several fields and is not masked here."""
-    if checker.rules:
-        return np.ones(n, bool)
+    Each field's check reads that field alone, so a value is judged once: the generated validator itself runs on
+    the class's default record holding that value (:class:`_Probe`), and the rows holding a value it flags are
+    flaggable. A float field's values inside its range (and the float32 range) pass without asking; a column of
+    too many other values is flaggable wherever such a value lies. A cross-field rule reads several fields: it is
+    masked only where its mask below is known to be exact (:data:`_RULE_MASKS`, tested against the oracle);
+    a message with any other rule has every row flaggable."""
+    rule_masks = [_RULE_MASKS.get((checker.message.qualified_name, rule)) for rule in checker.rules]
+    if any(m is None for m in rule_masks) or any(f.name not in columns for f in checker.message.fields):
+        return np.ones(n, bool)  # an unmasked rule; or a field at the record's default (not a column here)
     mask = np.zeros(n, bool)
+    for rule_mask in rule_masks:
+        if rule_mask is not None:
+            mask |= rule_mask(columns, n)
+    probe = _Probe(checker)
     for f in checker.message.fields:
-        if f.is_padding:
-            continue
-        column = columns.get(f.name)
-        if column is None:  # the record's default: checked once, it flags every row or none
-            return np.ones(n, bool)
-        mask |= _field_mask(f, column, n)
+        if mask.all():
+            break
+        if not f.is_padding:
+            mask |= _field_mask(probe, f, columns[f.name], n)
     return mask
 
 
-def _field_mask(f: Field, column: NDArray, n: int) -> NDArray:
-    """Rows whose value of one field may fail its check: conservative (every row) unless the field is a plain
-    number with no constraint, whose check is its type's range (and a float's NaN/inf, left to the check)."""
+_MAX_PROBES = 256  # values of one column judged one by one; beyond, every row holding an unjudged value
+_FLOAT_MAX = {32: float(np.finfo(np.float32).max), 64: float(np.finfo(np.float64).max)}
+
+
+class _Probe:
+    """The generated validator on the class's default record holding one field's value: does that field's own
+    check flag it (cross-field rules left out; they are masked apart)."""
+
+    def __init__(self, checker: Checker) -> None:
+        self.cls: Any = checker.cls
+        self.seen: dict[tuple[str, object], bool] = {}
+
+    def flags(self, f: Field, value: object) -> bool:
+        key = (f.name, value if value == value else "nan")  # NaN: one key
+        found = self.seen.get(key)
+        if found is None:
+            record = self.cls()
+            setattr(record, naming.field_identifier(f.name, f.pattern), value)
+            name = f.name
+            found = any(
+                not str(v.rule).startswith("cross-field:")
+                and (str(v.path) == name or str(v.path).startswith((name + "[", name + ".")))
+                for v in record.validate()
+            )
+            self.seen[key] = found
+        return found
+
+
+def _field_mask(probe: _Probe, f: Field, column: NDArray, n: int) -> NDArray:
+    """Rows whose value of one field its check may flag."""
     ftype = f.type
-    constrained = f.range or f.invalid or f.enums or f.const is not None or f.choices or f.required
-    if constrained or not isinstance(ftype, PrimitiveType) or column.dtype == object:
-        return np.ones(n, bool)
-    if ftype.kind is PrimitiveKind.FLOAT:
-        return np.asarray(~np.isfinite(column), bool) if column.dtype.kind == "f" else np.ones(n, bool)
-    if ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT) and column.dtype.kind in "iu":
-        lo, hi = _int_range(ftype)
-        return np.asarray((column < lo) | (column > hi), bool)
-    if ftype.kind is PrimitiveKind.BOOL and column.dtype == np.bool_:
+    if column.ndim == 2:
+        return _array_mask(f, column, n)
+    suspect = np.ones(n, bool)
+    plain = not (f.enums or f.const is not None or f.choices or f.required)
+    if plain and isinstance(ftype, PrimitiveType) and _numeric(ftype, column):
+        suspect = ~_inside(f, ftype, column)  # a (finite) value in range passes whatever the sentinel
+    if column.dtype == object or not suspect.any():
+        return suspect if column.dtype != object else np.ones(n, bool)
+    values = column[suspect]
+    unique = np.unique(values)
+    if len(unique) > _MAX_PROBES:
+        return suspect
+    flagged = [v for v in unique.tolist() if probe.flags(f, v)]
+    if not flagged:
         return np.zeros(n, bool)
-    return np.ones(n, bool)
+    out = np.zeros(n, bool)
+    hit = np.isin(values, np.array(flagged, values.dtype))
+    if values.dtype.kind == "f" and any(v != v for v in flagged):
+        hit |= np.isnan(values)
+    out[np.nonzero(suspect)[0][hit]] = True
+    return out
+
+
+def _numeric(ftype: PrimitiveType, column: NDArray) -> bool:
+    kind = str(column.dtype.kind)
+    if ftype.kind is PrimitiveKind.FLOAT:
+        return kind == "f"
+    return ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT) and kind in ("i", "u")
+
+
+def _inside(f: Field, ftype: PrimitiveType, column: NDArray) -> NDArray:
+    """Where a number lies within its type's range (a float: finite) and strictly inside its field's range (the
+    bounds themselves are probed)."""
+    with np.errstate(invalid="ignore"):
+        if ftype.kind is PrimitiveKind.FLOAT:
+            limit = _FLOAT_MAX.get(ftype.bits, _FLOAT_MAX[32])
+            ok = np.isfinite(column) & (np.abs(column) <= limit)
+        else:
+            lo, hi = _int_range(ftype)
+            ok = (column >= lo) & (column <= hi) if column.dtype.kind == "i" else column <= hi
+        if f.range is not None and f.range.minimum is not None:
+            ok &= column > float(f.range.minimum)
+        if f.range is not None and f.range.maximum is not None:
+            ok &= column < float(f.range.maximum)
+    return np.asarray(ok, bool)
 
 
 def _int_range(ftype: PrimitiveType) -> tuple[int, int]:
     if ftype.kind is PrimitiveKind.UINT:
         return 0, (1 << ftype.bits) - 1
     return -(1 << (ftype.bits - 1)), (1 << (ftype.bits - 1)) - 1
+
+
+def _array_mask(f: Field, column: NDArray, n: int) -> NDArray:
+    """An array's rows: a plain float array (no range, enum or choices) passes where every element is a finite
+    float32; any other array is flaggable everywhere."""
+    ftype = f.type
+    element = ftype.element if isinstance(ftype, ArrayType) else None
+    plain = not (f.enums or f.const is not None or f.choices or f.required or f.range)
+    if not (plain and isinstance(element, PrimitiveType) and element.kind is PrimitiveKind.FLOAT):
+        return np.ones(n, bool)
+    if not isinstance(ftype, ArrayType) or ftype.capacity != column.shape[1] or column.dtype.kind != "f":
+        return np.ones(n, bool)  # a width the schema's check would flag (or a dynamic length): judged per record
+    limit = _FLOAT_MAX.get(element.bits, _FLOAT_MAX[32])
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(column) & (np.abs(column) <= limit)
+    return np.asarray(~ok.all(axis=1), bool)
+
+
+def _cell_count_capacity(columns: Mapping[str, NDArray], n: int) -> NDArray:
+    """uorb.BatteryStatus ``cell-count-capacity``: ``cell_count <= len(voltage_cell_v)``."""
+    cells = columns["voltage_cell_v"]
+    return np.asarray(columns["cell_count"] > cells.shape[1], bool)
+
+
+def _cells_beyond_count_zero(columns: Mapping[str, NDArray], n: int) -> NDArray:
+    """uorb.BatteryStatus ``cells-beyond-count-zero``: where ``cell_count != 0``, every cell from ``cell_count``
+    on is 0 (NaN is not)."""
+    cells = columns["voltage_cell_v"]
+    count = np.asarray(columns["cell_count"], np.int64)
+    beyond = np.arange(cells.shape[1])[None, :] >= np.maximum(count, 0)[:, None]
+    return np.asarray((count != 0) & (beyond & (cells != 0)).any(axis=1), bool)
+
+
+# Cross-field rules masked over columns, by (message, rule id): each the rule's condition restated in numpy,
+# proved against the generated validator by tests/apps/test_column_checks.py. Any other rule: every row.
+_RULE_MASKS: dict[tuple[str, str], Callable[[Mapping[str, NDArray], int], NDArray]] = {
+    ("uorb.BatteryStatus", "cell-count-capacity"): _cell_count_capacity,
+    ("uorb.BatteryStatus", "cells-beyond-count-zero"): _cells_beyond_count_zero,
+}
 
 
 def row_instance(cls: MessageClass, message: Message, columns: Mapping[str, NDArray], row: int) -> GeneratedMessage:
