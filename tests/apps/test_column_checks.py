@@ -169,3 +169,20 @@ def _as_floats32(row: dict[str, Any]) -> dict[str, Any]:
         else:
             out[key] = value
     return out
+
+
+@pytest.mark.parametrize("keep", [0.5, 0.9])
+def test_a_truncated_real_ulog_reports_what_the_record_read_does(tmp_path: Path, keep: float) -> None:
+    """Damage (a log cut mid-record): the findings and notices are still the per-record read's."""
+    source = SHARED / "data" / "ulog" / "sample_px4_events.ulg"
+    if not source.is_file():
+        pytest.skip("../shared is missing")
+    data = source.read_bytes()
+    path = tmp_path / "cut.ulg"
+    path.write_bytes(data[: int(len(data) * keep)])
+    old = _record_input(path, SCHEMAS, path.as_posix(), None, "ulog")
+    report = read_input(path, SCHEMAS)
+    assert old.records > 0
+    assert repr((report.findings, report.notices, report.unreadable)) == repr(
+        (old.findings, old.notices, old.unreadable)
+    )
