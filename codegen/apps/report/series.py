@@ -27,6 +27,7 @@ from ...inputs.kinds import file_kind
 from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
 from ...ir import SourceFormat
+from ..battery.column_checks import Checked, column_findings
 from ..battery.columns import NDArray
 from ..battery.figures import FlightFigures, flight_figures
 from ..battery.view import Chunk, read_view
@@ -189,7 +190,11 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
     messages: list[str] = []
     records = 0
     word = INSTANCE_WORDS.get(kind, "id")
-    for chunk in read_view(path, name):
+    checkable = kind == "ulog"  # the kinds whose findings come from the view's columns (column_checks)
+    chunks: list[Chunk] = []
+    for chunk in read_view(path, name, all_fields=checkable):
+        if checkable:
+            chunks.append(chunk)
         table.add(chunk)
         records += chunk.n
         if chunk.batch.message not in messages:
@@ -207,7 +212,15 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
         name, ", ".join(messages) or "none", [batteries[k] for k in sorted(batteries)], [], [], [], records
     )
     out.samples = table
-    if kind != "dataflash":  # validate the records against their message (a DataFlash log has no message schema)
+    if kind == "dataflash":  # a DataFlash log has no message schema: nothing to validate
+        return out
+    column: Checked | None = None
+    if checkable:
+        _, checker = make_checker(schema_dir, default_message(path, kind), [str(path)], kind)
+        column = column_findings(path, name, kind, chunks, checker)
+    if column is not None:
+        out.findings, out.notices, out.unreadable = column.findings, column.notices, column.unreadable
+    else:  # the view's batches of this kind lack the records' places (a tlog's frames): read them one by one
         checked = _record_input(path, schema_dir, name, None, kind)
         out.findings, out.notices, out.unreadable = checked.findings, checked.notices, checked.unreadable
     return out
