@@ -147,9 +147,11 @@ class UlogReader:
         except ValueError as exc:  # a record that cannot be decoded ends the walk
             yield Unreadable(self.name, 0, str(exc))
             return
-        self.trailing = self._after_walk()
+        self.trailing = self.after_walk()
 
-    def _after_walk(self) -> list[Notice]:
+    def after_walk(self) -> list[Notice]:
+        """The notices a finished walk leaves (damage recovered from, topics missing), also for a reader whose
+        records were read another way (the battery view's columns)."""
         out: list[Notice] = []
         problems = self.log.warnings
         for text in problems[:MAX_DAMAGE_NOTICES]:

@@ -16,6 +16,7 @@ import pytest
 from conftest import ROOT
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from shared_data import SHARED
 
 from codegen.apps.battery.column_checks import column_findings, flaggable, row_instance
 from codegen.apps.battery.columns import NDArray
@@ -25,10 +26,6 @@ from codegen.apps.validate import make_checker
 from codegen.inputs.records import Record
 
 SCHEMAS = ROOT / "schemas"
-try:  # one finding of ../shared for every test, where main has it
-    from shared_data import SHARED  # type: ignore[import-not-found]
-except ImportError:
-    SHARED = ROOT.parent / "shared"
 
 
 def _logs(pattern: str) -> list[Path]:

@@ -266,7 +266,7 @@ def _ulog_findings(path: Path, name: str, chunks: list[Chunk], checker: Checker)
         rows = list(_located_rows(chunks, offsets, topic))
         if rows:
             out.findings = _checked_rows(name, rows, chunks, checker, topic, skip)
-        out.notices += _after_walk(reader)
+        out.notices += reader.after_walk()
         return out
     finally:
         reader.close()
@@ -321,10 +321,6 @@ def _fits(ctype: str, values: NDArray) -> NDArray | None:
     if values.dtype.kind in "iu":
         return np.asarray((values >= lo) & (values <= hi), bool)
     return np.asarray((values >= lo) & (values <= hi), bool) if values.dtype.kind == "f" else None
-
-
-def _after_walk(reader: UlogReader) -> list[Notice]:
-    return reader._after_walk()
 
 
 @dataclass
