@@ -123,5 +123,7 @@ def render_library(schema: Schema) -> dict[str, str]:
             continue
         rel = header_path(msg.qualified_name)
         files[rel] = clang_format(header.render(m=_message_context(msg)), rel)
-    files["battgen.h"] = clang_format(env.get_template("battgen.h.j2").render(headers=sorted(files)), "battgen.h")
+    headers = sorted(files)
+    files["battgen.h"] = clang_format(env.get_template("battgen.h.j2").render(headers=headers), "battgen.h")
+    files["README.md"] = env.get_template("README.md.j2").render(headers=headers)
     return files
