@@ -60,3 +60,14 @@ def test_headers_compile_as_cpp(tmp_path: Path) -> None:
         check=True,
         timeout=120,
     )
+
+
+def test_cli_writes_and_checks_a_c_library(tmp_path: Path) -> None:
+    from codegen.cli.main import main
+
+    out = tmp_path / "clib"
+    assert main(["generate", "--lang", "c", "-o", str(out)]) == 0
+    assert (out / "battgen.h").is_file()
+    assert main(["generate", "--lang", "c", "-o", str(out), "--check"]) == 0
+    (out / "battgen.h").write_text("/* edited */\n")
+    assert main(["generate", "--lang", "c", "-o", str(out), "--check"]) == 1
