@@ -14,6 +14,8 @@
 #include "mavlink/BATTERY_INFO.h"
 #include "mavlink/BATTERY_STATUS.h"
 #include "mavlink/BATTERY_STATUS_V2.h"
+#include "mavlink/HEARTBEAT.h"
+#include "mavlink/SYS_STATUS.h"
 #include "uorb/BatteryInfo.h"
 #include "uorb/BatteryStatus.h"
 #include "uorb/BatteryStatusV0.h"

@@ -38,8 +38,12 @@ def test_mavlink_id_and_crc_extra_equal_pymavlink(qualified: str) -> None:
     """pymavlink's own parser (mavgen's front half) reads the same XML and computes id and CRC_EXTRA."""
     from pymavlink.generator import mavparse
 
-    xml = mavparse.MAVXML(str(bundled_schemas() / "mavlink" / "battery.xml"), mavparse.PROTOCOL_2_0)
-    ref = {m.name: m for m in xml.message}[qualified.removeprefix("mavlink.")]
+    messages = {
+        m.name: m
+        for path in sorted((bundled_schemas() / "mavlink").glob("*.xml"))
+        for m in mavparse.MAVXML(str(path), mavparse.PROTOCOL_2_0).message
+    }
+    ref = messages[qualified.removeprefix("mavlink.")]
     defines = _defines(qualified.replace(".", "/") + ".h")
     prefix = type_name(qualified).upper()
     assert defines[prefix + "_MSG_ID"] == ref.id
