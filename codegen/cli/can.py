@@ -76,7 +76,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"{name}: stopped", file=sys.stderr)
             continue
         except LocatedError as exc:
-            print(f"{exc.file}: {exc.message}", file=sys.stderr)
+            where = f"{exc.file}:{exc.line}" if exc.line else exc.file  # line 0: the whole capture
+            print(f"{where}: {exc.message}", file=sys.stderr)
             code = EXIT_UNREADABLE
             continue
         reports.append(report)

@@ -18,6 +18,8 @@ import pytest
 from dataflash_writer import DataflashWriter
 
 from codegen.cli.main import main
+from codegen.inputs.can.captures import read_capture
+from codegen.inputs.records import InputError
 
 can = pytest.importorskip("can")
 dronecan = pytest.importorskip("dronecan")
@@ -169,8 +171,8 @@ def test_convert_pairs_each_battery_info_with_its_nodes_aux(tmp_path: Path, caps
     ("content", "expected"),
     [
         (b"", "no CAN frames"),
-        (b"\x00\xff" * 300, "cannot"),
-        (b"(1.0) can0 ZZZ#GG\n", "cannot"),
+        (b"\x00\xff" * 300, "junk.log:1: expected a candump -l line"),
+        (b"(1.0) can0 ZZZ#GG\n", "junk.log:1: expected a candump -l line"),
     ],
 )
 def test_unreadable_or_empty_capture_is_one_clear_line(
@@ -233,3 +235,13 @@ def test_gzip_capture_is_looked_through(tmp_path: Path) -> None:
     packed = tmp_path / "copy.log.gz"
     packed.write_bytes(gzip.compress(plain.read_bytes()))
     assert main(["validate", str(packed)]) == 0
+
+
+def test_a_line_numbered_candump_names_the_line_and_the_form_expected(tmp_path: Path) -> None:
+    # pretty_j1939's test logs number their lines ("1 (stamp) vcan0 ID#DATA"): not candump -l, which python-can
+    # reads; the error says where and what was expected instead of python-can's "too many values to unpack"
+    path = tmp_path / "numbered.log"
+    path.write_text("(1612543138.000000) vcan0 0CF00400#0041FF20481400F0\n2 (1612543138.001000) vcan0 18F00400#00\n")
+    with pytest.raises(InputError) as err:
+        list(read_capture(path, "numbered.log"))
+    assert err.value.line == 2 and "expected a candump -l line" in err.value.message

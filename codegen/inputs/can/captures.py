@@ -39,8 +39,13 @@ def _python_can(name: str) -> Any:
         raise InputError(name, 0, NEEDS_CAN) from exc
 
 
-def _frames_of(messages: Iterator[Any], name: str, what: str) -> Iterator[Frame]:
+CANDUMP_LINE = "a candump -l line such as '(1612543138.000000) can0 123#DEADBEEF'"
+
+
+def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: bool = False) -> Iterator[Frame]:
+    """``one_per_line``: a text capture with one frame a line (candump -l), so a failure is placed on its line."""
     index = 0
+    read = 0  # messages the reader gave, error and remote frames included
     t0: float | None = None
     while True:
         try:
@@ -48,8 +53,11 @@ def _frames_of(messages: Iterator[Any], name: str, what: str) -> Iterator[Frame]
         except StopIteration:
             return
         except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError) as exc:
-            # a damaged capture: the third-party reader's own complaint, located at the frame it reached
+            # a damaged capture: the third-party reader's own complaint, located at the frame (or line) it reached
+            if one_per_line:
+                raise InputError(name, read + 1, f"expected {CANDUMP_LINE} ({exc})") from exc
             raise InputError(name, 0, f"cannot read {what} after frame {index}: {exc}") from exc
+        read += 1
         if message.is_error_frame or message.is_remote_frame:
             continue
         stamp = float(message.timestamp or 0.0)
@@ -96,7 +104,7 @@ def read_capture(path: Path, name: str) -> Iterator[Frame]:
         return
     reader = _log_reader(path, name)
     try:
-        yield from _frames_of(iter(reader), name, "the CAN capture")
+        yield from _frames_of(iter(reader), name, "the CAN capture", one_per_line=path.suffix.lower() == ".log")
     finally:
         stop = getattr(reader, "stop", None)
         if callable(stop):
