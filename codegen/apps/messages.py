@@ -6,6 +6,20 @@ from ..backends.python import naming
 from ..errors import BattgenError
 from ..ir import Message, Schema
 
+# The battery message each log or capture kind carries, where the user names none: what a ULog's battery_status
+# topic holds, the battery message every MAVLink autopilot sends, the one every DroneCAN battery node sends. One
+# table for validate, convert and report (a DataFlash log's BAT records have no message schema).
+BATTERY_MESSAGES = {
+    "ulog": "uorb.BatteryStatus",
+    "tlog": "mavlink.BATTERY_STATUS",
+    "mavlink": "mavlink.BATTERY_STATUS",
+    "can": "dronecan.uavcan.equipment.power.BatteryInfo",
+}
+DATAFLASH_NOTE = (
+    "a DataFlash log's battery records (BAT, CURR) have no message schema: 'battgen report', 'export' and 'failsafe' "
+    "read them, and --message dronecan.<type> reads the DroneCAN messages of its CAN frames"
+)
+
 
 def message_aliases(msg: Message) -> set[str]:
     """The names a user may give for ``msg``: its qualified name, every dotted suffix of it, the

@@ -31,7 +31,7 @@ from . import dt_problems
 from .failsafe.checks import NONNEGATIVE, check_settings
 from .failsafe.vehicles import detect_vehicle
 from .gate import Gate
-from .messages import resolve_message
+from .messages import BATTERY_MESSAGES, DATAFLASH_NOTE, resolve_message
 from .package import data_error, model_class, model_package
 
 EXIT_OK, EXIT_INVALID, EXIT_UNREADABLE = 0, 1, 2
@@ -384,26 +384,29 @@ def json_document(message: Message, reports: list[FileReport], *, allow_empty: b
     }
 
 
-MAVLINK_DEFAULT = "mavlink.BATTERY_STATUS"
-CAPTURE_DEFAULT = "dronecan.uavcan.equipment.power.BatteryInfo"
-
-
 def default_message(schema: Schema, files: list[str], kind: str | None) -> str:
-    """The message to check when --message is omitted: the only one of the inputs' format, and
-    for MAVLink inputs BATTERY_STATUS (the battery message every autopilot sends)."""
+    """The message to check when --message is omitted: for logs and captures their kind's battery message
+    (:data:`.messages.BATTERY_MESSAGES`), else the only message of the inputs' format."""
     formats: set[SourceFormat | None] = set()
+    kinds: set[str | None] = set()
     for name in files:
         try:
-            formats.add(KIND_FORMATS.get(kind or file_kind(Path(name))))
+            found = kind or file_kind(Path(name))
         except LocatedError:
-            formats.add(None)
+            found = None
+        kinds.add(found)
+        formats.add(KIND_FORMATS.get(found) if found is not None else None)
+    batteries = {BATTERY_MESSAGES.get(k) if k is not None else None for k in kinds}
+    qualified = {m.qualified_name for m in schema.messages}
+    if len(batteries) == 1 and None not in batteries:
+        (battery,) = batteries
+        if battery in qualified:
+            return str(battery)
+    if kinds == {"dataflash"}:
+        raise BattgenError(f"--message is required: {DATAFLASH_NOTE}")
     candidates = [m.qualified_name for m in schema.messages if m.format in formats]
-    if formats == {SourceFormat.DRONECAN} and CAPTURE_DEFAULT in candidates:
-        return CAPTURE_DEFAULT  # a CAN capture: the battery's own message, the one every battery node sends
     if len(formats) == 1 and None not in formats and len(candidates) == 1:
         return candidates[0]
-    if formats == {SourceFormat.MAVLINK} and MAVLINK_DEFAULT in candidates:
-        return MAVLINK_DEFAULT  # BATTERY_INFO and BATTERY_STATUS_V2 are asked for by name
     if len(formats) == 1 and None not in formats and candidates:
         raise BattgenError(
             f"--message is required: the schemas hold {len(candidates)} such messages ({', '.join(candidates)})"

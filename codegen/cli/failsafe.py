@@ -39,7 +39,7 @@ from ..apps.failsafe.columnar import replay_table
 from ..apps.failsafe.distance import DistanceRule
 from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
 from ..apps.failsafe.levels import apply_level
-from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_parameters, log_samples
+from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_samples, own_parameters
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
@@ -83,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         # a flight log or capture is read through the battery view; JSON and JSON Lines are sample streams
         table: SampleTable | None = log_samples(stream, args.stream) if detect(stream) in FLIGHT_KINDS else None
-        own = log_parameters(stream) if table is not None and not args.params else None
+        own = own_parameters(table) if table is not None and not args.params else None
         if args.params:
             values: dict[str, float] = read_parameter_values(Path(args.params))
             where = args.params
@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
         elif own is not None:
             values, where = own, f"{args.stream} (PARM records)"
         else:
-            raise BattgenError("expected --params FILE (only a DataFlash log carries its own parameters)")
+            raise BattgenError(f"expected --params FILE: {_why_no_parameters(table)}")
         if args.params and not batt_parameter_count(values) and not args.allow_empty:
             print(
                 f"{where}: no BATT*_ parameter ({len(values)} parameters read): the failsafe would run on "
@@ -142,6 +142,17 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_UNREADABLE
     print(f"{read} samples, {len(fs.events)} events, final level {fs.level.name}", file=sys.stderr)
     return EXIT_OK
+
+
+def _why_no_parameters(table: SampleTable | None) -> str:
+    """Why a stream brings no ArduPilot parameters of its own."""
+    context = table.context if table is not None else None
+    if context is not None and context.autopilot == "px4":
+        return (
+            f"this is a PX4 log ({len(context.parameters)} PX4 parameters, such as BAT_LOW_THR); ArduPilot's "
+            "failsafe needs BATT_* values"
+        )
+    return "only a DataFlash log carries its own ArduPilot parameters"
 
 
 def _num(value: float, unit: str) -> str:

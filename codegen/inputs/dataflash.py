@@ -233,12 +233,20 @@ def log_parameters(log: DataflashLog) -> dict[str, float]:
     """The PARM records as {name: value}; a name logged again takes its later value."""
     out: dict[str, float] = {}
     for msg in log.messages({"PARM"}):
-        name, value = msg.fields.get("Name"), _number(msg.fields, "Value")
-        if isinstance(name, bytes):
-            name = name.decode("ascii", "replace")
-        if isinstance(name, str) and name and value is not None:
-            out[name.rstrip("\x00")] = value
+        parameter = _parameter(msg)
+        if parameter is not None:
+            out[parameter[0]] = parameter[1]
     return out
+
+
+def _parameter(msg: DataflashMessage) -> tuple[str, float] | None:
+    """A PARM record's name and value (None: a record without them)."""
+    name, value = msg.fields.get("Name"), _number(msg.fields, "Value")
+    if isinstance(name, bytes):
+        name = name.decode("ascii", "replace")
+    if isinstance(name, str) and name and value is not None:
+        return name.rstrip("\x00"), value
+    return None
 
 
 def _battery(msg: DataflashMessage) -> BatteryRecord | None:
@@ -289,12 +297,14 @@ def flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord]:
 
 @dataclass(frozen=True)
 class LogStart:
-    """The log's first record time (µs since boot), its ``LOG_DISARMED`` parameter (None: not
-    logged) and the firmware string of its first ``MSG`` (``APM:Copter V3.3-dev (ae3192b8)``)."""
+    """The log's first record time (µs since boot), its ``LOG_DISARMED`` parameter as the log starts (None: not
+    logged), the firmware string of its first ``MSG`` (``APM:Copter V3.3-dev (ae3192b8)``) and every ``PARM``
+    record's value (:func:`log_parameters`' rule: a name logged again takes its later value)."""
 
     time_us: int | None
     log_disarmed: float | None
     firmware: str | None
+    parameters: Mapping[str, float] = field(default_factory=dict)
 
 
 def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord | GpsClock | LogStart]:
@@ -303,6 +313,7 @@ def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRe
     start = first_time_us(log)  # a short pass: the unfiltered walk is ~15x slower than a filtered one
     log_disarmed: float | None = None
     firmware: str | None = None
+    parameters: dict[str, float] = {}
     for msg in log.messages(BATTERY_TYPES | ARMING_TYPES | {"GPS", "PARM", "MSG"}):
         if msg.type == "GPS":
             clock = _gps_clock(msg)
@@ -316,17 +327,19 @@ def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRe
             bat = _battery(msg)
             if bat is not None:
                 yield bat
-        elif (
-            msg.type == "PARM" and log_disarmed is None and msg.fields.get("Name") in ("LOG_DISARMED", b"LOG_DISARMED")
-        ):
-            log_disarmed = _number(msg.fields, "Value")
+        elif msg.type == "PARM":
+            parameter = _parameter(msg)
+            if parameter is not None:
+                parameters[parameter[0]] = parameter[1]
+                if parameter[0] == "LOG_DISARMED" and log_disarmed is None:
+                    log_disarmed = parameter[1]
         elif msg.type == "MSG" and firmware is None:
             text = msg.fields.get("Message")
             if isinstance(text, bytes):
                 text = text.decode("ascii", "replace")
             if isinstance(text, str) and (" V" in text or text.startswith(("Ardu", "APM"))):
                 firmware = text.rstrip("\x00")
-    yield LogStart(start, log_disarmed, firmware)
+    yield LogStart(start, log_disarmed, firmware, parameters)
 
 
 GPS_EPOCH_S = 315_964_800  # 1980-01-06 00:00 UTC, the start of GPS week 0, in Unix time

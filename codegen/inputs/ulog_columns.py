@@ -59,6 +59,7 @@ class ColumnLog(Protocol):
 
     timestamp: int
     info: Mapping[str, object]
+    parameters: Mapping[str, object]
     formats: Mapping[str, object]
     warnings: list[str]
 
@@ -123,6 +124,20 @@ class UlogColumns:
     def vehicle(self) -> str | None:
         uuid = self.log.info.get("sys_uuid")
         return str(uuid) if uuid else None
+
+    @property
+    def info(self) -> Mapping[str, object]:
+        """The log's information messages (``sys_name``, ``ver_sw``, ``ver_hw``, ...), as logged."""
+        return self.log.info
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The log's parameters as it started (its ``PARAM`` definitions); numbers only."""
+        return {
+            k: float(v)
+            for k, v in self.log.parameters.items()
+            if isinstance(v, int | float) and not isinstance(v, bool)
+        }
 
     def instances(self, chunk: int | None = None, fields: frozenset[str] | None = None) -> Iterator[TopicColumns]:
         """Every instance of the class's topics that has records, by topic then multi_id, in

@@ -12,7 +12,7 @@ from shared_data import SHARED
 from codegen.apps.battery.catalog import bundled_catalog
 from codegen.apps.battery.dataflash_batches import dataflash_batches
 from codegen.apps.failsafe.legacy_parameters import with_current_names
-from codegen.apps.failsafe.logs import log_parameters
+from codegen.apps.failsafe.logs import log_samples, own_parameters
 from codegen.cli.main import main
 from codegen.inputs.dataflash import battery_records, open_log
 
@@ -29,7 +29,7 @@ def log() -> Path:
 
 
 def test_legacy_names_map_to_batt(log: Path) -> None:
-    params = log_parameters(log)
+    params = own_parameters(log_samples(log))
     assert params is not None
     assert params["BATT_LOW_VOLT"] == 14.0 and params["BATT_LOW_MAH"] == 520.0 and params["BATT_FS_LOW_ACT"] == 2.0
     assert with_current_names({"FS_BATT_VOLTAGE": 10.0, "BATT_LOW_VOLT": 11.0})["BATT_LOW_VOLT"] == 11.0
@@ -91,8 +91,8 @@ def _corpus_log(name: str) -> Path:
 def test_log_disarmed_0_armed_from_the_first_record() -> None:
     # LOG_DISARMED 0, one ARM record (ArmState 0 at the end): armed from the log's start until it
     path = _corpus_log("wlichon_00000001.BIN")
-    assert log_parameters(path) is not None and (log_parameters(path) or {})["LOG_DISARMED"] == 0.0
     batch = dataflash_batches(path, path.name, bundled_catalog())[0]
+    assert batch.context is not None and batch.context.parameters["LOG_DISARMED"] == 0.0
     assert batch.armed is not None and batch.armed[0] == 1.0
     assert set(batch.armed.tolist()) <= {0.0, 1.0}
 
@@ -102,3 +102,26 @@ def test_log_disarmed_0_without_arm_records_is_armed_throughout() -> None:
     batch = dataflash_batches(path, path.name, bundled_catalog())[0]
     assert batch.armed is not None and batch.n > 0 and (batch.armed == 1.0).all()
     assert batch.t[0] >= 0.0 and batch.origin_us > 0
+
+
+def test_failsafe_reads_the_log_once(
+    log: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the log's own parameters come with the battery view's read (its context), not from a second pass over PARM
+    from codegen.apps.battery.view import read_view
+    from codegen.inputs import dataflash
+
+    opened: list[Path] = []
+    real = dataflash._open
+
+    def counting(path: Path, *args: object, **kwargs: object) -> object:
+        opened.append(path)
+        return real(path, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(dataflash, "_open", counting)
+    list(read_view(log))
+    by_view = len(opened)
+    opened.clear()
+    assert main(["failsafe", log.as_posix()]) == 0
+    capsys.readouterr()
+    assert len(opened) == by_view

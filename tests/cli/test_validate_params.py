@@ -118,10 +118,24 @@ def test_message_is_required_where_no_default_exists(capsys: pytest.CaptureFixtu
     path.write_text("{}", encoding="utf-8")
     assert main(["validate", str(path)]) == 2
     assert "--message is required" in capsys.readouterr().err
+    log = tmp_path / "x.jsonl"
+    log.write_text('{"voltage_v": 12.0}\n', encoding="utf-8")
+    assert main(["validate", str(log)]) == 2  # plain records of any format: which message?
+    assert "--message is required" in capsys.readouterr().err
+
+
+def test_a_log_defaults_to_its_battery_message(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    # a ULog holds battery_status, whatever older versions of the message the schemas also hold: the message the
+    # report and the export read it as (one table, codegen.apps.messages.BATTERY_MESSAGES)
     log = tmp_path / "x.ulg"
     log.write_bytes(b"")
-    assert main(["validate", str(log)]) == 2  # two uORB messages: which one?
-    assert "uorb.BatteryStatus, uorb.BatteryStatusV0" in capsys.readouterr().err
+    assert main(["validate", str(log)]) == 2
+    err = capsys.readouterr().err
+    assert "--message is required" not in err and "empty file" in err
+    dataflash = tmp_path / "x.bin"
+    dataflash.write_bytes(b"\xa3\x95\x80")
+    assert main(["validate", str(dataflash)]) == 2
+    assert "have no message schema" in capsys.readouterr().err
 
 
 def test_json_params_records_get_the_cross_field_checks_too(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:

@@ -24,6 +24,7 @@ from ...inputs.dataflash_arming import armed_at_start
 from ...ir.units import unit
 from .catalog import Catalog
 from .columns import ConceptColumn, NDArray, empty_columns
+from .context import ARMING_RULES, LogContext, arming_changes
 from .sources import Batch, as_of
 
 MESSAGE = "dataflash.BAT"
@@ -57,6 +58,16 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
     initially = armed_at_start(parameters, arming[0].armed if arming else None)
     arm_t = np.array([-np.inf] + [a.time_s - origin_us / 1e6 for a in arming], np.float64)
     arm_v = np.array([initially] + [a.armed for a in arming], bool)
+    context = LogContext(
+        "dataflash",
+        origin_us,
+        None if clock is None else clock.utc_us - clock.time_us,
+        firmware=start.firmware,
+        autopilot="ardupilot",  # DataFlash is ArduPilot's log format
+        parameters=dict(start.parameters),
+        arming=arming_changes(arm_t, arm_v),
+        arming_rule=ARMING_RULES["dataflash"],
+    )
     out: list[Batch] = []
     for instance, rows in sorted(readings.items()):
         n = len(rows)
@@ -72,6 +83,7 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
             batch.utc_offset_us = clock.utc_us - clock.time_us
             batch.time_us = np.round(t * 1e6).astype(np.int64) + origin_us + batch.utc_offset_us
         batch.armed = as_of(arm_t, arm_v, t)
+        batch.context = context
         if log.skipped_notes:
             batch.notes.append(f"{len(log.skipped_notes)} notes from the DataFlash reader (skipped data)")
         out.append(batch)

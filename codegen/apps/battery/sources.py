@@ -20,6 +20,7 @@ import numpy as np
 
 from ...backends.python import naming
 from ...errors import BattgenError
+from ...inputs.dataflash import shortest_float32
 from ...inputs.documents import read_jsonl
 from ...inputs.kinds import LOG_KINDS, detect
 from ...inputs.model import MessageClass, UorbClass
@@ -29,6 +30,7 @@ from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
 from .columns import ConceptColumn, NDArray, length_key
+from .context import ARMING_RULES, LogContext, arming_changes, px4_firmware
 
 
 @dataclass
@@ -49,6 +51,7 @@ class Batch:
     utc_offset_us: int | None = None  # the log's clock + this = µs since the epoch (None: unknown)
     vehicle_type: int | None = None  # MAVLink MAV_TYPE of the vehicle, where the log says (a tlog's HEARTBEAT)
     notes: list[str] = field(default_factory=list)
+    context: LogContext | None = None  # what the log says about itself, one object for all its batches
 
 
 def log_kind(path: Path) -> str:
@@ -82,6 +85,7 @@ def ulog_batches(
         start = log.start_us
         offset = log.utc_offset_us()
         armed = log.armed()
+        context = ulog_context(log, armed, offset)
         for inst in log.instances(fields=fields):
             stamps = inst.timestamps
             t = (stamps.astype(np.int64) - start) / 1e6 if stamps is not None else np.full(inst.n, np.nan)
@@ -93,7 +97,34 @@ def ulog_batches(
                 batch.vehicle = log.vehicle
             if stamps is not None and armed is not None:
                 batch.armed = as_of(armed[0], armed[1], stamps)
+            batch.context = context
             yield batch
+
+
+def ulog_context(log: UlogColumns, armed: tuple[NDArray, NDArray] | None, utc_offset_us: int | None) -> LogContext:
+    """A ULog's context (:mod:`.context`): its info messages, initial parameters and arming state."""
+    info = log.info
+    parameters = {
+        k: shortest_float32(v) if v != round(v) else v for k, v in log.parameters.items()
+    }  # a float32 parameter as a person reads it (0.005, not 0.004999999888241291)
+    mav_type = parameters.get("MAV_TYPE")
+    hardware = info.get("ver_hw")
+    changes: tuple[tuple[float, bool], ...] = ()
+    if armed is not None:
+        changes = arming_changes((armed[0].astype(np.int64) - log.start_us) / 1e6, armed[1])
+    return LogContext(
+        "ulog",
+        log.start_us,
+        utc_offset_us,
+        log.vehicle,
+        int(mav_type) if mav_type is not None else None,
+        "px4",
+        px4_firmware(info),
+        str(hardware) if hardware else None,
+        parameters,
+        changes,
+        ARMING_RULES["ulog"] if armed is not None else "",
+    )
 
 
 def as_of(times: NDArray, values: NDArray, at: NDArray) -> NDArray:

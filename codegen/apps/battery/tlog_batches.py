@@ -25,6 +25,7 @@ from ...errors import BattgenError
 from ...inputs.model import MavlinkClass
 from ...inputs.tlog import FrameRecord, StreamStats, read_messages
 from .catalog import Catalog
+from .context import ARMING_RULES, MAV_AUTOPILOT_FIRMWARE, LogContext, arming_changes
 from .sources import Batch, instances_to_columns, model_of
 
 BATTERY_STATUS, SYS_STATUS, HEARTBEAT = "mavlink.BATTERY_STATUS", "mavlink.SYS_STATUS", "mavlink.HEARTBEAT"
@@ -41,6 +42,8 @@ class _System:
     batteries: dict[int, list[FrameRecord]] = field(default_factory=dict)
     sys_status: list[FrameRecord] = field(default_factory=list)
     beats: list[tuple[int, bool, int]] = field(default_factory=list)
+    beat_stamps: list[int | None] = field(default_factory=list)  # each heartbeat's tlog stamp
+    autopilot: int | None = None  # MAV_AUTOPILOT of the last vehicle heartbeat
 
 
 def is_vehicle_heartbeat(compid: int, mav_type: int, autopilot: int) -> bool:
@@ -74,15 +77,19 @@ def tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
             if is_vehicle_heartbeat(rec.frame.compid, mav_type, autopilot):
                 armed = bool(int(getattr(hb, "base_mode")) & SAFETY_ARMED)  # noqa: B009
                 system.beats.append((rec.offset or 0, armed, mav_type))
+                system.beat_stamps.append(rec.timestamp)
+                system.autopilot = autopilot
     origin = stats.first_stamp or 0
     out: list[Batch] = []
     for sysid, system in sorted(systems.items()):
         groups = sorted(system.batteries.items())
         if not groups and system.sys_status:
             groups = [(0, system.sys_status)]
+        context = _context(system, sysid, origin)
         for instance, frames in groups:
             qualified = BATTERY_STATUS if frames[0].frame.msgid == battery_id else SYS_STATUS
             batch = _batch(catalog, qualified, frames, instance, origin, system, sysid)
+            batch.context = context
             if stats.damaged:
                 batch.notes.append(stats.summary("battery"))
             out.append(batch)
@@ -114,3 +121,23 @@ def _batch(
         batch.armed = np.where(idx >= 0, beat_armed[np.maximum(idx, 0)], np.nan)
         batch.vehicle_type = system.beats[-1][2]
     return batch
+
+
+def _context(system: _System, sysid: int, origin: int) -> LogContext:
+    """One system's context (:mod:`.context`): its id, MAV_TYPE, firmware family and arming changes."""
+    if not system.beats:
+        return LogContext("tlog", origin, 0, f"mavlink:{sysid}")
+    known = [(s, b[1]) for s, b in zip(system.beat_stamps, system.beats, strict=True) if s is not None and s < 1 << 63]
+    t = np.array([(s - origin) / 1e6 for s, _ in known], np.float64)
+    armed = np.array([a for _, a in known], np.float64)
+    autopilot = MAV_AUTOPILOT_FIRMWARE.get(system.autopilot) if system.autopilot is not None else None
+    return LogContext(
+        "tlog",
+        origin,
+        0,
+        f"mavlink:{sysid}",
+        system.beats[-1][2],
+        autopilot,
+        arming=arming_changes(t, armed),
+        arming_rule=ARMING_RULES["tlog"],
+    )

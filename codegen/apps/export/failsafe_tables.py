@@ -28,7 +28,7 @@ import pyarrow as pa
 from ...errors import BattgenError
 from ..battery.sources import Batch
 from ..failsafe.flight import replay_flight
-from ..failsafe.logs import SampleTable, log_parameters
+from ..failsafe.logs import SampleTable, own_parameters
 from ..failsafe.stream import batt_parameter_count, read_parameter_values
 from ..failsafe.vehicles import VEHICLES
 
@@ -126,7 +126,7 @@ def replay_tables(
         return "failsafe not replayed: a JSON Lines file is no flight log battgen failsafe reads"
     values = options.params
     if values is None:
-        values = log_parameters(path)
+        values = own_parameters(table)
         if values is None:
             return "failsafe not replayed: only a DataFlash log carries its own parameters (give --failsafe PARAMS)"
     replay = replay_flight(table, name, values, options.vehicle)

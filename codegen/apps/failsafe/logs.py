@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from ...inputs import dataflash
-from ...inputs.kinds import detect
 from ..battery.columns import NDArray
+from ..battery.context import LogContext
 from ..battery.view import Chunk, read_view
 from .legacy_parameters import with_current_names
 from .reading import BatteryReading
@@ -45,8 +45,11 @@ class SampleTable:
         self.has_arming = False
         self.messages: list[str] = []
         self._order: tuple[NDArray, ...] | None = None  # the columns in time order, once asked for
+        self.context: LogContext | None = None  # what the log says about itself (its first chunk's)
 
     def add(self, chunk: Chunk) -> None:
+        if self.context is None:
+            self.context = chunk.batch.context
         if not chunk.n:
             return
         self._order = None
@@ -135,9 +138,13 @@ def log_samples(path: Path, name: str | None = None) -> SampleTable:
     return table
 
 
-def log_parameters(path: Path) -> dict[str, float] | None:
-    """The parameters a log recorded, where its kind records ArduPilot's (a DataFlash log's PARM records; a value
-    set again in flight: its last); None for other kinds."""
-    if detect(path) != "dataflash":
+def own_parameters(table: SampleTable) -> dict[str, float] | None:
+    """The ArduPilot parameters a log recorded itself, from the context its read stated (a DataFlash log's PARM
+    records: a value set again in flight takes its last), older names mapped to today's; None for a log of another
+    firmware or a kind that records none (a PX4 log's parameters are PX4's: no BATT_* for ArduPilot's failsafe)."""
+    context = table.context
+    if context is None or context.autopilot != "ardupilot":
         return None
-    return with_current_names(dataflash.log_parameters(dataflash.open_log(path)))
+    if not context.parameters and context.kind != "dataflash":
+        return None  # a tlog: its frames carry no parameter values
+    return with_current_names(dict(context.parameters))

@@ -2,8 +2,10 @@
 
 Each battery carries the page's figures in the page's units (``charge_used_mah``, ``energy_used_wh``, ...) and,
 under ``flight``, the flight figures in SI as the fleet views have them (:mod:`codegen.apps.battery.figures`), so
-a script, a CI job or a consistency test reads the same numbers a person reads on the page. Unknown is ``null``;
-NaN never appears (JSON has none).
+a script, a CI job or a consistency test reads the same numbers a person reads on the page. Each input carries, under
+``log``, what the log says about itself (:class:`codegen.apps.battery.context.LogContext`: firmware, vehicle, start
+in UTC, the arming rule and the armed spans up to the last battery record; ``null`` for a data file). Unknown is
+``null``; NaN never appears (JSON has none).
 """
 
 from __future__ import annotations
@@ -51,9 +53,12 @@ def report_json(report: Report) -> dict[str, Any]:
                     ],
                 }
             )
+        context = item.samples.context if item.samples is not None else None
+        end = max((s.t[-1] for s in item.batteries if s.t), default=0.0)
         inputs.append(
             {
                 "source": item.source,
+                "log": context.to_dict(end) if context is not None else None,
                 "message": item.message,
                 "records": item.records,
                 "findings": len(item.findings),

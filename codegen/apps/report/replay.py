@@ -16,7 +16,7 @@ from pathlib import Path
 from ...errors import BattgenError
 from ..failsafe.columnar import replay_table
 from ..failsafe.evaluator import BatteryFailsafe, Event, make_failsafe
-from ..failsafe.logs import NO_ARMING_NOTE, log_parameters
+from ..failsafe.logs import NO_ARMING_NOTE, own_parameters
 from ..failsafe.reading import BatteryReading
 from ..failsafe.settings import battery_settings
 from ..failsafe.stream import Sample, read_parameter_values
@@ -41,7 +41,7 @@ def _series_samples(item: InputSeries) -> Iterator[Sample]:
 
 def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | None) -> Replay:
     """The failsafe events of every battery of one input, on the report's time axis."""
-    own = log_parameters(path) if params is None and item.samples is not None else None
+    own = own_parameters(item.samples) if params is None and item.samples is not None else None
     if params is not None:
         values, where = read_parameter_values(params), str(params)
     elif own is not None:

@@ -22,24 +22,19 @@ from typing import Any
 import numpy as np
 
 from ...errors import BattgenError
-from ...inputs.dispatch import KIND_FORMATS, read_records
+from ...inputs.dispatch import read_records
 from ...inputs.kinds import file_kind
 from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
-from ...ir import SourceFormat
 from ..battery.column_checks import Checked, column_findings
 from ..battery.columns import NDArray
 from ..battery.figures import FlightFigures, flight_figures
 from ..battery.view import Chunk, read_view
 from ..convert import Conversion
 from ..failsafe.logs import SampleTable
+from ..messages import BATTERY_MESSAGES
 from ..validate import Checker, Finding, make_checker
 
-DEFAULT_MESSAGES = {
-    SourceFormat.UORB: "uorb.BatteryStatus",
-    SourceFormat.MAVLINK: "mavlink.BATTERY_STATUS",
-    SourceFormat.DRONECAN: "dronecan.uavcan.equipment.power.BatteryInfo",
-}
 KELVIN = 273.15
 COULOMB_PER_MAH = 3.6
 VIEW_KINDS = ("ulog", "tlog", "dataflash", "can")  # read through the battery view (JSON Lines: record by record)
@@ -161,10 +156,10 @@ def _battery(record: Record, state: Mapping[str, Any]) -> tuple[int, str]:
 
 
 def default_message(path: Path, kind: str | None) -> str:
-    fmt = KIND_FORMATS.get(kind or file_kind(path))
-    if fmt is None or fmt not in DEFAULT_MESSAGES:
+    message = BATTERY_MESSAGES.get(kind or file_kind(path))
+    if message is None:
         raise BattgenError(f"{path}: give --message for this input (e.g. uorb.BatteryStatus)")
-    return DEFAULT_MESSAGES[fmt]
+    return message
 
 
 def read_input(

@@ -1,0 +1,145 @@
+"""What a log says about itself (:class:`codegen.apps.battery.context.LogContext`, stated once by the battery view's
+read) against the reference readers on every real log of ``../shared``:
+
+- PX4 ULog, against pyulog: the vehicle (``sys_uuid``), the release ``ver_sw_release`` decodes to
+  (``ULog.get_version_info``), the hardware, every initial parameter (a float32 value as its shortest decimal,
+  equal as a float32), and the arming changes (``vehicle_status.arming_state`` ARMED, else ``actuator_armed``);
+- ArduPilot DataFlash, against pymavlink's DFReader: every ``PARM`` value as the reader holds it after the whole
+  log (``DFReader.params``: a value set again in flight takes its last);
+- MAVLink tlog, against pymavlink: the MAV_TYPE and MAV_AUTOPILOT of each system's last vehicle heartbeat
+  (pymavlink's ``probably_vehicle_heartbeat``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from shared_data import SHARED, missing
+
+from codegen.apps.battery.context import LogContext
+from codegen.apps.battery.view import read_view
+from codegen.inputs.kinds import detect
+
+pyulog = pytest.importorskip("pyulog")
+
+
+def _logs(kind: str) -> list[Path]:
+    seen: set[bytes] = set()
+    out = []
+    for path in sorted(SHARED.joinpath("data").rglob("*")) + sorted(SHARED.joinpath("corpus").rglob("*")):
+        if not path.is_file() or "upstream" in path.parts or path.stat().st_size == 0 or detect(path) != kind:
+            continue
+        head = path.read_bytes()[:65536] + str(path.stat().st_size).encode()
+        if head not in seen:
+            seen.add(head)
+            out.append(path)
+    return out
+
+
+ULOGS, DATAFLASH, TLOGS = _logs("ulog"), _logs("dataflash"), _logs("tlog")
+
+
+def test_every_kind_is_present() -> None:
+    if not (ULOGS and DATAFLASH and TLOGS):
+        missing("the real ULogs, DataFlash logs and tlogs of ../shared")
+
+
+def _contexts(path: Path) -> list[LogContext]:
+    """Each distinct context the view's chunks carry (one per log; a tlog: one per system)."""
+    out: list[LogContext] = []
+    for chunk in read_view(path):
+        context = chunk.batch.context
+        assert context is not None, "every chunk of a log carries its context"
+        if all(context is not c for c in out):
+            out.append(context)
+    return out
+
+
+def _same_float32(a: float, b: float) -> bool:
+    return bool(np.float32(a) == np.float32(b)) or a == b
+
+
+@pytest.mark.parametrize("path", ULOGS, ids=[p.name for p in ULOGS])
+def test_ulog_context_matches_pyulog(path: Path) -> None:
+    contexts = _contexts(path)
+    if not contexts:
+        pytest.skip("no battery_status records: the view yields no chunk")  # none such in ../shared today
+    (context,) = contexts
+    log = pyulog.ULog(str(path), ["vehicle_status", "actuator_armed"])
+    info = log.msg_info_dict
+    assert context.vehicle == (str(info["sys_uuid"]) if info.get("sys_uuid") else None)
+    assert context.hardware == (info.get("ver_hw") or None)
+    assert context.start_us == log.start_timestamp
+    version = log.get_version_info()
+    if version is not None and any(version):
+        assert context.firmware is not None and f"v{version[0]}.{version[1]}.{version[2]}" in context.firmware
+    if info.get("ver_sw"):
+        assert context.firmware is not None and f"({info['ver_sw'][:8]})" in context.firmware
+    theirs = log.initial_parameters
+    assert set(context.parameters) == set(theirs)
+    for name, value in theirs.items():
+        assert _same_float32(context.parameters[name], float(value)), name
+    assert context.vehicle_type == (int(theirs["MAV_TYPE"]) if "MAV_TYPE" in theirs else None)
+    assert context.arming == _pyulog_arming(log)
+
+
+def _pyulog_arming(log: object) -> tuple[tuple[float, bool], ...]:
+    data = {d.name: d.data for d in log.data_list if d.multi_id == 0}  # type: ignore[attr-defined]
+    if "vehicle_status" in data:
+        stamps, armed = data["vehicle_status"]["timestamp"], data["vehicle_status"]["arming_state"] == 2
+    elif "actuator_armed" in data:
+        stamps, armed = data["actuator_armed"]["timestamp"], data["actuator_armed"]["armed"] != 0
+    else:
+        return ()
+    out: list[tuple[float, bool]] = []
+    start = log.start_timestamp  # type: ignore[attr-defined]
+    for stamp, state in sorted(zip(stamps.tolist(), armed.tolist(), strict=True), key=lambda x: x[0]):
+        if not out or out[-1][1] != bool(state):
+            out.append((max((int(stamp) - start) / 1e6, 0.0), bool(state)))
+    return tuple(out)
+
+
+@pytest.mark.parametrize("path", DATAFLASH, ids=[p.name for p in DATAFLASH])
+def test_dataflash_parameters_match_pymavlink(path: Path) -> None:
+    from pymavlink import DFReader
+
+    contexts = _contexts(path)
+    if not contexts:
+        pytest.skip("no battery records: the view yields no chunk")
+    (context,) = contexts
+    text = path.suffix.lower() != ".bin"
+    reader = (DFReader.DFReader_text if text else DFReader.DFReader_binary)(str(path), zero_time_base=True)
+    while reader.recv_match(type=["PARM"]) is not None:
+        pass
+    assert context.autopilot == "ardupilot"
+    assert set(context.parameters) == set(reader.params)
+    for name, value in reader.params.items():
+        assert _same_float32(context.parameters[name], float(value)), name
+
+
+@pytest.mark.parametrize("path", TLOGS, ids=[p.name for p in TLOGS])
+def test_tlog_vehicle_matches_pymavlink(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("MAVLINK20", "1")  # its MAVLink 2 parser, which reads MAVLink 1 frames too
+    from pymavlink import mavutil
+
+    mavutil.set_dialect("ardupilotmega")
+    conn = mavutil.mavmmaplog(str(path))  # what mavlink_connection opens for a .tlog
+    last: dict[int, tuple[int, int]] = {}
+    while (msg := conn.recv_match(type="HEARTBEAT")) is not None:
+        if conn.probably_vehicle_heartbeat(msg):
+            last[msg.get_srcSystem()] = (msg.type, msg.autopilot)
+    conn.close()
+    contexts = _contexts(path)
+    if not contexts:
+        pytest.skip("no battery records: the view yields no chunk")
+    for context in contexts:
+        assert context.vehicle is not None and context.vehicle.startswith("mavlink:")
+        sysid = int(context.vehicle.split(":")[1])
+        if sysid not in last:
+            assert context.vehicle_type is None and context.arming == ()
+            continue
+        mav_type, autopilot = last[sysid]
+        assert context.vehicle_type == mav_type
+        assert context.autopilot == {3: "ardupilot", 12: "px4"}.get(autopilot)
