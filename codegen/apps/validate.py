@@ -18,8 +18,8 @@ from typing import Any
 
 from ..errors import BattgenError, LocatedError
 from ..frontends.loader import load
-from ..inputs.dispatch import KIND_FORMATS, read_records
-from ..inputs.kinds import file_kind
+from ..inputs.dispatch import read_records
+from ..inputs.kinds import KIND_FORMATS, file_kind
 from ..inputs.model import GeneratedMessage, MessageClass, Violation
 from ..inputs.records import Notice, Record, Unreadable
 from ..ir import Message, Schema, SourceFormat

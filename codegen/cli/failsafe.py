@@ -45,10 +45,9 @@ from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_re
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
 from ..errors import BattgenError
 from ..inputs import parameter_files
-from ..inputs.kinds import detect
+from ..inputs.kinds import FLIGHT_LOG_KINDS, detect
 
 EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE = 0, 1, 2
-FLIGHT_KINDS = ("ulog", "tlog", "dataflash", "can")
 
 
 def register(subparsers: Any) -> None:
@@ -82,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
     stream = Path(args.stream)
     try:
         # a flight log or capture is read through the battery view; JSON and JSON Lines are sample streams
-        table: SampleTable | None = log_samples(stream, args.stream) if detect(stream) in FLIGHT_KINDS else None
+        table: SampleTable | None = log_samples(stream, args.stream) if detect(stream) in FLIGHT_LOG_KINDS else None
         own = own_parameters(table) if table is not None and not args.params else None
         if args.params:
             values: dict[str, float] = read_parameter_values(Path(args.params))

@@ -16,32 +16,12 @@ from ..ir import Message, SourceFormat
 from .can.records import capture_items
 from .devicetree.records import read_devicetree
 from .documents import read_json, read_jsonl, read_yaml
-from .kinds import file_kind
+from .kinds import KIND_FORMATS, KIND_HOLDS, file_kind
 from .model import MavlinkClass, MessageClass
 from .parameter_records import read_parameter_records
 from .records import InputError, Item
 from .tlog import mavlink_items
 from .ulog import ulog_items
-
-# the source format a file kind holds; the text kinds hold any
-KIND_FORMATS: dict[str, SourceFormat] = {
-    "dts": SourceFormat.DEVICETREE,
-    "dtb": SourceFormat.DEVICETREE,
-    "param": SourceFormat.PDEF,
-    "ulog": SourceFormat.UORB,
-    "tlog": SourceFormat.MAVLINK,
-    "mavlink": SourceFormat.MAVLINK,
-    "can": SourceFormat.DRONECAN,
-}
-_HOLDS = {
-    "dts": "a devicetree file holds devicetree nodes",
-    "dtb": "a devicetree file holds devicetree nodes",
-    "param": "a parameter file holds parameters",
-    "ulog": "a ULog file holds uORB topics",
-    "tlog": "a MAVLink log holds MAVLink messages",
-    "mavlink": "a MAVLink log holds MAVLink messages",
-    "can": "a CAN capture holds DroneCAN messages",
-}
 
 
 def read_records(
@@ -63,7 +43,9 @@ def read_records(
         raise InputError(name, 0, f"reading {kind} input needs the generated class of {message.qualified_name}")
     expected = KIND_FORMATS.get(kind)
     if expected is not None and message.format is not expected:
-        raise InputError(name, 0, f"{_HOLDS[kind]}, but {message.qualified_name} is a {message.format.value} message")
+        raise InputError(
+            name, 0, f"{KIND_HOLDS[kind]}, but {message.qualified_name} is a {message.format.value} message"
+        )
     if model is not None and kind == "can":
         return capture_items(path, name, model)
     if kind == "dataflash":

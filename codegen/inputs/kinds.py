@@ -25,11 +25,33 @@ import re
 import struct
 from pathlib import Path
 
+from ..ir import SourceFormat
 from .records import InputError
 
 KINDS = ("json", "jsonl", "yaml", "dts", "dtb", "param", "ulog", "tlog", "mavlink", "can", "dataflash")
-# the kinds a flight log or capture is: each has one reader into battery batches (codegen.apps.battery)
-LOG_KINDS = ("ulog", "tlog", "dataflash", "can", "jsonl")
+# the flight logs and captures: a clock and context of their own, read by every log command through the battery
+# view (codegen.apps.battery); a JSON Lines file of battery records is read by it too, as plain data
+FLIGHT_LOG_KINDS = ("ulog", "tlog", "dataflash", "can")
+LOG_KINDS = (*FLIGHT_LOG_KINDS, "jsonl")
+# the source format a file kind holds (the text kinds hold any), and how a message of another is refused
+KIND_FORMATS: dict[str, SourceFormat] = {
+    "dts": SourceFormat.DEVICETREE,
+    "dtb": SourceFormat.DEVICETREE,
+    "param": SourceFormat.PDEF,
+    "ulog": SourceFormat.UORB,
+    "tlog": SourceFormat.MAVLINK,
+    "mavlink": SourceFormat.MAVLINK,
+    "can": SourceFormat.DRONECAN,
+}
+KIND_HOLDS = {
+    "dts": "a devicetree file holds devicetree nodes",
+    "dtb": "a devicetree file holds devicetree nodes",
+    "param": "a parameter file holds parameters",
+    "ulog": "a ULog file holds uORB topics",
+    "tlog": "a MAVLink log holds MAVLink messages",
+    "mavlink": "a MAVLink log holds MAVLink messages",
+    "can": "a CAN capture holds DroneCAN messages",
+}
 
 SUFFIXES: dict[str, frozenset[str]] = {
     "json": frozenset({".json"}),

@@ -18,7 +18,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shared_data import SHARED
 
-from codegen.apps.battery.column_checks import column_findings, flaggable, row_instance
+from codegen.apps.battery.column_checks import (
+    column_finding_groups,
+    column_findings,
+    flaggable,
+    group_findings,
+    row_instance,
+)
 from codegen.apps.battery.columns import NDArray
 from codegen.apps.battery.view import read_view
 from codegen.apps.report.series import _record_input, read_input
@@ -50,11 +56,24 @@ def test_ulog_findings_from_columns_equal_the_record_read(path: Path) -> None:
     _, checker = make_checker(SCHEMAS, "uorb.BatteryStatus", [name], "ulog")
     new = column_findings(path, name, "ulog", read_view(path, name, all_fields=True), checker)
     assert new is not None, "every real ULog of ../shared is placed from the columns"
-    assert new.findings == old.findings
+    assert group_findings(new.findings) == old.findings  # the report keeps its findings as groups
     assert new.notices == old.notices
     assert new.unreadable == old.unreadable
     report = read_input(path, SCHEMAS)  # and the report takes them
     assert (report.findings, report.notices, report.unreadable) == (old.findings, old.notices, old.unreadable)
+
+
+@pytest.mark.parametrize("path", ULOGS, ids=_name)
+def test_ulog_finding_groups_equal_the_grouped_findings(path: Path) -> None:
+    """The report's groups, counted over the columns, are the per-record findings grouped: counts, the first of
+    each group (record index, t, message), the notices."""
+    name = path.as_posix()
+    _, checker = make_checker(SCHEMAS, "uorb.BatteryStatus", [name], "ulog")
+    chunks = list(read_view(path, name, all_fields=True))
+    exact = column_findings(path, name, "ulog", chunks, checker)
+    grouped = column_finding_groups(path, name, "ulog", chunks, checker)
+    assert exact is not None and grouped is not None
+    assert grouped == (group_findings(exact.findings), exact.notices, exact.unreadable)
 
 
 def test_real_ulogs_have_findings_placed_as_the_reader_places_them() -> None:
@@ -183,3 +202,47 @@ def test_a_truncated_real_ulog_reports_what_the_record_read_does(tmp_path: Path,
     assert repr((report.findings, report.notices, report.unreadable)) == repr(
         (old.findings, old.notices, old.unreadable)
     )
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.lists(
+        st.fixed_dictionaries(
+            {},
+            optional={
+                "voltage_v": _FLOATS,
+                "current_a": _FLOATS,
+                "remaining": _FLOATS,
+                "temperature": _FLOATS,
+                "max_error": st.one_of(st.sampled_from([0, 1, 50, 100, 101]), st.integers(0, 65535)),
+                "cell_count": st.one_of(st.sampled_from([0, 4, 6, 14, 15]), st.integers(0, 255)),
+                "warning": st.integers(0, 255),
+                "voltage_cell_v": st.lists(_FLOATS, min_size=14, max_size=14),
+            },
+        ),
+        min_size=1,
+        max_size=12,
+    ),
+    st.integers(0, 1),
+)
+def test_groups_of_a_written_log_equal_its_grouped_findings(rows: list[dict[str, Any]], instances: int) -> None:
+    """Drawn records (two battery instances at most) written as a ULog: the groups counted over the columns are
+    the per-record findings grouped, whatever fields they flag."""
+    import tempfile
+
+    from generated import _ulog_writer
+
+    with np.errstate(over="ignore"):
+        records = [
+            (_CLASS(**{**_VALID, **_as_floats32(row), "timestamp": 1000 * (k + 1)}), k % (instances + 1))
+            for k, row in enumerate(rows)
+        ]
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "drawn.ulg"
+        _ulog_writer.write(path, records)
+        name = path.as_posix()
+        chunks = list(read_view(path, name, all_fields=True))
+        exact = column_findings(path, name, "ulog", chunks, _CHECKER)
+        grouped = column_finding_groups(path, name, "ulog", chunks, _CHECKER)
+        assert exact is not None and grouped is not None
+        assert repr(grouped) == repr((group_findings(exact.findings), exact.notices, exact.unreadable))

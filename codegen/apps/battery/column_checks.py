@@ -60,6 +60,40 @@ class Checked:
     findings: list[tuple[float, int, Finding]] = field(default_factory=list)
     notices: list[Notice] = field(default_factory=list)
     unreadable: list[Unreadable] = field(default_factory=list)
+    groups: list[FindingGroup] = field(default_factory=list)  # the findings grouped, where asked for instead
+
+
+@dataclass
+class FindingGroup:
+    """The findings of one battery that share a rule, a field path and a severity: how many, and the first of them
+    in file order (its record's index, ``t`` and message). What a report shows of a million alike findings."""
+
+    battery: int
+    rule: str
+    path: str
+    severity: str
+    count: int
+    first: int  # the first finding's record index in file order
+    t: float
+    message: str
+
+
+def group_findings(findings: Iterable[tuple[float, int, Finding]]) -> list[FindingGroup]:
+    """Findings as (t, battery, finding), in file order, as groups (:func:`ordered`)."""
+    groups: dict[tuple[int, str, str, str], FindingGroup] = {}
+    for t, battery, f in findings:
+        key = (battery, str(f.rule), str(f.path), str(f.severity))
+        group = groups.get(key)
+        if group is None:
+            groups[key] = FindingGroup(battery, key[1], key[2], key[3], 1, int(f.record), t, str(f.message))
+        else:
+            group.count += 1
+    return ordered(groups.values())
+
+
+def ordered(groups: Iterable[FindingGroup]) -> list[FindingGroup]:
+    """Groups by battery, then where each first appears in the file."""
+    return sorted(groups, key=lambda g: (g.battery, g.first, g.rule, g.path, g.severity))
 
 
 def flaggable(checker: Checker, columns: Mapping[str, NDArray], n: int) -> NDArray:
@@ -249,7 +283,24 @@ def column_findings(path: Path, name: str, kind: str, chunks: Iterable[Chunk], c
     return _ulog_findings(path, name, list(chunks), checker)
 
 
-def _ulog_findings(path: Path, name: str, chunks: list[Chunk], checker: Checker) -> Checked | None:
+def column_finding_groups(
+    path: Path, name: str, kind: str, chunks: Iterable[Chunk], checker: Checker
+) -> tuple[list[FindingGroup], list[Notice], list[Unreadable]] | None:
+    """As :func:`column_findings`, the findings as groups (:func:`group_findings` of them, exactly), without a
+    finding made per record: a value of a field that its own check flags is judged once (the oracle on the class's
+    default record holding it), and its rows counted over the column; only rows a cross-field rule or an array's
+    check may flag, or whose column holds too many values to judge one by one, go through the oracle row by row."""
+    if kind != "ulog" or not isinstance(checker.cls, UorbClass) or len(checker.cls.UORB_TOPICS) != 1:
+        return None
+    checked = _ulog_findings(path, name, list(chunks), checker, grouped=True)
+    if checked is None:
+        return None
+    return checked.groups, checked.notices, checked.unreadable
+
+
+def _ulog_findings(
+    path: Path, name: str, chunks: list[Chunk], checker: Checker, *, grouped: bool = False
+) -> Checked | None:
     model = checker.cls
     topic = model.UORB_TOPICS[0]  # type: ignore[attr-defined]
     reader = UlogReader(path, name, model)
@@ -264,7 +315,9 @@ def _ulog_findings(path: Path, name: str, chunks: list[Chunk], checker: Checker)
             return None  # a value the schema's type cannot hold: the per-record decoder's "unfit" notice
         out = Checked(notices=list(reader.notices))
         rows = list(_located_rows(chunks, offsets, topic))
-        if rows:
+        if rows and grouped:
+            out.groups = _grouped_rows(name, rows, chunks, checker, topic, skip)
+        elif rows:
             out.findings = _checked_rows(name, rows, chunks, checker, topic, skip)
         out.notices += reader.after_walk()
         return out
@@ -388,3 +441,127 @@ def _stamps(chunk: Chunk, skip: frozenset[str]) -> NDArray:
 def _seconds(stamp: Any, index: int) -> float:
     """The report's time of a record (:func:`codegen.apps.report.series._time`): its timestamp, else its position."""
     return int(stamp) / 1e6 if stamp >= 0 else float(index)
+
+
+class _FieldFindings:
+    """The oracle's findings of one field's value alone (on the class's default record holding it; cross-field
+    rules left out), each value asked once."""
+
+    def __init__(self, checker: Checker, name: str, skip: frozenset[str]) -> None:
+        self.checker = checker
+        self.cls: Any = checker.cls
+        self.name = name
+        self.skip = skip
+        self.seen: dict[tuple[str, object], list[Finding]] = {}
+
+    def of(self, f: Field, value: object) -> list[Finding]:
+        key = (f.name, value if value == value else "nan")
+        found = self.seen.get(key)
+        if found is None:
+            instance = self.cls()
+            setattr(instance, naming.field_identifier(f.name, f.pattern), value)
+            record = Record(0, 0, None, self.name, instance=instance, skip=self.skip)
+            own = (f.name + "[", f.name + ".")
+            found = [
+                x
+                for x in self.checker.check(record)
+                if not str(x.rule).startswith("cross-field:") and (str(x.path) == f.name or str(x.path).startswith(own))
+            ]
+            self.seen[key] = found
+        return found
+
+
+def _rule_rows(checker: Checker, columns: Mapping[str, NDArray], n: int) -> NDArray:
+    """The rows a cross-field rule may flag (every row where a rule has no exact mask, or a field lacks a column)."""
+    masks = [_RULE_MASKS.get((checker.message.qualified_name, rule)) for rule in checker.rules]
+    if any(m is None for m in masks) or any(f.name not in columns for f in checker.message.fields):
+        return np.ones(n, bool)
+    out = np.zeros(n, bool)
+    for mask in masks:
+        if mask is not None:
+            out |= mask(columns, n)
+    return out
+
+
+def _grouped_rows(
+    name: str, rows: list[_Rows], chunks: list[Chunk], checker: Checker, topic: str, skip: frozenset[str]
+) -> list[FindingGroup]:
+    """:func:`_checked_rows`' findings as groups (see :func:`column_finding_groups`)."""
+    every = np.concatenate([r.offsets for r in rows])
+    if len(every) != sum(chunks[r.chunk].n for r in rows):
+        raise ValueError("the view's rows and the log's index disagree")  # a bug, never a quiet misplacement
+    if not len(every):
+        return []
+    order = np.argsort(every, kind="stable")
+    index = np.empty(len(every), np.int64)
+    index[order] = np.arange(len(every))
+    stamps_all = np.concatenate([_stamps(chunks[r.chunk], skip) for r in rows])
+    t0 = _seconds(stamps_all[int(order[0])], int(index[int(order[0])]))
+    groups: dict[tuple[int, str, str, str], FindingGroup] = {}
+
+    def add(battery: int, finding: Finding, count: int, at: int) -> None:
+        key = (battery, str(finding.rule), str(finding.path), str(finding.severity))
+        first = int(index[at])
+        group = groups.get(key)
+        if group is None:
+            t = _seconds(stamps_all[at], first) - t0
+            groups[key] = FindingGroup(battery, key[1], key[2], key[3], count, first, t, str(finding.message))
+            return
+        group.count += count
+        if first < group.first:
+            group.first, group.t, group.message = first, _seconds(stamps_all[at], first) - t0, str(finding.message)
+
+    values = _FieldFindings(checker, name, skip)
+    probe = _Probe(checker)
+    start = 0
+    for r in rows:
+        chunk = chunks[r.chunk]
+        columns, n = chunk.batch.columns, chunk.n
+        multi_id = int(chunk.batch.instance[0]) if n else 0
+        full = _rule_rows(checker, columns, n)
+        flagged_fields: list[tuple[Field, NDArray]] = []
+        for f in checker.message.fields:
+            if f.is_padding or f.name not in columns or full.all():
+                continue
+            column = columns[f.name]
+            mask = _field_mask(probe, f, column, n)
+            if not mask.any():
+                continue
+            judged = column.ndim == 1 and column.dtype != object
+            if judged:
+                unique = np.unique(column[mask & ~full])
+                judged = len(unique) <= _MAX_PROBES
+            if judged:
+                flagged_fields.append((f, mask))
+            else:
+                full |= mask  # an array, or a column of too many values to judge one by one: the oracle per row
+        picked = np.nonzero(full)[0]
+        for row, instance in zip(
+            picked.tolist(), row_instances(checker.cls, checker.message, columns, picked), strict=True
+        ):
+            at = start + row
+            stamp = int(stamps_all[at]) if stamps_all[at] >= 0 else None
+            offset = int(r.offsets[row]) - _D_HEAD
+            rec = LogRecord(topic, multi_id, offset, stamp, instance, skip, {}, ())
+            record = Record(
+                int(index[at]), 0, None, name, where=rec.where(), instance=instance, skip=skip,
+                location=rec.location(),
+            )  # fmt: skip
+            for finding in checker.check(record):
+                add(multi_id, finding, 1, at)
+        for f, mask in flagged_fields:
+            where = np.nonzero(mask & ~full)[0]
+            column = columns[f.name][where]
+            for value in np.unique(column).tolist():
+                same = where[column == value] if value == value else where[np.isnan(column)]
+                if not len(same):
+                    continue
+                found = values.of(f, value)
+                if not found:
+                    continue
+                positions = start + same
+                at = int(positions[int(np.argmin(index[positions]))])
+                for finding in found:
+                    add(multi_id, finding, len(same), at)
+        start += n
+    return ordered(groups.values())

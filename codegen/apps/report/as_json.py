@@ -61,7 +61,7 @@ def report_json(report: Report) -> dict[str, Any]:
                 "log": context.to_dict(end) if context is not None else None,
                 "message": item.message,
                 "records": item.records,
-                "findings": len(item.findings),
+                "findings": sum(g.count for g in item.findings),
                 "failsafe_note": rep.note or None,
                 "batteries": batteries,
             }

@@ -21,7 +21,7 @@ import jinja2
 
 from ... import __version__
 from ...errors import BattgenError
-from ..validate import Finding
+from ..battery.column_checks import FindingGroup
 from .downsample import POINT_BUDGET
 from .figures import compute
 from .fleet import FleetView
@@ -61,22 +61,17 @@ def plotly_js() -> str:
     return str(offline.get_plotlyjs())
 
 
-def _grouped(findings: Sequence[tuple[float, int, Finding]], battery: int) -> list[dict[str, object]]:
-    groups: dict[tuple[str, str, str], dict[str, object]] = {}
-    for t, b, f in findings:
-        if b != battery:
-            continue
-        key = (f.rule, f.path, f.severity)
-        group = groups.get(key)
-        if group is None:
-            groups[key] = {"count": 1, "t": t, "text": f.message, "css": _CSS.get(f.severity, "")}
-        else:
-            group["count"] = int(str(group["count"])) + 1
-    return sorted(groups.values(), key=lambda g: (-int(str(g["count"])), str(g["text"])))
+def _grouped(findings: Sequence[FindingGroup], battery: int) -> list[dict[str, object]]:
+    groups = [
+        {"count": g.count, "t": g.t, "text": g.message, "css": _CSS.get(g.severity, "")}
+        for g in findings
+        if g.battery == battery
+    ]
+    return sorted(groups, key=lambda g: (-int(str(g["count"])), str(g["text"])))
 
 
 def _section(
-    s: BatterySeries, findings: Sequence[tuple[float, int, Finding]], replay: Replay, index: int
+    s: BatterySeries, findings: Sequence[FindingGroup], replay: Replay, index: int
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     plot_id = f"plot-{index}"
     events = [e for e in replay.events if e.battery == s.battery]

@@ -23,10 +23,10 @@ import numpy as np
 
 from ...errors import BattgenError
 from ...inputs.dispatch import read_records
-from ...inputs.kinds import file_kind
+from ...inputs.kinds import FLIGHT_LOG_KINDS, file_kind
 from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
-from ..battery.column_checks import Checked, column_findings
+from ..battery.column_checks import FindingGroup, column_finding_groups, group_findings
 from ..battery.columns import NDArray
 from ..battery.figures import FlightFigures, flight_figures
 from ..battery.view import Chunk, read_view
@@ -37,7 +37,6 @@ from ..validate import Checker, Finding, make_checker
 
 KELVIN = 273.15
 COULOMB_PER_MAH = 3.6
-VIEW_KINDS = ("ulog", "tlog", "dataflash", "can")  # read through the battery view (JSON Lines: record by record)
 INSTANCE_WORDS = {"ulog": "multi_id", "can": "node", "dataflash": "instance"}
 
 
@@ -115,7 +114,7 @@ class InputSeries:
     source: str
     message: str
     batteries: list[BatterySeries]
-    findings: list[tuple[float, int, Finding]]  # (t, battery, finding)
+    findings: list[FindingGroup]  # the validator's findings, grouped per battery, rule, path and severity
     notices: list[Notice]
     unreadable: list[Unreadable]
     records: int
@@ -174,7 +173,7 @@ def read_input(
     schema (DataFlash has none). Other inputs (JSON, YAML) go record by record through the converters."""
     name = display or path.as_posix()
     kind = kind or file_kind(path)
-    if kind in VIEW_KINDS and message is None:
+    if kind in FLIGHT_LOG_KINDS and message is None:
         return _view_input(path, name, schema_dir, kind)
     return _record_input(path, schema_dir, name, message, kind)
 
@@ -209,12 +208,12 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
     out.samples = table
     if kind == "dataflash":  # a DataFlash log has no message schema: nothing to validate
         return out
-    column: Checked | None = None
+    column = None
     if checkable:
         _, checker = make_checker(schema_dir, default_message(path, kind), [str(path)], kind)
-        column = column_findings(path, name, kind, chunks, checker)
+        column = column_finding_groups(path, name, kind, chunks, checker)
     if column is not None:
-        out.findings, out.notices, out.unreadable = column.findings, column.notices, column.unreadable
+        out.findings, out.notices, out.unreadable = column
     else:  # the view's batches of this kind lack the records' places (a tlog's frames): read them one by one
         checked = _record_input(path, schema_dir, name, None, kind)
         out.findings, out.notices, out.unreadable = checked.findings, checked.notices, checked.unreadable
@@ -292,6 +291,7 @@ def _record_input(path: Path, schema_dir: Path, name: str, message: str | None, 
     batteries: dict[int, BatterySeries] = {}
     out = InputSeries(name, msg.qualified_name, [], [], [], [], 0)
     t0: float | None = None
+    found: list[tuple[float, int, Finding]] = []
     for item in read_records(path, msg, name, model=checker.cls, kind=kind):
         if isinstance(item, Notice):
             out.notices.append(item)
@@ -312,8 +312,9 @@ def _record_input(path: Path, schema_dir: Path, name: str, message: str | None, 
             series = batteries[number] = BatterySeries(name, number, word, msg.qualified_name, source)
         _append(series, (t or 0.0) - (t0 or 0.0), state)
         for finding in checker.check(item):
-            out.findings.append(((t or 0.0) - (t0 or 0.0), number, finding))
+            found.append(((t or 0.0) - (t0 or 0.0), number, finding))
     out.batteries = [batteries[k] for k in sorted(batteries)]
+    out.findings = group_findings(found)
     return out
 
 
