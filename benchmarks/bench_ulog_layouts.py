@@ -5,7 +5,8 @@ The log is a real older-layout log (default ../shared/data/ulog/sample_px4_event
 battery_status, 167 bytes) with its battery records repeated to --records records (built in a temp
 dir, never kept). Timed once each, in one run: ``battgen export`` (parse, columns, the IR's mapping,
 Parquet) against what a user writes by hand (pyulog -> pandas -> ``to_parquet``); printed as records/s
-of wall time and of the process's CPU time (every thread: records/s/core), and the ratios. Targets (issue 22): >= 1 M records/s/core and >= 3x the hand path.
+of wall time and of the process's CPU time (every thread: records/s/core), and the ratios.
+Targets (issue 22): >= 1 M records/s/core and >= 3x the hand path.
 """
 
 from __future__ import annotations

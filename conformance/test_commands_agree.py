@@ -82,9 +82,8 @@ def _report(path: Path, tmp: Path, capsys: pytest.CaptureFixture[str]) -> dict[i
     if code != 0:
         return None
     doc = json.loads(out.read_text())
-    return {
-        b["battery"]: b["flight"] | {"serial": b["serial"], "message": b["message"]} for b in doc["inputs"][0]["batteries"]
-    }
+    batteries = doc["inputs"][0]["batteries"]
+    return {b["battery"]: b["flight"] | {"serial": b["serial"], "message": b["message"]} for b in batteries}
 
 
 def _failsafe(path: Path) -> tuple[dict[int, FlightFigures], bool]:
