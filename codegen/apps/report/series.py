@@ -243,10 +243,15 @@ def _extend(series: BatterySeries, chunk: Chunk, rows: NDArray) -> None:
     else:
         series.armed.extend([math.nan] * len(rows))
     cells = chunk.concepts["cell_voltages"]
-    for k in rows.tolist():
-        width = int(cells.lengths[k]) if cells.valid[k] and cells.lengths is not None else 0
-        row = cells.values[k, :width].tolist() if width else []
-        series.cells.append([v for v in row if v == v and v > 0.0])
+    matrix = np.asarray(cells.values[rows], np.float64)
+    if matrix.ndim == 2 and matrix.shape[1]:
+        widths = cells.lengths[rows] if cells.lengths is not None else np.zeros(len(rows), np.int64)
+        beyond = np.arange(matrix.shape[1])[None, :] >= np.where(cells.valid[rows], widths, 0)[:, None]
+        with np.errstate(invalid="ignore"):
+            matrix[beyond | ~(matrix > 0.0)] = np.nan  # a cell past the count, unknown (NaN) or not positive
+        series.cells.extend([v for v in row if v == v] for row in matrix.tolist())
+    else:
+        series.cells.extend([] for _ in range(len(rows)))
     health = chunk.number("state_of_health")[rows]
     if (health > 0).any():
         series.state_of_health = float(health[health > 0][-1]) * 100.0
@@ -265,9 +270,10 @@ def _extend(series: BatterySeries, chunk: Chunk, rows: NDArray) -> None:
 
 def _order(series: BatterySeries) -> None:
     """A battery's samples in time order (a ULog's batteries come instance by instance, chunks in order)."""
-    order = sorted(range(len(series.t)), key=lambda k: series.t[k])
-    if order == list(range(len(order))):
-        return
+    t = np.array(series.t, np.float64)
+    if not len(t) or bool((t[1:] >= t[:-1]).all()):
+        return  # in order already (one instance, its chunks read in order)
+    order = np.argsort(t, kind="stable").tolist()  # a record without a time (NaN) last
     for name in (
         "t",
         "pack_voltage",
