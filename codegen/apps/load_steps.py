@@ -7,7 +7,7 @@ absolute value), and by at least :data:`STEP_MIN_A`; each gives R = -ΔV/ΔI, ke
 The estimate is the median of them, as one step is easily spoiled by a voltage reading lagging the
 current. Relative to the peak, the threshold suits a 2 A hobby pack and a 200 A heavy lifter alike.
 
-:func:`step_resistances` computes it over Python lists; :func:`resistance_sql` writes the same as
+:func:`step_resistances` computes it over a battery's samples; :func:`resistance_sql` writes the same as
 SQL over a table's columns (a window per battery), so the two cannot drift apart.
 """
 
@@ -15,6 +15,10 @@ from __future__ import annotations
 
 import statistics
 from collections.abc import Sequence
+
+import numpy as np
+
+from .battery.columns import NDArray
 
 STEP_FRACTION = 0.2
 STEP_MIN_A = 1.0
@@ -27,23 +31,25 @@ def step_threshold(peak_a: float) -> float:
 
 
 def step_resistances(
-    t: Sequence[float], voltage: Sequence[float | None], current: Sequence[float | None]
+    t: Sequence[float] | NDArray, voltage: Sequence[float | None] | NDArray, current: Sequence[float | None] | NDArray
 ) -> list[float]:
-    """Every load step's -ΔV/ΔI (Ω) of one battery's samples, in time order."""
-    known = [abs(i) for i in current if i is not None]
-    if not known:
+    """Every load step's -ΔV/ΔI (Ω) of one battery's samples, in time order (unknown: None, or NaN in an array)."""
+    times, volts, amps = _floats(t), _floats(voltage), _floats(current)
+    known = np.abs(amps[~np.isnan(amps)])
+    if not len(known):
         return []
-    threshold = step_threshold(max(known))
-    out = []
-    for k in range(1, len(t)):
-        v0, v1, i0, i1 = voltage[k - 1], voltage[k], current[k - 1], current[k]
-        if v0 is None or v1 is None or i0 is None or i1 is None or t[k] - t[k - 1] > STEP_MAX_DT_S:
-            continue
-        if abs(i1 - i0) >= threshold:
-            r = -(v1 - v0) / (i1 - i0)
-            if r > 0:
-                out.append(r)
-    return out
+    threshold = step_threshold(float(known.max()))
+    dv, di, dt = np.diff(volts), np.diff(amps), np.diff(times)
+    with np.errstate(invalid="ignore"):
+        step = ~np.isnan(dv) & ~np.isnan(di) & ~(dt > STEP_MAX_DT_S) & (np.abs(di) >= threshold)
+    r = -dv[step] / di[step]
+    return [float(x) for x in r[r > 0]]
+
+
+def _floats(values: Sequence[float | None] | NDArray) -> NDArray:
+    if isinstance(values, np.ndarray):
+        return np.asarray(values, np.float64)
+    return np.array([np.nan if v is None else v for v in values], np.float64)
 
 
 def internal_resistance(

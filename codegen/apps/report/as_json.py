@@ -54,7 +54,7 @@ def report_json(report: Report) -> dict[str, Any]:
                 }
             )
         context = item.samples.context if item.samples is not None else None
-        end = max((s.t[-1] for s in item.batteries if s.t), default=0.0)
+        end = max((float(s.t[-1]) for s in item.batteries if len(s.t)), default=0.0)
         inputs.append(
             {
                 "source": item.source,

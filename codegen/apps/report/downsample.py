@@ -12,6 +12,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
+
+from ..battery.columns import NDArray
+
 POINT_BUDGET = 2000  # points per trace; the README and the browser test rely on this number
 
 
@@ -21,27 +25,28 @@ def planned_length(n: int, budget: int = POINT_BUDGET) -> int:
 
 
 def decimate(
-    t: Sequence[float], values: Sequence[float | None], budget: int = POINT_BUDGET
+    times: Sequence[float] | NDArray, trace: Sequence[float | None] | NDArray, budget: int = POINT_BUDGET
 ) -> tuple[list[float], list[float | None]]:
-    """The points to draw of one trace: all when they fit the budget, else each bucket's min and max."""
-    known: list[tuple[float, float]] = [(x, y) for x, y in zip(t, values, strict=True) if y is not None]
+    """The points to draw of one trace (unknown: None, or NaN in an array): all when they fit the budget (unknown
+    ones as gaps, None), else each bucket's min and max."""
+    t = np.asarray(times, np.float64)
+    values = trace if isinstance(trace, np.ndarray) else np.array([np.nan if v is None else v for v in trace])
+    values = np.asarray(values, np.float64)
     if len(t) <= budget:
-        return list(t), list(values)
+        return [float(x) for x in t.tolist()], [None if y != y else y for y in values.tolist()]
+    known = ~np.isnan(values)
+    xs_known, ys_known = t[known], values[known]
     buckets = budget // 2
-    size = len(known) / buckets if buckets else len(known)
+    size = len(ys_known) / buckets if buckets else len(ys_known)
     xs: list[float] = []
     ys: list[float | None] = []
     for b in range(buckets):
-        part = known[int(b * size) : int((b + 1) * size)]
-        if not part:
+        lo, hi = int(b * size), int((b + 1) * size)
+        if hi <= lo:
             continue
-        low = min(part, key=_value)
-        high = max(part, key=_value)
-        first, second = (low, high) if low[0] <= high[0] else (high, low)
-        xs += (first[0], second[0])
-        ys += (first[1], second[1])
+        part = ys_known[lo:hi]
+        low, high = lo + int(np.argmin(part)), lo + int(np.argmax(part))  # the first of equal values, as min()
+        first, second = (low, high) if xs_known[low] <= xs_known[high] else (high, low)
+        xs += (float(xs_known[first]), float(xs_known[second]))
+        ys += (float(ys_known[first]), float(ys_known[second]))
     return xs, ys
-
-
-def _value(point: tuple[float, float]) -> float:
-    return point[1]

@@ -15,9 +15,11 @@ median is the better estimate of the pack's resistance when a log is noisy.
 from __future__ import annotations
 
 import statistics
-from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
+from ..battery.columns import NDArray
 from ..battery.figures import FlightFigures
 from ..load_steps import STEP_MAX_DT_S, step_resistances
 from .series import BatterySeries
@@ -79,8 +81,16 @@ class Figures:
         return out
 
 
-def _known(values: Sequence[float | None]) -> list[float]:
-    return [v for v in values if v is not None]
+def _max(values: NDArray) -> float | None:
+    known = values[~np.isnan(values)]
+    return float(known.max()) if len(known) else None
+
+
+def _pairs(s: BatterySeries) -> tuple[NDArray, NDArray, NDArray]:
+    """Consecutive samples at most STEP_MAX_DT apart with both voltages and currents known: ΔV, ΔI and Δt."""
+    dv, di, dt = np.diff(s.pack_voltage), np.diff(s.current), np.diff(s.t)
+    keep = ~np.isnan(dv) & ~np.isnan(di) & ~(dt > STEP_MAX_DT)
+    return dv[keep], di[keep], dt[keep]
 
 
 def _steps(s: BatterySeries) -> list[float]:
@@ -91,51 +101,45 @@ def _sag(s: BatterySeries) -> float | None:
     """-dV/dI as the least-squares slope through the origin of the sample-to-sample changes (ΔV on ΔI, samples
     at most STEP_MAX_DT apart): every change of load counts, small ones too, and the slow decline of the discharge
     adds little to ΔV between neighbours and nothing correlated with ΔI."""
-    num = den = 0.0
-    for k in range(1, len(s.t)):
-        v0, v1, i0, i1 = s.pack_voltage[k - 1], s.pack_voltage[k], s.current[k - 1], s.current[k]
-        if v0 is None or v1 is None or i0 is None or i1 is None or s.t[k] - s.t[k - 1] > STEP_MAX_DT:
-            continue
-        num += (i1 - i0) * (v1 - v0)
-        den += (i1 - i0) ** 2
+    dv, di, _ = _pairs(s)
+    num = sum((di * dv).tolist())  # summed in time order, as a person's loop would
+    den = sum((di * di).tolist())
     return -num / den if den > 1e-9 else None
 
 
 def _time_below(s: BatterySeries, threshold: float) -> float:
-    total = 0.0
-    for k in range(1, len(s.t)):
-        v = s.pack_voltage[k - 1]
-        if v is not None and v < threshold:
-            total += s.t[k] - s.t[k - 1]
-    return total
+    dt = np.diff(s.t)
+    with np.errstate(invalid="ignore"):
+        below = s.pack_voltage[:-1] < threshold
+    return float(sum(dt[below].tolist()))
 
 
 def compute(s: BatterySeries, thresholds: dict[str, float] | None = None) -> Figures:
     """The figures of one battery; ``thresholds`` (name -> volts, e.g. BATT_LOW_VOLT) for the time below each."""
-    power = s.power
     flight = s.flight()
     steps = _steps(s)
     energy = flight.energy_used
     duration = flight.duration_s
-    cells = [min(c) for c in s.cells if c]
-    imbalance = _known(s.imbalance)
-    temps = _known(s.temperature)
-    known_power = _known(power)
     return Figures(
         duration_s=duration,
         samples=len(s.t),
         charge_used_mah=None if flight.charge_used is None else flight.charge_used / 3.6,
         energy_used_wh=None if energy is None else energy / 3600.0,
         average_power_w=energy / duration if energy is not None and duration > 0 else None,
-        peak_power_w=max(known_power) if known_power else None,
+        peak_power_w=_max(s.power),
         peak_current_a=flight.max_current,
         min_pack_voltage_v=flight.min_voltage,
-        min_cell_voltage_v=min(cells) if cells else None,
-        max_cell_imbalance_v=max(imbalance) if imbalance else None,
-        max_temperature_c=max(temps) if temps else None,
+        min_cell_voltage_v=None if not s.cells.size else _min_cell(s.cells),
+        max_cell_imbalance_v=_max(s.imbalance),
+        max_temperature_c=_max(s.temperature),
         sag_per_amp_v_per_a=_sag(s),
         internal_resistance_ohm=statistics.median(steps) if steps else None,
         load_steps=len(steps),
         time_below_s={name: _time_below(s, v) for name, v in (thresholds or {}).items() if v > 0},
         flight=flight,
     )
+
+
+def _min_cell(cells: NDArray) -> float | None:
+    known = cells[~np.isnan(cells)]
+    return float(known.min()) if len(known) else None

@@ -12,6 +12,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
+from ..battery.columns import NDArray
 from .downsample import POINT_BUDGET, decimate
 from .series import BatterySeries
 
@@ -28,21 +31,21 @@ class Marker:
     text: str  # e.g. "LOW: RTL (voltage 10.4 V < 10.5 V)"
 
 
-def _rows(s: BatterySeries) -> list[tuple[str, str, list[tuple[str, Sequence[float | None]]]]]:
+def _rows(s: BatterySeries) -> list[tuple[str, str, list[tuple[str, NDArray]]]]:
     """(title, unit, traces) per row, leaving out rows the battery has no values for."""
-    rows: list[tuple[str, str, list[tuple[str, Sequence[float | None]]]]] = [
+    rows: list[tuple[str, str, list[tuple[str, NDArray]]]] = [
         ("pack voltage", "V", [("pack voltage", s.pack_voltage)]),
         ("current", "A", [("current", s.current)]),
         ("power", "W", [("power", s.power)]),
         ("state of charge", "%", [("state of charge", s.state_of_charge)]),
         ("temperature", "°C", [("temperature", s.temperature)]),
         ("cells", "V", [(f"cell {k + 1}", s.cell(k)) for k in range(s.cell_count)]),
-        ("cell imbalance", "mV", [("max - min", [None if v is None else v * 1000 for v in s.imbalance])]),
+        ("cell imbalance", "mV", [("max - min", s.imbalance * 1000)]),
     ]
     return [
-        (title, unit, [(n, v) for n, v in traces if any(x is not None for x in v)])
+        (title, unit, [(n, v) for n, v in traces if not np.isnan(v).all()])
         for title, unit, traces in rows
-        if any(any(x is not None for x in v) for _, v in traces)
+        if any(not np.isnan(v).all() for _, v in traces)
     ]
 
 
@@ -95,7 +98,7 @@ def figure(
                     "xaxis": f"x{axis}",
                     "yaxis": f"y{axis}",
                     "line": {"width": 1.2},
-                    "meta": {"row": title, "samples": sum(1 for v in values if v is not None)},
+                    "meta": {"row": title, "samples": int((~np.isnan(values)).sum())},
                     "hovertemplate": f"%{{y:.3f}} {unit}<extra>{name}</extra>",
                 }
             )

@@ -31,12 +31,17 @@ def _series_samples(item: InputSeries) -> Iterator[Sample]:
     """Samples from the report's series, in time order across batteries (armed throughout)."""
     rows = []
     for s in item.batteries:
-        for k, t in enumerate(s.t):
-            volts, amps, used = s.pack_voltage[k], s.current[k], s.discharged[k]
-            rows.append((t, s.battery + 1, BatteryReading(volts, amps if amps is None or amps >= 0 else None, used)))
+        columns = (s.t.tolist(), s.pack_voltage.tolist(), s.current.tolist(), s.discharged.tolist())
+        for t, volts, amps, used in zip(*columns, strict=True):
+            reading = BatteryReading(_known(volts), amps if amps == amps and amps >= 0 else None, _known(used))
+            rows.append((t, s.battery + 1, reading))
     rows.sort(key=lambda r: (r[0], r[1]))
     for k, (t, instance, reading) in enumerate(rows):
         yield Sample(k + 1, t, True, reading, None, None, {}, instance, f"sample {k + 1}")
+
+
+def _known(value: float) -> float | None:
+    return None if value != value else value
 
 
 def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | None) -> Replay:

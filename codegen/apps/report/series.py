@@ -14,6 +14,7 @@ record's position (one per second) -- said in the series' ``time_source``.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,27 +41,42 @@ COULOMB_PER_MAH = 3.6
 INSTANCE_WORDS = {"ulog": "multi_id", "can": "node", "dataflash": "instance"}
 
 
+_EMPTY = np.zeros(0)
+# the series of one battery, each a float64 array with NaN where unknown: name -> (concept, scale, offset)
+SERIES = {
+    "pack_voltage": ("pack_voltage", 1.0, 0.0),
+    "current": ("current", 1.0, 0.0),
+    "state_of_charge": ("state_of_charge", 100.0, 0.0),  # percent
+    "temperature": ("temperature", 1.0, -KELVIN),  # °C
+    "discharged": ("discharged", 1 / COULOMB_PER_MAH, 0.0),  # mAh
+    "remaining_energy": ("remaining_energy", 1 / 3600.0, 0.0),  # Wh
+    "charge_c": ("discharged", 1.0, 0.0),  # the discharged counter in C, for the flight figures
+    "energy_j": ("consumed_energy", 1.0, 0.0),  # the consumed-energy counter in J
+}
+
+
 @dataclass
 class BatterySeries:
-    """One battery of one input: its samples in SI (temperature in °C, charge in mAh, energy in Wh)."""
+    """One battery of one input: its samples as float64 arrays in time order, NaN where unknown (temperature in
+    °C, charge in mAh, energy in Wh; ``charge_c``/``energy_j`` in SI for the flight figures), and ``cells`` a
+    matrix of a column per cell (NaN: a cell the sample does not give)."""
 
     source: str
     battery: int
     instance_word: str  # how the input names its instances: "multi_id", "node", "id"
     message: str
     time_source: str = "log"
-    t: list[float] = field(default_factory=list)
-    pack_voltage: list[float | None] = field(default_factory=list)
-    current: list[float | None] = field(default_factory=list)
-    state_of_charge: list[float | None] = field(default_factory=list)  # percent
-    temperature: list[float | None] = field(default_factory=list)  # °C
-    discharged: list[float | None] = field(default_factory=list)  # mAh
-    remaining_energy: list[float | None] = field(default_factory=list)  # Wh
-    cells: list[list[float]] = field(default_factory=list)  # known cell voltages of each sample
-    # in the concepts' SI units, NaN unknown, for the flight figures (codegen.apps.battery.figures)
-    charge_c: list[float] = field(default_factory=list)  # the discharged counter
-    energy_j: list[float] = field(default_factory=list)  # the consumed-energy counter
-    armed: list[float] = field(default_factory=list)  # 1.0 / 0.0 / NaN
+    t: NDArray = field(default_factory=lambda: np.zeros(0))
+    pack_voltage: NDArray = field(default_factory=lambda: np.zeros(0))
+    current: NDArray = field(default_factory=lambda: np.zeros(0))
+    state_of_charge: NDArray = field(default_factory=lambda: np.zeros(0))
+    temperature: NDArray = field(default_factory=lambda: np.zeros(0))
+    discharged: NDArray = field(default_factory=lambda: np.zeros(0))
+    remaining_energy: NDArray = field(default_factory=lambda: np.zeros(0))
+    cells: NDArray = field(default_factory=lambda: np.zeros((0, 0)))
+    charge_c: NDArray = field(default_factory=lambda: np.zeros(0))
+    energy_j: NDArray = field(default_factory=lambda: np.zeros(0))
+    armed: NDArray = field(default_factory=lambda: np.zeros(0))  # 1.0 / 0.0 / NaN
     knows_arming: bool = False  # whether the input carries an arming state at all
     serial: str = ""
     cycle_count: int | None = None  # the last the battery reported
@@ -73,38 +89,39 @@ class BatterySeries:
         return f"battery {self.battery + 1} ({self.instance_word} {self.battery})"
 
     @property
-    def power(self) -> list[float | None]:
-        return [
-            v * i if v is not None and i is not None else None
-            for v, i in zip(self.pack_voltage, self.current, strict=True)
-        ]
+    def power(self) -> NDArray:
+        return np.asarray(self.pack_voltage * self.current, np.float64)
 
     def flight(self) -> FlightFigures:
         """The flight's figures, by the one definition the fleet views share."""
-
-        def array(values: list[float | None]) -> NDArray:
-            return np.array([np.nan if v is None else v for v in values], np.float64)
-
         return flight_figures(
-            np.array(self.t, np.float64),
-            array(self.pack_voltage),
-            array(self.current),
-            np.array(self.charge_c, np.float64),
-            np.array(self.energy_j, np.float64),
-            np.array(self.armed, np.float64) if self.knows_arming else None,
+            self.t,
+            self.pack_voltage,
+            self.current,
+            self.charge_c,
+            self.energy_j,
+            self.armed if self.knows_arming else None,
         )
 
     @property
     def cell_count(self) -> int:
-        return max((len(c) for c in self.cells), default=0)
+        """The cells some sample gives (the last column holding a value, counted from 1)."""
+        given = np.nonzero(~np.isnan(self.cells).all(axis=0))[0] if self.cells.size else _EMPTY
+        return int(given[-1]) + 1 if len(given) else 0
 
-    def cell(self, k: int) -> list[float | None]:
-        return [c[k] if k < len(c) else None for c in self.cells]
+    def cell(self, k: int) -> NDArray:
+        return np.asarray(self.cells[:, k], np.float64)
 
     @property
-    def imbalance(self) -> list[float | None]:
-        """max - min cell voltage of each sample with at least two known cells."""
-        return [max(c) - min(c) if len(c) >= 2 else None for c in self.cells]
+    def imbalance(self) -> NDArray:
+        """max - min cell voltage of each sample with at least two known cells (else NaN)."""
+        if not self.cells.size:
+            return np.full(len(self.t), np.nan)
+        known = (~np.isnan(self.cells)).sum(axis=1)
+        with np.errstate(invalid="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN row: NaN, as wanted
+            spread = np.nanmax(self.cells, axis=1) - np.nanmin(self.cells, axis=1)
+        return np.asarray(np.where(known >= 2, spread, np.nan), np.float64)
 
 
 @dataclass
@@ -179,7 +196,7 @@ def read_input(
 
 
 def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeries:
-    batteries: dict[int, BatterySeries] = {}
+    batteries: dict[int, _Parts] = {}
     table = SampleTable()
     messages: list[str] = []
     records = 0
@@ -196,14 +213,12 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
         numbers = chunk.battery
         for number in sorted(set(numbers.tolist())):
             rows = np.nonzero(numbers == number)[0]
-            series = batteries.get(number)
-            if series is None:
-                series = batteries[number] = BatterySeries(name, number, word, chunk.batch.message)
-            _extend(series, chunk, rows)
-    for series in batteries.values():
-        _order(series)
+            parts = batteries.get(number)
+            if parts is None:
+                parts = batteries[number] = _Parts(BatterySeries(name, number, word, chunk.batch.message))
+            parts.extend(chunk, rows)
     out = InputSeries(
-        name, ", ".join(messages) or "none", [batteries[k] for k in sorted(batteries)], [], [], [], records
+        name, ", ".join(messages) or "none", [batteries[k].finish() for k in sorted(batteries)], [], [], [], records
     )
     out.samples = table
     if kind == "dataflash":  # a DataFlash log has no message schema: nothing to validate
@@ -220,81 +235,69 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
     return out
 
 
-def _numbers(chunk: Chunk, concept: str, rows: NDArray, scale: float = 1.0, offset: float = 0.0) -> list[float | None]:
-    values = chunk.number(concept)[rows] * scale + offset
-    return [None if v != v else v for v in values.tolist()]
+class _Parts:
+    """A battery's series as the chunks give them, joined and put in time order at the end."""
 
+    def __init__(self, series: BatterySeries) -> None:
+        self.series = series
+        self.parts: dict[str, list[NDArray]] = {name: [] for name in ("t", "armed", "cells", *SERIES)}
 
-def _extend(series: BatterySeries, chunk: Chunk, rows: NDArray) -> None:
-    """Append a chunk's rows of one battery, in the units the page shows."""
-    series.t.extend(np.asarray(chunk.batch.t, np.float64)[rows].tolist())
-    series.pack_voltage.extend(_numbers(chunk, "pack_voltage", rows))
-    series.current.extend(_numbers(chunk, "current", rows))
-    series.state_of_charge.extend(_numbers(chunk, "state_of_charge", rows, 100.0))
-    series.temperature.extend(_numbers(chunk, "temperature", rows, 1.0, -KELVIN))
-    series.discharged.extend(_numbers(chunk, "discharged", rows, 1 / COULOMB_PER_MAH))
-    series.remaining_energy.extend(_numbers(chunk, "remaining_energy", rows, 1 / 3600.0))
-    series.charge_c.extend(chunk.number("discharged")[rows].tolist())
-    series.energy_j.extend(chunk.number("consumed_energy")[rows].tolist())
-    armed = chunk.batch.armed
-    if armed is not None:
-        series.knows_arming = True
-        series.armed.extend(np.asarray(armed, np.float64)[rows].tolist())
-    else:
-        series.armed.extend([math.nan] * len(rows))
-    cells = chunk.concepts["cell_voltages"]
-    matrix = np.asarray(cells.values[rows], np.float64)
-    if matrix.ndim == 2 and matrix.shape[1]:
-        widths = cells.lengths[rows] if cells.lengths is not None else np.zeros(len(rows), np.int64)
-        beyond = np.arange(matrix.shape[1])[None, :] >= np.where(cells.valid[rows], widths, 0)[:, None]
-        with np.errstate(invalid="ignore"):
-            matrix[beyond | ~(matrix > 0.0)] = np.nan  # a cell past the count, unknown (NaN) or not positive
-        series.cells.extend([v for v in row if v == v] for row in matrix.tolist())
-    else:
-        series.cells.extend([] for _ in range(len(rows)))
-    health = chunk.number("state_of_health")[rows]
-    if (health > 0).any():
-        series.state_of_health = float(health[health > 0][-1]) * 100.0
-    cycles = chunk.concepts["cycle_count"]
-    known_cycles = [int(v) for v, ok in zip(cycles.values[rows], cycles.valid[rows], strict=True) if ok and v > 0]
-    if known_cycles:
-        series.cycle_count = known_cycles[-1]
-    serial = chunk.concepts["serial_number"]
-    if not series.serial:
-        for v, ok in zip(serial.values[rows].tolist(), serial.valid[rows].tolist(), strict=True):
-            text = str(v) if ok and not isinstance(v, str) and v else v if ok and isinstance(v, str) else ""
-            if text.strip("\x00 0"):
-                series.serial = text
-                break
+    def extend(self, chunk: Chunk, rows: NDArray) -> None:
+        """A chunk's rows of this battery, in the units the page shows."""
+        s, parts = self.series, self.parts
+        parts["t"].append(np.asarray(chunk.batch.t, np.float64)[rows])
+        for name, (concept, scale, offset) in SERIES.items():
+            parts[name].append(chunk.number(concept)[rows] * scale + offset)
+        armed = chunk.batch.armed
+        if armed is not None:
+            s.knows_arming = True
+        parts["armed"].append(np.full(len(rows), np.nan) if armed is None else np.asarray(armed, np.float64)[rows])
+        cells = chunk.concepts["cell_voltages"]
+        matrix = np.asarray(cells.values[rows], np.float64).reshape(len(rows), -1)
+        if matrix.shape[1]:
+            widths = cells.lengths[rows] if cells.lengths is not None else np.zeros(len(rows), np.int64)
+            beyond = np.arange(matrix.shape[1])[None, :] >= np.where(cells.valid[rows], widths, 0)[:, None]
+            with np.errstate(invalid="ignore"):
+                matrix[beyond | ~(matrix > 0.0)] = np.nan  # past the count, unknown or not positive: no cell
+        parts["cells"].append(matrix)
+        health = chunk.number("state_of_health")[rows]
+        if (health > 0).any():
+            s.state_of_health = float(health[health > 0][-1]) * 100.0
+        cycles = chunk.concepts["cycle_count"]
+        reported = cycles.values[rows][cycles.valid[rows] & (cycles.values[rows] > 0)]
+        if len(reported):
+            s.cycle_count = int(reported[-1])
+        serial = chunk.concepts["serial_number"]
+        if not s.serial:
+            for v, ok in zip(serial.values[rows].tolist(), serial.valid[rows].tolist(), strict=True):
+                text = str(v) if ok and not isinstance(v, str) and v else v if ok and isinstance(v, str) else ""
+                if text.strip("\x00 0"):
+                    s.serial = text
+                    break
 
-
-def _order(series: BatterySeries) -> None:
-    """A battery's samples in time order (a ULog's batteries come instance by instance, chunks in order)."""
-    t = np.array(series.t, np.float64)
-    if not len(t) or bool((t[1:] >= t[:-1]).all()):
-        return  # in order already (one instance, its chunks read in order)
-    order = np.argsort(t, kind="stable").tolist()  # a record without a time (NaN) last
-    for name in (
-        "t",
-        "pack_voltage",
-        "current",
-        "state_of_charge",
-        "temperature",
-        "discharged",
-        "charge_c",
-        "energy_j",
-        "armed",
-    ):
-        values = getattr(series, name)
-        setattr(series, name, [values[k] for k in order])
-    series.remaining_energy = [series.remaining_energy[k] for k in order]
-    series.cells = [series.cells[k] for k in order]
+    def finish(self) -> BatterySeries:
+        """The series joined, in time order (a record without a time last)."""
+        s, parts = self.series, self.parts
+        for name in ("t", "armed", *SERIES):
+            setattr(s, name, np.concatenate(parts[name]) if parts[name] else _EMPTY)
+        width = max((m.shape[1] for m in parts["cells"]), default=0)
+        s.cells = np.full((len(s.t), width), np.nan)
+        at = 0
+        for m in parts["cells"]:
+            s.cells[at : at + len(m), : m.shape[1]] = m
+            at += len(m)
+        if len(s.t) and not bool((s.t[1:] >= s.t[:-1]).all()):  # a ULog's instances, or its chunks, out of order
+            order = np.argsort(s.t, kind="stable")
+            for name in ("t", "armed", *SERIES):
+                setattr(s, name, getattr(s, name)[order])
+            s.cells = s.cells[order]
+        return s
 
 
 def _record_input(path: Path, schema_dir: Path, name: str, message: str | None, kind: str | None) -> InputSeries:
     msg, checker = make_checker(schema_dir, message or default_message(path, kind), [str(path)], kind)
     conversion = Conversion(_package_of(checker), msg.qualified_name, "concepts", "strict")
-    batteries: dict[int, BatterySeries] = {}
+    batteries: dict[int, _Records] = {}
     out = InputSeries(name, msg.qualified_name, [], [], [], [], 0)
     t0: float | None = None
     found: list[tuple[float, int, Finding]] = []
@@ -313,13 +316,13 @@ def _record_input(path: Path, schema_dir: Path, name: str, message: str | None, 
             out.not_converted += 1
             continue
         number, word = _battery(item, state)
-        series = batteries.get(number)
-        if series is None:
-            series = batteries[number] = BatterySeries(name, number, word, msg.qualified_name, source)
-        _append(series, (t or 0.0) - (t0 or 0.0), state)
+        records = batteries.get(number)
+        if records is None:
+            records = batteries[number] = _Records(BatterySeries(name, number, word, msg.qualified_name, source))
+        records.append((t or 0.0) - (t0 or 0.0), state)
         for finding in checker.check(item):
             found.append(((t or 0.0) - (t0 or 0.0), number, finding))
-    out.batteries = [batteries[k] for k in sorted(batteries)]
+    out.batteries = [batteries[k].finish() for k in sorted(batteries)]
     out.findings = group_findings(found)
     return out
 
@@ -354,32 +357,40 @@ def _state(conversion: Conversion, record: Record) -> Mapping[str, Any] | None:
     return {name: getattr(state, name, None) for name in _CONCEPTS}
 
 
-def _append(series: BatterySeries, t: float, state: Mapping[str, Any]) -> None:
-    series.t.append(t)
-    series.pack_voltage.append(_number(state.get("pack_voltage")))
-    series.current.append(_number(state.get("current")))
-    soc = _number(state.get("state_of_charge"))
-    series.state_of_charge.append(None if soc is None else soc * 100.0)
-    kelvin = _number(state.get("temperature"))
-    series.temperature.append(None if kelvin is None else kelvin - KELVIN)
-    charge = _number(state.get("discharged"))
-    series.discharged.append(None if charge is None else charge / COULOMB_PER_MAH)
-    series.charge_c.append(math.nan if charge is None else charge)
-    consumed = _number(state.get("consumed_energy"))
-    series.energy_j.append(math.nan if consumed is None else consumed)
-    series.armed.append(math.nan)  # a data file carries no arming state
-    energy = _number(state.get("remaining_energy"))
-    series.remaining_energy.append(None if energy is None else energy / 3600.0)
-    cells = state.get("cell_voltages") or []
-    series.cells.append([v for v in (_number(c) for c in cells) if v is not None and v > 0.0])
-    health = _number(state.get("state_of_health"))
-    if health is not None and health > 0:
-        series.state_of_health = health * 100.0
-    cycles = state.get("cycle_count")
-    if isinstance(cycles, int) and not isinstance(cycles, bool) and cycles > 0:
-        series.cycle_count = cycles
-    serial = state.get("serial_number")
-    if isinstance(serial, int) and not isinstance(serial, bool) and serial > 0:
-        serial = str(serial)  # the concept is an integer (DroneCAN model_instance_id, PX4's uint16)
-    if isinstance(serial, str) and serial.strip("\x00 0") and not series.serial:
-        series.serial = serial
+class _Records:
+    """A battery's series gathered record by record (a data file: in file order), as arrays at the end."""
+
+    def __init__(self, series: BatterySeries) -> None:
+        self.series = series
+        self.rows: dict[str, list[float]] = {name: [] for name in ("t", "armed", *SERIES)}
+        self.cells: list[list[float]] = []
+
+    def append(self, t: float, state: Mapping[str, Any]) -> None:
+        s, rows = self.series, self.rows
+        rows["t"].append(t)
+        for name, (concept, scale, offset) in SERIES.items():
+            value = _number(state.get(concept))
+            rows[name].append(math.nan if value is None else value * scale + offset)
+        rows["armed"].append(math.nan)  # a data file carries no arming state
+        cells = state.get("cell_voltages") or []
+        self.cells.append([v if v is not None and v > 0.0 else math.nan for v in (_number(c) for c in cells)])
+        health = _number(state.get("state_of_health"))
+        if health is not None and health > 0:
+            s.state_of_health = health * 100.0
+        cycles = state.get("cycle_count")
+        if isinstance(cycles, int) and not isinstance(cycles, bool) and cycles > 0:
+            s.cycle_count = cycles
+        serial = state.get("serial_number")
+        if isinstance(serial, int) and not isinstance(serial, bool) and serial > 0:
+            serial = str(serial)  # the concept is an integer (DroneCAN model_instance_id, PX4's uint16)
+        if isinstance(serial, str) and serial.strip("\x00 0") and not s.serial:
+            s.serial = serial
+
+    def finish(self) -> BatterySeries:
+        s = self.series
+        for name, values in self.rows.items():
+            setattr(s, name, np.array(values, np.float64))
+        s.cells = np.full((len(self.cells), max((len(c) for c in self.cells), default=0)), np.nan)
+        for k, row in enumerate(self.cells):
+            s.cells[k, : len(row)] = row
+        return s
