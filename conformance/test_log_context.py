@@ -7,7 +7,9 @@ read) against the reference readers on every real log of ``../shared``:
 - ArduPilot DataFlash, against pymavlink's DFReader: every ``PARM`` value as the reader holds it after the whole
   log (``DFReader.params``: a value set again in flight takes its last);
 - MAVLink tlog, against pymavlink: the MAV_TYPE and MAV_AUTOPILOT of each system's last vehicle heartbeat
-  (pymavlink's ``probably_vehicle_heartbeat``).
+  (pymavlink's ``probably_vehicle_heartbeat``) and every PARAM_VALUE (the last of each name);
+- one flight's DataFlash log and tlog (``wlichon_baseline_20260406_010254``): the same parameters, but for one the
+  vehicle learns in flight.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import pytest
 from shared_data import SHARED, missing
 
 from codegen.apps.battery.context import LogContext
+from codegen.apps.battery.tlog_batches import parameter_name
 from codegen.apps.battery.view import read_view
 from codegen.inputs.kinds import detect
 
@@ -127,8 +130,13 @@ def test_tlog_vehicle_matches_pymavlink(path: Path, monkeypatch: pytest.MonkeyPa
     mavutil.set_dialect("ardupilotmega")
     conn = mavutil.mavmmaplog(str(path))  # what mavlink_connection opens for a .tlog
     last: dict[int, tuple[int, int]] = {}
-    while (msg := conn.recv_match(type="HEARTBEAT")) is not None:
-        if conn.probably_vehicle_heartbeat(msg):
+    params: dict[int, dict[str, float]] = {}
+    while (msg := conn.recv_match(type=["HEARTBEAT", "PARAM_VALUE"])) is not None:
+        if msg.get_type() == "PARAM_VALUE":
+            name = parameter_name(msg.param_id)  # pymavlink keeps a junk byte after a name (as U+FFFD)
+            if name:
+                params.setdefault(msg.get_srcSystem(), {})[name] = msg.param_value
+        elif conn.probably_vehicle_heartbeat(msg):
             last[msg.get_srcSystem()] = (msg.type, msg.autopilot)
     conn.close()
     contexts = _contexts(path)
@@ -137,9 +145,27 @@ def test_tlog_vehicle_matches_pymavlink(path: Path, monkeypatch: pytest.MonkeyPa
     for context in contexts:
         assert context.vehicle is not None and context.vehicle.startswith("mavlink:")
         sysid = int(context.vehicle.split(":")[1])
+        theirs = params.get(sysid, {})
+        assert set(context.parameters) == set(theirs)
+        if context.autopilot != "px4":  # ArduPilot sends the number itself (PX4's integers: their bytes)
+            for name, value in theirs.items():
+                assert _same_float32(context.parameters[name], float(value)), name
         if sysid not in last:
             assert context.vehicle_type is None and context.arming == ()
             continue
         mav_type, autopilot = last[sysid]
         assert context.vehicle_type == mav_type
         assert context.autopilot == {3: "ardupilot", 12: "px4"}.get(autopilot)
+
+
+def test_one_flights_dataflash_and_tlog_hold_the_same_parameters() -> None:
+    """The vehicle's PARM records and what the ground station downloaded (PARAM_VALUE) of the same flight agree, but
+    for MOT_THST_HOVER, which ArduCopter learns in flight (the two logs end at different moments of it)."""
+    pair = [p for p in DATAFLASH + TLOGS if p.stem == "wlichon_baseline_20260406_010254"]
+    if len(pair) != 2:
+        missing("wlichon_baseline_20260406_010254.BIN and .tlog")
+    (dataflash,), (tlog,) = _contexts(pair[0]), _contexts(pair[1])
+    assert dataflash.parameters.keys() == tlog.parameters.keys() and len(tlog.parameters) > 1000
+    differ = {k for k in tlog.parameters if tlog.parameters[k] != dataflash.parameters[k]}
+    assert differ == {"MOT_THST_HOVER"}
+    assert tlog.parameters["BATT_LOW_VOLT"] == 10.5 and tlog.parameters["BATT_CAPACITY"] == 3300.0

@@ -5,6 +5,7 @@
 REGISTRY: dict[int, tuple[int, str, int, str]] = {
     0: (50, "Heartbeat", 9, "HEARTBEAT"),
     1: (124, "SysStatus", 43, "SYS_STATUS"),
+    22: (220, "ParamValue", 25, "PARAM_VALUE"),
     147: (154, "BatteryStatus", 54, "BATTERY_STATUS"),
     369: (145, "BatteryStatusV2", 27, "BATTERY_STATUS_V2"),
     372: (26, "BatteryInfo", 140, "BATTERY_INFO"),

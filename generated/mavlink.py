@@ -31,10 +31,12 @@ __all__ = [
     "MavBatteryStatusFlags",
     "MavBatteryType",
     "MavModeFlag",
+    "MavParamType",
     "MavState",
     "MavSysStatusSensor",
     "MavSysStatusSensorExtended",
     "MavType",
+    "ParamValue",
     "SysStatus",
 ]
 
@@ -182,6 +184,24 @@ class MavModeFlag(_enum.IntFlag):
     HIL_ENABLED = 32
     MANUAL_INPUT_ENABLED = 64
     SAFETY_ARMED = 128
+
+
+class MavParamType(_enum.IntEnum):
+    """How a parameter's value is typed on the vehicle.
+
+    mavlink.MAV_PARAM_TYPE: values.
+    """
+
+    UINT8 = 1
+    INT8 = 2
+    UINT16 = 3
+    INT16 = 4
+    UINT32 = 5
+    INT32 = 6
+    UINT64 = 7
+    INT64 = 8
+    REAL32 = 9
+    REAL64 = 10
 
 
 class MavState(_enum.IntEnum):
@@ -878,6 +898,51 @@ _HEARTBEAT_SYSTEM_STATUS_SPEC = _v.Number(
     },
 )
 _HEARTBEAT_MAVLINK_VERSION_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+
+
+# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
+_PARAM_VALUE_PAYLOAD = _struct.Struct("<fHH16sB")
+_PARAM_VALUE_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("param_value", "param_value", "f", 0),
+    ("param_count", "param_count", "H", 0),
+    ("param_index", "param_index", "H", 0),
+    ("param_id", "param_id", "s", 16),
+    ("param_type", "param_type", "B", 0),
+)
+_PARAM_VALUE_DTYPE: list[tuple[_Any, ...]] = [
+    ("param_value", "<f4"),
+    ("param_count", "<u2"),
+    ("param_index", "<u2"),
+    ("param_id", "S16"),
+    ("param_type", "u1"),
+]
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_PARAM_VALUE_PARAM_ID_SPEC = _v.Text(capacity=16)
+_PARAM_VALUE_PARAM_VALUE_SPEC = _v.Number(
+    type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
+)
+_PARAM_VALUE_PARAM_TYPE_SPEC = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        1: "MAV_PARAM_TYPE_UINT8",
+        2: "MAV_PARAM_TYPE_INT8",
+        3: "MAV_PARAM_TYPE_UINT16",
+        4: "MAV_PARAM_TYPE_INT16",
+        5: "MAV_PARAM_TYPE_UINT32",
+        6: "MAV_PARAM_TYPE_INT32",
+        7: "MAV_PARAM_TYPE_UINT64",
+        8: "MAV_PARAM_TYPE_INT64",
+        9: "MAV_PARAM_TYPE_REAL32",
+        10: "MAV_PARAM_TYPE_REAL64",
+    },
+)
+_PARAM_VALUE_PARAM_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_PARAM_VALUE_PARAM_INDEX_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
@@ -2699,7 +2764,7 @@ class BatteryStatusV2:
 class Heartbeat:
     """Sent about once a second by every system and component: what it is, which autopilot it runs, its mode and state.
 
-    Schema: mavlink.HEARTBEAT (mavlink, vehicle.xml:407).
+    Schema: mavlink.HEARTBEAT (mavlink, vehicle.xml:441).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "mavlink.HEARTBEAT"
@@ -2974,10 +3039,215 @@ class Heartbeat:
 
 
 @_dataclasses.dataclass(slots=True)
+class ParamValue:
+    """One of the vehicle's parameters, as it sends them when asked for the list or after one is set.
+
+    Schema: mavlink.PARAM_VALUE (mavlink, vehicle.xml:470).
+    """
+
+    QUALIFIED_NAME: _ClassVar[str] = "mavlink.PARAM_VALUE"
+
+    param_id: str = _dataclasses.field(
+        default="",
+        metadata=_m.meta(
+            name="param_id",
+            type="char[16]",
+            doc="The parameter's name; NUL-terminated when shorter than 16 characters.",
+        ),
+    )
+    param_value: float = _dataclasses.field(
+        default=0.0,
+        metadata=_m.meta(
+            name="param_value",
+            type="float32",
+            doc="The value (ArduPilot: the number itself; a system that encodes bytewise: the integer's bytes).",
+        ),
+    )
+    param_type: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="param_type", type="uint8", enums=("mavlink.MAV_PARAM_TYPE",), doc="How the vehicle types the value."
+        ),
+    )
+    param_count: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="param_count", type="uint16", doc="How many parameters the vehicle has.")
+    )
+    param_index: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="param_index", type="uint16", doc="This parameter's index among them.")
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, _Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, _Any] = {}
+        out["param_id"] = self.param_id
+        out["param_value"] = self.param_value
+        out["param_type"] = self.param_type
+        out["param_count"] = self.param_count
+        out["param_index"] = self.param_index
+        return out
+
+    @classmethod
+    def from_dict(cls, data: _Mapping[str, _Any]) -> ParamValue:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(
+            data, frozenset({"param_id", "param_value", "param_type", "param_count", "param_index"}), (), "ParamValue"
+        )
+        obj = cls()
+        if "param_id" in data:
+            obj.param_id = _m.as_str(data["param_id"], "param_id")
+        if "param_value" in data:
+            obj.param_value = _m.as_float(data["param_value"], "param_value")
+        if "param_type" in data:
+            obj.param_type = _m.as_int(data["param_type"], "param_type")
+        if "param_count" in data:
+            obj.param_count = _m.as_int(data["param_count"], "param_count")
+        if "param_index" in data:
+            obj.param_index = _m.as_int(data["param_index"], "param_index")
+        return obj
+
+    MSG_ID: _ClassVar[int] = 22
+    CRC_EXTRA: _ClassVar[int] = 220
+    MAVLINK_BASE_LENGTH: _ClassVar[int] = 25
+    MAVLINK_MAX_LENGTH: _ClassVar[int] = 25
+
+    def encode(self, *, truncate: bool = True) -> bytes:
+        """The MAVLink 2 payload, 25 bytes in wire order; trailing zero bytes
+        are dropped (at least one byte is kept) unless ``truncate`` is False.
+        A value that does not fit its field raises EncodeError naming it."""
+        try:
+            t_param_id = self.param_id.encode("utf-8", "surrogateescape")
+            data = _PARAM_VALUE_PAYLOAD.pack(
+                self.param_value, self.param_count, self.param_index, t_param_id, self.param_type
+            )
+        except (_struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+            raise _mav.explain("PARAM_VALUE", self, _PARAM_VALUE_FIELDS) from exc
+        if len(t_param_id) > 16:
+            raise _mav.explain("PARAM_VALUE", self, _PARAM_VALUE_FIELDS)
+        if truncate:
+            return data.rstrip(b"\x00") or b"\x00"
+        return data
+
+    @classmethod
+    def decode(cls, data: _mav.BytesLike) -> ParamValue:
+        """A MAVLink 2 payload; a short one is zero-filled, one over 25 bytes is a DecodeError."""
+        if len(data) != 25:
+            data = _mav.fill(data, 25, "PARAM_VALUE")
+        v0, v1, v2, v3, v4 = _PARAM_VALUE_PAYLOAD.unpack(data)
+        obj = object.__new__(cls)
+        obj.param_value = v0
+        obj.param_count = v1
+        obj.param_index = v2
+        obj.param_id = _mav.text(v3)
+        obj.param_type = v4
+        return obj
+
+    def encode_frame(
+        self,
+        *,
+        seq: int = 0,
+        sysid: int = 1,
+        compid: int = 1,
+        mavlink1: bool = False,
+        incompat_flags: int = 0,
+        compat_flags: int = 0,
+        signature: bytes | None = None,
+    ) -> bytes:
+        """A whole frame: MAVLink 2 (0xFD, truncated payload, CRC with CRC_EXTRA; a 13-byte
+        ``signature`` is appended and flagged, not computed) or, with ``mavlink1``, MAVLink 1
+        (0xFE, the base payload without extensions; message ids below 256 only)."""
+        if mavlink1:
+            return _mav.frame_v1(
+                self.encode(truncate=False)[:25],
+                22,
+                b"\xdc",
+                seq,
+                sysid,
+                compid,
+                incompat_flags != 0 or compat_flags != 0 or signature is not None,
+            )
+        return _mav.frame_v2(self.encode(), 22, b"\xdc", seq, sysid, compid, incompat_flags, compat_flags, signature)
+
+    @classmethod
+    def decode_frame(cls, data: _mav.BytesLike) -> ParamValue:
+        """One whole MAVLink 1 or 2 frame of this message (CRC checked; a signature is skipped);
+        _mavlink.parse_frame gives the header fields."""
+        payload = _mav.frame_payload(data, 22, b"\xdc", 25, "PARAM_VALUE")
+        return cls.decode(payload)
+
+    @classmethod
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, _Any]:
+        """Records of 25 bytes (zero-filled payloads) -> columns keyed by field name: numpy
+        arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
+        tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
+        arrays = _mav.numpy_columns(data, 25, _PARAM_VALUE_DTYPE, use_numpy, "PARAM_VALUE")
+        if arrays is not None:
+            return arrays
+        c = _mav.struct_columns(data, _PARAM_VALUE_PAYLOAD, "PARAM_VALUE")
+        return {
+            "param_value": c[0],
+            "param_count": c[1],
+            "param_index": c[2],
+            "param_id": [_mav.text(b) for b in c[3]],
+            "param_type": c[4],
+        }
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: _Any
+        try:
+            x = self.param_id
+            if x.__class__ is not str or len(x.encode()) > 16:
+                _v.diag(out, "param_id", self.param_id, _PARAM_VALUE_PARAM_ID_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "param_id", self.param_id, _PARAM_VALUE_PARAM_ID_SPEC)
+        try:
+            if not (-3.4028234663852886e38 <= self.param_value <= 3.4028234663852886e38):
+                _v.diag(out, "param_value", self.param_value, _PARAM_VALUE_PARAM_VALUE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "param_value", self.param_value, _PARAM_VALUE_PARAM_VALUE_SPEC)
+        try:
+            if self.param_type not in {1, 2, 3, 4, 5, 6, 7, 8, 9, 10}:
+                _v.diag(out, "param_type", self.param_type, _PARAM_VALUE_PARAM_TYPE_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "param_type", self.param_type, _PARAM_VALUE_PARAM_TYPE_SPEC)
+        try:
+            if self.param_count & -65536:
+                _v.diag(out, "param_count", self.param_count, _PARAM_VALUE_PARAM_COUNT_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "param_count", self.param_count, _PARAM_VALUE_PARAM_COUNT_SPEC)
+        try:
+            if self.param_index & -65536:
+                _v.diag(out, "param_index", self.param_index, _PARAM_VALUE_PARAM_INDEX_SPEC)
+        except _v.SLOW:
+            _v.diag(out, "param_index", self.param_index, _PARAM_VALUE_PARAM_INDEX_SPEC)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "mavlink.PARAM_VALUE")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field in {"param_id", "param_value", "param_type", "param_count", "param_index"}:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "mavlink.PARAM_VALUE")
+
+
+@_dataclasses.dataclass(slots=True)
 class SysStatus:
     """General state of a system: its sensors, processor load, link errors and one battery reading.
 
-    Schema: mavlink.SYS_STATUS (mavlink, vehicle.xml:416).
+    Schema: mavlink.SYS_STATUS (mavlink, vehicle.xml:450).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "mavlink.SYS_STATUS"

@@ -3,8 +3,9 @@
 STREAM is a flight log or capture, or a JSON Lines file of samples, told apart by content (then extension).
 A log (PX4 ULog, MAVLink tlog, ArduPilot DataFlash binary or text, CAN capture) is read through the battery
 view ``export`` and ``report`` read too (``codegen.apps.battery``): the same records, clock (seconds since the
-log's start), battery numbers and arming state; a DataFlash log's own PARM records are the parameters when
-``--params`` is not given. A JSON Lines stream holds one sample a line::
+log's start), battery numbers and arming state; an ArduPilot log's own parameters (a DataFlash log's PARM records,
+a tlog's PARAM_VALUE frames) are the parameters when ``--params`` is not given. A JSON Lines stream holds one
+sample a line::
 
     {"t": 0.0, "armed": true, "message": "uorb.BatteryStatus", "data": {"voltage_v": 11.9, "current_a": 2.1}}
     {"t": 1.0, "armed": true, "instance": 2, "battery": {"voltage_v": 10.4, "current_a": 2.0}}
@@ -58,7 +59,7 @@ def register(subparsers: Any) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("stream", help=".ulg, .tlog, .bin or a JSON Lines file of battery samples")
-    p.add_argument("--params", help="parameter file with the BATT*_ parameters (a .bin's own PARM records otherwise)")
+    p.add_argument("--params", help="parameter file with the BATT*_ parameters (else an ArduPilot log's own)")
     p.add_argument("--vehicle", choices=sorted(VEHICLES), help="ArduPilot vehicle (default: detected, else rover)")
     p.add_argument("--variant", action="append", choices=sorted(VARIANTS), default=[], help="a seed variant (opt-in)")
     p.add_argument(
@@ -89,7 +90,8 @@ def run(args: argparse.Namespace) -> int:
             for repeat in parameter_files.repeats(parameter_files.load(Path(args.params))):
                 print(f"battgen: warning: {args.params}:{repeat.lines[-1]}: {repeat.message()}", file=sys.stderr)
         elif own is not None:
-            values, where = own, f"{args.stream} (PARM records)"
+            source = table.context.parameters_from if table is not None and table.context is not None else ""
+            values, where = own, f"{args.stream} ({source})"
         else:
             raise BattgenError(f"expected --params FILE: {_why_no_parameters(table)}")
         if args.params and not batt_parameter_count(values) and not args.allow_empty:
@@ -151,7 +153,7 @@ def _why_no_parameters(table: SampleTable | None) -> str:
             f"this is a PX4 log ({len(context.parameters)} PX4 parameters, such as BAT_LOW_THR); ArduPilot's "
             "failsafe needs BATT_* values"
         )
-    return "only a DataFlash log carries its own ArduPilot parameters"
+    return "the input carries no ArduPilot parameters of its own (a DataFlash log's PARM, a tlog's PARAM_VALUE)"
 
 
 def _num(value: float, unit: str) -> str:

@@ -125,7 +125,8 @@ def test_own_parameters_and_logs_without_any(tmp_path: Path, capsys: pytest.Capt
     ]
     notes = {json.loads(p.read_text())["source"]: json.loads(p.read_text())["notes"] for p in out.glob("logs/*.json")}
     assert notes["flight.tlog"] == [
-        "failsafe not replayed: only a DataFlash log carries its own parameters (give --failsafe PARAMS)"
+        "failsafe not replayed: the log carries no ArduPilot parameters of its own (a DataFlash log's PARM, a "
+        "tlog's PARAM_VALUE; give --failsafe PARAMS)"
     ]
     assert notes["b.jsonl"] == ["failsafe not replayed: a JSON Lines file is no flight log battgen failsafe reads"]
 

@@ -61,12 +61,18 @@ def write_bin(path: Path) -> Path:
     return battery_log(path, PARAMS, flight(), [(ARM_AT, True), (DISARM_AT, False)])
 
 
-def write_tlog(path: Path) -> Path:
+def write_tlog(path: Path, *, parameters: bool = False) -> Path:
+    """The flight as a tlog; with ``parameters``, a ground station's parameter download first (PARAM_VALUE frames,
+    ArduPilot's encoding: the number itself)."""
     from pymavlink.dialects.v20 import common
 
     mav = common.MAVLink(None, srcSystem=1, srcComponent=1)
     epoch = 1_700_000_000_000_000
     out = bytearray()
+    if parameters:
+        for k, (name, value) in enumerate(PARAMS.items()):
+            msg = mav.param_value_encode(name.encode(), float(value), common.MAV_PARAM_TYPE_REAL32, len(PARAMS), k)
+            out += struct.pack(">Q", epoch) + msg.pack(mav)
     last_second = -1
     for t, inst, volts, amps, used in flight():
         stamp = struct.pack(">Q", epoch + round(t * 1e6))
@@ -187,3 +193,15 @@ def test_jsonl_needs_params_and_empty_input_fails(tmp_path: Path, capsys: pytest
     broken = tmp_path / "broken.bin"
     broken.write_bytes(b"\xa3\x95\x80" + b"\x00" * 10)
     assert main(["failsafe", str(broken)]) == 2
+
+
+def test_a_tlog_replays_with_its_own_parameter_download(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # the PARAM_VALUE frames a ground station logged are the vehicle's parameters, as a .bin's PARM records are
+    params = tmp_path / "rover.param"
+    params.write_text("".join(f"{k},{v}\n" for k, v in PARAMS.items()), encoding="utf-8")
+    given, _ = events(capsys, "--params", str(params), str(write_tlog(tmp_path / "flight.tlog")))
+    own, err = events(capsys, str(write_tlog(tmp_path / "own.tlog", parameters=True)))
+    assert "(PARAM_VALUE frames)" in err and "detected from CRUISE_SPEED" in err
+    assert comparable(own) == comparable(given) and len(own) == 3
+    assert main(["failsafe", str(tmp_path / "flight.tlog")]) == 2  # no download logged: --params is needed
+    assert "carries no ArduPilot parameters of its own" in capsys.readouterr().err

@@ -15,7 +15,8 @@ parameters the firmware recorded. Per kind:
   the names the firmware logged (older names such as ``FS_BATT_VOLTAGE`` are the failsafe's to map).
 - **MAVLink tlog**: the clock the tlog's stamps (µs since the epoch, so UTC is known); the vehicle the system id
   of the vehicle heartbeats; vehicle type their ``type`` (MAV_TYPE) and the firmware family their ``autopilot``
-  (MAV_AUTOPILOT). A tlog records no parameter values in the frames battgen reads.
+  (MAV_AUTOPILOT); the parameters its PARAM_VALUE frames (a ground station's parameter download; a value sent
+  again: its last), ArduPilot's as numbers, PX4's integers decoded from the float's bytes.
 - **CAN captures, JSON Lines**: the clock only; no arming state, no firmware, no parameters.
 
 ``arming`` is the log's arming state as changes of state in ``t``, by the kind's one rule (``arming_rule``);
@@ -34,6 +35,7 @@ from .columns import NDArray
 MAV_AUTOPILOT_FIRMWARE = {3: "ardupilot", 12: "px4"}  # MAV_AUTOPILOT_ARDUPILOTMEGA, MAV_AUTOPILOT_PX4
 PX4_RELEASE_TYPES = ((255, ""), (192, "rc"), (128, "beta"), (64, "alpha"), (0, "dev"))  # the type byte's lower bound
 
+PARAMETER_SOURCES = {"ulog": "PARAM definitions", "dataflash": "PARM records", "tlog": "PARAM_VALUE frames"}
 ARMING_RULES = {
     "ulog": "vehicle_status.arming_state == ARMED (actuator_armed.armed where the log lacks vehicle_status)",
     "dataflash": "ARM.ArmState, else EV 10/11 (and 15 AUTO_ARMED); armed from the first record when LOG_DISARMED=0 "
@@ -78,6 +80,11 @@ class LogContext:
         if since is not None and end > since:
             out.append((since, end))
         return out
+
+    @property
+    def parameters_from(self) -> str:
+        """Where the log keeps its parameters, as a person names it ("PARM records")."""
+        return PARAMETER_SOURCES.get(self.kind, "parameters")
 
     def to_dict(self, end: float | None = None) -> dict[str, object]:
         """The context as JSON data; the parameters as a count (a log holds hundreds)."""

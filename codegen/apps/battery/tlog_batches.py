@@ -12,16 +12,20 @@
   receiver or onboard computer: pymavlink's ``probably_vehicle_heartbeat`` rule, which a GCS shows. A system with
   no vehicle heartbeat in the log has no arming state (``armed`` None).
 - **Vehicle**: ``mavlink:<system id>``, and ``vehicle_type`` the MAV_TYPE of its last vehicle heartbeat.
+- **Parameters**: the system's PARAM_VALUE frames (a ground station's parameter download; a value set again: its
+  last), in the context (:mod:`.context`).
 """
 
 from __future__ import annotations
 
+import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ...errors import BattgenError
+from ...inputs.dataflash import shortest_float32
 from ...inputs.model import MavlinkClass
 from ...inputs.tlog import FrameRecord, StreamStats, read_messages
 from .catalog import Catalog
@@ -29,6 +33,8 @@ from .context import ARMING_RULES, MAV_AUTOPILOT_FIRMWARE, LogContext, arming_ch
 from .sources import Batch, instances_to_columns, model_of
 
 BATTERY_STATUS, SYS_STATUS, HEARTBEAT = "mavlink.BATTERY_STATUS", "mavlink.SYS_STATUS", "mavlink.HEARTBEAT"
+PARAM_VALUE = "mavlink.PARAM_VALUE"
+PX4_BYTEWISE = {1: "<B", 2: "<b", 3: "<H", 4: "<h", 5: "<I", 6: "<i"}  # MAV_PARAM_TYPE -> the integer in its bytes
 SAFETY_ARMED = 128  # MAV_MODE_FLAG_SAFETY_ARMED
 NOT_VEHICLE_TYPES = frozenset({6, 18, 26, 27})  # MAV_TYPE_GCS, _ONBOARD_CONTROLLER, _GIMBAL, _ADSB
 AUTOPILOT_INVALID = 8  # MAV_AUTOPILOT_INVALID
@@ -44,6 +50,7 @@ class _System:
     beats: list[tuple[int, bool, int]] = field(default_factory=list)
     beat_stamps: list[int | None] = field(default_factory=list)  # each heartbeat's tlog stamp
     autopilot: int | None = None  # MAV_AUTOPILOT of the last vehicle heartbeat
+    parameters: dict[str, tuple[float, int]] = field(default_factory=dict)  # PARAM_VALUE: (value, MAV_PARAM_TYPE)
 
 
 def is_vehicle_heartbeat(compid: int, mav_type: int, autopilot: int) -> bool:
@@ -60,8 +67,10 @@ def _mavlink(catalog: Catalog, qualified: str) -> MavlinkClass:
 
 def tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
     """Every battery of a tlog as a batch (see the module's docs)."""
-    models = {m.MSG_ID: m for m in (_mavlink(catalog, q) for q in (BATTERY_STATUS, SYS_STATUS, HEARTBEAT))}
+    wanted = (BATTERY_STATUS, SYS_STATUS, HEARTBEAT, PARAM_VALUE)
+    models = {m.MSG_ID: m for m in (_mavlink(catalog, q) for q in wanted)}
     battery_id, status_id = _mavlink(catalog, BATTERY_STATUS).MSG_ID, _mavlink(catalog, SYS_STATUS).MSG_ID
+    param_id = _mavlink(catalog, PARAM_VALUE).MSG_ID
     stats = StreamStats()
     systems: dict[int, _System] = {}
     for rec in read_messages(path, name, models, stats):
@@ -71,6 +80,11 @@ def tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
             system.batteries.setdefault(int(getattr(rec.instance, "id")), []).append(rec)  # noqa: B009
         elif msgid == status_id:
             system.sys_status.append(rec)
+        elif msgid == param_id:
+            p = rec.instance
+            name = parameter_name(str(getattr(p, "param_id")))  # noqa: B009
+            if name:  # a set value is sent again: the last one stands, as the vehicle ended up with it
+                system.parameters[name] = (float(getattr(p, "param_value")), int(getattr(p, "param_type")))  # noqa: B009
         else:
             hb = rec.instance
             mav_type, autopilot = int(getattr(hb, "type")), int(getattr(hb, "autopilot"))  # noqa: B009
@@ -126,7 +140,7 @@ def _batch(
 def _context(system: _System, sysid: int, origin: int) -> LogContext:
     """One system's context (:mod:`.context`): its id, MAV_TYPE, firmware family and arming changes."""
     if not system.beats:
-        return LogContext("tlog", origin, 0, f"mavlink:{sysid}")
+        return LogContext("tlog", origin, 0, f"mavlink:{sysid}", parameters=_parameters(system, None))
     known = [(s, b[1]) for s, b in zip(system.beat_stamps, system.beats, strict=True) if s is not None and s < 1 << 63]
     t = np.array([(s - origin) / 1e6 for s, _ in known], np.float64)
     armed = np.array([a for _, a in known], np.float64)
@@ -138,6 +152,30 @@ def _context(system: _System, sysid: int, origin: int) -> LogContext:
         f"mavlink:{sysid}",
         system.beats[-1][2],
         autopilot,
+        parameters=_parameters(system, autopilot),
         arming=arming_changes(t, armed),
         arming_rule=ARMING_RULES["tlog"],
     )
+
+
+def parameter_name(param_id: str) -> str:
+    """A PARAM_VALUE's name up to its first character that is not printable ASCII: the firmware's names are ASCII
+    (at most 16, NUL-terminated when shorter), and older firmware left a byte of an earlier name after a short one."""
+    for k, c in enumerate(param_id):
+        if not (" " < c <= "~"):
+            return param_id[:k]
+    return param_id
+
+
+def _parameters(system: _System, autopilot: str | None) -> dict[str, float]:
+    """A system's PARAM_VALUE values: ArduPilot sends the number itself (a float32, taken as its shortest
+    decimal); PX4 encodes an integer parameter bytewise, its bytes in the float's."""
+    out: dict[str, float] = {}
+    for name, (value, kind) in system.parameters.items():
+        fmt = PX4_BYTEWISE.get(kind) if autopilot == "px4" else None
+        if fmt is not None:
+            raw = struct.pack("<f", value)
+            out[name] = float(struct.unpack_from(fmt, raw)[0])
+        else:
+            out[name] = shortest_float32(value) if value == value and value != round(value) else value
+    return out

@@ -35,7 +35,7 @@ from ..failsafe.vehicles import VEHICLES
 FAILSAFE = "failsafe"
 EVENTS_FILE = "events.parquet"
 REPLAYS_FILE = "replays.parquet"
-OWN_PARAMETERS = "log"  # --failsafe log: each DataFlash log's own PARM records
+OWN_PARAMETERS = "log"  # --failsafe log: each ArduPilot log's own parameters (DataFlash PARM, tlog PARAM_VALUE)
 
 
 @dataclass(frozen=True)
@@ -128,7 +128,10 @@ def replay_tables(
     if values is None:
         values = own_parameters(table)
         if values is None:
-            return "failsafe not replayed: only a DataFlash log carries its own parameters (give --failsafe PARAMS)"
+            return (
+                "failsafe not replayed: the log carries no ArduPilot parameters of its own (a DataFlash log's PARM, a "
+                "tlog's PARAM_VALUE; give --failsafe PARAMS)"
+            )
     replay = replay_flight(table, name, values, options.vehicle)
 
     def battery(instance: int) -> int:

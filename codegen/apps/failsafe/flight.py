@@ -1,7 +1,8 @@
 """One flight log replayed through the battery failsafe as ``battgen failsafe`` does it, for callers
 that want the events as data (the fleet export's events table) rather than printed.
 
-The parameters are given (a parameter file's values) or, for a DataFlash log, its own PARM records;
+The parameters are given (a parameter file's values) or, for an ArduPilot log, its own (DataFlash PARM records, tlog
+PARAM_VALUE frames);
 the vehicle is given or detected from them; the situation is the CLI's default (home set, a
 position fix, a SmartRTL path, no QuadPlane, no landing sequence), so the events are the ones
 ``battgen failsafe --json`` prints for the same log and parameters.

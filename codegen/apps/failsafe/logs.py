@@ -140,11 +140,12 @@ def log_samples(path: Path, name: str | None = None) -> SampleTable:
 
 def own_parameters(table: SampleTable) -> dict[str, float] | None:
     """The ArduPilot parameters a log recorded itself, from the context its read stated (a DataFlash log's PARM
-    records: a value set again in flight takes its last), older names mapped to today's; None for a log of another
-    firmware or a kind that records none (a PX4 log's parameters are PX4's: no BATT_* for ArduPilot's failsafe)."""
+    records, a tlog's PARAM_VALUE frames: a value set again takes its last), older names mapped to today's; None for
+    a log of another firmware or one that records none (a PX4 log's parameters are PX4's: no BATT_* for ArduPilot's
+    failsafe)."""
     context = table.context
     if context is None or context.autopilot != "ardupilot":
         return None
     if not context.parameters and context.kind != "dataflash":
-        return None  # a tlog: its frames carry no parameter values
+        return None  # a tlog without PARAM_VALUE frames
     return with_current_names(dict(context.parameters))

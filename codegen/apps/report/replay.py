@@ -1,6 +1,7 @@
 """The failsafe replay shown in a report: the same evaluator as ``battgen failsafe``, on the same samples.
 
-Parameters come from ``--params`` (a .param/.params file), else from a DataFlash log's own PARM records; the
+Parameters come from ``--params`` (a .param/.params file), else from an ArduPilot log's own (a DataFlash log's PARM
+records, a tlog's PARAM_VALUE frames); the
 vehicle from ``--vehicle``, else detected from the parameters (:func:`~..failsafe.vehicles.detect_vehicle`).
 A flight log or capture is replayed from the samples of the battery view the report's series come from (the same
 samples ``battgen failsafe`` replays, so the markers are exactly its events, on the same clock: seconds since the
@@ -50,7 +51,8 @@ def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | No
     if params is not None:
         values, where = read_parameter_values(params), str(params)
     elif own is not None:
-        values, where = own, "the log's PARM records"
+        context = item.samples.context if item.samples is not None else None
+        values, where = own, f"the log's {context.parameters_from if context is not None else 'parameters'}"
     else:
         return Replay(note=NO_PARAMS)
     try:
