@@ -182,6 +182,7 @@ VALID_BASE: dict[str, dict[str, Any]] = {
     "uorb.BatteryStatus": {"max_error": 1},
     "uorb.BatteryStatusV0": {"max_error": 1},
     "devicetree.power.supply.battery": {"compatible": ["simple-battery"]},
+    "mavlink.PARAM_VALUE": {"param_type": 9},  # MAV_PARAM_TYPE has no 0
 }
 
 
