@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import BattgenError
+from ..text.escape import line
 
 EXIT_OK, EXIT_FAILED, EXIT_UNREADABLE = 0, 1, 2
 _SUFFIXES = (".ulg", ".tlog", ".bin", ".jsonl", ".ndjson", ".asc", ".blf", ".trc")
@@ -138,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         replay = None if args.failsafe is None else failsafe_options(args.failsafe, args.vehicle)
     except BattgenError as exc:
-        print(f"battgen: --failsafe: {exc}", file=sys.stderr)
+        print(line(f"battgen: --failsafe: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     options = engine.ExportOptions(
         Path(args.out), raw=args.raw, message=args.message, failsafe=replay, partition=args.partition
@@ -159,19 +160,21 @@ def run(args: argparse.Namespace) -> int:
         )
         return EXIT_UNREADABLE
     except BattgenError as exc:
-        print(f"battgen: {exc}", file=sys.stderr)
+        print(line(f"battgen: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     finally:
         close()
     failed = [r for r in results if r.status == "failed"]
     for r in failed:
-        print(f"battgen: skipped {r.error}", file=sys.stderr)
+        print(line(f"battgen: skipped {r.error}"), file=sys.stderr)
     if not args.quiet:
         rows = sum(r.rows for r in results)
         done, skipped = engine.count(results, "exported"), engine.count(results, "skipped")
         print(
-            f"{len(results)} logs: {done} exported ({rows} rows), {skipped} already in the dataset, "
-            f"{len(failed)} unreadable -> {args.out}",
+            line(
+                f"{len(results)} logs: {done} exported ({rows} rows), {skipped} already in the dataset, "
+                f"{len(failed)} unreadable -> {args.out}"
+            ),
             file=sys.stderr,
         )
     return EXIT_FAILED if failed else EXIT_OK
