@@ -116,6 +116,10 @@ def _progress(total: int, quiet: bool) -> tuple[Callable[[Any], None] | None, Ca
     return step, bar.close
 
 
+def _tell(text: str) -> None:
+    print(line(f"battgen: {text}"), file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         from ..apps.export import engine
@@ -151,8 +155,8 @@ def run(args: argparse.Namespace) -> int:
 
             results = distributed.export_dask(logs, options, scheduler=args.scheduler, workers=args.jobs, progress=step)
         else:
-            results = engine.export_logs(logs, options, jobs=args.jobs, progress=step)
-        engine.finish(options.out)
+            results = engine.export_logs(logs, options, jobs=args.jobs, progress=step, on_wait=_tell)
+        engine.finish(options.out, on_wait=_tell)
     except ImportError as exc:
         print(
             f"battgen: the Dask engine needs dask.distributed ({exc.name} is missing): pip install 'battgen[fleet]'",
@@ -161,6 +165,9 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_UNREADABLE
     except BattgenError as exc:
         print(line(f"battgen: {exc}"), file=sys.stderr)
+        return EXIT_UNREADABLE
+    except OSError as exc:  # the dataset folder, not a log: a log's own errors are in its result
+        print(line(f"battgen: {exc.filename or args.out}: cannot write: {exc.strerror or exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     finally:
         close()
