@@ -13,6 +13,7 @@ from pathlib import Path
 from .. import __version__
 from ..apps.package import bundled_schemas, project_root
 from ..backends.c import generate_c
+from ..backends.python.name_clashes import refuse_clashes
 from ..backends.python.writer import generate
 from ..errors import BattgenError, ErrorList
 from ..frontends.loader import load
@@ -72,6 +73,7 @@ def _generate_c(schema: Schema, out: Path, check: bool) -> int:
 def cmd_generate(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     schema = _load([args.schema_dir] if args.schema_dir else [], args)
+    refuse_clashes(schema)  # before either language writes a file
     if args.lang == "c":
         return _generate_c(schema, Path(args.out) if args.out else project_root() / "generated" / "c", args.check)
     if args.lang is None and not args.out:
