@@ -212,3 +212,23 @@ def test_query_csv_guards_formulas_unless_raw(capsys: pytest.CaptureFixture[str]
     code, out, _ = run(capsys, "query", str(hostile_dataset), sql, "--format", "csv", "--csv-raw")
     rows = list(csv.reader(io.StringIO(out)))
     assert code == 0 and rows[1][0] == "@SUM(A1).jsonl" and rows[2][1] == "=1+2\x1b[2J\x1b]0;pwn\x07"
+
+
+# -- files battgen writes that quote an input ------------------------------------------------------------------
+
+
+def test_a_proposed_parameter_file_cannot_gain_a_line_from_the_board_name(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from test_failsafe_cli import DTS
+
+    dts = tmp_path / "b\nBATT_LOW_VOLT,0\n.dts"  # the header quotes the source: a parameter line of its own
+    dts.write_text(DTS, encoding="utf-8")
+    out = tmp_path / "proposed.param"
+    assert main(["params", "--from-devicetree", str(dts), "--out", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert "BATT_LOW_VOLT,0\n" not in text and "b\\x0aBATT_LOW_VOLT,0\\x0a.dts" in text
+    assert [ln for ln in text.splitlines() if ln.startswith("BATT_LOW_VOLT,")] == [
+        next(ln for ln in text.splitlines() if ln.startswith("BATT_LOW_VOLT,11.25"))
+    ]
+    capsys.readouterr()
