@@ -130,6 +130,9 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_UNREADABLE
+    if Path(args.out).exists() and not Path(args.out).is_dir():
+        print(line(f"battgen: -o {args.out}: is a file; expected a folder for the dataset"), file=sys.stderr)
+        return EXIT_UNREADABLE
     logs = _inputs(args.logs)
     if not logs:
         print("battgen: no logs to export (expected .ulg, .tlog, .bin, .jsonl or CAN capture files)", file=sys.stderr)

@@ -249,3 +249,12 @@ def _sample(steps: int) -> list[int]:
 
 def _copy(src: Path, dst: Path) -> None:
     shutil.copytree(src, dst)
+
+
+def test_an_output_that_is_a_file_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    target = tmp_path / "ds"
+    target.write_text("mine\n", encoding="utf-8")
+    assert main(["export", "-q", "-o", str(target), str(jsonl(tmp_path / "a.jsonl"))]) == 2
+    err = capsys.readouterr().err
+    assert err == f"battgen: -o {target}: is a file; expected a folder for the dataset\n"
+    assert target.read_text(encoding="utf-8") == "mine\n"
