@@ -18,6 +18,12 @@ that replay is exported again.
 ``--engine dask`` runs the same per-log export as tasks on a Dask cluster (``--scheduler
 ADDRESS``, else a local one with ``--jobs`` workers); the output folder must be reachable by
 every worker under the same path.
+
+A log becomes visible in one step, the rename of its marker (``DIR/logs/<id>.json``) naming its files;
+a re-export writes a new version beside the old and removes the old after that rename. A run stopped
+at any moment leaves each log old or new, and the next run removes what it left. One export writes a
+dataset at a time: a second waits, saying which process holds it. An unreadable ``DIR/dataset.json``
+is refused (exit 2), never replaced by defaults.
 """
 
 from __future__ import annotations
