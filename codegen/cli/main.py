@@ -47,7 +47,7 @@ def _include_path_option(p: argparse.ArgumentParser) -> None:
 def cmd_list(args: argparse.Namespace) -> int:
     schema = _load(args.paths, args)
     for msg in schema.messages:
-        print(msg.qualified_name)
+        print(line(msg.qualified_name))
     return EXIT_OK
 
 
@@ -115,8 +115,10 @@ def cmd_generate(args: argparse.Namespace) -> int:
     for rel in result.removed:
         print(line(f"removed {out / rel}"))
     print(
-        f"generated {len(schema.messages)} messages into {out}: {len(result.written)} written, "
-        f"{len(result.unchanged)} unchanged, {len(result.removed)} removed in {elapsed * 1000:.0f} ms"
+        line(
+            f"generated {len(schema.messages)} messages into {out}: {len(result.written)} written, "
+            f"{len(result.unchanged)} unchanged, {len(result.removed)} removed in {elapsed * 1000:.0f} ms"
+        )
     )
     return EXIT_OK
 

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import BattgenError
-from ..text.escape import csv_cell, shown
+from ..text.escape import csv_cell, line, shown
 
 EXIT_OK, EXIT_UNREADABLE = 0, 2
 MAX_CELL = 40  # characters of one value in the table format
@@ -107,11 +107,11 @@ def run(args: argparse.Namespace) -> int:
             if not args.out:
                 raise BattgenError("--format parquet needs -o FILE")
             rows = fleet_query.query_to_parquet(dataset, args.sql, Path(args.out))
-            print(f"{rows} rows -> {args.out}", file=sys.stderr)
+            print(line(f"{rows} rows -> {args.out}"), file=sys.stderr)
             return EXIT_OK
         result = fleet_query.run_query(dataset, args.sql)
     except BattgenError as exc:
-        print(f"battgen: {exc}", file=sys.stderr)
+        print(line(f"battgen: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     if args.format == "csv":
         buf = io.StringIO()
@@ -129,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             Path(args.out).write_text(text, encoding="utf-8")
         except OSError as exc:
-            print(f"battgen: {args.out}: cannot write: {exc.strerror or exc}", file=sys.stderr)
+            print(line(f"battgen: {args.out}: cannot write: {exc.strerror or exc}"), file=sys.stderr)
             return EXIT_UNREADABLE
     else:
         sys.stdout.write(text)
