@@ -258,3 +258,34 @@ def test_an_output_that_is_a_file_is_one_line(tmp_path: Path, capsys: pytest.Cap
     err = capsys.readouterr().err
     assert err == f"battgen: -o {target}: is a file; expected a folder for the dataset\n"
     assert target.read_text(encoding="utf-8") == "mine\n"
+
+
+def _as_before_versions(out: Path) -> None:
+    """The dataset as battgen wrote it before versions: fixed file names, markers naming no files."""
+    for path in (out / "logs").glob("*.json"):
+        manifest = json.loads(path.read_text())
+        for rel in (f for files in manifest.pop("files").values() for f in files):
+            stem = Path(rel).name.split("-", 1)[0]
+            (out / rel).rename((out / rel).with_name("part-0.parquet" if stem == "part" else f"{stem}.parquet"))
+        del manifest["version"]
+        path.write_text(json.dumps(manifest), encoding="utf-8")
+
+
+def test_a_dataset_from_before_versions_reads_and_reexports(tmp_path: Path, flights: tuple[list[Path], Path]) -> None:
+    logs, params = flights
+    out = tmp_path / "ds"
+    assert main(["export", "-q", "--raw", "-o", str(out), *map(str, logs), "--failsafe", str(params)]) == 0
+    want = state(out)
+    _as_before_versions(out)
+    legacy = {f for f in all_files(out) if f.endswith(".parquet")}
+    assert any(f.endswith("/part-0.parquet") for f in legacy) and any(f.endswith("/events.parquet") for f in legacy)
+    assert state(out) == want and leftovers(out) == set()  # read as they are, nothing taken for a leftover
+    (params.parent / "other.param").write_text(params.read_text().replace("10.5", "10.8"), encoding="utf-8")
+    assert (
+        main(
+            ["export", "-q", "--raw", "-o", str(out), *map(str, logs), "--failsafe", str(params.parent / "other.param")]
+        )
+        == 0
+    )
+    assert {s: v[0] for s, v in state(out).items()} == {s: v[0] for s, v in want.items()}
+    assert not legacy & all_files(out) and leftovers(out) == set()  # the old names went with the swap
