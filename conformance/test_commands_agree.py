@@ -143,7 +143,8 @@ def flights(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict[int, dic
     code = main(["export", "-q", "-o", str(out), *map(str, LOGS)])
     assert code in (0, 1)  # 1: some captures hold no battery records
     con = duckdb.connect()
-    con.execute((out / "views.sql").read_text().replace("read_parquet('", f"read_parquet('{out}/"))
+    con.execute(f"SET file_search_path = '{out}'")  # views.sql names the dataset's files relative to it
+    con.execute((out / "views.sql").read_text())
     names = [c for c in FIGURES if c != "max_current"] + ["peak_current", "duration_armed"]
     rows = con.execute(f"SELECT source, battery, {', '.join(names)} FROM flights").fetchall()
     view: dict[str, dict[int, dict[str, Any]]] = {}

@@ -8,7 +8,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import BattgenError
-from .export.dataset import BATTERY
+from .export.dataset import BATTERY, layout
+from .export.manifest import committed
 from .export.views import views_sql
 
 
@@ -24,7 +25,8 @@ def connect(dataset: Path) -> Any:
         import duckdb
     except ImportError:
         raise BattgenError("battgen query needs DuckDB: pip install 'battgen[fleet]'") from None
-    if not any((dataset / BATTERY).rglob("*.parquet")):
+    layout(dataset)  # an unreadable dataset.json is said so, before anything else
+    if not committed(dataset)[BATTERY]:
         raise BattgenError(f"{dataset}: no exported logs (expected {BATTERY}/log=*/*.parquet; run battgen export)")
     con = duckdb.connect()
     con.execute(views_sql(dataset))

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from urllib.parse import quote
 
+from ..text.escape import github_data, github_property
 from .gate import Settings, field_of, finding_code
 from .validate import Finding
 
@@ -65,29 +66,21 @@ class Grouper:
         return [g for g in self._groups.values() if bool(g.first.waived) == waived]
 
 
-def _escape_data(text: str) -> str:
-    return text.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
-
-
-def _escape_property(text: str) -> str:
-    return _escape_data(text).replace(":", "%3A").replace(",", "%2C")
-
-
 def github_line(group: Group) -> str:
     """A GitHub Actions workflow command annotating the group's file (and line, when it has one)."""
     f = group.first
     command = "warning" if f.severity == "warning" else "error"
-    props = [f"file={_escape_property(f.file)}"]
+    props = [f"file={github_property(f.file)}"]
     if f.line > 0:
         props.append(f"line={f.line}")
-    props.append(f"title={_escape_property('battgen ' + group.code)}")
+    props.append(f"title={github_property('battgen ' + group.code)}")
     where = f"{f.where}: " if f.where else ""
-    return f"::{command} {','.join(props)}::{_escape_data(where + f.message + group.repeats())}"
+    return f"::{command} {','.join(props)}::{github_data(where + f.message + group.repeats())}"
 
 
 def github_notice(file: str, message: str) -> str:
     """A workflow command for a problem with a whole input (unreadable, no records)."""
-    return f"::error file={_escape_property(file)},title=battgen::{_escape_data(message)}"
+    return f"::error file={github_property(file)},title=battgen::{github_data(message)}"
 
 
 def _uri(file: str) -> str:
@@ -118,13 +111,15 @@ def _result(group: Group, rule_index: Mapping[str, int]) -> dict[str, object]:
 def sarif_document(
     message: str,
     groups: Sequence[Group],
-    problems: Iterable[tuple[str, str]],
+    problems: Iterable[tuple[str, str, str]],
     settings: Settings,
     exit_code: int,
     version: str,
 ) -> dict[str, object]:
     """One SARIF 2.1.0 log: a run of battgen, a rule per finding code, a result per group (waived
-    ones suppressed), and the inputs that could not be read as tool execution notifications."""
+    ones suppressed), and what concerns a whole input -- unreadable (``error``), without records (``error``, or
+    ``note`` when allowed), a log's warnings such as a format that differs -- as tool execution notifications
+    (``problems``: file, level, text)."""
     rules: dict[str, dict[str, object]] = {}
     for g in groups:
         if g.code not in rules:
@@ -138,11 +133,11 @@ def sarif_document(
     index = {code: i for i, code in enumerate(rules)}
     notifications = [
         {
-            "level": "error",
+            "level": level,
             "message": {"text": text},
             "locations": [{"physicalLocation": {"artifactLocation": {"uri": _uri(file)}}}],
         }
-        for file, text in problems
+        for file, level, text in problems
     ]
     invocation: dict[str, object] = {"executionSuccessful": exit_code != 2, "exitCode": exit_code}
     if notifications:

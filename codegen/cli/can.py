@@ -27,6 +27,7 @@ from ..inputs.can.reassembly import Frame, Transfer
 from ..inputs.can.records import frames_of, registry
 from ..inputs.model import GeneratedMessage
 from ..ir.numbers import to_json_data
+from ..text.escape import line
 
 EXIT_OK, EXIT_ERRORS, EXIT_UNREADABLE = 0, 1, 2
 
@@ -43,15 +44,15 @@ def _print_record(transfer: Transfer, message: GeneratedMessage) -> None:
 
 
 def _text(report: CaptureReport) -> None:
-    print(f"{report.source}: {report.frames} frames, {report.transfers} transfers in {report.duration:.3f} s")
+    print(line(f"{report.source}: {report.frames} frames, {report.transfers} transfers in {report.duration:.3f} s"))
     for (node, kind, type_id), s in sorted(report.streams.items()):
         name = s.name or "(unknown type)"
         bad = f", {s.undecodable} undecodable" if s.undecodable else ""
-        print(f"  node {node:3d}  {kind:8s} {type_id:5d} {name:45s} {s.count:7d} x {s.rate:8.2f} Hz{bad}")
+        print(line(f"  node {node:3d}  {kind:8s} {type_id:5d} {name:45s} {s.count:7d} x {s.rate:8.2f} Hz{bad}"))
     for d in report.problems:
-        print(f"{report.source}: t={d.t:.6f} s, frame {d.frame}: {d.severity}: {d.message} [{d.code}]")
+        print(line(f"{report.source}: t={d.t:.6f} s, frame {d.frame}: {d.severity}: {d.message} [{d.code}]"))
     for code, n in sorted(report.counts.items()):
-        print(f"{report.source}: {n} x {code}", file=sys.stderr)
+        print(line(f"{report.source}: {n} x {code}"), file=sys.stderr)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -73,16 +74,16 @@ def run(args: argparse.Namespace) -> int:
         try:
             report = scan(frames, name, known, on_message=on_message)
         except KeyboardInterrupt:  # a live bus stopped by the user: the report of what was seen is still wanted
-            print(f"{name}: stopped", file=sys.stderr)
+            print(line(f"{name}: stopped"), file=sys.stderr)
             continue
         except LocatedError as exc:
             where = f"{exc.file}:{exc.line}" if exc.line else exc.file  # line 0: the whole capture
-            print(f"{where}: {exc.message}", file=sys.stderr)
+            print(line(f"{where}: {exc.message}"), file=sys.stderr)
             code = EXIT_UNREADABLE
             continue
         reports.append(report)
         if report.frames == 0:
-            print(f"{name}: no CAN frames", file=sys.stderr)
+            print(line(f"{name}: no CAN frames"), file=sys.stderr)
             code = max(code, EXIT_ERRORS)
         if report.errors:
             code = max(code, EXIT_ERRORS)

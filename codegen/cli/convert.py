@@ -34,6 +34,7 @@ import yaml
 from ..apps.convert import FORMATS, LOG_FORMATS, Conversion, Converted, input_format, output_format
 from ..errors import BattgenError
 from ..inputs.records import Notice
+from ..text.escape import line
 
 
 def register(subparsers: Any) -> None:
@@ -149,12 +150,12 @@ class Tally:
         code = 0
         for where in self.empty:
             if not allow_empty:
-                print(f"{where}: no records to convert (--allow-empty accepts that)", file=sys.stderr)
+                print(line(f"{where}: no records to convert (--allow-empty accepts that)"), file=sys.stderr)
                 code = 1
         for (field, detail), (n, first) in self.unheld.items():
             at = _where(cast(Mapping[str, object], first))
             times = f" ({n} records, the first shown)" if cast(int, n) > 1 else ""
-            print(f"{at}: {field}: {detail}{times}", file=sys.stderr)
+            print(line(f"{at}: {field}: {detail}{times}"), file=sys.stderr)
         if self.unheld:
             records = sum(cast(int, v[0]) for v in self.unheld.values())
             print(
@@ -184,7 +185,7 @@ def _write(events: Iterable[Converted | Notice], where: str, fmt: str, out_fmt: 
     for event in events:
         if isinstance(event, Notice):
             if event.severity == "warning":
-                print(f"{where}: warning: {event.message}", file=sys.stderr)
+                print(line(f"{where}: warning: {event.message}"), file=sys.stderr)
             continue
         if out_fmt in ("hex", "raw"):
             payloads = event.payloads

@@ -17,6 +17,7 @@ from ..apps.package import bundled_schemas
 from ..backends.markdown import render_docs
 from ..errors import BattgenError
 from ..frontends.loader import load
+from ..text.escape import line
 
 EXIT_OK, EXIT_STALE = 0, 1
 
@@ -31,18 +32,20 @@ def run(args: argparse.Namespace) -> int:
     if args.check:
         if written or removed:
             for name in written:
-                print(f"stale: {out / name}", file=sys.stderr)
+                print(line(f"stale: {out / name}"), file=sys.stderr)
             for name in removed:
-                print(f"not generated any more: {out / name}", file=sys.stderr)
-            print(f"{out} is stale: run 'battgen docs'", file=sys.stderr)
+                print(line(f"not generated any more: {out / name}"), file=sys.stderr)
+            print(line(f"{out} is stale: run 'battgen docs'"), file=sys.stderr)
             return EXIT_STALE
-        print(f"{out} is up to date ({len(unchanged)} pages)")
+        print(line(f"{out} is up to date ({len(unchanged)} pages)"))
         return EXIT_OK
     for name in written:
-        print(f"wrote {out / name}")
+        print(line(f"wrote {out / name}"))
     for name in removed:
-        print(f"removed {out / name}")
-    print(f"{len(pages)} pages in {out}: {len(written)} written, {len(unchanged)} unchanged, {len(removed)} removed")
+        print(line(f"removed {out / name}"))
+    print(
+        line(f"{len(pages)} pages in {out}: {len(written)} written, {len(unchanged)} unchanged, {len(removed)} removed")
+    )
     return EXIT_OK
 
 

@@ -18,6 +18,12 @@ that replay is exported again.
 ``--engine dask`` runs the same per-log export as tasks on a Dask cluster (``--scheduler
 ADDRESS``, else a local one with ``--jobs`` workers); the output folder must be reachable by
 every worker under the same path.
+
+A log becomes visible in one step, the rename of its marker (``DIR/logs/<id>.json``) naming its files;
+a re-export writes a new version beside the old and removes the old after that rename. A run stopped
+at any moment leaves each log old or new, and the next run removes what it left. One export writes a
+dataset at a time: a second waits, saying which process holds it. An unreadable ``DIR/dataset.json``
+is refused (exit 2), never replaced by defaults.
 """
 
 from __future__ import annotations
@@ -31,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import BattgenError
+from ..text.escape import line
 
 EXIT_OK, EXIT_FAILED, EXIT_UNREADABLE = 0, 1, 2
 _SUFFIXES = (".ulg", ".tlog", ".bin", ".jsonl", ".ndjson", ".asc", ".blf", ".trc")
@@ -115,6 +122,10 @@ def _progress(total: int, quiet: bool) -> tuple[Callable[[Any], None] | None, Ca
     return step, bar.close
 
 
+def _tell(text: str) -> None:
+    print(line(f"battgen: {text}"), file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         from ..apps.export import engine
@@ -124,6 +135,9 @@ def run(args: argparse.Namespace) -> int:
             f"battgen: export needs the fleet extra ({exc.name} is missing): pip install 'battgen[fleet]'",
             file=sys.stderr,
         )
+        return EXIT_UNREADABLE
+    if Path(args.out).exists() and not Path(args.out).is_dir():
+        print(line(f"battgen: -o {args.out}: is a file; expected a folder for the dataset"), file=sys.stderr)
         return EXIT_UNREADABLE
     logs = _inputs(args.logs)
     if not logs:
@@ -138,7 +152,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         replay = None if args.failsafe is None else failsafe_options(args.failsafe, args.vehicle)
     except BattgenError as exc:
-        print(f"battgen: --failsafe: {exc}", file=sys.stderr)
+        print(line(f"battgen: --failsafe: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     options = engine.ExportOptions(
         Path(args.out), raw=args.raw, message=args.message, failsafe=replay, partition=args.partition
@@ -150,8 +164,8 @@ def run(args: argparse.Namespace) -> int:
 
             results = distributed.export_dask(logs, options, scheduler=args.scheduler, workers=args.jobs, progress=step)
         else:
-            results = engine.export_logs(logs, options, jobs=args.jobs, progress=step)
-        engine.finish(options.out)
+            results = engine.export_logs(logs, options, jobs=args.jobs, progress=step, on_wait=_tell)
+        engine.finish(options.out, on_wait=_tell)
     except ImportError as exc:
         print(
             f"battgen: the Dask engine needs dask.distributed ({exc.name} is missing): pip install 'battgen[fleet]'",
@@ -159,19 +173,24 @@ def run(args: argparse.Namespace) -> int:
         )
         return EXIT_UNREADABLE
     except BattgenError as exc:
-        print(f"battgen: {exc}", file=sys.stderr)
+        print(line(f"battgen: {exc}"), file=sys.stderr)
+        return EXIT_UNREADABLE
+    except OSError as exc:  # the dataset folder, not a log: a log's own errors are in its result
+        print(line(f"battgen: {exc.filename or args.out}: cannot write: {exc.strerror or exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     finally:
         close()
     failed = [r for r in results if r.status == "failed"]
     for r in failed:
-        print(f"battgen: skipped {r.error}", file=sys.stderr)
+        print(line(f"battgen: skipped {r.error}"), file=sys.stderr)
     if not args.quiet:
         rows = sum(r.rows for r in results)
         done, skipped = engine.count(results, "exported"), engine.count(results, "skipped")
         print(
-            f"{len(results)} logs: {done} exported ({rows} rows), {skipped} already in the dataset, "
-            f"{len(failed)} unreadable -> {args.out}",
+            line(
+                f"{len(results)} logs: {done} exported ({rows} rows), {skipped} already in the dataset, "
+                f"{len(failed)} unreadable -> {args.out}"
+            ),
             file=sys.stderr,
         )
     return EXIT_FAILED if failed else EXIT_OK

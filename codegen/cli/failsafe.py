@@ -47,6 +47,7 @@ from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
 from ..errors import BattgenError
 from ..inputs import parameter_files
 from ..inputs.kinds import FLIGHT_LOG_KINDS, detect
+from ..text.escape import line
 
 EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE = 0, 1, 2
 
@@ -88,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
             values: dict[str, float] = read_parameter_values(Path(args.params))
             where = args.params
             for repeat in parameter_files.repeats(parameter_files.load(Path(args.params))):
-                print(f"battgen: warning: {args.params}:{repeat.lines[-1]}: {repeat.message()}", file=sys.stderr)
+                print(line(f"battgen: warning: {args.params}:{repeat.lines[-1]}: {repeat.message()}"), file=sys.stderr)
         elif own is not None:
             source = table.context.parameters_from if table is not None and table.context is not None else ""
             values, where = own, f"{args.stream} ({source})"
@@ -96,8 +97,10 @@ def run(args: argparse.Namespace) -> int:
             raise BattgenError(f"expected --params FILE: {_why_no_parameters(table)}")
         if args.params and not batt_parameter_count(values) and not args.allow_empty:
             print(
-                f"{where}: no BATT*_ parameter ({len(values)} parameters read): the failsafe would run on "
-                "defaults alone (--allow-empty accepts that)",
+                line(
+                    f"{where}: no BATT*_ parameter ({len(values)} parameters read): the failsafe would run on "
+                    "defaults alone (--allow-empty accepts that)"
+                ),
                 file=sys.stderr,
             )
             return EXIT_EMPTY
@@ -119,13 +122,13 @@ def run(args: argparse.Namespace) -> int:
             variants=args.variant,
             distance_rule=DistanceRule(margin=args.margin, consumption_mah_per_m=args.rate),
         )
-        print(f"battgen: vehicle {detection.how}; parameters from {where}", file=sys.stderr)
+        print(line(f"battgen: vehicle {detection.how}; parameters from {where}"), file=sys.stderr)
         for variant in args.variant:
-            print(f"battgen: variant {variant}: {VARIANTS[variant]}", file=sys.stderr)
+            print(line(f"battgen: variant {variant}: {VARIANTS[variant]}"), file=sys.stderr)
         reader = open_reader(Path(args.schemas) if args.schemas else None, args.message)
         replay = Replay(fs, reader)
         if table is not None and not table.has_arming:
-            print(f"battgen: {args.stream}: {NO_ARMING_NOTE}", file=sys.stderr)
+            print(line(f"battgen: {args.stream}: {NO_ARMING_NOTE}"), file=sys.stderr)
         events: Iterable[tuple[Event, Sample]]
         read = 0
         if table is not None:  # a log: replayed over its columns (the same events as sample by sample)
@@ -134,14 +137,14 @@ def run(args: argparse.Namespace) -> int:
         else:
             events = replay.run(stream, args.stream)
         for event, sample in events:
-            print(_json(event, sample, vehicle.name) if args.json else _line(event, sample))
+            print(_json(event, sample, vehicle.name) if args.json else line(_line(event, sample)))
         read = replay.samples if table is None else read
         if read == 0:
             raise BattgenError(f"{args.stream}: expected battery readings, found none")
     except (BattgenError, ValueError) as exc:
-        print(f"battgen: {exc}", file=sys.stderr)
+        print(line(f"battgen: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
-    print(f"{read} samples, {len(fs.events)} events, final level {fs.level.name}", file=sys.stderr)
+    print(line(f"{read} samples, {len(fs.events)} events, final level {fs.level.name}"), file=sys.stderr)
     return EXIT_OK
 
 

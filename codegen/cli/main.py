@@ -13,11 +13,13 @@ from pathlib import Path
 from .. import __version__
 from ..apps.package import bundled_schemas, project_root
 from ..backends.c import generate_c
+from ..backends.python.name_clashes import refuse_clashes
 from ..backends.python.writer import generate
 from ..errors import BattgenError, ErrorList
 from ..frontends.loader import load
 from ..ir import Schema
 from ..ir import json_form as irjson
+from ..text.escape import line
 from . import can, convert, docs, export, failsafe, params, query, report, schema, validate, vectors
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -29,7 +31,7 @@ def _load(paths: Sequence[str], args: argparse.Namespace) -> Schema:
     include_paths = [Path(p) for p in args.include_path or ()]
     schema = load([Path(p) for p in paths] if paths else [bundled_schemas()], include_paths=include_paths)
     for warning in schema.warnings:  # accepted, as upstream's tools accept it, but worth a look
-        print(f"battgen: {warning}", file=sys.stderr)
+        print(line(f"battgen: {warning}"), file=sys.stderr)
     return schema
 
 
@@ -45,7 +47,7 @@ def _include_path_option(p: argparse.ArgumentParser) -> None:
 def cmd_list(args: argparse.Namespace) -> int:
     schema = _load(args.paths, args)
     for msg in schema.messages:
-        print(msg.qualified_name)
+        print(line(msg.qualified_name))
     return EXIT_OK
 
 
@@ -59,18 +61,19 @@ def _generate_c(schema: Schema, out: Path, check: bool) -> int:
     written, removed, unchanged = generate_c(schema, out, check=check)
     if check and (written or removed):
         for rel in written:
-            print(f"stale: {out / rel}", file=sys.stderr)
+            print(line(f"stale: {out / rel}"), file=sys.stderr)
         for rel in removed:
-            print(f"not generated any more: {out / rel}", file=sys.stderr)
-        print(f"{out} is stale: run 'battgen generate'", file=sys.stderr)
+            print(line(f"not generated any more: {out / rel}"), file=sys.stderr)
+        print(line(f"{out} is stale: run 'battgen generate'"), file=sys.stderr)
         return EXIT_FAILED
-    print(f"{out}: {len(written)} written, {len(removed)} removed, {len(unchanged)} unchanged")
+    print(line(f"{out}: {len(written)} written, {len(removed)} removed, {len(unchanged)} unchanged"))
     return EXIT_OK
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     schema = _load([args.schema_dir] if args.schema_dir else [], args)
+    refuse_clashes(schema)  # before either language writes a file
     if args.lang == "c":
         return _generate_c(schema, Path(args.out) if args.out else project_root() / "generated" / "c", args.check)
     if args.lang is None and not args.out:
@@ -100,20 +103,22 @@ def cmd_generate(args: argparse.Namespace) -> int:
     if args.check:
         if result.stale:
             for rel in result.written:
-                print(f"stale: {out / rel}", file=sys.stderr)
+                print(line(f"stale: {out / rel}"), file=sys.stderr)
             for rel in result.removed:
-                print(f"not generated any more: {out / rel}", file=sys.stderr)
-            print(f"{out} is stale: run 'battgen generate'", file=sys.stderr)
+                print(line(f"not generated any more: {out / rel}"), file=sys.stderr)
+            print(line(f"{out} is stale: run 'battgen generate'"), file=sys.stderr)
             return EXIT_FAILED
-        print(f"{out} is up to date ({len(result.unchanged)} files, {len(schema.messages)} messages)")
+        print(line(f"{out} is up to date ({len(result.unchanged)} files, {len(schema.messages)} messages)"))
         return EXIT_OK
     for rel in result.written:
-        print(f"wrote {out / rel}")
+        print(line(f"wrote {out / rel}"))
     for rel in result.removed:
-        print(f"removed {out / rel}")
+        print(line(f"removed {out / rel}"))
     print(
-        f"generated {len(schema.messages)} messages into {out}: {len(result.written)} written, "
-        f"{len(result.unchanged)} unchanged, {len(result.removed)} removed in {elapsed * 1000:.0f} ms"
+        line(
+            f"generated {len(schema.messages)} messages into {out}: {len(result.written)} written, "
+            f"{len(result.unchanged)} unchanged, {len(result.removed)} removed in {elapsed * 1000:.0f} ms"
+        )
     )
     return EXIT_OK
 
@@ -121,7 +126,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # type: ignore[override]
         self.print_usage(sys.stderr)
-        print(f"{self.prog}: error: {message}", file=sys.stderr)
+        print(line(f"{self.prog}: error: {message}"), file=sys.stderr)
         raise SystemExit(EXIT_USAGE)
 
 
@@ -163,11 +168,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return func(args)
     except ErrorList as exc:  # every problem of the run, one line each, then the count
         for error in exc.errors:
-            print(f"battgen: {error}", file=sys.stderr)
-        print(f"battgen: {len(exc.errors)} errors", file=sys.stderr)
+            print(line(f"battgen: {error}"), file=sys.stderr)
+        print(line(f"battgen: {len(exc.errors)} errors"), file=sys.stderr)
         return EXIT_USAGE
     except BattgenError as exc:
-        print(f"battgen: {exc}", file=sys.stderr)
+        print(line(f"battgen: {exc}"), file=sys.stderr)
         return EXIT_USAGE
     except ModuleNotFoundError as exc:  # a dependency missing from this environment, e.g. pymavlink
         print(

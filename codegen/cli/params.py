@@ -26,6 +26,7 @@ from ..apps.failsafe.checks import CELL_RANGES
 from ..apps.failsafe.stream import batt_parameter_count, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES
 from ..errors import BattgenError
+from ..text.escape import line
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
@@ -70,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     )
     text = render(result, source, args.format)
     for finding in check_proposals(result):
-        print(f"battgen: {finding.severity}: {finding.message}", file=sys.stderr)
+        print(line(f"battgen: {finding.severity}: {finding.message}"), file=sys.stderr)
     if args.out:
         try:
             Path(args.out).write_text(text, encoding="utf-8")
@@ -85,21 +86,23 @@ def _check(path: Path, cells: int | None, chemistry: str, vehicle: str | None, a
     display = path.as_posix()
     report = check_parameter_file(path, cells=cells, chemistry=chemistry, vehicle=vehicle)
     if report.unreadable is not None:
-        print(f"battgen: {report.unreadable}", file=sys.stderr)
+        print(line(f"battgen: {report.unreadable}"), file=sys.stderr)
         return EXIT_USAGE
     values = read_parameter_values(path)
     if not batt_parameter_count(values) and not allow_empty:
         print(
-            f"{display}: no BATT*_ parameter in this file ({len(values)} parameters read): nothing to check "
-            "(--allow-empty accepts that)",
+            line(
+                f"{display}: no BATT*_ parameter in this file ({len(values)} parameters read): nothing to check "
+                "(--allow-empty accepts that)"
+            ),
             file=sys.stderr,
         )
         return EXIT_ERRORS
     for note in report.notes:
-        print(f"{display}: {note}", file=sys.stderr)
+        print(line(f"{display}: {note}"), file=sys.stderr)
     for f in report.findings:
-        print(f"{display}:{f.line}: {f.severity}: {f.message}")
+        print(line(f"{display}:{f.line}: {f.severity}: {f.message}"))
     errors = sum(f.severity == "error" for f in report.findings)
     warnings = sum(f.severity == "warning" for f in report.findings)
-    print(f"{display}: {errors} errors, {warnings} warnings", file=sys.stderr)
+    print(line(f"{display}: {errors} errors, {warnings} warnings"), file=sys.stderr)
     return EXIT_ERRORS if errors else EXIT_OK

@@ -9,6 +9,11 @@ state of health, internal resistance). ``DIR/views.sql`` holds the same views fo
 ``--format table`` (default) prints aligned columns; ``csv`` and ``json`` (an array of objects)
 go to standard output or ``-o FILE``; ``parquet`` needs ``-o FILE``. Exit 0, or 2 when the dataset
 cannot be read, the SQL fails or DuckDB is missing.
+
+Text from the logs (a ``sys_uuid``, a file name) is printed safely: in table and CSV form a control
+character shows as ``\\xNN``, and a CSV text cell that begins with ``=``, ``+``, ``-``, ``@``, a tab or a
+CR gets a leading single quote so that no spreadsheet takes it for a formula (OWASP's CSV injection
+guard). ``--csv-raw`` writes the CSV cells exactly as the dataset holds them, for a program to read.
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import BattgenError
+from ..text.escape import csv_cell, line, shown
 
 EXIT_OK, EXIT_UNREADABLE = 0, 2
 MAX_CELL = 40  # characters of one value in the table format
@@ -40,6 +46,11 @@ def register(subparsers: Any) -> None:
     p.add_argument("sql", metavar="SQL", help='e.g. "SELECT * FROM flights"')
     p.add_argument("--format", choices=("table", "csv", "json", "parquet"), default="table")
     p.add_argument("-o", "--out", metavar="FILE", help="write the result here (required for parquet)")
+    p.add_argument(
+        "--csv-raw",
+        action="store_true",
+        help="CSV cells as the dataset holds them: no quote before a leading = + - @, control characters kept",
+    )
     p.set_defaults(func=run)
 
 
@@ -59,11 +70,20 @@ def _plain(value: Any) -> Any:
 
 def _cell(value: Any) -> str:
     text = "" if value is None else json.dumps(_plain(value)) if isinstance(value, list | dict) else str(_plain(value))
+    text = shown(text)
     return text if len(text) <= MAX_CELL else text[: MAX_CELL - 1] + "…"
+
+
+def _csv_value(value: Any, raw: bool) -> Any:
+    """A CSV cell: JSON for a list or struct; text guarded by :func:`csv_cell` unless ``raw`` (numbers are
+    never guarded, infinities included: a negative current is data, not a formula)."""
+    plain = json.dumps(_plain(value)) if isinstance(value, list | dict) else _plain(value)
+    return csv_cell(plain) if isinstance(value, str) and not raw else plain
 
 
 def table_text(columns: list[str], rows: list[tuple[Any, ...]]) -> str:
     cells = [[_cell(v) for v in row] for row in rows]
+    columns = [shown(c) for c in columns]
     widths = [max([len(c)] + [len(r[i]) for r in cells]) for i, c in enumerate(columns)]
     lines = ["  ".join(c.ljust(w) for c, w in zip(columns, widths, strict=True)).rstrip()]
     lines.append("  ".join("-" * w for w in widths))
@@ -87,19 +107,17 @@ def run(args: argparse.Namespace) -> int:
             if not args.out:
                 raise BattgenError("--format parquet needs -o FILE")
             rows = fleet_query.query_to_parquet(dataset, args.sql, Path(args.out))
-            print(f"{rows} rows -> {args.out}", file=sys.stderr)
+            print(line(f"{rows} rows -> {args.out}"), file=sys.stderr)
             return EXIT_OK
         result = fleet_query.run_query(dataset, args.sql)
     except BattgenError as exc:
-        print(f"battgen: {exc}", file=sys.stderr)
+        print(line(f"battgen: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     if args.format == "csv":
         buf = io.StringIO()
         writer = csv.writer(buf, lineterminator="\n")
-        writer.writerow(result.columns)
-        writer.writerows(
-            [[json.dumps(_plain(v)) if isinstance(v, list | dict) else _plain(v) for v in r] for r in result.rows]
-        )
+        writer.writerow(result.columns if args.csv_raw else [csv_cell(c) for c in result.columns])
+        writer.writerows([[_csv_value(v, args.csv_raw) for v in r] for r in result.rows])
         text = buf.getvalue()
     elif args.format == "json":
         text = (
@@ -111,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             Path(args.out).write_text(text, encoding="utf-8")
         except OSError as exc:
-            print(f"battgen: {args.out}: cannot write: {exc.strerror or exc}", file=sys.stderr)
+            print(line(f"battgen: {args.out}: cannot write: {exc.strerror or exc}"), file=sys.stderr)
             return EXIT_UNREADABLE
     else:
         sys.stdout.write(text)

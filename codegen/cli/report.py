@@ -24,6 +24,7 @@ from ..apps.package import bundled_schemas
 from ..apps.report.as_json import report_json
 from ..apps.report.build import collect, html, pngs
 from ..errors import BattgenError
+from ..text.escape import line
 
 EXIT_OK = 0
 
@@ -44,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
         if folder.exists() and not folder.is_dir():
             raise BattgenError(f"{folder}: --format png writes a folder of images, and this is a file")
         for path in pngs(report, folder):
-            print(f"wrote {path}")
+            print(line(f"wrote {path}"))
         return EXIT_OK
     if args.format == "json":
         document = json.dumps(report_json(report), indent=2, ensure_ascii=True) + "\n"
@@ -52,13 +53,15 @@ def run(args: argparse.Namespace) -> int:
             sys.stdout.write(document)
             return EXIT_OK
         _write(Path(args.output), document)
-        print(f"wrote {args.output}")
+        print(line(f"wrote {args.output}"))
         return EXIT_OK
     out = Path(args.output or "report.html")
     text = html(report, title=args.title or "")
     _write(out, text)
     batteries = sum(len(i.batteries) for i in report.inputs)
-    print(f"wrote {out} ({len(report.inputs)} input(s), {batteries} battery instance(s), {len(text) // 1024} KiB)")
+    print(
+        line(f"wrote {out} ({len(report.inputs)} input(s), {batteries} battery instance(s), {len(text) // 1024} KiB)")
+    )
     return EXIT_OK
 
 

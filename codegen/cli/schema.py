@@ -18,6 +18,7 @@ from ..apps.package import bundled_schemas
 from ..backends.json_schema import export_all, message_json_schema
 from ..errors import BattgenError
 from ..frontends.loader import load
+from ..text.escape import line
 
 
 def _dumps(doc: Any) -> str:
@@ -40,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
             (out / f"{name}.schema.json").write_text(_dumps(doc), encoding="utf-8")
     except OSError as exc:
         raise BattgenError(f"{out}: cannot write: {exc.strerror or exc}") from None
-    print(f"wrote {len(documents)} JSON Schemas into {out}")
+    print(line(f"wrote {len(documents)} JSON Schemas into {out}"))
     return 0
 
 

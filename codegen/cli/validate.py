@@ -56,6 +56,7 @@ from ..apps.validate_formats import Group, Grouper, github_line, github_notice, 
 from ..inputs.kinds import KINDS
 from ..inputs.records import Notice, Unreadable
 from ..ir import Message
+from ..text.escape import line
 
 
 def _count(n: int, noun: str) -> str:
@@ -79,17 +80,17 @@ def print_event(event: Event) -> None:
     done (see :func:`print_groups`)."""
     if isinstance(event, Notice):
         if event.severity in ("warning", "error"):
-            print(f"{event.file}: {event.severity}: {event.message}", file=sys.stderr)
+            print(line(f"{event.file}: {event.severity}: {event.message}"), file=sys.stderr)
         elif event.kind == "stream":  # what a log or capture held (frames, nodes): one line, worth seeing
-            print(f"{event.file}: note: {event.message}", file=sys.stderr)
+            print(line(f"{event.file}: note: {event.message}"), file=sys.stderr)
     elif isinstance(event, Unreadable):
-        print(f"{_place(event.file, event.line)}: {event.message}", file=sys.stderr)
+        print(line(f"{_place(event.file, event.line)}: {event.message}"), file=sys.stderr)
 
 
 def print_groups(grouper: Grouper, github: bool) -> None:
     """Each group of reported findings once: its first finding, with how often it repeats."""
     for group in grouper.groups():
-        print(github_line(group) if github else finding_line(group.first) + group.repeats())
+        print(github_line(group) if github else line(finding_line(group.first) + group.repeats()))
     if grouper.overflow:
         print(f"... and {grouper.overflow} findings of further kinds (use --format json)")
 
@@ -141,7 +142,9 @@ def run(args: argparse.Namespace) -> int:
     message, checker = make_checker(schema_dir, args.message, args.files, kind, vehicle=args.vehicle)
     fmt = args.format
     text_like = fmt in ("text", "github")
-    reports, all_groups, problems = [], [], []
+    reports: list[FileReport] = []
+    all_groups: list[Group] = []
+    problems: list[tuple[str, str, str]] = []  # SARIF's tool notifications: (file, level, text)
     github = fmt == "github"
     for f in args.files:
         gate = Gate(chosen, message.qualified_name)
@@ -151,14 +154,17 @@ def run(args: argparse.Namespace) -> int:
         )
         reports.append(report)
         all_groups += grouper.groups() + grouper.groups(waived=True)
-        problems += [(u.file, f"{_place(u.file, u.line)}: {u.message}") for u in report.unreadable]
+        problems += [(n.file, n.severity, f"{n.file}: {n.message}") for n in report.notices if n.severity == "warning"]
+        problems += [(u.file, "error", f"{_place(u.file, u.line)}: {u.message}") for u in report.unreadable]
+        if is_empty(report) and args.allow_empty:  # accepted, but a scan that saw nothing should say so
+            problems.append((report.file, "note", f"{report.file}: no {message.qualified_name} records in this file"))
         if is_empty(report) and not args.allow_empty:
             text = f"no {message.qualified_name} records in this file (--allow-empty accepts that)"
-            problems.append((report.file, f"{report.file}: {text}"))
+            problems.append((report.file, "error", f"{report.file}: {text}"))
             if github:
                 print(github_notice(report.file, text))
             elif text_like:
-                print(f"{report.file}: {text}", file=sys.stderr)
+                print(line(f"{report.file}: {text}"), file=sys.stderr)
         if github:
             for u in report.unreadable:
                 print(github_notice(u.file, u.message))
@@ -171,7 +177,7 @@ def run(args: argparse.Namespace) -> int:
         json.dump(doc, sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
     else:
-        print(summary(message, reports, all_groups, chosen), file=sys.stderr)
+        print(line(summary(message, reports, all_groups, chosen)), file=sys.stderr)
     return code
 
 

@@ -15,6 +15,7 @@ import sys
 from typing import Any
 
 from ..apps.vectors import vectors_document
+from ..text.escape import line
 from .convert import open_output
 
 
@@ -40,8 +41,10 @@ def run(args: argparse.Namespace) -> int:
             out.write(text.encode("utf-8"))
         vectors = doc["vectors"]
         count = len(vectors) if isinstance(vectors, list) else 0
-        print(f"wrote {count} vectors of {doc['source']} -> {doc['target']} ({doc['policy']}) to {args.output}",
-              file=sys.stderr)  # fmt: skip
+        print(
+            line(f"wrote {count} vectors of {doc['source']} -> {doc['target']} ({doc['policy']}) to {args.output}"),
+            file=sys.stderr,
+        )
     else:
         sys.stdout.write(text)
     return 0

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from ..errors import BattgenError, LocatedError
 from ..text.brief import brief
+from ..text.escape import shown
 
 Value = int | float
 
@@ -172,20 +173,23 @@ def format_value(value: Value) -> str:
 
 
 def write_param(items: Sequence[tuple[str, Value, str]], *, header: Sequence[str] = ()) -> str:
-    """ArduPilot .param text: ``NAME,VALUE`` lines, each with its comment (``# ...``) when given."""
-    out = [f"# {h}" if h else "#" for h in header]
+    """ArduPilot .param text: ``NAME,VALUE`` lines, each with its comment (``# ...``) when given. Header and
+    comments quote inputs (a file name, a devicetree node): shown escaped, so none can end its line and
+    start a parameter line of its own."""
+    out = [f"# {shown(h)}" if h else "#" for h in header]
     for name, value, comment in items:
         _check_name(name)
         line = f"{name},{format_value(value)}"
-        out.append(f"{line}  # {comment}" if comment else line)
+        out.append(f"{line}  # {shown(comment)}" if comment else line)
     return "\n".join(out) + "\n"
 
 
 def write_qgc(
     items: Sequence[tuple[str, Value, int]], *, vehicle: int = 1, component: int = 1, header: Sequence[str] = ()
 ) -> str:
-    """QGroundControl .params text; each item is (NAME, value, MAV_PARAM_TYPE)."""
-    out = [f"# {h}" if h else "#" for h in header]
+    """QGroundControl .params text; each item is (NAME, value, MAV_PARAM_TYPE); the header escaped as
+    :func:`write_param`'s."""
+    out = [f"# {shown(h)}" if h else "#" for h in header]
     out.append("# Vehicle-Id Component-Id Name Value Type")
     for name, value, mav_type in items:
         _check_name(name)

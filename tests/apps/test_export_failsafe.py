@@ -159,7 +159,7 @@ def test_views_from_plain_duckdb_and_metadata(tmp_path: Path, capsys: pytest.Cap
     con.execute(f"SET file_search_path = '{out}'")
     con.execute((out / "views.sql").read_text(encoding="utf-8"))
     assert con.sql("SELECT failsafe_level FROM flights ORDER BY battery").fetchall() == [("CRITICAL",), ("LOW",)]
-    schema = pq.read_schema(next((out / "failsafe").glob("*/events.parquet")))
+    schema = pq.read_schema(next((out / "failsafe").glob("*/events-*.parquet")))
     assert schema.field("t").metadata[b"unit"] == b"s"
     assert b"STATUSTEXT" in schema.field("statustext").metadata[b"doc"]
 

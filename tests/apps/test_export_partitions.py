@@ -49,7 +49,7 @@ def test_day_layout_reads_back_as_the_log_layout(tmp_path: Path, capsys: pytest.
     days = sorted(p.name for p in (by_day / "battery").iterdir())
     assert days == ["day=2023-11-14", "day=__HIVE_DEFAULT_PARTITION__"]
     assert len(list((by_day / "battery" / "day=__HIVE_DEFAULT_PARTITION__").iterdir())) == 2  # .bin, .jsonl
-    assert sorted({p.parent.parent.name for p in (by_day / "failsafe").rglob("events.parquet")}) == [
+    assert sorted({p.parent.parent.name for p in (by_day / "failsafe").rglob("events-*.parquet")}) == [
         "day=2023-11-14",
         "day=__HIVE_DEFAULT_PARTITION__",
     ]

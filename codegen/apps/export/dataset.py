@@ -2,20 +2,24 @@
 
 Layout under the output folder::
 
-    battery/log=<id>/part-0.parquet        the normalised table (one file per log)
-    raw/<message>/log=<id>/part-0.parquet  --raw: every field as decoded, sentinels kept
-    failsafe/log=<id>/events.parquet       --failsafe: the replay's events (and replays.parquet)
-    logs/<id>.json                         what was exported from the log (its marker: present = done)
-    views.sql                              the DuckDB views (see codegen.apps.fleet_query)
-    dataset.json                           {"partition": "log" or "day", "content_id": "xxh128" or "sha256"}
+    battery/log=<id>/part-<version>.parquet        the normalised table (one file per log)
+    raw/<message>/log=<id>/part-<version>.parquet  --raw: every field as decoded, sentinels kept
+    failsafe/log=<id>/events-<version>.parquet     --failsafe: the replay's events (and replays-<version>)
+    logs/<id>.json                                 the log's marker: what was exported, the files of its version
+    views.sql                                      the DuckDB views (see codegen.apps.fleet_query)
+    dataset.json                                   {"partition": "log" or "day", "content_id": "xxh128" or "sha256"}
+    .battgen-export.lock                           the writers' lock (one export at a time)
 
 ``--partition day`` puts a ``day=YYYY-MM-DD`` level (UTC, from the log's first record with a time
 of day; Hive's ``__HIVE_DEFAULT_PARTITION__``, read as null, where the log has none) above each
 ``log=<id>`` folder.
 
-A log's files are written into a temporary folder beside them and moved into place, its marker
-last: a log whose marker exists is complete, and ``battgen export`` skips it when it meets the same
-content again.
+A log's files are written into a temporary folder beside them, fsynced, moved into place under a new
+version's names, and made visible by one rename, its marker's (:mod:`.manifest`): a log whose marker
+exists is complete, and ``battgen export`` skips it when it meets the same content again. A re-export
+(``--failsafe`` with other parameters) writes its version beside the old one and removes the old files
+after the marker names the new ones. ``dataset.json`` is written the same way, and an unreadable one is
+refused, never replaced by defaults (the layout and log ids of every later run depend on it).
 """
 
 from __future__ import annotations
@@ -23,8 +27,10 @@ from __future__ import annotations
 import functools
 import json
 import os
+import secrets
 import shutil
 import tempfile
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -36,11 +42,11 @@ import pyarrow.parquet as pq
 from ...errors import BattgenError
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..battery.sources import Batch
+from .durable import TMP_PREFIX, fsync_dir, fsync_file, write_atomic
+from .manifest import BATTERY, LOGS, RAW, marker, marker_files, read_marker
 from .table import floats, repeated
 
-BATTERY = "battery"
-RAW = "raw"
-LOGS = "logs"
+__all__ = ["BATTERY", "LOGS", "RAW", "marker"]  # the layout's names, defined with the markers
 ROW_GROUP = 1 << 18  # rows per Parquet row group (fewer, larger groups write faster; engines split them)
 LAYOUT_FILE = "dataset.json"
 PARTITIONS = ("log", "day")
@@ -49,18 +55,42 @@ UNKNOWN_DAY = "__HIVE_DEFAULT_PARTITION__"  # Hive's name for a null partition v
 
 
 def _settings(out: Path) -> dict[str, Any]:
+    """What ``dataset.json`` records; empty for a dataset without one (new, or from before it existed). One
+    that cannot be read or holds something else is refused: re-defaulting it would switch a ``day`` dataset
+    to ``log`` (its logs vanish from the views) or rename every log (each exported again)."""
+    path = out / LAYOUT_FILE
     try:
-        data = json.loads((out / LAYOUT_FILE).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
         return {}
-    return data if isinstance(data, dict) else {}
+    except (OSError, ValueError) as exc:
+        raise BattgenError(f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
+    try:
+        data = json.loads(text)
+    except ValueError:
+        data = None
+    if (
+        not isinstance(data, dict)
+        or data.get("partition") not in PARTITIONS
+        or data.get("content_id", CONTENT_IDS[0]) not in CONTENT_IDS
+    ):
+        raise BattgenError(
+            f"{path}: expected the dataset's layout as battgen export writes it, "
+            f'{{"partition": "log" or "day", "content_id": "xxh128" or "sha256"}}, got {text[:80]!r}: '
+            "restore it (a marker in logs/ names each log's partition) or export into a new folder"
+        )
+    return data
 
 
 def layout(out: Path) -> str:
     """How the dataset at ``out`` is partitioned: ``log`` (``<table>/log=<id>/``) or ``day``
-    (``<table>/day=YYYY-MM-DD/log=<id>/``); a dataset from before the choice existed is by log."""
+    (``<table>/day=YYYY-MM-DD/log=<id>/``); a dataset from before ``dataset.json`` existed is by log."""
     found = _settings(out).get("partition")
-    return found if found in PARTITIONS else "log"
+    if found is None:  # no dataset.json: the partition its markers name (a day dataset's file was lost)
+        first = next(iter(sorted((out / LOGS).glob("*.json"))), None) if (out / LOGS).is_dir() else None
+        manifest = read_marker(out, first.stem) if first is not None else None
+        found = "day" if manifest is not None and str(manifest.get("partition", "")).startswith("day=") else "log"
+    return str(found)
 
 
 def content_scheme(out: Path) -> str:
@@ -97,7 +127,8 @@ def claim_layout(out: Path, partition: str, scheme: str | None = None) -> str:
     chosen = found if existing or scheme is None else scheme
     out.mkdir(parents=True, exist_ok=True)
     settings = {"partition": partition, "content_id": chosen}
-    (out / LAYOUT_FILE).write_text(json.dumps(settings) + "\n", encoding="utf-8")
+    if _settings(out) != settings:  # written once, not on every run
+        write_atomic(out / LAYOUT_FILE, json.dumps(settings) + "\n")
     return chosen
 
 
@@ -114,21 +145,18 @@ def table_glob(out: Path, table: str, file_name: str = "*.parquet", *, relative:
     return f"{'' if relative else out.as_posix() + '/'}{table}/{depth}/{file_name}"
 
 
-def marker(out: Path, log: str) -> Path:
-    return out / LOGS / f"{log}.json"
-
-
 def is_exported(out: Path, log: str) -> bool:
-    return marker(out, log).is_file()
+    return read_marker(out, log) is not None
 
 
 def exported_manifest(out: Path, log: str) -> dict[str, Any] | None:
     """What the marker of an exported log records (None: not exported, or a marker unreadable)."""
-    try:
-        data = json.loads(marker(out, log).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return data if isinstance(data, dict) else None
+    return read_marker(out, log)
+
+
+def new_version() -> str:
+    """A version of a log's files: its time and a random part, so two writers never share one."""
+    return f"{time.time_ns():x}{secrets.token_hex(3)}"
 
 
 def _raw_type(ftype: object) -> Any:
@@ -238,7 +266,7 @@ class LogWriter:
     def __init__(self, out: Path, log: str, schema: Any) -> None:
         out.mkdir(parents=True, exist_ok=True)
         self.out, self.log, self.schema = out, log, schema
-        self.tmp = Path(tempfile.mkdtemp(prefix=f".tmp-{log}-", dir=out))
+        self.tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{log}-", dir=out))
         self._writers: dict[str, Any] = {}  # "" for the battery table, else the raw table's message
         self._pending: dict[str, list[Any]] = {}  # tables not yet written, by writer key
         self.rows = 0
@@ -278,10 +306,12 @@ class LogWriter:
         tables: Sequence[tuple[str, dict[str, Any]]] = (),
         partition: str | None = None,
     ) -> None:
-        """Close the files and move them into place, the marker last. ``tables``: more tables of
-        the log, (table folder, {file name: table}) (the failsafe replay's); ``partition``: the
-        log's folder under each table (:func:`partition_of`; default ``log=<id>``)."""
+        """Close the files, move them into place under a new version's names and publish them by renaming
+        the marker over the old one; then remove the old version's files (see the module docstring).
+        ``tables``: more tables of the log, (table folder, {file name: table}) (the failsafe replay's);
+        ``partition``: the log's folder under each table (:func:`partition_of`; default ``log=<id>``)."""
         where = partition or f"log={self.log}"
+        version = new_version()
         try:
             for key in list(self._pending):
                 self._flush(key)
@@ -290,24 +320,39 @@ class LogWriter:
             for writer in self._writers.values():
                 writer.close()
             self._writers.clear()
-            moves = [(folders.pop(""), self.out / BATTERY / where)]
-            moves += [(f, self.out / RAW / message / where) for message, f in sorted(folders.items())]
-            for i, (folder, files) in enumerate(tables):
+            # (file written in the temporary folder, its marker key, its place in the dataset)
+            staged = [(folders.pop("") / "part-0.parquet", BATTERY, f"{BATTERY}/{where}/part-{version}.parquet")]
+            staged += [
+                (f / "part-0.parquet", RAW, f"{RAW}/{message}/{where}/part-{version}.parquet")
+                for message, f in sorted(folders.items())
+            ]
+            for i, (table_folder, named) in enumerate(tables):
                 part = self.tmp / f"table-{i}"
                 part.mkdir()
-                for file_name, table in files.items():
+                for file_name, table in named.items():
                     pq.write_table(table, part / file_name, **_options(table.schema))
-                moves.append((part, self.out / folder / where))
-            for src, dst in moves:
+                    stem = Path(file_name).stem
+                    staged.append((part / file_name, stem, f"{table_folder}/{where}/{stem}-{version}.parquet"))
+            for src, _, _ in staged:
+                fsync_file(src)
+            old = read_marker(self.out, self.log)
+            for src, _, rel in staged:  # new names: nothing a reader reads is touched
+                dst = self.out / rel
                 dst.parent.mkdir(parents=True, exist_ok=True)
-                if dst.exists():  # an earlier run stopped before its marker: its partition is replaced
-                    shutil.rmtree(dst)
                 os.replace(src, dst)
-            mark = marker(self.out, self.log)
-            mark.parent.mkdir(parents=True, exist_ok=True)
-            tmp_mark = self.tmp / "marker.json"
-            tmp_mark.write_text(json.dumps(manifest, indent=2, sort_keys=True) + "\n", encoding="utf-8")
-            os.replace(tmp_mark, mark)
+            for parent in sorted({(self.out / rel).parent for _, _, rel in staged}):
+                fsync_dir(parent)
+            files: dict[str, list[str]] = {}
+            for _, key, rel in staged:
+                files.setdefault(key, []).append(rel)
+            manifest = {**manifest, "version": version, "files": files}
+            write_atomic(marker(self.out, self.log), json.dumps(manifest, indent=2, sort_keys=True) + "\n")
+            if old is not None:  # the swap is done: the old version goes
+                new = {rel for _, _, rel in staged}
+                for names in marker_files(self.out, old).values():
+                    for rel in names:
+                        if rel not in new:
+                            (self.out / rel).unlink(missing_ok=True)
         finally:
             self.abort()
 

@@ -8,13 +8,12 @@ finish. Without a scheduler address a local cluster of ``workers`` processes is 
 
 from __future__ import annotations
 
-import dataclasses
 import importlib
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from .dataset import claim_layout
-from .engine import ExportOptions, LogResult, export_one
+from .durable import writers_lock
+from .engine import ExportOptions, LogResult, export_one, start
 
 MAX_LOGS_PER_TASK = 8
 TASKS_PER_WORKER = 4  # at the least, while the logs last
@@ -58,7 +57,13 @@ def run_on(
     and a task's round trip through the scheduler costs about as much again (measured: 200 such
     logs in 4.1 s one per task on two workers, against 1.9 s by eight). Tasks stay many enough to
     keep every worker busy to the end and the progress moving."""
-    options = dataclasses.replace(options, content_id=claim_layout(options.out, options.partition, options.content_id))
+    with writers_lock(options.out):
+        return _run_on(client, paths, start(options), progress)
+
+
+def _run_on(
+    client: Any, paths: Sequence[str], options: ExportOptions, progress: Callable[[LogResult], None] | None
+) -> list[LogResult]:
     workers = max(1, sum(client.nthreads().values()))
     size = max(1, min(MAX_LOGS_PER_TASK, len(paths) // (TASKS_PER_WORKER * workers)))
     groups = [list(paths[i : i + size]) for i in range(0, len(paths), size)]

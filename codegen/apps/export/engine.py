@@ -36,7 +36,9 @@ from .dataset import (
     partition_of,
     raw_table,
 )
+from .durable import writers_lock
 from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, replay_tables
+from .manifest import sweep
 from .table import battery_schema, battery_table
 from .views import write_views
 
@@ -178,16 +180,27 @@ def export_logs(
     *,
     jobs: int = 1,
     progress: Callable[[LogResult], None] | None = None,
+    on_wait: Callable[[str], None] | None = None,
 ) -> list[LogResult]:
-    """Export every log, in input order of the results; ``jobs`` > 1 runs them in processes."""
-    options = dataclasses.replace(options, content_id=claim_layout(options.out, options.partition, options.content_id))
-    unique = list(dict.fromkeys(paths))
-    results: dict[str, LogResult] = {}
-    for res in _run(unique, options, jobs):
-        results[res.path] = res
-        if progress is not None:
-            progress(res)
-    return [results[p] for p in unique]
+    """Export every log, in input order of the results; ``jobs`` > 1 runs them in processes. The run
+    holds the dataset's writers' lock (``on_wait`` is told when another export holds it) and starts by
+    removing what a stopped run left (:func:`.manifest.sweep`)."""
+    with writers_lock(options.out, on_wait):
+        options = start(options)
+        unique = list(dict.fromkeys(paths))
+        results: dict[str, LogResult] = {}
+        for res in _run(unique, options, jobs):
+            results[res.path] = res
+            if progress is not None:
+                progress(res)
+        return [results[p] for p in unique]
+
+
+def start(options: ExportOptions) -> ExportOptions:
+    """The start of a run, under the writers' lock: leftovers of a stopped run removed, the layout
+    claimed (:func:`.dataset.claim_layout`); the options with the dataset's content id."""
+    sweep(options.out)
+    return dataclasses.replace(options, content_id=claim_layout(options.out, options.partition, options.content_id))
 
 
 def _run(paths: list[str], options: ExportOptions, jobs: int) -> Iterator[LogResult]:
@@ -205,7 +218,8 @@ def count(results: Iterable[LogResult], status: str) -> int:
     return sum(1 for r in results if r.status == status)
 
 
-def finish(out: Path) -> None:
-    """After a run: the views file in the dataset folder."""
-    out.mkdir(parents=True, exist_ok=True)
-    write_views(out)
+def finish(out: Path, on_wait: Callable[[str], None] | None = None) -> None:
+    """After a run: the views file in the dataset folder (under the writers' lock: the committed logs
+    of that moment)."""
+    with writers_lock(out, on_wait):
+        write_views(out)

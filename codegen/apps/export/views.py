@@ -26,13 +26,15 @@ from typing import Any
 from ..battery.figures import WINDOW_SQL, flight_sql
 from ..load_steps import resistance_sql
 from .dataset import BATTERY, table_glob
-from .failsafe_tables import EVENTS_FILE, EVENTS_SCHEMA, FAILSAFE, REPLAYS_FILE, REPLAYS_SCHEMA
+from .durable import write_atomic
+from .failsafe_tables import EVENTS_SCHEMA, REPLAYS_SCHEMA
+from .manifest import committed
 
 _STEP = resistance_sql("dt", "pack_voltage", "prev_voltage", "current", "prev_current", "peak_abs_current")
 VIEWS_FILE = "views.sql"
 
 _BATTERY_VIEW = """CREATE OR REPLACE VIEW battery AS
-SELECT * FROM read_parquet('{glob}', hive_partitioning = true, union_by_name = true);
+SELECT * FROM read_parquet({files}, hive_partitioning = true, union_by_name = true);
 """
 
 _FLIGHT_VIEWS = f"""-- One row per flight (a log and a battery instance). SI units: V, A, C, J, K, s, Ohm.
@@ -111,12 +113,12 @@ GROUP BY pack;
 _DUCKDB_TYPES = {"string": "VARCHAR", "int32": "INTEGER", "int64": "BIGINT", "double": "DOUBLE", "bool": "BOOLEAN"}
 
 
-def _table_view(name: str, glob: str | None, schema: Any) -> str:
+def _table_view(name: str, files: list[str], schema: Any) -> str:
     """A view over Parquet files, or, where there are none yet, an empty one with the same columns
-    (DuckDB refuses a glob that matches nothing)."""
-    if glob is not None:
+    (DuckDB refuses an empty list)."""
+    if files:
         return f"""CREATE OR REPLACE VIEW {name} AS
-SELECT * FROM read_parquet('{_quote(glob)}', hive_partitioning = true, union_by_name = true);
+SELECT * FROM read_parquet({_list(files)}, hive_partitioning = true, union_by_name = true);
 """
     columns = ", ".join(f"CAST(NULL AS {_DUCKDB_TYPES.get(str(f.type), 'TIMESTAMPTZ')}) AS {f.name}" for f in schema)
     return f"CREATE OR REPLACE VIEW {name} AS SELECT {columns} WHERE false;\n"
@@ -126,35 +128,43 @@ def _quote(text: str) -> str:
     return text.replace("'", "''")
 
 
+def _list(files: list[str]) -> str:
+    return "[" + ", ".join(f"'{_quote(f)}'" for f in files) + "]"
+
+
 def views_sql(out: Path, *, relative: bool = False) -> str:
-    """The views over the dataset at ``out`` in its layout (``relative``: paths relative to it);
-    the failsafe views are empty where no log was replayed."""
-    replayed = has_failsafe(out)
-    glob = table_glob(out, BATTERY, relative=relative)
-    events = table_glob(out, FAILSAFE, EVENTS_FILE, relative=relative) if replayed else None
-    replays = table_glob(out, FAILSAFE, REPLAYS_FILE, relative=relative) if replayed else None
+    """The views over the dataset at ``out`` (``relative``: paths relative to it): each reads the files its
+    logs' markers name (:func:`.manifest.committed`), so a version being written or one just replaced is
+    never read, and a log is seen whole or not at all. The failsafe views are empty where no log was
+    replayed; a dataset without logs gets its battery table's glob (DuckDB says it matches nothing)."""
+    files = committed(out)
+    prefix = "" if relative else out.as_posix() + "/"
+    battery = [prefix + f for f in files[BATTERY]]
     return "\n".join(
         (
-            _BATTERY_VIEW.format(glob=_quote(glob)),
+            _BATTERY_VIEW.format(
+                files=_list(battery) if battery else f"'{_quote(table_glob(out, BATTERY, relative=relative))}'"
+            ),
             "-- The failsafe replay (battgen export --failsafe): its events, and the batteries replayed.",
-            _table_view("failsafe_events", events, EVENTS_SCHEMA),
-            _table_view("failsafe_replays", replays, REPLAYS_SCHEMA),
+            _table_view("failsafe_events", [prefix + f for f in files["events"]], EVENTS_SCHEMA),
+            _table_view("failsafe_replays", [prefix + f for f in files["replays"]], REPLAYS_SCHEMA),
             _FLIGHT_VIEWS,
         )
     )
 
 
 def has_failsafe(out: Path) -> bool:
-    """Whether any log of the dataset at ``out`` was replayed through the failsafe."""
-    return any((out / FAILSAFE).rglob(REPLAYS_FILE))
+    """Whether any committed log of the dataset at ``out`` was replayed through the failsafe."""
+    return bool(committed(out)["replays"])
 
 
 def write_views(out: Path) -> Path:
-    """``views.sql`` in the dataset folder, with paths relative to it."""
+    """``views.sql`` in the dataset folder, with paths relative to it: the files committed now (a later
+    export writes it again); replaced in one rename."""
     path = out / VIEWS_FILE
     text = (
         "-- battgen fleet views: run DuckDB in this folder (duckdb -init views.sql) or use battgen query.\n"
         + views_sql(out, relative=True)
     )
-    path.write_text(text, encoding="utf-8")
+    write_atomic(path, text)
     return path

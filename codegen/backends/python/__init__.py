@@ -20,6 +20,7 @@ from .imports import from_imports
 from .layout import format_module
 from .literals import docstring, py_literal
 from .module_context import ModuleContext
+from .name_clashes import refuse_clashes
 from .registry import EXTENSIONS
 from .runtime import copied
 from .views import class_view, enum_views
@@ -67,7 +68,9 @@ def module_file(module: str, packages: set[str]) -> str:
 
 
 def render_package(schema: Schema) -> dict[str, str]:
-    """Every file of the generated package, by path relative to the package folder."""
+    """Every file of the generated package, by path relative to the package folder; definitions whose
+    generated names clash are refused first (:mod:`.name_clashes`)."""
+    refuse_clashes(schema)
     env = environment()
     by_module: dict[str, list[Message]] = defaultdict(list)
     for msg in schema.messages:

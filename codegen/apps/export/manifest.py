@@ -1,0 +1,97 @@
+"""What a dataset holds: each exported log's marker (``logs/<id>.json``) names the files of its committed
+version, and readers read those files only.
+
+A log's files are immutable and carry their version in their name (``part-<version>.parquet``,
+``events-<version>.parquet``); a new version is written beside the old one, and the rename of the marker
+that names it is the one step that makes it visible (as Delta Lake's log or Iceberg's snapshot swap do). A
+writer killed at any point leaves the old marker (the old version) or the new one (the new version),
+plus files no marker names; :func:`sweep` removes those at the next run's start, under the writers' lock.
+
+Markers written before versions existed name no files: their log's files are the fixed names of that
+time (``part-0.parquet``, ``events.parquet``, ``replays.parquet``) in the log's partition.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from .durable import TMP_PREFIX
+from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE
+
+BATTERY = "battery"
+RAW = "raw"
+LOGS = "logs"
+TABLE_FOLDERS = (BATTERY, RAW, FAILSAFE)
+# the keys of a marker's "files": the battery table, the raw tables, the failsafe replay's two tables
+FILE_KEYS = (BATTERY, RAW, "events", "replays")
+
+
+def marker(out: Path, log: str) -> Path:
+    return out / LOGS / f"{log}.json"
+
+
+def read_marker(out: Path, log: str) -> dict[str, Any] | None:
+    """What the marker of an exported log records (None: not exported, or a marker unreadable -- a
+    re-export replaces it)."""
+    try:
+        data = json.loads(marker(out, log).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def _markers(out: Path) -> list[dict[str, Any]]:
+    found = []
+    for path in sorted((out / LOGS).glob("*.json")) if (out / LOGS).is_dir() else []:
+        data = read_marker(out, path.stem)
+        if data is not None:
+            found.append(data)
+    return found
+
+
+def marker_files(out: Path, manifest: Mapping[str, Any]) -> dict[str, list[str]]:
+    """The files of the version a marker names, relative to ``out``, by :data:`FILE_KEYS` key."""
+    files = manifest.get("files")
+    if isinstance(files, dict):
+        return {str(k): [str(f) for f in v] for k, v in files.items() if isinstance(v, list)}
+    where = str(manifest.get("partition") or f"log={manifest.get('log')}")  # a marker of before versions
+    legacy = {
+        BATTERY: [f"{BATTERY}/{where}/part-0.parquet"],
+        "events": [f"{FAILSAFE}/{where}/{EVENTS_FILE}"],
+        "replays": [f"{FAILSAFE}/{where}/{REPLAYS_FILE}"],
+        RAW: sorted(p.relative_to(out).as_posix() for p in (out / RAW).glob(f"*/{where}/part-0.parquet")),
+    }
+    return {key: [f for f in names if (out / f).is_file()] for key, names in legacy.items()}
+
+
+def committed(out: Path) -> dict[str, list[str]]:
+    """Every committed file of the dataset at ``out`` (relative paths, sorted), by :data:`FILE_KEYS` key."""
+    files: dict[str, list[str]] = {key: [] for key in FILE_KEYS}
+    for manifest in _markers(out):
+        for key, names in marker_files(out, manifest).items():
+            files.setdefault(key, []).extend(names)
+    return {key: sorted(names) for key, names in files.items()}
+
+
+def sweep(out: Path) -> int:
+    """Remove what writers stopped before their commit left: temporary folders and files (``.tmp-*``) and
+    table files no marker names. Only under the writers' lock. Returns how many were removed."""
+    removed = 0
+    for folder in (out, out / LOGS):
+        for path in folder.glob(f"{TMP_PREFIX}*") if folder.is_dir() else []:
+            if path.is_dir():
+                shutil.rmtree(path, ignore_errors=True)
+            else:
+                path.unlink(missing_ok=True)
+            removed += 1
+    keep = {name for names in committed(out).values() for name in names}
+    for table in TABLE_FOLDERS:
+        for path in (out / table).rglob("*.parquet") if (out / table).is_dir() else []:
+            if path.relative_to(out).as_posix() not in keep:
+                path.unlink(missing_ok=True)
+                removed += 1
+    return removed
