@@ -1,0 +1,175 @@
+"""The generated Rust crate: the committed generated/rust/ is what the backend renders, it is
+`no_std` and forbids unsafe code, and in a temporary copy (cargo's target folder in the temp dir too)
+`cargo test --offline` replays every conformance vector record with identical bytes, values and
+problems to the generated Python package's (tests/rust_cases.py writes the cases at test time);
+`cargo fmt --check` and `cargo clippy -- -D warnings` pass, and a `no_std` library with its own
+panic handler builds against it (std linked in would clash with that handler)."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from rust_cases import Replay, collect, render_replay, replay_test_name
+
+from codegen.apps.package import bundled_schemas, project_root
+from codegen.backends.rust import render_crate
+from codegen.frontends.loader import load
+
+GENERATED = project_root() / "generated" / "rust"
+needs_rustfmt = pytest.mark.skipif(shutil.which("rustfmt") is None, reason="rustfmt not installed")
+needs_cargo = pytest.mark.skipif(shutil.which("cargo") is None, reason="cargo not installed")
+
+
+@needs_rustfmt
+def test_committed_crate_is_fresh() -> None:
+    files = render_crate(load([bundled_schemas()]))
+    assert "src/mavlink/battery_status.rs" in files
+    for rel, text in files.items():
+        assert (GENERATED / rel).read_text(encoding="utf-8") == text, rel
+
+
+def test_crate_is_no_std_without_unsafe_or_dependencies() -> None:
+    lib = (GENERATED / "src" / "lib.rs").read_text(encoding="utf-8")
+    assert "#![no_std]\n" in lib
+    assert "#![forbid(unsafe_code)]\n" in lib
+    for path in (GENERATED / "src").rglob("*.rs"):
+        text = path.read_text(encoding="utf-8")
+        assert re.search(r"\bstd::|extern crate", text) is None, path
+    manifest = (GENERATED / "Cargo.toml").read_text(encoding="utf-8")
+    assert manifest.rstrip().endswith("[dependencies]"), "the crate must have no dependencies"
+
+
+@needs_rustfmt
+def test_cli_writes_and_checks_a_rust_crate(tmp_path: Path) -> None:
+    from codegen.cli.main import main
+
+    out = tmp_path / "crate"
+    assert main(["generate", "--lang", "rust", "-o", str(out)]) == 0
+    assert (out / "src" / "lib.rs").is_file()
+    assert main(["generate", "--lang", "rust", "-o", str(out), "--check"]) == 0
+    (out / "src" / "lib.rs").write_text("// edited\n")
+    assert main(["generate", "--lang", "rust", "-o", str(out), "--check"]) == 1
+    (out / "src" / "stray.rs").write_text("// not generated\n")
+    assert main(["generate", "--lang", "rust", "-o", str(out)]) == 0
+    assert not (out / "src" / "stray.rs").exists()
+
+
+@dataclass(frozen=True)
+class Crate:
+    root: Path
+    target: Path
+    replays: list[Replay]
+
+
+def _cargo(crate: Crate, *args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "CARGO_TARGET_DIR": str(crate.target), "CARGO_NET_OFFLINE": "true"}
+    return subprocess.run(
+        ["cargo", *args], cwd=cwd or crate.root, env=env, capture_output=True, text=True, check=False, timeout=600
+    )
+
+
+@pytest.fixture(scope="module")
+def crate(tmp_path_factory: pytest.TempPathFactory) -> Crate:
+    """A copy of generated/rust with the replay cases written into its tests/ folder."""
+    if shutil.which("cargo") is None:
+        pytest.skip("cargo not installed")
+    work = tmp_path_factory.mktemp("rust")
+    root = work / "battgen"
+    shutil.copytree(GENERATED, root, ignore=shutil.ignore_patterns("target", "Cargo.lock"))
+    schema = load([bundled_schemas()])
+    replays = collect(schema)
+    (root / "tests").mkdir()
+    (root / "tests" / "replay.rs").write_text(render_replay(schema, replays), encoding="utf-8")
+    if shutil.which("rustfmt") is not None:  # so that `cargo fmt --check` sees the whole package formatted
+        subprocess.run(["rustfmt", "--edition", "2021", str(root / "tests" / "replay.rs")], check=True, timeout=300)
+    return Crate(root, work / "target", replays)
+
+
+@needs_cargo
+def test_cargo_test_replays_every_vector_record(crate: Crate) -> None:
+    counts = {r.qualified: len(r.cases) for r in crate.replays}
+    # the codecs' messages are all reached, each with many distinct records
+    for qualified in ("mavlink.BATTERY_STATUS", "mavlink.BATTERY_STATUS_V2", "uorb.BatteryStatus"):
+        assert counts.get(qualified, 0) >= 50, counts
+    assert any('range"' in c for r in crate.replays for c in r.cases), "no case breaks a range"
+    done = _cargo(crate, "test", "--offline")
+    assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-4000:]
+    for r in crate.replays:
+        assert f"test {replay_test_name(r)} ... ok" in done.stdout, replay_test_name(r)
+
+
+@needs_cargo
+def test_cargo_test_fails_on_a_wrong_byte(crate: Crate, tmp_path: Path) -> None:
+    """The replay compares: a case whose payload is off by one byte fails the run."""
+    broken = Crate(tmp_path / "battgen", crate.target, crate.replays)
+    shutil.copytree(crate.root, broken.root)
+    replay = broken.root / "tests" / "replay.rs"
+    text = replay.read_text(encoding="utf-8")
+    # the first case of uORB BatteryStatus: (id, value, &[bytes...], problems); its first byte changed
+    head, sep, rest = text.partition("fn uorb_battery_status()")
+    rest = re.sub(r"\},\s*&\[\s*(\d+)", lambda m: "}, &[" + str((int(m.group(1)) + 1) % 256), rest, count=1)
+    replay.write_text(head + sep + rest, encoding="utf-8")
+    done = _cargo(broken, "test", "--offline")
+    assert done.returncode != 0
+    assert "struct bytes" in done.stdout + done.stderr
+
+
+@needs_cargo
+@needs_rustfmt
+def test_cargo_fmt_check(crate: Crate) -> None:
+    done = _cargo(crate, "fmt", "--check")
+    assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-4000:]
+
+
+@needs_cargo
+def test_cargo_clippy_denies_every_warning(crate: Crate) -> None:
+    if _cargo(crate, "clippy", "--version").returncode != 0:
+        pytest.skip("clippy not installed")
+    done = _cargo(crate, "clippy", "--offline", "--", "-D", "warnings")
+    assert done.returncode == 0, done.stderr[-4000:]
+
+
+NO_STD_LIB = """#![no_std]
+//! A firmware-like user of the crate: no std, its own panic handler.
+
+use battgen::mavlink::BatteryStatus;
+use battgen::mavlink_wire::decode_frame;
+
+/// The remaining charge of a BATTERY_STATUS frame, None when unknown or not a valid frame.
+pub fn remaining(frame: &[u8]) -> Option<i8> {
+    let (_, msg) = decode_frame::<BatteryStatus>(frame).ok()?;
+    if msg.validate().is_empty() {
+        msg.battery_remaining()
+    } else {
+        None
+    }
+}
+
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    loop {}
+}
+"""
+
+
+@needs_cargo
+def test_a_no_std_library_builds_against_the_crate(crate: Crate) -> None:
+    user = crate.root.parent / "nostd_user"
+    (user / "src").mkdir(parents=True)
+    (user / "Cargo.toml").write_text(
+        '[package]\nname = "nostd_user"\nversion = "0.0.0"\nedition = "2021"\n\n'
+        '[lib]\ncrate-type = ["staticlib"]\n\n[dependencies]\nbattgen = { path = "../battgen" }\n\n'
+        '[profile.dev]\npanic = "abort"\n',
+        encoding="utf-8",
+    )
+    (user / "src" / "lib.rs").write_text(NO_STD_LIB, encoding="utf-8")
+    alone = Crate(user, crate.target.parent / "target-nostd", crate.replays)
+    done = _cargo(alone, "build", "--offline")
+    assert done.returncode == 0, done.stderr[-4000:]
+    assert (alone.target / "debug" / "libnostd_user.a").is_file()

@@ -1,0 +1,278 @@
+"""The Rust crate's replay data, written by the Python side at test time: every record of the
+conformance vectors (``battgen vectors``, inputs and outputs, of every converter between the message
+sides) with what the generated Python package makes of it -- the MAVLink 2 payload and frame, the
+uORB struct, the decoded values and the validator's problems -- as Rust test cases. The crate's
+tests (``rust_replay.rs`` beside the test) must give identical bytes, values and problems.
+
+Nothing here is committed to the crate: the cases are rendered into a temporary copy of it.
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import generated.convert as converters
+from codegen.apps.vectors import SIDES, VectorWriter
+from codegen.backends.rust.model import type_path
+from codegen.backends.rust.naming import field_ident, snake
+from codegen.backends.rust.types import scalar
+from codegen.ir import ArrayType, CompositeType, FieldType, Message, PrimitiveKind, PrimitiveType, Schema, StringType
+from codegen.ir.numbers import from_json_number
+
+# the validator rules of one value (the Rust crate does not run the cross-field rules yet)
+FIELD_RULES = frozenset({"nan", "type-bounds", "range", "enum", "bitmask", "length"})
+TARGETS = ("uorb", "uorb_v0", "uorb_info", "mavlink", "mavlink_info", "mavlink_v2", "dronecan")
+HARNESS = Path(__file__).parent / "backends" / "rust_replay.rs"
+
+
+def vector_pairs() -> list[tuple[str, str, str]]:
+    """(source, target, policy) of every converter between message sides, strict and px4."""
+    pairs = sorted(k for k in converters.CONVERTERS if k[0] in SIDES and k[1] in TARGETS)
+    return [(s, t, p) for s, t in pairs for p in converters.POLICIES.get((s, t), ("strict",))]
+
+
+def _from_json(value: object) -> object:
+    """JSON data back to values: the spellings of NaN and the infinities as floats."""
+    if isinstance(value, str):
+        number = from_json_number(value)
+        return value if number is None else number
+    if isinstance(value, list):
+        return [_from_json(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _from_json(v) for k, v in value.items()}
+    return value
+
+
+def _parts(data: object, items: tuple[tuple[str, type[Any]], ...]) -> Iterator[tuple[type[Any], dict[str, Any]]]:
+    """The messages of one side's record: a bare object for a one-message side, else by alias."""
+    if not isinstance(data, dict):
+        return
+    if len(items) == 1:
+        yield items[0][1], data
+        return
+    for alias, cls in items:
+        part = data.get(alias)
+        if isinstance(part, dict):
+            yield cls, part
+
+
+def vector_records() -> Iterator[tuple[str, type[Any], dict[str, Any]]]:
+    """(vector id, generated class, plain record) of every input and output of every vector."""
+    for source, target, policy in vector_pairs():
+        writer = VectorWriter(source, target, policy)
+        doc = writer.document()
+        sides = ((writer.conversion.source.items, "input"), (writer.conversion.target.items, "output"))
+        for vector in doc["vectors"]:  # type: ignore[attr-defined]
+            for items, key in sides:
+                for cls, plain in _parts(_from_json(vector.get(key)), items):
+                    yield f"{source}->{target}/{policy}/{vector['id']}/{key}", cls, plain
+
+
+class Unrepresentable(ValueError):
+    """A value the Rust field's type cannot hold (the Python object holds any int or float)."""
+
+
+def _f32_bits(value: object) -> int:
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        raise Unrepresentable(value)
+    try:
+        packed = struct.pack("<f", value)
+    except OverflowError:
+        raise Unrepresentable(value) from None
+    back = struct.unpack("<f", packed)[0]
+    if not (back == value or (math.isnan(back) and math.isnan(value))):
+        raise Unrepresentable(value)  # the Rust f32 would round it
+    return int.from_bytes(packed, "little")
+
+
+def _int(t: PrimitiveType, value: object) -> str:
+    rust = scalar(t)
+    if isinstance(value, bool) or not isinstance(value, int):
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        else:
+            raise Unrepresentable(value)
+    bits = int(rust[1:])
+    low, high = (0, (1 << bits) - 1) if rust[0] == "u" else (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+    if not low <= value <= high:
+        raise Unrepresentable(value)
+    return str(value)
+
+
+def _primitive(t: PrimitiveType, value: object) -> str:
+    rust = scalar(t)
+    if rust == "bool":
+        if value not in (True, False, 0, 1):
+            raise Unrepresentable(value)
+        return "true" if value else "false"
+    if t.kind is PrimitiveKind.CHAR:
+        raw = value.encode("latin-1") if isinstance(value, str) else bytes([int(value)])  # type: ignore[call-overload]
+        return str(raw[0]) if raw else "0"
+    if rust == "f32":
+        return f"f32::from_bits({_f32_bits(value):#010x})"
+    if rust == "f64":
+        if not isinstance(value, int | float):
+            raise Unrepresentable(value)
+        return f"f64::from_bits({struct.unpack('<Q', struct.pack('<d', value))[0]:#018x})"
+    return _int(t, value)
+
+
+def _bytes(value: object, capacity: int) -> list[str]:
+    raw = value.encode("utf-8") if isinstance(value, str) else bytes(value)  # type: ignore[arg-type]
+    if len(raw) > capacity:
+        raise Unrepresentable(value)
+    return [str(b) for b in raw] + ["0"] * (capacity - len(raw))
+
+
+def value_literal(schema: Schema, t: FieldType, value: object) -> tuple[str, int | None]:
+    """(Rust expression, used length of a dynamic array) of ``value`` in a field of type ``t``."""
+    if isinstance(t, PrimitiveType):
+        return _primitive(t, value), None
+    if isinstance(t, StringType):
+        return "[" + ", ".join(_bytes(value, t.capacity or 1)) + "]", None
+    if isinstance(t, CompositeType):
+        if not isinstance(value, dict):
+            raise Unrepresentable(value)
+        return struct_literal(schema, schema.message(t.name), value), None
+    assert isinstance(t, ArrayType)
+    cap = t.capacity or 1
+    el = t.element
+    if isinstance(el, PrimitiveType) and el.kind is PrimitiveKind.CHAR and isinstance(value, str):
+        return "[" + ", ".join(_bytes(value, cap)) + "]", None
+    if isinstance(value, bytes | bytearray | str):
+        value = list(value.encode("utf-8") if isinstance(value, str) else value)
+    if not isinstance(value, list) or len(value) > cap or (not t.dynamic and len(value) != cap):
+        raise Unrepresentable(value)
+    items = [value_literal(schema, el, v)[0] for v in value]
+    if len(items) < cap:
+        zero = value_literal(schema, el, _zero(el))[0]
+        items += [zero] * (cap - len(items))
+    return "[" + ", ".join(items) + "]", len(value) if t.dynamic else None
+
+
+def _zero(t: FieldType) -> object:
+    if isinstance(t, PrimitiveType):
+        return False if t.kind is PrimitiveKind.BOOL else 0
+    if isinstance(t, CompositeType):
+        return {}
+    return []
+
+
+def struct_literal(schema: Schema, msg: Message, plain: Mapping[str, object]) -> str:
+    """The message as a Rust struct expression (fields the record leaves out at their zero)."""
+    parts = []
+    for f in msg.fields:
+        if f.is_padding:
+            continue
+        ident = field_ident(f.name)
+        value = plain.get(f.name, _zero(f.type))
+        if isinstance(f.type, CompositeType) and isinstance(value, dict):
+            inner = schema.message(f.type.name)
+            value = {g.name: value.get(g.name, _zero(g.type)) for g in inner.fields if not g.is_padding}
+        text, length = value_literal(schema, f.type, value)
+        parts.append(f"{ident}: {text}")
+        if length is not None:
+            parts.append(f"{ident}_len: {length}")
+    return type_path(msg.qualified_name).replace("crate::", "battgen::", 1) + " { " + ", ".join(parts) + " }"
+
+
+def _bytes_literal(data: bytes) -> str:
+    return "&[" + ", ".join(str(b) for b in data) + "]"
+
+
+def _problems(obj: Any) -> str:
+    found = [f'"{v.path} {v.rule}"' for v in obj.validate() if v.rule in FIELD_RULES]
+    return "&[" + ", ".join(found) + "]"
+
+
+@dataclass
+class Replay:
+    """The cases of one message, as lines of a Rust ``vec![...]``, and the ids already taken."""
+
+    kind: str  # mavlink, uorb, values
+    qualified: str
+    cases: list[str] = field(default_factory=list)
+    seen: set[str] = field(default_factory=set)
+    skipped: int = 0
+
+
+def _case(schema: Schema, msg: Message, replay: Replay, cid: str, obj: Any) -> str | None:
+    """One Rust case of ``obj`` (None when the Python side cannot encode it or Rust cannot hold it)."""
+    cls = type(obj)
+    try:
+        if replay.kind == "mavlink":
+            payload = obj.encode()
+            seq = len(replay.cases) % 256
+            frame = obj.encode_frame(seq=seq, sysid=1, compid=1)
+            decoded = cls.decode(payload)
+            value = struct_literal(schema, msg, decoded.to_dict())
+            key = value
+            body = f"{value}, {_bytes_literal(payload)}, {_bytes_literal(frame)}, {seq}, {_problems(decoded)}"
+        elif replay.kind == "uorb":
+            payload = obj.encode()
+            decoded = cls.decode(payload)
+            value = struct_literal(schema, msg, decoded.to_dict())
+            key = value
+            body = f"{value}, {_bytes_literal(payload)}, {_problems(decoded)}"
+        else:
+            value = struct_literal(schema, msg, obj.to_dict())
+            key = value
+            body = f"{value}, {_problems(obj)}"
+    except (Unrepresentable, ValueError, TypeError, OverflowError, struct.error):
+        replay.skipped += 1
+        return None
+    if key in replay.seen:
+        return None
+    replay.seen.add(key)
+    return f'({_rust_str(cid)}, {body}),'
+
+
+def _rust_str(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def collect(schema: Schema) -> list[Replay]:
+    """The replays of every message the vectors reach, in a stable order."""
+    replays: dict[str, Replay] = {}
+    for cid, cls, plain in vector_records():
+        qualified = getattr(cls, "QUALIFIED_NAME", "")
+        try:
+            msg = schema.message(qualified)
+        except KeyError:
+            continue
+        kind = "mavlink" if msg.mavlink is not None else "uorb" if msg.uorb is not None else "values"
+        replay = replays.setdefault(qualified, Replay(kind, qualified))
+        try:
+            obj = cls.from_dict(plain)
+        except (ValueError, TypeError):
+            replay.skipped += 1
+            continue
+        line = _case(schema, msg, replay, cid, obj)
+        if line is not None:
+            replay.cases.append(line)
+    return [replays[q] for q in sorted(replays)]
+
+
+def replay_test_name(replay: Replay) -> str:
+    return snake(replay.qualified.replace(".", "_"))
+
+
+def render_replay(schema: Schema, replays: list[Replay]) -> str:
+    """The crate's ``tests/replay.rs``: the harness, then one test per message over its cases."""
+    out = [HARNESS.read_text(encoding="utf-8")]
+    for r in replays:
+        rust = type_path(r.qualified).replace("crate::", "battgen::", 1)
+        out.append("#[test]")
+        out.append(f"fn {replay_test_name(r)}() {{")
+        out.append(f"    let cases: Vec<{r.kind.capitalize()}Case<{rust}>> = vec![")
+        out += ["        " + c for c in r.cases]
+        out.append("    ];")
+        out.append(f"    replay_{r.kind}(&cases, {len(r.cases)});")
+        out.append("}")
+        out.append("")
+    return "\n".join(out)
