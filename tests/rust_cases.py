@@ -48,7 +48,7 @@ def _from_json(value: object) -> object:
     return value
 
 
-def _parts(data: object, items: tuple[tuple[str, type[Any]], ...]) -> Iterator[tuple[type[Any], dict[str, Any]]]:
+def _parts(data: object, items: tuple[tuple[str, Any], ...]) -> Iterator[tuple[Any, dict[str, Any]]]:
     """The messages of one side's record: a bare object for a one-message side, else by alias."""
     if not isinstance(data, dict):
         return
@@ -61,7 +61,7 @@ def _parts(data: object, items: tuple[tuple[str, type[Any]], ...]) -> Iterator[t
             yield cls, part
 
 
-def vector_records() -> Iterator[tuple[str, type[Any], dict[str, Any]]]:
+def vector_records() -> Iterator[tuple[str, Any, dict[str, Any]]]:
     """(vector id, generated class, plain record) of every input and output of every vector."""
     for source, target, policy in vector_pairs():
         writer = VectorWriter(source, target, policy)
@@ -123,7 +123,12 @@ def _primitive(t: PrimitiveType, value: object) -> str:
 
 
 def _bytes(value: object, capacity: int) -> list[str]:
-    raw = value.encode("utf-8") if isinstance(value, str) else bytes(value)  # type: ignore[arg-type]
+    if isinstance(value, str):
+        raw = value.encode("utf-8")
+    elif isinstance(value, bytes | bytearray | list):
+        raw = bytes(value)
+    else:
+        raise Unrepresentable(value)
     if len(raw) > capacity:
         raise Unrepresentable(value)
     return [str(b) for b in raw] + ["0"] * (capacity - len(raw))
@@ -229,7 +234,7 @@ def _case(schema: Schema, msg: Message, replay: Replay, cid: str, obj: Any) -> s
     if key in replay.seen:
         return None
     replay.seen.add(key)
-    return f'({_rust_str(cid)}, {body}),'
+    return f"({_rust_str(cid)}, {body}),"
 
 
 def _rust_str(text: str) -> str:

@@ -13,8 +13,8 @@ from pathlib import Path
 from .. import __version__
 from ..apps.package import bundled_schemas, project_root
 from ..backends.c import generate_c
-from ..backends.rust import generate_rust
 from ..backends.python.writer import generate
+from ..backends.rust import generate_rust
 from ..errors import BattgenError, ErrorList
 from ..frontends.loader import load
 from ..ir import Schema

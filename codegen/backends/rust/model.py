@@ -6,10 +6,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ...ir import ArrayType, CompositeType, Constant, EnumKind, Field, Message, PrimitiveType, Schema, StringType
+from ...ir import ArrayType, CompositeType, Constant, Field, FieldType, Message, PrimitiveType, Schema, StringType
 from .checks import FieldCheck, field_check
 from .codecs import Codec, mavlink_codec, uorb_codec
-from .docs import doc_lines, doc_text
+from .docs import doc_lines
 from .enums import EnumView, enum_view
 from .naming import camel, field_ident, snake, upper
 from .types import capacity, element, float_literal, scalar, scalar_literal
@@ -27,7 +27,7 @@ def type_path(qualified: str) -> str:
     return "crate::" + "::".join(snake(p) for p in space) + "::" + camel(name)
 
 
-def rust_type(t: object) -> str:
+def rust_type(t: FieldType) -> str:
     if isinstance(t, PrimitiveType):
         return scalar(t)
     if isinstance(t, StringType):
@@ -38,7 +38,7 @@ def rust_type(t: object) -> str:
     return f"[{rust_type(t.element)}; {capacity(t)}]"
 
 
-def default_value(f: Field, t: object = None, index: int = 0) -> str:
+def default_value(f: Field, t: FieldType | None = None, index: int = 0) -> str:
     """The value a new message holds: the field's "unknown" sentinel where it has one, else zero."""
     t = f.type if t is None else t
     s = f.invalid
@@ -126,9 +126,7 @@ def _unknown(f: Field, t: PrimitiveType) -> tuple[str, str | None] | None:
     if s.first_decides:
         return "false", scalar_literal(t, s.value)
     if s.elements:
-        conds = [
-            f"(i == {i} && {_equals(t, v)})" for i, v in enumerate(s.elements) if v is not None
-        ]
+        conds = [f"(i == {i} && {_equals(t, v)})" for i, v in enumerate(s.elements) if v is not None]
         return " || ".join(conds) or "false", None
     return _equals(t, s.value), None
 
@@ -147,8 +145,10 @@ def _accessor(f: Field, ident: str) -> Accessor | None:
         found = _unknown(f, t)
         assert found is not None
         return Accessor(ident, scalar(t), f.name, False, found[0], None, None)
-    if isinstance(t, ArrayType) and isinstance(t.element, PrimitiveType) and (
-        f.invalid.per_element or f.invalid.elements or f.invalid.first_decides
+    if (
+        isinstance(t, ArrayType)
+        and isinstance(t.element, PrimitiveType)
+        and (f.invalid.per_element or f.invalid.elements or f.invalid.first_decides)
     ):
         found = _unknown(f, t.element)
         assert found is not None
@@ -157,7 +157,7 @@ def _accessor(f: Field, ident: str) -> Accessor | None:
     return None
 
 
-def _enum_accessor(schema: Schema, msg: Message, f: Field, ident: str, views: dict[str, EnumView]) -> EnumAccessor | None:
+def _enum_accessor(msg: Message, f: Field, ident: str, views: dict[str, EnumView]) -> EnumAccessor | None:
     if len(f.enums) != 1 or not isinstance(f.type, PrimitiveType):
         return None
     view = views.get(f.enums[0])
@@ -183,7 +183,7 @@ def _fits(narrow: str, wide: str) -> bool:
     return (narrow[0] == wide[0] and n <= w) or (narrow[0] == "u" and wide[0] == "i" and n < w)
 
 
-def _constant(c: Constant, owner: str) -> ConstantView | None:
+def _constant(c: Constant) -> ConstantView:
     v = c.value
     if isinstance(c.type, StringType) or isinstance(v, str):
         text = str(v).replace("\\", "\\\\").replace('"', '\\"')
@@ -204,8 +204,8 @@ def _field_doc(f: Field) -> list[str]:
     if f.invalid is not None:
         notes.append(f"Unknown: `{f.invalid.text}` (the accessor gives `None`).")
     if f.range is not None:
-        r = f.range
-        notes.append(f"Range: {r.minimum if r.minimum is not None else '..'} to {r.maximum if r.maximum is not None else '..'}.")
+        low, high = f.range.minimum, f.range.maximum
+        notes.append(f"Range: {'..' if low is None else low} to {'..' if high is None else high}.")
     if f.enums:
         notes.append("Values: " + ", ".join(f"`{e}`" for e in f.enums) + ".")
     if isinstance(t, PrimitiveType):
@@ -223,19 +223,20 @@ def message_view(schema: Schema, msg: Message, shared: dict[str, EnumView]) -> M
         if f.is_padding:
             continue
         ident = idents[f.name]
-        dyn = isinstance(f.type, ArrayType) and f.type.dynamic
-        members.append(Member(ident, rust_type(f.type), _field_doc(f), default_value(f), f"{ident}_len" if dyn else None))
-        if dyn:
-            same.append(f"self.{ident}_len == other.{ident}_len")
-            same.append(f"self.{ident}[..self.{ident}_len.min({capacity(f.type)})].same(&other.{ident}[..other.{ident}_len.min({capacity(f.type)})])")  # type: ignore[arg-type]
+        t = f.type
+        length = f"{ident}_len" if isinstance(t, ArrayType) and t.dynamic else None
+        members.append(Member(ident, rust_type(t), _field_doc(f), default_value(f), length))
+        if isinstance(t, ArrayType) and t.dynamic:  # only the used elements are the message's data
+            used, cap = f"{ident}_len", capacity(t)
+            same.append(f"self.{used} == other.{used}")
+            same.append(f"self.{ident}[..self.{used}.min({cap})].same(&other.{ident}[..other.{used}.min({cap})])")
         else:
             same.append(f"self.{ident}.same(&other.{ident})")
-    accessors = [a for f in msg.fields if not f.is_padding if (a := _accessor(f, idents[f.name])) is not None]
-    enum_accessors = [
-        a for f in msg.fields if not f.is_padding if (a := _enum_accessor(schema, msg, f, idents[f.name], views)) is not None
-    ]
-    constants = [c for const in msg.constants if (c := _constant(const, msg.name)) is not None]
-    checks = [c for f in msg.fields if not f.is_padding if (c := field_check(schema, f, idents[f.name])) is not None]
+    fields = [f for f in msg.fields if not f.is_padding]
+    accessors = [a for f in fields if (a := _accessor(f, idents[f.name])) is not None]
+    enum_accessors = [e for f in fields if (e := _enum_accessor(msg, f, idents[f.name], views)) is not None]
+    constants = [_constant(c) for c in msg.constants]
+    checks = [c for f in fields if (c := field_check(schema, f, idents[f.name])) is not None]
     return MessageView(
         qualified=msg.qualified_name,
         name=camel(msg.name),
@@ -257,6 +258,3 @@ def message_view(schema: Schema, msg: Message, shared: dict[str, EnumView]) -> M
 def shared_enums(schema: Schema, formats: tuple[str, ...]) -> dict[str, EnumView]:
     """The schema-level enum groups of the formats written (MAVLink's), by qualified name."""
     return {e.name: enum_view(e) for e in schema.enums if e.name.split(".")[0] in formats}
-
-
-__all__ = ["EnumKind", "MessageView", "doc_text", "message_view", "module_parts", "shared_enums", "type_path"]

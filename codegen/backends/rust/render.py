@@ -12,13 +12,14 @@ from pathlib import Path
 
 import jinja2
 
-from ... import __version__
 from ...errors import BattgenError
 from ...ir import Schema, SourceFormat
 from .model import MessageView, message_view, shared_enums
 
 _HERE = Path(__file__).parent
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
+# the crate's own version (its API, not battgen's release): raised when the generated API changes
+CRATE_VERSION = "0.1.0"
 SUPPORT = ("crc", "mavlink_wire", "problems", "same", "uorb_wire", "wire")
 
 
@@ -60,10 +61,13 @@ def rustfmt(files: dict[str, str], config: str) -> dict[str, str]:
         return {rel: (root / "crate" / rel).read_text(encoding="utf-8") for rel in files}
 
 
-def _modules(views: list[MessageView]) -> tuple[dict[tuple[str, ...], set[str]], dict[tuple[str, ...], list[tuple[str, str]]]]:
-    """Namespace modules -> their submodules, and -> the structs they re-export."""
-    children: dict[tuple[str, ...], set[str]] = defaultdict(set)
-    exports: dict[tuple[str, ...], list[tuple[str, str]]] = defaultdict(list)
+ModulePath = tuple[str, ...]  # a module path under the crate root
+
+
+def _modules(views: list[MessageView]) -> tuple[dict[ModulePath, set[str]], dict[ModulePath, list[tuple[str, str]]]]:
+    """Namespace modules -> their submodules, and -> the (module, struct) pairs they re-export."""
+    children: dict[ModulePath, set[str]] = defaultdict(set)
+    exports: dict[ModulePath, list[tuple[str, str]]] = defaultdict(list)
     for v in views:
         parts = tuple(v.module)
         for i in range(len(parts)):
@@ -99,11 +103,12 @@ def render_crate(schema: Schema) -> dict[str, str]:
         )
     for name in SUPPORT:
         text = (_HERE / "support" / f"{name}.rs").read_text(encoding="utf-8")
-        rs[f"src/{name}.rs"] = f"// Copied by battgen from codegen/backends/rust/support/{name}.rs; do not edit.\n" + text
+        head = f"// Copied by battgen from codegen/backends/rust/support/{name}.rs; do not edit.\n"
+        rs[f"src/{name}.rs"] = head + text
     rs["src/lib.rs"] = env.get_template("lib.rs.j2").render(support=SUPPORT, modules=sorted(children[()]))
     config = env.get_template("rustfmt.toml.j2").render()
     files = rustfmt(rs, config)
-    files["Cargo.toml"] = env.get_template("Cargo.toml.j2").render(version=__version__)
+    files["Cargo.toml"] = env.get_template("Cargo.toml.j2").render(version=CRATE_VERSION)
     files["rustfmt.toml"] = config
     files["README.md"] = env.get_template("README.md.j2").render(messages=sorted(v.qualified for v in views))
     files[".gitignore"] = "# cargo's build output, never committed\n/target/\nCargo.lock\n"

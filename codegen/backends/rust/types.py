@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 import struct
 
-from ...ir import ArrayType, CompositeType, FieldType, PrimitiveKind, PrimitiveType, StringType
+from ...ir import ArrayType, FieldType, PrimitiveKind, PrimitiveType, StringType
 
 
 def scalar(t: PrimitiveType) -> str:
@@ -23,7 +23,7 @@ def scalar(t: PrimitiveType) -> str:
 
 def is_exact_width(t: PrimitiveType) -> bool:
     """True when the Rust type holds exactly the values of ``t`` (no width check needed)."""
-    return t.kind is not PrimitiveKind.UINT and t.kind is not PrimitiveKind.INT or t.bits in (8, 16, 32, 64)
+    return (t.kind is not PrimitiveKind.UINT and t.kind is not PrimitiveKind.INT) or t.bits in (8, 16, 32, 64)
 
 
 def element(t: FieldType) -> FieldType:

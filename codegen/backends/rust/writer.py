@@ -13,13 +13,14 @@ _NOT_OURS = ("target", "Cargo.lock")  # cargo's output beside the crate, never r
 def generate_rust(schema: Schema, out: Path, *, check: bool = False) -> tuple[list[str], list[str], list[str]]:
     """(written, removed, unchanged) relative paths; with ``check`` nothing is written."""
     files = render_crate(schema)
-    existing = set()
+    existing: set[str] = set()
     if out.is_dir():
         for p in out.rglob("*"):
-            rel = p.relative_to(out)
-            if p.is_file() and rel.parts[0] not in _NOT_OURS:
-                existing.add(rel.as_posix())
-    written, unchanged = [], []
+            parts = p.relative_to(out).parts
+            if p.is_file() and parts[0] not in _NOT_OURS:
+                existing.add("/".join(parts))
+    written: list[str] = []
+    unchanged: list[str] = []
     for rel, text in files.items():
         target = out / rel
         data = text.encode("utf-8")
