@@ -26,7 +26,17 @@ from codegen.ir.numbers import from_json_number
 
 # the validator rules of one value (the Rust crate does not run the cross-field rules yet)
 FIELD_RULES = frozenset({"nan", "type-bounds", "range", "enum", "bitmask", "length"})
-TARGETS = ("uorb", "uorb_v0", "uorb_info", "mavlink", "mavlink_info", "mavlink_v2", "dronecan")
+TARGETS = (
+    "uorb",
+    "uorb_v0",
+    "uorb_info",
+    "mavlink",
+    "mavlink_info",
+    "mavlink_v2",
+    "dronecan",
+    "ardupilot_battery",
+    "cbat",
+)
 HARNESS = Path(__file__).parent / "backends" / "rust_replay.rs"
 
 
@@ -77,7 +87,8 @@ class Unrepresentable(ValueError):
     """A value the Rust field's type cannot hold (the Python object holds any int or float)."""
 
 
-def _f32_bits(value: object) -> int:
+def _f32_bits(value: object, exact: bool) -> int:
+    """The f32 bits of a value; not ``exact``: rounded to the nearest f32, as the encoders round it."""
     if not isinstance(value, int | float) or isinstance(value, bool):
         raise Unrepresentable(value)
     try:
@@ -85,7 +96,7 @@ def _f32_bits(value: object) -> int:
     except OverflowError:
         raise Unrepresentable(value) from None
     back = struct.unpack("<f", packed)[0]
-    if not (back == value or (math.isnan(back) and math.isnan(value))):
+    if exact and not (back == value or (math.isnan(back) and math.isnan(value))):
         raise Unrepresentable(value)  # the Rust f32 would round it
     return int.from_bytes(packed, "little")
 
@@ -104,7 +115,7 @@ def _int(t: PrimitiveType, value: object) -> str:
     return str(value)
 
 
-def _primitive(t: PrimitiveType, value: object) -> str:
+def _primitive(t: PrimitiveType, value: object, exact: bool) -> str:
     rust = scalar(t)
     if rust == "bool":
         if value not in (True, False, 0, 1):
@@ -114,7 +125,7 @@ def _primitive(t: PrimitiveType, value: object) -> str:
         raw = value.encode("latin-1") if isinstance(value, str) else bytes([int(value)])  # type: ignore[call-overload]
         return str(raw[0]) if raw else "0"
     if rust == "f32":
-        return f"f32::from_bits({_f32_bits(value):#010x})"
+        return f"f32::from_bits({_f32_bits(value, exact):#010x})"
     if rust == "f64":
         if not isinstance(value, int | float):
             raise Unrepresentable(value)
@@ -134,16 +145,17 @@ def _bytes(value: object, capacity: int) -> list[str]:
     return [str(b) for b in raw] + ["0"] * (capacity - len(raw))
 
 
-def value_literal(schema: Schema, t: FieldType, value: object) -> tuple[str, int | None]:
-    """(Rust expression, used length of a dynamic array) of ``value`` in a field of type ``t``."""
+def value_literal(schema: Schema, t: FieldType, value: object, exact: bool = True) -> tuple[str, int | None]:
+    """(Rust expression, used length of a dynamic array) of ``value`` in a field of type ``t``; with
+    ``exact``, a float the Rust f32 would round is Unrepresentable."""
     if isinstance(t, PrimitiveType):
-        return _primitive(t, value), None
+        return _primitive(t, value, exact), None
     if isinstance(t, StringType):
         return "[" + ", ".join(_bytes(value, t.capacity or 1)) + "]", None
     if isinstance(t, CompositeType):
         if not isinstance(value, dict):
             raise Unrepresentable(value)
-        return struct_literal(schema, schema.message(t.name), value), None
+        return struct_literal(schema, schema.message(t.name), value, exact), None
     assert isinstance(t, ArrayType)
     cap = t.capacity or 1
     el = t.element
@@ -153,7 +165,7 @@ def value_literal(schema: Schema, t: FieldType, value: object) -> tuple[str, int
         value = list(value.encode("utf-8") if isinstance(value, str) else value)
     if not isinstance(value, list) or len(value) > cap or (not t.dynamic and len(value) != cap):
         raise Unrepresentable(value)
-    items = [value_literal(schema, el, v)[0] for v in value]
+    items = [value_literal(schema, el, v, exact)[0] for v in value]
     if len(items) < cap:
         zero = value_literal(schema, el, _zero(el))[0]
         items += [zero] * (cap - len(items))
@@ -168,7 +180,7 @@ def _zero(t: FieldType) -> object:
     return []
 
 
-def struct_literal(schema: Schema, msg: Message, plain: Mapping[str, object]) -> str:
+def struct_literal(schema: Schema, msg: Message, plain: Mapping[str, object], exact: bool = True) -> str:
     """The message as a Rust struct expression (fields the record leaves out at their zero)."""
     parts = []
     for f in msg.fields:
@@ -179,7 +191,7 @@ def struct_literal(schema: Schema, msg: Message, plain: Mapping[str, object]) ->
         if isinstance(f.type, CompositeType) and isinstance(value, dict):
             inner = schema.message(f.type.name)
             value = {g.name: value.get(g.name, _zero(g.type)) for g in inner.fields if not g.is_padding}
-        text, length = value_literal(schema, f.type, value)
+        text, length = value_literal(schema, f.type, value, exact)
         parts.append(f"{ident}: {text}")
         if length is not None:
             parts.append(f"{ident}_len: {length}")
@@ -206,8 +218,20 @@ class Replay:
     skipped: int = 0
 
 
+def _value(schema: Schema, msg: Message, obj: Any, decoded: Any) -> str:
+    """The record as the Rust struct holds it: its floats rounded to f32 (as every encoder rounds
+    them), or, when Rust cannot hold it at all (a float beyond f32), the decoded record."""
+    try:
+        return struct_literal(schema, msg, obj.to_dict(), exact=False)
+    except Unrepresentable:
+        return struct_literal(schema, msg, decoded.to_dict())
+
+
 def _case(schema: Schema, msg: Message, replay: Replay, cid: str, obj: Any) -> str | None:
-    """One Rust case of ``obj`` (None when the Python side cannot encode it or Rust cannot hold it)."""
+    """One Rust case of ``obj`` (None when the Python side cannot encode it or Rust cannot hold it).
+
+    A case holds the value given, the value decoded from the Python encoding (which the validator
+    checks), and the Python encoding."""
     cls = type(obj)
     try:
         if replay.kind == "mavlink":
@@ -215,19 +239,25 @@ def _case(schema: Schema, msg: Message, replay: Replay, cid: str, obj: Any) -> s
             seq = len(replay.cases) % 256
             frame = obj.encode_frame(seq=seq, sysid=1, compid=1)
             decoded = cls.decode(payload)
-            value = struct_literal(schema, msg, decoded.to_dict())
-            key = value
-            body = f"{value}, {_bytes_literal(payload)}, {_bytes_literal(frame)}, {seq}, {_problems(decoded)}"
+            wire = f"{_bytes_literal(payload)}, {_bytes_literal(frame)}, {seq}"
         elif replay.kind == "uorb":
             payload = obj.encode()
             decoded = cls.decode(payload)
-            value = struct_literal(schema, msg, decoded.to_dict())
-            key = value
-            body = f"{value}, {_bytes_literal(payload)}, {_problems(decoded)}"
+            wire = _bytes_literal(payload)
+        elif replay.kind == "dronecan":
+            payload = obj.encode()
+            fd = obj.encode(tao=False)
+            decoded = cls.decode(payload)
+            wire = f"{_bytes_literal(payload)}, {_bytes_literal(fd)}"
         else:
             value = struct_literal(schema, msg, obj.to_dict())
-            key = value
             body = f"{value}, {_problems(obj)}"
+            key = value
+        if replay.kind != "values":
+            value = _value(schema, msg, obj, decoded)
+            exact = struct_literal(schema, msg, decoded.to_dict())
+            body = f"{value}, {exact}, {wire}, {_problems(decoded)}"
+            key = value + exact
     except (Unrepresentable, ValueError, TypeError, OverflowError, struct.error):
         replay.skipped += 1
         return None
@@ -250,7 +280,7 @@ def collect(schema: Schema) -> list[Replay]:
             msg = schema.message(qualified)
         except KeyError:
             continue
-        kind = "mavlink" if msg.mavlink is not None else "uorb" if msg.uorb is not None else "values"
+        kind = "mavlink" if msg.mavlink else "uorb" if msg.uorb else "dronecan" if msg.dronecan else "values"
         replay = replays.setdefault(qualified, Replay(kind, qualified))
         try:
             obj = cls.from_dict(plain)

@@ -3,13 +3,18 @@
 // (tests/rust_cases.py). Each case must give the same bytes, values and problems here.
 
 use battgen::mavlink_wire::{self, DecodeError, Header};
-use battgen::{uorb_wire, Problems, Validate};
+use battgen::{dronecan_wire, uorb_wire, Problems, Validate};
 use core::fmt::Debug;
 
-/// (id, value, payload, frame, frame sequence number, problems)
-type MavlinkCase<M> = (&'static str, M, &'static [u8], &'static [u8], u8, &'static [&'static str]);
-/// (id, value, struct bytes, problems)
-type UorbCase<M> = (&'static str, M, &'static [u8], &'static [&'static str]);
+// A case: its id, the value given (floats rounded to f32), the value decoded from the Python
+// encoding, the Python encoding, and the problems of the decoded value.
+type ProblemList = &'static [&'static str];
+/// (id, value, decoded, payload, frame, frame sequence number, problems)
+type MavlinkCase<M> = (&'static str, M, M, &'static [u8], &'static [u8], u8, ProblemList);
+/// (id, value, decoded, struct bytes, problems)
+type UorbCase<M> = (&'static str, M, M, &'static [u8], ProblemList);
+/// (id, value, decoded, payload with the tail array optimisation, payload without (CAN FD), problems)
+type DronecanCase<M> = (&'static str, M, M, &'static [u8], &'static [u8], ProblemList);
 /// (id, value, problems): a message whose codec the crate does not have yet
 type ValuesCase<M> = (&'static str, M, &'static [&'static str]);
 
@@ -37,11 +42,11 @@ where
     M: mavlink_wire::Message + Validate + PartialEq + Debug,
 {
     assert_eq!(cases.len(), count);
-    for (id, value, payload, frame, seq, expected) in cases {
+    for (id, value, decoded, payload, frame, seq, expected) in cases {
         let mut buf = [0u8; 255];
         let n = value.encode(&mut buf);
         assert_eq!(&buf[..n], *payload, "{id}: payload");
-        assert_eq!(M::decode(payload).as_ref(), Ok(value), "{id}: decoded payload");
+        assert_eq!(M::decode(payload).as_ref(), Ok(decoded), "{id}: decoded payload");
 
         let header = Header {
             seq: *seq,
@@ -52,7 +57,7 @@ where
         let n = mavlink_wire::encode_frame(value, header, &mut out);
         assert_eq!(&out[..n], *frame, "{id}: frame");
         let (got_header, got) = mavlink_wire::decode_frame::<M>(frame).expect(id);
-        assert_eq!((got_header, &got), (header, value), "{id}: decoded frame");
+        assert_eq!((got_header, &got), (header, decoded), "{id}: decoded frame");
 
         // one bit flipped in the payload: the checksum must catch it
         let mut bad = frame.to_vec();
@@ -61,7 +66,7 @@ where
             matches!(mavlink_wire::decode_frame::<M>(&bad), Err(DecodeError::BadCrc { .. })),
             "{id}: corrupted frame accepted"
         );
-        check_problems(id, value, expected);
+        check_problems(id, decoded, expected);
     }
 }
 
@@ -70,12 +75,28 @@ where
     M: uorb_wire::Message + Validate + PartialEq + Debug,
 {
     assert_eq!(cases.len(), count);
-    for (id, value, data, expected) in cases {
+    for (id, value, decoded, data, expected) in cases {
         let mut buf = vec![0xAAu8; M::STRUCT_SIZE];
         value.encode(&mut buf);
         assert_eq!(&buf[..], *data, "{id}: struct bytes");
-        assert_eq!(M::decode(data).as_ref(), Ok(value), "{id}: decoded struct");
-        check_problems(id, value, expected);
+        assert_eq!(M::decode(data).as_ref(), Ok(decoded), "{id}: decoded struct");
+        check_problems(id, decoded, expected);
+    }
+}
+
+fn replay_dronecan<M>(cases: &[DronecanCase<M>], count: usize)
+where
+    M: dronecan_wire::Message + Validate + PartialEq + Debug,
+{
+    assert_eq!(cases.len(), count);
+    for (id, value, decoded, payload, fd, expected) in cases {
+        for (tao, bytes) in [(true, payload), (false, fd)] {
+            let mut buf = vec![0xAAu8; M::MAX_BYTES];
+            let n = value.encode(&mut buf, tao).expect(id);
+            assert_eq!(&buf[..n], *bytes, "{id}: payload (tao {tao})");
+            assert_eq!(M::decode(bytes, tao).as_ref(), Ok(decoded), "{id}: decoded (tao {tao})");
+        }
+        check_problems(id, decoded, expected);
     }
 }
 

@@ -10,6 +10,7 @@ from ...ir import ArrayType, CompositeType, Constant, Field, FieldType, Message,
 from .checks import FieldCheck, field_check
 from .codecs import Codec, mavlink_codec, uorb_codec
 from .docs import doc_lines
+from .dronecan_codec import DronecanCodec, dronecan_codec
 from .enums import EnumView, enum_view
 from .naming import camel, field_ident, snake, upper
 from .types import capacity, element, float_literal, scalar, scalar_literal
@@ -109,6 +110,7 @@ class MessageView:
     checks: list[FieldCheck]
     mavlink: Codec | None
     uorb: Codec | None
+    dronecan: DronecanCodec | None
     msg: Message
     same: list[str] = field(default_factory=list)  # the sameness terms of PartialEq
 
@@ -250,6 +252,7 @@ def message_view(schema: Schema, msg: Message, shared: dict[str, EnumView]) -> M
         checks=checks,
         mavlink=mavlink_codec(msg, idents),
         uorb=uorb_codec(msg, idents),
+        dronecan=dronecan_codec(schema, msg, idents),
         msg=msg,
         same=same,
     )

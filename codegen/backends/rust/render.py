@@ -20,7 +20,7 @@ _HERE = Path(__file__).parent
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
 # the crate's own version (its API, not battgen's release): raised when the generated API changes
 CRATE_VERSION = "0.1.0"
-SUPPORT = ("crc", "mavlink_wire", "problems", "same", "uorb_wire", "wire")
+SUPPORT = ("crc", "dronecan_wire", "mavlink_wire", "problems", "same", "uorb_wire", "wire")
 
 
 def _environment() -> jinja2.Environment:

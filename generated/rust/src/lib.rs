@@ -7,6 +7,7 @@
 
 pub mod crc;
 pub mod dronecan;
+pub mod dronecan_wire;
 pub mod mavlink;
 pub mod mavlink_wire;
 pub mod problems;
