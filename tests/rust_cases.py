@@ -9,7 +9,9 @@ Nothing here is committed to the crate: the cases are rendered into a temporary 
 
 from __future__ import annotations
 
+import importlib
 import math
+import random
 import struct
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
@@ -218,13 +220,19 @@ class Replay:
     skipped: int = 0
 
 
-def _value(schema: Schema, msg: Message, obj: Any, decoded: Any) -> str:
-    """The record as the Rust struct holds it: its floats rounded to f32 (as every encoder rounds
-    them), or, when Rust cannot hold it at all (a float beyond f32), the decoded record."""
+def _value(schema: Schema, msg: Message, obj: Any, decoded: Any) -> tuple[str, bool]:
+    """The record as the Rust struct holds it, and whether that is exactly the Python record: its
+    floats rounded to f32 (as every encoder rounds them), or, when Rust cannot hold it at all (a
+    float beyond f32), the decoded record."""
+    plain = obj.to_dict()
     try:
-        return struct_literal(schema, msg, obj.to_dict(), exact=False)
+        return struct_literal(schema, msg, plain), True
     except Unrepresentable:
-        return struct_literal(schema, msg, decoded.to_dict())
+        pass
+    try:
+        return struct_literal(schema, msg, plain, exact=False), False
+    except Unrepresentable:
+        return struct_literal(schema, msg, decoded.to_dict()), False
 
 
 def _case(schema: Schema, msg: Message, replay: Replay, cid: str, obj: Any) -> str | None:
@@ -251,12 +259,14 @@ def _case(schema: Schema, msg: Message, replay: Replay, cid: str, obj: Any) -> s
             wire = f"{_bytes_literal(payload)}, {_bytes_literal(fd)}"
         else:
             value = struct_literal(schema, msg, obj.to_dict())
-            body = f"{value}, {_problems(obj)}"
+            body = f"{_rust_str(cid)}, {value}, {_problems(obj)}"
             key = value
         if replay.kind != "values":
-            value = _value(schema, msg, obj, decoded)
+            value, same = _value(schema, msg, obj, decoded)
             exact = struct_literal(schema, msg, decoded.to_dict())
-            body = f"{value}, {exact}, {wire}, {_problems(decoded)}"
+            # the value's own problems where Rust holds exactly the Python record
+            given = f"Some({_problems(obj)})" if same else "None"
+            body = f"({_rust_str(cid)}, {value}, {given}, {exact}), {wire}, {_problems(decoded)}"
             key = value + exact
     except (Unrepresentable, ValueError, TypeError, OverflowError, struct.error):
         replay.skipped += 1
@@ -264,17 +274,92 @@ def _case(schema: Schema, msg: Message, replay: Replay, cid: str, obj: Any) -> s
     if key in replay.seen:
         return None
     replay.seen.add(key)
-    return f"({_rust_str(cid)}, {body}),"
+    return f"({body}),"
 
 
 def _rust_str(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
-def collect(schema: Schema) -> list[Replay]:
-    """The replays of every message the vectors reach, in a stable order."""
+RANDOM_RECORDS = 40  # per message with a codec, on top of the vectors
+
+
+def _random_float(rng: random.Random) -> float:
+    """Any f32 (NaN canonical), or a value near float16's edges: its largest, beyond, subnormal."""
+    pick = rng.random()
+    if pick < 0.4:
+        bits = rng.getrandbits(32)
+        if bits & 0x7F800000 == 0x7F800000 and bits & 0x7FFFFF:
+            return math.nan
+        return float(struct.unpack("<f", struct.pack("<I", bits))[0])
+    if pick < 0.6:
+        return rng.choice((-1.0, 1.0)) * rng.uniform(65000.0, 70000.0)
+    if pick < 0.8:
+        return float(struct.unpack("<f", struct.pack("<f", rng.choice((-1.0, 1.0)) * rng.uniform(0, 1e-4)))[0])
+    return float(struct.unpack("<f", struct.pack("<f", rng.uniform(-100.0, 100.0)))[0])
+
+
+def _random_value(t: FieldType, rng: random.Random) -> object:
+    if isinstance(t, PrimitiveType):
+        if t.kind is PrimitiveKind.BOOL:
+            return rng.random() < 0.5
+        if t.kind is PrimitiveKind.FLOAT:
+            return _random_float(rng)
+        rust = scalar(t)
+        bits = int(rust[1:]) if rng.random() < 0.5 else t.bits  # beyond a DSDL odd width half the time
+        if t.kind is PrimitiveKind.UINT:
+            return rng.randrange(0, 1 << bits)
+        return rng.randrange(-(1 << (bits - 1)), 1 << (bits - 1))
+    if isinstance(t, StringType) or (
+        isinstance(t, ArrayType) and isinstance(t.element, PrimitiveType) and t.element.kind is PrimitiveKind.CHAR
+    ):
+        cap = t.capacity or 1
+        return "".join(rng.choice("abcXYZ019 -") for _ in range(rng.randint(0, cap)))
+    if isinstance(t, ArrayType):
+        cap = t.capacity or 1
+        n = rng.randint(0, cap) if t.dynamic else cap
+        return [_random_value(t.element, rng) for _ in range(n)]
+    return {}
+
+
+def random_records(msg: Message) -> Iterator[tuple[str, dict[str, object]]]:
+    """Seeded random records of ``msg`` (the same every run): what the vectors do not reach, such
+    as float16 rounding and saturation, and the messages no converter reads or writes."""
+    rng = random.Random(msg.qualified_name)
+    for i in range(RANDOM_RECORDS):
+        plain = {
+            f.name: _random_value(f.type, rng)
+            for f in msg.fields
+            if not f.is_padding and not isinstance(f.type, CompositeType)
+        }
+        yield f"random/{i}", plain
+
+
+def generated_classes(schema: Schema) -> dict[str, Any]:
+    """Qualified name -> the generated Python class, of every message the crate has a codec for."""
+    out: dict[str, Any] = {}
+    for msg in schema.messages:
+        if msg.format.value not in ("mavlink", "uorb", "dronecan") or (msg.dronecan is not None and msg.dronecan.union):
+            continue
+        module = importlib.import_module("generated." + msg.qualified_name.rsplit(".", 1)[0])
+        out[msg.qualified_name] = next(
+            cls for cls in vars(module).values() if getattr(cls, "QUALIFIED_NAME", None) == msg.qualified_name
+        )
+    return out
+
+
+def _records(schema: Schema, classes: Mapping[str, Any]) -> Iterator[tuple[str, Any, dict[str, Any]]]:
+    yield from vector_records()
+    for qualified, cls in sorted(classes.items()):
+        for cid, plain in random_records(schema.message(qualified)):
+            yield cid, cls, plain
+
+
+def collect(schema: Schema, classes: Mapping[str, Any]) -> list[Replay]:
+    """The replays of every message the vectors reach and of ``classes`` (qualified name ->
+    generated class: random records), in a stable order."""
     replays: dict[str, Replay] = {}
-    for cid, cls, plain in vector_records():
+    for cid, cls, plain in _records(schema, classes):
         qualified = getattr(cls, "QUALIFIED_NAME", "")
         try:
             msg = schema.message(qualified)

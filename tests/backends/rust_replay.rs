@@ -6,15 +6,17 @@ use battgen::mavlink_wire::{self, DecodeError, Header};
 use battgen::{dronecan_wire, uorb_wire, Problems, Validate};
 use core::fmt::Debug;
 
-// A case: its id, the value given (floats rounded to f32), the value decoded from the Python
-// encoding, the Python encoding, and the problems of the decoded value.
+// A case: its id, the value given (floats rounded to f32) with its problems (when Rust holds the
+// Python record exactly), the value decoded from the Python encoding, the Python encoding, and the
+// problems of the decoded value.
 type ProblemList = &'static [&'static str];
-/// (id, value, decoded, payload, frame, frame sequence number, problems)
-type MavlinkCase<M> = (&'static str, M, M, &'static [u8], &'static [u8], u8, ProblemList);
-/// (id, value, decoded, struct bytes, problems)
-type UorbCase<M> = (&'static str, M, M, &'static [u8], ProblemList);
-/// (id, value, decoded, payload with the tail array optimisation, payload without (CAN FD), problems)
-type DronecanCase<M> = (&'static str, M, M, &'static [u8], &'static [u8], ProblemList);
+type Given<M> = (&'static str, M, Option<ProblemList>, M);
+/// (id, value, its problems, decoded, payload, frame, frame sequence number, problems)
+type MavlinkCase<M> = (Given<M>, &'static [u8], &'static [u8], u8, ProblemList);
+/// (id, value, its problems, decoded, struct bytes, problems)
+type UorbCase<M> = (Given<M>, &'static [u8], ProblemList);
+/// (id, value, its problems, decoded, payload with the tail array optimisation, without (CAN FD), problems)
+type DronecanCase<M> = (Given<M>, &'static [u8], &'static [u8], ProblemList);
 /// (id, value, problems): a message whose codec the crate does not have yet
 type ValuesCase<M> = (&'static str, M, &'static [&'static str]);
 
@@ -37,12 +39,19 @@ fn check_problems<T: Validate>(id: &str, value: &T, expected: &[&str]) {
     assert_eq!(found, expected, "{id}: problems");
 }
 
+fn check_given<T: Validate>(id: &str, value: &T, given: Option<ProblemList>) {
+    if let Some(expected) = given {
+        assert_eq!(problems(value), expected, "{id}: problems of the value given");
+    }
+}
+
 fn replay_mavlink<M>(cases: &[MavlinkCase<M>], count: usize)
 where
     M: mavlink_wire::Message + Validate + PartialEq + Debug,
 {
     assert_eq!(cases.len(), count);
-    for (id, value, decoded, payload, frame, seq, expected) in cases {
+    for ((id, value, given, decoded), payload, frame, seq, expected) in cases {
+        check_given(id, value, *given);
         let mut buf = [0u8; 255];
         let n = value.encode(&mut buf);
         assert_eq!(&buf[..n], *payload, "{id}: payload");
@@ -75,7 +84,8 @@ where
     M: uorb_wire::Message + Validate + PartialEq + Debug,
 {
     assert_eq!(cases.len(), count);
-    for (id, value, decoded, data, expected) in cases {
+    for ((id, value, given, decoded), data, expected) in cases {
+        check_given(id, value, *given);
         let mut buf = vec![0xAAu8; M::STRUCT_SIZE];
         value.encode(&mut buf);
         assert_eq!(&buf[..], *data, "{id}: struct bytes");
@@ -89,7 +99,8 @@ where
     M: dronecan_wire::Message + Validate + PartialEq + Debug,
 {
     assert_eq!(cases.len(), count);
-    for (id, value, decoded, payload, fd, expected) in cases {
+    for ((id, value, given, decoded), payload, fd, expected) in cases {
+        check_given(id, value, *given);
         for (tao, bytes) in [(true, payload), (false, fd)] {
             let mut buf = vec![0xAAu8; M::MAX_BYTES];
             let n = value.encode(&mut buf, tao).expect(id);

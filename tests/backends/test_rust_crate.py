@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from rust_cases import Replay, collect, render_replay, replay_test_name
+from rust_cases import Replay, collect, generated_classes, render_replay, replay_test_name
 
 from codegen.apps.package import bundled_schemas, project_root
 from codegen.backends.rust import render_crate
@@ -83,7 +83,7 @@ def crate(tmp_path_factory: pytest.TempPathFactory) -> Crate:
     root = work / "battgen"
     shutil.copytree(GENERATED, root, ignore=shutil.ignore_patterns("target", "Cargo.lock"))
     schema = load([bundled_schemas()])
-    replays = collect(schema)
+    replays = collect(schema, generated_classes(schema))
     (root / "tests").mkdir()
     (root / "tests" / "replay.rs").write_text(render_replay(schema, replays), encoding="utf-8")
     if shutil.which("rustfmt") is not None:  # so that `cargo fmt --check` sees the whole package formatted
@@ -106,16 +106,17 @@ def test_cargo_test_replays_every_vector_record(crate: Crate) -> None:
 
 @needs_cargo
 def test_cargo_test_fails_on_a_wrong_byte(crate: Crate, tmp_path: Path) -> None:
-    """The replay compares: a case whose payload is off by one byte fails the run."""
-    broken = Crate(tmp_path / "battgen", crate.target, crate.replays)
-    shutil.copytree(crate.root, broken.root)
-    replay = broken.root / "tests" / "replay.rs"
-    text = replay.read_text(encoding="utf-8")
-    # the first case of uORB BatteryStatus: (id, value, &[bytes...], problems); its first byte changed
-    head, sep, rest = text.partition("fn uorb_battery_status()")
-    rest = re.sub(r"\},\s*&\[\s*(\d+)", lambda m: "}, &[" + str((int(m.group(1)) + 1) % 256), rest, count=1)
-    replay.write_text(head + sep + rest, encoding="utf-8")
-    done = _cargo(broken, "test", "--offline")
+    """The replay compares: a uORB BatteryStatus case whose struct's first byte is off by one fails."""
+    root = tmp_path / "battgen"
+    shutil.copytree(crate.root, root, ignore=shutil.ignore_patterns("tests"))
+    (root / "tests").mkdir()
+    status = next(r for r in crate.replays if r.qualified == "uorb.BatteryStatus")
+    # a case is ((id, value, problems, decoded), &[struct bytes...], problems)
+    case = re.sub(r"\}\), &\[(\d+)", lambda m: "}), &[" + str((int(m.group(1)) + 1) % 256), status.cases[0], count=1)
+    assert case != status.cases[0]
+    broken = Replay(status.kind, status.qualified, [case])
+    (root / "tests" / "replay.rs").write_text(render_replay(load([bundled_schemas()]), [broken]), encoding="utf-8")
+    done = _cargo(Crate(root, crate.target, [broken]), "test", "--offline")
     assert done.returncode != 0
     assert "struct bytes" in done.stdout + done.stderr
 
