@@ -67,10 +67,11 @@ class Crate:
     replays: list[Replay]
 
 
-def _cargo(crate: Crate, *args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "CARGO_TARGET_DIR": str(crate.target), "CARGO_NET_OFFLINE": "true"}
+def _cargo(crate: Crate, *args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    """cargo in the crate's folder, its build output in the temp dir, never the network."""
+    full = {**os.environ, "CARGO_TARGET_DIR": str(crate.target), "CARGO_NET_OFFLINE": "true", **(env or {})}
     return subprocess.run(
-        ["cargo", *args], cwd=cwd or crate.root, env=env, capture_output=True, text=True, check=False, timeout=600
+        ["cargo", *args], cwd=crate.root, env=full, capture_output=True, text=True, check=False, timeout=600
     )
 
 
@@ -86,8 +87,6 @@ def crate(tmp_path_factory: pytest.TempPathFactory) -> Crate:
     replays = collect(schema, generated_classes(schema))
     (root / "tests").mkdir()
     (root / "tests" / "replay.rs").write_text(render_replay(schema, replays), encoding="utf-8")
-    if shutil.which("rustfmt") is not None:  # so that `cargo fmt --check` sees the whole package formatted
-        subprocess.run(["rustfmt", "--edition", "2021", str(root / "tests" / "replay.rs")], check=True, timeout=300)
     return Crate(root, work / "target", replays)
 
 
@@ -102,6 +101,7 @@ def test_cargo_test_replays_every_vector_record(crate: Crate) -> None:
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-4000:]
     for r in crate.replays:
         assert f"test {replay_test_name(r)} ... ok" in done.stdout, replay_test_name(r)
+    assert re.search(r"test src/lib\.rs - \(line \d+\) \.\.\. ok", done.stdout), "the crate's doc example did not run"
 
 
 @needs_cargo
@@ -123,8 +123,11 @@ def test_cargo_test_fails_on_a_wrong_byte(crate: Crate, tmp_path: Path) -> None:
 
 @needs_cargo
 @needs_rustfmt
-def test_cargo_fmt_check(crate: Crate) -> None:
-    done = _cargo(crate, "fmt", "--check")
+def test_cargo_fmt_check(crate: Crate, tmp_path: Path) -> None:
+    """The crate as committed (the replay data, not formatted, left out)."""
+    root = tmp_path / "battgen"
+    shutil.copytree(GENERATED, root, ignore=shutil.ignore_patterns("target", "Cargo.lock"))
+    done = _cargo(Crate(root, crate.target, []), "fmt", "--check")
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-4000:]
 
 
@@ -133,6 +136,13 @@ def test_cargo_clippy_denies_every_warning(crate: Crate) -> None:
     if _cargo(crate, "clippy", "--version").returncode != 0:
         pytest.skip("clippy not installed")
     done = _cargo(crate, "clippy", "--offline", "--", "-D", "warnings")
+    assert done.returncode == 0, done.stderr[-4000:]
+
+
+@needs_cargo
+def test_cargo_doc_without_warnings(crate: Crate) -> None:
+    """The schema's words reach rustdoc as words: no broken links, HTML or bare URLs."""
+    done = _cargo(crate, "doc", "--offline", "--no-deps", env={"RUSTDOCFLAGS": "-D warnings"})
     assert done.returncode == 0, done.stderr[-4000:]
 
 

@@ -1,8 +1,8 @@
 """Rust backend: a ``no_std`` Cargo crate of the IR's DroneCAN, MAVLink and uORB messages (structs,
-``Option`` accessors for sentinels, enums, constants, MAVLink 2 and uORB codecs, validators).
+``Option`` accessors for sentinels, enums, constants, MAVLink 2, uORB and DroneCAN codecs, validators).
 
 Templates render what varies per schema; hand-written support modules (``support/*.rs``: checksum,
-wire access, the problem list, the MAVLink frame) are copied verbatim. rustfmt formats every ``.rs``
+byte and bit access, float16, the problem list, the MAVLink frame) are copied verbatim. rustfmt formats every ``.rs``
 file, so the crate passes ``cargo fmt --check`` as committed.
 """
 
