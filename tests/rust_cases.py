@@ -284,22 +284,28 @@ def _rust_str(text: str) -> str:
 RANDOM_RECORDS = 40  # per message with a codec, on top of the vectors
 
 
+def _f32(x: float) -> float:
+    return float(struct.unpack("<f", struct.pack("<f", x))[0])
+
+
 def _random_float(rng: random.Random) -> float:
-    """Any f32 (NaN canonical), or a value near float16's edges: its largest, beyond, subnormal."""
+    """Any f32 (NaN canonical), or a value near float16's edges: its largest, beyond, subnormal;
+    always exactly an f32, so Rust holds the record the Python side validates."""
     pick = rng.random()
     if pick < 0.4:
         bits = rng.getrandbits(32)
         if bits & 0x7F800000 == 0x7F800000 and bits & 0x7FFFFF:
             return math.nan
         return float(struct.unpack("<f", struct.pack("<I", bits))[0])
+    sign = rng.choice((-1.0, 1.0))
     if pick < 0.6:
-        return rng.choice((-1.0, 1.0)) * rng.uniform(65000.0, 70000.0)
+        return _f32(sign * rng.uniform(65000.0, 70000.0))
     if pick < 0.8:
-        return float(struct.unpack("<f", struct.pack("<f", rng.choice((-1.0, 1.0)) * rng.uniform(0, 1e-4)))[0])
-    return float(struct.unpack("<f", struct.pack("<f", rng.uniform(-100.0, 100.0)))[0])
+        return _f32(sign * rng.uniform(0, 1e-4))
+    return _f32(rng.uniform(-100.0, 100.0))
 
 
-def _random_value(t: FieldType, rng: random.Random) -> object:
+def _random_value(schema: Schema, t: FieldType, rng: random.Random) -> object:
     if isinstance(t, PrimitiveType):
         if t.kind is PrimitiveKind.BOOL:
             return rng.random() < 0.5
@@ -318,21 +324,21 @@ def _random_value(t: FieldType, rng: random.Random) -> object:
     if isinstance(t, ArrayType):
         cap = t.capacity or 1
         n = rng.randint(0, cap) if t.dynamic else cap
-        return [_random_value(t.element, rng) for _ in range(n)]
-    return {}
+        return [_random_value(schema, t.element, rng) for _ in range(n)]
+    assert isinstance(t, CompositeType)
+    return _random_record(schema, schema.message(t.name), rng)
 
 
-def random_records(msg: Message) -> Iterator[tuple[str, dict[str, object]]]:
+def _random_record(schema: Schema, msg: Message, rng: random.Random) -> dict[str, object]:
+    return {f.name: _random_value(schema, f.type, rng) for f in msg.fields if not f.is_padding}
+
+
+def random_records(schema: Schema, msg: Message) -> Iterator[tuple[str, dict[str, object]]]:
     """Seeded random records of ``msg`` (the same every run): what the vectors do not reach, such
     as float16 rounding and saturation, and the messages no converter reads or writes."""
     rng = random.Random(msg.qualified_name)
     for i in range(RANDOM_RECORDS):
-        plain = {
-            f.name: _random_value(f.type, rng)
-            for f in msg.fields
-            if not f.is_padding and not isinstance(f.type, CompositeType)
-        }
-        yield f"random/{i}", plain
+        yield f"random/{i}", _random_record(schema, msg, rng)
 
 
 def generated_classes(schema: Schema) -> dict[str, Any]:
@@ -351,7 +357,7 @@ def generated_classes(schema: Schema) -> dict[str, Any]:
 def _records(schema: Schema, classes: Mapping[str, Any]) -> Iterator[tuple[str, Any, dict[str, Any]]]:
     yield from vector_records()
     for qualified, cls in sorted(classes.items()):
-        for cid, plain in random_records(schema.message(qualified)):
+        for cid, plain in random_records(schema, schema.message(qualified)):
             yield cid, cls, plain
 
 

@@ -97,6 +97,39 @@ class ConstantView:
 
 
 @dataclass(frozen=True)
+class CheckUse:
+    """One check as ``validate_into`` runs it: on a field of the message or of a message nested in it
+    (``timestamp.usec``), through the check function of the message that defines the field."""
+
+    path: str  # as problems name it
+    target: str  # the value's expression (``self.timestamp.usec``)
+    fn: str  # the check function's path
+    check: FieldCheck
+
+    @property
+    def length(self) -> str:
+        """A dynamic array's used length."""
+        return f"{self.target}_len"
+
+
+def check_uses(schema: Schema, msg: Message, path: str = "", target: str = "self.", depth: int = 0) -> list[CheckUse]:
+    """Every check of ``msg``'s fields and, path by path, of the messages nested in it (not in arrays)."""
+    module = "crate::" + "::".join(module_parts(msg.qualified_name)) + "::"
+    out: list[CheckUse] = []
+    for f in msg.fields:
+        if f.is_padding:
+            continue
+        ident = field_ident(f.name)
+        c = field_check(schema, f, ident)
+        if c is not None:
+            out.append(CheckUse(path + f.name, target + ident, (module if depth else "") + c.fn_name, c))
+        elif isinstance(f.type, CompositeType) and depth < 8:
+            inner = schema.message(f.type.name)
+            out += check_uses(schema, inner, f"{path}{f.name}.", f"{target}{ident}.", depth + 1)
+    return out
+
+
+@dataclass(frozen=True)
 class MessageView:
     qualified: str
     name: str
@@ -107,7 +140,8 @@ class MessageView:
     enum_accessors: list[EnumAccessor]
     constants: list[ConstantView]
     enums: list[EnumView]
-    checks: list[FieldCheck]
+    checks: list[FieldCheck]  # the check functions the message's module defines
+    uses: list[CheckUse]  # what its validate_into runs
     mavlink: Codec | None
     uorb: Codec | None
     dronecan: DronecanCodec | None
@@ -117,7 +151,7 @@ class MessageView:
     @property
     def max_problems(self) -> int:
         """Every value checked can break one rule, a dynamic array's length one more."""
-        return sum((c.count or 1) + (1 if c.dynamic else 0) for c in self.checks)
+        return sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in self.uses)
 
 
 def _unknown(f: Field, t: PrimitiveType) -> tuple[str, str | None] | None:
@@ -250,6 +284,7 @@ def message_view(schema: Schema, msg: Message, shared: dict[str, EnumView]) -> M
         constants=constants,
         enums=list(local.values()),
         checks=checks,
+        uses=check_uses(schema, msg),
         mavlink=mavlink_codec(msg, idents),
         uorb=uorb_codec(msg, idents),
         dronecan=dronecan_codec(schema, msg, idents),

@@ -350,21 +350,21 @@ impl Same for BatteryInfo {
     }
 }
 
-fn check_battery_function(v: u8) -> Option<Rule> {
+pub(crate) fn check_battery_function(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=4) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_type(v: u8) -> Option<Rule> {
+pub(crate) fn check_type(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=4) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_discharge_minimum_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_discharge_minimum_voltage(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -377,7 +377,7 @@ fn check_discharge_minimum_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_charging_minimum_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_charging_minimum_voltage(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -390,7 +390,7 @@ fn check_charging_minimum_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_resting_minimum_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_resting_minimum_voltage(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -403,7 +403,7 @@ fn check_resting_minimum_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_charging_maximum_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_charging_maximum_voltage(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -416,7 +416,7 @@ fn check_charging_maximum_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_charging_maximum_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_charging_maximum_current(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -429,7 +429,7 @@ fn check_charging_maximum_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_nominal_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_nominal_voltage(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -442,7 +442,7 @@ fn check_nominal_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_discharge_maximum_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_discharge_maximum_current(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -455,7 +455,7 @@ fn check_discharge_maximum_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_discharge_maximum_burst_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_discharge_maximum_burst_current(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -468,7 +468,7 @@ fn check_discharge_maximum_burst_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_design_capacity(v: f32) -> Option<Rule> {
+pub(crate) fn check_design_capacity(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -481,7 +481,7 @@ fn check_design_capacity(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_full_charge_capacity(v: f32) -> Option<Rule> {
+pub(crate) fn check_full_charge_capacity(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }

@@ -246,35 +246,35 @@ impl Same for BatteryStatus {
     }
 }
 
-fn check_battery_function(v: u8) -> Option<Rule> {
+pub(crate) fn check_battery_function(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=4) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_type(v: u8) -> Option<Rule> {
+pub(crate) fn check_type(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=4) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_charge_state(v: u8) -> Option<Rule> {
+pub(crate) fn check_charge_state(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=7) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_mode(v: u8) -> Option<Rule> {
+pub(crate) fn check_mode(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=2) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_fault_bitmask(v: u32) -> Option<Rule> {
+pub(crate) fn check_fault_bitmask(v: u32) -> Option<Rule> {
     if v & !0x1ff != 0 {
         return Some(Rule::Bitmask);
     }

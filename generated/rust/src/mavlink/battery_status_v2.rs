@@ -170,7 +170,7 @@ impl Same for BatteryStatusV2 {
     }
 }
 
-fn check_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -180,7 +180,7 @@ fn check_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -190,7 +190,7 @@ fn check_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_capacity_consumed(v: f32) -> Option<Rule> {
+pub(crate) fn check_capacity_consumed(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -200,7 +200,7 @@ fn check_capacity_consumed(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_capacity_remaining(v: f32) -> Option<Rule> {
+pub(crate) fn check_capacity_remaining(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -210,7 +210,7 @@ fn check_capacity_remaining(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_state_of_charge(v: f32) -> Option<Rule> {
+pub(crate) fn check_state_of_charge(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -220,7 +220,7 @@ fn check_state_of_charge(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_status_flags(v: u32) -> Option<Rule> {
+pub(crate) fn check_status_flags(v: u32) -> Option<Rule> {
     if v & !0x8007ffff != 0 {
         return Some(Rule::Bitmask);
     }

@@ -110,21 +110,21 @@ impl Same for Heartbeat {
     }
 }
 
-fn check_type(v: u8) -> Option<Rule> {
+pub(crate) fn check_type(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=49) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_autopilot(v: u8) -> Option<Rule> {
+pub(crate) fn check_autopilot(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=20) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_system_status(v: u8) -> Option<Rule> {
+pub(crate) fn check_system_status(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=8) {
         return Some(Rule::Enum);
     }

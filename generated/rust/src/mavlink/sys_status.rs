@@ -214,21 +214,21 @@ impl Same for SysStatus {
     }
 }
 
-fn check_onboard_control_sensors_present_extended(v: u32) -> Option<Rule> {
+pub(crate) fn check_onboard_control_sensors_present_extended(v: u32) -> Option<Rule> {
     if v & !0x3f != 0 {
         return Some(Rule::Bitmask);
     }
     None
 }
 
-fn check_onboard_control_sensors_enabled_extended(v: u32) -> Option<Rule> {
+pub(crate) fn check_onboard_control_sensors_enabled_extended(v: u32) -> Option<Rule> {
     if v & !0x3f != 0 {
         return Some(Rule::Bitmask);
     }
     None
 }
 
-fn check_onboard_control_sensors_health_extended(v: u32) -> Option<Rule> {
+pub(crate) fn check_onboard_control_sensors_health_extended(v: u32) -> Option<Rule> {
     if v & !0x3f != 0 {
         return Some(Rule::Bitmask);
     }

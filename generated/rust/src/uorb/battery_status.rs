@@ -621,7 +621,7 @@ impl Fault {
     }
 }
 
-fn check_voltage_v(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage_v(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -634,7 +634,7 @@ fn check_voltage_v(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_current_a(v: f32) -> Option<Rule> {
+pub(crate) fn check_current_a(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -647,7 +647,7 @@ fn check_current_a(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_current_average_a(v: f32) -> Option<Rule> {
+pub(crate) fn check_current_average_a(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -660,7 +660,7 @@ fn check_current_average_a(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_discharged_mah(v: f32) -> Option<Rule> {
+pub(crate) fn check_discharged_mah(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -673,7 +673,7 @@ fn check_discharged_mah(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_remaining(v: f32) -> Option<Rule> {
+pub(crate) fn check_remaining(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -692,7 +692,7 @@ fn check_remaining(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_scale(v: f32) -> Option<Rule> {
+pub(crate) fn check_scale(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -708,7 +708,7 @@ fn check_scale(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_time_remaining_s(v: f32) -> Option<Rule> {
+pub(crate) fn check_time_remaining_s(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -718,7 +718,7 @@ fn check_time_remaining_s(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_temperature(v: f32) -> Option<Rule> {
+pub(crate) fn check_temperature(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -728,21 +728,21 @@ fn check_temperature(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_source(v: u8) -> Option<Rule> {
+pub(crate) fn check_source(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=2) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_state_of_health(v: u16) -> Option<Rule> {
+pub(crate) fn check_state_of_health(v: u16) -> Option<Rule> {
     if v > 100 {
         return Some(Rule::Range);
     }
     None
 }
 
-fn check_max_error(v: u16) -> Option<Rule> {
+pub(crate) fn check_max_error(v: u16) -> Option<Rule> {
     if v < 1 {
         return Some(Rule::Range);
     }
@@ -752,7 +752,7 @@ fn check_max_error(v: u16) -> Option<Rule> {
     None
 }
 
-fn check_voltage_cell_v(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage_cell_v(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -765,7 +765,7 @@ fn check_voltage_cell_v(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_max_cell_voltage_delta(v: f32) -> Option<Rule> {
+pub(crate) fn check_max_cell_voltage_delta(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -775,21 +775,21 @@ fn check_max_cell_voltage_delta(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_warning(v: u8) -> Option<Rule> {
+pub(crate) fn check_warning(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=4 | 6..=7) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_faults(v: u16) -> Option<Rule> {
+pub(crate) fn check_faults(v: u16) -> Option<Rule> {
     if v & !0x7ff != 0 {
         return Some(Rule::Bitmask);
     }
     None
 }
 
-fn check_full_charge_capacity_wh(v: f32) -> Option<Rule> {
+pub(crate) fn check_full_charge_capacity_wh(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -799,7 +799,7 @@ fn check_full_charge_capacity_wh(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_remaining_capacity_wh(v: f32) -> Option<Rule> {
+pub(crate) fn check_remaining_capacity_wh(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -809,7 +809,7 @@ fn check_remaining_capacity_wh(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_nominal_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_nominal_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -819,7 +819,7 @@ fn check_nominal_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_internal_resistance_estimate(v: f32) -> Option<Rule> {
+pub(crate) fn check_internal_resistance_estimate(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -829,7 +829,7 @@ fn check_internal_resistance_estimate(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_ocv_estimate(v: f32) -> Option<Rule> {
+pub(crate) fn check_ocv_estimate(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -839,7 +839,7 @@ fn check_ocv_estimate(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_ocv_estimate_filtered(v: f32) -> Option<Rule> {
+pub(crate) fn check_ocv_estimate_filtered(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -849,7 +849,7 @@ fn check_ocv_estimate_filtered(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_volt_based_soc_estimate(v: f32) -> Option<Rule> {
+pub(crate) fn check_volt_based_soc_estimate(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -865,7 +865,7 @@ fn check_volt_based_soc_estimate(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_voltage_prediction(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage_prediction(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -875,7 +875,7 @@ fn check_voltage_prediction(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_prediction_error(v: f32) -> Option<Rule> {
+pub(crate) fn check_prediction_error(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -885,7 +885,7 @@ fn check_prediction_error(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_estimation_covariance_norm(v: f32) -> Option<Rule> {
+pub(crate) fn check_estimation_covariance_norm(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }

@@ -605,7 +605,7 @@ impl Fault {
     }
 }
 
-fn check_voltage_v(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage_v(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -618,7 +618,7 @@ fn check_voltage_v(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_current_a(v: f32) -> Option<Rule> {
+pub(crate) fn check_current_a(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -631,7 +631,7 @@ fn check_current_a(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_current_average_a(v: f32) -> Option<Rule> {
+pub(crate) fn check_current_average_a(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -644,7 +644,7 @@ fn check_current_average_a(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_discharged_mah(v: f32) -> Option<Rule> {
+pub(crate) fn check_discharged_mah(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -657,7 +657,7 @@ fn check_discharged_mah(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_remaining(v: f32) -> Option<Rule> {
+pub(crate) fn check_remaining(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -676,7 +676,7 @@ fn check_remaining(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_scale(v: f32) -> Option<Rule> {
+pub(crate) fn check_scale(v: f32) -> Option<Rule> {
     if v == -1.0 {
         return None;
     }
@@ -692,7 +692,7 @@ fn check_scale(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_time_remaining_s(v: f32) -> Option<Rule> {
+pub(crate) fn check_time_remaining_s(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -702,7 +702,7 @@ fn check_time_remaining_s(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_temperature(v: f32) -> Option<Rule> {
+pub(crate) fn check_temperature(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -712,21 +712,21 @@ fn check_temperature(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_source(v: u8) -> Option<Rule> {
+pub(crate) fn check_source(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=2) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_state_of_health(v: u16) -> Option<Rule> {
+pub(crate) fn check_state_of_health(v: u16) -> Option<Rule> {
     if v > 100 {
         return Some(Rule::Range);
     }
     None
 }
 
-fn check_max_error(v: u16) -> Option<Rule> {
+pub(crate) fn check_max_error(v: u16) -> Option<Rule> {
     if v < 1 {
         return Some(Rule::Range);
     }
@@ -736,7 +736,7 @@ fn check_max_error(v: u16) -> Option<Rule> {
     None
 }
 
-fn check_voltage_cell_v(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage_cell_v(v: f32) -> Option<Rule> {
     if v == 0.0 {
         return None;
     }
@@ -749,7 +749,7 @@ fn check_voltage_cell_v(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_max_cell_voltage_delta(v: f32) -> Option<Rule> {
+pub(crate) fn check_max_cell_voltage_delta(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -759,21 +759,21 @@ fn check_max_cell_voltage_delta(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_warning(v: u8) -> Option<Rule> {
+pub(crate) fn check_warning(v: u8) -> Option<Rule> {
     if !matches!(v, 0..=4 | 6..=7) {
         return Some(Rule::Enum);
     }
     None
 }
 
-fn check_faults(v: u16) -> Option<Rule> {
+pub(crate) fn check_faults(v: u16) -> Option<Rule> {
     if v & !0x7ff != 0 {
         return Some(Rule::Bitmask);
     }
     None
 }
 
-fn check_full_charge_capacity_wh(v: f32) -> Option<Rule> {
+pub(crate) fn check_full_charge_capacity_wh(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -783,7 +783,7 @@ fn check_full_charge_capacity_wh(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_remaining_capacity_wh(v: f32) -> Option<Rule> {
+pub(crate) fn check_remaining_capacity_wh(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -793,7 +793,7 @@ fn check_remaining_capacity_wh(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_nominal_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_nominal_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -803,7 +803,7 @@ fn check_nominal_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_internal_resistance_estimate(v: f32) -> Option<Rule> {
+pub(crate) fn check_internal_resistance_estimate(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -813,7 +813,7 @@ fn check_internal_resistance_estimate(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_ocv_estimate(v: f32) -> Option<Rule> {
+pub(crate) fn check_ocv_estimate(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -823,7 +823,7 @@ fn check_ocv_estimate(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_ocv_estimate_filtered(v: f32) -> Option<Rule> {
+pub(crate) fn check_ocv_estimate_filtered(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -833,7 +833,7 @@ fn check_ocv_estimate_filtered(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_volt_based_soc_estimate(v: f32) -> Option<Rule> {
+pub(crate) fn check_volt_based_soc_estimate(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -849,7 +849,7 @@ fn check_volt_based_soc_estimate(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_voltage_prediction(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage_prediction(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -859,7 +859,7 @@ fn check_voltage_prediction(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_prediction_error(v: f32) -> Option<Rule> {
+pub(crate) fn check_prediction_error(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -869,7 +869,7 @@ fn check_prediction_error(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_estimation_covariance_norm(v: f32) -> Option<Rule> {
+pub(crate) fn check_estimation_covariance_norm(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }

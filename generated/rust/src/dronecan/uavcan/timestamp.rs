@@ -67,7 +67,7 @@ impl Same for Timestamp {
     }
 }
 
-fn check_usec(v: u64) -> Option<Rule> {
+pub(crate) fn check_usec(v: u64) -> Option<Rule> {
     if v == 0 {
         return None;
     }

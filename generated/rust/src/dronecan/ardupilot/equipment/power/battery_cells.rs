@@ -69,7 +69,7 @@ impl Same for BatteryCells {
     }
 }
 
-fn check_voltages(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltages(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }

@@ -173,7 +173,7 @@ impl StatusFlag {
     }
 }
 
-fn check_temperature_cells(v: f32) -> Option<Rule> {
+pub(crate) fn check_temperature_cells(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -186,7 +186,7 @@ fn check_temperature_cells(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_temperature_pcb(v: f32) -> Option<Rule> {
+pub(crate) fn check_temperature_pcb(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -199,7 +199,7 @@ fn check_temperature_pcb(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_temperature_other(v: f32) -> Option<Rule> {
+pub(crate) fn check_temperature_other(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -212,7 +212,7 @@ fn check_temperature_other(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -222,7 +222,7 @@ fn check_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -232,7 +232,7 @@ fn check_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_state_of_charge(v: f32) -> Option<Rule> {
+pub(crate) fn check_state_of_charge(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -245,7 +245,7 @@ fn check_state_of_charge(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_capacity_consumed(v: f32) -> Option<Rule> {
+pub(crate) fn check_capacity_consumed(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -255,7 +255,7 @@ fn check_capacity_consumed(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_status_flags(v: u32) -> Option<Rule> {
+pub(crate) fn check_status_flags(v: u32) -> Option<Rule> {
     if v & !0x7ffff != 0 {
         return Some(Rule::Bitmask);
     }

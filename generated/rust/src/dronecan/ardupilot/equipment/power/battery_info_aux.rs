@@ -70,7 +70,7 @@ impl BatteryInfoAux {
 
     /// Every problem of the message, in field order.
     #[must_use]
-    pub fn validate(&self) -> Problems<258> {
+    pub fn validate(&self) -> Problems<259> {
         let mut out = Problems::new();
         self.validate_into(&mut out);
         out
@@ -105,7 +105,7 @@ impl Same for BatteryInfoAux {
     }
 }
 
-fn check_voltage_cell(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage_cell(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -118,7 +118,7 @@ fn check_voltage_cell(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_max_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_max_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -131,7 +131,7 @@ fn check_max_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_nominal_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_nominal_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -146,6 +146,9 @@ fn check_nominal_voltage(v: f32) -> Option<Rule> {
 
 impl Validate for BatteryInfoAux {
     fn validate_into<const N: usize>(&self, out: &mut Problems<N>) {
+        if let Some(rule) = crate::dronecan::uavcan::timestamp::check_usec(self.timestamp.usec) {
+            out.push("timestamp.usec", None, rule);
+        }
         if self.voltage_cell_len > 255 {
             out.push("voltage_cell", None, Rule::Length);
         }

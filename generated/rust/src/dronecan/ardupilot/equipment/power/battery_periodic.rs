@@ -170,7 +170,7 @@ impl Same for BatteryPeriodic {
     }
 }
 
-fn check_design_capacity(v: f32) -> Option<Rule> {
+pub(crate) fn check_design_capacity(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -180,7 +180,7 @@ fn check_design_capacity(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_nominal_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_nominal_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -193,7 +193,7 @@ fn check_nominal_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_discharge_minimum_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_discharge_minimum_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -206,7 +206,7 @@ fn check_discharge_minimum_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_charging_minimum_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_charging_minimum_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -219,7 +219,7 @@ fn check_charging_minimum_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_charging_maximum_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_charging_maximum_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -232,7 +232,7 @@ fn check_charging_maximum_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_charging_maximum_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_charging_maximum_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -242,7 +242,7 @@ fn check_charging_maximum_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_discharge_maximum_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_discharge_maximum_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -252,7 +252,7 @@ fn check_discharge_maximum_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_discharge_maximum_burst_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_discharge_maximum_burst_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -262,7 +262,7 @@ fn check_discharge_maximum_burst_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_full_charge_capacity(v: f32) -> Option<Rule> {
+pub(crate) fn check_full_charge_capacity(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }

@@ -92,7 +92,7 @@ impl Same for BatteryTag {
     }
 }
 
-fn check_armed_hours(v: f32) -> Option<Rule> {
+pub(crate) fn check_armed_hours(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }

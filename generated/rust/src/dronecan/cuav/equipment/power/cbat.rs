@@ -280,7 +280,7 @@ impl StatusFlag {
     }
 }
 
-fn check_temperature(v: f32) -> Option<Rule> {
+pub(crate) fn check_temperature(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -290,7 +290,7 @@ fn check_temperature(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -300,7 +300,7 @@ fn check_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_voltage_cell(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage_cell(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -310,7 +310,7 @@ fn check_voltage_cell(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -320,7 +320,7 @@ fn check_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_average_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_average_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -330,7 +330,7 @@ fn check_average_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_average_power(v: f32) -> Option<Rule> {
+pub(crate) fn check_average_power(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -340,7 +340,7 @@ fn check_average_power(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_available_energy(v: f32) -> Option<Rule> {
+pub(crate) fn check_available_energy(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -350,7 +350,7 @@ fn check_available_energy(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_remaining_capacity(v: f32) -> Option<Rule> {
+pub(crate) fn check_remaining_capacity(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -360,7 +360,7 @@ fn check_remaining_capacity(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_full_charge_capacity(v: f32) -> Option<Rule> {
+pub(crate) fn check_full_charge_capacity(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -370,7 +370,7 @@ fn check_full_charge_capacity(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_design_capacity(v: f32) -> Option<Rule> {
+pub(crate) fn check_design_capacity(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -380,28 +380,28 @@ fn check_design_capacity(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_state_of_health(v: u8) -> Option<Rule> {
+pub(crate) fn check_state_of_health(v: u8) -> Option<Rule> {
     if v > 127 {
         return Some(Rule::TypeBounds);
     }
     None
 }
 
-fn check_state_of_charge(v: u8) -> Option<Rule> {
+pub(crate) fn check_state_of_charge(v: u8) -> Option<Rule> {
     if v > 127 {
         return Some(Rule::TypeBounds);
     }
     None
 }
 
-fn check_max_error(v: u8) -> Option<Rule> {
+pub(crate) fn check_max_error(v: u8) -> Option<Rule> {
     if v > 127 {
         return Some(Rule::TypeBounds);
     }
     None
 }
 
-fn check_passed_charge(v: f32) -> Option<Rule> {
+pub(crate) fn check_passed_charge(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -411,7 +411,7 @@ fn check_passed_charge(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_nominal_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_nominal_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -421,7 +421,7 @@ fn check_nominal_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_status_flags(v: u16) -> Option<Rule> {
+pub(crate) fn check_status_flags(v: u16) -> Option<Rule> {
     if v > 2047 {
         return Some(Rule::TypeBounds);
     }

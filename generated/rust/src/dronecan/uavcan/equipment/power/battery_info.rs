@@ -306,7 +306,7 @@ impl StatusFlag {
     }
 }
 
-fn check_temperature(v: f32) -> Option<Rule> {
+pub(crate) fn check_temperature(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -319,7 +319,7 @@ fn check_temperature(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -332,7 +332,7 @@ fn check_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -345,7 +345,7 @@ fn check_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_average_power_10sec(v: f32) -> Option<Rule> {
+pub(crate) fn check_average_power_10sec(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -358,7 +358,7 @@ fn check_average_power_10sec(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_remaining_capacity_wh(v: f32) -> Option<Rule> {
+pub(crate) fn check_remaining_capacity_wh(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -371,7 +371,7 @@ fn check_remaining_capacity_wh(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_full_charge_capacity_wh(v: f32) -> Option<Rule> {
+pub(crate) fn check_full_charge_capacity_wh(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -384,7 +384,7 @@ fn check_full_charge_capacity_wh(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_hours_to_full_charge(v: f32) -> Option<Rule> {
+pub(crate) fn check_hours_to_full_charge(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return None;
     }
@@ -397,7 +397,7 @@ fn check_hours_to_full_charge(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_status_flags(v: u16) -> Option<Rule> {
+pub(crate) fn check_status_flags(v: u16) -> Option<Rule> {
     if v > 2047 {
         return Some(Rule::TypeBounds);
     }
@@ -407,7 +407,7 @@ fn check_status_flags(v: u16) -> Option<Rule> {
     None
 }
 
-fn check_state_of_health_pct(v: u8) -> Option<Rule> {
+pub(crate) fn check_state_of_health_pct(v: u8) -> Option<Rule> {
     if v == 127 {
         return None;
     }
@@ -417,14 +417,14 @@ fn check_state_of_health_pct(v: u8) -> Option<Rule> {
     None
 }
 
-fn check_state_of_charge_pct(v: u8) -> Option<Rule> {
+pub(crate) fn check_state_of_charge_pct(v: u8) -> Option<Rule> {
     if v > 127 {
         return Some(Rule::TypeBounds);
     }
     None
 }
 
-fn check_state_of_charge_pct_stdev(v: u8) -> Option<Rule> {
+pub(crate) fn check_state_of_charge_pct_stdev(v: u8) -> Option<Rule> {
     if v > 127 {
         return Some(Rule::TypeBounds);
     }

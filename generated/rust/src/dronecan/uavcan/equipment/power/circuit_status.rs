@@ -105,7 +105,7 @@ impl ErrorFlag {
     }
 }
 
-fn check_voltage(v: f32) -> Option<Rule> {
+pub(crate) fn check_voltage(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -118,7 +118,7 @@ fn check_voltage(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_current(v: f32) -> Option<Rule> {
+pub(crate) fn check_current(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -131,7 +131,7 @@ fn check_current(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_error_flags(v: u8) -> Option<Rule> {
+pub(crate) fn check_error_flags(v: u8) -> Option<Rule> {
     if v & !0xf != 0 {
         return Some(Rule::Bitmask);
     }

@@ -89,7 +89,7 @@ impl Same for PrimaryPowerSupplyStatus {
     }
 }
 
-fn check_hours_to_empty_at_10sec_avg_power(v: f32) -> Option<Rule> {
+pub(crate) fn check_hours_to_empty_at_10sec_avg_power(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -102,7 +102,7 @@ fn check_hours_to_empty_at_10sec_avg_power(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_hours_to_empty_at_10sec_avg_power_variance(v: f32) -> Option<Rule> {
+pub(crate) fn check_hours_to_empty_at_10sec_avg_power_variance(v: f32) -> Option<Rule> {
     if v.is_nan() {
         return Some(Rule::Nan);
     }
@@ -115,14 +115,14 @@ fn check_hours_to_empty_at_10sec_avg_power_variance(v: f32) -> Option<Rule> {
     None
 }
 
-fn check_remaining_energy_pct(v: u8) -> Option<Rule> {
+pub(crate) fn check_remaining_energy_pct(v: u8) -> Option<Rule> {
     if v > 127 {
         return Some(Rule::TypeBounds);
     }
     None
 }
 
-fn check_remaining_energy_pct_stdev(v: u8) -> Option<Rule> {
+pub(crate) fn check_remaining_energy_pct_stdev(v: u8) -> Option<Rule> {
     if v > 127 {
         return Some(Rule::TypeBounds);
     }
