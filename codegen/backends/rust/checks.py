@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ...ir import ArrayType, EnumKind, Field, PrimitiveKind, PrimitiveType, Schema, StringType, type_bounds
-from .types import f64_bound, is_exact_width, scalar, scalar_literal
+from .types import equals, f64_bound, is_exact_width, scalar
 
 
 @dataclass(frozen=True)
@@ -21,7 +21,7 @@ class FieldCheck:
     body: list[str]  # statements of the check function
     count: int | None  # None: a scalar; else the array's capacity
     dynamic: bool
-    first_marker: str | None  # MAVLink [X:]: element 0 at this value makes the array unknown
+    first: tuple[PrimitiveType, int | float] | None  # MAVLink [X:]: element 0 at this value makes the array unknown
 
 
 def _ranges(values: list[int]) -> str:
@@ -65,10 +65,7 @@ def _body(schema: Schema, f: Field, t: PrimitiveType) -> list[str]:
     s = f.invalid
     is_float = t.kind is PrimitiveKind.FLOAT
     if s is not None:
-        if s.is_nan:
-            out.append("if v.is_nan() { return None; }")
-        else:
-            out.append(f"if v == {scalar_literal(t, s.value)} {{ return None; }}")
+        out.append(f"if {equals(t, s.value, 'v')} {{ return None; }}")
     checks: list[str] = []  # (condition, rule) statements after the sentinel
     if is_float and not (s is not None and s.is_nan):
         checks.append("if v.is_nan() { return Some(Rule::Nan); }")
@@ -111,7 +108,9 @@ def _body(schema: Schema, f: Field, t: PrimitiveType) -> list[str]:
             fit = [v for v in values if type_low <= v <= type_high]
             checks.append(f"if !matches!(v, {_ranges(fit)}) {{ return Some(Rule::Enum); }}")
         elif mask is not None and mask & ((1 << t.bits) - 1) != (1 << t.bits) - 1:  # else every value passes
-            checks.append(f"if v & !{mask:#x} != 0 {{ return Some(Rule::Bitmask); }}")
+            width = int(rust[1:])
+            bits = "v" if rust[0] == "u" else f"(v as u{width})"  # a signed field's bits as they are sent
+            checks.append(f"if {bits} & !{mask & ((1 << width) - 1):#x} != 0 {{ return Some(Rule::Bitmask); }}")
     if not checks:
         return []
     return [*out, *checks, "None"]
@@ -135,5 +134,5 @@ def field_check(schema: Schema, f: Field, ident: str) -> FieldCheck | None:
         return None
     first = None
     if count is not None and f.invalid is not None and f.invalid.first_decides:
-        first = scalar_literal(t, f.invalid.value)
+        first = (t, f.invalid.value)
     return FieldCheck(f.name, ident, f"check_{ident.strip('_')}", scalar(t), body, count, dynamic, first)

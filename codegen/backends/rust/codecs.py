@@ -45,9 +45,15 @@ def _encode(ident: str, t: PrimitiveType, count: int | None, offset: int) -> lis
     value = "u8::from(*v)" if rust == "bool" else "v"
     return [
         f"for (i, v) in self.{ident}.iter().enumerate() {{",
-        f"wire::put(out, {offset} + {_width(t)} * i, &{value}.to_le_bytes());",
+        f"wire::put(out, {_at(offset, _width(t))}, &{value}.to_le_bytes());",
         "}",
     ]
+
+
+def _at(offset: int, width: int) -> str:
+    """The offset of element ``i`` (clippy refuses ``0 + ...`` and ``1 * i``)."""
+    step = "i" if width == 1 else f"{width} * i"
+    return step if offset == 0 else f"{offset} + {step}"
 
 
 def _decode(ident: str, t: PrimitiveType, count: int | None, offset: int) -> str:
@@ -62,8 +68,8 @@ def _decode(ident: str, t: PrimitiveType, count: int | None, offset: int) -> str
     if rust == "u8":
         return f"{ident}: wire::take(b, {offset}),"
     if rust == "bool":
-        return f"{ident}: core::array::from_fn(|i| b[{offset} + i] != 0),"
-    return f"{ident}: core::array::from_fn(|i| {rust}::from_le_bytes(wire::take(b, {offset} + {w} * i))),"
+        return f"{ident}: core::array::from_fn(|i| b[{_at(offset, 1)}] != 0),"
+    return f"{ident}: core::array::from_fn(|i| {rust}::from_le_bytes(wire::take(b, {_at(offset, w)}))),"
 
 
 def _codec(fields: list[tuple[Field, int]], idents: dict[str, str], size: int) -> Codec | None:

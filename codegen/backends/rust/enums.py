@@ -52,25 +52,43 @@ def _member_word(e: EnumDef, entry: str) -> str:
     return entry[len(prefix) :] if entry.startswith(prefix) and len(entry) > len(prefix) else entry
 
 
-def enum_view(e: EnumDef) -> EnumView:
+# names a type must not take in a message module: the prelude's and what the module imports
+TAKEN = frozenset(
+    "Option Some None Result Ok Err Default Clone Copy Debug PartialEq Eq PartialOrd Ord Hash Send Sync Sized "
+    "Drop Fn FnMut FnOnce Iterator IntoIterator Extend From Into TryFrom TryInto AsRef AsMut ToOwned ToString "
+    "String Vec Box Self Problems Problem Rule Validate Same BitReader BitWriter".split()
+)
+
+
+def enum_view(e: EnumDef, taken: frozenset[str] = TAKEN) -> EnumView:
+    """The Rust type of ``e``; a name in ``taken`` (the prelude's, the message struct's) gets the
+    suffix ``Kind`` (a value enum) or ``Flags`` (a bitmask)."""
     bitmask = e.kind is not EnumKind.VALUE
     spell = upper if bitmask else camel
     members: list[Member] = []
     used: set[str] = set()
     first_of: dict[int, str] = {}
     for entry in e.entries:
-        name = spell(_member_word(e, entry.name))
-        if name in used or name in ("Self", "SELF"):
-            name = spell(entry.name)
+        # names that differ only in separators ("CR_7_5_M", "CR_75_M") spell the same: the later
+        # member takes its full name, then its value besides
+        candidates = (spell(_member_word(e, entry.name)), spell(entry.name), f"{spell(entry.name)}{entry.value}")
+        name = next((c for c in candidates if c not in used and c not in ("Self", "SELF")), None)
+        if name is None:
+            raise ValueError(f"{e.name}: no free Rust name for {entry.name}")
         used.add(name)
         value = 1 << entry.value if e.kind is EnumKind.BIT_INDEX else entry.value
         alias = None if bitmask else first_of.get(value)
         if alias is not None:  # Rust allows one variant a value: the later name is a constant
             name = upper(_member_word(e, entry.name))
+            name = name if name not in used else upper(entry.name)
+            used.add(name)
         first_of.setdefault(value, name)
         members.append(Member(name, value, doc_lines(entry.doc), alias))
+    name = camel(e.short_name)
+    if name in taken:
+        name += "Flags" if bitmask else "Kind"
     return EnumView(
-        name=camel(e.short_name),
+        name=name,
         qualified=e.name,
         bitmask=bitmask,
         repr=repr_type([m.value for m in members]),

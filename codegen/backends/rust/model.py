@@ -11,9 +11,9 @@ from .checks import FieldCheck, field_check
 from .codecs import Codec, mavlink_codec, uorb_codec
 from .docs import doc_lines
 from .dronecan_codec import DronecanCodec, dronecan_codec
-from .enums import EnumView, enum_view
+from .enums import TAKEN, EnumView, enum_view
 from .naming import camel, field_ident, snake, upper
-from .types import capacity, element, float_literal, scalar, scalar_literal
+from .types import capacity, element, equals, float_literal, scalar, scalar_literal
 
 
 def module_parts(qualified: str) -> list[str]:
@@ -111,6 +111,12 @@ class CheckUse:
         """A dynamic array's used length."""
         return f"{self.target}_len"
 
+    @property
+    def first_known(self) -> str | None:
+        """MAVLink [X:]: the condition that element 0 is not X (the array's elements mean something)."""
+        first = self.check.first
+        return None if first is None else equals(first[0], first[1], f"{self.target}[0]", negate=True)
+
 
 def check_uses(schema: Schema, msg: Message, path: str = "", target: str = "self.", depth: int = 0) -> list[CheckUse]:
     """Every check of ``msg``'s fields and, path by path, of the messages nested in it (not in arrays)."""
@@ -154,23 +160,20 @@ class MessageView:
         return sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in self.uses)
 
 
-def _unknown(f: Field, t: PrimitiveType) -> tuple[str, str | None] | None:
-    """(condition on `v` meaning unknown, element 0's whole-array marker) for a field's values."""
+def _unknown(f: Field, t: PrimitiveType, ident: str) -> tuple[str, str | None] | None:
+    """(condition on `v` (element `i`) meaning unknown, condition meaning element 0 makes the whole
+    array unknown) for a field's values."""
     s = f.invalid
     if s is None:
         return None
     if s.first_decides:
-        return "false", scalar_literal(t, s.value)
+        return "false", equals(t, s.value, f"self.{ident}[0]")
     if s.elements:
-        conds = [f"(i == {i} && {_equals(t, v)})" for i, v in enumerate(s.elements) if v is not None]
+        conds = [f"i == {i} && {equals(t, v, 'v')}" for i, v in enumerate(s.elements) if v is not None]
+        if len(conds) > 1:
+            conds = [f"({c})" for c in conds]
         return " || ".join(conds) or "false", None
-    return _equals(t, s.value), None
-
-
-def _equals(t: PrimitiveType, value: float) -> str:
-    if isinstance(value, float) and value != value:
-        return "v.is_nan()"
-    return f"v == {scalar_literal(t, value)}"
+    return equals(t, s.value, "v"), None
 
 
 def _accessor(f: Field, ident: str) -> Accessor | None:
@@ -178,7 +181,7 @@ def _accessor(f: Field, ident: str) -> Accessor | None:
     if f.invalid is None:
         return None
     if isinstance(t, PrimitiveType):
-        found = _unknown(f, t)
+        found = _unknown(f, t, ident)
         assert found is not None
         return Accessor(ident, scalar(t), f.name, False, found[0], None, None)
     if (
@@ -186,7 +189,7 @@ def _accessor(f: Field, ident: str) -> Accessor | None:
         and isinstance(t.element, PrimitiveType)
         and (f.invalid.per_element or f.invalid.elements or f.invalid.first_decides)
     ):
-        found = _unknown(f, t.element)
+        found = _unknown(f, t.element, ident)
         assert found is not None
         length = f"{ident}_len" if t.dynamic else None
         return Accessor(ident, scalar(t.element), f.name, True, found[0], found[1], length)
@@ -251,7 +254,8 @@ def _field_doc(f: Field) -> list[str]:
 
 def message_view(schema: Schema, msg: Message, shared: dict[str, EnumView]) -> MessageView:
     idents = {f.name: field_ident(f.name) for f in msg.fields if not f.is_padding}
-    local = {e.name: enum_view(e) for e in msg.enums}
+    taken = TAKEN | {camel(msg.name)}
+    local = {e.name: enum_view(e, taken) for e in msg.enums}
     views = {**shared, **local}
     members: list[Member] = []
     same: list[str] = []

@@ -13,8 +13,9 @@ from pathlib import Path
 import jinja2
 
 from ...errors import BattgenError
-from ...ir import Schema, SourceFormat
+from ...ir import CompositeType, Message, Schema, SourceFormat
 from .model import MessageView, message_view, shared_enums
+from .types import element
 
 _HERE = Path(__file__).parent
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
@@ -76,12 +77,30 @@ def _modules(views: list[MessageView]) -> tuple[dict[ModulePath, set[str]], dict
     return children, exports
 
 
+def rust_messages(schema: Schema) -> list[Message]:
+    """The messages of the crate: DroneCAN, MAVLink and uORB ones, but not DSDL unions (a Rust enum
+    of branches, not written yet) nor the messages holding one."""
+    held: dict[str, Message] = {m.qualified_name: m for m in schema.messages if m.format in _FORMATS}
+    out: dict[str, bool] = {}
+
+    def ok(m: Message) -> bool:
+        if m.qualified_name not in out:
+            out[m.qualified_name] = False  # a cycle is no valid schema; refuse it rather than recurse
+            nested = [element(f.type) for f in m.fields]
+            out[m.qualified_name] = not m.is_union and all(
+                not isinstance(t, CompositeType) or (t.name in held and ok(held[t.name])) for t in nested
+            )
+        return out[m.qualified_name]
+
+    return [m for m in held.values() if ok(m)]
+
+
 def render_crate(schema: Schema) -> dict[str, str]:
     """Relative path -> text of every file of the crate (the Rust formatted by rustfmt)."""
     env = _environment()
     formats = tuple(f.value for f in _FORMATS)
     shared = shared_enums(schema, formats)
-    views = [message_view(schema, m, shared) for m in schema.messages if m.format in _FORMATS]
+    views = [message_view(schema, m, shared) for m in rust_messages(schema)]
     rs: dict[str, str] = {}
     message = env.get_template("message.rs.j2")
     for v in views:
@@ -99,7 +118,11 @@ def render_crate(schema: Schema) -> dict[str, str]:
             continue
         what = "the messages of this namespace" if len(parts) > 1 else f"the {parts[0]} messages"
         rs["src/" + "/".join(parts) + "/mod.rs"] = module.render(
-            path="::".join(parts), what=what, modules=sorted(subs), reexports=sorted(exports.get(parts, []))
+            path="::".join(parts),
+            name=parts[-1],
+            what=what,
+            modules=sorted(subs),
+            reexports=sorted(exports.get(parts, [])),
         )
     for name in SUPPORT:
         text = (_HERE / "support" / f"{name}.rs").read_text(encoding="utf-8")

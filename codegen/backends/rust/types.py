@@ -81,3 +81,10 @@ def scalar_literal(t: PrimitiveType, value: int | float | bool | str) -> str:
 def f64_bound(value: float) -> str:
     """A bound compared in f64 (the Python validators compare the exact value as a double)."""
     return float_literal(float(value), "f64")
+
+
+def equals(t: PrimitiveType, value: int | float, expr: str, negate: bool = False) -> str:
+    """``expr`` (of type ``t``) is ``value`` (NaN by ``is_nan``: it equals nothing), or is not."""
+    if isinstance(value, float) and math.isnan(value):
+        return ("!" if negate else "") + f"{expr}.is_nan()"
+    return f"{expr} {'!=' if negate else '=='} {scalar_literal(t, value)}"
