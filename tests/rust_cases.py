@@ -247,7 +247,13 @@ def _case(schema: Schema, msg: Message, replay: Replay, cid: str, obj: Any) -> s
             seq = len(replay.cases) % 256
             frame = obj.encode_frame(seq=seq, sysid=1, compid=1)
             decoded = cls.decode(payload)
-            wire = f"{_bytes_literal(payload)}, {_bytes_literal(frame)}, {seq}"
+            signed = obj.encode_frame(seq=seq, sysid=1, compid=1, signature=bytes(range(13)))
+            v1 = "None"
+            if cls.MSG_ID < 256:  # MAVLink 1: the base payload, extensions decoded as zero
+                frame_v1 = obj.encode_frame(seq=seq, sysid=1, compid=1, mavlink1=True)
+                decoded_v1 = struct_literal(schema, msg, cls.decode_frame(frame_v1).to_dict())
+                v1 = f"Some(({_bytes_literal(frame_v1)}, {decoded_v1}))"
+            wire = f"{_bytes_literal(payload)}, {_bytes_literal(frame)}, {seq}, {v1}, {_bytes_literal(signed)}"
         elif replay.kind == "uorb":
             payload = obj.encode()
             decoded = cls.decode(payload)

@@ -11,8 +11,17 @@ use core::fmt::Debug;
 // problems of the decoded value.
 type ProblemList = &'static [&'static str];
 type Given<M> = (&'static str, M, Option<ProblemList>, M);
-/// (id, value, its problems, decoded, payload, frame, frame sequence number, problems)
-type MavlinkCase<M> = (Given<M>, &'static [u8], &'static [u8], u8, ProblemList);
+/// (id, value, its problems, decoded, payload, frame, frame sequence number, the MAVLink 1 frame and
+/// what it decodes to (message ids below 256), the frame signed, problems)
+type MavlinkCase<M> = (
+    Given<M>,
+    &'static [u8],
+    &'static [u8],
+    u8,
+    Option<(&'static [u8], M)>,
+    &'static [u8],
+    ProblemList,
+);
 /// (id, value, its problems, decoded, struct bytes, problems)
 type UorbCase<M> = (Given<M>, &'static [u8], ProblemList);
 /// (id, value, its problems, decoded, payload with the tail array optimisation, without (CAN FD), problems)
@@ -50,7 +59,7 @@ where
     M: mavlink_wire::Message + Validate + PartialEq + Debug,
 {
     assert_eq!(cases.len(), count);
-    for ((id, value, given, decoded), payload, frame, seq, expected) in cases {
+    for ((id, value, given, decoded), payload, frame, seq, v1, signed, expected) in cases {
         check_given(id, value, *given);
         let mut buf = [0u8; 255];
         let n = value.encode(&mut buf);
@@ -67,6 +76,18 @@ where
         assert_eq!(&out[..n], *frame, "{id}: frame");
         let (got_header, got) = mavlink_wire::decode_frame::<M>(frame).expect(id);
         assert_eq!((got_header, &got), (header, decoded), "{id}: decoded frame");
+
+        let (got_header, got) = mavlink_wire::decode_frame::<M>(signed).expect(id);
+        assert_eq!((got_header, &got), (header, decoded), "{id}: decoded signed frame");
+        match v1 {
+            Some((frame_v1, decoded_v1)) => {
+                let n = mavlink_wire::encode_frame_v1(value, header, &mut out).expect(id);
+                assert_eq!(&out[..n], *frame_v1, "{id}: MAVLink 1 frame");
+                let (got_header, got) = mavlink_wire::decode_frame::<M>(frame_v1).expect(id);
+                assert_eq!((got_header, &got), (header, decoded_v1), "{id}: decoded MAVLink 1 frame");
+            }
+            None => assert_eq!(mavlink_wire::encode_frame_v1(value, header, &mut out), None),
+        }
 
         // one bit flipped in the payload: the checksum must catch it
         let mut bad = frame.to_vec();

@@ -1,11 +1,16 @@
 // Copied by battgen from codegen/backends/rust/support/mavlink_wire.rs; do not edit.
-//! MAVLink 2 on the wire: the payload contract of a message and the v2 frame around it
-//! (header, X.25 checksum seeded with the message's CRC_EXTRA, an optional signature skipped).
+//! MAVLink on the wire: the payload contract of a message and the frame around it, MAVLink 2
+//! (header, X.25 checksum seeded with the message's CRC_EXTRA, an optional signature skipped) or
+//! MAVLink 1 (the base payload without extensions, message ids below 256).
 
 use crate::crc::{crc16_update, CRC_INIT};
 
 /// The first byte of a MAVLink 2 frame.
 pub const MAGIC_V2: u8 = 0xFD;
+/// The first byte of a MAVLink 1 frame.
+pub const MAGIC_V1: u8 = 0xFE;
+/// Header bytes before a MAVLink 1 payload.
+pub const HEADER_LENGTH_V1: usize = 6;
 /// Header bytes before the payload.
 pub const HEADER_LENGTH: usize = 10;
 /// The incompatibility flag of a signed frame.
@@ -36,6 +41,8 @@ pub trait Message: Sized {
     const MSG_ID: u32;
     /// The byte that seeds the checksum with the message's definition.
     const CRC_EXTRA: u8;
+    /// Payload bytes without extensions (the MAVLink 1 payload).
+    const BASE_LENGTH: usize;
     /// Payload bytes with every extension.
     const MAX_LENGTH: usize;
     /// Write the whole payload (wire order, extensions included) into `out[..MAX_LENGTH]`;
@@ -85,8 +92,32 @@ pub fn encode_frame<M: Message>(msg: &M, header: Header, out: &mut [u8]) -> usiz
     end + 2
 }
 
-/// One whole MAVLink 2 frame holding `M` (checksum checked, a signature skipped): its header and message.
+/// A MAVLink 1 frame of `msg` (its base payload) into `out`; None for a message id above 255,
+/// which MAVLink 1 cannot carry.
+pub fn encode_frame_v1<M: Message>(msg: &M, header: Header, out: &mut [u8]) -> Option<usize> {
+    let id = u8::try_from(M::MSG_ID).ok()?;
+    let mut payload = [0u8; 255];
+    msg.encode(&mut payload);
+    let n = M::BASE_LENGTH;
+    out[0] = MAGIC_V1;
+    out[1] = n as u8;
+    out[2] = header.seq;
+    out[3] = header.sysid;
+    out[4] = header.compid;
+    out[5] = id;
+    out[HEADER_LENGTH_V1..HEADER_LENGTH_V1 + n].copy_from_slice(&payload[..n]);
+    let end = HEADER_LENGTH_V1 + n;
+    let crc = crc16_update(crc16_update(CRC_INIT, &out[1..end]), &[M::CRC_EXTRA]);
+    out[end..end + 2].copy_from_slice(&crc.to_le_bytes());
+    Some(end + 2)
+}
+
+/// One whole MAVLink 1 or 2 frame holding `M` (checksum checked, a signature skipped): its header
+/// and message.
 pub fn decode_frame<M: Message>(frame: &[u8]) -> Result<(Header, M), DecodeError> {
+    if frame.first() == Some(&MAGIC_V1) {
+        return decode_frame_v1(frame);
+    }
     if frame.len() < HEADER_LENGTH + 2 || frame[0] != MAGIC_V2 {
         return Err(DecodeError::NotAFrame);
     }
@@ -124,6 +155,37 @@ pub fn decode_frame<M: Message>(frame: &[u8]) -> Result<(Header, M), DecodeError
         compid: frame[6],
     };
     Ok((header, M::decode(&frame[HEADER_LENGTH..end])?))
+}
+
+fn decode_frame_v1<M: Message>(frame: &[u8]) -> Result<(Header, M), DecodeError> {
+    if frame.len() < HEADER_LENGTH_V1 + 2 {
+        return Err(DecodeError::NotAFrame);
+    }
+    let end = HEADER_LENGTH_V1 + usize::from(frame[1]);
+    if frame.len() != end + 2 {
+        return Err(DecodeError::NotAFrame);
+    }
+    let found = u32::from(frame[5]);
+    if found != M::MSG_ID {
+        return Err(DecodeError::WrongMessage {
+            found,
+            expected: M::MSG_ID,
+        });
+    }
+    let expected = crc16_update(crc16_update(CRC_INIT, &frame[1..end]), &[M::CRC_EXTRA]);
+    let got = u16::from_le_bytes([frame[end], frame[end + 1]]);
+    if got != expected {
+        return Err(DecodeError::BadCrc {
+            found: got,
+            expected,
+        });
+    }
+    let header = Header {
+        seq: frame[2],
+        sysid: frame[3],
+        compid: frame[4],
+    };
+    Ok((header, M::decode(&frame[HEADER_LENGTH_V1..end])?))
 }
 
 /// The payload zero-filled to `N` bytes (a longer one is an error).

@@ -93,9 +93,6 @@ pub struct BatteryInfo {
 }
 
 impl BatteryInfo {
-    /// Payload bytes without extensions (the MAVLink 1 length).
-    pub const BASE_LENGTH: usize = 140;
-
     /// A message with every field unknown where it can be, zero elsewhere.
     #[must_use]
     pub const fn new() -> Self {
@@ -537,6 +534,7 @@ impl Validate for BatteryInfo {
 impl crate::mavlink_wire::Message for BatteryInfo {
     const MSG_ID: u32 = 372;
     const CRC_EXTRA: u8 = 26;
+    const BASE_LENGTH: usize = 140;
     const MAX_LENGTH: usize = 140;
 
     fn encode(&self, out: &mut [u8]) -> usize {

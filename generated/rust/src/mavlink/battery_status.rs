@@ -69,9 +69,6 @@ pub struct BatteryStatus {
 }
 
 impl BatteryStatus {
-    /// Payload bytes without extensions (the MAVLink 1 length).
-    pub const BASE_LENGTH: usize = 36;
-
     /// A message with every field unknown where it can be, zero elsewhere.
     #[must_use]
     pub const fn new() -> Self {
@@ -304,6 +301,7 @@ impl Validate for BatteryStatus {
 impl crate::mavlink_wire::Message for BatteryStatus {
     const MSG_ID: u32 = 147;
     const CRC_EXTRA: u8 = 154;
+    const BASE_LENGTH: usize = 36;
     const MAX_LENGTH: usize = 54;
 
     fn encode(&self, out: &mut [u8]) -> usize {

@@ -45,9 +45,6 @@ pub struct BatteryStatusV2 {
 }
 
 impl BatteryStatusV2 {
-    /// Payload bytes without extensions (the MAVLink 1 length).
-    pub const BASE_LENGTH: usize = 27;
-
     /// A message with every field unknown where it can be, zero elsewhere.
     #[must_use]
     pub const fn new() -> Self {
@@ -253,6 +250,7 @@ impl Validate for BatteryStatusV2 {
 impl crate::mavlink_wire::Message for BatteryStatusV2 {
     const MSG_ID: u32 = 369;
     const CRC_EXTRA: u8 = 145;
+    const BASE_LENGTH: usize = 27;
     const MAX_LENGTH: usize = 27;
 
     fn encode(&self, out: &mut [u8]) -> usize {

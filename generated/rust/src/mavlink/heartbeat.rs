@@ -37,9 +37,6 @@ pub struct Heartbeat {
 }
 
 impl Heartbeat {
-    /// Payload bytes without extensions (the MAVLink 1 length).
-    pub const BASE_LENGTH: usize = 9;
-
     /// A message with every field unknown where it can be, zero elsewhere.
     #[must_use]
     pub const fn new() -> Self {
@@ -148,6 +145,7 @@ impl Validate for Heartbeat {
 impl crate::mavlink_wire::Message for Heartbeat {
     const MSG_ID: u32 = 0;
     const CRC_EXTRA: u8 = 50;
+    const BASE_LENGTH: usize = 9;
     const MAX_LENGTH: usize = 9;
 
     fn encode(&self, out: &mut [u8]) -> usize {

@@ -77,9 +77,6 @@ pub struct SysStatus {
 }
 
 impl SysStatus {
-    /// Payload bytes without extensions (the MAVLink 1 length).
-    pub const BASE_LENGTH: usize = 31;
-
     /// A message with every field unknown where it can be, zero elsewhere.
     #[must_use]
     pub const fn new() -> Self {
@@ -258,6 +255,7 @@ impl Validate for SysStatus {
 impl crate::mavlink_wire::Message for SysStatus {
     const MSG_ID: u32 = 1;
     const CRC_EXTRA: u8 = 124;
+    const BASE_LENGTH: usize = 31;
     const MAX_LENGTH: usize = 43;
 
     fn encode(&self, out: &mut [u8]) -> usize {
