@@ -1,9 +1,13 @@
 """The generated Rust crate: the committed generated/rust/ is what the backend renders, it is
-`no_std` and forbids unsafe code, and in a temporary copy (cargo's target folder in the temp dir too)
-`cargo test --offline` replays every conformance vector record with identical bytes, values and
-problems to the generated Python package's (tests/rust_cases.py writes the cases at test time);
-`cargo fmt --check` and `cargo clippy -- -D warnings` pass, and a `no_std` library with its own
-panic handler builds against it (std linked in would clash with that handler)."""
+`no_std`, forbids unsafe code and has no dependencies. In a temporary copy (cargo's target folder in
+the temp dir too) `cargo test --offline` replays every conformance vector record and 40 seeded random
+records per message (tests/rust_cases.py writes them at test time, from the generated Python package)
+and must give the same bytes (MAVLink 2 payloads, v2, v1 and signed frames; uORB structs; DroneCAN
+payloads with and without the tail array optimisation), decoded values and validator problems; a
+wrong byte fails it, and the crate's doc example runs. `cargo fmt --check`, `cargo clippy -- -D
+warnings` and `cargo doc` with warnings denied pass, upstream's whole MAVLink, DroneCAN and PX4
+definitions make a clippy-clean crate too, and a `no_std` library with its own panic handler builds
+against the crate (std linked in would clash with that handler)."""
 
 from __future__ import annotations
 
