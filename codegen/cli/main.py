@@ -15,6 +15,7 @@ from ..apps.package import bundled_schemas, project_root
 from ..backends.c import generate_c
 from ..backends.python.name_clashes import refuse_clashes
 from ..backends.python.writer import generate
+from ..backends.rust import generate_rust
 from ..errors import BattgenError, ErrorList
 from ..frontends.loader import load
 from ..ir import Schema
@@ -58,7 +59,14 @@ def cmd_ir(args: argparse.Namespace) -> int:
 
 
 def _generate_c(schema: Schema, out: Path, check: bool) -> int:
-    written, removed, unchanged = generate_c(schema, out, check=check)
+    return _report_library(out, check, *generate_c(schema, out, check=check))
+
+
+def _generate_rust(schema: Schema, out: Path, check: bool) -> int:
+    return _report_library(out, check, *generate_rust(schema, out, check=check))
+
+
+def _report_library(out: Path, check: bool, written: list[str], removed: list[str], unchanged: list[str]) -> int:
     if check and (written or removed):
         for rel in written:
             print(line(f"stale: {out / rel}"), file=sys.stderr)
@@ -76,6 +84,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
     refuse_clashes(schema)  # before either language writes a file
     if args.lang == "c":
         return _generate_c(schema, Path(args.out) if args.out else project_root() / "generated" / "c", args.check)
+    if args.lang == "rust":
+        return _generate_rust(schema, Path(args.out) if args.out else project_root() / "generated" / "rust", args.check)
     if args.lang is None and not args.out:
         # the C is formatted by clang-format: a machine without it still generates (and checks) the Python
         # package, the main job; CI installs clang-format, and tests/backends/test_c_headers.py checks generated/c
@@ -86,6 +96,13 @@ def cmd_generate(args: argparse.Namespace) -> int:
             )
         else:
             status = _generate_c(schema, project_root() / "generated" / "c", args.check)
+            if status != EXIT_OK:
+                return status
+        # the same for the Rust crate and rustfmt (tests/backends/test_rust_crate.py checks generated/rust)
+        if shutil.which("rustfmt") is None:
+            print("battgen: generated/rust left as it is: rustfmt is not installed (rustup's rustfmt)", file=sys.stderr)
+        else:
+            status = _generate_rust(schema, project_root() / "generated" / "rust", args.check)
             if status != EXIT_OK:
                 return status
     out = Path(args.out) if args.out else project_root() / "generated"
@@ -148,9 +165,16 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("generate", help="generate the Python package (default: schemas/ into generated/)")
     p.add_argument("schema_dir", nargs="?", help="schema folder (default: schemas/)")
     p.add_argument(
-        "--out", "-o", help="write here (Python: an importable package named as the folder; C: default generated/c)"
+        "--out",
+        "-o",
+        help="write here (Python: an importable package named as the folder; C: default generated/c; "
+        "Rust: default generated/rust)",
     )
-    p.add_argument("--lang", choices=("python", "c"), help="only this language (default: both, C into generated/c)")
+    p.add_argument(
+        "--lang",
+        choices=("python", "c", "rust"),
+        help="only this language (default: all, C into generated/c, the Rust crate into generated/rust)",
+    )
     p.add_argument("--check", action="store_true", help="write nothing; exit 1 naming stale files")
     _include_path_option(p)
     p.set_defaults(func=cmd_generate)
