@@ -390,6 +390,60 @@ impl MavModeFlag {
     }
 }
 
+/// How a parameter's value is typed on the vehicle.
+///
+/// Schema: `mavlink.MAV_PARAM_TYPE` (value).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum MavParamType {
+    /// 8-bit unsigned integer.
+    Uint8 = 1,
+    /// 8-bit signed integer.
+    Int8 = 2,
+    /// 16-bit unsigned integer.
+    Uint16 = 3,
+    /// 16-bit signed integer.
+    Int16 = 4,
+    /// 32-bit unsigned integer.
+    Uint32 = 5,
+    /// 32-bit signed integer.
+    Int32 = 6,
+    /// 64-bit unsigned integer.
+    Uint64 = 7,
+    /// 64-bit signed integer.
+    Int64 = 8,
+    /// 32-bit float.
+    Real32 = 9,
+    /// 64-bit float.
+    Real64 = 10,
+}
+
+impl MavParamType {
+    /// The member with this value (None for a value the schema does not define).
+    #[must_use]
+    pub const fn from_value(value: i64) -> Option<Self> {
+        match value {
+            1 => Some(Self::Uint8),
+            2 => Some(Self::Int8),
+            3 => Some(Self::Uint16),
+            4 => Some(Self::Int16),
+            5 => Some(Self::Uint32),
+            6 => Some(Self::Int32),
+            7 => Some(Self::Uint64),
+            8 => Some(Self::Int64),
+            9 => Some(Self::Real32),
+            10 => Some(Self::Real64),
+            _ => None,
+        }
+    }
+
+    /// The value on the wire.
+    #[must_use]
+    pub const fn value(self) -> i64 {
+        self as i64
+    }
+}
+
 /// Overall state of a system, as its heartbeat reports it.
 ///
 /// Schema: `mavlink.MAV_STATE` (value).
