@@ -135,23 +135,29 @@ def _columns(rows: list[dict[str, Any]]) -> dict[str, NDArray]:
     return out
 
 
+# a record's drawn fields: values in and out of every check's range, sentinels, NaN and the infinities
+_ROW_FIELDS = {
+    "voltage_v": _FLOATS,
+    "current_a": _FLOATS,
+    "remaining": _FLOATS,
+    "temperature": _FLOATS,
+    "max_error": st.one_of(st.sampled_from([0, 1, 50, 100, 101]), st.integers(0, 65535)),
+    "cell_count": st.one_of(st.sampled_from([0, 4, 6, 14, 15]), st.integers(0, 255)),
+    "warning": st.integers(0, 255),
+    "voltage_cell_v": st.lists(_FLOATS, min_size=14, max_size=14),
+}
+
+
 @settings(max_examples=30)
 @given(
     st.lists(
         st.fixed_dictionaries(
             {},
             optional={
-                "voltage_v": _FLOATS,
-                "current_a": _FLOATS,
-                "remaining": _FLOATS,
+                **_ROW_FIELDS,
                 "scale": _FLOATS,
-                "temperature": _FLOATS,
-                "max_error": st.one_of(st.sampled_from([0, 1, 50, 100, 101]), st.integers(0, 65535)),
-                "cell_count": st.one_of(st.sampled_from([0, 4, 6, 14, 15]), st.integers(0, 255)),
                 "remaining_capacity_wh": _FLOATS,
                 "timestamp": st.integers(0, 2**64 - 1),
-                "warning": st.integers(0, 255),
-                "voltage_cell_v": st.lists(_FLOATS, min_size=14, max_size=14),
             },
         ),
         min_size=1,
@@ -206,23 +212,7 @@ def test_a_truncated_real_ulog_reports_what_the_record_read_does(tmp_path: Path,
 
 @settings(max_examples=25, deadline=None)
 @given(
-    st.lists(
-        st.fixed_dictionaries(
-            {},
-            optional={
-                "voltage_v": _FLOATS,
-                "current_a": _FLOATS,
-                "remaining": _FLOATS,
-                "temperature": _FLOATS,
-                "max_error": st.one_of(st.sampled_from([0, 1, 50, 100, 101]), st.integers(0, 65535)),
-                "cell_count": st.one_of(st.sampled_from([0, 4, 6, 14, 15]), st.integers(0, 255)),
-                "warning": st.integers(0, 255),
-                "voltage_cell_v": st.lists(_FLOATS, min_size=14, max_size=14),
-            },
-        ),
-        min_size=1,
-        max_size=12,
-    ),
+    st.lists(st.fixed_dictionaries({}, optional=_ROW_FIELDS), min_size=1, max_size=12),
     st.integers(0, 1),
 )
 def test_groups_of_a_written_log_equal_its_grouped_findings(rows: list[dict[str, Any]], instances: int) -> None:

@@ -391,18 +391,35 @@ def _located_rows(chunks: list[Chunk], offsets: Mapping[tuple[str, int], NDArray
         yield _Rows(k, offsets.get((topic, multi_id), np.zeros(0, np.int64))[begin : begin + chunk.n])
 
 
-def _checked_rows(
-    name: str, rows: list[_Rows], chunks: list[Chunk], checker: Checker, topic: str, skip: frozenset[str]
-) -> list[tuple[float, int, Finding]]:
+def _placed(rows: list[_Rows], chunks: list[Chunk], skip: frozenset[str]) -> tuple[NDArray, NDArray, NDArray] | None:
+    """The rows' file order (argsort of their offsets), each row's index in it (``ulog_items``' index) and its
+    ``timestamp`` as the reader reports it; None for no rows."""
     every = np.concatenate([r.offsets for r in rows])
     if len(every) != sum(chunks[r.chunk].n for r in rows):
         raise ValueError("the view's rows and the log's index disagree")  # a bug, never a quiet misplacement
     if not len(every):
-        return []
+        return None
     order = np.argsort(every, kind="stable")
     index = np.empty(len(every), np.int64)
-    index[order] = np.arange(len(every))  # the record's position in file order (ulog_items' index)
-    stamps_all = np.concatenate([_stamps(chunks[r.chunk], skip) for r in rows])
+    index[order] = np.arange(len(every))
+    return order, index, np.concatenate([_stamps(chunks[r.chunk], skip) for r in rows])
+
+
+def _record(
+    name: str, topic: str, multi_id: int, offset: int, stamp: Any, index: int, instance: Any, skip: frozenset[str]
+) -> Record:
+    """A row as the per-record reader yields it (:func:`codegen.inputs.ulog.ulog_items`): its place in the log."""
+    rec = LogRecord(topic, multi_id, offset, int(stamp) if stamp >= 0 else None, instance, skip, {}, ())
+    return Record(index, 0, None, name, where=rec.where(), instance=instance, skip=skip, location=rec.location())
+
+
+def _checked_rows(
+    name: str, rows: list[_Rows], chunks: list[Chunk], checker: Checker, topic: str, skip: frozenset[str]
+) -> list[tuple[float, int, Finding]]:
+    placed = _placed(rows, chunks, skip)
+    if placed is None:
+        return []
+    order, index, stamps_all = placed
     first = int(order[0])
     t0 = _seconds(stamps_all[first], int(index[first]))
     found: list[tuple[int, float, int, Finding]] = []
@@ -416,12 +433,7 @@ def _checked_rows(
         offsets = (r.offsets[picked] - _D_HEAD).tolist()
         for row, instance, offset in zip(picked.tolist(), instances, offsets, strict=True):
             at = start + row
-            stamp = int(stamps_all[at]) if stamps_all[at] >= 0 else None
-            rec = LogRecord(topic, multi_id, offset, stamp, instance, skip, {}, ())
-            record = Record(
-                int(index[at]), 0, None, name, where=rec.where(), instance=instance, skip=skip,
-                location=rec.location(),
-            )  # fmt: skip
+            record = _record(name, topic, multi_id, offset, stamps_all[at], int(index[at]), instance, skip)
             t = _seconds(stamps_all[at], int(index[at])) - t0
             for finding in checker.check(record):
                 found.append((int(index[at]), t, multi_id, finding))
@@ -487,15 +499,10 @@ def _grouped_rows(
     name: str, rows: list[_Rows], chunks: list[Chunk], checker: Checker, topic: str, skip: frozenset[str]
 ) -> list[FindingGroup]:
     """:func:`_checked_rows`' findings as groups (see :func:`column_finding_groups`)."""
-    every = np.concatenate([r.offsets for r in rows])
-    if len(every) != sum(chunks[r.chunk].n for r in rows):
-        raise ValueError("the view's rows and the log's index disagree")  # a bug, never a quiet misplacement
-    if not len(every):
+    placed = _placed(rows, chunks, skip)
+    if placed is None:
         return []
-    order = np.argsort(every, kind="stable")
-    index = np.empty(len(every), np.int64)
-    index[order] = np.arange(len(every))
-    stamps_all = np.concatenate([_stamps(chunks[r.chunk], skip) for r in rows])
+    order, index, stamps_all = placed
     t0 = _seconds(stamps_all[int(order[0])], int(index[int(order[0])]))
     groups: dict[tuple[int, str, str, str], FindingGroup] = {}
 
@@ -540,13 +547,8 @@ def _grouped_rows(
             picked.tolist(), row_instances(checker.cls, checker.message, columns, picked), strict=True
         ):
             at = start + row
-            stamp = int(stamps_all[at]) if stamps_all[at] >= 0 else None
             offset = int(r.offsets[row]) - _D_HEAD
-            rec = LogRecord(topic, multi_id, offset, stamp, instance, skip, {}, ())
-            record = Record(
-                int(index[at]), 0, None, name, where=rec.where(), instance=instance, skip=skip,
-                location=rec.location(),
-            )  # fmt: skip
+            record = _record(name, topic, multi_id, offset, stamps_all[at], int(index[at]), instance, skip)
             for finding in checker.check(record):
                 add(multi_id, finding, 1, at)
         for f, mask in flagged_fields:
