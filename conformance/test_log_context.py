@@ -5,7 +5,8 @@ read) against the reference readers on every real log of ``../shared``:
   (``ULog.get_version_info``), the hardware, every initial parameter (a float32 value as its shortest decimal,
   equal as a float32), and the arming changes (``vehicle_status.arming_state`` ARMED, else ``actuator_armed``);
 - ArduPilot DataFlash, against pymavlink's DFReader: every ``PARM`` value as the reader holds it after the whole
-  log (``DFReader.params``: a value set again in flight takes its last);
+  log (``DFReader.params``: a value set again in flight takes its last), and the firmware the ``VER`` record names
+  (where the log has one);
 - MAVLink tlog, against pymavlink: the MAV_TYPE and MAV_AUTOPILOT of each system's last vehicle heartbeat
   (pymavlink's ``probably_vehicle_heartbeat``) and every PARAM_VALUE (the last of each name);
 - one flight's DataFlash log and tlog (``wlichon_baseline_20260406_010254``): the same parameters, but for one the
@@ -115,9 +116,13 @@ def test_dataflash_parameters_match_pymavlink(path: Path) -> None:
     (context,) = contexts
     text = path.suffix.lower() != ".bin"
     reader = (DFReader.DFReader_text if text else DFReader.DFReader_binary)(str(path), zero_time_base=True)
-    while reader.recv_match(type=["PARM"]) is not None:
-        pass
+    version = None
+    while (msg := reader.recv_match(type=["PARM", "VER"])) is not None:
+        if msg.get_type() == "VER" and version is None:
+            version = msg.FWS  # the firmware's own version record (ArduPilot 4.1 on)
     assert context.autopilot == "ardupilot"
+    if version:
+        assert context.firmware == version  # the start-up MSG we read names what VER records
     assert set(context.parameters) == set(reader.params)
     for name, value in reader.params.items():
         assert _same_float32(context.parameters[name], float(value)), name

@@ -26,6 +26,7 @@ from __future__ import annotations
 import contextlib
 import io
 import math
+import re
 import struct
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
@@ -43,6 +44,8 @@ FMT_TYPE = 0x80
 NUMBERED_TYPES = {f"BAT{n}": n - 1 for n in range(2, 10)} | {"CURR2": 1, "CUR2": 1}
 BATTERY_TYPES = frozenset({"BAT", "BATT", "CURR"} | set(NUMBERED_TYPES))
 ARMING_TYPES = frozenset({"ARM", "EV"})
+# ArduPilot's start-up MSG naming the board and its unique id: "Pixhawk4 0047002B 34385105 36363539"
+BOARD_ID = re.compile(r"(\S+) [0-9A-F]{8} [0-9A-F]{8} [0-9A-F]{8}")
 
 
 @dataclass(frozen=True)
@@ -305,6 +308,7 @@ class LogStart:
     log_disarmed: float | None
     firmware: str | None
     parameters: Mapping[str, float] = field(default_factory=dict)
+    hardware: str | None = None  # the board, from the MSG that gives its name and unique id (BOARD_ID)
 
 
 def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord | GpsClock | LogStart]:
@@ -313,6 +317,7 @@ def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRe
     start = first_time_us(log)  # a short pass: the unfiltered walk is ~15x slower than a filtered one
     log_disarmed: float | None = None
     firmware: str | None = None
+    hardware: str | None = None
     parameters: dict[str, float] = {}
     for msg in log.messages(BATTERY_TYPES | ARMING_TYPES | {"GPS", "PARM", "MSG"}):
         if msg.type == "GPS":
@@ -333,13 +338,19 @@ def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRe
                 parameters[parameter[0]] = parameter[1]
                 if parameter[0] == "LOG_DISARMED" and log_disarmed is None:
                     log_disarmed = parameter[1]
-        elif msg.type == "MSG" and firmware is None:
+        elif msg.type == "MSG" and (firmware is None or hardware is None):
             text = msg.fields.get("Message")
             if isinstance(text, bytes):
                 text = text.decode("ascii", "replace")
-            if isinstance(text, str) and (" V" in text or text.startswith(("Ardu", "APM"))):
-                firmware = text.rstrip("\x00")
-    yield LogStart(start, log_disarmed, firmware, parameters)
+            if not isinstance(text, str):
+                continue
+            text = text.rstrip("\x00")
+            board = BOARD_ID.fullmatch(text)
+            if board is not None and hardware is None:
+                hardware = board.group(1)
+            elif firmware is None and (" V" in text or text.startswith(("Ardu", "APM"))):
+                firmware = text
+    yield LogStart(start, log_disarmed, firmware, parameters, hardware)
 
 
 GPS_EPOCH_S = 315_964_800  # 1980-01-06 00:00 UTC, the start of GPS week 0, in Unix time

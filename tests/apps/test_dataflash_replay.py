@@ -75,6 +75,10 @@ def test_clock_and_arming(log: Path) -> None:
     assert batch.t[0] == pytest.approx(11.477 - 11.459)
     assert batch.armed is not None and batch.armed[0] == 0.0 and batch.armed[-1] == 1.0  # EV 10 at 72.6 s
     assert any("APM:Copter V3.3" in n for n in batch.notes)
+    context = batch.context
+    assert context is not None and context.firmware == "APM:Copter V3.3-dev (ae3192b8)"
+    assert context.hardware == "PX4v2"  # "PX4v2 004A002F 33345119 32383433": the board and its unique id
+    assert context.arming_rule and context.arming[0] == (0.0, False)
 
 
 def _corpus_log(name: str) -> Path:

@@ -10,7 +10,8 @@ parameters the firmware recorded. Per kind:
   ``ver_hw``; vehicle type PX4's ``MAV_TYPE`` parameter; parameters the log's initial values (``PARAM``
   definitions; a value changed in flight is not applied: the replay starts from what the vehicle took off with).
 - **ArduPilot DataFlash**: the clock ``TimeUS`` since boot (``t`` = 0 at the first record), UTC from the first
-  GPS record with a week; firmware the first ``MSG`` that names it (``APM:Copter V3.3-dev (ae3192b8)``); the
+  GPS record with a week; firmware the first ``MSG`` that names it (``APM:Copter V3.3-dev (ae3192b8)``), hardware
+  the board the start-up ``MSG`` names with its unique id (``Pixhawk4 0047002B 34385105 36363539``); the
   parameters every ``PARM`` record (a value set again in flight: its last, as the vehicle ended up with it), under
   the names the firmware logged (older names such as ``FS_BATT_VOLTAGE`` are the failsafe's to map).
 - **MAVLink tlog**: the clock the tlog's stamps (µs since the epoch, so UTC is known); the vehicle the system id

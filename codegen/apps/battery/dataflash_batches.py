@@ -63,6 +63,7 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
         origin_us,
         None if clock is None else clock.utc_us - clock.time_us,
         firmware=start.firmware,
+        hardware=start.hardware,
         autopilot="ardupilot",  # DataFlash is ArduPilot's log format
         parameters=dict(start.parameters),
         arming=arming_changes(arm_t, arm_v),
