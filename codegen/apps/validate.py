@@ -11,7 +11,7 @@ a callback as it is found, so that a caller can print them while a long file is 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -420,9 +420,12 @@ def make_checker(
     files: list[str] | None = None,
     kind: str | None = None,
     vehicle: str | None = None,
+    *,
+    only: Collection[str] | None = None,
 ) -> tuple[Message, Checker]:
-    """Load the schemas, resolve the message (or the inputs' default one) and its generated class."""
-    schema = load([schema_dir])
+    """Load the schemas, resolve the message (or the inputs' default one) and its generated class. ``only``: the
+    sub-folders of the schema folder to read (the message's format and the rules, where the caller knows it)."""
+    schema = load([schema_dir], only=only)
     if message_name is None:
         message_name = default_message(schema, files or [], kind)
     message = resolve_message(schema, message_name)

@@ -13,6 +13,7 @@ record's position (one per second) -- said in the series' ``time_source``.
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from collections.abc import Mapping
@@ -23,17 +24,19 @@ from typing import Any
 import numpy as np
 
 from ...errors import BattgenError
+from ...frontends.loader import RULES_DIR
 from ...inputs.dispatch import read_records
 from ...inputs.kinds import FLIGHT_LOG_KINDS, file_kind
 from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
 from ..battery.column_checks import FindingGroup, column_finding_groups, group_findings
-from ..battery.columns import NDArray
+from ..battery.columns import ConceptColumn, NDArray
 from ..battery.figures import FlightFigures, flight_figures
 from ..battery.view import Chunk, read_view
 from ..convert import Conversion
 from ..failsafe.logs import SampleTable
 from ..messages import BATTERY_MESSAGES
+from ..package import bundled_schemas
 from ..validate import Checker, Finding, make_checker
 
 KELVIN = 273.15
@@ -103,16 +106,15 @@ class BatterySeries:
             self.armed if self.knows_arming else None,
         )
 
-    @property
+    @functools.cached_property
     def cell_count(self) -> int:
         """The cells some sample gives (the last column holding a value, counted from 1)."""
-        given = np.nonzero(~np.isnan(self.cells).all(axis=0))[0] if self.cells.size else _EMPTY
-        return int(given[-1]) + 1 if len(given) else 0
+        return _given_width(self.cells)
 
     def cell(self, k: int) -> NDArray:
         return np.asarray(self.cells[:, k], np.float64)
 
-    @property
+    @functools.cached_property
     def imbalance(self) -> NDArray:
         """max - min cell voltage of each sample with at least two known cells (else NaN)."""
         if not self.cells.size:
@@ -225,7 +227,10 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
         return out
     column = None
     if checkable:
-        _, checker = make_checker(schema_dir, default_message(path, kind), [str(path)], kind)
+        message = default_message(path, kind)
+        # the bundled folder: its message's format and the rules are all the checker reads (not pydsdl's Cyphal)
+        only = (message.partition(".")[0], RULES_DIR) if schema_dir == bundled_schemas() else None
+        _, checker = make_checker(schema_dir, message, [str(path)], kind, only=only)
         column = column_finding_groups(path, name, kind, chunks, checker)
     if column is not None:
         out.findings, out.notices, out.unreadable = column
@@ -233,6 +238,28 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
         checked = _record_input(path, schema_dir, name, None, kind)
         out.findings, out.notices, out.unreadable = checked.findings, checked.notices, checked.unreadable
     return out
+
+
+def _given_width(cells: NDArray) -> int:
+    """The columns of a cell matrix up to the last that holds a value."""
+    if not cells.size:
+        return 0
+    given = np.flatnonzero(~np.isnan(cells).all(axis=0))
+    return int(given[-1]) + 1 if len(given) else 0
+
+
+def _first_serial(serial: ConceptColumn, rows: NDArray) -> str:
+    """The first serial number the rows give ("": none): an integer that is not 0, or a text that is not blank,
+    NULs or zeros. Each distinct value is judged once (a battery repeats its serial in every record)."""
+    values, valid = serial.values[rows], serial.valid[rows]
+    if values.dtype != object:
+        given = np.flatnonzero(valid & (values != 0))
+        return str(values[given[0]]) if len(given) else ""
+    for v in dict.fromkeys(values[valid].tolist()):  # in the order they first appear
+        text = v if isinstance(v, str) else str(v) if v else ""
+        if text.strip("\x00 0"):
+            return text
+    return ""
 
 
 class _Parts:
@@ -267,24 +294,19 @@ class _Parts:
         reported = cycles.values[rows][cycles.valid[rows] & (cycles.values[rows] > 0)]
         if len(reported):
             s.cycle_count = int(reported[-1])
-        serial = chunk.concepts["serial_number"]
         if not s.serial:
-            for v, ok in zip(serial.values[rows].tolist(), serial.valid[rows].tolist(), strict=True):
-                text = str(v) if ok and not isinstance(v, str) and v else v if ok and isinstance(v, str) else ""
-                if text.strip("\x00 0"):
-                    s.serial = text
-                    break
+            s.serial = _first_serial(chunk.concepts["serial_number"], rows)
 
     def finish(self) -> BatterySeries:
         """The series joined, in time order (a record without a time last)."""
         s, parts = self.series, self.parts
         for name in ("t", "armed", *SERIES):
             setattr(s, name, np.concatenate(parts[name]) if parts[name] else _EMPTY)
-        width = max((m.shape[1] for m in parts["cells"]), default=0)
-        s.cells = np.full((len(s.t), width), np.nan)
+        widths = [_given_width(m) for m in parts["cells"]]  # a format's 14 slots, of which a pack fills its cells
+        s.cells = np.full((len(s.t), max(widths, default=0)), np.nan)
         at = 0
-        for m in parts["cells"]:
-            s.cells[at : at + len(m), : m.shape[1]] = m
+        for m, width in zip(parts["cells"], widths, strict=True):
+            s.cells[at : at + len(m), :width] = m[:, :width]
             at += len(m)
         if len(s.t) and not bool((s.t[1:] >= s.t[:-1]).all()):  # a ULog's instances, or its chunks, out of order
             order = np.argsort(s.t, kind="stable")
