@@ -223,9 +223,8 @@ def _print(schema: Schema, t: FieldType, v: str) -> str:
     if t.kind is PrimitiveKind.BOOL:
         return f'printf("%d", {v} ? 1 : 0);'
     if t.kind is PrimitiveKind.UINT or t.kind is PrimitiveKind.CHAR:
-        return f'printf("%llu", (unsigned long long)(unsigned char){v});' if t.kind is PrimitiveKind.CHAR else (
-            f'printf("%llu", (unsigned long long){v});'
-        )
+        cast = "(unsigned long long)(unsigned char)" if t.kind is PrimitiveKind.CHAR else "(unsigned long long)"
+        return f'printf("%llu", {cast}{v});'
     return f'printf("%lld", (long long){v});'
 
 
@@ -239,6 +238,8 @@ class Case:
     exact: bool  # the initialiser holds exactly the Python record (its problems compare)
     wires: list[bytes]  # the Python encodings, as the kind orders them
     expected: list[tuple[str, str | None]]  # (tag, line) the harness must print; None: not compared
+    record: dict[str, Any]  # the Python record given (its to_dict())
+    seq: int  # a MAVLink frame's sequence number
 
 
 @dataclass
@@ -306,7 +307,7 @@ def _case(schema: Schema, replay: Replay, cid: str, obj: Any) -> Case | None:
     if key in replay.seen:
         return None
     replay.seen.add(key)
-    return Case(cid, given, exact, wires, expected)
+    return Case(cid, given, exact, wires, expected, obj.to_dict(), seq)
 
 
 def _records(schema: Schema, classes: Mapping[str, Any]) -> Iterator[tuple[str, Any, dict[str, Any]]]:
@@ -339,7 +340,12 @@ def collect(schema: Schema, classes: Mapping[str, Any]) -> list[Replay]:
 
 def expected_lines(replays: list[Replay]) -> list[tuple[str, str | None]]:
     """(``<message>#<case> <tag>``, what follows it) of every line the harness must print."""
-    return [(f"{r.msg.qualified_name}#{j} {tag}", line) for r in replays for j, c in enumerate(r.cases) for tag, line in c.expected]
+    return [
+        (f"{r.msg.qualified_name}#{j} {tag}", line)
+        for r in replays
+        for j, c in enumerate(r.cases)
+        for tag, line in c.expected
+    ]
 
 
 # --- the harness ----------------------------------------------------------------------------------
@@ -404,26 +410,27 @@ def _run(r: Replay) -> list[str]:
         "size_t np;",
         "int e;",
         f'#define TAG(x) printf("{q}#%lu " x " ", (unsigned long)j)',
+        f'#define SHOW(x, call) TAG(x); e = (call); printf("%d ", e); dump_{t}(&d); printf("\\n")',
     ]
     if r.kind == "mavlink":
         lines += [
-            f"uint8_t buf[BATTGEN_MAVLINK_MAX_FRAME_LENGTH + 16];",
+            "uint8_t buf[BATTGEN_MAVLINK_MAX_FRAME_LENGTH + 16];",
             "size_t n;",
             "battgen_mavlink_header h, got;",
             f"const span *w = wire_{t}[j];",
             "h.seq = (uint8_t)(j % 256u); h.sysid = 1; h.compid = 1;",
             f'TAG("enc"); n = {t}_encode(g, buf); hex(buf, n); printf("\\n");',
             f'TAG("frame"); n = {t}_encode_frame(g, h, buf); hex(buf, n); printf("\\n");',
-            f'TAG("dec"); e = {t}_decode(blob + w[0].off, w[0].len, &d); printf("%d ", e); dump_{t}(&d); printf("\\n");',
-            f'TAG("fdec"); e = {t}_decode_frame(blob + w[1].off, w[1].len, &got, &d);',
-            'if (e == 0 && (got.seq != h.seq || got.sysid != 1 || got.compid != 1)) { e = 99; }',
-            f'printf("%d ", e); dump_{t}(&d); printf("\\n");',
-            f'TAG("sdec"); e = {t}_decode_frame(blob + w[2].off, w[2].len, &got, &d); printf("%d ", e); dump_{t}(&d); printf("\\n");',
+            f'SHOW("dec", {t}_decode(blob + w[0].off, w[0].len, &d));',
+            f"e = {t}_decode_frame(blob + w[1].off, w[1].len, &got, &d);",
+            "if (e == 0 && (got.seq != h.seq || got.sysid != 1 || got.compid != 1)) { e = 99; }",
+            'SHOW("fdec", e);',
+            f'SHOW("sdec", {t}_decode_frame(blob + w[2].off, w[2].len, &got, &d));',
             "memcpy(buf, blob + w[1].off, w[1].len); buf[BATTGEN_MAVLINK_HEADER_LENGTH] ^= 1u;",
             f'TAG("badcrc"); printf("%d\\n", {t}_decode_frame(buf, w[1].len, &got, &d));',
             f'TAG("v1"); n = {t}_encode_frame_v1(g, h, buf); hex(buf, n); printf("\\n");',
-            f"if (w[3].len) {{",
-            f'TAG("v1dec"); e = {t}_decode_frame(blob + w[3].off, w[3].len, &got, &d); printf("%d ", e); dump_{t}(&d); printf("\\n");',
+            "if (w[3].len) {",
+            f'SHOW("v1dec", {t}_decode_frame(blob + w[3].off, w[3].len, &got, &d));',
             "}",
             f"e = {t}_decode(blob + w[0].off, w[0].len, &d); (void)e;",
         ]
@@ -433,7 +440,7 @@ def _run(r: Replay) -> list[str]:
             f"const span *w = wire_{t}[j];",
             "memset(buf, 0xAA, sizeof buf);",
             f'TAG("enc"); {t}_encode(g, buf); hex(buf, sizeof buf); printf("\\n");',
-            f'TAG("dec"); e = {t}_decode(blob + w[0].off, w[0].len, &d); printf("%d ", e); dump_{t}(&d); printf("\\n");',
+            f'SHOW("dec", {t}_decode(blob + w[0].off, w[0].len, &d));',
         ]
     else:
         lines += [
@@ -442,13 +449,14 @@ def _run(r: Replay) -> list[str]:
             f"const span *w = wire_{t}[j];",
             f'TAG("enc"); e = {t}_encode(g, true, buf, &n); printf("%d ", e); hex(buf, n); printf("\\n");',
             f'TAG("encfd"); e = {t}_encode(g, false, buf, &n); printf("%d ", e); hex(buf, n); printf("\\n");',
-            f'TAG("decfd"); e = {t}_decode(blob + w[1].off, w[1].len, false, &d); printf("%d ", e); dump_{t}(&d); printf("\\n");',
-            f'TAG("dec"); e = {t}_decode(blob + w[0].off, w[0].len, true, &d); printf("%d ", e); dump_{t}(&d); printf("\\n");',
+            f'SHOW("decfd", {t}_decode(blob + w[1].off, w[1].len, false, &d));',
+            f'SHOW("dec", {t}_decode(blob + w[0].off, w[0].len, true, &d));',
         ]
     lines += [
         f'TAG("prob"); np = {t}_validate(&d, probs, {up}_MAX_PROBLEMS + 1u); problems(probs, np); printf("\\n");',
         f'TAG("gprob"); np = {t}_validate(g, probs, {up}_MAX_PROBLEMS + 1u); problems(probs, np); printf("\\n");',
         "#undef TAG",
+        "#undef SHOW",
         "}",
         "}",
     ]
