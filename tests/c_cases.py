@@ -354,6 +354,7 @@ PRELUDE = r"""/* battgen's C replay harness (written by tests/c_cases.py at test
 #include "battgen.h"
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 typedef struct { size_t off, len; } span;
 

@@ -27,6 +27,8 @@ typedef struct {
   uint8_t compid;
 } battgen_mavlink_header;
 
+#ifndef __cplusplus /* the frame helpers are the C codecs' own, as battgen_wire.h's */
+
 /* The MAVLink 2 send length of a full payload: trailing zeros dropped, one byte at least. */
 static inline size_t battgen_mavlink_truncated(const uint8_t *payload, size_t n) {
   while (n > 1u && payload[n - 1u] == 0u) {
@@ -57,7 +59,7 @@ static inline size_t battgen_mavlink_frame_v2(uint32_t msg_id, uint8_t crc_extra
   out[7] = (uint8_t)(msg_id & 0xFFu);
   out[8] = (uint8_t)((msg_id >> 8) & 0xFFu);
   out[9] = (uint8_t)((msg_id >> 16) & 0xFFu);
-  memcpy(out + BATTGEN_MAVLINK_HEADER_LENGTH, payload, n);
+  battgen_copy(out + BATTGEN_MAVLINK_HEADER_LENGTH, payload, n);
   return battgen_mavlink_seal(out, BATTGEN_MAVLINK_HEADER_LENGTH + n, crc_extra);
 }
 
@@ -74,7 +76,7 @@ static inline size_t battgen_mavlink_frame_v1(uint32_t msg_id, uint8_t crc_extra
   out[3] = h.sysid;
   out[4] = h.compid;
   out[5] = (uint8_t)msg_id;
-  memcpy(out + BATTGEN_MAVLINK_HEADER_LENGTH_V1, payload, n);
+  battgen_copy(out + BATTGEN_MAVLINK_HEADER_LENGTH_V1, payload, n);
   return battgen_mavlink_seal(out, BATTGEN_MAVLINK_HEADER_LENGTH_V1 + n, crc_extra);
 }
 
@@ -129,6 +131,8 @@ static inline battgen_error battgen_mavlink_frame_parse(const uint8_t *frame, si
   *n = end - start;
   return BATTGEN_OK;
 }
+
+#endif /* !__cplusplus */
 
 #ifdef __cplusplus
 }

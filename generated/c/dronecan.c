@@ -10,12 +10,9 @@
 #include "dronecan/uavcan/equipment/power/CircuitStatus.h"
 #include "dronecan/uavcan/equipment/power/PrimaryPowerSupplyStatus.h"
 
-#include <math.h>
-#include <string.h>
-
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryCells_voltages(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -29,7 +26,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryCells_voltages(float v) 
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_temperature_cells(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -43,7 +40,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_temperature_c
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_temperature_pcb(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -57,7 +54,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_temperature_p
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_temperature_other(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -71,10 +68,10 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_temperature_o
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_current(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -82,10 +79,10 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_current(float
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -93,7 +90,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_voltage(float
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_state_of_charge(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -107,10 +104,10 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_state_of_char
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_capacity_consumed(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -126,7 +123,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_status_flags(
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_voltage_cell(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -140,7 +137,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_voltage_cell(flo
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_max_current(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -154,7 +151,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_max_current(floa
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_nominal_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -168,10 +165,10 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_nominal_voltage(
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_design_capacity(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -179,7 +176,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_design_capacity
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_nominal_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -194,7 +191,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_nominal_voltage
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_discharge_minimum_voltage(
     float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -208,7 +205,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_discharge_minim
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_charging_minimum_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -222,7 +219,7 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_charging_minimu
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_charging_maximum_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -236,10 +233,10 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_charging_maximu
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_charging_maximum_current(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -248,10 +245,10 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_charging_maximu
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_discharge_maximum_current(
     float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -260,10 +257,10 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_discharge_maxim
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_discharge_maximum_burst_current(
     float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -271,10 +268,10 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_discharge_maxim
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_full_charge_capacity(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -282,110 +279,110 @@ check_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_full_charge_cap
 
 static battgen_rule
 check_battgen_dronecan_ardupilot_equipment_power_BatteryTag_armed_hours(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_temperature(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_voltage_cell(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_current(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_average_current(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_average_power(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_available_energy(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_remaining_capacity(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_full_charge_capacity(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_design_capacity(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -413,20 +410,20 @@ static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_max_error(u
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_passed_charge(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_dronecan_cuav_equipment_power_CBAT_nominal_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -453,7 +450,7 @@ static battgen_rule check_battgen_dronecan_uavcan_Timestamp_usec(uint64_t v) {
 }
 
 static battgen_rule check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_temperature(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
   if ((double)v < -65504.0) {
@@ -466,7 +463,7 @@ static battgen_rule check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_te
 }
 
 static battgen_rule check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
   if ((double)v < -65504.0) {
@@ -479,7 +476,7 @@ static battgen_rule check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_vo
 }
 
 static battgen_rule check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_current(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
   if ((double)v < -65504.0) {
@@ -493,7 +490,7 @@ static battgen_rule check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_cu
 
 static battgen_rule
 check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_average_power_10sec(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
   if ((double)v < -65504.0) {
@@ -507,7 +504,7 @@ check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_average_power_10sec(fl
 
 static battgen_rule
 check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_remaining_capacity_wh(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
   if ((double)v < -65504.0) {
@@ -521,7 +518,7 @@ check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_remaining_capacity_wh(
 
 static battgen_rule
 check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_full_charge_capacity_wh(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
   if ((double)v < -65504.0) {
@@ -535,7 +532,7 @@ check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_full_charge_capacity_w
 
 static battgen_rule
 check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_hours_to_full_charge(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
   if ((double)v < -65504.0) {
@@ -586,7 +583,7 @@ check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_state_of_charge_pct_st
 }
 
 static battgen_rule check_battgen_dronecan_uavcan_equipment_power_CircuitStatus_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -599,7 +596,7 @@ static battgen_rule check_battgen_dronecan_uavcan_equipment_power_CircuitStatus_
 }
 
 static battgen_rule check_battgen_dronecan_uavcan_equipment_power_CircuitStatus_current(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -622,7 +619,7 @@ check_battgen_dronecan_uavcan_equipment_power_CircuitStatus_error_flags(uint8_t 
 static battgen_rule
 check_battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power(
     float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -637,7 +634,7 @@ check_battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_hours_to_
 static battgen_rule
 check_battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_hours_to_empty_at_10sec_avg_power_variance(
     float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
   if ((double)v < -65504.0) {
@@ -735,7 +732,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryCells_encode(
     uint8_t out[BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCELLS_MAX_BYTES], size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCELLS_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCELLS_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_ardupilot_equipment_power_BatteryCells_put(m, &w, tao);
@@ -751,7 +748,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryCells_decode(
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_ardupilot_equipment_power_BatteryCells_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;
@@ -873,7 +870,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_encod
     size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_put(m, &w, tao);
@@ -889,7 +886,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_decod
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;
@@ -1014,7 +1011,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_encode(
     uint8_t out[BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYINFOAUX_MAX_BYTES], size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYINFOAUX_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYINFOAUX_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_put(m, &w, tao);
@@ -1030,7 +1027,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_decode(
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;
@@ -1240,7 +1237,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_encode(
     size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_put(m, &w, tao);
@@ -1256,7 +1253,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_decode(
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;
@@ -1327,7 +1324,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryTag_encode(
     uint8_t out[BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_MAX_BYTES], size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_ardupilot_equipment_power_BatteryTag_put(m, &w, tao);
@@ -1343,7 +1340,7 @@ battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryTag_decode(
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_ardupilot_equipment_power_BatteryTag_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;
@@ -1595,7 +1592,7 @@ battgen_error battgen_dronecan_cuav_equipment_power_CBAT_encode(
     uint8_t out[BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_BYTES], size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_cuav_equipment_power_CBAT_put(m, &w, tao);
@@ -1611,7 +1608,7 @@ battgen_dronecan_cuav_equipment_power_CBAT_decode(const uint8_t *data, size_t le
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_cuav_equipment_power_CBAT_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;
@@ -1656,7 +1653,7 @@ battgen_dronecan_uavcan_Timestamp_encode(const battgen_dronecan_uavcan_Timestamp
                                          size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_UAVCAN_TIMESTAMP_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_UAVCAN_TIMESTAMP_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_uavcan_Timestamp_put(m, &w, tao);
@@ -1671,7 +1668,7 @@ battgen_error battgen_dronecan_uavcan_Timestamp_decode(const uint8_t *data, size
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_uavcan_Timestamp_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;
@@ -1854,7 +1851,7 @@ battgen_error battgen_dronecan_uavcan_equipment_power_BatteryInfo_encode(
     uint8_t out[BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_MAX_BYTES], size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_uavcan_equipment_power_BatteryInfo_put(m, &w, tao);
@@ -1870,7 +1867,7 @@ battgen_error battgen_dronecan_uavcan_equipment_power_BatteryInfo_decode(
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_uavcan_equipment_power_BatteryInfo_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;
@@ -1939,7 +1936,7 @@ battgen_error battgen_dronecan_uavcan_equipment_power_CircuitStatus_encode(
     uint8_t out[BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_CIRCUITSTATUS_MAX_BYTES], size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_CIRCUITSTATUS_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_CIRCUITSTATUS_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_uavcan_equipment_power_CircuitStatus_put(m, &w, tao);
@@ -1955,7 +1952,7 @@ battgen_error battgen_dronecan_uavcan_equipment_power_CircuitStatus_decode(
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_uavcan_equipment_power_CircuitStatus_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;
@@ -2040,7 +2037,7 @@ battgen_error battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_e
     size_t *len) {
   battgen_bit_writer w;
   battgen_error e;
-  memset(out, 0, BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_PRIMARYPOWERSUPPLYSTATUS_MAX_BYTES);
+  battgen_zero(out, BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_PRIMARYPOWERSUPPLYSTATUS_MAX_BYTES);
   w.buf = out;
   w.bit = 0;
   e = battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_put(m, &w, tao);
@@ -2056,7 +2053,7 @@ battgen_error battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_d
   r.data = data;
   r.len = len;
   r.bit = 0;
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   e = battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_get(m, &r, tao);
   if (e != BATTGEN_OK) {
     return e;

@@ -6,18 +6,15 @@
 #include "mavlink/PARAM_VALUE.h"
 #include "mavlink/SYS_STATUS.h"
 
-#include <math.h>
-#include <string.h>
-
 static battgen_rule check_battgen_mavlink_BATTERY_INFO_battery_function(uint8_t v) {
-  if (!((v <= 4u))) {
+  if (!(v <= 4u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_INFO_type(uint8_t v) {
-  if (!((v <= 4u))) {
+  if (!(v <= 4u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
@@ -27,10 +24,10 @@ static battgen_rule check_battgen_mavlink_BATTERY_INFO_discharge_minimum_voltage
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -40,10 +37,10 @@ static battgen_rule check_battgen_mavlink_BATTERY_INFO_charging_minimum_voltage(
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -53,10 +50,10 @@ static battgen_rule check_battgen_mavlink_BATTERY_INFO_resting_minimum_voltage(f
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -66,10 +63,10 @@ static battgen_rule check_battgen_mavlink_BATTERY_INFO_charging_maximum_voltage(
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -79,10 +76,10 @@ static battgen_rule check_battgen_mavlink_BATTERY_INFO_charging_maximum_current(
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -92,10 +89,10 @@ static battgen_rule check_battgen_mavlink_BATTERY_INFO_nominal_voltage(float v) 
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -105,10 +102,10 @@ static battgen_rule check_battgen_mavlink_BATTERY_INFO_discharge_maximum_current
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -118,10 +115,10 @@ static battgen_rule check_battgen_mavlink_BATTERY_INFO_discharge_maximum_burst_c
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -131,48 +128,48 @@ static battgen_rule check_battgen_mavlink_BATTERY_INFO_design_capacity(float v) 
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_INFO_full_charge_capacity(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_STATUS_battery_function(uint8_t v) {
-  if (!((v <= 4u))) {
+  if (!(v <= 4u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_STATUS_type(uint8_t v) {
-  if (!((v <= 4u))) {
+  if (!(v <= 4u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_STATUS_charge_state(uint8_t v) {
-  if (!((v <= 7u))) {
+  if (!(v <= 7u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_STATUS_mode(uint8_t v) {
-  if (!((v <= 2u))) {
+  if (!(v <= 2u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
@@ -186,50 +183,50 @@ static battgen_rule check_battgen_mavlink_BATTERY_STATUS_fault_bitmask(uint32_t 
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_STATUS_V2_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_STATUS_V2_current(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_STATUS_V2_capacity_consumed(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_STATUS_V2_capacity_remaining(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_BATTERY_STATUS_V2_state_of_charge(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -243,38 +240,38 @@ static battgen_rule check_battgen_mavlink_BATTERY_STATUS_V2_status_flags(uint32_
 }
 
 static battgen_rule check_battgen_mavlink_HEARTBEAT_type(uint8_t v) {
-  if (!((v <= 49u))) {
+  if (!(v <= 49u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_HEARTBEAT_autopilot(uint8_t v) {
-  if (!((v <= 20u))) {
+  if (!(v <= 20u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_HEARTBEAT_system_status(uint8_t v) {
-  if (!((v <= 8u))) {
+  if (!(v <= 8u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_PARAM_VALUE_param_value(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_mavlink_PARAM_VALUE_param_type(uint8_t v) {
-  if (!((v >= 1u && v <= 10u))) {
+  if (!(v >= 1u && v <= 10u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
@@ -366,7 +363,7 @@ size_t battgen_mavlink_BATTERY_INFO_encode(const battgen_mavlink_BATTERY_INFO *m
                                            uint8_t out[BATTGEN_MAVLINK_BATTERY_INFO_MAX_LENGTH]) {
   uint8_t *p = out;
   size_t i;
-  memset(p, 0, BATTGEN_MAVLINK_BATTERY_INFO_MAX_LENGTH);
+  battgen_zero(p, BATTGEN_MAVLINK_BATTERY_INFO_MAX_LENGTH);
   battgen_put_u32(p + 0, battgen_f32_bits(m->discharge_minimum_voltage));
   battgen_put_u32(p + 4, battgen_f32_bits(m->charging_minimum_voltage));
   battgen_put_u32(p + 8, battgen_f32_bits(m->resting_minimum_voltage));
@@ -404,9 +401,9 @@ battgen_error battgen_mavlink_BATTERY_INFO_decode(const uint8_t *payload, size_t
   if (len > BATTGEN_MAVLINK_BATTERY_INFO_MAX_LENGTH) {
     return BATTGEN_ERR_TOO_LONG;
   }
-  memset(p, 0, sizeof p);
-  memcpy(p, payload, len);
-  memset(m, 0, sizeof *m);
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, payload, len);
+  battgen_zero(m, sizeof *m);
   m->discharge_minimum_voltage = battgen_f32_from(battgen_get_u32(p + 0));
   m->charging_minimum_voltage = battgen_f32_from(battgen_get_u32(p + 4));
   m->resting_minimum_voltage = battgen_f32_from(battgen_get_u32(p + 8));
@@ -504,7 +501,7 @@ battgen_mavlink_BATTERY_STATUS_encode(const battgen_mavlink_BATTERY_STATUS *m,
                                       uint8_t out[BATTGEN_MAVLINK_BATTERY_STATUS_MAX_LENGTH]) {
   uint8_t *p = out;
   size_t i;
-  memset(p, 0, BATTGEN_MAVLINK_BATTERY_STATUS_MAX_LENGTH);
+  battgen_zero(p, BATTGEN_MAVLINK_BATTERY_STATUS_MAX_LENGTH);
   battgen_put_u32(p + 0, (uint32_t)m->current_consumed);
   battgen_put_u32(p + 4, (uint32_t)m->energy_consumed);
   battgen_put_u16(p + 8, (uint16_t)m->temperature);
@@ -534,9 +531,9 @@ battgen_error battgen_mavlink_BATTERY_STATUS_decode(const uint8_t *payload, size
   if (len > BATTGEN_MAVLINK_BATTERY_STATUS_MAX_LENGTH) {
     return BATTGEN_ERR_TOO_LONG;
   }
-  memset(p, 0, sizeof p);
-  memcpy(p, payload, len);
-  memset(m, 0, sizeof *m);
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, payload, len);
+  battgen_zero(m, sizeof *m);
   m->current_consumed = battgen_i32(battgen_get_u32(p + 0));
   m->energy_consumed = battgen_i32(battgen_get_u32(p + 4));
   m->temperature = battgen_i16(battgen_get_u16(p + 8));
@@ -626,7 +623,7 @@ size_t battgen_mavlink_BATTERY_STATUS_V2_encode(
     const battgen_mavlink_BATTERY_STATUS_V2 *m,
     uint8_t out[BATTGEN_MAVLINK_BATTERY_STATUS_V2_MAX_LENGTH]) {
   uint8_t *p = out;
-  memset(p, 0, BATTGEN_MAVLINK_BATTERY_STATUS_V2_MAX_LENGTH);
+  battgen_zero(p, BATTGEN_MAVLINK_BATTERY_STATUS_V2_MAX_LENGTH);
   battgen_put_u32(p + 0, battgen_f32_bits(m->voltage));
   battgen_put_u32(p + 4, battgen_f32_bits(m->current));
   battgen_put_u32(p + 8, battgen_f32_bits(m->capacity_consumed));
@@ -645,9 +642,9 @@ battgen_error battgen_mavlink_BATTERY_STATUS_V2_decode(const uint8_t *payload, s
   if (len > BATTGEN_MAVLINK_BATTERY_STATUS_V2_MAX_LENGTH) {
     return BATTGEN_ERR_TOO_LONG;
   }
-  memset(p, 0, sizeof p);
-  memcpy(p, payload, len);
-  memset(m, 0, sizeof *m);
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, payload, len);
+  battgen_zero(m, sizeof *m);
   m->voltage = battgen_f32_from(battgen_get_u32(p + 0));
   m->current = battgen_f32_from(battgen_get_u32(p + 4));
   m->capacity_consumed = battgen_f32_from(battgen_get_u32(p + 8));
@@ -714,7 +711,7 @@ size_t battgen_mavlink_HEARTBEAT_validate(const battgen_mavlink_HEARTBEAT *m, ba
 size_t battgen_mavlink_HEARTBEAT_encode(const battgen_mavlink_HEARTBEAT *m,
                                         uint8_t out[BATTGEN_MAVLINK_HEARTBEAT_MAX_LENGTH]) {
   uint8_t *p = out;
-  memset(p, 0, BATTGEN_MAVLINK_HEARTBEAT_MAX_LENGTH);
+  battgen_zero(p, BATTGEN_MAVLINK_HEARTBEAT_MAX_LENGTH);
   battgen_put_u32(p + 0, m->custom_mode);
   battgen_put_u8(p + 4, m->type);
   battgen_put_u8(p + 5, m->autopilot);
@@ -731,9 +728,9 @@ battgen_error battgen_mavlink_HEARTBEAT_decode(const uint8_t *payload, size_t le
   if (len > BATTGEN_MAVLINK_HEARTBEAT_MAX_LENGTH) {
     return BATTGEN_ERR_TOO_LONG;
   }
-  memset(p, 0, sizeof p);
-  memcpy(p, payload, len);
-  memset(m, 0, sizeof *m);
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, payload, len);
+  battgen_zero(m, sizeof *m);
   m->custom_mode = battgen_get_u32(p + 0);
   m->type = battgen_get_u8(p + 4);
   m->autopilot = battgen_get_u8(p + 5);
@@ -795,7 +792,7 @@ size_t battgen_mavlink_PARAM_VALUE_encode(const battgen_mavlink_PARAM_VALUE *m,
                                           uint8_t out[BATTGEN_MAVLINK_PARAM_VALUE_MAX_LENGTH]) {
   uint8_t *p = out;
   size_t i;
-  memset(p, 0, BATTGEN_MAVLINK_PARAM_VALUE_MAX_LENGTH);
+  battgen_zero(p, BATTGEN_MAVLINK_PARAM_VALUE_MAX_LENGTH);
   battgen_put_u32(p + 0, battgen_f32_bits(m->param_value));
   battgen_put_u16(p + 4, m->param_count);
   battgen_put_u16(p + 6, m->param_index);
@@ -814,9 +811,9 @@ battgen_error battgen_mavlink_PARAM_VALUE_decode(const uint8_t *payload, size_t 
   if (len > BATTGEN_MAVLINK_PARAM_VALUE_MAX_LENGTH) {
     return BATTGEN_ERR_TOO_LONG;
   }
-  memset(p, 0, sizeof p);
-  memcpy(p, payload, len);
-  memset(m, 0, sizeof *m);
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, payload, len);
+  battgen_zero(m, sizeof *m);
   m->param_value = battgen_f32_from(battgen_get_u32(p + 0));
   m->param_count = battgen_get_u16(p + 4);
   m->param_index = battgen_get_u16(p + 6);
@@ -886,7 +883,7 @@ size_t battgen_mavlink_SYS_STATUS_validate(const battgen_mavlink_SYS_STATUS *m,
 size_t battgen_mavlink_SYS_STATUS_encode(const battgen_mavlink_SYS_STATUS *m,
                                          uint8_t out[BATTGEN_MAVLINK_SYS_STATUS_MAX_LENGTH]) {
   uint8_t *p = out;
-  memset(p, 0, BATTGEN_MAVLINK_SYS_STATUS_MAX_LENGTH);
+  battgen_zero(p, BATTGEN_MAVLINK_SYS_STATUS_MAX_LENGTH);
   battgen_put_u32(p + 0, m->onboard_control_sensors_present);
   battgen_put_u32(p + 4, m->onboard_control_sensors_enabled);
   battgen_put_u32(p + 8, m->onboard_control_sensors_health);
@@ -913,9 +910,9 @@ battgen_error battgen_mavlink_SYS_STATUS_decode(const uint8_t *payload, size_t l
   if (len > BATTGEN_MAVLINK_SYS_STATUS_MAX_LENGTH) {
     return BATTGEN_ERR_TOO_LONG;
   }
-  memset(p, 0, sizeof p);
-  memcpy(p, payload, len);
-  memset(m, 0, sizeof *m);
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, payload, len);
+  battgen_zero(m, sizeof *m);
   m->onboard_control_sensors_present = battgen_get_u32(p + 0);
   m->onboard_control_sensors_enabled = battgen_get_u32(p + 4);
   m->onboard_control_sensors_health = battgen_get_u32(p + 8);

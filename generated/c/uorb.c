@@ -3,17 +3,14 @@
 #include "uorb/BatteryStatus.h"
 #include "uorb/BatteryStatusV0.h"
 
-#include <math.h>
-#include <string.h>
-
 static battgen_rule check_battgen_uorb_BatteryStatus_voltage_v(float v) {
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -23,10 +20,10 @@ static battgen_rule check_battgen_uorb_BatteryStatus_current_a(float v) {
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -36,10 +33,10 @@ static battgen_rule check_battgen_uorb_BatteryStatus_current_average_a(float v) 
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -49,10 +46,10 @@ static battgen_rule check_battgen_uorb_BatteryStatus_discharged_mah(float v) {
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -62,10 +59,10 @@ static battgen_rule check_battgen_uorb_BatteryStatus_remaining(float v) {
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   if ((double)v < 0.0) {
@@ -81,10 +78,10 @@ static battgen_rule check_battgen_uorb_BatteryStatus_scale(float v) {
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   if ((double)v < 1.0) {
@@ -94,27 +91,27 @@ static battgen_rule check_battgen_uorb_BatteryStatus_scale(float v) {
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_time_remaining_s(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_temperature(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_source(uint8_t v) {
-  if (!((v <= 2u))) {
+  if (!(v <= 2u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
@@ -141,27 +138,27 @@ static battgen_rule check_battgen_uorb_BatteryStatus_voltage_cell_v(float v) {
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_max_cell_voltage_delta(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_warning(uint8_t v) {
-  if (!((v <= 4u) || (v >= 6u && v <= 7u))) {
+  if (!(v <= 4u || (v >= 6u && v <= 7u))) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
@@ -175,70 +172,70 @@ static battgen_rule check_battgen_uorb_BatteryStatus_faults(uint16_t v) {
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_full_charge_capacity_wh(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_remaining_capacity_wh(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_nominal_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_internal_resistance_estimate(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_ocv_estimate(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_ocv_estimate_filtered(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_volt_based_soc_estimate(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   if ((double)v < 0.0) {
@@ -251,30 +248,30 @@ static battgen_rule check_battgen_uorb_BatteryStatus_volt_based_soc_estimate(flo
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_voltage_prediction(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_prediction_error(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatus_estimation_covariance_norm(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -284,10 +281,10 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_voltage_v(float v) {
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -297,10 +294,10 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_current_a(float v) {
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -310,10 +307,10 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_current_average_a(float v
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -323,10 +320,10 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_discharged_mah(float v) {
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -336,10 +333,10 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_remaining(float v) {
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   if ((double)v < 0.0) {
@@ -355,10 +352,10 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_scale(float v) {
   if (v == -1.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   if ((double)v < 1.0) {
@@ -368,27 +365,27 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_scale(float v) {
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_time_remaining_s(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_temperature(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NONE;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_source(uint8_t v) {
-  if (!((v <= 2u))) {
+  if (!(v <= 2u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
@@ -415,27 +412,27 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_voltage_cell_v(float v) {
   if (v == 0.0) {
     return BATTGEN_RULE_NONE;
   }
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_max_cell_voltage_delta(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_warning(uint8_t v) {
-  if (!((v <= 4u) || (v >= 6u && v <= 7u))) {
+  if (!(v <= 4u || (v >= 6u && v <= 7u))) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
@@ -449,70 +446,70 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_faults(uint16_t v) {
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_full_charge_capacity_wh(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_remaining_capacity_wh(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_nominal_voltage(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_internal_resistance_estimate(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_ocv_estimate(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_ocv_estimate_filtered(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_volt_based_soc_estimate(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   if ((double)v < 0.0) {
@@ -525,30 +522,30 @@ static battgen_rule check_battgen_uorb_BatteryStatusV0_volt_based_soc_estimate(f
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_voltage_prediction(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_prediction_error(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
 }
 
 static battgen_rule check_battgen_uorb_BatteryStatusV0_estimation_covariance_norm(float v) {
-  if (isnan(v)) {
+  if (battgen_f32_is_nan(v)) {
     return BATTGEN_RULE_NAN;
   }
-  if (isinf(v)) {
+  if (battgen_f32_is_inf(v)) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }
   return BATTGEN_RULE_NONE;
@@ -569,7 +566,7 @@ void battgen_uorb_BatteryInfo_encode(const battgen_uorb_BatteryInfo *m,
                                      uint8_t out[BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE]) {
   uint8_t *p = out;
   size_t i;
-  memset(p, 0, BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE); /* PX4's padding bytes as zero */
+  battgen_zero(p, BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE); /* PX4's padding bytes as zero */
   battgen_put_u64(p + 0, m->timestamp);
   battgen_put_u8(p + 8, m->id);
   for (i = 0; i < 32u; i++) {
@@ -587,7 +584,7 @@ battgen_error battgen_uorb_BatteryInfo_decode(const uint8_t *data, size_t len,
   if (len > BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE) {
     return BATTGEN_ERR_TOO_LONG;
   }
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   m->timestamp = battgen_get_u64(p + 0);
   m->id = battgen_get_u8(p + 8);
   for (i = 0; i < 32u; i++) {
@@ -714,7 +711,7 @@ void battgen_uorb_BatteryStatus_encode(const battgen_uorb_BatteryStatus *m,
                                        uint8_t out[BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE]) {
   uint8_t *p = out;
   size_t i;
-  memset(p, 0, BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE); /* PX4's padding bytes as zero */
+  battgen_zero(p, BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE); /* PX4's padding bytes as zero */
   battgen_put_u64(p + 0, m->timestamp);
   battgen_put_u32(p + 8, battgen_f32_bits(m->voltage_v));
   battgen_put_u32(p + 12, battgen_f32_bits(m->current_a));
@@ -767,7 +764,7 @@ battgen_error battgen_uorb_BatteryStatus_decode(const uint8_t *data, size_t len,
   if (len > BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE) {
     return BATTGEN_ERR_TOO_LONG;
   }
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   m->timestamp = battgen_get_u64(p + 0);
   m->voltage_v = battgen_f32_from(battgen_get_u32(p + 8));
   m->current_a = battgen_f32_from(battgen_get_u32(p + 12));
@@ -928,7 +925,7 @@ void battgen_uorb_BatteryStatusV0_encode(const battgen_uorb_BatteryStatusV0 *m,
                                          uint8_t out[BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE]) {
   uint8_t *p = out;
   size_t i;
-  memset(p, 0, BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE); /* PX4's padding bytes as zero */
+  battgen_zero(p, BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE); /* PX4's padding bytes as zero */
   battgen_put_u64(p + 0, m->timestamp);
   battgen_put_u32(p + 8, battgen_f32_bits(m->voltage_v));
   battgen_put_u32(p + 12, battgen_f32_bits(m->current_a));
@@ -982,7 +979,7 @@ battgen_error battgen_uorb_BatteryStatusV0_decode(const uint8_t *data, size_t le
   if (len > BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE) {
     return BATTGEN_ERR_TOO_LONG;
   }
-  memset(m, 0, sizeof *m);
+  battgen_zero(m, sizeof *m);
   m->timestamp = battgen_get_u64(p + 0);
   m->voltage_v = battgen_f32_from(battgen_get_u32(p + 8));
   m->current_a = battgen_f32_from(battgen_get_u32(p + 12));

@@ -64,9 +64,14 @@ def _double(value: float) -> str:
     return text if ("." in text or "e" in text) else text + ".0"
 
 
+def _float_fn(t: PrimitiveType, what: str, expr: str) -> str:
+    """``battgen_f32_is_nan(expr)`` and the like (float16 is held in a float)."""
+    return f"battgen_f{64 if t.bits > 32 else 32}_is_{what}({expr})"
+
+
 def _equals(t: PrimitiveType, value: int | float, expr: str) -> str:
     if isinstance(value, float) and math.isnan(value):
-        return f"isnan({expr})"
+        return _float_fn(t, "nan", expr)
     if t.kind is PrimitiveKind.FLOAT:
         return f"{expr} == {_double(float(value))}"
     return f"{expr} == {_int_literal(int(value), scalar(t))}"
@@ -107,7 +112,7 @@ def _allowed(values: list[int], low: float, high: float, ctype: str) -> str:
             continue
         part = [f"v >= {_int_literal(a, ctype)}"] if a > low else []
         part += [f"v <= {_int_literal(b, ctype)}"] if b < high else []
-        terms.append("(" + " && ".join(part) + ")" if part else "1")
+        terms.append(("(" + " && ".join(part) + ")" if len(part) > 1 else part[0]) if part else "1")
     return " || ".join(terms) if terms else "0"
 
 
@@ -122,7 +127,7 @@ def _body(schema: Schema, f: Field, t: PrimitiveType) -> list[str]:
         checks.append(f"if ({cond}) {{ return BATTGEN_RULE_{name}; }}")
 
     if is_float and not (s is not None and s.is_nan):
-        rule("isnan(v)", "NAN")
+        rule(_float_fn(t, "nan", "v"), "NAN")
     low, high = type_bounds(t, f.range)
     type_low, type_high = type_bounds(t, None)
     inf = float("inf")
@@ -130,11 +135,11 @@ def _body(schema: Schema, f: Field, t: PrimitiveType) -> list[str]:
     if is_float and t.bits >= 32:
         # the C type holds exactly the width's finite values, so beyond them is only an infinity
         if low != -inf and high != inf:
-            rule("isinf(v)", "TYPE_BOUNDS")
+            rule(_float_fn(t, "inf", "v"), "TYPE_BOUNDS")
         elif low != -inf:
-            rule("isinf(v) && v < 0", "TYPE_BOUNDS")
+            rule(f"{_float_fn(t, 'inf', 'v')} && v < 0", "TYPE_BOUNDS")
         elif high != inf:
-            rule("isinf(v) && v > 0", "TYPE_BOUNDS")
+            rule(f"{_float_fn(t, 'inf', 'v')} && v > 0", "TYPE_BOUNDS")
     elif is_float:  # float16 held in a float
         rule(f"{x} < {_double(low)}", "TYPE_BOUNDS")
         rule(f"{x} > {_double(high)}", "TYPE_BOUNDS")
@@ -164,7 +169,8 @@ def _body(schema: Schema, f: Field, t: PrimitiveType) -> list[str]:
         c_low, c_high = type_bounds(PrimitiveType(t.kind, _c_bits(t)), None)
         if values is not None:
             fit = [v for v in values if type_low <= v <= type_high]
-            rule(f"!({_allowed(fit, c_low, c_high, ctype)})", "ENUM")
+            allowed = _allowed(fit, c_low, c_high, ctype)
+            rule(f"!({allowed})" if " " in allowed and not allowed.startswith("(") else f"!{allowed}", "ENUM")
         elif mask is not None and mask & ((1 << t.bits) - 1) != (1 << t.bits) - 1:  # else every value passes
             w = _c_bits(t)
             bits = "v" if ctype.startswith("u") else f"(uint{w}_t)v"  # a signed field's bits as sent

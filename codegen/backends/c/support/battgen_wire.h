@@ -1,13 +1,14 @@
 /* battgen's C support, copied verbatim into every generated library: the byte and bit helpers the
  * codecs share, and what the validators report. Every value goes through explicit shifts, never a
- * cast of a byte pointer, so the codecs are independent of the host's endianness and alignment. */
+ * cast of a byte pointer, so the codecs are independent of the host's endianness and alignment.
+ * Only the compiler's own freestanding headers are included (no <string.h>, no <math.h>): the
+ * library builds for a microcontroller without a C library. */
 #ifndef BATTGEN_WIRE_H
 #define BATTGEN_WIRE_H
 
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
-#include <string.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -78,6 +79,37 @@ typedef enum {
   BATTGEN_ERR_TRAILING = 9         /* whole bytes follow a DroneCAN message */
 } battgen_error;
 
+/* DroneCAN bits: a writer into a zeroed buffer and a reader (what a message's put / get take). */
+typedef struct {
+  uint8_t *buf;
+  size_t bit;
+} battgen_bit_writer;
+
+typedef struct {
+  const uint8_t *data;
+  size_t len;
+  size_t bit;
+} battgen_bit_reader;
+
+/* The helpers below are the codecs' own (C, not C++: a float's bits are read through a union,
+ * which C99 defines and C++ does not); C++ firmware calls the codecs, not these. */
+#ifndef __cplusplus
+
+/* `n` bytes at `p` set to zero / copied (what <string.h> would do, for builds without it). */
+static inline void battgen_zero(void *p, size_t n) {
+  unsigned char *b = (unsigned char *)p;
+  size_t i;
+  for (i = 0; i < n; i++) {
+    b[i] = 0u;
+  }
+}
+static inline void battgen_copy(uint8_t *to, const uint8_t *from, size_t n) {
+  size_t i;
+  for (i = 0; i < n; i++) {
+    to[i] = from[i];
+  }
+}
+
 /* Little-endian bytes. */
 static inline void battgen_put_u8(uint8_t *p, uint8_t v) { p[0] = v; }
 static inline void battgen_put_u16(uint8_t *p, uint16_t v) {
@@ -121,26 +153,45 @@ static inline int64_t battgen_i64(uint64_t u) {
   return u < 0x8000000000000000ULL ? (int64_t)u : -(int64_t)(0xFFFFFFFFFFFFFFFFULL - u) - 1;
 }
 
-/* Float bits: a float and an integer of its width share the host's byte order. */
-static inline uint32_t battgen_f32_bits(float x) {
+/* Float bits through a union (C99 TC3 6.5.2.3): a float and an integer of its width share the
+ * host's byte order, so the bits are the IEEE 754 bits on every host. */
+typedef union {
+  float f;
   uint32_t u;
-  memcpy(&u, &x, sizeof u);
-  return u;
+} battgen_f32_pun;
+typedef union {
+  double f;
+  uint64_t u;
+} battgen_f64_pun;
+static inline uint32_t battgen_f32_bits(float x) {
+  battgen_f32_pun p;
+  p.f = x;
+  return p.u;
 }
 static inline float battgen_f32_from(uint32_t u) {
-  float x;
-  memcpy(&x, &u, sizeof x);
-  return x;
+  battgen_f32_pun p;
+  p.u = u;
+  return p.f;
 }
 static inline uint64_t battgen_f64_bits(double x) {
-  uint64_t u;
-  memcpy(&u, &x, sizeof u);
-  return u;
+  battgen_f64_pun p;
+  p.f = x;
+  return p.u;
 }
 static inline double battgen_f64_from(uint64_t u) {
-  double x;
-  memcpy(&x, &u, sizeof x);
-  return x;
+  battgen_f64_pun p;
+  p.u = u;
+  return p.f;
+}
+
+/* NaN and infinity by their bits (no <math.h>, and right under -ffast-math too). */
+static inline bool battgen_f32_is_nan(float x) { return (battgen_f32_bits(x) & 0x7FFFFFFFu) > 0x7F800000u; }
+static inline bool battgen_f32_is_inf(float x) { return (battgen_f32_bits(x) & 0x7FFFFFFFu) == 0x7F800000u; }
+static inline bool battgen_f64_is_nan(double x) {
+  return (battgen_f64_bits(x) & 0x7FFFFFFFFFFFFFFFULL) > 0x7FF0000000000000ULL;
+}
+static inline bool battgen_f64_is_inf(double x) {
+  return (battgen_f64_bits(x) & 0x7FFFFFFFFFFFFFFFULL) == 0x7FF0000000000000ULL;
 }
 
 /* MAVLink's checksum: CRC-16/MCRF4XX (X.25), one byte at a time. */
@@ -156,16 +207,6 @@ static inline uint16_t battgen_crc16(uint16_t crc, const uint8_t *data, size_t n
 
 /* DroneCAN bits: written most significant bit first, a value wider than a byte as its
  * little-endian bytes (the last holding the remaining high bits). */
-typedef struct {
-  uint8_t *buf;
-  size_t bit;
-} battgen_bit_writer;
-
-typedef struct {
-  const uint8_t *data;
-  size_t len;
-  size_t bit;
-} battgen_bit_reader;
 
 static inline void battgen_bits_put(battgen_bit_writer *w, uint64_t value, unsigned bits) {
   unsigned left = bits;
@@ -317,6 +358,8 @@ static inline float battgen_f16_value(uint16_t bits) {
   }
   return battgen_f32_from(out);
 }
+
+#endif /* !__cplusplus */
 
 #ifdef __cplusplus
 }
