@@ -10,6 +10,8 @@ the same validator problems. A corrupted frame is refused by its checksum."""
 from __future__ import annotations
 
 import importlib.util
+import os
+import re
 import shutil
 import subprocess
 from dataclasses import dataclass, replace
@@ -196,3 +198,60 @@ def test_a_wrong_byte_is_seen(native: Built) -> None:
 
     assert mismatches(only(line), output) == []
     assert mismatches(only(changed), output) != []
+
+
+def _tool(*names: str, files: tuple[Path, ...] = ()) -> None:
+    """Cross tools (Debian's gcc-s390x-linux-gnu with libc6-dev-s390x-cross, qemu-user,
+    gcc-arm-none-eabi): skip without them outside CI; under CI (which installs them) their absence fails."""
+    absent = [n for n in names if shutil.which(n) is None] + [str(f) for f in files if not f.is_file()]
+    if absent:
+        message = f"{', '.join(absent)} not installed"
+        if os.environ.get("CI"):
+            pytest.fail(message + " (CI installs them: .ci/run)")
+        pytest.skip(message)
+
+
+def test_big_endian_s390x_replays_every_case_as_python(replays: list[Replay], tmp_path: Path) -> None:
+    """The same replay, built static for s390x (big-endian) and run under qemu: the bytes on the wire
+    and the values decoded do not depend on the host's byte order."""
+    _tool("s390x-linux-gnu-gcc", "qemu-s390x", files=(Path("/usr/s390x-linux-gnu/include/stdio.h"),))
+    output = compile_and_run(["s390x-linux-gnu-gcc", "-static"], ["qemu-s390x"], tmp_path, replays)
+    probe = tmp_path / "order.c"
+    probe.write_text("int main(void) { unsigned x = 1; return *(unsigned char *)&x; }\n", encoding="utf-8")
+    subprocess.run(
+        ["s390x-linux-gnu-gcc", "-static", str(probe), "-o", str(tmp_path / "order")], check=True, timeout=120
+    )
+    assert subprocess.run(["qemu-s390x", str(tmp_path / "order")], timeout=60).returncode == 0, "not big-endian"
+    bad = mismatches(replays, output)
+    assert not bad, f"{len(bad)} differences, first:\n" + "\n".join(bad[:10])
+    assert len(output) == len(expected_lines(replays))
+
+
+# what a Cortex-M4 object may leave to the toolchain: libgcc's soft-float helpers and the memset
+# gcc makes of a zeroing loop; no heap, no printf, nothing else of a C library
+ALLOWED_UNDEFINED = re.compile(r"__aeabi_\w+|memset|memcpy")
+
+
+def test_cortex_m4_build_without_a_c_library(tmp_path: Path) -> None:
+    """Every source builds for a Cortex-M4 (``-Os -mthumb -mcpu=cortex-m4``, the strict warnings) with
+    the compiler's freestanding headers only, and calls nothing of a C library."""
+    _tool("arm-none-eabi-gcc", "arm-none-eabi-nm", "arm-none-eabi-size")
+    for src in SOURCES:
+        obj = tmp_path / (src + ".o")
+        cc = ["arm-none-eabi-gcc", *FLAGS, "-ffreestanding", "-Os", "-mthumb", "-mcpu=cortex-m4"]
+        done = subprocess.run(
+            [*cc, "-I", str(GENERATED), "-c", str(GENERATED / src), "-o", str(obj)],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            check=False,
+        )
+        assert done.returncode == 0, done.stderr[-4000:]
+        nm = subprocess.run(
+            ["arm-none-eabi-nm", "-u", str(obj)], capture_output=True, text=True, check=True, timeout=60
+        )
+        undefined = [line.split()[-1] for line in nm.stdout.splitlines() if line.strip()]
+        assert [u for u in undefined if not ALLOWED_UNDEFINED.fullmatch(u)] == [], src
+        size = subprocess.run(["arm-none-eabi-size", str(obj)], capture_output=True, text=True, check=True, timeout=60)
+        text, data, bss = (int(v) for v in size.stdout.splitlines()[1].split()[:3])
+        assert text > 0 and data == 0 and bss == 0, (src, size.stdout)  # no state: every call is re-entrant
