@@ -255,3 +255,26 @@ def test_cortex_m4_build_without_a_c_library(tmp_path: Path) -> None:
         size = subprocess.run(["arm-none-eabi-size", str(obj)], capture_output=True, text=True, check=True, timeout=60)
         text, data, bss = (int(v) for v in size.stdout.splitlines()[1].split()[:3])
         assert text > 0 and data == 0 and bss == 0, (src, size.stdout)  # no state: every call is re-entrant
+
+
+@needs_gcc
+def test_readme_example_runs_as_python_says(tmp_path: Path) -> None:
+    """generated/c/README.md's example compiles with the strict flags and prints what the Python
+    package says of the same BatteryInfo: its problems, its payload's length, the value read back."""
+    from rust_cases import FIELD_RULES
+
+    from generated.dronecan.uavcan.equipment.power import BatteryInfo
+
+    readme = (GENERATED / "README.md").read_text(encoding="utf-8")
+    example = readme.split("```c\n", 1)[1].split("```", 1)[0]
+    (tmp_path / "example.c").write_text(example, encoding="utf-8")
+    exe = tmp_path / "example"
+    cc = ["gcc", *FLAGS, "-I", str(GENERATED), str(tmp_path / "example.c"), str(GENERATED / "dronecan.c")]
+    subprocess.run([*cc, "-o", str(exe)], check=True, timeout=300)
+    ran = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60, check=True)
+    info = BatteryInfo.from_dict({"temperature": 298.15, "voltage": 16.8, "state_of_health_pct": 200})
+    payload = info.encode()
+    problems = [f"{v.path}: {v.rule}" for v in info.validate() if v.rule in FIELD_RULES]
+    back = BatteryInfo.decode(payload).state_of_health_pct
+    assert ran.stdout.splitlines() == [*problems, f"{len(payload)} bytes, state_of_health_pct {back}"]
+    assert problems == ["state_of_health_pct: type-bounds"]
