@@ -278,3 +278,17 @@ def test_readme_example_runs_as_python_says(tmp_path: Path) -> None:
     back = BatteryInfo.decode(payload).state_of_health_pct
     assert ran.stdout.splitlines() == [*problems, f"{len(payload)} bytes, state_of_health_pct {back}"]
     assert problems == ["state_of_health_pct: type-bounds"]
+
+
+@needs_gcc
+def test_sanitizers_find_nothing(replays: list[Replay], tmp_path: Path) -> None:
+    """The replay under AddressSanitizer and UndefinedBehaviorSanitizer (every report fatal): no
+    out-of-bounds access, no signed overflow, no shift beyond a width, no misaligned access."""
+    probe = tmp_path / "probe.c"
+    probe.write_text("int main(void) { return 0; }\n", encoding="utf-8")
+    sanitize = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-g"]
+    if subprocess.run(["gcc", *sanitize, str(probe), "-o", str(tmp_path / "probe")], timeout=120).returncode != 0:
+        pytest.skip("gcc's sanitizer runtimes (libasan, libubsan) not installed")
+    output = compile_and_run(["gcc", *sanitize], [], tmp_path, replays)
+    bad = mismatches(replays, output)
+    assert not bad, f"{len(bad)} differences, first:\n" + "\n".join(bad[:10])
