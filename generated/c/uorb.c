@@ -576,14 +576,13 @@ void battgen_uorb_BatteryInfo_encode(const battgen_uorb_BatteryInfo *m,
 
 battgen_error battgen_uorb_BatteryInfo_decode(const uint8_t *data, size_t len,
                                               battgen_uorb_BatteryInfo *m) {
-  const uint8_t *p = data;
+  uint8_t p[BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE];
   size_t i;
-  if (len < BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE) {
-    return BATTGEN_ERR_SHORT;
+  if (len != BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE && len != BATTGEN_UORB_BATTERYINFO_PACKED_SIZE) {
+    return len < BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE ? BATTGEN_ERR_SHORT : BATTGEN_ERR_TOO_LONG;
   }
-  if (len > BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE) {
-    return BATTGEN_ERR_TOO_LONG;
-  }
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, data, len);
   battgen_zero(m, sizeof *m);
   m->timestamp = battgen_get_u64(p + 0);
   m->id = battgen_get_u8(p + 8);
@@ -756,14 +755,14 @@ void battgen_uorb_BatteryStatus_encode(const battgen_uorb_BatteryStatus *m,
 
 battgen_error battgen_uorb_BatteryStatus_decode(const uint8_t *data, size_t len,
                                                 battgen_uorb_BatteryStatus *m) {
-  const uint8_t *p = data;
+  uint8_t p[BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE];
   size_t i;
-  if (len < BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE) {
-    return BATTGEN_ERR_SHORT;
+  if (len != BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE &&
+      len != BATTGEN_UORB_BATTERYSTATUS_PACKED_SIZE) {
+    return len < BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE ? BATTGEN_ERR_SHORT : BATTGEN_ERR_TOO_LONG;
   }
-  if (len > BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE) {
-    return BATTGEN_ERR_TOO_LONG;
-  }
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, data, len);
   battgen_zero(m, sizeof *m);
   m->timestamp = battgen_get_u64(p + 0);
   m->voltage_v = battgen_f32_from(battgen_get_u32(p + 8));
@@ -971,14 +970,15 @@ void battgen_uorb_BatteryStatusV0_encode(const battgen_uorb_BatteryStatusV0 *m,
 
 battgen_error battgen_uorb_BatteryStatusV0_decode(const uint8_t *data, size_t len,
                                                   battgen_uorb_BatteryStatusV0 *m) {
-  const uint8_t *p = data;
+  uint8_t p[BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE];
   size_t i;
-  if (len < BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE) {
-    return BATTGEN_ERR_SHORT;
+  if (len != BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE &&
+      len != BATTGEN_UORB_BATTERYSTATUSV0_PACKED_SIZE) {
+    return len < BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE ? BATTGEN_ERR_SHORT
+                                                          : BATTGEN_ERR_TOO_LONG;
   }
-  if (len > BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE) {
-    return BATTGEN_ERR_TOO_LONG;
-  }
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, data, len);
   battgen_zero(m, sizeof *m);
   m->timestamp = battgen_get_u64(p + 0);
   m->voltage_v = battgen_f32_from(battgen_get_u32(p + 8));

@@ -13,6 +13,7 @@ from .types import ident
 @dataclass(frozen=True)
 class ByteCodec:
     size: int  # bytes of the whole payload / struct
+    packed: int  # uORB: the struct without its trailing padding (as ULog records hold it); else size
     encode: list[str]  # statements writing `m` into `p` (size bytes, zeroed before)
     decode: list[str]  # statements reading `p` (size bytes) into `m`
 
@@ -64,7 +65,7 @@ def get(t: PrimitiveType, at: str) -> str:
     return raw
 
 
-def _codec(fields: list[tuple[Field, int]], size: int) -> ByteCodec | None:
+def _codec(fields: list[tuple[Field, int]], size: int, packed: int) -> ByteCodec | None:
     encode: list[str] = []
     decode: list[str] = []
     for f, offset in fields:
@@ -82,7 +83,7 @@ def _codec(fields: list[tuple[Field, int]], size: int) -> ByteCodec | None:
         decode += [f"for (i = 0; i < {count}u; i++) {{", f"{name}[i] = {get(t, f'p + {offset}u + {step}')};", "}"]
         if isinstance(f.type, StringType):
             decode.append(f"{name}[{count}] = '\\0';")  # the C string's terminator, one past the wire bytes
-    return ByteCodec(size, encode, decode)
+    return ByteCodec(size, packed, encode, decode)
 
 
 def mavlink_codec(msg: Message) -> ByteCodec | None:
@@ -100,7 +101,7 @@ def mavlink_codec(msg: Message) -> ByteCodec | None:
         placed.append((f, offset))
         offset += width(shape[0]) * (shape[1] or 1)
     assert offset == info.max_length, f"{msg.qualified_name}: wire order gives {offset} bytes"
-    return _codec(placed, info.max_length)
+    return _codec(placed, info.max_length, info.max_length)
 
 
 def uorb_codec(msg: Message) -> ByteCodec | None:
@@ -108,5 +109,6 @@ def uorb_codec(msg: Message) -> ByteCodec | None:
     info = msg.uorb
     if info is None:
         return None
-    placed = [(msg.field(slot.field), slot.offset) for slot in info.layout if slot.field is not None]
-    return _codec(placed, info.struct_size)
+    slots = [slot for slot in info.layout if slot.field is not None]
+    packed = max((slot.offset + slot.size for slot in slots), default=0)
+    return _codec([(msg.field(slot.field), slot.offset) for slot in slots if slot.field], info.struct_size, packed)

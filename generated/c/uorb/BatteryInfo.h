@@ -13,6 +13,8 @@ extern "C" {
 #endif
 
 #define BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE 48u
+/* the struct without its trailing padding, as a ULog record holds it */
+#define BATTGEN_UORB_BATTERYINFO_PACKED_SIZE 41u
 #define BATTGEN_UORB_BATTERYINFO_MAX_PROBLEMS 0u
 
 /** Battery information Static or near-invariant battery information. Should be streamed at low
@@ -36,7 +38,8 @@ size_t battgen_uorb_BatteryInfo_validate(const battgen_uorb_BatteryInfo *m, batt
 /* PX4's C struct bytes, every field at PX4's offset, padding zero. */
 void battgen_uorb_BatteryInfo_encode(const battgen_uorb_BatteryInfo *m,
                                      uint8_t out[BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE]);
-/* Exactly STRUCT_SIZE bytes of PX4's struct. */
+/* PX4's struct: STRUCT_SIZE bytes, or PACKED_SIZE (a ULog record leaves the trailing padding out).
+ */
 battgen_error battgen_uorb_BatteryInfo_decode(const uint8_t *data, size_t len,
                                               battgen_uorb_BatteryInfo *m);
 

@@ -47,6 +47,8 @@ extern "C" {
                                                               */
 #define BATTGEN_UORB_BATTERYSTATUS_FAULT_COUNT 11u /* Counter. Keep this as last element */
 #define BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE 168u
+/* the struct without its trailing padding, as a ULog record holds it */
+#define BATTGEN_UORB_BATTERYSTATUS_PACKED_SIZE 166u
 #define BATTGEN_UORB_BATTERYSTATUS_MAX_PROBLEMS 38u
 
 /** Battery status Battery status information for up to 3 battery instances. These are populated
@@ -117,7 +119,8 @@ size_t battgen_uorb_BatteryStatus_validate(const battgen_uorb_BatteryStatus *m,
 /* PX4's C struct bytes, every field at PX4's offset, padding zero. */
 void battgen_uorb_BatteryStatus_encode(const battgen_uorb_BatteryStatus *m,
                                        uint8_t out[BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE]);
-/* Exactly STRUCT_SIZE bytes of PX4's struct. */
+/* PX4's struct: STRUCT_SIZE bytes, or PACKED_SIZE (a ULog record leaves the trailing padding out).
+ */
 battgen_error battgen_uorb_BatteryStatus_decode(const uint8_t *data, size_t len,
                                                 battgen_uorb_BatteryStatus *m);
 
