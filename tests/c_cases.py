@@ -11,6 +11,7 @@ so -0.0 and float16 rounding show). Nothing here is committed to the library."""
 from __future__ import annotations
 
 import math
+import random
 import struct
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
@@ -176,7 +177,8 @@ def _dump_value(schema: Schema, t: FieldType, v: Any) -> str:
     if isinstance(t, PrimitiveType):
         return _dump_primitive(t, v)
     if _is_char_array(t):
-        raw = v.encode("utf-8") if isinstance(v, str) else bytes(v)
+        # text is UTF-8; bytes that are not decode through surrogateescape (the MAVLink runtime)
+        raw = v.encode("utf-8", "surrogateescape") if isinstance(v, str) else bytes(v)
         return raw.split(b"\0", 1)[0].hex()
     if isinstance(t, CompositeType):
         return "{" + dump(schema, schema.message(t.name), v) + "}"
@@ -249,6 +251,7 @@ class Replay:
     cases: list[Case] = field(default_factory=list)
     seen: set[str] = field(default_factory=set)
     skipped: int = 0
+    fuzz: list[tuple[bytes, list[tuple[str, str]]]] = field(default_factory=list)  # (bytes, expected lines)
 
 
 def _problems(obj: Any) -> str:
@@ -338,9 +341,66 @@ def collect(schema: Schema, classes: Mapping[str, Any]) -> list[Replay]:
     return [replays[q] for q in sorted(replays)]
 
 
+FUZZ_INPUTS = 120  # per message: random bytes and damaged encodings
+
+
+def _decoded(schema: Schema, msg: Message, decode: Any, data: bytes) -> str:
+    """What the harness prints of decoding ``data``: ``0`` and the values, or ``err``."""
+    try:
+        decoded = decode(data)
+    except ValueError:  # the runtimes' DecodeError
+        return "err"
+    plain = decoded.to_dict()
+    if msg.uorb is not None:
+        # the uORB runtime reads text as UTF-8 with U+FFFD for what is not; the C keeps the bytes,
+        # so text fields compare with the bytes at their offset (the other fields with Python's values)
+        for slot in msg.uorb.layout:
+            if slot.field is not None and _is_char_array(msg.field(slot.field).type):
+                plain[slot.field] = data[slot.offset : slot.offset + slot.size]
+    return "0 " + dump(schema, msg, plain)
+
+
+def add_fuzz(schema: Schema, replays: list[Replay], classes: Mapping[str, Any]) -> None:
+    """Seeded random bytes and damaged encodings (a byte changed, cut short, one byte more) for every
+    decoder, with what the Python decoder makes of each."""
+    for r in replays:
+        cls = classes[r.msg.qualified_name]
+        rng = random.Random("fuzz " + r.msg.qualified_name)
+        longest = max(len(w) for c in r.cases for w in c.wires)
+        inputs: list[bytes] = []
+        for k in range(FUZZ_INPUTS):
+            if k % 2 == 0 or not r.cases:
+                inputs.append(bytes(rng.getrandbits(8) for _ in range(rng.randint(0, longest + 3))))
+                continue
+            wire = bytearray(rng.choice(r.cases).wires[0])
+            damage = rng.randrange(3)
+            if damage == 0 and wire:
+                wire[rng.randrange(len(wire))] ^= 1 << rng.randrange(8)
+            elif damage == 1:
+                del wire[rng.randint(0, len(wire)) :]
+            else:
+                wire.append(rng.getrandbits(8))
+            inputs.append(bytes(wire))
+        for data in inputs:
+            if r.kind == "dronecan":
+                lines = [
+                    ("fz", _decoded(schema, r.msg, cls.decode, data)),
+                    ("fzfd", _decoded(schema, r.msg, lambda d, c=cls: c.decode(d, tao=False), data)),
+                ]
+            else:
+                lines = [("fz", _decoded(schema, r.msg, cls.decode, data))]
+            r.fuzz.append((data, lines))
+
+
 def expected_lines(replays: list[Replay]) -> list[tuple[str, str | None]]:
     """(``<message>#<case> <tag>``, what follows it) of every line the harness must print."""
-    return [
+    fuzz: list[tuple[str, str | None]] = [
+        (f"{r.msg.qualified_name}#f{k} {tag}", line)
+        for r in replays
+        for k, (_, lines) in enumerate(r.fuzz)
+        for tag, line in lines
+    ]
+    return fuzz + [
         (f"{r.msg.qualified_name}#{j} {tag}", line)
         for r in replays
         for j, c in enumerate(r.cases)
@@ -354,6 +414,7 @@ PRELUDE = r"""/* battgen's C replay harness (written by tests/c_cases.py at test
 #include "battgen.h"
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct { size_t off, len; } span;
@@ -464,6 +525,32 @@ def _run(r: Replay) -> list[str]:
     return lines
 
 
+def _fuzz_run(r: Replay) -> list[str]:
+    """The harness's loop decoding one message's fuzz inputs: ``0`` and the values, or ``err``."""
+    t = type_name(r.msg.qualified_name)
+    q = r.msg.qualified_name
+    calls = [("fz", "w.len, true, &d"), ("fzfd", "w.len, false, &d")] if r.kind == "dronecan" else [("fz", "w.len, &d")]
+    lines = [
+        f"static void fuzz_run_{t}(void) {{",
+        "size_t k;",
+        f"for (k = 0; k < {len(r.fuzz)}u; k++) {{",
+        f"const span w = fuzz_{t}[k];",
+        f"{t} d;",
+        "/* a copy of exactly the input's bytes: a read beyond them is the sanitizer's to see */",
+        "uint8_t *copy = (uint8_t *)malloc(w.len + 1u);",
+        "if (copy == NULL) { exit(2); }",
+        "memcpy(copy, blob + w.off, w.len);",
+    ]
+    for tag, args in calls:
+        lines += [
+            f'printf("{q}#f%lu {tag} ", (unsigned long)k);',
+            f"if ({t}_decode(copy, {args}) == BATTGEN_OK) {{",
+            f'printf("0 "); dump_{t}(&d); printf("\\n");',
+            '} else { printf("err\\n"); }',
+        ]
+    return [*lines, "free(copy);", "}", "}"]
+
+
 def render_harness(schema: Schema, replays: list[Replay]) -> str:
     """The harness's ``main.c``: the cases as data, a loop per message, ``main`` running them all."""
     blob = bytearray()
@@ -488,12 +575,22 @@ def render_harness(schema: Schema, replays: list[Replay]) -> str:
                 blob += w
             rows.append("{" + ", ".join(spans) + "},")
         tables += [f"static const span wire_{t}[][{width}] = {{", *rows, "};"]
+    for r in replays:
+        t = type_name(r.msg.qualified_name)
+        spans = []
+        for data, _ in r.fuzz:
+            spans.append(f"{{{len(blob)}u, {len(data)}u}},")
+            blob += data
+        tables += [f"static const span fuzz_{t}[] = {{", *(spans or ["{0u, 0u},"]), "};"]
     out.append("static const uint8_t blob[] = {" + ", ".join(str(b) for b in blob) + (", 0" if not blob else "") + "};")
     out += tables
     for r in replays:
         out += _run(r)
+    for r in replays:
+        out += _fuzz_run(r)
     out.append("int main(void) {")
     out.append("(void)pd;  /* the bundled schemas have no double field */")
+    out += [f"fuzz_run_{type_name(r.msg.qualified_name)}();" for r in replays]
     out += [f"run_{type_name(r.msg.qualified_name)}();" for r in replays]
     out += ["return 0;", "}", ""]
     return "\n".join(out)
