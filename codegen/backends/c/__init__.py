@@ -1,6 +1,6 @@
-"""C99 backend: one header per message of the IR (struct, enums, constants, size checks).
-
-This first slice writes the data types only; the codecs (DroneCAN, MAVLink v2) come next.
+"""C99 backend: one header per message of the IR (struct, constants, identities, prototypes) and one
+source file per format (MAVLink, uORB, DroneCAN) with the codecs and validators of its messages; no
+heap, no C library. The cross-field rules and the converters are not generated in C yet.
 Output is formatted by ``clang-format`` (Debian's) with the style in :data:`STYLE`, so it is
 deterministic and passes the formatter check.
 """

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -11,12 +12,17 @@ import jinja2
 
 from ...errors import BattgenError
 from ...ir import ArrayType, CompositeType, Constant, Message, PrimitiveKind, PrimitiveType, Schema, SourceFormat
+from .checks import check_uses, checks_of, validator
+from .codecs import mavlink_codec, uorb_codec
+from .dronecan_codec import BitCodec, dronecan_codec
 from .types import ident, member, type_name
 
 _HERE = Path(__file__).parent
 # clang-format's style, passed whole so no .clang-format found on disk changes the output
 STYLE = "{BasedOnStyle: LLVM, ColumnLimit: 100, SortIncludes: false}"
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
+# support headers copied verbatim (through clang-format, as every other file)
+_SUPPORT = ("battgen_wire.h", "battgen_mavlink.h")
 
 
 def _comment(text: str) -> str:
@@ -50,7 +56,11 @@ def header_path(qualified: str) -> str:
     return qualified.replace(".", "/") + ".h"
 
 
-def _message_context(msg: Message) -> dict[str, object]:
+def _uses_loop(lines: list[str]) -> bool:
+    return any(line.startswith("for (i = 0;") or "[i]" in line for line in lines)
+
+
+def _message_context(schema: Schema, msg: Message) -> dict[str, object]:
     members = []
     for f in msg.fields:
         if f.is_padding:
@@ -71,8 +81,21 @@ def _message_context(msg: Message) -> dict[str, object]:
         for c in msg.constants
         if (lit := _literal(c)) is not None
     ]
+    mav = mavlink_codec(msg)
+    uorb = uorb_codec(msg)
+    uses = check_uses(schema, msg)
+    checks = validator(uses)
     return {
         "name": name,
+        "mavlink_codec": mav,
+        "uorb_codec": uorb,
+        "dronecan_codec": dronecan_codec(schema, msg),
+        "checks": checks_of(schema, msg),
+        "validate": checks,
+        "validate_loops": _uses_loop(checks),
+        "mavlink_loops": mav is not None and _uses_loop(mav.encode),
+        "uorb_loops": uorb is not None and _uses_loop(uorb.encode),
+        "max_problems": sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in uses),
         "guard": name.upper() + "_H",
         "qualified": msg.qualified_name,
         "doc": _comment(msg.doc),
@@ -82,6 +105,26 @@ def _message_context(msg: Message) -> dict[str, object]:
         "struct_size": msg.uorb.struct_size if msg.uorb is not None else None,
         "dronecan": msg.dronecan,
         "mavlink": msg.mavlink,
+    }
+
+
+def _source_view(context: dict[str, object]) -> dict[str, object]:
+    """What the format's source file renders of one message (its codecs under short names)."""
+    dc = context["dronecan_codec"]
+    uses: dict[str, bool] = {}
+    if isinstance(dc, BitCodec):
+        for side, lines in (("put", dc.put), ("get", dc.get)):
+            uses[f"{side}_e"] = any(line.startswith("e = ") for line in lines)
+            uses[f"{side}_k"] = any(line.startswith("k = ") for line in lines)
+            uses[f"{side}_u"] = any("&u)" in line for line in lines)
+            uses[f"{side}_tao"] = any(re.search(r"\btao\b", line) for line in lines)
+            uses[f"{side}_m"] = any("m->" in line for line in lines)
+    return {
+        **context,
+        "dc": uses,
+        "mavlink": context["mavlink_codec"],
+        "uorb": context["uorb_codec"],
+        "dronecan": context["dronecan_codec"],
     }
 
 
@@ -117,13 +160,24 @@ def render_library(schema: Schema) -> dict[str, str]:
     """Relative path -> formatted text of every file of the C library."""
     env = _environment()
     header = env.get_template("message.h.j2")
+    source = env.get_template("format.c.j2")
     files: dict[str, str] = {}
+    contexts: dict[SourceFormat, list[dict[str, object]]] = {}
     for msg in schema.messages:
         if msg.format not in _FORMATS:
             continue
         rel = header_path(msg.qualified_name)
-        files[rel] = clang_format(header.render(m=_message_context(msg)), rel)
+        context = _message_context(schema, msg)
+        contexts.setdefault(msg.format, []).append(context)
+        files[rel] = clang_format(header.render(m=context), rel)
     headers = sorted(files)
+    for fmt, messages in sorted(contexts.items(), key=lambda item: item[0].value):
+        rel = f"{fmt.value}.c"
+        own = sorted(header_path(str(m["qualified"])) for m in messages)
+        view = [_source_view(m) for m in messages]
+        files[rel] = clang_format(source.render(format=fmt.value, headers=own, messages=view), rel)
+    for name in _SUPPORT:
+        files[name] = clang_format((_HERE / "support" / name).read_text(encoding="utf-8"), name)
     files["battgen.h"] = clang_format(env.get_template("battgen.h.j2").render(headers=headers), "battgen.h")
     files["README.md"] = env.get_template("README.md.j2").render(headers=headers)
     return files

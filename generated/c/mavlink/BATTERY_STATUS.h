@@ -3,7 +3,11 @@
 #define BATTGEN_MAVLINK_BATTERY_STATUS_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
+#include "battgen_mavlink.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -13,6 +17,7 @@ extern "C" {
 #define BATTGEN_MAVLINK_BATTERY_STATUS_CRC_EXTRA 154u
 #define BATTGEN_MAVLINK_BATTERY_STATUS_BASE_LENGTH 36u
 #define BATTGEN_MAVLINK_BATTERY_STATUS_MAX_LENGTH 54u
+#define BATTGEN_MAVLINK_BATTERY_STATUS_MAX_PROBLEMS 5u
 
 /** Battery information. Updates GCS with flight controller battery status. Smart batteries also use
  * this message, but may additionally send BATTERY_INFO. */
@@ -61,6 +66,30 @@ typedef struct {
 typedef char battgen_mavlink_BATTERY_STATUS_is_complete[(sizeof(battgen_mavlink_BATTERY_STATUS) > 0)
                                                             ? 1
                                                             : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_mavlink_BATTERY_STATUS_validate(const battgen_mavlink_BATTERY_STATUS *m,
+                                               battgen_problem *out, size_t cap);
+
+/* The MAVLink 2 payload (wire order, extensions last) into `out`; returns the length MAVLink 2
+ * sends: trailing zero bytes dropped, one byte at least. */
+size_t
+battgen_mavlink_BATTERY_STATUS_encode(const battgen_mavlink_BATTERY_STATUS *m,
+                                      uint8_t out[BATTGEN_MAVLINK_BATTERY_STATUS_MAX_LENGTH]);
+/* A payload of `len` bytes (a short one zero-filled, as MAVLink 2 truncation asks). */
+battgen_error battgen_mavlink_BATTERY_STATUS_decode(const uint8_t *payload, size_t len,
+                                                    battgen_mavlink_BATTERY_STATUS *m);
+/* A MAVLink 2 frame into `out` (BATTGEN_MAVLINK_MAX_FRAME_LENGTH bytes); returns its length. */
+size_t battgen_mavlink_BATTERY_STATUS_encode_frame(const battgen_mavlink_BATTERY_STATUS *m,
+                                                   battgen_mavlink_header h, uint8_t *out);
+/* A MAVLink 1 frame (the base payload) into `out`; 0 when the id is beyond MAVLink 1's 255. */
+size_t battgen_mavlink_BATTERY_STATUS_encode_frame_v1(const battgen_mavlink_BATTERY_STATUS *m,
+                                                      battgen_mavlink_header h, uint8_t *out);
+/* One whole MAVLink 1 or 2 frame (checksum checked, a signature skipped). */
+battgen_error battgen_mavlink_BATTERY_STATUS_decode_frame(const uint8_t *frame, size_t len,
+                                                          battgen_mavlink_header *h,
+                                                          battgen_mavlink_BATTERY_STATUS *m);
 
 #ifdef __cplusplus
 }

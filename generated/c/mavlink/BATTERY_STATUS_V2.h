@@ -3,7 +3,11 @@
 #define BATTGEN_MAVLINK_BATTERY_STATUS_V2_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
+#include "battgen_mavlink.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -13,6 +17,7 @@ extern "C" {
 #define BATTGEN_MAVLINK_BATTERY_STATUS_V2_CRC_EXTRA 145u
 #define BATTGEN_MAVLINK_BATTERY_STATUS_V2_BASE_LENGTH 27u
 #define BATTGEN_MAVLINK_BATTERY_STATUS_V2_MAX_LENGTH 27u
+#define BATTGEN_MAVLINK_BATTERY_STATUS_V2_MAX_PROBLEMS 6u
 
 /** Battery dynamic information. This should be streamed (nominally at 1Hz). Static/invariant
  * battery information is sent in BATTERY_INFO. Note that smart batteries should set the
@@ -47,6 +52,30 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_mavlink_BATTERY_STATUS_V2_is_complete
     [(sizeof(battgen_mavlink_BATTERY_STATUS_V2) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_mavlink_BATTERY_STATUS_V2_validate(const battgen_mavlink_BATTERY_STATUS_V2 *m,
+                                                  battgen_problem *out, size_t cap);
+
+/* The MAVLink 2 payload (wire order, extensions last) into `out`; returns the length MAVLink 2
+ * sends: trailing zero bytes dropped, one byte at least. */
+size_t
+battgen_mavlink_BATTERY_STATUS_V2_encode(const battgen_mavlink_BATTERY_STATUS_V2 *m,
+                                         uint8_t out[BATTGEN_MAVLINK_BATTERY_STATUS_V2_MAX_LENGTH]);
+/* A payload of `len` bytes (a short one zero-filled, as MAVLink 2 truncation asks). */
+battgen_error battgen_mavlink_BATTERY_STATUS_V2_decode(const uint8_t *payload, size_t len,
+                                                       battgen_mavlink_BATTERY_STATUS_V2 *m);
+/* A MAVLink 2 frame into `out` (BATTGEN_MAVLINK_MAX_FRAME_LENGTH bytes); returns its length. */
+size_t battgen_mavlink_BATTERY_STATUS_V2_encode_frame(const battgen_mavlink_BATTERY_STATUS_V2 *m,
+                                                      battgen_mavlink_header h, uint8_t *out);
+/* A MAVLink 1 frame (the base payload) into `out`; 0 when the id is beyond MAVLink 1's 255. */
+size_t battgen_mavlink_BATTERY_STATUS_V2_encode_frame_v1(const battgen_mavlink_BATTERY_STATUS_V2 *m,
+                                                         battgen_mavlink_header h, uint8_t *out);
+/* One whole MAVLink 1 or 2 frame (checksum checked, a signature skipped). */
+battgen_error battgen_mavlink_BATTERY_STATUS_V2_decode_frame(const uint8_t *frame, size_t len,
+                                                             battgen_mavlink_header *h,
+                                                             battgen_mavlink_BATTERY_STATUS_V2 *m);
 
 #ifdef __cplusplus
 }

@@ -3,11 +3,19 @@
 #define BATTGEN_UORB_BATTERYINFO_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+#define BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE 48u
+/* the struct without its trailing padding, as a ULog record holds it */
+#define BATTGEN_UORB_BATTERYINFO_PACKED_SIZE 41u
+#define BATTGEN_UORB_BATTERYINFO_MAX_PROBLEMS 0u
 
 /** Battery information Static or near-invariant battery information. Should be streamed at low
  * rate. */
@@ -21,6 +29,19 @@ typedef struct {
 /* PX4's struct is 48 bytes; this one is for values, not its wire layout. */
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_uorb_BatteryInfo_is_complete[(sizeof(battgen_uorb_BatteryInfo) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_uorb_BatteryInfo_validate(const battgen_uorb_BatteryInfo *m, battgen_problem *out,
+                                         size_t cap);
+
+/* PX4's C struct bytes, every field at PX4's offset, padding zero. */
+void battgen_uorb_BatteryInfo_encode(const battgen_uorb_BatteryInfo *m,
+                                     uint8_t out[BATTGEN_UORB_BATTERYINFO_STRUCT_SIZE]);
+/* PX4's struct: STRUCT_SIZE bytes, or PACKED_SIZE (a ULog record leaves the trailing padding out).
+ */
+battgen_error battgen_uorb_BatteryInfo_decode(const uint8_t *data, size_t len,
+                                              battgen_uorb_BatteryInfo *m);
 
 #ifdef __cplusplus
 }

@@ -3,7 +3,10 @@
 #define BATTGEN_UORB_BATTERYSTATUS_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -43,6 +46,10 @@ extern "C" {
 #define BATTGEN_UORB_BATTERYSTATUS_FAULT_FAILED_TO_ARM 10u   /* Battery had a problem while arming \
                                                               */
 #define BATTGEN_UORB_BATTERYSTATUS_FAULT_COUNT 11u /* Counter. Keep this as last element */
+#define BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE 168u
+/* the struct without its trailing padding, as a ULog record holds it */
+#define BATTGEN_UORB_BATTERYSTATUS_PACKED_SIZE 166u
+#define BATTGEN_UORB_BATTERYSTATUS_MAX_PROBLEMS 38u
 
 /** Battery status Battery status information for up to 3 battery instances. These are populated
  * from power module and smart battery device drivers, and one battery updated from MAVLink. Battery
@@ -103,6 +110,19 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char
     battgen_uorb_BatteryStatus_is_complete[(sizeof(battgen_uorb_BatteryStatus) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_uorb_BatteryStatus_validate(const battgen_uorb_BatteryStatus *m,
+                                           battgen_problem *out, size_t cap);
+
+/* PX4's C struct bytes, every field at PX4's offset, padding zero. */
+void battgen_uorb_BatteryStatus_encode(const battgen_uorb_BatteryStatus *m,
+                                       uint8_t out[BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE]);
+/* PX4's struct: STRUCT_SIZE bytes, or PACKED_SIZE (a ULog record leaves the trailing padding out).
+ */
+battgen_error battgen_uorb_BatteryStatus_decode(const uint8_t *data, size_t len,
+                                                battgen_uorb_BatteryStatus *m);
 
 #ifdef __cplusplus
 }

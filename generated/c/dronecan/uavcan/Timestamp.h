@@ -3,7 +3,10 @@
 #define BATTGEN_DRONECAN_UAVCAN_TIMESTAMP_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -12,6 +15,8 @@ extern "C" {
 #define BATTGEN_DRONECAN_UAVCAN_TIMESTAMP_UNKNOWN 0u /* The time is not known */
 #define BATTGEN_DRONECAN_UAVCAN_TIMESTAMP_DATA_TYPE_SIGNATURE 0x05BD0B5C81087E0DULL
 #define BATTGEN_DRONECAN_UAVCAN_TIMESTAMP_MAX_BITLEN 56u
+#define BATTGEN_DRONECAN_UAVCAN_TIMESTAMP_MAX_BYTES 7u
+#define BATTGEN_DRONECAN_UAVCAN_TIMESTAMP_MAX_PROBLEMS 1u
 
 /** Time since an arbitrary epoch, in microseconds (7 bytes on the wire). */
 typedef struct {
@@ -21,6 +26,26 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_dronecan_uavcan_Timestamp_is_complete
     [(sizeof(battgen_dronecan_uavcan_Timestamp) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_dronecan_uavcan_Timestamp_validate(const battgen_dronecan_uavcan_Timestamp *m,
+                                                  battgen_problem *out, size_t cap);
+
+/* The DroneCAN payload into `out` and its length into `*len`; `tao` applies the tail array
+ * optimisation (false for CAN FD). */
+battgen_error
+battgen_dronecan_uavcan_Timestamp_encode(const battgen_dronecan_uavcan_Timestamp *m, bool tao,
+                                         uint8_t out[BATTGEN_DRONECAN_UAVCAN_TIMESTAMP_MAX_BYTES],
+                                         size_t *len);
+/* One payload; whole bytes after the message are BATTGEN_ERR_TRAILING. */
+battgen_error battgen_dronecan_uavcan_Timestamp_decode(const uint8_t *data, size_t len, bool tao,
+                                                       battgen_dronecan_uavcan_Timestamp *m);
+/* The message's bits into a writer / from a reader (what a message nesting it calls). */
+battgen_error battgen_dronecan_uavcan_Timestamp_put(const battgen_dronecan_uavcan_Timestamp *m,
+                                                    battgen_bit_writer *w, bool tao);
+battgen_error battgen_dronecan_uavcan_Timestamp_get(battgen_dronecan_uavcan_Timestamp *m,
+                                                    battgen_bit_reader *r, bool tao);
 
 #ifdef __cplusplus
 }

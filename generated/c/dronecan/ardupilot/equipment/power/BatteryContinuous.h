@@ -3,7 +3,10 @@
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -47,6 +50,8 @@ extern "C" {
   0x756B561340D5E4AEULL
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_DATA_TYPE_ID 20010u
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_MAX_BITLEN 200u
+#define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_MAX_BYTES 25u
+#define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_MAX_PROBLEMS 8u
 
 /** Battery data to be sent continuously */
 typedef struct {
@@ -71,6 +76,30 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_is_complete
     [(sizeof(battgen_dronecan_ardupilot_equipment_power_BatteryContinuous) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_validate(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *m, battgen_problem *out,
+    size_t cap);
+
+/* The DroneCAN payload into `out` and its length into `*len`; `tao` applies the tail array
+ * optimisation (false for CAN FD). */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_encode(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *m, bool tao,
+    uint8_t out[BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_MAX_BYTES],
+    size_t *len);
+/* One payload; whole bytes after the message are BATTGEN_ERR_TRAILING. */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_decode(
+    const uint8_t *data, size_t len, bool tao,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *m);
+/* The message's bits into a writer / from a reader (what a message nesting it calls). */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_put(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *m, battgen_bit_writer *w,
+    bool tao);
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryContinuous_get(
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *m, battgen_bit_reader *r,
+    bool tao);
 
 #ifdef __cplusplus
 }

@@ -3,7 +3,10 @@
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYINFOAUX_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 #include "dronecan/uavcan/Timestamp.h"
 
 #ifdef __cplusplus
@@ -14,6 +17,8 @@ extern "C" {
   0x7D7F49FC75484882ULL
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYINFOAUX_DATA_TYPE_ID 20004u
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYINFOAUX_MAX_BITLEN 4217u
+#define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYINFOAUX_MAX_BYTES 528u
+#define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYINFOAUX_MAX_PROBLEMS 259u
 
 /** Extra battery data that complements uavcan.equipment.power.BatteryInfo. Send it before the
  * matching BatteryInfo. */
@@ -33,6 +38,28 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_is_complete
     [(sizeof(battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_validate(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *m, battgen_problem *out,
+    size_t cap);
+
+/* The DroneCAN payload into `out` and its length into `*len`; `tao` applies the tail array
+ * optimisation (false for CAN FD). */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_encode(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *m, bool tao,
+    uint8_t out[BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYINFOAUX_MAX_BYTES], size_t *len);
+/* One payload; whole bytes after the message are BATTGEN_ERR_TRAILING. */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_decode(
+    const uint8_t *data, size_t len, bool tao,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *m);
+/* The message's bits into a writer / from a reader (what a message nesting it calls). */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_put(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *m, battgen_bit_writer *w,
+    bool tao);
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux_get(
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *m, battgen_bit_reader *r, bool tao);
 
 #ifdef __cplusplus
 }

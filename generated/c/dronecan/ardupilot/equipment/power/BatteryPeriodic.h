@@ -3,7 +3,10 @@
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -13,6 +16,8 @@ extern "C" {
   0x0F012494E97358D2ULL
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_DATA_TYPE_ID 20011u
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_MAX_BITLEN 1000u
+#define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_MAX_BYTES 125u
+#define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_MAX_PROBLEMS 9u
 
 /** Battery data to be sent statically upon request or periodically at a low rate Recommend that
  * this message is sent at a maximum of 1Hz and nominally 0.2 Hz (IE: once every 5 seconds.) */
@@ -51,6 +56,28 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_is_complete
     [(sizeof(battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_validate(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *m, battgen_problem *out,
+    size_t cap);
+
+/* The DroneCAN payload into `out` and its length into `*len`; `tao` applies the tail array
+ * optimisation (false for CAN FD). */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_encode(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *m, bool tao,
+    uint8_t out[BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_MAX_BYTES], size_t *len);
+/* One payload; whole bytes after the message are BATTGEN_ERR_TRAILING. */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_decode(
+    const uint8_t *data, size_t len, bool tao,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *m);
+/* The message's bits into a writer / from a reader (what a message nesting it calls). */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_put(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *m, battgen_bit_writer *w,
+    bool tao);
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic_get(
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *m, battgen_bit_reader *r, bool tao);
 
 #ifdef __cplusplus
 }

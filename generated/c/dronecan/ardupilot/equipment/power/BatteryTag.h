@@ -3,7 +3,10 @@
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -13,6 +16,8 @@ extern "C" {
   0x4A5A9B42099F73E1ULL
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_DATA_TYPE_ID 20500u
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_MAX_BITLEN 192u
+#define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_MAX_BYTES 24u
+#define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_MAX_PROBLEMS 1u
 
 /** Battery tag information. This is broadcast by a battery tag device permanently attached to a
  * battery to record the lifecycle of the battery */
@@ -32,6 +37,28 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_dronecan_ardupilot_equipment_power_BatteryTag_is_complete
     [(sizeof(battgen_dronecan_ardupilot_equipment_power_BatteryTag) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_dronecan_ardupilot_equipment_power_BatteryTag_validate(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *m, battgen_problem *out,
+    size_t cap);
+
+/* The DroneCAN payload into `out` and its length into `*len`; `tao` applies the tail array
+ * optimisation (false for CAN FD). */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryTag_encode(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *m, bool tao,
+    uint8_t out[BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_MAX_BYTES], size_t *len);
+/* One payload; whole bytes after the message are BATTGEN_ERR_TRAILING. */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryTag_decode(
+    const uint8_t *data, size_t len, bool tao,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *m);
+/* The message's bits into a writer / from a reader (what a message nesting it calls). */
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryTag_put(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *m, battgen_bit_writer *w,
+    bool tao);
+battgen_error battgen_dronecan_ardupilot_equipment_power_BatteryTag_get(
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *m, battgen_bit_reader *r, bool tao);
 
 #ifdef __cplusplus
 }

@@ -3,7 +3,10 @@
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -31,6 +34,8 @@ extern "C" {
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_DATA_TYPE_SIGNATURE 0xB4DACE3A38E09A74ULL
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_DATA_TYPE_ID 20300u
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_BITLEN 989u
+#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_BYTES 124u
+#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_PROBLEMS 31u
 
 /** support for CUAV Smart Battery on UAVCAN */
 typedef struct {
@@ -70,6 +75,28 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_dronecan_cuav_equipment_power_CBAT_is_complete
     [(sizeof(battgen_dronecan_cuav_equipment_power_CBAT) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_dronecan_cuav_equipment_power_CBAT_validate(
+    const battgen_dronecan_cuav_equipment_power_CBAT *m, battgen_problem *out, size_t cap);
+
+/* The DroneCAN payload into `out` and its length into `*len`; `tao` applies the tail array
+ * optimisation (false for CAN FD). */
+battgen_error battgen_dronecan_cuav_equipment_power_CBAT_encode(
+    const battgen_dronecan_cuav_equipment_power_CBAT *m, bool tao,
+    uint8_t out[BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_BYTES], size_t *len);
+/* One payload; whole bytes after the message are BATTGEN_ERR_TRAILING. */
+battgen_error
+battgen_dronecan_cuav_equipment_power_CBAT_decode(const uint8_t *data, size_t len, bool tao,
+                                                  battgen_dronecan_cuav_equipment_power_CBAT *m);
+/* The message's bits into a writer / from a reader (what a message nesting it calls). */
+battgen_error
+battgen_dronecan_cuav_equipment_power_CBAT_put(const battgen_dronecan_cuav_equipment_power_CBAT *m,
+                                               battgen_bit_writer *w, bool tao);
+battgen_error
+battgen_dronecan_cuav_equipment_power_CBAT_get(battgen_dronecan_cuav_equipment_power_CBAT *m,
+                                               battgen_bit_reader *r, bool tao);
 
 #ifdef __cplusplus
 }

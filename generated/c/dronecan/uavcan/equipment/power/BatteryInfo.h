@@ -3,7 +3,10 @@
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -37,6 +40,8 @@ extern "C" {
   0x249C26548A711966ULL
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_DATA_TYPE_ID 1092u
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_MAX_BITLEN 437u
+#define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_MAX_BYTES 55u
+#define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_MAX_PROBLEMS 11u
 
 /** State of one battery. Sent at a low rate (about 0.2 to 1 Hz) by a battery monitor or a smart
  * battery. */
@@ -64,6 +69,26 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_dronecan_uavcan_equipment_power_BatteryInfo_is_complete
     [(sizeof(battgen_dronecan_uavcan_equipment_power_BatteryInfo) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_dronecan_uavcan_equipment_power_BatteryInfo_validate(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *m, battgen_problem *out, size_t cap);
+
+/* The DroneCAN payload into `out` and its length into `*len`; `tao` applies the tail array
+ * optimisation (false for CAN FD). */
+battgen_error battgen_dronecan_uavcan_equipment_power_BatteryInfo_encode(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *m, bool tao,
+    uint8_t out[BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_MAX_BYTES], size_t *len);
+/* One payload; whole bytes after the message are BATTGEN_ERR_TRAILING. */
+battgen_error battgen_dronecan_uavcan_equipment_power_BatteryInfo_decode(
+    const uint8_t *data, size_t len, bool tao,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *m);
+/* The message's bits into a writer / from a reader (what a message nesting it calls). */
+battgen_error battgen_dronecan_uavcan_equipment_power_BatteryInfo_put(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *m, battgen_bit_writer *w, bool tao);
+battgen_error battgen_dronecan_uavcan_equipment_power_BatteryInfo_get(
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *m, battgen_bit_reader *r, bool tao);
 
 #ifdef __cplusplus
 }

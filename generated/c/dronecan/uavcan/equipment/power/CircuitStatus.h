@@ -3,7 +3,10 @@
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_CIRCUITSTATUS_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -17,6 +20,8 @@ extern "C" {
   0x8313D33D0DDDA115ULL
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_CIRCUITSTATUS_DATA_TYPE_ID 1091u
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_CIRCUITSTATUS_MAX_BITLEN 56u
+#define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_CIRCUITSTATUS_MAX_BYTES 7u
+#define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_CIRCUITSTATUS_MAX_PROBLEMS 3u
 
 /** Voltage, current and faults of one electrical circuit. */
 typedef struct {
@@ -29,6 +34,28 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_dronecan_uavcan_equipment_power_CircuitStatus_is_complete
     [(sizeof(battgen_dronecan_uavcan_equipment_power_CircuitStatus) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_dronecan_uavcan_equipment_power_CircuitStatus_validate(
+    const battgen_dronecan_uavcan_equipment_power_CircuitStatus *m, battgen_problem *out,
+    size_t cap);
+
+/* The DroneCAN payload into `out` and its length into `*len`; `tao` applies the tail array
+ * optimisation (false for CAN FD). */
+battgen_error battgen_dronecan_uavcan_equipment_power_CircuitStatus_encode(
+    const battgen_dronecan_uavcan_equipment_power_CircuitStatus *m, bool tao,
+    uint8_t out[BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_CIRCUITSTATUS_MAX_BYTES], size_t *len);
+/* One payload; whole bytes after the message are BATTGEN_ERR_TRAILING. */
+battgen_error battgen_dronecan_uavcan_equipment_power_CircuitStatus_decode(
+    const uint8_t *data, size_t len, bool tao,
+    battgen_dronecan_uavcan_equipment_power_CircuitStatus *m);
+/* The message's bits into a writer / from a reader (what a message nesting it calls). */
+battgen_error battgen_dronecan_uavcan_equipment_power_CircuitStatus_put(
+    const battgen_dronecan_uavcan_equipment_power_CircuitStatus *m, battgen_bit_writer *w,
+    bool tao);
+battgen_error battgen_dronecan_uavcan_equipment_power_CircuitStatus_get(
+    battgen_dronecan_uavcan_equipment_power_CircuitStatus *m, battgen_bit_reader *r, bool tao);
 
 #ifdef __cplusplus
 }

@@ -4,7 +4,10 @@
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_PRIMARYPOWERSUPPLYSTATUS_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
+
+#include "battgen_wire.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -14,6 +17,8 @@ extern "C" {
   0xBBA05074AD757480ULL
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_PRIMARYPOWERSUPPLYSTATUS_DATA_TYPE_ID 1090u
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_PRIMARYPOWERSUPPLYSTATUS_MAX_BITLEN 47u
+#define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_PRIMARYPOWERSUPPLYSTATUS_MAX_BYTES 6u
+#define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_PRIMARYPOWERSUPPLYSTATUS_MAX_PROBLEMS 4u
 
 /** Summary of the main power supply, sent at about 1 to 2 Hz. */
 typedef struct {
@@ -28,6 +33,30 @@ typedef struct {
 /* C99 static assertion: a negative array size fails the build. */
 typedef char battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_is_complete
     [(sizeof(battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus) > 0) ? 1 : -1];
+
+/* Every problem of the message (ranges, enums, bitmasks, NaN, lengths; a value at its "unknown"
+ * sentinel is none), in field order: the first `cap` into `out`; returns how many there are. */
+size_t battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_validate(
+    const battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus *m, battgen_problem *out,
+    size_t cap);
+
+/* The DroneCAN payload into `out` and its length into `*len`; `tao` applies the tail array
+ * optimisation (false for CAN FD). */
+battgen_error battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_encode(
+    const battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus *m, bool tao,
+    uint8_t out[BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_PRIMARYPOWERSUPPLYSTATUS_MAX_BYTES],
+    size_t *len);
+/* One payload; whole bytes after the message are BATTGEN_ERR_TRAILING. */
+battgen_error battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_decode(
+    const uint8_t *data, size_t len, bool tao,
+    battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus *m);
+/* The message's bits into a writer / from a reader (what a message nesting it calls). */
+battgen_error battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_put(
+    const battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus *m,
+    battgen_bit_writer *w, bool tao);
+battgen_error battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_get(
+    battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus *m, battgen_bit_reader *r,
+    bool tao);
 
 #ifdef __cplusplus
 }
