@@ -18,7 +18,7 @@ import io
 import pkgutil
 import re
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from pathlib import Path
 from typing import Any
 from unittest import mock
@@ -30,7 +30,7 @@ from codegen.errors import BattgenError, LocatedError
 from codegen.frontends.loader import load
 from codegen.inputs.dispatch import read_records
 from codegen.inputs.records import Notice, Record, Unreadable
-from codegen.ir import Message
+from codegen.ir import Message, Schema
 from generated import _mavlink
 from generated.mavlink import BatteryStatus as MavBatteryStatus
 from generated.uorb import BatteryStatus, BatteryStatusV0
@@ -165,7 +165,11 @@ def checker(message: str) -> tuple[Message, Checker]:
 @contextlib.contextmanager
 def _cached_schemas() -> Iterator[None]:
     """The bundled schemas loaded once for all examples (the commands load them on every run)."""
-    with mock.patch.object(validate_app, "load", lambda paths: _schema() if paths == [SCHEMAS] else load(paths)):
+
+    def cached(paths: list[Path], only: Collection[str] | None = None) -> Schema:
+        return _schema() if paths == [SCHEMAS] else load(paths, only=only)  # the whole folder serves any ``only``
+
+    with mock.patch.object(validate_app, "load", cached):
         yield
 
 
