@@ -106,11 +106,12 @@ class Const(Op):
 
 @dataclass(frozen=True)
 class SocHybrid(Op):
-    """State of charge from ``from: [remaining energy, full energy, percent]``: remaining over full
-    when both are known and positive, else the percent (``unknown`` markers, at most ``valid_max``)."""
+    """State of charge from ``from: [remaining, full, percent]``: remaining over full (energy, or charge as
+    UDRAL's Status suggests) when both are known and positive, else the percent (``unknown`` markers, at
+    most ``valid_max``); without a percent (UDRAL has none), unknown then."""
 
     NAME: ClassVar[str] = "soc_hybrid"
-    SOURCES: ClassVar[Arity] = (3, 3)
+    SOURCES: ClassVar[Arity] = (2, 3)
     unknown: tuple[Number, ...] = ()
     valid_max: Number | None = None
 

@@ -333,9 +333,7 @@ class Parameters_0_3:
     )
     mass: _cyphal_uavcan_si_unit_mass.Scalar_1_0 = _dataclasses.field(
         default_factory=lambda: _scalar_1_0_class()(),
-        metadata=_m.meta(
-            name="mass", type="cyphal.uavcan.si.unit.mass.Scalar_1_0", unit="kilogram", quantity="unknown:kilogram"
-        ),
+        metadata=_m.meta(name="mass", type="cyphal.uavcan.si.unit.mass.Scalar_1_0", unit="kg", quantity="mass"),
     )
     design_capacity: _cyphal_uavcan_si_unit_electric_charge.Scalar_1_0 = _dataclasses.field(
         default_factory=lambda: _scalar_1_0_class_2()(),

@@ -25,7 +25,7 @@ _SCALAR_1_0_KILOGRAM_SPEC = _v.Number(
     kind="float",
     low=-3.4028234663852886e38,
     high=3.4028234663852886e38,
-    unit="kilogram",
+    unit="kg",
     sentinel=_math.nan,
     sentinel_text="NaN",
 )
@@ -43,12 +43,7 @@ class Scalar_1_0:
     kilogram: float = _dataclasses.field(
         default=_math.nan,
         metadata=_m.meta(
-            name="kilogram",
-            type="float32",
-            unit="kilogram",
-            quantity="unknown:kilogram",
-            invalid=_math.nan,
-            invalid_text="NaN",
+            name="kilogram", type="float32", unit="kg", quantity="mass", invalid=_math.nan, invalid_text="NaN"
         ),
     )
 
