@@ -7,7 +7,7 @@ from ..cyphal.reg.udral.physics.electricity import SourceTs_0_1
 from ..cyphal.reg.udral.service.battery import Parameters_0_3, Status_0_2
 from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
 from ..dronecan.uavcan.equipment.power import BatteryInfo
-from . import _map_dronecan, _map_udral
+from . import _map_dronecan, _map_px4_cyphal_battery, _map_px4_uavcannode, _map_udral
 from . import _runtime as _r
 
 
@@ -41,7 +41,7 @@ def udral_to_dronecan(
     """Convert udral to dronecan.
 
     strict: udral (forward) -> dronecan (backward)
-    px4: not available
+    px4: px4_cyphal_battery (forward) -> px4_uavcannode (forward)
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -50,5 +50,7 @@ def udral_to_dronecan(
         _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
     if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts udral to dronecan; use another policy")
+        _px4_1 = _map_px4_cyphal_battery.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
+        _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        return _px4_2
     raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")

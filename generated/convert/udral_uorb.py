@@ -6,7 +6,7 @@ from __future__ import annotations
 from ..cyphal.reg.udral.physics.electricity import SourceTs_0_1
 from ..cyphal.reg.udral.service.battery import Parameters_0_3, Status_0_2
 from ..uorb import BatteryStatus
-from . import _map_udral, _map_uorb
+from . import _map_px4_cyphal_battery, _map_udral, _map_uorb
 from . import _runtime as _r
 
 
@@ -21,7 +21,7 @@ def udral_to_uorb(
     """Convert udral to uorb.
 
     strict: udral (forward) -> uorb (backward)
-    px4: not available
+    px4: px4_cyphal_battery (forward)
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -30,7 +30,8 @@ def udral_to_uorb(
         _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
     if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts udral to uorb; use another policy")
+        _px4_1 = _map_px4_cyphal_battery.forward(source, status, parameters, rep=report, rep_d=report, rep_u=report)
+        return _px4_1[0]
     raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 from ..cyphal.reg.udral.physics.electricity import SourceTs_0_1
 from ..cyphal.reg.udral.service.battery import Parameters_0_3, Status_0_2
 from ..uorb import BatteryStatusV0
-from . import _map_udral, _map_uorb, _map_uorb_v0_down, _map_uorb_v0_up
+from . import _map_px4_cyphal_battery, _map_udral, _map_uorb, _map_uorb_v0_down, _map_uorb_v0_up
 from . import _runtime as _r
 
 
@@ -21,7 +21,7 @@ def udral_to_uorb_v0(
     """Convert udral to uorb_v0.
 
     strict: udral (forward) -> uorb (backward) -> uorb_v0_down (forward)
-    px4: not available
+    px4: px4_cyphal_battery (forward) -> uorb_v0_down (forward)
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -31,7 +31,9 @@ def udral_to_uorb_v0(
         _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
     if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts udral to uorb_v0; use another policy")
+        _px4_1 = _map_px4_cyphal_battery.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
+        _px4_2 = _map_uorb_v0_down.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        return _px4_2[0]
     raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
 
 

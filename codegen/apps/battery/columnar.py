@@ -346,6 +346,9 @@ class ColumnConverter(OpVisitor[None]):
     def visit_px4_bridge_estimates(self, rule: Rule, op: o.PX4BridgeEstimates) -> None:
         self._not_columnar(rule)
 
+    def visit_px4_udral_energy(self, rule: Rule, op: o.PX4UdralEnergy) -> None:
+        self._not_columnar(rule)
+
 
 def _text_in(value: object) -> str | None:
     """A text field's content (bytes are UTF-8, NUL padding dropped); empty means unknown."""
