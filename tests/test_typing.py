@@ -16,10 +16,25 @@ from conftest import ROOT
 from samples import NESTED, clashing_schema, hostile_schema, mavlink_thing_xml
 
 from codegen.backends.python.writer import generate
-from codegen.frontends import dsdl, mavlink, uorb
+from codegen.frontends import cyphal, dsdl, mavlink, uorb
 
 # target -> the folder whose files mypy reports on
-TARGETS = ("codegen", "generated", "hostile", "clashing", "mavlink_thing", "uorb_nested", "dronecan_unions")
+TARGETS = (
+    "codegen",
+    "generated",
+    "hostile",
+    "clashing",
+    "mavlink_thing",
+    "uorb_nested",
+    "dronecan_unions",
+    "cyphal_unions",
+)
+# a Cyphal union (held branch, delimited nesting) beside the bundled types, which have none
+CYPHAL_UNION = {
+    "Empty.1.0.dsdl": "@sealed\n",
+    "Pick.1.0.dsdl": "@union\nuint8 small\nfloat16[<=3] halves\ndemo.Empty.1.0 nothing\n@sealed\n",
+    "Holder.1.0.dsdl": "demo.Pick.1.0 pick\nuint8[<=4] raw\n@extent 256\n",
+}
 
 
 def _generate_samples(root: Path) -> None:
@@ -39,6 +54,10 @@ def _generate_samples(root: Path) -> None:
         dsdl.parse_file(specs / "uavcan" / "protocol" / "param" / "11.GetSet.uavcan", root=specs),
         root / "dronecan_unions",
     )
+    (work / "cyphal" / "demo").mkdir(parents=True)
+    for name, text in CYPHAL_UNION.items():
+        (work / "cyphal" / "demo" / name).write_text(text, encoding="utf-8")
+    generate(cyphal.parse_dir(work / "cyphal"), root / "cyphal_unions")
 
 
 @pytest.fixture(scope="module")

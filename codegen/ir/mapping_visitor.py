@@ -43,6 +43,7 @@ class OpVisitor(Protocol[T_co]):
     def visit_px4_cell_list(self, rule: Rule, op: ops.PX4CellList) -> T_co: ...
     def visit_px4_aux_capacity(self, rule: Rule, op: ops.PX4AuxCapacity) -> T_co: ...
     def visit_px4_bridge_estimates(self, rule: Rule, op: ops.PX4BridgeEstimates) -> T_co: ...
+    def visit_px4_udral_energy(self, rule: Rule, op: ops.PX4UdralEnergy) -> T_co: ...
 
 
 def visit(rule: Rule, visitor: OpVisitor[T_co]) -> T_co:
@@ -99,5 +100,7 @@ def visit(rule: Rule, visitor: OpVisitor[T_co]) -> T_co:
             return visitor.visit_px4_aux_capacity(rule, op)
         case ops.PX4BridgeEstimates():
             return visitor.visit_px4_bridge_estimates(rule, op)
+        case ops.PX4UdralEnergy():
+            return visitor.visit_px4_udral_energy(rule, op)
         case _:
             assert_never(op)

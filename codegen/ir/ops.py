@@ -106,11 +106,12 @@ class Const(Op):
 
 @dataclass(frozen=True)
 class SocHybrid(Op):
-    """State of charge from ``from: [remaining energy, full energy, percent]``: remaining over full
-    when both are known and positive, else the percent (``unknown`` markers, at most ``valid_max``)."""
+    """State of charge from ``from: [remaining, full, percent]``: remaining over full (energy, or charge as
+    UDRAL's Status suggests) when both are known and positive, else the percent (``unknown`` markers, at
+    most ``valid_max``); without a percent (UDRAL has none), unknown then."""
 
     NAME: ClassVar[str] = "soc_hybrid"
-    SOURCES: ClassVar[Arity] = (3, 3)
+    SOURCES: ClassVar[Arity] = (2, 3)
     unknown: tuple[Number, ...] = ()
     valid_max: Number | None = None
 
@@ -334,6 +335,21 @@ class PX4AuxCapacity(Op):
 
 
 @dataclass(frozen=True)
+class PX4UdralEnergy(Op):
+    """PX4's Cyphal battery subscriber (``Subscribers/udral/Battery.hpp``) on ``from: [energy, full energy,
+    nominal voltage]`` -> ``to: [remaining, discharged]``, in float32: remaining = energy / full energy,
+    unchecked (NaN or infinity as C divides); discharged = (full - energy) / (nominal voltage * 3600), which
+    is ampere-hours stored as the target's number unconverted, computed even when the nominal voltage is
+    NaN (PX4 tests ``!= NAN``, always true) or no Parameters message came (NaN then). The three are read in
+    joules and volts, as UDRAL gives them."""
+
+    NAME: ClassVar[str] = "px4_udral_energy"
+    SOURCES: ClassVar[Arity] = (3, 3)
+    TARGETS: ClassVar[Arity] = (2, 2)
+    HANDLES_MISSING: ClassVar[bool] = True
+
+
+@dataclass(frozen=True)
 class PX4BridgeEstimates(Op):
     """PX4's uavcan bridge with its Battery object: ``from: [current, a field of the companion message]``
     -> ``to: [discharged charge, time remaining, average current]``, reading the target's fields
@@ -384,6 +400,7 @@ MappingOp = (
     | PX4CellList
     | PX4AuxCapacity
     | PX4BridgeEstimates
+    | PX4UdralEnergy
 )
 
 # every op by the name mapping files give it, in the order above

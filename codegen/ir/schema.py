@@ -6,7 +6,8 @@ from dataclasses import dataclass, field
 
 from .basics import Location, SchemaWarning
 from .expr import RuleExpressions
-from .fields import EnumDef
+from .fields import EnumDef, Field
+from .fieldtypes import ArrayType, CompositeType
 from .mappings import MappingSet
 from .messages import Message
 
@@ -53,6 +54,25 @@ class Schema:
             if m.qualified_name == qualified_name:
                 return m
         raise KeyError(qualified_name)
+
+    def field_at(self, qualified_name: str, path: str) -> Field:
+        """The field a mapping's dotted path names: ``voltage``, or through composite fields and array
+        elements ``power.current.ampere`` / ``temperature_min_max.1.kelvin`` (Cyphal's nested types)."""
+        msg = self.message(qualified_name)
+        steps = path.split(".")
+        f = msg.field(steps[0])
+        t = f.type
+        for step in steps[1:]:
+            if step.isdigit() and isinstance(t, ArrayType) and (t.capacity is None or int(step) < t.capacity):
+                t = t.element
+                continue
+            if not isinstance(t, CompositeType):
+                raise KeyError(path)
+            f = self.message(t.name).field(step)
+            t = f.type
+        if len(steps) > 1 and steps[-1].isdigit():
+            raise KeyError(path)  # a path ends at a field, not at an element
+        return f
 
     def enum(self, name: str) -> EnumDef:
         for e in self.enums:

@@ -154,6 +154,7 @@ _ALIASES: dict[str, str] = {
     "mah": "mAh",
     "µAh": "uAh",
     "joule": "J",
+    "kilogram": "kg",  # Cyphal's uavcan.si.unit.mass.Scalar
     "hectojoule": "hJ",
     "watt hours": "Wh",
     "watt hour": "Wh",

@@ -121,11 +121,12 @@ def forward(
     # or above 100 = unknown), else unknown.
     _e13 = s_info.remaining_capacity_wh
     _f13 = s_info.full_charge_capacity_wh
-    _p13 = s_info.state_of_charge_pct
     if _e13 == _e13 and _f13 == _f13 and _e13 > 0 and _f13 > 0:
         t.state_of_charge = min(_e13 / _f13, 1.0)
-    elif _p13 != 127 and _p13 <= 100:
-        t.state_of_charge = float(_p13) * 0.01
+    else:
+        _p13 = s_info.state_of_charge_pct
+        if _p13 != 127 and _p13 <= 100:
+            t.state_of_charge = float(_p13) * 0.01
 
     # dronecan.yaml:56: scale info.state_of_charge_pct_stdev -> state_of_charge_stdev
     _v15 = s_info.state_of_charge_pct_stdev

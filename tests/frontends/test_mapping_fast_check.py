@@ -43,7 +43,7 @@ BROKEN = [
     "concepts:\n  v: {kind: choice, choices: [a, a]}\n",
     "concepts:\n  v: {kind: choice, choices: []}\n",
     "endpoints:\n  a: {messages: {}}\n",
-    "endpoints:\n  a: {messages: {b: cyphal.X}}\n",
+    "endpoints:\n  a: {messages: {b: params.X}}\n",
     "endpoints:\n  a: {messages: {b: uorb.}}\n",
     "mappings:\n- {name: m, source: a, rules: []}\n",
     _RULE.format(rule="{op: frobnicate, to: v, from: x}"),

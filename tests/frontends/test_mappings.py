@@ -235,7 +235,7 @@ def test_missing_parameter_is_named(tmp_path: Path) -> None:
 def test_reference_count_is_checked(tmp_path: Path) -> None:
     err = _error(tmp_path, _mapping("{op: soc_hybrid, from: voltage_v, to: pack_voltage}"))
     assert (err.file, err.line) == ("m.yaml", 6)
-    assert "expected 3 reference(s) in 'from' for op 'soc_hybrid', got 1" in err.message
+    assert "expected 2 to 3 reference(s) in 'from' for op 'soc_hybrid', got 1" in err.message
 
 
 def test_unknown_unit_parameter_is_named(tmp_path: Path) -> None:

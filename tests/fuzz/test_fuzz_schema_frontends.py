@@ -40,7 +40,7 @@ from codegen.frontends.loader import load, load_schema_dir
 from codegen.ir import Schema
 
 SCHEMAS = ROOT / "schemas"
-FORMATS = ("uorb", "dronecan", "devicetree", "mavlink", "params")
+FORMATS = ("uorb", "dronecan", "devicetree", "mavlink", "cyphal", "params")
 HANG_SECONDS = 30  # per input, on a loaded 2-core machine; the slowest real schema parses in 50 ms
 RENDER_SECONDS = 300  # generating the whole package takes 2 s alone, far more under load
 COMPILE_EVERY = 1 if LONG else 4

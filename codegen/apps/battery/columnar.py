@@ -189,19 +189,21 @@ class ColumnConverter(OpVisitor[None]):
                 con.set(value)
 
     def visit_soc_hybrid(self, rule: Rule, op: o.SocHybrid) -> None:
-        remaining, full, percent = rule.sources
+        remaining, full = rule.sources[:2]
         con = self.out[rule.targets[0].field]
-        f = self.fld(percent)
         e = self.col(remaining).astype(np.float64)
         full_v = self.col(full).astype(np.float64)
-        p = self.col(percent)
         by_energy = (e == e) & (full_v == full_v) & (e > 0) & (full_v > 0)
-        ok = self.known(p, self.markers(f, op.unknown))
-        if op.valid_max is not None:
-            ok = _and(ok, p <= op.valid_max)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.minimum(e / np.where(by_energy, full_v, 1.0), 1.0)
-        con.set(_affine(p, *_factor(f.unit, con.concept.unit)), _and(ok, ~by_energy))
+        if len(rule.sources) == 3:
+            percent = rule.sources[2]
+            f = self.fld(percent)
+            p = self.col(percent)
+            ok = self.known(p, self.markers(f, op.unknown))
+            if op.valid_max is not None:
+                ok = _and(ok, p <= op.valid_max)
+            con.set(_affine(p, *_factor(f.unit, con.concept.unit)), _and(ok, ~by_energy))
         con.set(ratio, by_energy)
 
     # -- bits and choices ----------------------------------------------------------------------
@@ -342,6 +344,9 @@ class ColumnConverter(OpVisitor[None]):
         self._not_columnar(rule)
 
     def visit_px4_bridge_estimates(self, rule: Rule, op: o.PX4BridgeEstimates) -> None:
+        self._not_columnar(rule)
+
+    def visit_px4_udral_energy(self, rule: Rule, op: o.PX4UdralEnergy) -> None:
         self._not_columnar(rule)
 
 

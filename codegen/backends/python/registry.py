@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 from . import validators
-from .codecs import dronecan, mavlink, uorb
+from .codecs import cyphal, dronecan, mavlink, uorb
 from .converters import EXTENSION as CONVERTERS
 from .extensions import Extension
 
 EXTENSIONS: tuple[Extension, ...] = (
     dronecan.EXTENSION,
+    cyphal.EXTENSION,
     uorb.EXTENSION,
     mavlink.EXTENSION,
     validators.EXTENSION,

@@ -30,7 +30,7 @@ __all__ = ["MAPPED_FORMATS", "all_mappings", "concepts", "endpoints", "mappings_
 
 # the formats an endpoint's messages may come from (the pattern of mappings.schema.json's endpoint
 # messages): a catalog of the mappings needs these folders and no other
-MAPPED_FORMATS = ("uorb", "dronecan", "devicetree", "mavlink")
+MAPPED_FORMATS = ("uorb", "dronecan", "devicetree", "mavlink", "cyphal")
 
 # the mapping files shipped with battgen (the checkout's schemas/mappings/, as codegen.apps.package
 # finds it): they take the compiled check (.fast_check), every other file jsonschema itself

@@ -71,8 +71,11 @@ class Resolver:
             known = ", ".join(endpoint.aliases)
             raise SchemaError(display, line, f"expected ALIAS.FIELD with ALIAS one of {known}, got {text!r}")
         msg = self.message(qualified, display, line)
-        if msg is not None and not any(f.name == field for f in msg.fields):
-            raise SchemaError(display, line, f"expected a field of {qualified}, got {field!r}")
+        if msg is not None and self.schema is not None:
+            try:
+                self.schema.field_at(qualified, field)
+            except KeyError:
+                raise SchemaError(display, line, f"expected a field of {qualified}, got {field!r}") from None
         return FieldRef(qualified, field)
 
     def check_rule(self, rule: Rule, display: str, line: int) -> None:
@@ -91,7 +94,7 @@ class Resolver:
         if isinstance(rule.op, Cells):
             for ref in rule.targets + rule.sources:
                 if ref.message != CONCEPTS_ENDPOINT and not isinstance(
-                    self.schema.message(ref.message).field(ref.field).type, ArrayType
+                    self.schema.field_at(ref.message, ref.field).type, ArrayType
                 ):
                     raise SchemaError(display, line, f"expected an array field for op 'cells', got {ref.field!r}")
         self._check_units(rule, display, line)
@@ -109,7 +112,7 @@ class Resolver:
         for ref in rule.sources + rule.targets:
             if ref.message == CONCEPTS_ENDPOINT or not ref.field:
                 continue
-            t = self.schema.message(ref.message).field(ref.field).type
+            t = self.schema.field_at(ref.message, ref.field).type
             while isinstance(t, ArrayType):
                 t = t.element
             if isinstance(t, PrimitiveType) and t.kind is not PrimitiveKind.FLOAT:
@@ -126,7 +129,7 @@ class Resolver:
             return concept.unit if concept is not None else None
         if self.schema is None or not ref.field:
             return None
-        return self.schema.message(ref.message).field(ref.field).unit
+        return self.schema.field_at(ref.message, ref.field).unit
 
     def _check_units(self, rule: Rule, display: str, line: int) -> None:
         """Ops that convert between units need units of one quantity (volts to millivolts, not to amperes)."""

@@ -12,6 +12,7 @@ from collections.abc import Mapping as _Mapping
 from typing import Any as _Any
 from typing import ClassVar as _ClassVar
 
+from ... import _cyphal as _cy
 from ... import _meta as _m
 from ... import _validate as _v
 
@@ -69,6 +70,26 @@ class Health_1_0:
         obj = cls()
         if "value" in data:
             obj.value = _m.as_int(data["value"], "value")
+        return obj
+
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "Health_1_0", (("value", ("u", 2, True)),), sealed=True, extent_bytes=1, union_tag_bits=0
+    )
+    EXTENT_BYTES: _ClassVar[int] = 1
+    SEALED: _ClassVar[bool] = True
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> Health_1_0:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: Health_1_0 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
         return obj
 
     def validate(self) -> list[_v.Violation]:

@@ -23,6 +23,7 @@ from ....errors import BattgenError
 from ....ir import (
     CONCEPTS_ENDPOINT,
     ArrayType,
+    CompositeType,
     Concept,
     Endpoint,
     Field,
@@ -187,12 +188,25 @@ class RuleContext:
         return self.schema.message(qualified)
 
     def fld(self, ref: FieldRef) -> Field:
-        return self.msg(ref.message).field(ref.field)
+        return self.schema.field_at(ref.message, ref.field)
 
     def attr(self, ref: FieldRef) -> str:
+        """The attribute (chain) of a field: ``voltage``, or a Cyphal path ``power.current.ampere``,
+        ``temperature_min_max[1].kelvin`` (each step by the backend's naming rule)."""
         if ref.message == CONCEPTS_ENDPOINT:
             return naming.identifier(ref.field)
-        return self.member(ref.message, ref.field)
+        head, *steps = ref.field.split(".")
+        out = self.member(ref.message, head)
+        t = self.msg(ref.message).field(head).type
+        for step in steps:
+            if isinstance(t, ArrayType):
+                out += f"[{int(step)}]"
+                t = t.element
+            else:
+                assert isinstance(t, CompositeType), ref
+                out += "." + self.member(t.name, step)
+                t = self.msg(t.name).field(step).type
+        return out
 
     def member(self, message: str, field: str) -> str:
         """The attribute of a message's field, by the backend's one naming rule."""
@@ -206,11 +220,13 @@ class RuleContext:
     def s(self, ref: FieldRef) -> str:
         """A source value (and note that it is read)."""
         self.read.add((ref.message, ref.field))
+        self.read.add((ref.message, ref.field.split(".")[0]))  # a path reads its top-level field
         return f"{self.src.var(ref.message)}.{self.attr(ref)}"
 
     def t(self, ref: FieldRef) -> str:
         """A target attribute (and note that it is written)."""
         self.written.add((ref.message, ref.field))
+        self.written.add((ref.message, ref.field.split(".")[0]))
         return f"{self.dst.var(ref.message)}.{self.attr(ref)}"
 
     def label(self, ref: FieldRef) -> str:

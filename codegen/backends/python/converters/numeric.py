@@ -118,21 +118,27 @@ class NumericEmitters(RuleContext):
             self.emit(f"{self.t(ref)} = {py_literal(value)}")
 
     def visit_soc_hybrid(self, rule: Rule, op: SocHybrid) -> None:
-        remaining, full, percent = rule.sources
+        remaining, full = rule.sources[:2]
+        target = self.t(rule.targets[0])
+        self.emit(
+            f"_e = {self.s(remaining)}",
+            f"_f = {self.s(full)}",
+            "if _e == _e and _f == _f and _e > 0 and _f > 0:",
+            f"    {target} = min(_e / _f, 1.0)",
+        )
+        if len(rule.sources) < 3:
+            return
+        percent = rule.sources[2]
         f = self.fld(percent)
         mul, add = factor(f.unit, self.concepts[rule.targets[0].field].unit)
         tests = self.known_test("_p", self.markers(f, op.unknown))
         if op.valid_max is not None:
             tests.append(f"_p <= {py_literal(op.valid_max)}")
-        target = self.t(rule.targets[0])
         self.emit(
-            f"_e = {self.s(remaining)}",
-            f"_f = {self.s(full)}",
-            f"_p = {self.s(percent)}",
-            "if _e == _e and _f == _f and _e > 0 and _f > 0:",
-            f"    {target} = min(_e / _f, 1.0)",
-            f"elif {' and '.join(tests) or 'True'}:",
-            f"    {target} = {affine('float(_p)', mul, add)}",
+            "else:",
+            f"    _p = {self.s(percent)}",
+            f"    if {' and '.join(tests) or 'True'}:",
+            f"        {target} = {affine('float(_p)', mul, add)}",
         )
 
 

@@ -20,6 +20,7 @@ from ....ir.ops import (
     PX4Convert,
     PX4Form,
     PX4Int,
+    PX4UdralEnergy,
     PX4Warning,
 )
 from .. import naming
@@ -126,6 +127,20 @@ class PX4Emitters(RuleContext):
         value = f"_r.f32(_r.f32({self.px4_read(energy)} * {float_literal(f32(mul))}) / _v)"
         self.emit(f"_v = {self.px4_read(voltage)}", f"if _v > {float_literal(eps)}:")
         self.emit_assign(self.t(dst), self.store_c(f_dst, value, self.label(dst)), 1)
+
+    def visit_px4_udral_energy(self, rule: Rule, op: PX4UdralEnergy) -> None:
+        """Runs without the Parameters message too (``HANDLES_MISSING``): the nominal voltage is NaN then."""
+        energy, full, nominal = rule.sources
+        remaining, discharged = rule.targets
+        nominal_read = self.px4_read(nominal)
+        if self.src.optional(nominal.message):
+            nominal_read = f"{float_literal(math.nan)} if {self.src.var(nominal.message)} is None else {nominal_read}"
+        self.emit(f"_e = {self.px4_read(energy)}", f"_f = {self.px4_read(full)}", f"_n = {nominal_read}")
+        ratio = self.store_c(self.fld(remaining), "_r.f32_div(_e, _f)", self.label(remaining))
+        self.emit_assign(self.t(remaining), ratio)
+        # (full - energy) / (nominal * WH_TO_JOULE): ampere-hours, into a field PX4 counts in mAh
+        spent = "_r.f32_div(_r.f32(_f - _e), _r.f32(_n * 3600.0))"
+        self.emit_assign(self.t(discharged), self.store_c(self.fld(discharged), spent, self.label(discharged)))
 
     def visit_px4_bridge_estimates(self, rule: Rule, op: PX4BridgeEstimates) -> None:
         """Runs without the companion message too (``HANDLES_MISSING``): PX4's raw mode."""

@@ -61,7 +61,7 @@ class _Codec:
             f"{sig_name}: _ClassVar[int] = 0x{info.signature:016X}",
         ]
         if info.union:
-            self._union(msg, ctx, view, emitter, lines)
+            union_members(msg, ctx, view, emitter.module_code, lines)
         methods = [
             emitter.method_encode(),
             emitter.method_decode(),
@@ -76,44 +76,44 @@ class _Codec:
             imports=(f"from {ctx.root()} import _dronecan as _dc",),
         )
 
-    @staticmethod
-    def _union(msg: Message, ctx: ModuleContext, view: ClassView, emitter: MessageEmitter, lines: list[str]) -> None:
-        """The branch table, ``union_field`` and the hooks that keep one branch held (``_dc.Union``)."""
-        branches = []
-        zeros = ["@staticmethod", "def _dc_zero(name: str) -> _Any:"]
-        zeros.append('    """A fresh default value of branch ``name``."""')
-        for f, fv in zip([f for f in msg.fields if not f.is_padding], view.fields, strict=True):
-            branches.append(f"({py_literal(f.name)}, {py_literal(fv.ident)})")
-            zero = FieldBuilder(ctx, f, optional=False).zero(f.type)
-            zeros += [f"    if name == {py_literal(f.name)}:", f"        return {zero}"]
-        zeros.append(f"    raise KeyError(name + {py_literal(' is not a field of ' + view.name)})")
-        table = ctx.constant(view.name, "UNION")
-        emitter.module_code.append(
-            f"# the branches of {view.name}: (DSDL name, attribute)\n"
-            f"{table} = _dc.Union({py_literal(view.name)}, ({', '.join(branches)},))"
-        )
-        meta = (
-            '_m.meta(name="union_field", type="union tag", '
-            'doc="DSDL name of the field this union holds (the one encoded)")'
-        )
-        lines += [
-            f"union_field: str = _dataclasses.field(init=False, metadata={meta})",
-            "",
-            "def __post_init__(self) -> None:",
-            '    """Select the one branch given (or the first, at its default); two given raise TypeError."""',
-            f"    {table}.settle(self)",
-            "",
-            "def __setattr__(self, name: str, value: _Any) -> None:",
-            '    """A value assigned to a branch selects it; assigning a branch name to union_field switches to it."""',
-            f"    {table}.assign(self, name, value)",
-            "",
-            *zeros,
-        ]
-
     def runtime_files(self, schema: Schema, header: str) -> dict[str, str]:
         if not any(m.format is SourceFormat.DRONECAN for m in schema.messages):
             return {}
         return copied("_dronecan.py")
+
+
+def union_members(msg: Message, ctx: ModuleContext, view: ClassView, module_code: list[str], lines: list[str]) -> None:
+    """The branch table (into ``module_code``), ``union_field`` and the hooks that keep one branch held
+    (``_dc.Union``), as class body ``lines``; Cyphal unions share them."""
+    branches = []
+    zeros = ["@staticmethod", "def _dc_zero(name: str) -> _Any:"]
+    zeros.append('    """A fresh default value of branch ``name``."""')
+    for f, fv in zip([f for f in msg.fields if not f.is_padding], view.fields, strict=True):
+        branches.append(f"({py_literal(f.name)}, {py_literal(fv.ident)})")
+        zero = FieldBuilder(ctx, f, optional=False).zero(f.type)
+        zeros += [f"    if name == {py_literal(f.name)}:", f"        return {zero}"]
+    zeros.append(f"    raise KeyError(name + {py_literal(' is not a field of ' + view.name)})")
+    table = ctx.constant(view.name, "UNION")
+    module_code.append(
+        f"# the branches of {view.name}: (DSDL name, attribute)\n"
+        f"{table} = _dc.Union({py_literal(view.name)}, ({', '.join(branches)},))"
+    )
+    meta = (
+        '_m.meta(name="union_field", type="union tag", doc="DSDL name of the field this union holds (the one encoded)")'
+    )
+    lines += [
+        f"union_field: str = _dataclasses.field(init=False, metadata={meta})",
+        "",
+        "def __post_init__(self) -> None:",
+        '    """Select the one branch given (or the first, at its default); two given raise TypeError."""',
+        f"    {table}.settle(self)",
+        "",
+        "def __setattr__(self, name: str, value: _Any) -> None:",
+        '    """A value assigned to a branch selects it; assigning a branch name to union_field switches to it."""',
+        f"    {table}.assign(self, name, value)",
+        "",
+        *zeros,
+    ]
 
 
 EXTENSION = _Codec()

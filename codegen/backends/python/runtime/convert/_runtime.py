@@ -136,6 +136,15 @@ def f32(x: float) -> float:
     return result
 
 
+def f32_div(a: float, b: float) -> float:
+    """C's float ``a / b``: a zero divisor gives infinity of the quotient's sign, or NaN for 0 / 0."""
+    if b == 0.0:
+        if a != a or a == 0.0:
+            return math.nan
+        return math.copysign(math.inf, a) * math.copysign(1.0, b)
+    return f32(a / b)
+
+
 def f16(x: float, rep: LossReport | None, label: str) -> float:
     """``x`` as a saturated IEEE float16 holds it (DroneCAN ``float16``): finite values beyond
     the range clamp to +-65504, the rest round to nearest even."""

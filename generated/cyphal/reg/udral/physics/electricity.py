@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from typing import Any as _Any
 from typing import ClassVar as _ClassVar
 
+from ..... import _cyphal as _cy
 from ..... import _meta as _m
 from ..... import _validate as _v
 
@@ -126,6 +127,33 @@ class PowerTs_0_1:
             obj.value = _m.as_object(data["value"], "value", _power_0_1_class())
         return obj
 
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "PowerTs_0_1",
+        (
+            ("timestamp", ("c", _synchronized_timestamp_1_0_class)),
+            ("value", ("c", _power_0_1_class)),
+        ),
+        sealed=True,
+        extent_bytes=15,
+        union_tag_bits=0,
+    )
+    EXTENT_BYTES: _ClassVar[int] = 15
+    SEALED: _ClassVar[bool] = True
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> PowerTs_0_1:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: PowerTs_0_1 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+        return obj
+
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
@@ -212,6 +240,33 @@ class Power_0_1:
             obj.voltage = _m.as_object(data["voltage"], "voltage", _scalar_1_0_class_2())
         return obj
 
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "Power_0_1",
+        (
+            ("current", ("c", _scalar_1_0_class)),
+            ("voltage", ("c", _scalar_1_0_class_2)),
+        ),
+        sealed=True,
+        extent_bytes=8,
+        union_tag_bits=0,
+    )
+    EXTENT_BYTES: _ClassVar[int] = 8
+    SEALED: _ClassVar[bool] = True
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> Power_0_1:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: Power_0_1 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+        return obj
+
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
@@ -294,6 +349,33 @@ class SourceTs_0_1:
             obj.timestamp = _m.as_object(data["timestamp"], "timestamp", _synchronized_timestamp_1_0_class())
         if "value" in data:
             obj.value = _m.as_object(data["value"], "value", _source_0_1_class())
+        return obj
+
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "SourceTs_0_1",
+        (
+            ("timestamp", ("c", _synchronized_timestamp_1_0_class)),
+            ("value", ("c", _source_0_1_class)),
+        ),
+        sealed=True,
+        extent_bytes=23,
+        union_tag_bits=0,
+    )
+    EXTENT_BYTES: _ClassVar[int] = 23
+    SEALED: _ClassVar[bool] = True
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> SourceTs_0_1:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: SourceTs_0_1 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
         return obj
 
     def validate(self) -> list[_v.Violation]:
@@ -387,6 +469,34 @@ class Source_0_1:
             obj.energy = _m.as_object(data["energy"], "energy", _scalar_1_0_class_3())
         if "full_energy" in data:
             obj.full_energy = _m.as_object(data["full_energy"], "full_energy", _scalar_1_0_class_3())
+        return obj
+
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "Source_0_1",
+        (
+            ("power", ("c", _power_0_1_class)),
+            ("energy", ("c", _scalar_1_0_class_3)),
+            ("full_energy", ("c", _scalar_1_0_class_3)),
+        ),
+        sealed=True,
+        extent_bytes=16,
+        union_tag_bits=0,
+    )
+    EXTENT_BYTES: _ClassVar[int] = 16
+    SEALED: _ClassVar[bool] = True
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> Source_0_1:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: Source_0_1 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
         return obj
 
     def validate(self) -> list[_v.Violation]:

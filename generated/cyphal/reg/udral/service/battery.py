@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 from typing import Any as _Any
 from typing import ClassVar as _ClassVar
 
+from ..... import _cyphal as _cy
 from ..... import _meta as _m
 from ..... import _validate as _v
 
@@ -273,6 +274,26 @@ class Error_0_1:
             obj.value = _m.as_int(data["value"], "value")
         return obj
 
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "Error_0_1", (("value", ("u", 8, True)),), sealed=True, extent_bytes=1, union_tag_bits=0
+    )
+    EXTENT_BYTES: _ClassVar[int] = 1
+    SEALED: _ClassVar[bool] = True
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> Error_0_1:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: Error_0_1 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+        return obj
+
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
@@ -312,9 +333,7 @@ class Parameters_0_3:
     )
     mass: _cyphal_uavcan_si_unit_mass.Scalar_1_0 = _dataclasses.field(
         default_factory=lambda: _scalar_1_0_class()(),
-        metadata=_m.meta(
-            name="mass", type="cyphal.uavcan.si.unit.mass.Scalar_1_0", unit="kilogram", quantity="unknown:kilogram"
-        ),
+        metadata=_m.meta(name="mass", type="cyphal.uavcan.si.unit.mass.Scalar_1_0", unit="kg", quantity="mass"),
     )
     design_capacity: _cyphal_uavcan_si_unit_electric_charge.Scalar_1_0 = _dataclasses.field(
         default_factory=lambda: _scalar_1_0_class_2()(),
@@ -529,6 +548,50 @@ class Parameters_0_3:
             obj.unix_manufacture_time = _m.as_int(data["unix_manufacture_time"], "unix_manufacture_time")
         if "name" in data:
             obj.name = _m.as_bytes(data["name"], "name", 64, False)
+        return obj
+
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "Parameters_0_3",
+        (
+            ("unique_id", ("u", 64, False)),
+            ("mass", ("c", _scalar_1_0_class)),
+            ("design_capacity", ("c", _scalar_1_0_class_2)),
+            ("design_cell_voltage_min_max", ("a", ("c", _scalar_1_0_class_3), 2, 0)),
+            ("discharge_current", ("c", _scalar_1_0_class_4)),
+            ("discharge_current_burst", ("c", _scalar_1_0_class_4)),
+            ("charge_current", ("c", _scalar_1_0_class_4)),
+            ("charge_current_fast", ("c", _scalar_1_0_class_4)),
+            ("charge_termination_threshold", ("c", _scalar_1_0_class_4)),
+            ("charge_voltage", ("c", _scalar_1_0_class_3)),
+            ("cycle_count", ("u", 16, True)),
+            ("", ("v", 8)),
+            ("series_cell_count", ("u", 8, True)),
+            ("state_of_health_pct", ("u", 7, True)),
+            ("", ("v", 1)),
+            ("technology", ("c", _technology_0_1_class)),
+            ("nominal_voltage", ("c", _scalar_1_0_class_3)),
+            ("unix_manufacture_time", ("u", 40, False)),
+            ("name", ("y", 64, 8)),
+        ),
+        sealed=False,
+        extent_bytes=300,
+        union_tag_bits=0,
+    )
+    EXTENT_BYTES: _ClassVar[int] = 300
+    SEALED: _ClassVar[bool] = False
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> Parameters_0_3:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: Parameters_0_3 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
         return obj
 
     def validate(self) -> list[_v.Violation]:
@@ -834,6 +897,36 @@ class Status_0_2:
             )
         return obj
 
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "Status_0_2",
+        (
+            ("heartbeat", ("c", _heartbeat_0_1_class)),
+            ("temperature_min_max", ("a", ("c", _scalar_1_0_class_5), 2, 0)),
+            ("available_charge", ("c", _scalar_1_0_class_2)),
+            ("error", ("c", _error_0_1_class)),
+            ("cell_voltages", ("a", ("f", 16, True), 255, 8)),
+        ),
+        sealed=False,
+        extent_bytes=600,
+        union_tag_bits=0,
+    )
+    EXTENT_BYTES: _ClassVar[int] = 600
+    SEALED: _ClassVar[bool] = False
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> Status_0_2:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: Status_0_2 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+        return obj
+
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
@@ -966,6 +1059,26 @@ class Technology_0_1:
             obj.value = _m.as_int(data["value"], "value")
         return obj
 
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "Technology_0_1", (("value", ("u", 8, True)),), sealed=True, extent_bytes=1, union_tag_bits=0
+    )
+    EXTENT_BYTES: _ClassVar[int] = 1
+    SEALED: _ClassVar[bool] = True
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> Technology_0_1:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: Technology_0_1 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+        return obj
+
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
@@ -1042,6 +1155,24 @@ class __0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
         data = _m.check_keys(data, frozenset(), (), "__0_1")
         obj = cls()
+        return obj
+
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct("__0_1", (), sealed=False, extent_bytes=0, union_tag_bits=0)
+    EXTENT_BYTES: _ClassVar[int] = 0
+    SEALED: _ClassVar[bool] = False
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> __0_1:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: __0_1 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
         return obj
 
     def validate(self) -> list[_v.Violation]:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 from typing import Any as _Any
 from typing import ClassVar as _ClassVar
 
+from ..... import _cyphal as _cy
 from ..... import _meta as _m
 from ..... import _validate as _v
 
@@ -97,6 +98,33 @@ class Heartbeat_0_1:
             obj.health = _m.as_object(data["health"], "health", _health_1_0_class())
         return obj
 
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "Heartbeat_0_1",
+        (
+            ("readiness", ("c", _readiness_0_1_class)),
+            ("health", ("c", _health_1_0_class)),
+        ),
+        sealed=True,
+        extent_bytes=2,
+        union_tag_bits=0,
+    )
+    EXTENT_BYTES: _ClassVar[int] = 2
+    SEALED: _ClassVar[bool] = True
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> Heartbeat_0_1:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: Heartbeat_0_1 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+        return obj
+
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
@@ -174,6 +202,26 @@ class Readiness_0_1:
         obj = cls()
         if "value" in data:
             obj.value = _m.as_int(data["value"], "value")
+        return obj
+
+    # how the fields lie on the wire (the runtime _cyphal.py walks it)
+    CYPHAL_STRUCT: _ClassVar[_cy.Struct] = _cy.Struct(
+        "Readiness_0_1", (("value", ("u", 2, False)),), sealed=True, extent_bytes=1, union_tag_bits=0
+    )
+    EXTENT_BYTES: _ClassVar[int] = 1
+    SEALED: _ClassVar[bool] = True
+    FIXED_PORT_ID: _ClassVar[int | None] = None
+
+    def encode(self, *, with_delimiter_header: bool = False) -> bytes:
+        """The serialization (pydsdl's ``serialize``); the delimiter header only when asked (a delimited
+        type nested in another has one, a whole transfer has none)."""
+        return _cy.encode(self, self.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
+
+    @classmethod
+    def decode(cls, data: bytes, /, *, with_delimiter_header: bool = False) -> Readiness_0_1:
+        """An object read from its serialization (pydsdl's ``deserialize``): missing bits read as zero,
+        bytes beyond the last field are ignored; raises _cy.DecodeError on a bad length, tag or header."""
+        obj: Readiness_0_1 = _cy.decode(cls, data, cls.CYPHAL_STRUCT, with_delimiter_header=with_delimiter_header)
         return obj
 
     def validate(self) -> list[_v.Violation]:
