@@ -131,13 +131,10 @@ class UlogColumns:
         return self.log.info
 
     @property
-    def parameters(self) -> dict[str, float]:
-        """The log's parameters as it started (its ``PARAM`` definitions); numbers only."""
-        return {
-            k: float(v)
-            for k, v in self.log.parameters.items()
-            if isinstance(v, int | float) and not isinstance(v, bool)
-        }
+    def parameters(self) -> dict[str, int | float]:
+        """The log's parameters as it started (its ``PARAM`` definitions), typed as the log types them (int32 or
+        float); numbers only."""
+        return {k: v for k, v in self.log.parameters.items() if isinstance(v, int | float) and not isinstance(v, bool)}
 
     def instances(self, chunk: int | None = None, fields: frozenset[str] | None = None) -> Iterator[TopicColumns]:
         """Every instance of the class's topics that has records, by topic then multi_id, in

@@ -104,9 +104,8 @@ def ulog_batches(
 def ulog_context(log: UlogColumns, armed: tuple[NDArray, NDArray] | None, utc_offset_us: int | None) -> LogContext:
     """A ULog's context (:mod:`.context`): its info messages, initial parameters and arming state."""
     info = log.info
-    parameters = {
-        k: shortest_float32(v) if v != round(v) else v for k, v in log.parameters.items()
-    }  # a float32 parameter as a person reads it (0.005, not 0.004999999888241291)
+    # a float parameter as a person reads it (0.005, not 0.004999999888241291); an int32 one as it is
+    parameters = {k: shortest_float32(v) if isinstance(v, float) else float(v) for k, v in log.parameters.items()}
     mav_type = parameters.get("MAV_TYPE")
     hardware = info.get("ver_hw")
     changes: tuple[tuple[float, bool], ...] = ()

@@ -177,5 +177,5 @@ def _parameters(system: _System, autopilot: str | None) -> dict[str, float]:
             raw = struct.pack("<f", value)
             out[name] = float(struct.unpack_from(fmt, raw)[0])
         else:
-            out[name] = shortest_float32(value) if value == value and value != round(value) else value
+            out[name] = shortest_float32(value)  # NaN, infinities and integers come back as they are
     return out
