@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .battery.columns import NDArray
+from .battery.columns import NDArray, floats
 
 STEP_FRACTION = 0.2
 STEP_MIN_A = 1.0
@@ -34,7 +34,7 @@ def step_resistances(
     t: Sequence[float] | NDArray, voltage: Sequence[float | None] | NDArray, current: Sequence[float | None] | NDArray
 ) -> list[float]:
     """Every load step's -ΔV/ΔI (Ω) of one battery's samples, in time order (unknown: None, or NaN in an array)."""
-    times, volts, amps = _floats(t), _floats(voltage), _floats(current)
+    times, volts, amps = floats(t), floats(voltage), floats(current)
     known = np.abs(amps[~np.isnan(amps)])
     if not len(known):
         return []
@@ -44,12 +44,6 @@ def step_resistances(
         step = ~np.isnan(dv) & ~np.isnan(di) & ~(dt > STEP_MAX_DT_S) & (np.abs(di) >= threshold)
     r = -dv[step] / di[step]
     return [float(x) for x in r[r > 0]]
-
-
-def _floats(values: Sequence[float | None] | NDArray) -> NDArray:
-    if isinstance(values, np.ndarray):
-        return np.asarray(values, np.float64)
-    return np.array([np.nan if v is None else v for v in values], np.float64)
 
 
 def internal_resistance(

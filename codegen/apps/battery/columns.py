@@ -13,6 +13,7 @@ per row. ``valid`` is False where the concept is unknown.
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -101,6 +102,13 @@ class ConceptColumn:
         assert self.lengths is not None
         self.lengths[where] = lengths[where]
         self.valid |= where
+
+
+def floats(values: Sequence[float | None] | NDArray) -> NDArray:
+    """Numbers as a float64 array, NaN where unknown (None in a sequence)."""
+    if isinstance(values, np.ndarray):
+        return np.asarray(values, np.float64)
+    return np.array([np.nan if v is None else v for v in values], np.float64)
 
 
 def length_key(field: str) -> str:

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..battery.columns import NDArray
+from ..battery.columns import NDArray, floats
 
 POINT_BUDGET = 2000  # points per trace; the README and the browser test rely on this number
 
@@ -29,9 +29,7 @@ def decimate(
 ) -> tuple[list[float], list[float | None]]:
     """The points to draw of one trace (unknown: None, or NaN in an array): all when they fit the budget (unknown
     ones as gaps, None), else each bucket's min and max."""
-    t = np.asarray(times, np.float64)
-    values = trace if isinstance(trace, np.ndarray) else np.array([np.nan if v is None else v for v in trace])
-    values = np.asarray(values, np.float64)
+    t, values = np.asarray(times, np.float64), floats(trace)
     if len(t) <= budget:
         return [float(x) for x in t.tolist()], [None if y != y else y for y in values.tolist()]
     known = ~np.isnan(values)

@@ -44,7 +44,6 @@ COULOMB_PER_MAH = 3.6
 INSTANCE_WORDS = {"ulog": "multi_id", "can": "node", "dataflash": "instance"}
 
 
-_EMPTY = np.zeros(0)
 # the series of one battery, each a float64 array with NaN where unknown: name -> (concept, scale, offset)
 SERIES = {
     "pack_voltage": ("pack_voltage", 1.0, 0.0),
@@ -301,7 +300,7 @@ class _Parts:
         """The series joined, in time order (a record without a time last)."""
         s, parts = self.series, self.parts
         for name in ("t", "armed", *SERIES):
-            setattr(s, name, np.concatenate(parts[name]) if parts[name] else _EMPTY)
+            setattr(s, name, np.concatenate(parts[name]) if parts[name] else np.zeros(0))
         widths = [_given_width(m) for m in parts["cells"]]  # a format's 14 slots, of which a pack fills its cells
         s.cells = np.full((len(s.t), max(widths, default=0)), np.nan)
         at = 0
