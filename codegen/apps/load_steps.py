@@ -30,18 +30,27 @@ def step_threshold(peak_a: float) -> float:
     return max(STEP_MIN_A, STEP_FRACTION * peak_a)
 
 
+def neighbour_changes(
+    t: Sequence[float] | NDArray, voltage: Sequence[float | None] | NDArray, current: Sequence[float | None] | NDArray
+) -> tuple[NDArray, NDArray]:
+    """ΔV and ΔI of consecutive samples at most :data:`STEP_MAX_DT_S` apart whose voltages and currents are known,
+    in time order (unknown: None, or NaN in an array): the changes a load step, or the report's sag, is read from."""
+    dv, di, dt = np.diff(floats(voltage)), np.diff(floats(current)), np.diff(floats(t))
+    with np.errstate(invalid="ignore"):
+        keep = ~np.isnan(dv) & ~np.isnan(di) & ~(dt > STEP_MAX_DT_S)
+    return dv[keep], di[keep]
+
+
 def step_resistances(
     t: Sequence[float] | NDArray, voltage: Sequence[float | None] | NDArray, current: Sequence[float | None] | NDArray
 ) -> list[float]:
     """Every load step's -ΔV/ΔI (Ω) of one battery's samples, in time order (unknown: None, or NaN in an array)."""
-    times, volts, amps = floats(t), floats(voltage), floats(current)
+    amps = floats(current)
     known = np.abs(amps[~np.isnan(amps)])
     if not len(known):
         return []
-    threshold = step_threshold(float(known.max()))
-    dv, di, dt = np.diff(volts), np.diff(amps), np.diff(times)
-    with np.errstate(invalid="ignore"):
-        step = ~np.isnan(dv) & ~np.isnan(di) & ~(dt > STEP_MAX_DT_S) & (np.abs(di) >= threshold)
+    dv, di = neighbour_changes(t, voltage, amps)
+    step = np.abs(di) >= step_threshold(float(known.max()))
     r = -dv[step] / di[step]
     return [float(x) for x in r[r > 0]]
 

@@ -21,10 +21,8 @@ import numpy as np
 
 from ..battery.columns import NDArray
 from ..battery.figures import FlightFigures
-from ..load_steps import STEP_MAX_DT_S, step_resistances
+from ..load_steps import neighbour_changes, step_resistances
 from .series import BatterySeries
-
-STEP_MAX_DT = STEP_MAX_DT_S
 
 
 @dataclass(frozen=True)
@@ -86,11 +84,9 @@ def _max(values: NDArray) -> float | None:
     return float(known.max()) if len(known) else None
 
 
-def _pairs(s: BatterySeries) -> tuple[NDArray, NDArray, NDArray]:
-    """Consecutive samples at most STEP_MAX_DT apart with both voltages and currents known: ΔV, ΔI and Δt."""
-    dv, di, dt = np.diff(s.pack_voltage), np.diff(s.current), np.diff(s.t)
-    keep = ~np.isnan(dv) & ~np.isnan(di) & ~(dt > STEP_MAX_DT)
-    return dv[keep], di[keep], dt[keep]
+def _min(values: NDArray) -> float | None:
+    known = values[~np.isnan(values)]
+    return float(known.min()) if len(known) else None
 
 
 def _steps(s: BatterySeries) -> list[float]:
@@ -99,9 +95,9 @@ def _steps(s: BatterySeries) -> list[float]:
 
 def _sag(s: BatterySeries) -> float | None:
     """-dV/dI as the least-squares slope through the origin of the sample-to-sample changes (ΔV on ΔI, samples
-    at most STEP_MAX_DT apart): every change of load counts, small ones too, and the slow decline of the discharge
+    at most STEP_MAX_DT_S apart): every change of load counts, small ones too, and the slow decline of the discharge
     adds little to ΔV between neighbours and nothing correlated with ΔI."""
-    dv, di, _ = _pairs(s)
+    dv, di = neighbour_changes(s.t, s.pack_voltage, s.current)
     num = sum((di * dv).tolist())  # summed in time order, as a person's loop would
     den = sum((di * di).tolist())
     return -num / den if den > 1e-9 else None
@@ -129,7 +125,7 @@ def compute(s: BatterySeries, thresholds: dict[str, float] | None = None) -> Fig
         peak_power_w=_max(s.power),
         peak_current_a=flight.max_current,
         min_pack_voltage_v=flight.min_voltage,
-        min_cell_voltage_v=None if not s.cells.size else _min_cell(s.cells),
+        min_cell_voltage_v=_min(s.cells),
         max_cell_imbalance_v=_max(s.imbalance),
         max_temperature_c=_max(s.temperature),
         sag_per_amp_v_per_a=_sag(s),
@@ -138,8 +134,3 @@ def compute(s: BatterySeries, thresholds: dict[str, float] | None = None) -> Fig
         time_below_s={name: _time_below(s, v) for name, v in (thresholds or {}).items() if v > 0},
         flight=flight,
     )
-
-
-def _min_cell(cells: NDArray) -> float | None:
-    known = cells[~np.isnan(cells)]
-    return float(known.min()) if len(known) else None
