@@ -10,7 +10,6 @@ and JSON Lines (.jsonl/.ndjson) read record by record through the shared readers
 
 from __future__ import annotations
 
-import mmap
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +21,7 @@ from ...backends.python import naming
 from ...errors import BattgenError
 from ...inputs.dataflash import shortest_float32
 from ...inputs.documents import read_jsonl
+from ...inputs.held_file import Buffer
 from ...inputs.kinds import LOG_KINDS, detect
 from ...inputs.model import MessageClass, UorbClass
 from ...inputs.records import InputError, Record, Unreadable
@@ -74,9 +74,7 @@ def model_of(catalog: Catalog, qualified: str) -> MessageClass:
 # -- ULog ------------------------------------------------------------------------------------------
 
 
-def ulog_batches(
-    path: Path, name: str, catalog: Catalog, source: mmap.mmap | None, all_fields: bool
-) -> Iterator[Batch]:
+def ulog_batches(path: Path, name: str, catalog: Catalog, source: Buffer | None, all_fields: bool) -> Iterator[Batch]:
     model = model_of(catalog, "uorb.BatteryStatus")
     fields = None if all_fields else catalog.source(model.QUALIFIED_NAME).fields
     if not isinstance(model, UorbClass):

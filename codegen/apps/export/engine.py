@@ -8,9 +8,9 @@ is reported in its :class:`LogResult` and the run goes on.
 
 from __future__ import annotations
 
-import concurrent.futures
 import dataclasses
 import datetime
+import functools
 import mmap
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -21,6 +21,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from ...errors import BattgenError
+from ...inputs.held_file import held
 from ..battery.catalog import bundled_catalog
 from ..battery.sources import Batch, log_kind
 from ..battery.view import read_view
@@ -41,6 +42,7 @@ from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOption
 from .manifest import sweep
 from .table import battery_schema, battery_table
 from .views import write_views
+from .workers import run_pooled
 
 
 @dataclass(frozen=True)
@@ -71,7 +73,15 @@ class LogResult:
 def export_one(path: str, options: ExportOptions) -> LogResult:
     """Export one log into the dataset at ``options.out``; never raises for a bad log."""
     file = Path(path)
-    source = map_file(file)  # a ULog is hashed and read through one memory map
+    try:
+        with held(file, path) as hold:
+            return _export_held(file, path, options, map_file(file, hold.leased))
+    except BattgenError as exc:  # the file changed while it was read (FileChanged): nothing of it was kept
+        return LogResult(path, "failed", error=str(exc))
+
+
+def _export_held(file: Path, path: str, options: ExportOptions, source: mmap.mmap | bytes | None) -> LogResult:
+    """:func:`export_one` of a file held still; ``source``: a ULog is hashed and read through one memory map."""
     try:
         try:
             log = content_id(file, source, options.content_id or content_scheme(options.out))
@@ -88,7 +98,7 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
                 return LogResult(path, "skipped", log, notes=("the same content was exported by another task",))
             return LogResult(path, "failed", log, error=f"{path}: cannot export: {type(exc).__name__}: {exc}")
     finally:
-        if source is not None and not source.closed:
+        if isinstance(source, mmap.mmap) and not source.closed:
             source.close()
 
 
@@ -100,7 +110,7 @@ def _replay_missing(options: ExportOptions, log: str) -> bool:
     return manifest is None or manifest.get("failsafe") != options.failsafe.key
 
 
-def _export(file: Path, name: str, log: str, options: ExportOptions, source: mmap.mmap | None) -> LogResult:
+def _export(file: Path, name: str, log: str, options: ExportOptions, source: mmap.mmap | bytes | None) -> LogResult:
     """The batches stream through: each converted, its rows written, and let go (a log of any length
     in flat memory); the failsafe replay keeps what it needs of each (its context, not its columns)."""
     catalog = bundled_catalog()
@@ -208,10 +218,11 @@ def _run(paths: list[str], options: ExportOptions, jobs: int) -> Iterator[LogRes
         for p in paths:
             yield export_one(p, options)
         return
-    with concurrent.futures.ProcessPoolExecutor(max_workers=jobs) as pool:
-        futures = [pool.submit(export_one, p, options) for p in paths]
-        for fut in concurrent.futures.as_completed(futures):
-            yield fut.result()
+    yield from run_pooled(functools.partial(export_one, options=options), paths, jobs, _died)
+
+
+def _died(path: str, why: str) -> LogResult:
+    return LogResult(path, "failed", error=f"{path}: {why}")
 
 
 def count(results: Iterable[LogResult], status: str) -> int:
