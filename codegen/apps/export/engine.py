@@ -68,6 +68,7 @@ class LogResult:
     rows: int = 0
     error: str = ""
     notes: tuple[str, ...] = field(default=())
+    warnings: tuple[str, ...] = field(default=())  # records the export left out, each said once (also in notes)
 
 
 def export_one(path: str, options: ExportOptions) -> LogResult:
@@ -118,6 +119,7 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
     kind = log_kind(file)
     writer = LogWriter(options.out, log, schema)
     notes: list[str] = []
+    warnings: list[str] = []
     messages: set[str] = set()
     replay = SampleTable()  # what the failsafe replay needs of each chunk (not its columns)
     clock: Batch | None = None  # a batch of the log, for the replay's time of day
@@ -133,6 +135,7 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
                 writer.add_raw(batch.message, raw_table(catalog.schema.message(batch.message), batch, log))
             messages.add(batch.message)
             notes.extend(n for n in batch.notes if n not in notes)
+            warnings.extend(batch.warnings)
             if options.partition == "day" and table.num_rows:  # only a day partition needs it
                 first = pc.min(table["time"].cast(pa.int64())).as_py()
                 if first is not None:
@@ -163,14 +166,14 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
         "source": file.name,
         "rows": writer.rows,
         "messages": sorted(messages),
-        "notes": notes,
+        "notes": notes + warnings,
     }
     if options.failsafe is not None:
         manifest["failsafe"] = options.failsafe.key
     where = partition_of(options.partition, log, utc_day(first_us))
     manifest["partition"] = where
     writer.commit(manifest, extra, where)
-    return LogResult(name, "exported", log, writer.rows, notes=tuple(notes))
+    return LogResult(name, "exported", log, writer.rows, notes=tuple(notes + warnings), warnings=tuple(warnings))
 
 
 def utc_day(us: int | None) -> str | None:
