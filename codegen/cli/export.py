@@ -182,6 +182,12 @@ def run(args: argparse.Namespace) -> int:
     finally:
         close()
     failed = [r for r in results if r.status == "failed"]
+    for r in results:
+        if r.replaced:
+            print(
+                line(f"battgen: {r.path}: replaces log {r.replaced}, its earlier export (the file has grown)"),
+                file=sys.stderr,
+            )
     for warning in (w for r in results for w in r.warnings):
         print(line(f"battgen: warning: {warning}"), file=sys.stderr)
     for r in failed:

@@ -32,6 +32,23 @@ def content_id(path: Path, source: mmap.mmap | bytes | None = None, scheme: str 
     return str(digest.hexdigest())[:ID_DIGITS]
 
 
+def prefix_id(path: Path, size: int, source: mmap.mmap | bytes | None = None, scheme: str = "xxh128") -> str:
+    """:func:`content_id` of the first ``size`` bytes of a file: the id an earlier, shorter copy of it had."""
+    digest: Any = hashlib.sha256() if scheme == "sha256" else xxhash.xxh3_128()
+    if source is not None:
+        digest.update(memoryview(source)[:size])
+    else:
+        with path.open("rb") as f:
+            left = size
+            while left > 0:
+                block = f.read(min(left, 1 << 20))
+                if not block:
+                    break
+                digest.update(block)
+                left -= len(block)
+    return str(digest.hexdigest())[:ID_DIGITS]
+
+
 def map_file(path: Path, held: bool = True) -> mmap.mmap | bytes | None:
     """A read-only memory map of a ULog file, for hashing and reading it in one pass (None for
     other kinds, and where a file cannot be mapped: empty, a pipe...); the file read whole where it

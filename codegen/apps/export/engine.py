@@ -26,7 +26,7 @@ from ..battery.catalog import bundled_catalog
 from ..battery.sources import Batch, log_kind
 from ..battery.view import read_view
 from ..failsafe.logs import SampleTable
-from .content import content_id, map_file
+from .content import content_id, map_file, prefix_id
 from .dataflash_raw import dataflash_raw_tables
 from .dataset import (
     LogWriter,
@@ -39,7 +39,7 @@ from .dataset import (
 )
 from .durable import writers_lock
 from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, replay_tables
-from .manifest import sweep
+from .manifest import exported_sources, retire, sweep
 from .table import battery_schema, battery_table
 from .views import write_views
 from .workers import run_pooled
@@ -55,6 +55,7 @@ class ExportOptions:
     failsafe: FailsafeOptions | None = None  # --failsafe: replay each log through the battery failsafe
     partition: str = "log"  # "log" or "day" (see .dataset)
     content_id: str | None = None  # the hash naming logs (None: the dataset's, .dataset.content_scheme)
+    earlier: tuple[tuple[str, str, int], ...] = ()  # (source, log, bytes) of the logs in the dataset at the start
 
 
 @dataclass(frozen=True)
@@ -67,6 +68,7 @@ class LogResult:
     log: str = ""
     rows: int = 0
     error: str = ""
+    replaced: str = ""  # the log this one replaces: an earlier export of the same file, shorter then
     notes: tuple[str, ...] = field(default=())
     warnings: tuple[str, ...] = field(default=())  # records the export left out, each said once (also in notes)
 
@@ -91,7 +93,7 @@ def _export_held(file: Path, path: str, options: ExportOptions, source: mmap.mma
         if is_exported(options.out, log) and not _replay_missing(options, log):
             return LogResult(path, "skipped", log, notes=("already in the dataset",))
         try:
-            return _export(file, path, log, options, source)
+            return _export(file, path, log, options, source, _grown_from(file, source, options))
         except BattgenError as exc:
             return LogResult(path, "failed", log, error=str(exc))
         except (OSError, ValueError, MemoryError) as exc:  # a log the readers did not foresee
@@ -103,6 +105,21 @@ def _export_held(file: Path, path: str, options: ExportOptions, source: mmap.mma
             source.close()
 
 
+def _grown_from(file: Path, source: mmap.mmap | bytes | None, options: ExportOptions) -> str | None:
+    """The log this file grew from: an earlier export of a file of the same name whose content is this one's
+    start (a tlog downloaded again with more frames). Its id is the hash of those bytes, so a match is that
+    content, not a name alone."""
+    try:
+        size = file.stat().st_size
+    except OSError:
+        return None
+    scheme = options.content_id or content_scheme(options.out)
+    for name, log, earlier_size in options.earlier:
+        if name == file.name and 0 < earlier_size < size and prefix_id(file, earlier_size, source, scheme) == log:
+            return log
+    return None
+
+
 def _replay_missing(options: ExportOptions, log: str) -> bool:
     """A log exported before without this run's failsafe replay is exported again (with it)."""
     if options.failsafe is None:
@@ -111,7 +128,9 @@ def _replay_missing(options: ExportOptions, log: str) -> bool:
     return manifest is None or manifest.get("failsafe") != options.failsafe.key
 
 
-def _export(file: Path, name: str, log: str, options: ExportOptions, source: mmap.mmap | bytes | None) -> LogResult:
+def _export(
+    file: Path, name: str, log: str, options: ExportOptions, source: mmap.mmap | bytes | None, grown: str | None
+) -> LogResult:
     """The batches stream through: each converted, its rows written, and let go (a log of any length
     in flat memory); the failsafe replay keeps what it needs of each (its context, not its columns)."""
     catalog = bundled_catalog()
@@ -161,9 +180,12 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
             notes.append(replayed)
         else:
             extra.append((FAILSAFE, {EVENTS_FILE: replayed[0], REPLAYS_FILE: replayed[1]}))
+    if grown is not None:
+        notes.append(f"replaces log {grown}: an earlier export of {file.name}, which this file continues")
     manifest: dict[str, object] = {
         "log": log,
         "source": file.name,
+        "bytes": len(source) if source is not None else file.stat().st_size,
         "rows": writer.rows,
         "messages": sorted(messages),
         "notes": notes + warnings,
@@ -172,8 +194,20 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
         manifest["failsafe"] = options.failsafe.key
     where = partition_of(options.partition, log, utc_day(first_us))
     manifest["partition"] = where
+    if grown is not None:
+        manifest["replaces"] = grown  # the commit that shows this log hides the one it continues
     writer.commit(manifest, extra, where)
-    return LogResult(name, "exported", log, writer.rows, notes=tuple(notes + warnings), warnings=tuple(warnings))
+    if grown is not None:
+        retire(options.out, grown)
+    return LogResult(
+        name,
+        "exported",
+        log,
+        writer.rows,
+        replaced=grown or "",
+        notes=tuple(notes + warnings),
+        warnings=tuple(warnings),
+    )
 
 
 def utc_day(us: int | None) -> str | None:
@@ -213,7 +247,8 @@ def start(options: ExportOptions) -> ExportOptions:
     """The start of a run, under the writers' lock: leftovers of a stopped run removed, the layout
     claimed (:func:`.dataset.claim_layout`); the options with the dataset's content id."""
     sweep(options.out)
-    return dataclasses.replace(options, content_id=claim_layout(options.out, options.partition, options.content_id))
+    scheme = claim_layout(options.out, options.partition, options.content_id)
+    return dataclasses.replace(options, content_id=scheme, earlier=exported_sources(options.out))
 
 
 def _run(paths: list[str], options: ExportOptions, jobs: int) -> Iterator[LogResult]:
