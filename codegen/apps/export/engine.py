@@ -133,6 +133,7 @@ def _export(
 ) -> LogResult:
     """The batches stream through: each converted, its rows written, and let go (a log of any length
     in flat memory); the failsafe replay keeps what it needs of each (its context, not its columns)."""
+    size = len(source) if source is not None else file.stat().st_size  # before the reader closes the map
     catalog = bundled_catalog()
     schema = battery_schema(catalog)
     kind = log_kind(file)
@@ -185,7 +186,7 @@ def _export(
     manifest: dict[str, object] = {
         "log": log,
         "source": file.name,
-        "bytes": len(source) if source is not None else file.stat().st_size,
+        "bytes": size,
         "rows": writer.rows,
         "messages": sorted(messages),
         "notes": notes + warnings,
