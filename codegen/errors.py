@@ -21,6 +21,15 @@ class LocatedError(BattgenError):
         self.message = message
 
 
+class OutputError(BattgenError):
+    """An output that cannot be written (a full disk, a folder that is a file): the run stops, whatever its
+    inputs; nothing half-written is left visible."""
+
+    @classmethod
+    def of(cls, path: object, exc: OSError) -> OutputError:
+        return cls(f"{path}: cannot write: {exc.strerror or exc}")
+
+
 class SchemaError(LocatedError):
     """A malformed schema."""
 

@@ -20,7 +20,7 @@ from typing import Any
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from ...errors import BattgenError
+from ...errors import BattgenError, OutputError
 from ...inputs.held_file import held
 from ..battery.catalog import bundled_catalog
 from ..battery.sources import Batch, log_kind
@@ -79,6 +79,8 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
     try:
         with held(file, path) as hold:
             return _export_held(file, path, options, map_file(file, hold.leased))
+    except OutputError:
+        raise  # the dataset cannot be written: the run stops (the CLI says where, in one line)
     except BattgenError as exc:  # the file changed while it was read (FileChanged): nothing of it was kept
         return LogResult(path, "failed", error=str(exc))
 
@@ -94,6 +96,8 @@ def _export_held(file: Path, path: str, options: ExportOptions, source: mmap.mma
             return LogResult(path, "skipped", log, notes=("already in the dataset",))
         try:
             return _export(file, path, log, options, source, _grown_from(file, source, options))
+        except OutputError:
+            raise
         except BattgenError as exc:
             return LogResult(path, "failed", log, error=str(exc))
         except (OSError, ValueError, MemoryError) as exc:  # a log the readers did not foresee

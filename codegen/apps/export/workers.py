@@ -73,7 +73,10 @@ def run_pooled(task: Callable[[str], Any], paths: list[str], jobs: int, failed: 
 
 
 def _child(task: Callable[[str], Any], path: str, out: Connection) -> None:
-    out.send(task(path))
+    try:
+        out.send((True, task(path)))
+    except Exception as exc:  # raised as the pool would raise it: in the caller
+        out.send((False, exc))
     out.close()
 
 
@@ -85,11 +88,13 @@ def run_alone(task: Callable[[str], Any], path: str, failed: Failed) -> Any:
     process.start()
     send.close()
     try:
-        result = receive.recv()
+        ok, result = receive.recv()
     except EOFError:  # the process ended without a result
-        result = None
+        ok, result = True, None
     process.join()
     receive.close()
+    if not ok:
+        raise result
     if result is not None:
         return result
     return failed(path, f"the export process died ({_ending(process.exitcode)}); the other logs went on")
