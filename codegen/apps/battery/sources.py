@@ -10,7 +10,8 @@ and JSON Lines (.jsonl/.ndjson) read record by record through the shared readers
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+import math
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
@@ -172,8 +173,42 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
         else:
             column = np.empty(len(values), object if texts else dtype)
             column[:] = values
-            out[f.name] = column
+            out[f.name] = _as_stored(column, f.type)
     return out
+
+
+def stored_data(message: Message, data: Mapping[str, Any]) -> dict[str, Any]:
+    """A record's plain data with each float16/float32 value as its field stores it (see :func:`_as_stored`)."""
+    out = dict(data)
+    for f in message.fields:
+        ftype = f.type.element if isinstance(f.type, ArrayType) else f.type
+        value = out.get(f.name)
+        if value is None or not isinstance(ftype, PrimitiveType) or ftype.kind is not PrimitiveKind.FLOAT:
+            continue
+        if ftype.bits in (16, 32):
+            narrow = np.float16 if ftype.bits == 16 else np.float32
+            with np.errstate(over="ignore"):
+                if isinstance(value, list):
+                    out[f.name] = [_narrowed(v, narrow) for v in value]
+                else:
+                    out[f.name] = _narrowed(value, narrow)
+    return out
+
+
+def _narrowed(value: Any, narrow: Any) -> Any:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return value  # not a number: from_dict says what it expected
+    return float(narrow(value))
+
+
+def _as_stored(column: NDArray, ftype: object) -> NDArray:
+    """A float column as its field stores the values (a float32 ``voltage_v`` of 5e-324 is 0.0, uORB's unknown):
+    what the firmware compares, so every command compares it too. Others as they are."""
+    if isinstance(ftype, PrimitiveType) and ftype.kind is PrimitiveKind.FLOAT and ftype.bits in (16, 32):
+        narrow = np.float16 if ftype.bits == 16 else np.float32
+        with np.errstate(over="ignore"):  # a value beyond the type was left out before (_unfit)
+            return column.astype(narrow).astype(np.float64)
+    return column
 
 
 JSONL_CHUNK = 1 << 16  # records per batch of a JSON Lines file: memory stays flat whatever its length
@@ -237,29 +272,35 @@ def _jsonl_batch(
     return Batch(qualified, n, columns, t, np.zeros(n, np.int64), warnings=notes), origin
 
 
-Limits = list[tuple[str, str, int, int]]  # (attribute, type name, lowest, highest) of each integer field
+Limits = list[tuple[str, str, float, float]]  # (attribute, type name, lowest, highest) of each number field
 
 
 def integer_limits(message: Message) -> Limits:
-    """The integer fields of a message (and arrays of them) with the range of their IR type."""
+    """The integer and float16/float32 fields of a message (and arrays of them) with the range of their IR type."""
     out: Limits = []
     for f in message.fields:
         ftype = f.type.element if isinstance(f.type, ArrayType) else f.type
-        if f.is_padding or not isinstance(ftype, PrimitiveType):
+        if f.is_padding or not isinstance(ftype, PrimitiveType) or ftype.kind is PrimitiveKind.BOOL:
             continue
-        if ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT):
-            lo, hi = cast(tuple[int, int], ftype.value_range)
+        if ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT) or (
+            ftype.kind is PrimitiveKind.FLOAT and ftype.bits in (16, 32)
+        ):
+            lo, hi = cast(tuple[float, float], ftype.value_range)
             out.append((naming.field_identifier(f.name, f.pattern), ftype.name, lo, hi))
     return out
 
 
 def _unfit(instance: object, limits: Limits) -> str | None:
-    """The first integer of a record outside its field's type, said as validate says it; None if all fit."""
+    """The first number of a record outside its field's type (a finite float beyond float32 too: stored, it
+    would be infinity), said as validate says it; None if all fit."""
     for attr, type_name, lo, hi in limits:
         value = getattr(instance, attr)
         for v in value if isinstance(value, list) else (value,):
-            if isinstance(v, int) and not isinstance(v, bool) and not lo <= v <= hi:
-                return f"{attr} = {v} does not fit {type_name} ({lo}..{hi})"
+            if isinstance(v, bool) or not isinstance(v, int | float) or (isinstance(v, float) and not math.isfinite(v)):
+                continue
+            if not lo <= v <= hi:
+                bounds = f"+-{hi:g}" if type_name.startswith("float") else f"{int(lo)}..{int(hi)}"
+                return f"{attr} = {v} does not fit {type_name} ({bounds})"
     return None
 
 
