@@ -173,12 +173,13 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
         else:
             column = np.empty(len(values), object if texts else dtype)
             column[:] = values
-            out[f.name] = _as_stored(column, f.type)
+            out[f.name] = column
     return out
 
 
 def stored_data(message: Message, data: Mapping[str, Any]) -> dict[str, Any]:
-    """A record's plain data with each float16/float32 value as its field stores it (see :func:`_as_stored`)."""
+    """A record's plain data with each float16/float32 value as its field stores it: a float32 ``voltage_v`` of
+    5e-324 is 0.0, uORB's unknown, as the firmware compares it (a value beyond the type stays, to be reported)."""
     out = dict(data)
     for f in message.fields:
         ftype = f.type.element if isinstance(f.type, ArrayType) else f.type
@@ -198,17 +199,8 @@ def stored_data(message: Message, data: Mapping[str, Any]) -> dict[str, Any]:
 def _narrowed(value: Any, narrow: Any) -> Any:
     if isinstance(value, bool) or not isinstance(value, int | float):
         return value  # not a number: from_dict says what it expected
-    return float(narrow(value))
-
-
-def _as_stored(column: NDArray, ftype: object) -> NDArray:
-    """A float column as its field stores the values (a float32 ``voltage_v`` of 5e-324 is 0.0, uORB's unknown):
-    what the firmware compares, so every command compares it too. Others as they are."""
-    if isinstance(ftype, PrimitiveType) and ftype.kind is PrimitiveKind.FLOAT and ftype.bits in (16, 32):
-        narrow = np.float16 if ftype.bits == 16 else np.float32
-        with np.errstate(over="ignore"):  # a value beyond the type was left out before (_unfit)
-            return column.astype(narrow).astype(np.float64)
-    return column
+    stored = float(narrow(value))
+    return stored if math.isfinite(stored) or not math.isfinite(value) else value  # beyond the type: left to say so
 
 
 JSONL_CHUNK = 1 << 16  # records per batch of a JSON Lines file: memory stays flat whatever its length
@@ -249,7 +241,8 @@ def _jsonl_batch(
     left_out = 0
     for rec in records:
         try:
-            instance = model.from_dict(rec.data)
+            data = stored_data(message, rec.data) if isinstance(rec.data, dict) else rec.data
+            instance = model.from_dict(data)
         except (ValueError, TypeError, KeyError) as exc:
             raise InputError(name, rec.line, f"expected a {qualified} record: {exc}") from None
         unfit = _unfit(instance, limits)
