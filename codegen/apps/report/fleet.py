@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import PurePath
 from typing import Any
 
-from .figures import Figures, compute
+from .figures import Figures, compute, shown
 from .series import InputSeries
 
 _COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf")
@@ -39,7 +39,7 @@ class FleetView:
 
 
 def _fmt(value: float | None, digits: int, scale: float = 1.0) -> str:
-    return "—" if value is None else f"{value * scale:.{digits}f}"
+    return "—" if value is None else shown(value * scale, digits)
 
 
 def _row(source: str, label: str, serial: str, f: Figures) -> list[str]:

@@ -1,7 +1,10 @@
 """The plotly figure of one battery: time plots sharing one time axis, failsafe events marked across them.
 
 Rows (each only when the battery reports it): pack voltage with the failsafe thresholds, current, power, state of
-charge, temperature, every cell, and the cell imbalance (max - min). Traces are decimated to the point budget of
+charge (on 0-100 %, with PX4's BAT_*_THR lines), temperature, every cell (with a legend), and the cell imbalance
+(max - min); no cell rows where the log's cells are the pack voltage split evenly (no per-cell data). The log's
+armed spans are shaded across every row, and the firmware's own warning levels marked (dotted) beside the
+replayed failsafe events (solid). Traces are decimated to the point budget of
 :mod:`.downsample`; every trace's ``meta`` holds its sample count before decimation, so a reader (or the browser
 test) can tell what was drawn from what was read.
 """
@@ -16,10 +19,13 @@ import numpy as np
 
 from ..battery.columns import NDArray
 from .downsample import POINT_BUDGET, decimate
+from .log_facts import WarningChange
 from .series import BatterySeries
 
 ROW_HEIGHT = 190
 LEVEL_COLOURS = {"LOW": "#d98200", "CRITICAL": "#c62828", "NONE": "#2e7d32"}
+WARNING_COLOURS = {"none": "#2e7d32", "low": "#d98200", "critical": "#c62828", "emergency": "#8e0000"}
+ARMED_FILL = "rgba(46, 125, 50, 0.08)"
 
 
 @dataclass(frozen=True)
@@ -39,9 +45,12 @@ def _rows(s: BatterySeries) -> list[tuple[str, str, list[tuple[str, NDArray]]]]:
         ("power", "W", [("power", s.power)]),
         ("state of charge", "%", [("state of charge", s.state_of_charge)]),
         ("temperature", "°C", [("temperature", s.temperature)]),
-        ("cells", "V", [(f"cell {k + 1}", s.cell(k)) for k in range(s.cell_count)]),
-        ("cell imbalance", "mV", [("max - min", s.imbalance * 1000)]),
     ]
+    if not s.cells_split_evenly:
+        rows += [
+            ("cells", "V", [(f"cell {k + 1}", s.cell(k)) for k in range(s.cell_count)]),
+            ("cell imbalance", "mV", [("max - min", s.imbalance * 1000)]),
+        ]
     return [
         (title, unit, [(n, v) for n, v in traces if not np.isnan(v).all()])
         for title, unit, traces in rows
@@ -54,15 +63,21 @@ def figure(
     markers: Sequence[Marker] = (),
     thresholds: dict[str, float] | None = None,
     budget: int = POINT_BUDGET,
+    *,
+    armed: Sequence[tuple[float, float]] = (),
+    warnings: Sequence[WarningChange] = (),
+    soc_thresholds: dict[str, float] | None = None,
 ) -> dict[str, Any]:
     """The figure as plotly JSON data (``{"data": [...], "layout": {...}}``), built without plotly's Python API
-    so that the page's JSON is exactly what this module says."""
+    so that the page's JSON is exactly what this module says. ``armed``: the log's armed spans; ``warnings``: the
+    firmware's own warning changes; ``soc_thresholds``: name -> percent, drawn on the state of charge."""
     rows = _rows(s)
     data: list[dict[str, Any]] = []
     layout: dict[str, Any] = {
         "height": max(1, len(rows)) * ROW_HEIGHT + 60,
-        "margin": {"l": 70, "r": 20, "t": 44, "b": 40},
+        "margin": {"l": 70, "r": 90, "t": 44, "b": 40},
         "showlegend": False,
+        "legend": {"x": 1.01, "xanchor": "left", "yanchor": "top", "font": {"size": 10}},
         "hovermode": "x unified",
         "shapes": [],
         "annotations": [],
@@ -86,6 +101,12 @@ def figure(
             "domain": [max(0.0, top - height), top],
             "anchor": f"x{axis}",
         }
+        if title == "state of charge" and _within(traces, 0.0, 100.0):  # a gauge, not a 0.04 % wiggle
+            layout[f"yaxis{axis}"]["range"] = [0, 100]
+        legend = title == "cells"  # six overlapping traces need their names
+        if legend:
+            layout["showlegend"] = True
+            layout["legend"]["y"] = top
         for name, values in traces:
             xs, ys = decimate(s.t, values, budget)
             data.append(
@@ -98,6 +119,7 @@ def figure(
                     "xaxis": f"x{axis}",
                     "yaxis": f"y{axis}",
                     "line": {"width": 1.2},
+                    "showlegend": legend,
                     "meta": {"row": title, "samples": int((~np.isnan(values)).sum())},
                     "hovertemplate": f"%{{y:.3f}} {unit}<extra>{name}</extra>",
                 }
@@ -105,31 +127,12 @@ def figure(
         if title == "pack voltage":
             for name, volts in (thresholds or {}).items():
                 if volts > 0:
-                    layout["shapes"].append(
-                        {
-                            "type": "line",
-                            "xref": "x domain",
-                            "x0": 0,
-                            "x1": 1,
-                            "yref": "y",
-                            "y0": volts,
-                            "y1": volts,
-                            "line": {"dash": "dash", "width": 1, "color": "#888"},
-                        }
-                    )
-                    layout["annotations"].append(
-                        {
-                            "xref": "x domain",
-                            "x": 1,
-                            "yref": "y",
-                            "y": volts,
-                            "text": name,
-                            "showarrow": False,
-                            "xanchor": "right",
-                            "yanchor": "bottom",
-                            "font": {"size": 10, "color": "#666"},
-                        }
-                    )
+                    _level_line(layout, f"y{axis}", volts, name)
+        if title == "state of charge":
+            for name, percent in (soc_thresholds or {}).items():
+                _level_line(layout, f"y{axis}", percent, name)
+    _shade(layout, armed)
+    _warnings(layout, warnings)
     for m in markers:
         colour = LEVEL_COLOURS.get(m.level, "#555")
         layout["shapes"].append(
@@ -162,3 +165,89 @@ def figure(
         if key.startswith("xaxis") and layout[key].get("matches") is None:
             layout[key].pop("matches", None)
     return {"data": data, "layout": layout}
+
+
+def _within(traces: Sequence[tuple[str, NDArray]], low: float, high: float) -> bool:
+    values = np.concatenate([v[~np.isnan(v)] for _, v in traces]) if traces else np.zeros(0)
+    return bool(len(values)) and bool(values.min() >= low and values.max() <= high)
+
+
+def _level_line(layout: dict[str, Any], yref: str, y: float, name: str) -> None:
+    """A threshold across a row, named at its right end."""
+    layout["shapes"].append(
+        {
+            "type": "line",
+            "xref": "x domain",
+            "x0": 0,
+            "x1": 1,
+            "yref": yref,
+            "y0": y,
+            "y1": y,
+            "line": {"dash": "dash", "width": 1, "color": "#888"},
+            "name": f"threshold {name}",
+        }
+    )
+    layout["annotations"].append(
+        {
+            "xref": "x domain",
+            "x": 1,
+            "yref": yref,
+            "y": y,
+            "text": name,
+            "showarrow": False,
+            "xanchor": "right",
+            "yanchor": "bottom",
+            "font": {"size": 10, "color": "#666"},
+        }
+    )
+
+
+def _shade(layout: dict[str, Any], armed: Sequence[tuple[float, float]]) -> None:
+    """The armed spans, behind every row."""
+    for start, end in armed:
+        layout["shapes"].append(
+            {
+                "type": "rect",
+                "xref": "x",
+                "x0": start,
+                "x1": end,
+                "yref": "paper",
+                "y0": 0,
+                "y1": 1,
+                "fillcolor": ARMED_FILL,
+                "line": {"width": 0},
+                "layer": "below",
+                "name": "armed",
+            }
+        )
+
+
+def _warnings(layout: dict[str, Any], changes: Sequence[WarningChange]) -> None:
+    """The firmware's own warning level at each change, dotted, labelled at the foot of the plot."""
+    for w in changes:
+        colour = WARNING_COLOURS.get(w.level, "#555")
+        layout["shapes"].append(
+            {
+                "type": "line",
+                "xref": "x",
+                "x0": w.t,
+                "x1": w.t,
+                "yref": "paper",
+                "y0": 0,
+                "y1": 1,
+                "line": {"color": colour, "width": 1.5, "dash": "dot"},
+                "name": f"log warning {w.level}",
+            }
+        )
+        layout["annotations"].append(
+            {
+                "xref": "x",
+                "x": w.t,
+                "yref": "paper",
+                "y": 0,
+                "text": f"log: {w.level}",
+                "showarrow": False,
+                "yanchor": "top",
+                "font": {"color": colour, "size": 10},
+            }
+        )
