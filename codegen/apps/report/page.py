@@ -26,7 +26,7 @@ from ..gate import describe
 from .downsample import POINT_BUDGET
 from .figures import compute
 from .fleet import FleetView
-from .log_facts import LogFacts, warning_changes
+from .log_facts import LogFacts, WarningChange, warning_changes
 from .plots import Marker, figure
 from .series import BatterySeries, InputSeries, warning_levels
 
@@ -92,6 +92,7 @@ def _section(
         "cells_note": cells_note,
         "events": [{"t": e.t, "level": e.level, "text": e.text, "css": _CSS.get(e.level, "")} for e in events],
         "warnings": [{"t": w.t, "level": w.level, "css": _CSS.get(w.level.upper(), "")} for w in warnings],
+        "first_warnings": _first_reached(warnings),
         "failsafe_note": replay.note,
         "findings": _grouped(findings, s.battery),
     }
@@ -167,6 +168,15 @@ def render(
         fleet=fleet_context,
         figures_json=text,
     )
+
+
+def _first_reached(warnings: Sequence[WarningChange]) -> list[dict[str, object]]:
+    """Each warning level the firmware set, at the first time it set it (what a person asks first)."""
+    first: dict[str, float] = {}
+    for w in warnings:
+        if w.level != "none":  # back to normal is in the full list
+            first.setdefault(w.level, w.t)
+    return [{"t": t, "level": level, "css": _CSS.get(level.upper(), "")} for level, t in first.items()]
 
 
 def _gate_text(item: InputSeries) -> str:

@@ -125,12 +125,11 @@ def figure(
                 }
             )
         if title == "pack voltage":
-            for name, volts in (thresholds or {}).items():
-                if volts > 0:
-                    _level_line(layout, f"y{axis}", volts, name)
+            for k, (name, volts) in enumerate(v for v in (thresholds or {}).items() if v[1] > 0):
+                _level_line(layout, f"y{axis}", volts, name, k)
         if title == "state of charge":
-            for name, percent in (soc_thresholds or {}).items():
-                _level_line(layout, f"y{axis}", percent, name)
+            for k, (name, percent) in enumerate((soc_thresholds or {}).items()):
+                _level_line(layout, f"y{axis}", percent, name, k)
     _shade(layout, armed)
     _warnings(layout, warnings)
     for m in markers:
@@ -172,8 +171,9 @@ def _within(traces: Sequence[tuple[str, NDArray]], low: float, high: float) -> b
     return bool(len(values)) and bool(values.min() >= low and values.max() <= high)
 
 
-def _level_line(layout: dict[str, Any], yref: str, y: float, name: str) -> None:
-    """A threshold across a row, named at its right end."""
+def _level_line(layout: dict[str, Any], yref: str, y: float, name: str, k: int = 0) -> None:
+    """A threshold across a row, named near its right end (the ``k``-th of a row a label's width further left,
+    so that close thresholds -- 7 % and 5 % -- keep readable names)."""
     layout["shapes"].append(
         {
             "type": "line",
@@ -190,7 +190,7 @@ def _level_line(layout: dict[str, Any], yref: str, y: float, name: str) -> None:
     layout["annotations"].append(
         {
             "xref": "x domain",
-            "x": 1,
+            "x": 1 - 0.16 * k,
             "yref": yref,
             "y": y,
             "text": name,
@@ -223,7 +223,9 @@ def _shade(layout: dict[str, Any], armed: Sequence[tuple[float, float]]) -> None
 
 
 def _warnings(layout: dict[str, Any], changes: Sequence[WarningChange]) -> None:
-    """The firmware's own warning level at each change, dotted, labelled at the foot of the plot."""
+    """The firmware's own warning level at each change, dotted; labelled at the foot of the plot where a level is
+    first reached (a level flickering near its threshold changes dozens of times: the labels would overprint)."""
+    seen: set[str] = set()
     for w in changes:
         colour = WARNING_COLOURS.get(w.level, "#555")
         layout["shapes"].append(
@@ -239,6 +241,9 @@ def _warnings(layout: dict[str, Any], changes: Sequence[WarningChange]) -> None:
                 "name": f"log warning {w.level}",
             }
         )
+        if w.level in seen or w.level == "none":  # back to none: the line says it
+            continue
+        seen.add(w.level)
         layout["annotations"].append(
             {
                 "xref": "x",
@@ -248,6 +253,7 @@ def _warnings(layout: dict[str, Any], changes: Sequence[WarningChange]) -> None:
                 "text": f"log: {w.level}",
                 "showarrow": False,
                 "yanchor": "top",
+                "yshift": -12 * (len(seen) - 1),  # first low, critical, emergency: often seconds apart
                 "font": {"color": colour, "size": 10},
             }
         )
