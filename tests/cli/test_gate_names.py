@@ -81,8 +81,9 @@ def test_a_misspelt_name_in_pyproject_is_exit_2(
     err = capsys.readouterr().err.splitlines()[-1]
     assert code == 2
     assert err == (
-        f"battgen: {tmp_path.as_posix()}/pyproject.toml: [tool.battgen] select: no rule or field of uorb.BatteryStatus "
-        "is called 'cells-beyond-count-zeor' (did you mean cells-beyond-count-zero, cross-field:cells-beyond-count-zero?)"
+        f"battgen: {tmp_path.as_posix()}/pyproject.toml: [tool.battgen] select: no rule or field of "
+        "uorb.BatteryStatus is called 'cells-beyond-count-zeor' (did you mean cells-beyond-count-zero, "
+        "cross-field:cells-beyond-count-zero?)"
     )
 
 
