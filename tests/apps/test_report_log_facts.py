@@ -31,6 +31,8 @@ for _p in [*real_logs(), *sorted(SHARED.glob("corpus/realworld3*/ulog/*.ulg"))]:
 ULOGS = sorted(_by_name.values(), key=lambda p: p.name)
 UORB_WARNINGS = ("none", "low", "critical", "emergency", "failed")  # battery_status WARNING_* 0..4 (BatteryStatus.msg)
 ARMING_STATE_ARMED = 2  # vehicle_status ARMING_STATE_ARMED (VehicleStatus.msg)
+# ArduPilot ModeReason (AP_Vehicle/ModeReason.h), the ones these logs give
+MODE_REASON_NAMES = {0: "UNKNOWN", 1: "RC_COMMAND", 2: "GCS_COMMAND", 3: "RADIO_FAILSAFE", 4: "BATTERY_FAILSAFE"}
 
 
 def _page(path: Path) -> tuple[Any, dict[str, Any]]:
@@ -90,7 +92,7 @@ def _expected_warnings(ulog: Any) -> list[tuple[float, str]]:
 
 @pytest.mark.parametrize("log", ULOGS, ids=[p.name for p in ULOGS])
 def test_px4_header_shading_warnings_and_parameters_agree_with_pyulog(log: Path) -> None:
-    ulog = pyulog.ULog(str(log), ["battery_status", "vehicle_status", "vehicle_gps_position"])
+    ulog = pyulog.ULog(str(log), ["battery_status", "vehicle_status", "vehicle_gps_position"])  # texts: always read
     if not any(d.name == "battery_status" for d in ulog.data_list):
         pytest.skip(f"{log.name} logs no battery_status")
     report, figures = _page(log)
@@ -122,10 +124,39 @@ def test_px4_header_shading_warnings_and_parameters_agree_with_pyulog(log: Path)
     assert [name for name, _ in facts.parameters] == sorted(params)
     for name, text in facts.parameters:
         assert float(text) == pytest.approx(params[name], rel=1e-6)
+    _px4_modes_texts_failsafes(ulog, facts, figures, end)
     for name in ("BAT_LOW_THR", "BAT_CRIT_THR", "BAT_EMERGEN_THR"):
         if params.get(name, 0) > 0:
             assert facts.soc_thresholds[name] == pytest.approx(params[name] * 100, rel=1e-6)
             assert facts.thresholds_from == "the log's PARAM definitions"
+
+
+def _px4_modes_texts_failsafes(ulog: Any, facts: Any, figures: dict[str, Any], end: float) -> None:
+    """Flight modes (nav_state changes), failsafe entries (vehicle_status.failsafe turning true) and logged
+    messages, as pyulog reads them, against the page."""
+    tagged = [(m.timestamp, m.message) for messages in ulog.logged_messages_tagged.values() for m in messages]
+    texts = sorted([(m.timestamp, m.message) for m in ulog.logged_messages] + tagged, key=lambda m: m[0])
+    assert [m.text for m in facts.texts] == [text.rstrip("\t\n\x00") for _, text in texts]
+    assert [m.t for m in facts.texts] == pytest.approx([(stamp - ulog.start_timestamp) / 1e6 for stamp, _ in texts])
+    status = [d for d in ulog.data_list if d.name == "vehicle_status"]
+    if not status:
+        assert facts.modes == [] and facts.failsafes == []
+        return
+    t = np.maximum((status[0].data["timestamp"].astype(np.int64) - ulog.start_timestamp) / 1e6, 0.0)
+    nav = status[0].data["nav_state"]
+    changes = [k for k in range(len(nav)) if k == 0 or nav[k] != nav[k - 1]]
+    want_modes = [(float(t[k]), int(nav[k])) for k in changes if t[k] <= end]
+    assert [m for m, _ in facts.modes] == pytest.approx([m for m, _ in want_modes], abs=1e-6)
+    assert all(
+        name.endswith(str(code)) or not name.startswith("nav_state")
+        for (_, name), (_, code) in zip(facts.modes, want_modes, strict=True)
+    )
+    bands = sorted({s["x0"] for s in _shapes(figures, "mode ")})
+    assert bands == pytest.approx(sorted({m for m, _ in facts.modes if m < end}), abs=1e-6)
+    flags = status[0].data["failsafe"]
+    rising = [float(t[k]) for k in range(len(flags)) if flags[k] and (k == 0 or not flags[k - 1]) and t[k] <= end]
+    assert [f for f, _ in facts.failsafes] == pytest.approx(rising, abs=1e-6)
+    assert sorted({s["x0"] for s in _shapes(figures, "log failsafe")}) == pytest.approx(sorted(set(rising)), abs=1e-6)
 
 
 DATAFLASH = sorted(SHARED.glob("corpus/realworld3*/dataflash/*.[bB][iI][nN]"))
@@ -137,11 +168,20 @@ def test_ardupilot_header_and_parameters_agree_with_pymavlink(log: Path) -> None
     reader = mavutil.mavlink_connection(str(log))
     params: dict[str, float] = {}
     firmware = None
-    while (m := reader.recv_match(type=["PARM", "MSG"])) is not None:
+    texts: list[str] = []
+    modes: list[tuple[int, int | None]] = []
+    errors: list[tuple[int, int]] = []
+    while (m := reader.recv_match(type=["PARM", "MSG", "MODE", "ERR"])) is not None:
         if m.get_type() == "PARM":
             params[m.Name] = m.Value
-        elif firmware is None and re.match(r"(APM|ArduPilot|Ardu)\S*[: ]", m.Message):
-            firmware = m.Message
+        elif m.get_type() == "MODE":
+            modes.append((m.ModeNum, getattr(m, "Rsn", None)))
+        elif m.get_type() == "ERR":
+            errors.append((m.Subsys, m.ECode))
+        else:
+            texts.append(m.Message)
+            if firmware is None and re.match(r"(APM|ArduPilot|Ardu)\S*[: ]", m.Message):
+                firmware = m.Message
     try:
         report, figures = _page(log)
     except Exception as exc:  # a log without battery records: the report says so, nothing to compare
@@ -157,6 +197,15 @@ def test_ardupilot_header_and_parameters_agree_with_pymavlink(log: Path) -> None
         assert float(text) == pytest.approx(wanted[name], rel=1e-6, abs=1e-9)
     context = item.context
     assert isinstance(context, LogContext) and context.autopilot == "ardupilot"
+    assert [m.text for m in context.texts] == texts
+    assert len(context.modes) == len(modes)
+    mapping = mavutil.mode_mapping_bynumber(2 if "Copter" in (firmware or "") else 1) or {}
+    for (_, name), (number, reason) in zip(context.modes, modes, strict=True):
+        assert name.startswith(mapping.get(number, f"mode {number}"))
+        assert reason is None or reason not in MODE_REASON_NAMES or name.endswith(f"({MODE_REASON_NAMES[reason]})")
+    failsafe_modes = sum(1 for _, reason in modes if reason in (3, 4, 5, 6, 11, 19, 25))
+    failsafe_errors = sum(1 for subsystem, code in errors if 5 <= subsystem <= 9 and code != 0)
+    assert len(context.failsafes) == failsafe_modes + failsafe_errors
     end = max(float(s.t[-1]) for s in item.batteries)
     got = sorted({(s["x0"], s["x1"]) for s in _shapes(figures, "armed")})
     assert _flat(got) == pytest.approx(_flat(context.armed_intervals(end)), abs=1e-6)

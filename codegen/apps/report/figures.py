@@ -90,7 +90,7 @@ def shown(value: float, digits: int) -> str:
     """A figure with the precision it carries: ``digits`` decimals, more for a small value that would show as 0 or
     with one significant digit (0.39 mAh, not 0 mAh)."""
     if value == 0 or value != value or math.isinf(value):
-        return f"{value:.{digits}f}"
+        return f"{value + 0.0:.{digits}f}"  # + 0.0: no "-0.0"
     return f"{value:.{max(digits, 1 - math.floor(math.log10(abs(value))))}f}"
 
 

@@ -19,11 +19,13 @@ from datetime import UTC, datetime
 import numpy as np
 
 from ..battery.columns import NDArray
-from ..battery.context import LogContext
+from ..battery.context import LogContext, LogText
 from ..package import bundled_package, package_module
 
 # the parameters about the battery a person looks for: PX4's BAT*_ and COM_*BAT*, ArduPilot's BATT*_ and older FS_BATT_*
 BATTERY_PARAMETER = re.compile(r"^(BAT\d*_|BATT\d?_|COM_[A-Z_]*BAT|FS_BATT_)")
+# a logged message that concerns the battery (or a failsafe the battery may have caused), by its words
+BATTERY_TEXT = re.compile(r"batt|volt|cell|charg|capacity|power|current|energy|failsafe", re.IGNORECASE)
 # PX4's state-of-charge thresholds (battery.cpp: remaining < BAT_*_THR sets the warning), fractions
 PX4_SOC_THRESHOLDS = ("BAT_LOW_THR", "BAT_CRIT_THR", "BAT_EMERGEN_THR")
 
@@ -48,6 +50,10 @@ class LogFacts:
     soc_thresholds: dict[str, float] = field(default_factory=dict)  # name -> percent
     thresholds_from: str = ""
     autopilot: str | None = None
+    texts: list[LogText] = field(default_factory=list)  # every message the firmware logged
+    battery_texts: list[LogText] = field(default_factory=list)  # those about the battery or a failsafe
+    modes: list[tuple[float, str]] = field(default_factory=list)  # (t, mode entered)
+    failsafes: list[tuple[float, str]] = field(default_factory=list)  # (t, what the firmware's failsafe did)
 
 
 def vehicle_type_name(code: int | None) -> str | None:
@@ -107,6 +113,15 @@ def log_facts(
             (k, number_text(v)) for k, v in sorted(context.parameters.items()) if BATTERY_PARAMETER.match(k)
         ]
         facts.parameters_from = f"the log's {context.parameters_from}" if context.parameters else ""
+        facts.texts = list(context.texts)
+        facts.battery_texts = [m for m in context.texts if BATTERY_TEXT.search(m.text)]
+        facts.modes = [(t, name) for t, name in context.modes if t <= end]
+        facts.failsafes = [(t, what) for t, what in context.failsafes if t <= end]
+        if facts.modes:
+            shown = ", ".join(f"{name} {t:.1f} s" for t, name in facts.modes[:8])
+            facts.header.append(
+                ("flight modes", shown + (f", … ({len(facts.modes)} changes)" if len(facts.modes) > 8 else ""))
+            )
     values: Mapping[str, float] = context.parameters if context is not None else {}
     facts.thresholds_from = facts.parameters_from
     if override:

@@ -21,7 +21,9 @@ import jinja2
 
 from ... import __version__
 from ...errors import BattgenError
+from ...text.escape import line
 from ..battery.column_checks import FindingGroup
+from ..battery.context import LogText
 from ..gate import describe
 from .downsample import POINT_BUDGET
 from .figures import compute
@@ -96,7 +98,16 @@ def _section(
         "failsafe_note": replay.note,
         "findings": _grouped(findings, s.battery),
     }
-    fig = figure(s, markers, thresholds, armed=facts.armed, warnings=warnings, soc_thresholds=facts.soc_thresholds)
+    fig = figure(
+        s,
+        markers,
+        thresholds,
+        armed=facts.armed,
+        warnings=warnings,
+        soc_thresholds=facts.soc_thresholds,
+        modes=facts.modes,
+        failsafes=facts.failsafes,
+    )
     return context, fig
 
 
@@ -138,6 +149,9 @@ def render(
                 "soc_thresholds": [(k, f"{v:g} %") for k, v in own.soc_thresholds.items()],
                 "thresholds_from": own.thresholds_from,
                 "gate": _gate_text(item),
+                "battery_texts": [_text_row(m) for m in own.battery_texts],
+                "texts": [_text_row(m) for m in own.texts],
+                "failsafes": [{"t": t, "text": line(what)} for t, what in own.failsafes],
             }
         )
     fleet_context = None
@@ -168,6 +182,12 @@ def render(
         fleet=fleet_context,
         figures_json=text,
     )
+
+
+def _text_row(m: LogText) -> dict[str, object]:
+    """A logged message for the page: its text with control characters shown, not run (ANSI colours...)."""
+    css = {"emergency": "bad", "alert": "bad", "critical": "bad", "error": "bad", "warning": "warn"}
+    return {"t": m.t, "severity": m.severity, "text": line(m.text), "css": css.get(m.severity, "")}
 
 
 def _first_reached(warnings: Sequence[WarningChange]) -> list[dict[str, object]]:

@@ -24,6 +24,8 @@ from .series import BatterySeries
 
 ROW_HEIGHT = 190
 LEVEL_COLOURS = {"LOW": "#d98200", "CRITICAL": "#c62828", "NONE": "#2e7d32"}
+MODE_FILLS = ("#e3f2fd", "#fff3e0", "#f3e5f5", "#e8f5e9", "#fce4ec", "#e0f7fa", "#f9fbe7", "#efebe9")
+FAILSAFE_COLOUR = "#6a1b9a"
 WARNING_COLOURS = {"none": "#2e7d32", "low": "#d98200", "critical": "#c62828", "emergency": "#8e0000"}
 ARMED_FILL = "rgba(46, 125, 50, 0.08)"
 
@@ -67,10 +69,13 @@ def figure(
     armed: Sequence[tuple[float, float]] = (),
     warnings: Sequence[WarningChange] = (),
     soc_thresholds: dict[str, float] | None = None,
+    modes: Sequence[tuple[float, str]] = (),
+    failsafes: Sequence[tuple[float, str]] = (),
 ) -> dict[str, Any]:
     """The figure as plotly JSON data (``{"data": [...], "layout": {...}}``), built without plotly's Python API
     so that the page's JSON is exactly what this module says. ``armed``: the log's armed spans; ``warnings``: the
-    firmware's own warning changes; ``soc_thresholds``: name -> percent, drawn on the state of charge."""
+    firmware's own warning changes; ``soc_thresholds``: name -> percent, drawn on the state of charge; ``modes``: the
+    flight-mode changes (t, name), a strip above the plots; ``failsafes``: the firmware's own failsafe entries."""
     rows = _rows(s)
     data: list[dict[str, Any]] = []
     layout: dict[str, Any] = {
@@ -132,6 +137,9 @@ def figure(
                 _level_line(layout, f"y{axis}", percent, name, k)
     _shade(layout, armed)
     _warnings(layout, warnings)
+    end = float(s.t[-1]) if len(s.t) else 0.0
+    _modes(layout, modes, end)
+    _failsafes(layout, failsafes)
     for m in markers:
         colour = LEVEL_COLOURS.get(m.level, "#555")
         layout["shapes"].append(
@@ -255,5 +263,81 @@ def _warnings(layout: dict[str, Any], changes: Sequence[WarningChange]) -> None:
                 "yanchor": "top",
                 "yshift": -12 * (len(seen) - 1),  # first low, critical, emergency: often seconds apart
                 "font": {"color": colour, "size": 10},
+            }
+        )
+
+
+def _modes(layout: dict[str, Any], modes: Sequence[tuple[float, str]], end: float) -> None:
+    """The flight modes as a strip of bands above the plots, one colour per mode name, each named at its start."""
+    colours: dict[str, str] = {}
+    span = max(end - (modes[0][0] if modes else 0.0), 1e-9)
+    for k, (start, name) in enumerate(modes):
+        stop = modes[k + 1][0] if k + 1 < len(modes) else end
+        if stop <= start:
+            continue
+        base = name.split(" (", 1)[0]  # ArduPilot's reason aside: one colour per mode
+        same = k > 0 and modes[k - 1][1].split(" (", 1)[0] == base  # the mode set again: one band goes on
+        colour = colours.setdefault(base, MODE_FILLS[len(colours) % len(MODE_FILLS)])
+        layout["shapes"].append(
+            {
+                "type": "rect",
+                "xref": "x",
+                "x0": start,
+                "x1": stop,
+                "yref": "paper",
+                "y0": 1.0,
+                "y1": 1.035,
+                "fillcolor": colour,
+                "line": {"width": 0.5, "color": "#b0bec5"},
+                "name": f"mode {name}",
+            }
+        )
+        if same or (stop - start) / span < 0.02:  # no label on a sliver: it would overprint the next
+            continue
+        layout["annotations"].append(
+            {
+                "xref": "x",
+                "x": start,
+                "yref": "paper",
+                "y": 1.0175,
+                "text": base,
+                "showarrow": False,
+                "xanchor": "left",
+                "hovertext": f"{name} from {start:.1f} s",
+                "font": {"size": 9, "color": "#37474f"},
+            }
+        )
+    if modes:
+        layout["margin"]["t"] = max(layout["margin"]["t"], 60)
+
+
+def _failsafes(layout: dict[str, Any], failsafes: Sequence[tuple[float, str]]) -> None:
+    """The firmware's own failsafe entries (PX4 vehicle_status.failsafe, ArduPilot's failsafe MODE and ERR)."""
+    for t, what in failsafes:
+        layout["shapes"].append(
+            {
+                "type": "line",
+                "xref": "x",
+                "x0": t,
+                "x1": t,
+                "yref": "paper",
+                "y0": 0,
+                "y1": 1,
+                "line": {"color": FAILSAFE_COLOUR, "width": 2, "dash": "dashdot"},
+                "name": f"log failsafe {what}",
+            }
+        )
+        layout["annotations"].append(
+            {
+                "xref": "x",
+                "x": t,
+                "yref": "paper",
+                "y": 0.5,
+                "text": "log failsafe",
+                "textangle": -90,
+                "showarrow": False,
+                "xanchor": "right",
+                "hovertext": what,
+                "font": {"color": FAILSAFE_COLOUR, "size": 10},
             }
         )
