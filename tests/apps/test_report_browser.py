@@ -163,6 +163,12 @@ def test_the_log_speaks_first_in_the_browser(tmp_path: Path) -> None:
     expected = [(t, levels[c]) for k, (t, c) in enumerate(zip(times, codes, strict=True)) if k and c != codes[k - 1]]
     assert [w["level"] for w in plot["warnings"]] == [level for _, level in expected]
     assert [w["t"] for w in plot["warnings"]] == pytest.approx([t for t, _ in expected], abs=1e-6)
+    nav, stamps = status.data["nav_state"], (status.data["timestamp"].astype(np.int64) - ulog.start_timestamp) / 1e6
+    changes = [max(float(stamps[k]), 0.0) for k in range(len(nav)) if k == 0 or nav[k] != nav[k - 1]]
+    assert [m["t"] for m in plot["modes"]] == pytest.approx([t for t in changes if t < times[-1]], abs=1e-6)
+    flags = status.data["failsafe"]
+    rising = [float(stamps[k]) for k in range(1, len(flags)) if flags[k] and not flags[k - 1]]
+    assert [f["t"] for f in plot["failsafes"]] == pytest.approx(rising, abs=1e-6) and rising
     shutil.copy(page.screenshot, tmp_path / "kept.png")  # the screenshot is the artefact a person looks at
 
     log = require(ARDUPILOT)

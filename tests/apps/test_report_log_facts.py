@@ -4,6 +4,7 @@ person reads (SoC on 0-100 %, cell legends, figures with their precision, no per
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 from datetime import UTC, datetime
@@ -12,12 +13,13 @@ from typing import Any
 
 import numpy as np
 import pytest
-from shared_data import SHARED, real_logs
+from shared_data import SHARED, real_logs, require
 
 from codegen.apps.battery.context import LogContext
 from codegen.apps.package import bundled_schemas
 from codegen.apps.report.build import collect, html
 from codegen.apps.report.figures import NO_CELLS, compute, shown
+from codegen.apps.report.fleet import fleet_view
 from codegen.apps.report.log_facts import BATTERY_PARAMETER, log_facts
 from codegen.apps.report.plots import figure
 from codegen.apps.report.series import BatterySeries
@@ -29,6 +31,7 @@ _by_name: dict[str, Path] = {}
 for _p in [*real_logs(), *sorted(SHARED.glob("corpus/realworld3*/ulog/*.ulg"))]:
     _by_name.setdefault(_p.name, _p)  # realworld3b repeats some of realworld3's logs
 ULOGS = sorted(_by_name.values(), key=lambda p: p.name)
+FLEET_PX4 = SHARED / "corpus" / "realworld3" / "ulog" / "fsyrh_log_123_2024-3-1-14-47-02.ulg"  # 559 mAh used
 UORB_WARNINGS = ("none", "low", "critical", "emergency", "failed")  # battery_status WARNING_* 0..4 (BatteryStatus.msg)
 ARMING_STATE_ARMED = 2  # vehicle_status ARMING_STATE_ARMED (VehicleStatus.msg)
 # ArduPilot ModeReason (AP_Vehicle/ModeReason.h), the ones these logs give
@@ -250,3 +253,23 @@ def test_params_override_the_logs_thresholds(tmp_path: Path) -> None:
     assert facts.thresholds_from == "the log's PARAM definitions"
     facts = log_facts(context, 10.0, {"BAT_LOW_THR": 0.25}, "my.params")
     assert facts.soc_thresholds == {"BAT_LOW_THR": 25.0} and facts.thresholds_from == "my.params"
+
+
+def test_fleet_rows_carry_date_and_firmware_and_trends_run_over_dates() -> None:
+    """Two flights of one pack: each row has the log's start (UTC) and firmware from its context; the pack's
+    trend is plotted over those dates, in date order whatever the input order."""
+    log = require(FLEET_PX4)
+    first, second = (collect([log], bundled_schemas()).inputs[0] for _ in range(2))
+    for item, start in ((first, 1_710_000_000_000_000), (second, 1_700_000_000_000_000)):
+        assert item.samples is not None and item.samples.context is not None
+        item.samples.context = dataclasses.replace(item.samples.context, start_us=0, utc_offset_us=start)
+        for s in item.batteries:
+            s.serial = "4242"
+    view = fleet_view([first, second])
+    date, firmware = view.header.index("date [UTC]"), view.header.index("firmware")
+    assert [row[date] for row in view.rows] == ["2024-03-09 16:00:00", "2023-11-14 22:13:20"]
+    assert first.samples.context.firmware.startswith("PX4 v1.14.0")
+    assert {row[firmware] for row in view.rows} == {first.samples.context.firmware}
+    (trace, *_) = view.trends["data"]
+    assert trace["x"] == ["2023-11-14 22:13:20", "2024-03-09 16:00:00"]
+    assert view.trends["layout"]["xaxis"]["type"] == "date"

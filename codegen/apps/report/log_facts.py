@@ -11,6 +11,7 @@ charge; ArduPilot's are the failsafe replay's volts (:mod:`.replay`). ``--params
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -75,7 +76,9 @@ def utc_text(us: int | None) -> str | None:
 
 def number_text(value: float) -> str:
     """A parameter as the log holds it: integers without a fraction, floats at their shortest."""
-    return str(int(value)) if value == int(value) and abs(value) < 1e15 else repr(value)
+    if math.isfinite(value) and value == int(value) and abs(value) < 1e15:
+        return str(int(value))
+    return repr(value)  # nan, inf, a fraction: as Python spells the shortest form
 
 
 def duration_text(seconds: float) -> str:
