@@ -126,7 +126,11 @@ def test_a_px4_logs_default_report_and_validation_have_no_finding_px4_explains(
     assert main(["report", "--format", "json", str(log)]) == 0
     out, err = capsys.readouterr()
     (item,) = json.loads(out)["inputs"]
-    assert item["findings"] == 0 and "note: profile px4, as the log's firmware is px4" in err
+    assert (
+        item["findings"] == 0
+        and "note: profile px4, as the log's firmware is PX4 v1." in err
+        and "--profile '' for none" in err
+    )
     assert main(["report", "--format", "json", "--profile", "", str(log)]) == 0
     (item,) = json.loads(capsys.readouterr().out)["inputs"]
     assert item["findings"] == item["records"]  # every record's max_error = 0

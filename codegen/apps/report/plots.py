@@ -142,19 +142,7 @@ def figure(
     _failsafes(layout, failsafes)
     for m in markers:
         colour = LEVEL_COLOURS.get(m.level, "#555")
-        layout["shapes"].append(
-            {
-                "type": "line",
-                "xref": "x",
-                "x0": m.t,
-                "x1": m.t,
-                "yref": "paper",
-                "y0": 0,
-                "y1": 1,
-                "line": {"color": colour, "width": 2},
-                "name": f"failsafe {m.level}",
-            }
-        )
+        layout["shapes"].append(_across(m.t, {"color": colour, "width": 2}, f"failsafe {m.level}"))
         layout["annotations"].append(
             {
                 "xref": "x",
@@ -210,24 +198,31 @@ def _level_line(layout: dict[str, Any], yref: str, y: float, name: str, k: int =
     )
 
 
+def _across(t: float, line: dict[str, Any], name: str) -> dict[str, Any]:
+    """A vertical line at ``t`` across every row (a shape named for the tests and readers of the JSON)."""
+    return {
+        "type": "line",
+        "xref": "x",
+        "x0": t,
+        "x1": t,
+        "yref": "paper",
+        "y0": 0,
+        "y1": 1,
+        "line": line,
+        "name": name,
+    }
+
+
+def _band(x0: float, x1: float, y0: float, y1: float, fill: str, name: str, **style: Any) -> dict[str, Any]:
+    """A rectangle from ``x0`` to ``x1`` s, ``y0`` to ``y1`` of the plot's height."""
+    box = {"type": "rect", "xref": "x", "x0": x0, "x1": x1, "yref": "paper", "y0": y0, "y1": y1}
+    return box | {"fillcolor": fill, "name": name, **style}
+
+
 def _shade(layout: dict[str, Any], armed: Sequence[tuple[float, float]]) -> None:
     """The armed spans, behind every row."""
     for start, end in armed:
-        layout["shapes"].append(
-            {
-                "type": "rect",
-                "xref": "x",
-                "x0": start,
-                "x1": end,
-                "yref": "paper",
-                "y0": 0,
-                "y1": 1,
-                "fillcolor": ARMED_FILL,
-                "line": {"width": 0},
-                "layer": "below",
-                "name": "armed",
-            }
-        )
+        layout["shapes"].append(_band(start, end, 0, 1, ARMED_FILL, "armed", line={"width": 0}, layer="below"))
 
 
 def _warnings(layout: dict[str, Any], changes: Sequence[WarningChange]) -> None:
@@ -236,19 +231,7 @@ def _warnings(layout: dict[str, Any], changes: Sequence[WarningChange]) -> None:
     seen: set[str] = set()
     for w in changes:
         colour = WARNING_COLOURS.get(w.level, "#555")
-        layout["shapes"].append(
-            {
-                "type": "line",
-                "xref": "x",
-                "x0": w.t,
-                "x1": w.t,
-                "yref": "paper",
-                "y0": 0,
-                "y1": 1,
-                "line": {"color": colour, "width": 1.5, "dash": "dot"},
-                "name": f"log warning {w.level}",
-            }
-        )
+        layout["shapes"].append(_across(w.t, {"color": colour, "width": 1.5, "dash": "dot"}, f"log warning {w.level}"))
         if w.level in seen or w.level == "none":  # back to none: the line says it
             continue
         seen.add(w.level)
@@ -279,18 +262,7 @@ def _modes(layout: dict[str, Any], modes: Sequence[tuple[float, str]], end: floa
         same = k > 0 and modes[k - 1][1].split(" (", 1)[0] == base  # the mode set again: one band goes on
         colour = colours.setdefault(base, MODE_FILLS[len(colours) % len(MODE_FILLS)])
         layout["shapes"].append(
-            {
-                "type": "rect",
-                "xref": "x",
-                "x0": start,
-                "x1": stop,
-                "yref": "paper",
-                "y0": 1.0,
-                "y1": 1.035,
-                "fillcolor": colour,
-                "line": {"width": 0.5, "color": "#b0bec5"},
-                "name": f"mode {name}",
-            }
+            _band(start, stop, 1.0, 1.035, colour, f"mode {name}", line={"width": 0.5, "color": "#b0bec5"})
         )
         if same or (stop - start) / span < 0.02:  # no label on a sliver: it would overprint the next
             continue
@@ -314,19 +286,8 @@ def _modes(layout: dict[str, Any], modes: Sequence[tuple[float, str]], end: floa
 def _failsafes(layout: dict[str, Any], failsafes: Sequence[tuple[float, str]]) -> None:
     """The firmware's own failsafe entries (PX4 vehicle_status.failsafe, ArduPilot's failsafe MODE and ERR)."""
     for t, what in failsafes:
-        layout["shapes"].append(
-            {
-                "type": "line",
-                "xref": "x",
-                "x0": t,
-                "x1": t,
-                "yref": "paper",
-                "y0": 0,
-                "y1": 1,
-                "line": {"color": FAILSAFE_COLOUR, "width": 2, "dash": "dashdot"},
-                "name": f"log failsafe {what}",
-            }
-        )
+        style = {"color": FAILSAFE_COLOUR, "width": 2, "dash": "dashdot"}
+        layout["shapes"].append(_across(t, style, f"log failsafe {what}"))
         layout["annotations"].append(
             {
                 "xref": "x",
