@@ -31,7 +31,7 @@ from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
 from .columns import ConceptColumn, NDArray, length_key
-from .context import ARMING_RULES, LogContext, arming_changes, px4_firmware
+from .context import ARMING_RULES, SYSLOG_LEVELS, LogContext, LogText, arming_changes, px4_firmware, px4_modes
 
 
 @dataclass
@@ -111,6 +111,11 @@ def ulog_context(log: UlogColumns, armed: tuple[NDArray, NDArray] | None, utc_of
     changes: tuple[tuple[float, bool], ...] = ()
     if armed is not None:
         changes = arming_changes((armed[0].astype(np.int64) - log.start_us) / 1e6, armed[1])
+    modes, failsafes = px4_modes(log.nav_states(), log.start_us)
+    texts = tuple(
+        LogText((stamp - log.start_us) / 1e6, _syslog(level), text.rstrip("\t\n\x00"))
+        for level, stamp, text in log.logged()
+    )
     return LogContext(
         "ulog",
         log.start_us,
@@ -123,7 +128,16 @@ def ulog_context(log: UlogColumns, armed: tuple[NDArray, NDArray] | None, utc_of
         parameters,
         changes,
         ARMING_RULES["ulog"] if armed is not None else "",
+        texts,
+        modes,
+        failsafes,
     )
+
+
+def _syslog(level: int) -> str:
+    """A ULog text's level byte (an ASCII digit, '0' emergency to '7' debug, as syslog) by name."""
+    index = level - ord("0")
+    return SYSLOG_LEVELS[index] if 0 <= index < len(SYSLOG_LEVELS) else ""
 
 
 def as_of(times: NDArray, values: NDArray, at: NDArray) -> NDArray:

@@ -26,6 +26,12 @@ from .page import FailsafeEvent, Replay
 from .series import InputSeries
 
 NO_PARAMS = "no failsafe parameters: give --params FILE (BATT_* values) to replay the failsafe"
+# A PX4 log: the replay is ArduPilot's failsafe; PX4's own decisions are the log's warning levels, marked instead.
+# Where a PX4 replay (codegen/apps/failsafe/, PX4 semantics) lands, replay() calls it for context.autopilot "px4".
+PX4_NOT_REPLAYED = (
+    "PX4's failsafe is not replayed here: the firmware's own warning levels (battery_status.warning) are marked "
+    "on the plots; give --params FILE with BATT_* values to replay ArduPilot's"
+)
 
 
 def _series_samples(item: InputSeries) -> Iterator[Sample]:
@@ -53,6 +59,8 @@ def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | No
     elif own is not None:
         context = item.samples.context if item.samples is not None else None
         values, where = own, f"the log's {context.parameters_from if context is not None else 'parameters'}"
+    elif item.context is not None and item.context.autopilot == "px4":
+        return Replay(note=PX4_NOT_REPLAYED)
     else:
         return Replay(note=NO_PARAMS)
     try:
