@@ -63,7 +63,9 @@ def test_a_held_file_makes_its_writer_wait_and_the_reader_stop(log_copy: Path) -
     assert log_copy.stat().st_size == 64 < size
 
 
-def test_a_log_truncated_during_export_fails_alone(log_copy: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_log_truncated_during_export_fails_alone(
+    log_copy: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The export of a log rewritten while it is read: that log reported, nothing of it in the dataset,
     the other log of the run exported (no SIGBUS, no traceback)."""
     if not _leases_work(log_copy):
