@@ -85,6 +85,7 @@ def main() -> None:
     parser.add_argument("--short", type=int, default=100_000)
     parser.add_argument("--long", type=int, default=1_000_000)
     parser.add_argument("--can-long", type=int, default=1_000_000)
+    parser.add_argument("--kinds", default="tlog,jsonl,can", help="comma-separated: tlog, jsonl, can")
     args = parser.parse_args()
     makers = {
         "tlog": (tlog, ".tlog", args.long),
@@ -94,6 +95,8 @@ def main() -> None:
     print(f"{'kind':6s} {'records':>10s} {'peak MB':>9s} {'seconds':>8s}  exit")
     with tempfile.TemporaryDirectory() as folder:
         for kind, (make, suffix, long) in makers.items():
+            if kind not in args.kinds.split(","):
+                continue
             peaks = []
             for n in (args.short, long):
                 path = make(Path(folder) / f"{kind}-{n}{suffix}", n)
