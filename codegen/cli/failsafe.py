@@ -1,4 +1,17 @@
-"""``battgen failsafe [--params FILE] [--vehicle NAME] STREAM``: replay batteries through ArduPilot's failsafe.
+"""``battgen failsafe [--firmware px4|ardupilot] [--params FILE] [--vehicle NAME] STREAM``: replay batteries through
+an autopilot's battery failsafe, PX4's or ArduPilot's.
+
+The firmware is ``--firmware``; else that of the given parameters (ArduPilot's BATT*_ or PX4's BAT_*/COM_*); else
+the log's own (its context: a ULog is PX4's, a DataFlash log ArduPilot's, a tlog's heartbeats name it); a JSON Lines
+stream is replayed through ArduPilot's. Both print their events in one format.
+
+PX4 (a ULog): each battery's logged state of charge through PX4's warning levels (BAT_LOW_THR, BAT_CRIT_THR,
+BAT_EMERGEN_THR), commander's failsafe warning and its action (COM_LOW_BAT_ACT, COM_FAIL_ACT_T), with the log's own
+parameters (``--params`` on top), and the replay checked against what the firmware logged (battery_status.warning,
+failsafe_flags.battery_warning, vehicle_status.nav_state): one ``check`` line each on stderr, ``--strict`` makes a
+check that fails exit 3.
+
+ArduPilot:
 
 STREAM is a flight log or capture, or a JSON Lines file of samples, told apart by content (then extension).
 A log (PX4 ULog, MAVLink tlog, ArduPilot DataFlash binary or text, CAN capture) is read through the battery
@@ -24,7 +37,8 @@ parameters only one vehicle has, else rover is assumed (said on stderr either wa
 Semantics are ArduPilot's AP_BattMonitor (see the README's failsafe section); ``--variant
 seed-critical`` and ``--variant distance`` turn on the seed's own choices. Prints one line per
 transition (``--json``: one JSON object per line). Exit 0; 1 when the parameters hold no BATT*_
-one (``--allow-empty`` accepts that); 2 when an input cannot be read or holds no battery reading.
+one (``--allow-empty`` accepts that); 2 when an input cannot be read or holds no battery reading; 3 with
+``--strict`` when a PX4 replay does not reproduce what the log recorded.
 """
 
 from __future__ import annotations
@@ -41,6 +55,8 @@ from ..apps.failsafe.distance import DistanceRule
 from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
 from ..apps.failsafe.levels import apply_level
 from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_samples, own_parameters
+from ..apps.failsafe.px4_log import read_px4_log
+from ..apps.failsafe.px4_replay import Check, Px4Event, replay_px4
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
@@ -49,18 +65,21 @@ from ..inputs import parameter_files
 from ..inputs.kinds import FLIGHT_LOG_KINDS, detect
 from ..text.escape import line
 
-EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE = 0, 1, 2
+EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE, EXIT_DIFFERS = 0, 1, 2, 3
+FIRMWARES = ("px4", "ardupilot")
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "failsafe",
-        help="replay a flight log (.ulg, .tlog, .bin) or JSON Lines samples through ArduPilot's battery failsafe",
+        help="replay a flight log (.ulg, .tlog, .bin) or JSON Lines samples through PX4's or ArduPilot's failsafe",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("stream", help=".ulg, .tlog, .bin or a JSON Lines file of battery samples")
-    p.add_argument("--params", help="parameter file with the BATT*_ parameters (else an ArduPilot log's own)")
+    p.add_argument("--firmware", choices=FIRMWARES, help="whose failsafe (default: the parameters', else the log's)")
+    p.add_argument("--params", help="parameter file (ArduPilot BATT*_ or PX4 BAT_*/COM_*; else the log's own)")
+    p.add_argument("--strict", action="store_true", help="PX4: exit 3 when the replay differs from the log")
     p.add_argument("--vehicle", choices=sorted(VEHICLES), help="ArduPilot vehicle (default: detected, else rover)")
     p.add_argument("--variant", action="append", choices=sorted(VARIANTS), default=[], help="a seed variant (opt-in)")
     p.add_argument(
@@ -81,6 +100,13 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     stream = Path(args.stream)
+    try:
+        firmware, how = _firmware(args, stream)
+    except (BattgenError, ValueError) as exc:
+        print(line(f"battgen: {exc}"), file=sys.stderr)
+        return EXIT_UNREADABLE
+    if firmware == "px4":
+        return _run_px4(args, stream, how)
     try:
         # a flight log or capture is read through the battery view; JSON and JSON Lines are sample streams
         table: SampleTable | None = log_samples(stream, args.stream) if detect(stream) in FLIGHT_LOG_KINDS else None
@@ -148,6 +174,90 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _firmware(args: argparse.Namespace, stream: Path) -> tuple[str, str]:
+    """Whose failsafe replays the stream, and the words saying why."""
+    if args.firmware:
+        return args.firmware, "given"
+    if args.params:
+        values = read_parameter_values(Path(args.params))
+        names = set(values)
+        if batt_parameter_count(values):
+            return "ardupilot", f"{args.params} holds ArduPilot's BATT*_ parameters"
+        if any(n.startswith(("BAT_", "BAT1_", "COM_LOW_BAT", "COM_FAIL_ACT")) for n in names):
+            return "px4", f"{args.params} holds PX4's BAT_/COM_ parameters"
+    if detect(stream) == "ulog":
+        return "px4", "the log is a PX4 ULog"
+    return "ardupilot", "the log's"
+
+
+def _run_px4(args: argparse.Namespace, stream: Path, how: str) -> int:
+    try:
+        if detect(stream) != "ulog":
+            raise BattgenError(
+                f"{args.stream}: expected a PX4 ULog (.ulg): PX4's replay starts from the battery_status the firmware "
+                "logged"
+            )
+        given = read_parameter_values(Path(args.params)) if args.params else {}
+        log = read_px4_log(stream, args.stream)
+        replay = replay_px4(log, given)
+        if replay.samples == 0:
+            raise BattgenError(f"{args.stream}: expected battery_status records, found none")
+    except (BattgenError, ValueError) as exc:
+        print(line(f"battgen: {exc}"), file=sys.stderr)
+        return EXIT_UNREADABLE
+    where = f"{args.params} over the log's PARAM definitions" if args.params else f"{args.stream} (PARAM definitions)"
+    thr, st = replay.thresholds, replay.settings
+    print(line(f"battgen: firmware px4 ({how}; {log.context.firmware or 'release unknown'}); parameters from {where}: "
+               f"BAT_LOW_THR {thr.low:g} BAT_CRIT_THR {thr.critical:g} BAT_EMERGEN_THR {thr.emergency:g} "
+               f"COM_LOW_BAT_ACT {st.low_bat_act} COM_FAIL_ACT_T {st.fail_act_t:g}"), file=sys.stderr)  # fmt: skip
+    if args.vehicle or args.variant:
+        print("battgen: warning: --vehicle and --variant are ArduPilot's: not used for PX4", file=sys.stderr)
+    for event in replay.events:
+        print(_px4_json(event) if args.json else line(_px4_line(event)))
+    for check in replay.checks:
+        print(line(f"battgen: check {check.what}: {_verdict(check)}"), file=sys.stderr)
+    level = max((e.level for e in replay.events), default=None)
+    print(line(f"{replay.samples} samples, {len(replay.events)} events, final level {level.name if level else 'NONE'}"),
+          file=sys.stderr)  # fmt: skip
+    return EXIT_DIFFERS if args.strict and any(c.problems for c in replay.checks) else EXIT_OK
+
+
+def _verdict(check: Check) -> str:
+    if check.undecided:
+        return f"undecided: {check.undecided}"
+    if check.problems:
+        return "DIFFERS: " + "; ".join(check.problems)
+    return f"reproduced ({len(check.logged)} logged changes)"
+
+
+def _px4_line(e: Px4Event) -> str:
+    return (
+        f"t={e.time:10.3f}s  battery {e.battery} {e.level.name:<8} {'charge':<8} value={e.value:.3f} "
+        f"threshold={e.threshold:.3f} action={e.action_name} ({e.action_code}) -> {e.outcome}  "
+        f'"{e.text}"  uorb.warning={int(e.level)}  ({e.place})'
+    )
+
+
+def _px4_json(e: Px4Event) -> str:
+    out: dict[str, Any] = {
+        "t": e.time,
+        "battery": e.battery,
+        "level": e.level.name,
+        "cause": "charge",
+        "value": e.value if e.value == e.value else None,
+        "threshold": e.threshold,
+        "action": e.action_name,
+        "action_code": e.action_code,
+        "executed": True,
+        "outcome": e.outcome,
+        "firmware": "px4",
+        "firmware_text": e.text,
+        "uorb_warning": int(e.level),
+        "where": e.place,
+    }
+    return json.dumps(out, allow_nan=False)
+
+
 def _why_no_parameters(table: SampleTable | None) -> str:
     """Why a stream brings no ArduPilot parameters of its own."""
     context = table.context if table is not None else None
@@ -194,6 +304,8 @@ def _json(e: Event, s: Sample, vehicle: str) -> str:
         "uorb_warning": e.uorb_warning,
         "mavlink_charge_state": e.mavlink_charge_state,
         "where": s.place,
+        "firmware": "ardupilot",
+        "firmware_text": e.ardupilot_text,
     }
     if s.message is not None and s.data is not None:
         out["message"] = s.message

@@ -1,0 +1,251 @@
+"""A PX4 log replayed through PX4's battery failsafe (:mod:`.px4_levels`, :mod:`.px4_actions`), and the replay
+checked against what the firmware logged.
+
+The replay starts from each battery's logged state of charge (``battery_status.remaining``: the firmware's own
+estimate, which its warning was computed from; re-estimating it from voltage and current is another model) and the
+log's own parameters (``BAT_LOW_THR`` .. ``COM_FAIL_ACT_T``, any given ones on top; absent ones at PX4's defaults):
+
+1. each battery's warning per update (``Battery::updateBatteryStatus``);
+2. commander's failsafe warning at each battery update (``BatteryChecks::checkAndReport``), with the arming state of
+   the battery view;
+3. an event where that warning rises while armed, or is above NONE when the vehicle arms, with commander's action
+   (``Failsafe::checkStateAndMode``).
+
+The checks compare each with the log: the battery's logged ``warning`` (same level, same sample or the next), the
+logged ``failsafe_flags.battery_warning`` (same level, within one sample of either topic: commander logs at its own
+rate) and, for a mode action, ``vehicle_status.nav_state`` reaching the action's mode (after the Hold of
+``COM_FAIL_ACT_T``). Where the log does not record what a check needs, the check says so instead of passing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..battery.columns import NDArray
+from ..battery.sources import as_of
+from .px4_actions import LOW_BAT_ACTIONS, NAV_STATES, TEXTS, Action, Px4Settings, acting_parameter, battery_action
+from .px4_levels import Px4Level, Thresholds, battery_warnings, commander_warning, latches, release_of
+from .px4_log import Px4Log
+
+FRAMEWORK_FROM = (1, 14)  # failsafe_flags and the failsafe framework (src/modules/commander/failsafe/)
+
+
+@dataclass(frozen=True)
+class Px4Event:
+    """A rise of commander's battery warning while armed, and what commander does about it."""
+
+    time: float
+    battery: int  # the battery whose warning is the worst (1-based)
+    level: Px4Level
+    value: float  # that battery's state of charge
+    threshold: float  # the threshold it is below
+    action_code: int  # the COM_LOW_BAT_ACT in effect (0 where the at-arming rule makes it a warning)
+    action: Action
+    delay_s: float  # the Hold before a mode action (COM_FAIL_ACT_T)
+    text: str  # the operator's notification (framework.cpp notifyUser)
+    place: str
+
+    @property
+    def action_name(self) -> str:
+        return LOW_BAT_ACTIONS.get(self.action_code, f"unknown ({self.action_code})")
+
+    @property
+    def outcome(self) -> str:
+        name = self.action.name.lower()
+        if self.action in (Action.RTL, Action.LAND) and self.delay_s > 0:
+            return f"hold {self.delay_s:g}s, then {name}"
+        return name
+
+
+@dataclass(frozen=True)
+class Change:
+    """A level (or mode) taken at time ``t`` (the first sample's value counts as a change from NONE)."""
+
+    t: float
+    value: int
+
+
+@dataclass
+class Check:
+    """One comparison of the replay with the log."""
+
+    what: str
+    logged: list[Change]
+    replayed: list[Change]
+    problems: list[str] = field(default_factory=list)
+    undecided: str = ""  # why the log cannot decide (then nothing was compared)
+
+    @property
+    def ok(self) -> bool:
+        return not self.undecided and not self.problems
+
+
+@dataclass
+class Px4Replay:
+    release: tuple[int, int, int] | None
+    thresholds: Thresholds
+    settings: Px4Settings
+    events: list[Px4Event]
+    checks: list[Check]
+    samples: int
+
+
+def changes(t: NDArray, values: NDArray, *, skip: int | None = None) -> list[Change]:
+    """The changes of a column (a first value other than 0 counts as one); ``skip``: a value that is unknown."""
+    out: list[Change] = []
+    last = 0
+    for tk, vk in zip(t.tolist(), values.tolist(), strict=True):
+        if skip is not None and vk == skip:
+            continue
+        if vk != last:
+            out.append(Change(tk, int(vk)))
+            last = vk
+    return out
+
+
+def replay_px4(log: Px4Log, given: Mapping[str, float] | None = None) -> Px4Replay:
+    """Replay a log (:func:`.px4_log.read_px4_log`) with its parameters, ``given`` ones on top (a ValueError names a
+    parameter that is no number)."""
+    values = {**log.context.parameters, **(given or {})}
+    thresholds, settings = Thresholds.from_values(values), Px4Settings.from_values(values)
+    release = release_of(log.context.firmware)
+    per_battery: list[tuple[NDArray, NDArray, NDArray]] = []
+    checks: list[Check] = []
+    for b in log.batteries:
+        warnings = battery_warnings(b.boot_s, b.remaining, b.connected, thresholds, latched=latches(release))
+        per_battery.append((b.t, warnings, b.connected))
+        checks.append(_battery_check(b.battery, b.t, b.warning, warnings))
+    t = np.unique(np.concatenate([b.t for b in log.batteries])) if log.batteries else np.zeros(0)
+    armed = _armed_at(log, t)
+    flag = commander_warning(per_battery, t, armed)
+    events = _events(log, t, armed, flag, per_battery, thresholds, settings, release)
+    checks.append(_commander_check(log, t, flag, release))
+    checks.extend(_action_checks(log, events))
+    return Px4Replay(release, thresholds, settings, events, checks, sum(len(b.t) for b in log.batteries))
+
+
+def _armed_at(log: Px4Log, t: NDArray) -> NDArray:
+    arming = log.context.arming
+    if not arming:
+        return np.zeros(len(t), bool)
+    times = np.array([a[0] for a in arming], np.float64)
+    states = np.array([1.0 if a[1] else 0.0 for a in arming])
+    return np.asarray(np.nan_to_num(as_of(times, states, t)) == 1.0)
+
+
+def _events(
+    log: Px4Log,
+    t: NDArray,
+    armed: NDArray,
+    flag: NDArray,
+    per_battery: list[tuple[NDArray, NDArray, NDArray]],
+    thresholds: Thresholds,
+    settings: Px4Settings,
+    release: tuple[int, int, int] | None,
+) -> list[Px4Event]:
+    out: list[Px4Event] = []
+    previous, was_armed, at_arming = 0, False, Px4Level.NONE
+    for tk, ak, fk in zip(t.tolist(), armed.tolist(), flag.tolist(), strict=True):
+        level = Px4Level(fk)
+        if ak and not was_armed:
+            at_arming = level  # Failsafe::updateArmingState
+        if ak and level > Px4Level.NONE and (level > previous or not was_armed):
+            code = acting_parameter(settings.low_bat_act, level, at_arming, release)
+            action = battery_action(code, level)
+            battery, value, row = _worst(log, per_battery, tk, level)
+            out.append(
+                Px4Event(
+                    tk,
+                    battery,
+                    level,
+                    value,
+                    thresholds.threshold(level),
+                    code,
+                    action,
+                    settings.delay_s if action in (Action.RTL, Action.LAND) else 0.0,
+                    TEXTS[level],
+                    f"battery_status record {row} of battery {battery}",
+                )
+            )
+        previous, was_armed = fk, ak
+    return out
+
+
+def _worst(
+    log: Px4Log, per_battery: list[tuple[NDArray, NDArray, NDArray]], t: float, level: Px4Level
+) -> tuple[int, float, int]:
+    """The battery at ``level`` as of ``t``, its state of charge and the index of its record."""
+    for b, (times, warnings, _) in zip(log.batteries, per_battery, strict=True):
+        k = int(np.searchsorted(times, t, side="right")) - 1
+        if k >= 0 and warnings[k] == level:
+            return b.battery, float(b.remaining[k]), k
+    return log.batteries[0].battery, float("nan"), -1
+
+
+def _within_one_sample(logged: list[Change], replayed: list[Change], times: list[NDArray]) -> list[str]:
+    """Problems: the levels differ, or a replayed change is further from its logged one than one sample of any of
+    ``times`` (the intervals around the logged change)."""
+    if [c.value for c in logged] != [c.value for c in replayed]:
+        return [f"levels {[c.value for c in logged]} logged, {[c.value for c in replayed]} replayed"]
+    problems = []
+    for got, want in zip(replayed, logged, strict=True):
+        slack = max(_interval(ts, want.t) for ts in times)
+        if abs(got.t - want.t) > slack + 1e-6:
+            problems.append(f"level {want.value} at {got.t:.3f}s, logged at {want.t:.3f}s (one sample: {slack:.3f}s)")
+    return problems
+
+
+def _interval(times: NDArray, t: float) -> float:
+    """The larger of the sample intervals around ``t`` in ``times``."""
+    k = int(np.searchsorted(times, t))
+    gaps = [times[i] - times[i - 1] for i in (k, k + 1) if 0 < i < len(times)]
+    return float(max(gaps, default=0.0))
+
+
+def _battery_check(battery: int, t: NDArray, logged: NDArray, replayed: NDArray) -> Check:
+    what = f"battery {battery} battery_status.warning"
+    want, got = changes(t, logged, skip=-1), changes(t, replayed)
+    check = Check(what, want, got)
+    if (logged < 0).all():
+        check.undecided = "the log's battery_status has no warning"
+    else:
+        check.problems = _within_one_sample(want, got, [t])
+    return check
+
+
+def _commander_check(log: Px4Log, t: NDArray, flag: NDArray, release: tuple[int, int, int] | None) -> Check:
+    got = changes(t, flag)
+    topic = log.failsafe_warning
+    if topic is None:
+        check = Check("failsafe_flags.battery_warning", [], got)
+        era = "before v1.14" if release is not None and release[:2] < FRAMEWORK_FROM else "not in this log"
+        check.undecided = f"the log does not record failsafe_flags ({era})"
+        return check
+    want = changes(topic.t, topic.values)
+    check = Check("failsafe_flags.battery_warning", want, got)
+    check.problems = _within_one_sample(want, got, [topic.t, t])
+    return check
+
+
+def _action_checks(log: Px4Log, events: list[Px4Event]) -> list[Check]:
+    out = []
+    for e in events:
+        what = f"t={e.time:.3f}s {e.level.name} action {e.outcome}"
+        mode = NAV_STATES.get(e.action)
+        if mode is None:
+            continue  # a warning changes no mode
+        check = Check(what, [], [Change(e.time + e.delay_s, mode)])
+        if log.nav_state is None:
+            check.undecided = "the log has no vehicle_status.nav_state"
+        else:
+            nav = log.nav_state
+            slack = _interval(nav.t, e.time) + 1.0
+            window = (nav.t >= e.time - slack) & (nav.t <= e.time + e.delay_s + slack)
+            check.logged = [Change(float(tk), int(v)) for tk, v in zip(nav.t[window], nav.values[window], strict=True)]
+            if mode not in nav.values[window].tolist():
+                check.problems.append(f"vehicle_status.nav_state never {mode} within {e.delay_s + slack:.1f}s")
+        out.append(check)
+    return out
