@@ -46,17 +46,18 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
 from ..apps.failsafe.columnar import replay_table
 from ..apps.failsafe.distance import DistanceRule
 from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
+from ..apps.failsafe.legacy_parameters import renamed, with_current_names
 from ..apps.failsafe.levels import apply_level
 from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_samples, own_parameters
 from ..apps.failsafe.px4_log import read_px4_log
-from ..apps.failsafe.px4_replay import Check, Px4Event, replay_px4
+from ..apps.failsafe.px4_replay import Px4Event, replay_px4
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
@@ -111,16 +112,20 @@ def run(args: argparse.Namespace) -> int:
         # a flight log or capture is read through the battery view; JSON and JSON Lines are sample streams
         table: SampleTable | None = log_samples(stream, args.stream) if detect(stream) in FLIGHT_LOG_KINDS else None
         own = own_parameters(table) if table is not None and not args.params else None
+        raw: Mapping[str, float] = {}
         if args.params:
-            values: dict[str, float] = read_parameter_values(Path(args.params))
+            raw = read_parameter_values(Path(args.params))
+            values: dict[str, float] = with_current_names(raw)
             where = args.params
             for repeat in parameter_files.repeats(parameter_files.load(Path(args.params))):
                 print(line(f"battgen: warning: {args.params}:{repeat.lines[-1]}: {repeat.message()}"), file=sys.stderr)
-        elif own is not None:
-            source = table.context.parameters_from if table is not None and table.context is not None else ""
-            values, where = own, f"{args.stream} ({source})"
+        elif own is not None and table is not None and table.context is not None:
+            raw = table.context.parameters
+            values, where = own, f"{args.stream} ({table.context.parameters_from})"
         else:
             raise BattgenError(f"expected --params FILE: {_why_no_parameters(table)}")
+        for old in renamed(raw):  # an older firmware's names, replayed under today's
+            print(line(f"battgen: warning: {where}: {old.message()}"), file=sys.stderr)
         if args.params and not batt_parameter_count(values) and not args.allow_empty:
             print(
                 line(
@@ -215,19 +220,11 @@ def _run_px4(args: argparse.Namespace, stream: Path, how: str) -> int:
     for event in replay.events:
         print(_px4_json(event) if args.json else line(_px4_line(event)))
     for check in replay.checks:
-        print(line(f"battgen: check {check.what}: {_verdict(check)}"), file=sys.stderr)
+        print(line(f"battgen: check {check.what}: {check.verdict()}"), file=sys.stderr)
     level = max((e.level for e in replay.events), default=None)
     print(line(f"{replay.samples} samples, {len(replay.events)} events, final level {level.name if level else 'NONE'}"),
           file=sys.stderr)  # fmt: skip
     return EXIT_DIFFERS if args.strict and any(c.problems for c in replay.checks) else EXIT_OK
-
-
-def _verdict(check: Check) -> str:
-    if check.undecided:
-        return f"undecided: {check.undecided}"
-    if check.problems:
-        return "DIFFERS: " + "; ".join(check.problems)
-    return f"reproduced ({len(check.logged)} logged changes)"
 
 
 def _px4_line(e: Px4Event) -> str:

@@ -15,7 +15,8 @@ import pytest
 from shared_data import SHARED
 
 from codegen.apps.failsafe.px4_log import read_px4_log
-from codegen.apps.failsafe.px4_replay import changes, replay_px4
+from codegen.apps.failsafe.px4_replay import replay_px4
+from codegen.apps.failsafe.replay_checks import changes
 
 BATTERY_WARNINGS_61 = [
     (23.775, 1), (25.375, 2), (26.376, 1), (27.575, 0), (27.775, 1), (28.175, 0), (32.975, 1), (33.576, 0),

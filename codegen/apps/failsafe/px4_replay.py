@@ -20,7 +20,7 @@ rate) and, for a mode action, ``vehicle_status.nav_state`` reaching the action's
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -29,6 +29,7 @@ from ..battery.sources import as_of
 from .px4_actions import LOW_BAT_ACTIONS, NAV_STATES, TEXTS, Action, Px4Settings, acting_parameter, battery_action
 from .px4_levels import Px4Level, Thresholds, battery_warnings, commander_warning, latches, release_of
 from .px4_log import Px4Log
+from .replay_checks import Change, Check, changes, interval, within_one_sample
 
 FRAMEWORK_FROM = (1, 14)  # failsafe_flags and the failsafe framework (src/modules/commander/failsafe/)
 
@@ -60,29 +61,6 @@ class Px4Event:
         return name
 
 
-@dataclass(frozen=True)
-class Change:
-    """A level (or mode) taken at time ``t`` (the first sample's value counts as a change from NONE)."""
-
-    t: float
-    value: int
-
-
-@dataclass
-class Check:
-    """One comparison of the replay with the log."""
-
-    what: str
-    logged: list[Change]
-    replayed: list[Change]
-    problems: list[str] = field(default_factory=list)
-    undecided: str = ""  # why the log cannot decide (then nothing was compared)
-
-    @property
-    def ok(self) -> bool:
-        return not self.undecided and not self.problems
-
-
 @dataclass
 class Px4Replay:
     release: tuple[int, int, int] | None
@@ -91,19 +69,6 @@ class Px4Replay:
     events: list[Px4Event]
     checks: list[Check]
     samples: int
-
-
-def changes(t: NDArray, values: NDArray, *, skip: int | None = None) -> list[Change]:
-    """The changes of a column (a first value other than 0 counts as one); ``skip``: a value that is unknown."""
-    out: list[Change] = []
-    last = 0
-    for tk, vk in zip(t.tolist(), values.tolist(), strict=True):
-        if skip is not None and vk == skip:
-            continue
-        if vk != last:
-            out.append(Change(tk, int(vk)))
-            last = vk
-    return out
 
 
 def replay_px4(log: Px4Log, given: Mapping[str, float] | None = None) -> Px4Replay:
@@ -185,26 +150,6 @@ def _worst(
     return log.batteries[0].battery, float("nan"), -1
 
 
-def _within_one_sample(logged: list[Change], replayed: list[Change], times: list[NDArray]) -> list[str]:
-    """Problems: the levels differ, or a replayed change is further from its logged one than one sample of any of
-    ``times`` (the intervals around the logged change)."""
-    if [c.value for c in logged] != [c.value for c in replayed]:
-        return [f"levels {[c.value for c in logged]} logged, {[c.value for c in replayed]} replayed"]
-    problems = []
-    for got, want in zip(replayed, logged, strict=True):
-        slack = max(_interval(ts, want.t) for ts in times)
-        if abs(got.t - want.t) > slack + 1e-6:
-            problems.append(f"level {want.value} at {got.t:.3f}s, logged at {want.t:.3f}s (one sample: {slack:.3f}s)")
-    return problems
-
-
-def _interval(times: NDArray, t: float) -> float:
-    """The larger of the sample intervals around ``t`` in ``times``."""
-    k = int(np.searchsorted(times, t))
-    gaps = [times[i] - times[i - 1] for i in (k, k + 1) if 0 < i < len(times)]
-    return float(max(gaps, default=0.0))
-
-
 def _battery_check(battery: int, t: NDArray, logged: NDArray, replayed: NDArray) -> Check:
     what = f"battery {battery} battery_status.warning"
     want, got = changes(t, logged, skip=-1), changes(t, replayed)
@@ -212,7 +157,7 @@ def _battery_check(battery: int, t: NDArray, logged: NDArray, replayed: NDArray)
     if (logged < 0).all():
         check.undecided = "the log's battery_status has no warning"
     else:
-        check.problems = _within_one_sample(want, got, [t])
+        check.problems = within_one_sample(want, got, [t])
     return check
 
 
@@ -226,7 +171,7 @@ def _commander_check(log: Px4Log, t: NDArray, flag: NDArray, release: tuple[int,
         return check
     want = changes(topic.t, topic.values)
     check = Check("failsafe_flags.battery_warning", want, got)
-    check.problems = _within_one_sample(want, got, [topic.t, t])
+    check.problems = within_one_sample(want, got, [topic.t, t])
     return check
 
 
@@ -242,7 +187,7 @@ def _action_checks(log: Px4Log, events: list[Px4Event]) -> list[Check]:
             check.undecided = "the log has no vehicle_status.nav_state"
         else:
             nav = log.nav_state
-            slack = _interval(nav.t, e.time) + 1.0
+            slack = interval(nav.t, e.time) + 1.0
             window = (nav.t >= e.time - slack) & (nav.t <= e.time + e.delay_s + slack)
             check.logged = [Change(float(tk), int(v)) for tk, v in zip(nav.t[window], nav.values[window], strict=True)]
             if mode not in nav.values[window].tolist():
