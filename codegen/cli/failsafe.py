@@ -9,7 +9,8 @@ PX4 (a ULog): each battery's logged state of charge through PX4's warning levels
 BAT_EMERGEN_THR), commander's failsafe warning and its action (COM_LOW_BAT_ACT, COM_FAIL_ACT_T), with the log's own
 parameters (``--params`` on top), and the replay checked against what the firmware logged (battery_status.warning,
 failsafe_flags.battery_warning, vehicle_status.nav_state): one ``check`` line each on stderr, ``--strict`` makes a
-check that fails exit 3.
+check that fails exit 3. An ArduPilot DataFlash log is checked the same way against its ERR (subsystem 6) and MODE
+(reason 4) records.
 
 ArduPilot:
 
@@ -38,7 +39,7 @@ Semantics are ArduPilot's AP_BattMonitor (see the README's failsafe section); ``
 seed-critical`` and ``--variant distance`` turn on the seed's own choices. Prints one line per
 transition (``--json``: one JSON object per line). Exit 0; 1 when the parameters hold no BATT*_
 one (``--allow-empty`` accepts that); 2 when an input cannot be read or holds no battery reading; 3 with
-``--strict`` when a PX4 replay does not reproduce what the log recorded.
+``--strict`` when a replay does not reproduce what the log recorded.
 """
 
 from __future__ import annotations
@@ -50,6 +51,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from ..apps.failsafe.ardupilot_logged import ardupilot_checks, logged_failsafes
 from ..apps.failsafe.columnar import replay_table
 from ..apps.failsafe.distance import DistanceRule
 from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
@@ -58,6 +60,7 @@ from ..apps.failsafe.levels import apply_level
 from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_samples, own_parameters
 from ..apps.failsafe.px4_log import read_px4_log
 from ..apps.failsafe.px4_replay import Px4Event, replay_px4
+from ..apps.failsafe.replay_checks import Change, Check
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
@@ -80,7 +83,7 @@ def register(subparsers: Any) -> None:
     p.add_argument("stream", help=".ulg, .tlog, .bin or a JSON Lines file of battery samples")
     p.add_argument("--firmware", choices=FIRMWARES, help="whose failsafe (default: the parameters', else the log's)")
     p.add_argument("--params", help="parameter file (ArduPilot BATT*_ or PX4 BAT_*/COM_*; else the log's own)")
-    p.add_argument("--strict", action="store_true", help="PX4: exit 3 when the replay differs from the log")
+    p.add_argument("--strict", action="store_true", help="exit 3 when the replay differs from what the log recorded")
     p.add_argument("--vehicle", choices=sorted(VEHICLES), help="ArduPilot vehicle (default: detected, else rover)")
     p.add_argument("--variant", action="append", choices=sorted(VARIANTS), default=[], help="a seed variant (opt-in)")
     p.add_argument(
@@ -172,11 +175,28 @@ def run(args: argparse.Namespace) -> int:
         read = replay.samples if table is None else read
         if read == 0:
             raise BattgenError(f"{args.stream}: expected battery readings, found none")
+        checks = _ardupilot_checks(stream, args.stream, table, fs.events)
+        for check in checks:
+            print(line(f"battgen: check {check.what}: {check.verdict()}"), file=sys.stderr)
     except (BattgenError, ValueError) as exc:
         print(line(f"battgen: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     print(line(f"{read} samples, {len(fs.events)} events, final level {fs.level.name}"), file=sys.stderr)
-    return EXIT_OK
+    return EXIT_DIFFERS if args.strict and any(c.problems for c in checks) else EXIT_OK
+
+
+def _ardupilot_checks(stream: Path, name: str, table: SampleTable | None, events: list[Event]) -> list[Check]:
+    """A DataFlash log's own failsafe records against the replay (other inputs record none the replay reads)."""
+    context = table.context if table is not None else None
+    if table is None or context is None or context.kind not in ("dataflash", "tlog"):
+        return []
+    if context.kind == "tlog":
+        replayed = [Change(e.time, 1) for e in events]
+        why = "a tlog records the failsafe as STATUSTEXT, which battgen does not read (no bundled STATUSTEXT schema)"
+        return [Check("STATUSTEXT of the battery failsafe", [], replayed, undecided=why)]
+    t, _, _, _, _, armed, _ = table.sorted_columns()
+    logged = logged_failsafes(stream, name, context.start_us or 0)
+    return ardupilot_checks(logged, events, t, armed == 1.0)
 
 
 def _firmware(args: argparse.Namespace, stream: Path) -> tuple[str, str]:
