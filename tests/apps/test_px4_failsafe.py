@@ -47,8 +47,8 @@ def test_levels_are_battery_status_warning() -> None:
 
 
 def test_defaults() -> None:
-    """src/lib/battery/module.yaml BAT_LOW_THR 0.15, BAT_CRIT_THR 0.07, BAT_EMERGEN_THR 0.05; commander_params.c
-    COM_LOW_BAT_ACT 0, COM_FLTT_LOW_ACT 3, COM_FAIL_ACT_T 5.0."""
+    """src/lib/battery/battery_params_common.c BAT_LOW_THR 0.15, BAT_CRIT_THR 0.07, BAT_EMERGEN_THR 0.05;
+    commander_params.c COM_LOW_BAT_ACT 0, COM_FLTT_LOW_ACT 3, COM_FAIL_ACT_T 5.0."""
     assert Thresholds.from_values({}) == Thresholds(0.15, 0.07, 0.05)
     assert Px4Settings.from_values({}) == Px4Settings(0, 3, 5.0)
     with pytest.raises(ValueError, match="COM_LOW_BAT_ACT: expected an integer"):

@@ -13,8 +13,8 @@ From PX4-Autopilot's source (each rule pinned in ``tests/apps/test_px4_failsafe.
   failsafe's warning (``failsafe_flags.battery_warning``) is the worst warning of the connected batteries; while
   armed it only rises ("if armed, only allow increase of battery warning severity"), while disarmed it follows.
 
-Parameter defaults (``src/lib/battery/module.yaml``, unchanged since the thresholds became fractions):
-``BAT_LOW_THR`` 0.15, ``BAT_CRIT_THR`` 0.07, ``BAT_EMERGEN_THR`` 0.05.
+Parameter defaults (``src/lib/battery/battery_params_common.c``, later ``module.yaml``; the same in the releases the
+corpus's logs name): ``BAT_LOW_THR`` 0.15, ``BAT_CRIT_THR`` 0.07, ``BAT_EMERGEN_THR`` 0.05.
 """
 
 from __future__ import annotations
