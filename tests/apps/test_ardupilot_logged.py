@@ -5,12 +5,11 @@ firmware's disarmed check (the ArduCopter 3.4 tlog) said, not guessed."""
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
 import pytest
-from shared_data import SHARED
+from shared_data import require, shared
 
 from codegen.apps.failsafe.ardupilot_logged import logged_failsafes
 from codegen.apps.failsafe.legacy_parameters import renamed, with_current_names
@@ -89,20 +88,11 @@ AP_LOGS = {  # every real ArduPilot DataFlash log of ../shared: the failsafe rec
 }
 
 
-def _shared(name: str) -> Path:
-    path = SHARED / name
-    if not path.is_file():
-        if os.environ.get("CI"):
-            pytest.fail(f"missing {path}")
-        pytest.skip(f"missing {path}")
-    return path
-
-
 @pytest.mark.parametrize("name", sorted(AP_LOGS))
 def test_real_logs_replay_what_they_logged(name: str, capsys: pytest.CaptureFixture[str]) -> None:
     from pymavlink import mavutil
 
-    path = _shared(name)
+    path = require(shared(name))
     reference = mavutil.mavlink_connection(str(path))
     theirs = []
     while (msg := reference.recv_match(type=["ERR", "MODE", "MSG"])) is not None:
@@ -128,7 +118,7 @@ def test_older_names_are_mapped_with_a_warning(capsys: pytest.CaptureFixture[str
         "ARMING_MIN_VOLT = 14.8 is the older name of BATT_ARM_VOLT: replayed as BATT_ARM_VOLT = 14.8",
     ]
     assert with_current_names({"FS_BATT_ENABLE": 2.0}) == {"FS_BATT_ENABLE": 2.0, "BATT_FS_LOW_ACT": 2.0}
-    path = _shared("corpus/realworld3/dataflash/dronekit_log171.bin")  # ArduCopter 3.3
+    path = require(shared("corpus/realworld3/dataflash/dronekit_log171.bin"))  # ArduCopter 3.3
     code, _, err = run(capsys, str(path))
     assert code == 0
     assert "(PARM records): FS_BATT_VOLTAGE = 14 is the older name of BATT_LOW_VOLT: replayed as BATT_LOW_VOLT" in err
@@ -139,7 +129,7 @@ def test_the_34_tlog_warned_disarmed_which_the_replay_says(tmp_path: Path, capsy
     # today's AP_BattMonitor checks only while armed, so the replay has no event, and it says it cannot compare
     from pymavlink import mavutil
 
-    source = _shared("corpus/realworld3b/tlog/dronekit-la_fs-batt.log")
+    source = require(shared("corpus/realworld3b/tlog/dronekit-la_fs-batt.log"))
     log = tmp_path / "fs-batt.tlog"
     log.write_bytes(source.read_bytes())
     reference = mavutil.mavlink_connection(str(log))

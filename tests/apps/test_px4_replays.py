@@ -7,12 +7,9 @@ failsafe_flags.battery_warning (None: the log does not record the topic), as (se
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 import numpy as np
 import pytest
-from shared_data import SHARED
+from shared_data import require, shared
 
 from codegen.apps.failsafe.px4_log import read_px4_log
 from codegen.apps.failsafe.px4_replay import replay_px4
@@ -46,15 +43,6 @@ LOGS: dict[str, tuple[dict[int, list[tuple[float, int]]], list[tuple[float, int]
 }
 
 
-def _log(name: str) -> Path:
-    path = SHARED / name
-    if not path.is_file():
-        if os.environ.get("CI"):
-            pytest.fail(f"missing {path}")
-        pytest.skip(f"missing {path}")
-    return path
-
-
 def _rounded(found: list[tuple[float, int]]) -> list[tuple[float, int]]:
     return [(round(t, 3), v) for t, v in found]
 
@@ -62,7 +50,7 @@ def _rounded(found: list[tuple[float, int]]) -> list[tuple[float, int]]:
 @pytest.mark.parametrize("name", sorted(LOGS))
 def test_replay_reproduces_the_logged_transitions(name: str) -> None:
     battery_changes, flag_changes = LOGS[name]
-    log = read_px4_log(_log(name))
+    log = read_px4_log(require(shared(name)))
     replay = replay_px4(log)
     checks = {c.what: c for c in replay.checks}
     for battery, expected in battery_changes.items():
@@ -82,7 +70,7 @@ def test_replay_reproduces_the_logged_transitions(name: str) -> None:
 def test_what_the_replay_compares_with_is_what_pyulog_reads(name: str) -> None:
     from pyulog import ULog
 
-    path = _log(name)
+    path = require(shared(name))
     ulog = ULog(str(path), ["battery_status", "failsafe_flags"])
     start = ulog.start_timestamp
     ours = read_px4_log(path)
@@ -111,7 +99,7 @@ def test_the_v114_flight_events_and_actions() -> None:
     # 51.7 s (pyulog's logged messages) and its nav_state, which stays Altitude (1)
     from pyulog import ULog
 
-    path = _log("corpus/realworld3/ulog/fsyrh_log_61_2024-2-6-16-27-02.ulg")
+    path = require(shared("corpus/realworld3/ulog/fsyrh_log_61_2024-2-6-16-27-02.ulg"))
     replay = replay_px4(read_px4_log(path))
     assert [(round(e.time, 3), e.level.name, e.action.name) for e in replay.events] == [
         (23.775, "LOW", "WARN"),
