@@ -241,7 +241,7 @@ def _run_px4(args: argparse.Namespace, stream: Path, how: str) -> int:
         print(_px4_json(event) if args.json else line(_px4_line(event)))
     for check in replay.checks:
         print(line(f"battgen: check {check.what}: {check.verdict()}"), file=sys.stderr)
-    level = max((e.level for e in replay.events), default=None)
+    level = max((e.level for e in replay.events if e.cause == "charge"), default=None)
     print(line(f"{replay.samples} samples, {len(replay.events)} events, final level {level.name if level else 'NONE'}"),
           file=sys.stderr)  # fmt: skip
     return EXIT_DIFFERS if args.strict and any(c.problems for c in replay.checks) else EXIT_OK
@@ -249,7 +249,7 @@ def _run_px4(args: argparse.Namespace, stream: Path, how: str) -> int:
 
 def _px4_line(e: Px4Event) -> str:
     return (
-        f"t={e.time:10.3f}s  battery {e.battery} {e.level.name:<8} {'charge':<8} value={e.value:.3f} "
+        f"t={e.time:10.3f}s  battery {e.battery} {e.label:<8} {e.cause:<8} value={e.value:.3f} "
         f"threshold={e.threshold:.3f} action={e.action_name} ({e.action_code}) -> {e.outcome}  "
         f'"{e.text}"  uorb.warning={int(e.level)}  ({e.place})'
     )
@@ -259,8 +259,8 @@ def _px4_json(e: Px4Event) -> str:
     out: dict[str, Any] = {
         "t": e.time,
         "battery": e.battery,
-        "level": e.level.name,
-        "cause": "charge",
+        "level": e.label,
+        "cause": e.cause,
         "value": e.value if e.value == e.value else None,
         "threshold": e.threshold,
         "action": e.action_name,

@@ -21,6 +21,7 @@ from codegen.apps.failsafe.px4_actions import (
     acting_parameter,
     battery_action,
     flight_time_action,
+    remaining_time_flags,
     remaining_time_low,
     selected,
 )
@@ -143,8 +144,29 @@ def test_remaining_flight_time() -> None:
     assert remaining_time_low(100.0, 100.0, True, False)
     assert not remaining_time_low(100.0, 105.0, True, False) and remaining_time_low(100.0, 105.0, True, True)
     assert not remaining_time_low(100.0, 50.0, False, False)  # disarmed
-    assert not remaining_time_low(100.0, float("nan"), True, False)  # issue #27929: no estimate is no estimate
+    assert not remaining_time_low(100.0, float("nan"), True, False)  # no estimate: no condition
+    assert remaining_time_low(100.0, 0.0, True, False)  # a time of 0 is finite: taken as valid (issue #27929)
     assert [flight_time_action(v) for v in (0, 1, 2, 3)] == [Action.NONE, Action.WARN, Action.NONE, Action.RTL]
+
+
+def test_remaining_time_over_a_flight() -> None:
+    """batteryCheck.cpp rtlEstimateCheck: the estimate must be valid and younger than 3 s; the worst finite
+    time_remaining_s of the connected batteries (checkAndReport's worst_battery_time_s); 1.1 to clear."""
+    t = np.arange(0.0, 8.0)
+    estimate = (np.array([0.0, 4.0]), np.array([100.0, np.nan]))  # valid at 0 s, not valid from 4 s
+    one = (t, np.array([200.0, 150.0, 105.0, 99.0, 95.0, 90.0, 90.0, 90.0]), np.ones(8, bool))
+    two = (t, np.full(8, 50.0), np.zeros(8, bool))  # not connected: not counted
+    flags = remaining_time_flags(t, estimate, [one, two], np.ones(8, bool))
+    # 99 s <= 100 s at 3 s; the estimate is 3 s old at 3 s (not younger than 3 s): off; from 4 s not valid
+    assert flags.tolist() == [False, False, False, False, False, False, False, False]
+    estimate = (t, np.full(8, 100.0))
+    flags = remaining_time_flags(t, estimate, [one, two], np.ones(8, bool))
+    assert flags.tolist() == [False, False, False, True, True, True, True, True]
+    back = (t, np.array([200.0, 99.0, 105.0, 111.0, 105.0, 90.0, 90.0, 90.0]), np.ones(8, bool))
+    flags = remaining_time_flags(t, estimate, [back], np.ones(8, bool))
+    assert flags.tolist() == [False, True, True, False, False, True, True, True]  # 105 < 110 holds, 111 clears
+    armed = np.array([True, True, False, False, True, True, True, True])
+    assert not remaining_time_flags(t, estimate, [back], armed)[2]
 
 
 def test_selection_and_modes() -> None:

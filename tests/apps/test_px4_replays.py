@@ -63,6 +63,11 @@ def test_replay_reproduces_the_logged_transitions(name: str) -> None:
     else:
         assert _rounded([(c.t, c.value) for c in flags.logged]) == flag_changes
         assert flags.ok, flags.problems
+    remaining = checks["failsafe_flags.battery_low_remaining_time"]
+    if flag_changes is None:
+        assert remaining.undecided
+    else:  # v1.14+: no log's flight ran short of time, and the replay agrees wherever the log had an RTL estimate
+        assert remaining.ok or "no rtl_time_estimate" in remaining.undecided, remaining.problems
     assert all(not c.problems for c in replay.checks)
 
 

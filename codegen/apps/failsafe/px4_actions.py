@@ -29,9 +29,13 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import numpy as np
+
+from ..battery.columns import NDArray
 from .px4_levels import Px4Level
 
 HYSTERESIS = 1.1  # batteryCheck.cpp rtlEstimateCheck: hysteresis_factor once battery_low_remaining_time is set
+ESTIMATE_MAX_AGE_S = 3.0  # rtlEstimateCheck: an rtl_time_estimate older than 3 s is not used
 AT_ARMING_FROM = (1, 16)  # PR #23784: the action only for a warning worse than at arming
 DEFAULTS: dict[str, float] = {"COM_LOW_BAT_ACT": 0, "COM_FLTT_LOW_ACT": 3, "COM_FAIL_ACT_T": 5.0}
 LOW_BAT_ACTIONS = {0: "Warning", 1: "Return", 2: "Land", 3: "Return or Land"}  # failsafe.h LowBatteryAction
@@ -115,6 +119,33 @@ def remaining_time_low(safe_time_s: float, worst_time_s: float, armed: bool, alr
     """``BatteryChecks::rtlEstimateCheck``: the flight time left no longer covers the way home."""
     factor = HYSTERESIS if already else 1.0
     return armed and math.isfinite(worst_time_s) and safe_time_s * factor >= worst_time_s
+
+
+def remaining_time_flags(
+    t: NDArray,
+    estimate: tuple[NDArray, NDArray],
+    per_battery: list[tuple[NDArray, NDArray, NDArray]],
+    armed: NDArray,
+) -> NDArray:
+    """``battery_low_remaining_time`` at each of the times ``t`` (``rtlEstimateCheck``): ``estimate`` is
+    rtl_time_estimate's (times, safe time, NaN where not valid); ``per_battery`` each battery's (times,
+    time_remaining_s, connected): the worst finite time of the connected batteries is compared."""
+    est_t, safe = estimate
+    k = np.searchsorted(est_t, t, side="right") - 1
+    fresh = (k >= 0) & (t - est_t[np.maximum(k, 0)] < ESTIMATE_MAX_AGE_S)
+    safe_now = np.where(fresh, safe[np.maximum(k, 0)], np.nan)
+    worst = np.full(len(t), np.inf)
+    for times, left, connected in per_battery:
+        j = np.searchsorted(times, t, side="right") - 1
+        ok = (j >= 0) & connected[np.maximum(j, 0)] & np.isfinite(left[np.maximum(j, 0)])
+        worst = np.where(ok, np.minimum(worst, left[np.maximum(j, 0)]), worst)
+    worst = np.where(np.isinf(worst), np.nan, worst)
+    out = np.zeros(len(t), bool)
+    flag = False
+    for i, (s, w, a) in enumerate(zip(safe_now.tolist(), worst.tolist(), armed.tolist(), strict=True)):
+        flag = s == s and remaining_time_low(s, w, a, flag)  # NaN: no valid, fresh estimate
+        out[i] = flag
+    return out
 
 
 def selected(actions: list[Action], armed: bool) -> Action:

@@ -6,8 +6,10 @@ updates' time, state of charge (``battery_status.remaining``, the estimate the f
 from), ``connected``, ``time_remaining_s`` and the warning the firmware logged.
 
 What commander did comes from topics the battery view does not read, through the same ULog reader
-(:class:`codegen.inputs.ulog_columns.UlogColumns`): ``failsafe_flags.battery_warning`` (v1.14+; older logs do not
-record it), and ``vehicle_status.nav_state`` (the mode a failsafe action puts the vehicle in).
+(:class:`codegen.inputs.ulog_columns.UlogColumns`): ``failsafe_flags.battery_warning`` and
+``.battery_low_remaining_time`` (v1.14+; older logs do not record them), ``vehicle_status.nav_state`` (the mode a
+failsafe action puts the vehicle in) and ``rtl_time_estimate`` (``safe_time_estimate`` where ``valid``: what the
+remaining-flight-time failsafe compares the batteries' ``time_remaining_s`` with).
 """
 
 from __future__ import annotations
@@ -42,7 +44,7 @@ class Px4Battery:
 
 @dataclass
 class Topic:
-    """A topic's timestamps (s since the log's start) and one field's values."""
+    """A topic's timestamps (s since the log's start) and one field's values (int64; float64 with ``real``)."""
 
     t: NDArray
     values: NDArray
@@ -54,6 +56,8 @@ class Px4Log:
     batteries: list[Px4Battery] = field(default_factory=list)
     failsafe_warning: Topic | None = None  # failsafe_flags.battery_warning
     nav_state: Topic | None = None  # vehicle_status.nav_state
+    low_remaining_time: Topic | None = None  # failsafe_flags.battery_low_remaining_time
+    rtl_safe_time: Topic | None = None  # rtl_time_estimate.safe_time_estimate, NaN where not valid
 
 
 def read_px4_log(path: Path, name: str | None = None) -> Px4Log:
@@ -96,19 +100,19 @@ def read_px4_log(path: Path, name: str | None = None) -> Px4Log:
         out.batteries.append(
             Px4Battery(battery, t, t + origin_s, soc[order], conn[order], warn[order], left[order], armed[order])
         )
-    out.failsafe_warning, out.nav_state = _commander_topics(path, display, context)
+    _read_commander_topics(path, display, context, out)
     return out
 
 
-def _commander_topics(path: Path, name: str, context: LogContext) -> tuple[Topic | None, Topic | None]:
+def _read_commander_topics(path: Path, name: str, context: LogContext, out: Px4Log) -> None:
     model = model_of(bundled_catalog(), "uorb.BatteryStatus")
     if not isinstance(model, UorbClass):
-        return None, None
+        return
     start = context.start_us or 0
     with UlogColumns(path, name, model) as log:
         present = {topic for topic, multi_id in log.log.topics() if multi_id == 0}
 
-        def topic(topic: str, field_name: str) -> Topic | None:
+        def topic(topic: str, field_name: str, real: bool = False) -> Topic | None:
             if topic not in present or field_name not in log.log.layout(topic).names:
                 return None
             records = log.records(topic, 0)
@@ -116,6 +120,12 @@ def _commander_topics(path: Path, name: str, context: LogContext) -> tuple[Topic
                 return None
             t = (records["timestamp"].astype(np.int64) - start) / 1e6
             order = np.argsort(t, kind="stable")
-            return Topic(t[order], np.asarray(records[field_name]).astype(np.int64)[order])
+            values = np.asarray(records[field_name]).astype(np.float64 if real else np.int64)[order]
+            return Topic(t[order], values)
 
-        return topic("failsafe_flags", "battery_warning"), topic("vehicle_status", "nav_state")
+        out.failsafe_warning = topic("failsafe_flags", "battery_warning")
+        out.low_remaining_time = topic("failsafe_flags", "battery_low_remaining_time")
+        out.nav_state = topic("vehicle_status", "nav_state")
+        safe, valid = topic("rtl_time_estimate", "safe_time_estimate", True), topic("rtl_time_estimate", "valid")
+        if safe is not None and valid is not None:
+            out.rtl_safe_time = Topic(safe.t, np.where(valid.values != 0, safe.values, np.nan))

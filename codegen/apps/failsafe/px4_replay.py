@@ -26,7 +26,19 @@ import numpy as np
 
 from ..battery.columns import NDArray
 from ..battery.sources import as_of
-from .px4_actions import LOW_BAT_ACTIONS, NAV_STATES, TEXTS, Action, Px4Settings, acting_parameter, battery_action
+from .px4_actions import (
+    FLIGHT_TIME_TEXT,
+    FLTT_ACTIONS,
+    LOW_BAT_ACTIONS,
+    NAV_STATES,
+    TEXTS,
+    Action,
+    Px4Settings,
+    acting_parameter,
+    battery_action,
+    flight_time_action,
+    remaining_time_flags,
+)
 from .px4_levels import Px4Level, Thresholds, battery_warnings, commander_warning, latches, release_of
 from .px4_log import Px4Log
 from .replay_checks import Change, Check, changes, interval, within_one_sample
@@ -36,22 +48,31 @@ FRAMEWORK_FROM = (1, 14)  # failsafe_flags and the failsafe framework (src/modul
 
 @dataclass(frozen=True)
 class Px4Event:
-    """A rise of commander's battery warning while armed, and what commander does about it."""
+    """A rise of commander's battery warning while armed (``cause`` "charge"), or of its remaining-flight-time
+    condition (``cause`` "time": value and threshold in seconds), and what commander does about it."""
 
     time: float
-    battery: int  # the battery whose warning is the worst (1-based)
-    level: Px4Level
-    value: float  # that battery's state of charge
-    threshold: float  # the threshold it is below
-    action_code: int  # the COM_LOW_BAT_ACT in effect (0 where the at-arming rule makes it a warning)
+    battery: int  # the battery whose warning is the worst, or whose time is the shortest (1-based)
+    level: Px4Level  # NONE for a remaining-flight-time event
+    value: float  # that battery's state of charge (its time_remaining_s)
+    threshold: float  # the threshold it is below (the RTL estimate's safe time)
+    action_code: (
+        int  # the COM_LOW_BAT_ACT in effect (0 where the at-arming rule makes it a warning), or COM_FLTT_LOW_ACT
+    )
     action: Action
     delay_s: float  # the Hold before a mode action (COM_FAIL_ACT_T)
     text: str  # the operator's notification (framework.cpp notifyUser)
     place: str
+    cause: str = "charge"
+
+    @property
+    def label(self) -> str:
+        return self.level.name if self.cause == "charge" else "TIME_LOW"
 
     @property
     def action_name(self) -> str:
-        return LOW_BAT_ACTIONS.get(self.action_code, f"unknown ({self.action_code})")
+        names = LOW_BAT_ACTIONS if self.cause == "charge" else FLTT_ACTIONS
+        return names.get(self.action_code, f"unknown ({self.action_code})")
 
     @property
     def outcome(self) -> str:
@@ -88,6 +109,9 @@ def replay_px4(log: Px4Log, given: Mapping[str, float] | None = None) -> Px4Repl
     flag = commander_warning(per_battery, t, armed)
     events = _events(log, t, armed, flag, per_battery, thresholds, settings, release)
     checks.append(_commander_check(log, t, flag, release))
+    time_events, time_check = _remaining_time(log, settings, release)
+    events = sorted(events + time_events, key=lambda e: e.time)
+    checks.append(time_check)
     checks.extend(_action_checks(log, events))
     return Px4Replay(release, thresholds, settings, events, checks, sum(len(b.t) for b in log.batteries))
 
@@ -139,6 +163,52 @@ def _events(
     return out
 
 
+def _remaining_time(
+    log: Px4Log, settings: Px4Settings, release: tuple[int, int, int] | None
+) -> tuple[list[Px4Event], Check]:
+    """The remaining-flight-time failsafe at every battery update and RTL estimate, and its check."""
+    what = "failsafe_flags.battery_low_remaining_time"
+    if release is not None and release[:2] < FRAMEWORK_FROM:
+        why = "the release predates the failsafe framework (v1.14) the replay follows"
+        return [], Check(what, [], [], undecided=why)
+    if log.rtl_safe_time is None:
+        return [], Check(what, [], [], undecided="the log has no rtl_time_estimate to compare the time left with")
+    est = log.rtl_safe_time
+    t = np.unique(np.concatenate([est.t, *(b.t for b in log.batteries)]))
+    armed = _armed_at(log, t)
+    per_battery = [(b.t, b.time_remaining, b.connected) for b in log.batteries]
+    flags = remaining_time_flags(t, (est.t, est.values), per_battery, armed).astype(np.int64)
+    got = changes(t, flags)
+    action = flight_time_action(settings.fltt_low_act)
+    events = []
+    for change in got:
+        if change.value and action is not Action.NONE:
+            battery, left = _shortest(log, change.t)
+            k = int(np.searchsorted(est.t, change.t, side="right")) - 1
+            delay = settings.delay_s if action is Action.RTL else 0.0
+            place = f"rtl_time_estimate record {k}"
+            code, safe = settings.fltt_low_act, float(est.values[k])
+            events.append(Px4Event(change.t, battery, Px4Level.NONE, left, safe, code, action, delay,
+                                   FLIGHT_TIME_TEXT, place, "time"))  # fmt: skip
+    if log.low_remaining_time is None:
+        return events, Check(what, [], got, undecided="the log does not record failsafe_flags")
+    want = changes(log.low_remaining_time.t, log.low_remaining_time.values)
+    check = Check(what, want, got)
+    check.problems = within_one_sample(want, got, [log.low_remaining_time.t, t])
+    return events, check
+
+
+def _shortest(log: Px4Log, t: float) -> tuple[int, float]:
+    """The battery with the least time remaining as of ``t``, and that time."""
+    best = (log.batteries[0].battery, float("nan"))
+    for b in log.batteries:
+        k = int(np.searchsorted(b.t, t, side="right")) - 1
+        left = float(b.time_remaining[k]) if k >= 0 else float("nan")
+        if left == left and not best[1] <= left:
+            best = (b.battery, left)
+    return best
+
+
 def _worst(
     log: Px4Log, per_battery: list[tuple[NDArray, NDArray, NDArray]], t: float, level: Px4Level
 ) -> tuple[int, float, int]:
@@ -178,7 +248,7 @@ def _commander_check(log: Px4Log, t: NDArray, flag: NDArray, release: tuple[int,
 def _action_checks(log: Px4Log, events: list[Px4Event]) -> list[Check]:
     out = []
     for e in events:
-        what = f"t={e.time:.3f}s {e.level.name} action {e.outcome}"
+        what = f"t={e.time:.3f}s {e.label} action {e.outcome}"
         mode = NAV_STATES.get(e.action)
         if mode is None:
             continue  # a warning changes no mode
