@@ -237,6 +237,8 @@ def _run_px4(args: argparse.Namespace, stream: Path, how: str) -> int:
                f"COM_LOW_BAT_ACT {st.low_bat_act} COM_FAIL_ACT_T {st.fail_act_t:g}"), file=sys.stderr)  # fmt: skip
     if args.vehicle or args.variant:
         print("battgen: warning: --vehicle and --variant are ArduPilot's: not used for PX4", file=sys.stderr)
+    for note in replay.notes:
+        print(line(f"battgen: note: {note}"), file=sys.stderr)
     for event in replay.events:
         print(_px4_json(event) if args.json else line(_px4_line(event)))
     for check in replay.checks:

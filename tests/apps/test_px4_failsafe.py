@@ -54,6 +54,8 @@ def test_defaults() -> None:
     assert Px4Settings.from_values({}) == Px4Settings(0, 3, 5.0)
     with pytest.raises(ValueError, match="COM_LOW_BAT_ACT: expected an integer"):
         Px4Settings.from_values({"COM_LOW_BAT_ACT": 1.5})
+    with pytest.raises(ValueError, match="COM_LOW_BAT_ACT: expected an int32, got 1e"):
+        Px4Settings.from_values({"COM_LOW_BAT_ACT": 1e300})
     with pytest.raises(ValueError, match="BAT_LOW_THR: expected a finite number"):
         Thresholds.from_values({"BAT_LOW_THR": float("nan")})
 

@@ -37,6 +37,7 @@ from .px4_levels import Px4Level
 HYSTERESIS = 1.1  # batteryCheck.cpp rtlEstimateCheck: hysteresis_factor once battery_low_remaining_time is set
 ESTIMATE_MAX_AGE_S = 3.0  # rtlEstimateCheck: an rtl_time_estimate older than 3 s is not used
 AT_ARMING_FROM = (1, 16)  # PR #23784: the action only for a warning worse than at arming
+INT32 = (-(2**31), 2**31 - 1)
 DEFAULTS: dict[str, float] = {"COM_LOW_BAT_ACT": 0, "COM_FLTT_LOW_ACT": 3, "COM_FAIL_ACT_T": 5.0}
 LOW_BAT_ACTIONS = {0: "Warning", 1: "Return", 2: "Land", 3: "Return or Land"}  # failsafe.h LowBatteryAction
 FLTT_ACTIONS = {0: "None", 1: "Warning", 3: "Return"}  # command_after_remaining_flight_time_low
@@ -77,6 +78,8 @@ class Px4Settings:
             value = values.get(name, DEFAULTS[name])
             if isinstance(value, bool) or not isinstance(value, int | float) or not float(value).is_integer():
                 raise ValueError(f"{name}: expected an integer, got {value!r}")
+            if not INT32[0] <= value <= INT32[1]:  # PX4 holds it as an int32 parameter
+                raise ValueError(f"{name}: expected an int32, got {value:g}")
             return int(value)
 
         delay = values.get("COM_FAIL_ACT_T", DEFAULTS["COM_FAIL_ACT_T"])

@@ -91,6 +91,17 @@ class Px4Replay:
     checks: list[Check]
     samples: int
 
+    @property
+    def notes(self) -> list[str]:
+        """What the replay takes on trust for this log's release."""
+        if self.release is not None and self.release[:2] < FRAMEWORK_FROM:
+            version = ".".join(map(str, self.release))
+            return [
+                f"PX4 v{version} predates the failsafe framework (v1.14): commander's reaction is replayed with its "
+                "rules (the actions per level are the same; the texts and the Hold before an action may differ)"
+            ]
+        return []
+
 
 def replay_px4(log: Px4Log, given: Mapping[str, float] | None = None) -> Px4Replay:
     """Replay a log (:func:`.px4_log.read_px4_log`) with its parameters, ``given`` ones on top (a ValueError names a
