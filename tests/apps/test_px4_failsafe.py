@@ -19,6 +19,7 @@ from codegen.apps.failsafe.px4_actions import (
     Action,
     Px4Settings,
     acting_parameter,
+    arming_refused,
     battery_action,
     flight_time_action,
     remaining_time_flags,
@@ -139,6 +140,18 @@ def test_action_at_arming() -> None:
     assert acting_parameter(2, C, N, None) == 2
 
 
+def test_arming_refused() -> None:
+    """batteryCheck.cpp BatteryChecks::checkAndReport while disarmed: `affected_modes =
+    (!configured_arm_threshold_in_use && critical_or_higher) || (configured_arm_threshold_in_use &&
+    below_configured_arm_threshold) ? All : None`, in use where COM_ARM_BAT_MIN >= -FLT_EPSILON (v1.16, PR #23784);
+    v1.15 (PR #22175): critical or below; v1.14: critical."""
+    assert not arming_refused(L, 0.1, None, (1, 14, 0)) and arming_refused(C, 0.06, None, (1, 14, 0))
+    assert arming_refused(L, 0.3, 0.4, (1, 15, 0)) and arming_refused(C, 0.06, 0.0, (1, 15, 0))
+    assert not arming_refused(C, 0.06, 0.05, (1, 16, 0))  # COM_ARM_BAT_MIN below the critical level: arms
+    assert arming_refused(N, 0.3, 0.4, (1, 16, 0)) and arming_refused(C, 0.06, -1.0, (1, 16, 0))
+    assert not arming_refused(C, 0.06, 0.0, None)  # 0: always allows (the newest rule)
+
+
 def test_remaining_flight_time() -> None:
     """batteryCheck.cpp BatteryChecks::rtlEstimateCheck: `safe_time_estimate * hysteresis_factor >=
     worst_battery_time_s`, factor 1.1 once set, armed and a finite time only; failsafe.cpp
@@ -238,3 +251,8 @@ def test_synthetic_log_arming_with_a_critical_battery(tmp_path: Path) -> None:
     assert [(e.level, e.action) for e in replay.events] == [(C, Action.WARN), (E, Action.LAND)]
     action = replay.checks[-1]
     assert action.ok and action.replayed[0].value == 18  # vehicle_status.nav_state AUTO_LAND, as logged
+    # the log's release is unknown (the newest rules): without COM_ARM_BAT_MIN, arming at CRITICAL is refused
+    arming = next(c for c in replay.checks if c.what == "arming with the battery's level")
+    assert "armed at 11.000s with CRITICAL, 0.060 left: the battery check refuses" in arming.problems[0]
+    allowed = replay_px4(read_px4_log(log), {"COM_LOW_BAT_ACT": 2, "COM_ARM_BAT_MIN": 0.05})
+    assert next(c for c in allowed.checks if c.what == "arming with the battery's level").ok

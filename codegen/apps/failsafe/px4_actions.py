@@ -8,6 +8,9 @@ From PX4-Autopilot's ``src/modules/commander/failsafe/`` (each rule pinned in ``
 - ``Failsafe::checkStateAndMode``: the action is the parameter's only while the warning is worse than it was at
   arming (``_battery_warning_at_arming``, from ``updateArmingState``), else a warning: arming with a low battery
   that ``COM_ARM_BAT_MIN`` allowed does not fail at once (PR #23784, v1.16; earlier releases acted at once);
+- ``batteryCheck.cpp`` ``BatteryChecks::checkAndReport`` refuses arming (a failure in every mode) with a CRITICAL or
+  worse warning; from v1.16, where ``COM_ARM_BAT_MIN`` is set (0 or more), instead exactly when the worst state of
+  charge is below it (PR #23784; v1.15 refused below it as well as at CRITICAL); a LOW warning never refuses;
 - ``Failsafe::fromRemainingFlightTimeLowActParam``: ``COM_FLTT_LOW_ACT`` 0 nothing, 1 warns, 3 returns, for
   ``battery_low_remaining_time``, which ``batteryCheck.cpp`` ``BatteryChecks::rtlEstimateCheck`` sets while armed
   when the RTL estimate's safe time is at least the worst battery's ``time_remaining_s`` (x 1.1 once set: the way
@@ -18,8 +21,10 @@ From PX4-Autopilot's ``src/modules/commander/failsafe/`` (each rule pinned in ``
   action other than a warning waits ``COM_FAIL_ACT_T`` seconds in Hold first (``UserTakeoverAllowed::Auto``, the
   battery's actions' default, in ``checkFailsafe``), where the parameter is above 0.1 s.
 
+The battery's rules are the same for every vehicle type: ``checkStateAndMode`` has no vehicle-type branch for them.
+
 Parameter defaults (``src/modules/commander/commander_params.c`` / ``module.yaml``): ``COM_LOW_BAT_ACT`` 0 (warning),
-``COM_FLTT_LOW_ACT`` 3 (return), ``COM_FAIL_ACT_T`` 5 s.
+``COM_FLTT_LOW_ACT`` 3 (return), ``COM_FAIL_ACT_T`` 5 s, ``COM_ARM_BAT_MIN`` -1 (not used; v1.15: 0).
 """
 
 from __future__ import annotations
@@ -34,6 +39,7 @@ import numpy as np
 from ..battery.columns import NDArray
 from .px4_levels import Px4Level
 
+FLT_EPSILON = 1.1920928955078125e-07
 HYSTERESIS = 1.1  # batteryCheck.cpp rtlEstimateCheck: hysteresis_factor once battery_low_remaining_time is set
 ESTIMATE_MAX_AGE_S = 3.0  # rtlEstimateCheck: an rtl_time_estimate older than 3 s is not used
 AT_ARMING_FROM = (1, 16)  # PR #23784: the action only for a warning worse than at arming
@@ -111,6 +117,21 @@ def acting_parameter(
     arming, from v1.16 (an unknown release: the newest rule)."""
     newer = release is None or release[:2] >= AT_ARMING_FROM
     return low_bat_act if not newer or warning > at_arming else 0
+
+
+def arming_refused(
+    warning: Px4Level, worst_remaining: float, arm_bat_min: float | None, release: tuple[int, int, int] | None
+) -> bool:
+    """``BatteryChecks::checkAndReport`` while disarmed: whether the battery check fails arming (``arm_bat_min``:
+    COM_ARM_BAT_MIN, None where the log has none). An unknown release: the newest rule."""
+    critical = warning >= Px4Level.CRITICAL
+    if arm_bat_min is None:
+        return critical
+    below = worst_remaining < arm_bat_min
+    if release is not None and release[:2] < AT_ARMING_FROM:
+        return critical or below
+    in_use = arm_bat_min >= -FLT_EPSILON
+    return below if in_use else critical
 
 
 def flight_time_action(fltt_low_act: int) -> Action:

@@ -35,6 +35,7 @@ from .px4_actions import (
     Action,
     Px4Settings,
     acting_parameter,
+    arming_refused,
     battery_action,
     flight_time_action,
     remaining_time_flags,
@@ -120,6 +121,7 @@ def replay_px4(log: Px4Log, given: Mapping[str, float] | None = None) -> Px4Repl
     flag = commander_warning(per_battery, t, armed)
     events = _events(log, t, armed, flag, per_battery, thresholds, settings, release)
     checks.append(_commander_check(log, t, flag, release))
+    checks.append(_arming_check(log, t, flag, values.get("COM_ARM_BAT_MIN"), release))
     time_events, time_check = _remaining_time(log, settings, release)
     events = sorted(events + time_events, key=lambda e: e.time)
     checks.append(time_check)
@@ -172,6 +174,41 @@ def _events(
             )
         previous, was_armed = fk, ak
     return out
+
+
+def _arming_check(
+    log: Px4Log, t: NDArray, flag: NDArray, arm_bat_min: float | None, release: tuple[int, int, int] | None
+) -> Check:
+    """Each arming the log records against the battery check's arming rule, with the level as of that moment."""
+    armings = [ta for ta, on in log.context.arming if on]
+    check = Check("arming with the battery's level", [Change(ta, 1) for ta in armings], [])
+    if release is not None and release[:2] < FRAMEWORK_FROM:
+        check.undecided = "the release predates the health and arming checks (v1.14) the replay follows"
+        return check
+    unknown = 0
+    for ta in armings:
+        k = int(np.searchsorted(t, ta, side="right")) - 1
+        if k < 0:
+            unknown += 1
+            continue
+        level, worst = Px4Level(int(flag[k])), _worst_remaining(log, ta)
+        if arming_refused(level, worst, arm_bat_min, release):
+            check.problems.append(f"armed at {ta:.3f}s with {level.name}, {worst:.3f} left: the battery check refuses")
+        else:
+            check.replayed.append(Change(ta, 1))
+    if armings and unknown == len(armings):
+        check.undecided = "the log has no battery update before its armings"
+    return check
+
+
+def _worst_remaining(log: Px4Log, t: float) -> float:
+    """The lowest state of charge of the connected batteries as of ``t`` (1 where none: checkAndReport's start)."""
+    worst = 1.0
+    for b in log.batteries:
+        k = int(np.searchsorted(b.t, t, side="right")) - 1
+        if k >= 0 and b.connected[k] and b.remaining[k] < worst:
+            worst = float(b.remaining[k])
+    return worst
 
 
 def _remaining_time(
