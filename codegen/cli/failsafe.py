@@ -283,7 +283,7 @@ def _why_no_parameters(table: SampleTable | None) -> str:
     if context is not None and context.autopilot == "px4":
         return (
             f"this is a PX4 log ({len(context.parameters)} PX4 parameters, such as BAT_LOW_THR); ArduPilot's "
-            "failsafe needs BATT_* values"
+            "failsafe needs BATT_* values, and PX4's replay reads a ULog (its battery_status)"
         )
     return "the input carries no ArduPilot parameters of its own (a DataFlash log's PARM, a tlog's PARAM_VALUE)"
 
