@@ -51,16 +51,16 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-from ..apps.failsafe.ardupilot_logged import ardupilot_checks, logged_failsafes
+from ..apps.failsafe.ardupilot_logged import check_log
 from ..apps.failsafe.columnar import replay_table
 from ..apps.failsafe.distance import DistanceRule
 from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
+from ..apps.failsafe.firmware import FIRMWARES, choose_firmware
 from ..apps.failsafe.legacy_parameters import renamed, with_current_names
 from ..apps.failsafe.levels import apply_level
 from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_samples, own_parameters
 from ..apps.failsafe.px4_log import read_px4_log
 from ..apps.failsafe.px4_replay import Px4Event, replay_px4
-from ..apps.failsafe.replay_checks import Change, Check
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
@@ -70,7 +70,6 @@ from ..inputs.kinds import FLIGHT_LOG_KINDS, detect
 from ..text.escape import line
 
 EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE, EXIT_DIFFERS = 0, 1, 2, 3
-FIRMWARES = ("px4", "ardupilot")
 
 
 def register(subparsers: Any) -> None:
@@ -105,12 +104,13 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     stream = Path(args.stream)
     try:
-        firmware, how = _firmware(args, stream)
+        given = read_parameter_values(Path(args.params)) if args.params else None
+        firmware, how = choose_firmware(args.firmware, given, args.params or "", stream)
     except (BattgenError, ValueError) as exc:
         print(line(f"battgen: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     if firmware == "px4":
-        return _run_px4(args, stream, how)
+        return _run_px4(args, stream, how, given or {})
     try:
         # a flight log or capture is read through the battery view; JSON and JSON Lines are sample streams
         table: SampleTable | None = log_samples(stream, args.stream) if detect(stream) in FLIGHT_LOG_KINDS else None
@@ -175,7 +175,7 @@ def run(args: argparse.Namespace) -> int:
         read = replay.samples if table is None else read
         if read == 0:
             raise BattgenError(f"{args.stream}: expected battery readings, found none")
-        checks = _ardupilot_checks(stream, args.stream, table, fs.events)
+        checks = check_log(stream, args.stream, table, fs.events) if table is not None else []
         for check in checks:
             print(line(f"battgen: check {check.what}: {check.verdict()}"), file=sys.stderr)
     except (BattgenError, ValueError) as exc:
@@ -185,44 +185,13 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_DIFFERS if args.strict and any(c.problems for c in checks) else EXIT_OK
 
 
-def _ardupilot_checks(stream: Path, name: str, table: SampleTable | None, events: list[Event]) -> list[Check]:
-    """A DataFlash log's own failsafe records against the replay (other inputs record none the replay reads)."""
-    context = table.context if table is not None else None
-    if table is None or context is None or context.kind not in ("dataflash", "tlog"):
-        return []
-    if context.kind == "tlog":
-        replayed = [Change(e.time, 1) for e in events]
-        why = "a tlog records the failsafe as STATUSTEXT, which battgen does not read (no bundled STATUSTEXT schema)"
-        return [Check("STATUSTEXT of the battery failsafe", [], replayed, undecided=why)]
-    t, _, _, _, _, armed, _ = table.sorted_columns()
-    logged = logged_failsafes(stream, name, context.start_us or 0)
-    return ardupilot_checks(logged, events, t, armed == 1.0)
-
-
-def _firmware(args: argparse.Namespace, stream: Path) -> tuple[str, str]:
-    """Whose failsafe replays the stream, and the words saying why."""
-    if args.firmware:
-        return args.firmware, "given"
-    if args.params:
-        values = read_parameter_values(Path(args.params))
-        names = set(values)
-        if batt_parameter_count(values):
-            return "ardupilot", f"{args.params} holds ArduPilot's BATT*_ parameters"
-        if any(n.startswith(("BAT_", "BAT1_", "COM_LOW_BAT", "COM_FAIL_ACT")) for n in names):
-            return "px4", f"{args.params} holds PX4's BAT_/COM_ parameters"
-    if detect(stream) == "ulog":
-        return "px4", "the log is a PX4 ULog"
-    return "ardupilot", "the log's"
-
-
-def _run_px4(args: argparse.Namespace, stream: Path, how: str) -> int:
+def _run_px4(args: argparse.Namespace, stream: Path, how: str, given: dict[str, float]) -> int:
     try:
         if detect(stream) != "ulog":
             raise BattgenError(
                 f"{args.stream}: expected a PX4 ULog (.ulg): PX4's replay starts from the battery_status the firmware "
                 "logged"
             )
-        given = read_parameter_values(Path(args.params)) if args.params else {}
         log = read_px4_log(stream, args.stream)
         replay = replay_px4(log, given)
         if replay.samples == 0:

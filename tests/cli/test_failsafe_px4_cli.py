@@ -70,3 +70,17 @@ def test_firmware_override_and_refusals(tmp_path: Path, capsys: pytest.CaptureFi
     write_px4_flight(empty, [])
     code, _, err = run(capsys, str(empty))
     assert code == 2 and "expected battery_status records, found none" in err
+
+
+def test_firmware_choice_order(tmp_path: Path) -> None:
+    from codegen.apps.failsafe.firmware import choose_firmware
+
+    ulog, jsonl = write_px4_flight(tmp_path / "f.ulg", DESCENT), tmp_path / "s.jsonl"
+    jsonl.write_text('{"t": 0, "armed": true, "battery": {"voltage_v": 12}}\n', encoding="utf-8")
+    assert choose_firmware("ardupilot", {"BAT_LOW_THR": 0.2}, "p", ulog) == ("ardupilot", "given")
+    assert choose_firmware(None, {"BATT2_LOW_VOLT": 10.0}, "p", ulog)[0] == "ardupilot"  # the parameters' firmware
+    assert choose_firmware(None, {"COM_LOW_BAT_ACT": 2}, "p", jsonl)[0] == "px4"
+    assert choose_firmware(None, {"SYSID_THISMAV": 1}, "p", ulog) == ("px4", "the log is a PX4 ULog")
+    assert choose_firmware(None, None, "", jsonl)[0] == "ardupilot"
+    with pytest.raises(ValueError, match="expected a firmware among px4, ardupilot"):
+        choose_firmware("betaflight", None, "", jsonl)

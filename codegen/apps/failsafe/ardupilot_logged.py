@@ -27,6 +27,7 @@ import numpy as np
 from ...inputs.dataflash import open_log
 from ..battery.columns import NDArray
 from .evaluator import Event
+from .logs import SampleTable
 from .replay_checks import Change, Check, within_one_sample
 
 FAILSAFE_BATT = 6  # LogErrorSubsystem::FAILSAFE_BATT
@@ -102,6 +103,20 @@ def ardupilot_checks(logged: LoggedFailsafe, events: list[Event], sample_t: NDAr
     else:
         modes.problems = within_one_sample(modes.logged, modes.replayed, [sample_t])
     return [check, modes]
+
+
+def check_log(path: Path, name: str, table: SampleTable, events: list[Event]) -> list[Check]:
+    """A log's own failsafe records against the ArduPilot replay of its samples (``table``): a DataFlash log's ERR and
+    MODE records; a tlog's STATUSTEXT is not read, which its check says; other inputs record nothing to compare."""
+    context = table.context
+    if context is None or context.kind not in ("dataflash", "tlog"):
+        return []
+    if context.kind == "tlog":
+        replayed = [Change(e.time, 1) for e in events]
+        why = "a tlog records the failsafe as STATUSTEXT, which battgen does not read (no bundled STATUSTEXT schema)"
+        return [Check("STATUSTEXT of the battery failsafe", [], replayed, undecided=why)]
+    t, _, _, _, _, armed, _ = table.sorted_columns()
+    return ardupilot_checks(logged_failsafes(path, name, context.start_us or 0), events, t, armed == 1.0)
 
 
 def _armed_at(t: NDArray, armed: NDArray, when: float) -> bool:
