@@ -14,18 +14,8 @@ import numpy as np
 import pytest
 from px4_flights import write_px4_flight
 
-from codegen.apps.failsafe.px4_actions import (
-    NAV_STATES,
-    Action,
-    Px4Settings,
-    acting_parameter,
-    arming_refused,
-    battery_action,
-    flight_time_action,
-    remaining_time_flags,
-    remaining_time_low,
-    selected,
-)
+from codegen.apps.failsafe import px4_actions as actions
+from codegen.apps.failsafe.px4_actions import Action
 from codegen.apps.failsafe.px4_levels import (
     Px4Level,
     Thresholds,
@@ -52,11 +42,11 @@ def test_defaults() -> None:
     """src/lib/battery/battery_params_common.c BAT_LOW_THR 0.15, BAT_CRIT_THR 0.07, BAT_EMERGEN_THR 0.05;
     commander_params.c COM_LOW_BAT_ACT 0, COM_FLTT_LOW_ACT 3, COM_FAIL_ACT_T 5.0."""
     assert Thresholds.from_values({}) == Thresholds(0.15, 0.07, 0.05)
-    assert Px4Settings.from_values({}) == Px4Settings(0, 3, 5.0)
+    assert actions.Px4Settings.from_values({}) == actions.Px4Settings(0, 3, 5.0)
     with pytest.raises(ValueError, match="COM_LOW_BAT_ACT: expected an integer"):
-        Px4Settings.from_values({"COM_LOW_BAT_ACT": 1.5})
+        actions.Px4Settings.from_values({"COM_LOW_BAT_ACT": 1.5})
     with pytest.raises(ValueError, match="COM_LOW_BAT_ACT: expected an int32, got 1e"):
-        Px4Settings.from_values({"COM_LOW_BAT_ACT": 1e300})
+        actions.Px4Settings.from_values({"COM_LOW_BAT_ACT": 1e300})
     with pytest.raises(ValueError, match="BAT_LOW_THR: expected a finite number"):
         Thresholds.from_values({"BAT_LOW_THR": float("nan")})
 
@@ -126,18 +116,18 @@ def test_commander_latches_while_armed() -> None:
 def test_battery_action_per_level(param: int, expected: dict[Px4Level, Action]) -> None:
     """failsafe.cpp Failsafe::fromBatteryWarningActParam (LowBatteryAction Warning 0, Return 1, Land 2,
     ReturnOrLand 3: Return at CRITICAL, Land at EMERGENCY)."""
-    assert {level: battery_action(param, level) for level in (L, C, E)} == expected
-    assert battery_action(param, N) is Action.NONE
+    assert {level: actions.battery_action(param, level) for level in (L, C, E)} == expected
+    assert actions.battery_action(param, N) is Action.NONE
 
 
 def test_action_at_arming() -> None:
     """failsafe.cpp Failsafe::checkStateAndMode: `warning_worse_than_at_arming ? _param_com_low_bat_act.get() :
     LowBatteryAction::Warning` (PR #23784, v1.16; issue #21206: a failsafe at arming); updateArmingState keeps
     the warning at arming."""
-    assert acting_parameter(2, C, C, (1, 16, 0)) == 0  # armed with CRITICAL: only a warning
-    assert acting_parameter(2, E, C, (1, 16, 0)) == 2  # worse than at arming: the action
-    assert acting_parameter(2, C, C, (1, 15, 0)) == 2  # before v1.16: at once
-    assert acting_parameter(2, C, N, None) == 2
+    assert actions.acting_parameter(2, C, C, (1, 16, 0)) == 0  # armed with CRITICAL: only a warning
+    assert actions.acting_parameter(2, E, C, (1, 16, 0)) == 2  # worse than at arming: the action
+    assert actions.acting_parameter(2, C, C, (1, 15, 0)) == 2  # before v1.16: at once
+    assert actions.acting_parameter(2, C, N, None) == 2
 
 
 def test_arming_refused() -> None:
@@ -145,23 +135,25 @@ def test_arming_refused() -> None:
     (!configured_arm_threshold_in_use && critical_or_higher) || (configured_arm_threshold_in_use &&
     below_configured_arm_threshold) ? All : None`, in use where COM_ARM_BAT_MIN >= -FLT_EPSILON (v1.16, PR #23784);
     v1.15 (PR #22175): critical or below; v1.14: critical."""
-    assert not arming_refused(L, 0.1, None, (1, 14, 0)) and arming_refused(C, 0.06, None, (1, 14, 0))
-    assert arming_refused(L, 0.3, 0.4, (1, 15, 0)) and arming_refused(C, 0.06, 0.0, (1, 15, 0))
-    assert not arming_refused(C, 0.06, 0.05, (1, 16, 0))  # COM_ARM_BAT_MIN below the critical level: arms
-    assert arming_refused(N, 0.3, 0.4, (1, 16, 0)) and arming_refused(C, 0.06, -1.0, (1, 16, 0))
-    assert not arming_refused(C, 0.06, 0.0, None)  # 0: always allows (the newest rule)
+    assert not actions.arming_refused(L, 0.1, None, (1, 14, 0)) and actions.arming_refused(C, 0.06, None, (1, 14, 0))
+    assert actions.arming_refused(L, 0.3, 0.4, (1, 15, 0)) and actions.arming_refused(C, 0.06, 0.0, (1, 15, 0))
+    assert not actions.arming_refused(C, 0.06, 0.05, (1, 16, 0))  # COM_ARM_BAT_MIN below the critical level: arms
+    assert actions.arming_refused(N, 0.3, 0.4, (1, 16, 0)) and actions.arming_refused(C, 0.06, -1.0, (1, 16, 0))
+    assert not actions.arming_refused(C, 0.06, 0.0, None)  # 0: always allows (the newest rule)
 
 
 def test_remaining_flight_time() -> None:
     """batteryCheck.cpp BatteryChecks::rtlEstimateCheck: `safe_time_estimate * hysteresis_factor >=
     worst_battery_time_s`, factor 1.1 once set, armed and a finite time only; failsafe.cpp
     fromRemainingFlightTimeLowActParam: 0 None, 1 Warning, 3 Return."""
-    assert remaining_time_low(100.0, 100.0, True, False)
-    assert not remaining_time_low(100.0, 105.0, True, False) and remaining_time_low(100.0, 105.0, True, True)
-    assert not remaining_time_low(100.0, 50.0, False, False)  # disarmed
-    assert not remaining_time_low(100.0, float("nan"), True, False)  # no estimate: no condition
-    assert remaining_time_low(100.0, 0.0, True, False)  # a time of 0 is finite: taken as valid (issue #27929)
-    assert [flight_time_action(v) for v in (0, 1, 2, 3)] == [Action.NONE, Action.WARN, Action.NONE, Action.RTL]
+    assert actions.remaining_time_low(100.0, 100.0, True, False)
+    assert not actions.remaining_time_low(100.0, 105.0, True, False) and actions.remaining_time_low(
+        100.0, 105.0, True, True
+    )
+    assert not actions.remaining_time_low(100.0, 50.0, False, False)  # disarmed
+    assert not actions.remaining_time_low(100.0, float("nan"), True, False)  # no estimate: no condition
+    assert actions.remaining_time_low(100.0, 0.0, True, False)  # a time of 0 is finite: taken as valid (issue #27929)
+    assert [actions.flight_time_action(v) for v in (0, 1, 2, 3)] == [Action.NONE, Action.WARN, Action.NONE, Action.RTL]
 
 
 def test_remaining_time_over_a_flight() -> None:
@@ -171,17 +163,17 @@ def test_remaining_time_over_a_flight() -> None:
     estimate = (np.array([0.0, 4.0]), np.array([100.0, np.nan]))  # valid at 0 s, not valid from 4 s
     one = (t, np.array([200.0, 150.0, 105.0, 99.0, 95.0, 90.0, 90.0, 90.0]), np.ones(8, bool))
     two = (t, np.full(8, 50.0), np.zeros(8, bool))  # not connected: not counted
-    flags = remaining_time_flags(t, estimate, [one, two], np.ones(8, bool))
+    flags = actions.remaining_time_flags(t, estimate, [one, two], np.ones(8, bool))
     # 99 s <= 100 s at 3 s; the estimate is 3 s old at 3 s (not younger than 3 s): off; from 4 s not valid
     assert flags.tolist() == [False, False, False, False, False, False, False, False]
     estimate = (t, np.full(8, 100.0))
-    flags = remaining_time_flags(t, estimate, [one, two], np.ones(8, bool))
+    flags = actions.remaining_time_flags(t, estimate, [one, two], np.ones(8, bool))
     assert flags.tolist() == [False, False, False, True, True, True, True, True]
     back = (t, np.array([200.0, 99.0, 105.0, 111.0, 105.0, 90.0, 90.0, 90.0]), np.ones(8, bool))
-    flags = remaining_time_flags(t, estimate, [back], np.ones(8, bool))
+    flags = actions.remaining_time_flags(t, estimate, [back], np.ones(8, bool))
     assert flags.tolist() == [False, True, True, False, False, True, True, True]  # 105 < 110 holds, 111 clears
     armed = np.array([True, True, False, False, True, True, True, True])
-    assert not remaining_time_flags(t, estimate, [back], armed)[2]
+    assert not actions.remaining_time_flags(t, estimate, [back], armed)[2]
 
 
 def test_selection_and_modes() -> None:
@@ -189,10 +181,10 @@ def test_selection_and_modes() -> None:
     None, Warn, FallbackPosCtrl, FallbackAltCtrl, FallbackStab, Hold, RTL, Land); checkFailsafe: Auto takeover waits
     COM_FAIL_ACT_T in Hold where it is above 0.1 s; modeFromAction: AUTO_LOITER 4, AUTO_RTL 5, AUTO_LAND 18."""
     assert (Action.WARN, Action.HOLD, Action.RTL, Action.LAND) == (1, 5, 6, 7)
-    assert selected([Action.WARN, Action.LAND, Action.RTL], armed=True) is Action.LAND
-    assert selected([Action.LAND], armed=False) is Action.NONE
-    assert Px4Settings(fail_act_t=0.1).delay_s == 0.0 and Px4Settings(fail_act_t=5).delay_s == 5.0
-    assert NAV_STATES == {Action.HOLD: 4, Action.RTL: 5, Action.LAND: 18}
+    assert actions.selected([Action.WARN, Action.LAND, Action.RTL], armed=True) is Action.LAND
+    assert actions.selected([Action.LAND], armed=False) is Action.NONE
+    assert actions.Px4Settings(fail_act_t=0.1).delay_s == 0.0 and actions.Px4Settings(fail_act_t=5).delay_s == 5.0
+    assert actions.NAV_STATES == {Action.HOLD: 4, Action.RTL: 5, Action.LAND: 18}
 
 
 # -- synthetic logs: every level and action at the boundaries
