@@ -6,7 +6,7 @@ constants shared by both directions (:class:`ModuleConstants`). The emitter mixi
 package (numeric, choices, cells, devicetree, messages, px4, px4_cells) build on it.
 
 Emitters write each statement on one line (a call as :func:`call` spells it); the module is
-laid out afterwards by the layout engine. Temporaries an emitter writes (``_v``, ``_c``, ...;
+formatted afterwards by ruff. Temporaries an emitter writes (``_v``, ``_c``, ...;
 see :data:`TEMPORARIES`) get the rule's number as a suffix when emitted, so each has one type
 across the function (mypy) and a reader can tell which rule made it.
 """
@@ -39,7 +39,7 @@ from ....ir import (
 )
 from ....ir.mapping_values import ConstantRef, Number, Value
 from .. import naming
-from ..layout import LINE_LENGTH
+from ..formatting import LINE_LENGTH
 from ..literals import float_literal, py_literal
 
 FLT_EPS = 1.1920928955078125e-07
