@@ -275,11 +275,6 @@ class RuleContext:
         """Conditions that ``var`` is none of ``marks`` (NaN by ``var == var``)."""
         return [f"{var} == {var}" if _nan(m) else f"{var} != {py_literal(m)}" for m in marks]
 
-    def unit_of(self, ref: FieldRef) -> Unit | None:
-        if ref.message == CONCEPTS_ENDPOINT:
-            return self.concepts[ref.field].unit
-        return self.fld(ref).unit
-
     def format_and_concept(self, rule: Rule) -> tuple[FieldRef, FieldRef]:
         """(the format field, the concept) of a rule relating one of each, whichever side is which."""
         fmt, con = rule.sources[0], rule.targets[0]
