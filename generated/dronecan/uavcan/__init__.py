@@ -78,6 +78,8 @@ class Timestamp:
             obj.usec = _m.as_int(data["usec"], "usec")
         return obj
 
+    # Wire layout (Timestamp.uavcan), bits from the start of the payload:
+    #   bits 0-55      uint56 usec  (line 6)
     DATA_TYPE_ID: _ClassVar[int | None] = None
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x05BD0B5C81087E0D
 

@@ -326,6 +326,9 @@ class BatteryCells:
             obj.index = _m.as_int(data["index"], "index")
         return obj
 
+    # Wire layout (20012.BatteryCells.uavcan), bits from the start of the payload:
+    #   bits 0-        float16[<=24] voltages: a 5-bit length, then <=24 x 16 bits  (line 6)
+    #   bits voltages+0 uint16 index  (line 7)
     DATA_TYPE_ID: _ClassVar[int | None] = 20012
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x5C8B1ABD15890EA4
 
@@ -628,6 +631,16 @@ class BatteryContinuous:
             obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
         return obj
 
+    # Wire layout (20010.BatteryContinuous.uavcan), bits from the start of the payload:
+    #   bits 0-15      float16 temperature_cells  (line 5)
+    #   bits 16-31     float16 temperature_pcb  (line 6)
+    #   bits 32-47     float16 temperature_other  (line 7)
+    #   bits 48-79     float32 current  (line 8)
+    #   bits 80-111    float32 voltage  (line 9)
+    #   bits 112-127   float16 state_of_charge  (line 10)
+    #   bits 128-135   uint8 slot_id  (line 11)
+    #   bits 136-167   float32 capacity_consumed  (line 12)
+    #   bits 168-199   uint32 status_flags  (line 13)
     DATA_TYPE_ID: _ClassVar[int | None] = 20010
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x756B561340D5E4AE
 
@@ -1036,6 +1049,15 @@ class BatteryInfoAux:
             obj.battery_id = _m.as_int(data["battery_id"], "battery_id")
         return obj
 
+    # Wire layout (20004.BatteryInfoAux.uavcan), bits from the start of the payload:
+    #   bits 0-55      dronecan.uavcan.Timestamp timestamp  (line 8)
+    #   bits 56-       float16[<=255] voltage_cell: a 8-bit length, then <=255 x 16 bits  (line 11)
+    #   bits voltage_cell+0 uint16 cycle_count  (line 14)
+    #   bits voltage_cell+16 uint16 over_discharge_count  (line 17)
+    #   bits voltage_cell+32 float16 max_current  (line 20)
+    #   bits voltage_cell+48 float16 nominal_voltage  (line 23)
+    #   bits voltage_cell+64 bool is_powering_off  (line 25)
+    #   bits voltage_cell+65 uint8 battery_id  (line 27)
     DATA_TYPE_ID: _ClassVar[int | None] = 20004
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x7D7F49FC75484882
 
@@ -1546,6 +1568,22 @@ class BatteryPeriodic:
             obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
         return obj
 
+    # Wire layout (20011.BatteryPeriodic.uavcan), bits from the start of the payload:
+    #   bits 0-        uint8[<=50] name: a 6-bit length, then <=50 x 8 bits  (line 5)
+    #   bits name+0-   uint8[<=32] serial_number: a 6-bit length, then <=32 x 8 bits  (line 6)
+    #   bits serial_number+0- uint8[<=9] manufacture_date: a 4-bit length, then <=9 x 8 bits  (line 7)
+    #   bits manufacture_date+0 float32 design_capacity  (line 8)
+    #   bits manufacture_date+32 uint8 cells_in_series  (line 9)
+    #   bits manufacture_date+40 float16 nominal_voltage  (line 10)
+    #   bits manufacture_date+56 float16 discharge_minimum_voltage  (line 11)
+    #   bits manufacture_date+72 float16 charging_minimum_voltage  (line 12)
+    #   bits manufacture_date+88 float16 charging_maximum_voltage  (line 13)
+    #   bits manufacture_date+104 float32 charging_maximum_current  (line 14)
+    #   bits manufacture_date+136 float32 discharge_maximum_current  (line 15)
+    #   bits manufacture_date+168 float32 discharge_maximum_burst_current  (line 16)
+    #   bits manufacture_date+200 float32 full_charge_capacity  (line 17)
+    #   bits manufacture_date+232 uint16 cycle_count  (line 18)
+    #   bits manufacture_date+248 uint8 state_of_health  (line 19)
     DATA_TYPE_ID: _ClassVar[int | None] = 20011
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x0F012494E97358D2
 
@@ -2197,6 +2235,13 @@ class BatteryTag:
             obj.last_arm_time_mins = _m.as_int(data["last_arm_time_mins"], "last_arm_time_mins")
         return obj
 
+    # Wire layout (20500.BatteryTag.uavcan), bits from the start of the payload:
+    #   bits 0-31      uint32 serial_number  (line 7)
+    #   bits 32-63     uint32 num_cycles  (line 11)
+    #   bits 64-95     float32 armed_hours  (line 15)
+    #   bits 96-127    uint32 battery_capacity_mAh  (line 18)
+    #   bits 128-159   uint32 first_use_mins  (line 21)
+    #   bits 160-191   uint32 last_arm_time_mins  (line 24)
     DATA_TYPE_ID: _ClassVar[int | None] = 20500
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x4A5A9B42099F73E1
 

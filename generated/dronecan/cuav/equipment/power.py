@@ -405,6 +405,32 @@ class CBAT:
             obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
         return obj
 
+    # Wire layout (20300.CBAT.uavcan), bits from the start of the payload:
+    #   bits 0-31      float32 temperature  (line 5)
+    #   bits 32-63     float32 voltage  (line 6)
+    #   bits 64-       float32[<=15] voltage_cell: a 4-bit length, then <=15 x 32 bits  (line 7)
+    #   bits voltage_cell+0 uint8 cell_count  (line 8)
+    #   bits voltage_cell+8 float32 current  (line 9)
+    #   bits voltage_cell+40 float32 average_current  (line 10)
+    #   bits voltage_cell+72 float32 average_power  (line 11)
+    #   bits voltage_cell+104 float32 available_energy  (line 12)
+    #   bits voltage_cell+136 float32 remaining_capacity  (line 13)
+    #   bits voltage_cell+168 float32 full_charge_capacity  (line 14)
+    #   bits voltage_cell+200 float32 design_capacity  (line 15)
+    #   bits voltage_cell+232 uint16 average_time_to_empty  (line 16)
+    #   bits voltage_cell+248 uint16 average_time_to_full  (line 17)
+    #   bits voltage_cell+264 uint7 state_of_health  (line 18)
+    #   bits voltage_cell+271 uint7 state_of_charge  (line 19)
+    #   bits voltage_cell+278 uint7 max_error  (line 20)
+    #   bits voltage_cell+285 uint16 serial_number  (line 21)
+    #   bits voltage_cell+301 uint16 manufacture_date  (line 22)
+    #   bits voltage_cell+317 uint16 cycle_count  (line 23)
+    #   bits voltage_cell+333 uint16 over_discharge_count  (line 24)
+    #   bits voltage_cell+349 float32 passed_charge  (line 25)
+    #   bits voltage_cell+381 float32 nominal_voltage  (line 26)
+    #   bits voltage_cell+413 bool is_powering_off  (line 27)
+    #   bits voltage_cell+414 uint16 interface_error  (line 28)
+    #   bits voltage_cell+430 uint11 status_flags  (line 41)
     DATA_TYPE_ID: _ClassVar[int | None] = 20300
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0xB4DACE3A38E09A74
 

@@ -441,6 +441,21 @@ class BatteryInfo:
             obj.model_name = _m.as_bytes(data["model_name"], "model_name", 31, False)
         return obj
 
+    # Wire layout (1092.BatteryInfo.uavcan), bits from the start of the payload:
+    #   bits 0-15      float16 temperature  (line 10)
+    #   bits 16-31     float16 voltage  (line 11)
+    #   bits 32-47     float16 current  (line 12)
+    #   bits 48-63     float16 average_power_10sec  (line 13)
+    #   bits 64-79     float16 remaining_capacity_wh  (line 14)
+    #   bits 80-95     float16 full_charge_capacity_wh  (line 15)
+    #   bits 96-111    float16 hours_to_full_charge  (line 16)
+    #   bits 112-122   uint11 status_flags  (line 33)
+    #   bits 123-129   uint7 state_of_health_pct  (line 37)
+    #   bits 130-136   uint7 state_of_charge_pct  (line 40)
+    #   bits 137-143   uint7 state_of_charge_pct_stdev  (line 41)
+    #   bits 144-151   uint8 battery_id  (line 44)
+    #   bits 152-183   uint32 model_instance_id  (line 45)
+    #   bits 184-      uint8[<=31] model_name: <=31 x 8 bits, the tail array (no length prefix with TAO)  (line 46)
     DATA_TYPE_ID: _ClassVar[int | None] = 1092
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x249C26548A711966
 
@@ -999,6 +1014,11 @@ class CircuitStatus:
             obj.error_flags = _m.as_int(data["error_flags"], "error_flags")
         return obj
 
+    # Wire layout (1091.CircuitStatus.uavcan), bits from the start of the payload:
+    #   bits 0-15      uint16 circuit_id  (line 5)
+    #   bits 16-31     float16 voltage  (line 7)
+    #   bits 32-47     float16 current  (line 8)
+    #   bits 48-55     uint8 error_flags  (line 14)
     DATA_TYPE_ID: _ClassVar[int | None] = 1091
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x8313D33D0DDDA115
 
@@ -1250,6 +1270,12 @@ class PrimaryPowerSupplyStatus:
             obj.remaining_energy_pct_stdev = _m.as_int(data["remaining_energy_pct_stdev"], "remaining_energy_pct_stdev")
         return obj
 
+    # Wire layout (1090.PrimaryPowerSupplyStatus.uavcan), bits from the start of the payload:
+    #   bits 0-15      float16 hours_to_empty_at_10sec_avg_power  (line 6)
+    #   bits 16-31     float16 hours_to_empty_at_10sec_avg_power_variance  (line 7)
+    #   bits 32-32     bool external_power_available  (line 10)
+    #   bits 33-39     uint7 remaining_energy_pct  (line 13)
+    #   bits 40-46     uint7 remaining_energy_pct_stdev  (line 14)
     DATA_TYPE_ID: _ClassVar[int | None] = 1090
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0xBBA05074AD757480
 
