@@ -272,57 +272,68 @@ class BattParams:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         x: _Any
+        # BATT_CAPACITY (battery_failsafe.pdef.xml:12): fits int32
         try:
             if (self.BATT_CAPACITY + 2147483648) & -4294967296:
                 _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)
+        # BATT_LOW_VOLT (battery_failsafe.pdef.xml:18): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.BATT_LOW_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _BATT_PARAMS_BATT_LOW_VOLT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _BATT_PARAMS_BATT_LOW_VOLT_SPEC)
+        # BATT_LOW_TIMER (battery_failsafe.pdef.xml:24): fits int8; 0 <= value <= 120
         try:
             x = self.BATT_LOW_TIMER
             if (x + 128) & -256 or not (0 <= x <= 120):
                 _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _BATT_PARAMS_BATT_LOW_TIMER_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _BATT_PARAMS_BATT_LOW_TIMER_SPEC)
+        # BATT_FS_VOLTSRC (battery_failsafe.pdef.xml:31): fits int8; a value of FS_VOLTSRC
         try:
             if self.BATT_FS_VOLTSRC not in {0, 1}:
                 _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _BATT_PARAMS_BATT_FS_VOLTSRC_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _BATT_PARAMS_BATT_FS_VOLTSRC_SPEC)
+        # BATT_LOW_MAH (battery_failsafe.pdef.xml:39): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.BATT_LOW_MAH <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _BATT_PARAMS_BATT_LOW_MAH_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _BATT_PARAMS_BATT_LOW_MAH_SPEC)
+        # BATT_CRT_VOLT (battery_failsafe.pdef.xml:45): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.BATT_CRT_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _BATT_PARAMS_BATT_CRT_VOLT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _BATT_PARAMS_BATT_CRT_VOLT_SPEC)
+        # BATT_CRT_MAH (battery_failsafe.pdef.xml:51): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.BATT_CRT_MAH <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _BATT_PARAMS_BATT_CRT_MAH_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _BATT_PARAMS_BATT_CRT_MAH_SPEC)
+        # BATT_FS_LOW_ACT (battery_failsafe.pdef.xml:57): fits int8
         try:
             if (self.BATT_FS_LOW_ACT + 128) & -256:
                 _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC)
+        # BATT_FS_CRT_ACT (battery_failsafe.pdef.xml:61): fits int8
         try:
             if (self.BATT_FS_CRT_ACT + 128) & -256:
                 _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC)
+        # BATT_ARM_VOLT (battery_failsafe.pdef.xml:65): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.BATT_ARM_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _BATT_PARAMS_BATT_ARM_VOLT_SPEC)
         except _v.SLOW:
             _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _BATT_PARAMS_BATT_ARM_VOLT_SPEC)
+        # BATT_ARM_MAH (battery_failsafe.pdef.xml:71): fits int32
         try:
             if (self.BATT_ARM_MAH + 2147483648) & -4294967296:
                 _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _BATT_PARAMS_BATT_ARM_MAH_SPEC)

@@ -95,6 +95,7 @@ class Health_1_0:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
+        # value (Health.1.0.dsdl:3): fits uint2; a value of VALUE
         try:
             if self.value not in {0, 1, 2, 3}:
                 _v.diag(out, "value", self.value, _HEALTH_1_0_VALUE_SPEC)

@@ -94,6 +94,7 @@ class SynchronizedTimestamp_1_0:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
+        # microsecond (SynchronizedTimestamp.1.0.dsdl:3): fits uint56; UNKNOWN means unknown (accepted)
         try:
             if self.microsecond & -72057594037927936:
                 _v.diag(out, "microsecond", self.microsecond, _SYNCHRONIZED_TIMESTAMP_1_0_MICROSECOND_SPEC)

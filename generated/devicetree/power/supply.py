@@ -939,11 +939,14 @@ class SimpleBattery:
         r_voltage_min_design_microvolt: _Any
         v_i: _Any
         v_table: _Any
+        # compatible (battery.yaml:31): fits string[]
         try:
             if (x := self.compatible) is None or (len(x) < 1 or any(_x0 != "simple-battery" for _x0 in x)):
                 _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)
         except _v.SLOW:
             _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)
+        # device-chemistry (battery.yaml:34): fits string; one of nickel-cadmium, nickel-metal-hydride, lithium-ion,
+        # lithium-ion-polymer, lithium-ion-iron-phosphate, lithium-ion-manganese-oxide
         try:
             if (x := self.device_chemistry) is not None and (
                 x
@@ -959,6 +962,7 @@ class SimpleBattery:
                 _v.diag(out, "device-chemistry", self.device_chemistry, _SIMPLE_BATTERY_DEVICE_CHEMISTRY_SPEC)
         except _v.SLOW:
             _v.diag(out, "device-chemistry", self.device_chemistry, _SIMPLE_BATTERY_DEVICE_CHEMISTRY_SPEC)
+        # over-voltage-threshold-microvolt (battery.yaml:48): fits int32[][]
         try:
             if (x := self.over_voltage_threshold_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
@@ -976,6 +980,7 @@ class SimpleBattery:
                 self.over_voltage_threshold_microvolt,
                 _SIMPLE_BATTERY_OVER_VOLTAGE_THRESHOLD_MICROVOLT_SPEC,
             )
+        # re-charge-voltage-microvolt (battery.yaml:51): fits int32[][]
         try:
             if (x := self.re_charge_voltage_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
@@ -993,6 +998,7 @@ class SimpleBattery:
                 self.re_charge_voltage_microvolt,
                 _SIMPLE_BATTERY_RE_CHARGE_VOLTAGE_MICROVOLT_SPEC,
             )
+        # voltage-min-design-microvolt (battery.yaml:54): fits int32[][]
         try:
             if (x := self.voltage_min_design_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
@@ -1010,6 +1016,7 @@ class SimpleBattery:
                 self.voltage_min_design_microvolt,
                 _SIMPLE_BATTERY_VOLTAGE_MIN_DESIGN_MICROVOLT_SPEC,
             )
+        # voltage-max-design-microvolt (battery.yaml:57): fits int32[][]
         try:
             if (x := self.voltage_max_design_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
@@ -1027,6 +1034,7 @@ class SimpleBattery:
                 self.voltage_max_design_microvolt,
                 _SIMPLE_BATTERY_VOLTAGE_MAX_DESIGN_MICROVOLT_SPEC,
             )
+        # energy-full-design-microwatt-hours (battery.yaml:60): fits uint32[]
         try:
             a = self.energy_full_design_microwatt_hours
             if a is not None:
@@ -1054,6 +1062,7 @@ class SimpleBattery:
                 self.energy_full_design_microwatt_hours,
                 _SIMPLE_BATTERY_ENERGY_FULL_DESIGN_MICROWATT_HOURS_SPEC,
             )
+        # charge-full-design-microamp-hours (battery.yaml:63): fits uint32[]
         try:
             a = self.charge_full_design_microamp_hours
             if a is not None:
@@ -1081,6 +1090,7 @@ class SimpleBattery:
                 self.charge_full_design_microamp_hours,
                 _SIMPLE_BATTERY_CHARGE_FULL_DESIGN_MICROAMP_HOURS_SPEC,
             )
+        # trickle-charge-current-microamp (battery.yaml:66): fits uint32[]
         try:
             a = self.trickle_charge_current_microamp
             if a is not None:
@@ -1108,6 +1118,7 @@ class SimpleBattery:
                 self.trickle_charge_current_microamp,
                 _SIMPLE_BATTERY_TRICKLE_CHARGE_CURRENT_MICROAMP_SPEC,
             )
+        # tricklecharge-upper-limit-microvolt (battery.yaml:74): fits int32[][]
         try:
             if (x := self.tricklecharge_upper_limit_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
@@ -1125,6 +1136,7 @@ class SimpleBattery:
                 self.tricklecharge_upper_limit_microvolt,
                 _SIMPLE_BATTERY_TRICKLECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
             )
+        # precharge-current-microamp (battery.yaml:78): fits uint32[]
         try:
             a = self.precharge_current_microamp
             if a is not None:
@@ -1152,6 +1164,7 @@ class SimpleBattery:
                 self.precharge_current_microamp,
                 _SIMPLE_BATTERY_PRECHARGE_CURRENT_MICROAMP_SPEC,
             )
+        # precharge-upper-limit-microvolt (battery.yaml:81): fits int32[][]
         try:
             if (x := self.precharge_upper_limit_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
@@ -1169,6 +1182,7 @@ class SimpleBattery:
                 self.precharge_upper_limit_microvolt,
                 _SIMPLE_BATTERY_PRECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
             )
+        # charge-term-current-microamp (battery.yaml:84): fits uint32[]
         try:
             a = self.charge_term_current_microamp
             if a is not None:
@@ -1196,6 +1210,7 @@ class SimpleBattery:
                 self.charge_term_current_microamp,
                 _SIMPLE_BATTERY_CHARGE_TERM_CURRENT_MICROAMP_SPEC,
             )
+        # constant-charge-current-max-microamp (battery.yaml:87): fits uint32[]
         try:
             a = self.constant_charge_current_max_microamp
             if a is not None:
@@ -1223,6 +1238,7 @@ class SimpleBattery:
                 self.constant_charge_current_max_microamp,
                 _SIMPLE_BATTERY_CONSTANT_CHARGE_CURRENT_MAX_MICROAMP_SPEC,
             )
+        # constant-charge-voltage-max-microvolt (battery.yaml:90): fits int32[][]
         try:
             if (x := self.constant_charge_voltage_max_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
@@ -1240,6 +1256,7 @@ class SimpleBattery:
                 self.constant_charge_voltage_max_microvolt,
                 _SIMPLE_BATTERY_CONSTANT_CHARGE_VOLTAGE_MAX_MICROVOLT_SPEC,
             )
+        # factory-internal-resistance-micro-ohms (battery.yaml:93): fits uint32[]
         try:
             a = self.factory_internal_resistance_micro_ohms
             if a is not None:
@@ -1267,6 +1284,7 @@ class SimpleBattery:
                 self.factory_internal_resistance_micro_ohms,
                 _SIMPLE_BATTERY_FACTORY_INTERNAL_RESISTANCE_MICRO_OHMS_SPEC,
             )
+        # resistance-temp-table (battery.yaml:96): fits uint32[2][]
         try:
             if (x := self.resistance_temp_table) is not None and (
                 len(x) < 1 or any(len(_x0) != 2 or any(_x1 & -4294967296 for _x1 in _x0) for _x0 in x)
@@ -1278,6 +1296,7 @@ class SimpleBattery:
             _v.diag(
                 out, "resistance-temp-table", self.resistance_temp_table, _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC
             )
+        # ocv-capacity-celsius (battery.yaml:108): fits int32[]
         try:
             a = self.ocv_capacity_celsius
             if a is not None:
@@ -1300,6 +1319,7 @@ class SimpleBattery:
                             break
         except _v.SLOW:
             _v.diag(out, "ocv-capacity-celsius", self.ocv_capacity_celsius, _SIMPLE_BATTERY_OCV_CAPACITY_CELSIUS_SPEC)
+        # operating-range-celsius (battery.yaml:113): fits int32[2]
         try:
             a = self.operating_range_celsius
             if a is not None:
@@ -1327,6 +1347,7 @@ class SimpleBattery:
                 self.operating_range_celsius,
                 _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC,
             )
+        # ambient-celsius (battery.yaml:119): fits int32[2]
         try:
             a = self.ambient_celsius
             if a is not None:
@@ -1339,6 +1360,7 @@ class SimpleBattery:
                             break
         except _v.SLOW:
             _v.diag(out, "ambient-celsius", self.ambient_celsius, _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC)
+        # alert-celsius (battery.yaml:125): fits int32[2]
         try:
             a = self.alert_celsius
             if a is not None:
@@ -1351,6 +1373,7 @@ class SimpleBattery:
                             break
         except _v.SLOW:
             _v.diag(out, "alert-celsius", self.alert_celsius, _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC)
+        # volt-drop-thresh-microvolt (battery.yaml:134): fits int32[1][1]; value <= 48000000
         try:
             if (x := self.volt_drop_thresh_microvolt) is not None and (
                 len(x) != 1
@@ -1373,6 +1396,7 @@ class SimpleBattery:
                 self.volt_drop_thresh_microvolt,
                 _SIMPLE_BATTERY_VOLT_DROP_THRESH_MICROVOLT_SPEC,
             )
+        # volt-drop-soc-bp (battery.yaml:138): fits int32[]
         try:
             a = self.volt_drop_soc_bp
             if a is not None:
@@ -1387,6 +1411,7 @@ class SimpleBattery:
                             break
         except _v.SLOW:
             _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _SIMPLE_BATTERY_VOLT_DROP_SOC_BP_SPEC)
+        # volt-drop-temperatures-millicelsius (battery.yaml:142): fits int32[]
         try:
             a = self.volt_drop_temperatures_millicelsius
             if a is not None:
@@ -1414,6 +1439,7 @@ class SimpleBattery:
                 self.volt_drop_temperatures_millicelsius,
                 _SIMPLE_BATTERY_VOLT_DROP_TEMPERATURES_MILLICELSIUS_SPEC,
             )
+        # ^ocv-capacity-table-[0-9]+$ (battery.yaml:150): fits uint32[2][<=100]
         try:
             if any(
                 not _v.search("^ocv-capacity-table-[0-9]+$", k)
@@ -1439,6 +1465,7 @@ class SimpleBattery:
             _v.diag(
                 out, "^ocv-capacity-table-[0-9]+$", self.ocv_capacity_table_n, _SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC
             )
+        # ^volt-drop-[0-9]-microvolt (battery.yaml:164): fits int32[][]
         try:
             if any(
                 not _v.search("^volt-drop-[0-9]-microvolt", k)

@@ -122,6 +122,7 @@ class Timestamp:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
+        # usec (Timestamp.uavcan:6): fits uint56; UNKNOWN means unknown (accepted)
         try:
             if self.usec & -72057594037927936:
                 _v.diag(out, "usec", self.usec, _TIMESTAMP_USEC_SPEC)

@@ -16,6 +16,7 @@ from ..module_context import ModuleContext
 from ..naming import upper_snake
 from ..runtime import copied
 from ..views import ClassView
+from .describe import check_comment
 from .fields import field_code, is_optional
 from .rules import known_expr, rule_lines
 
@@ -43,6 +44,8 @@ class _Validators:
             spec_name = ctx.constant(view.name, f"{upper_snake(ident)}_SPEC")
             code = field_code(ctx.schema, msg, f, ident, spec_name)
             specs.append(f"{spec_name} = {code.spec_source}")
+            if code.lines:
+                checks += check_comment(ctx.schema, msg, f)
             checks += code.lines
             field_names |= code.names
         if msg.is_union:

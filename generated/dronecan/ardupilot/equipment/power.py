@@ -413,6 +413,7 @@ class BatteryCells:
         out: list[_v.Violation] = []
         a: _Any
         e: _Any
+        # voltages (20012.BatteryCells.uavcan:6): fits float16[<=24]
         try:
             a = self.voltages
             if len(a) > 24:
@@ -424,6 +425,7 @@ class BatteryCells:
                         break
         except _v.SLOW:
             _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
+        # index (20012.BatteryCells.uavcan:7): fits uint16
         try:
             if self.index & -65536:
                 _v.diag(out, "index", self.index, _BATTERY_CELLS_INDEX_SPEC)
@@ -854,46 +856,55 @@ class BatteryContinuous:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
+        # temperature_cells (20010.BatteryContinuous.uavcan:5): fits float16
         try:
             if not (-65504.0 <= self.temperature_cells <= 65504.0):
                 _v.diag(out, "temperature_cells", self.temperature_cells, _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC)
         except _v.SLOW:
             _v.diag(out, "temperature_cells", self.temperature_cells, _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC)
+        # temperature_pcb (20010.BatteryContinuous.uavcan:6): fits float16
         try:
             if not (-65504.0 <= self.temperature_pcb <= 65504.0):
                 _v.diag(out, "temperature_pcb", self.temperature_pcb, _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC)
         except _v.SLOW:
             _v.diag(out, "temperature_pcb", self.temperature_pcb, _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC)
+        # temperature_other (20010.BatteryContinuous.uavcan:7): fits float16
         try:
             if not (-65504.0 <= self.temperature_other <= 65504.0):
                 _v.diag(out, "temperature_other", self.temperature_other, _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC)
         except _v.SLOW:
             _v.diag(out, "temperature_other", self.temperature_other, _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC)
+        # current (20010.BatteryContinuous.uavcan:8): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.current <= 3.4028234663852886e38):
                 _v.diag(out, "current", self.current, _BATTERY_CONTINUOUS_CURRENT_SPEC)
         except _v.SLOW:
             _v.diag(out, "current", self.current, _BATTERY_CONTINUOUS_CURRENT_SPEC)
+        # voltage (20010.BatteryContinuous.uavcan:9): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.voltage <= 3.4028234663852886e38):
                 _v.diag(out, "voltage", self.voltage, _BATTERY_CONTINUOUS_VOLTAGE_SPEC)
         except _v.SLOW:
             _v.diag(out, "voltage", self.voltage, _BATTERY_CONTINUOUS_VOLTAGE_SPEC)
+        # state_of_charge (20010.BatteryContinuous.uavcan:10): fits float16
         try:
             if not (-65504.0 <= self.state_of_charge <= 65504.0):
                 _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC)
         except _v.SLOW:
             _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC)
+        # slot_id (20010.BatteryContinuous.uavcan:11): fits uint8
         try:
             if self.slot_id & -256:
                 _v.diag(out, "slot_id", self.slot_id, _BATTERY_CONTINUOUS_SLOT_ID_SPEC)
         except _v.SLOW:
             _v.diag(out, "slot_id", self.slot_id, _BATTERY_CONTINUOUS_SLOT_ID_SPEC)
+        # capacity_consumed (20010.BatteryContinuous.uavcan:12): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.capacity_consumed <= 3.4028234663852886e38):
                 _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC)
         except _v.SLOW:
             _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC)
+        # status_flags (20010.BatteryContinuous.uavcan:13): fits uint32; bits of STATUS_FLAG only
         try:
             if self.status_flags & -524288:
                 _v.diag(out, "status_flags", self.status_flags, _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC)
@@ -1249,6 +1260,7 @@ class BatteryInfoAux:
         a: _Any
         e: _Any
         sub: _Any
+        # timestamp (20004.BatteryInfoAux.uavcan:8): fits dronecan.uavcan.Timestamp
         try:
             x = self.timestamp
             if x.QUALIFIED_NAME != "dronecan.uavcan.Timestamp":
@@ -1259,6 +1271,7 @@ class BatteryInfoAux:
                     out.extend(_v.prefixed("timestamp", sub))
         except _v.SLOW:
             _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_AUX_TIMESTAMP_SPEC)
+        # voltage_cell (20004.BatteryInfoAux.uavcan:11): fits float16[<=255]
         try:
             a = self.voltage_cell
             if len(a) > 255:
@@ -1270,11 +1283,13 @@ class BatteryInfoAux:
                         break
         except _v.SLOW:
             _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
+        # cycle_count (20004.BatteryInfoAux.uavcan:14): fits uint16
         try:
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC)
         except _v.SLOW:
             _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC)
+        # over_discharge_count (20004.BatteryInfoAux.uavcan:17): fits uint16
         try:
             if self.over_discharge_count & -65536:
                 _v.diag(
@@ -1282,22 +1297,26 @@ class BatteryInfoAux:
                 )
         except _v.SLOW:
             _v.diag(out, "over_discharge_count", self.over_discharge_count, _BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC)
+        # max_current (20004.BatteryInfoAux.uavcan:20): fits float16
         try:
             if not (-65504.0 <= self.max_current <= 65504.0):
                 _v.diag(out, "max_current", self.max_current, _BATTERY_INFO_AUX_MAX_CURRENT_SPEC)
         except _v.SLOW:
             _v.diag(out, "max_current", self.max_current, _BATTERY_INFO_AUX_MAX_CURRENT_SPEC)
+        # nominal_voltage (20004.BatteryInfoAux.uavcan:23): fits float16
         try:
             if not (-65504.0 <= self.nominal_voltage <= 65504.0):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC)
         except _v.SLOW:
             _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC)
+        # is_powering_off (20004.BatteryInfoAux.uavcan:25): fits bool
         try:
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC)
         except _v.SLOW:
             _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC)
+        # battery_id (20004.BatteryInfoAux.uavcan:27): fits uint8
         try:
             if self.battery_id & -256:
                 _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_AUX_BATTERY_ID_SPEC)
@@ -1963,39 +1982,46 @@ class BatteryPeriodic:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         x: _Any
+        # name (20011.BatteryPeriodic.uavcan:5): fits uint8[<=50]
         try:
             x = self.name
             if x.__class__ is not bytes or len(x) > 50:
                 _v.diag(out, "name", self.name, _BATTERY_PERIODIC_NAME_SPEC)
         except _v.SLOW:
             _v.diag(out, "name", self.name, _BATTERY_PERIODIC_NAME_SPEC)
+        # serial_number (20011.BatteryPeriodic.uavcan:6): fits uint8[<=32]
         try:
             x = self.serial_number
             if x.__class__ is not bytes or len(x) > 32:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC)
         except _v.SLOW:
             _v.diag(out, "serial_number", self.serial_number, _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC)
+        # manufacture_date (20011.BatteryPeriodic.uavcan:7): fits uint8[<=9]
         try:
             x = self.manufacture_date
             if x.__class__ is not bytes or len(x) > 9:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC)
         except _v.SLOW:
             _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC)
+        # design_capacity (20011.BatteryPeriodic.uavcan:8): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC)
         except _v.SLOW:
             _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC)
+        # cells_in_series (20011.BatteryPeriodic.uavcan:9): fits uint8
         try:
             if self.cells_in_series & -256:
                 _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC)
         except _v.SLOW:
             _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC)
+        # nominal_voltage (20011.BatteryPeriodic.uavcan:10): fits float16
         try:
             if not (-65504.0 <= self.nominal_voltage <= 65504.0):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC)
         except _v.SLOW:
             _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC)
+        # discharge_minimum_voltage (20011.BatteryPeriodic.uavcan:11): fits float16
         try:
             if not (-65504.0 <= self.discharge_minimum_voltage <= 65504.0):
                 _v.diag(
@@ -2011,6 +2037,7 @@ class BatteryPeriodic:
                 self.discharge_minimum_voltage,
                 _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
             )
+        # charging_minimum_voltage (20011.BatteryPeriodic.uavcan:12): fits float16
         try:
             if not (-65504.0 <= self.charging_minimum_voltage <= 65504.0):
                 _v.diag(
@@ -2026,6 +2053,7 @@ class BatteryPeriodic:
                 self.charging_minimum_voltage,
                 _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC,
             )
+        # charging_maximum_voltage (20011.BatteryPeriodic.uavcan:13): fits float16
         try:
             if not (-65504.0 <= self.charging_maximum_voltage <= 65504.0):
                 _v.diag(
@@ -2041,6 +2069,7 @@ class BatteryPeriodic:
                 self.charging_maximum_voltage,
                 _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC,
             )
+        # charging_maximum_current (20011.BatteryPeriodic.uavcan:14): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.charging_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
@@ -2056,6 +2085,7 @@ class BatteryPeriodic:
                 self.charging_maximum_current,
                 _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC,
             )
+        # discharge_maximum_current (20011.BatteryPeriodic.uavcan:15): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.discharge_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
@@ -2071,6 +2101,7 @@ class BatteryPeriodic:
                 self.discharge_maximum_current,
                 _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC,
             )
+        # discharge_maximum_burst_current (20011.BatteryPeriodic.uavcan:16): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.discharge_maximum_burst_current <= 3.4028234663852886e38):
                 _v.diag(
@@ -2086,6 +2117,7 @@ class BatteryPeriodic:
                 self.discharge_maximum_burst_current,
                 _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
             )
+        # full_charge_capacity (20011.BatteryPeriodic.uavcan:17): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.full_charge_capacity <= 3.4028234663852886e38):
                 _v.diag(
@@ -2093,11 +2125,13 @@ class BatteryPeriodic:
                 )
         except _v.SLOW:
             _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC)
+        # cycle_count (20011.BatteryPeriodic.uavcan:18): fits uint16
         try:
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_PERIODIC_CYCLE_COUNT_SPEC)
         except _v.SLOW:
             _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_PERIODIC_CYCLE_COUNT_SPEC)
+        # state_of_health (20011.BatteryPeriodic.uavcan:19): fits uint8
         try:
             if self.state_of_health & -256:
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC)
@@ -2321,31 +2355,37 @@ class BatteryTag:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
+        # serial_number (20500.BatteryTag.uavcan:7): fits uint32
         try:
             if self.serial_number & -4294967296:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_TAG_SERIAL_NUMBER_SPEC)
         except _v.SLOW:
             _v.diag(out, "serial_number", self.serial_number, _BATTERY_TAG_SERIAL_NUMBER_SPEC)
+        # num_cycles (20500.BatteryTag.uavcan:11): fits uint32
         try:
             if self.num_cycles & -4294967296:
                 _v.diag(out, "num_cycles", self.num_cycles, _BATTERY_TAG_NUM_CYCLES_SPEC)
         except _v.SLOW:
             _v.diag(out, "num_cycles", self.num_cycles, _BATTERY_TAG_NUM_CYCLES_SPEC)
+        # armed_hours (20500.BatteryTag.uavcan:15): fits float32
         try:
             if not (-3.4028234663852886e38 <= self.armed_hours <= 3.4028234663852886e38):
                 _v.diag(out, "armed_hours", self.armed_hours, _BATTERY_TAG_ARMED_HOURS_SPEC)
         except _v.SLOW:
             _v.diag(out, "armed_hours", self.armed_hours, _BATTERY_TAG_ARMED_HOURS_SPEC)
+        # battery_capacity_mAh (20500.BatteryTag.uavcan:18): fits uint32
         try:
             if self.battery_capacity_mAh & -4294967296:
                 _v.diag(out, "battery_capacity_mAh", self.battery_capacity_mAh, _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC)
         except _v.SLOW:
             _v.diag(out, "battery_capacity_mAh", self.battery_capacity_mAh, _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC)
+        # first_use_mins (20500.BatteryTag.uavcan:21): fits uint32
         try:
             if self.first_use_mins & -4294967296:
                 _v.diag(out, "first_use_mins", self.first_use_mins, _BATTERY_TAG_FIRST_USE_MINS_SPEC)
         except _v.SLOW:
             _v.diag(out, "first_use_mins", self.first_use_mins, _BATTERY_TAG_FIRST_USE_MINS_SPEC)
+        # last_arm_time_mins (20500.BatteryTag.uavcan:24): fits uint32
         try:
             if self.last_arm_time_mins & -4294967296:
                 _v.diag(out, "last_arm_time_mins", self.last_arm_time_mins, _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC)

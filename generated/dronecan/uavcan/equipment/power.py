@@ -785,30 +785,35 @@ class BatteryInfo:
         x: _Any
         r_state_of_charge_pct: _Any
         r_state_of_health_pct: _Any
+        # temperature (1092.BatteryInfo.uavcan:10): fits float16; NaN means unknown (accepted)
         try:
             x = self.temperature
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_INFO_TEMPERATURE_SPEC)
         except _v.SLOW:
             _v.diag(out, "temperature", self.temperature, _BATTERY_INFO_TEMPERATURE_SPEC)
+        # voltage (1092.BatteryInfo.uavcan:11): fits float16; NaN means unknown (accepted)
         try:
             x = self.voltage
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "voltage", self.voltage, _BATTERY_INFO_VOLTAGE_SPEC)
         except _v.SLOW:
             _v.diag(out, "voltage", self.voltage, _BATTERY_INFO_VOLTAGE_SPEC)
+        # current (1092.BatteryInfo.uavcan:12): fits float16; NaN means unknown (accepted)
         try:
             x = self.current
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "current", self.current, _BATTERY_INFO_CURRENT_SPEC)
         except _v.SLOW:
             _v.diag(out, "current", self.current, _BATTERY_INFO_CURRENT_SPEC)
+        # average_power_10sec (1092.BatteryInfo.uavcan:13): fits float16; NaN means unknown (accepted)
         try:
             x = self.average_power_10sec
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "average_power_10sec", self.average_power_10sec, _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC)
         except _v.SLOW:
             _v.diag(out, "average_power_10sec", self.average_power_10sec, _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC)
+        # remaining_capacity_wh (1092.BatteryInfo.uavcan:14): fits float16; NaN means unknown (accepted)
         try:
             x = self.remaining_capacity_wh
             if not (-65504.0 <= x <= 65504.0) and x == x:
@@ -817,6 +822,7 @@ class BatteryInfo:
                 )
         except _v.SLOW:
             _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC)
+        # full_charge_capacity_wh (1092.BatteryInfo.uavcan:15): fits float16; NaN means unknown (accepted)
         try:
             x = self.full_charge_capacity_wh
             if not (-65504.0 <= x <= 65504.0) and x == x:
@@ -830,27 +836,32 @@ class BatteryInfo:
             _v.diag(
                 out, "full_charge_capacity_wh", self.full_charge_capacity_wh, _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC
             )
+        # hours_to_full_charge (1092.BatteryInfo.uavcan:16): fits float16; NaN means unknown (accepted)
         try:
             x = self.hours_to_full_charge
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC)
         except _v.SLOW:
             _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC)
+        # status_flags (1092.BatteryInfo.uavcan:33): fits uint11; bits of STATUS_FLAG only
         try:
             if self.status_flags & -512:
                 _v.diag(out, "status_flags", self.status_flags, _BATTERY_INFO_STATUS_FLAGS_SPEC)
         except _v.SLOW:
             _v.diag(out, "status_flags", self.status_flags, _BATTERY_INFO_STATUS_FLAGS_SPEC)
+        # state_of_health_pct (1092.BatteryInfo.uavcan:37): fits uint7; STATE_OF_HEALTH_UNKNOWN means unknown (accepted)
         try:
             if self.state_of_health_pct & -128:
                 _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC)
         except _v.SLOW:
             _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC)
+        # state_of_charge_pct (1092.BatteryInfo.uavcan:40): fits uint7
         try:
             if self.state_of_charge_pct & -128:
                 _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC)
         except _v.SLOW:
             _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC)
+        # state_of_charge_pct_stdev (1092.BatteryInfo.uavcan:41): fits uint7
         try:
             if self.state_of_charge_pct_stdev & -128:
                 _v.diag(
@@ -866,16 +877,19 @@ class BatteryInfo:
                 self.state_of_charge_pct_stdev,
                 _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC,
             )
+        # battery_id (1092.BatteryInfo.uavcan:44): fits uint8
         try:
             if self.battery_id & -256:
                 _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_BATTERY_ID_SPEC)
         except _v.SLOW:
             _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_BATTERY_ID_SPEC)
+        # model_instance_id (1092.BatteryInfo.uavcan:45): fits uint32
         try:
             if self.model_instance_id & -4294967296:
                 _v.diag(out, "model_instance_id", self.model_instance_id, _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC)
         except _v.SLOW:
             _v.diag(out, "model_instance_id", self.model_instance_id, _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC)
+        # model_name (1092.BatteryInfo.uavcan:46): fits uint8[<=31]
         try:
             x = self.model_name
             if x.__class__ is not bytes or len(x) > 31:
@@ -1122,21 +1136,25 @@ class CircuitStatus:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
+        # circuit_id (1091.CircuitStatus.uavcan:5): fits uint16
         try:
             if self.circuit_id & -65536:
                 _v.diag(out, "circuit_id", self.circuit_id, _CIRCUIT_STATUS_CIRCUIT_ID_SPEC)
         except _v.SLOW:
             _v.diag(out, "circuit_id", self.circuit_id, _CIRCUIT_STATUS_CIRCUIT_ID_SPEC)
+        # voltage (1091.CircuitStatus.uavcan:7): fits float16
         try:
             if not (-65504.0 <= self.voltage <= 65504.0):
                 _v.diag(out, "voltage", self.voltage, _CIRCUIT_STATUS_VOLTAGE_SPEC)
         except _v.SLOW:
             _v.diag(out, "voltage", self.voltage, _CIRCUIT_STATUS_VOLTAGE_SPEC)
+        # current (1091.CircuitStatus.uavcan:8): fits float16
         try:
             if not (-65504.0 <= self.current <= 65504.0):
                 _v.diag(out, "current", self.current, _CIRCUIT_STATUS_CURRENT_SPEC)
         except _v.SLOW:
             _v.diag(out, "current", self.current, _CIRCUIT_STATUS_CURRENT_SPEC)
+        # error_flags (1091.CircuitStatus.uavcan:14): fits uint8; bits of ERROR_FLAG only
         try:
             if self.error_flags & -16:
                 _v.diag(out, "error_flags", self.error_flags, _CIRCUIT_STATUS_ERROR_FLAGS_SPEC)
@@ -1387,6 +1405,7 @@ class PrimaryPowerSupplyStatus:
         out: list[_v.Violation] = []
         x: _Any
         r_remaining_energy_pct: _Any
+        # hours_to_empty_at_10sec_avg_power (1090.PrimaryPowerSupplyStatus.uavcan:6): fits float16
         try:
             if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power <= 65504.0):
                 _v.diag(
@@ -1402,6 +1421,7 @@ class PrimaryPowerSupplyStatus:
                 self.hours_to_empty_at_10sec_avg_power,
                 _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC,
             )
+        # hours_to_empty_at_10sec_avg_power_variance (1090.PrimaryPowerSupplyStatus.uavcan:7): fits float16
         try:
             if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power_variance <= 65504.0):
                 _v.diag(
@@ -1417,6 +1437,7 @@ class PrimaryPowerSupplyStatus:
                 self.hours_to_empty_at_10sec_avg_power_variance,
                 _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC,
             )
+        # external_power_available (1090.PrimaryPowerSupplyStatus.uavcan:10): fits bool
         try:
             x = self.external_power_available
             if x is not True and x is not False:
@@ -1433,6 +1454,7 @@ class PrimaryPowerSupplyStatus:
                 self.external_power_available,
                 _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC,
             )
+        # remaining_energy_pct (1090.PrimaryPowerSupplyStatus.uavcan:13): fits uint7
         try:
             if self.remaining_energy_pct & -128:
                 _v.diag(
@@ -1448,6 +1470,7 @@ class PrimaryPowerSupplyStatus:
                 self.remaining_energy_pct,
                 _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC,
             )
+        # remaining_energy_pct_stdev (1090.PrimaryPowerSupplyStatus.uavcan:14): fits uint7
         try:
             if self.remaining_energy_pct_stdev & -128:
                 _v.diag(

@@ -159,6 +159,7 @@ class PowerTs_0_1:
         out: list[_v.Violation] = []
         x: _Any
         sub: _Any
+        # timestamp (PowerTs.0.1.dsdl:3): fits cyphal.uavcan.time.SynchronizedTimestamp_1_0
         try:
             x = self.timestamp
             if x.QUALIFIED_NAME != "cyphal.uavcan.time.SynchronizedTimestamp_1_0":
@@ -169,6 +170,7 @@ class PowerTs_0_1:
                     out.extend(_v.prefixed("timestamp", sub))
         except _v.SLOW:
             _v.diag(out, "timestamp", self.timestamp, _POWER_TS_0_1_TIMESTAMP_SPEC)
+        # value (PowerTs.0.1.dsdl:4): fits cyphal.reg.udral.physics.electricity.Power_0_1
         try:
             x = self.value
             if x.QUALIFIED_NAME != "cyphal.reg.udral.physics.electricity.Power_0_1":
@@ -272,6 +274,7 @@ class Power_0_1:
         out: list[_v.Violation] = []
         x: _Any
         sub: _Any
+        # current (Power.0.1.dsdl:4): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
         try:
             x = self.current
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
@@ -282,6 +285,7 @@ class Power_0_1:
                     out.extend(_v.prefixed("current", sub))
         except _v.SLOW:
             _v.diag(out, "current", self.current, _POWER_0_1_CURRENT_SPEC)
+        # voltage (Power.0.1.dsdl:5): fits cyphal.uavcan.si.unit.voltage.Scalar_1_0
         try:
             x = self.voltage
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.voltage.Scalar_1_0":
@@ -383,6 +387,7 @@ class SourceTs_0_1:
         out: list[_v.Violation] = []
         x: _Any
         sub: _Any
+        # timestamp (SourceTs.0.1.dsdl:3): fits cyphal.uavcan.time.SynchronizedTimestamp_1_0
         try:
             x = self.timestamp
             if x.QUALIFIED_NAME != "cyphal.uavcan.time.SynchronizedTimestamp_1_0":
@@ -393,6 +398,7 @@ class SourceTs_0_1:
                     out.extend(_v.prefixed("timestamp", sub))
         except _v.SLOW:
             _v.diag(out, "timestamp", self.timestamp, _SOURCE_TS_0_1_TIMESTAMP_SPEC)
+        # value (SourceTs.0.1.dsdl:4): fits cyphal.reg.udral.physics.electricity.Source_0_1
         try:
             x = self.value
             if x.QUALIFIED_NAME != "cyphal.reg.udral.physics.electricity.Source_0_1":
@@ -504,6 +510,7 @@ class Source_0_1:
         out: list[_v.Violation] = []
         x: _Any
         sub: _Any
+        # power (Source.0.1.dsdl:4): fits cyphal.reg.udral.physics.electricity.Power_0_1
         try:
             x = self.power
             if x.QUALIFIED_NAME != "cyphal.reg.udral.physics.electricity.Power_0_1":
@@ -514,6 +521,7 @@ class Source_0_1:
                     out.extend(_v.prefixed("power", sub))
         except _v.SLOW:
             _v.diag(out, "power", self.power, _SOURCE_0_1_POWER_SPEC)
+        # energy (Source.0.1.dsdl:5): fits cyphal.uavcan.si.unit.energy.Scalar_1_0
         try:
             x = self.energy
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.energy.Scalar_1_0":
@@ -524,6 +532,7 @@ class Source_0_1:
                     out.extend(_v.prefixed("energy", sub))
         except _v.SLOW:
             _v.diag(out, "energy", self.energy, _SOURCE_0_1_ENERGY_SPEC)
+        # full_energy (Source.0.1.dsdl:6): fits cyphal.uavcan.si.unit.energy.Scalar_1_0
         try:
             x = self.full_energy
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.energy.Scalar_1_0":

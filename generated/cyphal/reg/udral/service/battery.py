@@ -297,6 +297,7 @@ class Error_0_1:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
+        # value (Error.0.1.dsdl:3): fits uint8; a value of VALUE
         try:
             if self.value not in {0, 10, 11, 20, 30, 50, 51, 60, 61, 62, 100, 101}:
                 _v.diag(out, "value", self.value, _ERROR_0_1_VALUE_SPEC)
@@ -599,11 +600,13 @@ class Parameters_0_3:
         out: list[_v.Violation] = []
         x: _Any
         sub: _Any
+        # unique_id (Parameters.0.3.dsdl:4): fits uint64
         try:
             if self.unique_id & -18446744073709551616:
                 _v.diag(out, "unique_id", self.unique_id, _PARAMETERS_0_3_UNIQUE_ID_SPEC)
         except _v.SLOW:
             _v.diag(out, "unique_id", self.unique_id, _PARAMETERS_0_3_UNIQUE_ID_SPEC)
+        # mass (Parameters.0.3.dsdl:5): fits cyphal.uavcan.si.unit.mass.Scalar_1_0
         try:
             x = self.mass
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.mass.Scalar_1_0":
@@ -614,6 +617,7 @@ class Parameters_0_3:
                     out.extend(_v.prefixed("mass", sub))
         except _v.SLOW:
             _v.diag(out, "mass", self.mass, _PARAMETERS_0_3_MASS_SPEC)
+        # design_capacity (Parameters.0.3.dsdl:6): fits cyphal.uavcan.si.unit.electric_charge.Scalar_1_0
         try:
             x = self.design_capacity
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_charge.Scalar_1_0":
@@ -624,6 +628,7 @@ class Parameters_0_3:
                     out.extend(_v.prefixed("design_capacity", sub))
         except _v.SLOW:
             _v.diag(out, "design_capacity", self.design_capacity, _PARAMETERS_0_3_DESIGN_CAPACITY_SPEC)
+        # design_cell_voltage_min_max (Parameters.0.3.dsdl:7): fits cyphal.uavcan.si.unit.voltage.Scalar_1_0[2]
         try:
             x = self.design_cell_voltage_min_max
             if len(x) != 2 or any(
@@ -642,6 +647,7 @@ class Parameters_0_3:
                 self.design_cell_voltage_min_max,
                 _PARAMETERS_0_3_DESIGN_CELL_VOLTAGE_MIN_MAX_SPEC,
             )
+        # discharge_current (Parameters.0.3.dsdl:8): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
         try:
             x = self.discharge_current
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
@@ -652,6 +658,7 @@ class Parameters_0_3:
                     out.extend(_v.prefixed("discharge_current", sub))
         except _v.SLOW:
             _v.diag(out, "discharge_current", self.discharge_current, _PARAMETERS_0_3_DISCHARGE_CURRENT_SPEC)
+        # discharge_current_burst (Parameters.0.3.dsdl:9): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
         try:
             x = self.discharge_current_burst
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
@@ -672,6 +679,7 @@ class Parameters_0_3:
                 self.discharge_current_burst,
                 _PARAMETERS_0_3_DISCHARGE_CURRENT_BURST_SPEC,
             )
+        # charge_current (Parameters.0.3.dsdl:10): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
         try:
             x = self.charge_current
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
@@ -682,6 +690,7 @@ class Parameters_0_3:
                     out.extend(_v.prefixed("charge_current", sub))
         except _v.SLOW:
             _v.diag(out, "charge_current", self.charge_current, _PARAMETERS_0_3_CHARGE_CURRENT_SPEC)
+        # charge_current_fast (Parameters.0.3.dsdl:11): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
         try:
             x = self.charge_current_fast
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
@@ -692,6 +701,7 @@ class Parameters_0_3:
                     out.extend(_v.prefixed("charge_current_fast", sub))
         except _v.SLOW:
             _v.diag(out, "charge_current_fast", self.charge_current_fast, _PARAMETERS_0_3_CHARGE_CURRENT_FAST_SPEC)
+        # charge_termination_threshold (Parameters.0.3.dsdl:12): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
         try:
             x = self.charge_termination_threshold
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
@@ -712,6 +722,7 @@ class Parameters_0_3:
                 self.charge_termination_threshold,
                 _PARAMETERS_0_3_CHARGE_TERMINATION_THRESHOLD_SPEC,
             )
+        # charge_voltage (Parameters.0.3.dsdl:13): fits cyphal.uavcan.si.unit.voltage.Scalar_1_0
         try:
             x = self.charge_voltage
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.voltage.Scalar_1_0":
@@ -722,21 +733,25 @@ class Parameters_0_3:
                     out.extend(_v.prefixed("charge_voltage", sub))
         except _v.SLOW:
             _v.diag(out, "charge_voltage", self.charge_voltage, _PARAMETERS_0_3_CHARGE_VOLTAGE_SPEC)
+        # cycle_count (Parameters.0.3.dsdl:14): fits uint16
         try:
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _PARAMETERS_0_3_CYCLE_COUNT_SPEC)
         except _v.SLOW:
             _v.diag(out, "cycle_count", self.cycle_count, _PARAMETERS_0_3_CYCLE_COUNT_SPEC)
+        # series_cell_count (Parameters.0.3.dsdl:16): fits uint8
         try:
             if self.series_cell_count & -256:
                 _v.diag(out, "series_cell_count", self.series_cell_count, _PARAMETERS_0_3_SERIES_CELL_COUNT_SPEC)
         except _v.SLOW:
             _v.diag(out, "series_cell_count", self.series_cell_count, _PARAMETERS_0_3_SERIES_CELL_COUNT_SPEC)
+        # state_of_health_pct (Parameters.0.3.dsdl:17): fits uint7
         try:
             if self.state_of_health_pct & -128:
                 _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _PARAMETERS_0_3_STATE_OF_HEALTH_PCT_SPEC)
         except _v.SLOW:
             _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _PARAMETERS_0_3_STATE_OF_HEALTH_PCT_SPEC)
+        # technology (Parameters.0.3.dsdl:19): fits cyphal.reg.udral.service.battery.Technology_0_1
         try:
             x = self.technology
             if x.QUALIFIED_NAME != "cyphal.reg.udral.service.battery.Technology_0_1":
@@ -747,6 +762,7 @@ class Parameters_0_3:
                     out.extend(_v.prefixed("technology", sub))
         except _v.SLOW:
             _v.diag(out, "technology", self.technology, _PARAMETERS_0_3_TECHNOLOGY_SPEC)
+        # nominal_voltage (Parameters.0.3.dsdl:20): fits cyphal.uavcan.si.unit.voltage.Scalar_1_0
         try:
             x = self.nominal_voltage
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.voltage.Scalar_1_0":
@@ -757,6 +773,7 @@ class Parameters_0_3:
                     out.extend(_v.prefixed("nominal_voltage", sub))
         except _v.SLOW:
             _v.diag(out, "nominal_voltage", self.nominal_voltage, _PARAMETERS_0_3_NOMINAL_VOLTAGE_SPEC)
+        # unix_manufacture_time (Parameters.0.3.dsdl:21): fits uint40
         try:
             if self.unix_manufacture_time & -1099511627776:
                 _v.diag(
@@ -766,6 +783,7 @@ class Parameters_0_3:
             _v.diag(
                 out, "unix_manufacture_time", self.unix_manufacture_time, _PARAMETERS_0_3_UNIX_MANUFACTURE_TIME_SPEC
             )
+        # name (Parameters.0.3.dsdl:22): fits uint8[<=64]
         try:
             x = self.name
             if x.__class__ is not bytes or len(x) > 64:
@@ -934,6 +952,7 @@ class Status_0_2:
         a: _Any
         e: _Any
         sub: _Any
+        # heartbeat (Status.0.2.dsdl:3): fits cyphal.reg.udral.service.common.Heartbeat_0_1
         try:
             x = self.heartbeat
             if x.QUALIFIED_NAME != "cyphal.reg.udral.service.common.Heartbeat_0_1":
@@ -944,6 +963,7 @@ class Status_0_2:
                     out.extend(_v.prefixed("heartbeat", sub))
         except _v.SLOW:
             _v.diag(out, "heartbeat", self.heartbeat, _STATUS_0_2_HEARTBEAT_SPEC)
+        # temperature_min_max (Status.0.2.dsdl:4): fits cyphal.uavcan.si.unit.temperature.Scalar_1_0[2]
         try:
             x = self.temperature_min_max
             if len(x) != 2 or any(
@@ -953,6 +973,7 @@ class Status_0_2:
                 _v.diag(out, "temperature_min_max", self.temperature_min_max, _STATUS_0_2_TEMPERATURE_MIN_MAX_SPEC)
         except _v.SLOW:
             _v.diag(out, "temperature_min_max", self.temperature_min_max, _STATUS_0_2_TEMPERATURE_MIN_MAX_SPEC)
+        # available_charge (Status.0.2.dsdl:5): fits cyphal.uavcan.si.unit.electric_charge.Scalar_1_0
         try:
             x = self.available_charge
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_charge.Scalar_1_0":
@@ -963,6 +984,7 @@ class Status_0_2:
                     out.extend(_v.prefixed("available_charge", sub))
         except _v.SLOW:
             _v.diag(out, "available_charge", self.available_charge, _STATUS_0_2_AVAILABLE_CHARGE_SPEC)
+        # error (Status.0.2.dsdl:6): fits cyphal.reg.udral.service.battery.Error_0_1
         try:
             x = self.error
             if x.QUALIFIED_NAME != "cyphal.reg.udral.service.battery.Error_0_1":
@@ -973,6 +995,7 @@ class Status_0_2:
                     out.extend(_v.prefixed("error", sub))
         except _v.SLOW:
             _v.diag(out, "error", self.error, _STATUS_0_2_ERROR_SPEC)
+        # cell_voltages (Status.0.2.dsdl:8): fits float16[<=255]
         try:
             a = self.cell_voltages
             if len(a) > 255:
@@ -1082,6 +1105,7 @@ class Technology_0_1:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
+        # value (Technology.0.1.dsdl:3): fits uint8; a value of VALUE
         try:
             if self.value not in {
                 0,

@@ -130,6 +130,7 @@ class Heartbeat_0_1:
         out: list[_v.Violation] = []
         x: _Any
         sub: _Any
+        # readiness (Heartbeat.0.1.dsdl:3): fits cyphal.reg.udral.service.common.Readiness_0_1
         try:
             x = self.readiness
             if x.QUALIFIED_NAME != "cyphal.reg.udral.service.common.Readiness_0_1":
@@ -140,6 +141,7 @@ class Heartbeat_0_1:
                     out.extend(_v.prefixed("readiness", sub))
         except _v.SLOW:
             _v.diag(out, "readiness", self.readiness, _HEARTBEAT_0_1_READINESS_SPEC)
+        # health (Heartbeat.0.1.dsdl:4): fits cyphal.uavcan.node.Health_1_0
         try:
             x = self.health
             if x.QUALIFIED_NAME != "cyphal.uavcan.node.Health_1_0":
@@ -227,6 +229,7 @@ class Readiness_0_1:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
+        # value (Readiness.0.1.dsdl:3): fits uint2; a value of VALUE
         try:
             if self.value not in {0, 2, 3}:
                 _v.diag(out, "value", self.value, _READINESS_0_1_VALUE_SPEC)

@@ -92,6 +92,7 @@ class Scalar_1_0:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         x: _Any
+        # kilogram (Scalar.1.0.dsdl:3): fits float32; NaN means unknown (accepted)
         try:
             x = self.kilogram
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
