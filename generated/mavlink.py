@@ -3777,7 +3777,8 @@ class SysStatus:
                 _v.diag(out, "errors_count4", self.errors_count4, _SYS_STATUS_ERRORS_COUNT4_SPEC)
         except _v.SLOW:
             _v.diag(out, "errors_count4", self.errors_count4, _SYS_STATUS_ERRORS_COUNT4_SPEC)
-        # onboard_control_sensors_present_extended (vehicle.xml:466): fits uint32; bits of MAV_SYS_STATUS_SENSOR_EXTENDED only
+        # onboard_control_sensors_present_extended (vehicle.xml:466): fits uint32; bits of
+        # MAV_SYS_STATUS_SENSOR_EXTENDED only
         try:
             if self.onboard_control_sensors_present_extended & -64:
                 _v.diag(
@@ -3793,7 +3794,8 @@ class SysStatus:
                 self.onboard_control_sensors_present_extended,
                 _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_EXTENDED_SPEC,
             )
-        # onboard_control_sensors_enabled_extended (vehicle.xml:467): fits uint32; bits of MAV_SYS_STATUS_SENSOR_EXTENDED only
+        # onboard_control_sensors_enabled_extended (vehicle.xml:467): fits uint32; bits of
+        # MAV_SYS_STATUS_SENSOR_EXTENDED only
         try:
             if self.onboard_control_sensors_enabled_extended & -64:
                 _v.diag(
@@ -3809,7 +3811,8 @@ class SysStatus:
                 self.onboard_control_sensors_enabled_extended,
                 _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_EXTENDED_SPEC,
             )
-        # onboard_control_sensors_health_extended (vehicle.xml:468): fits uint32; bits of MAV_SYS_STATUS_SENSOR_EXTENDED only
+        # onboard_control_sensors_health_extended (vehicle.xml:468): fits uint32; bits of MAV_SYS_STATUS_SENSOR_EXTENDED
+        # only
         try:
             if self.onboard_control_sensors_health_extended & -64:
                 _v.diag(

@@ -85,9 +85,11 @@ class Timestamp:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.usec
-        p2 = r1 & 0xFFFFFFFFFFFFFF
-        head = _TIMESTAMP_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
+        usec = self.usec
+        usec_bits = usec & 0xFFFFFFFFFFFFFF
+        head = _TIMESTAMP_ENCODE_STRUCT.pack(
+            (usec_bits & 0xFFFFFFFF), ((usec_bits >> 32) & 0xFFFF), ((usec_bits >> 48) & 0xFF)
+        )
         return head
 
     @classmethod
@@ -96,17 +98,20 @@ class Timestamp:
         n = len(data)
         if n < 7:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, n << 3)
-        u1, u2, u3 = _TIMESTAMP_DECODE_STRUCT.unpack_from(data)
-        x4 = u1 | (u2 << 32) | (u3 << 48)
+        packed1, packed2, packed3 = _TIMESTAMP_DECODE_STRUCT.unpack_from(data)
+        usec = packed1 | (packed2 << 32) | (packed3 << 48)
         if n > 7:
             raise _dc.DecodeError("Timestamp: " + str(n - 7) + " byte(s) beyond the end of the message")
-        return cls(x4)
+        return cls(usec)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.usec
-        p2 = r1 & 0xFFFFFFFFFFFFFF
+        usec = self.usec
+        usec_bits = usec & 0xFFFFFFFFFFFFFF
         acc = (acc << 56) | int.from_bytes(
-            _TIMESTAMP_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
+            _TIMESTAMP_ENCODE_STRUCT.pack(
+                (usec_bits & 0xFFFFFFFF), ((usec_bits >> 32) & 0xFFFF), ((usec_bits >> 48) & 0xFF)
+            ),
+            "big",
         )
         return acc
 
@@ -115,9 +120,9 @@ class Timestamp:
         if rem < 56:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3 = _TIMESTAMP_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
-        x4 = u1 | (u2 << 32) | (u3 << 48)
-        return cls(x4), rem
+        packed1, packed2, packed3 = _TIMESTAMP_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        usec = packed1 | (packed2 << 32) | (packed3 << 48)
+        return cls(usec), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""

@@ -341,9 +341,11 @@ class BatteryCells:
             raise _dc.EncodeError("BatteryCells.voltages: length " + str(k2) + " exceeds capacity 24")
         acc = (acc << 5) | k2
         acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
-        r4 = self.index
+        index = self.index
         acc = (acc << 16) | int.from_bytes(
-            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
+            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(
+                index if 0 <= index <= 65535 else (65535 if index > 65535 else 0)
+            ),
             "big",
         )
         return _dc.finish(acc)
@@ -351,7 +353,7 @@ class BatteryCells:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryCells:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f0: list[_Any]
+        voltages: list[_Any]
         n = len(data)
         v = int.from_bytes(data, "big")
         rem = n << 3
@@ -365,14 +367,14 @@ class BatteryCells:
         if rem < n2:
             raise _dc.short("BatteryCells.voltages", n2, rem)
         rem -= n2
-        f0 = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
+        voltages = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
         if rem < 16:
             raise _dc.cut(_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX, rem)
         rem -= 16
-        (u3,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
+        (index,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
         if rem >= 8:
             raise _dc.DecodeError("BatteryCells: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(f0, u3)
+        return cls(voltages, index)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         x1 = self.voltages
@@ -381,16 +383,18 @@ class BatteryCells:
             raise _dc.EncodeError("BatteryCells.voltages: length " + str(k2) + " exceeds capacity 24")
         acc = (acc << 5) | k2
         acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
-        r4 = self.index
+        index = self.index
         acc = (acc << 16) | int.from_bytes(
-            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
+            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(
+                index if 0 <= index <= 65535 else (65535 if index > 65535 else 0)
+            ),
             "big",
         )
         return acc
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryCells, int]:
-        f0: list[_Any]
+        voltages: list[_Any]
         if rem < 5:
             raise _dc.short("BatteryCells.voltages (length)", 5, rem)
         rem -= 5
@@ -401,12 +405,12 @@ class BatteryCells:
         if rem < n2:
             raise _dc.short("BatteryCells.voltages", n2, rem)
         rem -= n2
-        f0 = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
+        voltages = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
         if rem < 16:
             raise _dc.cut(_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX, rem)
         rem -= 16
-        (u3,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
-        return cls(f0, u3), rem
+        (index,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
+        return cls(voltages, index), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -648,93 +652,83 @@ class BatteryContinuous:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.temperature_cells
-        r2 = self.temperature_pcb
-        r3 = self.temperature_other
-        r4 = self.state_of_charge
-        g5, g6, g7, g8 = _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
-            _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-                (
-                    r3
-                    if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
-                ),
-                (
-                    r4
-                    if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
-                ),
+        temperature_cells = self.temperature_cells
+        temperature_pcb = self.temperature_pcb
+        temperature_other = self.temperature_other
+        state_of_charge = self.state_of_charge
+        temperature_cells_f32, temperature_pcb_f32, temperature_other_f32, state_of_charge_f32 = (
+            _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
+                _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
+                    temperature_cells
+                    if -65504.0 <= temperature_cells <= 65504.0
+                    else _dc.f16_saturated(temperature_cells),
+                    temperature_pcb if -65504.0 <= temperature_pcb <= 65504.0 else _dc.f16_saturated(temperature_pcb),
+                    temperature_other
+                    if -65504.0 <= temperature_other <= 65504.0
+                    else _dc.f16_saturated(temperature_other),
+                    state_of_charge if -65504.0 <= state_of_charge <= 65504.0 else _dc.f16_saturated(state_of_charge),
+                )
             )
         )
-        h9 = (
-            ((g5 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g5 < 0x477FF000
-            else (((g5 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g5 < 0xC77FF000 else _dc.f16bits(g5))
+        temperature_cells_f16 = (
+            ((temperature_cells_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_cells_f32 < 0x477FF000
+            else _dc.f16bits(temperature_cells_f32)
         )
-        h10 = (
-            ((g6 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g6 < 0x477FF000
-            else (((g6 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g6 < 0xC77FF000 else _dc.f16bits(g6))
+        temperature_pcb_f16 = (
+            ((temperature_pcb_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_pcb_f32 < 0x477FF000
+            else _dc.f16bits(temperature_pcb_f32)
         )
-        h11 = (
-            ((g7 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g7 < 0x477FF000
-            else (((g7 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g7 < 0xC77FF000 else _dc.f16bits(g7))
+        temperature_other_f16 = (
+            ((temperature_other_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_other_f32 < 0x477FF000
+            else _dc.f16bits(temperature_other_f32)
         )
-        h12 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        state_of_charge_f16 = (
+            ((state_of_charge_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= state_of_charge_f32 < 0x477FF000
+            else _dc.f16bits(state_of_charge_f32)
         )
-        r13 = self.current
-        r14 = self.voltage
-        r15 = self.slot_id
-        r16 = self.capacity_consumed
-        r17 = self.status_flags
+        current = self.current
+        voltage = self.voltage
+        slot_id = self.slot_id
+        capacity_consumed = self.capacity_consumed
+        status_flags = self.status_flags
         head = _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
-            h9,
-            h10,
-            h11,
+            temperature_cells_f16,
+            temperature_pcb_f16,
+            temperature_other_f16,
             (
-                r13
-                if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
+                current
+                if -_dc.F32_MAX <= current <= _dc.F32_MAX
                 else (
                     _dc.F32_MAX
-                    if _dc.F32_MAX < r13 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
+                    if _dc.F32_MAX < current < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < current < -_dc.F32_MAX else current)
                 )
             ),
             (
-                r14
-                if -_dc.F32_MAX <= r14 <= _dc.F32_MAX
+                voltage
+                if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
                 else (
                     _dc.F32_MAX
-                    if _dc.F32_MAX < r14 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r14 < -_dc.F32_MAX else r14)
+                    if _dc.F32_MAX < voltage < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
                 )
             ),
-            h12,
-            (r15 if 0 <= r15 <= 255 else (255 if r15 > 255 else 0)),
+            state_of_charge_f16,
+            (slot_id if 0 <= slot_id <= 255 else (255 if slot_id > 255 else 0)),
             (
-                r16
-                if -_dc.F32_MAX <= r16 <= _dc.F32_MAX
+                capacity_consumed
+                if -_dc.F32_MAX <= capacity_consumed <= _dc.F32_MAX
                 else (
                     _dc.F32_MAX
-                    if _dc.F32_MAX < r16 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r16 < -_dc.F32_MAX else r16)
+                    if _dc.F32_MAX < capacity_consumed < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < capacity_consumed < -_dc.F32_MAX else capacity_consumed)
                 )
             ),
-            (r17 if 0 <= r17 <= 4294967295 else (4294967295 if r17 > 4294967295 else 0)),
+            (status_flags if 0 <= status_flags <= 4294967295 else (4294967295 if status_flags > 4294967295 else 0)),
         )
         return head
 
@@ -744,100 +738,110 @@ class BatteryContinuous:
         n = len(data)
         if n < 25:
             raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, n << 3)
-        u1, u2, u3, u4, u5, u6, u7, u8, u9 = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack_from(data)
+        (
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        ) = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack_from(data)
         if n > 25:
             raise _dc.DecodeError("BatteryContinuous: " + str(n - 25) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, u3, u4, u5, u6, u7, u8, u9)
+        return cls(
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.temperature_cells
-        r2 = self.temperature_pcb
-        r3 = self.temperature_other
-        r4 = self.state_of_charge
-        g5, g6, g7, g8 = _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
-            _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-                (
-                    r3
-                    if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
-                ),
-                (
-                    r4
-                    if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
-                ),
+        temperature_cells = self.temperature_cells
+        temperature_pcb = self.temperature_pcb
+        temperature_other = self.temperature_other
+        state_of_charge = self.state_of_charge
+        temperature_cells_f32, temperature_pcb_f32, temperature_other_f32, state_of_charge_f32 = (
+            _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
+                _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
+                    temperature_cells
+                    if -65504.0 <= temperature_cells <= 65504.0
+                    else _dc.f16_saturated(temperature_cells),
+                    temperature_pcb if -65504.0 <= temperature_pcb <= 65504.0 else _dc.f16_saturated(temperature_pcb),
+                    temperature_other
+                    if -65504.0 <= temperature_other <= 65504.0
+                    else _dc.f16_saturated(temperature_other),
+                    state_of_charge if -65504.0 <= state_of_charge <= 65504.0 else _dc.f16_saturated(state_of_charge),
+                )
             )
         )
-        h9 = (
-            ((g5 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g5 < 0x477FF000
-            else (((g5 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g5 < 0xC77FF000 else _dc.f16bits(g5))
+        temperature_cells_f16 = (
+            ((temperature_cells_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_cells_f32 < 0x477FF000
+            else _dc.f16bits(temperature_cells_f32)
         )
-        h10 = (
-            ((g6 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g6 < 0x477FF000
-            else (((g6 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g6 < 0xC77FF000 else _dc.f16bits(g6))
+        temperature_pcb_f16 = (
+            ((temperature_pcb_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_pcb_f32 < 0x477FF000
+            else _dc.f16bits(temperature_pcb_f32)
         )
-        h11 = (
-            ((g7 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g7 < 0x477FF000
-            else (((g7 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g7 < 0xC77FF000 else _dc.f16bits(g7))
+        temperature_other_f16 = (
+            ((temperature_other_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_other_f32 < 0x477FF000
+            else _dc.f16bits(temperature_other_f32)
         )
-        h12 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        state_of_charge_f16 = (
+            ((state_of_charge_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= state_of_charge_f32 < 0x477FF000
+            else _dc.f16bits(state_of_charge_f32)
         )
-        r13 = self.current
-        r14 = self.voltage
-        r15 = self.slot_id
-        r16 = self.capacity_consumed
-        r17 = self.status_flags
+        current = self.current
+        voltage = self.voltage
+        slot_id = self.slot_id
+        capacity_consumed = self.capacity_consumed
+        status_flags = self.status_flags
         acc = (acc << 200) | int.from_bytes(
             _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
-                h9,
-                h10,
-                h11,
+                temperature_cells_f16,
+                temperature_pcb_f16,
+                temperature_other_f16,
                 (
-                    r13
-                    if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
+                    current
+                    if -_dc.F32_MAX <= current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r13 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
+                        if _dc.F32_MAX < current < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < current < -_dc.F32_MAX else current)
                     )
                 ),
                 (
-                    r14
-                    if -_dc.F32_MAX <= r14 <= _dc.F32_MAX
+                    voltage
+                    if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r14 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r14 < -_dc.F32_MAX else r14)
+                        if _dc.F32_MAX < voltage < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
                     )
                 ),
-                h12,
-                (r15 if 0 <= r15 <= 255 else (255 if r15 > 255 else 0)),
+                state_of_charge_f16,
+                (slot_id if 0 <= slot_id <= 255 else (255 if slot_id > 255 else 0)),
                 (
-                    r16
-                    if -_dc.F32_MAX <= r16 <= _dc.F32_MAX
+                    capacity_consumed
+                    if -_dc.F32_MAX <= capacity_consumed <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r16 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r16 < -_dc.F32_MAX else r16)
+                        if _dc.F32_MAX < capacity_consumed < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < capacity_consumed < -_dc.F32_MAX else capacity_consumed)
                     )
                 ),
-                (r17 if 0 <= r17 <= 4294967295 else (4294967295 if r17 > 4294967295 else 0)),
+                (status_flags if 0 <= status_flags <= 4294967295 else (4294967295 if status_flags > 4294967295 else 0)),
             ),
             "big",
         )
@@ -848,10 +852,28 @@ class BatteryContinuous:
         if rem < 200:
             raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, rem)
         rem -= 200
-        u1, u2, u3, u4, u5, u6, u7, u8, u9 = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack(
-            ((v >> rem) & ((1 << 200) - 1)).to_bytes(25, "big")
-        )
-        return cls(u1, u2, u3, u4, u5, u6, u7, u8, u9), rem
+        (
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        ) = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 200) - 1)).to_bytes(25, "big"))
+        return cls(
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -1074,56 +1096,56 @@ class BatteryInfoAux:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.timestamp.usec
-        p2 = r1 & 0xFFFFFFFFFFFFFF
-        head = _BATTERY_INFO_AUX_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
+        timestamp_usec = self.timestamp.usec
+        timestamp_usec_bits = timestamp_usec & 0xFFFFFFFFFFFFFF
+        head = _BATTERY_INFO_AUX_ENCODE_STRUCT.pack(
+            (timestamp_usec_bits & 0xFFFFFFFF),
+            ((timestamp_usec_bits >> 32) & 0xFFFF),
+            ((timestamp_usec_bits >> 48) & 0xFF),
+        )
         acc = 0x100000000000000 | int.from_bytes(head, "big")
-        x3 = self.voltage_cell
-        k4 = len(x3)
-        if k4 > 255:
-            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
-        acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(_struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
-        r6 = self.max_current
-        r7 = self.nominal_voltage
-        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
+        x1 = self.voltage_cell
+        k2 = len(x1)
+        if k2 > 255:
+            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k2) + " exceeds capacity 255")
+        acc = (acc << 8) | k2
+        acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
+        max_current = self.max_current
+        nominal_voltage = self.nominal_voltage
+        max_current_f32, nominal_voltage_f32 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
             _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
-                (
-                    r6
-                    if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
-                ),
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
+                max_current if -65504.0 <= max_current <= 65504.0 else _dc.f16_saturated(max_current),
+                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
             )
         )
-        h10 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        max_current_f16 = (
+            ((max_current_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= max_current_f32 < 0x477FF000
+            else _dc.f16bits(max_current_f32)
         )
-        h11 = (
-            ((g9 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+        nominal_voltage_f16 = (
+            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
+            else _dc.f16bits(nominal_voltage_f32)
         )
-        r12 = self.cycle_count
-        r13 = self.over_discharge_count
-        r14 = self.is_powering_off
-        p15 = 1 if r14 else 0
-        r16 = self.battery_id
-        p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
+        cycle_count = self.cycle_count
+        over_discharge_count = self.over_discharge_count
+        is_powering_off = self.is_powering_off
+        is_powering_off_bits = 1 if is_powering_off else 0
+        battery_id = self.battery_id
+        battery_id_bits = battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)
         acc = (acc << 73) | (
             int.from_bytes(
                 _BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT.pack(
-                    (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
-                    (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
-                    h10,
-                    h11,
-                    (p15 << 7) | ((p17 & 0x1) << 15) | ((p17 >> 1) & 0x7F),
+                    (cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)),
+                    (
+                        over_discharge_count
+                        if 0 <= over_discharge_count <= 65535
+                        else (65535 if over_discharge_count > 65535 else 0)
+                    ),
+                    max_current_f16,
+                    nominal_voltage_f16,
+                    (is_powering_off_bits << 7) | ((battery_id_bits & 0x1) << 15) | ((battery_id_bits >> 1) & 0x7F),
                 ),
                 "big",
             )
@@ -1134,89 +1156,101 @@ class BatteryInfoAux:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfoAux:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f1: list[_Any]
+        voltage_cell: list[_Any]
         n = len(data)
         if n < 7:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, n << 3)
-        u1, u2, u3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack_from(data)
-        x4 = u1 | (u2 << 32) | (u3 << 48)
+        packed1, packed2, packed3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack_from(data)
+        timestamp_usec = packed1 | (packed2 << 32) | (packed3 << 48)
         v = int.from_bytes(data, "big")
         rem = (n << 3) - 56
         if rem < 8:
             raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
         rem -= 8
-        k5 = (v >> rem) & 0xFF
-        if k5 > 255:
-            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k5) + " exceeds capacity 255")
-        n6 = k5 * 16
-        if rem < n6:
-            raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
-        rem -= n6
-        f1 = list(_struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
+        k4 = (v >> rem) & 0xFF
+        if k4 > 255:
+            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
+        n5 = k4 * 16
+        if rem < n5:
+            raise _dc.short("BatteryInfoAux.voltage_cell", n5, rem)
+        rem -= n5
+        voltage_cell = list(_struct.unpack(f"<{k4}e", ((v >> rem) & ((1 << n5) - 1)).to_bytes(n5 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
-        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
-            (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
-        )
-        x12 = ((u11 >> 7) & 0x1) != 0
-        x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
-        if rem >= 8:
-            raise _dc.DecodeError("BatteryInfoAux: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(_timestamp_class()(x4), f1, u7, u8, u9, u10, x12, x13)
-
-    def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.timestamp.usec
-        p2 = r1 & 0xFFFFFFFFFFFFFF
-        acc = (acc << 56) | int.from_bytes(
-            _BATTERY_INFO_AUX_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
-        )
-        x3 = self.voltage_cell
-        k4 = len(x3)
-        if k4 > 255:
-            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
-        acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(_struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
-        r6 = self.max_current
-        r7 = self.nominal_voltage
-        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
-            _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
-                (
-                    r6
-                    if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
-                ),
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
+        cycle_count, over_discharge_count, max_current, nominal_voltage, packed6 = (
+            _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
+                (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
             )
         )
-        h10 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        is_powering_off = ((packed6 >> 7) & 0x1) != 0
+        battery_id = (packed6 >> 15) | ((packed6 & 0x7F) << 1)
+        if rem >= 8:
+            raise _dc.DecodeError("BatteryInfoAux: " + str(rem >> 3) + " byte(s) beyond the end of the message")
+        return cls(
+            _timestamp_class()(timestamp_usec),
+            voltage_cell,
+            cycle_count,
+            over_discharge_count,
+            max_current,
+            nominal_voltage,
+            is_powering_off,
+            battery_id,
         )
-        h11 = (
-            ((g9 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        timestamp_usec = self.timestamp.usec
+        timestamp_usec_bits = timestamp_usec & 0xFFFFFFFFFFFFFF
+        acc = (acc << 56) | int.from_bytes(
+            _BATTERY_INFO_AUX_ENCODE_STRUCT.pack(
+                (timestamp_usec_bits & 0xFFFFFFFF),
+                ((timestamp_usec_bits >> 32) & 0xFFFF),
+                ((timestamp_usec_bits >> 48) & 0xFF),
+            ),
+            "big",
         )
-        r12 = self.cycle_count
-        r13 = self.over_discharge_count
-        r14 = self.is_powering_off
-        p15 = 1 if r14 else 0
-        r16 = self.battery_id
-        p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
+        x1 = self.voltage_cell
+        k2 = len(x1)
+        if k2 > 255:
+            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k2) + " exceeds capacity 255")
+        acc = (acc << 8) | k2
+        acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
+        max_current = self.max_current
+        nominal_voltage = self.nominal_voltage
+        max_current_f32, nominal_voltage_f32 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
+            _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
+                max_current if -65504.0 <= max_current <= 65504.0 else _dc.f16_saturated(max_current),
+                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
+            )
+        )
+        max_current_f16 = (
+            ((max_current_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= max_current_f32 < 0x477FF000
+            else _dc.f16bits(max_current_f32)
+        )
+        nominal_voltage_f16 = (
+            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
+            else _dc.f16bits(nominal_voltage_f32)
+        )
+        cycle_count = self.cycle_count
+        over_discharge_count = self.over_discharge_count
+        is_powering_off = self.is_powering_off
+        is_powering_off_bits = 1 if is_powering_off else 0
+        battery_id = self.battery_id
+        battery_id_bits = battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)
         acc = (acc << 73) | (
             int.from_bytes(
                 _BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT.pack(
-                    (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
-                    (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
-                    h10,
-                    h11,
-                    (p15 << 7) | ((p17 & 0x1) << 15) | ((p17 >> 1) & 0x7F),
+                    (cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)),
+                    (
+                        over_discharge_count
+                        if 0 <= over_discharge_count <= 65535
+                        else (65535 if over_discharge_count > 65535 else 0)
+                    ),
+                    max_current_f16,
+                    nominal_voltage_f16,
+                    (is_powering_off_bits << 7) | ((battery_id_bits & 0x1) << 15) | ((battery_id_bits >> 1) & 0x7F),
                 ),
                 "big",
             )
@@ -1226,32 +1260,45 @@ class BatteryInfoAux:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfoAux, int]:
-        f1: list[_Any]
+        voltage_cell: list[_Any]
         if rem < 56:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
-        x4 = u1 | (u2 << 32) | (u3 << 48)
+        packed1, packed2, packed3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(
+            ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
+        )
+        timestamp_usec = packed1 | (packed2 << 32) | (packed3 << 48)
         if rem < 8:
             raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
         rem -= 8
-        k5 = (v >> rem) & 0xFF
-        if k5 > 255:
-            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k5) + " exceeds capacity 255")
-        n6 = k5 * 16
-        if rem < n6:
-            raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
-        rem -= n6
-        f1 = list(_struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
+        k4 = (v >> rem) & 0xFF
+        if k4 > 255:
+            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
+        n5 = k4 * 16
+        if rem < n5:
+            raise _dc.short("BatteryInfoAux.voltage_cell", n5, rem)
+        rem -= n5
+        voltage_cell = list(_struct.unpack(f"<{k4}e", ((v >> rem) & ((1 << n5) - 1)).to_bytes(n5 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
-        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
-            (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
+        cycle_count, over_discharge_count, max_current, nominal_voltage, packed6 = (
+            _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
+                (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
+            )
         )
-        x12 = ((u11 >> 7) & 0x1) != 0
-        x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
-        return cls(_timestamp_class()(x4), f1, u7, u8, u9, u10, x12, x13), rem
+        is_powering_off = ((packed6 >> 7) & 0x1) != 0
+        battery_id = (packed6 >> 15) | ((packed6 & 0x7F) << 1)
+        return cls(
+            _timestamp_class()(timestamp_usec),
+            voltage_cell,
+            cycle_count,
+            over_discharge_count,
+            max_current,
+            nominal_voltage,
+            is_powering_off,
+            battery_id,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -1627,116 +1674,123 @@ class BatteryPeriodic:
             raise _dc.EncodeError("BatteryPeriodic.manufacture_date: length " + str(k6) + " exceeds capacity 9")
         acc = (acc << 4) | k6
         acc = (acc << (k6 << 3)) | int.from_bytes(x5, "big")
-        r7 = self.nominal_voltage
-        r8 = self.discharge_minimum_voltage
-        r9 = self.charging_minimum_voltage
-        r10 = self.charging_maximum_voltage
-        g11, g12, g13, g14 = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+        nominal_voltage = self.nominal_voltage
+        discharge_minimum_voltage = self.discharge_minimum_voltage
+        charging_minimum_voltage = self.charging_minimum_voltage
+        charging_maximum_voltage = self.charging_maximum_voltage
+        (
+            nominal_voltage_f32,
+            discharge_minimum_voltage_f32,
+            charging_minimum_voltage_f32,
+            charging_maximum_voltage_f32,
+        ) = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
             _BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY.pack(
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
-                (
-                    r8
-                    if -65504.0 <= r8 <= 65504.0
-                    else (65504.0 if 65504.0 < r8 < _dc.INF else (-65504.0 if -_dc.INF < r8 < -65504.0 else r8))
-                ),
-                (
-                    r9
-                    if -65504.0 <= r9 <= 65504.0
-                    else (65504.0 if 65504.0 < r9 < _dc.INF else (-65504.0 if -_dc.INF < r9 < -65504.0 else r9))
-                ),
-                (
-                    r10
-                    if -65504.0 <= r10 <= 65504.0
-                    else (65504.0 if 65504.0 < r10 < _dc.INF else (-65504.0 if -_dc.INF < r10 < -65504.0 else r10))
-                ),
+                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
+                discharge_minimum_voltage
+                if -65504.0 <= discharge_minimum_voltage <= 65504.0
+                else _dc.f16_saturated(discharge_minimum_voltage),
+                charging_minimum_voltage
+                if -65504.0 <= charging_minimum_voltage <= 65504.0
+                else _dc.f16_saturated(charging_minimum_voltage),
+                charging_maximum_voltage
+                if -65504.0 <= charging_maximum_voltage <= 65504.0
+                else _dc.f16_saturated(charging_maximum_voltage),
             )
         )
-        h15 = (
-            ((g11 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        nominal_voltage_f16 = (
+            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
+            else _dc.f16bits(nominal_voltage_f32)
         )
-        h16 = (
-            ((g12 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        discharge_minimum_voltage_f16 = (
+            ((discharge_minimum_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= discharge_minimum_voltage_f32 < 0x477FF000
+            else _dc.f16bits(discharge_minimum_voltage_f32)
         )
-        h17 = (
-            ((g13 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        charging_minimum_voltage_f16 = (
+            ((charging_minimum_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= charging_minimum_voltage_f32 < 0x477FF000
+            else _dc.f16bits(charging_minimum_voltage_f32)
         )
-        h18 = (
-            ((g14 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        charging_maximum_voltage_f16 = (
+            ((charging_maximum_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= charging_maximum_voltage_f32 < 0x477FF000
+            else _dc.f16bits(charging_maximum_voltage_f32)
         )
-        r19 = self.design_capacity
-        r20 = self.cells_in_series
-        r21 = self.charging_maximum_current
-        r22 = self.discharge_maximum_current
-        r23 = self.discharge_maximum_burst_current
-        r24 = self.full_charge_capacity
-        r25 = self.cycle_count
-        r26 = self.state_of_health
+        design_capacity = self.design_capacity
+        cells_in_series = self.cells_in_series
+        charging_maximum_current = self.charging_maximum_current
+        discharge_maximum_current = self.discharge_maximum_current
+        discharge_maximum_burst_current = self.discharge_maximum_burst_current
+        full_charge_capacity = self.full_charge_capacity
+        cycle_count = self.cycle_count
+        state_of_health = self.state_of_health
         acc = (acc << 256) | int.from_bytes(
             _BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY.pack(
                 (
-                    r19
-                    if -_dc.F32_MAX <= r19 <= _dc.F32_MAX
+                    design_capacity
+                    if -_dc.F32_MAX <= design_capacity <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r19 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r19 < -_dc.F32_MAX else r19)
+                        if _dc.F32_MAX < design_capacity < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < design_capacity < -_dc.F32_MAX else design_capacity)
                     )
                 ),
-                (r20 if 0 <= r20 <= 255 else (255 if r20 > 255 else 0)),
-                h15,
-                h16,
-                h17,
-                h18,
+                (cells_in_series if 0 <= cells_in_series <= 255 else (255 if cells_in_series > 255 else 0)),
+                nominal_voltage_f16,
+                discharge_minimum_voltage_f16,
+                charging_minimum_voltage_f16,
+                charging_maximum_voltage_f16,
                 (
-                    r21
-                    if -_dc.F32_MAX <= r21 <= _dc.F32_MAX
+                    charging_maximum_current
+                    if -_dc.F32_MAX <= charging_maximum_current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r21 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r21 < -_dc.F32_MAX else r21)
-                    )
-                ),
-                (
-                    r22
-                    if -_dc.F32_MAX <= r22 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r22 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r22 < -_dc.F32_MAX else r22)
+                        if _dc.F32_MAX < charging_maximum_current < _dc.INF
+                        else (
+                            -_dc.F32_MAX
+                            if -_dc.INF < charging_maximum_current < -_dc.F32_MAX
+                            else charging_maximum_current
+                        )
                     )
                 ),
                 (
-                    r23
-                    if -_dc.F32_MAX <= r23 <= _dc.F32_MAX
+                    discharge_maximum_current
+                    if -_dc.F32_MAX <= discharge_maximum_current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r23 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r23 < -_dc.F32_MAX else r23)
+                        if _dc.F32_MAX < discharge_maximum_current < _dc.INF
+                        else (
+                            -_dc.F32_MAX
+                            if -_dc.INF < discharge_maximum_current < -_dc.F32_MAX
+                            else discharge_maximum_current
+                        )
                     )
                 ),
                 (
-                    r24
-                    if -_dc.F32_MAX <= r24 <= _dc.F32_MAX
+                    discharge_maximum_burst_current
+                    if -_dc.F32_MAX <= discharge_maximum_burst_current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r24 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r24 < -_dc.F32_MAX else r24)
+                        if _dc.F32_MAX < discharge_maximum_burst_current < _dc.INF
+                        else (
+                            -_dc.F32_MAX
+                            if -_dc.INF < discharge_maximum_burst_current < -_dc.F32_MAX
+                            else discharge_maximum_burst_current
+                        )
                     )
                 ),
-                (r25 if 0 <= r25 <= 65535 else (65535 if r25 > 65535 else 0)),
-                (r26 if 0 <= r26 <= 255 else (255 if r26 > 255 else 0)),
+                (
+                    full_charge_capacity
+                    if -_dc.F32_MAX <= full_charge_capacity <= _dc.F32_MAX
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < full_charge_capacity < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < full_charge_capacity < -_dc.F32_MAX else full_charge_capacity)
+                    )
+                ),
+                (cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)),
+                (state_of_health if 0 <= state_of_health <= 255 else (255 if state_of_health > 255 else 0)),
             ),
             "big",
         )
@@ -1745,9 +1799,9 @@ class BatteryPeriodic:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryPeriodic:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f0: bytes
-        f1: bytes
-        f2: bytes
+        name: bytes
+        serial_number: bytes
+        manufacture_date: bytes
         n = len(data)
         v = int.from_bytes(data, "big")
         rem = n << 3
@@ -1761,7 +1815,7 @@ class BatteryPeriodic:
         if rem < n2:
             raise _dc.short("BatteryPeriodic.name", n2, rem)
         rem -= n2
-        f0 = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
+        name = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
         if rem < 6:
             raise _dc.short("BatteryPeriodic.serial_number (length)", 6, rem)
         rem -= 6
@@ -1772,7 +1826,7 @@ class BatteryPeriodic:
         if rem < n4:
             raise _dc.short("BatteryPeriodic.serial_number", n4, rem)
         rem -= n4
-        f1 = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
+        serial_number = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
         if rem < 4:
             raise _dc.short("BatteryPeriodic.manufacture_date (length)", 4, rem)
         rem -= 4
@@ -1783,18 +1837,45 @@ class BatteryPeriodic:
         if rem < n6:
             raise _dc.short("BatteryPeriodic.manufacture_date", n6, rem)
         rem -= n6
-        f2 = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
+        manufacture_date = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
         if rem < 256:
             raise _dc.cut(_BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY, rem)
         rem -= 256
-        u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18 = (
-            _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-                ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
-            )
+        (
+            design_capacity,
+            cells_in_series,
+            nominal_voltage,
+            discharge_minimum_voltage,
+            charging_minimum_voltage,
+            charging_maximum_voltage,
+            charging_maximum_current,
+            discharge_maximum_current,
+            discharge_maximum_burst_current,
+            full_charge_capacity,
+            cycle_count,
+            state_of_health,
+        ) = _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+            ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
         )
         if rem >= 8:
             raise _dc.DecodeError("BatteryPeriodic: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(f0, f1, f2, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18)
+        return cls(
+            name,
+            serial_number,
+            manufacture_date,
+            design_capacity,
+            cells_in_series,
+            nominal_voltage,
+            discharge_minimum_voltage,
+            charging_minimum_voltage,
+            charging_maximum_voltage,
+            charging_maximum_current,
+            discharge_maximum_current,
+            discharge_maximum_burst_current,
+            full_charge_capacity,
+            cycle_count,
+            state_of_health,
+        )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         x1 = self.name
@@ -1815,116 +1896,123 @@ class BatteryPeriodic:
             raise _dc.EncodeError("BatteryPeriodic.manufacture_date: length " + str(k6) + " exceeds capacity 9")
         acc = (acc << 4) | k6
         acc = (acc << (k6 << 3)) | int.from_bytes(x5, "big")
-        r7 = self.nominal_voltage
-        r8 = self.discharge_minimum_voltage
-        r9 = self.charging_minimum_voltage
-        r10 = self.charging_maximum_voltage
-        g11, g12, g13, g14 = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+        nominal_voltage = self.nominal_voltage
+        discharge_minimum_voltage = self.discharge_minimum_voltage
+        charging_minimum_voltage = self.charging_minimum_voltage
+        charging_maximum_voltage = self.charging_maximum_voltage
+        (
+            nominal_voltage_f32,
+            discharge_minimum_voltage_f32,
+            charging_minimum_voltage_f32,
+            charging_maximum_voltage_f32,
+        ) = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
             _BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY.pack(
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
-                (
-                    r8
-                    if -65504.0 <= r8 <= 65504.0
-                    else (65504.0 if 65504.0 < r8 < _dc.INF else (-65504.0 if -_dc.INF < r8 < -65504.0 else r8))
-                ),
-                (
-                    r9
-                    if -65504.0 <= r9 <= 65504.0
-                    else (65504.0 if 65504.0 < r9 < _dc.INF else (-65504.0 if -_dc.INF < r9 < -65504.0 else r9))
-                ),
-                (
-                    r10
-                    if -65504.0 <= r10 <= 65504.0
-                    else (65504.0 if 65504.0 < r10 < _dc.INF else (-65504.0 if -_dc.INF < r10 < -65504.0 else r10))
-                ),
+                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
+                discharge_minimum_voltage
+                if -65504.0 <= discharge_minimum_voltage <= 65504.0
+                else _dc.f16_saturated(discharge_minimum_voltage),
+                charging_minimum_voltage
+                if -65504.0 <= charging_minimum_voltage <= 65504.0
+                else _dc.f16_saturated(charging_minimum_voltage),
+                charging_maximum_voltage
+                if -65504.0 <= charging_maximum_voltage <= 65504.0
+                else _dc.f16_saturated(charging_maximum_voltage),
             )
         )
-        h15 = (
-            ((g11 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        nominal_voltage_f16 = (
+            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
+            else _dc.f16bits(nominal_voltage_f32)
         )
-        h16 = (
-            ((g12 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        discharge_minimum_voltage_f16 = (
+            ((discharge_minimum_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= discharge_minimum_voltage_f32 < 0x477FF000
+            else _dc.f16bits(discharge_minimum_voltage_f32)
         )
-        h17 = (
-            ((g13 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        charging_minimum_voltage_f16 = (
+            ((charging_minimum_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= charging_minimum_voltage_f32 < 0x477FF000
+            else _dc.f16bits(charging_minimum_voltage_f32)
         )
-        h18 = (
-            ((g14 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        charging_maximum_voltage_f16 = (
+            ((charging_maximum_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= charging_maximum_voltage_f32 < 0x477FF000
+            else _dc.f16bits(charging_maximum_voltage_f32)
         )
-        r19 = self.design_capacity
-        r20 = self.cells_in_series
-        r21 = self.charging_maximum_current
-        r22 = self.discharge_maximum_current
-        r23 = self.discharge_maximum_burst_current
-        r24 = self.full_charge_capacity
-        r25 = self.cycle_count
-        r26 = self.state_of_health
+        design_capacity = self.design_capacity
+        cells_in_series = self.cells_in_series
+        charging_maximum_current = self.charging_maximum_current
+        discharge_maximum_current = self.discharge_maximum_current
+        discharge_maximum_burst_current = self.discharge_maximum_burst_current
+        full_charge_capacity = self.full_charge_capacity
+        cycle_count = self.cycle_count
+        state_of_health = self.state_of_health
         acc = (acc << 256) | int.from_bytes(
             _BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY.pack(
                 (
-                    r19
-                    if -_dc.F32_MAX <= r19 <= _dc.F32_MAX
+                    design_capacity
+                    if -_dc.F32_MAX <= design_capacity <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r19 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r19 < -_dc.F32_MAX else r19)
+                        if _dc.F32_MAX < design_capacity < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < design_capacity < -_dc.F32_MAX else design_capacity)
                     )
                 ),
-                (r20 if 0 <= r20 <= 255 else (255 if r20 > 255 else 0)),
-                h15,
-                h16,
-                h17,
-                h18,
+                (cells_in_series if 0 <= cells_in_series <= 255 else (255 if cells_in_series > 255 else 0)),
+                nominal_voltage_f16,
+                discharge_minimum_voltage_f16,
+                charging_minimum_voltage_f16,
+                charging_maximum_voltage_f16,
                 (
-                    r21
-                    if -_dc.F32_MAX <= r21 <= _dc.F32_MAX
+                    charging_maximum_current
+                    if -_dc.F32_MAX <= charging_maximum_current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r21 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r21 < -_dc.F32_MAX else r21)
-                    )
-                ),
-                (
-                    r22
-                    if -_dc.F32_MAX <= r22 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r22 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r22 < -_dc.F32_MAX else r22)
+                        if _dc.F32_MAX < charging_maximum_current < _dc.INF
+                        else (
+                            -_dc.F32_MAX
+                            if -_dc.INF < charging_maximum_current < -_dc.F32_MAX
+                            else charging_maximum_current
+                        )
                     )
                 ),
                 (
-                    r23
-                    if -_dc.F32_MAX <= r23 <= _dc.F32_MAX
+                    discharge_maximum_current
+                    if -_dc.F32_MAX <= discharge_maximum_current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r23 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r23 < -_dc.F32_MAX else r23)
+                        if _dc.F32_MAX < discharge_maximum_current < _dc.INF
+                        else (
+                            -_dc.F32_MAX
+                            if -_dc.INF < discharge_maximum_current < -_dc.F32_MAX
+                            else discharge_maximum_current
+                        )
                     )
                 ),
                 (
-                    r24
-                    if -_dc.F32_MAX <= r24 <= _dc.F32_MAX
+                    discharge_maximum_burst_current
+                    if -_dc.F32_MAX <= discharge_maximum_burst_current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r24 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r24 < -_dc.F32_MAX else r24)
+                        if _dc.F32_MAX < discharge_maximum_burst_current < _dc.INF
+                        else (
+                            -_dc.F32_MAX
+                            if -_dc.INF < discharge_maximum_burst_current < -_dc.F32_MAX
+                            else discharge_maximum_burst_current
+                        )
                     )
                 ),
-                (r25 if 0 <= r25 <= 65535 else (65535 if r25 > 65535 else 0)),
-                (r26 if 0 <= r26 <= 255 else (255 if r26 > 255 else 0)),
+                (
+                    full_charge_capacity
+                    if -_dc.F32_MAX <= full_charge_capacity <= _dc.F32_MAX
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < full_charge_capacity < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < full_charge_capacity < -_dc.F32_MAX else full_charge_capacity)
+                    )
+                ),
+                (cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)),
+                (state_of_health if 0 <= state_of_health <= 255 else (255 if state_of_health > 255 else 0)),
             ),
             "big",
         )
@@ -1932,9 +2020,9 @@ class BatteryPeriodic:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryPeriodic, int]:
-        f0: bytes
-        f1: bytes
-        f2: bytes
+        name: bytes
+        serial_number: bytes
+        manufacture_date: bytes
         if rem < 6:
             raise _dc.short("BatteryPeriodic.name (length)", 6, rem)
         rem -= 6
@@ -1945,7 +2033,7 @@ class BatteryPeriodic:
         if rem < n2:
             raise _dc.short("BatteryPeriodic.name", n2, rem)
         rem -= n2
-        f0 = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
+        name = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
         if rem < 6:
             raise _dc.short("BatteryPeriodic.serial_number (length)", 6, rem)
         rem -= 6
@@ -1956,7 +2044,7 @@ class BatteryPeriodic:
         if rem < n4:
             raise _dc.short("BatteryPeriodic.serial_number", n4, rem)
         rem -= n4
-        f1 = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
+        serial_number = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
         if rem < 4:
             raise _dc.short("BatteryPeriodic.manufacture_date (length)", 4, rem)
         rem -= 4
@@ -1967,16 +2055,43 @@ class BatteryPeriodic:
         if rem < n6:
             raise _dc.short("BatteryPeriodic.manufacture_date", n6, rem)
         rem -= n6
-        f2 = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
+        manufacture_date = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
         if rem < 256:
             raise _dc.cut(_BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY, rem)
         rem -= 256
-        u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18 = (
-            _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-                ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
-            )
+        (
+            design_capacity,
+            cells_in_series,
+            nominal_voltage,
+            discharge_minimum_voltage,
+            charging_minimum_voltage,
+            charging_maximum_voltage,
+            charging_maximum_current,
+            discharge_maximum_current,
+            discharge_maximum_burst_current,
+            full_charge_capacity,
+            cycle_count,
+            state_of_health,
+        ) = _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+            ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
         )
-        return cls(f0, f1, f2, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18), rem
+        return cls(
+            name,
+            serial_number,
+            manufacture_date,
+            design_capacity,
+            cells_in_series,
+            nominal_voltage,
+            discharge_minimum_voltage,
+            charging_minimum_voltage,
+            charging_maximum_voltage,
+            charging_maximum_current,
+            discharge_maximum_current,
+            discharge_maximum_burst_current,
+            full_charge_capacity,
+            cycle_count,
+            state_of_health,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -2281,27 +2396,39 @@ class BatteryTag:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.serial_number
-        r2 = self.num_cycles
-        r3 = self.armed_hours
-        r4 = self.battery_capacity_mAh
-        r5 = self.first_use_mins
-        r6 = self.last_arm_time_mins
+        serial_number = self.serial_number
+        num_cycles = self.num_cycles
+        armed_hours = self.armed_hours
+        battery_capacity_mah = self.battery_capacity_mAh
+        first_use_mins = self.first_use_mins
+        last_arm_time_mins = self.last_arm_time_mins
         head = _BATTERY_TAG_ENCODE_STRUCT.pack(
-            (r1 if 0 <= r1 <= 4294967295 else (4294967295 if r1 > 4294967295 else 0)),
-            (r2 if 0 <= r2 <= 4294967295 else (4294967295 if r2 > 4294967295 else 0)),
+            (serial_number if 0 <= serial_number <= 4294967295 else (4294967295 if serial_number > 4294967295 else 0)),
+            (num_cycles if 0 <= num_cycles <= 4294967295 else (4294967295 if num_cycles > 4294967295 else 0)),
             (
-                r3
-                if -_dc.F32_MAX <= r3 <= _dc.F32_MAX
+                armed_hours
+                if -_dc.F32_MAX <= armed_hours <= _dc.F32_MAX
                 else (
                     _dc.F32_MAX
-                    if _dc.F32_MAX < r3 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r3 < -_dc.F32_MAX else r3)
+                    if _dc.F32_MAX < armed_hours < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < armed_hours < -_dc.F32_MAX else armed_hours)
                 )
             ),
-            (r4 if 0 <= r4 <= 4294967295 else (4294967295 if r4 > 4294967295 else 0)),
-            (r5 if 0 <= r5 <= 4294967295 else (4294967295 if r5 > 4294967295 else 0)),
-            (r6 if 0 <= r6 <= 4294967295 else (4294967295 if r6 > 4294967295 else 0)),
+            (
+                battery_capacity_mah
+                if 0 <= battery_capacity_mah <= 4294967295
+                else (4294967295 if battery_capacity_mah > 4294967295 else 0)
+            ),
+            (
+                first_use_mins
+                if 0 <= first_use_mins <= 4294967295
+                else (4294967295 if first_use_mins > 4294967295 else 0)
+            ),
+            (
+                last_arm_time_mins
+                if 0 <= last_arm_time_mins <= 4294967295
+                else (4294967295 if last_arm_time_mins > 4294967295 else 0)
+            ),
         )
         return head
 
@@ -2311,34 +2438,52 @@ class BatteryTag:
         n = len(data)
         if n < 24:
             raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, n << 3)
-        u1, u2, u3, u4, u5, u6 = _BATTERY_TAG_DECODE_STRUCT.unpack_from(data)
+        serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins = (
+            _BATTERY_TAG_DECODE_STRUCT.unpack_from(data)
+        )
         if n > 24:
             raise _dc.DecodeError("BatteryTag: " + str(n - 24) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, u3, u4, u5, u6)
+        return cls(serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.serial_number
-        r2 = self.num_cycles
-        r3 = self.armed_hours
-        r4 = self.battery_capacity_mAh
-        r5 = self.first_use_mins
-        r6 = self.last_arm_time_mins
+        serial_number = self.serial_number
+        num_cycles = self.num_cycles
+        armed_hours = self.armed_hours
+        battery_capacity_mah = self.battery_capacity_mAh
+        first_use_mins = self.first_use_mins
+        last_arm_time_mins = self.last_arm_time_mins
         acc = (acc << 192) | int.from_bytes(
             _BATTERY_TAG_ENCODE_STRUCT.pack(
-                (r1 if 0 <= r1 <= 4294967295 else (4294967295 if r1 > 4294967295 else 0)),
-                (r2 if 0 <= r2 <= 4294967295 else (4294967295 if r2 > 4294967295 else 0)),
                 (
-                    r3
-                    if -_dc.F32_MAX <= r3 <= _dc.F32_MAX
+                    serial_number
+                    if 0 <= serial_number <= 4294967295
+                    else (4294967295 if serial_number > 4294967295 else 0)
+                ),
+                (num_cycles if 0 <= num_cycles <= 4294967295 else (4294967295 if num_cycles > 4294967295 else 0)),
+                (
+                    armed_hours
+                    if -_dc.F32_MAX <= armed_hours <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r3 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r3 < -_dc.F32_MAX else r3)
+                        if _dc.F32_MAX < armed_hours < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < armed_hours < -_dc.F32_MAX else armed_hours)
                     )
                 ),
-                (r4 if 0 <= r4 <= 4294967295 else (4294967295 if r4 > 4294967295 else 0)),
-                (r5 if 0 <= r5 <= 4294967295 else (4294967295 if r5 > 4294967295 else 0)),
-                (r6 if 0 <= r6 <= 4294967295 else (4294967295 if r6 > 4294967295 else 0)),
+                (
+                    battery_capacity_mah
+                    if 0 <= battery_capacity_mah <= 4294967295
+                    else (4294967295 if battery_capacity_mah > 4294967295 else 0)
+                ),
+                (
+                    first_use_mins
+                    if 0 <= first_use_mins <= 4294967295
+                    else (4294967295 if first_use_mins > 4294967295 else 0)
+                ),
+                (
+                    last_arm_time_mins
+                    if 0 <= last_arm_time_mins <= 4294967295
+                    else (4294967295 if last_arm_time_mins > 4294967295 else 0)
+                ),
             ),
             "big",
         )
@@ -2349,8 +2494,12 @@ class BatteryTag:
         if rem < 192:
             raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, rem)
         rem -= 192
-        u1, u2, u3, u4, u5, u6 = _BATTERY_TAG_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 192) - 1)).to_bytes(24, "big"))
-        return cls(u1, u2, u3, u4, u5, u6), rem
+        serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins = (
+            _BATTERY_TAG_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 192) - 1)).to_bytes(24, "big"))
+        )
+        return cls(
+            serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""

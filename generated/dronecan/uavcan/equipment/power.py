@@ -461,323 +461,380 @@ class BatteryInfo:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.temperature
-        r2 = self.voltage
-        r3 = self.current
-        r4 = self.average_power_10sec
-        r5 = self.remaining_capacity_wh
-        r6 = self.full_charge_capacity_wh
-        r7 = self.hours_to_full_charge
-        g8, g9, g10, g11, g12, g13, g14 = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
+        temperature = self.temperature
+        voltage = self.voltage
+        current = self.current
+        average_power_10sec = self.average_power_10sec
+        remaining_capacity_wh = self.remaining_capacity_wh
+        full_charge_capacity_wh = self.full_charge_capacity_wh
+        hours_to_full_charge = self.hours_to_full_charge
+        (
+            temperature_f32,
+            voltage_f32,
+            current_f32,
+            average_power_10sec_f32,
+            remaining_capacity_wh_f32,
+            full_charge_capacity_wh_f32,
+            hours_to_full_charge_f32,
+        ) = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
             _BATTERY_INFO_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-                (
-                    r3
-                    if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
-                ),
-                (
-                    r4
-                    if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
-                ),
-                (
-                    r5
-                    if -65504.0 <= r5 <= 65504.0
-                    else (65504.0 if 65504.0 < r5 < _dc.INF else (-65504.0 if -_dc.INF < r5 < -65504.0 else r5))
-                ),
-                (
-                    r6
-                    if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
-                ),
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
+                temperature if -65504.0 <= temperature <= 65504.0 else _dc.f16_saturated(temperature),
+                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
+                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
+                average_power_10sec
+                if -65504.0 <= average_power_10sec <= 65504.0
+                else _dc.f16_saturated(average_power_10sec),
+                remaining_capacity_wh
+                if -65504.0 <= remaining_capacity_wh <= 65504.0
+                else _dc.f16_saturated(remaining_capacity_wh),
+                full_charge_capacity_wh
+                if -65504.0 <= full_charge_capacity_wh <= 65504.0
+                else _dc.f16_saturated(full_charge_capacity_wh),
+                hours_to_full_charge
+                if -65504.0 <= hours_to_full_charge <= 65504.0
+                else _dc.f16_saturated(hours_to_full_charge),
             )
         )
-        h15 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        temperature_f16 = (
+            ((temperature_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_f32 < 0x477FF000
+            else _dc.f16bits(temperature_f32)
         )
-        h16 = (
-            ((g9 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+        voltage_f16 = (
+            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
         )
-        h17 = (
-            ((g10 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g10 < 0x477FF000
-            else (((g10 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
+        current_f16 = (
+            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
         )
-        h18 = (
-            ((g11 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        average_power_10sec_f16 = (
+            ((average_power_10sec_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= average_power_10sec_f32 < 0x477FF000
+            else _dc.f16bits(average_power_10sec_f32)
         )
-        h19 = (
-            ((g12 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        remaining_capacity_wh_f16 = (
+            ((remaining_capacity_wh_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= remaining_capacity_wh_f32 < 0x477FF000
+            else _dc.f16bits(remaining_capacity_wh_f32)
         )
-        h20 = (
-            ((g13 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        full_charge_capacity_wh_f16 = (
+            ((full_charge_capacity_wh_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= full_charge_capacity_wh_f32 < 0x477FF000
+            else _dc.f16bits(full_charge_capacity_wh_f32)
         )
-        h21 = (
-            ((g14 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        hours_to_full_charge_f16 = (
+            ((hours_to_full_charge_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= hours_to_full_charge_f32 < 0x477FF000
+            else _dc.f16bits(hours_to_full_charge_f32)
         )
-        r22 = self.status_flags
-        p23 = r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0)
-        r24 = self.state_of_health_pct
-        p25 = r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0)
-        r26 = self.state_of_charge_pct
-        p27 = r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0)
-        r28 = self.state_of_charge_pct_stdev
-        p29 = r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0)
-        r30 = self.battery_id
-        r31 = self.model_instance_id
+        status_flags = self.status_flags
+        status_flags_bits = status_flags if 0 <= status_flags <= 2047 else (2047 if status_flags > 2047 else 0)
+        state_of_health_pct = self.state_of_health_pct
+        state_of_health_pct_bits = (
+            state_of_health_pct if 0 <= state_of_health_pct <= 127 else (127 if state_of_health_pct > 127 else 0)
+        )
+        state_of_charge_pct = self.state_of_charge_pct
+        state_of_charge_pct_bits = (
+            state_of_charge_pct if 0 <= state_of_charge_pct <= 127 else (127 if state_of_charge_pct > 127 else 0)
+        )
+        state_of_charge_pct_stdev = self.state_of_charge_pct_stdev
+        state_of_charge_pct_stdev_bits = (
+            state_of_charge_pct_stdev
+            if 0 <= state_of_charge_pct_stdev <= 127
+            else (127 if state_of_charge_pct_stdev > 127 else 0)
+        )
+        battery_id = self.battery_id
+        model_instance_id = self.model_instance_id
         head = _BATTERY_INFO_ENCODE_STRUCT.pack(
-            h15,
-            h16,
-            h17,
-            h18,
-            h19,
-            h20,
-            h21,
-            (p23 & 0xFF)
-            | (((p23 >> 8) & 0x7) << 13)
-            | ((p25 & 0x3) << 22)
-            | (((p25 >> 2) & 0x1F) << 8)
-            | ((p27 & 0x1) << 31)
-            | (((p27 >> 1) & 0x3F) << 16)
-            | (p29 << 24),
-            (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)),
-            (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0)),
+            temperature_f16,
+            voltage_f16,
+            current_f16,
+            average_power_10sec_f16,
+            remaining_capacity_wh_f16,
+            full_charge_capacity_wh_f16,
+            hours_to_full_charge_f16,
+            (status_flags_bits & 0xFF)
+            | (((status_flags_bits >> 8) & 0x7) << 13)
+            | ((state_of_health_pct_bits & 0x3) << 22)
+            | (((state_of_health_pct_bits >> 2) & 0x1F) << 8)
+            | ((state_of_charge_pct_bits & 0x1) << 31)
+            | (((state_of_charge_pct_bits >> 1) & 0x3F) << 16)
+            | (state_of_charge_pct_stdev_bits << 24),
+            (battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)),
+            (
+                model_instance_id
+                if 0 <= model_instance_id <= 4294967295
+                else (4294967295 if model_instance_id > 4294967295 else 0)
+            ),
         )
         if tao:
-            x32 = self.model_name
-            if len(x32) > 31:
-                raise _dc.EncodeError("BatteryInfo.model_name: length " + str(len(x32)) + " exceeds capacity 31")
-            return head + bytes(x32)
+            x1 = self.model_name
+            if len(x1) > 31:
+                raise _dc.EncodeError("BatteryInfo.model_name: length " + str(len(x1)) + " exceeds capacity 31")
+            return head + bytes(x1)
         acc = 0x10000000000000000000000000000000000000000000000 | int.from_bytes(head, "big")
-        x33 = self.model_name
-        k34 = len(x33)
-        if k34 > 31:
-            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k34) + " exceeds capacity 31")
-        acc = (acc << 5) | k34
-        acc = (acc << (k34 << 3)) | int.from_bytes(x33, "big")
+        x2 = self.model_name
+        k3 = len(x2)
+        if k3 > 31:
+            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k3) + " exceeds capacity 31")
+        acc = (acc << 5) | k3
+        acc = (acc << (k3 << 3)) | int.from_bytes(x2, "big")
         return _dc.finish(acc)
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfo:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f13: bytes
+        model_name: bytes
         n = len(data)
         if n < 23:
             raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, n << 3)
-        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _BATTERY_INFO_DECODE_STRUCT.unpack_from(data)
-        x11 = (u8 & 0xFF) | (((u8 >> 13) & 0x7) << 8)
-        x12 = ((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1F) << 2)
-        x13 = (u8 >> 31) | (((u8 >> 16) & 0x3F) << 1)
-        x14 = (u8 >> 24) & 0x7F
+        (
+            temperature,
+            voltage,
+            current,
+            average_power_10sec,
+            remaining_capacity_wh,
+            full_charge_capacity_wh,
+            hours_to_full_charge,
+            packed1,
+            battery_id,
+            model_instance_id,
+        ) = _BATTERY_INFO_DECODE_STRUCT.unpack_from(data)
+        status_flags = (packed1 & 0xFF) | (((packed1 >> 13) & 0x7) << 8)
+        state_of_health_pct = ((packed1 >> 22) & 0x3) | (((packed1 >> 8) & 0x1F) << 2)
+        state_of_charge_pct = (packed1 >> 31) | (((packed1 >> 16) & 0x3F) << 1)
+        state_of_charge_pct_stdev = (packed1 >> 24) & 0x7F
         if tao:
-            f13 = bytes(data[23:])
-            k15 = len(f13)
-            if k15 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
-            return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
+            model_name = bytes(data[23:])
+            k2 = len(model_name)
+            if k2 > 31:
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
+            return cls(
+                temperature,
+                voltage,
+                current,
+                average_power_10sec,
+                remaining_capacity_wh,
+                full_charge_capacity_wh,
+                hours_to_full_charge,
+                status_flags,
+                state_of_health_pct,
+                state_of_charge_pct,
+                state_of_charge_pct_stdev,
+                battery_id,
+                model_instance_id,
+                model_name,
+            )
         v = int.from_bytes(data, "big")
         rem = (n << 3) - 184
         if rem < 5:
             raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
         rem -= 5
-        k16 = (v >> rem) & 0x1F
-        if k16 > 31:
-            raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k16) + " exceeds capacity 31")
-        n17 = k16 * 8
-        if rem < n17:
-            raise _dc.short("BatteryInfo.model_name", n17, rem)
-        rem -= n17
-        f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k16, "big")
+        k3 = (v >> rem) & 0x1F
+        if k3 > 31:
+            raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k3) + " exceeds capacity 31")
+        n4 = k3 * 8
+        if rem < n4:
+            raise _dc.short("BatteryInfo.model_name", n4, rem)
+        rem -= n4
+        model_name = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
         if rem >= 8:
             raise _dc.DecodeError("BatteryInfo: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
+        return cls(
+            temperature,
+            voltage,
+            current,
+            average_power_10sec,
+            remaining_capacity_wh,
+            full_charge_capacity_wh,
+            hours_to_full_charge,
+            status_flags,
+            state_of_health_pct,
+            state_of_charge_pct,
+            state_of_charge_pct_stdev,
+            battery_id,
+            model_instance_id,
+            model_name,
+        )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.temperature
-        r2 = self.voltage
-        r3 = self.current
-        r4 = self.average_power_10sec
-        r5 = self.remaining_capacity_wh
-        r6 = self.full_charge_capacity_wh
-        r7 = self.hours_to_full_charge
-        g8, g9, g10, g11, g12, g13, g14 = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
+        temperature = self.temperature
+        voltage = self.voltage
+        current = self.current
+        average_power_10sec = self.average_power_10sec
+        remaining_capacity_wh = self.remaining_capacity_wh
+        full_charge_capacity_wh = self.full_charge_capacity_wh
+        hours_to_full_charge = self.hours_to_full_charge
+        (
+            temperature_f32,
+            voltage_f32,
+            current_f32,
+            average_power_10sec_f32,
+            remaining_capacity_wh_f32,
+            full_charge_capacity_wh_f32,
+            hours_to_full_charge_f32,
+        ) = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
             _BATTERY_INFO_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-                (
-                    r3
-                    if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
-                ),
-                (
-                    r4
-                    if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
-                ),
-                (
-                    r5
-                    if -65504.0 <= r5 <= 65504.0
-                    else (65504.0 if 65504.0 < r5 < _dc.INF else (-65504.0 if -_dc.INF < r5 < -65504.0 else r5))
-                ),
-                (
-                    r6
-                    if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
-                ),
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
+                temperature if -65504.0 <= temperature <= 65504.0 else _dc.f16_saturated(temperature),
+                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
+                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
+                average_power_10sec
+                if -65504.0 <= average_power_10sec <= 65504.0
+                else _dc.f16_saturated(average_power_10sec),
+                remaining_capacity_wh
+                if -65504.0 <= remaining_capacity_wh <= 65504.0
+                else _dc.f16_saturated(remaining_capacity_wh),
+                full_charge_capacity_wh
+                if -65504.0 <= full_charge_capacity_wh <= 65504.0
+                else _dc.f16_saturated(full_charge_capacity_wh),
+                hours_to_full_charge
+                if -65504.0 <= hours_to_full_charge <= 65504.0
+                else _dc.f16_saturated(hours_to_full_charge),
             )
         )
-        h15 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        temperature_f16 = (
+            ((temperature_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_f32 < 0x477FF000
+            else _dc.f16bits(temperature_f32)
         )
-        h16 = (
-            ((g9 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+        voltage_f16 = (
+            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
         )
-        h17 = (
-            ((g10 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g10 < 0x477FF000
-            else (((g10 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
+        current_f16 = (
+            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
         )
-        h18 = (
-            ((g11 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        average_power_10sec_f16 = (
+            ((average_power_10sec_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= average_power_10sec_f32 < 0x477FF000
+            else _dc.f16bits(average_power_10sec_f32)
         )
-        h19 = (
-            ((g12 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        remaining_capacity_wh_f16 = (
+            ((remaining_capacity_wh_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= remaining_capacity_wh_f32 < 0x477FF000
+            else _dc.f16bits(remaining_capacity_wh_f32)
         )
-        h20 = (
-            ((g13 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        full_charge_capacity_wh_f16 = (
+            ((full_charge_capacity_wh_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= full_charge_capacity_wh_f32 < 0x477FF000
+            else _dc.f16bits(full_charge_capacity_wh_f32)
         )
-        h21 = (
-            ((g14 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        hours_to_full_charge_f16 = (
+            ((hours_to_full_charge_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= hours_to_full_charge_f32 < 0x477FF000
+            else _dc.f16bits(hours_to_full_charge_f32)
         )
-        r22 = self.status_flags
-        p23 = r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0)
-        r24 = self.state_of_health_pct
-        p25 = r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0)
-        r26 = self.state_of_charge_pct
-        p27 = r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0)
-        r28 = self.state_of_charge_pct_stdev
-        p29 = r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0)
-        r30 = self.battery_id
-        r31 = self.model_instance_id
+        status_flags = self.status_flags
+        status_flags_bits = status_flags if 0 <= status_flags <= 2047 else (2047 if status_flags > 2047 else 0)
+        state_of_health_pct = self.state_of_health_pct
+        state_of_health_pct_bits = (
+            state_of_health_pct if 0 <= state_of_health_pct <= 127 else (127 if state_of_health_pct > 127 else 0)
+        )
+        state_of_charge_pct = self.state_of_charge_pct
+        state_of_charge_pct_bits = (
+            state_of_charge_pct if 0 <= state_of_charge_pct <= 127 else (127 if state_of_charge_pct > 127 else 0)
+        )
+        state_of_charge_pct_stdev = self.state_of_charge_pct_stdev
+        state_of_charge_pct_stdev_bits = (
+            state_of_charge_pct_stdev
+            if 0 <= state_of_charge_pct_stdev <= 127
+            else (127 if state_of_charge_pct_stdev > 127 else 0)
+        )
+        battery_id = self.battery_id
+        model_instance_id = self.model_instance_id
         acc = (acc << 184) | int.from_bytes(
             _BATTERY_INFO_ENCODE_STRUCT.pack(
-                h15,
-                h16,
-                h17,
-                h18,
-                h19,
-                h20,
-                h21,
-                (p23 & 0xFF)
-                | (((p23 >> 8) & 0x7) << 13)
-                | ((p25 & 0x3) << 22)
-                | (((p25 >> 2) & 0x1F) << 8)
-                | ((p27 & 0x1) << 31)
-                | (((p27 >> 1) & 0x3F) << 16)
-                | (p29 << 24),
-                (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)),
-                (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0)),
+                temperature_f16,
+                voltage_f16,
+                current_f16,
+                average_power_10sec_f16,
+                remaining_capacity_wh_f16,
+                full_charge_capacity_wh_f16,
+                hours_to_full_charge_f16,
+                (status_flags_bits & 0xFF)
+                | (((status_flags_bits >> 8) & 0x7) << 13)
+                | ((state_of_health_pct_bits & 0x3) << 22)
+                | (((state_of_health_pct_bits >> 2) & 0x1F) << 8)
+                | ((state_of_charge_pct_bits & 0x1) << 31)
+                | (((state_of_charge_pct_bits >> 1) & 0x3F) << 16)
+                | (state_of_charge_pct_stdev_bits << 24),
+                (battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)),
+                (
+                    model_instance_id
+                    if 0 <= model_instance_id <= 4294967295
+                    else (4294967295 if model_instance_id > 4294967295 else 0)
+                ),
             ),
             "big",
         )
-        x32 = self.model_name
-        k33 = len(x32)
-        if k33 > 31:
-            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k33) + " exceeds capacity 31")
+        x1 = self.model_name
+        k2 = len(x1)
+        if k2 > 31:
+            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
         if not tao:
-            acc = (acc << 5) | k33
-        acc = (acc << (k33 << 3)) | int.from_bytes(x32, "big")
+            acc = (acc << 5) | k2
+        acc = (acc << (k2 << 3)) | int.from_bytes(x1, "big")
         return acc
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfo, int]:
-        f13: bytes
+        model_name: bytes
         if rem < 184:
             raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, rem)
         rem -= 184
-        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _BATTERY_INFO_DECODE_STRUCT.unpack(
-            ((v >> rem) & ((1 << 184) - 1)).to_bytes(23, "big")
-        )
-        x11 = (u8 & 0xFF) | (((u8 >> 13) & 0x7) << 8)
-        x12 = ((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1F) << 2)
-        x13 = (u8 >> 31) | (((u8 >> 16) & 0x3F) << 1)
-        x14 = (u8 >> 24) & 0x7F
+        (
+            temperature,
+            voltage,
+            current,
+            average_power_10sec,
+            remaining_capacity_wh,
+            full_charge_capacity_wh,
+            hours_to_full_charge,
+            packed1,
+            battery_id,
+            model_instance_id,
+        ) = _BATTERY_INFO_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 184) - 1)).to_bytes(23, "big"))
+        status_flags = (packed1 & 0xFF) | (((packed1 >> 13) & 0x7) << 8)
+        state_of_health_pct = ((packed1 >> 22) & 0x3) | (((packed1 >> 8) & 0x1F) << 2)
+        state_of_charge_pct = (packed1 >> 31) | (((packed1 >> 16) & 0x3F) << 1)
+        state_of_charge_pct_stdev = (packed1 >> 24) & 0x7F
         if tao:
-            k15 = rem // 8
-            if rem - k15 * 8 >= 8:
+            k2 = rem // 8
+            if rem - k2 * 8 >= 8:
                 raise _dc.DecodeError("BatteryInfo.model_name: input ends inside an element")
-            if k15 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
-            n16 = k15 * 8
-            if rem < n16:
-                raise _dc.short("BatteryInfo.model_name", n16, rem)
-            rem -= n16
-            f13 = ((v >> rem) & ((1 << n16) - 1)).to_bytes(k15, "big")
+            if k2 > 31:
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
+            n3 = k2 * 8
+            if rem < n3:
+                raise _dc.short("BatteryInfo.model_name", n3, rem)
+            rem -= n3
+            model_name = ((v >> rem) & ((1 << n3) - 1)).to_bytes(k2, "big")
         else:
             if rem < 5:
                 raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
             rem -= 5
-            k15 = (v >> rem) & 0x1F
-            if k15 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
-            n17 = k15 * 8
-            if rem < n17:
-                raise _dc.short("BatteryInfo.model_name", n17, rem)
-            rem -= n17
-            f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k15, "big")
-        return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13), rem
+            k2 = (v >> rem) & 0x1F
+            if k2 > 31:
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
+            n4 = k2 * 8
+            if rem < n4:
+                raise _dc.short("BatteryInfo.model_name", n4, rem)
+            rem -= n4
+            model_name = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k2, "big")
+        return cls(
+            temperature,
+            voltage,
+            current,
+            average_power_10sec,
+            remaining_capacity_wh,
+            full_charge_capacity_wh,
+            hours_to_full_charge,
+            status_flags,
+            state_of_health_pct,
+            state_of_charge_pct,
+            state_of_charge_pct_stdev,
+            battery_id,
+            model_instance_id,
+            model_name,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -1038,39 +1095,27 @@ class CircuitStatus:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.voltage
-        r2 = self.current
-        g3, g4 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
+        voltage = self.voltage
+        current = self.current
+        voltage_f32, current_f32 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
             _CIRCUIT_STATUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
+                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
+                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
             )
         )
-        h5 = (
-            ((g3 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        voltage_f16 = (
+            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
         )
-        h6 = (
-            ((g4 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        current_f16 = (
+            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
         )
-        r7 = self.circuit_id
-        r8 = self.error_flags
+        circuit_id = self.circuit_id
+        error_flags = self.error_flags
         head = _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
-            (r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)),
-            h5,
-            h6,
-            (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0)),
+            (circuit_id if 0 <= circuit_id <= 65535 else (65535 if circuit_id > 65535 else 0)),
+            voltage_f16,
+            current_f16,
+            (error_flags if 0 <= error_flags <= 255 else (255 if error_flags > 255 else 0)),
         )
         return head
 
@@ -1080,46 +1125,34 @@ class CircuitStatus:
         n = len(data)
         if n < 7:
             raise _dc.cut(_CIRCUIT_STATUS_FIELD_ENDS, n << 3)
-        u1, u2, u3, u4 = _CIRCUIT_STATUS_DECODE_STRUCT.unpack_from(data)
+        circuit_id, voltage, current, error_flags = _CIRCUIT_STATUS_DECODE_STRUCT.unpack_from(data)
         if n > 7:
             raise _dc.DecodeError("CircuitStatus: " + str(n - 7) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, u3, u4)
+        return cls(circuit_id, voltage, current, error_flags)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.voltage
-        r2 = self.current
-        g3, g4 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
+        voltage = self.voltage
+        current = self.current
+        voltage_f32, current_f32 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
             _CIRCUIT_STATUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
+                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
+                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
             )
         )
-        h5 = (
-            ((g3 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        voltage_f16 = (
+            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
         )
-        h6 = (
-            ((g4 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        current_f16 = (
+            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
         )
-        r7 = self.circuit_id
-        r8 = self.error_flags
+        circuit_id = self.circuit_id
+        error_flags = self.error_flags
         acc = (acc << 56) | int.from_bytes(
             _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
-                (r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)),
-                h5,
-                h6,
-                (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0)),
+                (circuit_id if 0 <= circuit_id <= 65535 else (65535 if circuit_id > 65535 else 0)),
+                voltage_f16,
+                current_f16,
+                (error_flags if 0 <= error_flags <= 255 else (255 if error_flags > 255 else 0)),
             ),
             "big",
         )
@@ -1130,8 +1163,10 @@ class CircuitStatus:
         if rem < 56:
             raise _dc.cut(_CIRCUIT_STATUS_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3, u4 = _CIRCUIT_STATUS_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
-        return cls(u1, u2, u3, u4), rem
+        circuit_id, voltage, current, error_flags = _CIRCUIT_STATUS_DECODE_STRUCT.unpack(
+            ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
+        )
+        return cls(circuit_id, voltage, current, error_flags), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -1299,39 +1334,47 @@ class PrimaryPowerSupplyStatus:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.hours_to_empty_at_10sec_avg_power
-        r2 = self.hours_to_empty_at_10sec_avg_power_variance
-        g3, g4 = _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
-            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
+        hours_to_empty_at_10sec_avg_power = self.hours_to_empty_at_10sec_avg_power
+        hours_to_empty_at_10sec_avg_power_variance = self.hours_to_empty_at_10sec_avg_power_variance
+        hours_to_empty_at_10sec_avg_power_f32, hours_to_empty_at_10sec_avg_power_variance_f32 = (
+            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
+                _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
+                    hours_to_empty_at_10sec_avg_power
+                    if -65504.0 <= hours_to_empty_at_10sec_avg_power <= 65504.0
+                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power),
+                    hours_to_empty_at_10sec_avg_power_variance
+                    if -65504.0 <= hours_to_empty_at_10sec_avg_power_variance <= 65504.0
+                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power_variance),
+                )
             )
         )
-        h5 = (
-            ((g3 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        hours_to_empty_at_10sec_avg_power_f16 = (
+            ((hours_to_empty_at_10sec_avg_power_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_f32 < 0x477FF000
+            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_f32)
         )
-        h6 = (
-            ((g4 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        hours_to_empty_at_10sec_avg_power_variance_f16 = (
+            ((hours_to_empty_at_10sec_avg_power_variance_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_variance_f32 < 0x477FF000
+            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_variance_f32)
         )
-        r7 = self.external_power_available
-        p8 = 1 if r7 else 0
-        r9 = self.remaining_energy_pct
-        p10 = r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0)
-        r11 = self.remaining_energy_pct_stdev
-        p12 = r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0)
-        head = _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9))
+        external_power_available = self.external_power_available
+        external_power_available_bits = 1 if external_power_available else 0
+        remaining_energy_pct = self.remaining_energy_pct
+        remaining_energy_pct_bits = (
+            remaining_energy_pct if 0 <= remaining_energy_pct <= 127 else (127 if remaining_energy_pct > 127 else 0)
+        )
+        remaining_energy_pct_stdev = self.remaining_energy_pct_stdev
+        remaining_energy_pct_stdev_bits = (
+            remaining_energy_pct_stdev
+            if 0 <= remaining_energy_pct_stdev <= 127
+            else (127 if remaining_energy_pct_stdev > 127 else 0)
+        )
+        head = _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(
+            hours_to_empty_at_10sec_avg_power_f16,
+            hours_to_empty_at_10sec_avg_power_variance_f16,
+            (external_power_available_bits << 7) | remaining_energy_pct_bits | (remaining_energy_pct_stdev_bits << 9),
+        )
         return head
 
     @classmethod
@@ -1340,49 +1383,70 @@ class PrimaryPowerSupplyStatus:
         n = len(data)
         if n < 6:
             raise _dc.cut(_PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS, n << 3)
-        u1, u2, u3 = _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack_from(data)
-        x4 = ((u3 >> 7) & 0x1) != 0
-        x5 = u3 & 0x7F
-        x6 = u3 >> 9
+        hours_to_empty_at_10sec_avg_power, hours_to_empty_at_10sec_avg_power_variance, packed1 = (
+            _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack_from(data)
+        )
+        external_power_available = ((packed1 >> 7) & 0x1) != 0
+        remaining_energy_pct = packed1 & 0x7F
+        remaining_energy_pct_stdev = packed1 >> 9
         if n > 6:
             raise _dc.DecodeError("PrimaryPowerSupplyStatus: " + str(n - 6) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, x4, x5, x6)
+        return cls(
+            hours_to_empty_at_10sec_avg_power,
+            hours_to_empty_at_10sec_avg_power_variance,
+            external_power_available,
+            remaining_energy_pct,
+            remaining_energy_pct_stdev,
+        )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.hours_to_empty_at_10sec_avg_power
-        r2 = self.hours_to_empty_at_10sec_avg_power_variance
-        g3, g4 = _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
-            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
+        hours_to_empty_at_10sec_avg_power = self.hours_to_empty_at_10sec_avg_power
+        hours_to_empty_at_10sec_avg_power_variance = self.hours_to_empty_at_10sec_avg_power_variance
+        hours_to_empty_at_10sec_avg_power_f32, hours_to_empty_at_10sec_avg_power_variance_f32 = (
+            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
+                _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
+                    hours_to_empty_at_10sec_avg_power
+                    if -65504.0 <= hours_to_empty_at_10sec_avg_power <= 65504.0
+                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power),
+                    hours_to_empty_at_10sec_avg_power_variance
+                    if -65504.0 <= hours_to_empty_at_10sec_avg_power_variance <= 65504.0
+                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power_variance),
+                )
             )
         )
-        h5 = (
-            ((g3 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        hours_to_empty_at_10sec_avg_power_f16 = (
+            ((hours_to_empty_at_10sec_avg_power_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_f32 < 0x477FF000
+            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_f32)
         )
-        h6 = (
-            ((g4 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        hours_to_empty_at_10sec_avg_power_variance_f16 = (
+            ((hours_to_empty_at_10sec_avg_power_variance_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_variance_f32 < 0x477FF000
+            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_variance_f32)
         )
-        r7 = self.external_power_available
-        p8 = 1 if r7 else 0
-        r9 = self.remaining_energy_pct
-        p10 = r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0)
-        r11 = self.remaining_energy_pct_stdev
-        p12 = r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0)
+        external_power_available = self.external_power_available
+        external_power_available_bits = 1 if external_power_available else 0
+        remaining_energy_pct = self.remaining_energy_pct
+        remaining_energy_pct_bits = (
+            remaining_energy_pct if 0 <= remaining_energy_pct <= 127 else (127 if remaining_energy_pct > 127 else 0)
+        )
+        remaining_energy_pct_stdev = self.remaining_energy_pct_stdev
+        remaining_energy_pct_stdev_bits = (
+            remaining_energy_pct_stdev
+            if 0 <= remaining_energy_pct_stdev <= 127
+            else (127 if remaining_energy_pct_stdev > 127 else 0)
+        )
         acc = (acc << 47) | (
-            int.from_bytes(_PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9)), "big")
+            int.from_bytes(
+                _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(
+                    hours_to_empty_at_10sec_avg_power_f16,
+                    hours_to_empty_at_10sec_avg_power_variance_f16,
+                    (external_power_available_bits << 7)
+                    | remaining_energy_pct_bits
+                    | (remaining_energy_pct_stdev_bits << 9),
+                ),
+                "big",
+            )
             >> 1
         )
         return acc
@@ -1392,13 +1456,19 @@ class PrimaryPowerSupplyStatus:
         if rem < 47:
             raise _dc.cut(_PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS, rem)
         rem -= 47
-        u1, u2, u3 = _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack(
-            (((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big")
+        hours_to_empty_at_10sec_avg_power, hours_to_empty_at_10sec_avg_power_variance, packed1 = (
+            _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack((((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big"))
         )
-        x4 = ((u3 >> 7) & 0x1) != 0
-        x5 = u3 & 0x7F
-        x6 = u3 >> 9
-        return cls(u1, u2, x4, x5, x6), rem
+        external_power_available = ((packed1 >> 7) & 0x1) != 0
+        remaining_energy_pct = packed1 & 0x7F
+        remaining_energy_pct_stdev = packed1 >> 9
+        return cls(
+            hours_to_empty_at_10sec_avg_power,
+            hours_to_empty_at_10sec_avg_power_variance,
+            external_power_available,
+            remaining_energy_pct,
+            remaining_energy_pct_stdev,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""

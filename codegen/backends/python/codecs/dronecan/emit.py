@@ -46,9 +46,9 @@ class MessageEmitter(VariableFieldEmitter):
                 for index, node in item.nodes:
                     values[index] = self.node_expr(node)
             else:
-                values[item.index] = f"f{item.index}"
                 label = f"{self.cls}.{item.field_name}"
-                self.var_get(item, f"f{item.index}", label, tao if item.last else "False", out)
+                values[item.index] = out.field_var(item.index, label)
+                self.var_get(item, values[item.index], label, tao if item.last else "False", out)
         return values
 
     def declare(self, items: list[Item], out: Lines) -> None:
@@ -56,7 +56,7 @@ class MessageEmitter(VariableFieldEmitter):
             if isinstance(item, VarField):
                 ann = self.annotation(item.type)
                 if ann is not None:
-                    out.add(f"f{item.index}: {ann}")
+                    out.add(f"{out.field_var(item.index, f'{self.cls}.{item.field_name}')}: {ann}")
 
     def construct(self, values: dict[int, str]) -> str:
         args = [values[i] for i, f in enumerate(self.msg.fields) if not f.is_padding]
@@ -255,7 +255,7 @@ class MessageEmitter(VariableFieldEmitter):
                 return self.wrap_decode(out)
         tail = self.tail_fast(items)
         if tail is not None:  # returns when tao is true: what follows runs only without it
-            values[tail.index] = f"f{tail.index}"
+            values[tail.index] = out.field_var(tail.index, f"{self.cls}.{tail.field_name}")
             self.tail_get(tail, (head_bits + 7) // 8, out)
             out.add(f"    return {self.construct(values)}")
         out.add('v = int.from_bytes(data, "big")')
@@ -269,7 +269,7 @@ class MessageEmitter(VariableFieldEmitter):
         t = item.type
         assert isinstance(t, ArrayType)
         label = f"{self.cls}.{item.field_name}"
-        target = f"f{item.index}"
+        target = out.field_var(item.index, label)
         out.add("if tao:")
         out.level += 1
         k = out.fresh("k")

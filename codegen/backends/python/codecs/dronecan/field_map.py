@@ -4,8 +4,11 @@ the definition without working the offsets out by hand."""
 
 from __future__ import annotations
 
+import textwrap
+
 from .....ir import ArrayType, CompositeType, Field, FieldType, Message, PrimitiveKind, PrimitiveType
 from ...field_source import type_text
+from ...formatting import LINE_LENGTH
 from ...literals import comment
 from .plan import Planner
 
@@ -59,7 +62,11 @@ def field_map(planner: Planner, msg: Message) -> list[str]:
             bits, more = f"{at}-{offset + planner.fixed_bits(f.type) - 1}" if not after else at, ""
         else:
             bits, more = f"{at}-", _varying(planner, f.type, tail=i == last)
-        out.append(f"#   bits {bits:<9} {_what(f)}{more}  (line {f.location.line})")
+        row = f"bits {bits:<9} {_what(f)}{more}  (line {f.location.line})"
+        # wrapped where the class body's indent leaves too little room (continuation lines indented);
+        # the text is DSDL names and numbers, which the DSDL frontend keeps to identifiers
+        wrapped = textwrap.wrap(row, LINE_LENGTH - 4 - 8, break_long_words=False, break_on_hyphens=False)
+        out += ["#   " + wrapped[0], *("#       " + line for line in wrapped[1:])]
         if union:
             continue
         if _sized(planner, f.type):
