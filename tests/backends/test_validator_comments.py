@@ -11,8 +11,11 @@ from generated.uorb import BatteryStatus
 
 
 def _comment(cls: type, field: str) -> str:
-    source = inspect.getsource(cls.validate)  # type: ignore[attr-defined]
-    return next(line.strip() for line in source.splitlines() if line.strip().startswith(f"# {field} ("))
+    """The comment above the field's check, its wrapped lines joined."""
+    lines = [line.strip() for line in inspect.getsource(cls.validate).splitlines()]  # type: ignore[attr-defined]
+    start = next(i for i, line in enumerate(lines) if line.startswith(f"# {field} ("))
+    end = next(i for i in range(start + 1, len(lines)) if not lines[i].startswith("#"))
+    return " ".join([lines[start], *(line[2:] for line in lines[start + 1 : end])])
 
 
 def _flagged(obj: object, field: str) -> bool:

@@ -31,6 +31,8 @@ _TIMESTAMP_DECODE_STRUCT = _struct.Struct("<IHB")
 _TIMESTAMP_USEC_SPEC = _v.Number(
     type="uint56", kind="uint", low=0, high=72057594037927935, unit="us", sentinel=0, sentinel_text="UNKNOWN"
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_TIMESTAMP_FIELD_SPECS = (("usec", "usec", _TIMESTAMP_USEC_SPEC),)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -127,12 +129,12 @@ class Timestamp:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        # usec (Timestamp.uavcan:6): fits uint56; UNKNOWN means unknown (accepted)
         try:
+            # usec (Timestamp.uavcan:6): fits uint56; UNKNOWN means unknown (accepted)
             if self.usec & -72057594037927936:
                 _v.diag(out, "usec", self.usec, _TIMESTAMP_USEC_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "usec", self.usec, _TIMESTAMP_USEC_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _TIMESTAMP_FIELD_SPECS)
         return out
 
     def check(self) -> None:

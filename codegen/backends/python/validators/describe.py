@@ -37,5 +37,5 @@ def check_comment(schema: Schema, msg: Message, f: Field) -> list[str]:
     if f.invalid is not None:
         parts.append(f"{f.invalid.text} means unknown (accepted)")
     where = f"{msg.location.file.rsplit('/', 1)[-1]}:{f.location.line}"
-    pad = " " * 8  # where the check stands: inside validate(), inside the class
+    pad = " " * 12  # where the check stands: in the try of validate(), in the class
     return [line[len(pad) :] for line in comment(f"{f.name} ({where}): " + "; ".join(parts), pad)]

@@ -69,6 +69,11 @@ _BATTERY_CELLS_VOLTAGES_SPEC = _v.Array(
     _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V"), 24, False
 )
 _BATTERY_CELLS_INDEX_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_CELLS_FIELD_SPECS = (
+    ("voltages", "voltages", _BATTERY_CELLS_VOLTAGES_SPEC),
+    ("index", "index", _BATTERY_CELLS_INDEX_SPEC),
+)
 
 
 # float16 fields packed as float32 ...
@@ -142,6 +147,18 @@ _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC = _v.Number(
         0x40000: "STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL",
     },
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_CONTINUOUS_FIELD_SPECS = (
+    ("temperature_cells", "temperature_cells", _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC),
+    ("temperature_pcb", "temperature_pcb", _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC),
+    ("temperature_other", "temperature_other", _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC),
+    ("current", "current", _BATTERY_CONTINUOUS_CURRENT_SPEC),
+    ("voltage", "voltage", _BATTERY_CONTINUOUS_VOLTAGE_SPEC),
+    ("state_of_charge", "state_of_charge", _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC),
+    ("slot_id", "slot_id", _BATTERY_CONTINUOUS_SLOT_ID_SPEC),
+    ("capacity_consumed", "capacity_consumed", _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC),
+    ("status_flags", "status_flags", _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC),
+)
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
@@ -180,6 +197,17 @@ _BATTERY_INFO_AUX_MAX_CURRENT_SPEC = _v.Number(type="float16", kind="float", low
 _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V")
 _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
 _BATTERY_INFO_AUX_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_INFO_AUX_FIELD_SPECS = (
+    ("timestamp", "timestamp", _BATTERY_INFO_AUX_TIMESTAMP_SPEC),
+    ("voltage_cell", "voltage_cell", _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC),
+    ("cycle_count", "cycle_count", _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC),
+    ("over_discharge_count", "over_discharge_count", _BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC),
+    ("max_current", "max_current", _BATTERY_INFO_AUX_MAX_CURRENT_SPEC),
+    ("nominal_voltage", "nominal_voltage", _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC),
+    ("is_powering_off", "is_powering_off", _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC),
+    ("battery_id", "battery_id", _BATTERY_INFO_AUX_BATTERY_ID_SPEC),
+)
 
 
 # float16 fields packed as float32 ...
@@ -243,6 +271,28 @@ _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC = _v.Number(
 )
 _BATTERY_PERIODIC_CYCLE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
 _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255, unit="%")
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_PERIODIC_FIELD_SPECS = (
+    ("name", "name", _BATTERY_PERIODIC_NAME_SPEC),
+    ("serial_number", "serial_number", _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC),
+    ("manufacture_date", "manufacture_date", _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC),
+    ("design_capacity", "design_capacity", _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC),
+    ("cells_in_series", "cells_in_series", _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC),
+    ("nominal_voltage", "nominal_voltage", _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC),
+    ("discharge_minimum_voltage", "discharge_minimum_voltage", _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC),
+    ("charging_minimum_voltage", "charging_minimum_voltage", _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC),
+    ("charging_maximum_voltage", "charging_maximum_voltage", _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC),
+    ("charging_maximum_current", "charging_maximum_current", _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC),
+    ("discharge_maximum_current", "discharge_maximum_current", _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC),
+    (
+        "discharge_maximum_burst_current",
+        "discharge_maximum_burst_current",
+        _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
+    ),
+    ("full_charge_capacity", "full_charge_capacity", _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC),
+    ("cycle_count", "cycle_count", _BATTERY_PERIODIC_CYCLE_COUNT_SPEC),
+    ("state_of_health", "state_of_health", _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC),
+)
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
@@ -269,6 +319,15 @@ _BATTERY_TAG_ARMED_HOURS_SPEC = _v.Number(
 _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
 _BATTERY_TAG_FIRST_USE_MINS_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
 _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_TAG_FIELD_SPECS = (
+    ("serial_number", "serial_number", _BATTERY_TAG_SERIAL_NUMBER_SPEC),
+    ("num_cycles", "num_cycles", _BATTERY_TAG_NUM_CYCLES_SPEC),
+    ("armed_hours", "armed_hours", _BATTERY_TAG_ARMED_HOURS_SPEC),
+    ("battery_capacity_mAh", "battery_capacity_mAh", _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC),
+    ("first_use_mins", "first_use_mins", _BATTERY_TAG_FIRST_USE_MINS_SPEC),
+    ("last_arm_time_mins", "last_arm_time_mins", _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC),
+)
 
 
 @_functools.cache
@@ -417,8 +476,8 @@ class BatteryCells:
         out: list[_v.Violation] = []
         a: _Any
         e: _Any
-        # voltages (20012.BatteryCells.uavcan:6): fits float16[<=24]
         try:
+            # voltages (20012.BatteryCells.uavcan:6): fits float16[<=24]
             a = self.voltages
             if len(a) > 24:
                 _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
@@ -427,14 +486,11 @@ class BatteryCells:
                     if not (-65504.0 <= e <= 65504.0):
                         _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
-        # index (20012.BatteryCells.uavcan:7): fits uint16
-        try:
+            # index (20012.BatteryCells.uavcan:7): fits uint16
             if self.index & -65536:
                 _v.diag(out, "index", self.index, _BATTERY_CELLS_INDEX_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "index", self.index, _BATTERY_CELLS_INDEX_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_CELLS_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -878,60 +934,36 @@ class BatteryContinuous:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        # temperature_cells (20010.BatteryContinuous.uavcan:5): fits float16
         try:
+            # temperature_cells (20010.BatteryContinuous.uavcan:5): fits float16
             if not (-65504.0 <= self.temperature_cells <= 65504.0):
                 _v.diag(out, "temperature_cells", self.temperature_cells, _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature_cells", self.temperature_cells, _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC)
-        # temperature_pcb (20010.BatteryContinuous.uavcan:6): fits float16
-        try:
+            # temperature_pcb (20010.BatteryContinuous.uavcan:6): fits float16
             if not (-65504.0 <= self.temperature_pcb <= 65504.0):
                 _v.diag(out, "temperature_pcb", self.temperature_pcb, _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature_pcb", self.temperature_pcb, _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC)
-        # temperature_other (20010.BatteryContinuous.uavcan:7): fits float16
-        try:
+            # temperature_other (20010.BatteryContinuous.uavcan:7): fits float16
             if not (-65504.0 <= self.temperature_other <= 65504.0):
                 _v.diag(out, "temperature_other", self.temperature_other, _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature_other", self.temperature_other, _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC)
-        # current (20010.BatteryContinuous.uavcan:8): fits float32
-        try:
+            # current (20010.BatteryContinuous.uavcan:8): fits float32
             if not (-3.4028234663852886e38 <= self.current <= 3.4028234663852886e38):
                 _v.diag(out, "current", self.current, _BATTERY_CONTINUOUS_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _BATTERY_CONTINUOUS_CURRENT_SPEC)
-        # voltage (20010.BatteryContinuous.uavcan:9): fits float32
-        try:
+            # voltage (20010.BatteryContinuous.uavcan:9): fits float32
             if not (-3.4028234663852886e38 <= self.voltage <= 3.4028234663852886e38):
                 _v.diag(out, "voltage", self.voltage, _BATTERY_CONTINUOUS_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _BATTERY_CONTINUOUS_VOLTAGE_SPEC)
-        # state_of_charge (20010.BatteryContinuous.uavcan:10): fits float16
-        try:
+            # state_of_charge (20010.BatteryContinuous.uavcan:10): fits float16
             if not (-65504.0 <= self.state_of_charge <= 65504.0):
                 _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC)
-        # slot_id (20010.BatteryContinuous.uavcan:11): fits uint8
-        try:
+            # slot_id (20010.BatteryContinuous.uavcan:11): fits uint8
             if self.slot_id & -256:
                 _v.diag(out, "slot_id", self.slot_id, _BATTERY_CONTINUOUS_SLOT_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "slot_id", self.slot_id, _BATTERY_CONTINUOUS_SLOT_ID_SPEC)
-        # capacity_consumed (20010.BatteryContinuous.uavcan:12): fits float32
-        try:
+            # capacity_consumed (20010.BatteryContinuous.uavcan:12): fits float32
             if not (-3.4028234663852886e38 <= self.capacity_consumed <= 3.4028234663852886e38):
                 _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC)
-        # status_flags (20010.BatteryContinuous.uavcan:13): fits uint32; bits of STATUS_FLAG only
-        try:
+            # status_flags (20010.BatteryContinuous.uavcan:13): fits uint32; bits of STATUS_FLAG only
             if self.status_flags & -524288:
                 _v.diag(out, "status_flags", self.status_flags, _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "status_flags", self.status_flags, _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_CONTINUOUS_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -1307,8 +1339,8 @@ class BatteryInfoAux:
         a: _Any
         e: _Any
         sub: _Any
-        # timestamp (20004.BatteryInfoAux.uavcan:8): fits dronecan.uavcan.Timestamp
         try:
+            # timestamp (20004.BatteryInfoAux.uavcan:8): fits dronecan.uavcan.Timestamp
             x = self.timestamp
             if x.QUALIFIED_NAME != "dronecan.uavcan.Timestamp":
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_AUX_TIMESTAMP_SPEC)
@@ -1316,10 +1348,7 @@ class BatteryInfoAux:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("timestamp", sub))
-        except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_AUX_TIMESTAMP_SPEC)
-        # voltage_cell (20004.BatteryInfoAux.uavcan:11): fits float16[<=255]
-        try:
+            # voltage_cell (20004.BatteryInfoAux.uavcan:11): fits float16[<=255]
             a = self.voltage_cell
             if len(a) > 255:
                 _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
@@ -1328,47 +1357,29 @@ class BatteryInfoAux:
                     if not (-65504.0 <= e <= 65504.0):
                         _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
-        # cycle_count (20004.BatteryInfoAux.uavcan:14): fits uint16
-        try:
+            # cycle_count (20004.BatteryInfoAux.uavcan:14): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC)
-        # over_discharge_count (20004.BatteryInfoAux.uavcan:17): fits uint16
-        try:
+            # over_discharge_count (20004.BatteryInfoAux.uavcan:17): fits uint16
             if self.over_discharge_count & -65536:
                 _v.diag(
                     out, "over_discharge_count", self.over_discharge_count, _BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(out, "over_discharge_count", self.over_discharge_count, _BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC)
-        # max_current (20004.BatteryInfoAux.uavcan:20): fits float16
-        try:
+            # max_current (20004.BatteryInfoAux.uavcan:20): fits float16
             if not (-65504.0 <= self.max_current <= 65504.0):
                 _v.diag(out, "max_current", self.max_current, _BATTERY_INFO_AUX_MAX_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "max_current", self.max_current, _BATTERY_INFO_AUX_MAX_CURRENT_SPEC)
-        # nominal_voltage (20004.BatteryInfoAux.uavcan:23): fits float16
-        try:
+            # nominal_voltage (20004.BatteryInfoAux.uavcan:23): fits float16
             if not (-65504.0 <= self.nominal_voltage <= 65504.0):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC)
-        # is_powering_off (20004.BatteryInfoAux.uavcan:25): fits bool
-        try:
+            # is_powering_off (20004.BatteryInfoAux.uavcan:25): fits bool
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC)
-        # battery_id (20004.BatteryInfoAux.uavcan:27): fits uint8
-        try:
+            # battery_id (20004.BatteryInfoAux.uavcan:27): fits uint8
             if self.battery_id & -256:
                 _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_AUX_BATTERY_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_AUX_BATTERY_ID_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_INFO_AUX_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -2097,47 +2108,29 @@ class BatteryPeriodic:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         x: _Any
-        # name (20011.BatteryPeriodic.uavcan:5): fits uint8[<=50]
         try:
+            # name (20011.BatteryPeriodic.uavcan:5): fits uint8[<=50]
             x = self.name
             if x.__class__ is not bytes or len(x) > 50:
                 _v.diag(out, "name", self.name, _BATTERY_PERIODIC_NAME_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "name", self.name, _BATTERY_PERIODIC_NAME_SPEC)
-        # serial_number (20011.BatteryPeriodic.uavcan:6): fits uint8[<=32]
-        try:
+            # serial_number (20011.BatteryPeriodic.uavcan:6): fits uint8[<=32]
             x = self.serial_number
             if x.__class__ is not bytes or len(x) > 32:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC)
-        # manufacture_date (20011.BatteryPeriodic.uavcan:7): fits uint8[<=9]
-        try:
+            # manufacture_date (20011.BatteryPeriodic.uavcan:7): fits uint8[<=9]
             x = self.manufacture_date
             if x.__class__ is not bytes or len(x) > 9:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC)
-        # design_capacity (20011.BatteryPeriodic.uavcan:8): fits float32
-        try:
+            # design_capacity (20011.BatteryPeriodic.uavcan:8): fits float32
             if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC)
-        # cells_in_series (20011.BatteryPeriodic.uavcan:9): fits uint8
-        try:
+            # cells_in_series (20011.BatteryPeriodic.uavcan:9): fits uint8
             if self.cells_in_series & -256:
                 _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC)
-        # nominal_voltage (20011.BatteryPeriodic.uavcan:10): fits float16
-        try:
+            # nominal_voltage (20011.BatteryPeriodic.uavcan:10): fits float16
             if not (-65504.0 <= self.nominal_voltage <= 65504.0):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC)
-        # discharge_minimum_voltage (20011.BatteryPeriodic.uavcan:11): fits float16
-        try:
+            # discharge_minimum_voltage (20011.BatteryPeriodic.uavcan:11): fits float16
             if not (-65504.0 <= self.discharge_minimum_voltage <= 65504.0):
                 _v.diag(
                     out,
@@ -2145,15 +2138,7 @@ class BatteryPeriodic:
                     self.discharge_minimum_voltage,
                     _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_minimum_voltage",
-                self.discharge_minimum_voltage,
-                _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
-            )
-        # charging_minimum_voltage (20011.BatteryPeriodic.uavcan:12): fits float16
-        try:
+            # charging_minimum_voltage (20011.BatteryPeriodic.uavcan:12): fits float16
             if not (-65504.0 <= self.charging_minimum_voltage <= 65504.0):
                 _v.diag(
                     out,
@@ -2161,15 +2146,7 @@ class BatteryPeriodic:
                     self.charging_minimum_voltage,
                     _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charging_minimum_voltage",
-                self.charging_minimum_voltage,
-                _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC,
-            )
-        # charging_maximum_voltage (20011.BatteryPeriodic.uavcan:13): fits float16
-        try:
+            # charging_maximum_voltage (20011.BatteryPeriodic.uavcan:13): fits float16
             if not (-65504.0 <= self.charging_maximum_voltage <= 65504.0):
                 _v.diag(
                     out,
@@ -2177,15 +2154,7 @@ class BatteryPeriodic:
                     self.charging_maximum_voltage,
                     _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charging_maximum_voltage",
-                self.charging_maximum_voltage,
-                _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC,
-            )
-        # charging_maximum_current (20011.BatteryPeriodic.uavcan:14): fits float32
-        try:
+            # charging_maximum_current (20011.BatteryPeriodic.uavcan:14): fits float32
             if not (-3.4028234663852886e38 <= self.charging_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2193,15 +2162,7 @@ class BatteryPeriodic:
                     self.charging_maximum_current,
                     _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charging_maximum_current",
-                self.charging_maximum_current,
-                _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC,
-            )
-        # discharge_maximum_current (20011.BatteryPeriodic.uavcan:15): fits float32
-        try:
+            # discharge_maximum_current (20011.BatteryPeriodic.uavcan:15): fits float32
             if not (-3.4028234663852886e38 <= self.discharge_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2209,15 +2170,7 @@ class BatteryPeriodic:
                     self.discharge_maximum_current,
                     _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_maximum_current",
-                self.discharge_maximum_current,
-                _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC,
-            )
-        # discharge_maximum_burst_current (20011.BatteryPeriodic.uavcan:16): fits float32
-        try:
+            # discharge_maximum_burst_current (20011.BatteryPeriodic.uavcan:16): fits float32
             if not (-3.4028234663852886e38 <= self.discharge_maximum_burst_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2225,33 +2178,19 @@ class BatteryPeriodic:
                     self.discharge_maximum_burst_current,
                     _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_maximum_burst_current",
-                self.discharge_maximum_burst_current,
-                _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
-            )
-        # full_charge_capacity (20011.BatteryPeriodic.uavcan:17): fits float32
-        try:
+            # full_charge_capacity (20011.BatteryPeriodic.uavcan:17): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity <= 3.4028234663852886e38):
                 _v.diag(
                     out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC)
-        # cycle_count (20011.BatteryPeriodic.uavcan:18): fits uint16
-        try:
+            # cycle_count (20011.BatteryPeriodic.uavcan:18): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_PERIODIC_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_PERIODIC_CYCLE_COUNT_SPEC)
-        # state_of_health (20011.BatteryPeriodic.uavcan:19): fits uint8
-        try:
+            # state_of_health (20011.BatteryPeriodic.uavcan:19): fits uint8
             if self.state_of_health & -256:
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_PERIODIC_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -2504,42 +2443,27 @@ class BatteryTag:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        # serial_number (20500.BatteryTag.uavcan:7): fits uint32
         try:
+            # serial_number (20500.BatteryTag.uavcan:7): fits uint32
             if self.serial_number & -4294967296:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_TAG_SERIAL_NUMBER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _BATTERY_TAG_SERIAL_NUMBER_SPEC)
-        # num_cycles (20500.BatteryTag.uavcan:11): fits uint32
-        try:
+            # num_cycles (20500.BatteryTag.uavcan:11): fits uint32
             if self.num_cycles & -4294967296:
                 _v.diag(out, "num_cycles", self.num_cycles, _BATTERY_TAG_NUM_CYCLES_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "num_cycles", self.num_cycles, _BATTERY_TAG_NUM_CYCLES_SPEC)
-        # armed_hours (20500.BatteryTag.uavcan:15): fits float32
-        try:
+            # armed_hours (20500.BatteryTag.uavcan:15): fits float32
             if not (-3.4028234663852886e38 <= self.armed_hours <= 3.4028234663852886e38):
                 _v.diag(out, "armed_hours", self.armed_hours, _BATTERY_TAG_ARMED_HOURS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "armed_hours", self.armed_hours, _BATTERY_TAG_ARMED_HOURS_SPEC)
-        # battery_capacity_mAh (20500.BatteryTag.uavcan:18): fits uint32
-        try:
+            # battery_capacity_mAh (20500.BatteryTag.uavcan:18): fits uint32
             if self.battery_capacity_mAh & -4294967296:
                 _v.diag(out, "battery_capacity_mAh", self.battery_capacity_mAh, _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_capacity_mAh", self.battery_capacity_mAh, _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC)
-        # first_use_mins (20500.BatteryTag.uavcan:21): fits uint32
-        try:
+            # first_use_mins (20500.BatteryTag.uavcan:21): fits uint32
             if self.first_use_mins & -4294967296:
                 _v.diag(out, "first_use_mins", self.first_use_mins, _BATTERY_TAG_FIRST_USE_MINS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "first_use_mins", self.first_use_mins, _BATTERY_TAG_FIRST_USE_MINS_SPEC)
-        # last_arm_time_mins (20500.BatteryTag.uavcan:24): fits uint32
-        try:
+            # last_arm_time_mins (20500.BatteryTag.uavcan:24): fits uint32
             if self.last_arm_time_mins & -4294967296:
                 _v.diag(out, "last_arm_time_mins", self.last_arm_time_mins, _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "last_arm_time_mins", self.last_arm_time_mins, _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_TAG_FIELD_SPECS)
         return out
 
     def check(self) -> None:

@@ -136,6 +136,34 @@ _CBAT_STATUS_FLAGS_SPEC = _v.Number(
         0x400: "STATUS_FLAG_RESERVED_B",
     },
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_CBAT_FIELD_SPECS = (
+    ("temperature", "temperature", _CBAT_TEMPERATURE_SPEC),
+    ("voltage", "voltage", _CBAT_VOLTAGE_SPEC),
+    ("voltage_cell", "voltage_cell", _CBAT_VOLTAGE_CELL_SPEC),
+    ("cell_count", "cell_count", _CBAT_CELL_COUNT_SPEC),
+    ("current", "current", _CBAT_CURRENT_SPEC),
+    ("average_current", "average_current", _CBAT_AVERAGE_CURRENT_SPEC),
+    ("average_power", "average_power", _CBAT_AVERAGE_POWER_SPEC),
+    ("available_energy", "available_energy", _CBAT_AVAILABLE_ENERGY_SPEC),
+    ("remaining_capacity", "remaining_capacity", _CBAT_REMAINING_CAPACITY_SPEC),
+    ("full_charge_capacity", "full_charge_capacity", _CBAT_FULL_CHARGE_CAPACITY_SPEC),
+    ("design_capacity", "design_capacity", _CBAT_DESIGN_CAPACITY_SPEC),
+    ("average_time_to_empty", "average_time_to_empty", _CBAT_AVERAGE_TIME_TO_EMPTY_SPEC),
+    ("average_time_to_full", "average_time_to_full", _CBAT_AVERAGE_TIME_TO_FULL_SPEC),
+    ("state_of_health", "state_of_health", _CBAT_STATE_OF_HEALTH_SPEC),
+    ("state_of_charge", "state_of_charge", _CBAT_STATE_OF_CHARGE_SPEC),
+    ("max_error", "max_error", _CBAT_MAX_ERROR_SPEC),
+    ("serial_number", "serial_number", _CBAT_SERIAL_NUMBER_SPEC),
+    ("manufacture_date", "manufacture_date", _CBAT_MANUFACTURE_DATE_SPEC),
+    ("cycle_count", "cycle_count", _CBAT_CYCLE_COUNT_SPEC),
+    ("over_discharge_count", "over_discharge_count", _CBAT_OVER_DISCHARGE_COUNT_SPEC),
+    ("passed_charge", "passed_charge", _CBAT_PASSED_CHARGE_SPEC),
+    ("nominal_voltage", "nominal_voltage", _CBAT_NOMINAL_VOLTAGE_SPEC),
+    ("is_powering_off", "is_powering_off", _CBAT_IS_POWERING_OFF_SPEC),
+    ("interface_error", "interface_error", _CBAT_INTERFACE_ERROR_SPEC),
+    ("status_flags", "status_flags", _CBAT_STATUS_FLAGS_SPEC),
+)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -1164,20 +1192,14 @@ class CBAT:
         x: _Any
         a: _Any
         e: _Any
-        # temperature (20300.CBAT.uavcan:5): fits float32
         try:
+            # temperature (20300.CBAT.uavcan:5): fits float32
             if not (-3.4028234663852886e38 <= self.temperature <= 3.4028234663852886e38):
                 _v.diag(out, "temperature", self.temperature, _CBAT_TEMPERATURE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _CBAT_TEMPERATURE_SPEC)
-        # voltage (20300.CBAT.uavcan:6): fits float32
-        try:
+            # voltage (20300.CBAT.uavcan:6): fits float32
             if not (-3.4028234663852886e38 <= self.voltage <= 3.4028234663852886e38):
                 _v.diag(out, "voltage", self.voltage, _CBAT_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _CBAT_VOLTAGE_SPEC)
-        # voltage_cell (20300.CBAT.uavcan:7): fits float32[<=15]
-        try:
+            # voltage_cell (20300.CBAT.uavcan:7): fits float32[<=15]
             a = self.voltage_cell
             if len(a) > 15:
                 _v.diag(out, "voltage_cell", self.voltage_cell, _CBAT_VOLTAGE_CELL_SPEC)
@@ -1186,141 +1208,75 @@ class CBAT:
                     if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
                         _v.diag(out, "voltage_cell", self.voltage_cell, _CBAT_VOLTAGE_CELL_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltage_cell", self.voltage_cell, _CBAT_VOLTAGE_CELL_SPEC)
-        # cell_count (20300.CBAT.uavcan:8): fits uint8
-        try:
+            # cell_count (20300.CBAT.uavcan:8): fits uint8
             if self.cell_count & -256:
                 _v.diag(out, "cell_count", self.cell_count, _CBAT_CELL_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cell_count", self.cell_count, _CBAT_CELL_COUNT_SPEC)
-        # current (20300.CBAT.uavcan:9): fits float32
-        try:
+            # current (20300.CBAT.uavcan:9): fits float32
             if not (-3.4028234663852886e38 <= self.current <= 3.4028234663852886e38):
                 _v.diag(out, "current", self.current, _CBAT_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _CBAT_CURRENT_SPEC)
-        # average_current (20300.CBAT.uavcan:10): fits float32
-        try:
+            # average_current (20300.CBAT.uavcan:10): fits float32
             if not (-3.4028234663852886e38 <= self.average_current <= 3.4028234663852886e38):
                 _v.diag(out, "average_current", self.average_current, _CBAT_AVERAGE_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_current", self.average_current, _CBAT_AVERAGE_CURRENT_SPEC)
-        # average_power (20300.CBAT.uavcan:11): fits float32
-        try:
+            # average_power (20300.CBAT.uavcan:11): fits float32
             if not (-3.4028234663852886e38 <= self.average_power <= 3.4028234663852886e38):
                 _v.diag(out, "average_power", self.average_power, _CBAT_AVERAGE_POWER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_power", self.average_power, _CBAT_AVERAGE_POWER_SPEC)
-        # available_energy (20300.CBAT.uavcan:12): fits float32
-        try:
+            # available_energy (20300.CBAT.uavcan:12): fits float32
             if not (-3.4028234663852886e38 <= self.available_energy <= 3.4028234663852886e38):
                 _v.diag(out, "available_energy", self.available_energy, _CBAT_AVAILABLE_ENERGY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "available_energy", self.available_energy, _CBAT_AVAILABLE_ENERGY_SPEC)
-        # remaining_capacity (20300.CBAT.uavcan:13): fits float32
-        try:
+            # remaining_capacity (20300.CBAT.uavcan:13): fits float32
             if not (-3.4028234663852886e38 <= self.remaining_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "remaining_capacity", self.remaining_capacity, _CBAT_REMAINING_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "remaining_capacity", self.remaining_capacity, _CBAT_REMAINING_CAPACITY_SPEC)
-        # full_charge_capacity (20300.CBAT.uavcan:14): fits float32
-        try:
+            # full_charge_capacity (20300.CBAT.uavcan:14): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _CBAT_FULL_CHARGE_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _CBAT_FULL_CHARGE_CAPACITY_SPEC)
-        # design_capacity (20300.CBAT.uavcan:15): fits float32
-        try:
+            # design_capacity (20300.CBAT.uavcan:15): fits float32
             if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "design_capacity", self.design_capacity, _CBAT_DESIGN_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "design_capacity", self.design_capacity, _CBAT_DESIGN_CAPACITY_SPEC)
-        # average_time_to_empty (20300.CBAT.uavcan:16): fits uint16
-        try:
+            # average_time_to_empty (20300.CBAT.uavcan:16): fits uint16
             if self.average_time_to_empty & -65536:
                 _v.diag(out, "average_time_to_empty", self.average_time_to_empty, _CBAT_AVERAGE_TIME_TO_EMPTY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_time_to_empty", self.average_time_to_empty, _CBAT_AVERAGE_TIME_TO_EMPTY_SPEC)
-        # average_time_to_full (20300.CBAT.uavcan:17): fits uint16
-        try:
+            # average_time_to_full (20300.CBAT.uavcan:17): fits uint16
             if self.average_time_to_full & -65536:
                 _v.diag(out, "average_time_to_full", self.average_time_to_full, _CBAT_AVERAGE_TIME_TO_FULL_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_time_to_full", self.average_time_to_full, _CBAT_AVERAGE_TIME_TO_FULL_SPEC)
-        # state_of_health (20300.CBAT.uavcan:18): fits uint7
-        try:
+            # state_of_health (20300.CBAT.uavcan:18): fits uint7
             if self.state_of_health & -128:
                 _v.diag(out, "state_of_health", self.state_of_health, _CBAT_STATE_OF_HEALTH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health", self.state_of_health, _CBAT_STATE_OF_HEALTH_SPEC)
-        # state_of_charge (20300.CBAT.uavcan:19): fits uint7
-        try:
+            # state_of_charge (20300.CBAT.uavcan:19): fits uint7
             if self.state_of_charge & -128:
                 _v.diag(out, "state_of_charge", self.state_of_charge, _CBAT_STATE_OF_CHARGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_charge", self.state_of_charge, _CBAT_STATE_OF_CHARGE_SPEC)
-        # max_error (20300.CBAT.uavcan:20): fits uint7
-        try:
+            # max_error (20300.CBAT.uavcan:20): fits uint7
             if self.max_error & -128:
                 _v.diag(out, "max_error", self.max_error, _CBAT_MAX_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "max_error", self.max_error, _CBAT_MAX_ERROR_SPEC)
-        # serial_number (20300.CBAT.uavcan:21): fits uint16
-        try:
+            # serial_number (20300.CBAT.uavcan:21): fits uint16
             if self.serial_number & -65536:
                 _v.diag(out, "serial_number", self.serial_number, _CBAT_SERIAL_NUMBER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _CBAT_SERIAL_NUMBER_SPEC)
-        # manufacture_date (20300.CBAT.uavcan:22): fits uint16
-        try:
+            # manufacture_date (20300.CBAT.uavcan:22): fits uint16
             if self.manufacture_date & -65536:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _CBAT_MANUFACTURE_DATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "manufacture_date", self.manufacture_date, _CBAT_MANUFACTURE_DATE_SPEC)
-        # cycle_count (20300.CBAT.uavcan:23): fits uint16
-        try:
+            # cycle_count (20300.CBAT.uavcan:23): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _CBAT_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _CBAT_CYCLE_COUNT_SPEC)
-        # over_discharge_count (20300.CBAT.uavcan:24): fits uint16
-        try:
+            # over_discharge_count (20300.CBAT.uavcan:24): fits uint16
             if self.over_discharge_count & -65536:
                 _v.diag(out, "over_discharge_count", self.over_discharge_count, _CBAT_OVER_DISCHARGE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "over_discharge_count", self.over_discharge_count, _CBAT_OVER_DISCHARGE_COUNT_SPEC)
-        # passed_charge (20300.CBAT.uavcan:25): fits float32
-        try:
+            # passed_charge (20300.CBAT.uavcan:25): fits float32
             if not (-3.4028234663852886e38 <= self.passed_charge <= 3.4028234663852886e38):
                 _v.diag(out, "passed_charge", self.passed_charge, _CBAT_PASSED_CHARGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "passed_charge", self.passed_charge, _CBAT_PASSED_CHARGE_SPEC)
-        # nominal_voltage (20300.CBAT.uavcan:26): fits float32
-        try:
+            # nominal_voltage (20300.CBAT.uavcan:26): fits float32
             if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _CBAT_NOMINAL_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _CBAT_NOMINAL_VOLTAGE_SPEC)
-        # is_powering_off (20300.CBAT.uavcan:27): fits bool
-        try:
+            # is_powering_off (20300.CBAT.uavcan:27): fits bool
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _CBAT_IS_POWERING_OFF_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "is_powering_off", self.is_powering_off, _CBAT_IS_POWERING_OFF_SPEC)
-        # interface_error (20300.CBAT.uavcan:28): fits uint16
-        try:
+            # interface_error (20300.CBAT.uavcan:28): fits uint16
             if self.interface_error & -65536:
                 _v.diag(out, "interface_error", self.interface_error, _CBAT_INTERFACE_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "interface_error", self.interface_error, _CBAT_INTERFACE_ERROR_SPEC)
-        # status_flags (20300.CBAT.uavcan:41): fits uint11; bits of STATUS_FLAG only
-        try:
+            # status_flags (20300.CBAT.uavcan:41): fits uint11; bits of STATUS_FLAG only
             if self.status_flags & -512:
                 _v.diag(out, "status_flags", self.status_flags, _CBAT_STATUS_FLAGS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "status_flags", self.status_flags, _CBAT_STATUS_FLAGS_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _CBAT_FIELD_SPECS)
         return out
 
     def check(self) -> None:

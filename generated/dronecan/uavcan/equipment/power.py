@@ -132,6 +132,23 @@ _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC = _v.Number(type="uint7", kind="uin
 _BATTERY_INFO_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
 _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
 _BATTERY_INFO_MODEL_NAME_SPEC = _v.Array(_v.Number(type="uint8", kind="uint", low=0, high=255), 31, False, byte=True)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_INFO_FIELD_SPECS = (
+    ("temperature", "temperature", _BATTERY_INFO_TEMPERATURE_SPEC),
+    ("voltage", "voltage", _BATTERY_INFO_VOLTAGE_SPEC),
+    ("current", "current", _BATTERY_INFO_CURRENT_SPEC),
+    ("average_power_10sec", "average_power_10sec", _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC),
+    ("remaining_capacity_wh", "remaining_capacity_wh", _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC),
+    ("full_charge_capacity_wh", "full_charge_capacity_wh", _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC),
+    ("hours_to_full_charge", "hours_to_full_charge", _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC),
+    ("status_flags", "status_flags", _BATTERY_INFO_STATUS_FLAGS_SPEC),
+    ("state_of_health_pct", "state_of_health_pct", _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC),
+    ("state_of_charge_pct", "state_of_charge_pct", _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC),
+    ("state_of_charge_pct_stdev", "state_of_charge_pct_stdev", _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC),
+    ("battery_id", "battery_id", _BATTERY_INFO_BATTERY_ID_SPEC),
+    ("model_instance_id", "model_instance_id", _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC),
+    ("model_name", "model_name", _BATTERY_INFO_MODEL_NAME_SPEC),
+)
 
 
 # float16 fields packed as float32 ...
@@ -168,6 +185,13 @@ _CIRCUIT_STATUS_ERROR_FLAGS_SPEC = _v.Number(
         0x8: "ERROR_FLAG_UNDERCURRENT",
     },
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_CIRCUIT_STATUS_FIELD_SPECS = (
+    ("circuit_id", "circuit_id", _CIRCUIT_STATUS_CIRCUIT_ID_SPEC),
+    ("voltage", "voltage", _CIRCUIT_STATUS_VOLTAGE_SPEC),
+    ("current", "current", _CIRCUIT_STATUS_CURRENT_SPEC),
+    ("error_flags", "error_flags", _CIRCUIT_STATUS_ERROR_FLAGS_SPEC),
+)
 
 
 # float16 fields packed as float32 ...
@@ -199,6 +223,30 @@ _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC = _v.Number(type="boo
 _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
 _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC = _v.Number(
     type="uint7", kind="uint", low=0, high=127, unit="%"
+)
+# (schema name, attribute, spec) of each field, for the careful way
+_PRIMARY_POWER_SUPPLY_STATUS_FIELD_SPECS = (
+    (
+        "hours_to_empty_at_10sec_avg_power",
+        "hours_to_empty_at_10sec_avg_power",
+        _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC,
+    ),
+    (
+        "hours_to_empty_at_10sec_avg_power_variance",
+        "hours_to_empty_at_10sec_avg_power_variance",
+        _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC,
+    ),
+    (
+        "external_power_available",
+        "external_power_available",
+        _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC,
+    ),
+    ("remaining_energy_pct", "remaining_energy_pct", _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC),
+    (
+        "remaining_energy_pct_stdev",
+        "remaining_energy_pct_stdev",
+        _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC,
+    ),
 )
 
 
@@ -842,45 +890,30 @@ class BatteryInfo:
         x: _Any
         r_state_of_charge_pct: _Any
         r_state_of_health_pct: _Any
-        # temperature (1092.BatteryInfo.uavcan:10): fits float16; NaN means unknown (accepted)
         try:
+            # temperature (1092.BatteryInfo.uavcan:10): fits float16; NaN means unknown (accepted)
             x = self.temperature
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_INFO_TEMPERATURE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _BATTERY_INFO_TEMPERATURE_SPEC)
-        # voltage (1092.BatteryInfo.uavcan:11): fits float16; NaN means unknown (accepted)
-        try:
+            # voltage (1092.BatteryInfo.uavcan:11): fits float16; NaN means unknown (accepted)
             x = self.voltage
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "voltage", self.voltage, _BATTERY_INFO_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _BATTERY_INFO_VOLTAGE_SPEC)
-        # current (1092.BatteryInfo.uavcan:12): fits float16; NaN means unknown (accepted)
-        try:
+            # current (1092.BatteryInfo.uavcan:12): fits float16; NaN means unknown (accepted)
             x = self.current
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "current", self.current, _BATTERY_INFO_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _BATTERY_INFO_CURRENT_SPEC)
-        # average_power_10sec (1092.BatteryInfo.uavcan:13): fits float16; NaN means unknown (accepted)
-        try:
+            # average_power_10sec (1092.BatteryInfo.uavcan:13): fits float16; NaN means unknown (accepted)
             x = self.average_power_10sec
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "average_power_10sec", self.average_power_10sec, _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_power_10sec", self.average_power_10sec, _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC)
-        # remaining_capacity_wh (1092.BatteryInfo.uavcan:14): fits float16; NaN means unknown (accepted)
-        try:
+            # remaining_capacity_wh (1092.BatteryInfo.uavcan:14): fits float16; NaN means unknown (accepted)
             x = self.remaining_capacity_wh
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(
                     out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC)
-        # full_charge_capacity_wh (1092.BatteryInfo.uavcan:15): fits float16; NaN means unknown (accepted)
-        try:
+            # full_charge_capacity_wh (1092.BatteryInfo.uavcan:15): fits float16; NaN means unknown (accepted)
             x = self.full_charge_capacity_wh
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(
@@ -889,37 +922,21 @@ class BatteryInfo:
                     self.full_charge_capacity_wh,
                     _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "full_charge_capacity_wh", self.full_charge_capacity_wh, _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC
-            )
-        # hours_to_full_charge (1092.BatteryInfo.uavcan:16): fits float16; NaN means unknown (accepted)
-        try:
+            # hours_to_full_charge (1092.BatteryInfo.uavcan:16): fits float16; NaN means unknown (accepted)
             x = self.hours_to_full_charge
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC)
-        # status_flags (1092.BatteryInfo.uavcan:33): fits uint11; bits of STATUS_FLAG only
-        try:
+            # status_flags (1092.BatteryInfo.uavcan:33): fits uint11; bits of STATUS_FLAG only
             if self.status_flags & -512:
                 _v.diag(out, "status_flags", self.status_flags, _BATTERY_INFO_STATUS_FLAGS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "status_flags", self.status_flags, _BATTERY_INFO_STATUS_FLAGS_SPEC)
-        # state_of_health_pct (1092.BatteryInfo.uavcan:37): fits uint7; STATE_OF_HEALTH_UNKNOWN means unknown (accepted)
-        try:
+            # state_of_health_pct (1092.BatteryInfo.uavcan:37): fits uint7; STATE_OF_HEALTH_UNKNOWN means unknown
+            # (accepted)
             if self.state_of_health_pct & -128:
                 _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC)
-        # state_of_charge_pct (1092.BatteryInfo.uavcan:40): fits uint7
-        try:
+            # state_of_charge_pct (1092.BatteryInfo.uavcan:40): fits uint7
             if self.state_of_charge_pct & -128:
                 _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC)
-        # state_of_charge_pct_stdev (1092.BatteryInfo.uavcan:41): fits uint7
-        try:
+            # state_of_charge_pct_stdev (1092.BatteryInfo.uavcan:41): fits uint7
             if self.state_of_charge_pct_stdev & -128:
                 _v.diag(
                     out,
@@ -927,32 +944,18 @@ class BatteryInfo:
                     self.state_of_charge_pct_stdev,
                     _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "state_of_charge_pct_stdev",
-                self.state_of_charge_pct_stdev,
-                _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC,
-            )
-        # battery_id (1092.BatteryInfo.uavcan:44): fits uint8
-        try:
+            # battery_id (1092.BatteryInfo.uavcan:44): fits uint8
             if self.battery_id & -256:
                 _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_BATTERY_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_BATTERY_ID_SPEC)
-        # model_instance_id (1092.BatteryInfo.uavcan:45): fits uint32
-        try:
+            # model_instance_id (1092.BatteryInfo.uavcan:45): fits uint32
             if self.model_instance_id & -4294967296:
                 _v.diag(out, "model_instance_id", self.model_instance_id, _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "model_instance_id", self.model_instance_id, _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC)
-        # model_name (1092.BatteryInfo.uavcan:46): fits uint8[<=31]
-        try:
+            # model_name (1092.BatteryInfo.uavcan:46): fits uint8[<=31]
             x = self.model_name
             if x.__class__ is not bytes or len(x) > 31:
                 _v.diag(out, "model_name", self.model_name, _BATTERY_INFO_MODEL_NAME_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "model_name", self.model_name, _BATTERY_INFO_MODEL_NAME_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_INFO_FIELD_SPECS)
         # rule state-of-health-percent (dronecan-power.yaml:7)
         try:
             r_state_of_health_pct = self.state_of_health_pct
@@ -1171,30 +1174,21 @@ class CircuitStatus:
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
-        # circuit_id (1091.CircuitStatus.uavcan:5): fits uint16
         try:
+            # circuit_id (1091.CircuitStatus.uavcan:5): fits uint16
             if self.circuit_id & -65536:
                 _v.diag(out, "circuit_id", self.circuit_id, _CIRCUIT_STATUS_CIRCUIT_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "circuit_id", self.circuit_id, _CIRCUIT_STATUS_CIRCUIT_ID_SPEC)
-        # voltage (1091.CircuitStatus.uavcan:7): fits float16
-        try:
+            # voltage (1091.CircuitStatus.uavcan:7): fits float16
             if not (-65504.0 <= self.voltage <= 65504.0):
                 _v.diag(out, "voltage", self.voltage, _CIRCUIT_STATUS_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _CIRCUIT_STATUS_VOLTAGE_SPEC)
-        # current (1091.CircuitStatus.uavcan:8): fits float16
-        try:
+            # current (1091.CircuitStatus.uavcan:8): fits float16
             if not (-65504.0 <= self.current <= 65504.0):
                 _v.diag(out, "current", self.current, _CIRCUIT_STATUS_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _CIRCUIT_STATUS_CURRENT_SPEC)
-        # error_flags (1091.CircuitStatus.uavcan:14): fits uint8; bits of ERROR_FLAG only
-        try:
+            # error_flags (1091.CircuitStatus.uavcan:14): fits uint8; bits of ERROR_FLAG only
             if self.error_flags & -16:
                 _v.diag(out, "error_flags", self.error_flags, _CIRCUIT_STATUS_ERROR_FLAGS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "error_flags", self.error_flags, _CIRCUIT_STATUS_ERROR_FLAGS_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _CIRCUIT_STATUS_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -1475,8 +1469,8 @@ class PrimaryPowerSupplyStatus:
         out: list[_v.Violation] = []
         x: _Any
         r_remaining_energy_pct: _Any
-        # hours_to_empty_at_10sec_avg_power (1090.PrimaryPowerSupplyStatus.uavcan:6): fits float16
         try:
+            # hours_to_empty_at_10sec_avg_power (1090.PrimaryPowerSupplyStatus.uavcan:6): fits float16
             if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power <= 65504.0):
                 _v.diag(
                     out,
@@ -1484,15 +1478,7 @@ class PrimaryPowerSupplyStatus:
                     self.hours_to_empty_at_10sec_avg_power,
                     _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "hours_to_empty_at_10sec_avg_power",
-                self.hours_to_empty_at_10sec_avg_power,
-                _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC,
-            )
-        # hours_to_empty_at_10sec_avg_power_variance (1090.PrimaryPowerSupplyStatus.uavcan:7): fits float16
-        try:
+            # hours_to_empty_at_10sec_avg_power_variance (1090.PrimaryPowerSupplyStatus.uavcan:7): fits float16
             if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power_variance <= 65504.0):
                 _v.diag(
                     out,
@@ -1500,15 +1486,7 @@ class PrimaryPowerSupplyStatus:
                     self.hours_to_empty_at_10sec_avg_power_variance,
                     _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "hours_to_empty_at_10sec_avg_power_variance",
-                self.hours_to_empty_at_10sec_avg_power_variance,
-                _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC,
-            )
-        # external_power_available (1090.PrimaryPowerSupplyStatus.uavcan:10): fits bool
-        try:
+            # external_power_available (1090.PrimaryPowerSupplyStatus.uavcan:10): fits bool
             x = self.external_power_available
             if x is not True and x is not False:
                 _v.diag(
@@ -1517,15 +1495,7 @@ class PrimaryPowerSupplyStatus:
                     self.external_power_available,
                     _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "external_power_available",
-                self.external_power_available,
-                _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC,
-            )
-        # remaining_energy_pct (1090.PrimaryPowerSupplyStatus.uavcan:13): fits uint7
-        try:
+            # remaining_energy_pct (1090.PrimaryPowerSupplyStatus.uavcan:13): fits uint7
             if self.remaining_energy_pct & -128:
                 _v.diag(
                     out,
@@ -1533,15 +1503,7 @@ class PrimaryPowerSupplyStatus:
                     self.remaining_energy_pct,
                     _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "remaining_energy_pct",
-                self.remaining_energy_pct,
-                _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC,
-            )
-        # remaining_energy_pct_stdev (1090.PrimaryPowerSupplyStatus.uavcan:14): fits uint7
-        try:
+            # remaining_energy_pct_stdev (1090.PrimaryPowerSupplyStatus.uavcan:14): fits uint7
             if self.remaining_energy_pct_stdev & -128:
                 _v.diag(
                     out,
@@ -1549,13 +1511,8 @@ class PrimaryPowerSupplyStatus:
                     self.remaining_energy_pct_stdev,
                     _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "remaining_energy_pct_stdev",
-                self.remaining_energy_pct_stdev,
-                _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC,
-            )
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _PRIMARY_POWER_SUPPLY_STATUS_FIELD_SPECS)
         # rule remaining-energy-percent (dronecan-primary-power.yaml:4)
         try:
             r_remaining_energy_pct = self.remaining_energy_pct
