@@ -87,12 +87,7 @@ class Timestamp:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        usec = self.usec
-        usec_bits = usec & 0xFFFFFFFFFFFFFF
-        head = _TIMESTAMP_ENCODE_STRUCT.pack(
-            (usec_bits & 0xFFFFFFFF), ((usec_bits >> 32) & 0xFFFF), ((usec_bits >> 48) & 0xFF)
-        )
-        return head
+        return self._dc_head()
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> Timestamp:
@@ -106,15 +101,16 @@ class Timestamp:
             raise _dc.DecodeError("Timestamp: " + str(n - 7) + " byte(s) beyond the end of the message")
         return cls(usec)
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
+    def _dc_head(self) -> bytes:
+        """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
         usec = self.usec
         usec_bits = usec & 0xFFFFFFFFFFFFFF
-        acc = (acc << 56) | int.from_bytes(
-            _TIMESTAMP_ENCODE_STRUCT.pack(
-                (usec_bits & 0xFFFFFFFF), ((usec_bits >> 32) & 0xFFFF), ((usec_bits >> 48) & 0xFF)
-            ),
-            "big",
+        return _TIMESTAMP_ENCODE_STRUCT.pack(
+            (usec_bits & 0xFFFFFFFF), ((usec_bits >> 32) & 0xFFFF), ((usec_bits >> 48) & 0xFF)
         )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 56) | int.from_bytes(self._dc_head(), "big")
         return acc
 
     @classmethod

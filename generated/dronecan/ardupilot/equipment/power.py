@@ -56,12 +56,12 @@ class BatteryContinuousStatusFlag(_enum.IntFlag):
     CAPACITY_RELATIVE_TO_FULL = 262144
 
 
-# fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_CELLS_FIELD_ENDS_FROM_INDEX = ((16, "BatteryCells.index"),)
 # fixed fields as decoded
 _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -163,12 +163,6 @@ _BATTERY_CONTINUOUS_FIELD_SPECS = (
 
 # fixed fields as encoded (a float16 as its bit pattern)
 _BATTERY_INFO_AUX_ENCODE_STRUCT = _struct.Struct("<IHB")
-# float16 fields packed as float32 ...
-_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2f")
-# ... and read back as bits, from which each half is cut
-_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2I")
-# fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHHHH")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_AUX_FIELD_ENDS = ((56, "BatteryInfoAux.timestamp.usec"),)
 # fixed fields as decoded
@@ -184,6 +178,12 @@ _BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT = (
 )
 # fixed fields as decoded
 _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHeeH")
+# float16 fields packed as float32 ...
+_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2f")
+# ... and read back as bits, from which each half is cut
+_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHHHH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -210,12 +210,6 @@ _BATTERY_INFO_AUX_FIELD_SPECS = (
 )
 
 
-# float16 fields packed as float32 ...
-_BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4f")
-# ... and read back as bits, from which each half is cut
-_BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4I")
-# fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBHHHHffffHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY = (
     (32, "BatteryPeriodic.design_capacity"),
@@ -233,6 +227,12 @@ _BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY = (
 )
 # fixed fields as decoded
 _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBeeeeffffHB")
+# float16 fields packed as float32 ...
+_BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4f")
+# ... and read back as bits, from which each half is cut
+_BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBHHHHffffHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -393,21 +393,7 @@ class BatteryCells:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        acc = 1
-        x1 = self.voltages
-        k2 = len(x1)
-        if k2 > 24:
-            raise _dc.EncodeError("BatteryCells.voltages: length " + str(k2) + " exceeds capacity 24")
-        acc = (acc << 5) | k2
-        acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
-        index = self.index
-        acc = (acc << 16) | int.from_bytes(
-            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(
-                index if 0 <= index <= 65535 else (65535 if index > 65535 else 0)
-            ),
-            "big",
-        )
-        return _dc.finish(acc)
+        return _dc.finish(self._dc_put(1, tao))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryCells:
@@ -708,6 +694,41 @@ class BatteryContinuous:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        return self._dc_head()
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> BatteryContinuous:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        n = len(data)
+        if n < 25:
+            raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, n << 3)
+        (
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        ) = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack_from(data)
+        if n > 25:
+            raise _dc.DecodeError("BatteryContinuous: " + str(n - 25) + " byte(s) beyond the end of the message")
+        return cls(
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        )
+
+    def _dc_head(self) -> bytes:
+        """Bits 0-199 (the fixed fields that open the payload) as bytes, zero padded."""
         temperature_cells = self.temperature_cells
         temperature_pcb = self.temperature_pcb
         temperature_other = self.temperature_other
@@ -751,7 +772,7 @@ class BatteryContinuous:
         slot_id = self.slot_id
         capacity_consumed = self.capacity_consumed
         status_flags = self.status_flags
-        head = _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
+        return _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
             temperature_cells_f16,
             temperature_pcb_f16,
             temperature_other_f16,
@@ -786,121 +807,9 @@ class BatteryContinuous:
             ),
             (status_flags if 0 <= status_flags <= 4294967295 else (4294967295 if status_flags > 4294967295 else 0)),
         )
-        return head
-
-    @classmethod
-    def decode(cls, data: bytes, *, tao: bool = True) -> BatteryContinuous:
-        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        n = len(data)
-        if n < 25:
-            raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, n << 3)
-        (
-            temperature_cells,
-            temperature_pcb,
-            temperature_other,
-            current,
-            voltage,
-            state_of_charge,
-            slot_id,
-            capacity_consumed,
-            status_flags,
-        ) = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack_from(data)
-        if n > 25:
-            raise _dc.DecodeError("BatteryContinuous: " + str(n - 25) + " byte(s) beyond the end of the message")
-        return cls(
-            temperature_cells,
-            temperature_pcb,
-            temperature_other,
-            current,
-            voltage,
-            state_of_charge,
-            slot_id,
-            capacity_consumed,
-            status_flags,
-        )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        temperature_cells = self.temperature_cells
-        temperature_pcb = self.temperature_pcb
-        temperature_other = self.temperature_other
-        state_of_charge = self.state_of_charge
-        temperature_cells_f32, temperature_pcb_f32, temperature_other_f32, state_of_charge_f32 = (
-            _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
-                _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
-                    temperature_cells
-                    if -65504.0 <= temperature_cells <= 65504.0
-                    else _dc.f16_saturated(temperature_cells),
-                    temperature_pcb if -65504.0 <= temperature_pcb <= 65504.0 else _dc.f16_saturated(temperature_pcb),
-                    temperature_other
-                    if -65504.0 <= temperature_other <= 65504.0
-                    else _dc.f16_saturated(temperature_other),
-                    state_of_charge if -65504.0 <= state_of_charge <= 65504.0 else _dc.f16_saturated(state_of_charge),
-                )
-            )
-        )
-        temperature_cells_f16 = (
-            ((temperature_cells_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= temperature_cells_f32 < 0x477FF000
-            else _dc.f16bits(temperature_cells_f32)
-        )
-        temperature_pcb_f16 = (
-            ((temperature_pcb_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= temperature_pcb_f32 < 0x477FF000
-            else _dc.f16bits(temperature_pcb_f32)
-        )
-        temperature_other_f16 = (
-            ((temperature_other_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= temperature_other_f32 < 0x477FF000
-            else _dc.f16bits(temperature_other_f32)
-        )
-        state_of_charge_f16 = (
-            ((state_of_charge_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= state_of_charge_f32 < 0x477FF000
-            else _dc.f16bits(state_of_charge_f32)
-        )
-        current = self.current
-        voltage = self.voltage
-        slot_id = self.slot_id
-        capacity_consumed = self.capacity_consumed
-        status_flags = self.status_flags
-        acc = (acc << 200) | int.from_bytes(
-            _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
-                temperature_cells_f16,
-                temperature_pcb_f16,
-                temperature_other_f16,
-                (
-                    current
-                    if -_dc.F32_MAX <= current <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < current < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < current < -_dc.F32_MAX else current)
-                    )
-                ),
-                (
-                    voltage
-                    if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < voltage < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
-                    )
-                ),
-                state_of_charge_f16,
-                (slot_id if 0 <= slot_id <= 255 else (255 if slot_id > 255 else 0)),
-                (
-                    capacity_consumed
-                    if -_dc.F32_MAX <= capacity_consumed <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < capacity_consumed < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < capacity_consumed < -_dc.F32_MAX else capacity_consumed)
-                    )
-                ),
-                (status_flags if 0 <= status_flags <= 4294967295 else (4294967295 if status_flags > 4294967295 else 0)),
-            ),
-            "big",
-        )
+        acc = (acc << 200) | int.from_bytes(self._dc_head(), "big")
         return acc
 
     @classmethod
@@ -1128,62 +1037,7 @@ class BatteryInfoAux:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        timestamp_usec = self.timestamp.usec
-        timestamp_usec_bits = timestamp_usec & 0xFFFFFFFFFFFFFF
-        head = _BATTERY_INFO_AUX_ENCODE_STRUCT.pack(
-            (timestamp_usec_bits & 0xFFFFFFFF),
-            ((timestamp_usec_bits >> 32) & 0xFFFF),
-            ((timestamp_usec_bits >> 48) & 0xFF),
-        )
-        acc = 0x100000000000000 | int.from_bytes(head, "big")
-        x1 = self.voltage_cell
-        k2 = len(x1)
-        if k2 > 255:
-            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k2) + " exceeds capacity 255")
-        acc = (acc << 8) | k2
-        acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
-        max_current = self.max_current
-        nominal_voltage = self.nominal_voltage
-        max_current_f32, nominal_voltage_f32 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
-            _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
-                max_current if -65504.0 <= max_current <= 65504.0 else _dc.f16_saturated(max_current),
-                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
-            )
-        )
-        max_current_f16 = (
-            ((max_current_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= max_current_f32 < 0x477FF000
-            else _dc.f16bits(max_current_f32)
-        )
-        nominal_voltage_f16 = (
-            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
-            else _dc.f16bits(nominal_voltage_f32)
-        )
-        cycle_count = self.cycle_count
-        over_discharge_count = self.over_discharge_count
-        is_powering_off = self.is_powering_off
-        is_powering_off_bits = 1 if is_powering_off else 0
-        battery_id = self.battery_id
-        battery_id_bits = battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)
-        acc = (acc << 73) | (
-            int.from_bytes(
-                _BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT.pack(
-                    (cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)),
-                    (
-                        over_discharge_count
-                        if 0 <= over_discharge_count <= 65535
-                        else (65535 if over_discharge_count > 65535 else 0)
-                    ),
-                    max_current_f16,
-                    nominal_voltage_f16,
-                    (is_powering_off_bits << 7) | ((battery_id_bits & 0x1) << 15) | ((battery_id_bits >> 1) & 0x7F),
-                ),
-                "big",
-            )
-            >> 7
-        )
-        return _dc.finish(acc)
+        return _dc.finish(self._dc_put(1, tao))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfoAux:
@@ -1230,17 +1084,18 @@ class BatteryInfoAux:
             battery_id,
         )
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
+    def _dc_head(self) -> bytes:
+        """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
         timestamp_usec = self.timestamp.usec
         timestamp_usec_bits = timestamp_usec & 0xFFFFFFFFFFFFFF
-        acc = (acc << 56) | int.from_bytes(
-            _BATTERY_INFO_AUX_ENCODE_STRUCT.pack(
-                (timestamp_usec_bits & 0xFFFFFFFF),
-                ((timestamp_usec_bits >> 32) & 0xFFFF),
-                ((timestamp_usec_bits >> 48) & 0xFF),
-            ),
-            "big",
+        return _BATTERY_INFO_AUX_ENCODE_STRUCT.pack(
+            (timestamp_usec_bits & 0xFFFFFFFF),
+            ((timestamp_usec_bits >> 32) & 0xFFFF),
+            ((timestamp_usec_bits >> 48) & 0xFF),
         )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 56) | int.from_bytes(self._dc_head(), "big")
         x1 = self.voltage_cell
         k2 = len(x1)
         if k2 > 255:
@@ -1666,146 +1521,7 @@ class BatteryPeriodic:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        acc = 1
-        x1 = self.name
-        k2 = len(x1)
-        if k2 > 50:
-            raise _dc.EncodeError("BatteryPeriodic.name: length " + str(k2) + " exceeds capacity 50")
-        acc = (acc << 6) | k2
-        acc = (acc << (k2 << 3)) | int.from_bytes(x1, "big")
-        x3 = self.serial_number
-        k4 = len(x3)
-        if k4 > 32:
-            raise _dc.EncodeError("BatteryPeriodic.serial_number: length " + str(k4) + " exceeds capacity 32")
-        acc = (acc << 6) | k4
-        acc = (acc << (k4 << 3)) | int.from_bytes(x3, "big")
-        x5 = self.manufacture_date
-        k6 = len(x5)
-        if k6 > 9:
-            raise _dc.EncodeError("BatteryPeriodic.manufacture_date: length " + str(k6) + " exceeds capacity 9")
-        acc = (acc << 4) | k6
-        acc = (acc << (k6 << 3)) | int.from_bytes(x5, "big")
-        nominal_voltage = self.nominal_voltage
-        discharge_minimum_voltage = self.discharge_minimum_voltage
-        charging_minimum_voltage = self.charging_minimum_voltage
-        charging_maximum_voltage = self.charging_maximum_voltage
-        (
-            nominal_voltage_f32,
-            discharge_minimum_voltage_f32,
-            charging_minimum_voltage_f32,
-            charging_maximum_voltage_f32,
-        ) = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-            _BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY.pack(
-                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
-                discharge_minimum_voltage
-                if -65504.0 <= discharge_minimum_voltage <= 65504.0
-                else _dc.f16_saturated(discharge_minimum_voltage),
-                charging_minimum_voltage
-                if -65504.0 <= charging_minimum_voltage <= 65504.0
-                else _dc.f16_saturated(charging_minimum_voltage),
-                charging_maximum_voltage
-                if -65504.0 <= charging_maximum_voltage <= 65504.0
-                else _dc.f16_saturated(charging_maximum_voltage),
-            )
-        )
-        nominal_voltage_f16 = (
-            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
-            else _dc.f16bits(nominal_voltage_f32)
-        )
-        discharge_minimum_voltage_f16 = (
-            ((discharge_minimum_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= discharge_minimum_voltage_f32 < 0x477FF000
-            else _dc.f16bits(discharge_minimum_voltage_f32)
-        )
-        charging_minimum_voltage_f16 = (
-            ((charging_minimum_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= charging_minimum_voltage_f32 < 0x477FF000
-            else _dc.f16bits(charging_minimum_voltage_f32)
-        )
-        charging_maximum_voltage_f16 = (
-            ((charging_maximum_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= charging_maximum_voltage_f32 < 0x477FF000
-            else _dc.f16bits(charging_maximum_voltage_f32)
-        )
-        design_capacity = self.design_capacity
-        cells_in_series = self.cells_in_series
-        charging_maximum_current = self.charging_maximum_current
-        discharge_maximum_current = self.discharge_maximum_current
-        discharge_maximum_burst_current = self.discharge_maximum_burst_current
-        full_charge_capacity = self.full_charge_capacity
-        cycle_count = self.cycle_count
-        state_of_health = self.state_of_health
-        acc = (acc << 256) | int.from_bytes(
-            _BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY.pack(
-                (
-                    design_capacity
-                    if -_dc.F32_MAX <= design_capacity <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < design_capacity < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < design_capacity < -_dc.F32_MAX else design_capacity)
-                    )
-                ),
-                (cells_in_series if 0 <= cells_in_series <= 255 else (255 if cells_in_series > 255 else 0)),
-                nominal_voltage_f16,
-                discharge_minimum_voltage_f16,
-                charging_minimum_voltage_f16,
-                charging_maximum_voltage_f16,
-                (
-                    charging_maximum_current
-                    if -_dc.F32_MAX <= charging_maximum_current <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < charging_maximum_current < _dc.INF
-                        else (
-                            -_dc.F32_MAX
-                            if -_dc.INF < charging_maximum_current < -_dc.F32_MAX
-                            else charging_maximum_current
-                        )
-                    )
-                ),
-                (
-                    discharge_maximum_current
-                    if -_dc.F32_MAX <= discharge_maximum_current <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < discharge_maximum_current < _dc.INF
-                        else (
-                            -_dc.F32_MAX
-                            if -_dc.INF < discharge_maximum_current < -_dc.F32_MAX
-                            else discharge_maximum_current
-                        )
-                    )
-                ),
-                (
-                    discharge_maximum_burst_current
-                    if -_dc.F32_MAX <= discharge_maximum_burst_current <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < discharge_maximum_burst_current < _dc.INF
-                        else (
-                            -_dc.F32_MAX
-                            if -_dc.INF < discharge_maximum_burst_current < -_dc.F32_MAX
-                            else discharge_maximum_burst_current
-                        )
-                    )
-                ),
-                (
-                    full_charge_capacity
-                    if -_dc.F32_MAX <= full_charge_capacity <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < full_charge_capacity < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < full_charge_capacity < -_dc.F32_MAX else full_charge_capacity)
-                    )
-                ),
-                (cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)),
-                (state_of_health if 0 <= state_of_health <= 255 else (255 if state_of_health > 255 else 0)),
-            ),
-            "big",
-        )
-        return _dc.finish(acc)
+        return _dc.finish(self._dc_put(1, tao))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryPeriodic:
@@ -2335,13 +2051,30 @@ class BatteryTag:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
+        return self._dc_head()
+
+    @classmethod
+    def decode(cls, data: bytes, *, tao: bool = True) -> BatteryTag:
+        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
+        n = len(data)
+        if n < 24:
+            raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, n << 3)
+        serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins = (
+            _BATTERY_TAG_DECODE_STRUCT.unpack_from(data)
+        )
+        if n > 24:
+            raise _dc.DecodeError("BatteryTag: " + str(n - 24) + " byte(s) beyond the end of the message")
+        return cls(serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins)
+
+    def _dc_head(self) -> bytes:
+        """Bits 0-191 (the fixed fields that open the payload) as bytes, zero padded."""
         serial_number = self.serial_number
         num_cycles = self.num_cycles
         armed_hours = self.armed_hours
         battery_capacity_mah = self.battery_capacity_mAh
         first_use_mins = self.first_use_mins
         last_arm_time_mins = self.last_arm_time_mins
-        head = _BATTERY_TAG_ENCODE_STRUCT.pack(
+        return _BATTERY_TAG_ENCODE_STRUCT.pack(
             (serial_number if 0 <= serial_number <= 4294967295 else (4294967295 if serial_number > 4294967295 else 0)),
             (num_cycles if 0 <= num_cycles <= 4294967295 else (4294967295 if num_cycles > 4294967295 else 0)),
             (
@@ -2369,63 +2102,9 @@ class BatteryTag:
                 else (4294967295 if last_arm_time_mins > 4294967295 else 0)
             ),
         )
-        return head
-
-    @classmethod
-    def decode(cls, data: bytes, *, tao: bool = True) -> BatteryTag:
-        """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        n = len(data)
-        if n < 24:
-            raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, n << 3)
-        serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins = (
-            _BATTERY_TAG_DECODE_STRUCT.unpack_from(data)
-        )
-        if n > 24:
-            raise _dc.DecodeError("BatteryTag: " + str(n - 24) + " byte(s) beyond the end of the message")
-        return cls(serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        serial_number = self.serial_number
-        num_cycles = self.num_cycles
-        armed_hours = self.armed_hours
-        battery_capacity_mah = self.battery_capacity_mAh
-        first_use_mins = self.first_use_mins
-        last_arm_time_mins = self.last_arm_time_mins
-        acc = (acc << 192) | int.from_bytes(
-            _BATTERY_TAG_ENCODE_STRUCT.pack(
-                (
-                    serial_number
-                    if 0 <= serial_number <= 4294967295
-                    else (4294967295 if serial_number > 4294967295 else 0)
-                ),
-                (num_cycles if 0 <= num_cycles <= 4294967295 else (4294967295 if num_cycles > 4294967295 else 0)),
-                (
-                    armed_hours
-                    if -_dc.F32_MAX <= armed_hours <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < armed_hours < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < armed_hours < -_dc.F32_MAX else armed_hours)
-                    )
-                ),
-                (
-                    battery_capacity_mah
-                    if 0 <= battery_capacity_mah <= 4294967295
-                    else (4294967295 if battery_capacity_mah > 4294967295 else 0)
-                ),
-                (
-                    first_use_mins
-                    if 0 <= first_use_mins <= 4294967295
-                    else (4294967295 if first_use_mins > 4294967295 else 0)
-                ),
-                (
-                    last_arm_time_mins
-                    if 0 <= last_arm_time_mins <= 4294967295
-                    else (4294967295 if last_arm_time_mins > 4294967295 else 0)
-                ),
-            ),
-            "big",
-        )
+        acc = (acc << 192) | int.from_bytes(self._dc_head(), "big")
         return acc
 
     @classmethod

@@ -38,8 +38,6 @@ class CBATStatusFlag(_enum.IntFlag):
 
 # fixed fields as encoded (a float16 as its bit pattern)
 _CBAT_ENCODE_STRUCT = _struct.Struct("<ff")
-# fixed fields as encoded (a float16 as its bit pattern)
-_CBAT_ENCODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _CBAT_FIELD_ENDS = ((32, "CBAT.temperature"), (64, "CBAT.voltage"))
 # fixed fields as decoded
@@ -71,6 +69,8 @@ _CBAT_FIELD_ENDS_FROM_CELL_COUNT = (
 )
 # fixed fields as decoded
 _CBAT_DECODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
+# fixed fields as encoded (a float16 as its bit pattern)
+_CBAT_ENCODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -464,241 +464,7 @@ class CBAT:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        temperature = self.temperature
-        voltage = self.voltage
-        head = _CBAT_ENCODE_STRUCT.pack(
-            (
-                temperature
-                if -_dc.F32_MAX <= temperature <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < temperature < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < temperature < -_dc.F32_MAX else temperature)
-                )
-            ),
-            (
-                voltage
-                if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < voltage < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
-                )
-            ),
-        )
-        acc = 0x10000000000000000 | int.from_bytes(head, "big")
-        x1 = self.voltage_cell
-        k2 = len(x1)
-        if k2 > 15:
-            raise _dc.EncodeError("CBAT.voltage_cell: length " + str(k2) + " exceeds capacity 15")
-        acc = (acc << 4) | k2
-        acc = (acc << (k2 * 32)) | int.from_bytes(
-            _struct.pack(
-                f"<{k2}f",
-                *[
-                    (
-                        e3
-                        if -_dc.F32_MAX <= e3 <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < e3 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < e3 < -_dc.F32_MAX else e3)
-                        )
-                    )
-                    for e3 in x1
-                ],
-            ),
-            "big",
-        )
-        cell_count = self.cell_count
-        current = self.current
-        average_current = self.average_current
-        average_power = self.average_power
-        available_energy = self.available_energy
-        remaining_capacity = self.remaining_capacity
-        full_charge_capacity = self.full_charge_capacity
-        design_capacity = self.design_capacity
-        average_time_to_empty = self.average_time_to_empty
-        average_time_to_full = self.average_time_to_full
-        state_of_health = self.state_of_health
-        state_of_health_bits = state_of_health if 0 <= state_of_health <= 127 else (127 if state_of_health > 127 else 0)
-        state_of_charge = self.state_of_charge
-        state_of_charge_bits = state_of_charge if 0 <= state_of_charge <= 127 else (127 if state_of_charge > 127 else 0)
-        max_error = self.max_error
-        max_error_bits = max_error if 0 <= max_error <= 127 else (127 if max_error > 127 else 0)
-        serial_number = self.serial_number
-        serial_number_bits = serial_number if 0 <= serial_number <= 65535 else (65535 if serial_number > 65535 else 0)
-        manufacture_date = self.manufacture_date
-        manufacture_date_bits = (
-            manufacture_date if 0 <= manufacture_date <= 65535 else (65535 if manufacture_date > 65535 else 0)
-        )
-        cycle_count = self.cycle_count
-        cycle_count_bits = cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)
-        over_discharge_count = self.over_discharge_count
-        over_discharge_count_bits = (
-            over_discharge_count
-            if 0 <= over_discharge_count <= 65535
-            else (65535 if over_discharge_count > 65535 else 0)
-        )
-        passed_charge = self.passed_charge
-        passed_charge_bits = _dc.f32bits(
-            passed_charge
-            if -_dc.F32_MAX <= passed_charge <= _dc.F32_MAX
-            else (
-                _dc.F32_MAX
-                if _dc.F32_MAX < passed_charge < _dc.INF
-                else (-_dc.F32_MAX if -_dc.INF < passed_charge < -_dc.F32_MAX else passed_charge)
-            )
-        )
-        nominal_voltage = self.nominal_voltage
-        nominal_voltage_bits = _dc.f32bits(
-            nominal_voltage
-            if -_dc.F32_MAX <= nominal_voltage <= _dc.F32_MAX
-            else (
-                _dc.F32_MAX
-                if _dc.F32_MAX < nominal_voltage < _dc.INF
-                else (-_dc.F32_MAX if -_dc.INF < nominal_voltage < -_dc.F32_MAX else nominal_voltage)
-            )
-        )
-        is_powering_off = self.is_powering_off
-        is_powering_off_bits = 1 if is_powering_off else 0
-        interface_error = self.interface_error
-        interface_error_bits = (
-            interface_error if 0 <= interface_error <= 65535 else (65535 if interface_error > 65535 else 0)
-        )
-        status_flags = self.status_flags
-        status_flags_bits = status_flags if 0 <= status_flags <= 2047 else (2047 if status_flags > 2047 else 0)
-        acc = (acc << 441) | (
-            int.from_bytes(
-                _CBAT_ENCODE_STRUCT_FROM_CELL_COUNT.pack(
-                    (cell_count if 0 <= cell_count <= 255 else (255 if cell_count > 255 else 0)),
-                    (
-                        current
-                        if -_dc.F32_MAX <= current <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < current < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < current < -_dc.F32_MAX else current)
-                        )
-                    ),
-                    (
-                        average_current
-                        if -_dc.F32_MAX <= average_current <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < average_current < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < average_current < -_dc.F32_MAX else average_current)
-                        )
-                    ),
-                    (
-                        average_power
-                        if -_dc.F32_MAX <= average_power <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < average_power < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < average_power < -_dc.F32_MAX else average_power)
-                        )
-                    ),
-                    (
-                        available_energy
-                        if -_dc.F32_MAX <= available_energy <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < available_energy < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < available_energy < -_dc.F32_MAX else available_energy)
-                        )
-                    ),
-                    (
-                        remaining_capacity
-                        if -_dc.F32_MAX <= remaining_capacity <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < remaining_capacity < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < remaining_capacity < -_dc.F32_MAX else remaining_capacity)
-                        )
-                    ),
-                    (
-                        full_charge_capacity
-                        if -_dc.F32_MAX <= full_charge_capacity <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < full_charge_capacity < _dc.INF
-                            else (
-                                -_dc.F32_MAX if -_dc.INF < full_charge_capacity < -_dc.F32_MAX else full_charge_capacity
-                            )
-                        )
-                    ),
-                    (
-                        design_capacity
-                        if -_dc.F32_MAX <= design_capacity <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < design_capacity < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < design_capacity < -_dc.F32_MAX else design_capacity)
-                        )
-                    ),
-                    (
-                        average_time_to_empty
-                        if 0 <= average_time_to_empty <= 65535
-                        else (65535 if average_time_to_empty > 65535 else 0)
-                    ),
-                    (
-                        average_time_to_full
-                        if 0 <= average_time_to_full <= 65535
-                        else (65535 if average_time_to_full > 65535 else 0)
-                    ),
-                    (state_of_health_bits << 1)
-                    | ((state_of_charge_bits & 0x3F) << 10)
-                    | ((state_of_charge_bits >> 6) & 0x1)
-                    | ((max_error_bits & 0x1F) << 19)
-                    | (((max_error_bits >> 5) & 0x3) << 8)
-                    | ((serial_number_bits & 0x1F) << 27)
-                    | (((serial_number_bits >> 5) & 0x7) << 16)
-                    | (((serial_number_bits >> 8) & 0x1F) << 35)
-                    | (((serial_number_bits >> 13) & 0x7) << 24)
-                    | ((manufacture_date_bits & 0x1F) << 43)
-                    | (((manufacture_date_bits >> 5) & 0x7) << 32)
-                    | (((manufacture_date_bits >> 8) & 0x1F) << 51)
-                    | (((manufacture_date_bits >> 13) & 0x7) << 40)
-                    | ((cycle_count_bits & 0x1F) << 59)
-                    | (((cycle_count_bits >> 5) & 0x7) << 48)
-                    | (((cycle_count_bits >> 13) & 0x7) << 56),
-                    (((cycle_count_bits >> 8) & 0x1F) << 3)
-                    | ((over_discharge_count_bits & 0x1F) << 11)
-                    | ((over_discharge_count_bits >> 5) & 0x7)
-                    | (((over_discharge_count_bits >> 8) & 0x1F) << 19)
-                    | (((over_discharge_count_bits >> 13) & 0x7) << 8)
-                    | ((passed_charge_bits & 0x1F) << 27)
-                    | (((passed_charge_bits >> 5) & 0x7) << 16)
-                    | (((passed_charge_bits >> 8) & 0x1F) << 35)
-                    | (((passed_charge_bits >> 13) & 0x7) << 24)
-                    | (((passed_charge_bits >> 16) & 0x1F) << 43)
-                    | (((passed_charge_bits >> 21) & 0x7) << 32)
-                    | (((passed_charge_bits >> 24) & 0x1F) << 51)
-                    | (((passed_charge_bits >> 29) & 0x7) << 40)
-                    | ((nominal_voltage_bits & 0x1F) << 59)
-                    | (((nominal_voltage_bits >> 5) & 0x7) << 48)
-                    | (((nominal_voltage_bits >> 13) & 0x7) << 56),
-                    (((nominal_voltage_bits >> 8) & 0x1F) << 3)
-                    | (((nominal_voltage_bits >> 16) & 0x1F) << 11)
-                    | ((nominal_voltage_bits >> 21) & 0x7)
-                    | (((nominal_voltage_bits >> 24) & 0x1F) << 19)
-                    | (((nominal_voltage_bits >> 29) & 0x7) << 8)
-                    | (is_powering_off_bits << 18)
-                    | ((interface_error_bits & 0x3F) << 26)
-                    | (((interface_error_bits >> 6) & 0x3) << 16)
-                    | (((interface_error_bits >> 14) & 0x3) << 24),
-                    (((interface_error_bits >> 8) & 0x3F) << 2)
-                    | ((status_flags_bits & 0x3F) << 10)
-                    | ((status_flags_bits >> 6) & 0x3)
-                    | (((status_flags_bits >> 9) & 0x3) << 8),
-                    (((status_flags_bits >> 8) & 0x1) << 7),
-                ),
-                "big",
-            )
-            >> 7
-        )
-        return _dc.finish(acc)
+        return _dc.finish(self._dc_put(1, tao))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> CBAT:
@@ -826,32 +592,33 @@ class CBAT:
             status_flags,
         )
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
+    def _dc_head(self) -> bytes:
+        """Bits 0-63 (the fixed fields that open the payload) as bytes, zero padded."""
         temperature = self.temperature
         voltage = self.voltage
-        acc = (acc << 64) | int.from_bytes(
-            _CBAT_ENCODE_STRUCT.pack(
-                (
-                    temperature
-                    if -_dc.F32_MAX <= temperature <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < temperature < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < temperature < -_dc.F32_MAX else temperature)
-                    )
-                ),
-                (
-                    voltage
-                    if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < voltage < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
-                    )
-                ),
+        return _CBAT_ENCODE_STRUCT.pack(
+            (
+                temperature
+                if -_dc.F32_MAX <= temperature <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < temperature < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < temperature < -_dc.F32_MAX else temperature)
+                )
             ),
-            "big",
+            (
+                voltage
+                if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < voltage < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
+                )
+            ),
         )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 64) | int.from_bytes(self._dc_head(), "big")
         x1 = self.voltage_cell
         k2 = len(x1)
         if k2 > 15:

@@ -509,124 +509,12 @@ class BatteryInfo:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        temperature = self.temperature
-        voltage = self.voltage
-        current = self.current
-        average_power_10sec = self.average_power_10sec
-        remaining_capacity_wh = self.remaining_capacity_wh
-        full_charge_capacity_wh = self.full_charge_capacity_wh
-        hours_to_full_charge = self.hours_to_full_charge
-        (
-            temperature_f32,
-            voltage_f32,
-            current_f32,
-            average_power_10sec_f32,
-            remaining_capacity_wh_f32,
-            full_charge_capacity_wh_f32,
-            hours_to_full_charge_f32,
-        ) = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
-            _BATTERY_INFO_FLOAT32_STRUCT.pack(
-                temperature if -65504.0 <= temperature <= 65504.0 else _dc.f16_saturated(temperature),
-                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
-                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
-                average_power_10sec
-                if -65504.0 <= average_power_10sec <= 65504.0
-                else _dc.f16_saturated(average_power_10sec),
-                remaining_capacity_wh
-                if -65504.0 <= remaining_capacity_wh <= 65504.0
-                else _dc.f16_saturated(remaining_capacity_wh),
-                full_charge_capacity_wh
-                if -65504.0 <= full_charge_capacity_wh <= 65504.0
-                else _dc.f16_saturated(full_charge_capacity_wh),
-                hours_to_full_charge
-                if -65504.0 <= hours_to_full_charge <= 65504.0
-                else _dc.f16_saturated(hours_to_full_charge),
-            )
-        )
-        temperature_f16 = (
-            ((temperature_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= temperature_f32 < 0x477FF000
-            else _dc.f16bits(temperature_f32)
-        )
-        voltage_f16 = (
-            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
-        )
-        current_f16 = (
-            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
-        )
-        average_power_10sec_f16 = (
-            ((average_power_10sec_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= average_power_10sec_f32 < 0x477FF000
-            else _dc.f16bits(average_power_10sec_f32)
-        )
-        remaining_capacity_wh_f16 = (
-            ((remaining_capacity_wh_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= remaining_capacity_wh_f32 < 0x477FF000
-            else _dc.f16bits(remaining_capacity_wh_f32)
-        )
-        full_charge_capacity_wh_f16 = (
-            ((full_charge_capacity_wh_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= full_charge_capacity_wh_f32 < 0x477FF000
-            else _dc.f16bits(full_charge_capacity_wh_f32)
-        )
-        hours_to_full_charge_f16 = (
-            ((hours_to_full_charge_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= hours_to_full_charge_f32 < 0x477FF000
-            else _dc.f16bits(hours_to_full_charge_f32)
-        )
-        status_flags = self.status_flags
-        status_flags_bits = status_flags if 0 <= status_flags <= 2047 else (2047 if status_flags > 2047 else 0)
-        state_of_health_pct = self.state_of_health_pct
-        state_of_health_pct_bits = (
-            state_of_health_pct if 0 <= state_of_health_pct <= 127 else (127 if state_of_health_pct > 127 else 0)
-        )
-        state_of_charge_pct = self.state_of_charge_pct
-        state_of_charge_pct_bits = (
-            state_of_charge_pct if 0 <= state_of_charge_pct <= 127 else (127 if state_of_charge_pct > 127 else 0)
-        )
-        state_of_charge_pct_stdev = self.state_of_charge_pct_stdev
-        state_of_charge_pct_stdev_bits = (
-            state_of_charge_pct_stdev
-            if 0 <= state_of_charge_pct_stdev <= 127
-            else (127 if state_of_charge_pct_stdev > 127 else 0)
-        )
-        battery_id = self.battery_id
-        model_instance_id = self.model_instance_id
-        head = _BATTERY_INFO_ENCODE_STRUCT.pack(
-            temperature_f16,
-            voltage_f16,
-            current_f16,
-            average_power_10sec_f16,
-            remaining_capacity_wh_f16,
-            full_charge_capacity_wh_f16,
-            hours_to_full_charge_f16,
-            (status_flags_bits & 0xFF)
-            | (((status_flags_bits >> 8) & 0x7) << 13)
-            | ((state_of_health_pct_bits & 0x3) << 22)
-            | (((state_of_health_pct_bits >> 2) & 0x1F) << 8)
-            | ((state_of_charge_pct_bits & 0x1) << 31)
-            | (((state_of_charge_pct_bits >> 1) & 0x3F) << 16)
-            | (state_of_charge_pct_stdev_bits << 24),
-            (battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)),
-            (
-                model_instance_id
-                if 0 <= model_instance_id <= 4294967295
-                else (4294967295 if model_instance_id > 4294967295 else 0)
-            ),
-        )
         if tao:
             x1 = self.model_name
             if len(x1) > 31:
                 raise _dc.EncodeError("BatteryInfo.model_name: length " + str(len(x1)) + " exceeds capacity 31")
-            return head + bytes(x1)
-        acc = 0x10000000000000000000000000000000000000000000000 | int.from_bytes(head, "big")
-        x2 = self.model_name
-        k3 = len(x2)
-        if k3 > 31:
-            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k3) + " exceeds capacity 31")
-        acc = (acc << 5) | k3
-        acc = (acc << (k3 << 3)) | int.from_bytes(x2, "big")
-        return _dc.finish(acc)
+            return self._dc_head() + bytes(x1)
+        return _dc.finish(self._dc_put(1, False))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfo:
@@ -704,7 +592,8 @@ class BatteryInfo:
             model_name,
         )
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
+    def _dc_head(self) -> bytes:
+        """Bits 0-183 (the fixed fields that open the payload) as bytes, zero padded."""
         temperature = self.temperature
         voltage = self.voltage
         current = self.current
@@ -788,31 +677,31 @@ class BatteryInfo:
         )
         battery_id = self.battery_id
         model_instance_id = self.model_instance_id
-        acc = (acc << 184) | int.from_bytes(
-            _BATTERY_INFO_ENCODE_STRUCT.pack(
-                temperature_f16,
-                voltage_f16,
-                current_f16,
-                average_power_10sec_f16,
-                remaining_capacity_wh_f16,
-                full_charge_capacity_wh_f16,
-                hours_to_full_charge_f16,
-                (status_flags_bits & 0xFF)
-                | (((status_flags_bits >> 8) & 0x7) << 13)
-                | ((state_of_health_pct_bits & 0x3) << 22)
-                | (((state_of_health_pct_bits >> 2) & 0x1F) << 8)
-                | ((state_of_charge_pct_bits & 0x1) << 31)
-                | (((state_of_charge_pct_bits >> 1) & 0x3F) << 16)
-                | (state_of_charge_pct_stdev_bits << 24),
-                (battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)),
-                (
-                    model_instance_id
-                    if 0 <= model_instance_id <= 4294967295
-                    else (4294967295 if model_instance_id > 4294967295 else 0)
-                ),
+        return _BATTERY_INFO_ENCODE_STRUCT.pack(
+            temperature_f16,
+            voltage_f16,
+            current_f16,
+            average_power_10sec_f16,
+            remaining_capacity_wh_f16,
+            full_charge_capacity_wh_f16,
+            hours_to_full_charge_f16,
+            (status_flags_bits & 0xFF)
+            | (((status_flags_bits >> 8) & 0x7) << 13)
+            | ((state_of_health_pct_bits & 0x3) << 22)
+            | (((state_of_health_pct_bits >> 2) & 0x1F) << 8)
+            | ((state_of_charge_pct_bits & 0x1) << 31)
+            | (((state_of_charge_pct_bits >> 1) & 0x3F) << 16)
+            | (state_of_charge_pct_stdev_bits << 24),
+            (battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)),
+            (
+                model_instance_id
+                if 0 <= model_instance_id <= 4294967295
+                else (4294967295 if model_instance_id > 4294967295 else 0)
             ),
-            "big",
         )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 184) | int.from_bytes(self._dc_head(), "big")
         x1 = self.model_name
         k2 = len(x1)
         if k2 > 31:
@@ -1098,29 +987,7 @@ class CircuitStatus:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        voltage = self.voltage
-        current = self.current
-        voltage_f32, current_f32 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
-            _CIRCUIT_STATUS_FLOAT32_STRUCT.pack(
-                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
-                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
-            )
-        )
-        voltage_f16 = (
-            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
-        )
-        current_f16 = (
-            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
-        )
-        circuit_id = self.circuit_id
-        error_flags = self.error_flags
-        head = _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
-            (circuit_id if 0 <= circuit_id <= 65535 else (65535 if circuit_id > 65535 else 0)),
-            voltage_f16,
-            current_f16,
-            (error_flags if 0 <= error_flags <= 255 else (255 if error_flags > 255 else 0)),
-        )
-        return head
+        return self._dc_head()
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> CircuitStatus:
@@ -1133,7 +1000,8 @@ class CircuitStatus:
             raise _dc.DecodeError("CircuitStatus: " + str(n - 7) + " byte(s) beyond the end of the message")
         return cls(circuit_id, voltage, current, error_flags)
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
+    def _dc_head(self) -> bytes:
+        """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
         voltage = self.voltage
         current = self.current
         voltage_f32, current_f32 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
@@ -1150,15 +1018,15 @@ class CircuitStatus:
         )
         circuit_id = self.circuit_id
         error_flags = self.error_flags
-        acc = (acc << 56) | int.from_bytes(
-            _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
-                (circuit_id if 0 <= circuit_id <= 65535 else (65535 if circuit_id > 65535 else 0)),
-                voltage_f16,
-                current_f16,
-                (error_flags if 0 <= error_flags <= 255 else (255 if error_flags > 255 else 0)),
-            ),
-            "big",
+        return _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
+            (circuit_id if 0 <= circuit_id <= 65535 else (65535 if circuit_id > 65535 else 0)),
+            voltage_f16,
+            current_f16,
+            (error_flags if 0 <= error_flags <= 255 else (255 if error_flags > 255 else 0)),
         )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 56) | int.from_bytes(self._dc_head(), "big")
         return acc
 
     @classmethod
@@ -1328,48 +1196,7 @@ class PrimaryPowerSupplyStatus:
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        hours_to_empty_at_10sec_avg_power = self.hours_to_empty_at_10sec_avg_power
-        hours_to_empty_at_10sec_avg_power_variance = self.hours_to_empty_at_10sec_avg_power_variance
-        hours_to_empty_at_10sec_avg_power_f32, hours_to_empty_at_10sec_avg_power_variance_f32 = (
-            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
-                _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
-                    hours_to_empty_at_10sec_avg_power
-                    if -65504.0 <= hours_to_empty_at_10sec_avg_power <= 65504.0
-                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power),
-                    hours_to_empty_at_10sec_avg_power_variance
-                    if -65504.0 <= hours_to_empty_at_10sec_avg_power_variance <= 65504.0
-                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power_variance),
-                )
-            )
-        )
-        hours_to_empty_at_10sec_avg_power_f16 = (
-            ((hours_to_empty_at_10sec_avg_power_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_f32 < 0x477FF000
-            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_f32)
-        )
-        hours_to_empty_at_10sec_avg_power_variance_f16 = (
-            ((hours_to_empty_at_10sec_avg_power_variance_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_variance_f32 < 0x477FF000
-            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_variance_f32)
-        )
-        external_power_available = self.external_power_available
-        external_power_available_bits = 1 if external_power_available else 0
-        remaining_energy_pct = self.remaining_energy_pct
-        remaining_energy_pct_bits = (
-            remaining_energy_pct if 0 <= remaining_energy_pct <= 127 else (127 if remaining_energy_pct > 127 else 0)
-        )
-        remaining_energy_pct_stdev = self.remaining_energy_pct_stdev
-        remaining_energy_pct_stdev_bits = (
-            remaining_energy_pct_stdev
-            if 0 <= remaining_energy_pct_stdev <= 127
-            else (127 if remaining_energy_pct_stdev > 127 else 0)
-        )
-        head = _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(
-            hours_to_empty_at_10sec_avg_power_f16,
-            hours_to_empty_at_10sec_avg_power_variance_f16,
-            (external_power_available_bits << 7) | remaining_energy_pct_bits | (remaining_energy_pct_stdev_bits << 9),
-        )
-        return head
+        return self._dc_head()
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> PrimaryPowerSupplyStatus:
@@ -1393,7 +1220,8 @@ class PrimaryPowerSupplyStatus:
             remaining_energy_pct_stdev,
         )
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
+    def _dc_head(self) -> bytes:
+        """Bits 0-46 (the fixed fields that open the payload) as bytes, zero padded."""
         hours_to_empty_at_10sec_avg_power = self.hours_to_empty_at_10sec_avg_power
         hours_to_empty_at_10sec_avg_power_variance = self.hours_to_empty_at_10sec_avg_power_variance
         hours_to_empty_at_10sec_avg_power_f32, hours_to_empty_at_10sec_avg_power_variance_f32 = (
@@ -1430,19 +1258,14 @@ class PrimaryPowerSupplyStatus:
             if 0 <= remaining_energy_pct_stdev <= 127
             else (127 if remaining_energy_pct_stdev > 127 else 0)
         )
-        acc = (acc << 47) | (
-            int.from_bytes(
-                _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(
-                    hours_to_empty_at_10sec_avg_power_f16,
-                    hours_to_empty_at_10sec_avg_power_variance_f16,
-                    (external_power_available_bits << 7)
-                    | remaining_energy_pct_bits
-                    | (remaining_energy_pct_stdev_bits << 9),
-                ),
-                "big",
-            )
-            >> 1
+        return _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(
+            hours_to_empty_at_10sec_avg_power_f16,
+            hours_to_empty_at_10sec_avg_power_variance_f16,
+            (external_power_available_bits << 7) | remaining_energy_pct_bits | (remaining_energy_pct_stdev_bits << 9),
         )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 47) | (int.from_bytes(self._dc_head(), "big") >> 1)
         return acc
 
     @classmethod

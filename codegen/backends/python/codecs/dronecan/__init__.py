@@ -64,9 +64,11 @@ class _Codec:
         ]
         if info.union:
             union_members(msg, ctx, view, emitter.module_code, lines)
+        head = emitter.method_head()
         methods = [
             emitter.method_encode(),
             emitter.method_decode(),
+            *([head] if head is not None else []),
             emitter.method_put(),
             emitter.method_get(),
         ]
