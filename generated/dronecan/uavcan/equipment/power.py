@@ -560,37 +560,10 @@ class BatteryInfo:
                 model_instance_id,
                 model_name,
             )
-        v = int.from_bytes(data, "big")
-        rem = (n << 3) - 184
-        if rem < 5:
-            raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
-        rem -= 5
-        k3 = (v >> rem) & 0x1F
-        if k3 > 31:
-            raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k3) + " exceeds capacity 31")
-        n4 = k3 * 8
-        if rem < n4:
-            raise _dc.short("BatteryInfo.model_name", n4, rem)
-        rem -= n4
-        model_name = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
+        obj, rem = cls._dc_get(int.from_bytes(data, "big"), n << 3, False)
         if rem >= 8:
             raise _dc.DecodeError("BatteryInfo: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(
-            temperature,
-            voltage,
-            current,
-            average_power_10sec,
-            remaining_capacity_wh,
-            full_charge_capacity_wh,
-            hours_to_full_charge,
-            status_flags,
-            state_of_health_pct,
-            state_of_charge_pct,
-            state_of_charge_pct_stdev,
-            battery_id,
-            model_instance_id,
-            model_name,
-        )
+        return obj
 
     def _dc_head(self) -> bytes:
         """Bits 0-183 (the fixed fields that open the payload) as bytes, zero padded."""
