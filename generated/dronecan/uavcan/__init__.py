@@ -96,6 +96,7 @@ class Timestamp:
         if n < 7:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, n << 3)
         packed1, packed2, packed3 = _TIMESTAMP_DECODE_STRUCT.unpack_from(data)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         usec = packed1 | (packed2 << 32) | (packed3 << 48)
         if n > 7:
             raise _dc.DecodeError("Timestamp: " + str(n - 7) + " byte(s) beyond the end of the message")
@@ -105,6 +106,7 @@ class Timestamp:
         """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
         usec = self.usec
         usec_bits = usec & 0xFFFFFFFFFFFFFF
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         return _TIMESTAMP_ENCODE_STRUCT.pack(
             (usec_bits & 0xFFFFFFFF), ((usec_bits >> 32) & 0xFFFF), ((usec_bits >> 48) & 0xFF)
         )
@@ -119,6 +121,7 @@ class Timestamp:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, rem)
         rem -= 56
         packed1, packed2, packed3 = _TIMESTAMP_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         usec = packed1 | (packed2 << 32) | (packed3 << 48)
         return cls(usec), rem
 

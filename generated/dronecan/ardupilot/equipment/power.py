@@ -1047,6 +1047,7 @@ class BatteryInfoAux:
         if n < 7:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, n << 3)
         packed1, packed2, packed3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack_from(data)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         timestamp_usec = packed1 | (packed2 << 32) | (packed3 << 48)
         v = int.from_bytes(data, "big")
         rem = (n << 3) - 56
@@ -1069,6 +1070,7 @@ class BatteryInfoAux:
                 (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
             )
         )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         is_powering_off = ((packed6 >> 7) & 0x1) != 0
         battery_id = (packed6 >> 15) | ((packed6 & 0x7F) << 1)
         if rem >= 8:
@@ -1088,6 +1090,7 @@ class BatteryInfoAux:
         """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
         timestamp_usec = self.timestamp.usec
         timestamp_usec_bits = timestamp_usec & 0xFFFFFFFFFFFFFF
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         return _BATTERY_INFO_AUX_ENCODE_STRUCT.pack(
             (timestamp_usec_bits & 0xFFFFFFFF),
             ((timestamp_usec_bits >> 32) & 0xFFFF),
@@ -1126,6 +1129,7 @@ class BatteryInfoAux:
         is_powering_off_bits = 1 if is_powering_off else 0
         battery_id = self.battery_id
         battery_id_bits = battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         acc = (acc << 73) | (
             int.from_bytes(
                 _BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT.pack(
@@ -1154,6 +1158,7 @@ class BatteryInfoAux:
         packed1, packed2, packed3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(
             ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
         )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         timestamp_usec = packed1 | (packed2 << 32) | (packed3 << 48)
         if rem < 8:
             raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
@@ -1174,6 +1179,7 @@ class BatteryInfoAux:
                 (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
             )
         )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         is_powering_off = ((packed6 >> 7) & 0x1) != 0
         battery_id = (packed6 >> 15) | ((packed6 & 0x7F) << 1)
         return cls(

@@ -507,6 +507,7 @@ class CBAT:
             packed6,
             packed7,
         ) = _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         state_of_health = (packed3 >> 1) & 0x7F
         state_of_charge = ((packed3 >> 10) & 0x3F) | ((packed3 & 0x1) << 6)
         max_error = ((packed3 >> 19) & 0x1F) | (((packed3 >> 8) & 0x3) << 5)
@@ -700,6 +701,7 @@ class CBAT:
         )
         status_flags = self.status_flags
         status_flags_bits = status_flags if 0 <= status_flags <= 2047 else (2047 if status_flags > 2047 else 0)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         acc = (acc << 441) | (
             int.from_bytes(
                 _CBAT_ENCODE_STRUCT_FROM_CELL_COUNT.pack(
@@ -870,6 +872,7 @@ class CBAT:
             packed6,
             packed7,
         ) = _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         state_of_health = (packed3 >> 1) & 0x7F
         state_of_charge = ((packed3 >> 10) & 0x3F) | ((packed3 & 0x1) << 6)
         max_error = ((packed3 >> 19) & 0x1F) | (((packed3 >> 8) & 0x3) << 5)

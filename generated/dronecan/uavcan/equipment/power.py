@@ -535,6 +535,7 @@ class BatteryInfo:
             battery_id,
             model_instance_id,
         ) = _BATTERY_INFO_DECODE_STRUCT.unpack_from(data)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         status_flags = (packed1 & 0xFF) | (((packed1 >> 13) & 0x7) << 8)
         state_of_health_pct = ((packed1 >> 22) & 0x3) | (((packed1 >> 8) & 0x1F) << 2)
         state_of_charge_pct = (packed1 >> 31) | (((packed1 >> 16) & 0x3F) << 1)
@@ -650,6 +651,7 @@ class BatteryInfo:
         )
         battery_id = self.battery_id
         model_instance_id = self.model_instance_id
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         return _BATTERY_INFO_ENCODE_STRUCT.pack(
             temperature_f16,
             voltage_f16,
@@ -702,6 +704,7 @@ class BatteryInfo:
             battery_id,
             model_instance_id,
         ) = _BATTERY_INFO_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 184) - 1)).to_bytes(23, "big"))
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         status_flags = (packed1 & 0xFF) | (((packed1 >> 13) & 0x7) << 8)
         state_of_health_pct = ((packed1 >> 22) & 0x3) | (((packed1 >> 8) & 0x1F) << 2)
         state_of_charge_pct = (packed1 >> 31) | (((packed1 >> 16) & 0x3F) << 1)
@@ -1180,6 +1183,7 @@ class PrimaryPowerSupplyStatus:
         hours_to_empty_at_10sec_avg_power, hours_to_empty_at_10sec_avg_power_variance, packed1 = (
             _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack_from(data)
         )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         external_power_available = ((packed1 >> 7) & 0x1) != 0
         remaining_energy_pct = packed1 & 0x7F
         remaining_energy_pct_stdev = packed1 >> 9
@@ -1231,6 +1235,7 @@ class PrimaryPowerSupplyStatus:
             if 0 <= remaining_energy_pct_stdev <= 127
             else (127 if remaining_energy_pct_stdev > 127 else 0)
         )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         return _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(
             hours_to_empty_at_10sec_avg_power_f16,
             hours_to_empty_at_10sec_avg_power_variance_f16,
@@ -1249,6 +1254,7 @@ class PrimaryPowerSupplyStatus:
         hours_to_empty_at_10sec_avg_power, hours_to_empty_at_10sec_avg_power_variance, packed1 = (
             _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack((((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big"))
         )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         external_power_available = ((packed1 >> 7) & 0x1) != 0
         remaining_energy_pct = packed1 & 0x7F
         remaining_energy_pct_stdev = packed1 >> 9

@@ -10,6 +10,9 @@ from ...naming import identifier, upper_snake
 from .plan import Node, Piece, Planner, Segment, Unit, plan_units
 from .values import Lines, decode_pattern, encode_value, error, mask, needs_name
 
+# said where fields off byte boundaries are assembled, since the shifts alone look arbitrary
+_SHARED_WORDS = "fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)"
+
 
 class SegmentEmitter:
     def __init__(self, planner: Planner, msg: Message, cls: str, ctx: ModuleContext, factory: dict[str, str]) -> None:
@@ -84,6 +87,8 @@ class SegmentEmitter:
                 value = name
             values[idx] = value
         by_unit: dict[int, list[str]] = {}
+        if pieces:
+            out.add(f"# {_SHARED_WORDS}")
         for idx, runs in pieces.items():
             leaf = seg.leaves[idx]
             for pc in runs:
@@ -191,6 +196,8 @@ class SegmentEmitter:
             call = f"{st}.unpack_from({source[5:]})" if source.startswith("from:") else f"{st}.unpack({source})"
             target = ", ".join(names) + ("," if len(names) == 1 else "")
             out.add(f"{target} = {call}")
+        if pieces:
+            out.add(f"# {_SHARED_WORDS}")
         for idx, runs in pieces.items():
             leaf = seg.leaves[idx]
             parts = []
