@@ -294,9 +294,6 @@ class Gate:
                 return f"profile {name}: {w.selector}: {w.reason}"
         return None
 
-    def leave_out(self, reason: str) -> None:
-        self.waived[reason] = self.waived.get(reason, 0) + 1
-
 
 def describe(settings: Settings) -> Iterable[str]:
     """The selection in force, in words (for the text summary)."""

@@ -189,9 +189,10 @@ def test_empty_and_foreign_captures(tmp_path: Path, capsys: pytest.CaptureFixtur
 def test_columnar_with_aux_equals_the_generated_converter(tmp_path: Path) -> None:
     """The export's concepts of a capture (columnar, the aux message's filled in) are the generated
     per-record converter's ``to_concepts(info, aux)`` on the same records, concept by concept."""
+    from per_record import states_to_columns
+
     from codegen.apps.battery.can_batches import AUX, CBAT, INFO, can_batches
     from codegen.apps.battery.catalog import bundled_catalog
-    from codegen.apps.battery.per_record import states_to_columns
     from codegen.apps.battery.sources import model_of
     from codegen.apps.export.table import concept_array
     from codegen.inputs.can.records import capture_side

@@ -6,7 +6,7 @@ constants shared by both directions (:class:`ModuleConstants`). The emitter mixi
 package (numeric, choices, cells, devicetree, messages, px4, px4_cells) build on it.
 
 Emitters write each statement on one line (a call as :func:`call` spells it); the module is
-laid out afterwards by the layout engine. Temporaries an emitter writes (``_v``, ``_c``, ...;
+formatted afterwards by ruff. Temporaries an emitter writes (``_v``, ``_c``, ...;
 see :data:`TEMPORARIES`) get the rule's number as a suffix when emitted, so each has one type
 across the function (mypy) and a reader can tell which rule made it.
 """
@@ -41,7 +41,7 @@ from ....ir.fieldtypes import allowed_range
 from ....ir.mapping_values import ConstantRef, Number, Value
 from ....ir.rules import rule_ranges
 from .. import naming
-from ..layout import LINE_LENGTH
+from ..formatting import LINE_LENGTH
 from ..literals import float_literal, py_literal
 
 FLT_EPS = 1.1920928955078125e-07
@@ -279,11 +279,6 @@ class RuleContext:
     def known_test(self, var: str, marks: list[float | int]) -> list[str]:
         """Conditions that ``var`` is none of ``marks`` (NaN by ``var == var``)."""
         return [f"{var} == {var}" if _nan(m) else f"{var} != {py_literal(m)}" for m in marks]
-
-    def unit_of(self, ref: FieldRef) -> Unit | None:
-        if ref.message == CONCEPTS_ENDPOINT:
-            return self.concepts[ref.field].unit
-        return self.fld(ref).unit
 
     def format_and_concept(self, rule: Rule) -> tuple[FieldRef, FieldRef]:
         """(the format field, the concept) of a rule relating one of each, whichever side is which."""
