@@ -52,10 +52,10 @@ from ..text.escape import line
 EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE = 0, 1, 2
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Any, summary: str) -> None:
     p = subparsers.add_parser(
         "failsafe",
-        help="replay a flight log (.ulg, .tlog, .bin) or JSON Lines samples through ArduPilot's battery failsafe",
+        help=summary,
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
