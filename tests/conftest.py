@@ -24,6 +24,19 @@ settings.register_profile("battgen-ci", parent=settings.get_profile("battgen"), 
 settings.load_profile("battgen-ci" if os.environ.get("CI") else "battgen")
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _own_ir_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """The bundled schemas' IR cache (codegen.frontends.cache) in a folder of this run, for in-process and
+    subprocess commands alike: the suite neither reads nor writes the user's ~/.cache/battgen."""
+    before = os.environ.get("XDG_CACHE_HOME")
+    os.environ["XDG_CACHE_HOME"] = str(tmp_path_factory.mktemp("xdg-cache"))
+    yield
+    if before is None:
+        os.environ.pop("XDG_CACHE_HOME", None)
+    else:
+        os.environ["XDG_CACHE_HOME"] = before
+
+
 @pytest.fixture
 def import_generated(tmp_path: Path) -> Iterator[object]:
     """Generate a Schema into a fresh package under tmp_path and import one of its modules."""

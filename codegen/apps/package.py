@@ -14,17 +14,18 @@ import atexit
 import hashlib
 import importlib
 import importlib.util
+import os
 import shutil
 import sys
 import tempfile
-from collections.abc import Iterable
+from collections.abc import Collection, Iterable
 from pathlib import Path
 from types import ModuleType
 from typing import cast
 
 from ..backends.python import naming
-from ..backends.python.writer import generate
 from ..errors import BattgenError
+from ..frontends.cache import load_cached
 from ..inputs.model import MessageClass
 from ..ir import Message, Schema
 
@@ -42,6 +43,23 @@ def project_root() -> Path:
 def bundled_schemas() -> Path:
     """The schema folder used when none is given."""
     return project_root() / "schemas"
+
+
+def cache_dir() -> Path:
+    """Where the parsed IR of the bundled schemas is kept between runs: ``$XDG_CACHE_HOME/battgen``
+    (default ``~/.cache/battgen``)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "battgen"
+
+
+def load_schemas(schema_dir: Path, *, only: Collection[str] | None = None) -> Schema:
+    """``load([schema_dir], only=only)``; the bundled schemas from the IR cache (:mod:`codegen.frontends.cache`),
+    so a command does not parse and check them again on every run (a folder of the user's is read afresh)."""
+    if schema_dir.resolve() == bundled_schemas().resolve():
+        return load_cached(schema_dir, cache_dir(), only=only)
+    from ..frontends.loader import load
+
+    return load([schema_dir], only=only)
 
 
 def _is_committed(schema_dir: Path, root: Path) -> bool:
@@ -90,6 +108,8 @@ def _temporary_package(schema: Schema, key: str) -> ModuleType:
     name = f"_battgen_models_{digest}"
     tmp = Path(tempfile.mkdtemp(prefix="battgen-models-"))
     atexit.register(shutil.rmtree, tmp, True)
+    from ..backends.python.writer import generate  # the code generator, for a folder other than the bundled one
+
     generate(schema, tmp / name)
     return _import_from(tmp / name, name)
 

@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import BattgenError, LocatedError
-from ..frontends.loader import load
 from ..inputs.dispatch import read_records
 from ..inputs.kinds import KIND_FORMATS, file_kind
 from ..inputs.model import GeneratedMessage, MessageClass, Violation
@@ -27,12 +26,11 @@ from ..ir.expr import referenced_fields
 from ..ir.numbers import to_json_data
 from ..ir.rules import bound_rules
 from ..text.brief import brief, clip, reportable
-from . import dt_problems
 from .failsafe.checks import NONNEGATIVE, check_settings
 from .failsafe.vehicles import detect_vehicle
 from .gate import Gate
 from .messages import BATTERY_MESSAGES, DATAFLASH_NOTE, resolve_message
-from .package import data_error, model_class, model_package
+from .package import data_error, load_schemas, model_class, model_package
 
 EXIT_OK, EXIT_INVALID, EXIT_UNREADABLE = 0, 1, 2
 
@@ -183,6 +181,7 @@ class Checker:
 
     def _check_node(self, record: Record, data: dict[str, Any]) -> list[Finding]:
         """A devicetree node: every problem, in dt-validate's order (:mod:`.dt_problems`)."""
+        from . import dt_problems  # imported by devicetree input alone: it reads the devicetree frontend's tables
 
         def problem(exc: BaseException) -> dt_problems.Problem:
             f = self._type_finding(record, exc)
@@ -425,7 +424,7 @@ def make_checker(
 ) -> tuple[Message, Checker]:
     """Load the schemas, resolve the message (or the inputs' default one) and its generated class. ``only``: the
     sub-folders of the schema folder to read (the message's format and the rules, where the caller knows it)."""
-    schema = load([schema_dir], only=only)
+    schema = load_schemas(schema_dir, only=only)
     if message_name is None:
         message_name = default_message(schema, files or [], kind)
     message = resolve_message(schema, message_name)

@@ -95,10 +95,10 @@ def run(args: argparse.Namespace) -> int:
     return code
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Any, summary: str) -> None:
     p = subparsers.add_parser(
         "can",
-        help="account for a DroneCAN capture or live bus: nodes, rates, transport errors",
+        help=summary,
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -37,10 +37,8 @@ from ..inputs.records import Notice
 from ..text.escape import line
 
 
-def register(subparsers: Any) -> None:
-    p = subparsers.add_parser(
-        "convert", help="convert battery records between formats (JSON, JSON Lines, YAML, binary)"
-    )
+def register(subparsers: Any, summary: str) -> None:
+    p = subparsers.add_parser("convert", help=summary)
     p.add_argument("--from", dest="source", required=True, help="source side (dronecan, uorb, uorb_v0, mavlink, ...)")
     p.add_argument("--to", dest="target", required=True, help="target side, or 'concepts' for the shared state")
     p.add_argument("--policy", choices=("strict", "px4"), default="strict", help="strict (default) or px4")

@@ -72,10 +72,10 @@ from ..text.escape import line
 EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE, EXIT_DIFFERS = 0, 1, 2, 3
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Any, summary: str) -> None:
     p = subparsers.add_parser(
         "failsafe",
-        help="replay a flight log (.ulg, .tlog, .bin) or JSON Lines samples through PX4's or ArduPilot's failsafe",
+        help=summary,
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -4,33 +4,51 @@ malformed schema. Errors are one line on stderr, never a traceback."""
 from __future__ import annotations
 
 import argparse
+import importlib
 import shutil
 import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .. import __version__
-from ..apps.package import bundled_schemas, project_root
-from ..backends.c import generate_c
-from ..backends.python.name_clashes import refuse_clashes
-from ..backends.python.writer import generate
-from ..backends.rust import generate_rust
 from ..errors import BattgenError, ErrorList
-from ..frontends.loader import load
-from ..ir import Schema
-from ..ir import json_form as irjson
 from ..text.escape import line
-from . import can, convert, docs, export, failsafe, params, query, report, schema, validate, vectors
+
+if TYPE_CHECKING:
+    from ..ir import Schema
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
-# in the order of the help text
-COMMAND_MODULES = (validate, docs, schema, convert, vectors, params, failsafe, can, export, query, report)
+# The commands kept in their own modules (codegen/cli/<name>.py), in the order of the help text, with the
+# one-line summary `battgen --help` lists. Only the module of the command a run names is imported (it adds its
+# arguments with register(subparsers, summary)): a command's dependencies (the code generator, numpy, pandas,
+# python-can, ...) are paid by that command alone, and `battgen --help` imports none of them.
+COMMANDS: tuple[tuple[str, str], ...] = (
+    ("validate", "check data files, parameter files and flight/telemetry logs (.ulg, .tlog, .mav) against a message"),
+    ("docs", "write a Markdown reference page per message (PX4 message reference layout)"),
+    ("schema", "print or write the JSON Schema (Draft 2020-12) of messages"),
+    ("convert", "convert battery records between formats (JSON, JSON Lines, YAML, binary)"),
+    ("vectors", "JSON conformance vectors of a converter (input -> expected output and loss report)"),
+    ("params", "propose battery failsafe parameters from a devicetree battery, or check a parameter file"),
+    ("failsafe", "replay a flight log (.ulg, .tlog, .bin) or JSON Lines samples through PX4's or ArduPilot's failsafe"),
+    ("can", "account for a DroneCAN capture or live bus: nodes, rates, transport errors"),
+    ("export", "export the battery records of many logs into a Parquet dataset (needs battgen[fleet])"),
+    ("query", "run SQL over an exported dataset with DuckDB (table battery, views flights and packs)"),
+    ("report", "an HTML report (or PNG images) of a flight's battery: plots, failsafe replay, findings, figures"),
+)
 
 
 def _load(paths: Sequence[str], args: argparse.Namespace) -> Schema:
+    from ..apps.package import bundled_schemas, load_schemas
+
     include_paths = [Path(p) for p in args.include_path or ()]
-    schema = load([Path(p) for p in paths] if paths else [bundled_schemas()], include_paths=include_paths)
+    if paths or include_paths:
+        from ..frontends.loader import load
+
+        schema = load([Path(p) for p in paths] if paths else [bundled_schemas()], include_paths=include_paths)
+    else:  # the bundled schemas, from the IR cache
+        schema = load_schemas(bundled_schemas())
     for warning in schema.warnings:  # accepted, as upstream's tools accept it, but worth a look
         print(line(f"battgen: {warning}"), file=sys.stderr)
     return schema
@@ -53,16 +71,22 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 
 def cmd_ir(args: argparse.Namespace) -> int:
+    from ..ir import json_form as irjson
+
     schema = _load(args.paths, args)
     sys.stdout.write(irjson.dumps(schema))
     return EXIT_OK
 
 
 def _generate_c(schema: Schema, out: Path, check: bool) -> int:
+    from ..backends.c import generate_c
+
     return _report_library(out, check, *generate_c(schema, out, check=check))
 
 
 def _generate_rust(schema: Schema, out: Path, check: bool) -> int:
+    from ..backends.rust import generate_rust
+
     return _report_library(out, check, *generate_rust(schema, out, check=check))
 
 
@@ -79,6 +103,11 @@ def _report_library(out: Path, check: bool, written: list[str], removed: list[st
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
+    # the code generator is imported by this command only
+    from ..apps.package import project_root
+    from ..backends.python.name_clashes import refuse_clashes
+    from ..backends.python.writer import generate
+
     started = time.perf_counter()
     schema = _load([args.schema_dir] if args.schema_dir else [], args)
     refuse_clashes(schema)  # before either language writes a file
@@ -147,7 +176,16 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(EXIT_USAGE)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _command_named(argv: Sequence[str]) -> str | None:
+    """The command a command line names: the first word that is not an option (battgen's own options take no
+    value), or None."""
+    return next((arg for arg in argv if not arg.startswith("-")), None)
+
+
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The parser of every command; given the command line, only the command it names is complete (its module
+    imported), the others are listed by name and summary, which is all that parsing that line can show."""
+    wanted = None if argv is None else _command_named(argv)
     parser = _Parser(prog="battgen", description="Battery telemetry schemas: one IR, generated models.")
     parser.add_argument("--version", action="version", version=f"battgen {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -179,13 +217,18 @@ def build_parser() -> argparse.ArgumentParser:
     _include_path_option(p)
     p.set_defaults(func=cmd_generate)
 
-    for module in COMMAND_MODULES:
-        module.register(sub)
+    for name, summary in COMMANDS:
+        if argv is None or name == wanted:
+            importlib.import_module(f"{__package__}.{name}").register(sub, summary)
+        else:
+            sub.add_parser(name, help=summary)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
+    if argv is None:
+        argv = sys.argv[1:]
+    parser = build_parser(argv)
     args = parser.parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
     try:

@@ -35,10 +35,10 @@ EXIT_OK, EXIT_UNREADABLE = 0, 2
 MAX_CELL = 40  # characters of one value in the table format
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Any, summary: str) -> None:
     p = subparsers.add_parser(
         "query",
-        help="run SQL over an exported dataset with DuckDB (table battery, views flights and packs)",
+        help=summary,
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -96,10 +96,10 @@ def _write(out: Path, text: str) -> None:
         raise BattgenError(f"{out}: cannot write: {exc.strerror or exc}") from None
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Any, summary: str) -> None:
     p = subparsers.add_parser(
         "report",
-        help="an HTML report (or PNG images) of a flight's battery: plots, failsafe replay, findings, figures",
+        help=summary,
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -41,7 +41,6 @@ Exit 0 valid, 1 violations or a file without records, 2 unreadable input or unkn
 from __future__ import annotations
 
 import argparse
-import importlib.metadata
 import json
 import sys
 from pathlib import Path
@@ -195,6 +194,8 @@ def file_settings(chosen: Settings, path: Path, kind: str | None, *, echo: bool)
 
 
 def version() -> str:
+    import importlib.metadata  # for SARIF output only: it costs a run more than reading one record
+
     try:
         return importlib.metadata.version("battgen")
     except importlib.metadata.PackageNotFoundError:
@@ -230,10 +231,10 @@ def summary(message: Message, reports: list[FileReport], groups: list[Group], ch
     return text
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Any, summary: str) -> None:
     p = subparsers.add_parser(
         "validate",
-        help="check data files, parameter files and flight/telemetry logs (.ulg, .tlog, .mav) against a message",
+        help=summary,
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -19,10 +19,10 @@ from ..text.escape import line
 from .convert import open_output
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: Any, summary: str) -> None:
     p = subparsers.add_parser(
         "vectors",
-        help="JSON conformance vectors of a converter (input -> expected output and loss report)",
+        help=summary,
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

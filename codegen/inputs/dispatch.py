@@ -13,15 +13,13 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ..ir import Message, SourceFormat
-from .can.records import capture_items
-from .devicetree.records import read_devicetree
 from .documents import read_json, read_jsonl, read_yaml
 from .kinds import KIND_FORMATS, KIND_HOLDS, file_kind
 from .model import MavlinkClass, MessageClass
-from .parameter_records import read_parameter_records
 from .records import InputError, Item
-from .tlog import mavlink_items
-from .ulog import ulog_items
+
+# The readers of the binary and devicetree kinds are imported in their branch below: a run reads one kind, and
+# the CAN captures' reader alone brings python-can, the devicetree one the devicetree frontend.
 
 
 def read_records(
@@ -47,6 +45,8 @@ def read_records(
             name, 0, f"{KIND_HOLDS[kind]}, but {message.qualified_name} is a {message.format.value} message"
         )
     if model is not None and kind == "can":
+        from .can.records import capture_items
+
         return capture_items(path, name, model)
     if kind == "dataflash":
         raise InputError(
@@ -56,14 +56,22 @@ def read_records(
             f"{message.qualified_name} is a {message.format.value} message",
         )
     if kind in ("dts", "dtb"):
+        from .devicetree.records import read_devicetree
+
         return read_devicetree(path, name, message, binary=kind == "dtb")
     if model is not None and kind == "param":
+        from .parameter_records import read_parameter_records
+
         return read_parameter_records(path, name, model)
     if model is not None and kind == "ulog":
+        from .ulog import ulog_items
+
         return ulog_items(path, name, model)
     if model is not None and kind in ("tlog", "mavlink"):
         if not isinstance(model, MavlinkClass):
             raise InputError(name, 0, f"{model.QUALIFIED_NAME} has no MAVLink codec: run 'battgen generate'")
+        from .tlog import mavlink_items
+
         return mavlink_items(path, name, model, timestamps=kind == "tlog")
     if kind == "jsonl":
         return read_jsonl(path, name)

@@ -166,10 +166,11 @@ def checker(message: str) -> tuple[Message, Checker]:
 def _cached_schemas() -> Iterator[None]:
     """The bundled schemas loaded once for all examples (the commands load them on every run)."""
 
-    def cached(paths: list[Path], only: Collection[str] | None = None) -> Schema:
-        return _schema() if paths == [SCHEMAS] else load(paths, only=only)  # the whole folder serves any ``only``
+    def cached(schema_dir: Path, *, only: Collection[str] | None = None) -> Schema:
+        # the whole folder serves any ``only``
+        return _schema() if schema_dir == SCHEMAS else load([schema_dir], only=only)
 
-    with mock.patch.object(validate_app, "load", cached):
+    with mock.patch.object(validate_app, "load_schemas", cached):
         yield
 
 

@@ -12,10 +12,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ...errors import BattgenError
-from ...frontends.loader import MAPPINGS_DIR, load
-from ...frontends.mappings import MAPPED_FORMATS
 from ...ir import CONCEPTS_ENDPOINT, Concept, Direction, Endpoint, Message, Rule, Schema
-from ..package import bundled_schemas
+from ..package import bundled_schemas, load_schemas
+
+# codegen.frontends.mappings.MAPPED_FORMATS and codegen.frontends.loader.MAPPINGS_DIR, written here as importing
+# either module imports the frontends, which a fresh cache spares (tests/apps/test_ir_cache.py checks they agree)
+_MAPPED_FORMATS = ("uorb", "dronecan", "devicetree", "mavlink", "cyphal")
+_MAPPINGS_DIR = "mappings"
 
 # endpoints whose messages are battery records in logs (devicetree nodes are static facts)
 RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan", "cbat", "mavlink_sys_status")
@@ -113,7 +116,10 @@ def bundled_catalog(schema_dir: Path | None = None) -> Catalog:
     Of the bundled folder only what the mappings can name is read (the formats their endpoints'
     messages come from, and the mappings): every command starts here, and the Cyphal types (pydsdl),
     the parameter metadata and the validator rules are no part of a battery reading. A folder
-    given is read whole, so every error in it is still reported."""
+    given is read whole, so every error in it is still reported. The bundled folder's IR comes from the cache
+    (:func:`~codegen.apps.package.load_schemas`): no frontend is imported when it is fresh."""
     if schema_dir is None:
-        return build_catalog(load([bundled_schemas()], only=(*MAPPED_FORMATS, MAPPINGS_DIR)))
+        return build_catalog(load_schemas(bundled_schemas(), only=(*_MAPPED_FORMATS, _MAPPINGS_DIR)))
+    from ...frontends.loader import load
+
     return build_catalog(load([schema_dir]))
