@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Literal, Protocol, cast
 
-from ..errors import BattgenError
+from ..errors import BattgenError, cannot_read, did_you_mean
 from ..inputs.can.records import capture_side
 from ..inputs.documents import read_json, read_jsonl, read_yaml
 from ..inputs.kinds import content_kind, kind_of_name
@@ -210,13 +210,23 @@ def _carried(result: object, field: str) -> float | None:
 class Conversion:
     """One converter of a generated package, checked: the pair exists, has the policy."""
 
+    def _no_pair(self) -> str:
+        """Why there is no converter: a side that does not exist (with the closest names), else the pair."""
+        sides = {side for pair in self.module.CONVERTERS for side in pair}
+        for option, name in (("--from", self.source_name), ("--to", self.target_name)):
+            if name not in sides:
+                return f"{option} {name!r}: expected a format or message, found no such name; " + did_you_mean(
+                    name, sides, what="formats"
+                )
+        targets = sorted(t for s, t in self.module.CONVERTERS if s == self.source_name)
+        return f"no converter from {self.source_name} to {self.target_name}; from {self.source_name}: {', '.join(targets)}"
+
     def __init__(self, package: str | None, source: str, target: str, policy: str) -> None:
         self.module = converters(package)
         self.source_name, self.target_name = side_name(self.module, source), side_name(self.module, target)
         key = (self.source_name, self.target_name)
         if key not in self.module.CONVERTERS:
-            pairs = ", ".join(f"{s}->{t}" for s, t in sorted(self.module.CONVERTERS))
-            raise BattgenError(f"no converter from {self.source_name!r} to {self.target_name!r} (known pairs: {pairs})")
+            raise BattgenError(self._no_pair())
         if policy not in self.module.POLICIES[key]:
             raise BattgenError(
                 f"{self.source_name} -> {self.target_name} has no {policy} policy (PX4 has no such code path)"
@@ -284,7 +294,7 @@ class Conversion:
         try:
             stream = source.open("rb")
         except OSError as exc:
-            raise BattgenError(f"{where}: cannot read: {exc.strerror or exc}") from None
+            raise BattgenError(f"{where}: {cannot_read(exc)}") from None
         with stream:
             yield from _stream_items(stream, where, fmt)
 

@@ -21,7 +21,7 @@ from typing import Any
 
 from ..apps.can_capture import CaptureReport, scan
 from ..apps.package import bundled_package
-from ..errors import BattgenError, LocatedError
+from ..errors import BattgenError, LocatedError, missing_file
 from ..inputs.can.captures import read_bus
 from ..inputs.can.reassembly import Frame, Transfer
 from ..inputs.can.records import frames_of, registry
@@ -64,8 +64,8 @@ def run(args: argparse.Namespace) -> int:
     for name in args.files:
         path = Path(name)
         if not path.is_file():
-            raise BattgenError(f"{name}: cannot read file: no such file")
-        sources.append((name, frames_of(path, name)))
+            raise missing_file(name)
+        sources.append((name, frames_of(path, name, args.input_format)))
     if not sources:
         raise BattgenError("give a capture file or --bus IFACE:CHANNEL")
     reports: list[CaptureReport] = []
@@ -105,6 +105,11 @@ def register(subparsers: Any) -> None:
     p.add_argument("files", nargs="*", metavar="CAPTURE", help="capture files (.log .asc .blf .trc, .bin DataFlash)")
     p.add_argument("--bus", metavar="IFACE:CHANNEL", help="read a live python-can bus instead (socketcan:can0, ...)")
     p.add_argument("--duration", type=float, metavar="S", help="with --bus: stop after S seconds (default: Ctrl-C)")
+    p.add_argument(
+        "--input-format",
+        choices=("can", "dataflash"),
+        help="read every CAPTURE as this: 'can' a python-can log (a .csv too), 'dataflash' a log's CANF/CAFD records",
+    )
     p.add_argument("--records", action="store_true", help="also print every decoded message as a JSON line")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output format (default: text)")
     p.set_defaults(func=run)

@@ -23,7 +23,7 @@ from typing import Any
 from ..apps.package import bundled_schemas
 from ..apps.report.as_json import report_json
 from ..apps.report.build import collect, html, pngs
-from ..errors import BattgenError
+from ..errors import BattgenError, missing_file
 from ..text.escape import line
 
 EXIT_OK = 0
@@ -34,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
     paths = [Path(p) for p in args.logs]
     for p in paths:
         if not p.is_file():
-            raise BattgenError(f"{p}: cannot read file: no such file")
+            raise missing_file(str(p))
     report = collect(
         paths, schema_dir, message=args.message, params=Path(args.params) if args.params else None, vehicle=args.vehicle
     )

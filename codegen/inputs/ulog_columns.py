@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol, cast
 
+from ..errors import cannot_read
 from . import ulog_layouts
 from .model import FormatDiff, UorbClass, ulog_runtime
 from .records import InputError
@@ -103,7 +104,7 @@ class UlogColumns:
             self.log = cast(ColumnLog, ulog_runtime(model).read(source or path, index=False, warn=False))
             self.offsets = record_offsets(self.log)
         except OSError as exc:
-            raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+            raise InputError(name, 0, cannot_read(exc)) from None
         except (ValueError, struct.error, IndexError) as exc:  # ULogError is a ValueError
             raise InputError(name, 0, f"expected a ULog file: {exc}") from None
 

@@ -20,7 +20,7 @@ from typing import Any
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from ...errors import BattgenError
+from ...errors import BattgenError, cannot_read
 from ..battery.catalog import bundled_catalog
 from ..battery.sources import Batch, log_kind
 from ..battery.view import read_view
@@ -76,7 +76,7 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
         try:
             log = content_id(file, source, options.content_id or content_scheme(options.out))
         except OSError as exc:
-            return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
+            return LogResult(path, "failed", error=f"{path}: {cannot_read(exc)}")
         if is_exported(options.out, log) and not _replay_missing(options, log):
             return LogResult(path, "skipped", log, notes=("already in the dataset",))
         try:
