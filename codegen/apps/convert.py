@@ -20,7 +20,16 @@ from ..errors import BattgenError, cannot_read, did_you_mean
 from ..inputs.can.records import capture_side
 from ..inputs.documents import read_json, read_jsonl, read_yaml
 from ..inputs.kinds import content_kind, kind_of_name
-from ..inputs.model import DecodingClass, Encodable, MavlinkClass, MessageClass, PlainClass, PlainData, UorbClass
+from ..inputs.model import (
+    DecodingClass,
+    DronecanClass,
+    Encodable,
+    MavlinkClass,
+    MessageClass,
+    PlainClass,
+    PlainData,
+    UorbClass,
+)
 from ..inputs.payloads import read_hex, read_raw
 from ..inputs.records import InputError, Item, Notice, Record, Unreadable
 from ..inputs.tlog import StreamStats, mavlink_items, message_name
@@ -65,7 +74,7 @@ def input_format(path: str, given: str | None) -> str:
     if given:
         return given
     kind = content_kind(Path(path))
-    if kind in ("ulog", "tlog", "can"):
+    if kind in ("ulog", "tlog", "can", "dataflash"):  # a DataFlash .bin is a log, never one message's bytes
         return kind
     if kind_of_name(Path(path)) == "can":  # looks through .gz
         return "can"
@@ -219,7 +228,9 @@ class Conversion:
                     name, sides, what="formats"
                 )
         targets = sorted(t for s, t in self.module.CONVERTERS if s == self.source_name)
-        return f"no converter from {self.source_name} to {self.target_name}; from {self.source_name}: {', '.join(targets)}"
+        return (
+            f"no converter from {self.source_name} to {self.target_name}; from {self.source_name}: {', '.join(targets)}"
+        )
 
     def __init__(self, package: str | None, source: str, target: str, policy: str) -> None:
         self.module = converters(package)
@@ -301,6 +312,12 @@ class Conversion:
     def _log_items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
         """Every record of the source side's first message in a .ulg, .tlog, raw MAVLink or CAN capture input."""
         cls = self.source.items[0][1]
+        if fmt == "dataflash" and not all(isinstance(c, DronecanClass) for _, c in self.source.items):
+            raise BattgenError(
+                f"{where}: expected a record file for --from {self.source_name}, found an ArduPilot DataFlash log "
+                "(convert reads only the DroneCAN frames it logged, CANF/CAFD; 'battgen export' or 'report' read "
+                "its BAT records)"
+            )
         if fmt in ("can", "dataflash"):
             if not isinstance(source, Path):
                 raise BattgenError(f"{where}: a CAN capture is read from a file, not from standard input")

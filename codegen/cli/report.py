@@ -9,7 +9,8 @@ and peak power, minimum pack and cell voltage, time under each threshold, voltag
 resistance estimate from load steps). Several inputs give a fleet page: a row per flight and battery, and trends
 per pack serial. ``--format png`` writes one static image per battery into the ``-o`` folder instead;
 ``--format json`` the figures, per input and battery (the page's and the flight's in SI), to ``-o`` or stdout.
-Exit 0 when written, 2 when an input cannot be read or the output cannot be written.
+Exit 0 when written, 1 when the inputs hold no battery record (``--allow-empty``: 0, nothing written), 2 when an
+input cannot be read or the output cannot be written.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from ..apps.report.build import collect, html, pngs
 from ..errors import BattgenError, missing_file
 from ..text.escape import line
 
-EXIT_OK = 0
+EXIT_OK, EXIT_EMPTY = 0, 1
 
 
 def run(args: argparse.Namespace) -> int:
@@ -38,8 +39,13 @@ def run(args: argparse.Namespace) -> int:
     report = collect(
         paths, schema_dir, message=args.message, params=Path(args.params) if args.params else None, vehicle=args.vehicle
     )
-    if not any(i.batteries for i in report.inputs):
-        raise BattgenError("no battery records in the input(s): nothing to report")
+    if not any(i.batteries for i in report.inputs):  # readable, but nothing to draw: exit 1 as the README says
+        names = ", ".join(str(p) for p in paths)
+        if args.allow_empty:
+            print(line(f"{names}: no battery records: nothing to report, nothing written"), file=sys.stderr)
+            return EXIT_OK
+        print(line(f"{names}: expected battery records, found none (--allow-empty accepts that)"), file=sys.stderr)
+        return EXIT_EMPTY
     if args.format == "png":
         folder = Path(args.output or "report")
         if folder.exists() and not folder.is_dir():
@@ -97,4 +103,5 @@ def register(subparsers: Any) -> None:
     p.add_argument("--params", metavar="FILE", help="BATT_* parameter file to replay the failsafe with")
     p.add_argument("--vehicle", metavar="NAME", help="vehicle profile of the failsafe (rover, copter, plane, sub)")
     p.add_argument("--title", metavar="TEXT", help="the page's title")
+    p.add_argument("--allow-empty", action="store_true", help="inputs without battery records are not an error")
     p.set_defaults(func=run)

@@ -57,7 +57,9 @@ def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: b
             # (the reader's exception text, "too many values to unpack", speaks of its code, not of the file)
             if one_per_line:
                 raise InputError(name, read + 1, f"expected {CANDUMP_LINE}, found a line it cannot read") from exc
-            raise InputError(name, 0, f"expected {what} frames after frame {index}, found bytes python-can cannot read") from exc
+            raise InputError(
+                name, 0, f"expected {what} frames after frame {index}, found bytes python-can cannot read"
+            ) from exc
         read += 1
         stamp = float(message.timestamp or 0.0)
         if t0 is None:
