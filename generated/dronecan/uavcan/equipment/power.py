@@ -127,7 +127,9 @@ _BATTERY_INFO_STATUS_FLAGS_SPEC = _v.Number(
 _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC = _v.Number(
     type="uint7", kind="uint", low=0, high=127, unit="%", sentinel=127, sentinel_text="STATE_OF_HEALTH_UNKNOWN"
 )
-_BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
+_BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC = _v.Number(
+    type="uint7", kind="uint", low=0, high=127, unit="%", sentinel=127, sentinel_text="STATE_OF_CHARGE_UNKNOWN"
+)
 _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
 _BATTERY_INFO_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
 _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
@@ -224,6 +226,7 @@ class BatteryInfo:
     STATUS_FLAG_RESERVED_A: _ClassVar[int] = 512
     STATUS_FLAG_RESERVED_B: _ClassVar[int] = 1024
     STATE_OF_HEALTH_UNKNOWN: _ClassVar[int] = 127
+    STATE_OF_CHARGE_UNKNOWN: _ClassVar[int] = 127
 
     temperature: float = _dataclasses.field(
         default=_math.nan,
@@ -324,7 +327,7 @@ class BatteryInfo:
         ),
     )
     state_of_charge_pct: int = _dataclasses.field(
-        default=0,
+        default=127,
         metadata=_m.meta(
             name="state_of_charge_pct",
             type="uint7",
@@ -332,7 +335,9 @@ class BatteryInfo:
             quantity="ratio",
             scale=0.01,
             offset=0.0,
-            doc="State of charge.\nRequired",
+            invalid=127,
+            invalid_text="STATE_OF_CHARGE_UNKNOWN",
+            doc="Required; 0..100, else the constant above",
         ),
     )
     state_of_charge_pct_stdev: int = _dataclasses.field(
@@ -889,17 +894,20 @@ class BatteryInfo:
         # rule state-of-charge-percent (dronecan-power.yaml:13)
         try:
             r_state_of_charge_pct = self.state_of_charge_pct
-            if not (r_state_of_charge_pct <= 100):
-                out.append(
-                    _v.rule(
-                        "state_of_charge_pct",
-                        "state-of-charge-percent",
-                        r_state_of_charge_pct,
-                        "state_of_charge_pct <= 100",
-                        "state_of_charge_pct = " + _v.fmt(r_state_of_charge_pct) + " % is above 100 %",
-                        "error",
+            if r_state_of_charge_pct != 127:
+                if not (r_state_of_charge_pct <= 100):
+                    out.append(
+                        _v.rule(
+                            "state_of_charge_pct",
+                            "state-of-charge-percent",
+                            r_state_of_charge_pct,
+                            "state_of_charge_pct <= 100",
+                            "state_of_charge_pct = "
+                            + _v.fmt(r_state_of_charge_pct)
+                            + " % is above 100 % (127 means unknown)",
+                            "error",
+                        )
                     )
-                )
         except _v.SLOW:
             pass  # the field checks report the cause
         return out
@@ -929,14 +937,9 @@ class BatteryInfo:
             return self.hours_to_full_charge == self.hours_to_full_charge
         if field == "state_of_health_pct":
             return self.state_of_health_pct != 127
-        if field in {
-            "status_flags",
-            "state_of_charge_pct",
-            "state_of_charge_pct_stdev",
-            "battery_id",
-            "model_instance_id",
-            "model_name",
-        }:
+        if field == "state_of_charge_pct":
+            return self.state_of_charge_pct != 127
+        if field in {"status_flags", "state_of_charge_pct_stdev", "battery_id", "model_instance_id", "model_name"}:
             return True
         raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.equipment.power.BatteryInfo")
 
