@@ -81,12 +81,13 @@ def propose_from_devicetree(
 def check_proposals(result: Result) -> list[Finding]:
     """The failsafe's cross-field findings about the proposed parameters (with the cell count and
     chemistry the proposal assumed)."""
-    return check_settings({p.name: p.value for p in result.proposals}, cells=result.cells, chemistry=result.chemistry)
+    cells = result.cells or None  # 0: not known (a node without design voltages)
+    return check_settings({p.name: p.value for p in result.proposals}, cells=cells, chemistry=result.chemistry)
 
 
 def render(result: Result, source: str, fmt: str) -> str:
     """The proposals as a parameter file: ``param`` (ArduPilot) or ``qgc`` (QGroundControl)."""
-    header = [f"Battery failsafe parameters proposed by battgen from {source}", *result.notes]
+    header = [f"Battery failsafe parameters proposed by battgen from {source}", *result.notes, *result.warnings]
     if fmt == "qgc":
         types = {f.name: f.metadata["type"] for f in dataclasses.fields(cast(Any, _batt_params()))}
         items = [

@@ -17,7 +17,9 @@ from pathlib import Path
 from typing import IO, Literal, Protocol, cast
 
 from ..errors import BattgenError, cannot_read, did_you_mean
+from ..frontends.loader import load
 from ..inputs.can.records import capture_side
+from ..inputs.devicetree.records import read_devicetree
 from ..inputs.documents import read_json, read_jsonl, read_yaml
 from ..inputs.kinds import content_kind, kind_of_name
 from ..inputs.model import (
@@ -35,14 +37,15 @@ from ..inputs.records import InputError, Item, Notice, Record, Unreadable
 from ..inputs.tlog import StreamStats, mavlink_items, message_name
 from ..inputs.ulog import ulog_items
 from ..ir.numbers import to_json_data
-from .package import named_package, package_module
+from .package import bundled_schemas, named_package, package_module
 
 FORMATS = ("json", "jsonl", "yaml", "hex", "raw")
 BINARY_FORMATS = ("hex", "raw")
-LOG_FORMATS = ("ulog", "tlog", "mavlink", "can", "dataflash")  # input only
+LOG_FORMATS = ("ulog", "tlog", "mavlink", "can", "dataflash", "dts", "dtb")  # input only
 _EXTENSIONS = {".json": "json", ".jsonl": "jsonl", ".ndjson": "jsonl", ".yaml": "yaml", ".yml": "yaml"}
 _EXTENSIONS |= {".hex": "hex", ".bin": "raw", ".raw": "raw", ".ulg": "ulog", ".tlog": "tlog", ".mav": "mavlink"}
 _EXTENSIONS |= {".log": "can", ".asc": "can", ".blf": "can", ".trc": "can"}
+_EXTENSIONS |= {".dts": "dts", ".dtsi": "dts", ".dtb": "dtb"}
 
 # (alias, class) of each message of a side, the first required; the concept state is a side too
 Side = tuple[tuple[str, PlainClass], ...]
@@ -281,6 +284,7 @@ class Conversion:
             except (ValueError, TypeError, AttributeError) as exc:
                 text = f"record {item.index + 1}: cannot convert (a value the input lacks or does not fit): {exc}"
                 raise fail(item.file, item.line, text) from None
+            _keep_capture_time(result, item)
             for name in carried:
                 extra[name] = _carried(result, name.removesuffix(CARRIED))
             lost = None if loss is None else report.summary() if loss == "summary" else report.to_dict()
@@ -310,8 +314,12 @@ class Conversion:
             yield from _stream_items(stream, where, fmt)
 
     def _log_items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
-        """Every record of the source side's first message in a .ulg, .tlog, raw MAVLink or CAN capture input."""
+        """Every record of the source side's first message in a .ulg, .tlog, raw MAVLink, CAN capture or
+        devicetree (.dts, .dtb) input."""
         cls = self.source.items[0][1]
+        if fmt in ("dts", "dtb"):
+            yield from _devicetree_items(source, where, fmt, cls)
+            return
         if fmt == "dataflash" and not all(isinstance(c, DronecanClass) for _, c in self.source.items):
             raise BattgenError(
                 f"{where}: expected a record file for --from {self.source_name}, found an ArduPilot DataFlash log "
@@ -330,6 +338,7 @@ class Conversion:
                         None,
                         f"{where} ({item.where})",
                         instance=item.instance,
+                        location=item.location,
                         companions=item.companions,
                     )
                 elif isinstance(item, Unreadable):
@@ -379,6 +388,34 @@ def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item]:
         if not exc.reason:
             raise
         raise fail(where, exc.line, _reworded(exc.message, exc.reason, fmt)) from None
+
+
+def _devicetree_items(source: Path | IO[bytes], where: str, fmt: str, cls: object) -> Iterator[Item]:
+    """The battery nodes of a .dts/.dtb as records of the devicetree side (its binding read from the bundled
+    schemas, as ``battgen validate`` reads them), each located by its node's line."""
+    name = getattr(cls, "QUALIFIED_NAME", "")
+    if not name.startswith("devicetree."):
+        raise BattgenError(f"{where}: expected --from devicetree for a devicetree file, found --from side {name}")
+    if not isinstance(source, Path):
+        raise BattgenError(f"{where}: a devicetree file is read from a file, not from standard input")
+    schema = load([bundled_schemas()])
+    try:
+        message = schema.message(name)
+    except KeyError:
+        raise BattgenError(f"{where}: the bundled schemas have no binding {name}") from None
+    for item in read_devicetree(source, where, message, binary=fmt == "dtb"):
+        if isinstance(item, Unreadable):
+            raise fail(item.file, item.line, item.message)
+        yield item
+
+
+def _keep_capture_time(result: object, item: Record) -> None:
+    """A record of a CAN capture carries its time (``t``, s since the capture's first frame) though DroneCAN's
+    BatteryInfo has no timestamp field: a uORB target's ``timestamp`` (µs) gets it, as PX4's bridge stamps
+    the message with the time it arrived, rather than 0 on every record."""
+    t = item.location.get("t") if item.location is not None and "frame" in item.location else None
+    if isinstance(t, float) and getattr(result, "timestamp", None) == 0:
+        setattr(result, "timestamp", round(t * 1e6))  # noqa: B010 (a generated class's field, by name)
 
 
 def _source(item: Record, where: str) -> dict[str, object]:

@@ -70,6 +70,8 @@ def run(args: argparse.Namespace) -> int:
         mah_thresholds=args.mah_thresholds,
     )
     text = render(result, source, args.format)
+    for warning in result.warnings:  # what the node could not give: said, as well as written into the file
+        print(line(f"battgen: warning: {source}: {warning}"), file=sys.stderr)
     for finding in check_proposals(result):
         print(line(f"battgen: {finding.severity}: {finding.message}"), file=sys.stderr)
     if args.out:
