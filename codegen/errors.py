@@ -16,10 +16,15 @@ class LocatedError(BattgenError):
     without a line, never as a fake ``file:0:``) and what was expected."""
 
     def __init__(self, file: str, line: int, message: str) -> None:
-        super().__init__(f"{file}:{line}: {message}" if line > 0 else f"{file}: {message}")
+        super().__init__(f"{place(file, line)}: {message}")
         self.file = file
         self.line = line
         self.message = message
+
+
+def place(file: str, line: int) -> str:
+    """``file:line``, or the file alone where the problem has no line (0: the whole file, a .dtb, a log)."""
+    return f"{file}:{line}" if line > 0 else file
 
 
 def cannot_read(exc: OSError) -> str:

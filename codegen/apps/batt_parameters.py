@@ -15,7 +15,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any, cast
 
-from ..errors import BattgenError
+from ..errors import BattgenError, place
 from ..frontends import devicetree as devicetree_schemas
 from ..inputs import devicetree, parameter_files
 from ..inputs.model import MessageClass
@@ -131,5 +131,5 @@ def check_parameter_file(
         pass
     findings = [ParameterFinding(f.line, f.severity, f.message) for f in report.findings]
     first = report.unreadable[0] if report.unreadable else None
-    unreadable = None if first is None else f"{first.file}:{first.line}: {first.message}"
+    unreadable = None if first is None else f"{place(first.file, first.line)}: {first.message}"
     return ParameterReport(findings, notes, unreadable)
