@@ -21,7 +21,7 @@ battery's BATT_, BATT2_ .. BATT9_, BATTA_ .. BATTG_ settings. The vehicle (``--v
 what an action code means, its priority and its fallbacks; without it, it is detected from
 parameters only one vehicle has, else rover is assumed (said on stderr either way).
 
-Semantics are ArduPilot's AP_BattMonitor (see the README's failsafe section); ``--variant
+Semantics are ArduPilot's AP_BattMonitor (see docs/failsafe.md); ``--variant
 seed-critical`` and ``--variant distance`` turn on the seed's own choices. Prints one line per
 transition (``--json``: one JSON object per line). Exit 0; 1 when the parameters hold no BATT*_
 one or the input no battery reading (``--allow-empty`` accepts both); 2 when an input cannot be read.
