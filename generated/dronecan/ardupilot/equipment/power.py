@@ -280,8 +280,8 @@ def _timestamp_class() -> type[_dronecan_uavcan.Timestamp]:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryCells:
-    """Battery cell voltages
-    Rate: set by parameter on smart battery (default off)
+    """A smart battery's cell voltages, in blocks of up to 24 cells (sent at a rate the battery's settings
+    choose; off by default). (battgen's text of ArduPilot's type 20012; the layout and names are upstream's.)
 
     Schema: dronecan.ardupilot.equipment.power.BatteryCells (dronecan,
     ardupilot/equipment/power/20012.BatteryCells.uavcan:1).
@@ -297,8 +297,7 @@ class BatteryCells:
         metadata=_m.meta(
             name="index",
             type="uint16",
-            doc="Index of the first cell in the array, index 0 is cells at array indices 0 - 23, "
-            "index 24 is cells at array indices 24 - 47, etc.",
+            doc="The first cell of this block: 0 for cells 0-23, 24 for cells 24-47, and so on",
         ),
     )
 
@@ -444,7 +443,9 @@ class BatteryCells:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryContinuous:
-    """Battery data to be sent continuously
+    """A smart battery's fast-changing state, sent at a steady rate.
+    (battgen's text of ArduPilot's type 20010; the layout and names are upstream's, checked against
+    pydronecan by conformance/test_dsdl_pydronecan.py.)
 
     Schema: dronecan.ardupilot.equipment.power.BatteryContinuous (dronecan,
     ardupilot/equipment/power/20010.BatteryContinuous.uavcan:1).
@@ -480,7 +481,7 @@ class BatteryContinuous:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="Pack mounted thermistor (preferably installed between cells), NAN: field not provided",
+            doc="Thermistor among the cells; NaN when the pack has none",
         ),
     )
     temperature_pcb: float = _dataclasses.field(
@@ -492,7 +493,7 @@ class BatteryContinuous:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="Battery PCB temperature (likely output FET(s) or current sense resistor), NAN: field not provided",
+            doc="Electronics temperature (switches, shunt); NaN when not measured",
         ),
     )
     temperature_other: float = _dataclasses.field(
@@ -504,7 +505,7 @@ class BatteryContinuous:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="Application dependent, NAN: field not provided",
+            doc="A third sensor, its place chosen by the vendor; NaN when absent",
         ),
     )
     current: float = _dataclasses.field(
@@ -514,13 +515,11 @@ class BatteryContinuous:
             type="float32",
             unit="A",
             quantity="current",
-            doc="Positive: defined as a discharge current. Negative: defined as a charging "
-            "current, NAN: field not provided",
+            doc="Discharge positive, charge negative; NaN when not measured",
         ),
     )
     voltage: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(name="voltage", type="float32", unit="V", quantity="voltage", doc="Battery voltage"),
+        default=0.0, metadata=_m.meta(name="voltage", type="float32", unit="V", quantity="voltage", doc="Pack voltage")
     )
     state_of_charge: float = _dataclasses.field(
         default=0.0,
@@ -531,16 +530,12 @@ class BatteryContinuous:
             quantity="ratio",
             scale=0.01,
             offset=0.0,
-            doc="The estimated state of charge, in percent remaining (0 - 100).",
+            doc="Charge left, 0 to 100",
         ),
     )
     slot_id: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(
-            name="slot_id",
-            type="uint8",
-            doc=": The physical location of the battery on the aircraft. 0: field not provided",
-        ),
+        metadata=_m.meta(name="slot_id", type="uint8", doc=": Where on the vehicle the pack sits; 0 when not known"),
     )
     capacity_consumed: float = _dataclasses.field(
         default=0.0,
@@ -551,9 +546,8 @@ class BatteryContinuous:
             quantity="charge",
             scale=3600.0,
             offset=0.0,
-            doc="This is either the consumption since power-on or since the battery was full, "
-            "depending on the value of STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL, NAN: field not "
-            "provided",
+            doc="Charge used since power-on, or since full when "
+            "STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL is set; NaN when not known",
         ),
     )
     status_flags: int = _dataclasses.field(
@@ -562,7 +556,7 @@ class BatteryContinuous:
             name="status_flags",
             type="uint32",
             enums=("dronecan.ardupilot.equipment.power.BatteryContinuous.STATUS_FLAG",),
-            doc=": Fault, health, readiness, and other status indications",
+            doc=": The STATUS_FLAG_* bits below",
         ),
     )
 
@@ -1308,8 +1302,8 @@ class BatteryInfoAux:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryPeriodic:
-    """Battery data to be sent statically upon request or periodically at a low rate
-     Recommend that this message is sent at a maximum of 1Hz and nominally 0.2 Hz (IE: once every 5 seconds.)
+    """A smart battery's slow-changing facts, sent on request or rarely (about every 5 s, at most 1 Hz).
+    (battgen's text of ArduPilot's type 20011; the layout and names are upstream's.)
 
     Schema: dronecan.ardupilot.equipment.power.BatteryPeriodic (dronecan,
     ardupilot/equipment/power/20011.BatteryPeriodic.uavcan:1).
@@ -1318,22 +1312,13 @@ class BatteryPeriodic:
     QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryPeriodic"
 
     name: bytes = _dataclasses.field(
-        default=b"",
-        metadata=_m.meta(name="name", type="uint8[<=50]", doc=": Formatted as manufacturer_product, 0 terminated"),
+        default=b"", metadata=_m.meta(name="name", type="uint8[<=50]", doc=": Maker and product, as maker_product text")
     )
     serial_number: bytes = _dataclasses.field(
-        default=b"",
-        metadata=_m.meta(
-            name="serial_number", type="uint8[<=32]", doc=": Serial number in ASCII characters, 0 terminated"
-        ),
+        default=b"", metadata=_m.meta(name="serial_number", type="uint8[<=32]", doc=": Serial number, as text")
     )
     manufacture_date: bytes = _dataclasses.field(
-        default=b"",
-        metadata=_m.meta(
-            name="manufacture_date",
-            type="uint8[<=9]",
-            doc=": Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated",
-        ),
+        default=b"", metadata=_m.meta(name="manufacture_date", type="uint8[<=9]", doc=": Date made, DDMMYYYY as text")
     )
     design_capacity: float = _dataclasses.field(
         default=0.0,
@@ -1344,14 +1329,11 @@ class BatteryPeriodic:
             quantity="charge",
             scale=3600.0,
             offset=0.0,
-            doc="Fully charged design capacity. 0: field not provided.",
+            doc="Design capacity when full; 0 when not given",
         ),
     )
     cells_in_series: int = _dataclasses.field(
-        default=0,
-        metadata=_m.meta(
-            name="cells_in_series", type="uint8", doc=": Number of battery cells in series. 0: field not provided."
-        ),
+        default=0, metadata=_m.meta(name="cells_in_series", type="uint8", doc=": Cells in series; 0 when not given")
     )
     nominal_voltage: float = _dataclasses.field(
         default=0.0,
@@ -1360,7 +1342,7 @@ class BatteryPeriodic:
             type="float16",
             unit="V",
             quantity="voltage",
-            doc="Battery nominal voltage. Used for conversion between Wh and Ah. 0: field not provided.",
+            doc="Nominal pack voltage (converts Wh to Ah); 0 when not given",
         ),
     )
     discharge_minimum_voltage: float = _dataclasses.field(
@@ -1370,7 +1352,7 @@ class BatteryPeriodic:
             type="float16",
             unit="V",
             quantity="voltage",
-            doc="Minimum per-cell voltage when discharging. 0: field not provided.",
+            doc="Lowest cell voltage while discharging; 0 when not given",
         ),
     )
     charging_minimum_voltage: float = _dataclasses.field(
@@ -1380,7 +1362,7 @@ class BatteryPeriodic:
             type="float16",
             unit="V",
             quantity="voltage",
-            doc="Minimum per-cell voltage when charging. 0: field not provided.",
+            doc="Lowest cell voltage while charging; 0 when not given",
         ),
     )
     charging_maximum_voltage: float = _dataclasses.field(
@@ -1390,7 +1372,7 @@ class BatteryPeriodic:
             type="float16",
             unit="V",
             quantity="voltage",
-            doc="Maximum per-cell voltage when charged. 0: field not provided.",
+            doc="Highest cell voltage when charged; 0 when not given",
         ),
     )
     charging_maximum_current: float = _dataclasses.field(
@@ -1400,7 +1382,7 @@ class BatteryPeriodic:
             type="float32",
             unit="A",
             quantity="current",
-            doc="Maximum pack continuous charge current. 0: field not provided.",
+            doc="Highest continuous charge current; 0 when not given",
         ),
     )
     discharge_maximum_current: float = _dataclasses.field(
@@ -1410,7 +1392,7 @@ class BatteryPeriodic:
             type="float32",
             unit="A",
             quantity="current",
-            doc="Maximum pack continuous discharge current. 0: field not provided.",
+            doc="Highest continuous discharge current; 0 when not given",
         ),
     )
     discharge_maximum_burst_current: float = _dataclasses.field(
@@ -1420,7 +1402,7 @@ class BatteryPeriodic:
             type="float32",
             unit="A",
             quantity="current",
-            doc="Maximum pack discharge burst current for 30 seconds. 0: field not provided",
+            doc="Highest discharge current for 30 s; 0 when not given",
         ),
     )
     full_charge_capacity: float = _dataclasses.field(
@@ -1432,17 +1414,13 @@ class BatteryPeriodic:
             quantity="charge",
             scale=3600.0,
             offset=0.0,
-            doc="Predicted battery capacity when fully charged (accounting for battery "
-            "degradation), NAN: field not provided",
+            doc="Capacity when full, the pack's wear counted; NaN when not given",
         ),
     )
     cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="cycle_count",
-            type="uint16",
-            doc=": Lifetime count of the number of charge/discharge cycles "
-            "(https://en.wikipedia.org/wiki/Charge_cycle). UINT16_MAX: field not provided.",
+            name="cycle_count", type="uint16", doc=": Charge and discharge cycles so far; 65535 when not given"
         ),
     )
     state_of_health: int = _dataclasses.field(
@@ -1454,7 +1432,7 @@ class BatteryPeriodic:
             quantity="ratio",
             scale=0.01,
             offset=0.0,
-            doc="State of Health (SOH) estimate, in percent (0 - 100). UINT8_MAX: field not provided.",
+            doc="Health, 0 to 100; 255 when not given",
         ),
     )
 
@@ -2099,8 +2077,8 @@ class BatteryPeriodic:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryTag:
-    """Battery tag information. This is broadcast by a battery tag device
-    permanently attached to a battery to record the lifecycle of the battery
+    """What a tag fixed to a battery records over the battery's life, broadcast by the tag.
+    (battgen's text of ArduPilot's type 20500; the layout and names are upstream's.)
 
     Schema: dronecan.ardupilot.equipment.power.BatteryTag (dronecan,
     ardupilot/equipment/power/20500.BatteryTag.uavcan:1).
@@ -2109,41 +2087,29 @@ class BatteryTag:
     QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryTag"
 
     serial_number: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="serial_number", type="uint32", doc="vendor supplied serial number")
+        default=0, metadata=_m.meta(name="serial_number", type="uint32", doc="the maker's serial number")
     )
     num_cycles: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="num_cycles",
-            type="uint32",
-            doc="number of cycles this battery has been through. Criteria for\ndefining a cycle is vendor specific",
+            name="num_cycles", type="uint32", doc="charge cycles so far, counted as the maker defines a cycle"
         ),
     )
     armed_hours: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(
-            name="armed_hours",
-            type="float32",
-            doc="number of hours that this battery has been running when\nvehicle is in an armed state",
-        ),
+        metadata=_m.meta(name="armed_hours", type="float32", doc="hours the battery has powered an armed vehicle"),
     )
     battery_capacity_mAh: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="battery_capacity_mAh", type="uint32", doc="battery capacity in milliAmpHours")
+        default=0, metadata=_m.meta(name="battery_capacity_mAh", type="uint32", doc="capacity in mAh")
     )
     first_use_mins: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(
-            name="first_use_mins",
-            type="uint32",
-            doc="time of first use of battery with vehicle armed, in minutes since 1/1/1970",
-        ),
+        metadata=_m.meta(name="first_use_mins", type="uint32", doc="first armed use, minutes since 1970-01-01"),
     )
     last_arm_time_mins: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="last_arm_time_mins",
-            type="uint32",
-            doc="time of most recent change to armed state, in minutes since 1/1/1970",
+            name="last_arm_time_mins", type="uint32", doc="latest change of the armed state, minutes since 1970-01-01"
         ),
     )
 

@@ -140,7 +140,8 @@ _CBAT_STATUS_FLAGS_SPEC = _v.Number(
 
 @_dataclasses.dataclass(slots=True)
 class CBAT:
-    """support for CUAV Smart Battery on UAVCAN
+    """CUAV's smart battery on DroneCAN.
+    (battgen's text of CUAV's type 20300; the layout and names are upstream's.)
 
     Schema: dronecan.cuav.equipment.power.CBAT (dronecan, cuav/equipment/power/20300.CBAT.uavcan:1).
     """
@@ -159,118 +160,86 @@ class CBAT:
     STATUS_FLAG_RESERVED_B: _ClassVar[int] = 1024
 
     temperature: float = _dataclasses.field(
-        default=0.0, metadata=_m.meta(name="temperature", type="float32", doc="The surface temperature of the battery")
+        default=0.0, metadata=_m.meta(name="temperature", type="float32", doc="Temperature at the pack's surface")
     )
     voltage: float = _dataclasses.field(
-        default=0.0, metadata=_m.meta(name="voltage", type="float32", doc="The total voltage of the battery")
+        default=0.0, metadata=_m.meta(name="voltage", type="float32", doc="Pack voltage")
     )
     voltage_cell: list[float] = _dataclasses.field(
-        default_factory=list,
-        metadata=_m.meta(name="voltage_cell", type="float32[<=15]", doc="Battery individual cell voltages"),
+        default_factory=list, metadata=_m.meta(name="voltage_cell", type="float32[<=15]", doc="Each cell's voltage")
     )
     cell_count: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="cell_count", type="uint8", doc="Number of cells")
+        default=0, metadata=_m.meta(name="cell_count", type="uint8", doc="Cells in the pack")
     )
     current: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(name="current", type="float32", doc="The current flowing through the sense resistor"),
+        default=0.0, metadata=_m.meta(name="current", type="float32", doc="Current through the shunt")
     )
     average_current: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(
-            name="average_current", type="float32", doc="The average current flowing through the sense resistor"
-        ),
+        default=0.0, metadata=_m.meta(name="average_current", type="float32", doc="Average current through the shunt")
     )
     average_power: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(name="average_power", type="float32", doc="The average power of the current discharge"),
+        default=0.0, metadata=_m.meta(name="average_power", type="float32", doc="Average power of this discharge")
     )
     available_energy: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(
-            name="available_energy", type="float32", doc="The predicted charge or energy remaining in the battery"
-        ),
+        metadata=_m.meta(name="available_energy", type="float32", doc="Charge or energy predicted to be left"),
     )
     remaining_capacity: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(name="remaining_capacity", type="float32", doc="The compensated battery capacity remaining"),
+        default=0.0, metadata=_m.meta(name="remaining_capacity", type="float32", doc="Capacity left, compensated")
     )
     full_charge_capacity: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(
-            name="full_charge_capacity",
-            type="float32",
-            doc="The compensated capacity of the battery when fully charged",
-        ),
+        metadata=_m.meta(name="full_charge_capacity", type="float32", doc="Capacity when full, compensated"),
     )
     design_capacity: float = _dataclasses.field(
-        default=0.0, metadata=_m.meta(name="design_capacity", type="float32", doc="The design capacity of the battery")
+        default=0.0, metadata=_m.meta(name="design_capacity", type="float32", doc="Design capacity")
     )
     average_time_to_empty: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="average_time_to_empty",
-            type="uint16",
-            doc="The predicted remaining battery life at the present rate of discharge, in minutes",
+            name="average_time_to_empty", type="uint16", doc="Minutes until empty at the present discharge"
         ),
     )
     average_time_to_full: int = _dataclasses.field(
-        default=0,
-        metadata=_m.meta(
-            name="average_time_to_full",
-            type="uint16",
-            doc="The predicted remaining time until the battery reaches full charge, in minutes",
-        ),
+        default=0, metadata=_m.meta(name="average_time_to_full", type="uint16", doc="Minutes until full")
     )
     state_of_health: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="state_of_health", type="uint7", doc="Health of the battery")
+        default=0, metadata=_m.meta(name="state_of_health", type="uint7", doc="Health")
     )
     state_of_charge: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="state_of_charge", type="uint7", doc="Percent of the full charge [0, 100]")
+        default=0, metadata=_m.meta(name="state_of_charge", type="uint7", doc="Charge left, 0 to 100 percent")
     )
     max_error: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="max_error",
-            type="uint7",
-            doc="max error, expected margin of error in % in the state-of-charge calculation with a range of 1 to 100%",
+            name="max_error", type="uint7", doc="Margin of error of the state of charge, 1 to 100 percent"
         ),
     )
     serial_number: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="serial number of the battery pack")
+        default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="The pack's serial number")
     )
     manufacture_date: int = _dataclasses.field(
-        default=0,
-        metadata=_m.meta(
-            name="manufacture_date", type="uint16", doc="manufacture date, part of serial number of the battery pack"
-        ),
+        default=0, metadata=_m.meta(name="manufacture_date", type="uint16", doc="Date made (part of the serial number)")
     )
     cycle_count: int = _dataclasses.field(
-        default=0,
-        metadata=_m.meta(
-            name="cycle_count", type="uint16", doc="number of discharge cycles the battery has experienced"
-        ),
+        default=0, metadata=_m.meta(name="cycle_count", type="uint16", doc="Discharge cycles so far")
     )
     over_discharge_count: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
+        default=0,
+        metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Times the pack was over-discharged"),
     )
     passed_charge: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(
-            name="passed_charge", type="float32", doc="The amount of charge passing through the sense resistor"
-        ),
+        default=0.0, metadata=_m.meta(name="passed_charge", type="float32", doc="Charge that passed through the shunt")
     )
     nominal_voltage: float = _dataclasses.field(
-        default=0.0, metadata=_m.meta(name="nominal_voltage", type="float32", doc="Nominal voltage of the battery pack")
+        default=0.0, metadata=_m.meta(name="nominal_voltage", type="float32", doc="Nominal pack voltage")
     )
     is_powering_off: bool = _dataclasses.field(
         default=False,
-        metadata=_m.meta(
-            name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
-        ),
+        metadata=_m.meta(name="is_powering_off", type="bool", doc="Power-off is imminent; false when not known"),
     )
     interface_error: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="interface error counter")
+        default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="Interface errors counted")
     )
     status_flags: int = _dataclasses.field(
         default=0,
