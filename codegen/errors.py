@@ -53,6 +53,15 @@ def did_you_mean(name: str, known: Iterable[str], *, what: str = "names") -> str
     return f"did you mean {' or '.join(repr(folded[c]) for c in close)}?"
 
 
+class OutputError(BattgenError):
+    """An output that cannot be written (a full disk, a folder that is a file): the run stops, whatever its
+    inputs; nothing half-written is left visible."""
+
+    @classmethod
+    def of(cls, path: object, exc: OSError) -> OutputError:
+        return cls(f"{path}: cannot write: {exc.strerror or exc}")
+
+
 class SchemaError(LocatedError):
     """A malformed schema."""
 

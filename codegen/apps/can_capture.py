@@ -33,12 +33,21 @@ class Stream:
     first_t: float = 0.0
     last_t: float = 0.0
     undecodable: int = 0
+    span: float = 0.0  # seconds between successive transfers where the clock went forward
+    steps: int = 0  # those intervals: a clock that jumps back breaks the count into monotonic stretches
+
+    def see(self, t: float) -> None:
+        """One more transfer at ``t``."""
+        if self.count and t >= self.last_t:
+            self.span += t - self.last_t
+            self.steps += 1
+        self.count += 1
+        self.last_t = t
 
     @property
     def rate(self) -> float:
-        """Transfers per second between the first and last one (0 for a single transfer)."""
-        span = self.last_t - self.first_t
-        return (self.count - 1) / span if self.count > 1 and span > 0 else 0.0
+        """Transfers per second over the stretches where the capture's clock ran forward (0 for a single one)."""
+        return self.steps / self.span if self.steps and self.span > 0 else 0.0
 
     def to_dict(self) -> dict[str, object]:
         return {
@@ -106,7 +115,15 @@ def scan(
         if report.counts[diag.code] <= KEEP_PER_CODE:
             report.problems.append(diag)
 
+    forward = 0.0  # seconds the clock ran forward: the capture's duration, however often it jumped back
     for frame in frames:
+        if last is not None:
+            if frame.t < last.t:
+                note(
+                    Diagnostic("can-clock-back", _clock_back(last.t, frame.t), frame.t, frame.index, severity="warning")
+                )
+            else:
+                forward += frame.t - last.t
         last = frame
         for event in reassembler.feed(frame):
             if isinstance(event, Diagnostic):
@@ -118,10 +135,17 @@ def scan(
     if last is not None:
         for diag in reassembler.finish(last.t, last.index):
             note(diag)
-        report.duration = last.t
+        report.duration = forward
     report.frames = reassembler.frames
     report.transfers = reassembler.transfers
     return report
+
+
+def _clock_back(before: float, now: float) -> str:
+    return (
+        f"the capture's clock went back {before - now:.6f} s (from {before:.6f} s to {now:.6f} s): "
+        "rates and the duration count only where it ran forward"
+    )
 
 
 def _count(
@@ -140,8 +164,7 @@ def _count(
         other = standard.get((kind, transfer.id.data_type_id))
         name = cls.QUALIFIED_NAME.removeprefix("dronecan.") if cls is not None else other[0] if other else ""
         stream = report.streams[key] = Stream(transfer.node, kind, transfer.id.data_type_id, name, 0, transfer.t)
-    stream.count += 1
-    stream.last_t = transfer.t
+    stream.see(transfer.t)
     if cls is None:
         return
     try:

@@ -7,8 +7,9 @@ bundled battery message (``--message``, else told from the first record's keys);
 for the logs under it. Every record becomes a row of one table in SI units, unknown values null,
 partitioned by log (``DIR/battery/log=<id>/``); ``--raw`` also writes each message's own table.
 A log already in the dataset (same content) is skipped; a log that cannot be read is reported at
-the end and the run goes on. Exit 0 when every log was exported or skipped, 1 when some failed,
-2 when there is nothing to read or the fleet extra is missing.
+the end and the run goes on. Exit 0 when every log was exported or skipped, 1 when some failed or
+had records left out (a battery number its type cannot hold: each said on stderr), 2 when there is
+nothing to read or the fleet extra is missing.
 
 ``--failsafe PARAMS`` also replays each flight log (.ulg, .tlog, .bin) through ArduPilot's battery
 failsafe as ``battgen failsafe`` does, with the parameter file PARAMS (``--failsafe log``: each
@@ -182,6 +183,14 @@ def run(args: argparse.Namespace) -> int:
     finally:
         close()
     failed = [r for r in results if r.status == "failed"]
+    for r in results:
+        if r.replaced:
+            print(
+                line(f"battgen: {r.path}: replaces log {r.replaced}, its earlier export (the file has grown)"),
+                file=sys.stderr,
+            )
+    for warning in (w for r in results for w in r.warnings):
+        print(line(f"battgen: warning: {warning}"), file=sys.stderr)
     for r in failed:
         print(line(f"battgen: skipped {r.error}"), file=sys.stderr)
     # a log read without one battery record is not success (the README's rule for every command)
@@ -201,4 +210,4 @@ def run(args: argparse.Namespace) -> int:
             ),
             file=sys.stderr,
         )
-    return EXIT_FAILED if failed or (empty and not args.allow_empty) else EXIT_OK
+    return EXIT_FAILED if failed or any(r.warnings for r in results) or (empty and not args.allow_empty) else EXIT_OK

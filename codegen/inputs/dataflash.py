@@ -261,8 +261,9 @@ def _battery(msg: DataflashMessage) -> BatteryRecord | None:
     if msg.type in NUMBERED_TYPES:
         instance = NUMBERED_TYPES[msg.type]
     else:
-        inst = _number(f, "Inst", "Instance")
-        instance = int(inst) if inst is not None else 0
+        raw = f.get("Inst", f.get("Instance"))
+        inst = raw if isinstance(raw, int) and not isinstance(raw, bool) else _number(f, "Inst", "Instance")
+        instance = int(inst) if inst is not None else 0  # an integer as logged: a float would round 2^64 - 1
     return BatteryRecord(
         time_s=when,
         instance=instance,

@@ -19,6 +19,7 @@ records, once the walk has seen the whole file.
 
 from __future__ import annotations
 
+import contextlib
 import struct
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ from pathlib import Path
 from typing import IO
 
 from ..errors import cannot_read
+from .held_file import held, whole
 from .model import FormatDiff, GeneratedMessage, MessageClass, UorbClass, ulog_runtime
 from .records import InputError, Item, Notice, Record, Unreadable
 
@@ -81,14 +83,23 @@ class UlogReader:
         self.name = name
         self.model = model
         self.ulog = ulog_runtime(model)
-        if isinstance(source, Path):
-            _check_file(source, name)
+        self._hold = contextlib.ExitStack()  # the file held still while it is read (.held_file)
+        data: Path | IO[bytes] | bytes = source
         try:
-            self.log = self.ulog.read(source, index=False, warn=False)  # damage: listed in Log.warnings
+            if isinstance(source, Path):
+                _check_file(source, name)
+                if not self._hold.enter_context(held(source, name)).leased:
+                    data = whole(source, name)  # unheld, a map could end in SIGBUS
+            self.log = self.ulog.read(data, index=False, warn=False)  # damage: listed in Log.warnings
         except OSError as exc:
+            self._hold.close()
             raise InputError(name, 0, cannot_read(exc)) from None
         except (ValueError, struct.error, IndexError) as exc:  # ULogError is a ValueError
+            self._hold.close()
             raise InputError(name, 0, f"expected a ULog file: {exc}") from None
+        except BaseException:
+            self._hold.close()
+            raise
         topics = model.UORB_TOPICS if isinstance(model, UorbClass) else ()
         self.topics = tuple(topics or (self.ulog.format_of(model).name,))
         self.notices: list[Notice] = []
@@ -97,7 +108,10 @@ class UlogReader:
         self._prepare()
 
     def close(self) -> None:
-        self.log.close()
+        try:
+            self.log.close()
+        finally:
+            self._hold.close()
 
     def _prepare(self) -> None:
         for topic in self.topics:

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import mmap
 import re
 import struct
 from collections.abc import Iterator, Mapping
@@ -29,6 +28,7 @@ from typing import Any, Protocol, cast
 
 from ..errors import cannot_read
 from . import ulog_layouts
+from .held_file import Buffer
 from .model import FormatDiff, UorbClass, ulog_runtime
 from .records import InputError
 from .ulog_index import gather, record_offsets
@@ -93,7 +93,7 @@ class UlogColumns:
     the log then uses as it is and closes.
     """
 
-    def __init__(self, path: Path, name: str, model: UorbClass, source: mmap.mmap | None = None) -> None:
+    def __init__(self, path: Path, name: str, model: UorbClass, source: Buffer | None = None) -> None:
         import numpy  # noqa: F401  (columns need numpy; fail here, with the file named, if absent)
 
         self.name = name

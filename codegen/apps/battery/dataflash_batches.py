@@ -37,12 +37,16 @@ FIELDS = (
 )
 
 
+INSTANCE_MAX = 255  # AP_BattMonitor logs its instance as a uint8 ('B' in its FMT)
+
+
 def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
     """Every battery instance of a DataFlash log as a batch with its concepts filled."""
     log = open_log(path, name)
     readings: dict[int, list[BatteryRecord]] = {}
     arming: list[ArmingRecord] = []
     clock: GpsClock | None = None
+    left_out: list[int] = []
     start = LogStart(None, None, None)
     for item in timed_flight_records(log):
         if isinstance(item, LogStart):
@@ -51,8 +55,10 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
             arming.append(item)
         elif isinstance(item, GpsClock):
             clock = clock or item
-        else:
+        elif 0 <= item.instance <= INSTANCE_MAX:
             readings.setdefault(item.instance, []).append(item)
+        else:  # a crafted or damaged record: cast, it would join another battery's readings
+            left_out.append(item.instance)
     origin_us = start.time_us or 0
     parameters = {} if start.log_disarmed is None else {"LOG_DISARMED": start.log_disarmed}
     initially = armed_at_start(parameters, arming[0].armed if arming else None)
@@ -85,6 +91,11 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
             batch.time_us = np.round(t * 1e6).astype(np.int64) + origin_us + batch.utc_offset_us
         batch.armed = as_of(arm_t, arm_v, t)
         batch.context = context
+        if left_out and not out:
+            batch.warnings.append(
+                f"{name}: {len(left_out)} battery record(s) left out whose instance is no battery's "
+                f"(0..{INSTANCE_MAX}): {', '.join(map(str, left_out[:5]))}{' ...' if len(left_out) > 5 else ''}"
+            )
         if log.skipped_notes:
             batch.notes.append(f"{len(log.skipped_notes)} notes from the DataFlash reader (skipped data)")
         out.append(batch)

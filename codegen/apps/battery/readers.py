@@ -4,10 +4,10 @@ the others through :mod:`.sources`."""
 
 from __future__ import annotations
 
-import mmap
 from collections.abc import Iterator
 from pathlib import Path
 
+from ...inputs.held_file import Buffer, held, whole
 from .can_batches import can_batches
 from .catalog import Catalog
 from .dataflash_batches import dataflash_batches
@@ -25,22 +25,26 @@ def read_log(
     name: str,
     catalog: Catalog,
     message: str | None = None,
-    source: mmap.mmap | None = None,
+    source: Buffer | None = None,
     all_fields: bool = True,
 ) -> Iterator[Batch]:
     """The battery batches of one log, one at a time (a ULog's in chunks: memory stays flat). Raises
     InputError (or another BattgenError) if unreadable. ``source``: a memory map of a ULog file the
     caller holds (the log closes it); without ``all_fields`` a ULog batch holds only the fields the
     mapping reads (and the timestamp); ``message``: that of JSON Lines records (None: told from
-    their keys)."""
+    their keys). The file is held still while it is read (:mod:`...inputs.held_file`): a program
+    that rewrites it meanwhile makes this raise FileChanged, never a crash."""
     kind = log_kind(path)
-    if kind == "ulog":
-        yield from ulog_batches(path, name, catalog, source, all_fields)
-    elif kind == "tlog":
-        yield from tlog_batches(path, name, catalog)
-    elif kind == "dataflash":
-        yield from dataflash_batches(path, name, catalog)
-    elif kind == "can":
-        yield from can_batches(path, name, catalog, model_of)
-    else:
-        yield from jsonl_batches(path, name, catalog, message)
+    with held(path, name) as hold:
+        if kind == "ulog":
+            if source is None and not hold.leased:  # unheld, a map could end in SIGBUS: read it whole
+                source = whole(path, name)
+            yield from ulog_batches(path, name, catalog, source, all_fields)
+        elif kind == "tlog":
+            yield from tlog_batches(path, name, catalog)
+        elif kind == "dataflash":
+            yield from dataflash_batches(path, name, catalog)
+        elif kind == "can":
+            yield from can_batches(path, name, catalog, model_of)
+        else:
+            yield from jsonl_batches(path, name, catalog, message)

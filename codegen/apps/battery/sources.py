@@ -10,7 +10,6 @@ and JSON Lines (.jsonl/.ndjson) read record by record through the shared readers
 
 from __future__ import annotations
 
-import mmap
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +21,7 @@ from ...backends.python import naming
 from ...errors import BattgenError
 from ...inputs.dataflash import shortest_float32
 from ...inputs.documents import read_jsonl
+from ...inputs.held_file import Buffer
 from ...inputs.kinds import LOG_KINDS, detect
 from ...inputs.model import MessageClass, UorbClass
 from ...inputs.records import InputError, Record, Unreadable
@@ -51,6 +51,7 @@ class Batch:
     utc_offset_us: int | None = None  # the log's clock + this = µs since the epoch (None: unknown)
     vehicle_type: int | None = None  # MAVLink MAV_TYPE of the vehicle, where the log says (a tlog's HEARTBEAT)
     notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # records left out, and why: for the user, not only the record
     context: LogContext | None = None  # what the log says about itself, one object for all its batches
 
 
@@ -74,9 +75,7 @@ def model_of(catalog: Catalog, qualified: str) -> MessageClass:
 # -- ULog ------------------------------------------------------------------------------------------
 
 
-def ulog_batches(
-    path: Path, name: str, catalog: Catalog, source: mmap.mmap | None, all_fields: bool
-) -> Iterator[Batch]:
+def ulog_batches(path: Path, name: str, catalog: Catalog, source: Buffer | None, all_fields: bool) -> Iterator[Batch]:
     model = model_of(catalog, "uorb.BatteryStatus")
     fields = None if all_fields else catalog.source(model.QUALIFIED_NAME).fields
     if not isinstance(model, UorbClass):
@@ -177,30 +176,91 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
     return out
 
 
-def jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None) -> list[Batch]:
+JSONL_CHUNK = 1 << 16  # records per batch of a JSON Lines file: memory stays flat whatever its length
+_LISTED = 10  # records left out that a batch's notes name one by one (the rest are counted)
+
+
+def jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None) -> Iterator[Batch]:
+    """A JSON Lines file's records in batches of :data:`JSONL_CHUNK`. A record whose integer does not fit its
+    field's type (a uORB ``id`` of 2^32 + 1) is left out with a note naming it: cast, it would wrap into another
+    battery's number."""
+    qualified: str | None = message
     records: list[Record] = []
+    first_stamp: float | None = None
     for item in read_jsonl(path, name):
         if isinstance(item, Unreadable):
             raise InputError(name, item.line, item.message)
         if isinstance(item, Record):
+            qualified = qualified or guess_message(catalog, item, name)
             records.append(item)
-    if not records:
-        return []
-    qualified = message or guess_message(catalog, records[0], name)
+            if len(records) == JSONL_CHUNK:
+                batch, first_stamp = _jsonl_batch(catalog, qualified, records, name, first_stamp)
+                yield batch
+                records = []
+    if records and qualified is not None:
+        yield _jsonl_batch(catalog, qualified, records, name, first_stamp)[0]
+
+
+def _jsonl_batch(
+    catalog: Catalog, qualified: str, records: list[Record], name: str, first: float | None
+) -> tuple[Batch, float | None]:
+    """One batch of JSON Lines records and the timestamp its ``t`` counts from: the first batch's smallest
+    (``first``, once an earlier batch had one)."""
     model = model_of(catalog, qualified)
+    message = catalog.schema.message(qualified)
+    limits = integer_limits(message)
     instances = []
+    notes: list[str] = []
+    left_out = 0
     for rec in records:
         try:
-            instances.append(model.from_dict(rec.data))
+            instance = model.from_dict(rec.data)
         except (ValueError, TypeError, KeyError) as exc:
             raise InputError(name, rec.line, f"expected a {qualified} record: {exc}") from None
-    columns = instances_to_columns(catalog.schema.message(qualified), instances)
+        unfit = _unfit(instance, limits)
+        if unfit is not None:
+            left_out += 1
+            if left_out <= _LISTED:
+                notes.append(f"{name}:{rec.line}: {unfit}: record left out")
+            continue
+        instances.append(instance)
+    if left_out > _LISTED:
+        notes.append(f"{name}: {left_out - _LISTED} more records left out whose integers do not fit their types")
+    columns = instances_to_columns(message, instances)
     n = len(instances)
     t = np.full(n, np.nan)
     stamps = columns.get("timestamp")
+    origin = first
     if stamps is not None and stamps.ndim == 1 and stamps.dtype != object and n:
-        t = (stamps - stamps.min()) / 1e6
-    return [Batch(qualified, n, columns, t, np.zeros(n, np.int64))]
+        origin = float(stamps.min()) if first is None else first
+        t = (stamps - origin) / 1e6
+    return Batch(qualified, n, columns, t, np.zeros(n, np.int64), warnings=notes), origin
+
+
+Limits = list[tuple[str, str, int, int]]  # (attribute, type name, lowest, highest) of each integer field
+
+
+def integer_limits(message: Message) -> Limits:
+    """The integer fields of a message (and arrays of them) with the range of their IR type."""
+    out: Limits = []
+    for f in message.fields:
+        ftype = f.type.element if isinstance(f.type, ArrayType) else f.type
+        if f.is_padding or not isinstance(ftype, PrimitiveType):
+            continue
+        if ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT):
+            lo, hi = cast(tuple[int, int], ftype.value_range)
+            out.append((naming.field_identifier(f.name, f.pattern), ftype.name, lo, hi))
+    return out
+
+
+def _unfit(instance: object, limits: Limits) -> str | None:
+    """The first integer of a record outside its field's type, said as validate says it; None if all fit."""
+    for attr, type_name, lo, hi in limits:
+        value = getattr(instance, attr)
+        for v in value if isinstance(value, list) else (value,):
+            if isinstance(v, int) and not isinstance(v, bool) and not lo <= v <= hi:
+                return f"{attr} = {v} does not fit {type_name} ({lo}..{hi})"
+    return None
 
 
 def guess_message(catalog: Catalog, record: Record, name: str) -> str:

@@ -17,13 +17,13 @@ instance (:func:`battery_of`).
 from __future__ import annotations
 
 import functools
-import mmap
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ...inputs.held_file import Buffer
 from .catalog import Catalog, bundled_catalog
 from .columnar import convert_columns
 from .columns import ConceptColumn, NDArray
@@ -69,7 +69,7 @@ def read_view(
     *,
     catalog: Catalog | None = None,
     message: str | None = None,
-    source: mmap.mmap | None = None,
+    source: Buffer | None = None,
     all_fields: bool = False,
 ) -> Iterator[Chunk]:
     """The chunks of one log, in the order its source reads them (a ULog topic instance in chunks of records;

@@ -12,7 +12,7 @@ import xxhash
 ID_DIGITS = 16
 
 
-def content_id(path: Path, source: mmap.mmap | None = None, scheme: str = "xxh128") -> str:
+def content_id(path: Path, source: mmap.mmap | bytes | None = None, scheme: str = "xxh128") -> str:
     """The stable id of a file's content: the first hex digits of its XXH3-128 (``xxh128sum``'s),
     or of its SHA-256 (``sha256sum``'s) in a dataset made before battgen chose XXH3 (see
     :func:`.dataset.content_scheme`).
@@ -32,11 +32,34 @@ def content_id(path: Path, source: mmap.mmap | None = None, scheme: str = "xxh12
     return str(digest.hexdigest())[:ID_DIGITS]
 
 
-def map_file(path: Path) -> mmap.mmap | None:
+def prefix_id(path: Path, size: int, source: mmap.mmap | bytes | None = None, scheme: str = "xxh128") -> str:
+    """:func:`content_id` of the first ``size`` bytes of a file: the id an earlier, shorter copy of it had."""
+    digest: Any = hashlib.sha256() if scheme == "sha256" else xxhash.xxh3_128()
+    if source is not None:
+        digest.update(memoryview(source)[:size])
+    else:
+        with path.open("rb") as f:
+            left = size
+            while left > 0:
+                block = f.read(min(left, 1 << 20))
+                if not block:
+                    break
+                digest.update(block)
+                left -= len(block)
+    return str(digest.hexdigest())[:ID_DIGITS]
+
+
+def map_file(path: Path, held: bool = True) -> mmap.mmap | bytes | None:
     """A read-only memory map of a ULog file, for hashing and reading it in one pass (None for
-    other kinds, and where a file cannot be mapped: empty, a pipe...)."""
+    other kinds, and where a file cannot be mapped: empty, a pipe...); the file read whole where it
+    is not ``held`` still (:mod:`...inputs.held_file`: a map of a file truncated meanwhile is a SIGBUS)."""
     if path.suffix.lower() != ".ulg":
         return None
+    if not held:
+        try:
+            return path.read_bytes()
+        except OSError:
+            return None  # the reader opens it again and says why it cannot
     try:
         with path.open("rb") as f:
             return mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)

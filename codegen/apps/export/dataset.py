@@ -24,6 +24,7 @@ refused, never replaced by defaults (the layout and log ids of every later run d
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import os
@@ -31,7 +32,7 @@ import secrets
 import shutil
 import tempfile
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -39,7 +40,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from ...errors import BattgenError
+from ...errors import BattgenError, OutputError
 from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..battery.sources import Batch
 from .durable import TMP_PREFIX, fsync_dir, fsync_file, write_atomic
@@ -264,9 +265,10 @@ class LogWriter:
     last (see the module docstring); :meth:`abort` leaves nothing behind."""
 
     def __init__(self, out: Path, log: str, schema: Any) -> None:
-        out.mkdir(parents=True, exist_ok=True)
         self.out, self.log, self.schema = out, log, schema
-        self.tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{log}-", dir=out))
+        with self.writing():
+            out.mkdir(parents=True, exist_ok=True)
+            self.tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{log}-", dir=out))
         self._writers: dict[str, Any] = {}  # "" for the battery table, else the raw table's message
         self._pending: dict[str, list[Any]] = {}  # tables not yet written, by writer key
         self.rows = 0
@@ -279,14 +281,25 @@ class LogWriter:
             writer = self._writers[key] = pq.ParquetWriter(folder / "part-0.parquet", schema, **_options(schema))
         return writer
 
+    @contextlib.contextmanager
+    def writing(self) -> Iterator[None]:
+        """The dataset's own failures (a full disk, a read-only folder) as OutputError: the run stops there,
+        rather than count the log being written as unreadable and go on to fail the next."""
+        try:
+            yield
+        except OSError as exc:
+            raise OutputError.of(exc.filename or self.out, exc) from None
+
     def add(self, table: Any) -> None:
         """Rows of the battery table."""
-        self._add("", table)
+        with self.writing():
+            self._add("", table)
         self.rows += table.num_rows
 
     def add_raw(self, message: str, table: Any) -> None:
         """Rows of ``message``'s raw table (--raw)."""
-        self._add(message, table)
+        with self.writing():
+            self._add(message, table)
 
     def _add(self, key: str, table: Any) -> None:
         """Tables are written in row groups of about ROW_GROUP rows: small ones cost per column."""
@@ -312,6 +325,12 @@ class LogWriter:
         ``partition``: the log's folder under each table (:func:`partition_of`; default ``log=<id>``)."""
         where = partition or f"log={self.log}"
         version = new_version()
+        with self.writing():
+            self._commit(manifest, tables, where, version)
+
+    def _commit(
+        self, manifest: dict[str, object], tables: Sequence[tuple[str, dict[str, Any]]], where: str, version: str
+    ) -> None:
         try:
             for key in list(self._pending):
                 self._flush(key)

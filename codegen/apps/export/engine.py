@@ -8,9 +8,9 @@ is reported in its :class:`LogResult` and the run goes on.
 
 from __future__ import annotations
 
-import concurrent.futures
 import dataclasses
 import datetime
+import functools
 import mmap
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -20,12 +20,13 @@ from typing import Any
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from ...errors import BattgenError, cannot_read
+from ...errors import BattgenError, OutputError, cannot_read
+from ...inputs.held_file import held
 from ..battery.catalog import bundled_catalog
 from ..battery.sources import Batch, log_kind
 from ..battery.view import read_view
 from ..failsafe.logs import SampleTable
-from .content import content_id, map_file
+from .content import content_id, map_file, prefix_id
 from .dataflash_raw import dataflash_raw_tables
 from .dataset import (
     LogWriter,
@@ -38,9 +39,10 @@ from .dataset import (
 )
 from .durable import writers_lock
 from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, replay_tables
-from .manifest import sweep
+from .manifest import exported_sources, retire, sweep
 from .table import battery_schema, battery_table
 from .views import write_views
+from .workers import run_pooled
 
 
 @dataclass(frozen=True)
@@ -53,6 +55,7 @@ class ExportOptions:
     failsafe: FailsafeOptions | None = None  # --failsafe: replay each log through the battery failsafe
     partition: str = "log"  # "log" or "day" (see .dataset)
     content_id: str | None = None  # the hash naming logs (None: the dataset's, .dataset.content_scheme)
+    earlier: tuple[tuple[str, str, int], ...] = ()  # (source, log, bytes) of the logs in the dataset at the start
 
 
 @dataclass(frozen=True)
@@ -65,13 +68,25 @@ class LogResult:
     log: str = ""
     rows: int = 0
     error: str = ""
+    replaced: str = ""  # the log this one replaces: an earlier export of the same file, shorter then
     notes: tuple[str, ...] = field(default=())
+    warnings: tuple[str, ...] = field(default=())  # records the export left out, each said once (also in notes)
 
 
 def export_one(path: str, options: ExportOptions) -> LogResult:
     """Export one log into the dataset at ``options.out``; never raises for a bad log."""
     file = Path(path)
-    source = map_file(file)  # a ULog is hashed and read through one memory map
+    try:
+        with held(file, path) as hold:
+            return _export_held(file, path, options, map_file(file, hold.leased))
+    except OutputError:
+        raise  # the dataset cannot be written: the run stops (the CLI says where, in one line)
+    except BattgenError as exc:  # the file changed while it was read (FileChanged): nothing of it was kept
+        return LogResult(path, "failed", error=str(exc))
+
+
+def _export_held(file: Path, path: str, options: ExportOptions, source: mmap.mmap | bytes | None) -> LogResult:
+    """:func:`export_one` of a file held still; ``source``: a ULog is hashed and read through one memory map."""
     try:
         try:
             log = content_id(file, source, options.content_id or content_scheme(options.out))
@@ -80,7 +95,9 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
         if is_exported(options.out, log) and not _replay_missing(options, log):
             return LogResult(path, "skipped", log, notes=("already in the dataset",))
         try:
-            return _export(file, path, log, options, source)
+            return _export(file, path, log, options, source, _grown_from(file, source, options))
+        except OutputError:
+            raise
         except BattgenError as exc:
             return LogResult(path, "failed", log, error=str(exc))
         except (OSError, ValueError, MemoryError) as exc:  # a log the readers did not foresee
@@ -88,8 +105,23 @@ def export_one(path: str, options: ExportOptions) -> LogResult:
                 return LogResult(path, "skipped", log, notes=("the same content was exported by another task",))
             return LogResult(path, "failed", log, error=f"{path}: cannot export: {type(exc).__name__}: {exc}")
     finally:
-        if source is not None and not source.closed:
+        if isinstance(source, mmap.mmap) and not source.closed:
             source.close()
+
+
+def _grown_from(file: Path, source: mmap.mmap | bytes | None, options: ExportOptions) -> str | None:
+    """The log this file grew from: an earlier export of a file of the same name whose content is this one's
+    start (a tlog downloaded again with more frames). Its id is the hash of those bytes, so a match is that
+    content, not a name alone."""
+    try:
+        size = file.stat().st_size
+    except OSError:
+        return None
+    scheme = options.content_id or content_scheme(options.out)
+    for name, log, earlier_size in options.earlier:
+        if name == file.name and 0 < earlier_size < size and prefix_id(file, earlier_size, source, scheme) == log:
+            return log
+    return None
 
 
 def _replay_missing(options: ExportOptions, log: str) -> bool:
@@ -100,14 +132,18 @@ def _replay_missing(options: ExportOptions, log: str) -> bool:
     return manifest is None or manifest.get("failsafe") != options.failsafe.key
 
 
-def _export(file: Path, name: str, log: str, options: ExportOptions, source: mmap.mmap | None) -> LogResult:
+def _export(
+    file: Path, name: str, log: str, options: ExportOptions, source: mmap.mmap | bytes | None, grown: str | None
+) -> LogResult:
     """The batches stream through: each converted, its rows written, and let go (a log of any length
     in flat memory); the failsafe replay keeps what it needs of each (its context, not its columns)."""
+    size = len(source) if source is not None else file.stat().st_size  # before the reader closes the map
     catalog = bundled_catalog()
     schema = battery_schema(catalog)
     kind = log_kind(file)
     writer = LogWriter(options.out, log, schema)
     notes: list[str] = []
+    warnings: list[str] = []
     messages: set[str] = set()
     replay = SampleTable()  # what the failsafe replay needs of each chunk (not its columns)
     clock: Batch | None = None  # a batch of the log, for the replay's time of day
@@ -123,6 +159,7 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
                 writer.add_raw(batch.message, raw_table(catalog.schema.message(batch.message), batch, log))
             messages.add(batch.message)
             notes.extend(n for n in batch.notes if n not in notes)
+            warnings.extend(batch.warnings)
             if options.partition == "day" and table.num_rows:  # only a day partition needs it
                 first = pc.min(table["time"].cast(pa.int64())).as_py()
                 if first is not None:
@@ -148,19 +185,34 @@ def _export(file: Path, name: str, log: str, options: ExportOptions, source: mma
             notes.append(replayed)
         else:
             extra.append((FAILSAFE, {EVENTS_FILE: replayed[0], REPLAYS_FILE: replayed[1]}))
+    if grown is not None:
+        notes.append(f"replaces log {grown}: an earlier export of {file.name}, which this file continues")
     manifest: dict[str, object] = {
         "log": log,
         "source": file.name,
+        "bytes": size,
         "rows": writer.rows,
         "messages": sorted(messages),
-        "notes": notes,
+        "notes": notes + warnings,
     }
     if options.failsafe is not None:
         manifest["failsafe"] = options.failsafe.key
     where = partition_of(options.partition, log, utc_day(first_us))
     manifest["partition"] = where
+    if grown is not None:
+        manifest["replaces"] = grown  # the commit that shows this log hides the one it continues
     writer.commit(manifest, extra, where)
-    return LogResult(name, "exported", log, writer.rows, notes=tuple(notes))
+    if grown is not None:
+        retire(options.out, grown)
+    return LogResult(
+        name,
+        "exported",
+        log,
+        writer.rows,
+        replaced=grown or "",
+        notes=tuple(notes + warnings),
+        warnings=tuple(warnings),
+    )
 
 
 def utc_day(us: int | None) -> str | None:
@@ -200,7 +252,8 @@ def start(options: ExportOptions) -> ExportOptions:
     """The start of a run, under the writers' lock: leftovers of a stopped run removed, the layout
     claimed (:func:`.dataset.claim_layout`); the options with the dataset's content id."""
     sweep(options.out)
-    return dataclasses.replace(options, content_id=claim_layout(options.out, options.partition, options.content_id))
+    scheme = claim_layout(options.out, options.partition, options.content_id)
+    return dataclasses.replace(options, content_id=scheme, earlier=exported_sources(options.out))
 
 
 def _run(paths: list[str], options: ExportOptions, jobs: int) -> Iterator[LogResult]:
@@ -208,10 +261,11 @@ def _run(paths: list[str], options: ExportOptions, jobs: int) -> Iterator[LogRes
         for p in paths:
             yield export_one(p, options)
         return
-    with concurrent.futures.ProcessPoolExecutor(max_workers=jobs) as pool:
-        futures = [pool.submit(export_one, p, options) for p in paths]
-        for fut in concurrent.futures.as_completed(futures):
-            yield fut.result()
+    yield from run_pooled(functools.partial(export_one, options=options), paths, jobs, _died)
+
+
+def _died(path: str, why: str) -> LogResult:
+    return LogResult(path, "failed", error=f"{path}: {why}")
 
 
 def count(results: Iterable[LogResult], status: str) -> int:

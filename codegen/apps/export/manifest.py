@@ -68,13 +68,41 @@ def marker_files(out: Path, manifest: Mapping[str, Any]) -> dict[str, list[str]]
     return {key: [f for f in names if (out / f).is_file()] for key, names in legacy.items()}
 
 
+def _current(markers: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The markers of logs no other marker replaces (a log exported again once it grew: :func:`retire`)."""
+    replaced = {str(m["replaces"]) for m in markers if m.get("replaces")}
+    return [m for m in markers if str(m.get("log")) not in replaced]
+
+
 def committed(out: Path) -> dict[str, list[str]]:
     """Every committed file of the dataset at ``out`` (relative paths, sorted), by :data:`FILE_KEYS` key."""
     files: dict[str, list[str]] = {key: [] for key in FILE_KEYS}
-    for manifest in _markers(out):
+    for manifest in _current(_markers(out)):
         for key, names in marker_files(out, manifest).items():
             files.setdefault(key, []).extend(names)
     return {key: sorted(names) for key, names in files.items()}
+
+
+def exported_sources(out: Path) -> tuple[tuple[str, str, int], ...]:
+    """(source file name, log id, its size in bytes) of every current log whose marker records its size."""
+    found = []
+    for m in _current(_markers(out)):
+        size = m.get("bytes")
+        if isinstance(size, int) and isinstance(m.get("source"), str):
+            found.append((str(m["source"]), str(m.get("log")), size))
+    return tuple(found)
+
+
+def retire(out: Path, log: str) -> None:
+    """Remove a log that another's marker replaces: its marker first (the replacing marker already hides it
+    from readers, so a stop in between changes nothing they see), then its files."""
+    old = read_marker(out, log)
+    if old is None:
+        return
+    marker(out, log).unlink(missing_ok=True)
+    for names in marker_files(out, old).values():
+        for rel in names:
+            (out / rel).unlink(missing_ok=True)
 
 
 def sweep(out: Path) -> int:
@@ -88,6 +116,10 @@ def sweep(out: Path) -> int:
             else:
                 path.unlink(missing_ok=True)
             removed += 1
+    markers = _markers(out)
+    for replaced in {str(m.get("log")) for m in markers} - {str(m.get("log")) for m in _current(markers)}:
+        retire(out, replaced)  # a run stopped between a grown log's commit and the removal of what it replaced
+        removed += 1
     keep = {name for names in committed(out).values() for name in names}
     for table in TABLE_FOLDERS:
         for path in (out / table).rglob("*.parquet") if (out / table).is_dir() else []:

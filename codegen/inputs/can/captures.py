@@ -15,13 +15,16 @@ failure on a damaged file is an :class:`InputError` naming the file and the fram
 from __future__ import annotations
 
 import importlib
+import struct
 import time
+import zlib
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 from ..dataflash import open_log
 from ..records import InputError
+from .bounded import bounded_reader
 from .candump_screen import read_screen, screen_stamp
 from .reassembly import Frame
 
@@ -52,7 +55,7 @@ def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: b
             message = next(messages)
         except StopIteration:
             return
-        except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError) as exc:
+        except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError, zlib.error) as exc:
             # a damaged capture: the third-party reader's own complaint, located at the frame (or line) it reached
             # (the reader's exception text, "too many values to unpack", speaks of its code, not of the file)
             if one_per_line:
@@ -61,15 +64,22 @@ def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: b
                 name, 0, f"expected {what} frames after frame {index}, found bytes python-can cannot read"
             ) from exc
         read += 1
+        kind = "error" if message.is_error_frame else "remote" if message.is_remote_frame else "data"
+        data = bytes(message.data)
+        if kind == "data" and not _fits(len(data), bool(message.is_fd)):
+            kind_text = (
+                "CAN FD frame (0..8, 12, 16, 20, 24, 32, 48 or 64)" if message.is_fd else "classic CAN frame (0..8)"
+            )
+            found = f"frame {index}: {len(data)} data bytes: expected a {kind_text}"
+            raise InputError(name, read if one_per_line else 0, found)
         stamp = float(message.timestamp or 0.0)
         if t0 is None:
             t0 = stamp
-        kind = "error" if message.is_error_frame else "remote" if message.is_remote_frame else "data"
         yield Frame(
             index,
             stamp - t0,
             int(message.arbitration_id),
-            b"" if kind != "data" else bytes(message.data),
+            b"" if kind != "data" else data,
             bool(message.is_extended_id),
             bool(message.is_fd),
             str(message.channel or ""),
@@ -78,12 +88,19 @@ def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: b
         index += 1
 
 
+def _fits(length: int, fd: bool) -> bool:
+    """Whether a frame's data length is one its kind can carry (an FD length is one of the DLC table's)."""
+    return length in _FD_LENGTHS if fd else length <= 8
+
+
 def _log_reader(path: Path, name: str) -> Any:
-    """python-can's log reader for the capture's suffix (InputError if it cannot open it)."""
+    """python-can's log reader for the capture's suffix, fed through :mod:`.bounded` (sizes checked before they
+    are trusted); InputError if it cannot open it."""
     can = _python_can(name)
     try:
-        return can.LogReader(str(path))
-    except (ValueError, OSError) as exc:
+        reader = bounded_reader(can, path, name)
+        return reader if reader is not None else can.LogReader(str(path))
+    except (ValueError, OSError, EOFError, zlib.error, struct.error, can.CanError) as exc:
         raise InputError(name, 0, f"cannot open the CAN capture: {exc}") from exc
 
 
@@ -127,7 +144,7 @@ def capture_start(path: Path, name: str) -> float | None:
     reader = _log_reader(path, name)
     try:
         first = next(iter(reader), None)
-    except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError):
+    except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError, zlib.error, InputError):
         return None  # the frame readers report the damage
     finally:
         stop = getattr(reader, "stop", None)
