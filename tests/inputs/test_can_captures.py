@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from can_logs import write_capture
 from dataflash_writer import DataflashWriter
 
 from codegen.cli.main import main
@@ -67,14 +68,7 @@ def _messages(*, aux_after: bool = False, corrupt_transfer: int | None = None) -
 WRITERS = {".log": "CanutilsLogWriter", ".asc": "ASCWriter", ".blf": "BLFWriter", ".trc": "TRCWriter"}
 
 
-def _write(path: Path, messages: list[Any]) -> Path:
-    writer = can.Logger(str(path))
-    try:
-        for m in messages:
-            writer.on_message_received(m)
-    finally:
-        writer.stop()
-    return path
+_write = write_capture
 
 
 def _validate(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, dict[str, Any], str]:

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from can_logs import write_capture
 
 from codegen.apps.can_types import shipped_tree, standard_types
 from codegen.cli.main import main
@@ -47,13 +48,7 @@ def _capture(path: Path, *, damage: int | None = None) -> Path:
                 data = bytes([data[0] ^ 0x33]) + data[1:]  # the transfer CRC's low byte
             t += 0.001
             messages.append(can.Message(timestamp=t, arbitration_id=frame.message_id, is_extended_id=True, data=data))
-    writer = can.Logger(str(path))
-    try:
-        for m in messages:
-            writer.on_message_received(m)
-    finally:
-        writer.stop()
-    return path
+    return write_capture(path, messages)
 
 
 def _report(capsys: pytest.CaptureFixture[str], path: Path) -> tuple[int, dict[str, Any]]:
