@@ -160,6 +160,25 @@ def f16s(x: float) -> int:
     return f16bits(u)
 
 
+def f16_saturated(x: float) -> float:
+    """A saturated float16 field's value before rounding: a finite value beyond +-65504 clamps to it;
+    infinity and NaN are kept (as :func:`f16s`)."""
+    if F16_MAX < x < INF:
+        return F16_MAX
+    if -INF < x < -F16_MAX:
+        return -F16_MAX
+    return x
+
+
+def f16_truncated(x: float) -> float:
+    """A truncated float16 field's value before rounding: beyond +-65504 it is infinity (as :func:`f16t`)."""
+    if x > F16_MAX:
+        return INF
+    if x < -F16_MAX:
+        return -INF
+    return x
+
+
 def f16t(x: float) -> int:
     """Bits of a truncated float16: a value beyond +-65504 becomes infinity (before rounding, as the
     reference casts); NaN is kept."""

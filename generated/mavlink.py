@@ -514,6 +514,33 @@ _BATTERY_INFO_FULL_CHARGE_CAPACITY_SPEC = _v.Number(
 _BATTERY_INFO_MANUFACTURE_DATE_SPEC = _v.Text(capacity=9)
 _BATTERY_INFO_SERIAL_NUMBER_SPEC = _v.Text(capacity=32)
 _BATTERY_INFO_NAME_SPEC = _v.Text(capacity=50)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_INFO_FIELD_SPECS = (
+    ("id", "id", _BATTERY_INFO_ID_SPEC),
+    ("battery_function", "battery_function", _BATTERY_INFO_BATTERY_FUNCTION_SPEC),
+    ("type", "type", _BATTERY_INFO_TYPE_SPEC),
+    ("state_of_health", "state_of_health", _BATTERY_INFO_STATE_OF_HEALTH_SPEC),
+    ("cells_in_series", "cells_in_series", _BATTERY_INFO_CELLS_IN_SERIES_SPEC),
+    ("cycle_count", "cycle_count", _BATTERY_INFO_CYCLE_COUNT_SPEC),
+    ("weight", "weight", _BATTERY_INFO_WEIGHT_SPEC),
+    ("discharge_minimum_voltage", "discharge_minimum_voltage", _BATTERY_INFO_DISCHARGE_MINIMUM_VOLTAGE_SPEC),
+    ("charging_minimum_voltage", "charging_minimum_voltage", _BATTERY_INFO_CHARGING_MINIMUM_VOLTAGE_SPEC),
+    ("resting_minimum_voltage", "resting_minimum_voltage", _BATTERY_INFO_RESTING_MINIMUM_VOLTAGE_SPEC),
+    ("charging_maximum_voltage", "charging_maximum_voltage", _BATTERY_INFO_CHARGING_MAXIMUM_VOLTAGE_SPEC),
+    ("charging_maximum_current", "charging_maximum_current", _BATTERY_INFO_CHARGING_MAXIMUM_CURRENT_SPEC),
+    ("nominal_voltage", "nominal_voltage", _BATTERY_INFO_NOMINAL_VOLTAGE_SPEC),
+    ("discharge_maximum_current", "discharge_maximum_current", _BATTERY_INFO_DISCHARGE_MAXIMUM_CURRENT_SPEC),
+    (
+        "discharge_maximum_burst_current",
+        "discharge_maximum_burst_current",
+        _BATTERY_INFO_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
+    ),
+    ("design_capacity", "design_capacity", _BATTERY_INFO_DESIGN_CAPACITY_SPEC),
+    ("full_charge_capacity", "full_charge_capacity", _BATTERY_INFO_FULL_CHARGE_CAPACITY_SPEC),
+    ("manufacture_date", "manufacture_date", _BATTERY_INFO_MANUFACTURE_DATE_SPEC),
+    ("serial_number", "serial_number", _BATTERY_INFO_SERIAL_NUMBER_SPEC),
+    ("name", "name", _BATTERY_INFO_NAME_SPEC),
+)
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
@@ -647,6 +674,23 @@ _BATTERY_STATUS_FAULT_BITMASK_SPEC = _v.Number(
         0x100: "BATTERY_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION",
     },
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_STATUS_FIELD_SPECS = (
+    ("id", "id", _BATTERY_STATUS_ID_SPEC),
+    ("battery_function", "battery_function", _BATTERY_STATUS_BATTERY_FUNCTION_SPEC),
+    ("type", "type", _BATTERY_STATUS_TYPE_SPEC),
+    ("temperature", "temperature", _BATTERY_STATUS_TEMPERATURE_SPEC),
+    ("voltages", "voltages", _BATTERY_STATUS_VOLTAGES_SPEC),
+    ("current_battery", "current_battery", _BATTERY_STATUS_CURRENT_BATTERY_SPEC),
+    ("current_consumed", "current_consumed", _BATTERY_STATUS_CURRENT_CONSUMED_SPEC),
+    ("energy_consumed", "energy_consumed", _BATTERY_STATUS_ENERGY_CONSUMED_SPEC),
+    ("battery_remaining", "battery_remaining", _BATTERY_STATUS_BATTERY_REMAINING_SPEC),
+    ("time_remaining", "time_remaining", _BATTERY_STATUS_TIME_REMAINING_SPEC),
+    ("charge_state", "charge_state", _BATTERY_STATUS_CHARGE_STATE_SPEC),
+    ("voltages_ext", "voltages_ext", _BATTERY_STATUS_VOLTAGES_EXT_SPEC),
+    ("mode", "mode", _BATTERY_STATUS_MODE_SPEC),
+    ("fault_bitmask", "fault_bitmask", _BATTERY_STATUS_FAULT_BITMASK_SPEC),
+)
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
@@ -751,6 +795,17 @@ _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC = _v.Number(
         0x40000: "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL",
         0x80000000: "MAV_BATTERY_STATUS_FLAGS_EXTENDED",
     },
+)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_STATUS_V2_FIELD_SPECS = (
+    ("id", "id", _BATTERY_STATUS_V2_ID_SPEC),
+    ("temperature", "temperature", _BATTERY_STATUS_V2_TEMPERATURE_SPEC),
+    ("voltage", "voltage", _BATTERY_STATUS_V2_VOLTAGE_SPEC),
+    ("current", "current", _BATTERY_STATUS_V2_CURRENT_SPEC),
+    ("capacity_consumed", "capacity_consumed", _BATTERY_STATUS_V2_CAPACITY_CONSUMED_SPEC),
+    ("capacity_remaining", "capacity_remaining", _BATTERY_STATUS_V2_CAPACITY_REMAINING_SPEC),
+    ("state_of_charge", "state_of_charge", _BATTERY_STATUS_V2_STATE_OF_CHARGE_SPEC),
+    ("status_flags", "status_flags", _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC),
 )
 
 
@@ -898,6 +953,15 @@ _HEARTBEAT_SYSTEM_STATUS_SPEC = _v.Number(
     },
 )
 _HEARTBEAT_MAVLINK_VERSION_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+# (schema name, attribute, spec) of each field, for the careful way
+_HEARTBEAT_FIELD_SPECS = (
+    ("type", "type", _HEARTBEAT_TYPE_SPEC),
+    ("autopilot", "autopilot", _HEARTBEAT_AUTOPILOT_SPEC),
+    ("base_mode", "base_mode", _HEARTBEAT_BASE_MODE_SPEC),
+    ("custom_mode", "custom_mode", _HEARTBEAT_CUSTOM_MODE_SPEC),
+    ("system_status", "system_status", _HEARTBEAT_SYSTEM_STATUS_SPEC),
+    ("mavlink_version", "mavlink_version", _HEARTBEAT_MAVLINK_VERSION_SPEC),
+)
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
@@ -943,6 +1007,14 @@ _PARAM_VALUE_PARAM_TYPE_SPEC = _v.Number(
 )
 _PARAM_VALUE_PARAM_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
 _PARAM_VALUE_PARAM_INDEX_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+# (schema name, attribute, spec) of each field, for the careful way
+_PARAM_VALUE_FIELD_SPECS = (
+    ("param_id", "param_id", _PARAM_VALUE_PARAM_ID_SPEC),
+    ("param_value", "param_value", _PARAM_VALUE_PARAM_VALUE_SPEC),
+    ("param_type", "param_type", _PARAM_VALUE_PARAM_TYPE_SPEC),
+    ("param_count", "param_count", _PARAM_VALUE_PARAM_COUNT_SPEC),
+    ("param_index", "param_index", _PARAM_VALUE_PARAM_INDEX_SPEC),
+)
 
 
 # the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
@@ -1169,6 +1241,49 @@ _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_EXTENDED_SPEC = _v.Number(
         0x10: "MAV_SYS_STATUS_SENSOR_3D_GYRO4",
         0x20: "MAV_SYS_STATUS_SENSOR_3D_ACCEL4",
     },
+)
+# (schema name, attribute, spec) of each field, for the careful way
+_SYS_STATUS_FIELD_SPECS = (
+    (
+        "onboard_control_sensors_present",
+        "onboard_control_sensors_present",
+        _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_SPEC,
+    ),
+    (
+        "onboard_control_sensors_enabled",
+        "onboard_control_sensors_enabled",
+        _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_SPEC,
+    ),
+    (
+        "onboard_control_sensors_health",
+        "onboard_control_sensors_health",
+        _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_SPEC,
+    ),
+    ("load", "load", _SYS_STATUS_LOAD_SPEC),
+    ("voltage_battery", "voltage_battery", _SYS_STATUS_VOLTAGE_BATTERY_SPEC),
+    ("current_battery", "current_battery", _SYS_STATUS_CURRENT_BATTERY_SPEC),
+    ("battery_remaining", "battery_remaining", _SYS_STATUS_BATTERY_REMAINING_SPEC),
+    ("drop_rate_comm", "drop_rate_comm", _SYS_STATUS_DROP_RATE_COMM_SPEC),
+    ("errors_comm", "errors_comm", _SYS_STATUS_ERRORS_COMM_SPEC),
+    ("errors_count1", "errors_count1", _SYS_STATUS_ERRORS_COUNT1_SPEC),
+    ("errors_count2", "errors_count2", _SYS_STATUS_ERRORS_COUNT2_SPEC),
+    ("errors_count3", "errors_count3", _SYS_STATUS_ERRORS_COUNT3_SPEC),
+    ("errors_count4", "errors_count4", _SYS_STATUS_ERRORS_COUNT4_SPEC),
+    (
+        "onboard_control_sensors_present_extended",
+        "onboard_control_sensors_present_extended",
+        _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_EXTENDED_SPEC,
+    ),
+    (
+        "onboard_control_sensors_enabled_extended",
+        "onboard_control_sensors_enabled_extended",
+        _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_EXTENDED_SPEC,
+    ),
+    (
+        "onboard_control_sensors_health_extended",
+        "onboard_control_sensors_health_extended",
+        _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_EXTENDED_SPEC,
+    ),
 )
 
 
@@ -1654,41 +1769,28 @@ class BatteryInfo:
         out: list[_v.Violation] = []
         x: _Any
         try:
+            # id (battery.xml:266): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
-        try:
+            # battery_function (battery.xml:267): fits uint8; a value of MAV_BATTERY_FUNCTION
             if self.battery_function not in {0, 1, 2, 3, 4}:
                 _v.diag(out, "battery_function", self.battery_function, _BATTERY_INFO_BATTERY_FUNCTION_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_function", self.battery_function, _BATTERY_INFO_BATTERY_FUNCTION_SPEC)
-        try:
+            # type (battery.xml:268): fits uint8; a value of MAV_BATTERY_TYPE
             if self.type not in {0, 1, 2, 3, 4}:
                 _v.diag(out, "type", self.type, _BATTERY_INFO_TYPE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "type", self.type, _BATTERY_INFO_TYPE_SPEC)
-        try:
+            # state_of_health (battery.xml:269): fits uint8; UINT8_MAX means unknown (accepted)
             if self.state_of_health & -256:
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_INFO_STATE_OF_HEALTH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_INFO_STATE_OF_HEALTH_SPEC)
-        try:
+            # cells_in_series (battery.xml:270): fits uint8; 0 means unknown (accepted)
             if self.cells_in_series & -256:
                 _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_INFO_CELLS_IN_SERIES_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_INFO_CELLS_IN_SERIES_SPEC)
-        try:
+            # cycle_count (battery.xml:271): fits uint16; UINT16_MAX means unknown (accepted)
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_CYCLE_COUNT_SPEC)
-        try:
+            # weight (battery.xml:272): fits uint16; 0 means unknown (accepted)
             if self.weight & -65536:
                 _v.diag(out, "weight", self.weight, _BATTERY_INFO_WEIGHT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "weight", self.weight, _BATTERY_INFO_WEIGHT_SPEC)
-        try:
+            # discharge_minimum_voltage (battery.xml:273): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharge_minimum_voltage <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1696,14 +1798,7 @@ class BatteryInfo:
                     self.discharge_minimum_voltage,
                     _BATTERY_INFO_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_minimum_voltage",
-                self.discharge_minimum_voltage,
-                _BATTERY_INFO_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
-            )
-        try:
+            # charging_minimum_voltage (battery.xml:274): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.charging_minimum_voltage <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1711,14 +1806,7 @@ class BatteryInfo:
                     self.charging_minimum_voltage,
                     _BATTERY_INFO_CHARGING_MINIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charging_minimum_voltage",
-                self.charging_minimum_voltage,
-                _BATTERY_INFO_CHARGING_MINIMUM_VOLTAGE_SPEC,
-            )
-        try:
+            # resting_minimum_voltage (battery.xml:275): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.resting_minimum_voltage <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1726,11 +1814,7 @@ class BatteryInfo:
                     self.resting_minimum_voltage,
                     _BATTERY_INFO_RESTING_MINIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "resting_minimum_voltage", self.resting_minimum_voltage, _BATTERY_INFO_RESTING_MINIMUM_VOLTAGE_SPEC
-            )
-        try:
+            # charging_maximum_voltage (battery.xml:276): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.charging_maximum_voltage <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1738,14 +1822,7 @@ class BatteryInfo:
                     self.charging_maximum_voltage,
                     _BATTERY_INFO_CHARGING_MAXIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charging_maximum_voltage",
-                self.charging_maximum_voltage,
-                _BATTERY_INFO_CHARGING_MAXIMUM_VOLTAGE_SPEC,
-            )
-        try:
+            # charging_maximum_current (battery.xml:277): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.charging_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1753,19 +1830,10 @@ class BatteryInfo:
                     self.charging_maximum_current,
                     _BATTERY_INFO_CHARGING_MAXIMUM_CURRENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charging_maximum_current",
-                self.charging_maximum_current,
-                _BATTERY_INFO_CHARGING_MAXIMUM_CURRENT_SPEC,
-            )
-        try:
+            # nominal_voltage (battery.xml:278): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_NOMINAL_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_NOMINAL_VOLTAGE_SPEC)
-        try:
+            # discharge_maximum_current (battery.xml:279): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharge_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1773,14 +1841,7 @@ class BatteryInfo:
                     self.discharge_maximum_current,
                     _BATTERY_INFO_DISCHARGE_MAXIMUM_CURRENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_maximum_current",
-                self.discharge_maximum_current,
-                _BATTERY_INFO_DISCHARGE_MAXIMUM_CURRENT_SPEC,
-            )
-        try:
+            # discharge_maximum_burst_current (battery.xml:280): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharge_maximum_burst_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1788,42 +1849,27 @@ class BatteryInfo:
                     self.discharge_maximum_burst_current,
                     _BATTERY_INFO_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_maximum_burst_current",
-                self.discharge_maximum_burst_current,
-                _BATTERY_INFO_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
-            )
-        try:
+            # design_capacity (battery.xml:281): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_INFO_DESIGN_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_INFO_DESIGN_CAPACITY_SPEC)
-        try:
+            # full_charge_capacity (battery.xml:282): fits float32; NaN means unknown (accepted)
             x = self.full_charge_capacity
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_INFO_FULL_CHARGE_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_INFO_FULL_CHARGE_CAPACITY_SPEC)
-        try:
+            # manufacture_date (battery.xml:283): fits char[9]; [0] means unknown (accepted)
             x = self.manufacture_date
             if x.__class__ is not str or len(x.encode()) > 9:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_INFO_MANUFACTURE_DATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_INFO_MANUFACTURE_DATE_SPEC)
-        try:
+            # serial_number (battery.xml:284): fits char[32]; [0] means unknown (accepted)
             x = self.serial_number
             if x.__class__ is not str or len(x.encode()) > 32:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
-        try:
+            # name (battery.xml:285): fits char[50]; [0] means unknown (accepted)
             x = self.name
             if x.__class__ is not str or len(x.encode()) > 50:
                 _v.diag(out, "name", self.name, _BATTERY_INFO_NAME_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "name", self.name, _BATTERY_INFO_NAME_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_INFO_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -2293,26 +2339,19 @@ class BatteryStatus:
         e: _Any
         r_battery_remaining: _Any
         try:
+            # id (battery.xml:227): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
-        try:
+            # battery_function (battery.xml:228): fits uint8; a value of MAV_BATTERY_FUNCTION
             if self.battery_function not in {0, 1, 2, 3, 4}:
                 _v.diag(out, "battery_function", self.battery_function, _BATTERY_STATUS_BATTERY_FUNCTION_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_function", self.battery_function, _BATTERY_STATUS_BATTERY_FUNCTION_SPEC)
-        try:
+            # type (battery.xml:229): fits uint8; a value of MAV_BATTERY_TYPE
             if self.type not in {0, 1, 2, 3, 4}:
                 _v.diag(out, "type", self.type, _BATTERY_STATUS_TYPE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "type", self.type, _BATTERY_STATUS_TYPE_SPEC)
-        try:
+            # temperature (battery.xml:230): fits int16; INT16_MAX means unknown (accepted)
             if (self.temperature + 32768) & -65536:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
-        try:
+            # voltages (battery.xml:231): fits uint16[10]; [UINT16_MAX] means unknown (accepted)
             a = self.voltages
             if len(a) != 10:
                 _v.diag(out, "voltages", self.voltages, _BATTERY_STATUS_VOLTAGES_SPEC)
@@ -2321,39 +2360,25 @@ class BatteryStatus:
                     if e & -65536:
                         _v.diag(out, "voltages", self.voltages, _BATTERY_STATUS_VOLTAGES_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltages", self.voltages, _BATTERY_STATUS_VOLTAGES_SPEC)
-        try:
+            # current_battery (battery.xml:232): fits int16; -1 means unknown (accepted)
             if (self.current_battery + 32768) & -65536:
                 _v.diag(out, "current_battery", self.current_battery, _BATTERY_STATUS_CURRENT_BATTERY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current_battery", self.current_battery, _BATTERY_STATUS_CURRENT_BATTERY_SPEC)
-        try:
+            # current_consumed (battery.xml:233): fits int32; -1 means unknown (accepted)
             if (self.current_consumed + 2147483648) & -4294967296:
                 _v.diag(out, "current_consumed", self.current_consumed, _BATTERY_STATUS_CURRENT_CONSUMED_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current_consumed", self.current_consumed, _BATTERY_STATUS_CURRENT_CONSUMED_SPEC)
-        try:
+            # energy_consumed (battery.xml:234): fits int32; -1 means unknown (accepted)
             if (self.energy_consumed + 2147483648) & -4294967296:
                 _v.diag(out, "energy_consumed", self.energy_consumed, _BATTERY_STATUS_ENERGY_CONSUMED_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "energy_consumed", self.energy_consumed, _BATTERY_STATUS_ENERGY_CONSUMED_SPEC)
-        try:
+            # battery_remaining (battery.xml:235): fits int8; -1 means unknown (accepted)
             if (self.battery_remaining + 128) & -256:
                 _v.diag(out, "battery_remaining", self.battery_remaining, _BATTERY_STATUS_BATTERY_REMAINING_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_remaining", self.battery_remaining, _BATTERY_STATUS_BATTERY_REMAINING_SPEC)
-        try:
+            # time_remaining (battery.xml:237): fits int32; 0 means unknown (accepted)
             if (self.time_remaining + 2147483648) & -4294967296:
                 _v.diag(out, "time_remaining", self.time_remaining, _BATTERY_STATUS_TIME_REMAINING_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "time_remaining", self.time_remaining, _BATTERY_STATUS_TIME_REMAINING_SPEC)
-        try:
+            # charge_state (battery.xml:238): fits uint8; a value of MAV_BATTERY_CHARGE_STATE
             if self.charge_state not in {0, 1, 2, 3, 4, 5, 6, 7}:
                 _v.diag(out, "charge_state", self.charge_state, _BATTERY_STATUS_CHARGE_STATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "charge_state", self.charge_state, _BATTERY_STATUS_CHARGE_STATE_SPEC)
-        try:
+            # voltages_ext (battery.xml:239): fits uint16[4]; [0] means unknown (accepted)
             a = self.voltages_ext
             if len(a) != 4:
                 _v.diag(out, "voltages_ext", self.voltages_ext, _BATTERY_STATUS_VOLTAGES_EXT_SPEC)
@@ -2362,18 +2387,14 @@ class BatteryStatus:
                     if e & -65536:
                         _v.diag(out, "voltages_ext", self.voltages_ext, _BATTERY_STATUS_VOLTAGES_EXT_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltages_ext", self.voltages_ext, _BATTERY_STATUS_VOLTAGES_EXT_SPEC)
-        try:
+            # mode (battery.xml:240): fits uint8; a value of MAV_BATTERY_MODE
             if self.mode not in {0, 1, 2}:
                 _v.diag(out, "mode", self.mode, _BATTERY_STATUS_MODE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "mode", self.mode, _BATTERY_STATUS_MODE_SPEC)
-        try:
+            # fault_bitmask (battery.xml:241): fits uint32; bits of MAV_BATTERY_FAULT only
             if self.fault_bitmask & -512:
                 _v.diag(out, "fault_bitmask", self.fault_bitmask, _BATTERY_STATUS_FAULT_BITMASK_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "fault_bitmask", self.fault_bitmask, _BATTERY_STATUS_FAULT_BITMASK_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_STATUS_FIELD_SPECS)
         # rule battery-remaining-percent (mavlink-battery-status.yaml:4)
         try:
             r_battery_remaining = self.battery_remaining
@@ -2688,50 +2709,37 @@ class BatteryStatusV2:
         out: list[_v.Violation] = []
         x: _Any
         try:
+            # id (battery.xml:250): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_V2_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "id", self.id, _BATTERY_STATUS_V2_ID_SPEC)
-        try:
+            # temperature (battery.xml:251): fits int16; INT16_MAX means unknown (accepted)
             if (self.temperature + 32768) & -65536:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V2_TEMPERATURE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V2_TEMPERATURE_SPEC)
-        try:
+            # voltage (battery.xml:252): fits float32; NaN means unknown (accepted)
             x = self.voltage
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "voltage", self.voltage, _BATTERY_STATUS_V2_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _BATTERY_STATUS_V2_VOLTAGE_SPEC)
-        try:
+            # current (battery.xml:253): fits float32; NaN means unknown (accepted)
             x = self.current
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "current", self.current, _BATTERY_STATUS_V2_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _BATTERY_STATUS_V2_CURRENT_SPEC)
-        try:
+            # capacity_consumed (battery.xml:254): fits float32; NaN means unknown (accepted)
             x = self.capacity_consumed
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_STATUS_V2_CAPACITY_CONSUMED_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_STATUS_V2_CAPACITY_CONSUMED_SPEC)
-        try:
+            # capacity_remaining (battery.xml:255): fits float32; NaN means unknown (accepted)
             x = self.capacity_remaining
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "capacity_remaining", self.capacity_remaining, _BATTERY_STATUS_V2_CAPACITY_REMAINING_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "capacity_remaining", self.capacity_remaining, _BATTERY_STATUS_V2_CAPACITY_REMAINING_SPEC)
-        try:
+            # state_of_charge (battery.xml:256): fits float32; NaN means unknown (accepted)
             x = self.state_of_charge
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_STATUS_V2_STATE_OF_CHARGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_STATUS_V2_STATE_OF_CHARGE_SPEC)
-        try:
+            # status_flags (battery.xml:257): fits uint32; bits of MAV_BATTERY_STATUS_FLAGS only
             if self.status_flags & -2148007936:
                 _v.diag(out, "status_flags", self.status_flags, _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "status_flags", self.status_flags, _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_STATUS_V2_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -2942,6 +2950,7 @@ class Heartbeat:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # type (vehicle.xml:443): fits uint8; a value of MAV_TYPE
             if self.type not in {
                 0,
                 1,
@@ -2995,33 +3004,23 @@ class Heartbeat:
                 49,
             }:
                 _v.diag(out, "type", self.type, _HEARTBEAT_TYPE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "type", self.type, _HEARTBEAT_TYPE_SPEC)
-        try:
+            # autopilot (vehicle.xml:444): fits uint8; a value of MAV_AUTOPILOT
             if self.autopilot not in {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20}:
                 _v.diag(out, "autopilot", self.autopilot, _HEARTBEAT_AUTOPILOT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "autopilot", self.autopilot, _HEARTBEAT_AUTOPILOT_SPEC)
-        try:
+            # base_mode (vehicle.xml:445): fits uint8; bits of MAV_MODE_FLAG only
             if self.base_mode & -256:
                 _v.diag(out, "base_mode", self.base_mode, _HEARTBEAT_BASE_MODE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "base_mode", self.base_mode, _HEARTBEAT_BASE_MODE_SPEC)
-        try:
+            # custom_mode (vehicle.xml:446): fits uint32
             if self.custom_mode & -4294967296:
                 _v.diag(out, "custom_mode", self.custom_mode, _HEARTBEAT_CUSTOM_MODE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "custom_mode", self.custom_mode, _HEARTBEAT_CUSTOM_MODE_SPEC)
-        try:
+            # system_status (vehicle.xml:447): fits uint8; a value of MAV_STATE
             if self.system_status not in {0, 1, 2, 3, 4, 5, 6, 7, 8}:
                 _v.diag(out, "system_status", self.system_status, _HEARTBEAT_SYSTEM_STATUS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "system_status", self.system_status, _HEARTBEAT_SYSTEM_STATUS_SPEC)
-        try:
+            # mavlink_version (vehicle.xml:448): fits uint8
             if self.mavlink_version & -256:
                 _v.diag(out, "mavlink_version", self.mavlink_version, _HEARTBEAT_MAVLINK_VERSION_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "mavlink_version", self.mavlink_version, _HEARTBEAT_MAVLINK_VERSION_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _HEARTBEAT_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -3202,31 +3201,24 @@ class ParamValue:
         out: list[_v.Violation] = []
         x: _Any
         try:
+            # param_id (vehicle.xml:472): fits char[16]
             x = self.param_id
             if x.__class__ is not str or len(x.encode()) > 16:
                 _v.diag(out, "param_id", self.param_id, _PARAM_VALUE_PARAM_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "param_id", self.param_id, _PARAM_VALUE_PARAM_ID_SPEC)
-        try:
+            # param_value (vehicle.xml:473): fits float32
             if not (-3.4028234663852886e38 <= self.param_value <= 3.4028234663852886e38):
                 _v.diag(out, "param_value", self.param_value, _PARAM_VALUE_PARAM_VALUE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "param_value", self.param_value, _PARAM_VALUE_PARAM_VALUE_SPEC)
-        try:
+            # param_type (vehicle.xml:474): fits uint8; a value of MAV_PARAM_TYPE
             if self.param_type not in {1, 2, 3, 4, 5, 6, 7, 8, 9, 10}:
                 _v.diag(out, "param_type", self.param_type, _PARAM_VALUE_PARAM_TYPE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "param_type", self.param_type, _PARAM_VALUE_PARAM_TYPE_SPEC)
-        try:
+            # param_count (vehicle.xml:475): fits uint16
             if self.param_count & -65536:
                 _v.diag(out, "param_count", self.param_count, _PARAM_VALUE_PARAM_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "param_count", self.param_count, _PARAM_VALUE_PARAM_COUNT_SPEC)
-        try:
+            # param_index (vehicle.xml:476): fits uint16
             if self.param_index & -65536:
                 _v.diag(out, "param_index", self.param_index, _PARAM_VALUE_PARAM_INDEX_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "param_index", self.param_index, _PARAM_VALUE_PARAM_INDEX_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _PARAM_VALUE_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -3617,6 +3609,7 @@ class SysStatus:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # onboard_control_sensors_present (vehicle.xml:452): fits uint32; bits of MAV_SYS_STATUS_SENSOR only
             if self.onboard_control_sensors_present & -4294967296:
                 _v.diag(
                     out,
@@ -3624,14 +3617,7 @@ class SysStatus:
                     self.onboard_control_sensors_present,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "onboard_control_sensors_present",
-                self.onboard_control_sensors_present,
-                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_SPEC,
-            )
-        try:
+            # onboard_control_sensors_enabled (vehicle.xml:453): fits uint32; bits of MAV_SYS_STATUS_SENSOR only
             if self.onboard_control_sensors_enabled & -4294967296:
                 _v.diag(
                     out,
@@ -3639,14 +3625,7 @@ class SysStatus:
                     self.onboard_control_sensors_enabled,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "onboard_control_sensors_enabled",
-                self.onboard_control_sensors_enabled,
-                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_SPEC,
-            )
-        try:
+            # onboard_control_sensors_health (vehicle.xml:454): fits uint32; bits of MAV_SYS_STATUS_SENSOR only
             if self.onboard_control_sensors_health & -4294967296:
                 _v.diag(
                     out,
@@ -3654,64 +3633,38 @@ class SysStatus:
                     self.onboard_control_sensors_health,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "onboard_control_sensors_health",
-                self.onboard_control_sensors_health,
-                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_SPEC,
-            )
-        try:
+            # load (vehicle.xml:455): fits uint16
             if self.load & -65536:
                 _v.diag(out, "load", self.load, _SYS_STATUS_LOAD_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "load", self.load, _SYS_STATUS_LOAD_SPEC)
-        try:
+            # voltage_battery (vehicle.xml:456): fits uint16; UINT16_MAX means unknown (accepted)
             if self.voltage_battery & -65536:
                 _v.diag(out, "voltage_battery", self.voltage_battery, _SYS_STATUS_VOLTAGE_BATTERY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage_battery", self.voltage_battery, _SYS_STATUS_VOLTAGE_BATTERY_SPEC)
-        try:
+            # current_battery (vehicle.xml:457): fits int16; -1 means unknown (accepted)
             if (self.current_battery + 32768) & -65536:
                 _v.diag(out, "current_battery", self.current_battery, _SYS_STATUS_CURRENT_BATTERY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current_battery", self.current_battery, _SYS_STATUS_CURRENT_BATTERY_SPEC)
-        try:
+            # battery_remaining (vehicle.xml:458): fits int8; -1 means unknown (accepted)
             if (self.battery_remaining + 128) & -256:
                 _v.diag(out, "battery_remaining", self.battery_remaining, _SYS_STATUS_BATTERY_REMAINING_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_remaining", self.battery_remaining, _SYS_STATUS_BATTERY_REMAINING_SPEC)
-        try:
+            # drop_rate_comm (vehicle.xml:459): fits uint16
             if self.drop_rate_comm & -65536:
                 _v.diag(out, "drop_rate_comm", self.drop_rate_comm, _SYS_STATUS_DROP_RATE_COMM_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "drop_rate_comm", self.drop_rate_comm, _SYS_STATUS_DROP_RATE_COMM_SPEC)
-        try:
+            # errors_comm (vehicle.xml:460): fits uint16
             if self.errors_comm & -65536:
                 _v.diag(out, "errors_comm", self.errors_comm, _SYS_STATUS_ERRORS_COMM_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "errors_comm", self.errors_comm, _SYS_STATUS_ERRORS_COMM_SPEC)
-        try:
+            # errors_count1 (vehicle.xml:461): fits uint16
             if self.errors_count1 & -65536:
                 _v.diag(out, "errors_count1", self.errors_count1, _SYS_STATUS_ERRORS_COUNT1_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "errors_count1", self.errors_count1, _SYS_STATUS_ERRORS_COUNT1_SPEC)
-        try:
+            # errors_count2 (vehicle.xml:462): fits uint16
             if self.errors_count2 & -65536:
                 _v.diag(out, "errors_count2", self.errors_count2, _SYS_STATUS_ERRORS_COUNT2_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "errors_count2", self.errors_count2, _SYS_STATUS_ERRORS_COUNT2_SPEC)
-        try:
+            # errors_count3 (vehicle.xml:463): fits uint16
             if self.errors_count3 & -65536:
                 _v.diag(out, "errors_count3", self.errors_count3, _SYS_STATUS_ERRORS_COUNT3_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "errors_count3", self.errors_count3, _SYS_STATUS_ERRORS_COUNT3_SPEC)
-        try:
+            # errors_count4 (vehicle.xml:464): fits uint16
             if self.errors_count4 & -65536:
                 _v.diag(out, "errors_count4", self.errors_count4, _SYS_STATUS_ERRORS_COUNT4_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "errors_count4", self.errors_count4, _SYS_STATUS_ERRORS_COUNT4_SPEC)
-        try:
+            # onboard_control_sensors_present_extended (vehicle.xml:466): fits uint32; bits of
+            # MAV_SYS_STATUS_SENSOR_EXTENDED only
             if self.onboard_control_sensors_present_extended & -64:
                 _v.diag(
                     out,
@@ -3719,14 +3672,8 @@ class SysStatus:
                     self.onboard_control_sensors_present_extended,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_EXTENDED_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "onboard_control_sensors_present_extended",
-                self.onboard_control_sensors_present_extended,
-                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_EXTENDED_SPEC,
-            )
-        try:
+            # onboard_control_sensors_enabled_extended (vehicle.xml:467): fits uint32; bits of
+            # MAV_SYS_STATUS_SENSOR_EXTENDED only
             if self.onboard_control_sensors_enabled_extended & -64:
                 _v.diag(
                     out,
@@ -3734,14 +3681,8 @@ class SysStatus:
                     self.onboard_control_sensors_enabled_extended,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_EXTENDED_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "onboard_control_sensors_enabled_extended",
-                self.onboard_control_sensors_enabled_extended,
-                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_EXTENDED_SPEC,
-            )
-        try:
+            # onboard_control_sensors_health_extended (vehicle.xml:468): fits uint32; bits of
+            # MAV_SYS_STATUS_SENSOR_EXTENDED only
             if self.onboard_control_sensors_health_extended & -64:
                 _v.diag(
                     out,
@@ -3749,13 +3690,8 @@ class SysStatus:
                     self.onboard_control_sensors_health_extended,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_EXTENDED_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "onboard_control_sensors_health_extended",
-                self.onboard_control_sensors_health_extended,
-                _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_EXTENDED_SPEC,
-            )
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _SYS_STATUS_FIELD_SPECS)
         return out
 
     def check(self) -> None:

@@ -55,6 +55,20 @@ _BATT_PARAMS_BATT_ARM_VOLT_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38, unit="V"
 )
 _BATT_PARAMS_BATT_ARM_MAH_SPEC = _v.Number(type="int32", kind="int", low=-2147483648, high=2147483647, unit="mAh")
+# (schema name, attribute, spec) of each field, for the careful way
+_BATT_PARAMS_FIELD_SPECS = (
+    ("BATT_CAPACITY", "BATT_CAPACITY", _BATT_PARAMS_BATT_CAPACITY_SPEC),
+    ("BATT_LOW_VOLT", "BATT_LOW_VOLT", _BATT_PARAMS_BATT_LOW_VOLT_SPEC),
+    ("BATT_LOW_TIMER", "BATT_LOW_TIMER", _BATT_PARAMS_BATT_LOW_TIMER_SPEC),
+    ("BATT_FS_VOLTSRC", "BATT_FS_VOLTSRC", _BATT_PARAMS_BATT_FS_VOLTSRC_SPEC),
+    ("BATT_LOW_MAH", "BATT_LOW_MAH", _BATT_PARAMS_BATT_LOW_MAH_SPEC),
+    ("BATT_CRT_VOLT", "BATT_CRT_VOLT", _BATT_PARAMS_BATT_CRT_VOLT_SPEC),
+    ("BATT_CRT_MAH", "BATT_CRT_MAH", _BATT_PARAMS_BATT_CRT_MAH_SPEC),
+    ("BATT_FS_LOW_ACT", "BATT_FS_LOW_ACT", _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC),
+    ("BATT_FS_CRT_ACT", "BATT_FS_CRT_ACT", _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC),
+    ("BATT_ARM_VOLT", "BATT_ARM_VOLT", _BATT_PARAMS_BATT_ARM_VOLT_SPEC),
+    ("BATT_ARM_MAH", "BATT_ARM_MAH", _BATT_PARAMS_BATT_ARM_MAH_SPEC),
+)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -273,61 +287,42 @@ class BattParams:
         out: list[_v.Violation] = []
         x: _Any
         try:
+            # BATT_CAPACITY (battery_failsafe.pdef.xml:12): fits int32
             if (self.BATT_CAPACITY + 2147483648) & -4294967296:
                 _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)
-        try:
+            # BATT_LOW_VOLT (battery_failsafe.pdef.xml:18): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_LOW_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _BATT_PARAMS_BATT_LOW_VOLT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _BATT_PARAMS_BATT_LOW_VOLT_SPEC)
-        try:
+            # BATT_LOW_TIMER (battery_failsafe.pdef.xml:24): fits int8; 0 <= value <= 120
             x = self.BATT_LOW_TIMER
             if (x + 128) & -256 or not (0 <= x <= 120):
                 _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _BATT_PARAMS_BATT_LOW_TIMER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _BATT_PARAMS_BATT_LOW_TIMER_SPEC)
-        try:
+            # BATT_FS_VOLTSRC (battery_failsafe.pdef.xml:31): fits int8; a value of FS_VOLTSRC
             if self.BATT_FS_VOLTSRC not in {0, 1}:
                 _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _BATT_PARAMS_BATT_FS_VOLTSRC_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _BATT_PARAMS_BATT_FS_VOLTSRC_SPEC)
-        try:
+            # BATT_LOW_MAH (battery_failsafe.pdef.xml:39): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_LOW_MAH <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _BATT_PARAMS_BATT_LOW_MAH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _BATT_PARAMS_BATT_LOW_MAH_SPEC)
-        try:
+            # BATT_CRT_VOLT (battery_failsafe.pdef.xml:45): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_CRT_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _BATT_PARAMS_BATT_CRT_VOLT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _BATT_PARAMS_BATT_CRT_VOLT_SPEC)
-        try:
+            # BATT_CRT_MAH (battery_failsafe.pdef.xml:51): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_CRT_MAH <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _BATT_PARAMS_BATT_CRT_MAH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _BATT_PARAMS_BATT_CRT_MAH_SPEC)
-        try:
+            # BATT_FS_LOW_ACT (battery_failsafe.pdef.xml:57): fits int8
             if (self.BATT_FS_LOW_ACT + 128) & -256:
                 _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC)
-        try:
+            # BATT_FS_CRT_ACT (battery_failsafe.pdef.xml:61): fits int8
             if (self.BATT_FS_CRT_ACT + 128) & -256:
                 _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC)
-        try:
+            # BATT_ARM_VOLT (battery_failsafe.pdef.xml:65): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_ARM_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _BATT_PARAMS_BATT_ARM_VOLT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _BATT_PARAMS_BATT_ARM_VOLT_SPEC)
-        try:
+            # BATT_ARM_MAH (battery_failsafe.pdef.xml:71): fits int32
             if (self.BATT_ARM_MAH + 2147483648) & -4294967296:
                 _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _BATT_PARAMS_BATT_ARM_MAH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _BATT_PARAMS_BATT_ARM_MAH_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATT_PARAMS_FIELD_SPECS)
         return out
 
     def check(self) -> None:

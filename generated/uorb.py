@@ -137,6 +137,12 @@ _BATTERY_INFO_PACKED_FIELDS: tuple[tuple[str, str, str, int], ...] = (
 _BATTERY_INFO_TIMESTAMP_SPEC = _v.Number(type="uint64", kind="uint", low=0, high=18446744073709551615, unit="us")
 _BATTERY_INFO_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
 _BATTERY_INFO_SERIAL_NUMBER_SPEC = _v.Text(capacity=32)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_INFO_FIELD_SPECS = (
+    ("timestamp", "timestamp", _BATTERY_INFO_TIMESTAMP_SPEC),
+    ("id", "id", _BATTERY_INFO_ID_SPEC),
+    ("serial_number", "serial_number", _BATTERY_INFO_SERIAL_NUMBER_SPEC),
+)
 
 
 # the C struct, nested messages inlined (decoding reads them in place)
@@ -546,6 +552,47 @@ _BATTERY_STATUS_PREDICTION_ERROR_SPEC = _v.Number(
 _BATTERY_STATUS_ESTIMATION_COVARIANCE_NORM_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_STATUS_FIELD_SPECS = (
+    ("timestamp", "timestamp", _BATTERY_STATUS_TIMESTAMP_SPEC),
+    ("connected", "connected", _BATTERY_STATUS_CONNECTED_SPEC),
+    ("voltage_v", "voltage_v", _BATTERY_STATUS_VOLTAGE_V_SPEC),
+    ("current_a", "current_a", _BATTERY_STATUS_CURRENT_A_SPEC),
+    ("current_average_a", "current_average_a", _BATTERY_STATUS_CURRENT_AVERAGE_A_SPEC),
+    ("discharged_mah", "discharged_mah", _BATTERY_STATUS_DISCHARGED_MAH_SPEC),
+    ("remaining", "remaining", _BATTERY_STATUS_REMAINING_SPEC),
+    ("scale", "scale", _BATTERY_STATUS_SCALE_SPEC),
+    ("time_remaining_s", "time_remaining_s", _BATTERY_STATUS_TIME_REMAINING_S_SPEC),
+    ("temperature", "temperature", _BATTERY_STATUS_TEMPERATURE_SPEC),
+    ("cell_count", "cell_count", _BATTERY_STATUS_CELL_COUNT_SPEC),
+    ("source", "source", _BATTERY_STATUS_SOURCE_SPEC),
+    ("priority", "priority", _BATTERY_STATUS_PRIORITY_SPEC),
+    ("capacity", "capacity", _BATTERY_STATUS_CAPACITY_SPEC),
+    ("cycle_count", "cycle_count", _BATTERY_STATUS_CYCLE_COUNT_SPEC),
+    ("average_time_to_empty", "average_time_to_empty", _BATTERY_STATUS_AVERAGE_TIME_TO_EMPTY_SPEC),
+    ("manufacture_date", "manufacture_date", _BATTERY_STATUS_MANUFACTURE_DATE_SPEC),
+    ("state_of_health", "state_of_health", _BATTERY_STATUS_STATE_OF_HEALTH_SPEC),
+    ("max_error", "max_error", _BATTERY_STATUS_MAX_ERROR_SPEC),
+    ("id", "id", _BATTERY_STATUS_ID_SPEC),
+    ("interface_error", "interface_error", _BATTERY_STATUS_INTERFACE_ERROR_SPEC),
+    ("voltage_cell_v", "voltage_cell_v", _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC),
+    ("max_cell_voltage_delta", "max_cell_voltage_delta", _BATTERY_STATUS_MAX_CELL_VOLTAGE_DELTA_SPEC),
+    ("is_powering_off", "is_powering_off", _BATTERY_STATUS_IS_POWERING_OFF_SPEC),
+    ("is_required", "is_required", _BATTERY_STATUS_IS_REQUIRED_SPEC),
+    ("warning", "warning", _BATTERY_STATUS_WARNING_SPEC),
+    ("faults", "faults", _BATTERY_STATUS_FAULTS_SPEC),
+    ("full_charge_capacity_wh", "full_charge_capacity_wh", _BATTERY_STATUS_FULL_CHARGE_CAPACITY_WH_SPEC),
+    ("remaining_capacity_wh", "remaining_capacity_wh", _BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC),
+    ("over_discharge_count", "over_discharge_count", _BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC),
+    ("nominal_voltage", "nominal_voltage", _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC),
+    ("internal_resistance_estimate", "internal_resistance_estimate", _BATTERY_STATUS_INTERNAL_RESISTANCE_ESTIMATE_SPEC),
+    ("ocv_estimate", "ocv_estimate", _BATTERY_STATUS_OCV_ESTIMATE_SPEC),
+    ("ocv_estimate_filtered", "ocv_estimate_filtered", _BATTERY_STATUS_OCV_ESTIMATE_FILTERED_SPEC),
+    ("volt_based_soc_estimate", "volt_based_soc_estimate", _BATTERY_STATUS_VOLT_BASED_SOC_ESTIMATE_SPEC),
+    ("voltage_prediction", "voltage_prediction", _BATTERY_STATUS_VOLTAGE_PREDICTION_SPEC),
+    ("prediction_error", "prediction_error", _BATTERY_STATUS_PREDICTION_ERROR_SPEC),
+    ("estimation_covariance_norm", "estimation_covariance_norm", _BATTERY_STATUS_ESTIMATION_COVARIANCE_NORM_SPEC),
+)
 
 
 # the C struct, nested messages inlined (decoding reads them in place)
@@ -948,6 +995,52 @@ _BATTERY_STATUS_V0_PREDICTION_ERROR_SPEC = _v.Number(
 _BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC = _v.Number(
     type="float32", kind="float", low=-3.4028234663852886e38, high=3.4028234663852886e38
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_STATUS_V0_FIELD_SPECS = (
+    ("timestamp", "timestamp", _BATTERY_STATUS_V0_TIMESTAMP_SPEC),
+    ("connected", "connected", _BATTERY_STATUS_V0_CONNECTED_SPEC),
+    ("voltage_v", "voltage_v", _BATTERY_STATUS_V0_VOLTAGE_V_SPEC),
+    ("current_a", "current_a", _BATTERY_STATUS_V0_CURRENT_A_SPEC),
+    ("current_average_a", "current_average_a", _BATTERY_STATUS_V0_CURRENT_AVERAGE_A_SPEC),
+    ("discharged_mah", "discharged_mah", _BATTERY_STATUS_V0_DISCHARGED_MAH_SPEC),
+    ("remaining", "remaining", _BATTERY_STATUS_V0_REMAINING_SPEC),
+    ("scale", "scale", _BATTERY_STATUS_V0_SCALE_SPEC),
+    ("time_remaining_s", "time_remaining_s", _BATTERY_STATUS_V0_TIME_REMAINING_S_SPEC),
+    ("temperature", "temperature", _BATTERY_STATUS_V0_TEMPERATURE_SPEC),
+    ("cell_count", "cell_count", _BATTERY_STATUS_V0_CELL_COUNT_SPEC),
+    ("source", "source", _BATTERY_STATUS_V0_SOURCE_SPEC),
+    ("priority", "priority", _BATTERY_STATUS_V0_PRIORITY_SPEC),
+    ("capacity", "capacity", _BATTERY_STATUS_V0_CAPACITY_SPEC),
+    ("cycle_count", "cycle_count", _BATTERY_STATUS_V0_CYCLE_COUNT_SPEC),
+    ("average_time_to_empty", "average_time_to_empty", _BATTERY_STATUS_V0_AVERAGE_TIME_TO_EMPTY_SPEC),
+    ("serial_number", "serial_number", _BATTERY_STATUS_V0_SERIAL_NUMBER_SPEC),
+    ("manufacture_date", "manufacture_date", _BATTERY_STATUS_V0_MANUFACTURE_DATE_SPEC),
+    ("state_of_health", "state_of_health", _BATTERY_STATUS_V0_STATE_OF_HEALTH_SPEC),
+    ("max_error", "max_error", _BATTERY_STATUS_V0_MAX_ERROR_SPEC),
+    ("id", "id", _BATTERY_STATUS_V0_ID_SPEC),
+    ("interface_error", "interface_error", _BATTERY_STATUS_V0_INTERFACE_ERROR_SPEC),
+    ("voltage_cell_v", "voltage_cell_v", _BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC),
+    ("max_cell_voltage_delta", "max_cell_voltage_delta", _BATTERY_STATUS_V0_MAX_CELL_VOLTAGE_DELTA_SPEC),
+    ("is_powering_off", "is_powering_off", _BATTERY_STATUS_V0_IS_POWERING_OFF_SPEC),
+    ("is_required", "is_required", _BATTERY_STATUS_V0_IS_REQUIRED_SPEC),
+    ("warning", "warning", _BATTERY_STATUS_V0_WARNING_SPEC),
+    ("faults", "faults", _BATTERY_STATUS_V0_FAULTS_SPEC),
+    ("full_charge_capacity_wh", "full_charge_capacity_wh", _BATTERY_STATUS_V0_FULL_CHARGE_CAPACITY_WH_SPEC),
+    ("remaining_capacity_wh", "remaining_capacity_wh", _BATTERY_STATUS_V0_REMAINING_CAPACITY_WH_SPEC),
+    ("over_discharge_count", "over_discharge_count", _BATTERY_STATUS_V0_OVER_DISCHARGE_COUNT_SPEC),
+    ("nominal_voltage", "nominal_voltage", _BATTERY_STATUS_V0_NOMINAL_VOLTAGE_SPEC),
+    (
+        "internal_resistance_estimate",
+        "internal_resistance_estimate",
+        _BATTERY_STATUS_V0_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
+    ),
+    ("ocv_estimate", "ocv_estimate", _BATTERY_STATUS_V0_OCV_ESTIMATE_SPEC),
+    ("ocv_estimate_filtered", "ocv_estimate_filtered", _BATTERY_STATUS_V0_OCV_ESTIMATE_FILTERED_SPEC),
+    ("volt_based_soc_estimate", "volt_based_soc_estimate", _BATTERY_STATUS_V0_VOLT_BASED_SOC_ESTIMATE_SPEC),
+    ("voltage_prediction", "voltage_prediction", _BATTERY_STATUS_V0_VOLTAGE_PREDICTION_SPEC),
+    ("prediction_error", "prediction_error", _BATTERY_STATUS_V0_PREDICTION_ERROR_SPEC),
+    ("estimation_covariance_norm", "estimation_covariance_norm", _BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC),
+)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -1102,21 +1195,18 @@ class BatteryInfo:
         out: list[_v.Violation] = []
         x: _Any
         try:
+            # timestamp (BatteryInfo.msg:9): fits uint64
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_TIMESTAMP_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_TIMESTAMP_SPEC)
-        try:
+            # id (BatteryInfo.msg:11): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
-        try:
+            # serial_number (BatteryInfo.msg:12): fits char[32]; 0 means unknown (accepted)
             x = self.serial_number
             if x.__class__ is not str or len(x.encode()) > 32:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_INFO_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -1947,122 +2037,79 @@ class BatteryStatus:
         r_voltage_cell_v: _Any
         v_i: _Any
         try:
+            # timestamp (BatteryStatus.msg:13): fits uint64
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_TIMESTAMP_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_TIMESTAMP_SPEC)
-        try:
+            # connected (BatteryStatus.msg:15): fits bool
             x = self.connected
             if x is not True and x is not False:
                 _v.diag(out, "connected", self.connected, _BATTERY_STATUS_CONNECTED_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "connected", self.connected, _BATTERY_STATUS_CONNECTED_SPEC)
-        try:
+            # voltage_v (BatteryStatus.msg:16): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.voltage_v <= 3.4028234663852886e38):
                 _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_VOLTAGE_V_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_VOLTAGE_V_SPEC)
-        try:
+            # current_a (BatteryStatus.msg:17): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.current_a <= 3.4028234663852886e38):
                 _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_CURRENT_A_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_CURRENT_A_SPEC)
-        try:
+            # current_average_a (BatteryStatus.msg:18): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.current_average_a <= 3.4028234663852886e38):
                 _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_CURRENT_AVERAGE_A_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_CURRENT_AVERAGE_A_SPEC)
-        try:
+            # discharged_mah (BatteryStatus.msg:19): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharged_mah <= 3.4028234663852886e38):
                 _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_DISCHARGED_MAH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_DISCHARGED_MAH_SPEC)
-        try:
+            # remaining (BatteryStatus.msg:20): fits float32; 0 <= value <= 1; -1 means unknown (accepted)
             x = self.remaining
             if not (0.0 <= x <= 1.0) and x != -1.0:
                 _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_REMAINING_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_REMAINING_SPEC)
-        try:
+            # scale (BatteryStatus.msg:21): fits float32; 1 <= value; -1 means unknown (accepted)
             x = self.scale
             if not (1.0 <= x <= 3.4028234663852886e38) and x != -1.0:
                 _v.diag(out, "scale", self.scale, _BATTERY_STATUS_SCALE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "scale", self.scale, _BATTERY_STATUS_SCALE_SPEC)
-        try:
+            # time_remaining_s (BatteryStatus.msg:22): fits float32; NaN means unknown (accepted)
             x = self.time_remaining_s
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_TIME_REMAINING_S_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_TIME_REMAINING_S_SPEC)
-        try:
+            # temperature (BatteryStatus.msg:23): fits float32; NaN means unknown (accepted)
             x = self.temperature
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
-        try:
+            # cell_count (BatteryStatus.msg:24): fits uint8; 0 means unknown (accepted)
             if self.cell_count & -256:
                 _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_CELL_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_CELL_COUNT_SPEC)
-        try:
+            # source (BatteryStatus.msg:26): fits uint8; a value of SOURCE
             if self.source not in {0, 1, 2}:
                 _v.diag(out, "source", self.source, _BATTERY_STATUS_SOURCE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "source", self.source, _BATTERY_STATUS_SOURCE_SPEC)
-        try:
+            # priority (BatteryStatus.msg:31): fits uint8
             if self.priority & -256:
                 _v.diag(out, "priority", self.priority, _BATTERY_STATUS_PRIORITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "priority", self.priority, _BATTERY_STATUS_PRIORITY_SPEC)
-        try:
+            # capacity (BatteryStatus.msg:32): fits uint16
             if self.capacity & -65536:
                 _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_CAPACITY_SPEC)
-        try:
+            # cycle_count (BatteryStatus.msg:33): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_CYCLE_COUNT_SPEC)
-        try:
+            # average_time_to_empty (BatteryStatus.msg:34): fits uint16
             if self.average_time_to_empty & -65536:
                 _v.diag(
                     out, "average_time_to_empty", self.average_time_to_empty, _BATTERY_STATUS_AVERAGE_TIME_TO_EMPTY_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "average_time_to_empty", self.average_time_to_empty, _BATTERY_STATUS_AVERAGE_TIME_TO_EMPTY_SPEC
-            )
-        try:
+            # manufacture_date (BatteryStatus.msg:35): fits uint16
             if self.manufacture_date & -65536:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_MANUFACTURE_DATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_MANUFACTURE_DATE_SPEC)
-        try:
+            # state_of_health (BatteryStatus.msg:36): fits uint16; 0 <= value <= 100
             x = self.state_of_health
             if x & -65536 or not (0 <= x <= 100):
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_STATE_OF_HEALTH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_STATE_OF_HEALTH_SPEC)
-        try:
+            # max_error (BatteryStatus.msg:37): fits uint16; 1 <= value <= 100
             x = self.max_error
             if x & -65536 or not (1 <= x <= 100):
                 _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_MAX_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_MAX_ERROR_SPEC)
-        try:
+            # id (BatteryStatus.msg:38): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
-        try:
+            # interface_error (BatteryStatus.msg:39): fits uint16
             if self.interface_error & -65536:
                 _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_INTERFACE_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_INTERFACE_ERROR_SPEC)
-        try:
+            # voltage_cell_v (BatteryStatus.msg:41): fits float32[14]; 0 means unknown (accepted)
             a = self.voltage_cell_v
             if len(a) != 14:
                 _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC)
@@ -2071,9 +2118,7 @@ class BatteryStatus:
                     if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
                         _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC)
-        try:
+            # max_cell_voltage_delta (BatteryStatus.msg:42): fits float32
             if not (-3.4028234663852886e38 <= self.max_cell_voltage_delta <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2081,33 +2126,21 @@ class BatteryStatus:
                     self.max_cell_voltage_delta,
                     _BATTERY_STATUS_MAX_CELL_VOLTAGE_DELTA_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "max_cell_voltage_delta", self.max_cell_voltage_delta, _BATTERY_STATUS_MAX_CELL_VOLTAGE_DELTA_SPEC
-            )
-        try:
+            # is_powering_off (BatteryStatus.msg:44): fits bool
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_IS_POWERING_OFF_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_IS_POWERING_OFF_SPEC)
-        try:
+            # is_required (BatteryStatus.msg:45): fits bool
             x = self.is_required
             if x is not True and x is not False:
                 _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_IS_REQUIRED_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_IS_REQUIRED_SPEC)
-        try:
+            # warning (BatteryStatus.msg:47): fits uint8; a value of WARNING or a value of STATE
             if self.warning not in {0, 1, 2, 3, 4, 6, 7}:
                 _v.diag(out, "warning", self.warning, _BATTERY_STATUS_WARNING_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "warning", self.warning, _BATTERY_STATUS_WARNING_SPEC)
-        try:
+            # faults (BatteryStatus.msg:56): fits uint16; bits of FAULT only
             if self.faults & -2048:
                 _v.diag(out, "faults", self.faults, _BATTERY_STATUS_FAULTS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "faults", self.faults, _BATTERY_STATUS_FAULTS_SPEC)
-        try:
+            # full_charge_capacity_wh (BatteryStatus.msg:70): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2115,37 +2148,22 @@ class BatteryStatus:
                     self.full_charge_capacity_wh,
                     _BATTERY_STATUS_FULL_CHARGE_CAPACITY_WH_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "full_charge_capacity_wh",
-                self.full_charge_capacity_wh,
-                _BATTERY_STATUS_FULL_CHARGE_CAPACITY_WH_SPEC,
-            )
-        try:
+            # remaining_capacity_wh (BatteryStatus.msg:71): fits float32; NaN means unknown (accepted)
             x = self.remaining_capacity_wh
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(
                     out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC
-            )
-        try:
+            # over_discharge_count (BatteryStatus.msg:72): fits uint16
             if self.over_discharge_count & -65536:
                 _v.diag(
                     out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC)
-        try:
+            # nominal_voltage (BatteryStatus.msg:73): fits float32; NaN means unknown (accepted)
             x = self.nominal_voltage
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC)
-        try:
+            # internal_resistance_estimate (BatteryStatus.msg:75): fits float32
             if not (-3.4028234663852886e38 <= self.internal_resistance_estimate <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2153,28 +2171,15 @@ class BatteryStatus:
                     self.internal_resistance_estimate,
                     _BATTERY_STATUS_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "internal_resistance_estimate",
-                self.internal_resistance_estimate,
-                _BATTERY_STATUS_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
-            )
-        try:
+            # ocv_estimate (BatteryStatus.msg:76): fits float32
             if not (-3.4028234663852886e38 <= self.ocv_estimate <= 3.4028234663852886e38):
                 _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_OCV_ESTIMATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_OCV_ESTIMATE_SPEC)
-        try:
+            # ocv_estimate_filtered (BatteryStatus.msg:77): fits float32
             if not (-3.4028234663852886e38 <= self.ocv_estimate_filtered <= 3.4028234663852886e38):
                 _v.diag(
                     out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _BATTERY_STATUS_OCV_ESTIMATE_FILTERED_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _BATTERY_STATUS_OCV_ESTIMATE_FILTERED_SPEC
-            )
-        try:
+            # volt_based_soc_estimate (BatteryStatus.msg:78): fits float32; 0 <= value <= 1
             if not (0.0 <= self.volt_based_soc_estimate <= 1.0):
                 _v.diag(
                     out,
@@ -2182,24 +2187,13 @@ class BatteryStatus:
                     self.volt_based_soc_estimate,
                     _BATTERY_STATUS_VOLT_BASED_SOC_ESTIMATE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "volt_based_soc_estimate",
-                self.volt_based_soc_estimate,
-                _BATTERY_STATUS_VOLT_BASED_SOC_ESTIMATE_SPEC,
-            )
-        try:
+            # voltage_prediction (BatteryStatus.msg:79): fits float32
             if not (-3.4028234663852886e38 <= self.voltage_prediction <= 3.4028234663852886e38):
                 _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_VOLTAGE_PREDICTION_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_VOLTAGE_PREDICTION_SPEC)
-        try:
+            # prediction_error (BatteryStatus.msg:80): fits float32
             if not (-3.4028234663852886e38 <= self.prediction_error <= 3.4028234663852886e38):
                 _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_PREDICTION_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_PREDICTION_ERROR_SPEC)
-        try:
+            # estimation_covariance_norm (BatteryStatus.msg:81): fits float32
             if not (-3.4028234663852886e38 <= self.estimation_covariance_norm <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2207,13 +2201,8 @@ class BatteryStatus:
                     self.estimation_covariance_norm,
                     _BATTERY_STATUS_ESTIMATION_COVARIANCE_NORM_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "estimation_covariance_norm",
-                self.estimation_covariance_norm,
-                _BATTERY_STATUS_ESTIMATION_COVARIANCE_NORM_SPEC,
-            )
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_STATUS_FIELD_SPECS)
         # rule cell-count-capacity (uorb-battery-status.yaml:5)
         try:
             r_cell_count = self.cell_count
@@ -3102,86 +3091,57 @@ class BatteryStatusV0:
         r_voltage_cell_v: _Any
         v_i: _Any
         try:
+            # timestamp (BatteryStatusV0.msg:8): fits uint64
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_V0_TIMESTAMP_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_V0_TIMESTAMP_SPEC)
-        try:
+            # connected (BatteryStatusV0.msg:9): fits bool
             x = self.connected
             if x is not True and x is not False:
                 _v.diag(out, "connected", self.connected, _BATTERY_STATUS_V0_CONNECTED_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "connected", self.connected, _BATTERY_STATUS_V0_CONNECTED_SPEC)
-        try:
+            # voltage_v (BatteryStatusV0.msg:10): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.voltage_v <= 3.4028234663852886e38):
                 _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_V0_VOLTAGE_V_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_V0_VOLTAGE_V_SPEC)
-        try:
+            # current_a (BatteryStatusV0.msg:11): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.current_a <= 3.4028234663852886e38):
                 _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_V0_CURRENT_A_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_V0_CURRENT_A_SPEC)
-        try:
+            # current_average_a (BatteryStatusV0.msg:12): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.current_average_a <= 3.4028234663852886e38):
                 _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_V0_CURRENT_AVERAGE_A_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_V0_CURRENT_AVERAGE_A_SPEC)
-        try:
+            # discharged_mah (BatteryStatusV0.msg:13): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharged_mah <= 3.4028234663852886e38):
                 _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_V0_DISCHARGED_MAH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_V0_DISCHARGED_MAH_SPEC)
-        try:
+            # remaining (BatteryStatusV0.msg:14): fits float32; 0 <= value <= 1; -1 means unknown (accepted)
             x = self.remaining
             if not (0.0 <= x <= 1.0) and x != -1.0:
                 _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_V0_REMAINING_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_V0_REMAINING_SPEC)
-        try:
+            # scale (BatteryStatusV0.msg:15): fits float32; 1 <= value; -1 means unknown (accepted)
             x = self.scale
             if not (1.0 <= x <= 3.4028234663852886e38) and x != -1.0:
                 _v.diag(out, "scale", self.scale, _BATTERY_STATUS_V0_SCALE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "scale", self.scale, _BATTERY_STATUS_V0_SCALE_SPEC)
-        try:
+            # time_remaining_s (BatteryStatusV0.msg:16): fits float32; NaN means unknown (accepted)
             x = self.time_remaining_s
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_V0_TIME_REMAINING_S_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_V0_TIME_REMAINING_S_SPEC)
-        try:
+            # temperature (BatteryStatusV0.msg:17): fits float32; NaN means unknown (accepted)
             x = self.temperature
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V0_TEMPERATURE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V0_TEMPERATURE_SPEC)
-        try:
+            # cell_count (BatteryStatusV0.msg:18): fits uint8; 0 means unknown (accepted)
             if self.cell_count & -256:
                 _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_V0_CELL_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_V0_CELL_COUNT_SPEC)
-        try:
+            # source (BatteryStatusV0.msg:19): fits uint8; a value of SOURCE
             if self.source not in {0, 1, 2}:
                 _v.diag(out, "source", self.source, _BATTERY_STATUS_V0_SOURCE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "source", self.source, _BATTERY_STATUS_V0_SOURCE_SPEC)
-        try:
+            # priority (BatteryStatusV0.msg:23): fits uint8
             if self.priority & -256:
                 _v.diag(out, "priority", self.priority, _BATTERY_STATUS_V0_PRIORITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "priority", self.priority, _BATTERY_STATUS_V0_PRIORITY_SPEC)
-        try:
+            # capacity (BatteryStatusV0.msg:24): fits uint16
             if self.capacity & -65536:
                 _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_V0_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_V0_CAPACITY_SPEC)
-        try:
+            # cycle_count (BatteryStatusV0.msg:25): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_V0_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_V0_CYCLE_COUNT_SPEC)
-        try:
+            # average_time_to_empty (BatteryStatusV0.msg:26): fits uint16
             if self.average_time_to_empty & -65536:
                 _v.diag(
                     out,
@@ -3189,43 +3149,27 @@ class BatteryStatusV0:
                     self.average_time_to_empty,
                     _BATTERY_STATUS_V0_AVERAGE_TIME_TO_EMPTY_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "average_time_to_empty", self.average_time_to_empty, _BATTERY_STATUS_V0_AVERAGE_TIME_TO_EMPTY_SPEC
-            )
-        try:
+            # serial_number (BatteryStatusV0.msg:27): fits uint16
             if self.serial_number & -65536:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_STATUS_V0_SERIAL_NUMBER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _BATTERY_STATUS_V0_SERIAL_NUMBER_SPEC)
-        try:
+            # manufacture_date (BatteryStatusV0.msg:28): fits uint16
             if self.manufacture_date & -65536:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_V0_MANUFACTURE_DATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_V0_MANUFACTURE_DATE_SPEC)
-        try:
+            # state_of_health (BatteryStatusV0.msg:29): fits uint16; 0 <= value <= 100
             x = self.state_of_health
             if x & -65536 or not (0 <= x <= 100):
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_V0_STATE_OF_HEALTH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_V0_STATE_OF_HEALTH_SPEC)
-        try:
+            # max_error (BatteryStatusV0.msg:30): fits uint16; 1 <= value <= 100
             x = self.max_error
             if x & -65536 or not (1 <= x <= 100):
                 _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_V0_MAX_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_V0_MAX_ERROR_SPEC)
-        try:
+            # id (BatteryStatusV0.msg:31): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_V0_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "id", self.id, _BATTERY_STATUS_V0_ID_SPEC)
-        try:
+            # interface_error (BatteryStatusV0.msg:32): fits uint16
             if self.interface_error & -65536:
                 _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_V0_INTERFACE_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_V0_INTERFACE_ERROR_SPEC)
-        try:
+            # voltage_cell_v (BatteryStatusV0.msg:33): fits float32[14]; 0 means unknown (accepted)
             a = self.voltage_cell_v
             if len(a) != 14:
                 _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC)
@@ -3234,9 +3178,7 @@ class BatteryStatusV0:
                     if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
                         _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC)
-        try:
+            # max_cell_voltage_delta (BatteryStatusV0.msg:34): fits float32
             if not (-3.4028234663852886e38 <= self.max_cell_voltage_delta <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3244,36 +3186,21 @@ class BatteryStatusV0:
                     self.max_cell_voltage_delta,
                     _BATTERY_STATUS_V0_MAX_CELL_VOLTAGE_DELTA_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "max_cell_voltage_delta",
-                self.max_cell_voltage_delta,
-                _BATTERY_STATUS_V0_MAX_CELL_VOLTAGE_DELTA_SPEC,
-            )
-        try:
+            # is_powering_off (BatteryStatusV0.msg:35): fits bool
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_V0_IS_POWERING_OFF_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_V0_IS_POWERING_OFF_SPEC)
-        try:
+            # is_required (BatteryStatusV0.msg:36): fits bool
             x = self.is_required
             if x is not True and x is not False:
                 _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_V0_IS_REQUIRED_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_V0_IS_REQUIRED_SPEC)
-        try:
+            # warning (BatteryStatusV0.msg:37): fits uint8; a value of WARNING or a value of STATE
             if self.warning not in {0, 1, 2, 3, 4, 6, 7}:
                 _v.diag(out, "warning", self.warning, _BATTERY_STATUS_V0_WARNING_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "warning", self.warning, _BATTERY_STATUS_V0_WARNING_SPEC)
-        try:
+            # faults (BatteryStatusV0.msg:45): fits uint16; bits of FAULT only
             if self.faults & -2048:
                 _v.diag(out, "faults", self.faults, _BATTERY_STATUS_V0_FAULTS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "faults", self.faults, _BATTERY_STATUS_V0_FAULTS_SPEC)
-        try:
+            # full_charge_capacity_wh (BatteryStatusV0.msg:58): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3281,14 +3208,7 @@ class BatteryStatusV0:
                     self.full_charge_capacity_wh,
                     _BATTERY_STATUS_V0_FULL_CHARGE_CAPACITY_WH_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "full_charge_capacity_wh",
-                self.full_charge_capacity_wh,
-                _BATTERY_STATUS_V0_FULL_CHARGE_CAPACITY_WH_SPEC,
-            )
-        try:
+            # remaining_capacity_wh (BatteryStatusV0.msg:59): fits float32
             if not (-3.4028234663852886e38 <= self.remaining_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3296,25 +3216,15 @@ class BatteryStatusV0:
                     self.remaining_capacity_wh,
                     _BATTERY_STATUS_V0_REMAINING_CAPACITY_WH_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_STATUS_V0_REMAINING_CAPACITY_WH_SPEC
-            )
-        try:
+            # over_discharge_count (BatteryStatusV0.msg:60): fits uint16
             if self.over_discharge_count & -65536:
                 _v.diag(
                     out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_V0_OVER_DISCHARGE_COUNT_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_V0_OVER_DISCHARGE_COUNT_SPEC
-            )
-        try:
+            # nominal_voltage (BatteryStatusV0.msg:61): fits float32
             if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_V0_NOMINAL_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_V0_NOMINAL_VOLTAGE_SPEC)
-        try:
+            # internal_resistance_estimate (BatteryStatusV0.msg:62): fits float32
             if not (-3.4028234663852886e38 <= self.internal_resistance_estimate <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3322,19 +3232,10 @@ class BatteryStatusV0:
                     self.internal_resistance_estimate,
                     _BATTERY_STATUS_V0_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "internal_resistance_estimate",
-                self.internal_resistance_estimate,
-                _BATTERY_STATUS_V0_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
-            )
-        try:
+            # ocv_estimate (BatteryStatusV0.msg:63): fits float32
             if not (-3.4028234663852886e38 <= self.ocv_estimate <= 3.4028234663852886e38):
                 _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_V0_OCV_ESTIMATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_V0_OCV_ESTIMATE_SPEC)
-        try:
+            # ocv_estimate_filtered (BatteryStatusV0.msg:64): fits float32
             if not (-3.4028234663852886e38 <= self.ocv_estimate_filtered <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3342,11 +3243,7 @@ class BatteryStatusV0:
                     self.ocv_estimate_filtered,
                     _BATTERY_STATUS_V0_OCV_ESTIMATE_FILTERED_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _BATTERY_STATUS_V0_OCV_ESTIMATE_FILTERED_SPEC
-            )
-        try:
+            # volt_based_soc_estimate (BatteryStatusV0.msg:65): fits float32; 0 <= value <= 1
             if not (0.0 <= self.volt_based_soc_estimate <= 1.0):
                 _v.diag(
                     out,
@@ -3354,24 +3251,13 @@ class BatteryStatusV0:
                     self.volt_based_soc_estimate,
                     _BATTERY_STATUS_V0_VOLT_BASED_SOC_ESTIMATE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "volt_based_soc_estimate",
-                self.volt_based_soc_estimate,
-                _BATTERY_STATUS_V0_VOLT_BASED_SOC_ESTIMATE_SPEC,
-            )
-        try:
+            # voltage_prediction (BatteryStatusV0.msg:66): fits float32
             if not (-3.4028234663852886e38 <= self.voltage_prediction <= 3.4028234663852886e38):
                 _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_V0_VOLTAGE_PREDICTION_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_V0_VOLTAGE_PREDICTION_SPEC)
-        try:
+            # prediction_error (BatteryStatusV0.msg:67): fits float32
             if not (-3.4028234663852886e38 <= self.prediction_error <= 3.4028234663852886e38):
                 _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_V0_PREDICTION_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_V0_PREDICTION_ERROR_SPEC)
-        try:
+            # estimation_covariance_norm (BatteryStatusV0.msg:68): fits float32
             if not (-3.4028234663852886e38 <= self.estimation_covariance_norm <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3379,13 +3265,8 @@ class BatteryStatusV0:
                     self.estimation_covariance_norm,
                     _BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "estimation_covariance_norm",
-                self.estimation_covariance_norm,
-                _BATTERY_STATUS_V0_ESTIMATION_COVARIANCE_NORM_SPEC,
-            )
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_STATUS_V0_FIELD_SPECS)
         # rule cell-count-capacity (uorb-battery-status.yaml:5)
         try:
             r_cell_count = self.cell_count

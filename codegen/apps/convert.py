@@ -11,7 +11,7 @@ Errors name the input and the record's line (or a log record's location) and sto
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Literal, Protocol, cast
@@ -219,6 +219,22 @@ def _carried(result: object, field: str) -> float | None:
     return None
 
 
+TYPE_BOUNDS = "type-bounds"  # the generated validators' rule: a value its field's type cannot hold
+
+
+def _refuse_unfit(objs: Sequence[object], item: Record) -> None:
+    """A source value its field's type cannot hold (a MAVLink ``current_battery`` of 70000: no int16) is the
+    validator's error, and strict converts nothing of such a record: no encoder would write it either."""
+    for obj in objs:
+        check = getattr(obj, "validate", None)
+        for violation in check() if callable(check) else ():
+            if getattr(violation, "rule", None) == TYPE_BOUNDS:
+                message = getattr(violation, "message", str(violation))
+                raise fail(
+                    item.file, item.line, f"record {item.index + 1}: cannot convert (--policy strict): {message}"
+                )
+
+
 class Conversion:
     """One converter of a generated package, checked: the pair exists, has the policy."""
 
@@ -275,6 +291,8 @@ class Conversion:
             if isinstance(item, Unreadable):
                 raise fail(where, item.line, _reworded(item.message, item.reason, fmt))
             objs = self.source.build(item)
+            if self.policy == "strict":  # strict refuses what validate refuses of the values' types
+                _refuse_unfit(objs, item)
             # always kept: what the target could not hold is told even without --report
             report = self.module.LossReport()
             try:

@@ -12,11 +12,18 @@ Settings come from ``[tool.battgen]`` in the nearest ``pyproject.toml`` from the
 (``select``, ``ignore``: lists of selectors; ``profile``: a bundled profile's name), and from the
 command line, whose ``--select``, ``--ignore`` and ``--profile`` replace the file's. Profiles are
 YAML files in ``codegen/apps/profiles/``: each waiver names its message, the selector, the reason and
-its evidence (upstream source and what real logs show).
+its evidence (upstream source and what real logs show). Without a profile from either, a log's firmware
+chooses it (:func:`for_firmware`: a PX4 log is judged by what PX4 writes); ``--profile ''`` turns that off.
+
+A gate that a typo could open is no gate: every selector must name a rule or a field of the message checked
+(a wildcard must match one), else :func:`check_selectors` refuses it with the closest names, as an unknown
+profile is refused.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import difflib
 import fnmatch
 import re
 import tomllib
@@ -27,11 +34,44 @@ from pathlib import Path
 import yaml
 
 from ..errors import BattgenError
+from ..ir import Message
 
 PROFILES = Path(__file__).resolve().parent / "profiles"
 CONFIG_KEYS = ("select", "ignore", "profile")
 _INDEX = re.compile(r"\[\d+\]")
 _CROSS = "cross-field:"
+# The rules of the generated validators (generated/_validate.py: a Violation's rule), and the validate app's own
+# ("internal": the validator failed); tests/cli/test_gate_names.py reads the generated module to keep this in step.
+GENERIC_RULES = (
+    "type",
+    "type-bounds",
+    "nan",
+    "range",
+    "enum",
+    "bitmask",
+    "pattern",
+    "length",
+    "required",
+    "union",
+    "internal",
+)
+FAILSAFE_RULE = "cross-field:failsafe"  # the validate app's failsafe checks of a parameter set
+
+
+def closest(name: str, known: Iterable[str]) -> str:
+    """`` (did you mean a, b?)`` with the known names closest to ``name``; "" when none is close."""
+    close = difflib.get_close_matches(name, sorted(set(known)), n=3, cutoff=0.6)
+    return f" (did you mean {', '.join(close)}?)" if close else ""
+
+
+def unknown_name(what: str, name: str, known: Iterable[str]) -> BattgenError:
+    """The error for a name an option does not know: the closest known names, else all of them (up to 12)."""
+    names = sorted(set(known))
+    hint = closest(name, names)
+    if not hint:
+        shown = ", ".join(names[:12]) + (", ..." if len(names) > 12 else "")
+        hint = f" (known: {shown})"
+    return BattgenError(f"unknown {what} {name!r}{hint}")
 
 
 def field_of(path: str) -> str:
@@ -80,7 +120,8 @@ def load_profile(name: str) -> Profile:
     """A bundled profile by name; BattgenError naming the known ones otherwise."""
     path = PROFILES / f"{name}.yaml"
     if not re.fullmatch(r"[a-z0-9_-]+", name) or not path.is_file():
-        raise BattgenError(f"unknown profile {name!r} (bundled profiles: {', '.join(profile_names())})")
+        hint = closest(name, profile_names())
+        raise BattgenError(f"unknown profile {name!r}{hint} (bundled profiles: {', '.join(profile_names())})")
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
     waivers = tuple(
         Waiver(str(w["message"]), str(w["ignore"]), " ".join(str(w["reason"]).split()), tuple(w["evidence"]))
@@ -91,12 +132,18 @@ def load_profile(name: str) -> Profile:
 
 @dataclass(frozen=True)
 class Settings:
-    """The selection in force and where it came from (``origin``: the pyproject.toml read, if any)."""
+    """The selection in force and where it came from (``origin``: the pyproject.toml read, if any; ``where``: per
+    key, the option or file that gave it, for errors; ``profile_given``: whether a profile was asked for at all,
+    ``--profile ''`` included, so that the log's firmware does not choose one; ``profile_from``: "" when asked for,
+    else why the profile applies)."""
 
     select: tuple[str, ...] = ()
     ignore: tuple[str, ...] = ()
     profile: Profile | None = None
     origin: str | None = None
+    where: Mapping[str, str] = field(default_factory=dict)
+    profile_given: bool = False
+    profile_from: str = ""
 
 
 def find_config(start: Path) -> Path | None:
@@ -140,8 +187,85 @@ def settings(select: Sequence[str] | None, ignore: Sequence[str] | None, profile
     name = profile if profile is not None else table.get("profile")
     if name is not None and not isinstance(name, str):
         raise BattgenError(f"{where}: [tool.battgen] profile: expected a profile name")
-    chosen = load_profile(name) if name else None  # "" (--profile '') turns a configured profile off
-    return Settings(chosen_select, chosen_ignore, chosen, where or None)
+    origins = {
+        key: f"--{key}" if given is not None else f"{where}: [tool.battgen] {key}"
+        for key, given in (("select", select), ("ignore", ignore), ("profile", profile))
+    }
+    try:
+        chosen = load_profile(name) if name else None  # "" (--profile '') turns a configured profile off
+    except BattgenError as exc:
+        raise BattgenError(f"{origins['profile']}: {exc}") from None
+    return Settings(chosen_select, chosen_ignore, chosen, where or None, origins, name is not None)
+
+
+# The firmware a log kind is written by, where the kind alone tells it (a ULog is PX4's format, DataFlash
+# ArduPilot's); the report reads a log's own context (LogContext.autopilot), which says the same for these.
+KIND_FIRMWARE = {"ulog": "px4", "dataflash": "ardupilot"}
+
+
+def for_firmware(chosen: Settings, autopilot: str | None, firmware: str | None = None) -> Settings:
+    """The settings for a log of this firmware family (``px4``, ``ardupilot``): its bundled profile when none was
+    asked for, with where that came from; else the settings as they are."""
+    if chosen.profile_given or autopilot is None or autopilot not in profile_names():
+        return chosen
+    why = f"the log's firmware is {firmware or autopilot}"
+    return dataclasses.replace(chosen, profile=load_profile(autopilot), profile_from=why)
+
+
+@dataclass(frozen=True)
+class Names:
+    """What a selector may name for one message: its rules (cross-field ones by their full and short names) and
+    its fields (``patterns``: devicetree properties named by a regular expression)."""
+
+    message: str
+    rules: frozenset[str]
+    fields: frozenset[str]
+    patterns: tuple[str, ...] = ()
+
+    def rule_known(self, selector: str) -> bool:
+        return any(fnmatch.fnmatchcase(r, selector) for r in self.rules)
+
+    def field_known(self, selector: str) -> bool:
+        """A field, or a member of one (``timestamp.usec``: its field is ``timestamp``)."""
+        head = selector.split(".", 1)[0]
+        if any(fnmatch.fnmatchcase(f, head) for f in self.fields):
+            return True
+        return any(re.fullmatch(p, head) for p in self.patterns if not any(c in head for c in "*?["))
+
+
+def names_of(message: Message, rule_ids: Iterable[str], failsafe: bool = False) -> Names:
+    """The names of one message: the generic rules, its cross-field rules (``rule_ids``, as the checker has
+    them), the failsafe rule where the validate app runs it, and its fields."""
+    cross = [*(_CROSS + r for r in rule_ids), *([FAILSAFE_RULE] if failsafe else [])]
+    rules = frozenset((*GENERIC_RULES, *cross, *(c[len(_CROSS) :] for c in cross)))
+    fields = frozenset(f.name for f in message.fields if f.pattern is None)
+    patterns = tuple(f.pattern for f in message.fields if f.pattern is not None)
+    return Names(message.qualified_name, rules, fields, patterns)
+
+
+def unknown_selector(selector: str, names: Names) -> str | None:
+    """Why a selector names nothing of the message (None when it names something)."""
+    if "/" in selector:
+        rule, _, name = selector.partition("/")
+        if not names.rule_known(rule):
+            return f"no rule of {names.message} is called {rule!r}{closest(rule, names.rules)}"
+        if not names.field_known(name):
+            return f"{names.message} has no field {name!r}{closest(name, names.fields)}"
+        return None
+    if names.rule_known(selector) or names.field_known(selector):
+        return None
+    hint = closest(selector, names.rules | names.fields)
+    return f"no rule or field of {names.message} is called {selector!r}{hint}"
+
+
+def check_selectors(chosen: Settings, names: Names) -> None:
+    """Refuse a selector that names no rule or field of the message: a misspelt ``--select`` would leave every
+    finding out, a misspelt ``--ignore`` would look as if it had worked."""
+    for key, selectors in (("select", chosen.select), ("ignore", chosen.ignore)):
+        for s in selectors:
+            problem = unknown_selector(s, names)
+            if problem is not None:
+                raise BattgenError(f"{chosen.where.get(key, '--' + key)}: {problem}")
 
 
 @dataclass
@@ -170,9 +294,6 @@ class Gate:
                 return f"profile {name}: {w.selector}: {w.reason}"
         return None
 
-    def leave_out(self, reason: str) -> None:
-        self.waived[reason] = self.waived.get(reason, 0) + 1
-
 
 def describe(settings: Settings) -> Iterable[str]:
     """The selection in force, in words (for the text summary)."""
@@ -181,4 +302,4 @@ def describe(settings: Settings) -> Iterable[str]:
     if settings.ignore:
         yield "ignore " + ", ".join(settings.ignore)
     if settings.profile is not None:
-        yield f"profile {settings.profile.name}"
+        yield f"profile {settings.profile.name}" + (f" (as {settings.profile_from})" if settings.profile_from else "")

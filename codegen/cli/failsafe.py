@@ -1,4 +1,18 @@
-"""``battgen failsafe [--params FILE] [--vehicle NAME] STREAM``: replay batteries through ArduPilot's failsafe.
+"""``battgen failsafe [--firmware px4|ardupilot] [--params FILE] [--vehicle NAME] STREAM``: replay batteries through
+an autopilot's battery failsafe, PX4's or ArduPilot's.
+
+The firmware is ``--firmware``; else that of the given parameters (ArduPilot's BATT*_ or PX4's BAT_*/COM_*); else
+the log's own (its context: a ULog is PX4's, a DataFlash log ArduPilot's, a tlog's heartbeats name it); a JSON Lines
+stream is replayed through ArduPilot's. Both print their events in one format.
+
+PX4 (a ULog): each battery's logged state of charge through PX4's warning levels (BAT_LOW_THR, BAT_CRIT_THR,
+BAT_EMERGEN_THR), commander's failsafe warning and its action (COM_LOW_BAT_ACT, COM_FAIL_ACT_T), with the log's own
+parameters (``--params`` on top), and the replay checked against what the firmware logged (battery_status.warning,
+failsafe_flags.battery_warning, vehicle_status.nav_state): one ``check`` line each on stderr, ``--strict`` makes a
+check that fails exit 3. An ArduPilot DataFlash log is checked the same way against its ERR (subsystem 6) and MODE
+(reason 4) records.
+
+ArduPilot:
 
 STREAM is a flight log or capture, or a JSON Lines file of samples, told apart by content (then extension).
 A log (PX4 ULog, MAVLink tlog, ArduPilot DataFlash binary or text, CAN capture) is read through the battery
@@ -24,7 +38,8 @@ parameters only one vehicle has, else rover is assumed (said on stderr either wa
 Semantics are ArduPilot's AP_BattMonitor (see docs/failsafe.md); ``--variant
 seed-critical`` and ``--variant distance`` turn on the seed's own choices. Prints one line per
 transition (``--json``: one JSON object per line). Exit 0; 1 when the parameters hold no BATT*_
-one or the input no battery reading (``--allow-empty`` accepts both); 2 when an input cannot be read.
+one or the input no battery reading (``--allow-empty`` accepts both); 2 when an input cannot be read; 3 with
+``--strict`` when a replay does not reproduce what the log recorded.
 """
 
 from __future__ import annotations
@@ -32,15 +47,20 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from ..apps.failsafe.ardupilot_logged import check_log
 from ..apps.failsafe.columnar import replay_table
 from ..apps.failsafe.distance import DistanceRule
 from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
+from ..apps.failsafe.firmware import FIRMWARES, choose_firmware
+from ..apps.failsafe.legacy_parameters import renamed, with_current_names
 from ..apps.failsafe.levels import apply_level
 from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_samples, own_parameters
+from ..apps.failsafe.px4_log import read_px4_log
+from ..apps.failsafe.px4_replay import Px4Event, replay_px4
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
@@ -49,18 +69,20 @@ from ..inputs import parameter_files
 from ..inputs.kinds import FLIGHT_LOG_KINDS, detect
 from ..text.escape import line
 
-EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE = 0, 1, 2
+EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE, EXIT_DIFFERS = 0, 1, 2, 3
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "failsafe",
-        help="replay a flight log (.ulg, .tlog, .bin) or JSON Lines samples through ArduPilot's battery failsafe",
+        help="replay a flight log (.ulg, .tlog, .bin) or JSON Lines samples through PX4's or ArduPilot's failsafe",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("stream", help=".ulg, .tlog, .bin or a JSON Lines file of battery samples")
-    p.add_argument("--params", help="parameter file with the BATT*_ parameters (else an ArduPilot log's own)")
+    p.add_argument("--firmware", choices=FIRMWARES, help="whose failsafe (default: the parameters', else the log's)")
+    p.add_argument("--params", help="parameter file (ArduPilot BATT*_ or PX4 BAT_*/COM_*; else the log's own)")
+    p.add_argument("--strict", action="store_true", help="exit 3 when the replay differs from what the log recorded")
     p.add_argument("--vehicle", choices=sorted(VEHICLES), help="ArduPilot vehicle (default: detected, else rover)")
     p.add_argument("--variant", action="append", choices=sorted(VARIANTS), default=[], help="a seed variant (opt-in)")
     p.add_argument(
@@ -87,19 +109,31 @@ def run(args: argparse.Namespace) -> int:
         if given is not None and given != "-" and not Path(given).is_file():
             raise missing_file(given)
     try:
+        given = read_parameter_values(Path(args.params)) if args.params else None
+        firmware, how = choose_firmware(args.firmware, given, args.params or "", stream)
+    except (BattgenError, ValueError) as exc:
+        print(line(f"battgen: {exc}"), file=sys.stderr)
+        return EXIT_UNREADABLE
+    if firmware == "px4":
+        return _run_px4(args, stream, how, given or {})
+    try:
         # a flight log or capture is read through the battery view; JSON and JSON Lines are sample streams
         table: SampleTable | None = log_samples(stream, args.stream) if detect(stream) in FLIGHT_LOG_KINDS else None
         own = own_parameters(table) if table is not None and not args.params else None
+        raw: Mapping[str, float] = {}
         if args.params:
-            values: dict[str, float] = read_parameter_values(Path(args.params))
+            raw = read_parameter_values(Path(args.params))
+            values: dict[str, float] = with_current_names(raw)
             where = args.params
             for repeat in parameter_files.repeats(parameter_files.load(Path(args.params))):
                 print(line(f"battgen: warning: {args.params}:{repeat.lines[-1]}: {repeat.message()}"), file=sys.stderr)
-        elif own is not None:
-            source = table.context.parameters_from if table is not None and table.context is not None else ""
-            values, where = own, f"{args.stream} ({source})"
+        elif own is not None and table is not None and table.context is not None:
+            raw = table.context.parameters
+            values, where = own, f"{args.stream} ({table.context.parameters_from})"
         else:
             raise BattgenError(f"expected --params FILE: {_why_no_parameters(table)}")
+        for old in renamed(raw):  # an older firmware's names, replayed under today's
+            print(line(f"battgen: warning: {where}: {old.message()}"), file=sys.stderr)
         if args.params and not batt_parameter_count(values) and not args.allow_empty:
             print(
                 line(
@@ -153,11 +187,75 @@ def run(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
             return EXIT_EMPTY
+        checks = check_log(stream, args.stream, table, fs.events) if table is not None else []
+        for check in checks:
+            print(line(f"battgen: check {check.what}: {check.verdict()}"), file=sys.stderr)
     except (BattgenError, ValueError) as exc:
         print(line(f"battgen: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     print(line(f"{read} samples, {len(fs.events)} events, final level {fs.level.name}"), file=sys.stderr)
-    return EXIT_OK
+    return EXIT_DIFFERS if args.strict and any(c.problems for c in checks) else EXIT_OK
+
+
+def _run_px4(args: argparse.Namespace, stream: Path, how: str, given: dict[str, float]) -> int:
+    try:
+        if detect(stream) != "ulog":
+            raise BattgenError(
+                f"{args.stream}: expected a PX4 ULog (.ulg): PX4's replay starts from the battery_status the firmware "
+                "logged"
+            )
+        log = read_px4_log(stream, args.stream)
+        replay = replay_px4(log, given)
+        if replay.samples == 0:
+            raise BattgenError(f"{args.stream}: expected battery_status records, found none")
+    except (BattgenError, ValueError) as exc:
+        print(line(f"battgen: {exc}"), file=sys.stderr)
+        return EXIT_UNREADABLE
+    where = f"{args.params} over the log's PARAM definitions" if args.params else f"{args.stream} (PARAM definitions)"
+    thr, st = replay.thresholds, replay.settings
+    print(line(f"battgen: firmware px4 ({how}; {log.context.firmware or 'release unknown'}); parameters from {where}: "
+               f"BAT_LOW_THR {thr.low:g} BAT_CRIT_THR {thr.critical:g} BAT_EMERGEN_THR {thr.emergency:g} "
+               f"COM_LOW_BAT_ACT {st.low_bat_act} COM_FAIL_ACT_T {st.fail_act_t:g}"), file=sys.stderr)  # fmt: skip
+    if args.vehicle or args.variant:
+        print("battgen: warning: --vehicle and --variant are ArduPilot's: not used for PX4", file=sys.stderr)
+    for note in replay.notes:
+        print(line(f"battgen: note: {note}"), file=sys.stderr)
+    for event in replay.events:
+        print(_px4_json(event) if args.json else line(_px4_line(event)))
+    for check in replay.checks:
+        print(line(f"battgen: check {check.what}: {check.verdict()}"), file=sys.stderr)
+    level = max((e.level for e in replay.events if e.cause == "charge"), default=None)
+    print(line(f"{replay.samples} samples, {len(replay.events)} events, final level {level.name if level else 'NONE'}"),
+          file=sys.stderr)  # fmt: skip
+    return EXIT_DIFFERS if args.strict and any(c.problems for c in replay.checks) else EXIT_OK
+
+
+def _px4_line(e: Px4Event) -> str:
+    return (
+        f"t={e.time:10.3f}s  battery {e.battery} {e.label:<8} {e.cause:<8} value={e.value:.3f} "
+        f"threshold={e.threshold:.3f} action={e.action_name} ({e.action_code}) -> {e.outcome}  "
+        f'"{e.text}"  uorb.warning={int(e.level)}  ({e.place})'
+    )
+
+
+def _px4_json(e: Px4Event) -> str:
+    out: dict[str, Any] = {
+        "t": e.time,
+        "battery": e.battery,
+        "level": e.label,
+        "cause": e.cause,
+        "value": e.value if e.value == e.value else None,
+        "threshold": e.threshold,
+        "action": e.action_name,
+        "action_code": e.action_code,
+        "executed": True,
+        "outcome": e.outcome,
+        "firmware": "px4",
+        "firmware_text": e.text,
+        "uorb_warning": int(e.level),
+        "where": e.place,
+    }
+    return json.dumps(out, allow_nan=False)
 
 
 def _why_no_parameters(table: SampleTable | None) -> str:
@@ -166,7 +264,7 @@ def _why_no_parameters(table: SampleTable | None) -> str:
     if context is not None and context.autopilot == "px4":
         return (
             f"this is a PX4 log ({len(context.parameters)} PX4 parameters, such as BAT_LOW_THR); ArduPilot's "
-            "failsafe needs BATT_* values"
+            "failsafe needs BATT_* values, and PX4's replay reads a ULog (its battery_status)"
         )
     return "the input carries no ArduPilot parameters of its own (a DataFlash log's PARM, a tlog's PARAM_VALUE)"
 
@@ -206,6 +304,8 @@ def _json(e: Event, s: Sample, vehicle: str) -> str:
         "uorb_warning": e.uorb_warning,
         "mavlink_charge_state": e.mavlink_charge_state,
         "where": s.place,
+        "firmware": "ardupilot",
+        "firmware_text": e.ardupilot_text,
     }
     if s.message is not None and s.data is not None:
         out["message"] = s.message

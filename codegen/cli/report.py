@@ -6,8 +6,14 @@ instance the time plots of pack voltage, current, power, state of charge, temper
 imbalance, the failsafe replay marked on the time axis (``--params`` with the BATT_* values, ``--vehicle``), the
 validation findings grouped by rule with links to their time, and the figures (charge and energy used, average
 and peak power, minimum pack and cell voltage, time under each threshold, voltage sag per amp and an internal
-resistance estimate from load steps). Several inputs give a fleet page: a row per flight and battery, and trends
-per pack serial. ``--format png`` writes one static image per battery into the ``-o`` folder instead;
+resistance estimate from load steps). Each input opens with what the log says about itself: vehicle type, firmware,
+hardware, start (UTC where known), duration, armed spans (shaded on the plots), the battery parameters it recorded,
+and the firmware's own warning levels (PX4 ``battery_status.warning``, MAVLink ``charge_state``) marked on the time
+axis; thresholds come from the log's own parameters unless ``--params`` gives others, and the page says which.
+Findings are gated as ``validate`` gates them: ``--select``, ``--ignore``, ``--profile`` and ``[tool.battgen]``,
+the profile following the log's firmware unless given (a PX4 log: ``px4``); an unknown name is exit 2.
+Several inputs give a fleet page: a row per flight and battery with its date and firmware, and trends per pack
+serial over the flights' dates. ``--format png`` writes one static image per battery into the ``-o`` folder instead;
 ``--format json`` the figures, per input and battery (the page's and the flight's in SI), to ``-o`` or stdout.
 Exit 0 when written, 1 when the inputs hold no battery record (``--allow-empty``: 0, nothing written), 2 when an
 input cannot be read or the output cannot be written.
@@ -21,11 +27,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..apps.failsafe.vehicles import VEHICLES
+from ..apps.gate import unknown_name
 from ..apps.package import bundled_schemas
 from ..apps.report.as_json import report_json
 from ..apps.report.build import collect, html, pngs
 from ..errors import BattgenError, missing_file
 from ..text.escape import line
+from .gate_options import add_gate_options, firmware_note, gate_settings
 
 EXIT_OK, EXIT_EMPTY = 0, 1
 
@@ -36,9 +45,20 @@ def run(args: argparse.Namespace) -> int:
     for p in paths:
         if not p.is_file():
             raise missing_file(str(p))
+    if args.vehicle is not None and args.vehicle not in VEHICLES:
+        raise unknown_name("vehicle", args.vehicle, VEHICLES)
     report = collect(
-        paths, schema_dir, message=args.message, params=Path(args.params) if args.params else None, vehicle=args.vehicle
+        paths,
+        schema_dir,
+        message=args.message,
+        params=Path(args.params) if args.params else None,
+        vehicle=args.vehicle,
+        gate=gate_settings(args),
     )
+    for item in report.inputs:  # the profile the log's firmware chose, as validate says it
+        note = firmware_note(item.source, item.gate) if item.gate is not None else None
+        if note is not None:
+            print(line(note), file=sys.stderr)
     if not any(i.batteries for i in report.inputs):  # readable, but nothing to draw: exit 1 as the README says
         names = ", ".join(str(p) for p in paths)
         if args.allow_empty:
@@ -100,8 +120,14 @@ def register(subparsers: Any) -> None:
     p.add_argument("--format", choices=("html", "png", "json"), default="html", help="output (default: html)")
     p.add_argument("--message", metavar="NAME", help="the message of data-file inputs (default by log kind)")
     p.add_argument("--schemas", metavar="DIR", help="schema folder (default: the bundled schemas/)")
-    p.add_argument("--params", metavar="FILE", help="BATT_* parameter file to replay the failsafe with")
-    p.add_argument("--vehicle", metavar="NAME", help="vehicle profile of the failsafe (rover, copter, plane, sub)")
+    p.add_argument(
+        "--params",
+        metavar="FILE",
+        help="parameter file whose values replace the log's own for the thresholds and the failsafe replay "
+        "(default: the log's own parameters)",
+    )
+    p.add_argument("--vehicle", metavar="NAME", help=f"vehicle of the failsafe ({', '.join(sorted(VEHICLES))})")
+    add_gate_options(p)
     p.add_argument("--title", metavar="TEXT", help="the page's title")
     p.add_argument("--allow-empty", action="store_true", help="inputs without battery records are not an error")
     p.set_defaults(func=run)

@@ -49,14 +49,16 @@ from typing import Any
 
 from ..apps import validate as engine
 from ..apps.failsafe.vehicles import VEHICLES
-from ..apps.gate import Gate, Settings, describe, profile_names, settings
+from ..apps.gate import KIND_FIRMWARE, Gate, Settings, check_selectors, describe, for_firmware, names_of
 from ..apps.package import bundled_schemas
 from ..apps.validate import Checker, Event, FileReport, Finding, exit_code, is_empty, json_document, make_checker
 from ..apps.validate_formats import Group, Grouper, github_line, github_notice, sarif_document
-from ..inputs.kinds import KINDS
+from ..errors import BattgenError
+from ..inputs.kinds import KINDS, file_kind
 from ..inputs.records import Notice, Unreadable
 from ..ir import Message
 from ..text.escape import line
+from .gate_options import add_gate_options, firmware_note, gate_settings
 
 
 def _count(n: int, noun: str) -> str:
@@ -128,26 +130,22 @@ def check_file(
     return report
 
 
-def _selectors(values: list[str] | None) -> list[str] | None:
-    """--select/--ignore values: repeatable, each comma-separated; None when not given."""
-    if values is None:
-        return None
-    return [s.strip() for v in values for s in v.split(",") if s.strip()]
-
-
 def run(args: argparse.Namespace) -> int:
     schema_dir = Path(args.schemas) if args.schemas else bundled_schemas()
     kind = args.input_format
-    chosen = settings(_selectors(args.select), _selectors(args.ignore), args.profile, Path.cwd())
+    chosen = gate_settings(args)
     message, checker = make_checker(schema_dir, args.message, args.files, kind, vehicle=args.vehicle)
+    check_selectors(chosen, names_of(message, checker.rules, checker.extra is not None))
     fmt = args.format
     text_like = fmt in ("text", "github")
     reports: list[FileReport] = []
     all_groups: list[Group] = []
     problems: list[tuple[str, str, str]] = []  # SARIF's tool notifications: (file, level, text)
     github = fmt == "github"
+    in_force: list[Settings] = []
     for f in args.files:
-        gate = Gate(chosen, message.qualified_name)
+        in_force.append(file_settings(chosen, Path(f), kind, echo=text_like))
+        gate = Gate(in_force[-1], message.qualified_name)
         grouper = Grouper()
         report = check_file(
             Path(f), message, checker, grouper, echo=text_like, keep=fmt == "json", kind=kind, gate=gate, github=github
@@ -169,6 +167,8 @@ def run(args: argparse.Namespace) -> int:
             for u in report.unreadable:
                 print(github_notice(u.file, u.message))
     code = exit_code(reports, allow_empty=args.allow_empty)
+    if in_force and all(s == in_force[0] for s in in_force):  # one profile for all files: the summary names it
+        chosen = in_force[0]
     if fmt == "json":
         json.dump(json_document(message, reports, allow_empty=args.allow_empty), sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
@@ -179,6 +179,19 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(line(summary(message, reports, all_groups, chosen)), file=sys.stderr)
     return code
+
+
+def file_settings(chosen: Settings, path: Path, kind: str | None, *, echo: bool) -> Settings:
+    """The settings for one file: the profile of its firmware where none was asked for (said on stderr)."""
+    try:
+        found = kind or file_kind(path)
+    except BattgenError:  # unreadable: the check says so
+        return chosen
+    own = for_firmware(chosen, KIND_FIRMWARE.get(found))
+    note = firmware_note(path.as_posix(), own)
+    if echo and note is not None:
+        print(line(note), file=sys.stderr)
+    return own
 
 
 def version() -> str:
@@ -239,24 +252,7 @@ def register(subparsers: Any) -> None:
         default="text",
         help="text (default), json, github (workflow-command annotations) or sarif (SARIF 2.1.0, code scanning)",
     )
-    p.add_argument(
-        "--select",
-        action="append",
-        metavar="SELECTORS",
-        help="report only these findings: RULE/FIELD, RULE or FIELD, wildcards allowed, comma-separated "
-        "(replaces [tool.battgen] select)",
-    )
-    p.add_argument(
-        "--ignore",
-        action="append",
-        metavar="SELECTORS",
-        help="leave these findings out (counted in the summary; replaces [tool.battgen] ignore)",
-    )
-    p.add_argument(
-        "--profile",
-        metavar="NAME",
-        help=f"waive a bundled profile's known firmware deviations ({', '.join(profile_names())}); '' for none",
-    )
+    add_gate_options(p)
     p.add_argument("--allow-empty", action="store_true", help="a file without records is not an error")
     p.add_argument(
         "--input-format",

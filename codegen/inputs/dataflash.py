@@ -311,6 +311,68 @@ class LogStart:
     firmware: str | None
     parameters: Mapping[str, float] = field(default_factory=dict)
     hardware: str | None = None  # the board, from the MSG that gives its name and unique id (BOARD_ID)
+    texts: tuple[tuple[float | None, str], ...] = ()  # every MSG: (seconds on the log's clock, text)
+    modes: tuple[tuple[float | None, int, int | None], ...] = ()  # every MODE: (seconds, mode number, reason)
+    errors: tuple[tuple[float | None, int, int], ...] = ()  # every ERR: (seconds, subsystem, error code)
+
+
+# ArduPilot's ModeReason (libraries/AP_Vehicle/ModeReason.h), the reasons a MODE record gives, up to the general
+# FAILSAFE; a later number is shown as it is
+MODE_REASONS = (
+    "UNKNOWN",
+    "RC_COMMAND",
+    "GCS_COMMAND",
+    "RADIO_FAILSAFE",
+    "BATTERY_FAILSAFE",
+    "GCS_FAILSAFE",
+    "EKF_FAILSAFE",
+    "GPS_GLITCH",
+    "MISSION_END",
+    "THROTTLE_LAND_ESCAPE",
+    "FENCE_BREACHED",
+    "TERRAIN_FAILSAFE",
+    "BRAKE_TIMEOUT",
+    "FLIP_COMPLETE",
+    "AVOIDANCE",
+    "AVOIDANCE_RECOVERY",
+    "THROW_COMPLETE",
+    "TERMINATE",
+    "TOY_MODE",
+    "CRASH_FAILSAFE",
+    "SOARING_FBW_B_WITH_MOTOR_RUNNING",
+    "SOARING_THERMAL_DETECTED",
+    "SOARING_THERMAL_ESTIMATE_DETERIORATED",
+    "VTOL_FAILED_TRANSITION",
+    "VTOL_FAILED_TAKEOFF",
+    "FAILSAFE",
+)
+# ArduPilot's failsafe subsystems of an ERR record (AP_Logger's LogErrorSubsystem); ECode 0 is "resolved"
+FAILSAFE_SUBSYSTEMS = {
+    5: "FAILSAFE_RADIO",
+    6: "FAILSAFE_BATT",
+    7: "FAILSAFE_GPS",
+    8: "FAILSAFE_GCS",
+    9: "FAILSAFE_FENCE",
+}
+# the vehicle a firmware string names, as MAV_TYPE, for pymavlink's table of its mode numbers
+_FIRMWARE_MAV_TYPE = (("Copter", 2), ("Plane", 1), ("Rover", 10), ("Sub", 12), ("Tracker", 5))
+
+
+def mode_name(number: int, firmware: str | None) -> str:
+    """An ArduPilot mode number by name, for the vehicle its firmware string names (pymavlink's tables), else
+    ``mode N``."""
+    mav_type = next((t for word, t in _FIRMWARE_MAV_TYPE if firmware and word in firmware), None)
+    if mav_type is not None:
+        from pymavlink import mavutil  # the DataFlash reader's own dependency
+
+        names = mavutil.mode_mapping_bynumber(mav_type) or {}
+        if number in names:
+            return str(names[number])
+    return f"mode {number}"
+
+
+def reason_name(reason: int) -> str:
+    return MODE_REASONS[reason] if 0 <= reason < len(MODE_REASONS) else f"reason {reason}"
 
 
 def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRecord | GpsClock | LogStart]:
@@ -321,7 +383,10 @@ def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRe
     firmware: str | None = None
     hardware: str | None = None
     parameters: dict[str, float] = {}
-    for msg in log.messages(BATTERY_TYPES | ARMING_TYPES | {"GPS", "PARM", "MSG"}):
+    texts: list[tuple[float | None, str]] = []
+    modes: list[tuple[float | None, int, int | None]] = []
+    errors: list[tuple[float | None, int, int]] = []
+    for msg in log.messages(BATTERY_TYPES | ARMING_TYPES | {"GPS", "PARM", "MSG", "MODE", "ERR"}):
         if msg.type == "GPS":
             clock = _gps_clock(msg)
             if clock is not None:
@@ -340,19 +405,31 @@ def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRe
                 parameters[parameter[0]] = parameter[1]
                 if parameter[0] == "LOG_DISARMED" and log_disarmed is None:
                     log_disarmed = parameter[1]
-        elif msg.type == "MSG" and (firmware is None or hardware is None):
+        elif msg.type == "MODE":
+            number, reason = _number(msg.fields, "ModeNum"), _number(msg.fields, "Rsn")
+            number = number if number is not None else _number(msg.fields, "Mode")
+            if number is not None:
+                modes.append((msg.when_s, int(number), None if reason is None else int(reason)))
+        elif msg.type == "ERR":
+            subsystem, code = _number(msg.fields, "Subsys"), _number(msg.fields, "ECode")
+            if subsystem is not None and code is not None:
+                errors.append((msg.when_s, int(subsystem), int(code)))
+        elif msg.type == "MSG":
             text = msg.fields.get("Message")
             if isinstance(text, bytes):
                 text = text.decode("ascii", "replace")
             if not isinstance(text, str):
                 continue
             text = text.rstrip("\x00")
+            texts.append((msg.when_s, text))
+            if firmware is not None and hardware is not None:
+                continue
             board = BOARD_ID.fullmatch(text)
             if board is not None and hardware is None:
                 hardware = board.group(1)
             elif firmware is None and (" V" in text or text.startswith(("Ardu", "APM"))):
                 firmware = text
-    yield LogStart(start, log_disarmed, firmware, parameters, hardware)
+    yield LogStart(start, log_disarmed, firmware, parameters, hardware, tuple(texts), tuple(modes), tuple(errors))
 
 
 GPS_EPOCH_S = 315_964_800  # 1980-01-06 00:00 UTC, the start of GPS week 0, in Unix time

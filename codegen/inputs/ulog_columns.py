@@ -63,6 +63,8 @@ class ColumnLog(Protocol):
     parameters: Mapping[str, object]
     formats: Mapping[str, object]
     warnings: list[str]
+    logged: list[tuple[int, int, str]]  # (level, timestamp, text)
+    logged_tagged: list[tuple[int, int, int, str]]  # (tag, level, timestamp, text)
 
     data: Any
 
@@ -272,6 +274,22 @@ class UlogColumns:
         utc, stamp = recs["time_utc_usec"], recs["timestamp"]
         known = np.nonzero(utc > 0)[0]
         return int(utc[known[0]]) - int(stamp[known[0]]) if len(known) else None
+
+    def nav_states(self) -> tuple[NDArray, NDArray, NDArray | None] | None:
+        """(timestamps, nav_state, failsafe) of ``vehicle_status`` (failsafe None where the log lacks it), if the
+        log has it: the mode commander put the vehicle in, and whether a failsafe put it there."""
+        status = self._topic_records("vehicle_status", ("timestamp", "nav_state"))
+        if status is None or not len(status):
+            return None
+        failsafe = status["failsafe"] if "failsafe" in (status.dtype.names or ()) else None
+        return status["timestamp"], status["nav_state"], failsafe
+
+    def logged(self) -> list[tuple[int, int, str]]:
+        """The log's text messages (``L`` and tagged ``C`` records) as (level byte, timestamp, text), by time;
+        complete once the log was walked (the columns' reading walks it)."""
+        plain = list(self.log.logged)
+        tagged = [(level, stamp, text) for _, level, stamp, text in self.log.logged_tagged]
+        return sorted(plain + tagged, key=lambda m: m[1])
 
     def armed(self) -> tuple[NDArray, NDArray] | None:
         """(timestamps, armed) of the vehicle's arming state, if the log has one. The rule: ``vehicle_status``'s

@@ -9,8 +9,10 @@ to each message the rule names; :class:`UnboundName` is for a schema assembled b
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
-from .expr import Const, Expr, FieldRef, Loop, Name, Template, children, rebuild
+from .expr import Call, Compare, Const, Expr, FieldRef, Loop, Name, Template, children, rebuild
+from .fieldtypes import Range
 from .messages import Message
 from .schema import CrossFieldRule, Schema
 
@@ -84,3 +86,56 @@ def rules_for(schema: Schema, msg: Message) -> tuple[CrossFieldRule, ...]:
 def bound_rules(schema: Schema, msg: Message) -> list[BoundRule]:
     """The schema's rules for ``msg``, bound to its fields and constants."""
     return [bind(rule, msg) for rule in rules_for(schema, msg)]
+
+
+def rule_ranges(schema: Schema) -> dict[tuple[str, str], Range]:
+    """The ranges that rules state of a single field: ``(message, field) -> Range`` for each error rule of the
+    form ``A <= f <= B`` (or one side, ``f <= B``; with ``<`` exclusive), checked where ``f`` is known (no
+    ``where``, or ``where: is_known(f)``). A converter writing the field keeps to these as to the schema's own
+    range: what it writes must pass the validator."""
+    out: dict[tuple[str, str], Range] = {}
+    for rule in schema.rules:
+        if rule.severity != "error" or rule.loops:
+            continue
+        for name in rule.messages:
+            try:
+                bound = bind(rule, schema.message(name))
+            except (KeyError, UnboundName):
+                continue
+            found = _single_field_range(bound.check, bound.where)
+            if found is not None:
+                key = (name, found[0])
+                out[key] = found[1].intersect(out.get(key))
+    return out
+
+
+def _single_field_range(check: Expr, where: Expr | None) -> tuple[str, Range] | None:
+    if not isinstance(check, Compare) or not all(op in ("<", "<=") for op in check.ops):
+        return None
+    fields = [i for i, e in enumerate(check.operands) if isinstance(e, FieldRef)]
+    if len(fields) != 1 or not all(isinstance(e, Const | FieldRef) for e in check.operands):
+        return None
+    at = fields[0]
+    name = cast(FieldRef, check.operands[at]).name
+    if where is not None and not (
+        isinstance(where, Call) and where.func == "is_known" and where.args == (FieldRef(name),)
+    ):
+        return None
+    low = check.operands[at - 1] if at > 0 else None
+    high = check.operands[at + 1] if at + 1 < len(check.operands) else None
+    number = (int, float)
+    lo = (
+        low.value
+        if isinstance(low, Const) and isinstance(low.value, number) and not isinstance(low.value, bool)
+        else None
+    )
+    hi = (
+        high.value
+        if isinstance(high, Const) and isinstance(high.value, number) and not isinstance(high.value, bool)
+        else None
+    )
+    if lo is None and hi is None:
+        return None
+    return name, Range(
+        lo, hi, at > 0 and check.ops[at - 1] == "<", at + 1 < len(check.operands) and check.ops[at] == "<"
+    )

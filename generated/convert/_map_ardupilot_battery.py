@@ -366,7 +366,7 @@ def backward(
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryContinuous.slot_id")
     else:
         t_continuous.slot_id = _r.to_int(
-            _v10 - -1, 0, 255, rep, "dronecan.ardupilot.equipment.power.BatteryContinuous.slot_id"
+            _v10 - -1, 1, 255, rep, "dronecan.ardupilot.equipment.power.BatteryContinuous.slot_id"
         )
         if rep is not None and t_continuous.slot_id in (0,):
             rep.clamped(
@@ -413,7 +413,7 @@ def backward(
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryPeriodic.cells_in_series")
     else:
         t_periodic.cells_in_series = _r.to_int(
-            _v14, 0, 255, rep, "dronecan.ardupilot.equipment.power.BatteryPeriodic.cells_in_series"
+            _v14, 1, 255, rep, "dronecan.ardupilot.equipment.power.BatteryPeriodic.cells_in_series"
         )
         if rep is not None and t_periodic.cells_in_series in (0,):
             rep.clamped(
@@ -445,7 +445,7 @@ def backward(
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryPeriodic.cycle_count")
     else:
         t_periodic.cycle_count = _r.to_int(
-            _v16, 0, 65535, rep, "dronecan.ardupilot.equipment.power.BatteryPeriodic.cycle_count"
+            _v16, 0, 65534, rep, "dronecan.ardupilot.equipment.power.BatteryPeriodic.cycle_count"
         )
         if rep is not None and t_periodic.cycle_count in (65535,):
             rep.clamped(
@@ -493,7 +493,7 @@ def backward(
             rep_u.unknown("dronecan.ardupilot.equipment.power.BatteryTag.serial_number")
     else:
         t_tag.serial_number = _r.to_int(
-            _v19, 0, 4294967295, rep, "dronecan.ardupilot.equipment.power.BatteryTag.serial_number"
+            _v19, 1, 4294967295, rep, "dronecan.ardupilot.equipment.power.BatteryTag.serial_number"
         )
         if rep is not None and t_tag.serial_number in (0,):
             rep.clamped(

@@ -281,7 +281,7 @@ def backward(
             rep_u.unknown("dronecan.cuav.equipment.power.CBAT.average_time_to_empty")
     else:
         t_cbat.average_time_to_empty = _r.to_int(
-            _v9 * 0.016666666666666666, 0, 65535, rep, "dronecan.cuav.equipment.power.CBAT.average_time_to_empty"
+            _v9 * 0.016666666666666666, 0, 65534, rep, "dronecan.cuav.equipment.power.CBAT.average_time_to_empty"
         )
         if rep is not None and t_cbat.average_time_to_empty in (65535,):
             rep.clamped(
@@ -297,7 +297,7 @@ def backward(
             rep_u.unknown("dronecan.cuav.equipment.power.CBAT.average_time_to_full")
     else:
         t_cbat.average_time_to_full = _r.to_int(
-            _v10 * 0.016666666666666666, 0, 65535, rep, "dronecan.cuav.equipment.power.CBAT.average_time_to_full"
+            _v10 * 0.016666666666666666, 0, 65534, rep, "dronecan.cuav.equipment.power.CBAT.average_time_to_full"
         )
         if rep is not None and t_cbat.average_time_to_full in (65535,):
             rep.clamped(

@@ -344,7 +344,7 @@ def backward(
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct")
     else:
         t_info.state_of_charge_pct = _r.to_int(
-            _v14 * 100.0, 0, 127, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct"
+            _v14 * 100.0, 0, 100, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct"
         )
         if rep is not None and t_info.state_of_charge_pct in (127,):
             rep.clamped(
@@ -388,7 +388,7 @@ def backward(
             rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id")
     else:
         t_info.model_instance_id = _r.to_int(
-            _v18, 0, 4294967295, rep, "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id"
+            _v18, 1, 4294967295, rep, "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id"
         )
         if rep is not None and t_info.model_instance_id in (0,):
             rep.clamped(

@@ -239,7 +239,7 @@ def backward(
             rep_u.unknown("mavlink.BATTERY_STATUS.temperature")
     else:
         t_msg.temperature = _r.to_int(
-            _v4 * 100.0 + -27314.999999999996, -32768, 32767, rep, "mavlink.BATTERY_STATUS.temperature"
+            _v4 * 100.0 + -27314.999999999996, -32768, 32766, rep, "mavlink.BATTERY_STATUS.temperature"
         )
         if rep is not None and t_msg.temperature in (32767,):
             rep.clamped("mavlink.BATTERY_STATUS.temperature", "a known value written as the unknown marker")
@@ -306,7 +306,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_STATUS.battery_remaining")
     else:
-        t_msg.battery_remaining = _r.to_int(_v9 * 100.0, -128, 100, rep, "mavlink.BATTERY_STATUS.battery_remaining")
+        t_msg.battery_remaining = _r.to_int(_v9 * 100.0, 0, 100, rep, "mavlink.BATTERY_STATUS.battery_remaining")
         if rep is not None and t_msg.battery_remaining in (-1,):
             rep.clamped("mavlink.BATTERY_STATUS.battery_remaining", "a known value written as the unknown marker")
 

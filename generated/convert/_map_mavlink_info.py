@@ -223,7 +223,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_INFO.cells_in_series")
     else:
-        t_info.cells_in_series = _r.to_int(_v5, 0, 255, rep, "mavlink.BATTERY_INFO.cells_in_series")
+        t_info.cells_in_series = _r.to_int(_v5, 1, 255, rep, "mavlink.BATTERY_INFO.cells_in_series")
         if rep is not None and t_info.cells_in_series in (0,):
             rep.clamped("mavlink.BATTERY_INFO.cells_in_series", "a known value written as the unknown marker")
 
@@ -234,7 +234,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_INFO.cycle_count")
     else:
-        t_info.cycle_count = _r.to_int(_v6, 0, 65535, rep, "mavlink.BATTERY_INFO.cycle_count")
+        t_info.cycle_count = _r.to_int(_v6, 0, 65534, rep, "mavlink.BATTERY_INFO.cycle_count")
         if rep is not None and t_info.cycle_count in (65535,):
             rep.clamped("mavlink.BATTERY_INFO.cycle_count", "a known value written as the unknown marker")
 
@@ -245,7 +245,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_INFO.weight")
     else:
-        t_info.weight = _r.to_int(_v7 * 1000.0, 0, 65535, rep, "mavlink.BATTERY_INFO.weight")
+        t_info.weight = _r.to_int(_v7 * 1000.0, 1, 65535, rep, "mavlink.BATTERY_INFO.weight")
         if rep is not None and t_info.weight in (0,):
             rep.clamped("mavlink.BATTERY_INFO.weight", "a known value written as the unknown marker")
 

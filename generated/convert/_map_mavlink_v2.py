@@ -173,7 +173,7 @@ def backward(
             rep_u.unknown("mavlink.BATTERY_STATUS_V2.temperature")
     else:
         t_status.temperature = _r.to_int(
-            _v2 * 100.0 + -27314.999999999996, -32768, 32767, rep, "mavlink.BATTERY_STATUS_V2.temperature"
+            _v2 * 100.0 + -27314.999999999996, -32768, 32766, rep, "mavlink.BATTERY_STATUS_V2.temperature"
         )
         if rep is not None and t_status.temperature in (32767,):
             rep.clamped("mavlink.BATTERY_STATUS_V2.temperature", "a known value written as the unknown marker")

@@ -145,7 +145,7 @@ def forward(
     # px4_uavcannode.yaml:37: const 0 -> info.model_instance_id
     t_info.model_instance_id = 0
 
-    # px4_uavcannode.yaml:38: const "PX4 CAN Battery" -> info.model_name
+    # px4_uavcannode.yaml:38: const 'PX4 CAN Battery' -> info.model_name
     t_info.model_name = b"PX4 CAN Battery"
 
     # px4_uavcannode.yaml:39: px4_int state_of_health -> info.state_of_health_pct

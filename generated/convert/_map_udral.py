@@ -330,7 +330,7 @@ def backward(
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.unique_id")
     else:
         t_parameters.unique_id = _r.to_int(
-            _v12, 0, 18446744073709551615, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.unique_id"
+            _v12, 1, 18446744073709551615, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.unique_id"
         )
         if rep is not None and t_parameters.unique_id in (0,):
             rep.clamped(
@@ -436,7 +436,7 @@ def backward(
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.series_cell_count")
     else:
         t_parameters.series_cell_count = _r.to_int(
-            _v23, 0, 255, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.series_cell_count"
+            _v23, 1, 255, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.series_cell_count"
         )
         if rep is not None and t_parameters.series_cell_count in (0,):
             rep.clamped(

@@ -341,7 +341,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.cell_count")
     else:
-        t_status.cell_count = _r.to_int(_v9, 0, 255, rep, "uorb.BatteryStatus.cell_count")
+        t_status.cell_count = _r.to_int(_v9, 1, 255, rep, "uorb.BatteryStatus.cell_count")
         if rep is not None and t_status.cell_count in (0,):
             rep.clamped("uorb.BatteryStatus.cell_count", "a known value written as the unknown marker")
 
@@ -370,7 +370,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.capacity")
     else:
-        t_status.capacity = _r.to_int(_v11 * 0.2777777777777778, 0, 65535, rep, "uorb.BatteryStatus.capacity")
+        t_status.capacity = _r.to_int(_v11 * 0.2777777777777778, 1, 65535, rep, "uorb.BatteryStatus.capacity")
         if rep is not None and t_status.capacity in (0,):
             rep.clamped("uorb.BatteryStatus.capacity", "a known value written as the unknown marker")
 
@@ -389,7 +389,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.state_of_health")
     else:
-        t_status.state_of_health = _r.to_int(_v13 * 100.0, 0, 65535, rep, "uorb.BatteryStatus.state_of_health")
+        t_status.state_of_health = _r.to_int(_v13 * 100.0, 1, 100, rep, "uorb.BatteryStatus.state_of_health")
         if rep is not None and t_status.state_of_health in (0,):
             rep.clamped("uorb.BatteryStatus.state_of_health", "a known value written as the unknown marker")
 
@@ -401,7 +401,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryStatus.id")
     else:
-        t_status.id = _r.to_int(_v14 - -1, 0, 255, rep, "uorb.BatteryStatus.id")
+        t_status.id = _r.to_int(_v14 - -1, 1, 255, rep, "uorb.BatteryStatus.id")
         if rep is not None and t_status.id in (0,):
             rep.clamped("uorb.BatteryStatus.id", "a known value written as the unknown marker")
 

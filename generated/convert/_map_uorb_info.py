@@ -110,7 +110,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryInfo.id")
     else:
-        t_info.id = _r.to_int(_v1 - -1, 0, 255, rep, "uorb.BatteryInfo.id")
+        t_info.id = _r.to_int(_v1 - -1, 1, 255, rep, "uorb.BatteryInfo.id")
         if rep is not None and t_info.id in (0,):
             rep.clamped("uorb.BatteryInfo.id", "a known value written as the unknown marker")
 

@@ -190,10 +190,11 @@ def to_int(x: float, lo: int, hi: int, rep: LossReport | None, label: str) -> in
     """The nearest integer (halves away from zero) clamped into [lo, hi]; reports what it changed."""
     if math.isnan(x):
         raise ConversionError(f"{label}: NaN has no integer value")
-    if math.isinf(x):
-        n = hi if x > 0 else lo
-    else:
-        n = int(math.copysign(math.floor(abs(x) + 0.5), x))
+    if math.isinf(x):  # out of range like any finite excess: clamped, and said so
+        if rep is not None:
+            rep.clamped(label, f"{x!r} outside {lo}..{hi}")
+        return hi if x > 0 else lo
+    n = int(math.copysign(math.floor(abs(x) + 0.5), x))
     if n < lo or n > hi:
         clamped = lo if n < lo else hi
         if rep is not None:

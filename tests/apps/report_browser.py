@@ -2,7 +2,8 @@
 
 What a page is checked for: it renders (the page's script sets ``data-rendered``) with no console errors and no
 network request but the file itself, and every plot's traces as plotly holds them (row, samples before
-decimation, points drawn) and the failsafe marker lines, read back from the live page. A screenshot of every
+decimation, points drawn), the failsafe marker lines, the armed shading, the log's own warning markers, flight
+modes and failsafe entries, and each input's header table, read back from the live page. A screenshot of every
 page is kept under ``build/test-artifacts/`` (or ``$BATTGEN_ARTIFACTS``) for a person to look at.
 """
 
@@ -45,8 +46,29 @@ return Array.from(document.querySelectorAll('.battery-plot, #trends')).map(funct
     }),
     markers: ((div.layout && div.layout.shapes) || []).filter(function (s) {
       return s.name && s.name.indexOf('failsafe') === 0;
-    }).map(function (s) { return {t: s.x0, level: s.name.slice(9)}; })
+    }).map(function (s) { return {t: s.x0, level: s.name.slice(9)}; }),
+    armed: ((div.layout && div.layout.shapes) || []).filter(function (s) {
+      return s.name === 'armed';
+    }).map(function (s) { return [s.x0, s.x1]; }),
+    warnings: ((div.layout && div.layout.shapes) || []).filter(function (s) {
+      return s.name && s.name.indexOf('log warning ') === 0;
+    }).map(function (s) { return {t: s.x0, level: s.name.slice(12)}; }),
+    modes: ((div.layout && div.layout.shapes) || []).filter(function (s) {
+      return s.name && s.name.indexOf('mode ') === 0;
+    }).map(function (s) { return {t: s.x0, mode: s.name.slice(5)}; }),
+    failsafes: ((div.layout && div.layout.shapes) || []).filter(function (s) {
+      return s.name && s.name.indexOf('log failsafe ') === 0;
+    }).map(function (s) { return {t: s.x0, what: s.name.slice(13)}; })
   };
+});
+"""
+_READ_HEADERS = """
+return Array.from(document.querySelectorAll('table.log-header')).map(function (table) {
+  var rows = {};
+  table.querySelectorAll('tr').forEach(function (tr) {
+    rows[tr.querySelector('th').textContent] = tr.querySelector('td').textContent;
+  });
+  return rows;
 });
 """
 
@@ -54,6 +76,7 @@ return Array.from(document.querySelectorAll('.battery-plot, #trends')).map(funct
 @dataclass
 class Page:
     plots: list[dict[str, Any]]
+    headers: list[dict[str, str]]  # each input's header table as the page shows it: label -> text
     console: list[dict[str, Any]]
     requests: set[str]
     load_s: float
@@ -93,6 +116,7 @@ def open_page(path: Path, name: str) -> Page:
             time.sleep(0.05)
         load_s = time.perf_counter() - start
         plots = driver.execute_script(_READ_PLOTS)
+        headers = driver.execute_script(_READ_HEADERS)
         console = driver.get_log("browser")
         requests = set()
         for entry in driver.get_log("performance"):
@@ -102,6 +126,6 @@ def open_page(path: Path, name: str) -> Page:
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         shot = ARTIFACTS / f"{name}.png"
         driver.save_screenshot(str(shot))
-        return Page(plots, console, requests, load_s, shot)
+        return Page(plots, headers, console, requests, load_s, shot)
     finally:
         driver.quit()

@@ -9,6 +9,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from codegen.apps.fleet_query import run_query
@@ -188,9 +189,10 @@ def test_empty_and_foreign_captures(tmp_path: Path, capsys: pytest.CaptureFixtur
 def test_columnar_with_aux_equals_the_generated_converter(tmp_path: Path) -> None:
     """The export's concepts of a capture (columnar, the aux message's filled in) are the generated
     per-record converter's ``to_concepts(info, aux)`` on the same records, concept by concept."""
+    from per_record import states_to_columns
+
     from codegen.apps.battery.can_batches import AUX, CBAT, INFO, can_batches
     from codegen.apps.battery.catalog import bundled_catalog
-    from codegen.apps.battery.per_record import states_to_columns
     from codegen.apps.battery.sources import model_of
     from codegen.apps.export.table import concept_array
     from codegen.inputs.can.records import capture_side
@@ -200,7 +202,7 @@ def test_columnar_with_aux_equals_the_generated_converter(tmp_path: Path) -> Non
     capture = tmp_path / "bus.log"
     _capture(capture, {10: 0, 11: 3}, cbat_node=12)
     catalog = bundled_catalog()
-    batches = can_batches(capture, capture.name, catalog, model_of)
+    batches = list(can_batches(capture, capture.name, catalog, model_of))
     for qualified, endpoint in (((INFO, AUX), "dronecan"), ((CBAT,), "cbat")):
         items = capture_side(capture, capture.name, [model_of(catalog, q) for q in qualified])
         records = [i for i in items if isinstance(i, Record)]
@@ -217,3 +219,32 @@ def test_columnar_with_aux_equals_the_generated_converter(tmp_path: Path) -> Non
         ("BatteryInfo", 11),
         ("CBAT", 12),
     ]
+
+
+@pytest.mark.parametrize("shared_id", [False, True])
+def test_a_capture_read_twice_gives_the_batches_of_one_read(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, shared_id: bool
+) -> None:
+    """A large capture is read twice and handed out in chunks (flat memory): the same records, battery numbers
+    (node ids where two nodes share a battery_id), times and notes as one read."""
+    from codegen.apps.battery import can_batches as can
+    from codegen.apps.battery.catalog import bundled_catalog
+    from codegen.apps.battery.sources import model_of
+
+    capture = tmp_path / "bus.log"
+    _capture(capture, {10: 0, 11: 0 if shared_id else 3}, cbat_node=12)
+    catalog = bundled_catalog()
+    once = list(can.can_batches(capture, capture.name, catalog, model_of))
+    monkeypatch.setattr(can, "STREAM_ABOVE", 0)
+    monkeypatch.setattr(can, "CHUNK", 2)
+    twice = list(can.can_batches(capture, capture.name, catalog, model_of))
+    assert all(b.n <= 2 for b in twice) and sum(b.n for b in twice) == sum(b.n for b in once)
+    assert [n for b in once for n in b.notes] == [n for b in twice for n in b.notes]
+    assert any("share battery_id" in n for b in once for n in b.notes) == shared_id
+    for whole in once:
+        parts = [b for b in twice if b.message == whole.message and b.instance[0] == whole.instance[0]]
+        assert whole.concepts is not None and all(p.concepts is not None for p in parts)
+        for name, column in whole.concepts.items():
+            joined = np.concatenate([p.concepts[name].values for p in parts if p.concepts is not None])
+            np.testing.assert_array_equal(joined, column.values, err_msg=name)
+        np.testing.assert_array_equal(np.concatenate([p.t for p in parts]), whole.t)

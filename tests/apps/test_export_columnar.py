@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from per_record import concept_converter, states_to_columns
 from shared_data import SHARED, real_logs
 
 from codegen.apps.battery.catalog import bundled_catalog
 from codegen.apps.battery.columnar import NotColumnar, convert_columns
-from codegen.apps.battery.per_record import concept_converter, states_to_columns
 from codegen.apps.battery.readers import read_batches
 from codegen.apps.battery.sources import instances_to_columns
 from codegen.apps.export.table import concept_array

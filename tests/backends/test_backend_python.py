@@ -62,9 +62,8 @@ def test_devicetree_model_and_pattern_properties(import_generated: Any) -> None:
         dt.SimpleBattery.from_dict({"x-1": 1})
 
 
-# Statements the layout engine breaks or normalises, each one line as an emitter writes it; the
-# engine must lay them out exactly as ruff does (ruff only checks here, generation never runs it).
-LAYOUT_CASES = (
+# Statements ruff breaks or normalises, each one line as an emitter writes it.
+FORMAT_CASES = (
     "_SPEC = _v.Number(type='float32', kind='float', low=-3.4028234663852886e+38, "
     "high=3.4028234663852886e+38, unit='V', mask=0x7ff)",
     "_TABLE: tuple[tuple[str, str, str, int], ...] = (('timestamp', 'timestamp', 'Q', 0), ('voltage_v', "
@@ -106,13 +105,20 @@ LAYOUT_CASES = (
 )
 
 
-def test_layout_engine_agrees_with_ruff(tmp_path: Path) -> None:
-    from codegen.backends.python.layout import format_module
+def _cases_module() -> str:
+    body = "\n\n".join(FORMAT_CASES).replace("\n", "\n    ").replace("\n    \n", "\n\n")
+    return f"def f():\n    {body}\n"
 
+
+def test_generation_formats_as_the_projects_ruff_settings_check(tmp_path: Path) -> None:
+    """The settings generation passes ruff are the ones generated/ is checked against (pyproject.toml)."""
+    from codegen.backends.python.formatting import ruff_format
+
+    source = _cases_module()
+    formatted = ruff_format({"cases.py": source})["cases.py"]
+    assert formatted != source  # the long statements were broken
     path = tmp_path / "cases.py"
-    body = "\n\n".join(LAYOUT_CASES).replace("\n", "\n    ").replace("\n    \n", "\n\n")
-    path.write_text(f"def f():\n    {body}\n")
-    path.write_text(format_module(path.read_text()))
+    path.write_text(formatted)
     proc = subprocess.run(
         [sys.executable, "-m", "ruff", "format", "--diff", "--config", str(ROOT / "pyproject.toml"), str(path)],
         capture_output=True,
@@ -120,6 +126,24 @@ def test_layout_engine_agrees_with_ruff(tmp_path: Path) -> None:
         check=False,
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_generation_formatting_ignores_ruff_configuration_on_disk(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A ruff.toml above the folder ruff runs in (another line length, single quotes) changes nothing."""
+    import tempfile
+
+    from codegen.backends.python.formatting import ruff_format
+
+    files = {"cases.py": _cases_module(), "README.txt": "not Python"}
+    plain = ruff_format(files)
+    (tmp_path / "ruff.toml").write_text('line-length = 40\n[format]\nquote-style = "single"\n')
+    (tmp_path / "pyproject.toml").write_text("[tool.ruff]\nline-length = 40\n")
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    assert ruff_format(files) == plain
+    assert plain["README.txt"] == "not Python"
+    assert 'short = ("a", "b",)' not in plain["cases.py"] and '"a",\n' in plain["cases.py"]  # magic trailing comma
 
 
 def test_generated_models_of_hostile_schemas_are_formatted(tmp_path: Path) -> None:

@@ -44,7 +44,7 @@ def test_real_logs_are_green_under_the_px4_profile(capsys: pytest.CaptureFixture
 
 def test_without_the_profile_max_error_is_reported_once_per_log_grouped(capsys: pytest.CaptureFixture[str]) -> None:
     small, events = logs()
-    code, lines, err = run(capsys, "--message", "uorb.BatteryStatus", small, events)
+    code, lines, err = run(capsys, "--message", "uorb.BatteryStatus", "--profile", "", small, events)
     assert code == 1 and len(lines) == 2
     assert lines[0] == (
         f"{small}: battery_status multi_id 0, timestamp 20630667 us, offset 86347: max_error = 0 % is below the "
@@ -128,7 +128,7 @@ def test_each_waiver_of_the_px4_profile_is_documented_and_needed(capsys: pytest.
     for w in profile.waivers:
         assert w.message in names and w.reason and len(w.evidence) >= 1
         assert any("PX4" in e or "schemas/" in e for e in w.evidence)
-    code = main(["validate", "--message", "uorb.BatteryStatus", "--format", "json", *logs()])
+    code = main(["validate", "--message", "uorb.BatteryStatus", "--format", "json", "--profile", "", *logs()])
     doc = json.loads(capsys.readouterr().out)
     assert code == 1
     codes = {finding_code(v["rule"], v["path"]) for f in doc["files"] for v in f["violations"]}
@@ -186,7 +186,7 @@ def test_sarif_validates_against_the_published_schema(capsys: pytest.CaptureFixt
 
 
 def test_sarif_of_real_logs_and_of_unreadable_input(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
-    code, doc = _sarif(capsys, "--message", "uorb.BatteryStatus", *logs())
+    code, doc = _sarif(capsys, "--message", "uorb.BatteryStatus", "--profile", "", *logs())
     results = doc["runs"][0]["results"]  # type: ignore[index]
     assert code == 1 and [r["properties"]["count"] for r in results] == [42, 157]
     assert results[0]["locations"][0]["physicalLocation"]["artifactLocation"]["uri"].startswith("file:///")

@@ -18,7 +18,7 @@ without any CAN frame is unreadable.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import cast
 
@@ -40,10 +40,48 @@ MESSAGES = ((INFO, AUX), (CBAT,))  # each read with its companions
 ModelOf = Callable[[Catalog, str], MessageClass]
 
 
-def can_batches(path: Path, name: str, catalog: Catalog, model_of: ModelOf) -> list[Batch]:
-    """Every battery node's batches of a capture; raises InputError if the capture is unreadable."""
-    out: list[Batch] = []
+STREAM_ABOVE = 8 << 20  # bytes: a larger capture is read twice, its batteries handed out in chunks (flat memory)
+CHUNK = 1 << 16  # records per batch of a capture read twice
+
+
+def can_batches(path: Path, name: str, catalog: Catalog, model_of: ModelOf) -> Iterator[Batch]:
+    """Every battery node's batches of a capture; raises InputError if the capture is unreadable. A capture of up
+    to :data:`STREAM_ABOVE` bytes is read once, each node's message one batch; a larger one twice -- first to
+    learn which battery ids the nodes use (the numbering needs them all), then handing out each node's records
+    every :data:`CHUNK` -- so memory stays flat whatever its length. Both give the same records."""
+    try:
+        streamed = path.stat().st_size > STREAM_ABOVE
+    except OSError:
+        streamed = False  # the reader says why it cannot read it
     notes: list[str] = []
+    if not streamed:
+        out = list(_walk(path, name, catalog, model_of, notes, None))
+        shared = _shared_ids(_battery_ids(out))
+        yield from _finished(out, shared, _told(notes, shared), capture_start(path, name) if out else None)
+        return
+    ids: dict[int, set[int]] = {}
+    for batch in _walk(path, name, catalog, model_of, [], CHUNK):
+        for node, found in _battery_ids([batch]).items():
+            ids.setdefault(node, set()).update(found)
+    shared = _shared_ids(ids)
+    start = capture_start(path, name)
+    previous: Batch | None = None
+    for batch in _walk(path, name, catalog, model_of, notes, CHUNK):
+        if previous is not None:
+            yield from _finished([previous], shared, [], start)
+        previous = batch
+    if previous is not None:  # the notes (damage counts) are known once the capture is read: on its last batch
+        yield from _finished([previous], shared, _told(notes, shared), start)
+
+
+def _told(notes: list[str], shared: str | None) -> list[str]:
+    return notes + ([shared] if shared else [])
+
+
+def _walk(
+    path: Path, name: str, catalog: Catalog, model_of: ModelOf, notes: list[str], chunk: int | None
+) -> Iterator[Batch]:
+    """Each node's records of each message as batches: at most ``chunk`` records each (None: one per node)."""
     for qualified in MESSAGES:
         models = [model_of(catalog, q) for q in qualified]
         by_node: dict[int, list[Record]] = {}
@@ -51,7 +89,11 @@ def can_batches(path: Path, name: str, catalog: Catalog, model_of: ModelOf) -> l
         for item in capture_side(path, name, models):
             if isinstance(item, Record):
                 node = int(cast(int, (item.location or {}).get("node", 0)))
-                by_node.setdefault(node, []).append(item)
+                records = by_node.setdefault(node, [])
+                records.append(item)
+                if chunk is not None and len(records) == chunk:
+                    yield _batch(catalog, qualified, node, records)
+                    by_node[node] = []
             elif isinstance(item, Unreadable):
                 damaged.append(item.message)
             elif isinstance(item, Notice):
@@ -62,17 +104,24 @@ def can_batches(path: Path, name: str, catalog: Catalog, model_of: ModelOf) -> l
         if damaged:
             notes.append(f"{len(damaged)} damaged or undecodable transfers skipped (first: {damaged[0]})")
         for node, records in sorted(by_node.items()):
-            out.append(_batch(catalog, qualified, node, records))
-    _number_batteries(out, notes)
-    start = capture_start(path, name) if out else None
-    if start is not None:  # absolute stamps: the time of day of each record
-        origin = round(start * 1e6)
-        for b in out:
+            if records:
+                yield _batch(catalog, qualified, node, records)
+
+
+def _finished(batches: list[Batch], shared: str | None, notes: list[str], start: float | None) -> list[Batch]:
+    """Batches numbered (``shared``: the note saying the nodes share an id, so they are numbered by node), timed
+    (``start``: the capture's absolute first stamp, if it has one), the first of them given ``notes``."""
+    for b in batches:
+        if shared is not None:
+            assert b.concepts is not None
+            b.concepts["battery_index"].set(np.asarray(b.instance, np.int64))
+        if start is not None:  # absolute stamps: the time of day of each record
+            origin = round(start * 1e6)
             b.utc_offset_us = origin
             b.time_us = np.round(b.t * 1e6).astype(np.int64) + origin
-    if out:
-        out[0].notes.extend(notes)
-    return out
+    if batches:
+        batches[0].notes.extend(notes)
+    return batches
 
 
 def _batch(catalog: Catalog, qualified: Sequence[str], node: int, records: list[Record]) -> Batch:
@@ -118,24 +167,24 @@ def _fill(target: ConceptColumn, source: ConceptColumn, rows: NDArray) -> None:
     target.set(values, where)
 
 
-def _number_batteries(batches: list[Batch], notes: list[str]) -> None:
-    """battery_id as the battery, unless two nodes share one: then the node id for all."""
+def _battery_ids(batches: list[Batch]) -> dict[int, set[int]]:
+    """The battery ids each node's records give."""
     ids: dict[int, set[int]] = {}
     for b in batches:
         assert b.concepts is not None
         index = b.concepts["battery_index"]
-        node = int(b.instance[0])
-        ids.setdefault(node, set()).update(int(v) for v in index.values[index.valid])
+        ids.setdefault(int(b.instance[0]), set()).update(int(v) for v in index.values[index.valid])
+    return ids
+
+
+def _shared_ids(ids: dict[int, set[int]]) -> str | None:
+    """battery_id is the battery, unless two nodes share one: then every battery is numbered by its node id, and
+    this says so (None where no id is shared)."""
     owners: dict[int, set[int]] = {}
     for node, found in ids.items():
         for battery in found:
             owners.setdefault(battery, set()).add(node)
     shared = sorted(b for b, nodes in owners.items() if len(nodes) > 1)
     if not shared:
-        return
-    for b in batches:
-        assert b.concepts is not None
-        b.concepts["battery_index"].set(np.asarray(b.instance, np.int64))
-    notes.append(
-        f"nodes {', '.join(map(str, sorted(ids)))} share battery_id {shared[0]}: batteries numbered by node id"
-    )
+        return None
+    return f"nodes {', '.join(map(str, sorted(ids)))} share battery_id {shared[0]}: batteries numbered by node id"

@@ -1,7 +1,7 @@
 """The concept columns a conversion fills: one :class:`ConceptColumn` per concept, numpy arrays.
 
 Both conversions write these -- the columnar one (:mod:`.columnar`, whole columns at a time) and
-the per-record one (:mod:`.per_record`, through the generated converters) -- so the two can be
+the per-record one the tests check it with (tests/per_record.py, through the generated converters) -- so the two can be
 compared exactly, and :mod:`.table` turns them into Arrow columns in one place.
 
 Per kind: ``number`` float64, ``integer`` int64, ``bool`` bool, ``text`` object (str),

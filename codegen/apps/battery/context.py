@@ -21,7 +21,11 @@ parameters the firmware recorded. Per kind:
 - **CAN captures, JSON Lines**: the clock only; no arming state, no firmware, no parameters.
 
 ``arming`` is the log's arming state as changes of state in ``t``, by the kind's one rule (``arming_rule``);
-``armed_intervals`` gives them as [start, end) spans.
+``armed_intervals`` gives them as [start, end) spans. What the firmware said and did, where the log keeps it:
+``texts`` its logged messages (ULog ``L``/``C`` records with their syslog level, DataFlash ``MSG``), ``modes`` its
+flight-mode changes (PX4 ``vehicle_status.nav_state``; DataFlash ``MODE`` with the reason ArduPilot gave), and
+``failsafes`` the moments it entered a failsafe (PX4 ``vehicle_status.failsafe`` turning true, with the mode it
+chose; ArduPilot a ``MODE`` change for a failsafe reason and ``ERR`` records of a failsafe subsystem).
 """
 
 from __future__ import annotations
@@ -46,6 +50,19 @@ ARMING_RULES = {
 
 
 @dataclass(frozen=True)
+class LogText:
+    """A message the firmware logged: at ``t``, its severity (a syslog name: ``warning``, ``info``...; "" where
+    the log gives none) and its text."""
+
+    t: float
+    severity: str
+    text: str
+
+
+SYSLOG_LEVELS = ("emergency", "alert", "critical", "error", "warning", "notice", "info", "debug")
+
+
+@dataclass(frozen=True)
 class LogContext:
     """A log's context (see the module's docs); ``None`` fields are what the log does not say."""
 
@@ -60,6 +77,9 @@ class LogContext:
     parameters: Mapping[str, float] = field(default_factory=dict)
     arming: tuple[tuple[float, bool], ...] = ()  # (t, armed) at each change of the arming state
     arming_rule: str = ""  # "" where the log carries no arming state
+    texts: tuple[LogText, ...] = ()
+    modes: tuple[tuple[float, str], ...] = ()  # (t, the mode entered, with the reason where the log gives one)
+    failsafes: tuple[tuple[float, str], ...] = ()  # (t, what the firmware did or which failsafe)
 
     @property
     def start_utc_us(self) -> int | None:
@@ -140,3 +160,51 @@ def px4_firmware(info: Mapping[str, object]) -> str | None:
     if isinstance(commit, str) and commit:
         parts.append(f"({commit[:8]})")
     return " ".join(parts) if len(parts) > 1 or name else None
+
+
+# PX4's vehicle_status.nav_state values whose names every release since 1.14 keeps (msg/VehicleStatus.msg); the
+# others were renamed or reused between releases and are shown by number
+PX4_NAV_STATES = {
+    0: "MANUAL",
+    1: "ALTCTL",
+    2: "POSCTL",
+    3: "AUTO_MISSION",
+    4: "AUTO_LOITER",
+    5: "AUTO_RTL",
+    10: "ACRO",
+    12: "DESCEND",
+    13: "TERMINATION",
+    14: "OFFBOARD",
+    15: "STAB",
+    17: "AUTO_TAKEOFF",
+    18: "AUTO_LAND",
+    19: "AUTO_FOLLOW_TARGET",
+    20: "AUTO_PRECLAND",
+    21: "ORBIT",
+    22: "AUTO_VTOL_TAKEOFF",
+}
+
+
+def px4_modes(
+    states: tuple[NDArray, NDArray, NDArray | None] | None, start_us: int
+) -> tuple[tuple[tuple[float, str], ...], tuple[tuple[float, str], ...]]:
+    """PX4's mode changes (each change of ``nav_state``, the first state too) and failsafe entries (``failsafe``
+    turning true, with the mode commander chose), in ``t``, from ``vehicle_status`` records."""
+    if states is None:
+        return (), ()
+    stamps, navs, failsafe = states
+    t = (np.asarray(stamps, np.int64) - start_us) / 1e6
+    modes: list[tuple[float, str]] = []
+    failsafes: list[tuple[float, str]] = []
+    last_nav: int | None = None
+    was_failsafe = False
+    flags = [False] * len(t) if failsafe is None else np.asarray(failsafe, bool).tolist()
+    for tk, nav, fs in zip(t.tolist(), np.asarray(navs).tolist(), flags, strict=True):
+        name = PX4_NAV_STATES.get(int(nav), f"nav_state {int(nav)}")
+        if nav != last_nav:
+            modes.append((max(tk, 0.0), name))
+            last_nav = nav
+        if fs and not was_failsafe:
+            failsafes.append((max(tk, 0.0), f"failsafe: {name}"))
+        was_failsafe = bool(fs)
+    return tuple(modes), tuple(failsafes)

@@ -19,12 +19,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ...inputs.dataflash import ArmingRecord, BatteryRecord, GpsClock, LogStart, open_log, timed_flight_records
+from ...inputs.dataflash import (
+    FAILSAFE_SUBSYSTEMS,
+    ArmingRecord,
+    BatteryRecord,
+    GpsClock,
+    LogStart,
+    mode_name,
+    open_log,
+    reason_name,
+    timed_flight_records,
+)
 from ...inputs.dataflash_arming import armed_at_start
 from ...ir.units import unit
 from .catalog import Catalog
 from .columns import ConceptColumn, NDArray, empty_columns
-from .context import ARMING_RULES, LogContext, arming_changes
+from .context import ARMING_RULES, LogContext, LogText, arming_changes
 from .sources import Batch, as_of
 
 MESSAGE = "dataflash.BAT"
@@ -74,6 +84,9 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
         parameters=dict(start.parameters),
         arming=arming_changes(arm_t, arm_v),
         arming_rule=ARMING_RULES["dataflash"],
+        texts=tuple(LogText(_t(at, origin_us), "", text) for at, text in start.texts),
+        modes=tuple(_mode(at, number, reason, start.firmware, origin_us) for at, number, reason in start.modes),
+        failsafes=_failsafes(start, origin_us),
     )
     out: list[Batch] = []
     for instance, rows in sorted(readings.items()):
@@ -100,6 +113,34 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
             batch.notes.append(f"{len(log.skipped_notes)} notes from the DataFlash reader (skipped data)")
         out.append(batch)
     return out
+
+
+def _t(seconds: float | None, origin_us: int) -> float:
+    """A record's time in ``t`` (a record without any time: the log's start)."""
+    return 0.0 if seconds is None else max(seconds - origin_us / 1e6, 0.0)
+
+
+def _mode(
+    seconds: float | None, number: int, reason: int | None, firmware: str | None, origin_us: int
+) -> tuple[float, str]:
+    why = "" if reason is None else f" ({reason_name(reason)})"
+    return _t(seconds, origin_us), mode_name(number, firmware) + why
+
+
+def _failsafes(start: LogStart, origin_us: int) -> tuple[tuple[float, str], ...]:
+    """The failsafes ArduPilot logged: a MODE change for a failsafe reason, an ERR of a failsafe subsystem (its
+    code 0, resolved, left out)."""
+    out = [
+        _mode(at, number, reason, start.firmware, origin_us)
+        for at, number, reason in start.modes
+        if reason is not None and "FAILSAFE" in reason_name(reason)
+    ]
+    out += [
+        (_t(at, origin_us), f"{FAILSAFE_SUBSYSTEMS[subsystem]} (ECode {code})")
+        for at, subsystem, code in start.errors
+        if subsystem in FAILSAFE_SUBSYSTEMS and code != 0
+    ]
+    return tuple(sorted(out))
 
 
 def _concepts(catalog: Catalog, columns: dict[str, NDArray], n: int) -> dict[str, ConceptColumn]:

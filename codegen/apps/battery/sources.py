@@ -10,7 +10,8 @@ and JSON Lines (.jsonl/.ndjson) read record by record through the shared readers
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+import math
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
@@ -30,7 +31,7 @@ from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
 from .columns import ConceptColumn, NDArray, length_key
-from .context import ARMING_RULES, LogContext, arming_changes, px4_firmware
+from .context import ARMING_RULES, SYSLOG_LEVELS, LogContext, LogText, arming_changes, px4_firmware, px4_modes
 
 
 @dataclass
@@ -110,6 +111,11 @@ def ulog_context(log: UlogColumns, armed: tuple[NDArray, NDArray] | None, utc_of
     changes: tuple[tuple[float, bool], ...] = ()
     if armed is not None:
         changes = arming_changes((armed[0].astype(np.int64) - log.start_us) / 1e6, armed[1])
+    modes, failsafes = px4_modes(log.nav_states(), log.start_us)
+    texts = tuple(
+        LogText((stamp - log.start_us) / 1e6, _syslog(level), text.rstrip("\t\n\x00"))
+        for level, stamp, text in log.logged()
+    )
     return LogContext(
         "ulog",
         log.start_us,
@@ -122,7 +128,16 @@ def ulog_context(log: UlogColumns, armed: tuple[NDArray, NDArray] | None, utc_of
         parameters,
         changes,
         ARMING_RULES["ulog"] if armed is not None else "",
+        texts,
+        modes,
+        failsafes,
     )
+
+
+def _syslog(level: int) -> str:
+    """A ULog text's level byte (an ASCII digit, '0' emergency to '7' debug, as syslog) by name."""
+    index = level - ord("0")
+    return SYSLOG_LEVELS[index] if 0 <= index < len(SYSLOG_LEVELS) else ""
 
 
 def as_of(times: NDArray, values: NDArray, at: NDArray) -> NDArray:
@@ -176,6 +191,32 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
     return out
 
 
+def stored_data(message: Message, data: Mapping[str, Any]) -> dict[str, Any]:
+    """A record's plain data with each float16/float32 value as its field stores it: a float32 ``voltage_v`` of
+    5e-324 is 0.0, uORB's unknown, as the firmware compares it (a value beyond the type stays, to be reported)."""
+    out = dict(data)
+    for f in message.fields:
+        ftype = f.type.element if isinstance(f.type, ArrayType) else f.type
+        value = out.get(f.name)
+        if value is None or not isinstance(ftype, PrimitiveType) or ftype.kind is not PrimitiveKind.FLOAT:
+            continue
+        if ftype.bits in (16, 32):
+            narrow = np.float16 if ftype.bits == 16 else np.float32
+            with np.errstate(over="ignore"):
+                if isinstance(value, list):
+                    out[f.name] = [_narrowed(v, narrow) for v in value]
+                else:
+                    out[f.name] = _narrowed(value, narrow)
+    return out
+
+
+def _narrowed(value: Any, narrow: Any) -> Any:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return value  # not a number: from_dict says what it expected
+    stored = float(narrow(value))
+    return stored if math.isfinite(stored) or not math.isfinite(value) else value  # beyond the type: left to say so
+
+
 JSONL_CHUNK = 1 << 16  # records per batch of a JSON Lines file: memory stays flat whatever its length
 _LISTED = 10  # records left out that a batch's notes name one by one (the rest are counted)
 
@@ -214,7 +255,8 @@ def _jsonl_batch(
     left_out = 0
     for rec in records:
         try:
-            instance = model.from_dict(rec.data)
+            data = stored_data(message, rec.data) if isinstance(rec.data, dict) else rec.data
+            instance = model.from_dict(data)
         except (ValueError, TypeError, KeyError) as exc:
             raise InputError(name, rec.line, f"expected a {qualified} record: {exc}") from None
         unfit = _unfit(instance, limits)
@@ -237,29 +279,35 @@ def _jsonl_batch(
     return Batch(qualified, n, columns, t, np.zeros(n, np.int64), warnings=notes), origin
 
 
-Limits = list[tuple[str, str, int, int]]  # (attribute, type name, lowest, highest) of each integer field
+Limits = list[tuple[str, str, float, float]]  # (attribute, type name, lowest, highest) of each number field
 
 
 def integer_limits(message: Message) -> Limits:
-    """The integer fields of a message (and arrays of them) with the range of their IR type."""
+    """The integer and float16/float32 fields of a message (and arrays of them) with the range of their IR type."""
     out: Limits = []
     for f in message.fields:
         ftype = f.type.element if isinstance(f.type, ArrayType) else f.type
-        if f.is_padding or not isinstance(ftype, PrimitiveType):
+        if f.is_padding or not isinstance(ftype, PrimitiveType) or ftype.kind is PrimitiveKind.BOOL:
             continue
-        if ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT):
-            lo, hi = cast(tuple[int, int], ftype.value_range)
+        if ftype.kind in (PrimitiveKind.INT, PrimitiveKind.UINT) or (
+            ftype.kind is PrimitiveKind.FLOAT and ftype.bits in (16, 32)
+        ):
+            lo, hi = cast(tuple[float, float], ftype.value_range)
             out.append((naming.field_identifier(f.name, f.pattern), ftype.name, lo, hi))
     return out
 
 
 def _unfit(instance: object, limits: Limits) -> str | None:
-    """The first integer of a record outside its field's type, said as validate says it; None if all fit."""
+    """The first number of a record outside its field's type (a finite float beyond float32 too: stored, it
+    would be infinity), said as validate says it; None if all fit."""
     for attr, type_name, lo, hi in limits:
         value = getattr(instance, attr)
         for v in value if isinstance(value, list) else (value,):
-            if isinstance(v, int) and not isinstance(v, bool) and not lo <= v <= hi:
-                return f"{attr} = {v} does not fit {type_name} ({lo}..{hi})"
+            if isinstance(v, bool) or not isinstance(v, int | float) or (isinstance(v, float) and not math.isfinite(v)):
+                continue
+            if not lo <= v <= hi:
+                bounds = f"+-{hi:g}" if type_name.startswith("float") else f"{int(lo)}..{int(hi)}"
+                return f"{attr} = {v} does not fit {type_name} ({bounds})"
     return None
 
 

@@ -19,6 +19,7 @@
 from __future__ import annotations
 
 import struct
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -51,6 +52,7 @@ class _System:
     beat_stamps: list[int | None] = field(default_factory=list)  # each heartbeat's tlog stamp
     autopilot: int | None = None  # MAV_AUTOPILOT of the last vehicle heartbeat
     parameters: dict[str, tuple[float, int]] = field(default_factory=dict)  # PARAM_VALUE: (value, MAV_PARAM_TYPE)
+    status_only: bool = True  # no BATTERY_STATUS seen: its SYS_STATUS frames stand for battery 0
 
 
 def is_vehicle_heartbeat(compid: int, mav_type: int, autopilot: int) -> bool:
@@ -65,22 +67,79 @@ def _mavlink(catalog: Catalog, qualified: str) -> MavlinkClass:
     return model
 
 
-def tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
-    """Every battery of a tlog as a batch (see the module's docs)."""
+STREAM_ABOVE = 4 << 20  # bytes (some 60k frames): a larger tlog is walked twice, its batteries in chunks (flat memory)
+CHUNK = 1 << 16  # battery frames per batch of a tlog walked twice
+
+
+def tlog_batches(path: Path, name: str, catalog: Catalog) -> Iterator[Batch]:
+    """Every battery of a tlog as batches (see the module's docs). A tlog of up to :data:`STREAM_ABOVE` bytes is
+    walked once, each battery one batch; a larger one twice: first what the batteries' context needs (heartbeats,
+    parameters, which systems send BATTERY_STATUS), then the battery frames, handed out every :data:`CHUNK`
+    frames, so memory stays flat whatever the log's length. Both give the same records, clock and arming."""
     wanted = (BATTERY_STATUS, SYS_STATUS, HEARTBEAT, PARAM_VALUE)
     models = {m.MSG_ID: m for m in (_mavlink(catalog, q) for q in wanted)}
-    battery_id, status_id = _mavlink(catalog, BATTERY_STATUS).MSG_ID, _mavlink(catalog, SYS_STATUS).MSG_ID
-    param_id = _mavlink(catalog, PARAM_VALUE).MSG_ID
+    ids = _Ids(
+        _mavlink(catalog, BATTERY_STATUS).MSG_ID,
+        _mavlink(catalog, SYS_STATUS).MSG_ID,
+        _mavlink(catalog, PARAM_VALUE).MSG_ID,
+    )
+    try:
+        streamed = path.stat().st_size > STREAM_ABOVE
+    except OSError:
+        streamed = False  # the walk says why it cannot read it
     stats = StreamStats()
+    systems = _survey(read_messages(path, name, models, stats), ids, keep=not streamed)
+    origin = stats.first_stamp or 0
+    contexts = {sysid: _context(system, sysid, origin) for sysid, system in systems.items()}
+    note = stats.summary("battery") if stats.damaged else None
+    if not streamed:
+        for sysid, system in sorted(systems.items()):
+            groups = sorted(system.batteries.items())
+            if not groups and system.sys_status:
+                groups = [(0, system.sys_status)]
+            for instance, frames in groups:
+                yield _made(catalog, ids, frames, instance, origin, system, sysid, contexts[sysid], note)
+        return
+    battery_models = {k: m for k, m in models.items() if k in (ids.battery, ids.status)}
+    pending: dict[tuple[int, int], list[FrameRecord]] = {}
+    for rec in read_messages(path, name, battery_models, StreamStats()):
+        sysid = rec.frame.sysid
+        owner = systems.get(sysid)
+        if owner is None or (rec.frame.msgid == ids.status) != owner.status_only:
+            continue  # SYS_STATUS counts only for a system that sends no BATTERY_STATUS
+        instance = int(getattr(rec.instance, "id")) if rec.frame.msgid == ids.battery else 0  # noqa: B009
+        frames = pending.setdefault((sysid, instance), [])
+        frames.append(rec)
+        if len(frames) == CHUNK:
+            yield _made(catalog, ids, frames, instance, origin, owner, sysid, contexts[sysid], None)
+            pending[(sysid, instance)] = []
+    for (sysid, instance), frames in sorted(pending.items()):
+        if frames:
+            yield _made(catalog, ids, frames, instance, origin, systems[sysid], sysid, contexts[sysid], note)
+
+
+@dataclass(frozen=True)
+class _Ids:
+    battery: int
+    status: int
+    param: int
+
+
+def _survey(records: Iterable[FrameRecord], ids: _Ids, *, keep: bool) -> dict[int, _System]:
+    """What each system sent: heartbeats, parameters, whether it sends BATTERY_STATUS, and (``keep``) its battery
+    and SYS_STATUS frames themselves."""
     systems: dict[int, _System] = {}
-    for rec in read_messages(path, name, models, stats):
+    for rec in records:
         system = systems.setdefault(rec.frame.sysid, _System())
         msgid = rec.frame.msgid
-        if msgid == battery_id:
-            system.batteries.setdefault(int(getattr(rec.instance, "id")), []).append(rec)  # noqa: B009
-        elif msgid == status_id:
-            system.sys_status.append(rec)
-        elif msgid == param_id:
+        if msgid == ids.battery:
+            system.status_only = False
+            if keep:
+                system.batteries.setdefault(int(getattr(rec.instance, "id")), []).append(rec)  # noqa: B009
+        elif msgid == ids.status:
+            if keep:
+                system.sys_status.append(rec)
+        elif msgid == ids.param:
             p = rec.instance
             name = parameter_name(str(getattr(p, "param_id")))  # noqa: B009
             if name:  # a set value is sent again: the last one stands, as the vehicle ended up with it
@@ -93,21 +152,26 @@ def tlog_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
                 system.beats.append((rec.offset or 0, armed, mav_type))
                 system.beat_stamps.append(rec.timestamp)
                 system.autopilot = autopilot
-    origin = stats.first_stamp or 0
-    out: list[Batch] = []
-    for sysid, system in sorted(systems.items()):
-        groups = sorted(system.batteries.items())
-        if not groups and system.sys_status:
-            groups = [(0, system.sys_status)]
-        context = _context(system, sysid, origin)
-        for instance, frames in groups:
-            qualified = BATTERY_STATUS if frames[0].frame.msgid == battery_id else SYS_STATUS
-            batch = _batch(catalog, qualified, frames, instance, origin, system, sysid)
-            batch.context = context
-            if stats.damaged:
-                batch.notes.append(stats.summary("battery"))
-            out.append(batch)
-    return out
+    return systems
+
+
+def _made(
+    catalog: Catalog,
+    ids: _Ids,
+    frames: list[FrameRecord],
+    instance: int,
+    origin: int,
+    system: _System,
+    sysid: int,
+    context: LogContext,
+    note: str | None,
+) -> Batch:
+    qualified = BATTERY_STATUS if frames[0].frame.msgid == ids.battery else SYS_STATUS
+    batch = _batch(catalog, qualified, frames, instance, origin, system, sysid)
+    batch.context = context
+    if note:
+        batch.notes.append(note)
+    return batch
 
 
 def _batch(

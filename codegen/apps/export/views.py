@@ -153,11 +153,6 @@ def views_sql(out: Path, *, relative: bool = False) -> str:
     )
 
 
-def has_failsafe(out: Path) -> bool:
-    """Whether any committed log of the dataset at ``out`` was replayed through the failsafe."""
-    return bool(committed(out)["replays"])
-
-
 def write_views(out: Path) -> Path:
     """``views.sql`` in the dataset folder, with paths relative to it: the files committed now (a later
     export writes it again); replaced in one rename."""

@@ -37,6 +37,7 @@ from ...inputs.documents import read_jsonl
 from ...inputs.model import GeneratedMessage, MessageClass, package_name
 from ...inputs.records import Record, Unreadable
 from ...ir import Schema
+from ..battery.sources import stored_data
 from ..convert import ConvertModule
 from ..messages import resolve_message
 from ..package import bundled_schemas, model_class, model_package
@@ -223,7 +224,9 @@ class Reader:
             raise fail(f'expected "data": an object of {name} fields')
         qualified, cls = self.model(name, file, line)
         try:
-            model = cls.from_dict(data)
+            # as the fields store them: a float32 voltage of 5e-324 is 0.0, the unknown, as validate and the
+            # export read it
+            model = cls.from_dict(stored_data(self.schema.message(qualified), data))
             battery = battery_state(qualified, model)
         except (ValueError, BattgenError) as exc:
             raise fail(f"expected {qualified} data: {exc}") from None

@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..failsafe.stream import read_parameter_values
+from ..gate import Settings
 from .fleet import fleet_view
+from .gating import apply_gate
+from .log_facts import LogFacts, log_facts
 from .page import Replay, render
 from .plots import Marker
 from .png import write_png
@@ -19,6 +23,7 @@ from .series import InputSeries, read_input
 class Report:
     inputs: list[InputSeries]
     replays: dict[str, Replay]
+    facts: dict[str, LogFacts] = field(default_factory=dict)  # per input: what the log says about itself
 
 
 def collect(
@@ -28,15 +33,24 @@ def collect(
     message: str | None = None,
     params: Path | None = None,
     vehicle: str | None = None,
+    gate: Settings | None = None,
 ) -> Report:
-    """Every input read and replayed (a BattgenError for an input that cannot be read)."""
+    """Every input read, gated as ``validate`` gates it, and replayed (a BattgenError for an input that cannot be
+    read, or for a selector that names nothing of an input's message)."""
     inputs = [read_input(p, schema_dir, message=message) for p in paths]
-    return Report(inputs, {i.source: replay(i, p, params, vehicle) for i, p in zip(inputs, paths, strict=True)})
+    for item in inputs:
+        apply_gate(item, gate or Settings())
+    override = read_parameter_values(params) if params is not None else None
+    report = Report(inputs, {i.source: replay(i, p, params, vehicle) for i, p in zip(inputs, paths, strict=True)})
+    for item in inputs:
+        end = max((float(s.t[-1]) for s in item.batteries if len(s.t)), default=0.0)
+        report.facts[item.source] = log_facts(item.context, end, override, params.as_posix() if params else "")
+    return report
 
 
 def html(report: Report, *, title: str = "") -> str:
     fleet = fleet_view(report.inputs) if len(report.inputs) > 1 else None
-    return render(report.inputs, report.replays, fleet=fleet, title=title)
+    return render(report.inputs, report.replays, report.facts, fleet=fleet, title=title)
 
 
 def _slug(text: str) -> str:

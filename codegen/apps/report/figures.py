@@ -14,6 +14,7 @@ median is the better estimate of the pack's resistance when a log is noisy.
 
 from __future__ import annotations
 
+import math
 import statistics
 from dataclasses import dataclass
 
@@ -44,11 +45,12 @@ class Figures:
     time_below_s: dict[str, float]  # threshold name -> seconds spent below it
     flight: FlightFigures  # in SI, as the fleet views have them
 
-    def rows(self) -> list[tuple[str, str]]:
-        """The figures as (label, text) rows for the page."""
+    def rows(self, per_cell: bool = True) -> list[tuple[str, str]]:
+        """The figures as (label, text) rows for the page (``per_cell`` False: the log's cells are no measurement,
+        said instead of their figures)."""
 
         def num(value: float | None, unit: str, digits: int = 2) -> str:
-            return "unknown" if value is None else f"{value:.{digits}f} {unit}"
+            return "unknown" if value is None else f"{shown(value, digits)} {unit}"
 
         out = [
             ("duration", num(self.duration_s, "s", 1)),
@@ -75,8 +77,21 @@ class Figures:
                 + (f" from {self.load_steps} steps" if self.load_steps else ""),
             ),
         ]
+        if not per_cell:
+            out = [(label, NO_CELLS if "cell" in label else text) for label, text in out]
         out += [(f"time below {name}", num(s, "s", 1)) for name, s in self.time_below_s.items()]
         return out
+
+
+NO_CELLS = "no per-cell data"
+
+
+def shown(value: float, digits: int) -> str:
+    """A figure with the precision it carries: ``digits`` decimals, more for a small value that would show as 0 or
+    with one significant digit (0.39 mAh, not 0 mAh)."""
+    if value == 0 or value != value or math.isinf(value):
+        return f"{value + 0.0:.{digits}f}"  # + 0.0: no "-0.0"
+    return f"{value:.{max(digits, 1 - math.floor(math.log10(abs(value))))}f}"
 
 
 def _max(values: NDArray) -> float | None:

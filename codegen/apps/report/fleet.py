@@ -1,23 +1,28 @@
 """Many flights on one page: a row per flight and battery, and trends per pack serial across flights.
 
-Flights are ordered as the inputs were given (sort the file names by date to get a time axis); a pack is
-followed across flights by its serial number, where the battery reports one. The trends plotted per pack: charge
-used and internal resistance (load steps), and the state of health and cycle count where the pack reports them.
+Each flight row gives the log's start (UTC, from its own clock where it tells it: LogContext) and its firmware. A
+pack is followed across flights by its serial number, where the battery reports one; its trends are plotted over
+the flights' dates when every input tells its date (else over the flights in input order, as the axis says):
+charge used and internal resistance (load steps), and the state of health and cycle count where the pack reports
+them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from datetime import UTC, datetime
 from pathlib import PurePath
 from typing import Any
 
-from .figures import Figures, compute
+from .figures import Figures, compute, shown
 from .series import InputSeries
 
 _COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf")
 HEADER = [
     "flight",
+    "date [UTC]",
+    "firmware",
     "battery",
     "duration [s]",
     "min pack [V]",
@@ -39,12 +44,14 @@ class FleetView:
 
 
 def _fmt(value: float | None, digits: int, scale: float = 1.0) -> str:
-    return "—" if value is None else f"{value * scale:.{digits}f}"
+    return "—" if value is None else shown(value * scale, digits)
 
 
-def _row(source: str, label: str, serial: str, f: Figures) -> list[str]:
+def _row(source: str, date: str | None, firmware: str | None, label: str, serial: str, f: Figures) -> list[str]:
     return [
         source,
+        date or "—",
+        firmware or "—",
         label,
         _fmt(f.duration_s, 1),
         _fmt(f.min_pack_voltage_v, 2),
@@ -58,15 +65,27 @@ def _row(source: str, label: str, serial: str, f: Figures) -> list[str]:
     ]
 
 
+def _date(item: InputSeries) -> str | None:
+    """The log's start in UTC (``2024-03-18 14:49:10``), where the log tells it."""
+    start = item.context.start_utc_us if item.context is not None else None
+    return None if start is None else datetime.fromtimestamp(start / 1e6, UTC).strftime("%Y-%m-%d %H:%M:%S")
+
+
 def fleet_view(inputs: Sequence[InputSeries]) -> FleetView:
     rows: list[list[str]] = []
-    by_serial: dict[str, list[tuple[int, Figures, float | None, int | None]]] = {}
+    by_serial: dict[str, list[tuple[int | str, Figures, float | None, int | None]]] = {}
+    dates = [_date(item) for item in inputs]
+    dated = all(d is not None for d in dates)  # one axis for every pack: dates only when every flight has one
     for flight, item in enumerate(inputs):
+        firmware = item.context.firmware if item.context is not None else None
         for s in item.batteries:
             f = compute(s)
-            rows.append(_row(PurePath(item.source).name, s.label, s.serial, f))
+            rows.append(_row(PurePath(item.source).name, dates[flight], firmware, s.label, s.serial, f))
             if s.serial:
-                by_serial.setdefault(s.serial, []).append((flight + 1, f, s.state_of_health, s.cycle_count))
+                x: int | str = (dates[flight] or "") if dated else flight + 1
+                by_serial.setdefault(s.serial, []).append((x, f, s.state_of_health, s.cycle_count))
+    for points in by_serial.values():
+        points.sort(key=lambda p: str(p[0]) if dated else int(p[0]))
     quantities = (
         ("charge used [mAh]", lambda p: p[1].charge_used_mah),
         (
@@ -92,10 +111,14 @@ def fleet_view(inputs: Sequence[InputSeries]) -> FleetView:
         axis = "" if r == 0 else str(r + 1)
         layout[f"xaxis{axis}"] = {
             "anchor": f"y{axis}",
-            "dtick": 1,
+            **({"type": "date"} if dated else {"dtick": 1}),
             "showticklabels": r == len(shown) - 1,
             **({"matches": "x"} if r else {}),
-            **({"title": {"text": "flight (input order)"}} if r == len(shown) - 1 else {}),
+            **(
+                {"title": {"text": "log start [UTC]" if dated else "flight (input order)"}}
+                if r == len(shown) - 1
+                else {}
+            ),
         }
         layout[f"yaxis{axis}"] = {
             "title": {"text": name, "font": {"size": 11}},

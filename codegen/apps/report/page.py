@@ -21,12 +21,16 @@ import jinja2
 
 from ... import __version__
 from ...errors import BattgenError
+from ...text.escape import line
 from ..battery.column_checks import FindingGroup
+from ..battery.context import LogText
+from ..gate import describe
 from .downsample import POINT_BUDGET
 from .figures import compute
 from .fleet import FleetView
+from .log_facts import LogFacts, WarningChange, warning_changes
 from .plots import Marker, figure
-from .series import BatterySeries, InputSeries
+from .series import BatterySeries, InputSeries, warning_levels
 
 NEEDS_PLOTLY = "the HTML report embeds plotly's JavaScript: pip install 'battgen[report]'"
 _CSS = {"LOW": "warn", "CRITICAL": "bad", "error": "bad", "warning": "warn"}
@@ -71,27 +75,46 @@ def _grouped(findings: Sequence[FindingGroup], battery: int) -> list[dict[str, o
 
 
 def _section(
-    s: BatterySeries, findings: Sequence[FindingGroup], replay: Replay, index: int
+    s: BatterySeries, findings: Sequence[FindingGroup], replay: Replay, index: int, facts: LogFacts
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     plot_id = f"plot-{index}"
     events = [e for e in replay.events if e.battery == s.battery]
     markers = [Marker(e.t, e.level, e.text) for e in events]
+    warnings = warning_changes(s.t, s.warning, s.battery, warning_levels())
+    thresholds = replay.thresholds.get(s.battery, {})
+    cells_note = ""
+    if s.cells_split_evenly:
+        cells_note = f"no per-cell data: the log's {s.cell_count} cell voltages are the pack voltage split evenly"
     context = {
         "id": f"battery-{index}",
         "plot_id": plot_id,
         "label": s.label,
         "serial": s.serial,
-        "figures": compute(s, replay.thresholds.get(s.battery, {})).rows(),
+        "figures": compute(s, thresholds).rows(per_cell=not s.cells_split_evenly),
+        "cells_note": cells_note,
         "events": [{"t": e.t, "level": e.level, "text": e.text, "css": _CSS.get(e.level, "")} for e in events],
+        "warnings": [{"t": w.t, "level": w.level, "css": _CSS.get(w.level.upper(), "")} for w in warnings],
+        "first_warnings": _first_reached(warnings),
         "failsafe_note": replay.note,
         "findings": _grouped(findings, s.battery),
     }
-    return context, figure(s, markers, replay.thresholds.get(s.battery, {}))
+    fig = figure(
+        s,
+        markers,
+        thresholds,
+        armed=facts.armed,
+        warnings=warnings,
+        soc_thresholds=facts.soc_thresholds,
+        modes=facts.modes,
+        failsafes=facts.failsafes,
+    )
+    return context, fig
 
 
 def render(
     inputs: Sequence[InputSeries],
     replays: Mapping[str, Replay],
+    facts: Mapping[str, LogFacts] | None = None,
     *,
     fleet: FleetView | None = None,
     title: str = "",
@@ -104,16 +127,33 @@ def render(
     index = 0
     for item in inputs:
         replay = replays.get(item.source, Replay())
+        own = (facts or {}).get(item.source, LogFacts())
         batteries = []
         for s in item.batteries:
-            context, fig = _section(s, item.findings, replay, index)
+            context, fig = _section(s, item.findings, replay, index, own)
             figures[context["plot_id"]] = fig
             batteries.append(context)
             index += 1
         notices = [n.message for n in item.notices if n.severity != "info"]
         notices += [u.message for u in item.unreadable]
         name = PurePath(item.source).name or item.source
-        sections.append({"source": item.source, "name": name, "batteries": batteries, "notices": notices})
+        sections.append(
+            {
+                "source": item.source,
+                "name": name,
+                "batteries": batteries,
+                "notices": notices,
+                "header": own.header,
+                "parameters": own.parameters,
+                "parameters_from": own.parameters_from,
+                "soc_thresholds": [(k, f"{v:g} %") for k, v in own.soc_thresholds.items()],
+                "thresholds_from": own.thresholds_from,
+                "gate": _gate_text(item),
+                "battery_texts": [_text_row(m) for m in own.battery_texts],
+                "texts": [_text_row(m) for m in own.texts],
+                "failsafes": [{"t": t, "text": line(what)} for t, what in own.failsafes],
+            }
+        )
     fleet_context = None
     if fleet is not None:
         fleet_context = {
@@ -142,6 +182,33 @@ def render(
         fleet=fleet_context,
         figures_json=text,
     )
+
+
+def _text_row(m: LogText) -> dict[str, object]:
+    """A logged message for the page: its text with control characters shown, not run (ANSI colours...)."""
+    css = {"emergency": "bad", "alert": "bad", "critical": "bad", "error": "bad", "warning": "warn"}
+    return {"t": m.t, "severity": m.severity, "text": line(m.text), "css": css.get(m.severity, "")}
+
+
+def _first_reached(warnings: Sequence[WarningChange]) -> list[dict[str, object]]:
+    """Each warning level the firmware set, at the first time it set it (what a person asks first)."""
+    first: dict[str, float] = {}
+    for w in warnings:
+        if w.level != "none":  # back to normal is in the full list
+            first.setdefault(w.level, w.t)
+    return [{"t": t, "level": level, "css": _CSS.get(level.upper(), "")} for level, t in first.items()]
+
+
+def _gate_text(item: InputSeries) -> str:
+    """What the gate left out of the findings and why (the profile and where it came from), or ""."""
+    parts = []
+    if item.gate is not None:
+        parts += list(describe(item.gate))
+        if item.gate.origin:
+            parts.append(f"settings from {item.gate.origin}")
+    if item.left_out:
+        parts += [f"{n} left out: {why}" for why, n in sorted(item.left_out.items())]
+    return "; ".join(parts)
 
 
 def _template(name: str) -> str:

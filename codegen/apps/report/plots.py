@@ -1,7 +1,10 @@
 """The plotly figure of one battery: time plots sharing one time axis, failsafe events marked across them.
 
 Rows (each only when the battery reports it): pack voltage with the failsafe thresholds, current, power, state of
-charge, temperature, every cell, and the cell imbalance (max - min). Traces are decimated to the point budget of
+charge (on 0-100 %, with PX4's BAT_*_THR lines), temperature, every cell (with a legend), and the cell imbalance
+(max - min); no cell rows where the log's cells are the pack voltage split evenly (no per-cell data). The log's
+armed spans are shaded across every row, and the firmware's own warning levels marked (dotted) beside the
+replayed failsafe events (solid). Traces are decimated to the point budget of
 :mod:`.downsample`; every trace's ``meta`` holds its sample count before decimation, so a reader (or the browser
 test) can tell what was drawn from what was read.
 """
@@ -16,10 +19,15 @@ import numpy as np
 
 from ..battery.columns import NDArray
 from .downsample import POINT_BUDGET, decimate
+from .log_facts import WarningChange
 from .series import BatterySeries
 
 ROW_HEIGHT = 190
 LEVEL_COLOURS = {"LOW": "#d98200", "CRITICAL": "#c62828", "NONE": "#2e7d32"}
+MODE_FILLS = ("#e3f2fd", "#fff3e0", "#f3e5f5", "#e8f5e9", "#fce4ec", "#e0f7fa", "#f9fbe7", "#efebe9")
+FAILSAFE_COLOUR = "#6a1b9a"
+WARNING_COLOURS = {"none": "#2e7d32", "low": "#d98200", "critical": "#c62828", "emergency": "#8e0000"}
+ARMED_FILL = "rgba(46, 125, 50, 0.08)"
 
 
 @dataclass(frozen=True)
@@ -39,9 +47,12 @@ def _rows(s: BatterySeries) -> list[tuple[str, str, list[tuple[str, NDArray]]]]:
         ("power", "W", [("power", s.power)]),
         ("state of charge", "%", [("state of charge", s.state_of_charge)]),
         ("temperature", "°C", [("temperature", s.temperature)]),
-        ("cells", "V", [(f"cell {k + 1}", s.cell(k)) for k in range(s.cell_count)]),
-        ("cell imbalance", "mV", [("max - min", s.imbalance * 1000)]),
     ]
+    if not s.cells_split_evenly:
+        rows += [
+            ("cells", "V", [(f"cell {k + 1}", s.cell(k)) for k in range(s.cell_count)]),
+            ("cell imbalance", "mV", [("max - min", s.imbalance * 1000)]),
+        ]
     return [
         (title, unit, [(n, v) for n, v in traces if not np.isnan(v).all()])
         for title, unit, traces in rows
@@ -54,15 +65,24 @@ def figure(
     markers: Sequence[Marker] = (),
     thresholds: dict[str, float] | None = None,
     budget: int = POINT_BUDGET,
+    *,
+    armed: Sequence[tuple[float, float]] = (),
+    warnings: Sequence[WarningChange] = (),
+    soc_thresholds: dict[str, float] | None = None,
+    modes: Sequence[tuple[float, str]] = (),
+    failsafes: Sequence[tuple[float, str]] = (),
 ) -> dict[str, Any]:
     """The figure as plotly JSON data (``{"data": [...], "layout": {...}}``), built without plotly's Python API
-    so that the page's JSON is exactly what this module says."""
+    so that the page's JSON is exactly what this module says. ``armed``: the log's armed spans; ``warnings``: the
+    firmware's own warning changes; ``soc_thresholds``: name -> percent, drawn on the state of charge; ``modes``: the
+    flight-mode changes (t, name), a strip above the plots; ``failsafes``: the firmware's own failsafe entries."""
     rows = _rows(s)
     data: list[dict[str, Any]] = []
     layout: dict[str, Any] = {
         "height": max(1, len(rows)) * ROW_HEIGHT + 60,
-        "margin": {"l": 70, "r": 20, "t": 44, "b": 40},
+        "margin": {"l": 70, "r": 90, "t": 44, "b": 40},
         "showlegend": False,
+        "legend": {"x": 1.01, "xanchor": "left", "yanchor": "top", "font": {"size": 10}},
         "hovermode": "x unified",
         "shapes": [],
         "annotations": [],
@@ -86,6 +106,12 @@ def figure(
             "domain": [max(0.0, top - height), top],
             "anchor": f"x{axis}",
         }
+        if title == "state of charge" and _within(traces, 0.0, 100.0):  # a gauge, not a 0.04 % wiggle
+            layout[f"yaxis{axis}"]["range"] = [0, 100]
+        legend = title == "cells"  # six overlapping traces need their names
+        if legend:
+            layout["showlegend"] = True
+            layout["legend"]["y"] = top
         for name, values in traces:
             xs, ys = decimate(s.t, values, budget)
             data.append(
@@ -98,53 +124,25 @@ def figure(
                     "xaxis": f"x{axis}",
                     "yaxis": f"y{axis}",
                     "line": {"width": 1.2},
+                    "showlegend": legend,
                     "meta": {"row": title, "samples": int((~np.isnan(values)).sum())},
                     "hovertemplate": f"%{{y:.3f}} {unit}<extra>{name}</extra>",
                 }
             )
         if title == "pack voltage":
-            for name, volts in (thresholds or {}).items():
-                if volts > 0:
-                    layout["shapes"].append(
-                        {
-                            "type": "line",
-                            "xref": "x domain",
-                            "x0": 0,
-                            "x1": 1,
-                            "yref": "y",
-                            "y0": volts,
-                            "y1": volts,
-                            "line": {"dash": "dash", "width": 1, "color": "#888"},
-                        }
-                    )
-                    layout["annotations"].append(
-                        {
-                            "xref": "x domain",
-                            "x": 1,
-                            "yref": "y",
-                            "y": volts,
-                            "text": name,
-                            "showarrow": False,
-                            "xanchor": "right",
-                            "yanchor": "bottom",
-                            "font": {"size": 10, "color": "#666"},
-                        }
-                    )
+            for k, (name, volts) in enumerate(v for v in (thresholds or {}).items() if v[1] > 0):
+                _level_line(layout, f"y{axis}", volts, name, k)
+        if title == "state of charge":
+            for k, (name, percent) in enumerate((soc_thresholds or {}).items()):
+                _level_line(layout, f"y{axis}", percent, name, k)
+    _shade(layout, armed)
+    _warnings(layout, warnings)
+    end = float(s.t[-1]) if len(s.t) else 0.0
+    _modes(layout, modes, end)
+    _failsafes(layout, failsafes)
     for m in markers:
         colour = LEVEL_COLOURS.get(m.level, "#555")
-        layout["shapes"].append(
-            {
-                "type": "line",
-                "xref": "x",
-                "x0": m.t,
-                "x1": m.t,
-                "yref": "paper",
-                "y0": 0,
-                "y1": 1,
-                "line": {"color": colour, "width": 2},
-                "name": f"failsafe {m.level}",
-            }
-        )
+        layout["shapes"].append(_across(m.t, {"color": colour, "width": 2}, f"failsafe {m.level}"))
         layout["annotations"].append(
             {
                 "xref": "x",
@@ -162,3 +160,145 @@ def figure(
         if key.startswith("xaxis") and layout[key].get("matches") is None:
             layout[key].pop("matches", None)
     return {"data": data, "layout": layout}
+
+
+def _within(traces: Sequence[tuple[str, NDArray]], low: float, high: float) -> bool:
+    values = np.concatenate([v[~np.isnan(v)] for _, v in traces]) if traces else np.zeros(0)
+    return bool(len(values)) and bool(values.min() >= low and values.max() <= high)
+
+
+def _level_line(layout: dict[str, Any], yref: str, y: float, name: str, k: int = 0) -> None:
+    """A threshold across a row, named near its right end (the ``k``-th of a row a label's width further left,
+    so that close thresholds -- 7 % and 5 % -- keep readable names)."""
+    layout["shapes"].append(
+        {
+            "type": "line",
+            "xref": "x domain",
+            "x0": 0,
+            "x1": 1,
+            "yref": yref,
+            "y0": y,
+            "y1": y,
+            "line": {"dash": "dash", "width": 1, "color": "#888"},
+            "name": f"threshold {name}",
+        }
+    )
+    layout["annotations"].append(
+        {
+            "xref": "x domain",
+            "x": 1 - 0.16 * k,
+            "yref": yref,
+            "y": y,
+            "text": name,
+            "showarrow": False,
+            "xanchor": "right",
+            "yanchor": "bottom",
+            "font": {"size": 10, "color": "#666"},
+        }
+    )
+
+
+def _across(t: float, line: dict[str, Any], name: str) -> dict[str, Any]:
+    """A vertical line at ``t`` across every row (a shape named for the tests and readers of the JSON)."""
+    return {
+        "type": "line",
+        "xref": "x",
+        "x0": t,
+        "x1": t,
+        "yref": "paper",
+        "y0": 0,
+        "y1": 1,
+        "line": line,
+        "name": name,
+    }
+
+
+def _band(x0: float, x1: float, y0: float, y1: float, fill: str, name: str, **style: Any) -> dict[str, Any]:
+    """A rectangle from ``x0`` to ``x1`` s, ``y0`` to ``y1`` of the plot's height."""
+    box = {"type": "rect", "xref": "x", "x0": x0, "x1": x1, "yref": "paper", "y0": y0, "y1": y1}
+    return box | {"fillcolor": fill, "name": name, **style}
+
+
+def _shade(layout: dict[str, Any], armed: Sequence[tuple[float, float]]) -> None:
+    """The armed spans, behind every row."""
+    for start, end in armed:
+        layout["shapes"].append(_band(start, end, 0, 1, ARMED_FILL, "armed", line={"width": 0}, layer="below"))
+
+
+def _warnings(layout: dict[str, Any], changes: Sequence[WarningChange]) -> None:
+    """The firmware's own warning level at each change, dotted; labelled at the foot of the plot where a level is
+    first reached (a level flickering near its threshold changes dozens of times: the labels would overprint)."""
+    seen: set[str] = set()
+    for w in changes:
+        colour = WARNING_COLOURS.get(w.level, "#555")
+        layout["shapes"].append(_across(w.t, {"color": colour, "width": 1.5, "dash": "dot"}, f"log warning {w.level}"))
+        if w.level in seen or w.level == "none":  # back to none: the line says it
+            continue
+        seen.add(w.level)
+        layout["annotations"].append(
+            {
+                "xref": "x",
+                "x": w.t,
+                "yref": "paper",
+                "y": 0,
+                "text": f"log: {w.level}",
+                "showarrow": False,
+                "yanchor": "top",
+                "yshift": -12 * (len(seen) - 1),  # first low, critical, emergency: often seconds apart
+                "font": {"color": colour, "size": 10},
+            }
+        )
+
+
+def _modes(layout: dict[str, Any], modes: Sequence[tuple[float, str]], end: float) -> None:
+    """The flight modes as a strip of bands above the plots, one colour per mode name, each named at its start."""
+    colours: dict[str, str] = {}
+    span = max(end - (modes[0][0] if modes else 0.0), 1e-9)
+    for k, (start, name) in enumerate(modes):
+        stop = modes[k + 1][0] if k + 1 < len(modes) else end
+        if stop <= start:
+            continue
+        base = name.split(" (", 1)[0]  # ArduPilot's reason aside: one colour per mode
+        same = k > 0 and modes[k - 1][1].split(" (", 1)[0] == base  # the mode set again: one band goes on
+        colour = colours.setdefault(base, MODE_FILLS[len(colours) % len(MODE_FILLS)])
+        layout["shapes"].append(
+            _band(start, stop, 1.0, 1.035, colour, f"mode {name}", line={"width": 0.5, "color": "#b0bec5"})
+        )
+        if same or (stop - start) / span < 0.02:  # no label on a sliver: it would overprint the next
+            continue
+        layout["annotations"].append(
+            {
+                "xref": "x",
+                "x": start,
+                "yref": "paper",
+                "y": 1.0175,
+                "text": base,
+                "showarrow": False,
+                "xanchor": "left",
+                "hovertext": f"{name} from {start:.1f} s",
+                "font": {"size": 9, "color": "#37474f"},
+            }
+        )
+    if modes:
+        layout["margin"]["t"] = max(layout["margin"]["t"], 60)
+
+
+def _failsafes(layout: dict[str, Any], failsafes: Sequence[tuple[float, str]]) -> None:
+    """The firmware's own failsafe entries (PX4 vehicle_status.failsafe, ArduPilot's failsafe MODE and ERR)."""
+    for t, what in failsafes:
+        style = {"color": FAILSAFE_COLOUR, "width": 2, "dash": "dashdot"}
+        layout["shapes"].append(_across(t, style, f"log failsafe {what}"))
+        layout["annotations"].append(
+            {
+                "xref": "x",
+                "x": t,
+                "yref": "paper",
+                "y": 0.5,
+                "text": "log failsafe",
+                "textangle": -90,
+                "showarrow": False,
+                "xanchor": "right",
+                "hovertext": what,
+                "font": {"color": FAILSAFE_COLOUR, "size": 10},
+            }
+        )

@@ -18,6 +18,8 @@ from ...errors import BattgenError
 from ..failsafe.columnar import replay_table
 from ..failsafe.evaluator import BatteryFailsafe, Event, make_failsafe
 from ..failsafe.logs import NO_ARMING_NOTE, own_parameters
+from ..failsafe.px4_log import read_px4_log
+from ..failsafe.px4_replay import replay_px4
 from ..failsafe.reading import BatteryReading
 from ..failsafe.settings import battery_settings
 from ..failsafe.stream import Sample, read_parameter_values
@@ -26,6 +28,11 @@ from .page import FailsafeEvent, Replay
 from .series import InputSeries
 
 NO_PARAMS = "no failsafe parameters: give --params FILE (BATT_* values) to replay the failsafe"
+# A PX4 log without --params: replayed through PX4's own failsafe (_px4); where that cannot read the log, this says so.
+PX4_NOT_REPLAYED = (
+    "PX4's failsafe is not replayed here: the firmware's own warning levels (battery_status.warning) are marked "
+    "on the plots; give --params FILE with BATT_* values to replay ArduPilot's"
+)
 
 
 def _series_samples(item: InputSeries) -> Iterator[Sample]:
@@ -53,6 +60,8 @@ def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | No
     elif own is not None:
         context = item.samples.context if item.samples is not None else None
         values, where = own, f"the log's {context.parameters_from if context is not None else 'parameters'}"
+    elif item.context is not None and item.context.autopilot == "px4":
+        return _px4(path, item)
     else:
         return Replay(note=NO_PARAMS)
     try:
@@ -69,6 +78,23 @@ def replay(item: InputSeries, path: Path, params: Path | None, vehicle: str | No
     }
     events = [FailsafeEvent(e.time, e.battery - 1, e.level.name, _text(e)) for e in failsafe.events]
     return Replay(events, note, thresholds)
+
+
+def _px4(path: Path, item: InputSeries) -> Replay:
+    """A PX4 log replayed through PX4's own battery failsafe (:mod:`..failsafe.px4_replay`) with the log's
+    parameters: its warning levels and commander's actions, at their times."""
+    try:
+        replayed = replay_px4(read_px4_log(path))
+    except ValueError as exc:  # a log without what PX4's replay reads
+        return Replay(note=f"{PX4_NOT_REPLAYED} ({exc})")
+    events = [
+        FailsafeEvent(e.time, e.battery - 1, e.label, f"{e.action_name} -> {e.outcome}: \u201c{e.text}\u201d")
+        for e in replayed.events
+    ]
+    note = "; ".join(
+        ["replayed through PX4's battery failsafe with the log's own BAT_*/COM_* parameters", *replayed.notes]
+    )
+    return Replay(events, note)  # its thresholds are charges, drawn on the state of charge (log_facts), not volts
 
 
 def _run(failsafe: BatteryFailsafe, samples: Iterator[Sample]) -> None:

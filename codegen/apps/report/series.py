@@ -29,12 +29,15 @@ from ...inputs.dispatch import read_records
 from ...inputs.kinds import FLIGHT_LOG_KINDS, file_kind
 from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
+from ..battery.catalog import bundled_catalog
 from ..battery.column_checks import FindingGroup, column_finding_groups, group_findings
 from ..battery.columns import ConceptColumn, NDArray
+from ..battery.context import LogContext
 from ..battery.figures import FlightFigures, flight_figures
 from ..battery.view import Chunk, read_view
 from ..convert import Conversion
 from ..failsafe.logs import SampleTable
+from ..gate import Names, Settings, names_of
 from ..messages import BATTERY_MESSAGES
 from ..package import bundled_schemas
 from ..validate import Checker, Finding, make_checker
@@ -54,7 +57,14 @@ SERIES = {
     "remaining_energy": ("remaining_energy", 1 / 3600.0, 0.0),  # Wh
     "charge_c": ("discharged", 1.0, 0.0),  # the discharged counter in C, for the flight figures
     "energy_j": ("consumed_energy", 1.0, 0.0),  # the consumed-energy counter in J
+    "warning": ("warning", 1.0, 0.0),  # the firmware's own warning level: a code into warning_levels()
 }
+
+
+def warning_levels() -> tuple[str, ...]:
+    """The warning concept's choices (schemas/mappings/concepts.yaml), which the view's codes index; a data file's
+    records carry the choice by name and are coded by this order too."""
+    return bundled_catalog().concept("warning").choices
 
 
 @dataclass
@@ -78,6 +88,7 @@ class BatterySeries:
     cells: NDArray = field(default_factory=lambda: np.zeros((0, 0)))
     charge_c: NDArray = field(default_factory=lambda: np.zeros(0))
     energy_j: NDArray = field(default_factory=lambda: np.zeros(0))
+    warning: NDArray = field(default_factory=lambda: np.zeros(0))  # codes into warning_levels(), NaN unknown
     armed: NDArray = field(default_factory=lambda: np.zeros(0))  # 1.0 / 0.0 / NaN
     knows_arming: bool = False  # whether the input carries an arming state at all
     serial: str = ""
@@ -114,6 +125,22 @@ class BatterySeries:
         return np.asarray(self.cells[:, k], np.float64)
 
     @functools.cached_property
+    def cells_split_evenly(self) -> bool:
+        """Whether the cells are no measurement: every sample's known cells equal to each other and together the
+        pack voltage (PX4's battery library fills the cells so when the driver measures none)."""
+        if not self.cell_count:
+            return False
+        rows = ~np.isnan(self.cells[:, : self.cell_count]).any(axis=1) & ~np.isnan(self.pack_voltage)
+        if not rows.any():
+            return False
+        cells = self.cells[rows, : self.cell_count]
+        even = bool((np.ptp(cells, axis=1) < 1e-4).all())
+        total = cells.sum(axis=1)
+        return even and bool(
+            (np.abs(total - self.pack_voltage[rows]) <= 0.01 * np.abs(self.pack_voltage[rows]) + 1e-3).all()
+        )
+
+    @functools.cached_property
     def imbalance(self) -> NDArray:
         """max - min cell voltage of each sample with at least two known cells (else NaN)."""
         if not self.cells.size:
@@ -138,6 +165,14 @@ class InputSeries:
     records: int
     not_converted: int = 0
     samples: SampleTable | None = None  # the failsafe's samples of a log read through the battery view
+    names: Names | None = None  # what the gate's selectors may name: the checked message's rules and fields
+    left_out: dict[str, int] = field(default_factory=dict)  # findings the gate left out: why -> how many
+    gate: Settings | None = None  # the gate's settings in force for this input (the firmware's profile applied)
+
+    @property
+    def context(self) -> LogContext | None:
+        """What the log says about itself (None: a data file)."""
+        return self.samples.context if self.samples is not None else None
 
 
 def _number(value: Any) -> float | None:
@@ -230,12 +265,14 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
         # the bundled folder: its message's format and the rules are all the checker reads (not pydsdl's Cyphal)
         only = (message.partition(".")[0], RULES_DIR) if schema_dir == bundled_schemas() else None
         _, checker = make_checker(schema_dir, message, [str(path)], kind, only=only)
+        out.names = names_of(checker.message, checker.rules, checker.extra is not None)
         column = column_finding_groups(path, name, kind, chunks, checker)
     if column is not None:
         out.findings, out.notices, out.unreadable = column
     else:  # the view's batches of this kind lack the records' places (a tlog's frames): read them one by one
         checked = _record_input(path, schema_dir, name, None, kind)
         out.findings, out.notices, out.unreadable = checked.findings, checked.notices, checked.unreadable
+        out.names = checked.names
     return out
 
 
@@ -320,6 +357,7 @@ def _record_input(path: Path, schema_dir: Path, name: str, message: str | None, 
     conversion = Conversion(_package_of(checker), msg.qualified_name, "concepts", "strict")
     batteries: dict[int, _Records] = {}
     out = InputSeries(name, msg.qualified_name, [], [], [], [], 0)
+    out.names = names_of(msg, checker.rules, checker.extra is not None)
     t0: float | None = None
     found: list[tuple[float, int, Finding]] = []
     for item in read_records(path, msg, name, model=checker.cls, kind=kind):
@@ -365,6 +403,7 @@ _CONCEPTS = (
     "cycle_count",
     "serial_number",
     "battery_index",
+    "warning",
 )
 
 
@@ -393,6 +432,8 @@ class _Records:
             value = _number(state.get(concept))
             rows[name].append(math.nan if value is None else value * scale + offset)
         rows["armed"].append(math.nan)  # a data file carries no arming state
+        level, levels = state.get("warning"), warning_levels()
+        rows["warning"][-1] = float(levels.index(level)) if level in levels else math.nan
         cells = state.get("cell_voltages") or []
         self.cells.append([v if v is not None and v > 0.0 else math.nan for v in (_number(c) for c in cells)])
         health = _number(state.get("state_of_health"))

@@ -1,8 +1,8 @@
 """The Python backend: a package of typed dataclasses (and, through extensions, codecs and
 validators) generated from the IR. Output is a pure function of the IR: same IR, same bytes.
 
-Templates and extensions write each statement on one line; every module is then laid out by
-:mod:`.layout` as ``ruff format`` would write it, so generated code reads like reviewed code.
+Templates and extensions write each statement on one line; ruff then formats every module
+(:mod:`.formatting`), so generated code reads like reviewed code.
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ import jinja2
 from ...ir import DronecanKind, Message, Schema, SourceFormat
 from . import naming
 from .extensions import Contribution
+from .formatting import ruff_format
 from .imports import from_imports
-from .layout import format_module
 from .literals import docstring, py_literal
 from .module_context import ModuleContext
 from .name_clashes import refuse_clashes
@@ -83,16 +83,16 @@ def render_package(schema: Schema) -> dict[str, str]:
 
     for module in sorted(modules):
         text = _render_module(env, schema, module, by_module[module], packages)
-        files[module_file(module, packages)] = format_module(text)
+        files[module_file(module, packages)] = text
 
     for package in sorted(packages - modules):
-        files[module_file(package, packages)] = format_module(_render_package_init(env, schema, package, by_module))
+        files[module_file(package, packages)] = _render_package_init(env, schema, package, by_module)
     formats = ", ".join(sorted({m.split(".")[0] for m in modules}))
     root = env.get_template("package.py.j2").render(
         header=HEADER, doc=docstring(f"battgen generated models.\n\nFormats: {formats}.", ""), imports=[], exports=[]
     )
-    files["__init__.py"] = format_module(root)
-    return files
+    files["__init__.py"] = root
+    return ruff_format(files)
 
 
 def _render_module(

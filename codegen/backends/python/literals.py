@@ -1,9 +1,9 @@
 """Python source literals for schema-supplied values: everything a schema says reaches generated
 code only through these functions, so no name, comment or value can break out of a literal.
 
-Literals are spelled as ruff writes them (double quotes unless the text holds more of them,
-upper-case hex digits), and long text is cut into implicitly concatenated parts that the layout
-engine can put on lines of their own.
+Literals are Python's own ``repr`` (ruff then spells them its way: double quotes, upper-case hex
+digits), and long text is cut into implicitly concatenated parts that ruff can put on lines of
+their own.
 """
 
 from __future__ import annotations
@@ -12,8 +12,7 @@ import math
 import textwrap
 import unicodedata
 
-from .layout import LINE_LENGTH
-from .layout.source import normalize_number, normalize_string
+from .formatting import LINE_LENGTH
 
 TEXT_PART = 80  # characters of text per part of a long string literal
 
@@ -29,9 +28,9 @@ def py_literal(value: object) -> str:
             return "_math.nan"
         if math.isinf(value):
             return "_math.inf" if value > 0 else "-_math.inf"
-        return normalize_number(repr(value))
+        return repr(value)
     if isinstance(value, str | bytes):
-        return normalize_string(repr(value))
+        return repr(value)
     if isinstance(value, tuple):
         inner = ", ".join(py_literal(v) for v in value)
         return f"({inner},)" if len(value) == 1 else f"({inner})"
@@ -70,7 +69,7 @@ def hex_literal(value: int) -> str:
 def text_literal(text: str) -> str:
     """A string literal for text that may be long (documentation, a struct format): implicitly
     concatenated parts of at most :data:`TEXT_PART` characters, each cut after a space or a
-    newline where there is one, so that the layout can put the parts on lines of their own."""
+    newline where there is one, so that ruff can put the parts on lines of their own."""
     if len(text) <= TEXT_PART:
         return py_literal(text)
     parts: list[str] = []

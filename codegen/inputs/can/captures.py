@@ -20,7 +20,7 @@ import time
 import zlib
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from ..dataflash import open_log
 from ..records import InputError
@@ -45,6 +45,36 @@ def _python_can(name: str) -> Any:
 CANDUMP_LINE = "a candump -l line such as '(1612543138.000000) can0 123#DEADBEEF'"
 
 
+def _blf_parse_error() -> type[Exception]:
+    """python-can's BLF reader's own error (a bare Exception subclass), where python-can is installed."""
+    try:
+        from can.io.blf import BLFParseError
+    except ImportError:
+        return ValueError
+    return cast(type[Exception], BLFParseError)
+
+
+# what python-can's readers raise on a damaged capture (its BLF reader: BLFParseError, zlib.error, struct.error)
+_READER_ERRORS = (
+    ValueError,
+    KeyError,
+    IndexError,
+    TypeError,
+    OSError,
+    EOFError,
+    AttributeError,
+    zlib.error,
+    struct.error,
+    _blf_parse_error(),
+)
+_BRIEF = 160  # characters of a reader's complaint quoted (it may quote a whole hostile line)
+
+
+def _brief(exc: BaseException) -> str:
+    text = str(exc) or type(exc).__name__
+    return text if len(text) <= _BRIEF else text[:_BRIEF] + f"... ({len(text)} characters)"
+
+
 def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: bool = False) -> Iterator[Frame]:
     """``one_per_line``: a text capture with one frame a line (candump -l), so a failure is placed on its line."""
     index = 0
@@ -55,14 +85,12 @@ def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: b
             message = next(messages)
         except StopIteration:
             return
-        except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError, zlib.error) as exc:
+        except _READER_ERRORS as exc:
             # a damaged capture: the third-party reader's own complaint, located at the frame (or line) it reached
             # (the reader's exception text, "too many values to unpack", speaks of its code, not of the file)
             if one_per_line:
                 raise InputError(name, read + 1, f"expected {CANDUMP_LINE}, found a line it cannot read") from exc
-            raise InputError(
-                name, 0, f"expected {what} frames after frame {index}, found bytes python-can cannot read"
-            ) from exc
+            raise InputError(name, 0, f"cannot read {what} after frame {index}: {_brief(exc)}") from exc
         read += 1
         kind = "error" if message.is_error_frame else "remote" if message.is_remote_frame else "data"
         data = bytes(message.data)
@@ -100,8 +128,8 @@ def _log_reader(path: Path, name: str) -> Any:
     try:
         reader = bounded_reader(can, path, name)
         return reader if reader is not None else can.LogReader(str(path))
-    except (ValueError, OSError, EOFError, zlib.error, struct.error, can.CanError) as exc:
-        raise InputError(name, 0, f"cannot open the CAN capture: {exc}") from exc
+    except (*_READER_ERRORS, can.CanError) as exc:
+        raise InputError(name, 0, f"cannot open the CAN capture: {_brief(exc)}") from exc
 
 
 def _screen_capture(path: Path) -> float | bool | None:
@@ -144,7 +172,7 @@ def capture_start(path: Path, name: str) -> float | None:
     reader = _log_reader(path, name)
     try:
         first = next(iter(reader), None)
-    except (ValueError, KeyError, IndexError, TypeError, OSError, EOFError, AttributeError, zlib.error, InputError):
+    except (*_READER_ERRORS, InputError):
         return None  # the frame readers report the damage
     finally:
         stop = getattr(reader, "stop", None)

@@ -32,6 +32,8 @@ class Health_1_0Value(_enum.IntEnum):
 _HEALTH_1_0_VALUE_SPEC = _v.Number(
     type="uint2", kind="uint", low=0, high=3, values={0: "NOMINAL", 1: "ADVISORY", 2: "CAUTION", 3: "WARNING"}
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_HEALTH_1_0_FIELD_SPECS = (("value", "value", _HEALTH_1_0_VALUE_SPEC),)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -96,10 +98,11 @@ class Health_1_0:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # value (Health.1.0.dsdl:3): fits uint2; a value of VALUE
             if self.value not in {0, 1, 2, 3}:
                 _v.diag(out, "value", self.value, _HEALTH_1_0_VALUE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "value", self.value, _HEALTH_1_0_VALUE_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _HEALTH_1_0_FIELD_SPECS)
         return out
 
     def check(self) -> None:

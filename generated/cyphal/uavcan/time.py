@@ -22,6 +22,10 @@ __all__ = ["SynchronizedTimestamp_1_0"]
 _SYNCHRONIZED_TIMESTAMP_1_0_MICROSECOND_SPEC = _v.Number(
     type="uint56", kind="uint", low=0, high=72057594037927935, unit="us", sentinel=0, sentinel_text="UNKNOWN"
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_SYNCHRONIZED_TIMESTAMP_1_0_FIELD_SPECS = (
+    ("microsecond", "microsecond", _SYNCHRONIZED_TIMESTAMP_1_0_MICROSECOND_SPEC),
+)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -95,10 +99,11 @@ class SynchronizedTimestamp_1_0:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # microsecond (SynchronizedTimestamp.1.0.dsdl:3): fits uint56; UNKNOWN means unknown (accepted)
             if self.microsecond & -72057594037927936:
                 _v.diag(out, "microsecond", self.microsecond, _SYNCHRONIZED_TIMESTAMP_1_0_MICROSECOND_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "microsecond", self.microsecond, _SYNCHRONIZED_TIMESTAMP_1_0_MICROSECOND_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _SYNCHRONIZED_TIMESTAMP_1_0_FIELD_SPECS)
         return out
 
     def check(self) -> None:

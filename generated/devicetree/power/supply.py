@@ -307,6 +307,75 @@ _SIMPLE_BATTERY_VOLT_DROP_N_MICROVOLT_SPEC = _v.Pattern(
         min_length=1,
     ),
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_SIMPLE_BATTERY_FIELD_SPECS = (
+    ("compatible", "compatible", _SIMPLE_BATTERY_COMPATIBLE_SPEC),
+    ("device-chemistry", "device_chemistry", _SIMPLE_BATTERY_DEVICE_CHEMISTRY_SPEC),
+    (
+        "over-voltage-threshold-microvolt",
+        "over_voltage_threshold_microvolt",
+        _SIMPLE_BATTERY_OVER_VOLTAGE_THRESHOLD_MICROVOLT_SPEC,
+    ),
+    ("re-charge-voltage-microvolt", "re_charge_voltage_microvolt", _SIMPLE_BATTERY_RE_CHARGE_VOLTAGE_MICROVOLT_SPEC),
+    ("voltage-min-design-microvolt", "voltage_min_design_microvolt", _SIMPLE_BATTERY_VOLTAGE_MIN_DESIGN_MICROVOLT_SPEC),
+    ("voltage-max-design-microvolt", "voltage_max_design_microvolt", _SIMPLE_BATTERY_VOLTAGE_MAX_DESIGN_MICROVOLT_SPEC),
+    (
+        "energy-full-design-microwatt-hours",
+        "energy_full_design_microwatt_hours",
+        _SIMPLE_BATTERY_ENERGY_FULL_DESIGN_MICROWATT_HOURS_SPEC,
+    ),
+    (
+        "charge-full-design-microamp-hours",
+        "charge_full_design_microamp_hours",
+        _SIMPLE_BATTERY_CHARGE_FULL_DESIGN_MICROAMP_HOURS_SPEC,
+    ),
+    (
+        "trickle-charge-current-microamp",
+        "trickle_charge_current_microamp",
+        _SIMPLE_BATTERY_TRICKLE_CHARGE_CURRENT_MICROAMP_SPEC,
+    ),
+    (
+        "tricklecharge-upper-limit-microvolt",
+        "tricklecharge_upper_limit_microvolt",
+        _SIMPLE_BATTERY_TRICKLECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
+    ),
+    ("precharge-current-microamp", "precharge_current_microamp", _SIMPLE_BATTERY_PRECHARGE_CURRENT_MICROAMP_SPEC),
+    (
+        "precharge-upper-limit-microvolt",
+        "precharge_upper_limit_microvolt",
+        _SIMPLE_BATTERY_PRECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
+    ),
+    ("charge-term-current-microamp", "charge_term_current_microamp", _SIMPLE_BATTERY_CHARGE_TERM_CURRENT_MICROAMP_SPEC),
+    (
+        "constant-charge-current-max-microamp",
+        "constant_charge_current_max_microamp",
+        _SIMPLE_BATTERY_CONSTANT_CHARGE_CURRENT_MAX_MICROAMP_SPEC,
+    ),
+    (
+        "constant-charge-voltage-max-microvolt",
+        "constant_charge_voltage_max_microvolt",
+        _SIMPLE_BATTERY_CONSTANT_CHARGE_VOLTAGE_MAX_MICROVOLT_SPEC,
+    ),
+    (
+        "factory-internal-resistance-micro-ohms",
+        "factory_internal_resistance_micro_ohms",
+        _SIMPLE_BATTERY_FACTORY_INTERNAL_RESISTANCE_MICRO_OHMS_SPEC,
+    ),
+    ("resistance-temp-table", "resistance_temp_table", _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC),
+    ("ocv-capacity-celsius", "ocv_capacity_celsius", _SIMPLE_BATTERY_OCV_CAPACITY_CELSIUS_SPEC),
+    ("operating-range-celsius", "operating_range_celsius", _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC),
+    ("ambient-celsius", "ambient_celsius", _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC),
+    ("alert-celsius", "alert_celsius", _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC),
+    ("volt-drop-thresh-microvolt", "volt_drop_thresh_microvolt", _SIMPLE_BATTERY_VOLT_DROP_THRESH_MICROVOLT_SPEC),
+    ("volt-drop-soc-bp", "volt_drop_soc_bp", _SIMPLE_BATTERY_VOLT_DROP_SOC_BP_SPEC),
+    (
+        "volt-drop-temperatures-millicelsius",
+        "volt_drop_temperatures_millicelsius",
+        _SIMPLE_BATTERY_VOLT_DROP_TEMPERATURES_MILLICELSIUS_SPEC,
+    ),
+    ("^ocv-capacity-table-[0-9]+$", "ocv_capacity_table_n", _SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC),
+    ("^volt-drop-[0-9]-microvolt", "volt_drop_n_microvolt", _SIMPLE_BATTERY_VOLT_DROP_N_MICROVOLT_SPEC),
+)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -940,11 +1009,11 @@ class SimpleBattery:
         v_i: _Any
         v_table: _Any
         try:
+            # compatible (battery.yaml:31): fits string[]
             if (x := self.compatible) is None or (len(x) < 1 or any(_x0 != "simple-battery" for _x0 in x)):
                 _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)
-        try:
+            # device-chemistry (battery.yaml:34): fits string; one of nickel-cadmium, nickel-metal-hydride, lithium-ion,
+            # lithium-ion-polymer, lithium-ion-iron-phosphate, lithium-ion-manganese-oxide
             if (x := self.device_chemistry) is not None and (
                 x
                 not in {
@@ -957,9 +1026,7 @@ class SimpleBattery:
                 }
             ):
                 _v.diag(out, "device-chemistry", self.device_chemistry, _SIMPLE_BATTERY_DEVICE_CHEMISTRY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "device-chemistry", self.device_chemistry, _SIMPLE_BATTERY_DEVICE_CHEMISTRY_SPEC)
-        try:
+            # over-voltage-threshold-microvolt (battery.yaml:48): fits int32[][]
             if (x := self.over_voltage_threshold_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -969,14 +1036,7 @@ class SimpleBattery:
                     self.over_voltage_threshold_microvolt,
                     _SIMPLE_BATTERY_OVER_VOLTAGE_THRESHOLD_MICROVOLT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "over-voltage-threshold-microvolt",
-                self.over_voltage_threshold_microvolt,
-                _SIMPLE_BATTERY_OVER_VOLTAGE_THRESHOLD_MICROVOLT_SPEC,
-            )
-        try:
+            # re-charge-voltage-microvolt (battery.yaml:51): fits int32[][]
             if (x := self.re_charge_voltage_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -986,14 +1046,7 @@ class SimpleBattery:
                     self.re_charge_voltage_microvolt,
                     _SIMPLE_BATTERY_RE_CHARGE_VOLTAGE_MICROVOLT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "re-charge-voltage-microvolt",
-                self.re_charge_voltage_microvolt,
-                _SIMPLE_BATTERY_RE_CHARGE_VOLTAGE_MICROVOLT_SPEC,
-            )
-        try:
+            # voltage-min-design-microvolt (battery.yaml:54): fits int32[][]
             if (x := self.voltage_min_design_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -1003,14 +1056,7 @@ class SimpleBattery:
                     self.voltage_min_design_microvolt,
                     _SIMPLE_BATTERY_VOLTAGE_MIN_DESIGN_MICROVOLT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "voltage-min-design-microvolt",
-                self.voltage_min_design_microvolt,
-                _SIMPLE_BATTERY_VOLTAGE_MIN_DESIGN_MICROVOLT_SPEC,
-            )
-        try:
+            # voltage-max-design-microvolt (battery.yaml:57): fits int32[][]
             if (x := self.voltage_max_design_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -1020,14 +1066,7 @@ class SimpleBattery:
                     self.voltage_max_design_microvolt,
                     _SIMPLE_BATTERY_VOLTAGE_MAX_DESIGN_MICROVOLT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "voltage-max-design-microvolt",
-                self.voltage_max_design_microvolt,
-                _SIMPLE_BATTERY_VOLTAGE_MAX_DESIGN_MICROVOLT_SPEC,
-            )
-        try:
+            # energy-full-design-microwatt-hours (battery.yaml:60): fits uint32[]
             a = self.energy_full_design_microwatt_hours
             if a is not None:
                 if len(a) < 1:
@@ -1047,14 +1086,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_ENERGY_FULL_DESIGN_MICROWATT_HOURS_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "energy-full-design-microwatt-hours",
-                self.energy_full_design_microwatt_hours,
-                _SIMPLE_BATTERY_ENERGY_FULL_DESIGN_MICROWATT_HOURS_SPEC,
-            )
-        try:
+            # charge-full-design-microamp-hours (battery.yaml:63): fits uint32[]
             a = self.charge_full_design_microamp_hours
             if a is not None:
                 if len(a) < 1:
@@ -1074,14 +1106,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_CHARGE_FULL_DESIGN_MICROAMP_HOURS_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charge-full-design-microamp-hours",
-                self.charge_full_design_microamp_hours,
-                _SIMPLE_BATTERY_CHARGE_FULL_DESIGN_MICROAMP_HOURS_SPEC,
-            )
-        try:
+            # trickle-charge-current-microamp (battery.yaml:66): fits uint32[]
             a = self.trickle_charge_current_microamp
             if a is not None:
                 if len(a) < 1:
@@ -1101,14 +1126,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_TRICKLE_CHARGE_CURRENT_MICROAMP_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "trickle-charge-current-microamp",
-                self.trickle_charge_current_microamp,
-                _SIMPLE_BATTERY_TRICKLE_CHARGE_CURRENT_MICROAMP_SPEC,
-            )
-        try:
+            # tricklecharge-upper-limit-microvolt (battery.yaml:74): fits int32[][]
             if (x := self.tricklecharge_upper_limit_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -1118,14 +1136,7 @@ class SimpleBattery:
                     self.tricklecharge_upper_limit_microvolt,
                     _SIMPLE_BATTERY_TRICKLECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "tricklecharge-upper-limit-microvolt",
-                self.tricklecharge_upper_limit_microvolt,
-                _SIMPLE_BATTERY_TRICKLECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
-            )
-        try:
+            # precharge-current-microamp (battery.yaml:78): fits uint32[]
             a = self.precharge_current_microamp
             if a is not None:
                 if len(a) < 1:
@@ -1145,14 +1156,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_PRECHARGE_CURRENT_MICROAMP_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "precharge-current-microamp",
-                self.precharge_current_microamp,
-                _SIMPLE_BATTERY_PRECHARGE_CURRENT_MICROAMP_SPEC,
-            )
-        try:
+            # precharge-upper-limit-microvolt (battery.yaml:81): fits int32[][]
             if (x := self.precharge_upper_limit_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -1162,14 +1166,7 @@ class SimpleBattery:
                     self.precharge_upper_limit_microvolt,
                     _SIMPLE_BATTERY_PRECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "precharge-upper-limit-microvolt",
-                self.precharge_upper_limit_microvolt,
-                _SIMPLE_BATTERY_PRECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
-            )
-        try:
+            # charge-term-current-microamp (battery.yaml:84): fits uint32[]
             a = self.charge_term_current_microamp
             if a is not None:
                 if len(a) < 1:
@@ -1189,14 +1186,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_CHARGE_TERM_CURRENT_MICROAMP_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charge-term-current-microamp",
-                self.charge_term_current_microamp,
-                _SIMPLE_BATTERY_CHARGE_TERM_CURRENT_MICROAMP_SPEC,
-            )
-        try:
+            # constant-charge-current-max-microamp (battery.yaml:87): fits uint32[]
             a = self.constant_charge_current_max_microamp
             if a is not None:
                 if len(a) < 1:
@@ -1216,14 +1206,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_CONSTANT_CHARGE_CURRENT_MAX_MICROAMP_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "constant-charge-current-max-microamp",
-                self.constant_charge_current_max_microamp,
-                _SIMPLE_BATTERY_CONSTANT_CHARGE_CURRENT_MAX_MICROAMP_SPEC,
-            )
-        try:
+            # constant-charge-voltage-max-microvolt (battery.yaml:90): fits int32[][]
             if (x := self.constant_charge_voltage_max_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -1233,14 +1216,7 @@ class SimpleBattery:
                     self.constant_charge_voltage_max_microvolt,
                     _SIMPLE_BATTERY_CONSTANT_CHARGE_VOLTAGE_MAX_MICROVOLT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "constant-charge-voltage-max-microvolt",
-                self.constant_charge_voltage_max_microvolt,
-                _SIMPLE_BATTERY_CONSTANT_CHARGE_VOLTAGE_MAX_MICROVOLT_SPEC,
-            )
-        try:
+            # factory-internal-resistance-micro-ohms (battery.yaml:93): fits uint32[]
             a = self.factory_internal_resistance_micro_ohms
             if a is not None:
                 if len(a) < 1:
@@ -1260,25 +1236,14 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_FACTORY_INTERNAL_RESISTANCE_MICRO_OHMS_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "factory-internal-resistance-micro-ohms",
-                self.factory_internal_resistance_micro_ohms,
-                _SIMPLE_BATTERY_FACTORY_INTERNAL_RESISTANCE_MICRO_OHMS_SPEC,
-            )
-        try:
+            # resistance-temp-table (battery.yaml:96): fits uint32[2][]
             if (x := self.resistance_temp_table) is not None and (
                 len(x) < 1 or any(len(_x0) != 2 or any(_x1 & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out, "resistance-temp-table", self.resistance_temp_table, _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "resistance-temp-table", self.resistance_temp_table, _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC
-            )
-        try:
+            # ocv-capacity-celsius (battery.yaml:108): fits int32[]
             a = self.ocv_capacity_celsius
             if a is not None:
                 if len(a) < 1:
@@ -1298,9 +1263,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_OCV_CAPACITY_CELSIUS_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(out, "ocv-capacity-celsius", self.ocv_capacity_celsius, _SIMPLE_BATTERY_OCV_CAPACITY_CELSIUS_SPEC)
-        try:
+            # operating-range-celsius (battery.yaml:113): fits int32[2]
             a = self.operating_range_celsius
             if a is not None:
                 if len(a) != 2:
@@ -1320,14 +1283,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "operating-range-celsius",
-                self.operating_range_celsius,
-                _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC,
-            )
-        try:
+            # ambient-celsius (battery.yaml:119): fits int32[2]
             a = self.ambient_celsius
             if a is not None:
                 if len(a) != 2:
@@ -1337,9 +1293,7 @@ class SimpleBattery:
                         if (e + 2147483648) & -4294967296:
                             _v.diag(out, "ambient-celsius", self.ambient_celsius, _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC)
                             break
-        except _v.SLOW:
-            _v.diag(out, "ambient-celsius", self.ambient_celsius, _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC)
-        try:
+            # alert-celsius (battery.yaml:125): fits int32[2]
             a = self.alert_celsius
             if a is not None:
                 if len(a) != 2:
@@ -1349,9 +1303,7 @@ class SimpleBattery:
                         if (e + 2147483648) & -4294967296:
                             _v.diag(out, "alert-celsius", self.alert_celsius, _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC)
                             break
-        except _v.SLOW:
-            _v.diag(out, "alert-celsius", self.alert_celsius, _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC)
-        try:
+            # volt-drop-thresh-microvolt (battery.yaml:134): fits int32[1][1]; value <= 48000000
             if (x := self.volt_drop_thresh_microvolt) is not None and (
                 len(x) != 1
                 or any(
@@ -1366,14 +1318,7 @@ class SimpleBattery:
                     self.volt_drop_thresh_microvolt,
                     _SIMPLE_BATTERY_VOLT_DROP_THRESH_MICROVOLT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "volt-drop-thresh-microvolt",
-                self.volt_drop_thresh_microvolt,
-                _SIMPLE_BATTERY_VOLT_DROP_THRESH_MICROVOLT_SPEC,
-            )
-        try:
+            # volt-drop-soc-bp (battery.yaml:138): fits int32[]
             a = self.volt_drop_soc_bp
             if a is not None:
                 if len(a) < 1:
@@ -1385,9 +1330,7 @@ class SimpleBattery:
                                 out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _SIMPLE_BATTERY_VOLT_DROP_SOC_BP_SPEC
                             )
                             break
-        except _v.SLOW:
-            _v.diag(out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _SIMPLE_BATTERY_VOLT_DROP_SOC_BP_SPEC)
-        try:
+            # volt-drop-temperatures-millicelsius (battery.yaml:142): fits int32[]
             a = self.volt_drop_temperatures_millicelsius
             if a is not None:
                 if len(a) < 1:
@@ -1407,14 +1350,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_VOLT_DROP_TEMPERATURES_MILLICELSIUS_SPEC,
                             )
                             break
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "volt-drop-temperatures-millicelsius",
-                self.volt_drop_temperatures_millicelsius,
-                _SIMPLE_BATTERY_VOLT_DROP_TEMPERATURES_MILLICELSIUS_SPEC,
-            )
-        try:
+            # ^ocv-capacity-table-[0-9]+$ (battery.yaml:150): fits uint32[2][<=100]
             if any(
                 not _v.search("^ocv-capacity-table-[0-9]+$", k)
                 or (
@@ -1435,11 +1371,7 @@ class SimpleBattery:
                     self.ocv_capacity_table_n,
                     _SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "^ocv-capacity-table-[0-9]+$", self.ocv_capacity_table_n, _SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC
-            )
-        try:
+            # ^volt-drop-[0-9]-microvolt (battery.yaml:164): fits int32[][]
             if any(
                 not _v.search("^volt-drop-[0-9]-microvolt", k)
                 or (
@@ -1453,13 +1385,8 @@ class SimpleBattery:
                     self.volt_drop_n_microvolt,
                     _SIMPLE_BATTERY_VOLT_DROP_N_MICROVOLT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "^volt-drop-[0-9]-microvolt",
-                self.volt_drop_n_microvolt,
-                _SIMPLE_BATTERY_VOLT_DROP_N_MICROVOLT_SPEC,
-            )
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _SIMPLE_BATTERY_FIELD_SPECS)
         # rule voltage-design-order (devicetree-battery.yaml:9)
         try:
             r_voltage_min_design_microvolt = self.voltage_min_design_microvolt

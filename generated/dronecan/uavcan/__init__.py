@@ -31,6 +31,8 @@ _TIMESTAMP_DECODE_STRUCT = _struct.Struct("<IHB")
 _TIMESTAMP_USEC_SPEC = _v.Number(
     type="uint56", kind="uint", low=0, high=72057594037927935, unit="us", sentinel=0, sentinel_text="UNKNOWN"
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_TIMESTAMP_FIELD_SPECS = (("usec", "usec", _TIMESTAMP_USEC_SPEC),)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -78,15 +80,14 @@ class Timestamp:
             obj.usec = _m.as_int(data["usec"], "usec")
         return obj
 
+    # Wire layout (Timestamp.uavcan), bits from the start of the payload:
+    #   bits 0-55      uint56 usec  (line 6)
     DATA_TYPE_ID: _ClassVar[int | None] = None
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x05BD0B5C81087E0D
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.usec
-        p2 = r1 & 0xFFFFFFFFFFFFFF
-        head = _TIMESTAMP_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
-        return head
+        return self._dc_head()
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> Timestamp:
@@ -94,18 +95,24 @@ class Timestamp:
         n = len(data)
         if n < 7:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, n << 3)
-        u1, u2, u3 = _TIMESTAMP_DECODE_STRUCT.unpack_from(data)
-        x4 = u1 | (u2 << 32) | (u3 << 48)
+        packed1, packed2, packed3 = _TIMESTAMP_DECODE_STRUCT.unpack_from(data)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        usec = packed1 | (packed2 << 32) | (packed3 << 48)
         if n > 7:
             raise _dc.DecodeError("Timestamp: " + str(n - 7) + " byte(s) beyond the end of the message")
-        return cls(x4)
+        return cls(usec)
+
+    def _dc_head(self) -> bytes:
+        """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
+        usec = self.usec
+        usec_bits = usec & 0xFFFFFFFFFFFFFF
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        return _TIMESTAMP_ENCODE_STRUCT.pack(
+            (usec_bits & 0xFFFFFFFF), ((usec_bits >> 32) & 0xFFFF), ((usec_bits >> 48) & 0xFF)
+        )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.usec
-        p2 = r1 & 0xFFFFFFFFFFFFFF
-        acc = (acc << 56) | int.from_bytes(
-            _TIMESTAMP_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
-        )
+        acc = (acc << 56) | int.from_bytes(self._dc_head(), "big")
         return acc
 
     @classmethod
@@ -113,18 +120,20 @@ class Timestamp:
         if rem < 56:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3 = _TIMESTAMP_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
-        x4 = u1 | (u2 << 32) | (u3 << 48)
-        return cls(x4), rem
+        packed1, packed2, packed3 = _TIMESTAMP_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        usec = packed1 | (packed2 << 32) | (packed3 << 48)
+        return cls(usec), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # usec (Timestamp.uavcan:6): fits uint56; UNKNOWN means unknown (accepted)
             if self.usec & -72057594037927936:
                 _v.diag(out, "usec", self.usec, _TIMESTAMP_USEC_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "usec", self.usec, _TIMESTAMP_USEC_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _TIMESTAMP_FIELD_SPECS)
         return out
 
     def check(self) -> None:

@@ -18,7 +18,7 @@ Modules of this package: :mod:`.mapping_module` writes a mapping's functions, ru
 :mod:`.choices`, :mod:`.cells`, :mod:`.devicetree`, :mod:`.messages`, :mod:`.px4`, :mod:`.px4_cells`);
 :mod:`.routes` chains them into converters; :mod:`.concepts_module` writes ``BatteryState``.
 Emitters write one statement a line, with literals from :mod:`..literals`; every module is then
-laid out by :mod:`..layout`, as the model modules are.
+formatted by ruff (:mod:`..formatting`), as the model modules are.
 """
 
 from __future__ import annotations

@@ -12,8 +12,8 @@ Import = tuple[str, str, str | None]  # (relative module, name, alias or None)
 
 
 def import_lines(names: Iterable[Import]) -> list[str]:
-    """The ``from`` imports binding ``names``, in isort order (one statement a line: the layout
-    engine breaks the long ones)."""
+    """The ``from`` imports binding ``names``, in isort order (one statement a line: ruff
+    breaks the long ones)."""
     return from_imports(f"from {m} import {name}" + (f" as {alias}" if alias else "") for m, name, alias in names)
 
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from ....ir import Concept
 from .. import naming
-from ..layout import format_module
 from ..literals import docstring, py_literal
 from .context import INDENT
 
@@ -53,4 +52,4 @@ def concepts_module(concepts: dict[str, Concept], header: str) -> str:
         unit = f" [{c.unit.symbol}]" if c.unit else ""
         lines.append(f"{INDENT}{naming.identifier(c.name)}: {_KIND_TYPES[c.kind]} = None")
         lines.append(docstring(f"{c.doc}{unit}", INDENT))
-    return format_module("\n".join(lines) + "\n")
+    return "\n".join(lines) + "\n"

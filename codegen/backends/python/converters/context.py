@@ -6,7 +6,7 @@ constants shared by both directions (:class:`ModuleConstants`). The emitter mixi
 package (numeric, choices, cells, devicetree, messages, px4, px4_cells) build on it.
 
 Emitters write each statement on one line (a call as :func:`call` spells it); the module is
-laid out afterwards by the layout engine. Temporaries an emitter writes (``_v``, ``_c``, ...;
+formatted afterwards by ruff. Temporaries an emitter writes (``_v``, ``_c``, ...;
 see :data:`TEMPORARIES`) get the rule's number as a suffix when emitted, so each has one type
 across the function (mypy) and a reader can tell which rule made it.
 """
@@ -37,9 +37,11 @@ from ....ir import (
     Unit,
     units,
 )
+from ....ir.fieldtypes import allowed_range
 from ....ir.mapping_values import ConstantRef, Number, Value
+from ....ir.rules import rule_ranges
 from .. import naming
-from ..layout import LINE_LENGTH
+from ..formatting import LINE_LENGTH
 from ..literals import float_literal, py_literal
 
 FLT_EPS = 1.1920928955078125e-07
@@ -129,6 +131,9 @@ class RuleContext:
         constants: ModuleConstants,
     ) -> None:
         self.schema = schema
+        # the ranges rules state of single fields (MAVLink's battery_remaining: 0..100), by field: a converter
+        # keeps to them as to the schema's own ranges (int_bounds)
+        self.rule_ranges = {schema.field_at(m, name): rng for (m, name), rng in rule_ranges(schema).items()}
         self.mapping = mapping
         self.concepts = concepts
         self.src = src
@@ -275,11 +280,6 @@ class RuleContext:
         """Conditions that ``var`` is none of ``marks`` (NaN by ``var == var``)."""
         return [f"{var} == {var}" if _nan(m) else f"{var} != {py_literal(m)}" for m in marks]
 
-    def unit_of(self, ref: FieldRef) -> Unit | None:
-        if ref.message == CONCEPTS_ENDPOINT:
-            return self.concepts[ref.field].unit
-        return self.fld(ref).unit
-
     def format_and_concept(self, rule: Rule) -> tuple[FieldRef, FieldRef]:
         """(the format field, the concept) of a rule relating one of each, whichever side is which."""
         fmt, con = rule.sources[0], rule.targets[0]
@@ -303,8 +303,9 @@ class RuleContext:
     def marker_literal(self, f: Field, mark: float | int) -> str:
         return float_literal(mark) if self.is_float(f) else py_literal(int(mark))
 
-    def store(self, f: Field, expr: str, label: str, hi: Number | None = None) -> str:
-        """``expr`` (a float) as the field holds it: float16/float32, bool, or a rounded, clamped integer."""
+    def store(self, f: Field, expr: str, label: str, hi: Number | None = None, marks: tuple[Number, ...] = ()) -> str:
+        """``expr`` (a float) as the field holds it: float16/float32, bool, or a rounded integer clamped into
+        :meth:`int_bounds` (``marks``: the rule's own unknown values, beside the field's sentinel)."""
         p = self.prim(f)
         if p is None:
             return expr
@@ -316,11 +317,40 @@ class RuleContext:
             return expr
         if p.kind is PrimitiveKind.BOOL:
             return f"bool({expr})"
-        rng = p.value_range
-        if rng is None:
+        if p.value_range is None:
             return expr
-        top = int(rng[1]) if hi is None else min(int(rng[1]), int(hi))
-        return call("_r.to_int", [expr, py_literal(int(rng[0])), py_literal(top), "rep", label])
+        lo, top = self.int_bounds(f, p, hi, self.markers(f, marks))
+        return call("_r.to_int", [expr, py_literal(lo), py_literal(top), "rep", label])
+
+    def int_bounds(self, f: Field, p: PrimitiveType, hi: Number | None, marks: list[float | int]) -> tuple[int, int]:
+        """The integers a converter may write into an integer field: its type's, within the schema's range, the
+        rule's ``valid_max`` and a validation rule's ``lo <= f <= hi``, less a sentinel at either end -- a value
+        clamped onto it would read as unknown (a 400 degC temperature as MAVLink's INT16_MAX, a charge of -5 %
+        as -1). What validate allows, so a clamp never writes what validate refuses."""
+        rng = allowed_range(p, f.range).intersect(self.rule_ranges.get(f))
+        type_lo, type_hi = (int(v) for v in p.value_range or (0, 0))
+        lo = (
+            type_lo
+            if rng.minimum is None
+            else math.floor(rng.minimum) + 1
+            if rng.exclusive_minimum
+            else math.ceil(rng.minimum)
+        )
+        top = (
+            type_hi
+            if rng.maximum is None
+            else math.ceil(rng.maximum) - 1
+            if rng.exclusive_maximum
+            else math.floor(rng.maximum)
+        )
+        if hi is not None:
+            top = min(top, math.floor(hi))
+        lo, top = max(lo, type_lo), min(top, type_hi)
+        while lo < top and any(_same(lo, m) for m in marks):
+            lo += 1
+        while top > lo and any(_same(top, m) for m in marks):
+            top -= 1
+        return (lo, top) if lo <= top else (type_lo, type_hi)
 
     def store_c(self, f: Field, expr: str, label: str) -> str:
         """A C assignment of a float32 value to the field's type, then DroneCAN saturation."""

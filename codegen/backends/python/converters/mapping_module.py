@@ -7,7 +7,6 @@ from dataclasses import dataclass
 
 from ....ir import CONCEPTS_ENDPOINT, Concept, Endpoint, Mapping, Schema
 from .. import naming
-from ..layout import format_module
 from ..literals import docstring
 from .classes import class_names, import_lines
 from .context import INDENT, ModuleConstants, Side
@@ -86,7 +85,7 @@ def mapping_module(
     head += import_lines(names)
     text = "\n".join([*head, *(["", *consts] if consts else [])]) + "\n\n\n"
     text += "\n\n\n".join("\n".join(f) for f in functions)
-    return module, format_module(text + "\n"), made
+    return module, text + "\n", made
 
 
 def _function(b: FunctionBuilder, src: str, dst: str, body: list[str]) -> list[str]:

@@ -52,7 +52,9 @@ class NumericEmitters(RuleContext):
         self.emit("    if rep_u is not None:")
         self.emit_call("rep_u.unknown", [label], 2)
         self.emit("else:")
-        stored = self.store(f, _signed(affine("_v", mul, add), op.negate and add == 0.0), label, op.valid_max)
+        stored = self.store(
+            f, _signed(affine("_v", mul, add), op.negate and add == 0.0), label, op.valid_max, op.unknown
+        )
         if is_list:  # a devicetree list of one
             self.emit_assign("_w", stored, 1)
             self.emit(f"    {target} = [[_w]]")
@@ -101,7 +103,7 @@ class NumericEmitters(RuleContext):
                 self.emit_assign(target, call("_r.bytes_out", ["_v", py_literal(cap), "rep", label]), 1)
             return
         value = f"_v - {py_literal(add)}" if add else "_v"
-        self.emit_assign(target, self.store(f, value, label), 1)
+        self.emit_assign(target, self.store(f, value, label, marks=op.unknown), 1)
         if marks and kind != "bool":
             self.emit(f"    if rep is not None and {target} in {py_literal(tuple(marks))}:")
             self.emit_call("rep.clamped", [label, _WRITTEN_AS_MARKER], 2)

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 from ....errors import BattgenError
 from ....ir import CONCEPTS_ENDPOINT, Endpoint, Schema
 from .. import naming
-from ..layout import format_module
 from ..literals import docstring, py_literal
 from .classes import Import, class_names, import_lines
 from .context import INDENT, call
@@ -109,7 +108,7 @@ class Routes:
             return
         head = [self.header, docstring(doc, ""), "", "from __future__ import annotations", "", *import_lines(used)]
         text = "\n".join([*head, "", "", ""]) + "\n\n\n".join(functions) + "\n"
-        self.files[f"{PACKAGE}/{module}.py"] = format_module(text)
+        self.files[f"{PACKAGE}/{module}.py"] = text
 
     def function(
         self, fname: str, source: str, target: str, routes: dict[str, list[Edge] | None], classes: dict[str, str]
@@ -231,4 +230,4 @@ class Routes:
             '        raise ConversionError(f"no converter from {source!r} to {target!r} (known: {pairs})")',
             "    return found",
         ]
-        return format_module("\n".join(lines) + "\n")
+        return "\n".join(lines) + "\n"

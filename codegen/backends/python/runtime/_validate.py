@@ -227,6 +227,15 @@ def diag(out: list[Violation], path: str, value: object, spec: Spec) -> None:
         _pattern(out, path, value, spec)
 
 
+def diagnose(obj: object, fields: tuple[tuple[str, str, Spec], ...]) -> list[Violation]:
+    """Every violation of every field of ``obj``, each judged by :func:`diag` (``fields``: schema name,
+    attribute, spec): what ``validate()`` falls back to when a fast test meets a value it cannot take."""
+    out: list[Violation] = []
+    for path, attr, spec in fields:
+        diag(out, path, getattr(obj, attr), spec)
+    return out
+
+
 def is_sentinel(value: object, spec: Number) -> bool:
     return _is_marker(value, spec.sentinel)
 

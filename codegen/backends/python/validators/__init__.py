@@ -16,6 +16,7 @@ from ..module_context import ModuleContext
 from ..naming import upper_snake
 from ..runtime import copied
 from ..views import ClassView
+from .describe import check_comment
 from .fields import field_code, is_optional
 from .rules import known_expr, rule_lines
 
@@ -34,7 +35,8 @@ class _Validators:
     def contribute(self, msg: Message, ctx: ModuleContext, view: ClassView) -> Contribution:
         idents = {fv.source_name: fv.ident for fv in view.fields}
         specs: list[str] = []
-        checks: list[str] = []
+        table: list[str] = []
+        fast: list[str] = []
         field_names: set[str] = set()
         for f in msg.fields:
             if f.is_padding:
@@ -43,8 +45,25 @@ class _Validators:
             spec_name = ctx.constant(view.name, f"{upper_snake(ident)}_SPEC")
             code = field_code(ctx.schema, msg, f, ident, spec_name)
             specs.append(f"{spec_name} = {code.spec_source}")
-            checks += code.lines
+            table.append(f"({py_literal(f.name)}, {py_literal(ident)}, {spec_name})")
+            if code.lines:
+                fast += check_comment(ctx.schema, msg, f)
+            fast += code.lines
             field_names |= code.names
+        checks: list[str] = []
+        if fast:
+            # one fast test a field; a value of another type than the field's makes a test raise, and
+            # then every field is diagnosed the careful way instead (the same findings, in the same order)
+            every = ctx.constant(view.name, "FIELD_SPECS")
+            specs.append(
+                f"# (schema name, attribute, spec) of each field, for the careful way\n{every} = ({', '.join(table)},)"
+            )
+            checks = [
+                "try:",
+                *["    " + line for line in fast],
+                "except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way",
+                f"    out = _v.diagnose(self, {every})",
+            ]
         if msg.is_union:
             held = ", ".join(f"{py_literal(name)}: self.{ident}" for name, ident in idents.items())
             checks.append(f"_v.union(out, self.union_field, {{{held}}})")

@@ -14,7 +14,7 @@ from .checks import ArrayCheck, NestedCheck, NumberCheck, V, build
 class FieldCode:
     spec_name: str
     spec_source: str
-    lines: list[str]  # statements in validate(), unindented
+    lines: list[str]  # statements in validate(), unindented (inside the one try of the field checks)
     names: frozenset[str]  # locals the statements assign (validate() declares them)
 
 
@@ -84,7 +84,7 @@ def field_code(schema: Schema, msg: Message, f: Field, ident: str, spec_name: st
         else:  # the value is tested more than once: read the attribute once
             names.add("x")
             body = [f"x = {attr}", f"if {unparenthesized(cond).replace(V, 'x')}:", f"    {slow}"]
-    return FieldCode(spec_name, spec, _wrap(body, slow), frozenset(names))
+    return FieldCode(spec_name, spec, body, frozenset(names))
 
 
 def is_optional(msg: Message, f: Field) -> bool:
@@ -92,7 +92,3 @@ def is_optional(msg: Message, f: Field) -> bool:
     if f.pattern is not None:
         return False
     return msg.devicetree is not None or msg.is_union
-
-
-def _wrap(body: list[str], slow: str) -> list[str]:
-    return ["try:", *["    " + line for line in body], "except _v.SLOW:", f"    {slow}"]

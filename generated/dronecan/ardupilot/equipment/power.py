@@ -56,12 +56,12 @@ class BatteryContinuousStatusFlag(_enum.IntFlag):
     CAPACITY_RELATIVE_TO_FULL = 262144
 
 
-# fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_CELLS_FIELD_ENDS_FROM_INDEX = ((16, "BatteryCells.index"),)
 # fixed fields as decoded
 _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -69,6 +69,11 @@ _BATTERY_CELLS_VOLTAGES_SPEC = _v.Array(
     _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V"), 24, False
 )
 _BATTERY_CELLS_INDEX_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_CELLS_FIELD_SPECS = (
+    ("voltages", "voltages", _BATTERY_CELLS_VOLTAGES_SPEC),
+    ("index", "index", _BATTERY_CELLS_INDEX_SPEC),
+)
 
 
 # float16 fields packed as float32 ...
@@ -142,16 +147,22 @@ _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC = _v.Number(
         0x40000: "STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL",
     },
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_CONTINUOUS_FIELD_SPECS = (
+    ("temperature_cells", "temperature_cells", _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC),
+    ("temperature_pcb", "temperature_pcb", _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC),
+    ("temperature_other", "temperature_other", _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC),
+    ("current", "current", _BATTERY_CONTINUOUS_CURRENT_SPEC),
+    ("voltage", "voltage", _BATTERY_CONTINUOUS_VOLTAGE_SPEC),
+    ("state_of_charge", "state_of_charge", _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC),
+    ("slot_id", "slot_id", _BATTERY_CONTINUOUS_SLOT_ID_SPEC),
+    ("capacity_consumed", "capacity_consumed", _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC),
+    ("status_flags", "status_flags", _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC),
+)
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
 _BATTERY_INFO_AUX_ENCODE_STRUCT = _struct.Struct("<IHB")
-# float16 fields packed as float32 ...
-_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2f")
-# ... and read back as bits, from which each half is cut
-_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2I")
-# fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHHHH")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_AUX_FIELD_ENDS = ((56, "BatteryInfoAux.timestamp.usec"),)
 # fixed fields as decoded
@@ -167,6 +178,12 @@ _BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT = (
 )
 # fixed fields as decoded
 _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHeeH")
+# float16 fields packed as float32 ...
+_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2f")
+# ... and read back as bits, from which each half is cut
+_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHHHH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -180,14 +197,19 @@ _BATTERY_INFO_AUX_MAX_CURRENT_SPEC = _v.Number(type="float16", kind="float", low
 _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC = _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V")
 _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC = _v.Number(type="bool", kind="bool", low=0, high=1)
 _BATTERY_INFO_AUX_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_INFO_AUX_FIELD_SPECS = (
+    ("timestamp", "timestamp", _BATTERY_INFO_AUX_TIMESTAMP_SPEC),
+    ("voltage_cell", "voltage_cell", _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC),
+    ("cycle_count", "cycle_count", _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC),
+    ("over_discharge_count", "over_discharge_count", _BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC),
+    ("max_current", "max_current", _BATTERY_INFO_AUX_MAX_CURRENT_SPEC),
+    ("nominal_voltage", "nominal_voltage", _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC),
+    ("is_powering_off", "is_powering_off", _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC),
+    ("battery_id", "battery_id", _BATTERY_INFO_AUX_BATTERY_ID_SPEC),
+)
 
 
-# float16 fields packed as float32 ...
-_BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4f")
-# ... and read back as bits, from which each half is cut
-_BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4I")
-# fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBHHHHffffHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY = (
     (32, "BatteryPeriodic.design_capacity"),
@@ -205,6 +227,12 @@ _BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY = (
 )
 # fixed fields as decoded
 _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBeeeeffffHB")
+# float16 fields packed as float32 ...
+_BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4f")
+# ... and read back as bits, from which each half is cut
+_BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4I")
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBHHHHffffHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -243,6 +271,28 @@ _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC = _v.Number(
 )
 _BATTERY_PERIODIC_CYCLE_COUNT_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
 _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255, unit="%")
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_PERIODIC_FIELD_SPECS = (
+    ("name", "name", _BATTERY_PERIODIC_NAME_SPEC),
+    ("serial_number", "serial_number", _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC),
+    ("manufacture_date", "manufacture_date", _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC),
+    ("design_capacity", "design_capacity", _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC),
+    ("cells_in_series", "cells_in_series", _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC),
+    ("nominal_voltage", "nominal_voltage", _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC),
+    ("discharge_minimum_voltage", "discharge_minimum_voltage", _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC),
+    ("charging_minimum_voltage", "charging_minimum_voltage", _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC),
+    ("charging_maximum_voltage", "charging_maximum_voltage", _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC),
+    ("charging_maximum_current", "charging_maximum_current", _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC),
+    ("discharge_maximum_current", "discharge_maximum_current", _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC),
+    (
+        "discharge_maximum_burst_current",
+        "discharge_maximum_burst_current",
+        _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
+    ),
+    ("full_charge_capacity", "full_charge_capacity", _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC),
+    ("cycle_count", "cycle_count", _BATTERY_PERIODIC_CYCLE_COUNT_SPEC),
+    ("state_of_health", "state_of_health", _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC),
+)
 
 
 # fixed fields as encoded (a float16 as its bit pattern)
@@ -269,6 +319,15 @@ _BATTERY_TAG_ARMED_HOURS_SPEC = _v.Number(
 _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
 _BATTERY_TAG_FIRST_USE_MINS_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
 _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_TAG_FIELD_SPECS = (
+    ("serial_number", "serial_number", _BATTERY_TAG_SERIAL_NUMBER_SPEC),
+    ("num_cycles", "num_cycles", _BATTERY_TAG_NUM_CYCLES_SPEC),
+    ("armed_hours", "armed_hours", _BATTERY_TAG_ARMED_HOURS_SPEC),
+    ("battery_capacity_mAh", "battery_capacity_mAh", _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC),
+    ("first_use_mins", "first_use_mins", _BATTERY_TAG_FIRST_USE_MINS_SPEC),
+    ("last_arm_time_mins", "last_arm_time_mins", _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC),
+)
 
 
 @_functools.cache
@@ -325,29 +384,20 @@ class BatteryCells:
             obj.index = _m.as_int(data["index"], "index")
         return obj
 
+    # Wire layout (20012.BatteryCells.uavcan), bits from the start of the payload:
+    #   bits 0-        float16[<=24] voltages: a 5-bit length, then <=24 x 16 bits  (line 6)
+    #   bits voltages+0 uint16 index  (line 7)
     DATA_TYPE_ID: _ClassVar[int | None] = 20012
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x5C8B1ABD15890EA4
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        acc = 1
-        x1 = self.voltages
-        k2 = len(x1)
-        if k2 > 24:
-            raise _dc.EncodeError("BatteryCells.voltages: length " + str(k2) + " exceeds capacity 24")
-        acc = (acc << 5) | k2
-        acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
-        r4 = self.index
-        acc = (acc << 16) | int.from_bytes(
-            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
-            "big",
-        )
-        return _dc.finish(acc)
+        return _dc.finish(self._dc_put(1, tao))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryCells:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f0: list[_Any]
+        voltages: list[_Any]
         n = len(data)
         v = int.from_bytes(data, "big")
         rem = n << 3
@@ -361,14 +411,14 @@ class BatteryCells:
         if rem < n2:
             raise _dc.short("BatteryCells.voltages", n2, rem)
         rem -= n2
-        f0 = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
+        voltages = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
         if rem < 16:
             raise _dc.cut(_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX, rem)
         rem -= 16
-        (u3,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
+        (index,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
         if rem >= 8:
             raise _dc.DecodeError("BatteryCells: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(f0, u3)
+        return cls(voltages, index)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         x1 = self.voltages
@@ -377,16 +427,18 @@ class BatteryCells:
             raise _dc.EncodeError("BatteryCells.voltages: length " + str(k2) + " exceeds capacity 24")
         acc = (acc << 5) | k2
         acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
-        r4 = self.index
+        index = self.index
         acc = (acc << 16) | int.from_bytes(
-            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(r4 if 0 <= r4 <= 65535 else (65535 if r4 > 65535 else 0)),
+            _BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX.pack(
+                index if 0 <= index <= 65535 else (65535 if index > 65535 else 0)
+            ),
             "big",
         )
         return acc
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryCells, int]:
-        f0: list[_Any]
+        voltages: list[_Any]
         if rem < 5:
             raise _dc.short("BatteryCells.voltages (length)", 5, rem)
         rem -= 5
@@ -397,12 +449,12 @@ class BatteryCells:
         if rem < n2:
             raise _dc.short("BatteryCells.voltages", n2, rem)
         rem -= n2
-        f0 = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
+        voltages = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
         if rem < 16:
             raise _dc.cut(_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX, rem)
         rem -= 16
-        (u3,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
-        return cls(f0, u3), rem
+        (index,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
+        return cls(voltages, index), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -410,6 +462,7 @@ class BatteryCells:
         a: _Any
         e: _Any
         try:
+            # voltages (20012.BatteryCells.uavcan:6): fits float16[<=24]
             a = self.voltages
             if len(a) > 24:
                 _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
@@ -418,13 +471,11 @@ class BatteryCells:
                     if not (-65504.0 <= e <= 65504.0):
                         _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltages", self.voltages, _BATTERY_CELLS_VOLTAGES_SPEC)
-        try:
+            # index (20012.BatteryCells.uavcan:7): fits uint16
             if self.index & -65536:
                 _v.diag(out, "index", self.index, _BATTERY_CELLS_INDEX_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "index", self.index, _BATTERY_CELLS_INDEX_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_CELLS_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -622,100 +673,22 @@ class BatteryContinuous:
             obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
         return obj
 
+    # Wire layout (20010.BatteryContinuous.uavcan), bits from the start of the payload:
+    #   bits 0-15      float16 temperature_cells  (line 7)
+    #   bits 16-31     float16 temperature_pcb  (line 8)
+    #   bits 32-47     float16 temperature_other  (line 9)
+    #   bits 48-79     float32 current  (line 10)
+    #   bits 80-111    float32 voltage  (line 11)
+    #   bits 112-127   float16 state_of_charge  (line 12)
+    #   bits 128-135   uint8 slot_id  (line 13)
+    #   bits 136-167   float32 capacity_consumed  (line 14)
+    #   bits 168-199   uint32 status_flags  (line 15)
     DATA_TYPE_ID: _ClassVar[int | None] = 20010
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x756B561340D5E4AE
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.temperature_cells
-        r2 = self.temperature_pcb
-        r3 = self.temperature_other
-        r4 = self.state_of_charge
-        g5, g6, g7, g8 = _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
-            _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-                (
-                    r3
-                    if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
-                ),
-                (
-                    r4
-                    if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
-                ),
-            )
-        )
-        h9 = (
-            ((g5 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g5 < 0x477FF000
-            else (((g5 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g5 < 0xC77FF000 else _dc.f16bits(g5))
-        )
-        h10 = (
-            ((g6 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g6 < 0x477FF000
-            else (((g6 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g6 < 0xC77FF000 else _dc.f16bits(g6))
-        )
-        h11 = (
-            ((g7 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g7 < 0x477FF000
-            else (((g7 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g7 < 0xC77FF000 else _dc.f16bits(g7))
-        )
-        h12 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
-        )
-        r13 = self.current
-        r14 = self.voltage
-        r15 = self.slot_id
-        r16 = self.capacity_consumed
-        r17 = self.status_flags
-        head = _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
-            h9,
-            h10,
-            h11,
-            (
-                r13
-                if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < r13 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
-                )
-            ),
-            (
-                r14
-                if -_dc.F32_MAX <= r14 <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < r14 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r14 < -_dc.F32_MAX else r14)
-                )
-            ),
-            h12,
-            (r15 if 0 <= r15 <= 255 else (255 if r15 > 255 else 0)),
-            (
-                r16
-                if -_dc.F32_MAX <= r16 <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < r16 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r16 < -_dc.F32_MAX else r16)
-                )
-            ),
-            (r17 if 0 <= r17 <= 4294967295 else (4294967295 if r17 > 4294967295 else 0)),
-        )
-        return head
+        return self._dc_head()
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryContinuous:
@@ -723,103 +696,114 @@ class BatteryContinuous:
         n = len(data)
         if n < 25:
             raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, n << 3)
-        u1, u2, u3, u4, u5, u6, u7, u8, u9 = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack_from(data)
+        (
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        ) = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack_from(data)
         if n > 25:
             raise _dc.DecodeError("BatteryContinuous: " + str(n - 25) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, u3, u4, u5, u6, u7, u8, u9)
+        return cls(
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        )
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.temperature_cells
-        r2 = self.temperature_pcb
-        r3 = self.temperature_other
-        r4 = self.state_of_charge
-        g5, g6, g7, g8 = _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
-            _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-                (
-                    r3
-                    if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
-                ),
-                (
-                    r4
-                    if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
-                ),
+    def _dc_head(self) -> bytes:
+        """Bits 0-199 (the fixed fields that open the payload) as bytes, zero padded."""
+        temperature_cells = self.temperature_cells
+        temperature_pcb = self.temperature_pcb
+        temperature_other = self.temperature_other
+        state_of_charge = self.state_of_charge
+        temperature_cells_f32, temperature_pcb_f32, temperature_other_f32, state_of_charge_f32 = (
+            _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
+                _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
+                    temperature_cells
+                    if -65504.0 <= temperature_cells <= 65504.0
+                    else _dc.f16_saturated(temperature_cells),
+                    temperature_pcb if -65504.0 <= temperature_pcb <= 65504.0 else _dc.f16_saturated(temperature_pcb),
+                    temperature_other
+                    if -65504.0 <= temperature_other <= 65504.0
+                    else _dc.f16_saturated(temperature_other),
+                    state_of_charge if -65504.0 <= state_of_charge <= 65504.0 else _dc.f16_saturated(state_of_charge),
+                )
             )
         )
-        h9 = (
-            ((g5 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g5 < 0x477FF000
-            else (((g5 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g5 < 0xC77FF000 else _dc.f16bits(g5))
+        temperature_cells_f16 = (
+            ((temperature_cells_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_cells_f32 < 0x477FF000
+            else _dc.f16bits(temperature_cells_f32)
         )
-        h10 = (
-            ((g6 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g6 < 0x477FF000
-            else (((g6 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g6 < 0xC77FF000 else _dc.f16bits(g6))
+        temperature_pcb_f16 = (
+            ((temperature_pcb_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_pcb_f32 < 0x477FF000
+            else _dc.f16bits(temperature_pcb_f32)
         )
-        h11 = (
-            ((g7 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g7 < 0x477FF000
-            else (((g7 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g7 < 0xC77FF000 else _dc.f16bits(g7))
+        temperature_other_f16 = (
+            ((temperature_other_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_other_f32 < 0x477FF000
+            else _dc.f16bits(temperature_other_f32)
         )
-        h12 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        state_of_charge_f16 = (
+            ((state_of_charge_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= state_of_charge_f32 < 0x477FF000
+            else _dc.f16bits(state_of_charge_f32)
         )
-        r13 = self.current
-        r14 = self.voltage
-        r15 = self.slot_id
-        r16 = self.capacity_consumed
-        r17 = self.status_flags
-        acc = (acc << 200) | int.from_bytes(
-            _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
-                h9,
-                h10,
-                h11,
-                (
-                    r13
-                    if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r13 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
-                    )
-                ),
-                (
-                    r14
-                    if -_dc.F32_MAX <= r14 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r14 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r14 < -_dc.F32_MAX else r14)
-                    )
-                ),
-                h12,
-                (r15 if 0 <= r15 <= 255 else (255 if r15 > 255 else 0)),
-                (
-                    r16
-                    if -_dc.F32_MAX <= r16 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r16 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r16 < -_dc.F32_MAX else r16)
-                    )
-                ),
-                (r17 if 0 <= r17 <= 4294967295 else (4294967295 if r17 > 4294967295 else 0)),
+        current = self.current
+        voltage = self.voltage
+        slot_id = self.slot_id
+        capacity_consumed = self.capacity_consumed
+        status_flags = self.status_flags
+        return _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
+            temperature_cells_f16,
+            temperature_pcb_f16,
+            temperature_other_f16,
+            (
+                current
+                if -_dc.F32_MAX <= current <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < current < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < current < -_dc.F32_MAX else current)
+                )
             ),
-            "big",
+            (
+                voltage
+                if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < voltage < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
+                )
+            ),
+            state_of_charge_f16,
+            (slot_id if 0 <= slot_id <= 255 else (255 if slot_id > 255 else 0)),
+            (
+                capacity_consumed
+                if -_dc.F32_MAX <= capacity_consumed <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < capacity_consumed < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < capacity_consumed < -_dc.F32_MAX else capacity_consumed)
+                )
+            ),
+            (status_flags if 0 <= status_flags <= 4294967295 else (4294967295 if status_flags > 4294967295 else 0)),
         )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 200) | int.from_bytes(self._dc_head(), "big")
         return acc
 
     @classmethod
@@ -827,59 +811,62 @@ class BatteryContinuous:
         if rem < 200:
             raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, rem)
         rem -= 200
-        u1, u2, u3, u4, u5, u6, u7, u8, u9 = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack(
-            ((v >> rem) & ((1 << 200) - 1)).to_bytes(25, "big")
-        )
-        return cls(u1, u2, u3, u4, u5, u6, u7, u8, u9), rem
+        (
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        ) = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 200) - 1)).to_bytes(25, "big"))
+        return cls(
+            temperature_cells,
+            temperature_pcb,
+            temperature_other,
+            current,
+            voltage,
+            state_of_charge,
+            slot_id,
+            capacity_consumed,
+            status_flags,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # temperature_cells (20010.BatteryContinuous.uavcan:7): fits float16
             if not (-65504.0 <= self.temperature_cells <= 65504.0):
                 _v.diag(out, "temperature_cells", self.temperature_cells, _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature_cells", self.temperature_cells, _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC)
-        try:
+            # temperature_pcb (20010.BatteryContinuous.uavcan:8): fits float16
             if not (-65504.0 <= self.temperature_pcb <= 65504.0):
                 _v.diag(out, "temperature_pcb", self.temperature_pcb, _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature_pcb", self.temperature_pcb, _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC)
-        try:
+            # temperature_other (20010.BatteryContinuous.uavcan:9): fits float16
             if not (-65504.0 <= self.temperature_other <= 65504.0):
                 _v.diag(out, "temperature_other", self.temperature_other, _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature_other", self.temperature_other, _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC)
-        try:
+            # current (20010.BatteryContinuous.uavcan:10): fits float32
             if not (-3.4028234663852886e38 <= self.current <= 3.4028234663852886e38):
                 _v.diag(out, "current", self.current, _BATTERY_CONTINUOUS_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _BATTERY_CONTINUOUS_CURRENT_SPEC)
-        try:
+            # voltage (20010.BatteryContinuous.uavcan:11): fits float32
             if not (-3.4028234663852886e38 <= self.voltage <= 3.4028234663852886e38):
                 _v.diag(out, "voltage", self.voltage, _BATTERY_CONTINUOUS_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _BATTERY_CONTINUOUS_VOLTAGE_SPEC)
-        try:
+            # state_of_charge (20010.BatteryContinuous.uavcan:12): fits float16
             if not (-65504.0 <= self.state_of_charge <= 65504.0):
                 _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC)
-        try:
+            # slot_id (20010.BatteryContinuous.uavcan:13): fits uint8
             if self.slot_id & -256:
                 _v.diag(out, "slot_id", self.slot_id, _BATTERY_CONTINUOUS_SLOT_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "slot_id", self.slot_id, _BATTERY_CONTINUOUS_SLOT_ID_SPEC)
-        try:
+            # capacity_consumed (20010.BatteryContinuous.uavcan:14): fits float32
             if not (-3.4028234663852886e38 <= self.capacity_consumed <= 3.4028234663852886e38):
                 _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC)
-        try:
+            # status_flags (20010.BatteryContinuous.uavcan:15): fits uint32; bits of STATUS_FLAG only
             if self.status_flags & -524288:
                 _v.diag(out, "status_flags", self.status_flags, _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "status_flags", self.status_flags, _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_CONTINUOUS_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -1030,154 +1017,125 @@ class BatteryInfoAux:
             obj.battery_id = _m.as_int(data["battery_id"], "battery_id")
         return obj
 
+    # Wire layout (20004.BatteryInfoAux.uavcan), bits from the start of the payload:
+    #   bits 0-55      dronecan.uavcan.Timestamp timestamp  (line 8)
+    #   bits 56-       float16[<=255] voltage_cell: a 8-bit length, then <=255 x 16 bits  (line 11)
+    #   bits voltage_cell+0 uint16 cycle_count  (line 14)
+    #   bits voltage_cell+16 uint16 over_discharge_count  (line 17)
+    #   bits voltage_cell+32 float16 max_current  (line 20)
+    #   bits voltage_cell+48 float16 nominal_voltage  (line 23)
+    #   bits voltage_cell+64 bool is_powering_off  (line 25)
+    #   bits voltage_cell+65 uint8 battery_id  (line 27)
     DATA_TYPE_ID: _ClassVar[int | None] = 20004
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x7D7F49FC75484882
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.timestamp.usec
-        p2 = r1 & 0xFFFFFFFFFFFFFF
-        head = _BATTERY_INFO_AUX_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF))
-        acc = 0x100000000000000 | int.from_bytes(head, "big")
-        x3 = self.voltage_cell
-        k4 = len(x3)
-        if k4 > 255:
-            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
-        acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(_struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
-        r6 = self.max_current
-        r7 = self.nominal_voltage
-        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
-            _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
-                (
-                    r6
-                    if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
-                ),
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
-            )
-        )
-        h10 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
-        )
-        h11 = (
-            ((g9 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
-        )
-        r12 = self.cycle_count
-        r13 = self.over_discharge_count
-        r14 = self.is_powering_off
-        p15 = 1 if r14 else 0
-        r16 = self.battery_id
-        p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
-        acc = (acc << 73) | (
-            int.from_bytes(
-                _BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT.pack(
-                    (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
-                    (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
-                    h10,
-                    h11,
-                    (p15 << 7) | ((p17 & 0x1) << 15) | ((p17 >> 1) & 0x7F),
-                ),
-                "big",
-            )
-            >> 7
-        )
-        return _dc.finish(acc)
+        return _dc.finish(self._dc_put(1, tao))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfoAux:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f1: list[_Any]
+        voltage_cell: list[_Any]
         n = len(data)
         if n < 7:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, n << 3)
-        u1, u2, u3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack_from(data)
-        x4 = u1 | (u2 << 32) | (u3 << 48)
+        packed1, packed2, packed3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack_from(data)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        timestamp_usec = packed1 | (packed2 << 32) | (packed3 << 48)
         v = int.from_bytes(data, "big")
         rem = (n << 3) - 56
         if rem < 8:
             raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
         rem -= 8
-        k5 = (v >> rem) & 0xFF
-        if k5 > 255:
-            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k5) + " exceeds capacity 255")
-        n6 = k5 * 16
-        if rem < n6:
-            raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
-        rem -= n6
-        f1 = list(_struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
+        k4 = (v >> rem) & 0xFF
+        if k4 > 255:
+            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
+        n5 = k4 * 16
+        if rem < n5:
+            raise _dc.short("BatteryInfoAux.voltage_cell", n5, rem)
+        rem -= n5
+        voltage_cell = list(_struct.unpack(f"<{k4}e", ((v >> rem) & ((1 << n5) - 1)).to_bytes(n5 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
-        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
-            (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
-        )
-        x12 = ((u11 >> 7) & 0x1) != 0
-        x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
-        if rem >= 8:
-            raise _dc.DecodeError("BatteryInfoAux: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(_timestamp_class()(x4), f1, u7, u8, u9, u10, x12, x13)
-
-    def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.timestamp.usec
-        p2 = r1 & 0xFFFFFFFFFFFFFF
-        acc = (acc << 56) | int.from_bytes(
-            _BATTERY_INFO_AUX_ENCODE_STRUCT.pack((p2 & 0xFFFFFFFF), ((p2 >> 32) & 0xFFFF), ((p2 >> 48) & 0xFF)), "big"
-        )
-        x3 = self.voltage_cell
-        k4 = len(x3)
-        if k4 > 255:
-            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
-        acc = (acc << 8) | k4
-        acc = (acc << (k4 * 16)) | int.from_bytes(_struct.pack(f"<{k4}H", *[_dc.f16s(e5) for e5 in x3]), "big")
-        r6 = self.max_current
-        r7 = self.nominal_voltage
-        g8, g9 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
-            _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
-                (
-                    r6
-                    if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
-                ),
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
+        cycle_count, over_discharge_count, max_current, nominal_voltage, packed6 = (
+            _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
+                (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
             )
         )
-        h10 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        is_powering_off = ((packed6 >> 7) & 0x1) != 0
+        battery_id = (packed6 >> 15) | ((packed6 & 0x7F) << 1)
+        if rem >= 8:
+            raise _dc.DecodeError("BatteryInfoAux: " + str(rem >> 3) + " byte(s) beyond the end of the message")
+        return cls(
+            _timestamp_class()(timestamp_usec),
+            voltage_cell,
+            cycle_count,
+            over_discharge_count,
+            max_current,
+            nominal_voltage,
+            is_powering_off,
+            battery_id,
         )
-        h11 = (
-            ((g9 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+
+    def _dc_head(self) -> bytes:
+        """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
+        timestamp_usec = self.timestamp.usec
+        timestamp_usec_bits = timestamp_usec & 0xFFFFFFFFFFFFFF
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        return _BATTERY_INFO_AUX_ENCODE_STRUCT.pack(
+            (timestamp_usec_bits & 0xFFFFFFFF),
+            ((timestamp_usec_bits >> 32) & 0xFFFF),
+            ((timestamp_usec_bits >> 48) & 0xFF),
         )
-        r12 = self.cycle_count
-        r13 = self.over_discharge_count
-        r14 = self.is_powering_off
-        p15 = 1 if r14 else 0
-        r16 = self.battery_id
-        p17 = r16 if 0 <= r16 <= 255 else (255 if r16 > 255 else 0)
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 56) | int.from_bytes(self._dc_head(), "big")
+        x1 = self.voltage_cell
+        k2 = len(x1)
+        if k2 > 255:
+            raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k2) + " exceeds capacity 255")
+        acc = (acc << 8) | k2
+        acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
+        max_current = self.max_current
+        nominal_voltage = self.nominal_voltage
+        max_current_f32, nominal_voltage_f32 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
+            _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
+                max_current if -65504.0 <= max_current <= 65504.0 else _dc.f16_saturated(max_current),
+                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
+            )
+        )
+        max_current_f16 = (
+            ((max_current_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= max_current_f32 < 0x477FF000
+            else _dc.f16bits(max_current_f32)
+        )
+        nominal_voltage_f16 = (
+            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
+            else _dc.f16bits(nominal_voltage_f32)
+        )
+        cycle_count = self.cycle_count
+        over_discharge_count = self.over_discharge_count
+        is_powering_off = self.is_powering_off
+        is_powering_off_bits = 1 if is_powering_off else 0
+        battery_id = self.battery_id
+        battery_id_bits = battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         acc = (acc << 73) | (
             int.from_bytes(
                 _BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT.pack(
-                    (r12 if 0 <= r12 <= 65535 else (65535 if r12 > 65535 else 0)),
-                    (r13 if 0 <= r13 <= 65535 else (65535 if r13 > 65535 else 0)),
-                    h10,
-                    h11,
-                    (p15 << 7) | ((p17 & 0x1) << 15) | ((p17 >> 1) & 0x7F),
+                    (cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)),
+                    (
+                        over_discharge_count
+                        if 0 <= over_discharge_count <= 65535
+                        else (65535 if over_discharge_count > 65535 else 0)
+                    ),
+                    max_current_f16,
+                    nominal_voltage_f16,
+                    (is_powering_off_bits << 7) | ((battery_id_bits & 0x1) << 15) | ((battery_id_bits >> 1) & 0x7F),
                 ),
                 "big",
             )
@@ -1187,32 +1145,47 @@ class BatteryInfoAux:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfoAux, int]:
-        f1: list[_Any]
+        voltage_cell: list[_Any]
         if rem < 56:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
-        x4 = u1 | (u2 << 32) | (u3 << 48)
+        packed1, packed2, packed3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(
+            ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
+        )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        timestamp_usec = packed1 | (packed2 << 32) | (packed3 << 48)
         if rem < 8:
             raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
         rem -= 8
-        k5 = (v >> rem) & 0xFF
-        if k5 > 255:
-            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k5) + " exceeds capacity 255")
-        n6 = k5 * 16
-        if rem < n6:
-            raise _dc.short("BatteryInfoAux.voltage_cell", n6, rem)
-        rem -= n6
-        f1 = list(_struct.unpack(f"<{k5}e", ((v >> rem) & ((1 << n6) - 1)).to_bytes(n6 >> 3, "big")))
+        k4 = (v >> rem) & 0xFF
+        if k4 > 255:
+            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
+        n5 = k4 * 16
+        if rem < n5:
+            raise _dc.short("BatteryInfoAux.voltage_cell", n5, rem)
+        rem -= n5
+        voltage_cell = list(_struct.unpack(f"<{k4}e", ((v >> rem) & ((1 << n5) - 1)).to_bytes(n5 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
-        u7, u8, u9, u10, u11 = _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
-            (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
+        cycle_count, over_discharge_count, max_current, nominal_voltage, packed6 = (
+            _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
+                (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
+            )
         )
-        x12 = ((u11 >> 7) & 0x1) != 0
-        x13 = (u11 >> 15) | ((u11 & 0x7F) << 1)
-        return cls(_timestamp_class()(x4), f1, u7, u8, u9, u10, x12, x13), rem
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        is_powering_off = ((packed6 >> 7) & 0x1) != 0
+        battery_id = (packed6 >> 15) | ((packed6 & 0x7F) << 1)
+        return cls(
+            _timestamp_class()(timestamp_usec),
+            voltage_cell,
+            cycle_count,
+            over_discharge_count,
+            max_current,
+            nominal_voltage,
+            is_powering_off,
+            battery_id,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -1222,6 +1195,7 @@ class BatteryInfoAux:
         e: _Any
         sub: _Any
         try:
+            # timestamp (20004.BatteryInfoAux.uavcan:8): fits dronecan.uavcan.Timestamp
             x = self.timestamp
             if x.QUALIFIED_NAME != "dronecan.uavcan.Timestamp":
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_AUX_TIMESTAMP_SPEC)
@@ -1229,9 +1203,7 @@ class BatteryInfoAux:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("timestamp", sub))
-        except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_AUX_TIMESTAMP_SPEC)
-        try:
+            # voltage_cell (20004.BatteryInfoAux.uavcan:11): fits float16[<=255]
             a = self.voltage_cell
             if len(a) > 255:
                 _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
@@ -1240,41 +1212,29 @@ class BatteryInfoAux:
                     if not (-65504.0 <= e <= 65504.0):
                         _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltage_cell", self.voltage_cell, _BATTERY_INFO_AUX_VOLTAGE_CELL_SPEC)
-        try:
+            # cycle_count (20004.BatteryInfoAux.uavcan:14): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_AUX_CYCLE_COUNT_SPEC)
-        try:
+            # over_discharge_count (20004.BatteryInfoAux.uavcan:17): fits uint16
             if self.over_discharge_count & -65536:
                 _v.diag(
                     out, "over_discharge_count", self.over_discharge_count, _BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(out, "over_discharge_count", self.over_discharge_count, _BATTERY_INFO_AUX_OVER_DISCHARGE_COUNT_SPEC)
-        try:
+            # max_current (20004.BatteryInfoAux.uavcan:20): fits float16
             if not (-65504.0 <= self.max_current <= 65504.0):
                 _v.diag(out, "max_current", self.max_current, _BATTERY_INFO_AUX_MAX_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "max_current", self.max_current, _BATTERY_INFO_AUX_MAX_CURRENT_SPEC)
-        try:
+            # nominal_voltage (20004.BatteryInfoAux.uavcan:23): fits float16
             if not (-65504.0 <= self.nominal_voltage <= 65504.0):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_AUX_NOMINAL_VOLTAGE_SPEC)
-        try:
+            # is_powering_off (20004.BatteryInfoAux.uavcan:25): fits bool
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_INFO_AUX_IS_POWERING_OFF_SPEC)
-        try:
+            # battery_id (20004.BatteryInfoAux.uavcan:27): fits uint8
             if self.battery_id & -256:
                 _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_AUX_BATTERY_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_AUX_BATTERY_ID_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_INFO_AUX_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -1524,151 +1484,35 @@ class BatteryPeriodic:
             obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
         return obj
 
+    # Wire layout (20011.BatteryPeriodic.uavcan), bits from the start of the payload:
+    #   bits 0-        uint8[<=50] name: a 6-bit length, then <=50 x 8 bits  (line 6)
+    #   bits name+0-   uint8[<=32] serial_number: a 6-bit length, then <=32 x 8 bits  (line 7)
+    #   bits serial_number+0- uint8[<=9] manufacture_date: a 4-bit length, then <=9 x 8 bits  (line 8)
+    #   bits manufacture_date+0 float32 design_capacity  (line 9)
+    #   bits manufacture_date+32 uint8 cells_in_series  (line 10)
+    #   bits manufacture_date+40 float16 nominal_voltage  (line 11)
+    #   bits manufacture_date+56 float16 discharge_minimum_voltage  (line 12)
+    #   bits manufacture_date+72 float16 charging_minimum_voltage  (line 13)
+    #   bits manufacture_date+88 float16 charging_maximum_voltage  (line 14)
+    #   bits manufacture_date+104 float32 charging_maximum_current  (line 15)
+    #   bits manufacture_date+136 float32 discharge_maximum_current  (line 16)
+    #   bits manufacture_date+168 float32 discharge_maximum_burst_current  (line 17)
+    #   bits manufacture_date+200 float32 full_charge_capacity  (line 18)
+    #   bits manufacture_date+232 uint16 cycle_count  (line 19)
+    #   bits manufacture_date+248 uint8 state_of_health  (line 20)
     DATA_TYPE_ID: _ClassVar[int | None] = 20011
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x0F012494E97358D2
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        acc = 1
-        x1 = self.name
-        k2 = len(x1)
-        if k2 > 50:
-            raise _dc.EncodeError("BatteryPeriodic.name: length " + str(k2) + " exceeds capacity 50")
-        acc = (acc << 6) | k2
-        acc = (acc << (k2 << 3)) | int.from_bytes(x1, "big")
-        x3 = self.serial_number
-        k4 = len(x3)
-        if k4 > 32:
-            raise _dc.EncodeError("BatteryPeriodic.serial_number: length " + str(k4) + " exceeds capacity 32")
-        acc = (acc << 6) | k4
-        acc = (acc << (k4 << 3)) | int.from_bytes(x3, "big")
-        x5 = self.manufacture_date
-        k6 = len(x5)
-        if k6 > 9:
-            raise _dc.EncodeError("BatteryPeriodic.manufacture_date: length " + str(k6) + " exceeds capacity 9")
-        acc = (acc << 4) | k6
-        acc = (acc << (k6 << 3)) | int.from_bytes(x5, "big")
-        r7 = self.nominal_voltage
-        r8 = self.discharge_minimum_voltage
-        r9 = self.charging_minimum_voltage
-        r10 = self.charging_maximum_voltage
-        g11, g12, g13, g14 = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-            _BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY.pack(
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
-                (
-                    r8
-                    if -65504.0 <= r8 <= 65504.0
-                    else (65504.0 if 65504.0 < r8 < _dc.INF else (-65504.0 if -_dc.INF < r8 < -65504.0 else r8))
-                ),
-                (
-                    r9
-                    if -65504.0 <= r9 <= 65504.0
-                    else (65504.0 if 65504.0 < r9 < _dc.INF else (-65504.0 if -_dc.INF < r9 < -65504.0 else r9))
-                ),
-                (
-                    r10
-                    if -65504.0 <= r10 <= 65504.0
-                    else (65504.0 if 65504.0 < r10 < _dc.INF else (-65504.0 if -_dc.INF < r10 < -65504.0 else r10))
-                ),
-            )
-        )
-        h15 = (
-            ((g11 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
-        )
-        h16 = (
-            ((g12 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
-        )
-        h17 = (
-            ((g13 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
-        )
-        h18 = (
-            ((g14 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
-        )
-        r19 = self.design_capacity
-        r20 = self.cells_in_series
-        r21 = self.charging_maximum_current
-        r22 = self.discharge_maximum_current
-        r23 = self.discharge_maximum_burst_current
-        r24 = self.full_charge_capacity
-        r25 = self.cycle_count
-        r26 = self.state_of_health
-        acc = (acc << 256) | int.from_bytes(
-            _BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY.pack(
-                (
-                    r19
-                    if -_dc.F32_MAX <= r19 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r19 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r19 < -_dc.F32_MAX else r19)
-                    )
-                ),
-                (r20 if 0 <= r20 <= 255 else (255 if r20 > 255 else 0)),
-                h15,
-                h16,
-                h17,
-                h18,
-                (
-                    r21
-                    if -_dc.F32_MAX <= r21 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r21 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r21 < -_dc.F32_MAX else r21)
-                    )
-                ),
-                (
-                    r22
-                    if -_dc.F32_MAX <= r22 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r22 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r22 < -_dc.F32_MAX else r22)
-                    )
-                ),
-                (
-                    r23
-                    if -_dc.F32_MAX <= r23 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r23 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r23 < -_dc.F32_MAX else r23)
-                    )
-                ),
-                (
-                    r24
-                    if -_dc.F32_MAX <= r24 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r24 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r24 < -_dc.F32_MAX else r24)
-                    )
-                ),
-                (r25 if 0 <= r25 <= 65535 else (65535 if r25 > 65535 else 0)),
-                (r26 if 0 <= r26 <= 255 else (255 if r26 > 255 else 0)),
-            ),
-            "big",
-        )
-        return _dc.finish(acc)
+        return _dc.finish(self._dc_put(1, tao))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryPeriodic:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f0: bytes
-        f1: bytes
-        f2: bytes
+        name: bytes
+        serial_number: bytes
+        manufacture_date: bytes
         n = len(data)
         v = int.from_bytes(data, "big")
         rem = n << 3
@@ -1682,7 +1526,7 @@ class BatteryPeriodic:
         if rem < n2:
             raise _dc.short("BatteryPeriodic.name", n2, rem)
         rem -= n2
-        f0 = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
+        name = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
         if rem < 6:
             raise _dc.short("BatteryPeriodic.serial_number (length)", 6, rem)
         rem -= 6
@@ -1693,7 +1537,7 @@ class BatteryPeriodic:
         if rem < n4:
             raise _dc.short("BatteryPeriodic.serial_number", n4, rem)
         rem -= n4
-        f1 = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
+        serial_number = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
         if rem < 4:
             raise _dc.short("BatteryPeriodic.manufacture_date (length)", 4, rem)
         rem -= 4
@@ -1704,18 +1548,45 @@ class BatteryPeriodic:
         if rem < n6:
             raise _dc.short("BatteryPeriodic.manufacture_date", n6, rem)
         rem -= n6
-        f2 = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
+        manufacture_date = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
         if rem < 256:
             raise _dc.cut(_BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY, rem)
         rem -= 256
-        u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18 = (
-            _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-                ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
-            )
+        (
+            design_capacity,
+            cells_in_series,
+            nominal_voltage,
+            discharge_minimum_voltage,
+            charging_minimum_voltage,
+            charging_maximum_voltage,
+            charging_maximum_current,
+            discharge_maximum_current,
+            discharge_maximum_burst_current,
+            full_charge_capacity,
+            cycle_count,
+            state_of_health,
+        ) = _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+            ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
         )
         if rem >= 8:
             raise _dc.DecodeError("BatteryPeriodic: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(f0, f1, f2, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18)
+        return cls(
+            name,
+            serial_number,
+            manufacture_date,
+            design_capacity,
+            cells_in_series,
+            nominal_voltage,
+            discharge_minimum_voltage,
+            charging_minimum_voltage,
+            charging_maximum_voltage,
+            charging_maximum_current,
+            discharge_maximum_current,
+            discharge_maximum_burst_current,
+            full_charge_capacity,
+            cycle_count,
+            state_of_health,
+        )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         x1 = self.name
@@ -1736,116 +1607,123 @@ class BatteryPeriodic:
             raise _dc.EncodeError("BatteryPeriodic.manufacture_date: length " + str(k6) + " exceeds capacity 9")
         acc = (acc << 4) | k6
         acc = (acc << (k6 << 3)) | int.from_bytes(x5, "big")
-        r7 = self.nominal_voltage
-        r8 = self.discharge_minimum_voltage
-        r9 = self.charging_minimum_voltage
-        r10 = self.charging_maximum_voltage
-        g11, g12, g13, g14 = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+        nominal_voltage = self.nominal_voltage
+        discharge_minimum_voltage = self.discharge_minimum_voltage
+        charging_minimum_voltage = self.charging_minimum_voltage
+        charging_maximum_voltage = self.charging_maximum_voltage
+        (
+            nominal_voltage_f32,
+            discharge_minimum_voltage_f32,
+            charging_minimum_voltage_f32,
+            charging_maximum_voltage_f32,
+        ) = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
             _BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY.pack(
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
-                (
-                    r8
-                    if -65504.0 <= r8 <= 65504.0
-                    else (65504.0 if 65504.0 < r8 < _dc.INF else (-65504.0 if -_dc.INF < r8 < -65504.0 else r8))
-                ),
-                (
-                    r9
-                    if -65504.0 <= r9 <= 65504.0
-                    else (65504.0 if 65504.0 < r9 < _dc.INF else (-65504.0 if -_dc.INF < r9 < -65504.0 else r9))
-                ),
-                (
-                    r10
-                    if -65504.0 <= r10 <= 65504.0
-                    else (65504.0 if 65504.0 < r10 < _dc.INF else (-65504.0 if -_dc.INF < r10 < -65504.0 else r10))
-                ),
+                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
+                discharge_minimum_voltage
+                if -65504.0 <= discharge_minimum_voltage <= 65504.0
+                else _dc.f16_saturated(discharge_minimum_voltage),
+                charging_minimum_voltage
+                if -65504.0 <= charging_minimum_voltage <= 65504.0
+                else _dc.f16_saturated(charging_minimum_voltage),
+                charging_maximum_voltage
+                if -65504.0 <= charging_maximum_voltage <= 65504.0
+                else _dc.f16_saturated(charging_maximum_voltage),
             )
         )
-        h15 = (
-            ((g11 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        nominal_voltage_f16 = (
+            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
+            else _dc.f16bits(nominal_voltage_f32)
         )
-        h16 = (
-            ((g12 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        discharge_minimum_voltage_f16 = (
+            ((discharge_minimum_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= discharge_minimum_voltage_f32 < 0x477FF000
+            else _dc.f16bits(discharge_minimum_voltage_f32)
         )
-        h17 = (
-            ((g13 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        charging_minimum_voltage_f16 = (
+            ((charging_minimum_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= charging_minimum_voltage_f32 < 0x477FF000
+            else _dc.f16bits(charging_minimum_voltage_f32)
         )
-        h18 = (
-            ((g14 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        charging_maximum_voltage_f16 = (
+            ((charging_maximum_voltage_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= charging_maximum_voltage_f32 < 0x477FF000
+            else _dc.f16bits(charging_maximum_voltage_f32)
         )
-        r19 = self.design_capacity
-        r20 = self.cells_in_series
-        r21 = self.charging_maximum_current
-        r22 = self.discharge_maximum_current
-        r23 = self.discharge_maximum_burst_current
-        r24 = self.full_charge_capacity
-        r25 = self.cycle_count
-        r26 = self.state_of_health
+        design_capacity = self.design_capacity
+        cells_in_series = self.cells_in_series
+        charging_maximum_current = self.charging_maximum_current
+        discharge_maximum_current = self.discharge_maximum_current
+        discharge_maximum_burst_current = self.discharge_maximum_burst_current
+        full_charge_capacity = self.full_charge_capacity
+        cycle_count = self.cycle_count
+        state_of_health = self.state_of_health
         acc = (acc << 256) | int.from_bytes(
             _BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY.pack(
                 (
-                    r19
-                    if -_dc.F32_MAX <= r19 <= _dc.F32_MAX
+                    design_capacity
+                    if -_dc.F32_MAX <= design_capacity <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r19 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r19 < -_dc.F32_MAX else r19)
+                        if _dc.F32_MAX < design_capacity < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < design_capacity < -_dc.F32_MAX else design_capacity)
                     )
                 ),
-                (r20 if 0 <= r20 <= 255 else (255 if r20 > 255 else 0)),
-                h15,
-                h16,
-                h17,
-                h18,
+                (cells_in_series if 0 <= cells_in_series <= 255 else (255 if cells_in_series > 255 else 0)),
+                nominal_voltage_f16,
+                discharge_minimum_voltage_f16,
+                charging_minimum_voltage_f16,
+                charging_maximum_voltage_f16,
                 (
-                    r21
-                    if -_dc.F32_MAX <= r21 <= _dc.F32_MAX
+                    charging_maximum_current
+                    if -_dc.F32_MAX <= charging_maximum_current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r21 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r21 < -_dc.F32_MAX else r21)
-                    )
-                ),
-                (
-                    r22
-                    if -_dc.F32_MAX <= r22 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r22 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r22 < -_dc.F32_MAX else r22)
+                        if _dc.F32_MAX < charging_maximum_current < _dc.INF
+                        else (
+                            -_dc.F32_MAX
+                            if -_dc.INF < charging_maximum_current < -_dc.F32_MAX
+                            else charging_maximum_current
+                        )
                     )
                 ),
                 (
-                    r23
-                    if -_dc.F32_MAX <= r23 <= _dc.F32_MAX
+                    discharge_maximum_current
+                    if -_dc.F32_MAX <= discharge_maximum_current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r23 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r23 < -_dc.F32_MAX else r23)
+                        if _dc.F32_MAX < discharge_maximum_current < _dc.INF
+                        else (
+                            -_dc.F32_MAX
+                            if -_dc.INF < discharge_maximum_current < -_dc.F32_MAX
+                            else discharge_maximum_current
+                        )
                     )
                 ),
                 (
-                    r24
-                    if -_dc.F32_MAX <= r24 <= _dc.F32_MAX
+                    discharge_maximum_burst_current
+                    if -_dc.F32_MAX <= discharge_maximum_burst_current <= _dc.F32_MAX
                     else (
                         _dc.F32_MAX
-                        if _dc.F32_MAX < r24 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r24 < -_dc.F32_MAX else r24)
+                        if _dc.F32_MAX < discharge_maximum_burst_current < _dc.INF
+                        else (
+                            -_dc.F32_MAX
+                            if -_dc.INF < discharge_maximum_burst_current < -_dc.F32_MAX
+                            else discharge_maximum_burst_current
+                        )
                     )
                 ),
-                (r25 if 0 <= r25 <= 65535 else (65535 if r25 > 65535 else 0)),
-                (r26 if 0 <= r26 <= 255 else (255 if r26 > 255 else 0)),
+                (
+                    full_charge_capacity
+                    if -_dc.F32_MAX <= full_charge_capacity <= _dc.F32_MAX
+                    else (
+                        _dc.F32_MAX
+                        if _dc.F32_MAX < full_charge_capacity < _dc.INF
+                        else (-_dc.F32_MAX if -_dc.INF < full_charge_capacity < -_dc.F32_MAX else full_charge_capacity)
+                    )
+                ),
+                (cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)),
+                (state_of_health if 0 <= state_of_health <= 255 else (255 if state_of_health > 255 else 0)),
             ),
             "big",
         )
@@ -1853,9 +1731,9 @@ class BatteryPeriodic:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryPeriodic, int]:
-        f0: bytes
-        f1: bytes
-        f2: bytes
+        name: bytes
+        serial_number: bytes
+        manufacture_date: bytes
         if rem < 6:
             raise _dc.short("BatteryPeriodic.name (length)", 6, rem)
         rem -= 6
@@ -1866,7 +1744,7 @@ class BatteryPeriodic:
         if rem < n2:
             raise _dc.short("BatteryPeriodic.name", n2, rem)
         rem -= n2
-        f0 = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
+        name = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
         if rem < 6:
             raise _dc.short("BatteryPeriodic.serial_number (length)", 6, rem)
         rem -= 6
@@ -1877,7 +1755,7 @@ class BatteryPeriodic:
         if rem < n4:
             raise _dc.short("BatteryPeriodic.serial_number", n4, rem)
         rem -= n4
-        f1 = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
+        serial_number = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
         if rem < 4:
             raise _dc.short("BatteryPeriodic.manufacture_date (length)", 4, rem)
         rem -= 4
@@ -1888,55 +1766,71 @@ class BatteryPeriodic:
         if rem < n6:
             raise _dc.short("BatteryPeriodic.manufacture_date", n6, rem)
         rem -= n6
-        f2 = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
+        manufacture_date = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
         if rem < 256:
             raise _dc.cut(_BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY, rem)
         rem -= 256
-        u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18 = (
-            _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-                ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
-            )
+        (
+            design_capacity,
+            cells_in_series,
+            nominal_voltage,
+            discharge_minimum_voltage,
+            charging_minimum_voltage,
+            charging_maximum_voltage,
+            charging_maximum_current,
+            discharge_maximum_current,
+            discharge_maximum_burst_current,
+            full_charge_capacity,
+            cycle_count,
+            state_of_health,
+        ) = _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
+            ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
         )
-        return cls(f0, f1, f2, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18), rem
+        return cls(
+            name,
+            serial_number,
+            manufacture_date,
+            design_capacity,
+            cells_in_series,
+            nominal_voltage,
+            discharge_minimum_voltage,
+            charging_minimum_voltage,
+            charging_maximum_voltage,
+            charging_maximum_current,
+            discharge_maximum_current,
+            discharge_maximum_burst_current,
+            full_charge_capacity,
+            cycle_count,
+            state_of_health,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         x: _Any
         try:
+            # name (20011.BatteryPeriodic.uavcan:6): fits uint8[<=50]
             x = self.name
             if x.__class__ is not bytes or len(x) > 50:
                 _v.diag(out, "name", self.name, _BATTERY_PERIODIC_NAME_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "name", self.name, _BATTERY_PERIODIC_NAME_SPEC)
-        try:
+            # serial_number (20011.BatteryPeriodic.uavcan:7): fits uint8[<=32]
             x = self.serial_number
             if x.__class__ is not bytes or len(x) > 32:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC)
-        try:
+            # manufacture_date (20011.BatteryPeriodic.uavcan:8): fits uint8[<=9]
             x = self.manufacture_date
             if x.__class__ is not bytes or len(x) > 9:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC)
-        try:
+            # design_capacity (20011.BatteryPeriodic.uavcan:9): fits float32
             if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC)
-        try:
+            # cells_in_series (20011.BatteryPeriodic.uavcan:10): fits uint8
             if self.cells_in_series & -256:
                 _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC)
-        try:
+            # nominal_voltage (20011.BatteryPeriodic.uavcan:11): fits float16
             if not (-65504.0 <= self.nominal_voltage <= 65504.0):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC)
-        try:
+            # discharge_minimum_voltage (20011.BatteryPeriodic.uavcan:12): fits float16
             if not (-65504.0 <= self.discharge_minimum_voltage <= 65504.0):
                 _v.diag(
                     out,
@@ -1944,14 +1838,7 @@ class BatteryPeriodic:
                     self.discharge_minimum_voltage,
                     _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_minimum_voltage",
-                self.discharge_minimum_voltage,
-                _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
-            )
-        try:
+            # charging_minimum_voltage (20011.BatteryPeriodic.uavcan:13): fits float16
             if not (-65504.0 <= self.charging_minimum_voltage <= 65504.0):
                 _v.diag(
                     out,
@@ -1959,14 +1846,7 @@ class BatteryPeriodic:
                     self.charging_minimum_voltage,
                     _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charging_minimum_voltage",
-                self.charging_minimum_voltage,
-                _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC,
-            )
-        try:
+            # charging_maximum_voltage (20011.BatteryPeriodic.uavcan:14): fits float16
             if not (-65504.0 <= self.charging_maximum_voltage <= 65504.0):
                 _v.diag(
                     out,
@@ -1974,14 +1854,7 @@ class BatteryPeriodic:
                     self.charging_maximum_voltage,
                     _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charging_maximum_voltage",
-                self.charging_maximum_voltage,
-                _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC,
-            )
-        try:
+            # charging_maximum_current (20011.BatteryPeriodic.uavcan:15): fits float32
             if not (-3.4028234663852886e38 <= self.charging_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1989,14 +1862,7 @@ class BatteryPeriodic:
                     self.charging_maximum_current,
                     _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charging_maximum_current",
-                self.charging_maximum_current,
-                _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC,
-            )
-        try:
+            # discharge_maximum_current (20011.BatteryPeriodic.uavcan:16): fits float32
             if not (-3.4028234663852886e38 <= self.discharge_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2004,14 +1870,7 @@ class BatteryPeriodic:
                     self.discharge_maximum_current,
                     _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_maximum_current",
-                self.discharge_maximum_current,
-                _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC,
-            )
-        try:
+            # discharge_maximum_burst_current (20011.BatteryPeriodic.uavcan:17): fits float32
             if not (-3.4028234663852886e38 <= self.discharge_maximum_burst_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2019,30 +1878,19 @@ class BatteryPeriodic:
                     self.discharge_maximum_burst_current,
                     _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_maximum_burst_current",
-                self.discharge_maximum_burst_current,
-                _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
-            )
-        try:
+            # full_charge_capacity (20011.BatteryPeriodic.uavcan:18): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity <= 3.4028234663852886e38):
                 _v.diag(
                     out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC)
-        try:
+            # cycle_count (20011.BatteryPeriodic.uavcan:19): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_PERIODIC_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_PERIODIC_CYCLE_COUNT_SPEC)
-        try:
+            # state_of_health (20011.BatteryPeriodic.uavcan:20): fits uint8
             if self.state_of_health & -256:
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_PERIODIC_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -2163,34 +2011,19 @@ class BatteryTag:
             obj.last_arm_time_mins = _m.as_int(data["last_arm_time_mins"], "last_arm_time_mins")
         return obj
 
+    # Wire layout (20500.BatteryTag.uavcan), bits from the start of the payload:
+    #   bits 0-31      uint32 serial_number  (line 7)
+    #   bits 32-63     uint32 num_cycles  (line 10)
+    #   bits 64-95     float32 armed_hours  (line 13)
+    #   bits 96-127    uint32 battery_capacity_mAh  (line 16)
+    #   bits 128-159   uint32 first_use_mins  (line 19)
+    #   bits 160-191   uint32 last_arm_time_mins  (line 22)
     DATA_TYPE_ID: _ClassVar[int | None] = 20500
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x4A5A9B42099F73E1
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.serial_number
-        r2 = self.num_cycles
-        r3 = self.armed_hours
-        r4 = self.battery_capacity_mAh
-        r5 = self.first_use_mins
-        r6 = self.last_arm_time_mins
-        head = _BATTERY_TAG_ENCODE_STRUCT.pack(
-            (r1 if 0 <= r1 <= 4294967295 else (4294967295 if r1 > 4294967295 else 0)),
-            (r2 if 0 <= r2 <= 4294967295 else (4294967295 if r2 > 4294967295 else 0)),
-            (
-                r3
-                if -_dc.F32_MAX <= r3 <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < r3 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r3 < -_dc.F32_MAX else r3)
-                )
-            ),
-            (r4 if 0 <= r4 <= 4294967295 else (4294967295 if r4 > 4294967295 else 0)),
-            (r5 if 0 <= r5 <= 4294967295 else (4294967295 if r5 > 4294967295 else 0)),
-            (r6 if 0 <= r6 <= 4294967295 else (4294967295 if r6 > 4294967295 else 0)),
-        )
-        return head
+        return self._dc_head()
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryTag:
@@ -2198,37 +2031,52 @@ class BatteryTag:
         n = len(data)
         if n < 24:
             raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, n << 3)
-        u1, u2, u3, u4, u5, u6 = _BATTERY_TAG_DECODE_STRUCT.unpack_from(data)
+        serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins = (
+            _BATTERY_TAG_DECODE_STRUCT.unpack_from(data)
+        )
         if n > 24:
             raise _dc.DecodeError("BatteryTag: " + str(n - 24) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, u3, u4, u5, u6)
+        return cls(serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins)
+
+    def _dc_head(self) -> bytes:
+        """Bits 0-191 (the fixed fields that open the payload) as bytes, zero padded."""
+        serial_number = self.serial_number
+        num_cycles = self.num_cycles
+        armed_hours = self.armed_hours
+        battery_capacity_mah = self.battery_capacity_mAh
+        first_use_mins = self.first_use_mins
+        last_arm_time_mins = self.last_arm_time_mins
+        return _BATTERY_TAG_ENCODE_STRUCT.pack(
+            (serial_number if 0 <= serial_number <= 4294967295 else (4294967295 if serial_number > 4294967295 else 0)),
+            (num_cycles if 0 <= num_cycles <= 4294967295 else (4294967295 if num_cycles > 4294967295 else 0)),
+            (
+                armed_hours
+                if -_dc.F32_MAX <= armed_hours <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < armed_hours < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < armed_hours < -_dc.F32_MAX else armed_hours)
+                )
+            ),
+            (
+                battery_capacity_mah
+                if 0 <= battery_capacity_mah <= 4294967295
+                else (4294967295 if battery_capacity_mah > 4294967295 else 0)
+            ),
+            (
+                first_use_mins
+                if 0 <= first_use_mins <= 4294967295
+                else (4294967295 if first_use_mins > 4294967295 else 0)
+            ),
+            (
+                last_arm_time_mins
+                if 0 <= last_arm_time_mins <= 4294967295
+                else (4294967295 if last_arm_time_mins > 4294967295 else 0)
+            ),
+        )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.serial_number
-        r2 = self.num_cycles
-        r3 = self.armed_hours
-        r4 = self.battery_capacity_mAh
-        r5 = self.first_use_mins
-        r6 = self.last_arm_time_mins
-        acc = (acc << 192) | int.from_bytes(
-            _BATTERY_TAG_ENCODE_STRUCT.pack(
-                (r1 if 0 <= r1 <= 4294967295 else (4294967295 if r1 > 4294967295 else 0)),
-                (r2 if 0 <= r2 <= 4294967295 else (4294967295 if r2 > 4294967295 else 0)),
-                (
-                    r3
-                    if -_dc.F32_MAX <= r3 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r3 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r3 < -_dc.F32_MAX else r3)
-                    )
-                ),
-                (r4 if 0 <= r4 <= 4294967295 else (4294967295 if r4 > 4294967295 else 0)),
-                (r5 if 0 <= r5 <= 4294967295 else (4294967295 if r5 > 4294967295 else 0)),
-                (r6 if 0 <= r6 <= 4294967295 else (4294967295 if r6 > 4294967295 else 0)),
-            ),
-            "big",
-        )
+        acc = (acc << 192) | int.from_bytes(self._dc_head(), "big")
         return acc
 
     @classmethod
@@ -2236,42 +2084,37 @@ class BatteryTag:
         if rem < 192:
             raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, rem)
         rem -= 192
-        u1, u2, u3, u4, u5, u6 = _BATTERY_TAG_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 192) - 1)).to_bytes(24, "big"))
-        return cls(u1, u2, u3, u4, u5, u6), rem
+        serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins = (
+            _BATTERY_TAG_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 192) - 1)).to_bytes(24, "big"))
+        )
+        return cls(
+            serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # serial_number (20500.BatteryTag.uavcan:7): fits uint32
             if self.serial_number & -4294967296:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_TAG_SERIAL_NUMBER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _BATTERY_TAG_SERIAL_NUMBER_SPEC)
-        try:
+            # num_cycles (20500.BatteryTag.uavcan:10): fits uint32
             if self.num_cycles & -4294967296:
                 _v.diag(out, "num_cycles", self.num_cycles, _BATTERY_TAG_NUM_CYCLES_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "num_cycles", self.num_cycles, _BATTERY_TAG_NUM_CYCLES_SPEC)
-        try:
+            # armed_hours (20500.BatteryTag.uavcan:13): fits float32
             if not (-3.4028234663852886e38 <= self.armed_hours <= 3.4028234663852886e38):
                 _v.diag(out, "armed_hours", self.armed_hours, _BATTERY_TAG_ARMED_HOURS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "armed_hours", self.armed_hours, _BATTERY_TAG_ARMED_HOURS_SPEC)
-        try:
+            # battery_capacity_mAh (20500.BatteryTag.uavcan:16): fits uint32
             if self.battery_capacity_mAh & -4294967296:
                 _v.diag(out, "battery_capacity_mAh", self.battery_capacity_mAh, _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_capacity_mAh", self.battery_capacity_mAh, _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC)
-        try:
+            # first_use_mins (20500.BatteryTag.uavcan:19): fits uint32
             if self.first_use_mins & -4294967296:
                 _v.diag(out, "first_use_mins", self.first_use_mins, _BATTERY_TAG_FIRST_USE_MINS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "first_use_mins", self.first_use_mins, _BATTERY_TAG_FIRST_USE_MINS_SPEC)
-        try:
+            # last_arm_time_mins (20500.BatteryTag.uavcan:22): fits uint32
             if self.last_arm_time_mins & -4294967296:
                 _v.diag(out, "last_arm_time_mins", self.last_arm_time_mins, _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "last_arm_time_mins", self.last_arm_time_mins, _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_TAG_FIELD_SPECS)
         return out
 
     def check(self) -> None:

@@ -38,8 +38,6 @@ class CBATStatusFlag(_enum.IntFlag):
 
 # fixed fields as encoded (a float16 as its bit pattern)
 _CBAT_ENCODE_STRUCT = _struct.Struct("<ff")
-# fixed fields as encoded (a float16 as its bit pattern)
-_CBAT_ENCODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _CBAT_FIELD_ENDS = ((32, "CBAT.temperature"), (64, "CBAT.voltage"))
 # fixed fields as decoded
@@ -71,6 +69,8 @@ _CBAT_FIELD_ENDS_FROM_CELL_COUNT = (
 )
 # fixed fields as decoded
 _CBAT_DECODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
+# fixed fields as encoded (a float16 as its bit pattern)
+_CBAT_ENCODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -135,6 +135,34 @@ _CBAT_STATUS_FLAGS_SPEC = _v.Number(
         0x200: "STATUS_FLAG_RESERVED_A",
         0x400: "STATUS_FLAG_RESERVED_B",
     },
+)
+# (schema name, attribute, spec) of each field, for the careful way
+_CBAT_FIELD_SPECS = (
+    ("temperature", "temperature", _CBAT_TEMPERATURE_SPEC),
+    ("voltage", "voltage", _CBAT_VOLTAGE_SPEC),
+    ("voltage_cell", "voltage_cell", _CBAT_VOLTAGE_CELL_SPEC),
+    ("cell_count", "cell_count", _CBAT_CELL_COUNT_SPEC),
+    ("current", "current", _CBAT_CURRENT_SPEC),
+    ("average_current", "average_current", _CBAT_AVERAGE_CURRENT_SPEC),
+    ("average_power", "average_power", _CBAT_AVERAGE_POWER_SPEC),
+    ("available_energy", "available_energy", _CBAT_AVAILABLE_ENERGY_SPEC),
+    ("remaining_capacity", "remaining_capacity", _CBAT_REMAINING_CAPACITY_SPEC),
+    ("full_charge_capacity", "full_charge_capacity", _CBAT_FULL_CHARGE_CAPACITY_SPEC),
+    ("design_capacity", "design_capacity", _CBAT_DESIGN_CAPACITY_SPEC),
+    ("average_time_to_empty", "average_time_to_empty", _CBAT_AVERAGE_TIME_TO_EMPTY_SPEC),
+    ("average_time_to_full", "average_time_to_full", _CBAT_AVERAGE_TIME_TO_FULL_SPEC),
+    ("state_of_health", "state_of_health", _CBAT_STATE_OF_HEALTH_SPEC),
+    ("state_of_charge", "state_of_charge", _CBAT_STATE_OF_CHARGE_SPEC),
+    ("max_error", "max_error", _CBAT_MAX_ERROR_SPEC),
+    ("serial_number", "serial_number", _CBAT_SERIAL_NUMBER_SPEC),
+    ("manufacture_date", "manufacture_date", _CBAT_MANUFACTURE_DATE_SPEC),
+    ("cycle_count", "cycle_count", _CBAT_CYCLE_COUNT_SPEC),
+    ("over_discharge_count", "over_discharge_count", _CBAT_OVER_DISCHARGE_COUNT_SPEC),
+    ("passed_charge", "passed_charge", _CBAT_PASSED_CHARGE_SPEC),
+    ("nominal_voltage", "nominal_voltage", _CBAT_NOMINAL_VOLTAGE_SPEC),
+    ("is_powering_off", "is_powering_off", _CBAT_IS_POWERING_OFF_SPEC),
+    ("interface_error", "interface_error", _CBAT_INTERFACE_ERROR_SPEC),
+    ("status_flags", "status_flags", _CBAT_STATUS_FLAGS_SPEC),
 )
 
 
@@ -374,526 +402,400 @@ class CBAT:
             obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
         return obj
 
+    # Wire layout (20300.CBAT.uavcan), bits from the start of the payload:
+    #   bits 0-31      float32 temperature  (line 6)
+    #   bits 32-63     float32 voltage  (line 7)
+    #   bits 64-       float32[<=15] voltage_cell: a 4-bit length, then <=15 x 32 bits  (line 8)
+    #   bits voltage_cell+0 uint8 cell_count  (line 9)
+    #   bits voltage_cell+8 float32 current  (line 10)
+    #   bits voltage_cell+40 float32 average_current  (line 11)
+    #   bits voltage_cell+72 float32 average_power  (line 12)
+    #   bits voltage_cell+104 float32 available_energy  (line 13)
+    #   bits voltage_cell+136 float32 remaining_capacity  (line 14)
+    #   bits voltage_cell+168 float32 full_charge_capacity  (line 15)
+    #   bits voltage_cell+200 float32 design_capacity  (line 16)
+    #   bits voltage_cell+232 uint16 average_time_to_empty  (line 17)
+    #   bits voltage_cell+248 uint16 average_time_to_full  (line 18)
+    #   bits voltage_cell+264 uint7 state_of_health  (line 19)
+    #   bits voltage_cell+271 uint7 state_of_charge  (line 20)
+    #   bits voltage_cell+278 uint7 max_error  (line 21)
+    #   bits voltage_cell+285 uint16 serial_number  (line 22)
+    #   bits voltage_cell+301 uint16 manufacture_date  (line 23)
+    #   bits voltage_cell+317 uint16 cycle_count  (line 24)
+    #   bits voltage_cell+333 uint16 over_discharge_count  (line 25)
+    #   bits voltage_cell+349 float32 passed_charge  (line 26)
+    #   bits voltage_cell+381 float32 nominal_voltage  (line 27)
+    #   bits voltage_cell+413 bool is_powering_off  (line 28)
+    #   bits voltage_cell+414 uint16 interface_error  (line 29)
+    #   bits voltage_cell+430 uint11 status_flags  (line 42)
     DATA_TYPE_ID: _ClassVar[int | None] = 20300
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0xB4DACE3A38E09A74
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.temperature
-        r2 = self.voltage
-        head = _CBAT_ENCODE_STRUCT.pack(
-            (
-                r1
-                if -_dc.F32_MAX <= r1 <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < r1 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r1 < -_dc.F32_MAX else r1)
-                )
-            ),
-            (
-                r2
-                if -_dc.F32_MAX <= r2 <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < r2 < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < r2 < -_dc.F32_MAX else r2)
-                )
-            ),
-        )
-        acc = 0x10000000000000000 | int.from_bytes(head, "big")
-        x3 = self.voltage_cell
-        k4 = len(x3)
-        if k4 > 15:
-            raise _dc.EncodeError("CBAT.voltage_cell: length " + str(k4) + " exceeds capacity 15")
-        acc = (acc << 4) | k4
-        acc = (acc << (k4 * 32)) | int.from_bytes(
-            _struct.pack(
-                f"<{k4}f",
-                *[
-                    (
-                        e5
-                        if -_dc.F32_MAX <= e5 <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < e5 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < e5 < -_dc.F32_MAX else e5)
-                        )
-                    )
-                    for e5 in x3
-                ],
-            ),
-            "big",
-        )
-        r6 = self.cell_count
-        r7 = self.current
-        r8 = self.average_current
-        r9 = self.average_power
-        r10 = self.available_energy
-        r11 = self.remaining_capacity
-        r12 = self.full_charge_capacity
-        r13 = self.design_capacity
-        r14 = self.average_time_to_empty
-        r15 = self.average_time_to_full
-        r16 = self.state_of_health
-        p17 = r16 if 0 <= r16 <= 127 else (127 if r16 > 127 else 0)
-        r18 = self.state_of_charge
-        p19 = r18 if 0 <= r18 <= 127 else (127 if r18 > 127 else 0)
-        r20 = self.max_error
-        p21 = r20 if 0 <= r20 <= 127 else (127 if r20 > 127 else 0)
-        r22 = self.serial_number
-        p23 = r22 if 0 <= r22 <= 65535 else (65535 if r22 > 65535 else 0)
-        r24 = self.manufacture_date
-        p25 = r24 if 0 <= r24 <= 65535 else (65535 if r24 > 65535 else 0)
-        r26 = self.cycle_count
-        p27 = r26 if 0 <= r26 <= 65535 else (65535 if r26 > 65535 else 0)
-        r28 = self.over_discharge_count
-        p29 = r28 if 0 <= r28 <= 65535 else (65535 if r28 > 65535 else 0)
-        r30 = self.passed_charge
-        p31 = _dc.f32bits(
-            r30
-            if -_dc.F32_MAX <= r30 <= _dc.F32_MAX
-            else (
-                _dc.F32_MAX if _dc.F32_MAX < r30 < _dc.INF else (-_dc.F32_MAX if -_dc.INF < r30 < -_dc.F32_MAX else r30)
-            )
-        )
-        r32 = self.nominal_voltage
-        p33 = _dc.f32bits(
-            r32
-            if -_dc.F32_MAX <= r32 <= _dc.F32_MAX
-            else (
-                _dc.F32_MAX if _dc.F32_MAX < r32 < _dc.INF else (-_dc.F32_MAX if -_dc.INF < r32 < -_dc.F32_MAX else r32)
-            )
-        )
-        r34 = self.is_powering_off
-        p35 = 1 if r34 else 0
-        r36 = self.interface_error
-        p37 = r36 if 0 <= r36 <= 65535 else (65535 if r36 > 65535 else 0)
-        r38 = self.status_flags
-        p39 = r38 if 0 <= r38 <= 2047 else (2047 if r38 > 2047 else 0)
-        acc = (acc << 441) | (
-            int.from_bytes(
-                _CBAT_ENCODE_STRUCT_FROM_CELL_COUNT.pack(
-                    (r6 if 0 <= r6 <= 255 else (255 if r6 > 255 else 0)),
-                    (
-                        r7
-                        if -_dc.F32_MAX <= r7 <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < r7 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r7 < -_dc.F32_MAX else r7)
-                        )
-                    ),
-                    (
-                        r8
-                        if -_dc.F32_MAX <= r8 <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < r8 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r8 < -_dc.F32_MAX else r8)
-                        )
-                    ),
-                    (
-                        r9
-                        if -_dc.F32_MAX <= r9 <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < r9 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r9 < -_dc.F32_MAX else r9)
-                        )
-                    ),
-                    (
-                        r10
-                        if -_dc.F32_MAX <= r10 <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < r10 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r10 < -_dc.F32_MAX else r10)
-                        )
-                    ),
-                    (
-                        r11
-                        if -_dc.F32_MAX <= r11 <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < r11 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r11 < -_dc.F32_MAX else r11)
-                        )
-                    ),
-                    (
-                        r12
-                        if -_dc.F32_MAX <= r12 <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < r12 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r12 < -_dc.F32_MAX else r12)
-                        )
-                    ),
-                    (
-                        r13
-                        if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
-                        else (
-                            _dc.F32_MAX
-                            if _dc.F32_MAX < r13 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
-                        )
-                    ),
-                    (r14 if 0 <= r14 <= 65535 else (65535 if r14 > 65535 else 0)),
-                    (r15 if 0 <= r15 <= 65535 else (65535 if r15 > 65535 else 0)),
-                    (p17 << 1)
-                    | ((p19 & 0x3F) << 10)
-                    | ((p19 >> 6) & 0x1)
-                    | ((p21 & 0x1F) << 19)
-                    | (((p21 >> 5) & 0x3) << 8)
-                    | ((p23 & 0x1F) << 27)
-                    | (((p23 >> 5) & 0x7) << 16)
-                    | (((p23 >> 8) & 0x1F) << 35)
-                    | (((p23 >> 13) & 0x7) << 24)
-                    | ((p25 & 0x1F) << 43)
-                    | (((p25 >> 5) & 0x7) << 32)
-                    | (((p25 >> 8) & 0x1F) << 51)
-                    | (((p25 >> 13) & 0x7) << 40)
-                    | ((p27 & 0x1F) << 59)
-                    | (((p27 >> 5) & 0x7) << 48)
-                    | (((p27 >> 13) & 0x7) << 56),
-                    (((p27 >> 8) & 0x1F) << 3)
-                    | ((p29 & 0x1F) << 11)
-                    | ((p29 >> 5) & 0x7)
-                    | (((p29 >> 8) & 0x1F) << 19)
-                    | (((p29 >> 13) & 0x7) << 8)
-                    | ((p31 & 0x1F) << 27)
-                    | (((p31 >> 5) & 0x7) << 16)
-                    | (((p31 >> 8) & 0x1F) << 35)
-                    | (((p31 >> 13) & 0x7) << 24)
-                    | (((p31 >> 16) & 0x1F) << 43)
-                    | (((p31 >> 21) & 0x7) << 32)
-                    | (((p31 >> 24) & 0x1F) << 51)
-                    | (((p31 >> 29) & 0x7) << 40)
-                    | ((p33 & 0x1F) << 59)
-                    | (((p33 >> 5) & 0x7) << 48)
-                    | (((p33 >> 13) & 0x7) << 56),
-                    (((p33 >> 8) & 0x1F) << 3)
-                    | (((p33 >> 16) & 0x1F) << 11)
-                    | ((p33 >> 21) & 0x7)
-                    | (((p33 >> 24) & 0x1F) << 19)
-                    | (((p33 >> 29) & 0x7) << 8)
-                    | (p35 << 18)
-                    | ((p37 & 0x3F) << 26)
-                    | (((p37 >> 6) & 0x3) << 16)
-                    | (((p37 >> 14) & 0x3) << 24),
-                    (((p37 >> 8) & 0x3F) << 2) | ((p39 & 0x3F) << 10) | ((p39 >> 6) & 0x3) | (((p39 >> 9) & 0x3) << 8),
-                    (((p39 >> 8) & 0x1) << 7),
-                ),
-                "big",
-            )
-            >> 7
-        )
-        return _dc.finish(acc)
+        return _dc.finish(self._dc_put(1, tao))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> CBAT:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f2: list[_Any]
+        voltage_cell: list[_Any]
         n = len(data)
         if n < 8:
             raise _dc.cut(_CBAT_FIELD_ENDS, n << 3)
-        u1, u2 = _CBAT_DECODE_STRUCT.unpack_from(data)
+        temperature, voltage = _CBAT_DECODE_STRUCT.unpack_from(data)
         v = int.from_bytes(data, "big")
         rem = (n << 3) - 64
         if rem < 4:
             raise _dc.short("CBAT.voltage_cell (length)", 4, rem)
         rem -= 4
-        k3 = (v >> rem) & 0xF
-        if k3 > 15:
-            raise _dc.DecodeError("CBAT.voltage_cell: length " + str(k3) + " exceeds capacity 15")
-        n4 = k3 * 32
-        if rem < n4:
-            raise _dc.short("CBAT.voltage_cell", n4, rem)
-        rem -= n4
-        f2 = list(_struct.unpack(f"<{k3}f", ((v >> rem) & ((1 << n4) - 1)).to_bytes(n4 >> 3, "big")))
+        k1 = (v >> rem) & 0xF
+        if k1 > 15:
+            raise _dc.DecodeError("CBAT.voltage_cell: length " + str(k1) + " exceeds capacity 15")
+        n2 = k1 * 32
+        if rem < n2:
+            raise _dc.short("CBAT.voltage_cell", n2, rem)
+        rem -= n2
+        voltage_cell = list(_struct.unpack(f"<{k1}f", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
         if rem < 441:
             raise _dc.cut(_CBAT_FIELD_ENDS_FROM_CELL_COUNT, rem)
         rem -= 441
-        u5, u6, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18, u19 = (
-            _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
+        (
+            cell_count,
+            current,
+            average_current,
+            average_power,
+            available_energy,
+            remaining_capacity,
+            full_charge_capacity,
+            design_capacity,
+            average_time_to_empty,
+            average_time_to_full,
+            packed3,
+            packed4,
+            packed5,
+            packed6,
+            packed7,
+        ) = _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        state_of_health = (packed3 >> 1) & 0x7F
+        state_of_charge = ((packed3 >> 10) & 0x3F) | ((packed3 & 0x1) << 6)
+        max_error = ((packed3 >> 19) & 0x1F) | (((packed3 >> 8) & 0x3) << 5)
+        serial_number = (
+            ((packed3 >> 27) & 0x1F)
+            | (((packed3 >> 16) & 0x7) << 5)
+            | (((packed3 >> 35) & 0x1F) << 8)
+            | (((packed3 >> 24) & 0x7) << 13)
         )
-        x20 = (u15 >> 1) & 0x7F
-        x21 = ((u15 >> 10) & 0x3F) | ((u15 & 0x1) << 6)
-        x22 = ((u15 >> 19) & 0x1F) | (((u15 >> 8) & 0x3) << 5)
-        x23 = (
-            ((u15 >> 27) & 0x1F)
-            | (((u15 >> 16) & 0x7) << 5)
-            | (((u15 >> 35) & 0x1F) << 8)
-            | (((u15 >> 24) & 0x7) << 13)
+        manufacture_date = (
+            ((packed3 >> 43) & 0x1F)
+            | (((packed3 >> 32) & 0x7) << 5)
+            | (((packed3 >> 51) & 0x1F) << 8)
+            | (((packed3 >> 40) & 0x7) << 13)
         )
-        x24 = (
-            ((u15 >> 43) & 0x1F)
-            | (((u15 >> 32) & 0x7) << 5)
-            | (((u15 >> 51) & 0x1F) << 8)
-            | (((u15 >> 40) & 0x7) << 13)
+        cycle_count = (
+            (packed3 >> 59)
+            | (((packed3 >> 48) & 0x7) << 5)
+            | (((packed4 >> 3) & 0x1F) << 8)
+            | (((packed3 >> 56) & 0x7) << 13)
         )
-        x25 = (u15 >> 59) | (((u15 >> 48) & 0x7) << 5) | (((u16 >> 3) & 0x1F) << 8) | (((u15 >> 56) & 0x7) << 13)
-        x26 = ((u16 >> 11) & 0x1F) | ((u16 & 0x7) << 5) | (((u16 >> 19) & 0x1F) << 8) | (((u16 >> 8) & 0x7) << 13)
-        x27 = _dc.f32v(
-            ((u16 >> 27) & 0x1F)
-            | (((u16 >> 16) & 0x7) << 5)
-            | (((u16 >> 35) & 0x1F) << 8)
-            | (((u16 >> 24) & 0x7) << 13)
-            | (((u16 >> 43) & 0x1F) << 16)
-            | (((u16 >> 32) & 0x7) << 21)
-            | (((u16 >> 51) & 0x1F) << 24)
-            | (((u16 >> 40) & 0x7) << 29)
+        over_discharge_count = (
+            ((packed4 >> 11) & 0x1F)
+            | ((packed4 & 0x7) << 5)
+            | (((packed4 >> 19) & 0x1F) << 8)
+            | (((packed4 >> 8) & 0x7) << 13)
         )
-        x28 = _dc.f32v(
-            (u16 >> 59)
-            | (((u16 >> 48) & 0x7) << 5)
-            | (((u17 >> 3) & 0x1F) << 8)
-            | (((u16 >> 56) & 0x7) << 13)
-            | (((u17 >> 11) & 0x1F) << 16)
-            | ((u17 & 0x7) << 21)
-            | (((u17 >> 19) & 0x1F) << 24)
-            | (((u17 >> 8) & 0x7) << 29)
+        passed_charge = _dc.f32v(
+            ((packed4 >> 27) & 0x1F)
+            | (((packed4 >> 16) & 0x7) << 5)
+            | (((packed4 >> 35) & 0x1F) << 8)
+            | (((packed4 >> 24) & 0x7) << 13)
+            | (((packed4 >> 43) & 0x1F) << 16)
+            | (((packed4 >> 32) & 0x7) << 21)
+            | (((packed4 >> 51) & 0x1F) << 24)
+            | (((packed4 >> 40) & 0x7) << 29)
         )
-        x29 = ((u17 >> 18) & 0x1) != 0
-        x30 = (u17 >> 26) | (((u17 >> 16) & 0x3) << 6) | (((u18 >> 2) & 0x3F) << 8) | (((u17 >> 24) & 0x3) << 14)
-        x31 = (u18 >> 10) | ((u18 & 0x3) << 6) | ((u19 >> 7) << 8) | (((u18 >> 8) & 0x3) << 9)
+        nominal_voltage = _dc.f32v(
+            (packed4 >> 59)
+            | (((packed4 >> 48) & 0x7) << 5)
+            | (((packed5 >> 3) & 0x1F) << 8)
+            | (((packed4 >> 56) & 0x7) << 13)
+            | (((packed5 >> 11) & 0x1F) << 16)
+            | ((packed5 & 0x7) << 21)
+            | (((packed5 >> 19) & 0x1F) << 24)
+            | (((packed5 >> 8) & 0x7) << 29)
+        )
+        is_powering_off = ((packed5 >> 18) & 0x1) != 0
+        interface_error = (
+            (packed5 >> 26)
+            | (((packed5 >> 16) & 0x3) << 6)
+            | (((packed6 >> 2) & 0x3F) << 8)
+            | (((packed5 >> 24) & 0x3) << 14)
+        )
+        status_flags = (packed6 >> 10) | ((packed6 & 0x3) << 6) | ((packed7 >> 7) << 8) | (((packed6 >> 8) & 0x3) << 9)
         if rem >= 8:
             raise _dc.DecodeError("CBAT: " + str(rem >> 3) + " byte(s) beyond the end of the message")
         return cls(
-            u1,
-            u2,
-            f2,
-            u5,
-            u6,
-            u7,
-            u8,
-            u9,
-            u10,
-            u11,
-            u12,
-            u13,
-            u14,
-            x20,
-            x21,
-            x22,
-            x23,
-            x24,
-            x25,
-            x26,
-            x27,
-            x28,
-            x29,
-            x30,
-            x31,
+            temperature,
+            voltage,
+            voltage_cell,
+            cell_count,
+            current,
+            average_current,
+            average_power,
+            available_energy,
+            remaining_capacity,
+            full_charge_capacity,
+            design_capacity,
+            average_time_to_empty,
+            average_time_to_full,
+            state_of_health,
+            state_of_charge,
+            max_error,
+            serial_number,
+            manufacture_date,
+            cycle_count,
+            over_discharge_count,
+            passed_charge,
+            nominal_voltage,
+            is_powering_off,
+            interface_error,
+            status_flags,
+        )
+
+    def _dc_head(self) -> bytes:
+        """Bits 0-63 (the fixed fields that open the payload) as bytes, zero padded."""
+        temperature = self.temperature
+        voltage = self.voltage
+        return _CBAT_ENCODE_STRUCT.pack(
+            (
+                temperature
+                if -_dc.F32_MAX <= temperature <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < temperature < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < temperature < -_dc.F32_MAX else temperature)
+                )
+            ),
+            (
+                voltage
+                if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < voltage < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
+                )
+            ),
         )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.temperature
-        r2 = self.voltage
-        acc = (acc << 64) | int.from_bytes(
-            _CBAT_ENCODE_STRUCT.pack(
-                (
-                    r1
-                    if -_dc.F32_MAX <= r1 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r1 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r1 < -_dc.F32_MAX else r1)
-                    )
-                ),
-                (
-                    r2
-                    if -_dc.F32_MAX <= r2 <= _dc.F32_MAX
-                    else (
-                        _dc.F32_MAX
-                        if _dc.F32_MAX < r2 < _dc.INF
-                        else (-_dc.F32_MAX if -_dc.INF < r2 < -_dc.F32_MAX else r2)
-                    )
-                ),
-            ),
-            "big",
-        )
-        x3 = self.voltage_cell
-        k4 = len(x3)
-        if k4 > 15:
-            raise _dc.EncodeError("CBAT.voltage_cell: length " + str(k4) + " exceeds capacity 15")
-        acc = (acc << 4) | k4
-        acc = (acc << (k4 * 32)) | int.from_bytes(
+        acc = (acc << 64) | int.from_bytes(self._dc_head(), "big")
+        x1 = self.voltage_cell
+        k2 = len(x1)
+        if k2 > 15:
+            raise _dc.EncodeError("CBAT.voltage_cell: length " + str(k2) + " exceeds capacity 15")
+        acc = (acc << 4) | k2
+        acc = (acc << (k2 * 32)) | int.from_bytes(
             _struct.pack(
-                f"<{k4}f",
+                f"<{k2}f",
                 *[
                     (
-                        e5
-                        if -_dc.F32_MAX <= e5 <= _dc.F32_MAX
+                        e3
+                        if -_dc.F32_MAX <= e3 <= _dc.F32_MAX
                         else (
                             _dc.F32_MAX
-                            if _dc.F32_MAX < e5 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < e5 < -_dc.F32_MAX else e5)
+                            if _dc.F32_MAX < e3 < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < e3 < -_dc.F32_MAX else e3)
                         )
                     )
-                    for e5 in x3
+                    for e3 in x1
                 ],
             ),
             "big",
         )
-        r6 = self.cell_count
-        r7 = self.current
-        r8 = self.average_current
-        r9 = self.average_power
-        r10 = self.available_energy
-        r11 = self.remaining_capacity
-        r12 = self.full_charge_capacity
-        r13 = self.design_capacity
-        r14 = self.average_time_to_empty
-        r15 = self.average_time_to_full
-        r16 = self.state_of_health
-        p17 = r16 if 0 <= r16 <= 127 else (127 if r16 > 127 else 0)
-        r18 = self.state_of_charge
-        p19 = r18 if 0 <= r18 <= 127 else (127 if r18 > 127 else 0)
-        r20 = self.max_error
-        p21 = r20 if 0 <= r20 <= 127 else (127 if r20 > 127 else 0)
-        r22 = self.serial_number
-        p23 = r22 if 0 <= r22 <= 65535 else (65535 if r22 > 65535 else 0)
-        r24 = self.manufacture_date
-        p25 = r24 if 0 <= r24 <= 65535 else (65535 if r24 > 65535 else 0)
-        r26 = self.cycle_count
-        p27 = r26 if 0 <= r26 <= 65535 else (65535 if r26 > 65535 else 0)
-        r28 = self.over_discharge_count
-        p29 = r28 if 0 <= r28 <= 65535 else (65535 if r28 > 65535 else 0)
-        r30 = self.passed_charge
-        p31 = _dc.f32bits(
-            r30
-            if -_dc.F32_MAX <= r30 <= _dc.F32_MAX
+        cell_count = self.cell_count
+        current = self.current
+        average_current = self.average_current
+        average_power = self.average_power
+        available_energy = self.available_energy
+        remaining_capacity = self.remaining_capacity
+        full_charge_capacity = self.full_charge_capacity
+        design_capacity = self.design_capacity
+        average_time_to_empty = self.average_time_to_empty
+        average_time_to_full = self.average_time_to_full
+        state_of_health = self.state_of_health
+        state_of_health_bits = state_of_health if 0 <= state_of_health <= 127 else (127 if state_of_health > 127 else 0)
+        state_of_charge = self.state_of_charge
+        state_of_charge_bits = state_of_charge if 0 <= state_of_charge <= 127 else (127 if state_of_charge > 127 else 0)
+        max_error = self.max_error
+        max_error_bits = max_error if 0 <= max_error <= 127 else (127 if max_error > 127 else 0)
+        serial_number = self.serial_number
+        serial_number_bits = serial_number if 0 <= serial_number <= 65535 else (65535 if serial_number > 65535 else 0)
+        manufacture_date = self.manufacture_date
+        manufacture_date_bits = (
+            manufacture_date if 0 <= manufacture_date <= 65535 else (65535 if manufacture_date > 65535 else 0)
+        )
+        cycle_count = self.cycle_count
+        cycle_count_bits = cycle_count if 0 <= cycle_count <= 65535 else (65535 if cycle_count > 65535 else 0)
+        over_discharge_count = self.over_discharge_count
+        over_discharge_count_bits = (
+            over_discharge_count
+            if 0 <= over_discharge_count <= 65535
+            else (65535 if over_discharge_count > 65535 else 0)
+        )
+        passed_charge = self.passed_charge
+        passed_charge_bits = _dc.f32bits(
+            passed_charge
+            if -_dc.F32_MAX <= passed_charge <= _dc.F32_MAX
             else (
-                _dc.F32_MAX if _dc.F32_MAX < r30 < _dc.INF else (-_dc.F32_MAX if -_dc.INF < r30 < -_dc.F32_MAX else r30)
+                _dc.F32_MAX
+                if _dc.F32_MAX < passed_charge < _dc.INF
+                else (-_dc.F32_MAX if -_dc.INF < passed_charge < -_dc.F32_MAX else passed_charge)
             )
         )
-        r32 = self.nominal_voltage
-        p33 = _dc.f32bits(
-            r32
-            if -_dc.F32_MAX <= r32 <= _dc.F32_MAX
+        nominal_voltage = self.nominal_voltage
+        nominal_voltage_bits = _dc.f32bits(
+            nominal_voltage
+            if -_dc.F32_MAX <= nominal_voltage <= _dc.F32_MAX
             else (
-                _dc.F32_MAX if _dc.F32_MAX < r32 < _dc.INF else (-_dc.F32_MAX if -_dc.INF < r32 < -_dc.F32_MAX else r32)
+                _dc.F32_MAX
+                if _dc.F32_MAX < nominal_voltage < _dc.INF
+                else (-_dc.F32_MAX if -_dc.INF < nominal_voltage < -_dc.F32_MAX else nominal_voltage)
             )
         )
-        r34 = self.is_powering_off
-        p35 = 1 if r34 else 0
-        r36 = self.interface_error
-        p37 = r36 if 0 <= r36 <= 65535 else (65535 if r36 > 65535 else 0)
-        r38 = self.status_flags
-        p39 = r38 if 0 <= r38 <= 2047 else (2047 if r38 > 2047 else 0)
+        is_powering_off = self.is_powering_off
+        is_powering_off_bits = 1 if is_powering_off else 0
+        interface_error = self.interface_error
+        interface_error_bits = (
+            interface_error if 0 <= interface_error <= 65535 else (65535 if interface_error > 65535 else 0)
+        )
+        status_flags = self.status_flags
+        status_flags_bits = status_flags if 0 <= status_flags <= 2047 else (2047 if status_flags > 2047 else 0)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         acc = (acc << 441) | (
             int.from_bytes(
                 _CBAT_ENCODE_STRUCT_FROM_CELL_COUNT.pack(
-                    (r6 if 0 <= r6 <= 255 else (255 if r6 > 255 else 0)),
+                    (cell_count if 0 <= cell_count <= 255 else (255 if cell_count > 255 else 0)),
                     (
-                        r7
-                        if -_dc.F32_MAX <= r7 <= _dc.F32_MAX
+                        current
+                        if -_dc.F32_MAX <= current <= _dc.F32_MAX
                         else (
                             _dc.F32_MAX
-                            if _dc.F32_MAX < r7 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r7 < -_dc.F32_MAX else r7)
+                            if _dc.F32_MAX < current < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < current < -_dc.F32_MAX else current)
                         )
                     ),
                     (
-                        r8
-                        if -_dc.F32_MAX <= r8 <= _dc.F32_MAX
+                        average_current
+                        if -_dc.F32_MAX <= average_current <= _dc.F32_MAX
                         else (
                             _dc.F32_MAX
-                            if _dc.F32_MAX < r8 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r8 < -_dc.F32_MAX else r8)
+                            if _dc.F32_MAX < average_current < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < average_current < -_dc.F32_MAX else average_current)
                         )
                     ),
                     (
-                        r9
-                        if -_dc.F32_MAX <= r9 <= _dc.F32_MAX
+                        average_power
+                        if -_dc.F32_MAX <= average_power <= _dc.F32_MAX
                         else (
                             _dc.F32_MAX
-                            if _dc.F32_MAX < r9 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r9 < -_dc.F32_MAX else r9)
+                            if _dc.F32_MAX < average_power < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < average_power < -_dc.F32_MAX else average_power)
                         )
                     ),
                     (
-                        r10
-                        if -_dc.F32_MAX <= r10 <= _dc.F32_MAX
+                        available_energy
+                        if -_dc.F32_MAX <= available_energy <= _dc.F32_MAX
                         else (
                             _dc.F32_MAX
-                            if _dc.F32_MAX < r10 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r10 < -_dc.F32_MAX else r10)
+                            if _dc.F32_MAX < available_energy < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < available_energy < -_dc.F32_MAX else available_energy)
                         )
                     ),
                     (
-                        r11
-                        if -_dc.F32_MAX <= r11 <= _dc.F32_MAX
+                        remaining_capacity
+                        if -_dc.F32_MAX <= remaining_capacity <= _dc.F32_MAX
                         else (
                             _dc.F32_MAX
-                            if _dc.F32_MAX < r11 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r11 < -_dc.F32_MAX else r11)
+                            if _dc.F32_MAX < remaining_capacity < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < remaining_capacity < -_dc.F32_MAX else remaining_capacity)
                         )
                     ),
                     (
-                        r12
-                        if -_dc.F32_MAX <= r12 <= _dc.F32_MAX
+                        full_charge_capacity
+                        if -_dc.F32_MAX <= full_charge_capacity <= _dc.F32_MAX
                         else (
                             _dc.F32_MAX
-                            if _dc.F32_MAX < r12 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r12 < -_dc.F32_MAX else r12)
+                            if _dc.F32_MAX < full_charge_capacity < _dc.INF
+                            else (
+                                -_dc.F32_MAX if -_dc.INF < full_charge_capacity < -_dc.F32_MAX else full_charge_capacity
+                            )
                         )
                     ),
                     (
-                        r13
-                        if -_dc.F32_MAX <= r13 <= _dc.F32_MAX
+                        design_capacity
+                        if -_dc.F32_MAX <= design_capacity <= _dc.F32_MAX
                         else (
                             _dc.F32_MAX
-                            if _dc.F32_MAX < r13 < _dc.INF
-                            else (-_dc.F32_MAX if -_dc.INF < r13 < -_dc.F32_MAX else r13)
+                            if _dc.F32_MAX < design_capacity < _dc.INF
+                            else (-_dc.F32_MAX if -_dc.INF < design_capacity < -_dc.F32_MAX else design_capacity)
                         )
                     ),
-                    (r14 if 0 <= r14 <= 65535 else (65535 if r14 > 65535 else 0)),
-                    (r15 if 0 <= r15 <= 65535 else (65535 if r15 > 65535 else 0)),
-                    (p17 << 1)
-                    | ((p19 & 0x3F) << 10)
-                    | ((p19 >> 6) & 0x1)
-                    | ((p21 & 0x1F) << 19)
-                    | (((p21 >> 5) & 0x3) << 8)
-                    | ((p23 & 0x1F) << 27)
-                    | (((p23 >> 5) & 0x7) << 16)
-                    | (((p23 >> 8) & 0x1F) << 35)
-                    | (((p23 >> 13) & 0x7) << 24)
-                    | ((p25 & 0x1F) << 43)
-                    | (((p25 >> 5) & 0x7) << 32)
-                    | (((p25 >> 8) & 0x1F) << 51)
-                    | (((p25 >> 13) & 0x7) << 40)
-                    | ((p27 & 0x1F) << 59)
-                    | (((p27 >> 5) & 0x7) << 48)
-                    | (((p27 >> 13) & 0x7) << 56),
-                    (((p27 >> 8) & 0x1F) << 3)
-                    | ((p29 & 0x1F) << 11)
-                    | ((p29 >> 5) & 0x7)
-                    | (((p29 >> 8) & 0x1F) << 19)
-                    | (((p29 >> 13) & 0x7) << 8)
-                    | ((p31 & 0x1F) << 27)
-                    | (((p31 >> 5) & 0x7) << 16)
-                    | (((p31 >> 8) & 0x1F) << 35)
-                    | (((p31 >> 13) & 0x7) << 24)
-                    | (((p31 >> 16) & 0x1F) << 43)
-                    | (((p31 >> 21) & 0x7) << 32)
-                    | (((p31 >> 24) & 0x1F) << 51)
-                    | (((p31 >> 29) & 0x7) << 40)
-                    | ((p33 & 0x1F) << 59)
-                    | (((p33 >> 5) & 0x7) << 48)
-                    | (((p33 >> 13) & 0x7) << 56),
-                    (((p33 >> 8) & 0x1F) << 3)
-                    | (((p33 >> 16) & 0x1F) << 11)
-                    | ((p33 >> 21) & 0x7)
-                    | (((p33 >> 24) & 0x1F) << 19)
-                    | (((p33 >> 29) & 0x7) << 8)
-                    | (p35 << 18)
-                    | ((p37 & 0x3F) << 26)
-                    | (((p37 >> 6) & 0x3) << 16)
-                    | (((p37 >> 14) & 0x3) << 24),
-                    (((p37 >> 8) & 0x3F) << 2) | ((p39 & 0x3F) << 10) | ((p39 >> 6) & 0x3) | (((p39 >> 9) & 0x3) << 8),
-                    (((p39 >> 8) & 0x1) << 7),
+                    (
+                        average_time_to_empty
+                        if 0 <= average_time_to_empty <= 65535
+                        else (65535 if average_time_to_empty > 65535 else 0)
+                    ),
+                    (
+                        average_time_to_full
+                        if 0 <= average_time_to_full <= 65535
+                        else (65535 if average_time_to_full > 65535 else 0)
+                    ),
+                    (state_of_health_bits << 1)
+                    | ((state_of_charge_bits & 0x3F) << 10)
+                    | ((state_of_charge_bits >> 6) & 0x1)
+                    | ((max_error_bits & 0x1F) << 19)
+                    | (((max_error_bits >> 5) & 0x3) << 8)
+                    | ((serial_number_bits & 0x1F) << 27)
+                    | (((serial_number_bits >> 5) & 0x7) << 16)
+                    | (((serial_number_bits >> 8) & 0x1F) << 35)
+                    | (((serial_number_bits >> 13) & 0x7) << 24)
+                    | ((manufacture_date_bits & 0x1F) << 43)
+                    | (((manufacture_date_bits >> 5) & 0x7) << 32)
+                    | (((manufacture_date_bits >> 8) & 0x1F) << 51)
+                    | (((manufacture_date_bits >> 13) & 0x7) << 40)
+                    | ((cycle_count_bits & 0x1F) << 59)
+                    | (((cycle_count_bits >> 5) & 0x7) << 48)
+                    | (((cycle_count_bits >> 13) & 0x7) << 56),
+                    (((cycle_count_bits >> 8) & 0x1F) << 3)
+                    | ((over_discharge_count_bits & 0x1F) << 11)
+                    | ((over_discharge_count_bits >> 5) & 0x7)
+                    | (((over_discharge_count_bits >> 8) & 0x1F) << 19)
+                    | (((over_discharge_count_bits >> 13) & 0x7) << 8)
+                    | ((passed_charge_bits & 0x1F) << 27)
+                    | (((passed_charge_bits >> 5) & 0x7) << 16)
+                    | (((passed_charge_bits >> 8) & 0x1F) << 35)
+                    | (((passed_charge_bits >> 13) & 0x7) << 24)
+                    | (((passed_charge_bits >> 16) & 0x1F) << 43)
+                    | (((passed_charge_bits >> 21) & 0x7) << 32)
+                    | (((passed_charge_bits >> 24) & 0x1F) << 51)
+                    | (((passed_charge_bits >> 29) & 0x7) << 40)
+                    | ((nominal_voltage_bits & 0x1F) << 59)
+                    | (((nominal_voltage_bits >> 5) & 0x7) << 48)
+                    | (((nominal_voltage_bits >> 13) & 0x7) << 56),
+                    (((nominal_voltage_bits >> 8) & 0x1F) << 3)
+                    | (((nominal_voltage_bits >> 16) & 0x1F) << 11)
+                    | ((nominal_voltage_bits >> 21) & 0x7)
+                    | (((nominal_voltage_bits >> 24) & 0x1F) << 19)
+                    | (((nominal_voltage_bits >> 29) & 0x7) << 8)
+                    | (is_powering_off_bits << 18)
+                    | ((interface_error_bits & 0x3F) << 26)
+                    | (((interface_error_bits >> 6) & 0x3) << 16)
+                    | (((interface_error_bits >> 14) & 0x3) << 24),
+                    (((interface_error_bits >> 8) & 0x3F) << 2)
+                    | ((status_flags_bits & 0x3F) << 10)
+                    | ((status_flags_bits >> 6) & 0x3)
+                    | (((status_flags_bits >> 9) & 0x3) << 8),
+                    (((status_flags_bits >> 8) & 0x1) << 7),
                 ),
                 "big",
             )
@@ -903,94 +805,124 @@ class CBAT:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[CBAT, int]:
-        f2: list[_Any]
+        voltage_cell: list[_Any]
         if rem < 64:
             raise _dc.cut(_CBAT_FIELD_ENDS, rem)
         rem -= 64
-        u1, u2 = _CBAT_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFFFF).to_bytes(8, "big"))
+        temperature, voltage = _CBAT_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFFFF).to_bytes(8, "big"))
         if rem < 4:
             raise _dc.short("CBAT.voltage_cell (length)", 4, rem)
         rem -= 4
-        k3 = (v >> rem) & 0xF
-        if k3 > 15:
-            raise _dc.DecodeError("CBAT.voltage_cell: length " + str(k3) + " exceeds capacity 15")
-        n4 = k3 * 32
-        if rem < n4:
-            raise _dc.short("CBAT.voltage_cell", n4, rem)
-        rem -= n4
-        f2 = list(_struct.unpack(f"<{k3}f", ((v >> rem) & ((1 << n4) - 1)).to_bytes(n4 >> 3, "big")))
+        k1 = (v >> rem) & 0xF
+        if k1 > 15:
+            raise _dc.DecodeError("CBAT.voltage_cell: length " + str(k1) + " exceeds capacity 15")
+        n2 = k1 * 32
+        if rem < n2:
+            raise _dc.short("CBAT.voltage_cell", n2, rem)
+        rem -= n2
+        voltage_cell = list(_struct.unpack(f"<{k1}f", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
         if rem < 441:
             raise _dc.cut(_CBAT_FIELD_ENDS_FROM_CELL_COUNT, rem)
         rem -= 441
-        u5, u6, u7, u8, u9, u10, u11, u12, u13, u14, u15, u16, u17, u18, u19 = (
-            _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
+        (
+            cell_count,
+            current,
+            average_current,
+            average_power,
+            available_energy,
+            remaining_capacity,
+            full_charge_capacity,
+            design_capacity,
+            average_time_to_empty,
+            average_time_to_full,
+            packed3,
+            packed4,
+            packed5,
+            packed6,
+            packed7,
+        ) = _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        state_of_health = (packed3 >> 1) & 0x7F
+        state_of_charge = ((packed3 >> 10) & 0x3F) | ((packed3 & 0x1) << 6)
+        max_error = ((packed3 >> 19) & 0x1F) | (((packed3 >> 8) & 0x3) << 5)
+        serial_number = (
+            ((packed3 >> 27) & 0x1F)
+            | (((packed3 >> 16) & 0x7) << 5)
+            | (((packed3 >> 35) & 0x1F) << 8)
+            | (((packed3 >> 24) & 0x7) << 13)
         )
-        x20 = (u15 >> 1) & 0x7F
-        x21 = ((u15 >> 10) & 0x3F) | ((u15 & 0x1) << 6)
-        x22 = ((u15 >> 19) & 0x1F) | (((u15 >> 8) & 0x3) << 5)
-        x23 = (
-            ((u15 >> 27) & 0x1F)
-            | (((u15 >> 16) & 0x7) << 5)
-            | (((u15 >> 35) & 0x1F) << 8)
-            | (((u15 >> 24) & 0x7) << 13)
+        manufacture_date = (
+            ((packed3 >> 43) & 0x1F)
+            | (((packed3 >> 32) & 0x7) << 5)
+            | (((packed3 >> 51) & 0x1F) << 8)
+            | (((packed3 >> 40) & 0x7) << 13)
         )
-        x24 = (
-            ((u15 >> 43) & 0x1F)
-            | (((u15 >> 32) & 0x7) << 5)
-            | (((u15 >> 51) & 0x1F) << 8)
-            | (((u15 >> 40) & 0x7) << 13)
+        cycle_count = (
+            (packed3 >> 59)
+            | (((packed3 >> 48) & 0x7) << 5)
+            | (((packed4 >> 3) & 0x1F) << 8)
+            | (((packed3 >> 56) & 0x7) << 13)
         )
-        x25 = (u15 >> 59) | (((u15 >> 48) & 0x7) << 5) | (((u16 >> 3) & 0x1F) << 8) | (((u15 >> 56) & 0x7) << 13)
-        x26 = ((u16 >> 11) & 0x1F) | ((u16 & 0x7) << 5) | (((u16 >> 19) & 0x1F) << 8) | (((u16 >> 8) & 0x7) << 13)
-        x27 = _dc.f32v(
-            ((u16 >> 27) & 0x1F)
-            | (((u16 >> 16) & 0x7) << 5)
-            | (((u16 >> 35) & 0x1F) << 8)
-            | (((u16 >> 24) & 0x7) << 13)
-            | (((u16 >> 43) & 0x1F) << 16)
-            | (((u16 >> 32) & 0x7) << 21)
-            | (((u16 >> 51) & 0x1F) << 24)
-            | (((u16 >> 40) & 0x7) << 29)
+        over_discharge_count = (
+            ((packed4 >> 11) & 0x1F)
+            | ((packed4 & 0x7) << 5)
+            | (((packed4 >> 19) & 0x1F) << 8)
+            | (((packed4 >> 8) & 0x7) << 13)
         )
-        x28 = _dc.f32v(
-            (u16 >> 59)
-            | (((u16 >> 48) & 0x7) << 5)
-            | (((u17 >> 3) & 0x1F) << 8)
-            | (((u16 >> 56) & 0x7) << 13)
-            | (((u17 >> 11) & 0x1F) << 16)
-            | ((u17 & 0x7) << 21)
-            | (((u17 >> 19) & 0x1F) << 24)
-            | (((u17 >> 8) & 0x7) << 29)
+        passed_charge = _dc.f32v(
+            ((packed4 >> 27) & 0x1F)
+            | (((packed4 >> 16) & 0x7) << 5)
+            | (((packed4 >> 35) & 0x1F) << 8)
+            | (((packed4 >> 24) & 0x7) << 13)
+            | (((packed4 >> 43) & 0x1F) << 16)
+            | (((packed4 >> 32) & 0x7) << 21)
+            | (((packed4 >> 51) & 0x1F) << 24)
+            | (((packed4 >> 40) & 0x7) << 29)
         )
-        x29 = ((u17 >> 18) & 0x1) != 0
-        x30 = (u17 >> 26) | (((u17 >> 16) & 0x3) << 6) | (((u18 >> 2) & 0x3F) << 8) | (((u17 >> 24) & 0x3) << 14)
-        x31 = (u18 >> 10) | ((u18 & 0x3) << 6) | ((u19 >> 7) << 8) | (((u18 >> 8) & 0x3) << 9)
+        nominal_voltage = _dc.f32v(
+            (packed4 >> 59)
+            | (((packed4 >> 48) & 0x7) << 5)
+            | (((packed5 >> 3) & 0x1F) << 8)
+            | (((packed4 >> 56) & 0x7) << 13)
+            | (((packed5 >> 11) & 0x1F) << 16)
+            | ((packed5 & 0x7) << 21)
+            | (((packed5 >> 19) & 0x1F) << 24)
+            | (((packed5 >> 8) & 0x7) << 29)
+        )
+        is_powering_off = ((packed5 >> 18) & 0x1) != 0
+        interface_error = (
+            (packed5 >> 26)
+            | (((packed5 >> 16) & 0x3) << 6)
+            | (((packed6 >> 2) & 0x3F) << 8)
+            | (((packed5 >> 24) & 0x3) << 14)
+        )
+        status_flags = (packed6 >> 10) | ((packed6 & 0x3) << 6) | ((packed7 >> 7) << 8) | (((packed6 >> 8) & 0x3) << 9)
         return cls(
-            u1,
-            u2,
-            f2,
-            u5,
-            u6,
-            u7,
-            u8,
-            u9,
-            u10,
-            u11,
-            u12,
-            u13,
-            u14,
-            x20,
-            x21,
-            x22,
-            x23,
-            x24,
-            x25,
-            x26,
-            x27,
-            x28,
-            x29,
-            x30,
-            x31,
+            temperature,
+            voltage,
+            voltage_cell,
+            cell_count,
+            current,
+            average_current,
+            average_power,
+            available_energy,
+            remaining_capacity,
+            full_charge_capacity,
+            design_capacity,
+            average_time_to_empty,
+            average_time_to_full,
+            state_of_health,
+            state_of_charge,
+            max_error,
+            serial_number,
+            manufacture_date,
+            cycle_count,
+            over_discharge_count,
+            passed_charge,
+            nominal_voltage,
+            is_powering_off,
+            interface_error,
+            status_flags,
         ), rem
 
     def validate(self) -> list[_v.Violation]:
@@ -1000,16 +932,13 @@ class CBAT:
         a: _Any
         e: _Any
         try:
+            # temperature (20300.CBAT.uavcan:6): fits float32
             if not (-3.4028234663852886e38 <= self.temperature <= 3.4028234663852886e38):
                 _v.diag(out, "temperature", self.temperature, _CBAT_TEMPERATURE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _CBAT_TEMPERATURE_SPEC)
-        try:
+            # voltage (20300.CBAT.uavcan:7): fits float32
             if not (-3.4028234663852886e38 <= self.voltage <= 3.4028234663852886e38):
                 _v.diag(out, "voltage", self.voltage, _CBAT_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _CBAT_VOLTAGE_SPEC)
-        try:
+            # voltage_cell (20300.CBAT.uavcan:8): fits float32[<=15]
             a = self.voltage_cell
             if len(a) > 15:
                 _v.diag(out, "voltage_cell", self.voltage_cell, _CBAT_VOLTAGE_CELL_SPEC)
@@ -1018,119 +947,75 @@ class CBAT:
                     if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
                         _v.diag(out, "voltage_cell", self.voltage_cell, _CBAT_VOLTAGE_CELL_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "voltage_cell", self.voltage_cell, _CBAT_VOLTAGE_CELL_SPEC)
-        try:
+            # cell_count (20300.CBAT.uavcan:9): fits uint8
             if self.cell_count & -256:
                 _v.diag(out, "cell_count", self.cell_count, _CBAT_CELL_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cell_count", self.cell_count, _CBAT_CELL_COUNT_SPEC)
-        try:
+            # current (20300.CBAT.uavcan:10): fits float32
             if not (-3.4028234663852886e38 <= self.current <= 3.4028234663852886e38):
                 _v.diag(out, "current", self.current, _CBAT_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _CBAT_CURRENT_SPEC)
-        try:
+            # average_current (20300.CBAT.uavcan:11): fits float32
             if not (-3.4028234663852886e38 <= self.average_current <= 3.4028234663852886e38):
                 _v.diag(out, "average_current", self.average_current, _CBAT_AVERAGE_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_current", self.average_current, _CBAT_AVERAGE_CURRENT_SPEC)
-        try:
+            # average_power (20300.CBAT.uavcan:12): fits float32
             if not (-3.4028234663852886e38 <= self.average_power <= 3.4028234663852886e38):
                 _v.diag(out, "average_power", self.average_power, _CBAT_AVERAGE_POWER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_power", self.average_power, _CBAT_AVERAGE_POWER_SPEC)
-        try:
+            # available_energy (20300.CBAT.uavcan:13): fits float32
             if not (-3.4028234663852886e38 <= self.available_energy <= 3.4028234663852886e38):
                 _v.diag(out, "available_energy", self.available_energy, _CBAT_AVAILABLE_ENERGY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "available_energy", self.available_energy, _CBAT_AVAILABLE_ENERGY_SPEC)
-        try:
+            # remaining_capacity (20300.CBAT.uavcan:14): fits float32
             if not (-3.4028234663852886e38 <= self.remaining_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "remaining_capacity", self.remaining_capacity, _CBAT_REMAINING_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "remaining_capacity", self.remaining_capacity, _CBAT_REMAINING_CAPACITY_SPEC)
-        try:
+            # full_charge_capacity (20300.CBAT.uavcan:15): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _CBAT_FULL_CHARGE_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _CBAT_FULL_CHARGE_CAPACITY_SPEC)
-        try:
+            # design_capacity (20300.CBAT.uavcan:16): fits float32
             if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "design_capacity", self.design_capacity, _CBAT_DESIGN_CAPACITY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "design_capacity", self.design_capacity, _CBAT_DESIGN_CAPACITY_SPEC)
-        try:
+            # average_time_to_empty (20300.CBAT.uavcan:17): fits uint16
             if self.average_time_to_empty & -65536:
                 _v.diag(out, "average_time_to_empty", self.average_time_to_empty, _CBAT_AVERAGE_TIME_TO_EMPTY_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_time_to_empty", self.average_time_to_empty, _CBAT_AVERAGE_TIME_TO_EMPTY_SPEC)
-        try:
+            # average_time_to_full (20300.CBAT.uavcan:18): fits uint16
             if self.average_time_to_full & -65536:
                 _v.diag(out, "average_time_to_full", self.average_time_to_full, _CBAT_AVERAGE_TIME_TO_FULL_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_time_to_full", self.average_time_to_full, _CBAT_AVERAGE_TIME_TO_FULL_SPEC)
-        try:
+            # state_of_health (20300.CBAT.uavcan:19): fits uint7
             if self.state_of_health & -128:
                 _v.diag(out, "state_of_health", self.state_of_health, _CBAT_STATE_OF_HEALTH_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health", self.state_of_health, _CBAT_STATE_OF_HEALTH_SPEC)
-        try:
+            # state_of_charge (20300.CBAT.uavcan:20): fits uint7
             if self.state_of_charge & -128:
                 _v.diag(out, "state_of_charge", self.state_of_charge, _CBAT_STATE_OF_CHARGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_charge", self.state_of_charge, _CBAT_STATE_OF_CHARGE_SPEC)
-        try:
+            # max_error (20300.CBAT.uavcan:21): fits uint7
             if self.max_error & -128:
                 _v.diag(out, "max_error", self.max_error, _CBAT_MAX_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "max_error", self.max_error, _CBAT_MAX_ERROR_SPEC)
-        try:
+            # serial_number (20300.CBAT.uavcan:22): fits uint16
             if self.serial_number & -65536:
                 _v.diag(out, "serial_number", self.serial_number, _CBAT_SERIAL_NUMBER_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "serial_number", self.serial_number, _CBAT_SERIAL_NUMBER_SPEC)
-        try:
+            # manufacture_date (20300.CBAT.uavcan:23): fits uint16
             if self.manufacture_date & -65536:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _CBAT_MANUFACTURE_DATE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "manufacture_date", self.manufacture_date, _CBAT_MANUFACTURE_DATE_SPEC)
-        try:
+            # cycle_count (20300.CBAT.uavcan:24): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _CBAT_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _CBAT_CYCLE_COUNT_SPEC)
-        try:
+            # over_discharge_count (20300.CBAT.uavcan:25): fits uint16
             if self.over_discharge_count & -65536:
                 _v.diag(out, "over_discharge_count", self.over_discharge_count, _CBAT_OVER_DISCHARGE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "over_discharge_count", self.over_discharge_count, _CBAT_OVER_DISCHARGE_COUNT_SPEC)
-        try:
+            # passed_charge (20300.CBAT.uavcan:26): fits float32
             if not (-3.4028234663852886e38 <= self.passed_charge <= 3.4028234663852886e38):
                 _v.diag(out, "passed_charge", self.passed_charge, _CBAT_PASSED_CHARGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "passed_charge", self.passed_charge, _CBAT_PASSED_CHARGE_SPEC)
-        try:
+            # nominal_voltage (20300.CBAT.uavcan:27): fits float32
             if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _CBAT_NOMINAL_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _CBAT_NOMINAL_VOLTAGE_SPEC)
-        try:
+            # is_powering_off (20300.CBAT.uavcan:28): fits bool
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _CBAT_IS_POWERING_OFF_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "is_powering_off", self.is_powering_off, _CBAT_IS_POWERING_OFF_SPEC)
-        try:
+            # interface_error (20300.CBAT.uavcan:29): fits uint16
             if self.interface_error & -65536:
                 _v.diag(out, "interface_error", self.interface_error, _CBAT_INTERFACE_ERROR_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "interface_error", self.interface_error, _CBAT_INTERFACE_ERROR_SPEC)
-        try:
+            # status_flags (20300.CBAT.uavcan:42): fits uint11; bits of STATUS_FLAG only
             if self.status_flags & -512:
                 _v.diag(out, "status_flags", self.status_flags, _CBAT_STATUS_FLAGS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "status_flags", self.status_flags, _CBAT_STATUS_FLAGS_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _CBAT_FIELD_SPECS)
         return out
 
     def check(self) -> None:

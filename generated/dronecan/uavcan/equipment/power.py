@@ -134,6 +134,23 @@ _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC = _v.Number(type="uint7", kind="uin
 _BATTERY_INFO_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
 _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
 _BATTERY_INFO_MODEL_NAME_SPEC = _v.Array(_v.Number(type="uint8", kind="uint", low=0, high=255), 31, False, byte=True)
+# (schema name, attribute, spec) of each field, for the careful way
+_BATTERY_INFO_FIELD_SPECS = (
+    ("temperature", "temperature", _BATTERY_INFO_TEMPERATURE_SPEC),
+    ("voltage", "voltage", _BATTERY_INFO_VOLTAGE_SPEC),
+    ("current", "current", _BATTERY_INFO_CURRENT_SPEC),
+    ("average_power_10sec", "average_power_10sec", _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC),
+    ("remaining_capacity_wh", "remaining_capacity_wh", _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC),
+    ("full_charge_capacity_wh", "full_charge_capacity_wh", _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC),
+    ("hours_to_full_charge", "hours_to_full_charge", _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC),
+    ("status_flags", "status_flags", _BATTERY_INFO_STATUS_FLAGS_SPEC),
+    ("state_of_health_pct", "state_of_health_pct", _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC),
+    ("state_of_charge_pct", "state_of_charge_pct", _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC),
+    ("state_of_charge_pct_stdev", "state_of_charge_pct_stdev", _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC),
+    ("battery_id", "battery_id", _BATTERY_INFO_BATTERY_ID_SPEC),
+    ("model_instance_id", "model_instance_id", _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC),
+    ("model_name", "model_name", _BATTERY_INFO_MODEL_NAME_SPEC),
+)
 
 
 # float16 fields packed as float32 ...
@@ -170,6 +187,13 @@ _CIRCUIT_STATUS_ERROR_FLAGS_SPEC = _v.Number(
         0x8: "ERROR_FLAG_UNDERCURRENT",
     },
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_CIRCUIT_STATUS_FIELD_SPECS = (
+    ("circuit_id", "circuit_id", _CIRCUIT_STATUS_CIRCUIT_ID_SPEC),
+    ("voltage", "voltage", _CIRCUIT_STATUS_VOLTAGE_SPEC),
+    ("current", "current", _CIRCUIT_STATUS_CURRENT_SPEC),
+    ("error_flags", "error_flags", _CIRCUIT_STATUS_ERROR_FLAGS_SPEC),
+)
 
 
 # float16 fields packed as float32 ...
@@ -201,6 +225,30 @@ _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC = _v.Number(type="boo
 _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
 _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC = _v.Number(
     type="uint7", kind="uint", low=0, high=127, unit="%"
+)
+# (schema name, attribute, spec) of each field, for the careful way
+_PRIMARY_POWER_SUPPLY_STATUS_FIELD_SPECS = (
+    (
+        "hours_to_empty_at_10sec_avg_power",
+        "hours_to_empty_at_10sec_avg_power",
+        _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC,
+    ),
+    (
+        "hours_to_empty_at_10sec_avg_power_variance",
+        "hours_to_empty_at_10sec_avg_power_variance",
+        _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC,
+    ),
+    (
+        "external_power_available",
+        "external_power_available",
+        _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC,
+    ),
+    ("remaining_energy_pct", "remaining_energy_pct", _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC),
+    (
+        "remaining_energy_pct_stdev",
+        "remaining_energy_pct_stdev",
+        _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC,
+    ),
 )
 
 
@@ -446,328 +494,265 @@ class BatteryInfo:
             obj.model_name = _m.as_bytes(data["model_name"], "model_name", 31, False)
         return obj
 
+    # Wire layout (1092.BatteryInfo.uavcan), bits from the start of the payload:
+    #   bits 0-15      float16 temperature  (line 10)
+    #   bits 16-31     float16 voltage  (line 11)
+    #   bits 32-47     float16 current  (line 12)
+    #   bits 48-63     float16 average_power_10sec  (line 13)
+    #   bits 64-79     float16 remaining_capacity_wh  (line 14)
+    #   bits 80-95     float16 full_charge_capacity_wh  (line 15)
+    #   bits 96-111    float16 hours_to_full_charge  (line 16)
+    #   bits 112-122   uint11 status_flags  (line 33)
+    #   bits 123-129   uint7 state_of_health_pct  (line 37)
+    #   bits 130-136   uint7 state_of_charge_pct  (line 41)
+    #   bits 137-143   uint7 state_of_charge_pct_stdev  (line 42)
+    #   bits 144-151   uint8 battery_id  (line 45)
+    #   bits 152-183   uint32 model_instance_id  (line 46)
+    #   bits 184-      uint8[<=31] model_name: <=31 x 8 bits, the tail array (no length prefix with TAO)  (line 47)
     DATA_TYPE_ID: _ClassVar[int | None] = 1092
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x249C26548A711966
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.temperature
-        r2 = self.voltage
-        r3 = self.current
-        r4 = self.average_power_10sec
-        r5 = self.remaining_capacity_wh
-        r6 = self.full_charge_capacity_wh
-        r7 = self.hours_to_full_charge
-        g8, g9, g10, g11, g12, g13, g14 = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
-            _BATTERY_INFO_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-                (
-                    r3
-                    if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
-                ),
-                (
-                    r4
-                    if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
-                ),
-                (
-                    r5
-                    if -65504.0 <= r5 <= 65504.0
-                    else (65504.0 if 65504.0 < r5 < _dc.INF else (-65504.0 if -_dc.INF < r5 < -65504.0 else r5))
-                ),
-                (
-                    r6
-                    if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
-                ),
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
-            )
-        )
-        h15 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
-        )
-        h16 = (
-            ((g9 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
-        )
-        h17 = (
-            ((g10 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g10 < 0x477FF000
-            else (((g10 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
-        )
-        h18 = (
-            ((g11 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
-        )
-        h19 = (
-            ((g12 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
-        )
-        h20 = (
-            ((g13 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
-        )
-        h21 = (
-            ((g14 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
-        )
-        r22 = self.status_flags
-        p23 = r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0)
-        r24 = self.state_of_health_pct
-        p25 = r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0)
-        r26 = self.state_of_charge_pct
-        p27 = r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0)
-        r28 = self.state_of_charge_pct_stdev
-        p29 = r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0)
-        r30 = self.battery_id
-        r31 = self.model_instance_id
-        head = _BATTERY_INFO_ENCODE_STRUCT.pack(
-            h15,
-            h16,
-            h17,
-            h18,
-            h19,
-            h20,
-            h21,
-            (p23 & 0xFF)
-            | (((p23 >> 8) & 0x7) << 13)
-            | ((p25 & 0x3) << 22)
-            | (((p25 >> 2) & 0x1F) << 8)
-            | ((p27 & 0x1) << 31)
-            | (((p27 >> 1) & 0x3F) << 16)
-            | (p29 << 24),
-            (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)),
-            (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0)),
-        )
         if tao:
-            x32 = self.model_name
-            if len(x32) > 31:
-                raise _dc.EncodeError("BatteryInfo.model_name: length " + str(len(x32)) + " exceeds capacity 31")
-            return head + bytes(x32)
-        acc = 0x10000000000000000000000000000000000000000000000 | int.from_bytes(head, "big")
-        x33 = self.model_name
-        k34 = len(x33)
-        if k34 > 31:
-            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k34) + " exceeds capacity 31")
-        acc = (acc << 5) | k34
-        acc = (acc << (k34 << 3)) | int.from_bytes(x33, "big")
-        return _dc.finish(acc)
+            x1 = self.model_name
+            if len(x1) > 31:
+                raise _dc.EncodeError("BatteryInfo.model_name: length " + str(len(x1)) + " exceeds capacity 31")
+            return self._dc_head() + bytes(x1)
+        return _dc.finish(self._dc_put(1, False))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfo:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        f13: bytes
+        model_name: bytes
         n = len(data)
         if n < 23:
             raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, n << 3)
-        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _BATTERY_INFO_DECODE_STRUCT.unpack_from(data)
-        x11 = (u8 & 0xFF) | (((u8 >> 13) & 0x7) << 8)
-        x12 = ((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1F) << 2)
-        x13 = (u8 >> 31) | (((u8 >> 16) & 0x3F) << 1)
-        x14 = (u8 >> 24) & 0x7F
+        (
+            temperature,
+            voltage,
+            current,
+            average_power_10sec,
+            remaining_capacity_wh,
+            full_charge_capacity_wh,
+            hours_to_full_charge,
+            packed1,
+            battery_id,
+            model_instance_id,
+        ) = _BATTERY_INFO_DECODE_STRUCT.unpack_from(data)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        status_flags = (packed1 & 0xFF) | (((packed1 >> 13) & 0x7) << 8)
+        state_of_health_pct = ((packed1 >> 22) & 0x3) | (((packed1 >> 8) & 0x1F) << 2)
+        state_of_charge_pct = (packed1 >> 31) | (((packed1 >> 16) & 0x3F) << 1)
+        state_of_charge_pct_stdev = (packed1 >> 24) & 0x7F
         if tao:
-            f13 = bytes(data[23:])
-            k15 = len(f13)
-            if k15 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
-            return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
-        v = int.from_bytes(data, "big")
-        rem = (n << 3) - 184
-        if rem < 5:
-            raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
-        rem -= 5
-        k16 = (v >> rem) & 0x1F
-        if k16 > 31:
-            raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k16) + " exceeds capacity 31")
-        n17 = k16 * 8
-        if rem < n17:
-            raise _dc.short("BatteryInfo.model_name", n17, rem)
-        rem -= n17
-        f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k16, "big")
+            model_name = bytes(data[23:])
+            k2 = len(model_name)
+            if k2 > 31:
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
+            return cls(
+                temperature,
+                voltage,
+                current,
+                average_power_10sec,
+                remaining_capacity_wh,
+                full_charge_capacity_wh,
+                hours_to_full_charge,
+                status_flags,
+                state_of_health_pct,
+                state_of_charge_pct,
+                state_of_charge_pct_stdev,
+                battery_id,
+                model_instance_id,
+                model_name,
+            )
+        obj, rem = cls._dc_get(int.from_bytes(data, "big"), n << 3, False)
         if rem >= 8:
             raise _dc.DecodeError("BatteryInfo: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13)
+        return obj
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.temperature
-        r2 = self.voltage
-        r3 = self.current
-        r4 = self.average_power_10sec
-        r5 = self.remaining_capacity_wh
-        r6 = self.full_charge_capacity_wh
-        r7 = self.hours_to_full_charge
-        g8, g9, g10, g11, g12, g13, g14 = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
+    def _dc_head(self) -> bytes:
+        """Bits 0-183 (the fixed fields that open the payload) as bytes, zero padded."""
+        temperature = self.temperature
+        voltage = self.voltage
+        current = self.current
+        average_power_10sec = self.average_power_10sec
+        remaining_capacity_wh = self.remaining_capacity_wh
+        full_charge_capacity_wh = self.full_charge_capacity_wh
+        hours_to_full_charge = self.hours_to_full_charge
+        (
+            temperature_f32,
+            voltage_f32,
+            current_f32,
+            average_power_10sec_f32,
+            remaining_capacity_wh_f32,
+            full_charge_capacity_wh_f32,
+            hours_to_full_charge_f32,
+        ) = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
             _BATTERY_INFO_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-                (
-                    r3
-                    if -65504.0 <= r3 <= 65504.0
-                    else (65504.0 if 65504.0 < r3 < _dc.INF else (-65504.0 if -_dc.INF < r3 < -65504.0 else r3))
-                ),
-                (
-                    r4
-                    if -65504.0 <= r4 <= 65504.0
-                    else (65504.0 if 65504.0 < r4 < _dc.INF else (-65504.0 if -_dc.INF < r4 < -65504.0 else r4))
-                ),
-                (
-                    r5
-                    if -65504.0 <= r5 <= 65504.0
-                    else (65504.0 if 65504.0 < r5 < _dc.INF else (-65504.0 if -_dc.INF < r5 < -65504.0 else r5))
-                ),
-                (
-                    r6
-                    if -65504.0 <= r6 <= 65504.0
-                    else (65504.0 if 65504.0 < r6 < _dc.INF else (-65504.0 if -_dc.INF < r6 < -65504.0 else r6))
-                ),
-                (
-                    r7
-                    if -65504.0 <= r7 <= 65504.0
-                    else (65504.0 if 65504.0 < r7 < _dc.INF else (-65504.0 if -_dc.INF < r7 < -65504.0 else r7))
-                ),
+                temperature if -65504.0 <= temperature <= 65504.0 else _dc.f16_saturated(temperature),
+                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
+                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
+                average_power_10sec
+                if -65504.0 <= average_power_10sec <= 65504.0
+                else _dc.f16_saturated(average_power_10sec),
+                remaining_capacity_wh
+                if -65504.0 <= remaining_capacity_wh <= 65504.0
+                else _dc.f16_saturated(remaining_capacity_wh),
+                full_charge_capacity_wh
+                if -65504.0 <= full_charge_capacity_wh <= 65504.0
+                else _dc.f16_saturated(full_charge_capacity_wh),
+                hours_to_full_charge
+                if -65504.0 <= hours_to_full_charge <= 65504.0
+                else _dc.f16_saturated(hours_to_full_charge),
             )
         )
-        h15 = (
-            ((g8 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g8 < 0x477FF000
-            else (((g8 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g8 < 0xC77FF000 else _dc.f16bits(g8))
+        temperature_f16 = (
+            ((temperature_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= temperature_f32 < 0x477FF000
+            else _dc.f16bits(temperature_f32)
         )
-        h16 = (
-            ((g9 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g9 < 0x477FF000
-            else (((g9 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g9 < 0xC77FF000 else _dc.f16bits(g9))
+        voltage_f16 = (
+            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
         )
-        h17 = (
-            ((g10 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g10 < 0x477FF000
-            else (((g10 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g10 < 0xC77FF000 else _dc.f16bits(g10))
+        current_f16 = (
+            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
         )
-        h18 = (
-            ((g11 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g11 < 0x477FF000
-            else (((g11 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g11 < 0xC77FF000 else _dc.f16bits(g11))
+        average_power_10sec_f16 = (
+            ((average_power_10sec_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= average_power_10sec_f32 < 0x477FF000
+            else _dc.f16bits(average_power_10sec_f32)
         )
-        h19 = (
-            ((g12 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g12 < 0x477FF000
-            else (((g12 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g12 < 0xC77FF000 else _dc.f16bits(g12))
+        remaining_capacity_wh_f16 = (
+            ((remaining_capacity_wh_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= remaining_capacity_wh_f32 < 0x477FF000
+            else _dc.f16bits(remaining_capacity_wh_f32)
         )
-        h20 = (
-            ((g13 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g13 < 0x477FF000
-            else (((g13 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g13 < 0xC77FF000 else _dc.f16bits(g13))
+        full_charge_capacity_wh_f16 = (
+            ((full_charge_capacity_wh_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= full_charge_capacity_wh_f32 < 0x477FF000
+            else _dc.f16bits(full_charge_capacity_wh_f32)
         )
-        h21 = (
-            ((g14 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g14 < 0x477FF000
-            else (((g14 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g14 < 0xC77FF000 else _dc.f16bits(g14))
+        hours_to_full_charge_f16 = (
+            ((hours_to_full_charge_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= hours_to_full_charge_f32 < 0x477FF000
+            else _dc.f16bits(hours_to_full_charge_f32)
         )
-        r22 = self.status_flags
-        p23 = r22 if 0 <= r22 <= 2047 else (2047 if r22 > 2047 else 0)
-        r24 = self.state_of_health_pct
-        p25 = r24 if 0 <= r24 <= 127 else (127 if r24 > 127 else 0)
-        r26 = self.state_of_charge_pct
-        p27 = r26 if 0 <= r26 <= 127 else (127 if r26 > 127 else 0)
-        r28 = self.state_of_charge_pct_stdev
-        p29 = r28 if 0 <= r28 <= 127 else (127 if r28 > 127 else 0)
-        r30 = self.battery_id
-        r31 = self.model_instance_id
-        acc = (acc << 184) | int.from_bytes(
-            _BATTERY_INFO_ENCODE_STRUCT.pack(
-                h15,
-                h16,
-                h17,
-                h18,
-                h19,
-                h20,
-                h21,
-                (p23 & 0xFF)
-                | (((p23 >> 8) & 0x7) << 13)
-                | ((p25 & 0x3) << 22)
-                | (((p25 >> 2) & 0x1F) << 8)
-                | ((p27 & 0x1) << 31)
-                | (((p27 >> 1) & 0x3F) << 16)
-                | (p29 << 24),
-                (r30 if 0 <= r30 <= 255 else (255 if r30 > 255 else 0)),
-                (r31 if 0 <= r31 <= 4294967295 else (4294967295 if r31 > 4294967295 else 0)),
+        status_flags = self.status_flags
+        status_flags_bits = status_flags if 0 <= status_flags <= 2047 else (2047 if status_flags > 2047 else 0)
+        state_of_health_pct = self.state_of_health_pct
+        state_of_health_pct_bits = (
+            state_of_health_pct if 0 <= state_of_health_pct <= 127 else (127 if state_of_health_pct > 127 else 0)
+        )
+        state_of_charge_pct = self.state_of_charge_pct
+        state_of_charge_pct_bits = (
+            state_of_charge_pct if 0 <= state_of_charge_pct <= 127 else (127 if state_of_charge_pct > 127 else 0)
+        )
+        state_of_charge_pct_stdev = self.state_of_charge_pct_stdev
+        state_of_charge_pct_stdev_bits = (
+            state_of_charge_pct_stdev
+            if 0 <= state_of_charge_pct_stdev <= 127
+            else (127 if state_of_charge_pct_stdev > 127 else 0)
+        )
+        battery_id = self.battery_id
+        model_instance_id = self.model_instance_id
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        return _BATTERY_INFO_ENCODE_STRUCT.pack(
+            temperature_f16,
+            voltage_f16,
+            current_f16,
+            average_power_10sec_f16,
+            remaining_capacity_wh_f16,
+            full_charge_capacity_wh_f16,
+            hours_to_full_charge_f16,
+            (status_flags_bits & 0xFF)
+            | (((status_flags_bits >> 8) & 0x7) << 13)
+            | ((state_of_health_pct_bits & 0x3) << 22)
+            | (((state_of_health_pct_bits >> 2) & 0x1F) << 8)
+            | ((state_of_charge_pct_bits & 0x1) << 31)
+            | (((state_of_charge_pct_bits >> 1) & 0x3F) << 16)
+            | (state_of_charge_pct_stdev_bits << 24),
+            (battery_id if 0 <= battery_id <= 255 else (255 if battery_id > 255 else 0)),
+            (
+                model_instance_id
+                if 0 <= model_instance_id <= 4294967295
+                else (4294967295 if model_instance_id > 4294967295 else 0)
             ),
-            "big",
         )
-        x32 = self.model_name
-        k33 = len(x32)
-        if k33 > 31:
-            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k33) + " exceeds capacity 31")
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 184) | int.from_bytes(self._dc_head(), "big")
+        x1 = self.model_name
+        k2 = len(x1)
+        if k2 > 31:
+            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
         if not tao:
-            acc = (acc << 5) | k33
-        acc = (acc << (k33 << 3)) | int.from_bytes(x32, "big")
+            acc = (acc << 5) | k2
+        acc = (acc << (k2 << 3)) | int.from_bytes(x1, "big")
         return acc
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfo, int]:
-        f13: bytes
+        model_name: bytes
         if rem < 184:
             raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, rem)
         rem -= 184
-        u1, u2, u3, u4, u5, u6, u7, u8, u9, u10 = _BATTERY_INFO_DECODE_STRUCT.unpack(
-            ((v >> rem) & ((1 << 184) - 1)).to_bytes(23, "big")
-        )
-        x11 = (u8 & 0xFF) | (((u8 >> 13) & 0x7) << 8)
-        x12 = ((u8 >> 22) & 0x3) | (((u8 >> 8) & 0x1F) << 2)
-        x13 = (u8 >> 31) | (((u8 >> 16) & 0x3F) << 1)
-        x14 = (u8 >> 24) & 0x7F
+        (
+            temperature,
+            voltage,
+            current,
+            average_power_10sec,
+            remaining_capacity_wh,
+            full_charge_capacity_wh,
+            hours_to_full_charge,
+            packed1,
+            battery_id,
+            model_instance_id,
+        ) = _BATTERY_INFO_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 184) - 1)).to_bytes(23, "big"))
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        status_flags = (packed1 & 0xFF) | (((packed1 >> 13) & 0x7) << 8)
+        state_of_health_pct = ((packed1 >> 22) & 0x3) | (((packed1 >> 8) & 0x1F) << 2)
+        state_of_charge_pct = (packed1 >> 31) | (((packed1 >> 16) & 0x3F) << 1)
+        state_of_charge_pct_stdev = (packed1 >> 24) & 0x7F
         if tao:
-            k15 = rem // 8
-            if rem - k15 * 8 >= 8:
+            k2 = rem // 8
+            if rem - k2 * 8 >= 8:
                 raise _dc.DecodeError("BatteryInfo.model_name: input ends inside an element")
-            if k15 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
-            n16 = k15 * 8
-            if rem < n16:
-                raise _dc.short("BatteryInfo.model_name", n16, rem)
-            rem -= n16
-            f13 = ((v >> rem) & ((1 << n16) - 1)).to_bytes(k15, "big")
+            if k2 > 31:
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
+            n3 = k2 * 8
+            if rem < n3:
+                raise _dc.short("BatteryInfo.model_name", n3, rem)
+            rem -= n3
+            model_name = ((v >> rem) & ((1 << n3) - 1)).to_bytes(k2, "big")
         else:
             if rem < 5:
                 raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
             rem -= 5
-            k15 = (v >> rem) & 0x1F
-            if k15 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k15) + " exceeds capacity 31")
-            n17 = k15 * 8
-            if rem < n17:
-                raise _dc.short("BatteryInfo.model_name", n17, rem)
-            rem -= n17
-            f13 = ((v >> rem) & ((1 << n17) - 1)).to_bytes(k15, "big")
-        return cls(u1, u2, u3, u4, u5, u6, u7, x11, x12, x13, x14, u9, u10, f13), rem
+            k2 = (v >> rem) & 0x1F
+            if k2 > 31:
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
+            n4 = k2 * 8
+            if rem < n4:
+                raise _dc.short("BatteryInfo.model_name", n4, rem)
+            rem -= n4
+            model_name = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k2, "big")
+        return cls(
+            temperature,
+            voltage,
+            current,
+            average_power_10sec,
+            remaining_capacity_wh,
+            full_charge_capacity_wh,
+            hours_to_full_charge,
+            status_flags,
+            state_of_health_pct,
+            state_of_charge_pct,
+            state_of_charge_pct_stdev,
+            battery_id,
+            model_instance_id,
+            model_name,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -776,38 +761,29 @@ class BatteryInfo:
         r_state_of_charge_pct: _Any
         r_state_of_health_pct: _Any
         try:
+            # temperature (1092.BatteryInfo.uavcan:10): fits float16; NaN means unknown (accepted)
             x = self.temperature
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_INFO_TEMPERATURE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature", self.temperature, _BATTERY_INFO_TEMPERATURE_SPEC)
-        try:
+            # voltage (1092.BatteryInfo.uavcan:11): fits float16; NaN means unknown (accepted)
             x = self.voltage
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "voltage", self.voltage, _BATTERY_INFO_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _BATTERY_INFO_VOLTAGE_SPEC)
-        try:
+            # current (1092.BatteryInfo.uavcan:12): fits float16; NaN means unknown (accepted)
             x = self.current
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "current", self.current, _BATTERY_INFO_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _BATTERY_INFO_CURRENT_SPEC)
-        try:
+            # average_power_10sec (1092.BatteryInfo.uavcan:13): fits float16; NaN means unknown (accepted)
             x = self.average_power_10sec
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "average_power_10sec", self.average_power_10sec, _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "average_power_10sec", self.average_power_10sec, _BATTERY_INFO_AVERAGE_POWER_10SEC_SPEC)
-        try:
+            # remaining_capacity_wh (1092.BatteryInfo.uavcan:14): fits float16; NaN means unknown (accepted)
             x = self.remaining_capacity_wh
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(
                     out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_INFO_REMAINING_CAPACITY_WH_SPEC)
-        try:
+            # full_charge_capacity_wh (1092.BatteryInfo.uavcan:15): fits float16; NaN means unknown (accepted)
             x = self.full_charge_capacity_wh
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(
@@ -816,32 +792,22 @@ class BatteryInfo:
                     self.full_charge_capacity_wh,
                     _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "full_charge_capacity_wh", self.full_charge_capacity_wh, _BATTERY_INFO_FULL_CHARGE_CAPACITY_WH_SPEC
-            )
-        try:
+            # hours_to_full_charge (1092.BatteryInfo.uavcan:16): fits float16; NaN means unknown (accepted)
             x = self.hours_to_full_charge
             if not (-65504.0 <= x <= 65504.0) and x == x:
                 _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "hours_to_full_charge", self.hours_to_full_charge, _BATTERY_INFO_HOURS_TO_FULL_CHARGE_SPEC)
-        try:
+            # status_flags (1092.BatteryInfo.uavcan:33): fits uint11; bits of STATUS_FLAG only
             if self.status_flags & -512:
                 _v.diag(out, "status_flags", self.status_flags, _BATTERY_INFO_STATUS_FLAGS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "status_flags", self.status_flags, _BATTERY_INFO_STATUS_FLAGS_SPEC)
-        try:
+            # state_of_health_pct (1092.BatteryInfo.uavcan:37): fits uint7; STATE_OF_HEALTH_UNKNOWN means unknown
+            # (accepted)
             if self.state_of_health_pct & -128:
                 _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC)
-        try:
+            # state_of_charge_pct (1092.BatteryInfo.uavcan:41): fits uint7; STATE_OF_CHARGE_UNKNOWN means unknown
+            # (accepted)
             if self.state_of_charge_pct & -128:
                 _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC)
-        try:
+            # state_of_charge_pct_stdev (1092.BatteryInfo.uavcan:42): fits uint7
             if self.state_of_charge_pct_stdev & -128:
                 _v.diag(
                     out,
@@ -849,29 +815,18 @@ class BatteryInfo:
                     self.state_of_charge_pct_stdev,
                     _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "state_of_charge_pct_stdev",
-                self.state_of_charge_pct_stdev,
-                _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC,
-            )
-        try:
+            # battery_id (1092.BatteryInfo.uavcan:45): fits uint8
             if self.battery_id & -256:
                 _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_BATTERY_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_BATTERY_ID_SPEC)
-        try:
+            # model_instance_id (1092.BatteryInfo.uavcan:46): fits uint32
             if self.model_instance_id & -4294967296:
                 _v.diag(out, "model_instance_id", self.model_instance_id, _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "model_instance_id", self.model_instance_id, _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC)
-        try:
+            # model_name (1092.BatteryInfo.uavcan:47): fits uint8[<=31]
             x = self.model_name
             if x.__class__ is not bytes or len(x) > 31:
                 _v.diag(out, "model_name", self.model_name, _BATTERY_INFO_MODEL_NAME_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "model_name", self.model_name, _BATTERY_INFO_MODEL_NAME_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _BATTERY_INFO_FIELD_SPECS)
         # rule state-of-health-percent (dronecan-power.yaml:7)
         try:
             r_state_of_health_pct = self.state_of_health_pct
@@ -1002,46 +957,17 @@ class CircuitStatus:
             obj.error_flags = _m.as_int(data["error_flags"], "error_flags")
         return obj
 
+    # Wire layout (1091.CircuitStatus.uavcan), bits from the start of the payload:
+    #   bits 0-15      uint16 circuit_id  (line 5)
+    #   bits 16-31     float16 voltage  (line 7)
+    #   bits 32-47     float16 current  (line 8)
+    #   bits 48-55     uint8 error_flags  (line 14)
     DATA_TYPE_ID: _ClassVar[int | None] = 1091
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x8313D33D0DDDA115
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.voltage
-        r2 = self.current
-        g3, g4 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
-            _CIRCUIT_STATUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-            )
-        )
-        h5 = (
-            ((g3 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
-        )
-        h6 = (
-            ((g4 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
-        )
-        r7 = self.circuit_id
-        r8 = self.error_flags
-        head = _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
-            (r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)),
-            h5,
-            h6,
-            (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0)),
-        )
-        return head
+        return self._dc_head()
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> CircuitStatus:
@@ -1049,49 +975,38 @@ class CircuitStatus:
         n = len(data)
         if n < 7:
             raise _dc.cut(_CIRCUIT_STATUS_FIELD_ENDS, n << 3)
-        u1, u2, u3, u4 = _CIRCUIT_STATUS_DECODE_STRUCT.unpack_from(data)
+        circuit_id, voltage, current, error_flags = _CIRCUIT_STATUS_DECODE_STRUCT.unpack_from(data)
         if n > 7:
             raise _dc.DecodeError("CircuitStatus: " + str(n - 7) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, u3, u4)
+        return cls(circuit_id, voltage, current, error_flags)
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.voltage
-        r2 = self.current
-        g3, g4 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
+    def _dc_head(self) -> bytes:
+        """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
+        voltage = self.voltage
+        current = self.current
+        voltage_f32, current_f32 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
             _CIRCUIT_STATUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
+                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
+                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
             )
         )
-        h5 = (
-            ((g3 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        voltage_f16 = (
+            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
         )
-        h6 = (
-            ((g4 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        current_f16 = (
+            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
         )
-        r7 = self.circuit_id
-        r8 = self.error_flags
-        acc = (acc << 56) | int.from_bytes(
-            _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
-                (r7 if 0 <= r7 <= 65535 else (65535 if r7 > 65535 else 0)),
-                h5,
-                h6,
-                (r8 if 0 <= r8 <= 255 else (255 if r8 > 255 else 0)),
-            ),
-            "big",
+        circuit_id = self.circuit_id
+        error_flags = self.error_flags
+        return _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
+            (circuit_id if 0 <= circuit_id <= 65535 else (65535 if circuit_id > 65535 else 0)),
+            voltage_f16,
+            current_f16,
+            (error_flags if 0 <= error_flags <= 255 else (255 if error_flags > 255 else 0)),
         )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 56) | int.from_bytes(self._dc_head(), "big")
         return acc
 
     @classmethod
@@ -1099,32 +1014,29 @@ class CircuitStatus:
         if rem < 56:
             raise _dc.cut(_CIRCUIT_STATUS_FIELD_ENDS, rem)
         rem -= 56
-        u1, u2, u3, u4 = _CIRCUIT_STATUS_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
-        return cls(u1, u2, u3, u4), rem
+        circuit_id, voltage, current, error_flags = _CIRCUIT_STATUS_DECODE_STRUCT.unpack(
+            ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
+        )
+        return cls(circuit_id, voltage, current, error_flags), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # circuit_id (1091.CircuitStatus.uavcan:5): fits uint16
             if self.circuit_id & -65536:
                 _v.diag(out, "circuit_id", self.circuit_id, _CIRCUIT_STATUS_CIRCUIT_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "circuit_id", self.circuit_id, _CIRCUIT_STATUS_CIRCUIT_ID_SPEC)
-        try:
+            # voltage (1091.CircuitStatus.uavcan:7): fits float16
             if not (-65504.0 <= self.voltage <= 65504.0):
                 _v.diag(out, "voltage", self.voltage, _CIRCUIT_STATUS_VOLTAGE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _CIRCUIT_STATUS_VOLTAGE_SPEC)
-        try:
+            # current (1091.CircuitStatus.uavcan:8): fits float16
             if not (-65504.0 <= self.current <= 65504.0):
                 _v.diag(out, "current", self.current, _CIRCUIT_STATUS_CURRENT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _CIRCUIT_STATUS_CURRENT_SPEC)
-        try:
+            # error_flags (1091.CircuitStatus.uavcan:14): fits uint8; bits of ERROR_FLAG only
             if self.error_flags & -16:
                 _v.diag(out, "error_flags", self.error_flags, _CIRCUIT_STATUS_ERROR_FLAGS_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "error_flags", self.error_flags, _CIRCUIT_STATUS_ERROR_FLAGS_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _CIRCUIT_STATUS_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -1253,45 +1165,18 @@ class PrimaryPowerSupplyStatus:
             obj.remaining_energy_pct_stdev = _m.as_int(data["remaining_energy_pct_stdev"], "remaining_energy_pct_stdev")
         return obj
 
+    # Wire layout (1090.PrimaryPowerSupplyStatus.uavcan), bits from the start of the payload:
+    #   bits 0-15      float16 hours_to_empty_at_10sec_avg_power  (line 6)
+    #   bits 16-31     float16 hours_to_empty_at_10sec_avg_power_variance  (line 7)
+    #   bits 32-32     bool external_power_available  (line 10)
+    #   bits 33-39     uint7 remaining_energy_pct  (line 13)
+    #   bits 40-46     uint7 remaining_energy_pct_stdev  (line 14)
     DATA_TYPE_ID: _ClassVar[int | None] = 1090
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0xBBA05074AD757480
 
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
-        r1 = self.hours_to_empty_at_10sec_avg_power
-        r2 = self.hours_to_empty_at_10sec_avg_power_variance
-        g3, g4 = _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
-            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
-            )
-        )
-        h5 = (
-            ((g3 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
-        )
-        h6 = (
-            ((g4 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
-        )
-        r7 = self.external_power_available
-        p8 = 1 if r7 else 0
-        r9 = self.remaining_energy_pct
-        p10 = r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0)
-        r11 = self.remaining_energy_pct_stdev
-        p12 = r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0)
-        head = _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9))
-        return head
+        return self._dc_head()
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> PrimaryPowerSupplyStatus:
@@ -1299,51 +1184,70 @@ class PrimaryPowerSupplyStatus:
         n = len(data)
         if n < 6:
             raise _dc.cut(_PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS, n << 3)
-        u1, u2, u3 = _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack_from(data)
-        x4 = ((u3 >> 7) & 0x1) != 0
-        x5 = u3 & 0x7F
-        x6 = u3 >> 9
+        hours_to_empty_at_10sec_avg_power, hours_to_empty_at_10sec_avg_power_variance, packed1 = (
+            _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack_from(data)
+        )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        external_power_available = ((packed1 >> 7) & 0x1) != 0
+        remaining_energy_pct = packed1 & 0x7F
+        remaining_energy_pct_stdev = packed1 >> 9
         if n > 6:
             raise _dc.DecodeError("PrimaryPowerSupplyStatus: " + str(n - 6) + " byte(s) beyond the end of the message")
-        return cls(u1, u2, x4, x5, x6)
+        return cls(
+            hours_to_empty_at_10sec_avg_power,
+            hours_to_empty_at_10sec_avg_power_variance,
+            external_power_available,
+            remaining_energy_pct,
+            remaining_energy_pct_stdev,
+        )
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
-        r1 = self.hours_to_empty_at_10sec_avg_power
-        r2 = self.hours_to_empty_at_10sec_avg_power_variance
-        g3, g4 = _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
-            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
-                (
-                    r1
-                    if -65504.0 <= r1 <= 65504.0
-                    else (65504.0 if 65504.0 < r1 < _dc.INF else (-65504.0 if -_dc.INF < r1 < -65504.0 else r1))
-                ),
-                (
-                    r2
-                    if -65504.0 <= r2 <= 65504.0
-                    else (65504.0 if 65504.0 < r2 < _dc.INF else (-65504.0 if -_dc.INF < r2 < -65504.0 else r2))
-                ),
+    def _dc_head(self) -> bytes:
+        """Bits 0-46 (the fixed fields that open the payload) as bytes, zero padded."""
+        hours_to_empty_at_10sec_avg_power = self.hours_to_empty_at_10sec_avg_power
+        hours_to_empty_at_10sec_avg_power_variance = self.hours_to_empty_at_10sec_avg_power_variance
+        hours_to_empty_at_10sec_avg_power_f32, hours_to_empty_at_10sec_avg_power_variance_f32 = (
+            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
+                _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
+                    hours_to_empty_at_10sec_avg_power
+                    if -65504.0 <= hours_to_empty_at_10sec_avg_power <= 65504.0
+                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power),
+                    hours_to_empty_at_10sec_avg_power_variance
+                    if -65504.0 <= hours_to_empty_at_10sec_avg_power_variance <= 65504.0
+                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power_variance),
+                )
             )
         )
-        h5 = (
-            ((g3 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g3 < 0x477FF000
-            else (((g3 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g3 < 0xC77FF000 else _dc.f16bits(g3))
+        hours_to_empty_at_10sec_avg_power_f16 = (
+            ((hours_to_empty_at_10sec_avg_power_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_f32 < 0x477FF000
+            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_f32)
         )
-        h6 = (
-            ((g4 - 0x37FFF000) >> 13)
-            if 0x38800000 <= g4 < 0x477FF000
-            else (((g4 - 0xB7FFF000) >> 13) | 0x8000 if 0xB8800000 <= g4 < 0xC77FF000 else _dc.f16bits(g4))
+        hours_to_empty_at_10sec_avg_power_variance_f16 = (
+            ((hours_to_empty_at_10sec_avg_power_variance_f32 - 0x37FFF000) >> 13)
+            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_variance_f32 < 0x477FF000
+            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_variance_f32)
         )
-        r7 = self.external_power_available
-        p8 = 1 if r7 else 0
-        r9 = self.remaining_energy_pct
-        p10 = r9 if 0 <= r9 <= 127 else (127 if r9 > 127 else 0)
-        r11 = self.remaining_energy_pct_stdev
-        p12 = r11 if 0 <= r11 <= 127 else (127 if r11 > 127 else 0)
-        acc = (acc << 47) | (
-            int.from_bytes(_PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(h5, h6, (p8 << 7) | p10 | (p12 << 9)), "big")
-            >> 1
+        external_power_available = self.external_power_available
+        external_power_available_bits = 1 if external_power_available else 0
+        remaining_energy_pct = self.remaining_energy_pct
+        remaining_energy_pct_bits = (
+            remaining_energy_pct if 0 <= remaining_energy_pct <= 127 else (127 if remaining_energy_pct > 127 else 0)
         )
+        remaining_energy_pct_stdev = self.remaining_energy_pct_stdev
+        remaining_energy_pct_stdev_bits = (
+            remaining_energy_pct_stdev
+            if 0 <= remaining_energy_pct_stdev <= 127
+            else (127 if remaining_energy_pct_stdev > 127 else 0)
+        )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        return _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(
+            hours_to_empty_at_10sec_avg_power_f16,
+            hours_to_empty_at_10sec_avg_power_variance_f16,
+            (external_power_available_bits << 7) | remaining_energy_pct_bits | (remaining_energy_pct_stdev_bits << 9),
+        )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 47) | (int.from_bytes(self._dc_head(), "big") >> 1)
         return acc
 
     @classmethod
@@ -1351,13 +1255,20 @@ class PrimaryPowerSupplyStatus:
         if rem < 47:
             raise _dc.cut(_PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS, rem)
         rem -= 47
-        u1, u2, u3 = _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack(
-            (((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big")
+        hours_to_empty_at_10sec_avg_power, hours_to_empty_at_10sec_avg_power_variance, packed1 = (
+            _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack((((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big"))
         )
-        x4 = ((u3 >> 7) & 0x1) != 0
-        x5 = u3 & 0x7F
-        x6 = u3 >> 9
-        return cls(u1, u2, x4, x5, x6), rem
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        external_power_available = ((packed1 >> 7) & 0x1) != 0
+        remaining_energy_pct = packed1 & 0x7F
+        remaining_energy_pct_stdev = packed1 >> 9
+        return cls(
+            hours_to_empty_at_10sec_avg_power,
+            hours_to_empty_at_10sec_avg_power_variance,
+            external_power_available,
+            remaining_energy_pct,
+            remaining_energy_pct_stdev,
+        ), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -1365,6 +1276,7 @@ class PrimaryPowerSupplyStatus:
         x: _Any
         r_remaining_energy_pct: _Any
         try:
+            # hours_to_empty_at_10sec_avg_power (1090.PrimaryPowerSupplyStatus.uavcan:6): fits float16
             if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power <= 65504.0):
                 _v.diag(
                     out,
@@ -1372,14 +1284,7 @@ class PrimaryPowerSupplyStatus:
                     self.hours_to_empty_at_10sec_avg_power,
                     _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "hours_to_empty_at_10sec_avg_power",
-                self.hours_to_empty_at_10sec_avg_power,
-                _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_SPEC,
-            )
-        try:
+            # hours_to_empty_at_10sec_avg_power_variance (1090.PrimaryPowerSupplyStatus.uavcan:7): fits float16
             if not (-65504.0 <= self.hours_to_empty_at_10sec_avg_power_variance <= 65504.0):
                 _v.diag(
                     out,
@@ -1387,14 +1292,7 @@ class PrimaryPowerSupplyStatus:
                     self.hours_to_empty_at_10sec_avg_power_variance,
                     _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "hours_to_empty_at_10sec_avg_power_variance",
-                self.hours_to_empty_at_10sec_avg_power_variance,
-                _PRIMARY_POWER_SUPPLY_STATUS_HOURS_TO_EMPTY_AT_10SEC_AVG_POWER_VARIANCE_SPEC,
-            )
-        try:
+            # external_power_available (1090.PrimaryPowerSupplyStatus.uavcan:10): fits bool
             x = self.external_power_available
             if x is not True and x is not False:
                 _v.diag(
@@ -1403,14 +1301,7 @@ class PrimaryPowerSupplyStatus:
                     self.external_power_available,
                     _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "external_power_available",
-                self.external_power_available,
-                _PRIMARY_POWER_SUPPLY_STATUS_EXTERNAL_POWER_AVAILABLE_SPEC,
-            )
-        try:
+            # remaining_energy_pct (1090.PrimaryPowerSupplyStatus.uavcan:13): fits uint7
             if self.remaining_energy_pct & -128:
                 _v.diag(
                     out,
@@ -1418,14 +1309,7 @@ class PrimaryPowerSupplyStatus:
                     self.remaining_energy_pct,
                     _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "remaining_energy_pct",
-                self.remaining_energy_pct,
-                _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_SPEC,
-            )
-        try:
+            # remaining_energy_pct_stdev (1090.PrimaryPowerSupplyStatus.uavcan:14): fits uint7
             if self.remaining_energy_pct_stdev & -128:
                 _v.diag(
                     out,
@@ -1433,13 +1317,8 @@ class PrimaryPowerSupplyStatus:
                     self.remaining_energy_pct_stdev,
                     _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "remaining_energy_pct_stdev",
-                self.remaining_energy_pct_stdev,
-                _PRIMARY_POWER_SUPPLY_STATUS_REMAINING_ENERGY_PCT_STDEV_SPEC,
-            )
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _PRIMARY_POWER_SUPPLY_STATUS_FIELD_SPECS)
         # rule remaining-energy-percent (dronecan-primary-power.yaml:4)
         try:
             r_remaining_energy_pct = self.remaining_energy_pct

@@ -19,6 +19,7 @@ from ...module_context import ModuleContext
 from ...runtime import copied
 from ...views import ClassView
 from .emit import MessageEmitter
+from .field_map import field_map
 from .plan import Planner
 
 
@@ -57,14 +58,17 @@ class _Codec:
         id_name = _free_name("DATA_TYPE_ID", taken)
         sig_name = _free_name("DATA_TYPE_SIGNATURE", taken | {id_name})
         lines = [
+            *field_map(planner, msg),
             f"{id_name}: _ClassVar[int | None] = {py_literal(info.data_type_id)}",
             f"{sig_name}: _ClassVar[int] = 0x{info.signature:016X}",
         ]
         if info.union:
             union_members(msg, ctx, view, emitter.module_code, lines)
+        head = emitter.method_head()
         methods = [
             emitter.method_encode(),
             emitter.method_decode(),
+            *([head] if head is not None else []),
             emitter.method_put(),
             emitter.method_get(),
         ]

@@ -1,10 +1,13 @@
 """Emits the straight-line encode/decode source of one DroneCAN type (see :mod:`.plan`).
 
 Generated methods per class:
-* ``_dc_put(self, acc, tao) -> acc``: append the type's bits to a sentinel-led accumulator int;
+* ``_dc_head(self) -> bytes``: the fixed fields that open the payload, packed with one ``struct`` call;
+* ``_dc_put(self, acc, tao) -> acc``: append the type's bits to a sentinel-led accumulator int (the
+  one encoding: it starts from ``_dc_head``);
 * ``_dc_get(cls, v, rem, tao) -> (obj, rem)``: read it from payload int ``v`` with ``rem`` bits left;
-* ``encode`` / ``decode``: the public top level, which packs a leading fixed run with one
-  ``struct`` call straight from or into the bytes, and a byte-aligned tail array by slicing.
+* ``encode`` / ``decode``: the public top level; ``encode`` is ``_dc_put`` finished, except that a
+  byte-aligned tail array sent with TAO is appended to ``_dc_head``'s bytes by slicing; ``decode``
+  unpacks the opening fixed run with one ``struct`` call straight from the bytes.
 
 Fixed runs of fields are :mod:`.segments`, the variable parts :mod:`.variable`; this module puts
 them together into whole structures and unions.
@@ -13,7 +16,7 @@ them together into whole structures and unions.
 from __future__ import annotations
 
 from .....ir import ArrayType, FieldType
-from ...literals import hex_literal, py_literal
+from ...literals import py_literal
 from .plan import Item, Segment, VarField, is_u8, struct_code
 from .values import Lines, encode_value, error, mask, structable_element
 from .variable import VariableFieldEmitter
@@ -46,9 +49,9 @@ class MessageEmitter(VariableFieldEmitter):
                 for index, node in item.nodes:
                     values[index] = self.node_expr(node)
             else:
-                values[item.index] = f"f{item.index}"
                 label = f"{self.cls}.{item.field_name}"
-                self.var_get(item, f"f{item.index}", label, tao if item.last else "False", out)
+                values[item.index] = out.field_var(item.index, label)
+                self.var_get(item, values[item.index], label, tao if item.last else "False", out)
         return values
 
     def declare(self, items: list[Item], out: Lines) -> None:
@@ -56,7 +59,7 @@ class MessageEmitter(VariableFieldEmitter):
             if isinstance(item, VarField):
                 ann = self.annotation(item.type)
                 if ann is not None:
-                    out.add(f"f{item.index}: {ann}")
+                    out.add(f"{out.field_var(item.index, f'{self.cls}.{item.field_name}')}: {ann}")
 
     def construct(self, values: dict[int, str]) -> str:
         args = [values[i] for i, f in enumerate(self.msg.fields) if not f.is_padding]
@@ -69,12 +72,41 @@ class MessageEmitter(VariableFieldEmitter):
             + error("DecodeError", f"{self.cls}: ", "str(rem >> 3)", " byte(s) beyond the end of the message")
         )
 
+    @staticmethod
+    def head_segment(items: list[Item]) -> Segment | None:
+        """The run of fixed fields that opens the payload, when there is one."""
+        return items[0] if items and isinstance(items[0], Segment) and items[0].bits else None
+
+    def method_head(self) -> str | None:
+        """``_dc_head``: the opening fixed fields packed into bytes, the one packing ``encode`` and
+        ``_dc_put`` share (None for a union, or a type that opens with a field of varying size)."""
+        if self.msg.dronecan is not None and self.msg.dronecan.union:
+            return None
+        head = self.head_segment(self.items("self"))
+        if head is None:
+            return None
+        out = Lines()
+        out.add(f"return {self.seg_bytes(head, out)}")
+        doc = f'    """Bits 0-{head.bits - 1} (the fixed fields that open the payload) as bytes, zero padded."""\n'
+        return "def _dc_head(self) -> bytes:\n" + doc + out.text(1)
+
     def method_put(self) -> str:
         out = Lines()
         if self.msg.dronecan is not None and self.msg.dronecan.union:
             self.union_put(out)
         else:
-            self.body_put(self.items("self"), out)
+            items = self.items("self")
+            head = self.head_segment(items)
+            if head is not None:
+                pad = -head.bits % 8
+                bits = (
+                    '(int.from_bytes(self._dc_head(), "big") >> ' + f"{pad})"
+                    if pad
+                    else 'int.from_bytes(self._dc_head(), "big")'
+                )
+                out.add(f"acc = (acc << {head.bits}) | {bits}")
+                items = items[1:]
+            self.body_put(items, out)
         out.add("return acc")
         return "def _dc_put(self, acc: int, tao: bool) -> int:\n" + out.text(1)
 
@@ -170,29 +202,19 @@ class MessageEmitter(VariableFieldEmitter):
         return None
 
     def method_encode(self) -> str:
+        """``encode``: the bit accumulator of ``_dc_put``, the one encoding; a type of fixed fields alone, or
+        ending in a byte-aligned tail array sent with TAO, is returned as the packed head (and the array's
+        bytes) without it."""
         out = Lines()
-        if self.msg.dronecan is not None and self.msg.dronecan.union:
-            out.add("return _dc.finish(self._dc_put(1, tao))")
-        else:
-            items = self.items("self")
-            head_seg = items[0] if items and isinstance(items[0], Segment) and items[0].bits else None
-            rest = items[1:] if head_seg is not None else items
-            if head_seg is not None:
-                out.add(f"head = {self.seg_bytes(head_seg, out)}")
-                if not rest:
-                    out.add("return head")
-                    return self.wrap_encode(out)
-            tail = self.tail_fast(items)
-            if tail is not None:  # returns when tao is true: what follows runs only without it
-                self.tail_put(tail, "head" if head_seg is not None else 'b""', out)
-            if head_seg is not None:
-                pad = -head_seg.bits % 8
-                bits = f'(int.from_bytes(head, "big") >> {pad})' if pad else 'int.from_bytes(head, "big")'
-                out.add(f"acc = {hex_literal(1 << head_seg.bits)} | {bits}")
-            else:
-                out.add("acc = 1")
-            self.body_put(rest, out, "False" if tail is not None else "tao")
-            out.add("return _dc.finish(acc)")
+        items = [] if self.msg.dronecan is not None and self.msg.dronecan.union else self.items("self")
+        head_seg = self.head_segment(items)
+        if head_seg is not None and len(items) == 1:
+            out.add("return self._dc_head()")
+            return self.wrap_encode(out)
+        tail = self.tail_fast(items)
+        if tail is not None:  # returns when tao is true: what follows runs only without it
+            self.tail_put(tail, "self._dc_head()" if head_seg is not None else 'b""', out)
+        out.add(f"return _dc.finish(self._dc_put(1, {'False' if tail is not None else 'tao'}))")
         return self.wrap_encode(out)
 
     def wrap_encode(self, out: Lines) -> str:
@@ -255,12 +277,17 @@ class MessageEmitter(VariableFieldEmitter):
                 return self.wrap_decode(out)
         tail = self.tail_fast(items)
         if tail is not None:  # returns when tao is true: what follows runs only without it
-            values[tail.index] = f"f{tail.index}"
+            values[tail.index] = out.field_var(tail.index, f"{self.cls}.{tail.field_name}")
             self.tail_get(tail, (head_bits + 7) // 8, out)
             out.add(f"    return {self.construct(values)}")
+            # without TAO the array has its length prefix: the bit reader, as when the type is nested
+            out.add('obj, rem = cls._dc_get(int.from_bytes(data, "big"), n << 3, False)')
+            self.trailing(out)
+            out.add("return obj")
+            return self.wrap_decode(out)
         out.add('v = int.from_bytes(data, "big")')
         out.add(f"rem = (n << 3) - {head_bits}" if head_bits else "rem = n << 3")
-        values.update(self.body_get(rest, out, "False" if tail is not None else "tao"))
+        values.update(self.body_get(rest, out))
         self.trailing(out)
         out.add(f"return {self.construct(values)}")
         return self.wrap_decode(out)
@@ -269,7 +296,7 @@ class MessageEmitter(VariableFieldEmitter):
         t = item.type
         assert isinstance(t, ArrayType)
         label = f"{self.cls}.{item.field_name}"
-        target = f"f{item.index}"
+        target = out.field_var(item.index, label)
         out.add("if tao:")
         out.level += 1
         k = out.fresh("k")

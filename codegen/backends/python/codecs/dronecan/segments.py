@@ -8,7 +8,10 @@ from ...literals import py_literal, text_literal, unparenthesized
 from ...module_context import ModuleContext
 from ...naming import identifier, upper_snake
 from .plan import Node, Piece, Planner, Segment, Unit, plan_units
-from .values import Lines, clamp, decode_pattern, encode_value, error, mask, needs_name, saturate
+from .values import Lines, decode_pattern, encode_value, error, mask, needs_name
+
+# said where fields off byte boundaries are assembled, since the shifts alone look arbitrary
+_SHARED_WORDS = "fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)"
 
 
 class SegmentEmitter:
@@ -74,16 +77,18 @@ class SegmentEmitter:
                 continue
             group = not leaf.structable
             if needs_name(leaf.type) or group:
-                name = out.fresh("r")
+                name = out.named(leaf.label)
                 out.add(f"{name} = {raw}")
                 raw = name
             value = encode_value(leaf.type, raw, pattern=group)
             if group:
-                name = out.fresh("p")
+                name = out.named(leaf.label, "bits")
                 out.add(f"{name} = {unparenthesized(value)}")
                 value = name
             values[idx] = value
         by_unit: dict[int, list[str]] = {}
+        if pieces:
+            out.add(f"# {_SHARED_WORDS}")
         for idx, runs in pieces.items():
             leaf = seg.leaves[idx]
             for pc in runs:
@@ -103,8 +108,10 @@ class SegmentEmitter:
         return args
 
     def float16_batch(self, seg: Segment, out: Lines) -> dict[int, str]:
-        """float16 bits of several fields at once: one struct round trip gives every float32
-        pattern, a normal half is then a subtraction and a shift (the rest go to the runtime)."""
+        """float16 bits of several fields at once: one struct round trip gives every float32 pattern,
+        from which a positive normal half is a subtraction and a shift; the runtime handles the rest
+        (a value beyond +-65504, a sign, a subnormal, infinity, NaN: ``_dc.f16_saturated`` /
+        ``_dc.f16_truncated`` and ``_dc.f16bits``), so the common case costs no call."""
         halves = [
             (idx, leaf)
             for idx, leaf in enumerate(seg.leaves)
@@ -114,14 +121,12 @@ class SegmentEmitter:
             return {}
         clamped = []
         for _, leaf in halves:
-            raw = out.fresh("r")
+            raw = out.named(leaf.label)
             out.add(f"{raw} = {leaf.enc}")
-            if leaf.type.cast is CastMode.SATURATED:
-                clamped.append(saturate(raw, "-65504.0", "65504.0"))
-            else:
-                clamped.append(clamp(raw, "-65504.0", "65504.0", "-_dc.INF", "_dc.INF"))
+            cast = "_dc.f16_saturated" if leaf.type.cast is CastMode.SATURATED else "_dc.f16_truncated"
+            clamped.append(f"{raw} if -65504.0 <= {raw} <= 65504.0 else {cast}({raw})")
         n = len(halves)
-        words = [out.fresh("g") for _ in halves]
+        words = [out.named(leaf.label, "f32") for _, leaf in halves]
         floats = self.struct_name(
             f"<{n}f", self.segment_role(seg, "FLOAT32_STRUCT"), "float16 fields packed as float32 ..."
         )
@@ -132,14 +137,9 @@ class SegmentEmitter:
         )
         out.add(f"{', '.join(words)} = {ints}.unpack({floats}.pack({', '.join(clamped)}))")
         values: dict[int, str] = {}
-        for (idx, _), g in zip(halves, words, strict=True):
-            h = out.fresh("h")
-            out.add(f"{h} = (")  # positive normal, negative normal, anything else
-            out.add(f"    (({g} - 0x37FFF000) >> 13)")
-            out.add(f"    if 0x38800000 <= {g} < 0x477FF000")
-            out.add(f"    else ((({g} - 0xB7FFF000) >> 13) | 0x8000")
-            out.add(f"          if 0xB8800000 <= {g} < 0xC77FF000 else _dc.f16bits({g}))")
-            out.add(")")
+        for (idx, leaf), g in zip(halves, words, strict=True):
+            h = out.named(leaf.label, "f16")
+            out.add(f"{h} = (({g} - 0x37FFF000) >> 13) if 0x38800000 <= {g} < 0x477FF000 else _dc.f16bits({g})")
             values[idx] = h
         return values
 
@@ -165,7 +165,7 @@ class SegmentEmitter:
             leaf = live[0]
             raw = leaf.enc
             if needs_name(leaf.type):
-                raw = out.fresh("r")
+                raw = out.named(leaf.label)
                 out.add(f"{raw} = {leaf.enc}")
             out.add(f"acc = (acc << {seg.bits}) | {encode_value(leaf.type, raw, pattern=True)}")
             return
@@ -181,11 +181,12 @@ class SegmentEmitter:
         units, pieces = plan_units(seg)
         fmt = "<" + "".join(u.unpack for u in units)
         unit_vars: dict[int, str] = {}
+        grouped = {pc.unit for runs in pieces.values() for pc in runs}  # units several fields share
         names = []
         for k, u in enumerate(units):
             if u.pack.endswith("x"):
                 continue
-            var = out.fresh("u")
+            var = out.named(u.leaf.label) if u.leaf is not None and k not in grouped else out.fresh("packed")
             unit_vars[k] = var
             names.append(var)
             if u.leaf is not None:
@@ -195,6 +196,8 @@ class SegmentEmitter:
             call = f"{st}.unpack_from({source[5:]})" if source.startswith("from:") else f"{st}.unpack({source})"
             target = ", ".join(names) + ("," if len(names) == 1 else "")
             out.add(f"{target} = {call}")
+        if pieces:
+            out.add(f"# {_SHARED_WORDS}")
         for idx, runs in pieces.items():
             leaf = seg.leaves[idx]
             parts = []
@@ -206,7 +209,7 @@ class SegmentEmitter:
                     term = f"({term} & {mask(pc.size)})"
                 parts.append(f"({term} << {pc.src})" if pc.src else term)
             bits = parts[0] if len(parts) == 1 else "(" + " | ".join(parts) + ")"
-            var = out.fresh("x")
+            var = out.named(leaf.label)
             out.add(f"{var} = {unparenthesized(decode_pattern(leaf.type, bits))}")
             leaf.var = var
 
@@ -221,7 +224,7 @@ class SegmentEmitter:
         if not live:
             return
         if len(seg.leaves) == 1 and seg.bits <= 8 and not live[0].nbytes:
-            var = out.fresh("x")
+            var = out.named(live[0].label)
             pattern = decode_pattern(live[0].type, f"((v >> rem) & {mask(seg.bits)})")
             out.add(f"{var} = {unparenthesized(pattern)}")
             live[0].var = var

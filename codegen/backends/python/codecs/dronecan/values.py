@@ -3,6 +3,9 @@ float views on decode, the v0 byte order of a field wider than 8 bits; plus a li
 
 from __future__ import annotations
 
+import keyword
+import re
+
 from .....ir import CastMode, FieldType, PrimitiveKind, PrimitiveType
 from ...literals import hex_literal, py_literal, unparenthesized
 from .plan import reorder_terms
@@ -10,18 +13,52 @@ from .plan import reorder_terms
 F32_MAX = "_dc.F32_MAX"
 
 
+# names a generated method uses itself, or that shadowing would break (the builtins its code calls)
+_RESERVED = frozenset(
+    {"acc", "tao", "head", "v", "rem", "n", "data", "cls", "self", "obj", "extra", "u", "t", "out", "_dc", "_struct"}
+    | {"bytes", "len", "str", "list", "int", "divmod", "range", "float", "bool", "any", "all", "sum", "min", "max"}
+)
+_NUMBERED = re.compile(r"[a-z][0-9]+")
+
+
 class Lines:
     def __init__(self) -> None:
         self.out: list[str] = []
         self.level = 0
         self.count = 0
+        self.used: set[str] = set()
+        self.fields: dict[int, str] = {}  # field index -> the variable a decoder reads it into
 
     def add(self, line: str) -> None:
         self.out.append("    " * self.level + line)
 
     def fresh(self, stem: str) -> str:
+        """A numbered temporary (``k3``): for the loop counters and lengths no field names."""
         self.count += 1
-        return f"{stem}{self.count}"
+        name = f"{stem}{self.count}"
+        self.used.add(name)
+        return name
+
+    def field_var(self, index: int, label: str) -> str:
+        """The one variable of this method holding field ``index`` (named for it on first use)."""
+        if index not in self.fields:
+            self.fields[index] = self.named(label)
+        return self.fields[index]
+
+    def named(self, label: str, suffix: str = "") -> str:
+        """A temporary named for the field it holds, so the code reads against the layout comment:
+        ``BatteryInfo.cells[2].voltage`` with suffix ``f16`` gives ``cells_2_voltage_f16``; a name
+        already used, reserved, or shaped like a numbered temporary gets a trailing underscore."""
+        field = label.split(".", 1)[1] if "." in label else label
+        name = re.sub(r"\W+", "_", field).strip("_").lower() or "value"
+        if suffix:
+            name += "_" + suffix
+        if name[0].isdigit():
+            name = "f_" + name
+        while name in self.used or name in _RESERVED or _NUMBERED.fullmatch(name) or keyword.iskeyword(name):
+            name += "_"
+        self.used.add(name)
+        return name
 
     def text(self, indent: int) -> str:
         pad = "    " * indent

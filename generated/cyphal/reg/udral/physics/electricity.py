@@ -29,22 +29,43 @@ __all__ = ["PowerTs_0_1", "Power_0_1", "SourceTs_0_1", "Source_0_1"]
 # what validate() reports against, field by field (read only when a fast test trips)
 _POWER_TS_0_1_TIMESTAMP_SPEC = _v.Nested("cyphal.uavcan.time.SynchronizedTimestamp_1_0")
 _POWER_TS_0_1_VALUE_SPEC = _v.Nested("cyphal.reg.udral.physics.electricity.Power_0_1")
+# (schema name, attribute, spec) of each field, for the careful way
+_POWER_TS_0_1_FIELD_SPECS = (
+    ("timestamp", "timestamp", _POWER_TS_0_1_TIMESTAMP_SPEC),
+    ("value", "value", _POWER_TS_0_1_VALUE_SPEC),
+)
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
 _POWER_0_1_CURRENT_SPEC = _v.Nested("cyphal.uavcan.si.unit.electric_current.Scalar_1_0")
 _POWER_0_1_VOLTAGE_SPEC = _v.Nested("cyphal.uavcan.si.unit.voltage.Scalar_1_0")
+# (schema name, attribute, spec) of each field, for the careful way
+_POWER_0_1_FIELD_SPECS = (
+    ("current", "current", _POWER_0_1_CURRENT_SPEC),
+    ("voltage", "voltage", _POWER_0_1_VOLTAGE_SPEC),
+)
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
 _SOURCE_TS_0_1_TIMESTAMP_SPEC = _v.Nested("cyphal.uavcan.time.SynchronizedTimestamp_1_0")
 _SOURCE_TS_0_1_VALUE_SPEC = _v.Nested("cyphal.reg.udral.physics.electricity.Source_0_1")
+# (schema name, attribute, spec) of each field, for the careful way
+_SOURCE_TS_0_1_FIELD_SPECS = (
+    ("timestamp", "timestamp", _SOURCE_TS_0_1_TIMESTAMP_SPEC),
+    ("value", "value", _SOURCE_TS_0_1_VALUE_SPEC),
+)
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
 _SOURCE_0_1_POWER_SPEC = _v.Nested("cyphal.reg.udral.physics.electricity.Power_0_1")
 _SOURCE_0_1_ENERGY_SPEC = _v.Nested("cyphal.uavcan.si.unit.energy.Scalar_1_0")
 _SOURCE_0_1_FULL_ENERGY_SPEC = _v.Nested("cyphal.uavcan.si.unit.energy.Scalar_1_0")
+# (schema name, attribute, spec) of each field, for the careful way
+_SOURCE_0_1_FIELD_SPECS = (
+    ("power", "power", _SOURCE_0_1_POWER_SPEC),
+    ("energy", "energy", _SOURCE_0_1_ENERGY_SPEC),
+    ("full_energy", "full_energy", _SOURCE_0_1_FULL_ENERGY_SPEC),
+)
 
 
 @_functools.cache
@@ -160,6 +181,7 @@ class PowerTs_0_1:
         x: _Any
         sub: _Any
         try:
+            # timestamp (PowerTs.0.1.dsdl:3): fits cyphal.uavcan.time.SynchronizedTimestamp_1_0
             x = self.timestamp
             if x.QUALIFIED_NAME != "cyphal.uavcan.time.SynchronizedTimestamp_1_0":
                 _v.diag(out, "timestamp", self.timestamp, _POWER_TS_0_1_TIMESTAMP_SPEC)
@@ -167,9 +189,7 @@ class PowerTs_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("timestamp", sub))
-        except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _POWER_TS_0_1_TIMESTAMP_SPEC)
-        try:
+            # value (PowerTs.0.1.dsdl:4): fits cyphal.reg.udral.physics.electricity.Power_0_1
             x = self.value
             if x.QUALIFIED_NAME != "cyphal.reg.udral.physics.electricity.Power_0_1":
                 _v.diag(out, "value", self.value, _POWER_TS_0_1_VALUE_SPEC)
@@ -177,8 +197,8 @@ class PowerTs_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("value", sub))
-        except _v.SLOW:
-            _v.diag(out, "value", self.value, _POWER_TS_0_1_VALUE_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _POWER_TS_0_1_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -273,6 +293,7 @@ class Power_0_1:
         x: _Any
         sub: _Any
         try:
+            # current (Power.0.1.dsdl:4): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
             x = self.current
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
                 _v.diag(out, "current", self.current, _POWER_0_1_CURRENT_SPEC)
@@ -280,9 +301,7 @@ class Power_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("current", sub))
-        except _v.SLOW:
-            _v.diag(out, "current", self.current, _POWER_0_1_CURRENT_SPEC)
-        try:
+            # voltage (Power.0.1.dsdl:5): fits cyphal.uavcan.si.unit.voltage.Scalar_1_0
             x = self.voltage
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.voltage.Scalar_1_0":
                 _v.diag(out, "voltage", self.voltage, _POWER_0_1_VOLTAGE_SPEC)
@@ -290,8 +309,8 @@ class Power_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("voltage", sub))
-        except _v.SLOW:
-            _v.diag(out, "voltage", self.voltage, _POWER_0_1_VOLTAGE_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _POWER_0_1_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -384,6 +403,7 @@ class SourceTs_0_1:
         x: _Any
         sub: _Any
         try:
+            # timestamp (SourceTs.0.1.dsdl:3): fits cyphal.uavcan.time.SynchronizedTimestamp_1_0
             x = self.timestamp
             if x.QUALIFIED_NAME != "cyphal.uavcan.time.SynchronizedTimestamp_1_0":
                 _v.diag(out, "timestamp", self.timestamp, _SOURCE_TS_0_1_TIMESTAMP_SPEC)
@@ -391,9 +411,7 @@ class SourceTs_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("timestamp", sub))
-        except _v.SLOW:
-            _v.diag(out, "timestamp", self.timestamp, _SOURCE_TS_0_1_TIMESTAMP_SPEC)
-        try:
+            # value (SourceTs.0.1.dsdl:4): fits cyphal.reg.udral.physics.electricity.Source_0_1
             x = self.value
             if x.QUALIFIED_NAME != "cyphal.reg.udral.physics.electricity.Source_0_1":
                 _v.diag(out, "value", self.value, _SOURCE_TS_0_1_VALUE_SPEC)
@@ -401,8 +419,8 @@ class SourceTs_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("value", sub))
-        except _v.SLOW:
-            _v.diag(out, "value", self.value, _SOURCE_TS_0_1_VALUE_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _SOURCE_TS_0_1_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -505,6 +523,7 @@ class Source_0_1:
         x: _Any
         sub: _Any
         try:
+            # power (Source.0.1.dsdl:4): fits cyphal.reg.udral.physics.electricity.Power_0_1
             x = self.power
             if x.QUALIFIED_NAME != "cyphal.reg.udral.physics.electricity.Power_0_1":
                 _v.diag(out, "power", self.power, _SOURCE_0_1_POWER_SPEC)
@@ -512,9 +531,7 @@ class Source_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("power", sub))
-        except _v.SLOW:
-            _v.diag(out, "power", self.power, _SOURCE_0_1_POWER_SPEC)
-        try:
+            # energy (Source.0.1.dsdl:5): fits cyphal.uavcan.si.unit.energy.Scalar_1_0
             x = self.energy
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.energy.Scalar_1_0":
                 _v.diag(out, "energy", self.energy, _SOURCE_0_1_ENERGY_SPEC)
@@ -522,9 +539,7 @@ class Source_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("energy", sub))
-        except _v.SLOW:
-            _v.diag(out, "energy", self.energy, _SOURCE_0_1_ENERGY_SPEC)
-        try:
+            # full_energy (Source.0.1.dsdl:6): fits cyphal.uavcan.si.unit.energy.Scalar_1_0
             x = self.full_energy
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.energy.Scalar_1_0":
                 _v.diag(out, "full_energy", self.full_energy, _SOURCE_0_1_FULL_ENERGY_SPEC)
@@ -532,8 +547,8 @@ class Source_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("full_energy", sub))
-        except _v.SLOW:
-            _v.diag(out, "full_energy", self.full_energy, _SOURCE_0_1_FULL_ENERGY_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _SOURCE_0_1_FIELD_SPECS)
         return out
 
     def check(self) -> None:

@@ -104,6 +104,8 @@ _ERROR_0_1_VALUE_SPEC = _v.Number(
         101: "TEMPERATURE_COLD",
     },
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_ERROR_0_1_FIELD_SPECS = (("value", "value", _ERROR_0_1_VALUE_SPEC),)
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -126,6 +128,26 @@ _PARAMETERS_0_3_TECHNOLOGY_SPEC = _v.Nested("cyphal.reg.udral.service.battery.Te
 _PARAMETERS_0_3_NOMINAL_VOLTAGE_SPEC = _v.Nested("cyphal.uavcan.si.unit.voltage.Scalar_1_0")
 _PARAMETERS_0_3_UNIX_MANUFACTURE_TIME_SPEC = _v.Number(type="uint40", kind="uint", low=0, high=1099511627775)
 _PARAMETERS_0_3_NAME_SPEC = _v.Array(_v.Number(type="uint8", kind="uint", low=0, high=255), 64, False, byte=True)
+# (schema name, attribute, spec) of each field, for the careful way
+_PARAMETERS_0_3_FIELD_SPECS = (
+    ("unique_id", "unique_id", _PARAMETERS_0_3_UNIQUE_ID_SPEC),
+    ("mass", "mass", _PARAMETERS_0_3_MASS_SPEC),
+    ("design_capacity", "design_capacity", _PARAMETERS_0_3_DESIGN_CAPACITY_SPEC),
+    ("design_cell_voltage_min_max", "design_cell_voltage_min_max", _PARAMETERS_0_3_DESIGN_CELL_VOLTAGE_MIN_MAX_SPEC),
+    ("discharge_current", "discharge_current", _PARAMETERS_0_3_DISCHARGE_CURRENT_SPEC),
+    ("discharge_current_burst", "discharge_current_burst", _PARAMETERS_0_3_DISCHARGE_CURRENT_BURST_SPEC),
+    ("charge_current", "charge_current", _PARAMETERS_0_3_CHARGE_CURRENT_SPEC),
+    ("charge_current_fast", "charge_current_fast", _PARAMETERS_0_3_CHARGE_CURRENT_FAST_SPEC),
+    ("charge_termination_threshold", "charge_termination_threshold", _PARAMETERS_0_3_CHARGE_TERMINATION_THRESHOLD_SPEC),
+    ("charge_voltage", "charge_voltage", _PARAMETERS_0_3_CHARGE_VOLTAGE_SPEC),
+    ("cycle_count", "cycle_count", _PARAMETERS_0_3_CYCLE_COUNT_SPEC),
+    ("series_cell_count", "series_cell_count", _PARAMETERS_0_3_SERIES_CELL_COUNT_SPEC),
+    ("state_of_health_pct", "state_of_health_pct", _PARAMETERS_0_3_STATE_OF_HEALTH_PCT_SPEC),
+    ("technology", "technology", _PARAMETERS_0_3_TECHNOLOGY_SPEC),
+    ("nominal_voltage", "nominal_voltage", _PARAMETERS_0_3_NOMINAL_VOLTAGE_SPEC),
+    ("unix_manufacture_time", "unix_manufacture_time", _PARAMETERS_0_3_UNIX_MANUFACTURE_TIME_SPEC),
+    ("name", "name", _PARAMETERS_0_3_NAME_SPEC),
+)
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -137,6 +159,14 @@ _STATUS_0_2_AVAILABLE_CHARGE_SPEC = _v.Nested("cyphal.uavcan.si.unit.electric_ch
 _STATUS_0_2_ERROR_SPEC = _v.Nested("cyphal.reg.udral.service.battery.Error_0_1")
 _STATUS_0_2_CELL_VOLTAGES_SPEC = _v.Array(
     _v.Number(type="float16", kind="float", low=-65504.0, high=65504.0, unit="V"), 255, False
+)
+# (schema name, attribute, spec) of each field, for the careful way
+_STATUS_0_2_FIELD_SPECS = (
+    ("heartbeat", "heartbeat", _STATUS_0_2_HEARTBEAT_SPEC),
+    ("temperature_min_max", "temperature_min_max", _STATUS_0_2_TEMPERATURE_MIN_MAX_SPEC),
+    ("available_charge", "available_charge", _STATUS_0_2_AVAILABLE_CHARGE_SPEC),
+    ("error", "error", _STATUS_0_2_ERROR_SPEC),
+    ("cell_voltages", "cell_voltages", _STATUS_0_2_CELL_VOLTAGES_SPEC),
 )
 
 
@@ -173,6 +203,8 @@ _TECHNOLOGY_0_1_VALUE_SPEC = _v.Number(
         200: "EDLC",
     },
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_TECHNOLOGY_0_1_FIELD_SPECS = (("value", "value", _TECHNOLOGY_0_1_VALUE_SPEC),)
 
 
 @_functools.cache
@@ -298,10 +330,11 @@ class Error_0_1:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # value (Error.0.1.dsdl:3): fits uint8; a value of VALUE
             if self.value not in {0, 10, 11, 20, 30, 50, 51, 60, 61, 62, 100, 101}:
                 _v.diag(out, "value", self.value, _ERROR_0_1_VALUE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "value", self.value, _ERROR_0_1_VALUE_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _ERROR_0_1_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -600,11 +633,10 @@ class Parameters_0_3:
         x: _Any
         sub: _Any
         try:
+            # unique_id (Parameters.0.3.dsdl:4): fits uint64
             if self.unique_id & -18446744073709551616:
                 _v.diag(out, "unique_id", self.unique_id, _PARAMETERS_0_3_UNIQUE_ID_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "unique_id", self.unique_id, _PARAMETERS_0_3_UNIQUE_ID_SPEC)
-        try:
+            # mass (Parameters.0.3.dsdl:5): fits cyphal.uavcan.si.unit.mass.Scalar_1_0
             x = self.mass
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.mass.Scalar_1_0":
                 _v.diag(out, "mass", self.mass, _PARAMETERS_0_3_MASS_SPEC)
@@ -612,9 +644,7 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("mass", sub))
-        except _v.SLOW:
-            _v.diag(out, "mass", self.mass, _PARAMETERS_0_3_MASS_SPEC)
-        try:
+            # design_capacity (Parameters.0.3.dsdl:6): fits cyphal.uavcan.si.unit.electric_charge.Scalar_1_0
             x = self.design_capacity
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_charge.Scalar_1_0":
                 _v.diag(out, "design_capacity", self.design_capacity, _PARAMETERS_0_3_DESIGN_CAPACITY_SPEC)
@@ -622,9 +652,7 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("design_capacity", sub))
-        except _v.SLOW:
-            _v.diag(out, "design_capacity", self.design_capacity, _PARAMETERS_0_3_DESIGN_CAPACITY_SPEC)
-        try:
+            # design_cell_voltage_min_max (Parameters.0.3.dsdl:7): fits cyphal.uavcan.si.unit.voltage.Scalar_1_0[2]
             x = self.design_cell_voltage_min_max
             if len(x) != 2 or any(
                 _x0.QUALIFIED_NAME != "cyphal.uavcan.si.unit.voltage.Scalar_1_0" or bool(_x0.validate()) for _x0 in x
@@ -635,14 +663,7 @@ class Parameters_0_3:
                     self.design_cell_voltage_min_max,
                     _PARAMETERS_0_3_DESIGN_CELL_VOLTAGE_MIN_MAX_SPEC,
                 )
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "design_cell_voltage_min_max",
-                self.design_cell_voltage_min_max,
-                _PARAMETERS_0_3_DESIGN_CELL_VOLTAGE_MIN_MAX_SPEC,
-            )
-        try:
+            # discharge_current (Parameters.0.3.dsdl:8): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
             x = self.discharge_current
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
                 _v.diag(out, "discharge_current", self.discharge_current, _PARAMETERS_0_3_DISCHARGE_CURRENT_SPEC)
@@ -650,9 +671,7 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("discharge_current", sub))
-        except _v.SLOW:
-            _v.diag(out, "discharge_current", self.discharge_current, _PARAMETERS_0_3_DISCHARGE_CURRENT_SPEC)
-        try:
+            # discharge_current_burst (Parameters.0.3.dsdl:9): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
             x = self.discharge_current_burst
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
                 _v.diag(
@@ -665,14 +684,7 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("discharge_current_burst", sub))
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "discharge_current_burst",
-                self.discharge_current_burst,
-                _PARAMETERS_0_3_DISCHARGE_CURRENT_BURST_SPEC,
-            )
-        try:
+            # charge_current (Parameters.0.3.dsdl:10): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
             x = self.charge_current
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
                 _v.diag(out, "charge_current", self.charge_current, _PARAMETERS_0_3_CHARGE_CURRENT_SPEC)
@@ -680,9 +692,7 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("charge_current", sub))
-        except _v.SLOW:
-            _v.diag(out, "charge_current", self.charge_current, _PARAMETERS_0_3_CHARGE_CURRENT_SPEC)
-        try:
+            # charge_current_fast (Parameters.0.3.dsdl:11): fits cyphal.uavcan.si.unit.electric_current.Scalar_1_0
             x = self.charge_current_fast
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
                 _v.diag(out, "charge_current_fast", self.charge_current_fast, _PARAMETERS_0_3_CHARGE_CURRENT_FAST_SPEC)
@@ -690,9 +700,8 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("charge_current_fast", sub))
-        except _v.SLOW:
-            _v.diag(out, "charge_current_fast", self.charge_current_fast, _PARAMETERS_0_3_CHARGE_CURRENT_FAST_SPEC)
-        try:
+            # charge_termination_threshold (Parameters.0.3.dsdl:12): fits
+            # cyphal.uavcan.si.unit.electric_current.Scalar_1_0
             x = self.charge_termination_threshold
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_current.Scalar_1_0":
                 _v.diag(
@@ -705,14 +714,7 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("charge_termination_threshold", sub))
-        except _v.SLOW:
-            _v.diag(
-                out,
-                "charge_termination_threshold",
-                self.charge_termination_threshold,
-                _PARAMETERS_0_3_CHARGE_TERMINATION_THRESHOLD_SPEC,
-            )
-        try:
+            # charge_voltage (Parameters.0.3.dsdl:13): fits cyphal.uavcan.si.unit.voltage.Scalar_1_0
             x = self.charge_voltage
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.voltage.Scalar_1_0":
                 _v.diag(out, "charge_voltage", self.charge_voltage, _PARAMETERS_0_3_CHARGE_VOLTAGE_SPEC)
@@ -720,24 +722,16 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("charge_voltage", sub))
-        except _v.SLOW:
-            _v.diag(out, "charge_voltage", self.charge_voltage, _PARAMETERS_0_3_CHARGE_VOLTAGE_SPEC)
-        try:
+            # cycle_count (Parameters.0.3.dsdl:14): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _PARAMETERS_0_3_CYCLE_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "cycle_count", self.cycle_count, _PARAMETERS_0_3_CYCLE_COUNT_SPEC)
-        try:
+            # series_cell_count (Parameters.0.3.dsdl:16): fits uint8
             if self.series_cell_count & -256:
                 _v.diag(out, "series_cell_count", self.series_cell_count, _PARAMETERS_0_3_SERIES_CELL_COUNT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "series_cell_count", self.series_cell_count, _PARAMETERS_0_3_SERIES_CELL_COUNT_SPEC)
-        try:
+            # state_of_health_pct (Parameters.0.3.dsdl:17): fits uint7
             if self.state_of_health_pct & -128:
                 _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _PARAMETERS_0_3_STATE_OF_HEALTH_PCT_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _PARAMETERS_0_3_STATE_OF_HEALTH_PCT_SPEC)
-        try:
+            # technology (Parameters.0.3.dsdl:19): fits cyphal.reg.udral.service.battery.Technology_0_1
             x = self.technology
             if x.QUALIFIED_NAME != "cyphal.reg.udral.service.battery.Technology_0_1":
                 _v.diag(out, "technology", self.technology, _PARAMETERS_0_3_TECHNOLOGY_SPEC)
@@ -745,9 +739,7 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("technology", sub))
-        except _v.SLOW:
-            _v.diag(out, "technology", self.technology, _PARAMETERS_0_3_TECHNOLOGY_SPEC)
-        try:
+            # nominal_voltage (Parameters.0.3.dsdl:20): fits cyphal.uavcan.si.unit.voltage.Scalar_1_0
             x = self.nominal_voltage
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.voltage.Scalar_1_0":
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _PARAMETERS_0_3_NOMINAL_VOLTAGE_SPEC)
@@ -755,23 +747,17 @@ class Parameters_0_3:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("nominal_voltage", sub))
-        except _v.SLOW:
-            _v.diag(out, "nominal_voltage", self.nominal_voltage, _PARAMETERS_0_3_NOMINAL_VOLTAGE_SPEC)
-        try:
+            # unix_manufacture_time (Parameters.0.3.dsdl:21): fits uint40
             if self.unix_manufacture_time & -1099511627776:
                 _v.diag(
                     out, "unix_manufacture_time", self.unix_manufacture_time, _PARAMETERS_0_3_UNIX_MANUFACTURE_TIME_SPEC
                 )
-        except _v.SLOW:
-            _v.diag(
-                out, "unix_manufacture_time", self.unix_manufacture_time, _PARAMETERS_0_3_UNIX_MANUFACTURE_TIME_SPEC
-            )
-        try:
+            # name (Parameters.0.3.dsdl:22): fits uint8[<=64]
             x = self.name
             if x.__class__ is not bytes or len(x) > 64:
                 _v.diag(out, "name", self.name, _PARAMETERS_0_3_NAME_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "name", self.name, _PARAMETERS_0_3_NAME_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _PARAMETERS_0_3_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -935,6 +921,7 @@ class Status_0_2:
         e: _Any
         sub: _Any
         try:
+            # heartbeat (Status.0.2.dsdl:3): fits cyphal.reg.udral.service.common.Heartbeat_0_1
             x = self.heartbeat
             if x.QUALIFIED_NAME != "cyphal.reg.udral.service.common.Heartbeat_0_1":
                 _v.diag(out, "heartbeat", self.heartbeat, _STATUS_0_2_HEARTBEAT_SPEC)
@@ -942,18 +929,14 @@ class Status_0_2:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("heartbeat", sub))
-        except _v.SLOW:
-            _v.diag(out, "heartbeat", self.heartbeat, _STATUS_0_2_HEARTBEAT_SPEC)
-        try:
+            # temperature_min_max (Status.0.2.dsdl:4): fits cyphal.uavcan.si.unit.temperature.Scalar_1_0[2]
             x = self.temperature_min_max
             if len(x) != 2 or any(
                 _x0.QUALIFIED_NAME != "cyphal.uavcan.si.unit.temperature.Scalar_1_0" or bool(_x0.validate())
                 for _x0 in x
             ):
                 _v.diag(out, "temperature_min_max", self.temperature_min_max, _STATUS_0_2_TEMPERATURE_MIN_MAX_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "temperature_min_max", self.temperature_min_max, _STATUS_0_2_TEMPERATURE_MIN_MAX_SPEC)
-        try:
+            # available_charge (Status.0.2.dsdl:5): fits cyphal.uavcan.si.unit.electric_charge.Scalar_1_0
             x = self.available_charge
             if x.QUALIFIED_NAME != "cyphal.uavcan.si.unit.electric_charge.Scalar_1_0":
                 _v.diag(out, "available_charge", self.available_charge, _STATUS_0_2_AVAILABLE_CHARGE_SPEC)
@@ -961,9 +944,7 @@ class Status_0_2:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("available_charge", sub))
-        except _v.SLOW:
-            _v.diag(out, "available_charge", self.available_charge, _STATUS_0_2_AVAILABLE_CHARGE_SPEC)
-        try:
+            # error (Status.0.2.dsdl:6): fits cyphal.reg.udral.service.battery.Error_0_1
             x = self.error
             if x.QUALIFIED_NAME != "cyphal.reg.udral.service.battery.Error_0_1":
                 _v.diag(out, "error", self.error, _STATUS_0_2_ERROR_SPEC)
@@ -971,9 +952,7 @@ class Status_0_2:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("error", sub))
-        except _v.SLOW:
-            _v.diag(out, "error", self.error, _STATUS_0_2_ERROR_SPEC)
-        try:
+            # cell_voltages (Status.0.2.dsdl:8): fits float16[<=255]
             a = self.cell_voltages
             if len(a) > 255:
                 _v.diag(out, "cell_voltages", self.cell_voltages, _STATUS_0_2_CELL_VOLTAGES_SPEC)
@@ -982,8 +961,8 @@ class Status_0_2:
                     if not (-65504.0 <= e <= 65504.0):
                         _v.diag(out, "cell_voltages", self.cell_voltages, _STATUS_0_2_CELL_VOLTAGES_SPEC)
                         break
-        except _v.SLOW:
-            _v.diag(out, "cell_voltages", self.cell_voltages, _STATUS_0_2_CELL_VOLTAGES_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _STATUS_0_2_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -1083,6 +1062,7 @@ class Technology_0_1:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # value (Technology.0.1.dsdl:3): fits uint8; a value of VALUE
             if self.value not in {
                 0,
                 10,
@@ -1110,8 +1090,8 @@ class Technology_0_1:
                 200,
             }:
                 _v.diag(out, "value", self.value, _TECHNOLOGY_0_1_VALUE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "value", self.value, _TECHNOLOGY_0_1_VALUE_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _TECHNOLOGY_0_1_FIELD_SPECS)
         return out
 
     def check(self) -> None:

@@ -35,12 +35,19 @@ class Readiness_0_1Value(_enum.IntEnum):
 # what validate() reports against, field by field (read only when a fast test trips)
 _HEARTBEAT_0_1_READINESS_SPEC = _v.Nested("cyphal.reg.udral.service.common.Readiness_0_1")
 _HEARTBEAT_0_1_HEALTH_SPEC = _v.Nested("cyphal.uavcan.node.Health_1_0")
+# (schema name, attribute, spec) of each field, for the careful way
+_HEARTBEAT_0_1_FIELD_SPECS = (
+    ("readiness", "readiness", _HEARTBEAT_0_1_READINESS_SPEC),
+    ("health", "health", _HEARTBEAT_0_1_HEALTH_SPEC),
+)
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
 _READINESS_0_1_VALUE_SPEC = _v.Number(
     type="uint2", kind="uint", low=0, high=3, values={0: "SLEEP", 2: "STANDBY", 3: "ENGAGED"}
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_READINESS_0_1_FIELD_SPECS = (("value", "value", _READINESS_0_1_VALUE_SPEC),)
 
 
 @_functools.cache
@@ -131,6 +138,7 @@ class Heartbeat_0_1:
         x: _Any
         sub: _Any
         try:
+            # readiness (Heartbeat.0.1.dsdl:3): fits cyphal.reg.udral.service.common.Readiness_0_1
             x = self.readiness
             if x.QUALIFIED_NAME != "cyphal.reg.udral.service.common.Readiness_0_1":
                 _v.diag(out, "readiness", self.readiness, _HEARTBEAT_0_1_READINESS_SPEC)
@@ -138,9 +146,7 @@ class Heartbeat_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("readiness", sub))
-        except _v.SLOW:
-            _v.diag(out, "readiness", self.readiness, _HEARTBEAT_0_1_READINESS_SPEC)
-        try:
+            # health (Heartbeat.0.1.dsdl:4): fits cyphal.uavcan.node.Health_1_0
             x = self.health
             if x.QUALIFIED_NAME != "cyphal.uavcan.node.Health_1_0":
                 _v.diag(out, "health", self.health, _HEARTBEAT_0_1_HEALTH_SPEC)
@@ -148,8 +154,8 @@ class Heartbeat_0_1:
                 sub = x.validate()
                 if sub:
                     out.extend(_v.prefixed("health", sub))
-        except _v.SLOW:
-            _v.diag(out, "health", self.health, _HEARTBEAT_0_1_HEALTH_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _HEARTBEAT_0_1_FIELD_SPECS)
         return out
 
     def check(self) -> None:
@@ -228,10 +234,11 @@ class Readiness_0_1:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
+            # value (Readiness.0.1.dsdl:3): fits uint2; a value of VALUE
             if self.value not in {0, 2, 3}:
                 _v.diag(out, "value", self.value, _READINESS_0_1_VALUE_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "value", self.value, _READINESS_0_1_VALUE_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _READINESS_0_1_FIELD_SPECS)
         return out
 
     def check(self) -> None:

@@ -29,6 +29,8 @@ _SCALAR_1_0_KILOGRAM_SPEC = _v.Number(
     sentinel=_math.nan,
     sentinel_text="NaN",
 )
+# (schema name, attribute, spec) of each field, for the careful way
+_SCALAR_1_0_FIELD_SPECS = (("kilogram", "kilogram", _SCALAR_1_0_KILOGRAM_SPEC),)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -93,11 +95,12 @@ class Scalar_1_0:
         out: list[_v.Violation] = []
         x: _Any
         try:
+            # kilogram (Scalar.1.0.dsdl:3): fits float32; NaN means unknown (accepted)
             x = self.kilogram
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "kilogram", self.kilogram, _SCALAR_1_0_KILOGRAM_SPEC)
-        except _v.SLOW:
-            _v.diag(out, "kilogram", self.kilogram, _SCALAR_1_0_KILOGRAM_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _SCALAR_1_0_FIELD_SPECS)
         return out
 
     def check(self) -> None:

@@ -1,7 +1,8 @@
 """The per-record conversion: each decoded record through the generated converter to the concepts
 (``generated/convert``), gathered into the same :class:`ConceptColumn`\\ s the columnar path fills.
 
-The reference the columnar conversion is checked against; the export itself uses the columnar one.
+The reference the columnar conversion is checked against (tests/apps/test_export_columnar.py); the
+export itself uses the columnar one, so this lives beside the tests.
 """
 
 from __future__ import annotations
@@ -11,10 +12,10 @@ from typing import Any, cast
 
 import numpy as np
 
-from ...inputs.model import PlainData
-from ..convert import converters
-from .catalog import Catalog, SourceMapping
-from .columns import ConceptColumn, empty_columns
+from codegen.apps.battery.catalog import Catalog, SourceMapping
+from codegen.apps.battery.columns import ConceptColumn, empty_columns
+from codegen.apps.convert import converters
+from codegen.inputs.model import PlainData
 
 
 def concept_converter(package: str, source: SourceMapping) -> Callable[[object], PlainData]:

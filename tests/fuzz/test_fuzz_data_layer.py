@@ -1,0 +1,80 @@
+"""Fuzzing the data layer every log command reads through (``read_view``: ULog, DataFlash, tlog, CAN captures in
+candump, ASC and BLF, JSON Lines), on mutated real files of ``../shared/corpus`` and the seed corpus: a log either
+reads or raises a located BattgenError naming it, with a short message -- never another exception, a hang or a
+memory blow-up (the BLF and text bounds of codegen/inputs/can/bounded.py included).
+
+A failing input is saved by hand under ``tests/fuzz/crashers/view-<kind>/`` and replayed on every run here.
+``BATTGEN_FUZZ=long`` runs far more inputs per kind (tests/fuzz/budget.py).
+"""
+
+from __future__ import annotations
+
+import functools
+import tempfile
+from pathlib import Path
+
+import pytest
+from budget import crashers, fuzz_settings
+from fuzz_inputs import mutated
+from hypothesis import given
+from hypothesis import strategies as st
+
+from codegen.apps.battery.catalog import bundled_catalog
+from codegen.apps.battery.view import read_view
+from codegen.errors import BattgenError
+from tests.shared_data import require, shared
+
+SEEDS = Path(__file__).resolve().parent / "seeds"
+MAX_MESSAGE = 4000
+# kind -> (suffix, seed files: the seed corpus, then small real files of the shared corpus)
+KINDS: dict[str, tuple[str, list[Path]]] = {
+    "ulog": (".ulg", [SEEDS / "flight.ulg"]),
+    "tlog": (".tlog", [SEEDS / "flight.tlog", shared("corpus", "realworld3b", "tlog", "dronekit-python_test.tlog")]),
+    "dataflash": (".bin", [shared("corpus", "realworld3b", "dataflash", "amc_backend_log_80k.bin")]),
+    "candump": (".log", [shared("corpus", "realworld3b", "can", "px4-issue2568_uavcan_v0.log")]),
+    "asc": (".asc", [shared("corpus", "realworld3b", "can", "pythoncan_logfile.asc")]),
+    "blf": (
+        ".blf",
+        [
+            shared("corpus", "realworld3b", "can", "pythoncan_test_CanMessage.blf"),
+            shared("corpus", "realworld3b", "can", "pythoncan_test_CanFdMessage.blf"),
+        ],
+    ),
+    "jsonl": (".jsonl", [Path(__file__).resolve().parents[1] / "data" / "instances" / "uorb_records.jsonl"]),
+}
+
+
+@functools.cache
+def _seeds(kind: str) -> list[bytes]:
+    return [require(p).read_bytes() for p in KINDS[kind][1]]
+
+
+def view(kind: str, data: bytes) -> None:
+    """Every chunk of the bytes read as a log of ``kind``; a BattgenError is the one allowed failure."""
+    suffix = KINDS[kind][0]
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / f"input{suffix}"
+        path.write_bytes(data)
+        try:
+            for chunk in read_view(
+                path, path.name, catalog=bundled_catalog(), message="uorb.BatteryStatus" if kind == "jsonl" else None
+            ):
+                assert chunk.n >= 0
+        except BattgenError as exc:
+            text = str(exc)
+            assert len(text) <= MAX_MESSAGE, text[:200]
+            assert "input" in text or text.startswith("the generated"), text
+
+
+@pytest.mark.parametrize("kind", sorted(KINDS))
+def test_fuzz_data_layer(kind: str) -> None:
+    seeds = _seeds(kind)
+    for saved in crashers(f"view-{kind}"):  # inputs that once failed here, first
+        view(kind, saved.read_bytes())
+
+    @fuzz_settings(ci=40)
+    @given(st.one_of(mutated(seeds), st.binary(max_size=512)))
+    def run(data: bytes) -> None:
+        view(kind, data)
+
+    run()
