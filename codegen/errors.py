@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
+from difflib import get_close_matches
 
 
 class BattgenError(Exception):
@@ -11,14 +12,45 @@ class BattgenError(Exception):
 
 
 class LocatedError(BattgenError):
-    """A problem at a place in an input file: names the file, the 1-based line (0: the whole file)
-    and what was expected."""
+    """A problem at a place in an input file: names the file, the 1-based line (0: the whole file, printed
+    without a line, never as a fake ``file:0:``) and what was expected."""
 
     def __init__(self, file: str, line: int, message: str) -> None:
-        super().__init__(f"{file}:{line}: {message}")
+        super().__init__(f"{place(file, line)}: {message}")
         self.file = file
         self.line = line
         self.message = message
+
+
+def place(file: str, line: int) -> str:
+    """``file:line``, or the file alone where the problem has no line (0: the whole file, a .dtb, a log)."""
+    return f"{file}:{line}" if line > 0 else file
+
+
+def cannot_read(exc: OSError) -> str:
+    """The one wording of a file that cannot be opened, whichever command and reader met it:
+    ``cannot read file: no such file or directory``."""
+    return f"cannot read file: {(exc.strerror or str(exc)).lower()}"
+
+
+def missing_file(name: str) -> BattgenError:
+    """A named input that does not exist, checked before a command starts, in :func:`cannot_read`'s words."""
+    return BattgenError(f"{name}: {cannot_read(FileNotFoundError(2, 'No such file or directory'))}")
+
+
+def did_you_mean(name: str, known: Iterable[str], *, what: str = "names") -> str:
+    """The end of an unknown-name error: the few known names closest to ``name`` (case ignored), else how many
+    names there are, never the whole list (a package knows thousands of messages)."""
+    names = sorted(set(known))
+    folded = {n.casefold(): n for n in names}
+    close = get_close_matches(name.casefold(), list(folded), n=3, cutoff=0.6)
+    if not close:  # a short form typed with the wrong prefix: compare the last dotted parts too
+        tails = {n.rsplit(".", 1)[-1].casefold(): n for n in names}
+        close = [tails[t] for t in get_close_matches(name.rsplit(".", 1)[-1].casefold(), list(tails), n=3)]
+        if close:
+            return f"did you mean {' or '.join(map(repr, close))}?"
+        return f"known {what}: {', '.join(names)}" if len(names) <= 16 else f"{len(names)} {what} known"
+    return f"did you mean {' or '.join(repr(folded[c]) for c in close)}?"
 
 
 class OutputError(BattgenError):

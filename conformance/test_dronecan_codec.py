@@ -481,6 +481,7 @@ def test_ids_signatures_and_transfer_crc(sides: dict[str, Side]) -> None:
         model_name=b"battgen test pack 4S",
         model_instance_id=7,
         state_of_health_pct=0,
+        state_of_charge_pct=0,  # its default is STATE_OF_CHARGE_UNKNOWN (127) since dronecan/DSDL's 2026 change
         **unknown_as_zero,
     )
     payload = obj.encode()

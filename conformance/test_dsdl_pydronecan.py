@@ -21,6 +21,7 @@ from codegen.ir import ArrayType, CompositeType, DronecanKind, FieldType, Messag
 dronecan = pytest.importorskip("dronecan")
 from dronecan import dsdl as pydsdl  # noqa: E402
 from dronecan import transport  # noqa: E402
+from shared_data import SHARED, missing  # noqa: E402
 
 SPECS = Path(os.path.dirname(dronecan.__file__)) / "dsdl_specs"
 BUNDLED = Path(__file__).resolve().parents[1] / "schemas" / "dronecan"
@@ -213,18 +214,41 @@ BUNDLED_TYPES = [
 ]
 
 
-def test_bundled_schemas_equal_pydronecan_definitions(reference: dict[str, Any], bundled: Schema) -> None:
+# dronecan/DSDL as upstream has it today (February 2026: BatteryInfo's STATE_OF_CHARGE_UNKNOWN, which the dronecan
+# package's copy predates), read by pydronecan's own parser
+UPSTREAM_DSDL = SHARED / "corpus" / "realworld3b" / "dsdl" / "DSDL"
+
+
+@pytest.fixture(scope="module")
+def upstream_today() -> dict[str, Any]:
+    if not UPSTREAM_DSDL.is_dir():
+        missing("dronecan/DSDL (corpus/realworld3b/dsdl/DSDL)")
+    return _reference(UPSTREAM_DSDL)
+
+
+def test_bundled_schemas_equal_upstream_definitions(upstream_today: dict[str, Any], bundled: Schema) -> None:
     assert sorted(m.dronecan.full_name for m in bundled.messages if m.dronecan) == sorted(BUNDLED_TYPES)
     for name in BUNDLED_TYPES:
-        _assert_same(reference[name], bundled)
-        _assert_wire_lengths(reference[name], bundled)
+        _assert_same(upstream_today[name], bundled)
+        _assert_wire_lengths(upstream_today[name], bundled)
 
 
-def test_bundled_schemas_parse_with_pydronecan(bundled: Schema, reference: dict[str, Any]) -> None:
-    """pydronecan reads our files too, and finds the same signatures as for its own."""
+def test_bundled_battery_info_knows_the_unknown_charge(bundled: Schema, upstream_today: dict[str, Any]) -> None:
+    """The constant pydronecan's package lacks: ours has it, a sentinel of state_of_charge_pct only."""
+    ref = upstream_today["uavcan.equipment.power.BatteryInfo"]
+    assert ("STATE_OF_CHARGE_UNKNOWN", 127) in [(c.name, c.value) for c in ref.constants]
+    info = bundled.message("dronecan.uavcan.equipment.power.BatteryInfo")
+    fields = {f.name: f for f in info.fields}
+    assert fields["state_of_charge_pct"].invalid is not None and fields["state_of_charge_pct"].invalid.value == 127
+    assert fields["state_of_charge_pct_stdev"].invalid is None
+    assert [e.name.rsplit(".", 1)[-1] for e in info.enums] == ["STATUS_FLAG"]  # the two sentinels are no enum
+
+
+def test_bundled_schemas_parse_with_pydronecan(bundled: Schema, upstream_today: dict[str, Any]) -> None:
+    """pydronecan reads our files too, and finds the same signatures as for upstream's."""
     ours_by_pydronecan = _reference(BUNDLED)
     assert sorted(ours_by_pydronecan) == sorted(BUNDLED_TYPES)
     for name, t in ours_by_pydronecan.items():
-        assert t.get_data_type_signature() == reference[name].get_data_type_signature()
+        assert t.get_data_type_signature() == upstream_today[name].get_data_type_signature()
         m: Message = bundled.message(f"dronecan.{name}")
         assert m.dronecan is not None and m.dronecan.signature == t.get_data_type_signature()

@@ -15,7 +15,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any, cast
 
-from ..errors import BattgenError
+from ..errors import BattgenError, place
 from ..frontends import devicetree as devicetree_schemas
 from ..inputs import devicetree, parameter_files
 from ..inputs.model import MessageClass
@@ -81,12 +81,13 @@ def propose_from_devicetree(
 def check_proposals(result: Result) -> list[Finding]:
     """The failsafe's cross-field findings about the proposed parameters (with the cell count and
     chemistry the proposal assumed)."""
-    return check_settings({p.name: p.value for p in result.proposals}, cells=result.cells, chemistry=result.chemistry)
+    cells = result.cells or None  # 0: not known (a node without design voltages)
+    return check_settings({p.name: p.value for p in result.proposals}, cells=cells, chemistry=result.chemistry)
 
 
 def render(result: Result, source: str, fmt: str) -> str:
     """The proposals as a parameter file: ``param`` (ArduPilot) or ``qgc`` (QGroundControl)."""
-    header = [f"Battery failsafe parameters proposed by battgen from {source}", *result.notes]
+    header = [f"Battery failsafe parameters proposed by battgen from {source}", *result.notes, *result.warnings]
     if fmt == "qgc":
         types = {f.name: f.metadata["type"] for f in dataclasses.fields(cast(Any, _batt_params()))}
         items = [
@@ -130,5 +131,5 @@ def check_parameter_file(
         pass
     findings = [ParameterFinding(f.line, f.severity, f.message) for f in report.findings]
     first = report.unreadable[0] if report.unreadable else None
-    unreadable = None if first is None else f"{first.file}:{first.line}: {first.message}"
+    unreadable = None if first is None else f"{place(first.file, first.line)}: {first.message}"
     return ParameterReport(findings, notes, unreadable)

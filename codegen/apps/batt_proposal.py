@@ -2,7 +2,9 @@
 
 BATT_CAPACITY comes from ``charge-full-design-microamp-hours``; BATT_LOW_VOLT / BATT_CRT_VOLT are
 the open-circuit voltages at 20 % / 10 % state of charge (configurable) read off an
-``ocv-capacity-table-N`` by linear interpolation, times the cell count. The cell count is given, or
+``ocv-capacity-table-N`` by linear interpolation, times the cell count. What the node supports is
+proposed and the rest named in ``Result.warnings``: a node without a table gets BATT_CAPACITY alone,
+a table that does not reach a threshold's state of charge leaves that voltage out. The cell count is given, or
 inferred from ``voltage-max-design-microvolt`` (else ``-min-``) and the chemistry's per-cell
 voltage; a table whose voltages exceed any single cell's is taken as a whole-pack table.
 Each proposal says where its value came from, for the comment in the written .param file.
@@ -43,6 +45,7 @@ class Result:
     cells: int
     chemistry: str  # the checks' name (lipo, life...)
     notes: tuple[str, ...]  # header lines: what was assumed
+    warnings: tuple[str, ...] = ()  # what the node could not give (a parameter not proposed, and why)
 
 
 def _scalar(value: Any) -> float | None:
@@ -77,7 +80,10 @@ def voltage_at(table: Sequence[tuple[float, float]], soc_percent: float) -> floa
     return rows[-1][0]
 
 
-def _pick_table(props: Mapping[str, Any], index: int | None, where: str) -> tuple[int, list[tuple[float, float]]]:
+def _pick_table(
+    props: Mapping[str, Any], index: int | None, where: str
+) -> tuple[int, list[tuple[float, float]]] | None:
+    """The OCV table to read voltages from (None: the node has none)."""
     tables = {}
     for name, value in props.items():
         if name.startswith("ocv-capacity-table-") and name.rsplit("-", 1)[1].isdigit():
@@ -85,8 +91,8 @@ def _pick_table(props: Mapping[str, Any], index: int | None, where: str) -> tupl
             if table is None:
                 raise BattgenError(f"{where}: expected {name} as <microvolt percent> pairs")
             tables[int(name.rsplit("-", 1)[1])] = table
-    if not tables:
-        raise BattgenError(f"{where}: expected an ocv-capacity-table-N to read LOW/CRITICAL voltages from")
+    if not tables and index is None:
+        return None
     if index is not None:
         if index not in tables:
             raise BattgenError(f"{where}: no ocv-capacity-table-{index} (have {sorted(tables)})")
@@ -146,30 +152,43 @@ def propose(
             f"{chem_text}, {cells} cells: voltage-min-design {vmin / 1e6:g} V / {cell_empty:g} V per cell "
             f"({at('voltage-min-design-microvolt')})"
         )
-    else:
-        raise BattgenError(f"{where}: cannot infer the cell count (no voltage-max/min-design-microvolt): give --cells")
-
     out: list[Proposal] = []
+    warnings: list[str] = []
     charge = _scalar(props.get("charge-full-design-microamp-hours"))
     capacity = round(charge / 1000) if charge else None
     if capacity:
         src = "charge-full-design-microamp-hours"
         out.append(Proposal("BATT_CAPACITY", capacity, f"{src} = {charge:.0f} uAh ({at(src)})"))
     else:
-        notes.append("no charge-full-design-microamp-hours: BATT_CAPACITY not proposed")
+        warnings.append("no charge-full-design-microamp-hours: BATT_CAPACITY not proposed")
 
-    index, rows = _pick_table(props, table, where)
-    src = f"ocv-capacity-table-{index}"
-    per_pack = max(v for v, _ in rows) > MAX_CELL_VOLTS
-    factor = 1 if per_pack else cells
-    for name, soc in (("BATT_LOW_VOLT", low_soc), ("BATT_CRT_VOLT", critical_soc)):
-        try:
-            volts = voltage_at(rows, soc)
-        except BattgenError as exc:
-            raise BattgenError(f"{where}: {src}: {exc}") from None
-        how = f"{volts:.3f} V (whole pack)" if per_pack else f"{volts:.3f} V per cell x {cells} cells"
-        out.append(Proposal(name, round(volts * factor, 2), f"OCV at {soc:g} % SOC: {how} ({at(src)})"))
+    # the voltages: from the part of the OCV table the node has (seed 004's binding example covers 90..100 %
+    # only, and most boards' nodes have no table at all): what cannot be read off it is named, not guessed
+    picked = _pick_table(props, table, where)
+    if picked is None:
+        warnings.append("no ocv-capacity-table-N: BATT_LOW_VOLT and BATT_CRT_VOLT not proposed")
+    elif cells is None:
+        warnings.append(
+            "no voltage-max/min-design-microvolt to count the cells by: BATT_LOW_VOLT and BATT_CRT_VOLT not "
+            "proposed (give --cells)"
+        )
+    else:
+        index, rows = picked
+        src = f"ocv-capacity-table-{index}"
+        per_pack = max(v for v, _ in rows) > MAX_CELL_VOLTS
+        factor = 1 if per_pack else cells
+        for name, soc in (("BATT_LOW_VOLT", low_soc), ("BATT_CRT_VOLT", critical_soc)):
+            try:
+                volts = voltage_at(rows, soc)
+            except BattgenError as exc:
+                warnings.append(f"{name} not proposed: {exc} ({at(src)})")
+                continue
+            how = f"{volts:.3f} V (whole pack)" if per_pack else f"{volts:.3f} V per cell x {cells} cells"
+            out.append(Proposal(name, round(volts * factor, 2), f"OCV at {soc:g} % SOC: {how} ({at(src)})"))
     if mah_thresholds and capacity:
         for name, soc in (("BATT_LOW_MAH", low_soc), ("BATT_CRT_MAH", critical_soc)):
             out.append(Proposal(name, round(capacity * soc / 100), f"{soc:g} % of BATT_CAPACITY"))
-    return Result(tuple(out), cells, chem, tuple(notes))
+    if not out:
+        raise BattgenError(f"{where}: expected charge-full-design-microamp-hours or an ocv-capacity-table-N, found "
+                           f"neither: nothing to propose ({'; '.join(warnings)})")  # fmt: skip
+    return Result(tuple(out), cells or 0, chem, tuple(notes), tuple(warnings))

@@ -16,6 +16,7 @@ from ..inputs.can.ordering import AuxOrder
 from ..inputs.can.reassembly import Diagnostic, Frame, Reassembler, Transfer
 from ..inputs.can.records import Registry, decode_transfer, signatures
 from ..inputs.model import GeneratedMessage
+from .can_types import TypeTable
 
 KEEP_PER_CODE = 20  # problems listed per code; the rest are counted
 
@@ -96,9 +97,14 @@ def scan(
     known: Registry,
     *,
     on_message: Callable[[Transfer, GeneratedMessage], None] | None = None,
+    standard: TypeTable | None = None,
 ) -> CaptureReport:
-    """Account for every frame; ``on_message`` is called with each decoded transfer of a known type."""
-    reassembler = Reassembler(signatures(known))
+    """Account for every frame; ``on_message`` is called with each decoded transfer of a known type.
+    ``standard``: more types (:func:`.can_types.standard_types`) whose transfers are named and CRC-checked."""
+    seeds = signatures(known)
+    for (kind, type_id), (_, signature) in (standard or {}).items():
+        seeds.setdefault(("message" if kind == "message" else "service", type_id), signature)
+    reassembler = Reassembler(seeds)
     order = AuxOrder(known)
     report = CaptureReport(source)
     last: Frame | None = None
@@ -125,7 +131,7 @@ def scan(
                 continue
             for diag in order.see(event):
                 note(diag)
-            _count(report, event, known, note, on_message)
+            _count(report, event, known, note, on_message, standard or {})
     if last is not None:
         for diag in reassembler.finish(last.t, last.index):
             note(diag)
@@ -148,13 +154,15 @@ def _count(
     known: Registry,
     note: Callable[[Diagnostic], None],
     on_message: Callable[[Transfer, GeneratedMessage], None] | None,
+    standard: TypeTable,
 ) -> None:
     kind = transfer.id.kind
     cls = known.get((kind, transfer.id.data_type_id))
     key = (transfer.node, kind, transfer.id.data_type_id)
     stream = report.streams.get(key)
     if stream is None:
-        name = cls.QUALIFIED_NAME.removeprefix("dronecan.") if cls is not None else ""
+        other = standard.get((kind, transfer.id.data_type_id))
+        name = cls.QUALIFIED_NAME.removeprefix("dronecan.") if cls is not None else other[0] if other else ""
         stream = report.streams[key] = Stream(transfer.node, kind, transfer.id.data_type_id, name, 0, transfer.t)
     stream.see(transfer.t)
     if cls is None:

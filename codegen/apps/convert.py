@@ -16,24 +16,36 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Literal, Protocol, cast
 
-from ..errors import BattgenError
+from ..errors import BattgenError, cannot_read, did_you_mean
+from ..frontends.loader import load
 from ..inputs.can.records import capture_side
+from ..inputs.devicetree.records import read_devicetree
 from ..inputs.documents import read_json, read_jsonl, read_yaml
 from ..inputs.kinds import content_kind, kind_of_name
-from ..inputs.model import DecodingClass, Encodable, MavlinkClass, MessageClass, PlainClass, PlainData, UorbClass
+from ..inputs.model import (
+    DecodingClass,
+    DronecanClass,
+    Encodable,
+    MavlinkClass,
+    MessageClass,
+    PlainClass,
+    PlainData,
+    UorbClass,
+)
 from ..inputs.payloads import read_hex, read_raw
 from ..inputs.records import InputError, Item, Notice, Record, Unreadable
 from ..inputs.tlog import StreamStats, mavlink_items, message_name
 from ..inputs.ulog import ulog_items
 from ..ir.numbers import to_json_data
-from .package import named_package, package_module
+from .package import bundled_schemas, named_package, package_module
 
 FORMATS = ("json", "jsonl", "yaml", "hex", "raw")
 BINARY_FORMATS = ("hex", "raw")
-LOG_FORMATS = ("ulog", "tlog", "mavlink", "can", "dataflash")  # input only
+LOG_FORMATS = ("ulog", "tlog", "mavlink", "can", "dataflash", "dts", "dtb")  # input only
 _EXTENSIONS = {".json": "json", ".jsonl": "jsonl", ".ndjson": "jsonl", ".yaml": "yaml", ".yml": "yaml"}
 _EXTENSIONS |= {".hex": "hex", ".bin": "raw", ".raw": "raw", ".ulg": "ulog", ".tlog": "tlog", ".mav": "mavlink"}
 _EXTENSIONS |= {".log": "can", ".asc": "can", ".blf": "can", ".trc": "can"}
+_EXTENSIONS |= {".dts": "dts", ".dtsi": "dts", ".dtb": "dtb"}
 
 # (alias, class) of each message of a side, the first required; the concept state is a side too
 Side = tuple[tuple[str, PlainClass], ...]
@@ -65,7 +77,7 @@ def input_format(path: str, given: str | None) -> str:
     if given:
         return given
     kind = content_kind(Path(path))
-    if kind in ("ulog", "tlog", "can"):
+    if kind in ("ulog", "tlog", "can", "dataflash"):  # a DataFlash .bin is a log, never one message's bytes
         return kind
     if kind_of_name(Path(path)) == "can":  # looks through .gz
         return "can"
@@ -226,13 +238,25 @@ def _refuse_unfit(objs: Sequence[object], item: Record) -> None:
 class Conversion:
     """One converter of a generated package, checked: the pair exists, has the policy."""
 
+    def _no_pair(self) -> str:
+        """Why there is no converter: a side that does not exist (with the closest names), else the pair."""
+        sides = {side for pair in self.module.CONVERTERS for side in pair}
+        for option, name in (("--from", self.source_name), ("--to", self.target_name)):
+            if name not in sides:
+                return f"{option} {name!r}: expected a format or message, found no such name; " + did_you_mean(
+                    name, sides, what="formats"
+                )
+        targets = sorted(t for s, t in self.module.CONVERTERS if s == self.source_name)
+        return (
+            f"no converter from {self.source_name} to {self.target_name}; from {self.source_name}: {', '.join(targets)}"
+        )
+
     def __init__(self, package: str | None, source: str, target: str, policy: str) -> None:
         self.module = converters(package)
         self.source_name, self.target_name = side_name(self.module, source), side_name(self.module, target)
         key = (self.source_name, self.target_name)
         if key not in self.module.CONVERTERS:
-            pairs = ", ".join(f"{s}->{t}" for s, t in sorted(self.module.CONVERTERS))
-            raise BattgenError(f"no converter from {self.source_name!r} to {self.target_name!r} (known pairs: {pairs})")
+            raise BattgenError(self._no_pair())
         if policy not in self.module.POLICIES[key]:
             raise BattgenError(
                 f"{self.source_name} -> {self.target_name} has no {policy} policy (PX4 has no such code path)"
@@ -278,6 +302,7 @@ class Conversion:
             except (ValueError, TypeError, AttributeError) as exc:
                 text = f"record {item.index + 1}: cannot convert (a value the input lacks or does not fit): {exc}"
                 raise fail(item.file, item.line, text) from None
+            _keep_capture_time(result, item)
             for name in carried:
                 extra[name] = _carried(result, name.removesuffix(CARRIED))
             lost = None if loss is None else report.summary() if loss == "summary" else report.to_dict()
@@ -302,13 +327,23 @@ class Conversion:
         try:
             stream = source.open("rb")
         except OSError as exc:
-            raise BattgenError(f"{where}: cannot read: {exc.strerror or exc}") from None
+            raise BattgenError(f"{where}: {cannot_read(exc)}") from None
         with stream:
             yield from _stream_items(stream, where, fmt)
 
     def _log_items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
-        """Every record of the source side's first message in a .ulg, .tlog, raw MAVLink or CAN capture input."""
+        """Every record of the source side's first message in a .ulg, .tlog, raw MAVLink, CAN capture or
+        devicetree (.dts, .dtb) input."""
         cls = self.source.items[0][1]
+        if fmt in ("dts", "dtb"):
+            yield from _devicetree_items(source, where, fmt, cls)
+            return
+        if fmt == "dataflash" and not all(isinstance(c, DronecanClass) for _, c in self.source.items):
+            raise BattgenError(
+                f"{where}: expected a record file for --from {self.source_name}, found an ArduPilot DataFlash log "
+                "(convert reads only the DroneCAN frames it logged, CANF/CAFD; 'battgen export' or 'report' read "
+                "its BAT records)"
+            )
         if fmt in ("can", "dataflash"):
             if not isinstance(source, Path):
                 raise BattgenError(f"{where}: a CAN capture is read from a file, not from standard input")
@@ -321,6 +356,7 @@ class Conversion:
                         None,
                         f"{where} ({item.where})",
                         instance=item.instance,
+                        location=item.location,
                         companions=item.companions,
                     )
                 elif isinstance(item, Unreadable):
@@ -370,6 +406,34 @@ def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item]:
         if not exc.reason:
             raise
         raise fail(where, exc.line, _reworded(exc.message, exc.reason, fmt)) from None
+
+
+def _devicetree_items(source: Path | IO[bytes], where: str, fmt: str, cls: object) -> Iterator[Item]:
+    """The battery nodes of a .dts/.dtb as records of the devicetree side (its binding read from the bundled
+    schemas, as ``battgen validate`` reads them), each located by its node's line."""
+    name = getattr(cls, "QUALIFIED_NAME", "")
+    if not name.startswith("devicetree."):
+        raise BattgenError(f"{where}: expected --from devicetree for a devicetree file, found --from side {name}")
+    if not isinstance(source, Path):
+        raise BattgenError(f"{where}: a devicetree file is read from a file, not from standard input")
+    schema = load([bundled_schemas()])
+    try:
+        message = schema.message(name)
+    except KeyError:
+        raise BattgenError(f"{where}: the bundled schemas have no binding {name}") from None
+    for item in read_devicetree(source, where, message, binary=fmt == "dtb"):
+        if isinstance(item, Unreadable):
+            raise fail(item.file, item.line, item.message)
+        yield item
+
+
+def _keep_capture_time(result: object, item: Record) -> None:
+    """A record of a CAN capture carries its time (``t``, s since the capture's first frame) though DroneCAN's
+    BatteryInfo has no timestamp field: a uORB target's ``timestamp`` (µs) gets it, as PX4's bridge stamps
+    the message with the time it arrived, rather than 0 on every record."""
+    t = item.location.get("t") if item.location is not None and "frame" in item.location else None
+    if isinstance(t, float) and getattr(result, "timestamp", None) == 0:
+        setattr(result, "timestamp", round(t * 1e6))  # noqa: B010 (a generated class's field, by name)
 
 
 def _source(item: Record, where: str) -> dict[str, object]:

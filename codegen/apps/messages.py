@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..backends.python import naming
-from ..errors import BattgenError
+from ..errors import BattgenError, did_you_mean
 from ..ir import Message, Schema
 
 # The battery message each log or capture kind carries, where the user names none: what a ULog's battery_status
@@ -46,5 +46,5 @@ def resolve_message(schema: Schema, name: str) -> Message:
     if matches:
         candidates = ", ".join(m.qualified_name for m in matches)
         raise BattgenError(f"message name {name!r} is ambiguous: it could be {candidates}")
-    known = ", ".join(m.qualified_name for m in schema.messages)
-    raise BattgenError(f"no message called {name!r} (known: {known})")
+    hint = did_you_mean(name, (a for m in schema.messages for a in message_aliases(m)), what="message names")
+    raise BattgenError(f"no message called {name!r} in the schemas; {hint}")

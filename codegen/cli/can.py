@@ -20,8 +20,9 @@ from pathlib import Path
 from typing import Any
 
 from ..apps.can_capture import CaptureReport, scan
+from ..apps.can_types import shipped_tree, standard_types
 from ..apps.package import bundled_package
-from ..errors import BattgenError, LocatedError
+from ..errors import BattgenError, LocatedError, missing_file
 from ..inputs.can.captures import read_bus
 from ..inputs.can.reassembly import Frame, Transfer
 from ..inputs.can.records import frames_of, registry
@@ -57,6 +58,8 @@ def _text(report: CaptureReport) -> None:
 
 def run(args: argparse.Namespace) -> int:
     known = registry(bundled_package().__name__)
+    # every standard type is CRC-checked and named, not only the generated package's battery types
+    standard = standard_types(Path(args.dsdl) if args.dsdl else shipped_tree())
     on_message = _print_record if args.records else None
     sources: list[tuple[str, Iterator[Frame]]] = []
     if args.bus:
@@ -64,15 +67,15 @@ def run(args: argparse.Namespace) -> int:
     for name in args.files:
         path = Path(name)
         if not path.is_file():
-            raise BattgenError(f"{name}: cannot read file: no such file")
-        sources.append((name, frames_of(path, name)))
+            raise missing_file(name)
+        sources.append((name, frames_of(path, name, args.input_format)))
     if not sources:
         raise BattgenError("give a capture file or --bus IFACE:CHANNEL")
     reports: list[CaptureReport] = []
     code = EXIT_OK
     for name, frames in sources:
         try:
-            report = scan(frames, name, known, on_message=on_message)
+            report = scan(frames, name, known, on_message=on_message, standard=standard)
         except KeyboardInterrupt:  # a live bus stopped by the user: the report of what was seen is still wanted
             print(line(f"{name}: stopped"), file=sys.stderr)
             continue
@@ -105,6 +108,17 @@ def register(subparsers: Any, summary: str) -> None:
     p.add_argument("files", nargs="*", metavar="CAPTURE", help="capture files (.log .asc .blf .trc, .bin DataFlash)")
     p.add_argument("--bus", metavar="IFACE:CHANNEL", help="read a live python-can bus instead (socketcan:can0, ...)")
     p.add_argument("--duration", type=float, metavar="S", help="with --bus: stop after S seconds (default: Ctrl-C)")
+    p.add_argument(
+        "--input-format",
+        choices=("can", "dataflash"),
+        help="read every CAPTURE as this: 'can' a python-can log (a .csv too), 'dataflash' a log's CANF/CAFD records",
+    )
+    p.add_argument(
+        "--dsdl",
+        metavar="DIR",
+        help="a DroneCAN DSDL root (a copy of dronecan/DSDL) whose types are named and CRC-checked "
+        "(default: the tree the dronecan package ships, where installed)",
+    )
     p.add_argument("--records", action="store_true", help="also print every decoded message as a JSON line")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output format (default: text)")
     p.set_defaults(func=run)

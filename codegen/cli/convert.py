@@ -104,7 +104,9 @@ def run(args: argparse.Namespace) -> int:
             before = tally.records
             _write(tally.count(events, where), where, fmt, out_fmt, out_stream)
             if tally.records == before:
-                tally.empty.append(where)
+                # a DataFlash log without logged CAN frames is most likely a flight log given for its BAT records
+                log = " (an ArduPilot DataFlash log: convert reads its CANF/CAFD CAN frames, and it has none)"
+                tally.empty.append(where + (log if fmt == "dataflash" else ""))
     finally:
         if args.output:
             out_stream.close()

@@ -74,6 +74,7 @@ def register(subparsers: Any, summary: str) -> None:
     p.add_argument("--engine", choices=("local", "dask"), default="local", help="local processes or a Dask cluster")
     p.add_argument("--scheduler", metavar="ADDRESS", help="the Dask scheduler (default: a local cluster)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
+    p.add_argument("--allow-empty", action="store_true", help="a log without battery records is not an error")
     p.set_defaults(func=run)
 
 
@@ -192,6 +193,13 @@ def run(args: argparse.Namespace) -> int:
         print(line(f"battgen: warning: {warning}"), file=sys.stderr)
     for r in failed:
         print(line(f"battgen: skipped {r.error}"), file=sys.stderr)
+    # a log read without one battery record is not success (the README's rule for every command)
+    empty = [r for r in results if r.status == "exported" and not r.rows]
+    for r in empty if not args.allow_empty else ():
+        print(
+            line(f"battgen: {r.path}: expected battery records, found none (--allow-empty accepts that)"),
+            file=sys.stderr,
+        )
     if not args.quiet:
         rows = sum(r.rows for r in results)
         done, skipped = engine.count(results, "exported"), engine.count(results, "skipped")
@@ -202,4 +210,4 @@ def run(args: argparse.Namespace) -> int:
             ),
             file=sys.stderr,
         )
-    return EXIT_FAILED if failed or any(r.warnings for r in results) else EXIT_OK
+    return EXIT_FAILED if failed or any(r.warnings for r in results) or (empty and not args.allow_empty) else EXIT_OK

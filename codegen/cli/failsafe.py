@@ -35,10 +35,10 @@ battery's BATT_, BATT2_ .. BATT9_, BATTA_ .. BATTG_ settings. The vehicle (``--v
 what an action code means, its priority and its fallbacks; without it, it is detected from
 parameters only one vehicle has, else rover is assumed (said on stderr either way).
 
-Semantics are ArduPilot's AP_BattMonitor (see the README's failsafe section); ``--variant
+Semantics are ArduPilot's AP_BattMonitor (see docs/failsafe.md); ``--variant
 seed-critical`` and ``--variant distance`` turn on the seed's own choices. Prints one line per
 transition (``--json``: one JSON object per line). Exit 0; 1 when the parameters hold no BATT*_
-one (``--allow-empty`` accepts that); 2 when an input cannot be read or holds no battery reading; 3 with
+one or the input no battery reading (``--allow-empty`` accepts both); 2 when an input cannot be read; 3 with
 ``--strict`` when a replay does not reproduce what the log recorded.
 """
 
@@ -64,7 +64,7 @@ from ..apps.failsafe.px4_replay import Px4Event, replay_px4
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
-from ..errors import BattgenError
+from ..errors import BattgenError, missing_file
 from ..inputs import parameter_files
 from ..inputs.kinds import FLIGHT_LOG_KINDS, detect
 from ..text.escape import line
@@ -86,7 +86,9 @@ def register(subparsers: Any, summary: str) -> None:
     p.add_argument("--vehicle", choices=sorted(VEHICLES), help="ArduPilot vehicle (default: detected, else rover)")
     p.add_argument("--variant", action="append", choices=sorted(VARIANTS), default=[], help="a seed variant (opt-in)")
     p.add_argument(
-        "--allow-empty", action="store_true", help="parameters without any BATT*_ one are not an error (exit 1)"
+        "--allow-empty",
+        action="store_true",
+        help="parameters without any BATT*_ one, or an input without battery readings, are not an error",
     )
     p.add_argument("--message", help="message of samples that name none (e.g. uorb.BatteryStatus)")
     p.add_argument("--schemas", help="schema folder the messages come from (default: the bundled schemas/)")
@@ -103,6 +105,9 @@ def register(subparsers: Any, summary: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     stream = Path(args.stream)
+    for given in (args.stream, args.params):  # before anything asks for what a missing file would have held
+        if given is not None and given != "-" and not Path(given).is_file():
+            raise missing_file(given)
     try:
         given = read_parameter_values(Path(args.params)) if args.params else None
         firmware, how = choose_firmware(args.firmware, given, args.params or "", stream)
@@ -173,8 +178,15 @@ def run(args: argparse.Namespace) -> int:
         for event, sample in events:
             print(_json(event, sample, vehicle.name) if args.json else line(_line(event, sample)))
         read = replay.samples if table is None else read
-        if read == 0:
-            raise BattgenError(f"{args.stream}: expected battery readings, found none")
+        if read == 0:  # a readable input without battery readings: exit 1 like every command (README)
+            if args.allow_empty:
+                print(line(f"{args.stream}: no battery readings"), file=sys.stderr)
+                return EXIT_OK
+            print(
+                line(f"{args.stream}: expected battery readings, found none (--allow-empty accepts that)"),
+                file=sys.stderr,
+            )
+            return EXIT_EMPTY
         checks = check_log(stream, args.stream, table, fs.events) if table is not None else []
         for check in checks:
             print(line(f"battgen: check {check.what}: {check.verdict()}"), file=sys.stderr)

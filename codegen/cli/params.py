@@ -25,7 +25,7 @@ from ..apps.batt_parameters import check_parameter_file, check_proposals, propos
 from ..apps.failsafe.checks import CELL_RANGES
 from ..apps.failsafe.stream import batt_parameter_count, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES
-from ..errors import BattgenError
+from ..errors import BattgenError, place
 from ..text.escape import line
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
@@ -70,6 +70,8 @@ def run(args: argparse.Namespace) -> int:
         mah_thresholds=args.mah_thresholds,
     )
     text = render(result, source, args.format)
+    for warning in result.warnings:  # what the node could not give: said, as well as written into the file
+        print(line(f"battgen: warning: {source}: {warning}"), file=sys.stderr)
     for finding in check_proposals(result):
         print(line(f"battgen: {finding.severity}: {finding.message}"), file=sys.stderr)
     if args.out:
@@ -101,7 +103,7 @@ def _check(path: Path, cells: int | None, chemistry: str, vehicle: str | None, a
     for note in report.notes:
         print(line(f"{display}: {note}"), file=sys.stderr)
     for f in report.findings:
-        print(line(f"{display}:{f.line}: {f.severity}: {f.message}"))
+        print(line(f"{place(display, f.line)}: {f.severity}: {f.message}"))
     errors = sum(f.severity == "error" for f in report.findings)
     warnings = sum(f.severity == "warning" for f in report.findings)
     print(line(f"{display}: {errors} errors, {warnings} warnings"), file=sys.stderr)

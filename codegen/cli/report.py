@@ -15,7 +15,8 @@ the profile following the log's firmware unless given (a PX4 log: ``px4``); an u
 Several inputs give a fleet page: a row per flight and battery with its date and firmware, and trends per pack
 serial over the flights' dates. ``--format png`` writes one static image per battery into the ``-o`` folder instead;
 ``--format json`` the figures, per input and battery (the page's and the flight's in SI), to ``-o`` or stdout.
-Exit 0 when written, 2 when an input cannot be read or the output cannot be written.
+Exit 0 when written, 1 when the inputs hold no battery record (``--allow-empty``: 0, nothing written), 2 when an
+input cannot be read or the output cannot be written.
 """
 
 from __future__ import annotations
@@ -31,11 +32,11 @@ from ..apps.gate import unknown_name
 from ..apps.package import bundled_schemas
 from ..apps.report.as_json import report_json
 from ..apps.report.build import collect, html, pngs
-from ..errors import BattgenError
+from ..errors import BattgenError, missing_file
 from ..text.escape import line
 from .gate_options import add_gate_options, firmware_note, gate_settings
 
-EXIT_OK = 0
+EXIT_OK, EXIT_EMPTY = 0, 1
 
 
 def run(args: argparse.Namespace) -> int:
@@ -43,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
     paths = [Path(p) for p in args.logs]
     for p in paths:
         if not p.is_file():
-            raise BattgenError(f"{p}: cannot read file: no such file")
+            raise missing_file(str(p))
     if args.vehicle is not None and args.vehicle not in VEHICLES:
         raise unknown_name("vehicle", args.vehicle, VEHICLES)
     report = collect(
@@ -58,8 +59,13 @@ def run(args: argparse.Namespace) -> int:
         note = firmware_note(item.source, item.gate) if item.gate is not None else None
         if note is not None:
             print(line(note), file=sys.stderr)
-    if not any(i.batteries for i in report.inputs):
-        raise BattgenError("no battery records in the input(s): nothing to report")
+    if not any(i.batteries for i in report.inputs):  # readable, but nothing to draw: exit 1 as the README says
+        names = ", ".join(str(p) for p in paths)
+        if args.allow_empty:
+            print(line(f"{names}: no battery records: nothing to report, nothing written"), file=sys.stderr)
+            return EXIT_OK
+        print(line(f"{names}: expected battery records, found none (--allow-empty accepts that)"), file=sys.stderr)
+        return EXIT_EMPTY
     if args.format == "png":
         folder = Path(args.output or "report")
         if folder.exists() and not folder.is_dir():
@@ -123,4 +129,5 @@ def register(subparsers: Any, summary: str) -> None:
     p.add_argument("--vehicle", metavar="NAME", help=f"vehicle of the failsafe ({', '.join(sorted(VEHICLES))})")
     add_gate_options(p)
     p.add_argument("--title", metavar="TEXT", help="the page's title")
+    p.add_argument("--allow-empty", action="store_true", help="inputs without battery records are not an error")
     p.set_defaults(func=run)

@@ -214,8 +214,9 @@ def summary(message: Message, reports: list[FileReport], groups: list[Group], ch
         f"{message.qualified_name}: {_count(records, 'record')} in {_count(len(reports), 'file')}, "
         f"{_count(errors, 'error')}, {_count(warnings, 'warning')}"
     )
-    if errors or warnings:
-        text += f" (shown as {_count(len(shown), 'line')})"
+    if errors or warnings:  # a reader's damage notice (a CAN transfer's bad CRC) is an error on a line of its own
+        lines = len(shown) + sum(1 for r in reports for n in r.notices if n.severity == "error")
+        text += f" (shown as {_count(lines, 'line')})"
     unreadable = sum(len(r.unreadable) for r in reports)
     if unreadable:
         text += f", {unreadable} unreadable"

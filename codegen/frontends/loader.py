@@ -72,7 +72,7 @@ def is_schema_dir(path: Path) -> bool:
 
 def load_schema_dir(root: Path, *, include_paths: Sequence[Path] = (), only: Collection[str] | None = None) -> Schema:
     """A folder laid out as uorb/, dronecan/, devicetree/, mavlink/ (any subset); MAVLink includes
-    may also come from ``include_paths`` (README Limits). ``only``: the sub-folders to read (format
+    may also come from ``include_paths`` (docs/limits.md). ``only``: the sub-folders to read (format
     folders, ``mappings``, ``rules``), for a caller that needs just those; every one when None."""
     schema = Schema()
     errors: list[BattgenError] = []

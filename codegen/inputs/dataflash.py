@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..errors import cannot_read
 from .dataflash_arming import event_state
 from .dataflash_text import HEAD_BYTES, is_text_dataflash, open_text_reader
 from .dataflash_units import field_scales
@@ -163,7 +164,7 @@ def open_log(path: Path, display: str | None = None) -> DataflashLog:
         with path.open("rb") as f:
             head = f.read(HEAD_BYTES)
     except OSError as exc:
-        raise InputError(shown, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise InputError(shown, 0, cannot_read(exc)) from None
     if not head:
         raise InputError(shown, 0, "expected a DataFlash log, got an empty file")
     if head[:3] == HEAD + bytes([FMT_TYPE]):

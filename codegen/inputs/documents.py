@@ -24,6 +24,7 @@ from typing import IO
 
 import yaml
 
+from ..errors import cannot_read
 from ..text.files import read_text
 from .records import TOO_DEEP, InputError, Item, Record, Unreadable, join_path, nearest_line
 
@@ -41,7 +42,7 @@ def _text_stream(source: Source, name: str) -> Iterator[IO[str]]:
         try:
             stream = source.open(encoding="utf-8", newline="")
         except OSError as exc:
-            raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+            raise InputError(name, 0, cannot_read(exc)) from None
         with stream:
             yield stream
         return

@@ -22,7 +22,7 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import BattgenError, LocatedError
+from ..errors import BattgenError, LocatedError, cannot_read
 from ..text.brief import brief
 from ..text.escape import shown
 
@@ -126,7 +126,7 @@ def load(path: Path, display: str | None = None) -> list[ParamEntry]:
     try:
         data = path.read_bytes()
     except OSError as exc:
-        raise ParameterFileError(shown, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise ParameterFileError(shown, 0, cannot_read(exc)) from None
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
+from ..errors import cannot_read
 from .model import Frame, GeneratedMessage, MavlinkClass, MavlinkRuntime, mavlink_runtime
 from .records import InputError, Item, Notice, Record
 
@@ -273,7 +274,7 @@ def _open_map(path: Path, name: str) -> mmap.mmap | bytes:
                 return b""
             return mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
     except OSError as exc:
-        raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise InputError(name, 0, cannot_read(exc)) from None
 
 
 def read_frames(
@@ -286,7 +287,7 @@ def read_frames(
             try:
                 stream: IO[bytes] = path.open("rb")
             except OSError as exc:
-                raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+                raise InputError(name, 0, cannot_read(exc)) from None
         else:
             stream = path
         try:

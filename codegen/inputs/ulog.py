@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
 
+from ..errors import cannot_read
 from .held_file import held, whole
 from .model import FormatDiff, GeneratedMessage, MessageClass, UorbClass, ulog_runtime
 from .records import InputError, Item, Notice, Record, Unreadable
@@ -92,7 +93,7 @@ class UlogReader:
             self.log = self.ulog.read(data, index=False, warn=False)  # damage: listed in Log.warnings
         except OSError as exc:
             self._hold.close()
-            raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+            raise InputError(name, 0, cannot_read(exc)) from None
         except (ValueError, struct.error, IndexError) as exc:  # ULogError is a ValueError
             self._hold.close()
             raise InputError(name, 0, f"expected a ULog file: {exc}") from None
@@ -186,7 +187,7 @@ def _check_file(path: Path, name: str) -> None:
         if path.is_file() and path.stat().st_size == 0:
             raise InputError(name, 0, "empty file: expected a ULog file")
     except OSError as exc:
-        raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise InputError(name, 0, cannot_read(exc)) from None
 
 
 def ulog_items(source: Path | IO[bytes], name: str, model: MessageClass) -> Iterator[Item]:

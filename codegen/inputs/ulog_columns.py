@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol, cast
 
+from ..errors import cannot_read
 from . import ulog_layouts
 from .held_file import Buffer
 from .model import FormatDiff, UorbClass, ulog_runtime
@@ -105,7 +106,7 @@ class UlogColumns:
             self.log = cast(ColumnLog, ulog_runtime(model).read(source or path, index=False, warn=False))
             self.offsets = record_offsets(self.log)
         except OSError as exc:
-            raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+            raise InputError(name, 0, cannot_read(exc)) from None
         except (ValueError, struct.error, IndexError) as exc:  # ULogError is a ValueError
             raise InputError(name, 0, f"expected a ULog file: {exc}") from None
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import LocatedError, SchemaError
+from ..errors import LocatedError, SchemaError, cannot_read
 
 
 def display_path(path: Path, root: Path | None) -> str:
@@ -23,7 +23,7 @@ def read_text(path: Path, display: str, error: type[LocatedError] = SchemaError)
     try:
         data = path.read_bytes()
     except OSError as exc:
-        raise error(display, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise error(display, 0, cannot_read(exc)) from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -33,7 +33,7 @@ def check_schema_size(size: int, display: str) -> None:
     """Refuse a schema file larger than MAX_SCHEMA_BYTES (SchemaError at line 0)."""
     if size > MAX_SCHEMA_BYTES:
         raise SchemaError(
-            display, 0, f"expected a schema file of at most {MAX_SCHEMA_BYTES} bytes (README Limits), got {size}"
+            display, 0, f"expected a schema file of at most {MAX_SCHEMA_BYTES} bytes (docs/limits.md), got {size}"
         )
 
 
@@ -46,7 +46,7 @@ def check_schema_text(text: str, display: str) -> str:
         raise SchemaError(
             display,
             line,
-            f"expected a number of at most {MAX_NUMBER_DIGITS} digits (README Limits), "
+            f"expected a number of at most {MAX_NUMBER_DIGITS} digits (docs/limits.md), "
             f"got one of {len(match.group())} digits",
         )
     return text

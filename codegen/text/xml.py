@@ -96,7 +96,7 @@ class XmlReader:
         self._depth += 1
         self._text_length = 0
         if self._depth > MAX_XML_DEPTH:
-            raise self.error(f"expected elements nested at most {MAX_XML_DEPTH} deep (README Limits)")
+            raise self.error(f"expected elements nested at most {MAX_XML_DEPTH} deep (docs/limits.md)")
         self.start(tag, attrs)
 
     def _end(self, tag: str) -> None:
@@ -107,7 +107,7 @@ class XmlReader:
     def _text(self, data: str) -> None:
         self._text_length += len(data)
         if self._text_length > MAX_XML_TEXT:
-            raise self.error(f"expected at most {MAX_XML_TEXT} characters of text in one element (README Limits)")
+            raise self.error(f"expected at most {MAX_XML_TEXT} characters of text in one element (docs/limits.md)")
         self.text(data)
 
     def _doctype(self, *_: object) -> None:

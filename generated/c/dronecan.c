@@ -568,6 +568,9 @@ check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_state_of_health_pct(ui
 
 static battgen_rule
 check_battgen_dronecan_uavcan_equipment_power_BatteryInfo_state_of_charge_pct(uint8_t v) {
+  if (v == 127u) {
+    return BATTGEN_RULE_NONE;
+  }
   if (v > 127u) {
     return BATTGEN_RULE_TYPE_BOUNDS;
   }

@@ -117,74 +117,76 @@ def forward(
 
     # dronecan.yaml:46: soc_hybrid info.remaining_capacity_wh, info.full_charge_capacity_wh, info.state_of_charge_pct ->
     # state_of_charge
-    # Remaining over full energy when both are known and positive (finer than whole percent), else the percentage (127
-    # or above 100 = unknown), else unknown.
+    # Remaining over full energy when both are known and positive (finer than whole percent), else the percentage, else
+    # unknown. The percentage counts when 0 < SOC <= 100 (the validity test of the DroneCAN SOC investigation, seed 001:
+    # a node that cannot estimate sends 0 or STATE_OF_CHARGE_UNKNOWN = 127); PX4's bridge takes it unchecked (the px4
+    # policy).
     _e13 = s_info.remaining_capacity_wh
     _f13 = s_info.full_charge_capacity_wh
     if _e13 == _e13 and _f13 == _f13 and _e13 > 0 and _f13 > 0:
         t.state_of_charge = min(_e13 / _f13, 1.0)
     else:
         _p13 = s_info.state_of_charge_pct
-        if _p13 != 127 and _p13 <= 100:
+        if _p13 != 127 and _p13 != 0 and _p13 <= 100:
             t.state_of_charge = float(_p13) * 0.01
 
-    # dronecan.yaml:56: scale info.state_of_charge_pct_stdev -> state_of_charge_stdev
+    # dronecan.yaml:58: scale info.state_of_charge_pct_stdev -> state_of_charge_stdev
     _v15 = s_info.state_of_charge_pct_stdev
     t.state_of_charge_stdev = float(_v15) * 0.01
 
-    # dronecan.yaml:57: copy aux.battery_id -> battery_index
+    # dronecan.yaml:59: copy aux.battery_id -> battery_index
     # Same as BatteryInfo's; the BatteryInfo rule below wins.
     if s_aux is not None:
         _v16 = s_aux.battery_id
         t.battery_index = _v16
 
-    # dronecan.yaml:58: copy info.battery_id -> battery_index
+    # dronecan.yaml:60: copy info.battery_id -> battery_index
     # 0-based (0 = main battery).
     _v17 = s_info.battery_id
     t.battery_index = _v17
 
-    # dronecan.yaml:59: copy info.model_instance_id -> serial_number
+    # dronecan.yaml:61: copy info.model_instance_id -> serial_number
     _v18 = s_info.model_instance_id
     if _v18 != 0:
         t.serial_number = _v18
 
-    # dronecan.yaml:60: copy info.model_name -> model_name
+    # dronecan.yaml:62: copy info.model_name -> model_name
     _v19 = s_info.model_name
     t.model_name = _r.text_in(_v19)
 
-    # dronecan.yaml:61: const True -> connected
+    # dronecan.yaml:63: const True -> connected
     # Only an attached battery sends BatteryInfo.
     t.connected = True
 
-    # dronecan.yaml:62: cells aux.voltage_cell -> cell_voltages
+    # dronecan.yaml:64: cells aux.voltage_cell -> cell_voltages
     if s_aux is not None:
         _c21 = list(s_aux.voltage_cell)
         t.cell_voltages = tuple(float(_x21) for _x21 in _c21) or None
 
-    # dronecan.yaml:63: copy aux.cycle_count -> cycle_count
+    # dronecan.yaml:65: copy aux.cycle_count -> cycle_count
     if s_aux is not None:
         _v22 = s_aux.cycle_count
         t.cycle_count = _v22
 
-    # dronecan.yaml:64: copy aux.over_discharge_count -> over_discharge_count
+    # dronecan.yaml:66: copy aux.over_discharge_count -> over_discharge_count
     if s_aux is not None:
         _v23 = s_aux.over_discharge_count
         t.over_discharge_count = _v23
 
-    # dronecan.yaml:65: scale aux.max_current -> max_current
+    # dronecan.yaml:67: scale aux.max_current -> max_current
     if s_aux is not None:
         _v24 = s_aux.max_current
         if _v24 == _v24:
             t.max_current = float(_v24)
 
-    # dronecan.yaml:66: scale aux.nominal_voltage -> nominal_voltage
+    # dronecan.yaml:68: scale aux.nominal_voltage -> nominal_voltage
     # Zero disables it.
     if s_aux is not None:
         _v25 = s_aux.nominal_voltage
         if _v25 != 0 and _v25 == _v25:
             t.nominal_voltage = float(_v25)
 
-    # dronecan.yaml:67: copy aux.is_powering_off -> is_powering_off
+    # dronecan.yaml:69: copy aux.is_powering_off -> is_powering_off
     if s_aux is not None:
         _v26 = s_aux.is_powering_off
         t.is_powering_off = bool(_v26)
@@ -334,7 +336,7 @@ def backward(
                 "a known value written as the unknown marker",
             )
 
-    # dronecan.yaml:55: scale info.state_of_charge_pct -> state_of_charge
+    # dronecan.yaml:57: scale info.state_of_charge_pct -> state_of_charge
     _v14 = s.state_of_charge
     if _v14 is None or _v14 != _v14:
         t_info.state_of_charge_pct = 127
@@ -350,7 +352,7 @@ def backward(
                 "a known value written as the unknown marker",
             )
 
-    # dronecan.yaml:56: scale info.state_of_charge_pct_stdev -> state_of_charge_stdev
+    # dronecan.yaml:58: scale info.state_of_charge_pct_stdev -> state_of_charge_stdev
     _v15 = s.state_of_charge_stdev
     if _v15 is None or _v15 != _v15:
         if rep_u is not None:
@@ -360,7 +362,7 @@ def backward(
             _v15 * 100.0, 0, 127, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev"
         )
 
-    # dronecan.yaml:57: copy aux.battery_id -> battery_index
+    # dronecan.yaml:59: copy aux.battery_id -> battery_index
     # Same as BatteryInfo's; the BatteryInfo rule below wins.
     _v16 = s.battery_index
     if _v16 is None:
@@ -369,7 +371,7 @@ def backward(
     else:
         t_aux.battery_id = _r.to_int(_v16, 0, 255, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.battery_id")
 
-    # dronecan.yaml:58: copy info.battery_id -> battery_index
+    # dronecan.yaml:60: copy info.battery_id -> battery_index
     # 0-based (0 = main battery).
     _v17 = s.battery_index
     if _v17 is None:
@@ -378,7 +380,7 @@ def backward(
     else:
         t_info.battery_id = _r.to_int(_v17, 0, 255, rep, "dronecan.uavcan.equipment.power.BatteryInfo.battery_id")
 
-    # dronecan.yaml:59: copy info.model_instance_id -> serial_number
+    # dronecan.yaml:61: copy info.model_instance_id -> serial_number
     _v18 = s.serial_number
     if _v18 is None:
         t_info.model_instance_id = 0
@@ -394,7 +396,7 @@ def backward(
                 "a known value written as the unknown marker",
             )
 
-    # dronecan.yaml:60: copy info.model_name -> model_name
+    # dronecan.yaml:62: copy info.model_name -> model_name
     _v19 = s.model_name
     if _v19 is None:
         if rep_u is not None:
@@ -402,7 +404,7 @@ def backward(
     else:
         t_info.model_name = _r.bytes_out(_v19, 31, rep, "dronecan.uavcan.equipment.power.BatteryInfo.model_name")
 
-    # dronecan.yaml:62: cells aux.voltage_cell -> cell_voltages
+    # dronecan.yaml:64: cells aux.voltage_cell -> cell_voltages
     _c21 = s.cell_voltages
     if _c21 is None:
         if rep_u is not None:
@@ -417,7 +419,7 @@ def backward(
         _l21 = [_r.f16(_x21, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell") for _x21 in _c21]
         t_aux.voltage_cell = _l21
 
-    # dronecan.yaml:63: copy aux.cycle_count -> cycle_count
+    # dronecan.yaml:65: copy aux.cycle_count -> cycle_count
     _v22 = s.cycle_count
     if _v22 is None:
         if rep_u is not None:
@@ -427,7 +429,7 @@ def backward(
             _v22, 0, 65535, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count"
         )
 
-    # dronecan.yaml:64: copy aux.over_discharge_count -> over_discharge_count
+    # dronecan.yaml:66: copy aux.over_discharge_count -> over_discharge_count
     _v23 = s.over_discharge_count
     if _v23 is None:
         if rep_u is not None:
@@ -437,7 +439,7 @@ def backward(
             _v23, 0, 65535, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count"
         )
 
-    # dronecan.yaml:65: scale aux.max_current -> max_current
+    # dronecan.yaml:67: scale aux.max_current -> max_current
     _v24 = s.max_current
     if _v24 is None or _v24 != _v24:
         t_aux.max_current = _math.nan
@@ -446,7 +448,7 @@ def backward(
     else:
         t_aux.max_current = _r.f16(_v24, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current")
 
-    # dronecan.yaml:66: scale aux.nominal_voltage -> nominal_voltage
+    # dronecan.yaml:68: scale aux.nominal_voltage -> nominal_voltage
     # Zero disables it.
     _v25 = s.nominal_voltage
     if _v25 is None or _v25 != _v25:
@@ -461,7 +463,7 @@ def backward(
                 "a known value written as the unknown marker",
             )
 
-    # dronecan.yaml:67: copy aux.is_powering_off -> is_powering_off
+    # dronecan.yaml:69: copy aux.is_powering_off -> is_powering_off
     _v26 = s.is_powering_off
     if _v26 is None:
         if rep_u is not None:

@@ -65,6 +65,7 @@ def forward(
     t_info.full_charge_capacity_wh = 0.0
     t_info.hours_to_full_charge = 0.0
     t_info.state_of_health_pct = 0
+    t_info.state_of_charge_pct = 0
 
     # px4_uavcannode.yaml:13: px4_cell_list voltage_cell_v, cell_count -> aux.voltage_cell
     # voltage_cell = voltage_cell_v[0 .. cell_count)
@@ -179,6 +180,8 @@ def forward(
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh")
     if rep_u is not None and _r.is_marker(t_info.state_of_health_pct, 127):
         rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct")
+    if rep_u is not None and _r.is_marker(t_info.state_of_charge_pct, 127):
+        rep_u.unknown("dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct")
     if rep_u is not None:
         for _n in _UNWRITTEN_AUX_FIELDS:
             rep_u.unknown(_n)

@@ -181,7 +181,7 @@ def test_empty_and_foreign_captures(tmp_path: Path, capsys: pytest.CaptureFixtur
     _capture(folder / "bus.log", {10: 0})
     code, err = _export(capsys, tmp_path / "ds", empty, folder)
     assert code == 1
-    assert "empty.log:0: no CAN frames in this capture" in err
+    assert "empty.log: no CAN frames in this capture" in err and ":0:" not in err  # no fake line 0
     assert "syslog" not in err  # a folder's .log that is no candump capture is not an input
     assert "2 logs: 1 exported" in err
 

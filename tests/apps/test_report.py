@@ -108,7 +108,6 @@ def test_png_images(tmp_path: Path, flight: Path) -> None:
         (["absent.ulg"], "absent.ulg: cannot read file"),
         (["{flight}", "-o", "{tmp}"], "is a folder"),
         (["{flight}", "-o", "{tmp}/missing/r.html"], "no such folder"),
-        (["{empty}", "--message", "uorb.BatteryStatus"], "no battery records"),
     ],
 )
 def test_errors_are_one_line(
@@ -120,6 +119,16 @@ def test_errors_are_one_line(
     code = main(["report", *argv])
     err = capsys.readouterr().err
     assert code == 2 and expected in err and "Traceback" not in err
+
+
+def test_an_input_without_battery_records_is_exit_1(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Readable, but nothing to report: exit 1 as for every command (--allow-empty: 0, nothing written)."""
+    empty = tmp_path / "empty.jsonl"
+    empty.write_text("")
+    assert main(["report", str(empty), "--message", "uorb.BatteryStatus", "-o", str(tmp_path / "r.html")]) == 1
+    assert "expected battery records, found none (--allow-empty accepts that)" in capsys.readouterr().err
+    assert main(["report", str(empty), "--message", "uorb.BatteryStatus", "--allow-empty"]) == 0
+    assert not (tmp_path / "r.html").exists()
 
 
 def test_json_format_gives_the_page_figures_per_battery(

@@ -95,7 +95,9 @@ def test_devicetree_inputs_with_set(tmp_path: Path, capsys: pytest.CaptureFixtur
 
 def test_unknown_pair_is_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = run(capsys, "convert", "--from", "dronecan", "--to", "canbus", "/dev/null")
-    assert code == 2 and "no converter from 'dronecan' to 'canbus'" in err and "Traceback" not in err
+    assert code == 2 and "--to 'canbus': expected a format or message" in err and "Traceback" not in err
+    code, _, err = run(capsys, "convert", "--from", "dronecn", "--to", "uorb", "/dev/null")  # a short hint, one line
+    assert code == 2 and err.strip().endswith("did you mean 'dronecan'?") and len(err) < 200
 
 
 def test_px4_where_px4_has_no_code_path_is_exit_2(capsys: pytest.CaptureFixture[str]) -> None:

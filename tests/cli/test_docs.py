@@ -175,7 +175,11 @@ def test_dronecan_page_has_type_id_signature_and_bit_lengths(bundled: Schema) ->
     flags = tables(section(page, "## Enums"))["STATUS_FLAG"]
     assert ["STATUS_FLAG_RESERVED_B", "`uint11`", "1024"] in [r[:3] for r in flags]
     constants = table(section(page, "## Constants"))
-    assert [r[:3] for r in constants] == [["STATE_OF_HEALTH_UNKNOWN", "`uint7`", "127"]]
+    assert [r[:3] for r in constants] == [
+        ["STATE_OF_HEALTH_UNKNOWN", "`uint7`", "127"],
+        ["STATE_OF_CHARGE_UNKNOWN", "`uint7`", "127"],
+    ]
+    assert rows["state_of_charge_pct"][4].endswith("(Invalid: STATE_OF_CHARGE_UNKNOWN)")
     aux = render_message(bundled, bundled.message("dronecan.ardupilot.equipment.power.BatteryInfoAux"))
     assert "[`uavcan.Timestamp`](dronecan.uavcan.Timestamp.md)" in aux
 

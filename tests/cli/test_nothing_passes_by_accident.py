@@ -46,8 +46,10 @@ def test_failsafe_without_batt_parameters_or_samples(capsys: pytest.CaptureFixtu
     )
     code, out, err = run(capsys, "failsafe", "--allow-empty", "--params", str(other), str(stream))
     assert "no BATT*_ parameter" not in err and "vehicle" in err  # went on to the replay
-    code, out, err = run(capsys, "failsafe", "--params", str(batt), str(empty))  # no samples: failsafe's exit 2
-    assert code == 2 and "expected battery readings, found none" in err
+    code, out, err = run(capsys, "failsafe", "--params", str(batt), str(empty))  # readable, no samples: exit 1
+    assert code == 1 and "expected battery readings, found none" in err
+    code, out, err = run(capsys, "failsafe", "--allow-empty", "--params", str(batt), str(empty))
+    assert code == 0 and "no battery readings" in err
 
 
 def test_generate_and_docs_out_onto_a_file(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:

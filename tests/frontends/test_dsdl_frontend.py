@@ -343,8 +343,9 @@ def test_battery_info_units_enums_sentinels() -> None:
     assert m.field("status_flags").enums == (flags.name,)
     assert schema.enum(flags.name) == flags
     assert m.field("state_of_health_pct").invalid == Sentinel(127, "STATE_OF_HEALTH_UNKNOWN")
-    assert m.field("state_of_charge_pct").invalid is None
-    assert len(m.constants) == 12 and m.constants[-1].name == "STATE_OF_HEALTH_UNKNOWN"
+    assert m.field("state_of_charge_pct").invalid == Sentinel(127, "STATE_OF_CHARGE_UNKNOWN")  # dronecan/DSDL 2026
+    assert m.field("state_of_charge_pct_stdev").invalid is None
+    assert len(m.constants) == 13 and m.constants[-1].name == "STATE_OF_CHARGE_UNKNOWN"
     # the referenced-type-free file yields exactly one message
     assert [x.qualified_name for x in schema.messages] == [m.qualified_name]
 

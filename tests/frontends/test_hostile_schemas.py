@@ -79,7 +79,7 @@ def _write(rel: str, text: str) -> Callable[[Path], None]:
     return make
 
 
-DIGITS = rf"expected a number of at most {MAX_NUMBER_DIGITS} digits \(README Limits\), got one of 5000 digits"
+DIGITS = rf"expected a number of at most {MAX_NUMBER_DIGITS} digits \(docs/limits.md\), got one of 5000 digits"
 TIMESTAMP = "uint64 timestamp # [us] Time since system start"
 MAVLINK = "mavlink/battery.xml"
 PDEF = "params/battery_failsafe.pdef.xml"
@@ -271,15 +271,15 @@ def _copy_with(make: Callable[[Path], None], *formats: str) -> Callable[[Path], 
     return lambda tmp: _schema_copy(tmp, Case(make, formats, ""))
 
 
-CAPACITY_LIMIT = f"at most {MAX_ARRAY_CAPACITY} \\(README Limits\\)"
+CAPACITY_LIMIT = f"at most {MAX_ARRAY_CAPACITY} \\(docs/limits.md\\)"
 HANGS: dict[str, tuple[Callable[[Path], Path], str]] = {
     "mavlink-100000-nested-tags": (
         lambda tmp: _mavlink_with(tmp, "<a>" * 100_000 + "</a>" * 100_000),
-        rf"battery\.xml:\d+: expected elements nested at most {MAX_XML_DEPTH} deep \(README Limits\)",
+        rf"battery\.xml:\d+: expected elements nested at most {MAX_XML_DEPTH} deep \(docs/limits.md\)",
     ),
     "mavlink-huge-text": (
         lambda tmp: _mavlink_with(tmp, "x\n" * 2_000_000),
-        rf"battery\.xml:\d+: expected at most {MAX_XML_TEXT} characters of text in one element \(README Limits\)",
+        rf"battery\.xml:\d+: expected at most {MAX_XML_TEXT} characters of text in one element \(docs/limits.md\)",
     ),
     "pdef-640k-lines-of-text": (
         _copy_with(_edit(PDEF, '<field name="Type">', '<field name="Type">' + "y\n" * 640_000), "params"),

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from can_logs import write_capture
 from dataflash_writer import DataflashWriter
 
 from codegen.cli.main import main
@@ -67,14 +68,7 @@ def _messages(*, aux_after: bool = False, corrupt_transfer: int | None = None) -
 WRITERS = {".log": "CanutilsLogWriter", ".asc": "ASCWriter", ".blf": "BLFWriter", ".trc": "TRCWriter"}
 
 
-def _write(path: Path, messages: list[Any]) -> Path:
-    writer = can.Logger(str(path))
-    try:
-        for m in messages:
-            writer.on_message_received(m)
-    finally:
-        writer.stop()
-    return path
+_write = write_capture
 
 
 def _validate(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, dict[str, Any], str]:
@@ -245,3 +239,36 @@ def test_a_line_numbered_candump_names_the_line_and_the_form_expected(tmp_path: 
     with pytest.raises(InputError) as err:
         list(read_capture(path, "numbered.log"))
     assert err.value.line == 2 and "expected a candump -l line" in err.value.message
+
+
+def test_converted_capture_keeps_each_record_time(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """BatteryInfo has no timestamp field: a uORB record converted from a capture is stamped with the frame's time
+    since the capture's start (µs), not 0 on every record."""
+    path = _write(tmp_path / "bus.log", _messages())
+    assert main(["convert", "--from", "dronecan", "--to", "uorb", str(path)]) == 0
+    records = [json.loads(x) for x in capsys.readouterr().out.splitlines()]
+    stamps = [r["timestamp"] for r in records]
+    assert len(stamps) == CYCLES * len(NODES) and stamps == sorted(stamps) and len(set(stamps)) == len(stamps)
+    # the messages are 0.5 ms apart, the first frame at 0.5 ms after the first message: each BatteryInfo starts
+    # after its node's BatteryInfoAux (a transfer of several frames)
+    assert 0 < stamps[0] < 10_000 and stamps[-1] < CYCLES * 100_000
+
+
+def test_error_and_remote_frames_are_counted_and_reported(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    messages = _messages()
+    t = messages[-1].timestamp
+    messages.append(can.Message(timestamp=t + 0.001, is_error_frame=True, channel="can0"))
+    messages.append(can.Message(timestamp=t + 0.002, arbitration_id=0x1004E37F, is_extended_id=True,
+                                is_remote_frame=True, dlc=8, channel="can0"))  # fmt: skip
+    path = _write(tmp_path / "bus.asc", messages)
+    assert main(["can", "--format", "json", str(path)]) == 0  # warnings: no transfer was lost by them
+    report = json.loads(capsys.readouterr().out)["captures"][0]
+    assert report["problem_counts"] == {"can-error-frame": 1, "can-remote-frame": 1}
+    assert report["frames"] == len(messages)
+
+
+def test_can_command_takes_the_documented_input_format(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = _write(tmp_path / "bus.csv", _messages())
+    assert main(["can", "--input-format", "can", "--format", "json", str(path)]) == 0
+    report = json.loads(capsys.readouterr().out)["captures"][0]
+    assert sum(s["count"] for s in report["streams"]) == 2 * CYCLES * len(NODES)

@@ -178,8 +178,8 @@ def test_proposal_from_battery_properties() -> None:
 @pytest.mark.parametrize(
     ("props", "kw", "expected"),
     [
-        ({"ocv-capacity-table-0": TABLE}, {}, "cannot infer the cell count"),
-        ({"voltage-max-design-microvolt": [[8400000]]}, {}, "expected an ocv-capacity-table-N"),
+        ({"ocv-capacity-table-0": TABLE}, {}, "nothing to propose .*give --cells"),
+        ({"voltage-max-design-microvolt": [[8400000]]}, {}, "found neither: nothing to propose"),
         ({"device-chemistry": "plutonium", "ocv-capacity-table-0": TABLE}, {"cells": 1}, "expected a device-chemistry"),
         ({"ocv-capacity-table-0": [[4200000, 100], [3700000, 30]]}, {"cells": 1}, "outside the OCV table"),
         ({"ocv-capacity-table-0": TABLE}, {"cells": 1, "low_soc": 5.0}, "critical SOC < low SOC"),
@@ -188,3 +188,22 @@ def test_proposal_from_battery_properties() -> None:
 def test_proposal_errors(props: dict[str, object], kw: dict[str, object], expected: str) -> None:
     with pytest.raises(BattgenError, match=expected):
         propose(props, where="b.dts:3", lines={}, **kw)  # type: ignore[arg-type]
+
+
+def test_a_node_gets_what_it_supports_and_a_warning_for_the_rest() -> None:
+    """Seed 004: a board's node without an OCV table (rk3399-pinebook-pro: 9.8 Ah) still gets BATT_CAPACITY; the
+    binding's own example, whose tables cover 90..100 %, gets the capacity and a warning per voltage left out."""
+    board = {"charge-full-design-microamp-hours": [[9800000]], "voltage-max-design-microvolt": [[4350000]]}
+    r = propose(board, where="pinebook.dts:6", lines={})
+    assert [(p.name, p.value) for p in r.proposals] == [("BATT_CAPACITY", 9800)]
+    assert r.warnings == ("no ocv-capacity-table-N: BATT_LOW_VOLT and BATT_CRT_VOLT not proposed",)
+    example = {
+        "charge-full-design-microamp-hours": [[1430000]],
+        "voltage-max-design-microvolt": [[4200000]],
+        "ocv-capacity-table-0": [[4185000, 100], [4113000, 95], [4066000, 90]],
+    }
+    r = propose(example, where="example.dts:7", lines={"ocv-capacity-table-0": "example.dts:20"}, low_soc=95)
+    assert {p.name: p.value for p in r.proposals} == {"BATT_CAPACITY": 1430, "BATT_LOW_VOLT": 4.11}
+    (warning,) = r.warnings
+    assert warning.startswith("BATT_CRT_VOLT not proposed: 10 % is outside the OCV table (90..100 %)")
+    assert warning.endswith("(ocv-capacity-table-0, example.dts:20)")

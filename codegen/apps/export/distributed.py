@@ -12,10 +12,12 @@ import importlib
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from ...errors import BattgenError
 from .durable import writers_lock
 from .engine import ExportOptions, LogResult, export_one, start
 
 MAX_LOGS_PER_TASK = 8
+CONNECT_TIMEOUT_S = 5.0  # a scheduler on the network answers in well under a second; Dask's default waits 30 s
 TASKS_PER_WORKER = 4  # at the least, while the logs last
 
 
@@ -39,7 +41,14 @@ def export_dask(
         )
         client = dist.Client(cluster)
     else:
-        client = dist.Client(scheduler)
+        try:  # a scheduler that is not there is one line, after seconds, not Dask's 30 s and its traceback
+            client = dist.Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+        except (OSError, TimeoutError, ValueError) as exc:
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise BattgenError(
+                f"--scheduler {scheduler}: expected a Dask scheduler there, found none within "
+                f"{CONNECT_TIMEOUT_S:g} s ({reason})"
+            ) from None
     try:
         return run_on(client, unique, options, progress)
     finally:

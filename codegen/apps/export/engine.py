@@ -20,7 +20,7 @@ from typing import Any
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from ...errors import BattgenError, OutputError
+from ...errors import BattgenError, OutputError, cannot_read
 from ...inputs.held_file import held
 from ..battery.catalog import bundled_catalog
 from ..battery.sources import Batch, log_kind
@@ -91,7 +91,7 @@ def _export_held(file: Path, path: str, options: ExportOptions, source: mmap.mma
         try:
             log = content_id(file, source, options.content_id or content_scheme(options.out))
         except OSError as exc:
-            return LogResult(path, "failed", error=f"{path}: cannot read: {exc.strerror or exc}")
+            return LogResult(path, "failed", error=f"{path}: {cannot_read(exc)}")
         if is_exported(options.out, log) and not _replay_missing(options, log):
             return LogResult(path, "skipped", log, notes=("already in the dataset",))
         try:

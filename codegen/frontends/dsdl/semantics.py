@@ -13,9 +13,11 @@ Rules (generic, applied to every definition):
   or more; the group prefix is extended to the longest ``_``-delimited prefix all members share
   (``STATUS_FLAG_``). The group is the enum ``<message>.<STEM>``; fields whose upper-cased name
   starts with the stem (``status_flags`` for ``STATUS_FLAG``) draw on it. It is a BITMASK when all
-  values are distinct powers of two and such a field exists, else VALUE.
+  values are distinct powers of two and such a field exists, else VALUE. Constants that all end in
+  ``_UNKNOWN`` are the sentinels of as many fields (below), not an enum.
 * Sentinels: a constant ``<X>_UNKNOWN`` marks the "unknown" value of the only field whose
-  upper-cased name starts with ``X``; a bare ``UNKNOWN`` does so for a structure's only field.
+  upper-cased name starts with ``X`` (of several, the one whose name the others extend); a bare ``UNKNOWN``
+  does so for a structure's only field.
   Where DSDL has no constant for it (float fields that are NaN when unknown), a trailing comment
   may carry the uORB-style tag ``[@invalid NaN]`` (or a number); comments never change the wire
   format or the signature, so this stays compatible with every other DSDL tool.
@@ -103,8 +105,8 @@ def group_enums(
     enums: list[EnumDef] = []
     links: dict[str, list[str]] = {}
     for members in groups.values():
-        if len(members) < 2:
-            continue
+        if len(members) < 2 or all(m.name.endswith("_UNKNOWN") for m in members):
+            continue  # STATE_OF_HEALTH_UNKNOWN and STATE_OF_CHARGE_UNKNOWN: two fields' sentinels, not an enum
         stem = _common_stem([m.name.split("_") for m in members])
         name = f"{message_qn}.{stem}"
         linked = [f.name for f in fields if f.name and _stem_matches(f.name, stem)]
@@ -139,6 +141,10 @@ def sentinels(constants: tuple[ConstDef, ...], fields: tuple[FieldDef, ...]) -> 
         elif c.name.endswith("_UNKNOWN") and len(c.name) > len("_UNKNOWN"):
             prefix = c.name[: -len("_UNKNOWN")]
             matches = [f for f in named if _stem_matches(f.name, prefix)]
+            # STATE_OF_CHARGE_UNKNOWN matches state_of_charge_pct and state_of_charge_pct_stdev: the field the
+            # others extend (their name is its name and a suffix) is the quantity the constant speaks of
+            base = [f for f in matches if all(g is f or str(g.name).startswith(f"{f.name}_") for g in matches)]
+            matches = base if len(base) == 1 else matches
         else:
             continue
         if len(matches) == 1 and matches[0].name not in found:

@@ -82,7 +82,7 @@ def _array_bound(spec: str) -> tuple[int, bool]:
     if size <= 0:
         raise _LineError(f"expected an array capacity of at least 1, got [{spec}]")
     if size > MAX_ARRAY_CAPACITY:
-        raise _LineError(f"expected an array capacity of at most {MAX_ARRAY_CAPACITY} (README Limits), got [{spec}]")
+        raise _LineError(f"expected an array capacity of at most {MAX_ARRAY_CAPACITY} (docs/limits.md), got [{spec}]")
     return size, dynamic
 
 

@@ -140,7 +140,7 @@ def _type(token: str, file: str, line: int) -> tuple[str, int | None]:
         raise SchemaError(file, line, f"expected an array size of at least 1, got {count}")
     if count > MAX_ARRAY_CAPACITY:
         raise SchemaError(
-            file, line, f"expected an array size of at most {MAX_ARRAY_CAPACITY} (README Limits), got {count}"
+            file, line, f"expected an array size of at most {MAX_ARRAY_CAPACITY} (docs/limits.md), got {count}"
         )
     return base, count
 

@@ -12,6 +12,7 @@ import re
 from collections.abc import Iterator
 from pathlib import Path
 
+from ...errors import cannot_read
 from ..records import InputError
 from .reassembly import Frame
 
@@ -37,7 +38,7 @@ def read_screen(path: Path, name: str) -> Iterator[Frame]:
     try:
         f = path.open("r", encoding="utf-8", errors="replace")
     except OSError as exc:
-        raise InputError(name, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise InputError(name, 0, cannot_read(exc)) from None
     with f:
         for number, line in enumerate(iter(lambda: f.readline(MAX_LINE + 1), ""), 1):
             if len(line) > MAX_LINE:

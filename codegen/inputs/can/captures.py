@@ -8,8 +8,8 @@ DataFlash reader. A live bus is any python-can interface, named ``interface:chan
 without it the readers say so.
 
 Every source yields :class:`~.reassembly.Frame`\\ s in capture order, with ``t`` in seconds since the first frame;
-error and remote frames are skipped. A reader's own failure on a damaged file is an :class:`InputError` naming the
-file and the frame it stopped at, never a traceback.
+error and remote frames come as frames of that ``kind`` (the reassembler counts and reports them). A reader's own
+failure on a damaged file is an :class:`InputError` naming the file and the frame it stopped at, never a traceback.
 """
 
 from __future__ import annotations
@@ -87,17 +87,18 @@ def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: b
             return
         except _READER_ERRORS as exc:
             # a damaged capture: the third-party reader's own complaint, located at the frame (or line) it reached
-            said = _brief(exc)
+            # (the reader's exception text, "too many values to unpack", speaks of its code, not of the file)
             if one_per_line:
-                raise InputError(name, read + 1, f"expected {CANDUMP_LINE} ({said})") from exc
-            raise InputError(name, 0, f"cannot read {what} after frame {index}: {said}") from exc
+                raise InputError(name, read + 1, f"expected {CANDUMP_LINE}, found a line it cannot read") from exc
+            raise InputError(name, 0, f"cannot read {what} after frame {index}: {_brief(exc)}") from exc
         read += 1
-        if message.is_error_frame or message.is_remote_frame:
-            continue
+        kind = "error" if message.is_error_frame else "remote" if message.is_remote_frame else "data"
         data = bytes(message.data)
-        if not _fits(len(data), bool(message.is_fd)):
-            kind = "CAN FD frame (0..8, 12, 16, 20, 24, 32, 48 or 64)" if message.is_fd else "classic CAN frame (0..8)"
-            found = f"frame {index}: {len(data)} data bytes: expected a {kind}"
+        if kind == "data" and not _fits(len(data), bool(message.is_fd)):
+            kind_text = (
+                "CAN FD frame (0..8, 12, 16, 20, 24, 32, 48 or 64)" if message.is_fd else "classic CAN frame (0..8)"
+            )
+            found = f"frame {index}: {len(data)} data bytes: expected a {kind_text}"
             raise InputError(name, read if one_per_line else 0, found)
         stamp = float(message.timestamp or 0.0)
         if t0 is None:
@@ -106,10 +107,11 @@ def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: b
             index,
             stamp - t0,
             int(message.arbitration_id),
-            data,
+            b"" if kind != "data" else data,
             bool(message.is_extended_id),
             bool(message.is_fd),
             str(message.channel or ""),
+            kind,
         )
         index += 1
 
@@ -190,9 +192,10 @@ def read_dataflash_frames(path: Path, name: str) -> Iterator[Frame]:
         values = record.fields
         try:
             raw_id = int(values["Id"])
-            if raw_id & (_RTR_FLAG | _ERR_FLAG):
-                continue
-            if record.type == "CAFD":
+            kind = "error" if raw_id & _ERR_FLAG else "remote" if raw_id & _RTR_FLAG else "data"
+            if kind != "data":
+                data = b""
+            elif record.type == "CAFD":
                 words = b"".join((int(values[f"D{i}"]) & (2**64 - 1)).to_bytes(8, "little") for i in range(8))
                 data = words[: _FD_LENGTHS[int(values["DLC"]) & 0xF]]
             else:
@@ -211,6 +214,7 @@ def read_dataflash_frames(path: Path, name: str) -> Iterator[Frame]:
             bool(raw_id & _EXTENDED_FLAG),
             record.type == "CAFD",
             f"bus{bus}",
+            kind,
         )
         index += 1
 

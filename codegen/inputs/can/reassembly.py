@@ -30,6 +30,7 @@ class Frame:
     extended: bool = True
     fd: bool = False
     channel: str = ""
+    kind: str = "data"  # "error" or "remote": not DroneCAN, but a bus that carries them is worth a word
 
 
 @dataclass(frozen=True, slots=True)
@@ -122,6 +123,9 @@ class Reassembler:
         out: list[Event] = []
         if not self.frames & 63 and self._pending:  # now and then, transfers whose sender went quiet
             out.extend(self._expire(frame.t, frame.index))
+        if frame.kind != "data":
+            out.append(self._signal(frame))
+            return out
         data = frame.data
         if not frame.extended or not data:
             out.extend(self._not_dronecan(frame))
@@ -182,6 +186,12 @@ class Reassembler:
                 out.append(self._lost(self._pending.pop(oldest), "dropped: too many transfers in progress", frame))
             self._pending[key] = pending
         return pending
+
+    def _signal(self, frame: Frame) -> Diagnostic:
+        # an error frame is the controller reporting bus damage (each frame counted, as a warning: no transfer
+        # is lost by it alone); a remote frame asks for data, which DroneCAN never does
+        what = "a bus error frame" if frame.kind == "error" else "a remote (RTR) frame: not DroneCAN, skipped"
+        return Diagnostic(f"can-{frame.kind}-frame", what, frame.t, frame.index, severity="warning")
 
     def _not_dronecan(self, frame: Frame) -> list[Diagnostic]:
         if frame.data:

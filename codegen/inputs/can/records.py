@@ -87,9 +87,10 @@ def decode_transfer(cls: DronecanClass, transfer: Transfer) -> GeneratedMessage:
     raise error
 
 
-def frames_of(path: Path, name: str) -> Iterator[Frame]:
-    """The frames of a capture file or of a DataFlash log's CANF/CAFD records."""
-    if detect(path) == "dataflash":
+def frames_of(path: Path, name: str, kind: str | None = None) -> Iterator[Frame]:
+    """The frames of a capture file or of a DataFlash log's CANF/CAFD records; ``kind`` (``can`` or
+    ``dataflash``, as ``--input-format`` gives it) overrides what the file's name and content say."""
+    if (kind or detect(path)) == "dataflash":
         return read_dataflash_frames(path, name)
     return read_capture(path, name)
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ...errors import cannot_read
 from ...text.files import display_path
 from .dtb import Blob, parse_dtb
 from .model import DevicetreeError, DtNode
@@ -24,7 +25,7 @@ def read_dtb_blob(path: Path, *, root: Path | None = None) -> Blob:
     try:
         data = path.read_bytes()
     except OSError as exc:
-        raise DevicetreeError(display, 0, f"cannot read file: {exc.strerror or exc}") from None
+        raise DevicetreeError(display, 0, cannot_read(exc)) from None
     return parse_dtb(data, display)
 
 

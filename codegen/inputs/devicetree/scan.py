@@ -204,8 +204,8 @@ class Scanner:
         if src.pos >= len(src.text):
             return "end of file"
         word = _WORD.match(src.text, src.pos)
-        if not word:
-            return "end of file"
+        if not word:  # a character no token starts with (a no-break space pasted from a web page, say)
+            return f"the character {src.text[src.pos]!r}"
         text = word.group(0)  # quoted briefly: a "word" of hostile input can be megabytes long
         return repr(text) if len(text) <= 60 else repr(text[:57]) + "..."
 

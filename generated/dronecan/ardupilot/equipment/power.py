@@ -339,8 +339,8 @@ def _timestamp_class() -> type[_dronecan_uavcan.Timestamp]:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryCells:
-    """Battery cell voltages
-    Rate: set by parameter on smart battery (default off)
+    """A smart battery's cell voltages, in blocks of up to 24 cells (sent at a rate the battery's settings
+    choose; off by default). (battgen's text of ArduPilot's type 20012; the layout and names are upstream's.)
 
     Schema: dronecan.ardupilot.equipment.power.BatteryCells (dronecan,
     ardupilot/equipment/power/20012.BatteryCells.uavcan:1).
@@ -356,8 +356,7 @@ class BatteryCells:
         metadata=_m.meta(
             name="index",
             type="uint16",
-            doc="Index of the first cell in the array, index 0 is cells at array indices 0 - 23, "
-            "index 24 is cells at array indices 24 - 47, etc.",
+            doc="The first cell of this block: 0 for cells 0-23, 24 for cells 24-47, and so on",
         ),
     )
 
@@ -495,7 +494,9 @@ class BatteryCells:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryContinuous:
-    """Battery data to be sent continuously
+    """A smart battery's fast-changing state, sent at a steady rate.
+    (battgen's text of ArduPilot's type 20010; the layout and names are upstream's, checked against
+    pydronecan by conformance/test_dsdl_pydronecan.py.)
 
     Schema: dronecan.ardupilot.equipment.power.BatteryContinuous (dronecan,
     ardupilot/equipment/power/20010.BatteryContinuous.uavcan:1).
@@ -531,7 +532,7 @@ class BatteryContinuous:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="Pack mounted thermistor (preferably installed between cells), NAN: field not provided",
+            doc="Thermistor among the cells; NaN when the pack has none",
         ),
     )
     temperature_pcb: float = _dataclasses.field(
@@ -543,7 +544,7 @@ class BatteryContinuous:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="Battery PCB temperature (likely output FET(s) or current sense resistor), NAN: field not provided",
+            doc="Electronics temperature (switches, shunt); NaN when not measured",
         ),
     )
     temperature_other: float = _dataclasses.field(
@@ -555,7 +556,7 @@ class BatteryContinuous:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="Application dependent, NAN: field not provided",
+            doc="A third sensor, its place chosen by the vendor; NaN when absent",
         ),
     )
     current: float = _dataclasses.field(
@@ -565,13 +566,11 @@ class BatteryContinuous:
             type="float32",
             unit="A",
             quantity="current",
-            doc="Positive: defined as a discharge current. Negative: defined as a charging "
-            "current, NAN: field not provided",
+            doc="Discharge positive, charge negative; NaN when not measured",
         ),
     )
     voltage: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(name="voltage", type="float32", unit="V", quantity="voltage", doc="Battery voltage"),
+        default=0.0, metadata=_m.meta(name="voltage", type="float32", unit="V", quantity="voltage", doc="Pack voltage")
     )
     state_of_charge: float = _dataclasses.field(
         default=0.0,
@@ -582,16 +581,12 @@ class BatteryContinuous:
             quantity="ratio",
             scale=0.01,
             offset=0.0,
-            doc="The estimated state of charge, in percent remaining (0 - 100).",
+            doc="Charge left, 0 to 100",
         ),
     )
     slot_id: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(
-            name="slot_id",
-            type="uint8",
-            doc=": The physical location of the battery on the aircraft. 0: field not provided",
-        ),
+        metadata=_m.meta(name="slot_id", type="uint8", doc=": Where on the vehicle the pack sits; 0 when not known"),
     )
     capacity_consumed: float = _dataclasses.field(
         default=0.0,
@@ -602,9 +597,8 @@ class BatteryContinuous:
             quantity="charge",
             scale=3600.0,
             offset=0.0,
-            doc="This is either the consumption since power-on or since the battery was full, "
-            "depending on the value of STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL, NAN: field not "
-            "provided",
+            doc="Charge used since power-on, or since full when "
+            "STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL is set; NaN when not known",
         ),
     )
     status_flags: int = _dataclasses.field(
@@ -613,7 +607,7 @@ class BatteryContinuous:
             name="status_flags",
             type="uint32",
             enums=("dronecan.ardupilot.equipment.power.BatteryContinuous.STATUS_FLAG",),
-            doc=": Fault, health, readiness, and other status indications",
+            doc=": The STATUS_FLAG_* bits below",
         ),
     )
 
@@ -680,15 +674,15 @@ class BatteryContinuous:
         return obj
 
     # Wire layout (20010.BatteryContinuous.uavcan), bits from the start of the payload:
-    #   bits 0-15      float16 temperature_cells  (line 5)
-    #   bits 16-31     float16 temperature_pcb  (line 6)
-    #   bits 32-47     float16 temperature_other  (line 7)
-    #   bits 48-79     float32 current  (line 8)
-    #   bits 80-111    float32 voltage  (line 9)
-    #   bits 112-127   float16 state_of_charge  (line 10)
-    #   bits 128-135   uint8 slot_id  (line 11)
-    #   bits 136-167   float32 capacity_consumed  (line 12)
-    #   bits 168-199   uint32 status_flags  (line 13)
+    #   bits 0-15      float16 temperature_cells  (line 7)
+    #   bits 16-31     float16 temperature_pcb  (line 8)
+    #   bits 32-47     float16 temperature_other  (line 9)
+    #   bits 48-79     float32 current  (line 10)
+    #   bits 80-111    float32 voltage  (line 11)
+    #   bits 112-127   float16 state_of_charge  (line 12)
+    #   bits 128-135   uint8 slot_id  (line 13)
+    #   bits 136-167   float32 capacity_consumed  (line 14)
+    #   bits 168-199   uint32 status_flags  (line 15)
     DATA_TYPE_ID: _ClassVar[int | None] = 20010
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x756B561340D5E4AE
 
@@ -844,31 +838,31 @@ class BatteryContinuous:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
-            # temperature_cells (20010.BatteryContinuous.uavcan:5): fits float16
+            # temperature_cells (20010.BatteryContinuous.uavcan:7): fits float16
             if not (-65504.0 <= self.temperature_cells <= 65504.0):
                 _v.diag(out, "temperature_cells", self.temperature_cells, _BATTERY_CONTINUOUS_TEMPERATURE_CELLS_SPEC)
-            # temperature_pcb (20010.BatteryContinuous.uavcan:6): fits float16
+            # temperature_pcb (20010.BatteryContinuous.uavcan:8): fits float16
             if not (-65504.0 <= self.temperature_pcb <= 65504.0):
                 _v.diag(out, "temperature_pcb", self.temperature_pcb, _BATTERY_CONTINUOUS_TEMPERATURE_PCB_SPEC)
-            # temperature_other (20010.BatteryContinuous.uavcan:7): fits float16
+            # temperature_other (20010.BatteryContinuous.uavcan:9): fits float16
             if not (-65504.0 <= self.temperature_other <= 65504.0):
                 _v.diag(out, "temperature_other", self.temperature_other, _BATTERY_CONTINUOUS_TEMPERATURE_OTHER_SPEC)
-            # current (20010.BatteryContinuous.uavcan:8): fits float32
+            # current (20010.BatteryContinuous.uavcan:10): fits float32
             if not (-3.4028234663852886e38 <= self.current <= 3.4028234663852886e38):
                 _v.diag(out, "current", self.current, _BATTERY_CONTINUOUS_CURRENT_SPEC)
-            # voltage (20010.BatteryContinuous.uavcan:9): fits float32
+            # voltage (20010.BatteryContinuous.uavcan:11): fits float32
             if not (-3.4028234663852886e38 <= self.voltage <= 3.4028234663852886e38):
                 _v.diag(out, "voltage", self.voltage, _BATTERY_CONTINUOUS_VOLTAGE_SPEC)
-            # state_of_charge (20010.BatteryContinuous.uavcan:10): fits float16
+            # state_of_charge (20010.BatteryContinuous.uavcan:12): fits float16
             if not (-65504.0 <= self.state_of_charge <= 65504.0):
                 _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_CONTINUOUS_STATE_OF_CHARGE_SPEC)
-            # slot_id (20010.BatteryContinuous.uavcan:11): fits uint8
+            # slot_id (20010.BatteryContinuous.uavcan:13): fits uint8
             if self.slot_id & -256:
                 _v.diag(out, "slot_id", self.slot_id, _BATTERY_CONTINUOUS_SLOT_ID_SPEC)
-            # capacity_consumed (20010.BatteryContinuous.uavcan:12): fits float32
+            # capacity_consumed (20010.BatteryContinuous.uavcan:14): fits float32
             if not (-3.4028234663852886e38 <= self.capacity_consumed <= 3.4028234663852886e38):
                 _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_CONTINUOUS_CAPACITY_CONSUMED_SPEC)
-            # status_flags (20010.BatteryContinuous.uavcan:13): fits uint32; bits of STATUS_FLAG only
+            # status_flags (20010.BatteryContinuous.uavcan:15): fits uint32; bits of STATUS_FLAG only
             if self.status_flags & -524288:
                 _v.diag(out, "status_flags", self.status_flags, _BATTERY_CONTINUOUS_STATUS_FLAGS_SPEC)
         except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
@@ -1268,8 +1262,8 @@ class BatteryInfoAux:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryPeriodic:
-    """Battery data to be sent statically upon request or periodically at a low rate
-     Recommend that this message is sent at a maximum of 1Hz and nominally 0.2 Hz (IE: once every 5 seconds.)
+    """A smart battery's slow-changing facts, sent on request or rarely (about every 5 s, at most 1 Hz).
+    (battgen's text of ArduPilot's type 20011; the layout and names are upstream's.)
 
     Schema: dronecan.ardupilot.equipment.power.BatteryPeriodic (dronecan,
     ardupilot/equipment/power/20011.BatteryPeriodic.uavcan:1).
@@ -1278,22 +1272,13 @@ class BatteryPeriodic:
     QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryPeriodic"
 
     name: bytes = _dataclasses.field(
-        default=b"",
-        metadata=_m.meta(name="name", type="uint8[<=50]", doc=": Formatted as manufacturer_product, 0 terminated"),
+        default=b"", metadata=_m.meta(name="name", type="uint8[<=50]", doc=": Maker and product, as maker_product text")
     )
     serial_number: bytes = _dataclasses.field(
-        default=b"",
-        metadata=_m.meta(
-            name="serial_number", type="uint8[<=32]", doc=": Serial number in ASCII characters, 0 terminated"
-        ),
+        default=b"", metadata=_m.meta(name="serial_number", type="uint8[<=32]", doc=": Serial number, as text")
     )
     manufacture_date: bytes = _dataclasses.field(
-        default=b"",
-        metadata=_m.meta(
-            name="manufacture_date",
-            type="uint8[<=9]",
-            doc=": Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated",
-        ),
+        default=b"", metadata=_m.meta(name="manufacture_date", type="uint8[<=9]", doc=": Date made, DDMMYYYY as text")
     )
     design_capacity: float = _dataclasses.field(
         default=0.0,
@@ -1304,14 +1289,11 @@ class BatteryPeriodic:
             quantity="charge",
             scale=3600.0,
             offset=0.0,
-            doc="Fully charged design capacity. 0: field not provided.",
+            doc="Design capacity when full; 0 when not given",
         ),
     )
     cells_in_series: int = _dataclasses.field(
-        default=0,
-        metadata=_m.meta(
-            name="cells_in_series", type="uint8", doc=": Number of battery cells in series. 0: field not provided."
-        ),
+        default=0, metadata=_m.meta(name="cells_in_series", type="uint8", doc=": Cells in series; 0 when not given")
     )
     nominal_voltage: float = _dataclasses.field(
         default=0.0,
@@ -1320,7 +1302,7 @@ class BatteryPeriodic:
             type="float16",
             unit="V",
             quantity="voltage",
-            doc="Battery nominal voltage. Used for conversion between Wh and Ah. 0: field not provided.",
+            doc="Nominal pack voltage (converts Wh to Ah); 0 when not given",
         ),
     )
     discharge_minimum_voltage: float = _dataclasses.field(
@@ -1330,7 +1312,7 @@ class BatteryPeriodic:
             type="float16",
             unit="V",
             quantity="voltage",
-            doc="Minimum per-cell voltage when discharging. 0: field not provided.",
+            doc="Lowest cell voltage while discharging; 0 when not given",
         ),
     )
     charging_minimum_voltage: float = _dataclasses.field(
@@ -1340,7 +1322,7 @@ class BatteryPeriodic:
             type="float16",
             unit="V",
             quantity="voltage",
-            doc="Minimum per-cell voltage when charging. 0: field not provided.",
+            doc="Lowest cell voltage while charging; 0 when not given",
         ),
     )
     charging_maximum_voltage: float = _dataclasses.field(
@@ -1350,7 +1332,7 @@ class BatteryPeriodic:
             type="float16",
             unit="V",
             quantity="voltage",
-            doc="Maximum per-cell voltage when charged. 0: field not provided.",
+            doc="Highest cell voltage when charged; 0 when not given",
         ),
     )
     charging_maximum_current: float = _dataclasses.field(
@@ -1360,7 +1342,7 @@ class BatteryPeriodic:
             type="float32",
             unit="A",
             quantity="current",
-            doc="Maximum pack continuous charge current. 0: field not provided.",
+            doc="Highest continuous charge current; 0 when not given",
         ),
     )
     discharge_maximum_current: float = _dataclasses.field(
@@ -1370,7 +1352,7 @@ class BatteryPeriodic:
             type="float32",
             unit="A",
             quantity="current",
-            doc="Maximum pack continuous discharge current. 0: field not provided.",
+            doc="Highest continuous discharge current; 0 when not given",
         ),
     )
     discharge_maximum_burst_current: float = _dataclasses.field(
@@ -1380,7 +1362,7 @@ class BatteryPeriodic:
             type="float32",
             unit="A",
             quantity="current",
-            doc="Maximum pack discharge burst current for 30 seconds. 0: field not provided",
+            doc="Highest discharge current for 30 s; 0 when not given",
         ),
     )
     full_charge_capacity: float = _dataclasses.field(
@@ -1392,17 +1374,13 @@ class BatteryPeriodic:
             quantity="charge",
             scale=3600.0,
             offset=0.0,
-            doc="Predicted battery capacity when fully charged (accounting for battery "
-            "degradation), NAN: field not provided",
+            doc="Capacity when full, the pack's wear counted; NaN when not given",
         ),
     )
     cycle_count: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="cycle_count",
-            type="uint16",
-            doc=": Lifetime count of the number of charge/discharge cycles "
-            "(https://en.wikipedia.org/wiki/Charge_cycle). UINT16_MAX: field not provided.",
+            name="cycle_count", type="uint16", doc=": Charge and discharge cycles so far; 65535 when not given"
         ),
     )
     state_of_health: int = _dataclasses.field(
@@ -1414,7 +1392,7 @@ class BatteryPeriodic:
             quantity="ratio",
             scale=0.01,
             offset=0.0,
-            doc="State of Health (SOH) estimate, in percent (0 - 100). UINT8_MAX: field not provided.",
+            doc="Health, 0 to 100; 255 when not given",
         ),
     )
 
@@ -1507,21 +1485,21 @@ class BatteryPeriodic:
         return obj
 
     # Wire layout (20011.BatteryPeriodic.uavcan), bits from the start of the payload:
-    #   bits 0-        uint8[<=50] name: a 6-bit length, then <=50 x 8 bits  (line 5)
-    #   bits name+0-   uint8[<=32] serial_number: a 6-bit length, then <=32 x 8 bits  (line 6)
-    #   bits serial_number+0- uint8[<=9] manufacture_date: a 4-bit length, then <=9 x 8 bits  (line 7)
-    #   bits manufacture_date+0 float32 design_capacity  (line 8)
-    #   bits manufacture_date+32 uint8 cells_in_series  (line 9)
-    #   bits manufacture_date+40 float16 nominal_voltage  (line 10)
-    #   bits manufacture_date+56 float16 discharge_minimum_voltage  (line 11)
-    #   bits manufacture_date+72 float16 charging_minimum_voltage  (line 12)
-    #   bits manufacture_date+88 float16 charging_maximum_voltage  (line 13)
-    #   bits manufacture_date+104 float32 charging_maximum_current  (line 14)
-    #   bits manufacture_date+136 float32 discharge_maximum_current  (line 15)
-    #   bits manufacture_date+168 float32 discharge_maximum_burst_current  (line 16)
-    #   bits manufacture_date+200 float32 full_charge_capacity  (line 17)
-    #   bits manufacture_date+232 uint16 cycle_count  (line 18)
-    #   bits manufacture_date+248 uint8 state_of_health  (line 19)
+    #   bits 0-        uint8[<=50] name: a 6-bit length, then <=50 x 8 bits  (line 6)
+    #   bits name+0-   uint8[<=32] serial_number: a 6-bit length, then <=32 x 8 bits  (line 7)
+    #   bits serial_number+0- uint8[<=9] manufacture_date: a 4-bit length, then <=9 x 8 bits  (line 8)
+    #   bits manufacture_date+0 float32 design_capacity  (line 9)
+    #   bits manufacture_date+32 uint8 cells_in_series  (line 10)
+    #   bits manufacture_date+40 float16 nominal_voltage  (line 11)
+    #   bits manufacture_date+56 float16 discharge_minimum_voltage  (line 12)
+    #   bits manufacture_date+72 float16 charging_minimum_voltage  (line 13)
+    #   bits manufacture_date+88 float16 charging_maximum_voltage  (line 14)
+    #   bits manufacture_date+104 float32 charging_maximum_current  (line 15)
+    #   bits manufacture_date+136 float32 discharge_maximum_current  (line 16)
+    #   bits manufacture_date+168 float32 discharge_maximum_burst_current  (line 17)
+    #   bits manufacture_date+200 float32 full_charge_capacity  (line 18)
+    #   bits manufacture_date+232 uint16 cycle_count  (line 19)
+    #   bits manufacture_date+248 uint8 state_of_health  (line 20)
     DATA_TYPE_ID: _ClassVar[int | None] = 20011
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x0F012494E97358D2
 
@@ -1831,28 +1809,28 @@ class BatteryPeriodic:
         out: list[_v.Violation] = []
         x: _Any
         try:
-            # name (20011.BatteryPeriodic.uavcan:5): fits uint8[<=50]
+            # name (20011.BatteryPeriodic.uavcan:6): fits uint8[<=50]
             x = self.name
             if x.__class__ is not bytes or len(x) > 50:
                 _v.diag(out, "name", self.name, _BATTERY_PERIODIC_NAME_SPEC)
-            # serial_number (20011.BatteryPeriodic.uavcan:6): fits uint8[<=32]
+            # serial_number (20011.BatteryPeriodic.uavcan:7): fits uint8[<=32]
             x = self.serial_number
             if x.__class__ is not bytes or len(x) > 32:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_PERIODIC_SERIAL_NUMBER_SPEC)
-            # manufacture_date (20011.BatteryPeriodic.uavcan:7): fits uint8[<=9]
+            # manufacture_date (20011.BatteryPeriodic.uavcan:8): fits uint8[<=9]
             x = self.manufacture_date
             if x.__class__ is not bytes or len(x) > 9:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_PERIODIC_MANUFACTURE_DATE_SPEC)
-            # design_capacity (20011.BatteryPeriodic.uavcan:8): fits float32
+            # design_capacity (20011.BatteryPeriodic.uavcan:9): fits float32
             if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_PERIODIC_DESIGN_CAPACITY_SPEC)
-            # cells_in_series (20011.BatteryPeriodic.uavcan:9): fits uint8
+            # cells_in_series (20011.BatteryPeriodic.uavcan:10): fits uint8
             if self.cells_in_series & -256:
                 _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_PERIODIC_CELLS_IN_SERIES_SPEC)
-            # nominal_voltage (20011.BatteryPeriodic.uavcan:10): fits float16
+            # nominal_voltage (20011.BatteryPeriodic.uavcan:11): fits float16
             if not (-65504.0 <= self.nominal_voltage <= 65504.0):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_PERIODIC_NOMINAL_VOLTAGE_SPEC)
-            # discharge_minimum_voltage (20011.BatteryPeriodic.uavcan:11): fits float16
+            # discharge_minimum_voltage (20011.BatteryPeriodic.uavcan:12): fits float16
             if not (-65504.0 <= self.discharge_minimum_voltage <= 65504.0):
                 _v.diag(
                     out,
@@ -1860,7 +1838,7 @@ class BatteryPeriodic:
                     self.discharge_minimum_voltage,
                     _BATTERY_PERIODIC_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
                 )
-            # charging_minimum_voltage (20011.BatteryPeriodic.uavcan:12): fits float16
+            # charging_minimum_voltage (20011.BatteryPeriodic.uavcan:13): fits float16
             if not (-65504.0 <= self.charging_minimum_voltage <= 65504.0):
                 _v.diag(
                     out,
@@ -1868,7 +1846,7 @@ class BatteryPeriodic:
                     self.charging_minimum_voltage,
                     _BATTERY_PERIODIC_CHARGING_MINIMUM_VOLTAGE_SPEC,
                 )
-            # charging_maximum_voltage (20011.BatteryPeriodic.uavcan:13): fits float16
+            # charging_maximum_voltage (20011.BatteryPeriodic.uavcan:14): fits float16
             if not (-65504.0 <= self.charging_maximum_voltage <= 65504.0):
                 _v.diag(
                     out,
@@ -1876,7 +1854,7 @@ class BatteryPeriodic:
                     self.charging_maximum_voltage,
                     _BATTERY_PERIODIC_CHARGING_MAXIMUM_VOLTAGE_SPEC,
                 )
-            # charging_maximum_current (20011.BatteryPeriodic.uavcan:14): fits float32
+            # charging_maximum_current (20011.BatteryPeriodic.uavcan:15): fits float32
             if not (-3.4028234663852886e38 <= self.charging_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1884,7 +1862,7 @@ class BatteryPeriodic:
                     self.charging_maximum_current,
                     _BATTERY_PERIODIC_CHARGING_MAXIMUM_CURRENT_SPEC,
                 )
-            # discharge_maximum_current (20011.BatteryPeriodic.uavcan:15): fits float32
+            # discharge_maximum_current (20011.BatteryPeriodic.uavcan:16): fits float32
             if not (-3.4028234663852886e38 <= self.discharge_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1892,7 +1870,7 @@ class BatteryPeriodic:
                     self.discharge_maximum_current,
                     _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_CURRENT_SPEC,
                 )
-            # discharge_maximum_burst_current (20011.BatteryPeriodic.uavcan:16): fits float32
+            # discharge_maximum_burst_current (20011.BatteryPeriodic.uavcan:17): fits float32
             if not (-3.4028234663852886e38 <= self.discharge_maximum_burst_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1900,15 +1878,15 @@ class BatteryPeriodic:
                     self.discharge_maximum_burst_current,
                     _BATTERY_PERIODIC_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
                 )
-            # full_charge_capacity (20011.BatteryPeriodic.uavcan:17): fits float32
+            # full_charge_capacity (20011.BatteryPeriodic.uavcan:18): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity <= 3.4028234663852886e38):
                 _v.diag(
                     out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_PERIODIC_FULL_CHARGE_CAPACITY_SPEC
                 )
-            # cycle_count (20011.BatteryPeriodic.uavcan:18): fits uint16
+            # cycle_count (20011.BatteryPeriodic.uavcan:19): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_PERIODIC_CYCLE_COUNT_SPEC)
-            # state_of_health (20011.BatteryPeriodic.uavcan:19): fits uint8
+            # state_of_health (20011.BatteryPeriodic.uavcan:20): fits uint8
             if self.state_of_health & -256:
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_PERIODIC_STATE_OF_HEALTH_SPEC)
         except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
@@ -1947,8 +1925,8 @@ class BatteryPeriodic:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryTag:
-    """Battery tag information. This is broadcast by a battery tag device
-    permanently attached to a battery to record the lifecycle of the battery
+    """What a tag fixed to a battery records over the battery's life, broadcast by the tag.
+    (battgen's text of ArduPilot's type 20500; the layout and names are upstream's.)
 
     Schema: dronecan.ardupilot.equipment.power.BatteryTag (dronecan,
     ardupilot/equipment/power/20500.BatteryTag.uavcan:1).
@@ -1957,41 +1935,29 @@ class BatteryTag:
     QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryTag"
 
     serial_number: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="serial_number", type="uint32", doc="vendor supplied serial number")
+        default=0, metadata=_m.meta(name="serial_number", type="uint32", doc="the maker's serial number")
     )
     num_cycles: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="num_cycles",
-            type="uint32",
-            doc="number of cycles this battery has been through. Criteria for\ndefining a cycle is vendor specific",
+            name="num_cycles", type="uint32", doc="charge cycles so far, counted as the maker defines a cycle"
         ),
     )
     armed_hours: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(
-            name="armed_hours",
-            type="float32",
-            doc="number of hours that this battery has been running when\nvehicle is in an armed state",
-        ),
+        metadata=_m.meta(name="armed_hours", type="float32", doc="hours the battery has powered an armed vehicle"),
     )
     battery_capacity_mAh: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="battery_capacity_mAh", type="uint32", doc="battery capacity in milliAmpHours")
+        default=0, metadata=_m.meta(name="battery_capacity_mAh", type="uint32", doc="capacity in mAh")
     )
     first_use_mins: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(
-            name="first_use_mins",
-            type="uint32",
-            doc="time of first use of battery with vehicle armed, in minutes since 1/1/1970",
-        ),
+        metadata=_m.meta(name="first_use_mins", type="uint32", doc="first armed use, minutes since 1970-01-01"),
     )
     last_arm_time_mins: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="last_arm_time_mins",
-            type="uint32",
-            doc="time of most recent change to armed state, in minutes since 1/1/1970",
+            name="last_arm_time_mins", type="uint32", doc="latest change of the armed state, minutes since 1970-01-01"
         ),
     )
 
@@ -2047,11 +2013,11 @@ class BatteryTag:
 
     # Wire layout (20500.BatteryTag.uavcan), bits from the start of the payload:
     #   bits 0-31      uint32 serial_number  (line 7)
-    #   bits 32-63     uint32 num_cycles  (line 11)
-    #   bits 64-95     float32 armed_hours  (line 15)
-    #   bits 96-127    uint32 battery_capacity_mAh  (line 18)
-    #   bits 128-159   uint32 first_use_mins  (line 21)
-    #   bits 160-191   uint32 last_arm_time_mins  (line 24)
+    #   bits 32-63     uint32 num_cycles  (line 10)
+    #   bits 64-95     float32 armed_hours  (line 13)
+    #   bits 96-127    uint32 battery_capacity_mAh  (line 16)
+    #   bits 128-159   uint32 first_use_mins  (line 19)
+    #   bits 160-191   uint32 last_arm_time_mins  (line 22)
     DATA_TYPE_ID: _ClassVar[int | None] = 20500
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x4A5A9B42099F73E1
 
@@ -2132,19 +2098,19 @@ class BatteryTag:
             # serial_number (20500.BatteryTag.uavcan:7): fits uint32
             if self.serial_number & -4294967296:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_TAG_SERIAL_NUMBER_SPEC)
-            # num_cycles (20500.BatteryTag.uavcan:11): fits uint32
+            # num_cycles (20500.BatteryTag.uavcan:10): fits uint32
             if self.num_cycles & -4294967296:
                 _v.diag(out, "num_cycles", self.num_cycles, _BATTERY_TAG_NUM_CYCLES_SPEC)
-            # armed_hours (20500.BatteryTag.uavcan:15): fits float32
+            # armed_hours (20500.BatteryTag.uavcan:13): fits float32
             if not (-3.4028234663852886e38 <= self.armed_hours <= 3.4028234663852886e38):
                 _v.diag(out, "armed_hours", self.armed_hours, _BATTERY_TAG_ARMED_HOURS_SPEC)
-            # battery_capacity_mAh (20500.BatteryTag.uavcan:18): fits uint32
+            # battery_capacity_mAh (20500.BatteryTag.uavcan:16): fits uint32
             if self.battery_capacity_mAh & -4294967296:
                 _v.diag(out, "battery_capacity_mAh", self.battery_capacity_mAh, _BATTERY_TAG_BATTERY_CAPACITY_M_AH_SPEC)
-            # first_use_mins (20500.BatteryTag.uavcan:21): fits uint32
+            # first_use_mins (20500.BatteryTag.uavcan:19): fits uint32
             if self.first_use_mins & -4294967296:
                 _v.diag(out, "first_use_mins", self.first_use_mins, _BATTERY_TAG_FIRST_USE_MINS_SPEC)
-            # last_arm_time_mins (20500.BatteryTag.uavcan:24): fits uint32
+            # last_arm_time_mins (20500.BatteryTag.uavcan:22): fits uint32
             if self.last_arm_time_mins & -4294967296:
                 _v.diag(out, "last_arm_time_mins", self.last_arm_time_mins, _BATTERY_TAG_LAST_ARM_TIME_MINS_SPEC)
         except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way

@@ -168,7 +168,8 @@ _CBAT_FIELD_SPECS = (
 
 @_dataclasses.dataclass(slots=True)
 class CBAT:
-    """support for CUAV Smart Battery on UAVCAN
+    """CUAV's smart battery on DroneCAN.
+    (battgen's text of CUAV's type 20300; the layout and names are upstream's.)
 
     Schema: dronecan.cuav.equipment.power.CBAT (dronecan, cuav/equipment/power/20300.CBAT.uavcan:1).
     """
@@ -187,118 +188,86 @@ class CBAT:
     STATUS_FLAG_RESERVED_B: _ClassVar[int] = 1024
 
     temperature: float = _dataclasses.field(
-        default=0.0, metadata=_m.meta(name="temperature", type="float32", doc="The surface temperature of the battery")
+        default=0.0, metadata=_m.meta(name="temperature", type="float32", doc="Temperature at the pack's surface")
     )
     voltage: float = _dataclasses.field(
-        default=0.0, metadata=_m.meta(name="voltage", type="float32", doc="The total voltage of the battery")
+        default=0.0, metadata=_m.meta(name="voltage", type="float32", doc="Pack voltage")
     )
     voltage_cell: list[float] = _dataclasses.field(
-        default_factory=list,
-        metadata=_m.meta(name="voltage_cell", type="float32[<=15]", doc="Battery individual cell voltages"),
+        default_factory=list, metadata=_m.meta(name="voltage_cell", type="float32[<=15]", doc="Each cell's voltage")
     )
     cell_count: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="cell_count", type="uint8", doc="Number of cells")
+        default=0, metadata=_m.meta(name="cell_count", type="uint8", doc="Cells in the pack")
     )
     current: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(name="current", type="float32", doc="The current flowing through the sense resistor"),
+        default=0.0, metadata=_m.meta(name="current", type="float32", doc="Current through the shunt")
     )
     average_current: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(
-            name="average_current", type="float32", doc="The average current flowing through the sense resistor"
-        ),
+        default=0.0, metadata=_m.meta(name="average_current", type="float32", doc="Average current through the shunt")
     )
     average_power: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(name="average_power", type="float32", doc="The average power of the current discharge"),
+        default=0.0, metadata=_m.meta(name="average_power", type="float32", doc="Average power of this discharge")
     )
     available_energy: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(
-            name="available_energy", type="float32", doc="The predicted charge or energy remaining in the battery"
-        ),
+        metadata=_m.meta(name="available_energy", type="float32", doc="Charge or energy predicted to be left"),
     )
     remaining_capacity: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(name="remaining_capacity", type="float32", doc="The compensated battery capacity remaining"),
+        default=0.0, metadata=_m.meta(name="remaining_capacity", type="float32", doc="Capacity left, compensated")
     )
     full_charge_capacity: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(
-            name="full_charge_capacity",
-            type="float32",
-            doc="The compensated capacity of the battery when fully charged",
-        ),
+        metadata=_m.meta(name="full_charge_capacity", type="float32", doc="Capacity when full, compensated"),
     )
     design_capacity: float = _dataclasses.field(
-        default=0.0, metadata=_m.meta(name="design_capacity", type="float32", doc="The design capacity of the battery")
+        default=0.0, metadata=_m.meta(name="design_capacity", type="float32", doc="Design capacity")
     )
     average_time_to_empty: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="average_time_to_empty",
-            type="uint16",
-            doc="The predicted remaining battery life at the present rate of discharge, in minutes",
+            name="average_time_to_empty", type="uint16", doc="Minutes until empty at the present discharge"
         ),
     )
     average_time_to_full: int = _dataclasses.field(
-        default=0,
-        metadata=_m.meta(
-            name="average_time_to_full",
-            type="uint16",
-            doc="The predicted remaining time until the battery reaches full charge, in minutes",
-        ),
+        default=0, metadata=_m.meta(name="average_time_to_full", type="uint16", doc="Minutes until full")
     )
     state_of_health: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="state_of_health", type="uint7", doc="Health of the battery")
+        default=0, metadata=_m.meta(name="state_of_health", type="uint7", doc="Health")
     )
     state_of_charge: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="state_of_charge", type="uint7", doc="Percent of the full charge [0, 100]")
+        default=0, metadata=_m.meta(name="state_of_charge", type="uint7", doc="Charge left, 0 to 100 percent")
     )
     max_error: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="max_error",
-            type="uint7",
-            doc="max error, expected margin of error in % in the state-of-charge calculation with a range of 1 to 100%",
+            name="max_error", type="uint7", doc="Margin of error of the state of charge, 1 to 100 percent"
         ),
     )
     serial_number: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="serial number of the battery pack")
+        default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="The pack's serial number")
     )
     manufacture_date: int = _dataclasses.field(
-        default=0,
-        metadata=_m.meta(
-            name="manufacture_date", type="uint16", doc="manufacture date, part of serial number of the battery pack"
-        ),
+        default=0, metadata=_m.meta(name="manufacture_date", type="uint16", doc="Date made (part of the serial number)")
     )
     cycle_count: int = _dataclasses.field(
-        default=0,
-        metadata=_m.meta(
-            name="cycle_count", type="uint16", doc="number of discharge cycles the battery has experienced"
-        ),
+        default=0, metadata=_m.meta(name="cycle_count", type="uint16", doc="Discharge cycles so far")
     )
     over_discharge_count: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
+        default=0,
+        metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Times the pack was over-discharged"),
     )
     passed_charge: float = _dataclasses.field(
-        default=0.0,
-        metadata=_m.meta(
-            name="passed_charge", type="float32", doc="The amount of charge passing through the sense resistor"
-        ),
+        default=0.0, metadata=_m.meta(name="passed_charge", type="float32", doc="Charge that passed through the shunt")
     )
     nominal_voltage: float = _dataclasses.field(
-        default=0.0, metadata=_m.meta(name="nominal_voltage", type="float32", doc="Nominal voltage of the battery pack")
+        default=0.0, metadata=_m.meta(name="nominal_voltage", type="float32", doc="Nominal pack voltage")
     )
     is_powering_off: bool = _dataclasses.field(
         default=False,
-        metadata=_m.meta(
-            name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
-        ),
+        metadata=_m.meta(name="is_powering_off", type="bool", doc="Power-off is imminent; false when not known"),
     )
     interface_error: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="interface error counter")
+        default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="Interface errors counted")
     )
     status_flags: int = _dataclasses.field(
         default=0,
@@ -434,31 +403,31 @@ class CBAT:
         return obj
 
     # Wire layout (20300.CBAT.uavcan), bits from the start of the payload:
-    #   bits 0-31      float32 temperature  (line 5)
-    #   bits 32-63     float32 voltage  (line 6)
-    #   bits 64-       float32[<=15] voltage_cell: a 4-bit length, then <=15 x 32 bits  (line 7)
-    #   bits voltage_cell+0 uint8 cell_count  (line 8)
-    #   bits voltage_cell+8 float32 current  (line 9)
-    #   bits voltage_cell+40 float32 average_current  (line 10)
-    #   bits voltage_cell+72 float32 average_power  (line 11)
-    #   bits voltage_cell+104 float32 available_energy  (line 12)
-    #   bits voltage_cell+136 float32 remaining_capacity  (line 13)
-    #   bits voltage_cell+168 float32 full_charge_capacity  (line 14)
-    #   bits voltage_cell+200 float32 design_capacity  (line 15)
-    #   bits voltage_cell+232 uint16 average_time_to_empty  (line 16)
-    #   bits voltage_cell+248 uint16 average_time_to_full  (line 17)
-    #   bits voltage_cell+264 uint7 state_of_health  (line 18)
-    #   bits voltage_cell+271 uint7 state_of_charge  (line 19)
-    #   bits voltage_cell+278 uint7 max_error  (line 20)
-    #   bits voltage_cell+285 uint16 serial_number  (line 21)
-    #   bits voltage_cell+301 uint16 manufacture_date  (line 22)
-    #   bits voltage_cell+317 uint16 cycle_count  (line 23)
-    #   bits voltage_cell+333 uint16 over_discharge_count  (line 24)
-    #   bits voltage_cell+349 float32 passed_charge  (line 25)
-    #   bits voltage_cell+381 float32 nominal_voltage  (line 26)
-    #   bits voltage_cell+413 bool is_powering_off  (line 27)
-    #   bits voltage_cell+414 uint16 interface_error  (line 28)
-    #   bits voltage_cell+430 uint11 status_flags  (line 41)
+    #   bits 0-31      float32 temperature  (line 6)
+    #   bits 32-63     float32 voltage  (line 7)
+    #   bits 64-       float32[<=15] voltage_cell: a 4-bit length, then <=15 x 32 bits  (line 8)
+    #   bits voltage_cell+0 uint8 cell_count  (line 9)
+    #   bits voltage_cell+8 float32 current  (line 10)
+    #   bits voltage_cell+40 float32 average_current  (line 11)
+    #   bits voltage_cell+72 float32 average_power  (line 12)
+    #   bits voltage_cell+104 float32 available_energy  (line 13)
+    #   bits voltage_cell+136 float32 remaining_capacity  (line 14)
+    #   bits voltage_cell+168 float32 full_charge_capacity  (line 15)
+    #   bits voltage_cell+200 float32 design_capacity  (line 16)
+    #   bits voltage_cell+232 uint16 average_time_to_empty  (line 17)
+    #   bits voltage_cell+248 uint16 average_time_to_full  (line 18)
+    #   bits voltage_cell+264 uint7 state_of_health  (line 19)
+    #   bits voltage_cell+271 uint7 state_of_charge  (line 20)
+    #   bits voltage_cell+278 uint7 max_error  (line 21)
+    #   bits voltage_cell+285 uint16 serial_number  (line 22)
+    #   bits voltage_cell+301 uint16 manufacture_date  (line 23)
+    #   bits voltage_cell+317 uint16 cycle_count  (line 24)
+    #   bits voltage_cell+333 uint16 over_discharge_count  (line 25)
+    #   bits voltage_cell+349 float32 passed_charge  (line 26)
+    #   bits voltage_cell+381 float32 nominal_voltage  (line 27)
+    #   bits voltage_cell+413 bool is_powering_off  (line 28)
+    #   bits voltage_cell+414 uint16 interface_error  (line 29)
+    #   bits voltage_cell+430 uint11 status_flags  (line 42)
     DATA_TYPE_ID: _ClassVar[int | None] = 20300
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0xB4DACE3A38E09A74
 
@@ -963,13 +932,13 @@ class CBAT:
         a: _Any
         e: _Any
         try:
-            # temperature (20300.CBAT.uavcan:5): fits float32
+            # temperature (20300.CBAT.uavcan:6): fits float32
             if not (-3.4028234663852886e38 <= self.temperature <= 3.4028234663852886e38):
                 _v.diag(out, "temperature", self.temperature, _CBAT_TEMPERATURE_SPEC)
-            # voltage (20300.CBAT.uavcan:6): fits float32
+            # voltage (20300.CBAT.uavcan:7): fits float32
             if not (-3.4028234663852886e38 <= self.voltage <= 3.4028234663852886e38):
                 _v.diag(out, "voltage", self.voltage, _CBAT_VOLTAGE_SPEC)
-            # voltage_cell (20300.CBAT.uavcan:7): fits float32[<=15]
+            # voltage_cell (20300.CBAT.uavcan:8): fits float32[<=15]
             a = self.voltage_cell
             if len(a) > 15:
                 _v.diag(out, "voltage_cell", self.voltage_cell, _CBAT_VOLTAGE_CELL_SPEC)
@@ -978,71 +947,71 @@ class CBAT:
                     if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
                         _v.diag(out, "voltage_cell", self.voltage_cell, _CBAT_VOLTAGE_CELL_SPEC)
                         break
-            # cell_count (20300.CBAT.uavcan:8): fits uint8
+            # cell_count (20300.CBAT.uavcan:9): fits uint8
             if self.cell_count & -256:
                 _v.diag(out, "cell_count", self.cell_count, _CBAT_CELL_COUNT_SPEC)
-            # current (20300.CBAT.uavcan:9): fits float32
+            # current (20300.CBAT.uavcan:10): fits float32
             if not (-3.4028234663852886e38 <= self.current <= 3.4028234663852886e38):
                 _v.diag(out, "current", self.current, _CBAT_CURRENT_SPEC)
-            # average_current (20300.CBAT.uavcan:10): fits float32
+            # average_current (20300.CBAT.uavcan:11): fits float32
             if not (-3.4028234663852886e38 <= self.average_current <= 3.4028234663852886e38):
                 _v.diag(out, "average_current", self.average_current, _CBAT_AVERAGE_CURRENT_SPEC)
-            # average_power (20300.CBAT.uavcan:11): fits float32
+            # average_power (20300.CBAT.uavcan:12): fits float32
             if not (-3.4028234663852886e38 <= self.average_power <= 3.4028234663852886e38):
                 _v.diag(out, "average_power", self.average_power, _CBAT_AVERAGE_POWER_SPEC)
-            # available_energy (20300.CBAT.uavcan:12): fits float32
+            # available_energy (20300.CBAT.uavcan:13): fits float32
             if not (-3.4028234663852886e38 <= self.available_energy <= 3.4028234663852886e38):
                 _v.diag(out, "available_energy", self.available_energy, _CBAT_AVAILABLE_ENERGY_SPEC)
-            # remaining_capacity (20300.CBAT.uavcan:13): fits float32
+            # remaining_capacity (20300.CBAT.uavcan:14): fits float32
             if not (-3.4028234663852886e38 <= self.remaining_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "remaining_capacity", self.remaining_capacity, _CBAT_REMAINING_CAPACITY_SPEC)
-            # full_charge_capacity (20300.CBAT.uavcan:14): fits float32
+            # full_charge_capacity (20300.CBAT.uavcan:15): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _CBAT_FULL_CHARGE_CAPACITY_SPEC)
-            # design_capacity (20300.CBAT.uavcan:15): fits float32
+            # design_capacity (20300.CBAT.uavcan:16): fits float32
             if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "design_capacity", self.design_capacity, _CBAT_DESIGN_CAPACITY_SPEC)
-            # average_time_to_empty (20300.CBAT.uavcan:16): fits uint16
+            # average_time_to_empty (20300.CBAT.uavcan:17): fits uint16
             if self.average_time_to_empty & -65536:
                 _v.diag(out, "average_time_to_empty", self.average_time_to_empty, _CBAT_AVERAGE_TIME_TO_EMPTY_SPEC)
-            # average_time_to_full (20300.CBAT.uavcan:17): fits uint16
+            # average_time_to_full (20300.CBAT.uavcan:18): fits uint16
             if self.average_time_to_full & -65536:
                 _v.diag(out, "average_time_to_full", self.average_time_to_full, _CBAT_AVERAGE_TIME_TO_FULL_SPEC)
-            # state_of_health (20300.CBAT.uavcan:18): fits uint7
+            # state_of_health (20300.CBAT.uavcan:19): fits uint7
             if self.state_of_health & -128:
                 _v.diag(out, "state_of_health", self.state_of_health, _CBAT_STATE_OF_HEALTH_SPEC)
-            # state_of_charge (20300.CBAT.uavcan:19): fits uint7
+            # state_of_charge (20300.CBAT.uavcan:20): fits uint7
             if self.state_of_charge & -128:
                 _v.diag(out, "state_of_charge", self.state_of_charge, _CBAT_STATE_OF_CHARGE_SPEC)
-            # max_error (20300.CBAT.uavcan:20): fits uint7
+            # max_error (20300.CBAT.uavcan:21): fits uint7
             if self.max_error & -128:
                 _v.diag(out, "max_error", self.max_error, _CBAT_MAX_ERROR_SPEC)
-            # serial_number (20300.CBAT.uavcan:21): fits uint16
+            # serial_number (20300.CBAT.uavcan:22): fits uint16
             if self.serial_number & -65536:
                 _v.diag(out, "serial_number", self.serial_number, _CBAT_SERIAL_NUMBER_SPEC)
-            # manufacture_date (20300.CBAT.uavcan:22): fits uint16
+            # manufacture_date (20300.CBAT.uavcan:23): fits uint16
             if self.manufacture_date & -65536:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _CBAT_MANUFACTURE_DATE_SPEC)
-            # cycle_count (20300.CBAT.uavcan:23): fits uint16
+            # cycle_count (20300.CBAT.uavcan:24): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _CBAT_CYCLE_COUNT_SPEC)
-            # over_discharge_count (20300.CBAT.uavcan:24): fits uint16
+            # over_discharge_count (20300.CBAT.uavcan:25): fits uint16
             if self.over_discharge_count & -65536:
                 _v.diag(out, "over_discharge_count", self.over_discharge_count, _CBAT_OVER_DISCHARGE_COUNT_SPEC)
-            # passed_charge (20300.CBAT.uavcan:25): fits float32
+            # passed_charge (20300.CBAT.uavcan:26): fits float32
             if not (-3.4028234663852886e38 <= self.passed_charge <= 3.4028234663852886e38):
                 _v.diag(out, "passed_charge", self.passed_charge, _CBAT_PASSED_CHARGE_SPEC)
-            # nominal_voltage (20300.CBAT.uavcan:26): fits float32
+            # nominal_voltage (20300.CBAT.uavcan:27): fits float32
             if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _CBAT_NOMINAL_VOLTAGE_SPEC)
-            # is_powering_off (20300.CBAT.uavcan:27): fits bool
+            # is_powering_off (20300.CBAT.uavcan:28): fits bool
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _CBAT_IS_POWERING_OFF_SPEC)
-            # interface_error (20300.CBAT.uavcan:28): fits uint16
+            # interface_error (20300.CBAT.uavcan:29): fits uint16
             if self.interface_error & -65536:
                 _v.diag(out, "interface_error", self.interface_error, _CBAT_INTERFACE_ERROR_SPEC)
-            # status_flags (20300.CBAT.uavcan:41): fits uint11; bits of STATUS_FLAG only
+            # status_flags (20300.CBAT.uavcan:42): fits uint11; bits of STATUS_FLAG only
             if self.status_flags & -512:
                 _v.diag(out, "status_flags", self.status_flags, _CBAT_STATUS_FLAGS_SPEC)
         except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way

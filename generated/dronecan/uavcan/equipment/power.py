@@ -127,7 +127,9 @@ _BATTERY_INFO_STATUS_FLAGS_SPEC = _v.Number(
 _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC = _v.Number(
     type="uint7", kind="uint", low=0, high=127, unit="%", sentinel=127, sentinel_text="STATE_OF_HEALTH_UNKNOWN"
 )
-_BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
+_BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC = _v.Number(
+    type="uint7", kind="uint", low=0, high=127, unit="%", sentinel=127, sentinel_text="STATE_OF_CHARGE_UNKNOWN"
+)
 _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC = _v.Number(type="uint7", kind="uint", low=0, high=127, unit="%")
 _BATTERY_INFO_BATTERY_ID_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
 _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC = _v.Number(type="uint32", kind="uint", low=0, high=4294967295)
@@ -272,6 +274,7 @@ class BatteryInfo:
     STATUS_FLAG_RESERVED_A: _ClassVar[int] = 512
     STATUS_FLAG_RESERVED_B: _ClassVar[int] = 1024
     STATE_OF_HEALTH_UNKNOWN: _ClassVar[int] = 127
+    STATE_OF_CHARGE_UNKNOWN: _ClassVar[int] = 127
 
     temperature: float = _dataclasses.field(
         default=_math.nan,
@@ -372,7 +375,7 @@ class BatteryInfo:
         ),
     )
     state_of_charge_pct: int = _dataclasses.field(
-        default=0,
+        default=127,
         metadata=_m.meta(
             name="state_of_charge_pct",
             type="uint7",
@@ -380,7 +383,9 @@ class BatteryInfo:
             quantity="ratio",
             scale=0.01,
             offset=0.0,
-            doc="State of charge.\nRequired",
+            invalid=127,
+            invalid_text="STATE_OF_CHARGE_UNKNOWN",
+            doc="Required; 0..100, else the constant above",
         ),
     )
     state_of_charge_pct_stdev: int = _dataclasses.field(
@@ -499,11 +504,11 @@ class BatteryInfo:
     #   bits 96-111    float16 hours_to_full_charge  (line 16)
     #   bits 112-122   uint11 status_flags  (line 33)
     #   bits 123-129   uint7 state_of_health_pct  (line 37)
-    #   bits 130-136   uint7 state_of_charge_pct  (line 40)
-    #   bits 137-143   uint7 state_of_charge_pct_stdev  (line 41)
-    #   bits 144-151   uint8 battery_id  (line 44)
-    #   bits 152-183   uint32 model_instance_id  (line 45)
-    #   bits 184-      uint8[<=31] model_name: <=31 x 8 bits, the tail array (no length prefix with TAO)  (line 46)
+    #   bits 130-136   uint7 state_of_charge_pct  (line 41)
+    #   bits 137-143   uint7 state_of_charge_pct_stdev  (line 42)
+    #   bits 144-151   uint8 battery_id  (line 45)
+    #   bits 152-183   uint32 model_instance_id  (line 46)
+    #   bits 184-      uint8[<=31] model_name: <=31 x 8 bits, the tail array (no length prefix with TAO)  (line 47)
     DATA_TYPE_ID: _ClassVar[int | None] = 1092
     DATA_TYPE_SIGNATURE: _ClassVar[int] = 0x249C26548A711966
 
@@ -798,10 +803,11 @@ class BatteryInfo:
             # (accepted)
             if self.state_of_health_pct & -128:
                 _v.diag(out, "state_of_health_pct", self.state_of_health_pct, _BATTERY_INFO_STATE_OF_HEALTH_PCT_SPEC)
-            # state_of_charge_pct (1092.BatteryInfo.uavcan:40): fits uint7
+            # state_of_charge_pct (1092.BatteryInfo.uavcan:41): fits uint7; STATE_OF_CHARGE_UNKNOWN means unknown
+            # (accepted)
             if self.state_of_charge_pct & -128:
                 _v.diag(out, "state_of_charge_pct", self.state_of_charge_pct, _BATTERY_INFO_STATE_OF_CHARGE_PCT_SPEC)
-            # state_of_charge_pct_stdev (1092.BatteryInfo.uavcan:41): fits uint7
+            # state_of_charge_pct_stdev (1092.BatteryInfo.uavcan:42): fits uint7
             if self.state_of_charge_pct_stdev & -128:
                 _v.diag(
                     out,
@@ -809,13 +815,13 @@ class BatteryInfo:
                     self.state_of_charge_pct_stdev,
                     _BATTERY_INFO_STATE_OF_CHARGE_PCT_STDEV_SPEC,
                 )
-            # battery_id (1092.BatteryInfo.uavcan:44): fits uint8
+            # battery_id (1092.BatteryInfo.uavcan:45): fits uint8
             if self.battery_id & -256:
                 _v.diag(out, "battery_id", self.battery_id, _BATTERY_INFO_BATTERY_ID_SPEC)
-            # model_instance_id (1092.BatteryInfo.uavcan:45): fits uint32
+            # model_instance_id (1092.BatteryInfo.uavcan:46): fits uint32
             if self.model_instance_id & -4294967296:
                 _v.diag(out, "model_instance_id", self.model_instance_id, _BATTERY_INFO_MODEL_INSTANCE_ID_SPEC)
-            # model_name (1092.BatteryInfo.uavcan:46): fits uint8[<=31]
+            # model_name (1092.BatteryInfo.uavcan:47): fits uint8[<=31]
             x = self.model_name
             if x.__class__ is not bytes or len(x) > 31:
                 _v.diag(out, "model_name", self.model_name, _BATTERY_INFO_MODEL_NAME_SPEC)
@@ -843,17 +849,20 @@ class BatteryInfo:
         # rule state-of-charge-percent (dronecan-power.yaml:13)
         try:
             r_state_of_charge_pct = self.state_of_charge_pct
-            if not (r_state_of_charge_pct <= 100):
-                out.append(
-                    _v.rule(
-                        "state_of_charge_pct",
-                        "state-of-charge-percent",
-                        r_state_of_charge_pct,
-                        "state_of_charge_pct <= 100",
-                        "state_of_charge_pct = " + _v.fmt(r_state_of_charge_pct) + " % is above 100 %",
-                        "error",
+            if r_state_of_charge_pct != 127:
+                if not (r_state_of_charge_pct <= 100):
+                    out.append(
+                        _v.rule(
+                            "state_of_charge_pct",
+                            "state-of-charge-percent",
+                            r_state_of_charge_pct,
+                            "state_of_charge_pct <= 100",
+                            "state_of_charge_pct = "
+                            + _v.fmt(r_state_of_charge_pct)
+                            + " % is above 100 % (127 means unknown)",
+                            "error",
+                        )
                     )
-                )
         except _v.SLOW:
             pass  # the field checks report the cause
         return out
@@ -883,14 +892,9 @@ class BatteryInfo:
             return self.hours_to_full_charge == self.hours_to_full_charge
         if field == "state_of_health_pct":
             return self.state_of_health_pct != 127
-        if field in {
-            "status_flags",
-            "state_of_charge_pct",
-            "state_of_charge_pct_stdev",
-            "battery_id",
-            "model_instance_id",
-            "model_name",
-        }:
+        if field == "state_of_charge_pct":
+            return self.state_of_charge_pct != 127
+        if field in {"status_flags", "state_of_charge_pct_stdev", "battery_id", "model_instance_id", "model_name"}:
             return True
         raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.equipment.power.BatteryInfo")
 

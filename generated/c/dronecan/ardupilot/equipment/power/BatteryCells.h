@@ -19,12 +19,14 @@ extern "C" {
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCELLS_MAX_BYTES 51u
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCELLS_MAX_PROBLEMS 25u
 
-/** Battery cell voltages Rate: set by parameter on smart battery (default off) */
+/** A smart battery's cell voltages, in blocks of up to 24 cells (sent at a rate the battery's
+ * settings choose; off by default). (battgen's text of ArduPilot's type 20012; the layout and names
+ * are upstream's.) */
 typedef struct {
   uint16_t voltages_len;
   float voltages[24]; /* [Volt] */
-  uint16_t index; /* uint16 Index of the first cell in the array, index 0 is cells at array indices
-                     0 - 23, index 24 is cells at array indices 24 - 47, etc. */
+  uint16_t index; /* uint16 The first cell of this block: 0 for cells 0-23, 24 for cells 24-47, and
+                     so on */
 } battgen_dronecan_ardupilot_equipment_power_BatteryCells;
 
 /* C99 static assertion: a negative array size fails the build. */

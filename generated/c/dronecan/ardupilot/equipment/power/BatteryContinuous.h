@@ -53,24 +53,22 @@ extern "C" {
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_MAX_BYTES 25u
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYCONTINUOUS_MAX_PROBLEMS 8u
 
-/** Battery data to be sent continuously */
+/** A smart battery's fast-changing state, sent at a steady rate. (battgen's text of ArduPilot's
+ * type 20010; the layout and names are upstream's, checked against pydronecan by
+ * conformance/test_dsdl_pydronecan.py.) */
 typedef struct {
-  float temperature_cells; /* [C] float16 Pack mounted thermistor (preferably installed between
-                              cells), NAN: field not provided */
-  float temperature_pcb;   /* [C] float16 Battery PCB temperature (likely output FET(s) or current
-                              sense resistor), NAN: field not provided */
-  float temperature_other; /* [C] float16 Application dependent, NAN: field not provided */
-  float current; /* [A] float32 Positive: defined as a discharge current. Negative: defined as a
-                    charging current, NAN: field not provided */
-  float voltage; /* [V] float32 Battery voltage */
-  float state_of_charge; /* [%] float16 The estimated state of charge, in percent remaining (0 -
-                            100). */
-  uint8_t slot_id; /* uint8 : The physical location of the battery on the aircraft. 0: field not
-                      provided */
-  float capacity_consumed; /* [Ah] float32 This is either the consumption since power-on or since
-                              the battery was full, depending on the value of
-                              STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL, NAN: field not provided */
-  uint32_t status_flags;   /* uint32 : Fault, health, readiness, and other status indications */
+  float temperature_cells; /* [C] float16 Thermistor among the cells; NaN when the pack has none */
+  float temperature_pcb;   /* [C] float16 Electronics temperature (switches, shunt); NaN when not
+                              measured */
+  float temperature_other; /* [C] float16 A third sensor, its place chosen by the vendor; NaN when
+                              absent */
+  float current; /* [A] float32 Discharge positive, charge negative; NaN when not measured */
+  float voltage; /* [V] float32 Pack voltage */
+  float state_of_charge;   /* [%] float16 Charge left, 0 to 100 */
+  uint8_t slot_id;         /* uint8 : Where on the vehicle the pack sits; 0 when not known */
+  float capacity_consumed; /* [Ah] float32 Charge used since power-on, or since full when
+                              STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL is set; NaN when not known */
+  uint32_t status_flags;   /* uint32 : The STATUS_FLAG_* bits below */
 } battgen_dronecan_ardupilot_equipment_power_BatteryContinuous;
 
 /* C99 static assertion: a negative array size fails the build. */

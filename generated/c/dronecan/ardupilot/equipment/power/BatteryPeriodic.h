@@ -19,38 +19,35 @@ extern "C" {
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_MAX_BYTES 125u
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYPERIODIC_MAX_PROBLEMS 9u
 
-/** Battery data to be sent statically upon request or periodically at a low rate Recommend that
- * this message is sent at a maximum of 1Hz and nominally 0.2 Hz (IE: once every 5 seconds.) */
+/** A smart battery's slow-changing facts, sent on request or rarely (about every 5 s, at most 1
+ * Hz). (battgen's text of ArduPilot's type 20011; the layout and names are upstream's.) */
 typedef struct {
   uint16_t name_len;
-  uint8_t name[50]; /* : Formatted as manufacturer_product, 0 terminated */
+  uint8_t name[50]; /* : Maker and product, as maker_product text */
   uint16_t serial_number_len;
-  uint8_t serial_number[32]; /* : Serial number in ASCII characters, 0 terminated */
+  uint8_t serial_number[32]; /* : Serial number, as text */
   uint16_t manufacture_date_len;
-  uint8_t manufacture_date[9]; /* : Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated */
-  float design_capacity;   /* [Ah] float32 Fully charged design capacity. 0: field not provided. */
-  uint8_t cells_in_series; /* uint8 : Number of battery cells in series. 0: field not provided. */
-  float nominal_voltage; /* [V] float16 Battery nominal voltage. Used for conversion between Wh and
-                            Ah. 0: field not provided. */
-  float discharge_minimum_voltage; /* [V] float16 Minimum per-cell voltage when discharging. 0:
-                                      field not provided. */
-  float charging_minimum_voltage;  /* [V] float16 Minimum per-cell voltage when charging. 0: field
-                                      not provided. */
-  float charging_maximum_voltage; /* [V] float16 Maximum per-cell voltage when charged. 0: field not
-                                     provided. */
-  float charging_maximum_current; /* [A] float32 Maximum pack continuous charge current. 0: field
-                                     not provided. */
-  float discharge_maximum_current; /* [A] float32 Maximum pack continuous discharge current. 0:
-                                      field not provided. */
-  float discharge_maximum_burst_current; /* [A] float32 Maximum pack discharge burst current for 30
-                                            seconds. 0: field not provided */
-  float full_charge_capacity; /* [Ah] float32 Predicted battery capacity when fully charged
-                                 (accounting for battery degradation), NAN: field not provided */
-  uint16_t cycle_count;       /* uint16 : Lifetime count of the number of charge/discharge cycles
-                                 (https://en.wikipedia.org/wiki/Charge_cycle). UINT16_MAX: field not
-                                 provided. */
-  uint8_t state_of_health;    /* [%] uint8 State of Health (SOH) estimate, in percent (0 - 100).
-                                 UINT8_MAX: field not provided. */
+  uint8_t manufacture_date[9]; /* : Date made, DDMMYYYY as text */
+  float design_capacity;       /* [Ah] float32 Design capacity when full; 0 when not given */
+  uint8_t cells_in_series;     /* uint8 : Cells in series; 0 when not given */
+  float
+      nominal_voltage; /* [V] float16 Nominal pack voltage (converts Wh to Ah); 0 when not given */
+  float discharge_minimum_voltage; /* [V] float16 Lowest cell voltage while discharging; 0 when not
+                                      given */
+  float charging_minimum_voltage;  /* [V] float16 Lowest cell voltage while charging; 0 when not
+                                      given */
+  float charging_maximum_voltage; /* [V] float16 Highest cell voltage when charged; 0 when not given
+                                   */
+  float charging_maximum_current; /* [A] float32 Highest continuous charge current; 0 when not given
+                                   */
+  float discharge_maximum_current; /* [A] float32 Highest continuous discharge current; 0 when not
+                                      given */
+  float discharge_maximum_burst_current; /* [A] float32 Highest discharge current for 30 s; 0 when
+                                            not given */
+  float full_charge_capacity; /* [Ah] float32 Capacity when full, the pack's wear counted; NaN when
+                                 not given */
+  uint16_t cycle_count;    /* uint16 : Charge and discharge cycles so far; 65535 when not given */
+  uint8_t state_of_health; /* [%] uint8 Health, 0 to 100; 255 when not given */
 } battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic;
 
 /* C99 static assertion: a negative array size fails the build. */

@@ -19,19 +19,16 @@ extern "C" {
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_MAX_BYTES 24u
 #define BATTGEN_DRONECAN_ARDUPILOT_EQUIPMENT_POWER_BATTERYTAG_MAX_PROBLEMS 1u
 
-/** Battery tag information. This is broadcast by a battery tag device permanently attached to a
- * battery to record the lifecycle of the battery */
+/** What a tag fixed to a battery records over the battery's life, broadcast by the tag. (battgen's
+ * text of ArduPilot's type 20500; the layout and names are upstream's.) */
 typedef struct {
-  uint32_t serial_number; /* uint32 vendor supplied serial number */
-  uint32_t num_cycles;    /* uint32 number of cycles this battery has been through. Criteria for
-                             defining a cycle is vendor specific */
-  float armed_hours; /* float32 number of hours that this battery has been running when vehicle is
-                        in an armed state */
-  uint32_t battery_capacity_mAh; /* uint32 battery capacity in milliAmpHours */
-  uint32_t first_use_mins;     /* uint32 time of first use of battery with vehicle armed, in minutes
-                                  since 1/1/1970 */
-  uint32_t last_arm_time_mins; /* uint32 time of most recent change to armed state, in minutes since
-                                  1/1/1970 */
+  uint32_t serial_number; /* uint32 the maker's serial number */
+  uint32_t num_cycles;    /* uint32 charge cycles so far, counted as the maker defines a cycle */
+  float armed_hours;      /* float32 hours the battery has powered an armed vehicle */
+  uint32_t battery_capacity_mAh; /* uint32 capacity in mAh */
+  uint32_t first_use_mins;       /* uint32 first armed use, minutes since 1970-01-01 */
+  uint32_t
+      last_arm_time_mins; /* uint32 latest change of the armed state, minutes since 1970-01-01 */
 } battgen_dronecan_ardupilot_equipment_power_BatteryTag;
 
 /* C99 static assertion: a negative array size fails the build. */

@@ -12,64 +12,57 @@
 extern "C" {
 #endif
 
-#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_IN_USE                              \
-  1u /* The battery is currently used as a power supply */
-#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_CHARGING 2u /* Charger is active */
+#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_IN_USE 1u   /* Supplying power */
+#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_CHARGING 2u /* Charger active */
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_CHARGED                             \
-  4u /* Charging complete, but the charger is still active */
-#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_TEMP_HOT                            \
-  8u /* Battery temperature is above normal */
-#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_TEMP_COLD                           \
-  16u /* Battery temperature is below normal */
+  4u /* Full, charger still active */
+#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_TEMP_HOT 8u   /* Too hot */
+#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_TEMP_COLD 16u /* Too cold */
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_OVERLOAD                            \
-  32u /* Safe operating area violation */
+  32u /* Outside the safe operating area */
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_BAD_BATTERY                         \
-  64u /* This battery should not be used anymore (e.g. low SOH) */
+  64u /* Do not use (worn out) */
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_NEED_SERVICE                        \
-  128u /* This battery requires maintenance (e.g. balancing, full recharge) */
+  128u /* Needs maintenance (balancing, a full charge) */
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_BMS_ERROR                           \
-  256u /* Battery management system/controller error, smart battery interface error */
-#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_RESERVED_A 512u  /* Keep zero */
-#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_RESERVED_B 1024u /* Keep zero */
+  256u /* Fault in the management electronics or its interface */
+#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_RESERVED_A 512u  /* Always zero */
+#define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_STATUS_FLAG_RESERVED_B 1024u /* Always zero */
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_DATA_TYPE_SIGNATURE 0xB4DACE3A38E09A74ULL
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_DATA_TYPE_ID 20300u
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_BITLEN 989u
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_BYTES 124u
 #define BATTGEN_DRONECAN_CUAV_EQUIPMENT_POWER_CBAT_MAX_PROBLEMS 31u
 
-/** support for CUAV Smart Battery on UAVCAN */
+/** CUAV's smart battery on DroneCAN. (battgen's text of CUAV's type 20300; the layout and names are
+ * upstream's.) */
 typedef struct {
-  float temperature; /* float32 The surface temperature of the battery */
-  float voltage;     /* float32 The total voltage of the battery */
+  float temperature; /* float32 Temperature at the pack's surface */
+  float voltage;     /* float32 Pack voltage */
   uint16_t voltage_cell_len;
-  float voltage_cell[15];   /* Battery individual cell voltages */
-  uint8_t cell_count;       /* uint8 Number of cells */
-  float current;            /* float32 The current flowing through the sense resistor */
-  float average_current;    /* float32 The average current flowing through the sense resistor */
-  float average_power;      /* float32 The average power of the current discharge */
-  float available_energy;   /* float32 The predicted charge or energy remaining in the battery */
-  float remaining_capacity; /* float32 The compensated battery capacity remaining */
-  float
-      full_charge_capacity; /* float32 The compensated capacity of the battery when fully charged */
-  float design_capacity;    /* float32 The design capacity of the battery */
-  uint16_t average_time_to_empty; /* uint16 The predicted remaining battery life at the present rate
-                                     of discharge, in minutes */
-  uint16_t average_time_to_full;  /* uint16 The predicted remaining time until the battery reaches
-                                     full charge, in minutes */
-  uint8_t state_of_health;        /* uint7 Health of the battery */
-  uint8_t state_of_charge;        /* uint7 Percent of the full charge [0, 100] */
-  uint8_t max_error;      /* uint7 max error, expected margin of error in % in the state-of-charge
-                             calculation with a range of 1 to 100% */
-  uint16_t serial_number; /* uint16 serial number of the battery pack */
-  uint16_t
-      manufacture_date; /* uint16 manufacture date, part of serial number of the battery pack */
-  uint16_t cycle_count; /* uint16 number of discharge cycles the battery has experienced */
-  uint16_t over_discharge_count; /* uint16 Number of battery overdischarge */
-  float passed_charge;      /* float32 The amount of charge passing through the sense resistor */
-  float nominal_voltage;    /* float32 Nominal voltage of the battery pack */
-  bool is_powering_off;     /* Power off event imminent indication, false if unknown */
-  uint16_t interface_error; /* uint16 interface error counter */
-  uint16_t status_flags;    /* uint11 */
+  float voltage_cell[15];         /* Each cell's voltage */
+  uint8_t cell_count;             /* uint8 Cells in the pack */
+  float current;                  /* float32 Current through the shunt */
+  float average_current;          /* float32 Average current through the shunt */
+  float average_power;            /* float32 Average power of this discharge */
+  float available_energy;         /* float32 Charge or energy predicted to be left */
+  float remaining_capacity;       /* float32 Capacity left, compensated */
+  float full_charge_capacity;     /* float32 Capacity when full, compensated */
+  float design_capacity;          /* float32 Design capacity */
+  uint16_t average_time_to_empty; /* uint16 Minutes until empty at the present discharge */
+  uint16_t average_time_to_full;  /* uint16 Minutes until full */
+  uint8_t state_of_health;        /* uint7 Health */
+  uint8_t state_of_charge;        /* uint7 Charge left, 0 to 100 percent */
+  uint8_t max_error;         /* uint7 Margin of error of the state of charge, 1 to 100 percent */
+  uint16_t serial_number;    /* uint16 The pack's serial number */
+  uint16_t manufacture_date; /* uint16 Date made (part of the serial number) */
+  uint16_t cycle_count;      /* uint16 Discharge cycles so far */
+  uint16_t over_discharge_count; /* uint16 Times the pack was over-discharged */
+  float passed_charge;           /* float32 Charge that passed through the shunt */
+  float nominal_voltage;         /* float32 Nominal pack voltage */
+  bool is_powering_off;          /* Power-off is imminent; false when not known */
+  uint16_t interface_error;      /* uint16 Interface errors counted */
+  uint16_t status_flags;         /* uint11 */
 } battgen_dronecan_cuav_equipment_power_CBAT;
 
 /* C99 static assertion: a negative array size fails the build. */

@@ -36,6 +36,9 @@ extern "C" {
   1024u /* Always zero */
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_STATE_OF_HEALTH_UNKNOWN                \
   127u /* State of health. Health cannot be estimated */
+#define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_STATE_OF_CHARGE_UNKNOWN                \
+  127u /* State of charge (dronecan/DSDL gave it an "unknown" value in February 2026). Charge      \
+          cannot be estimated */
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_DATA_TYPE_SIGNATURE                    \
   0x249C26548A711966ULL
 #define BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_DATA_TYPE_ID 1092u
@@ -58,7 +61,8 @@ typedef struct {
                                     charging */
   uint16_t status_flags;         /* uint11 */
   uint8_t state_of_health_pct;   /* [Percent] invalid: STATE_OF_HEALTH_UNKNOWN uint7 Optional */
-  uint8_t state_of_charge_pct;   /* [Percent] uint7 State of charge. Required */
+  uint8_t state_of_charge_pct; /* [Percent] invalid: STATE_OF_CHARGE_UNKNOWN uint7 Required; 0..100,
+                                  else the constant above */
   uint8_t state_of_charge_pct_stdev; /* [Percent] uint7 Standard deviation of the estimate */
   uint8_t battery_id;                /* uint8 Identity. Which battery of this vehicle (0 = main) */
   uint32_t model_instance_id;        /* uint32 Serial number within the model; zero if none */

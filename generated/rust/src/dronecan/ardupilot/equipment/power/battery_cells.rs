@@ -5,7 +5,7 @@ use crate::dronecan_wire::{self, BitReader, BitWriter};
 use crate::problems::{Problems, Rule, Validate};
 use crate::same::Same;
 
-/// Battery cell voltages Rate: set by parameter on smart battery (default off)
+/// A smart battery's cell voltages, in blocks of up to 24 cells (sent at a rate the battery's settings choose; off by default). (battgen's text of ArduPilot's type 20012; the layout and names are upstream's.)
 ///
 /// Schema: `dronecan.ardupilot.equipment.power.BatteryCells` (ardupilot/equipment/power/20012.BatteryCells.uavcan:1).
 #[derive(Clone, Copy, Debug)]
@@ -14,7 +14,7 @@ pub struct BatteryCells {
     pub voltages: [f32; 24],
     /// How many elements of `voltages` are used.
     pub voltages_len: usize,
-    /// Index of the first cell in the array, index 0 is cells at array indices 0 - 23, index 24 is cells at array indices 24 - 47, etc.
+    /// The first cell of this block: 0 for cells 0-23, 24 for cells 24-47, and so on
     ///
     /// Wire type: `uint16`.
     pub index: u16,

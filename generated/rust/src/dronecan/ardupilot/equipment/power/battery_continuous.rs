@@ -5,44 +5,44 @@ use crate::dronecan_wire::{self, BitReader, BitWriter};
 use crate::problems::{Problems, Rule, Validate};
 use crate::same::Same;
 
-/// Battery data to be sent continuously
+/// A smart battery's fast-changing state, sent at a steady rate. (battgen's text of ArduPilot's type 20010; the layout and names are upstream's, checked against pydronecan by conformance/test_dsdl_pydronecan.py.)
 ///
 /// Schema: `dronecan.ardupilot.equipment.power.BatteryContinuous` (ardupilot/equipment/power/20010.BatteryContinuous.uavcan:1).
 #[derive(Clone, Copy, Debug)]
 pub struct BatteryContinuous {
-    /// Pack mounted thermistor (preferably installed between cells), NAN: field not provided
+    /// Thermistor among the cells; NaN when the pack has none
     ///
     /// Unit: `C`. Wire type: `float16`.
     pub temperature_cells: f32,
-    /// Battery PCB temperature (likely output FET(s) or current sense resistor), NAN: field not provided
+    /// Electronics temperature (switches, shunt); NaN when not measured
     ///
     /// Unit: `C`. Wire type: `float16`.
     pub temperature_pcb: f32,
-    /// Application dependent, NAN: field not provided
+    /// A third sensor, its place chosen by the vendor; NaN when absent
     ///
     /// Unit: `C`. Wire type: `float16`.
     pub temperature_other: f32,
-    /// Positive: defined as a discharge current. Negative: defined as a charging current, NAN: field not provided
+    /// Discharge positive, charge negative; NaN when not measured
     ///
     /// Unit: `A`. Wire type: `float32`.
     pub current: f32,
-    /// Battery voltage
+    /// Pack voltage
     ///
     /// Unit: `V`. Wire type: `float32`.
     pub voltage: f32,
-    /// The estimated state of charge, in percent remaining (0 - 100).
+    /// Charge left, 0 to 100
     ///
     /// Unit: `%`. Wire type: `float16`.
     pub state_of_charge: f32,
-    /// : The physical location of the battery on the aircraft. 0: field not provided
+    /// : Where on the vehicle the pack sits; 0 when not known
     ///
     /// Wire type: `uint8`.
     pub slot_id: u8,
-    /// This is either the consumption since power-on or since the battery was full, depending on the value of STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL, NAN: field not provided
+    /// Charge used since power-on, or since full when STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL is set; NaN when not known
     ///
     /// Unit: `Ah`. Wire type: `float32`.
     pub capacity_consumed: f32,
-    /// : Fault, health, readiness, and other status indications
+    /// : The STATUS_FLAG_\* bits below
     ///
     /// Values: `dronecan.ardupilot.equipment.power.BatteryContinuous.STATUS_FLAG`. Wire type: `uint32`.
     pub status_flags: u32,

@@ -5,74 +5,74 @@ use crate::dronecan_wire::{self, BitReader, BitWriter};
 use crate::problems::{Problems, Rule, Validate};
 use crate::same::Same;
 
-/// Battery data to be sent statically upon request or periodically at a low rate Recommend that this message is sent at a maximum of 1Hz and nominally 0.2 Hz (IE: once every 5 seconds.)
+/// A smart battery's slow-changing facts, sent on request or rarely (about every 5 s, at most 1 Hz). (battgen's text of ArduPilot's type 20011; the layout and names are upstream's.)
 ///
 /// Schema: `dronecan.ardupilot.equipment.power.BatteryPeriodic` (ardupilot/equipment/power/20011.BatteryPeriodic.uavcan:1).
 #[derive(Clone, Copy, Debug)]
 pub struct BatteryPeriodic {
-    /// : Formatted as manufacturer_product, 0 terminated
+    /// : Maker and product, as maker_product text
     ///
     /// Wire type: `uint8`.
     pub name: [u8; 50],
     /// How many elements of `name` are used.
     pub name_len: usize,
-    /// : Serial number in ASCII characters, 0 terminated
+    /// : Serial number, as text
     ///
     /// Wire type: `uint8`.
     pub serial_number: [u8; 32],
     /// How many elements of `serial_number` are used.
     pub serial_number_len: usize,
-    /// : Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated
+    /// : Date made, DDMMYYYY as text
     ///
     /// Wire type: `uint8`.
     pub manufacture_date: [u8; 9],
     /// How many elements of `manufacture_date` are used.
     pub manufacture_date_len: usize,
-    /// Fully charged design capacity. 0: field not provided.
+    /// Design capacity when full; 0 when not given
     ///
     /// Unit: `Ah`. Wire type: `float32`.
     pub design_capacity: f32,
-    /// : Number of battery cells in series. 0: field not provided.
+    /// : Cells in series; 0 when not given
     ///
     /// Wire type: `uint8`.
     pub cells_in_series: u8,
-    /// Battery nominal voltage. Used for conversion between Wh and Ah. 0: field not provided.
+    /// Nominal pack voltage (converts Wh to Ah); 0 when not given
     ///
     /// Unit: `V`. Wire type: `float16`.
     pub nominal_voltage: f32,
-    /// Minimum per-cell voltage when discharging. 0: field not provided.
+    /// Lowest cell voltage while discharging; 0 when not given
     ///
     /// Unit: `V`. Wire type: `float16`.
     pub discharge_minimum_voltage: f32,
-    /// Minimum per-cell voltage when charging. 0: field not provided.
+    /// Lowest cell voltage while charging; 0 when not given
     ///
     /// Unit: `V`. Wire type: `float16`.
     pub charging_minimum_voltage: f32,
-    /// Maximum per-cell voltage when charged. 0: field not provided.
+    /// Highest cell voltage when charged; 0 when not given
     ///
     /// Unit: `V`. Wire type: `float16`.
     pub charging_maximum_voltage: f32,
-    /// Maximum pack continuous charge current. 0: field not provided.
+    /// Highest continuous charge current; 0 when not given
     ///
     /// Unit: `A`. Wire type: `float32`.
     pub charging_maximum_current: f32,
-    /// Maximum pack continuous discharge current. 0: field not provided.
+    /// Highest continuous discharge current; 0 when not given
     ///
     /// Unit: `A`. Wire type: `float32`.
     pub discharge_maximum_current: f32,
-    /// Maximum pack discharge burst current for 30 seconds. 0: field not provided
+    /// Highest discharge current for 30 s; 0 when not given
     ///
     /// Unit: `A`. Wire type: `float32`.
     pub discharge_maximum_burst_current: f32,
-    /// Predicted battery capacity when fully charged (accounting for battery degradation), NAN: field not provided
+    /// Capacity when full, the pack's wear counted; NaN when not given
     ///
     /// Unit: `Ah`. Wire type: `float32`.
     pub full_charge_capacity: f32,
-    /// : Lifetime count of the number of charge/discharge cycles (<https://en.wikipedia.org/wiki/Charge_cycle>). UINT16_MAX: field not provided.
+    /// : Charge and discharge cycles so far; 65535 when not given
     ///
     /// Wire type: `uint16`.
     pub cycle_count: u16,
-    /// State of Health (SOH) estimate, in percent (0 - 100). UINT8_MAX: field not provided.
+    /// Health, 0 to 100; 255 when not given
     ///
     /// Unit: `%`. Wire type: `uint8`.
     pub state_of_health: u8,

@@ -5,32 +5,32 @@ use crate::dronecan_wire::{self, BitReader, BitWriter};
 use crate::problems::{Problems, Rule, Validate};
 use crate::same::Same;
 
-/// Battery tag information. This is broadcast by a battery tag device permanently attached to a battery to record the lifecycle of the battery
+/// What a tag fixed to a battery records over the battery's life, broadcast by the tag. (battgen's text of ArduPilot's type 20500; the layout and names are upstream's.)
 ///
 /// Schema: `dronecan.ardupilot.equipment.power.BatteryTag` (ardupilot/equipment/power/20500.BatteryTag.uavcan:1).
 #[derive(Clone, Copy, Debug)]
 pub struct BatteryTag {
-    /// vendor supplied serial number
+    /// the maker's serial number
     ///
     /// Wire type: `uint32`.
     pub serial_number: u32,
-    /// number of cycles this battery has been through. Criteria for defining a cycle is vendor specific
+    /// charge cycles so far, counted as the maker defines a cycle
     ///
     /// Wire type: `uint32`.
     pub num_cycles: u32,
-    /// number of hours that this battery has been running when vehicle is in an armed state
+    /// hours the battery has powered an armed vehicle
     ///
     /// Wire type: `float32`.
     pub armed_hours: f32,
-    /// battery capacity in milliAmpHours
+    /// capacity in mAh
     ///
     /// Wire type: `uint32`.
     pub battery_capacity_m_ah: u32,
-    /// time of first use of battery with vehicle armed, in minutes since 1/1/1970
+    /// first armed use, minutes since 1970-01-01
     ///
     /// Wire type: `uint32`.
     pub first_use_mins: u32,
-    /// time of most recent change to armed state, in minutes since 1/1/1970
+    /// latest change of the armed state, minutes since 1970-01-01
     ///
     /// Wire type: `uint32`.
     pub last_arm_time_mins: u32,

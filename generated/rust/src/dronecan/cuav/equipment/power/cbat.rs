@@ -5,106 +5,106 @@ use crate::dronecan_wire::{self, BitReader, BitWriter};
 use crate::problems::{Problems, Rule, Validate};
 use crate::same::Same;
 
-/// support for CUAV Smart Battery on UAVCAN
+/// CUAV's smart battery on DroneCAN. (battgen's text of CUAV's type 20300; the layout and names are upstream's.)
 ///
 /// Schema: `dronecan.cuav.equipment.power.CBAT` (cuav/equipment/power/20300.CBAT.uavcan:1).
 #[derive(Clone, Copy, Debug)]
 pub struct Cbat {
-    /// The surface temperature of the battery
+    /// Temperature at the pack's surface
     ///
     /// Wire type: `float32`.
     pub temperature: f32,
-    /// The total voltage of the battery
+    /// Pack voltage
     ///
     /// Wire type: `float32`.
     pub voltage: f32,
-    /// Battery individual cell voltages
+    /// Each cell's voltage
     ///
     /// Wire type: `float32`.
     pub voltage_cell: [f32; 15],
     /// How many elements of `voltage_cell` are used.
     pub voltage_cell_len: usize,
-    /// Number of cells
+    /// Cells in the pack
     ///
     /// Wire type: `uint8`.
     pub cell_count: u8,
-    /// The current flowing through the sense resistor
+    /// Current through the shunt
     ///
     /// Wire type: `float32`.
     pub current: f32,
-    /// The average current flowing through the sense resistor
+    /// Average current through the shunt
     ///
     /// Wire type: `float32`.
     pub average_current: f32,
-    /// The average power of the current discharge
+    /// Average power of this discharge
     ///
     /// Wire type: `float32`.
     pub average_power: f32,
-    /// The predicted charge or energy remaining in the battery
+    /// Charge or energy predicted to be left
     ///
     /// Wire type: `float32`.
     pub available_energy: f32,
-    /// The compensated battery capacity remaining
+    /// Capacity left, compensated
     ///
     /// Wire type: `float32`.
     pub remaining_capacity: f32,
-    /// The compensated capacity of the battery when fully charged
+    /// Capacity when full, compensated
     ///
     /// Wire type: `float32`.
     pub full_charge_capacity: f32,
-    /// The design capacity of the battery
+    /// Design capacity
     ///
     /// Wire type: `float32`.
     pub design_capacity: f32,
-    /// The predicted remaining battery life at the present rate of discharge, in minutes
+    /// Minutes until empty at the present discharge
     ///
     /// Wire type: `uint16`.
     pub average_time_to_empty: u16,
-    /// The predicted remaining time until the battery reaches full charge, in minutes
+    /// Minutes until full
     ///
     /// Wire type: `uint16`.
     pub average_time_to_full: u16,
-    /// Health of the battery
+    /// Health
     ///
     /// Wire type: `uint7`.
     pub state_of_health: u8,
-    /// Percent of the full charge \[0, 100\]
+    /// Charge left, 0 to 100 percent
     ///
     /// Wire type: `uint7`.
     pub state_of_charge: u8,
-    /// max error, expected margin of error in % in the state-of-charge calculation with a range of 1 to 100%
+    /// Margin of error of the state of charge, 1 to 100 percent
     ///
     /// Wire type: `uint7`.
     pub max_error: u8,
-    /// serial number of the battery pack
+    /// The pack's serial number
     ///
     /// Wire type: `uint16`.
     pub serial_number: u16,
-    /// manufacture date, part of serial number of the battery pack
+    /// Date made (part of the serial number)
     ///
     /// Wire type: `uint16`.
     pub manufacture_date: u16,
-    /// number of discharge cycles the battery has experienced
+    /// Discharge cycles so far
     ///
     /// Wire type: `uint16`.
     pub cycle_count: u16,
-    /// Number of battery overdischarge
+    /// Times the pack was over-discharged
     ///
     /// Wire type: `uint16`.
     pub over_discharge_count: u16,
-    /// The amount of charge passing through the sense resistor
+    /// Charge that passed through the shunt
     ///
     /// Wire type: `float32`.
     pub passed_charge: f32,
-    /// Nominal voltage of the battery pack
+    /// Nominal pack voltage
     ///
     /// Wire type: `float32`.
     pub nominal_voltage: f32,
-    /// Power off event imminent indication, false if unknown
+    /// Power-off is imminent; false when not known
     ///
     /// Wire type: `bool`.
     pub is_powering_off: bool,
-    /// interface error counter
+    /// Interface errors counted
     ///
     /// Wire type: `uint16`.
     pub interface_error: u16,
@@ -113,27 +113,27 @@ pub struct Cbat {
 }
 
 impl Cbat {
-    /// The battery is currently used as a power supply
+    /// Supplying power
     pub const STATUS_FLAG_IN_USE: u16 = 1;
-    /// Charger is active
+    /// Charger active
     pub const STATUS_FLAG_CHARGING: u16 = 2;
-    /// Charging complete, but the charger is still active
+    /// Full, charger still active
     pub const STATUS_FLAG_CHARGED: u16 = 4;
-    /// Battery temperature is above normal
+    /// Too hot
     pub const STATUS_FLAG_TEMP_HOT: u16 = 8;
-    /// Battery temperature is below normal
+    /// Too cold
     pub const STATUS_FLAG_TEMP_COLD: u16 = 16;
-    /// Safe operating area violation
+    /// Outside the safe operating area
     pub const STATUS_FLAG_OVERLOAD: u16 = 32;
-    /// This battery should not be used anymore (e.g. low SOH)
+    /// Do not use (worn out)
     pub const STATUS_FLAG_BAD_BATTERY: u16 = 64;
-    /// This battery requires maintenance (e.g. balancing, full recharge)
+    /// Needs maintenance (balancing, a full charge)
     pub const STATUS_FLAG_NEED_SERVICE: u16 = 128;
-    /// Battery management system/controller error, smart battery interface error
+    /// Fault in the management electronics or its interface
     pub const STATUS_FLAG_BMS_ERROR: u16 = 256;
-    /// Keep zero
+    /// Always zero
     pub const STATUS_FLAG_RESERVED_A: u16 = 512;
-    /// Keep zero
+    /// Always zero
     pub const STATUS_FLAG_RESERVED_B: u16 = 1024;
     /// The DroneCAN data type signature.
     pub const DATA_TYPE_SIGNATURE: u64 = 0xb4dace3a38e09a74;
@@ -242,27 +242,27 @@ impl Same for Cbat {
 pub struct StatusFlag(pub u16);
 
 impl StatusFlag {
-    /// The battery is currently used as a power supply
+    /// Supplying power
     pub const IN_USE: Self = Self(0x1);
-    /// Charger is active
+    /// Charger active
     pub const CHARGING: Self = Self(0x2);
-    /// Charging complete, but the charger is still active
+    /// Full, charger still active
     pub const CHARGED: Self = Self(0x4);
-    /// Battery temperature is above normal
+    /// Too hot
     pub const TEMP_HOT: Self = Self(0x8);
-    /// Battery temperature is below normal
+    /// Too cold
     pub const TEMP_COLD: Self = Self(0x10);
-    /// Safe operating area violation
+    /// Outside the safe operating area
     pub const OVERLOAD: Self = Self(0x20);
-    /// This battery should not be used anymore (e.g. low SOH)
+    /// Do not use (worn out)
     pub const BAD_BATTERY: Self = Self(0x40);
-    /// This battery requires maintenance (e.g. balancing, full recharge)
+    /// Needs maintenance (balancing, a full charge)
     pub const NEED_SERVICE: Self = Self(0x80);
-    /// Battery management system/controller error, smart battery interface error
+    /// Fault in the management electronics or its interface
     pub const BMS_ERROR: Self = Self(0x100);
-    /// Keep zero
+    /// Always zero
     pub const RESERVED_A: Self = Self(0x200);
-    /// Keep zero
+    /// Always zero
     pub const RESERVED_B: Self = Self(0x400);
     /// Every defined flag.
     pub const ALL: Self = Self(0x7ff);

@@ -40,9 +40,9 @@ pub struct BatteryInfo {
     ///
     /// Unit: `Percent`. Unknown: `STATE_OF_HEALTH_UNKNOWN` (the accessor gives `None`). Wire type: `uint7`.
     pub state_of_health_pct: u8,
-    /// State of charge. Required
+    /// Required; 0..100, else the constant above
     ///
-    /// Unit: `Percent`. Wire type: `uint7`.
+    /// Unit: `Percent`. Unknown: `STATE_OF_CHARGE_UNKNOWN` (the accessor gives `None`). Wire type: `uint7`.
     pub state_of_charge_pct: u8,
     /// Standard deviation of the estimate
     ///
@@ -89,6 +89,8 @@ impl BatteryInfo {
     pub const STATUS_FLAG_RESERVED_B: u16 = 1024;
     /// State of health. Health cannot be estimated
     pub const STATE_OF_HEALTH_UNKNOWN: u8 = 127;
+    /// State of charge (dronecan/DSDL gave it an "unknown" value in February 2026). Charge cannot be estimated
+    pub const STATE_OF_CHARGE_UNKNOWN: u8 = 127;
     /// The DroneCAN data type signature.
     pub const DATA_TYPE_SIGNATURE: u64 = 0x249c26548a711966;
     /// The default DroneCAN data type id.
@@ -109,7 +111,7 @@ impl BatteryInfo {
             hours_to_full_charge: f32::NAN,
             status_flags: 0,
             state_of_health_pct: 127,
-            state_of_charge_pct: 0,
+            state_of_charge_pct: 127,
             state_of_charge_pct_stdev: 0,
             battery_id: 0,
             model_instance_id: 0,
@@ -199,6 +201,17 @@ impl BatteryInfo {
     #[must_use]
     pub fn state_of_health_pct(&self) -> Option<u8> {
         let v = self.state_of_health_pct;
+        if v == 127 {
+            None
+        } else {
+            Some(v)
+        }
+    }
+
+    /// `state_of_charge_pct`, None when it holds its "unknown" value.
+    #[must_use]
+    pub fn state_of_charge_pct(&self) -> Option<u8> {
+        let v = self.state_of_charge_pct;
         if v == 127 {
             None
         } else {
@@ -418,6 +431,9 @@ pub(crate) fn check_state_of_health_pct(v: u8) -> Option<Rule> {
 }
 
 pub(crate) fn check_state_of_charge_pct(v: u8) -> Option<Rule> {
+    if v == 127 {
+        return None;
+    }
     if v > 127 {
         return Some(Rule::TypeBounds);
     }

@@ -1,0 +1,44 @@
+"""The DroneCAN types ``battgen can`` names and CRC-checks beyond those of the generated package.
+
+A bus carries far more than batteries (NodeStatus, GetNodeInfo, parameters, ``uavcan.protocol.file.Read``);
+their multi-frame transfers are CRC-checked only with their data type signature, which the DSDL defines. The
+standard tree is the one the ``dronecan`` package ships (``dsdl_specs``: uavcan, ardupilot, dronecan, cuav,
+com, mppt), read with battgen's own DSDL frontend, or a user's copy of dronecan/DSDL (``--dsdl DIR``). These
+types are named and checked, not decoded: decoding is the generated package's job.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.util
+from pathlib import Path
+
+from ..frontends import dsdl
+from ..ir import DronecanKind
+
+# (message | request | response, data type id) -> (DSDL full name, data type signature)
+TypeTable = dict[tuple[str, int], tuple[str, int]]
+
+
+def shipped_tree() -> Path | None:
+    """The DSDL root the ``dronecan`` package ships, where it is installed (found without importing it)."""
+    spec = importlib.util.find_spec("dronecan")
+    if spec is None or spec.origin is None:
+        return None
+    root = Path(spec.origin).parent / "dsdl_specs"
+    return root if root.is_dir() else None
+
+
+@functools.cache
+def standard_types(root: Path | None) -> TypeTable:
+    """Every type with a data type id under the DSDL root ``root`` (None: no table)."""
+    if root is None:
+        return {}
+    table: TypeTable = {}
+    for message in dsdl.parse_dir(root).messages:
+        info = message.dronecan
+        if info is None or info.data_type_id is None:
+            continue
+        kind = "message" if info.kind is DronecanKind.MESSAGE else info.kind.value
+        table.setdefault((kind, info.data_type_id), (info.full_name, info.signature))
+    return table
