@@ -3,7 +3,9 @@ candump, ASC and BLF, JSON Lines), on mutated real files of ``../shared/corpus``
 reads or raises a located BattgenError naming it, with a short message -- never another exception, a hang or a
 memory blow-up (the BLF and text bounds of codegen/inputs/can/bounded.py included).
 
-A failing input is saved by hand under ``tests/fuzz/crashers/view-<kind>/`` and replayed on every run here.
+A failing input becomes a regression: rebuilt from the format as a test of its own where it is a mutation of an
+upstream file (the corpus stays in ``../shared``), else saved under ``tests/fuzz/crashers/view-<kind>/`` and
+replayed on every run here.
 ``BATTGEN_FUZZ=long`` runs far more inputs per kind (tests/fuzz/budget.py).
 """
 

@@ -96,6 +96,25 @@ def test_a_damaged_compressed_blf_container_is_one_error(tmp_path: Path) -> None
         list(read_capture(damaged, "damaged.blf"))
 
 
+def test_a_container_python_can_cannot_parse_is_one_error(tmp_path: Path) -> None:
+    """A container whose frames hold no LOBJ where the next object should start: python-can raises its own
+    BLFParseError (a bare Exception), which the reader reports as the capture's error (found by the data-layer
+    fuzzer on a mutated real BLF; rebuilt here from the format)."""
+    broken = tmp_path / "broken.blf"
+    broken.write_bytes(_blf([_container(bytes(32), 32, method=0)]))
+    with pytest.raises(InputError, match="cannot read the CAN capture after frame 0: Could not find next object"):
+        list(read_capture(broken, "broken.blf"))
+
+
+def test_a_hostile_line_is_quoted_briefly(tmp_path: Path) -> None:
+    """python-can's complaint quotes the whole line; the error does not (the fuzzer's 5 KB timestamp)."""
+    capture = tmp_path / "long.log"
+    capture.write_text("9" * 5000 + "(1436992770.657995) can0 1E3081FD#230D007B0100009B\n", encoding="ascii")
+    with pytest.raises(InputError) as err:
+        list(read_capture(capture, "long.log"))
+    assert err.value.line == 1 and "9999" not in str(err.value) and len(str(err.value)) < 400
+
+
 def test_an_endless_line_in_a_gzip_capture_is_refused(tmp_path: Path) -> None:
     endless = tmp_path / "endless.log.gz"
     with gzip.open(endless, "wb") as f:
