@@ -191,22 +191,32 @@ def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[
     return out
 
 
-def stored_data(message: Message, data: Mapping[str, Any]) -> dict[str, Any]:
-    """A record's plain data with each float16/float32 value as its field stores it: a float32 ``voltage_v`` of
-    5e-324 is 0.0, uORB's unknown, as the firmware compares it (a value beyond the type stays, to be reported)."""
-    out = dict(data)
+FloatFields = tuple[tuple[str, Any], ...]  # (schema name, numpy type) of each float16/float32 field of a message
+
+
+def float_fields(message: Message) -> FloatFields:
+    """A message's float16 and float32 fields (and arrays of them), with the numpy type that stores each: found once
+    per message, not per record (:func:`stored_data` runs for every record)."""
+    out = []
     for f in message.fields:
         ftype = f.type.element if isinstance(f.type, ArrayType) else f.type
-        value = out.get(f.name)
-        if value is None or not isinstance(ftype, PrimitiveType) or ftype.kind is not PrimitiveKind.FLOAT:
-            continue
-        if ftype.bits in (16, 32):
-            narrow = np.float16 if ftype.bits == 16 else np.float32
-            with np.errstate(over="ignore"):
-                if isinstance(value, list):
-                    out[f.name] = [_narrowed(v, narrow) for v in value]
-                else:
-                    out[f.name] = _narrowed(value, narrow)
+        if isinstance(ftype, PrimitiveType) and ftype.kind is PrimitiveKind.FLOAT and ftype.bits in (16, 32):
+            out.append((f.name, np.float16 if ftype.bits == 16 else np.float32))
+    return tuple(out)
+
+
+def stored_data(fields: FloatFields, data: Mapping[str, Any]) -> dict[str, Any]:
+    """A record's plain data with each float16/float32 value (``fields``: :func:`float_fields`) as its field stores
+    it: a float32 ``voltage_v`` of 5e-324 is 0.0, uORB's unknown, as the firmware compares it (a value beyond the
+    type stays, to be reported)."""
+    out = dict(data)
+    with np.errstate(over="ignore"):
+        for name, narrow in fields:
+            value = out.get(name)
+            if isinstance(value, list):
+                out[name] = [_narrowed(v, narrow) for v in value]
+            elif value is not None:
+                out[name] = _narrowed(value, narrow)
     return out
 
 
@@ -222,9 +232,9 @@ _LISTED = 10  # records left out that a batch's notes name one by one (the rest 
 
 
 def jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None) -> Iterator[Batch]:
-    """A JSON Lines file's records in batches of :data:`JSONL_CHUNK`. A record whose integer does not fit its
-    field's type (a uORB ``id`` of 2^32 + 1) is left out with a note naming it: cast, it would wrap into another
-    battery's number."""
+    """A JSON Lines file's records in batches of :data:`JSONL_CHUNK`. A record whose number does not fit its
+    field's type (a uORB ``id`` of 2^32 + 1, a float32 of 1e300) is left out with a note naming it: cast, it would
+    wrap into another battery's number (or be infinity)."""
     qualified: str | None = message
     records: list[Record] = []
     first_stamp: float | None = None
@@ -249,13 +259,13 @@ def _jsonl_batch(
     (``first``, once an earlier batch had one)."""
     model = model_of(catalog, qualified)
     message = catalog.schema.message(qualified)
-    limits = integer_limits(message)
+    limits, floats = number_limits(message), float_fields(message)
     instances = []
     notes: list[str] = []
     left_out = 0
     for rec in records:
         try:
-            data = stored_data(message, rec.data) if isinstance(rec.data, dict) else rec.data
+            data = stored_data(floats, rec.data) if isinstance(rec.data, dict) else rec.data
             instance = model.from_dict(data)
         except (ValueError, TypeError, KeyError) as exc:
             raise InputError(name, rec.line, f"expected a {qualified} record: {exc}") from None
@@ -267,7 +277,7 @@ def _jsonl_batch(
             continue
         instances.append(instance)
     if left_out > _LISTED:
-        notes.append(f"{name}: {left_out - _LISTED} more records left out whose integers do not fit their types")
+        notes.append(f"{name}: {left_out - _LISTED} more records left out whose numbers do not fit their types")
     columns = instances_to_columns(message, instances)
     n = len(instances)
     t = np.full(n, np.nan)
@@ -282,7 +292,7 @@ def _jsonl_batch(
 Limits = list[tuple[str, str, float, float]]  # (attribute, type name, lowest, highest) of each number field
 
 
-def integer_limits(message: Message) -> Limits:
+def number_limits(message: Message) -> Limits:
     """The integer and float16/float32 fields of a message (and arrays of them) with the range of their IR type."""
     out: Limits = []
     for f in message.fields:

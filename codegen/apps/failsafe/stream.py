@@ -37,7 +37,7 @@ from ...inputs.documents import read_jsonl
 from ...inputs.model import GeneratedMessage, MessageClass, package_name
 from ...inputs.records import Record, Unreadable
 from ...ir import Schema
-from ..battery.sources import stored_data
+from ..battery.sources import FloatFields, float_fields, stored_data
 from ..convert import ConvertModule
 from ..messages import resolve_message
 from ..package import bundled_schemas, model_class, model_package
@@ -158,15 +158,16 @@ class Reader:
         self.schema = schema
         self.package = package
         self.default_message = default_message
-        self._classes: dict[str, tuple[str, MessageClass]] = {}
+        self._classes: dict[str, tuple[str, MessageClass, FloatFields]] = {}
 
-    def model(self, name: str, file: str, line: int) -> tuple[str, MessageClass]:
+    def model(self, name: str, file: str, line: int) -> tuple[str, MessageClass, FloatFields]:
+        """A message name's qualified name, generated class and float fields (resolved once per name)."""
         if name not in self._classes:
             try:
                 msg = resolve_message(self.schema, name)
             except BattgenError as exc:
                 raise StreamError(file, line, str(exc)) from None
-            self._classes[name] = (msg.qualified_name, model_class(self.package, msg))
+            self._classes[name] = (msg.qualified_name, model_class(self.package, msg), float_fields(msg))
         return self._classes[name]
 
     def read(self, path: Path) -> Iterator[Sample]:
@@ -222,11 +223,10 @@ class Reader:
         data = obj.get("data")
         if not isinstance(data, dict):
             raise fail(f'expected "data": an object of {name} fields')
-        qualified, cls = self.model(name, file, line)
+        qualified, cls, floats = self.model(name, file, line)
         try:
-            # as the fields store them: a float32 voltage of 5e-324 is 0.0, the unknown, as validate and the
-            # export read it
-            model = cls.from_dict(stored_data(self.schema.message(qualified), data))
+            # as the fields store them: a float32 voltage of 5e-324 is 0.0, the unknown, as the export reads it
+            model = cls.from_dict(stored_data(floats, data))
             battery = battery_state(qualified, model)
         except (ValueError, BattgenError) as exc:
             raise fail(f"expected {qualified} data: {exc}") from None
