@@ -14,6 +14,8 @@ half of it. Errors are not cached: a folder that fails to parse fails on every r
 from __future__ import annotations
 
 import hashlib
+import io
+import math
 import os
 import pickle
 import sys
@@ -27,7 +29,23 @@ _CODE_DIRS = (Path(__file__).resolve().parent, Path(__file__).resolve().parents[
 # the package face, whose __version__ is battgen's version (read as bytes: importing it from here would make the
 # frontends depend on the package face, which names the backends)
 _VERSION_FILE = Path(__file__).resolve().parents[1] / "__init__.py"
-_MAGIC = b"battgen-ir-cache 1\n"
+_MAGIC = b"battgen-ir-cache 2\n"
+_NAN_ID = "nan"
+
+
+class _Pickler(pickle.Pickler):
+    # The frontends give every NaN of the IR as the one object math.nan, so that equal ops and sentinels
+    # compare equal (tuples compare members by identity first, and NaN != NaN); pickle would write each as a
+    # float of its own and read back distinct objects, making a cached IR unequal to a parsed one.
+    def persistent_id(self, obj: object) -> str | None:
+        return _NAN_ID if isinstance(obj, float) and obj != obj else None
+
+
+class _Unpickler(pickle.Unpickler):
+    def persistent_load(self, pid: object) -> object:
+        if pid == _NAN_ID:
+            return math.nan
+        raise pickle.UnpicklingError(f"unknown persistent id {pid!r}")
 
 
 def _tree(root: Path, suffix: str = "") -> list[Path]:
@@ -62,7 +80,7 @@ def _read(file: Path, key: str) -> Schema | None:
     if not data.startswith(head):  # a different key (a clash of names cut short) or a torn file
         return None
     try:
-        schema = pickle.loads(data[len(head) :])
+        schema = _Unpickler(io.BytesIO(data[len(head) :])).load()
     except Exception:  # an unreadable cache is only a cache: parse afresh
         return None
     return schema if isinstance(schema, Schema) else None
@@ -75,7 +93,7 @@ def _write(file: Path, key: str, schema: Schema) -> None:
         try:
             with os.fdopen(fd, "wb") as out:
                 out.write(_MAGIC + key.encode() + b"\n")
-                pickle.dump(schema, out, protocol=pickle.HIGHEST_PROTOCOL)
+                _Pickler(out, protocol=pickle.HIGHEST_PROTOCOL).dump(schema)
             os.replace(tmp, file)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
