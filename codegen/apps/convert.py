@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import IO, Literal, Protocol, cast
 
 from ..errors import BattgenError, cannot_read, did_you_mean
-from ..frontends.loader import load
 from ..inputs.can.records import capture_side
 from ..inputs.devicetree.records import read_devicetree
 from ..inputs.documents import read_json, read_jsonl, read_yaml
@@ -37,7 +36,7 @@ from ..inputs.records import InputError, Item, Notice, Record, Unreadable
 from ..inputs.tlog import StreamStats, mavlink_items, message_name
 from ..inputs.ulog import ulog_items
 from ..ir.numbers import to_json_data
-from .package import bundled_schemas, named_package, package_module
+from .package import bundled_schemas, load_schemas, named_package, package_module
 
 FORMATS = ("json", "jsonl", "yaml", "hex", "raw")
 BINARY_FORMATS = ("hex", "raw")
@@ -416,7 +415,7 @@ def _devicetree_items(source: Path | IO[bytes], where: str, fmt: str, cls: objec
         raise BattgenError(f"{where}: expected --from devicetree for a devicetree file, found --from side {name}")
     if not isinstance(source, Path):
         raise BattgenError(f"{where}: a devicetree file is read from a file, not from standard input")
-    schema = load([bundled_schemas()])
+    schema = load_schemas(bundled_schemas())
     try:
         message = schema.message(name)
     except KeyError:

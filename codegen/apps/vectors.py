@@ -21,12 +21,11 @@ from collections.abc import Iterator, Mapping
 from typing import Any, cast
 
 from ..errors import BattgenError
-from ..frontends.loader import load
 from ..inputs.records import Record
 from ..ir import EnumKind, Schema
 from ..ir.numbers import to_json_data
 from .convert import Conversion
-from .package import bundled_schemas
+from .package import bundled_schemas, load_schemas
 
 FORMAT_VERSION = 1
 SIDES = ("dronecan", "uorb", "uorb_v0", "mavlink")  # sources with message fields to vary
@@ -200,7 +199,7 @@ def edges(spec: FieldSpec, schema: Schema) -> Iterator[tuple[str, object]]:
 @functools.cache
 def _bundled_schema() -> Schema:
     """The bundled schemas' IR (enum entries), read once per process."""
-    return load([bundled_schemas()])
+    return load_schemas(bundled_schemas())
 
 
 class VectorWriter:
