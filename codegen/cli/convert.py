@@ -41,7 +41,12 @@ def register(subparsers: Any, summary: str) -> None:
     p = subparsers.add_parser("convert", help=summary)
     p.add_argument("--from", dest="source", required=True, help="source side (dronecan, uorb, uorb_v0, mavlink, ...)")
     p.add_argument("--to", dest="target", required=True, help="target side, or 'concepts' for the shared state")
-    p.add_argument("--policy", choices=("strict", "px4"), default="strict", help="strict (default) or px4")
+    p.add_argument(
+        "--policy",
+        choices=("strict", "px4", "ardupilot"),
+        default="strict",
+        help="strict (default), px4 or ardupilot: as the specifications say, or as that firmware's code does",
+    )
     p.add_argument("--report", action="store_true", help="add each record's loss report (to stderr for binary output)")
     p.add_argument(
         "--report-summary",

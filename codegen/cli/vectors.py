@@ -28,7 +28,12 @@ def register(subparsers: Any, summary: str) -> None:
     )
     p.add_argument("--from", dest="source", required=True, help="source side (dronecan, uorb, uorb_v0, mavlink)")
     p.add_argument("--to", dest="target", required=True, help="target side (any, 'concepts' included)")
-    p.add_argument("--policy", choices=("strict", "px4"), default="strict", help="strict (default) or px4")
+    p.add_argument(
+        "--policy",
+        choices=("strict", "px4", "ardupilot"),
+        default="strict",
+        help="strict (default), px4 or ardupilot: as the specifications say, or as that firmware's code does",
+    )
     p.add_argument("-o", "--output", help="output file (default: standard output)")
     p.set_defaults(func=run)
 

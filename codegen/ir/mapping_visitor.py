@@ -44,6 +44,10 @@ class OpVisitor(Protocol[T_co]):
     def visit_px4_aux_capacity(self, rule: Rule, op: ops.PX4AuxCapacity) -> T_co: ...
     def visit_px4_bridge_estimates(self, rule: Rule, op: ops.PX4BridgeEstimates) -> T_co: ...
     def visit_px4_udral_energy(self, rule: Rule, op: ops.PX4UdralEnergy) -> T_co: ...
+    def visit_ardupilot_temperature(self, rule: Rule, op: ops.ArduPilotTemperature) -> T_co: ...
+    def visit_ardupilot_current(self, rule: Rule, op: ops.ArduPilotCurrent) -> T_co: ...
+    def visit_ardupilot_cells(self, rule: Rule, op: ops.ArduPilotCells) -> T_co: ...
+    def visit_ardupilot_estimates(self, rule: Rule, op: ops.ArduPilotEstimates) -> T_co: ...
 
 
 def visit(rule: Rule, visitor: OpVisitor[T_co]) -> T_co:
@@ -102,5 +106,13 @@ def visit(rule: Rule, visitor: OpVisitor[T_co]) -> T_co:
             return visitor.visit_px4_bridge_estimates(rule, op)
         case ops.PX4UdralEnergy():
             return visitor.visit_px4_udral_energy(rule, op)
+        case ops.ArduPilotTemperature():
+            return visitor.visit_ardupilot_temperature(rule, op)
+        case ops.ArduPilotCurrent():
+            return visitor.visit_ardupilot_current(rule, op)
+        case ops.ArduPilotCells():
+            return visitor.visit_ardupilot_cells(rule, op)
+        case ops.ArduPilotEstimates():
+            return visitor.visit_ardupilot_estimates(rule, op)
         case _:
             assert_never(op)

@@ -73,7 +73,7 @@ class Mapping:
     """How to turn the ``source`` endpoint into the ``target`` endpoint under ``policy``.
 
     ``reversible`` mappings are also generated target -> source; ``policy`` is ``strict``,
-    ``px4`` or ``any``.
+    ``px4``, ``ardupilot`` (the code of that firmware) or ``any``.
     """
 
     name: str

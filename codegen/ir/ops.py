@@ -374,6 +374,69 @@ class PX4BridgeEstimates(Op):
     discharged_input: str
 
 
+@dataclass(frozen=True)
+class ArduPilotTemperature(Op):
+    """ArduPilot's DroneCAN battery monitor and its BATTERY_STATUS: a temperature in kelvin taken only
+    when it is a number above 0 (``update_interim_state``), sent as ``(int16_t)((K - 273.15f) * 100)``
+    centidegrees, else INT16_MAX (``send_battery_status``: no temperature)."""
+
+    NAME: ClassVar[str] = "ardupilot_temperature"
+
+
+@dataclass(frozen=True)
+class ArduPilotCurrent(Op):
+    """ArduPilot's current: the message's current times the converter input ``curr_mult_input``
+    (BATT_CURR_MULT, 1 if not given), sent as ``constrain_float(amps * 100, -INT16_MAX, INT16_MAX)``
+    centiamperes (AP_Math's constrain turns NaN into the middle of the range: 0)."""
+
+    NAME: ClassVar[str] = "ardupilot_current"
+    curr_mult_input: str
+
+
+@dataclass(frozen=True)
+class ArduPilotCells(Op):
+    """ArduPilot's cell voltages in BATTERY_STATUS: ``from: [pack voltage, aux cells]`` -> ``to:
+    [voltages, voltages_ext]``. Without the companion message (no cell voltages) the pack voltage in
+    mV is spread over the ten cells, at most UINT16_MAX - 1 each, UINT16_MAX once less than 0.001 mV
+    is left, and no extended cells; with it the first ``max_cells`` cells in mV (float to uint16), the
+    rest 0, each raised by an equal share of what the pack voltage exceeds their sum."""
+
+    NAME: ClassVar[str] = "ardupilot_cells"
+    SOURCES: ClassVar[Arity] = (2, 2)
+    TARGETS: ClassVar[Arity] = (2, 2)
+    HANDLES_MISSING: ClassVar[bool] = True
+    max_cells: Number
+
+
+@dataclass(frozen=True)
+class ArduPilotEstimates(Op):
+    """ArduPilot's consumed charge and energy, remaining percentage and time for a DroneCAN battery:
+    ``from: [voltage, current, state of charge %, remaining Wh, full Wh, aux nominal voltage]`` -> ``to:
+    [consumed mAh, consumed hJ, remaining %, time remaining s]``, all in float32 as AP_BattMonitor holds
+    them. The charge and energy so far come in as the converter inputs ``consumed_input`` (mAh) and
+    ``energy_input`` (Wh), the seconds since the previous message as ``dt_input`` (none: the first
+    message), BATT_CAPACITY as ``capacity_input`` (mAh, ``capacity_default`` if not given),
+    BATT_OPTIONS as ``options_input`` and BATT_CURR_MULT as ``curr_mult_input``.
+
+    The battery's state of charge is used unless BATT_OPTIONS bit 0 (ignore it) is set or it is 127
+    (unknown); otherwise the percentage comes from the capacity and the charge consumed, which grows by
+    the current over the time since the previous message (under 2 s) whenever no companion message
+    came or the state of charge is not used. A companion message with a nominal voltage above 0 sets
+    the consumed charge and energy from the full and remaining energy, and the time remaining."""
+
+    NAME: ClassVar[str] = "ardupilot_estimates"
+    SOURCES: ClassVar[Arity] = (6, 6)
+    TARGETS: ClassVar[Arity] = (4, 4)
+    HANDLES_MISSING: ClassVar[bool] = True
+    dt_input: str
+    consumed_input: str
+    energy_input: str
+    capacity_input: str
+    options_input: str
+    curr_mult_input: str
+    capacity_default: Number
+
+
 MappingOp = (
     Scale
     | Copy
@@ -401,6 +464,10 @@ MappingOp = (
     | PX4AuxCapacity
     | PX4BridgeEstimates
     | PX4UdralEnergy
+    | ArduPilotTemperature
+    | ArduPilotCurrent
+    | ArduPilotCells
+    | ArduPilotEstimates
 )
 
 # every op by the name mapping files give it, in the order above

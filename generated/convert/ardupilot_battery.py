@@ -22,6 +22,7 @@ def to_concepts(
 
     strict: ardupilot_battery (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -30,9 +31,9 @@ def to_concepts(
             continuous, periodic, cells, tag, rep=report, rep_d=report, rep_u=report
         )
         return _strict_1[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts ardupilot_battery to concepts; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts ardupilot_battery to concepts; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def from_concepts(
@@ -42,12 +43,13 @@ def from_concepts(
 
     strict: ardupilot_battery (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
         _strict_1 = _map_ardupilot_battery.backward(state, rep=report, rep_d=report, rep_u=report)
         return _strict_1
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts concepts to ardupilot_battery; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts concepts to ardupilot_battery; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -22,6 +22,7 @@ def ardupilot_battery_to_mavlink_v2(
 
     strict: ardupilot_battery (forward) -> mavlink_v2 (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -31,9 +32,9 @@ def ardupilot_battery_to_mavlink_v2(
         )
         _strict_2 = _map_mavlink_v2.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts ardupilot_battery to mavlink_v2; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts ardupilot_battery to mavlink_v2; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_v2_to_ardupilot_battery(
@@ -43,6 +44,7 @@ def mavlink_v2_to_ardupilot_battery(
 
     strict: mavlink_v2 (forward) -> ardupilot_battery (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -50,6 +52,6 @@ def mavlink_v2_to_ardupilot_battery(
         _strict_1 = _map_mavlink_v2.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_ardupilot_battery.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_v2 to ardupilot_battery; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_v2 to ardupilot_battery; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

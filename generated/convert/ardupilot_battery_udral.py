@@ -23,6 +23,7 @@ def ardupilot_battery_to_udral(
 
     strict: ardupilot_battery (forward) -> udral (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -32,9 +33,9 @@ def ardupilot_battery_to_udral(
         )
         _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts ardupilot_battery to udral; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts ardupilot_battery to udral; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def udral_to_ardupilot_battery(
@@ -49,6 +50,7 @@ def udral_to_ardupilot_battery(
 
     strict: udral (forward) -> ardupilot_battery (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -56,6 +58,6 @@ def udral_to_ardupilot_battery(
         _strict_1 = _map_udral.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_ardupilot_battery.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts udral to ardupilot_battery; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts udral to ardupilot_battery; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -22,6 +22,7 @@ def ardupilot_battery_to_uorb_v0(
 
     strict: ardupilot_battery (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -32,9 +33,9 @@ def ardupilot_battery_to_uorb_v0(
         _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts ardupilot_battery to uorb_v0; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts ardupilot_battery to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_v0_to_ardupilot_battery(
@@ -44,6 +45,7 @@ def uorb_v0_to_ardupilot_battery(
 
     strict: uorb_v0_up (forward) -> uorb (forward) -> ardupilot_battery (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -52,6 +54,6 @@ def uorb_v0_to_ardupilot_battery(
         _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_ardupilot_battery.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_v0 to ardupilot_battery; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to ardupilot_battery; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

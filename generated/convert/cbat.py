@@ -14,15 +14,16 @@ def to_concepts(cbat: CBAT, *, policy: str = "strict", report: _r.LossReport | N
 
     strict: cbat (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
         _strict_1 = _map_cbat.forward(cbat, rep=report, rep_d=report, rep_u=report)
         return _strict_1[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts cbat to concepts; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts cbat to concepts; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def from_concepts(state: BatteryState, *, policy: str = "strict", report: _r.LossReport | None = None) -> CBAT:
@@ -30,12 +31,13 @@ def from_concepts(state: BatteryState, *, policy: str = "strict", report: _r.Los
 
     strict: cbat (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
         _strict_1 = _map_cbat.backward(state, rep=report, rep_d=report, rep_u=report)
         return _strict_1[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts concepts to cbat; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts concepts to cbat; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

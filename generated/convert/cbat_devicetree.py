@@ -21,6 +21,7 @@ def devicetree_to_cbat(
 
     strict: devicetree (forward) -> cbat (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -30,6 +31,6 @@ def devicetree_to_cbat(
         )
         _strict_2 = _map_cbat.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts devicetree to cbat; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts devicetree to cbat; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

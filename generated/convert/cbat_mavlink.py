@@ -14,6 +14,7 @@ def cbat_to_mavlink(cbat: CBAT, *, policy: str = "strict", report: _r.LossReport
 
     strict: cbat (forward) -> mavlink (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -21,9 +22,9 @@ def cbat_to_mavlink(cbat: CBAT, *, policy: str = "strict", report: _r.LossReport
         _strict_1 = _map_cbat.forward(cbat, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts cbat to mavlink; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts cbat to mavlink; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_to_cbat(msg: BatteryStatus, *, policy: str = "strict", report: _r.LossReport | None = None) -> CBAT:
@@ -31,6 +32,7 @@ def mavlink_to_cbat(msg: BatteryStatus, *, policy: str = "strict", report: _r.Lo
 
     strict: mavlink (forward) -> cbat (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -38,6 +40,6 @@ def mavlink_to_cbat(msg: BatteryStatus, *, policy: str = "strict", report: _r.Lo
         _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_cbat.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink to cbat; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink to cbat; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -17,6 +17,7 @@ def cbat_to_udral(
 
     strict: cbat (forward) -> udral (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -24,9 +25,9 @@ def cbat_to_udral(
         _strict_1 = _map_cbat.forward(cbat, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts cbat to udral; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts cbat to udral; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def udral_to_cbat(
@@ -41,6 +42,7 @@ def udral_to_cbat(
 
     strict: udral (forward) -> cbat (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -48,6 +50,6 @@ def udral_to_cbat(
         _strict_1 = _map_udral.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_cbat.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts udral to cbat; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts udral to cbat; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -14,6 +14,7 @@ def cbat_to_uorb_v0(cbat: CBAT, *, policy: str = "strict", report: _r.LossReport
 
     strict: cbat (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -22,9 +23,9 @@ def cbat_to_uorb_v0(cbat: CBAT, *, policy: str = "strict", report: _r.LossReport
         _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts cbat to uorb_v0; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts cbat to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_v0_to_cbat(status: BatteryStatusV0, *, policy: str = "strict", report: _r.LossReport | None = None) -> CBAT:
@@ -32,6 +33,7 @@ def uorb_v0_to_cbat(status: BatteryStatusV0, *, policy: str = "strict", report: 
 
     strict: uorb_v0_up (forward) -> uorb (forward) -> cbat (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -40,6 +42,6 @@ def uorb_v0_to_cbat(status: BatteryStatusV0, *, policy: str = "strict", report: 
         _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_cbat.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_v0 to cbat; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to cbat; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

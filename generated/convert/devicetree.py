@@ -21,6 +21,7 @@ def to_concepts(
 
     strict: devicetree (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -29,6 +30,6 @@ def to_concepts(
             node, rep=report, rep_d=report, rep_u=report, ocv_v=ocv_v, temperature_c=temperature_c
         )
         return _strict_1[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts devicetree to concepts; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts devicetree to concepts; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

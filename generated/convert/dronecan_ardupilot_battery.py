@@ -22,6 +22,7 @@ def dronecan_to_ardupilot_battery(
 
     strict: dronecan (forward) -> ardupilot_battery (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -29,9 +30,9 @@ def dronecan_to_ardupilot_battery(
         _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_ardupilot_battery.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts dronecan to ardupilot_battery; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts dronecan to ardupilot_battery; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def ardupilot_battery_to_dronecan(
@@ -47,6 +48,7 @@ def ardupilot_battery_to_dronecan(
 
     strict: ardupilot_battery (forward) -> dronecan (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -56,6 +58,6 @@ def ardupilot_battery_to_dronecan(
         )
         _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts ardupilot_battery to dronecan; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts ardupilot_battery to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -22,6 +22,7 @@ def devicetree_to_dronecan(
 
     strict: devicetree (forward) -> dronecan (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -31,6 +32,6 @@ def devicetree_to_dronecan(
         )
         _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts devicetree to dronecan; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts devicetree to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

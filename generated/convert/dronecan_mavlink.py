@@ -7,6 +7,7 @@ from ..dronecan.ardupilot.equipment.power import BatteryInfoAux
 from ..dronecan.uavcan.equipment.power import BatteryInfo
 from ..mavlink import BatteryStatus
 from . import (
+    _map_ardupilot_dronecan,
     _map_dronecan,
     _map_mavlink,
     _map_px4_mavlink_receiver,
@@ -23,13 +24,19 @@ def dronecan_to_mavlink(
     *,
     policy: str = "strict",
     report: _r.LossReport | None = None,
+    capacity_mah: float | None = None,
+    consumed_mah_before: float | None = None,
+    consumed_wh_before: float | None = None,
+    curr_mult: float | None = None,
     discharged_mah_before: float | None = None,
     dt_s: float | None = None,
+    options: float | None = None,
 ) -> BatteryStatus:
     """Convert dronecan to mavlink.
 
     strict: dronecan (forward) -> mavlink (backward)
     px4: px4_uavcan_bridge (forward) -> px4_mavlink_stream (forward)
+    ardupilot: ardupilot_dronecan (forward)
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -43,7 +50,22 @@ def dronecan_to_mavlink(
         )
         _px4_2 = _map_px4_mavlink_stream.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
         return _px4_2[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        _ardupilot_1 = _map_ardupilot_dronecan.forward(
+            info,
+            aux,
+            rep=report,
+            rep_d=report,
+            rep_u=report,
+            curr_mult=curr_mult,
+            capacity_mah=capacity_mah,
+            dt_s=dt_s,
+            consumed_mah_before=consumed_mah_before,
+            consumed_wh_before=consumed_wh_before,
+            options=options,
+        )
+        return _ardupilot_1[0]
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_to_dronecan(
@@ -53,6 +75,7 @@ def mavlink_to_dronecan(
 
     strict: mavlink (forward) -> dronecan (backward)
     px4: px4_mavlink_receiver (forward) -> px4_uavcannode (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -64,4 +87,6 @@ def mavlink_to_dronecan(
         _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=None)
         _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
         return _px4_2
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

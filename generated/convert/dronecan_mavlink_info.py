@@ -21,6 +21,7 @@ def dronecan_to_mavlink_info(
 
     strict: dronecan (forward) -> mavlink_info (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -28,9 +29,9 @@ def dronecan_to_mavlink_info(
         _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_mavlink_info.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts dronecan to mavlink_info; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts dronecan to mavlink_info; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_info_to_dronecan(
@@ -40,6 +41,7 @@ def mavlink_info_to_dronecan(
 
     strict: mavlink_info (forward) -> dronecan (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -47,6 +49,6 @@ def mavlink_info_to_dronecan(
         _strict_1 = _map_mavlink_info.forward(info, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_info to dronecan; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_info to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

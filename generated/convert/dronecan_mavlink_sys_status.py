@@ -17,6 +17,7 @@ def mavlink_sys_status_to_dronecan(
 
     strict: mavlink_sys_status (forward) -> dronecan (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -24,6 +25,6 @@ def mavlink_sys_status_to_dronecan(
         _strict_1 = _map_mavlink_sys_status.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_sys_status to dronecan; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_sys_status to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

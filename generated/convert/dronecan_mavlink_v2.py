@@ -17,6 +17,7 @@ def dronecan_to_mavlink_v2(
 
     strict: dronecan (forward) -> mavlink_v2 (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -24,9 +25,9 @@ def dronecan_to_mavlink_v2(
         _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_mavlink_v2.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts dronecan to mavlink_v2; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts dronecan to mavlink_v2; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_v2_to_dronecan(
@@ -36,6 +37,7 @@ def mavlink_v2_to_dronecan(
 
     strict: mavlink_v2 (forward) -> dronecan (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -43,6 +45,6 @@ def mavlink_v2_to_dronecan(
         _strict_1 = _map_mavlink_v2.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_v2 to dronecan; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_v2 to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

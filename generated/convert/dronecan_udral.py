@@ -18,6 +18,7 @@ def dronecan_to_udral(
 
     strict: dronecan (forward) -> udral (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -25,9 +26,9 @@ def dronecan_to_udral(
         _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts dronecan to udral; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts dronecan to udral; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def udral_to_dronecan(
@@ -42,6 +43,7 @@ def udral_to_dronecan(
 
     strict: udral (forward) -> dronecan (backward)
     px4: px4_cyphal_battery (forward) -> px4_uavcannode (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -53,4 +55,6 @@ def udral_to_dronecan(
         _px4_1 = _map_px4_cyphal_battery.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
         _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
         return _px4_2
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts udral to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -23,6 +23,7 @@ def dronecan_to_uorb(
 
     strict: dronecan (forward) -> uorb (backward)
     px4: px4_uavcan_bridge (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -35,7 +36,9 @@ def dronecan_to_uorb(
             info, aux, rep=report, rep_d=report, rep_u=report, dt_s=dt_s, discharged_mah_before=discharged_mah_before
         )
         return _px4_1[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts dronecan to uorb; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_to_dronecan(
@@ -45,6 +48,7 @@ def uorb_to_dronecan(
 
     strict: uorb (forward) -> dronecan (backward)
     px4: px4_uavcannode (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -55,4 +59,6 @@ def uorb_to_dronecan(
     if policy == "px4":
         _px4_1 = _map_px4_uavcannode.forward(status, rep=report, rep_d=report, rep_u=report)
         return _px4_1
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

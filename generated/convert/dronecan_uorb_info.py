@@ -21,6 +21,7 @@ def dronecan_to_uorb_info(
 
     strict: dronecan (forward) -> uorb_info (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -28,9 +29,9 @@ def dronecan_to_uorb_info(
         _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_uorb_info.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts dronecan to uorb_info; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts dronecan to uorb_info; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_info_to_dronecan(
@@ -40,6 +41,7 @@ def uorb_info_to_dronecan(
 
     strict: uorb_info (forward) -> dronecan (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -47,6 +49,6 @@ def uorb_info_to_dronecan(
         _strict_1 = _map_uorb_info.forward(info, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_info to dronecan; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_info to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -23,6 +23,7 @@ def dronecan_to_uorb_v0(
 
     strict: dronecan (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: px4_uavcan_bridge (forward) -> uorb_v0_down (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -37,7 +38,9 @@ def dronecan_to_uorb_v0(
         )
         _px4_2 = _map_uorb_v0_down.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
         return _px4_2[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts dronecan to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_v0_to_dronecan(
@@ -47,6 +50,7 @@ def uorb_v0_to_dronecan(
 
     strict: uorb_v0_up (forward) -> uorb (forward) -> dronecan (backward)
     px4: uorb_v0_up (forward) -> px4_uavcannode (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -59,4 +63,6 @@ def uorb_v0_to_dronecan(
         _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
         _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=report, rep_u=report)
         return _px4_2
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to dronecan; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

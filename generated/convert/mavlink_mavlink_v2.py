@@ -15,6 +15,7 @@ def mavlink_to_mavlink_v2(
 
     strict: mavlink (forward) -> mavlink_v2 (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -22,9 +23,9 @@ def mavlink_to_mavlink_v2(
         _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_mavlink_v2.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink to mavlink_v2; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink to mavlink_v2; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_v2_to_mavlink(
@@ -34,6 +35,7 @@ def mavlink_v2_to_mavlink(
 
     strict: mavlink_v2 (forward) -> mavlink (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -41,6 +43,6 @@ def mavlink_v2_to_mavlink(
         _strict_1 = _map_mavlink_v2.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_v2 to mavlink; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_v2 to mavlink; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -14,12 +14,13 @@ def to_concepts(status: SysStatus, *, policy: str = "strict", report: _r.LossRep
 
     strict: mavlink_sys_status (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
         _strict_1 = _map_mavlink_sys_status.forward(status, rep=report, rep_d=report, rep_u=report)
         return _strict_1[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_sys_status to concepts; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_sys_status to concepts; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

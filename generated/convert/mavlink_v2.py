@@ -16,15 +16,16 @@ def to_concepts(
 
     strict: mavlink_v2 (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
         _strict_1 = _map_mavlink_v2.forward(status, rep=report, rep_d=report, rep_u=report)
         return _strict_1[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_v2 to concepts; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_v2 to concepts; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def from_concepts(
@@ -34,12 +35,13 @@ def from_concepts(
 
     strict: mavlink_v2 (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
         _strict_1 = _map_mavlink_v2.backward(state, rep=report, rep_d=report, rep_u=report)
         return _strict_1[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts concepts to mavlink_v2; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts concepts to mavlink_v2; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

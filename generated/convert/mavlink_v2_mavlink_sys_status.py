@@ -15,6 +15,7 @@ def mavlink_sys_status_to_mavlink_v2(
 
     strict: mavlink_sys_status (forward) -> mavlink_v2 (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -22,6 +23,6 @@ def mavlink_sys_status_to_mavlink_v2(
         _strict_1 = _map_mavlink_sys_status.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_mavlink_v2.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_sys_status to mavlink_v2; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_sys_status to mavlink_v2; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -22,6 +22,7 @@ def udral_to_mavlink(
 
     strict: udral (forward) -> mavlink (backward)
     px4: px4_cyphal_battery (forward) -> px4_mavlink_stream (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -33,7 +34,9 @@ def udral_to_mavlink(
         _px4_1 = _map_px4_cyphal_battery.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
         _px4_2 = _map_px4_mavlink_stream.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
         return _px4_2[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts udral to mavlink; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_to_udral(
@@ -43,6 +46,7 @@ def mavlink_to_udral(
 
     strict: mavlink (forward) -> udral (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -50,6 +54,6 @@ def mavlink_to_udral(
         _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink to udral; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink to udral; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

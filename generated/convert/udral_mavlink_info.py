@@ -22,6 +22,7 @@ def udral_to_mavlink_info(
 
     strict: udral (forward) -> mavlink_info (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -29,9 +30,9 @@ def udral_to_mavlink_info(
         _strict_1 = _map_udral.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_mavlink_info.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts udral to mavlink_info; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts udral to mavlink_info; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_info_to_udral(
@@ -41,6 +42,7 @@ def mavlink_info_to_udral(
 
     strict: mavlink_info (forward) -> udral (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -48,6 +50,6 @@ def mavlink_info_to_udral(
         _strict_1 = _map_mavlink_info.forward(info, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_info to udral; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_info to udral; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -22,6 +22,7 @@ def udral_to_uorb(
 
     strict: udral (forward) -> uorb (backward)
     px4: px4_cyphal_battery (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -32,7 +33,9 @@ def udral_to_uorb(
     if policy == "px4":
         _px4_1 = _map_px4_cyphal_battery.forward(source, status, parameters, rep=report, rep_d=report, rep_u=report)
         return _px4_1[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts udral to uorb; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_to_udral(
@@ -42,6 +45,7 @@ def uorb_to_udral(
 
     strict: uorb (forward) -> udral (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -49,6 +53,6 @@ def uorb_to_udral(
         _strict_1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb to udral; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb to udral; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -22,6 +22,7 @@ def udral_to_uorb_v0(
 
     strict: udral (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: px4_cyphal_battery (forward) -> uorb_v0_down (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -34,7 +35,9 @@ def udral_to_uorb_v0(
         _px4_1 = _map_px4_cyphal_battery.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
         _px4_2 = _map_uorb_v0_down.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
         return _px4_2[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts udral to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_v0_to_udral(
@@ -44,6 +47,7 @@ def uorb_v0_to_udral(
 
     strict: uorb_v0_up (forward) -> uorb (forward) -> udral (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -52,6 +56,6 @@ def uorb_v0_to_udral(
         _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_udral.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_v0 to udral; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to udral; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -14,15 +14,16 @@ def to_concepts(info: BatteryInfo, *, policy: str = "strict", report: _r.LossRep
 
     strict: uorb_info (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
         _strict_1 = _map_uorb_info.forward(info, rep=report, rep_d=report, rep_u=report)
         return _strict_1[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_info to concepts; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_info to concepts; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def from_concepts(state: BatteryState, *, policy: str = "strict", report: _r.LossReport | None = None) -> BatteryInfo:
@@ -30,12 +31,13 @@ def from_concepts(state: BatteryState, *, policy: str = "strict", report: _r.Los
 
     strict: uorb_info (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
     if policy == "strict":
         _strict_1 = _map_uorb_info.backward(state, rep=report, rep_d=report, rep_u=report)
         return _strict_1[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts concepts to uorb_info; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts concepts to uorb_info; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

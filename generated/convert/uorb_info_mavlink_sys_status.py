@@ -16,6 +16,7 @@ def mavlink_sys_status_to_uorb_info(
 
     strict: mavlink_sys_status (forward) -> uorb_info (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -23,6 +24,6 @@ def mavlink_sys_status_to_uorb_info(
         _strict_1 = _map_mavlink_sys_status.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_uorb_info.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_sys_status to uorb_info; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_sys_status to uorb_info; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

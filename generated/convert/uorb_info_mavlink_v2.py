@@ -16,6 +16,7 @@ def uorb_info_to_mavlink_v2(
 
     strict: uorb_info (forward) -> mavlink_v2 (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -23,9 +24,9 @@ def uorb_info_to_mavlink_v2(
         _strict_1 = _map_uorb_info.forward(info, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_mavlink_v2.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_info to mavlink_v2; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_info to mavlink_v2; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_v2_to_uorb_info(
@@ -35,6 +36,7 @@ def mavlink_v2_to_uorb_info(
 
     strict: mavlink_v2 (forward) -> uorb_info (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -42,6 +44,6 @@ def mavlink_v2_to_uorb_info(
         _strict_1 = _map_mavlink_v2.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_uorb_info.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_v2 to uorb_info; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_v2 to uorb_info; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -16,6 +16,7 @@ def uorb_to_mavlink(
 
     strict: uorb (forward) -> mavlink (backward)
     px4: px4_mavlink_stream (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -26,7 +27,9 @@ def uorb_to_mavlink(
     if policy == "px4":
         _px4_1 = _map_px4_mavlink_stream.forward(status, rep=report, rep_d=report, rep_u=report)
         return _px4_1[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb to mavlink; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_to_uorb(
@@ -36,6 +39,7 @@ def mavlink_to_uorb(
 
     strict: mavlink (forward) -> uorb (backward)
     px4: px4_mavlink_receiver (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -46,4 +50,6 @@ def mavlink_to_uorb(
     if policy == "px4":
         _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=report)
         return _px4_1[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink to uorb; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -15,6 +15,7 @@ def uorb_to_uorb_info(
 
     strict: uorb (forward) -> uorb_info (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -22,9 +23,9 @@ def uorb_to_uorb_info(
         _strict_1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_uorb_info.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb to uorb_info; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb to uorb_info; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_info_to_uorb(
@@ -34,6 +35,7 @@ def uorb_info_to_uorb(
 
     strict: uorb_info (forward) -> uorb (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -41,6 +43,6 @@ def uorb_info_to_uorb(
         _strict_1 = _map_uorb_info.forward(info, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_info to uorb; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_info to uorb; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -15,6 +15,7 @@ def uorb_to_uorb_v0(
 
     strict: uorb_v0_down (forward)
     px4: uorb_v0_down (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -24,7 +25,9 @@ def uorb_to_uorb_v0(
     if policy == "px4":
         _px4_1 = _map_uorb_v0_down.forward(status, rep=report, rep_d=report, rep_u=report)
         return _px4_1[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_v0_to_uorb(
@@ -34,6 +37,7 @@ def uorb_v0_to_uorb(
 
     strict: uorb_v0_up (forward)
     px4: uorb_v0_up (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -43,4 +47,6 @@ def uorb_v0_to_uorb(
     if policy == "px4":
         _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=report)
         return _px4_1[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to uorb; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -16,6 +16,7 @@ def to_concepts(
 
     strict: uorb_v0_up (forward) -> uorb (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -23,9 +24,9 @@ def to_concepts(
         _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_v0 to concepts; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to concepts; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def from_concepts(
@@ -35,6 +36,7 @@ def from_concepts(
 
     strict: uorb (backward) -> uorb_v0_down (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -42,6 +44,6 @@ def from_concepts(
         _strict_1 = _map_uorb.backward(state, rep=report, rep_d=report, rep_u=None)
         _strict_2 = _map_uorb_v0_down.forward(*_strict_1, rep=report, rep_d=report, rep_u=report)
         return _strict_2[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts concepts to uorb_v0; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts concepts to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -21,6 +21,7 @@ def devicetree_to_uorb_v0(
 
     strict: devicetree (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -31,6 +32,6 @@ def devicetree_to_uorb_v0(
         _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts devicetree to uorb_v0; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts devicetree to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

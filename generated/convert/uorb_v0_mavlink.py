@@ -23,6 +23,7 @@ def uorb_v0_to_mavlink(
 
     strict: uorb_v0_up (forward) -> uorb (forward) -> mavlink (backward)
     px4: uorb_v0_up (forward) -> px4_mavlink_stream (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -35,7 +36,9 @@ def uorb_v0_to_mavlink(
         _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
         _px4_2 = _map_px4_mavlink_stream.forward(*_px4_1, rep=report, rep_d=report, rep_u=report)
         return _px4_2[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to mavlink; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_to_uorb_v0(
@@ -45,6 +48,7 @@ def mavlink_to_uorb_v0(
 
     strict: mavlink (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: px4_mavlink_receiver (forward) -> uorb_v0_down (forward)
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -57,4 +61,6 @@ def mavlink_to_uorb_v0(
         _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=None)
         _px4_2 = _map_uorb_v0_down.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
         return _px4_2[0]
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy == "ardupilot":
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -16,6 +16,7 @@ def uorb_v0_to_mavlink_v2(
 
     strict: uorb_v0_up (forward) -> uorb (forward) -> mavlink_v2 (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -24,9 +25,9 @@ def uorb_v0_to_mavlink_v2(
         _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_mavlink_v2.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_v0 to mavlink_v2; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to mavlink_v2; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def mavlink_v2_to_uorb_v0(
@@ -36,6 +37,7 @@ def mavlink_v2_to_uorb_v0(
 
     strict: mavlink_v2 (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -44,6 +46,6 @@ def mavlink_v2_to_uorb_v0(
         _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts mavlink_v2 to uorb_v0; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts mavlink_v2 to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

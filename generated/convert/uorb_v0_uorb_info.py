@@ -15,6 +15,7 @@ def uorb_v0_to_uorb_info(
 
     strict: uorb_v0_up (forward) -> uorb (forward) -> uorb_info (backward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -23,9 +24,9 @@ def uorb_v0_to_uorb_info(
         _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_uorb_info.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_v0 to uorb_info; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to uorb_info; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")
 
 
 def uorb_info_to_uorb_v0(
@@ -35,6 +36,7 @@ def uorb_info_to_uorb_v0(
 
     strict: uorb_info (forward) -> uorb (backward) -> uorb_v0_down (forward)
     px4: not available
+    ardupilot: not available
 
     Pass a LossReport as report to learn what did not survive.
     """
@@ -43,6 +45,6 @@ def uorb_info_to_uorb_v0(
         _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
         _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
         return _strict_3[0]
-    if policy == "px4":
-        raise _r.ConversionError("no px4 behaviour converts uorb_info to uorb_v0; use another policy")
-    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict or px4)")
+    if policy in ("px4", "ardupilot"):
+        raise _r.ConversionError(f"no {policy} behaviour converts uorb_info to uorb_v0; use another policy")
+    raise _r.ConversionError(f"unknown policy {policy!r} (expected strict, px4 or ardupilot)")

@@ -349,6 +349,18 @@ class ColumnConverter(OpVisitor[None]):
     def visit_px4_udral_energy(self, rule: Rule, op: o.PX4UdralEnergy) -> None:
         self._not_columnar(rule)
 
+    def visit_ardupilot_temperature(self, rule: Rule, op: o.ArduPilotTemperature) -> None:
+        self._not_columnar(rule)
+
+    def visit_ardupilot_current(self, rule: Rule, op: o.ArduPilotCurrent) -> None:
+        self._not_columnar(rule)
+
+    def visit_ardupilot_cells(self, rule: Rule, op: o.ArduPilotCells) -> None:
+        self._not_columnar(rule)
+
+    def visit_ardupilot_estimates(self, rule: Rule, op: o.ArduPilotEstimates) -> None:
+        self._not_columnar(rule)
+
 
 def _text_in(value: object) -> str | None:
     """A text field's content (bytes are UTF-8, NUL padding dropped); empty means unknown."""

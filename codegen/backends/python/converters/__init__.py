@@ -4,18 +4,20 @@ Layout of the generated package:
 
 - ``convert/_runtime.py``  the loss report and numeric helpers (copied from ``runtime/convert/_runtime.py``)
 - ``convert/_cells.py``    the array algorithms the mappings name (copied from ``runtime/convert/_cells.py``)
+- ``convert/_ardupilot.py`` ArduPilot's battery arithmetic, for the ardupilot policy (``runtime/convert/_ardupilot.py``)
 - ``convert/_state.py``    ``BatteryState``'s base: plain data in and out (copied from ``runtime/convert/_state.py``)
 - ``convert/_concepts.py`` ``BatteryState``: the shared concepts as a dataclass (SI units, None = unknown)
 - ``convert/_map_<mapping>.py`` one function per direction of each mapping (``forward``/``backward``)
 - ``convert/<endpoint>.py``  ``to_concepts`` / ``from_concepts`` for each format with a concept mapping
 - ``convert/<a>_<b>.py``  ``a_to_b`` / ``b_to_a`` for every pair: each policy is a chain of
-  mapping functions found at generation time (strict through the concepts, px4 through PX4's
-  own code paths); nothing is interpreted at run time.
+  mapping functions found at generation time (strict through the concepts, px4 and ardupilot
+  through the firmware's own code paths); nothing is interpreted at run time.
 
 Modules of this package: :mod:`.mapping_module` writes a mapping's functions, rule by rule through
 :class:`~.function.FunctionBuilder` (the backend's implementation of the op contract,
 :class:`~codegen.ir.mapping_visitor.OpVisitor`, from the emitter mixins :mod:`.numeric`,
-:mod:`.choices`, :mod:`.cells`, :mod:`.devicetree`, :mod:`.messages`, :mod:`.px4`, :mod:`.px4_cells`);
+:mod:`.choices`, :mod:`.cells`, :mod:`.devicetree`, :mod:`.messages`, :mod:`.px4`, :mod:`.px4_cells`,
+:mod:`.ardupilot`);
 :mod:`.routes` chains them into converters; :mod:`.concepts_module` writes ``BatteryState``.
 Emitters write one statement a line, with literals from :mod:`..literals`; every module is then
 formatted by ruff (:mod:`..formatting`), as the model modules are.
@@ -62,7 +64,9 @@ class _Generator:
         self.files[f"{PACKAGE}/__init__.py"] = registry.init_module()
 
     def render(self) -> dict[str, str]:
-        self.files.update(copied(f"{PACKAGE}/_runtime.py", f"{PACKAGE}/_cells.py", f"{PACKAGE}/_state.py"))
+        self.files.update(
+            copied(f"{PACKAGE}/_runtime.py", f"{PACKAGE}/_cells.py", f"{PACKAGE}/_ardupilot.py", f"{PACKAGE}/_state.py")
+        )
         self.concepts_module()
         for mapping in _mappings(self.schema):
             self.mapping_module(mapping)

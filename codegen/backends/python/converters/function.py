@@ -14,6 +14,7 @@ from ....ir.mapping_values import ConstantRef
 from ....ir.mapping_visitor import OpVisitor, visit
 from ....ir.ops import Const
 from ..literals import comment, py_literal
+from .ardupilot import ArduPilotEmitters
 from .cells import CellEmitters
 from .choices import ChoiceEmitters
 from .context import INDENT, Side, constant_name
@@ -32,6 +33,7 @@ class FunctionBuilder(
     MessageEmitters,
     PX4Emitters,
     PX4CellEmitters,
+    ArduPilotEmitters,
     OpVisitor[None],
 ):
     def build(self) -> list[str]:

@@ -14,6 +14,7 @@ from .function import FunctionBuilder
 
 # a call into the array algorithms module, not an endpoint alias ending in "cells" (s_cells.voltages)
 _USES_CELLS = re.compile(r"(?<![\w.])_cells\.")
+_USES_ARDUPILOT = re.compile(r"(?<![\w.])_ap\.")
 
 # names a mapping module binds besides its message classes
 _TAKEN = ("BatteryState", "forward", "backward", "_math")
@@ -77,6 +78,8 @@ def mapping_module(
     names = set(class_imports) | {(".", "_runtime", "_r")}
     if any(_USES_CELLS.search(line) for line in code if not line.lstrip().startswith("#")):
         names.add((".", "_cells", None))  # the array algorithms (runtime/convert/_cells.py)
+    if any(_USES_ARDUPILOT.search(line) for line in code if not line.lstrip().startswith("#")):
+        names.add((".", "_ardupilot", "_ap"))  # ArduPilot's battery arithmetic (runtime/convert/_ardupilot.py)
     if CONCEPTS_ENDPOINT in (mapping.source, mapping.target):
         names.add(("._concepts", "BatteryState", None))
     head = [header, doc, "", "from __future__ import annotations", ""]

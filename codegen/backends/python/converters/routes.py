@@ -3,7 +3,7 @@ package's ``__init__.py``.
 
 Each policy of a converter is a chain of mapping functions (:class:`~.mapping_module.Edge`)
 found at generation time, the shortest in mapping-name order: strict through the concepts,
-px4 through PX4's own code paths. Nothing is looked up at run time.
+px4 and ardupilot through the firmware's own code paths. Nothing is looked up at run time.
 """
 
 from __future__ import annotations
@@ -20,8 +20,10 @@ from .context import INDENT, call
 from .mapping_module import Edge
 
 PACKAGE = "convert"
-POLICIES = ("strict", "px4")
-_NO_ROUTE = "no {p} behaviour converts {s} to {t}; use another policy"
+POLICIES = ("strict", "px4", "ardupilot")
+# the policies that restate a firmware's own code: after one, a chain reports losses only at its ends
+FIRMWARE_POLICIES = ("px4", "ardupilot")
+_NO_ROUTE = "no {{policy}} behaviour converts {s} to {t}; use another policy"
 # names a converter module binds besides its message classes
 _TAKEN = ("BatteryState", "policy", "report")
 
@@ -42,8 +44,20 @@ def _policies(edge: Edge) -> frozenset[str]:
     return frozenset(POLICIES) if edge.mapping.policy == "any" else frozenset({edge.mapping.policy})
 
 
+# ArduPilot has no uORB: a chain made only of steps inside a format (policy any: the uORB versions) is
+# no ArduPilot behaviour, so its routes must take one of its own mappings (PX4 does run those steps)
+_NEEDS_OWN_STEP = frozenset({"ardupilot"})
+
+
 def route(edges: list[Edge], source: str, target: str, policy: str) -> list[Edge] | None:
     """The shortest chain of functions from ``source`` to ``target`` under ``policy``."""
+    found = _shortest(edges, source, target, policy)
+    if found is not None and policy in _NEEDS_OWN_STEP and all(e.mapping.policy != policy for e in found):
+        return None
+    return found
+
+
+def _shortest(edges: list[Edge], source: str, target: str, policy: str) -> list[Edge] | None:
     usable = sorted((e for e in edges if policy in _policies(e)), key=lambda e: (e.mapping.name, e.function))
     queue: deque[tuple[str, list[Edge]]] = deque([(source, [])])
     seen = {source}
@@ -137,13 +151,15 @@ class Routes:
         docs += ["", "Pass a LossReport as report to learn what did not survive."]
         lines = [f"def {fname}({', '.join(params)}) -> {returns}:", docstring("\n".join(docs), INDENT)]
         for p, r in routes.items():
-            lines.append(f"{INDENT}if policy == {py_literal(p)}:")
-            if r is None:
-                no_route = py_literal(_NO_ROUTE.format(p=p, s=source, t=target))
-                lines.append(f"{INDENT * 2}raise _r.ConversionError({no_route})")
-            else:
+            if r is not None:
+                lines.append(f"{INDENT}if policy == {py_literal(p)}:")
                 lines += self.calls(r, args, inputs, single, p)
-        expected = " or ".join(POLICIES)
+        missing = tuple(p for p, r in routes.items() if r is None)
+        if missing:  # one branch for the policies with no code path between the two
+            test = f"policy == {py_literal(missing[0])}" if len(missing) == 1 else f"policy in {py_literal(missing)}"
+            no_route = "f" + py_literal(_NO_ROUTE.format(s=source, t=target))
+            lines += [f"{INDENT}if {test}:", f"{INDENT * 2}raise _r.ConversionError({no_route})"]
+        expected = ", ".join(POLICIES[:-1]) + " or " + POLICIES[-1]
         lines.append(f'{INDENT}raise _r.ConversionError(f"unknown policy {{policy!r}} (expected {expected})")')
         return "\n".join(lines), {*src_t, *dst_t}
 
@@ -161,7 +177,7 @@ class Routes:
             given += [f"{n}={n}" for n in e.inputs if n in inputs] if first else []
             result = f"_{naming.identifier(policy)}_{i + 1}"
             out.append(f"{INDENT * 2}{result} = {call(f'{e.module}.{e.function}', given)}")
-            after_px4 = after_px4 or e.mapping.policy == "px4"
+            after_px4 = after_px4 or e.mapping.policy in FIRMWARE_POLICIES
         out.append(f"{INDENT * 2}return {result}[0]" if single else f"{INDENT * 2}return {result}")
         return out
 
