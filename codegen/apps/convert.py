@@ -209,8 +209,12 @@ class Endpoint:
 CARRIED = "_before"  # the suffix of a converter input fed from the previous record's result
 
 
-def _carried(result: object, field: str) -> float | None:
-    """The value of ``field`` in a converter's result (one object or a tuple of them), None if absent."""
+def _carried(result: object, report: object, field: str) -> float | None:
+    """The value of ``field`` a converter carries to the next record: what its report says it keeps (a
+    firmware's float total), else the field of its result (one object or a tuple of them); None if absent."""
+    kept = getattr(report, "carried", {}).get(field)
+    if isinstance(kept, float):
+        return kept
     for obj in result if isinstance(result, tuple) else (result,):
         value = getattr(obj, field, None)
         if isinstance(value, int | float) and not isinstance(value, bool):
@@ -303,7 +307,7 @@ class Conversion:
                 raise fail(item.file, item.line, text) from None
             _keep_capture_time(result, item)
             for name in carried:
-                extra[name] = _carried(result, name.removesuffix(CARRIED))
+                extra[name] = _carried(result, report, name.removesuffix(CARRIED))
             lost = None if loss is None else report.summary() if loss == "summary" else report.to_dict()
             unheld = tuple(
                 (str(e["field"]), str(e.get("detail", ""))) for e in report.to_dict() if e["kind"] == "unrepresentable"

@@ -56,10 +56,16 @@ class LossReport:
     Entries are kept as (kind, field, detail) keys of an insertion-ordered dict; the
     :class:`LossEntry` objects are made when asked for, so a conversion only pays for a dict store."""
 
-    __slots__ = ("_keys",)
+    __slots__ = ("_keys", "carried")
 
     def __init__(self) -> None:
         self._keys: dict[tuple[str, str, str], None] = {}
+        # what a firmware keeps between messages at a precision its output does not show (ArduPilot's
+        # consumed charge is a float, BATTERY_STATUS sends whole mAh): the next message's <name>_before
+        self.carried: dict[str, float] = {}
+
+    def carry(self, name: str, value: float) -> None:
+        self.carried[name] = value
 
     @property
     def entries(self) -> list[LossEntry]:

@@ -129,6 +129,9 @@ def ardupilot_estimates(
             left = f32(pack - mah)
             percent = c_float_to_int(constrain(f32_div(f32(100.0 * left), f32(pack)), 0.0, 255.0), 8, False)
     remaining = -1 if percent is None else max(-1, min(min(percent, 127), 100))
+    if rep is not None:  # the float totals the monitor keeps for its next message
+        rep.carry("consumed_mah", mah)
+        rep.carry("consumed_wh", wh)
     consumed = c_float_to_int(mah, 32, True, rep, labels[0])
     energy = c_float_to_int(f32(wh * 36.0), 32, True, rep, labels[1])  # consumed_wh *= 36: hJ
     return consumed, energy, remaining, time_s
