@@ -11,10 +11,11 @@ the end and the run goes on. Exit 0 when every log was exported or skipped, 1 wh
 had records left out (a battery number its type cannot hold: each said on stderr), 2 when there is
 nothing to read or the fleet extra is missing.
 
-``--failsafe PARAMS`` also replays each flight log (.ulg, .tlog, .bin) through ArduPilot's battery
-failsafe as ``battgen failsafe`` does, with the parameter file PARAMS (``--failsafe log``: each
-DataFlash log's own PARM records), into ``DIR/failsafe/log=<id>/``; a log exported before without
-that replay is exported again.
+``--failsafe PARAMS`` also replays each flight log (.ulg, .tlog, .bin) through its firmware's battery
+failsafe as ``battgen failsafe`` does and chooses (``--firmware``; else ArduPilot's for ArduPilot's BATT*_
+parameters, PX4's for PX4's or for a ULog), with the parameter file PARAMS (``--failsafe log``: each
+log's own parameters), into ``DIR/failsafe/log=<id>/``; a log exported before without that replay is
+exported again.
 
 ``--engine dask`` runs the same per-log export as tasks on a Dask cluster (``--scheduler
 ADDRESS``, else a local one with ``--jobs`` workers); the output folder must be reachable by
@@ -60,10 +61,16 @@ def register(subparsers: Any, summary: str) -> None:
     p.add_argument(
         "--failsafe",
         metavar="PARAMS",
-        help="replay every log through ArduPilot's battery failsafe with this parameter file, or 'log' for each "
-        "DataFlash log's own PARM records (events in DIR/failsafe/, summed up in the flights view)",
+        help="replay every log through its firmware's battery failsafe (as battgen failsafe chooses it) with this "
+        "parameter file, or 'log' for each log's own parameters (events in DIR/failsafe/, summed up in the flights "
+        "view)",
     )
     p.add_argument("--vehicle", help="--failsafe: the ArduPilot vehicle (default: detected from the parameters)")
+    p.add_argument(
+        "--firmware",
+        choices=("px4", "ardupilot"),
+        help="--failsafe: whose failsafe (default: the parameters', else the log's: PX4's for a ULog)",
+    )
     p.add_argument(
         "--partition",
         choices=("log", "day"),
@@ -148,11 +155,14 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs < 1:
         print("battgen: --jobs must be at least 1", file=sys.stderr)
         return EXIT_UNREADABLE
+    if args.firmware is not None and args.failsafe is None:
+        print("battgen: --firmware is the failsafe replay's: give --failsafe PARAMS too", file=sys.stderr)
+        return 2
     if args.vehicle is not None and args.failsafe is None:
         print("battgen: --vehicle is the failsafe replay's: give --failsafe PARAMS too", file=sys.stderr)
         return EXIT_UNREADABLE
     try:
-        replay = None if args.failsafe is None else failsafe_options(args.failsafe, args.vehicle)
+        replay = None if args.failsafe is None else failsafe_options(args.failsafe, args.vehicle, args.firmware)
     except BattgenError as exc:
         print(line(f"battgen: --failsafe: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE

@@ -208,4 +208,52 @@ def test_options_travel_to_workers(tmp_path: Path) -> None:
     (tmp_path / "rover.param").unlink()
     back = pickle.loads(pickle.dumps(options))
     assert back == options and back.failsafe is not None
-    assert back.failsafe.params == PARAMS and back.failsafe.key.endswith("|vehicle=rover")
+    assert back.failsafe.params == PARAMS and back.failsafe.key.endswith("|vehicle=rover|firmware=detected")
+
+
+PX4_SAME = {
+    "replay_t": "t",
+    "instance": "battery",
+    "level": "level",
+    "cause": "cause",
+    "value": "value",
+    "threshold": "threshold",
+    "action": "action",
+    "action_code": "action_code",
+    "executed": "executed",
+    "outcome": "outcome",
+    "statustext": "firmware_text",
+}
+
+
+def test_a_px4_log_replays_px4s_failsafe_as_battgen_failsafe_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A real PX4 flight reaching LOW, CRITICAL and EMERGENCY: ``--failsafe log`` replays PX4's own failsafe
+    with the log's BAT_*/COM_* parameters (battgen failsafe's choice for a ULog), event for event as
+    ``battgen failsafe --json`` prints them, on the battery table's clock."""
+    from shared_data import require, shared
+
+    log = require(shared("corpus", "realworld3", "ulog", "fsyrh_log_61_2024-2-6-16-27-02.ulg"))
+    out = tmp_path / "ds"
+    _export(capsys, out, str(log), "--failsafe", "log")
+    reference = _reference(capsys, str(log))
+    ours = _events(out, log.name)
+    assert [{k: e[k] for k in PX4_SAME} for e in ours] == [{k: r[v] for k, v in PX4_SAME.items()} for r in reference]
+    assert [e["level"] for e in ours] == ["LOW", "CRITICAL", "EMERGENCY"]
+    assert {e["vehicle_type"] for e in ours} == {"px4"} and {e["priority"] for e in ours} == {None}
+    for e in ours:  # the state of charge that crossed is the battery table's, at the same t
+        soc = run_query(
+            out, f"SELECT state_of_charge FROM battery WHERE battery = {e['battery']} AND t = {e['t']}"
+        ).rows
+        assert soc and soc[0][0] == pytest.approx(e["value"], rel=1e-6)
+    replays = run_query(out, "SELECT instance, level, vehicle_type, readings > 0 FROM failsafe_replays").rows
+    assert replays == [(1, "EMERGENCY", "px4", True)]
+    # ArduPilot's BATT_ parameters still choose ArduPilot's failsafe for the same log, as battgen failsafe does
+    params = _params(tmp_path, {"BATT_LOW_VOLT": 16.1, "BATT_LOW_TIMER": 1, "BATT_FS_LOW_ACT": 2}, "ap.param")
+    _export(capsys, tmp_path / "ap", str(log), "--failsafe", str(params))
+    assert "px4" not in {e["vehicle_type"] for e in _events(tmp_path / "ap", log.name)}
+    replayed = run_query(tmp_path / "ap", "SELECT vehicle_type FROM failsafe_replays").rows
+    assert replayed and all(v != "px4" for (v,) in replayed)
+    _export(capsys, tmp_path / "forced", str(log), "--failsafe", str(params), "--firmware", "px4")
+    assert [e["level"] for e in _events(tmp_path / "forced", log.name)] == ["LOW", "CRITICAL", "EMERGENCY"]

@@ -1,5 +1,6 @@
-"""``battgen export --failsafe``: each log replayed through ArduPilot's battery failsafe
-(:mod:`codegen.apps.failsafe.flight`, the engine of ``battgen failsafe``), its events as tables.
+"""``battgen export --failsafe``: each log replayed through its firmware's battery failsafe as ``battgen failsafe``
+chooses it (:mod:`..failsafe.firmware`): ArduPilot's (:mod:`codegen.apps.failsafe.flight`), or PX4's for a ULog
+(:mod:`.px4_failsafe_tables`), its events as tables.
 
 Two tables per replayed log, in the log's partition of ``failsafe/``:
 
@@ -27,6 +28,7 @@ import pyarrow as pa
 
 from ...errors import BattgenError
 from ..battery.sources import Batch
+from ..failsafe.firmware import FIRMWARES, PX4_PREFIXES, choose_firmware
 from ..failsafe.flight import replay_flight
 from ..failsafe.logs import SampleTable, own_parameters
 from ..failsafe.stream import batt_parameter_count, read_parameter_values
@@ -45,25 +47,31 @@ class FailsafeOptions:
     params: dict[str, float] | None
     source: str  # what the parameters are, as the tables and the manifest record it
     vehicle: str | None = None
+    firmware: str | None = None  # px4 or ardupilot; None: as battgen failsafe chooses (the parameters', the log's)
 
     @property
     def key(self) -> str:
         """Says whether a log's recorded replay was made with these options."""
-        return f"{self.source}|vehicle={self.vehicle or 'detected'}"
+        return f"{self.source}|vehicle={self.vehicle or 'detected'}|firmware={self.firmware or 'detected'}"
 
 
-def failsafe_options(given: str, vehicle: str | None = None) -> FailsafeOptions:
+def failsafe_options(given: str, vehicle: str | None = None, firmware: str | None = None) -> FailsafeOptions:
     """The options of ``--failsafe GIVEN``: a parameter file, or ``log`` for each log's own."""
     if vehicle is not None and vehicle not in VEHICLES:
         raise BattgenError(f"expected a vehicle among {', '.join(sorted(VEHICLES))}, got {vehicle!r}")
+    if firmware is not None and firmware not in FIRMWARES:
+        raise BattgenError(f"expected a firmware among {', '.join(FIRMWARES)}, got {firmware!r}")
     if given == OWN_PARAMETERS:
-        return FailsafeOptions(None, "log parameters (PARM)", vehicle)
+        return FailsafeOptions(None, "log parameters (PARM)", vehicle, firmware)
     path = Path(given)
     values = read_parameter_values(path)
-    if not batt_parameter_count(values):
-        raise BattgenError(f"{given}: no BATT*_ parameter ({len(values)} parameters read): expected battery settings")
+    if not batt_parameter_count(values) and not any(name.startswith(PX4_PREFIXES) for name in values):
+        raise BattgenError(
+            f"{given}: no BATT*_ parameter (ArduPilot) nor BAT_*/COM_* battery parameter (PX4) ({len(values)} "
+            "parameters read): expected battery settings"
+        )
     digest = hashlib.sha256(path.read_bytes()).hexdigest()[:16]
-    return FailsafeOptions(values, f"{path.name} ({digest})", vehicle)
+    return FailsafeOptions(values, f"{path.name} ({digest})", vehicle, firmware)
 
 
 _TEXT, _INT, _FLOAT = pa.string(), pa.int32(), pa.float64()
@@ -75,17 +83,17 @@ EVENT_COLUMNS: tuple[tuple[str, Any, str, str | None], ...] = (
     ("t", _FLOAT, "seconds since the log's start, on the battery table's clock", "s"),
     ("replay_t", _FLOAT, "seconds from the log's first reading, as battgen failsafe prints it", "s"),
     ("time", pa.timestamp("us", tz="UTC"), "time of day (UTC), where the log has it", None),
-    ("level", _TEXT, "LOW or CRITICAL", None),
-    ("cause", _TEXT, "voltage or capacity", None),
-    ("value", _FLOAT, "the value that crossed: V (cause voltage) or remaining mAh (cause capacity)", None),
+    ("level", _TEXT, "LOW or CRITICAL (PX4: LOW, CRITICAL, EMERGENCY or TIME_LOW)", None),
+    ("cause", _TEXT, "voltage or capacity (PX4: charge or time)", None),
+    ("value", _FLOAT, "the value that crossed: V, remaining mAh, state of charge 0..1 or s, by cause", None),
     ("threshold", _FLOAT, "the parameter crossed: V or mAh, as value", None),
     ("action", _TEXT, "the vehicle's name for the FS_LOW_ACT / FS_CRT_ACT action", None),
     ("action_code", _INT, "the FS_LOW_ACT / FS_CRT_ACT value", None),
     ("executed", pa.bool_(), "whether the priority rule let the action run", None),
     ("outcome", _TEXT, "what the vehicle does after the handler's fallbacks", None),
-    ("priority", _INT, "the action's index in the vehicle's priority list", None),
-    ("statustext", _TEXT, "the STATUSTEXT AP_BattMonitor sends", None),
-    ("vehicle_type", _TEXT, "the ArduPilot vehicle whose semantics the replay used", None),
+    ("priority", _INT, "the action's index in the vehicle's priority list (PX4: null)", None),
+    ("statustext", _TEXT, "the STATUSTEXT AP_BattMonitor sends (PX4: commander's notification)", None),
+    ("vehicle_type", _TEXT, "the ArduPilot vehicle whose semantics the replay used, or px4", None),
     ("parameters", _TEXT, "the parameters the replay used", None),
 )
 REPLAY_COLUMNS: tuple[tuple[str, Any, str, str | None], ...] = (
@@ -93,8 +101,8 @@ REPLAY_COLUMNS: tuple[tuple[str, Any, str, str | None], ...] = (
     ("battery", _INT, "the battery table's battery (0-based)", None),
     ("instance", _INT, "the battery as ArduPilot numbers it (1-based)", None),
     ("readings", pa.int64(), "battery readings replayed", None),
-    ("level", _TEXT, "the highest level reached: NONE, LOW or CRITICAL", None),
-    ("vehicle_type", _TEXT, "the ArduPilot vehicle whose semantics the replay used", None),
+    ("level", _TEXT, "the highest level reached: NONE, LOW or CRITICAL (PX4: EMERGENCY too)", None),
+    ("vehicle_type", _TEXT, "the ArduPilot vehicle whose semantics the replay used, or px4", None),
     ("parameters", _TEXT, "the parameters the replay used", None),
 )
 
@@ -124,6 +132,11 @@ def replay_tables(
     (``table``), or a note saying why it was not replayed. ``clock``: a batch of the log, for the time of day."""
     if kind == "jsonl":
         return "failsafe not replayed: a JSON Lines file is no flight log battgen failsafe reads"
+    firmware, _ = choose_firmware(options.firmware, options.params, options.source, path)
+    if firmware == "px4":  # battgen failsafe's choice: PX4's own failsafe for a ULog, unless ArduPilot's is asked
+        from .px4_failsafe_tables import px4_tables
+
+        return px4_tables(path, name, log, options.params, None if options.params is None else options.source, clock)
     values = options.params
     if values is None:
         values = own_parameters(table)

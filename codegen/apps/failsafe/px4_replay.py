@@ -91,6 +91,7 @@ class Px4Replay:
     events: list[Px4Event]
     checks: list[Check]
     samples: int
+    readings: dict[int, int]  # the updates replayed per battery (1-based)
 
     @property
     def notes(self) -> list[str]:
@@ -126,7 +127,8 @@ def replay_px4(log: Px4Log, given: Mapping[str, float] | None = None) -> Px4Repl
     events = sorted(events + time_events, key=lambda e: e.time)
     checks.append(time_check)
     checks.extend(_action_checks(log, events))
-    return Px4Replay(release, thresholds, settings, events, checks, sum(len(b.t) for b in log.batteries))
+    readings = {b.battery: len(b.t) for b in log.batteries}
+    return Px4Replay(release, thresholds, settings, events, checks, sum(readings.values()), readings)
 
 
 def _armed_at(log: Px4Log, t: NDArray) -> NDArray:
