@@ -15,6 +15,7 @@ read) against the reference readers on every real log of ``../shared``:
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -175,3 +176,44 @@ def test_one_flights_dataflash_and_tlog_hold_the_same_parameters() -> None:
     differ = {k for k in tlog.parameters if tlog.parameters[k] != dataflash.parameters[k]}
     assert differ == {"MOT_THST_HOVER"}
     assert tlog.parameters["BATT_LOW_VOLT"] == 10.5 and tlog.parameters["BATT_CAPACITY"] == 3300.0
+
+
+@pytest.mark.parametrize("path", TLOGS, ids=[p.name for p in TLOGS])
+def test_tlog_modes_and_texts_match_pymavlink(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each change of a system's mode as pymavlink names it (``mode_string_v10`` of its vehicle heartbeats) and
+    its STATUSTEXTs with their severity, at the tlog's own stamps."""
+    monkeypatch.setenv("MAVLINK20", "1")
+    from pymavlink import mavutil
+
+    mavutil.set_dialect("ardupilotmega")
+    conn = mavutil.mavmmaplog(str(path))
+    modes: dict[int, list[tuple[float, str]]] = {}
+    texts: dict[int, list[tuple[float, int, str]]] = {}
+    while (msg := conn.recv_match()) is not None:
+        stamp = getattr(msg, "_timestamp", None)
+        kind = msg.get_type()
+        if kind == "HEARTBEAT" and conn.probably_vehicle_heartbeat(msg):
+            seen = modes.setdefault(msg.get_srcSystem(), [])
+            name = mavutil.mode_string_v10(msg)
+            if not seen or seen[-1][1] != name:
+                seen.append((stamp, name))
+        elif kind == "STATUSTEXT":
+            texts.setdefault(msg.get_srcSystem(), []).append((stamp, msg.severity, msg.text))
+    conn.close()
+    contexts = _contexts(path)
+    if not contexts:
+        pytest.skip("no battery records: the view yields no chunk")
+    levels = ("emergency", "alert", "critical", "error", "warning", "notice", "info", "debug")
+    for context in contexts:
+        assert context.vehicle is not None
+        sysid = int(context.vehicle.split(":")[1])
+        assert context.start_us is not None
+        first = context.start_us / 1e6  # t = 0: the tlog's first stamp
+        assert [m for _, m in context.modes] == [m for _, m in modes.get(sysid, [])]
+        assert [t for t, _ in context.modes] == pytest.approx([s - first for s, _ in modes.get(sysid, [])], abs=2e-6)
+        theirs = texts.get(sysid, [])
+        assert [(x.severity, x.text) for x in context.texts] == [(levels[v], text) for _, v, text in theirs]
+        assert [x.t for x in context.texts] == pytest.approx([s - first for s, _, _ in theirs], abs=2e-6)
+        banner = next((text for _, _, text in theirs if re.match(r"(Ardu\w+|APM:\w+) V\d", text)), None)
+        assert context.firmware == banner  # ArduPilot's boot banner names the firmware and its version
+    assert any(c.modes for c in contexts) or not any(modes.values())

@@ -1,7 +1,8 @@
-"""The shipped schemas/mavlink/vehicle.xml (HEARTBEAT, SYS_STATUS, PARAM_VALUE and their enums; descriptions our
-own) against upstream's facts: the corpus's minimal.xml/common.xml (``../shared/corpus/upstream/mavlink``) and the
-installed pymavlink's own generated common dialect: message ids, CRC_EXTRA, wire lengths, fields (name, type, order,
-extensions, units, invalid markers, enums) and every enum entry's value."""
+"""The shipped schemas/mavlink/vehicle.xml (HEARTBEAT, SYS_STATUS, PARAM_VALUE, STATUSTEXT and their enums;
+descriptions our own) against upstream's facts: the corpus's minimal.xml/common.xml
+(``../shared/corpus/upstream/mavlink``) and the installed pymavlink's own generated common dialect: message ids,
+CRC_EXTRA, wire lengths, fields (name, type, order, extensions, units, invalid markers, enums) and every enum
+entry's value."""
 
 from __future__ import annotations
 
@@ -22,9 +23,9 @@ from codegen.frontends import mavlink as frontend
 ROOT = Path(__file__).resolve().parent.parent
 VEHICLE_XML = ROOT / "schemas" / "mavlink" / "vehicle.xml"
 UPSTREAM = UPSTREAM_CORPUS / "mavlink"
-MESSAGES = {"HEARTBEAT": (0, 50), "SYS_STATUS": (1, 124), "PARAM_VALUE": (22, 220)}
+MESSAGES = {"HEARTBEAT": (0, 50), "SYS_STATUS": (1, 124), "PARAM_VALUE": (22, 220), "STATUSTEXT": (253, 83)}
 ENUMS = ("MAV_TYPE", "MAV_AUTOPILOT", "MAV_MODE_FLAG", "MAV_STATE", "MAV_SYS_STATUS_SENSOR",
-         "MAV_SYS_STATUS_SENSOR_EXTENDED", "MAV_PARAM_TYPE")  # fmt: skip
+         "MAV_SYS_STATUS_SENSOR_EXTENDED", "MAV_PARAM_TYPE", "MAV_SEVERITY")  # fmt: skip
 
 
 def _parse(path: Path) -> Any:

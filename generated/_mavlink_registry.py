@@ -7,6 +7,7 @@ REGISTRY: dict[int, tuple[int, str, int, str]] = {
     1: (124, "SysStatus", 43, "SYS_STATUS"),
     22: (220, "ParamValue", 25, "PARAM_VALUE"),
     147: (154, "BatteryStatus", 54, "BATTERY_STATUS"),
+    253: (83, "Statustext", 54, "STATUSTEXT"),
     369: (145, "BatteryStatusV2", 27, "BATTERY_STATUS_V2"),
     372: (26, "BatteryInfo", 140, "BATTERY_INFO"),
 }

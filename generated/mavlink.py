@@ -32,11 +32,13 @@ __all__ = [
     "MavBatteryType",
     "MavModeFlag",
     "MavParamType",
+    "MavSeverity",
     "MavState",
     "MavSysStatusSensor",
     "MavSysStatusSensorExtended",
     "MavType",
     "ParamValue",
+    "Statustext",
     "SysStatus",
 ]
 
@@ -202,6 +204,22 @@ class MavParamType(_enum.IntEnum):
     INT64 = 8
     REAL32 = 9
     REAL64 = 10
+
+
+class MavSeverity(_enum.IntEnum):
+    """How urgent a text the vehicle sends is; the eight levels of syslog (RFC 5424), most urgent first.
+
+    mavlink.MAV_SEVERITY: values.
+    """
+
+    EMERGENCY = 0
+    ALERT = 1
+    CRITICAL = 2
+    ERROR = 3
+    WARNING = 4
+    NOTICE = 5
+    INFO = 6
+    DEBUG = 7
 
 
 class MavState(_enum.IntEnum):
@@ -1014,6 +1032,46 @@ _PARAM_VALUE_FIELD_SPECS = (
     ("param_type", "param_type", _PARAM_VALUE_PARAM_TYPE_SPEC),
     ("param_count", "param_count", _PARAM_VALUE_PARAM_COUNT_SPEC),
     ("param_index", "param_index", _PARAM_VALUE_PARAM_INDEX_SPEC),
+)
+
+
+# the payload in wire order; (attribute, field, struct code, count) per field; numpy dtype
+_STATUSTEXT_PAYLOAD = _struct.Struct("<B50sHB")
+_STATUSTEXT_FIELDS: tuple[tuple[str, str, str, int], ...] = (
+    ("severity", "severity", "B", 0),
+    ("text", "text", "s", 50),
+    ("id", "id", "H", 0),
+    ("chunk_seq", "chunk_seq", "B", 0),
+)
+_STATUSTEXT_DTYPE: list[tuple[_Any, ...]] = [("severity", "u1"), ("text", "S50"), ("id", "<u2"), ("chunk_seq", "u1")]
+
+
+# what validate() reports against, field by field (read only when a fast test trips)
+_STATUSTEXT_SEVERITY_SPEC = _v.Number(
+    type="uint8",
+    kind="uint",
+    low=0,
+    high=255,
+    values={
+        0: "MAV_SEVERITY_EMERGENCY",
+        1: "MAV_SEVERITY_ALERT",
+        2: "MAV_SEVERITY_CRITICAL",
+        3: "MAV_SEVERITY_ERROR",
+        4: "MAV_SEVERITY_WARNING",
+        5: "MAV_SEVERITY_NOTICE",
+        6: "MAV_SEVERITY_INFO",
+        7: "MAV_SEVERITY_DEBUG",
+    },
+)
+_STATUSTEXT_TEXT_SPEC = _v.Text(capacity=50)
+_STATUSTEXT_ID_SPEC = _v.Number(type="uint16", kind="uint", low=0, high=65535)
+_STATUSTEXT_CHUNK_SEQ_SPEC = _v.Number(type="uint8", kind="uint", low=0, high=255)
+# (schema name, attribute, spec) of each field, for the careful way
+_STATUSTEXT_FIELD_SPECS = (
+    ("severity", "severity", _STATUSTEXT_SEVERITY_SPEC),
+    ("text", "text", _STATUSTEXT_TEXT_SPEC),
+    ("id", "id", _STATUSTEXT_ID_SPEC),
+    ("chunk_seq", "chunk_seq", _STATUSTEXT_CHUNK_SEQ_SPEC),
 )
 
 
@@ -2772,7 +2830,7 @@ class BatteryStatusV2:
 class Heartbeat:
     """Sent about once a second by every system and component: what it is, which autopilot it runs, its mode and state.
 
-    Schema: mavlink.HEARTBEAT (mavlink, vehicle.xml:441).
+    Schema: mavlink.HEARTBEAT (mavlink, vehicle.xml:468).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "mavlink.HEARTBEAT"
@@ -2950,7 +3008,7 @@ class Heartbeat:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
-            # type (vehicle.xml:443): fits uint8; a value of MAV_TYPE
+            # type (vehicle.xml:470): fits uint8; a value of MAV_TYPE
             if self.type not in {
                 0,
                 1,
@@ -3004,19 +3062,19 @@ class Heartbeat:
                 49,
             }:
                 _v.diag(out, "type", self.type, _HEARTBEAT_TYPE_SPEC)
-            # autopilot (vehicle.xml:444): fits uint8; a value of MAV_AUTOPILOT
+            # autopilot (vehicle.xml:471): fits uint8; a value of MAV_AUTOPILOT
             if self.autopilot not in {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20}:
                 _v.diag(out, "autopilot", self.autopilot, _HEARTBEAT_AUTOPILOT_SPEC)
-            # base_mode (vehicle.xml:445): fits uint8; bits of MAV_MODE_FLAG only
+            # base_mode (vehicle.xml:472): fits uint8; bits of MAV_MODE_FLAG only
             if self.base_mode & -256:
                 _v.diag(out, "base_mode", self.base_mode, _HEARTBEAT_BASE_MODE_SPEC)
-            # custom_mode (vehicle.xml:446): fits uint32
+            # custom_mode (vehicle.xml:473): fits uint32
             if self.custom_mode & -4294967296:
                 _v.diag(out, "custom_mode", self.custom_mode, _HEARTBEAT_CUSTOM_MODE_SPEC)
-            # system_status (vehicle.xml:447): fits uint8; a value of MAV_STATE
+            # system_status (vehicle.xml:474): fits uint8; a value of MAV_STATE
             if self.system_status not in {0, 1, 2, 3, 4, 5, 6, 7, 8}:
                 _v.diag(out, "system_status", self.system_status, _HEARTBEAT_SYSTEM_STATUS_SPEC)
-            # mavlink_version (vehicle.xml:448): fits uint8
+            # mavlink_version (vehicle.xml:475): fits uint8
             if self.mavlink_version & -256:
                 _v.diag(out, "mavlink_version", self.mavlink_version, _HEARTBEAT_MAVLINK_VERSION_SPEC)
         except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
@@ -3041,7 +3099,7 @@ class Heartbeat:
 class ParamValue:
     """One of the vehicle's parameters, as it sends them when asked for the list or after one is set.
 
-    Schema: mavlink.PARAM_VALUE (mavlink, vehicle.xml:470).
+    Schema: mavlink.PARAM_VALUE (mavlink, vehicle.xml:497).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "mavlink.PARAM_VALUE"
@@ -3201,20 +3259,20 @@ class ParamValue:
         out: list[_v.Violation] = []
         x: _Any
         try:
-            # param_id (vehicle.xml:472): fits char[16]
+            # param_id (vehicle.xml:499): fits char[16]
             x = self.param_id
             if x.__class__ is not str or len(x.encode()) > 16:
                 _v.diag(out, "param_id", self.param_id, _PARAM_VALUE_PARAM_ID_SPEC)
-            # param_value (vehicle.xml:473): fits float32
+            # param_value (vehicle.xml:500): fits float32
             if not (-3.4028234663852886e38 <= self.param_value <= 3.4028234663852886e38):
                 _v.diag(out, "param_value", self.param_value, _PARAM_VALUE_PARAM_VALUE_SPEC)
-            # param_type (vehicle.xml:474): fits uint8; a value of MAV_PARAM_TYPE
+            # param_type (vehicle.xml:501): fits uint8; a value of MAV_PARAM_TYPE
             if self.param_type not in {1, 2, 3, 4, 5, 6, 7, 8, 9, 10}:
                 _v.diag(out, "param_type", self.param_type, _PARAM_VALUE_PARAM_TYPE_SPEC)
-            # param_count (vehicle.xml:475): fits uint16
+            # param_count (vehicle.xml:502): fits uint16
             if self.param_count & -65536:
                 _v.diag(out, "param_count", self.param_count, _PARAM_VALUE_PARAM_COUNT_SPEC)
-            # param_index (vehicle.xml:476): fits uint16
+            # param_index (vehicle.xml:503): fits uint16
             if self.param_index & -65536:
                 _v.diag(out, "param_index", self.param_index, _PARAM_VALUE_PARAM_INDEX_SPEC)
         except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
@@ -3236,10 +3294,193 @@ class ParamValue:
 
 
 @_dataclasses.dataclass(slots=True)
+class Statustext:
+    """A line of text the vehicle sends to the operator (warnings, failsafes, mode and arming messages).
+
+    Schema: mavlink.STATUSTEXT (mavlink, vehicle.xml:505).
+    """
+
+    QUALIFIED_NAME: _ClassVar[str] = "mavlink.STATUSTEXT"
+
+    severity: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(name="severity", type="uint8", enums=("mavlink.MAV_SEVERITY",), doc="How urgent the text is."),
+    )
+    text: str = _dataclasses.field(
+        default="",
+        metadata=_m.meta(
+            name="text", type="char[50]", doc="The text, UTF-8; NUL-terminated when shorter than 50 bytes."
+        ),
+    )
+    id: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="id",
+            type="uint16",
+            extension=True,
+            doc="Which long text this chunk belongs to; 0 for a text sent whole.",
+        ),
+    )
+    chunk_seq: int = _dataclasses.field(
+        default=0,
+        metadata=_m.meta(
+            name="chunk_seq", type="uint8", extension=True, doc="The chunk's place in its long text, from 0."
+        ),
+    )
+
+    def __eq__(self, other: object) -> bool:
+        """Field-by-field equality in which NaN equals NaN: a sentinel is the same data."""
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _m.same_message(self, other)
+
+    def to_dict(self) -> dict[str, _Any]:
+        """Plain data keyed by the schema's field names (arrays as lists, bytes as lists of ints)."""
+        out: dict[str, _Any] = {}
+        out["severity"] = self.severity
+        out["text"] = self.text
+        out["id"] = self.id
+        out["chunk_seq"] = self.chunk_seq
+        return out
+
+    @classmethod
+    def from_dict(cls, data: _Mapping[str, _Any]) -> Statustext:
+        """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        data = _m.check_keys(data, frozenset({"severity", "text", "id", "chunk_seq"}), (), "Statustext")
+        obj = cls()
+        if "severity" in data:
+            obj.severity = _m.as_int(data["severity"], "severity")
+        if "text" in data:
+            obj.text = _m.as_str(data["text"], "text")
+        if "id" in data:
+            obj.id = _m.as_int(data["id"], "id")
+        if "chunk_seq" in data:
+            obj.chunk_seq = _m.as_int(data["chunk_seq"], "chunk_seq")
+        return obj
+
+    MSG_ID: _ClassVar[int] = 253
+    CRC_EXTRA: _ClassVar[int] = 83
+    MAVLINK_BASE_LENGTH: _ClassVar[int] = 51
+    MAVLINK_MAX_LENGTH: _ClassVar[int] = 54
+
+    def encode(self, *, truncate: bool = True) -> bytes:
+        """The MAVLink 2 payload, 54 bytes in wire order; trailing zero bytes
+        are dropped (at least one byte is kept) unless ``truncate`` is False.
+        A value that does not fit its field raises EncodeError naming it."""
+        try:
+            t_text = self.text.encode("utf-8", "surrogateescape")
+            data = _STATUSTEXT_PAYLOAD.pack(self.severity, t_text, self.id, self.chunk_seq)
+        except (_struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+            raise _mav.explain("STATUSTEXT", self, _STATUSTEXT_FIELDS) from exc
+        if len(t_text) > 50:
+            raise _mav.explain("STATUSTEXT", self, _STATUSTEXT_FIELDS)
+        if truncate:
+            return data.rstrip(b"\x00") or b"\x00"
+        return data
+
+    @classmethod
+    def decode(cls, data: _mav.BytesLike) -> Statustext:
+        """A MAVLink 2 payload; a short one is zero-filled, one over 54 bytes is a DecodeError."""
+        if len(data) != 54:
+            data = _mav.fill(data, 54, "STATUSTEXT")
+        v0, v1, v2, v3 = _STATUSTEXT_PAYLOAD.unpack(data)
+        obj = object.__new__(cls)
+        obj.severity = v0
+        obj.text = _mav.text(v1)
+        obj.id = v2
+        obj.chunk_seq = v3
+        return obj
+
+    def encode_frame(
+        self,
+        *,
+        seq: int = 0,
+        sysid: int = 1,
+        compid: int = 1,
+        mavlink1: bool = False,
+        incompat_flags: int = 0,
+        compat_flags: int = 0,
+        signature: bytes | None = None,
+    ) -> bytes:
+        """A whole frame: MAVLink 2 (0xFD, truncated payload, CRC with CRC_EXTRA; a 13-byte
+        ``signature`` is appended and flagged, not computed) or, with ``mavlink1``, MAVLink 1
+        (0xFE, the base payload without extensions; message ids below 256 only)."""
+        if mavlink1:
+            return _mav.frame_v1(
+                self.encode(truncate=False)[:51],
+                253,
+                b"S",
+                seq,
+                sysid,
+                compid,
+                incompat_flags != 0 or compat_flags != 0 or signature is not None,
+            )
+        return _mav.frame_v2(self.encode(), 253, b"S", seq, sysid, compid, incompat_flags, compat_flags, signature)
+
+    @classmethod
+    def decode_frame(cls, data: _mav.BytesLike) -> Statustext:
+        """One whole MAVLink 1 or 2 frame of this message (CRC checked; a signature is skipped);
+        _mavlink.parse_frame gives the header fields."""
+        payload = _mav.frame_payload(data, 253, b"S", 54, "STATUSTEXT")
+        return cls.decode(payload)
+
+    @classmethod
+    def decode_batch(cls, data: _mav.BytesLike, *, use_numpy: bool | None = None) -> dict[str, _Any]:
+        """Records of 54 bytes (zero-filled payloads) -> columns keyed by field name: numpy
+        arrays (structured dtype) when numpy is installed and ``use_numpy`` is not False, else
+        tuples from struct.iter_unpack (arrays as a tuple per record, text as str)."""
+        arrays = _mav.numpy_columns(data, 54, _STATUSTEXT_DTYPE, use_numpy, "STATUSTEXT")
+        if arrays is not None:
+            return arrays
+        c = _mav.struct_columns(data, _STATUSTEXT_PAYLOAD, "STATUSTEXT")
+        return {
+            "severity": c[0],
+            "text": [_mav.text(b) for b in c[1]],
+            "id": c[2],
+            "chunk_seq": c[3],
+        }
+
+    def validate(self) -> list[_v.Violation]:
+        """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
+        out: list[_v.Violation] = []
+        x: _Any
+        try:
+            # severity (vehicle.xml:507): fits uint8; a value of MAV_SEVERITY
+            if self.severity not in {0, 1, 2, 3, 4, 5, 6, 7}:
+                _v.diag(out, "severity", self.severity, _STATUSTEXT_SEVERITY_SPEC)
+            # text (vehicle.xml:508): fits char[50]
+            x = self.text
+            if x.__class__ is not str or len(x.encode()) > 50:
+                _v.diag(out, "text", self.text, _STATUSTEXT_TEXT_SPEC)
+            # id (vehicle.xml:510): fits uint16
+            if self.id & -65536:
+                _v.diag(out, "id", self.id, _STATUSTEXT_ID_SPEC)
+            # chunk_seq (vehicle.xml:511): fits uint8
+            if self.chunk_seq & -256:
+                _v.diag(out, "chunk_seq", self.chunk_seq, _STATUSTEXT_CHUNK_SEQ_SPEC)
+        except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
+            out = _v.diagnose(self, _STATUSTEXT_FIELD_SPECS)
+        return out
+
+    def check(self) -> None:
+        """Raise ValidationError, carrying every violation, when validate() finds an error."""
+        found = self.validate()
+        for v in found:
+            if v.severity == "error":
+                raise _v.ValidationError(found, "mavlink.STATUSTEXT")
+
+    def is_known(self, field: str) -> bool:
+        """False when the field (schema name) holds its "unknown" sentinel or is absent."""
+        if field in {"severity", "text", "id", "chunk_seq"}:
+            return True
+        raise KeyError(f"{field!r} is not a field of " + "mavlink.STATUSTEXT")
+
+
+@_dataclasses.dataclass(slots=True)
 class SysStatus:
     """General state of a system: its sensors, processor load, link errors and one battery reading.
 
-    Schema: mavlink.SYS_STATUS (mavlink, vehicle.xml:450).
+    Schema: mavlink.SYS_STATUS (mavlink, vehicle.xml:477).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "mavlink.SYS_STATUS"
@@ -3609,7 +3850,7 @@ class SysStatus:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
         out: list[_v.Violation] = []
         try:
-            # onboard_control_sensors_present (vehicle.xml:452): fits uint32; bits of MAV_SYS_STATUS_SENSOR only
+            # onboard_control_sensors_present (vehicle.xml:479): fits uint32; bits of MAV_SYS_STATUS_SENSOR only
             if self.onboard_control_sensors_present & -4294967296:
                 _v.diag(
                     out,
@@ -3617,7 +3858,7 @@ class SysStatus:
                     self.onboard_control_sensors_present,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_SPEC,
                 )
-            # onboard_control_sensors_enabled (vehicle.xml:453): fits uint32; bits of MAV_SYS_STATUS_SENSOR only
+            # onboard_control_sensors_enabled (vehicle.xml:480): fits uint32; bits of MAV_SYS_STATUS_SENSOR only
             if self.onboard_control_sensors_enabled & -4294967296:
                 _v.diag(
                     out,
@@ -3625,7 +3866,7 @@ class SysStatus:
                     self.onboard_control_sensors_enabled,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_SPEC,
                 )
-            # onboard_control_sensors_health (vehicle.xml:454): fits uint32; bits of MAV_SYS_STATUS_SENSOR only
+            # onboard_control_sensors_health (vehicle.xml:481): fits uint32; bits of MAV_SYS_STATUS_SENSOR only
             if self.onboard_control_sensors_health & -4294967296:
                 _v.diag(
                     out,
@@ -3633,37 +3874,37 @@ class SysStatus:
                     self.onboard_control_sensors_health,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_HEALTH_SPEC,
                 )
-            # load (vehicle.xml:455): fits uint16
+            # load (vehicle.xml:482): fits uint16
             if self.load & -65536:
                 _v.diag(out, "load", self.load, _SYS_STATUS_LOAD_SPEC)
-            # voltage_battery (vehicle.xml:456): fits uint16; UINT16_MAX means unknown (accepted)
+            # voltage_battery (vehicle.xml:483): fits uint16; UINT16_MAX means unknown (accepted)
             if self.voltage_battery & -65536:
                 _v.diag(out, "voltage_battery", self.voltage_battery, _SYS_STATUS_VOLTAGE_BATTERY_SPEC)
-            # current_battery (vehicle.xml:457): fits int16; -1 means unknown (accepted)
+            # current_battery (vehicle.xml:484): fits int16; -1 means unknown (accepted)
             if (self.current_battery + 32768) & -65536:
                 _v.diag(out, "current_battery", self.current_battery, _SYS_STATUS_CURRENT_BATTERY_SPEC)
-            # battery_remaining (vehicle.xml:458): fits int8; -1 means unknown (accepted)
+            # battery_remaining (vehicle.xml:485): fits int8; -1 means unknown (accepted)
             if (self.battery_remaining + 128) & -256:
                 _v.diag(out, "battery_remaining", self.battery_remaining, _SYS_STATUS_BATTERY_REMAINING_SPEC)
-            # drop_rate_comm (vehicle.xml:459): fits uint16
+            # drop_rate_comm (vehicle.xml:486): fits uint16
             if self.drop_rate_comm & -65536:
                 _v.diag(out, "drop_rate_comm", self.drop_rate_comm, _SYS_STATUS_DROP_RATE_COMM_SPEC)
-            # errors_comm (vehicle.xml:460): fits uint16
+            # errors_comm (vehicle.xml:487): fits uint16
             if self.errors_comm & -65536:
                 _v.diag(out, "errors_comm", self.errors_comm, _SYS_STATUS_ERRORS_COMM_SPEC)
-            # errors_count1 (vehicle.xml:461): fits uint16
+            # errors_count1 (vehicle.xml:488): fits uint16
             if self.errors_count1 & -65536:
                 _v.diag(out, "errors_count1", self.errors_count1, _SYS_STATUS_ERRORS_COUNT1_SPEC)
-            # errors_count2 (vehicle.xml:462): fits uint16
+            # errors_count2 (vehicle.xml:489): fits uint16
             if self.errors_count2 & -65536:
                 _v.diag(out, "errors_count2", self.errors_count2, _SYS_STATUS_ERRORS_COUNT2_SPEC)
-            # errors_count3 (vehicle.xml:463): fits uint16
+            # errors_count3 (vehicle.xml:490): fits uint16
             if self.errors_count3 & -65536:
                 _v.diag(out, "errors_count3", self.errors_count3, _SYS_STATUS_ERRORS_COUNT3_SPEC)
-            # errors_count4 (vehicle.xml:464): fits uint16
+            # errors_count4 (vehicle.xml:491): fits uint16
             if self.errors_count4 & -65536:
                 _v.diag(out, "errors_count4", self.errors_count4, _SYS_STATUS_ERRORS_COUNT4_SPEC)
-            # onboard_control_sensors_present_extended (vehicle.xml:466): fits uint32; bits of
+            # onboard_control_sensors_present_extended (vehicle.xml:493): fits uint32; bits of
             # MAV_SYS_STATUS_SENSOR_EXTENDED only
             if self.onboard_control_sensors_present_extended & -64:
                 _v.diag(
@@ -3672,7 +3913,7 @@ class SysStatus:
                     self.onboard_control_sensors_present_extended,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_PRESENT_EXTENDED_SPEC,
                 )
-            # onboard_control_sensors_enabled_extended (vehicle.xml:467): fits uint32; bits of
+            # onboard_control_sensors_enabled_extended (vehicle.xml:494): fits uint32; bits of
             # MAV_SYS_STATUS_SENSOR_EXTENDED only
             if self.onboard_control_sensors_enabled_extended & -64:
                 _v.diag(
@@ -3681,7 +3922,7 @@ class SysStatus:
                     self.onboard_control_sensors_enabled_extended,
                     _SYS_STATUS_ONBOARD_CONTROL_SENSORS_ENABLED_EXTENDED_SPEC,
                 )
-            # onboard_control_sensors_health_extended (vehicle.xml:468): fits uint32; bits of
+            # onboard_control_sensors_health_extended (vehicle.xml:495): fits uint32; bits of
             # MAV_SYS_STATUS_SENSOR_EXTENDED only
             if self.onboard_control_sensors_health_extended & -64:
                 _v.diag(

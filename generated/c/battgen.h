@@ -16,6 +16,7 @@
 #include "mavlink/BATTERY_STATUS_V2.h"
 #include "mavlink/HEARTBEAT.h"
 #include "mavlink/PARAM_VALUE.h"
+#include "mavlink/STATUSTEXT.h"
 #include "mavlink/SYS_STATUS.h"
 #include "uorb/BatteryInfo.h"
 #include "uorb/BatteryStatus.h"

@@ -4,6 +4,7 @@
 #include "mavlink/BATTERY_STATUS_V2.h"
 #include "mavlink/HEARTBEAT.h"
 #include "mavlink/PARAM_VALUE.h"
+#include "mavlink/STATUSTEXT.h"
 #include "mavlink/SYS_STATUS.h"
 
 static battgen_rule check_battgen_mavlink_BATTERY_INFO_battery_function(uint8_t v) {
@@ -272,6 +273,13 @@ static battgen_rule check_battgen_mavlink_PARAM_VALUE_param_value(float v) {
 
 static battgen_rule check_battgen_mavlink_PARAM_VALUE_param_type(uint8_t v) {
   if (!(v >= 1u && v <= 10u)) {
+    return BATTGEN_RULE_ENUM;
+  }
+  return BATTGEN_RULE_NONE;
+}
+
+static battgen_rule check_battgen_mavlink_STATUSTEXT_severity(uint8_t v) {
+  if (!(v <= 7u)) {
     return BATTGEN_RULE_ENUM;
   }
   return BATTGEN_RULE_NONE;
@@ -854,6 +862,85 @@ battgen_error battgen_mavlink_PARAM_VALUE_decode_frame(const uint8_t *frame, siz
     return e;
   }
   return battgen_mavlink_PARAM_VALUE_decode(payload, n, m);
+}
+
+/* mavlink.STATUSTEXT */
+
+size_t battgen_mavlink_STATUSTEXT_validate(const battgen_mavlink_STATUSTEXT *m,
+                                           battgen_problem *out, size_t cap) {
+  size_t n = 0;
+  battgen_rule r;
+  r = check_battgen_mavlink_STATUSTEXT_severity(m->severity);
+  if (r != BATTGEN_RULE_NONE) {
+    battgen_report(out, cap, &n, "severity", -1, r);
+  }
+  return n;
+}
+
+size_t battgen_mavlink_STATUSTEXT_encode(const battgen_mavlink_STATUSTEXT *m,
+                                         uint8_t out[BATTGEN_MAVLINK_STATUSTEXT_MAX_LENGTH]) {
+  uint8_t *p = out;
+  size_t i;
+  battgen_zero(p, BATTGEN_MAVLINK_STATUSTEXT_MAX_LENGTH);
+  battgen_put_u8(p + 0, m->severity);
+  for (i = 0; i < 50u; i++) {
+    battgen_put_u8(p + 1u + 1u * i, (uint8_t)m->text[i]);
+  }
+  battgen_put_u16(p + 51, m->id);
+  battgen_put_u8(p + 53, m->chunk_seq);
+  return battgen_mavlink_truncated(p, BATTGEN_MAVLINK_STATUSTEXT_MAX_LENGTH);
+}
+
+battgen_error battgen_mavlink_STATUSTEXT_decode(const uint8_t *payload, size_t len,
+                                                battgen_mavlink_STATUSTEXT *m) {
+  /* MAVLink 2 drops trailing zero bytes: a short payload reads as zero-filled */
+  uint8_t p[BATTGEN_MAVLINK_STATUSTEXT_MAX_LENGTH];
+  size_t i;
+  if (len > BATTGEN_MAVLINK_STATUSTEXT_MAX_LENGTH) {
+    return BATTGEN_ERR_TOO_LONG;
+  }
+  battgen_zero(p, sizeof p);
+  battgen_copy(p, payload, len);
+  battgen_zero(m, sizeof *m);
+  m->severity = battgen_get_u8(p + 0);
+  for (i = 0; i < 50u; i++) {
+    m->text[i] = (char)battgen_get_u8(p + 1u + 1u * i);
+  }
+  m->text[50] = '\0';
+  m->id = battgen_get_u16(p + 51);
+  m->chunk_seq = battgen_get_u8(p + 53);
+  return BATTGEN_OK;
+}
+
+size_t battgen_mavlink_STATUSTEXT_encode_frame(const battgen_mavlink_STATUSTEXT *m,
+                                               battgen_mavlink_header h, uint8_t *out) {
+  uint8_t payload[BATTGEN_MAVLINK_STATUSTEXT_MAX_LENGTH];
+  size_t n = battgen_mavlink_STATUSTEXT_encode(m, payload);
+  return battgen_mavlink_frame_v2(BATTGEN_MAVLINK_STATUSTEXT_MSG_ID,
+                                  BATTGEN_MAVLINK_STATUSTEXT_CRC_EXTRA, payload, n, h, out);
+}
+
+size_t battgen_mavlink_STATUSTEXT_encode_frame_v1(const battgen_mavlink_STATUSTEXT *m,
+                                                  battgen_mavlink_header h, uint8_t *out) {
+  uint8_t payload[BATTGEN_MAVLINK_STATUSTEXT_MAX_LENGTH];
+  (void)battgen_mavlink_STATUSTEXT_encode(m, payload);
+  return battgen_mavlink_frame_v1(BATTGEN_MAVLINK_STATUSTEXT_MSG_ID,
+                                  BATTGEN_MAVLINK_STATUSTEXT_CRC_EXTRA, payload,
+                                  BATTGEN_MAVLINK_STATUSTEXT_BASE_LENGTH, h, out);
+}
+
+battgen_error battgen_mavlink_STATUSTEXT_decode_frame(const uint8_t *frame, size_t len,
+                                                      battgen_mavlink_header *h,
+                                                      battgen_mavlink_STATUSTEXT *m) {
+  const uint8_t *payload = NULL;
+  size_t n = 0;
+  battgen_error e =
+      battgen_mavlink_frame_parse(frame, len, BATTGEN_MAVLINK_STATUSTEXT_MSG_ID,
+                                  BATTGEN_MAVLINK_STATUSTEXT_CRC_EXTRA, h, &payload, &n);
+  if (e != BATTGEN_OK) {
+    return e;
+  }
+  return battgen_mavlink_STATUSTEXT_decode(payload, n, m);
 }
 
 /* mavlink.SYS_STATUS */

@@ -153,3 +153,20 @@ def test_json_format_gives_the_page_figures_per_battery(
     assert json.loads(out.read_text()) == doc
     assert main(["report", "--format", "json", "-o", str(tmp_path), str(flight)]) == 2
     assert "is a folder" in capsys.readouterr().err
+
+
+def test_json_format_carries_the_logs_modes_and_messages(capsys: pytest.CaptureFixture[str]) -> None:
+    """The JSON report says what the page shows of the log: its mode changes and logged messages, as the data
+    layer's context reads them (a real ArduPilot tlog: HEARTBEAT modes, STATUSTEXT)."""
+    from shared_data import require, shared
+
+    from codegen.apps.battery.catalog import bundled_catalog
+    from codegen.apps.battery.readers import read_log
+
+    log = require(shared("corpus", "realworld3", "tlog", "uavlogviewer_vtol.tlog"))
+    assert main(["report", "--format", "json", str(log)]) == 0
+    [item] = json.loads(capsys.readouterr().out)["inputs"]
+    context = next(b.context for b in read_log(log, log.name, bundled_catalog()) if b.context is not None)
+    assert item["log"]["modes"] == [{"t": t, "mode": m} for t, m in context.modes] and len(context.modes) == 4
+    assert [x["text"] for x in item["log"]["texts"]] == [x.text for x in context.texts] and context.texts
+    assert item["log"]["firmware"] == "ArduPlane V3.10.0-dev (f2b4e06a)"

@@ -108,7 +108,8 @@ class LogContext:
         return PARAMETER_SOURCES.get(self.kind, "parameters")
 
     def to_dict(self, end: float | None = None) -> dict[str, object]:
-        """The context as JSON data; the parameters as a count (a log holds hundreds)."""
+        """The context as JSON data; the parameters as a count (a log holds hundreds), the modes, failsafes and
+        logged texts in full."""
         out: dict[str, object] = {
             "kind": self.kind,
             "start_utc_us": self.start_utc_us,
@@ -122,6 +123,10 @@ class LogContext:
         }
         if end is not None:
             out["armed"] = [list(span) for span in self.armed_intervals(end)] if self.arming_rule else None
+        # what the firmware said and did, as the report's page shows it (each at t, seconds since the log's start)
+        out["modes"] = [{"t": t, "mode": name} for t, name in self.modes]
+        out["failsafes"] = [{"t": t, "failsafe": what} for t, what in self.failsafes]
+        out["texts"] = [{"t": x.t, "severity": x.severity or None, "text": x.text} for x in self.texts]
         return out
 
 

@@ -14,14 +14,20 @@
 - **Vehicle**: ``mavlink:<system id>``, and ``vehicle_type`` the MAV_TYPE of its last vehicle heartbeat.
 - **Parameters**: the system's PARAM_VALUE frames (a ground station's parameter download; a value set again: its
   last), in the context (:mod:`.context`).
+- **Modes and texts**: each change of the mode its vehicle heartbeats give (``custom_mode`` named as a ground station
+  names it: pymavlink's ``mode_string_v10``, PX4's main and sub mode, ArduPilot's per vehicle type), and its
+  STATUSTEXT messages with their severity (a long text sent in chunks joined), in the context; the firmware the
+  first ArduPilot banner among them names ("ArduPlane V3.10.0-dev (f2b4e06a)").
 """
 
 from __future__ import annotations
 
+import re
 import struct
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -30,13 +36,17 @@ from ...inputs.dataflash import shortest_float32
 from ...inputs.model import MavlinkClass
 from ...inputs.tlog import FrameRecord, StreamStats, read_messages
 from .catalog import Catalog
-from .context import ARMING_RULES, MAV_AUTOPILOT_FIRMWARE, LogContext, arming_changes
+from .context import ARMING_RULES, MAV_AUTOPILOT_FIRMWARE, SYSLOG_LEVELS, LogContext, LogText, arming_changes
 from .sources import Batch, instances_to_columns, model_of
 
 BATTERY_STATUS, SYS_STATUS, HEARTBEAT = "mavlink.BATTERY_STATUS", "mavlink.SYS_STATUS", "mavlink.HEARTBEAT"
-PARAM_VALUE = "mavlink.PARAM_VALUE"
+PARAM_VALUE, STATUSTEXT = "mavlink.PARAM_VALUE", "mavlink.STATUSTEXT"
 PX4_BYTEWISE = {1: "<B", 2: "<b", 3: "<H", 4: "<h", 5: "<I", 6: "<i"}  # MAV_PARAM_TYPE -> the integer in its bytes
 SAFETY_ARMED = 128  # MAV_MODE_FLAG_SAFETY_ARMED
+CUSTOM_MODE_ENABLED = 1  # MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+PX4_AUTOPILOT = 12  # MAV_AUTOPILOT_PX4
+# the banner ArduPilot sends at boot and on a ground station's connection ("ArduPlane V4.5.7 (b0d6e8f3)")
+FIRMWARE_BANNER = re.compile(r"(Ardu\w+|APM:\w+) V\d")
 NOT_VEHICLE_TYPES = frozenset({6, 18, 26, 27})  # MAV_TYPE_GCS, _ONBOARD_CONTROLLER, _GIMBAL, _ADSB
 AUTOPILOT_INVALID = 8  # MAV_AUTOPILOT_INVALID
 COMP_GIMBAL = 154  # MAV_COMP_ID_GIMBAL
@@ -50,8 +60,12 @@ class _System:
     sys_status: list[FrameRecord] = field(default_factory=list)
     beats: list[tuple[int, bool, int]] = field(default_factory=list)
     beat_stamps: list[int | None] = field(default_factory=list)  # each heartbeat's tlog stamp
+    beat_modes: list[tuple[int, int]] = field(default_factory=list)  # each heartbeat's (base_mode, custom_mode)
     autopilot: int | None = None  # MAV_AUTOPILOT of the last vehicle heartbeat
     parameters: dict[str, tuple[float, int]] = field(default_factory=dict)  # PARAM_VALUE: (value, MAV_PARAM_TYPE)
+    texts: list[tuple[int | None, int, str, int]] = field(
+        default_factory=list
+    )  # STATUSTEXT (stamp, severity, text, id)
     status_only: bool = True  # no BATTERY_STATUS seen: its SYS_STATUS frames stand for battery 0
 
 
@@ -76,13 +90,9 @@ def tlog_batches(path: Path, name: str, catalog: Catalog) -> Iterator[Batch]:
     walked once, each battery one batch; a larger one twice: first what the batteries' context needs (heartbeats,
     parameters, which systems send BATTERY_STATUS), then the battery frames, handed out every :data:`CHUNK`
     frames, so memory stays flat whatever the log's length. Both give the same records, clock and arming."""
-    wanted = (BATTERY_STATUS, SYS_STATUS, HEARTBEAT, PARAM_VALUE)
+    wanted = (BATTERY_STATUS, SYS_STATUS, HEARTBEAT, PARAM_VALUE, STATUSTEXT)
     models = {m.MSG_ID: m for m in (_mavlink(catalog, q) for q in wanted)}
-    ids = _Ids(
-        _mavlink(catalog, BATTERY_STATUS).MSG_ID,
-        _mavlink(catalog, SYS_STATUS).MSG_ID,
-        _mavlink(catalog, PARAM_VALUE).MSG_ID,
-    )
+    ids = _Ids(*(_mavlink(catalog, q).MSG_ID for q in (BATTERY_STATUS, SYS_STATUS, PARAM_VALUE, STATUSTEXT)))
     try:
         streamed = path.stat().st_size > STREAM_ABOVE
     except OSError:
@@ -123,6 +133,7 @@ class _Ids:
     battery: int
     status: int
     param: int
+    text: int
 
 
 def _survey(records: Iterable[FrameRecord], ids: _Ids, *, keep: bool) -> dict[int, _System]:
@@ -144,6 +155,10 @@ def _survey(records: Iterable[FrameRecord], ids: _Ids, *, keep: bool) -> dict[in
             name = parameter_name(str(getattr(p, "param_id")))  # noqa: B009
             if name:  # a set value is sent again: the last one stands, as the vehicle ended up with it
                 system.parameters[name] = (float(getattr(p, "param_value")), int(getattr(p, "param_type")))  # noqa: B009
+        elif msgid == ids.text:
+            m = rec.instance
+            text = _text(getattr(m, "text"))  # noqa: B009
+            system.texts.append((rec.timestamp, int(getattr(m, "severity")), text, int(getattr(m, "id") or 0)))  # noqa: B009
         else:
             hb = rec.instance
             mav_type, autopilot = int(getattr(hb, "type")), int(getattr(hb, "autopilot"))  # noqa: B009
@@ -151,6 +166,7 @@ def _survey(records: Iterable[FrameRecord], ids: _Ids, *, keep: bool) -> dict[in
                 armed = bool(int(getattr(hb, "base_mode")) & SAFETY_ARMED)  # noqa: B009
                 system.beats.append((rec.offset or 0, armed, mav_type))
                 system.beat_stamps.append(rec.timestamp)
+                system.beat_modes.append((int(getattr(hb, "base_mode")), int(getattr(hb, "custom_mode"))))  # noqa: B009
                 system.autopilot = autopilot
     return systems
 
@@ -209,6 +225,7 @@ def _context(system: _System, sysid: int, origin: int) -> LogContext:
     t = np.array([(s - origin) / 1e6 for s, _ in known], np.float64)
     armed = np.array([a for _, a in known], np.float64)
     autopilot = MAV_AUTOPILOT_FIRMWARE.get(system.autopilot) if system.autopilot is not None else None
+    texts = _texts(system, origin)
     return LogContext(
         "tlog",
         origin,
@@ -219,7 +236,68 @@ def _context(system: _System, sysid: int, origin: int) -> LogContext:
         parameters=_parameters(system, autopilot),
         arming=arming_changes(t, armed),
         arming_rule=ARMING_RULES["tlog"],
+        firmware=next((x.text for x in texts if FIRMWARE_BANNER.match(x.text)), None),
+        texts=texts,
+        modes=_modes(system, origin),
     )
+
+
+def _seconds(stamp: int | None, origin: int) -> float | None:
+    return None if stamp is None or stamp >= 1 << 63 else (stamp - origin) / 1e6
+
+
+def _text(value: object) -> str:
+    """A STATUSTEXT's text up to its NUL (the field may hold bytes or text)."""
+    if isinstance(value, bytes | bytearray):
+        value = bytes(value).split(b"\x00", 1)[0].decode("utf-8", "replace")
+    return str(value).split("\x00", 1)[0]
+
+
+def _texts(system: _System, origin: int) -> tuple[LogText, ...]:
+    """The system's STATUSTEXTs in order; the chunks of one long text (the same nonzero id, in a row) joined."""
+    out: list[LogText] = []
+    last_id = 0
+    for stamp, severity, text, text_id in system.texts:
+        t = _seconds(stamp, origin)
+        if t is None:
+            continue
+        level = SYSLOG_LEVELS[severity] if 0 <= severity < len(SYSLOG_LEVELS) else f"severity {severity}"
+        if text_id and text_id == last_id and out:
+            out[-1] = LogText(out[-1].t, out[-1].severity, out[-1].text + text)
+        else:
+            out.append(LogText(t, level, text))
+        last_id = text_id
+    return tuple(out)
+
+
+def _modes(system: _System, origin: int) -> tuple[tuple[float, str], ...]:
+    """Each change of the mode the vehicle heartbeats give, named as a ground station names it."""
+    from pymavlink import mavutil  # the tlog reader's reference, already a dependency
+
+    out: list[tuple[float, str]] = []
+    last: str | None = None
+    for stamp, (_, _, mav_type), (base, custom) in zip(
+        system.beat_stamps, system.beats, system.beat_modes, strict=True
+    ):
+        t = _seconds(stamp, origin)
+        if t is None:
+            continue
+        name = mode_name(mavutil, base, custom, mav_type, system.autopilot)
+        if name != last:
+            out.append((t, name))
+            last = name
+    return tuple(out)
+
+
+def mode_name(mavutil: Any, base_mode: int, custom_mode: int, mav_type: int, autopilot: int | None) -> str:
+    """pymavlink's ``mode_string_v10`` for a heartbeat's fields: PX4's main and sub mode, else the vehicle
+    type's mode table (ArduPilot's), else ``Mode(N)``."""
+    if autopilot == PX4_AUTOPILOT:
+        return str(mavutil.interpret_px4_mode(base_mode, custom_mode))
+    if not base_mode & CUSTOM_MODE_ENABLED:
+        return f"Mode(0x{base_mode:08x})"
+    names = mavutil.mode_mapping_bynumber(mav_type) or {}
+    return str(names[custom_mode]) if custom_mode in names else f"Mode({custom_mode})"
 
 
 def parameter_name(param_id: str) -> str:

@@ -444,6 +444,54 @@ impl MavParamType {
     }
 }
 
+/// How urgent a text the vehicle sends is; the eight levels of syslog (RFC 5424), most urgent first.
+///
+/// Schema: `mavlink.MAV_SEVERITY` (value).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum MavSeverity {
+    /// The vehicle cannot be used.
+    Emergency = 0,
+    /// Act now.
+    Alert = 1,
+    /// A critical condition, such as a failed primary system.
+    Critical = 2,
+    /// An error in a secondary system.
+    Error = 3,
+    /// Something may go wrong if nothing is done.
+    Warning = 4,
+    /// An unusual event, not an error.
+    Notice = 5,
+    /// For information.
+    Info = 6,
+    /// For developers.
+    Debug = 7,
+}
+
+impl MavSeverity {
+    /// The member with this value (None for a value the schema does not define).
+    #[must_use]
+    pub const fn from_value(value: i64) -> Option<Self> {
+        match value {
+            0 => Some(Self::Emergency),
+            1 => Some(Self::Alert),
+            2 => Some(Self::Critical),
+            3 => Some(Self::Error),
+            4 => Some(Self::Warning),
+            5 => Some(Self::Notice),
+            6 => Some(Self::Info),
+            7 => Some(Self::Debug),
+            _ => None,
+        }
+    }
+
+    /// The value on the wire.
+    #[must_use]
+    pub const fn value(self) -> i64 {
+        self as i64
+    }
+}
+
 /// Overall state of a system, as its heartbeat reports it.
 ///
 /// Schema: `mavlink.MAV_STATE` (value).

@@ -7,7 +7,7 @@ use crate::wire;
 
 /// Sent about once a second by every system and component: what it is, which autopilot it runs, its mode and state.
 ///
-/// Schema: `mavlink.HEARTBEAT` (vehicle.xml:441).
+/// Schema: `mavlink.HEARTBEAT` (vehicle.xml:468).
 #[derive(Clone, Copy, Debug)]
 pub struct Heartbeat {
     /// Vehicle type of a flight controller, else the component's type.

@@ -7,7 +7,7 @@ use crate::wire;
 
 /// One of the vehicle's parameters, as it sends them when asked for the list or after one is set.
 ///
-/// Schema: `mavlink.PARAM_VALUE` (vehicle.xml:470).
+/// Schema: `mavlink.PARAM_VALUE` (vehicle.xml:497).
 #[derive(Clone, Copy, Debug)]
 pub struct ParamValue {
     /// The parameter's name; NUL-terminated when shorter than 16 characters.

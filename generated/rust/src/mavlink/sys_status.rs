@@ -7,7 +7,7 @@ use crate::wire;
 
 /// General state of a system: its sensors, processor load, link errors and one battery reading.
 ///
-/// Schema: `mavlink.SYS_STATUS` (vehicle.xml:450).
+/// Schema: `mavlink.SYS_STATUS` (vehicle.xml:477).
 #[derive(Clone, Copy, Debug)]
 pub struct SysStatus {
     /// Sensors and controllers present (bit set: present).
