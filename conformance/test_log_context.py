@@ -217,3 +217,32 @@ def test_tlog_modes_and_texts_match_pymavlink(path: Path, monkeypatch: pytest.Mo
         banner = next((text for _, _, text in theirs if re.match(r"(Ardu\w+|APM:\w+) V\d", text)), None)
         assert context.firmware == banner  # ArduPilot's boot banner names the firmware and its version
     assert any(c.modes for c in contexts) or not any(modes.values())
+
+
+@pytest.mark.parametrize("path", ULOGS, ids=[p.name for p in ULOGS])
+def test_ulog_battery_failsafe_flags_match_pyulog(path: Path) -> None:
+    """The report's markers of commander's battery failsafe inputs: each rise of ``failsafe_flags.battery_warning``
+    and each time ``battery_low_remaining_time`` turns true, at pyulog's timestamps of the same records."""
+    contexts = _contexts(path)
+    if not contexts:
+        pytest.skip("no battery records: the view yields no chunk")
+    (context,) = contexts
+    log = pyulog.ULog(str(path), ["failsafe_flags"])
+    data = next((d.data for d in log.data_list if d.multi_id == 0), None)
+    expected: list[tuple[float, str]] = []
+    if data is not None:
+        level, was_low = 0, False
+        low = data.get("battery_low_remaining_time", np.zeros(len(data["timestamp"])))
+        for stamp, warning, flag in zip(data["timestamp"], data["battery_warning"], low, strict=True):
+            t = (int(stamp) - log.start_timestamp) / 1e6
+            if int(warning) > level and int(warning) in (1, 2, 3):
+                expected.append(
+                    (t, f"battery warning {('LOW', 'CRITICAL', 'EMERGENCY')[int(warning) - 1]} (failsafe_flags)")
+                )
+            level = int(warning)
+            if flag and not was_low:
+                expected.append((t, "remaining flight time low (failsafe_flags)"))
+            was_low = bool(flag)
+    ours = [f for f in context.failsafes if "(failsafe_flags)" in f[1]]
+    assert [w for _, w in ours] == [w for _, w in expected]
+    assert [t for t, _ in ours] == pytest.approx([t for t, _ in expected], abs=1e-6)

@@ -284,6 +284,16 @@ class UlogColumns:
         failsafe = status["failsafe"] if "failsafe" in (status.dtype.names or ()) else None
         return status["timestamp"], status["nav_state"], failsafe
 
+    def battery_failsafe_flags(self) -> tuple[NDArray, NDArray, NDArray | None] | None:
+        """(timestamps, battery_warning, battery_low_remaining_time) of ``failsafe_flags`` (PX4 v1.14 and later:
+        the inputs commander's failsafe framework acts on; the remaining-time flag None where the log lacks it), if
+        the log has it."""
+        flags = self._topic_records("failsafe_flags", ("timestamp", "battery_warning"))
+        if flags is None or not len(flags):
+            return None
+        low = flags["battery_low_remaining_time"] if "battery_low_remaining_time" in (flags.dtype.names or ()) else None
+        return flags["timestamp"], flags["battery_warning"], low
+
     def logged(self) -> list[tuple[int, int, str]]:
         """The log's text messages (``L`` and tagged ``C`` records) as (level byte, timestamp, text), by time;
         complete once the log was walked (the columns' reading walks it)."""

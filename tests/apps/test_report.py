@@ -170,3 +170,35 @@ def test_json_format_carries_the_logs_modes_and_messages(capsys: pytest.CaptureF
     assert item["log"]["modes"] == [{"t": t, "mode": m} for t, m in context.modes] and len(context.modes) == 4
     assert [x["text"] for x in item["log"]["texts"]] == [x.text for x in context.texts] and context.texts
     assert item["log"]["firmware"] == "ArduPlane V3.10.0-dev (f2b4e06a)"
+
+
+def test_png_images_show_the_logs_modes_and_armed_spans(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A PNG shows what the page shows of the log: the armed spans shaded and every mode change named (a real
+    ArduPilot tlog), taken from the same facts as the HTML page."""
+    pytest.importorskip("matplotlib")
+    from matplotlib.axes import Axes
+    from shared_data import require, shared
+
+    from codegen.apps.battery.catalog import bundled_catalog
+    from codegen.apps.battery.readers import read_log
+
+    log = require(shared("corpus", "realworld3", "tlog", "uavlogviewer_vtol.tlog"))
+    context = next(b.context for b in read_log(log, log.name, bundled_catalog()) if b.context is not None)
+    texts: list[str] = []
+    spans: list[tuple[float, float]] = []
+    real_text, real_span = Axes.text, Axes.axvspan
+
+    def text(self: Axes, x: float, y: float, s: str, *args: object, **kwargs: object) -> object:
+        texts.append(s)
+        return real_text(self, x, y, s, *args, **kwargs)  # type: ignore[arg-type]
+
+    def axvspan(self: Axes, xmin: float, xmax: float, *args: object, **kwargs: object) -> object:
+        spans.append((xmin, xmax))
+        return real_span(self, xmin, xmax, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(Axes, "text", text)
+    monkeypatch.setattr(Axes, "axvspan", axvspan)
+    assert main(["report", str(log), "--format", "png", "-o", str(tmp_path / "images")]) == 0
+    assert [name for _, name in context.modes] == [t for t in texts if t in {n for _, n in context.modes}]
+    armed = context.armed_intervals(float("inf"))
+    assert armed and {(a, b) for a, b in spans} >= {(a, b) for a, b in armed if b != float("inf")}

@@ -25,7 +25,9 @@ parameters the firmware recorded. Per kind:
 ``texts`` its logged messages (ULog ``L``/``C`` records with their syslog level, DataFlash ``MSG``), ``modes`` its
 flight-mode changes (PX4 ``vehicle_status.nav_state``; DataFlash ``MODE`` with the reason ArduPilot gave), and
 ``failsafes`` the moments it entered a failsafe (PX4 ``vehicle_status.failsafe`` turning true, with the mode it
-chose; ArduPilot a ``MODE`` change for a failsafe reason and ``ERR`` records of a failsafe subsystem).
+chose, and each rise of the battery inputs of commander's failsafe framework, ``failsafe_flags.battery_warning``
+and ``battery_low_remaining_time``; ArduPilot a ``MODE`` change for a failsafe reason and ``ERR`` records of a
+failsafe subsystem).
 """
 
 from __future__ import annotations
@@ -213,3 +215,28 @@ def px4_modes(
             failsafes.append((max(tk, 0.0), f"failsafe: {name}"))
         was_failsafe = bool(fs)
     return tuple(modes), tuple(failsafes)
+
+
+PX4_WARNINGS = {1: "LOW", 2: "CRITICAL", 3: "EMERGENCY"}  # battery_status.warning / failsafe_flags.battery_warning
+
+
+def px4_battery_failsafes(
+    flags: tuple[NDArray, NDArray, NDArray | None] | None, start_us: int
+) -> tuple[tuple[float, str], ...]:
+    """Each rise of commander's battery warning and each time its remaining-flight-time flag turns true, in ``t``,
+    from ``failsafe_flags`` records."""
+    if flags is None:
+        return ()
+    stamps, warnings, low_time = flags
+    t = ((np.asarray(stamps, np.int64) - start_us) / 1e6).tolist()
+    lows = [False] * len(t) if low_time is None else np.asarray(low_time, bool).tolist()
+    out: list[tuple[float, str]] = []
+    level, was_low = 0, False
+    for tk, w, low in zip(t, np.asarray(warnings).tolist(), lows, strict=True):
+        if w > level and w in PX4_WARNINGS:
+            out.append((max(tk, 0.0), f"battery warning {PX4_WARNINGS[w]} (failsafe_flags)"))
+        level = int(w)
+        if low and not was_low:
+            out.append((max(tk, 0.0), "remaining flight time low (failsafe_flags)"))
+        was_low = bool(low)
+    return tuple(out)

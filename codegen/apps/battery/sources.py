@@ -31,7 +31,16 @@ from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
 from .columns import ConceptColumn, NDArray, length_key
-from .context import ARMING_RULES, SYSLOG_LEVELS, LogContext, LogText, arming_changes, px4_firmware, px4_modes
+from .context import (
+    ARMING_RULES,
+    SYSLOG_LEVELS,
+    LogContext,
+    LogText,
+    arming_changes,
+    px4_battery_failsafes,
+    px4_firmware,
+    px4_modes,
+)
 
 
 @dataclass
@@ -112,6 +121,7 @@ def ulog_context(log: UlogColumns, armed: tuple[NDArray, NDArray] | None, utc_of
     if armed is not None:
         changes = arming_changes((armed[0].astype(np.int64) - log.start_us) / 1e6, armed[1])
     modes, failsafes = px4_modes(log.nav_states(), log.start_us)
+    failsafes = tuple(sorted(failsafes + px4_battery_failsafes(log.battery_failsafe_flags(), log.start_us)))
     texts = tuple(
         LogText((stamp - log.start_us) / 1e6, _syslog(level), text.rstrip("\t\n\x00"))
         for level, stamp, text in log.logged()

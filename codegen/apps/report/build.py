@@ -65,6 +65,15 @@ def pngs(report: Report, folder: Path) -> list[Path]:
         for s in item.batteries:
             path = folder / f"{_slug(item.source)}-battery{s.battery + 1}.png"
             markers = [Marker(e.t, e.level, e.text) for e in rep.events if e.battery == s.battery]
-            write_png(s, path, markers, rep.thresholds.get(s.battery, {}))
+            facts = report.facts.get(item.source)
+            write_png(
+                s,
+                path,
+                markers,
+                rep.thresholds.get(s.battery, {}),
+                armed=facts.armed if facts else (),
+                modes=facts.modes if facts else (),
+                failsafes=facts.failsafes if facts else (),
+            )
             written.append(path)
     return written

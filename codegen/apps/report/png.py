@@ -1,12 +1,14 @@
 """Static images of a report, one PNG per battery, for tickets and documents (matplotlib, no browser).
 
 The same rows as the HTML plots (:mod:`.plots`), one panel each on a shared time axis, failsafe events as
-vertical lines. matplotlib comes with the ``report`` extra.
+vertical lines; what the log says of the flight as the page shows it: armed spans shaded, flight modes named
+above the top panel, the firmware's own failsafe entries dashed. matplotlib comes with the ``report`` extra.
 """
 
 from __future__ import annotations
 
 import importlib
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -15,10 +17,20 @@ from .plots import LEVEL_COLOURS, figure
 from .series import BatterySeries
 
 NEEDS_MATPLOTLIB = "--format png draws with matplotlib: pip install 'battgen[report]'"
+ARMED_COLOUR, FAILSAFE_COLOUR = "#2a9d8f", "#c0392b"
 
 
-def write_png(s: BatterySeries, path: Path, markers: list[Any], thresholds: dict[str, float]) -> None:
-    """One image of a battery's plots."""
+def write_png(
+    s: BatterySeries,
+    path: Path,
+    markers: list[Any],
+    thresholds: dict[str, float],
+    *,
+    armed: Sequence[tuple[float, float]] = (),
+    modes: Sequence[tuple[float, str]] = (),
+    failsafes: Sequence[tuple[float, str]] = (),
+) -> None:
+    """One image of a battery's plots; ``armed``, ``modes`` and ``failsafes`` as :func:`.plots.figure` takes them."""
     try:
         matplotlib = importlib.import_module("matplotlib")
         matplotlib.use("Agg")  # no screen: draw into memory
@@ -38,12 +50,20 @@ def write_png(s: BatterySeries, path: Path, markers: list[Any], thresholds: dict
             unit = trace["hovertemplate"].split(" ", 1)[1].split("<", 1)[0]
             ax.set_ylabel(f"{title}\n[{unit}]", fontsize=8)
             ax.grid(True, alpha=0.3)
+            for start, stop in armed:
+                ax.axvspan(start, stop, color=ARMED_COLOUR, alpha=0.10, linewidth=0)
+            for t, _ in failsafes:
+                ax.axvline(t, color=FAILSAFE_COLOUR, linestyle="--", linewidth=1.0)
             for m in markers:
                 ax.axvline(m.t, color=LEVEL_COLOURS.get(m.level, "#555"), linewidth=1.5)
             if title == "pack voltage":
                 for name, volts in thresholds.items():
                     ax.axhline(volts, linestyle="--", linewidth=0.8, color="#888")
                     ax.text(1.0, volts, name, transform=ax.get_yaxis_transform(), ha="right", va="bottom", fontsize=7)
+        top = axes[0, 0]
+        for t, name in modes:  # each mode named where it starts, above the top panel
+            top.axvline(t, color="#999", linewidth=0.6)
+            top.text(t, 1.02, name, transform=top.get_xaxis_transform(), rotation=30, fontsize=6, va="bottom")
         axes[-1, 0].set_xlabel("time [s]")
         fig.suptitle(f"{s.source} — {s.label}", fontsize=10)
         fig.tight_layout()
