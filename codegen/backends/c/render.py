@@ -14,6 +14,7 @@ from ...errors import BattgenError
 from ...ir import ArrayType, CompositeType, Constant, Message, PrimitiveKind, PrimitiveType, Schema, SourceFormat
 from .checks import check_uses, checks_of, validator
 from .codecs import mavlink_codec, uorb_codec
+from .converters import c_converters
 from .dronecan_codec import BitCodec, dronecan_codec
 from .types import ident, member, type_name
 
@@ -22,7 +23,7 @@ _HERE = Path(__file__).parent
 STYLE = "{BasedOnStyle: LLVM, ColumnLimit: 100, SortIncludes: false}"
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
 # support headers copied verbatim (through clang-format, as every other file)
-_SUPPORT = ("battgen_wire.h", "battgen_mavlink.h")
+_SUPPORT = ("battgen_wire.h", "battgen_mavlink.h", "battgen_convert.h")
 
 
 def _comment(text: str) -> str:
@@ -178,6 +179,16 @@ def render_library(schema: Schema) -> dict[str, str]:
         files[rel] = clang_format(source.render(format=fmt.value, headers=own, messages=view), rel)
     for name in _SUPPORT:
         files[name] = clang_format((_HERE / "support" / name).read_text(encoding="utf-8"), name)
+    converters, helpers, left = c_converters(schema)
+    if converters:
+        used = sorted(
+            {header_path(q) for c in converters for q in (*(s[0] for s in c.sources), *(t[0] for t in c.targets))}
+        )
+        text = env.get_template("convert.h.j2").render(headers=used, converters=converters)
+        files["convert.h"] = clang_format(text, "convert.h")
+        text = env.get_template("convert.c.j2").render(helpers=helpers, converters=converters)
+        files["convert.c"] = clang_format(text, "convert.c")
+        headers.append("convert.h")
     files["battgen.h"] = clang_format(env.get_template("battgen.h.j2").render(headers=headers), "battgen.h")
-    files["README.md"] = env.get_template("README.md.j2").render(headers=headers)
+    files["README.md"] = env.get_template("README.md.j2").render(headers=headers, converters=converters, left=left)
     return files

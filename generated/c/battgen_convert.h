@@ -1,0 +1,207 @@
+/* Run-time support of the generated converters: the loss report (a fixed array, no allocation) and
+ * the arithmetic PX4's own C code does, as the Python package's convert/_runtime.py emulates it:
+ * float16 rounding (IEEE, nearest even, finite values beyond +-65504 clamped) and C's float to
+ * integer assignment as a Cortex-M FPU performs it (VCVT: truncate, saturate to 32 bits, NaN 0). */
+#ifndef BATTGEN_CONVERT_H
+#define BATTGEN_CONVERT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "battgen_wire.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What did not survive a conversion (the Python LossReport's kinds). */
+typedef enum {
+  BATTGEN_LOSS_UNKNOWN = 1,        /* a target field left at its "unknown" value */
+  BATTGEN_LOSS_DROPPED = 2,        /* source information with no place in the target */
+  BATTGEN_LOSS_CLAMPED = 3,        /* a value forced into range */
+  BATTGEN_LOSS_ROUNDED = 4,        /* a value quantised */
+  BATTGEN_LOSS_UNREPRESENTABLE = 5 /* a value the target cannot hold, written as its "unknown" */
+} battgen_loss_kind;
+
+typedef struct {
+  battgen_loss_kind kind;
+  const char *field; /* "uorb.BatteryStatus.capacity": a string literal of the library */
+} battgen_loss;
+
+/* Entries beyond the capacity are counted in `missed`, not kept. */
+#define BATTGEN_LOSS_CAPACITY 96u
+
+typedef struct {
+  size_t count;
+  size_t missed;
+  battgen_loss entries[BATTGEN_LOSS_CAPACITY];
+} battgen_loss_report;
+
+#ifndef __cplusplus
+
+static inline const char *battgen_loss_kind_name(battgen_loss_kind kind) {
+  switch (kind) {
+  case BATTGEN_LOSS_UNKNOWN:
+    return "unknown";
+  case BATTGEN_LOSS_DROPPED:
+    return "dropped";
+  case BATTGEN_LOSS_CLAMPED:
+    return "clamped";
+  case BATTGEN_LOSS_ROUNDED:
+    return "rounded";
+  case BATTGEN_LOSS_UNREPRESENTABLE:
+    return "unrepresentable";
+  }
+  return "?";
+}
+
+static inline void battgen_loss_clear(battgen_loss_report *r) {
+  r->count = 0;
+  r->missed = 0;
+}
+
+static inline bool battgen_same_text(const char *a, const char *b) {
+  while (*a != '\0' && *a == *b) {
+    a++;
+    b++;
+  }
+  return *a == *b;
+}
+
+/* Two texts of at most `n` chars equal up to the first NUL (as Python compares the strings). */
+static inline bool battgen_same_chars(const char *a, const char *b, size_t n) {
+  size_t i;
+  for (i = 0; i < n; i++) {
+    if (a[i] != b[i]) {
+      return false;
+    }
+    if (a[i] == '\0') {
+      return true;
+    }
+  }
+  return true;
+}
+
+/* One entry, once (as the Python report keeps each (kind, field) once, in the order first seen);
+ * a NULL report is no report. */
+static inline void battgen_loss_add(battgen_loss_report *r, battgen_loss_kind kind,
+                                    const char *field) {
+  size_t i;
+  if (r == NULL) {
+    return;
+  }
+  for (i = 0; i < r->count; i++) {
+    if (r->entries[i].kind == kind && battgen_same_text(r->entries[i].field, field)) {
+      return;
+    }
+  }
+  if (r->count < BATTGEN_LOSS_CAPACITY) {
+    r->entries[r->count].kind = kind;
+    r->entries[r->count].field = field;
+    r->count++;
+  } else {
+    r->missed++;
+  }
+}
+
+static inline float battgen_absf(float x) {
+  return battgen_f32_from(battgen_f32_bits(x) & 0x7FFFFFFFu);
+}
+
+static inline bool battgen_f32_same(float a, float b) {
+  return a == b || (battgen_f32_is_nan(a) && battgen_f32_is_nan(b));
+}
+
+static inline bool battgen_f64_same(double a, double b) {
+  return a == b || (battgen_f64_is_nan(a) && battgen_f64_is_nan(b));
+}
+
+/* The float16 value nearest `x` (ties to even), a finite value beyond +-65504 clamped to it
+ * (reported clamped), a changed value reported rounded; infinity and NaN stay as they are. */
+static inline float battgen_f16_round(float x, battgen_loss_report *rep, const char *field) {
+  uint32_t u = battgen_f32_bits(x);
+  uint32_t sign = (u >> 16) & 0x8000u;
+  uint32_t a = u & 0x7FFFFFFFu;
+  uint32_t h, rest, e, sig, shift;
+  float y;
+  if (a >= 0x7F800000u) {
+    return x;
+  }
+  if (x > BATTGEN_F16_MAX || x < -BATTGEN_F16_MAX) {
+    battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, field);
+    return x > 0.0f ? BATTGEN_F16_MAX : -BATTGEN_F16_MAX;
+  }
+  e = a >> 23;
+  if (e >= 113u) { /* a normal half: 13 bits dropped, rounded to nearest even */
+    h = ((e - 112u) << 10) | ((a & 0x7FFFFFu) >> 13);
+    rest = a & 0x1FFFu;
+    if (rest > 0x1000u || (rest == 0x1000u && (h & 1u) != 0u)) {
+      h += 1u;
+    }
+  } else if (e == 0u) { /* a float32 subnormal: below half the smallest half */
+    h = 0u;
+  } else { /* a subnormal half: the value in units of 2^-24, rounded to nearest even */
+    sig = 0x800000u | (a & 0x7FFFFFu);
+    shift = 126u - e;
+    if (shift > 25u) {
+      h = 0u;
+    } else {
+      h = sig >> shift;
+      rest = sig & ((1u << shift) - 1u);
+      if (rest > (1u << (shift - 1u)) || (rest == (1u << (shift - 1u)) && (h & 1u) != 0u)) {
+        h += 1u;
+      }
+    }
+  }
+  y = battgen_f16_value((uint16_t)(sign | h));
+  if (y != x) {
+    battgen_loss_add(rep, BATTGEN_LOSS_ROUNDED, field);
+  }
+  return y;
+}
+
+/* C's float to int32 as VCVT.S32.F32: toward zero, saturated, NaN 0. */
+static inline int32_t battgen_vcvt_s32(float x) {
+  if (battgen_f32_is_nan(x)) {
+    return 0;
+  }
+  if (x <= -2147483648.0f) {
+    return (-2147483647 - 1);
+  }
+  if (x >= 2147483648.0f) {
+    return 2147483647;
+  }
+  return (int32_t)x;
+}
+
+/* C's float to uint32 as VCVT.U32.F32: toward zero, saturated, NaN 0. */
+static inline uint32_t battgen_vcvt_u32(float x) {
+  if (battgen_f32_is_nan(x) || x <= 0.0f) {
+    return 0u;
+  }
+  if (x >= 4294967296.0f) {
+    return 4294967295u;
+  }
+  return (uint32_t)x;
+}
+
+/* Whether a field that kept `kept` of `x` (after VCVT and the field's width) lost it: the Python
+ * c_float_to_int's "does not fit" (NaN is no loss, an infinity always is). */
+static inline bool battgen_float_int_lost(float x, int64_t kept) {
+  if (battgen_f32_is_nan(x)) {
+    return false;
+  }
+  if (battgen_f32_is_inf(x) || x >= 9223372036854775808.0f || x < -9223372036854775808.0f) {
+    return true;
+  }
+  return (int64_t)x != kept;
+}
+
+#endif /* !__cplusplus */
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
