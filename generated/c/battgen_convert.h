@@ -105,6 +105,51 @@ static inline void battgen_loss_add(battgen_loss_report *r, battgen_loss_kind ki
   }
 }
 
+/* Withdraw the entries of one kind and field (a later rule filled a field an earlier one left
+ * unknown). */
+static inline void battgen_loss_discard(battgen_loss_report *r, battgen_loss_kind kind,
+                                        const char *field) {
+  size_t i, j = 0;
+  if (r == NULL) {
+    return;
+  }
+  for (i = 0; i < r->count; i++) {
+    if (!(r->entries[i].kind == kind && battgen_same_text(r->entries[i].field, field))) {
+      r->entries[j++] = r->entries[i];
+    }
+  }
+  r->count = j;
+}
+
+/* The nearest integer (halves away from zero) clamped into [lo, hi], what it changed reported (the
+ * Python to_int; NaN, which the Python converter refuses, gives lo). */
+static inline int64_t battgen_to_int(double x, int64_t lo, int64_t hi, battgen_loss_report *rep,
+                                     const char *field) {
+  double a = x < 0.0 ? -x : x;
+  double r;
+  int64_t n;
+  if (battgen_f64_is_nan(x)) {
+    return lo;
+  }
+  if (a >= 9.2e18) { /* an infinity too: beyond every field */
+    battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, field);
+    return x > 0.0 ? hi : lo;
+  }
+  n = (int64_t)(a + 0.5); /* the floor of a positive number */
+  if (x < 0.0) {
+    n = -n;
+  }
+  if (n < lo || n > hi) {
+    battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, field);
+    return n < lo ? lo : hi;
+  }
+  r = (double)n - x;
+  if ((r < 0.0 ? -r : r) > 1e-9 * (a > 1.0 ? a : 1.0)) {
+    battgen_loss_add(rep, BATTGEN_LOSS_ROUNDED, field);
+  }
+  return n;
+}
+
 static inline float battgen_absf(float x) {
   return battgen_f32_from(battgen_f32_bits(x) & 0x7FFFFFFFu);
 }

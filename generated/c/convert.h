@@ -7,23 +7,132 @@
 #include <stdint.h>
 
 #include "battgen_convert.h"
+#include "dronecan/ardupilot/equipment/power/BatteryCells.h"
+#include "dronecan/ardupilot/equipment/power/BatteryContinuous.h"
 #include "dronecan/ardupilot/equipment/power/BatteryInfoAux.h"
+#include "dronecan/ardupilot/equipment/power/BatteryPeriodic.h"
+#include "dronecan/ardupilot/equipment/power/BatteryTag.h"
+#include "dronecan/cuav/equipment/power/CBAT.h"
 #include "dronecan/uavcan/equipment/power/BatteryInfo.h"
+#include "mavlink/BATTERY_INFO.h"
+#include "mavlink/BATTERY_STATUS_V2.h"
+#include "mavlink/SYS_STATUS.h"
+#include "uorb/BatteryInfo.h"
 #include "uorb/BatteryStatus.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* px4_uavcan_bridge (policy px4): dronecan -> uorb. PX4's uavcan battery bridge.
- * `s_aux` may be NULL (not received).
+/* dronecan -> uorb, policy strict: dronecan -> uorb.
+ * `aux` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_uorb_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_uorb_BatteryStatus *out_status, battgen_loss_report *rep);
+
+/* dronecan -> uorb, policy px4: px4_uavcan_bridge.
+ * `aux` may be NULL (not received).
  * `dt_s` may be NULL (not given).
  * `discharged_mah_before` may be NULL (not given).
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
-void battgen_convert_px4_uavcan_bridge(
-    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *s_info,
-    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *s_aux, const float *dt_s,
-    const float *discharged_mah_before, battgen_uorb_BatteryStatus *t_status,
+void battgen_convert_dronecan_to_uorb_px4(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux, const float *dt_s,
+    const float *discharged_mah_before, battgen_uorb_BatteryStatus *out_status,
+    battgen_loss_report *rep);
+
+/* dronecan -> mavlink_v2, policy strict: dronecan -> mavlink_v2.
+ * `aux` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_mavlink_v2_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_mavlink_BATTERY_STATUS_V2 *out_status, battgen_loss_report *rep);
+
+/* ardupilot_battery -> uorb, policy strict: ardupilot_battery -> uorb.
+ * `periodic` may be NULL (not received).
+ * `cells` may be NULL (not received).
+ * `tag` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_ardupilot_battery_to_uorb_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_uorb_BatteryStatus *out_status, battgen_loss_report *rep);
+
+/* ardupilot_battery -> mavlink_v2, policy strict: ardupilot_battery -> mavlink_v2.
+ * `periodic` may be NULL (not received).
+ * `cells` may be NULL (not received).
+ * `tag` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_ardupilot_battery_to_mavlink_v2_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_mavlink_BATTERY_STATUS_V2 *out_status, battgen_loss_report *rep);
+
+/* cbat -> uorb, policy strict: cbat -> uorb.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_cbat_to_uorb_strict(const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+                                         battgen_uorb_BatteryStatus *out_status,
+                                         battgen_loss_report *rep);
+
+/* cbat -> mavlink_v2, policy strict: cbat -> mavlink_v2.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_cbat_to_mavlink_v2_strict(
+    const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+    battgen_mavlink_BATTERY_STATUS_V2 *out_status, battgen_loss_report *rep);
+
+/* uorb -> mavlink_v2, policy strict: uorb -> mavlink_v2.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_mavlink_v2_strict(const battgen_uorb_BatteryStatus *status,
+                                               battgen_mavlink_BATTERY_STATUS_V2 *out_status,
+                                               battgen_loss_report *rep);
+
+/* uorb_info -> uorb, policy strict: uorb_info -> uorb.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_info_to_uorb_strict(const battgen_uorb_BatteryInfo *info,
+                                              battgen_uorb_BatteryStatus *out_status,
+                                              battgen_loss_report *rep);
+
+/* uorb_info -> mavlink_v2, policy strict: uorb_info -> mavlink_v2.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_info_to_mavlink_v2_strict(const battgen_uorb_BatteryInfo *info,
+                                                    battgen_mavlink_BATTERY_STATUS_V2 *out_status,
+                                                    battgen_loss_report *rep);
+
+/* mavlink_info -> uorb, policy strict: mavlink_info -> uorb.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_info_to_uorb_strict(const battgen_mavlink_BATTERY_INFO *info,
+                                                 battgen_uorb_BatteryStatus *out_status,
+                                                 battgen_loss_report *rep);
+
+/* mavlink_info -> mavlink_v2, policy strict: mavlink_info -> mavlink_v2.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_info_to_mavlink_v2_strict(
+    const battgen_mavlink_BATTERY_INFO *info, battgen_mavlink_BATTERY_STATUS_V2 *out_status,
+    battgen_loss_report *rep);
+
+/* mavlink_v2 -> uorb, policy strict: mavlink_v2 -> uorb.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_v2_to_uorb_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
+                                               battgen_uorb_BatteryStatus *out_status,
+                                               battgen_loss_report *rep);
+
+/* mavlink_sys_status -> uorb, policy strict: mavlink_sys_status -> uorb.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_sys_status_to_uorb_strict(const battgen_mavlink_SYS_STATUS *status,
+                                                       battgen_uorb_BatteryStatus *out_status,
+                                                       battgen_loss_report *rep);
+
+/* mavlink_sys_status -> mavlink_v2, policy strict: mavlink_sys_status -> mavlink_v2.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_sys_status_to_mavlink_v2_strict(
+    const battgen_mavlink_SYS_STATUS *status, battgen_mavlink_BATTERY_STATUS_V2 *out_status,
     battgen_loss_report *rep);
 
 #ifdef __cplusplus

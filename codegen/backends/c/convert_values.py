@@ -6,6 +6,7 @@ their elements), so the loss report names the same source fields nobody read."""
 from __future__ import annotations
 
 import math
+import struct
 
 from ...ir import ArrayType, CompositeType, Field, FieldType, Message, PrimitiveKind, PrimitiveType, Schema, StringType
 from .types import ident, scalar, type_name
@@ -15,11 +16,18 @@ class Unsupported(Exception):
     """A rule (or value) the C converters do not write yet: its mapping is left out of the library."""
 
 
+def f32(x: float) -> float:
+    """``x`` rounded to the nearest float32 (an infinity beyond it)."""
+    try:
+        value: float = struct.unpack("<f", struct.pack("<f", x))[0]
+    except OverflowError:
+        return math.copysign(math.inf, x)
+    return value
+
+
 def f32_literal(value: float) -> str:
     """A C float expression of the float32 nearest ``value`` (NaN and the infinities by their bits)."""
-    import struct
-
-    v = struct.unpack("<f", struct.pack("<f", value))[0] if math.isfinite(value) else value
+    v = f32(value) if math.isfinite(value) else value
     if math.isnan(v):
         return "battgen_f32_from(0x7FC00000u)"  # NAN, without <math.h> (a freestanding build has none)
     if math.isinf(v):

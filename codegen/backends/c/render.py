@@ -14,6 +14,7 @@ from ...errors import BattgenError
 from ...ir import ArrayType, CompositeType, Constant, Message, PrimitiveKind, PrimitiveType, Schema, SourceFormat
 from .checks import check_uses, checks_of, validator
 from .codecs import mavlink_codec, uorb_codec
+from .convert_concepts import state_lines
 from .converters import c_converters
 from .dronecan_codec import BitCodec, dronecan_codec
 from .types import ident, member, type_name
@@ -186,7 +187,8 @@ def render_library(schema: Schema) -> dict[str, str]:
         )
         text = env.get_template("convert.h.j2").render(headers=used, converters=converters)
         files["convert.h"] = clang_format(text, "convert.h")
-        text = env.get_template("convert.c.j2").render(helpers=helpers, converters=converters)
+        state = state_lines({c.name: c for s in schema.mappings for c in s.concepts})
+        text = env.get_template("convert.c.j2").render(state=state, functions=helpers, converters=converters)
         files["convert.c"] = clang_format(text, "convert.c")
         headers.append("convert.h")
     files["battgen.h"] = clang_format(env.get_template("battgen.h.j2").render(headers=headers), "battgen.h")
