@@ -27,6 +27,7 @@ typedef enum {
 typedef struct {
   battgen_loss_kind kind;
   const char *field; /* "uorb.BatteryStatus.capacity": a string literal of the library */
+  uint32_t hash;     /* of kind and field: an entry is looked for by it before its text */
 } battgen_loss;
 
 /* Entries beyond the capacity are counted in `missed`, not kept. */
@@ -87,17 +88,24 @@ static inline bool battgen_same_chars(const char *a, const char *b, size_t n) {
  * a NULL report is no report. */
 static inline void battgen_loss_add(battgen_loss_report *r, battgen_loss_kind kind, const char *field) {
   size_t i;
+  uint32_t hash = 2166136261u ^ (uint32_t)kind; /* FNV-1a */
+  const char *c;
   if (r == NULL) {
     return;
   }
+  for (c = field; *c != '\0'; c++) {
+    hash = (hash ^ (uint32_t)(unsigned char)*c) * 16777619u;
+  }
   for (i = 0; i < r->count; i++) {
-    if (r->entries[i].kind == kind && battgen_same_text(r->entries[i].field, field)) {
+    if (r->entries[i].hash == hash && r->entries[i].kind == kind &&
+        (r->entries[i].field == field || battgen_same_text(r->entries[i].field, field))) {
       return;
     }
   }
   if (r->count < BATTGEN_LOSS_CAPACITY) {
     r->entries[r->count].kind = kind;
     r->entries[r->count].field = field;
+    r->entries[r->count].hash = hash;
     r->count++;
   } else {
     r->missed++;
