@@ -133,6 +133,13 @@ def test_cases_reach_every_codec(replays: list[Replay]) -> None:
     lines = [line for _, line in expected_lines(replays) if line]
     assert any(" range" in line for line in lines), "no case breaks a range"
     assert any(" nan" in line for line in lines), "no case holds a NaN where it is not allowed"
+    for rule in (
+        "cells-beyond-count-zero",
+        "cell-count-capacity",
+        "state-of-health-percent",
+        "battery-remaining-percent",
+    ):
+        assert any(f" cross-field:{rule}" in line for line in lines), f"no case breaks the cross-field rule {rule}"
     for r in replays:  # the fuzz inputs reach both the decoder's errors and its values
         results = [line for _, fuzz in r.fuzz for _, line in fuzz]
         assert "err" in results and any(line.startswith("0 ") for line in results), r.msg.qualified_name

@@ -17,6 +17,7 @@ from .codecs import mavlink_codec, uorb_codec
 from .convert_concepts import state_lines
 from .converters import c_converters
 from .dronecan_codec import BitCodec, dronecan_codec
+from .rules import rule_lines
 from .types import ident, member, type_name
 
 _HERE = Path(__file__).parent
@@ -86,7 +87,8 @@ def _message_context(schema: Schema, msg: Message) -> dict[str, object]:
     mav = mavlink_codec(msg)
     uorb = uorb_codec(msg)
     uses = check_uses(schema, msg)
-    checks = validator(uses)
+    cross, most, _ = rule_lines(schema, msg)
+    checks = validator(uses) + cross
     return {
         "name": name,
         "mavlink_codec": mav,
@@ -97,7 +99,7 @@ def _message_context(schema: Schema, msg: Message) -> dict[str, object]:
         "validate_loops": _uses_loop(checks),
         "mavlink_loops": mav is not None and _uses_loop(mav.encode),
         "uorb_loops": uorb is not None and _uses_loop(uorb.encode),
-        "max_problems": sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in uses),
+        "max_problems": sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in uses) + most,
         "guard": name.upper() + "_H",
         "qualified": msg.qualified_name,
         "doc": _comment(msg.doc),
