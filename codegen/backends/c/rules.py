@@ -66,7 +66,9 @@ class _Rule:
             if any(op not in _OPS for op in e.ops):
                 raise Unsupported("membership")
             terms = [self.expr(x) for x in e.operands]
-            return "(" + " && ".join(f"{a} {op} {b}" for a, op, b in zip(terms, e.ops, terms[1:])) + ")"
+            return (
+                "(" + " && ".join(f"{a} {op} {b}" for a, op, b in zip(terms[:-1], e.ops, terms[1:], strict=True)) + ")"
+            )
         if isinstance(e, BoolOp):
             return "(" + (" && " if e.op == "and" else " || ").join(self.expr(v) for v in e.values) + ")"
         if isinstance(e, Not):
