@@ -12,7 +12,7 @@ import jinja2
 
 from ...errors import BattgenError
 from ...ir import ArrayType, CompositeType, Constant, Message, PrimitiveKind, PrimitiveType, Schema, SourceFormat
-from .checks import check_uses, checks_of, validator
+from .checks import CheckUse, check_uses, checks_of, validator
 from .codecs import mavlink_codec, uorb_codec
 from .convert_concepts import state_lines
 from .converters import c_converters
@@ -63,6 +63,16 @@ def _uses_loop(lines: list[str]) -> bool:
     return any(line.startswith("for (i = 0;") or "[i]" in line for line in lines)
 
 
+def _union_checks(msg: Message, uses: list[CheckUse]) -> list[str]:
+    """A union's validator: the checks of the field it holds only (the others are not sent)."""
+    lines: list[str] = []
+    for k, f in enumerate(msg.fields):
+        mine = [u for u in uses if u.path.split(".")[0].split("[")[0] == f.name]
+        if mine:
+            lines += [f"if (m->union_tag == {k}u) {{", *validator(mine), "}"]
+    return lines
+
+
 def _message_context(schema: Schema, msg: Message) -> dict[str, object]:
     members = []
     for f in msg.fields:
@@ -79,16 +89,25 @@ def _message_context(schema: Schema, msg: Message) -> dict[str, object]:
             notes.append(f.doc)
         members.append({"decls": member(f.type, ident(f.name)), "note": _comment(" ".join(notes))})
     name = type_name(msg.qualified_name)
+    if msg.dronecan is not None and msg.dronecan.union:
+        held = "the field held, by its place (BATTGEN_..._TAG_<FIELD>); the others are not sent"
+        members.insert(0, {"decls": ["uint8_t union_tag;"], "note": held})
     constants = [
         {"name": f"{name.upper()}_{ident(c.name).upper()}", "value": lit, "doc": _comment(c.doc)}
         for c in msg.constants
         if (lit := _literal(c)) is not None
     ]
+    if msg.dronecan is not None and msg.dronecan.union:
+        constants += [
+            {"name": f"{name.upper()}_TAG_{ident(f.name).upper()}", "value": f"{k}u", "doc": ""}
+            for k, f in enumerate(msg.fields)
+        ]
     mav = mavlink_codec(msg)
     uorb = uorb_codec(msg)
     uses = check_uses(schema, msg)
     cross, most, _ = rule_lines(schema, msg)
-    checks = validator(uses) + cross
+    checks = _union_checks(msg, uses) if msg.dronecan is not None and msg.dronecan.union else validator(uses)
+    checks += cross
     return {
         "name": name,
         "mavlink_codec": mav,

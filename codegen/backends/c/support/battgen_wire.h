@@ -91,7 +91,8 @@ typedef enum {
   BATTGEN_ERR_UNKNOWN_FLAGS = 6,   /* MAVLink incompatibility flags not known */
   BATTGEN_ERR_WRONG_MESSAGE = 7,   /* the frame holds another message */
   BATTGEN_ERR_BAD_CRC = 8,         /* the checksum does not match */
-  BATTGEN_ERR_TRAILING = 9         /* whole bytes follow a DroneCAN message */
+  BATTGEN_ERR_TRAILING = 9,        /* whole bytes follow a DroneCAN message */
+  BATTGEN_ERR_TAG = 10             /* a DroneCAN union's tag names no field */
 } battgen_error;
 
 /* DroneCAN bits: a writer into a zeroed buffer and a reader (what a message's put / get take). */
