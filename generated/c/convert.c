@@ -1874,7 +1874,9 @@ static void map_px4_uavcan_bridge_forward(
     float v = battgen_f16_round(s_aux->nominal_voltage, NULL, NULL);
     if (v > 1.1920928955078125e-07f) {
       t_status->capacity =
-          cvt_u16(((battgen_f16_round(s_info->full_charge_capacity_wh, NULL, NULL) * 1000.0f) / v),
+          cvt_u16((float)((float)(battgen_f16_round(s_info->full_charge_capacity_wh, NULL, NULL) *
+                                  1000.0f) /
+                          v),
                   rep, "uorb.BatteryStatus.capacity");
     }
   }
@@ -1886,7 +1888,7 @@ static void map_px4_uavcan_bridge_forward(
       float x = battgen_absf(battgen_f16_round(s_info->current, NULL, NULL));
       float t = dt_s == NULL ? 0.0f : (2.0f < *dt_s ? 2.0f : *dt_s);
       if (t > 1.1920928955078125e-07f) {
-        v = v + (x * 1000.0f) * (t / 3600.0f);
+        v = v + (float)((float)(x * 1000.0f) * (float)(t / 3600.0f));
       }
       t_status->time_remaining_s = battgen_f32_from(0x7FC00000u);
     } else {
@@ -1901,7 +1903,7 @@ static void map_px4_uavcan_bridge_forward(
       if (cap > 0.0f) {
         d = m * 1000.0f;
         d = 1.1920928955078125e-07f > d ? 1.1920928955078125e-07f : d;
-        t_status->time_remaining_s = ((s * cap) / d) * 3600.0f;
+        t_status->time_remaining_s = (float)((float)((float)(s * cap) / d) * 3600.0f);
       }
     }
     t_status->discharged_mah = v;

@@ -9,11 +9,13 @@ float16 rounding show) and the loss reports the same entries (kind and field) in
 from __future__ import annotations
 
 import math
+import os
 import random
 import shutil
 import struct
 import subprocess
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -201,6 +203,30 @@ class Run:
     convs: list[tuple[CConverter, list[Case]]]
     skipped: int
     output: dict[str, str]
+    harness: str
+
+
+def build_and_run(cc: list[str], runner: list[str], tmp: Path, harness: str) -> dict[str, str]:
+    """convert.c built by ``cc`` with the strict flags, the harness linked to it, run (through
+    ``runner``: an emulator, or nothing); the harness's lines by case."""
+    (tmp / "main.c").write_text(harness, encoding="utf-8")
+    obj = tmp / "convert.o"
+    done = subprocess.run(
+        [*cc, *FLAGS, "-I", str(GENERATED), "-c", str(GENERATED / "convert.c"), "-o", str(obj)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr[-4000:]
+    exe = tmp / "convert_replay"
+    loose = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-Wno-missing-braces", "-Wno-missing-field-initializers"]
+    link = [*cc, *loose, "-I", str(GENERATED), str(tmp / "main.c"), str(obj), "-lm", "-o", str(exe)]
+    done = subprocess.run(link, capture_output=True, text=True, timeout=300, check=False)
+    assert done.returncode == 0, done.stderr[-4000:]
+    ran = subprocess.run([*runner, str(exe)], capture_output=True, text=True, timeout=300, check=False)
+    assert ran.returncode == 0, ran.stderr[-4000:]
+    return dict(line.split(" ", 1) for line in ran.stdout.splitlines())
 
 
 @pytest.fixture(scope="module")
@@ -215,40 +241,19 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Run:
         cases, lost = _cases(schema, conv)
         convs.append((conv, cases))
         skipped += lost
-    tmp = tmp_path_factory.mktemp("cconv")
-    (tmp / "main.c").write_text(render(schema, convs), encoding="utf-8")
-    obj = tmp / "convert.o"
-    cc = ["gcc", *FLAGS, "-I", str(GENERATED)]
-    done = subprocess.run(
-        [*cc, "-c", str(GENERATED / "convert.c"), "-o", str(obj)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-    )
-    assert done.returncode == 0, done.stderr[-4000:]
-    exe = tmp / "convert_replay"
-    harness = [
-        "gcc",
-        "-std=c99",
-        "-Wall",
-        "-Wextra",
-        "-Werror",
-        "-Wno-missing-braces",
-        "-Wno-missing-field-initializers",
-        "-I",
-        str(GENERATED),
-        str(tmp / "main.c"),
-        str(obj),
-        "-lm",
-        "-o",
-        str(exe),
-    ]
-    done = subprocess.run(harness, capture_output=True, text=True, timeout=300, check=False)
-    assert done.returncode == 0, done.stderr[-4000:]
-    ran = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120, check=True)
-    output = dict(line.split(" ", 1) for line in ran.stdout.splitlines())
-    return Run(convs, skipped, output)
+    harness = render(schema, convs)
+    output = build_and_run(["gcc"], [], tmp_path_factory.mktemp("cconv"), harness)
+    return Run(convs, skipped, output, harness)
+
+
+def differences(run: Run, output: dict[str, str]) -> list[str]:
+    bad = []
+    for conv, cases in run.convs:
+        for j, case in enumerate(cases):
+            got = output.get(f"{conv.name}#{j}")
+            if got != case.expected:
+                bad.append(f"{conv.name} {case.cid}:\n  C:      {got}\n  Python: {case.expected}")
+    return bad
 
 
 @needs_gcc
@@ -265,19 +270,37 @@ def test_dronecan_to_uorb_is_in_c_under_both_policies(run: Run) -> None:
 
 @needs_gcc
 def test_c_converts_every_case_as_python(run: Run) -> None:
-    bad = []
-    compared = 0
-    for conv, cases in run.convs:
-        for j, case in enumerate(cases):
-            got = run.output.get(f"{conv.name}#{j}")
-            compared += 1
-            if got != case.expected:
-                bad.append(f"{conv.name} {case.cid}:\n  C:      {got}\n  Python: {case.expected}")
+    bad = differences(run, run.output)
+    compared = sum(len(cases) for _, cases in run.convs)
     assert not bad, f"{len(bad)} of {compared} differ, first:\n" + "\n".join(bad[:5])
     lines = " ".join(c.expected for _, cases in run.convs for c in cases)
-    for kind in ("unknown", "dropped", "clamped"):  # the cases reach every kind the converters report
+    for kind in ("unknown", "dropped", "clamped", "rounded"):  # the cases reach every kind the converters report
         assert f"{kind} " in lines, kind
     assert "=nan;" in lines and "=80000000;" in lines  # NaN and -0.0 among the values compared
+
+
+@needs_gcc
+def test_sanitizers_find_nothing_in_the_converters(run: Run, tmp_path: Path) -> None:
+    """The same cases under AddressSanitizer and UndefinedBehaviorSanitizer (every report fatal)."""
+    sanitize = ["gcc", "-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-g"]
+    probe = tmp_path / "probe.c"
+    probe.write_text("int main(void) { return 0; }\n", encoding="utf-8")
+    if subprocess.run([*sanitize, str(probe), "-o", str(tmp_path / "probe")], timeout=120).returncode != 0:
+        pytest.skip("gcc's sanitizer runtimes not installed")
+    bad = differences(run, build_and_run(sanitize, [], tmp_path, run.harness))
+    assert not bad, "\n".join(bad[:5])
+
+
+def test_big_endian_s390x_converts_as_python(run: Run, tmp_path: Path) -> None:
+    """The same cases built static for s390x (big-endian) and run under qemu."""
+    tools = ("s390x-linux-gnu-gcc", "qemu-s390x")
+    absent = [t for t in tools if shutil.which(t) is None]
+    if absent:
+        if os.environ.get("CI"):
+            pytest.fail(f"{', '.join(absent)} not installed (CI installs them: .ci/run)")
+        pytest.skip(f"{', '.join(absent)} not installed")
+    bad = differences(run, build_and_run(["s390x-linux-gnu-gcc", "-static"], ["qemu-s390x"], tmp_path, run.harness))
+    assert not bad, "\n".join(bad[:5])
 
 
 @needs_gcc

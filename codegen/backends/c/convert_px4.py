@@ -15,6 +15,9 @@ FLT_EPS = 1.1920928955078125e-07
 
 
 class PX4Ops(CBase):
+    """Every float32 operation is cast (or assigned) to float: a compiler evaluating float
+    expressions in double (FLT_EVAL_METHOD 1, s390x's gcc) then rounds each step as PX4's does."""
+
     def visit_zero_all(self, rule: Rule, op: o.ZeroAll) -> None:
         for ref in rule.targets:
             var = self.var(self.dst, ref.message, "t")
@@ -172,7 +175,7 @@ class PX4Ops(CBase):
         unit = self.fld(dst).unit
         mul = ah.factor_to(unit)[0] if ah is not None and unit is not None else 1.0
         eps = f32(float(op.above if op.above is not None else FLT_EPS))
-        value = f"(({self.px4_read(energy)} * {f32_literal(f32(mul))}) / v)"
+        value = f"(float)((float)({self.px4_read(energy)} * {f32_literal(f32(mul))}) / v)"
         self.emit(
             f"float v = {self.px4_read(voltage)};",
             f"if (v > {f32_literal(eps)}) {{",
@@ -197,7 +200,7 @@ class PX4Ops(CBase):
             f"float x = battgen_absf({self.px4_read(current)});",
             f"float t = {dt} == NULL ? 0.0f : (2.0f < *{dt} ? 2.0f : *{dt});",
             f"if (t > {eps}) {{",
-            "v = v + (x * 1000.0f) * (t / 3600.0f);",
+            "v = v + (float)((float)(x * 1000.0f) * (float)(t / 3600.0f));",
             "}",
             f"{self.t(remaining_time)} = {f32_literal(math.nan)};",
             "} else {",
@@ -211,7 +214,7 @@ class PX4Ops(CBase):
             "if (cap > 0.0f) {",
             "d = m * 1000.0f;",
             f"d = {eps} > d ? {eps} : d;",
-            f"{self.t(remaining_time)} = ((s * cap) / d) * 3600.0f;",
+            f"{self.t(remaining_time)} = (float)((float)((float)(s * cap) / d) * 3600.0f);",
             "}",
             "}",
             f"{self.t(discharged)} = v;",
