@@ -127,10 +127,45 @@ typedef struct {
   uint32_t faults; /* BATTGEN_FAULTS__ bits */
 } battgen_concepts;
 
+static int16_t cvt_i16(float x, battgen_loss_report *rep, const char *field) {
+  int16_t v = battgen_i16((uint16_t)(uint32_t)battgen_vcvt_s32(x));
+  if (battgen_float_int_lost(x, (int64_t)v)) {
+    battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, field);
+  }
+  return v;
+}
+
+static int32_t cvt_i32(float x, battgen_loss_report *rep, const char *field) {
+  int32_t v = battgen_i32((uint32_t)(uint32_t)battgen_vcvt_s32(x));
+  if (battgen_float_int_lost(x, (int64_t)v)) {
+    battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, field);
+  }
+  return v;
+}
+
+static int8_t cvt_i8(float x, battgen_loss_report *rep, const char *field) {
+  int8_t v = battgen_i8((uint8_t)(uint32_t)battgen_vcvt_s32(x));
+  if (battgen_float_int_lost(x, (int64_t)v)) {
+    battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, field);
+  }
+  return v;
+}
+
 static uint16_t cvt_u16(float x, battgen_loss_report *rep, const char *field) {
   uint16_t v = (uint16_t)battgen_vcvt_u32(x);
   if (battgen_float_int_lost(x, (int64_t)v)) {
     battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, field);
+  }
+  return v;
+}
+
+static uint8_t cvt_u8_7(float x, battgen_loss_report *rep, const char *field) {
+  uint8_t v = (uint8_t)battgen_vcvt_u32(x);
+  if (battgen_float_int_lost(x, (int64_t)v)) {
+    battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, field);
+  }
+  if (v > 127u) {
+    v = 127u;
   }
   return v;
 }
@@ -179,6 +214,25 @@ static void defaults_battgen_dronecan_uavcan_equipment_power_BatteryInfo(
   (*m).state_of_charge_pct = (uint8_t)127u;
 }
 
+static void defaults_battgen_mavlink_BATTERY_STATUS(battgen_mavlink_BATTERY_STATUS *m) {
+  battgen_zero(m, sizeof *m);
+  (*m).temperature = (int16_t)32767;
+  (*m).voltages[0] = (uint16_t)65535u;
+  (*m).voltages[1] = (uint16_t)65535u;
+  (*m).voltages[2] = (uint16_t)65535u;
+  (*m).voltages[3] = (uint16_t)65535u;
+  (*m).voltages[4] = (uint16_t)65535u;
+  (*m).voltages[5] = (uint16_t)65535u;
+  (*m).voltages[6] = (uint16_t)65535u;
+  (*m).voltages[7] = (uint16_t)65535u;
+  (*m).voltages[8] = (uint16_t)65535u;
+  (*m).voltages[9] = (uint16_t)65535u;
+  (*m).current_battery = (int16_t)(-1);
+  (*m).current_consumed = (int32_t)(-1);
+  (*m).energy_consumed = (int32_t)(-1);
+  (*m).battery_remaining = (int8_t)(-1);
+}
+
 static void defaults_battgen_mavlink_BATTERY_STATUS_V2(battgen_mavlink_BATTERY_STATUS_V2 *m) {
   battgen_zero(m, sizeof *m);
   (*m).temperature = (int16_t)32767;
@@ -212,6 +266,10 @@ static void defaults_battgen_uorb_BatteryStatus(battgen_uorb_BatteryStatus *m) {
   (*m).remaining_capacity_wh = battgen_f32_from(0x7FC00000u);
   (*m).nominal_voltage = battgen_f32_from(0x7FC00000u);
 }
+
+static uint16_t saturate_uint16_11(uint16_t v) { return v > 2047u ? 2047u : v; }
+
+static uint8_t saturate_uint8_7(uint8_t v) { return v > 127u ? 127u : v; }
 
 static void map_ardupilot_battery_forward(
     const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *s_continuous,
@@ -1746,6 +1804,607 @@ static void map_mavlink_v2_forward(const battgen_mavlink_BATTERY_STATUS_V2 *s_st
   }
 }
 
+static void map_px4_mavlink_receiver_forward(const battgen_mavlink_BATTERY_STATUS *s_msg,
+                                             battgen_uorb_BatteryStatus *t_status,
+                                             battgen_loss_report *rep, battgen_loss_report *rep_d,
+                                             battgen_loss_report *rep_u) {
+  (void)s_msg;
+  (void)t_status;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_uorb_BatteryStatus(t_status);
+  /* px4_mavlink_receiver.yaml:11: zero_all */
+  {
+    t_status->voltage_v = 0.0f;
+    t_status->current_a = 0.0f;
+    t_status->current_average_a = 0.0f;
+    t_status->discharged_mah = 0.0f;
+    t_status->remaining = 0.0f;
+    t_status->scale = 0.0f;
+    t_status->time_remaining_s = 0.0f;
+    t_status->temperature = 0.0f;
+    t_status->cell_count = (uint8_t)0u;
+    battgen_zero(t_status->voltage_cell_v, sizeof t_status->voltage_cell_v);
+    t_status->remaining_capacity_wh = 0.0f;
+    t_status->nominal_voltage = 0.0f;
+  }
+  /* px4_mavlink_receiver.yaml:12: px4_receiver_cells */
+  {
+    size_t i, n = 0;
+    float acc = 0.0f;
+    while (n < 10u && s_msg->voltages[n] < 65535u) {
+      n++;
+    }
+    for (i = 0; i < 14u; i++) {
+      t_status->voltage_cell_v[i] = 0.0f;
+    }
+    for (i = 0; i < n; i++) {
+      t_status->voltage_cell_v[i] = (float)((double)s_msg->voltages[i] / (double)1000.0f);
+      acc = (float)(acc + t_status->voltage_cell_v[i]);
+    }
+    t_status->cell_count = (uint8_t)n;
+    t_status->voltage_v = acc;
+  }
+  /* px4_mavlink_receiver.yaml:18: px4_convert */
+  {
+    float x = (float)s_msg->current_battery;
+    x = x / 100.0f;
+    t_status->current_a = x;
+  }
+  /* px4_mavlink_receiver.yaml:19: px4_convert */
+  {
+    float x = (float)s_msg->battery_remaining;
+    x = x / 100.0f;
+    t_status->remaining = x;
+  }
+  /* px4_mavlink_receiver.yaml:26: px4_convert */
+  {
+    float x = (float)s_msg->current_consumed;
+    t_status->discharged_mah = x;
+  }
+  /* px4_mavlink_receiver.yaml:27: px4_convert */
+  {
+    float x = (float)s_msg->temperature;
+    t_status->temperature = x;
+  }
+  /* px4_mavlink_receiver.yaml:32: const */
+  { t_status->connected = true; }
+  /* px4_mavlink_receiver.yaml:33: px4_warning */
+  {
+    float s = t_status->remaining;
+    if (s < 0.05000000074505806f) {
+      t_status->warning = (uint8_t)3u;
+    } else if (s < 0.07000000029802322f) {
+      t_status->warning = (uint8_t)2u;
+    } else if (s < 0.15000000596046448f) {
+      t_status->warning = (uint8_t)1u;
+    } else {
+      t_status->warning = (uint8_t)0u;
+    }
+  }
+  /* what did not survive the conversion */
+  if (rep_d != NULL && s_msg != NULL) {
+    battgen_mavlink_BATTERY_STATUS fresh;
+    bool d;
+    size_t i;
+    defaults_battgen_mavlink_BATTERY_STATUS(&fresh);
+    d = false;
+    if (s_msg->id != fresh.id) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.id");
+    }
+    d = false;
+    if (s_msg->battery_function != fresh.battery_function) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.battery_function");
+    }
+    d = false;
+    if (s_msg->type != fresh.type) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.type");
+    }
+    d = false;
+    if (s_msg->energy_consumed != fresh.energy_consumed) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.energy_consumed");
+    }
+    d = false;
+    if (s_msg->time_remaining != fresh.time_remaining) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.time_remaining");
+    }
+    d = false;
+    if (s_msg->charge_state != fresh.charge_state) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.charge_state");
+    }
+    d = false;
+    for (i = 0; i < 4u; i++) {
+      if (s_msg->voltages_ext[i] != fresh.voltages_ext[i]) {
+        d = true;
+      }
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.voltages_ext");
+    }
+    d = false;
+    if (s_msg->mode != fresh.mode) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.mode");
+    }
+    d = false;
+    if (s_msg->fault_bitmask != fresh.fault_bitmask) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.fault_bitmask");
+    }
+  }
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.timestamp");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.current_average_a");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.scale");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.time_remaining_s");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.source");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.priority");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.capacity");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.cycle_count");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.average_time_to_empty");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.manufacture_date");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.state_of_health");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.max_error");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.id");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.interface_error");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.max_cell_voltage_delta");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.is_powering_off");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.is_required");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.faults");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.full_charge_capacity_wh");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.remaining_capacity_wh");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.over_discharge_count");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.nominal_voltage");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.internal_resistance_estimate");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.ocv_estimate");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.ocv_estimate_filtered");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.volt_based_soc_estimate");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.voltage_prediction");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.prediction_error");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.estimation_covariance_norm");
+  if (t_status->voltage_v == 0.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.voltage_v");
+  }
+  if (t_status->current_a == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.current_a");
+  }
+  if (t_status->discharged_mah == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.discharged_mah");
+  }
+  if (t_status->remaining == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.remaining");
+  }
+  if (battgen_f32_is_nan(t_status->temperature)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.temperature");
+  }
+  if (t_status->cell_count == (uint8_t)0u) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.cell_count");
+  }
+  {
+    size_t i;
+    bool all = true;
+    for (i = 0; i < 14u; i++) {
+      if (!(t_status->voltage_cell_v[i] == 0.0f)) {
+        all = false;
+      }
+    }
+    if (all) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.voltage_cell_v");
+    }
+  }
+}
+
+static void map_px4_mavlink_stream_forward(const battgen_uorb_BatteryStatus *s_status,
+                                           battgen_mavlink_BATTERY_STATUS *t_msg,
+                                           battgen_loss_report *rep, battgen_loss_report *rep_d,
+                                           battgen_loss_report *rep_u) {
+  (void)s_status;
+  (void)t_msg;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_mavlink_BATTERY_STATUS(t_msg);
+  /* px4_mavlink_stream.yaml:12: zero_all */
+  {
+    t_msg->temperature = (int16_t)0;
+    battgen_zero(t_msg->voltages, sizeof t_msg->voltages);
+    t_msg->current_battery = (int16_t)0;
+    t_msg->current_consumed = (int32_t)0;
+    t_msg->energy_consumed = (int32_t)0;
+    t_msg->battery_remaining = (int8_t)0;
+    t_msg->time_remaining = (int32_t)0;
+    battgen_zero(t_msg->voltages_ext, sizeof t_msg->voltages_ext);
+  }
+  /* px4_mavlink_stream.yaml:13: px4_int */
+  { t_msg->id = (uint8_t)(uint64_t)(((int64_t)s_status->id + -1LL)); }
+  /* px4_mavlink_stream.yaml:14: const */
+  { t_msg->battery_function = (uint8_t)1u; }
+  /* px4_mavlink_stream.yaml:15: const */
+  { t_msg->type = (uint8_t)1u; }
+  /* px4_mavlink_stream.yaml:16: px4_convert */
+  {
+    float x = s_status->discharged_mah;
+    if ((s_status->connected != 0)) {
+      t_msg->current_consumed = cvt_i32(x, rep, "mavlink.BATTERY_STATUS.current_consumed");
+    } else {
+      t_msg->current_consumed = (int32_t)(-1);
+    }
+  }
+  /* px4_mavlink_stream.yaml:23: const */
+  { t_msg->energy_consumed = (int32_t)(-1); }
+  /* px4_mavlink_stream.yaml:24: px4_convert */
+  {
+    float x = s_status->current_a;
+    x = x * 100.0f;
+    if ((s_status->connected != 0)) {
+      t_msg->current_battery = cvt_i16(x, rep, "mavlink.BATTERY_STATUS.current_battery");
+    } else {
+      t_msg->current_battery = (int16_t)(-1);
+    }
+  }
+  /* px4_mavlink_stream.yaml:31: px4_convert */
+  {
+    float x = s_status->remaining;
+    x = x * 100.0f;
+    x = battgen_roundf(x);
+    if ((s_status->connected != 0)) {
+      t_msg->battery_remaining = cvt_i8(x, rep, "mavlink.BATTERY_STATUS.battery_remaining");
+    } else {
+      t_msg->battery_remaining = (int8_t)(-1);
+    }
+  }
+  /* px4_mavlink_stream.yaml:40: px4_convert */
+  {
+    float x = s_status->time_remaining_s;
+    if ((s_status->connected != 0) && !battgen_f32_is_nan(x) && !battgen_f32_is_inf(x)) {
+      {
+        int32_t y = cvt_i32(x, rep, "mavlink.BATTERY_STATUS.time_remaining");
+        t_msg->time_remaining = ((int32_t)1 > y ? (int32_t)1 : y);
+      }
+    } else {
+      t_msg->time_remaining = (int32_t)0;
+    }
+  }
+  /* px4_mavlink_stream.yaml:49: enum_map */
+  {
+    switch ((int64_t)s_status->warning) {
+    case 0LL:
+      t_msg->charge_state = (uint8_t)1u;
+      break;
+    case 1LL:
+      t_msg->charge_state = (uint8_t)2u;
+      break;
+    case 2LL:
+      t_msg->charge_state = (uint8_t)3u;
+      break;
+    case 3LL:
+      t_msg->charge_state = (uint8_t)4u;
+      break;
+    case 4LL:
+      t_msg->charge_state = (uint8_t)5u;
+      break;
+    case 6LL:
+      t_msg->charge_state = (uint8_t)6u;
+      break;
+    case 7LL:
+      t_msg->charge_state = (uint8_t)7u;
+      break;
+    default:
+      t_msg->charge_state = (uint8_t)0u;
+      break;
+    }
+  }
+  /* px4_mavlink_stream.yaml:62: const */
+  { t_msg->mode = (uint8_t)0u; }
+  /* px4_mavlink_stream.yaml:63: px4_int */
+  { t_msg->fault_bitmask = (uint32_t)(uint64_t)((int64_t)s_status->faults); }
+  /* px4_mavlink_stream.yaml:64: px4_convert */
+  {
+    float x = s_status->temperature;
+    x = x * 100.0f;
+    if ((s_status->connected != 0) && !battgen_f32_is_nan(x) && !battgen_f32_is_inf(x)) {
+      t_msg->temperature = cvt_i16(x, rep, "mavlink.BATTERY_STATUS.temperature");
+    } else {
+      t_msg->temperature = (int16_t)32767;
+    }
+  }
+  /* px4_mavlink_stream.yaml:72: px4_stream_cells */
+  {
+    size_t i;
+    for (i = 0; i < 10u; i++) {
+      t_msg->voltages[i] = 65535u;
+    }
+    for (i = 0; i < 4u; i++) {
+      t_msg->voltages_ext[i] = 0u;
+    }
+    if (s_status->connected) {
+      if (s_status->cell_count == 0 || s_status->voltage_cell_v[0] < 9.999999747378752e-05f) {
+        float total = (float)(s_status->voltage_v * 1000.0f);
+        int64_t fields = (int64_t)(battgen_vcvt_s32(total) / 65534) + 1;
+        if (fields >= 1 && fields <= 10) {
+          float rest = total;
+          for (i = 0; i < (size_t)(fields - 1); i++) {
+            t_msg->voltages[i] = 65534u;
+            rest = (float)(rest - 65534.0f);
+          }
+          t_msg->voltages[fields - 1] = cvt_u16(rest, rep, "mavlink.BATTERY_STATUS.voltages");
+        } else {
+          battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_STATUS.voltages");
+        }
+      } else {
+        size_t slots = (size_t)s_status->cell_count;
+        if (slots > 14u) {
+          slots = 14u;
+        }
+        for (i = 0; i < slots; i++) {
+          uint16_t v = cvt_u16((float)(s_status->voltage_cell_v[i] * 1000.0f), rep,
+                               "mavlink.BATTERY_STATUS.voltages");
+          if (i < 10u) {
+            t_msg->voltages[i] = v;
+          } else {
+            t_msg->voltages_ext[i - 10u] = v;
+          }
+        }
+      }
+    }
+  }
+  /* what did not survive the conversion */
+  if (rep_d != NULL && s_status != NULL) {
+    battgen_uorb_BatteryStatus fresh;
+    bool d;
+    defaults_battgen_uorb_BatteryStatus(&fresh);
+    d = false;
+    if (s_status->timestamp != fresh.timestamp) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.timestamp");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->current_average_a, fresh.current_average_a)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.current_average_a");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->scale, fresh.scale)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.scale");
+    }
+    d = false;
+    if (s_status->source != fresh.source) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.source");
+    }
+    d = false;
+    if (s_status->priority != fresh.priority) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.priority");
+    }
+    d = false;
+    if (s_status->capacity != fresh.capacity) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.capacity");
+    }
+    d = false;
+    if (s_status->cycle_count != fresh.cycle_count) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.cycle_count");
+    }
+    d = false;
+    if (s_status->average_time_to_empty != fresh.average_time_to_empty) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.average_time_to_empty");
+    }
+    d = false;
+    if (s_status->manufacture_date != fresh.manufacture_date) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.manufacture_date");
+    }
+    d = false;
+    if (s_status->state_of_health != fresh.state_of_health) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.state_of_health");
+    }
+    d = false;
+    if (s_status->max_error != fresh.max_error) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.max_error");
+    }
+    d = false;
+    if (s_status->interface_error != fresh.interface_error) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.interface_error");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->max_cell_voltage_delta, fresh.max_cell_voltage_delta)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.max_cell_voltage_delta");
+    }
+    d = false;
+    if (s_status->is_powering_off != fresh.is_powering_off) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.is_powering_off");
+    }
+    d = false;
+    if (s_status->is_required != fresh.is_required) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.is_required");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->full_charge_capacity_wh, fresh.full_charge_capacity_wh)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.full_charge_capacity_wh");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->remaining_capacity_wh, fresh.remaining_capacity_wh)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.remaining_capacity_wh");
+    }
+    d = false;
+    if (s_status->over_discharge_count != fresh.over_discharge_count) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.over_discharge_count");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->nominal_voltage, fresh.nominal_voltage)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.nominal_voltage");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->internal_resistance_estimate,
+                          fresh.internal_resistance_estimate)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED,
+                       "uorb.BatteryStatus.internal_resistance_estimate");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->ocv_estimate, fresh.ocv_estimate)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.ocv_estimate");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->ocv_estimate_filtered, fresh.ocv_estimate_filtered)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.ocv_estimate_filtered");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->volt_based_soc_estimate, fresh.volt_based_soc_estimate)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.volt_based_soc_estimate");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->voltage_prediction, fresh.voltage_prediction)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.voltage_prediction");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->prediction_error, fresh.prediction_error)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.prediction_error");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->estimation_covariance_norm, fresh.estimation_covariance_norm)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED,
+                       "uorb.BatteryStatus.estimation_covariance_norm");
+    }
+  }
+  if (t_msg->temperature == (int16_t)32767) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.temperature");
+  }
+  {
+    size_t i;
+    bool all = true;
+    for (i = 0; i < 10u; i++) {
+      if (!(t_msg->voltages[i] == (uint16_t)65535u)) {
+        all = false;
+      }
+    }
+    if (all) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.voltages");
+    }
+  }
+  if (t_msg->current_battery == (int16_t)(-1)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.current_battery");
+  }
+  if (t_msg->current_consumed == (int32_t)(-1)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.current_consumed");
+  }
+  if (t_msg->energy_consumed == (int32_t)(-1)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.energy_consumed");
+  }
+  if (t_msg->battery_remaining == (int8_t)(-1)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.battery_remaining");
+  }
+  if (t_msg->time_remaining == (int32_t)0) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.time_remaining");
+  }
+  {
+    size_t i;
+    bool all = true;
+    for (i = 0; i < 4u; i++) {
+      if (!(t_msg->voltages_ext[i] == (uint16_t)0u)) {
+        all = false;
+      }
+    }
+    if (all) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.voltages_ext");
+    }
+  }
+}
+
 static void map_px4_uavcan_bridge_forward(
     const battgen_dronecan_uavcan_equipment_power_BatteryInfo *s_info,
     const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *s_aux, const float *dt_s,
@@ -2059,6 +2718,342 @@ static void map_px4_uavcan_bridge_forward(
   if (battgen_f32_is_nan(t_status->nominal_voltage)) {
     battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.nominal_voltage");
   }
+}
+
+static void
+map_px4_uavcannode_forward(const battgen_uorb_BatteryStatus *s_status,
+                           battgen_dronecan_uavcan_equipment_power_BatteryInfo *t_info,
+                           battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *t_aux,
+                           battgen_loss_report *rep, battgen_loss_report *rep_d,
+                           battgen_loss_report *rep_u) {
+  (void)s_status;
+  (void)t_info;
+  (void)t_aux;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_dronecan_uavcan_equipment_power_BatteryInfo(t_info);
+  defaults_battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux(t_aux);
+  /* px4_uavcannode.yaml:12: zero_all */
+  {
+    t_info->temperature = 0.0f;
+    t_info->voltage = 0.0f;
+    t_info->current = 0.0f;
+    t_info->average_power_10sec = 0.0f;
+    t_info->remaining_capacity_wh = 0.0f;
+    t_info->full_charge_capacity_wh = 0.0f;
+    t_info->hours_to_full_charge = 0.0f;
+    t_info->state_of_health_pct = (uint8_t)0u;
+    t_info->state_of_charge_pct = (uint8_t)0u;
+  }
+  /* px4_uavcannode.yaml:13: px4_cell_list */
+  {
+    size_t i;
+    size_t n = (size_t)s_status->cell_count;
+    if (n > 14u) {
+      battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                       "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell");
+      n = 14u;
+    }
+    t_aux->voltage_cell_len = (uint16_t)n;
+    for (i = 0; i < n; i++) {
+      t_aux->voltage_cell[i] =
+          battgen_f16_round(s_status->voltage_cell_v[i], rep,
+                            "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell");
+    }
+  }
+  /* px4_uavcannode.yaml:14: px4_int */
+  { t_aux->cycle_count = (uint16_t)(uint64_t)((int64_t)s_status->cycle_count); }
+  /* px4_uavcannode.yaml:15: px4_int */
+  { t_aux->over_discharge_count = (uint16_t)(uint64_t)((int64_t)s_status->over_discharge_count); }
+  /* px4_uavcannode.yaml:16: px4_convert */
+  {
+    float x = s_status->current_a;
+    t_aux->max_current =
+        battgen_f16_round(x, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current");
+  }
+  /* px4_uavcannode.yaml:17: px4_convert */
+  {
+    float x = s_status->nominal_voltage;
+    t_aux->nominal_voltage = battgen_f16_round(
+        x, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage");
+  }
+  /* px4_uavcannode.yaml:18: px4_int */
+  { t_aux->is_powering_off = (((int64_t)s_status->is_powering_off) != 0); }
+  /* px4_uavcannode.yaml:19: px4_int */
+  { t_aux->battery_id = (uint8_t)(uint64_t)((int64_t)s_status->id); }
+  /* px4_uavcannode.yaml:20: px4_convert */
+  {
+    float x = s_status->voltage_v;
+    t_info->voltage =
+        battgen_f16_round(x, rep, "dronecan.uavcan.equipment.power.BatteryInfo.voltage");
+  }
+  /* px4_uavcannode.yaml:21: px4_convert */
+  {
+    float x = s_status->current_a;
+    t_info->current =
+        battgen_f16_round(x, rep, "dronecan.uavcan.equipment.power.BatteryInfo.current");
+  }
+  /* px4_uavcannode.yaml:22: px4_convert */
+  {
+    float x = s_status->temperature;
+    x = x + 273.1499938964844f;
+    t_info->temperature =
+        battgen_f16_round(x, rep, "dronecan.uavcan.equipment.power.BatteryInfo.temperature");
+  }
+  /* px4_uavcannode.yaml:27: px4_convert */
+  {
+    float x = s_status->full_charge_capacity_wh;
+    t_info->full_charge_capacity_wh = battgen_f16_round(
+        x, rep, "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh");
+  }
+  /* px4_uavcannode.yaml:28: px4_convert */
+  {
+    float x = s_status->remaining_capacity_wh;
+    t_info->remaining_capacity_wh = battgen_f16_round(
+        x, rep, "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh");
+  }
+  /* px4_uavcannode.yaml:29: px4_convert */
+  {
+    float x = s_status->remaining;
+    x = x * 100.0f;
+    t_info->state_of_charge_pct =
+        cvt_u8_7(x, rep, "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct");
+  }
+  /* px4_uavcannode.yaml:35: px4_int */
+  {
+    t_info->state_of_charge_pct_stdev =
+        saturate_uint8_7((uint8_t)(uint64_t)((int64_t)s_status->max_error));
+  }
+  /* px4_uavcannode.yaml:36: px4_int */
+  { t_info->battery_id = (uint8_t)(uint64_t)((int64_t)s_status->id); }
+  /* px4_uavcannode.yaml:37: const */
+  { t_info->model_instance_id = (uint32_t)0u; }
+  /* px4_uavcannode.yaml:38: const */
+  {
+    t_info->model_name_len = 15u;
+    t_info->model_name[0] = 80u;
+    t_info->model_name[1] = 88u;
+    t_info->model_name[2] = 52u;
+    t_info->model_name[3] = 32u;
+    t_info->model_name[4] = 67u;
+    t_info->model_name[5] = 65u;
+    t_info->model_name[6] = 78u;
+    t_info->model_name[7] = 32u;
+    t_info->model_name[8] = 66u;
+    t_info->model_name[9] = 97u;
+    t_info->model_name[10] = 116u;
+    t_info->model_name[11] = 116u;
+    t_info->model_name[12] = 101u;
+    t_info->model_name[13] = 114u;
+    t_info->model_name[14] = 121u;
+  }
+  /* px4_uavcannode.yaml:39: px4_int */
+  {
+    t_info->state_of_health_pct =
+        saturate_uint8_7((uint8_t)(uint64_t)((int64_t)s_status->state_of_health));
+  }
+  /* px4_uavcannode.yaml:40: bits_from */
+  {
+    uint64_t b = 0u;
+    if (s_status->connected != 0) {
+      b |= 1ULL;
+    }
+    if (s_status->warning == (uint8_t)7u) {
+      b |= 2ULL;
+    }
+    t_info->status_flags = saturate_uint16_11((uint16_t)(uint64_t)((int64_t)b));
+  }
+  /* what did not survive the conversion */
+  if (rep_d != NULL && s_status != NULL) {
+    battgen_uorb_BatteryStatus fresh;
+    bool d;
+    defaults_battgen_uorb_BatteryStatus(&fresh);
+    d = false;
+    if (s_status->timestamp != fresh.timestamp) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.timestamp");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->current_average_a, fresh.current_average_a)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.current_average_a");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->discharged_mah, fresh.discharged_mah)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.discharged_mah");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->scale, fresh.scale)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.scale");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->time_remaining_s, fresh.time_remaining_s)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.time_remaining_s");
+    }
+    d = false;
+    if (s_status->source != fresh.source) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.source");
+    }
+    d = false;
+    if (s_status->priority != fresh.priority) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.priority");
+    }
+    d = false;
+    if (s_status->capacity != fresh.capacity) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.capacity");
+    }
+    d = false;
+    if (s_status->average_time_to_empty != fresh.average_time_to_empty) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.average_time_to_empty");
+    }
+    d = false;
+    if (s_status->manufacture_date != fresh.manufacture_date) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.manufacture_date");
+    }
+    d = false;
+    if (s_status->interface_error != fresh.interface_error) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.interface_error");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->max_cell_voltage_delta, fresh.max_cell_voltage_delta)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.max_cell_voltage_delta");
+    }
+    d = false;
+    if (s_status->is_required != fresh.is_required) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.is_required");
+    }
+    d = false;
+    if (s_status->faults != fresh.faults) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.faults");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->internal_resistance_estimate,
+                          fresh.internal_resistance_estimate)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED,
+                       "uorb.BatteryStatus.internal_resistance_estimate");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->ocv_estimate, fresh.ocv_estimate)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.ocv_estimate");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->ocv_estimate_filtered, fresh.ocv_estimate_filtered)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.ocv_estimate_filtered");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->volt_based_soc_estimate, fresh.volt_based_soc_estimate)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.volt_based_soc_estimate");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->voltage_prediction, fresh.voltage_prediction)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.voltage_prediction");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->prediction_error, fresh.prediction_error)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatus.prediction_error");
+    }
+    d = false;
+    if (!battgen_f32_same(s_status->estimation_covariance_norm, fresh.estimation_covariance_norm)) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED,
+                       "uorb.BatteryStatus.estimation_covariance_norm");
+    }
+  }
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge");
+  if (battgen_f32_is_nan(t_info->temperature)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                     "dronecan.uavcan.equipment.power.BatteryInfo.temperature");
+  }
+  if (battgen_f32_is_nan(t_info->voltage)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                     "dronecan.uavcan.equipment.power.BatteryInfo.voltage");
+  }
+  if (battgen_f32_is_nan(t_info->current)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                     "dronecan.uavcan.equipment.power.BatteryInfo.current");
+  }
+  if (battgen_f32_is_nan(t_info->remaining_capacity_wh)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                     "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh");
+  }
+  if (battgen_f32_is_nan(t_info->full_charge_capacity_wh)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                     "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh");
+  }
+  if (t_info->state_of_health_pct == (uint8_t)127u) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                     "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct");
+  }
+  if (t_info->state_of_charge_pct == (uint8_t)127u) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                     "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct");
+  }
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp");
 }
 
 static void map_uorb_backward(const battgen_concepts *s, battgen_uorb_BatteryStatus *t_status,
@@ -2912,6 +3907,16 @@ void battgen_convert_dronecan_to_uorb_px4(
   map_px4_uavcan_bridge_forward(info, aux, dt_s, discharged_mah_before, out_status, rep, rep, rep);
 }
 
+void battgen_convert_dronecan_to_mavlink_px4(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux, const float *dt_s,
+    const float *discharged_mah_before, battgen_mavlink_BATTERY_STATUS *out_msg,
+    battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  map_px4_uavcan_bridge_forward(info, aux, dt_s, discharged_mah_before, &c1_0, rep, rep, NULL);
+  map_px4_mavlink_stream_forward(&c1_0, out_msg, rep, NULL, rep);
+}
+
 void battgen_convert_dronecan_to_mavlink_v2_strict(
     const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
     const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
@@ -2959,6 +3964,19 @@ void battgen_convert_cbat_to_mavlink_v2_strict(
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_uorb_to_dronecan_px4(
+    const battgen_uorb_BatteryStatus *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  map_px4_uavcannode_forward(status, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_uorb_to_mavlink_px4(const battgen_uorb_BatteryStatus *status,
+                                         battgen_mavlink_BATTERY_STATUS *out_msg,
+                                         battgen_loss_report *rep) {
+  map_px4_mavlink_stream_forward(status, out_msg, rep, rep, rep);
+}
+
 void battgen_convert_uorb_to_mavlink_v2_strict(const battgen_uorb_BatteryStatus *status,
                                                battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                battgen_loss_report *rep) {
@@ -2981,6 +3999,21 @@ void battgen_convert_uorb_info_to_mavlink_v2_strict(const battgen_uorb_BatteryIn
   battgen_concepts c1;
   map_uorb_info_forward(info, &c1, rep, rep, NULL);
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_to_dronecan_px4(
+    const battgen_mavlink_BATTERY_STATUS *msg,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  map_px4_mavlink_receiver_forward(msg, &c1_0, rep, rep, NULL);
+  map_px4_uavcannode_forward(&c1_0, out_info, out_aux, rep, NULL, rep);
+}
+
+void battgen_convert_mavlink_to_uorb_px4(const battgen_mavlink_BATTERY_STATUS *msg,
+                                         battgen_uorb_BatteryStatus *out_status,
+                                         battgen_loss_report *rep) {
+  map_px4_mavlink_receiver_forward(msg, out_status, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_info_to_uorb_strict(const battgen_mavlink_BATTERY_INFO *info,

@@ -15,6 +15,7 @@
 #include "dronecan/cuav/equipment/power/CBAT.h"
 #include "dronecan/uavcan/equipment/power/BatteryInfo.h"
 #include "mavlink/BATTERY_INFO.h"
+#include "mavlink/BATTERY_STATUS.h"
 #include "mavlink/BATTERY_STATUS_V2.h"
 #include "mavlink/SYS_STATUS.h"
 #include "uorb/BatteryInfo.h"
@@ -41,6 +42,17 @@ void battgen_convert_dronecan_to_uorb_px4(
     const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
     const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux, const float *dt_s,
     const float *discharged_mah_before, battgen_uorb_BatteryStatus *out_status,
+    battgen_loss_report *rep);
+
+/* dronecan -> mavlink, policy px4: px4_uavcan_bridge -> px4_mavlink_stream.
+ * `aux` may be NULL (not received).
+ * `dt_s` may be NULL (not given).
+ * `discharged_mah_before` may be NULL (not given).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_mavlink_px4(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux, const float *dt_s,
+    const float *discharged_mah_before, battgen_mavlink_BATTERY_STATUS *out_msg,
     battgen_loss_report *rep);
 
 /* dronecan -> mavlink_v2, policy strict: dronecan -> mavlink_v2.
@@ -87,6 +99,19 @@ void battgen_convert_cbat_to_mavlink_v2_strict(
     const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
     battgen_mavlink_BATTERY_STATUS_V2 *out_status, battgen_loss_report *rep);
 
+/* uorb -> dronecan, policy px4: px4_uavcannode.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_dronecan_px4(
+    const battgen_uorb_BatteryStatus *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* uorb -> mavlink, policy px4: px4_mavlink_stream.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_mavlink_px4(const battgen_uorb_BatteryStatus *status,
+                                         battgen_mavlink_BATTERY_STATUS *out_msg,
+                                         battgen_loss_report *rep);
+
 /* uorb -> mavlink_v2, policy strict: uorb -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_uorb_to_mavlink_v2_strict(const battgen_uorb_BatteryStatus *status,
@@ -104,6 +129,19 @@ void battgen_convert_uorb_info_to_uorb_strict(const battgen_uorb_BatteryInfo *in
 void battgen_convert_uorb_info_to_mavlink_v2_strict(const battgen_uorb_BatteryInfo *info,
                                                     battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                     battgen_loss_report *rep);
+
+/* mavlink -> dronecan, policy px4: px4_mavlink_receiver -> px4_uavcannode.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_dronecan_px4(
+    const battgen_mavlink_BATTERY_STATUS *msg,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* mavlink -> uorb, policy px4: px4_mavlink_receiver.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_uorb_px4(const battgen_mavlink_BATTERY_STATUS *msg,
+                                         battgen_uorb_BatteryStatus *out_status,
+                                         battgen_loss_report *rep);
 
 /* mavlink_info -> uorb, policy strict: mavlink_info -> uorb.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */

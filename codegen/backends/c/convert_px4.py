@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from ...ir import CONCEPTS_ENDPOINT, ArrayType, FieldRef, PrimitiveType, Rule, units
+from ...ir import CONCEPTS_ENDPOINT, ArrayType, FieldRef, PrimitiveKind, PrimitiveType, Rule, StringType, units
 from ...ir import ops as o
 from .convert_context import CBase
 from .convert_values import Unsupported, f32, f32_literal, literal
@@ -41,9 +41,27 @@ class PX4Ops(CBase):
             if ref.message == CONCEPTS_ENDPOINT:
                 self.concept_const(ref, value)
                 continue
-            if not isinstance(self.fld(ref).type, PrimitiveType):
+            t = self.fld(ref).type
+            if isinstance(value, str) and isinstance(t, ArrayType | StringType):
+                self.text_const(ref, t, value)
+                continue
+            if not isinstance(t, PrimitiveType):
                 raise Unsupported("a constant into an array")
             self.emit(f"{self.t(ref)} = {literal(self.prim(ref), value)};")
+
+    def text_const(self, ref: FieldRef, t: ArrayType | StringType, value: str) -> None:
+        """A text constant into a byte array (its bytes, the rest zero) as Python writes the bytes."""
+        data = value.encode("utf-8")
+        cap = t.capacity or 0
+        if len(data) > cap:
+            raise Unsupported("a text constant longer than its field")
+        target = self.t(ref)
+        cast = "(char)" if isinstance(t, StringType) or getattr(t.element, "kind", None) is PrimitiveKind.CHAR else ""
+        if isinstance(t, ArrayType) and t.dynamic:
+            self.emit(f"{target}_len = {len(data)}u;")
+        else:
+            self.emit(f"battgen_zero({target}, sizeof {target});")
+        self.emit(*(f"{target}[{i}] = {cast}{b}u;" for i, b in enumerate(data)))
 
     def visit_px4_convert(self, rule: Rule, op: o.PX4Convert) -> None:
         src, dst = rule.sources[0], rule.targets[0]
@@ -62,12 +80,12 @@ class PX4Ops(CBase):
             if add != 0.0:
                 self.emit(f"x = x + {f32_literal(f32(add))};")
         if op.round:
-            raise Unsupported("roundf")
+            self.emit("x = battgen_roundf(x);")
         value = self.store_c(dst, "x")
         p = self.prim(dst)
-        if op.at_least is not None:
+        stored = [f"{{ {scalar(p)} y = {value};", "", "}"] if op.at_least is not None else None
+        if op.at_least is not None:  # max(value, at_least), the value converted only where it is stored
             k = literal(p, op.at_least)
-            self.emit(f"{scalar(p)} y = {value};")
             value = f"({k} > y ? {k} : y)"
         tests = []
         if op.guard is not None:
@@ -77,13 +95,16 @@ class PX4Ops(CBase):
         if op.above is not None:
             tests.append(f"x > {f32_literal(f32(float(op.above)))}")
         target = self.t(dst)
+        assign = [f"{target} = {value};"]
+        if stored is not None:
+            assign = [stored[0], *assign, stored[2]]
         if not tests:
-            self.emit(f"{target} = {value};")
+            self.emit(*assign)
             return
         otherwise = self.value_of(op.otherwise if op.otherwise is not None else 0, [dst])
         self.emit(
             f"if ({' && '.join(tests)}) {{",
-            f"{target} = {value};",
+            *assign,
             "} else {",
             f"{target} = {literal(p, otherwise)};",
             "}",

@@ -32,6 +32,7 @@ from ..python.converters.mapping_module import Edge
 from ..python.converters.routes import POLICIES, route
 from .convert_concepts import STATE, ConceptOps
 from .convert_px4 import PX4Ops
+from .convert_px4_cells import PX4CellOps
 from .convert_values import Unsupported, c_type, defaults, differs, literal, primitive
 from .types import ident
 
@@ -47,6 +48,7 @@ class MapFunction:
     params: list[str]  # C parameter declarations, reports last
     body: list[str]
     inputs: list[str]
+    targets: list[str]  # the qualified messages it writes (none: the concepts)
 
 
 @dataclass(frozen=True)
@@ -72,15 +74,21 @@ class CConverter:
     def body(self) -> list[str]:
         """The calls along the route; a loss reported where it happens, as the Python converter does."""
         out: list[str] = []
-        if len(self.chain) > 1:
-            out += [f"{STATE} c{i};" for i in range(1, len(self.chain))]
+        between: list[list[str]] = []  # each intermediate stage's objects
+        for i, f in enumerate(self.chain[:-1], 1):
+            if not f.targets:
+                out.append(f"{STATE} c{i};")
+                between.append([f"&c{i}"])
+            else:
+                out += [f"{c_type(q)} c{i}_{k};" for k, q in enumerate(f.targets)]
+                between.append([f"&c{i}_{k}" for k in range(len(f.targets))])
         after_px4 = False
         for i, f in enumerate(self.chain):
             first, last = i == 0, i == len(self.chain) - 1
             e = f.edge
-            args = [v for _, v, _ in self.sources] if first else [f"&c{i}"]
+            args = [v for _, v, _ in self.sources] if first else list(between[i - 1])
             args += [n if n in self.inputs else "NULL" for n in f.inputs] if first else ["NULL" for _ in f.inputs]
-            args += [v for _, v in self.targets] if last else [f"&c{i + 1}"]
+            args += [v for _, v in self.targets] if last else list(between[i])
             rep_d = "rep" if first or e.source == CONCEPTS_ENDPOINT or not after_px4 else "NULL"
             args += ["rep", rep_d, "rep" if last else "NULL"]
             out.append(f"{f.name}({', '.join(args)});")
@@ -88,14 +96,13 @@ class CConverter:
         return out
 
 
-class _Builder(PX4Ops, ConceptOps):
+class _Builder(PX4Ops, PX4CellOps, ConceptOps):
     """One direction of one mapping as C (see the module docstring)."""
 
     def _unsupported(self, rule: Rule, op: object) -> None:
         raise Unsupported(f"op {rule.op.NAME}")
 
-    visit_mavlink_voltages = visit_dt_pack = visit_ocv_soc = visit_same_names = _unsupported
-    visit_px4_stream_cells = visit_px4_receiver_cells = visit_px4_cell_list = visit_px4_udral_energy = _unsupported
+    visit_mavlink_voltages = visit_dt_pack = visit_ocv_soc = visit_same_names = visit_px4_udral_energy = _unsupported
 
     # -- the function ----------------------------------------------------------------------
 
@@ -282,7 +289,8 @@ def c_converters(schema: Schema) -> tuple[list[CConverter], dict[str, str], list
             try:
                 body = b.build()
                 name = f"map_{ident(e.mapping.name)}_{e.function}"
-                functions[key] = MapFunction(e, name, b.params(), b.unused() + body, list(b.inputs))
+                targets = list(sides[1].messages) if sides[1] is not None else []
+                functions[key] = MapFunction(e, name, b.params(), b.unused() + body, list(b.inputs), targets)
             except Unsupported as why:
                 helpers.clear()
                 helpers.update(saved)

@@ -155,6 +155,18 @@ static inline int64_t battgen_to_int(double x, int64_t lo, int64_t hi, battgen_l
   return n;
 }
 
+/* C's roundf: halves away from zero, the sign kept (-0.3 gives -0.0); no <math.h> needed. */
+static inline float battgen_roundf(float x) {
+  uint32_t u = battgen_f32_bits(x);
+  uint32_t a = u & 0x7FFFFFFFu;
+  float r;
+  if (a >= 0x4B000000u) { /* 2^23 and beyond (infinity, NaN): already whole */
+    return x;
+  }
+  r = (float)(int32_t)((double)battgen_f32_from(a) + 0.5); /* exact in double: floor(a + 0.5) */
+  return battgen_f32_from(battgen_f32_bits(r) | (u & 0x80000000u));
+}
+
 static inline float battgen_absf(float x) { return battgen_f32_from(battgen_f32_bits(x) & 0x7FFFFFFFu); }
 
 static inline bool battgen_f32_same(float a, float b) {
