@@ -1104,6 +1104,651 @@ map_dronecan_forward(const battgen_dronecan_uavcan_equipment_power_BatteryInfo *
   }
 }
 
+static void map_mavlink_backward(const battgen_concepts *s, battgen_mavlink_BATTERY_STATUS *t_msg,
+                                 battgen_loss_report *rep, battgen_loss_report *rep_d,
+                                 battgen_loss_report *rep_u) {
+  (void)s;
+  (void)t_msg;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_mavlink_BATTERY_STATUS(t_msg);
+  /* mavlink.yaml:10: copy */
+  {
+    if (!s->has_battery_index) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.id");
+    } else {
+      t_msg->id = (uint8_t)battgen_to_int((double)s->battery_index, 0LL, 255LL, rep,
+                                          "mavlink.BATTERY_STATUS.id");
+    }
+  }
+  /* mavlink.yaml:11: choice */
+  {
+    bool w = false;
+    if (s->has_battery_function) {
+      switch (s->battery_function) {
+      case BATTGEN_BATTERY_FUNCTION_ALL:
+        t_msg->battery_function = (uint8_t)1u;
+        w = true;
+        break;
+      case BATTGEN_BATTERY_FUNCTION_PROPULSION:
+        t_msg->battery_function = (uint8_t)2u;
+        w = true;
+        break;
+      case BATTGEN_BATTERY_FUNCTION_AVIONICS:
+        t_msg->battery_function = (uint8_t)3u;
+        w = true;
+        break;
+      case BATTGEN_BATTERY_FUNCTION_PAYLOAD:
+        t_msg->battery_function = (uint8_t)4u;
+        w = true;
+        break;
+      default:
+        break;
+      }
+    }
+    if (!w) {
+      t_msg->battery_function = (uint8_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.battery_function");
+      if (s->has_battery_function) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.battery_function");
+      }
+    }
+  }
+  /* mavlink.yaml:20: choice */
+  {
+    bool w = false;
+    if (s->has_chemistry) {
+      switch (s->chemistry) {
+      case BATTGEN_CHEMISTRY_LIPO:
+        t_msg->type = (uint8_t)1u;
+        w = true;
+        break;
+      case BATTGEN_CHEMISTRY_LIFE:
+        t_msg->type = (uint8_t)2u;
+        w = true;
+        break;
+      case BATTGEN_CHEMISTRY_LION:
+        t_msg->type = (uint8_t)3u;
+        w = true;
+        break;
+      case BATTGEN_CHEMISTRY_NIMH:
+        t_msg->type = (uint8_t)4u;
+        w = true;
+        break;
+      default:
+        break;
+      }
+    }
+    if (!w) {
+      t_msg->type = (uint8_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.type");
+      if (s->has_chemistry) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.chemistry");
+      }
+    }
+  }
+  /* mavlink.yaml:25: scale */
+  {
+    if (!s->has_temperature || battgen_f64_is_nan(s->temperature)) {
+      t_msg->temperature = (int16_t)32767;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.temperature");
+    } else {
+      t_msg->temperature =
+          (int16_t)battgen_to_int(s->temperature * 100.0 + -27314.999999999996, -32768LL, 32766LL,
+                                  rep, "mavlink.BATTERY_STATUS.temperature");
+      if (t_msg->temperature == (int16_t)32767) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_STATUS.temperature");
+      }
+    }
+  }
+  /* mavlink.yaml:26: mavlink_voltages */
+  {
+    size_t i, n = 0;
+    bool any = false;
+    for (i = 0; i < 10u; i++) {
+      t_msg->voltages[i] = 65535u;
+    }
+    for (i = 0; i < 4u; i++) {
+      t_msg->voltages_ext[i] = 0u;
+    }
+    if (s->has_cell_voltages) {
+      n = (size_t)s->cell_voltages_len;
+      for (i = 0; i < n; i++) {
+        if (!battgen_f64_is_nan(s->cell_voltages[i])) {
+          any = true;
+        }
+      }
+    }
+    if (n > 0u && any) {
+      if (n > 14u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_STATUS.voltages_ext");
+        n = 14u;
+      }
+      for (i = 0; i < n; i++) {
+        double c = s->cell_voltages[i] * 1000.0;
+        if (i < 10u) {
+          if (battgen_f64_is_nan(c)) {
+            t_msg->voltages[i] = 65535u;
+            battgen_loss_add(rep, BATTGEN_LOSS_UNREPRESENTABLE, "mavlink.BATTERY_STATUS.voltages");
+          } else {
+            t_msg->voltages[i] =
+                (uint16_t)battgen_to_int(c, 0, 65534, rep, "mavlink.BATTERY_STATUS.voltages");
+          }
+        } else if (battgen_f64_is_nan(c)) {
+          t_msg->voltages_ext[i - 10u] = 0u;
+          battgen_loss_add(rep, BATTGEN_LOSS_UNREPRESENTABLE,
+                           "mavlink.BATTERY_STATUS.voltages_ext");
+        } else {
+          int64_t v = battgen_to_int(c, 0, 65534, rep, "mavlink.BATTERY_STATUS.voltages_ext");
+          t_msg->voltages_ext[i - 10u] = (uint16_t)(v < 1 ? 1 : v);
+        }
+      }
+    } else if (s->has_pack_voltage && !battgen_f64_is_nan(s->pack_voltage)) {
+      int64_t mv = battgen_to_int(s->pack_voltage * 1000.0, 0, 655340, rep,
+                                  "mavlink.BATTERY_STATUS.voltages");
+      i = 0;
+      while (mv > 65534 && i < 9u) {
+        t_msg->voltages[i] = 65534u;
+        mv -= 65534;
+        i++;
+      }
+      t_msg->voltages[i] = (uint16_t)mv;
+    } else {
+      battgen_loss_add(rep, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.voltages");
+    }
+  }
+  /* mavlink.yaml:33: scale */
+  {
+    if (!s->has_current || battgen_f64_is_nan(s->current)) {
+      t_msg->current_battery = (int16_t)(-1);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.current_battery");
+    } else {
+      t_msg->current_battery = (int16_t)battgen_to_int(s->current * 100.0, -32768LL, 32767LL, rep,
+                                                       "mavlink.BATTERY_STATUS.current_battery");
+      if (t_msg->current_battery == (int16_t)(-1)) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_STATUS.current_battery");
+      }
+    }
+  }
+  /* mavlink.yaml:34: scale */
+  {
+    if (!s->has_discharged || battgen_f64_is_nan(s->discharged)) {
+      t_msg->current_consumed = (int32_t)(-1);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.current_consumed");
+    } else {
+      t_msg->current_consumed =
+          (int32_t)battgen_to_int(s->discharged * 0.2777777777777778, -2147483648LL, 2147483647LL,
+                                  rep, "mavlink.BATTERY_STATUS.current_consumed");
+      if (t_msg->current_consumed == (int32_t)(-1)) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_STATUS.current_consumed");
+      }
+    }
+  }
+  /* mavlink.yaml:35: scale */
+  {
+    if (!s->has_consumed_energy || battgen_f64_is_nan(s->consumed_energy)) {
+      t_msg->energy_consumed = (int32_t)(-1);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.energy_consumed");
+    } else {
+      t_msg->energy_consumed =
+          (int32_t)battgen_to_int(s->consumed_energy * 0.01, -2147483648LL, 2147483647LL, rep,
+                                  "mavlink.BATTERY_STATUS.energy_consumed");
+      if (t_msg->energy_consumed == (int32_t)(-1)) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_STATUS.energy_consumed");
+      }
+    }
+  }
+  /* mavlink.yaml:36: scale */
+  {
+    if (!s->has_state_of_charge || battgen_f64_is_nan(s->state_of_charge)) {
+      t_msg->battery_remaining = (int8_t)(-1);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.battery_remaining");
+    } else {
+      t_msg->battery_remaining = (int8_t)battgen_to_int(s->state_of_charge * 100.0, 0LL, 100LL, rep,
+                                                        "mavlink.BATTERY_STATUS.battery_remaining");
+      if (t_msg->battery_remaining == (int8_t)(-1)) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_STATUS.battery_remaining");
+      }
+    }
+  }
+  /* mavlink.yaml:37: scale */
+  {
+    if (!s->has_time_remaining || battgen_f64_is_nan(s->time_remaining)) {
+      t_msg->time_remaining = (int32_t)0;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.time_remaining");
+    } else {
+      t_msg->time_remaining =
+          (int32_t)battgen_to_int(s->time_remaining, -2147483648LL, 2147483647LL, rep,
+                                  "mavlink.BATTERY_STATUS.time_remaining");
+      if (t_msg->time_remaining == (int32_t)0) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_STATUS.time_remaining");
+      }
+    }
+  }
+  /* mavlink.yaml:38: choice */
+  {
+    bool w = false;
+    if (s->has_warning) {
+      switch (s->warning) {
+      case BATTGEN_WARNING_NONE:
+        t_msg->charge_state = (uint8_t)1u;
+        w = true;
+        break;
+      case BATTGEN_WARNING_LOW:
+        t_msg->charge_state = (uint8_t)2u;
+        w = true;
+        break;
+      case BATTGEN_WARNING_CRITICAL:
+        t_msg->charge_state = (uint8_t)3u;
+        w = true;
+        break;
+      case BATTGEN_WARNING_EMERGENCY:
+        t_msg->charge_state = (uint8_t)4u;
+        w = true;
+        break;
+      case BATTGEN_WARNING_FAILED:
+        t_msg->charge_state = (uint8_t)5u;
+        w = true;
+        break;
+      case BATTGEN_WARNING_UNHEALTHY:
+        t_msg->charge_state = (uint8_t)6u;
+        w = true;
+        break;
+      case BATTGEN_WARNING_CHARGING:
+        t_msg->charge_state = (uint8_t)7u;
+        w = true;
+        break;
+      default:
+        break;
+      }
+    }
+    if (!w) {
+      t_msg->charge_state = (uint8_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.charge_state");
+      if (s->has_warning) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.warning");
+      }
+    }
+  }
+  /* mavlink.yaml:50: flags */
+  {
+    if (!s->has_faults) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.fault_bitmask");
+    } else {
+      uint64_t b = (uint64_t)t_msg->fault_bitmask;
+      if ((s->faults & BATTGEN_FAULTS_DEEP_DISCHARGE) != 0u) {
+        b |= 1uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_SPIKES) != 0u) {
+        b |= 2uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_CELL_FAIL) != 0u) {
+        b |= 4uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_OVER_CURRENT) != 0u) {
+        b |= 8uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_OVER_TEMPERATURE) != 0u) {
+        b |= 16uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_UNDER_TEMPERATURE) != 0u) {
+        b |= 32uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_INCOMPATIBLE_VOLTAGE) != 0u) {
+        b |= 64uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_INCOMPATIBLE_FIRMWARE) != 0u) {
+        b |= 128uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_INCOMPATIBLE_CELLS_CONFIGURATION) != 0u) {
+        b |= 256uLL;
+      }
+      t_msg->fault_bitmask = (uint32_t)b;
+      if ((s->faults & (BATTGEN_FAULTS_INCOMPATIBLE_MODEL | BATTGEN_FAULTS_HARDWARE_FAILURE |
+                        BATTGEN_FAULTS_FAILED_TO_ARM)) != 0u) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.faults");
+      }
+    }
+  }
+  /* what did not survive the conversion */
+  if (s->has_connected) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.connected");
+  }
+  if (s->has_in_use) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.in_use");
+  }
+  if (s->has_charging) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.charging");
+  }
+  if (s->has_average_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_current");
+  }
+  if (s->has_max_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_current");
+  }
+  if (s->has_average_power) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_power");
+  }
+  if (s->has_state_of_charge_stdev) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.state_of_charge_stdev");
+  }
+  if (s->has_state_of_health) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.state_of_health");
+  }
+  if (s->has_remaining_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_energy");
+  }
+  if (s->has_full_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.full_energy");
+  }
+  if (s->has_design_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.design_energy");
+  }
+  if (s->has_full_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.full_capacity");
+  }
+  if (s->has_design_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.design_capacity");
+  }
+  if (s->has_time_to_full) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.time_to_full");
+  }
+  if (s->has_cell_count) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_count");
+  }
+  if (s->has_cycle_count) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cycle_count");
+  }
+  if (s->has_over_discharge_count) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.over_discharge_count");
+  }
+  if (s->has_nominal_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.nominal_voltage");
+  }
+  if (s->has_voltage_min_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_min_design");
+  }
+  if (s->has_voltage_max_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_max_design");
+  }
+  if (s->has_serial_number) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.serial_number");
+  }
+  if (s->has_model_name) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.model_name");
+  }
+  if (s->has_is_powering_off) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.is_powering_off");
+  }
+  if (s->has_remaining_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_capacity");
+  }
+  if (s->has_serial_number_text) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.serial_number_text");
+  }
+  if (s->has_manufacture_date) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.manufacture_date");
+  }
+  if (s->has_weight) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.weight");
+  }
+  if (s->has_cell_discharge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_discharge_min_voltage");
+  }
+  if (s->has_cell_charge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_min_voltage");
+  }
+  if (s->has_cell_rest_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_rest_min_voltage");
+  }
+  if (s->has_cell_charge_max_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_max_voltage");
+  }
+  if (s->has_max_charge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_charge_current");
+  }
+  if (s->has_max_discharge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_discharge_current");
+  }
+  if (s->has_max_burst_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_burst_current");
+  }
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_STATUS.mode");
+}
+
+static void map_mavlink_forward(const battgen_mavlink_BATTERY_STATUS *s_msg, battgen_concepts *t,
+                                battgen_loss_report *rep, battgen_loss_report *rep_d,
+                                battgen_loss_report *rep_u) {
+  (void)s_msg;
+  (void)t;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  battgen_zero(t, sizeof *t);
+  /* mavlink.yaml:10: copy */
+  {
+    int64_t v = (int64_t)s_msg->id;
+    t->has_battery_index = true;
+    t->battery_index = v;
+  }
+  /* mavlink.yaml:11: choice */
+  {
+    int64_t v = (int64_t)s_msg->battery_function;
+    t->has_battery_function = true;
+    switch (v) {
+    case 1LL:
+      t->battery_function = BATTGEN_BATTERY_FUNCTION_ALL;
+      break;
+    case 2LL:
+      t->battery_function = BATTGEN_BATTERY_FUNCTION_PROPULSION;
+      break;
+    case 3LL:
+      t->battery_function = BATTGEN_BATTERY_FUNCTION_AVIONICS;
+      break;
+    case 4LL:
+      t->battery_function = BATTGEN_BATTERY_FUNCTION_PAYLOAD;
+      break;
+    default:
+      t->has_battery_function = false;
+      if (1 && v != 0LL) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.battery_function");
+      }
+      break;
+    }
+  }
+  /* mavlink.yaml:20: choice */
+  {
+    int64_t v = (int64_t)s_msg->type;
+    t->has_chemistry = true;
+    switch (v) {
+    case 1LL:
+      t->chemistry = BATTGEN_CHEMISTRY_LIPO;
+      break;
+    case 2LL:
+      t->chemistry = BATTGEN_CHEMISTRY_LIFE;
+      break;
+    case 3LL:
+      t->chemistry = BATTGEN_CHEMISTRY_LION;
+      break;
+    case 4LL:
+      t->chemistry = BATTGEN_CHEMISTRY_NIMH;
+      break;
+    default:
+      t->has_chemistry = false;
+      if (1 && v != 0LL) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.type");
+      }
+      break;
+    }
+  }
+  /* mavlink.yaml:25: scale */
+  {
+    int64_t v = (int64_t)s_msg->temperature;
+    if (v != 32767) {
+      t->has_temperature = true;
+      t->temperature = (double)v * 0.01 + 273.15;
+    }
+  }
+  /* mavlink.yaml:26: mavlink_voltages */
+  {
+    int64_t got[14], sum = 0;
+    size_t n = 0, k;
+    while (n < 10u && s_msg->voltages[n] != 65535u) {
+      got[n] = (int64_t)s_msg->voltages[n];
+      n++;
+    }
+    if (n == 10u) {
+      for (k = 0; k < 4u && s_msg->voltages_ext[k] != 0u; k++) {
+        got[n++] = (int64_t)s_msg->voltages_ext[k];
+      }
+    }
+    for (k = 0; k < n; k++) {
+      sum += got[k];
+    }
+    if (n > 0u) {
+      t->has_pack_voltage = true;
+      t->pack_voltage = (double)sum * 0.001;
+      if (n > 1u && got[0] != 65534) {
+        t->has_cell_voltages = true;
+        t->cell_voltages_len = (uint16_t)n;
+        for (k = 0; k < n; k++) {
+          t->cell_voltages[k] = (double)got[k] * 0.001;
+        }
+      }
+    }
+  }
+  /* mavlink.yaml:33: scale */
+  {
+    int64_t v = (int64_t)s_msg->current_battery;
+    if (v != -1) {
+      t->has_current = true;
+      t->current = (double)v * 0.01;
+    }
+  }
+  /* mavlink.yaml:34: scale */
+  {
+    int64_t v = (int64_t)s_msg->current_consumed;
+    if (v != -1) {
+      t->has_discharged = true;
+      t->discharged = (double)v * 3.6;
+    }
+  }
+  /* mavlink.yaml:35: scale */
+  {
+    int64_t v = (int64_t)s_msg->energy_consumed;
+    if (v != -1) {
+      t->has_consumed_energy = true;
+      t->consumed_energy = (double)v * 100.0;
+    }
+  }
+  /* mavlink.yaml:36: scale */
+  {
+    int64_t v = (int64_t)s_msg->battery_remaining;
+    if (v != -1 && v <= 100) {
+      t->has_state_of_charge = true;
+      t->state_of_charge = (double)v * 0.01;
+    }
+  }
+  /* mavlink.yaml:37: scale */
+  {
+    int64_t v = (int64_t)s_msg->time_remaining;
+    if (v != 0) {
+      t->has_time_remaining = true;
+      t->time_remaining = (double)v;
+    }
+  }
+  /* mavlink.yaml:38: choice */
+  {
+    int64_t v = (int64_t)s_msg->charge_state;
+    t->has_warning = true;
+    switch (v) {
+    case 1LL:
+      t->warning = BATTGEN_WARNING_NONE;
+      break;
+    case 2LL:
+      t->warning = BATTGEN_WARNING_LOW;
+      break;
+    case 3LL:
+      t->warning = BATTGEN_WARNING_CRITICAL;
+      break;
+    case 4LL:
+      t->warning = BATTGEN_WARNING_EMERGENCY;
+      break;
+    case 5LL:
+      t->warning = BATTGEN_WARNING_FAILED;
+      break;
+    case 6LL:
+      t->warning = BATTGEN_WARNING_UNHEALTHY;
+      break;
+    case 7LL:
+      t->warning = BATTGEN_WARNING_CHARGING;
+      break;
+    default:
+      t->has_warning = false;
+      if (1 && v != 0LL) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.charge_state");
+      }
+      break;
+    }
+  }
+  /* mavlink.yaml:50: flags */
+  {
+    uint64_t v = (uint64_t)s_msg->fault_bitmask;
+    uint32_t b = 0u;
+    if ((v & 1uLL) != 0u) {
+      b |= BATTGEN_FAULTS_DEEP_DISCHARGE;
+    }
+    if ((v & 2uLL) != 0u) {
+      b |= BATTGEN_FAULTS_SPIKES;
+    }
+    if ((v & 4uLL) != 0u) {
+      b |= BATTGEN_FAULTS_CELL_FAIL;
+    }
+    if ((v & 8uLL) != 0u) {
+      b |= BATTGEN_FAULTS_OVER_CURRENT;
+    }
+    if ((v & 16uLL) != 0u) {
+      b |= BATTGEN_FAULTS_OVER_TEMPERATURE;
+    }
+    if ((v & 32uLL) != 0u) {
+      b |= BATTGEN_FAULTS_UNDER_TEMPERATURE;
+    }
+    if ((v & 64uLL) != 0u) {
+      b |= BATTGEN_FAULTS_INCOMPATIBLE_VOLTAGE;
+    }
+    if ((v & 128uLL) != 0u) {
+      b |= BATTGEN_FAULTS_INCOMPATIBLE_FIRMWARE;
+    }
+    if ((v & 256uLL) != 0u) {
+      b |= BATTGEN_FAULTS_INCOMPATIBLE_CELLS_CONFIGURATION;
+    }
+    t->has_faults = true;
+    t->faults = b;
+  }
+  /* mavlink.yaml:63: const */
+  {
+    t->has_connected = true;
+    t->connected = true;
+  }
+  /* what did not survive the conversion */
+  if (((uint64_t)s_msg->fault_bitmask & ~(uint64_t)511u) != 0u) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.fault_bitmask");
+  }
+  if (rep_d != NULL && s_msg != NULL) {
+    battgen_mavlink_BATTERY_STATUS fresh;
+    bool d;
+    defaults_battgen_mavlink_BATTERY_STATUS(&fresh);
+    d = false;
+    if (s_msg->mode != fresh.mode) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "mavlink.BATTERY_STATUS.mode");
+    }
+  }
+}
+
 static void map_mavlink_info_forward(const battgen_mavlink_BATTERY_INFO *s_info,
                                      battgen_concepts *t, battgen_loss_report *rep,
                                      battgen_loss_report *rep_d, battgen_loss_report *rep_u) {
@@ -3907,6 +4552,15 @@ void battgen_convert_dronecan_to_uorb_px4(
   map_px4_uavcan_bridge_forward(info, aux, dt_s, discharged_mah_before, out_status, rep, rep, rep);
 }
 
+void battgen_convert_dronecan_to_mavlink_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_mavlink_BATTERY_STATUS *out_msg, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_dronecan_forward(info, aux, &c1, rep, rep, NULL);
+  map_mavlink_backward(&c1, out_msg, rep, rep, rep);
+}
+
 void battgen_convert_dronecan_to_mavlink_px4(
     const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
     const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux, const float *dt_s,
@@ -3937,6 +4591,17 @@ void battgen_convert_ardupilot_battery_to_uorb_strict(
   map_uorb_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_ardupilot_battery_to_mavlink_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_mavlink_BATTERY_STATUS *out_msg, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_ardupilot_battery_forward(continuous, periodic, cells, tag, &c1, rep, rep, NULL);
+  map_mavlink_backward(&c1, out_msg, rep, rep, rep);
+}
+
 void battgen_convert_ardupilot_battery_to_mavlink_v2_strict(
     const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
     const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
@@ -3956,6 +4621,14 @@ void battgen_convert_cbat_to_uorb_strict(const battgen_dronecan_cuav_equipment_p
   map_uorb_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_cbat_to_mavlink_strict(const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+                                            battgen_mavlink_BATTERY_STATUS *out_msg,
+                                            battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_cbat_forward(cbat, &c1, rep, rep, NULL);
+  map_mavlink_backward(&c1, out_msg, rep, rep, rep);
+}
+
 void battgen_convert_cbat_to_mavlink_v2_strict(
     const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
     battgen_mavlink_BATTERY_STATUS_V2 *out_status, battgen_loss_report *rep) {
@@ -3969,6 +4642,14 @@ void battgen_convert_uorb_to_dronecan_px4(
     battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
     battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
   map_px4_uavcannode_forward(status, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_uorb_to_mavlink_strict(const battgen_uorb_BatteryStatus *status,
+                                            battgen_mavlink_BATTERY_STATUS *out_msg,
+                                            battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_forward(status, &c1, rep, rep, NULL);
+  map_mavlink_backward(&c1, out_msg, rep, rep, rep);
 }
 
 void battgen_convert_uorb_to_mavlink_px4(const battgen_uorb_BatteryStatus *status,
@@ -3993,6 +4674,14 @@ void battgen_convert_uorb_info_to_uorb_strict(const battgen_uorb_BatteryInfo *in
   map_uorb_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_uorb_info_to_mavlink_strict(const battgen_uorb_BatteryInfo *info,
+                                                 battgen_mavlink_BATTERY_STATUS *out_msg,
+                                                 battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_info_forward(info, &c1, rep, rep, NULL);
+  map_mavlink_backward(&c1, out_msg, rep, rep, rep);
+}
+
 void battgen_convert_uorb_info_to_mavlink_v2_strict(const battgen_uorb_BatteryInfo *info,
                                                     battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                     battgen_loss_report *rep) {
@@ -4010,10 +4699,26 @@ void battgen_convert_mavlink_to_dronecan_px4(
   map_px4_uavcannode_forward(&c1_0, out_info, out_aux, rep, NULL, rep);
 }
 
+void battgen_convert_mavlink_to_uorb_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                            battgen_uorb_BatteryStatus *out_status,
+                                            battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_forward(msg, &c1, rep, rep, NULL);
+  map_uorb_backward(&c1, out_status, rep, rep, rep);
+}
+
 void battgen_convert_mavlink_to_uorb_px4(const battgen_mavlink_BATTERY_STATUS *msg,
                                          battgen_uorb_BatteryStatus *out_status,
                                          battgen_loss_report *rep) {
   map_px4_mavlink_receiver_forward(msg, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_to_mavlink_v2_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                                  battgen_mavlink_BATTERY_STATUS_V2 *out_status,
+                                                  battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_forward(msg, &c1, rep, rep, NULL);
+  map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_info_to_uorb_strict(const battgen_mavlink_BATTERY_INFO *info,
@@ -4022,6 +4727,14 @@ void battgen_convert_mavlink_info_to_uorb_strict(const battgen_mavlink_BATTERY_I
   battgen_concepts c1;
   map_mavlink_info_forward(info, &c1, rep, rep, NULL);
   map_uorb_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_info_to_mavlink_strict(const battgen_mavlink_BATTERY_INFO *info,
+                                                    battgen_mavlink_BATTERY_STATUS *out_msg,
+                                                    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_info_forward(info, &c1, rep, rep, NULL);
+  map_mavlink_backward(&c1, out_msg, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_info_to_mavlink_v2_strict(
@@ -4040,12 +4753,28 @@ void battgen_convert_mavlink_v2_to_uorb_strict(const battgen_mavlink_BATTERY_STA
   map_uorb_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_mavlink_v2_to_mavlink_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
+                                                  battgen_mavlink_BATTERY_STATUS *out_msg,
+                                                  battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_v2_forward(status, &c1, rep, rep, NULL);
+  map_mavlink_backward(&c1, out_msg, rep, rep, rep);
+}
+
 void battgen_convert_mavlink_sys_status_to_uorb_strict(const battgen_mavlink_SYS_STATUS *status,
                                                        battgen_uorb_BatteryStatus *out_status,
                                                        battgen_loss_report *rep) {
   battgen_concepts c1;
   map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
   map_uorb_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_sys_status_to_mavlink_strict(const battgen_mavlink_SYS_STATUS *status,
+                                                          battgen_mavlink_BATTERY_STATUS *out_msg,
+                                                          battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
+  map_mavlink_backward(&c1, out_msg, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_sys_status_to_mavlink_v2_strict(

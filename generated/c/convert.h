@@ -44,6 +44,14 @@ void battgen_convert_dronecan_to_uorb_px4(
     const float *discharged_mah_before, battgen_uorb_BatteryStatus *out_status,
     battgen_loss_report *rep);
 
+/* dronecan -> mavlink, policy strict: dronecan -> mavlink.
+ * `aux` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_mavlink_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_mavlink_BATTERY_STATUS *out_msg, battgen_loss_report *rep);
+
 /* dronecan -> mavlink, policy px4: px4_uavcan_bridge -> px4_mavlink_stream.
  * `aux` may be NULL (not received).
  * `dt_s` may be NULL (not given).
@@ -75,6 +83,18 @@ void battgen_convert_ardupilot_battery_to_uorb_strict(
     const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
     battgen_uorb_BatteryStatus *out_status, battgen_loss_report *rep);
 
+/* ardupilot_battery -> mavlink, policy strict: ardupilot_battery -> mavlink.
+ * `periodic` may be NULL (not received).
+ * `cells` may be NULL (not received).
+ * `tag` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_ardupilot_battery_to_mavlink_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_mavlink_BATTERY_STATUS *out_msg, battgen_loss_report *rep);
+
 /* ardupilot_battery -> mavlink_v2, policy strict: ardupilot_battery -> mavlink_v2.
  * `periodic` may be NULL (not received).
  * `cells` may be NULL (not received).
@@ -93,6 +113,12 @@ void battgen_convert_cbat_to_uorb_strict(const battgen_dronecan_cuav_equipment_p
                                          battgen_uorb_BatteryStatus *out_status,
                                          battgen_loss_report *rep);
 
+/* cbat -> mavlink, policy strict: cbat -> mavlink.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_cbat_to_mavlink_strict(const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+                                            battgen_mavlink_BATTERY_STATUS *out_msg,
+                                            battgen_loss_report *rep);
+
 /* cbat -> mavlink_v2, policy strict: cbat -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_cbat_to_mavlink_v2_strict(
@@ -105,6 +131,12 @@ void battgen_convert_uorb_to_dronecan_px4(
     const battgen_uorb_BatteryStatus *status,
     battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
     battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* uorb -> mavlink, policy strict: uorb -> mavlink.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_mavlink_strict(const battgen_uorb_BatteryStatus *status,
+                                            battgen_mavlink_BATTERY_STATUS *out_msg,
+                                            battgen_loss_report *rep);
 
 /* uorb -> mavlink, policy px4: px4_mavlink_stream.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -124,6 +156,12 @@ void battgen_convert_uorb_info_to_uorb_strict(const battgen_uorb_BatteryInfo *in
                                               battgen_uorb_BatteryStatus *out_status,
                                               battgen_loss_report *rep);
 
+/* uorb_info -> mavlink, policy strict: uorb_info -> mavlink.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_info_to_mavlink_strict(const battgen_uorb_BatteryInfo *info,
+                                                 battgen_mavlink_BATTERY_STATUS *out_msg,
+                                                 battgen_loss_report *rep);
+
 /* uorb_info -> mavlink_v2, policy strict: uorb_info -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_uorb_info_to_mavlink_v2_strict(const battgen_uorb_BatteryInfo *info,
@@ -137,17 +175,35 @@ void battgen_convert_mavlink_to_dronecan_px4(
     battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
     battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
 
+/* mavlink -> uorb, policy strict: mavlink -> uorb.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_uorb_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                            battgen_uorb_BatteryStatus *out_status,
+                                            battgen_loss_report *rep);
+
 /* mavlink -> uorb, policy px4: px4_mavlink_receiver.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_to_uorb_px4(const battgen_mavlink_BATTERY_STATUS *msg,
                                          battgen_uorb_BatteryStatus *out_status,
                                          battgen_loss_report *rep);
 
+/* mavlink -> mavlink_v2, policy strict: mavlink -> mavlink_v2.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_mavlink_v2_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                                  battgen_mavlink_BATTERY_STATUS_V2 *out_status,
+                                                  battgen_loss_report *rep);
+
 /* mavlink_info -> uorb, policy strict: mavlink_info -> uorb.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_info_to_uorb_strict(const battgen_mavlink_BATTERY_INFO *info,
                                                  battgen_uorb_BatteryStatus *out_status,
                                                  battgen_loss_report *rep);
+
+/* mavlink_info -> mavlink, policy strict: mavlink_info -> mavlink.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_info_to_mavlink_strict(const battgen_mavlink_BATTERY_INFO *info,
+                                                    battgen_mavlink_BATTERY_STATUS *out_msg,
+                                                    battgen_loss_report *rep);
 
 /* mavlink_info -> mavlink_v2, policy strict: mavlink_info -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -161,11 +217,23 @@ void battgen_convert_mavlink_v2_to_uorb_strict(const battgen_mavlink_BATTERY_STA
                                                battgen_uorb_BatteryStatus *out_status,
                                                battgen_loss_report *rep);
 
+/* mavlink_v2 -> mavlink, policy strict: mavlink_v2 -> mavlink.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_v2_to_mavlink_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
+                                                  battgen_mavlink_BATTERY_STATUS *out_msg,
+                                                  battgen_loss_report *rep);
+
 /* mavlink_sys_status -> uorb, policy strict: mavlink_sys_status -> uorb.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_sys_status_to_uorb_strict(const battgen_mavlink_SYS_STATUS *status,
                                                        battgen_uorb_BatteryStatus *out_status,
                                                        battgen_loss_report *rep);
+
+/* mavlink_sys_status -> mavlink, policy strict: mavlink_sys_status -> mavlink.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_sys_status_to_mavlink_strict(const battgen_mavlink_SYS_STATUS *status,
+                                                          battgen_mavlink_BATTERY_STATUS *out_msg,
+                                                          battgen_loss_report *rep);
 
 /* mavlink_sys_status -> mavlink_v2, policy strict: mavlink_sys_status -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */

@@ -508,3 +508,84 @@ class ConceptOps(CBase):
                 "}",
             )
         self.emit("}")
+
+    def visit_mavlink_voltages(self, rule: Rule, op: o.MavlinkVoltages) -> None:
+        """BATTERY_STATUS voltages (+ voltages_ext) <-> pack voltage and cells, as the run-time
+        ``mavlink_cells_in`` / ``mavlink_cells_out`` do."""
+        main_ref, ext_ref = rule.sources
+        pack, cells = rule.targets
+        main_f, ext_f = self.fld(main_ref), self.fld(ext_ref)
+        n_main = main_f.type.capacity if isinstance(main_f.type, ArrayType) else None
+        n_ext = ext_f.type.capacity if isinstance(ext_f.type, ArrayType) else None
+        if not n_main or not n_ext:
+            raise Unsupported("MAVLink voltages of unknown size")
+        mm = int(main_f.invalid.value) if main_f.invalid is not None else 0xFFFF
+        em = int(ext_f.invalid.value) if ext_f.invalid is not None else 0
+        v_unit = self.concept(pack).unit
+        pn, cn = ident(pack.field), ident(cells.field)
+        if not self.backward:
+            mul, add = _factor(main_f.unit, v_unit)
+            main, ext = self.s(main_ref), self.s(ext_ref)
+            self.written |= {(CONCEPTS_ENDPOINT, pack.field), (CONCEPTS_ENDPOINT, cells.field)}
+            self.emit(
+                f"int64_t got[{n_main + n_ext}], sum = 0;",
+                "size_t n = 0, k;",
+                f"while (n < {n_main}u && {main}[n] != {mm}u) {{ got[n] = (int64_t){main}[n]; n++; }}",
+                f"if (n == {n_main}u) {{",
+                f"for (k = 0; k < {n_ext}u && {ext}[k] != {em}u; k++) {{ got[n++] = (int64_t){ext}[k]; }}",
+                "}",
+                "for (k = 0; k < n; k++) { sum += got[k]; }",
+                "if (n > 0u) {",
+                f"t->has_{pn} = true;",
+                f"t->{pn} = {_affine('(double)sum', mul, add)};",
+                f"if (n > 1u && got[0] != {mm - 1}) {{",
+                f"t->has_{cn} = true;",
+                f"t->{cn}_len = (uint16_t)n;",
+                f"for (k = 0; k < n; k++) {{ t->{cn}[k] = {_affine('(double)got[k]', mul, add)}; }}",
+                "}",
+                "}",
+            )
+            return
+        mul, add = _factor(v_unit, main_f.unit)
+        top = mm - 1
+        main, ext = self.t(main_ref), self.t(ext_ref)
+        lm, le = self.label(main_ref), self.label(ext_ref)
+        self.read |= {(CONCEPTS_ENDPOINT, pack.field), (CONCEPTS_ENDPOINT, cells.field)}
+        c_main, c_ext = scalar(self.prim(main_ref)), scalar(self.prim(ext_ref))
+        self.emit(
+            "size_t i, n = 0;",
+            "bool any = false;",
+            f"for (i = 0; i < {n_main}u; i++) {{ {main}[i] = {mm}u; }}",
+            f"for (i = 0; i < {n_ext}u; i++) {{ {ext}[i] = {em}u; }}",
+            f"if (s->has_{cn}) {{",
+            f"n = (size_t)s->{cn}_len;",
+            f"for (i = 0; i < n; i++) {{ if (!battgen_f64_is_nan(s->{cn}[i])) {{ any = true; }} }}",
+            "}",
+            "if (n > 0u && any) {",
+            f"if (n > {n_main + n_ext}u) {{ battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, {le}); n = {n_main + n_ext}u; }}",
+            "for (i = 0; i < n; i++) {",
+            f"double c = {_affine(f's->{cn}[i]', mul, add)};",
+            f"if (i < {n_main}u) {{",
+            "if (battgen_f64_is_nan(c)) {",
+            f"{main}[i] = {mm}u;",
+            f"battgen_loss_add(rep, BATTGEN_LOSS_UNREPRESENTABLE, {lm});",
+            "} else {",
+            f"{main}[i] = ({c_main})battgen_to_int(c, 0, {top}, rep, {lm});",
+            "}",
+            "} else if (battgen_f64_is_nan(c)) {",
+            f"{ext}[i - {n_main}u] = {em}u;",
+            f"battgen_loss_add(rep, BATTGEN_LOSS_UNREPRESENTABLE, {le});",
+            "} else {",
+            f"int64_t v = battgen_to_int(c, 0, {top}, rep, {le});",
+            f"{ext}[i - {n_main}u] = ({c_ext})(v < {1 if em == 0 else 0} ? {1 if em == 0 else 0} : v);",
+            "}",
+            "}",
+            f"}} else if (s->has_{pn} && !battgen_f64_is_nan(s->{pn})) {{",
+            f"int64_t mv = battgen_to_int({_affine(f's->{pn}', mul, add)}, 0, {top * n_main}, rep, {lm});",
+            "i = 0;",
+            f"while (mv > {top} && i < {n_main - 1}u) {{ {main}[i] = {top}u; mv -= {top}; i++; }}",
+            f"{main}[i] = ({c_main})mv;",
+            "} else {",
+            f"battgen_loss_add(rep, BATTGEN_LOSS_UNKNOWN, {lm});",
+            "}",
+        )
