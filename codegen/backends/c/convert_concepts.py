@@ -37,25 +37,25 @@ LIST_MAX = 255  # the elements a list concept holds (DroneCAN's voltage_cell: up
 _MARKED = "a known value written as the unknown marker"
 
 
-def _double(value: float | int) -> str:
+def double_literal(value: float | int) -> str:
     return f64_literal(float(value))
 
 
-def _factor(frm: Unit | None, to: Unit | None) -> tuple[float, float]:
+def unit_factor(frm: Unit | None, to: Unit | None) -> tuple[float, float]:
     return (1.0, 0.0) if frm is None or to is None else frm.factor_to(to)
 
 
-def _affine(expr: str, mul: float, add: float) -> str:
+def affine(expr: str, mul: float, add: float) -> str:
     """Python's ``affine``: ``expr * mul + add``, each step in double as Python computes it."""
     out = expr
     if mul != 1.0:
-        out = f"{out} * {_double(mul)}"
+        out = f"{out} * {double_literal(mul)}"
     if add != 0.0:
-        out = f"{out} + {_double(add)}"
+        out = f"{out} + {double_literal(add)}"
     return out
 
 
-def _nan(value: object) -> bool:
+def is_nan_value(value: object) -> bool:
     return isinstance(value, float) and math.isnan(value)
 
 
@@ -111,7 +111,7 @@ class ConceptOps(CBase):
     def markers(self, f: Field, unknown: tuple[Number, ...]) -> list[float | int]:
         out: list[float | int] = []
         for m in ([f.invalid.value] if f.invalid is not None else []) + list(unknown):
-            if not any((_nan(m) and _nan(x)) or m == x for x in out):
+            if not any((is_nan_value(m) and is_nan_value(x)) or m == x for x in out):
                 out.append(m)
         return out
 
@@ -126,11 +126,11 @@ class ConceptOps(CBase):
     def known_tests(self, var: str, ctype: str, marks: list[float | int]) -> list[str]:
         out = []
         for m in marks:
-            if _nan(m):
+            if is_nan_value(m):
                 if ctype == "double":
                     out.append(f"!battgen_f64_is_nan({var})")
             else:
-                out.append(f"{var} != {_double(m) if ctype == 'double' else int(m)}")
+                out.append(f"{var} != {double_literal(m) if ctype == 'double' else int(m)}")
         return out
 
     def concept(self, con: FieldRef) -> Concept:
@@ -163,9 +163,9 @@ class ConceptOps(CBase):
         if hi is not None:
             top = min(top, math.floor(hi))
         lo, top = max(lo, type_lo), min(top, type_hi)
-        while lo < top and any(lo == m for m in marks if not _nan(m)):
+        while lo < top and any(lo == m for m in marks if not is_nan_value(m)):
             lo += 1
-        while top > lo and any(top == m for m in marks if not _nan(m)):
+        while top > lo and any(top == m for m in marks if not is_nan_value(m)):
             top -= 1
         return (lo, top) if lo <= top else (type_lo, type_hi)
 
@@ -200,7 +200,7 @@ class ConceptOps(CBase):
         elif kind == "bool":
             text = "true" if value else "false"
         elif kind == "number" and isinstance(value, int | float):
-            text = _double(value)
+            text = double_literal(value)
         elif kind == "integer" and isinstance(value, int):
             text = f"{value}LL"
         else:
@@ -217,21 +217,21 @@ class ConceptOps(CBase):
         f_unit = f.unit or (units.lookup(op.unit) if op.unit is not None else c_unit)
         negated = op.negate
         if not self.backward:
-            mul, add = _factor(f_unit, c_unit)
+            mul, add = unit_factor(f_unit, c_unit)
             if negated:
                 mul, add = -mul, -add
             ctype, value = self.read_value(fmt)
             self.emit(f"{ctype} v = {value};")
             tests = self.known_tests("v", ctype, marks)
             if op.valid_above is not None:
-                tests.append(f"v > {_double(op.valid_above) if ctype == 'double' else op.valid_above}")
+                tests.append(f"v > {double_literal(op.valid_above) if ctype == 'double' else op.valid_above}")
             if op.valid_max is not None:
-                tests.append(f"v <= {_double(op.valid_max) if ctype == 'double' else op.valid_max}")
-            out = _affine("(double)v", mul, add) + (" + 0.0" if negated and add == 0.0 else "")
+                tests.append(f"v <= {double_literal(op.valid_max) if ctype == 'double' else op.valid_max}")
+            out = affine("(double)v", mul, add) + (" + 0.0" if negated and add == 0.0 else "")
             body = self.set_concept(con, out)
             self.emit(*([f"if ({' && '.join(tests)}) {{", *body, "}"] if tests else body))
             return
-        mul, add = _factor(c_unit, f_unit)
+        mul, add = unit_factor(c_unit, f_unit)
         if negated:
             mul = -mul
         target, label = self.t(fmt), self.label(fmt)
@@ -240,9 +240,9 @@ class ConceptOps(CBase):
         if marks:
             self.emit(f"{target} = {literal(self.prim(fmt), marks[0])};")
         self.emit(f"battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, {label});", "} else {")
-        value = _affine(f"s->{name}", mul, add) + (" + 0.0" if negated and add == 0.0 else "")
+        value = affine(f"s->{name}", mul, add) + (" + 0.0" if negated and add == 0.0 else "")
         self.emit(f"{target} = {self.store(fmt, value, op.valid_max, op.unknown)};")
-        for m in (m for m in marks if not _nan(m)):
+        for m in (m for m in marks if not is_nan_value(m)):
             self.emit(self.marked(target, fmt, m, label))
         self.emit("}")
 
@@ -271,7 +271,7 @@ class ConceptOps(CBase):
                     raise Unsupported("a float copied into an integer concept")
                 value = f"v + {int(add)}" if add else "v"
             else:
-                value = f"(double)v + {_double(add)}" if add else "(double)v"
+                value = f"(double)v + {double_literal(add)}" if add else "(double)v"
             tests = self.known_tests("v", ctype, marks)
             body = self.set_concept(con, value)
             self.emit(*([f"if ({' && '.join(tests)}) {{", *body, "}"] if tests else body))
@@ -283,12 +283,12 @@ class ConceptOps(CBase):
         if marks:
             self.emit(f"{target} = {literal(self.prim(fmt), marks[0])};")
         self.emit(f"battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, {label});", "} else {")
-        value = f"(double)s->{name}" + (f" - {_double(add)}" if add else "")
+        value = f"(double)s->{name}" + (f" - {double_literal(add)}" if add else "")
         if kind == "bool":
             value = f"(s->{name} ? 1.0 : 0.0)"
         self.emit(f"{target} = {self.store(fmt, value, None, op.unknown)};")
         if kind != "bool":
-            for m in (m for m in marks if not _nan(m)):
+            for m in (m for m in marks if not is_nan_value(m)):
                 self.emit(self.marked(target, fmt, m, label))
         self.emit("}")
 
@@ -309,16 +309,16 @@ class ConceptOps(CBase):
             return
         percent = rule.sources[2]
         f = self.fld(percent)
-        mul, add = _factor(f.unit, self.concept(con).unit)
+        mul, add = unit_factor(f.unit, self.concept(con).unit)
         ctype, read = self.read_value(percent)
         tests = self.known_tests("p", ctype, self.markers(f, op.unknown))
         if op.valid_max is not None:
-            tests.append(f"p <= {_double(op.valid_max) if ctype == 'double' else op.valid_max}")
+            tests.append(f"p <= {double_literal(op.valid_max) if ctype == 'double' else op.valid_max}")
         self.emit(
             "} else {",
             f"{ctype} p = {read};",
             f"if ({' && '.join(tests) or '1'}) {{",
-            *self.set_concept(con, _affine("(double)p", mul, add)),
+            *self.set_concept(con, affine("(double)p", mul, add)),
             "}",
             "}",
         )
@@ -418,177 +418,5 @@ class ConceptOps(CBase):
         self.emit(
             f"battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, {label});",
             f'if (s->has_{name}) {{ battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.{con.field}"); }}',
-            "}",
-        )
-
-    def visit_cells(self, rule: Rule, op: o.Cells) -> None:
-        fmt, con = self.format_and_concept(rule)
-        f = self.fld(fmt)
-        t = f.type
-        if not isinstance(t, ArrayType) or not isinstance(t.element, PrimitiveType):
-            raise Unsupported("cells of a non-array")
-        cap = t.capacity or 0
-        mark = f.invalid.value if f.invalid is not None and f.invalid.per_element else None
-        c_unit = self.concept(con).unit
-        f_unit = f.unit or c_unit
-        count_ref = FieldRef(fmt.message, op.count_field) if op.count_field else None
-        name = ident(con.field)
-        el = t.element
-
-        def is_mark(x: str) -> str:
-            assert mark is not None
-            if _nan(mark):
-                return f"battgen_f64_is_nan((double){x})" if el.kind is PrimitiveKind.FLOAT else "false"
-            return f"{x} == {literal(el, mark)}"
-
-        if not self.backward:
-            mul, add = _factor(f_unit, c_unit)
-            src = self.s(fmt)
-            n = f"{src}_len" if t.dynamic else f"{cap}u"
-            self.emit("size_t i, n;", f"n = (size_t){n};")
-            if f.invalid is not None and f.invalid.first_decides:
-                first = f.invalid.value
-                test = f"battgen_f64_is_nan((double){src}[0])" if _nan(first) else f"{src}[0] == {literal(el, first)}"
-                self.emit(f"if (n > 0u && {test}) {{ n = 0u; }}")
-            leading = (
-                ["for (i = 0; i < n; i++) {", f"if ({is_mark(src + '[i]')}) {{ break; }}", "}", "n = i;"]
-                if mark is not None
-                else []
-            )
-            if count_ref is not None:
-                count = self.s(count_ref)
-                self.emit(
-                    f"if ({count} != 0) {{",
-                    f"if ((size_t){count} < n) {{ n = (size_t){count}; }}",
-                    "} else {",
-                    *leading,
-                    "}",
-                )
-            else:
-                self.emit(*leading)
-            value = _affine(f"(double){src}[i]", mul, add)
-            if mark is not None:
-                value = f"{is_mark(src + '[i]')} ? {_double(math.nan)} : {value}"
-            self.emit(
-                f"if (n > {LIST_MAX}u) {{ n = {LIST_MAX}u; }}",
-                f"t->has_{name} = n > 0u;",
-                f"t->{name}_len = (uint16_t)n;",
-                f"for (i = 0; i < n; i++) {{ t->{name}[i] = {value}; }}",
-            )
-            self.written.add((CONCEPTS_ENDPOINT, con.field))
-            return
-        mul, add = _factor(c_unit, f_unit)
-        target, label = self.t(fmt), self.label(fmt)
-        if t.dynamic:
-            raise Unsupported("cells into a dynamic array")
-        self.emit(
-            "size_t i, n;",
-            f"if (!s->has_{name}) {{",
-            f"battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, {label});",
-            "} else {",
-            f"n = (size_t)s->{name}_len;",
-            f"if (n > {cap}u) {{ battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, {label}); n = {cap}u; }}",
-            "for (i = 0; i < n; i++) {",
-            f"double x = s->{name}[i];",
-        )
-        stored = self.store(fmt, _affine("x", mul, add))
-        stored = stored.replace(f"{self.label(fmt)})", f"{label})")
-        if mark is not None:
-            self.emit(f"{target}[i] = battgen_f64_is_nan(x) ? {literal(el, mark)} : {stored};")
-        else:
-            self.emit(f"{target}[i] = {stored};")
-        fill = literal(el, mark) if mark is not None else literal(el, 0)
-        self.emit("}", f"for (i = n; i < {cap}u; i++) {{ {target}[i] = {fill}; }}")
-        if count_ref is not None:
-            count = self.t(count_ref)
-            self.emit(
-                f"if ({count} == 0) {{",
-                f"{count} = ({scalar(self.prim(count_ref))})n;",
-                f"battgen_loss_discard(rep_u, BATTGEN_LOSS_UNKNOWN, {self.label(count_ref)});",
-                "}",
-            )
-        self.emit("}")
-
-    def visit_mavlink_voltages(self, rule: Rule, op: o.MavlinkVoltages) -> None:
-        """BATTERY_STATUS voltages (+ voltages_ext) <-> pack voltage and cells, as the run-time
-        ``mavlink_cells_in`` / ``mavlink_cells_out`` do."""
-        main_ref, ext_ref = rule.sources
-        pack, cells = rule.targets
-        main_f, ext_f = self.fld(main_ref), self.fld(ext_ref)
-        n_main = main_f.type.capacity if isinstance(main_f.type, ArrayType) else None
-        n_ext = ext_f.type.capacity if isinstance(ext_f.type, ArrayType) else None
-        if not n_main or not n_ext:
-            raise Unsupported("MAVLink voltages of unknown size")
-        mm = int(main_f.invalid.value) if main_f.invalid is not None else 0xFFFF
-        em = int(ext_f.invalid.value) if ext_f.invalid is not None else 0
-        v_unit = self.concept(pack).unit
-        pn, cn = ident(pack.field), ident(cells.field)
-        if not self.backward:
-            mul, add = _factor(main_f.unit, v_unit)
-            main, ext = self.s(main_ref), self.s(ext_ref)
-            self.written |= {(CONCEPTS_ENDPOINT, pack.field), (CONCEPTS_ENDPOINT, cells.field)}
-            self.emit(
-                f"int64_t got[{n_main + n_ext}], sum = 0;",
-                "size_t n = 0, k;",
-                f"while (n < {n_main}u && {main}[n] != {mm}u) {{ got[n] = (int64_t){main}[n]; n++; }}",
-                f"if (n == {n_main}u) {{",
-                f"for (k = 0; k < {n_ext}u && {ext}[k] != {em}u; k++) {{ got[n++] = (int64_t){ext}[k]; }}",
-                "}",
-                "for (k = 0; k < n; k++) { sum += got[k]; }",
-                "if (n > 0u) {",
-                f"t->has_{pn} = true;",
-                f"t->{pn} = {_affine('(double)sum', mul, add)};",
-                f"if (n > 1u && got[0] != {mm - 1}) {{",
-                f"t->has_{cn} = true;",
-                f"t->{cn}_len = (uint16_t)n;",
-                f"for (k = 0; k < n; k++) {{ t->{cn}[k] = {_affine('(double)got[k]', mul, add)}; }}",
-                "}",
-                "}",
-            )
-            return
-        mul, add = _factor(v_unit, main_f.unit)
-        top = mm - 1
-        main, ext = self.t(main_ref), self.t(ext_ref)
-        lm, le = self.label(main_ref), self.label(ext_ref)
-        self.read |= {(CONCEPTS_ENDPOINT, pack.field), (CONCEPTS_ENDPOINT, cells.field)}
-        c_main, c_ext = scalar(self.prim(main_ref)), scalar(self.prim(ext_ref))
-        self.emit(
-            "size_t i, n = 0;",
-            "bool any = false;",
-            f"for (i = 0; i < {n_main}u; i++) {{ {main}[i] = {mm}u; }}",
-            f"for (i = 0; i < {n_ext}u; i++) {{ {ext}[i] = {em}u; }}",
-            f"if (s->has_{cn}) {{",
-            f"n = (size_t)s->{cn}_len;",
-            f"for (i = 0; i < n; i++) {{ if (!battgen_f64_is_nan(s->{cn}[i])) {{ any = true; }} }}",
-            "}",
-            "if (n > 0u && any) {",
-            f"if (n > {n_main + n_ext}u) {{",
-            f"battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, {le});",
-            f"n = {n_main + n_ext}u;",
-            "}",
-            "for (i = 0; i < n; i++) {",
-            f"double c = {_affine(f's->{cn}[i]', mul, add)};",
-            f"if (i < {n_main}u) {{",
-            "if (battgen_f64_is_nan(c)) {",
-            f"{main}[i] = {mm}u;",
-            f"battgen_loss_add(rep, BATTGEN_LOSS_UNREPRESENTABLE, {lm});",
-            "} else {",
-            f"{main}[i] = ({c_main})battgen_to_int(c, 0, {top}, rep, {lm});",
-            "}",
-            "} else if (battgen_f64_is_nan(c)) {",
-            f"{ext}[i - {n_main}u] = {em}u;",
-            f"battgen_loss_add(rep, BATTGEN_LOSS_UNREPRESENTABLE, {le});",
-            "} else {",
-            f"int64_t v = battgen_to_int(c, 0, {top}, rep, {le});",
-            f"{ext}[i - {n_main}u] = ({c_ext})(v < {1 if em == 0 else 0} ? {1 if em == 0 else 0} : v);",
-            "}",
-            "}",
-            f"}} else if (s->has_{pn} && !battgen_f64_is_nan(s->{pn})) {{",
-            f"int64_t mv = battgen_to_int({_affine(f's->{pn}', mul, add)}, 0, {top * n_main}, rep, {lm});",
-            "i = 0;",
-            f"while (mv > {top} && i < {n_main - 1}u) {{ {main}[i] = {top}u; mv -= {top}; i++; }}",
-            f"{main}[i] = ({c_main})mv;",
-            "} else {",
-            f"battgen_loss_add(rep, BATTGEN_LOSS_UNKNOWN, {lm});",
             "}",
         )

@@ -30,7 +30,8 @@ from ...ir import (
 from ...ir.mapping_visitor import visit
 from ..python.converters.mapping_module import Edge
 from ..python.converters.routes import POLICIES, route
-from .convert_concepts import STATE, ConceptOps
+from .convert_concept_cells import ConceptCellOps
+from .convert_concepts import STATE
 from .convert_px4 import PX4Ops
 from .convert_px4_cells import PX4CellOps
 from .convert_values import Unsupported, c_type, defaults, differs, literal, primitive
@@ -96,7 +97,7 @@ class CConverter:
         return out
 
 
-class _Builder(PX4Ops, PX4CellOps, ConceptOps):
+class _Builder(PX4Ops, PX4CellOps, ConceptCellOps):
     """One direction of one mapping as C (see the module docstring)."""
 
     def _unsupported(self, rule: Rule, op: object) -> None:
