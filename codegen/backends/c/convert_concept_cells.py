@@ -8,7 +8,7 @@ import math
 
 from ...ir import CONCEPTS_ENDPOINT, ArrayType, FieldRef, PrimitiveKind, PrimitiveType, Rule
 from ...ir import ops as o
-from .convert_concepts import LIST_MAX, ConceptOps, affine, double_literal, unit_factor, is_nan_value
+from .convert_concepts import LIST_MAX, ConceptOps, affine, double_literal, is_nan_value, unit_factor
 from .convert_values import Unsupported, literal
 from .types import ident, scalar
 
