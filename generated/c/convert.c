@@ -95,12 +95,18 @@ typedef struct {
   bool has_serial_number;
   int64_t serial_number;
   bool has_model_name;
+  uint16_t model_name_len;
+  uint8_t model_name[768]; /* UTF-8 */
   bool has_is_powering_off;
   bool is_powering_off;
   bool has_remaining_capacity;
   double remaining_capacity; /* [C] */
   bool has_serial_number_text;
+  uint16_t serial_number_text_len;
+  uint8_t serial_number_text[768]; /* UTF-8 */
   bool has_manufacture_date;
+  uint16_t manufacture_date_len;
+  uint8_t manufacture_date[768]; /* UTF-8 */
   bool has_weight;
   double weight; /* [kg] */
   bool has_cell_discharge_min_voltage;
@@ -214,6 +220,13 @@ static void defaults_battgen_dronecan_uavcan_equipment_power_BatteryInfo(
   (*m).state_of_charge_pct = (uint8_t)127u;
 }
 
+static void defaults_battgen_mavlink_BATTERY_INFO(battgen_mavlink_BATTERY_INFO *m) {
+  battgen_zero(m, sizeof *m);
+  (*m).state_of_health = (uint8_t)255u;
+  (*m).cycle_count = (uint16_t)65535u;
+  (*m).full_charge_capacity = battgen_f32_from(0x7FC00000u);
+}
+
 static void defaults_battgen_mavlink_BATTERY_STATUS(battgen_mavlink_BATTERY_STATUS *m) {
   battgen_zero(m, sizeof *m);
   (*m).temperature = (int16_t)32767;
@@ -270,6 +283,413 @@ static void defaults_battgen_uorb_BatteryStatus(battgen_uorb_BatteryStatus *m) {
 static uint16_t saturate_uint16_11(uint16_t v) { return v > 2047u ? 2047u : v; }
 
 static uint8_t saturate_uint8_7(uint8_t v) { return v > 127u ? 127u : v; }
+
+static void map_ardupilot_battery_backward(
+    const battgen_concepts *s,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *t_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *t_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *t_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *t_tag, battgen_loss_report *rep,
+    battgen_loss_report *rep_d, battgen_loss_report *rep_u) {
+  (void)s;
+  (void)t_continuous;
+  (void)t_periodic;
+  (void)t_cells;
+  (void)t_tag;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_dronecan_ardupilot_equipment_power_BatteryContinuous(t_continuous);
+  defaults_battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic(t_periodic);
+  defaults_battgen_dronecan_ardupilot_equipment_power_BatteryCells(t_cells);
+  defaults_battgen_dronecan_ardupilot_equipment_power_BatteryTag(t_tag);
+  /* ardupilot_battery.yaml:15: scale */
+  {
+    if (!s->has_pack_voltage || battgen_f64_is_nan(s->pack_voltage)) {
+      t_continuous->voltage = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryContinuous.voltage");
+    } else {
+      t_continuous->voltage = (float)(s->pack_voltage);
+    }
+  }
+  /* ardupilot_battery.yaml:16: scale */
+  {
+    if (!s->has_current || battgen_f64_is_nan(s->current)) {
+      t_continuous->current = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryContinuous.current");
+    } else {
+      t_continuous->current = (float)(s->current);
+    }
+  }
+  /* ardupilot_battery.yaml:17: scale */
+  {
+    if (!s->has_temperature || battgen_f64_is_nan(s->temperature)) {
+      t_continuous->temperature_cells = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryContinuous.temperature_cells");
+    } else {
+      t_continuous->temperature_cells = battgen_f16_round_d(
+          s->temperature + -273.15, rep,
+          "dronecan.ardupilot.equipment.power.BatteryContinuous.temperature_cells");
+    }
+  }
+  /* ardupilot_battery.yaml:22: scale */
+  {
+    if (!s->has_state_of_charge || battgen_f64_is_nan(s->state_of_charge)) {
+      t_continuous->state_of_charge = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryContinuous.state_of_charge");
+    } else {
+      t_continuous->state_of_charge = battgen_f16_round_d(
+          s->state_of_charge * 100.0, rep,
+          "dronecan.ardupilot.equipment.power.BatteryContinuous.state_of_charge");
+    }
+  }
+  /* ardupilot_battery.yaml:23: scale */
+  {
+    if (!s->has_discharged || battgen_f64_is_nan(s->discharged)) {
+      t_continuous->capacity_consumed = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryContinuous.capacity_consumed");
+    } else {
+      t_continuous->capacity_consumed = (float)(s->discharged * 0.0002777777777777778);
+    }
+  }
+  /* ardupilot_battery.yaml:25: flag */
+  {
+    if (s->has_charging && s->charging) {
+      t_continuous->status_flags |= 2u;
+    }
+  }
+  /* ardupilot_battery.yaml:26: flag_choice */
+  {
+    if (s->has_warning && s->warning == BATTGEN_WARNING_CHARGING) {
+      t_continuous->status_flags |= 2u;
+    }
+  }
+  /* ardupilot_battery.yaml:32: flags */
+  {
+    if (!s->has_faults) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryContinuous.status_flags");
+    } else {
+      uint64_t b = (uint64_t)t_continuous->status_flags;
+      if ((s->faults & BATTGEN_FAULTS_DEEP_DISCHARGE) != 0u) {
+        b |= 1024uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_OVER_CURRENT) != 0u) {
+        b |= 8192uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_OVER_TEMPERATURE) != 0u) {
+        b |= 2048uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_UNDER_TEMPERATURE) != 0u) {
+        b |= 4096uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_INCOMPATIBLE_VOLTAGE) != 0u) {
+        b |= 32768uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_INCOMPATIBLE_FIRMWARE) != 0u) {
+        b |= 65536uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_HARDWARE_FAILURE) != 0u) {
+        b |= 64uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_INCOMPATIBLE_CELLS_CONFIGURATION) != 0u) {
+        b |= 131072uLL;
+      }
+      t_continuous->status_flags = (uint32_t)b;
+      if ((s->faults & (BATTGEN_FAULTS_SPIKES | BATTGEN_FAULTS_CELL_FAIL |
+                        BATTGEN_FAULTS_INCOMPATIBLE_MODEL | BATTGEN_FAULTS_FAILED_TO_ARM)) != 0u) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.faults");
+      }
+    }
+  }
+  /* ardupilot_battery.yaml:45: copy */
+  {
+    if (!s->has_battery_index) {
+      t_continuous->slot_id = (uint8_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryContinuous.slot_id");
+    } else {
+      t_continuous->slot_id =
+          (uint8_t)battgen_to_int((double)s->battery_index - -1.0, 1LL, 255LL, rep,
+                                  "dronecan.ardupilot.equipment.power.BatteryContinuous.slot_id");
+      if (t_continuous->slot_id == (uint8_t)0u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryContinuous.slot_id");
+      }
+    }
+  }
+  /* ardupilot_battery.yaml:46: copy */
+  {
+    if (!s->has_model_name) {
+      t_periodic->name_len = 0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryPeriodic.name");
+    } else {
+      size_t i;
+      size_t n = (size_t)s->model_name_len;
+      if (n > 50u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryPeriodic.name");
+        n = 50u;
+      }
+      for (i = 0; i < n; i++) {
+        t_periodic->name[i] = s->model_name[i];
+      }
+      t_periodic->name_len = (uint16_t)n;
+    }
+  }
+  /* ardupilot_battery.yaml:47: scale */
+  {
+    if (!s->has_design_capacity || battgen_f64_is_nan(s->design_capacity)) {
+      t_periodic->design_capacity = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryPeriodic.design_capacity");
+    } else {
+      t_periodic->design_capacity = (float)(s->design_capacity * 0.0002777777777777778);
+      if (t_periodic->design_capacity == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryPeriodic.design_capacity");
+      }
+    }
+  }
+  /* ardupilot_battery.yaml:48: scale */
+  {
+    if (!s->has_full_capacity || battgen_f64_is_nan(s->full_capacity)) {
+      t_periodic->full_charge_capacity = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryPeriodic.full_charge_capacity");
+    } else {
+      t_periodic->full_charge_capacity = (float)(s->full_capacity * 0.0002777777777777778);
+    }
+  }
+  /* ardupilot_battery.yaml:49: copy */
+  {
+    if (!s->has_cell_count) {
+      t_periodic->cells_in_series = (uint8_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryPeriodic.cells_in_series");
+    } else {
+      t_periodic->cells_in_series = (uint8_t)battgen_to_int(
+          (double)s->cell_count, 1LL, 255LL, rep,
+          "dronecan.ardupilot.equipment.power.BatteryPeriodic.cells_in_series");
+      if (t_periodic->cells_in_series == (uint8_t)0u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryPeriodic.cells_in_series");
+      }
+    }
+  }
+  /* ardupilot_battery.yaml:50: scale */
+  {
+    if (!s->has_nominal_voltage || battgen_f64_is_nan(s->nominal_voltage)) {
+      t_periodic->nominal_voltage = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryPeriodic.nominal_voltage");
+    } else {
+      t_periodic->nominal_voltage =
+          battgen_f16_round_d(s->nominal_voltage, rep,
+                              "dronecan.ardupilot.equipment.power.BatteryPeriodic.nominal_voltage");
+      if (t_periodic->nominal_voltage == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryPeriodic.nominal_voltage");
+      }
+    }
+  }
+  /* ardupilot_battery.yaml:51: copy */
+  {
+    if (!s->has_cycle_count) {
+      t_periodic->cycle_count = (uint16_t)65535u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryPeriodic.cycle_count");
+    } else {
+      t_periodic->cycle_count = (uint16_t)battgen_to_int(
+          (double)s->cycle_count, 0LL, 65534LL, rep,
+          "dronecan.ardupilot.equipment.power.BatteryPeriodic.cycle_count");
+      if (t_periodic->cycle_count == (uint16_t)65535u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryPeriodic.cycle_count");
+      }
+    }
+  }
+  /* ardupilot_battery.yaml:52: scale */
+  {
+    if (!s->has_state_of_health || battgen_f64_is_nan(s->state_of_health)) {
+      t_periodic->state_of_health = (uint8_t)255u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryPeriodic.state_of_health");
+    } else {
+      t_periodic->state_of_health = (uint8_t)battgen_to_int(
+          s->state_of_health * 100.0, 0LL, 100LL, rep,
+          "dronecan.ardupilot.equipment.power.BatteryPeriodic.state_of_health");
+      if (t_periodic->state_of_health == (uint8_t)255u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryPeriodic.state_of_health");
+      }
+    }
+  }
+  /* ardupilot_battery.yaml:53: cells */
+  {
+    size_t i, n;
+    if (!s->has_cell_voltages) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryCells.voltages");
+    } else {
+      n = (size_t)s->cell_voltages_len;
+      if (n > 24u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryCells.voltages");
+        n = 24u;
+      }
+      for (i = 0; i < n; i++) {
+        double x = s->cell_voltages[i];
+        t_cells->voltages[i] =
+            battgen_f16_round_d(x, rep, "dronecan.ardupilot.equipment.power.BatteryCells.voltages");
+      }
+      t_cells->voltages_len = (uint16_t)n;
+    }
+  }
+  /* ardupilot_battery.yaml:57: copy */
+  {
+    if (!s->has_serial_number) {
+      t_tag->serial_number = (uint32_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryTag.serial_number");
+    } else {
+      t_tag->serial_number =
+          (uint32_t)battgen_to_int((double)s->serial_number, 1LL, 4294967295LL, rep,
+                                   "dronecan.ardupilot.equipment.power.BatteryTag.serial_number");
+      if (t_tag->serial_number == (uint32_t)0u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryTag.serial_number");
+      }
+    }
+  }
+  /* what did not survive the conversion */
+  if (s->has_connected) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.connected");
+  }
+  if (s->has_in_use) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.in_use");
+  }
+  if (s->has_average_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_current");
+  }
+  if (s->has_max_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_current");
+  }
+  if (s->has_average_power) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_power");
+  }
+  if (s->has_state_of_charge_stdev) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.state_of_charge_stdev");
+  }
+  if (s->has_remaining_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_energy");
+  }
+  if (s->has_full_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.full_energy");
+  }
+  if (s->has_design_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.design_energy");
+  }
+  if (s->has_consumed_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.consumed_energy");
+  }
+  if (s->has_time_remaining) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.time_remaining");
+  }
+  if (s->has_time_to_full) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.time_to_full");
+  }
+  if (s->has_over_discharge_count) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.over_discharge_count");
+  }
+  if (s->has_voltage_min_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_min_design");
+  }
+  if (s->has_voltage_max_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_max_design");
+  }
+  if (s->has_is_powering_off) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.is_powering_off");
+  }
+  if (s->has_remaining_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_capacity");
+  }
+  if (s->has_serial_number_text) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.serial_number_text");
+  }
+  if (s->has_manufacture_date) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.manufacture_date");
+  }
+  if (s->has_weight) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.weight");
+  }
+  if (s->has_cell_discharge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_discharge_min_voltage");
+  }
+  if (s->has_cell_charge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_min_voltage");
+  }
+  if (s->has_cell_rest_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_rest_min_voltage");
+  }
+  if (s->has_cell_charge_max_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_max_voltage");
+  }
+  if (s->has_max_charge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_charge_current");
+  }
+  if (s->has_max_discharge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_discharge_current");
+  }
+  if (s->has_max_burst_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_burst_current");
+  }
+  if (s->has_battery_function) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.battery_function");
+  }
+  if (s->has_chemistry) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.chemistry");
+  }
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryContinuous.temperature_pcb");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryContinuous.temperature_other");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryPeriodic.serial_number");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryPeriodic.manufacture_date");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryPeriodic.discharge_minimum_voltage");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryPeriodic.charging_minimum_voltage");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryPeriodic.charging_maximum_voltage");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryPeriodic.charging_maximum_current");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryPeriodic.discharge_maximum_current");
+  battgen_loss_add(
+      rep_u, BATTGEN_LOSS_UNKNOWN,
+      "dronecan.ardupilot.equipment.power.BatteryPeriodic.discharge_maximum_burst_current");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryCells.index");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryTag.num_cycles");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryTag.armed_hours");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryTag.battery_capacity_mAh");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryTag.first_use_mins");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryTag.last_arm_time_mins");
+}
 
 static void map_ardupilot_battery_forward(
     const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *s_continuous,
@@ -384,7 +804,13 @@ static void map_ardupilot_battery_forward(
   }
   /* ardupilot_battery.yaml:46: copy */
   if (s_periodic != NULL) {
-    t->has_model_name = s_periodic->name_len > 0u && s_periodic->name[0] != 0;
+    size_t n = 0;
+    while (n < (size_t)s_periodic->name_len && s_periodic->name[n] != 0u) {
+      n++;
+    }
+    n = battgen_utf8_replace((const uint8_t *)s_periodic->name, n, t->model_name);
+    t->model_name_len = (uint16_t)n;
+    t->has_model_name = n > 0u;
   }
   /* ardupilot_battery.yaml:47: scale */
   if (s_periodic != NULL) {
@@ -626,6 +1052,362 @@ static void map_ardupilot_battery_forward(
                        "dronecan.ardupilot.equipment.power.BatteryTag.last_arm_time_mins");
     }
   }
+}
+
+static void map_cbat_backward(const battgen_concepts *s,
+                              battgen_dronecan_cuav_equipment_power_CBAT *t_cbat,
+                              battgen_loss_report *rep, battgen_loss_report *rep_d,
+                              battgen_loss_report *rep_u) {
+  (void)s;
+  (void)t_cbat;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_dronecan_cuav_equipment_power_CBAT(t_cbat);
+  /* cbat.yaml:13: scale */
+  {
+    if (!s->has_pack_voltage || battgen_f64_is_nan(s->pack_voltage)) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "dronecan.cuav.equipment.power.CBAT.voltage");
+    } else {
+      t_cbat->voltage = (float)(s->pack_voltage);
+    }
+  }
+  /* cbat.yaml:14: scale */
+  {
+    if (!s->has_current || battgen_f64_is_nan(s->current)) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "dronecan.cuav.equipment.power.CBAT.current");
+    } else {
+      t_cbat->current = (float)(s->current * -1.0 + 0.0);
+    }
+  }
+  /* cbat.yaml:15: scale */
+  {
+    if (!s->has_average_current || battgen_f64_is_nan(s->average_current)) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.average_current");
+    } else {
+      t_cbat->average_current = (float)(s->average_current * -1.0 + 0.0);
+    }
+  }
+  /* cbat.yaml:16: scale */
+  {
+    if (!s->has_temperature || battgen_f64_is_nan(s->temperature)) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.temperature");
+    } else {
+      t_cbat->temperature = (float)(s->temperature);
+    }
+  }
+  /* cbat.yaml:17: scale */
+  {
+    if (!s->has_state_of_charge || battgen_f64_is_nan(s->state_of_charge)) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.state_of_charge");
+    } else {
+      t_cbat->state_of_charge =
+          (uint8_t)battgen_to_int(s->state_of_charge * 100.0, 0LL, 100LL, rep,
+                                  "dronecan.cuav.equipment.power.CBAT.state_of_charge");
+    }
+  }
+  /* cbat.yaml:18: scale */
+  {
+    if (!s->has_state_of_health || battgen_f64_is_nan(s->state_of_health)) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.state_of_health");
+    } else {
+      t_cbat->state_of_health =
+          (uint8_t)battgen_to_int(s->state_of_health * 100.0, 0LL, 100LL, rep,
+                                  "dronecan.cuav.equipment.power.CBAT.state_of_health");
+    }
+  }
+  /* cbat.yaml:19: scale */
+  {
+    if (!s->has_full_capacity || battgen_f64_is_nan(s->full_capacity)) {
+      t_cbat->full_charge_capacity = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.full_charge_capacity");
+    } else {
+      t_cbat->full_charge_capacity = (float)(s->full_capacity * 0.2777777777777778);
+      if (t_cbat->full_charge_capacity == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.cuav.equipment.power.CBAT.full_charge_capacity");
+      }
+    }
+  }
+  /* cbat.yaml:20: scale */
+  {
+    if (!s->has_design_capacity || battgen_f64_is_nan(s->design_capacity)) {
+      t_cbat->design_capacity = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.design_capacity");
+    } else {
+      t_cbat->design_capacity = (float)(s->design_capacity * 0.2777777777777778);
+      if (t_cbat->design_capacity == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.cuav.equipment.power.CBAT.design_capacity");
+      }
+    }
+  }
+  /* cbat.yaml:21: scale */
+  {
+    if (!s->has_time_remaining || battgen_f64_is_nan(s->time_remaining)) {
+      t_cbat->average_time_to_empty = (uint16_t)65535u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.average_time_to_empty");
+    } else {
+      t_cbat->average_time_to_empty =
+          (uint16_t)battgen_to_int(s->time_remaining * 0.016666666666666666, 0LL, 65534LL, rep,
+                                   "dronecan.cuav.equipment.power.CBAT.average_time_to_empty");
+      if (t_cbat->average_time_to_empty == (uint16_t)65535u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.cuav.equipment.power.CBAT.average_time_to_empty");
+      }
+    }
+  }
+  /* cbat.yaml:22: scale */
+  {
+    if (!s->has_time_to_full || battgen_f64_is_nan(s->time_to_full)) {
+      t_cbat->average_time_to_full = (uint16_t)65535u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.average_time_to_full");
+    } else {
+      t_cbat->average_time_to_full =
+          (uint16_t)battgen_to_int(s->time_to_full * 0.016666666666666666, 0LL, 65534LL, rep,
+                                   "dronecan.cuav.equipment.power.CBAT.average_time_to_full");
+      if (t_cbat->average_time_to_full == (uint16_t)65535u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.cuav.equipment.power.CBAT.average_time_to_full");
+      }
+    }
+  }
+  /* cbat.yaml:23: scale */
+  {
+    if (!s->has_nominal_voltage || battgen_f64_is_nan(s->nominal_voltage)) {
+      t_cbat->nominal_voltage = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.nominal_voltage");
+    } else {
+      t_cbat->nominal_voltage = (float)(s->nominal_voltage);
+      if (t_cbat->nominal_voltage == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.cuav.equipment.power.CBAT.nominal_voltage");
+      }
+    }
+  }
+  /* cbat.yaml:24: cells */
+  {
+    size_t i, n;
+    if (!s->has_cell_voltages) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.voltage_cell");
+    } else {
+      n = (size_t)s->cell_voltages_len;
+      if (n > 15u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.cuav.equipment.power.CBAT.voltage_cell");
+        n = 15u;
+      }
+      for (i = 0; i < n; i++) {
+        double x = s->cell_voltages[i];
+        t_cbat->voltage_cell[i] = (float)(x);
+      }
+      t_cbat->voltage_cell_len = (uint16_t)n;
+      if (t_cbat->cell_count == 0) {
+        t_cbat->cell_count = (uint8_t)n;
+        battgen_loss_discard(rep_u, BATTGEN_LOSS_UNKNOWN,
+                             "dronecan.cuav.equipment.power.CBAT.cell_count");
+      }
+    }
+  }
+  /* cbat.yaml:25: copy */
+  {
+    if (!s->has_cell_count) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.cell_count");
+    } else {
+      t_cbat->cell_count = (uint8_t)battgen_to_int((double)s->cell_count, 0LL, 255LL, rep,
+                                                   "dronecan.cuav.equipment.power.CBAT.cell_count");
+    }
+  }
+  /* cbat.yaml:26: copy */
+  {
+    if (!s->has_cycle_count) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.cycle_count");
+    } else {
+      t_cbat->cycle_count =
+          (uint16_t)battgen_to_int((double)s->cycle_count, 0LL, 65535LL, rep,
+                                   "dronecan.cuav.equipment.power.CBAT.cycle_count");
+    }
+  }
+  /* cbat.yaml:27: copy */
+  {
+    if (!s->has_over_discharge_count) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.over_discharge_count");
+    } else {
+      t_cbat->over_discharge_count =
+          (uint16_t)battgen_to_int((double)s->over_discharge_count, 0LL, 65535LL, rep,
+                                   "dronecan.cuav.equipment.power.CBAT.over_discharge_count");
+    }
+  }
+  /* cbat.yaml:28: copy */
+  {
+    if (!s->has_serial_number) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.serial_number");
+    } else {
+      t_cbat->serial_number =
+          (uint16_t)battgen_to_int((double)s->serial_number, 0LL, 65535LL, rep,
+                                   "dronecan.cuav.equipment.power.CBAT.serial_number");
+    }
+  }
+  /* cbat.yaml:29: copy */
+  {
+    if (!s->has_is_powering_off) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.is_powering_off");
+    } else {
+      t_cbat->is_powering_off = (((s->is_powering_off ? 1.0 : 0.0)) != 0);
+    }
+  }
+  /* cbat.yaml:31: flag */
+  {
+    if (s->has_in_use && s->in_use) {
+      t_cbat->status_flags |= 1u;
+    }
+  }
+  /* cbat.yaml:32: flag */
+  {
+    if (s->has_charging && s->charging) {
+      t_cbat->status_flags |= 2u;
+    }
+  }
+  /* cbat.yaml:33: flag_choice */
+  {
+    if (s->has_warning && s->warning == BATTGEN_WARNING_CHARGING) {
+      t_cbat->status_flags |= 2u;
+    }
+  }
+  /* cbat.yaml:38: flags */
+  {
+    if (!s->has_faults) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.cuav.equipment.power.CBAT.status_flags");
+    } else {
+      uint64_t b = (uint64_t)t_cbat->status_flags;
+      if ((s->faults & BATTGEN_FAULTS_OVER_CURRENT) != 0u) {
+        b |= 32uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_OVER_TEMPERATURE) != 0u) {
+        b |= 8uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_UNDER_TEMPERATURE) != 0u) {
+        b |= 16uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_HARDWARE_FAILURE) != 0u) {
+        b |= 64uLL;
+      }
+      t_cbat->status_flags = (uint16_t)b;
+      if ((s->faults &
+           (BATTGEN_FAULTS_DEEP_DISCHARGE | BATTGEN_FAULTS_SPIKES | BATTGEN_FAULTS_CELL_FAIL |
+            BATTGEN_FAULTS_INCOMPATIBLE_VOLTAGE | BATTGEN_FAULTS_INCOMPATIBLE_FIRMWARE |
+            BATTGEN_FAULTS_INCOMPATIBLE_MODEL | BATTGEN_FAULTS_FAILED_TO_ARM |
+            BATTGEN_FAULTS_INCOMPATIBLE_CELLS_CONFIGURATION)) != 0u) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.faults");
+      }
+    }
+  }
+  /* what did not survive the conversion */
+  if (s->has_connected) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.connected");
+  }
+  if (s->has_max_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_current");
+  }
+  if (s->has_average_power) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_power");
+  }
+  if (s->has_state_of_charge_stdev) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.state_of_charge_stdev");
+  }
+  if (s->has_remaining_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_energy");
+  }
+  if (s->has_full_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.full_energy");
+  }
+  if (s->has_design_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.design_energy");
+  }
+  if (s->has_discharged) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.discharged");
+  }
+  if (s->has_consumed_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.consumed_energy");
+  }
+  if (s->has_voltage_min_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_min_design");
+  }
+  if (s->has_voltage_max_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_max_design");
+  }
+  if (s->has_battery_index) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.battery_index");
+  }
+  if (s->has_model_name) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.model_name");
+  }
+  if (s->has_remaining_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_capacity");
+  }
+  if (s->has_serial_number_text) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.serial_number_text");
+  }
+  if (s->has_manufacture_date) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.manufacture_date");
+  }
+  if (s->has_weight) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.weight");
+  }
+  if (s->has_cell_discharge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_discharge_min_voltage");
+  }
+  if (s->has_cell_charge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_min_voltage");
+  }
+  if (s->has_cell_rest_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_rest_min_voltage");
+  }
+  if (s->has_cell_charge_max_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_max_voltage");
+  }
+  if (s->has_max_charge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_charge_current");
+  }
+  if (s->has_max_discharge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_discharge_current");
+  }
+  if (s->has_max_burst_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_burst_current");
+  }
+  if (s->has_battery_function) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.battery_function");
+  }
+  if (s->has_chemistry) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.chemistry");
+  }
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "dronecan.cuav.equipment.power.CBAT.average_power");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.cuav.equipment.power.CBAT.available_energy");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.cuav.equipment.power.CBAT.remaining_capacity");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "dronecan.cuav.equipment.power.CBAT.max_error");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.cuav.equipment.power.CBAT.manufacture_date");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "dronecan.cuav.equipment.power.CBAT.passed_charge");
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.cuav.equipment.power.CBAT.interface_error");
 }
 
 static void map_cbat_forward(const battgen_dronecan_cuav_equipment_power_CBAT *s_cbat,
@@ -876,6 +1658,403 @@ static void map_cbat_forward(const battgen_dronecan_cuav_equipment_power_CBAT *s
   }
 }
 
+static void map_dronecan_backward(const battgen_concepts *s,
+                                  battgen_dronecan_uavcan_equipment_power_BatteryInfo *t_info,
+                                  battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *t_aux,
+                                  battgen_loss_report *rep, battgen_loss_report *rep_d,
+                                  battgen_loss_report *rep_u) {
+  (void)s;
+  (void)t_info;
+  (void)t_aux;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_dronecan_uavcan_equipment_power_BatteryInfo(t_info);
+  defaults_battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux(t_aux);
+  /* dronecan.yaml:12: scale */
+  {
+    if (!s->has_pack_voltage || battgen_f64_is_nan(s->pack_voltage)) {
+      t_info->voltage = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.voltage");
+    } else {
+      t_info->voltage = battgen_f16_round_d(s->pack_voltage, rep,
+                                            "dronecan.uavcan.equipment.power.BatteryInfo.voltage");
+    }
+  }
+  /* dronecan.yaml:13: scale */
+  {
+    if (!s->has_current || battgen_f64_is_nan(s->current)) {
+      t_info->current = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.current");
+    } else {
+      t_info->current = battgen_f16_round_d(s->current, rep,
+                                            "dronecan.uavcan.equipment.power.BatteryInfo.current");
+    }
+  }
+  /* dronecan.yaml:14: scale */
+  {
+    if (!s->has_temperature || battgen_f64_is_nan(s->temperature)) {
+      t_info->temperature = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.temperature");
+    } else {
+      t_info->temperature = battgen_f16_round_d(
+          s->temperature, rep, "dronecan.uavcan.equipment.power.BatteryInfo.temperature");
+    }
+  }
+  /* dronecan.yaml:20: scale */
+  {
+    if (!s->has_average_power || battgen_f64_is_nan(s->average_power)) {
+      t_info->average_power_10sec = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec");
+    } else {
+      t_info->average_power_10sec = battgen_f16_round_d(
+          s->average_power, rep, "dronecan.uavcan.equipment.power.BatteryInfo.average_power_10sec");
+    }
+  }
+  /* dronecan.yaml:21: scale */
+  {
+    if (!s->has_remaining_energy || battgen_f64_is_nan(s->remaining_energy)) {
+      t_info->remaining_capacity_wh = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh");
+    } else {
+      t_info->remaining_capacity_wh =
+          battgen_f16_round_d(s->remaining_energy * 0.0002777777777777778, rep,
+                              "dronecan.uavcan.equipment.power.BatteryInfo.remaining_capacity_wh");
+    }
+  }
+  /* dronecan.yaml:22: scale */
+  {
+    if (!s->has_full_energy || battgen_f64_is_nan(s->full_energy)) {
+      t_info->full_charge_capacity_wh = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh");
+    } else {
+      t_info->full_charge_capacity_wh = battgen_f16_round_d(
+          s->full_energy * 0.0002777777777777778, rep,
+          "dronecan.uavcan.equipment.power.BatteryInfo.full_charge_capacity_wh");
+    }
+  }
+  /* dronecan.yaml:23: scale */
+  {
+    if (!s->has_time_to_full || battgen_f64_is_nan(s->time_to_full)) {
+      t_info->hours_to_full_charge = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge");
+    } else {
+      t_info->hours_to_full_charge =
+          battgen_f16_round_d(s->time_to_full * 0.0002777777777777778, rep,
+                              "dronecan.uavcan.equipment.power.BatteryInfo.hours_to_full_charge");
+    }
+  }
+  /* dronecan.yaml:24: flag */
+  {
+    if (s->has_in_use && s->in_use) {
+      t_info->status_flags |= 1u;
+    }
+  }
+  /* dronecan.yaml:25: flag */
+  {
+    if (s->has_charging && s->charging) {
+      t_info->status_flags |= 2u;
+    }
+  }
+  /* dronecan.yaml:26: flag_choice */
+  {
+    if (s->has_warning && s->warning == BATTGEN_WARNING_CHARGING) {
+      t_info->status_flags |= 2u;
+    }
+  }
+  /* dronecan.yaml:32: flags */
+  {
+    if (!s->has_faults) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.status_flags");
+    } else {
+      uint64_t b = (uint64_t)t_info->status_flags;
+      if ((s->faults & BATTGEN_FAULTS_OVER_CURRENT) != 0u) {
+        b |= 32uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_OVER_TEMPERATURE) != 0u) {
+        b |= 8uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_UNDER_TEMPERATURE) != 0u) {
+        b |= 16uLL;
+      }
+      if ((s->faults & BATTGEN_FAULTS_HARDWARE_FAILURE) != 0u) {
+        b |= 64uLL;
+      }
+      t_info->status_flags = (uint16_t)b;
+      if ((s->faults &
+           (BATTGEN_FAULTS_DEEP_DISCHARGE | BATTGEN_FAULTS_SPIKES | BATTGEN_FAULTS_CELL_FAIL |
+            BATTGEN_FAULTS_INCOMPATIBLE_VOLTAGE | BATTGEN_FAULTS_INCOMPATIBLE_FIRMWARE |
+            BATTGEN_FAULTS_INCOMPATIBLE_MODEL | BATTGEN_FAULTS_FAILED_TO_ARM |
+            BATTGEN_FAULTS_INCOMPATIBLE_CELLS_CONFIGURATION)) != 0u) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.faults");
+      }
+    }
+  }
+  /* dronecan.yaml:41: scale */
+  {
+    if (!s->has_state_of_health || battgen_f64_is_nan(s->state_of_health)) {
+      t_info->state_of_health_pct = (uint8_t)127u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct");
+    } else {
+      t_info->state_of_health_pct = (uint8_t)battgen_to_int(
+          s->state_of_health * 100.0, 0LL, 100LL, rep,
+          "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct");
+      if (t_info->state_of_health_pct == (uint8_t)127u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.uavcan.equipment.power.BatteryInfo.state_of_health_pct");
+      }
+    }
+  }
+  /* dronecan.yaml:57: scale */
+  {
+    if (!s->has_state_of_charge || battgen_f64_is_nan(s->state_of_charge)) {
+      t_info->state_of_charge_pct = (uint8_t)127u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct");
+    } else {
+      t_info->state_of_charge_pct = (uint8_t)battgen_to_int(
+          s->state_of_charge * 100.0, 0LL, 100LL, rep,
+          "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct");
+      if (t_info->state_of_charge_pct == (uint8_t)127u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct");
+      }
+    }
+  }
+  /* dronecan.yaml:58: scale */
+  {
+    if (!s->has_state_of_charge_stdev || battgen_f64_is_nan(s->state_of_charge_stdev)) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev");
+    } else {
+      t_info->state_of_charge_pct_stdev = (uint8_t)battgen_to_int(
+          s->state_of_charge_stdev * 100.0, 0LL, 127LL, rep,
+          "dronecan.uavcan.equipment.power.BatteryInfo.state_of_charge_pct_stdev");
+    }
+  }
+  /* dronecan.yaml:59: copy */
+  {
+    if (!s->has_battery_index) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryInfoAux.battery_id");
+    } else {
+      t_aux->battery_id =
+          (uint8_t)battgen_to_int((double)s->battery_index, 0LL, 255LL, rep,
+                                  "dronecan.ardupilot.equipment.power.BatteryInfoAux.battery_id");
+    }
+  }
+  /* dronecan.yaml:60: copy */
+  {
+    if (!s->has_battery_index) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.battery_id");
+    } else {
+      t_info->battery_id =
+          (uint8_t)battgen_to_int((double)s->battery_index, 0LL, 255LL, rep,
+                                  "dronecan.uavcan.equipment.power.BatteryInfo.battery_id");
+    }
+  }
+  /* dronecan.yaml:61: copy */
+  {
+    if (!s->has_serial_number) {
+      t_info->model_instance_id = (uint32_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id");
+    } else {
+      t_info->model_instance_id =
+          (uint32_t)battgen_to_int((double)s->serial_number, 1LL, 4294967295LL, rep,
+                                   "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id");
+      if (t_info->model_instance_id == (uint32_t)0u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.uavcan.equipment.power.BatteryInfo.model_instance_id");
+      }
+    }
+  }
+  /* dronecan.yaml:62: copy */
+  {
+    if (!s->has_model_name) {
+      t_info->model_name_len = 0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.uavcan.equipment.power.BatteryInfo.model_name");
+    } else {
+      size_t i;
+      size_t n = (size_t)s->model_name_len;
+      if (n > 31u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.uavcan.equipment.power.BatteryInfo.model_name");
+        n = 31u;
+      }
+      for (i = 0; i < n; i++) {
+        t_info->model_name[i] = s->model_name[i];
+      }
+      t_info->model_name_len = (uint16_t)n;
+    }
+  }
+  /* dronecan.yaml:64: cells */
+  {
+    size_t i, n;
+    if (!s->has_cell_voltages) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell");
+    } else {
+      n = (size_t)s->cell_voltages_len;
+      if (n > 255u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell");
+        n = 255u;
+      }
+      for (i = 0; i < n; i++) {
+        double x = s->cell_voltages[i];
+        t_aux->voltage_cell[i] = battgen_f16_round_d(
+            x, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.voltage_cell");
+      }
+      t_aux->voltage_cell_len = (uint16_t)n;
+    }
+  }
+  /* dronecan.yaml:65: copy */
+  {
+    if (!s->has_cycle_count) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count");
+    } else {
+      t_aux->cycle_count =
+          (uint16_t)battgen_to_int((double)s->cycle_count, 0LL, 65535LL, rep,
+                                   "dronecan.ardupilot.equipment.power.BatteryInfoAux.cycle_count");
+    }
+  }
+  /* dronecan.yaml:66: copy */
+  {
+    if (!s->has_over_discharge_count) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count");
+    } else {
+      t_aux->over_discharge_count = (uint16_t)battgen_to_int(
+          (double)s->over_discharge_count, 0LL, 65535LL, rep,
+          "dronecan.ardupilot.equipment.power.BatteryInfoAux.over_discharge_count");
+    }
+  }
+  /* dronecan.yaml:67: scale */
+  {
+    if (!s->has_max_current || battgen_f64_is_nan(s->max_current)) {
+      t_aux->max_current = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current");
+    } else {
+      t_aux->max_current = battgen_f16_round_d(
+          s->max_current, rep, "dronecan.ardupilot.equipment.power.BatteryInfoAux.max_current");
+    }
+  }
+  /* dronecan.yaml:68: scale */
+  {
+    if (!s->has_nominal_voltage || battgen_f64_is_nan(s->nominal_voltage)) {
+      t_aux->nominal_voltage = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage");
+    } else {
+      t_aux->nominal_voltage =
+          battgen_f16_round_d(s->nominal_voltage, rep,
+                              "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage");
+      if (t_aux->nominal_voltage == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "dronecan.ardupilot.equipment.power.BatteryInfoAux.nominal_voltage");
+      }
+    }
+  }
+  /* dronecan.yaml:69: copy */
+  {
+    if (!s->has_is_powering_off) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "dronecan.ardupilot.equipment.power.BatteryInfoAux.is_powering_off");
+    } else {
+      t_aux->is_powering_off = (((s->is_powering_off ? 1.0 : 0.0)) != 0);
+    }
+  }
+  /* what did not survive the conversion */
+  if (s->has_connected) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.connected");
+  }
+  if (s->has_average_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_current");
+  }
+  if (s->has_design_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.design_energy");
+  }
+  if (s->has_full_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.full_capacity");
+  }
+  if (s->has_design_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.design_capacity");
+  }
+  if (s->has_discharged) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.discharged");
+  }
+  if (s->has_consumed_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.consumed_energy");
+  }
+  if (s->has_time_remaining) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.time_remaining");
+  }
+  if (s->has_cell_count) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_count");
+  }
+  if (s->has_voltage_min_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_min_design");
+  }
+  if (s->has_voltage_max_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_max_design");
+  }
+  if (s->has_remaining_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_capacity");
+  }
+  if (s->has_serial_number_text) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.serial_number_text");
+  }
+  if (s->has_manufacture_date) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.manufacture_date");
+  }
+  if (s->has_weight) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.weight");
+  }
+  if (s->has_cell_discharge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_discharge_min_voltage");
+  }
+  if (s->has_cell_charge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_min_voltage");
+  }
+  if (s->has_cell_rest_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_rest_min_voltage");
+  }
+  if (s->has_cell_charge_max_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_max_voltage");
+  }
+  if (s->has_max_charge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_charge_current");
+  }
+  if (s->has_max_discharge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_discharge_current");
+  }
+  if (s->has_max_burst_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_burst_current");
+  }
+  if (s->has_battery_function) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.battery_function");
+  }
+  if (s->has_chemistry) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.chemistry");
+  }
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                   "dronecan.ardupilot.equipment.power.BatteryInfoAux.timestamp");
+}
+
 static void
 map_dronecan_forward(const battgen_dronecan_uavcan_equipment_power_BatteryInfo *s_info,
                      const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *s_aux,
@@ -1031,7 +2210,15 @@ map_dronecan_forward(const battgen_dronecan_uavcan_equipment_power_BatteryInfo *
     }
   }
   /* dronecan.yaml:62: copy */
-  { t->has_model_name = s_info->model_name_len > 0u && s_info->model_name[0] != 0; }
+  {
+    size_t n = 0;
+    while (n < (size_t)s_info->model_name_len && s_info->model_name[n] != 0u) {
+      n++;
+    }
+    n = battgen_utf8_replace((const uint8_t *)s_info->model_name, n, t->model_name);
+    t->model_name_len = (uint16_t)n;
+    t->has_model_name = n > 0u;
+  }
   /* dronecan.yaml:63: const */
   {
     t->has_connected = true;
@@ -1749,6 +2936,407 @@ static void map_mavlink_forward(const battgen_mavlink_BATTERY_STATUS *s_msg, bat
   }
 }
 
+static void map_mavlink_info_backward(const battgen_concepts *s,
+                                      battgen_mavlink_BATTERY_INFO *t_info,
+                                      battgen_loss_report *rep, battgen_loss_report *rep_d,
+                                      battgen_loss_report *rep_u) {
+  (void)s;
+  (void)t_info;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_mavlink_BATTERY_INFO(t_info);
+  /* mavlink_info.yaml:11: copy */
+  {
+    if (!s->has_battery_index) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.id");
+    } else {
+      t_info->id = (uint8_t)battgen_to_int((double)s->battery_index, 0LL, 255LL, rep,
+                                           "mavlink.BATTERY_INFO.id");
+    }
+  }
+  /* mavlink_info.yaml:12: choice */
+  {
+    bool w = false;
+    if (s->has_battery_function) {
+      switch (s->battery_function) {
+      case BATTGEN_BATTERY_FUNCTION_ALL:
+        t_info->battery_function = (uint8_t)1u;
+        w = true;
+        break;
+      case BATTGEN_BATTERY_FUNCTION_PROPULSION:
+        t_info->battery_function = (uint8_t)2u;
+        w = true;
+        break;
+      case BATTGEN_BATTERY_FUNCTION_AVIONICS:
+        t_info->battery_function = (uint8_t)3u;
+        w = true;
+        break;
+      case BATTGEN_BATTERY_FUNCTION_PAYLOAD:
+        t_info->battery_function = (uint8_t)4u;
+        w = true;
+        break;
+      default:
+        break;
+      }
+    }
+    if (!w) {
+      t_info->battery_function = (uint8_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.battery_function");
+      if (s->has_battery_function) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.battery_function");
+      }
+    }
+  }
+  /* mavlink_info.yaml:21: choice */
+  {
+    bool w = false;
+    if (s->has_chemistry) {
+      switch (s->chemistry) {
+      case BATTGEN_CHEMISTRY_LIPO:
+        t_info->type = (uint8_t)1u;
+        w = true;
+        break;
+      case BATTGEN_CHEMISTRY_LIFE:
+        t_info->type = (uint8_t)2u;
+        w = true;
+        break;
+      case BATTGEN_CHEMISTRY_LION:
+        t_info->type = (uint8_t)3u;
+        w = true;
+        break;
+      case BATTGEN_CHEMISTRY_NIMH:
+        t_info->type = (uint8_t)4u;
+        w = true;
+        break;
+      default:
+        break;
+      }
+    }
+    if (!w) {
+      t_info->type = (uint8_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.type");
+      if (s->has_chemistry) {
+        battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.chemistry");
+      }
+    }
+  }
+  /* mavlink_info.yaml:26: scale */
+  {
+    if (!s->has_state_of_health || battgen_f64_is_nan(s->state_of_health)) {
+      t_info->state_of_health = (uint8_t)255u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.state_of_health");
+    } else {
+      t_info->state_of_health = (uint8_t)battgen_to_int(s->state_of_health * 100.0, 0LL, 100LL, rep,
+                                                        "mavlink.BATTERY_INFO.state_of_health");
+      if (t_info->state_of_health == (uint8_t)255u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.state_of_health");
+      }
+    }
+  }
+  /* mavlink_info.yaml:27: copy */
+  {
+    if (!s->has_cell_count) {
+      t_info->cells_in_series = (uint8_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.cells_in_series");
+    } else {
+      t_info->cells_in_series = (uint8_t)battgen_to_int((double)s->cell_count, 1LL, 255LL, rep,
+                                                        "mavlink.BATTERY_INFO.cells_in_series");
+      if (t_info->cells_in_series == (uint8_t)0u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.cells_in_series");
+      }
+    }
+  }
+  /* mavlink_info.yaml:28: copy */
+  {
+    if (!s->has_cycle_count) {
+      t_info->cycle_count = (uint16_t)65535u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.cycle_count");
+    } else {
+      t_info->cycle_count = (uint16_t)battgen_to_int((double)s->cycle_count, 0LL, 65534LL, rep,
+                                                     "mavlink.BATTERY_INFO.cycle_count");
+      if (t_info->cycle_count == (uint16_t)65535u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.cycle_count");
+      }
+    }
+  }
+  /* mavlink_info.yaml:29: scale */
+  {
+    if (!s->has_weight || battgen_f64_is_nan(s->weight)) {
+      t_info->weight = (uint16_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.weight");
+    } else {
+      t_info->weight = (uint16_t)battgen_to_int(s->weight * 1000.0, 1LL, 65535LL, rep,
+                                                "mavlink.BATTERY_INFO.weight");
+      if (t_info->weight == (uint16_t)0u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.weight");
+      }
+    }
+  }
+  /* mavlink_info.yaml:30: scale */
+  {
+    if (!s->has_cell_discharge_min_voltage || battgen_f64_is_nan(s->cell_discharge_min_voltage)) {
+      t_info->discharge_minimum_voltage = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "mavlink.BATTERY_INFO.discharge_minimum_voltage");
+    } else {
+      t_info->discharge_minimum_voltage = (float)(s->cell_discharge_min_voltage);
+      if (t_info->discharge_minimum_voltage == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "mavlink.BATTERY_INFO.discharge_minimum_voltage");
+      }
+    }
+  }
+  /* mavlink_info.yaml:31: scale */
+  {
+    if (!s->has_cell_charge_min_voltage || battgen_f64_is_nan(s->cell_charge_min_voltage)) {
+      t_info->charging_minimum_voltage = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "mavlink.BATTERY_INFO.charging_minimum_voltage");
+    } else {
+      t_info->charging_minimum_voltage = (float)(s->cell_charge_min_voltage);
+      if (t_info->charging_minimum_voltage == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "mavlink.BATTERY_INFO.charging_minimum_voltage");
+      }
+    }
+  }
+  /* mavlink_info.yaml:32: scale */
+  {
+    if (!s->has_cell_rest_min_voltage || battgen_f64_is_nan(s->cell_rest_min_voltage)) {
+      t_info->resting_minimum_voltage = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.resting_minimum_voltage");
+    } else {
+      t_info->resting_minimum_voltage = (float)(s->cell_rest_min_voltage);
+      if (t_info->resting_minimum_voltage == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.resting_minimum_voltage");
+      }
+    }
+  }
+  /* mavlink_info.yaml:33: scale */
+  {
+    if (!s->has_cell_charge_max_voltage || battgen_f64_is_nan(s->cell_charge_max_voltage)) {
+      t_info->charging_maximum_voltage = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "mavlink.BATTERY_INFO.charging_maximum_voltage");
+    } else {
+      t_info->charging_maximum_voltage = (float)(s->cell_charge_max_voltage);
+      if (t_info->charging_maximum_voltage == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "mavlink.BATTERY_INFO.charging_maximum_voltage");
+      }
+    }
+  }
+  /* mavlink_info.yaml:34: scale */
+  {
+    if (!s->has_max_charge_current || battgen_f64_is_nan(s->max_charge_current)) {
+      t_info->charging_maximum_current = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "mavlink.BATTERY_INFO.charging_maximum_current");
+    } else {
+      t_info->charging_maximum_current = (float)(s->max_charge_current);
+      if (t_info->charging_maximum_current == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "mavlink.BATTERY_INFO.charging_maximum_current");
+      }
+    }
+  }
+  /* mavlink_info.yaml:35: scale */
+  {
+    if (!s->has_nominal_voltage || battgen_f64_is_nan(s->nominal_voltage)) {
+      t_info->nominal_voltage = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.nominal_voltage");
+    } else {
+      t_info->nominal_voltage = (float)(s->nominal_voltage);
+      if (t_info->nominal_voltage == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.nominal_voltage");
+      }
+    }
+  }
+  /* mavlink_info.yaml:36: scale */
+  {
+    if (!s->has_max_discharge_current || battgen_f64_is_nan(s->max_discharge_current)) {
+      t_info->discharge_maximum_current = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "mavlink.BATTERY_INFO.discharge_maximum_current");
+    } else {
+      t_info->discharge_maximum_current = (float)(s->max_discharge_current);
+      if (t_info->discharge_maximum_current == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "mavlink.BATTERY_INFO.discharge_maximum_current");
+      }
+    }
+  }
+  /* mavlink_info.yaml:37: scale */
+  {
+    if (!s->has_max_burst_current || battgen_f64_is_nan(s->max_burst_current)) {
+      t_info->discharge_maximum_burst_current = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN,
+                       "mavlink.BATTERY_INFO.discharge_maximum_burst_current");
+    } else {
+      t_info->discharge_maximum_burst_current = (float)(s->max_burst_current);
+      if (t_info->discharge_maximum_burst_current == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED,
+                         "mavlink.BATTERY_INFO.discharge_maximum_burst_current");
+      }
+    }
+  }
+  /* mavlink_info.yaml:38: scale */
+  {
+    if (!s->has_design_capacity || battgen_f64_is_nan(s->design_capacity)) {
+      t_info->design_capacity = 0.0f;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.design_capacity");
+    } else {
+      t_info->design_capacity = (float)(s->design_capacity * 0.0002777777777777778);
+      if (t_info->design_capacity == 0.0f) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.design_capacity");
+      }
+    }
+  }
+  /* mavlink_info.yaml:39: scale */
+  {
+    if (!s->has_full_capacity || battgen_f64_is_nan(s->full_capacity)) {
+      t_info->full_charge_capacity = battgen_f32_from(0x7FC00000u);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.full_charge_capacity");
+    } else {
+      t_info->full_charge_capacity = (float)(s->full_capacity * 0.0002777777777777778);
+    }
+  }
+  /* mavlink_info.yaml:40: copy */
+  {
+    if (!s->has_manufacture_date) {
+      battgen_zero(t_info->manufacture_date, sizeof t_info->manufacture_date);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.manufacture_date");
+    } else {
+      size_t i;
+      size_t n = (size_t)s->manufacture_date_len;
+      if (n > 9u) {
+        n = 9u;
+      } /* Python keeps the whole text; C has room for 9 */
+      battgen_zero(t_info->manufacture_date, sizeof t_info->manufacture_date);
+      for (i = 0; i < n; i++) {
+        t_info->manufacture_date[i] = (char)s->manufacture_date[i];
+      }
+    }
+  }
+  /* mavlink_info.yaml:41: copy */
+  {
+    if (!s->has_serial_number_text) {
+      battgen_zero(t_info->serial_number, sizeof t_info->serial_number);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.serial_number");
+    } else {
+      size_t i;
+      size_t n = (size_t)s->serial_number_text_len;
+      if (n > 32u) {
+        n = 32u;
+      } /* Python keeps the whole text; C has room for 32 */
+      battgen_zero(t_info->serial_number, sizeof t_info->serial_number);
+      for (i = 0; i < n; i++) {
+        t_info->serial_number[i] = (char)s->serial_number_text[i];
+      }
+    }
+  }
+  /* mavlink_info.yaml:42: copy */
+  {
+    if (!s->has_model_name) {
+      battgen_zero(t_info->name, sizeof t_info->name);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "mavlink.BATTERY_INFO.name");
+    } else {
+      size_t i;
+      size_t n = (size_t)s->model_name_len;
+      if (n > 50u) {
+        n = 50u;
+      } /* Python keeps the whole text; C has room for 50 */
+      battgen_zero(t_info->name, sizeof t_info->name);
+      for (i = 0; i < n; i++) {
+        t_info->name[i] = (char)s->model_name[i];
+      }
+    }
+  }
+  /* what did not survive the conversion */
+  if (s->has_connected) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.connected");
+  }
+  if (s->has_in_use) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.in_use");
+  }
+  if (s->has_charging) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.charging");
+  }
+  if (s->has_pack_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.pack_voltage");
+  }
+  if (s->has_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.current");
+  }
+  if (s->has_average_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_current");
+  }
+  if (s->has_max_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_current");
+  }
+  if (s->has_average_power) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_power");
+  }
+  if (s->has_temperature) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.temperature");
+  }
+  if (s->has_state_of_charge) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.state_of_charge");
+  }
+  if (s->has_state_of_charge_stdev) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.state_of_charge_stdev");
+  }
+  if (s->has_remaining_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_energy");
+  }
+  if (s->has_full_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.full_energy");
+  }
+  if (s->has_design_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.design_energy");
+  }
+  if (s->has_discharged) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.discharged");
+  }
+  if (s->has_consumed_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.consumed_energy");
+  }
+  if (s->has_time_remaining) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.time_remaining");
+  }
+  if (s->has_time_to_full) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.time_to_full");
+  }
+  if (s->has_cell_voltages) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_voltages");
+  }
+  if (s->has_over_discharge_count) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.over_discharge_count");
+  }
+  if (s->has_voltage_min_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_min_design");
+  }
+  if (s->has_voltage_max_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_max_design");
+  }
+  if (s->has_serial_number) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.serial_number");
+  }
+  if (s->has_is_powering_off) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.is_powering_off");
+  }
+  if (s->has_remaining_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_capacity");
+  }
+  if (s->has_warning) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.warning");
+  }
+  if (s->has_faults) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.faults");
+  }
+}
+
 static void map_mavlink_info_forward(const battgen_mavlink_BATTERY_INFO *s_info,
                                      battgen_concepts *t, battgen_loss_report *rep,
                                      battgen_loss_report *rep_d, battgen_loss_report *rep_u) {
@@ -1927,11 +3515,35 @@ static void map_mavlink_info_forward(const battgen_mavlink_BATTERY_INFO *s_info,
     }
   }
   /* mavlink_info.yaml:40: copy */
-  { t->has_manufacture_date = s_info->manufacture_date[0] != 0; }
+  {
+    size_t n = 0;
+    while (n < 9u && s_info->manufacture_date[n] != 0) {
+      t->manufacture_date[n] = (uint8_t)s_info->manufacture_date[n];
+      n++;
+    }
+    t->manufacture_date_len = (uint16_t)n;
+    t->has_manufacture_date = n > 0u;
+  }
   /* mavlink_info.yaml:41: copy */
-  { t->has_serial_number_text = s_info->serial_number[0] != 0; }
+  {
+    size_t n = 0;
+    while (n < 32u && s_info->serial_number[n] != 0) {
+      t->serial_number_text[n] = (uint8_t)s_info->serial_number[n];
+      n++;
+    }
+    t->serial_number_text_len = (uint16_t)n;
+    t->has_serial_number_text = n > 0u;
+  }
   /* mavlink_info.yaml:42: copy */
-  { t->has_model_name = s_info->name[0] != 0; }
+  {
+    size_t n = 0;
+    while (n < 50u && s_info->name[n] != 0) {
+      t->model_name[n] = (uint8_t)s_info->name[n];
+      n++;
+    }
+    t->model_name_len = (uint16_t)n;
+    t->has_model_name = n > 0u;
+  }
   /* mavlink_info.yaml:43: const */
   {
     t->has_connected = true;
@@ -4501,6 +6113,184 @@ static void map_uorb_forward(const battgen_uorb_BatteryStatus *s_status, battgen
   }
 }
 
+static void map_uorb_info_backward(const battgen_concepts *s, battgen_uorb_BatteryInfo *t_info,
+                                   battgen_loss_report *rep, battgen_loss_report *rep_d,
+                                   battgen_loss_report *rep_u) {
+  (void)s;
+  (void)t_info;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_uorb_BatteryInfo(t_info);
+  /* uorb_info.yaml:14: copy */
+  {
+    if (!s->has_battery_index) {
+      t_info->id = (uint8_t)0u;
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryInfo.id");
+    } else {
+      t_info->id = (uint8_t)battgen_to_int((double)s->battery_index - -1.0, 1LL, 255LL, rep,
+                                           "uorb.BatteryInfo.id");
+      if (t_info->id == (uint8_t)0u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "uorb.BatteryInfo.id");
+      }
+    }
+  }
+  /* uorb_info.yaml:15: copy */
+  {
+    if (!s->has_serial_number_text) {
+      battgen_zero(t_info->serial_number, sizeof t_info->serial_number);
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryInfo.serial_number");
+    } else {
+      size_t i;
+      size_t n = (size_t)s->serial_number_text_len;
+      if (n > 32u) {
+        n = 32u;
+      } /* Python keeps the whole text; C has room for 32 */
+      battgen_zero(t_info->serial_number, sizeof t_info->serial_number);
+      for (i = 0; i < n; i++) {
+        t_info->serial_number[i] = (char)s->serial_number_text[i];
+      }
+    }
+  }
+  /* what did not survive the conversion */
+  if (s->has_connected) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.connected");
+  }
+  if (s->has_in_use) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.in_use");
+  }
+  if (s->has_charging) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.charging");
+  }
+  if (s->has_pack_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.pack_voltage");
+  }
+  if (s->has_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.current");
+  }
+  if (s->has_average_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_current");
+  }
+  if (s->has_max_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_current");
+  }
+  if (s->has_average_power) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.average_power");
+  }
+  if (s->has_temperature) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.temperature");
+  }
+  if (s->has_state_of_charge) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.state_of_charge");
+  }
+  if (s->has_state_of_charge_stdev) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.state_of_charge_stdev");
+  }
+  if (s->has_state_of_health) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.state_of_health");
+  }
+  if (s->has_remaining_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_energy");
+  }
+  if (s->has_full_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.full_energy");
+  }
+  if (s->has_design_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.design_energy");
+  }
+  if (s->has_full_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.full_capacity");
+  }
+  if (s->has_design_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.design_capacity");
+  }
+  if (s->has_discharged) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.discharged");
+  }
+  if (s->has_consumed_energy) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.consumed_energy");
+  }
+  if (s->has_time_remaining) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.time_remaining");
+  }
+  if (s->has_time_to_full) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.time_to_full");
+  }
+  if (s->has_cell_voltages) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_voltages");
+  }
+  if (s->has_cell_count) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_count");
+  }
+  if (s->has_cycle_count) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cycle_count");
+  }
+  if (s->has_over_discharge_count) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.over_discharge_count");
+  }
+  if (s->has_nominal_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.nominal_voltage");
+  }
+  if (s->has_voltage_min_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_min_design");
+  }
+  if (s->has_voltage_max_design) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.voltage_max_design");
+  }
+  if (s->has_serial_number) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.serial_number");
+  }
+  if (s->has_model_name) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.model_name");
+  }
+  if (s->has_is_powering_off) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.is_powering_off");
+  }
+  if (s->has_remaining_capacity) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.remaining_capacity");
+  }
+  if (s->has_manufacture_date) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.manufacture_date");
+  }
+  if (s->has_weight) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.weight");
+  }
+  if (s->has_cell_discharge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_discharge_min_voltage");
+  }
+  if (s->has_cell_charge_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_min_voltage");
+  }
+  if (s->has_cell_rest_min_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_rest_min_voltage");
+  }
+  if (s->has_cell_charge_max_voltage) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.cell_charge_max_voltage");
+  }
+  if (s->has_max_charge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_charge_current");
+  }
+  if (s->has_max_discharge_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_discharge_current");
+  }
+  if (s->has_max_burst_current) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.max_burst_current");
+  }
+  if (s->has_battery_function) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.battery_function");
+  }
+  if (s->has_chemistry) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.chemistry");
+  }
+  if (s->has_warning) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.warning");
+  }
+  if (s->has_faults) {
+    battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "concepts.faults");
+  }
+  battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryInfo.timestamp");
+}
+
 static void map_uorb_info_forward(const battgen_uorb_BatteryInfo *s_info, battgen_concepts *t,
                                   battgen_loss_report *rep, battgen_loss_report *rep_d,
                                   battgen_loss_report *rep_u) {
@@ -4519,7 +6309,15 @@ static void map_uorb_info_forward(const battgen_uorb_BatteryInfo *s_info, battge
     }
   }
   /* uorb_info.yaml:15: copy */
-  { t->has_serial_number_text = s_info->serial_number[0] != 0; }
+  {
+    size_t n = 0;
+    while (n < 32u && s_info->serial_number[n] != 0) {
+      t->serial_number_text[n] = (uint8_t)s_info->serial_number[n];
+      n++;
+    }
+    t->serial_number_text_len = (uint16_t)n;
+    t->has_serial_number_text = n > 0u;
+  }
   /* what did not survive the conversion */
   if (rep_d != NULL && s_info != NULL) {
     battgen_uorb_BatteryInfo fresh;
@@ -4533,6 +6331,28 @@ static void map_uorb_info_forward(const battgen_uorb_BatteryInfo *s_info, battge
       battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryInfo.timestamp");
     }
   }
+}
+
+void battgen_convert_dronecan_to_ardupilot_battery_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_dronecan_forward(info, aux, &c1, rep, rep, NULL);
+  map_ardupilot_battery_backward(&c1, out_continuous, out_periodic, out_cells, out_tag, rep, rep,
+                                 rep);
+}
+
+void battgen_convert_dronecan_to_cbat_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_dronecan_cuav_equipment_power_CBAT *out_cbat, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_dronecan_forward(info, aux, &c1, rep, rep, NULL);
+  map_cbat_backward(&c1, out_cbat, rep, rep, rep);
 }
 
 void battgen_convert_dronecan_to_uorb_strict(
@@ -4550,6 +6370,15 @@ void battgen_convert_dronecan_to_uorb_px4(
     const float *discharged_mah_before, battgen_uorb_BatteryStatus *out_status,
     battgen_loss_report *rep) {
   map_px4_uavcan_bridge_forward(info, aux, dt_s, discharged_mah_before, out_status, rep, rep, rep);
+}
+
+void battgen_convert_dronecan_to_uorb_info_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_uorb_BatteryInfo *out_info, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_dronecan_forward(info, aux, &c1, rep, rep, NULL);
+  map_uorb_info_backward(&c1, out_info, rep, rep, rep);
 }
 
 void battgen_convert_dronecan_to_mavlink_strict(
@@ -4571,6 +6400,15 @@ void battgen_convert_dronecan_to_mavlink_px4(
   map_px4_mavlink_stream_forward(&c1_0, out_msg, rep, NULL, rep);
 }
 
+void battgen_convert_dronecan_to_mavlink_info_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_mavlink_BATTERY_INFO *out_info, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_dronecan_forward(info, aux, &c1, rep, rep, NULL);
+  map_mavlink_info_backward(&c1, out_info, rep, rep, rep);
+}
+
 void battgen_convert_dronecan_to_mavlink_v2_strict(
     const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
     const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
@@ -4578,6 +6416,29 @@ void battgen_convert_dronecan_to_mavlink_v2_strict(
   battgen_concepts c1;
   map_dronecan_forward(info, aux, &c1, rep, rep, NULL);
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_ardupilot_battery_to_dronecan_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_ardupilot_battery_forward(continuous, periodic, cells, tag, &c1, rep, rep, NULL);
+  map_dronecan_backward(&c1, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_ardupilot_battery_to_cbat_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_dronecan_cuav_equipment_power_CBAT *out_cbat, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_ardupilot_battery_forward(continuous, periodic, cells, tag, &c1, rep, rep, NULL);
+  map_cbat_backward(&c1, out_cbat, rep, rep, rep);
 }
 
 void battgen_convert_ardupilot_battery_to_uorb_strict(
@@ -4591,6 +6452,17 @@ void battgen_convert_ardupilot_battery_to_uorb_strict(
   map_uorb_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_ardupilot_battery_to_uorb_info_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_uorb_BatteryInfo *out_info, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_ardupilot_battery_forward(continuous, periodic, cells, tag, &c1, rep, rep, NULL);
+  map_uorb_info_backward(&c1, out_info, rep, rep, rep);
+}
+
 void battgen_convert_ardupilot_battery_to_mavlink_strict(
     const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
     const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
@@ -4600,6 +6472,17 @@ void battgen_convert_ardupilot_battery_to_mavlink_strict(
   battgen_concepts c1;
   map_ardupilot_battery_forward(continuous, periodic, cells, tag, &c1, rep, rep, NULL);
   map_mavlink_backward(&c1, out_msg, rep, rep, rep);
+}
+
+void battgen_convert_ardupilot_battery_to_mavlink_info_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_mavlink_BATTERY_INFO *out_info, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_ardupilot_battery_forward(continuous, periodic, cells, tag, &c1, rep, rep, NULL);
+  map_mavlink_info_backward(&c1, out_info, rep, rep, rep);
 }
 
 void battgen_convert_ardupilot_battery_to_mavlink_v2_strict(
@@ -4613,12 +6496,41 @@ void battgen_convert_ardupilot_battery_to_mavlink_v2_strict(
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_cbat_to_dronecan_strict(
+    const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_cbat_forward(cbat, &c1, rep, rep, NULL);
+  map_dronecan_backward(&c1, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_cbat_to_ardupilot_battery_strict(
+    const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_cbat_forward(cbat, &c1, rep, rep, NULL);
+  map_ardupilot_battery_backward(&c1, out_continuous, out_periodic, out_cells, out_tag, rep, rep,
+                                 rep);
+}
+
 void battgen_convert_cbat_to_uorb_strict(const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
                                          battgen_uorb_BatteryStatus *out_status,
                                          battgen_loss_report *rep) {
   battgen_concepts c1;
   map_cbat_forward(cbat, &c1, rep, rep, NULL);
   map_uorb_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_cbat_to_uorb_info_strict(
+    const battgen_dronecan_cuav_equipment_power_CBAT *cbat, battgen_uorb_BatteryInfo *out_info,
+    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_cbat_forward(cbat, &c1, rep, rep, NULL);
+  map_uorb_info_backward(&c1, out_info, rep, rep, rep);
 }
 
 void battgen_convert_cbat_to_mavlink_strict(const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
@@ -4629,6 +6541,14 @@ void battgen_convert_cbat_to_mavlink_strict(const battgen_dronecan_cuav_equipmen
   map_mavlink_backward(&c1, out_msg, rep, rep, rep);
 }
 
+void battgen_convert_cbat_to_mavlink_info_strict(
+    const battgen_dronecan_cuav_equipment_power_CBAT *cbat, battgen_mavlink_BATTERY_INFO *out_info,
+    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_cbat_forward(cbat, &c1, rep, rep, NULL);
+  map_mavlink_info_backward(&c1, out_info, rep, rep, rep);
+}
+
 void battgen_convert_cbat_to_mavlink_v2_strict(
     const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
     battgen_mavlink_BATTERY_STATUS_V2 *out_status, battgen_loss_report *rep) {
@@ -4637,11 +6557,48 @@ void battgen_convert_cbat_to_mavlink_v2_strict(
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_uorb_to_dronecan_strict(
+    const battgen_uorb_BatteryStatus *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_forward(status, &c1, rep, rep, NULL);
+  map_dronecan_backward(&c1, out_info, out_aux, rep, rep, rep);
+}
+
 void battgen_convert_uorb_to_dronecan_px4(
     const battgen_uorb_BatteryStatus *status,
     battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
     battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
   map_px4_uavcannode_forward(status, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_uorb_to_ardupilot_battery_strict(
+    const battgen_uorb_BatteryStatus *status,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_forward(status, &c1, rep, rep, NULL);
+  map_ardupilot_battery_backward(&c1, out_continuous, out_periodic, out_cells, out_tag, rep, rep,
+                                 rep);
+}
+
+void battgen_convert_uorb_to_cbat_strict(const battgen_uorb_BatteryStatus *status,
+                                         battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                         battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_forward(status, &c1, rep, rep, NULL);
+  map_cbat_backward(&c1, out_cbat, rep, rep, rep);
+}
+
+void battgen_convert_uorb_to_uorb_info_strict(const battgen_uorb_BatteryStatus *status,
+                                              battgen_uorb_BatteryInfo *out_info,
+                                              battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_forward(status, &c1, rep, rep, NULL);
+  map_uorb_info_backward(&c1, out_info, rep, rep, rep);
 }
 
 void battgen_convert_uorb_to_mavlink_strict(const battgen_uorb_BatteryStatus *status,
@@ -4658,12 +6615,49 @@ void battgen_convert_uorb_to_mavlink_px4(const battgen_uorb_BatteryStatus *statu
   map_px4_mavlink_stream_forward(status, out_msg, rep, rep, rep);
 }
 
+void battgen_convert_uorb_to_mavlink_info_strict(const battgen_uorb_BatteryStatus *status,
+                                                 battgen_mavlink_BATTERY_INFO *out_info,
+                                                 battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_forward(status, &c1, rep, rep, NULL);
+  map_mavlink_info_backward(&c1, out_info, rep, rep, rep);
+}
+
 void battgen_convert_uorb_to_mavlink_v2_strict(const battgen_uorb_BatteryStatus *status,
                                                battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                battgen_loss_report *rep) {
   battgen_concepts c1;
   map_uorb_forward(status, &c1, rep, rep, NULL);
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_uorb_info_to_dronecan_strict(
+    const battgen_uorb_BatteryInfo *info,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_info_forward(info, &c1, rep, rep, NULL);
+  map_dronecan_backward(&c1, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_uorb_info_to_ardupilot_battery_strict(
+    const battgen_uorb_BatteryInfo *info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_info_forward(info, &c1, rep, rep, NULL);
+  map_ardupilot_battery_backward(&c1, out_continuous, out_periodic, out_cells, out_tag, rep, rep,
+                                 rep);
+}
+
+void battgen_convert_uorb_info_to_cbat_strict(const battgen_uorb_BatteryInfo *info,
+                                              battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                              battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_info_forward(info, &c1, rep, rep, NULL);
+  map_cbat_backward(&c1, out_cbat, rep, rep, rep);
 }
 
 void battgen_convert_uorb_info_to_uorb_strict(const battgen_uorb_BatteryInfo *info,
@@ -4682,12 +6676,29 @@ void battgen_convert_uorb_info_to_mavlink_strict(const battgen_uorb_BatteryInfo 
   map_mavlink_backward(&c1, out_msg, rep, rep, rep);
 }
 
+void battgen_convert_uorb_info_to_mavlink_info_strict(const battgen_uorb_BatteryInfo *info,
+                                                      battgen_mavlink_BATTERY_INFO *out_info,
+                                                      battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_uorb_info_forward(info, &c1, rep, rep, NULL);
+  map_mavlink_info_backward(&c1, out_info, rep, rep, rep);
+}
+
 void battgen_convert_uorb_info_to_mavlink_v2_strict(const battgen_uorb_BatteryInfo *info,
                                                     battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                     battgen_loss_report *rep) {
   battgen_concepts c1;
   map_uorb_info_forward(info, &c1, rep, rep, NULL);
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_to_dronecan_strict(
+    const battgen_mavlink_BATTERY_STATUS *msg,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_forward(msg, &c1, rep, rep, NULL);
+  map_dronecan_backward(&c1, out_info, out_aux, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_to_dronecan_px4(
@@ -4697,6 +6708,26 @@ void battgen_convert_mavlink_to_dronecan_px4(
   battgen_uorb_BatteryStatus c1_0;
   map_px4_mavlink_receiver_forward(msg, &c1_0, rep, rep, NULL);
   map_px4_uavcannode_forward(&c1_0, out_info, out_aux, rep, NULL, rep);
+}
+
+void battgen_convert_mavlink_to_ardupilot_battery_strict(
+    const battgen_mavlink_BATTERY_STATUS *msg,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_forward(msg, &c1, rep, rep, NULL);
+  map_ardupilot_battery_backward(&c1, out_continuous, out_periodic, out_cells, out_tag, rep, rep,
+                                 rep);
+}
+
+void battgen_convert_mavlink_to_cbat_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                            battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                            battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_forward(msg, &c1, rep, rep, NULL);
+  map_cbat_backward(&c1, out_cbat, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_to_uorb_strict(const battgen_mavlink_BATTERY_STATUS *msg,
@@ -4713,6 +6744,22 @@ void battgen_convert_mavlink_to_uorb_px4(const battgen_mavlink_BATTERY_STATUS *m
   map_px4_mavlink_receiver_forward(msg, out_status, rep, rep, rep);
 }
 
+void battgen_convert_mavlink_to_uorb_info_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                                 battgen_uorb_BatteryInfo *out_info,
+                                                 battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_forward(msg, &c1, rep, rep, NULL);
+  map_uorb_info_backward(&c1, out_info, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_to_mavlink_info_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                                    battgen_mavlink_BATTERY_INFO *out_info,
+                                                    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_forward(msg, &c1, rep, rep, NULL);
+  map_mavlink_info_backward(&c1, out_info, rep, rep, rep);
+}
+
 void battgen_convert_mavlink_to_mavlink_v2_strict(const battgen_mavlink_BATTERY_STATUS *msg,
                                                   battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                   battgen_loss_report *rep) {
@@ -4721,12 +6768,49 @@ void battgen_convert_mavlink_to_mavlink_v2_strict(const battgen_mavlink_BATTERY_
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_mavlink_info_to_dronecan_strict(
+    const battgen_mavlink_BATTERY_INFO *info,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_info_forward(info, &c1, rep, rep, NULL);
+  map_dronecan_backward(&c1, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_info_to_ardupilot_battery_strict(
+    const battgen_mavlink_BATTERY_INFO *info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_info_forward(info, &c1, rep, rep, NULL);
+  map_ardupilot_battery_backward(&c1, out_continuous, out_periodic, out_cells, out_tag, rep, rep,
+                                 rep);
+}
+
+void battgen_convert_mavlink_info_to_cbat_strict(
+    const battgen_mavlink_BATTERY_INFO *info, battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_info_forward(info, &c1, rep, rep, NULL);
+  map_cbat_backward(&c1, out_cbat, rep, rep, rep);
+}
+
 void battgen_convert_mavlink_info_to_uorb_strict(const battgen_mavlink_BATTERY_INFO *info,
                                                  battgen_uorb_BatteryStatus *out_status,
                                                  battgen_loss_report *rep) {
   battgen_concepts c1;
   map_mavlink_info_forward(info, &c1, rep, rep, NULL);
   map_uorb_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_info_to_uorb_info_strict(const battgen_mavlink_BATTERY_INFO *info,
+                                                      battgen_uorb_BatteryInfo *out_info,
+                                                      battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_info_forward(info, &c1, rep, rep, NULL);
+  map_uorb_info_backward(&c1, out_info, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_info_to_mavlink_strict(const battgen_mavlink_BATTERY_INFO *info,
@@ -4745,12 +6829,49 @@ void battgen_convert_mavlink_info_to_mavlink_v2_strict(
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_mavlink_v2_to_dronecan_strict(
+    const battgen_mavlink_BATTERY_STATUS_V2 *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_v2_forward(status, &c1, rep, rep, NULL);
+  map_dronecan_backward(&c1, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_v2_to_ardupilot_battery_strict(
+    const battgen_mavlink_BATTERY_STATUS_V2 *status,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_v2_forward(status, &c1, rep, rep, NULL);
+  map_ardupilot_battery_backward(&c1, out_continuous, out_periodic, out_cells, out_tag, rep, rep,
+                                 rep);
+}
+
+void battgen_convert_mavlink_v2_to_cbat_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
+                                               battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                               battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_v2_forward(status, &c1, rep, rep, NULL);
+  map_cbat_backward(&c1, out_cbat, rep, rep, rep);
+}
+
 void battgen_convert_mavlink_v2_to_uorb_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
                                                battgen_uorb_BatteryStatus *out_status,
                                                battgen_loss_report *rep) {
   battgen_concepts c1;
   map_mavlink_v2_forward(status, &c1, rep, rep, NULL);
   map_uorb_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_v2_to_uorb_info_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
+                                                    battgen_uorb_BatteryInfo *out_info,
+                                                    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_v2_forward(status, &c1, rep, rep, NULL);
+  map_uorb_info_backward(&c1, out_info, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_v2_to_mavlink_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
@@ -4761,6 +6882,43 @@ void battgen_convert_mavlink_v2_to_mavlink_strict(const battgen_mavlink_BATTERY_
   map_mavlink_backward(&c1, out_msg, rep, rep, rep);
 }
 
+void battgen_convert_mavlink_v2_to_mavlink_info_strict(
+    const battgen_mavlink_BATTERY_STATUS_V2 *status, battgen_mavlink_BATTERY_INFO *out_info,
+    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_v2_forward(status, &c1, rep, rep, NULL);
+  map_mavlink_info_backward(&c1, out_info, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_sys_status_to_dronecan_strict(
+    const battgen_mavlink_SYS_STATUS *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
+  map_dronecan_backward(&c1, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_sys_status_to_ardupilot_battery_strict(
+    const battgen_mavlink_SYS_STATUS *status,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
+  map_ardupilot_battery_backward(&c1, out_continuous, out_periodic, out_cells, out_tag, rep, rep,
+                                 rep);
+}
+
+void battgen_convert_mavlink_sys_status_to_cbat_strict(
+    const battgen_mavlink_SYS_STATUS *status, battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
+  map_cbat_backward(&c1, out_cbat, rep, rep, rep);
+}
+
 void battgen_convert_mavlink_sys_status_to_uorb_strict(const battgen_mavlink_SYS_STATUS *status,
                                                        battgen_uorb_BatteryStatus *out_status,
                                                        battgen_loss_report *rep) {
@@ -4769,12 +6927,28 @@ void battgen_convert_mavlink_sys_status_to_uorb_strict(const battgen_mavlink_SYS
   map_uorb_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_mavlink_sys_status_to_uorb_info_strict(
+    const battgen_mavlink_SYS_STATUS *status, battgen_uorb_BatteryInfo *out_info,
+    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
+  map_uorb_info_backward(&c1, out_info, rep, rep, rep);
+}
+
 void battgen_convert_mavlink_sys_status_to_mavlink_strict(const battgen_mavlink_SYS_STATUS *status,
                                                           battgen_mavlink_BATTERY_STATUS *out_msg,
                                                           battgen_loss_report *rep) {
   battgen_concepts c1;
   map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
   map_mavlink_backward(&c1, out_msg, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_sys_status_to_mavlink_info_strict(
+    const battgen_mavlink_SYS_STATUS *status, battgen_mavlink_BATTERY_INFO *out_info,
+    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
+  map_mavlink_info_backward(&c1, out_info, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_sys_status_to_mavlink_v2_strict(

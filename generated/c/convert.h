@@ -25,6 +25,25 @@
 extern "C" {
 #endif
 
+/* dronecan -> ardupilot_battery, policy strict: dronecan -> ardupilot_battery.
+ * `aux` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_ardupilot_battery_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep);
+
+/* dronecan -> cbat, policy strict: dronecan -> cbat.
+ * `aux` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_cbat_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_dronecan_cuav_equipment_power_CBAT *out_cbat, battgen_loss_report *rep);
+
 /* dronecan -> uorb, policy strict: dronecan -> uorb.
  * `aux` may be NULL (not received).
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -43,6 +62,14 @@ void battgen_convert_dronecan_to_uorb_px4(
     const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux, const float *dt_s,
     const float *discharged_mah_before, battgen_uorb_BatteryStatus *out_status,
     battgen_loss_report *rep);
+
+/* dronecan -> uorb_info, policy strict: dronecan -> uorb_info.
+ * `aux` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_uorb_info_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_uorb_BatteryInfo *out_info, battgen_loss_report *rep);
 
 /* dronecan -> mavlink, policy strict: dronecan -> mavlink.
  * `aux` may be NULL (not received).
@@ -63,6 +90,14 @@ void battgen_convert_dronecan_to_mavlink_px4(
     const float *discharged_mah_before, battgen_mavlink_BATTERY_STATUS *out_msg,
     battgen_loss_report *rep);
 
+/* dronecan -> mavlink_info, policy strict: dronecan -> mavlink_info.
+ * `aux` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_mavlink_info_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_mavlink_BATTERY_INFO *out_info, battgen_loss_report *rep);
+
 /* dronecan -> mavlink_v2, policy strict: dronecan -> mavlink_v2.
  * `aux` may be NULL (not received).
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -70,6 +105,31 @@ void battgen_convert_dronecan_to_mavlink_v2_strict(
     const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
     const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
     battgen_mavlink_BATTERY_STATUS_V2 *out_status, battgen_loss_report *rep);
+
+/* ardupilot_battery -> dronecan, policy strict: ardupilot_battery -> dronecan.
+ * `periodic` may be NULL (not received).
+ * `cells` may be NULL (not received).
+ * `tag` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_ardupilot_battery_to_dronecan_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* ardupilot_battery -> cbat, policy strict: ardupilot_battery -> cbat.
+ * `periodic` may be NULL (not received).
+ * `cells` may be NULL (not received).
+ * `tag` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_ardupilot_battery_to_cbat_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_dronecan_cuav_equipment_power_CBAT *out_cbat, battgen_loss_report *rep);
 
 /* ardupilot_battery -> uorb, policy strict: ardupilot_battery -> uorb.
  * `periodic` may be NULL (not received).
@@ -83,6 +143,18 @@ void battgen_convert_ardupilot_battery_to_uorb_strict(
     const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
     battgen_uorb_BatteryStatus *out_status, battgen_loss_report *rep);
 
+/* ardupilot_battery -> uorb_info, policy strict: ardupilot_battery -> uorb_info.
+ * `periodic` may be NULL (not received).
+ * `cells` may be NULL (not received).
+ * `tag` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_ardupilot_battery_to_uorb_info_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_uorb_BatteryInfo *out_info, battgen_loss_report *rep);
+
 /* ardupilot_battery -> mavlink, policy strict: ardupilot_battery -> mavlink.
  * `periodic` may be NULL (not received).
  * `cells` may be NULL (not received).
@@ -94,6 +166,18 @@ void battgen_convert_ardupilot_battery_to_mavlink_strict(
     const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
     const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
     battgen_mavlink_BATTERY_STATUS *out_msg, battgen_loss_report *rep);
+
+/* ardupilot_battery -> mavlink_info, policy strict: ardupilot_battery -> mavlink_info.
+ * `periodic` may be NULL (not received).
+ * `cells` may be NULL (not received).
+ * `tag` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_ardupilot_battery_to_mavlink_info_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_mavlink_BATTERY_INFO *out_info, battgen_loss_report *rep);
 
 /* ardupilot_battery -> mavlink_v2, policy strict: ardupilot_battery -> mavlink_v2.
  * `periodic` may be NULL (not received).
@@ -107,11 +191,33 @@ void battgen_convert_ardupilot_battery_to_mavlink_v2_strict(
     const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
     battgen_mavlink_BATTERY_STATUS_V2 *out_status, battgen_loss_report *rep);
 
+/* cbat -> dronecan, policy strict: cbat -> dronecan.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_cbat_to_dronecan_strict(
+    const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* cbat -> ardupilot_battery, policy strict: cbat -> ardupilot_battery.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_cbat_to_ardupilot_battery_strict(
+    const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep);
+
 /* cbat -> uorb, policy strict: cbat -> uorb.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_cbat_to_uorb_strict(const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
                                          battgen_uorb_BatteryStatus *out_status,
                                          battgen_loss_report *rep);
+
+/* cbat -> uorb_info, policy strict: cbat -> uorb_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_cbat_to_uorb_info_strict(
+    const battgen_dronecan_cuav_equipment_power_CBAT *cbat, battgen_uorb_BatteryInfo *out_info,
+    battgen_loss_report *rep);
 
 /* cbat -> mavlink, policy strict: cbat -> mavlink.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -119,11 +225,24 @@ void battgen_convert_cbat_to_mavlink_strict(const battgen_dronecan_cuav_equipmen
                                             battgen_mavlink_BATTERY_STATUS *out_msg,
                                             battgen_loss_report *rep);
 
+/* cbat -> mavlink_info, policy strict: cbat -> mavlink_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_cbat_to_mavlink_info_strict(
+    const battgen_dronecan_cuav_equipment_power_CBAT *cbat, battgen_mavlink_BATTERY_INFO *out_info,
+    battgen_loss_report *rep);
+
 /* cbat -> mavlink_v2, policy strict: cbat -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_cbat_to_mavlink_v2_strict(
     const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
     battgen_mavlink_BATTERY_STATUS_V2 *out_status, battgen_loss_report *rep);
+
+/* uorb -> dronecan, policy strict: uorb -> dronecan.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_dronecan_strict(
+    const battgen_uorb_BatteryStatus *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
 
 /* uorb -> dronecan, policy px4: px4_uavcannode.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -131,6 +250,27 @@ void battgen_convert_uorb_to_dronecan_px4(
     const battgen_uorb_BatteryStatus *status,
     battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
     battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* uorb -> ardupilot_battery, policy strict: uorb -> ardupilot_battery.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_ardupilot_battery_strict(
+    const battgen_uorb_BatteryStatus *status,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep);
+
+/* uorb -> cbat, policy strict: uorb -> cbat.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_cbat_strict(const battgen_uorb_BatteryStatus *status,
+                                         battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                         battgen_loss_report *rep);
+
+/* uorb -> uorb_info, policy strict: uorb -> uorb_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_uorb_info_strict(const battgen_uorb_BatteryStatus *status,
+                                              battgen_uorb_BatteryInfo *out_info,
+                                              battgen_loss_report *rep);
 
 /* uorb -> mavlink, policy strict: uorb -> mavlink.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -144,11 +284,39 @@ void battgen_convert_uorb_to_mavlink_px4(const battgen_uorb_BatteryStatus *statu
                                          battgen_mavlink_BATTERY_STATUS *out_msg,
                                          battgen_loss_report *rep);
 
+/* uorb -> mavlink_info, policy strict: uorb -> mavlink_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_mavlink_info_strict(const battgen_uorb_BatteryStatus *status,
+                                                 battgen_mavlink_BATTERY_INFO *out_info,
+                                                 battgen_loss_report *rep);
+
 /* uorb -> mavlink_v2, policy strict: uorb -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_uorb_to_mavlink_v2_strict(const battgen_uorb_BatteryStatus *status,
                                                battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                battgen_loss_report *rep);
+
+/* uorb_info -> dronecan, policy strict: uorb_info -> dronecan.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_info_to_dronecan_strict(
+    const battgen_uorb_BatteryInfo *info,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* uorb_info -> ardupilot_battery, policy strict: uorb_info -> ardupilot_battery.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_info_to_ardupilot_battery_strict(
+    const battgen_uorb_BatteryInfo *info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep);
+
+/* uorb_info -> cbat, policy strict: uorb_info -> cbat.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_info_to_cbat_strict(const battgen_uorb_BatteryInfo *info,
+                                              battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                              battgen_loss_report *rep);
 
 /* uorb_info -> uorb, policy strict: uorb_info -> uorb.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -162,11 +330,24 @@ void battgen_convert_uorb_info_to_mavlink_strict(const battgen_uorb_BatteryInfo 
                                                  battgen_mavlink_BATTERY_STATUS *out_msg,
                                                  battgen_loss_report *rep);
 
+/* uorb_info -> mavlink_info, policy strict: uorb_info -> mavlink_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_info_to_mavlink_info_strict(const battgen_uorb_BatteryInfo *info,
+                                                      battgen_mavlink_BATTERY_INFO *out_info,
+                                                      battgen_loss_report *rep);
+
 /* uorb_info -> mavlink_v2, policy strict: uorb_info -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_uorb_info_to_mavlink_v2_strict(const battgen_uorb_BatteryInfo *info,
                                                     battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                     battgen_loss_report *rep);
+
+/* mavlink -> dronecan, policy strict: mavlink -> dronecan.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_dronecan_strict(
+    const battgen_mavlink_BATTERY_STATUS *msg,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
 
 /* mavlink -> dronecan, policy px4: px4_mavlink_receiver -> px4_uavcannode.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -174,6 +355,21 @@ void battgen_convert_mavlink_to_dronecan_px4(
     const battgen_mavlink_BATTERY_STATUS *msg,
     battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
     battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* mavlink -> ardupilot_battery, policy strict: mavlink -> ardupilot_battery.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_ardupilot_battery_strict(
+    const battgen_mavlink_BATTERY_STATUS *msg,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep);
+
+/* mavlink -> cbat, policy strict: mavlink -> cbat.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_cbat_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                            battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                            battgen_loss_report *rep);
 
 /* mavlink -> uorb, policy strict: mavlink -> uorb.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -187,17 +383,57 @@ void battgen_convert_mavlink_to_uorb_px4(const battgen_mavlink_BATTERY_STATUS *m
                                          battgen_uorb_BatteryStatus *out_status,
                                          battgen_loss_report *rep);
 
+/* mavlink -> uorb_info, policy strict: mavlink -> uorb_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_uorb_info_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                                 battgen_uorb_BatteryInfo *out_info,
+                                                 battgen_loss_report *rep);
+
+/* mavlink -> mavlink_info, policy strict: mavlink -> mavlink_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_mavlink_info_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                                    battgen_mavlink_BATTERY_INFO *out_info,
+                                                    battgen_loss_report *rep);
+
 /* mavlink -> mavlink_v2, policy strict: mavlink -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_to_mavlink_v2_strict(const battgen_mavlink_BATTERY_STATUS *msg,
                                                   battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                   battgen_loss_report *rep);
 
+/* mavlink_info -> dronecan, policy strict: mavlink_info -> dronecan.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_info_to_dronecan_strict(
+    const battgen_mavlink_BATTERY_INFO *info,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* mavlink_info -> ardupilot_battery, policy strict: mavlink_info -> ardupilot_battery.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_info_to_ardupilot_battery_strict(
+    const battgen_mavlink_BATTERY_INFO *info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep);
+
+/* mavlink_info -> cbat, policy strict: mavlink_info -> cbat.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_info_to_cbat_strict(
+    const battgen_mavlink_BATTERY_INFO *info, battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+    battgen_loss_report *rep);
+
 /* mavlink_info -> uorb, policy strict: mavlink_info -> uorb.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_info_to_uorb_strict(const battgen_mavlink_BATTERY_INFO *info,
                                                  battgen_uorb_BatteryStatus *out_status,
                                                  battgen_loss_report *rep);
+
+/* mavlink_info -> uorb_info, policy strict: mavlink_info -> uorb_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_info_to_uorb_info_strict(const battgen_mavlink_BATTERY_INFO *info,
+                                                      battgen_uorb_BatteryInfo *out_info,
+                                                      battgen_loss_report *rep);
 
 /* mavlink_info -> mavlink, policy strict: mavlink_info -> mavlink.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -211,11 +447,39 @@ void battgen_convert_mavlink_info_to_mavlink_v2_strict(
     const battgen_mavlink_BATTERY_INFO *info, battgen_mavlink_BATTERY_STATUS_V2 *out_status,
     battgen_loss_report *rep);
 
+/* mavlink_v2 -> dronecan, policy strict: mavlink_v2 -> dronecan.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_v2_to_dronecan_strict(
+    const battgen_mavlink_BATTERY_STATUS_V2 *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* mavlink_v2 -> ardupilot_battery, policy strict: mavlink_v2 -> ardupilot_battery.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_v2_to_ardupilot_battery_strict(
+    const battgen_mavlink_BATTERY_STATUS_V2 *status,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep);
+
+/* mavlink_v2 -> cbat, policy strict: mavlink_v2 -> cbat.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_v2_to_cbat_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
+                                               battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                               battgen_loss_report *rep);
+
 /* mavlink_v2 -> uorb, policy strict: mavlink_v2 -> uorb.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_v2_to_uorb_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
                                                battgen_uorb_BatteryStatus *out_status,
                                                battgen_loss_report *rep);
+
+/* mavlink_v2 -> uorb_info, policy strict: mavlink_v2 -> uorb_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_v2_to_uorb_info_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
+                                                    battgen_uorb_BatteryInfo *out_info,
+                                                    battgen_loss_report *rep);
 
 /* mavlink_v2 -> mavlink, policy strict: mavlink_v2 -> mavlink.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -223,17 +487,57 @@ void battgen_convert_mavlink_v2_to_mavlink_strict(const battgen_mavlink_BATTERY_
                                                   battgen_mavlink_BATTERY_STATUS *out_msg,
                                                   battgen_loss_report *rep);
 
+/* mavlink_v2 -> mavlink_info, policy strict: mavlink_v2 -> mavlink_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_v2_to_mavlink_info_strict(
+    const battgen_mavlink_BATTERY_STATUS_V2 *status, battgen_mavlink_BATTERY_INFO *out_info,
+    battgen_loss_report *rep);
+
+/* mavlink_sys_status -> dronecan, policy strict: mavlink_sys_status -> dronecan.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_sys_status_to_dronecan_strict(
+    const battgen_mavlink_SYS_STATUS *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* mavlink_sys_status -> ardupilot_battery, policy strict: mavlink_sys_status -> ardupilot_battery.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_sys_status_to_ardupilot_battery_strict(
+    const battgen_mavlink_SYS_STATUS *status,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep);
+
+/* mavlink_sys_status -> cbat, policy strict: mavlink_sys_status -> cbat.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_sys_status_to_cbat_strict(
+    const battgen_mavlink_SYS_STATUS *status, battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+    battgen_loss_report *rep);
+
 /* mavlink_sys_status -> uorb, policy strict: mavlink_sys_status -> uorb.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_sys_status_to_uorb_strict(const battgen_mavlink_SYS_STATUS *status,
                                                        battgen_uorb_BatteryStatus *out_status,
                                                        battgen_loss_report *rep);
 
+/* mavlink_sys_status -> uorb_info, policy strict: mavlink_sys_status -> uorb_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_sys_status_to_uorb_info_strict(
+    const battgen_mavlink_SYS_STATUS *status, battgen_uorb_BatteryInfo *out_info,
+    battgen_loss_report *rep);
+
 /* mavlink_sys_status -> mavlink, policy strict: mavlink_sys_status -> mavlink.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_sys_status_to_mavlink_strict(const battgen_mavlink_SYS_STATUS *status,
                                                           battgen_mavlink_BATTERY_STATUS *out_msg,
                                                           battgen_loss_report *rep);
+
+/* mavlink_sys_status -> mavlink_info, policy strict: mavlink_sys_status -> mavlink_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_sys_status_to_mavlink_info_strict(
+    const battgen_mavlink_SYS_STATUS *status, battgen_mavlink_BATTERY_INFO *out_info,
+    battgen_loss_report *rep);
 
 /* mavlink_sys_status -> mavlink_v2, policy strict: mavlink_sys_status -> mavlink_v2.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */

@@ -76,8 +76,6 @@ class ConceptCellOps(ConceptOps):
             return
         mul, add = unit_factor(c_unit, f_unit)
         target, label = self.t(fmt), self.label(fmt)
-        if t.dynamic:
-            raise Unsupported("cells into a dynamic array")
         self.emit(
             "size_t i, n;",
             f"if (!s->has_{name}) {{",
@@ -95,7 +93,10 @@ class ConceptCellOps(ConceptOps):
         else:
             self.emit(f"{target}[i] = {stored};")
         fill = literal(el, mark) if mark is not None else literal(el, 0)
-        self.emit("}", f"for (i = n; i < {cap}u; i++) {{ {target}[i] = {fill}; }}")
+        if t.dynamic:
+            self.emit("}", f"{target}_len = (uint16_t)n;")
+        else:
+            self.emit("}", f"for (i = n; i < {cap}u; i++) {{ {target}[i] = {fill}; }}")
         if count_ref is not None:
             count = self.t(count_ref)
             self.emit(

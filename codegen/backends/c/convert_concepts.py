@@ -6,8 +6,9 @@ clamped, rounded, written as a marker or has no counterpart is reported.
 
 The concepts are :data:`STATE` (``battgen_concepts``): per concept ``has_<name>`` (Python's
 ``None``) and its value -- a double for numbers, int64_t for integers, a code for a choice
-(``BATTGEN_<CONCEPT>_<CHOICE>``, 0 none), a bit per choice for flags, doubles for a list; a text
-concept holds only whether it is known (no C converter writes text yet)."""
+(``BATTGEN_<CONCEPT>_<CHOICE>``, 0 none), a bit per choice for flags, doubles for a list, UTF-8
+bytes for a text (bytes read from a byte array decoded as Python decodes them, invalid sequences
+as U+FFFD; a MAVLink string's chars as they are)."""
 
 from __future__ import annotations
 
@@ -22,6 +23,7 @@ from ...ir import (
     PrimitiveKind,
     PrimitiveType,
     Rule,
+    StringType,
     Unit,
     units,
 )
@@ -34,6 +36,7 @@ from .types import ident, scalar
 
 STATE = "battgen_concepts"
 LIST_MAX = 255  # the elements a list concept holds (DroneCAN's voltage_cell: up to 255)
+TEXT_MAX = 3 * 256  # the UTF-8 bytes a text concept holds (255 bytes, each possibly U+FFFD)
 _MARKED = "a known value written as the unknown marker"
 
 
@@ -87,6 +90,8 @@ def state_lines(concepts: dict[str, Concept]) -> list[str]:
             members.append(f"uint32_t {name}; /* {choice_name(c.name, '*')} bits */")
         elif c.kind == "list":
             members += [f"uint16_t {name}_len;", f"double {name}[{LIST_MAX}];{unit}"]
+        elif c.kind == "text":
+            members += [f"uint16_t {name}_len;", f"uint8_t {name}[{TEXT_MAX}]; /* UTF-8 */"]
     return [
         *defines,
         "",
@@ -175,7 +180,7 @@ class ConceptOps(CBase):
         p = self.prim(fmt)
         if p.kind is PrimitiveKind.FLOAT:
             if p.bits == 16:
-                return f"battgen_f16_round((float)({expr}), rep, {self.label(fmt)})"
+                return f"battgen_f16_round_d({expr}, rep, {self.label(fmt)})"
             return f"(float)({expr})" if p.bits == 32 else f"({expr})"
         if p.kind is PrimitiveKind.BOOL:
             return f"(({expr}) != 0)"
@@ -255,12 +260,7 @@ class ConceptOps(CBase):
         name = ident(con.field)
         if not self.backward:
             if kind == "text":
-                t = f.type
-                src = self.s(fmt)
-                # Python's text_in: bytes up to the first NUL, empty is unknown
-                known = (f"{src}_len > 0u && " if isinstance(t, ArrayType) and t.dynamic else "") + f"{src}[0] != 0"
-                self.emit(f"t->has_{name} = {known};")
-                self.written.add((CONCEPTS_ENDPOINT, con.field))
+                self.text_in(fmt, con)
                 return
             ctype, read = self.read_value(fmt)
             self.emit(f"{ctype} v = {read};")
@@ -277,7 +277,8 @@ class ConceptOps(CBase):
             self.emit(*([f"if ({' && '.join(tests)}) {{", *body, "}"] if tests else body))
             return
         if kind == "text":
-            raise Unsupported("text written to a field")
+            self.text_out(fmt, con)
+            return
         target, label = self.t(fmt), self.label(fmt)
         self.emit(f"if (!s->has_{name}) {{")
         if marks:
@@ -290,6 +291,57 @@ class ConceptOps(CBase):
         if kind != "bool":
             for m in (m for m in marks if not is_nan_value(m)):
                 self.emit(self.marked(target, fmt, m, label))
+        self.emit("}")
+
+    def text_in(self, fmt: FieldRef, con: FieldRef) -> None:
+        """Python's ``text_in``: a byte array up to its first NUL, decoded (invalid UTF-8 as U+FFFD); a
+        MAVLink string's chars as they are; empty is unknown."""
+        t = self.fld(fmt).type
+        src, name = self.s(fmt), ident(con.field)
+        self.written.add((CONCEPTS_ENDPOINT, con.field))
+        if isinstance(t, StringType):
+            cap = (t.capacity or 0) + 0
+            self.emit(
+                "size_t n = 0;",
+                f"while (n < {cap}u && {src}[n] != 0) {{ t->{name}[n] = (uint8_t){src}[n]; n++; }}",
+            )
+        elif isinstance(t, ArrayType) and isinstance(t.element, PrimitiveType) and t.element.bits == 8:
+            count = f"(size_t){src}_len" if t.dynamic else f"{t.capacity or 0}u"
+            self.emit(
+                "size_t n = 0;",
+                f"while (n < {count} && {src}[n] != 0u) {{ n++; }}",
+                f"n = battgen_utf8_replace((const uint8_t *){src}, n, t->{name});",
+            )
+        else:
+            raise Unsupported("text from a field that is not bytes")
+        self.emit(f"t->{name}_len = (uint16_t)n;", f"t->has_{name} = n > 0u;")
+
+    def text_out(self, fmt: FieldRef, con: FieldRef) -> None:
+        """Unknown: the field's empty text; else a string gets the text, a byte array its UTF-8 bytes
+        (Python's ``bytes_out``: beyond the capacity reported clamped and cut)."""
+        f = self.fld(fmt)
+        t = f.type
+        target, label, name = self.t(fmt), self.label(fmt), ident(con.field)
+        if not isinstance(t, StringType | ArrayType):
+            raise Unsupported("text into a number")
+        cap = t.capacity or 0
+        dynamic = isinstance(t, ArrayType) and t.dynamic
+        cast = "(char)" if isinstance(t, StringType) else ""
+        clear = f"{target}_len = 0u;" if dynamic else f"battgen_zero({target}, sizeof {target});"
+        self.emit(f"if (!s->has_{name}) {{")
+        if f.invalid is not None or dynamic:
+            self.emit(clear)
+        self.emit(f"battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, {label});", "} else {", "size_t i;")
+        self.emit(f"size_t n = (size_t)s->{name}_len;")
+        if not isinstance(t, StringType):
+            self.emit(f"if (n > {cap}u) {{ battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, {label}); n = {cap}u; }}")
+        else:
+            self.emit(f"if (n > {cap}u) {{ n = {cap}u; }} /* Python keeps the whole text; C has room for {cap} */")
+        if not dynamic:
+            self.emit(f"battgen_zero({target}, sizeof {target});")
+        self.emit(f"for (i = 0; i < n; i++) {{ {target}[i] = {cast}s->{name}[i]; }}")
+        if dynamic:
+            self.emit(f"{target}_len = (uint16_t)n;")
         self.emit("}")
 
     def visit_soc_hybrid(self, rule: Rule, op: o.SocHybrid) -> None:

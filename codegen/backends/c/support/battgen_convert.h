@@ -167,6 +167,58 @@ static inline float battgen_roundf(float x) {
   return battgen_f32_from(battgen_f32_bits(r) | (u & 0x80000000u));
 }
 
+/* Bytes as Python's bytes.decode("utf-8", "replace") and str.encode("utf-8") leave them: valid UTF-8
+ * kept, each maximal invalid subpart (Unicode's practice, CPython's) replaced by U+FFFD (EF BF BD).
+ * `out` has room for 3 * n bytes; returns how many it holds. */
+static inline size_t battgen_utf8_replace(const uint8_t *in, size_t n, uint8_t *out) {
+  size_t i = 0, o = 0, need, k;
+  uint8_t b, lo, hi, c;
+  while (i < n) {
+    b = in[i];
+    lo = 0x80u;
+    hi = 0xBFu;
+    if (b < 0x80u) {
+      out[o++] = b;
+      i++;
+      continue;
+    }
+    if (b >= 0xC2u && b <= 0xDFu) {
+      need = 1u;
+    } else if (b >= 0xE0u && b <= 0xEFu) {
+      need = 2u;
+      lo = b == 0xE0u ? 0xA0u : 0x80u;
+      hi = b == 0xEDu ? 0x9Fu : 0xBFu;
+    } else if (b >= 0xF0u && b <= 0xF4u) {
+      need = 3u;
+      lo = b == 0xF0u ? 0x90u : 0x80u;
+      hi = b == 0xF4u ? 0x8Fu : 0xBFu;
+    } else {
+      need = 0u; /* never a start byte */
+    }
+    for (k = 1u; k <= need; k++) {
+      if (i + k >= n) {
+        break;
+      }
+      c = in[i + k];
+      if (c < (k == 1u ? lo : 0x80u) || c > (k == 1u ? hi : 0xBFu)) {
+        break;
+      }
+    }
+    if (need > 0u && k > need) {
+      for (k = 0u; k <= need; k++) {
+        out[o++] = in[i + k];
+      }
+      i += need + 1u;
+    } else {
+      out[o++] = 0xEFu;
+      out[o++] = 0xBFu;
+      out[o++] = 0xBDu;
+      i += need > 0u ? k : 1u;
+    }
+  }
+  return o;
+}
+
 static inline float battgen_absf(float x) { return battgen_f32_from(battgen_f32_bits(x) & 0x7FFFFFFFu); }
 
 static inline bool battgen_f32_same(float a, float b) {
@@ -219,6 +271,34 @@ static inline float battgen_f16_round(float x, battgen_loss_report *rep, const c
     battgen_loss_add(rep, BATTGEN_LOSS_ROUNDED, field);
   }
   return y;
+}
+
+/* The float16 nearest a double (ties to even), as Python's struct "e" rounds it: the double is first
+ * made a float rounded to odd (exact for the half's 11 bits), a finite value beyond +-65504 clamped
+ * (reported), a changed value reported rounded. */
+static inline float battgen_f16_round_d(double x, battgen_loss_report *rep, const char *field) {
+  float f;
+  uint32_t u;
+  if (battgen_f64_is_nan(x) || battgen_f64_is_inf(x)) {
+    return (float)x;
+  }
+  if (x > 65504.0 || x < -65504.0) {
+    battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, field);
+    return x > 0.0 ? BATTGEN_F16_MAX : -BATTGEN_F16_MAX;
+  }
+  f = (float)x;
+  u = battgen_f32_bits(f);
+  if ((double)f != x) {
+    if ((f > 0.0f && (double)f > x) || (f < 0.0f && (double)f < x)) {
+      u -= 1u; /* toward zero: the float below the double's magnitude */
+    }
+    u |= 1u; /* sticky: round to odd */
+  }
+  f = battgen_f16_round(battgen_f32_from(u), NULL, NULL);
+  if ((double)f != x) {
+    battgen_loss_add(rep, BATTGEN_LOSS_ROUNDED, field);
+  }
+  return f;
 }
 
 /* C's float to int32 as VCVT.S32.F32: toward zero, saturated, NaN 0. */
