@@ -280,6 +280,17 @@ static void defaults_battgen_uorb_BatteryStatus(battgen_uorb_BatteryStatus *m) {
   (*m).nominal_voltage = battgen_f32_from(0x7FC00000u);
 }
 
+static void defaults_battgen_uorb_BatteryStatusV0(battgen_uorb_BatteryStatusV0 *m) {
+  battgen_zero(m, sizeof *m);
+  (*m).current_a = -1.0f;
+  (*m).current_average_a = -1.0f;
+  (*m).discharged_mah = -1.0f;
+  (*m).remaining = -1.0f;
+  (*m).scale = -1.0f;
+  (*m).time_remaining_s = battgen_f32_from(0x7FC00000u);
+  (*m).temperature = battgen_f32_from(0x7FC00000u);
+}
+
 static uint16_t saturate_uint16_11(uint16_t v) { return v > 2047u ? 2047u : v; }
 
 static uint8_t saturate_uint8_7(uint8_t v) { return v > 127u ? 127u : v; }
@@ -6333,6 +6344,217 @@ static void map_uorb_info_forward(const battgen_uorb_BatteryInfo *s_info, battge
   }
 }
 
+static void map_uorb_v0_down_forward(const battgen_uorb_BatteryStatus *s_status,
+                                     battgen_uorb_BatteryStatusV0 *t_status,
+                                     battgen_loss_report *rep, battgen_loss_report *rep_d,
+                                     battgen_loss_report *rep_u) {
+  (void)s_status;
+  (void)t_status;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_uorb_BatteryStatusV0(t_status);
+  /* uorb_versions.yaml:21: same_names */
+  {
+    size_t i;
+    t_status->timestamp = (uint64_t)s_status->timestamp;
+    t_status->connected = (bool)s_status->connected;
+    t_status->voltage_v = (float)s_status->voltage_v;
+    t_status->current_a = (float)s_status->current_a;
+    t_status->current_average_a = (float)s_status->current_average_a;
+    t_status->discharged_mah = (float)s_status->discharged_mah;
+    t_status->remaining = (float)s_status->remaining;
+    t_status->scale = (float)s_status->scale;
+    t_status->time_remaining_s = (float)s_status->time_remaining_s;
+    t_status->temperature = (float)s_status->temperature;
+    t_status->cell_count = (uint8_t)s_status->cell_count;
+    t_status->source = (uint8_t)s_status->source;
+    t_status->priority = (uint8_t)s_status->priority;
+    t_status->capacity = (uint16_t)s_status->capacity;
+    t_status->cycle_count = (uint16_t)s_status->cycle_count;
+    t_status->average_time_to_empty = (uint16_t)s_status->average_time_to_empty;
+    t_status->manufacture_date = (uint16_t)s_status->manufacture_date;
+    t_status->state_of_health = (uint16_t)s_status->state_of_health;
+    t_status->max_error = (uint16_t)s_status->max_error;
+    t_status->id = (uint8_t)s_status->id;
+    t_status->interface_error = (uint16_t)s_status->interface_error;
+    for (i = 0; i < 14u; i++) {
+      t_status->voltage_cell_v[i] = s_status->voltage_cell_v[i];
+    }
+    t_status->max_cell_voltage_delta = (float)s_status->max_cell_voltage_delta;
+    t_status->is_powering_off = (bool)s_status->is_powering_off;
+    t_status->is_required = (bool)s_status->is_required;
+    t_status->warning = (uint8_t)s_status->warning;
+    t_status->faults = (uint16_t)s_status->faults;
+    t_status->full_charge_capacity_wh = (float)s_status->full_charge_capacity_wh;
+    t_status->remaining_capacity_wh = (float)s_status->remaining_capacity_wh;
+    t_status->over_discharge_count = (uint16_t)s_status->over_discharge_count;
+    t_status->nominal_voltage = (float)s_status->nominal_voltage;
+    t_status->internal_resistance_estimate = (float)s_status->internal_resistance_estimate;
+    t_status->ocv_estimate = (float)s_status->ocv_estimate;
+    t_status->ocv_estimate_filtered = (float)s_status->ocv_estimate_filtered;
+    t_status->volt_based_soc_estimate = (float)s_status->volt_based_soc_estimate;
+    t_status->voltage_prediction = (float)s_status->voltage_prediction;
+    t_status->prediction_error = (float)s_status->prediction_error;
+    t_status->estimation_covariance_norm = (float)s_status->estimation_covariance_norm;
+  }
+  /* uorb_versions.yaml:22: const */
+  { t_status->serial_number = (uint16_t)0u; }
+  /* what did not survive the conversion */
+  if (t_status->voltage_v == 0.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.voltage_v");
+  }
+  if (t_status->current_a == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.current_a");
+  }
+  if (t_status->current_average_a == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.current_average_a");
+  }
+  if (t_status->discharged_mah == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.discharged_mah");
+  }
+  if (t_status->remaining == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.remaining");
+  }
+  if (t_status->scale == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.scale");
+  }
+  if (battgen_f32_is_nan(t_status->time_remaining_s)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.time_remaining_s");
+  }
+  if (battgen_f32_is_nan(t_status->temperature)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.temperature");
+  }
+  if (t_status->cell_count == (uint8_t)0u) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.cell_count");
+  }
+  {
+    size_t i;
+    bool all = true;
+    for (i = 0; i < 14u; i++) {
+      if (!(t_status->voltage_cell_v[i] == 0.0f)) {
+        all = false;
+      }
+    }
+    if (all) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatusV0.voltage_cell_v");
+    }
+  }
+}
+
+static void map_uorb_v0_up_forward(const battgen_uorb_BatteryStatusV0 *s_status,
+                                   battgen_uorb_BatteryStatus *t_status, battgen_loss_report *rep,
+                                   battgen_loss_report *rep_d, battgen_loss_report *rep_u) {
+  (void)s_status;
+  (void)t_status;
+  (void)rep;
+  (void)rep_d;
+  (void)rep_u;
+  defaults_battgen_uorb_BatteryStatus(t_status);
+  /* uorb_versions.yaml:13: same_names */
+  {
+    size_t i;
+    t_status->timestamp = (uint64_t)s_status->timestamp;
+    t_status->connected = (bool)s_status->connected;
+    t_status->voltage_v = (float)s_status->voltage_v;
+    t_status->current_a = (float)s_status->current_a;
+    t_status->current_average_a = (float)s_status->current_average_a;
+    t_status->discharged_mah = (float)s_status->discharged_mah;
+    t_status->remaining = (float)s_status->remaining;
+    t_status->scale = (float)s_status->scale;
+    t_status->time_remaining_s = (float)s_status->time_remaining_s;
+    t_status->temperature = (float)s_status->temperature;
+    t_status->cell_count = (uint8_t)s_status->cell_count;
+    t_status->source = (uint8_t)s_status->source;
+    t_status->priority = (uint8_t)s_status->priority;
+    t_status->capacity = (uint16_t)s_status->capacity;
+    t_status->cycle_count = (uint16_t)s_status->cycle_count;
+    t_status->average_time_to_empty = (uint16_t)s_status->average_time_to_empty;
+    t_status->manufacture_date = (uint16_t)s_status->manufacture_date;
+    t_status->state_of_health = (uint16_t)s_status->state_of_health;
+    t_status->max_error = (uint16_t)s_status->max_error;
+    t_status->id = (uint8_t)s_status->id;
+    t_status->interface_error = (uint16_t)s_status->interface_error;
+    for (i = 0; i < 14u; i++) {
+      t_status->voltage_cell_v[i] = s_status->voltage_cell_v[i];
+    }
+    t_status->max_cell_voltage_delta = (float)s_status->max_cell_voltage_delta;
+    t_status->is_powering_off = (bool)s_status->is_powering_off;
+    t_status->is_required = (bool)s_status->is_required;
+    t_status->warning = (uint8_t)s_status->warning;
+    t_status->faults = (uint16_t)s_status->faults;
+    t_status->full_charge_capacity_wh = (float)s_status->full_charge_capacity_wh;
+    t_status->remaining_capacity_wh = (float)s_status->remaining_capacity_wh;
+    t_status->over_discharge_count = (uint16_t)s_status->over_discharge_count;
+    t_status->nominal_voltage = (float)s_status->nominal_voltage;
+    t_status->internal_resistance_estimate = (float)s_status->internal_resistance_estimate;
+    t_status->ocv_estimate = (float)s_status->ocv_estimate;
+    t_status->ocv_estimate_filtered = (float)s_status->ocv_estimate_filtered;
+    t_status->volt_based_soc_estimate = (float)s_status->volt_based_soc_estimate;
+    t_status->voltage_prediction = (float)s_status->voltage_prediction;
+    t_status->prediction_error = (float)s_status->prediction_error;
+    t_status->estimation_covariance_norm = (float)s_status->estimation_covariance_norm;
+  }
+  /* what did not survive the conversion */
+  if (rep_d != NULL && s_status != NULL) {
+    battgen_uorb_BatteryStatusV0 fresh;
+    bool d;
+    defaults_battgen_uorb_BatteryStatusV0(&fresh);
+    d = false;
+    if (s_status->serial_number != fresh.serial_number) {
+      d = true;
+    }
+    if (d) {
+      battgen_loss_add(rep_d, BATTGEN_LOSS_DROPPED, "uorb.BatteryStatusV0.serial_number");
+    }
+  }
+  if (t_status->voltage_v == 0.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.voltage_v");
+  }
+  if (t_status->current_a == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.current_a");
+  }
+  if (t_status->current_average_a == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.current_average_a");
+  }
+  if (t_status->discharged_mah == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.discharged_mah");
+  }
+  if (t_status->remaining == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.remaining");
+  }
+  if (t_status->scale == -1.0f) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.scale");
+  }
+  if (battgen_f32_is_nan(t_status->time_remaining_s)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.time_remaining_s");
+  }
+  if (battgen_f32_is_nan(t_status->temperature)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.temperature");
+  }
+  if (t_status->cell_count == (uint8_t)0u) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.cell_count");
+  }
+  {
+    size_t i;
+    bool all = true;
+    for (i = 0; i < 14u; i++) {
+      if (!(t_status->voltage_cell_v[i] == 0.0f)) {
+        all = false;
+      }
+    }
+    if (all) {
+      battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.voltage_cell_v");
+    }
+  }
+  if (battgen_f32_is_nan(t_status->remaining_capacity_wh)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.remaining_capacity_wh");
+  }
+  if (battgen_f32_is_nan(t_status->nominal_voltage)) {
+    battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, "uorb.BatteryStatus.nominal_voltage");
+  }
+}
+
 void battgen_convert_dronecan_to_ardupilot_battery_strict(
     const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
     const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
@@ -6370,6 +6592,27 @@ void battgen_convert_dronecan_to_uorb_px4(
     const float *discharged_mah_before, battgen_uorb_BatteryStatus *out_status,
     battgen_loss_report *rep) {
   map_px4_uavcan_bridge_forward(info, aux, dt_s, discharged_mah_before, out_status, rep, rep, rep);
+}
+
+void battgen_convert_dronecan_to_uorb_v0_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_uorb_BatteryStatusV0 *out_status, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  battgen_uorb_BatteryStatus c2_0;
+  map_dronecan_forward(info, aux, &c1, rep, rep, NULL);
+  map_uorb_backward(&c1, &c2_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c2_0, out_status, rep, rep, rep);
+}
+
+void battgen_convert_dronecan_to_uorb_v0_px4(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux, const float *dt_s,
+    const float *discharged_mah_before, battgen_uorb_BatteryStatusV0 *out_status,
+    battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  map_px4_uavcan_bridge_forward(info, aux, dt_s, discharged_mah_before, &c1_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c1_0, out_status, rep, NULL, rep);
 }
 
 void battgen_convert_dronecan_to_uorb_info_strict(
@@ -6452,6 +6695,19 @@ void battgen_convert_ardupilot_battery_to_uorb_strict(
   map_uorb_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_ardupilot_battery_to_uorb_v0_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_uorb_BatteryStatusV0 *out_status, battgen_loss_report *rep) {
+  battgen_concepts c1;
+  battgen_uorb_BatteryStatus c2_0;
+  map_ardupilot_battery_forward(continuous, periodic, cells, tag, &c1, rep, rep, NULL);
+  map_uorb_backward(&c1, &c2_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c2_0, out_status, rep, rep, rep);
+}
+
 void battgen_convert_ardupilot_battery_to_uorb_info_strict(
     const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
     const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
@@ -6525,6 +6781,16 @@ void battgen_convert_cbat_to_uorb_strict(const battgen_dronecan_cuav_equipment_p
   map_uorb_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_cbat_to_uorb_v0_strict(const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+                                            battgen_uorb_BatteryStatusV0 *out_status,
+                                            battgen_loss_report *rep) {
+  battgen_concepts c1;
+  battgen_uorb_BatteryStatus c2_0;
+  map_cbat_forward(cbat, &c1, rep, rep, NULL);
+  map_uorb_backward(&c1, &c2_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c2_0, out_status, rep, rep, rep);
+}
+
 void battgen_convert_cbat_to_uorb_info_strict(
     const battgen_dronecan_cuav_equipment_power_CBAT *cbat, battgen_uorb_BatteryInfo *out_info,
     battgen_loss_report *rep) {
@@ -6593,6 +6859,18 @@ void battgen_convert_uorb_to_cbat_strict(const battgen_uorb_BatteryStatus *statu
   map_cbat_backward(&c1, out_cbat, rep, rep, rep);
 }
 
+void battgen_convert_uorb_to_uorb_v0_strict(const battgen_uorb_BatteryStatus *status,
+                                            battgen_uorb_BatteryStatusV0 *out_status,
+                                            battgen_loss_report *rep) {
+  map_uorb_v0_down_forward(status, out_status, rep, rep, rep);
+}
+
+void battgen_convert_uorb_to_uorb_v0_px4(const battgen_uorb_BatteryStatus *status,
+                                         battgen_uorb_BatteryStatusV0 *out_status,
+                                         battgen_loss_report *rep) {
+  map_uorb_v0_down_forward(status, out_status, rep, rep, rep);
+}
+
 void battgen_convert_uorb_to_uorb_info_strict(const battgen_uorb_BatteryStatus *status,
                                               battgen_uorb_BatteryInfo *out_info,
                                               battgen_loss_report *rep) {
@@ -6631,6 +6909,110 @@ void battgen_convert_uorb_to_mavlink_v2_strict(const battgen_uorb_BatteryStatus 
   map_mavlink_v2_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_uorb_v0_to_dronecan_strict(
+    const battgen_uorb_BatteryStatusV0 *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  battgen_concepts c2;
+  map_uorb_v0_up_forward(status, &c1_0, rep, rep, NULL);
+  map_uorb_forward(&c1_0, &c2, rep, rep, NULL);
+  map_dronecan_backward(&c2, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_uorb_v0_to_dronecan_px4(
+    const battgen_uorb_BatteryStatusV0 *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  map_uorb_v0_up_forward(status, &c1_0, rep, rep, NULL);
+  map_px4_uavcannode_forward(&c1_0, out_info, out_aux, rep, rep, rep);
+}
+
+void battgen_convert_uorb_v0_to_ardupilot_battery_strict(
+    const battgen_uorb_BatteryStatusV0 *status,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  battgen_concepts c2;
+  map_uorb_v0_up_forward(status, &c1_0, rep, rep, NULL);
+  map_uorb_forward(&c1_0, &c2, rep, rep, NULL);
+  map_ardupilot_battery_backward(&c2, out_continuous, out_periodic, out_cells, out_tag, rep, rep,
+                                 rep);
+}
+
+void battgen_convert_uorb_v0_to_cbat_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                            battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                            battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  battgen_concepts c2;
+  map_uorb_v0_up_forward(status, &c1_0, rep, rep, NULL);
+  map_uorb_forward(&c1_0, &c2, rep, rep, NULL);
+  map_cbat_backward(&c2, out_cbat, rep, rep, rep);
+}
+
+void battgen_convert_uorb_v0_to_uorb_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                            battgen_uorb_BatteryStatus *out_status,
+                                            battgen_loss_report *rep) {
+  map_uorb_v0_up_forward(status, out_status, rep, rep, rep);
+}
+
+void battgen_convert_uorb_v0_to_uorb_px4(const battgen_uorb_BatteryStatusV0 *status,
+                                         battgen_uorb_BatteryStatus *out_status,
+                                         battgen_loss_report *rep) {
+  map_uorb_v0_up_forward(status, out_status, rep, rep, rep);
+}
+
+void battgen_convert_uorb_v0_to_uorb_info_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                                 battgen_uorb_BatteryInfo *out_info,
+                                                 battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  battgen_concepts c2;
+  map_uorb_v0_up_forward(status, &c1_0, rep, rep, NULL);
+  map_uorb_forward(&c1_0, &c2, rep, rep, NULL);
+  map_uorb_info_backward(&c2, out_info, rep, rep, rep);
+}
+
+void battgen_convert_uorb_v0_to_mavlink_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                               battgen_mavlink_BATTERY_STATUS *out_msg,
+                                               battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  battgen_concepts c2;
+  map_uorb_v0_up_forward(status, &c1_0, rep, rep, NULL);
+  map_uorb_forward(&c1_0, &c2, rep, rep, NULL);
+  map_mavlink_backward(&c2, out_msg, rep, rep, rep);
+}
+
+void battgen_convert_uorb_v0_to_mavlink_px4(const battgen_uorb_BatteryStatusV0 *status,
+                                            battgen_mavlink_BATTERY_STATUS *out_msg,
+                                            battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  map_uorb_v0_up_forward(status, &c1_0, rep, rep, NULL);
+  map_px4_mavlink_stream_forward(&c1_0, out_msg, rep, rep, rep);
+}
+
+void battgen_convert_uorb_v0_to_mavlink_info_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                                    battgen_mavlink_BATTERY_INFO *out_info,
+                                                    battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  battgen_concepts c2;
+  map_uorb_v0_up_forward(status, &c1_0, rep, rep, NULL);
+  map_uorb_forward(&c1_0, &c2, rep, rep, NULL);
+  map_mavlink_info_backward(&c2, out_info, rep, rep, rep);
+}
+
+void battgen_convert_uorb_v0_to_mavlink_v2_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                                  battgen_mavlink_BATTERY_STATUS_V2 *out_status,
+                                                  battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  battgen_concepts c2;
+  map_uorb_v0_up_forward(status, &c1_0, rep, rep, NULL);
+  map_uorb_forward(&c1_0, &c2, rep, rep, NULL);
+  map_mavlink_v2_backward(&c2, out_status, rep, rep, rep);
+}
+
 void battgen_convert_uorb_info_to_dronecan_strict(
     const battgen_uorb_BatteryInfo *info,
     battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
@@ -6666,6 +7048,16 @@ void battgen_convert_uorb_info_to_uorb_strict(const battgen_uorb_BatteryInfo *in
   battgen_concepts c1;
   map_uorb_info_forward(info, &c1, rep, rep, NULL);
   map_uorb_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_uorb_info_to_uorb_v0_strict(const battgen_uorb_BatteryInfo *info,
+                                                 battgen_uorb_BatteryStatusV0 *out_status,
+                                                 battgen_loss_report *rep) {
+  battgen_concepts c1;
+  battgen_uorb_BatteryStatus c2_0;
+  map_uorb_info_forward(info, &c1, rep, rep, NULL);
+  map_uorb_backward(&c1, &c2_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c2_0, out_status, rep, rep, rep);
 }
 
 void battgen_convert_uorb_info_to_mavlink_strict(const battgen_uorb_BatteryInfo *info,
@@ -6744,6 +7136,24 @@ void battgen_convert_mavlink_to_uorb_px4(const battgen_mavlink_BATTERY_STATUS *m
   map_px4_mavlink_receiver_forward(msg, out_status, rep, rep, rep);
 }
 
+void battgen_convert_mavlink_to_uorb_v0_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                               battgen_uorb_BatteryStatusV0 *out_status,
+                                               battgen_loss_report *rep) {
+  battgen_concepts c1;
+  battgen_uorb_BatteryStatus c2_0;
+  map_mavlink_forward(msg, &c1, rep, rep, NULL);
+  map_uorb_backward(&c1, &c2_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c2_0, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_to_uorb_v0_px4(const battgen_mavlink_BATTERY_STATUS *msg,
+                                            battgen_uorb_BatteryStatusV0 *out_status,
+                                            battgen_loss_report *rep) {
+  battgen_uorb_BatteryStatus c1_0;
+  map_px4_mavlink_receiver_forward(msg, &c1_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c1_0, out_status, rep, NULL, rep);
+}
+
 void battgen_convert_mavlink_to_uorb_info_strict(const battgen_mavlink_BATTERY_STATUS *msg,
                                                  battgen_uorb_BatteryInfo *out_info,
                                                  battgen_loss_report *rep) {
@@ -6803,6 +7213,16 @@ void battgen_convert_mavlink_info_to_uorb_strict(const battgen_mavlink_BATTERY_I
   battgen_concepts c1;
   map_mavlink_info_forward(info, &c1, rep, rep, NULL);
   map_uorb_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_info_to_uorb_v0_strict(const battgen_mavlink_BATTERY_INFO *info,
+                                                    battgen_uorb_BatteryStatusV0 *out_status,
+                                                    battgen_loss_report *rep) {
+  battgen_concepts c1;
+  battgen_uorb_BatteryStatus c2_0;
+  map_mavlink_info_forward(info, &c1, rep, rep, NULL);
+  map_uorb_backward(&c1, &c2_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c2_0, out_status, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_info_to_uorb_info_strict(const battgen_mavlink_BATTERY_INFO *info,
@@ -6866,6 +7286,16 @@ void battgen_convert_mavlink_v2_to_uorb_strict(const battgen_mavlink_BATTERY_STA
   map_uorb_backward(&c1, out_status, rep, rep, rep);
 }
 
+void battgen_convert_mavlink_v2_to_uorb_v0_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
+                                                  battgen_uorb_BatteryStatusV0 *out_status,
+                                                  battgen_loss_report *rep) {
+  battgen_concepts c1;
+  battgen_uorb_BatteryStatus c2_0;
+  map_mavlink_v2_forward(status, &c1, rep, rep, NULL);
+  map_uorb_backward(&c1, &c2_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c2_0, out_status, rep, rep, rep);
+}
+
 void battgen_convert_mavlink_v2_to_uorb_info_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
                                                     battgen_uorb_BatteryInfo *out_info,
                                                     battgen_loss_report *rep) {
@@ -6925,6 +7355,16 @@ void battgen_convert_mavlink_sys_status_to_uorb_strict(const battgen_mavlink_SYS
   battgen_concepts c1;
   map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
   map_uorb_backward(&c1, out_status, rep, rep, rep);
+}
+
+void battgen_convert_mavlink_sys_status_to_uorb_v0_strict(const battgen_mavlink_SYS_STATUS *status,
+                                                          battgen_uorb_BatteryStatusV0 *out_status,
+                                                          battgen_loss_report *rep) {
+  battgen_concepts c1;
+  battgen_uorb_BatteryStatus c2_0;
+  map_mavlink_sys_status_forward(status, &c1, rep, rep, NULL);
+  map_uorb_backward(&c1, &c2_0, rep, rep, NULL);
+  map_uorb_v0_down_forward(&c2_0, out_status, rep, rep, rep);
 }
 
 void battgen_convert_mavlink_sys_status_to_uorb_info_strict(

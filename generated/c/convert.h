@@ -20,6 +20,7 @@
 #include "mavlink/SYS_STATUS.h"
 #include "uorb/BatteryInfo.h"
 #include "uorb/BatteryStatus.h"
+#include "uorb/BatteryStatusV0.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -61,6 +62,25 @@ void battgen_convert_dronecan_to_uorb_px4(
     const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
     const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux, const float *dt_s,
     const float *discharged_mah_before, battgen_uorb_BatteryStatus *out_status,
+    battgen_loss_report *rep);
+
+/* dronecan -> uorb_v0, policy strict: dronecan -> uorb -> uorb_v0_down.
+ * `aux` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_uorb_v0_strict(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux,
+    battgen_uorb_BatteryStatusV0 *out_status, battgen_loss_report *rep);
+
+/* dronecan -> uorb_v0, policy px4: px4_uavcan_bridge -> uorb_v0_down.
+ * `aux` may be NULL (not received).
+ * `dt_s` may be NULL (not given).
+ * `discharged_mah_before` may be NULL (not given).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_dronecan_to_uorb_v0_px4(
+    const battgen_dronecan_uavcan_equipment_power_BatteryInfo *info,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *aux, const float *dt_s,
+    const float *discharged_mah_before, battgen_uorb_BatteryStatusV0 *out_status,
     battgen_loss_report *rep);
 
 /* dronecan -> uorb_info, policy strict: dronecan -> uorb_info.
@@ -143,6 +163,18 @@ void battgen_convert_ardupilot_battery_to_uorb_strict(
     const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
     battgen_uorb_BatteryStatus *out_status, battgen_loss_report *rep);
 
+/* ardupilot_battery -> uorb_v0, policy strict: ardupilot_battery -> uorb -> uorb_v0_down.
+ * `periodic` may be NULL (not received).
+ * `cells` may be NULL (not received).
+ * `tag` may be NULL (not received).
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_ardupilot_battery_to_uorb_v0_strict(
+    const battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *continuous,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *periodic,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryCells *cells,
+    const battgen_dronecan_ardupilot_equipment_power_BatteryTag *tag,
+    battgen_uorb_BatteryStatusV0 *out_status, battgen_loss_report *rep);
+
 /* ardupilot_battery -> uorb_info, policy strict: ardupilot_battery -> uorb_info.
  * `periodic` may be NULL (not received).
  * `cells` may be NULL (not received).
@@ -213,6 +245,12 @@ void battgen_convert_cbat_to_uorb_strict(const battgen_dronecan_cuav_equipment_p
                                          battgen_uorb_BatteryStatus *out_status,
                                          battgen_loss_report *rep);
 
+/* cbat -> uorb_v0, policy strict: cbat -> uorb -> uorb_v0_down.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_cbat_to_uorb_v0_strict(const battgen_dronecan_cuav_equipment_power_CBAT *cbat,
+                                            battgen_uorb_BatteryStatusV0 *out_status,
+                                            battgen_loss_report *rep);
+
 /* cbat -> uorb_info, policy strict: cbat -> uorb_info.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_cbat_to_uorb_info_strict(
@@ -266,6 +304,18 @@ void battgen_convert_uorb_to_cbat_strict(const battgen_uorb_BatteryStatus *statu
                                          battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
                                          battgen_loss_report *rep);
 
+/* uorb -> uorb_v0, policy strict: uorb_v0_down.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_uorb_v0_strict(const battgen_uorb_BatteryStatus *status,
+                                            battgen_uorb_BatteryStatusV0 *out_status,
+                                            battgen_loss_report *rep);
+
+/* uorb -> uorb_v0, policy px4: uorb_v0_down.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_to_uorb_v0_px4(const battgen_uorb_BatteryStatus *status,
+                                         battgen_uorb_BatteryStatusV0 *out_status,
+                                         battgen_loss_report *rep);
+
 /* uorb -> uorb_info, policy strict: uorb -> uorb_info.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_uorb_to_uorb_info_strict(const battgen_uorb_BatteryStatus *status,
@@ -296,6 +346,77 @@ void battgen_convert_uorb_to_mavlink_v2_strict(const battgen_uorb_BatteryStatus 
                                                battgen_mavlink_BATTERY_STATUS_V2 *out_status,
                                                battgen_loss_report *rep);
 
+/* uorb_v0 -> dronecan, policy strict: uorb_v0_up -> uorb -> dronecan.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_dronecan_strict(
+    const battgen_uorb_BatteryStatusV0 *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* uorb_v0 -> dronecan, policy px4: uorb_v0_up -> px4_uavcannode.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_dronecan_px4(
+    const battgen_uorb_BatteryStatusV0 *status,
+    battgen_dronecan_uavcan_equipment_power_BatteryInfo *out_info,
+    battgen_dronecan_ardupilot_equipment_power_BatteryInfoAux *out_aux, battgen_loss_report *rep);
+
+/* uorb_v0 -> ardupilot_battery, policy strict: uorb_v0_up -> uorb -> ardupilot_battery.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_ardupilot_battery_strict(
+    const battgen_uorb_BatteryStatusV0 *status,
+    battgen_dronecan_ardupilot_equipment_power_BatteryContinuous *out_continuous,
+    battgen_dronecan_ardupilot_equipment_power_BatteryPeriodic *out_periodic,
+    battgen_dronecan_ardupilot_equipment_power_BatteryCells *out_cells,
+    battgen_dronecan_ardupilot_equipment_power_BatteryTag *out_tag, battgen_loss_report *rep);
+
+/* uorb_v0 -> cbat, policy strict: uorb_v0_up -> uorb -> cbat.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_cbat_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                            battgen_dronecan_cuav_equipment_power_CBAT *out_cbat,
+                                            battgen_loss_report *rep);
+
+/* uorb_v0 -> uorb, policy strict: uorb_v0_up.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_uorb_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                            battgen_uorb_BatteryStatus *out_status,
+                                            battgen_loss_report *rep);
+
+/* uorb_v0 -> uorb, policy px4: uorb_v0_up.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_uorb_px4(const battgen_uorb_BatteryStatusV0 *status,
+                                         battgen_uorb_BatteryStatus *out_status,
+                                         battgen_loss_report *rep);
+
+/* uorb_v0 -> uorb_info, policy strict: uorb_v0_up -> uorb -> uorb_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_uorb_info_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                                 battgen_uorb_BatteryInfo *out_info,
+                                                 battgen_loss_report *rep);
+
+/* uorb_v0 -> mavlink, policy strict: uorb_v0_up -> uorb -> mavlink.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_mavlink_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                               battgen_mavlink_BATTERY_STATUS *out_msg,
+                                               battgen_loss_report *rep);
+
+/* uorb_v0 -> mavlink, policy px4: uorb_v0_up -> px4_mavlink_stream.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_mavlink_px4(const battgen_uorb_BatteryStatusV0 *status,
+                                            battgen_mavlink_BATTERY_STATUS *out_msg,
+                                            battgen_loss_report *rep);
+
+/* uorb_v0 -> mavlink_info, policy strict: uorb_v0_up -> uorb -> mavlink_info.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_mavlink_info_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                                    battgen_mavlink_BATTERY_INFO *out_info,
+                                                    battgen_loss_report *rep);
+
+/* uorb_v0 -> mavlink_v2, policy strict: uorb_v0_up -> uorb -> mavlink_v2.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_v0_to_mavlink_v2_strict(const battgen_uorb_BatteryStatusV0 *status,
+                                                  battgen_mavlink_BATTERY_STATUS_V2 *out_status,
+                                                  battgen_loss_report *rep);
+
 /* uorb_info -> dronecan, policy strict: uorb_info -> dronecan.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_uorb_info_to_dronecan_strict(
@@ -323,6 +444,12 @@ void battgen_convert_uorb_info_to_cbat_strict(const battgen_uorb_BatteryInfo *in
 void battgen_convert_uorb_info_to_uorb_strict(const battgen_uorb_BatteryInfo *info,
                                               battgen_uorb_BatteryStatus *out_status,
                                               battgen_loss_report *rep);
+
+/* uorb_info -> uorb_v0, policy strict: uorb_info -> uorb -> uorb_v0_down.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_uorb_info_to_uorb_v0_strict(const battgen_uorb_BatteryInfo *info,
+                                                 battgen_uorb_BatteryStatusV0 *out_status,
+                                                 battgen_loss_report *rep);
 
 /* uorb_info -> mavlink, policy strict: uorb_info -> mavlink.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -383,6 +510,18 @@ void battgen_convert_mavlink_to_uorb_px4(const battgen_mavlink_BATTERY_STATUS *m
                                          battgen_uorb_BatteryStatus *out_status,
                                          battgen_loss_report *rep);
 
+/* mavlink -> uorb_v0, policy strict: mavlink -> uorb -> uorb_v0_down.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_uorb_v0_strict(const battgen_mavlink_BATTERY_STATUS *msg,
+                                               battgen_uorb_BatteryStatusV0 *out_status,
+                                               battgen_loss_report *rep);
+
+/* mavlink -> uorb_v0, policy px4: px4_mavlink_receiver -> uorb_v0_down.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_to_uorb_v0_px4(const battgen_mavlink_BATTERY_STATUS *msg,
+                                            battgen_uorb_BatteryStatusV0 *out_status,
+                                            battgen_loss_report *rep);
+
 /* mavlink -> uorb_info, policy strict: mavlink -> uorb_info.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_to_uorb_info_strict(const battgen_mavlink_BATTERY_STATUS *msg,
@@ -428,6 +567,12 @@ void battgen_convert_mavlink_info_to_cbat_strict(
 void battgen_convert_mavlink_info_to_uorb_strict(const battgen_mavlink_BATTERY_INFO *info,
                                                  battgen_uorb_BatteryStatus *out_status,
                                                  battgen_loss_report *rep);
+
+/* mavlink_info -> uorb_v0, policy strict: mavlink_info -> uorb -> uorb_v0_down.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_info_to_uorb_v0_strict(const battgen_mavlink_BATTERY_INFO *info,
+                                                    battgen_uorb_BatteryStatusV0 *out_status,
+                                                    battgen_loss_report *rep);
 
 /* mavlink_info -> uorb_info, policy strict: mavlink_info -> uorb_info.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
@@ -475,6 +620,12 @@ void battgen_convert_mavlink_v2_to_uorb_strict(const battgen_mavlink_BATTERY_STA
                                                battgen_uorb_BatteryStatus *out_status,
                                                battgen_loss_report *rep);
 
+/* mavlink_v2 -> uorb_v0, policy strict: mavlink_v2 -> uorb -> uorb_v0_down.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_v2_to_uorb_v0_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
+                                                  battgen_uorb_BatteryStatusV0 *out_status,
+                                                  battgen_loss_report *rep);
+
 /* mavlink_v2 -> uorb_info, policy strict: mavlink_v2 -> uorb_info.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
 void battgen_convert_mavlink_v2_to_uorb_info_strict(const battgen_mavlink_BATTERY_STATUS_V2 *status,
@@ -520,6 +671,12 @@ void battgen_convert_mavlink_sys_status_to_cbat_strict(
 void battgen_convert_mavlink_sys_status_to_uorb_strict(const battgen_mavlink_SYS_STATUS *status,
                                                        battgen_uorb_BatteryStatus *out_status,
                                                        battgen_loss_report *rep);
+
+/* mavlink_sys_status -> uorb_v0, policy strict: mavlink_sys_status -> uorb -> uorb_v0_down.
+ * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */
+void battgen_convert_mavlink_sys_status_to_uorb_v0_strict(const battgen_mavlink_SYS_STATUS *status,
+                                                          battgen_uorb_BatteryStatusV0 *out_status,
+                                                          battgen_loss_report *rep);
 
 /* mavlink_sys_status -> uorb_info, policy strict: mavlink_sys_status -> uorb_info.
  * The targets are written whole; what did not survive is added to `rep` (NULL: not reported). */

@@ -49,6 +49,28 @@ class PX4Ops(CBase):
                 raise Unsupported("a constant into an array")
             self.emit(f"{self.t(ref)} = {literal(self.prim(ref), value)};")
 
+    def visit_same_names(self, rule: Rule, op: o.SameNames) -> None:
+        """uORB versions: every field of the same name copied as it is."""
+        src_m = self.schema.message(rule.sources[0].message)
+        dst_m = self.schema.message(rule.targets[0].message)
+        dst_fields = {f.name: f for f in dst_m.fields}
+        loops = False
+        lines: list[str] = []
+        for f in src_m.fields:
+            g = dst_fields.get(f.name)
+            if f.is_padding or g is None:
+                continue
+            src = self.s(FieldRef(src_m.qualified_name, f.name))
+            dst = self.t(FieldRef(dst_m.qualified_name, g.name))
+            if isinstance(f.type, PrimitiveType) and isinstance(g.type, PrimitiveType):
+                lines.append(f"{dst} = ({scalar(g.type)}){src};")
+            elif isinstance(f.type, ArrayType) and f.type == g.type and not f.type.dynamic:
+                loops = True
+                lines.append(f"for (i = 0; i < {f.type.capacity or 0}u; i++) {{ {dst}[i] = {src}[i]; }}")
+            else:
+                raise Unsupported(f"same_names: {f.name} changes its type")
+        self.emit(*(["size_t i;"] if loops else []), *lines)
+
     def text_const(self, ref: FieldRef, t: ArrayType | StringType, value: str) -> None:
         """A text constant into a byte array (its bytes, the rest zero) as Python writes the bytes."""
         data = value.encode("utf-8")

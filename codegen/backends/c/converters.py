@@ -103,7 +103,7 @@ class _Builder(PX4Ops, PX4CellOps, ConceptCellOps):
     def _unsupported(self, rule: Rule, op: object) -> None:
         raise Unsupported(f"op {rule.op.NAME}")
 
-    visit_dt_pack = visit_ocv_soc = visit_same_names = visit_px4_udral_energy = _unsupported
+    visit_dt_pack = visit_ocv_soc = visit_px4_udral_energy = _unsupported
 
     # -- the function ----------------------------------------------------------------------
 
