@@ -28,7 +28,7 @@ from ...ir import (
     units,
 )
 from ...ir import ops as o
-from ...ir.fieldtypes import allowed_range
+from ...ir.fieldtypes import allowed_range, writable_ints
 from ...ir.mapping_values import Number
 from .convert_context import CBase
 from .convert_values import Unsupported, f64_literal, literal
@@ -150,29 +150,7 @@ class ConceptOps(CBase):
     def int_range(self, f: Field, p: PrimitiveType, hi: Number | None, marks: list[float | int]) -> tuple[int, int]:
         """Python's ``RuleContext.int_bounds``: the integers a converter may write into the field."""
         rng = allowed_range(p, f.range).intersect(self.rule_ranges.get(f))
-        type_lo, type_hi = (int(v) for v in p.value_range or (0, 0))
-        lo = (
-            type_lo
-            if rng.minimum is None
-            else math.floor(rng.minimum) + 1
-            if rng.exclusive_minimum
-            else math.ceil(rng.minimum)
-        )
-        top = (
-            type_hi
-            if rng.maximum is None
-            else math.ceil(rng.maximum) - 1
-            if rng.exclusive_maximum
-            else math.floor(rng.maximum)
-        )
-        if hi is not None:
-            top = min(top, math.floor(hi))
-        lo, top = max(lo, type_lo), min(top, type_hi)
-        while lo < top and any(lo == m for m in marks if not is_nan_value(m)):
-            lo += 1
-        while top > lo and any(top == m for m in marks if not is_nan_value(m)):
-            top -= 1
-        return (lo, top) if lo <= top else (type_lo, type_hi)
+        return writable_ints(p, rng, hi, marks)
 
     def store(self, fmt: FieldRef, expr: str, hi: Number | None = None, marks: tuple[Number, ...] = ()) -> str:
         """The double ``expr`` as the field holds it (Python's ``store``)."""
