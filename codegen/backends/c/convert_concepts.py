@@ -24,12 +24,13 @@ from ...ir import (
     PrimitiveType,
     Rule,
     StringType,
-    Unit,
     units,
 )
 from ...ir import ops as o
 from ...ir.fieldtypes import allowed_range, writable_ints
 from ...ir.mapping_values import Number
+from ..python.converters.context import affine as python_affine
+from ..python.converters.context import factor as python_factor
 from .convert_context import CBase
 from .convert_values import Unsupported, f64_literal, literal
 from .types import ident, scalar
@@ -44,18 +45,10 @@ def double_literal(value: float | int) -> str:
     return f64_literal(float(value))
 
 
-def unit_factor(frm: Unit | None, to: Unit | None) -> tuple[float, float]:
-    return (1.0, 0.0) if frm is None or to is None else frm.factor_to(to)
-
-
-def affine(expr: str, mul: float, add: float) -> str:
-    """Python's ``affine``: ``expr * mul + add``, each step in double as Python computes it."""
-    out = expr
-    if mul != 1.0:
-        out = f"{out} * {double_literal(mul)}"
-    if add != 0.0:
-        out = f"{out} + {double_literal(add)}"
-    return out
+# ``expr * mul + add`` spelled as the Python converters spell it (a finite factor's repr is a C double
+# literal too), so C computes the same steps in double as Python does
+affine = python_affine
+unit_factor = python_factor
 
 
 def is_nan_value(value: object) -> bool:
