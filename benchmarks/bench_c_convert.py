@@ -112,20 +112,21 @@ def python_times(number: int) -> dict[str, float]:
     return out
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def main(argv: list[str] | None = None) -> dict[str, float]:
+    """Times both policies; returns ns per record by ``<side>_<policy>`` (``c_strict``, ``python_px4``, ...)."""
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--number", type=int, default=20000)
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     if shutil.which("gcc") is None:
         print("gcc not installed", file=sys.stderr)
-        return 2
+        return {}
     c = c_times(args.number * 50)
     py = python_times(args.number)
     for policy in ("strict", "px4"):
         ratio = py[policy] / c[policy]
         print(f"dronecan->uorb {policy}: C {c[policy]:.1f} ns/record, Python {py[policy]:.0f} ns/record, x{ratio:.0f}")
-    return 0
+    return {**{f"c_{k}": v for k, v in c.items()}, **{f"python_{k}": v for k, v in py.items()}}
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    main()
