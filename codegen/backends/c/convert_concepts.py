@@ -24,13 +24,12 @@ from ...ir import (
     PrimitiveType,
     Rule,
     StringType,
+    Unit,
     units,
 )
 from ...ir import ops as o
 from ...ir.fieldtypes import allowed_range, writable_ints
 from ...ir.mapping_values import Number
-from ..python.converters.context import affine as python_affine
-from ..python.converters.context import factor as python_factor
 from .convert_context import CBase
 from .convert_values import Unsupported, f64_literal, literal
 from .types import ident, scalar
@@ -45,10 +44,14 @@ def double_literal(value: float | int) -> str:
     return f64_literal(float(value))
 
 
-# ``expr * mul + add`` spelled as the Python converters spell it (a finite factor's repr is a C double
-# literal too), so C computes the same steps in double as Python does
-affine = python_affine
-unit_factor = python_factor
+def unit_factor(frm: Unit | None, to: Unit | None) -> tuple[float, float]:
+    return (1.0, 0.0) if frm is None or to is None else frm.factor_to(to)
+
+
+def affine(expr: str, mul: float, add: float) -> str:
+    """``expr * mul + add`` in the order Python evaluates it, each step in double as Python computes it."""
+    out = f"{expr} * {double_literal(mul)}" if mul != 1.0 else expr
+    return f"{out} + {double_literal(add)}" if add != 0.0 else out
 
 
 def is_nan_value(value: object) -> bool:

@@ -22,14 +22,14 @@ from ...ir import (
     Concept,
     Direction,
     Field,
+    Mapping,
     PrimitiveKind,
     Rule,
     Schema,
     SourceFormat,
 )
+from ...ir.mapping_routes import POLICIES, route
 from ...ir.mapping_visitor import visit
-from ..python.converters.mapping_module import Edge
-from ..python.converters.routes import POLICIES, route
 from .convert_concept_cells import ConceptCellOps
 from .convert_concepts import STATE
 from .convert_px4 import PX4Ops
@@ -38,6 +38,16 @@ from .convert_values import Unsupported, c_type, defaults, differs, literal, pri
 from .types import ident
 
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
+
+
+@dataclass(frozen=True)
+class Edge:
+    """One direction of one mapping (a :class:`~codegen.ir.mapping_routes.MappingEdge`)."""
+
+    source: str
+    target: str
+    function: str
+    mapping: Mapping
 
 
 @dataclass(frozen=True)
@@ -264,9 +274,9 @@ def _edges(schema: Schema) -> list[Edge]:
     """Every direction of every mapping, as the Python backend's route finder takes them."""
     out = []
     for m in (m for s in schema.mappings for m in s.mappings):
-        out.append(Edge(m.source, m.target, f"_map_{ident(m.name)}", "forward", m, ()))
+        out.append(Edge(m.source, m.target, "forward", m))
         if m.reversible:
-            out.append(Edge(m.target, m.source, f"_map_{ident(m.name)}", "backward", m, ()))
+            out.append(Edge(m.target, m.source, "backward", m))
     return out
 
 

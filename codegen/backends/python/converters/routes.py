@@ -8,11 +8,11 @@ px4 through PX4's own code paths. Nothing is looked up at run time.
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 
 from ....errors import BattgenError
 from ....ir import CONCEPTS_ENDPOINT, Endpoint, Schema
+from ....ir.mapping_routes import POLICIES, route
 from .. import naming
 from ..literals import docstring, py_literal
 from .classes import Import, class_names, import_lines
@@ -20,7 +20,6 @@ from .context import INDENT, call
 from .mapping_module import Edge
 
 PACKAGE = "convert"
-POLICIES = ("strict", "px4")
 _NO_ROUTE = "no {p} behaviour converts {s} to {t}; use another policy"
 # names a converter module binds besides its message classes
 _TAKEN = ("BatteryState", "policy", "report")
@@ -36,26 +35,6 @@ class Converter:
     function: str
     policies: tuple[str, ...]
     inputs: tuple[str, ...]
-
-
-def _policies(edge: Edge) -> frozenset[str]:
-    return frozenset(POLICIES) if edge.mapping.policy == "any" else frozenset({edge.mapping.policy})
-
-
-def route(edges: list[Edge], source: str, target: str, policy: str) -> list[Edge] | None:
-    """The shortest chain of functions from ``source`` to ``target`` under ``policy``."""
-    usable = sorted((e for e in edges if policy in _policies(e)), key=lambda e: (e.mapping.name, e.function))
-    queue: deque[tuple[str, list[Edge]]] = deque([(source, [])])
-    seen = {source}
-    while queue:
-        node, path = queue.popleft()
-        if node == target:
-            return path
-        for e in usable:
-            if e.source == node and e.target not in seen:
-                seen.add(e.target)
-                queue.append((e.target, [*path, e]))
-    return None
 
 
 class Routes:
