@@ -19,9 +19,13 @@ from typing import Any
 
 from rust_cases import FIELD_RULES, Unrepresentable, random_records, vector_records
 
+from codegen.apps.package import bundled_schemas
 from codegen.backends.c.types import ident, scalar, type_name
+from codegen.frontends.loader import load
 from codegen.ir import ArrayType, CompositeType, FieldType, Message, PrimitiveKind, PrimitiveType, Schema, StringType
 
+# the ids of the bundled cross-field rules, which the C validators check
+CROSS_RULES = frozenset("cross-field:" + r.id for r in load([bundled_schemas()]).rules)
 SIGNATURE = bytes(range(13))  # the signed frames' signature block (skipped by both decoders)
 
 
@@ -255,7 +259,9 @@ class Replay:
 
 
 def _problems(obj: Any) -> str:
-    return ", ".join(f"{v.path} {v.rule}" for v in obj.validate() if v.rule in FIELD_RULES)
+    """The problems the C validator reports too: every field rule, and the cross-field rules of
+    schemas/rules (by their id) -- all of them, as the C validators check every bundled rule."""
+    return ", ".join(f"{v.path} {v.rule}" for v in obj.validate() if v.rule in FIELD_RULES or v.rule in CROSS_RULES)
 
 
 def _flip(frame: bytes, at: int) -> bytes:
@@ -437,8 +443,9 @@ static void problems(const battgen_problem *p, size_t n) {
   size_t i;
   for (i = 0; i < n; i++) {
     if (i) { printf(", "); }
-    if (p[i].index >= 0) { printf("%s[%ld] %s", p[i].field, (long)p[i].index, battgen_rule_name(p[i].rule)); }
-    else { printf("%s %s", p[i].field, battgen_rule_name(p[i].rule)); }
+    const char *rule = p[i].check != NULL ? p[i].check : battgen_rule_name(p[i].rule);
+    if (p[i].index >= 0) { printf("%s[%ld] %s", p[i].field, (long)p[i].index, rule); }
+    else { printf("%s %s", p[i].field, rule); }
   }
 }
 """

@@ -164,3 +164,33 @@ def allowed_range(t: PrimitiveType, rng: Range | None) -> Range:
     """The interval a value of type ``t`` must lie in: the type's bounds folded with the schema's range."""
     low, high = type_bounds(t, rng)
     return Range(low, high).intersect(rng)
+
+
+def writable_ints(t: PrimitiveType, rng: Range, hi: float | None, marks: list[float | int]) -> tuple[int, int]:
+    """The integers a converter may write into an integer field of type ``t`` whose values must lie in
+    ``rng`` (the schema's range with a rule's, :func:`allowed_range`), at most ``hi``, less a marker at
+    either end -- a value clamped onto it would read as unknown. Both backends' converters clamp to it."""
+    type_lo, type_hi = (int(v) for v in t.value_range or (0, 0))
+    lo = (
+        type_lo
+        if rng.minimum is None
+        else math.floor(rng.minimum) + 1
+        if rng.exclusive_minimum
+        else math.ceil(rng.minimum)
+    )
+    top = (
+        type_hi
+        if rng.maximum is None
+        else math.ceil(rng.maximum) - 1
+        if rng.exclusive_maximum
+        else math.floor(rng.maximum)
+    )
+    if hi is not None:
+        top = min(top, math.floor(hi))
+    lo, top = max(lo, type_lo), min(top, type_hi)
+    numbers = [m for m in marks if not (isinstance(m, float) and math.isnan(m))]
+    while lo < top and lo in numbers:
+        lo += 1
+    while top > lo and top in numbers:
+        top -= 1
+    return (lo, top) if lo <= top else (type_lo, type_hi)

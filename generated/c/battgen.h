@@ -21,4 +21,5 @@
 #include "uorb/BatteryInfo.h"
 #include "uorb/BatteryStatus.h"
 #include "uorb/BatteryStatusV0.h"
+#include "convert.h"
 #endif

@@ -23,15 +23,18 @@ typedef enum {
   BATTGEN_RULE_RANGE = 3,       /* outside the schema's range */
   BATTGEN_RULE_ENUM = 4,        /* not one of the field's enum values */
   BATTGEN_RULE_BITMASK = 5,     /* sets bits its bitmask does not define */
-  BATTGEN_RULE_LENGTH = 6       /* a variable-length array longer than its capacity */
+  BATTGEN_RULE_LENGTH = 6,      /* a variable-length array longer than its capacity */
+  BATTGEN_RULE_CHECK = 7 /* a cross-field rule of schemas/rules: "cross-field:<id>" in `check` */
 } battgen_rule;
 
 /* One broken rule: the field as the schema names it (nested: "timestamp.usec"), the element of an
- * array field (-1 for a scalar), the rule. */
+ * array field (-1 for a scalar), the rule; a cross-field rule's id (as the Python validator names
+ * it) in `check`, NULL for the others. */
 typedef struct {
   const char *field;
   int32_t index;
   battgen_rule rule;
+  const char *check;
 } battgen_problem;
 
 static inline const char *battgen_rule_name(battgen_rule rule) {
@@ -50,6 +53,8 @@ static inline const char *battgen_rule_name(battgen_rule rule) {
     return "bitmask";
   case BATTGEN_RULE_LENGTH:
     return "length";
+  case BATTGEN_RULE_CHECK:
+    return "check";
   }
   return "?";
 }
@@ -62,8 +67,18 @@ static inline void battgen_report(battgen_problem *out, size_t cap, size_t *n, c
     out[*n].field = field;
     out[*n].index = index;
     out[*n].rule = rule;
+    out[*n].check = NULL;
   }
   *n += 1u;
+}
+
+/* The same for a cross-field rule, by its id. */
+static inline void battgen_report_check(battgen_problem *out, size_t cap, size_t *n,
+                                        const char *field, int32_t index, const char *check) {
+  battgen_report(out, cap, n, field, index, BATTGEN_RULE_CHECK);
+  if (*n <= cap) {
+    out[*n - 1u].check = check;
+  }
 }
 
 /* Why bytes are not an encoding of the message asked for (0: they are). */
@@ -77,7 +92,8 @@ typedef enum {
   BATTGEN_ERR_UNKNOWN_FLAGS = 6,   /* MAVLink incompatibility flags not known */
   BATTGEN_ERR_WRONG_MESSAGE = 7,   /* the frame holds another message */
   BATTGEN_ERR_BAD_CRC = 8,         /* the checksum does not match */
-  BATTGEN_ERR_TRAILING = 9         /* whole bytes follow a DroneCAN message */
+  BATTGEN_ERR_TRAILING = 9,        /* whole bytes follow a DroneCAN message */
+  BATTGEN_ERR_TAG = 10             /* a DroneCAN union's tag names no field */
 } battgen_error;
 
 /* DroneCAN bits: a writer into a zeroed buffer and a reader (what a message's put / get take). */

@@ -1737,6 +1737,24 @@ size_t battgen_dronecan_uavcan_equipment_power_BatteryInfo_validate(
   if (r != BATTGEN_RULE_NONE) {
     battgen_report(out, cap, &n, "state_of_charge_pct_stdev", -1, r);
   }
+  /* rule state-of-health-percent (dronecan-power.yaml:7) */
+  {
+    if ((m->state_of_health_pct != (uint8_t)127u)) {
+      if (!(((int64_t)m->state_of_health_pct) <= 100LL)) {
+        battgen_report_check(out, cap, &n, "state_of_health_pct", -1,
+                             "cross-field:state-of-health-percent");
+      }
+    }
+  }
+  /* rule state-of-charge-percent (dronecan-power.yaml:13) */
+  {
+    if ((m->state_of_charge_pct != (uint8_t)127u)) {
+      if (!(((int64_t)m->state_of_charge_pct) <= 100LL)) {
+        battgen_report_check(out, cap, &n, "state_of_charge_pct", -1,
+                             "cross-field:state-of-charge-percent");
+      }
+    }
+  }
   return n;
 }
 
@@ -1989,6 +2007,13 @@ size_t battgen_dronecan_uavcan_equipment_power_PrimaryPowerSupplyStatus_validate
       m->remaining_energy_pct_stdev);
   if (r != BATTGEN_RULE_NONE) {
     battgen_report(out, cap, &n, "remaining_energy_pct_stdev", -1, r);
+  }
+  /* rule remaining-energy-percent (dronecan-primary-power.yaml:4) */
+  {
+    if (!(((int64_t)m->remaining_energy_pct) <= 100LL)) {
+      battgen_report_check(out, cap, &n, "remaining_energy_pct", -1,
+                           "cross-field:remaining-energy-percent");
+    }
   }
   return n;
 }

@@ -501,6 +501,15 @@ size_t battgen_mavlink_BATTERY_STATUS_validate(const battgen_mavlink_BATTERY_STA
   if (r != BATTGEN_RULE_NONE) {
     battgen_report(out, cap, &n, "fault_bitmask", -1, r);
   }
+  /* rule battery-remaining-percent (mavlink-battery-status.yaml:4) */
+  {
+    if ((m->battery_remaining != (int8_t)(-1))) {
+      if (!(0LL <= ((int64_t)m->battery_remaining) && ((int64_t)m->battery_remaining) <= 100LL)) {
+        battgen_report_check(out, cap, &n, "battery_remaining", -1,
+                             "cross-field:battery-remaining-percent");
+      }
+    }
+  }
   return n;
 }
 

@@ -703,6 +703,30 @@ size_t battgen_uorb_BatteryStatus_validate(const battgen_uorb_BatteryStatus *m,
   if (r != BATTGEN_RULE_NONE) {
     battgen_report(out, cap, &n, "estimation_covariance_norm", -1, r);
   }
+  /* rule cell-count-capacity (uorb-battery-status.yaml:5) */
+  {
+    if (!(((int64_t)m->cell_count) <= 14LL)) {
+      battgen_report_check(out, cap, &n, "cell_count", -1, "cross-field:cell-count-capacity");
+    }
+  }
+  /* rule cells-beyond-count-zero (uorb-battery-status.yaml:11) */
+  {
+    int64_t v_i, lo = ((int64_t)m->cell_count), hi = 14LL;
+    if (lo < 0) {
+      lo = 0;
+    }
+    if (hi > 14LL) {
+      hi = 14LL;
+    }
+    if ((m->cell_count != (uint8_t)0u)) {
+      for (v_i = lo; v_i < hi; v_i++) {
+        if (!(((double)m->voltage_cell_v[v_i]) == 0LL)) {
+          battgen_report_check(out, cap, &n, "voltage_cell_v", (int32_t)v_i,
+                               "cross-field:cells-beyond-count-zero");
+        }
+      }
+    }
+  }
   return n;
 }
 
@@ -916,6 +940,30 @@ size_t battgen_uorb_BatteryStatusV0_validate(const battgen_uorb_BatteryStatusV0 
   r = check_battgen_uorb_BatteryStatusV0_estimation_covariance_norm(m->estimation_covariance_norm);
   if (r != BATTGEN_RULE_NONE) {
     battgen_report(out, cap, &n, "estimation_covariance_norm", -1, r);
+  }
+  /* rule cell-count-capacity (uorb-battery-status.yaml:5) */
+  {
+    if (!(((int64_t)m->cell_count) <= 14LL)) {
+      battgen_report_check(out, cap, &n, "cell_count", -1, "cross-field:cell-count-capacity");
+    }
+  }
+  /* rule cells-beyond-count-zero (uorb-battery-status.yaml:11) */
+  {
+    int64_t v_i, lo = ((int64_t)m->cell_count), hi = 14LL;
+    if (lo < 0) {
+      lo = 0;
+    }
+    if (hi > 14LL) {
+      hi = 14LL;
+    }
+    if ((m->cell_count != (uint8_t)0u)) {
+      for (v_i = lo; v_i < hi; v_i++) {
+        if (!(((double)m->voltage_cell_v[v_i]) == 0LL)) {
+          battgen_report_check(out, cap, &n, "voltage_cell_v", (int32_t)v_i,
+                               "cross-field:cells-beyond-count-zero");
+        }
+      }
+    }
   }
   return n;
 }

@@ -31,7 +31,7 @@ from codegen.frontends.loader import load
 
 GENERATED = project_root() / "generated" / "c"
 FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wconversion", "-Werror", "-pedantic"]
-SOURCES = ("mavlink.c", "uorb.c", "dronecan.c")
+SOURCES = ("mavlink.c", "uorb.c", "dronecan.c", "convert.c")
 needs_gcc = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
 
 
@@ -133,6 +133,13 @@ def test_cases_reach_every_codec(replays: list[Replay]) -> None:
     lines = [line for _, line in expected_lines(replays) if line]
     assert any(" range" in line for line in lines), "no case breaks a range"
     assert any(" nan" in line for line in lines), "no case holds a NaN where it is not allowed"
+    for rule in (
+        "cells-beyond-count-zero",
+        "cell-count-capacity",
+        "state-of-health-percent",
+        "battery-remaining-percent",
+    ):
+        assert any(f" cross-field:{rule}" in line for line in lines), f"no case breaks the cross-field rule {rule}"
     for r in replays:  # the fuzz inputs reach both the decoder's errors and its values
         results = [line for _, fuzz in r.fuzz for _, line in fuzz]
         assert "err" in results and any(line.startswith("0 ") for line in results), r.msg.qualified_name
@@ -269,25 +276,31 @@ def test_cortex_m4_build_without_a_c_library(tmp_path: Path) -> None:
 
 @needs_gcc
 def test_readme_example_runs_as_python_says(tmp_path: Path) -> None:
-    """generated/c/README.md's example compiles with the strict flags and prints what the Python
-    package says of the same BatteryInfo: its problems, its payload's length, the value read back."""
-    from rust_cases import FIELD_RULES
-
+    """generated/c/README.md's example (decode a DroneCAN BatteryInfo, convert it with the px4 policy)
+    compiles with the strict flags and prints what the Python package makes of the same payload: the
+    same battery_status figures and the same loss report."""
+    import generated.convert as converters
     from generated.dronecan.uavcan.equipment.power import BatteryInfo
 
     readme = (GENERATED / "README.md").read_text(encoding="utf-8")
     example = readme.split("```c\n", 1)[1].split("```", 1)[0]
+    assert 15 <= len(example.strip().splitlines()) <= 35
     (tmp_path / "example.c").write_text(example, encoding="utf-8")
     exe = tmp_path / "example"
-    cc = ["gcc", *FLAGS, "-I", str(GENERATED), str(tmp_path / "example.c"), str(GENERATED / "dronecan.c")]
+    sources = [str(GENERATED / "dronecan.c"), str(GENERATED / "convert.c")]
+    cc = ["gcc", *FLAGS, "-I", str(GENERATED), str(tmp_path / "example.c"), *sources]
     subprocess.run([*cc, "-o", str(exe)], check=True, timeout=300)
     ran = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60, check=True)
-    info = BatteryInfo.from_dict({"temperature": 298.15, "voltage": 16.8, "state_of_health_pct": 200})
-    payload = info.encode()
-    problems = [f"{v.path}: {v.rule}" for v in info.validate() if v.rule in FIELD_RULES]
-    back = BatteryInfo.decode(payload).state_of_health_pct
-    assert ran.stdout.splitlines() == [*problems, f"{len(payload)} bytes, state_of_health_pct {back}"]
-    assert problems == ["state_of_health_pct: type-bounds"]
+    block = example.split("payload[] = {", 1)[1].split("}", 1)[0]
+    payload = bytes(int(b, 16) for b in block.replace(",", " ").split())
+    report = converters.LossReport()
+    status = converters.converter("dronecan", "uorb")(BatteryInfo.decode(payload), policy="px4", report=report)
+    head = (
+        f"{status.voltage_v:.2f} V, {status.current_a:.2f} A, {status.temperature:.2f} degC, "
+        f"remaining {status.remaining:.2f}, warning {status.warning}"
+    )
+    assert ran.stdout.splitlines() == [head, *(f"{e.kind} {e.field}" for e in report.entries)]
+    assert head == "16.80 V, -1.50 A, 25.10 degC, remaining 0.87, warning 0"
 
 
 @needs_gcc

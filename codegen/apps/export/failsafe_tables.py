@@ -18,8 +18,6 @@ Two tables per replayed log, in the log's partition of ``failsafe/``:
 from __future__ import annotations
 
 import hashlib
-import json
-from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -33,6 +31,8 @@ from ..failsafe.flight import replay_flight
 from ..failsafe.logs import SampleTable, own_parameters
 from ..failsafe.stream import batt_parameter_count, read_parameter_values
 from ..failsafe.vehicles import VEHICLES
+from .failsafe_columns import EVENT_COLUMNS, EVENTS_SCHEMA, REPLAYS_SCHEMA
+from .px4_failsafe_tables import px4_tables
 
 FAILSAFE = "failsafe"
 EVENTS_FILE = "events.parquet"
@@ -74,51 +74,6 @@ def failsafe_options(given: str, vehicle: str | None = None, firmware: str | Non
     return FailsafeOptions(values, f"{path.name} ({digest})", vehicle, firmware)
 
 
-_TEXT, _INT, _FLOAT = pa.string(), pa.int32(), pa.float64()
-# (name, type, doc, unit)
-EVENT_COLUMNS: tuple[tuple[str, Any, str, str | None], ...] = (
-    ("log", _TEXT, "stable id of the log's content", None),
-    ("battery", _INT, "the battery table's battery (0-based)", None),
-    ("instance", _INT, "the battery as ArduPilot numbers it (1-based)", None),
-    ("t", _FLOAT, "seconds since the log's start, on the battery table's clock", "s"),
-    ("replay_t", _FLOAT, "seconds from the log's first reading, as battgen failsafe prints it", "s"),
-    ("time", pa.timestamp("us", tz="UTC"), "time of day (UTC), where the log has it", None),
-    ("level", _TEXT, "LOW or CRITICAL (PX4: LOW, CRITICAL, EMERGENCY or TIME_LOW)", None),
-    ("cause", _TEXT, "voltage or capacity (PX4: charge or time)", None),
-    ("value", _FLOAT, "the value that crossed: V, remaining mAh, state of charge 0..1 or s, by cause", None),
-    ("threshold", _FLOAT, "the parameter crossed: V or mAh, as value", None),
-    ("action", _TEXT, "the vehicle's name for the FS_LOW_ACT / FS_CRT_ACT action", None),
-    ("action_code", _INT, "the FS_LOW_ACT / FS_CRT_ACT value", None),
-    ("executed", pa.bool_(), "whether the priority rule let the action run", None),
-    ("outcome", _TEXT, "what the vehicle does after the handler's fallbacks", None),
-    ("priority", _INT, "the action's index in the vehicle's priority list (PX4: null)", None),
-    ("statustext", _TEXT, "the STATUSTEXT AP_BattMonitor sends (PX4: commander's notification)", None),
-    ("vehicle_type", _TEXT, "the ArduPilot vehicle whose semantics the replay used, or px4", None),
-    ("parameters", _TEXT, "the parameters the replay used", None),
-)
-REPLAY_COLUMNS: tuple[tuple[str, Any, str, str | None], ...] = (
-    ("log", _TEXT, "stable id of the log's content", None),
-    ("battery", _INT, "the battery table's battery (0-based)", None),
-    ("instance", _INT, "the battery as ArduPilot numbers it (1-based)", None),
-    ("readings", pa.int64(), "battery readings replayed", None),
-    ("level", _TEXT, "the highest level reached: NONE, LOW or CRITICAL (PX4: EMERGENCY too)", None),
-    ("vehicle_type", _TEXT, "the ArduPilot vehicle whose semantics the replay used, or px4", None),
-    ("parameters", _TEXT, "the parameters the replay used", None),
-)
-
-
-def table_schema(columns: Sequence[tuple[str, Any, str, str | None]], table: str) -> Any:
-    fields = []
-    for name, typ, doc, unit in columns:
-        meta = {"doc": doc} | ({"unit": unit, "quantity": "time"} if unit else {})
-        fields.append(pa.field(name, typ, nullable=name != "log", metadata=meta))
-    return pa.schema(fields, metadata={"battgen": json.dumps({"table": table, "version": 1})})
-
-
-EVENTS_SCHEMA = table_schema(EVENT_COLUMNS, "failsafe_events")
-REPLAYS_SCHEMA = table_schema(REPLAY_COLUMNS, "failsafe_replays")
-
-
 def replay_tables(
     path: Path,
     name: str,
@@ -134,8 +89,6 @@ def replay_tables(
         return "failsafe not replayed: a JSON Lines file is no flight log battgen failsafe reads"
     firmware, _ = choose_firmware(options.firmware, options.params, options.source, path)
     if firmware == "px4":  # battgen failsafe's choice: PX4's own failsafe for a ULog, unless ArduPilot's is asked
-        from .px4_failsafe_tables import px4_tables
-
         return px4_tables(path, name, log, options.params, None if options.params is None else options.source, clock)
     values = options.params
     if values is None:

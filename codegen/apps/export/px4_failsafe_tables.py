@@ -20,7 +20,7 @@ import pyarrow as pa
 from ..battery.sources import Batch
 from ..failsafe.px4_log import read_px4_log
 from ..failsafe.px4_replay import replay_px4
-from .failsafe_tables import EVENT_COLUMNS, EVENTS_SCHEMA, REPLAYS_SCHEMA
+from .failsafe_columns import EVENT_COLUMNS, EVENTS_SCHEMA, REPLAYS_SCHEMA
 
 PX4 = "px4"
 OWN = "log parameters (BAT_*, COM_*)"

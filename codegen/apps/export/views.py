@@ -27,7 +27,7 @@ from ..battery.figures import WINDOW_SQL, flight_sql
 from ..load_steps import resistance_sql
 from .dataset import BATTERY, table_glob
 from .durable import write_atomic
-from .failsafe_tables import EVENTS_SCHEMA, REPLAYS_SCHEMA
+from .failsafe_columns import EVENTS_SCHEMA, REPLAYS_SCHEMA
 from .manifest import committed
 
 _STEP = resistance_sql("dt", "pack_voltage", "prev_voltage", "current", "prev_current", "peak_abs_current")

@@ -1,6 +1,7 @@
 """C99 backend: one header per message of the IR (struct, constants, identities, prototypes) and one
 source file per format (MAVLink, uORB, DroneCAN) with the codecs and validators of its messages; no
-heap, no C library. The cross-field rules and the converters are not generated in C yet.
+heap, no C library: the codecs, the validators (field checks, then the cross-field rules) and the
+converters generated from the mappings (``convert.c``).
 Output is formatted by ``clang-format`` (Debian's) with the style in :data:`STYLE`, so it is
 deterministic and passes the formatter check.
 """

@@ -40,6 +40,8 @@ def _sensitive(schema: Schema, t: FieldType) -> bool:
         return _eligible(schema, t) or _sensitive(schema, t.element)
     if isinstance(t, CompositeType):
         m = schema.message(t.name)
+        if m.dronecan is not None and m.dronecan.union:  # the held field is told the union's flag
+            return any(_sensitive(schema, f.type) for f in m.fields)
         return bool(m.fields) and _sensitive(schema, m.fields[-1].type)
     return False
 
@@ -78,38 +80,74 @@ def _read(bits: int) -> str:
     return f"if (!battgen_bits_get(r, {bits}u, &u)) {{ return BATTGEN_ERR_SHORT; }}"
 
 
+def union_tag_bits(count: int) -> int:
+    """pydronecan's tag width: ceil(log2(fields))."""
+    return max(count - 1, 0).bit_length()
+
+
 def dronecan_codec(schema: Schema, msg: Message) -> BitCodec | None:
-    """The codec of ``msg`` (None if it is not a DroneCAN message, or a union, or holds arrays of
-    composites, which DroneCAN v0's battery messages do not)."""
+    """The codec of ``msg`` (None if it is not a DroneCAN message, or holds arrays of composites,
+    which DroneCAN v0's battery messages do not). A union writes its tag (``m->union_tag``, in
+    ceil(log2(fields)) bits) and then the one field it holds, told the union's own tail array flag."""
     info = msg.dronecan
-    if info is None or info.union:
+    if info is None:
         return None
     put: list[str] = []
     get: list[str] = []
     loops = False
+    if info.union:
+        n = len(msg.fields)
+        bits = union_tag_bits(n)
+        put += [f"if (m->union_tag >= {n}u) {{ return BATTGEN_ERR_TAG; }}"]
+        put += [f"battgen_bits_put(w, (uint64_t)m->union_tag, {bits}u);"] if bits else []
+        if bits:
+            get += [_read(bits), f"if (u >= {n}u) {{ return BATTGEN_ERR_TAG; }}", "m->union_tag = (uint8_t)u;"]
+        else:
+            get.append("m->union_tag = 0u;")
+        put.append("switch (m->union_tag) {")
+        get.append("switch (m->union_tag) {")
+        for k, f in enumerate(msg.fields):
+            branch_put: list[str] = []
+            branch_get: list[str] = []
+            tao = "tao" if _sensitive(schema, f.type) else "false"
+            if not _field(schema, f, tao, branch_put, branch_get):
+                return None
+            loops = loops or isinstance(f.type, ArrayType)
+            put += [f"case {k}u: {{", *branch_put, "break;", "}"]
+            get += [f"case {k}u: {{", *branch_get, "break;", "}"]
+        put += ["default:", "break;", "}"]
+        get += ["default:", "break;", "}"]
+        return BitCodec(max(1, (info.max_bitlen + 7) // 8), put, get, loops)  # C has no empty array
     for n, f in enumerate(msg.fields):
         last = n == len(msg.fields) - 1
-        t = f.type
-        if f.is_padding:
-            assert isinstance(t, PrimitiveType)
-            put.append(f"battgen_bits_put(w, 0u, {t.bits}u);")
-            get.append(_read(t.bits))
-            continue
-        name = f"m->{ident(f.name)}"
-        tao = "tao" if last and _sensitive(schema, t) else "false"
-        if isinstance(t, PrimitiveType):
-            put.append(f"battgen_bits_put(w, {_put_value(t, name)}, {t.bits}u);")
-            get += [_read(t.bits), f"{name} = {_get_value(t)};"]
-        elif isinstance(t, CompositeType):
-            inner = type_name(t.name)
-            put += [f"e = {inner}_put(&{name}, w, {tao});", "if (e != BATTGEN_OK) { return e; }"]
-            get += [f"e = {inner}_get(&{name}, r, {tao});", "if (e != BATTGEN_OK) { return e; }"]
-        elif isinstance(t, ArrayType) and isinstance(t.element, PrimitiveType):
-            loops = True
-            _array(schema, f, t, t.element, name, tao, put, get)
-        else:
+        tao = "tao" if last and _sensitive(schema, f.type) else "false"
+        if not _field(schema, f, tao, put, get):
             return None
-    return BitCodec((info.max_bitlen + 7) // 8, put, get, loops)
+        loops = loops or isinstance(f.type, ArrayType)
+    return BitCodec(max(1, (info.max_bitlen + 7) // 8), put, get, loops)  # C has no empty array
+
+
+def _field(schema: Schema, f: Field, tao: str, put: list[str], get: list[str]) -> bool:
+    """The statements of one field (False: a type the C codec does not write)."""
+    t = f.type
+    if f.is_padding:
+        assert isinstance(t, PrimitiveType)
+        put.append(f"battgen_bits_put(w, 0u, {t.bits}u);")
+        get.append(_read(t.bits))
+        return True
+    name = f"m->{ident(f.name)}"
+    if isinstance(t, PrimitiveType):
+        put.append(f"battgen_bits_put(w, {_put_value(t, name)}, {t.bits}u);")
+        get.extend([_read(t.bits), f"{name} = {_get_value(t)};"])
+    elif isinstance(t, CompositeType):
+        inner = type_name(t.name)
+        put.extend([f"e = {inner}_put(&{name}, w, {tao});", "if (e != BATTGEN_OK) { return e; }"])
+        get.extend([f"e = {inner}_get(&{name}, r, {tao});", "if (e != BATTGEN_OK) { return e; }"])
+    elif isinstance(t, ArrayType) and isinstance(t.element, PrimitiveType):
+        _array(schema, f, t, t.element, name, tao, put, get)
+    else:
+        return False
+    return True
 
 
 def _array(

@@ -12,9 +12,12 @@ import jinja2
 
 from ...errors import BattgenError
 from ...ir import ArrayType, CompositeType, Constant, Message, PrimitiveKind, PrimitiveType, Schema, SourceFormat
-from .checks import check_uses, checks_of, validator
+from .checks import CheckUse, check_uses, checks_of, validator
 from .codecs import mavlink_codec, uorb_codec
+from .convert_concepts import state_lines
+from .converters import c_converters
 from .dronecan_codec import BitCodec, dronecan_codec
+from .rules import rule_lines
 from .types import ident, member, type_name
 
 _HERE = Path(__file__).parent
@@ -22,7 +25,7 @@ _HERE = Path(__file__).parent
 STYLE = "{BasedOnStyle: LLVM, ColumnLimit: 100, SortIncludes: false}"
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
 # support headers copied verbatim (through clang-format, as every other file)
-_SUPPORT = ("battgen_wire.h", "battgen_mavlink.h")
+_SUPPORT = ("battgen_wire.h", "battgen_mavlink.h", "battgen_convert.h")
 
 
 def _comment(text: str) -> str:
@@ -60,6 +63,16 @@ def _uses_loop(lines: list[str]) -> bool:
     return any(line.startswith("for (i = 0;") or "[i]" in line for line in lines)
 
 
+def _union_checks(msg: Message, uses: list[CheckUse]) -> list[str]:
+    """A union's validator: the checks of the field it holds only (the others are not sent)."""
+    lines: list[str] = []
+    for k, f in enumerate(msg.fields):
+        mine = [u for u in uses if u.path.split(".")[0].split("[")[0] == f.name]
+        if mine:
+            lines += [f"if (m->union_tag == {k}u) {{", *validator(mine), "}"]
+    return lines
+
+
 def _message_context(schema: Schema, msg: Message) -> dict[str, object]:
     members = []
     for f in msg.fields:
@@ -76,15 +89,25 @@ def _message_context(schema: Schema, msg: Message) -> dict[str, object]:
             notes.append(f.doc)
         members.append({"decls": member(f.type, ident(f.name)), "note": _comment(" ".join(notes))})
     name = type_name(msg.qualified_name)
+    if msg.dronecan is not None and msg.dronecan.union:
+        held = "the field held, by its place (BATTGEN_..._TAG_<FIELD>); the others are not sent"
+        members.insert(0, {"decls": ["uint8_t union_tag;"], "note": held})
     constants = [
         {"name": f"{name.upper()}_{ident(c.name).upper()}", "value": lit, "doc": _comment(c.doc)}
         for c in msg.constants
         if (lit := _literal(c)) is not None
     ]
+    if msg.dronecan is not None and msg.dronecan.union:
+        constants += [
+            {"name": f"{name.upper()}_TAG_{ident(f.name).upper()}", "value": f"{k}u", "doc": ""}
+            for k, f in enumerate(msg.fields)
+        ]
     mav = mavlink_codec(msg)
     uorb = uorb_codec(msg)
     uses = check_uses(schema, msg)
-    checks = validator(uses)
+    cross, most, _ = rule_lines(schema, msg)
+    checks = _union_checks(msg, uses) if msg.dronecan is not None and msg.dronecan.union else validator(uses)
+    checks += cross
     return {
         "name": name,
         "mavlink_codec": mav,
@@ -95,7 +118,7 @@ def _message_context(schema: Schema, msg: Message) -> dict[str, object]:
         "validate_loops": _uses_loop(checks),
         "mavlink_loops": mav is not None and _uses_loop(mav.encode),
         "uorb_loops": uorb is not None and _uses_loop(uorb.encode),
-        "max_problems": sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in uses),
+        "max_problems": sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in uses) + most,
         "guard": name.upper() + "_H",
         "qualified": msg.qualified_name,
         "doc": _comment(msg.doc),
@@ -178,6 +201,17 @@ def render_library(schema: Schema) -> dict[str, str]:
         files[rel] = clang_format(source.render(format=fmt.value, headers=own, messages=view), rel)
     for name in _SUPPORT:
         files[name] = clang_format((_HERE / "support" / name).read_text(encoding="utf-8"), name)
+    converters, helpers, left = c_converters(schema)
+    if converters:
+        used = sorted(
+            {header_path(q) for c in converters for q in (*(s[0] for s in c.sources), *(t[0] for t in c.targets))}
+        )
+        text = env.get_template("convert.h.j2").render(headers=used, converters=converters)
+        files["convert.h"] = clang_format(text, "convert.h")
+        state = state_lines({c.name: c for s in schema.mappings for c in s.concepts})
+        text = env.get_template("convert.c.j2").render(state=state, functions=helpers, converters=converters)
+        files["convert.c"] = clang_format(text, "convert.c")
+        headers.append("convert.h")
     files["battgen.h"] = clang_format(env.get_template("battgen.h.j2").render(headers=headers), "battgen.h")
-    files["README.md"] = env.get_template("README.md.j2").render(headers=headers)
+    files["README.md"] = env.get_template("README.md.j2").render(headers=headers, converters=converters, left=left)
     return files

@@ -17,7 +17,7 @@ extern "C" {
 #define BATTGEN_MAVLINK_BATTERY_STATUS_CRC_EXTRA 154u
 #define BATTGEN_MAVLINK_BATTERY_STATUS_BASE_LENGTH 36u
 #define BATTGEN_MAVLINK_BATTERY_STATUS_MAX_LENGTH 54u
-#define BATTGEN_MAVLINK_BATTERY_STATUS_MAX_PROBLEMS 5u
+#define BATTGEN_MAVLINK_BATTERY_STATUS_MAX_PROBLEMS 6u
 
 /** Battery information. Updates GCS with flight controller battery status. Smart batteries also use
  * this message, but may additionally send BATTERY_INFO. */

@@ -49,7 +49,7 @@ extern "C" {
 #define BATTGEN_UORB_BATTERYSTATUSV0_STRUCT_SIZE 168u
 /* the struct without its trailing padding, as a ULog record holds it */
 #define BATTGEN_UORB_BATTERYSTATUSV0_PACKED_SIZE 168u
-#define BATTGEN_UORB_BATTERYSTATUSV0_MAX_PROBLEMS 38u
+#define BATTGEN_UORB_BATTERYSTATUSV0_MAX_PROBLEMS 53u
 
 /** Battery status Battery status information for up to 4 battery instances. These are populated
  * from power module and smart battery device drivers, and one battery updated from MAVLink. Battery

@@ -37,7 +37,7 @@ from ....ir import (
     Unit,
     units,
 )
-from ....ir.fieldtypes import allowed_range
+from ....ir.fieldtypes import allowed_range, writable_ints
 from ....ir.mapping_values import ConstantRef, Number, Value
 from ....ir.rules import rule_ranges
 from .. import naming
@@ -328,29 +328,7 @@ class RuleContext:
         clamped onto it would read as unknown (a 400 degC temperature as MAVLink's INT16_MAX, a charge of -5 %
         as -1). What validate allows, so a clamp never writes what validate refuses."""
         rng = allowed_range(p, f.range).intersect(self.rule_ranges.get(f))
-        type_lo, type_hi = (int(v) for v in p.value_range or (0, 0))
-        lo = (
-            type_lo
-            if rng.minimum is None
-            else math.floor(rng.minimum) + 1
-            if rng.exclusive_minimum
-            else math.ceil(rng.minimum)
-        )
-        top = (
-            type_hi
-            if rng.maximum is None
-            else math.ceil(rng.maximum) - 1
-            if rng.exclusive_maximum
-            else math.floor(rng.maximum)
-        )
-        if hi is not None:
-            top = min(top, math.floor(hi))
-        lo, top = max(lo, type_lo), min(top, type_hi)
-        while lo < top and any(_same(lo, m) for m in marks):
-            lo += 1
-        while top > lo and any(_same(top, m) for m in marks):
-            top -= 1
-        return (lo, top) if lo <= top else (type_lo, type_hi)
+        return writable_ints(p, rng, hi, marks)
 
     def store_c(self, f: Field, expr: str, label: str) -> str:
         """A C assignment of a float32 value to the field's type, then DroneCAN saturation."""

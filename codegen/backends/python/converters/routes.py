@@ -8,11 +8,11 @@ px4 and ardupilot through the firmware's own code paths. Nothing is looked up at
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 
 from ....errors import BattgenError
 from ....ir import CONCEPTS_ENDPOINT, Endpoint, Schema
+from ....ir.mapping_routes import FIRMWARE_POLICIES, POLICIES, route
 from .. import naming
 from ..literals import docstring, py_literal
 from .classes import Import, class_names, import_lines
@@ -20,9 +20,6 @@ from .context import INDENT, call
 from .mapping_module import Edge
 
 PACKAGE = "convert"
-POLICIES = ("strict", "px4", "ardupilot")
-# the policies that restate a firmware's own code: after one, a chain reports losses only at its ends
-FIRMWARE_POLICIES = ("px4", "ardupilot")
 _NO_ROUTE = "no {{policy}} behaviour converts {s} to {t}; use another policy"
 # names a converter module binds besides its message classes
 _TAKEN = ("BatteryState", "policy", "report")
@@ -38,38 +35,6 @@ class Converter:
     function: str
     policies: tuple[str, ...]
     inputs: tuple[str, ...]
-
-
-def _policies(edge: Edge) -> frozenset[str]:
-    return frozenset(POLICIES) if edge.mapping.policy == "any" else frozenset({edge.mapping.policy})
-
-
-# ArduPilot has no uORB: a chain made only of steps inside a format (policy any: the uORB versions) is
-# no ArduPilot behaviour, so its routes must take one of its own mappings (PX4 does run those steps)
-_NEEDS_OWN_STEP = frozenset({"ardupilot"})
-
-
-def route(edges: list[Edge], source: str, target: str, policy: str) -> list[Edge] | None:
-    """The shortest chain of functions from ``source`` to ``target`` under ``policy``."""
-    found = _shortest(edges, source, target, policy)
-    if found is not None and policy in _NEEDS_OWN_STEP and all(e.mapping.policy != policy for e in found):
-        return None
-    return found
-
-
-def _shortest(edges: list[Edge], source: str, target: str, policy: str) -> list[Edge] | None:
-    usable = sorted((e for e in edges if policy in _policies(e)), key=lambda e: (e.mapping.name, e.function))
-    queue: deque[tuple[str, list[Edge]]] = deque([(source, [])])
-    seen = {source}
-    while queue:
-        node, path = queue.popleft()
-        if node == target:
-            return path
-        for e in usable:
-            if e.source == node and e.target not in seen:
-                seen.add(e.target)
-                queue.append((e.target, [*path, e]))
-    return None
 
 
 class Routes:
