@@ -1,5 +1,6 @@
 """One copy of the generated Rust crate a test session, with its replay data written into its tests/
-folder (the vector replay of tests/rust_cases.py, the failsafe replay of tests/rust_failsafe_cases.py), and
+folder (the vector replay of tests/rust_cases.py, the failsafe replay of tests/rust_failsafe_cases.py, the
+parameter tables' printout of backends/rust_params_table.rs), and
 cargo run in it with its build output in the session's temp dir: the Rust test modules share one build."""
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from codegen.apps.package import bundled_schemas, project_root
 from codegen.frontends.loader import load
 
 GENERATED = project_root() / "generated" / "rust"
+PARAMS_HARNESS = Path(__file__).parent / "backends" / "rust_params_table.rs"
 
 
 @dataclass(frozen=True)
@@ -56,5 +58,6 @@ def shared_crate(tmp_path_factory: pytest.TempPathFactory) -> Crate:
         streams = rust_failsafe_cases.collect()
         rust_failsafe_cases.write(streams, root / "tests" / "failsafe_streams.txt")
         shutil.copyfile(rust_failsafe_cases.HARNESS, root / "tests" / "failsafe_replay.rs")
+        shutil.copyfile(PARAMS_HARNESS, root / "tests" / "params_table.rs")
         _CRATES[base] = Crate(root, work / "target", replays, streams)
     return _CRATES[base]

@@ -15,6 +15,7 @@ import jinja2
 from ...errors import BattgenError
 from ...ir import CompositeType, Message, Schema, SourceFormat
 from .model import MessageView, message_view, shared_enums
+from .params import render_params
 from .types import element
 
 _HERE = Path(__file__).parent
@@ -131,6 +132,10 @@ def render_crate(schema: Schema) -> dict[str, str]:
     qualified = sorted(v.qualified for v in views)
     # the README's example decodes a MAVLink BATTERY_STATUS: shown (and run as a doc test) when it is there
     example = "mavlink.BATTERY_STATUS" in qualified
+    params = render_params(schema)
+    if params is not None:
+        rs["src/params.rs"] = params
+        children[()].add("params")
     rs["src/lib.rs"] = env.get_template("lib.rs.j2").render(
         support=SUPPORT, modules=sorted(children[()]), example=example
     )

@@ -203,27 +203,45 @@ impl Vehicle {
         list.iter().position(|&a| a == action).unwrap_or(list.len())
     }
 
+    /// The action a `BATT_FS_LOW_ACT` (`critical` false) or `BATT_FS_CRT_ACT` code means on this
+    /// vehicle (the `@Values{Vehicle}` of `AP_BattMonitor_Params.cpp`), None for a code it lacks.
+    #[must_use]
+    pub const fn action(self, critical: bool, code: i32) -> Option<Action> {
+        use Action as A;
+        use Vehicle as V;
+        Some(match (self, code) {
+            (_, 0) => A::None,
+            (V::Rover, 1) | (V::Copter, 2) | (V::Plane, 1) => A::Rtl,
+            (V::Rover, 2) => A::Hold,
+            (V::Rover, 3) => A::SmartRtl,
+            (V::Rover, 4) => A::SmartRtlOrHold,
+            (V::Rover, 5) | (V::Copter, 5) | (V::Plane, 3) => A::Terminate,
+            (V::Copter, 1) | (V::Plane, 2) => A::Land,
+            (V::Copter, 3) => A::SmartRtlOrRtl,
+            (V::Copter, 4) => A::SmartRtlOrLand,
+            (V::Copter, 6) => A::AutoDoLandStartOrRtl,
+            (V::Plane, 4) => A::Qland,
+            (V::Plane, 5) if critical => A::Parachute,
+            (V::Plane, 6) => A::LoiterToQland,
+            (V::Sub, 2) => A::Disarm,
+            (V::Sub, 3) => A::Surface,
+            _ => return None,
+        })
+    }
+
+    /// The code of an action on this vehicle (`critical`: as `BATT_FS_CRT_ACT`), None when the
+    /// vehicle has no such action.
+    #[must_use]
+    pub fn code(self, critical: bool, action: Action) -> Option<i32> {
+        (0..=6).find(|&c| self.action(critical, c) == Some(action))
+    }
+
     /// ArduPilot's label of a `BATT_FS_LOW_ACT` (`critical` false) or `BATT_FS_CRT_ACT` code.
     #[must_use]
-    pub const fn action_name(self, critical: bool, action: i32) -> Option<&'static str> {
-        match (self, action) {
-            (_, 0) => Some("None"),
-            (Vehicle::Rover, 1) | (Vehicle::Plane, 1) => Some("RTL"),
-            (Vehicle::Rover, 2) => Some("Hold"),
-            (Vehicle::Rover, 3) => Some("SmartRTL"),
-            (Vehicle::Rover, 4) => Some("SmartRTL or Hold"),
-            (Vehicle::Rover, 5) | (Vehicle::Copter, 5) | (Vehicle::Plane, 3) => Some("Terminate"),
-            (Vehicle::Copter, 1) | (Vehicle::Plane, 2) => Some("Land"),
-            (Vehicle::Copter, 2) => Some("RTL"),
-            (Vehicle::Copter, 3) => Some("SmartRTL or RTL"),
-            (Vehicle::Copter, 4) => Some("SmartRTL or Land"),
-            (Vehicle::Copter, 6) => Some("Auto DO_LAND_START or RTL"),
-            (Vehicle::Plane, 4) => Some("QLand"),
-            (Vehicle::Plane, 5) if critical => Some("Parachute"),
-            (Vehicle::Plane, 6) => Some("Loiter to QLand"),
-            (Vehicle::Sub, 2) => Some("Disarm"),
-            (Vehicle::Sub, 3) => Some("Enter surface mode"),
-            _ => None,
+    pub const fn action_name(self, critical: bool, code: i32) -> Option<&'static str> {
+        match self.action(critical, code) {
+            Some(action) => Some(action.label()),
+            None => None,
         }
     }
 
@@ -271,6 +289,94 @@ impl Vehicle {
             },
         }
     }
+}
+
+/// A battery failsafe action, as the vehicles' `@Values` name them; [`Vehicle::action`] gives a
+/// code's action on a vehicle, [`Vehicle::code`] the way back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    /// No action.
+    None,
+    /// Return to launch.
+    Rtl,
+    /// Rover: hold.
+    Hold,
+    /// Rover: SmartRTL, else RTL, else Hold.
+    SmartRtl,
+    /// Rover: SmartRTL, else Hold.
+    SmartRtlOrHold,
+    /// Disarm at once.
+    Terminate,
+    /// Land where it is.
+    Land,
+    /// Copter: SmartRTL, else RTL.
+    SmartRtlOrRtl,
+    /// Copter: SmartRTL, else Land.
+    SmartRtlOrLand,
+    /// Copter: the mission's DO_LAND_START, else RTL.
+    AutoDoLandStartOrRtl,
+    /// Plane: QuadPlane land.
+    Qland,
+    /// Plane: loiter down, then QuadPlane land.
+    LoiterToQland,
+    /// Plane: release the parachute (CRITICAL only).
+    Parachute,
+    /// Sub: disarm.
+    Disarm,
+    /// Sub: surface.
+    Surface,
+}
+
+impl Action {
+    /// ArduPilot's label (`@Values{Vehicle}`).
+    #[must_use]
+    pub const fn label(self) -> &'static str {
+        match self {
+            Action::None => "None",
+            Action::Rtl => "RTL",
+            Action::Hold => "Hold",
+            Action::SmartRtl => "SmartRTL",
+            Action::SmartRtlOrHold => "SmartRTL or Hold",
+            Action::Terminate => "Terminate",
+            Action::Land => "Land",
+            Action::SmartRtlOrRtl => "SmartRTL or RTL",
+            Action::SmartRtlOrLand => "SmartRTL or Land",
+            Action::AutoDoLandStartOrRtl => "Auto DO_LAND_START or RTL",
+            Action::Qland => "QLand",
+            Action::LoiterToQland => "Loiter to QLand",
+            Action::Parachute => "Parachute",
+            Action::Disarm => "Disarm",
+            Action::Surface => "Enter surface mode",
+        }
+    }
+}
+
+/// Battery `instance`'s (1-based) parameter prefix: `BATT_`, `BATT2_` .. `BATT9_`, `BATTA_` ..
+/// `BATTG_` (`AP_BattMonitor.cpp` `var_info`).
+#[must_use]
+pub const fn battery_prefix(instance: u8) -> Option<&'static str> {
+    const PREFIXES: [&str; MAX_INSTANCES] = [
+        "BATT_", "BATT2_", "BATT3_", "BATT4_", "BATT5_", "BATT6_", "BATT7_", "BATT8_", "BATT9_",
+        "BATTA_", "BATTB_", "BATTC_", "BATTD_", "BATTE_", "BATTF_", "BATTG_",
+    ];
+    match instance {
+        1..=16 => Some(PREFIXES[instance as usize - 1]),
+        _ => None,
+    }
+}
+
+/// A `BATT*_` parameter name split into its battery (1-based) and battery 1's name of it
+/// (`BATT2_LOW_VOLT` -> `(2, "LOW_VOLT")`); None for other names.
+#[must_use]
+pub fn split_battery_name(name: &str) -> Option<(u8, &str)> {
+    (1..=MAX_INSTANCES as u8).find_map(|i| {
+        let rest = name.strip_prefix(battery_prefix(i)?)?;
+        let ok = !rest.is_empty()
+            && rest
+                .bytes()
+                .all(|b| b.is_ascii_uppercase() || b.is_ascii_digit() || b == b'_');
+        ok.then_some((i, rest))
+    })
 }
 
 /// What the vehicle does once a failsafe's action has gone through its handler.
@@ -402,6 +508,48 @@ impl Settings {
             volt_source: 0,
             monitor: None,
         }
+    }
+
+    /// One battery's settings from a parameter set: `get` gives a parameter's value by battery 1's
+    /// name without the `BATT_` prefix (`LOW_VOLT`), None when absent (ArduPilot's default).
+    ///
+    /// # Errors
+    /// The field whose value is not finite, or not an integer where a code is expected.
+    pub fn from_params(
+        vehicle: Vehicle,
+        mut get: impl FnMut(&str) -> Option<f64>,
+    ) -> Result<Settings, &'static str> {
+        let d = Settings::defaults(vehicle);
+        let mut number = |field: &'static str, default: f64| match get(field) {
+            None => Ok(default),
+            Some(v) if v.is_finite() => Ok(v),
+            Some(_) => Err(field),
+        };
+        let capacity_mah = number("CAPACITY", d.capacity_mah)?;
+        let low_volt = number("LOW_VOLT", d.low_volt)?;
+        let low_timer_s = number("LOW_TIMER", d.low_timer_s)?;
+        let low_mah = number("LOW_MAH", d.low_mah)?;
+        let crt_volt = number("CRT_VOLT", d.crt_volt)?;
+        let crt_mah = number("CRT_MAH", d.crt_mah)?;
+        let mut code = |field: &'static str| -> Result<Option<i32>, &'static str> {
+            match get(field) {
+                None => Ok(None),
+                Some(v) if v.is_finite() && v == (v as i32) as f64 => Ok(Some(v as i32)),
+                Some(_) => Err(field),
+            }
+        };
+        Ok(Settings {
+            capacity_mah,
+            low_volt,
+            low_timer_s,
+            low_mah,
+            crt_volt,
+            crt_mah,
+            low_action: code("FS_LOW_ACT")?.unwrap_or(0),
+            crt_action: code("FS_CRT_ACT")?.unwrap_or(0),
+            volt_source: code("FS_VOLTSRC")?.unwrap_or(0),
+            monitor: code("MONITOR")?,
+        })
     }
 
     /// `BATT_MONITOR` is not 0.

@@ -28,6 +28,7 @@ pub mod dronecan_wire;
 pub mod failsafe;
 pub mod mavlink;
 pub mod mavlink_wire;
+pub mod params;
 pub mod problems;
 pub mod same;
 pub mod uorb;
