@@ -115,48 +115,37 @@ def collect() -> list[Stream]:
     discharges (:func:`flight_rows`) with the same parameter sets."""
     out: list[Stream] = []
 
-    @settings(max_examples=EXAMPLES, derandomize=False, database=None, deadline=None,
-              suppress_health_check=list(HealthCheck))  # fmt: skip
-    @seed(24)
-    @given(
-        st.lists(ROW, max_size=60),
-        VALUES,
-        st.sampled_from(sorted(VEHICLES)),
-        st.sampled_from(VARIANTS),
-        st.builds(Situation, st.booleans(), st.booleans(), st.booleans(), st.booleans(), st.booleans()),
-        st.sampled_from([None, 2.0, 8.0]),
-    )
-    def draw(rows: list[Any], values: dict[str, float], vehicle: str, variants: tuple[str, ...],
-             situation: Situation, speed: float | None) -> None:  # fmt: skip
-        out.append(stream(timed(rows), values, vehicle, variants, situation, speed))
+    def run(rows: st.SearchStrategy[list[Row]], examples: int) -> None:
+        @settings(max_examples=examples, derandomize=False, database=None, deadline=None,
+                  suppress_health_check=list(HealthCheck))  # fmt: skip
+        @seed(24)
+        @given(
+            rows,
+            VALUES,
+            st.sampled_from(sorted(VEHICLES)),
+            st.sampled_from(VARIANTS),
+            st.builds(Situation, st.booleans(), st.booleans(), st.booleans(), st.booleans(), st.booleans()),
+            st.sampled_from([None, 2.0, 8.0]),
+        )
+        def draw(rows: list[Row], values: dict[str, float], vehicle: str, variants: tuple[str, ...],
+                 situation: Situation, speed: float | None) -> None:  # fmt: skip
+            out.append(stream(rows, values, vehicle, variants, situation, speed))
 
-    @settings(max_examples=FLIGHTS, derandomize=False, database=None, deadline=None,
-              suppress_health_check=list(HealthCheck))  # fmt: skip
-    @seed(24)
-    @given(
-        st.builds(
-            flight_rows,
-            st.integers(40, 300),
-            st.sampled_from([50, 100, 250, 500]),
-            st.floats(11.5, 12.6).map(lambda x: round(x, 2)),
-            st.floats(0.005, 0.05),
-            st.floats(20.0, 150.0),
-            st.integers(0, 200),
-            st.booleans(),
-            st.booleans(),
-        ),
-        VALUES,
-        st.sampled_from(sorted(VEHICLES)),
-        st.sampled_from(VARIANTS),
-        st.builds(Situation, st.booleans(), st.booleans(), st.booleans(), st.booleans(), st.booleans()),
-        st.sampled_from([None, 2.0, 8.0]),
-    )
-    def fly(rows: list[Row], values: dict[str, float], vehicle: str, variants: tuple[str, ...],
-            situation: Situation, speed: float | None) -> None:  # fmt: skip
-        out.append(stream(rows, values, vehicle, variants, situation, speed))
+        draw()
 
-    draw()
-    fly()
+    run(st.lists(ROW, max_size=60).map(timed), EXAMPLES)
+    flights = st.builds(
+        flight_rows,
+        st.integers(40, 300),
+        st.sampled_from([50, 100, 250, 500]),
+        st.floats(11.5, 12.6).map(lambda x: round(x, 2)),
+        st.floats(0.005, 0.05),
+        st.floats(20.0, 150.0),
+        st.integers(0, 200),
+        st.booleans(),
+        st.booleans(),
+    )
+    run(flights, FLIGHTS)
     # the distance variant fires only when no capacity threshold has fired first: drawn parameter sets
     # seldom leave it the room, so these discharges do (every vehicle, charge logged or integrated)
     for k, vehicle in enumerate(sorted(VEHICLES)):
