@@ -35,6 +35,32 @@ fn print_tables() {
             bits(Some(d.low_volt)),
             bits(Some(d.low_timer_s))
         ));
+        // Settings::from_params on the parameter sets the Python side reads (battery 1's names)
+        let sets: [&[(&str, f64)]; 3] = [
+            &[],
+            &[("LOW_VOLT", 11.1), ("CRT_MAH", 400.0), ("FS_LOW_ACT", 2.0), ("MONITOR", 4.0)],
+            &[("CAPACITY", 5000.0), ("LOW_TIMER", 0.3), ("FS_CRT_ACT", 5.0), ("FS_VOLTSRC", 1.0)],
+        ];
+        for (k, set) in sets.iter().enumerate() {
+            let get = |field: &str| set.iter().find(|(n, _)| *n == field).map(|(_, v)| *v);
+            let s = Settings::from_params(v, get).unwrap();
+            out.push(format!(
+                "settings {} {k} {} {} {} {} {} {} {} {} {} {}",
+                v.name(),
+                bits(Some(s.capacity_mah)),
+                bits(Some(s.low_volt)),
+                bits(Some(s.low_timer_s)),
+                bits(Some(s.low_mah)),
+                bits(Some(s.crt_volt)),
+                bits(Some(s.crt_mah)),
+                s.low_action,
+                s.crt_action,
+                s.volt_source,
+                s.monitor.map_or("-".to_string(), |m| m.to_string())
+            ));
+        }
+        let half = |field: &str| (field == "FS_LOW_ACT").then_some(1.5);
+        assert_eq!(Settings::from_params(v, half), Err("FS_LOW_ACT"));
         for critical in [false, true] {
             for code in -1..=7 {
                 let name = v.action_name(critical, code).unwrap_or("-");

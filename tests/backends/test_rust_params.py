@@ -2,7 +2,8 @@
 the Python package's (generated/params.py: names, types, defaults, ranges, units, named values), and its
 per-vehicle failsafe tables (`battgen::failsafe::Vehicle`: each action code's meaning on Rover, Copter, Plane
 and Sub, the priority list, the handlers' fallbacks in every situation, the default BATT_LOW_VOLT) and the
-battery prefixes are battgen's (codegen/apps/failsafe/vehicles.py, settings.py). The crate prints them
+battery prefixes and a battery's settings read from a parameter set (`Settings::from_params`) are battgen's
+(codegen/apps/failsafe/vehicles.py, settings.py). The crate prints them
 (backends/rust_params_table.rs); every line must be the one Python gives."""
 
 from __future__ import annotations
@@ -25,6 +26,14 @@ needs_cargo = pytest.mark.skipif(shutil.which("cargo") is None, reason="cargo no
 @pytest.fixture(scope="module")
 def crate(tmp_path_factory: pytest.TempPathFactory) -> Crate:
     return shared_crate(tmp_path_factory)
+
+
+# the parameter sets (battery 1's names without BATT_) rust_params_table.rs gives Settings::from_params
+SETTINGS: list[dict[str, float]] = [
+    {},
+    {"LOW_VOLT": 11.1, "CRT_MAH": 400.0, "FS_LOW_ACT": 2.0, "MONITOR": 4.0},
+    {"CAPACITY": 5000.0, "LOW_TIMER": 0.3, "FS_CRT_ACT": 5.0, "FS_VOLTSRC": 1.0},
+]
 
 
 def _bits(value: float | None) -> str:
@@ -52,6 +61,12 @@ def expected_lines() -> list[str]:
         v = VEHICLES[name]
         d = BatterySettings.from_values({}, 1, v)
         out.append(f"defaults {name} {_bits(d.capacity_mah)} {_bits(d.low_volt)} {_bits(d.low_timer_s)}")
+        for k, values in enumerate(SETTINGS):
+            s = BatterySettings.from_values({"BATT_" + n: x for n, x in values.items()}, 1, v)
+            numbers = (s.capacity_mah, s.low_volt, s.low_timer_s, s.low_mah, s.crt_volt, s.crt_mah)
+            monitor = "-" if s.monitor is None else s.monitor
+            out.append(f"settings {name} {k} {' '.join(map(_bits, numbers))} {s.low_action} {s.crt_action} "
+                       f"{s.volt_source} {monitor}")  # fmt: skip
         for critical in (0, 1):
             table = v.actions("critical" if critical else "low")
             out.extend(
@@ -80,6 +95,6 @@ def test_the_tables_are_worth_comparing() -> None:
 def test_the_crate_prints_pythons_tables(crate: Crate) -> None:
     done = cargo(crate, "test", "--offline", "--test", "params_table", "--", "--nocapture")
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-4000:]
-    got = [line for line in done.stdout.splitlines() if line.split(" ", 1)[0] in {"param", "defaults", "action",
-                                                                                  "resolve", "prefix"}]  # fmt: skip
+    kinds = {"param", "defaults", "settings", "action", "resolve", "prefix"}
+    got = [line for line in done.stdout.splitlines() if line.split(" ", 1)[0] in kinds]
     assert got == expected_lines()
