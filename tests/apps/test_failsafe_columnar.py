@@ -9,10 +9,10 @@ from typing import Any
 
 import numpy as np
 import pytest
+from failsafe_streams import ROW, VALUES, table_of, timed
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from codegen.apps.battery.sources import Batch
 from codegen.apps.battery.view import read_view
 from codegen.apps.failsafe.columnar import _per_sample, replay_table
 from codegen.apps.failsafe.evaluator import make_failsafe
@@ -89,61 +89,8 @@ def test_real_logs_give_the_oracles_events() -> None:
     assert replayed > 50 and fired > 20  # the threshold sets do fire
 
 
-class _Chunk:
-    """What SampleTable.add reads of a battery view's chunk."""
-
-    def __init__(self, rows: list[tuple[float, int, float, float, float, float]], battery: int) -> None:
-        self.rows = rows
-        self.n = len(rows)
-        self.battery = np.full(self.n, battery, np.int32)
-        self.batch = Batch("test", self.n, {}, np.array([r[0] for r in rows]), np.full(self.n, battery))
-        self.batch.armed = np.array([r[5] for r in rows])
-
-    def number(self, concept: str) -> Any:
-        column = {"pack_voltage": 2, "current": 3, "discharged": 4}[concept]
-        scale = 3.6 if concept == "discharged" else 1.0
-        return np.array([r[column] for r in self.rows]) * scale
-
-
-def _table_of(rows: list[tuple[float, int, float, float, float, float]]) -> SampleTable:
-    """A table of one batch a battery (t, battery, V, A, mAh, armed; NaN is unknown)."""
-    table = SampleTable()
-    for b in sorted({r[1] for r in rows}):
-        table.add(_Chunk([r for r in rows if r[1] == b], b))  # type: ignore[arg-type]
-    return table
-
-
-_maybe = st.one_of(st.just(float("nan")), st.floats(9.0, 13.0, allow_nan=False).map(lambda x: round(x, 2)))
-_row = st.tuples(
-    st.integers(0, 400),  # tenths of a second
-    st.integers(0, 1),
-    _maybe,
-    st.one_of(st.just(float("nan")), st.just(-0.0), st.floats(-5.0, 60.0).map(lambda x: round(x, 1))),
-    st.one_of(st.just(float("nan")), st.floats(0.0, 3000.0).map(lambda x: round(x, 0))),
-    st.sampled_from([0.0, 1.0, float("nan")]),
-)
-_values = st.fixed_dictionaries(
-    {
-        "BATT_LOW_VOLT": st.sampled_from([0.0, 11.0, 12.0]),
-        "BATT_CRT_VOLT": st.sampled_from([0.0, 10.0, 11.5]),
-        "BATT_LOW_TIMER": st.sampled_from([0.0, 0.3, 1.0, 2.0]),
-        "BATT_CAPACITY": st.sampled_from([0.0, 2000.0, 3300.0]),
-        "BATT_LOW_MAH": st.sampled_from([0.0, 1000.0, 2500.0]),
-        "BATT_CRT_MAH": st.sampled_from([0.0, 500.0]),
-        "BATT_FS_LOW_ACT": st.sampled_from([0, 1, 2, 5]),
-        "BATT_FS_CRT_ACT": st.sampled_from([0, 1, 5]),
-        "BATT_FS_VOLTSRC": st.sampled_from([0, 1]),
-        "BATT_MONITOR": st.sampled_from([4, 3, 0]),
-        "BATT2_LOW_VOLT": st.sampled_from([0.0, 11.5]),
-        "BATT2_FS_LOW_ACT": st.sampled_from([0, 5]),
-        "BATT2_CRT_MAH": st.sampled_from([0.0, 800.0]),
-    }
-)
-
-
 @settings(max_examples=300)
-@given(st.lists(_row, max_size=60), _values, st.sampled_from(["copter", "rover", "plane"]), st.booleans())
+@given(st.lists(ROW, max_size=60), VALUES, st.sampled_from(["copter", "rover", "plane"]), st.booleans())
 def test_synthetic_streams_give_the_oracles_events(rows: list[Any], values: dict[str, float], vehicle: str,
                                                    seed: bool) -> None:  # fmt: skip
-    rows = sorted((t / 10, b, v, i, m, a) for t, b, v, i, m, a in rows)
-    _same(_table_of(rows), values, vehicle, ("seed-critical",) if seed else ())
+    _same(table_of(timed(rows)), values, vehicle, ("seed-critical",) if seed else ())

@@ -4,29 +4,28 @@ the temp dir too) `cargo test --offline` replays every conformance vector record
 records per message (tests/rust_cases.py writes them at test time, from the generated Python package)
 and must give the same bytes (MAVLink 2 payloads, v2, v1 and signed frames; uORB structs; DroneCAN
 payloads with and without the tail array optimisation), decoded values and validator problems; a
-wrong byte fails it, and the crate's doc example runs. `cargo fmt --check`, `cargo clippy -- -D
-warnings` and `cargo doc` with warnings denied pass, upstream's whole MAVLink, DroneCAN and PX4
-definitions make a clippy-clean crate too, and a `no_std` library with its own panic handler builds
-against the crate (std linked in would clash with that handler)."""
+wrong byte fails it, and the crate's doc examples run (the README's: decode a BATTERY_STATUS, feed
+the failsafe, act on its event). `cargo fmt --check`, `cargo clippy -- -D warnings` and `cargo doc`
+with warnings denied pass, upstream's whole MAVLink, DroneCAN and PX4 definitions make a clippy-clean
+crate too, and a `no_std` library with its own panic handler builds against the crate (std linked in
+would clash with that handler). The copy is the session's (tests/rust_crate.py), shared with the
+failsafe replay (test_rust_failsafe.py): one build."""
 
 from __future__ import annotations
 
-import os
 import re
 import shutil
-import subprocess
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from rust_cases import Replay, collect, generated_classes, render_replay, replay_test_name
+from rust_cases import Replay, render_replay, replay_test_name
+from rust_crate import GENERATED, Crate, cargo, shared_crate
 from shared_data import UPSTREAM, require
 
-from codegen.apps.package import bundled_schemas, project_root
+from codegen.apps.package import bundled_schemas
 from codegen.backends.rust import render_crate
 from codegen.frontends.loader import load
 
-GENERATED = project_root() / "generated" / "rust"
 needs_rustfmt = pytest.mark.skipif(shutil.which("rustfmt") is None, reason="rustfmt not installed")
 needs_cargo = pytest.mark.skipif(shutil.which("cargo") is None, reason="cargo not installed")
 
@@ -65,34 +64,10 @@ def test_cli_writes_and_checks_a_rust_crate(tmp_path: Path) -> None:
     assert not (out / "src" / "stray.rs").exists()
 
 
-@dataclass(frozen=True)
-class Crate:
-    root: Path
-    target: Path
-    replays: list[Replay]
-
-
-def _cargo(crate: Crate, *args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
-    """cargo in the crate's folder, its build output in the temp dir, never the network."""
-    full = {**os.environ, "CARGO_TARGET_DIR": str(crate.target), "CARGO_NET_OFFLINE": "true", **(env or {})}
-    return subprocess.run(
-        ["cargo", *args], cwd=crate.root, env=full, capture_output=True, text=True, check=False, timeout=600
-    )
-
-
 @pytest.fixture(scope="module")
 def crate(tmp_path_factory: pytest.TempPathFactory) -> Crate:
-    """A copy of generated/rust with the replay cases written into its tests/ folder."""
-    if shutil.which("cargo") is None:
-        pytest.skip("cargo not installed")
-    work = tmp_path_factory.mktemp("rust")
-    root = work / "battgen"
-    shutil.copytree(GENERATED, root, ignore=shutil.ignore_patterns("target", "Cargo.lock"))
-    schema = load([bundled_schemas()])
-    replays = collect(schema, generated_classes(schema))
-    (root / "tests").mkdir()
-    (root / "tests" / "replay.rs").write_text(render_replay(schema, replays), encoding="utf-8")
-    return Crate(root, work / "target", replays)
+    """The session's copy of generated/rust with the replay cases written into its tests/ folder."""
+    return shared_crate(tmp_path_factory)
 
 
 @needs_cargo
@@ -102,11 +77,13 @@ def test_cargo_test_replays_every_vector_record(crate: Crate) -> None:
     for qualified in ("mavlink.BATTERY_STATUS", "mavlink.BATTERY_STATUS_V2", "uorb.BatteryStatus"):
         assert counts.get(qualified, 0) >= 50, counts
     assert any('range"' in c for r in crate.replays for c in r.cases), "no case breaks a range"
-    done = _cargo(crate, "test", "--offline")
+    done = cargo(crate, "test", "--offline")
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-4000:]
     for r in crate.replays:
         assert f"test {replay_test_name(r)} ... ok" in done.stdout, replay_test_name(r)
     assert re.search(r"test src/lib\.rs - \(line \d+\) \.\.\. ok", done.stdout), "the crate's doc example did not run"
+    # the README's example: decode a BATTERY_STATUS, feed the failsafe, act on its event
+    assert re.search(r"test src/lib\.rs - ReadmeDoctests \(line \d+\) \.\.\. ok", done.stdout), "README example"
 
 
 @needs_cargo
@@ -121,7 +98,7 @@ def test_cargo_test_fails_on_a_wrong_byte(crate: Crate, tmp_path: Path) -> None:
     assert case != status.cases[0]
     broken = Replay(status.kind, status.qualified, [case])
     (root / "tests" / "replay.rs").write_text(render_replay(load([bundled_schemas()]), [broken]), encoding="utf-8")
-    done = _cargo(Crate(root, crate.target, [broken]), "test", "--offline")
+    done = cargo(Crate(root, crate.target, [broken], []), "test", "--offline")
     assert done.returncode != 0
     assert "struct bytes" in done.stdout + done.stderr
 
@@ -132,22 +109,22 @@ def test_cargo_fmt_check(crate: Crate, tmp_path: Path) -> None:
     """The crate as committed (the replay data, not formatted, left out)."""
     root = tmp_path / "battgen"
     shutil.copytree(GENERATED, root, ignore=shutil.ignore_patterns("target", "Cargo.lock"))
-    done = _cargo(Crate(root, crate.target, []), "fmt", "--check")
+    done = cargo(Crate(root, crate.target, [], []), "fmt", "--check")
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-4000:]
 
 
 @needs_cargo
 def test_cargo_clippy_denies_every_warning(crate: Crate) -> None:
-    if _cargo(crate, "clippy", "--version").returncode != 0:
+    if cargo(crate, "clippy", "--version").returncode != 0:
         pytest.skip("clippy not installed")
-    done = _cargo(crate, "clippy", "--offline", "--", "-D", "warnings")
+    done = cargo(crate, "clippy", "--offline", "--", "-D", "warnings")
     assert done.returncode == 0, done.stderr[-4000:]
 
 
 @needs_cargo
 def test_cargo_doc_without_warnings(crate: Crate) -> None:
     """The schema's words reach rustdoc as words: no broken links, HTML or bare URLs."""
-    done = _cargo(crate, "doc", "--offline", "--no-deps", env={"RUSTDOCFLAGS": "-D warnings"})
+    done = cargo(crate, "doc", "--offline", "--no-deps", env={"RUSTDOCFLAGS": "-D warnings"})
     assert done.returncode == 0, done.stderr[-4000:]
 
 
@@ -170,8 +147,8 @@ def test_upstream_definitions_make_a_clippy_clean_crate(crate: Crate, tmp_path: 
     for rel, text in files.items():
         (root / rel).parent.mkdir(parents=True, exist_ok=True)
         (root / rel).write_text(text, encoding="utf-8")
-    done = _cargo(
-        Crate(root, crate.target.parent / "target-upstream", []), "clippy", "--offline", "--", "-D", "warnings"
+    done = cargo(
+        Crate(root, crate.target.parent / "target-upstream", [], []), "clippy", "--offline", "--", "-D", "warnings"
     )
     if "no such command" in done.stderr:
         pytest.skip("clippy not installed")
@@ -212,7 +189,7 @@ def test_a_no_std_library_builds_against_the_crate(crate: Crate) -> None:
         encoding="utf-8",
     )
     (user / "src" / "lib.rs").write_text(NO_STD_LIB, encoding="utf-8")
-    alone = Crate(user, crate.target.parent / "target-nostd", crate.replays)
-    done = _cargo(alone, "build", "--offline")
+    alone = Crate(user, crate.target.parent / "target-nostd", [], [])
+    done = cargo(alone, "build", "--offline")
     assert done.returncode == 0, done.stderr[-4000:]
     assert (alone.target / "debug" / "libnostd_user.a").is_file()

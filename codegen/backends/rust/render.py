@@ -15,13 +15,14 @@ import jinja2
 from ...errors import BattgenError
 from ...ir import CompositeType, Message, Schema, SourceFormat
 from .model import MessageView, message_view, shared_enums
+from .params import render_params
 from .types import element
 
 _HERE = Path(__file__).parent
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
 # the crate's own version (its API, not battgen's release): raised when the generated API changes
 CRATE_VERSION = "0.1.0"
-SUPPORT = ("crc", "dronecan_wire", "mavlink_wire", "problems", "same", "uorb_wire", "wire")
+SUPPORT = ("crc", "dronecan_wire", "failsafe", "mavlink_wire", "problems", "same", "uorb_wire", "wire")
 
 
 def _environment() -> jinja2.Environment:
@@ -128,11 +129,20 @@ def render_crate(schema: Schema) -> dict[str, str]:
         text = (_HERE / "support" / f"{name}.rs").read_text(encoding="utf-8")
         head = f"// Copied by battgen from codegen/backends/rust/support/{name}.rs; do not edit.\n"
         rs[f"src/{name}.rs"] = head + text
-    rs["src/lib.rs"] = env.get_template("lib.rs.j2").render(support=SUPPORT, modules=sorted(children[()]))
+    qualified = sorted(v.qualified for v in views)
+    # the README's example decodes a MAVLink BATTERY_STATUS: shown (and run as a doc test) when it is there
+    example = "mavlink.BATTERY_STATUS" in qualified
+    params = render_params(schema)
+    if params is not None:
+        rs["src/params.rs"] = params
+        children[()].add("params")
+    rs["src/lib.rs"] = env.get_template("lib.rs.j2").render(
+        support=SUPPORT, modules=sorted(children[()]), example=example
+    )
     config = env.get_template("rustfmt.toml.j2").render()
     files = rustfmt(rs, config)
     files["Cargo.toml"] = env.get_template("Cargo.toml.j2").render(version=CRATE_VERSION)
     files["rustfmt.toml"] = config
-    files["README.md"] = env.get_template("README.md.j2").render(messages=sorted(v.qualified for v in views))
+    files["README.md"] = env.get_template("README.md.j2").render(messages=qualified, example=example)
     files[".gitignore"] = "# cargo's build output, never committed\n/target/\nCargo.lock\n"
     return dict(sorted(files.items()))

@@ -25,8 +25,10 @@
 pub mod crc;
 pub mod dronecan;
 pub mod dronecan_wire;
+pub mod failsafe;
 pub mod mavlink;
 pub mod mavlink_wire;
+pub mod params;
 pub mod problems;
 pub mod same;
 pub mod uorb;
@@ -34,4 +36,9 @@ pub mod uorb_wire;
 pub mod wire;
 
 pub use problems::{Problem, Problems, Rule, Validate};
+
+/// The README's example, run by `cargo test` as a doc test.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
 pub use same::Same;
