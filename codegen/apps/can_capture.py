@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 from typing import cast
 
 from ..inputs.can.cyphal_ports import Subjects, dsdl_name
-from ..inputs.can.cyphal_reassembly import reassembler_for
+from ..inputs.can.cyphal_reassembly import cyphal_hint, reassembler_for
 from ..inputs.can.ordering import AuxOrder
-from ..inputs.can.reassembly import Diagnostic, Frame, Reassembler, Transfer
+from ..inputs.can.reassembly import Diagnostic, Frame, Transfer
 from ..inputs.can.records import Registry, decode_transfer, signatures
 from ..inputs.model import CyphalClass, DronecanClass, GeneratedMessage
 from .can_types import TypeTable
@@ -145,19 +145,12 @@ def scan(
         for diag in reassembler.finish(last.t, last.index):
             note(diag)
         report.duration = forward
-        if transport == "dronecan" and isinstance(reassembler, Reassembler) and reassembler.cyphal_like:
-            note(_cyphal_hint(reassembler.cyphal_like, last))
+        hint = cyphal_hint(reassembler, last.t, last.index)
+        if hint is not None:
+            note(hint)
     report.frames = reassembler.frames
     report.transfers = reassembler.transfers
     return report
-
-
-def _cyphal_hint(count: int, last: Frame) -> Diagnostic:
-    text = (
-        f"{count} start frame(s) had their toggle bit set, as Cyphal/CAN's start frames do: if this bus carries "
-        "Cyphal, read it as such (battgen can --transport cyphal or mixed, --cyphal-subject ID=TYPE)"
-    )
-    return Diagnostic("can-cyphal-like", text, last.t, last.index, severity="info")
 
 
 def _clock_back(before: float, now: float) -> str:

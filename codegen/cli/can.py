@@ -34,6 +34,7 @@ from ..inputs.can.records import frames_of, registry
 from ..inputs.model import GeneratedMessage
 from ..ir.numbers import to_json_data
 from ..text.escape import line
+from .cyphal_options import add_cyphal_subject
 
 EXIT_OK, EXIT_ERRORS, EXIT_UNREADABLE = 0, 1, 2
 
@@ -137,15 +138,7 @@ def register(subparsers: Any, summary: str) -> None:
         help="what the bus carries: DroneCAN (v0), Cyphal/CAN (v1), or both, told apart by the start frame's toggle "
         "bit (default: dronecan, mixed with --cyphal-subject)",
     )
-    p.add_argument(
-        "--cyphal-subject",
-        action="append",
-        default=[],
-        metavar="ID=TYPE",
-        help="the Cyphal type a subject id carries, as the node's uavcan.pub.<port>.id register says: a DSDL name "
-        "(reg.udral.service.battery.Status.0.2, version optional) or a UDRAL battery port (energy_source, status, "
-        "parameters); repeatable",
-    )
+    add_cyphal_subject(p)
     p.add_argument("--records", action="store_true", help="also print every decoded message as a JSON line")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output format (default: text)")
     p.set_defaults(func=run)

@@ -273,3 +273,37 @@ def test_bad_subject_options_are_one_line_errors(tmp_path: Path, capsys: pytest.
         assert main(["can", str(path), "--cyphal-subject", option]) == 2
         err = capsys.readouterr().err
         assert expected in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_validate_checks_each_node_s_cyphal_battery_status(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``battgen validate`` on a Cyphal/CAN capture: the message the first subject names, every node's records
+    located by node and frame, the values pycyphal sent; a damaged transfer is an error (exit 1)."""
+    path = _capture(tmp_path / "bus.log", _bus(dsdl))
+    code = main(["validate", "--format", "json", *SUBJECTS, str(path)])
+    doc = json.loads(capsys.readouterr().out)
+    (report,) = doc["files"]
+    assert code == 0 and doc["message"] == "cyphal.reg.udral.service.battery.Status_0_2"
+    assert report["records"] == CYCLES * len(NODES) and report["errors"] == 0
+    stream = next(n for n in report["notices"] if n["kind"] == "stream")
+    assert "node 12: 3, node 13: 3" in stream["message"]
+    frames = _bus(dsdl)
+    frames[1] = (frames[1][0], bytes([frames[1][1][0] ^ 0xFF]) + frames[1][1][1:])
+    bad = _capture(tmp_path / "bad.log", frames)
+    assert main(["validate", "--format", "json", *SUBJECTS, str(bad)]) == 1
+    (report,) = json.loads(capsys.readouterr().out)["files"]
+    assert report["records"] == CYCLES * len(NODES) - 1 and report["errors"] == 1
+
+
+def test_validate_without_the_subject_of_its_message_says_so(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _capture(tmp_path / "bus.log", _bus(dsdl))
+    message = "cyphal.reg.udral.service.battery.Parameters_0_3"
+    assert main(["validate", "--message", message, f"--cyphal-subject={STATUS}=status", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "expected --cyphal-subject ID=reg.udral.service.battery.Parameters.0.3" in err and "Traceback" not in err
+    # read as DroneCAN, the capture's start frames are refused, with a word on how to read it as Cyphal
+    assert main(["can", str(path)]) == 1
+    assert "can-cyphal-like" in capsys.readouterr().out

@@ -106,3 +106,15 @@ def reassembler_for(transport: str, signatures: Signatures) -> Reassembler | Mix
     if transport == "mixed":
         return MixedReassembler(signatures)
     return Reassembler(signatures)
+
+
+def cyphal_hint(reassembler: Reassembler | MixedReassembler, t: float, index: int) -> Diagnostic | None:
+    """Where a bus read as DroneCAN only had start frames with their toggle bit set as Cyphal/CAN's are: a
+    ``can-cyphal-like`` note saying how to read it as Cyphal (None otherwise)."""
+    if type(reassembler) is not Reassembler or not reassembler.cyphal_like:
+        return None
+    text = (
+        f"{reassembler.cyphal_like} start frame(s) had their toggle bit set, as Cyphal/CAN's start frames do: if "
+        "this bus carries Cyphal, read it as such (--transport cyphal or mixed, --cyphal-subject ID=TYPE)"
+    )
+    return Diagnostic("can-cyphal-like", text, t, index, severity="warning")
