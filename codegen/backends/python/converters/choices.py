@@ -1,4 +1,4 @@
-"""Emitters of the ops between enumerated values and concepts: flag, flag_choice, flags, choice.
+"""Emitters of the ops between enumerated values and concepts: flag, flag_choice, flags, choice, value_flags.
 
 Bits read into bool, choice or flags concepts are noted, so the function's epilogue reports the
 bits of the field nothing reads as dropped; choices with no counterpart are reported too.
@@ -7,7 +7,7 @@ bits of the field nothing reads as dropped; choices with no counterpart are repo
 from __future__ import annotations
 
 from ....ir import Rule
-from ....ir.ops import Choice, Flag, FlagChoice, Flags
+from ....ir.ops import Choice, Flag, FlagChoice, Flags, ValueFlags
 from ..literals import py_literal
 from .context import RuleContext, constant_name
 
@@ -82,3 +82,26 @@ class ChoiceEmitters(RuleContext):
         self.emit_call("rep_u.unknown", [label], 2)
         self.emit("    if rep_d is not None and _v is not None:")
         self.emit_call("rep_d.dropped", [py_literal(f"concepts.{con.field}"), _NO_COUNTERPART], 2)
+
+    def visit_value_flags(self, rule: Rule, op: ValueFlags) -> None:
+        """One condition at a time (UDRAL's Error) <-> a flags concept: the most severe set flag is written."""
+        fmt, con = self.format_and_concept(rule)
+        table = [(entry.choice, self.value_of(entry.value, [fmt])) for entry in op.map]
+        none = self.value_of(op.none, [fmt]) if op.none is not None else None
+        if not self.backward:
+            by_value = self.const(constant_name(con.field, "by", fmt.field), {v: (k,) for k, v in table})
+            self.emit(f"_v = {self.s(fmt)}", f"{self.t(con)} = None if _v is None else {by_value}.get(_v, ())")
+            skip = f"({py_literal(None)}, {py_literal(none)})"
+            self.emit(f"if rep_d is not None and _v not in {by_value} and _v not in {skip}:")
+            self.emit_call("rep_d.dropped", [self.label(fmt), _NO_COUNTERPART], 1)
+            return
+        order = self.const(constant_name(fmt.field, "by", con.field), tuple(table))
+        target, label = self.t(fmt), self.label(fmt)
+        self.emit(f"_v = {self.s(con)}", "if _v is None:", "    if rep_u is not None:")
+        self.emit_call("rep_u.unknown", [label], 2)
+        self.emit("else:", f"    _w = next(((_n, _x) for _n, _x in {order} if _n in _v), (None, {py_literal(none)}))")
+        self.emit(f"    {target} = _w[1]", "    if rep_d is not None:", "        for _n in _v:")
+        known = self.const(constant_name(con.field, "with", fmt.field), tuple(sorted(k for k, _ in table)))
+        why = f'_n + (" not written: one condition at a time" if _n in {known} else " has no counterpart")'
+        self.emit("            if _n != _w[0]:")
+        self.emit_call("rep_d.dropped", [py_literal(f"concepts.{con.field}"), why], 4)
