@@ -5,7 +5,7 @@ register); a reader of its transfers must be told the same. :func:`subject_table
 ``ID=TYPE`` pairs (``--cyphal-subject 4096=reg.udral.service.battery.Status.0.2``) and from the fixed port
 ids the generated package's types declare. TYPE is a DSDL full name, its version optional (the newest the
 package has), or one of the ports of UDRAL's battery service as its ``_.0.1`` lists them: ``energy_source``,
-``status``, ``parameters``.
+``status``, ``parameters`` (``battery_status``, ``battery_parameters`` as PX4 names them).
 """
 
 from __future__ import annotations
@@ -22,11 +22,14 @@ from .cyphal_wire import SUBJECT_MASK
 Subjects = Mapping[int, CyphalClass]
 _HALVES = (".Request", ".Response")
 _DRONE = "reg.drone."
-# the subjects of reg.udral.service.battery._.0.1 (its own table) and the type each carries
+# the subjects of reg.udral.service.battery._.0.1 (its own table) and the type each carries; PX4's Cyphal
+# battery subscriber names the last two battery_status and battery_parameters (its port registers)
 BATTERY_PORTS = {
     "energy_source": "reg.udral.physics.electricity.SourceTs",
     "status": "reg.udral.service.battery.Status",
     "parameters": "reg.udral.service.battery.Parameters",
+    "battery_status": "reg.udral.service.battery.Status",
+    "battery_parameters": "reg.udral.service.battery.Parameters",
 }
 
 
