@@ -307,3 +307,28 @@ def test_validate_without_the_subject_of_its_message_says_so(
     # read as DroneCAN, the capture's start frames are refused, with a word on how to read it as Cyphal
     assert main(["can", str(path)]) == 1
     assert "can-cyphal-like" in capsys.readouterr().out
+
+
+def test_subject_types_by_name_port_and_older_namespace() -> None:
+    """A TYPE is a DSDL name (version optional: the newest), a UDRAL battery port (UDRAL's or PX4's name for
+    it), or a name of the older reg.drone namespace NXP's BMS publishes, read as its reg.udral twin."""
+    from codegen.inputs.can.cyphal_ports import cyphal_classes, dsdl_name, subject_table
+
+    classes = cyphal_classes("generated")
+    table = subject_table(
+        [
+            "1=reg.udral.service.battery.Status.0.2",
+            "2=reg.udral.service.battery.Status",
+            "3=reg.udral.service.battery.Status.0",
+            "4=status",
+            "5=battery_status",
+            "6=reg.drone.service.battery.Status.0.2",
+            "7=energy_source",
+            "8=battery_parameters",
+        ],
+        classes,
+    )
+    names = {port: dsdl_name(cls) for port, cls in table.items()}
+    assert {names[p] for p in range(1, 7)} == {"reg.udral.service.battery.Status.0.2"}
+    assert names[7] == "reg.udral.physics.electricity.SourceTs.0.1"
+    assert names[8] == "reg.udral.service.battery.Parameters.0.3"
