@@ -2,7 +2,8 @@
 
 Every bundled battery and physics type (schemas/cyphal/) is compiled by ``pycyphal.dsdl.compile_all`` (nunavut
 underneath) at test time; hypothesis draws values in pydsdl's form (the strategy of ``test_cyphal_codec``, which
-follows pydsdl's reading of each type), pycyphal builds its object from them (``update_from_builtin``) and
+follows pydsdl's reading of each type; the bundled types hold no text or ``byte`` arrays, so its plain data is
+pycyphal's builtin form too), pycyphal builds its object from them (``update_from_builtin``) and
 serializes it: our class built from the same values must give the same bytes, read pycyphal's bytes back to the
 same values, and pycyphal must read our bytes back to them too.
 """
@@ -42,17 +43,6 @@ def pycyphal_classes(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[
             del sys.modules[module]
 
 
-def _builtin(v: Any) -> Any:
-    """pydsdl's form -> pycyphal's builtin form (text as str is pycyphal's too; bytes as lists of ints)."""
-    if isinstance(v, bytes | bytearray):
-        return list(v)
-    if isinstance(v, dict):
-        return {k: _builtin(x) for k, x in v.items() if k != "union_field"}
-    if isinstance(v, list | tuple):
-        return [_builtin(x) for x in v]
-    return v
-
-
 def test_every_bundled_type_is_compiled(pycyphal_classes: dict[str, Any]) -> None:
     assert len(pycyphal_classes) == len(BUNDLED) == 19
     for name, cls in pycyphal_classes.items():
@@ -67,7 +57,7 @@ def test_bundled_values_as_pycyphal(pycyphal_classes: dict[str, Any], name: str,
     ours_cls, t = _bundled()[name]
     theirs_cls = pycyphal_classes[name]
     value = data.draw(values(t))
-    theirs = pycyphal_dsdl.update_from_builtin(theirs_cls(), _builtin(value))
+    theirs = pycyphal_dsdl.update_from_builtin(theirs_cls(), plain(value))
     expected = b"".join(bytes(f) for f in pycyphal_dsdl.serialize(theirs))
     ours = ours_cls.from_dict(plain(value))
     assert ours.encode() == expected
@@ -78,4 +68,4 @@ def test_bundled_values_as_pycyphal(pycyphal_classes: dict[str, Any], name: str,
         # NameError in pycyphal's reading of it, whatever the bytes (its writing, above, is sound)
         return
     back = pycyphal_dsdl.deserialize(theirs_cls, [memoryview(ours.encode())])
-    assert back is not None and same(pycyphal_dsdl.to_builtin(back)) == same(_builtin(value))
+    assert back is not None and same(pycyphal_dsdl.to_builtin(back)) == same(plain(value))

@@ -6,7 +6,7 @@ bits of the field nothing reads as dropped; choices with no counterpart are repo
 
 from __future__ import annotations
 
-from ....ir import Rule
+from ....ir import FieldRef, Rule
 from ....ir.ops import Choice, Flag, FlagChoice, Flags, ValueFlags
 from ..literals import py_literal
 from .context import RuleContext, constant_name
@@ -61,16 +61,23 @@ class ChoiceEmitters(RuleContext):
         self.emit(f"            if _n not in {known}:")
         self.emit_call("rep_d.dropped", [py_literal(f"concepts.{con.field}"), '_n + " has no counterpart"'], 4)
 
+    def _read_value(
+        self, fmt: FieldRef, con: FieldRef, by_value: dict[object, object], absent: str, unknown: object
+    ) -> None:
+        """A field's value looked up in ``by_value`` (``.get``'s ``absent`` default where it is not there); a
+        value that is neither there nor ``unknown`` is reported dropped."""
+        table = self.const(constant_name(con.field, "by", fmt.field), by_value)
+        self.emit(f"_v = {self.s(fmt)}", f"{self.t(con)} = None if _v is None else {table}.get(_v{absent})")
+        skip = f"({py_literal(None)}, {py_literal(unknown)})"
+        self.emit(f"if rep_d is not None and _v not in {table} and _v not in {skip}:")
+        self.emit_call("rep_d.dropped", [self.label(fmt), _NO_COUNTERPART], 1)
+
     def visit_choice(self, rule: Rule, op: Choice) -> None:
         fmt, con = self.format_and_concept(rule)
         table = [(entry.choice, self.value_of(entry.value, [fmt])) for entry in op.map]
         unknown = self.value_of(op.unknown, [fmt]) if op.unknown is not None else None
         if not self.backward:
-            by_value = self.const(constant_name(con.field, "by", fmt.field), {v: k for k, v in table})
-            self.emit(f"_v = {self.s(fmt)}", f"{self.t(con)} = None if _v is None else {by_value}.get(_v)")
-            skip = f"({py_literal(None)}, {py_literal(unknown)})"
-            self.emit(f"if rep_d is not None and _v not in {by_value} and _v not in {skip}:")
-            self.emit_call("rep_d.dropped", [self.label(fmt), _NO_COUNTERPART], 1)
+            self._read_value(fmt, con, {v: k for k, v in table}, "", unknown)
             return
         by_choice = self.const(constant_name(fmt.field, "by", con.field), dict(table))
         target, label = self.t(fmt), self.label(fmt)
@@ -89,11 +96,7 @@ class ChoiceEmitters(RuleContext):
         table = [(entry.choice, self.value_of(entry.value, [fmt])) for entry in op.map]
         none = self.value_of(op.none, [fmt]) if op.none is not None else None
         if not self.backward:
-            by_value = self.const(constant_name(con.field, "by", fmt.field), {v: (k,) for k, v in table})
-            self.emit(f"_v = {self.s(fmt)}", f"{self.t(con)} = None if _v is None else {by_value}.get(_v, ())")
-            skip = f"({py_literal(None)}, {py_literal(none)})"
-            self.emit(f"if rep_d is not None and _v not in {by_value} and _v not in {skip}:")
-            self.emit_call("rep_d.dropped", [self.label(fmt), _NO_COUNTERPART], 1)
+            self._read_value(fmt, con, {v: (k,) for k, v in table}, ", ()", none)
             return
         order = self.const(constant_name(fmt.field, "by", con.field), tuple(table))
         target, label = self.t(fmt), self.label(fmt)
