@@ -15,14 +15,17 @@ import pytest
 from shared_data import require, shared
 
 from generated.convert import LossReport
-from generated.convert.dronecan_udral import udral_to_dronecan
+from generated.convert.dronecan_udral import dronecan_to_udral, udral_to_dronecan
 from generated.convert.udral import to_concepts as udral_to_concepts
+from generated.convert.udral_mavlink import udral_to_mavlink
 from generated.convert.udral_mavlink_info import mavlink_info_to_udral, udral_to_mavlink_info
 from generated.convert.udral_mavlink_v2 import udral_to_mavlink_v2
 from generated.convert.udral_uorb import udral_to_uorb, uorb_to_udral
 from generated.cyphal.reg.udral.physics.electricity import SourceTs_0_1
-from generated.cyphal.reg.udral.service.battery import Parameters_0_3, Status_0_2
-from generated.uorb import BatteryStatus
+from generated.cyphal.reg.udral.service.battery import Error_0_1Value, Parameters_0_3, Status_0_2
+from generated.dronecan.uavcan.equipment.power import BatteryInfo
+from generated.mavlink import MavBatteryFault
+from generated.uorb import BatteryStatus, BatteryStatusFault
 
 
 def udral_text(path: str) -> str:
@@ -144,3 +147,88 @@ def test_round_trip_through_uorb_keeps_the_values() -> None:
     assert back_parameters.series_cell_count == 6
     # every UDRAL object a converter writes serializes as pydsdl expects (the codec under the converters)
     assert SourceTs_0_1.decode(back_source.encode()) == back_source
+
+
+# UDRAL Error value -> (its comment in Error.0.1, uORB fault, DroneCAN status flag, MAVLink fault bit)
+ERRORS = {
+    "BAD_BATTERY": ("The battery should not be used anymore.", "HARDWARE_FAILURE", "BAD_BATTERY", None),
+    "OVERDISCHARGE": (
+        "The battery is discharged beyond the design limits",
+        "DEEP_DISCHARGE",
+        None,
+        "DEEP_DISCHARGE",
+    ),
+    "OVERLOAD": (
+        "The charge or discharge rate exceeds the safe operating limits.",
+        "OVER_CURRENT",
+        "OVERLOAD",
+        "OVER_CURRENT",
+    ),
+    "TEMPERATURE_HOT": (
+        "At least one cell is above/below the temperature SOA.",
+        "OVER_TEMPERATURE",
+        "TEMP_HOT",
+        "OVER_TEMPERATURE",
+    ),
+    "TEMPERATURE_COLD": (
+        "At least one cell is above/below the temperature SOA.",
+        "UNDER_TEMPERATURE",
+        "TEMP_COLD",
+        "UNDER_TEMPERATURE",
+    ),
+}
+
+
+def _status(error: str) -> Status_0_2:
+    status = Status_0_2()
+    status.error.value = getattr(Error_0_1Value, error)
+    return status
+
+
+@pytest.mark.parametrize("error", sorted(ERRORS))
+def test_errors_become_the_faults_of_every_other_format(error: str) -> None:
+    comment, uorb_fault, dronecan_flag, mavlink_fault = ERRORS[error]
+    says("reg/udral/service/battery/Error.0.1.dsdl", comment)
+    faults = udral_to_uorb(source(), _status(error)).faults
+    assert faults == 1 << getattr(BatteryStatusFault, uorb_fault)  # uORB's FAULT_* are bit positions
+    flags = udral_to_dronecan(source(), _status(error))[0].status_flags
+    assert flags == (getattr(BatteryInfo, f"STATUS_FLAG_{dronecan_flag}") if dronecan_flag else 0)
+    bitmask = udral_to_mavlink(source(), _status(error)).fault_bitmask
+    assert bitmask == (getattr(MavBatteryFault, mavlink_fault).value if mavlink_fault else 0)
+
+
+@pytest.mark.parametrize(
+    ("error", "comment"),
+    [
+        ("NEEDS_SERVICE", "The battery requires offline maintenance."),
+        ("BMS_ERROR", "An internal error in the battery management system, not related to the battery itself."),
+        ("CONFIGURATION", "The battery/BMS/node/service configuration is missing or invalid."),
+        ("CELL_UNDERVOLTAGE", "Voltage of one of the battery cells exceeds its SOA."),
+        ("CELL_COUNT", "The sum of cell voltages is far from the total pack voltage."),
+    ],
+)
+def test_errors_without_a_fault_are_reported_dropped(error: str, comment: str) -> None:
+    says("reg/udral/service/battery/Error.0.1.dsdl", comment)
+    report = LossReport()
+    assert udral_to_uorb(source(), _status(error), report=report).faults == 0
+    dropped = [e for e in report.entries if e.field.endswith("Status_0_2.error.value")]
+    assert [e.kind for e in dropped] == ["dropped"]
+
+
+def test_the_most_severe_fault_is_the_error_written() -> None:
+    """UDRAL's Error holds one condition: of several faults, the one of the smallest code, the others dropped."""
+    says(
+        "reg/udral/service/battery/Error.0.1.dsdl",
+        "it is recommended to give preference to errors whose code is smaller "
+        "(e.g., BAD_BATTERY trumps TEMPERATURE_COLD).",
+    )
+    report = LossReport()
+    faults = 1 << BatteryStatusFault.OVER_TEMPERATURE | 1 << BatteryStatusFault.DEEP_DISCHARGE
+    status = uorb_to_udral(BatteryStatus(faults=faults), report=report)[1]
+    assert status.error.value == Error_0_1Value.OVERDISCHARGE
+    assert [e.detail for e in report.entries if e.field == "concepts.faults"] == [
+        "over_temperature not written: one condition at a time"
+    ]
+    info = BatteryInfo(status_flags=BatteryInfo.STATUS_FLAG_BAD_BATTERY | BatteryInfo.STATUS_FLAG_TEMP_COLD)
+    assert dronecan_to_udral(info)[1].error.value == Error_0_1Value.BAD_BATTERY
+    assert uorb_to_udral(BatteryStatus())[1].error.value == Error_0_1Value.NONE

@@ -67,3 +67,22 @@ def test_the_fields_px4_copies() -> None:
     assert (px4.cycle_count, px4.state_of_health) == (12, 97)
     assert (px4.scale, px4.max_error, px4.id, px4.connected) == (-1.0, 1, 0, True)
     assert px4.voltage_v == 24.5
+
+
+def test_px4_sets_no_fault_from_the_error() -> None:
+    """Battery.hpp's Status callback copies the temperature and the cells and never reads ``error``: an
+    over-temperature UDRAL reports reaches PX4 as no fault (and the loss report names the error dropped), where
+    the strict converter sets FAULT_OVER_TEMPERATURE."""
+    from generated.convert import LossReport
+    from generated.cyphal.reg.udral.service.battery import Error_0_1Value
+    from generated.uorb import BatteryStatusFault
+
+    source, status, parameters = battery()
+    status.error.value = Error_0_1Value.TEMPERATURE_HOT
+    report = LossReport()
+    px4 = udral_to_uorb(source, status, parameters, policy="px4", report=report)
+    assert px4.faults == 0
+    assert ("cyphal.reg.udral.service.battery.Status_0_2.error", "dropped") in {
+        (e.field, e.kind) for e in report.entries
+    }
+    assert udral_to_uorb(source, status, parameters).faults == 1 << BatteryStatusFault.OVER_TEMPERATURE

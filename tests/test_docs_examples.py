@@ -71,6 +71,6 @@ def test_binary_examples_are_what_the_documented_command_writes(tmp_path: Path) 
                           capture_output=True, text=True, timeout=300, check=False)  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     written = sorted(p.name for p in tmp_path.iterdir())
-    assert written == ["bench.log", "flight.bin", "flight.ulg"]
+    assert written == ["bench.log", "cyphal-bench.txt", "flight.bin", "flight.ulg"]
     for name in written:
         assert (tmp_path / name).read_bytes() == (EXAMPLES / name).read_bytes(), name

@@ -11,11 +11,14 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import cast
 
+from ..inputs.can.cyphal_ports import Subjects, dsdl_name
+from ..inputs.can.cyphal_reassembly import cyphal_hint, reassembler_for
 from ..inputs.can.ordering import AuxOrder
-from ..inputs.can.reassembly import Diagnostic, Frame, Reassembler, Transfer
+from ..inputs.can.reassembly import Diagnostic, Frame, Transfer
 from ..inputs.can.records import Registry, decode_transfer, signatures
-from ..inputs.model import GeneratedMessage
+from ..inputs.model import CyphalClass, DronecanClass, GeneratedMessage
 from .can_types import TypeTable
 
 KEEP_PER_CODE = 20  # problems listed per code; the rest are counted
@@ -23,11 +26,11 @@ KEEP_PER_CODE = 20  # problems listed per code; the rest are counted
 
 @dataclass
 class Stream:
-    """The transfers of one (node, kind, data type) seen in a capture."""
+    """The transfers of one (node, kind, data type or port, protocol) seen in a capture."""
 
     node: int
-    kind: str
-    data_type_id: int
+    kind: str  # message, request, response; a Cyphal message's is "subject"
+    data_type_id: int  # a Cyphal transfer's port id
     name: str  # the DSDL name where the generated package knows the type, else ""
     count: int = 0
     first_t: float = 0.0
@@ -35,6 +38,7 @@ class Stream:
     undecodable: int = 0
     span: float = 0.0  # seconds between successive transfers where the clock went forward
     steps: int = 0  # those intervals: a clock that jumps back breaks the count into monotonic stretches
+    protocol: str = "dronecan"
 
     def see(self, t: float) -> None:
         """One more transfer at ``t``."""
@@ -51,6 +55,7 @@ class Stream:
 
     def to_dict(self) -> dict[str, object]:
         return {
+            "protocol": self.protocol,
             "node": self.node,
             "kind": self.kind,
             "data_type_id": self.data_type_id,
@@ -69,7 +74,7 @@ class CaptureReport:
     frames: int = 0
     transfers: int = 0
     duration: float = 0.0
-    streams: dict[tuple[int, str, int], Stream] = field(default_factory=dict)
+    streams: dict[tuple[int, str, int, str], Stream] = field(default_factory=dict)
     counts: Counter[str] = field(default_factory=Counter)  # problems per code
     problems: list[Diagnostic] = field(default_factory=list)  # the first KEEP_PER_CODE of each code
     severities: dict[str, str] = field(default_factory=dict)  # code -> severity
@@ -98,13 +103,17 @@ def scan(
     *,
     on_message: Callable[[Transfer, GeneratedMessage], None] | None = None,
     standard: TypeTable | None = None,
+    transport: str = "dronecan",
+    subjects: Subjects | None = None,
 ) -> CaptureReport:
     """Account for every frame; ``on_message`` is called with each decoded transfer of a known type.
-    ``standard``: more types (:func:`.can_types.standard_types`) whose transfers are named and CRC-checked."""
+    ``standard``: more types (:func:`.can_types.standard_types`) whose transfers are named and CRC-checked.
+    ``transport``: ``dronecan``, ``cyphal`` or ``mixed`` (both on one bus); ``subjects``: the Cyphal type of
+    each subject id (:func:`~codegen.inputs.can.cyphal_ports.subject_table`), decoded as DroneCAN types are."""
     seeds = signatures(known)
     for (kind, type_id), (_, signature) in (standard or {}).items():
         seeds.setdefault(("message" if kind == "message" else "service", type_id), signature)
-    reassembler = Reassembler(seeds)
+    reassembler = reassembler_for(transport, seeds)
     order = AuxOrder(known)
     report = CaptureReport(source)
     last: Frame | None = None
@@ -131,11 +140,14 @@ def scan(
                 continue
             for diag in order.see(event):
                 note(diag)
-            _count(report, event, known, note, on_message, standard or {})
+            _count(report, event, _types(event, known, subjects or {}), note, on_message, standard or {})
     if last is not None:
         for diag in reassembler.finish(last.t, last.index):
             note(diag)
         report.duration = forward
+        hint = cyphal_hint(reassembler, last.t, last.index)
+        if hint is not None:
+            note(hint)
     report.frames = reassembler.frames
     report.transfers = reassembler.transfers
     return report
@@ -148,27 +160,42 @@ def _clock_back(before: float, now: float) -> str:
     )
 
 
+def _types(transfer: Transfer, known: Registry, subjects: Subjects) -> tuple[DronecanClass | CyphalClass | None, str]:
+    """The generated class of a transfer's type, where known, and its DSDL name."""
+    if transfer.id.protocol == "cyphal":
+        found = subjects.get(transfer.id.data_type_id) if not transfer.id.service else None
+        return found, dsdl_name(found) if found is not None else ""
+    cls = known.get((transfer.id.kind, transfer.id.data_type_id))
+    return cls, cls.QUALIFIED_NAME.removeprefix("dronecan.") if cls is not None else ""
+
+
 def _count(
     report: CaptureReport,
     transfer: Transfer,
-    known: Registry,
+    typed: tuple[DronecanClass | CyphalClass | None, str],
     note: Callable[[Diagnostic], None],
     on_message: Callable[[Transfer, GeneratedMessage], None] | None,
     standard: TypeTable,
 ) -> None:
     kind = transfer.id.kind
-    cls = known.get((kind, transfer.id.data_type_id))
-    key = (transfer.node, kind, transfer.id.data_type_id)
+    cls, name = typed
+    protocol = transfer.id.protocol
+    key = (transfer.node, kind, transfer.id.data_type_id, protocol)
     stream = report.streams.get(key)
     if stream is None:
-        other = standard.get((kind, transfer.id.data_type_id))
-        name = cls.QUALIFIED_NAME.removeprefix("dronecan.") if cls is not None else other[0] if other else ""
-        stream = report.streams[key] = Stream(transfer.node, kind, transfer.id.data_type_id, name, 0, transfer.t)
+        other = standard.get((kind, transfer.id.data_type_id)) if protocol == "dronecan" else None
+        name = name or (other[0] if other else "")
+        stream = report.streams[key] = Stream(
+            transfer.node, kind, transfer.id.data_type_id, name, 0, transfer.t, protocol=protocol
+        )
     stream.see(transfer.t)
     if cls is None:
         return
     try:
-        message = decode_transfer(cls, transfer)
+        if protocol == "cyphal":  # padding past the last field reads as Cyphal's implicit extension: ignored
+            message = cast(CyphalClass, cls).decode(transfer.payload)
+        else:
+            message = decode_transfer(cast(DronecanClass, cls), transfer)
     except ValueError as exc:  # the generated DecodeError
         stream.undecodable += 1
         note(

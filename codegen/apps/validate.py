@@ -272,12 +272,13 @@ def check_file(
     keep_findings: bool = True,
     on_event: Callable[[Event], None] | None = None,
     gate: Gate | None = None,
+    subjects: Sequence[str] = (),
 ) -> FileReport:
     """Check every record of one file. Each finding, notice and unreadable part goes to
     ``on_event`` as soon as it is found; findings are kept in the report only with
     ``keep_findings`` (so a caller printing them streams a file of any size in constant memory).
     ``gate`` leaves findings out by rule selection or a profile: they are marked ``waived`` and
-    counted, never errors."""
+    counted, never errors. ``subjects``: which subject of a Cyphal/CAN capture carries which type (``ID=TYPE``)."""
     report = FileReport(path.as_posix())
 
     def tell(event: Event) -> None:
@@ -285,7 +286,7 @@ def check_file(
             on_event(event)
 
     try:
-        for item in read_records(path, message, report.file, model=checker.cls, kind=kind):
+        for item in read_records(path, message, report.file, model=checker.cls, kind=kind, subjects=subjects):
             if isinstance(item, Notice):
                 report.notices.append(item)
                 if item.severity == "error":  # damage a reader found (a CAN transfer's bad CRC): a finding too

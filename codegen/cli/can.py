@@ -1,4 +1,5 @@
-"""``battgen can CAPTURE... | --bus IFACE:CHANNEL``: what a DroneCAN bus carried, and what was wrong on the wire.
+"""``battgen can CAPTURE... | --bus IFACE:CHANNEL``: what a DroneCAN or Cyphal/CAN bus carried, and what was wrong on
+the wire.
 
 Reads CAN captures (candump ``.log``, ``.asc``, ``.blf``, ``.trc``, python-can ``.csv`` with ``--input-format can``,
 each also ``.gz``; ArduPilot DataFlash ``.bin`` logs with CANF/CAFD records) or a live python-can bus
@@ -7,6 +8,8 @@ DroneCAN transfer and prints, per capture: each node's data types with counts an
 problems (toggle errors, CRC mismatches and the signature they point to, missing start or end frames, transfer-id
 gaps, BatteryInfoAux sent out of order, transfers that do not decode), the first few of each kind with the frame's
 time and position, and counts. ``--records`` also prints every decoded message as a JSON line on stdout.
+Cyphal/CAN (``--transport cyphal``, or ``mixed`` beside DroneCAN, told apart by the start frame's toggle bit):
+each ``--cyphal-subject ID=TYPE`` names the type a subject carries, whose transfers are then decoded.
 ``--format json`` prints one JSON document instead. Exit 0 clean, 1 transport errors, 2 unreadable input.
 """
 
@@ -24,29 +27,34 @@ from ..apps.can_types import shipped_tree, standard_types
 from ..apps.package import bundled_package
 from ..errors import BattgenError, LocatedError, missing_file
 from ..inputs.can.captures import read_bus
+from ..inputs.can.cyphal_ports import cyphal_classes, subject_table
+from ..inputs.can.cyphal_reassembly import TRANSPORTS
 from ..inputs.can.reassembly import Frame, Transfer
 from ..inputs.can.records import frames_of, registry
 from ..inputs.model import GeneratedMessage
 from ..ir.numbers import to_json_data
 from ..text.escape import line
+from .cyphal_options import add_cyphal_subject
 
 EXIT_OK, EXIT_ERRORS, EXIT_UNREADABLE = 0, 1, 2
 
 
 def _print_record(transfer: Transfer, message: GeneratedMessage) -> None:
-    data = {
+    data: dict[str, object] = {
         "t": transfer.t,
         "node": transfer.node,
         "frame": transfer.frame,
         "type": type(message).__name__,
-        "message": to_json_data(message.to_dict()),
     }
+    if transfer.id.protocol == "cyphal":
+        data.update(protocol="cyphal", subject=transfer.id.data_type_id)
+    data["message"] = to_json_data(message.to_dict())
     print(json.dumps(data, allow_nan=False))
 
 
 def _text(report: CaptureReport) -> None:
     print(line(f"{report.source}: {report.frames} frames, {report.transfers} transfers in {report.duration:.3f} s"))
-    for (node, kind, type_id), s in sorted(report.streams.items()):
+    for (node, kind, type_id, _), s in sorted(report.streams.items()):
         name = s.name or "(unknown type)"
         bad = f", {s.undecodable} undecodable" if s.undecodable else ""
         print(line(f"  node {node:3d}  {kind:8s} {type_id:5d} {name:45s} {s.count:7d} x {s.rate:8.2f} Hz{bad}"))
@@ -57,7 +65,10 @@ def _text(report: CaptureReport) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    known = registry(bundled_package().__name__)
+    package = bundled_package().__name__
+    known = registry(package)
+    subjects = subject_table(args.cyphal_subject, cyphal_classes(package))
+    transport = args.transport or ("mixed" if args.cyphal_subject else "dronecan")
     # every standard type is CRC-checked and named, not only the generated package's battery types
     standard = standard_types(Path(args.dsdl) if args.dsdl else shipped_tree())
     on_message = _print_record if args.records else None
@@ -75,7 +86,9 @@ def run(args: argparse.Namespace) -> int:
     code = EXIT_OK
     for name, frames in sources:
         try:
-            report = scan(frames, name, known, on_message=on_message, standard=standard)
+            report = scan(
+                frames, name, known, on_message=on_message, standard=standard, transport=transport, subjects=subjects
+            )
         except KeyboardInterrupt:  # a live bus stopped by the user: the report of what was seen is still wanted
             print(line(f"{name}: stopped"), file=sys.stderr)
             continue
@@ -119,6 +132,13 @@ def register(subparsers: Any, summary: str) -> None:
         help="a DroneCAN DSDL root (a copy of dronecan/DSDL) whose types are named and CRC-checked "
         "(default: the tree the dronecan package ships, where installed)",
     )
+    p.add_argument(
+        "--transport",
+        choices=TRANSPORTS,
+        help="what the bus carries: DroneCAN (v0), Cyphal/CAN (v1), or both, told apart by the start frame's toggle "
+        "bit (default: dronecan, mixed with --cyphal-subject)",
+    )
+    add_cyphal_subject(p)
     p.add_argument("--records", action="store_true", help="also print every decoded message as a JSON line")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output format (default: text)")
     p.set_defaults(func=run)

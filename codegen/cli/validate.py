@@ -43,13 +43,14 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from ..apps import validate as engine
 from ..apps.failsafe.vehicles import VEHICLES
 from ..apps.gate import KIND_FIRMWARE, Gate, Settings, check_selectors, describe, for_firmware, names_of
-from ..apps.package import bundled_schemas
+from ..apps.package import bundled_package, bundled_schemas
 from ..apps.validate import Checker, Event, FileReport, Finding, exit_code, is_empty, json_document, make_checker
 from ..apps.validate_formats import Group, Grouper, github_line, github_notice, sarif_document
 from ..errors import BattgenError
@@ -57,6 +58,7 @@ from ..inputs.kinds import KINDS, file_kind
 from ..inputs.records import Notice, Unreadable
 from ..ir import Message
 from ..text.escape import line
+from .cyphal_options import add_cyphal_subject, check_subjects, subject_message
 from .gate_options import add_gate_options, firmware_note, gate_settings
 
 
@@ -107,6 +109,7 @@ def check_file(
     kind: str | None = None,
     gate: Gate | None = None,
     github: bool = False,
+    subjects: Sequence[str] = (),
 ) -> FileReport:
     """Check every record of one file, grouping its findings as they come (memory bounded by the
     kinds of finding, not the records). With ``echo``, print notices as they come and the groups
@@ -122,7 +125,7 @@ def check_file(
 
     keep_findings = not echo if keep is None else keep
     report = engine.check_file(
-        path, message, checker, kind=kind, keep_findings=keep_findings, on_event=on_event, gate=gate
+        path, message, checker, kind=kind, keep_findings=keep_findings, on_event=on_event, gate=gate, subjects=subjects
     )
     if echo:
         print_groups(groups, github)
@@ -133,7 +136,9 @@ def run(args: argparse.Namespace) -> int:
     schema_dir = Path(args.schemas) if args.schemas else bundled_schemas()
     kind = args.input_format
     chosen = gate_settings(args)
-    message, checker = make_checker(schema_dir, args.message, args.files, kind, vehicle=args.vehicle)
+    message_name = args.message or subject_message(args.cyphal_subject, bundled_package().__name__)
+    message, checker = make_checker(schema_dir, message_name, args.files, kind, vehicle=args.vehicle)
+    check_subjects(args.cyphal_subject, checker.cls)
     check_selectors(chosen, names_of(message, checker.rules, checker.extra is not None))
     fmt = args.format
     text_like = fmt in ("text", "github")
@@ -147,7 +152,16 @@ def run(args: argparse.Namespace) -> int:
         gate = Gate(in_force[-1], message.qualified_name)
         grouper = Grouper()
         report = check_file(
-            Path(f), message, checker, grouper, echo=text_like, keep=fmt == "json", kind=kind, gate=gate, github=github
+            Path(f),
+            message,
+            checker,
+            grouper,
+            echo=text_like,
+            keep=fmt == "json",
+            kind=kind,
+            gate=gate,
+            github=github,
+            subjects=args.cyphal_subject,
         )
         reports.append(report)
         all_groups += grouper.groups() + grouper.groups(waived=True)
@@ -260,6 +274,7 @@ def register(subparsers: Any, summary: str) -> None:
         choices=KINDS,
         help="read every FILE as this format (default: from each extension; 'mavlink' is a raw MAVLink stream)",
     )
+    add_cyphal_subject(p)
     p.add_argument(
         "--vehicle",
         choices=sorted(VEHICLES),

@@ -9,7 +9,7 @@ the binary ones are decoded by the message's generated class.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from ..ir import Message, SourceFormat
@@ -29,10 +29,12 @@ def read_records(
     *,
     model: MessageClass | None = None,
     kind: str | None = None,
+    subjects: Sequence[str] = (),
 ) -> Iterator[Item]:
     """The records of one data file for ``message``, in file order. Raises InputError (or another
     LocatedError) when the file is unreadable. ``model`` is the generated class of ``message``:
-    parameter files and binary logs need it; ``kind`` overrides the kind the extension says."""
+    parameter files and binary logs need it; ``kind`` overrides the kind the extension says; ``subjects``: the
+    ``ID=TYPE`` pairs that say which subject of a Cyphal/CAN capture carries which type."""
     name = display if display is not None else path.as_posix()
     kind = kind or file_kind(path)
     if kind == "dataflash" and message.format is SourceFormat.DRONECAN:
@@ -40,14 +42,15 @@ def read_records(
     if kind in ("param", "ulog", "tlog", "mavlink", "can") and model is None:
         raise InputError(name, 0, f"reading {kind} input needs the generated class of {message.qualified_name}")
     expected = KIND_FORMATS.get(kind)
-    if expected is not None and message.format is not expected:
+    cyphal_capture = kind == "can" and message.format is SourceFormat.CYPHAL  # Cyphal/CAN: a CAN capture too
+    if expected is not None and message.format is not expected and not cyphal_capture:
         raise InputError(
             name, 0, f"{KIND_HOLDS[kind]}, but {message.qualified_name} is a {message.format.value} message"
         )
     if model is not None and kind == "can":
         from .can.records import capture_items
 
-        return capture_items(path, name, model)
+        return capture_items(path, name, model, subjects)
     if kind == "dataflash":
         raise InputError(
             name,

@@ -284,3 +284,14 @@ class DronecanClass(MessageClass, Protocol):
     DATA_TYPE_SIGNATURE: int
 
     def decode(self, data: bytes, /, *, tao: bool = True) -> GeneratedMessage: ...
+
+
+@runtime_checkable
+class CyphalClass(MessageClass, Protocol):
+    """A generated Cyphal class: its fixed port id (None for most types) and its codec (a whole transfer's
+    payload: no delimiter header; padding past the last field is ignored, as Cyphal's implicit extension has it)."""
+
+    FIXED_PORT_ID: int | None
+    EXTENT_BYTES: int
+
+    def decode(self, data: bytes, /) -> GeneratedMessage: ...

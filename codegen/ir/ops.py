@@ -152,6 +152,18 @@ class Choice(Op):
 
 
 @dataclass(frozen=True)
+class ValueFlags(Op):
+    """A flags concept from a field that holds one condition at a time (UDRAL's ``Error``): each choice in
+    ``map`` stands for one value of the field, ``none`` is the value of no condition. Other values have no
+    counterpart (reported dropped). Written back, the first choice of ``map`` that is set wins (the map lists
+    the most severe first) and the others are reported dropped; no choice set writes ``none``."""
+
+    NAME: ClassVar[str] = "value_flags"
+    map: tuple[ChoiceValue, ...]
+    none: Value | None = None
+
+
+@dataclass(frozen=True)
 class Cells(Op):
     """A list of numbers (cell voltages) in an array field, converted between units. ``count_field``
     (of the same message) holds how many are valid; without it, a per-element sentinel ends the list."""
@@ -446,6 +458,7 @@ MappingOp = (
     | FlagChoice
     | Flags
     | Choice
+    | ValueFlags
     | Cells
     | MavlinkVoltages
     | DtPack

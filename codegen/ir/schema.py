@@ -58,6 +58,18 @@ class Schema:
     def field_at(self, qualified_name: str, path: str) -> Field:
         """The field a mapping's dotted path names: ``voltage``, or through composite fields and array
         elements ``power.current.ampere`` / ``temperature_min_max.1.kelvin`` (Cyphal's nested types)."""
+        return self._walk(qualified_name, path)[1]
+
+    def owner_at(self, qualified_name: str, path: str) -> Message:
+        """The message that declares the field a dotted path names: for ``error.value`` of a UDRAL Status, the
+        Error type (whose constants name the field's values); the message itself for a path that names none of
+        its fields (a rule on the whole message)."""
+        try:
+            return self._walk(qualified_name, path)[0]
+        except KeyError:
+            return self.message(qualified_name)
+
+    def _walk(self, qualified_name: str, path: str) -> tuple[Message, Field]:
         msg = self.message(qualified_name)
         steps = path.split(".")
         f = msg.field(steps[0])
@@ -68,11 +80,12 @@ class Schema:
                 continue
             if not isinstance(t, CompositeType):
                 raise KeyError(path)
-            f = self.message(t.name).field(step)
+            msg = self.message(t.name)
+            f = msg.field(step)
             t = f.type
         if len(steps) > 1 and steps[-1].isdigit():
             raise KeyError(path)  # a path ends at a field, not at an element
-        return f
+        return msg, f
 
     def enum(self, name: str) -> EnumDef:
         for e in self.enums:

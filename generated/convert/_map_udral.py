@@ -13,9 +13,16 @@ from ..cyphal.reg.udral.service.battery import Parameters_0_3, Status_0_2
 from . import _runtime as _r
 from ._concepts import BatteryState
 
+_FAULTS_BY_ERROR_VALUE = {
+    10: ("hardware_failure",),
+    50: ("deep_discharge",),
+    51: ("over_current",),
+    100: ("over_temperature",),
+    101: ("under_temperature",),
+}
 _UNREAD_SOURCE_FIELDS = (("timestamp", "timestamp"),)
 _SOURCE_DEFAULTS = SourceTs_0_1()
-_UNREAD_STATUS_FIELDS = (("heartbeat", "heartbeat"), ("error", "error"))
+_UNREAD_STATUS_FIELDS = (("heartbeat", "heartbeat"),)
 _STATUS_DEFAULTS = Status_0_2()
 _UNREAD_PARAMETERS_FIELDS = (
     ("charge_current_fast", "charge_current_fast"),
@@ -25,6 +32,20 @@ _UNREAD_PARAMETERS_FIELDS = (
     ("unix_manufacture_time", "unix_manufacture_time"),
 )
 _PARAMETERS_DEFAULTS = Parameters_0_3()
+_ERROR_VALUE_BY_FAULTS = (
+    ("hardware_failure", 10),
+    ("deep_discharge", 50),
+    ("over_current", 51),
+    ("over_temperature", 100),
+    ("under_temperature", 101),
+)
+_FAULTS_WITH_ERROR_VALUE = (
+    "deep_discharge",
+    "hardware_failure",
+    "over_current",
+    "over_temperature",
+    "under_temperature",
+)
 _UNREAD_CONCEPTS = (
     "connected",
     "in_use",
@@ -52,13 +73,9 @@ _UNREAD_CONCEPTS = (
     "battery_function",
     "chemistry",
     "warning",
-    "faults",
 )
 _UNWRITTEN_SOURCE_FIELDS = ("cyphal.reg.udral.physics.electricity.SourceTs_0_1.timestamp",)
-_UNWRITTEN_STATUS_FIELDS = (
-    "cyphal.reg.udral.service.battery.Status_0_2.heartbeat",
-    "cyphal.reg.udral.service.battery.Status_0_2.error",
-)
+_UNWRITTEN_STATUS_FIELDS = ("cyphal.reg.udral.service.battery.Status_0_2.heartbeat",)
 _UNWRITTEN_PARAMETERS_FIELDS = (
     "cyphal.reg.udral.service.battery.Parameters_0_3.charge_current_fast",
     "cyphal.reg.udral.service.battery.Parameters_0_3.charge_termination_threshold",
@@ -136,80 +153,94 @@ def forward(
         _c10 = list(s_status.cell_voltages)
         t.cell_voltages = tuple(float(_x10) for _x10 in _c10) or None
 
-    # udral.yaml:45: const True -> connected
+    # udral.yaml:45: value_flags status.error.value -> faults
+    # UDRAL (Error.0.1) reports one condition, the most severe ("preference to errors whose code is smaller"), so the
+    # map runs from the smallest code and the first fault set is the one written. BAD_BATTERY ("should not be used
+    # anymore") is DroneCAN's BAD_BATTERY, a hardware failure; OVERDISCHARGE ("discharged beyond the design limits") a
+    # deep discharge; OVERLOAD ("charge or discharge rate exceeds the safe operating limits") an over-current;
+    # TEMPERATURE_HOT/COLD the over and under temperature. NEEDS_SERVICE, BMS_ERROR, CONFIGURATION, CELL_OVERVOLTAGE,
+    # CELL_UNDERVOLTAGE (a cell outside its safe voltage is not a failed cell) and CELL_COUNT (a sum of cells far from
+    # the pack voltage, not a wrong cell configuration) have no fault counterpart and are reported dropped.
+    if s_status is not None:
+        _v11 = s_status.error.value
+        t.faults = None if _v11 is None else _FAULTS_BY_ERROR_VALUE.get(_v11, ())
+        if rep_d is not None and _v11 not in _FAULTS_BY_ERROR_VALUE and _v11 not in (None, 0):
+            rep_d.dropped("cyphal.reg.udral.service.battery.Status_0_2.error.value", f"{_v11!r} has no counterpart")
+
+    # udral.yaml:64: const True -> connected
     # Only an attached battery publishes.
     t.connected = True
 
-    # udral.yaml:46: copy parameters.unique_id -> serial_number
+    # udral.yaml:65: copy parameters.unique_id -> serial_number
     if s_parameters is not None:
-        _v12 = s_parameters.unique_id
-        if _v12 != 0:
-            t.serial_number = _v12
+        _v13 = s_parameters.unique_id
+        if _v13 != 0:
+            t.serial_number = _v13
 
-    # udral.yaml:47: copy parameters.name -> model_name
+    # udral.yaml:66: copy parameters.name -> model_name
     if s_parameters is not None:
-        _v13 = s_parameters.name
-        t.model_name = _r.text_in(_v13)
+        _v14 = s_parameters.name
+        t.model_name = _r.text_in(_v14)
 
-    # udral.yaml:48: scale parameters.mass.kilogram -> weight
+    # udral.yaml:67: scale parameters.mass.kilogram -> weight
     if s_parameters is not None:
-        _v14 = s_parameters.mass.kilogram
-        if _v14 == _v14:
-            t.weight = float(_v14)
-
-    # udral.yaml:49: scale parameters.design_capacity.coulomb -> design_capacity
-    if s_parameters is not None:
-        _v15 = s_parameters.design_capacity.coulomb
+        _v15 = s_parameters.mass.kilogram
         if _v15 == _v15:
-            t.design_capacity = float(_v15)
+            t.weight = float(_v15)
 
-    # udral.yaml:50: scale parameters.nominal_voltage.volt -> nominal_voltage
+    # udral.yaml:68: scale parameters.design_capacity.coulomb -> design_capacity
     if s_parameters is not None:
-        _v16 = s_parameters.nominal_voltage.volt
+        _v16 = s_parameters.design_capacity.coulomb
         if _v16 == _v16:
-            t.nominal_voltage = float(_v16)
+            t.design_capacity = float(_v16)
 
-    # udral.yaml:51: scale parameters.discharge_current.ampere -> max_discharge_current
+    # udral.yaml:69: scale parameters.nominal_voltage.volt -> nominal_voltage
     if s_parameters is not None:
-        _v17 = s_parameters.discharge_current.ampere
+        _v17 = s_parameters.nominal_voltage.volt
         if _v17 == _v17:
-            t.max_discharge_current = float(_v17)
+            t.nominal_voltage = float(_v17)
 
-    # udral.yaml:52: scale parameters.discharge_current_burst.ampere -> max_burst_current
+    # udral.yaml:70: scale parameters.discharge_current.ampere -> max_discharge_current
     if s_parameters is not None:
-        _v18 = s_parameters.discharge_current_burst.ampere
+        _v18 = s_parameters.discharge_current.ampere
         if _v18 == _v18:
-            t.max_burst_current = float(_v18)
+            t.max_discharge_current = float(_v18)
 
-    # udral.yaml:53: scale parameters.charge_current.ampere -> max_charge_current
+    # udral.yaml:71: scale parameters.discharge_current_burst.ampere -> max_burst_current
     if s_parameters is not None:
-        _v19 = s_parameters.charge_current.ampere
+        _v19 = s_parameters.discharge_current_burst.ampere
         if _v19 == _v19:
-            t.max_charge_current = float(_v19)
+            t.max_burst_current = float(_v19)
 
-    # udral.yaml:54: scale parameters.design_cell_voltage_min_max.0.volt -> cell_rest_min_voltage
+    # udral.yaml:72: scale parameters.charge_current.ampere -> max_charge_current
     if s_parameters is not None:
-        _v20 = s_parameters.design_cell_voltage_min_max[0].volt
+        _v20 = s_parameters.charge_current.ampere
         if _v20 == _v20:
-            t.cell_rest_min_voltage = float(_v20)
+            t.max_charge_current = float(_v20)
 
-    # udral.yaml:56: copy parameters.cycle_count -> cycle_count
+    # udral.yaml:73: scale parameters.design_cell_voltage_min_max.0.volt -> cell_rest_min_voltage
     if s_parameters is not None:
-        _v22 = s_parameters.cycle_count
-        t.cycle_count = _v22
+        _v21 = s_parameters.design_cell_voltage_min_max[0].volt
+        if _v21 == _v21:
+            t.cell_rest_min_voltage = float(_v21)
 
-    # udral.yaml:57: copy parameters.series_cell_count -> cell_count
+    # udral.yaml:75: copy parameters.cycle_count -> cycle_count
     if s_parameters is not None:
-        _v23 = s_parameters.series_cell_count
-        if _v23 != 0:
-            t.cell_count = _v23
+        _v23 = s_parameters.cycle_count
+        t.cycle_count = _v23
 
-    # udral.yaml:58: scale parameters.state_of_health_pct -> state_of_health
+    # udral.yaml:76: copy parameters.series_cell_count -> cell_count
+    if s_parameters is not None:
+        _v24 = s_parameters.series_cell_count
+        if _v24 != 0:
+            t.cell_count = _v24
+
+    # udral.yaml:77: scale parameters.state_of_health_pct -> state_of_health
     # 0 unusable, 100 new; above 100 is no percentage and reads as unknown.
     if s_parameters is not None:
-        _v24 = s_parameters.state_of_health_pct
-        if _v24 <= 100:
-            t.state_of_health = float(_v24) * 0.01
+        _v25 = s_parameters.state_of_health_pct
+        if _v25 <= 100:
+            t.state_of_health = float(_v25) * 0.01
 
     # what did not survive the conversion
     if rep_d is not None:
@@ -322,15 +353,43 @@ def backward(
         _l10 = [_r.f16(_x10, rep, "cyphal.reg.udral.service.battery.Status_0_2.cell_voltages") for _x10 in _c10]
         t_status.cell_voltages = _l10
 
-    # udral.yaml:46: copy parameters.unique_id -> serial_number
-    _v12 = s.serial_number
-    if _v12 is None:
+    # udral.yaml:45: value_flags status.error.value -> faults
+    # UDRAL (Error.0.1) reports one condition, the most severe ("preference to errors whose code is smaller"), so the
+    # map runs from the smallest code and the first fault set is the one written. BAD_BATTERY ("should not be used
+    # anymore") is DroneCAN's BAD_BATTERY, a hardware failure; OVERDISCHARGE ("discharged beyond the design limits") a
+    # deep discharge; OVERLOAD ("charge or discharge rate exceeds the safe operating limits") an over-current;
+    # TEMPERATURE_HOT/COLD the over and under temperature. NEEDS_SERVICE, BMS_ERROR, CONFIGURATION, CELL_OVERVOLTAGE,
+    # CELL_UNDERVOLTAGE (a cell outside its safe voltage is not a failed cell) and CELL_COUNT (a sum of cells far from
+    # the pack voltage, not a wrong cell configuration) have no fault counterpart and are reported dropped.
+    _v11 = s.faults
+    if _v11 is None:
+        if rep_u is not None:
+            rep_u.unknown("cyphal.reg.udral.service.battery.Status_0_2.error.value")
+    else:
+        _w11 = next(((_n11, _x11) for _n11, _x11 in _ERROR_VALUE_BY_FAULTS if _n11 in _v11), (None, 0))
+        t_status.error.value = _w11[1]
+        if rep_d is not None:
+            for _n11 in _v11:
+                if _n11 != _w11[0]:
+                    rep_d.dropped(
+                        "concepts.faults",
+                        _n11
+                        + (
+                            " not written: one condition at a time"
+                            if _n11 in _FAULTS_WITH_ERROR_VALUE
+                            else " has no counterpart"
+                        ),
+                    )
+
+    # udral.yaml:65: copy parameters.unique_id -> serial_number
+    _v13 = s.serial_number
+    if _v13 is None:
         t_parameters.unique_id = 0
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.unique_id")
     else:
         t_parameters.unique_id = _r.to_int(
-            _v12, 1, 18446744073709551615, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.unique_id"
+            _v13, 1, 18446744073709551615, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.unique_id"
         )
         if rep is not None and t_parameters.unique_id in (0,):
             rep.clamped(
@@ -338,105 +397,105 @@ def backward(
                 "a known value written as the unknown marker",
             )
 
-    # udral.yaml:47: copy parameters.name -> model_name
-    _v13 = s.model_name
-    if _v13 is None:
+    # udral.yaml:66: copy parameters.name -> model_name
+    _v14 = s.model_name
+    if _v14 is None:
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.name")
     else:
-        t_parameters.name = _r.bytes_out(_v13, 64, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.name")
+        t_parameters.name = _r.bytes_out(_v14, 64, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.name")
 
-    # udral.yaml:48: scale parameters.mass.kilogram -> weight
-    _v14 = s.weight
-    if _v14 is None or _v14 != _v14:
+    # udral.yaml:67: scale parameters.mass.kilogram -> weight
+    _v15 = s.weight
+    if _v15 is None or _v15 != _v15:
         t_parameters.mass.kilogram = _math.nan
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.mass.kilogram")
     else:
-        t_parameters.mass.kilogram = _r.f32(_v14)
+        t_parameters.mass.kilogram = _r.f32(_v15)
 
-    # udral.yaml:49: scale parameters.design_capacity.coulomb -> design_capacity
-    _v15 = s.design_capacity
-    if _v15 is None or _v15 != _v15:
+    # udral.yaml:68: scale parameters.design_capacity.coulomb -> design_capacity
+    _v16 = s.design_capacity
+    if _v16 is None or _v16 != _v16:
         t_parameters.design_capacity.coulomb = _math.nan
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.design_capacity.coulomb")
     else:
-        t_parameters.design_capacity.coulomb = _r.f32(_v15)
+        t_parameters.design_capacity.coulomb = _r.f32(_v16)
 
-    # udral.yaml:50: scale parameters.nominal_voltage.volt -> nominal_voltage
-    _v16 = s.nominal_voltage
-    if _v16 is None or _v16 != _v16:
+    # udral.yaml:69: scale parameters.nominal_voltage.volt -> nominal_voltage
+    _v17 = s.nominal_voltage
+    if _v17 is None or _v17 != _v17:
         t_parameters.nominal_voltage.volt = _math.nan
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.nominal_voltage.volt")
     else:
-        t_parameters.nominal_voltage.volt = _r.f32(_v16)
+        t_parameters.nominal_voltage.volt = _r.f32(_v17)
 
-    # udral.yaml:51: scale parameters.discharge_current.ampere -> max_discharge_current
-    _v17 = s.max_discharge_current
-    if _v17 is None or _v17 != _v17:
+    # udral.yaml:70: scale parameters.discharge_current.ampere -> max_discharge_current
+    _v18 = s.max_discharge_current
+    if _v18 is None or _v18 != _v18:
         t_parameters.discharge_current.ampere = _math.nan
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.discharge_current.ampere")
     else:
-        t_parameters.discharge_current.ampere = _r.f32(_v17)
+        t_parameters.discharge_current.ampere = _r.f32(_v18)
 
-    # udral.yaml:52: scale parameters.discharge_current_burst.ampere -> max_burst_current
-    _v18 = s.max_burst_current
-    if _v18 is None or _v18 != _v18:
+    # udral.yaml:71: scale parameters.discharge_current_burst.ampere -> max_burst_current
+    _v19 = s.max_burst_current
+    if _v19 is None or _v19 != _v19:
         t_parameters.discharge_current_burst.ampere = _math.nan
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.discharge_current_burst.ampere")
     else:
-        t_parameters.discharge_current_burst.ampere = _r.f32(_v18)
+        t_parameters.discharge_current_burst.ampere = _r.f32(_v19)
 
-    # udral.yaml:53: scale parameters.charge_current.ampere -> max_charge_current
-    _v19 = s.max_charge_current
-    if _v19 is None or _v19 != _v19:
+    # udral.yaml:72: scale parameters.charge_current.ampere -> max_charge_current
+    _v20 = s.max_charge_current
+    if _v20 is None or _v20 != _v20:
         t_parameters.charge_current.ampere = _math.nan
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.charge_current.ampere")
     else:
-        t_parameters.charge_current.ampere = _r.f32(_v19)
+        t_parameters.charge_current.ampere = _r.f32(_v20)
 
-    # udral.yaml:54: scale parameters.design_cell_voltage_min_max.0.volt -> cell_rest_min_voltage
-    _v20 = s.cell_rest_min_voltage
-    if _v20 is None or _v20 != _v20:
+    # udral.yaml:73: scale parameters.design_cell_voltage_min_max.0.volt -> cell_rest_min_voltage
+    _v21 = s.cell_rest_min_voltage
+    if _v21 is None or _v21 != _v21:
         t_parameters.design_cell_voltage_min_max[0].volt = _math.nan
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.design_cell_voltage_min_max.0.volt")
     else:
-        t_parameters.design_cell_voltage_min_max[0].volt = _r.f32(_v20)
+        t_parameters.design_cell_voltage_min_max[0].volt = _r.f32(_v21)
 
-    # udral.yaml:55: scale parameters.charge_voltage.volt -> cell_charge_max_voltage
-    _v21 = s.cell_charge_max_voltage
-    if _v21 is None or _v21 != _v21:
+    # udral.yaml:74: scale parameters.charge_voltage.volt -> cell_charge_max_voltage
+    _v22 = s.cell_charge_max_voltage
+    if _v22 is None or _v22 != _v22:
         t_parameters.charge_voltage.volt = _math.nan
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.charge_voltage.volt")
     else:
-        t_parameters.charge_voltage.volt = _r.f32(_v21)
+        t_parameters.charge_voltage.volt = _r.f32(_v22)
 
-    # udral.yaml:56: copy parameters.cycle_count -> cycle_count
-    _v22 = s.cycle_count
-    if _v22 is None:
+    # udral.yaml:75: copy parameters.cycle_count -> cycle_count
+    _v23 = s.cycle_count
+    if _v23 is None:
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.cycle_count")
     else:
         t_parameters.cycle_count = _r.to_int(
-            _v22, 0, 65535, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.cycle_count"
+            _v23, 0, 65535, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.cycle_count"
         )
 
-    # udral.yaml:57: copy parameters.series_cell_count -> cell_count
-    _v23 = s.cell_count
-    if _v23 is None:
+    # udral.yaml:76: copy parameters.series_cell_count -> cell_count
+    _v24 = s.cell_count
+    if _v24 is None:
         t_parameters.series_cell_count = 0
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.series_cell_count")
     else:
         t_parameters.series_cell_count = _r.to_int(
-            _v23, 1, 255, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.series_cell_count"
+            _v24, 1, 255, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.series_cell_count"
         )
         if rep is not None and t_parameters.series_cell_count in (0,):
             rep.clamped(
@@ -444,15 +503,15 @@ def backward(
                 "a known value written as the unknown marker",
             )
 
-    # udral.yaml:58: scale parameters.state_of_health_pct -> state_of_health
+    # udral.yaml:77: scale parameters.state_of_health_pct -> state_of_health
     # 0 unusable, 100 new; above 100 is no percentage and reads as unknown.
-    _v24 = s.state_of_health
-    if _v24 is None or _v24 != _v24:
+    _v25 = s.state_of_health
+    if _v25 is None or _v25 != _v25:
         if rep_u is not None:
             rep_u.unknown("cyphal.reg.udral.service.battery.Parameters_0_3.state_of_health_pct")
     else:
         t_parameters.state_of_health_pct = _r.to_int(
-            _v24 * 100.0, 0, 100, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.state_of_health_pct"
+            _v25 * 100.0, 0, 100, rep, "cyphal.reg.udral.service.battery.Parameters_0_3.state_of_health_pct"
         )
 
     # what did not survive the conversion

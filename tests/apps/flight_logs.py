@@ -169,6 +169,43 @@ def write_capture_flight(
     return path
 
 
+def write_cyphal_capture(
+    path: Path, *, seconds: float = 10.0, node: int = 12, status: int = 4096, source: int = 4097
+) -> Path:
+    """A capture of one UDRAL battery node on Cyphal/CAN, as ``candump -ta can0`` prints it on screen: its
+    ``energy_source`` (SourceTs, 5 Hz) and ``status`` (Status, 1 Hz; six cells) on the given subject ids, both
+    multi-frame transfers, discharging at 15 A (UDRAL's current is negative while the battery powers the
+    vehicle)."""
+    from codegen.inputs.can import cyphal_wire
+    from generated.cyphal.reg.udral.physics.electricity import SourceTs_0_1
+    from generated.cyphal.reg.udral.service.battery import Status_0_2
+
+    lines = []
+    for k in range(int(seconds * 5)):
+        t = k / 5
+        soc = 1.0 - 0.5 * t / seconds
+        volts = CELLS * _ocv_per_cell(soc)
+        energy = SourceTs_0_1()
+        energy.value.power.current.ampere = -15.0
+        energy.value.power.voltage.volt = volts
+        energy.value.energy.joule = soc * 720_000.0
+        energy.value.full_energy.joule = 720_000.0
+        sent = [(source, energy.encode(), k)]
+        if k % 5 == 0:
+            state = Status_0_2(cell_voltages=[volts / CELLS] * CELLS)
+            state.available_charge.coulomb = soc * 36_000.0
+            for sensor, kelvin in zip(state.temperature_min_max, (298.15, 303.15), strict=True):
+                sensor.kelvin = kelvin
+            sent.append((status, state.encode(), k // 5))
+        for subject, payload, transfer_id in sent:
+            for data in cyphal_wire.split_transfer(payload, transfer_id):
+                stamp = 1_700_000_000 + t
+                can_id = cyphal_wire.message_id(subject, node)
+                lines.append(f"({stamp:.6f})  can0  {can_id:08X}   [{len(data)}]  {' '.join(f'{b:02X}' for b in data)}")
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
 if __name__ == "__main__":  # the README's example flight: python tests/apps/flight_logs.py flight.ulg
     import argparse
 

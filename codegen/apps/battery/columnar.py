@@ -124,7 +124,9 @@ class ColumnConverter(OpVisitor[None]):
         if not isinstance(value, ConstantRef):
             return value
         msg = self.source.message
-        for c in msg.constants:
+        schema = self.catalog.schema
+        owners = [schema.owner_at(r.message, r.field) for r in refs if r.message == msg.qualified_name]
+        for c in (*msg.constants, *(c for owner in owners for c in owner.constants)):
             if c.name == value.name:
                 return c.value
         for e in self.catalog.schema.enums:
@@ -239,6 +241,15 @@ class ColumnConverter(OpVisitor[None]):
             codes[x == int(str(value))] = con.concept.choices.index(entry.choice)
         # the generated code assigns the lookup whatever it finds: no match is unknown again
         con.assign(np.maximum(codes, 0), codes >= 0)
+
+    def visit_value_flags(self, rule: Rule, op: o.ValueFlags) -> None:
+        fmt, con = self.pair(rule)
+        x = self.col(fmt).astype(np.int64)
+        bits = np.zeros(self.n, np.int64)
+        for entry in op.map:
+            value = self.constant(entry.value, (fmt,))
+            bits[x == int(str(value))] = 1 << con.concept.choices.index(entry.choice)
+        con.set(bits)
 
     # -- cells ---------------------------------------------------------------------------------
 

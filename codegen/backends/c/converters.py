@@ -117,6 +117,7 @@ class _Builder(PX4Ops, PX4CellOps, ConceptCellOps):
     # ArduPilot's DroneCAN monitor (the ardupilot policy): not written in C yet, so that converter is left out
     visit_ardupilot_temperature = visit_ardupilot_current = _unsupported
     visit_ardupilot_cells = visit_ardupilot_estimates = _unsupported
+    visit_value_flags = _unsupported  # one condition of several as flags (UDRAL's error): no C codec for UDRAL yet
 
     # -- the function ----------------------------------------------------------------------
 

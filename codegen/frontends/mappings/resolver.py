@@ -86,6 +86,7 @@ class Resolver:
         for ref in rule.targets + rule.sources:
             if ref.message != CONCEPTS_ENDPOINT:
                 names.update(c.name for c in self.schema.message(ref.message).constants)
+                names.update(c.name for c in self.schema.owner_at(ref.message, ref.field).constants)
         for e in self.schema.enums:
             names.update(x.name for x in e.entries)
         for const in _constants(rule.op):

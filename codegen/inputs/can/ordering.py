@@ -44,7 +44,9 @@ class AuxOrder:
         self._nodes: dict[int, _Node] = {}
 
     def see(self, transfer: Transfer) -> list[Diagnostic]:
-        if transfer.id.service or transfer.id.anonymous or transfer.id.data_type_id not in (self._info, self._aux):
+        if transfer.id.protocol != "dronecan" or transfer.id.service or transfer.id.anonymous:
+            return []
+        if transfer.id.data_type_id not in (self._info, self._aux):
             return []
         node = self._nodes.setdefault(transfer.node, _Node())
         if transfer.id.data_type_id == self._aux:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from . import wire
+from . import cyphal_wire, wire
 
 TIMEOUT = 2.0  # seconds a transfer may take between frames (libcanard's and pydronecan's receive timeout)
 MAX_PAYLOAD = 4096  # bytes: far above any DroneCAN v0 data type; a longer transfer is damage
@@ -40,7 +40,7 @@ class Transfer:
     t: float  # time of its first frame
     frame: int  # index of its first frame
     last_frame: int
-    id: wire.CanId
+    id: wire.CanId | cyphal_wire.CyphalId
     transfer_id: int
     payload: bytes
     frames: int
@@ -79,7 +79,7 @@ class Diagnostic:
 @dataclass(slots=True)
 class _Pending:
     first: Frame
-    id: wire.CanId
+    id: wire.CanId | cyphal_wire.CyphalId
     transfer_id: int
     last_t: float
     toggle: int = 0
@@ -95,25 +95,33 @@ _KEY_MASK = wire.ID_MASK >> 5  # the identifier less its 5 priority bits: one tr
 Signatures = Mapping[tuple[str, int], int]  # ("message" | "service", data type id) -> signature
 
 
-def _where(id_: wire.CanId) -> str:
-    kind = "service" if id_.service else "message"
-    node = f"node {id_.source}" if id_.source else "an anonymous node"
-    return f"{kind} type {id_.data_type_id} from {node}"
+def _where(id_: wire.CanId | cyphal_wire.CyphalId) -> str:
+    return id_.where()
 
 
 class Reassembler:
     """Frames in, transfers and diagnostics out. ``signatures`` gives the data type signature of each known
     (``"message"``/``"service"``, id) for the transfer CRC; a multi-frame transfer of another type is handed
-    out with ``crc_checked=False`` and one ``can-unknown-type`` notice per type."""
+    out with ``crc_checked=False`` and one ``can-unknown-type`` notice per type. ``name``: the protocol(s) a
+    skipped frame is said not to be.
 
-    def __init__(self, signatures: Signatures, *, timeout: float = TIMEOUT) -> None:
+    DroneCAN's; :class:`.cyphal_reassembly.CyphalReassembler` overrides what Cyphal/CAN does otherwise (the
+    identifier, the start frame's toggle, where the CRC is and what seeds it)."""
+
+    NAME = "DroneCAN"
+    START_TOGGLE = 0  # the toggle bit of a transfer's first frame
+    KEY_MASK = _KEY_MASK
+
+    def __init__(self, signatures: Signatures, *, timeout: float = TIMEOUT, name: str | None = None) -> None:
+        self.name = name or self.NAME
         self._signatures = signatures
         self._seeds: dict[int, int] = {}  # signature -> its CRC seed, computed once
         self._timeout = timeout
         self._pending: dict[int, _Pending] = {}
         self._last_tid: dict[tuple[int, bool, int], int] = {}
         self._unknown: set[tuple[bool, int]] = set()
-        self._standard = 0
+        self._skipped: dict[str, int] = {}
+        self.cyphal_like = 0  # DroneCAN start frames refused for a toggle bit set as Cyphal/CAN's start frames have it
         self.frames = 0
         self.transfers = 0
 
@@ -127,11 +135,11 @@ class Reassembler:
             out.append(self._signal(frame))
             return out
         data = frame.data
-        if not frame.extended or not data:
+        if not frame.extended or not data or self._foreign(frame.can_id):
             out.extend(self._not_dronecan(frame))
             return out
         tail = data[-1]
-        key = frame.can_id & _KEY_MASK
+        key = frame.can_id & self.KEY_MASK
         pending = self._pending.get(key)
         if pending is not None and frame.t - pending.last_t > self._timeout:
             out.append(self._lost(pending, "timed out", frame))
@@ -169,17 +177,36 @@ class Reassembler:
             out.extend(self._complete(pending, frame))
         return out if out else _NOTHING
 
+    def _parse_id(self, can_id: int) -> wire.CanId | cyphal_wire.CyphalId:
+        return wire.parse_id(can_id)
+
+    def _foreign(self, can_id: int) -> bool:
+        """Whether an extended identifier cannot be this protocol's (every one can be DroneCAN's)."""
+        return False
+
+    def _refused(self, id_: wire.CanId | cyphal_wire.CyphalId, frame: Frame, tail: int) -> Diagnostic | None:
+        """A start frame the protocol forbids whatever its toggle bit (none in DroneCAN)."""
+        return None
+
     def _start(self, key: int, frame: Frame, tail: int, out: list[Event]) -> _Pending | None:
         """A transfer's first frame: its state (kept in progress unless it also ends here), or None if refused."""
-        id_ = wire.parse_id(frame.can_id)
+        id_ = self._parse_id(frame.can_id)
         tid = tail & wire.TRANSFER_ID_MASK
-        if tail & wire.TAIL_TOGGLE:
-            text = f"{_where(id_)}: toggle bit set on the start frame of transfer {tid} (expected clear); dropped"
+        refused = self._refused(id_, frame, tail)
+        if refused is not None:
+            out.append(refused)
+            return None
+        if tail & wire.TAIL_TOGGLE != self.START_TOGGLE:
+            if not self.START_TOGGLE and cyphal_wire.parse_id(frame.can_id) is not None:
+                self.cyphal_like += 1
+            found, expected = ("clear", "set") if self.START_TOGGLE else ("set", "clear")
+            text = (
+                f"{_where(id_)}: toggle bit {found} on the start frame of transfer {tid} (expected {expected}); dropped"
+            )
             out.append(Diagnostic("can-toggle", text, frame.t, frame.index, id_.source, id_.data_type_id))
             return None
-        pending = _Pending(
-            frame, id_, tid, frame.t, wire.TAIL_TOGGLE, 1, frame.fd, [frame.data[:-1]], len(frame.data) - 1
-        )
+        toggle = self.START_TOGGLE ^ wire.TAIL_TOGGLE  # the next frame's
+        pending = _Pending(frame, id_, tid, frame.t, toggle, 1, frame.fd, [frame.data[:-1]], len(frame.data) - 1)
         if not tail & wire.TAIL_END:
             if len(self._pending) >= MAX_PENDING:
                 oldest = min(self._pending, key=lambda k: self._pending[k].last_t)
@@ -190,20 +217,22 @@ class Reassembler:
     def _signal(self, frame: Frame) -> Diagnostic:
         # an error frame is the controller reporting bus damage (each frame counted, as a warning: no transfer
         # is lost by it alone); a remote frame asks for data, which DroneCAN never does
-        what = "a bus error frame" if frame.kind == "error" else "a remote (RTR) frame: not DroneCAN, skipped"
+        what = "a bus error frame" if frame.kind == "error" else f"a remote (RTR) frame: not {self.name}, skipped"
         return Diagnostic(f"can-{frame.kind}-frame", what, frame.t, frame.index, severity="warning")
 
     def _not_dronecan(self, frame: Frame) -> list[Diagnostic]:
         if frame.data:
-            self._standard += 1
-            if self._standard > 1:
+            # an 11-bit frame, or a 29-bit one with an identifier this protocol cannot have: said once each
+            code, what = ("can-foreign-id", "a 29-bit") if frame.extended else ("can-standard-id", "an 11-bit")
+            self._skipped[code] = seen = self._skipped.get(code, 0) + 1
+            if seen > 1:
                 return []
-            text = "an 11-bit frame: not DroneCAN, skipped (counted once)"
-            return [Diagnostic("can-standard-id", text, frame.t, frame.index, severity="info")]
+            text = f"{what} frame: not {self.name}, skipped (counted once)"
+            return [Diagnostic(code, text, frame.t, frame.index, severity="info")]
         return [Diagnostic("can-empty-frame", "a frame without data: no tail byte", frame.t, frame.index)]
 
     def _stray(self, frame: Frame, tail: int, pending: _Pending | None) -> Diagnostic:
-        id_ = wire.parse_id(frame.can_id)
+        id_ = self._parse_id(frame.can_id)
         tid = tail & wire.TRANSFER_ID_MASK
         if pending is None:
             text = f"{_where(id_)}: a frame of transfer {tid} without its start frame"
@@ -250,60 +279,48 @@ class Reassembler:
         body = p.chunks[0] if p.count == 1 else b"".join(p.chunks)
         checked = True
         if p.count > 1:
-            kind = "service" if p.id.service else "message"
-            signature = self._signatures.get((kind, p.id.data_type_id))
-            if len(body) < 2:
-                out.append(
-                    Diagnostic(
-                        "can-crc",
-                        f"{_where(p.id)}: transfer {p.transfer_id} too short for its CRC",
-                        p.first.t,
-                        p.first.index,
-                        p.id.source,
-                        p.id.data_type_id,
-                    )
-                )
+            crc_checked = self._multi_frame(p, body, out)
+            if crc_checked is None:
                 return out
-            carried, body = body[0] | (body[1] << 8), body[2:]
-            if signature is None:
-                checked = False
-                if (p.id.service, p.id.data_type_id) not in self._unknown:
-                    self._unknown.add((p.id.service, p.id.data_type_id))
-                    out.append(
-                        Diagnostic(
-                            "can-unknown-type",
-                            f"{_where(p.id)}: data type not known, so its transfer "
-                            "CRC is not checked (reported once per type)",
-                            p.first.t,
-                            p.first.index,
-                            p.id.source,
-                            p.id.data_type_id,
-                            severity="info",
-                        )
-                    )
-            else:
-                seed = self._seeds.get(signature)
-                if seed is None:
-                    seed = self._seeds[signature] = wire.signature_crc(signature)
-                computed = wire.crc16(body, seed)
-                if computed != carried:
-                    out.append(
-                        Diagnostic(
-                            "can-crc",
-                            f"{_where(p.id)}: transfer {p.transfer_id} CRC 0x{carried:04X}, "
-                            f"expected 0x{computed:04X} for signature 0x{signature:016X}; dropped",
-                            p.first.t,
-                            p.first.index,
-                            p.id.source,
-                            p.id.data_type_id,
-                        )
-                    )
-                    return out
+            body, checked = crc_checked
         if not p.id.service and not p.id.anonymous:
             out.extend(self._gap(p))
         self.transfers += 1
         out.append(Transfer(p.first.t, p.first.index, last.index, p.id, p.transfer_id, body, p.count, p.fd, checked))
         return out
+
+    def _multi_frame(self, p: _Pending, body: bytes, out: list[Event]) -> tuple[bytes, bool] | None:
+        """A multi-frame transfer's payload without its CRC, and whether the CRC was checked; None (and the
+        problem in ``out``) where the CRC does not match."""
+        if len(body) < 2:
+            out.append(self._crc_problem(p, f"transfer {p.transfer_id} too short for its CRC"))
+            return None
+        kind = "service" if p.id.service else "message"
+        signature = self._signatures.get((kind, p.id.data_type_id))
+        carried, body = body[0] | (body[1] << 8), body[2:]
+        if signature is None:
+            if (p.id.service, p.id.data_type_id) not in self._unknown:
+                self._unknown.add((p.id.service, p.id.data_type_id))
+                text = "data type not known, so its transfer CRC is not checked (reported once per type)"
+                out.append(self._crc_problem(p, text, "can-unknown-type", "info"))
+            return body, False
+        seed = self._seeds.get(signature)
+        if seed is None:
+            seed = self._seeds[signature] = wire.signature_crc(signature)
+        computed = wire.crc16(body, seed)
+        if computed != carried:
+            text = (
+                f"transfer {p.transfer_id} CRC 0x{carried:04X}, "
+                f"expected 0x{computed:04X} for signature 0x{signature:016X}; dropped"
+            )
+            out.append(self._crc_problem(p, text))
+            return None
+        return body, True
+
+    def _crc_problem(self, p: _Pending, text: str, code: str = "can-crc", severity: str = "error") -> Diagnostic:
+        return Diagnostic(
+            code, f"{_where(p.id)}: {text}", p.first.t, p.first.index, p.id.source, p.id.data_type_id, severity
+        )
 
     def _gap(self, p: _Pending) -> list[Diagnostic]:
         key = (p.id.source, p.id.service, p.id.data_type_id)

@@ -14,15 +14,18 @@ import functools
 import importlib
 import pkgutil
 from collections import Counter
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
+from typing import cast
 
 from ..kinds import detect
-from ..model import DronecanClass, GeneratedMessage, MessageClass, package_name
+from ..model import CyphalClass, DronecanClass, GeneratedMessage, MessageClass, package_name
 from ..records import InputError, Item, Notice, Record, Unreadable
 from .captures import read_capture, read_dataflash_frames
+from .cyphal_ports import cyphal_classes, dsdl_name, subject_table
+from .cyphal_reassembly import cyphal_hint, reassembler_for
 from .ordering import AuxOrder
-from .reassembly import Diagnostic, Frame, Reassembler, Transfer
+from .reassembly import Diagnostic, Frame, Transfer
 
 MAX_NOTICES_PER_CODE = 50  # a damaged bus repeats itself: the rest of each kind is counted, not listed
 Registry = dict[tuple[str, int], DronecanClass]
@@ -121,15 +124,18 @@ class _Notices:
         ]
 
 
-def capture_items(path: Path, name: str, model: MessageClass) -> Iterator[Item]:
+def capture_items(path: Path, name: str, model: MessageClass, subjects: Sequence[str] = ()) -> Iterator[Item]:
     """The records of ``model``'s message in a CAN capture, with transport notices and a closing summary."""
-    return capture_side(path, name, [model])
+    return capture_side(path, name, [model], subjects)
 
 
-def capture_side(path: Path, name: str, models: Sequence[MessageClass]) -> Iterator[Item]:
+def capture_side(path: Path, name: str, models: Sequence[MessageClass], subjects: Sequence[str] = ()) -> Iterator[Item]:
     """The records of ``models[0]``'s message in a CAN capture, each with the same node's latest message of each
     other model as its ``companions`` (None until the node sent one): BatteryInfo with its node's BatteryInfoAux,
-    paired the way PX4's bridge pairs them."""
+    paired the way PX4's bridge pairs them. Cyphal messages are read from the subjects ``subjects`` (``ID=TYPE``
+    pairs, :func:`.cyphal_ports.subject_table`) gives them, on a bus read as DroneCAN and Cyphal/CAN."""
+    if models and isinstance(models[0], CyphalClass):
+        return _cyphal_side(path, name, models, subjects)
     classes = []
     for model in models:
         if not isinstance(model, DronecanClass) or model.DATA_TYPE_ID is None:
@@ -137,22 +143,62 @@ def capture_side(path: Path, name: str, models: Sequence[MessageClass]) -> Itera
                 name, 0, f"a CAN capture holds DroneCAN messages with a data type id; {model.QUALIFIED_NAME} has none"
             )
         classes.append(model)
-    return _items(frames_of(path, name), name, classes)
+    wanted = {
+        ("dronecan", c.DATA_TYPE_ID or 0): i for i, c in reversed(list(enumerate(classes))) if type_kind(c) == "message"
+    }
+    return _items(frames_of(path, name), name, classes, wanted, "dronecan")
+
+
+def _cyphal_side(path: Path, name: str, models: Sequence[MessageClass], subjects: Sequence[str]) -> Iterator[Item]:
+    classes: list[CyphalClass] = []
+    for model in models:
+        if not isinstance(model, CyphalClass):
+            raise InputError(
+                name, 0, f"a Cyphal capture's companions are Cyphal messages; {model.QUALIFIED_NAME} is not"
+            )
+        classes.append(model)
+    table = subject_table(subjects, cyphal_classes(package_name(classes[0])))
+    wanted = {("cyphal", port): classes.index(cls) for port, cls in table.items() if cls in classes}
+    if not any(position == 0 for position in wanted.values()):
+        raise InputError(
+            name,
+            0,
+            f"Cyphal/CAN frames name subjects, not types: expected --cyphal-subject ID={dsdl_name(classes[0])} "
+            "(the subject id the node publishes it on)",
+        )
+    return _items(frames_of(path, name), name, classes, wanted, "mixed")
 
 
 def transfer_items(frames: Iterable[Frame], name: str, model: DronecanClass) -> Iterator[Item]:
     """As :func:`capture_items`, for frames from anywhere (a live bus)."""
-    return _items(iter(frames), name, [model])
+    return _items(iter(frames), name, [model], {("dronecan", model.DATA_TYPE_ID or 0): 0}, "dronecan")
 
 
-def _items(frames: Iterator[Frame], name: str, classes: Sequence[DronecanClass]) -> Iterator[Item]:
+def _decoder(cls: MessageClass) -> Callable[[Transfer], GeneratedMessage]:
+    """How a transfer of ``cls`` is read: a DroneCAN one as :func:`decode_transfer` does, a Cyphal one whole
+    (padding past the last field is ignored, as Cyphal's implicit extension has it)."""
+    if isinstance(cls, DronecanClass):
+        return functools.partial(decode_transfer, cls)
+    cyphal = cast(CyphalClass, cls)
+    return lambda transfer: cyphal.decode(transfer.payload)
+
+
+def _items(
+    frames: Iterator[Frame],
+    name: str,
+    classes: Sequence[MessageClass],
+    wanted: dict[tuple[str, int], int],
+    transport: str,
+) -> Iterator[Item]:
+    """``wanted``: the position in ``classes`` of each (protocol, data type id or subject id) read."""
     model = classes[0]
     known = registry(package_name(model))
     seeds = signatures(known)
     for cls in classes:
-        seeds.setdefault(("message", cls.DATA_TYPE_ID or 0), cls.DATA_TYPE_SIGNATURE)
-    wanted = {cls.DATA_TYPE_ID: i for i, cls in reversed(list(enumerate(classes))) if type_kind(cls) == "message"}
-    reassembler = Reassembler(seeds)
+        if isinstance(cls, DronecanClass):
+            seeds.setdefault(("message", cls.DATA_TYPE_ID or 0), cls.DATA_TYPE_SIGNATURE)
+    reassembler = reassembler_for(transport, seeds)
+    decoders = [_decoder(cls) for cls in classes]
     order = AuxOrder(known)
     notices = _Notices(name)
     latest: dict[tuple[int, int], GeneratedMessage] = {}  # (node, position in classes) -> its last message
@@ -171,12 +217,12 @@ def _items(frames: Iterator[Frame], name: str, classes: Sequence[DronecanClass])
                 note = notices.notice(diag)
                 if note is not None:
                     yield note
-            position = None if event.id.service else wanted.get(event.id.data_type_id)
+            position = None if event.id.service else wanted.get((event.id.protocol, event.id.data_type_id))
             if position is None:
                 continue
             cls = classes[position]
             try:
-                instance = decode_transfer(cls, event)
+                instance = decoders[position](event)
             except ValueError as exc:  # the generated DecodeError: bytes that are not this message
                 yield Unreadable(name, 0, f"{_where(event)}: cannot decode {cls.QUALIFIED_NAME}: {exc}")
                 continue
@@ -195,7 +241,8 @@ def _items(frames: Iterator[Frame], name: str, classes: Sequence[DronecanClass])
                 companions=tuple(latest.get((event.node, i)) for i in range(1, len(classes))),
             )
             index += 1
-    for diag in reassembler.finish(last.t, last.index):
+    hint = cyphal_hint(reassembler, last.t, last.index)
+    for diag in reassembler.finish(last.t, last.index) + ([hint] if hint is not None else []):
         note = notices.notice(diag)
         if note is not None:
             yield note

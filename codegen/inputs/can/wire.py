@@ -63,6 +63,16 @@ class CanId:
         return not self.service and self.source == 0
 
     @property
+    def protocol(self) -> str:
+        return "dronecan"
+
+    def where(self) -> str:
+        """The data type and the sender, as a diagnostic names them."""
+        kind = "service" if self.service else "message"
+        node = f"node {self.source}" if self.source else "an anonymous node"
+        return f"{kind} type {self.data_type_id} from {node}"
+
+    @property
     def kind(self) -> str:
         if self.service:
             return "request" if self.request else "response"

@@ -1,4 +1,4 @@
-"""Emitters of the ops between enumerated values and concepts: flag, flag_choice, flags, choice.
+"""Emitters of the ops between enumerated values and concepts: flag, flag_choice, flags, choice, value_flags.
 
 Bits read into bool, choice or flags concepts are noted, so the function's epilogue reports the
 bits of the field nothing reads as dropped; choices with no counterpart are reported too.
@@ -6,8 +6,8 @@ bits of the field nothing reads as dropped; choices with no counterpart are repo
 
 from __future__ import annotations
 
-from ....ir import Rule
-from ....ir.ops import Choice, Flag, FlagChoice, Flags
+from ....ir import FieldRef, Rule
+from ....ir.ops import Choice, Flag, FlagChoice, Flags, ValueFlags
 from ..literals import py_literal
 from .context import RuleContext, constant_name
 
@@ -61,16 +61,23 @@ class ChoiceEmitters(RuleContext):
         self.emit(f"            if _n not in {known}:")
         self.emit_call("rep_d.dropped", [py_literal(f"concepts.{con.field}"), '_n + " has no counterpart"'], 4)
 
+    def _read_value(
+        self, fmt: FieldRef, con: FieldRef, by_value: dict[object, object], absent: str, unknown: object
+    ) -> None:
+        """A field's value looked up in ``by_value`` (``.get``'s ``absent`` default where it is not there); a
+        value that is neither there nor ``unknown`` is reported dropped."""
+        table = self.const(constant_name(con.field, "by", fmt.field), by_value)
+        self.emit(f"_v = {self.s(fmt)}", f"{self.t(con)} = None if _v is None else {table}.get(_v{absent})")
+        skip = f"({py_literal(None)}, {py_literal(unknown)})"
+        self.emit(f"if rep_d is not None and _v not in {table} and _v not in {skip}:")
+        self.emit_call("rep_d.dropped", [self.label(fmt), _NO_COUNTERPART], 1)
+
     def visit_choice(self, rule: Rule, op: Choice) -> None:
         fmt, con = self.format_and_concept(rule)
         table = [(entry.choice, self.value_of(entry.value, [fmt])) for entry in op.map]
         unknown = self.value_of(op.unknown, [fmt]) if op.unknown is not None else None
         if not self.backward:
-            by_value = self.const(constant_name(con.field, "by", fmt.field), {v: k for k, v in table})
-            self.emit(f"_v = {self.s(fmt)}", f"{self.t(con)} = None if _v is None else {by_value}.get(_v)")
-            skip = f"({py_literal(None)}, {py_literal(unknown)})"
-            self.emit(f"if rep_d is not None and _v not in {by_value} and _v not in {skip}:")
-            self.emit_call("rep_d.dropped", [self.label(fmt), _NO_COUNTERPART], 1)
+            self._read_value(fmt, con, {v: k for k, v in table}, "", unknown)
             return
         by_choice = self.const(constant_name(fmt.field, "by", con.field), dict(table))
         target, label = self.t(fmt), self.label(fmt)
@@ -82,3 +89,22 @@ class ChoiceEmitters(RuleContext):
         self.emit_call("rep_u.unknown", [label], 2)
         self.emit("    if rep_d is not None and _v is not None:")
         self.emit_call("rep_d.dropped", [py_literal(f"concepts.{con.field}"), _NO_COUNTERPART], 2)
+
+    def visit_value_flags(self, rule: Rule, op: ValueFlags) -> None:
+        """One condition at a time (UDRAL's Error) <-> a flags concept: the most severe set flag is written."""
+        fmt, con = self.format_and_concept(rule)
+        table = [(entry.choice, self.value_of(entry.value, [fmt])) for entry in op.map]
+        none = self.value_of(op.none, [fmt]) if op.none is not None else None
+        if not self.backward:
+            self._read_value(fmt, con, {v: (k,) for k, v in table}, ", ()", none)
+            return
+        order = self.const(constant_name(fmt.field, "by", con.field), tuple(table))
+        target, label = self.t(fmt), self.label(fmt)
+        self.emit(f"_v = {self.s(con)}", "if _v is None:", "    if rep_u is not None:")
+        self.emit_call("rep_u.unknown", [label], 2)
+        self.emit("else:", f"    _w = next(((_n, _x) for _n, _x in {order} if _n in _v), (None, {py_literal(none)}))")
+        self.emit(f"    {target} = _w[1]", "    if rep_d is not None:", "        for _n in _v:")
+        known = self.const(constant_name(con.field, "with", fmt.field), tuple(sorted(k for k, _ in table)))
+        why = f'_n + (" not written: one condition at a time" if _n in {known} else " has no counterpart")'
+        self.emit("            if _n != _w[0]:")
+        self.emit_call("rep_d.dropped", [py_literal(f"concepts.{con.field}"), why], 4)

@@ -242,7 +242,8 @@ class RuleContext:
         """A constant by name, looked up in the messages a rule uses, then in dialect enums."""
         for ref in refs:
             if ref.message != CONCEPTS_ENDPOINT:
-                for c in self.msg(ref.message).constants:
+                # the message's own constants, then those of the nested type declaring the field (UDRAL's Error)
+                for c in (*self.msg(ref.message).constants, *self.schema.owner_at(ref.message, ref.field).constants):
                     if c.name == name:
                         return c.value
         for e in self.schema.enums:
