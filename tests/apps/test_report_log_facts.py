@@ -95,7 +95,8 @@ def _expected_warnings(ulog: Any) -> list[tuple[float, str]]:
 
 @pytest.mark.parametrize("log", ULOGS, ids=[p.name for p in ULOGS])
 def test_px4_header_shading_warnings_and_parameters_agree_with_pyulog(log: Path) -> None:
-    ulog = pyulog.ULog(str(log), ["battery_status", "vehicle_status", "vehicle_gps_position"])  # texts: always read
+    topics = ["battery_status", "vehicle_status", "vehicle_gps_position", "failsafe_flags"]
+    ulog = pyulog.ULog(str(log), topics)  # texts: always read
     if not any(d.name == "battery_status" for d in ulog.data_list):
         pytest.skip(f"{log.name} logs no battery_status")
     report, figures = _page(log)
@@ -158,8 +159,29 @@ def _px4_modes_texts_failsafes(ulog: Any, facts: Any, figures: dict[str, Any], e
     assert bands == pytest.approx(sorted({m for m, _ in facts.modes if m < end}), abs=1e-6)
     flags = status[0].data["failsafe"]
     rising = [float(t[k]) for k in range(len(flags)) if flags[k] and (k == 0 or not flags[k - 1]) and t[k] <= end]
+    rising = sorted(rising + _commander_inputs(ulog, end))
     assert [f for f, _ in facts.failsafes] == pytest.approx(rising, abs=1e-6)
     assert sorted({s["x0"] for s in _shapes(figures, "log failsafe")}) == pytest.approx(sorted(set(rising)), abs=1e-6)
+
+
+def _commander_inputs(ulog: Any, end: float) -> list[float]:
+    """The times failsafe_flags.battery_warning rises and battery_low_remaining_time turns true (PX4 v1.14+)."""
+    flagged = [d for d in ulog.data_list if d.name == "failsafe_flags" and d.multi_id == 0]
+    if not flagged:
+        return []
+    data = flagged[0].data
+    t = np.maximum((data["timestamp"].astype(np.int64) - ulog.start_timestamp) / 1e6, 0.0)
+    low = data.get("battery_low_remaining_time", np.zeros(len(t)))
+    out: list[float] = []
+    level, was_low = 0, False
+    for tk, warning, flag in zip(t.tolist(), data["battery_warning"].tolist(), low.tolist(), strict=True):
+        if warning > level and warning in (1, 2, 3) and tk <= end:
+            out.append(tk)
+        level = warning
+        if flag and not was_low and tk <= end:
+            out.append(tk)
+        was_low = bool(flag)
+    return out
 
 
 DATAFLASH = sorted(SHARED.glob("corpus/realworld3*/dataflash/*.[bB][iI][nN]"))
