@@ -59,7 +59,8 @@ def prose(path: Path) -> list[str]:
     text = path.read_text(encoding="utf-8")
     if path.suffix == ".xml":
         root = ET.fromstring(text)
-        return [_fold(e.text or "") for e in root.iter() if e.tag in ("description", "field") and (e.text or "").strip()]
+        texts = [e.text or "" for e in root.iter() if e.tag in ("description", "field")]
+        return [_fold(text) for text in texts if text.strip()]
     out = [_fold(_TAGS.sub("", line.split("#", 1)[1])) for line in text.splitlines() if "#" in line]
     if path.suffix == ".yaml":
         out = [c for c in out if not c.startswith(("/", "'"))]  # '#' inside $ref values and patterns

@@ -59,7 +59,8 @@ def test_the_facts_catch_a_changed_fact(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("name", ["BatteryStatus", "BatteryInfo"])
 def test_header_names_the_corpus_commit(name: str) -> None:
-    note = re.search(r"# Facts from PX4-Autopilot (\S+), as px4_msgs main (\w+) ", (SHIPPED / f"{name}.msg").read_text())
+    text = (SHIPPED / f"{name}.msg").read_text(encoding="utf-8")
+    note = re.search(r"# Facts from PX4-Autopilot (\S+), as px4_msgs main (\w+) ", text)
     assert note is not None
     source = require(CORPUS / "SOURCE.md").read_text(encoding="utf-8")
     main_row = next(line for line in source.splitlines() if line.startswith("| `main/`"))
