@@ -219,7 +219,7 @@ def test_devicetree_page_has_required_patterns_and_additional_properties(bundled
     assert rows["voltage-min-design-microvolt"][1:3] == ["`int32-matrix`", "microvolt"]
     ocv = rows["`^ocv-capacity-table-[0-9]+$`"]
     assert ocv[3] == "[*][1]: [- : 100]"  # the percent column of every row, from the IR's columns
-    assert ocv[4].endswith("<br>`[*][0]`: open-circuit voltage, microvolts <br>`[*][1]`: state of charge, percent")
+    assert ocv[4].endswith("<br>`[*][0]`: open-circuit voltage in microvolts <br>`[*][1]`: state of charge in percent")
     span = rows["operating-range-celsius"]
     assert span[3] == "" and "<br>`[1]`: highest usable temperature" in span[4]
 

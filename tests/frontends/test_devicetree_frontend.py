@@ -204,8 +204,8 @@ def test_battery_ocv_table_pattern_field(battery: Message) -> None:
     assert f.pattern == f.name and not f.required and f.location.line == 146
     where = "power/supply/battery.yaml"
     columns = (
-        Column("open-circuit voltage, microvolts", location=Location(where, 155)),
-        Column("state of charge, percent", range=Range(maximum=100), location=Location(where, 156)),
+        Column("open-circuit voltage in microvolts", location=Location(where, 155)),
+        Column("state of charge in percent", range=Range(maximum=100), location=Location(where, 156)),
     )
     row = ArrayType(PrimitiveType(PrimitiveKind.UINT, 32), 2, dynamic=False, min_length=2, columns=columns)
     assert f.type == ArrayType(row, 100, dynamic=True, min_length=1)  # the columns sit on the row type
@@ -225,8 +225,8 @@ def test_battery_columns_of_arrays(battery: Message) -> None:
     table = battery.field("resistance-temp-table").type
     assert isinstance(table, ArrayType) and isinstance(table.element, ArrayType) and table.columns == ()
     assert [c.doc for c in table.element.columns] == [
-        "temperature, degrees Celsius",
-        "internal resistance, percent of the factory value",
+        "temperature in degrees Celsius",
+        "internal resistance in percent of the factory value",
     ]
 
 

@@ -147,11 +147,11 @@ _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC = _v.Optional(
             True,
             min_length=2,
             columns=(
-                _v.Number(type="uint32", kind="uint", label="temperature, degrees Celsius", low=0, high=4294967295),
+                _v.Number(type="uint32", kind="uint", label="temperature in degrees Celsius", low=0, high=4294967295),
                 _v.Number(
                     type="uint32",
                     kind="uint",
-                    label="internal resistance, percent of the factory value",
+                    label="internal resistance in percent of the factory value",
                     low=0,
                     high=4294967295,
                 ),
@@ -285,9 +285,11 @@ _SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC = _v.Pattern(
             True,
             min_length=2,
             columns=(
-                _v.Number(type="uint32", kind="uint", label="open-circuit voltage, microvolts", low=0, high=4294967295),
                 _v.Number(
-                    type="uint32", kind="uint", label="state of charge, percent", low=0, high=4294967295, maximum=100
+                    type="uint32", kind="uint", label="open-circuit voltage in microvolts", low=0, high=4294967295
+                ),
+                _v.Number(
+                    type="uint32", kind="uint", label="state of charge in percent", low=0, high=4294967295, maximum=100
                 ),
             ),
         ),
@@ -425,7 +427,7 @@ class SimpleBattery:
             quantity="voltage",
             scale=1e-06,
             offset=0.0,
-            doc="drop below full voltage at which charging restarts",
+            doc="threshold at which a charged battery starts charging again",
         ),
     )
     voltage_min_design_microvolt: list[list[int]] | None = _dataclasses.field(
