@@ -38,19 +38,27 @@ def missing_file(name: str) -> BattgenError:
     return BattgenError(f"{name}: {cannot_read(FileNotFoundError(2, 'No such file or directory'))}")
 
 
-def did_you_mean(name: str, known: Iterable[str], *, what: str = "names") -> str:
-    """The end of an unknown-name error: the few known names closest to ``name`` (case ignored), else how many
-    names there are, never the whole list (a package knows thousands of messages)."""
+def close_names(name: str, known: Iterable[str]) -> list[str]:
+    """The (up to three) known names closest to ``name``, case ignored; where none is close, the names whose last
+    dotted part is close to ``name``'s (a short form typed with the wrong prefix). Every "did you mean" of battgen
+    is made from this list."""
     names = sorted(set(known))
     folded = {n.casefold(): n for n in names}
     close = get_close_matches(name.casefold(), list(folded), n=3, cutoff=0.6)
-    if not close:  # a short form typed with the wrong prefix: compare the last dotted parts too
-        tails = {n.rsplit(".", 1)[-1].casefold(): n for n in names}
-        close = [tails[t] for t in get_close_matches(name.rsplit(".", 1)[-1].casefold(), list(tails), n=3)]
-        if close:
-            return f"did you mean {' or '.join(map(repr, close))}?"
-        return f"known {what}: {', '.join(names)}" if len(names) <= 16 else f"{len(names)} {what} known"
-    return f"did you mean {' or '.join(repr(folded[c]) for c in close)}?"
+    if close:
+        return [folded[c] for c in close]
+    tails = {n.rsplit(".", 1)[-1].casefold(): n for n in names}
+    return [tails[t] for t in get_close_matches(name.rsplit(".", 1)[-1].casefold(), list(tails), n=3)]
+
+
+def did_you_mean(name: str, known: Iterable[str], *, what: str = "names") -> str:
+    """The end of an unknown-name error: the few known names closest to ``name`` (:func:`close_names`), else how
+    many names there are, never the whole list (a package knows thousands of messages)."""
+    close = close_names(name, known)
+    if close:
+        return f"did you mean {' or '.join(map(repr, close))}?"
+    names = sorted(set(known))
+    return f"known {what}: {', '.join(names)}" if len(names) <= 16 else f"{len(names)} {what} known"
 
 
 class OutputError(BattgenError):

@@ -274,7 +274,7 @@ def test_column_bounds_agree() -> None:
         assert got is valid, (cell, found)
         if not valid and cell == 101:
             assert isinstance(found, list) and [x.path for x in found] == ["ocv-capacity-table-0[1][1]"]
-            assert found[0].message.endswith("battery capacity percent = 101 is above the maximum 100")
+            assert found[0].message.endswith("state of charge in percent = 101 is above the maximum 100")
     errors = list(v.iter_errors({**base, "ocv-capacity-table-3": [[4200000, 101]]}))
     assert [list(e.absolute_path) for e in errors] == [["ocv-capacity-table-3", 0, 1]]
 

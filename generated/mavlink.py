@@ -73,7 +73,7 @@ class MavAutopilot(_enum.IntEnum):
 
 
 class MavBatteryChargeState(_enum.IntEnum):
-    """Enumeration for battery charge states.
+    """How far a battery is discharged, as the autopilot rates it for warnings and failsafes.
 
     mavlink.MAV_BATTERY_CHARGE_STATE: values.
     """
@@ -89,8 +89,7 @@ class MavBatteryChargeState(_enum.IntEnum):
 
 
 class MavBatteryFault(_enum.IntFlag):
-    """Smart battery supply status/fault flags (bitmask) for health indication. The battery must also report either
-    MAV_BATTERY_CHARGE_STATE_FAILED or MAV_BATTERY_CHARGE_STATE_UNHEALTHY if any of these are set.
+    """Fault bits of a smart battery. Any bit set comes with charge_state FAILED or UNHEALTHY.
 
     mavlink.MAV_BATTERY_FAULT: bit masks, combined with |.
     """
@@ -107,7 +106,7 @@ class MavBatteryFault(_enum.IntFlag):
 
 
 class MavBatteryFunction(_enum.IntEnum):
-    """Enumeration of battery functions
+    """What a battery powers.
 
     mavlink.MAV_BATTERY_FUNCTION: values.
     """
@@ -120,8 +119,8 @@ class MavBatteryFunction(_enum.IntEnum):
 
 
 class MavBatteryMode(_enum.IntEnum):
-    """Battery mode. Note, the normal operation mode (i.e. when flying) should be reported as MAV_BATTERY_MODE_UNKNOWN
-    to allow message trimming in normal flight.
+    """Special mode of a smart battery. A battery in normal use reports UNKNOWN (0), so the field can be trimmed off the
+    wire in flight.
 
     mavlink.MAV_BATTERY_MODE: values.
     """
@@ -132,7 +131,7 @@ class MavBatteryMode(_enum.IntEnum):
 
 
 class MavBatteryStatusFlags(_enum.IntFlag):
-    """Battery status flags for fault, health and state indication.
+    """Fault, health and state bits of a battery (BATTERY_STATUS_V2.status_flags).
 
     mavlink.MAV_BATTERY_STATUS_FLAGS: bit masks, combined with |.
     """
@@ -160,7 +159,7 @@ class MavBatteryStatusFlags(_enum.IntFlag):
 
 
 class MavBatteryType(_enum.IntEnum):
-    """Enumeration of battery types
+    """Cell chemistry of a battery.
 
     mavlink.MAV_BATTERY_TYPE: values.
     """
@@ -1347,30 +1346,30 @@ _SYS_STATUS_FIELD_SPECS = (
 
 @_dataclasses.dataclass(slots=True)
 class BatteryInfo:
-    """Battery information that is static, or requires infrequent update. This message should requested using
-    MAV_CMD_REQUEST_MESSAGE and/or streamed at very low rate. BATTERY_STATUS_V2 is used for higher-rate battery
-    status information. [work in progress]
+    """What does not change about a battery, or seldom: design limits, identity, wear. Request it with
+    MAV_CMD_REQUEST_MESSAGE or stream it slowly; BATTERY_STATUS_V2 carries the fast-changing values. [work in
+    progress]
 
-    Schema: mavlink.BATTERY_INFO (mavlink, battery.xml:259).
+    Schema: mavlink.BATTERY_INFO (mavlink, battery.xml:211).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "mavlink.BATTERY_INFO"
 
-    id: int = _dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
+    id: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="id", type="uint8", doc="Which battery (instance) this is.")
+    )
     battery_function: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="battery_function",
             type="uint8",
             enums=("mavlink.MAV_BATTERY_FUNCTION",),
-            doc="Function of the battery.",
+            doc="What the battery powers.",
         ),
     )
     type: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(
-            name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Type (chemistry) of the battery."
-        ),
+        metadata=_m.meta(name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Cell chemistry."),
     )
     state_of_health: int = _dataclasses.field(
         default=255,
@@ -1383,18 +1382,13 @@ class BatteryInfo:
             offset=0.0,
             invalid=255,
             invalid_text="UINT8_MAX",
-            doc="State of Health (SOH) estimate. Typically 100% at the time of manufacture and "
-            "will decrease over time and use. -1: field not provided.",
+            doc="Health: about 100 when new, falling with age and use; UINT8_MAX when not given.",
         ),
     )
     cells_in_series: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="cells_in_series",
-            type="uint8",
-            invalid=0,
-            invalid_text="0",
-            doc="Number of battery cells in series. 0: field not provided.",
+            name="cells_in_series", type="uint8", invalid=0, invalid_text="0", doc="Cells in series; 0 when not given."
         ),
     )
     cycle_count: int = _dataclasses.field(
@@ -1404,8 +1398,7 @@ class BatteryInfo:
             type="uint16",
             invalid=65535,
             invalid_text="UINT16_MAX",
-            doc="Lifetime count of the number of charge/discharge cycles "
-            "(https://en.wikipedia.org/wiki/Charge_cycle). UINT16_MAX: field not provided.",
+            doc="Full charge/discharge cycles over the pack's life; UINT16_MAX when not given.",
         ),
     )
     weight: int = _dataclasses.field(
@@ -1419,7 +1412,7 @@ class BatteryInfo:
             offset=0.0,
             invalid=0,
             invalid_text="0",
-            doc="Battery weight. 0: field not provided.",
+            doc="Mass of the pack; 0 when not given.",
         ),
     )
     discharge_minimum_voltage: float = _dataclasses.field(
@@ -1431,7 +1424,7 @@ class BatteryInfo:
             quantity="voltage",
             invalid=0.0,
             invalid_text="0",
-            doc="Minimum per-cell voltage when discharging. 0: field not provided.",
+            doc="Lowest cell voltage allowed while discharging; 0 when not given.",
         ),
     )
     charging_minimum_voltage: float = _dataclasses.field(
@@ -1443,7 +1436,7 @@ class BatteryInfo:
             quantity="voltage",
             invalid=0.0,
             invalid_text="0",
-            doc="Minimum per-cell voltage when charging. 0: field not provided.",
+            doc="Lowest cell voltage allowed while charging; 0 when not given.",
         ),
     )
     resting_minimum_voltage: float = _dataclasses.field(
@@ -1455,7 +1448,7 @@ class BatteryInfo:
             quantity="voltage",
             invalid=0.0,
             invalid_text="0",
-            doc="Minimum per-cell voltage when resting. 0: field not provided.",
+            doc="Lowest cell voltage allowed at rest; 0 when not given.",
         ),
     )
     charging_maximum_voltage: float = _dataclasses.field(
@@ -1467,7 +1460,7 @@ class BatteryInfo:
             quantity="voltage",
             invalid=0.0,
             invalid_text="0",
-            doc="Maximum per-cell voltage when charged. 0: field not provided.",
+            doc="Cell voltage of a full cell; 0 when not given.",
         ),
     )
     charging_maximum_current: float = _dataclasses.field(
@@ -1479,7 +1472,7 @@ class BatteryInfo:
             quantity="current",
             invalid=0.0,
             invalid_text="0",
-            doc="Maximum pack continuous charge current. 0: field not provided.",
+            doc="Highest continuous charge current of the pack; 0 when not given.",
         ),
     )
     nominal_voltage: float = _dataclasses.field(
@@ -1491,7 +1484,7 @@ class BatteryInfo:
             quantity="voltage",
             invalid=0.0,
             invalid_text="0",
-            doc="Battery nominal voltage. Used for conversion between Wh and Ah. 0: field not provided.",
+            doc="Rated pack voltage, which converts between Wh and Ah; 0 when not given.",
         ),
     )
     discharge_maximum_current: float = _dataclasses.field(
@@ -1503,7 +1496,7 @@ class BatteryInfo:
             quantity="current",
             invalid=0.0,
             invalid_text="0",
-            doc="Maximum pack discharge current. 0: field not provided.",
+            doc="Highest continuous discharge current of the pack; 0 when not given.",
         ),
     )
     discharge_maximum_burst_current: float = _dataclasses.field(
@@ -1515,7 +1508,7 @@ class BatteryInfo:
             quantity="current",
             invalid=0.0,
             invalid_text="0",
-            doc="Maximum pack discharge burst current. 0: field not provided.",
+            doc="Highest short-burst discharge current of the pack; 0 when not given.",
         ),
     )
     design_capacity: float = _dataclasses.field(
@@ -1529,7 +1522,7 @@ class BatteryInfo:
             offset=0.0,
             invalid=0.0,
             invalid_text="0",
-            doc="Fully charged design capacity. 0: field not provided.",
+            doc="Charge of a full pack by design; 0 when not given.",
         ),
     )
     full_charge_capacity: float = _dataclasses.field(
@@ -1543,8 +1536,7 @@ class BatteryInfo:
             offset=0.0,
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Predicted battery capacity when fully charged (accounting for battery "
-            "degradation). NAN: field not provided.",
+            doc="Charge of the pack when full now, wear counted; NaN when not given.",
         ),
     )
     manufacture_date: str = _dataclasses.field(
@@ -1555,7 +1547,7 @@ class BatteryInfo:
             invalid=0,
             invalid_text="[0]",
             per_element=True,
-            doc="Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated. All 0: field not provided.",
+            doc="Date made, DDMMYYYY as ASCII text ending in a zero byte; all zero when not given.",
         ),
     )
     serial_number: str = _dataclasses.field(
@@ -1566,7 +1558,7 @@ class BatteryInfo:
             invalid=0,
             invalid_text="[0]",
             per_element=True,
-            doc="Serial number in ASCII characters, 0 terminated. All 0: field not provided.",
+            doc="Serial number as ASCII text ending in a zero byte; all zero when not given.",
         ),
     )
     name: str = _dataclasses.field(
@@ -1577,9 +1569,8 @@ class BatteryInfo:
             invalid=0,
             invalid_text="[0]",
             per_element=True,
-            doc="Battery device name. Formatted as manufacturer name then product name, "
-            "separated with an underscore (in ASCII characters), 0 terminated. All 0: field "
-            "not provided.",
+            doc="Maker and product names joined by an underscore, as ASCII text ending in a zero "
+            "byte; all zero when not given.",
         ),
     )
 
@@ -1827,28 +1818,28 @@ class BatteryInfo:
         out: list[_v.Violation] = []
         x: _Any
         try:
-            # id (battery.xml:266): fits uint8
+            # id (battery.xml:214): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
-            # battery_function (battery.xml:267): fits uint8; a value of MAV_BATTERY_FUNCTION
+            # battery_function (battery.xml:215): fits uint8; a value of MAV_BATTERY_FUNCTION
             if self.battery_function not in {0, 1, 2, 3, 4}:
                 _v.diag(out, "battery_function", self.battery_function, _BATTERY_INFO_BATTERY_FUNCTION_SPEC)
-            # type (battery.xml:268): fits uint8; a value of MAV_BATTERY_TYPE
+            # type (battery.xml:216): fits uint8; a value of MAV_BATTERY_TYPE
             if self.type not in {0, 1, 2, 3, 4}:
                 _v.diag(out, "type", self.type, _BATTERY_INFO_TYPE_SPEC)
-            # state_of_health (battery.xml:269): fits uint8; UINT8_MAX means unknown (accepted)
+            # state_of_health (battery.xml:217): fits uint8; UINT8_MAX means unknown (accepted)
             if self.state_of_health & -256:
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_INFO_STATE_OF_HEALTH_SPEC)
-            # cells_in_series (battery.xml:270): fits uint8; 0 means unknown (accepted)
+            # cells_in_series (battery.xml:218): fits uint8; 0 means unknown (accepted)
             if self.cells_in_series & -256:
                 _v.diag(out, "cells_in_series", self.cells_in_series, _BATTERY_INFO_CELLS_IN_SERIES_SPEC)
-            # cycle_count (battery.xml:271): fits uint16; UINT16_MAX means unknown (accepted)
+            # cycle_count (battery.xml:219): fits uint16; UINT16_MAX means unknown (accepted)
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_INFO_CYCLE_COUNT_SPEC)
-            # weight (battery.xml:272): fits uint16; 0 means unknown (accepted)
+            # weight (battery.xml:220): fits uint16; 0 means unknown (accepted)
             if self.weight & -65536:
                 _v.diag(out, "weight", self.weight, _BATTERY_INFO_WEIGHT_SPEC)
-            # discharge_minimum_voltage (battery.xml:273): fits float32; 0 means unknown (accepted)
+            # discharge_minimum_voltage (battery.xml:221): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharge_minimum_voltage <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1856,7 +1847,7 @@ class BatteryInfo:
                     self.discharge_minimum_voltage,
                     _BATTERY_INFO_DISCHARGE_MINIMUM_VOLTAGE_SPEC,
                 )
-            # charging_minimum_voltage (battery.xml:274): fits float32; 0 means unknown (accepted)
+            # charging_minimum_voltage (battery.xml:222): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.charging_minimum_voltage <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1864,7 +1855,7 @@ class BatteryInfo:
                     self.charging_minimum_voltage,
                     _BATTERY_INFO_CHARGING_MINIMUM_VOLTAGE_SPEC,
                 )
-            # resting_minimum_voltage (battery.xml:275): fits float32; 0 means unknown (accepted)
+            # resting_minimum_voltage (battery.xml:223): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.resting_minimum_voltage <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1872,7 +1863,7 @@ class BatteryInfo:
                     self.resting_minimum_voltage,
                     _BATTERY_INFO_RESTING_MINIMUM_VOLTAGE_SPEC,
                 )
-            # charging_maximum_voltage (battery.xml:276): fits float32; 0 means unknown (accepted)
+            # charging_maximum_voltage (battery.xml:224): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.charging_maximum_voltage <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1880,7 +1871,7 @@ class BatteryInfo:
                     self.charging_maximum_voltage,
                     _BATTERY_INFO_CHARGING_MAXIMUM_VOLTAGE_SPEC,
                 )
-            # charging_maximum_current (battery.xml:277): fits float32; 0 means unknown (accepted)
+            # charging_maximum_current (battery.xml:225): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.charging_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1888,10 +1879,10 @@ class BatteryInfo:
                     self.charging_maximum_current,
                     _BATTERY_INFO_CHARGING_MAXIMUM_CURRENT_SPEC,
                 )
-            # nominal_voltage (battery.xml:278): fits float32; 0 means unknown (accepted)
+            # nominal_voltage (battery.xml:226): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_INFO_NOMINAL_VOLTAGE_SPEC)
-            # discharge_maximum_current (battery.xml:279): fits float32; 0 means unknown (accepted)
+            # discharge_maximum_current (battery.xml:227): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharge_maximum_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1899,7 +1890,7 @@ class BatteryInfo:
                     self.discharge_maximum_current,
                     _BATTERY_INFO_DISCHARGE_MAXIMUM_CURRENT_SPEC,
                 )
-            # discharge_maximum_burst_current (battery.xml:280): fits float32; 0 means unknown (accepted)
+            # discharge_maximum_burst_current (battery.xml:228): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharge_maximum_burst_current <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -1907,22 +1898,22 @@ class BatteryInfo:
                     self.discharge_maximum_burst_current,
                     _BATTERY_INFO_DISCHARGE_MAXIMUM_BURST_CURRENT_SPEC,
                 )
-            # design_capacity (battery.xml:281): fits float32; 0 means unknown (accepted)
+            # design_capacity (battery.xml:229): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.design_capacity <= 3.4028234663852886e38):
                 _v.diag(out, "design_capacity", self.design_capacity, _BATTERY_INFO_DESIGN_CAPACITY_SPEC)
-            # full_charge_capacity (battery.xml:282): fits float32; NaN means unknown (accepted)
+            # full_charge_capacity (battery.xml:230): fits float32; NaN means unknown (accepted)
             x = self.full_charge_capacity
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "full_charge_capacity", self.full_charge_capacity, _BATTERY_INFO_FULL_CHARGE_CAPACITY_SPEC)
-            # manufacture_date (battery.xml:283): fits char[9]; [0] means unknown (accepted)
+            # manufacture_date (battery.xml:231): fits char[9]; [0] means unknown (accepted)
             x = self.manufacture_date
             if x.__class__ is not str or len(x.encode()) > 9:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_INFO_MANUFACTURE_DATE_SPEC)
-            # serial_number (battery.xml:284): fits char[32]; [0] means unknown (accepted)
+            # serial_number (battery.xml:232): fits char[32]; [0] means unknown (accepted)
             x = self.serial_number
             if x.__class__ is not str or len(x.encode()) > 32:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
-            # name (battery.xml:285): fits char[50]; [0] means unknown (accepted)
+            # name (battery.xml:233): fits char[50]; [0] means unknown (accepted)
             x = self.name
             if x.__class__ is not str or len(x.encode()) > 50:
                 _v.diag(out, "name", self.name, _BATTERY_INFO_NAME_SPEC)
@@ -1980,29 +1971,29 @@ class BatteryInfo:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryStatus:
-    """Battery information. Updates GCS with flight controller battery status. Smart batteries also use this message,
-    but may additionally send BATTERY_INFO.
+    """A battery as the flight controller monitors it: cell voltages, current, charge and energy used, charge left.
+    Smart batteries send it too, and may add BATTERY_INFO.
 
-    Schema: mavlink.BATTERY_STATUS (mavlink, battery.xml:225).
+    Schema: mavlink.BATTERY_STATUS (mavlink, battery.xml:182).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "mavlink.BATTERY_STATUS"
 
-    id: int = _dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
+    id: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="id", type="uint8", doc="Which battery (instance) this is.")
+    )
     battery_function: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
             name="battery_function",
             type="uint8",
             enums=("mavlink.MAV_BATTERY_FUNCTION",),
-            doc="Function of the battery",
+            doc="What the battery powers.",
         ),
     )
     type: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(
-            name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Type (chemistry) of the battery"
-        ),
+        metadata=_m.meta(name="type", type="uint8", enums=("mavlink.MAV_BATTERY_TYPE",), doc="Cell chemistry."),
     )
     temperature: int = _dataclasses.field(
         default=32767,
@@ -2015,7 +2006,7 @@ class BatteryStatus:
             offset=273.15,
             invalid=32767,
             invalid_text="INT16_MAX",
-            doc="Temperature of the battery. INT16_MAX for unknown temperature.",
+            doc="Pack temperature; INT16_MAX when not measured.",
         ),
     )
     voltages: list[int] = _dataclasses.field(
@@ -2030,14 +2021,10 @@ class BatteryStatus:
             invalid=65535,
             invalid_text="[UINT16_MAX]",
             per_element=True,
-            doc="Battery voltage of cells 1 to 10 (see voltages_ext for cells 11-14). Cells in "
-            "this field above the valid cell count for this battery should have the "
-            "UINT16_MAX value. If individual cell voltages are unknown or not measured for "
-            "this battery, then the overall battery voltage should be filled in cell 0, with "
-            "all others set to UINT16_MAX. If the voltage of the battery is greater than "
-            "(UINT16_MAX - 1), then cell 0 should be set to (UINT16_MAX - 1), and cell 1 to "
-            "the remaining voltage. This can be extended to multiple cells if the total "
-            "voltage is greater than 2 * (UINT16_MAX - 1).",
+            doc="Voltage of cells 1 to 10 (cells 11 to 14 are in voltages_ext); UINT16_MAX past "
+            "the last cell. A monitor that sees only the pack puts the pack voltage in the "
+            "first element and UINT16_MAX in the rest; a pack voltage above UINT16_MAX - 1 "
+            "mV spills over into the next elements, each holding at most UINT16_MAX - 1.",
         ),
     )
     current_battery: int = _dataclasses.field(
@@ -2051,8 +2038,7 @@ class BatteryStatus:
             offset=0.0,
             invalid=-1,
             invalid_text="-1",
-            doc="Battery current, -1: autopilot does not measure the current. Value may "
-            "overflow/rollover for very high currents (> 327.67A)",
+            doc="Pack current; -1 when the autopilot does not measure it. Wraps above 327.67 A.",
         ),
     )
     current_consumed: int = _dataclasses.field(
@@ -2066,7 +2052,7 @@ class BatteryStatus:
             offset=0.0,
             invalid=-1,
             invalid_text="-1",
-            doc="Consumed charge, -1: autopilot does not provide consumption estimate",
+            doc="Charge drawn; -1 when the autopilot does not count it.",
         ),
     )
     energy_consumed: int = _dataclasses.field(
@@ -2080,7 +2066,7 @@ class BatteryStatus:
             offset=0.0,
             invalid=-1,
             invalid_text="-1",
-            doc="Consumed energy, -1: autopilot does not provide energy consumption estimate",
+            doc="Energy drawn; -1 when the autopilot does not count it.",
         ),
     )
     battery_remaining: int = _dataclasses.field(
@@ -2094,7 +2080,7 @@ class BatteryStatus:
             offset=0.0,
             invalid=-1,
             invalid_text="-1",
-            doc="Remaining battery energy. Values: [0-100], -1: autopilot does not estimate the remaining battery.",
+            doc="Energy left, 0 to 100; -1 when the autopilot does not estimate it.",
         ),
     )
     time_remaining: int = _dataclasses.field(
@@ -2107,7 +2093,7 @@ class BatteryStatus:
             invalid=0,
             invalid_text="0",
             extension=True,
-            doc="Remaining battery time, 0: autopilot does not provide remaining battery time estimate",
+            doc="Time until empty; 0 when the autopilot does not estimate it.",
         ),
     )
     charge_state: int = _dataclasses.field(
@@ -2117,7 +2103,7 @@ class BatteryStatus:
             type="uint8",
             enums=("mavlink.MAV_BATTERY_CHARGE_STATE",),
             extension=True,
-            doc="State for extent of discharge, provided by autopilot for warning or external reactions",
+            doc="How far the pack is discharged, for warnings and reactions of other systems.",
         ),
     )
     voltages_ext: list[int] = _dataclasses.field(
@@ -2133,10 +2119,9 @@ class BatteryStatus:
             invalid_text="[0]",
             per_element=True,
             extension=True,
-            doc="Battery voltages for cells 11 to 14. Cells above the valid cell count for this "
-            "battery should have a value of 0, where zero indicates not supported (note, "
-            "this is different than for the voltages field and allows empty byte "
-            "truncation). If the measured value is 0 then 1 should be sent instead.",
+            doc="Voltage of cells 11 to 14. Unlike voltages, an unused or unsupported cell is 0 "
+            "(so the trailing bytes can be trimmed off the wire); a cell that really reads 0 "
+            "mV is sent as 1.",
         ),
     )
     mode: int = _dataclasses.field(
@@ -2146,8 +2131,7 @@ class BatteryStatus:
             type="uint8",
             enums=("mavlink.MAV_BATTERY_MODE",),
             extension=True,
-            doc="Battery mode. Default (0) is that battery mode reporting is not supported or "
-            "battery is in normal-use mode.",
+            doc="Smart-battery mode; 0 in normal use or when the battery has no modes.",
         ),
     )
     fault_bitmask: int = _dataclasses.field(
@@ -2157,9 +2141,8 @@ class BatteryStatus:
             type="uint32",
             enums=("mavlink.MAV_BATTERY_FAULT",),
             extension=True,
-            doc="Fault/health indications. These should be set when charge_state is "
-            "MAV_BATTERY_CHARGE_STATE_FAILED or MAV_BATTERY_CHARGE_STATE_UNHEALTHY (if not, "
-            "fault reporting is not supported).",
+            doc="Fault bits, meaningful when charge_state is FAILED or UNHEALTHY (else the "
+            "sender does not report faults).",
         ),
     )
 
@@ -2397,19 +2380,19 @@ class BatteryStatus:
         e: _Any
         r_battery_remaining: _Any
         try:
-            # id (battery.xml:227): fits uint8
+            # id (battery.xml:184): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
-            # battery_function (battery.xml:228): fits uint8; a value of MAV_BATTERY_FUNCTION
+            # battery_function (battery.xml:185): fits uint8; a value of MAV_BATTERY_FUNCTION
             if self.battery_function not in {0, 1, 2, 3, 4}:
                 _v.diag(out, "battery_function", self.battery_function, _BATTERY_STATUS_BATTERY_FUNCTION_SPEC)
-            # type (battery.xml:229): fits uint8; a value of MAV_BATTERY_TYPE
+            # type (battery.xml:186): fits uint8; a value of MAV_BATTERY_TYPE
             if self.type not in {0, 1, 2, 3, 4}:
                 _v.diag(out, "type", self.type, _BATTERY_STATUS_TYPE_SPEC)
-            # temperature (battery.xml:230): fits int16; INT16_MAX means unknown (accepted)
+            # temperature (battery.xml:187): fits int16; INT16_MAX means unknown (accepted)
             if (self.temperature + 32768) & -65536:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
-            # voltages (battery.xml:231): fits uint16[10]; [UINT16_MAX] means unknown (accepted)
+            # voltages (battery.xml:188): fits uint16[10]; [UINT16_MAX] means unknown (accepted)
             a = self.voltages
             if len(a) != 10:
                 _v.diag(out, "voltages", self.voltages, _BATTERY_STATUS_VOLTAGES_SPEC)
@@ -2418,25 +2401,25 @@ class BatteryStatus:
                     if e & -65536:
                         _v.diag(out, "voltages", self.voltages, _BATTERY_STATUS_VOLTAGES_SPEC)
                         break
-            # current_battery (battery.xml:232): fits int16; -1 means unknown (accepted)
+            # current_battery (battery.xml:189): fits int16; -1 means unknown (accepted)
             if (self.current_battery + 32768) & -65536:
                 _v.diag(out, "current_battery", self.current_battery, _BATTERY_STATUS_CURRENT_BATTERY_SPEC)
-            # current_consumed (battery.xml:233): fits int32; -1 means unknown (accepted)
+            # current_consumed (battery.xml:190): fits int32; -1 means unknown (accepted)
             if (self.current_consumed + 2147483648) & -4294967296:
                 _v.diag(out, "current_consumed", self.current_consumed, _BATTERY_STATUS_CURRENT_CONSUMED_SPEC)
-            # energy_consumed (battery.xml:234): fits int32; -1 means unknown (accepted)
+            # energy_consumed (battery.xml:191): fits int32; -1 means unknown (accepted)
             if (self.energy_consumed + 2147483648) & -4294967296:
                 _v.diag(out, "energy_consumed", self.energy_consumed, _BATTERY_STATUS_ENERGY_CONSUMED_SPEC)
-            # battery_remaining (battery.xml:235): fits int8; -1 means unknown (accepted)
+            # battery_remaining (battery.xml:192): fits int8; -1 means unknown (accepted)
             if (self.battery_remaining + 128) & -256:
                 _v.diag(out, "battery_remaining", self.battery_remaining, _BATTERY_STATUS_BATTERY_REMAINING_SPEC)
-            # time_remaining (battery.xml:237): fits int32; 0 means unknown (accepted)
+            # time_remaining (battery.xml:194): fits int32; 0 means unknown (accepted)
             if (self.time_remaining + 2147483648) & -4294967296:
                 _v.diag(out, "time_remaining", self.time_remaining, _BATTERY_STATUS_TIME_REMAINING_SPEC)
-            # charge_state (battery.xml:238): fits uint8; a value of MAV_BATTERY_CHARGE_STATE
+            # charge_state (battery.xml:195): fits uint8; a value of MAV_BATTERY_CHARGE_STATE
             if self.charge_state not in {0, 1, 2, 3, 4, 5, 6, 7}:
                 _v.diag(out, "charge_state", self.charge_state, _BATTERY_STATUS_CHARGE_STATE_SPEC)
-            # voltages_ext (battery.xml:239): fits uint16[4]; [0] means unknown (accepted)
+            # voltages_ext (battery.xml:196): fits uint16[4]; [0] means unknown (accepted)
             a = self.voltages_ext
             if len(a) != 4:
                 _v.diag(out, "voltages_ext", self.voltages_ext, _BATTERY_STATUS_VOLTAGES_EXT_SPEC)
@@ -2445,10 +2428,10 @@ class BatteryStatus:
                     if e & -65536:
                         _v.diag(out, "voltages_ext", self.voltages_ext, _BATTERY_STATUS_VOLTAGES_EXT_SPEC)
                         break
-            # mode (battery.xml:240): fits uint8; a value of MAV_BATTERY_MODE
+            # mode (battery.xml:197): fits uint8; a value of MAV_BATTERY_MODE
             if self.mode not in {0, 1, 2}:
                 _v.diag(out, "mode", self.mode, _BATTERY_STATUS_MODE_SPEC)
-            # fault_bitmask (battery.xml:241): fits uint32; bits of MAV_BATTERY_FAULT only
+            # fault_bitmask (battery.xml:198): fits uint32; bits of MAV_BATTERY_FAULT only
             if self.fault_bitmask & -512:
                 _v.diag(out, "fault_bitmask", self.fault_bitmask, _BATTERY_STATUS_FAULT_BITMASK_SPEC)
         except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way
@@ -2506,18 +2489,18 @@ class BatteryStatus:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryStatusV2:
-    """Battery dynamic information. This should be streamed (nominally at 1Hz). Static/invariant battery information is
-    sent in BATTERY_INFO. Note that smart batteries should set the MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL
-    bit to indicate that supplied capacity values are relative to a battery that is known to be full. Power monitors
-    would not set this bit, indicating that capacity_consumed is relative to drone power-on, and that other values
-    are estimated based on the assumption that the battery was full on power-on.
+    """What changes about a battery, sent about once a second; what does not is in BATTERY_INFO. A smart battery that
+    knows when it is full sets MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL; a power monitor leaves it clear,
+    and its figures then count from power-on and assume a full pack at that moment.
 
-    Schema: mavlink.BATTERY_STATUS_V2 (mavlink, battery.xml:243).
+    Schema: mavlink.BATTERY_STATUS_V2 (mavlink, battery.xml:200).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "mavlink.BATTERY_STATUS_V2"
 
-    id: int = _dataclasses.field(default=0, metadata=_m.meta(name="id", type="uint8", doc="Battery ID"))
+    id: int = _dataclasses.field(
+        default=0, metadata=_m.meta(name="id", type="uint8", doc="Which battery (instance) this is.")
+    )
     temperature: int = _dataclasses.field(
         default=32767,
         metadata=_m.meta(
@@ -2529,7 +2512,7 @@ class BatteryStatusV2:
             offset=273.15,
             invalid=32767,
             invalid_text="INT16_MAX",
-            doc="Temperature of the whole battery pack (not internal electronics). INT16_MAX field not provided.",
+            doc="Temperature of the pack as a whole (not of its electronics); INT16_MAX when not given.",
         ),
     )
     voltage: float = _dataclasses.field(
@@ -2541,7 +2524,7 @@ class BatteryStatusV2:
             quantity="voltage",
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Battery voltage (total). NaN: field not provided.",
+            doc="Pack voltage; NaN when not given.",
         ),
     )
     current: float = _dataclasses.field(
@@ -2553,8 +2536,7 @@ class BatteryStatusV2:
             quantity="current",
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Battery current (through all cells/loads). Positive value when discharging and "
-            "negative if charging. NaN: field not provided.",
+            doc="Current through the pack: positive discharging, negative charging; NaN when not given.",
         ),
     )
     capacity_consumed: float = _dataclasses.field(
@@ -2568,9 +2550,8 @@ class BatteryStatusV2:
             offset=0.0,
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Consumed charge. NaN: field not provided. This is either the consumption since "
-            "power-on or since the battery was full, depending on the value of "
-            "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL.",
+            doc="Charge drawn, since power-on or since full as "
+            "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL says; NaN when not given.",
         ),
     )
     capacity_remaining: float = _dataclasses.field(
@@ -2584,9 +2565,9 @@ class BatteryStatusV2:
             offset=0.0,
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Remaining charge (until empty). NaN: field not provided. Note: If "
-            "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL is unset, this value is "
-            "based on the assumption the battery was full when the system was powered.",
+            doc="Charge left until empty; NaN when not given. Without "
+            "MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL it assumes the pack was full "
+            "at power-on.",
         ),
     )
     state_of_charge: float = _dataclasses.field(
@@ -2600,10 +2581,8 @@ class BatteryStatusV2:
             offset=0.0,
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="State of Charge (SoC). Remaining capacity relative to current fully-charged "
-            "capacity as a percentage. Values: [0-100], NaN: field not provided. Note that "
-            "the value may be calculated from design_capacity if current "
-            "full_charge_capacity is not known (see BATTERY_INFO).",
+            doc="Charge left as a share of the full-charge capacity, 0 to 100 (of the design "
+            "capacity when the full-charge capacity is not known); NaN when not given.",
         ),
     )
     status_flags: int = _dataclasses.field(
@@ -2612,7 +2591,7 @@ class BatteryStatusV2:
             name="status_flags",
             type="uint32",
             enums=("mavlink.MAV_BATTERY_STATUS_FLAGS",),
-            doc="Fault, health, readiness, and other status indications.",
+            doc="Fault, health, readiness and other state bits.",
         ),
     )
 
@@ -2767,33 +2746,33 @@ class BatteryStatusV2:
         out: list[_v.Violation] = []
         x: _Any
         try:
-            # id (battery.xml:250): fits uint8
+            # id (battery.xml:202): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_V2_ID_SPEC)
-            # temperature (battery.xml:251): fits int16; INT16_MAX means unknown (accepted)
+            # temperature (battery.xml:203): fits int16; INT16_MAX means unknown (accepted)
             if (self.temperature + 32768) & -65536:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V2_TEMPERATURE_SPEC)
-            # voltage (battery.xml:252): fits float32; NaN means unknown (accepted)
+            # voltage (battery.xml:204): fits float32; NaN means unknown (accepted)
             x = self.voltage
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "voltage", self.voltage, _BATTERY_STATUS_V2_VOLTAGE_SPEC)
-            # current (battery.xml:253): fits float32; NaN means unknown (accepted)
+            # current (battery.xml:205): fits float32; NaN means unknown (accepted)
             x = self.current
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "current", self.current, _BATTERY_STATUS_V2_CURRENT_SPEC)
-            # capacity_consumed (battery.xml:254): fits float32; NaN means unknown (accepted)
+            # capacity_consumed (battery.xml:206): fits float32; NaN means unknown (accepted)
             x = self.capacity_consumed
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "capacity_consumed", self.capacity_consumed, _BATTERY_STATUS_V2_CAPACITY_CONSUMED_SPEC)
-            # capacity_remaining (battery.xml:255): fits float32; NaN means unknown (accepted)
+            # capacity_remaining (battery.xml:207): fits float32; NaN means unknown (accepted)
             x = self.capacity_remaining
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "capacity_remaining", self.capacity_remaining, _BATTERY_STATUS_V2_CAPACITY_REMAINING_SPEC)
-            # state_of_charge (battery.xml:256): fits float32; NaN means unknown (accepted)
+            # state_of_charge (battery.xml:208): fits float32; NaN means unknown (accepted)
             x = self.state_of_charge
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "state_of_charge", self.state_of_charge, _BATTERY_STATUS_V2_STATE_OF_CHARGE_SPEC)
-            # status_flags (battery.xml:257): fits uint32; bits of MAV_BATTERY_STATUS_FLAGS only
+            # status_flags (battery.xml:209): fits uint32; bits of MAV_BATTERY_STATUS_FLAGS only
             if self.status_flags & -2148007936:
                 _v.diag(out, "status_flags", self.status_flags, _BATTERY_STATUS_V2_STATUS_FLAGS_SPEC)
         except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way

@@ -76,7 +76,7 @@ class BattParams:
     """Battery monitor: capacity, the two-stage (LOW, CRITICAL) failsafe thresholds and their actions, and arming
     limits. A threshold of 0 is disabled.
 
-    Schema: params.BATT (params, battery_failsafe.pdef.xml:11).
+    Schema: params.BATT (params, battery_failsafe.pdef.xml:13).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "params.BATT"
@@ -287,38 +287,38 @@ class BattParams:
         out: list[_v.Violation] = []
         x: _Any
         try:
-            # BATT_CAPACITY (battery_failsafe.pdef.xml:12): fits int32
+            # BATT_CAPACITY (battery_failsafe.pdef.xml:14): fits int32
             if (self.BATT_CAPACITY + 2147483648) & -4294967296:
                 _v.diag(out, "BATT_CAPACITY", self.BATT_CAPACITY, _BATT_PARAMS_BATT_CAPACITY_SPEC)
-            # BATT_LOW_VOLT (battery_failsafe.pdef.xml:18): fits float32
+            # BATT_LOW_VOLT (battery_failsafe.pdef.xml:20): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_LOW_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_LOW_VOLT", self.BATT_LOW_VOLT, _BATT_PARAMS_BATT_LOW_VOLT_SPEC)
-            # BATT_LOW_TIMER (battery_failsafe.pdef.xml:24): fits int8; 0 <= value <= 120
+            # BATT_LOW_TIMER (battery_failsafe.pdef.xml:26): fits int8; 0 <= value <= 120
             x = self.BATT_LOW_TIMER
             if (x + 128) & -256 or not (0 <= x <= 120):
                 _v.diag(out, "BATT_LOW_TIMER", self.BATT_LOW_TIMER, _BATT_PARAMS_BATT_LOW_TIMER_SPEC)
-            # BATT_FS_VOLTSRC (battery_failsafe.pdef.xml:31): fits int8; a value of FS_VOLTSRC
+            # BATT_FS_VOLTSRC (battery_failsafe.pdef.xml:33): fits int8; a value of FS_VOLTSRC
             if self.BATT_FS_VOLTSRC not in {0, 1}:
                 _v.diag(out, "BATT_FS_VOLTSRC", self.BATT_FS_VOLTSRC, _BATT_PARAMS_BATT_FS_VOLTSRC_SPEC)
-            # BATT_LOW_MAH (battery_failsafe.pdef.xml:39): fits float32
+            # BATT_LOW_MAH (battery_failsafe.pdef.xml:41): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_LOW_MAH <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_LOW_MAH", self.BATT_LOW_MAH, _BATT_PARAMS_BATT_LOW_MAH_SPEC)
-            # BATT_CRT_VOLT (battery_failsafe.pdef.xml:45): fits float32
+            # BATT_CRT_VOLT (battery_failsafe.pdef.xml:47): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_CRT_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_CRT_VOLT", self.BATT_CRT_VOLT, _BATT_PARAMS_BATT_CRT_VOLT_SPEC)
-            # BATT_CRT_MAH (battery_failsafe.pdef.xml:51): fits float32
+            # BATT_CRT_MAH (battery_failsafe.pdef.xml:53): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_CRT_MAH <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_CRT_MAH", self.BATT_CRT_MAH, _BATT_PARAMS_BATT_CRT_MAH_SPEC)
-            # BATT_FS_LOW_ACT (battery_failsafe.pdef.xml:57): fits int8
+            # BATT_FS_LOW_ACT (battery_failsafe.pdef.xml:59): fits int8
             if (self.BATT_FS_LOW_ACT + 128) & -256:
                 _v.diag(out, "BATT_FS_LOW_ACT", self.BATT_FS_LOW_ACT, _BATT_PARAMS_BATT_FS_LOW_ACT_SPEC)
-            # BATT_FS_CRT_ACT (battery_failsafe.pdef.xml:61): fits int8
+            # BATT_FS_CRT_ACT (battery_failsafe.pdef.xml:63): fits int8
             if (self.BATT_FS_CRT_ACT + 128) & -256:
                 _v.diag(out, "BATT_FS_CRT_ACT", self.BATT_FS_CRT_ACT, _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC)
-            # BATT_ARM_VOLT (battery_failsafe.pdef.xml:65): fits float32
+            # BATT_ARM_VOLT (battery_failsafe.pdef.xml:67): fits float32
             if not (-3.4028234663852886e38 <= self.BATT_ARM_VOLT <= 3.4028234663852886e38):
                 _v.diag(out, "BATT_ARM_VOLT", self.BATT_ARM_VOLT, _BATT_PARAMS_BATT_ARM_VOLT_SPEC)
-            # BATT_ARM_MAH (battery_failsafe.pdef.xml:71): fits int32
+            # BATT_ARM_MAH (battery_failsafe.pdef.xml:73): fits int32
             if (self.BATT_ARM_MAH + 2147483648) & -4294967296:
                 _v.diag(out, "BATT_ARM_MAH", self.BATT_ARM_MAH, _BATT_PARAMS_BATT_ARM_MAH_SPEC)
         except _v.SLOW:  # a field holds a value its fast test cannot take: every field the careful way

@@ -1045,10 +1045,7 @@ _BATTERY_STATUS_V0_FIELD_SPECS = (
 
 @_dataclasses.dataclass(slots=True)
 class BatteryInfo:
-    """Battery information
-
-    Static or near-invariant battery information.
-    Should be streamed at low rate.
+    """What a battery says about itself that rarely changes (its serial number); sent at a low rate.
 
     Schema: uorb.BatteryInfo (uorb, BatteryInfo.msg:1).
     """
@@ -1064,14 +1061,12 @@ class BatteryInfo:
             quantity="time",
             scale=1e-06,
             offset=0.0,
-            doc="Time since system start",
+            doc="When this sample was taken, on the autopilot's boot clock",
         ),
     )
     id: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(
-            name="id", type="uint8", doc="Must match the id in the battery_status message for the same battery"
-        ),
+        metadata=_m.meta(name="id", type="uint8", doc="The pack this describes: the id of its battery_status"),
     )
     serial_number: str = _dataclasses.field(
         default="",
@@ -1081,7 +1076,7 @@ class BatteryInfo:
             invalid=0,
             invalid_text="0",
             per_element=True,
-            doc="Serial number of the battery pack in ASCII characters, 0 terminated",
+            doc="Serial number as ASCII text, ended by a zero byte",
         ),
     )
 
@@ -1195,13 +1190,13 @@ class BatteryInfo:
         out: list[_v.Violation] = []
         x: _Any
         try:
-            # timestamp (BatteryInfo.msg:9): fits uint64
+            # timestamp (BatteryInfo.msg:7): fits uint64
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_INFO_TIMESTAMP_SPEC)
-            # id (BatteryInfo.msg:11): fits uint8
+            # id (BatteryInfo.msg:9): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_INFO_ID_SPEC)
-            # serial_number (BatteryInfo.msg:12): fits char[32]; 0 means unknown (accepted)
+            # serial_number (BatteryInfo.msg:10): fits char[32]; 0 means unknown (accepted)
             x = self.serial_number
             if x.__class__ is not str or len(x.encode()) > 32:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_INFO_SERIAL_NUMBER_SPEC)
@@ -1227,11 +1222,9 @@ class BatteryInfo:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryStatus:
-    """Battery status
-
-    Battery status information for up to 3 battery instances.
-    These are populated from power module and smart battery device drivers, and one battery updated from MAVLink.
-    Battery instance information is also logged and streamed in MAVLink telemetry.
+    """State of one battery as the autopilot sees it, one instance per pack (MAX_INSTANCES of them).
+    Filled by analog or I2C power monitors, smart-battery drivers, ESC telemetry or a MAVLink source;
+    the autopilot logs it and forwards it as MAVLink telemetry.
 
     Schema: uorb.BatteryStatus (uorb, BatteryStatus.msg:1).
     """
@@ -1271,7 +1264,7 @@ class BatteryStatus:
             quantity="time",
             scale=1e-06,
             offset=0.0,
-            doc="Time since system start",
+            doc="When this sample was taken, on the autopilot's boot clock",
         ),
     )
     connected: bool = _dataclasses.field(
@@ -1279,7 +1272,7 @@ class BatteryStatus:
         metadata=_m.meta(
             name="connected",
             type="bool",
-            doc="Whether or not a battery is connected. For power modules this is based on a voltage threshold.",
+            doc="A pack is present (for an analog monitor: the voltage is above its detection threshold)",
         ),
     )
     voltage_v: float = _dataclasses.field(
@@ -1291,7 +1284,7 @@ class BatteryStatus:
             quantity="voltage",
             invalid=0.0,
             invalid_text="0",
-            doc="Battery voltage",
+            doc="Pack voltage",
         ),
     )
     current_a: float = _dataclasses.field(
@@ -1303,7 +1296,7 @@ class BatteryStatus:
             quantity="current",
             invalid=-1.0,
             invalid_text="-1",
-            doc="Battery current",
+            doc="Pack current, discharge positive",
         ),
     )
     current_average_a: float = _dataclasses.field(
@@ -1315,7 +1308,7 @@ class BatteryStatus:
             quantity="current",
             invalid=-1.0,
             invalid_text="-1",
-            doc="Battery current average (for FW average in level flight)",
+            doc="Smoothed current (what a fixed-wing draws in level cruise)",
         ),
     )
     discharged_mah: float = _dataclasses.field(
@@ -1329,7 +1322,7 @@ class BatteryStatus:
             offset=0.0,
             invalid=-1.0,
             invalid_text="-1",
-            doc="Discharged amount",
+            doc="Charge drawn since the autopilot started",
         ),
     )
     remaining: float = _dataclasses.field(
@@ -1341,7 +1334,7 @@ class BatteryStatus:
             maximum=1,
             invalid=-1.0,
             invalid_text="-1",
-            doc="Remaining capacity",
+            doc="Fraction of the charge left, 1 is full",
         ),
     )
     scale: float = _dataclasses.field(
@@ -1355,7 +1348,7 @@ class BatteryStatus:
             maximum=None,
             invalid=-1.0,
             invalid_text="-1",
-            doc="Scaling factor to compensate for lower actuation power caused by voltage sag",
+            doc="Throttle gain that makes up for the thrust lost to voltage sag",
         ),
     )
     time_remaining_s: float = _dataclasses.field(
@@ -1367,7 +1360,7 @@ class BatteryStatus:
             quantity="time",
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Predicted time remaining until battery is empty under previous averaged load",
+            doc="Estimated time until empty at the recent mean load",
         ),
     )
     temperature: float = _dataclasses.field(
@@ -1381,7 +1374,7 @@ class BatteryStatus:
             offset=273.15,
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Temperature of the battery",
+            doc="Pack temperature",
         ),
     )
     cell_count: int = _dataclasses.field(
@@ -1393,12 +1386,14 @@ class BatteryStatus:
             quantity="ratio",
             invalid=0,
             invalid_text="0",
-            doc="Number of cells",
+            doc="Cells in series",
         ),
     )
     source: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(name="source", type="uint8", enums=("uorb.BatteryStatus.SOURCE",), doc="Battery source"),
+        metadata=_m.meta(
+            name="source", type="uint8", enums=("uorb.BatteryStatus.SOURCE",), doc="Where the reading comes from"
+        ),
     )
     priority: int = _dataclasses.field(
         default=0,
@@ -1407,7 +1402,7 @@ class BatteryStatus:
             type="uint8",
             unit="1",
             quantity="ratio",
-            doc="Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1",
+            doc="Which power input feeds from this pack, counted from 0 (input V1 is 0)",
         ),
     )
     capacity: int = _dataclasses.field(
@@ -1419,18 +1414,12 @@ class BatteryStatus:
             quantity="charge",
             scale=3.6,
             offset=0.0,
-            doc="Capacity of the battery when fully charged",
+            doc="Charge of the full pack",
         ),
     )
     cycle_count: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(
-            name="cycle_count",
-            type="uint16",
-            unit="1",
-            quantity="ratio",
-            doc="Number of discharge cycles the battery has experienced",
-        ),
+        metadata=_m.meta(name="cycle_count", type="uint16", unit="1", quantity="ratio", doc="Discharge cycles so far"),
     )
     average_time_to_empty: int = _dataclasses.field(
         default=0,
@@ -1441,7 +1430,7 @@ class BatteryStatus:
             quantity="time",
             scale=60.0,
             offset=0.0,
-            doc="Predicted remaining battery capacity based on the average rate of discharge",
+            doc="Time until empty at the mean discharge rate, as the pack reports it",
         ),
     )
     manufacture_date: int = _dataclasses.field(
@@ -1451,8 +1440,7 @@ class BatteryStatus:
             type="uint16",
             unit="1",
             quantity="ratio",
-            doc="Manufacture date, part of serial number of the battery pack. Formatted as: Day "
-            "+ Month×32 + (Year–1980)×512",
+            doc="Date made, packed as day + 32 * month + 512 * (year - 1980)",
         ),
     )
     state_of_health: int = _dataclasses.field(
@@ -1466,7 +1454,7 @@ class BatteryStatus:
             offset=0.0,
             minimum=0,
             maximum=100,
-            doc="State of health. FullChargeCapacity/DesignCapacity",
+            doc="Full-charge capacity as a share of design capacity",
         ),
     )
     max_error: int = _dataclasses.field(
@@ -1480,7 +1468,7 @@ class BatteryStatus:
             offset=0.0,
             minimum=1,
             maximum=100,
-            doc="Max error, expected margin of error in the state-of-charge calculation",
+            doc="How far off the pack's charge estimate may be",
         ),
     )
     id: int = _dataclasses.field(
@@ -1490,13 +1478,17 @@ class BatteryStatus:
             type="uint8",
             unit="1",
             quantity="ratio",
-            doc="ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed",
+            doc="The pack's number on this vehicle, from 1, the same for the vehicle's whole life",
         ),
     )
     interface_error: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="interface_error", type="uint16", unit="1", quantity="ratio", doc="Interface error counter"
+            name="interface_error",
+            type="uint16",
+            unit="1",
+            quantity="ratio",
+            doc="Communication errors counted with the pack",
         ),
     )
     voltage_cell_v: list[float] = _dataclasses.field(
@@ -1509,7 +1501,7 @@ class BatteryStatus:
             invalid=0.0,
             invalid_text="0",
             per_element=True,
-            doc="Battery individual cell voltages",
+            doc="Voltage of each cell",
         ),
     )
     max_cell_voltage_delta: float = _dataclasses.field(
@@ -1519,20 +1511,17 @@ class BatteryStatus:
             type="float32",
             unit="V",
             quantity="voltage",
-            doc="Max difference between individual cell voltages",
+            doc="Spread between the highest and the lowest cell voltage",
         ),
     )
     is_powering_off: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
-            name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
+            name="is_powering_off", type="bool", doc="The pack is about to switch itself off (false when not known)"
         ),
     )
     is_required: bool = _dataclasses.field(
-        default=False,
-        metadata=_m.meta(
-            name="is_required", type="bool", doc="Set if the battery is explicitly required before arming"
-        ),
+        default=False, metadata=_m.meta(name="is_required", type="bool", doc="Arming waits for this pack")
     )
     warning: int = _dataclasses.field(
         default=0,
@@ -1540,7 +1529,7 @@ class BatteryStatus:
             name="warning",
             type="uint8",
             enums=("uorb.BatteryStatus.WARNING", "uorb.BatteryStatus.STATE"),
-            doc="Current battery warning",
+            doc="Warning level, or charging/unhealthy state",
         ),
     )
     faults: int = _dataclasses.field(
@@ -1549,7 +1538,7 @@ class BatteryStatus:
             name="faults",
             type="uint16",
             enums=("uorb.BatteryStatus.FAULT",),
-            doc="Smart battery supply status/fault flags (bitmask) for health indication",
+            doc="Fault bitmask of a smart battery, one bit per FAULT_* index",
         ),
     )
     full_charge_capacity_wh: float = _dataclasses.field(
@@ -1561,7 +1550,7 @@ class BatteryStatus:
             quantity="energy",
             scale=3600.0,
             offset=0.0,
-            doc="Compensated battery capacity",
+            doc="Energy of the full pack, corrected for wear and conditions",
         ),
     )
     remaining_capacity_wh: float = _dataclasses.field(
@@ -1575,7 +1564,7 @@ class BatteryStatus:
             offset=0.0,
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Compensated battery capacity remaining",
+            doc="Energy left, corrected the same way",
         ),
     )
     over_discharge_count: int = _dataclasses.field(
@@ -1585,7 +1574,7 @@ class BatteryStatus:
             type="uint16",
             unit="1",
             quantity="ratio",
-            doc="Number of battery overdischarge",
+            doc="Times the pack was over-discharged",
         ),
     )
     nominal_voltage: float = _dataclasses.field(
@@ -1597,7 +1586,7 @@ class BatteryStatus:
             quantity="voltage",
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Nominal voltage of the battery pack",
+            doc="Rated pack voltage",
         ),
     )
     internal_resistance_estimate: float = _dataclasses.field(
@@ -1607,13 +1596,17 @@ class BatteryStatus:
             type="float32",
             unit="Ohm",
             quantity="resistance",
-            doc="Internal resistance per cell estimate",
+            doc="Estimated resistance of one cell",
         ),
     )
     ocv_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
-            name="ocv_estimate", type="float32", unit="V", quantity="voltage", doc="Open circuit voltage estimate"
+            name="ocv_estimate",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            doc="Estimated open-circuit (no-load) voltage",
         ),
     )
     ocv_estimate_filtered: float = _dataclasses.field(
@@ -1623,7 +1616,7 @@ class BatteryStatus:
             type="float32",
             unit="V",
             quantity="voltage",
-            doc="Filtered open circuit voltage estimate",
+            doc="The open-circuit estimate after filtering",
         ),
     )
     volt_based_soc_estimate: float = _dataclasses.field(
@@ -1635,18 +1628,24 @@ class BatteryStatus:
             quantity="ratio",
             minimum=0,
             maximum=1,
-            doc="Normalized volt based state of charge estimate",
+            doc="Charge left as read from the voltage alone",
         ),
     )
     voltage_prediction: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
-            name="voltage_prediction", type="float32", unit="V", quantity="voltage", doc="Predicted voltage"
+            name="voltage_prediction",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            doc="Voltage the estimator expected",
         ),
     )
     prediction_error: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Prediction error"),
+        metadata=_m.meta(
+            name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Measured minus expected voltage"
+        ),
     )
     estimation_covariance_norm: float = _dataclasses.field(
         default=0.0,
@@ -1655,7 +1654,7 @@ class BatteryStatus:
             type="float32",
             unit="1",
             quantity="ratio",
-            doc="Norm of the covariance matrix",
+            doc="Size (norm) of the estimator's covariance",
         ),
     )
 
@@ -2037,79 +2036,79 @@ class BatteryStatus:
         r_voltage_cell_v: _Any
         v_i: _Any
         try:
-            # timestamp (BatteryStatus.msg:13): fits uint64
+            # timestamp (BatteryStatus.msg:12): fits uint64
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_TIMESTAMP_SPEC)
-            # connected (BatteryStatus.msg:15): fits bool
+            # connected (BatteryStatus.msg:14): fits bool
             x = self.connected
             if x is not True and x is not False:
                 _v.diag(out, "connected", self.connected, _BATTERY_STATUS_CONNECTED_SPEC)
-            # voltage_v (BatteryStatus.msg:16): fits float32; 0 means unknown (accepted)
+            # voltage_v (BatteryStatus.msg:15): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.voltage_v <= 3.4028234663852886e38):
                 _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_VOLTAGE_V_SPEC)
-            # current_a (BatteryStatus.msg:17): fits float32; -1 means unknown (accepted)
+            # current_a (BatteryStatus.msg:16): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.current_a <= 3.4028234663852886e38):
                 _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_CURRENT_A_SPEC)
-            # current_average_a (BatteryStatus.msg:18): fits float32; -1 means unknown (accepted)
+            # current_average_a (BatteryStatus.msg:17): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.current_average_a <= 3.4028234663852886e38):
                 _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_CURRENT_AVERAGE_A_SPEC)
-            # discharged_mah (BatteryStatus.msg:19): fits float32; -1 means unknown (accepted)
+            # discharged_mah (BatteryStatus.msg:18): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharged_mah <= 3.4028234663852886e38):
                 _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_DISCHARGED_MAH_SPEC)
-            # remaining (BatteryStatus.msg:20): fits float32; 0 <= value <= 1; -1 means unknown (accepted)
+            # remaining (BatteryStatus.msg:19): fits float32; 0 <= value <= 1; -1 means unknown (accepted)
             x = self.remaining
             if not (0.0 <= x <= 1.0) and x != -1.0:
                 _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_REMAINING_SPEC)
-            # scale (BatteryStatus.msg:21): fits float32; 1 <= value; -1 means unknown (accepted)
+            # scale (BatteryStatus.msg:20): fits float32; 1 <= value; -1 means unknown (accepted)
             x = self.scale
             if not (1.0 <= x <= 3.4028234663852886e38) and x != -1.0:
                 _v.diag(out, "scale", self.scale, _BATTERY_STATUS_SCALE_SPEC)
-            # time_remaining_s (BatteryStatus.msg:22): fits float32; NaN means unknown (accepted)
+            # time_remaining_s (BatteryStatus.msg:21): fits float32; NaN means unknown (accepted)
             x = self.time_remaining_s
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_TIME_REMAINING_S_SPEC)
-            # temperature (BatteryStatus.msg:23): fits float32; NaN means unknown (accepted)
+            # temperature (BatteryStatus.msg:22): fits float32; NaN means unknown (accepted)
             x = self.temperature
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_TEMPERATURE_SPEC)
-            # cell_count (BatteryStatus.msg:24): fits uint8; 0 means unknown (accepted)
+            # cell_count (BatteryStatus.msg:23): fits uint8; 0 means unknown (accepted)
             if self.cell_count & -256:
                 _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_CELL_COUNT_SPEC)
-            # source (BatteryStatus.msg:26): fits uint8; a value of SOURCE
+            # source (BatteryStatus.msg:25): fits uint8; a value of SOURCE
             if self.source not in {0, 1, 2}:
                 _v.diag(out, "source", self.source, _BATTERY_STATUS_SOURCE_SPEC)
-            # priority (BatteryStatus.msg:31): fits uint8
+            # priority (BatteryStatus.msg:30): fits uint8
             if self.priority & -256:
                 _v.diag(out, "priority", self.priority, _BATTERY_STATUS_PRIORITY_SPEC)
-            # capacity (BatteryStatus.msg:32): fits uint16
+            # capacity (BatteryStatus.msg:31): fits uint16
             if self.capacity & -65536:
                 _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_CAPACITY_SPEC)
-            # cycle_count (BatteryStatus.msg:33): fits uint16
+            # cycle_count (BatteryStatus.msg:32): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_CYCLE_COUNT_SPEC)
-            # average_time_to_empty (BatteryStatus.msg:34): fits uint16
+            # average_time_to_empty (BatteryStatus.msg:33): fits uint16
             if self.average_time_to_empty & -65536:
                 _v.diag(
                     out, "average_time_to_empty", self.average_time_to_empty, _BATTERY_STATUS_AVERAGE_TIME_TO_EMPTY_SPEC
                 )
-            # manufacture_date (BatteryStatus.msg:35): fits uint16
+            # manufacture_date (BatteryStatus.msg:34): fits uint16
             if self.manufacture_date & -65536:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_MANUFACTURE_DATE_SPEC)
-            # state_of_health (BatteryStatus.msg:36): fits uint16; 0 <= value <= 100
+            # state_of_health (BatteryStatus.msg:35): fits uint16; 0 <= value <= 100
             x = self.state_of_health
             if x & -65536 or not (0 <= x <= 100):
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_STATE_OF_HEALTH_SPEC)
-            # max_error (BatteryStatus.msg:37): fits uint16; 1 <= value <= 100
+            # max_error (BatteryStatus.msg:36): fits uint16; 1 <= value <= 100
             x = self.max_error
             if x & -65536 or not (1 <= x <= 100):
                 _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_MAX_ERROR_SPEC)
-            # id (BatteryStatus.msg:38): fits uint8
+            # id (BatteryStatus.msg:37): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_ID_SPEC)
-            # interface_error (BatteryStatus.msg:39): fits uint16
+            # interface_error (BatteryStatus.msg:38): fits uint16
             if self.interface_error & -65536:
                 _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_INTERFACE_ERROR_SPEC)
-            # voltage_cell_v (BatteryStatus.msg:41): fits float32[14]; 0 means unknown (accepted)
+            # voltage_cell_v (BatteryStatus.msg:40): fits float32[14]; 0 means unknown (accepted)
             a = self.voltage_cell_v
             if len(a) != 14:
                 _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC)
@@ -2118,7 +2117,7 @@ class BatteryStatus:
                     if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
                         _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_VOLTAGE_CELL_V_SPEC)
                         break
-            # max_cell_voltage_delta (BatteryStatus.msg:42): fits float32
+            # max_cell_voltage_delta (BatteryStatus.msg:41): fits float32
             if not (-3.4028234663852886e38 <= self.max_cell_voltage_delta <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2126,21 +2125,21 @@ class BatteryStatus:
                     self.max_cell_voltage_delta,
                     _BATTERY_STATUS_MAX_CELL_VOLTAGE_DELTA_SPEC,
                 )
-            # is_powering_off (BatteryStatus.msg:44): fits bool
+            # is_powering_off (BatteryStatus.msg:43): fits bool
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_IS_POWERING_OFF_SPEC)
-            # is_required (BatteryStatus.msg:45): fits bool
+            # is_required (BatteryStatus.msg:44): fits bool
             x = self.is_required
             if x is not True and x is not False:
                 _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_IS_REQUIRED_SPEC)
-            # warning (BatteryStatus.msg:47): fits uint8; a value of WARNING or a value of STATE
+            # warning (BatteryStatus.msg:46): fits uint8; a value of WARNING or a value of STATE
             if self.warning not in {0, 1, 2, 3, 4, 6, 7}:
                 _v.diag(out, "warning", self.warning, _BATTERY_STATUS_WARNING_SPEC)
-            # faults (BatteryStatus.msg:56): fits uint16; bits of FAULT only
+            # faults (BatteryStatus.msg:55): fits uint16; bits of FAULT only
             if self.faults & -2048:
                 _v.diag(out, "faults", self.faults, _BATTERY_STATUS_FAULTS_SPEC)
-            # full_charge_capacity_wh (BatteryStatus.msg:70): fits float32
+            # full_charge_capacity_wh (BatteryStatus.msg:69): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2148,22 +2147,22 @@ class BatteryStatus:
                     self.full_charge_capacity_wh,
                     _BATTERY_STATUS_FULL_CHARGE_CAPACITY_WH_SPEC,
                 )
-            # remaining_capacity_wh (BatteryStatus.msg:71): fits float32; NaN means unknown (accepted)
+            # remaining_capacity_wh (BatteryStatus.msg:70): fits float32; NaN means unknown (accepted)
             x = self.remaining_capacity_wh
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(
                     out, "remaining_capacity_wh", self.remaining_capacity_wh, _BATTERY_STATUS_REMAINING_CAPACITY_WH_SPEC
                 )
-            # over_discharge_count (BatteryStatus.msg:72): fits uint16
+            # over_discharge_count (BatteryStatus.msg:71): fits uint16
             if self.over_discharge_count & -65536:
                 _v.diag(
                     out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_OVER_DISCHARGE_COUNT_SPEC
                 )
-            # nominal_voltage (BatteryStatus.msg:73): fits float32; NaN means unknown (accepted)
+            # nominal_voltage (BatteryStatus.msg:72): fits float32; NaN means unknown (accepted)
             x = self.nominal_voltage
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_NOMINAL_VOLTAGE_SPEC)
-            # internal_resistance_estimate (BatteryStatus.msg:75): fits float32
+            # internal_resistance_estimate (BatteryStatus.msg:74): fits float32
             if not (-3.4028234663852886e38 <= self.internal_resistance_estimate <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2171,15 +2170,15 @@ class BatteryStatus:
                     self.internal_resistance_estimate,
                     _BATTERY_STATUS_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
                 )
-            # ocv_estimate (BatteryStatus.msg:76): fits float32
+            # ocv_estimate (BatteryStatus.msg:75): fits float32
             if not (-3.4028234663852886e38 <= self.ocv_estimate <= 3.4028234663852886e38):
                 _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_OCV_ESTIMATE_SPEC)
-            # ocv_estimate_filtered (BatteryStatus.msg:77): fits float32
+            # ocv_estimate_filtered (BatteryStatus.msg:76): fits float32
             if not (-3.4028234663852886e38 <= self.ocv_estimate_filtered <= 3.4028234663852886e38):
                 _v.diag(
                     out, "ocv_estimate_filtered", self.ocv_estimate_filtered, _BATTERY_STATUS_OCV_ESTIMATE_FILTERED_SPEC
                 )
-            # volt_based_soc_estimate (BatteryStatus.msg:78): fits float32; 0 <= value <= 1
+            # volt_based_soc_estimate (BatteryStatus.msg:77): fits float32; 0 <= value <= 1
             if not (0.0 <= self.volt_based_soc_estimate <= 1.0):
                 _v.diag(
                     out,
@@ -2187,13 +2186,13 @@ class BatteryStatus:
                     self.volt_based_soc_estimate,
                     _BATTERY_STATUS_VOLT_BASED_SOC_ESTIMATE_SPEC,
                 )
-            # voltage_prediction (BatteryStatus.msg:79): fits float32
+            # voltage_prediction (BatteryStatus.msg:78): fits float32
             if not (-3.4028234663852886e38 <= self.voltage_prediction <= 3.4028234663852886e38):
                 _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_VOLTAGE_PREDICTION_SPEC)
-            # prediction_error (BatteryStatus.msg:80): fits float32
+            # prediction_error (BatteryStatus.msg:79): fits float32
             if not (-3.4028234663852886e38 <= self.prediction_error <= 3.4028234663852886e38):
                 _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_PREDICTION_ERROR_SPEC)
-            # estimation_covariance_norm (BatteryStatus.msg:81): fits float32
+            # estimation_covariance_norm (BatteryStatus.msg:80): fits float32
             if not (-3.4028234663852886e38 <= self.estimation_covariance_norm <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -2321,11 +2320,8 @@ class BatteryStatus:
 
 @_dataclasses.dataclass(slots=True)
 class BatteryStatusV0:
-    """Battery status
-
-    Battery status information for up to 4 battery instances.
-    These are populated from power module and smart battery device drivers, and one battery updated from MAVLink.
-    Battery instance information is also logged and streamed in MAVLink telemetry.
+    """State of one battery as the autopilot sees it, in the layout of message version 0 (up to four packs, with
+    a 16-bit serial number), which PX4 logs written before version 1 carry.
 
     Schema: uorb.BatteryStatusV0 (uorb, BatteryStatusV0.msg:1).
     """
@@ -2365,7 +2361,7 @@ class BatteryStatusV0:
             quantity="time",
             scale=1e-06,
             offset=0.0,
-            doc="Time since system start",
+            doc="When this sample was taken, on the autopilot's boot clock",
         ),
     )
     connected: bool = _dataclasses.field(
@@ -2373,7 +2369,7 @@ class BatteryStatusV0:
         metadata=_m.meta(
             name="connected",
             type="bool",
-            doc="Whether or not a battery is connected. For power modules this is based on a voltage threshold.",
+            doc="A pack is present (for an analog monitor: the voltage is above its detection threshold)",
         ),
     )
     voltage_v: float = _dataclasses.field(
@@ -2385,7 +2381,7 @@ class BatteryStatusV0:
             quantity="voltage",
             invalid=0.0,
             invalid_text="0",
-            doc="Battery voltage",
+            doc="Pack voltage",
         ),
     )
     current_a: float = _dataclasses.field(
@@ -2397,7 +2393,7 @@ class BatteryStatusV0:
             quantity="current",
             invalid=-1.0,
             invalid_text="-1",
-            doc="Battery current",
+            doc="Pack current, discharge positive",
         ),
     )
     current_average_a: float = _dataclasses.field(
@@ -2409,7 +2405,7 @@ class BatteryStatusV0:
             quantity="current",
             invalid=-1.0,
             invalid_text="-1",
-            doc="Battery current average (for FW average in level flight)",
+            doc="Smoothed current (what a fixed-wing draws in level cruise)",
         ),
     )
     discharged_mah: float = _dataclasses.field(
@@ -2423,7 +2419,7 @@ class BatteryStatusV0:
             offset=0.0,
             invalid=-1.0,
             invalid_text="-1",
-            doc="Discharged amount",
+            doc="Charge drawn since the autopilot started",
         ),
     )
     remaining: float = _dataclasses.field(
@@ -2435,7 +2431,7 @@ class BatteryStatusV0:
             maximum=1,
             invalid=-1.0,
             invalid_text="-1",
-            doc="Remaining capacity",
+            doc="Fraction of the charge left, 1 is full",
         ),
     )
     scale: float = _dataclasses.field(
@@ -2447,7 +2443,7 @@ class BatteryStatusV0:
             maximum=None,
             invalid=-1.0,
             invalid_text="-1",
-            doc="Scaling factor to compensate for lower actuation power caused by voltage sag",
+            doc="Throttle gain that makes up for the thrust lost to voltage sag",
         ),
     )
     time_remaining_s: float = _dataclasses.field(
@@ -2459,7 +2455,7 @@ class BatteryStatusV0:
             quantity="time",
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Predicted time remaining until battery is empty under previous averaged load",
+            doc="Estimated time until empty at the recent mean load",
         ),
     )
     temperature: float = _dataclasses.field(
@@ -2473,22 +2469,22 @@ class BatteryStatusV0:
             offset=273.15,
             invalid=_math.nan,
             invalid_text="NaN",
-            doc="Temperature of the battery",
+            doc="Pack temperature",
         ),
     )
     cell_count: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="cell_count", type="uint8", invalid=0, invalid_text="0", doc="Number of cells")
+        default=0, metadata=_m.meta(name="cell_count", type="uint8", invalid=0, invalid_text="0", doc="Cells in series")
     )
     source: int = _dataclasses.field(
         default=0,
-        metadata=_m.meta(name="source", type="uint8", enums=("uorb.BatteryStatusV0.SOURCE",), doc="Battery source"),
+        metadata=_m.meta(
+            name="source", type="uint8", enums=("uorb.BatteryStatusV0.SOURCE",), doc="Where the reading comes from"
+        ),
     )
     priority: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="priority",
-            type="uint8",
-            doc="Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1",
+            name="priority", type="uint8", doc="Which power input feeds from this pack, counted from 0 (input V1 is 0)"
         ),
     )
     capacity: int = _dataclasses.field(
@@ -2500,14 +2496,11 @@ class BatteryStatusV0:
             quantity="charge",
             scale=3.6,
             offset=0.0,
-            doc="Capacity of the battery when fully charged",
+            doc="Charge of the full pack",
         ),
     )
     cycle_count: int = _dataclasses.field(
-        default=0,
-        metadata=_m.meta(
-            name="cycle_count", type="uint16", doc="Number of discharge cycles the battery has experienced"
-        ),
+        default=0, metadata=_m.meta(name="cycle_count", type="uint16", doc="Discharge cycles so far")
     )
     average_time_to_empty: int = _dataclasses.field(
         default=0,
@@ -2518,19 +2511,16 @@ class BatteryStatusV0:
             quantity="time",
             scale=60.0,
             offset=0.0,
-            doc="Predicted remaining battery capacity based on the average rate of discharge",
+            doc="Time until empty at the mean discharge rate, as the pack reports it",
         ),
     )
     serial_number: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="Serial number of the battery pack")
+        default=0, metadata=_m.meta(name="serial_number", type="uint16", doc="The pack's serial number")
     )
     manufacture_date: int = _dataclasses.field(
         default=0,
         metadata=_m.meta(
-            name="manufacture_date",
-            type="uint16",
-            doc="Manufacture date, part of serial number of the battery pack. Formatted as: Day "
-            "+ Month×32 + (Year–1980)×512",
+            name="manufacture_date", type="uint16", doc="Date made, packed as day + 32 * month + 512 * (year - 1980)"
         ),
     )
     state_of_health: int = _dataclasses.field(
@@ -2544,7 +2534,7 @@ class BatteryStatusV0:
             offset=0.0,
             minimum=0,
             maximum=100,
-            doc="State of health. FullChargeCapacity/DesignCapacity",
+            doc="Full-charge capacity as a share of design capacity",
         ),
     )
     max_error: int = _dataclasses.field(
@@ -2558,7 +2548,7 @@ class BatteryStatusV0:
             offset=0.0,
             minimum=1,
             maximum=100,
-            doc="Max error, expected margin of error in the state-of-charge calculation",
+            doc="How far off the pack's charge estimate may be",
         ),
     )
     id: int = _dataclasses.field(
@@ -2566,11 +2556,12 @@ class BatteryStatusV0:
         metadata=_m.meta(
             name="id",
             type="uint8",
-            doc="ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed",
+            doc="The pack's number on this vehicle, from 1, the same for the vehicle's whole life",
         ),
     )
     interface_error: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="interface_error", type="uint16", doc="Interface error counter")
+        default=0,
+        metadata=_m.meta(name="interface_error", type="uint16", doc="Communication errors counted with the pack"),
     )
     voltage_cell_v: list[float] = _dataclasses.field(
         default_factory=lambda: [0.0] * 14,
@@ -2582,26 +2573,23 @@ class BatteryStatusV0:
             invalid=0.0,
             invalid_text="0",
             per_element=True,
-            doc="Battery individual cell voltages",
+            doc="Voltage of each cell",
         ),
     )
     max_cell_voltage_delta: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
-            name="max_cell_voltage_delta", type="float32", doc="Max difference between individual cell voltages"
+            name="max_cell_voltage_delta", type="float32", doc="Spread between the highest and the lowest cell voltage"
         ),
     )
     is_powering_off: bool = _dataclasses.field(
         default=False,
         metadata=_m.meta(
-            name="is_powering_off", type="bool", doc="Power off event imminent indication, false if unknown"
+            name="is_powering_off", type="bool", doc="The pack is about to switch itself off (false when not known)"
         ),
     )
     is_required: bool = _dataclasses.field(
-        default=False,
-        metadata=_m.meta(
-            name="is_required", type="bool", doc="Set if the battery is explicitly required before arming"
-        ),
+        default=False, metadata=_m.meta(name="is_required", type="bool", doc="Arming waits for this pack")
     )
     warning: int = _dataclasses.field(
         default=0,
@@ -2609,7 +2597,7 @@ class BatteryStatusV0:
             name="warning",
             type="uint8",
             enums=("uorb.BatteryStatusV0.WARNING", "uorb.BatteryStatusV0.STATE"),
-            doc="Current battery warning",
+            doc="Warning level, or charging/unhealthy state",
         ),
     )
     faults: int = _dataclasses.field(
@@ -2618,7 +2606,7 @@ class BatteryStatusV0:
             name="faults",
             type="uint16",
             enums=("uorb.BatteryStatusV0.FAULT",),
-            doc="Smart battery supply status/fault flags (bitmask) for health indication",
+            doc="Fault bitmask of a smart battery, one bit per FAULT_* index",
         ),
     )
     full_charge_capacity_wh: float = _dataclasses.field(
@@ -2630,7 +2618,7 @@ class BatteryStatusV0:
             quantity="energy",
             scale=3600.0,
             offset=0.0,
-            doc="Compensated battery capacity",
+            doc="Energy of the full pack, corrected for wear and conditions",
         ),
     )
     remaining_capacity_wh: float = _dataclasses.field(
@@ -2642,20 +2630,17 @@ class BatteryStatusV0:
             quantity="energy",
             scale=3600.0,
             offset=0.0,
-            doc="Compensated battery capacity remaining",
+            doc="Energy left, corrected the same way",
         ),
     )
     over_discharge_count: int = _dataclasses.field(
-        default=0, metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Number of battery overdischarge")
+        default=0,
+        metadata=_m.meta(name="over_discharge_count", type="uint16", doc="Times the pack was over-discharged"),
     )
     nominal_voltage: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
-            name="nominal_voltage",
-            type="float32",
-            unit="V",
-            quantity="voltage",
-            doc="Nominal voltage of the battery pack",
+            name="nominal_voltage", type="float32", unit="V", quantity="voltage", doc="Rated pack voltage"
         ),
     )
     internal_resistance_estimate: float = _dataclasses.field(
@@ -2665,13 +2650,17 @@ class BatteryStatusV0:
             type="float32",
             unit="Ohm",
             quantity="resistance",
-            doc="Internal resistance per cell estimate",
+            doc="Estimated resistance of one cell",
         ),
     )
     ocv_estimate: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
-            name="ocv_estimate", type="float32", unit="V", quantity="voltage", doc="Open circuit voltage estimate"
+            name="ocv_estimate",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            doc="Estimated open-circuit (no-load) voltage",
         ),
     )
     ocv_estimate_filtered: float = _dataclasses.field(
@@ -2681,7 +2670,7 @@ class BatteryStatusV0:
             type="float32",
             unit="V",
             quantity="voltage",
-            doc="Filtered open circuit voltage estimate",
+            doc="The open-circuit estimate after filtering",
         ),
     )
     volt_based_soc_estimate: float = _dataclasses.field(
@@ -2691,22 +2680,30 @@ class BatteryStatusV0:
             type="float32",
             minimum=0,
             maximum=1,
-            doc="Normalized volt based state of charge estimate",
+            doc="Charge left as read from the voltage alone",
         ),
     )
     voltage_prediction: float = _dataclasses.field(
         default=0.0,
         metadata=_m.meta(
-            name="voltage_prediction", type="float32", unit="V", quantity="voltage", doc="Predicted voltage"
+            name="voltage_prediction",
+            type="float32",
+            unit="V",
+            quantity="voltage",
+            doc="Voltage the estimator expected",
         ),
     )
     prediction_error: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Prediction error"),
+        metadata=_m.meta(
+            name="prediction_error", type="float32", unit="V", quantity="voltage", doc="Measured minus expected voltage"
+        ),
     )
     estimation_covariance_norm: float = _dataclasses.field(
         default=0.0,
-        metadata=_m.meta(name="estimation_covariance_norm", type="float32", doc="Norm of the covariance matrix"),
+        metadata=_m.meta(
+            name="estimation_covariance_norm", type="float32", doc="Size (norm) of the estimator's covariance"
+        ),
     )
 
     def __eq__(self, other: object) -> bool:
@@ -3091,57 +3088,57 @@ class BatteryStatusV0:
         r_voltage_cell_v: _Any
         v_i: _Any
         try:
-            # timestamp (BatteryStatusV0.msg:8): fits uint64
+            # timestamp (BatteryStatusV0.msg:9): fits uint64
             if self.timestamp & -18446744073709551616:
                 _v.diag(out, "timestamp", self.timestamp, _BATTERY_STATUS_V0_TIMESTAMP_SPEC)
-            # connected (BatteryStatusV0.msg:9): fits bool
+            # connected (BatteryStatusV0.msg:10): fits bool
             x = self.connected
             if x is not True and x is not False:
                 _v.diag(out, "connected", self.connected, _BATTERY_STATUS_V0_CONNECTED_SPEC)
-            # voltage_v (BatteryStatusV0.msg:10): fits float32; 0 means unknown (accepted)
+            # voltage_v (BatteryStatusV0.msg:11): fits float32; 0 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.voltage_v <= 3.4028234663852886e38):
                 _v.diag(out, "voltage_v", self.voltage_v, _BATTERY_STATUS_V0_VOLTAGE_V_SPEC)
-            # current_a (BatteryStatusV0.msg:11): fits float32; -1 means unknown (accepted)
+            # current_a (BatteryStatusV0.msg:12): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.current_a <= 3.4028234663852886e38):
                 _v.diag(out, "current_a", self.current_a, _BATTERY_STATUS_V0_CURRENT_A_SPEC)
-            # current_average_a (BatteryStatusV0.msg:12): fits float32; -1 means unknown (accepted)
+            # current_average_a (BatteryStatusV0.msg:13): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.current_average_a <= 3.4028234663852886e38):
                 _v.diag(out, "current_average_a", self.current_average_a, _BATTERY_STATUS_V0_CURRENT_AVERAGE_A_SPEC)
-            # discharged_mah (BatteryStatusV0.msg:13): fits float32; -1 means unknown (accepted)
+            # discharged_mah (BatteryStatusV0.msg:14): fits float32; -1 means unknown (accepted)
             if not (-3.4028234663852886e38 <= self.discharged_mah <= 3.4028234663852886e38):
                 _v.diag(out, "discharged_mah", self.discharged_mah, _BATTERY_STATUS_V0_DISCHARGED_MAH_SPEC)
-            # remaining (BatteryStatusV0.msg:14): fits float32; 0 <= value <= 1; -1 means unknown (accepted)
+            # remaining (BatteryStatusV0.msg:15): fits float32; 0 <= value <= 1; -1 means unknown (accepted)
             x = self.remaining
             if not (0.0 <= x <= 1.0) and x != -1.0:
                 _v.diag(out, "remaining", self.remaining, _BATTERY_STATUS_V0_REMAINING_SPEC)
-            # scale (BatteryStatusV0.msg:15): fits float32; 1 <= value; -1 means unknown (accepted)
+            # scale (BatteryStatusV0.msg:16): fits float32; 1 <= value; -1 means unknown (accepted)
             x = self.scale
             if not (1.0 <= x <= 3.4028234663852886e38) and x != -1.0:
                 _v.diag(out, "scale", self.scale, _BATTERY_STATUS_V0_SCALE_SPEC)
-            # time_remaining_s (BatteryStatusV0.msg:16): fits float32; NaN means unknown (accepted)
+            # time_remaining_s (BatteryStatusV0.msg:17): fits float32; NaN means unknown (accepted)
             x = self.time_remaining_s
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "time_remaining_s", self.time_remaining_s, _BATTERY_STATUS_V0_TIME_REMAINING_S_SPEC)
-            # temperature (BatteryStatusV0.msg:17): fits float32; NaN means unknown (accepted)
+            # temperature (BatteryStatusV0.msg:18): fits float32; NaN means unknown (accepted)
             x = self.temperature
             if not (-3.4028234663852886e38 <= x <= 3.4028234663852886e38) and x == x:
                 _v.diag(out, "temperature", self.temperature, _BATTERY_STATUS_V0_TEMPERATURE_SPEC)
-            # cell_count (BatteryStatusV0.msg:18): fits uint8; 0 means unknown (accepted)
+            # cell_count (BatteryStatusV0.msg:19): fits uint8; 0 means unknown (accepted)
             if self.cell_count & -256:
                 _v.diag(out, "cell_count", self.cell_count, _BATTERY_STATUS_V0_CELL_COUNT_SPEC)
-            # source (BatteryStatusV0.msg:19): fits uint8; a value of SOURCE
+            # source (BatteryStatusV0.msg:20): fits uint8; a value of SOURCE
             if self.source not in {0, 1, 2}:
                 _v.diag(out, "source", self.source, _BATTERY_STATUS_V0_SOURCE_SPEC)
-            # priority (BatteryStatusV0.msg:23): fits uint8
+            # priority (BatteryStatusV0.msg:24): fits uint8
             if self.priority & -256:
                 _v.diag(out, "priority", self.priority, _BATTERY_STATUS_V0_PRIORITY_SPEC)
-            # capacity (BatteryStatusV0.msg:24): fits uint16
+            # capacity (BatteryStatusV0.msg:25): fits uint16
             if self.capacity & -65536:
                 _v.diag(out, "capacity", self.capacity, _BATTERY_STATUS_V0_CAPACITY_SPEC)
-            # cycle_count (BatteryStatusV0.msg:25): fits uint16
+            # cycle_count (BatteryStatusV0.msg:26): fits uint16
             if self.cycle_count & -65536:
                 _v.diag(out, "cycle_count", self.cycle_count, _BATTERY_STATUS_V0_CYCLE_COUNT_SPEC)
-            # average_time_to_empty (BatteryStatusV0.msg:26): fits uint16
+            # average_time_to_empty (BatteryStatusV0.msg:27): fits uint16
             if self.average_time_to_empty & -65536:
                 _v.diag(
                     out,
@@ -3149,27 +3146,27 @@ class BatteryStatusV0:
                     self.average_time_to_empty,
                     _BATTERY_STATUS_V0_AVERAGE_TIME_TO_EMPTY_SPEC,
                 )
-            # serial_number (BatteryStatusV0.msg:27): fits uint16
+            # serial_number (BatteryStatusV0.msg:28): fits uint16
             if self.serial_number & -65536:
                 _v.diag(out, "serial_number", self.serial_number, _BATTERY_STATUS_V0_SERIAL_NUMBER_SPEC)
-            # manufacture_date (BatteryStatusV0.msg:28): fits uint16
+            # manufacture_date (BatteryStatusV0.msg:29): fits uint16
             if self.manufacture_date & -65536:
                 _v.diag(out, "manufacture_date", self.manufacture_date, _BATTERY_STATUS_V0_MANUFACTURE_DATE_SPEC)
-            # state_of_health (BatteryStatusV0.msg:29): fits uint16; 0 <= value <= 100
+            # state_of_health (BatteryStatusV0.msg:30): fits uint16; 0 <= value <= 100
             x = self.state_of_health
             if x & -65536 or not (0 <= x <= 100):
                 _v.diag(out, "state_of_health", self.state_of_health, _BATTERY_STATUS_V0_STATE_OF_HEALTH_SPEC)
-            # max_error (BatteryStatusV0.msg:30): fits uint16; 1 <= value <= 100
+            # max_error (BatteryStatusV0.msg:31): fits uint16; 1 <= value <= 100
             x = self.max_error
             if x & -65536 or not (1 <= x <= 100):
                 _v.diag(out, "max_error", self.max_error, _BATTERY_STATUS_V0_MAX_ERROR_SPEC)
-            # id (BatteryStatusV0.msg:31): fits uint8
+            # id (BatteryStatusV0.msg:32): fits uint8
             if self.id & -256:
                 _v.diag(out, "id", self.id, _BATTERY_STATUS_V0_ID_SPEC)
-            # interface_error (BatteryStatusV0.msg:32): fits uint16
+            # interface_error (BatteryStatusV0.msg:33): fits uint16
             if self.interface_error & -65536:
                 _v.diag(out, "interface_error", self.interface_error, _BATTERY_STATUS_V0_INTERFACE_ERROR_SPEC)
-            # voltage_cell_v (BatteryStatusV0.msg:33): fits float32[14]; 0 means unknown (accepted)
+            # voltage_cell_v (BatteryStatusV0.msg:34): fits float32[14]; 0 means unknown (accepted)
             a = self.voltage_cell_v
             if len(a) != 14:
                 _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC)
@@ -3178,7 +3175,7 @@ class BatteryStatusV0:
                     if not (-3.4028234663852886e38 <= e <= 3.4028234663852886e38):
                         _v.diag(out, "voltage_cell_v", self.voltage_cell_v, _BATTERY_STATUS_V0_VOLTAGE_CELL_V_SPEC)
                         break
-            # max_cell_voltage_delta (BatteryStatusV0.msg:34): fits float32
+            # max_cell_voltage_delta (BatteryStatusV0.msg:35): fits float32
             if not (-3.4028234663852886e38 <= self.max_cell_voltage_delta <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3186,21 +3183,21 @@ class BatteryStatusV0:
                     self.max_cell_voltage_delta,
                     _BATTERY_STATUS_V0_MAX_CELL_VOLTAGE_DELTA_SPEC,
                 )
-            # is_powering_off (BatteryStatusV0.msg:35): fits bool
+            # is_powering_off (BatteryStatusV0.msg:36): fits bool
             x = self.is_powering_off
             if x is not True and x is not False:
                 _v.diag(out, "is_powering_off", self.is_powering_off, _BATTERY_STATUS_V0_IS_POWERING_OFF_SPEC)
-            # is_required (BatteryStatusV0.msg:36): fits bool
+            # is_required (BatteryStatusV0.msg:37): fits bool
             x = self.is_required
             if x is not True and x is not False:
                 _v.diag(out, "is_required", self.is_required, _BATTERY_STATUS_V0_IS_REQUIRED_SPEC)
-            # warning (BatteryStatusV0.msg:37): fits uint8; a value of WARNING or a value of STATE
+            # warning (BatteryStatusV0.msg:38): fits uint8; a value of WARNING or a value of STATE
             if self.warning not in {0, 1, 2, 3, 4, 6, 7}:
                 _v.diag(out, "warning", self.warning, _BATTERY_STATUS_V0_WARNING_SPEC)
-            # faults (BatteryStatusV0.msg:45): fits uint16; bits of FAULT only
+            # faults (BatteryStatusV0.msg:46): fits uint16; bits of FAULT only
             if self.faults & -2048:
                 _v.diag(out, "faults", self.faults, _BATTERY_STATUS_V0_FAULTS_SPEC)
-            # full_charge_capacity_wh (BatteryStatusV0.msg:58): fits float32
+            # full_charge_capacity_wh (BatteryStatusV0.msg:59): fits float32
             if not (-3.4028234663852886e38 <= self.full_charge_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3208,7 +3205,7 @@ class BatteryStatusV0:
                     self.full_charge_capacity_wh,
                     _BATTERY_STATUS_V0_FULL_CHARGE_CAPACITY_WH_SPEC,
                 )
-            # remaining_capacity_wh (BatteryStatusV0.msg:59): fits float32
+            # remaining_capacity_wh (BatteryStatusV0.msg:60): fits float32
             if not (-3.4028234663852886e38 <= self.remaining_capacity_wh <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3216,15 +3213,15 @@ class BatteryStatusV0:
                     self.remaining_capacity_wh,
                     _BATTERY_STATUS_V0_REMAINING_CAPACITY_WH_SPEC,
                 )
-            # over_discharge_count (BatteryStatusV0.msg:60): fits uint16
+            # over_discharge_count (BatteryStatusV0.msg:61): fits uint16
             if self.over_discharge_count & -65536:
                 _v.diag(
                     out, "over_discharge_count", self.over_discharge_count, _BATTERY_STATUS_V0_OVER_DISCHARGE_COUNT_SPEC
                 )
-            # nominal_voltage (BatteryStatusV0.msg:61): fits float32
+            # nominal_voltage (BatteryStatusV0.msg:62): fits float32
             if not (-3.4028234663852886e38 <= self.nominal_voltage <= 3.4028234663852886e38):
                 _v.diag(out, "nominal_voltage", self.nominal_voltage, _BATTERY_STATUS_V0_NOMINAL_VOLTAGE_SPEC)
-            # internal_resistance_estimate (BatteryStatusV0.msg:62): fits float32
+            # internal_resistance_estimate (BatteryStatusV0.msg:63): fits float32
             if not (-3.4028234663852886e38 <= self.internal_resistance_estimate <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3232,10 +3229,10 @@ class BatteryStatusV0:
                     self.internal_resistance_estimate,
                     _BATTERY_STATUS_V0_INTERNAL_RESISTANCE_ESTIMATE_SPEC,
                 )
-            # ocv_estimate (BatteryStatusV0.msg:63): fits float32
+            # ocv_estimate (BatteryStatusV0.msg:64): fits float32
             if not (-3.4028234663852886e38 <= self.ocv_estimate <= 3.4028234663852886e38):
                 _v.diag(out, "ocv_estimate", self.ocv_estimate, _BATTERY_STATUS_V0_OCV_ESTIMATE_SPEC)
-            # ocv_estimate_filtered (BatteryStatusV0.msg:64): fits float32
+            # ocv_estimate_filtered (BatteryStatusV0.msg:65): fits float32
             if not (-3.4028234663852886e38 <= self.ocv_estimate_filtered <= 3.4028234663852886e38):
                 _v.diag(
                     out,
@@ -3243,7 +3240,7 @@ class BatteryStatusV0:
                     self.ocv_estimate_filtered,
                     _BATTERY_STATUS_V0_OCV_ESTIMATE_FILTERED_SPEC,
                 )
-            # volt_based_soc_estimate (BatteryStatusV0.msg:65): fits float32; 0 <= value <= 1
+            # volt_based_soc_estimate (BatteryStatusV0.msg:66): fits float32; 0 <= value <= 1
             if not (0.0 <= self.volt_based_soc_estimate <= 1.0):
                 _v.diag(
                     out,
@@ -3251,13 +3248,13 @@ class BatteryStatusV0:
                     self.volt_based_soc_estimate,
                     _BATTERY_STATUS_V0_VOLT_BASED_SOC_ESTIMATE_SPEC,
                 )
-            # voltage_prediction (BatteryStatusV0.msg:66): fits float32
+            # voltage_prediction (BatteryStatusV0.msg:67): fits float32
             if not (-3.4028234663852886e38 <= self.voltage_prediction <= 3.4028234663852886e38):
                 _v.diag(out, "voltage_prediction", self.voltage_prediction, _BATTERY_STATUS_V0_VOLTAGE_PREDICTION_SPEC)
-            # prediction_error (BatteryStatusV0.msg:67): fits float32
+            # prediction_error (BatteryStatusV0.msg:68): fits float32
             if not (-3.4028234663852886e38 <= self.prediction_error <= 3.4028234663852886e38):
                 _v.diag(out, "prediction_error", self.prediction_error, _BATTERY_STATUS_V0_PREDICTION_ERROR_SPEC)
-            # estimation_covariance_norm (BatteryStatusV0.msg:68): fits float32
+            # estimation_covariance_norm (BatteryStatusV0.msg:69): fits float32
             if not (-3.4028234663852886e38 <= self.estimation_covariance_norm <= 3.4028234663852886e38):
                 _v.diag(
                     out,

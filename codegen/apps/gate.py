@@ -23,7 +23,6 @@ profile is refused.
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import fnmatch
 import re
 import tomllib
@@ -33,7 +32,7 @@ from pathlib import Path
 
 import yaml
 
-from ..errors import BattgenError
+from ..errors import BattgenError, close_names
 from ..ir import Message
 
 PROFILES = Path(__file__).resolve().parent / "profiles"
@@ -59,8 +58,9 @@ FAILSAFE_RULE = "cross-field:failsafe"  # the validate app's failsafe checks of 
 
 
 def closest(name: str, known: Iterable[str]) -> str:
-    """`` (did you mean a, b?)`` with the known names closest to ``name``; "" when none is close."""
-    close = difflib.get_close_matches(name, sorted(set(known)), n=3, cutoff=0.6)
+    """`` (did you mean a, b?)`` with the known names closest to ``name`` (:func:`close_names`, as every other
+    "did you mean"); "" when none is close."""
+    close = close_names(name, known)
     return f" (did you mean {', '.join(close)}?)" if close else ""
 
 

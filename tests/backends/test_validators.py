@@ -262,7 +262,7 @@ def test_devicetree_columns_name_what_the_position_holds() -> None:
             "range",
             101,
             100,
-            "ocv-capacity-table-0[3][1]: battery capacity percent = 101 is above the maximum 100",
+            "ocv-capacity-table-0[3][1]: state of charge in percent = 101 is above the maximum 100",
         )
     ]
     # the OCV column has no bound beyond uint32; a wrong type there is named by its column too
@@ -271,13 +271,11 @@ def test_devicetree_columns_name_what_the_position_holds() -> None:
     node.ocv_capacity_table_n["ocv-capacity-table-0"] = table
     (v,) = node.validate()
     assert v.path == "ocv-capacity-table-0[3][0]" and v.rule == "type-bounds"
-    assert v.message.startswith(
-        "ocv-capacity-table-0[3][0]: open circuit voltage (OCV) in microvolts = -1 does not fit"
-    )
+    assert v.message.startswith("ocv-capacity-table-0[3][0]: open-circuit voltage in microvolts = -1 does not fit")
     node = SimpleBattery.from_dict(EXAMPLE)
     node.operating_range_celsius = [-30, 1 << 31]
     (v,) = node.validate()
-    assert v.message.startswith("operating-range-celsius[1]: maximum temperature at which battery can operate = ")
+    assert v.message.startswith("operating-range-celsius[1]: highest usable temperature = ")
     assert SimpleBattery.from_dict({**EXAMPLE, "ocv-capacity-table-2": [[3000000, 100], [2900000, 0]]}).validate() == []
 
 

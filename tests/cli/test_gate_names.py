@@ -134,3 +134,23 @@ def test_a_px4_logs_default_report_and_validation_have_no_finding_px4_explains(
     assert main(["report", "--format", "json", "--profile", "", str(log)]) == 0
     (item,) = json.loads(capsys.readouterr().out)["inputs"]
     assert item["findings"] == item["records"]  # every record's max_error = 0
+
+
+def test_one_did_you_mean_for_every_command() -> None:
+    """The gate's hints and the other commands' come from one matcher (codegen.errors.close_names): case is ignored
+    and a dotted name's last part is compared, wherever the name was typed; each keeps its own sentence."""
+    from codegen.apps.gate import closest, unknown_name
+    from codegen.errors import close_names, did_you_mean
+
+    known = ["copter", "plane", "rover", "uorb.BatteryStatus"]
+    assert close_names("COPTR", known) == ["copter"] and close_names("px4.BatteryStatu", known) == [
+        "uorb.BatteryStatus"
+    ]
+    assert closest("COPTR", known) == " (did you mean copter?)"
+    assert did_you_mean("COPTR", known) == "did you mean 'copter'?"
+    assert str(unknown_name("vehicle", "px4.BatteryStatu", known)) == (
+        "unknown vehicle 'px4.BatteryStatu' (did you mean uorb.BatteryStatus?)"
+    )
+    assert str(unknown_name("vehicle", "boat", known)) == (
+        "unknown vehicle 'boat' (known: copter, plane, rover, uorb.BatteryStatus)"
+    )

@@ -145,8 +145,8 @@ def battery() -> Message:
 
 def test_battery_message(battery: Message) -> None:
     assert battery.name == "battery"
-    assert str(battery.location) == "power/supply/battery.yaml:4"
-    assert battery.doc.startswith("The devicetree battery node provides static battery characteristics.")
+    assert str(battery.location) == "power/supply/battery.yaml:3"
+    assert battery.doc.startswith("Fixed facts about a battery (design voltages, capacity, charging limits,")
     info = battery.devicetree
     assert info is not None
     assert info.schema_id == "http://devicetree.org/schemas/power/supply/battery.yaml#"
@@ -189,8 +189,8 @@ def test_battery_types(battery: Message) -> None:
     alert = battery.field("alert-celsius").type
     assert isinstance(alert, ArrayType) and replace(alert, columns=()) == ArrayType(i32, 2, False, 2)
     assert [c.doc for c in alert.columns] == [
-        "alert when battery temperature is lower than this value",
-        "alert when battery temperature is higher than this value",
+        "alert below this battery temperature",
+        "alert above this battery temperature",
     ]
     chem = battery.field("device-chemistry")
     assert chem.type == StringType() and chem.choices[:2] == ("nickel-cadmium", "nickel-metal-hydride")
@@ -201,32 +201,32 @@ def test_battery_types(battery: Message) -> None:
 
 def test_battery_ocv_table_pattern_field(battery: Message) -> None:
     f = battery.field("^ocv-capacity-table-[0-9]+$")
-    assert f.pattern == f.name and not f.required and f.location.line == 150
+    assert f.pattern == f.name and not f.required and f.location.line == 146
     where = "power/supply/battery.yaml"
     columns = (
-        Column("open circuit voltage (OCV) in microvolts", location=Location(where, 160)),
-        Column("battery capacity percent", range=Range(maximum=100), location=Location(where, 161)),
+        Column("open-circuit voltage in microvolts", location=Location(where, 155)),
+        Column("state of charge in percent", range=Range(maximum=100), location=Location(where, 156)),
     )
     row = ArrayType(PrimitiveType(PrimitiveKind.UINT, 32), 2, dynamic=False, min_length=2, columns=columns)
     assert f.type == ArrayType(row, 100, dynamic=True, min_length=1)  # the columns sit on the row type
     notes = dict(f.annotations)
     assert notes == {"dt-type": "uint32-matrix", "dt-type-source": "ref"}  # nothing left over
     assert f.range is None  # only the percent column is bounded
-    assert "[1]" not in f.doc and f.doc.startswith("An array providing the open circuit voltage")
+    assert "[1]" not in f.doc and f.doc.startswith("Rows of (open-circuit voltage, charge percent)")
 
 
 def test_battery_columns_of_arrays(battery: Message) -> None:
     t = battery.field("operating-range-celsius").type
     assert isinstance(t, ArrayType) and [c.doc for c in t.columns] == [
-        "minimum temperature at which battery can operate",
-        "maximum temperature at which battery can operate",
+        "lowest usable temperature",
+        "highest usable temperature",
     ]
     assert all(c.range is None and c.unit is None for c in t.columns)
     table = battery.field("resistance-temp-table").type
     assert isinstance(table, ArrayType) and isinstance(table.element, ArrayType) and table.columns == ()
     assert [c.doc for c in table.element.columns] == [
-        "the temperature in degree Celsius",
-        "battery internal resistance percent",
+        "temperature in degrees Celsius",
+        "internal resistance in percent of the factory value",
     ]
 
 

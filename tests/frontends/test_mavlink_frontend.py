@@ -369,7 +369,7 @@ def test_battery_status_message(battery_schema: Schema) -> None:
     assert battery_schema.sources == ("battery.xml",)
     assert (msg.name, msg.location.file) == ("BATTERY_STATUS", "battery.xml")
     assert msg.location.line == line_of(SCHEMAS / "battery.xml", '<message id="147"')
-    assert msg.doc.startswith("Battery information. Updates GCS with flight controller battery status.")
+    assert msg.doc.startswith("A battery as the flight controller monitors it: cell voltages, current,")
     info = msg.mavlink
     assert info is not None
     assert (info.msg_id, info.crc_extra, info.dialect, info.base_length, info.max_length) == (

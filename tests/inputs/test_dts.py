@@ -233,14 +233,14 @@ def test_model_dict_of_the_binding_example(message: Message) -> None:
     data = node_to_model_dict(battery, message)
     assert "phandle" not in data  # devicetree plumbing, not battery data
     assert data["compatible"] == ["simple-battery"]
-    assert data["voltage-min-design-microvolt"] == [[3200000]]  # -microvolt is an int32 matrix
-    assert data["charge-full-design-microamp-hours"] == [1430000]
-    assert data["ocv-capacity-celsius"] == [-10, 0, 10]  # int32: signed
-    assert data["ocv-capacity-table-0"] == [[4185000, 100], [4113000, 95], [4066000, 90]]
-    assert data["resistance-temp-table"] == [[20, 100], [10, 90], [0, 80], [0xFFFFFFF6, 60]]  # uint32 matrix
-    assert data["operating-range-celsius"] == [-30, 50]
+    assert data["voltage-min-design-microvolt"] == [[12000000]]  # -microvolt is an int32 matrix
+    assert data["charge-full-design-microamp-hours"] == [5000000]
+    assert data["ocv-capacity-celsius"] == [-10, 25]  # int32: signed
+    assert data["ocv-capacity-table-0"] == [[4150000, 100], [3920000, 70], [3760000, 30], [3400000, 0]]
+    assert data["resistance-temp-table"] == [[25, 100], [10, 130], [0, 170], [0xFFFFFFF6, 250]]  # uint32 matrix
+    assert data["operating-range-celsius"] == [-10, 60]
     model = SimpleBattery.from_dict(data)
-    assert model.ocv_capacity_table_n["ocv-capacity-table-2"][0] == [4250000, 100]
+    assert model.ocv_capacity_table_n["ocv-capacity-table-1"][0] == [4200000, 100]
 
 
 def test_model_dict_of_includes_and_overlays(message: Message) -> None:

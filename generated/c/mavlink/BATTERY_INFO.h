@@ -19,50 +19,45 @@ extern "C" {
 #define BATTGEN_MAVLINK_BATTERY_INFO_MAX_LENGTH 140u
 #define BATTGEN_MAVLINK_BATTERY_INFO_MAX_PROBLEMS 12u
 
-/** Battery information that is static, or requires infrequent update. This message should requested
- * using MAV_CMD_REQUEST_MESSAGE and/or streamed at very low rate. BATTERY_STATUS_V2 is used for
- * higher-rate battery status information. [work in progress] */
+/** What does not change about a battery, or seldom: design limits, identity, wear. Request it with
+ * MAV_CMD_REQUEST_MESSAGE or stream it slowly; BATTERY_STATUS_V2 carries the fast-changing values.
+ * [work in progress] */
 typedef struct {
-  uint8_t id;               /* uint8 Battery ID */
-  uint8_t battery_function; /* uint8 Function of the battery. */
-  uint8_t type;             /* uint8 Type (chemistry) of the battery. */
-  uint8_t state_of_health; /* [%] invalid: UINT8_MAX uint8 State of Health (SOH) estimate. Typically
-                              100% at the time of manufacture and will decrease over time and use.
-                              -1: field not provided. */
-  uint8_t cells_in_series; /* invalid: 0 uint8 Number of battery cells in series. 0: field not
-                              provided. */
-  uint16_t cycle_count;    /* invalid: UINT16_MAX uint16 Lifetime count of the number of
-                              charge/discharge cycles (https://en.wikipedia.org/wiki/Charge_cycle).
-                              UINT16_MAX: field not provided. */
-  uint16_t weight;         /* [g] invalid: 0 uint16 Battery weight. 0: field not provided. */
-  float discharge_minimum_voltage; /* [V] invalid: 0 float32 Minimum per-cell voltage when
-                                      discharging. 0: field not provided. */
-  float charging_minimum_voltage;  /* [V] invalid: 0 float32 Minimum per-cell voltage when charging.
-                                      0: field not provided. */
-  float resting_minimum_voltage; /* [V] invalid: 0 float32 Minimum per-cell voltage when resting. 0:
-                                    field not provided. */
-  float charging_maximum_voltage; /* [V] invalid: 0 float32 Maximum per-cell voltage when charged.
-                                     0: field not provided. */
-  float charging_maximum_current; /* [A] invalid: 0 float32 Maximum pack continuous charge current.
-                                     0: field not provided. */
-  float nominal_voltage; /* [V] invalid: 0 float32 Battery nominal voltage. Used for conversion
-                            between Wh and Ah. 0: field not provided. */
-  float discharge_maximum_current; /* [A] invalid: 0 float32 Maximum pack discharge current. 0:
-                                      field not provided. */
-  float discharge_maximum_burst_current; /* [A] invalid: 0 float32 Maximum pack discharge burst
-                                            current. 0: field not provided. */
-  float design_capacity;      /* [Ah] invalid: 0 float32 Fully charged design capacity. 0: field not
-                                 provided. */
-  float full_charge_capacity; /* [Ah] invalid: NaN float32 Predicted battery capacity when fully
-                                 charged (accounting for battery degradation). NAN: field not
-                                 provided. */
-  char manufacture_date[10];  /* invalid: [0] Manufacture date (DDMMYYYY) in ASCII characters, 0
-                                 terminated. All 0: field not provided. */
-  char serial_number[33]; /* invalid: [0] Serial number in ASCII characters, 0 terminated. All 0:
-                             field not provided. */
-  char name[51]; /* invalid: [0] Battery device name. Formatted as manufacturer name then product
-                    name, separated with an underscore (in ASCII characters), 0 terminated. All 0:
-                    field not provided. */
+  uint8_t id;               /* uint8 Which battery (instance) this is. */
+  uint8_t battery_function; /* uint8 What the battery powers. */
+  uint8_t type;             /* uint8 Cell chemistry. */
+  uint8_t state_of_health;  /* [%] invalid: UINT8_MAX uint8 Health: about 100 when new, falling with
+                               age and use; UINT8_MAX when not given. */
+  uint8_t cells_in_series;  /* invalid: 0 uint8 Cells in series; 0 when not given. */
+  uint16_t cycle_count; /* invalid: UINT16_MAX uint16 Full charge/discharge cycles over the pack's
+                           life; UINT16_MAX when not given. */
+  uint16_t weight;      /* [g] invalid: 0 uint16 Mass of the pack; 0 when not given. */
+  float discharge_minimum_voltage; /* [V] invalid: 0 float32 Lowest cell voltage allowed while
+                                      discharging; 0 when not given. */
+  float charging_minimum_voltage;  /* [V] invalid: 0 float32 Lowest cell voltage allowed while
+                                      charging; 0 when not given. */
+  float resting_minimum_voltage;   /* [V] invalid: 0 float32 Lowest cell voltage allowed at rest; 0
+                                      when not given. */
+  float charging_maximum_voltage;  /* [V] invalid: 0 float32 Cell voltage of a full cell; 0 when not
+                                      given. */
+  float charging_maximum_current; /* [A] invalid: 0 float32 Highest continuous charge current of the
+                                     pack; 0 when not given. */
+  float nominal_voltage; /* [V] invalid: 0 float32 Rated pack voltage, which converts between Wh and
+                            Ah; 0 when not given. */
+  float discharge_maximum_current; /* [A] invalid: 0 float32 Highest continuous discharge current of
+                                      the pack; 0 when not given. */
+  float discharge_maximum_burst_current; /* [A] invalid: 0 float32 Highest short-burst discharge
+                                            current of the pack; 0 when not given. */
+  float design_capacity;      /* [Ah] invalid: 0 float32 Charge of a full pack by design; 0 when not
+                                 given. */
+  float full_charge_capacity; /* [Ah] invalid: NaN float32 Charge of the pack when full now, wear
+                                 counted; NaN when not given. */
+  char manufacture_date[10];  /* invalid: [0] Date made, DDMMYYYY as ASCII text ending in a zero
+                                 byte; all zero when not given. */
+  char serial_number[33];     /* invalid: [0] Serial number as ASCII text ending in a zero byte; all
+                                 zero when not given. */
+  char name[51]; /* invalid: [0] Maker and product names joined by an underscore, as ASCII text
+                    ending in a zero byte; all zero when not given. */
 } battgen_mavlink_BATTERY_INFO;
 
 /* C99 static assertion: a negative array size fails the build. */

@@ -19,47 +19,37 @@ extern "C" {
 #define BATTGEN_MAVLINK_BATTERY_STATUS_MAX_LENGTH 54u
 #define BATTGEN_MAVLINK_BATTERY_STATUS_MAX_PROBLEMS 6u
 
-/** Battery information. Updates GCS with flight controller battery status. Smart batteries also use
- * this message, but may additionally send BATTERY_INFO. */
+/** A battery as the flight controller monitors it: cell voltages, current, charge and energy used,
+ * charge left. Smart batteries send it too, and may add BATTERY_INFO. */
 typedef struct {
-  uint8_t id;               /* uint8 Battery ID */
-  uint8_t battery_function; /* uint8 Function of the battery */
-  uint8_t type;             /* uint8 Type (chemistry) of the battery */
-  int16_t temperature; /* [cdegC] invalid: INT16_MAX int16 Temperature of the battery. INT16_MAX for
-                          unknown temperature. */
-  uint16_t voltages[10]; /* [mV] invalid: [UINT16_MAX] Battery voltage of cells 1 to 10 (see
-                            voltages_ext for cells 11-14). Cells in this field above the valid cell
-                            count for this battery should have the UINT16_MAX value. If individual
-                            cell voltages are unknown or not measured for this battery, then the
-                            overall battery voltage should be filled in cell 0, with all others set
-                            to UINT16_MAX. If the voltage of the battery is greater than (UINT16_MAX
-                            - 1), then cell 0 should be set to (UINT16_MAX - 1), and cell 1 to the
-                            remaining voltage. This can be extended to multiple cells if the total
-                            voltage is greater than 2 * (UINT16_MAX - 1). */
-  int16_t
-      current_battery; /* [cA] invalid: -1 int16 Battery current, -1: autopilot does not measure the
-                          current. Value may overflow/rollover for very high currents (> 327.67A) */
-  int32_t current_consumed; /* [mAh] invalid: -1 int32 Consumed charge, -1: autopilot does not
-                               provide consumption estimate */
-  int32_t energy_consumed; /* [hJ] invalid: -1 int32 Consumed energy, -1: autopilot does not provide
-                              energy consumption estimate */
-  int8_t battery_remaining; /* [%] invalid: -1 int8 Remaining battery energy. Values: [0-100], -1:
-                               autopilot does not estimate the remaining battery. */
-  int32_t time_remaining;   /* [s] invalid: 0 int32 Remaining battery time, 0: autopilot does not
-                               provide remaining battery time estimate */
-  uint8_t charge_state; /* uint8 State for extent of discharge, provided by autopilot for warning or
-                           external reactions */
-  uint16_t voltages_ext[4]; /* [mV] invalid: [0] Battery voltages for cells 11 to 14. Cells above
-                               the valid cell count for this battery should have a value of 0, where
-                               zero indicates not supported (note, this is different than for the
-                               voltages field and allows empty byte truncation). If the measured
-                               value is 0 then 1 should be sent instead. */
-  uint8_t mode; /* uint8 Battery mode. Default (0) is that battery mode reporting is not supported
-                   or battery is in normal-use mode. */
-  uint32_t
-      fault_bitmask; /* uint32 Fault/health indications. These should be set when charge_state is
-                        MAV_BATTERY_CHARGE_STATE_FAILED or MAV_BATTERY_CHARGE_STATE_UNHEALTHY (if
-                        not, fault reporting is not supported). */
+  uint8_t id;               /* uint8 Which battery (instance) this is. */
+  uint8_t battery_function; /* uint8 What the battery powers. */
+  uint8_t type;             /* uint8 Cell chemistry. */
+  int16_t temperature;      /* [cdegC] invalid: INT16_MAX int16 Pack temperature; INT16_MAX when not
+                               measured. */
+  uint16_t voltages[10]; /* [mV] invalid: [UINT16_MAX] Voltage of cells 1 to 10 (cells 11 to 14 are
+                            in voltages_ext); UINT16_MAX past the last cell. A monitor that sees
+                            only the pack puts the pack voltage in the first element and UINT16_MAX
+                            in the rest; a pack voltage above UINT16_MAX - 1 mV spills over into the
+                            next elements, each holding at most UINT16_MAX - 1. */
+  int16_t current_battery;  /* [cA] invalid: -1 int16 Pack current; -1 when the autopilot does not
+                               measure it. Wraps above 327.67 A. */
+  int32_t current_consumed; /* [mAh] invalid: -1 int32 Charge drawn; -1 when the autopilot does not
+                               count it. */
+  int32_t energy_consumed;  /* [hJ] invalid: -1 int32 Energy drawn; -1 when the autopilot does not
+                               count it. */
+  int8_t battery_remaining; /* [%] invalid: -1 int8 Energy left, 0 to 100; -1 when the autopilot
+                               does not estimate it. */
+  int32_t time_remaining;   /* [s] invalid: 0 int32 Time until empty; 0 when the autopilot does not
+                               estimate it. */
+  uint8_t charge_state; /* uint8 How far the pack is discharged, for warnings and reactions of other
+                           systems. */
+  uint16_t voltages_ext[4]; /* [mV] invalid: [0] Voltage of cells 11 to 14. Unlike voltages, an
+                               unused or unsupported cell is 0 (so the trailing bytes can be trimmed
+                               off the wire); a cell that really reads 0 mV is sent as 1. */
+  uint8_t mode; /* uint8 Smart-battery mode; 0 in normal use or when the battery has no modes. */
+  uint32_t fault_bitmask; /* uint32 Fault bits, meaningful when charge_state is FAILED or UNHEALTHY
+                             (else the sender does not report faults). */
 } battgen_mavlink_BATTERY_STATUS;
 
 /* C99 static assertion: a negative array size fails the build. */

@@ -19,34 +19,27 @@ extern "C" {
 #define BATTGEN_MAVLINK_BATTERY_STATUS_V2_MAX_LENGTH 27u
 #define BATTGEN_MAVLINK_BATTERY_STATUS_V2_MAX_PROBLEMS 6u
 
-/** Battery dynamic information. This should be streamed (nominally at 1Hz). Static/invariant
- * battery information is sent in BATTERY_INFO. Note that smart batteries should set the
- * MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL bit to indicate that supplied capacity values
- * are relative to a battery that is known to be full. Power monitors would not set this bit,
- * indicating that capacity_consumed is relative to drone power-on, and that other values are
- * estimated based on the assumption that the battery was full on power-on. */
+/** What changes about a battery, sent about once a second; what does not is in BATTERY_INFO. A
+ * smart battery that knows when it is full sets MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL;
+ * a power monitor leaves it clear, and its figures then count from power-on and assume a full pack
+ * at that moment. */
 typedef struct {
-  uint8_t id;          /* uint8 Battery ID */
-  int16_t temperature; /* [cdegC] invalid: INT16_MAX int16 Temperature of the whole battery pack
-                          (not internal electronics). INT16_MAX field not provided. */
-  float voltage; /* [V] invalid: NaN float32 Battery voltage (total). NaN: field not provided. */
-  float current; /* [A] invalid: NaN float32 Battery current (through all cells/loads). Positive
-                    value when discharging and negative if charging. NaN: field not provided. */
-  float capacity_consumed;  /* [Ah] invalid: NaN float32 Consumed charge. NaN: field not provided.
-                               This is either the consumption since power-on or since the battery was
-                               full, depending on the value of
-                               MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL. */
-  float capacity_remaining; /* [Ah] invalid: NaN float32 Remaining charge (until empty). NaN: field
-                               not provided. Note: If
-                               MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL is unset, this
-                               value is based on the assumption the battery was full when the system
-                               was powered. */
-  float state_of_charge;    /* [%] invalid: NaN float32 State of Charge (SoC). Remaining capacity
-                               relative to current fully-charged capacity as a percentage. Values:
-                               [0-100], NaN: field not provided. Note that the value may be calculated
-                               from design_capacity if current full_charge_capacity is not known (see
-                               BATTERY_INFO). */
-  uint32_t status_flags;    /* uint32 Fault, health, readiness, and other status indications. */
+  uint8_t id;          /* uint8 Which battery (instance) this is. */
+  int16_t temperature; /* [cdegC] invalid: INT16_MAX int16 Temperature of the pack as a whole (not
+                          of its electronics); INT16_MAX when not given. */
+  float voltage;       /* [V] invalid: NaN float32 Pack voltage; NaN when not given. */
+  float current;       /* [A] invalid: NaN float32 Current through the pack: positive discharging,
+                          negative charging; NaN when not given. */
+  float capacity_consumed;  /* [Ah] invalid: NaN float32 Charge drawn, since power-on or since full
+                               as MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL says; NaN when
+                               not given. */
+  float capacity_remaining; /* [Ah] invalid: NaN float32 Charge left until empty; NaN when not
+                               given. Without MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL it
+                               assumes the pack was full at power-on. */
+  float state_of_charge;    /* [%] invalid: NaN float32 Charge left as a share of the full-charge
+                               capacity, 0 to 100 (of the design capacity when the full-charge capacity
+                               is not known); NaN when not given. */
+  uint32_t status_flags;    /* uint32 Fault, health, readiness and other state bits. */
 } battgen_mavlink_BATTERY_STATUS_V2;
 
 /* C99 static assertion: a negative array size fails the build. */

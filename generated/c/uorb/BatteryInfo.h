@@ -17,13 +17,11 @@ extern "C" {
 #define BATTGEN_UORB_BATTERYINFO_PACKED_SIZE 41u
 #define BATTGEN_UORB_BATTERYINFO_MAX_PROBLEMS 0u
 
-/** Battery information Static or near-invariant battery information. Should be streamed at low
- * rate. */
+/** What a battery says about itself that rarely changes (its serial number); sent at a low rate. */
 typedef struct {
-  uint64_t timestamp; /* [us] uint64 Time since system start */
-  uint8_t id; /* uint8 Must match the id in the battery_status message for the same battery */
-  char serial_number[33]; /* invalid: 0 Serial number of the battery pack in ASCII characters, 0
-                             terminated */
+  uint64_t timestamp; /* [us] uint64 When this sample was taken, on the autopilot's boot clock */
+  uint8_t id;         /* uint8 The pack this describes: the id of its battery_status */
+  char serial_number[33]; /* invalid: 0 Serial number as ASCII text, ended by a zero byte */
 } battgen_uorb_BatteryInfo;
 
 /* PX4's struct is 48 bytes; this one is for values, not its wire layout. */

@@ -15,95 +15,91 @@ extern "C" {
 #define BATTGEN_UORB_BATTERYSTATUS_MESSAGE_VERSION 1u
 #define BATTGEN_UORB_BATTERYSTATUS_MAX_INSTANCES 3u
 #define BATTGEN_UORB_BATTERYSTATUS_SOURCE_POWER_MODULE                                             \
-  0u /* Power module (analog ADC or I2C power monitor) */
+  0u /* A power module: analog sense lines or an I2C monitor */
 #define BATTGEN_UORB_BATTERYSTATUS_SOURCE_EXTERNAL                                                 \
-  1u                                               /* External (MAVLink, CAN, or external driver) */
-#define BATTGEN_UORB_BATTERYSTATUS_SOURCE_ESCS 2u  /* ESCs (via ESC telemetry) */
-#define BATTGEN_UORB_BATTERYSTATUS_WARNING_NONE 0u /* No battery low voltage warning active */
-#define BATTGEN_UORB_BATTERYSTATUS_WARNING_LOW 1u  /* Low voltage warning */
-#define BATTGEN_UORB_BATTERYSTATUS_WARNING_CRITICAL                                                \
-  2u /* Critical voltage, return / abort immediately */
-#define BATTGEN_UORB_BATTERYSTATUS_WARNING_EMERGENCY 3u /* Immediate landing required */
-#define BATTGEN_UORB_BATTERYSTATUS_WARNING_FAILED 4u    /* Battery has failed completely */
+  1u /* Another system: MAVLink, CAN or an external driver */
+#define BATTGEN_UORB_BATTERYSTATUS_SOURCE_ESCS 2u       /* Summed ESC telemetry */
+#define BATTGEN_UORB_BATTERYSTATUS_WARNING_NONE 0u      /* Nothing to report */
+#define BATTGEN_UORB_BATTERYSTATUS_WARNING_LOW 1u       /* Low: warn the pilot */
+#define BATTGEN_UORB_BATTERYSTATUS_WARNING_CRITICAL 2u  /* Critical: return or abort now */
+#define BATTGEN_UORB_BATTERYSTATUS_WARNING_EMERGENCY 3u /* Emergency: land where you are */
+#define BATTGEN_UORB_BATTERYSTATUS_WARNING_FAILED 4u    /* The pack no longer works */
 #define BATTGEN_UORB_BATTERYSTATUS_STATE_UNHEALTHY                                                 \
-  6u /* Battery is diagnosed to be defective or an error occurred, usage is discouraged /          \
-        prohibited. Possible causes (faults) are listed in faults field */
-#define BATTGEN_UORB_BATTERYSTATUS_STATE_CHARGING 7u          /* Battery is charging */
-#define BATTGEN_UORB_BATTERYSTATUS_FAULT_DEEP_DISCHARGE 0u    /* Battery has deep discharged */
-#define BATTGEN_UORB_BATTERYSTATUS_FAULT_SPIKES 1u            /* Voltage spikes */
-#define BATTGEN_UORB_BATTERYSTATUS_FAULT_CELL_FAIL 2u         /* One or more cells have failed */
-#define BATTGEN_UORB_BATTERYSTATUS_FAULT_OVER_CURRENT 3u      /* Over-current */
-#define BATTGEN_UORB_BATTERYSTATUS_FAULT_OVER_TEMPERATURE 4u  /* Over-temperature */
-#define BATTGEN_UORB_BATTERYSTATUS_FAULT_UNDER_TEMPERATURE 5u /* Under-temperature fault */
+  6u /* Faulty or in error, do not use; the faults bitmask says why */
+#define BATTGEN_UORB_BATTERYSTATUS_STATE_CHARGING 7u          /* On charge */
+#define BATTGEN_UORB_BATTERYSTATUS_FAULT_DEEP_DISCHARGE 0u    /* Discharged too deep */
+#define BATTGEN_UORB_BATTERYSTATUS_FAULT_SPIKES 1u            /* Voltage spikes seen */
+#define BATTGEN_UORB_BATTERYSTATUS_FAULT_CELL_FAIL 2u         /* A cell has failed */
+#define BATTGEN_UORB_BATTERYSTATUS_FAULT_OVER_CURRENT 3u      /* Current too high */
+#define BATTGEN_UORB_BATTERYSTATUS_FAULT_OVER_TEMPERATURE 4u  /* Too hot */
+#define BATTGEN_UORB_BATTERYSTATUS_FAULT_UNDER_TEMPERATURE 5u /* Too cold */
 #define BATTGEN_UORB_BATTERYSTATUS_FAULT_INCOMPATIBLE_VOLTAGE                                      \
-  6u /* Vehicle voltage is not compatible with this battery (batteries on same power rail should   \
-        have similar voltage) */
+  6u /* Voltage does not match the other packs on the same rail */
 #define BATTGEN_UORB_BATTERYSTATUS_FAULT_INCOMPATIBLE_FIRMWARE                                     \
-  7u /* Battery firmware is not compatible with current autopilot firmware */
+  7u /* Pack firmware does not work with this autopilot firmware */
 #define BATTGEN_UORB_BATTERYSTATUS_FAULT_INCOMPATIBLE_MODEL                                        \
-  8u /* Battery model is not supported by the system */
-#define BATTGEN_UORB_BATTERYSTATUS_FAULT_HARDWARE_FAILURE 9u /* Hardware problem */
-#define BATTGEN_UORB_BATTERYSTATUS_FAULT_FAILED_TO_ARM 10u   /* Battery had a problem while arming \
-                                                              */
-#define BATTGEN_UORB_BATTERYSTATUS_FAULT_COUNT 11u /* Counter. Keep this as last element */
+  8u                                                         /* This pack model is not supported */
+#define BATTGEN_UORB_BATTERYSTATUS_FAULT_HARDWARE_FAILURE 9u /* Hardware fault in the pack */
+#define BATTGEN_UORB_BATTERYSTATUS_FAULT_FAILED_TO_ARM                                             \
+  10u                                              /* The pack reported a problem while arming */
+#define BATTGEN_UORB_BATTERYSTATUS_FAULT_COUNT 11u /* One past the last fault index */
 #define BATTGEN_UORB_BATTERYSTATUS_STRUCT_SIZE 168u
 /* the struct without its trailing padding, as a ULog record holds it */
 #define BATTGEN_UORB_BATTERYSTATUS_PACKED_SIZE 166u
 #define BATTGEN_UORB_BATTERYSTATUS_MAX_PROBLEMS 53u
 
-/** Battery status Battery status information for up to 3 battery instances. These are populated
- * from power module and smart battery device drivers, and one battery updated from MAVLink. Battery
- * instance information is also logged and streamed in MAVLink telemetry. */
+/** State of one battery as the autopilot sees it, one instance per pack (MAX_INSTANCES of them).
+ * Filled by analog or I2C power monitors, smart-battery drivers, ESC telemetry or a MAVLink source;
+ * the autopilot logs it and forwards it as MAVLink telemetry. */
 typedef struct {
-  uint64_t timestamp; /* [us] uint64 Time since system start */
-  bool connected;     /* Whether or not a battery is connected. For power modules this is based on a
-                         voltage threshold. */
-  float voltage_v;    /* [V] invalid: 0 float32 Battery voltage */
-  float current_a;    /* [A] invalid: -1 float32 Battery current */
-  float current_average_a; /* [A] invalid: -1 float32 Battery current average (for FW average in
-                              level flight) */
-  float discharged_mah;    /* [mAh] invalid: -1 float32 Discharged amount */
-  float remaining;         /* invalid: -1 float32 Remaining capacity */
-  float scale; /* [-] invalid: -1 float32 Scaling factor to compensate for lower actuation power
-                  caused by voltage sag */
-  float time_remaining_s; /* [s] invalid: NaN float32 Predicted time remaining until battery is
-                             empty under previous averaged load */
-  float temperature;      /* [degC] invalid: NaN float32 Temperature of the battery */
-  uint8_t cell_count;     /* [-] invalid: 0 uint8 Number of cells */
-  uint8_t source;         /* uint8 Battery source */
-  uint8_t priority;       /* [-] uint8 Zero based priority is the connection on the Power Controller
-                             V1..Vn AKA BrickN-1 */
-  uint16_t capacity;      /* [mAh] uint16 Capacity of the battery when fully charged */
-  uint16_t cycle_count;   /* [-] uint16 Number of discharge cycles the battery has experienced */
-  uint16_t average_time_to_empty; /* [minutes] uint16 Predicted remaining battery capacity based on
-                                     the average rate of discharge */
-  uint16_t manufacture_date; /* [-] uint16 Manufacture date, part of serial number of the battery
-                                pack. Formatted as: Day + Month×32 + (Year–1980)×512 */
-  uint16_t state_of_health;  /* [%] uint16 State of health. FullChargeCapacity/DesignCapacity */
-  uint16_t max_error; /* [%] uint16 Max error, expected margin of error in the state-of-charge
-                         calculation */
-  uint8_t id; /* [-] uint8 ID number of a battery. Should be unique and consistent for the lifetime
-                 of a vehicle. 1-indexed */
-  uint16_t interface_error;     /* [-] uint16 Interface error counter */
-  float voltage_cell_v[14];     /* [V] invalid: 0 Battery individual cell voltages */
-  float max_cell_voltage_delta; /* [V] float32 Max difference between individual cell voltages */
-  bool is_powering_off;         /* Power off event imminent indication, false if unknown */
-  bool is_required;             /* Set if the battery is explicitly required before arming */
-  uint8_t warning;              /* uint8 Current battery warning */
+  uint64_t timestamp; /* [us] uint64 When this sample was taken, on the autopilot's boot clock */
+  bool connected;  /* A pack is present (for an analog monitor: the voltage is above its detection
+                      threshold) */
+  float voltage_v; /* [V] invalid: 0 float32 Pack voltage */
+  float current_a; /* [A] invalid: -1 float32 Pack current, discharge positive */
+  float current_average_a; /* [A] invalid: -1 float32 Smoothed current (what a fixed-wing draws in
+                              level cruise) */
+  float discharged_mah;    /* [mAh] invalid: -1 float32 Charge drawn since the autopilot started */
+  float remaining;         /* invalid: -1 float32 Fraction of the charge left, 1 is full */
+  float scale; /* [-] invalid: -1 float32 Throttle gain that makes up for the thrust lost to voltage
+                  sag */
+  float time_remaining_s; /* [s] invalid: NaN float32 Estimated time until empty at the recent mean
+                             load */
+  float temperature;      /* [degC] invalid: NaN float32 Pack temperature */
+  uint8_t cell_count;     /* [-] invalid: 0 uint8 Cells in series */
+  uint8_t source;         /* uint8 Where the reading comes from */
+  uint8_t priority; /* [-] uint8 Which power input feeds from this pack, counted from 0 (input V1 is
+                       0) */
+  uint16_t capacity;              /* [mAh] uint16 Charge of the full pack */
+  uint16_t cycle_count;           /* [-] uint16 Discharge cycles so far */
+  uint16_t average_time_to_empty; /* [minutes] uint16 Time until empty at the mean discharge rate,
+                                     as the pack reports it */
   uint16_t
-      faults; /* uint16 Smart battery supply status/fault flags (bitmask) for health indication */
-  float full_charge_capacity_wh; /* [Wh] float32 Compensated battery capacity */
-  float
-      remaining_capacity_wh; /* [Wh] invalid: NaN float32 Compensated battery capacity remaining */
-  uint16_t over_discharge_count; /* [-] uint16 Number of battery overdischarge */
-  float nominal_voltage;         /* [V] invalid: NaN float32 Nominal voltage of the battery pack */
-  float internal_resistance_estimate; /* [Ohm] float32 Internal resistance per cell estimate */
-  float ocv_estimate;                 /* [V] float32 Open circuit voltage estimate */
-  float ocv_estimate_filtered;        /* [V] float32 Filtered open circuit voltage estimate */
-  float volt_based_soc_estimate;    /* [-] float32 Normalized volt based state of charge estimate */
-  float voltage_prediction;         /* [V] float32 Predicted voltage */
-  float prediction_error;           /* [V] float32 Prediction error */
-  float estimation_covariance_norm; /* [-] float32 Norm of the covariance matrix */
+      manufacture_date; /* [-] uint16 Date made, packed as day + 32 * month + 512 * (year - 1980) */
+  uint16_t state_of_health; /* [%] uint16 Full-charge capacity as a share of design capacity */
+  uint16_t max_error;       /* [%] uint16 How far off the pack's charge estimate may be */
+  uint8_t id; /* [-] uint8 The pack's number on this vehicle, from 1, the same for the vehicle's
+                 whole life */
+  uint16_t interface_error;     /* [-] uint16 Communication errors counted with the pack */
+  float voltage_cell_v[14];     /* [V] invalid: 0 Voltage of each cell */
+  float max_cell_voltage_delta; /* [V] float32 Spread between the highest and the lowest cell
+                                   voltage */
+  bool is_powering_off;         /* The pack is about to switch itself off (false when not known) */
+  bool is_required;             /* Arming waits for this pack */
+  uint8_t warning;              /* uint8 Warning level, or charging/unhealthy state */
+  uint16_t faults; /* uint16 Fault bitmask of a smart battery, one bit per FAULT_* index */
+  float full_charge_capacity_wh; /* [Wh] float32 Energy of the full pack, corrected for wear and
+                                    conditions */
+  float remaining_capacity_wh;   /* [Wh] invalid: NaN float32 Energy left, corrected the same way */
+  uint16_t over_discharge_count; /* [-] uint16 Times the pack was over-discharged */
+  float nominal_voltage;         /* [V] invalid: NaN float32 Rated pack voltage */
+  float internal_resistance_estimate; /* [Ohm] float32 Estimated resistance of one cell */
+  float ocv_estimate;                 /* [V] float32 Estimated open-circuit (no-load) voltage */
+  float ocv_estimate_filtered;        /* [V] float32 The open-circuit estimate after filtering */
+  float volt_based_soc_estimate;      /* [-] float32 Charge left as read from the voltage alone */
+  float voltage_prediction;           /* [V] float32 Voltage the estimator expected */
+  float prediction_error;             /* [V] float32 Measured minus expected voltage */
+  float estimation_covariance_norm;   /* [-] float32 Size (norm) of the estimator's covariance */
 } battgen_uorb_BatteryStatus;
 
 /* PX4's struct is 168 bytes; this one is for values, not its wire layout. */

@@ -147,11 +147,13 @@ _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC = _v.Optional(
             True,
             min_length=2,
             columns=(
+                _v.Number(type="uint32", kind="uint", label="temperature in degrees Celsius", low=0, high=4294967295),
                 _v.Number(
-                    type="uint32", kind="uint", label="the temperature in degree Celsius", low=0, high=4294967295
-                ),
-                _v.Number(
-                    type="uint32", kind="uint", label="battery internal resistance percent", low=0, high=4294967295
+                    type="uint32",
+                    kind="uint",
+                    label="internal resistance in percent of the factory value",
+                    low=0,
+                    high=4294967295,
                 ),
             ),
         ),
@@ -177,7 +179,7 @@ _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC = _v.Optional(
             _v.Number(
                 type="int32",
                 kind="int",
-                label="minimum temperature at which battery can operate",
+                label="lowest usable temperature",
                 low=-2147483648,
                 high=2147483647,
                 unit="degC",
@@ -185,7 +187,7 @@ _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC = _v.Optional(
             _v.Number(
                 type="int32",
                 kind="int",
-                label="maximum temperature at which battery can operate",
+                label="highest usable temperature",
                 low=-2147483648,
                 high=2147483647,
                 unit="degC",
@@ -204,7 +206,7 @@ _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC = _v.Optional(
             _v.Number(
                 type="int32",
                 kind="int",
-                label="alert when ambient temperature is lower than this value",
+                label="alert below this ambient temperature",
                 low=-2147483648,
                 high=2147483647,
                 unit="degC",
@@ -212,7 +214,7 @@ _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC = _v.Optional(
             _v.Number(
                 type="int32",
                 kind="int",
-                label="alert when ambient temperature is higher than this value",
+                label="alert above this ambient temperature",
                 low=-2147483648,
                 high=2147483647,
                 unit="degC",
@@ -231,7 +233,7 @@ _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC = _v.Optional(
             _v.Number(
                 type="int32",
                 kind="int",
-                label="alert when battery temperature is lower than this value",
+                label="alert below this battery temperature",
                 low=-2147483648,
                 high=2147483647,
                 unit="degC",
@@ -239,7 +241,7 @@ _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC = _v.Optional(
             _v.Number(
                 type="int32",
                 kind="int",
-                label="alert when battery temperature is higher than this value",
+                label="alert above this battery temperature",
                 low=-2147483648,
                 high=2147483647,
                 unit="degC",
@@ -284,10 +286,10 @@ _SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC = _v.Pattern(
             min_length=2,
             columns=(
                 _v.Number(
-                    type="uint32", kind="uint", label="open circuit voltage (OCV) in microvolts", low=0, high=4294967295
+                    type="uint32", kind="uint", label="open-circuit voltage in microvolts", low=0, high=4294967295
                 ),
                 _v.Number(
-                    type="uint32", kind="uint", label="battery capacity percent", low=0, high=4294967295, maximum=100
+                    type="uint32", kind="uint", label="state of charge in percent", low=0, high=4294967295, maximum=100
                 ),
             ),
         ),
@@ -380,24 +382,20 @@ _SIMPLE_BATTERY_FIELD_SPECS = (
 
 @_dataclasses.dataclass(slots=True)
 class SimpleBattery:
-    """The devicetree battery node provides static battery characteristics.
-    In smart batteries, these are typically stored in non-volatile memory
-    on a fuel gauge chip. The battery node should be used where there is
-    no appropriate non-volatile memory, or it is unprogrammed/incorrect.
+    """Fixed facts about a battery (design voltages, capacity, charging limits,
+    temperature limits, open-circuit-voltage tables) that a charger or fuel
+    gauge driver reads from the devicetree, for packs whose gauge does not
+    store them itself or stores them wrongly.
 
-    Upstream dts files should not include battery nodes, unless the battery
-    represented cannot easily be replaced in the system by one of a
-    different type. This prevents unpredictable, potentially harmful,
-    behavior should a replacement that changes the battery type occur
-    without a corresponding update to the dtb.
+    A board file describes a battery only when the battery cannot easily be
+    swapped for a different type; otherwise a replacement pack would be
+    driven with the wrong limits.
 
-    Battery properties are named, where possible, for the corresponding elements
-    in enum power_supply_property, defined in include/linux/power_supply.h
+    Property names follow the kernel's power-supply property names where one
+    exists. Chargers and fuel gauges point at the node with a
+    "monitored-battery" phandle.
 
-    Batteries must be referenced by chargers and/or fuel-gauges using a phandle.
-    The phandle's property should be named "monitored-battery".
-
-    Schema: devicetree.power.supply.battery (devicetree, power/supply/battery.yaml:4).
+    Schema: devicetree.power.supply.battery (devicetree, power/supply/battery.yaml:3).
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "devicetree.power.supply.battery"
@@ -406,10 +404,7 @@ class SimpleBattery:
         default_factory=list, metadata=_m.meta(name="compatible", type="string[]")
     )
     device_chemistry: str | None = _dataclasses.field(
-        default=None,
-        metadata=_m.meta(
-            name="device-chemistry", type="string", doc="This describes the chemical technology of the battery."
-        ),
+        default=None, metadata=_m.meta(name="device-chemistry", type="string", doc="Cell chemistry of the battery.")
     )
     over_voltage_threshold_microvolt: list[list[int]] | None = _dataclasses.field(
         default=None,
@@ -420,7 +415,7 @@ class SimpleBattery:
             quantity="voltage",
             scale=1e-06,
             offset=0.0,
-            doc="battery over-voltage limit",
+            doc="pack voltage above which the battery is over-voltage",
         ),
     )
     re_charge_voltage_microvolt: list[list[int]] | None = _dataclasses.field(
@@ -432,7 +427,7 @@ class SimpleBattery:
             quantity="voltage",
             scale=1e-06,
             offset=0.0,
-            doc="limit to automatically start charging again",
+            doc="threshold at which a charged battery starts charging again",
         ),
     )
     voltage_min_design_microvolt: list[list[int]] | None = _dataclasses.field(
@@ -444,7 +439,7 @@ class SimpleBattery:
             quantity="voltage",
             scale=1e-06,
             offset=0.0,
-            doc="drained battery voltage",
+            doc="pack voltage when empty, by design",
         ),
     )
     voltage_max_design_microvolt: list[list[int]] | None = _dataclasses.field(
@@ -456,7 +451,7 @@ class SimpleBattery:
             quantity="voltage",
             scale=1e-06,
             offset=0.0,
-            doc="fully charged battery voltage",
+            doc="pack voltage when full, by design",
         ),
     )
     energy_full_design_microwatt_hours: list[int] | None = _dataclasses.field(
@@ -468,7 +463,7 @@ class SimpleBattery:
             quantity="energy",
             scale=0.0036,
             offset=0.0,
-            doc="battery design energy",
+            doc="energy of a full pack, by design",
         ),
     )
     charge_full_design_microamp_hours: list[int] | None = _dataclasses.field(
@@ -480,7 +475,7 @@ class SimpleBattery:
             quantity="charge",
             scale=0.0036,
             offset=0.0,
-            doc="battery design capacity",
+            doc="charge of a full pack, by design (the capacity)",
         ),
     )
     trickle_charge_current_microamp: list[int] | None = _dataclasses.field(
@@ -492,10 +487,9 @@ class SimpleBattery:
             quantity="current",
             scale=1e-06,
             offset=0.0,
-            doc="current for trickle-charge phase. Please note that the trickle-charging here, "
-            'refers "wake-up" or "pre-pre" -charging, for very empty batteries. Similar term '
-            'is also used for "maintenance" or "top-off" -charging of batteries (like NiMh '
-            "bq24400) - that is different and not controlled by this property.",
+            doc="current of the trickle (wake-up) phase that revives a deeply discharged pack "
+            "before pre-charge; not the maintenance top-off charge some chargers apply to a "
+            "full pack",
         ),
     )
     tricklecharge_upper_limit_microvolt: list[list[int]] | None = _dataclasses.field(
@@ -507,8 +501,7 @@ class SimpleBattery:
             quantity="voltage",
             scale=1e-06,
             offset=0.0,
-            doc="limit when to change to precharge from trickle charge Trickle-charging here "
-            'refers "wake-up" or "pre-pre" -charging.',
+            doc="voltage at which the trickle (wake-up) phase hands over to pre-charge",
         ),
     )
     precharge_current_microamp: list[int] | None = _dataclasses.field(
@@ -520,7 +513,7 @@ class SimpleBattery:
             quantity="current",
             scale=1e-06,
             offset=0.0,
-            doc="current for pre-charge phase",
+            doc="current of the pre-charge phase",
         ),
     )
     precharge_upper_limit_microvolt: list[list[int]] | None = _dataclasses.field(
@@ -532,7 +525,7 @@ class SimpleBattery:
             quantity="voltage",
             scale=1e-06,
             offset=0.0,
-            doc="limit when to change to constant charging",
+            doc="voltage at which pre-charge hands over to constant-current charging",
         ),
     )
     charge_term_current_microamp: list[int] | None = _dataclasses.field(
@@ -544,7 +537,7 @@ class SimpleBattery:
             quantity="current",
             scale=1e-06,
             offset=0.0,
-            doc="current for charge termination phase",
+            doc="current below which charging ends",
         ),
     )
     constant_charge_current_max_microamp: list[int] | None = _dataclasses.field(
@@ -556,7 +549,7 @@ class SimpleBattery:
             quantity="current",
             scale=1e-06,
             offset=0.0,
-            doc="maximum constant input current",
+            doc="highest current of the constant-current phase",
         ),
     )
     constant_charge_voltage_max_microvolt: list[list[int]] | None = _dataclasses.field(
@@ -568,7 +561,7 @@ class SimpleBattery:
             quantity="voltage",
             scale=1e-06,
             offset=0.0,
-            doc="maximum constant input voltage",
+            doc="highest voltage of the constant-voltage phase",
         ),
     )
     factory_internal_resistance_micro_ohms: list[int] | None = _dataclasses.field(
@@ -580,7 +573,7 @@ class SimpleBattery:
             quantity="resistance",
             scale=1e-06,
             offset=0.0,
-            doc="battery factory internal resistance",
+            doc="internal resistance of a new pack",
         ),
     )
     resistance_temp_table: list[list[int]] | None = _dataclasses.field(
@@ -588,10 +581,9 @@ class SimpleBattery:
         metadata=_m.meta(
             name="resistance-temp-table",
             type="uint32[2][]",
-            doc="A table providing the temperature in degree Celsius\n"
-            "and corresponding battery internal resistance percent, which is used to\n"
-            "look up the resistance percent according to current temperature to get an\n"
-            "accurate batterty internal resistance in different temperatures.",
+            doc="Rows of (temperature, resistance percent): how the internal\n"
+            "resistance changes with temperature, relative to\n"
+            "factory-internal-resistance-micro-ohms.",
         ),
     )
     ocv_capacity_celsius: list[int] | None = _dataclasses.field(
@@ -603,8 +595,8 @@ class SimpleBattery:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="An array containing the temperature in degree Celsius,\n"
-            "for each of the battery capacity lookup table.",
+            doc="The temperature, in degrees Celsius, of each ocv-capacity-table-N\n"
+            "(the Nth entry belongs to table N).",
         ),
     )
     operating_range_celsius: list[int] | None = _dataclasses.field(
@@ -616,7 +608,7 @@ class SimpleBattery:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="operating temperature range of a battery",
+            doc="temperatures the battery may be used at",
         ),
     )
     ambient_celsius: list[int] | None = _dataclasses.field(
@@ -628,7 +620,7 @@ class SimpleBattery:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="safe range of ambient temperature",
+            doc="ambient temperatures outside which to raise an alert",
         ),
     )
     alert_celsius: list[int] | None = _dataclasses.field(
@@ -640,7 +632,7 @@ class SimpleBattery:
             quantity="temperature",
             scale=1.0,
             offset=273.15,
-            doc="safe range of battery temperature",
+            doc="battery temperatures outside which to raise an alert",
         ),
     )
     volt_drop_thresh_microvolt: list[list[int]] | None = _dataclasses.field(
@@ -654,7 +646,7 @@ class SimpleBattery:
             offset=0.0,
             minimum=None,
             maximum=48000000,
-            doc="Threshold for starting the VDR correction",
+            doc="voltage drop above which the correction starts",
         ),
     )
     volt_drop_soc_bp: list[int] | None = _dataclasses.field(
@@ -666,8 +658,7 @@ class SimpleBattery:
             quantity="ratio",
             scale=0.0001,
             offset=0.0,
-            doc="Table of capacity values matching the values in VDR tables. The value should be "
-            "given as basis points, 1/100 of a percent.",
+            doc="State-of-charge points of the volt-drop-N tables, in basis points (hundredths of a percent).",
         ),
     )
     volt_drop_temperatures_millicelsius: list[int] | None = _dataclasses.field(
@@ -679,7 +670,7 @@ class SimpleBattery:
             quantity="temperature",
             scale=0.001,
             offset=273.15,
-            doc="An array containing the temperature in milli celsius, for each of the VDR lookup table.",
+            doc="The temperature, in thousandths of a degree Celsius, of each volt-drop-N table.",
         ),
     )
     ocv_capacity_table_n: dict[str, list[list[int]]] = _dataclasses.field(
@@ -688,10 +679,9 @@ class SimpleBattery:
             name="^ocv-capacity-table-[0-9]+$",
             type="uint32[2][<=100]",
             pattern="^ocv-capacity-table-[0-9]+$",
-            doc="An array providing the open circuit voltage (OCV)\n"
-            "of the battery and corresponding battery capacity percent, which is used\n"
-            "to look up battery capacity according to current OCV value. And the open\n"
-            "circuit voltage unit is microvolt.",
+            doc="Rows of (open-circuit voltage, charge percent) at the temperature\n"
+            "ocv-capacity-celsius gives for this table: reading the resting\n"
+            "voltage against it gives the state of charge.",
         ),
     )
     volt_drop_n_microvolt: dict[str, list[list[int]]] = _dataclasses.field(
@@ -704,11 +694,8 @@ class SimpleBattery:
             scale=1e-06,
             offset=0.0,
             pattern="^volt-drop-[0-9]-microvolt",
-            doc="Table of the voltage drop rate (VDR) values. Each entry in the table should "
-            "match a capacity value in the volt-drop-soc table. Furthermore, the values "
-            "should be obtained for the temperature given in "
-            "volt-drop-temperatures-millicelsius table at index matching the number in this "
-            "table's name.",
+            doc="Voltage-drop rates, one per state-of-charge point of volt-drop-soc-bp, measured "
+            "at the temperature the Nth entry of volt-drop-temperatures-millicelsius gives.",
         ),
     )
 
@@ -1009,10 +996,10 @@ class SimpleBattery:
         v_i: _Any
         v_table: _Any
         try:
-            # compatible (battery.yaml:31): fits string[]
+            # compatible (battery.yaml:33): fits string[]
             if (x := self.compatible) is None or (len(x) < 1 or any(_x0 != "simple-battery" for _x0 in x)):
                 _v.diag(out, "compatible", self.compatible, _SIMPLE_BATTERY_COMPATIBLE_SPEC)
-            # device-chemistry (battery.yaml:34): fits string; one of nickel-cadmium, nickel-metal-hydride, lithium-ion,
+            # device-chemistry (battery.yaml:36): fits string; one of nickel-cadmium, nickel-metal-hydride, lithium-ion,
             # lithium-ion-polymer, lithium-ion-iron-phosphate, lithium-ion-manganese-oxide
             if (x := self.device_chemistry) is not None and (
                 x
@@ -1126,7 +1113,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_TRICKLE_CHARGE_CURRENT_MICROAMP_SPEC,
                             )
                             break
-            # tricklecharge-upper-limit-microvolt (battery.yaml:74): fits int32[][]
+            # tricklecharge-upper-limit-microvolt (battery.yaml:71): fits int32[][]
             if (x := self.tricklecharge_upper_limit_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -1136,7 +1123,7 @@ class SimpleBattery:
                     self.tricklecharge_upper_limit_microvolt,
                     _SIMPLE_BATTERY_TRICKLECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
                 )
-            # precharge-current-microamp (battery.yaml:78): fits uint32[]
+            # precharge-current-microamp (battery.yaml:75): fits uint32[]
             a = self.precharge_current_microamp
             if a is not None:
                 if len(a) < 1:
@@ -1156,7 +1143,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_PRECHARGE_CURRENT_MICROAMP_SPEC,
                             )
                             break
-            # precharge-upper-limit-microvolt (battery.yaml:81): fits int32[][]
+            # precharge-upper-limit-microvolt (battery.yaml:78): fits int32[][]
             if (x := self.precharge_upper_limit_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -1166,7 +1153,7 @@ class SimpleBattery:
                     self.precharge_upper_limit_microvolt,
                     _SIMPLE_BATTERY_PRECHARGE_UPPER_LIMIT_MICROVOLT_SPEC,
                 )
-            # charge-term-current-microamp (battery.yaml:84): fits uint32[]
+            # charge-term-current-microamp (battery.yaml:82): fits uint32[]
             a = self.charge_term_current_microamp
             if a is not None:
                 if len(a) < 1:
@@ -1186,7 +1173,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_CHARGE_TERM_CURRENT_MICROAMP_SPEC,
                             )
                             break
-            # constant-charge-current-max-microamp (battery.yaml:87): fits uint32[]
+            # constant-charge-current-max-microamp (battery.yaml:85): fits uint32[]
             a = self.constant_charge_current_max_microamp
             if a is not None:
                 if len(a) < 1:
@@ -1206,7 +1193,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_CONSTANT_CHARGE_CURRENT_MAX_MICROAMP_SPEC,
                             )
                             break
-            # constant-charge-voltage-max-microvolt (battery.yaml:90): fits int32[][]
+            # constant-charge-voltage-max-microvolt (battery.yaml:88): fits int32[][]
             if (x := self.constant_charge_voltage_max_microvolt) is not None and (
                 len(x) < 1 or any(len(_x0) < 1 or any((_x1 + 2147483648) & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
@@ -1216,7 +1203,7 @@ class SimpleBattery:
                     self.constant_charge_voltage_max_microvolt,
                     _SIMPLE_BATTERY_CONSTANT_CHARGE_VOLTAGE_MAX_MICROVOLT_SPEC,
                 )
-            # factory-internal-resistance-micro-ohms (battery.yaml:93): fits uint32[]
+            # factory-internal-resistance-micro-ohms (battery.yaml:91): fits uint32[]
             a = self.factory_internal_resistance_micro_ohms
             if a is not None:
                 if len(a) < 1:
@@ -1236,14 +1223,14 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_FACTORY_INTERNAL_RESISTANCE_MICRO_OHMS_SPEC,
                             )
                             break
-            # resistance-temp-table (battery.yaml:96): fits uint32[2][]
+            # resistance-temp-table (battery.yaml:94): fits uint32[2][]
             if (x := self.resistance_temp_table) is not None and (
                 len(x) < 1 or any(len(_x0) != 2 or any(_x1 & -4294967296 for _x1 in _x0) for _x0 in x)
             ):
                 _v.diag(
                     out, "resistance-temp-table", self.resistance_temp_table, _SIMPLE_BATTERY_RESISTANCE_TEMP_TABLE_SPEC
                 )
-            # ocv-capacity-celsius (battery.yaml:108): fits int32[]
+            # ocv-capacity-celsius (battery.yaml:105): fits int32[]
             a = self.ocv_capacity_celsius
             if a is not None:
                 if len(a) < 1:
@@ -1263,7 +1250,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_OCV_CAPACITY_CELSIUS_SPEC,
                             )
                             break
-            # operating-range-celsius (battery.yaml:113): fits int32[2]
+            # operating-range-celsius (battery.yaml:110): fits int32[2]
             a = self.operating_range_celsius
             if a is not None:
                 if len(a) != 2:
@@ -1283,7 +1270,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_OPERATING_RANGE_CELSIUS_SPEC,
                             )
                             break
-            # ambient-celsius (battery.yaml:119): fits int32[2]
+            # ambient-celsius (battery.yaml:116): fits int32[2]
             a = self.ambient_celsius
             if a is not None:
                 if len(a) != 2:
@@ -1293,7 +1280,7 @@ class SimpleBattery:
                         if (e + 2147483648) & -4294967296:
                             _v.diag(out, "ambient-celsius", self.ambient_celsius, _SIMPLE_BATTERY_AMBIENT_CELSIUS_SPEC)
                             break
-            # alert-celsius (battery.yaml:125): fits int32[2]
+            # alert-celsius (battery.yaml:122): fits int32[2]
             a = self.alert_celsius
             if a is not None:
                 if len(a) != 2:
@@ -1303,7 +1290,7 @@ class SimpleBattery:
                         if (e + 2147483648) & -4294967296:
                             _v.diag(out, "alert-celsius", self.alert_celsius, _SIMPLE_BATTERY_ALERT_CELSIUS_SPEC)
                             break
-            # volt-drop-thresh-microvolt (battery.yaml:134): fits int32[1][1]; value <= 48000000
+            # volt-drop-thresh-microvolt (battery.yaml:130): fits int32[1][1]; value <= 48000000
             if (x := self.volt_drop_thresh_microvolt) is not None and (
                 len(x) != 1
                 or any(
@@ -1318,7 +1305,7 @@ class SimpleBattery:
                     self.volt_drop_thresh_microvolt,
                     _SIMPLE_BATTERY_VOLT_DROP_THRESH_MICROVOLT_SPEC,
                 )
-            # volt-drop-soc-bp (battery.yaml:138): fits int32[]
+            # volt-drop-soc-bp (battery.yaml:134): fits int32[]
             a = self.volt_drop_soc_bp
             if a is not None:
                 if len(a) < 1:
@@ -1330,7 +1317,7 @@ class SimpleBattery:
                                 out, "volt-drop-soc-bp", self.volt_drop_soc_bp, _SIMPLE_BATTERY_VOLT_DROP_SOC_BP_SPEC
                             )
                             break
-            # volt-drop-temperatures-millicelsius (battery.yaml:142): fits int32[]
+            # volt-drop-temperatures-millicelsius (battery.yaml:138): fits int32[]
             a = self.volt_drop_temperatures_millicelsius
             if a is not None:
                 if len(a) < 1:
@@ -1350,7 +1337,7 @@ class SimpleBattery:
                                 _SIMPLE_BATTERY_VOLT_DROP_TEMPERATURES_MILLICELSIUS_SPEC,
                             )
                             break
-            # ^ocv-capacity-table-[0-9]+$ (battery.yaml:150): fits uint32[2][<=100]
+            # ^ocv-capacity-table-[0-9]+$ (battery.yaml:146): fits uint32[2][<=100]
             if any(
                 not _v.search("^ocv-capacity-table-[0-9]+$", k)
                 or (
@@ -1371,7 +1358,7 @@ class SimpleBattery:
                     self.ocv_capacity_table_n,
                     _SIMPLE_BATTERY_OCV_CAPACITY_TABLE_N_SPEC,
                 )
-            # ^volt-drop-[0-9]-microvolt (battery.yaml:164): fits int32[][]
+            # ^volt-drop-[0-9]-microvolt (battery.yaml:159): fits int32[][]
             if any(
                 not _v.search("^volt-drop-[0-9]-microvolt", k)
                 or (

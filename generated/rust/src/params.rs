@@ -50,7 +50,7 @@ pub fn find(table: &'static [Param], name: &str) -> Option<&'static Param> {
 
 /// Battery monitor: capacity, the two-stage (LOW, CRITICAL) failsafe thresholds and their actions, and arming limits. A threshold of 0 is disabled.
 ///
-/// Schema: `params.BATT` (battery_failsafe.pdef.xml:11).
+/// Schema: `params.BATT` (battery_failsafe.pdef.xml:13).
 pub const BATT: &[Param] = &[
     Param {
         name: "BATT_CAPACITY",

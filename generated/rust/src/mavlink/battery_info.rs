@@ -5,88 +5,88 @@ use crate::problems::{Problems, Rule, Validate};
 use crate::same::Same;
 use crate::wire;
 
-/// Battery information that is static, or requires infrequent update. This message should requested using MAV_CMD_REQUEST_MESSAGE and/or streamed at very low rate. BATTERY_STATUS_V2 is used for higher-rate battery status information. \[work in progress\]
+/// What does not change about a battery, or seldom: design limits, identity, wear. Request it with MAV_CMD_REQUEST_MESSAGE or stream it slowly; BATTERY_STATUS_V2 carries the fast-changing values. \[work in progress\]
 ///
-/// Schema: `mavlink.BATTERY_INFO` (battery.xml:259).
+/// Schema: `mavlink.BATTERY_INFO` (battery.xml:211).
 #[derive(Clone, Copy, Debug)]
 pub struct BatteryInfo {
-    /// Battery ID
+    /// Which battery (instance) this is.
     ///
     /// Wire type: `uint8`.
     pub id: u8,
-    /// Function of the battery.
+    /// What the battery powers.
     ///
     /// Values: `mavlink.MAV_BATTERY_FUNCTION`. Wire type: `uint8`.
     pub battery_function: u8,
-    /// Type (chemistry) of the battery.
+    /// Cell chemistry.
     ///
     /// Values: `mavlink.MAV_BATTERY_TYPE`. Wire type: `uint8`.
     pub type_: u8,
-    /// State of Health (SOH) estimate. Typically 100% at the time of manufacture and will decrease over time and use. -1: field not provided.
+    /// Health: about 100 when new, falling with age and use; UINT8_MAX when not given.
     ///
     /// Unit: `%`. Unknown: `UINT8_MAX` (the accessor gives `None`). Wire type: `uint8`.
     pub state_of_health: u8,
-    /// Number of battery cells in series. 0: field not provided.
+    /// Cells in series; 0 when not given.
     ///
     /// Unknown: `0` (the accessor gives `None`). Wire type: `uint8`.
     pub cells_in_series: u8,
-    /// Lifetime count of the number of charge/discharge cycles (<https://en.wikipedia.org/wiki/Charge_cycle>). UINT16_MAX: field not provided.
+    /// Full charge/discharge cycles over the pack's life; UINT16_MAX when not given.
     ///
     /// Unknown: `UINT16_MAX` (the accessor gives `None`). Wire type: `uint16`.
     pub cycle_count: u16,
-    /// Battery weight. 0: field not provided.
+    /// Mass of the pack; 0 when not given.
     ///
     /// Unit: `g`. Unknown: `0` (the accessor gives `None`). Wire type: `uint16`.
     pub weight: u16,
-    /// Minimum per-cell voltage when discharging. 0: field not provided.
+    /// Lowest cell voltage allowed while discharging; 0 when not given.
     ///
     /// Unit: `V`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub discharge_minimum_voltage: f32,
-    /// Minimum per-cell voltage when charging. 0: field not provided.
+    /// Lowest cell voltage allowed while charging; 0 when not given.
     ///
     /// Unit: `V`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub charging_minimum_voltage: f32,
-    /// Minimum per-cell voltage when resting. 0: field not provided.
+    /// Lowest cell voltage allowed at rest; 0 when not given.
     ///
     /// Unit: `V`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub resting_minimum_voltage: f32,
-    /// Maximum per-cell voltage when charged. 0: field not provided.
+    /// Cell voltage of a full cell; 0 when not given.
     ///
     /// Unit: `V`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub charging_maximum_voltage: f32,
-    /// Maximum pack continuous charge current. 0: field not provided.
+    /// Highest continuous charge current of the pack; 0 when not given.
     ///
     /// Unit: `A`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub charging_maximum_current: f32,
-    /// Battery nominal voltage. Used for conversion between Wh and Ah. 0: field not provided.
+    /// Rated pack voltage, which converts between Wh and Ah; 0 when not given.
     ///
     /// Unit: `V`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub nominal_voltage: f32,
-    /// Maximum pack discharge current. 0: field not provided.
+    /// Highest continuous discharge current of the pack; 0 when not given.
     ///
     /// Unit: `A`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub discharge_maximum_current: f32,
-    /// Maximum pack discharge burst current. 0: field not provided.
+    /// Highest short-burst discharge current of the pack; 0 when not given.
     ///
     /// Unit: `A`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub discharge_maximum_burst_current: f32,
-    /// Fully charged design capacity. 0: field not provided.
+    /// Charge of a full pack by design; 0 when not given.
     ///
     /// Unit: `Ah`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub design_capacity: f32,
-    /// Predicted battery capacity when fully charged (accounting for battery degradation). NAN: field not provided.
+    /// Charge of the pack when full now, wear counted; NaN when not given.
     ///
     /// Unit: `Ah`. Unknown: `NaN` (the accessor gives `None`). Wire type: `float32`.
     pub full_charge_capacity: f32,
-    /// Manufacture date (DDMMYYYY) in ASCII characters, 0 terminated. All 0: field not provided.
+    /// Date made, DDMMYYYY as ASCII text ending in a zero byte; all zero when not given.
     ///
     /// Unknown: `[0]` (the accessor gives `None`).
     pub manufacture_date: [u8; 9],
-    /// Serial number in ASCII characters, 0 terminated. All 0: field not provided.
+    /// Serial number as ASCII text ending in a zero byte; all zero when not given.
     ///
     /// Unknown: `[0]` (the accessor gives `None`).
     pub serial_number: [u8; 32],
-    /// Battery device name. Formatted as manufacturer name then product name, separated with an underscore (in ASCII characters), 0 terminated. All 0: field not provided.
+    /// Maker and product names joined by an underscore, as ASCII text ending in a zero byte; all zero when not given.
     ///
     /// Unknown: `[0]` (the accessor gives `None`).
     pub name: [u8; 50],

@@ -5,64 +5,64 @@ use crate::problems::{Problems, Rule, Validate};
 use crate::same::Same;
 use crate::wire;
 
-/// Battery information. Updates GCS with flight controller battery status. Smart batteries also use this message, but may additionally send BATTERY_INFO.
+/// A battery as the flight controller monitors it: cell voltages, current, charge and energy used, charge left. Smart batteries send it too, and may add BATTERY_INFO.
 ///
-/// Schema: `mavlink.BATTERY_STATUS` (battery.xml:225).
+/// Schema: `mavlink.BATTERY_STATUS` (battery.xml:182).
 #[derive(Clone, Copy, Debug)]
 pub struct BatteryStatus {
-    /// Battery ID
+    /// Which battery (instance) this is.
     ///
     /// Wire type: `uint8`.
     pub id: u8,
-    /// Function of the battery
+    /// What the battery powers.
     ///
     /// Values: `mavlink.MAV_BATTERY_FUNCTION`. Wire type: `uint8`.
     pub battery_function: u8,
-    /// Type (chemistry) of the battery
+    /// Cell chemistry.
     ///
     /// Values: `mavlink.MAV_BATTERY_TYPE`. Wire type: `uint8`.
     pub type_: u8,
-    /// Temperature of the battery. INT16_MAX for unknown temperature.
+    /// Pack temperature; INT16_MAX when not measured.
     ///
     /// Unit: `cdegC`. Unknown: `INT16_MAX` (the accessor gives `None`). Wire type: `int16`.
     pub temperature: i16,
-    /// Battery voltage of cells 1 to 10 (see voltages_ext for cells 11-14). Cells in this field above the valid cell count for this battery should have the UINT16_MAX value. If individual cell voltages are unknown or not measured for this battery, then the overall battery voltage should be filled in cell 0, with all others set to UINT16_MAX. If the voltage of the battery is greater than (UINT16_MAX - 1), then cell 0 should be set to (UINT16_MAX - 1), and cell 1 to the remaining voltage. This can be extended to multiple cells if the total voltage is greater than 2 \* (UINT16_MAX - 1).
+    /// Voltage of cells 1 to 10 (cells 11 to 14 are in voltages_ext); UINT16_MAX past the last cell. A monitor that sees only the pack puts the pack voltage in the first element and UINT16_MAX in the rest; a pack voltage above UINT16_MAX - 1 mV spills over into the next elements, each holding at most UINT16_MAX - 1.
     ///
     /// Unit: `mV`. Unknown: `[UINT16_MAX]` (the accessor gives `None`). Wire type: `uint16`.
     pub voltages: [u16; 10],
-    /// Battery current, -1: autopilot does not measure the current. Value may overflow/rollover for very high currents (\> 327.67A)
+    /// Pack current; -1 when the autopilot does not measure it. Wraps above 327.67 A.
     ///
     /// Unit: `cA`. Unknown: `-1` (the accessor gives `None`). Wire type: `int16`.
     pub current_battery: i16,
-    /// Consumed charge, -1: autopilot does not provide consumption estimate
+    /// Charge drawn; -1 when the autopilot does not count it.
     ///
     /// Unit: `mAh`. Unknown: `-1` (the accessor gives `None`). Wire type: `int32`.
     pub current_consumed: i32,
-    /// Consumed energy, -1: autopilot does not provide energy consumption estimate
+    /// Energy drawn; -1 when the autopilot does not count it.
     ///
     /// Unit: `hJ`. Unknown: `-1` (the accessor gives `None`). Wire type: `int32`.
     pub energy_consumed: i32,
-    /// Remaining battery energy. Values: \[0-100\], -1: autopilot does not estimate the remaining battery.
+    /// Energy left, 0 to 100; -1 when the autopilot does not estimate it.
     ///
     /// Unit: `%`. Unknown: `-1` (the accessor gives `None`). Wire type: `int8`.
     pub battery_remaining: i8,
-    /// Remaining battery time, 0: autopilot does not provide remaining battery time estimate
+    /// Time until empty; 0 when the autopilot does not estimate it.
     ///
     /// Unit: `s`. Unknown: `0` (the accessor gives `None`). Wire type: `int32` (MAVLink 2 extension).
     pub time_remaining: i32,
-    /// State for extent of discharge, provided by autopilot for warning or external reactions
+    /// How far the pack is discharged, for warnings and reactions of other systems.
     ///
     /// Values: `mavlink.MAV_BATTERY_CHARGE_STATE`. Wire type: `uint8` (MAVLink 2 extension).
     pub charge_state: u8,
-    /// Battery voltages for cells 11 to 14. Cells above the valid cell count for this battery should have a value of 0, where zero indicates not supported (note, this is different than for the voltages field and allows empty byte truncation). If the measured value is 0 then 1 should be sent instead.
+    /// Voltage of cells 11 to 14. Unlike voltages, an unused or unsupported cell is 0 (so the trailing bytes can be trimmed off the wire); a cell that really reads 0 mV is sent as 1.
     ///
     /// Unit: `mV`. Unknown: `[0]` (the accessor gives `None`). Wire type: `uint16` (MAVLink 2 extension).
     pub voltages_ext: [u16; 4],
-    /// Battery mode. Default (0) is that battery mode reporting is not supported or battery is in normal-use mode.
+    /// Smart-battery mode; 0 in normal use or when the battery has no modes.
     ///
     /// Values: `mavlink.MAV_BATTERY_MODE`. Wire type: `uint8` (MAVLink 2 extension).
     pub mode: u8,
-    /// Fault/health indications. These should be set when charge_state is MAV_BATTERY_CHARGE_STATE_FAILED or MAV_BATTERY_CHARGE_STATE_UNHEALTHY (if not, fault reporting is not supported).
+    /// Fault bits, meaningful when charge_state is FAILED or UNHEALTHY (else the sender does not report faults).
     ///
     /// Values: `mavlink.MAV_BATTERY_FAULT`. Wire type: `uint32` (MAVLink 2 extension).
     pub fault_bitmask: u32,

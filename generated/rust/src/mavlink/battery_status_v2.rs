@@ -5,40 +5,40 @@ use crate::problems::{Problems, Rule, Validate};
 use crate::same::Same;
 use crate::wire;
 
-/// Battery dynamic information. This should be streamed (nominally at 1Hz). Static/invariant battery information is sent in BATTERY_INFO. Note that smart batteries should set the MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL bit to indicate that supplied capacity values are relative to a battery that is known to be full. Power monitors would not set this bit, indicating that capacity_consumed is relative to drone power-on, and that other values are estimated based on the assumption that the battery was full on power-on.
+/// What changes about a battery, sent about once a second; what does not is in BATTERY_INFO. A smart battery that knows when it is full sets MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL; a power monitor leaves it clear, and its figures then count from power-on and assume a full pack at that moment.
 ///
-/// Schema: `mavlink.BATTERY_STATUS_V2` (battery.xml:243).
+/// Schema: `mavlink.BATTERY_STATUS_V2` (battery.xml:200).
 #[derive(Clone, Copy, Debug)]
 pub struct BatteryStatusV2 {
-    /// Battery ID
+    /// Which battery (instance) this is.
     ///
     /// Wire type: `uint8`.
     pub id: u8,
-    /// Temperature of the whole battery pack (not internal electronics). INT16_MAX field not provided.
+    /// Temperature of the pack as a whole (not of its electronics); INT16_MAX when not given.
     ///
     /// Unit: `cdegC`. Unknown: `INT16_MAX` (the accessor gives `None`). Wire type: `int16`.
     pub temperature: i16,
-    /// Battery voltage (total). NaN: field not provided.
+    /// Pack voltage; NaN when not given.
     ///
     /// Unit: `V`. Unknown: `NaN` (the accessor gives `None`). Wire type: `float32`.
     pub voltage: f32,
-    /// Battery current (through all cells/loads). Positive value when discharging and negative if charging. NaN: field not provided.
+    /// Current through the pack: positive discharging, negative charging; NaN when not given.
     ///
     /// Unit: `A`. Unknown: `NaN` (the accessor gives `None`). Wire type: `float32`.
     pub current: f32,
-    /// Consumed charge. NaN: field not provided. This is either the consumption since power-on or since the battery was full, depending on the value of MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL.
+    /// Charge drawn, since power-on or since full as MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL says; NaN when not given.
     ///
     /// Unit: `Ah`. Unknown: `NaN` (the accessor gives `None`). Wire type: `float32`.
     pub capacity_consumed: f32,
-    /// Remaining charge (until empty). NaN: field not provided. Note: If MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL is unset, this value is based on the assumption the battery was full when the system was powered.
+    /// Charge left until empty; NaN when not given. Without MAV_BATTERY_STATUS_FLAGS_CAPACITY_RELATIVE_TO_FULL it assumes the pack was full at power-on.
     ///
     /// Unit: `Ah`. Unknown: `NaN` (the accessor gives `None`). Wire type: `float32`.
     pub capacity_remaining: f32,
-    /// State of Charge (SoC). Remaining capacity relative to current fully-charged capacity as a percentage. Values: \[0-100\], NaN: field not provided. Note that the value may be calculated from design_capacity if current full_charge_capacity is not known (see BATTERY_INFO).
+    /// Charge left as a share of the full-charge capacity, 0 to 100 (of the design capacity when the full-charge capacity is not known); NaN when not given.
     ///
     /// Unit: `%`. Unknown: `NaN` (the accessor gives `None`). Wire type: `float32`.
     pub state_of_charge: f32,
-    /// Fault, health, readiness, and other status indications.
+    /// Fault, health, readiness and other state bits.
     ///
     /// Values: `mavlink.MAV_BATTERY_STATUS_FLAGS`. Wire type: `uint32`.
     pub status_flags: u32,

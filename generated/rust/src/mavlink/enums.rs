@@ -88,27 +88,27 @@ impl MavAutopilot {
     }
 }
 
-/// Enumeration for battery charge states.
+/// How far a battery is discharged, as the autopilot rates it for warnings and failsafes.
 ///
 /// Schema: `mavlink.MAV_BATTERY_CHARGE_STATE` (value).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum MavBatteryChargeState {
-    /// Low battery state is not provided
+    /// The sender does not rate the charge.
     Undefined = 0,
-    /// Battery is not in low state. Normal operation.
+    /// Enough charge: normal flight.
     Ok = 1,
-    /// Battery state is low, warn and monitor close.
+    /// Low: warn, and watch the battery.
     Low = 2,
-    /// Battery state is critical, return or abort immediately.
+    /// Critical: return or abort now.
     Critical = 3,
-    /// Battery state is too low for ordinary abort sequence. Perform fastest possible emergency stop to prevent damage.
+    /// Too low even for a normal abort: stop as fast as possible to limit damage.
     Emergency = 4,
-    /// Battery failed, damage unavoidable. Possible causes (faults) are listed in MAV_BATTERY_FAULT.
+    /// The battery has failed and damage cannot be avoided; fault_bitmask says why.
     Failed = 5,
-    /// Battery is diagnosed to be defective or an error occurred, usage is discouraged / prohibited. Possible causes (faults) are listed in MAV_BATTERY_FAULT.
+    /// Found defective or in error: do not use; fault_bitmask says why.
     Unhealthy = 6,
-    /// Battery is charging.
+    /// On charge.
     Charging = 7,
 }
 
@@ -136,30 +136,30 @@ impl MavBatteryChargeState {
     }
 }
 
-/// Smart battery supply status/fault flags (bitmask) for health indication. The battery must also report either MAV_BATTERY_CHARGE_STATE_FAILED or MAV_BATTERY_CHARGE_STATE_UNHEALTHY if any of these are set.
+/// Fault bits of a smart battery. Any bit set comes with charge_state FAILED or UNHEALTHY.
 ///
 /// Schema: `mavlink.MAV_BATTERY_FAULT` (bitmask).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct MavBatteryFault(pub u16);
 
 impl MavBatteryFault {
-    /// Battery has deep discharged.
+    /// Discharged too deep.
     pub const DEEP_DISCHARGE: Self = Self(0x1);
-    /// Voltage spikes.
+    /// Voltage spikes seen.
     pub const SPIKES: Self = Self(0x2);
-    /// One or more cells have failed. Battery should also report MAV_BATTERY_CHARGE_STATE_FAILE (and should not be used).
+    /// A cell has failed; the charge state is FAILED and the pack must not be used.
     pub const CELL_FAIL: Self = Self(0x4);
-    /// Over-current fault.
+    /// Current too high.
     pub const OVER_CURRENT: Self = Self(0x8);
-    /// Over-temperature fault.
+    /// Too hot.
     pub const OVER_TEMPERATURE: Self = Self(0x10);
-    /// Under-temperature fault.
+    /// Too cold.
     pub const UNDER_TEMPERATURE: Self = Self(0x20);
-    /// Vehicle voltage is not compatible with this battery (batteries on same power rail should have similar voltage).
+    /// Its voltage does not match the vehicle (packs on one power rail need about the same voltage).
     pub const INCOMPATIBLE_VOLTAGE: Self = Self(0x40);
-    /// Battery firmware is not compatible with current autopilot firmware.
+    /// Its firmware does not work with this autopilot firmware.
     pub const INCOMPATIBLE_FIRMWARE: Self = Self(0x80);
-    /// Battery is not compatible due to cell configuration (e.g. 5s1p when vehicle requires 6s).
+    /// Wrong cell arrangement for this vehicle (say 5S1P where it needs 6S).
     pub const BATTERY_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION: Self = Self(0x100);
     /// Every defined flag.
     pub const ALL: Self = Self(0x1ff);
@@ -177,21 +177,21 @@ impl MavBatteryFault {
     }
 }
 
-/// Enumeration of battery functions
+/// What a battery powers.
 ///
 /// Schema: `mavlink.MAV_BATTERY_FUNCTION` (value).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum MavBatteryFunction {
-    /// Battery function is unknown
+    /// Not known.
     Unknown = 0,
-    /// Battery supports all flight systems
+    /// Everything on the vehicle.
     All = 1,
-    /// Battery for the propulsion system
+    /// The motors.
     Propulsion = 2,
-    /// Avionics battery
+    /// The flight electronics.
     Avionics = 3,
-    /// Payload battery
+    /// The payload.
     Payload = 4,
 }
 
@@ -216,17 +216,17 @@ impl MavBatteryFunction {
     }
 }
 
-/// Battery mode. Note, the normal operation mode (i.e. when flying) should be reported as MAV_BATTERY_MODE_UNKNOWN to allow message trimming in normal flight.
+/// Special mode of a smart battery. A battery in normal use reports UNKNOWN (0), so the field can be trimmed off the wire in flight.
 ///
 /// Schema: `mavlink.MAV_BATTERY_MODE` (value).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum MavBatteryMode {
-    /// Battery mode not supported/unknown battery mode/normal operation.
+    /// Normal use, or the battery does not report a mode.
     Unknown = 0,
-    /// Battery is auto discharging (towards storage level).
+    /// Discharging itself down to its storage level.
     AutoDischarging = 1,
-    /// Battery in hot-swap mode (current limited to prevent spikes that might damage sensitive electrical circuits).
+    /// Hot-swap: the current is limited so that plugging in causes no damaging spike.
     HotSwap = 2,
 }
 
@@ -249,52 +249,52 @@ impl MavBatteryMode {
     }
 }
 
-/// Battery status flags for fault, health and state indication.
+/// Fault, health and state bits of a battery (BATTERY_STATUS_V2.status_flags).
 ///
 /// Schema: `mavlink.MAV_BATTERY_STATUS_FLAGS` (bitmask).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct MavBatteryStatusFlags(pub u32);
 
 impl MavBatteryStatusFlags {
-    /// The battery is not ready to use (fly). Set if the battery has faults or other conditions that make it unsafe to fly with. Note: It will be the logical OR of other status bits (chosen by the manufacturer/integrator).
+    /// Not safe to fly with: set when any fault or condition the maker or integrator chose applies (an OR of other bits).
     pub const NOT_READY_TO_USE: Self = Self(0x1);
-    /// Battery is charging.
+    /// On charge.
     pub const CHARGING: Self = Self(0x2);
-    /// Battery is cell balancing (during charging). Not ready to use (MAV_BATTERY_STATUS_FLAGS_NOT_READY_TO_USE may be set).
+    /// Balancing its cells, usually while charging; not ready to use meanwhile.
     pub const CELL_BALANCING: Self = Self(0x4);
-    /// Battery cells are not balanced. Not ready to use.
+    /// Cell voltages differ too much; not ready to use.
     pub const FAULT_CELL_IMBALANCE: Self = Self(0x8);
-    /// Battery is auto discharging (towards storage level). Not ready to use (MAV_BATTERY_STATUS_FLAGS_NOT_READY_TO_USE would be set).
+    /// Discharging itself down to its storage level; not ready to use.
     pub const AUTO_DISCHARGING: Self = Self(0x10);
-    /// Battery requires service (not safe to fly). This is set at vendor discretion. It is likely to be set for most faults, and may also be set according to a maintenance schedule (such as age, or number of recharge cycles, etc.).
+    /// Needs servicing before flight; the maker decides when (after most faults, or by age or cycle count).
     pub const REQUIRES_SERVICE: Self = Self(0x20);
-    /// Battery is faulty and cannot be repaired (not safe to fly). This is set at vendor discretion. The battery should be disposed of safely.
+    /// Broken beyond repair: do not fly it, dispose of it safely. The maker decides when.
     pub const BAD_BATTERY: Self = Self(0x40);
-    /// Automatic battery protection monitoring is enabled. When enabled, the system will monitor for certain kinds of faults, such as cells being over-voltage. If a fault is triggered then and protections are enabled then a safety fault (MAV_BATTERY_STATUS_FLAGS_FAULT_PROTECTION_SYSTEM) will be set and power from the battery will be stopped. Note that battery protection monitoring should only be enabled when the vehicle is landed. Once the vehicle is armed, or starts moving, the protections should be disabled to prevent false positives from disabling the output.
+    /// The pack guards itself (against over-voltage cells and the like) and cuts its output on a fault, which then sets FAULT_PROTECTION_SYSTEM. Meant for a landed vehicle only: it should be off once the vehicle is armed or moving, so that a false alarm cannot cut power in flight.
     pub const PROTECTIONS_ENABLED: Self = Self(0x80);
-    /// The battery fault protection system had detected a fault and cut all power from the battery. This will only trigger if MAV_BATTERY_STATUS_FLAGS_PROTECTIONS_ENABLED is set. Other faults like MAV_BATTERY_STATUS_FLAGS_FAULT_OVER_VOLT may also be set, indicating the cause of the protection fault.
+    /// The pack's protection (PROTECTIONS_ENABLED) found a fault and cut its output; other fault bits, such as FAULT_OVER_VOLT, may say which.
     pub const FAULT_PROTECTION_SYSTEM: Self = Self(0x100);
-    /// One or more cells are above their maximum voltage rating.
+    /// A cell is above its highest rated voltage.
     pub const FAULT_OVER_VOLT: Self = Self(0x200);
-    /// One or more cells are below their minimum voltage rating. A battery that had deep-discharged might be irrepairably damaged, and set both MAV_BATTERY_STATUS_FLAGS_FAULT_UNDER_VOLT and MAV_BATTERY_STATUS_FLAGS_BAD_BATTERY.
+    /// A cell is below its lowest rated voltage. A deep-discharged pack may be ruined, in which case BAD_BATTERY is set too.
     pub const FAULT_UNDER_VOLT: Self = Self(0x400);
-    /// Over-temperature fault.
+    /// Too hot.
     pub const FAULT_OVER_TEMPERATURE: Self = Self(0x800);
-    /// Under-temperature fault.
+    /// Too cold.
     pub const FAULT_UNDER_TEMPERATURE: Self = Self(0x1000);
-    /// Over-current fault.
+    /// Current too high.
     pub const FAULT_OVER_CURRENT: Self = Self(0x2000);
-    /// Short circuit event detected. The battery may or may not be safe to use (check other flags).
+    /// A short circuit was detected; whether the pack is still usable depends on the other bits.
     pub const FAULT_SHORT_CIRCUIT: Self = Self(0x4000);
-    /// Voltage not compatible with power rail voltage (batteries on same power rail should have similar voltage).
+    /// Its voltage does not match the power rail (packs on one rail need about the same voltage).
     pub const FAULT_INCOMPATIBLE_VOLTAGE: Self = Self(0x8000);
-    /// Battery firmware is not compatible with current autopilot firmware.
+    /// Its firmware does not work with this autopilot firmware.
     pub const FAULT_INCOMPATIBLE_FIRMWARE: Self = Self(0x10000);
-    /// Battery is not compatible due to cell configuration (e.g. 5s1p when vehicle requires 6s).
+    /// Wrong cell arrangement for this vehicle (say 5S1P where it needs 6S).
     pub const FAULT_INCOMPATIBLE_CELLS_CONFIGURATION: Self = Self(0x20000);
-    /// Battery capacity_consumed and capacity_remaining values are relative to a full battery (they sum to the total capacity of the battery). This flag would be set for a smart battery that can accurately determine its remaining charge across vehicle reboots and discharge/recharge cycles. If unset the capacity_consumed indicates the consumption since vehicle power-on, as measured using a power monitor. The capacity_remaining, if provided, indicates the estimated remaining capacity on the assumption that the battery was full on vehicle boot. If unset a GCS is recommended to advise that users fully charge the battery on power on.
+    /// Set: capacity_consumed and capacity_remaining count from a full pack and add up to its capacity (a smart battery that tracks its charge across reboots and cycles). Clear: capacity_consumed counts from power-on, as a power monitor measures it, and capacity_remaining assumes the pack was full at power-on; a ground station should then ask for a full pack at start.
     pub const CAPACITY_RELATIVE_TO_FULL: Self = Self(0x40000);
-    /// Reserved (not used). If set, this will indicate that an additional status field exists for higher status values.
+    /// Reserved, unused; meant to announce a further status field for more bits.
     pub const EXTENDED: Self = Self(0x80000000);
     /// Every defined flag.
     pub const ALL: Self = Self(0x8007ffff);
@@ -312,21 +312,21 @@ impl MavBatteryStatusFlags {
     }
 }
 
-/// Enumeration of battery types
+/// Cell chemistry of a battery.
 ///
 /// Schema: `mavlink.MAV_BATTERY_TYPE` (value).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum MavBatteryType {
-    /// Not specified.
+    /// Not given.
     Unknown = 0,
-    /// Lithium polymer battery
+    /// LiPo (lithium polymer).
     Lipo = 1,
-    /// Lithium-iron-phosphate battery
+    /// LiFePO4 (lithium iron phosphate).
     Life = 2,
-    /// Lithium-ION battery
+    /// Li-ion (lithium ion, cylindrical or prismatic cells).
     Lion = 3,
-    /// Nickel metal hydride battery
+    /// NiMH (nickel metal hydride).
     Nimh = 4,
 }
 
@@ -396,21 +396,21 @@ impl MavModeFlag {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum MavParamType {
-    /// 8-bit unsigned integer.
+    /// Unsigned integer, 8 bits.
     Uint8 = 1,
-    /// 8-bit signed integer.
+    /// Signed integer, 8 bits.
     Int8 = 2,
-    /// 16-bit unsigned integer.
+    /// Unsigned integer, 16 bits.
     Uint16 = 3,
-    /// 16-bit signed integer.
+    /// Signed integer, 16 bits.
     Int16 = 4,
-    /// 32-bit unsigned integer.
+    /// Unsigned integer, 32 bits.
     Uint32 = 5,
-    /// 32-bit signed integer.
+    /// Signed integer, 32 bits.
     Int32 = 6,
-    /// 64-bit unsigned integer.
+    /// Unsigned integer, 64 bits.
     Uint64 = 7,
-    /// 64-bit signed integer.
+    /// Signed integer, 64 bits.
     Int64 = 8,
     /// 32-bit float.
     Real32 = 9,

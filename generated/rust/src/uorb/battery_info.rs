@@ -5,20 +5,20 @@ use crate::problems::{Problems, Validate};
 use crate::same::Same;
 use crate::wire;
 
-/// Battery information Static or near-invariant battery information. Should be streamed at low rate.
+/// What a battery says about itself that rarely changes (its serial number); sent at a low rate.
 ///
 /// Schema: `uorb.BatteryInfo` (BatteryInfo.msg:1).
 #[derive(Clone, Copy, Debug)]
 pub struct BatteryInfo {
-    /// Time since system start
+    /// When this sample was taken, on the autopilot's boot clock
     ///
     /// Unit: `us`. Wire type: `uint64`.
     pub timestamp: u64,
-    /// Must match the id in the battery_status message for the same battery
+    /// The pack this describes: the id of its battery_status
     ///
     /// Wire type: `uint8`.
     pub id: u8,
-    /// Serial number of the battery pack in ASCII characters, 0 terminated
+    /// Serial number as ASCII text, ended by a zero byte
     ///
     /// Unknown: `0` (the accessor gives `None`).
     pub serial_number: [u8; 32],

@@ -5,164 +5,164 @@ use crate::problems::{Problems, Rule, Validate};
 use crate::same::Same;
 use crate::wire;
 
-/// Battery status Battery status information for up to 4 battery instances. These are populated from power module and smart battery device drivers, and one battery updated from MAVLink. Battery instance information is also logged and streamed in MAVLink telemetry.
+/// State of one battery as the autopilot sees it, in the layout of message version 0 (up to four packs, with a 16-bit serial number), which PX4 logs written before version 1 carry.
 ///
 /// Schema: `uorb.BatteryStatusV0` (BatteryStatusV0.msg:1).
 #[derive(Clone, Copy, Debug)]
 pub struct BatteryStatusV0 {
-    /// Time since system start
+    /// When this sample was taken, on the autopilot's boot clock
     ///
     /// Unit: `us`. Wire type: `uint64`.
     pub timestamp: u64,
-    /// Whether or not a battery is connected. For power modules this is based on a voltage threshold.
+    /// A pack is present (for an analog monitor: the voltage is above its detection threshold)
     ///
     /// Wire type: `bool`.
     pub connected: bool,
-    /// Battery voltage
+    /// Pack voltage
     ///
     /// Unit: `V`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub voltage_v: f32,
-    /// Battery current
+    /// Pack current, discharge positive
     ///
     /// Unit: `A`. Unknown: `-1` (the accessor gives `None`). Wire type: `float32`.
     pub current_a: f32,
-    /// Battery current average (for FW average in level flight)
+    /// Smoothed current (what a fixed-wing draws in level cruise)
     ///
     /// Unit: `A`. Unknown: `-1` (the accessor gives `None`). Wire type: `float32`.
     pub current_average_a: f32,
-    /// Discharged amount
+    /// Charge drawn since the autopilot started
     ///
     /// Unit: `mAh`. Unknown: `-1` (the accessor gives `None`). Wire type: `float32`.
     pub discharged_mah: f32,
-    /// Remaining capacity
+    /// Fraction of the charge left, 1 is full
     ///
     /// Unknown: `-1` (the accessor gives `None`). Range: 0 to 1. Wire type: `float32`.
     pub remaining: f32,
-    /// Scaling factor to compensate for lower actuation power caused by voltage sag
+    /// Throttle gain that makes up for the thrust lost to voltage sag
     ///
     /// Unknown: `-1` (the accessor gives `None`). Range: 1 to ... Wire type: `float32`.
     pub scale: f32,
-    /// Predicted time remaining until battery is empty under previous averaged load
+    /// Estimated time until empty at the recent mean load
     ///
     /// Unit: `s`. Unknown: `NaN` (the accessor gives `None`). Wire type: `float32`.
     pub time_remaining_s: f32,
-    /// Temperature of the battery
+    /// Pack temperature
     ///
     /// Unit: `°C`. Unknown: `NaN` (the accessor gives `None`). Wire type: `float32`.
     pub temperature: f32,
-    /// Number of cells
+    /// Cells in series
     ///
     /// Unknown: `0` (the accessor gives `None`). Wire type: `uint8`.
     pub cell_count: u8,
-    /// Battery source
+    /// Where the reading comes from
     ///
     /// Values: `uorb.BatteryStatusV0.SOURCE`. Wire type: `uint8`.
     pub source: u8,
-    /// Zero based priority is the connection on the Power Controller V1..Vn AKA BrickN-1
+    /// Which power input feeds from this pack, counted from 0 (input V1 is 0)
     ///
     /// Wire type: `uint8`.
     pub priority: u8,
-    /// Capacity of the battery when fully charged
+    /// Charge of the full pack
     ///
     /// Unit: `mAh`. Wire type: `uint16`.
     pub capacity: u16,
-    /// Number of discharge cycles the battery has experienced
+    /// Discharge cycles so far
     ///
     /// Wire type: `uint16`.
     pub cycle_count: u16,
-    /// Predicted remaining battery capacity based on the average rate of discharge
+    /// Time until empty at the mean discharge rate, as the pack reports it
     ///
     /// Unit: `minutes`. Wire type: `uint16`.
     pub average_time_to_empty: u16,
-    /// Serial number of the battery pack
+    /// The pack's serial number
     ///
     /// Wire type: `uint16`.
     pub serial_number: u16,
-    /// Manufacture date, part of serial number of the battery pack. Formatted as: Day + Month×32 + (Year–1980)×512
+    /// Date made, packed as day + 32 \* month + 512 \* (year - 1980)
     ///
     /// Wire type: `uint16`.
     pub manufacture_date: u16,
-    /// State of health. FullChargeCapacity/DesignCapacity
+    /// Full-charge capacity as a share of design capacity
     ///
     /// Unit: `%`. Range: 0 to 100. Wire type: `uint16`.
     pub state_of_health: u16,
-    /// Max error, expected margin of error in the state-of-charge calculation
+    /// How far off the pack's charge estimate may be
     ///
     /// Unit: `%`. Range: 1 to 100. Wire type: `uint16`.
     pub max_error: u16,
-    /// ID number of a battery. Should be unique and consistent for the lifetime of a vehicle. 1-indexed
+    /// The pack's number on this vehicle, from 1, the same for the vehicle's whole life
     ///
     /// Wire type: `uint8`.
     pub id: u8,
-    /// Interface error counter
+    /// Communication errors counted with the pack
     ///
     /// Wire type: `uint16`.
     pub interface_error: u16,
-    /// Battery individual cell voltages
+    /// Voltage of each cell
     ///
     /// Unit: `V`. Unknown: `0` (the accessor gives `None`). Wire type: `float32`.
     pub voltage_cell_v: [f32; 14],
-    /// Max difference between individual cell voltages
+    /// Spread between the highest and the lowest cell voltage
     ///
     /// Wire type: `float32`.
     pub max_cell_voltage_delta: f32,
-    /// Power off event imminent indication, false if unknown
+    /// The pack is about to switch itself off (false when not known)
     ///
     /// Wire type: `bool`.
     pub is_powering_off: bool,
-    /// Set if the battery is explicitly required before arming
+    /// Arming waits for this pack
     ///
     /// Wire type: `bool`.
     pub is_required: bool,
-    /// Current battery warning
+    /// Warning level, or charging/unhealthy state
     ///
     /// Values: `uorb.BatteryStatusV0.WARNING`, `uorb.BatteryStatusV0.STATE`. Wire type: `uint8`.
     pub warning: u8,
-    /// Smart battery supply status/fault flags (bitmask) for health indication
+    /// Fault bitmask of a smart battery, one bit per FAULT_\* index
     ///
     /// Values: `uorb.BatteryStatusV0.FAULT`. Wire type: `uint16`.
     pub faults: u16,
-    /// Compensated battery capacity
+    /// Energy of the full pack, corrected for wear and conditions
     ///
     /// Unit: `Wh`. Wire type: `float32`.
     pub full_charge_capacity_wh: f32,
-    /// Compensated battery capacity remaining
+    /// Energy left, corrected the same way
     ///
     /// Unit: `Wh`. Wire type: `float32`.
     pub remaining_capacity_wh: f32,
-    /// Number of battery overdischarge
+    /// Times the pack was over-discharged
     ///
     /// Wire type: `uint16`.
     pub over_discharge_count: u16,
-    /// Nominal voltage of the battery pack
+    /// Rated pack voltage
     ///
     /// Unit: `V`. Wire type: `float32`.
     pub nominal_voltage: f32,
-    /// Internal resistance per cell estimate
+    /// Estimated resistance of one cell
     ///
     /// Unit: `Ohm`. Wire type: `float32`.
     pub internal_resistance_estimate: f32,
-    /// Open circuit voltage estimate
+    /// Estimated open-circuit (no-load) voltage
     ///
     /// Unit: `V`. Wire type: `float32`.
     pub ocv_estimate: f32,
-    /// Filtered open circuit voltage estimate
+    /// The open-circuit estimate after filtering
     ///
     /// Unit: `V`. Wire type: `float32`.
     pub ocv_estimate_filtered: f32,
-    /// Normalized volt based state of charge estimate
+    /// Charge left as read from the voltage alone
     ///
     /// Range: 0 to 1. Wire type: `float32`.
     pub volt_based_soc_estimate: f32,
-    /// Predicted voltage
+    /// Voltage the estimator expected
     ///
     /// Unit: `V`. Wire type: `float32`.
     pub voltage_prediction: f32,
-    /// Prediction error
+    /// Measured minus expected voltage
     ///
     /// Unit: `V`. Wire type: `float32`.
     pub prediction_error: f32,
-    /// Norm of the covariance matrix
+    /// Size (norm) of the estimator's covariance
     ///
     /// Wire type: `float32`.
     pub estimation_covariance_norm: f32,
@@ -171,49 +171,49 @@ pub struct BatteryStatusV0 {
 impl BatteryStatusV0 {
     pub const MESSAGE_VERSION: u32 = 0;
     pub const MAX_INSTANCES: u8 = 4;
-    /// Power module (analog ADC or I2C power monitor)
+    /// A power module: analog sense lines or an I2C monitor
     pub const SOURCE_POWER_MODULE: u8 = 0;
-    /// External (MAVLink, CAN, or external driver)
+    /// Another system: MAVLink, CAN or an external driver
     pub const SOURCE_EXTERNAL: u8 = 1;
-    /// ESCs (via ESC telemetry)
+    /// Summed ESC telemetry
     pub const SOURCE_ESCS: u8 = 2;
-    /// No battery low voltage warning active
+    /// Nothing to report
     pub const WARNING_NONE: u8 = 0;
-    /// Low voltage warning
+    /// Low: warn the pilot
     pub const WARNING_LOW: u8 = 1;
-    /// Critical voltage, return / abort immediately
+    /// Critical: return or abort now
     pub const WARNING_CRITICAL: u8 = 2;
-    /// Immediate landing required
+    /// Emergency: land where you are
     pub const WARNING_EMERGENCY: u8 = 3;
-    /// Battery has failed completely
+    /// The pack no longer works
     pub const WARNING_FAILED: u8 = 4;
-    /// Battery is diagnosed to be defective or an error occurred, usage is discouraged / prohibited. Possible causes (faults) are listed in faults field
+    /// Faulty or in error, do not use; the faults bitmask says why
     pub const STATE_UNHEALTHY: u8 = 6;
-    /// Battery is charging
+    /// On charge
     pub const STATE_CHARGING: u8 = 7;
-    /// Battery has deep discharged
+    /// Discharged too deep
     pub const FAULT_DEEP_DISCHARGE: u8 = 0;
-    /// Voltage spikes
+    /// Voltage spikes seen
     pub const FAULT_SPIKES: u8 = 1;
-    /// One or more cells have failed
+    /// A cell has failed
     pub const FAULT_CELL_FAIL: u8 = 2;
-    /// Over-current
+    /// Current too high
     pub const FAULT_OVER_CURRENT: u8 = 3;
-    /// Over-temperature
+    /// Too hot
     pub const FAULT_OVER_TEMPERATURE: u8 = 4;
-    /// Under-temperature fault
+    /// Too cold
     pub const FAULT_UNDER_TEMPERATURE: u8 = 5;
-    /// Vehicle voltage is not compatible with this battery (batteries on same power rail should have similar voltage)
+    /// Voltage does not match the other packs on the same rail
     pub const FAULT_INCOMPATIBLE_VOLTAGE: u8 = 6;
-    /// Battery firmware is not compatible with current autopilot firmware
+    /// Pack firmware does not work with this autopilot firmware
     pub const FAULT_INCOMPATIBLE_FIRMWARE: u8 = 7;
-    /// Battery model is not supported by the system
+    /// This pack model is not supported
     pub const FAULT_INCOMPATIBLE_MODEL: u8 = 8;
-    /// Hardware problem
+    /// Hardware fault in the pack
     pub const FAULT_HARDWARE_FAILURE: u8 = 9;
-    /// Battery had a problem while arming
+    /// The pack reported a problem while arming
     pub const FAULT_FAILED_TO_ARM: u8 = 10;
-    /// Counter. Keep this as last element
+    /// One past the last fault index
     pub const FAULT_COUNT: u8 = 11;
 
     /// A message with every field unknown where it can be, zero elsewhere.
@@ -470,11 +470,11 @@ impl Same for BatteryStatusV0 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum Source {
-    /// Power module (analog ADC or I2C power monitor)
+    /// A power module: analog sense lines or an I2C monitor
     PowerModule = 0,
-    /// External (MAVLink, CAN, or external driver)
+    /// Another system: MAVLink, CAN or an external driver
     External = 1,
-    /// ESCs (via ESC telemetry)
+    /// Summed ESC telemetry
     Escs = 2,
 }
 
@@ -501,15 +501,15 @@ impl Source {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum Warning {
-    /// No battery low voltage warning active
+    /// Nothing to report
     None = 0,
-    /// Low voltage warning
+    /// Low: warn the pilot
     Low = 1,
-    /// Critical voltage, return / abort immediately
+    /// Critical: return or abort now
     Critical = 2,
-    /// Immediate landing required
+    /// Emergency: land where you are
     Emergency = 3,
-    /// Battery has failed completely
+    /// The pack no longer works
     Failed = 4,
 }
 
@@ -538,9 +538,9 @@ impl Warning {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum State {
-    /// Battery is diagnosed to be defective or an error occurred, usage is discouraged / prohibited. Possible causes (faults) are listed in faults field
+    /// Faulty or in error, do not use; the faults bitmask says why
     Unhealthy = 6,
-    /// Battery is charging
+    /// On charge
     Charging = 7,
 }
 
@@ -567,27 +567,27 @@ impl State {
 pub struct Fault(pub u16);
 
 impl Fault {
-    /// Battery has deep discharged
+    /// Discharged too deep
     pub const DEEP_DISCHARGE: Self = Self(0x1);
-    /// Voltage spikes
+    /// Voltage spikes seen
     pub const SPIKES: Self = Self(0x2);
-    /// One or more cells have failed
+    /// A cell has failed
     pub const CELL_FAIL: Self = Self(0x4);
-    /// Over-current
+    /// Current too high
     pub const OVER_CURRENT: Self = Self(0x8);
-    /// Over-temperature
+    /// Too hot
     pub const OVER_TEMPERATURE: Self = Self(0x10);
-    /// Under-temperature fault
+    /// Too cold
     pub const UNDER_TEMPERATURE: Self = Self(0x20);
-    /// Vehicle voltage is not compatible with this battery (batteries on same power rail should have similar voltage)
+    /// Voltage does not match the other packs on the same rail
     pub const INCOMPATIBLE_VOLTAGE: Self = Self(0x40);
-    /// Battery firmware is not compatible with current autopilot firmware
+    /// Pack firmware does not work with this autopilot firmware
     pub const INCOMPATIBLE_FIRMWARE: Self = Self(0x80);
-    /// Battery model is not supported by the system
+    /// This pack model is not supported
     pub const INCOMPATIBLE_MODEL: Self = Self(0x100);
-    /// Hardware problem
+    /// Hardware fault in the pack
     pub const HARDWARE_FAILURE: Self = Self(0x200);
-    /// Battery had a problem while arming
+    /// The pack reported a problem while arming
     pub const FAILED_TO_ARM: Self = Self(0x400);
     /// Every defined flag.
     pub const ALL: Self = Self(0x7ff);
