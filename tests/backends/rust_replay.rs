@@ -37,8 +37,8 @@ fn problems<T: Validate>(value: &T) -> Vec<String> {
     out.as_slice()
         .iter()
         .map(|p| match p.index {
-            Some(i) => format!("{}[{}] {}", p.field, i, p.rule.name()),
-            None => format!("{} {}", p.field, p.rule.name()),
+            Some(i) => format!("{}[{}] {}", p.field, i, p.rule),
+            None => format!("{} {}", p.field, p.rule),
         })
         .collect()
 }

@@ -13,6 +13,7 @@ from .docs import doc_lines
 from .dronecan_codec import DronecanCodec, dronecan_codec
 from .enums import TAKEN, EnumView, enum_view
 from .naming import camel, field_ident, snake, upper
+from .rules import RustRules, rust_rules
 from .types import capacity, element, equals, float_literal, scalar, scalar_literal
 
 
@@ -153,11 +154,13 @@ class MessageView:
     dronecan: DronecanCodec | None
     msg: Message
     same: list[str] = field(default_factory=list)  # the sameness terms of PartialEq
+    rules: RustRules = field(default_factory=RustRules)  # the cross-field rules, after the field checks
 
     @property
     def max_problems(self) -> int:
-        """Every value checked can break one rule, a dynamic array's length one more."""
-        return sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in self.uses)
+        """Every value checked can break one rule, a dynamic array's length one more, and each
+        cross-field rule once (once per index of its loop)."""
+        return sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in self.uses) + self.rules.most
 
 
 def _unknown(f: Field, t: PrimitiveType, ident: str) -> tuple[str, str | None] | None:
@@ -294,6 +297,7 @@ def message_view(schema: Schema, msg: Message, shared: dict[str, EnumView]) -> M
         dronecan=dronecan_codec(schema, msg, idents),
         msg=msg,
         same=same,
+        rules=rust_rules(schema, msg),
     )
 
 

@@ -22,7 +22,7 @@ _HERE = Path(__file__).parent
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
 # the crate's own version (its API, not battgen's release): raised when the generated API changes
 CRATE_VERSION = "0.1.0"
-SUPPORT = ("crc", "dronecan_wire", "failsafe", "mavlink_wire", "problems", "same", "uorb_wire", "wire")
+SUPPORT = ("crc", "dronecan_wire", "failsafe", "mavlink_wire", "problems", "rules", "same", "uorb_wire", "wire")
 
 
 def _environment() -> jinja2.Environment:

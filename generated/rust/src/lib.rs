@@ -30,6 +30,7 @@ pub mod mavlink;
 pub mod mavlink_wire;
 pub mod params;
 pub mod problems;
+pub mod rules;
 pub mod same;
 pub mod uorb;
 pub mod uorb_wire;

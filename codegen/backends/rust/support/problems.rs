@@ -15,10 +15,13 @@ pub enum Rule {
     Bitmask,
     /// A variable-length array longer than its capacity.
     Length,
+    /// Breaks the cross-field rule of this id (schemas/rules/).
+    CrossField(&'static str),
 }
 
 impl Rule {
-    /// The rule's name as battgen's Python validators spell it.
+    /// The rule's name as battgen's Python validators spell it (`cross-field` without its id:
+    /// [`Rule::rule_id`] gives that, and `Display` writes both).
     #[must_use]
     pub const fn name(self) -> &'static str {
         match self {
@@ -28,6 +31,26 @@ impl Rule {
             Rule::Enum => "enum",
             Rule::Bitmask => "bitmask",
             Rule::Length => "length",
+            Rule::CrossField(_) => "cross-field",
+        }
+    }
+
+    /// The id of the cross-field rule broken (None for a rule of one value).
+    #[must_use]
+    pub const fn rule_id(self) -> Option<&'static str> {
+        match self {
+            Rule::CrossField(id) => Some(id),
+            _ => None,
+        }
+    }
+}
+
+/// The rule as the Python validators spell a violation's `rule`: `range`, `cross-field:<id>`.
+impl core::fmt::Display for Rule {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Rule::CrossField(id) => write!(f, "cross-field:{id}"),
+            _ => f.write_str(self.name()),
         }
     }
 }

@@ -204,7 +204,7 @@ impl BatteryStatus {
 
     /// Every problem of the message, in field order.
     #[must_use]
-    pub fn validate(&self) -> Problems<5> {
+    pub fn validate(&self) -> Problems<6> {
         let mut out = Problems::new();
         self.validate_into(&mut out);
         out
@@ -295,6 +295,30 @@ impl Validate for BatteryStatus {
         if let Some(rule) = check_fault_bitmask(self.fault_bitmask) {
             out.push("fault_bitmask", None, rule);
         }
+        self.rule_battery_remaining_percent(out);
+    }
+}
+
+/// The cross-field rules of the message (schemas/rules/), as the Python validators check them.
+// comparison chains stay as their rule file writes them, for review against it
+#[allow(clippy::manual_range_contains)]
+impl BatteryStatus {
+    /// `battery-remaining-percent` (mavlink-battery-status.yaml:4): Remaining energy is 0..100 %, or -1 when the autopilot does not estimate it.
+    fn rule_battery_remaining_percent<const N: usize>(&self, out: &mut Problems<N>) -> Option<()> {
+        let applies = self.battery_remaining != -1;
+        if !applies {
+            return Some(());
+        }
+        let holds =
+            0 <= i128::from(self.battery_remaining) && i128::from(self.battery_remaining) <= 100;
+        if !holds {
+            out.push(
+                "battery_remaining",
+                None,
+                Rule::CrossField("battery-remaining-percent"),
+            );
+        }
+        Some(())
     }
 }
 

@@ -386,7 +386,7 @@ impl BatteryStatusV0 {
 
     /// Every problem of the message, in field order.
     #[must_use]
-    pub fn validate(&self) -> Problems<38> {
+    pub fn validate(&self) -> Problems<53> {
         let mut out = Problems::new();
         self.validate_into(&mut out);
         out
@@ -958,6 +958,49 @@ impl Validate for BatteryStatusV0 {
         if let Some(rule) = check_estimation_covariance_norm(self.estimation_covariance_norm) {
             out.push("estimation_covariance_norm", None, rule);
         }
+        self.rule_cell_count_capacity(out);
+        self.rule_cells_beyond_count_zero(out);
+    }
+}
+
+/// The cross-field rules of the message (schemas/rules/), as the Python validators check them.
+// comparison chains stay as their rule file writes them, for review against it
+#[allow(clippy::manual_range_contains)]
+impl BatteryStatusV0 {
+    /// `cell-count-capacity` (uorb-battery-status.yaml:5): voltage_cell_v has room for 14 cells; a larger count cannot be reported.
+    fn rule_cell_count_capacity<const N: usize>(&self, out: &mut Problems<N>) -> Option<()> {
+        let holds = i128::from(self.cell_count) <= 14;
+        if !holds {
+            out.push("cell_count", None, Rule::CrossField("cell-count-capacity"));
+        }
+        Some(())
+    }
+    /// `cells-beyond-count-zero` (uorb-battery-status.yaml:11): Drivers fill voltage_cell_v for the cells present; the rest stays zero.
+    fn rule_cells_beyond_count_zero<const N: usize>(&self, out: &mut Problems<N>) -> Option<()> {
+        let applies = self.cell_count != 0;
+        if !applies {
+            return Some(());
+        }
+        for v in crate::rules::span(i128::from(self.cell_count), 14, 14) {
+            self.rule_cells_beyond_count_zero_at(out, v);
+        }
+        Some(())
+    }
+    /// `cells-beyond-count-zero` at one `i`.
+    fn rule_cells_beyond_count_zero_at<const N: usize>(
+        &self,
+        out: &mut Problems<N>,
+        v_i: i128,
+    ) -> Option<()> {
+        let holds = f64::from(crate::rules::at(&self.voltage_cell_v, v_i)?) == 0.0;
+        if !holds {
+            out.push(
+                "voltage_cell_v",
+                crate::rules::position(v_i),
+                Rule::CrossField("cells-beyond-count-zero"),
+            );
+        }
+        Some(())
     }
 }
 

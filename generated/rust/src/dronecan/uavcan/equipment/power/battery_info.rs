@@ -227,7 +227,7 @@ impl BatteryInfo {
 
     /// Every problem of the message, in field order.
     #[must_use]
-    pub fn validate(&self) -> Problems<11> {
+    pub fn validate(&self) -> Problems<13> {
         let mut out = Problems::new();
         self.validate_into(&mut out);
         out
@@ -482,6 +482,46 @@ impl Validate for BatteryInfo {
         if let Some(rule) = check_state_of_charge_pct_stdev(self.state_of_charge_pct_stdev) {
             out.push("state_of_charge_pct_stdev", None, rule);
         }
+        self.rule_state_of_health_percent(out);
+        self.rule_state_of_charge_percent(out);
+    }
+}
+
+/// The cross-field rules of the message (schemas/rules/), as the Python validators check them.
+// comparison chains stay as their rule file writes them, for review against it
+#[allow(clippy::manual_range_contains)]
+impl BatteryInfo {
+    /// `state-of-health-percent` (dronecan-power.yaml:7): state_of_health_pct <= 100
+    fn rule_state_of_health_percent<const N: usize>(&self, out: &mut Problems<N>) -> Option<()> {
+        let applies = self.state_of_health_pct != 127;
+        if !applies {
+            return Some(());
+        }
+        let holds = i128::from(self.state_of_health_pct) <= 100;
+        if !holds {
+            out.push(
+                "state_of_health_pct",
+                None,
+                Rule::CrossField("state-of-health-percent"),
+            );
+        }
+        Some(())
+    }
+    /// `state-of-charge-percent` (dronecan-power.yaml:13): Required; 127 (STATE_OF_CHARGE_UNKNOWN) says the node cannot estimate it.
+    fn rule_state_of_charge_percent<const N: usize>(&self, out: &mut Problems<N>) -> Option<()> {
+        let applies = self.state_of_charge_pct != 127;
+        if !applies {
+            return Some(());
+        }
+        let holds = i128::from(self.state_of_charge_pct) <= 100;
+        if !holds {
+            out.push(
+                "state_of_charge_pct",
+                None,
+                Rule::CrossField("state-of-charge-percent"),
+            );
+        }
+        Some(())
     }
 }
 

@@ -52,7 +52,7 @@ impl PrimaryPowerSupplyStatus {
 
     /// Every problem of the message, in field order.
     #[must_use]
-    pub fn validate(&self) -> Problems<4> {
+    pub fn validate(&self) -> Problems<5> {
         let mut out = Problems::new();
         self.validate_into(&mut out);
         out
@@ -147,6 +147,25 @@ impl Validate for PrimaryPowerSupplyStatus {
         if let Some(rule) = check_remaining_energy_pct_stdev(self.remaining_energy_pct_stdev) {
             out.push("remaining_energy_pct_stdev", None, rule);
         }
+        self.rule_remaining_energy_percent(out);
+    }
+}
+
+/// The cross-field rules of the message (schemas/rules/), as the Python validators check them.
+// comparison chains stay as their rule file writes them, for review against it
+#[allow(clippy::manual_range_contains)]
+impl PrimaryPowerSupplyStatus {
+    /// `remaining-energy-percent` (dronecan-primary-power.yaml:4): remaining_energy_pct <= 100
+    fn rule_remaining_energy_percent<const N: usize>(&self, out: &mut Problems<N>) -> Option<()> {
+        let holds = i128::from(self.remaining_energy_pct) <= 100;
+        if !holds {
+            out.push(
+                "remaining_energy_pct",
+                None,
+                Rule::CrossField("remaining-energy-percent"),
+            );
+        }
+        Some(())
     }
 }
 
