@@ -20,6 +20,7 @@ class DronecanCodec:
     get: list[str]  # statements binding `f_<ident>` from `r` and `tao`
     fields: list[tuple[str, str]]  # (ident, bound name) of the struct expression
     uses_tao: bool
+    whole: str = ""  # a union's: the value `get` builds (its fields are set branch by branch)
 
 
 def _min_bits(schema: Schema, t: FieldType) -> int:
@@ -43,6 +44,8 @@ def _sensitive(schema: Schema, t: FieldType) -> bool:
         return _eligible(schema, t) or _sensitive(schema, t.element)
     if isinstance(t, CompositeType):
         m = schema.message(t.name)
+        if m.dronecan is not None and m.dronecan.union:  # the held field is told the union's flag
+            return any(_sensitive(schema, f.type) for f in m.fields)
         return bool(m.fields) and _sensitive(schema, m.fields[-1].type)
     return False
 
@@ -87,38 +90,95 @@ def _zero(t: PrimitiveType) -> str:
 
 
 def dronecan_codec(schema: Schema, msg: Message, idents: dict[str, str]) -> DronecanCodec | None:
-    """The codec of ``msg`` (None if it is not a DroneCAN message, or a union, or holds arrays of
-    composites, which the bundled schemas do not)."""
+    """The codec of ``msg`` (None if it is not a DroneCAN message, or holds arrays of composites,
+    which the bundled schemas do not). A union writes its tag (``union_tag``, in ceil(log2(fields))
+    bits, as pydronecan) and then the one field it holds, told the union's own tail array flag; a
+    tag naming no field is an error both ways."""
     info = msg.dronecan
-    if info is None or info.union:
+    if info is None:
         return None
+    if info.union:
+        return _union(schema, msg, idents)
     put: list[str] = []
     get: list[str] = []
     bound: list[tuple[str, str]] = []
     uses_tao = False
     for n, f in enumerate(msg.fields):
         last = n == len(msg.fields) - 1
-        t = f.type
-        if f.is_padding:
-            assert isinstance(t, PrimitiveType)
-            put.append(f"w.put(0, {t.bits});")
-            get.append(f"r.get({t.bits})?;")
-            continue
-        ident = idents[f.name]
-        name = f"f_{ident.strip('_')}"
-        tao = "tao" if last and _sensitive(schema, t) else "false"
+        tao = "tao" if last and _sensitive(schema, f.type) else "false"
         uses_tao = uses_tao or tao == "tao"
-        if isinstance(t, PrimitiveType):
-            put.append(f"w.put({_put_value(t, f'self.{ident}')}, {t.bits});")
-            get.append(f"let {name} = {_get_value(t)};")
-            bound.append((ident, name))
-        elif isinstance(t, CompositeType):
-            put.append(f"{WIRE}::Message::put(&self.{ident}, w, {tao})?;")
-            get.append(f"let {name} = {WIRE}::Message::get(r, {tao})?;")
-            bound.append((ident, name))
-        elif not isinstance(t, ArrayType) or not _array(schema, f, t, ident, name, tao, put, get, bound):
-            return None  # a string type or an array of composites: not in DroneCAN v0's battery messages
+        if not _field(schema, f, idents, tao, put, get, bound):
+            return None
     return DronecanCodec((info.max_bitlen + 7) // 8, put, get, bound, uses_tao)
+
+
+def union_tag_bits(count: int) -> int:
+    """pydronecan's tag width: ceil(log2(fields))."""
+    return max(count - 1, 0).bit_length()
+
+
+def _union(schema: Schema, msg: Message, idents: dict[str, str]) -> DronecanCodec | None:
+    n = len(msg.fields)
+    bits = union_tag_bits(n)
+    wrong = f"{{ tag: usize::from(self.union_tag), fields: {n} }}"
+    put = [f"if usize::from(self.union_tag) >= {n} {{", f"return Err({WIRE}::EncodeError::Tag {wrong});", "}"]
+    put += [f"w.put(u64::from(self.union_tag), {bits});"] if bits else []
+    get = ["let mut m = Self::new();"]
+    if bits:
+        get += [f"let tag = r.get({bits})? as usize;", f"if tag >= {n} {{"]
+        get += [f"return Err({WIRE}::DecodeError::Tag {{ tag, fields: {n} }});", "}", "m.union_tag = tag as u8;"]
+    else:
+        get.append("let tag = 0;")
+    uses_tao = False
+    for k, f in enumerate(msg.fields):
+        tao = "tao" if _sensitive(schema, f.type) else "false"
+        uses_tao = uses_tao or tao == "tao"
+        branch_put: list[str] = []
+        branch_get: list[str] = []
+        bound: list[tuple[str, str]] = []
+        if not _field(schema, f, idents, tao, branch_put, branch_get, bound):
+            return None
+        head = "if" if k == 0 else "} else if"
+        put += [f"{head} self.union_tag == {k} {{", *branch_put]
+        get += [f"{head} tag == {k} {{", *branch_get, *(f"m.{ident} = {name};" for ident, name in bound)]
+    if msg.fields:
+        put.append("}")
+        get.append("}")
+    info = msg.dronecan
+    assert info is not None
+    return DronecanCodec((info.max_bitlen + 7) // 8, put, get, [], uses_tao, whole="m")
+
+
+def _field(
+    schema: Schema,
+    f: Field,
+    idents: dict[str, str],
+    tao: str,
+    put: list[str],
+    get: list[str],
+    bound: list[tuple[str, str]],
+) -> bool:
+    """The statements of one field (False: a type the Rust codec does not write)."""
+    t = f.type
+    if f.is_padding:
+        assert isinstance(t, PrimitiveType)
+        put.append(f"w.put(0, {t.bits});")
+        get.append(f"r.get({t.bits})?;")
+        return True
+    ident = idents[f.name]
+    name = f"f_{ident.strip('_')}"
+    if isinstance(t, PrimitiveType):
+        put.append(f"w.put({_put_value(t, f'self.{ident}')}, {t.bits});")
+        get.append(f"let {name} = {_get_value(t)};")
+        bound.append((ident, name))
+        return True
+    if isinstance(t, CompositeType):
+        put.append(f"{WIRE}::Message::put(&self.{ident}, w, {tao})?;")
+        get.append(f"let {name} = {WIRE}::Message::get(r, {tao})?;")
+        bound.append((ident, name))
+        return True
+    # a string type or an array of composites: not in DroneCAN v0's battery messages
+    return isinstance(t, ArrayType) and _array(schema, f, t, ident, name, tao, put, get, bound)
 
 
 def _array(

@@ -106,6 +106,7 @@ class CheckUse:
     target: str  # the value's expression (``self.timestamp.usec``)
     fn: str  # the check function's path
     check: FieldCheck
+    held: str | None = None  # in a union: the condition that it holds this field (the others are not sent)
 
     @property
     def length(self) -> str:
@@ -119,20 +120,27 @@ class CheckUse:
         return None if first is None else equals(first[0], first[1], f"{self.target}[0]", negate=True)
 
 
-def check_uses(schema: Schema, msg: Message, path: str = "", target: str = "self.", depth: int = 0) -> list[CheckUse]:
-    """Every check of ``msg``'s fields and, path by path, of the messages nested in it (not in arrays)."""
+def check_uses(
+    schema: Schema, msg: Message, path: str = "", target: str = "self.", depth: int = 0, held: str | None = None
+) -> list[CheckUse]:
+    """Every check of ``msg``'s fields and, path by path, of the messages nested in it (not in arrays);
+    of a union's fields, the one it holds only, as the C library checks them."""
     module = "crate::" + "::".join(module_parts(msg.qualified_name)) + "::"
+    union = msg.dronecan is not None and msg.dronecan.union
     out: list[CheckUse] = []
-    for f in msg.fields:
+    for k, f in enumerate(msg.fields):
         if f.is_padding:
             continue
+        mine = held
+        if union:
+            mine = " && ".join(c for c in (held, f"{target}union_tag == {k}") if c)
         ident = field_ident(f.name)
         c = field_check(schema, f, ident)
         if c is not None:
-            out.append(CheckUse(path + f.name, target + ident, (module if depth else "") + c.fn_name, c))
+            out.append(CheckUse(path + f.name, target + ident, (module if depth else "") + c.fn_name, c, mine))
         elif isinstance(f.type, CompositeType) and depth < 8:
             inner = schema.message(f.type.name)
-            out += check_uses(schema, inner, f"{path}{f.name}.", f"{target}{ident}.", depth + 1)
+            out += check_uses(schema, inner, f"{path}{f.name}.", f"{target}{ident}.", depth + 1, mine)
     return out
 
 
@@ -262,6 +270,11 @@ def message_view(schema: Schema, msg: Message, shared: dict[str, EnumView]) -> M
     views = {**shared, **local}
     members: list[Member] = []
     same: list[str] = []
+    if msg.dronecan is not None and msg.dronecan.union:
+        names = ", ".join(f"{k} `{f.name}`" for k, f in enumerate(msg.fields))
+        doc = [f"The field the union holds ({names}); only that one is sent."]
+        members.append(Member("union_tag", "u8", doc, "0", None))
+        same.append("self.union_tag == other.union_tag")
     for f in msg.fields:
         if f.is_padding:
             continue

@@ -79,8 +79,8 @@ def _modules(views: list[MessageView]) -> tuple[dict[ModulePath, set[str]], dict
 
 
 def rust_messages(schema: Schema) -> list[Message]:
-    """The messages of the crate: DroneCAN, MAVLink and uORB ones, but not DSDL unions (a Rust enum
-    of branches, not written yet) nor the messages holding one."""
+    """The messages of the crate: DroneCAN, MAVLink and uORB ones (a DSDL union as a struct of its
+    fields and the `union_tag` saying which one is held, as the C library holds it)."""
     held: dict[str, Message] = {m.qualified_name: m for m in schema.messages if m.format in _FORMATS}
     out: dict[str, bool] = {}
 
@@ -88,7 +88,7 @@ def rust_messages(schema: Schema) -> list[Message]:
         if m.qualified_name not in out:
             out[m.qualified_name] = False  # a cycle is no valid schema; refuse it rather than recurse
             nested = [element(f.type) for f in m.fields]
-            out[m.qualified_name] = not m.is_union and all(
+            out[m.qualified_name] = all(
                 not isinstance(t, CompositeType) or (t.name in held and ok(held[t.name])) for t in nested
             )
         return out[m.qualified_name]

@@ -13,6 +13,8 @@ pub enum EncodeError {
         length: usize,
         capacity: usize,
     },
+    /// A union's tag names no field (`tag` is beyond its `fields`).
+    Tag { tag: usize, fields: usize },
 }
 
 /// Why bytes are not an encoding of the message asked for.
@@ -30,6 +32,8 @@ pub enum DecodeError {
     PartialElement { field: &'static str },
     /// Whole bytes follow the message.
     Trailing { bytes: usize },
+    /// A union's tag names no field (`tag` is beyond its `fields`).
+    Tag { tag: usize, fields: usize },
 }
 
 /// Writes bits into a zeroed buffer.

@@ -8,6 +8,8 @@
 pub enum EncodeError {
     /// A dynamic array's length is beyond its capacity.
     Length { field: &'static str, length: usize, capacity: usize },
+    /// A union's tag names no field (`tag` is beyond its `fields`).
+    Tag { tag: usize, fields: usize },
 }
 
 /// Why bytes are not an encoding of the message asked for.
@@ -21,6 +23,8 @@ pub enum DecodeError {
     PartialElement { field: &'static str },
     /// Whole bytes follow the message.
     Trailing { bytes: usize },
+    /// A union's tag names no field (`tag` is beyond its `fields`).
+    Tag { tag: usize, fields: usize },
 }
 
 /// Writes bits into a zeroed buffer.
