@@ -1,4 +1,4 @@
-"""The Cyphal options of the commands that read CAN captures (``battgen can``, ``battgen validate``).
+"""The Cyphal options of the commands that read CAN captures (``battgen can``, ``validate``, ``convert``, ``export``).
 
 The subject tables are imported where a pair is given: ``battgen validate`` of a JSON file starts without them."""
 
@@ -10,7 +10,7 @@ from ..inputs.model import MessageClass, package_name
 
 
 def add_cyphal_subject(p: argparse.ArgumentParser) -> None:
-    """``--cyphal-subject ID=TYPE``, as ``battgen can`` and ``battgen validate`` take it."""
+    """``--cyphal-subject ID=TYPE``, as every command reading CAN captures takes it."""
     p.add_argument(
         "--cyphal-subject",
         action="append",

@@ -1,0 +1,87 @@
+"""``battgen convert`` and ``battgen export`` of Cyphal/CAN captures whose frames pycyphal made.
+
+Each UDRAL SourceTs transfer is one record, with its node's latest Status and Parameters beside it (as a DroneCAN
+BatteryInfo takes its node's BatteryInfoAux); the values are compared with what pycyphal sent, read back by
+pycyphal's own deserializer from the same transfers' payloads.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+from test_can_cyphal import CYCLES, NODES, PARAMETERS, SOURCE, STATUS, SUBJECTS, _capture, _frames, _source, _status
+from test_can_cyphal import dsdl as dsdl  # the module's fixture: nunavut's classes of the bundled types
+
+from codegen.cli.main import main
+
+pytest.importorskip("pycyphal")
+import pycyphal.dsdl
+
+SERIAL = {12: 0xDEADBEEF12, 13: 0xDEADBEEF13}
+CAPACITY_AH = 10.0
+
+
+def _parameters(d: Any, node: int) -> Any:
+    charge = d["charge"].Scalar_1_0(coulomb=CAPACITY_AH * 3600.0)
+    return d["battery"].Parameters_0_3(
+        unique_id=SERIAL[node], design_capacity=charge, cycle_count=17, series_cell_count=6, name="pack"
+    )
+
+
+def _bus(d: Any, starts: list[float] | None = None) -> list[tuple[int, bytes]]:
+    """Each node's Parameters once, then Status and SourceTs every cycle: each SourceTs has both companions.
+    ``starts``: given, gets each SourceTs transfer's time (its start frame's; the capture has one frame a ms)."""
+    frames: list[tuple[int, bytes]] = []
+    for node in NODES:
+        frames += _frames(_parameters(d, node), PARAMETERS, node, 0, 7)
+    for cycle in range(CYCLES):
+        for node, cell in NODES.items():
+            frames += _frames(_status(d, cell, cycle), STATUS, node, cycle, 7)
+            if starts is not None:
+                starts.append(0.001 * len(frames))
+            frames += _frames(_source(d, cycle), SOURCE, node, cycle, 7)
+    return frames
+
+
+def _read_back(d: Any, obj: Any) -> Any:
+    """What pycyphal reads of the bytes it wrote: the values a receiver sees (float32, not the floats given)."""
+    return pycyphal.dsdl.deserialize(type(obj), [memoryview(bytes(b)) for b in pycyphal.dsdl.serialize(obj)])
+
+
+def test_convert_udral_capture_to_uorb_with_each_node_s_status_and_parameters(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    starts: list[float] = []
+    path = _capture(tmp_path / "bus.log", _bus(dsdl, starts))
+    code = main(["convert", "--from", "udral", "--to", "uorb", *SUBJECTS, str(path)])
+    records = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert code == 0 and len(records) == CYCLES * len(NODES)
+    for i, got in enumerate(records):  # the capture's order: each cycle, every node
+        cycle, node = divmod(i, len(NODES))
+        node = list(NODES)[node]
+        source = _read_back(dsdl, _source(dsdl, cycle)).value
+        status = _read_back(dsdl, _status(dsdl, NODES[node], cycle))
+        parameters = _read_back(dsdl, _parameters(dsdl, node))
+        assert got["voltage_v"] == pytest.approx(source.power.voltage.volt)
+        assert got["current_a"] == -source.power.current.ampere  # UDRAL's discharge is negative, uORB's positive
+        assert got["remaining"] == pytest.approx(source.energy.joule / source.full_energy.joule, rel=1e-6)
+        assert got["remaining_capacity_wh"] == pytest.approx(source.energy.joule / 3600.0, rel=1e-6)
+        assert got["temperature"] == pytest.approx(status.temperature_min_max[1].kelvin - 273.15, abs=1e-4)
+        cells = got["voltage_cell_v"][: len(status.cell_voltages)]
+        assert cells == pytest.approx([float(v) for v in status.cell_voltages])
+        assert got["cell_count"] == parameters.series_cell_count and got["cycle_count"] == parameters.cycle_count
+        assert math.isclose(got["timestamp"] / 1e6, starts[i], abs_tol=1e-6)  # s since the capture's first frame
+
+
+def test_convert_without_the_source_subject_is_one_line(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _capture(tmp_path / "bus.log", _bus(dsdl))
+    code = main(["convert", "--from", "udral", "--to", "uorb", f"--cyphal-subject={STATUS}=status", str(path)])
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert "expected --cyphal-subject ID=reg.udral.physics.electricity.SourceTs.0.1" in err
