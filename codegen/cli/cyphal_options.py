@@ -30,6 +30,15 @@ def check_subjects(pairs: list[str], cls: MessageClass) -> None:
         subject_table(pairs, cyphal_classes(package_name(cls)))
 
 
+def check_bundled_subjects(pairs: list[str]) -> None:
+    """As :func:`check_subjects`, for a command that reads with the bundled package (``battgen export``)."""
+    if pairs:
+        from ..apps.package import bundled_package
+        from ..inputs.can.cyphal_ports import cyphal_classes, subject_table
+
+        subject_table(pairs, cyphal_classes(bundled_package().__name__))
+
+
 def subject_message(pairs: list[str], package: str) -> str | None:
     """The message ``battgen validate`` checks by default given ``--cyphal-subject`` pairs: the first pair's type."""
     if not pairs:

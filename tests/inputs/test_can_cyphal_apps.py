@@ -16,6 +16,7 @@ import pytest
 from test_can_cyphal import CYCLES, NODES, PARAMETERS, SOURCE, STATUS, SUBJECTS, _capture, _frames, _source, _status
 from test_can_cyphal import dsdl as dsdl  # the module's fixture: nunavut's classes of the bundled types
 
+from codegen.apps.fleet_query import run_query
 from codegen.cli.main import main
 
 pytest.importorskip("pycyphal")
@@ -85,3 +86,44 @@ def test_convert_without_the_source_subject_is_one_line(
     err = capsys.readouterr().err
     assert code == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert "expected --cyphal-subject ID=reg.udral.physics.electricity.SourceTs.0.1" in err
+
+
+def test_export_udral_capture_rows_per_node_with_pycyphal_values(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    starts: list[float] = []
+    path = _capture(tmp_path / "bus.log", _bus(dsdl, starts))
+    out = tmp_path / "ds"
+    code = main(["export", "-q", "-o", str(out), *SUBJECTS, str(path)])
+    assert code == 0, capsys.readouterr().err
+    result = run_query(out, "SELECT * FROM battery ORDER BY t")
+    rows = [dict(zip(result.columns, row, strict=True)) for row in result.rows]
+    assert len(rows) == CYCLES * len(NODES)
+    for i, row in enumerate(rows):
+        cycle, node = divmod(i, len(NODES))
+        node = list(NODES)[node]
+        source = _read_back(dsdl, _source(dsdl, cycle)).value
+        status = _read_back(dsdl, _status(dsdl, NODES[node], cycle))
+        parameters = _read_back(dsdl, _parameters(dsdl, node))
+        assert row["message"] == "cyphal.reg.udral.physics.electricity.SourceTs_0_1"
+        assert row["battery"] == node  # UDRAL has no battery index: the node's id
+        assert row["t"] == pytest.approx(starts[i], abs=1e-6)  # the capture's clock: a transfer's start frame
+        assert row["time"].timestamp() == pytest.approx(1_700_000_000.0 + starts[i], abs=2e-5)
+        assert row["pack_voltage"] == pytest.approx(source.power.voltage.volt)
+        assert row["current"] == -source.power.current.ampere  # the concept counts a discharge as positive
+        assert row["remaining_energy"] == pytest.approx(source.energy.joule)
+        assert row["state_of_charge"] == pytest.approx(source.energy.joule / source.full_energy.joule, rel=1e-6)
+        assert row["temperature"] == pytest.approx(status.temperature_min_max[1].kelvin)
+        assert row["cell_voltages"] == pytest.approx([float(v) for v in status.cell_voltages])
+        assert row["serial_number"] == parameters.unique_id and row["cycle_count"] == parameters.cycle_count
+        assert row["design_capacity"] == pytest.approx(parameters.design_capacity.coulomb)
+
+
+def test_export_without_subjects_says_how_to_read_cyphal(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _capture(tmp_path / "bus.log", _bus(dsdl))
+    code = main(["export", "-q", "-o", str(tmp_path / "ds"), str(path)])
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert f"{path}: no battery records; its start frames are Cyphal/CAN's" in err and "--cyphal-subject" in err

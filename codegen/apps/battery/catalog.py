@@ -21,7 +21,7 @@ _MAPPED_FORMATS = ("uorb", "dronecan", "devicetree", "mavlink", "cyphal")
 _MAPPINGS_DIR = "mappings"
 
 # endpoints whose messages are battery records in logs (devicetree nodes are static facts)
-RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan", "cbat", "mavlink_sys_status")
+RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan", "cbat", "mavlink_sys_status", "udral")
 
 
 @dataclass(frozen=True)

@@ -95,6 +95,8 @@ class ColumnConverter(OpVisitor[None]):
     # -- facts ---------------------------------------------------------------------------------
 
     def fld(self, ref: FieldRef) -> Field:
+        if "." in ref.field:  # a number inside a composite (Cyphal's uavcan.si Scalars): its column is by the path
+            return self.catalog.schema.field_at(ref.message, ref.field)
         return self.source.message.field(ref.field)
 
     def col(self, ref: FieldRef) -> NDArray:
