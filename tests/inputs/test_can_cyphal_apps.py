@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+import pyarrow.parquet as pq
 import pytest
 from test_can_cyphal import CYCLES, NODES, PARAMETERS, SOURCE, STATUS, SUBJECTS, _capture, _frames, _source, _status
 from test_can_cyphal import dsdl as dsdl  # the module's fixture: nunavut's classes of the bundled types
@@ -94,7 +95,7 @@ def test_export_udral_capture_rows_per_node_with_pycyphal_values(
     starts: list[float] = []
     path = _capture(tmp_path / "bus.log", _bus(dsdl, starts))
     out = tmp_path / "ds"
-    code = main(["export", "-q", "-o", str(out), *SUBJECTS, str(path)])
+    code = main(["export", "-q", "--raw", "-o", str(out), *SUBJECTS, str(path)])
     assert code == 0, capsys.readouterr().err
     result = run_query(out, "SELECT * FROM battery ORDER BY t")
     rows = [dict(zip(result.columns, row, strict=True)) for row in result.rows]
@@ -117,6 +118,14 @@ def test_export_udral_capture_rows_per_node_with_pycyphal_values(
         assert row["cell_voltages"] == pytest.approx([float(v) for v in status.cell_voltages])
         assert row["serial_number"] == parameters.unique_id and row["cycle_count"] == parameters.cycle_count
         assert row["design_capacity"] == pytest.approx(parameters.design_capacity.coulomb)
+    # --raw: SourceTs's own table, the numbers inside its Scalars by their paths, as pycyphal reads them
+    (raw,) = (out / "raw" / "cyphal.reg.udral.physics.electricity.SourceTs_0_1").glob("*/*.parquet")
+    table = pq.read_table(raw).sort_by([("instance", "ascending"), ("t", "ascending")])
+    sent = [_read_back(dsdl, _source(dsdl, cycle)).value for cycle in range(CYCLES)] * len(NODES)
+    assert table["instance"].to_pylist() == [n for n in NODES for _ in range(CYCLES)]
+    assert table["value.power.voltage.volt"].to_pylist() == [float(s.power.voltage.volt) for s in sent]
+    assert table["value.energy.joule"].to_pylist() == [float(s.energy.joule) for s in sent]
+    assert table.schema.field("value.power.current.ampere").metadata == {b"unit": b"A", b"invalid": b"NaN"}
 
 
 def test_export_without_subjects_says_how_to_read_cyphal(

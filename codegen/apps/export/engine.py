@@ -163,7 +163,9 @@ def _export(
             table = battery_table(catalog, schema, columns, batch, log, file.name)
             writer.add(table)
             if options.raw and batch.message in catalog.sources:
-                writer.add_raw(batch.message, raw_table(catalog.schema.message(batch.message), batch, log))
+                writer.add_raw(
+                    batch.message, raw_table(catalog.schema.message(batch.message), batch, log, catalog.schema)
+                )
             messages.add(batch.message)
             notes.extend(n for n in batch.notes if n not in notes)
             warnings.extend(batch.warnings)
