@@ -34,7 +34,15 @@ def _parameters(d: Any, node: int) -> Any:
     )
 
 
-def _bus(d: Any, starts: list[float] | None = None) -> list[tuple[int, bytes]]:
+def _no_energy(d: Any, cycle: int) -> Any:
+    """A SourceTs without its energies (NaN: unknown, as UDRAL's rule has it): the SoC is Status's charge over
+    Parameters' design capacity."""
+    sent = _source(d, cycle)
+    sent.value.energy.joule = sent.value.full_energy.joule = math.nan
+    return sent
+
+
+def _bus(d: Any, starts: list[float] | None = None, source: Any = _source) -> list[tuple[int, bytes]]:
     """Each node's Parameters once, then Status and SourceTs every cycle: each SourceTs has both companions.
     ``starts``: given, gets each SourceTs transfer's time (its start frame's; the capture has one frame a ms)."""
     frames: list[tuple[int, bytes]] = []
@@ -45,7 +53,7 @@ def _bus(d: Any, starts: list[float] | None = None) -> list[tuple[int, bytes]]:
             frames += _frames(_status(d, cell, cycle), STATUS, node, cycle, 7)
             if starts is not None:
                 starts.append(0.001 * len(frames))
-            frames += _frames(_source(d, cycle), SOURCE, node, cycle, 7)
+            frames += _frames(source(d, cycle), SOURCE, node, cycle, 7)
     return frames
 
 
@@ -126,6 +134,24 @@ def test_export_udral_capture_rows_per_node_with_pycyphal_values(
     assert table["value.power.voltage.volt"].to_pylist() == [float(s.power.voltage.volt) for s in sent]
     assert table["value.energy.joule"].to_pylist() == [float(s.energy.joule) for s in sent]
     assert table.schema.field("value.power.current.ampere").metadata == {b"unit": b"A", b"invalid": b"NaN"}
+
+
+def test_soc_from_status_and_parameters_where_the_source_has_no_energy(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """UDRAL (Status.0.2): the SoC "can be derived by dividing this value by the nominal battery capacity reported
+    in the Parameters message"; convert and export agree on it."""
+    path = _capture(tmp_path / "bus.log", _bus(dsdl, source=_no_energy))
+    assert main(["convert", "--from", "udral", "--to", "uorb", *SUBJECTS, str(path)]) == 0
+    converted = [json.loads(line)["remaining"] for line in capsys.readouterr().out.splitlines()]
+    assert main(["export", "-q", "-o", str(tmp_path / "ds"), *SUBJECTS, str(path)]) == 0
+    exported = [r[0] for r in run_query(tmp_path / "ds", "SELECT state_of_charge FROM battery ORDER BY t").rows]
+    expected = []
+    for cycle in range(CYCLES):
+        for node, cell in NODES.items():
+            charge = _read_back(dsdl, _status(dsdl, cell, cycle)).available_charge.coulomb
+            expected.append(charge / _read_back(dsdl, _parameters(dsdl, node)).design_capacity.coulomb)
+    assert converted == pytest.approx(expected, rel=1e-6) and exported == pytest.approx(expected, rel=1e-6)
 
 
 def test_export_without_subjects_says_how_to_read_cyphal(

@@ -28,7 +28,7 @@ from ...inputs.can.captures import capture_start
 from ...inputs.can.records import capture_side
 from ...inputs.model import MessageClass
 from ...inputs.records import InputError, Notice, Record, Unreadable
-from .catalog import Catalog
+from .catalog import Catalog, SourceMapping
 from .columnar import convert_columns
 from .columns import ConceptColumn, NDArray
 from .sources import Batch, instances_to_columns
@@ -170,8 +170,36 @@ def _batch(catalog: Catalog, qualified: Sequence[str], node: int, records: list[
         aux = convert_columns(catalog, mapping, aux_columns, len(seen))
         for concept, column in aux.items():
             _fill(concepts[concept], column, rows)
+    together = catalog.joint.get(main)
+    if together is not None:
+        _joint(catalog, together, qualified, records, concepts)
     batch.concepts = concepts
     return batch
+
+
+def _joint(
+    catalog: Catalog,
+    mapping: SourceMapping,
+    qualified: Sequence[str],
+    records: list[Record],
+    concepts: dict[str, ConceptColumn],
+) -> None:
+    """The rules reading several companions together (UDRAL's SoC from Status and Parameters), on the records
+    beside which the node had sent each of them; like a companion's, they fill only what is still unknown."""
+    read = {s.message for rule in mapping.rules for s in rule.sources}
+    positions = [i for i, q in enumerate(qualified[1:]) if q in read]
+    rows = np.array([all(r.companions[i] is not None for i in positions) for r in records], bool)
+    if not rows.any():
+        return
+    columns: dict[str, NDArray] = {}
+    for i in positions:
+        message = catalog.schema.message(qualified[1 + i])
+        paths = {s.field for rule in mapping.rules for s in rule.sources if s.message == message.qualified_name}
+        seen = [r.companions[i] for r, ok in zip(records, rows, strict=True) if ok]
+        found = instances_to_columns(message, seen, catalog.schema, paths)
+        columns.update((k, v) for k, v in found.items() if k.partition("#")[0] in paths)
+    for concept, column in convert_columns(catalog, mapping, columns, int(rows.sum())).items():
+        _fill(concepts[concept], column, rows)
 
 
 def _fill(target: ConceptColumn, source: ConceptColumn, rows: NDArray) -> None:

@@ -95,7 +95,9 @@ class ColumnConverter(OpVisitor[None]):
     # -- facts ---------------------------------------------------------------------------------
 
     def fld(self, ref: FieldRef) -> Field:
-        if "." in ref.field:  # a number inside a composite (Cyphal's uavcan.si Scalars): its column is by the path
+        # a number inside a composite (Cyphal's uavcan.si Scalars), its column by the path; or a field of another
+        # message read beside this one (a rule reading two companions together)
+        if "." in ref.field or ref.message != self.source.message.qualified_name:
             return self.catalog.schema.field_at(ref.message, ref.field)
         return self.source.message.field(ref.field)
 
