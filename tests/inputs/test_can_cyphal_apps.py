@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pyarrow.parquet as pq
 import pytest
 from test_can_cyphal import CYCLES, NODES, PARAMETERS, SOURCE, STATUS, SUBJECTS, _capture, _frames, _source, _status
@@ -162,3 +163,27 @@ def test_export_without_subjects_says_how_to_read_cyphal(
     err = capsys.readouterr().err
     assert code == 1 and "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert f"{path}: no battery records; its start frames are Cyphal/CAN's" in err and "--cyphal-subject" in err
+
+
+def test_a_large_udral_capture_read_twice_gives_the_batches_of_one_read(
+    dsdl: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A capture past the streaming size is read in chunks: the same UDRAL concepts as one read."""
+    from codegen.apps.battery import can_batches as can
+    from codegen.apps.battery.catalog import bundled_catalog
+    from codegen.apps.battery.sources import model_of
+
+    path = _capture(tmp_path / "bus.log", _bus(dsdl))
+    subjects = [s.partition("=")[2] for s in SUBJECTS]
+    catalog = bundled_catalog()
+    once = list(can.can_batches(path, path.name, catalog, model_of, subjects))
+    monkeypatch.setattr(can, "STREAM_ABOVE", 0)
+    monkeypatch.setattr(can, "CHUNK", 2)
+    twice = list(can.can_batches(path, path.name, catalog, model_of, subjects))
+    assert [b.instance[0] for b in once] == list(NODES) and all(b.n <= 2 for b in twice)
+    for whole in once:
+        parts = [b for b in twice if b.instance[0] == whole.instance[0]]
+        assert whole.concepts is not None
+        for name, column in whole.concepts.items():
+            joined = np.concatenate([p.concepts[name].values for p in parts if p.concepts is not None])
+            np.testing.assert_array_equal(joined, column.values, err_msg=name)
