@@ -187,3 +187,16 @@ def test_a_large_udral_capture_read_twice_gives_the_batches_of_one_read(
         for name, column in whole.concepts.items():
             joined = np.concatenate([p.concepts[name].values for p in parts if p.concepts is not None])
             np.testing.assert_array_equal(joined, column.values, err_msg=name)
+
+
+def test_export_in_worker_processes_takes_the_subjects(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--jobs: the subjects travel to the worker processes with the export's options."""
+    first = _capture(tmp_path / "a.log", _bus(dsdl))
+    second = _capture(tmp_path / "b.log", _bus(dsdl, source=_no_energy))
+    out = tmp_path / "ds"
+    code = main(["export", "-q", "--jobs", "2", "-o", str(out), *SUBJECTS, str(first), str(second)])
+    assert code == 0, capsys.readouterr().err
+    rows = run_query(out, "SELECT source, count(*) FROM battery GROUP BY source ORDER BY source").rows
+    assert rows == [("a.log", CYCLES * len(NODES)), ("b.log", CYCLES * len(NODES))]
