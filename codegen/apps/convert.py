@@ -254,8 +254,11 @@ class Conversion:
             f"no converter from {self.source_name} to {self.target_name}; from {self.source_name}: {', '.join(targets)}"
         )
 
-    def __init__(self, package: str | None, source: str, target: str, policy: str) -> None:
+    def __init__(
+        self, package: str | None, source: str, target: str, policy: str, subjects: Sequence[str] = ()
+    ) -> None:
         self.module = converters(package)
+        self.subjects = tuple(subjects)  # ``ID=TYPE`` pairs: the Cyphal types a capture's subjects carry
         self.source_name, self.target_name = side_name(self.module, source), side_name(self.module, target)
         key = (self.source_name, self.target_name)
         if key not in self.module.CONVERTERS:
@@ -351,7 +354,7 @@ class Conversion:
             if not isinstance(source, Path):
                 raise BattgenError(f"{where}: a CAN capture is read from a file, not from standard input")
             models = [c for _, c in self.source.items if isinstance(c, MessageClass)]
-            for item in capture_side(source, where, models):
+            for item in capture_side(source, where, models, self.subjects):
                 if isinstance(item, Record):
                     yield Record(
                         item.index,

@@ -33,8 +33,10 @@ import yaml
 
 from ..apps.convert import FORMATS, LOG_FORMATS, Conversion, Converted, input_format, output_format
 from ..errors import BattgenError
+from ..inputs.model import MessageClass
 from ..inputs.records import Notice
 from ..text.escape import line
+from .cyphal_options import add_cyphal_subject, check_subjects
 
 
 def register(subparsers: Any, summary: str) -> None:
@@ -69,6 +71,7 @@ def register(subparsers: Any, summary: str) -> None:
     p.add_argument(
         "--allow-empty", action="store_true", help="an input without records is not an error (default: exit 1)"
     )
+    add_cyphal_subject(p)
     p.set_defaults(func=run)
 
 
@@ -86,7 +89,10 @@ def _inputs(settings: list[str]) -> dict[str, float]:
 
 
 def run(args: argparse.Namespace) -> int:
-    conversion = Conversion(args.package, args.source, args.target, args.policy)
+    conversion = Conversion(args.package, args.source, args.target, args.policy, args.cyphal_subject)
+    first = conversion.source.items[0][1]
+    if isinstance(first, MessageClass):
+        check_subjects(args.cyphal_subject, first)
     extra = _inputs(args.set)
     for name in extra:
         if name not in conversion.inputs_taken:

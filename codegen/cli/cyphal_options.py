@@ -1,4 +1,4 @@
-"""The Cyphal options of the commands that read CAN captures (``battgen can``, ``battgen validate``).
+"""The Cyphal options of the commands that read CAN captures (``battgen can``, ``validate``, ``convert``, ``export``).
 
 The subject tables are imported where a pair is given: ``battgen validate`` of a JSON file starts without them."""
 
@@ -10,7 +10,7 @@ from ..inputs.model import MessageClass, package_name
 
 
 def add_cyphal_subject(p: argparse.ArgumentParser) -> None:
-    """``--cyphal-subject ID=TYPE``, as ``battgen can`` and ``battgen validate`` take it."""
+    """``--cyphal-subject ID=TYPE``, as every command reading CAN captures takes it."""
     p.add_argument(
         "--cyphal-subject",
         action="append",
@@ -28,6 +28,15 @@ def check_subjects(pairs: list[str], cls: MessageClass) -> None:
         from ..inputs.can.cyphal_ports import cyphal_classes, subject_table
 
         subject_table(pairs, cyphal_classes(package_name(cls)))
+
+
+def check_bundled_subjects(pairs: list[str]) -> None:
+    """As :func:`check_subjects`, for a command that reads with the bundled package (``battgen export``)."""
+    if pairs:
+        from ..apps.package import bundled_package
+        from ..inputs.can.cyphal_ports import cyphal_classes, subject_table
+
+        subject_table(pairs, cyphal_classes(bundled_package().__name__))
 
 
 def subject_message(pairs: list[str], package: str) -> str | None:

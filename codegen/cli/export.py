@@ -40,6 +40,7 @@ from typing import Any
 
 from ..errors import BattgenError
 from ..text.escape import line
+from .cyphal_options import add_cyphal_subject, check_bundled_subjects
 
 EXIT_OK, EXIT_FAILED, EXIT_UNREADABLE = 0, 1, 2
 _SUFFIXES = (".ulg", ".tlog", ".bin", ".jsonl", ".ndjson", ".asc", ".blf", ".trc")
@@ -58,6 +59,7 @@ def register(subparsers: Any, summary: str) -> None:
     p.add_argument("-o", "--out", required=True, metavar="DIR", help="the dataset folder (created if needed)")
     p.add_argument("--raw", action="store_true", help="also write each message's table, fields as decoded")
     p.add_argument("--message", help="the message of JSON Lines inputs (default: told from their keys)")
+    add_cyphal_subject(p)
     p.add_argument(
         "--failsafe",
         metavar="PARAMS",
@@ -162,12 +164,22 @@ def run(args: argparse.Namespace) -> int:
         print("battgen: --vehicle is the failsafe replay's: give --failsafe PARAMS too", file=sys.stderr)
         return EXIT_UNREADABLE
     try:
+        check_bundled_subjects(args.cyphal_subject)
+    except BattgenError as exc:
+        print(line(f"battgen: --cyphal-subject: {exc}"), file=sys.stderr)
+        return EXIT_UNREADABLE
+    try:
         replay = None if args.failsafe is None else failsafe_options(args.failsafe, args.vehicle, args.firmware)
     except BattgenError as exc:
         print(line(f"battgen: --failsafe: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     options = engine.ExportOptions(
-        Path(args.out), raw=args.raw, message=args.message, failsafe=replay, partition=args.partition
+        Path(args.out),
+        raw=args.raw,
+        message=args.message,
+        failsafe=replay,
+        partition=args.partition,
+        cyphal_subjects=tuple(args.cyphal_subject),
     )
     step, close = _progress(len(logs), args.quiet)
     try:

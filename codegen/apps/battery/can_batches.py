@@ -28,7 +28,7 @@ from ...inputs.can.captures import capture_start
 from ...inputs.can.records import capture_side
 from ...inputs.model import MessageClass
 from ...inputs.records import InputError, Notice, Record, Unreadable
-from .catalog import Catalog
+from .catalog import Catalog, SourceMapping
 from .columnar import convert_columns
 from .columns import ConceptColumn, NDArray
 from .sources import Batch, instances_to_columns
@@ -37,41 +37,59 @@ INFO = "dronecan.uavcan.equipment.power.BatteryInfo"
 AUX = "dronecan.ardupilot.equipment.power.BatteryInfoAux"
 CBAT = "dronecan.cuav.equipment.power.CBAT"
 MESSAGES = ((INFO, AUX), (CBAT,))  # each read with its companions
+# UDRAL's battery service (read where --cyphal-subject names its subjects: Cyphal/CAN frames carry no type)
+UDRAL = (
+    "cyphal.reg.udral.physics.electricity.SourceTs_0_1",
+    "cyphal.reg.udral.service.battery.Status_0_2",
+    "cyphal.reg.udral.service.battery.Parameters_0_3",
+)
 ModelOf = Callable[[Catalog, str], MessageClass]
 
 
+# said where a capture read as DroneCAN gave no battery record but had start frames as Cyphal/CAN sends them
+CYPHAL_LIKE = (
+    "no battery records; its start frames are Cyphal/CAN's (toggle bit set): give --cyphal-subject ID=TYPE for the "
+    "subjects its UDRAL batteries publish (energy_source, status, parameters)"
+)
 STREAM_ABOVE = 8 << 20  # bytes: a larger capture is read twice, its batteries handed out in chunks (flat memory)
 CHUNK = 1 << 16  # records per batch of a capture read twice
 
 
-def can_batches(path: Path, name: str, catalog: Catalog, model_of: ModelOf) -> Iterator[Batch]:
+def can_batches(
+    path: Path, name: str, catalog: Catalog, model_of: ModelOf, subjects: Sequence[str] = ()
+) -> Iterator[Batch]:
     """Every battery node's batches of a capture; raises InputError if the capture is unreadable. A capture of up
     to :data:`STREAM_ABOVE` bytes is read once, each node's message one batch; a larger one twice -- first to
     learn which battery ids the nodes use (the numbering needs them all), then handing out each node's records
-    every :data:`CHUNK` -- so memory stays flat whatever its length. Both give the same records."""
+    every :data:`CHUNK` -- so memory stays flat whatever its length. Both give the same records. ``subjects``: the
+    ``--cyphal-subject`` pairs; given, UDRAL's SourceTs records (with their node's Status and Parameters) too."""
     try:
         streamed = path.stat().st_size > STREAM_ABOVE
     except OSError:
         streamed = False  # the reader says why it cannot read it
     notes: list[str] = []
     if not streamed:
-        out = list(_walk(path, name, catalog, model_of, notes, None))
+        out = list(_walk(path, name, catalog, model_of, notes, None, subjects))
+        if not out and CYPHAL_LIKE in notes:
+            raise InputError(name, 0, CYPHAL_LIKE)
         shared = _shared_ids(_battery_ids(out))
         yield from _finished(out, shared, _told(notes, shared), capture_start(path, name) if out else None)
         return
     ids: dict[int, set[int]] = {}
-    for batch in _walk(path, name, catalog, model_of, [], CHUNK):
+    for batch in _walk(path, name, catalog, model_of, [], CHUNK, subjects):
         for node, found in _battery_ids([batch]).items():
             ids.setdefault(node, set()).update(found)
     shared = _shared_ids(ids)
     start = capture_start(path, name)
     previous: Batch | None = None
-    for batch in _walk(path, name, catalog, model_of, notes, CHUNK):
+    for batch in _walk(path, name, catalog, model_of, notes, CHUNK, subjects):
         if previous is not None:
             yield from _finished([previous], shared, [], start)
         previous = batch
     if previous is not None:  # the notes (damage counts) are known once the capture is read: on its last batch
         yield from _finished([previous], shared, _told(notes, shared), start)
+    elif CYPHAL_LIKE in notes:
+        raise InputError(name, 0, CYPHAL_LIKE)
 
 
 def _told(notes: list[str], shared: str | None) -> list[str]:
@@ -79,14 +97,22 @@ def _told(notes: list[str], shared: str | None) -> list[str]:
 
 
 def _walk(
-    path: Path, name: str, catalog: Catalog, model_of: ModelOf, notes: list[str], chunk: int | None
+    path: Path,
+    name: str,
+    catalog: Catalog,
+    model_of: ModelOf,
+    notes: list[str],
+    chunk: int | None,
+    subjects: Sequence[str],
 ) -> Iterator[Batch]:
     """Each node's records of each message as batches: at most ``chunk`` records each (None: one per node)."""
-    for qualified in MESSAGES:
+    # the damage is counted once: by the pass that reads the bus as it is (both protocols where subjects are given)
+    counted = UDRAL[0] if subjects else INFO
+    for qualified in (*MESSAGES, UDRAL) if subjects else MESSAGES:
         models = [model_of(catalog, q) for q in qualified]
         by_node: dict[int, list[Record]] = {}
         damaged: list[str] = []
-        for item in capture_side(path, name, models):
+        for item in capture_side(path, name, models, subjects):
             if isinstance(item, Record):
                 node = int(cast(int, (item.location or {}).get("node", 0)))
                 records = by_node.setdefault(node, [])
@@ -99,8 +125,10 @@ def _walk(
             elif isinstance(item, Notice):
                 if item.kind == "empty" and item.severity == "error":
                     raise InputError(name, 0, item.message)
-                if item.kind == "transport" and item.severity == "error" and qualified[0] == INFO:
+                if item.kind == "transport" and item.severity == "error" and qualified[0] == counted:
                     damaged.append(item.message)
+                if (item.data or {}).get("code") == "can-cyphal-like" and CYPHAL_LIKE not in notes:
+                    notes.append(CYPHAL_LIKE)
         if damaged:
             notes.append(f"{len(damaged)} damaged or undecodable transfers skipped (first: {damaged[0]})")
         for node, records in sorted(by_node.items()):
@@ -128,7 +156,7 @@ def _batch(catalog: Catalog, qualified: Sequence[str], node: int, records: list[
     n = len(records)
     main = qualified[0]
     instances = [r.instance for r in records]
-    columns = instances_to_columns(catalog.schema.message(main), instances)
+    columns = instances_to_columns(catalog.schema.message(main), instances, catalog.schema, catalog.source(main).fields)
     t = np.array([float(cast(float, (r.location or {}).get("t", np.nan))) for r in records])
     batch = Batch(main, n, columns, t, np.full(n, node))
     concepts = convert_columns(catalog, catalog.source(main), columns, n)
@@ -137,12 +165,41 @@ def _batch(catalog: Catalog, qualified: Sequence[str], node: int, records: list[
         if not rows.any():
             continue
         seen = [m for m in (r.companions[position] for r in records) if m is not None]
-        aux_columns = instances_to_columns(catalog.schema.message(companion), seen)
-        aux = convert_columns(catalog, catalog.companions[companion], aux_columns, len(seen))
+        mapping = catalog.companions[companion]
+        aux_columns = instances_to_columns(mapping.message, seen, catalog.schema, mapping.fields)
+        aux = convert_columns(catalog, mapping, aux_columns, len(seen))
         for concept, column in aux.items():
             _fill(concepts[concept], column, rows)
+    together = catalog.joint.get(main)
+    if together is not None:
+        _joint(catalog, together, qualified, records, concepts)
     batch.concepts = concepts
     return batch
+
+
+def _joint(
+    catalog: Catalog,
+    mapping: SourceMapping,
+    qualified: Sequence[str],
+    records: list[Record],
+    concepts: dict[str, ConceptColumn],
+) -> None:
+    """The rules reading several companions together (UDRAL's SoC from Status and Parameters), on the records
+    beside which the node had sent each of them; like a companion's, they fill only what is still unknown."""
+    read = {s.message for rule in mapping.rules for s in rule.sources}
+    positions = [i for i, q in enumerate(qualified[1:]) if q in read]
+    rows = np.array([all(r.companions[i] is not None for i in positions) for r in records], bool)
+    if not rows.any():
+        return
+    columns: dict[str, NDArray] = {}
+    for i in positions:
+        message = catalog.schema.message(qualified[1 + i])
+        paths = {s.field for rule in mapping.rules for s in rule.sources if s.message == message.qualified_name}
+        seen = [r.companions[i] for r, ok in zip(records, rows, strict=True) if ok]
+        found = instances_to_columns(message, seen, catalog.schema, paths)
+        columns.update((k, v) for k, v in found.items() if k.partition("#")[0] in paths)
+    for concept, column in convert_columns(catalog, mapping, columns, int(rows.sum())).items():
+        _fill(concepts[concept], column, rows)
 
 
 def _fill(target: ConceptColumn, source: ConceptColumn, rows: NDArray) -> None:

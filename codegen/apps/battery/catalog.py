@@ -7,6 +7,7 @@ each one all come from here, so the export has no unit, sentinel or field name o
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,7 +22,7 @@ _MAPPED_FORMATS = ("uorb", "dronecan", "devicetree", "mavlink", "cyphal")
 _MAPPINGS_DIR = "mappings"
 
 # endpoints whose messages are battery records in logs (devicetree nodes are static facts)
-RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan", "cbat", "mavlink_sys_status")
+RECORD_ENDPOINTS = ("uorb", "uorb_v0", "mavlink", "dronecan", "cbat", "mavlink_sys_status", "udral")
 
 
 @dataclass(frozen=True)
@@ -58,6 +59,9 @@ class Catalog:
     sources: dict[str, SourceMapping]  # by qualified message name
     # an endpoint's other messages (DroneCAN's BatteryInfoAux), with the rules that read them alone
     companions: dict[str, SourceMapping]
+    # by record message: the rules reading several of its companions together (UDRAL's SoC from Status's charge
+    # over Parameters' design capacity), as a mapping of the first companion they read
+    joint: dict[str, SourceMapping] = dataclasses.field(default_factory=dict)
 
     def concept(self, name: str) -> Concept:
         for c in self.concepts:
@@ -82,6 +86,7 @@ def build_catalog(schema: Schema) -> Catalog:
         endpoints.update({e.name: e for e in mset.endpoints})
     sources: dict[str, SourceMapping] = {}
     companions: dict[str, SourceMapping] = {}
+    joint: dict[str, SourceMapping] = {}
     for mset in schema.mappings:
         for mapping in mset.mappings:
             if mapping.target != CONCEPTS_ENDPOINT or mapping.source not in RECORD_ENDPOINTS:
@@ -104,9 +109,18 @@ def build_catalog(schema: Schema) -> Catalog:
                 )
                 if alone:
                     companions[other] = SourceMapping(mapping.source, schema.message(other), alone)
+            together = tuple(
+                r
+                for r in mapping.rules
+                if r.only in (None, Direction.FORWARD)
+                and len({s.message for s in r.sources}) > 1
+                and all(s.message in endpoint.messages[1:] for s in r.sources)
+            )
+            if together:
+                joint[first] = SourceMapping(mapping.source, schema.message(together[0].sources[0].message), together)
     if not concepts or not sources:
         raise BattgenError("the schemas hold no battery concepts or mappings to them (schemas/mappings/)")
-    return Catalog(schema, tuple(concepts), sources, companions)
+    return Catalog(schema, tuple(concepts), sources, companions, joint)
 
 
 @functools.cache

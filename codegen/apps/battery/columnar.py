@@ -95,6 +95,10 @@ class ColumnConverter(OpVisitor[None]):
     # -- facts ---------------------------------------------------------------------------------
 
     def fld(self, ref: FieldRef) -> Field:
+        # a number inside a composite (Cyphal's uavcan.si Scalars), its column by the path; or a field of another
+        # message read beside this one (a rule reading two companions together)
+        if "." in ref.field or ref.message != self.source.message.qualified_name:
+            return self.catalog.schema.field_at(ref.message, ref.field)
         return self.source.message.field(ref.field)
 
     def col(self, ref: FieldRef) -> NDArray:

@@ -4,7 +4,7 @@ the others through :mod:`.sources`."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from ...inputs.held_file import Buffer, held, whole
@@ -27,13 +27,15 @@ def read_log(
     message: str | None = None,
     source: Buffer | None = None,
     all_fields: bool = True,
+    subjects: Sequence[str] = (),
 ) -> Iterator[Batch]:
     """The battery batches of one log, one at a time (a ULog's in chunks: memory stays flat). Raises
     InputError (or another BattgenError) if unreadable. ``source``: a memory map of a ULog file the
     caller holds (the log closes it); without ``all_fields`` a ULog batch holds only the fields the
     mapping reads (and the timestamp); ``message``: that of JSON Lines records (None: told from
-    their keys). The file is held still while it is read (:mod:`...inputs.held_file`): a program
-    that rewrites it meanwhile makes this raise FileChanged, never a crash."""
+    their keys); ``subjects``: the ``--cyphal-subject`` pairs a CAN capture is read with. The file is
+    held still while it is read (:mod:`...inputs.held_file`): a program that rewrites it meanwhile
+    makes this raise FileChanged, never a crash."""
     kind = log_kind(path)
     with held(path, name) as hold:
         if kind == "ulog":
@@ -45,6 +47,6 @@ def read_log(
         elif kind == "dataflash":
             yield from dataflash_batches(path, name, catalog)
         elif kind == "can":
-            yield from can_batches(path, name, catalog, model_of)
+            yield from can_batches(path, name, catalog, model_of, subjects)
         else:
             yield from jsonl_batches(path, name, catalog, message)

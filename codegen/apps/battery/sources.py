@@ -11,7 +11,7 @@ and JSON Lines (.jsonl/.ndjson) read record by record through the shared readers
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
@@ -27,7 +27,7 @@ from ...inputs.kinds import LOG_KINDS, detect
 from ...inputs.model import MessageClass, UorbClass
 from ...inputs.records import InputError, Record, Unreadable
 from ...inputs.ulog_columns import UlogColumns
-from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
+from ...ir import ArrayType, Field, Message, PrimitiveKind, PrimitiveType, Schema, StringType
 from ..package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
 from .columns import ConceptColumn, NDArray, length_key
@@ -176,29 +176,56 @@ def _dtype(ftype: object) -> Any:
     return object
 
 
-def instances_to_columns(message: Message, instances: Sequence[object]) -> dict[str, NDArray]:
-    """Decoded records (generated instances) as columns by schema field name."""
+def instances_to_columns(
+    message: Message, instances: Sequence[object], schema: Schema | None = None, paths: Iterable[str] = ()
+) -> dict[str, NDArray]:
+    """Decoded records (generated instances) as columns by schema field name; and, given the ``schema``, a column for
+    each dotted path of ``paths`` (a number inside a Cyphal composite: ``value.power.voltage.volt``,
+    ``temperature_min_max.1.kelvin``), keyed by the path as the mapping's rules name it."""
     out: dict[str, NDArray] = {}
     for f in message.fields:
-        if f.is_padding:
+        if not f.is_padding:
+            attr = naming.field_identifier(f.name, f.pattern)
+            out.update(_field_columns(f, f.name, [getattr(x, attr) for x in instances]))
+    for path in paths:
+        if "." not in path or schema is None:
             continue
-        attr = naming.field_identifier(f.name, f.pattern)
-        values = [getattr(x, attr) for x in instances]
-        dtype = _dtype(f.type)
-        texts = any(isinstance(v, bytes | str) for v in values)
-        if isinstance(f.type, ArrayType) and not isinstance(f.type.element, StringType) and not texts:
-            width = f.type.capacity or max((len(v) for v in values), default=0)
-            matrix = np.zeros((len(values), width), dtype)
-            for i, v in enumerate(values):
-                matrix[i, : len(v)] = v
-            out[f.name] = matrix
-            if f.type.dynamic:
-                out[length_key(f.name)] = np.array([len(v) for v in values], np.int64)
-        else:
-            column = np.empty(len(values), object if texts else dtype)
-            column[:] = values
-            out[f.name] = column
+        steps = path.split(".")
+        getters: list[str | int] = []
+        for i, step in enumerate(steps):
+            if step.isdigit():
+                getters.append(int(step))
+            else:
+                at = schema.field_at(message.qualified_name, ".".join(steps[: i + 1]))
+                getters.append(naming.field_identifier(at.name, at.pattern))
+        values = [_follow(x, getters) for x in instances]
+        out.update(_field_columns(schema.field_at(message.qualified_name, path), path, values))
     return out
+
+
+def _follow(instance: object, getters: Sequence[str | int]) -> object:
+    value = instance
+    for g in getters:
+        value = value[g] if isinstance(g, int) else getattr(value, g)  # type: ignore[index]
+    return value
+
+
+def _field_columns(f: Field, key: str, values: Sequence[Any]) -> dict[str, NDArray]:
+    """One field's values as its column (an array field: a matrix, and its lengths if it is dynamic)."""
+    dtype = _dtype(f.type)
+    texts = any(isinstance(v, bytes | str) for v in values)
+    if isinstance(f.type, ArrayType) and not isinstance(f.type.element, StringType) and not texts:
+        width = f.type.capacity or max((len(v) for v in values), default=0)
+        matrix = np.zeros((len(values), width), dtype)
+        for i, v in enumerate(values):
+            matrix[i, : len(v)] = v
+        out = {key: matrix}
+        if f.type.dynamic:
+            out[length_key(key)] = np.array([len(v) for v in values], np.int64)
+        return out
+    column = np.empty(len(values), object if texts else dtype)
+    column[:] = values
+    return {key: column}
 
 
 FloatFields = tuple[tuple[str, Any], ...]  # (schema name, numpy type) of each float16/float32 field of a message

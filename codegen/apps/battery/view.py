@@ -17,7 +17,7 @@ instance (:func:`battery_of`).
 from __future__ import annotations
 
 import functools
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -71,13 +71,15 @@ def read_view(
     message: str | None = None,
     source: Buffer | None = None,
     all_fields: bool = False,
+    subjects: Sequence[str] = (),
 ) -> Iterator[Chunk]:
     """The chunks of one log, in the order its source reads them (a ULog topic instance in chunks of records;
     memory stays flat). Raises InputError (or another BattgenError) for a log that cannot be read. ``message``:
     that of JSON Lines records (None: told from their keys); ``source``: a memory map of a ULog the caller holds;
-    ``all_fields``: every field of ULog records in the batch, not only those the mapping reads."""
+    ``all_fields``: every field of ULog records in the batch, not only those the mapping reads; ``subjects``: the
+    ``--cyphal-subject`` pairs (``ID=TYPE``) a CAN capture's Cyphal subjects are read with."""
     catalog = catalog or bundled_catalog()
-    for batch in read_log(path, name or path.as_posix(), catalog, message, source, all_fields):
+    for batch in read_log(path, name or path.as_posix(), catalog, message, source, all_fields, subjects):
         concepts = batch.concepts
         if concepts is None:
             concepts = convert_columns(catalog, catalog.source(batch.message), batch.columns, batch.n)

@@ -41,7 +41,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from ...errors import BattgenError, OutputError
-from ...ir import ArrayType, Message, PrimitiveKind, PrimitiveType, StringType
+from ...ir import ArrayType, CompositeType, Field, Message, PrimitiveKind, PrimitiveType, Schema, StringType
+from ..battery.columns import length_key
 from ..battery.sources import Batch
 from .durable import TMP_PREFIX, fsync_dir, fsync_file, write_atomic
 from .manifest import BATTERY, LOGS, RAW, marker, marker_files, read_marker
@@ -183,19 +184,31 @@ def _raw_type(ftype: object) -> Any:
     return pa.string()
 
 
-def raw_table(message: Message, batch: Batch, log: str) -> Any:
-    """One batch as its message's own table: every field as decoded (arrays as lists)."""
+def _raw_fields(message: Message, batch: Batch, schema: Schema | None) -> Iterator[tuple[str, Field]]:
+    """The columns of a raw table, by name, with their fields: the message's own fields, but a composite one (a
+    Cyphal ``uavcan.si`` Scalar) as the numbers inside it the mapping reads, by their dotted paths
+    (``value.power.voltage.volt``)."""
+    for f in message.fields:
+        inner = f.type.element if isinstance(f.type, ArrayType) else f.type
+        if not f.is_padding and f.name in batch.columns and not isinstance(inner, CompositeType):
+            yield f.name, f
+    if schema is not None:
+        for key in sorted(k for k in batch.columns if "." in k and not k.endswith(length_key(""))):
+            yield key, schema.field_at(message.qualified_name, key)
+
+
+def raw_table(message: Message, batch: Batch, log: str, schema: Schema | None = None) -> Any:
+    """One batch as its message's own table: every field as decoded (arrays as lists); ``schema``: the one the
+    message is in, naming the fields inside its composite ones."""
     arrays = [
         repeated(log, batch.n),
         pa.array(np.asarray(batch.instance, np.int32), type=pa.int32()),
         floats(batch.t),
     ]
     fields = [pa.field("log", pa.string()), pa.field("instance", pa.int32()), pa.field("t", pa.float64())]
-    for f in message.fields:
-        if f.is_padding or f.name not in batch.columns:
-            continue
+    for name, f in _raw_fields(message, batch, schema):
         typ = _raw_type(f.type)
-        values = batch.columns[f.name]
+        values = batch.columns[name]
         if pa.types.is_list(typ) or pa.types.is_fixed_size_list(typ):
             if values.dtype == object:
                 arr = pa.array([list(v) for v in values], type=typ)
@@ -212,7 +225,7 @@ def raw_table(message: Message, batch: Batch, log: str) -> Any:
         meta = {"unit": f.unit.symbol} if f.unit is not None else {}
         if f.invalid is not None:
             meta["invalid"] = f.invalid.text
-        fields.append(pa.field(f.name, typ, metadata=meta or None))
+        fields.append(pa.field(name, typ, metadata=meta or None))
         arrays.append(arr)
     return pa.Table.from_arrays(
         arrays, schema=pa.schema(fields, metadata={"battgen": json.dumps({"message": message.qualified_name})})

@@ -56,6 +56,7 @@ class ExportOptions:
     partition: str = "log"  # "log" or "day" (see .dataset)
     content_id: str | None = None  # the hash naming logs (None: the dataset's, .dataset.content_scheme)
     earlier: tuple[tuple[str, str, int], ...] = ()  # (source, log, bytes) of the logs in the dataset at the start
+    cyphal_subjects: tuple[str, ...] = ()  # --cyphal-subject ID=TYPE: the Cyphal types of a CAN capture's subjects
 
 
 @dataclass(frozen=True)
@@ -150,13 +151,21 @@ def _export(
     first_us: int | None = None  # the log's first time of day (UTC µs), which names its day partition (--partition day)
     try:
         for chunk in read_view(
-            file, name, catalog=catalog, message=options.message, source=source, all_fields=options.raw
+            file,
+            name,
+            catalog=catalog,
+            message=options.message,
+            source=source,
+            all_fields=options.raw,
+            subjects=options.cyphal_subjects,
         ):
             batch, columns = chunk.batch, chunk.concepts
             table = battery_table(catalog, schema, columns, batch, log, file.name)
             writer.add(table)
             if options.raw and batch.message in catalog.sources:
-                writer.add_raw(batch.message, raw_table(catalog.schema.message(batch.message), batch, log))
+                writer.add_raw(
+                    batch.message, raw_table(catalog.schema.message(batch.message), batch, log, catalog.schema)
+                )
             messages.add(batch.message)
             notes.extend(n for n in batch.notes if n not in notes)
             warnings.extend(batch.warnings)
