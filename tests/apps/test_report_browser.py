@@ -16,6 +16,7 @@ import pytest
 from flight_logs import write_capture_flight, write_flight
 from report_browser import Page, open_page, require_browser
 from shared_data import SHARED, real_logs, require
+from test_report_log_facts import _commander_inputs
 
 from codegen.apps.report.downsample import POINT_BUDGET, planned_length
 from codegen.cli.main import main
@@ -145,7 +146,7 @@ def test_the_log_speaks_first_in_the_browser(tmp_path: Path) -> None:
     out = _report(tmp_path, "px4-warnings", log)
     page = open_page(out, "report-px4-warnings")
     _check(page, out.resolve().as_uri())
-    ulog = pyulog.ULog(str(log), ["battery_status", "vehicle_status"])
+    ulog = pyulog.ULog(str(log), ["battery_status", "vehicle_status", "failsafe_flags"])
     (header,) = page.headers
     assert header["hardware"] == ulog.msg_info_dict["ver_hw"]
     assert f"({ulog.msg_info_dict['ver_sw'][:8]})" in header["firmware"]
@@ -168,6 +169,7 @@ def test_the_log_speaks_first_in_the_browser(tmp_path: Path) -> None:
     assert [m["t"] for m in plot["modes"]] == pytest.approx([t for t in changes if t < times[-1]], abs=1e-6)
     flags = status.data["failsafe"]
     rising = [float(stamps[k]) for k in range(1, len(flags)) if flags[k] and not flags[k - 1]]
+    rising = sorted(rising + _commander_inputs(ulog, times[-1]))  # and commander's battery inputs (failsafe_flags)
     assert [f["t"] for f in plot["failsafes"]] == pytest.approx(rising, abs=1e-6) and rising
     shutil.copy(page.screenshot, tmp_path / "kept.png")  # the screenshot is the artefact a person looks at
 
