@@ -9,6 +9,8 @@ from typing import Any
 
 import pyarrow as pa
 
+from ..battery.sources import Batch
+
 _TEXT, _INT, _FLOAT = pa.string(), pa.int32(), pa.float64()
 # (name, type, doc, unit)
 EVENT_COLUMNS: tuple[tuple[str, Any, str, str | None], ...] = (
@@ -52,3 +54,13 @@ def table_schema(columns: Sequence[tuple[str, Any, str, str | None]], table: str
 
 EVENTS_SCHEMA = table_schema(EVENT_COLUMNS, "failsafe_events")
 REPLAYS_SCHEMA = table_schema(REPLAY_COLUMNS, "failsafe_replays")
+
+
+def events_table(rows: dict[str, list[Any]], clock: Batch | None) -> Any:
+    """The events table of one replay's rows (every column but ``time``, which each row's ``t`` gives where
+    ``clock``, a batch of the log, tells the time of day)."""
+    offset = None if clock is None else clock.utc_offset_us
+    origin = 0 if clock is None else clock.origin_us
+    times = [None if offset is None else origin + round(t * 1e6) + offset for t in rows["t"]]
+    columns = {**rows, "time": pa.array(times, pa.int64()).cast(EVENTS_SCHEMA.field("time").type)}
+    return pa.Table.from_pydict({name: columns[name] for name, *_ in EVENT_COLUMNS}, schema=EVENTS_SCHEMA)

@@ -26,12 +26,12 @@ import pyarrow as pa
 
 from ...errors import BattgenError
 from ..battery.sources import Batch
-from ..failsafe.firmware import FIRMWARES, PX4_PREFIXES, choose_firmware
+from ..failsafe.firmware import FIRMWARES, choose_firmware, px4_parameter_count
 from ..failsafe.flight import replay_flight
 from ..failsafe.logs import SampleTable, own_parameters
 from ..failsafe.stream import batt_parameter_count, read_parameter_values
 from ..failsafe.vehicles import VEHICLES
-from .failsafe_columns import EVENT_COLUMNS, EVENTS_SCHEMA, REPLAYS_SCHEMA
+from .failsafe_columns import EVENT_COLUMNS, REPLAYS_SCHEMA, events_table
 from .px4_failsafe_tables import px4_tables
 
 FAILSAFE = "failsafe"
@@ -65,7 +65,7 @@ def failsafe_options(given: str, vehicle: str | None = None, firmware: str | Non
         return FailsafeOptions(None, "log parameters (PARM)", vehicle, firmware)
     path = Path(given)
     values = read_parameter_values(path)
-    if not batt_parameter_count(values) and not any(name.startswith(PX4_PREFIXES) for name in values):
+    if not batt_parameter_count(values) and not px4_parameter_count(values):
         raise BattgenError(
             f"{given}: no BATT*_ parameter (ArduPilot) nor BAT_*/COM_* battery parameter (PX4) ({len(values)} "
             "parameters read): expected battery settings"
@@ -103,8 +103,6 @@ def replay_tables(
     def battery(instance: int) -> int:
         return instance - 1
 
-    offset = None if clock is None else clock.utc_offset_us
-    origin = 0 if clock is None else clock.origin_us
     rows: dict[str, list[Any]] = {c[0]: [] for c in EVENT_COLUMNS}
     for event, sample in replay.events:
         rows["log"].append(log)
@@ -112,20 +110,13 @@ def replay_tables(
         rows["instance"].append(event.battery)
         rows["t"].append(sample.t)
         rows["replay_t"].append(event.time)
-        rows["time"].append(None if offset is None else origin + round(sample.t * 1e6) + offset)
         rows["level"].append(event.level.name)
         for key in ("cause", "value", "threshold", "action", "action_code", "executed", "outcome", "priority"):
             rows[key].append(getattr(event, key))
         rows["statustext"].append(event.ardupilot_text)
         rows["vehicle_type"].append(replay.vehicle)
         rows["parameters"].append(options.source)
-    events = pa.Table.from_pydict(
-        {
-            k: v if k != "time" else pa.array(v, pa.int64()).cast(EVENTS_SCHEMA.field("time").type)
-            for k, v in rows.items()
-        },
-        schema=EVENTS_SCHEMA,
-    )
+    events = events_table(rows, clock)
     replays = pa.Table.from_pydict(
         {
             "log": [log] * len(replay.samples),

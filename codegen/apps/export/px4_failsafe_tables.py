@@ -18,9 +18,10 @@ from typing import Any
 import pyarrow as pa
 
 from ..battery.sources import Batch
+from ..failsafe.px4_levels import Px4Level
 from ..failsafe.px4_log import read_px4_log
 from ..failsafe.px4_replay import replay_px4
-from .failsafe_columns import EVENT_COLUMNS, EVENTS_SCHEMA, REPLAYS_SCHEMA
+from .failsafe_columns import EVENT_COLUMNS, REPLAYS_SCHEMA, events_table
 
 PX4 = "px4"
 OWN = "log parameters (BAT_*, COM_*)"
@@ -36,8 +37,6 @@ def px4_tables(
     except ValueError as exc:  # a log without battery_status, or a parameter that is no number
         return f"failsafe not replayed: {exc}"
     parameters = OWN if source is None else f"{OWN}, {source} on top"
-    offset = None if clock is None else clock.utc_offset_us
-    origin = 0 if clock is None else clock.origin_us
     rows: dict[str, list[Any]] = {c[0]: [] for c in EVENT_COLUMNS}
     highest: dict[int, int] = {}
     for e in replayed.events:
@@ -46,7 +45,6 @@ def px4_tables(
         rows["instance"].append(e.battery)
         rows["t"].append(e.time)  # the data layer's clock, as the battery table's t
         rows["replay_t"].append(e.time)
-        rows["time"].append(None if offset is None else origin + round(e.time * 1e6) + offset)
         rows["level"].append(e.label)
         rows["cause"].append(e.cause)
         rows["value"].append(e.value if e.value == e.value else None)
@@ -61,22 +59,15 @@ def px4_tables(
         rows["parameters"].append(parameters)
         if e.cause == "charge":
             highest[e.battery] = max(highest.get(e.battery, 0), int(e.level))
-    events = pa.Table.from_pydict(
-        {
-            k: v if k != "time" else pa.array(v, pa.int64()).cast(EVENTS_SCHEMA.field("time").type)
-            for k, v in rows.items()
-        },
-        schema=EVENTS_SCHEMA,
-    )
+    events = events_table(rows, clock)
     batteries = sorted(replayed.readings)
-    levels = {1: "LOW", 2: "CRITICAL", 3: "EMERGENCY"}
     replays = pa.Table.from_pydict(
         {
             "log": [log] * len(batteries),
             "battery": [b - 1 for b in batteries],
             "instance": batteries,
             "readings": [replayed.readings[b] for b in batteries],
-            "level": [levels.get(highest.get(b, 0), "NONE") for b in batteries],
+            "level": [Px4Level(highest.get(b, 0)).name for b in batteries],
             "vehicle_type": [PX4] * len(batteries),
             "parameters": [parameters] * len(batteries),
         },

@@ -17,6 +17,11 @@ FIRMWARES = ("px4", "ardupilot")
 PX4_PREFIXES = ("BAT_", "BAT1_", "COM_LOW_BAT", "COM_FAIL_ACT", "COM_FLTT_LOW", "COM_ARM_BAT")
 
 
+def px4_parameter_count(values: Mapping[str, float]) -> int:
+    """How many of ``values`` are PX4's battery failsafe parameters (``BAT_*`` thresholds, ``COM_*`` actions)."""
+    return sum(1 for name in values if name.startswith(PX4_PREFIXES))
+
+
 def choose_firmware(
     given: str | None, parameters: Mapping[str, float] | None, where: str, stream: Path
 ) -> tuple[str, str]:
@@ -28,7 +33,7 @@ def choose_firmware(
     if parameters:
         if batt_parameter_count(parameters):
             return "ardupilot", f"{where} holds ArduPilot's BATT*_ parameters"
-        if any(name.startswith(PX4_PREFIXES) for name in parameters):
+        if px4_parameter_count(parameters):
             return "px4", f"{where} holds PX4's BAT_/COM_ parameters"
     if detect(stream) == "ulog":
         return "px4", "the log is a PX4 ULog"
