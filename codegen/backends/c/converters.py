@@ -93,17 +93,17 @@ class CConverter:
             else:
                 out += [f"{c_type(q)} c{i}_{k};" for k, q in enumerate(f.targets)]
                 between.append([f"&c{i}_{k}" for k in range(len(f.targets))])
-        after_px4 = False
+        after_firmware = False
         for i, f in enumerate(self.chain):
             first, last = i == 0, i == len(self.chain) - 1
             e = f.edge
             args = [v for _, v, _ in self.sources] if first else list(between[i - 1])
             args += [n if n in self.inputs else "NULL" for n in f.inputs] if first else ["NULL" for _ in f.inputs]
             args += [v for _, v in self.targets] if last else list(between[i])
-            rep_d = "rep" if first or e.source == CONCEPTS_ENDPOINT or not after_px4 else "NULL"
+            rep_d = "rep" if first or e.source == CONCEPTS_ENDPOINT or not after_firmware else "NULL"
             args += ["rep", rep_d, "rep" if last else "NULL"]
             out.append(f"{f.name}({', '.join(args)});")
-            after_px4 = after_px4 or e.mapping.policy in FIRMWARE_POLICIES
+            after_firmware = after_firmware or e.mapping.policy in FIRMWARE_POLICIES
         return out
 
 

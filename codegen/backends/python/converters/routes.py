@@ -131,18 +131,18 @@ class Routes:
     def calls(self, path: list[Edge], args: list[str], inputs: list[str], single: bool, policy: str) -> list[str]:
         """The chain of mapping calls of one policy; a loss is reported where it happens."""
         out = []
-        after_px4 = False
+        after_firmware = False
         result = ""
         for i, e in enumerate(path):
             first, last = i == 0, i == len(path) - 1
-            rep_d = "report" if first or e.source == CONCEPTS_ENDPOINT or not after_px4 else "None"
+            rep_d = "report" if first or e.source == CONCEPTS_ENDPOINT or not after_firmware else "None"
             rep_u = "report" if last else "None"
             given = [*args] if first else [f"*{result}"]
             given += ["rep=report", f"rep_d={rep_d}", f"rep_u={rep_u}"]
             given += [f"{n}={n}" for n in e.inputs if n in inputs] if first else []
             result = f"_{naming.identifier(policy)}_{i + 1}"
             out.append(f"{INDENT * 2}{result} = {call(f'{e.module}.{e.function}', given)}")
-            after_px4 = after_px4 or e.mapping.policy in FIRMWARE_POLICIES
+            after_firmware = after_firmware or e.mapping.policy in FIRMWARE_POLICIES
         out.append(f"{INDENT * 2}return {result}[0]" if single else f"{INDENT * 2}return {result}")
         return out
 
