@@ -314,6 +314,7 @@ class LogStart:
     texts: tuple[tuple[float | None, str], ...] = ()  # every MSG: (seconds on the log's clock, text)
     modes: tuple[tuple[float | None, int, int | None], ...] = ()  # every MODE: (seconds, mode number, reason)
     errors: tuple[tuple[float | None, int, int], ...] = ()  # every ERR: (seconds, subsystem, error code)
+    events: tuple[tuple[float | None, int], ...] = ()  # every EV: (seconds, event id)
 
 
 # ArduPilot's ModeReason (libraries/AP_Vehicle/ModeReason.h), the reasons a MODE record gives, up to the general
@@ -354,6 +355,87 @@ FAILSAFE_SUBSYSTEMS = {
     8: "FAILSAFE_GCS",
     9: "FAILSAFE_FENCE",
 }
+# ArduPilot's LogEvent ids (AP_Logger.h), the events an EV record gives; with the ids older firmware logged as EV
+# (DATA_SYSTEM_TIME_SET 8, DATA_TAKEOFF 16, DATA_EXIT_FLIP 23, DATA_SAVEWP_CLEAR_MISSION_RTL 40), which are no
+# longer events. An id not here is shown as ``EV <id>``.
+LOG_EVENTS = {
+    7: "AP_STATE",
+    8: "SYSTEM_TIME_SET",
+    9: "INIT_SIMPLE_BEARING",
+    10: "ARMED",
+    11: "DISARMED",
+    15: "AUTO_ARMED",
+    16: "TAKEOFF",
+    17: "LAND_COMPLETE_MAYBE",
+    18: "LAND_COMPLETE",
+    19: "LOST_GPS",
+    21: "FLIP_START",
+    22: "FLIP_END",
+    23: "EXIT_FLIP",
+    25: "SET_HOME",
+    26: "SET_SIMPLE_ON",
+    27: "SET_SIMPLE_OFF",
+    28: "NOT_LANDED",
+    29: "SET_SUPERSIMPLE_ON",
+    30: "AUTOTUNE_INITIALISED",
+    31: "AUTOTUNE_OFF",
+    32: "AUTOTUNE_RESTART",
+    33: "AUTOTUNE_SUCCESS",
+    34: "AUTOTUNE_FAILED",
+    35: "AUTOTUNE_REACHED_LIMIT",
+    36: "AUTOTUNE_PILOT_TESTING",
+    37: "AUTOTUNE_SAVEDGAINS",
+    38: "SAVE_TRIM",
+    39: "SAVEWP_ADD_WP",
+    40: "SAVEWP_CLEAR_MISSION_RTL",
+    41: "FENCE_ENABLE",
+    42: "FENCE_DISABLE",
+    43: "ACRO_TRAINER_OFF",
+    44: "ACRO_TRAINER_LEVELING",
+    45: "ACRO_TRAINER_LIMITED",
+    46: "GRIPPER_GRAB",
+    47: "GRIPPER_RELEASE",
+    49: "PARACHUTE_DISABLED",
+    50: "PARACHUTE_ENABLED",
+    51: "PARACHUTE_RELEASED",
+    52: "LANDING_GEAR_DEPLOYED",
+    53: "LANDING_GEAR_RETRACTED",
+    54: "MOTORS_EMERGENCY_STOPPED",
+    55: "MOTORS_EMERGENCY_STOP_CLEARED",
+    56: "MOTORS_INTERLOCK_DISABLED",
+    57: "MOTORS_INTERLOCK_ENABLED",
+    58: "ROTOR_RUNUP_COMPLETE",
+    59: "ROTOR_SPEED_BELOW_CRITICAL",
+    60: "EKF_ALT_RESET",
+    61: "LAND_CANCELLED_BY_PILOT",
+    62: "EKF_YAW_RESET",
+    63: "AVOIDANCE_ADSB_ENABLE",
+    64: "AVOIDANCE_ADSB_DISABLE",
+    65: "AVOIDANCE_PROXIMITY_ENABLE",
+    66: "AVOIDANCE_PROXIMITY_DISABLE",
+    67: "GPS_PRIMARY_CHANGED",
+    71: "ZIGZAG_STORE_A",
+    72: "ZIGZAG_STORE_B",
+    73: "LAND_REPO_ACTIVE",
+    74: "STANDBY_ENABLE",
+    75: "STANDBY_DISABLE",
+    76: "FENCE_ALT_MAX_ENABLE",
+    77: "FENCE_ALT_MAX_DISABLE",
+    78: "FENCE_CIRCLE_ENABLE",
+    79: "FENCE_CIRCLE_DISABLE",
+    80: "FENCE_ALT_MIN_ENABLE",
+    81: "FENCE_ALT_MIN_DISABLE",
+    82: "FENCE_POLYGON_ENABLE",
+    83: "FENCE_POLYGON_DISABLE",
+    85: "EK3_SOURCES_SET_TO_PRIMARY",
+    86: "EK3_SOURCES_SET_TO_SECONDARY",
+    87: "EK3_SOURCES_SET_TO_TERTIARY",
+    90: "AIRSPEED_PRIMARY_CHANGED",
+    163: "SURFACED",
+    164: "NOT_SURFACED",
+    165: "BOTTOMED",
+    166: "NOT_BOTTOMED",
+}
 # the vehicle a firmware string names, as MAV_TYPE, for pymavlink's table of its mode numbers
 _FIRMWARE_MAV_TYPE = (("Copter", 2), ("Plane", 1), ("Rover", 10), ("Sub", 12), ("Tracker", 5))
 
@@ -371,6 +453,11 @@ def mode_name(number: int, firmware: str | None) -> str:
     return f"mode {number}"
 
 
+def event_name(event: int) -> str:
+    """An EV record's id by ArduPilot's name for it, else ``EV <id>``."""
+    return LOG_EVENTS.get(event, f"EV {event}")
+
+
 def reason_name(reason: int) -> str:
     return MODE_REASONS[reason] if 0 <= reason < len(MODE_REASONS) else f"reason {reason}"
 
@@ -386,6 +473,7 @@ def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRe
     texts: list[tuple[float | None, str]] = []
     modes: list[tuple[float | None, int, int | None]] = []
     errors: list[tuple[float | None, int, int]] = []
+    events: list[tuple[float | None, int]] = []
     for msg in log.messages(BATTERY_TYPES | ARMING_TYPES | {"GPS", "PARM", "MSG", "MODE", "ERR"}):
         if msg.type == "GPS":
             clock = _gps_clock(msg)
@@ -395,6 +483,9 @@ def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRe
             arm = _arming(msg)
             if arm is not None:
                 yield arm
+            event = _number(msg.fields, "Id") if msg.type == "EV" else None
+            if event is not None:
+                events.append((msg.when_s, int(event)))
         elif msg.type in BATTERY_TYPES:
             bat = _battery(msg)
             if bat is not None:
@@ -429,7 +520,9 @@ def timed_flight_records(log: DataflashLog) -> Iterator[BatteryRecord | ArmingRe
                 hardware = board.group(1)
             elif firmware is None and (" V" in text or text.startswith(("Ardu", "APM"))):
                 firmware = text
-    yield LogStart(start, log_disarmed, firmware, parameters, hardware, tuple(texts), tuple(modes), tuple(errors))
+    yield LogStart(
+        start, log_disarmed, firmware, parameters, hardware, tuple(texts), tuple(modes), tuple(errors), tuple(events)
+    )
 
 
 GPS_EPOCH_S = 315_964_800  # 1980-01-06 00:00 UTC, the start of GPS week 0, in Unix time

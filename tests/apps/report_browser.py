@@ -3,7 +3,7 @@
 What a page is checked for: it renders (the page's script sets ``data-rendered``) with no console errors and no
 network request but the file itself, and every plot's traces as plotly holds them (row, samples before
 decimation, points drawn), the failsafe marker lines, the armed shading, the log's own warning markers, flight
-modes and failsafe entries, and each input's header table, read back from the live page. A screenshot of every
+modes, failsafe entries and events, and each input's header table, read back from the live page. A screenshot of every
 page is kept under ``build/test-artifacts/`` (or ``$BATTGEN_ARTIFACTS``) for a person to look at.
 """
 
@@ -58,7 +58,10 @@ return Array.from(document.querySelectorAll('.battery-plot, #trends')).map(funct
     }).map(function (s) { return {t: s.x0, mode: s.name.slice(5)}; }),
     failsafes: ((div.layout && div.layout.shapes) || []).filter(function (s) {
       return s.name && s.name.indexOf('log failsafe ') === 0;
-    }).map(function (s) { return {t: s.x0, what: s.name.slice(13)}; })
+    }).map(function (s) { return {t: s.x0, what: s.name.slice(13)}; }),
+    events: ((div.layout && div.layout.shapes) || []).filter(function (s) {
+      return s.name && s.name.indexOf('log event ') === 0;
+    }).map(function (s) { return {t: s.x0, what: s.name.slice(10)}; })
   };
 });
 """

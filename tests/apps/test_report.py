@@ -202,3 +202,19 @@ def test_png_images_show_the_logs_modes_and_armed_spans(tmp_path: Path, monkeypa
     assert [name for _, name in context.modes] == [t for t in texts if t in {n for _, n in context.modes}]
     armed = context.armed_intervals(float("inf"))
     assert armed and {(a, b) for a, b in spans} >= {(a, b) for a, b in armed if b != float("inf")}
+
+
+def test_json_report_carries_the_logs_events(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--format json`` gives an ArduPilot log's EV records by name, as the battery view's context holds them (a
+    real DataFlash log of ArduCopter 3.3: SET_HOME, ARMED, AUTO_ARMED, NOT_LANDED)."""
+    from shared_data import require, shared
+
+    from codegen.apps.battery.catalog import bundled_catalog
+    from codegen.apps.battery.readers import read_log
+
+    log = require(shared("corpus", "realworld3", "dataflash", "dronekit_log171.bin"))
+    assert main(["report", "--format", "json", str(log)]) == 0
+    [item] = json.loads(capsys.readouterr().out)["inputs"]
+    context = next(b.context for b in read_log(log, log.name, bundled_catalog()) if b.context is not None)
+    assert item["log"]["events"] == [{"t": t, "event": e} for t, e in context.events]
+    assert [e for _, e in context.events] == ["SYSTEM_TIME_SET", "SET_HOME", "ARMED", "AUTO_ARMED", "NOT_LANDED"]

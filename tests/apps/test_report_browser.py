@@ -184,3 +184,11 @@ def test_the_log_speaks_first_in_the_browser(tmp_path: Path) -> None:
     (header,) = page.headers
     assert firmware is not None and firmware in header["firmware"]
     assert "duration" in header and header.get("log start")
+    # the log's EV records as markers: one per record (this log's all fall within its battery records), and the
+    # ARMED event where the armed shading starts (the arming rule reads the same record)
+    reader = mavutil.mavlink_connection(str(log))
+    events = sum(1 for _ in iter(lambda: reader.recv_match(type="EV"), None))
+    (plot,) = [p for p in page.plots if p["id"].startswith("plot-")]
+    assert len(plot["events"]) == events > 0
+    (armed_at,) = [e["t"] for e in plot["events"] if e["what"] == "ARMED"]
+    assert plot["armed"] and plot["armed"][0][0] == pytest.approx(armed_at, abs=1e-6)

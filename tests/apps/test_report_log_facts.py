@@ -36,6 +36,20 @@ UORB_WARNINGS = ("none", "low", "critical", "emergency", "failed")  # battery_st
 ARMING_STATE_ARMED = 2  # vehicle_status ARMING_STATE_ARMED (VehicleStatus.msg)
 # ArduPilot ModeReason (AP_Vehicle/ModeReason.h), the ones these logs give
 MODE_REASON_NAMES = {0: "UNKNOWN", 1: "RC_COMMAND", 2: "GCS_COMMAND", 3: "RADIO_FAILSAFE", 4: "BATTERY_FAILSAFE"}
+# ArduPilot LogEvent (AP_Logger/AP_Logger.h), the ids these logs' EV records give; 8 and 16 are older firmware's
+# DATA_SYSTEM_TIME_SET and DATA_TAKEOFF
+LOG_EVENT_NAMES = {
+    8: "SYSTEM_TIME_SET",
+    10: "ARMED",
+    11: "DISARMED",
+    15: "AUTO_ARMED",
+    16: "TAKEOFF",
+    25: "SET_HOME",
+    28: "NOT_LANDED",
+    56: "MOTORS_INTERLOCK_DISABLED",
+    57: "MOTORS_INTERLOCK_ENABLED",
+    62: "EKF_YAW_RESET",
+}
 
 
 def _page(path: Path) -> tuple[Any, dict[str, Any]]:
@@ -234,6 +248,30 @@ def test_ardupilot_header_and_parameters_agree_with_pymavlink(log: Path) -> None
     end = max(float(s.t[-1]) for s in item.batteries)
     got = sorted({(s["x0"], s["x1"]) for s in _shapes(figures, "armed")})
     assert _flat(got) == pytest.approx(_flat(context.armed_intervals(end)), abs=1e-6)
+    # every EV record, named as AP_Logger names it, at its time on the log's clock: its TimeUS, or before 3.4 (no
+    # time field) pymavlink's clock at the record in a walk of every record, zero-based as the battery view reads
+    # it. The view's walk reads fewer types, so its clock there is the last battery/GPS/arming record's: within
+    # 0.1 s of the full walk's (those records come at 5-10 Hz).
+    from pymavlink import DFReader
+
+    events: list[tuple[float, int]] = []  # (µs, Id)
+    timeless = False
+    ev_reader = DFReader.DFReader_binary(str(log), zero_time_base=True)
+    while (m := ev_reader.recv_match(type=["EV"])) is not None:
+        timeless = timeless or "TimeUS" not in m.to_dict()
+        events.append((float(getattr(m, "TimeUS", 0)), m.Id))
+    if timeless:
+        ev_reader = DFReader.DFReader_binary(str(log), zero_time_base=True)
+        events = [(m._timestamp * 1e6, m.Id) for m in iter(ev_reader.recv_msg, None) if m.get_type() == "EV"]
+    origin = context.start_us or 0
+    tolerance = 0.1 if timeless else 1e-6
+    expected = [(max((stamp - origin) / 1e6, 0.0), LOG_EVENT_NAMES[event]) for stamp, event in events]
+    assert [name for _, name in context.events] == [name for _, name in expected]
+    assert [t for t, _ in context.events] == pytest.approx([t for t, _ in expected], abs=tolerance)
+    shown = [(t, name) for t, name in context.events if t <= end]
+    assert facts.events == shown
+    marked = sorted(s["x0"] for s in _shapes(figures, "log event"))
+    assert marked == pytest.approx(sorted(t for t, _ in shown) * len(item.batteries), abs=1e-6)
 
 
 def _series(pack: list[float], cells: list[list[float]], soc: list[float]) -> BatterySeries:
@@ -295,3 +333,17 @@ def test_fleet_rows_carry_date_and_firmware_and_trends_run_over_dates() -> None:
     (trace, *_) = view.trends["data"]
     assert trace["x"] == ["2023-11-14 22:13:20", "2024-03-09 16:00:00"]
     assert view.trends["layout"]["xaxis"]["type"] == "date"
+
+
+def test_fleet_cell_columns_say_what_the_battery_figures_say() -> None:
+    """A log whose cells are its pack voltage split evenly (PX4 1.11's sample log) has no per-cell data: its fleet
+    row leaves the cell columns empty ("—"), as its battery's figures say "no per-cell data", never 0 mV."""
+    log = require(SHARED / "data" / "ulog" / "sample_log_small.ulg")
+    (item,) = collect([log], bundled_schemas()).inputs
+    view = fleet_view([item])
+    cell, imbalance = view.header.index("min cell [V]"), view.header.index("max imbalance [mV]")
+    assert item.batteries and all(s.cells_split_evenly for s in item.batteries)
+    for row, s in zip(view.rows, item.batteries, strict=True):
+        figures = dict(compute(s).rows(per_cell=not s.cells_split_evenly))
+        assert figures["max cell imbalance"] == NO_CELLS
+        assert row[cell] == row[imbalance] == "—"

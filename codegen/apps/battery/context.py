@@ -27,7 +27,8 @@ flight-mode changes (PX4 ``vehicle_status.nav_state``; DataFlash ``MODE`` with t
 ``failsafes`` the moments it entered a failsafe (PX4 ``vehicle_status.failsafe`` turning true, with the mode it
 chose, and each rise of the battery inputs of commander's failsafe framework, ``failsafe_flags.battery_warning``
 and ``battery_low_remaining_time``; ArduPilot a ``MODE`` change for a failsafe reason and ``ERR`` records of a
-failsafe subsystem).
+failsafe subsystem), and ``events`` the events it logged as such (DataFlash ``EV`` records, by AP_Logger's names:
+``ARMED``, ``LAND_COMPLETE``, ``MOTORS_EMERGENCY_STOPPED``...).
 """
 
 from __future__ import annotations
@@ -82,6 +83,7 @@ class LogContext:
     texts: tuple[LogText, ...] = ()
     modes: tuple[tuple[float, str], ...] = ()  # (t, the mode entered, with the reason where the log gives one)
     failsafes: tuple[tuple[float, str], ...] = ()  # (t, what the firmware did or which failsafe)
+    events: tuple[tuple[float, str], ...] = ()  # (t, the event the firmware logged, by its name)
 
     @property
     def start_utc_us(self) -> int | None:
@@ -110,8 +112,8 @@ class LogContext:
         return PARAMETER_SOURCES.get(self.kind, "parameters")
 
     def to_dict(self, end: float | None = None) -> dict[str, object]:
-        """The context as JSON data; the parameters as a count (a log holds hundreds), the modes, failsafes and
-        logged texts in full."""
+        """The context as JSON data; the parameters as a count (a log holds hundreds), the modes, failsafes, events
+        and logged texts in full."""
         out: dict[str, object] = {
             "kind": self.kind,
             "start_utc_us": self.start_utc_us,
@@ -128,6 +130,7 @@ class LogContext:
         # what the firmware said and did, as the report's page shows it (each at t, seconds since the log's start)
         out["modes"] = [{"t": t, "mode": name} for t, name in self.modes]
         out["failsafes"] = [{"t": t, "failsafe": what} for t, what in self.failsafes]
+        out["events"] = [{"t": t, "event": what} for t, what in self.events]
         out["texts"] = [{"t": x.t, "severity": x.severity or None, "text": x.text} for x in self.texts]
         return out
 

@@ -25,6 +25,7 @@ from ...inputs.dataflash import (
     BatteryRecord,
     GpsClock,
     LogStart,
+    event_name,
     mode_name,
     open_log,
     reason_name,
@@ -87,6 +88,7 @@ def dataflash_batches(path: Path, name: str, catalog: Catalog) -> list[Batch]:
         texts=tuple(LogText(_t(at, origin_us), "", text) for at, text in start.texts),
         modes=tuple(_mode(at, number, reason, start.firmware, origin_us) for at, number, reason in start.modes),
         failsafes=_failsafes(start, origin_us),
+        events=tuple((_t(at, origin_us), event_name(event)) for at, event in start.events),
     )
     out: list[Batch] = []
     for instance, rows in sorted(readings.items()):

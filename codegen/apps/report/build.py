@@ -74,6 +74,7 @@ def pngs(report: Report, folder: Path) -> list[Path]:
                 armed=facts.armed if facts else (),
                 modes=facts.modes if facts else (),
                 failsafes=facts.failsafes if facts else (),
+                events=facts.events if facts else (),
             )
             written.append(path)
     return written

@@ -47,7 +47,11 @@ def _fmt(value: float | None, digits: int, scale: float = 1.0) -> str:
     return "—" if value is None else shown(value * scale, digits)
 
 
-def _row(source: str, date: str | None, firmware: str | None, label: str, serial: str, f: Figures) -> list[str]:
+def _row(
+    source: str, date: str | None, firmware: str | None, label: str, serial: str, f: Figures, per_cell: bool
+) -> list[str]:
+    """A flight's row; the cell columns "—" where the log's cells are the pack voltage split evenly (no per-cell
+    data, as the battery's own figures say)."""
     return [
         source,
         date or "—",
@@ -55,11 +59,11 @@ def _row(source: str, date: str | None, firmware: str | None, label: str, serial
         label,
         _fmt(f.duration_s, 1),
         _fmt(f.min_pack_voltage_v, 2),
-        _fmt(f.min_cell_voltage_v, 3),
+        _fmt(f.min_cell_voltage_v if per_cell else None, 3),
         _fmt(f.peak_current_a, 1),
         _fmt(f.charge_used_mah, 0),
         _fmt(f.energy_used_wh, 2),
-        _fmt(f.max_cell_imbalance_v, 0, 1000.0),
+        _fmt(f.max_cell_imbalance_v if per_cell else None, 0, 1000.0),
         _fmt(f.internal_resistance_ohm, 1, 1000.0),
         serial or "—",
     ]
@@ -80,7 +84,8 @@ def fleet_view(inputs: Sequence[InputSeries]) -> FleetView:
         firmware = item.context.firmware if item.context is not None else None
         for s in item.batteries:
             f = compute(s)
-            rows.append(_row(PurePath(item.source).name, dates[flight], firmware, s.label, s.serial, f))
+            per_cell = not s.cells_split_evenly
+            rows.append(_row(PurePath(item.source).name, dates[flight], firmware, s.label, s.serial, f, per_cell))
             if s.serial:
                 x: int | str = (dates[flight] or "") if dated else flight + 1
                 by_serial.setdefault(s.serial, []).append((x, f, s.state_of_health, s.cycle_count))

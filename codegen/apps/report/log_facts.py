@@ -55,6 +55,7 @@ class LogFacts:
     battery_texts: list[LogText] = field(default_factory=list)  # those about the battery or a failsafe
     modes: list[tuple[float, str]] = field(default_factory=list)  # (t, mode entered)
     failsafes: list[tuple[float, str]] = field(default_factory=list)  # (t, what the firmware's failsafe did)
+    events: list[tuple[float, str]] = field(default_factory=list)  # (t, an event the firmware logged)
 
 
 def vehicle_type_name(code: int | None) -> str | None:
@@ -120,6 +121,7 @@ def log_facts(
         facts.battery_texts = [m for m in context.texts if BATTERY_TEXT.search(m.text)]
         facts.modes = [(t, name) for t, name in context.modes if t <= end]
         facts.failsafes = [(t, what) for t, what in context.failsafes if t <= end]
+        facts.events = [(t, what) for t, what in context.events if t <= end]
         if facts.modes:
             shown = ", ".join(f"{name} {t:.1f} s" for t, name in facts.modes[:8])
             facts.header.append(

@@ -107,6 +107,7 @@ def _section(
         soc_thresholds=facts.soc_thresholds,
         modes=facts.modes,
         failsafes=facts.failsafes,
+        events=facts.events,
     )
     return context, fig
 
@@ -152,6 +153,7 @@ def render(
                 "battery_texts": [_text_row(m) for m in own.battery_texts],
                 "texts": [_text_row(m) for m in own.texts],
                 "failsafes": [{"t": t, "text": line(what)} for t, what in own.failsafes],
+                "events": [{"t": t, "text": line(what)} for t, what in own.events],
             }
         )
     fleet_context = None

@@ -26,6 +26,7 @@ ROW_HEIGHT = 190
 LEVEL_COLOURS = {"LOW": "#d98200", "CRITICAL": "#c62828", "NONE": "#2e7d32"}
 MODE_FILLS = ("#e3f2fd", "#fff3e0", "#f3e5f5", "#e8f5e9", "#fce4ec", "#e0f7fa", "#f9fbe7", "#efebe9")
 FAILSAFE_COLOUR = "#6a1b9a"
+EVENT_COLOUR = "#78909c"
 WARNING_COLOURS = {"none": "#2e7d32", "low": "#d98200", "critical": "#c62828", "emergency": "#8e0000"}
 ARMED_FILL = "rgba(46, 125, 50, 0.08)"
 
@@ -71,11 +72,13 @@ def figure(
     soc_thresholds: dict[str, float] | None = None,
     modes: Sequence[tuple[float, str]] = (),
     failsafes: Sequence[tuple[float, str]] = (),
+    events: Sequence[tuple[float, str]] = (),
 ) -> dict[str, Any]:
     """The figure as plotly JSON data (``{"data": [...], "layout": {...}}``), built without plotly's Python API
     so that the page's JSON is exactly what this module says. ``armed``: the log's armed spans; ``warnings``: the
     firmware's own warning changes; ``soc_thresholds``: name -> percent, drawn on the state of charge; ``modes``: the
-    flight-mode changes (t, name), a strip above the plots; ``failsafes``: the firmware's own failsafe entries."""
+    flight-mode changes (t, name), a strip above the plots; ``failsafes``: the firmware's own failsafe entries;
+    ``events``: the events it logged (ArduPilot's EV records), thin dotted lines named on hover."""
     rows = _rows(s)
     data: list[dict[str, Any]] = []
     layout: dict[str, Any] = {
@@ -140,6 +143,7 @@ def figure(
     end = float(s.t[-1]) if len(s.t) else 0.0
     _modes(layout, modes, end)
     _failsafes(layout, failsafes)
+    _events(layout, events)
     for m in markers:
         colour = LEVEL_COLOURS.get(m.level, "#555")
         layout["shapes"].append(_across(m.t, {"color": colour, "width": 2}, f"failsafe {m.level}"))
@@ -281,6 +285,27 @@ def _modes(layout: dict[str, Any], modes: Sequence[tuple[float, str]], end: floa
         )
     if modes:
         layout["margin"]["t"] = max(layout["margin"]["t"], 60)
+
+
+def _events(layout: dict[str, Any], events: Sequence[tuple[float, str]]) -> None:
+    """The events the firmware logged: a thin long-dashed grey line each, named on hover, ``ev`` at the top of the
+    plots (a log holds a handful: arming, landing, motor interlock, EKF resets). Dotted lines are the warnings'."""
+    for t, what in events:
+        style = {"color": EVENT_COLOUR, "width": 1, "dash": "longdash"}
+        layout["shapes"].append(_across(t, style, f"log event {what}"))
+        layout["annotations"].append(
+            {
+                "xref": "x",
+                "x": t,
+                "yref": "paper",
+                "y": 1.0,
+                "text": "ev",
+                "showarrow": False,
+                "yanchor": "top",
+                "hovertext": what,
+                "font": {"color": EVENT_COLOUR, "size": 9},
+            }
+        )
 
 
 def _failsafes(layout: dict[str, Any], failsafes: Sequence[tuple[float, str]]) -> None:

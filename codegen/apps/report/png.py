@@ -2,7 +2,8 @@
 
 The same rows as the HTML plots (:mod:`.plots`), one panel each on a shared time axis, failsafe events as
 vertical lines; what the log says of the flight as the page shows it: armed spans shaded, flight modes named
-above the top panel, the firmware's own failsafe entries dashed. matplotlib comes with the ``report`` extra.
+above the top panel, the firmware's own failsafe entries dashed, its logged events (ArduPilot's EV) thin and
+grey. matplotlib comes with the ``report`` extra.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import BattgenError
-from .plots import LEVEL_COLOURS, figure
+from .plots import EVENT_COLOUR, LEVEL_COLOURS, figure
 from .series import BatterySeries
 
 NEEDS_MATPLOTLIB = "--format png draws with matplotlib: pip install 'battgen[report]'"
@@ -29,8 +30,10 @@ def write_png(
     armed: Sequence[tuple[float, float]] = (),
     modes: Sequence[tuple[float, str]] = (),
     failsafes: Sequence[tuple[float, str]] = (),
+    events: Sequence[tuple[float, str]] = (),
 ) -> None:
-    """One image of a battery's plots; ``armed``, ``modes`` and ``failsafes`` as :func:`.plots.figure` takes them."""
+    """One image of a battery's plots; ``armed``, ``modes``, ``failsafes`` and ``events`` as :func:`.plots.figure`
+    takes them."""
     try:
         matplotlib = importlib.import_module("matplotlib")
         matplotlib.use("Agg")  # no screen: draw into memory
@@ -54,6 +57,8 @@ def write_png(
                 ax.axvspan(start, stop, color=ARMED_COLOUR, alpha=0.10, linewidth=0)
             for t, _ in failsafes:
                 ax.axvline(t, color=FAILSAFE_COLOUR, linestyle="--", linewidth=1.0)
+            for t, _ in events:
+                ax.axvline(t, color=EVENT_COLOUR, linestyle=(0, (8, 3)), linewidth=0.6)
             for m in markers:
                 ax.axvline(m.t, color=LEVEL_COLOURS.get(m.level, "#555"), linewidth=1.5)
             if title == "pack voltage":

@@ -126,8 +126,9 @@ class BatterySeries:
 
     @functools.cached_property
     def cells_split_evenly(self) -> bool:
-        """Whether the cells are no measurement: every sample's known cells equal to each other and together the
-        pack voltage (PX4's battery library fills the cells so when the driver measures none)."""
+        """Whether the cells are no measurement: every sample's known cells equal to each other and the pack voltage
+        a whole number of them, at least as many as are given (PX4's battery library fills the cells with the pack
+        voltage over its cell count when the driver measures none; a 12-cell pack in a 10-cell array: the first 10)."""
         if not self.cell_count:
             return False
         rows = ~np.isnan(self.cells[:, : self.cell_count]).any(axis=1) & ~np.isnan(self.pack_voltage)
@@ -135,9 +136,11 @@ class BatterySeries:
             return False
         cells = self.cells[rows, : self.cell_count]
         even = bool((np.ptp(cells, axis=1) < 1e-4).all())
-        total = cells.sum(axis=1)
+        pack, cell = self.pack_voltage[rows], cells[:, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            count = np.round(pack / cell)
         return even and bool(
-            (np.abs(total - self.pack_voltage[rows]) <= 0.01 * np.abs(self.pack_voltage[rows]) + 1e-3).all()
+            ((count >= self.cell_count) & (np.abs(count * cell - pack) <= 0.01 * np.abs(pack) + 1e-3)).all()
         )
 
     @functools.cached_property
