@@ -103,3 +103,18 @@ def test_failsafe_without_subjects_says_how_to_read_cyphal(
     code = main(["failsafe", "--params", str(params), str(path)])
     err = capsys.readouterr().err
     assert code == 2 and "Traceback" not in err and "--cyphal-subject" in err
+
+
+def test_convert_a_capture_from_nxp_s_bms_reads_its_temperatures_with_272_15(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--sender nxp-bms772 on decoded transfers (not only JSON records): the hottest sensor pycyphal sent, less
+    NXP's 272.15 (NXP rddrone-bms772, src/uavcan.c: CELSIUS_TO_KELVIN), is the °C written."""
+    path = _capture(tmp_path / "bus.log", _bus(dsdl))
+    code = main(["convert", "--from", "udral", "--to", "uorb", "--sender", "nxp-bms772", *SUBJECTS, str(path)])
+    records = [json.loads(x) for x in capsys.readouterr().out.splitlines()]
+    assert code == 0 and len(records) == CYCLES * len(NODES)
+    for i, got in enumerate(records):
+        cycle, node = divmod(i, len(NODES))
+        status = _read_back(dsdl, _status(dsdl, NODES[list(NODES)[node]], cycle))
+        assert got["temperature"] == pytest.approx(status.temperature_min_max[1].kelvin - 272.15, abs=1e-4)
