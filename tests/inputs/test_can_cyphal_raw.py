@@ -105,3 +105,23 @@ def test_export_raw_writes_every_subject_type_as_pycyphal_decodes_it(
     assert bytes(parameters["name"][0].as_py()) == b"pack"  # uint8[<=64], as UDRAL declares it: its bytes
     status = pq.read_table(next((out / "raw" / TABLES[STATUS][0]).glob("*/*.parquet")))
     assert status.schema.field("temperature_min_max.1.kelvin").metadata[b"unit"] == b"K"
+
+
+def test_a_mixed_bus_keeps_its_dronecan_raw_table_beside_the_cyphal_ones(
+    dsdl: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """DroneCAN BatteryInfo (made by pydronecan) on the same bus as the UDRAL battery: --raw writes both."""
+    dronecan = pytest.importorskip("dronecan")
+    frames = _bus(dsdl)
+    for cycle in range(CYCLES):
+        info = dronecan.uavcan.equipment.power.BatteryInfo(voltage=23.5, battery_id=3)
+        transfer = dronecan.transport.Transfer(transfer_id=cycle, source_node_id=30, payload=info, transfer_priority=20)
+        frames += [(frame.message_id, bytes(frame.bytes)) for frame in transfer.to_frames()]
+    path = _capture(tmp_path / "bus.log", frames)
+    out = tmp_path / "ds"
+    assert main(["export", "-q", "--raw", "-o", str(out), *RAW_SUBJECTS, str(path)]) == 0, capsys.readouterr().err
+    (file,) = (out / "raw" / "dronecan.uavcan.equipment.power.BatteryInfo").glob("*/*.parquet")
+    assert pq.read_table(file)["voltage"].to_pylist() == [23.5] * CYCLES
+    for qualified, _ in TABLES.values():
+        (file,) = (out / "raw" / qualified).glob("*/*.parquet")
+        assert pq.read_table(file).num_rows == CYCLES * len(NODES)

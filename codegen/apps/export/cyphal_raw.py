@@ -26,6 +26,7 @@ from ...ir import ArrayType, CompositeType, Message, Schema
 from ..battery.sources import Batch, instances_to_columns
 from .dataset import raw_table
 
+CYPHAL_PREFIX = "cyphal."  # the qualified names of Cyphal types (the view's own batches of them are not raw-written)
 CHUNK = 1 << 16  # rows of one node's table written at a time: a long capture in flat memory
 
 

@@ -28,7 +28,7 @@ from ..battery.view import read_view
 from ..failsafe.logs import SampleTable
 from ..package import bundled_package
 from .content import content_id, map_file, prefix_id
-from .cyphal_raw import cyphal_raw_tables
+from .cyphal_raw import CYPHAL_PREFIX, cyphal_raw_tables
 from .dataflash_raw import dataflash_raw_tables
 from .dataset import (
     LogWriter,
@@ -164,8 +164,9 @@ def _export(
             batch, columns = chunk.batch, chunk.concepts
             table = battery_table(catalog, schema, columns, batch, log, file.name)
             writer.add(table)
-            cyphal_raw = options.raw and kind == "can" and bool(options.cyphal_subjects)
-            if options.raw and batch.message in catalog.sources and not cyphal_raw:
+            # a Cyphal capture's types are written by cyphal_raw_tables below, each subject's every transfer
+            cyphal = kind == "can" and batch.message.startswith(CYPHAL_PREFIX)
+            if options.raw and batch.message in catalog.sources and not cyphal:
                 writer.add_raw(
                     batch.message, raw_table(catalog.schema.message(batch.message), batch, log, catalog.schema)
                 )
