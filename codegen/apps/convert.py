@@ -37,6 +37,7 @@ from ..inputs.tlog import StreamStats, mavlink_items, message_name
 from ..inputs.ulog import ulog_items
 from ..ir.numbers import to_json_data
 from .package import bundled_schemas, load_schemas, named_package, package_module
+from .senders import find_sender
 
 FORMATS = ("json", "jsonl", "yaml", "hex", "raw")
 BINARY_FORMATS = ("hex", "raw")
@@ -255,7 +256,13 @@ class Conversion:
         )
 
     def __init__(
-        self, package: str | None, source: str, target: str, policy: str, subjects: Sequence[str] = ()
+        self,
+        package: str | None,
+        source: str,
+        target: str,
+        policy: str,
+        subjects: Sequence[str] = (),
+        sender: str | None = None,
     ) -> None:
         self.module = converters(package)
         self.subjects = tuple(subjects)  # ``ID=TYPE`` pairs: the Cyphal types a capture's subjects carry
@@ -272,6 +279,13 @@ class Conversion:
         self.inputs_taken: tuple[str, ...] = self.module.INPUTS.get(key, ())
         self.source = Endpoint(self.source_name, self.module.ENDPOINTS[self.source_name])
         self.target = Endpoint(self.target_name, self.module.ENDPOINTS[self.target_name])
+        # a sender whose firmware states a value wrong in a known way (--sender): its records corrected first
+        self.sender = find_sender(sender, self.source_name) if sender else None
+        if self.sender is not None and policy != "strict":
+            raise BattgenError(
+                f"--sender {sender}: reads what the sender meant, the {policy} policy what {policy} does with what it "
+                "receives; give one of them"
+            )
 
     def run(
         self,
@@ -301,6 +315,8 @@ class Conversion:
                 _refuse_unfit(objs, item)
             # always kept: what the target could not hold is told even without --report
             report = self.module.LossReport()
+            if self.sender is not None:
+                objs = self.sender.correct(objs, [a for a, _ in self.source.items], report)
             try:
                 result = self.func(*objs, policy=self.policy, report=report, **extra)
             except self.module.ConversionError as exc:

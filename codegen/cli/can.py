@@ -9,7 +9,8 @@ problems (toggle errors, CRC mismatches and the signature they point to, missing
 gaps, BatteryInfoAux sent out of order, transfers that do not decode), the first few of each kind with the frame's
 time and position, and counts. ``--records`` also prints every decoded message as a JSON line on stdout.
 Cyphal/CAN (``--transport cyphal``, or ``mixed`` beside DroneCAN, told apart by the start frame's toggle bit):
-each ``--cyphal-subject ID=TYPE`` names the type a subject carries, whose transfers are then decoded.
+each ``--cyphal-subject ID=TYPE`` names the type a subject carries, whose transfers are then decoded; ``--schemas
+DIR`` reads a Cyphal DSDL tree, whose types with a fixed port id (the Heartbeat on 7509, ...) are named and decoded.
 ``--format json`` prints one JSON document instead. Exit 0 clean, 1 transport errors, 2 unreadable input.
 """
 
@@ -23,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..apps.can_capture import CaptureReport, scan
-from ..apps.can_types import shipped_tree, standard_types
+from ..apps.can_types import cyphal_types, shipped_tree, standard_types
 from ..apps.package import bundled_package
 from ..errors import BattgenError, LocatedError, missing_file
 from ..inputs.can.captures import read_bus
@@ -67,8 +68,11 @@ def _text(report: CaptureReport) -> None:
 def run(args: argparse.Namespace) -> int:
     package = bundled_package().__name__
     known = registry(package)
-    subjects = subject_table(args.cyphal_subject, cyphal_classes(package))
-    transport = args.transport or ("mixed" if args.cyphal_subject else "dronecan")
+    classes = cyphal_classes(package)
+    if args.schemas:  # a user's Cyphal tree: its fixed-port types named and decoded (the bundled ones win a name)
+        classes = {**cyphal_types(Path(args.schemas)), **classes}
+    subjects = subject_table(args.cyphal_subject, classes)
+    transport = args.transport or ("mixed" if args.cyphal_subject or args.schemas else "dronecan")
     # every standard type is CRC-checked and named, not only the generated package's battery types
     standard = standard_types(Path(args.dsdl) if args.dsdl else shipped_tree())
     on_message = _print_record if args.records else None
@@ -139,6 +143,12 @@ def register(subparsers: Any, summary: str) -> None:
         "bit (default: dronecan, mixed with --cyphal-subject)",
     )
     add_cyphal_subject(p)
+    p.add_argument(
+        "--schemas",
+        metavar="DIR",
+        help="a Cyphal DSDL tree (a copy of public_regulated_data_types: uavcan/, reg/) whose types with a fixed "
+        "port id (uavcan.node.Heartbeat.1.0 on 7509, ...) are named and decoded; implies --transport mixed",
+    )
     p.add_argument("--records", action="store_true", help="also print every decoded message as a JSON line")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output format (default: text)")
     p.set_defaults(func=run)

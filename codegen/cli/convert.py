@@ -32,6 +32,7 @@ from typing import IO, Any, Literal, cast
 import yaml
 
 from ..apps.convert import FORMATS, LOG_FORMATS, Conversion, Converted, input_format, output_format
+from ..apps.senders import SENDERS
 from ..errors import BattgenError
 from ..inputs.model import MessageClass
 from ..inputs.records import Notice
@@ -64,6 +65,12 @@ def register(subparsers: Any, summary: str) -> None:
         help="input format (default: from the extension, else jsonl; .ulg ulog, .tlog tlog, .mav mavlink)",
     )
     p.add_argument("--out-format", choices=FORMATS, help="output format (default: the input's, text for binary)")
+    p.add_argument(
+        "--sender",
+        choices=sorted(SENDERS),
+        help="the device that sent the input, read as its firmware means its values (nxp-bms772: NXP's BMS sends "
+        "temperatures as degrees Celsius + 272.15); each corrected value is in the loss report",
+    )
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="extra converter input (number)")
     p.add_argument(
         "--package", help="a generated package to use, by import name (default: the one installed with battgen)"
@@ -89,7 +96,7 @@ def _inputs(settings: list[str]) -> dict[str, float]:
 
 
 def run(args: argparse.Namespace) -> int:
-    conversion = Conversion(args.package, args.source, args.target, args.policy, args.cyphal_subject)
+    conversion = Conversion(args.package, args.source, args.target, args.policy, args.cyphal_subject, args.sender)
     first = conversion.source.items[0][1]
     if isinstance(first, MessageClass):
         check_subjects(args.cyphal_subject, first)

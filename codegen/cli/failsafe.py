@@ -17,7 +17,8 @@ ArduPilot:
 STREAM is a flight log or capture, or a JSON Lines file of samples, told apart by content (then extension).
 A log (PX4 ULog, MAVLink tlog, ArduPilot DataFlash binary or text, CAN capture) is read through the battery
 view ``export`` and ``report`` read too (``codegen.apps.battery``): the same records, clock (seconds since the
-log's start), battery numbers and arming state; an ArduPilot log's own parameters (a DataFlash log's PARM records,
+log's start), battery numbers and arming state (a Cyphal/CAN capture's UDRAL batteries with ``--cyphal-subject
+ID=TYPE``, as ``export`` reads them); an ArduPilot log's own parameters (a DataFlash log's PARM records,
 a tlog's PARAM_VALUE frames) are the parameters when ``--params`` is not given. A JSON Lines stream holds one
 sample a line::
 
@@ -68,6 +69,7 @@ from ..errors import BattgenError, missing_file
 from ..inputs import parameter_files
 from ..inputs.kinds import FLIGHT_LOG_KINDS, detect
 from ..text.escape import line
+from .cyphal_options import add_cyphal_subject, check_bundled_subjects
 
 EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE, EXIT_DIFFERS = 0, 1, 2, 3
 
@@ -91,6 +93,7 @@ def register(subparsers: Any, summary: str) -> None:
         help="parameters without any BATT*_ one, or an input without battery readings, are not an error",
     )
     p.add_argument("--message", help="message of samples that name none (e.g. uorb.BatteryStatus)")
+    add_cyphal_subject(p)
     p.add_argument("--schemas", help="schema folder the messages come from (default: the bundled schemas/)")
     p.add_argument("--no-home", action="store_true", help="no home position is set (RTL falls back)")
     p.add_argument("--no-fix", action="store_true", help="no position fix (RTL falls back)")
@@ -110,6 +113,7 @@ def run(args: argparse.Namespace) -> int:
             raise missing_file(given)
     try:
         given = read_parameter_values(Path(args.params)) if args.params else None
+        check_bundled_subjects(args.cyphal_subject)  # a wrong ID=TYPE pair said once, before the log is read
         firmware, how = choose_firmware(args.firmware, given, args.params or "", stream)
     except (BattgenError, ValueError) as exc:
         print(line(f"battgen: {exc}"), file=sys.stderr)
@@ -118,7 +122,9 @@ def run(args: argparse.Namespace) -> int:
         return _run_px4(args, stream, how, given or {})
     try:
         # a flight log or capture is read through the battery view; JSON and JSON Lines are sample streams
-        table: SampleTable | None = log_samples(stream, args.stream) if detect(stream) in FLIGHT_LOG_KINDS else None
+        table: SampleTable | None = None
+        if detect(stream) in FLIGHT_LOG_KINDS:
+            table = log_samples(stream, args.stream, args.cyphal_subject)
         own = own_parameters(table) if table is not None and not args.params else None
         raw: Mapping[str, float] = {}
         if args.params:

@@ -1,7 +1,8 @@
 """``battgen report LOG... [-o report.html] [--format html|png]``: a flight's battery at a glance.
 
-Reads any log or capture battgen reads (PX4 ``.ulg``, MAVLink ``.tlog``, CAN captures, JSON Lines of a bundled
-message with ``--message``) and writes one self-contained HTML page (plotly embedded, opens offline): per battery
+Reads any log or capture battgen reads (PX4 ``.ulg``, MAVLink ``.tlog``, CAN captures -- a Cyphal/CAN capture's UDRAL
+batteries with ``--cyphal-subject ID=TYPE`` as ``export`` reads them --, JSON Lines of a bundled message with
+``--message``) and writes one self-contained HTML page (plotly embedded, opens offline): per battery
 instance the time plots of pack voltage, current, power, state of charge, temperature and every cell with the
 imbalance, the failsafe replay marked on the time axis (``--params`` with the BATT_* values, ``--vehicle``), the
 validation findings grouped by rule with links to their time, and the figures (charge and energy used, average
@@ -34,6 +35,7 @@ from ..apps.report.as_json import report_json
 from ..apps.report.build import collect, html, pngs
 from ..errors import BattgenError, missing_file
 from ..text.escape import line
+from .cyphal_options import add_cyphal_subject, check_bundled_subjects
 from .gate_options import add_gate_options, firmware_note, gate_settings
 
 EXIT_OK, EXIT_EMPTY = 0, 1
@@ -45,6 +47,7 @@ def run(args: argparse.Namespace) -> int:
     for p in paths:
         if not p.is_file():
             raise missing_file(str(p))
+    check_bundled_subjects(args.cyphal_subject)  # a wrong ID=TYPE pair said once, before any input is read
     if args.vehicle is not None and args.vehicle not in VEHICLES:
         raise unknown_name("vehicle", args.vehicle, VEHICLES)
     report = collect(
@@ -54,6 +57,7 @@ def run(args: argparse.Namespace) -> int:
         params=Path(args.params) if args.params else None,
         vehicle=args.vehicle,
         gate=gate_settings(args),
+        subjects=args.cyphal_subject,
     )
     for item in report.inputs:  # the profile the log's firmware chose, as validate says it
         note = firmware_note(item.source, item.gate) if item.gate is not None else None
@@ -119,6 +123,7 @@ def register(subparsers: Any, summary: str) -> None:
     )
     p.add_argument("--format", choices=("html", "png", "json"), default="html", help="output (default: html)")
     p.add_argument("--message", metavar="NAME", help="the message of data-file inputs (default by log kind)")
+    add_cyphal_subject(p)
     p.add_argument("--schemas", metavar="DIR", help="schema folder (default: the bundled schemas/)")
     p.add_argument(
         "--params",

@@ -212,6 +212,12 @@ def raw_table(message: Message, batch: Batch, log: str, schema: Schema | None = 
         if pa.types.is_list(typ) or pa.types.is_fixed_size_list(typ):
             if values.dtype == object:
                 arr = pa.array([list(v) for v in values], type=typ)
+            elif length_key(name) in batch.columns:  # a variable-length array: each row its own length, not padded
+                lengths = np.asarray(batch.columns[length_key(name)], np.int64)
+                keep = np.arange(values.shape[1])[None, :] < lengths[:, None]
+                offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int32)
+                flat = pa.array(values[keep], type=typ.value_type)
+                arr = pa.ListArray.from_arrays(pa.array(offsets, pa.int32()), flat).cast(typ)
             else:
                 flat = pa.array(values.reshape(-1), type=typ.value_type)
                 width = values.shape[1] if values.ndim == 2 else 0

@@ -26,7 +26,9 @@ from ..battery.catalog import bundled_catalog
 from ..battery.sources import Batch, log_kind
 from ..battery.view import read_view
 from ..failsafe.logs import SampleTable
+from ..package import bundled_package
 from .content import content_id, map_file, prefix_id
+from .cyphal_raw import CYPHAL_PREFIX, cyphal_raw_tables
 from .dataflash_raw import dataflash_raw_tables
 from .dataset import (
     LogWriter,
@@ -162,7 +164,9 @@ def _export(
             batch, columns = chunk.batch, chunk.concepts
             table = battery_table(catalog, schema, columns, batch, log, file.name)
             writer.add(table)
-            if options.raw and batch.message in catalog.sources:
+            # a Cyphal capture's types are written by cyphal_raw_tables below, each subject's every transfer
+            cyphal = kind == "can" and batch.message.startswith(CYPHAL_PREFIX)
+            if options.raw and batch.message in catalog.sources and not cyphal:
                 writer.add_raw(
                     batch.message, raw_table(catalog.schema.message(batch.message), batch, log, catalog.schema)
                 )
@@ -178,6 +182,10 @@ def _export(
                 clock = clock or (batch if batch.n else None)
         if options.raw and kind == "dataflash":
             for message, raw in dataflash_raw_tables(file, name, log):
+                writer.add_raw(message, raw)
+        if options.raw and kind == "can" and options.cyphal_subjects:  # every subject's type, not only SourceTs
+            package = bundled_package().__name__
+            for message, raw in cyphal_raw_tables(file, name, log, options.cyphal_subjects, catalog.schema, package):
                 writer.add_raw(message, raw)
     except BaseException:
         writer.abort()

@@ -20,7 +20,7 @@ replays a log from the chunks it has already read, without reading the file agai
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -130,10 +130,11 @@ def _as_logged(values: NDArray) -> NDArray:
     return out
 
 
-def log_samples(path: Path, name: str | None = None) -> SampleTable:
-    """Every battery record of a log as samples (an InputError, or another BattgenError, if unreadable)."""
+def log_samples(path: Path, name: str | None = None, subjects: Sequence[str] = ()) -> SampleTable:
+    """Every battery record of a log as samples (an InputError, or another BattgenError, if unreadable);
+    ``subjects``: the ``--cyphal-subject`` pairs a CAN capture's Cyphal subjects are read with."""
     table = SampleTable()
-    for chunk in read_view(path, name):
+    for chunk in read_view(path, name, subjects=subjects):
         table.add(chunk)
     return table
 

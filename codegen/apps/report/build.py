@@ -34,10 +34,12 @@ def collect(
     params: Path | None = None,
     vehicle: str | None = None,
     gate: Settings | None = None,
+    subjects: Sequence[str] = (),
 ) -> Report:
     """Every input read, gated as ``validate`` gates it, and replayed (a BattgenError for an input that cannot be
-    read, or for a selector that names nothing of an input's message)."""
-    inputs = [read_input(p, schema_dir, message=message) for p in paths]
+    read, or for a selector that names nothing of an input's message). ``subjects``: the ``--cyphal-subject`` pairs
+    a CAN capture's Cyphal subjects are read with."""
+    inputs = [read_input(p, schema_dir, message=message, subjects=subjects) for p in paths]
     for item in inputs:
         apply_gate(item, gate or Settings())
     override = read_parameter_values(params) if params is not None else None

@@ -16,7 +16,7 @@ from __future__ import annotations
 import functools
 import math
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,6 +29,7 @@ from ...inputs.dispatch import read_records
 from ...inputs.kinds import FLIGHT_LOG_KINDS, file_kind
 from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
+from ..battery.can_batches import UDRAL
 from ..battery.catalog import bundled_catalog
 from ..battery.column_checks import FindingGroup, column_finding_groups, group_findings
 from ..battery.columns import ConceptColumn, NDArray
@@ -218,7 +219,13 @@ def default_message(path: Path, kind: str | None) -> str:
 
 
 def read_input(
-    path: Path, schema_dir: Path, *, message: str | None = None, kind: str | None = None, display: str | None = None
+    path: Path,
+    schema_dir: Path,
+    *,
+    message: str | None = None,
+    kind: str | None = None,
+    display: str | None = None,
+    subjects: Sequence[str] = (),
 ) -> InputSeries:
     """Every battery of one input as series, with the validator's findings. Raises a BattgenError (a
     LocatedError naming file and line for a damaged input) when the input cannot be read at all.
@@ -226,15 +233,17 @@ def read_input(
     A flight log or capture (every kind the battery view reads) gives its series from the view, the reading
     ``export`` and ``failsafe`` share (:mod:`codegen.apps.battery.view`), with the samples for the failsafe
     replay (:attr:`InputSeries.samples`); its records are also validated one by one where its kind has a message
-    schema (DataFlash has none). Other inputs (JSON, YAML) go record by record through the converters."""
+    schema (DataFlash has none). Other inputs (JSON, YAML) go record by record through the converters.
+    ``subjects``: the ``--cyphal-subject`` pairs a CAN capture's Cyphal subjects are read with, as ``export`` reads
+    them (its UDRAL batteries' records are then checked as the energy source's type)."""
     name = display or path.as_posix()
     kind = kind or file_kind(path)
     if kind in FLIGHT_LOG_KINDS and message is None:
-        return _view_input(path, name, schema_dir, kind)
+        return _view_input(path, name, schema_dir, kind, subjects)
     return _record_input(path, schema_dir, name, message, kind)
 
 
-def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeries:
+def _view_input(path: Path, name: str, schema_dir: Path, kind: str, subjects: Sequence[str] = ()) -> InputSeries:
     batteries: dict[int, _Parts] = {}
     table = SampleTable()
     messages: list[str] = []
@@ -242,7 +251,7 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
     word = INSTANCE_WORDS.get(kind, "id")
     checkable = kind == "ulog"  # the kinds whose findings come from the view's columns (column_checks)
     chunks: list[Chunk] = []
-    for chunk in read_view(path, name, all_fields=checkable):
+    for chunk in read_view(path, name, all_fields=checkable, subjects=subjects):
         if checkable:
             chunks.append(chunk)
         table.add(chunk)
@@ -273,7 +282,9 @@ def _view_input(path: Path, name: str, schema_dir: Path, kind: str) -> InputSeri
     if column is not None:
         out.findings, out.notices, out.unreadable = column
     else:  # the view's batches of this kind lack the records' places (a tlog's frames): read them one by one
-        checked = _record_input(path, schema_dir, name, None, kind)
+        # a capture whose UDRAL batteries were read: their energy source's transfers are the records checked
+        udral = UDRAL[0] if subjects and UDRAL[0] in messages else None
+        checked = _record_input(path, schema_dir, name, udral, kind, subjects)
         out.findings, out.notices, out.unreadable = checked.findings, checked.notices, checked.unreadable
         out.names = checked.names
     return out
@@ -355,7 +366,9 @@ class _Parts:
         return s
 
 
-def _record_input(path: Path, schema_dir: Path, name: str, message: str | None, kind: str | None) -> InputSeries:
+def _record_input(
+    path: Path, schema_dir: Path, name: str, message: str | None, kind: str | None, subjects: Sequence[str] = ()
+) -> InputSeries:
     msg, checker = make_checker(schema_dir, message or default_message(path, kind), [str(path)], kind)
     conversion = Conversion(_package_of(checker), msg.qualified_name, "concepts", "strict")
     batteries: dict[int, _Records] = {}
@@ -363,7 +376,7 @@ def _record_input(path: Path, schema_dir: Path, name: str, message: str | None, 
     out.names = names_of(msg, checker.rules, checker.extra is not None)
     t0: float | None = None
     found: list[tuple[float, int, Finding]] = []
-    for item in read_records(path, msg, name, model=checker.cls, kind=kind):
+    for item in read_records(path, msg, name, model=checker.cls, kind=kind, subjects=subjects):
         if isinstance(item, Notice):
             out.notices.append(item)
             continue
