@@ -21,9 +21,9 @@ from generated.convert.dronecan_mavlink import dronecan_to_mavlink, mavlink_to_d
 from generated.convert.dronecan_uorb import dronecan_to_uorb, uorb_to_dronecan
 from generated.convert.uorb_mavlink import mavlink_to_uorb, uorb_to_mavlink
 from generated.dronecan.ardupilot.equipment.power import BatteryInfoAux
-from generated.dronecan.uavcan.equipment.power import BatteryInfo
+from generated.dronecan.uavcan.equipment.power import BatteryInfo, BatteryInfoStatusFlag
 from generated.mavlink import BatteryStatus as MavBatteryStatus
-from generated.uorb import BatteryStatus
+from generated.uorb import BatteryStatus, BatteryStatusState, BatteryStatusWarning
 
 F32, F16 = np.float32, np.float16
 
@@ -72,7 +72,7 @@ def test_battery_id_0_becomes_mavlink_id_255() -> None:
 
 
 def test_bridge_raw_mode_fields() -> None:
-    info = BatteryInfo(voltage=16.8, current=12.5, status_flags=BatteryInfo.STATUS_FLAG_IN_USE | 8,
+    info = BatteryInfo(voltage=16.8, current=12.5, status_flags=BatteryInfoStatusFlag.IN_USE | 8,
                        full_charge_capacity_wh=99.0, remaining_capacity_wh=44.0, state_of_charge_pct=44)  # fmt: skip
     s = dronecan_to_uorb(info, policy="px4")
     assert s.voltage_v == float(F16(16.8)) and s.current_a == 12.5 and s.connected
@@ -86,9 +86,9 @@ def test_bridge_raw_mode_fields() -> None:
 
 @pytest.mark.parametrize(
     ("pct", "warning"),
-    [(4, BatteryStatus.WARNING_EMERGENCY), (5, BatteryStatus.WARNING_CRITICAL), (6, BatteryStatus.WARNING_CRITICAL),
-     (7, BatteryStatus.WARNING_LOW), (14, BatteryStatus.WARNING_LOW), (15, BatteryStatus.WARNING_NONE),
-     (127, BatteryStatus.WARNING_NONE)],
+    [(4, BatteryStatusWarning.EMERGENCY), (5, BatteryStatusWarning.CRITICAL), (6, BatteryStatusWarning.CRITICAL),
+     (7, BatteryStatusWarning.LOW), (14, BatteryStatusWarning.LOW), (15, BatteryStatusWarning.NONE),
+     (127, BatteryStatusWarning.NONE)],
 )  # fmt: skip
 def test_bridge_warning_thresholds(pct: int, warning: int) -> None:
     # determineWarning(remaining): < BAT_EMERGEN_THR 0.05, < BAT_CRIT_THR 0.07, < BAT_LOW_THR 0.15 (float32)
@@ -206,7 +206,7 @@ def test_receiver_fields() -> None:
     assert s.voltage_v == float(F32(F32(cells[0] + cells[1]) + cells[2]))
     assert s.current_a == float(F32(1234) / F32(100.0)) and s.remaining == float(F32(-1) / F32(100.0))
     assert s.discharged_mah == 321.0 and s.temperature == 2510.0 and s.connected
-    assert s.warning == BatteryStatus.WARNING_EMERGENCY  # remaining -0.01 < 0.05
+    assert s.warning == BatteryStatusWarning.EMERGENCY  # remaining -0.01 < 0.05
     assert s.id == 0 and s.time_remaining_s == 0.0 and s.scale == 0.0  # battery_status_s{} zero-initialised
 
 
@@ -215,7 +215,7 @@ def test_receiver_fields() -> None:
 
 def test_uavcannode_publisher_fields() -> None:
     s = BatteryStatus(connected=True, voltage_v=16.2, current_a=-3.0, temperature=25.1, remaining=0.876,
-                      max_error=300, state_of_health=95, id=2, warning=BatteryStatus.STATE_CHARGING, cell_count=2,
+                      max_error=300, state_of_health=95, id=2, warning=BatteryStatusState.CHARGING, cell_count=2,
                       voltage_cell_v=[4.05, 4.06] + [0.0] * 12, nominal_voltage=14.8, cycle_count=7)  # fmt: skip
     info, aux = uorb_to_dronecan(s, policy="px4")
     assert info.voltage == float(F16(F32(16.2))) and info.current == -3.0
@@ -224,7 +224,7 @@ def test_uavcannode_publisher_fields() -> None:
     assert info.state_of_charge_pct_stdev == min(300 % 256, 127)  # uint8 store, then uint7 saturation
     assert (info.battery_id, info.state_of_health_pct, info.model_instance_id) == (2, 95, 0)
     assert info.model_name == b"PX4 CAN Battery"
-    assert info.status_flags == BatteryInfo.STATUS_FLAG_IN_USE | BatteryInfo.STATUS_FLAG_CHARGING
+    assert info.status_flags == BatteryInfoStatusFlag.IN_USE | BatteryInfoStatusFlag.CHARGING
     assert aux.voltage_cell == [float(F16(F32(4.05))), float(F16(F32(4.06)))]
     assert (aux.cycle_count, aux.battery_id, aux.max_current) == (7, 2, -3.0)
 

@@ -23,7 +23,7 @@ from generated.convert.udral_mavlink_v2 import udral_to_mavlink_v2
 from generated.convert.udral_uorb import udral_to_uorb, uorb_to_udral
 from generated.cyphal.reg.udral.physics.electricity import SourceTs_0_1
 from generated.cyphal.reg.udral.service.battery import Error_0_1Value, Parameters_0_3, Status_0_2
-from generated.dronecan.uavcan.equipment.power import BatteryInfo
+from generated.dronecan.uavcan.equipment.power import BatteryInfo, BatteryInfoStatusFlag
 from generated.mavlink import MavBatteryFault
 from generated.uorb import BatteryStatus, BatteryStatusFault
 
@@ -192,7 +192,7 @@ def test_errors_become_the_faults_of_every_other_format(error: str) -> None:
     faults = udral_to_uorb(source(), _status(error)).faults
     assert faults == 1 << getattr(BatteryStatusFault, uorb_fault)  # uORB's FAULT_* are bit positions
     flags = udral_to_dronecan(source(), _status(error))[0].status_flags
-    assert flags == (getattr(BatteryInfo, f"STATUS_FLAG_{dronecan_flag}") if dronecan_flag else 0)
+    assert flags == (BatteryInfoStatusFlag[dronecan_flag] if dronecan_flag else 0)
     bitmask = udral_to_mavlink(source(), _status(error)).fault_bitmask
     assert bitmask == (getattr(MavBatteryFault, mavlink_fault).value if mavlink_fault else 0)
 
@@ -229,6 +229,6 @@ def test_the_most_severe_fault_is_the_error_written() -> None:
     assert [e.detail for e in report.entries if e.field == "concepts.faults"] == [
         "over_temperature not written: one condition at a time"
     ]
-    info = BatteryInfo(status_flags=BatteryInfo.STATUS_FLAG_BAD_BATTERY | BatteryInfo.STATUS_FLAG_TEMP_COLD)
+    info = BatteryInfo(status_flags=BatteryInfoStatusFlag.BAD_BATTERY | BatteryInfoStatusFlag.TEMP_COLD)
     assert dronecan_to_udral(info)[1].error.value == Error_0_1Value.BAD_BATTERY
     assert uorb_to_udral(BatteryStatus())[1].error.value == Error_0_1Value.NONE

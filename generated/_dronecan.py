@@ -9,8 +9,8 @@ whole payload, counting the bits that remain after the read position.
 from __future__ import annotations
 
 import struct
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Callable, Mapping
+from typing import Any, TypeVar
 
 from ._meta import DataError
 
@@ -24,6 +24,8 @@ _U16 = struct.Struct("<H")
 F16_MAX = 65504.0
 F32_MAX = 3.4028234663852886e38
 INF = float("inf")
+
+T = TypeVar("T")
 
 
 class DecodeError(ValueError):
@@ -160,6 +162,39 @@ def f16s(x: float) -> int:
     return f16bits(u)
 
 
+def f16bits_saturated(u: int) -> int:
+    """float16 bits of a saturated field from the float32 bits ``u`` of its value as given: beyond +-65504 (and
+    short of infinity) it is +-65504, else as :func:`f16bits` (the cut the encoders leave the uncommon halves to)."""
+    if 0x477FF000 <= u & 0x7FFFFFFF < 0x7F800000:
+        return ((u >> 16) & 0x8000) | 0x7BFF
+    return f16bits(u)
+
+
+def float32_bits(count: int, truncated: tuple[int, ...] = ()) -> Callable[..., tuple[int, ...]]:
+    """A function giving the float32 bit patterns of ``count`` float16 field values in one struct round trip;
+    an encoder cuts each half out of them: a positive normal half is a subtraction and a shift, the rest is
+    :func:`f16bits_saturated`'s or :func:`f16bits`'s. A saturated value beyond +-65504 is left for the cut to
+    clamp (one beyond float32's range is clamped here); the values at the positions ``truncated`` become
+    infinity beyond +-65504 first, as a truncated field's do."""
+    pack = struct.Struct(f"<{count}f").pack
+    unpack = struct.Struct(f"<{count}I").unpack
+    if truncated:
+
+        def cast_bits(*values: float) -> tuple[int, ...]:
+            cast = [f16_truncated(x) if i in truncated else f16_saturated(x) for i, x in enumerate(values)]
+            return unpack(pack(*cast))
+
+        return cast_bits
+
+    def bits(*values: float) -> tuple[int, ...]:
+        try:
+            return unpack(pack(*values))
+        except OverflowError:  # beyond float32: of such a value a saturated float16 keeps +-65504
+            return unpack(pack(*map(f16_saturated, values)))
+
+    return bits
+
+
 def f16_saturated(x: float) -> float:
     """A saturated float16 field's value before rounding: a finite value beyond +-65504 clamps to it;
     infinity and NaN are kept (as :func:`f16s`)."""
@@ -225,8 +260,74 @@ def cut(table: tuple[tuple[int, str], ...], have: int) -> DecodeError:
     return DecodeError(f"{table[-1][1]}: input ends inside this field")
 
 
+def beyond(owner: str, extra: int) -> DecodeError:
+    """The error for ``extra`` bytes after the end of a message."""
+    return DecodeError(f"{owner}: {extra} byte(s) beyond the end of the message")
+
+
+def read(cls: type[T], data: bytes, tao: bool) -> T:
+    """A whole payload read by the type's bit reader ``_dc_get`` (``decode`` for what it does not read itself:
+    a union, a payload with fields of varying size before its end, a tail array without TAO)."""
+    get: Callable[[int, int, bool], tuple[T, int]] = getattr(cls, "_dc_get")  # noqa: B009 (generated, unknown to T)
+    obj, rem = get(int.from_bytes(data, "big"), len(data) << 3, tao)
+    if rem >= 8:
+        raise beyond(cls.__name__, rem >> 3)
+    return obj
+
+
 def short(label: str, need: int, have: int) -> DecodeError:
     return DecodeError(f"{label}: input ends inside this field ({have} bits left, {need} needed)")
+
+
+def stream(value: int, width: int) -> int:
+    """The ``width``-bit unsigned ``value`` in stream order (DSDL v0: low byte first, a last partial byte
+    keeping only its top bits)."""
+    out = 0
+    for chunk in range((width + 7) // 8):
+        length = min(8, width - 8 * chunk)
+        out |= ((value >> (8 * chunk)) & ((1 << length) - 1)) << (width - 8 * chunk - length)
+    return out
+
+
+def unstream(bits: int, width: int) -> int:
+    """The value of ``width`` bits read in stream order (the inverse of :func:`stream`)."""
+    out = 0
+    for chunk in range((width + 7) // 8):
+        length = min(8, width - 8 * chunk)
+        out |= ((bits >> (width - 8 * chunk - length)) & ((1 << length) - 1)) << (8 * chunk)
+    return out
+
+
+def put_bytes(acc: int, value: bytes, capacity: int, tail: bool, label: str) -> int:
+    """``acc`` followed by a dynamic uint8 array: its length in ``capacity.bit_length()`` bits, unless it is
+    the tail array sent with TAO (``tail``), then its bytes."""
+    k = len(value)
+    if k > capacity:
+        raise EncodeError(f"{label}: length {k} exceeds capacity {capacity}")
+    if not tail:
+        width = capacity.bit_length()
+        acc = (acc << width) | stream(k, width)
+    return (acc << (k << 3)) | int.from_bytes(value, "big")
+
+
+def get_bytes(v: int, rem: int, capacity: int, tail: bool, label: str) -> tuple[bytes, int]:
+    """A dynamic uint8 array read from payload int ``v`` with ``rem`` bits left, and the bits left after it:
+    the tail array sent with TAO (``tail``) is every whole byte that is left, any other has its length first."""
+    if tail:
+        k = rem >> 3
+    else:
+        width = capacity.bit_length()
+        if rem < width:
+            raise short(f"{label} (length)", width, rem)
+        rem -= width
+        k = unstream((v >> rem) & ((1 << width) - 1), width)
+    if k > capacity:
+        raise DecodeError(f"{label}: length {k} exceeds capacity {capacity}")
+    need = k << 3
+    if rem < need:
+        raise short(label, need, rem)
+    rem -= need
+    return ((v >> rem) & ((1 << need) - 1)).to_bytes(k, "big"), rem
 
 
 def _crc_table() -> tuple[int, ...]:

@@ -80,8 +80,6 @@ class BattParams:
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "params.BATT"
-    FS_VOLTSRC_RAW_VOLTAGE: _ClassVar[int] = 0
-    FS_VOLTSRC_SAG_COMPENSATED_VOLTAGE: _ClassVar[int] = 1
 
     BATT_CAPACITY: int = _dataclasses.field(
         default=3300,

@@ -39,9 +39,9 @@ from generated.convert.uorb_mavlink import mavlink_to_uorb, uorb_to_mavlink
 from generated.convert.uorb_uorb_v0 import uorb_to_uorb_v0, uorb_v0_to_uorb
 from generated.devicetree import SimpleBattery
 from generated.dronecan.ardupilot.equipment.power import BatteryInfoAux
-from generated.dronecan.uavcan.equipment.power import BatteryInfo
+from generated.dronecan.uavcan.equipment.power import BatteryInfo, BatteryInfoStatusFlag
 from generated.mavlink import BatteryStatus as MavBatteryStatus
-from generated.uorb import BatteryStatus, BatteryStatusV0
+from generated.uorb import BatteryStatus, BatteryStatusFault, BatteryStatusState, BatteryStatusV0
 
 NAN = math.nan
 
@@ -117,13 +117,13 @@ def test_strict_state_of_charge_hybrid_rule() -> None:
 
 
 def test_strict_status_flags_to_faults_and_warning() -> None:
-    flags = BatteryInfo.STATUS_FLAG_TEMP_HOT | BatteryInfo.STATUS_FLAG_OVERLOAD | BatteryInfo.STATUS_FLAG_BAD_BATTERY
+    flags = BatteryInfoStatusFlag.TEMP_HOT | BatteryInfoStatusFlag.OVERLOAD | BatteryInfoStatusFlag.BAD_BATTERY
     report = LossReport()
-    out = dronecan_to_uorb(BatteryInfo(status_flags=flags | BatteryInfo.STATUS_FLAG_NEED_SERVICE), report=report)
+    out = dronecan_to_uorb(BatteryInfo(status_flags=flags | BatteryInfoStatusFlag.NEED_SERVICE), report=report)
     expected = {
-        BatteryStatus.FAULT_OVER_TEMPERATURE,
-        BatteryStatus.FAULT_OVER_CURRENT,
-        BatteryStatus.FAULT_HARDWARE_FAILURE,
+        BatteryStatusFault.OVER_TEMPERATURE,
+        BatteryStatusFault.OVER_CURRENT,
+        BatteryStatusFault.HARDWARE_FAILURE,
     }
     assert out.faults == sum(1 << b for b in expected)
     assert report.entries[0].to_dict() == {
@@ -131,11 +131,11 @@ def test_strict_status_flags_to_faults_and_warning() -> None:
         "field": "dronecan.uavcan.equipment.power.BatteryInfo.status_flags",
         "detail": "bits 0x80 have no counterpart",
     }
-    cold = dronecan_to_uorb(BatteryInfo(status_flags=BatteryInfo.STATUS_FLAG_TEMP_COLD))
-    assert cold.faults == 1 << BatteryStatus.FAULT_UNDER_TEMPERATURE
-    charging = dronecan_to_uorb(BatteryInfo(status_flags=BatteryInfo.STATUS_FLAG_CHARGING))
-    assert charging.warning == BatteryStatus.STATE_CHARGING
-    assert mavlink_to_dronecan(MavBatteryStatus(charge_state=7))[0].status_flags & BatteryInfo.STATUS_FLAG_CHARGING
+    cold = dronecan_to_uorb(BatteryInfo(status_flags=BatteryInfoStatusFlag.TEMP_COLD))
+    assert cold.faults == 1 << BatteryStatusFault.UNDER_TEMPERATURE
+    charging = dronecan_to_uorb(BatteryInfo(status_flags=BatteryInfoStatusFlag.CHARGING))
+    assert charging.warning == BatteryStatusState.CHARGING
+    assert mavlink_to_dronecan(MavBatteryStatus(charge_state=7))[0].status_flags & BatteryInfoStatusFlag.CHARGING
 
 
 def test_sentinels_map_to_sentinels() -> None:

@@ -122,7 +122,12 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
             fields[-1].pattern_literal = py_literal(f.pattern)
 
     constants: list[tuple[str, str, str]] = []
+    # an enum's entries are its IntEnum/IntFlag class's members alone (BatteryInfoStatusFlag.IN_USE), not
+    # class constants as well; a constant outside every enum (FAULT_COUNT) stays a class attribute
+    entries = {entry.name for e in msg.enums for entry in e.entries}
     for c in msg.constants:
+        if c.name in entries:
+            continue
         name = names[("constant", c.name)]
         if isinstance(c.type, PrimitiveType):
             literal = py_literal(typed(c.value, c.type) if isinstance(c.value, int | float) else c.value)

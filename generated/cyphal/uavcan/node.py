@@ -44,10 +44,6 @@ class Health_1_0:
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "cyphal.uavcan.node.Health_1_0"
-    NOMINAL: _ClassVar[int] = 0
-    ADVISORY: _ClassVar[int] = 1
-    CAUTION: _ClassVar[int] = 2
-    WARNING: _ClassVar[int] = 3
 
     value: int = _dataclasses.field(
         default=0, metadata=_m.meta(name="value", type="uint2", enums=("cyphal.uavcan.node.Health_1_0.VALUE",))

@@ -21,10 +21,10 @@ __all__ = ["Timestamp"]
 
 # fixed fields as encoded (a float16 as its bit pattern)
 _TIMESTAMP_ENCODE_STRUCT = _struct.Struct("<IHB")
-# (bit where each field ends, field): names the field a short payload cuts
-_TIMESTAMP_FIELD_ENDS = ((56, "Timestamp.usec"),)
 # fixed fields as decoded
 _TIMESTAMP_DECODE_STRUCT = _struct.Struct("<IHB")
+# (bit where each field ends, field): names the field a short payload cuts
+_TIMESTAMP_FIELD_ENDS = ((56, "Timestamp.usec"),)
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -95,12 +95,9 @@ class Timestamp:
         n = len(data)
         if n < 7:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, n << 3)
-        packed1, packed2, packed3 = _TIMESTAMP_DECODE_STRUCT.unpack_from(data)
-        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        usec = packed1 | (packed2 << 32) | (packed3 << 48)
         if n > 7:
-            raise _dc.DecodeError("Timestamp: " + str(n - 7) + " byte(s) beyond the end of the message")
-        return cls(usec)
+            raise _dc.beyond("Timestamp", n - 7)
+        return cls._dc_from_head(data)
 
     def _dc_head(self) -> bytes:
         """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
@@ -109,6 +106,15 @@ class Timestamp:
         # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         return _TIMESTAMP_ENCODE_STRUCT.pack(
             (usec_bits & 0xFFFFFFFF), ((usec_bits >> 32) & 0xFFFF), ((usec_bits >> 48) & 0xFF)
+        )
+
+    @classmethod
+    def _dc_from_head(cls, data: bytes) -> Timestamp:
+        """A new instance of bits 0-55 (the fixed fields that open the payload) read from ``data``."""
+        packed1, packed2, packed3 = _TIMESTAMP_DECODE_STRUCT.unpack_from(data)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        return cls(
+            packed1 | (packed2 << 32) | (packed3 << 48),  # usec
         )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
@@ -120,10 +126,8 @@ class Timestamp:
         if rem < 56:
             raise _dc.cut(_TIMESTAMP_FIELD_ENDS, rem)
         rem -= 56
-        packed1, packed2, packed3 = _TIMESTAMP_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big"))
-        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        usec = packed1 | (packed2 << 32) | (packed3 << 48)
-        return cls(usec), rem
+        head = ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
+        return cls._dc_from_head(head), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""

@@ -56,12 +56,12 @@ class BatteryContinuousStatusFlag(_enum.IntFlag):
     CAPACITY_RELATIVE_TO_FULL = 262144
 
 
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_CELLS_FIELD_ENDS_FROM_INDEX = ((16, "BatteryCells.index"),)
 # fixed fields as decoded
 _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
-# fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_CELLS_ENCODE_STRUCT_FROM_INDEX = _struct.Struct("<H")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -76,12 +76,12 @@ _BATTERY_CELLS_FIELD_SPECS = (
 )
 
 
-# float16 fields packed as float32 ...
-_BATTERY_CONTINUOUS_FLOAT32_STRUCT = _struct.Struct("<4f")
-# ... and read back as bits, from which each half is cut
-_BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT = _struct.Struct("<4I")
+# float16 fields as float32 bits, from which each half is cut
+_BATTERY_CONTINUOUS_FLOAT32_BITS = _dc.float32_bits(4)
 # fixed fields as encoded (a float16 as its bit pattern)
 _BATTERY_CONTINUOUS_ENCODE_STRUCT = _struct.Struct("<HHHffHBfI")
+# fixed fields as decoded
+_BATTERY_CONTINUOUS_DECODE_STRUCT = _struct.Struct("<eeeffeBfI")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_CONTINUOUS_FIELD_ENDS = (
     (16, "BatteryContinuous.temperature_cells"),
@@ -94,8 +94,6 @@ _BATTERY_CONTINUOUS_FIELD_ENDS = (
     (168, "BatteryContinuous.capacity_consumed"),
     (200, "BatteryContinuous.status_flags"),
 )
-# fixed fields as decoded
-_BATTERY_CONTINUOUS_DECODE_STRUCT = _struct.Struct("<eeeffeBfI")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -163,10 +161,14 @@ _BATTERY_CONTINUOUS_FIELD_SPECS = (
 
 # fixed fields as encoded (a float16 as its bit pattern)
 _BATTERY_INFO_AUX_ENCODE_STRUCT = _struct.Struct("<IHB")
-# (bit where each field ends, field): names the field a short payload cuts
-_BATTERY_INFO_AUX_FIELD_ENDS = ((56, "BatteryInfoAux.timestamp.usec"),)
 # fixed fields as decoded
 _BATTERY_INFO_AUX_DECODE_STRUCT = _struct.Struct("<IHB")
+# float16 fields as float32 bits, from which each half is cut
+_BATTERY_INFO_AUX_FLOAT32_BITS_FROM_CYCLE_COUNT = _dc.float32_bits(2)
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHHHH")
+# (bit where each field ends, field): names the field a short payload cuts
+_BATTERY_INFO_AUX_FIELD_ENDS = ((56, "BatteryInfoAux.timestamp.usec"),)
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT = (
     (16, "BatteryInfoAux.cycle_count"),
@@ -178,12 +180,6 @@ _BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT = (
 )
 # fixed fields as decoded
 _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHeeH")
-# float16 fields packed as float32 ...
-_BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2f")
-# ... and read back as bits, from which each half is cut
-_BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<2I")
-# fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_INFO_AUX_ENCODE_STRUCT_FROM_CYCLE_COUNT = _struct.Struct("<HHHHH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -210,6 +206,10 @@ _BATTERY_INFO_AUX_FIELD_SPECS = (
 )
 
 
+# float16 fields as float32 bits, from which each half is cut
+_BATTERY_PERIODIC_FLOAT32_BITS_FROM_DESIGN_CAPACITY = _dc.float32_bits(4)
+# fixed fields as encoded (a float16 as its bit pattern)
+_BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBHHHHffffHB")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY = (
     (32, "BatteryPeriodic.design_capacity"),
@@ -227,12 +227,6 @@ _BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY = (
 )
 # fixed fields as decoded
 _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBeeeeffffHB")
-# float16 fields packed as float32 ...
-_BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4f")
-# ... and read back as bits, from which each half is cut
-_BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<4I")
-# fixed fields as encoded (a float16 as its bit pattern)
-_BATTERY_PERIODIC_ENCODE_STRUCT_FROM_DESIGN_CAPACITY = _struct.Struct("<fBHHHHffffHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -297,6 +291,8 @@ _BATTERY_PERIODIC_FIELD_SPECS = (
 
 # fixed fields as encoded (a float16 as its bit pattern)
 _BATTERY_TAG_ENCODE_STRUCT = _struct.Struct("<IIfIII")
+# fixed fields as decoded
+_BATTERY_TAG_DECODE_STRUCT = _struct.Struct("<IIfIII")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_TAG_FIELD_ENDS = (
     (32, "BatteryTag.serial_number"),
@@ -306,8 +302,6 @@ _BATTERY_TAG_FIELD_ENDS = (
     (160, "BatteryTag.first_use_mins"),
     (192, "BatteryTag.last_arm_time_mins"),
 )
-# fixed fields as decoded
-_BATTERY_TAG_DECODE_STRUCT = _struct.Struct("<IIfIII")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -397,28 +391,7 @@ class BatteryCells:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryCells:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        voltages: list[_Any]
-        n = len(data)
-        v = int.from_bytes(data, "big")
-        rem = n << 3
-        if rem < 5:
-            raise _dc.short("BatteryCells.voltages (length)", 5, rem)
-        rem -= 5
-        k1 = (v >> rem) & 0x1F
-        if k1 > 24:
-            raise _dc.DecodeError("BatteryCells.voltages: length " + str(k1) + " exceeds capacity 24")
-        n2 = k1 * 16
-        if rem < n2:
-            raise _dc.short("BatteryCells.voltages", n2, rem)
-        rem -= n2
-        voltages = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
-        if rem < 16:
-            raise _dc.cut(_BATTERY_CELLS_FIELD_ENDS_FROM_INDEX, rem)
-        rem -= 16
-        (index,) = _BATTERY_CELLS_DECODE_STRUCT_FROM_INDEX.unpack(((v >> rem) & 0xFFFF).to_bytes(2, "big"))
-        if rem >= 8:
-            raise _dc.DecodeError("BatteryCells: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(voltages, index)
+        return _dc.read(cls, data, tao)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         x1 = self.voltages
@@ -503,25 +476,6 @@ class BatteryContinuous:
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "dronecan.ardupilot.equipment.power.BatteryContinuous"
-    STATUS_FLAG_READY_TO_USE: _ClassVar[int] = 1
-    STATUS_FLAG_CHARGING: _ClassVar[int] = 2
-    STATUS_FLAG_CELL_BALANCING: _ClassVar[int] = 4
-    STATUS_FLAG_FAULT_CELL_IMBALANCE: _ClassVar[int] = 8
-    STATUS_FLAG_AUTO_DISCHARGING: _ClassVar[int] = 16
-    STATUS_FLAG_REQUIRES_SERVICE: _ClassVar[int] = 32
-    STATUS_FLAG_BAD_BATTERY: _ClassVar[int] = 64
-    STATUS_FLAG_PROTECTIONS_ENABLED: _ClassVar[int] = 128
-    STATUS_FLAG_FAULT_PROTECTION_SYSTEM: _ClassVar[int] = 256
-    STATUS_FLAG_FAULT_OVER_VOLT: _ClassVar[int] = 512
-    STATUS_FLAG_FAULT_UNDER_VOLT: _ClassVar[int] = 1024
-    STATUS_FLAG_FAULT_OVER_TEMP: _ClassVar[int] = 2048
-    STATUS_FLAG_FAULT_UNDER_TEMP: _ClassVar[int] = 4096
-    STATUS_FLAG_FAULT_OVER_CURRENT: _ClassVar[int] = 8192
-    STATUS_FLAG_FAULT_SHORT_CIRCUIT: _ClassVar[int] = 16384
-    STATUS_FLAG_FAULT_INCOMPATIBLE_VOLTAGE: _ClassVar[int] = 32768
-    STATUS_FLAG_FAULT_INCOMPATIBLE_FIRMWARE: _ClassVar[int] = 65536
-    STATUS_FLAG_FAULT_INCOMPATIBLE_CELLS_CONFIGURATION: _ClassVar[int] = 131072
-    STATUS_FLAG_CAPACITY_RELATIVE_TO_FULL: _ClassVar[int] = 262144
 
     temperature_cells: float = _dataclasses.field(
         default=0.0,
@@ -696,70 +650,14 @@ class BatteryContinuous:
         n = len(data)
         if n < 25:
             raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, n << 3)
-        (
-            temperature_cells,
-            temperature_pcb,
-            temperature_other,
-            current,
-            voltage,
-            state_of_charge,
-            slot_id,
-            capacity_consumed,
-            status_flags,
-        ) = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack_from(data)
         if n > 25:
-            raise _dc.DecodeError("BatteryContinuous: " + str(n - 25) + " byte(s) beyond the end of the message")
-        return cls(
-            temperature_cells,
-            temperature_pcb,
-            temperature_other,
-            current,
-            voltage,
-            state_of_charge,
-            slot_id,
-            capacity_consumed,
-            status_flags,
-        )
+            raise _dc.beyond("BatteryContinuous", n - 25)
+        return cls._dc_from_head(data)
 
     def _dc_head(self) -> bytes:
         """Bits 0-199 (the fixed fields that open the payload) as bytes, zero padded."""
-        temperature_cells = self.temperature_cells
-        temperature_pcb = self.temperature_pcb
-        temperature_other = self.temperature_other
-        state_of_charge = self.state_of_charge
-        temperature_cells_f32, temperature_pcb_f32, temperature_other_f32, state_of_charge_f32 = (
-            _BATTERY_CONTINUOUS_FLOAT32_BITS_STRUCT.unpack(
-                _BATTERY_CONTINUOUS_FLOAT32_STRUCT.pack(
-                    temperature_cells
-                    if -65504.0 <= temperature_cells <= 65504.0
-                    else _dc.f16_saturated(temperature_cells),
-                    temperature_pcb if -65504.0 <= temperature_pcb <= 65504.0 else _dc.f16_saturated(temperature_pcb),
-                    temperature_other
-                    if -65504.0 <= temperature_other <= 65504.0
-                    else _dc.f16_saturated(temperature_other),
-                    state_of_charge if -65504.0 <= state_of_charge <= 65504.0 else _dc.f16_saturated(state_of_charge),
-                )
-            )
-        )
-        temperature_cells_f16 = (
-            ((temperature_cells_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= temperature_cells_f32 < 0x477FF000
-            else _dc.f16bits(temperature_cells_f32)
-        )
-        temperature_pcb_f16 = (
-            ((temperature_pcb_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= temperature_pcb_f32 < 0x477FF000
-            else _dc.f16bits(temperature_pcb_f32)
-        )
-        temperature_other_f16 = (
-            ((temperature_other_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= temperature_other_f32 < 0x477FF000
-            else _dc.f16bits(temperature_other_f32)
-        )
-        state_of_charge_f16 = (
-            ((state_of_charge_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= state_of_charge_f32 < 0x477FF000
-            else _dc.f16bits(state_of_charge_f32)
+        f32 = _BATTERY_CONTINUOUS_FLOAT32_BITS(
+            self.temperature_cells, self.temperature_pcb, self.temperature_other, self.state_of_charge
         )
         current = self.current
         voltage = self.voltage
@@ -767,9 +665,9 @@ class BatteryContinuous:
         capacity_consumed = self.capacity_consumed
         status_flags = self.status_flags
         return _BATTERY_CONTINUOUS_ENCODE_STRUCT.pack(
-            temperature_cells_f16,
-            temperature_pcb_f16,
-            temperature_other_f16,
+            (((f32[0] - 0x37FFF000) >> 13) if 0x38800000 <= f32[0] < 0x477FF000 else _dc.f16bits_saturated(f32[0])),
+            (((f32[1] - 0x37FFF000) >> 13) if 0x38800000 <= f32[1] < 0x477FF000 else _dc.f16bits_saturated(f32[1])),
+            (((f32[2] - 0x37FFF000) >> 13) if 0x38800000 <= f32[2] < 0x477FF000 else _dc.f16bits_saturated(f32[2])),
             (
                 current
                 if -_dc.F32_MAX <= current <= _dc.F32_MAX
@@ -788,7 +686,7 @@ class BatteryContinuous:
                     else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
                 )
             ),
-            state_of_charge_f16,
+            (((f32[3] - 0x37FFF000) >> 13) if 0x38800000 <= f32[3] < 0x477FF000 else _dc.f16bits_saturated(f32[3])),
             (slot_id if 0 <= slot_id <= 255 else (255 if slot_id > 255 else 0)),
             (
                 capacity_consumed
@@ -802,15 +700,9 @@ class BatteryContinuous:
             (status_flags if 0 <= status_flags <= 4294967295 else (4294967295 if status_flags > 4294967295 else 0)),
         )
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
-        acc = (acc << 200) | int.from_bytes(self._dc_head(), "big")
-        return acc
-
     @classmethod
-    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryContinuous, int]:
-        if rem < 200:
-            raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, rem)
-        rem -= 200
+    def _dc_from_head(cls, data: bytes) -> BatteryContinuous:
+        """A new instance of bits 0-199 (the fixed fields that open the payload) read from ``data``."""
         (
             temperature_cells,
             temperature_pcb,
@@ -821,7 +713,7 @@ class BatteryContinuous:
             slot_id,
             capacity_consumed,
             status_flags,
-        ) = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 200) - 1)).to_bytes(25, "big"))
+        ) = _BATTERY_CONTINUOUS_DECODE_STRUCT.unpack_from(data)
         return cls(
             temperature_cells,
             temperature_pcb,
@@ -832,7 +724,19 @@ class BatteryContinuous:
             slot_id,
             capacity_consumed,
             status_flags,
-        ), rem
+        )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 200) | int.from_bytes(self._dc_head(), "big")
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryContinuous, int]:
+        if rem < 200:
+            raise _dc.cut(_BATTERY_CONTINUOUS_FIELD_ENDS, rem)
+        rem -= 200
+        head = ((v >> rem) & ((1 << 200) - 1)).to_bytes(25, "big")
+        return cls._dc_from_head(head), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -1036,49 +940,7 @@ class BatteryInfoAux:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfoAux:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        voltage_cell: list[_Any]
-        n = len(data)
-        if n < 7:
-            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, n << 3)
-        packed1, packed2, packed3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack_from(data)
-        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        timestamp_usec = packed1 | (packed2 << 32) | (packed3 << 48)
-        v = int.from_bytes(data, "big")
-        rem = (n << 3) - 56
-        if rem < 8:
-            raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
-        rem -= 8
-        k4 = (v >> rem) & 0xFF
-        if k4 > 255:
-            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
-        n5 = k4 * 16
-        if rem < n5:
-            raise _dc.short("BatteryInfoAux.voltage_cell", n5, rem)
-        rem -= n5
-        voltage_cell = list(_struct.unpack(f"<{k4}e", ((v >> rem) & ((1 << n5) - 1)).to_bytes(n5 >> 3, "big")))
-        if rem < 73:
-            raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
-        rem -= 73
-        cycle_count, over_discharge_count, max_current, nominal_voltage, packed6 = (
-            _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
-                (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
-            )
-        )
-        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        is_powering_off = ((packed6 >> 7) & 0x1) != 0
-        battery_id = (packed6 >> 15) | ((packed6 & 0x7F) << 1)
-        if rem >= 8:
-            raise _dc.DecodeError("BatteryInfoAux: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(
-            _timestamp_class()(timestamp_usec),
-            voltage_cell,
-            cycle_count,
-            over_discharge_count,
-            max_current,
-            nominal_voltage,
-            is_powering_off,
-            battery_id,
-        )
+        return _dc.read(cls, data, tao)
 
     def _dc_head(self) -> bytes:
         """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
@@ -1091,6 +953,33 @@ class BatteryInfoAux:
             ((timestamp_usec_bits >> 48) & 0xFF),
         )
 
+    @classmethod
+    def _dc_from_head(
+        cls,
+        data: bytes,
+        voltage_cell: _Any,
+        cycle_count: _Any,
+        over_discharge_count: _Any,
+        max_current: _Any,
+        nominal_voltage: _Any,
+        is_powering_off: _Any,
+        battery_id: _Any,
+    ) -> BatteryInfoAux:
+        """A new instance of bits 0-55 (the fixed fields that open the payload) read from ``data``,
+        and of the values of the fields after them."""
+        packed1, packed2, packed3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack_from(data)
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        return cls(
+            _timestamp_class()(packed1 | (packed2 << 32) | (packed3 << 48)),  # timestamp
+            voltage_cell,
+            cycle_count,
+            over_discharge_count,
+            max_current,
+            nominal_voltage,
+            is_powering_off,
+            battery_id,
+        )
+
     def _dc_put(self, acc: int, tao: bool) -> int:
         acc = (acc << 56) | int.from_bytes(self._dc_head(), "big")
         x1 = self.voltage_cell
@@ -1099,24 +988,7 @@ class BatteryInfoAux:
             raise _dc.EncodeError("BatteryInfoAux.voltage_cell: length " + str(k2) + " exceeds capacity 255")
         acc = (acc << 8) | k2
         acc = (acc << (k2 * 16)) | int.from_bytes(_struct.pack(f"<{k2}H", *[_dc.f16s(e3) for e3 in x1]), "big")
-        max_current = self.max_current
-        nominal_voltage = self.nominal_voltage
-        max_current_f32, nominal_voltage_f32 = _BATTERY_INFO_AUX_FLOAT32_BITS_STRUCT_FROM_CYCLE_COUNT.unpack(
-            _BATTERY_INFO_AUX_FLOAT32_STRUCT_FROM_CYCLE_COUNT.pack(
-                max_current if -65504.0 <= max_current <= 65504.0 else _dc.f16_saturated(max_current),
-                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
-            )
-        )
-        max_current_f16 = (
-            ((max_current_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= max_current_f32 < 0x477FF000
-            else _dc.f16bits(max_current_f32)
-        )
-        nominal_voltage_f16 = (
-            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
-            else _dc.f16bits(nominal_voltage_f32)
-        )
+        f32 = _BATTERY_INFO_AUX_FLOAT32_BITS_FROM_CYCLE_COUNT(self.max_current, self.nominal_voltage)
         cycle_count = self.cycle_count
         over_discharge_count = self.over_discharge_count
         is_powering_off = self.is_powering_off
@@ -1133,8 +1005,16 @@ class BatteryInfoAux:
                         if 0 <= over_discharge_count <= 65535
                         else (65535 if over_discharge_count > 65535 else 0)
                     ),
-                    max_current_f16,
-                    nominal_voltage_f16,
+                    (
+                        ((f32[0] - 0x37FFF000) >> 13)
+                        if 0x38800000 <= f32[0] < 0x477FF000
+                        else _dc.f16bits_saturated(f32[0])
+                    ),
+                    (
+                        ((f32[1] - 0x37FFF000) >> 13)
+                        if 0x38800000 <= f32[1] < 0x477FF000
+                        else _dc.f16bits_saturated(f32[1])
+                    ),
                     (is_powering_off_bits << 7) | ((battery_id_bits & 0x1) << 15) | ((battery_id_bits >> 1) & 0x7F),
                 ),
                 "big",
@@ -1149,42 +1029,36 @@ class BatteryInfoAux:
         if rem < 56:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS, rem)
         rem -= 56
-        packed1, packed2, packed3 = _BATTERY_INFO_AUX_DECODE_STRUCT.unpack(
-            ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
-        )
-        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        timestamp_usec = packed1 | (packed2 << 32) | (packed3 << 48)
+        head = ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
         if rem < 8:
             raise _dc.short("BatteryInfoAux.voltage_cell (length)", 8, rem)
         rem -= 8
-        k4 = (v >> rem) & 0xFF
-        if k4 > 255:
-            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k4) + " exceeds capacity 255")
-        n5 = k4 * 16
-        if rem < n5:
-            raise _dc.short("BatteryInfoAux.voltage_cell", n5, rem)
-        rem -= n5
-        voltage_cell = list(_struct.unpack(f"<{k4}e", ((v >> rem) & ((1 << n5) - 1)).to_bytes(n5 >> 3, "big")))
+        k1 = (v >> rem) & 0xFF
+        if k1 > 255:
+            raise _dc.DecodeError("BatteryInfoAux.voltage_cell: length " + str(k1) + " exceeds capacity 255")
+        n2 = k1 * 16
+        if rem < n2:
+            raise _dc.short("BatteryInfoAux.voltage_cell", n2, rem)
+        rem -= n2
+        voltage_cell = list(_struct.unpack(f"<{k1}e", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
         if rem < 73:
             raise _dc.cut(_BATTERY_INFO_AUX_FIELD_ENDS_FROM_CYCLE_COUNT, rem)
         rem -= 73
-        cycle_count, over_discharge_count, max_current, nominal_voltage, packed6 = (
+        cycle_count, over_discharge_count, max_current, nominal_voltage, packed3 = (
             _BATTERY_INFO_AUX_DECODE_STRUCT_FROM_CYCLE_COUNT.unpack(
                 (((v >> rem) & ((1 << 73) - 1)) << 7).to_bytes(10, "big")
             )
         )
         # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        is_powering_off = ((packed6 >> 7) & 0x1) != 0
-        battery_id = (packed6 >> 15) | ((packed6 & 0x7F) << 1)
-        return cls(
-            _timestamp_class()(timestamp_usec),
+        return cls._dc_from_head(
+            head,
             voltage_cell,
             cycle_count,
             over_discharge_count,
             max_current,
             nominal_voltage,
-            is_powering_off,
-            battery_id,
+            ((packed3 >> 7) & 0x1) != 0,
+            (packed3 >> 15) | ((packed3 & 0x7F) << 1),
         ), rem
 
     def validate(self) -> list[_v.Violation]:
@@ -1510,145 +1384,17 @@ class BatteryPeriodic:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryPeriodic:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        name: bytes
-        serial_number: bytes
-        manufacture_date: bytes
-        n = len(data)
-        v = int.from_bytes(data, "big")
-        rem = n << 3
-        if rem < 6:
-            raise _dc.short("BatteryPeriodic.name (length)", 6, rem)
-        rem -= 6
-        k1 = (v >> rem) & 0x3F
-        if k1 > 50:
-            raise _dc.DecodeError("BatteryPeriodic.name: length " + str(k1) + " exceeds capacity 50")
-        n2 = k1 * 8
-        if rem < n2:
-            raise _dc.short("BatteryPeriodic.name", n2, rem)
-        rem -= n2
-        name = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
-        if rem < 6:
-            raise _dc.short("BatteryPeriodic.serial_number (length)", 6, rem)
-        rem -= 6
-        k3 = (v >> rem) & 0x3F
-        if k3 > 32:
-            raise _dc.DecodeError("BatteryPeriodic.serial_number: length " + str(k3) + " exceeds capacity 32")
-        n4 = k3 * 8
-        if rem < n4:
-            raise _dc.short("BatteryPeriodic.serial_number", n4, rem)
-        rem -= n4
-        serial_number = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
-        if rem < 4:
-            raise _dc.short("BatteryPeriodic.manufacture_date (length)", 4, rem)
-        rem -= 4
-        k5 = (v >> rem) & 0xF
-        if k5 > 9:
-            raise _dc.DecodeError("BatteryPeriodic.manufacture_date: length " + str(k5) + " exceeds capacity 9")
-        n6 = k5 * 8
-        if rem < n6:
-            raise _dc.short("BatteryPeriodic.manufacture_date", n6, rem)
-        rem -= n6
-        manufacture_date = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
-        if rem < 256:
-            raise _dc.cut(_BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY, rem)
-        rem -= 256
-        (
-            design_capacity,
-            cells_in_series,
-            nominal_voltage,
-            discharge_minimum_voltage,
-            charging_minimum_voltage,
-            charging_maximum_voltage,
-            charging_maximum_current,
-            discharge_maximum_current,
-            discharge_maximum_burst_current,
-            full_charge_capacity,
-            cycle_count,
-            state_of_health,
-        ) = _BATTERY_PERIODIC_DECODE_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-            ((v >> rem) & ((1 << 256) - 1)).to_bytes(32, "big")
-        )
-        if rem >= 8:
-            raise _dc.DecodeError("BatteryPeriodic: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return cls(
-            name,
-            serial_number,
-            manufacture_date,
-            design_capacity,
-            cells_in_series,
-            nominal_voltage,
-            discharge_minimum_voltage,
-            charging_minimum_voltage,
-            charging_maximum_voltage,
-            charging_maximum_current,
-            discharge_maximum_current,
-            discharge_maximum_burst_current,
-            full_charge_capacity,
-            cycle_count,
-            state_of_health,
-        )
+        return _dc.read(cls, data, tao)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
-        x1 = self.name
-        k2 = len(x1)
-        if k2 > 50:
-            raise _dc.EncodeError("BatteryPeriodic.name: length " + str(k2) + " exceeds capacity 50")
-        acc = (acc << 6) | k2
-        acc = (acc << (k2 << 3)) | int.from_bytes(x1, "big")
-        x3 = self.serial_number
-        k4 = len(x3)
-        if k4 > 32:
-            raise _dc.EncodeError("BatteryPeriodic.serial_number: length " + str(k4) + " exceeds capacity 32")
-        acc = (acc << 6) | k4
-        acc = (acc << (k4 << 3)) | int.from_bytes(x3, "big")
-        x5 = self.manufacture_date
-        k6 = len(x5)
-        if k6 > 9:
-            raise _dc.EncodeError("BatteryPeriodic.manufacture_date: length " + str(k6) + " exceeds capacity 9")
-        acc = (acc << 4) | k6
-        acc = (acc << (k6 << 3)) | int.from_bytes(x5, "big")
-        nominal_voltage = self.nominal_voltage
-        discharge_minimum_voltage = self.discharge_minimum_voltage
-        charging_minimum_voltage = self.charging_minimum_voltage
-        charging_maximum_voltage = self.charging_maximum_voltage
-        (
-            nominal_voltage_f32,
-            discharge_minimum_voltage_f32,
-            charging_minimum_voltage_f32,
-            charging_maximum_voltage_f32,
-        ) = _BATTERY_PERIODIC_FLOAT32_BITS_STRUCT_FROM_DESIGN_CAPACITY.unpack(
-            _BATTERY_PERIODIC_FLOAT32_STRUCT_FROM_DESIGN_CAPACITY.pack(
-                nominal_voltage if -65504.0 <= nominal_voltage <= 65504.0 else _dc.f16_saturated(nominal_voltage),
-                discharge_minimum_voltage
-                if -65504.0 <= discharge_minimum_voltage <= 65504.0
-                else _dc.f16_saturated(discharge_minimum_voltage),
-                charging_minimum_voltage
-                if -65504.0 <= charging_minimum_voltage <= 65504.0
-                else _dc.f16_saturated(charging_minimum_voltage),
-                charging_maximum_voltage
-                if -65504.0 <= charging_maximum_voltage <= 65504.0
-                else _dc.f16_saturated(charging_maximum_voltage),
-            )
-        )
-        nominal_voltage_f16 = (
-            ((nominal_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= nominal_voltage_f32 < 0x477FF000
-            else _dc.f16bits(nominal_voltage_f32)
-        )
-        discharge_minimum_voltage_f16 = (
-            ((discharge_minimum_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= discharge_minimum_voltage_f32 < 0x477FF000
-            else _dc.f16bits(discharge_minimum_voltage_f32)
-        )
-        charging_minimum_voltage_f16 = (
-            ((charging_minimum_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= charging_minimum_voltage_f32 < 0x477FF000
-            else _dc.f16bits(charging_minimum_voltage_f32)
-        )
-        charging_maximum_voltage_f16 = (
-            ((charging_maximum_voltage_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= charging_maximum_voltage_f32 < 0x477FF000
-            else _dc.f16bits(charging_maximum_voltage_f32)
+        acc = _dc.put_bytes(acc, self.name, 50, False, "BatteryPeriodic.name")
+        acc = _dc.put_bytes(acc, self.serial_number, 32, False, "BatteryPeriodic.serial_number")
+        acc = _dc.put_bytes(acc, self.manufacture_date, 9, False, "BatteryPeriodic.manufacture_date")
+        f32 = _BATTERY_PERIODIC_FLOAT32_BITS_FROM_DESIGN_CAPACITY(
+            self.nominal_voltage,
+            self.discharge_minimum_voltage,
+            self.charging_minimum_voltage,
+            self.charging_maximum_voltage,
         )
         design_capacity = self.design_capacity
         cells_in_series = self.cells_in_series
@@ -1670,10 +1416,10 @@ class BatteryPeriodic:
                     )
                 ),
                 (cells_in_series if 0 <= cells_in_series <= 255 else (255 if cells_in_series > 255 else 0)),
-                nominal_voltage_f16,
-                discharge_minimum_voltage_f16,
-                charging_minimum_voltage_f16,
-                charging_maximum_voltage_f16,
+                (((f32[0] - 0x37FFF000) >> 13) if 0x38800000 <= f32[0] < 0x477FF000 else _dc.f16bits_saturated(f32[0])),
+                (((f32[1] - 0x37FFF000) >> 13) if 0x38800000 <= f32[1] < 0x477FF000 else _dc.f16bits_saturated(f32[1])),
+                (((f32[2] - 0x37FFF000) >> 13) if 0x38800000 <= f32[2] < 0x477FF000 else _dc.f16bits_saturated(f32[2])),
+                (((f32[3] - 0x37FFF000) >> 13) if 0x38800000 <= f32[3] < 0x477FF000 else _dc.f16bits_saturated(f32[3])),
                 (
                     charging_maximum_current
                     if -_dc.F32_MAX <= charging_maximum_current <= _dc.F32_MAX
@@ -1731,42 +1477,9 @@ class BatteryPeriodic:
 
     @classmethod
     def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryPeriodic, int]:
-        name: bytes
-        serial_number: bytes
-        manufacture_date: bytes
-        if rem < 6:
-            raise _dc.short("BatteryPeriodic.name (length)", 6, rem)
-        rem -= 6
-        k1 = (v >> rem) & 0x3F
-        if k1 > 50:
-            raise _dc.DecodeError("BatteryPeriodic.name: length " + str(k1) + " exceeds capacity 50")
-        n2 = k1 * 8
-        if rem < n2:
-            raise _dc.short("BatteryPeriodic.name", n2, rem)
-        rem -= n2
-        name = ((v >> rem) & ((1 << n2) - 1)).to_bytes(k1, "big")
-        if rem < 6:
-            raise _dc.short("BatteryPeriodic.serial_number (length)", 6, rem)
-        rem -= 6
-        k3 = (v >> rem) & 0x3F
-        if k3 > 32:
-            raise _dc.DecodeError("BatteryPeriodic.serial_number: length " + str(k3) + " exceeds capacity 32")
-        n4 = k3 * 8
-        if rem < n4:
-            raise _dc.short("BatteryPeriodic.serial_number", n4, rem)
-        rem -= n4
-        serial_number = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k3, "big")
-        if rem < 4:
-            raise _dc.short("BatteryPeriodic.manufacture_date (length)", 4, rem)
-        rem -= 4
-        k5 = (v >> rem) & 0xF
-        if k5 > 9:
-            raise _dc.DecodeError("BatteryPeriodic.manufacture_date: length " + str(k5) + " exceeds capacity 9")
-        n6 = k5 * 8
-        if rem < n6:
-            raise _dc.short("BatteryPeriodic.manufacture_date", n6, rem)
-        rem -= n6
-        manufacture_date = ((v >> rem) & ((1 << n6) - 1)).to_bytes(k5, "big")
+        name, rem = _dc.get_bytes(v, rem, 50, False, "BatteryPeriodic.name")
+        serial_number, rem = _dc.get_bytes(v, rem, 32, False, "BatteryPeriodic.serial_number")
+        manufacture_date, rem = _dc.get_bytes(v, rem, 9, False, "BatteryPeriodic.manufacture_date")
         if rem < 256:
             raise _dc.cut(_BATTERY_PERIODIC_FIELD_ENDS_FROM_DESIGN_CAPACITY, rem)
         rem -= 256
@@ -2031,12 +1744,9 @@ class BatteryTag:
         n = len(data)
         if n < 24:
             raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, n << 3)
-        serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins = (
-            _BATTERY_TAG_DECODE_STRUCT.unpack_from(data)
-        )
         if n > 24:
-            raise _dc.DecodeError("BatteryTag: " + str(n - 24) + " byte(s) beyond the end of the message")
-        return cls(serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins)
+            raise _dc.beyond("BatteryTag", n - 24)
+        return cls._dc_from_head(data)
 
     def _dc_head(self) -> bytes:
         """Bits 0-191 (the fixed fields that open the payload) as bytes, zero padded."""
@@ -2075,6 +1785,14 @@ class BatteryTag:
             ),
         )
 
+    @classmethod
+    def _dc_from_head(cls, data: bytes) -> BatteryTag:
+        """A new instance of bits 0-191 (the fixed fields that open the payload) read from ``data``."""
+        serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins = (
+            _BATTERY_TAG_DECODE_STRUCT.unpack_from(data)
+        )
+        return cls(serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins)
+
     def _dc_put(self, acc: int, tao: bool) -> int:
         acc = (acc << 192) | int.from_bytes(self._dc_head(), "big")
         return acc
@@ -2084,12 +1802,8 @@ class BatteryTag:
         if rem < 192:
             raise _dc.cut(_BATTERY_TAG_FIELD_ENDS, rem)
         rem -= 192
-        serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins = (
-            _BATTERY_TAG_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 192) - 1)).to_bytes(24, "big"))
-        )
-        return cls(
-            serial_number, num_cycles, armed_hours, battery_capacity_mah, first_use_mins, last_arm_time_mins
-        ), rem
+        head = ((v >> rem) & ((1 << 192) - 1)).to_bytes(24, "big")
+        return cls._dc_from_head(head), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""

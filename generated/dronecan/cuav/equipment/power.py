@@ -38,10 +38,12 @@ class CBATStatusFlag(_enum.IntFlag):
 
 # fixed fields as encoded (a float16 as its bit pattern)
 _CBAT_ENCODE_STRUCT = _struct.Struct("<ff")
-# (bit where each field ends, field): names the field a short payload cuts
-_CBAT_FIELD_ENDS = ((32, "CBAT.temperature"), (64, "CBAT.voltage"))
 # fixed fields as decoded
 _CBAT_DECODE_STRUCT = _struct.Struct("<ff")
+# fixed fields as encoded (a float16 as its bit pattern)
+_CBAT_ENCODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
+# (bit where each field ends, field): names the field a short payload cuts
+_CBAT_FIELD_ENDS = ((32, "CBAT.temperature"), (64, "CBAT.voltage"))
 # (bit where each field ends, field): names the field a short payload cuts
 _CBAT_FIELD_ENDS_FROM_CELL_COUNT = (
     (8, "CBAT.cell_count"),
@@ -69,8 +71,6 @@ _CBAT_FIELD_ENDS_FROM_CELL_COUNT = (
 )
 # fixed fields as decoded
 _CBAT_DECODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
-# fixed fields as encoded (a float16 as its bit pattern)
-_CBAT_ENCODE_STRUCT_FROM_CELL_COUNT = _struct.Struct("<BfffffffHHQQIHB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -175,17 +175,6 @@ class CBAT:
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "dronecan.cuav.equipment.power.CBAT"
-    STATUS_FLAG_IN_USE: _ClassVar[int] = 1
-    STATUS_FLAG_CHARGING: _ClassVar[int] = 2
-    STATUS_FLAG_CHARGED: _ClassVar[int] = 4
-    STATUS_FLAG_TEMP_HOT: _ClassVar[int] = 8
-    STATUS_FLAG_TEMP_COLD: _ClassVar[int] = 16
-    STATUS_FLAG_OVERLOAD: _ClassVar[int] = 32
-    STATUS_FLAG_BAD_BATTERY: _ClassVar[int] = 64
-    STATUS_FLAG_NEED_SERVICE: _ClassVar[int] = 128
-    STATUS_FLAG_BMS_ERROR: _ClassVar[int] = 256
-    STATUS_FLAG_RESERVED_A: _ClassVar[int] = 512
-    STATUS_FLAG_RESERVED_B: _ClassVar[int] = 1024
 
     temperature: float = _dataclasses.field(
         default=0.0, metadata=_m.meta(name="temperature", type="float32", doc="Temperature at the pack's surface")
@@ -438,102 +427,64 @@ class CBAT:
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> CBAT:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        voltage_cell: list[_Any]
-        n = len(data)
-        if n < 8:
-            raise _dc.cut(_CBAT_FIELD_ENDS, n << 3)
+        return _dc.read(cls, data, tao)
+
+    def _dc_head(self) -> bytes:
+        """Bits 0-63 (the fixed fields that open the payload) as bytes, zero padded."""
+        temperature = self.temperature
+        voltage = self.voltage
+        return _CBAT_ENCODE_STRUCT.pack(
+            (
+                temperature
+                if -_dc.F32_MAX <= temperature <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < temperature < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < temperature < -_dc.F32_MAX else temperature)
+                )
+            ),
+            (
+                voltage
+                if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
+                else (
+                    _dc.F32_MAX
+                    if _dc.F32_MAX < voltage < _dc.INF
+                    else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
+                )
+            ),
+        )
+
+    @classmethod
+    def _dc_from_head(
+        cls,
+        data: bytes,
+        voltage_cell: _Any,
+        cell_count: _Any,
+        current: _Any,
+        average_current: _Any,
+        average_power: _Any,
+        available_energy: _Any,
+        remaining_capacity: _Any,
+        full_charge_capacity: _Any,
+        design_capacity: _Any,
+        average_time_to_empty: _Any,
+        average_time_to_full: _Any,
+        state_of_health: _Any,
+        state_of_charge: _Any,
+        max_error: _Any,
+        serial_number: _Any,
+        manufacture_date: _Any,
+        cycle_count: _Any,
+        over_discharge_count: _Any,
+        passed_charge: _Any,
+        nominal_voltage: _Any,
+        is_powering_off: _Any,
+        interface_error: _Any,
+        status_flags: _Any,
+    ) -> CBAT:
+        """A new instance of bits 0-63 (the fixed fields that open the payload) read from ``data``,
+        and of the values of the fields after them."""
         temperature, voltage = _CBAT_DECODE_STRUCT.unpack_from(data)
-        v = int.from_bytes(data, "big")
-        rem = (n << 3) - 64
-        if rem < 4:
-            raise _dc.short("CBAT.voltage_cell (length)", 4, rem)
-        rem -= 4
-        k1 = (v >> rem) & 0xF
-        if k1 > 15:
-            raise _dc.DecodeError("CBAT.voltage_cell: length " + str(k1) + " exceeds capacity 15")
-        n2 = k1 * 32
-        if rem < n2:
-            raise _dc.short("CBAT.voltage_cell", n2, rem)
-        rem -= n2
-        voltage_cell = list(_struct.unpack(f"<{k1}f", ((v >> rem) & ((1 << n2) - 1)).to_bytes(n2 >> 3, "big")))
-        if rem < 441:
-            raise _dc.cut(_CBAT_FIELD_ENDS_FROM_CELL_COUNT, rem)
-        rem -= 441
-        (
-            cell_count,
-            current,
-            average_current,
-            average_power,
-            available_energy,
-            remaining_capacity,
-            full_charge_capacity,
-            design_capacity,
-            average_time_to_empty,
-            average_time_to_full,
-            packed3,
-            packed4,
-            packed5,
-            packed6,
-            packed7,
-        ) = _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
-        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        state_of_health = (packed3 >> 1) & 0x7F
-        state_of_charge = ((packed3 >> 10) & 0x3F) | ((packed3 & 0x1) << 6)
-        max_error = ((packed3 >> 19) & 0x1F) | (((packed3 >> 8) & 0x3) << 5)
-        serial_number = (
-            ((packed3 >> 27) & 0x1F)
-            | (((packed3 >> 16) & 0x7) << 5)
-            | (((packed3 >> 35) & 0x1F) << 8)
-            | (((packed3 >> 24) & 0x7) << 13)
-        )
-        manufacture_date = (
-            ((packed3 >> 43) & 0x1F)
-            | (((packed3 >> 32) & 0x7) << 5)
-            | (((packed3 >> 51) & 0x1F) << 8)
-            | (((packed3 >> 40) & 0x7) << 13)
-        )
-        cycle_count = (
-            (packed3 >> 59)
-            | (((packed3 >> 48) & 0x7) << 5)
-            | (((packed4 >> 3) & 0x1F) << 8)
-            | (((packed3 >> 56) & 0x7) << 13)
-        )
-        over_discharge_count = (
-            ((packed4 >> 11) & 0x1F)
-            | ((packed4 & 0x7) << 5)
-            | (((packed4 >> 19) & 0x1F) << 8)
-            | (((packed4 >> 8) & 0x7) << 13)
-        )
-        passed_charge = _dc.f32v(
-            ((packed4 >> 27) & 0x1F)
-            | (((packed4 >> 16) & 0x7) << 5)
-            | (((packed4 >> 35) & 0x1F) << 8)
-            | (((packed4 >> 24) & 0x7) << 13)
-            | (((packed4 >> 43) & 0x1F) << 16)
-            | (((packed4 >> 32) & 0x7) << 21)
-            | (((packed4 >> 51) & 0x1F) << 24)
-            | (((packed4 >> 40) & 0x7) << 29)
-        )
-        nominal_voltage = _dc.f32v(
-            (packed4 >> 59)
-            | (((packed4 >> 48) & 0x7) << 5)
-            | (((packed5 >> 3) & 0x1F) << 8)
-            | (((packed4 >> 56) & 0x7) << 13)
-            | (((packed5 >> 11) & 0x1F) << 16)
-            | ((packed5 & 0x7) << 21)
-            | (((packed5 >> 19) & 0x1F) << 24)
-            | (((packed5 >> 8) & 0x7) << 29)
-        )
-        is_powering_off = ((packed5 >> 18) & 0x1) != 0
-        interface_error = (
-            (packed5 >> 26)
-            | (((packed5 >> 16) & 0x3) << 6)
-            | (((packed6 >> 2) & 0x3F) << 8)
-            | (((packed5 >> 24) & 0x3) << 14)
-        )
-        status_flags = (packed6 >> 10) | ((packed6 & 0x3) << 6) | ((packed7 >> 7) << 8) | (((packed6 >> 8) & 0x3) << 9)
-        if rem >= 8:
-            raise _dc.DecodeError("CBAT: " + str(rem >> 3) + " byte(s) beyond the end of the message")
         return cls(
             temperature,
             voltage,
@@ -560,31 +511,6 @@ class CBAT:
             is_powering_off,
             interface_error,
             status_flags,
-        )
-
-    def _dc_head(self) -> bytes:
-        """Bits 0-63 (the fixed fields that open the payload) as bytes, zero padded."""
-        temperature = self.temperature
-        voltage = self.voltage
-        return _CBAT_ENCODE_STRUCT.pack(
-            (
-                temperature
-                if -_dc.F32_MAX <= temperature <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < temperature < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < temperature < -_dc.F32_MAX else temperature)
-                )
-            ),
-            (
-                voltage
-                if -_dc.F32_MAX <= voltage <= _dc.F32_MAX
-                else (
-                    _dc.F32_MAX
-                    if _dc.F32_MAX < voltage < _dc.INF
-                    else (-_dc.F32_MAX if -_dc.INF < voltage < -_dc.F32_MAX else voltage)
-                )
-            ),
         )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
@@ -809,7 +735,7 @@ class CBAT:
         if rem < 64:
             raise _dc.cut(_CBAT_FIELD_ENDS, rem)
         rem -= 64
-        temperature, voltage = _CBAT_DECODE_STRUCT.unpack(((v >> rem) & 0xFFFFFFFFFFFFFFFF).to_bytes(8, "big"))
+        head = ((v >> rem) & 0xFFFFFFFFFFFFFFFF).to_bytes(8, "big")
         if rem < 4:
             raise _dc.short("CBAT.voltage_cell (length)", 4, rem)
         rem -= 4
@@ -842,64 +768,8 @@ class CBAT:
             packed7,
         ) = _CBAT_DECODE_STRUCT_FROM_CELL_COUNT.unpack((((v >> rem) & ((1 << 441) - 1)) << 7).to_bytes(56, "big"))
         # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        state_of_health = (packed3 >> 1) & 0x7F
-        state_of_charge = ((packed3 >> 10) & 0x3F) | ((packed3 & 0x1) << 6)
-        max_error = ((packed3 >> 19) & 0x1F) | (((packed3 >> 8) & 0x3) << 5)
-        serial_number = (
-            ((packed3 >> 27) & 0x1F)
-            | (((packed3 >> 16) & 0x7) << 5)
-            | (((packed3 >> 35) & 0x1F) << 8)
-            | (((packed3 >> 24) & 0x7) << 13)
-        )
-        manufacture_date = (
-            ((packed3 >> 43) & 0x1F)
-            | (((packed3 >> 32) & 0x7) << 5)
-            | (((packed3 >> 51) & 0x1F) << 8)
-            | (((packed3 >> 40) & 0x7) << 13)
-        )
-        cycle_count = (
-            (packed3 >> 59)
-            | (((packed3 >> 48) & 0x7) << 5)
-            | (((packed4 >> 3) & 0x1F) << 8)
-            | (((packed3 >> 56) & 0x7) << 13)
-        )
-        over_discharge_count = (
-            ((packed4 >> 11) & 0x1F)
-            | ((packed4 & 0x7) << 5)
-            | (((packed4 >> 19) & 0x1F) << 8)
-            | (((packed4 >> 8) & 0x7) << 13)
-        )
-        passed_charge = _dc.f32v(
-            ((packed4 >> 27) & 0x1F)
-            | (((packed4 >> 16) & 0x7) << 5)
-            | (((packed4 >> 35) & 0x1F) << 8)
-            | (((packed4 >> 24) & 0x7) << 13)
-            | (((packed4 >> 43) & 0x1F) << 16)
-            | (((packed4 >> 32) & 0x7) << 21)
-            | (((packed4 >> 51) & 0x1F) << 24)
-            | (((packed4 >> 40) & 0x7) << 29)
-        )
-        nominal_voltage = _dc.f32v(
-            (packed4 >> 59)
-            | (((packed4 >> 48) & 0x7) << 5)
-            | (((packed5 >> 3) & 0x1F) << 8)
-            | (((packed4 >> 56) & 0x7) << 13)
-            | (((packed5 >> 11) & 0x1F) << 16)
-            | ((packed5 & 0x7) << 21)
-            | (((packed5 >> 19) & 0x1F) << 24)
-            | (((packed5 >> 8) & 0x7) << 29)
-        )
-        is_powering_off = ((packed5 >> 18) & 0x1) != 0
-        interface_error = (
-            (packed5 >> 26)
-            | (((packed5 >> 16) & 0x3) << 6)
-            | (((packed6 >> 2) & 0x3F) << 8)
-            | (((packed5 >> 24) & 0x3) << 14)
-        )
-        status_flags = (packed6 >> 10) | ((packed6 & 0x3) << 6) | ((packed7 >> 7) << 8) | (((packed6 >> 8) & 0x3) << 9)
-        return cls(
-            temperature,
-            voltage,
+        return cls._dc_from_head(
+            head,
             voltage_cell,
             cell_count,
             current,
@@ -911,18 +781,51 @@ class CBAT:
             design_capacity,
             average_time_to_empty,
             average_time_to_full,
-            state_of_health,
-            state_of_charge,
-            max_error,
-            serial_number,
-            manufacture_date,
-            cycle_count,
-            over_discharge_count,
-            passed_charge,
-            nominal_voltage,
-            is_powering_off,
-            interface_error,
-            status_flags,
+            (packed3 >> 1) & 0x7F,
+            ((packed3 >> 10) & 0x3F) | ((packed3 & 0x1) << 6),
+            ((packed3 >> 19) & 0x1F) | (((packed3 >> 8) & 0x3) << 5),
+            ((packed3 >> 27) & 0x1F)
+            | (((packed3 >> 16) & 0x7) << 5)
+            | (((packed3 >> 35) & 0x1F) << 8)
+            | (((packed3 >> 24) & 0x7) << 13),
+            ((packed3 >> 43) & 0x1F)
+            | (((packed3 >> 32) & 0x7) << 5)
+            | (((packed3 >> 51) & 0x1F) << 8)
+            | (((packed3 >> 40) & 0x7) << 13),
+            (packed3 >> 59)
+            | (((packed3 >> 48) & 0x7) << 5)
+            | (((packed4 >> 3) & 0x1F) << 8)
+            | (((packed3 >> 56) & 0x7) << 13),
+            ((packed4 >> 11) & 0x1F)
+            | ((packed4 & 0x7) << 5)
+            | (((packed4 >> 19) & 0x1F) << 8)
+            | (((packed4 >> 8) & 0x7) << 13),
+            _dc.f32v(
+                ((packed4 >> 27) & 0x1F)
+                | (((packed4 >> 16) & 0x7) << 5)
+                | (((packed4 >> 35) & 0x1F) << 8)
+                | (((packed4 >> 24) & 0x7) << 13)
+                | (((packed4 >> 43) & 0x1F) << 16)
+                | (((packed4 >> 32) & 0x7) << 21)
+                | (((packed4 >> 51) & 0x1F) << 24)
+                | (((packed4 >> 40) & 0x7) << 29)
+            ),
+            _dc.f32v(
+                (packed4 >> 59)
+                | (((packed4 >> 48) & 0x7) << 5)
+                | (((packed5 >> 3) & 0x1F) << 8)
+                | (((packed4 >> 56) & 0x7) << 13)
+                | (((packed5 >> 11) & 0x1F) << 16)
+                | ((packed5 & 0x7) << 21)
+                | (((packed5 >> 19) & 0x1F) << 24)
+                | (((packed5 >> 8) & 0x7) << 29)
+            ),
+            ((packed5 >> 18) & 0x1) != 0,
+            (packed5 >> 26)
+            | (((packed5 >> 16) & 0x3) << 6)
+            | (((packed6 >> 2) & 0x3F) << 8)
+            | (((packed5 >> 24) & 0x3) << 14),
+            (packed6 >> 10) | ((packed6 & 0x3) << 6) | ((packed7 >> 7) << 8) | (((packed6 >> 8) & 0x3) << 9),
         ), rem
 
     def validate(self) -> list[_v.Violation]:

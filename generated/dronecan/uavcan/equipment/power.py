@@ -56,12 +56,12 @@ class CircuitStatusErrorFlag(_enum.IntFlag):
     UNDERCURRENT = 8
 
 
-# float16 fields packed as float32 ...
-_BATTERY_INFO_FLOAT32_STRUCT = _struct.Struct("<7f")
-# ... and read back as bits, from which each half is cut
-_BATTERY_INFO_FLOAT32_BITS_STRUCT = _struct.Struct("<7I")
+# float16 fields as float32 bits, from which each half is cut
+_BATTERY_INFO_FLOAT32_BITS = _dc.float32_bits(7)
 # fixed fields as encoded (a float16 as its bit pattern)
 _BATTERY_INFO_ENCODE_STRUCT = _struct.Struct("<HHHHHHHIBI")
+# fixed fields as decoded
+_BATTERY_INFO_DECODE_STRUCT = _struct.Struct("<eeeeeeeIBI")
 # (bit where each field ends, field): names the field a short payload cuts
 _BATTERY_INFO_FIELD_ENDS = (
     (16, "BatteryInfo.temperature"),
@@ -78,8 +78,6 @@ _BATTERY_INFO_FIELD_ENDS = (
     (152, "BatteryInfo.battery_id"),
     (184, "BatteryInfo.model_instance_id"),
 )
-# fixed fields as decoded
-_BATTERY_INFO_DECODE_STRUCT = _struct.Struct("<eeeeeeeIBI")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -153,12 +151,12 @@ _BATTERY_INFO_FIELD_SPECS = (
 )
 
 
-# float16 fields packed as float32 ...
-_CIRCUIT_STATUS_FLOAT32_STRUCT = _struct.Struct("<2f")
-# ... and read back as bits, from which each half is cut
-_CIRCUIT_STATUS_FLOAT32_BITS_STRUCT = _struct.Struct("<2I")
+# float16 fields as float32 bits, from which each half is cut
+_CIRCUIT_STATUS_FLOAT32_BITS = _dc.float32_bits(2)
 # fixed fields as encoded (a float16 as its bit pattern)
 _CIRCUIT_STATUS_ENCODE_STRUCT = _struct.Struct("<HHHB")
+# fixed fields as decoded
+_CIRCUIT_STATUS_DECODE_STRUCT = _struct.Struct("<HeeB")
 # (bit where each field ends, field): names the field a short payload cuts
 _CIRCUIT_STATUS_FIELD_ENDS = (
     (16, "CircuitStatus.circuit_id"),
@@ -166,8 +164,6 @@ _CIRCUIT_STATUS_FIELD_ENDS = (
     (48, "CircuitStatus.current"),
     (56, "CircuitStatus.error_flags"),
 )
-# fixed fields as decoded
-_CIRCUIT_STATUS_DECODE_STRUCT = _struct.Struct("<HeeB")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -196,12 +192,12 @@ _CIRCUIT_STATUS_FIELD_SPECS = (
 )
 
 
-# float16 fields packed as float32 ...
-_PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT = _struct.Struct("<2f")
-# ... and read back as bits, from which each half is cut
-_PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT = _struct.Struct("<2I")
+# float16 fields as float32 bits, from which each half is cut
+_PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS = _dc.float32_bits(2)
 # fixed fields as encoded (a float16 as its bit pattern)
 _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT = _struct.Struct("<HHH")
+# fixed fields as decoded
+_PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT = _struct.Struct("<eeH")
 # (bit where each field ends, field): names the field a short payload cuts
 _PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS = (
     (16, "PrimaryPowerSupplyStatus.hours_to_empty_at_10sec_avg_power"),
@@ -210,8 +206,6 @@ _PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS = (
     (40, "PrimaryPowerSupplyStatus.remaining_energy_pct"),
     (47, "PrimaryPowerSupplyStatus.remaining_energy_pct_stdev"),
 )
-# fixed fields as decoded
-_PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT = _struct.Struct("<eeH")
 
 
 # what validate() reports against, field by field (read only when a fast test trips)
@@ -262,17 +256,6 @@ class BatteryInfo:
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "dronecan.uavcan.equipment.power.BatteryInfo"
-    STATUS_FLAG_IN_USE: _ClassVar[int] = 1
-    STATUS_FLAG_CHARGING: _ClassVar[int] = 2
-    STATUS_FLAG_CHARGED: _ClassVar[int] = 4
-    STATUS_FLAG_TEMP_HOT: _ClassVar[int] = 8
-    STATUS_FLAG_TEMP_COLD: _ClassVar[int] = 16
-    STATUS_FLAG_OVERLOAD: _ClassVar[int] = 32
-    STATUS_FLAG_BAD_BATTERY: _ClassVar[int] = 64
-    STATUS_FLAG_NEED_SERVICE: _ClassVar[int] = 128
-    STATUS_FLAG_BMS_ERROR: _ClassVar[int] = 256
-    STATUS_FLAG_RESERVED_A: _ClassVar[int] = 512
-    STATUS_FLAG_RESERVED_B: _ClassVar[int] = 1024
     STATE_OF_HEALTH_UNKNOWN: _ClassVar[int] = 127
     STATE_OF_CHARGE_UNKNOWN: _ClassVar[int] = 127
 
@@ -515,128 +498,34 @@ class BatteryInfo:
     def encode(self, *, tao: bool = True) -> bytes:
         """The DroneCAN payload; ``tao=False`` turns the tail array optimisation off (CAN FD)."""
         if tao:
-            x1 = self.model_name
-            if len(x1) > 31:
-                raise _dc.EncodeError("BatteryInfo.model_name: length " + str(len(x1)) + " exceeds capacity 31")
-            return self._dc_head() + bytes(x1)
+            model_name = self.model_name
+            if len(model_name) > 31:
+                raise _dc.EncodeError("BatteryInfo.model_name: length " + str(len(model_name)) + " exceeds capacity 31")
+            return self._dc_head() + bytes(model_name)
         return _dc.finish(self._dc_put(1, False))
 
     @classmethod
     def decode(cls, data: bytes, *, tao: bool = True) -> BatteryInfo:
         """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""
-        model_name: bytes
         n = len(data)
         if n < 23:
             raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, n << 3)
-        (
-            temperature,
-            voltage,
-            current,
-            average_power_10sec,
-            remaining_capacity_wh,
-            full_charge_capacity_wh,
-            hours_to_full_charge,
-            packed1,
-            battery_id,
-            model_instance_id,
-        ) = _BATTERY_INFO_DECODE_STRUCT.unpack_from(data)
-        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        status_flags = (packed1 & 0xFF) | (((packed1 >> 13) & 0x7) << 8)
-        state_of_health_pct = ((packed1 >> 22) & 0x3) | (((packed1 >> 8) & 0x1F) << 2)
-        state_of_charge_pct = (packed1 >> 31) | (((packed1 >> 16) & 0x3F) << 1)
-        state_of_charge_pct_stdev = (packed1 >> 24) & 0x7F
         if tao:
-            model_name = bytes(data[23:])
-            k2 = len(model_name)
-            if k2 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
-            return cls(
-                temperature,
-                voltage,
-                current,
-                average_power_10sec,
-                remaining_capacity_wh,
-                full_charge_capacity_wh,
-                hours_to_full_charge,
-                status_flags,
-                state_of_health_pct,
-                state_of_charge_pct,
-                state_of_charge_pct_stdev,
-                battery_id,
-                model_instance_id,
-                model_name,
-            )
-        obj, rem = cls._dc_get(int.from_bytes(data, "big"), n << 3, False)
-        if rem >= 8:
-            raise _dc.DecodeError("BatteryInfo: " + str(rem >> 3) + " byte(s) beyond the end of the message")
-        return obj
+            if n > 54:
+                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(n - 23) + " exceeds capacity 31")
+            return cls._dc_from_head(data, bytes(data[23:]))
+        return _dc.read(cls, data, False)
 
     def _dc_head(self) -> bytes:
         """Bits 0-183 (the fixed fields that open the payload) as bytes, zero padded."""
-        temperature = self.temperature
-        voltage = self.voltage
-        current = self.current
-        average_power_10sec = self.average_power_10sec
-        remaining_capacity_wh = self.remaining_capacity_wh
-        full_charge_capacity_wh = self.full_charge_capacity_wh
-        hours_to_full_charge = self.hours_to_full_charge
-        (
-            temperature_f32,
-            voltage_f32,
-            current_f32,
-            average_power_10sec_f32,
-            remaining_capacity_wh_f32,
-            full_charge_capacity_wh_f32,
-            hours_to_full_charge_f32,
-        ) = _BATTERY_INFO_FLOAT32_BITS_STRUCT.unpack(
-            _BATTERY_INFO_FLOAT32_STRUCT.pack(
-                temperature if -65504.0 <= temperature <= 65504.0 else _dc.f16_saturated(temperature),
-                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
-                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
-                average_power_10sec
-                if -65504.0 <= average_power_10sec <= 65504.0
-                else _dc.f16_saturated(average_power_10sec),
-                remaining_capacity_wh
-                if -65504.0 <= remaining_capacity_wh <= 65504.0
-                else _dc.f16_saturated(remaining_capacity_wh),
-                full_charge_capacity_wh
-                if -65504.0 <= full_charge_capacity_wh <= 65504.0
-                else _dc.f16_saturated(full_charge_capacity_wh),
-                hours_to_full_charge
-                if -65504.0 <= hours_to_full_charge <= 65504.0
-                else _dc.f16_saturated(hours_to_full_charge),
-            )
-        )
-        temperature_f16 = (
-            ((temperature_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= temperature_f32 < 0x477FF000
-            else _dc.f16bits(temperature_f32)
-        )
-        voltage_f16 = (
-            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
-        )
-        current_f16 = (
-            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
-        )
-        average_power_10sec_f16 = (
-            ((average_power_10sec_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= average_power_10sec_f32 < 0x477FF000
-            else _dc.f16bits(average_power_10sec_f32)
-        )
-        remaining_capacity_wh_f16 = (
-            ((remaining_capacity_wh_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= remaining_capacity_wh_f32 < 0x477FF000
-            else _dc.f16bits(remaining_capacity_wh_f32)
-        )
-        full_charge_capacity_wh_f16 = (
-            ((full_charge_capacity_wh_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= full_charge_capacity_wh_f32 < 0x477FF000
-            else _dc.f16bits(full_charge_capacity_wh_f32)
-        )
-        hours_to_full_charge_f16 = (
-            ((hours_to_full_charge_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= hours_to_full_charge_f32 < 0x477FF000
-            else _dc.f16bits(hours_to_full_charge_f32)
+        f32 = _BATTERY_INFO_FLOAT32_BITS(
+            self.temperature,
+            self.voltage,
+            self.current,
+            self.average_power_10sec,
+            self.remaining_capacity_wh,
+            self.full_charge_capacity_wh,
+            self.hours_to_full_charge,
         )
         status_flags = self.status_flags
         status_flags_bits = status_flags if 0 <= status_flags <= 2047 else (2047 if status_flags > 2047 else 0)
@@ -658,13 +547,13 @@ class BatteryInfo:
         model_instance_id = self.model_instance_id
         # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         return _BATTERY_INFO_ENCODE_STRUCT.pack(
-            temperature_f16,
-            voltage_f16,
-            current_f16,
-            average_power_10sec_f16,
-            remaining_capacity_wh_f16,
-            full_charge_capacity_wh_f16,
-            hours_to_full_charge_f16,
+            (((f32[0] - 0x37FFF000) >> 13) if 0x38800000 <= f32[0] < 0x477FF000 else _dc.f16bits_saturated(f32[0])),
+            (((f32[1] - 0x37FFF000) >> 13) if 0x38800000 <= f32[1] < 0x477FF000 else _dc.f16bits_saturated(f32[1])),
+            (((f32[2] - 0x37FFF000) >> 13) if 0x38800000 <= f32[2] < 0x477FF000 else _dc.f16bits_saturated(f32[2])),
+            (((f32[3] - 0x37FFF000) >> 13) if 0x38800000 <= f32[3] < 0x477FF000 else _dc.f16bits_saturated(f32[3])),
+            (((f32[4] - 0x37FFF000) >> 13) if 0x38800000 <= f32[4] < 0x477FF000 else _dc.f16bits_saturated(f32[4])),
+            (((f32[5] - 0x37FFF000) >> 13) if 0x38800000 <= f32[5] < 0x477FF000 else _dc.f16bits_saturated(f32[5])),
+            (((f32[6] - 0x37FFF000) >> 13) if 0x38800000 <= f32[6] < 0x477FF000 else _dc.f16bits_saturated(f32[6])),
             (status_flags_bits & 0xFF)
             | (((status_flags_bits >> 8) & 0x7) << 13)
             | ((state_of_health_pct_bits & 0x3) << 22)
@@ -680,23 +569,10 @@ class BatteryInfo:
             ),
         )
 
-    def _dc_put(self, acc: int, tao: bool) -> int:
-        acc = (acc << 184) | int.from_bytes(self._dc_head(), "big")
-        x1 = self.model_name
-        k2 = len(x1)
-        if k2 > 31:
-            raise _dc.EncodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
-        if not tao:
-            acc = (acc << 5) | k2
-        acc = (acc << (k2 << 3)) | int.from_bytes(x1, "big")
-        return acc
-
     @classmethod
-    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfo, int]:
-        model_name: bytes
-        if rem < 184:
-            raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, rem)
-        rem -= 184
+    def _dc_from_head(cls, data: bytes, model_name: _Any) -> BatteryInfo:
+        """A new instance of bits 0-183 (the fixed fields that open the payload) read from ``data``,
+        and of the values of the fields after them."""
         (
             temperature,
             voltage,
@@ -708,35 +584,8 @@ class BatteryInfo:
             packed1,
             battery_id,
             model_instance_id,
-        ) = _BATTERY_INFO_DECODE_STRUCT.unpack(((v >> rem) & ((1 << 184) - 1)).to_bytes(23, "big"))
+        ) = _BATTERY_INFO_DECODE_STRUCT.unpack_from(data)
         # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        status_flags = (packed1 & 0xFF) | (((packed1 >> 13) & 0x7) << 8)
-        state_of_health_pct = ((packed1 >> 22) & 0x3) | (((packed1 >> 8) & 0x1F) << 2)
-        state_of_charge_pct = (packed1 >> 31) | (((packed1 >> 16) & 0x3F) << 1)
-        state_of_charge_pct_stdev = (packed1 >> 24) & 0x7F
-        if tao:
-            k2 = rem // 8
-            if rem - k2 * 8 >= 8:
-                raise _dc.DecodeError("BatteryInfo.model_name: input ends inside an element")
-            if k2 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
-            n3 = k2 * 8
-            if rem < n3:
-                raise _dc.short("BatteryInfo.model_name", n3, rem)
-            rem -= n3
-            model_name = ((v >> rem) & ((1 << n3) - 1)).to_bytes(k2, "big")
-        else:
-            if rem < 5:
-                raise _dc.short("BatteryInfo.model_name (length)", 5, rem)
-            rem -= 5
-            k2 = (v >> rem) & 0x1F
-            if k2 > 31:
-                raise _dc.DecodeError("BatteryInfo.model_name: length " + str(k2) + " exceeds capacity 31")
-            n4 = k2 * 8
-            if rem < n4:
-                raise _dc.short("BatteryInfo.model_name", n4, rem)
-            rem -= n4
-            model_name = ((v >> rem) & ((1 << n4) - 1)).to_bytes(k2, "big")
         return cls(
             temperature,
             voltage,
@@ -745,14 +594,28 @@ class BatteryInfo:
             remaining_capacity_wh,
             full_charge_capacity_wh,
             hours_to_full_charge,
-            status_flags,
-            state_of_health_pct,
-            state_of_charge_pct,
-            state_of_charge_pct_stdev,
+            (packed1 & 0xFF) | (((packed1 >> 13) & 0x7) << 8),  # status_flags
+            ((packed1 >> 22) & 0x3) | (((packed1 >> 8) & 0x1F) << 2),  # state_of_health_pct
+            (packed1 >> 31) | (((packed1 >> 16) & 0x3F) << 1),  # state_of_charge_pct
+            (packed1 >> 24) & 0x7F,  # state_of_charge_pct_stdev
             battery_id,
             model_instance_id,
             model_name,
-        ), rem
+        )
+
+    def _dc_put(self, acc: int, tao: bool) -> int:
+        acc = (acc << 184) | int.from_bytes(self._dc_head(), "big")
+        acc = _dc.put_bytes(acc, self.model_name, 31, tao, "BatteryInfo.model_name")
+        return acc
+
+    @classmethod
+    def _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[BatteryInfo, int]:
+        if rem < 184:
+            raise _dc.cut(_BATTERY_INFO_FIELD_ENDS, rem)
+        rem -= 184
+        head = ((v >> rem) & ((1 << 184) - 1)).to_bytes(23, "big")
+        model_name, rem = _dc.get_bytes(v, rem, 31, tao, "BatteryInfo.model_name")
+        return cls._dc_from_head(head, model_name), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -908,10 +771,6 @@ class CircuitStatus:
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "dronecan.uavcan.equipment.power.CircuitStatus"
-    ERROR_FLAG_OVERVOLTAGE: _ClassVar[int] = 1
-    ERROR_FLAG_UNDERVOLTAGE: _ClassVar[int] = 2
-    ERROR_FLAG_OVERCURRENT: _ClassVar[int] = 4
-    ERROR_FLAG_UNDERCURRENT: _ClassVar[int] = 8
 
     circuit_id: int = _dataclasses.field(default=0, metadata=_m.meta(name="circuit_id", type="uint16"))
     voltage: float = _dataclasses.field(
@@ -975,35 +834,27 @@ class CircuitStatus:
         n = len(data)
         if n < 7:
             raise _dc.cut(_CIRCUIT_STATUS_FIELD_ENDS, n << 3)
-        circuit_id, voltage, current, error_flags = _CIRCUIT_STATUS_DECODE_STRUCT.unpack_from(data)
         if n > 7:
-            raise _dc.DecodeError("CircuitStatus: " + str(n - 7) + " byte(s) beyond the end of the message")
-        return cls(circuit_id, voltage, current, error_flags)
+            raise _dc.beyond("CircuitStatus", n - 7)
+        return cls._dc_from_head(data)
 
     def _dc_head(self) -> bytes:
         """Bits 0-55 (the fixed fields that open the payload) as bytes, zero padded."""
-        voltage = self.voltage
-        current = self.current
-        voltage_f32, current_f32 = _CIRCUIT_STATUS_FLOAT32_BITS_STRUCT.unpack(
-            _CIRCUIT_STATUS_FLOAT32_STRUCT.pack(
-                voltage if -65504.0 <= voltage <= 65504.0 else _dc.f16_saturated(voltage),
-                current if -65504.0 <= current <= 65504.0 else _dc.f16_saturated(current),
-            )
-        )
-        voltage_f16 = (
-            ((voltage_f32 - 0x37FFF000) >> 13) if 0x38800000 <= voltage_f32 < 0x477FF000 else _dc.f16bits(voltage_f32)
-        )
-        current_f16 = (
-            ((current_f32 - 0x37FFF000) >> 13) if 0x38800000 <= current_f32 < 0x477FF000 else _dc.f16bits(current_f32)
-        )
+        f32 = _CIRCUIT_STATUS_FLOAT32_BITS(self.voltage, self.current)
         circuit_id = self.circuit_id
         error_flags = self.error_flags
         return _CIRCUIT_STATUS_ENCODE_STRUCT.pack(
             (circuit_id if 0 <= circuit_id <= 65535 else (65535 if circuit_id > 65535 else 0)),
-            voltage_f16,
-            current_f16,
+            (((f32[0] - 0x37FFF000) >> 13) if 0x38800000 <= f32[0] < 0x477FF000 else _dc.f16bits_saturated(f32[0])),
+            (((f32[1] - 0x37FFF000) >> 13) if 0x38800000 <= f32[1] < 0x477FF000 else _dc.f16bits_saturated(f32[1])),
             (error_flags if 0 <= error_flags <= 255 else (255 if error_flags > 255 else 0)),
         )
+
+    @classmethod
+    def _dc_from_head(cls, data: bytes) -> CircuitStatus:
+        """A new instance of bits 0-55 (the fixed fields that open the payload) read from ``data``."""
+        circuit_id, voltage, current, error_flags = _CIRCUIT_STATUS_DECODE_STRUCT.unpack_from(data)
+        return cls(circuit_id, voltage, current, error_flags)
 
     def _dc_put(self, acc: int, tao: bool) -> int:
         acc = (acc << 56) | int.from_bytes(self._dc_head(), "big")
@@ -1014,10 +865,8 @@ class CircuitStatus:
         if rem < 56:
             raise _dc.cut(_CIRCUIT_STATUS_FIELD_ENDS, rem)
         rem -= 56
-        circuit_id, voltage, current, error_flags = _CIRCUIT_STATUS_DECODE_STRUCT.unpack(
-            ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
-        )
-        return cls(circuit_id, voltage, current, error_flags), rem
+        head = ((v >> rem) & 0xFFFFFFFFFFFFFF).to_bytes(7, "big")
+        return cls._dc_from_head(head), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""
@@ -1184,48 +1033,14 @@ class PrimaryPowerSupplyStatus:
         n = len(data)
         if n < 6:
             raise _dc.cut(_PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS, n << 3)
-        hours_to_empty_at_10sec_avg_power, hours_to_empty_at_10sec_avg_power_variance, packed1 = (
-            _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack_from(data)
-        )
-        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        external_power_available = ((packed1 >> 7) & 0x1) != 0
-        remaining_energy_pct = packed1 & 0x7F
-        remaining_energy_pct_stdev = packed1 >> 9
         if n > 6:
-            raise _dc.DecodeError("PrimaryPowerSupplyStatus: " + str(n - 6) + " byte(s) beyond the end of the message")
-        return cls(
-            hours_to_empty_at_10sec_avg_power,
-            hours_to_empty_at_10sec_avg_power_variance,
-            external_power_available,
-            remaining_energy_pct,
-            remaining_energy_pct_stdev,
-        )
+            raise _dc.beyond("PrimaryPowerSupplyStatus", n - 6)
+        return cls._dc_from_head(data)
 
     def _dc_head(self) -> bytes:
         """Bits 0-46 (the fixed fields that open the payload) as bytes, zero padded."""
-        hours_to_empty_at_10sec_avg_power = self.hours_to_empty_at_10sec_avg_power
-        hours_to_empty_at_10sec_avg_power_variance = self.hours_to_empty_at_10sec_avg_power_variance
-        hours_to_empty_at_10sec_avg_power_f32, hours_to_empty_at_10sec_avg_power_variance_f32 = (
-            _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS_STRUCT.unpack(
-                _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_STRUCT.pack(
-                    hours_to_empty_at_10sec_avg_power
-                    if -65504.0 <= hours_to_empty_at_10sec_avg_power <= 65504.0
-                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power),
-                    hours_to_empty_at_10sec_avg_power_variance
-                    if -65504.0 <= hours_to_empty_at_10sec_avg_power_variance <= 65504.0
-                    else _dc.f16_saturated(hours_to_empty_at_10sec_avg_power_variance),
-                )
-            )
-        )
-        hours_to_empty_at_10sec_avg_power_f16 = (
-            ((hours_to_empty_at_10sec_avg_power_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_f32 < 0x477FF000
-            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_f32)
-        )
-        hours_to_empty_at_10sec_avg_power_variance_f16 = (
-            ((hours_to_empty_at_10sec_avg_power_variance_f32 - 0x37FFF000) >> 13)
-            if 0x38800000 <= hours_to_empty_at_10sec_avg_power_variance_f32 < 0x477FF000
-            else _dc.f16bits(hours_to_empty_at_10sec_avg_power_variance_f32)
+        f32 = _PRIMARY_POWER_SUPPLY_STATUS_FLOAT32_BITS(
+            self.hours_to_empty_at_10sec_avg_power, self.hours_to_empty_at_10sec_avg_power_variance
         )
         external_power_available = self.external_power_available
         external_power_available_bits = 1 if external_power_available else 0
@@ -1241,9 +1056,24 @@ class PrimaryPowerSupplyStatus:
         )
         # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
         return _PRIMARY_POWER_SUPPLY_STATUS_ENCODE_STRUCT.pack(
-            hours_to_empty_at_10sec_avg_power_f16,
-            hours_to_empty_at_10sec_avg_power_variance_f16,
+            (((f32[0] - 0x37FFF000) >> 13) if 0x38800000 <= f32[0] < 0x477FF000 else _dc.f16bits_saturated(f32[0])),
+            (((f32[1] - 0x37FFF000) >> 13) if 0x38800000 <= f32[1] < 0x477FF000 else _dc.f16bits_saturated(f32[1])),
             (external_power_available_bits << 7) | remaining_energy_pct_bits | (remaining_energy_pct_stdev_bits << 9),
+        )
+
+    @classmethod
+    def _dc_from_head(cls, data: bytes) -> PrimaryPowerSupplyStatus:
+        """A new instance of bits 0-46 (the fixed fields that open the payload) read from ``data``."""
+        hours_to_empty_at_10sec_avg_power, hours_to_empty_at_10sec_avg_power_variance, packed1 = (
+            _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack_from(data)
+        )
+        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
+        return cls(
+            hours_to_empty_at_10sec_avg_power,
+            hours_to_empty_at_10sec_avg_power_variance,
+            ((packed1 >> 7) & 0x1) != 0,  # external_power_available
+            packed1 & 0x7F,  # remaining_energy_pct
+            packed1 >> 9,  # remaining_energy_pct_stdev
         )
 
     def _dc_put(self, acc: int, tao: bool) -> int:
@@ -1255,20 +1085,8 @@ class PrimaryPowerSupplyStatus:
         if rem < 47:
             raise _dc.cut(_PRIMARY_POWER_SUPPLY_STATUS_FIELD_ENDS, rem)
         rem -= 47
-        hours_to_empty_at_10sec_avg_power, hours_to_empty_at_10sec_avg_power_variance, packed1 = (
-            _PRIMARY_POWER_SUPPLY_STATUS_DECODE_STRUCT.unpack((((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big"))
-        )
-        # fields off byte boundaries share words; one over 8 bits has its low byte first (DSDL v0)
-        external_power_available = ((packed1 >> 7) & 0x1) != 0
-        remaining_energy_pct = packed1 & 0x7F
-        remaining_energy_pct_stdev = packed1 >> 9
-        return cls(
-            hours_to_empty_at_10sec_avg_power,
-            hours_to_empty_at_10sec_avg_power_variance,
-            external_power_available,
-            remaining_energy_pct,
-            remaining_energy_pct_stdev,
-        ), rem
+        head = (((v >> rem) & 0x7FFFFFFFFFFF) << 1).to_bytes(6, "big")
+        return cls._dc_from_head(head), rem
 
     def validate(self) -> list[_v.Violation]:
         """Every violation of the schema and its cross-field rules (empty when valid); warnings included."""

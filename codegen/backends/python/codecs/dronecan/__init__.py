@@ -4,8 +4,9 @@ Every DroneCAN class gets ``encode(*, tao=True) -> bytes``, ``decode(data, *, ta
 ``DATA_TYPE_ID`` / ``DATA_TYPE_SIGNATURE`` class attributes and, for a ``@union``, a
 ``union_field`` attribute naming the held branch, kept by the runtime's ``Union`` (branch
 attributes are None except the held one; assigning a branch selects it, as in pydronecan).
-The shared runtime (``_dronecan.py``) holds float16 rounding, the bit-stream finisher,
-``DecodeError`` and ``transfer_crc``.
+The shared runtime (``_dronecan.py``) holds float16 rounding (``float32_bits`` and the cuts off the
+common path), the dynamic uint8 arrays (``put_bytes``, ``get_bytes``), the bit-stream finisher and
+reader (``finish``, ``read``), ``DecodeError`` and ``transfer_crc``.
 Layout planning lives in :mod:`.plan`, code emission in :mod:`.emit`.
 """
 
@@ -64,11 +65,12 @@ class _Codec:
         ]
         if info.union:
             union_members(msg, ctx, view, emitter.module_code, lines)
-        head = emitter.method_head()
+        head, head_values = emitter.method_head(), emitter.method_from_head()
         methods = [
             emitter.method_encode(),
             emitter.method_decode(),
             *([head] if head is not None else []),
+            *([head_values] if head_values is not None else []),
             emitter.method_put(),
             emitter.method_get(),
         ]

@@ -1,13 +1,16 @@
 """Emits the straight-line encode/decode source of one DroneCAN type (see :mod:`.plan`).
 
-Generated methods per class:
+Generated methods per class, one encoding and one decoding:
 * ``_dc_head(self) -> bytes``: the fixed fields that open the payload, packed with one ``struct`` call;
-* ``_dc_put(self, acc, tao) -> acc``: append the type's bits to a sentinel-led accumulator int (the
-  one encoding: it starts from ``_dc_head``);
-* ``_dc_get(cls, v, rem, tao) -> (obj, rem)``: read it from payload int ``v`` with ``rem`` bits left;
-* ``encode`` / ``decode``: the public top level; ``encode`` is ``_dc_put`` finished, except that a
-  byte-aligned tail array sent with TAO is appended to ``_dc_head``'s bytes by slicing; ``decode``
-  unpacks the opening fixed run with one ``struct`` call straight from the bytes.
+* ``_dc_from_head(cls, data, *after) -> obj``: the same fields read back from bytes with one ``struct`` call,
+  into a new instance with the values of the fields after them;
+* ``_dc_put(self, acc, tao) -> acc``: append the type's bits to a sentinel-led accumulator int (starting
+  from ``_dc_head``);
+* ``_dc_get(cls, v, rem, tao) -> (obj, rem)``: read it from payload int ``v`` with ``rem`` bits left
+  (starting from ``_dc_from_head``);
+* ``encode`` / ``decode``: the public top level. A type of fixed fields alone is its head; one ending in a
+  byte-aligned tail array sent with TAO is its head and the array's bytes, sliced; anything else is
+  ``_dc_put`` finished or ``_dc_get`` through ``_dc.read``.
 
 Fixed runs of fields are :mod:`.segments`, the variable parts :mod:`.variable`; this module puts
 them together into whole structures and unions.
@@ -56,6 +59,9 @@ class MessageEmitter(VariableFieldEmitter):
 
     def declare(self, items: list[Item], out: Lines) -> None:
         for item in items:
+            t = item.type if isinstance(item, VarField) else None
+            if isinstance(t, ArrayType) and t.dynamic and is_u8(t.element):
+                continue  # read by _dc.get_bytes, typed there
             if isinstance(item, VarField):
                 ann = self.annotation(item.type)
                 if ann is not None:
@@ -64,13 +70,6 @@ class MessageEmitter(VariableFieldEmitter):
     def construct(self, values: dict[int, str]) -> str:
         args = [values[i] for i, f in enumerate(self.msg.fields) if not f.is_padding]
         return f"cls({', '.join(args)})"
-
-    def trailing(self, out: Lines) -> None:
-        out.add("if rem >= 8:")
-        out.add(
-            "    raise "
-            + error("DecodeError", f"{self.cls}: ", "str(rem >> 3)", " byte(s) beyond the end of the message")
-        )
 
     @staticmethod
     def head_segment(items: list[Item]) -> Segment | None:
@@ -89,6 +88,41 @@ class MessageEmitter(VariableFieldEmitter):
         out.add(f"return {self.seg_bytes(head, out)}")
         doc = f'    """Bits 0-{head.bits - 1} (the fixed fields that open the payload) as bytes, zero padded."""\n'
         return "def _dc_head(self) -> bytes:\n" + doc + out.text(1)
+
+    def method_from_head(self) -> str | None:
+        """``_dc_from_head``: a new instance of the opening fixed fields read back from bytes and of the values of
+        the fields after them, the one reading ``decode`` and ``_dc_get`` share (None where there is no
+        ``_dc_head``). Those values are parameters of their own, as ``*rest`` would cost the decoder a tenth."""
+        if self.msg.dronecan is not None and self.msg.dronecan.union:
+            return None
+        items = self.items("self")
+        head = self.head_segment(items)
+        if head is None:
+            return None
+        out = Lines()
+        after = [
+            out.field_var(i, f"{self.cls}.{f.name}")
+            for i, f in enumerate(self.msg.fields)
+            if not f.is_padding and i not in dict(head.nodes)
+        ]
+        self.seg_unpack(head, out, "from:data")
+        values = [self.node_expr(node) for _, node in head.nodes]
+        if all(v.isidentifier() for v in values):
+            out.add(f"return cls({', '.join(values + after)})")
+        else:  # a field assembled in place is named beside it
+            out.add("return cls(")
+            for (index, _), value in zip(head.nodes, values, strict=True):
+                name = self.msg.fields[index].name
+                # a DSDL field name is an identifier (the DSDL frontend keeps them so): safe in a comment
+                out.add(f"    {value}," if value.isidentifier() else f"    {value},  # {name}")
+            for name in after:
+                out.add(f"    {name},")
+            out.add(")")
+        what = ",\n    and of the values of the fields after them" if after else ""
+        bits = f"bits 0-{head.bits - 1} (the fixed fields that open the payload)"
+        doc = f'    """A new instance of {bits} read from ``data``{what}."""\n'
+        params = ", ".join(["data: bytes", *(f"{name}: _Any" for name in after)])
+        return f"@classmethod\ndef _dc_from_head(cls, {params}) -> {self.cls}:\n" + doc + out.text(1)
 
     def method_put(self) -> str:
         out = Lines()
@@ -117,10 +151,24 @@ class MessageEmitter(VariableFieldEmitter):
         else:
             items = self.items("self")
             self.declare(items, out)
+            head = self.head_segment(items)
+            first = ""
+            if head is not None:
+                nb, pad = (head.bits + 7) // 8, -head.bits % 8
+                chunk = f"((v >> rem) & {mask(head.bits)})"
+                out.add(f"if rem < {head.bits}:")
+                out.add(f"    raise _dc.cut({self.cut_table(head)}, rem)")
+                out.add(f"rem -= {head.bits}")
+                out.add(f'head = {f"({chunk} << {pad})" if pad else chunk}.to_bytes({nb}, "big")')
+                items, first = items[1:], "head"
             values = self.body_get(items, out)
-            out.add(f"return {self.construct(values)}, rem")
-        head = f"@classmethod\ndef _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[{self.cls}, int]:\n"
-        return head + out.text(1)
+            if first:
+                args = [values[i] for i, f in enumerate(self.msg.fields) if not f.is_padding and i in values]
+                out.add(f"return cls._dc_from_head({', '.join([first, *args])}), rem")
+            else:
+                out.add(f"return {self.construct(values)}, rem")
+        signature = f"@classmethod\ndef _dc_get(cls, v: int, rem: int, tao: bool) -> tuple[{self.cls}, int]:\n"
+        return signature + out.text(1)
 
     def union_fields(self) -> list[tuple[int, str]]:
         return [(i, self.idents[i]) for i, f in enumerate(self.msg.fields)]
@@ -227,7 +275,7 @@ class MessageEmitter(VariableFieldEmitter):
         label = f"{self.cls}.{item.field_name}"
         out.add("if tao:")
         out.level += 1
-        x = out.fresh("x")
+        x = out.named(label)
         out.add(f"{x} = self.{item.ident}")
         out.add(f"if len({x}) > {t.capacity}:")
         out.add(
@@ -246,78 +294,60 @@ class MessageEmitter(VariableFieldEmitter):
         out.level -= 1
 
     def method_decode(self) -> str:
+        """``decode``: a type of fixed fields alone is read by ``_dc_from_head``; one ending in a byte-aligned
+        tail array sent with TAO by it and a slice; anything else by ``_dc_get`` (``_dc.read``)."""
         out = Lines()
-        if self.msg.dronecan is not None and self.msg.dronecan.union:
-            out.add('obj, rem = cls._dc_get(int.from_bytes(data, "big"), len(data) << 3, tao)')
-            self.trailing(out)
-            out.add("return obj")
+        union = self.msg.dronecan is not None and self.msg.dronecan.union
+        items = [] if union else self.items("self")
+        head_seg = self.head_segment(items)
+        tail = self.tail_fast(items)
+        if tail is None and (head_seg is None or len(items) > 1):
+            out.add("return _dc.read(cls, data, tao)")
             return self.wrap_decode(out)
-        items = self.items("self")
-        self.declare(items, out)
-        head_seg = items[0] if items and isinstance(items[0], Segment) and items[0].bits else None
-        rest = items[1:] if head_seg is not None else items
-        values: dict[int, str] = {}
         out.add("n = len(data)")
-        head_bits = 0
+        nb = 0
         if head_seg is not None:
-            head_bits = head_seg.bits
-            nb = (head_bits + 7) // 8
+            nb = (head_seg.bits + 7) // 8
             out.add(f"if n < {nb}:")
             out.add(f"    raise _dc.cut({self.cut_table(head_seg)}, n << 3)")
-            self.seg_unpack(head_seg, out, "from:data")
-            for index, node in head_seg.nodes:
-                values[index] = self.node_expr(node)
-            if not rest:
-                out.add(f"if n > {nb}:")
-                out.add(
-                    "    raise "
-                    + error("DecodeError", f"{self.cls}: ", f"str(n - {nb})", " byte(s) beyond the end of the message")
-                )
-                out.add(f"return {self.construct(values)}")
-                return self.wrap_decode(out)
-        tail = self.tail_fast(items)
-        if tail is not None:  # returns when tao is true: what follows runs only without it
-            values[tail.index] = out.field_var(tail.index, f"{self.cls}.{tail.field_name}")
-            self.tail_get(tail, (head_bits + 7) // 8, out)
-            out.add(f"    return {self.construct(values)}")
-            # without TAO the array has its length prefix: the bit reader, as when the type is nested
-            out.add('obj, rem = cls._dc_get(int.from_bytes(data, "big"), n << 3, False)')
-            self.trailing(out)
-            out.add("return obj")
+        if tail is None:
+            out.add(f"if n > {nb}:")
+            out.add(f"    raise _dc.beyond({py_literal(self.cls)}, n - {nb})")
+            out.add("return cls._dc_from_head(data)")
             return self.wrap_decode(out)
-        out.add('v = int.from_bytes(data, "big")')
-        out.add(f"rem = (n << 3) - {head_bits}" if head_bits else "rem = n << 3")
-        values.update(self.body_get(rest, out))
-        self.trailing(out)
-        out.add(f"return {self.construct(values)}")
+        out.add("if tao:")
+        out.level += 1
+        value = self.tail_get(tail, nb, out)
+        out.add(f"return cls._dc_from_head(data, {value})" if head_seg is not None else f"return cls({value})")
+        out.level -= 1
+        # without TAO the array has its length prefix: the bit reader, as when the type is nested
+        out.add("return _dc.read(cls, data, False)")
         return self.wrap_decode(out)
 
-    def tail_get(self, item: VarField, start: int, out: Lines) -> None:
+    def tail_get(self, item: VarField, start: int, out: Lines) -> str:
+        """Lines checking the tail array that fills the payload from byte ``start``; returns its value."""
         t = item.type
         assert isinstance(t, ArrayType)
         label = f"{self.cls}.{item.field_name}"
-        target = out.field_var(item.index, label)
-        out.add("if tao:")
-        out.level += 1
-        k = out.fresh("k")
-        too_long = error("DecodeError", f"{label}: length ", f"str({k})", f" exceeds capacity {t.capacity}")
         if is_u8(t.element):
-            out.add(f"{target} = bytes(data[{start}:])" if start else f"{target} = bytes(data)")
-            out.add(f"{k} = len({target})")
-            out.add(f"if {k} > {t.capacity}:")
-            out.add(f"    raise {too_long}")
-        else:
-            word = structable_element(t.element)
-            assert word is not None
-            size = word.bits // 8
-            out.add(f"{k}, extra = divmod(n - {start}, {size})")
-            out.add("if extra:")
-            out.add("    raise " + error("DecodeError", f"{label}: input ends inside an element"))
-            out.add(f"if {k} > {t.capacity}:")
-            out.add(f"    raise {too_long}")
-            code = struct_code(word, pack=False)
-            out.add(f'{target} = list(_struct.unpack_from(f"<{{{k}}}{code}", data, {start}))')
-        out.level -= 1
+            count = f"n - {start}" if start else "n"
+            out.add(f"if n > {start + (t.capacity or 0)}:")
+            out.add(
+                "    raise "
+                + error("DecodeError", f"{label}: length ", f"str({count})", f" exceeds capacity {t.capacity}")
+            )
+            return f"bytes(data[{start}:])" if start else "bytes(data)"
+        word = structable_element(t.element)
+        assert word is not None
+        k = out.named(label, "count")
+        out.add(f"{k}, extra = divmod(n - {start}, {word.bits // 8})")
+        out.add("if extra:")
+        out.add("    raise " + error("DecodeError", f"{label}: input ends inside an element"))
+        out.add(f"if {k} > {t.capacity}:")
+        out.add(
+            "    raise " + error("DecodeError", f"{label}: length ", f"str({k})", f" exceeds capacity {t.capacity}")
+        )
+        return f'list(_struct.unpack_from(f"<{{{k}}}{struct_code(word, pack=False)}", data, {start}))'
 
     def wrap_decode(self, out: Lines) -> str:
         doc = '    """Read a DroneCAN payload; ``tao=False`` for CAN FD. Raises DecodeError naming the field."""\n'

@@ -108,10 +108,10 @@ class SegmentEmitter:
         return args
 
     def float16_batch(self, seg: Segment, out: Lines) -> dict[int, str]:
-        """float16 bits of several fields at once: one struct round trip gives every float32 pattern,
-        from which a positive normal half is a subtraction and a shift; the runtime handles the rest
-        (a value beyond +-65504, a sign, a subnormal, infinity, NaN: ``_dc.f16_saturated`` /
-        ``_dc.f16_truncated`` and ``_dc.f16bits``), so the common case costs no call."""
+        """float16 bits of several fields at once: one runtime call (``_dc.float32_bits``, a struct round trip)
+        gives every float32 pattern, from which a positive normal half is a subtraction and a shift; the runtime
+        cuts the rest (a sign, a subnormal, beyond +-65504, infinity, NaN: ``_dc.f16bits_saturated`` or, for a
+        truncated field, ``_dc.f16bits``), so the common case costs no call per field."""
         halves = [
             (idx, leaf)
             for idx, leaf in enumerate(seg.leaves)
@@ -119,27 +119,23 @@ class SegmentEmitter:
         ]
         if len(halves) < 2:
             return {}
-        clamped = []
-        for _, leaf in halves:
-            raw = out.named(leaf.label)
-            out.add(f"{raw} = {leaf.enc}")
-            cast = "_dc.f16_saturated" if leaf.type.cast is CastMode.SATURATED else "_dc.f16_truncated"
-            clamped.append(f"{raw} if -65504.0 <= {raw} <= 65504.0 else {cast}({raw})")
+        truncated = tuple(k for k, (_, leaf) in enumerate(halves) if leaf.type.cast is not CastMode.SATURATED)
         n = len(halves)
-        words = [out.named(leaf.label, "f32") for _, leaf in halves]
-        floats = self.struct_name(
-            f"<{n}f", self.segment_role(seg, "FLOAT32_STRUCT"), "float16 fields packed as float32 ..."
-        )
-        ints = self.struct_name(
-            f"<{n}I",
-            self.segment_role(seg, "FLOAT32_BITS_STRUCT"),
-            "... and read back as bits, from which each half is cut",
-        )
-        out.add(f"{', '.join(words)} = {ints}.unpack({floats}.pack({', '.join(clamped)}))")
+        source = f"_dc.float32_bits({n}, truncated={py_literal(truncated)})" if truncated else f"_dc.float32_bits({n})"
+        comment = "float16 fields as float32 bits, from which each half is cut"
+        bits = self.module_value(source, self.segment_role(seg, "FLOAT32_BITS"), comment)
+        # one tuple, read by position (in the order of the call's arguments): each half's cut fits a line
+        out.add(f"f32 = {bits}({', '.join(leaf.enc for _, leaf in halves)})")
         values: dict[int, str] = {}
-        for (idx, leaf), g in zip(halves, words, strict=True):
-            h = out.named(leaf.label, "f16")
-            out.add(f"{h} = (({g} - 0x37FFF000) >> 13) if 0x38800000 <= {g} < 0x477FF000 else _dc.f16bits({g})")
+        for k, (idx, leaf) in enumerate(halves):
+            g = f"f32[{k}]"
+            rest = "_dc.f16bits_saturated" if leaf.type.cast is CastMode.SATURATED else "_dc.f16bits"
+            cut = f"(({g} - 0x37FFF000) >> 13) if 0x38800000 <= {g} < 0x477FF000 else {rest}({g})"
+            if leaf.structable:  # the struct argument itself
+                values[idx] = f"({cut})"
+                continue
+            h = out.named(leaf.label, "f16")  # shifted into a shared word, where it is used more than once
+            out.add(f"{h} = {cut}")
             values[idx] = h
         return values
 
@@ -209,9 +205,7 @@ class SegmentEmitter:
                     term = f"({term} & {mask(pc.size)})"
                 parts.append(f"({term} << {pc.src})" if pc.src else term)
             bits = parts[0] if len(parts) == 1 else "(" + " | ".join(parts) + ")"
-            var = out.named(leaf.label)
-            out.add(f"{var} = {unparenthesized(decode_pattern(leaf.type, bits))}")
-            leaf.var = var
+            leaf.var = unparenthesized(decode_pattern(leaf.type, bits))  # an argument of the constructor call
 
     def seg_get(self, seg: Segment, out: Lines) -> None:
         """Read a segment from ``v`` with ``rem`` bits left."""

@@ -16,6 +16,7 @@ F32_MAX = "_dc.F32_MAX"
 # names a generated method uses itself, or that shadowing would break (the builtins its code calls)
 _RESERVED = frozenset(
     {"acc", "tao", "head", "v", "rem", "n", "data", "cls", "self", "obj", "extra", "u", "t", "out", "_dc", "_struct"}
+    | {"f32"}
     | {"bytes", "len", "str", "list", "int", "divmod", "range", "float", "bool", "any", "all", "sum", "min", "max"}
 )
 _NUMBERED = re.compile(r"[a-z][0-9]+")

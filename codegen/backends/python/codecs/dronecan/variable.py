@@ -56,6 +56,10 @@ class VariableFieldEmitter(SegmentEmitter):
             return
         assert isinstance(t, ArrayType)
         cap = t.capacity or 0
+        if t.dynamic and is_u8(t.element):  # bytes: the runtime writes the length and the bytes
+            tail = tao if self.p.tao_eligible(t) and tao != "False" else "False"
+            out.add(f"acc = _dc.put_bytes(acc, {expr}, {cap}, {tail}, {py_literal(label)})")
+            return
         x, k = out.fresh("x"), out.fresh("k")
         out.add(f"{x} = {expr}")
         out.add(f"{k} = len({x})")
@@ -129,6 +133,10 @@ class VariableFieldEmitter(SegmentEmitter):
         elem_tao = tao if (not eligible and self.p.tao_sensitive(t.element)) else "False"
         if not t.dynamic:
             self.elements_get(t.element, str(cap), target, label, elem_tao, out)
+            return
+        if is_u8(t.element):  # bytes: the runtime reads the length and the bytes
+            tail = tao if eligible and tao != "False" else "False"
+            out.add(f"{target}, rem = _dc.get_bytes(v, rem, {cap}, {tail}, {py_literal(label)})")
             return
         k = out.fresh("k")
         too_long = error("DecodeError", f"{label}: length ", f"str({k})", f" exceeds capacity {cap}")

@@ -267,18 +267,6 @@ class Error_0_1:
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "cyphal.reg.udral.service.battery.Error_0_1"
-    NONE: _ClassVar[int] = 0
-    BAD_BATTERY: _ClassVar[int] = 10
-    NEEDS_SERVICE: _ClassVar[int] = 11
-    BMS_ERROR: _ClassVar[int] = 20
-    CONFIGURATION: _ClassVar[int] = 30
-    OVERDISCHARGE: _ClassVar[int] = 50
-    OVERLOAD: _ClassVar[int] = 51
-    CELL_OVERVOLTAGE: _ClassVar[int] = 60
-    CELL_UNDERVOLTAGE: _ClassVar[int] = 61
-    CELL_COUNT: _ClassVar[int] = 62
-    TEMPERATURE_HOT: _ClassVar[int] = 100
-    TEMPERATURE_COLD: _ClassVar[int] = 101
 
     value: int = _dataclasses.field(
         default=0,
@@ -987,30 +975,6 @@ class Technology_0_1:
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "cyphal.reg.udral.service.battery.Technology_0_1"
-    OTHER: _ClassVar[int] = 0
-    LI_SOCL2: _ClassVar[int] = 10
-    LI_BCX: _ClassVar[int] = 11
-    LI_MNO2: _ClassVar[int] = 12
-    ZN_O2: _ClassVar[int] = 20
-    AL_O2: _ClassVar[int] = 21
-    ZN_MNO2_NH4CL: _ClassVar[int] = 30
-    ZN_MNO2_ZNCL2: _ClassVar[int] = 31
-    ZN_MNO2_KOH: _ClassVar[int] = 32
-    LI_LCO: _ClassVar[int] = 100
-    LI_LFP: _ClassVar[int] = 101
-    LI_NMC: _ClassVar[int] = 102
-    LI_NCA: _ClassVar[int] = 103
-    LI_LMO: _ClassVar[int] = 104
-    LI_S: _ClassVar[int] = 105
-    LI_LCO_POUCH: _ClassVar[int] = 110
-    LI_LFP_POUCH: _ClassVar[int] = 111
-    NI_MH: _ClassVar[int] = 120
-    NI_CD: _ClassVar[int] = 121
-    NI_ZN: _ClassVar[int] = 122
-    NI_FE: _ClassVar[int] = 123
-    PB_AC: _ClassVar[int] = 130
-    PB_AC_SEALED: _ClassVar[int] = 131
-    EDLC: _ClassVar[int] = 200
 
     value: int = _dataclasses.field(
         default=0,

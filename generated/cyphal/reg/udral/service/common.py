@@ -180,9 +180,6 @@ class Readiness_0_1:
     """
 
     QUALIFIED_NAME: _ClassVar[str] = "cyphal.reg.udral.service.common.Readiness_0_1"
-    SLEEP: _ClassVar[int] = 0
-    STANDBY: _ClassVar[int] = 2
-    ENGAGED: _ClassVar[int] = 3
 
     value: int = _dataclasses.field(
         default=0,
