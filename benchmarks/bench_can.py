@@ -120,7 +120,13 @@ def run(transfers: int = 4000) -> dict[str, float]:
     return out
 
 
-if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def main(argv: list[str] | None = None) -> dict[str, float]:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").split("\n")[0])
     parser.add_argument("--transfers", type=int, default=4000)
-    run(parser.parse_args().transfers)
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
+    args = parser.parse_args(argv)
+    return run(min(args.transfers, 100) if args.quick else args.transfers)
+
+
+if __name__ == "__main__":
+    main()
