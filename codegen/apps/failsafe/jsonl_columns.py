@@ -27,6 +27,7 @@ from ..battery.columns import NDArray
 
 TOP = ("t", "armed", "instance", "battery")
 BATTERY = ("voltage_v", "current_a", "consumed_mah")
+_CONTROL = bytes(b for b in range(32) if b != 10)  # none may be in the file: the markers are its only ones
 MAX_BYTES = 1 << 30  # a stream read whole (its columns take about as much again)
 NULL = 30  # the byte "null" becomes; markers are 1..29 except the newline
 _MARKERS = [b for b in range(1, NULL) if b != 10]
@@ -104,9 +105,8 @@ def read_sample_columns(path: Path) -> SampleColumns | None:
         return None
     names, spans = found
     # no control byte but the newlines, so that the markers are the file's only ones
-    raw = np.frombuffer(data, np.uint8)
     lines = data.count(b"\n")
-    if int(np.count_nonzero(raw < 32)) != lines:
+    if len(data.translate(None, _CONTROL)) != len(data):
         return None
     # the literals between the values; armed's value joins the literals on its sides (one marker for true, one for
     # false)
@@ -155,9 +155,10 @@ def read_sample_columns(path: Path) -> SampleColumns | None:
         elif not np.isin(seq[:, i], mk).all():
             return None
     armed = seq[:, armed_group] == markers[armed_group][0]
-    gaps = (np.diff(np.append(pos, len(c) + pos[0])) - 1).reshape(lines, per_line)
-    if (gaps[:, :-1] <= 0).any() or (gaps[:, -1] != 0).any():
-        return None  # every value a token, nothing between one line's end and the next's start
+    # every value a token (a marker is followed by a number), nothing between a line's end and the next's start
+    followed = np.append(is_mark[pos[:-1] + 1], True).reshape(lines, per_line)
+    if followed[:, :-1].any() or not followed[:, -1].all():
+        return None
     if not _numbers_valid(c, pos, per_line, [values.index("instance")] if "instance" in values else []):
         return None
     grid = pos.reshape(lines, per_line)
