@@ -116,7 +116,10 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     """Times both policies; returns ns per record by ``<side>_<policy>`` (``c_strict``, ``python_px4``, ...)."""
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--number", type=int, default=20000)
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.number = min(args.number, 50)
     if shutil.which("gcc") is None:
         print("gcc not installed", file=sys.stderr)
         return {}

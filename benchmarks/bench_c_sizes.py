@@ -9,6 +9,7 @@ where the compiler placed them.
 
 from __future__ import annotations
 
+import argparse
 import shutil
 import subprocess
 import sys
@@ -48,7 +49,10 @@ def measure() -> dict[str, dict[str, int]]:
     return dict(sizes)
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
+    parser.parse_args(argv)  # --quick: the sizes take one build either way
     if shutil.which("arm-none-eabi-gcc") is None or shutil.which("arm-none-eabi-nm") is None:
         print("arm-none-eabi-gcc not installed (Debian: gcc-arm-none-eabi)")
         return 1

@@ -109,7 +109,10 @@ def run(number: int) -> dict[str, float]:
 def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--number", type=int, default=200_000)
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.number = min(args.number, 2000)
     ns = run(args.number)
     print("BATTERY_STATUS (MAVLink 2 frame), ns per call:")
     for what in ("encode", "decode"):

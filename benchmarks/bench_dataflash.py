@@ -53,11 +53,12 @@ def run(path: Path) -> dict[str, float]:
     return figures
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("log", nargs="?", type=Path)
-    args = parser.parse_args()
-    run(args.log or default_log())
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
+    args = parser.parse_args(argv)
+    return run(args.log or default_log())
 
 
 if __name__ == "__main__":

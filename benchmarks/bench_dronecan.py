@@ -118,11 +118,12 @@ def run(number: int = 20000, ref_number: int | None = None) -> dict[str, float]:
     return t
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
     parser.add_argument("--number", type=int, default=20000, help="calls per timing run of our codec")
-    args = parser.parse_args()
-    run(args.number)
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
+    args = parser.parse_args(argv)
+    return run(min(args.number, 200) if args.quick else args.number)
 
 
 if __name__ == "__main__":

@@ -80,13 +80,16 @@ def peak(args: list[str]) -> tuple[int, float, float]:
     return int(code), int(kib) / 1024, time.perf_counter() - start
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--short", type=int, default=100_000)
     parser.add_argument("--long", type=int, default=1_000_000)
     parser.add_argument("--can-long", type=int, default=1_000_000)
     parser.add_argument("--kinds", default="tlog,jsonl,can", help="comma-separated: tlog, jsonl, can")
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.short, args.long, args.can_long, args.kinds = 200, 400, 400, "jsonl"
     makers = {
         "tlog": (tlog, ".tlog", args.long),
         "jsonl": (jsonl, ".jsonl", args.long),

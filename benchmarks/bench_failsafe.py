@@ -165,9 +165,16 @@ def run(
     return results
 
 
-if __name__ == "__main__":
+def main(argv: list[str] | None = None) -> dict[str, dict[str, float]]:
     parser = argparse.ArgumentParser(description=(__doc__ or "").split("\n")[0])
     parser.add_argument("--records", type=int, default=1_000_000)
     parser.add_argument("--source", default="sample_px4_events.ulg", help="the real log under ../shared/data/ulog")
-    args = parser.parse_args()
-    run(args.records, args.source)
+    parser.add_argument("--quick", action="store_true", help="2 000 records, the repeated log only (a smoke run)")
+    args = parser.parse_args(argv)
+    if args.quick:
+        return run(min(args.records, 2000), args.source, real=False)
+    return run(args.records, args.source)
+
+
+if __name__ == "__main__":
+    main()

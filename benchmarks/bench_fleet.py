@@ -28,6 +28,7 @@ import timeit
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 from pyulog import ULog
 
@@ -113,9 +114,29 @@ def single_log(path: Path, tmp: Path, key: str, r: dict[str, float]) -> None:
 
     rows = ours()
     assert rows == hand(), "the hand path and ours disagree on the number of records"
+    same_values(path, tmp / f"values-{key}")
     r[f"{key}_records"] = rows
     r[f"{key}_ours_rps"] = rows / best(ours)
     r[f"{key}_hand_rps"] = rows / best(hand)
+
+
+def same_values(path: Path, out: Path) -> None:
+    """The voltage and charge each path wrote, value for value (as float32, the log's type), in time order."""
+    import pyarrow.parquet as pq
+
+    res = export_one(path.as_posix(), ExportOptions(out / "ours"))
+    assert res.status == "exported", res.error
+    ours = pd.concat(pq.read_table(p).to_pandas() for p in sorted((out / "ours").rglob("*.parquet")))
+    ours = ours.sort_values(["t", "battery"], kind="stable")
+    (out / "hand").mkdir(parents=True)
+    hand_path(path.as_posix(), out / "hand")
+    hand = pd.concat(pd.read_parquet(p) for p in sorted((out / "hand").glob("*.parquet")))
+    hand = hand.sort_values(["timestamp", "id"], kind="stable")
+    for mine, theirs in (("pack_voltage", "voltage_v"), ("state_of_charge", "remaining")):
+        a = ours[mine].to_numpy(np.float64).astype(np.float32)
+        b = hand[theirs].to_numpy(np.float64).astype(np.float32)
+        np.testing.assert_array_equal(a, b, err_msg=f"{path.name}: {mine} against pyulog's {theirs}")
+    shutil.rmtree(out)
 
 
 def fleet(tmp: Path, logs: int, per_log: int, dask: bool, r: dict[str, float]) -> None:
@@ -226,7 +247,10 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     parser.add_argument("--log-records", type=int, default=2000, help="records per fleet log")
     parser.add_argument("--repeat", type=int, default=3, help="timing repeats (the best one counts)")
     parser.add_argument("--no-dask", action="store_true", help="skip the Dask run")
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.records, args.logs, args.log_records, args.repeat, args.no_dask = 2000, 3, 200, 1, True
     REPEAT[0] = args.repeat
     results = run(args.records, args.logs, args.log_records, not args.no_dask)
     report(results)

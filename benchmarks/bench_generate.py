@@ -30,7 +30,10 @@ def best(fn: object, repeat: int) -> float:
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.repeat = 1
     import pymavlink.generator.mavparse  # noqa: F401  (one-off import cost, not per generation)
 
     for fmt in FORMAT_FRONTENDS:

@@ -98,7 +98,10 @@ def main(argv: list[str] | None = None) -> dict[str, tuple[float, float]]:
     parser.add_argument("--commit", default="HEAD", help="the earlier commit (default: HEAD, against the work tree)")
     parser.add_argument("--rounds", type=int, default=15)
     parser.add_argument("--number", type=int, default=2000, help="calls per timing")
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.rounds, args.number = 1, 20
     with tempfile.TemporaryDirectory(prefix="battgen-ab-") as tmp:
         unpack_commit(args.commit, Path(tmp))
         sys.path.insert(0, tmp)

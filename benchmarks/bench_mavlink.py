@@ -87,7 +87,10 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser()
     parser.add_argument("--number", type=int, default=20000, help="calls per timing run")
     parser.add_argument("--records", type=int, default=200000, help="records per batch")
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
     opts = parser.parse_args(argv)
+    if opts.quick:
+        opts.number, opts.records = 50, 500
     results = run(opts.number, opts.records)
     print(report(results))
     return results

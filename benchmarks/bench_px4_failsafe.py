@@ -52,15 +52,18 @@ def run(logs: list[Path], repeat: int = 5) -> dict[str, dict[str, float]]:
     return {log.name: bench(log, repeat) for log in logs}
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict[str, dict[str, float]]:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("logs", nargs="*", type=Path)
     parser.add_argument("--repeat", type=int, default=5)
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.repeat = 1
     logs = args.logs or [SHARED / name for name in LOGS if (SHARED / name).is_file()]
     if not logs:
         raise SystemExit(f"no logs: give some, or put ../shared beside the repository ({SHARED})")
-    run(logs, args.repeat)
+    return run(logs[-1:] if args.quick else logs, args.repeat)
 
 
 if __name__ == "__main__":

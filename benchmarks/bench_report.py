@@ -77,7 +77,13 @@ def run(seconds: float = 3600.0) -> dict[str, float]:
     return figures
 
 
-if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def main(argv: list[str] | None = None) -> dict[str, float]:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").split("\n")[0])
     parser.add_argument("--seconds", type=float, default=3600.0)
-    run(parser.parse_args().seconds)
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
+    args = parser.parse_args(argv)
+    return run(60.0 if args.quick else args.seconds)
+
+
+if __name__ == "__main__":
+    main()

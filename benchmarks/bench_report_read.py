@@ -97,10 +97,17 @@ def run(seconds: float = 3600.0, real: bool = True) -> dict[str, dict[str, float
     return results
 
 
-if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def main(argv: list[str] | None = None) -> dict[str, dict[str, float]]:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--seconds", type=float, default=3600.0, help="the synthetic flight's length")
     parser.add_argument("--no-real", action="store_true", help="the synthetic flight only")
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
+    args = parser.parse_args(argv)
     sys.path.insert(0, str(ROOT))
-    run(args.seconds, real=not args.no_real)
+    if args.quick:
+        return run(60.0, real=False)
+    return run(args.seconds, real=not args.no_real)
+
+
+if __name__ == "__main__":
+    main()

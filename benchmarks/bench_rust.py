@@ -138,7 +138,10 @@ def python(number: int) -> dict[str, float]:
 def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--number", type=int, default=200_000)
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.number = min(args.number, 2000)
     ns = {**rust(args.number), **c(args.number), **python(max(args.number // 20, 1))}
     r, cc, py = ns["decode_rust"], ns["decode_ours"], ns["decode_python"]
     print("BATTERY_STATUS MAVLink 2 frame decode, ns per call:")

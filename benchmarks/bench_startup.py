@@ -128,10 +128,15 @@ def run(ulog: Path = DEFAULT_ULOG, tlog: Path = DEFAULT_TLOG, rounds: int = 7) -
     return figures
 
 
-if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def main(argv: list[str] | None = None) -> dict[str, float]:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("ulog", nargs="?", type=Path, default=DEFAULT_ULOG)
     parser.add_argument("tlog", nargs="?", type=Path, default=DEFAULT_TLOG)
     parser.add_argument("--rounds", type=int, default=7)
-    options = parser.parse_args()
-    run(options.ulog, options.tlog, options.rounds)
+    parser.add_argument("--quick", action="store_true", help="one round (a smoke run)")
+    options = parser.parse_args(argv)
+    return run(options.ulog, options.tlog, 1 if options.quick else options.rounds)
+
+
+if __name__ == "__main__":
+    main()

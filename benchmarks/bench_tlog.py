@@ -56,7 +56,10 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("tlog", nargs="?", type=Path)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="one run each (a smoke run)")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.repeat = 1
     path = args.tlog or default_tlog()
     t_ours, records = best(ours, path, args.repeat)
     t_theirs, messages = best(pymavlink, path, args.repeat)

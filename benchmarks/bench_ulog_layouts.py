@@ -93,7 +93,10 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     parser.add_argument("--records", type=int, default=1_000_000)
     parser.add_argument("--log", type=Path, default=DEFAULT_LOG)
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.records = min(args.records, 2000)
     results = run(args.log, args.records)
     report(results, args.log)
     return results

@@ -23,7 +23,7 @@ def test_bench_c_sizes_runs(capsys: pytest.CaptureFixture[str]) -> None:
     sys.modules["bench_c_sizes"] = module
     try:
         spec.loader.exec_module(module)
-        assert module.main() == 0
+        assert module.main([]) == 0
         sizes = module.measure()
     finally:
         del sys.modules["bench_c_sizes"]

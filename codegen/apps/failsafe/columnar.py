@@ -27,6 +27,7 @@ the sample's extra fields), a time that is not finite or a battery outside 1..16
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,8 +38,8 @@ from .evaluator import DISTANCE, SEED_CRITICAL, BatteryFailsafe, Event
 from .levels import Level
 from .logs import SampleTable
 from .monitor import FLT_EPSILON, MAH_PER_AMP_MS, MAX_INTEGRATION_MS, ResistanceEstimator, Trigger
+from .reading import Sample
 from .settings import MAX_INSTANCES, MONITOR_VOLTAGE_ONLY, VOLTSRC_RESTING, BatterySettings
-from .stream import Sample
 
 
 @dataclass
@@ -66,16 +67,36 @@ def replay_table(
     t, battery, volts, amps, mah, armed, where = table.sorted_columns()
     instance = battery + 1
     counts = {int(i): int(c) for i, c in zip(*np.unique(instance, return_counts=True), strict=True)}
+    at = table.sample_at
+    out = replay_columns(failsafe, t, instance, volts, amps, mah, armed == 1.0, lambda row: at(int(where[row])))
+    return (_per_sample(failsafe, table, name) if out is None else out), counts
+
+
+def replay_columns(
+    failsafe: BatteryFailsafe,
+    t: NDArray,
+    instance: NDArray,
+    volts: NDArray,
+    amps: NDArray,
+    mah: NDArray,
+    armed_b: NDArray,
+    sample_at: Callable[[int], Sample],
+) -> list[tuple[Event, Sample]] | None:
+    """The events of samples given as columns in the order the evaluator reads them (``sample_at``: the sample of a
+    row, for the events' places), or None where the columns cannot restate the evaluator exactly (the caller replays
+    sample by sample, with the evaluator's errors): the distance variant, a used evaluator, a time that is not
+    finite or goes back, a battery outside 1..16."""
     exact = DISTANCE not in failsafe.variants and not failsafe.monitors and not failsafe.events
     if not exact or not np.isfinite(t).all() or ((instance < 1) | (instance > MAX_INSTANCES)).any():
-        return _per_sample(failsafe, table, name), counts
+        return None
     now = np.rint(t * 1000.0).astype(np.int64)
-    armed_b = armed == 1.0
+    if len(now) and (np.diff(now) < 0).any():
+        return None
     batteries: list[_Battery] = []
     enabled = np.zeros(len(t), bool)
-    for inst in sorted(counts):
+    for inst in np.unique(instance).tolist():
         rows = np.flatnonzero(instance == inst)
-        mon = failsafe.monitor(inst)
+        mon = failsafe.monitor(int(inst))
         if mon.settings.enabled:
             enabled[rows] = True
             batteries.append(_columns(mon.settings, rows, now[rows], volts[rows], amps[rows], mah[rows]))
@@ -98,12 +119,12 @@ def replay_table(
         mon = failsafe.monitors[b.settings.instance]
         mon.voltage, mon.consumed_mah = float(b.voltage[k]), float(b.consumed[k])
         event = failsafe.fire(float(t[row]), mon, trigger)
-        out.append((event, table.sample_at(int(where[row]))))
+        out.append((event, sample_at(row)))
         if event.outcome == "disarm":  # silent until a disarmed sample of an enabled battery
             later = np.flatnonzero(enabled[row + 1 :] & ~armed_b[row + 1 :])
             end = row + 1 + int(later[0]) if len(later) else len(t)
             checked[row + 1 : end] = False
-    return out, counts
+    return out
 
 
 def _columns(s: BatterySettings, rows: NDArray, now: NDArray, volts: NDArray, amps: NDArray, mah: NDArray) -> _Battery:

@@ -30,8 +30,7 @@ from ..battery.columns import NDArray
 from ..battery.context import LogContext
 from ..battery.view import Chunk, read_view
 from .legacy_parameters import with_current_names
-from .reading import BatteryReading
-from .stream import Sample
+from .reading import BatteryReading, Sample
 
 COULOMB_PER_MAH = 3.6
 NO_ARMING_NOTE = "taken as armed throughout (this input has no arming state)"

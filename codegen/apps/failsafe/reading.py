@@ -1,4 +1,5 @@
-"""One battery reading in SI units, from any object or mapping that carries it."""
+"""One battery reading in SI units, from any object or mapping that carries it, and a timed sample of one (what
+every replay feeds the evaluator: :mod:`.stream` reads them from JSON Lines, :mod:`.logs` from flight logs)."""
 
 from __future__ import annotations
 
@@ -50,3 +51,21 @@ def reading_of(state: Any) -> BatteryReading:
         consumed_mah=consumed,
         remaining_mah=remaining,
     )
+
+
+@dataclass(frozen=True)
+class Sample:
+    line: int
+    t: float
+    armed: bool
+    battery: BatteryReading
+    message: str | None  # qualified name the battery came from (None: given in SI)
+    data: Mapping[str, Any] | None
+    extra: Mapping[str, Any]  # distance_to_home_m, travelled_m, home_set, position_fix
+    instance: int = 1  # the battery, 1-based as ArduPilot prints it
+    where: str = ""  # how to find it again: "line 12", "offset 4711"
+    stamp_us: int | None = None  # the log's own clock (ULog/DataFlash µs since boot, tlog µs since the epoch)
+
+    @property
+    def place(self) -> str:
+        return self.where or f"line {self.line}"

@@ -22,10 +22,10 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import json
 import math
 import re
-from collections.abc import Iterable, Iterator, Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from types import ModuleType
 from typing import Any, cast
@@ -41,8 +41,11 @@ from ..battery.sources import FloatFields, float_fields, stored_data
 from ..convert import ConvertModule
 from ..messages import resolve_message
 from ..package import bundled_schemas, model_class, model_package
+from .columnar import replay_columns
 from .evaluator import BatteryFailsafe, Event
+from .jsonl_columns import read_sample_columns
 from .reading import BatteryReading, reading_of
+from .reading import Sample as Sample  # where the CLI, the report and the logs' replay import it from
 
 # which field carries what, per message (units come from the IR metadata)
 ROLES: dict[str, dict[str, str]] = {
@@ -61,24 +64,6 @@ _OPTIONAL = {"distance_to_home_m": float, "travelled_m": float, "home_set": bool
 
 class StreamError(LocatedError):
     """A malformed input file, located by file and line."""
-
-
-@dataclass(frozen=True)
-class Sample:
-    line: int
-    t: float
-    armed: bool
-    battery: BatteryReading
-    message: str | None  # qualified name the battery came from (None: given in SI)
-    data: Mapping[str, Any] | None
-    extra: Mapping[str, Any]  # distance_to_home_m, travelled_m, home_set, position_fix
-    instance: int = 1  # the battery, 1-based as ArduPilot prints it
-    where: str = ""  # how to find it again: "line 12", "offset 4711"
-    stamp_us: int | None = None  # the log's own clock (ULog/DataFlash µs since boot, tlog µs since the epoch)
-
-    @property
-    def place(self) -> str:
-        return self.where or f"line {self.line}"
 
 
 def _si(meta: Mapping[str, Any], value: Any) -> float | None:
@@ -154,11 +139,36 @@ def battery_state_from_ir(qualified_name: str, model: GeneratedMessage) -> Batte
 class Reader:
     """Reads a stream, resolving message names against a schema and its generated package."""
 
-    def __init__(self, schema: Schema, package: ModuleType, default_message: str | None = None) -> None:
-        self.schema = schema
-        self.package = package
+    def __init__(
+        self,
+        schema: Schema | None,
+        package: ModuleType | None,
+        default_message: str | None = None,
+        loader: Callable[[], tuple[Schema, ModuleType]] | None = None,
+    ) -> None:
+        self._schema = schema
+        self._package = package
+        self._loader = loader  # the schema and package, loaded when a message first asks for them
         self.default_message = default_message
         self._classes: dict[str, tuple[str, MessageClass, FloatFields]] = {}
+
+    def _load(self) -> None:
+        if self._schema is None or self._package is None:
+            if self._loader is None:
+                raise ValueError("a Reader needs a schema and package, or a loader of them")
+            self._schema, self._package = self._loader()
+
+    @property
+    def schema(self) -> Schema:
+        self._load()
+        assert self._schema is not None
+        return self._schema
+
+    @property
+    def package(self) -> ModuleType:
+        self._load()
+        assert self._package is not None
+        return self._package
 
     def model(self, name: str, file: str, line: int) -> tuple[str, MessageClass, FloatFields]:
         """A message name's qualified name, generated class and float fields (resolved once per name)."""
@@ -235,7 +245,13 @@ class Reader:
 
 def open_reader(schema_dir: Path | None, default_message: str | None = None) -> Reader:
     """A reader of samples whose messages come from ``schema_dir`` (default: the bundled schemas)."""
-    schema_dir = schema_dir or bundled_schemas()
+    if schema_dir is None:  # the bundled schemas load: only a stream of messages needs them (samples in SI do not)
+
+        def bundled() -> tuple[Schema, ModuleType]:
+            schema = load([bundled_schemas()])
+            return schema, model_package(schema, bundled_schemas())
+
+        return Reader(None, None, default_message, bundled)
     schema = load([schema_dir])
     return Reader(schema, model_package(schema, schema_dir), default_message)
 
@@ -280,7 +296,13 @@ class Replay:
 
     def run(self, path: Path, name: str, samples: Iterable[Sample] | None = None) -> Iterator[tuple[Event, Sample]]:
         """Every transition with the sample that caused it; errors name the stream as ``name``.
-        ``samples`` replaces the JSON Lines reader (a flight log's samples)."""
+        ``samples`` replaces the JSON Lines reader (a flight log's samples). A stream of one plain shape is
+        replayed over its columns (:mod:`.jsonl_columns`, :func:`.columnar.replay_columns`: the same events)."""
+        if samples is None:
+            fast = self._columnar(path)
+            if fast is not None:
+                yield from fast
+                return
         for sample in self.reader.read(path) if samples is None else samples:
             self.samples += 1
             try:
@@ -290,3 +312,19 @@ class Replay:
             except ValueError as exc:
                 raise BattgenError(f"{name}: {sample.place}: {exc}") from None
             yield from ((event, sample) for event in events)
+
+    def _columnar(self, path: Path) -> list[tuple[Event, Sample]] | None:
+        """The events of a plain-shaped stream replayed over its columns; None to read it sample by sample."""
+        columns = read_sample_columns(path)
+        if columns is None:
+            return None
+        file = path.as_posix()
+
+        def sample_at(k: int) -> Sample:
+            return self.reader.sample(json.loads(columns.line(k)), file, k + 1)
+
+        c = columns
+        events = replay_columns(self.failsafe, c.t, c.instance, c.voltage, c.current, c.consumed, c.armed, sample_at)
+        if events is not None:
+            self.samples = len(c.t)
+        return events
