@@ -9,6 +9,7 @@ reads from them. Nothing here is committed to the generated code."""
 from __future__ import annotations
 
 import math
+import struct
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -60,14 +61,19 @@ def drawn(strategy: st.SearchStrategy[Any], n: int) -> list[Any]:
     return out[:n]
 
 
-def _has_nan(v: Any) -> bool:
+def has_nan(v: Any) -> bool:
     if isinstance(v, float):
         return math.isnan(v)
     if isinstance(v, dict):
-        return any(_has_nan(x) for x in v.values())
+        return any(has_nan(x) for x in v.values())
     if isinstance(v, list | tuple):
-        return any(_has_nan(x) for x in v)
+        return any(has_nan(x) for x in v)
     return False
+
+
+def _f32(*xs: float) -> list[float]:
+    """Values as an f32 holds them (the native structs hold a float16 in a float32)."""
+    return [struct.unpack("<f", struct.pack("<f", x))[0] for x in xs]
 
 
 # values beyond a cast's range, set on a drawn value: (type, field, value); float16 values that round
@@ -76,8 +82,8 @@ CASTS: dict[str, list[tuple[str, Any]]] = {
     "cyphal.reg.udral.service.common.Readiness_0_1": [("value", 7), ("value", 6)],
     "cyphal.uavcan.node.Health_1_0": [("value", 9), ("value", 255)],
     "cyphal.reg.udral.service.battery.Status_0_2": [
-        ("cell_voltages", [70000.0, -70000.0, 65519.0, 65520.0, 1e-8, 2.9802322387695312e-08]),
-        ("cell_voltages", [3.1415927410125732, 4.199999809265137, 5.960464477539063e-08, -0.0, 0.0001]),
+        ("cell_voltages", _f32(70000.0, -70000.0, 65519.0, 65520.0, 1e-8, 2.9802322387695312e-08)),
+        ("cell_voltages", _f32(3.1415927410125732, 4.2, 5.960464477539063e-08, -0.0, 0.0001, 4.4e-08)),
         ("cell_voltages", [float("inf"), float("-inf"), 65504.0, 1.0009765625, 1.00048828125, 1.00146484375]),
     ],
 }
@@ -88,7 +94,7 @@ def _read(t: pydsdl.CompositeType, data: bytes, header: bool) -> Read:
         got = pydsdl.deserialize(t, data, with_delimiter_header=header)
     except pydsdl.SerDesError:
         return Read(data, header, None, None)
-    again = None if _has_nan(got) else pydsdl.serialize(t, got)
+    again = None if has_nan(got) else pydsdl.serialize(t, got)
     return Read(data, header, plain(got), again)
 
 

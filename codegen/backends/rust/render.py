@@ -14,6 +14,7 @@ import jinja2
 
 from ...errors import BattgenError
 from ...ir import CompositeType, Message, Schema, SourceFormat
+from .cyphal_codec import cyphal_modules
 from .model import MessageView, message_view, shared_enums
 from .params import render_params
 from .types import element
@@ -22,7 +23,18 @@ _HERE = Path(__file__).parent
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
 # the crate's own version (its API, not battgen's release): raised when the generated API changes
 CRATE_VERSION = "0.1.0"
-SUPPORT = ("crc", "dronecan_wire", "failsafe", "mavlink_wire", "problems", "rules", "same", "uorb_wire", "wire")
+SUPPORT = (
+    "crc",
+    "cyphal_wire",
+    "dronecan_wire",
+    "failsafe",
+    "mavlink_wire",
+    "problems",
+    "rules",
+    "same",
+    "uorb_wire",
+    "wire",
+)
 
 
 def _environment() -> jinja2.Environment:
@@ -125,6 +137,10 @@ def render_crate(schema: Schema) -> dict[str, str]:
             modules=sorted(subs),
             reexports=sorted(exports.get(parts, [])),
         )
+    cyphal = cyphal_modules(schema, env)
+    if cyphal:
+        rs.update(cyphal)
+        children[()].add("cyphal")
     for name in SUPPORT:
         text = (_HERE / "support" / f"{name}.rs").read_text(encoding="utf-8")
         head = f"// Copied by battgen from codegen/backends/rust/support/{name}.rs; do not edit.\n"
