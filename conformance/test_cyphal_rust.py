@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import shutil
 import struct
 import subprocess
@@ -17,15 +18,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from c_cases import dump
-from cyphal_native_cases import TypeCases, all_cases, has_nan
+from cyphal_native_cases import TypeCases, all_cases, definition_cases, dump, has_nan
 from test_cyphal_c import compare
 
-from codegen.apps.package import bundled_schemas, project_root
+from codegen.apps.package import project_root
 from codegen.backends.rust.cyphal_codec import rust_path
 from codegen.backends.rust.naming import field_ident
+from codegen.backends.rust.render import render_crate
 from codegen.backends.rust.types import scalar, scalar_literal
-from codegen.frontends.loader import load
 from codegen.ir import ArrayType, CompositeType, FieldType, Message, PrimitiveKind, PrimitiveType, Schema
 
 CRATE = project_root() / "generated" / "rust"
@@ -100,10 +100,10 @@ def _assigns(schema: Schema, t: FieldType, v: Any, target: str) -> list[str]:
         return [f"{target} = {_literal(t, v)};"]
     if isinstance(t, CompositeType):
         msg = schema.message(t.name)
-        out = []
-        for f in msg.fields:
-            if not f.is_padding:
-                out += _assigns(schema, f.type, v[f.name], f"{target}.{field_ident(f.name)}")
+        fields = [(k, f) for k, f in enumerate(msg.fields) if not f.is_padding and f.name in v]
+        out = [f"{target}.union_tag = {fields[0][0]};"] if msg.is_union else []
+        for _, f in fields:
+            out += _assigns(schema, f.type, v[f.name], f"{target}.{field_ident(f.name)}")
         return out
     assert isinstance(t, ArrayType), t
     out = [line for i, e in enumerate(v) for line in _assigns(schema, t.element, e, f"{target}[{i}]")]
@@ -125,26 +125,32 @@ def _dump_rust(schema: Schema, msg: Message) -> list[str]:
     """The example's ``Dump`` of a type: every field as ``c_cases.dump`` prints it."""
     lines = [f"impl Dump for {rust_path(schema, msg.qualified_name).replace('crate::', 'battgen::')} {{"]
     lines.append("fn dump(&self, o: &mut String) {")
-    for f in msg.fields:
-        if f.is_padding:
-            continue
+    fields = [f for f in msg.fields if not f.is_padding]
+    if msg.is_union:
+        lines += ['o.push_str(&format!("tag={};", self.union_tag));', "match self.union_tag {"]
+    for k, f in enumerate(fields):
+        if msg.is_union:
+            lines.append(f"{k} => {{")
         ident = f"self.{field_ident(f.name)}"
         lines.append(f'o.push_str("{f.name}=");')
         t = f.type
         if isinstance(t, ArrayType):
             used = f"{ident}[..{ident}_len]" if t.dynamic else ident
             lines += ["o.push('[');", f"for (i, e) in {used}.iter().enumerate() {{", "if i > 0 { o.push(','); }"]
-            lines += [*_print(t.element, "(*e)"), "}", "o.push(']');"]
+            lines += [*_print(t.element, "e" if isinstance(t.element, CompositeType) else "*e"), "}", "o.push(']');"]
         else:
             lines += _print(t, ident)
         lines.append("o.push(';');")
-    if not any(not f.is_padding for f in msg.fields):
+        if msg.is_union:
+            lines.append("}")
+    if msg.is_union:
+        lines += ["_ => {}", "}"]
+    if not fields:
         lines.append("let _ = o;")
     return [*lines, "}", "}"]
 
 
-def _program(cases: list[TypeCases]) -> tuple[str, list[str]]:
-    schema = load([bundled_schemas()])
+def _program(schema: Schema, cases: list[TypeCases]) -> tuple[str, list[str]]:
     expected: list[str] = []
     body: list[str] = []
     impls: list[str] = []
@@ -177,15 +183,18 @@ def _program(cases: list[TypeCases]) -> tuple[str, list[str]]:
     return "\n".join(program), expected
 
 
-def test_rust_cyphal_codecs_are_pydsdls(tmp_path: Path) -> None:
+def _cargo_run(tmp_path: Path, files: dict[str, str] | None, text: str) -> list[str]:
+    """The program run as an example of the crate (generated/rust, or ``files`` rendered for other types)."""
     if shutil.which("cargo") is None:
         if os.environ.get("CI"):
             pytest.fail("cargo not installed (CI installs it)")
         pytest.skip("cargo not installed")
-    cases = all_cases()
-    text, expected = _program(cases)
     crate = tmp_path / "crate"
-    shutil.copytree(CRATE, crate, ignore=shutil.ignore_patterns("target", "Cargo.lock"))
+    if files is None:
+        shutil.copytree(CRATE, crate, ignore=shutil.ignore_patterns("target", "Cargo.lock"))
+    for rel, body in (files or {}).items():
+        (crate / rel).parent.mkdir(parents=True, exist_ok=True)
+        (crate / rel).write_text(body, encoding="utf-8")
     (crate / "examples").mkdir()
     (crate / "examples" / "cyphal.rs").write_text(text, encoding="utf-8")
     env = {**os.environ, "CARGO_TARGET_DIR": str(tmp_path / "target"), "CARGO_NET_OFFLINE": "true"}
@@ -199,7 +208,24 @@ def test_rust_cyphal_codecs_are_pydsdls(tmp_path: Path) -> None:
         check=False,
     )
     assert done.returncode == 0, done.stderr[-3000:]
-    got = done.stdout.splitlines()
+    return done.stdout.splitlines()
+
+
+def test_rust_cyphal_codecs_are_pydsdls(tmp_path: Path) -> None:
+    schema, cases = all_cases()
+    text, expected = _program(schema, cases)
+    got = _cargo_run(tmp_path, None, text)
     compare(expected, got, cases)
+    assert len(cases) == 19
     assert {line.split(" ")[0] for line in got} == {"enc", "hdr", "dec"}
     assert sum(1 for line in got if line.endswith(" error")) >= 19
+
+
+def test_rust_cyphal_unions_and_nested_delimited_types_are_pydsdls(tmp_path: Path) -> None:
+    """What the bundled types lack (cyphal_native_cases.DEFINITIONS): a union's tag and held field, a
+    delimited type nested alone and in an array behind its delimiter header; the crate rendered for them."""
+    schema, cases = definition_cases(tmp_path / "dsdl")
+    text, expected = _program(schema, cases)
+    got = _cargo_run(tmp_path, render_crate(schema), text)
+    compare(expected, got, cases)
+    assert any(re.search(r"pick=\{tag=2;inner=\{a=\d+;b=\[[0-9a-f,]+\];\};\}", line) for line in got)

@@ -134,7 +134,8 @@ impl<'a> BitReader<'a> {
         if size > left {
             return Err(DecodeError::Delimiter { size, left });
         }
-        let start = self.bit / 8;
+        // past the end of the data (zero extension), an empty object's bytes are the empty slice
+        let start = (self.bit / 8).min(self.data.len());
         self.bit += size * 8;
         Ok(BitReader::new(&self.data[start..start + size]))
     }
