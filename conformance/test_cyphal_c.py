@@ -205,10 +205,15 @@ def _needs(*tools: str) -> None:
         pytest.skip(f"{', '.join(absent)} not installed")
 
 
+# AddressSanitizer and UBSan: a read or write out of bounds, or undefined arithmetic, ends the program
+SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]
+
+
 def test_c_cyphal_codecs_are_pydsdls(program: tuple[Path, list[str], list[TypeCases]]) -> None:
+    """Natively, under the sanitizers (the bytes read include short, extended, bad-header and random ones)."""
     _needs("gcc")
     folder, expected, cases = program
-    got = _run(folder, ["gcc"], [], "native")
+    got = _run(folder, ["gcc", *SANITIZE], [], "native")
     compare(expected, got, cases)
     assert len(cases) == 19
     # the comparison sees a difference: each kind of line is there, and refusals among the reads
@@ -248,6 +253,6 @@ def test_c_cyphal_unions_and_nested_delimited_types_are_pydsdls(tmp_path: Path) 
         (library / rel).write_text(text, encoding="utf-8")
     text, expected = _program(schema, cases)
     (tmp_path / "main.c").write_text(text, encoding="utf-8")
-    got = _run(tmp_path, ["gcc"], [], "definitions", library)
+    got = _run(tmp_path, ["gcc", *SANITIZE], [], "definitions", library)
     compare(expected, got, cases)
     assert any(re.search(r"pick=\{tag=2;inner=\{a=\d+;b=\[[0-9a-f,]+\];\};\}", line) for line in got)
