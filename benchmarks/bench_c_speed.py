@@ -1,5 +1,6 @@
 """The generated C library's speed against mavgen's C (pymavlink's generator, run here on the same XML):
-BATTERY_STATUS frame encode and decode, and DroneCAN BatteryInfo decode against a memcpy of its payload.
+BATTERY_STATUS frame encode and decode, and DroneCAN BatteryInfo decode and Cyphal (UDRAL) battery Status.0.2
+encode and decode against a memcpy of their payloads.
 
 Run: python benchmarks/bench_c_speed.py [--number N]
 Both sides are built with gcc -O2 into a temp dir and timed in one process, best of five runs of N calls;
@@ -28,6 +29,7 @@ PROGRAM = r"""
 
 typedef battgen_mavlink_BATTERY_STATUS ours_t;
 typedef battgen_dronecan_uavcan_equipment_power_BatteryInfo info_t;
+typedef battgen_cyphal_reg_udral_service_battery_Status_0_2 udral_t;
 static volatile unsigned sink;
 
 static double now(void) {
@@ -62,6 +64,14 @@ int main(void) {
   info_t info;
   uint8_t payload[BATTGEN_DRONECAN_UAVCAN_EQUIPMENT_POWER_BATTERYINFO_MAX_BYTES], copy[64];
   size_t pn = 0;
+  udral_t udral;
+  uint8_t cy[BATTGEN_CYPHAL_REG_UDRAL_SERVICE_BATTERY_STATUS_0_2_BUFFER_BYTES], cycopy[600];
+  size_t cn = 0;
+  memset(&udral, 0, sizeof udral);
+  udral.cell_voltages_len = 12;
+  for (k = 0; k < 12; k++) { udral.cell_voltages[k] = 3.7f + 0.01f * (float)k; }
+  udral.temperature_min_max[0].kelvin = 298.15f;
+  udral.available_charge.coulomb = 5000.0f;
   memset(&ours, 0, sizeof ours);
   memset(&theirs, 0, sizeof theirs);
   memset(&info, 0, sizeof info);
@@ -84,6 +94,11 @@ int main(void) {
   BEST("dronecan_info_decode", battgen_dronecan_uavcan_equipment_power_BatteryInfo_decode(payload, pn, true, &info);
        sink += info.state_of_charge_pct);
   BEST("dronecan_info_memcpy", memcpy(copy, payload, pn); sink += copy[pn - 1]; payload[0] ^= (uint8_t)sink);
+  BEST("cyphal_status_encode", battgen_cyphal_reg_udral_service_battery_Status_0_2_encode(&udral, false, cy, &cn);
+       sink += cy[cn - 1]; udral.error.value = (uint8_t)sink);
+  BEST("cyphal_status_decode", battgen_cyphal_reg_udral_service_battery_Status_0_2_decode(cy, cn, false, &udral);
+       sink += udral.error.value);
+  BEST("cyphal_status_memcpy", memcpy(cycopy, cy, cn); sink += cycopy[cn - 1]; cy[0] ^= (uint8_t)sink);
   return 0;
 }
 """
@@ -99,7 +114,7 @@ def run(number: int) -> dict[str, float]:
         if not mavgen.mavgen(opts, [str(ROOT / "schemas" / "mavlink" / "battery.xml")]):
             raise RuntimeError("mavgen failed")
         (out / "bench.c").write_text(PROGRAM.replace("NUMBER", str(number)), encoding="utf-8")
-        sources = [str(GENERATED / "mavlink.c"), str(GENERATED / "dronecan.c")]
+        sources = [str(GENERATED / "mavlink.c"), str(GENERATED / "dronecan.c"), str(GENERATED / "cyphal.c")]
         cc = ["gcc", "-O2", "-std=c99", "-w", "-I", str(out / "mavgen"), "-I", str(GENERATED)]
         subprocess.run([*cc, str(out / "bench.c"), *sources, "-o", str(out / "bench")], check=True, timeout=300)
         done = subprocess.run([str(out / "bench")], capture_output=True, text=True, check=True, timeout=600)
@@ -122,6 +137,10 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     print(
         f"DroneCAN BatteryInfo decode: {decode:.1f} ns, {decode / floor:.1f}x a memcpy of the payload ({floor:.1f} ns)"
     )
+    floor = ns["cyphal_status_memcpy"]
+    for what in ("encode", "decode"):
+        took = ns[f"cyphal_status_{what}"]
+        print(f"Cyphal Status.0.2 (12 cells) {what}: {took:.1f} ns, {took / floor:.1f}x a memcpy ({floor:.1f} ns)")
     return ns
 
 

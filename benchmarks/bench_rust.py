@@ -1,7 +1,8 @@
 """The Rust crate's speed next to the C library and the Python package, in one run: a MAVLink 2 BATTERY_STATUS
 frame decode (Rust `decode_frame`, C `battgen_mavlink_BATTERY_STATUS_decode_frame` as bench_c_speed.py builds
 it, Python `BatteryStatus.decode_frame`) and one step of the battery failsafe on an armed sample (Rust
-`Failsafe::update`, Python `BatteryFailsafe.update`; the C library has no failsafe).
+`Failsafe::update`, Python `BatteryFailsafe.update`; the C library has no failsafe), and a Cyphal (UDRAL) battery
+Status.0.2 decode with 12 cells (Rust, C, the Python package, and pydsdl's own `deserialize`).
 
 Run: python benchmarks/bench_rust.py [--number N]
 The Rust side is built with cargo --release --offline into a temp dir; each figure is the best of five runs of N
@@ -24,6 +25,8 @@ ROOT = Path(__file__).resolve().parent.parent
 CRATE = ROOT / "generated" / "rust"
 
 MAIN = r"""
+use battgen::cyphal::reg::udral::service::battery::Status0_2;
+use battgen::cyphal_wire::Message as _;
 use battgen::failsafe::{Failsafe, Reading, Sample, Settings, Variants, Vehicle};
 use battgen::mavlink::BatteryStatus;
 use battgen::mavlink_wire::{decode_frame, encode_frame, Header, MAX_FRAME_LENGTH};
@@ -78,6 +81,20 @@ fn main() {
         let event = fs.update(t, 1, &black_box(Sample::armed(reading))).expect("a sample");
         sink += u64::from(event.is_some());
     });
+    let mut status = Status0_2::new();
+    status.cell_voltages_len = 12;
+    for (k, v) in status.cell_voltages.iter_mut().take(12).enumerate() {
+        *v = 3.7 + 0.01 * k as f32;
+    }
+    status.temperature_min_max[0].kelvin = 298.15;
+    status.available_charge.coulomb = 5000.0;
+    let mut cy = [0u8; 600];
+    let cn = status.encode(&mut cy, false).expect("an encoding");
+    let cyphal = best(n, |_| {
+        let m = Status0_2::decode(black_box(&cy[..cn]), false).expect("a status");
+        sink += u64::from(m.error.value);
+    });
+    println!("cyphal_status_decode_rust {cyphal:.2}");
     println!("decode_rust {decode:.2}");
     println!("failsafe_step_rust {step:.2}");
     println!("sink {sink}");
@@ -132,7 +149,38 @@ def python(number: int) -> dict[str, float]:
         fs.update(clock[0], samples[int(clock[0] * 10) % 35], armed=True)
 
     step_s = min(timeit.repeat(step, number=number, repeat=5)) / number
-    return {"decode_python": decode * 1e9, "failsafe_step_python": step_s * 1e9}
+    cyphal_python, cyphal_pydsdl = _cyphal_python(number)
+    return {
+        "decode_python": decode * 1e9,
+        "failsafe_step_python": step_s * 1e9,
+        "cyphal_status_decode_python": cyphal_python * 1e9,
+        "cyphal_status_decode_pydsdl": cyphal_pydsdl * 1e9,
+    }
+
+
+def _cyphal_python(number: int) -> tuple[float, float]:
+    """Seconds per Status.0.2 decode (12 cells): the Python package's, and pydsdl's ``deserialize``."""
+    import pydsdl
+
+    from generated.cyphal.reg.udral.service.battery import Status_0_2
+
+    status = Status_0_2.from_dict(
+        {
+            "heartbeat": {"readiness": {"value": 0}, "health": {"value": 0}},
+            "temperature_min_max": [{"kelvin": 298.15}, {"kelvin": 0.0}],
+            "available_charge": {"coulomb": 5000.0},
+            "error": {"value": 0},
+            "cell_voltages": [3.7 + 0.01 * k for k in range(12)],
+        }
+    )
+    data = status.encode()
+    root = ROOT / "schemas" / "cyphal"
+    spaces = sorted(p for p in root.iterdir() if p.is_dir())
+    types = [t for s in spaces for t in pydsdl.read_namespace(s, [o for o in spaces if o != s])]
+    t = next(t for t in types if t.full_name == "reg.udral.service.battery.Status" and t.version == (0, 2))
+    ours = min(timeit.repeat(lambda: Status_0_2.decode(data), number=number, repeat=5)) / number
+    theirs = min(timeit.repeat(lambda: pydsdl.deserialize(t, data), number=number, repeat=5)) / number
+    return ours, theirs
 
 
 def main(argv: list[str] | None = None) -> dict[str, float]:
@@ -149,6 +197,11 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     r, py = ns["failsafe_step_rust"], ns["failsafe_step_python"]
     print("battery failsafe, one armed sample, ns per call (the C library has no failsafe):")
     print(f"  Rust {r:8.1f}  Python {py:9.1f}   Rust/Python {r / py:7.4f}")
+    r, cc = ns["cyphal_status_decode_rust"], ns["cyphal_status_decode"]
+    py, ref = ns["cyphal_status_decode_python"], ns["cyphal_status_decode_pydsdl"]
+    print("Cyphal battery Status.0.2 decode (12 cells), ns per call:")
+    print(f"  Rust {r:8.1f}  C {cc:8.1f}  Python {py:9.1f}  pydsdl {ref:9.1f}")
+    print(f"  Rust/C {r / cc:5.2f}  Python/pydsdl {py / ref:5.2f}")
     return ns
 
 

@@ -93,7 +93,9 @@ typedef enum {
   BATTGEN_ERR_WRONG_MESSAGE = 7,   /* the frame holds another message */
   BATTGEN_ERR_BAD_CRC = 8,         /* the checksum does not match */
   BATTGEN_ERR_TRAILING = 9,        /* whole bytes follow a DroneCAN message */
-  BATTGEN_ERR_TAG = 10             /* a DroneCAN union's tag names no field */
+  BATTGEN_ERR_TAG = 10,            /* a DroneCAN or Cyphal union's tag names no field */
+  BATTGEN_ERR_DELIMITER = 11,      /* a Cyphal delimiter header gives more bytes than follow */
+  BATTGEN_ERR_SEALED = 12          /* a delimiter header asked of a sealed Cyphal type */
 } battgen_error;
 
 /* DroneCAN bits: a writer into a zeroed buffer and a reader (what a message's put / get take). */

@@ -16,6 +16,7 @@ from .checks import CheckUse, check_uses, checks_of, validator
 from .codecs import mavlink_codec, uorb_codec
 from .convert_concepts import state_lines
 from .converters import c_converters
+from .cyphal_codec import cyphal_codec
 from .dronecan_codec import BitCodec, dronecan_codec
 from .rules import rule_lines
 from .types import ident, member, type_name
@@ -26,6 +27,7 @@ STYLE = "{BasedOnStyle: LLVM, ColumnLimit: 100, SortIncludes: false}"
 _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
 # support headers copied verbatim (through clang-format, as every other file)
 _SUPPORT = ("battgen_wire.h", "battgen_mavlink.h", "battgen_convert.h")
+_CYPHAL_SUPPORT = "battgen_cyphal.h"
 
 
 def _comment(text: str) -> str:
@@ -74,20 +76,7 @@ def _union_checks(msg: Message, uses: list[CheckUse]) -> list[str]:
 
 
 def _message_context(schema: Schema, msg: Message) -> dict[str, object]:
-    members = []
-    for f in msg.fields:
-        if f.is_padding:
-            continue
-        notes = []
-        if f.unit_text:
-            notes.append(f"[{f.unit_text}]")
-        if f.invalid is not None:
-            notes.append(f"invalid: {f.invalid.text}")
-        if isinstance(f.type, PrimitiveType) and f.type.kind is not PrimitiveKind.BOOL:
-            notes.append(f.type.name)
-        if f.doc:
-            notes.append(f.doc)
-        members.append({"decls": member(f.type, ident(f.name)), "note": _comment(" ".join(notes))})
+    members = _members(msg)
     name = type_name(msg.qualified_name)
     if msg.dronecan is not None and msg.dronecan.union:
         held = "the field held, by its place (BATTGEN_..._TAG_<FIELD>); the others are not sent"
@@ -151,6 +140,87 @@ def _source_view(context: dict[str, object]) -> dict[str, object]:
     }
 
 
+def _members(msg: Message) -> list[dict[str, object]]:
+    """The struct members of a message (padding left out), each with its comment."""
+    members: list[dict[str, object]] = []
+    for f in msg.fields:
+        if f.is_padding:
+            continue
+        notes = []
+        if f.unit_text:
+            notes.append(f"[{f.unit_text}]")
+        if f.invalid is not None:
+            notes.append(f"invalid: {f.invalid.text}")
+        if isinstance(f.type, PrimitiveType) and f.type.kind is not PrimitiveKind.BOOL:
+            notes.append(f.type.name)
+        if f.doc:
+            notes.append(f.doc)
+        members.append({"decls": member(f.type, ident(f.name)), "note": _comment(" ".join(notes))})
+    return members
+
+
+def _cyphal_context(schema: Schema, msg: Message) -> dict[str, object]:
+    """What the Cyphal header and source render of one type: its struct, constants and codec (the
+    variables each function declares found in its statements)."""
+    codec = cyphal_codec(schema, msg)
+    assert codec is not None, msg.qualified_name
+    name = type_name(msg.qualified_name)
+    members = _members(msg)
+    constants = [
+        {"name": f"{name.upper()}_{ident(c.name).upper()}", "value": lit, "doc": _comment(c.doc)}
+        for c in msg.constants
+        if (lit := _literal(c)) is not None
+    ]
+    if msg.is_union:
+        held = "the field held, by its place (BATTGEN_..._TAG_<FIELD>); the others are not sent"
+        members.insert(0, {"decls": ["uint8_t union_tag;"], "note": held})
+        constants += [
+            {"name": f"{name.upper()}_TAG_{ident(f.name).upper()}", "value": f"{k}u", "doc": ""}
+            for k, f in enumerate(msg.fields)
+        ]
+
+    def uses(lines: list[str]) -> dict[str, bool]:
+        text = "\n".join(lines)
+        return {
+            "e": any(line.startswith("e = ") for line in lines),
+            "i": "[i]" in text or "(i = 0;" in text,
+            "h": any(line.startswith("h = ") for line in lines),
+            "u": any(line.startswith("u = ") for line in lines),
+            "sub": "&sub" in text,
+            "m": "m->" in text,
+        }
+
+    return {
+        "name": name,
+        "qualified": msg.qualified_name,
+        "guard": name.upper() + "_H",
+        "doc": _comment(msg.doc),
+        "members": members,
+        "constants": constants,
+        "includes": [header_path(d) for d in _dependencies(msg)],
+        "codec": codec,
+        "put_uses": uses(codec.put),
+        "get_uses": uses(codec.get),
+    }
+
+
+def _cyphal_files(schema: Schema, env: jinja2.Environment) -> dict[str, str]:
+    """The Cyphal types' headers, ``cyphal.c`` and ``battgen_cyphal.h`` (nothing without Cyphal types)."""
+    contexts = [_cyphal_context(schema, m) for m in schema.messages if m.format is SourceFormat.CYPHAL]
+    if not contexts:
+        return {}
+    header = env.get_template("cyphal.h.j2")
+    files = {}
+    for c in contexts:
+        rel = header_path(str(c["qualified"]))
+        files[rel] = clang_format(header.render(m=c), rel)
+    source = env.get_template("cyphal.c.j2").render(headers=sorted(files), messages=contexts)
+    files["cyphal.c"] = clang_format(source, "cyphal.c")
+    text = (_HERE / "support" / _CYPHAL_SUPPORT).read_text(encoding="utf-8")
+    files[_CYPHAL_SUPPORT] = clang_format(text, _CYPHAL_SUPPORT)
+    return files
+
+
 def _environment() -> jinja2.Environment:
     return jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(_HERE / "templates")),
@@ -193,7 +263,9 @@ def render_library(schema: Schema) -> dict[str, str]:
         context = _message_context(schema, msg)
         contexts.setdefault(msg.format, []).append(context)
         files[rel] = clang_format(header.render(m=context), rel)
-    headers = sorted(files)
+    cyphal = _cyphal_files(schema, env)
+    headers = sorted([*files, *(rel for rel in cyphal if rel.endswith(".h") and "/" in rel)])
+    files.update(cyphal)
     for fmt, messages in sorted(contexts.items(), key=lambda item: item[0].value):
         rel = f"{fmt.value}.c"
         own = sorted(header_path(str(m["qualified"])) for m in messages)

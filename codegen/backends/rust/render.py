@@ -14,6 +14,7 @@ import jinja2
 
 from ...errors import BattgenError
 from ...ir import CompositeType, Message, Schema, SourceFormat
+from .cyphal_codec import cyphal_modules
 from .model import MessageView, message_view, shared_enums
 from .params import render_params
 from .types import element
@@ -23,6 +24,8 @@ _FORMATS = (SourceFormat.DRONECAN, SourceFormat.MAVLINK, SourceFormat.UORB)
 # the crate's own version (its API, not battgen's release): raised when the generated API changes
 CRATE_VERSION = "0.1.0"
 SUPPORT = ("crc", "dronecan_wire", "failsafe", "mavlink_wire", "problems", "rules", "same", "uorb_wire", "wire")
+# the Cyphal codecs' bits (cyphal_codec), beside the rest (rustfmt sorts the `mod` lines)
+CRATE_SUPPORT = (*SUPPORT, "cyphal_wire")
 
 
 def _environment() -> jinja2.Environment:
@@ -125,7 +128,11 @@ def render_crate(schema: Schema) -> dict[str, str]:
             modules=sorted(subs),
             reexports=sorted(exports.get(parts, [])),
         )
-    for name in SUPPORT:
+    cyphal = cyphal_modules(schema, env)
+    if cyphal:
+        rs.update(cyphal)
+        children[()].add("cyphal")
+    for name in CRATE_SUPPORT:
         text = (_HERE / "support" / f"{name}.rs").read_text(encoding="utf-8")
         head = f"// Copied by battgen from codegen/backends/rust/support/{name}.rs; do not edit.\n"
         rs[f"src/{name}.rs"] = head + text
@@ -137,7 +144,7 @@ def render_crate(schema: Schema) -> dict[str, str]:
         rs["src/params.rs"] = params
         children[()].add("params")
     rs["src/lib.rs"] = env.get_template("lib.rs.j2").render(
-        support=SUPPORT, modules=sorted(children[()]), example=example
+        support=CRATE_SUPPORT, modules=sorted(children[()]), example=example
     )
     config = env.get_template("rustfmt.toml.j2").render()
     files = rustfmt(rs, config)
