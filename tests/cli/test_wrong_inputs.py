@@ -17,6 +17,8 @@ import pytest
 from inputs.dataflash_writer import battery_log
 
 from codegen.cli.main import main
+from generated._ulog_writer import write as ulog_write
+from generated.uorb import BatteryInfo as UorbBatteryInfo
 
 MISSING = "cannot read file: no such file or directory"
 LONGEST_LINE = 300  # characters: an error is a sentence, not the list of every known name
@@ -26,6 +28,13 @@ def _flight_bin(folder: Path) -> None:
     """An ArduPilot DataFlash log with PARM, ARM and BAT records: a flight log, not a file of records."""
     rows = [(t / 10, 0, 12.0 - t / 100, 5.0, t * 1.5) for t in range(20)]
     battery_log(folder / "flight.bin", {"BATT_MONITOR": 4, "BATT_CAPACITY": 3300}, rows, [(0.5, True)])
+
+
+def _log_without_batteries(folder: Path) -> None:
+    """A readable DataFlash log with its PARM and ARM records but no BAT record, and a PX4 ULog without
+    battery_status: a log the failsafe and the report have nothing to replay or draw from."""
+    battery_log(folder / "nobat.bin", {"BATT_MONITOR": 4, "BATT_CAPACITY": 3300}, [], [(0.5, True)])
+    ulog_write(folder / "nobat.ulg", [], info={"sys_name": "PX4"}, messages=[UorbBatteryInfo])
 
 
 def _capture(folder: Path, name: str, lines: list[str]) -> None:
@@ -83,6 +92,19 @@ CASES = [
         "no message called 'BatteryStatu' in the schemas; did you mean 'BatteryStatus'",
         {"x.jsonl": "{}\n"},
     ),
+    Case(
+        "convert-misspelt-to",
+        ("convert", "--from", "dronecan", "--to", "uorbb", "x.jsonl"),
+        2,
+        "--to 'uorbb': expected a format or message, found no such name; did you mean 'uorb' or 'uorb_v0'?",
+        {"x.jsonl": "{}\n"},
+    ),
+    Case(
+        "convert-missing-dts",
+        ("convert", "--from", "dronecan", "--to", "uorb", "nope.dts"),
+        2,
+        f"nope.dts: {MISSING}",
+    ),
     # what a file is
     Case(
         "convert-dataflash-as-records",
@@ -134,6 +156,14 @@ CASES = [
         make=lambda d: _capture(d, "ef.log", ["1004E37F#00000000000000C0", "20000080#0000000000000000", "1004E37F#R"]),
         needs="can",
     ),
+    Case(
+        "can-remote-frames",
+        ("can", "rf.log"),
+        0,
+        "1 x can-remote-frame",
+        make=lambda d: _capture(d, "rf.log", ["1004E37F#00000000000000C0", "1004E37F#R"]),
+        needs="can",
+    ),
     # a readable input without what the command needs: 1, and 0 with --allow-empty
     Case(
         "export-empty",
@@ -164,6 +194,42 @@ CASES = [
         0,
         "empty.jsonl: no battery readings",
         {"v.param": BATTERY_PARAMS, "empty.jsonl": ""},
+    ),
+    Case(
+        "failsafe-log-without-batteries",
+        ("failsafe", "nobat.bin"),
+        1,
+        "nobat.bin: expected battery readings, found none (--allow-empty accepts that)",
+        make=_log_without_batteries,
+    ),
+    Case(
+        "failsafe-log-without-batteries-allowed",
+        ("failsafe", "--allow-empty", "nobat.bin"),
+        0,
+        "nobat.bin: no battery readings",
+        make=_log_without_batteries,
+    ),
+    Case(
+        "failsafe-ulog-without-batteries",
+        ("failsafe", "nobat.ulg"),
+        1,
+        "nobat.ulg: expected battery readings, found none (--allow-empty accepts that)",
+        make=_log_without_batteries,
+    ),
+    Case(
+        "failsafe-ulog-without-batteries-allowed",
+        ("failsafe", "--allow-empty", "nobat.ulg"),
+        0,
+        "nobat.ulg: no battery readings",
+        make=_log_without_batteries,
+    ),
+    Case(
+        "report-log-without-batteries",
+        ("report", "nobat.bin"),
+        1,
+        "nobat.bin: expected battery records, found none (--allow-empty accepts that)",
+        make=_log_without_batteries,
+        needs="plotly",
     ),
     Case(
         "report-empty",
