@@ -128,6 +128,15 @@ CASES = [
         "cannot read",
         {"j1939.log": "(1.0) vcan0 0CF00400#0041FF20\n2 (1.1) vcan0 18F00400#00\n"},
     ),
+    Case(
+        "csv-capture-bad-row",
+        ("can", "--input-format", "can", "bus.csv"),
+        2,
+        "bus.csv:2: expected a python-can CSV row (timestamp,arbitration_id,extended,remote,error,dlc,data), found a "
+        "line it cannot read",
+        {"bus.csv": "a,b\n1,2\n"},
+        needs="can",
+    ),
     # options the help documents are accepted
     Case(
         "can-input-format",
