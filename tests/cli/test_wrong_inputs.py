@@ -105,6 +105,12 @@ CASES = [
         2,
         f"nope.dts: {MISSING}",
     ),
+    Case(
+        "schema-unknown-message",  # no close name: how many there are (the names were once read twice from one pass)
+        ("schema", "--message", "nope"),
+        2,
+        "no message called 'nope' in the schemas; ",
+    ),
     # what a file is
     Case(
         "convert-dataflash-as-records",
@@ -303,3 +309,4 @@ def test_wrong_input_is_one_line_and_the_documented_exit_code(
     assert len(saying) == 1, lines  # said once, on one line
     assert "Traceback" not in err and all(len(x) <= LONGEST_LINE for x in err.splitlines()), err
     assert ":0:" not in err  # no fake line 0
+    assert not any(x.rstrip().endswith(":") for x in lines)  # no sentence cut before what it announces
