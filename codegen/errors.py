@@ -54,10 +54,10 @@ def close_names(name: str, known: Iterable[str]) -> list[str]:
 def did_you_mean(name: str, known: Iterable[str], *, what: str = "names") -> str:
     """The end of an unknown-name error: the few known names closest to ``name`` (:func:`close_names`), else how
     many names there are, never the whole list (a package knows thousands of messages)."""
-    close = close_names(name, known)
+    names = sorted(set(known))  # once: ``known`` may be a generator, and both steps read it
+    close = close_names(name, names)
     if close:
         return f"did you mean {' or '.join(map(repr, close))}?"
-    names = sorted(set(known))
     return f"known {what}: {', '.join(names)}" if len(names) <= 16 else f"{len(names)} {what} known"
 
 

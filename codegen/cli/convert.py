@@ -33,7 +33,7 @@ import yaml
 
 from ..apps.convert import FORMATS, LOG_FORMATS, Conversion, Converted, input_format, output_format
 from ..apps.senders import SENDERS
-from ..errors import BattgenError
+from ..errors import BattgenError, missing_file
 from ..inputs.model import MessageClass
 from ..inputs.records import Notice
 from ..text.escape import line
@@ -96,6 +96,9 @@ def _inputs(settings: list[str]) -> dict[str, float]:
 
 
 def run(args: argparse.Namespace) -> int:
+    for given in args.files:  # a missing file said first, before what its name would make of it (a .dts's side)
+        if given != "-" and not Path(given).exists():
+            raise missing_file(given)
     conversion = Conversion(args.package, args.source, args.target, args.policy, args.cyphal_subject, args.sender)
     first = conversion.source.items[0][1]
     if isinstance(first, MessageClass):

@@ -60,7 +60,7 @@ from ..apps.failsafe.firmware import FIRMWARES, choose_firmware
 from ..apps.failsafe.legacy_parameters import renamed, with_current_names
 from ..apps.failsafe.levels import apply_level
 from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_samples, own_parameters
-from ..apps.failsafe.px4_log import read_px4_log
+from ..apps.failsafe.px4_log import NoBatteryRecords, read_px4_log
 from ..apps.failsafe.px4_replay import Px4Event, replay_px4
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
@@ -125,6 +125,8 @@ def run(args: argparse.Namespace) -> int:
         table: SampleTable | None = None
         if detect(stream) in FLIGHT_LOG_KINDS:
             table = log_samples(stream, args.stream, args.cyphal_subject)
+        if table is not None and table.empty:  # said before the parameters a log without batteries may also lack
+            return _no_readings(args)
         own = own_parameters(table) if table is not None and not args.params else None
         raw: Mapping[str, float] = {}
         if args.params:
@@ -185,14 +187,7 @@ def run(args: argparse.Namespace) -> int:
             print(_json(event, sample, vehicle.name) if args.json else line(_line(event, sample)))
         read = replay.samples if table is None else read
         if read == 0:  # a readable input without battery readings: exit 1 like every command (README)
-            if args.allow_empty:
-                print(line(f"{args.stream}: no battery readings"), file=sys.stderr)
-                return EXIT_OK
-            print(
-                line(f"{args.stream}: expected battery readings, found none (--allow-empty accepts that)"),
-                file=sys.stderr,
-            )
-            return EXIT_EMPTY
+            return _no_readings(args)
         checks = check_log(stream, args.stream, table, fs.events) if table is not None else []
         for check in checks:
             print(line(f"battgen: check {check.what}: {check.verdict()}"), file=sys.stderr)
@@ -212,11 +207,13 @@ def _run_px4(args: argparse.Namespace, stream: Path, how: str, given: dict[str, 
             )
         log = read_px4_log(stream, args.stream)
         replay = replay_px4(log, given)
-        if replay.samples == 0:
-            raise BattgenError(f"{args.stream}: expected battery_status records, found none")
+    except NoBatteryRecords:
+        return _no_readings(args)
     except (BattgenError, ValueError) as exc:
         print(line(f"battgen: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
+    if replay.samples == 0:  # a readable ULog without battery_status: exit 1, as for ArduPilot's replay
+        return _no_readings(args)
     where = f"{args.params} over the log's PARAM definitions" if args.params else f"{args.stream} (PARAM definitions)"
     thr, st = replay.thresholds, replay.settings
     print(line(f"battgen: firmware px4 ({how}; {log.context.firmware or 'release unknown'}); parameters from {where}: "
@@ -234,6 +231,15 @@ def _run_px4(args: argparse.Namespace, stream: Path, how: str, given: dict[str, 
     print(line(f"{replay.samples} samples, {len(replay.events)} events, final level {level.name if level else 'NONE'}"),
           file=sys.stderr)  # fmt: skip
     return EXIT_DIFFERS if args.strict and any(c.problems for c in replay.checks) else EXIT_OK
+
+
+def _no_readings(args: argparse.Namespace) -> int:
+    """A readable input without battery readings: exit 1, or 0 with ``--allow-empty``."""
+    if args.allow_empty:
+        print(line(f"{args.stream}: no battery readings"), file=sys.stderr)
+        return EXIT_OK
+    print(line(f"{args.stream}: expected battery readings, found none (--allow-empty accepts that)"), file=sys.stderr)
+    return EXIT_EMPTY
 
 
 def _px4_line(e: Px4Event) -> str:

@@ -69,7 +69,8 @@ def test_firmware_override_and_refusals(tmp_path: Path, capsys: pytest.CaptureFi
     empty = tmp_path / "nothing.ulg"
     write_px4_flight(empty, [])
     code, _, err = run(capsys, str(empty))
-    assert code == 2 and "expected battery_status records, found none" in err
+    assert code == 1 and "expected battery readings, found none (--allow-empty accepts that)" in err  # readable
+    assert run(capsys, "--allow-empty", str(empty))[0] == 0
 
 
 def test_firmware_choice_order(tmp_path: Path) -> None:

@@ -17,6 +17,8 @@ import pytest
 from inputs.dataflash_writer import battery_log
 
 from codegen.cli.main import main
+from generated._ulog_writer import write as ulog_write
+from generated.uorb import BatteryInfo as UorbBatteryInfo
 
 MISSING = "cannot read file: no such file or directory"
 LONGEST_LINE = 300  # characters: an error is a sentence, not the list of every known name
@@ -26,6 +28,13 @@ def _flight_bin(folder: Path) -> None:
     """An ArduPilot DataFlash log with PARM, ARM and BAT records: a flight log, not a file of records."""
     rows = [(t / 10, 0, 12.0 - t / 100, 5.0, t * 1.5) for t in range(20)]
     battery_log(folder / "flight.bin", {"BATT_MONITOR": 4, "BATT_CAPACITY": 3300}, rows, [(0.5, True)])
+
+
+def _log_without_batteries(folder: Path) -> None:
+    """A readable DataFlash log with its PARM and ARM records but no BAT record, and a PX4 ULog without
+    battery_status: a log the failsafe and the report have nothing to replay or draw from."""
+    battery_log(folder / "nobat.bin", {"BATT_MONITOR": 4, "BATT_CAPACITY": 3300}, [], [(0.5, True)])
+    ulog_write(folder / "nobat.ulg", [], info={"sys_name": "PX4"}, messages=[UorbBatteryInfo])
 
 
 def _capture(folder: Path, name: str, lines: list[str]) -> None:
@@ -83,6 +92,25 @@ CASES = [
         "no message called 'BatteryStatu' in the schemas; did you mean 'BatteryStatus'",
         {"x.jsonl": "{}\n"},
     ),
+    Case(
+        "convert-misspelt-to",
+        ("convert", "--from", "dronecan", "--to", "uorbb", "x.jsonl"),
+        2,
+        "--to 'uorbb': expected a format or message, found no such name; did you mean 'uorb' or 'uorb_v0'?",
+        {"x.jsonl": "{}\n"},
+    ),
+    Case(
+        "convert-missing-dts",
+        ("convert", "--from", "dronecan", "--to", "uorb", "nope.dts"),
+        2,
+        f"nope.dts: {MISSING}",
+    ),
+    Case(
+        "schema-unknown-message",  # no close name: how many there are (the names were once read twice from one pass)
+        ("schema", "--message", "nope"),
+        2,
+        "no message called 'nope' in the schemas; ",
+    ),
     # what a file is
     Case(
         "convert-dataflash-as-records",
@@ -105,6 +133,15 @@ CASES = [
         "j1939.log:2: expected a candump -l line such as '(1612543138.000000) can0 123#DEADBEEF', found a line it "
         "cannot read",
         {"j1939.log": "(1.0) vcan0 0CF00400#0041FF20\n2 (1.1) vcan0 18F00400#00\n"},
+    ),
+    Case(
+        "csv-capture-bad-row",
+        ("can", "--input-format", "can", "bus.csv"),
+        2,
+        "bus.csv:2: expected a python-can CSV row (timestamp,arbitration_id,extended,remote,error,dlc,data), found a "
+        "line it cannot read",
+        {"bus.csv": "a,b\n1,2\n"},
+        needs="can",
     ),
     # options the help documents are accepted
     Case(
@@ -132,6 +169,14 @@ CASES = [
         0,
         "1 x can-error-frame",
         make=lambda d: _capture(d, "ef.log", ["1004E37F#00000000000000C0", "20000080#0000000000000000", "1004E37F#R"]),
+        needs="can",
+    ),
+    Case(
+        "can-remote-frames",
+        ("can", "rf.log"),
+        0,
+        "1 x can-remote-frame",
+        make=lambda d: _capture(d, "rf.log", ["1004E37F#00000000000000C0", "1004E37F#R"]),
         needs="can",
     ),
     # a readable input without what the command needs: 1, and 0 with --allow-empty
@@ -164,6 +209,42 @@ CASES = [
         0,
         "empty.jsonl: no battery readings",
         {"v.param": BATTERY_PARAMS, "empty.jsonl": ""},
+    ),
+    Case(
+        "failsafe-log-without-batteries",
+        ("failsafe", "nobat.bin"),
+        1,
+        "nobat.bin: expected battery readings, found none (--allow-empty accepts that)",
+        make=_log_without_batteries,
+    ),
+    Case(
+        "failsafe-log-without-batteries-allowed",
+        ("failsafe", "--allow-empty", "nobat.bin"),
+        0,
+        "nobat.bin: no battery readings",
+        make=_log_without_batteries,
+    ),
+    Case(
+        "failsafe-ulog-without-batteries",
+        ("failsafe", "nobat.ulg"),
+        1,
+        "nobat.ulg: expected battery readings, found none (--allow-empty accepts that)",
+        make=_log_without_batteries,
+    ),
+    Case(
+        "failsafe-ulog-without-batteries-allowed",
+        ("failsafe", "--allow-empty", "nobat.ulg"),
+        0,
+        "nobat.ulg: no battery readings",
+        make=_log_without_batteries,
+    ),
+    Case(
+        "report-log-without-batteries",
+        ("report", "nobat.bin"),
+        1,
+        "nobat.bin: expected battery records, found none (--allow-empty accepts that)",
+        make=_log_without_batteries,
+        needs="plotly",
     ),
     Case(
         "report-empty",
@@ -228,3 +309,4 @@ def test_wrong_input_is_one_line_and_the_documented_exit_code(
     assert len(saying) == 1, lines  # said once, on one line
     assert "Traceback" not in err and all(len(x) <= LONGEST_LINE for x in err.splitlines()), err
     assert ":0:" not in err  # no fake line 0
+    assert not any(x.rstrip().endswith(":") for x in lines)  # no sentence cut before what it announces

@@ -46,6 +46,11 @@ class SampleTable:
         self._order: tuple[NDArray, ...] | None = None  # the columns in time order, once asked for
         self.context: LogContext | None = None  # what the log says about itself (its first chunk's)
 
+    @property
+    def empty(self) -> bool:
+        """No battery record at all (a readable log may hold none)."""
+        return not self._parts
+
     def add(self, chunk: Chunk) -> None:
         if self.context is None:
             self.context = chunk.batch.context

@@ -60,6 +60,10 @@ class Px4Log:
     rtl_safe_time: Topic | None = None  # rtl_time_estimate.safe_time_estimate, NaN where not valid
 
 
+class NoBatteryRecords(ValueError):
+    """A readable log without battery records (commands exit 1 for it, or 0 with ``--allow-empty``)."""
+
+
 def read_px4_log(path: Path, name: str | None = None) -> Px4Log:
     """A PX4 log's battery updates and commander topics (an InputError, or another BattgenError, if unreadable; a
     ValueError for a log of another firmware)."""
@@ -88,7 +92,7 @@ def read_px4_log(path: Path, name: str | None = None) -> Px4Log:
                 )
             )
     if context is None:
-        raise ValueError(f"{display}: expected battery_status records, found none")
+        raise NoBatteryRecords(f"{display}: expected battery_status records, found none")
     if context.autopilot != "px4":
         raise ValueError(f"{display}: expected a PX4 log (a ULog), found a {context.kind} log of {context.autopilot}")
     out = Px4Log(context)

@@ -43,6 +43,9 @@ def _python_can(name: str) -> Any:
 
 
 CANDUMP_LINE = "a candump -l line such as '(1612543138.000000) can0 123#DEADBEEF'"
+CSV_ROW = "a python-can CSV row (timestamp,arbitration_id,extended,remote,error,dlc,data)"
+# text captures with one frame a line: what a line holds, and the line of the first frame (after a CSV's header)
+_ONE_FRAME_A_LINE = {".log": (CANDUMP_LINE, 1), ".csv": (CSV_ROW, 2)}
 
 
 def _blf_parse_error() -> type[Exception]:
@@ -75,8 +78,11 @@ def _brief(exc: BaseException) -> str:
     return text if len(text) <= _BRIEF else text[:_BRIEF] + f"... ({len(text)} characters)"
 
 
-def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: bool = False) -> Iterator[Frame]:
-    """``one_per_line``: a text capture with one frame a line (candump -l), so a failure is placed on its line."""
+def _frames_of(
+    messages: Iterator[Any], name: str, what: str, *, one_per_line: tuple[str, int] | None = None
+) -> Iterator[Frame]:
+    """``one_per_line``: a text capture with one frame a line (candump -l, python-can CSV): what a line holds and the
+    line of the first frame, so a failure is placed on its line."""
     index = 0
     read = 0  # messages the reader gave, error and remote frames included
     t0: float | None = None
@@ -88,8 +94,9 @@ def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: b
         except _READER_ERRORS as exc:
             # a damaged capture: the third-party reader's own complaint, located at the frame (or line) it reached
             # (the reader's exception text, "too many values to unpack", speaks of its code, not of the file)
-            if one_per_line:
-                raise InputError(name, read + 1, f"expected {CANDUMP_LINE}, found a line it cannot read") from exc
+            if one_per_line is not None:
+                expected, first = one_per_line
+                raise InputError(name, read + first, f"expected {expected}, found a line it cannot read") from exc
             raise InputError(name, 0, f"cannot read {what} after frame {index}: {_brief(exc)}") from exc
         read += 1
         kind = "error" if message.is_error_frame else "remote" if message.is_remote_frame else "data"
@@ -99,7 +106,7 @@ def _frames_of(messages: Iterator[Any], name: str, what: str, *, one_per_line: b
                 "CAN FD frame (0..8, 12, 16, 20, 24, 32, 48 or 64)" if message.is_fd else "classic CAN frame (0..8)"
             )
             found = f"frame {index}: {len(data)} data bytes: expected a {kind_text}"
-            raise InputError(name, read if one_per_line else 0, found)
+            raise InputError(name, read + one_per_line[1] - 1 if one_per_line else 0, found)
         stamp = float(message.timestamp or 0.0)
         if t0 is None:
             t0 = stamp
@@ -152,7 +159,9 @@ def read_capture(path: Path, name: str) -> Iterator[Frame]:
         return
     reader = _log_reader(path, name)
     try:
-        yield from _frames_of(iter(reader), name, "the CAN capture", one_per_line=path.suffix.lower() == ".log")
+        yield from _frames_of(
+            iter(reader), name, "the CAN capture", one_per_line=_ONE_FRAME_A_LINE.get(path.suffix.lower())
+        )
     finally:
         stop = getattr(reader, "stop", None)
         if callable(stop):
