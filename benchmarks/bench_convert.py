@@ -8,6 +8,9 @@ process) against a script looping over the same file with battgen's own converte
 over the rounds, wall and CPU seconds min and median; both outputs are read back and compared value for value
 (NaN as battgen spells it).
 
+The generated mavlink -> uorb px4 converter is timed against the same assignments written by hand (PX4's
+mavlink_receiver, float32 where its C computes in float), on the same messages, results compared field by field.
+
 Run: python benchmarks/bench_convert.py [--records N] [--repeat N] [--cli-records N] [--rounds N] [--quick]
 """
 
@@ -20,10 +23,12 @@ import math
 import os
 import random
 import statistics
+import struct
 import subprocess
 import sys
 import tempfile
 import time
+from array import array
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -34,6 +39,73 @@ from generated.convert.dronecan_uorb import dronecan_to_uorb, uorb_to_dronecan
 from generated.convert.uorb_mavlink import mavlink_to_uorb, uorb_to_mavlink
 from generated.dronecan.ardupilot.equipment.power import BatteryInfoAux
 from generated.dronecan.uavcan.equipment.power import BatteryInfo
+from generated.mavlink import BatteryStatus as MavlinkBatteryStatus
+from generated.uorb import BatteryStatus as UorbBatteryStatus
+
+_F32 = struct.Struct("<f")
+
+
+def hand_mavlink_to_uorb_px4(m: MavlinkBatteryStatus) -> UorbBatteryStatus:
+    """PX4's mavlink_receiver written by hand: the same assignments, float32 where its C computes in float."""
+    pack, unpack = _F32.pack, _F32.unpack
+    voltages = m.voltages
+    n = 0
+    while n < 10 and voltages[n] < 65535:
+        n += 1
+    cells = array("f", [v / 1000.0 for v in voltages[:n]]).tolist() + [0.0] * (14 - n)
+    total = 0.0
+    for c in cells[:n]:
+        total = unpack(pack(total + c))[0]
+    remaining = unpack(pack(m.battery_remaining / 100.0))[0]
+    if remaining < 0.05000000074505806:  # the receiver's thresholds, as float32 compares see them
+        warning = 3
+    elif remaining < 0.07000000029802322:
+        warning = 2
+    elif remaining < 0.15000000596046448:
+        warning = 1
+    else:
+        warning = 0
+    return UorbBatteryStatus(
+        connected=True,
+        voltage_v=total,
+        current_a=unpack(pack(m.current_battery / 100.0))[0],
+        current_average_a=0.0,
+        discharged_mah=unpack(pack(float(m.current_consumed)))[0],
+        remaining=remaining,
+        scale=0.0,
+        time_remaining_s=0.0,
+        temperature=float(m.temperature),
+        cell_count=n,
+        voltage_cell_v=cells,
+        warning=warning,
+        remaining_capacity_wh=0.0,
+        nominal_voltage=0.0,
+    )
+
+
+def generated_vs_hand(items: list[tuple[Any, ...]], rounds: int) -> dict[str, float]:
+    """The generated mavlink -> uorb px4 converter against the hand-written assignments, on the same messages,
+    interleaved rounds; the results compared field by field."""
+    messages = [args[0] for args in items]
+    if [mavlink_to_uorb(m, policy="px4") for m in messages] != [hand_mavlink_to_uorb_px4(m) for m in messages]:
+        raise RuntimeError("the generated converter and the hand-written one disagree")
+    times: dict[str, list[float]] = {"generated": [], "hand-written": []}
+    for _ in range(rounds):
+        for name, fn in (
+            ("generated", lambda m: mavlink_to_uorb(m, policy="px4")),
+            ("hand-written", hand_mavlink_to_uorb_px4),
+        ):
+            started = time.perf_counter()
+            for m in messages:
+                fn(m)
+            times[name].append(time.perf_counter() - started)
+    n = len(messages)
+    print(f"mavlink -> uorb px4, {n} messages, {rounds} interleaved rounds, us/record min / median:")
+    for name, t in times.items():
+        print(f"  {name:<14} {min(t) / n * 1e6:8.2f} / {statistics.median(t) / n * 1e6:8.2f}")
+    ratio = statistics.median(times["generated"]) / statistics.median(times["hand-written"])
+    print(f"  the generated converter takes {ratio:.2f}x the hand-written assignments (target <= 1.5x); results equal")
+    return {"generated x_hand_written": ratio}
 
 
 def records(n: int) -> tuple[list[tuple[Any, ...]], list[tuple[Any, ...]]]:
@@ -212,6 +284,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
             print(f"{name:<20} {policy:<7} {plain:12,.0f} {reported:12,.0f}")
     results["cli jsonl dronecan->mavlink px4"] = cli_rate(args.records, max(1, args.repeat // 2))
     print(f"{'CLI JSON Lines':<20} {'px4':<7} {results['cli jsonl dronecan->mavlink px4']:12,.0f}")
+    results.update(generated_vs_hand(mav, args.rounds))
     results.update(cli_vs_script(args.cli_records, args.rounds))
     return results
 
