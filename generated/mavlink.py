@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses as _dataclasses
 import enum as _enum
 import math as _math
+import operator as _operator
 import struct as _struct
 from collections.abc import Mapping as _Mapping
 from typing import Any as _Any
@@ -1344,6 +1345,54 @@ _SYS_STATUS_FIELD_SPECS = (
 )
 
 
+_BATTERY_INFO_KEYS: frozenset[str] = frozenset(
+    {
+        "id",
+        "battery_function",
+        "type",
+        "state_of_health",
+        "cells_in_series",
+        "cycle_count",
+        "weight",
+        "discharge_minimum_voltage",
+        "charging_minimum_voltage",
+        "resting_minimum_voltage",
+        "charging_maximum_voltage",
+        "charging_maximum_current",
+        "nominal_voltage",
+        "discharge_maximum_current",
+        "discharge_maximum_burst_current",
+        "design_capacity",
+        "full_charge_capacity",
+        "manufacture_date",
+        "serial_number",
+        "name",
+    }
+)
+_BATTERY_INFO_VALUES = _operator.itemgetter(
+    "id",
+    "battery_function",
+    "type",
+    "state_of_health",
+    "cells_in_series",
+    "cycle_count",
+    "weight",
+    "discharge_minimum_voltage",
+    "charging_minimum_voltage",
+    "resting_minimum_voltage",
+    "charging_maximum_voltage",
+    "charging_maximum_current",
+    "nominal_voltage",
+    "discharge_maximum_current",
+    "discharge_maximum_burst_current",
+    "design_capacity",
+    "full_charge_capacity",
+    "manufacture_date",
+    "serial_number",
+    "name",
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryInfo:
     """What does not change about a battery, or seldom: design limits, identity, wear. Request it with
@@ -1608,78 +1657,98 @@ class BatteryInfo:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfo:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "id",
-                    "battery_function",
-                    "type",
-                    "state_of_health",
-                    "cells_in_series",
-                    "cycle_count",
-                    "weight",
-                    "discharge_minimum_voltage",
-                    "charging_minimum_voltage",
-                    "resting_minimum_voltage",
-                    "charging_maximum_voltage",
-                    "charging_maximum_current",
-                    "nominal_voltage",
-                    "discharge_maximum_current",
-                    "discharge_maximum_burst_current",
-                    "design_capacity",
-                    "full_charge_capacity",
-                    "manufacture_date",
-                    "serial_number",
-                    "name",
-                }
-            ),
-            (),
-            "BatteryInfo",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_INFO_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_INFO_KEYS, (), "BatteryInfo")
+        elif len(data) == 20:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15, v16, v17, v18, v19 = (
+                _BATTERY_INFO_VALUES(data)
+            )
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "id"),
+                v1 if v1.__class__ is int else _m.as_int(v1, "battery_function"),
+                v2 if v2.__class__ is int else _m.as_int(v2, "type"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "state_of_health"),
+                v4 if v4.__class__ is int else _m.as_int(v4, "cells_in_series"),
+                v5 if v5.__class__ is int else _m.as_int(v5, "cycle_count"),
+                v6 if v6.__class__ is int else _m.as_int(v6, "weight"),
+                v7 if v7.__class__ is float else _m.as_float(v7, "discharge_minimum_voltage"),
+                v8 if v8.__class__ is float else _m.as_float(v8, "charging_minimum_voltage"),
+                v9 if v9.__class__ is float else _m.as_float(v9, "resting_minimum_voltage"),
+                v10 if v10.__class__ is float else _m.as_float(v10, "charging_maximum_voltage"),
+                v11 if v11.__class__ is float else _m.as_float(v11, "charging_maximum_current"),
+                v12 if v12.__class__ is float else _m.as_float(v12, "nominal_voltage"),
+                v13 if v13.__class__ is float else _m.as_float(v13, "discharge_maximum_current"),
+                v14 if v14.__class__ is float else _m.as_float(v14, "discharge_maximum_burst_current"),
+                v15 if v15.__class__ is float else _m.as_float(v15, "design_capacity"),
+                v16 if v16.__class__ is float else _m.as_float(v16, "full_charge_capacity"),
+                v17 if v17.__class__ is str else _m.as_str(v17, "manufacture_date"),
+                v18 if v18.__class__ is str else _m.as_str(v18, "serial_number"),
+                v19 if v19.__class__ is str else _m.as_str(v19, "name"),
+            )
         obj = cls()
         if "id" in data:
-            obj.id = _m.as_int(data["id"], "id")
+            x = data["id"]
+            obj.id = x if x.__class__ is int else _m.as_int(x, "id")
         if "battery_function" in data:
-            obj.battery_function = _m.as_int(data["battery_function"], "battery_function")
+            x = data["battery_function"]
+            obj.battery_function = x if x.__class__ is int else _m.as_int(x, "battery_function")
         if "type" in data:
-            obj.type = _m.as_int(data["type"], "type")
+            x = data["type"]
+            obj.type = x if x.__class__ is int else _m.as_int(x, "type")
         if "state_of_health" in data:
-            obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
+            x = data["state_of_health"]
+            obj.state_of_health = x if x.__class__ is int else _m.as_int(x, "state_of_health")
         if "cells_in_series" in data:
-            obj.cells_in_series = _m.as_int(data["cells_in_series"], "cells_in_series")
+            x = data["cells_in_series"]
+            obj.cells_in_series = x if x.__class__ is int else _m.as_int(x, "cells_in_series")
         if "cycle_count" in data:
-            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+            x = data["cycle_count"]
+            obj.cycle_count = x if x.__class__ is int else _m.as_int(x, "cycle_count")
         if "weight" in data:
-            obj.weight = _m.as_int(data["weight"], "weight")
+            x = data["weight"]
+            obj.weight = x if x.__class__ is int else _m.as_int(x, "weight")
         if "discharge_minimum_voltage" in data:
-            obj.discharge_minimum_voltage = _m.as_float(data["discharge_minimum_voltage"], "discharge_minimum_voltage")
+            x = data["discharge_minimum_voltage"]
+            obj.discharge_minimum_voltage = x if x.__class__ is float else _m.as_float(x, "discharge_minimum_voltage")
         if "charging_minimum_voltage" in data:
-            obj.charging_minimum_voltage = _m.as_float(data["charging_minimum_voltage"], "charging_minimum_voltage")
+            x = data["charging_minimum_voltage"]
+            obj.charging_minimum_voltage = x if x.__class__ is float else _m.as_float(x, "charging_minimum_voltage")
         if "resting_minimum_voltage" in data:
-            obj.resting_minimum_voltage = _m.as_float(data["resting_minimum_voltage"], "resting_minimum_voltage")
+            x = data["resting_minimum_voltage"]
+            obj.resting_minimum_voltage = x if x.__class__ is float else _m.as_float(x, "resting_minimum_voltage")
         if "charging_maximum_voltage" in data:
-            obj.charging_maximum_voltage = _m.as_float(data["charging_maximum_voltage"], "charging_maximum_voltage")
+            x = data["charging_maximum_voltage"]
+            obj.charging_maximum_voltage = x if x.__class__ is float else _m.as_float(x, "charging_maximum_voltage")
         if "charging_maximum_current" in data:
-            obj.charging_maximum_current = _m.as_float(data["charging_maximum_current"], "charging_maximum_current")
+            x = data["charging_maximum_current"]
+            obj.charging_maximum_current = x if x.__class__ is float else _m.as_float(x, "charging_maximum_current")
         if "nominal_voltage" in data:
-            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+            x = data["nominal_voltage"]
+            obj.nominal_voltage = x if x.__class__ is float else _m.as_float(x, "nominal_voltage")
         if "discharge_maximum_current" in data:
-            obj.discharge_maximum_current = _m.as_float(data["discharge_maximum_current"], "discharge_maximum_current")
+            x = data["discharge_maximum_current"]
+            obj.discharge_maximum_current = x if x.__class__ is float else _m.as_float(x, "discharge_maximum_current")
         if "discharge_maximum_burst_current" in data:
-            obj.discharge_maximum_burst_current = _m.as_float(
-                data["discharge_maximum_burst_current"], "discharge_maximum_burst_current"
+            x = data["discharge_maximum_burst_current"]
+            obj.discharge_maximum_burst_current = (
+                x if x.__class__ is float else _m.as_float(x, "discharge_maximum_burst_current")
             )
         if "design_capacity" in data:
-            obj.design_capacity = _m.as_float(data["design_capacity"], "design_capacity")
+            x = data["design_capacity"]
+            obj.design_capacity = x if x.__class__ is float else _m.as_float(x, "design_capacity")
         if "full_charge_capacity" in data:
-            obj.full_charge_capacity = _m.as_float(data["full_charge_capacity"], "full_charge_capacity")
+            x = data["full_charge_capacity"]
+            obj.full_charge_capacity = x if x.__class__ is float else _m.as_float(x, "full_charge_capacity")
         if "manufacture_date" in data:
-            obj.manufacture_date = _m.as_str(data["manufacture_date"], "manufacture_date")
+            x = data["manufacture_date"]
+            obj.manufacture_date = x if x.__class__ is str else _m.as_str(x, "manufacture_date")
         if "serial_number" in data:
-            obj.serial_number = _m.as_str(data["serial_number"], "serial_number")
+            x = data["serial_number"]
+            obj.serial_number = x if x.__class__ is str else _m.as_str(x, "serial_number")
         if "name" in data:
-            obj.name = _m.as_str(data["name"], "name")
+            x = data["name"]
+            obj.name = x if x.__class__ is str else _m.as_str(x, "name")
         return obj
 
     MSG_ID: _ClassVar[int] = 372
@@ -1969,6 +2038,42 @@ class BatteryInfo:
         raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_INFO")
 
 
+_BATTERY_STATUS_KEYS: frozenset[str] = frozenset(
+    {
+        "id",
+        "battery_function",
+        "type",
+        "temperature",
+        "voltages",
+        "current_battery",
+        "current_consumed",
+        "energy_consumed",
+        "battery_remaining",
+        "time_remaining",
+        "charge_state",
+        "voltages_ext",
+        "mode",
+        "fault_bitmask",
+    }
+)
+_BATTERY_STATUS_VALUES = _operator.itemgetter(
+    "id",
+    "battery_function",
+    "type",
+    "temperature",
+    "voltages",
+    "current_battery",
+    "current_consumed",
+    "energy_consumed",
+    "battery_remaining",
+    "time_remaining",
+    "charge_state",
+    "voltages_ext",
+    "mode",
+    "fault_bitmask",
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryStatus:
     """A battery as the flight controller monitors it: cell voltages, current, charge and energy used, charge left.
@@ -2174,60 +2279,70 @@ class BatteryStatus:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "id",
-                    "battery_function",
-                    "type",
-                    "temperature",
-                    "voltages",
-                    "current_battery",
-                    "current_consumed",
-                    "energy_consumed",
-                    "battery_remaining",
-                    "time_remaining",
-                    "charge_state",
-                    "voltages_ext",
-                    "mode",
-                    "fault_bitmask",
-                }
-            ),
-            (),
-            "BatteryStatus",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_STATUS_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_STATUS_KEYS, (), "BatteryStatus")
+        elif len(data) == 14:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13 = _BATTERY_STATUS_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "id"),
+                v1 if v1.__class__ is int else _m.as_int(v1, "battery_function"),
+                v2 if v2.__class__ is int else _m.as_int(v2, "type"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "temperature"),
+                _m.as_typed_list(v4, "voltages", 10, True, int, _m.as_int),
+                v5 if v5.__class__ is int else _m.as_int(v5, "current_battery"),
+                v6 if v6.__class__ is int else _m.as_int(v6, "current_consumed"),
+                v7 if v7.__class__ is int else _m.as_int(v7, "energy_consumed"),
+                v8 if v8.__class__ is int else _m.as_int(v8, "battery_remaining"),
+                v9 if v9.__class__ is int else _m.as_int(v9, "time_remaining"),
+                v10 if v10.__class__ is int else _m.as_int(v10, "charge_state"),
+                _m.as_typed_list(v11, "voltages_ext", 4, True, int, _m.as_int),
+                v12 if v12.__class__ is int else _m.as_int(v12, "mode"),
+                v13 if v13.__class__ is int else _m.as_int(v13, "fault_bitmask"),
+            )
         obj = cls()
         if "id" in data:
-            obj.id = _m.as_int(data["id"], "id")
+            x = data["id"]
+            obj.id = x if x.__class__ is int else _m.as_int(x, "id")
         if "battery_function" in data:
-            obj.battery_function = _m.as_int(data["battery_function"], "battery_function")
+            x = data["battery_function"]
+            obj.battery_function = x if x.__class__ is int else _m.as_int(x, "battery_function")
         if "type" in data:
-            obj.type = _m.as_int(data["type"], "type")
+            x = data["type"]
+            obj.type = x if x.__class__ is int else _m.as_int(x, "type")
         if "temperature" in data:
-            obj.temperature = _m.as_int(data["temperature"], "temperature")
+            x = data["temperature"]
+            obj.temperature = x if x.__class__ is int else _m.as_int(x, "temperature")
         if "voltages" in data:
-            obj.voltages = _m.as_list(data["voltages"], "voltages", 10, True, lambda item, p: _m.as_int(item, p))
+            x = data["voltages"]
+            obj.voltages = _m.as_typed_list(x, "voltages", 10, True, int, _m.as_int)
         if "current_battery" in data:
-            obj.current_battery = _m.as_int(data["current_battery"], "current_battery")
+            x = data["current_battery"]
+            obj.current_battery = x if x.__class__ is int else _m.as_int(x, "current_battery")
         if "current_consumed" in data:
-            obj.current_consumed = _m.as_int(data["current_consumed"], "current_consumed")
+            x = data["current_consumed"]
+            obj.current_consumed = x if x.__class__ is int else _m.as_int(x, "current_consumed")
         if "energy_consumed" in data:
-            obj.energy_consumed = _m.as_int(data["energy_consumed"], "energy_consumed")
+            x = data["energy_consumed"]
+            obj.energy_consumed = x if x.__class__ is int else _m.as_int(x, "energy_consumed")
         if "battery_remaining" in data:
-            obj.battery_remaining = _m.as_int(data["battery_remaining"], "battery_remaining")
+            x = data["battery_remaining"]
+            obj.battery_remaining = x if x.__class__ is int else _m.as_int(x, "battery_remaining")
         if "time_remaining" in data:
-            obj.time_remaining = _m.as_int(data["time_remaining"], "time_remaining")
+            x = data["time_remaining"]
+            obj.time_remaining = x if x.__class__ is int else _m.as_int(x, "time_remaining")
         if "charge_state" in data:
-            obj.charge_state = _m.as_int(data["charge_state"], "charge_state")
+            x = data["charge_state"]
+            obj.charge_state = x if x.__class__ is int else _m.as_int(x, "charge_state")
         if "voltages_ext" in data:
-            obj.voltages_ext = _m.as_list(
-                data["voltages_ext"], "voltages_ext", 4, True, lambda item, p: _m.as_int(item, p)
-            )
+            x = data["voltages_ext"]
+            obj.voltages_ext = _m.as_typed_list(x, "voltages_ext", 4, True, int, _m.as_int)
         if "mode" in data:
-            obj.mode = _m.as_int(data["mode"], "mode")
+            x = data["mode"]
+            obj.mode = x if x.__class__ is int else _m.as_int(x, "mode")
         if "fault_bitmask" in data:
-            obj.fault_bitmask = _m.as_int(data["fault_bitmask"], "fault_bitmask")
+            x = data["fault_bitmask"]
+            obj.fault_bitmask = x if x.__class__ is int else _m.as_int(x, "fault_bitmask")
         return obj
 
     MSG_ID: _ClassVar[int] = 147
@@ -2487,6 +2602,30 @@ class BatteryStatus:
         raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_STATUS")
 
 
+_BATTERY_STATUS_V2_KEYS: frozenset[str] = frozenset(
+    {
+        "id",
+        "temperature",
+        "voltage",
+        "current",
+        "capacity_consumed",
+        "capacity_remaining",
+        "state_of_charge",
+        "status_flags",
+    }
+)
+_BATTERY_STATUS_V2_VALUES = _operator.itemgetter(
+    "id",
+    "temperature",
+    "voltage",
+    "current",
+    "capacity_consumed",
+    "capacity_remaining",
+    "state_of_charge",
+    "status_flags",
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryStatusV2:
     """What changes about a battery, sent about once a second; what does not is in BATTERY_INFO. A smart battery that
@@ -2617,40 +2756,46 @@ class BatteryStatusV2:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatusV2:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "id",
-                    "temperature",
-                    "voltage",
-                    "current",
-                    "capacity_consumed",
-                    "capacity_remaining",
-                    "state_of_charge",
-                    "status_flags",
-                }
-            ),
-            (),
-            "BatteryStatusV2",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_STATUS_V2_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_STATUS_V2_KEYS, (), "BatteryStatusV2")
+        elif len(data) == 8:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7 = _BATTERY_STATUS_V2_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "id"),
+                v1 if v1.__class__ is int else _m.as_int(v1, "temperature"),
+                v2 if v2.__class__ is float else _m.as_float(v2, "voltage"),
+                v3 if v3.__class__ is float else _m.as_float(v3, "current"),
+                v4 if v4.__class__ is float else _m.as_float(v4, "capacity_consumed"),
+                v5 if v5.__class__ is float else _m.as_float(v5, "capacity_remaining"),
+                v6 if v6.__class__ is float else _m.as_float(v6, "state_of_charge"),
+                v7 if v7.__class__ is int else _m.as_int(v7, "status_flags"),
+            )
         obj = cls()
         if "id" in data:
-            obj.id = _m.as_int(data["id"], "id")
+            x = data["id"]
+            obj.id = x if x.__class__ is int else _m.as_int(x, "id")
         if "temperature" in data:
-            obj.temperature = _m.as_int(data["temperature"], "temperature")
+            x = data["temperature"]
+            obj.temperature = x if x.__class__ is int else _m.as_int(x, "temperature")
         if "voltage" in data:
-            obj.voltage = _m.as_float(data["voltage"], "voltage")
+            x = data["voltage"]
+            obj.voltage = x if x.__class__ is float else _m.as_float(x, "voltage")
         if "current" in data:
-            obj.current = _m.as_float(data["current"], "current")
+            x = data["current"]
+            obj.current = x if x.__class__ is float else _m.as_float(x, "current")
         if "capacity_consumed" in data:
-            obj.capacity_consumed = _m.as_float(data["capacity_consumed"], "capacity_consumed")
+            x = data["capacity_consumed"]
+            obj.capacity_consumed = x if x.__class__ is float else _m.as_float(x, "capacity_consumed")
         if "capacity_remaining" in data:
-            obj.capacity_remaining = _m.as_float(data["capacity_remaining"], "capacity_remaining")
+            x = data["capacity_remaining"]
+            obj.capacity_remaining = x if x.__class__ is float else _m.as_float(x, "capacity_remaining")
         if "state_of_charge" in data:
-            obj.state_of_charge = _m.as_float(data["state_of_charge"], "state_of_charge")
+            x = data["state_of_charge"]
+            obj.state_of_charge = x if x.__class__ is float else _m.as_float(x, "state_of_charge")
         if "status_flags" in data:
-            obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
+            x = data["status_flags"]
+            obj.status_flags = x if x.__class__ is int else _m.as_int(x, "status_flags")
         return obj
 
     MSG_ID: _ClassVar[int] = 369
@@ -2805,6 +2950,14 @@ class BatteryStatusV2:
         raise KeyError(f"{field!r} is not a field of " + "mavlink.BATTERY_STATUS_V2")
 
 
+_HEARTBEAT_KEYS: frozenset[str] = frozenset(
+    {"type", "autopilot", "base_mode", "custom_mode", "system_status", "mavlink_version"}
+)
+_HEARTBEAT_VALUES = _operator.itemgetter(
+    "type", "autopilot", "base_mode", "custom_mode", "system_status", "mavlink_version"
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class Heartbeat:
     """Sent about once a second by every system and component: what it is, which autopilot it runs, its mode and state.
@@ -2877,25 +3030,38 @@ class Heartbeat:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Heartbeat:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset({"type", "autopilot", "base_mode", "custom_mode", "system_status", "mavlink_version"}),
-            (),
-            "Heartbeat",
-        )
+        if data.__class__ is not dict or not data.keys() <= _HEARTBEAT_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _HEARTBEAT_KEYS, (), "Heartbeat")
+        elif len(data) == 6:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5 = _HEARTBEAT_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "type"),
+                v1 if v1.__class__ is int else _m.as_int(v1, "autopilot"),
+                v2 if v2.__class__ is int else _m.as_int(v2, "base_mode"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "custom_mode"),
+                v4 if v4.__class__ is int else _m.as_int(v4, "system_status"),
+                v5 if v5.__class__ is int else _m.as_int(v5, "mavlink_version"),
+            )
         obj = cls()
         if "type" in data:
-            obj.type = _m.as_int(data["type"], "type")
+            x = data["type"]
+            obj.type = x if x.__class__ is int else _m.as_int(x, "type")
         if "autopilot" in data:
-            obj.autopilot = _m.as_int(data["autopilot"], "autopilot")
+            x = data["autopilot"]
+            obj.autopilot = x if x.__class__ is int else _m.as_int(x, "autopilot")
         if "base_mode" in data:
-            obj.base_mode = _m.as_int(data["base_mode"], "base_mode")
+            x = data["base_mode"]
+            obj.base_mode = x if x.__class__ is int else _m.as_int(x, "base_mode")
         if "custom_mode" in data:
-            obj.custom_mode = _m.as_int(data["custom_mode"], "custom_mode")
+            x = data["custom_mode"]
+            obj.custom_mode = x if x.__class__ is int else _m.as_int(x, "custom_mode")
         if "system_status" in data:
-            obj.system_status = _m.as_int(data["system_status"], "system_status")
+            x = data["system_status"]
+            obj.system_status = x if x.__class__ is int else _m.as_int(x, "system_status")
         if "mavlink_version" in data:
-            obj.mavlink_version = _m.as_int(data["mavlink_version"], "mavlink_version")
+            x = data["mavlink_version"]
+            obj.mavlink_version = x if x.__class__ is int else _m.as_int(x, "mavlink_version")
         return obj
 
     MSG_ID: _ClassVar[int] = 0
@@ -3074,6 +3240,10 @@ class Heartbeat:
         raise KeyError(f"{field!r} is not a field of " + "mavlink.HEARTBEAT")
 
 
+_PARAM_VALUE_KEYS: frozenset[str] = frozenset({"param_id", "param_value", "param_type", "param_count", "param_index"})
+_PARAM_VALUE_VALUES = _operator.itemgetter("param_id", "param_value", "param_type", "param_count", "param_index")
+
+
 @_dataclasses.dataclass(slots=True)
 class ParamValue:
     """One of the vehicle's parameters, as it sends them when asked for the list or after one is set.
@@ -3131,20 +3301,34 @@ class ParamValue:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> ParamValue:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data, frozenset({"param_id", "param_value", "param_type", "param_count", "param_index"}), (), "ParamValue"
-        )
+        if data.__class__ is not dict or not data.keys() <= _PARAM_VALUE_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _PARAM_VALUE_KEYS, (), "ParamValue")
+        elif len(data) == 5:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4 = _PARAM_VALUE_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is str else _m.as_str(v0, "param_id"),
+                v1 if v1.__class__ is float else _m.as_float(v1, "param_value"),
+                v2 if v2.__class__ is int else _m.as_int(v2, "param_type"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "param_count"),
+                v4 if v4.__class__ is int else _m.as_int(v4, "param_index"),
+            )
         obj = cls()
         if "param_id" in data:
-            obj.param_id = _m.as_str(data["param_id"], "param_id")
+            x = data["param_id"]
+            obj.param_id = x if x.__class__ is str else _m.as_str(x, "param_id")
         if "param_value" in data:
-            obj.param_value = _m.as_float(data["param_value"], "param_value")
+            x = data["param_value"]
+            obj.param_value = x if x.__class__ is float else _m.as_float(x, "param_value")
         if "param_type" in data:
-            obj.param_type = _m.as_int(data["param_type"], "param_type")
+            x = data["param_type"]
+            obj.param_type = x if x.__class__ is int else _m.as_int(x, "param_type")
         if "param_count" in data:
-            obj.param_count = _m.as_int(data["param_count"], "param_count")
+            x = data["param_count"]
+            obj.param_count = x if x.__class__ is int else _m.as_int(x, "param_count")
         if "param_index" in data:
-            obj.param_index = _m.as_int(data["param_index"], "param_index")
+            x = data["param_index"]
+            obj.param_index = x if x.__class__ is int else _m.as_int(x, "param_index")
         return obj
 
     MSG_ID: _ClassVar[int] = 22
@@ -3272,6 +3456,10 @@ class ParamValue:
         raise KeyError(f"{field!r} is not a field of " + "mavlink.PARAM_VALUE")
 
 
+_STATUSTEXT_KEYS: frozenset[str] = frozenset({"severity", "text", "id", "chunk_seq"})
+_STATUSTEXT_VALUES = _operator.itemgetter("severity", "text", "id", "chunk_seq")
+
+
 @_dataclasses.dataclass(slots=True)
 class Statustext:
     """A line of text the vehicle sends to the operator (warnings, failsafes, mode and arming messages).
@@ -3325,16 +3513,30 @@ class Statustext:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Statustext:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"severity", "text", "id", "chunk_seq"}), (), "Statustext")
+        if data.__class__ is not dict or not data.keys() <= _STATUSTEXT_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _STATUSTEXT_KEYS, (), "Statustext")
+        elif len(data) == 4:  # every field named: fetched in one call
+            v0, v1, v2, v3 = _STATUSTEXT_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "severity"),
+                v1 if v1.__class__ is str else _m.as_str(v1, "text"),
+                v2 if v2.__class__ is int else _m.as_int(v2, "id"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "chunk_seq"),
+            )
         obj = cls()
         if "severity" in data:
-            obj.severity = _m.as_int(data["severity"], "severity")
+            x = data["severity"]
+            obj.severity = x if x.__class__ is int else _m.as_int(x, "severity")
         if "text" in data:
-            obj.text = _m.as_str(data["text"], "text")
+            x = data["text"]
+            obj.text = x if x.__class__ is str else _m.as_str(x, "text")
         if "id" in data:
-            obj.id = _m.as_int(data["id"], "id")
+            x = data["id"]
+            obj.id = x if x.__class__ is int else _m.as_int(x, "id")
         if "chunk_seq" in data:
-            obj.chunk_seq = _m.as_int(data["chunk_seq"], "chunk_seq")
+            x = data["chunk_seq"]
+            obj.chunk_seq = x if x.__class__ is int else _m.as_int(x, "chunk_seq")
         return obj
 
     MSG_ID: _ClassVar[int] = 253
@@ -3453,6 +3655,46 @@ class Statustext:
         if field in {"severity", "text", "id", "chunk_seq"}:
             return True
         raise KeyError(f"{field!r} is not a field of " + "mavlink.STATUSTEXT")
+
+
+_SYS_STATUS_KEYS: frozenset[str] = frozenset(
+    {
+        "onboard_control_sensors_present",
+        "onboard_control_sensors_enabled",
+        "onboard_control_sensors_health",
+        "load",
+        "voltage_battery",
+        "current_battery",
+        "battery_remaining",
+        "drop_rate_comm",
+        "errors_comm",
+        "errors_count1",
+        "errors_count2",
+        "errors_count3",
+        "errors_count4",
+        "onboard_control_sensors_present_extended",
+        "onboard_control_sensors_enabled_extended",
+        "onboard_control_sensors_health_extended",
+    }
+)
+_SYS_STATUS_VALUES = _operator.itemgetter(
+    "onboard_control_sensors_present",
+    "onboard_control_sensors_enabled",
+    "onboard_control_sensors_health",
+    "load",
+    "voltage_battery",
+    "current_battery",
+    "battery_remaining",
+    "drop_rate_comm",
+    "errors_comm",
+    "errors_count1",
+    "errors_count2",
+    "errors_count3",
+    "errors_count4",
+    "onboard_control_sensors_present_extended",
+    "onboard_control_sensors_enabled_extended",
+    "onboard_control_sensors_health_extended",
+)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -3633,75 +3875,89 @@ class SysStatus:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> SysStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "onboard_control_sensors_present",
-                    "onboard_control_sensors_enabled",
-                    "onboard_control_sensors_health",
-                    "load",
-                    "voltage_battery",
-                    "current_battery",
-                    "battery_remaining",
-                    "drop_rate_comm",
-                    "errors_comm",
-                    "errors_count1",
-                    "errors_count2",
-                    "errors_count3",
-                    "errors_count4",
-                    "onboard_control_sensors_present_extended",
-                    "onboard_control_sensors_enabled_extended",
-                    "onboard_control_sensors_health_extended",
-                }
-            ),
-            (),
-            "SysStatus",
-        )
+        if data.__class__ is not dict or not data.keys() <= _SYS_STATUS_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _SYS_STATUS_KEYS, (), "SysStatus")
+        elif len(data) == 16:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15 = _SYS_STATUS_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "onboard_control_sensors_present"),
+                v1 if v1.__class__ is int else _m.as_int(v1, "onboard_control_sensors_enabled"),
+                v2 if v2.__class__ is int else _m.as_int(v2, "onboard_control_sensors_health"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "load"),
+                v4 if v4.__class__ is int else _m.as_int(v4, "voltage_battery"),
+                v5 if v5.__class__ is int else _m.as_int(v5, "current_battery"),
+                v6 if v6.__class__ is int else _m.as_int(v6, "battery_remaining"),
+                v7 if v7.__class__ is int else _m.as_int(v7, "drop_rate_comm"),
+                v8 if v8.__class__ is int else _m.as_int(v8, "errors_comm"),
+                v9 if v9.__class__ is int else _m.as_int(v9, "errors_count1"),
+                v10 if v10.__class__ is int else _m.as_int(v10, "errors_count2"),
+                v11 if v11.__class__ is int else _m.as_int(v11, "errors_count3"),
+                v12 if v12.__class__ is int else _m.as_int(v12, "errors_count4"),
+                v13 if v13.__class__ is int else _m.as_int(v13, "onboard_control_sensors_present_extended"),
+                v14 if v14.__class__ is int else _m.as_int(v14, "onboard_control_sensors_enabled_extended"),
+                v15 if v15.__class__ is int else _m.as_int(v15, "onboard_control_sensors_health_extended"),
+            )
         obj = cls()
         if "onboard_control_sensors_present" in data:
-            obj.onboard_control_sensors_present = _m.as_int(
-                data["onboard_control_sensors_present"], "onboard_control_sensors_present"
+            x = data["onboard_control_sensors_present"]
+            obj.onboard_control_sensors_present = (
+                x if x.__class__ is int else _m.as_int(x, "onboard_control_sensors_present")
             )
         if "onboard_control_sensors_enabled" in data:
-            obj.onboard_control_sensors_enabled = _m.as_int(
-                data["onboard_control_sensors_enabled"], "onboard_control_sensors_enabled"
+            x = data["onboard_control_sensors_enabled"]
+            obj.onboard_control_sensors_enabled = (
+                x if x.__class__ is int else _m.as_int(x, "onboard_control_sensors_enabled")
             )
         if "onboard_control_sensors_health" in data:
-            obj.onboard_control_sensors_health = _m.as_int(
-                data["onboard_control_sensors_health"], "onboard_control_sensors_health"
+            x = data["onboard_control_sensors_health"]
+            obj.onboard_control_sensors_health = (
+                x if x.__class__ is int else _m.as_int(x, "onboard_control_sensors_health")
             )
         if "load" in data:
-            obj.load = _m.as_int(data["load"], "load")
+            x = data["load"]
+            obj.load = x if x.__class__ is int else _m.as_int(x, "load")
         if "voltage_battery" in data:
-            obj.voltage_battery = _m.as_int(data["voltage_battery"], "voltage_battery")
+            x = data["voltage_battery"]
+            obj.voltage_battery = x if x.__class__ is int else _m.as_int(x, "voltage_battery")
         if "current_battery" in data:
-            obj.current_battery = _m.as_int(data["current_battery"], "current_battery")
+            x = data["current_battery"]
+            obj.current_battery = x if x.__class__ is int else _m.as_int(x, "current_battery")
         if "battery_remaining" in data:
-            obj.battery_remaining = _m.as_int(data["battery_remaining"], "battery_remaining")
+            x = data["battery_remaining"]
+            obj.battery_remaining = x if x.__class__ is int else _m.as_int(x, "battery_remaining")
         if "drop_rate_comm" in data:
-            obj.drop_rate_comm = _m.as_int(data["drop_rate_comm"], "drop_rate_comm")
+            x = data["drop_rate_comm"]
+            obj.drop_rate_comm = x if x.__class__ is int else _m.as_int(x, "drop_rate_comm")
         if "errors_comm" in data:
-            obj.errors_comm = _m.as_int(data["errors_comm"], "errors_comm")
+            x = data["errors_comm"]
+            obj.errors_comm = x if x.__class__ is int else _m.as_int(x, "errors_comm")
         if "errors_count1" in data:
-            obj.errors_count1 = _m.as_int(data["errors_count1"], "errors_count1")
+            x = data["errors_count1"]
+            obj.errors_count1 = x if x.__class__ is int else _m.as_int(x, "errors_count1")
         if "errors_count2" in data:
-            obj.errors_count2 = _m.as_int(data["errors_count2"], "errors_count2")
+            x = data["errors_count2"]
+            obj.errors_count2 = x if x.__class__ is int else _m.as_int(x, "errors_count2")
         if "errors_count3" in data:
-            obj.errors_count3 = _m.as_int(data["errors_count3"], "errors_count3")
+            x = data["errors_count3"]
+            obj.errors_count3 = x if x.__class__ is int else _m.as_int(x, "errors_count3")
         if "errors_count4" in data:
-            obj.errors_count4 = _m.as_int(data["errors_count4"], "errors_count4")
+            x = data["errors_count4"]
+            obj.errors_count4 = x if x.__class__ is int else _m.as_int(x, "errors_count4")
         if "onboard_control_sensors_present_extended" in data:
-            obj.onboard_control_sensors_present_extended = _m.as_int(
-                data["onboard_control_sensors_present_extended"], "onboard_control_sensors_present_extended"
+            x = data["onboard_control_sensors_present_extended"]
+            obj.onboard_control_sensors_present_extended = (
+                x if x.__class__ is int else _m.as_int(x, "onboard_control_sensors_present_extended")
             )
         if "onboard_control_sensors_enabled_extended" in data:
-            obj.onboard_control_sensors_enabled_extended = _m.as_int(
-                data["onboard_control_sensors_enabled_extended"], "onboard_control_sensors_enabled_extended"
+            x = data["onboard_control_sensors_enabled_extended"]
+            obj.onboard_control_sensors_enabled_extended = (
+                x if x.__class__ is int else _m.as_int(x, "onboard_control_sensors_enabled_extended")
             )
         if "onboard_control_sensors_health_extended" in data:
-            obj.onboard_control_sensors_health_extended = _m.as_int(
-                data["onboard_control_sensors_health_extended"], "onboard_control_sensors_health_extended"
+            x = data["onboard_control_sensors_health_extended"]
+            obj.onboard_control_sensors_health_extended = (
+                x if x.__class__ is int else _m.as_int(x, "onboard_control_sensors_health_extended")
             )
         return obj
 

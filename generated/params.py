@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses as _dataclasses
 import enum as _enum
+import operator as _operator
 from collections.abc import Mapping as _Mapping
 from typing import Any as _Any
 from typing import ClassVar as _ClassVar
@@ -68,6 +69,36 @@ _BATT_PARAMS_FIELD_SPECS = (
     ("BATT_FS_CRT_ACT", "BATT_FS_CRT_ACT", _BATT_PARAMS_BATT_FS_CRT_ACT_SPEC),
     ("BATT_ARM_VOLT", "BATT_ARM_VOLT", _BATT_PARAMS_BATT_ARM_VOLT_SPEC),
     ("BATT_ARM_MAH", "BATT_ARM_MAH", _BATT_PARAMS_BATT_ARM_MAH_SPEC),
+)
+
+
+_BATT_PARAMS_KEYS: frozenset[str] = frozenset(
+    {
+        "BATT_CAPACITY",
+        "BATT_LOW_VOLT",
+        "BATT_LOW_TIMER",
+        "BATT_FS_VOLTSRC",
+        "BATT_LOW_MAH",
+        "BATT_CRT_VOLT",
+        "BATT_CRT_MAH",
+        "BATT_FS_LOW_ACT",
+        "BATT_FS_CRT_ACT",
+        "BATT_ARM_VOLT",
+        "BATT_ARM_MAH",
+    }
+)
+_BATT_PARAMS_VALUES = _operator.itemgetter(
+    "BATT_CAPACITY",
+    "BATT_LOW_VOLT",
+    "BATT_LOW_TIMER",
+    "BATT_FS_VOLTSRC",
+    "BATT_LOW_MAH",
+    "BATT_CRT_VOLT",
+    "BATT_CRT_MAH",
+    "BATT_FS_LOW_ACT",
+    "BATT_FS_CRT_ACT",
+    "BATT_ARM_VOLT",
+    "BATT_ARM_MAH",
 )
 
 
@@ -235,49 +266,58 @@ class BattParams:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BattParams:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "BATT_CAPACITY",
-                    "BATT_LOW_VOLT",
-                    "BATT_LOW_TIMER",
-                    "BATT_FS_VOLTSRC",
-                    "BATT_LOW_MAH",
-                    "BATT_CRT_VOLT",
-                    "BATT_CRT_MAH",
-                    "BATT_FS_LOW_ACT",
-                    "BATT_FS_CRT_ACT",
-                    "BATT_ARM_VOLT",
-                    "BATT_ARM_MAH",
-                }
-            ),
-            (),
-            "BattParams",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATT_PARAMS_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATT_PARAMS_KEYS, (), "BattParams")
+        elif len(data) == 11:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10 = _BATT_PARAMS_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "BATT_CAPACITY"),
+                v1 if v1.__class__ is float else _m.as_float(v1, "BATT_LOW_VOLT"),
+                v2 if v2.__class__ is int else _m.as_int(v2, "BATT_LOW_TIMER"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "BATT_FS_VOLTSRC"),
+                v4 if v4.__class__ is float else _m.as_float(v4, "BATT_LOW_MAH"),
+                v5 if v5.__class__ is float else _m.as_float(v5, "BATT_CRT_VOLT"),
+                v6 if v6.__class__ is float else _m.as_float(v6, "BATT_CRT_MAH"),
+                v7 if v7.__class__ is int else _m.as_int(v7, "BATT_FS_LOW_ACT"),
+                v8 if v8.__class__ is int else _m.as_int(v8, "BATT_FS_CRT_ACT"),
+                v9 if v9.__class__ is float else _m.as_float(v9, "BATT_ARM_VOLT"),
+                v10 if v10.__class__ is int else _m.as_int(v10, "BATT_ARM_MAH"),
+            )
         obj = cls()
         if "BATT_CAPACITY" in data:
-            obj.BATT_CAPACITY = _m.as_int(data["BATT_CAPACITY"], "BATT_CAPACITY")
+            x = data["BATT_CAPACITY"]
+            obj.BATT_CAPACITY = x if x.__class__ is int else _m.as_int(x, "BATT_CAPACITY")
         if "BATT_LOW_VOLT" in data:
-            obj.BATT_LOW_VOLT = _m.as_float(data["BATT_LOW_VOLT"], "BATT_LOW_VOLT")
+            x = data["BATT_LOW_VOLT"]
+            obj.BATT_LOW_VOLT = x if x.__class__ is float else _m.as_float(x, "BATT_LOW_VOLT")
         if "BATT_LOW_TIMER" in data:
-            obj.BATT_LOW_TIMER = _m.as_int(data["BATT_LOW_TIMER"], "BATT_LOW_TIMER")
+            x = data["BATT_LOW_TIMER"]
+            obj.BATT_LOW_TIMER = x if x.__class__ is int else _m.as_int(x, "BATT_LOW_TIMER")
         if "BATT_FS_VOLTSRC" in data:
-            obj.BATT_FS_VOLTSRC = _m.as_int(data["BATT_FS_VOLTSRC"], "BATT_FS_VOLTSRC")
+            x = data["BATT_FS_VOLTSRC"]
+            obj.BATT_FS_VOLTSRC = x if x.__class__ is int else _m.as_int(x, "BATT_FS_VOLTSRC")
         if "BATT_LOW_MAH" in data:
-            obj.BATT_LOW_MAH = _m.as_float(data["BATT_LOW_MAH"], "BATT_LOW_MAH")
+            x = data["BATT_LOW_MAH"]
+            obj.BATT_LOW_MAH = x if x.__class__ is float else _m.as_float(x, "BATT_LOW_MAH")
         if "BATT_CRT_VOLT" in data:
-            obj.BATT_CRT_VOLT = _m.as_float(data["BATT_CRT_VOLT"], "BATT_CRT_VOLT")
+            x = data["BATT_CRT_VOLT"]
+            obj.BATT_CRT_VOLT = x if x.__class__ is float else _m.as_float(x, "BATT_CRT_VOLT")
         if "BATT_CRT_MAH" in data:
-            obj.BATT_CRT_MAH = _m.as_float(data["BATT_CRT_MAH"], "BATT_CRT_MAH")
+            x = data["BATT_CRT_MAH"]
+            obj.BATT_CRT_MAH = x if x.__class__ is float else _m.as_float(x, "BATT_CRT_MAH")
         if "BATT_FS_LOW_ACT" in data:
-            obj.BATT_FS_LOW_ACT = _m.as_int(data["BATT_FS_LOW_ACT"], "BATT_FS_LOW_ACT")
+            x = data["BATT_FS_LOW_ACT"]
+            obj.BATT_FS_LOW_ACT = x if x.__class__ is int else _m.as_int(x, "BATT_FS_LOW_ACT")
         if "BATT_FS_CRT_ACT" in data:
-            obj.BATT_FS_CRT_ACT = _m.as_int(data["BATT_FS_CRT_ACT"], "BATT_FS_CRT_ACT")
+            x = data["BATT_FS_CRT_ACT"]
+            obj.BATT_FS_CRT_ACT = x if x.__class__ is int else _m.as_int(x, "BATT_FS_CRT_ACT")
         if "BATT_ARM_VOLT" in data:
-            obj.BATT_ARM_VOLT = _m.as_float(data["BATT_ARM_VOLT"], "BATT_ARM_VOLT")
+            x = data["BATT_ARM_VOLT"]
+            obj.BATT_ARM_VOLT = x if x.__class__ is float else _m.as_float(x, "BATT_ARM_VOLT")
         if "BATT_ARM_MAH" in data:
-            obj.BATT_ARM_MAH = _m.as_int(data["BATT_ARM_MAH"], "BATT_ARM_MAH")
+            x = data["BATT_ARM_MAH"]
+            obj.BATT_ARM_MAH = x if x.__class__ is int else _m.as_int(x, "BATT_ARM_MAH")
         return obj
 
     def validate(self) -> list[_v.Violation]:

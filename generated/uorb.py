@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses as _dataclasses
 import enum as _enum
 import math as _math
+import operator as _operator
 import struct as _struct
 from collections.abc import Mapping as _Mapping
 from typing import Any as _Any
@@ -1043,6 +1044,10 @@ _BATTERY_STATUS_V0_FIELD_SPECS = (
 )
 
 
+_BATTERY_INFO_KEYS: frozenset[str] = frozenset({"timestamp", "id", "serial_number"})
+_BATTERY_INFO_VALUES = _operator.itemgetter("timestamp", "id", "serial_number")
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryInfo:
     """What a battery says about itself that rarely changes (its serial number); sent at a low rate.
@@ -1097,14 +1102,26 @@ class BatteryInfo:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfo:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"timestamp", "id", "serial_number"}), (), "BatteryInfo")
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_INFO_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_INFO_KEYS, (), "BatteryInfo")
+        elif len(data) == 3:  # every field named: fetched in one call
+            v0, v1, v2 = _BATTERY_INFO_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "timestamp"),
+                v1 if v1.__class__ is int else _m.as_int(v1, "id"),
+                v2 if v2.__class__ is str else _m.as_str(v2, "serial_number"),
+            )
         obj = cls()
         if "timestamp" in data:
-            obj.timestamp = _m.as_int(data["timestamp"], "timestamp")
+            x = data["timestamp"]
+            obj.timestamp = x if x.__class__ is int else _m.as_int(x, "timestamp")
         if "id" in data:
-            obj.id = _m.as_int(data["id"], "id")
+            x = data["id"]
+            obj.id = x if x.__class__ is int else _m.as_int(x, "id")
         if "serial_number" in data:
-            obj.serial_number = _m.as_str(data["serial_number"], "serial_number")
+            x = data["serial_number"]
+            obj.serial_number = x if x.__class__ is str else _m.as_str(x, "serial_number")
         return obj
 
     UORB_FORMAT: _ClassVar[str] = "<QB32s7x"
@@ -1218,6 +1235,90 @@ class BatteryInfo:
         if field in {"timestamp", "id"}:
             return True
         raise KeyError(f"{field!r} is not a field of " + "uorb.BatteryInfo")
+
+
+_BATTERY_STATUS_KEYS: frozenset[str] = frozenset(
+    {
+        "timestamp",
+        "connected",
+        "voltage_v",
+        "current_a",
+        "current_average_a",
+        "discharged_mah",
+        "remaining",
+        "scale",
+        "time_remaining_s",
+        "temperature",
+        "cell_count",
+        "source",
+        "priority",
+        "capacity",
+        "cycle_count",
+        "average_time_to_empty",
+        "manufacture_date",
+        "state_of_health",
+        "max_error",
+        "id",
+        "interface_error",
+        "voltage_cell_v",
+        "max_cell_voltage_delta",
+        "is_powering_off",
+        "is_required",
+        "warning",
+        "faults",
+        "full_charge_capacity_wh",
+        "remaining_capacity_wh",
+        "over_discharge_count",
+        "nominal_voltage",
+        "internal_resistance_estimate",
+        "ocv_estimate",
+        "ocv_estimate_filtered",
+        "volt_based_soc_estimate",
+        "voltage_prediction",
+        "prediction_error",
+        "estimation_covariance_norm",
+    }
+)
+_BATTERY_STATUS_VALUES = _operator.itemgetter(
+    "timestamp",
+    "connected",
+    "voltage_v",
+    "current_a",
+    "current_average_a",
+    "discharged_mah",
+    "remaining",
+    "scale",
+    "time_remaining_s",
+    "temperature",
+    "cell_count",
+    "source",
+    "priority",
+    "capacity",
+    "cycle_count",
+    "average_time_to_empty",
+    "manufacture_date",
+    "state_of_health",
+    "max_error",
+    "id",
+    "interface_error",
+    "voltage_cell_v",
+    "max_cell_voltage_delta",
+    "is_powering_off",
+    "is_required",
+    "warning",
+    "faults",
+    "full_charge_capacity_wh",
+    "remaining_capacity_wh",
+    "over_discharge_count",
+    "nominal_voltage",
+    "internal_resistance_estimate",
+    "ocv_estimate",
+    "ocv_estimate_filtered",
+    "volt_based_soc_estimate",
+    "voltage_prediction",
+    "prediction_error",
+    "estimation_covariance_norm",
+)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -1689,136 +1790,207 @@ class BatteryStatus:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "timestamp",
-                    "connected",
-                    "voltage_v",
-                    "current_a",
-                    "current_average_a",
-                    "discharged_mah",
-                    "remaining",
-                    "scale",
-                    "time_remaining_s",
-                    "temperature",
-                    "cell_count",
-                    "source",
-                    "priority",
-                    "capacity",
-                    "cycle_count",
-                    "average_time_to_empty",
-                    "manufacture_date",
-                    "state_of_health",
-                    "max_error",
-                    "id",
-                    "interface_error",
-                    "voltage_cell_v",
-                    "max_cell_voltage_delta",
-                    "is_powering_off",
-                    "is_required",
-                    "warning",
-                    "faults",
-                    "full_charge_capacity_wh",
-                    "remaining_capacity_wh",
-                    "over_discharge_count",
-                    "nominal_voltage",
-                    "internal_resistance_estimate",
-                    "ocv_estimate",
-                    "ocv_estimate_filtered",
-                    "volt_based_soc_estimate",
-                    "voltage_prediction",
-                    "prediction_error",
-                    "estimation_covariance_norm",
-                }
-            ),
-            (),
-            "BatteryStatus",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_STATUS_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_STATUS_KEYS, (), "BatteryStatus")
+        elif len(data) == 38:  # every field named: fetched in one call
+            (
+                v0,
+                v1,
+                v2,
+                v3,
+                v4,
+                v5,
+                v6,
+                v7,
+                v8,
+                v9,
+                v10,
+                v11,
+                v12,
+                v13,
+                v14,
+                v15,
+                v16,
+                v17,
+                v18,
+                v19,
+                v20,
+                v21,
+                v22,
+                v23,
+                v24,
+                v25,
+                v26,
+                v27,
+                v28,
+                v29,
+                v30,
+                v31,
+                v32,
+                v33,
+                v34,
+                v35,
+                v36,
+                v37,
+            ) = _BATTERY_STATUS_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "timestamp"),
+                v1 if v1.__class__ is bool else _m.as_bool(v1, "connected"),
+                v2 if v2.__class__ is float else _m.as_float(v2, "voltage_v"),
+                v3 if v3.__class__ is float else _m.as_float(v3, "current_a"),
+                v4 if v4.__class__ is float else _m.as_float(v4, "current_average_a"),
+                v5 if v5.__class__ is float else _m.as_float(v5, "discharged_mah"),
+                v6 if v6.__class__ is float else _m.as_float(v6, "remaining"),
+                v7 if v7.__class__ is float else _m.as_float(v7, "scale"),
+                v8 if v8.__class__ is float else _m.as_float(v8, "time_remaining_s"),
+                v9 if v9.__class__ is float else _m.as_float(v9, "temperature"),
+                v10 if v10.__class__ is int else _m.as_int(v10, "cell_count"),
+                v11 if v11.__class__ is int else _m.as_int(v11, "source"),
+                v12 if v12.__class__ is int else _m.as_int(v12, "priority"),
+                v13 if v13.__class__ is int else _m.as_int(v13, "capacity"),
+                v14 if v14.__class__ is int else _m.as_int(v14, "cycle_count"),
+                v15 if v15.__class__ is int else _m.as_int(v15, "average_time_to_empty"),
+                v16 if v16.__class__ is int else _m.as_int(v16, "manufacture_date"),
+                v17 if v17.__class__ is int else _m.as_int(v17, "state_of_health"),
+                v18 if v18.__class__ is int else _m.as_int(v18, "max_error"),
+                v19 if v19.__class__ is int else _m.as_int(v19, "id"),
+                v20 if v20.__class__ is int else _m.as_int(v20, "interface_error"),
+                _m.as_typed_list(v21, "voltage_cell_v", 14, True, float, _m.as_float),
+                v22 if v22.__class__ is float else _m.as_float(v22, "max_cell_voltage_delta"),
+                v23 if v23.__class__ is bool else _m.as_bool(v23, "is_powering_off"),
+                v24 if v24.__class__ is bool else _m.as_bool(v24, "is_required"),
+                v25 if v25.__class__ is int else _m.as_int(v25, "warning"),
+                v26 if v26.__class__ is int else _m.as_int(v26, "faults"),
+                v27 if v27.__class__ is float else _m.as_float(v27, "full_charge_capacity_wh"),
+                v28 if v28.__class__ is float else _m.as_float(v28, "remaining_capacity_wh"),
+                v29 if v29.__class__ is int else _m.as_int(v29, "over_discharge_count"),
+                v30 if v30.__class__ is float else _m.as_float(v30, "nominal_voltage"),
+                v31 if v31.__class__ is float else _m.as_float(v31, "internal_resistance_estimate"),
+                v32 if v32.__class__ is float else _m.as_float(v32, "ocv_estimate"),
+                v33 if v33.__class__ is float else _m.as_float(v33, "ocv_estimate_filtered"),
+                v34 if v34.__class__ is float else _m.as_float(v34, "volt_based_soc_estimate"),
+                v35 if v35.__class__ is float else _m.as_float(v35, "voltage_prediction"),
+                v36 if v36.__class__ is float else _m.as_float(v36, "prediction_error"),
+                v37 if v37.__class__ is float else _m.as_float(v37, "estimation_covariance_norm"),
+            )
         obj = cls()
         if "timestamp" in data:
-            obj.timestamp = _m.as_int(data["timestamp"], "timestamp")
+            x = data["timestamp"]
+            obj.timestamp = x if x.__class__ is int else _m.as_int(x, "timestamp")
         if "connected" in data:
-            obj.connected = _m.as_bool(data["connected"], "connected")
+            x = data["connected"]
+            obj.connected = x if x.__class__ is bool else _m.as_bool(x, "connected")
         if "voltage_v" in data:
-            obj.voltage_v = _m.as_float(data["voltage_v"], "voltage_v")
+            x = data["voltage_v"]
+            obj.voltage_v = x if x.__class__ is float else _m.as_float(x, "voltage_v")
         if "current_a" in data:
-            obj.current_a = _m.as_float(data["current_a"], "current_a")
+            x = data["current_a"]
+            obj.current_a = x if x.__class__ is float else _m.as_float(x, "current_a")
         if "current_average_a" in data:
-            obj.current_average_a = _m.as_float(data["current_average_a"], "current_average_a")
+            x = data["current_average_a"]
+            obj.current_average_a = x if x.__class__ is float else _m.as_float(x, "current_average_a")
         if "discharged_mah" in data:
-            obj.discharged_mah = _m.as_float(data["discharged_mah"], "discharged_mah")
+            x = data["discharged_mah"]
+            obj.discharged_mah = x if x.__class__ is float else _m.as_float(x, "discharged_mah")
         if "remaining" in data:
-            obj.remaining = _m.as_float(data["remaining"], "remaining")
+            x = data["remaining"]
+            obj.remaining = x if x.__class__ is float else _m.as_float(x, "remaining")
         if "scale" in data:
-            obj.scale = _m.as_float(data["scale"], "scale")
+            x = data["scale"]
+            obj.scale = x if x.__class__ is float else _m.as_float(x, "scale")
         if "time_remaining_s" in data:
-            obj.time_remaining_s = _m.as_float(data["time_remaining_s"], "time_remaining_s")
+            x = data["time_remaining_s"]
+            obj.time_remaining_s = x if x.__class__ is float else _m.as_float(x, "time_remaining_s")
         if "temperature" in data:
-            obj.temperature = _m.as_float(data["temperature"], "temperature")
+            x = data["temperature"]
+            obj.temperature = x if x.__class__ is float else _m.as_float(x, "temperature")
         if "cell_count" in data:
-            obj.cell_count = _m.as_int(data["cell_count"], "cell_count")
+            x = data["cell_count"]
+            obj.cell_count = x if x.__class__ is int else _m.as_int(x, "cell_count")
         if "source" in data:
-            obj.source = _m.as_int(data["source"], "source")
+            x = data["source"]
+            obj.source = x if x.__class__ is int else _m.as_int(x, "source")
         if "priority" in data:
-            obj.priority = _m.as_int(data["priority"], "priority")
+            x = data["priority"]
+            obj.priority = x if x.__class__ is int else _m.as_int(x, "priority")
         if "capacity" in data:
-            obj.capacity = _m.as_int(data["capacity"], "capacity")
+            x = data["capacity"]
+            obj.capacity = x if x.__class__ is int else _m.as_int(x, "capacity")
         if "cycle_count" in data:
-            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+            x = data["cycle_count"]
+            obj.cycle_count = x if x.__class__ is int else _m.as_int(x, "cycle_count")
         if "average_time_to_empty" in data:
-            obj.average_time_to_empty = _m.as_int(data["average_time_to_empty"], "average_time_to_empty")
+            x = data["average_time_to_empty"]
+            obj.average_time_to_empty = x if x.__class__ is int else _m.as_int(x, "average_time_to_empty")
         if "manufacture_date" in data:
-            obj.manufacture_date = _m.as_int(data["manufacture_date"], "manufacture_date")
+            x = data["manufacture_date"]
+            obj.manufacture_date = x if x.__class__ is int else _m.as_int(x, "manufacture_date")
         if "state_of_health" in data:
-            obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
+            x = data["state_of_health"]
+            obj.state_of_health = x if x.__class__ is int else _m.as_int(x, "state_of_health")
         if "max_error" in data:
-            obj.max_error = _m.as_int(data["max_error"], "max_error")
+            x = data["max_error"]
+            obj.max_error = x if x.__class__ is int else _m.as_int(x, "max_error")
         if "id" in data:
-            obj.id = _m.as_int(data["id"], "id")
+            x = data["id"]
+            obj.id = x if x.__class__ is int else _m.as_int(x, "id")
         if "interface_error" in data:
-            obj.interface_error = _m.as_int(data["interface_error"], "interface_error")
+            x = data["interface_error"]
+            obj.interface_error = x if x.__class__ is int else _m.as_int(x, "interface_error")
         if "voltage_cell_v" in data:
-            obj.voltage_cell_v = _m.as_list(
-                data["voltage_cell_v"], "voltage_cell_v", 14, True, lambda item, p: _m.as_float(item, p)
-            )
+            x = data["voltage_cell_v"]
+            obj.voltage_cell_v = _m.as_typed_list(x, "voltage_cell_v", 14, True, float, _m.as_float)
         if "max_cell_voltage_delta" in data:
-            obj.max_cell_voltage_delta = _m.as_float(data["max_cell_voltage_delta"], "max_cell_voltage_delta")
+            x = data["max_cell_voltage_delta"]
+            obj.max_cell_voltage_delta = x if x.__class__ is float else _m.as_float(x, "max_cell_voltage_delta")
         if "is_powering_off" in data:
-            obj.is_powering_off = _m.as_bool(data["is_powering_off"], "is_powering_off")
+            x = data["is_powering_off"]
+            obj.is_powering_off = x if x.__class__ is bool else _m.as_bool(x, "is_powering_off")
         if "is_required" in data:
-            obj.is_required = _m.as_bool(data["is_required"], "is_required")
+            x = data["is_required"]
+            obj.is_required = x if x.__class__ is bool else _m.as_bool(x, "is_required")
         if "warning" in data:
-            obj.warning = _m.as_int(data["warning"], "warning")
+            x = data["warning"]
+            obj.warning = x if x.__class__ is int else _m.as_int(x, "warning")
         if "faults" in data:
-            obj.faults = _m.as_int(data["faults"], "faults")
+            x = data["faults"]
+            obj.faults = x if x.__class__ is int else _m.as_int(x, "faults")
         if "full_charge_capacity_wh" in data:
-            obj.full_charge_capacity_wh = _m.as_float(data["full_charge_capacity_wh"], "full_charge_capacity_wh")
+            x = data["full_charge_capacity_wh"]
+            obj.full_charge_capacity_wh = x if x.__class__ is float else _m.as_float(x, "full_charge_capacity_wh")
         if "remaining_capacity_wh" in data:
-            obj.remaining_capacity_wh = _m.as_float(data["remaining_capacity_wh"], "remaining_capacity_wh")
+            x = data["remaining_capacity_wh"]
+            obj.remaining_capacity_wh = x if x.__class__ is float else _m.as_float(x, "remaining_capacity_wh")
         if "over_discharge_count" in data:
-            obj.over_discharge_count = _m.as_int(data["over_discharge_count"], "over_discharge_count")
+            x = data["over_discharge_count"]
+            obj.over_discharge_count = x if x.__class__ is int else _m.as_int(x, "over_discharge_count")
         if "nominal_voltage" in data:
-            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+            x = data["nominal_voltage"]
+            obj.nominal_voltage = x if x.__class__ is float else _m.as_float(x, "nominal_voltage")
         if "internal_resistance_estimate" in data:
-            obj.internal_resistance_estimate = _m.as_float(
-                data["internal_resistance_estimate"], "internal_resistance_estimate"
+            x = data["internal_resistance_estimate"]
+            obj.internal_resistance_estimate = (
+                x if x.__class__ is float else _m.as_float(x, "internal_resistance_estimate")
             )
         if "ocv_estimate" in data:
-            obj.ocv_estimate = _m.as_float(data["ocv_estimate"], "ocv_estimate")
+            x = data["ocv_estimate"]
+            obj.ocv_estimate = x if x.__class__ is float else _m.as_float(x, "ocv_estimate")
         if "ocv_estimate_filtered" in data:
-            obj.ocv_estimate_filtered = _m.as_float(data["ocv_estimate_filtered"], "ocv_estimate_filtered")
+            x = data["ocv_estimate_filtered"]
+            obj.ocv_estimate_filtered = x if x.__class__ is float else _m.as_float(x, "ocv_estimate_filtered")
         if "volt_based_soc_estimate" in data:
-            obj.volt_based_soc_estimate = _m.as_float(data["volt_based_soc_estimate"], "volt_based_soc_estimate")
+            x = data["volt_based_soc_estimate"]
+            obj.volt_based_soc_estimate = x if x.__class__ is float else _m.as_float(x, "volt_based_soc_estimate")
         if "voltage_prediction" in data:
-            obj.voltage_prediction = _m.as_float(data["voltage_prediction"], "voltage_prediction")
+            x = data["voltage_prediction"]
+            obj.voltage_prediction = x if x.__class__ is float else _m.as_float(x, "voltage_prediction")
         if "prediction_error" in data:
-            obj.prediction_error = _m.as_float(data["prediction_error"], "prediction_error")
+            x = data["prediction_error"]
+            obj.prediction_error = x if x.__class__ is float else _m.as_float(x, "prediction_error")
         if "estimation_covariance_norm" in data:
-            obj.estimation_covariance_norm = _m.as_float(
-                data["estimation_covariance_norm"], "estimation_covariance_norm"
-            )
+            x = data["estimation_covariance_norm"]
+            obj.estimation_covariance_norm = x if x.__class__ is float else _m.as_float(x, "estimation_covariance_norm")
         return obj
 
     UORB_FORMAT: _ClassVar[str] = "<Q33f9H?4B2?B2x"
@@ -2297,6 +2469,92 @@ class BatteryStatus:
         raise KeyError(f"{field!r} is not a field of " + "uorb.BatteryStatus")
 
 
+_BATTERY_STATUS_V0_KEYS: frozenset[str] = frozenset(
+    {
+        "timestamp",
+        "connected",
+        "voltage_v",
+        "current_a",
+        "current_average_a",
+        "discharged_mah",
+        "remaining",
+        "scale",
+        "time_remaining_s",
+        "temperature",
+        "cell_count",
+        "source",
+        "priority",
+        "capacity",
+        "cycle_count",
+        "average_time_to_empty",
+        "serial_number",
+        "manufacture_date",
+        "state_of_health",
+        "max_error",
+        "id",
+        "interface_error",
+        "voltage_cell_v",
+        "max_cell_voltage_delta",
+        "is_powering_off",
+        "is_required",
+        "warning",
+        "faults",
+        "full_charge_capacity_wh",
+        "remaining_capacity_wh",
+        "over_discharge_count",
+        "nominal_voltage",
+        "internal_resistance_estimate",
+        "ocv_estimate",
+        "ocv_estimate_filtered",
+        "volt_based_soc_estimate",
+        "voltage_prediction",
+        "prediction_error",
+        "estimation_covariance_norm",
+    }
+)
+_BATTERY_STATUS_V0_VALUES = _operator.itemgetter(
+    "timestamp",
+    "connected",
+    "voltage_v",
+    "current_a",
+    "current_average_a",
+    "discharged_mah",
+    "remaining",
+    "scale",
+    "time_remaining_s",
+    "temperature",
+    "cell_count",
+    "source",
+    "priority",
+    "capacity",
+    "cycle_count",
+    "average_time_to_empty",
+    "serial_number",
+    "manufacture_date",
+    "state_of_health",
+    "max_error",
+    "id",
+    "interface_error",
+    "voltage_cell_v",
+    "max_cell_voltage_delta",
+    "is_powering_off",
+    "is_required",
+    "warning",
+    "faults",
+    "full_charge_capacity_wh",
+    "remaining_capacity_wh",
+    "over_discharge_count",
+    "nominal_voltage",
+    "internal_resistance_estimate",
+    "ocv_estimate",
+    "ocv_estimate_filtered",
+    "volt_based_soc_estimate",
+    "voltage_prediction",
+    "prediction_error",
+    "estimation_covariance_norm",
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryStatusV0:
     """State of one battery as the autopilot sees it, in the layout of message version 0 (up to four packs, with
@@ -2717,139 +2975,212 @@ class BatteryStatusV0:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatusV0:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "timestamp",
-                    "connected",
-                    "voltage_v",
-                    "current_a",
-                    "current_average_a",
-                    "discharged_mah",
-                    "remaining",
-                    "scale",
-                    "time_remaining_s",
-                    "temperature",
-                    "cell_count",
-                    "source",
-                    "priority",
-                    "capacity",
-                    "cycle_count",
-                    "average_time_to_empty",
-                    "serial_number",
-                    "manufacture_date",
-                    "state_of_health",
-                    "max_error",
-                    "id",
-                    "interface_error",
-                    "voltage_cell_v",
-                    "max_cell_voltage_delta",
-                    "is_powering_off",
-                    "is_required",
-                    "warning",
-                    "faults",
-                    "full_charge_capacity_wh",
-                    "remaining_capacity_wh",
-                    "over_discharge_count",
-                    "nominal_voltage",
-                    "internal_resistance_estimate",
-                    "ocv_estimate",
-                    "ocv_estimate_filtered",
-                    "volt_based_soc_estimate",
-                    "voltage_prediction",
-                    "prediction_error",
-                    "estimation_covariance_norm",
-                }
-            ),
-            (),
-            "BatteryStatusV0",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_STATUS_V0_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_STATUS_V0_KEYS, (), "BatteryStatusV0")
+        elif len(data) == 39:  # every field named: fetched in one call
+            (
+                v0,
+                v1,
+                v2,
+                v3,
+                v4,
+                v5,
+                v6,
+                v7,
+                v8,
+                v9,
+                v10,
+                v11,
+                v12,
+                v13,
+                v14,
+                v15,
+                v16,
+                v17,
+                v18,
+                v19,
+                v20,
+                v21,
+                v22,
+                v23,
+                v24,
+                v25,
+                v26,
+                v27,
+                v28,
+                v29,
+                v30,
+                v31,
+                v32,
+                v33,
+                v34,
+                v35,
+                v36,
+                v37,
+                v38,
+            ) = _BATTERY_STATUS_V0_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "timestamp"),
+                v1 if v1.__class__ is bool else _m.as_bool(v1, "connected"),
+                v2 if v2.__class__ is float else _m.as_float(v2, "voltage_v"),
+                v3 if v3.__class__ is float else _m.as_float(v3, "current_a"),
+                v4 if v4.__class__ is float else _m.as_float(v4, "current_average_a"),
+                v5 if v5.__class__ is float else _m.as_float(v5, "discharged_mah"),
+                v6 if v6.__class__ is float else _m.as_float(v6, "remaining"),
+                v7 if v7.__class__ is float else _m.as_float(v7, "scale"),
+                v8 if v8.__class__ is float else _m.as_float(v8, "time_remaining_s"),
+                v9 if v9.__class__ is float else _m.as_float(v9, "temperature"),
+                v10 if v10.__class__ is int else _m.as_int(v10, "cell_count"),
+                v11 if v11.__class__ is int else _m.as_int(v11, "source"),
+                v12 if v12.__class__ is int else _m.as_int(v12, "priority"),
+                v13 if v13.__class__ is int else _m.as_int(v13, "capacity"),
+                v14 if v14.__class__ is int else _m.as_int(v14, "cycle_count"),
+                v15 if v15.__class__ is int else _m.as_int(v15, "average_time_to_empty"),
+                v16 if v16.__class__ is int else _m.as_int(v16, "serial_number"),
+                v17 if v17.__class__ is int else _m.as_int(v17, "manufacture_date"),
+                v18 if v18.__class__ is int else _m.as_int(v18, "state_of_health"),
+                v19 if v19.__class__ is int else _m.as_int(v19, "max_error"),
+                v20 if v20.__class__ is int else _m.as_int(v20, "id"),
+                v21 if v21.__class__ is int else _m.as_int(v21, "interface_error"),
+                _m.as_typed_list(v22, "voltage_cell_v", 14, True, float, _m.as_float),
+                v23 if v23.__class__ is float else _m.as_float(v23, "max_cell_voltage_delta"),
+                v24 if v24.__class__ is bool else _m.as_bool(v24, "is_powering_off"),
+                v25 if v25.__class__ is bool else _m.as_bool(v25, "is_required"),
+                v26 if v26.__class__ is int else _m.as_int(v26, "warning"),
+                v27 if v27.__class__ is int else _m.as_int(v27, "faults"),
+                v28 if v28.__class__ is float else _m.as_float(v28, "full_charge_capacity_wh"),
+                v29 if v29.__class__ is float else _m.as_float(v29, "remaining_capacity_wh"),
+                v30 if v30.__class__ is int else _m.as_int(v30, "over_discharge_count"),
+                v31 if v31.__class__ is float else _m.as_float(v31, "nominal_voltage"),
+                v32 if v32.__class__ is float else _m.as_float(v32, "internal_resistance_estimate"),
+                v33 if v33.__class__ is float else _m.as_float(v33, "ocv_estimate"),
+                v34 if v34.__class__ is float else _m.as_float(v34, "ocv_estimate_filtered"),
+                v35 if v35.__class__ is float else _m.as_float(v35, "volt_based_soc_estimate"),
+                v36 if v36.__class__ is float else _m.as_float(v36, "voltage_prediction"),
+                v37 if v37.__class__ is float else _m.as_float(v37, "prediction_error"),
+                v38 if v38.__class__ is float else _m.as_float(v38, "estimation_covariance_norm"),
+            )
         obj = cls()
         if "timestamp" in data:
-            obj.timestamp = _m.as_int(data["timestamp"], "timestamp")
+            x = data["timestamp"]
+            obj.timestamp = x if x.__class__ is int else _m.as_int(x, "timestamp")
         if "connected" in data:
-            obj.connected = _m.as_bool(data["connected"], "connected")
+            x = data["connected"]
+            obj.connected = x if x.__class__ is bool else _m.as_bool(x, "connected")
         if "voltage_v" in data:
-            obj.voltage_v = _m.as_float(data["voltage_v"], "voltage_v")
+            x = data["voltage_v"]
+            obj.voltage_v = x if x.__class__ is float else _m.as_float(x, "voltage_v")
         if "current_a" in data:
-            obj.current_a = _m.as_float(data["current_a"], "current_a")
+            x = data["current_a"]
+            obj.current_a = x if x.__class__ is float else _m.as_float(x, "current_a")
         if "current_average_a" in data:
-            obj.current_average_a = _m.as_float(data["current_average_a"], "current_average_a")
+            x = data["current_average_a"]
+            obj.current_average_a = x if x.__class__ is float else _m.as_float(x, "current_average_a")
         if "discharged_mah" in data:
-            obj.discharged_mah = _m.as_float(data["discharged_mah"], "discharged_mah")
+            x = data["discharged_mah"]
+            obj.discharged_mah = x if x.__class__ is float else _m.as_float(x, "discharged_mah")
         if "remaining" in data:
-            obj.remaining = _m.as_float(data["remaining"], "remaining")
+            x = data["remaining"]
+            obj.remaining = x if x.__class__ is float else _m.as_float(x, "remaining")
         if "scale" in data:
-            obj.scale = _m.as_float(data["scale"], "scale")
+            x = data["scale"]
+            obj.scale = x if x.__class__ is float else _m.as_float(x, "scale")
         if "time_remaining_s" in data:
-            obj.time_remaining_s = _m.as_float(data["time_remaining_s"], "time_remaining_s")
+            x = data["time_remaining_s"]
+            obj.time_remaining_s = x if x.__class__ is float else _m.as_float(x, "time_remaining_s")
         if "temperature" in data:
-            obj.temperature = _m.as_float(data["temperature"], "temperature")
+            x = data["temperature"]
+            obj.temperature = x if x.__class__ is float else _m.as_float(x, "temperature")
         if "cell_count" in data:
-            obj.cell_count = _m.as_int(data["cell_count"], "cell_count")
+            x = data["cell_count"]
+            obj.cell_count = x if x.__class__ is int else _m.as_int(x, "cell_count")
         if "source" in data:
-            obj.source = _m.as_int(data["source"], "source")
+            x = data["source"]
+            obj.source = x if x.__class__ is int else _m.as_int(x, "source")
         if "priority" in data:
-            obj.priority = _m.as_int(data["priority"], "priority")
+            x = data["priority"]
+            obj.priority = x if x.__class__ is int else _m.as_int(x, "priority")
         if "capacity" in data:
-            obj.capacity = _m.as_int(data["capacity"], "capacity")
+            x = data["capacity"]
+            obj.capacity = x if x.__class__ is int else _m.as_int(x, "capacity")
         if "cycle_count" in data:
-            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+            x = data["cycle_count"]
+            obj.cycle_count = x if x.__class__ is int else _m.as_int(x, "cycle_count")
         if "average_time_to_empty" in data:
-            obj.average_time_to_empty = _m.as_int(data["average_time_to_empty"], "average_time_to_empty")
+            x = data["average_time_to_empty"]
+            obj.average_time_to_empty = x if x.__class__ is int else _m.as_int(x, "average_time_to_empty")
         if "serial_number" in data:
-            obj.serial_number = _m.as_int(data["serial_number"], "serial_number")
+            x = data["serial_number"]
+            obj.serial_number = x if x.__class__ is int else _m.as_int(x, "serial_number")
         if "manufacture_date" in data:
-            obj.manufacture_date = _m.as_int(data["manufacture_date"], "manufacture_date")
+            x = data["manufacture_date"]
+            obj.manufacture_date = x if x.__class__ is int else _m.as_int(x, "manufacture_date")
         if "state_of_health" in data:
-            obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
+            x = data["state_of_health"]
+            obj.state_of_health = x if x.__class__ is int else _m.as_int(x, "state_of_health")
         if "max_error" in data:
-            obj.max_error = _m.as_int(data["max_error"], "max_error")
+            x = data["max_error"]
+            obj.max_error = x if x.__class__ is int else _m.as_int(x, "max_error")
         if "id" in data:
-            obj.id = _m.as_int(data["id"], "id")
+            x = data["id"]
+            obj.id = x if x.__class__ is int else _m.as_int(x, "id")
         if "interface_error" in data:
-            obj.interface_error = _m.as_int(data["interface_error"], "interface_error")
+            x = data["interface_error"]
+            obj.interface_error = x if x.__class__ is int else _m.as_int(x, "interface_error")
         if "voltage_cell_v" in data:
-            obj.voltage_cell_v = _m.as_list(
-                data["voltage_cell_v"], "voltage_cell_v", 14, True, lambda item, p: _m.as_float(item, p)
-            )
+            x = data["voltage_cell_v"]
+            obj.voltage_cell_v = _m.as_typed_list(x, "voltage_cell_v", 14, True, float, _m.as_float)
         if "max_cell_voltage_delta" in data:
-            obj.max_cell_voltage_delta = _m.as_float(data["max_cell_voltage_delta"], "max_cell_voltage_delta")
+            x = data["max_cell_voltage_delta"]
+            obj.max_cell_voltage_delta = x if x.__class__ is float else _m.as_float(x, "max_cell_voltage_delta")
         if "is_powering_off" in data:
-            obj.is_powering_off = _m.as_bool(data["is_powering_off"], "is_powering_off")
+            x = data["is_powering_off"]
+            obj.is_powering_off = x if x.__class__ is bool else _m.as_bool(x, "is_powering_off")
         if "is_required" in data:
-            obj.is_required = _m.as_bool(data["is_required"], "is_required")
+            x = data["is_required"]
+            obj.is_required = x if x.__class__ is bool else _m.as_bool(x, "is_required")
         if "warning" in data:
-            obj.warning = _m.as_int(data["warning"], "warning")
+            x = data["warning"]
+            obj.warning = x if x.__class__ is int else _m.as_int(x, "warning")
         if "faults" in data:
-            obj.faults = _m.as_int(data["faults"], "faults")
+            x = data["faults"]
+            obj.faults = x if x.__class__ is int else _m.as_int(x, "faults")
         if "full_charge_capacity_wh" in data:
-            obj.full_charge_capacity_wh = _m.as_float(data["full_charge_capacity_wh"], "full_charge_capacity_wh")
+            x = data["full_charge_capacity_wh"]
+            obj.full_charge_capacity_wh = x if x.__class__ is float else _m.as_float(x, "full_charge_capacity_wh")
         if "remaining_capacity_wh" in data:
-            obj.remaining_capacity_wh = _m.as_float(data["remaining_capacity_wh"], "remaining_capacity_wh")
+            x = data["remaining_capacity_wh"]
+            obj.remaining_capacity_wh = x if x.__class__ is float else _m.as_float(x, "remaining_capacity_wh")
         if "over_discharge_count" in data:
-            obj.over_discharge_count = _m.as_int(data["over_discharge_count"], "over_discharge_count")
+            x = data["over_discharge_count"]
+            obj.over_discharge_count = x if x.__class__ is int else _m.as_int(x, "over_discharge_count")
         if "nominal_voltage" in data:
-            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+            x = data["nominal_voltage"]
+            obj.nominal_voltage = x if x.__class__ is float else _m.as_float(x, "nominal_voltage")
         if "internal_resistance_estimate" in data:
-            obj.internal_resistance_estimate = _m.as_float(
-                data["internal_resistance_estimate"], "internal_resistance_estimate"
+            x = data["internal_resistance_estimate"]
+            obj.internal_resistance_estimate = (
+                x if x.__class__ is float else _m.as_float(x, "internal_resistance_estimate")
             )
         if "ocv_estimate" in data:
-            obj.ocv_estimate = _m.as_float(data["ocv_estimate"], "ocv_estimate")
+            x = data["ocv_estimate"]
+            obj.ocv_estimate = x if x.__class__ is float else _m.as_float(x, "ocv_estimate")
         if "ocv_estimate_filtered" in data:
-            obj.ocv_estimate_filtered = _m.as_float(data["ocv_estimate_filtered"], "ocv_estimate_filtered")
+            x = data["ocv_estimate_filtered"]
+            obj.ocv_estimate_filtered = x if x.__class__ is float else _m.as_float(x, "ocv_estimate_filtered")
         if "volt_based_soc_estimate" in data:
-            obj.volt_based_soc_estimate = _m.as_float(data["volt_based_soc_estimate"], "volt_based_soc_estimate")
+            x = data["volt_based_soc_estimate"]
+            obj.volt_based_soc_estimate = x if x.__class__ is float else _m.as_float(x, "volt_based_soc_estimate")
         if "voltage_prediction" in data:
-            obj.voltage_prediction = _m.as_float(data["voltage_prediction"], "voltage_prediction")
+            x = data["voltage_prediction"]
+            obj.voltage_prediction = x if x.__class__ is float else _m.as_float(x, "voltage_prediction")
         if "prediction_error" in data:
-            obj.prediction_error = _m.as_float(data["prediction_error"], "prediction_error")
+            x = data["prediction_error"]
+            obj.prediction_error = x if x.__class__ is float else _m.as_float(x, "prediction_error")
         if "estimation_covariance_norm" in data:
-            obj.estimation_covariance_norm = _m.as_float(
-                data["estimation_covariance_norm"], "estimation_covariance_norm"
-            )
+            x = data["estimation_covariance_norm"]
+            obj.estimation_covariance_norm = x if x.__class__ is float else _m.as_float(x, "estimation_covariance_norm")
         return obj
 
     UORB_FORMAT: _ClassVar[str] = "<Q33f10H?4B2?B"

@@ -14,11 +14,9 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Literal, Protocol, cast
+from typing import IO, Any, Literal, Protocol, cast
 
 from ..errors import BattgenError, cannot_read, did_you_mean
-from ..inputs.can.records import capture_side
-from ..inputs.devicetree.records import read_devicetree
 from ..inputs.documents import read_json, read_jsonl, read_yaml
 from ..inputs.kinds import content_kind, kind_of_name
 from ..inputs.model import (
@@ -33,8 +31,6 @@ from ..inputs.model import (
 )
 from ..inputs.payloads import read_hex, read_raw
 from ..inputs.records import InputError, Item, Notice, Record, Unreadable
-from ..inputs.tlog import StreamStats, mavlink_items, message_name
-from ..inputs.ulog import ulog_items
 from ..ir.numbers import to_json_data
 from .package import bundled_schemas, load_schemas, named_package, package_module
 from .senders import find_sender
@@ -56,6 +52,7 @@ class LossReport(Protocol):
 
     def to_dict(self) -> list[dict[str, str]]: ...
     def summary(self) -> str: ...
+    def details(self, kind: str) -> list[tuple[str, str]]: ...
 
 
 class ConvertModule(Protocol):
@@ -67,7 +64,7 @@ class ConvertModule(Protocol):
     INPUTS: Mapping[tuple[str, str], tuple[str, ...]]
     ConversionError: type[Exception]
 
-    def LossReport(self) -> LossReport: ...  # the class, called to make one
+    def LossReport(self, *, full: bool = True) -> LossReport: ...  # the class, called to make one
     def converter(self, source: str, target: str) -> Callable[..., object]: ...
 
 
@@ -189,8 +186,8 @@ class Endpoint:
     def to_plain(self, objs: object) -> object:
         seq = cast(tuple[PlainData | None, ...], objs if isinstance(objs, tuple) else (objs,))
         if len(self.items) == 1:
-            return to_json_data(cast(PlainData, seq[0]).to_dict())
-        return {a: to_json_data(o.to_dict()) for (a, _), o in zip(self.items, seq, strict=True) if o is not None}
+            return _json_data(cast(PlainData, seq[0]).to_dict())
+        return {a: _json_data(o.to_dict()) for (a, _), o in zip(self.items, seq, strict=True) if o is not None}
 
     def to_binary(self, objs: object, file: str, line: int) -> tuple[bytes, ...]:
         seq = cast(tuple[object, ...], objs if isinstance(objs, tuple) else (objs,))
@@ -205,6 +202,31 @@ class Endpoint:
             except (ValueError, TypeError, OverflowError) as exc:
                 raise fail(file, line, f"cannot encode {alias}: {exc}") from None
         return tuple(out)
+
+
+_SCALARS = frozenset({int, str, bool, type(None)})
+
+
+def _json_data(data: dict[str, object]) -> object:
+    """A message's ``to_dict()`` as strict JSON data: the dict itself when it holds only what JSON writes as it
+    is (the usual record: finite numbers, text, flat lists of them), else :func:`to_json_data`'s copy (NaN and
+    the infinities spelled, bytes and enum members made plain, nested messages walked)."""
+    value: Any
+    for value in data.values():
+        kind = value.__class__
+        if kind is float:
+            if value - value != 0.0:  # NaN or an infinity
+                return to_json_data(data)
+        elif kind is list:
+            for item in value:
+                if item.__class__ is float:
+                    if item - item != 0.0:
+                        return to_json_data(data)
+                elif item.__class__ not in _SCALARS:
+                    return to_json_data(data)
+        elif kind not in _SCALARS:
+            return to_json_data(data)
+    return data
 
 
 CARRIED = "_before"  # the suffix of a converter input fed from the previous record's result
@@ -313,8 +335,9 @@ class Conversion:
             objs = self.source.build(item)
             if self.policy == "strict":  # strict refuses what validate refuses of the values' types
                 _refuse_unfit(objs, item)
-            # always kept: what the target could not hold is told even without --report
-            report = self.module.LossReport()
+            # always kept: what the target could not hold is told even without --report (the fields dropped
+            # or left unknown, alike for every record, only with it)
+            report = self.module.LossReport(full=loss is not None)
             if self.sender is not None:
                 objs = self.sender.correct(objs, [a for a, _ in self.source.items], report)
             try:
@@ -328,10 +351,9 @@ class Conversion:
             for name in carried:
                 extra[name] = _carried(result, report, name.removesuffix(CARRIED))
             lost = None if loss is None else report.summary() if loss == "summary" else report.to_dict()
-            unheld = tuple(
-                (str(e["field"]), str(e.get("detail", ""))) for e in report.to_dict() if e["kind"] == "unrepresentable"
-            )
-            at = _source(item, where)
+            unheld = tuple(report.details("unrepresentable"))
+            # where the record came from: read only beside a loss (the report, a value the target cannot hold)
+            at = _source(item, where) if unheld or lost is not None else None
             if binary:
                 payloads = self.target.to_binary(result, item.file, item.line)
                 yield Converted(item.line, payloads=payloads, loss=lost, source=at, unrepresentable=unheld)
@@ -355,7 +377,12 @@ class Conversion:
 
     def _log_items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
         """Every record of the source side's first message in a .ulg, .tlog, raw MAVLink, CAN capture or
-        devicetree (.dts, .dtb) input."""
+        devicetree (.dts, .dtb) input. The readers are imported here: a JSON Lines run loads none of them
+        (python-can alone is half a second of start-up)."""
+        from ..inputs.can.records import capture_side
+        from ..inputs.tlog import StreamStats, mavlink_items, message_name
+        from ..inputs.ulog import ulog_items
+
         cls = self.source.items[0][1]
         if fmt in ("dts", "dtb"):
             yield from _devicetree_items(source, where, fmt, cls)
@@ -433,6 +460,8 @@ def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item]:
 def _devicetree_items(source: Path | IO[bytes], where: str, fmt: str, cls: object) -> Iterator[Item]:
     """The battery nodes of a .dts/.dtb as records of the devicetree side (its binding read from the bundled
     schemas, as ``battgen validate`` reads them), each located by its node's line."""
+    from ..inputs.devicetree.records import read_devicetree
+
     name = getattr(cls, "QUALIFIED_NAME", "")
     if not name.startswith("devicetree."):
         raise BattgenError(f"{where}: expected --from devicetree for a devicetree file, found --from side {name}")

@@ -29,8 +29,6 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import IO, Any, Literal, cast
 
-import yaml
-
 from ..apps.convert import FORMATS, LOG_FORMATS, Conversion, Converted, input_format, output_format
 from ..apps.senders import SENDERS
 from ..errors import BattgenError, missing_file
@@ -123,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
             where = "<stdin>" if path == "-" else path
             events = conversion.run(source, where, fmt, binary=out_fmt in ("hex", "raw"), loss=loss, inputs=extra)
             before = tally.records
-            _write(tally.count(events, where), where, fmt, out_fmt, out_stream)
+            _write(tally.count(events, where), where, fmt, out_fmt, out_stream, streaming=path == "-")
             if tally.records == before:
                 # a DataFlash log without logged CAN frames is most likely a flight log given for its BAT records
                 log = " (an ArduPilot DataFlash log: convert reads its CANF/CAFD CAN frames, and it has none)"
@@ -199,9 +197,13 @@ def _where(source: Mapping[str, object]) -> str:
     return text
 
 
-def _write(events: Iterable[Converted | Notice], where: str, fmt: str, out_fmt: str, out: IO[bytes]) -> None:
+def _write(
+    events: Iterable[Converted | Notice], where: str, fmt: str, out_fmt: str, out: IO[bytes], *, streaming: bool = True
+) -> None:
     """Converted records to ``out`` in ``out_fmt`` (JSON Lines and binary as they come, JSON and
-    YAML once the input is done); warning notices, and the loss of binary records, to stderr."""
+    YAML once the input is done); warning notices, and the loss of binary records, to stderr.
+    ``streaming`` (standard input): each JSON Lines record is flushed as it is written, for a reader at
+    the other end of a pipe; a file's records are written through the buffer."""
     collected: list[Any] = []
     for event in events:
         if isinstance(event, Notice):
@@ -222,12 +224,15 @@ def _write(events: Iterable[Converted | Notice], where: str, fmt: str, out_fmt: 
                 record["source"] = dict(event.source)
         if out_fmt == "jsonl":
             out.write(json.dumps(record, allow_nan=False).encode() + b"\n")
-            out.flush()
+            if streaming:
+                out.flush()
         else:
             collected.append(record)
     if out_fmt == "json":
         data = collected[0] if len(collected) == 1 and fmt == "json" else collected
         out.write(json.dumps(data, indent=2, allow_nan=False).encode() + b"\n")
     elif out_fmt == "yaml":
+        import yaml  # only for YAML output: a JSON Lines run does without it
+
         data = collected[0] if len(collected) == 1 else collected
         out.write(yaml.safe_dump(data, sort_keys=False).encode())

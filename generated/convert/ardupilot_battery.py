@@ -26,9 +26,10 @@ def to_concepts(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
         _strict_1 = _map_ardupilot_battery.forward(
-            continuous, periodic, cells, tag, rep=report, rep_d=report, rep_u=report
+            continuous, periodic, cells, tag, rep=report, rep_d=_full, rep_u=_full
         )
         return _strict_1[0]
     if policy in ("px4", "ardupilot"):
@@ -47,8 +48,9 @@ def from_concepts(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_ardupilot_battery.backward(state, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_ardupilot_battery.backward(state, rep=report, rep_d=_full, rep_u=_full)
         return _strict_1
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts concepts to ardupilot_battery; use another policy")

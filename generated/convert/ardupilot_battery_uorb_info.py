@@ -26,11 +26,12 @@ def ardupilot_battery_to_uorb_info(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
         _strict_1 = _map_ardupilot_battery.forward(
-            continuous, periodic, cells, tag, rep=report, rep_d=report, rep_u=None
+            continuous, periodic, cells, tag, rep=report, rep_d=_full, rep_u=None
         )
-        _strict_2 = _map_uorb_info.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_2 = _map_uorb_info.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts ardupilot_battery to uorb_info; use another policy")
@@ -48,9 +49,10 @@ def uorb_info_to_ardupilot_battery(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb_info.forward(info, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_ardupilot_battery.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb_info.forward(info, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_ardupilot_battery.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts uorb_info to ardupilot_battery; use another policy")

@@ -26,12 +26,13 @@ def ardupilot_battery_to_uorb_v0(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
         _strict_1 = _map_ardupilot_battery.forward(
-            continuous, periodic, cells, tag, rep=report, rep_d=report, rep_u=None
+            continuous, periodic, cells, tag, rep=report, rep_d=_full, rep_u=None
         )
-        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
-        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=_full, rep_u=None)
+        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=_full, rep_u=_full)
         return _strict_3[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts ardupilot_battery to uorb_v0; use another policy")
@@ -49,10 +50,11 @@ def uorb_v0_to_ardupilot_battery(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
-        _strict_3 = _map_ardupilot_battery.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=_full, rep_u=None)
+        _strict_3 = _map_ardupilot_battery.backward(*_strict_2, rep=report, rep_d=_full, rep_u=_full)
         return _strict_3
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to ardupilot_battery; use another policy")

@@ -21,9 +21,10 @@ def cbat_to_udral(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_cbat.forward(cbat, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_cbat.forward(cbat, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts cbat to udral; use another policy")
@@ -46,9 +47,10 @@ def udral_to_cbat(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_udral.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_cbat.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_udral.forward(source, status, parameters, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_cbat.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts udral to cbat; use another policy")

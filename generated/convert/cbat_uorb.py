@@ -18,9 +18,10 @@ def cbat_to_uorb(cbat: CBAT, *, policy: str = "strict", report: _r.LossReport | 
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_cbat.forward(cbat, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_cbat.forward(cbat, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts cbat to uorb; use another policy")
@@ -36,9 +37,10 @@ def uorb_to_cbat(status: BatteryStatus, *, policy: str = "strict", report: _r.Lo
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_cbat.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_cbat.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts uorb to cbat; use another policy")

@@ -18,10 +18,11 @@ def cbat_to_uorb_v0(cbat: CBAT, *, policy: str = "strict", report: _r.LossReport
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_cbat.forward(cbat, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
-        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_cbat.forward(cbat, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=_full, rep_u=None)
+        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=_full, rep_u=_full)
         return _strict_3[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts cbat to uorb_v0; use another policy")
@@ -37,10 +38,11 @@ def uorb_v0_to_cbat(status: BatteryStatusV0, *, policy: str = "strict", report: 
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
-        _strict_3 = _map_cbat.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=_full, rep_u=None)
+        _strict_3 = _map_cbat.backward(*_strict_2, rep=report, rep_d=_full, rep_u=_full)
         return _strict_3[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to cbat; use another policy")

@@ -25,9 +25,10 @@ def to_concepts(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
         _strict_1 = _map_devicetree.forward(
-            node, rep=report, rep_d=report, rep_u=report, ocv_v=ocv_v, temperature_c=temperature_c
+            node, rep=report, rep_d=_full, rep_u=_full, ocv_v=ocv_v, temperature_c=temperature_c
         )
         return _strict_1[0]
     if policy in ("px4", "ardupilot"):

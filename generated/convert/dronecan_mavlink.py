@@ -40,23 +40,24 @@ def dronecan_to_mavlink(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy == "px4":
         _px4_1 = _map_px4_uavcan_bridge.forward(
-            info, aux, rep=report, rep_d=report, rep_u=None, dt_s=dt_s, discharged_mah_before=discharged_mah_before
+            info, aux, rep=report, rep_d=_full, rep_u=None, dt_s=dt_s, discharged_mah_before=discharged_mah_before
         )
-        _px4_2 = _map_px4_mavlink_stream.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        _px4_2 = _map_px4_mavlink_stream.forward(*_px4_1, rep=report, rep_d=None, rep_u=_full)
         return _px4_2[0]
     if policy == "ardupilot":
         _ardupilot_1 = _map_ardupilot_dronecan.forward(
             info,
             aux,
             rep=report,
-            rep_d=report,
-            rep_u=report,
+            rep_d=_full,
+            rep_u=_full,
             curr_mult=curr_mult,
             capacity_mah=capacity_mah,
             dt_s=dt_s,
@@ -79,13 +80,14 @@ def mavlink_to_dronecan(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2
     if policy == "px4":
-        _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=None)
-        _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=_full, rep_u=None)
+        _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=None, rep_u=_full)
         return _px4_2
     if policy == "ardupilot":
         raise _r.ConversionError(f"no {policy} behaviour converts mavlink to dronecan; use another policy")

@@ -27,13 +27,14 @@ def dronecan_to_uorb(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy == "px4":
         _px4_1 = _map_px4_uavcan_bridge.forward(
-            info, aux, rep=report, rep_d=report, rep_u=report, dt_s=dt_s, discharged_mah_before=discharged_mah_before
+            info, aux, rep=report, rep_d=_full, rep_u=_full, dt_s=dt_s, discharged_mah_before=discharged_mah_before
         )
         return _px4_1[0]
     if policy == "ardupilot":
@@ -52,12 +53,13 @@ def uorb_to_dronecan(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_dronecan.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2
     if policy == "px4":
-        _px4_1 = _map_px4_uavcannode.forward(status, rep=report, rep_d=report, rep_u=report)
+        _px4_1 = _map_px4_uavcannode.forward(status, rep=report, rep_d=_full, rep_u=_full)
         return _px4_1
     if policy == "ardupilot":
         raise _r.ConversionError(f"no {policy} behaviour converts uorb to dronecan; use another policy")

@@ -27,16 +27,17 @@ def dronecan_to_uorb_v0(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
-        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_dronecan.forward(info, aux, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=_full, rep_u=None)
+        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=_full, rep_u=_full)
         return _strict_3[0]
     if policy == "px4":
         _px4_1 = _map_px4_uavcan_bridge.forward(
-            info, aux, rep=report, rep_d=report, rep_u=None, dt_s=dt_s, discharged_mah_before=discharged_mah_before
+            info, aux, rep=report, rep_d=_full, rep_u=None, dt_s=dt_s, discharged_mah_before=discharged_mah_before
         )
-        _px4_2 = _map_uorb_v0_down.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        _px4_2 = _map_uorb_v0_down.forward(*_px4_1, rep=report, rep_d=None, rep_u=_full)
         return _px4_2[0]
     if policy == "ardupilot":
         raise _r.ConversionError(f"no {policy} behaviour converts dronecan to uorb_v0; use another policy")
@@ -54,14 +55,15 @@ def uorb_v0_to_dronecan(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=None)
-        _strict_3 = _map_dronecan.backward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=_full, rep_u=None)
+        _strict_3 = _map_dronecan.backward(*_strict_2, rep=report, rep_d=_full, rep_u=_full)
         return _strict_3
     if policy == "px4":
-        _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=report, rep_u=report)
+        _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _px4_2 = _map_px4_uavcannode.forward(*_px4_1, rep=report, rep_d=_full, rep_u=_full)
         return _px4_2
     if policy == "ardupilot":
         raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to dronecan; use another policy")

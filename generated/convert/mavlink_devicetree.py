@@ -25,11 +25,12 @@ def devicetree_to_mavlink(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
         _strict_1 = _map_devicetree.forward(
-            node, rep=report, rep_d=report, rep_u=None, ocv_v=ocv_v, temperature_c=temperature_c
+            node, rep=report, rep_d=_full, rep_u=None, ocv_v=ocv_v, temperature_c=temperature_c
         )
-        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts devicetree to mavlink; use another policy")

@@ -18,8 +18,9 @@ def to_concepts(info: BatteryInfo, *, policy: str = "strict", report: _r.LossRep
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_mavlink_info.forward(info, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_mavlink_info.forward(info, rep=report, rep_d=_full, rep_u=_full)
         return _strict_1[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts mavlink_info to concepts; use another policy")
@@ -35,8 +36,9 @@ def from_concepts(state: BatteryState, *, policy: str = "strict", report: _r.Los
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_mavlink_info.backward(state, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_mavlink_info.backward(state, rep=report, rep_d=_full, rep_u=_full)
         return _strict_1[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts concepts to mavlink_info; use another policy")

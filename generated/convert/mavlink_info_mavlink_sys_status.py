@@ -19,9 +19,10 @@ def mavlink_sys_status_to_mavlink_info(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_mavlink_sys_status.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_mavlink_info.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_mavlink_sys_status.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_mavlink_info.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(

@@ -18,8 +18,9 @@ def to_concepts(status: SysStatus, *, policy: str = "strict", report: _r.LossRep
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_mavlink_sys_status.forward(status, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_mavlink_sys_status.forward(status, rep=report, rep_d=_full, rep_u=_full)
         return _strict_1[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts mavlink_sys_status to concepts; use another policy")

@@ -26,8 +26,9 @@ def to_concepts(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_udral.forward(source, status, parameters, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_udral.forward(source, status, parameters, rep=report, rep_d=_full, rep_u=_full)
         return _strict_1[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts udral to concepts; use another policy")
@@ -45,8 +46,9 @@ def from_concepts(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_udral.backward(state, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_udral.backward(state, rep=report, rep_d=_full, rep_u=_full)
         return _strict_1
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts concepts to udral; use another policy")

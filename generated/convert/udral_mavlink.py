@@ -26,13 +26,14 @@ def udral_to_mavlink(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_udral.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_udral.forward(source, status, parameters, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy == "px4":
-        _px4_1 = _map_px4_cyphal_battery.forward(source, status, parameters, rep=report, rep_d=report, rep_u=None)
-        _px4_2 = _map_px4_mavlink_stream.forward(*_px4_1, rep=report, rep_d=None, rep_u=report)
+        _px4_1 = _map_px4_cyphal_battery.forward(source, status, parameters, rep=report, rep_d=_full, rep_u=None)
+        _px4_2 = _map_px4_mavlink_stream.forward(*_px4_1, rep=report, rep_d=None, rep_u=_full)
         return _px4_2[0]
     if policy == "ardupilot":
         raise _r.ConversionError(f"no {policy} behaviour converts udral to mavlink; use another policy")
@@ -50,9 +51,10 @@ def mavlink_to_udral(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_udral.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts mavlink to udral; use another policy")

@@ -20,12 +20,13 @@ def uorb_to_mavlink(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_mavlink.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy == "px4":
-        _px4_1 = _map_px4_mavlink_stream.forward(status, rep=report, rep_d=report, rep_u=report)
+        _px4_1 = _map_px4_mavlink_stream.forward(status, rep=report, rep_d=_full, rep_u=_full)
         return _px4_1[0]
     if policy == "ardupilot":
         raise _r.ConversionError(f"no {policy} behaviour converts uorb to mavlink; use another policy")
@@ -43,12 +44,13 @@ def mavlink_to_uorb(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_mavlink.forward(msg, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy == "px4":
-        _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=report, rep_u=report)
+        _px4_1 = _map_px4_mavlink_receiver.forward(msg, rep=report, rep_d=_full, rep_u=_full)
         return _px4_1[0]
     if policy == "ardupilot":
         raise _r.ConversionError(f"no {policy} behaviour converts mavlink to uorb; use another policy")

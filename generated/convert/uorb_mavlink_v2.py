@@ -20,9 +20,10 @@ def uorb_to_mavlink_v2(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_mavlink_v2.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_mavlink_v2.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts uorb to mavlink_v2; use another policy")
@@ -40,9 +41,10 @@ def mavlink_v2_to_uorb(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_mavlink_v2.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_mavlink_v2.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts mavlink_v2 to uorb; use another policy")

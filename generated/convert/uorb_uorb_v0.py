@@ -19,11 +19,12 @@ def uorb_to_uorb_v0(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb_v0_down.forward(status, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb_v0_down.forward(status, rep=report, rep_d=_full, rep_u=_full)
         return _strict_1[0]
     if policy == "px4":
-        _px4_1 = _map_uorb_v0_down.forward(status, rep=report, rep_d=report, rep_u=report)
+        _px4_1 = _map_uorb_v0_down.forward(status, rep=report, rep_d=_full, rep_u=_full)
         return _px4_1[0]
     if policy == "ardupilot":
         raise _r.ConversionError(f"no {policy} behaviour converts uorb to uorb_v0; use another policy")
@@ -41,11 +42,12 @@ def uorb_v0_to_uorb(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=_full, rep_u=_full)
         return _strict_1[0]
     if policy == "px4":
-        _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=report)
+        _px4_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=_full, rep_u=_full)
         return _px4_1[0]
     if policy == "ardupilot":
         raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to uorb; use another policy")

@@ -20,9 +20,10 @@ def to_concepts(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb_v0_up.forward(status, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb.forward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts uorb_v0 to concepts; use another policy")
@@ -40,9 +41,10 @@ def from_concepts(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
-        _strict_1 = _map_uorb.backward(state, rep=report, rep_d=report, rep_u=None)
-        _strict_2 = _map_uorb_v0_down.forward(*_strict_1, rep=report, rep_d=report, rep_u=report)
+        _strict_1 = _map_uorb.backward(state, rep=report, rep_d=_full, rep_u=None)
+        _strict_2 = _map_uorb_v0_down.forward(*_strict_1, rep=report, rep_d=_full, rep_u=_full)
         return _strict_2[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts concepts to uorb_v0; use another policy")

@@ -25,12 +25,13 @@ def devicetree_to_uorb_v0(
 
     Pass a LossReport as report to learn what did not survive.
     """
+    _full = report if report is not None and report.full else None
     if policy == "strict":
         _strict_1 = _map_devicetree.forward(
-            node, rep=report, rep_d=report, rep_u=None, ocv_v=ocv_v, temperature_c=temperature_c
+            node, rep=report, rep_d=_full, rep_u=None, ocv_v=ocv_v, temperature_c=temperature_c
         )
-        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=report, rep_u=None)
-        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=report, rep_u=report)
+        _strict_2 = _map_uorb.backward(*_strict_1, rep=report, rep_d=_full, rep_u=None)
+        _strict_3 = _map_uorb_v0_down.forward(*_strict_2, rep=report, rep_d=_full, rep_u=_full)
         return _strict_3[0]
     if policy in ("px4", "ardupilot"):
         raise _r.ConversionError(f"no {policy} behaviour converts devicetree to uorb_v0; use another policy")

@@ -16,9 +16,10 @@ def test_bench_convert_runs(capsys: pytest.CaptureFixture[str]) -> None:
     sys.modules["bench_convert"] = module
     try:
         spec.loader.exec_module(module)
-        results = module.main(["--records", "20", "--repeat", "1"])
+        results = module.main(["--records", "20", "--repeat", "1", "--cli-records", "50", "--rounds", "1"])
     finally:
         del sys.modules["bench_convert"]
     assert all(value > 0 for value in results.values())
     assert {"dronecan->uorb px4", "uorb->mavlink strict report", "cli jsonl dronecan->mavlink px4"} <= set(results)
-    assert "records/s" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "records/s" in out and "outputs: 50 records, equal value for value" in out

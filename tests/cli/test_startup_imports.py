@@ -64,10 +64,16 @@ def test_validate_of_one_record_parses_no_schema_once_cached(tmp_path: Path) -> 
     assert any((cache / "battgen").iterdir())  # the bundled schemas' IR stored
     code, out, modules = _modules(args, cache)
     assert (code, out) == first[:2]  # the same verdict from the cached IR
-    assert _heavy(modules, ("jsonschema", "pandas", "pyarrow", "plotly", "numpy", "pydsdl", "can")) == []
+    assert _heavy(modules, ("jsonschema", "pandas", "pyarrow", "plotly", "numpy", "pydsdl", "can", "jinja2")) == []
     # no schema parsed: neither the loader nor any frontend; no code generator
     assert sorted(m for m in modules if m.startswith(("codegen.frontends.", "codegen.backends.python.writer"))) == [
         "codegen.frontends.cache"
+    ]
+    # of the Python backend, the naming of a message's module and class alone (not the renderer's parts)
+    assert sorted(m for m in modules if m.startswith("codegen.backends.python.")) == [
+        "codegen.backends.python.formatting",
+        "codegen.backends.python.literals",
+        "codegen.backends.python.naming",
     ]
     assert not any(
         m.startswith("codegen.cli.")
@@ -75,6 +81,20 @@ def test_validate_of_one_record_parses_no_schema_once_cached(tmp_path: Path) -> 
         not in ("codegen.cli.main", "codegen.cli.validate", "codegen.cli.gate_options", "codegen.cli.cyphal_options")
         for m in modules
     )
+
+
+def test_convert_of_json_lines_imports_no_log_reader_nor_generator(tmp_path: Path) -> None:
+    record = tmp_path / "one.jsonl"
+    record.write_text('{"voltage": 16.4, "temperature": 298.15}\n', encoding="utf-8")
+    out = tmp_path / "out.jsonl"
+    args = ["convert", "--from", "dronecan", "--to", "mavlink", "--policy", "px4", str(record), "-o", str(out)]
+    code, _, modules = _modules(args, tmp_path / "cache")
+    assert code == 0 and len(out.read_text(encoding="utf-8").splitlines()) == 1
+    # python-can, the log and devicetree readers and the code generator belong to other inputs and commands
+    assert _heavy(modules, ("jsonschema", "pandas", "pyarrow", "plotly", "numpy", "pydsdl", "can", "jinja2")) == []
+    readers = ("codegen.inputs.can", "codegen.inputs.devicetree", "codegen.inputs.ulog", "codegen.inputs.tlog")
+    assert sorted(m for m in modules if m.startswith(readers)) == []
+    assert "codegen.backends.python.registry" not in modules
 
 
 @pytest.mark.parametrize("command", [None, *(name for name, _ in cli.COMMANDS), "list", "generate"])

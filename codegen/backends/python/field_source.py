@@ -136,6 +136,19 @@ class FieldBuilder:
         inner = self.importer(t.element, "item", "p")
         return f"_m.as_list({expr}, {path}, {capacity}, {fixed}, lambda item, p: {inner})"
 
+    def fast_importer(self, t: FieldType, var: str, path: str) -> str:
+        """Like :meth:`importer` on the plain value in variable ``var``, with the IR's type deciding the
+        test: a value already of the attribute's exact Python type (what JSON gives) is taken as it is,
+        anything else goes to the runtime reader, which converts it or raises DataError naming ``path``."""
+        if isinstance(t, PrimitiveType | StringType):
+            scalar = "str" if isinstance(t, StringType) else python_scalar(t)
+            return f"{var} if {var}.__class__ is {scalar} else _m.as_{scalar}({var}, {path})"
+        if isinstance(t, ArrayType) and isinstance(t.element, PrimitiveType) and not is_byte_array(t):
+            scalar = python_scalar(t.element)
+            capacity, fixed = py_literal(t.capacity), py_literal(not t.dynamic)
+            return f"_m.as_typed_list({var}, {path}, {capacity}, {fixed}, {scalar}, _m.as_{scalar})"
+        return self.importer(t, var, path)
+
 
 def typed(value: int | float, t: PrimitiveType) -> int | float | bool:
     if t.kind is PrimitiveKind.FLOAT:

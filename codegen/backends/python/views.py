@@ -4,6 +4,7 @@ through :mod:`.literals` and :mod:`.naming`, so templates just lay lines out."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 from ...ir import (
     EnumDef,
@@ -48,9 +49,15 @@ class ClassView:
     fields: list[FieldView]
     source: str
     keys_literal: str  # frozenset of accepted source names
+    keys_name: str  # the module-level constant holding it (built once, not on every from_dict)
     pattern_literal: str  # tuple of (regex, ident) for pattern fields
     extensions: list[str] = field(default_factory=list)  # extra, already indented class-body code
     union_table: str = ""  # a DroneCAN union's module-level _dc.Union (from_dict lets it pick the branch)
+    # a record naming every field (as to_dict writes one): its values in one look-up, the class built from them
+    whole_getter: str = ""  # module-level operator.itemgetter of every field's name, in field order
+    whole_keys: str = ""  # the itemgetter's arguments
+    whole_count: int = 0  # how many
+    whole_from_dict: str = ""  # statements reading such a record (unindented), returning the instance
 
 
 def enum_views(enums: tuple[EnumDef, ...], owner: str) -> list[EnumView]:
@@ -88,6 +95,7 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
     # a DSDL union: every branch is None but the one held (see runtime/_dronecan.Union)
     union = msg.is_union
     fields: list[FieldView] = []
+    whole: list[str] = []  # each field's reader of the local holding its value, for the whole-record path
     names = naming.member_names(msg, ctx.module_classes)
     patterns: list[str] = []
     keys: list[str] = []
@@ -113,8 +121,9 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
                 to_dict = f"if self.{ident} is not None:\n    out[{key}] = {value}"
             else:
                 to_dict = f"out[{key}] = {value}"
-            reader = b.importer(f.type, f"data[{key}]", key)
-            from_dict = f"if {key} in data:\n    obj.{ident} = {reader}"
+            reader = b.fast_importer(f.type, "x", key)
+            from_dict = f"if {key} in data:\n    x = data[{key}]\n    obj.{ident} = {reader}"
+            whole.append(b.fast_importer(f.type, f"v{len(whole)}", key))
         fields.append(FieldView(ident, annotation, b.default(), meta(f), to_dict, from_dict, f.name))
         if f.pattern is not None:
             reader = b.importer(f.type, "value", "key")
@@ -136,6 +145,7 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
             literal, annotation = py_literal(str(c.value)), "str"
         constants.append((name, annotation, literal))
 
+    view_whole = _whole_record(ctx, cls, keys, whole) if not union and not patterns and len(whole) > 1 else None
     if union:
         keys.append("union_field")
     src = msg.location
@@ -149,6 +159,23 @@ def class_view(ctx: ModuleContext, msg: Message) -> ClassView:
         fields=fields,
         source=f"{src.file}",
         keys_literal="frozenset({" + ", ".join(py_literal(k) for k in keys) + "})" if keys else "frozenset()",
+        keys_name=ctx.constant(cls, "KEYS"),
         pattern_literal="(" + ", ".join(patterns) + ",)" if patterns else "()",
         union_table=ctx.constant(cls, "UNION") if union else "",
+        **(view_whole or {}),
     )
+
+
+def _whole_record(ctx: ModuleContext, cls: str, keys: list[str], readers: list[str]) -> dict[str, Any]:
+    """The path of ``from_dict`` for a plain dict naming every field: one ``itemgetter`` call fetches the
+    values into locals ``v0``.. (no per-field membership test, no default set and then overwritten), each
+    taken as it is when of the attribute's type, and the class is called with them in field order."""
+    targets = ", ".join(f"v{i}" for i in range(len(readers)))
+    body = f"{targets} = {{getter}}(data)\nreturn cls(\n" + "".join(f"    {r},\n" for r in readers) + ")"
+    getter = ctx.constant(cls, "VALUES")
+    return {
+        "whole_getter": getter,
+        "whole_keys": ", ".join(py_literal(k) for k in keys),
+        "whole_count": len(keys),
+        "whole_from_dict": body.replace("{getter}", getter),
+    }

@@ -36,6 +36,9 @@ _HEALTH_1_0_VALUE_SPEC = _v.Number(
 _HEALTH_1_0_FIELD_SPECS = (("value", "value", _HEALTH_1_0_VALUE_SPEC),)
 
 
+_HEALTH_1_0_KEYS: frozenset[str] = frozenset({"value"})
+
+
 @_dataclasses.dataclass(slots=True)
 class Health_1_0:
     """Health of a node or service, from nominal to warning.
@@ -64,10 +67,13 @@ class Health_1_0:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Health_1_0:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"value"}), (), "Health_1_0")
+        if data.__class__ is not dict or not data.keys() <= _HEALTH_1_0_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _HEALTH_1_0_KEYS, (), "Health_1_0")
         obj = cls()
         if "value" in data:
-            obj.value = _m.as_int(data["value"], "value")
+            x = data["value"]
+            obj.value = x if x.__class__ is int else _m.as_int(x, "value")
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)

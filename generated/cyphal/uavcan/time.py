@@ -28,6 +28,9 @@ _SYNCHRONIZED_TIMESTAMP_1_0_FIELD_SPECS = (
 )
 
 
+_SYNCHRONIZED_TIMESTAMP_1_0_KEYS: frozenset[str] = frozenset({"microsecond"})
+
+
 @_dataclasses.dataclass(slots=True)
 class SynchronizedTimestamp_1_0:
     """Microseconds of the network's synchronized time; zero when the time is not known.
@@ -67,10 +70,13 @@ class SynchronizedTimestamp_1_0:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> SynchronizedTimestamp_1_0:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"microsecond"}), (), "SynchronizedTimestamp_1_0")
+        if data.__class__ is not dict or not data.keys() <= _SYNCHRONIZED_TIMESTAMP_1_0_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _SYNCHRONIZED_TIMESTAMP_1_0_KEYS, (), "SynchronizedTimestamp_1_0")
         obj = cls()
         if "microsecond" in data:
-            obj.microsecond = _m.as_int(data["microsecond"], "microsecond")
+            x = data["microsecond"]
+            obj.microsecond = x if x.__class__ is int else _m.as_int(x, "microsecond")
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)

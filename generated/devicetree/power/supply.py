@@ -380,6 +380,36 @@ _SIMPLE_BATTERY_FIELD_SPECS = (
 )
 
 
+_SIMPLE_BATTERY_KEYS: frozenset[str] = frozenset(
+    {
+        "compatible",
+        "device-chemistry",
+        "over-voltage-threshold-microvolt",
+        "re-charge-voltage-microvolt",
+        "voltage-min-design-microvolt",
+        "voltage-max-design-microvolt",
+        "energy-full-design-microwatt-hours",
+        "charge-full-design-microamp-hours",
+        "trickle-charge-current-microamp",
+        "tricklecharge-upper-limit-microvolt",
+        "precharge-current-microamp",
+        "precharge-upper-limit-microvolt",
+        "charge-term-current-microamp",
+        "constant-charge-current-max-microamp",
+        "constant-charge-voltage-max-microvolt",
+        "factory-internal-resistance-micro-ohms",
+        "resistance-temp-table",
+        "ocv-capacity-celsius",
+        "operating-range-celsius",
+        "ambient-celsius",
+        "alert-celsius",
+        "volt-drop-thresh-microvolt",
+        "volt-drop-soc-bp",
+        "volt-drop-temperatures-millicelsius",
+    }
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class SimpleBattery:
     """Fixed facts about a battery (design voltages, capacity, charging limits,
@@ -762,204 +792,159 @@ class SimpleBattery:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> SimpleBattery:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "compatible",
-                    "device-chemistry",
-                    "over-voltage-threshold-microvolt",
-                    "re-charge-voltage-microvolt",
-                    "voltage-min-design-microvolt",
-                    "voltage-max-design-microvolt",
-                    "energy-full-design-microwatt-hours",
-                    "charge-full-design-microamp-hours",
-                    "trickle-charge-current-microamp",
-                    "tricklecharge-upper-limit-microvolt",
-                    "precharge-current-microamp",
-                    "precharge-upper-limit-microvolt",
-                    "charge-term-current-microamp",
-                    "constant-charge-current-max-microamp",
-                    "constant-charge-voltage-max-microvolt",
-                    "factory-internal-resistance-micro-ohms",
-                    "resistance-temp-table",
-                    "ocv-capacity-celsius",
-                    "operating-range-celsius",
-                    "ambient-celsius",
-                    "alert-celsius",
-                    "volt-drop-thresh-microvolt",
-                    "volt-drop-soc-bp",
-                    "volt-drop-temperatures-millicelsius",
-                }
-            ),
-            (
-                ("^ocv-capacity-table-[0-9]+$", "ocv_capacity_table_n"),
-                ("^volt-drop-[0-9]-microvolt", "volt_drop_n_microvolt"),
-            ),
-            "SimpleBattery",
-        )
+        if data.__class__ is not dict or not data.keys() <= _SIMPLE_BATTERY_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(
+                data,
+                _SIMPLE_BATTERY_KEYS,
+                (
+                    ("^ocv-capacity-table-[0-9]+$", "ocv_capacity_table_n"),
+                    ("^volt-drop-[0-9]-microvolt", "volt_drop_n_microvolt"),
+                ),
+                "SimpleBattery",
+            )
         obj = cls()
         if "compatible" in data:
-            obj.compatible = _m.as_list(
-                data["compatible"], "compatible", None, False, lambda item, p: _m.as_str(item, p)
-            )
+            x = data["compatible"]
+            obj.compatible = _m.as_list(x, "compatible", None, False, lambda item, p: _m.as_str(item, p))
         if "device-chemistry" in data:
-            obj.device_chemistry = _m.as_str(data["device-chemistry"], "device-chemistry")
+            x = data["device-chemistry"]
+            obj.device_chemistry = x if x.__class__ is str else _m.as_str(x, "device-chemistry")
         if "over-voltage-threshold-microvolt" in data:
+            x = data["over-voltage-threshold-microvolt"]
             obj.over_voltage_threshold_microvolt = _m.as_list(
-                data["over-voltage-threshold-microvolt"],
+                x,
                 "over-voltage-threshold-microvolt",
                 None,
                 False,
                 lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
             )
         if "re-charge-voltage-microvolt" in data:
+            x = data["re-charge-voltage-microvolt"]
             obj.re_charge_voltage_microvolt = _m.as_list(
-                data["re-charge-voltage-microvolt"],
+                x,
                 "re-charge-voltage-microvolt",
                 None,
                 False,
                 lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
             )
         if "voltage-min-design-microvolt" in data:
+            x = data["voltage-min-design-microvolt"]
             obj.voltage_min_design_microvolt = _m.as_list(
-                data["voltage-min-design-microvolt"],
+                x,
                 "voltage-min-design-microvolt",
                 None,
                 False,
                 lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
             )
         if "voltage-max-design-microvolt" in data:
+            x = data["voltage-max-design-microvolt"]
             obj.voltage_max_design_microvolt = _m.as_list(
-                data["voltage-max-design-microvolt"],
+                x,
                 "voltage-max-design-microvolt",
                 None,
                 False,
                 lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
             )
         if "energy-full-design-microwatt-hours" in data:
-            obj.energy_full_design_microwatt_hours = _m.as_list(
-                data["energy-full-design-microwatt-hours"],
-                "energy-full-design-microwatt-hours",
-                None,
-                False,
-                lambda item, p: _m.as_int(item, p),
+            x = data["energy-full-design-microwatt-hours"]
+            obj.energy_full_design_microwatt_hours = _m.as_typed_list(
+                x, "energy-full-design-microwatt-hours", None, False, int, _m.as_int
             )
         if "charge-full-design-microamp-hours" in data:
-            obj.charge_full_design_microamp_hours = _m.as_list(
-                data["charge-full-design-microamp-hours"],
-                "charge-full-design-microamp-hours",
-                None,
-                False,
-                lambda item, p: _m.as_int(item, p),
+            x = data["charge-full-design-microamp-hours"]
+            obj.charge_full_design_microamp_hours = _m.as_typed_list(
+                x, "charge-full-design-microamp-hours", None, False, int, _m.as_int
             )
         if "trickle-charge-current-microamp" in data:
-            obj.trickle_charge_current_microamp = _m.as_list(
-                data["trickle-charge-current-microamp"],
-                "trickle-charge-current-microamp",
-                None,
-                False,
-                lambda item, p: _m.as_int(item, p),
+            x = data["trickle-charge-current-microamp"]
+            obj.trickle_charge_current_microamp = _m.as_typed_list(
+                x, "trickle-charge-current-microamp", None, False, int, _m.as_int
             )
         if "tricklecharge-upper-limit-microvolt" in data:
+            x = data["tricklecharge-upper-limit-microvolt"]
             obj.tricklecharge_upper_limit_microvolt = _m.as_list(
-                data["tricklecharge-upper-limit-microvolt"],
+                x,
                 "tricklecharge-upper-limit-microvolt",
                 None,
                 False,
                 lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
             )
         if "precharge-current-microamp" in data:
-            obj.precharge_current_microamp = _m.as_list(
-                data["precharge-current-microamp"],
-                "precharge-current-microamp",
-                None,
-                False,
-                lambda item, p: _m.as_int(item, p),
+            x = data["precharge-current-microamp"]
+            obj.precharge_current_microamp = _m.as_typed_list(
+                x, "precharge-current-microamp", None, False, int, _m.as_int
             )
         if "precharge-upper-limit-microvolt" in data:
+            x = data["precharge-upper-limit-microvolt"]
             obj.precharge_upper_limit_microvolt = _m.as_list(
-                data["precharge-upper-limit-microvolt"],
+                x,
                 "precharge-upper-limit-microvolt",
                 None,
                 False,
                 lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
             )
         if "charge-term-current-microamp" in data:
-            obj.charge_term_current_microamp = _m.as_list(
-                data["charge-term-current-microamp"],
-                "charge-term-current-microamp",
-                None,
-                False,
-                lambda item, p: _m.as_int(item, p),
+            x = data["charge-term-current-microamp"]
+            obj.charge_term_current_microamp = _m.as_typed_list(
+                x, "charge-term-current-microamp", None, False, int, _m.as_int
             )
         if "constant-charge-current-max-microamp" in data:
-            obj.constant_charge_current_max_microamp = _m.as_list(
-                data["constant-charge-current-max-microamp"],
-                "constant-charge-current-max-microamp",
-                None,
-                False,
-                lambda item, p: _m.as_int(item, p),
+            x = data["constant-charge-current-max-microamp"]
+            obj.constant_charge_current_max_microamp = _m.as_typed_list(
+                x, "constant-charge-current-max-microamp", None, False, int, _m.as_int
             )
         if "constant-charge-voltage-max-microvolt" in data:
+            x = data["constant-charge-voltage-max-microvolt"]
             obj.constant_charge_voltage_max_microvolt = _m.as_list(
-                data["constant-charge-voltage-max-microvolt"],
+                x,
                 "constant-charge-voltage-max-microvolt",
                 None,
                 False,
                 lambda item, p: _m.as_list(item, p, None, False, lambda item, p: _m.as_int(item, p)),
             )
         if "factory-internal-resistance-micro-ohms" in data:
-            obj.factory_internal_resistance_micro_ohms = _m.as_list(
-                data["factory-internal-resistance-micro-ohms"],
-                "factory-internal-resistance-micro-ohms",
-                None,
-                False,
-                lambda item, p: _m.as_int(item, p),
+            x = data["factory-internal-resistance-micro-ohms"]
+            obj.factory_internal_resistance_micro_ohms = _m.as_typed_list(
+                x, "factory-internal-resistance-micro-ohms", None, False, int, _m.as_int
             )
         if "resistance-temp-table" in data:
+            x = data["resistance-temp-table"]
             obj.resistance_temp_table = _m.as_list(
-                data["resistance-temp-table"],
+                x,
                 "resistance-temp-table",
                 None,
                 False,
                 lambda item, p: _m.as_list(item, p, 2, True, lambda item, p: _m.as_int(item, p)),
             )
         if "ocv-capacity-celsius" in data:
-            obj.ocv_capacity_celsius = _m.as_list(
-                data["ocv-capacity-celsius"], "ocv-capacity-celsius", None, False, lambda item, p: _m.as_int(item, p)
-            )
+            x = data["ocv-capacity-celsius"]
+            obj.ocv_capacity_celsius = _m.as_typed_list(x, "ocv-capacity-celsius", None, False, int, _m.as_int)
         if "operating-range-celsius" in data:
-            obj.operating_range_celsius = _m.as_list(
-                data["operating-range-celsius"], "operating-range-celsius", 2, True, lambda item, p: _m.as_int(item, p)
-            )
+            x = data["operating-range-celsius"]
+            obj.operating_range_celsius = _m.as_typed_list(x, "operating-range-celsius", 2, True, int, _m.as_int)
         if "ambient-celsius" in data:
-            obj.ambient_celsius = _m.as_list(
-                data["ambient-celsius"], "ambient-celsius", 2, True, lambda item, p: _m.as_int(item, p)
-            )
+            x = data["ambient-celsius"]
+            obj.ambient_celsius = _m.as_typed_list(x, "ambient-celsius", 2, True, int, _m.as_int)
         if "alert-celsius" in data:
-            obj.alert_celsius = _m.as_list(
-                data["alert-celsius"], "alert-celsius", 2, True, lambda item, p: _m.as_int(item, p)
-            )
+            x = data["alert-celsius"]
+            obj.alert_celsius = _m.as_typed_list(x, "alert-celsius", 2, True, int, _m.as_int)
         if "volt-drop-thresh-microvolt" in data:
+            x = data["volt-drop-thresh-microvolt"]
             obj.volt_drop_thresh_microvolt = _m.as_list(
-                data["volt-drop-thresh-microvolt"],
+                x,
                 "volt-drop-thresh-microvolt",
                 1,
                 True,
                 lambda item, p: _m.as_list(item, p, 1, True, lambda item, p: _m.as_int(item, p)),
             )
         if "volt-drop-soc-bp" in data:
-            obj.volt_drop_soc_bp = _m.as_list(
-                data["volt-drop-soc-bp"], "volt-drop-soc-bp", None, False, lambda item, p: _m.as_int(item, p)
-            )
+            x = data["volt-drop-soc-bp"]
+            obj.volt_drop_soc_bp = _m.as_typed_list(x, "volt-drop-soc-bp", None, False, int, _m.as_int)
         if "volt-drop-temperatures-millicelsius" in data:
-            obj.volt_drop_temperatures_millicelsius = _m.as_list(
-                data["volt-drop-temperatures-millicelsius"],
-                "volt-drop-temperatures-millicelsius",
-                None,
-                False,
-                lambda item, p: _m.as_int(item, p),
+            x = data["volt-drop-temperatures-millicelsius"]
+            obj.volt_drop_temperatures_millicelsius = _m.as_typed_list(
+                x, "volt-drop-temperatures-millicelsius", None, False, int, _m.as_int
             )
         for key, value in data.items():
             if _m._match("^ocv-capacity-table-[0-9]+$", key):

@@ -35,6 +35,9 @@ _TIMESTAMP_USEC_SPEC = _v.Number(
 _TIMESTAMP_FIELD_SPECS = (("usec", "usec", _TIMESTAMP_USEC_SPEC),)
 
 
+_TIMESTAMP_KEYS: frozenset[str] = frozenset({"usec"})
+
+
 @_dataclasses.dataclass(slots=True)
 class Timestamp:
     """Time since an arbitrary epoch, in microseconds (7 bytes on the wire).
@@ -74,10 +77,13 @@ class Timestamp:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Timestamp:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"usec"}), (), "Timestamp")
+        if data.__class__ is not dict or not data.keys() <= _TIMESTAMP_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _TIMESTAMP_KEYS, (), "Timestamp")
         obj = cls()
         if "usec" in data:
-            obj.usec = _m.as_int(data["usec"], "usec")
+            x = data["usec"]
+            obj.usec = x if x.__class__ is int else _m.as_int(x, "usec")
         return obj
 
     # Wire layout (Timestamp.uavcan), bits from the start of the payload:

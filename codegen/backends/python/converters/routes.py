@@ -115,10 +115,14 @@ class Routes:
             docs.append(f"{p}: {how}")
         docs += ["", "Pass a LossReport as report to learn what did not survive."]
         lines = [f"def {fname}({', '.join(params)}) -> {returns}:", docstring("\n".join(docs), INDENT)]
+        body: list[str] = []
         for p, r in routes.items():
             if r is not None:
-                lines.append(f"{INDENT}if policy == {py_literal(p)}:")
-                lines += self.calls(r, args, inputs, single, p)
+                body.append(f"{INDENT}if policy == {py_literal(p)}:")
+                body += self.calls(r, args, inputs, single, p)
+        if any("_full" in text for text in body):  # dropped and unknown fields only when the report asks for them
+            lines.append(f"{INDENT}_full = report if report is not None and report.full else None")
+        lines += body
         missing = tuple(p for p, r in routes.items() if r is None)
         if missing:  # one branch for the policies with no code path between the two
             test = f"policy == {py_literal(missing[0])}" if len(missing) == 1 else f"policy in {py_literal(missing)}"
@@ -135,8 +139,8 @@ class Routes:
         result = ""
         for i, e in enumerate(path):
             first, last = i == 0, i == len(path) - 1
-            rep_d = "report" if first or e.source == CONCEPTS_ENDPOINT or not after_firmware else "None"
-            rep_u = "report" if last else "None"
+            rep_d = "_full" if first or e.source == CONCEPTS_ENDPOINT or not after_firmware else "None"
+            rep_u = "_full" if last else "None"
             given = [*args] if first else [f"*{result}"]
             given += ["rep=report", f"rep_d={rep_d}", f"rep_u={rep_u}"]
             given += [f"{n}={n}" for n in e.inputs if n in inputs] if first else []

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses as _dataclasses
 import enum as _enum
 import functools as _functools
+import operator as _operator
 import struct as _struct
 from collections.abc import Mapping as _Mapping
 from typing import TYPE_CHECKING
@@ -331,6 +332,10 @@ def _timestamp_class() -> type[_dronecan_uavcan.Timestamp]:
     return cls
 
 
+_BATTERY_CELLS_KEYS: frozenset[str] = frozenset({"voltages", "index"})
+_BATTERY_CELLS_VALUES = _operator.itemgetter("voltages", "index")
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryCells:
     """A smart battery's cell voltages, in blocks of up to 24 cells (sent at a rate the battery's settings
@@ -370,12 +375,22 @@ class BatteryCells:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryCells:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"voltages", "index"}), (), "BatteryCells")
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_CELLS_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_CELLS_KEYS, (), "BatteryCells")
+        elif len(data) == 2:  # every field named: fetched in one call
+            v0, v1 = _BATTERY_CELLS_VALUES(data)
+            return cls(
+                _m.as_typed_list(v0, "voltages", 24, False, float, _m.as_float),
+                v1 if v1.__class__ is int else _m.as_int(v1, "index"),
+            )
         obj = cls()
         if "voltages" in data:
-            obj.voltages = _m.as_list(data["voltages"], "voltages", 24, False, lambda item, p: _m.as_float(item, p))
+            x = data["voltages"]
+            obj.voltages = _m.as_typed_list(x, "voltages", 24, False, float, _m.as_float)
         if "index" in data:
-            obj.index = _m.as_int(data["index"], "index")
+            x = data["index"]
+            obj.index = x if x.__class__ is int else _m.as_int(x, "index")
         return obj
 
     # Wire layout (20012.BatteryCells.uavcan), bits from the start of the payload:
@@ -463,6 +478,32 @@ class BatteryCells:
         if field in {"voltages", "index"}:
             return True
         raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryCells")
+
+
+_BATTERY_CONTINUOUS_KEYS: frozenset[str] = frozenset(
+    {
+        "temperature_cells",
+        "temperature_pcb",
+        "temperature_other",
+        "current",
+        "voltage",
+        "state_of_charge",
+        "slot_id",
+        "capacity_consumed",
+        "status_flags",
+    }
+)
+_BATTERY_CONTINUOUS_VALUES = _operator.itemgetter(
+    "temperature_cells",
+    "temperature_pcb",
+    "temperature_other",
+    "current",
+    "voltage",
+    "state_of_charge",
+    "slot_id",
+    "capacity_consumed",
+    "status_flags",
+)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -588,43 +629,50 @@ class BatteryContinuous:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryContinuous:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "temperature_cells",
-                    "temperature_pcb",
-                    "temperature_other",
-                    "current",
-                    "voltage",
-                    "state_of_charge",
-                    "slot_id",
-                    "capacity_consumed",
-                    "status_flags",
-                }
-            ),
-            (),
-            "BatteryContinuous",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_CONTINUOUS_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_CONTINUOUS_KEYS, (), "BatteryContinuous")
+        elif len(data) == 9:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7, v8 = _BATTERY_CONTINUOUS_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is float else _m.as_float(v0, "temperature_cells"),
+                v1 if v1.__class__ is float else _m.as_float(v1, "temperature_pcb"),
+                v2 if v2.__class__ is float else _m.as_float(v2, "temperature_other"),
+                v3 if v3.__class__ is float else _m.as_float(v3, "current"),
+                v4 if v4.__class__ is float else _m.as_float(v4, "voltage"),
+                v5 if v5.__class__ is float else _m.as_float(v5, "state_of_charge"),
+                v6 if v6.__class__ is int else _m.as_int(v6, "slot_id"),
+                v7 if v7.__class__ is float else _m.as_float(v7, "capacity_consumed"),
+                v8 if v8.__class__ is int else _m.as_int(v8, "status_flags"),
+            )
         obj = cls()
         if "temperature_cells" in data:
-            obj.temperature_cells = _m.as_float(data["temperature_cells"], "temperature_cells")
+            x = data["temperature_cells"]
+            obj.temperature_cells = x if x.__class__ is float else _m.as_float(x, "temperature_cells")
         if "temperature_pcb" in data:
-            obj.temperature_pcb = _m.as_float(data["temperature_pcb"], "temperature_pcb")
+            x = data["temperature_pcb"]
+            obj.temperature_pcb = x if x.__class__ is float else _m.as_float(x, "temperature_pcb")
         if "temperature_other" in data:
-            obj.temperature_other = _m.as_float(data["temperature_other"], "temperature_other")
+            x = data["temperature_other"]
+            obj.temperature_other = x if x.__class__ is float else _m.as_float(x, "temperature_other")
         if "current" in data:
-            obj.current = _m.as_float(data["current"], "current")
+            x = data["current"]
+            obj.current = x if x.__class__ is float else _m.as_float(x, "current")
         if "voltage" in data:
-            obj.voltage = _m.as_float(data["voltage"], "voltage")
+            x = data["voltage"]
+            obj.voltage = x if x.__class__ is float else _m.as_float(x, "voltage")
         if "state_of_charge" in data:
-            obj.state_of_charge = _m.as_float(data["state_of_charge"], "state_of_charge")
+            x = data["state_of_charge"]
+            obj.state_of_charge = x if x.__class__ is float else _m.as_float(x, "state_of_charge")
         if "slot_id" in data:
-            obj.slot_id = _m.as_int(data["slot_id"], "slot_id")
+            x = data["slot_id"]
+            obj.slot_id = x if x.__class__ is int else _m.as_int(x, "slot_id")
         if "capacity_consumed" in data:
-            obj.capacity_consumed = _m.as_float(data["capacity_consumed"], "capacity_consumed")
+            x = data["capacity_consumed"]
+            obj.capacity_consumed = x if x.__class__ is float else _m.as_float(x, "capacity_consumed")
         if "status_flags" in data:
-            obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
+            x = data["status_flags"]
+            obj.status_flags = x if x.__class__ is int else _m.as_int(x, "status_flags")
         return obj
 
     # Wire layout (20010.BatteryContinuous.uavcan), bits from the start of the payload:
@@ -797,6 +845,30 @@ class BatteryContinuous:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryContinuous")
 
 
+_BATTERY_INFO_AUX_KEYS: frozenset[str] = frozenset(
+    {
+        "timestamp",
+        "voltage_cell",
+        "cycle_count",
+        "over_discharge_count",
+        "max_current",
+        "nominal_voltage",
+        "is_powering_off",
+        "battery_id",
+    }
+)
+_BATTERY_INFO_AUX_VALUES = _operator.itemgetter(
+    "timestamp",
+    "voltage_cell",
+    "cycle_count",
+    "over_discharge_count",
+    "max_current",
+    "nominal_voltage",
+    "is_powering_off",
+    "battery_id",
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryInfoAux:
     """Extra battery data that complements uavcan.equipment.power.BatteryInfo.
@@ -883,42 +955,46 @@ class BatteryInfoAux:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfoAux:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "timestamp",
-                    "voltage_cell",
-                    "cycle_count",
-                    "over_discharge_count",
-                    "max_current",
-                    "nominal_voltage",
-                    "is_powering_off",
-                    "battery_id",
-                }
-            ),
-            (),
-            "BatteryInfoAux",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_INFO_AUX_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_INFO_AUX_KEYS, (), "BatteryInfoAux")
+        elif len(data) == 8:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7 = _BATTERY_INFO_AUX_VALUES(data)
+            return cls(
+                _m.as_object(v0, "timestamp", _timestamp_class()),
+                _m.as_typed_list(v1, "voltage_cell", 255, False, float, _m.as_float),
+                v2 if v2.__class__ is int else _m.as_int(v2, "cycle_count"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "over_discharge_count"),
+                v4 if v4.__class__ is float else _m.as_float(v4, "max_current"),
+                v5 if v5.__class__ is float else _m.as_float(v5, "nominal_voltage"),
+                v6 if v6.__class__ is bool else _m.as_bool(v6, "is_powering_off"),
+                v7 if v7.__class__ is int else _m.as_int(v7, "battery_id"),
+            )
         obj = cls()
         if "timestamp" in data:
-            obj.timestamp = _m.as_object(data["timestamp"], "timestamp", _timestamp_class())
+            x = data["timestamp"]
+            obj.timestamp = _m.as_object(x, "timestamp", _timestamp_class())
         if "voltage_cell" in data:
-            obj.voltage_cell = _m.as_list(
-                data["voltage_cell"], "voltage_cell", 255, False, lambda item, p: _m.as_float(item, p)
-            )
+            x = data["voltage_cell"]
+            obj.voltage_cell = _m.as_typed_list(x, "voltage_cell", 255, False, float, _m.as_float)
         if "cycle_count" in data:
-            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+            x = data["cycle_count"]
+            obj.cycle_count = x if x.__class__ is int else _m.as_int(x, "cycle_count")
         if "over_discharge_count" in data:
-            obj.over_discharge_count = _m.as_int(data["over_discharge_count"], "over_discharge_count")
+            x = data["over_discharge_count"]
+            obj.over_discharge_count = x if x.__class__ is int else _m.as_int(x, "over_discharge_count")
         if "max_current" in data:
-            obj.max_current = _m.as_float(data["max_current"], "max_current")
+            x = data["max_current"]
+            obj.max_current = x if x.__class__ is float else _m.as_float(x, "max_current")
         if "nominal_voltage" in data:
-            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+            x = data["nominal_voltage"]
+            obj.nominal_voltage = x if x.__class__ is float else _m.as_float(x, "nominal_voltage")
         if "is_powering_off" in data:
-            obj.is_powering_off = _m.as_bool(data["is_powering_off"], "is_powering_off")
+            x = data["is_powering_off"]
+            obj.is_powering_off = x if x.__class__ is bool else _m.as_bool(x, "is_powering_off")
         if "battery_id" in data:
-            obj.battery_id = _m.as_int(data["battery_id"], "battery_id")
+            x = data["battery_id"]
+            obj.battery_id = x if x.__class__ is int else _m.as_int(x, "battery_id")
         return obj
 
     # Wire layout (20004.BatteryInfoAux.uavcan), bits from the start of the payload:
@@ -1134,6 +1210,44 @@ class BatteryInfoAux:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryInfoAux")
 
 
+_BATTERY_PERIODIC_KEYS: frozenset[str] = frozenset(
+    {
+        "name",
+        "serial_number",
+        "manufacture_date",
+        "design_capacity",
+        "cells_in_series",
+        "nominal_voltage",
+        "discharge_minimum_voltage",
+        "charging_minimum_voltage",
+        "charging_maximum_voltage",
+        "charging_maximum_current",
+        "discharge_maximum_current",
+        "discharge_maximum_burst_current",
+        "full_charge_capacity",
+        "cycle_count",
+        "state_of_health",
+    }
+)
+_BATTERY_PERIODIC_VALUES = _operator.itemgetter(
+    "name",
+    "serial_number",
+    "manufacture_date",
+    "design_capacity",
+    "cells_in_series",
+    "nominal_voltage",
+    "discharge_minimum_voltage",
+    "charging_minimum_voltage",
+    "charging_maximum_voltage",
+    "charging_maximum_current",
+    "discharge_maximum_current",
+    "discharge_maximum_burst_current",
+    "full_charge_capacity",
+    "cycle_count",
+    "state_of_health",
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryPeriodic:
     """A smart battery's slow-changing facts, sent on request or rarely (about every 5 s, at most 1 Hz).
@@ -1299,63 +1413,76 @@ class BatteryPeriodic:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryPeriodic:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "name",
-                    "serial_number",
-                    "manufacture_date",
-                    "design_capacity",
-                    "cells_in_series",
-                    "nominal_voltage",
-                    "discharge_minimum_voltage",
-                    "charging_minimum_voltage",
-                    "charging_maximum_voltage",
-                    "charging_maximum_current",
-                    "discharge_maximum_current",
-                    "discharge_maximum_burst_current",
-                    "full_charge_capacity",
-                    "cycle_count",
-                    "state_of_health",
-                }
-            ),
-            (),
-            "BatteryPeriodic",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_PERIODIC_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_PERIODIC_KEYS, (), "BatteryPeriodic")
+        elif len(data) == 15:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14 = _BATTERY_PERIODIC_VALUES(data)
+            return cls(
+                _m.as_bytes(v0, "name", 50, False),
+                _m.as_bytes(v1, "serial_number", 32, False),
+                _m.as_bytes(v2, "manufacture_date", 9, False),
+                v3 if v3.__class__ is float else _m.as_float(v3, "design_capacity"),
+                v4 if v4.__class__ is int else _m.as_int(v4, "cells_in_series"),
+                v5 if v5.__class__ is float else _m.as_float(v5, "nominal_voltage"),
+                v6 if v6.__class__ is float else _m.as_float(v6, "discharge_minimum_voltage"),
+                v7 if v7.__class__ is float else _m.as_float(v7, "charging_minimum_voltage"),
+                v8 if v8.__class__ is float else _m.as_float(v8, "charging_maximum_voltage"),
+                v9 if v9.__class__ is float else _m.as_float(v9, "charging_maximum_current"),
+                v10 if v10.__class__ is float else _m.as_float(v10, "discharge_maximum_current"),
+                v11 if v11.__class__ is float else _m.as_float(v11, "discharge_maximum_burst_current"),
+                v12 if v12.__class__ is float else _m.as_float(v12, "full_charge_capacity"),
+                v13 if v13.__class__ is int else _m.as_int(v13, "cycle_count"),
+                v14 if v14.__class__ is int else _m.as_int(v14, "state_of_health"),
+            )
         obj = cls()
         if "name" in data:
-            obj.name = _m.as_bytes(data["name"], "name", 50, False)
+            x = data["name"]
+            obj.name = _m.as_bytes(x, "name", 50, False)
         if "serial_number" in data:
-            obj.serial_number = _m.as_bytes(data["serial_number"], "serial_number", 32, False)
+            x = data["serial_number"]
+            obj.serial_number = _m.as_bytes(x, "serial_number", 32, False)
         if "manufacture_date" in data:
-            obj.manufacture_date = _m.as_bytes(data["manufacture_date"], "manufacture_date", 9, False)
+            x = data["manufacture_date"]
+            obj.manufacture_date = _m.as_bytes(x, "manufacture_date", 9, False)
         if "design_capacity" in data:
-            obj.design_capacity = _m.as_float(data["design_capacity"], "design_capacity")
+            x = data["design_capacity"]
+            obj.design_capacity = x if x.__class__ is float else _m.as_float(x, "design_capacity")
         if "cells_in_series" in data:
-            obj.cells_in_series = _m.as_int(data["cells_in_series"], "cells_in_series")
+            x = data["cells_in_series"]
+            obj.cells_in_series = x if x.__class__ is int else _m.as_int(x, "cells_in_series")
         if "nominal_voltage" in data:
-            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+            x = data["nominal_voltage"]
+            obj.nominal_voltage = x if x.__class__ is float else _m.as_float(x, "nominal_voltage")
         if "discharge_minimum_voltage" in data:
-            obj.discharge_minimum_voltage = _m.as_float(data["discharge_minimum_voltage"], "discharge_minimum_voltage")
+            x = data["discharge_minimum_voltage"]
+            obj.discharge_minimum_voltage = x if x.__class__ is float else _m.as_float(x, "discharge_minimum_voltage")
         if "charging_minimum_voltage" in data:
-            obj.charging_minimum_voltage = _m.as_float(data["charging_minimum_voltage"], "charging_minimum_voltage")
+            x = data["charging_minimum_voltage"]
+            obj.charging_minimum_voltage = x if x.__class__ is float else _m.as_float(x, "charging_minimum_voltage")
         if "charging_maximum_voltage" in data:
-            obj.charging_maximum_voltage = _m.as_float(data["charging_maximum_voltage"], "charging_maximum_voltage")
+            x = data["charging_maximum_voltage"]
+            obj.charging_maximum_voltage = x if x.__class__ is float else _m.as_float(x, "charging_maximum_voltage")
         if "charging_maximum_current" in data:
-            obj.charging_maximum_current = _m.as_float(data["charging_maximum_current"], "charging_maximum_current")
+            x = data["charging_maximum_current"]
+            obj.charging_maximum_current = x if x.__class__ is float else _m.as_float(x, "charging_maximum_current")
         if "discharge_maximum_current" in data:
-            obj.discharge_maximum_current = _m.as_float(data["discharge_maximum_current"], "discharge_maximum_current")
+            x = data["discharge_maximum_current"]
+            obj.discharge_maximum_current = x if x.__class__ is float else _m.as_float(x, "discharge_maximum_current")
         if "discharge_maximum_burst_current" in data:
-            obj.discharge_maximum_burst_current = _m.as_float(
-                data["discharge_maximum_burst_current"], "discharge_maximum_burst_current"
+            x = data["discharge_maximum_burst_current"]
+            obj.discharge_maximum_burst_current = (
+                x if x.__class__ is float else _m.as_float(x, "discharge_maximum_burst_current")
             )
         if "full_charge_capacity" in data:
-            obj.full_charge_capacity = _m.as_float(data["full_charge_capacity"], "full_charge_capacity")
+            x = data["full_charge_capacity"]
+            obj.full_charge_capacity = x if x.__class__ is float else _m.as_float(x, "full_charge_capacity")
         if "cycle_count" in data:
-            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+            x = data["cycle_count"]
+            obj.cycle_count = x if x.__class__ is int else _m.as_int(x, "cycle_count")
         if "state_of_health" in data:
-            obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
+            x = data["state_of_health"]
+            obj.state_of_health = x if x.__class__ is int else _m.as_int(x, "state_of_health")
         return obj
 
     # Wire layout (20011.BatteryPeriodic.uavcan), bits from the start of the payload:
@@ -1636,6 +1763,14 @@ class BatteryPeriodic:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.ardupilot.equipment.power.BatteryPeriodic")
 
 
+_BATTERY_TAG_KEYS: frozenset[str] = frozenset(
+    {"serial_number", "num_cycles", "armed_hours", "battery_capacity_mAh", "first_use_mins", "last_arm_time_mins"}
+)
+_BATTERY_TAG_VALUES = _operator.itemgetter(
+    "serial_number", "num_cycles", "armed_hours", "battery_capacity_mAh", "first_use_mins", "last_arm_time_mins"
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryTag:
     """What a tag fixed to a battery records over the battery's life, broadcast by the tag.
@@ -1694,34 +1829,38 @@ class BatteryTag:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryTag:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "serial_number",
-                    "num_cycles",
-                    "armed_hours",
-                    "battery_capacity_mAh",
-                    "first_use_mins",
-                    "last_arm_time_mins",
-                }
-            ),
-            (),
-            "BatteryTag",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_TAG_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_TAG_KEYS, (), "BatteryTag")
+        elif len(data) == 6:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5 = _BATTERY_TAG_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "serial_number"),
+                v1 if v1.__class__ is int else _m.as_int(v1, "num_cycles"),
+                v2 if v2.__class__ is float else _m.as_float(v2, "armed_hours"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "battery_capacity_mAh"),
+                v4 if v4.__class__ is int else _m.as_int(v4, "first_use_mins"),
+                v5 if v5.__class__ is int else _m.as_int(v5, "last_arm_time_mins"),
+            )
         obj = cls()
         if "serial_number" in data:
-            obj.serial_number = _m.as_int(data["serial_number"], "serial_number")
+            x = data["serial_number"]
+            obj.serial_number = x if x.__class__ is int else _m.as_int(x, "serial_number")
         if "num_cycles" in data:
-            obj.num_cycles = _m.as_int(data["num_cycles"], "num_cycles")
+            x = data["num_cycles"]
+            obj.num_cycles = x if x.__class__ is int else _m.as_int(x, "num_cycles")
         if "armed_hours" in data:
-            obj.armed_hours = _m.as_float(data["armed_hours"], "armed_hours")
+            x = data["armed_hours"]
+            obj.armed_hours = x if x.__class__ is float else _m.as_float(x, "armed_hours")
         if "battery_capacity_mAh" in data:
-            obj.battery_capacity_mAh = _m.as_int(data["battery_capacity_mAh"], "battery_capacity_mAh")
+            x = data["battery_capacity_mAh"]
+            obj.battery_capacity_mAh = x if x.__class__ is int else _m.as_int(x, "battery_capacity_mAh")
         if "first_use_mins" in data:
-            obj.first_use_mins = _m.as_int(data["first_use_mins"], "first_use_mins")
+            x = data["first_use_mins"]
+            obj.first_use_mins = x if x.__class__ is int else _m.as_int(x, "first_use_mins")
         if "last_arm_time_mins" in data:
-            obj.last_arm_time_mins = _m.as_int(data["last_arm_time_mins"], "last_arm_time_mins")
+            x = data["last_arm_time_mins"]
+            obj.last_arm_time_mins = x if x.__class__ is int else _m.as_int(x, "last_arm_time_mins")
         return obj
 
     # Wire layout (20500.BatteryTag.uavcan), bits from the start of the payload:

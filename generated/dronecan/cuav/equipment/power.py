@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses as _dataclasses
 import enum as _enum
+import operator as _operator
 import struct as _struct
 from collections.abc import Mapping as _Mapping
 from typing import Any as _Any
@@ -166,6 +167,64 @@ _CBAT_FIELD_SPECS = (
 )
 
 
+_CBAT_KEYS: frozenset[str] = frozenset(
+    {
+        "temperature",
+        "voltage",
+        "voltage_cell",
+        "cell_count",
+        "current",
+        "average_current",
+        "average_power",
+        "available_energy",
+        "remaining_capacity",
+        "full_charge_capacity",
+        "design_capacity",
+        "average_time_to_empty",
+        "average_time_to_full",
+        "state_of_health",
+        "state_of_charge",
+        "max_error",
+        "serial_number",
+        "manufacture_date",
+        "cycle_count",
+        "over_discharge_count",
+        "passed_charge",
+        "nominal_voltage",
+        "is_powering_off",
+        "interface_error",
+        "status_flags",
+    }
+)
+_CBAT_VALUES = _operator.itemgetter(
+    "temperature",
+    "voltage",
+    "voltage_cell",
+    "cell_count",
+    "current",
+    "average_current",
+    "average_power",
+    "available_energy",
+    "remaining_capacity",
+    "full_charge_capacity",
+    "design_capacity",
+    "average_time_to_empty",
+    "average_time_to_full",
+    "state_of_health",
+    "state_of_charge",
+    "max_error",
+    "serial_number",
+    "manufacture_date",
+    "cycle_count",
+    "over_discharge_count",
+    "passed_charge",
+    "nominal_voltage",
+    "is_powering_off",
+    "interface_error",
+    "status_flags",
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class CBAT:
     """CUAV's smart battery on DroneCAN.
@@ -302,93 +361,140 @@ class CBAT:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> CBAT:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "temperature",
-                    "voltage",
-                    "voltage_cell",
-                    "cell_count",
-                    "current",
-                    "average_current",
-                    "average_power",
-                    "available_energy",
-                    "remaining_capacity",
-                    "full_charge_capacity",
-                    "design_capacity",
-                    "average_time_to_empty",
-                    "average_time_to_full",
-                    "state_of_health",
-                    "state_of_charge",
-                    "max_error",
-                    "serial_number",
-                    "manufacture_date",
-                    "cycle_count",
-                    "over_discharge_count",
-                    "passed_charge",
-                    "nominal_voltage",
-                    "is_powering_off",
-                    "interface_error",
-                    "status_flags",
-                }
-            ),
-            (),
-            "CBAT",
-        )
+        if data.__class__ is not dict or not data.keys() <= _CBAT_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _CBAT_KEYS, (), "CBAT")
+        elif len(data) == 25:  # every field named: fetched in one call
+            (
+                v0,
+                v1,
+                v2,
+                v3,
+                v4,
+                v5,
+                v6,
+                v7,
+                v8,
+                v9,
+                v10,
+                v11,
+                v12,
+                v13,
+                v14,
+                v15,
+                v16,
+                v17,
+                v18,
+                v19,
+                v20,
+                v21,
+                v22,
+                v23,
+                v24,
+            ) = _CBAT_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is float else _m.as_float(v0, "temperature"),
+                v1 if v1.__class__ is float else _m.as_float(v1, "voltage"),
+                _m.as_typed_list(v2, "voltage_cell", 15, False, float, _m.as_float),
+                v3 if v3.__class__ is int else _m.as_int(v3, "cell_count"),
+                v4 if v4.__class__ is float else _m.as_float(v4, "current"),
+                v5 if v5.__class__ is float else _m.as_float(v5, "average_current"),
+                v6 if v6.__class__ is float else _m.as_float(v6, "average_power"),
+                v7 if v7.__class__ is float else _m.as_float(v7, "available_energy"),
+                v8 if v8.__class__ is float else _m.as_float(v8, "remaining_capacity"),
+                v9 if v9.__class__ is float else _m.as_float(v9, "full_charge_capacity"),
+                v10 if v10.__class__ is float else _m.as_float(v10, "design_capacity"),
+                v11 if v11.__class__ is int else _m.as_int(v11, "average_time_to_empty"),
+                v12 if v12.__class__ is int else _m.as_int(v12, "average_time_to_full"),
+                v13 if v13.__class__ is int else _m.as_int(v13, "state_of_health"),
+                v14 if v14.__class__ is int else _m.as_int(v14, "state_of_charge"),
+                v15 if v15.__class__ is int else _m.as_int(v15, "max_error"),
+                v16 if v16.__class__ is int else _m.as_int(v16, "serial_number"),
+                v17 if v17.__class__ is int else _m.as_int(v17, "manufacture_date"),
+                v18 if v18.__class__ is int else _m.as_int(v18, "cycle_count"),
+                v19 if v19.__class__ is int else _m.as_int(v19, "over_discharge_count"),
+                v20 if v20.__class__ is float else _m.as_float(v20, "passed_charge"),
+                v21 if v21.__class__ is float else _m.as_float(v21, "nominal_voltage"),
+                v22 if v22.__class__ is bool else _m.as_bool(v22, "is_powering_off"),
+                v23 if v23.__class__ is int else _m.as_int(v23, "interface_error"),
+                v24 if v24.__class__ is int else _m.as_int(v24, "status_flags"),
+            )
         obj = cls()
         if "temperature" in data:
-            obj.temperature = _m.as_float(data["temperature"], "temperature")
+            x = data["temperature"]
+            obj.temperature = x if x.__class__ is float else _m.as_float(x, "temperature")
         if "voltage" in data:
-            obj.voltage = _m.as_float(data["voltage"], "voltage")
+            x = data["voltage"]
+            obj.voltage = x if x.__class__ is float else _m.as_float(x, "voltage")
         if "voltage_cell" in data:
-            obj.voltage_cell = _m.as_list(
-                data["voltage_cell"], "voltage_cell", 15, False, lambda item, p: _m.as_float(item, p)
-            )
+            x = data["voltage_cell"]
+            obj.voltage_cell = _m.as_typed_list(x, "voltage_cell", 15, False, float, _m.as_float)
         if "cell_count" in data:
-            obj.cell_count = _m.as_int(data["cell_count"], "cell_count")
+            x = data["cell_count"]
+            obj.cell_count = x if x.__class__ is int else _m.as_int(x, "cell_count")
         if "current" in data:
-            obj.current = _m.as_float(data["current"], "current")
+            x = data["current"]
+            obj.current = x if x.__class__ is float else _m.as_float(x, "current")
         if "average_current" in data:
-            obj.average_current = _m.as_float(data["average_current"], "average_current")
+            x = data["average_current"]
+            obj.average_current = x if x.__class__ is float else _m.as_float(x, "average_current")
         if "average_power" in data:
-            obj.average_power = _m.as_float(data["average_power"], "average_power")
+            x = data["average_power"]
+            obj.average_power = x if x.__class__ is float else _m.as_float(x, "average_power")
         if "available_energy" in data:
-            obj.available_energy = _m.as_float(data["available_energy"], "available_energy")
+            x = data["available_energy"]
+            obj.available_energy = x if x.__class__ is float else _m.as_float(x, "available_energy")
         if "remaining_capacity" in data:
-            obj.remaining_capacity = _m.as_float(data["remaining_capacity"], "remaining_capacity")
+            x = data["remaining_capacity"]
+            obj.remaining_capacity = x if x.__class__ is float else _m.as_float(x, "remaining_capacity")
         if "full_charge_capacity" in data:
-            obj.full_charge_capacity = _m.as_float(data["full_charge_capacity"], "full_charge_capacity")
+            x = data["full_charge_capacity"]
+            obj.full_charge_capacity = x if x.__class__ is float else _m.as_float(x, "full_charge_capacity")
         if "design_capacity" in data:
-            obj.design_capacity = _m.as_float(data["design_capacity"], "design_capacity")
+            x = data["design_capacity"]
+            obj.design_capacity = x if x.__class__ is float else _m.as_float(x, "design_capacity")
         if "average_time_to_empty" in data:
-            obj.average_time_to_empty = _m.as_int(data["average_time_to_empty"], "average_time_to_empty")
+            x = data["average_time_to_empty"]
+            obj.average_time_to_empty = x if x.__class__ is int else _m.as_int(x, "average_time_to_empty")
         if "average_time_to_full" in data:
-            obj.average_time_to_full = _m.as_int(data["average_time_to_full"], "average_time_to_full")
+            x = data["average_time_to_full"]
+            obj.average_time_to_full = x if x.__class__ is int else _m.as_int(x, "average_time_to_full")
         if "state_of_health" in data:
-            obj.state_of_health = _m.as_int(data["state_of_health"], "state_of_health")
+            x = data["state_of_health"]
+            obj.state_of_health = x if x.__class__ is int else _m.as_int(x, "state_of_health")
         if "state_of_charge" in data:
-            obj.state_of_charge = _m.as_int(data["state_of_charge"], "state_of_charge")
+            x = data["state_of_charge"]
+            obj.state_of_charge = x if x.__class__ is int else _m.as_int(x, "state_of_charge")
         if "max_error" in data:
-            obj.max_error = _m.as_int(data["max_error"], "max_error")
+            x = data["max_error"]
+            obj.max_error = x if x.__class__ is int else _m.as_int(x, "max_error")
         if "serial_number" in data:
-            obj.serial_number = _m.as_int(data["serial_number"], "serial_number")
+            x = data["serial_number"]
+            obj.serial_number = x if x.__class__ is int else _m.as_int(x, "serial_number")
         if "manufacture_date" in data:
-            obj.manufacture_date = _m.as_int(data["manufacture_date"], "manufacture_date")
+            x = data["manufacture_date"]
+            obj.manufacture_date = x if x.__class__ is int else _m.as_int(x, "manufacture_date")
         if "cycle_count" in data:
-            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+            x = data["cycle_count"]
+            obj.cycle_count = x if x.__class__ is int else _m.as_int(x, "cycle_count")
         if "over_discharge_count" in data:
-            obj.over_discharge_count = _m.as_int(data["over_discharge_count"], "over_discharge_count")
+            x = data["over_discharge_count"]
+            obj.over_discharge_count = x if x.__class__ is int else _m.as_int(x, "over_discharge_count")
         if "passed_charge" in data:
-            obj.passed_charge = _m.as_float(data["passed_charge"], "passed_charge")
+            x = data["passed_charge"]
+            obj.passed_charge = x if x.__class__ is float else _m.as_float(x, "passed_charge")
         if "nominal_voltage" in data:
-            obj.nominal_voltage = _m.as_float(data["nominal_voltage"], "nominal_voltage")
+            x = data["nominal_voltage"]
+            obj.nominal_voltage = x if x.__class__ is float else _m.as_float(x, "nominal_voltage")
         if "is_powering_off" in data:
-            obj.is_powering_off = _m.as_bool(data["is_powering_off"], "is_powering_off")
+            x = data["is_powering_off"]
+            obj.is_powering_off = x if x.__class__ is bool else _m.as_bool(x, "is_powering_off")
         if "interface_error" in data:
-            obj.interface_error = _m.as_int(data["interface_error"], "interface_error")
+            x = data["interface_error"]
+            obj.interface_error = x if x.__class__ is int else _m.as_int(x, "interface_error")
         if "status_flags" in data:
-            obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
+            x = data["status_flags"]
+            obj.status_flags = x if x.__class__ is int else _m.as_int(x, "status_flags")
         return obj
 
     # Wire layout (20300.CBAT.uavcan), bits from the start of the payload:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses as _dataclasses
 import enum as _enum
 import math as _math
+import operator as _operator
 import struct as _struct
 from collections.abc import Mapping as _Mapping
 from typing import Any as _Any
@@ -246,6 +247,42 @@ _PRIMARY_POWER_SUPPLY_STATUS_FIELD_SPECS = (
 )
 
 
+_BATTERY_INFO_KEYS: frozenset[str] = frozenset(
+    {
+        "temperature",
+        "voltage",
+        "current",
+        "average_power_10sec",
+        "remaining_capacity_wh",
+        "full_charge_capacity_wh",
+        "hours_to_full_charge",
+        "status_flags",
+        "state_of_health_pct",
+        "state_of_charge_pct",
+        "state_of_charge_pct_stdev",
+        "battery_id",
+        "model_instance_id",
+        "model_name",
+    }
+)
+_BATTERY_INFO_VALUES = _operator.itemgetter(
+    "temperature",
+    "voltage",
+    "current",
+    "average_power_10sec",
+    "remaining_capacity_wh",
+    "full_charge_capacity_wh",
+    "hours_to_full_charge",
+    "status_flags",
+    "state_of_health_pct",
+    "state_of_charge_pct",
+    "state_of_charge_pct_stdev",
+    "battery_id",
+    "model_instance_id",
+    "model_name",
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class BatteryInfo:
     """State of one battery.
@@ -423,58 +460,70 @@ class BatteryInfo:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfo:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "temperature",
-                    "voltage",
-                    "current",
-                    "average_power_10sec",
-                    "remaining_capacity_wh",
-                    "full_charge_capacity_wh",
-                    "hours_to_full_charge",
-                    "status_flags",
-                    "state_of_health_pct",
-                    "state_of_charge_pct",
-                    "state_of_charge_pct_stdev",
-                    "battery_id",
-                    "model_instance_id",
-                    "model_name",
-                }
-            ),
-            (),
-            "BatteryInfo",
-        )
+        if data.__class__ is not dict or not data.keys() <= _BATTERY_INFO_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _BATTERY_INFO_KEYS, (), "BatteryInfo")
+        elif len(data) == 14:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13 = _BATTERY_INFO_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is float else _m.as_float(v0, "temperature"),
+                v1 if v1.__class__ is float else _m.as_float(v1, "voltage"),
+                v2 if v2.__class__ is float else _m.as_float(v2, "current"),
+                v3 if v3.__class__ is float else _m.as_float(v3, "average_power_10sec"),
+                v4 if v4.__class__ is float else _m.as_float(v4, "remaining_capacity_wh"),
+                v5 if v5.__class__ is float else _m.as_float(v5, "full_charge_capacity_wh"),
+                v6 if v6.__class__ is float else _m.as_float(v6, "hours_to_full_charge"),
+                v7 if v7.__class__ is int else _m.as_int(v7, "status_flags"),
+                v8 if v8.__class__ is int else _m.as_int(v8, "state_of_health_pct"),
+                v9 if v9.__class__ is int else _m.as_int(v9, "state_of_charge_pct"),
+                v10 if v10.__class__ is int else _m.as_int(v10, "state_of_charge_pct_stdev"),
+                v11 if v11.__class__ is int else _m.as_int(v11, "battery_id"),
+                v12 if v12.__class__ is int else _m.as_int(v12, "model_instance_id"),
+                _m.as_bytes(v13, "model_name", 31, False),
+            )
         obj = cls()
         if "temperature" in data:
-            obj.temperature = _m.as_float(data["temperature"], "temperature")
+            x = data["temperature"]
+            obj.temperature = x if x.__class__ is float else _m.as_float(x, "temperature")
         if "voltage" in data:
-            obj.voltage = _m.as_float(data["voltage"], "voltage")
+            x = data["voltage"]
+            obj.voltage = x if x.__class__ is float else _m.as_float(x, "voltage")
         if "current" in data:
-            obj.current = _m.as_float(data["current"], "current")
+            x = data["current"]
+            obj.current = x if x.__class__ is float else _m.as_float(x, "current")
         if "average_power_10sec" in data:
-            obj.average_power_10sec = _m.as_float(data["average_power_10sec"], "average_power_10sec")
+            x = data["average_power_10sec"]
+            obj.average_power_10sec = x if x.__class__ is float else _m.as_float(x, "average_power_10sec")
         if "remaining_capacity_wh" in data:
-            obj.remaining_capacity_wh = _m.as_float(data["remaining_capacity_wh"], "remaining_capacity_wh")
+            x = data["remaining_capacity_wh"]
+            obj.remaining_capacity_wh = x if x.__class__ is float else _m.as_float(x, "remaining_capacity_wh")
         if "full_charge_capacity_wh" in data:
-            obj.full_charge_capacity_wh = _m.as_float(data["full_charge_capacity_wh"], "full_charge_capacity_wh")
+            x = data["full_charge_capacity_wh"]
+            obj.full_charge_capacity_wh = x if x.__class__ is float else _m.as_float(x, "full_charge_capacity_wh")
         if "hours_to_full_charge" in data:
-            obj.hours_to_full_charge = _m.as_float(data["hours_to_full_charge"], "hours_to_full_charge")
+            x = data["hours_to_full_charge"]
+            obj.hours_to_full_charge = x if x.__class__ is float else _m.as_float(x, "hours_to_full_charge")
         if "status_flags" in data:
-            obj.status_flags = _m.as_int(data["status_flags"], "status_flags")
+            x = data["status_flags"]
+            obj.status_flags = x if x.__class__ is int else _m.as_int(x, "status_flags")
         if "state_of_health_pct" in data:
-            obj.state_of_health_pct = _m.as_int(data["state_of_health_pct"], "state_of_health_pct")
+            x = data["state_of_health_pct"]
+            obj.state_of_health_pct = x if x.__class__ is int else _m.as_int(x, "state_of_health_pct")
         if "state_of_charge_pct" in data:
-            obj.state_of_charge_pct = _m.as_int(data["state_of_charge_pct"], "state_of_charge_pct")
+            x = data["state_of_charge_pct"]
+            obj.state_of_charge_pct = x if x.__class__ is int else _m.as_int(x, "state_of_charge_pct")
         if "state_of_charge_pct_stdev" in data:
-            obj.state_of_charge_pct_stdev = _m.as_int(data["state_of_charge_pct_stdev"], "state_of_charge_pct_stdev")
+            x = data["state_of_charge_pct_stdev"]
+            obj.state_of_charge_pct_stdev = x if x.__class__ is int else _m.as_int(x, "state_of_charge_pct_stdev")
         if "battery_id" in data:
-            obj.battery_id = _m.as_int(data["battery_id"], "battery_id")
+            x = data["battery_id"]
+            obj.battery_id = x if x.__class__ is int else _m.as_int(x, "battery_id")
         if "model_instance_id" in data:
-            obj.model_instance_id = _m.as_int(data["model_instance_id"], "model_instance_id")
+            x = data["model_instance_id"]
+            obj.model_instance_id = x if x.__class__ is int else _m.as_int(x, "model_instance_id")
         if "model_name" in data:
-            obj.model_name = _m.as_bytes(data["model_name"], "model_name", 31, False)
+            x = data["model_name"]
+            obj.model_name = _m.as_bytes(x, "model_name", 31, False)
         return obj
 
     # Wire layout (1092.BatteryInfo.uavcan), bits from the start of the payload:
@@ -762,6 +811,10 @@ class BatteryInfo:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.equipment.power.BatteryInfo")
 
 
+_CIRCUIT_STATUS_KEYS: frozenset[str] = frozenset({"circuit_id", "voltage", "current", "error_flags"})
+_CIRCUIT_STATUS_VALUES = _operator.itemgetter("circuit_id", "voltage", "current", "error_flags")
+
+
 @_dataclasses.dataclass(slots=True)
 class CircuitStatus:
     """Voltage, current and faults of one electrical circuit.
@@ -804,16 +857,30 @@ class CircuitStatus:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> CircuitStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"circuit_id", "voltage", "current", "error_flags"}), (), "CircuitStatus")
+        if data.__class__ is not dict or not data.keys() <= _CIRCUIT_STATUS_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _CIRCUIT_STATUS_KEYS, (), "CircuitStatus")
+        elif len(data) == 4:  # every field named: fetched in one call
+            v0, v1, v2, v3 = _CIRCUIT_STATUS_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "circuit_id"),
+                v1 if v1.__class__ is float else _m.as_float(v1, "voltage"),
+                v2 if v2.__class__ is float else _m.as_float(v2, "current"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "error_flags"),
+            )
         obj = cls()
         if "circuit_id" in data:
-            obj.circuit_id = _m.as_int(data["circuit_id"], "circuit_id")
+            x = data["circuit_id"]
+            obj.circuit_id = x if x.__class__ is int else _m.as_int(x, "circuit_id")
         if "voltage" in data:
-            obj.voltage = _m.as_float(data["voltage"], "voltage")
+            x = data["voltage"]
+            obj.voltage = x if x.__class__ is float else _m.as_float(x, "voltage")
         if "current" in data:
-            obj.current = _m.as_float(data["current"], "current")
+            x = data["current"]
+            obj.current = x if x.__class__ is float else _m.as_float(x, "current")
         if "error_flags" in data:
-            obj.error_flags = _m.as_int(data["error_flags"], "error_flags")
+            x = data["error_flags"]
+            obj.error_flags = x if x.__class__ is int else _m.as_int(x, "error_flags")
         return obj
 
     # Wire layout (1091.CircuitStatus.uavcan), bits from the start of the payload:
@@ -902,6 +969,24 @@ class CircuitStatus:
         raise KeyError(f"{field!r} is not a field of " + "dronecan.uavcan.equipment.power.CircuitStatus")
 
 
+_PRIMARY_POWER_SUPPLY_STATUS_KEYS: frozenset[str] = frozenset(
+    {
+        "hours_to_empty_at_10sec_avg_power",
+        "hours_to_empty_at_10sec_avg_power_variance",
+        "external_power_available",
+        "remaining_energy_pct",
+        "remaining_energy_pct_stdev",
+    }
+)
+_PRIMARY_POWER_SUPPLY_STATUS_VALUES = _operator.itemgetter(
+    "hours_to_empty_at_10sec_avg_power",
+    "hours_to_empty_at_10sec_avg_power_variance",
+    "external_power_available",
+    "remaining_energy_pct",
+    "remaining_energy_pct_stdev",
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class PrimaryPowerSupplyStatus:
     """Summary of the main power supply, sent at about 1 to 2 Hz.
@@ -983,35 +1068,38 @@ class PrimaryPowerSupplyStatus:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> PrimaryPowerSupplyStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "hours_to_empty_at_10sec_avg_power",
-                    "hours_to_empty_at_10sec_avg_power_variance",
-                    "external_power_available",
-                    "remaining_energy_pct",
-                    "remaining_energy_pct_stdev",
-                }
-            ),
-            (),
-            "PrimaryPowerSupplyStatus",
-        )
+        if data.__class__ is not dict or not data.keys() <= _PRIMARY_POWER_SUPPLY_STATUS_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _PRIMARY_POWER_SUPPLY_STATUS_KEYS, (), "PrimaryPowerSupplyStatus")
+        elif len(data) == 5:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4 = _PRIMARY_POWER_SUPPLY_STATUS_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is float else _m.as_float(v0, "hours_to_empty_at_10sec_avg_power"),
+                v1 if v1.__class__ is float else _m.as_float(v1, "hours_to_empty_at_10sec_avg_power_variance"),
+                v2 if v2.__class__ is bool else _m.as_bool(v2, "external_power_available"),
+                v3 if v3.__class__ is int else _m.as_int(v3, "remaining_energy_pct"),
+                v4 if v4.__class__ is int else _m.as_int(v4, "remaining_energy_pct_stdev"),
+            )
         obj = cls()
         if "hours_to_empty_at_10sec_avg_power" in data:
-            obj.hours_to_empty_at_10sec_avg_power = _m.as_float(
-                data["hours_to_empty_at_10sec_avg_power"], "hours_to_empty_at_10sec_avg_power"
+            x = data["hours_to_empty_at_10sec_avg_power"]
+            obj.hours_to_empty_at_10sec_avg_power = (
+                x if x.__class__ is float else _m.as_float(x, "hours_to_empty_at_10sec_avg_power")
             )
         if "hours_to_empty_at_10sec_avg_power_variance" in data:
-            obj.hours_to_empty_at_10sec_avg_power_variance = _m.as_float(
-                data["hours_to_empty_at_10sec_avg_power_variance"], "hours_to_empty_at_10sec_avg_power_variance"
+            x = data["hours_to_empty_at_10sec_avg_power_variance"]
+            obj.hours_to_empty_at_10sec_avg_power_variance = (
+                x if x.__class__ is float else _m.as_float(x, "hours_to_empty_at_10sec_avg_power_variance")
             )
         if "external_power_available" in data:
-            obj.external_power_available = _m.as_bool(data["external_power_available"], "external_power_available")
+            x = data["external_power_available"]
+            obj.external_power_available = x if x.__class__ is bool else _m.as_bool(x, "external_power_available")
         if "remaining_energy_pct" in data:
-            obj.remaining_energy_pct = _m.as_int(data["remaining_energy_pct"], "remaining_energy_pct")
+            x = data["remaining_energy_pct"]
+            obj.remaining_energy_pct = x if x.__class__ is int else _m.as_int(x, "remaining_energy_pct")
         if "remaining_energy_pct_stdev" in data:
-            obj.remaining_energy_pct_stdev = _m.as_int(data["remaining_energy_pct_stdev"], "remaining_energy_pct_stdev")
+            x = data["remaining_energy_pct_stdev"]
+            obj.remaining_energy_pct_stdev = x if x.__class__ is int else _m.as_int(x, "remaining_energy_pct_stdev")
         return obj
 
     # Wire layout (1090.PrimaryPowerSupplyStatus.uavcan), bits from the start of the payload:

@@ -55,10 +55,13 @@ class LossReport:
     Entries are kept as (kind, field, detail) keys of an insertion-ordered dict; the
     :class:`LossEntry` objects are made when asked for, so a conversion only pays for a dict store."""
 
-    __slots__ = ("_keys", "carried")
+    __slots__ = ("_keys", "carried", "full")
 
-    def __init__(self) -> None:
+    def __init__(self, *, full: bool = True) -> None:
         self._keys: dict[tuple[str, str, str], None] = {}
+        # False: only what happens to values (clamped, rounded, unrepresentable) is recorded, not the fields
+        # dropped or left unknown, which every record of a pair loses alike (a converter then skips finding them)
+        self.full = full
         # what a firmware keeps between messages at a precision its output does not show (ArduPilot's
         # consumed charge is a float, BATTERY_STATUS sends whole mAh): the next message's <name>_before
         self.carried: dict[str, float] = {}
@@ -94,6 +97,10 @@ class LossReport:
 
     def fields(self, kind: str) -> list[str]:
         return [k[1] for k in self._keys if k[0] == kind]
+
+    def details(self, kind: str) -> list[tuple[str, str]]:
+        """(field, detail) of each entry of ``kind``; no entry objects made (convert asks it of every record)."""
+        return [(k[1], k[2]) for k in self._keys if k[0] == kind] if self._keys else []
 
     def to_dict(self) -> list[dict[str, str]]:
         return [e.to_dict() for e in self.entries]
@@ -133,10 +140,14 @@ _F16 = struct.Struct("<e")
 F16_MAX = 65504.0
 
 
+_F32_PACK, _F32_UNPACK = _F32.pack, _F32.unpack
+_F16_PACK, _F16_UNPACK = _F16.pack, _F16.unpack
+
+
 def f32(x: float) -> float:
     """``x`` rounded to IEEE float32, as a C ``float`` holds it (overflow becomes infinity)."""
     try:
-        result: float = _F32.unpack(_F32.pack(x))[0]
+        result: float = _F32_UNPACK(_F32_PACK(x))[0]
     except OverflowError:
         return math.copysign(math.inf, x)
     return result
@@ -154,16 +165,16 @@ def f32_div(a: float, b: float) -> float:
 def f16(x: float, rep: LossReport | None, label: str) -> float:
     """``x`` as a saturated IEEE float16 holds it (DroneCAN ``float16``): finite values beyond
     the range clamp to +-65504, the rest round to nearest even."""
+    if -F16_MAX <= x <= F16_MAX:  # the usual case first (NaN fails the test and is kept below)
+        y: float = _F16_UNPACK(_F16_PACK(x))[0]
+        if rep is not None and y != x:
+            rep.rounded(label, "float16")
+        return y
     if math.isnan(x) or math.isinf(x):
         return x
-    if abs(x) > F16_MAX:
-        if rep is not None:
-            rep.clamped(label, f"{x!r} beyond float16")
-        return math.copysign(F16_MAX, x)
-    y: float = _F16.unpack(_F16.pack(x))[0]
-    if rep is not None and y != x:
-        rep.rounded(label, "float16")
-    return y
+    if rep is not None:  # finite beyond the range
+        rep.clamped(label, f"{x!r} beyond float16")
+    return math.copysign(F16_MAX, x)
 
 
 def roundf(x: float) -> float:

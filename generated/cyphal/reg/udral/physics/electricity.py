@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses as _dataclasses
 import functools as _functools
+import operator as _operator
 from collections.abc import Mapping as _Mapping
 from typing import TYPE_CHECKING
 from typing import Any as _Any
@@ -106,6 +107,10 @@ def _synchronized_timestamp_1_0_class() -> type[_cyphal_uavcan_time.Synchronized
     return cls
 
 
+_POWER_TS_0_1_KEYS: frozenset[str] = frozenset({"timestamp", "value"})
+_POWER_TS_0_1_VALUES = _operator.itemgetter("timestamp", "value")
+
+
 @_dataclasses.dataclass(slots=True)
 class PowerTs_0_1:
     """Power.0.1 with the time it was sampled.
@@ -140,12 +145,22 @@ class PowerTs_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> PowerTs_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"timestamp", "value"}), (), "PowerTs_0_1")
+        if data.__class__ is not dict or not data.keys() <= _POWER_TS_0_1_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _POWER_TS_0_1_KEYS, (), "PowerTs_0_1")
+        elif len(data) == 2:  # every field named: fetched in one call
+            v0, v1 = _POWER_TS_0_1_VALUES(data)
+            return cls(
+                _m.as_object(v0, "timestamp", _synchronized_timestamp_1_0_class()),
+                _m.as_object(v1, "value", _power_0_1_class()),
+            )
         obj = cls()
         if "timestamp" in data:
-            obj.timestamp = _m.as_object(data["timestamp"], "timestamp", _synchronized_timestamp_1_0_class())
+            x = data["timestamp"]
+            obj.timestamp = _m.as_object(x, "timestamp", _synchronized_timestamp_1_0_class())
         if "value" in data:
-            obj.value = _m.as_object(data["value"], "value", _power_0_1_class())
+            x = data["value"]
+            obj.value = _m.as_object(x, "value", _power_0_1_class())
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)
@@ -215,6 +230,10 @@ class PowerTs_0_1:
         raise KeyError(f"{field!r} is not a field of " + "cyphal.reg.udral.physics.electricity.PowerTs_0_1")
 
 
+_POWER_0_1_KEYS: frozenset[str] = frozenset({"current", "voltage"})
+_POWER_0_1_VALUES = _operator.itemgetter("current", "voltage")
+
+
 @_dataclasses.dataclass(slots=True)
 class Power_0_1:
     """Electric power at a point: the current through it and the voltage across it.
@@ -252,12 +271,22 @@ class Power_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Power_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"current", "voltage"}), (), "Power_0_1")
+        if data.__class__ is not dict or not data.keys() <= _POWER_0_1_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _POWER_0_1_KEYS, (), "Power_0_1")
+        elif len(data) == 2:  # every field named: fetched in one call
+            v0, v1 = _POWER_0_1_VALUES(data)
+            return cls(
+                _m.as_object(v0, "current", _scalar_1_0_class()),
+                _m.as_object(v1, "voltage", _scalar_1_0_class_2()),
+            )
         obj = cls()
         if "current" in data:
-            obj.current = _m.as_object(data["current"], "current", _scalar_1_0_class())
+            x = data["current"]
+            obj.current = _m.as_object(x, "current", _scalar_1_0_class())
         if "voltage" in data:
-            obj.voltage = _m.as_object(data["voltage"], "voltage", _scalar_1_0_class_2())
+            x = data["voltage"]
+            obj.voltage = _m.as_object(x, "voltage", _scalar_1_0_class_2())
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)
@@ -327,6 +356,10 @@ class Power_0_1:
         raise KeyError(f"{field!r} is not a field of " + "cyphal.reg.udral.physics.electricity.Power_0_1")
 
 
+_SOURCE_TS_0_1_KEYS: frozenset[str] = frozenset({"timestamp", "value"})
+_SOURCE_TS_0_1_VALUES = _operator.itemgetter("timestamp", "value")
+
+
 @_dataclasses.dataclass(slots=True)
 class SourceTs_0_1:
     """Source.0.1 with the time it was sampled; a battery publishes it on its energy_source subject.
@@ -362,12 +395,22 @@ class SourceTs_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> SourceTs_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"timestamp", "value"}), (), "SourceTs_0_1")
+        if data.__class__ is not dict or not data.keys() <= _SOURCE_TS_0_1_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _SOURCE_TS_0_1_KEYS, (), "SourceTs_0_1")
+        elif len(data) == 2:  # every field named: fetched in one call
+            v0, v1 = _SOURCE_TS_0_1_VALUES(data)
+            return cls(
+                _m.as_object(v0, "timestamp", _synchronized_timestamp_1_0_class()),
+                _m.as_object(v1, "value", _source_0_1_class()),
+            )
         obj = cls()
         if "timestamp" in data:
-            obj.timestamp = _m.as_object(data["timestamp"], "timestamp", _synchronized_timestamp_1_0_class())
+            x = data["timestamp"]
+            obj.timestamp = _m.as_object(x, "timestamp", _synchronized_timestamp_1_0_class())
         if "value" in data:
-            obj.value = _m.as_object(data["value"], "value", _source_0_1_class())
+            x = data["value"]
+            obj.value = _m.as_object(x, "value", _source_0_1_class())
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)
@@ -437,6 +480,10 @@ class SourceTs_0_1:
         raise KeyError(f"{field!r} is not a field of " + "cyphal.reg.udral.physics.electricity.SourceTs_0_1")
 
 
+_SOURCE_0_1_KEYS: frozenset[str] = frozenset({"power", "energy", "full_energy"})
+_SOURCE_0_1_VALUES = _operator.itemgetter("power", "energy", "full_energy")
+
+
 @_dataclasses.dataclass(slots=True)
 class Source_0_1:
     """An energy source (a battery): its power now, the energy left and the energy when full.
@@ -479,14 +526,26 @@ class Source_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Source_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"power", "energy", "full_energy"}), (), "Source_0_1")
+        if data.__class__ is not dict or not data.keys() <= _SOURCE_0_1_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _SOURCE_0_1_KEYS, (), "Source_0_1")
+        elif len(data) == 3:  # every field named: fetched in one call
+            v0, v1, v2 = _SOURCE_0_1_VALUES(data)
+            return cls(
+                _m.as_object(v0, "power", _power_0_1_class()),
+                _m.as_object(v1, "energy", _scalar_1_0_class_3()),
+                _m.as_object(v2, "full_energy", _scalar_1_0_class_3()),
+            )
         obj = cls()
         if "power" in data:
-            obj.power = _m.as_object(data["power"], "power", _power_0_1_class())
+            x = data["power"]
+            obj.power = _m.as_object(x, "power", _power_0_1_class())
         if "energy" in data:
-            obj.energy = _m.as_object(data["energy"], "energy", _scalar_1_0_class_3())
+            x = data["energy"]
+            obj.energy = _m.as_object(x, "energy", _scalar_1_0_class_3())
         if "full_energy" in data:
-            obj.full_energy = _m.as_object(data["full_energy"], "full_energy", _scalar_1_0_class_3())
+            x = data["full_energy"]
+            obj.full_energy = _m.as_object(x, "full_energy", _scalar_1_0_class_3())
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses as _dataclasses
 import enum as _enum
 import functools as _functools
+import operator as _operator
 from collections.abc import Mapping as _Mapping
 from typing import TYPE_CHECKING
 from typing import Any as _Any
@@ -259,6 +260,9 @@ def _technology_0_1_class() -> type[Technology_0_1]:
     return Technology_0_1
 
 
+_ERROR_0_1_KEYS: frozenset[str] = frozenset({"value"})
+
+
 @_dataclasses.dataclass(slots=True)
 class Error_0_1:
     """Error reported by a battery (NONE when it works normally).
@@ -288,10 +292,13 @@ class Error_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Error_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"value"}), (), "Error_0_1")
+        if data.__class__ is not dict or not data.keys() <= _ERROR_0_1_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _ERROR_0_1_KEYS, (), "Error_0_1")
         obj = cls()
         if "value" in data:
-            obj.value = _m.as_int(data["value"], "value")
+            x = data["value"]
+            obj.value = x if x.__class__ is int else _m.as_int(x, "value")
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)
@@ -337,6 +344,48 @@ class Error_0_1:
         if field in {"value"}:
             return True
         raise KeyError(f"{field!r} is not a field of " + "cyphal.reg.udral.service.battery.Error_0_1")
+
+
+_PARAMETERS_0_3_KEYS: frozenset[str] = frozenset(
+    {
+        "unique_id",
+        "mass",
+        "design_capacity",
+        "design_cell_voltage_min_max",
+        "discharge_current",
+        "discharge_current_burst",
+        "charge_current",
+        "charge_current_fast",
+        "charge_termination_threshold",
+        "charge_voltage",
+        "cycle_count",
+        "series_cell_count",
+        "state_of_health_pct",
+        "technology",
+        "nominal_voltage",
+        "unix_manufacture_time",
+        "name",
+    }
+)
+_PARAMETERS_0_3_VALUES = _operator.itemgetter(
+    "unique_id",
+    "mass",
+    "design_capacity",
+    "design_cell_voltage_min_max",
+    "discharge_current",
+    "discharge_current_burst",
+    "charge_current",
+    "charge_current_fast",
+    "charge_termination_threshold",
+    "charge_voltage",
+    "cycle_count",
+    "series_cell_count",
+    "state_of_health_pct",
+    "technology",
+    "nominal_voltage",
+    "unix_manufacture_time",
+    "name",
+)
 
 
 @_dataclasses.dataclass(slots=True)
@@ -496,79 +545,90 @@ class Parameters_0_3:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Parameters_0_3:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset(
-                {
-                    "unique_id",
-                    "mass",
-                    "design_capacity",
+        if data.__class__ is not dict or not data.keys() <= _PARAMETERS_0_3_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _PARAMETERS_0_3_KEYS, (), "Parameters_0_3")
+        elif len(data) == 17:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15, v16 = _PARAMETERS_0_3_VALUES(data)
+            return cls(
+                v0 if v0.__class__ is int else _m.as_int(v0, "unique_id"),
+                _m.as_object(v1, "mass", _scalar_1_0_class()),
+                _m.as_object(v2, "design_capacity", _scalar_1_0_class_2()),
+                _m.as_list(
+                    v3,
                     "design_cell_voltage_min_max",
-                    "discharge_current",
-                    "discharge_current_burst",
-                    "charge_current",
-                    "charge_current_fast",
-                    "charge_termination_threshold",
-                    "charge_voltage",
-                    "cycle_count",
-                    "series_cell_count",
-                    "state_of_health_pct",
-                    "technology",
-                    "nominal_voltage",
-                    "unix_manufacture_time",
-                    "name",
-                }
-            ),
-            (),
-            "Parameters_0_3",
-        )
+                    2,
+                    True,
+                    lambda item, p: _m.as_object(item, p, _scalar_1_0_class_3()),
+                ),
+                _m.as_object(v4, "discharge_current", _scalar_1_0_class_4()),
+                _m.as_object(v5, "discharge_current_burst", _scalar_1_0_class_4()),
+                _m.as_object(v6, "charge_current", _scalar_1_0_class_4()),
+                _m.as_object(v7, "charge_current_fast", _scalar_1_0_class_4()),
+                _m.as_object(v8, "charge_termination_threshold", _scalar_1_0_class_4()),
+                _m.as_object(v9, "charge_voltage", _scalar_1_0_class_3()),
+                v10 if v10.__class__ is int else _m.as_int(v10, "cycle_count"),
+                v11 if v11.__class__ is int else _m.as_int(v11, "series_cell_count"),
+                v12 if v12.__class__ is int else _m.as_int(v12, "state_of_health_pct"),
+                _m.as_object(v13, "technology", _technology_0_1_class()),
+                _m.as_object(v14, "nominal_voltage", _scalar_1_0_class_3()),
+                v15 if v15.__class__ is int else _m.as_int(v15, "unix_manufacture_time"),
+                _m.as_bytes(v16, "name", 64, False),
+            )
         obj = cls()
         if "unique_id" in data:
-            obj.unique_id = _m.as_int(data["unique_id"], "unique_id")
+            x = data["unique_id"]
+            obj.unique_id = x if x.__class__ is int else _m.as_int(x, "unique_id")
         if "mass" in data:
-            obj.mass = _m.as_object(data["mass"], "mass", _scalar_1_0_class())
+            x = data["mass"]
+            obj.mass = _m.as_object(x, "mass", _scalar_1_0_class())
         if "design_capacity" in data:
-            obj.design_capacity = _m.as_object(data["design_capacity"], "design_capacity", _scalar_1_0_class_2())
+            x = data["design_capacity"]
+            obj.design_capacity = _m.as_object(x, "design_capacity", _scalar_1_0_class_2())
         if "design_cell_voltage_min_max" in data:
+            x = data["design_cell_voltage_min_max"]
             obj.design_cell_voltage_min_max = _m.as_list(
-                data["design_cell_voltage_min_max"],
-                "design_cell_voltage_min_max",
-                2,
-                True,
-                lambda item, p: _m.as_object(item, p, _scalar_1_0_class_3()),
+                x, "design_cell_voltage_min_max", 2, True, lambda item, p: _m.as_object(item, p, _scalar_1_0_class_3())
             )
         if "discharge_current" in data:
-            obj.discharge_current = _m.as_object(data["discharge_current"], "discharge_current", _scalar_1_0_class_4())
+            x = data["discharge_current"]
+            obj.discharge_current = _m.as_object(x, "discharge_current", _scalar_1_0_class_4())
         if "discharge_current_burst" in data:
-            obj.discharge_current_burst = _m.as_object(
-                data["discharge_current_burst"], "discharge_current_burst", _scalar_1_0_class_4()
-            )
+            x = data["discharge_current_burst"]
+            obj.discharge_current_burst = _m.as_object(x, "discharge_current_burst", _scalar_1_0_class_4())
         if "charge_current" in data:
-            obj.charge_current = _m.as_object(data["charge_current"], "charge_current", _scalar_1_0_class_4())
+            x = data["charge_current"]
+            obj.charge_current = _m.as_object(x, "charge_current", _scalar_1_0_class_4())
         if "charge_current_fast" in data:
-            obj.charge_current_fast = _m.as_object(
-                data["charge_current_fast"], "charge_current_fast", _scalar_1_0_class_4()
-            )
+            x = data["charge_current_fast"]
+            obj.charge_current_fast = _m.as_object(x, "charge_current_fast", _scalar_1_0_class_4())
         if "charge_termination_threshold" in data:
-            obj.charge_termination_threshold = _m.as_object(
-                data["charge_termination_threshold"], "charge_termination_threshold", _scalar_1_0_class_4()
-            )
+            x = data["charge_termination_threshold"]
+            obj.charge_termination_threshold = _m.as_object(x, "charge_termination_threshold", _scalar_1_0_class_4())
         if "charge_voltage" in data:
-            obj.charge_voltage = _m.as_object(data["charge_voltage"], "charge_voltage", _scalar_1_0_class_3())
+            x = data["charge_voltage"]
+            obj.charge_voltage = _m.as_object(x, "charge_voltage", _scalar_1_0_class_3())
         if "cycle_count" in data:
-            obj.cycle_count = _m.as_int(data["cycle_count"], "cycle_count")
+            x = data["cycle_count"]
+            obj.cycle_count = x if x.__class__ is int else _m.as_int(x, "cycle_count")
         if "series_cell_count" in data:
-            obj.series_cell_count = _m.as_int(data["series_cell_count"], "series_cell_count")
+            x = data["series_cell_count"]
+            obj.series_cell_count = x if x.__class__ is int else _m.as_int(x, "series_cell_count")
         if "state_of_health_pct" in data:
-            obj.state_of_health_pct = _m.as_int(data["state_of_health_pct"], "state_of_health_pct")
+            x = data["state_of_health_pct"]
+            obj.state_of_health_pct = x if x.__class__ is int else _m.as_int(x, "state_of_health_pct")
         if "technology" in data:
-            obj.technology = _m.as_object(data["technology"], "technology", _technology_0_1_class())
+            x = data["technology"]
+            obj.technology = _m.as_object(x, "technology", _technology_0_1_class())
         if "nominal_voltage" in data:
-            obj.nominal_voltage = _m.as_object(data["nominal_voltage"], "nominal_voltage", _scalar_1_0_class_3())
+            x = data["nominal_voltage"]
+            obj.nominal_voltage = _m.as_object(x, "nominal_voltage", _scalar_1_0_class_3())
         if "unix_manufacture_time" in data:
-            obj.unix_manufacture_time = _m.as_int(data["unix_manufacture_time"], "unix_manufacture_time")
+            x = data["unix_manufacture_time"]
+            obj.unix_manufacture_time = x if x.__class__ is int else _m.as_int(x, "unix_manufacture_time")
         if "name" in data:
-            obj.name = _m.as_bytes(data["name"], "name", 64, False)
+            x = data["name"]
+            obj.name = _m.as_bytes(x, "name", 64, False)
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)
@@ -780,6 +840,14 @@ class Parameters_0_3:
         raise KeyError(f"{field!r} is not a field of " + "cyphal.reg.udral.service.battery.Parameters_0_3")
 
 
+_STATUS_0_2_KEYS: frozenset[str] = frozenset(
+    {"heartbeat", "temperature_min_max", "available_charge", "error", "cell_voltages"}
+)
+_STATUS_0_2_VALUES = _operator.itemgetter(
+    "heartbeat", "temperature_min_max", "available_charge", "error", "cell_voltages"
+)
+
+
 @_dataclasses.dataclass(slots=True)
 class Status_0_2:
     """Battery status for monitoring and maintenance, published at about 1 Hz or faster.
@@ -844,31 +912,38 @@ class Status_0_2:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Status_0_2:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(
-            data,
-            frozenset({"heartbeat", "temperature_min_max", "available_charge", "error", "cell_voltages"}),
-            (),
-            "Status_0_2",
-        )
+        if data.__class__ is not dict or not data.keys() <= _STATUS_0_2_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _STATUS_0_2_KEYS, (), "Status_0_2")
+        elif len(data) == 5:  # every field named: fetched in one call
+            v0, v1, v2, v3, v4 = _STATUS_0_2_VALUES(data)
+            return cls(
+                _m.as_object(v0, "heartbeat", _heartbeat_0_1_class()),
+                _m.as_list(
+                    v1, "temperature_min_max", 2, True, lambda item, p: _m.as_object(item, p, _scalar_1_0_class_5())
+                ),
+                _m.as_object(v2, "available_charge", _scalar_1_0_class_2()),
+                _m.as_object(v3, "error", _error_0_1_class()),
+                _m.as_typed_list(v4, "cell_voltages", 255, False, float, _m.as_float),
+            )
         obj = cls()
         if "heartbeat" in data:
-            obj.heartbeat = _m.as_object(data["heartbeat"], "heartbeat", _heartbeat_0_1_class())
+            x = data["heartbeat"]
+            obj.heartbeat = _m.as_object(x, "heartbeat", _heartbeat_0_1_class())
         if "temperature_min_max" in data:
+            x = data["temperature_min_max"]
             obj.temperature_min_max = _m.as_list(
-                data["temperature_min_max"],
-                "temperature_min_max",
-                2,
-                True,
-                lambda item, p: _m.as_object(item, p, _scalar_1_0_class_5()),
+                x, "temperature_min_max", 2, True, lambda item, p: _m.as_object(item, p, _scalar_1_0_class_5())
             )
         if "available_charge" in data:
-            obj.available_charge = _m.as_object(data["available_charge"], "available_charge", _scalar_1_0_class_2())
+            x = data["available_charge"]
+            obj.available_charge = _m.as_object(x, "available_charge", _scalar_1_0_class_2())
         if "error" in data:
-            obj.error = _m.as_object(data["error"], "error", _error_0_1_class())
+            x = data["error"]
+            obj.error = _m.as_object(x, "error", _error_0_1_class())
         if "cell_voltages" in data:
-            obj.cell_voltages = _m.as_list(
-                data["cell_voltages"], "cell_voltages", 255, False, lambda item, p: _m.as_float(item, p)
-            )
+            x = data["cell_voltages"]
+            obj.cell_voltages = _m.as_typed_list(x, "cell_voltages", 255, False, float, _m.as_float)
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)
@@ -967,6 +1042,9 @@ class Status_0_2:
         raise KeyError(f"{field!r} is not a field of " + "cyphal.reg.udral.service.battery.Status_0_2")
 
 
+_TECHNOLOGY_0_1_KEYS: frozenset[str] = frozenset({"value"})
+
+
 @_dataclasses.dataclass(slots=True)
 class Technology_0_1:
     """Cell chemistry and form factor of a battery.
@@ -996,10 +1074,13 @@ class Technology_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Technology_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"value"}), (), "Technology_0_1")
+        if data.__class__ is not dict or not data.keys() <= _TECHNOLOGY_0_1_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _TECHNOLOGY_0_1_KEYS, (), "Technology_0_1")
         obj = cls()
         if "value" in data:
-            obj.value = _m.as_int(data["value"], "value")
+            x = data["value"]
+            obj.value = x if x.__class__ is int else _m.as_int(x, "value")
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)
@@ -1072,6 +1153,9 @@ class Technology_0_1:
         raise KeyError(f"{field!r} is not a field of " + "cyphal.reg.udral.service.battery.Technology_0_1")
 
 
+_0_1_KEYS: frozenset[str] = frozenset()
+
+
 @_dataclasses.dataclass(slots=True)
 class __0_1:
     """Marks the UDRAL battery service; not sent. A battery publishes three subjects:
@@ -1097,7 +1181,9 @@ class __0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> __0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset(), (), "__0_1")
+        if data.__class__ is not dict or not data.keys() <= _0_1_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _0_1_KEYS, (), "__0_1")
         obj = cls()
         return obj
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses as _dataclasses
 import enum as _enum
 import functools as _functools
+import operator as _operator
 from collections.abc import Mapping as _Mapping
 from typing import TYPE_CHECKING
 from typing import Any as _Any
@@ -62,6 +63,10 @@ def _readiness_0_1_class() -> type[Readiness_0_1]:
     return Readiness_0_1
 
 
+_HEARTBEAT_0_1_KEYS: frozenset[str] = frozenset({"readiness", "health"})
+_HEARTBEAT_0_1_VALUES = _operator.itemgetter("readiness", "health")
+
+
 @_dataclasses.dataclass(slots=True)
 class Heartbeat_0_1:
     """The readiness and health of a UDRAL service, as its status messages carry them.
@@ -97,12 +102,22 @@ class Heartbeat_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Heartbeat_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"readiness", "health"}), (), "Heartbeat_0_1")
+        if data.__class__ is not dict or not data.keys() <= _HEARTBEAT_0_1_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _HEARTBEAT_0_1_KEYS, (), "Heartbeat_0_1")
+        elif len(data) == 2:  # every field named: fetched in one call
+            v0, v1 = _HEARTBEAT_0_1_VALUES(data)
+            return cls(
+                _m.as_object(v0, "readiness", _readiness_0_1_class()),
+                _m.as_object(v1, "health", _health_1_0_class()),
+            )
         obj = cls()
         if "readiness" in data:
-            obj.readiness = _m.as_object(data["readiness"], "readiness", _readiness_0_1_class())
+            x = data["readiness"]
+            obj.readiness = _m.as_object(x, "readiness", _readiness_0_1_class())
         if "health" in data:
-            obj.health = _m.as_object(data["health"], "health", _health_1_0_class())
+            x = data["health"]
+            obj.health = _m.as_object(x, "health", _health_1_0_class())
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)
@@ -172,6 +187,9 @@ class Heartbeat_0_1:
         raise KeyError(f"{field!r} is not a field of " + "cyphal.reg.udral.service.common.Heartbeat_0_1")
 
 
+_READINESS_0_1_KEYS: frozenset[str] = frozenset({"value"})
+
+
 @_dataclasses.dataclass(slots=True)
 class Readiness_0_1:
     """Readiness of a UDRAL service: asleep, in standby or engaged.
@@ -201,10 +219,13 @@ class Readiness_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Readiness_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"value"}), (), "Readiness_0_1")
+        if data.__class__ is not dict or not data.keys() <= _READINESS_0_1_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _READINESS_0_1_KEYS, (), "Readiness_0_1")
         obj = cls()
         if "value" in data:
-            obj.value = _m.as_int(data["value"], "value")
+            x = data["value"]
+            obj.value = x if x.__class__ is int else _m.as_int(x, "value")
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)

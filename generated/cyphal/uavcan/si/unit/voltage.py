@@ -33,6 +33,9 @@ _SCALAR_1_0_VOLT_SPEC = _v.Number(
 _SCALAR_1_0_FIELD_SPECS = (("volt", "volt", _SCALAR_1_0_VOLT_SPEC),)
 
 
+_SCALAR_1_0_KEYS: frozenset[str] = frozenset({"volt"})
+
+
 @_dataclasses.dataclass(slots=True)
 class Scalar_1_0:
     """A voltage in SI units; NaN when unknown.
@@ -64,10 +67,13 @@ class Scalar_1_0:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Scalar_1_0:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
-        data = _m.check_keys(data, frozenset({"volt"}), (), "Scalar_1_0")
+        if data.__class__ is not dict or not data.keys() <= _SCALAR_1_0_KEYS:
+            # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
+            data = _m.check_keys(data, _SCALAR_1_0_KEYS, (), "Scalar_1_0")
         obj = cls()
         if "volt" in data:
-            obj.volt = _m.as_float(data["volt"], "volt")
+            x = data["volt"]
+            obj.volt = x if x.__class__ is float else _m.as_float(x, "volt")
         return obj
 
     # how the fields lie on the wire (the runtime _cyphal.py walks it)
