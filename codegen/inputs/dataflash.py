@@ -26,9 +26,12 @@ from __future__ import annotations
 import contextlib
 import io
 import math
+import os
 import re
 import struct
-from collections.abc import Iterable, Iterator, Mapping
+import sys
+import tempfile
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -192,12 +195,41 @@ def _open(path: Path, display: str, notes: list[str], text: bool = False) -> Any
 
 @contextlib.contextmanager
 def _captured(notes: list[str]) -> Iterator[None]:
-    """pymavlink's prints (skipped bytes, unknown formats) as notes instead of output."""
+    """pymavlink's prints (skipped bytes, unknown formats) as notes instead of output: Python's prints, and what its
+    C indexer writes to the process's own stderr/stdout (``Invalid length in FMT message at 0``), which no Python
+    redirection sees; that text would reach a terminal or CI log unescaped, between battgen's own lines."""
     out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+    with _fd_captured() as native, contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         yield
-    for text in (out.getvalue(), err.getvalue()):
+    for text in (out.getvalue(), err.getvalue(), native()):
         notes.extend(line for line in text.splitlines() if line.strip())
+
+
+@contextlib.contextmanager
+def _fd_captured() -> Iterator[Callable[[], str]]:
+    """File descriptors 1 and 2 pointed at one temporary file while the block runs; yields what was written (read
+    after the block, at most 64 KiB of it). Where the descriptors cannot be duplicated, nothing is captured."""
+    captured = ""
+    try:
+        saved = [os.dup(1), os.dup(2)]
+    except OSError:
+        yield lambda: captured
+        return
+    with tempfile.TemporaryFile() as sink:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        os.dup2(sink.fileno(), 1)
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lambda: captured
+        finally:
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for fd in saved:
+                os.close(fd)
+            sink.seek(0)
+            captured = sink.read(65536).decode("utf-8", "replace")
 
 
 def _time_us(values: Mapping[str, Any]) -> int | None:
