@@ -43,7 +43,7 @@ def run_query(dataset: Path, sql: str) -> QueryResult:
         columns = [d[0] for d in cur.description or []]
         return QueryResult(columns, cur.fetchall() if columns else [])
     except duckdb.Error as exc:
-        raise BattgenError(f"query failed: {exc}") from None
+        raise BattgenError(f"query failed: {_one_line(exc)}") from None
     finally:
         con.close()
 
@@ -59,6 +59,14 @@ def query_to_parquet(dataset: Path, sql: str, out: Path) -> int:
         row = con.execute(f"SELECT count(*) FROM read_parquet('{target}')").fetchall()[0]
         return int(row[0])
     except duckdb.Error as exc:
-        raise BattgenError(f"query failed: {exc}") from None
+        raise BattgenError(f"query failed: {_one_line(exc)}") from None
     finally:
         con.close()
+
+
+def _one_line(exc: Exception) -> str:
+    """DuckDB's message on one line: its sentences joined, the echo of the query and its caret line left out (the
+    user has the query; a multi-line message would print as escaped line breaks)."""
+    lines = [x.strip() for x in str(exc).splitlines()]
+    kept = [x for x in lines if x and not x.startswith("LINE ") and set(x) != {"^"}]
+    return "; ".join(kept) or type(exc).__name__
