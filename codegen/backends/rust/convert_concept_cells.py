@@ -68,11 +68,16 @@ class ConceptCellOps(ConceptOps):
                 count = self.s(count_ref)
                 crust = self.rust(count_ref)
                 as_usize = cast(count, crust, "usize")
-                self.emit(
-                    f"if {count} != 0 {{",
-                    f"if {paren(as_usize)} < n {{ n = {as_usize}; }}",
-                    *(["} else {", *leading, "}"] if leading else ["}"]),
-                )
+                if leading:
+                    self.emit(
+                        f"if {count} != 0 {{",
+                        f"if {paren(as_usize)} < n {{ n = {as_usize}; }}",
+                        "} else {",
+                        *leading,
+                        "}",
+                    )
+                else:
+                    self.emit(f"if {count} != 0 && {paren(as_usize)} < n {{ n = {as_usize}; }}")
             else:
                 self.emit(*leading)
             value = affine(as_f64(f"{src}[i]"), mul, add)
@@ -155,7 +160,7 @@ class ConceptCellOps(ConceptOps):
                 f"if n > 1 && got[0] != {mm - 1} {{",
                 f"t.has_{cn} = true;",
                 f"t.{cn}_len = n;",
-                f"for k in 0..n {{ t.{cn}[k] = {affine('(got[k] as f64)', mul, add)}; }}",
+                f"for (c, g) in t.{cn}.iter_mut().zip(&got[..n]) {{ *c = {affine('(*g as f64)', mul, add)}; }}",
                 "}",
                 "}",
             )
