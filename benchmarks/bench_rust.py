@@ -4,6 +4,9 @@ it, Python `BatteryStatus.decode_frame`) and one step of the battery failsafe on
 `Failsafe::update`, Python `BatteryFailsafe.update`; the C library has no failsafe), and a Cyphal (UDRAL) battery
 Status.0.2 decode with 12 cells (Rust, C, the Python package, and pydsdl's own `deserialize`).
 
+Also a converter (DroneCAN BatteryInfo + BatteryInfoAux -> uORB battery_status, strict and px4) in Rust, C and
+Python, bench_c_convert.py's record and programs.
+
 Run: python benchmarks/bench_rust.py [--number N]
 The Rust side is built with cargo --release --offline into a temp dir; each figure is the best of five runs of N
 calls; prints ns per call and the ratios (below 1: Rust is faster).
@@ -20,6 +23,7 @@ import sys
 import tempfile
 import timeit
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
 CRATE = ROOT / "generated" / "rust"
@@ -27,6 +31,9 @@ CRATE = ROOT / "generated" / "rust"
 MAIN = r"""
 use battgen::cyphal::reg::udral::service::battery::Status0_2;
 use battgen::cyphal_wire::Message as _;
+use battgen::convert::{dronecan_to_uorb_px4, dronecan_to_uorb_strict, LossReport};
+use battgen::dronecan::ardupilot::equipment::power::BatteryInfoAux;
+use battgen::dronecan::uavcan::equipment::power::BatteryInfo;
 use battgen::failsafe::{Failsafe, Reading, Sample, Settings, Variants, Vehicle};
 use battgen::mavlink::BatteryStatus;
 use battgen::mavlink_wire::{decode_frame, encode_frame, Header, MAX_FRAME_LENGTH};
@@ -95,6 +102,29 @@ fn main() {
         sink += u64::from(m.error.value);
     });
     println!("cyphal_status_decode_rust {cyphal:.2}");
+    // a converter: DroneCAN BatteryInfo + BatteryInfoAux -> uORB battery_status, bench_c_convert.py's record
+    let mut info = BatteryInfo::new();
+    (info.temperature, info.voltage, info.current) = (298.25, 16.796875, -1.5);
+    (info.average_power_10sec, info.remaining_capacity_wh, info.full_charge_capacity_wh) = (25.0, 60.0, 80.0);
+    (info.hours_to_full_charge, info.status_flags, info.state_of_health_pct) = (0.0, 1, 97);
+    (info.state_of_charge_pct, info.model_instance_id) = (75, 7);
+    let mut aux = BatteryInfoAux::new();
+    aux.voltage_cell_len = 4;
+    aux.voltage_cell[..4].copy_from_slice(&[4.199_218_8; 4]);
+    (aux.nominal_voltage, aux.cycle_count) = (14.796875, 12);
+    let mut rep = LossReport::new();
+    for (name, px4) in [("convert_strict_rust", false), ("convert_px4_rust", true)] {
+        let ns = best(n, |_| {
+            rep.clear();
+            let out = if px4 {
+                dronecan_to_uorb_px4(black_box(&info), Some(&aux), None, None, &mut rep)
+            } else {
+                dronecan_to_uorb_strict(black_box(&info), Some(&aux), &mut rep)
+            };
+            sink += u64::from(out.voltage_v.to_bits() & 1);
+        });
+        println!("{name} {ns:.2}");
+    }
     println!("decode_rust {decode:.2}");
     println!("failsafe_step_rust {step:.2}");
     println!("sink {sink}");
@@ -119,13 +149,18 @@ def rust(number: int) -> dict[str, float]:
     return {name: float(value) for name, value in (line.split() for line in done.stdout.splitlines())}
 
 
-def c(number: int) -> dict[str, float]:
-    """bench_c_speed.py's figures (its C program, built the same way)."""
-    spec = importlib.util.spec_from_file_location("bench_c_speed", Path(__file__).parent / "bench_c_speed.py")
+def _module(name: str) -> Any:
+    """A sibling benchmark (its C program, built the same way)."""
+    spec = importlib.util.spec_from_file_location(name, Path(__file__).parent / f"{name}.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    result: dict[str, float] = module.run(number)
+    return module
+
+
+def c(number: int) -> dict[str, float]:
+    """bench_c_speed.py's figures."""
+    result: dict[str, float] = _module("bench_c_speed").run(number)
     return result
 
 
@@ -202,6 +237,14 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     print("Cyphal battery Status.0.2 decode (12 cells), ns per call:")
     print(f"  Rust {r:8.1f}  C {cc:8.1f}  Python {py:9.1f}  pydsdl {ref:9.1f}")
     print(f"  Rust/C {r / cc:5.2f}  Python/pydsdl {py / ref:5.2f}")
+    convert = _module("bench_c_convert")
+    ns |= {f"convert_{k}_c": v for k, v in convert.c_times(args.number).items()}
+    ns |= {f"convert_{k}_python": v for k, v in convert.python_times(max(args.number // 100, 1)).items()}
+    print("DroneCAN BatteryInfo + BatteryInfoAux -> uORB battery_status, with a loss report, ns per call:")
+    for policy in ("strict", "px4"):
+        r, cc, py = (ns[f"convert_{policy}_{side}"] for side in ("rust", "c", "python"))
+        ratios = f"Rust/C {r / cc:5.2f}  Rust/Python {r / py:7.4f}"
+        print(f"  {policy:6} Rust {r:8.1f}  C {cc:8.1f}  Python {py:9.1f}   {ratios}")
     return ns
 
 

@@ -7,9 +7,11 @@ bytes; a tag naming no field is refused both ways; the validator checks the held
 
 from __future__ import annotations
 
+import importlib
 import os
 import shutil
 import subprocess
+import sys
 from typing import Any
 
 import pytest
@@ -17,6 +19,7 @@ import pytest
 # the same definitions as the C library's union test, and pydronecan's bytes for them
 from test_c_dronecan_unions_c import DEFINITIONS, _reference
 
+from codegen.backends.python.writer import generate
 from codegen.backends.rust.render import render_crate
 from codegen.frontends import dsdl
 
@@ -78,6 +81,14 @@ CASES
     p.union_tag = 3;
     let found = p.validate();
     println!("{} {} {}", held.len(), found.len(), found.as_slice()[0].field);
+    // a tag naming no field: the validator's union problem, as Python's (printed `path rule;...`)
+    let named = |v: &[battgen::Problem]| -> String {
+        v.iter().map(|p| format!("{} {};", p.field, p.rule.name())).collect()
+    };
+    println!("{}", named(Three { union_tag: 3, ..Three::new() }.validate().as_slice()));
+    println!("{}", named(Three { union_tag: 255, ..Three::new() }.validate().as_slice()));
+    let pick = Pick { union_tag: 4, number: 2, ..Pick::new() };
+    println!("{}", named(Holder { index: 1, pick }.validate().as_slice()));
 }
 """
 
@@ -119,7 +130,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[str], dict[str, 
 
 def test_every_branch_is_pydronecans_bytes(run: tuple[list[str], dict[str, Any]]) -> None:
     out, types = run
-    assert len(out) == len(CASES) + 2
+    assert len(out) == len(CASES) + 5
     for line, (name, given, values) in zip(out, CASES, strict=False):
         tao, fd, _, _ = line.split(" ")
         assert tao == _reference(types, name, values, True), (name, given)
@@ -136,9 +147,37 @@ def test_bytes_read_back_hold_the_same_branch(run: tuple[list[str], dict[str, An
 
 def test_a_tag_naming_no_field_is_refused(run: tuple[list[str], dict[str, Any]]) -> None:
     out, _ = run
-    assert out[-2] == "refused"  # the example asserts both errors before printing this
+    assert out[-5] == "refused"  # the example asserts both errors before printing this
 
 
 def test_a_union_validates_the_field_it_holds(run: tuple[list[str], dict[str, Any]]) -> None:
     out, _ = run
-    assert out[-1] == "0 1 half"  # NaN in half: no problem while number is held, one once half is
+    assert out[-4] == "0 1 half"  # NaN in half: no problem while number is held, one once half is
+
+
+def test_a_tag_naming_no_field_is_pythons_union_problem(
+    run: tuple[list[str], dict[str, Any]], tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    """The generated Python package of the same definitions, its union_field set to no field (what a
+    Rust tag beyond the fields is), reports the same problems (path and rule) as the Rust validator."""
+    base = tmp_path_factory.mktemp("py_union")
+    (base / "dsdl" / "test").mkdir(parents=True)
+    for name, text in DEFINITIONS.items():
+        (base / "dsdl" / "test" / name).write_text(text)
+    generate(dsdl.parse_dir(base / "dsdl"), base / "out" / "rs_union")
+    sys.path.insert(0, str(base / "out"))
+    try:
+        mod = importlib.import_module("rs_union.dronecan.test")
+        three = mod.Three(a=0)
+        object.__setattr__(three, "union_field", None)  # no field of the union, as tags 3 and 255
+        pick = mod.Pick(number=2)
+        object.__setattr__(pick, "union_field", None)
+        holder = mod.Holder(index=1, pick=pick)
+        expected = ["".join(f"{v.path} {v.rule};" for v in obj.validate()) for obj in (three, three, holder)]
+    finally:
+        sys.path.remove(str(base / "out"))
+        for name in [n for n in sys.modules if n.split(".")[0] == "rs_union"]:
+            del sys.modules[name]
+    out, _ = run
+    assert expected == ["union_field union;", "union_field union;", "pick.union_field union;"]
+    assert out[-3:] == expected

@@ -145,6 +145,31 @@ def check_uses(
 
 
 @dataclass(frozen=True)
+class UnionUse:
+    """A DroneCAN union's tag checked by ``validate_into``: it must name one of the union's fields (the
+    Python validator's ``union_field`` problem), the message's own or one nested in it."""
+
+    path: str  # as problems name it (``pick.union_field``)
+    target: str  # the tag's expression (``self.pick.union_tag``)
+    count: int  # the union's fields
+    held: str | None = None  # nested in a union: the condition that it holds the field
+
+
+def union_uses(
+    schema: Schema, msg: Message, path: str = "", target: str = "self.", depth: int = 0, held: str | None = None
+) -> list[UnionUse]:
+    """The union tags ``msg`` holds, its own and those of the messages nested in it (not in arrays)."""
+    union = msg.dronecan is not None and msg.dronecan.union
+    out = [UnionUse(path + "union_field", target + "union_tag", len(msg.fields), held)] if union else []
+    for k, f in enumerate(msg.fields):
+        if isinstance(f.type, CompositeType) and not f.is_padding and depth < 8:
+            mine = " && ".join(c for c in (held, f"{target}union_tag == {k}" if union else None) if c) or None
+            inner = schema.message(f.type.name)
+            out += union_uses(schema, inner, f"{path}{f.name}.", f"{target}{field_ident(f.name)}.", depth + 1, mine)
+    return out
+
+
+@dataclass(frozen=True)
 class MessageView:
     qualified: str
     name: str
@@ -163,12 +188,14 @@ class MessageView:
     msg: Message
     same: list[str] = field(default_factory=list)  # the sameness terms of PartialEq
     rules: RustRules = field(default_factory=RustRules)  # the cross-field rules, after the field checks
+    unions: list[UnionUse] = field(default_factory=list)  # the union tags checked, after the field checks
 
     @property
     def max_problems(self) -> int:
         """Every value checked can break one rule, a dynamic array's length one more, and each
         cross-field rule once (once per index of its loop)."""
-        return sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in self.uses) + self.rules.most
+        checks = sum((u.check.count or 1) + (1 if u.check.dynamic else 0) for u in self.uses)
+        return checks + len(self.unions) + self.rules.most
 
 
 def _unknown(f: Field, t: PrimitiveType, ident: str) -> tuple[str, str | None] | None:
@@ -311,6 +338,7 @@ def message_view(schema: Schema, msg: Message, shared: dict[str, EnumView]) -> M
         msg=msg,
         same=same,
         rules=rust_rules(schema, msg),
+        unions=union_uses(schema, msg),
     )
 
 

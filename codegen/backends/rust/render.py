@@ -14,6 +14,7 @@ import jinja2
 
 from ...errors import BattgenError
 from ...ir import CompositeType, Message, Schema, SourceFormat
+from .convert_module import render_convert
 from .cyphal_codec import cyphal_modules
 from .model import MessageView, message_view, shared_enums
 from .params import render_params
@@ -143,6 +144,14 @@ def render_crate(schema: Schema) -> dict[str, str]:
     if params is not None:
         rs["src/params.rs"] = params
         children[()].add("params")
+    convert, _, _ = render_convert(env, schema)
+    if convert is not None:  # the converters, and their run-time support copied beside them
+        rs["src/convert.rs"] = convert
+        text = (_HERE / "support" / "convert_runtime.rs").read_text(encoding="utf-8")
+        rs["src/convert_runtime.rs"] = (
+            "// Copied by battgen from codegen/backends/rust/support/convert_runtime.rs; do not edit.\n" + text
+        )
+        children[()] |= {"convert", "convert_runtime"}
     rs["src/lib.rs"] = env.get_template("lib.rs.j2").render(
         support=CRATE_SUPPORT, modules=sorted(children[()]), example=example
     )

@@ -3,7 +3,8 @@
 into Python: the rule's ``where`` guard, its ``for i in range(a, b)`` loop (kept to the message's largest
 array, as the Python ``_v.span``), its check, and a problem (the field its ``path`` names, the element, the
 rule id) when the check fails. Values are read as Python compares them: integers in i128 (every wire
-integer fits), floats in f64. Where Python would raise (an index beyond the array, a division by zero,
+integer fits), floats in f64, an integer compared with a float exactly (``support/rules.rs``:
+``int_float``). Where Python would raise (an index beyond the array, a division by zero,
 an overflow) the rule reports nothing, as the Python ``except _v.SLOW`` does: each method returns
 ``Option`` and stops at ``?``. A rule using what this module does not spell (text, ``in``,
 ``all``/``any``, floor division, nested loops) is left out of the crate; :class:`RustRules` says which."""
@@ -67,6 +68,35 @@ def _float(v: _Value) -> str:
     if v.const is not None:
         return float_literal(float(v.const), "f64")
     return f"({v.code} as f64)"
+
+
+# an integer Python compares with a float exactly; one of at most 2^53 is exact as an f64 too
+_EXACT = 1 << 53
+_ORDER = {
+    "<": "Some(Ordering::Less)",
+    "<=": "Some(Ordering::Less | Ordering::Equal)",
+    ">": "Some(Ordering::Greater)",
+    ">=": "Some(Ordering::Greater | Ordering::Equal)",
+    "==": "Some(Ordering::Equal)",
+    "!=": "Some(Ordering::Equal)",
+}
+
+
+def _pair(a: _Value, op: str, b: _Value) -> str:
+    """``a op b`` as Python compares them: an integer with a float exactly (not rounded to an f64;
+    NaN unordered), unless the integer is a constant an f64 holds exactly."""
+    if a.kind == b.kind:
+        return f"{a.code} {op} {b.code}"
+    small = [v for v in (a, b) if v.kind == "int" and v.const is not None and abs(int(v.const)) <= _EXACT]
+    if small:
+        return f"{_float(a)} {op} {_float(b)}"
+    order = (
+        f"crate::rules::int_float({_strip(a.code)}, {_strip(b.code)})"
+        if a.kind == "int"
+        else f"crate::rules::float_int({_strip(a.code)}, {_strip(b.code)})"
+    )
+    test = f"matches!({order}, {_ORDER[op].replace('Ordering::', 'core::cmp::Ordering::')})"
+    return f"!{test}" if op == "!=" else test
 
 
 class _Rule:
@@ -168,13 +198,9 @@ class _Rule:
         if any(op not in _OPS for op in e.ops):
             raise Unsupported("membership")
         terms = [self.expr(x) for x in e.operands]
-        if any(t.kind == "float" for t in terms):
-            codes = [_float(t) for t in terms]
-        elif all(t.kind == terms[0].kind for t in terms):
-            codes = [t.code for t in terms]
-        else:
+        if any(t.kind == "bool" for t in terms) and not all(t.kind == "bool" for t in terms):
             raise Unsupported("a truth value compared with a number")
-        pairs = [f"{a} {op} {b}" for a, op, b in zip(codes[:-1], e.ops, codes[1:], strict=True)]
+        pairs = [_pair(a, op, b) for a, op, b in zip(terms[:-1], e.ops, terms[1:], strict=True)]
         return _Value("(" + " && ".join(pairs) + ")", "bool")
 
     def call(self, e: Call) -> _Value:

@@ -22,6 +22,8 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod convert;
+pub mod convert_runtime;
 pub mod crc;
 pub mod cyphal;
 pub mod cyphal_wire;

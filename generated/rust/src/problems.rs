@@ -18,6 +18,8 @@ pub enum Rule {
     Length,
     /// Breaks the cross-field rule of this id (schemas/rules/).
     CrossField(&'static str),
+    /// A DroneCAN union's tag names none of its fields.
+    Union,
 }
 
 impl Rule {
@@ -33,6 +35,7 @@ impl Rule {
             Rule::Bitmask => "bitmask",
             Rule::Length => "length",
             Rule::CrossField(_) => "cross-field",
+            Rule::Union => "union",
         }
     }
 

@@ -33,3 +33,40 @@ pub fn span(start: i128, stop: i128, limit: i128) -> core::ops::Range<i128> {
 pub fn position(i: i128) -> Option<usize> {
     usize::try_from(i).ok()
 }
+
+/// Python's comparison of an integer with a float: exact (the integer is not rounded to an f64, so
+/// 2^53 + 1 is above 2^53 as a float), `None` for NaN (every comparison with it false but `!=`).
+#[must_use]
+pub fn int_float(i: i128, f: f64) -> Option<core::cmp::Ordering> {
+    use core::cmp::Ordering;
+    const TOP: f64 = 170_141_183_460_469_231_731_687_303_715_884_105_728.0; // 2^127: beyond every i128
+    if f.is_nan() {
+        return None;
+    }
+    if f >= TOP {
+        return Some(Ordering::Less);
+    }
+    if f < -TOP {
+        return Some(Ordering::Greater);
+    }
+    let whole = f as i128; // toward zero, exact below 2^127
+    Some(match i.cmp(&whole) {
+        Ordering::Equal => {
+            let fraction = f - whole as f64; // exact: a float less its integer part
+            if fraction > 0.0 {
+                Ordering::Less
+            } else if fraction < 0.0 {
+                Ordering::Greater
+            } else {
+                Ordering::Equal
+            }
+        }
+        other => other,
+    })
+}
+
+/// [`int_float`] the other way round: a float compared with an integer.
+#[must_use]
+pub fn float_int(f: f64, i: i128) -> Option<core::cmp::Ordering> {
+    int_float(i, f).map(core::cmp::Ordering::reverse)
+}

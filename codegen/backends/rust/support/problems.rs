@@ -17,6 +17,8 @@ pub enum Rule {
     Length,
     /// Breaks the cross-field rule of this id (schemas/rules/).
     CrossField(&'static str),
+    /// A DroneCAN union's tag names none of its fields.
+    Union,
 }
 
 impl Rule {
@@ -32,6 +34,7 @@ impl Rule {
             Rule::Bitmask => "bitmask",
             Rule::Length => "length",
             Rule::CrossField(_) => "cross-field",
+            Rule::Union => "union",
         }
     }
 
