@@ -109,7 +109,9 @@ def type_cases(msg: Message, t: pydsdl.CompositeType, cls: Any = None) -> TypeCa
     name = msg.qualified_name
     sealed = not isinstance(t, pydsdl.DelimitedType)
     out = TypeCases(name, msg, sealed)
-    drawn_values = [plain(v) for v in drawn(values(t), VALUES)]
+    # the values a test type exists for come first (the draws differ with the checkout's path, so what they hold
+    # is not promised), then the draws
+    drawn_values = [*EXPLICIT.get(name, []), *(plain(v) for v in drawn(values(t), VALUES))]
     for attr, value in CASTS.get(name, []):
         drawn_values.append({**drawn_values[len(out.values) % len(drawn_values)], attr: value})
     for value in drawn_values:
@@ -144,6 +146,22 @@ DEFINITIONS = {
     "Inner.1.0.dsdl": "uint8 a\nfloat16[<=3] b\n@extent 128\n",
     "Pick.1.0.dsdl": "@union\nuint8 small\nint16 number\nInner.1.0 inner\nfloat32[2] pair\n@sealed\n",
     "Outer.1.0.dsdl": "Inner.1.0 first\nPick.1.0 pick\nInner.1.0[<=2] many\nbool flag\nint5 five\n@extent 1024\n",
+}
+
+
+# per test type, values the native codecs must meet whatever the draws hold: the union holding the delimited type
+# with a non-empty array, and a delimited type in the variable-length array
+EXPLICIT: dict[str, list[dict[str, Any]]] = {
+    "cyphal.test.Pick_1_0": [{"inner": {"a": 7, "b": [1.0, -2.0]}}],
+    "cyphal.test.Outer_1_0": [
+        {
+            "first": {"a": 1, "b": [0.5]},
+            "pick": {"inner": {"a": 7, "b": [1.0, -2.0, 65504.0]}},
+            "many": [{"a": 2, "b": [0.25]}, {"a": 3, "b": []}],
+            "flag": True,
+            "five": -9,
+        }
+    ],
 }
 
 

@@ -3222,8 +3222,9 @@ static void map_mavlink_info_backward(const battgen_concepts *s,
       size_t i;
       size_t n = (size_t)s->manufacture_date_len;
       if (n > 9u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.manufacture_date");
         n = 9u;
-      } /* Python keeps the whole text; C has room for 9 */
+      }
       battgen_zero(t_info->manufacture_date, sizeof t_info->manufacture_date);
       for (i = 0; i < n; i++) {
         t_info->manufacture_date[i] = (char)s->manufacture_date[i];
@@ -3239,8 +3240,9 @@ static void map_mavlink_info_backward(const battgen_concepts *s,
       size_t i;
       size_t n = (size_t)s->serial_number_text_len;
       if (n > 32u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.serial_number");
         n = 32u;
-      } /* Python keeps the whole text; C has room for 32 */
+      }
       battgen_zero(t_info->serial_number, sizeof t_info->serial_number);
       for (i = 0; i < n; i++) {
         t_info->serial_number[i] = (char)s->serial_number_text[i];
@@ -3256,8 +3258,9 @@ static void map_mavlink_info_backward(const battgen_concepts *s,
       size_t i;
       size_t n = (size_t)s->model_name_len;
       if (n > 50u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "mavlink.BATTERY_INFO.name");
         n = 50u;
-      } /* Python keeps the whole text; C has room for 50 */
+      }
       battgen_zero(t_info->name, sizeof t_info->name);
       for (i = 0; i < n; i++) {
         t_info->name[i] = (char)s->model_name[i];
@@ -6155,8 +6158,9 @@ static void map_uorb_info_backward(const battgen_concepts *s, battgen_uorb_Batte
       size_t i;
       size_t n = (size_t)s->serial_number_text_len;
       if (n > 32u) {
+        battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, "uorb.BatteryInfo.serial_number");
         n = 32u;
-      } /* Python keeps the whole text; C has room for 32 */
+      }
       battgen_zero(t_info->serial_number, sizeof t_info->serial_number);
       for (i = 0; i < n; i++) {
         t_info->serial_number[i] = (char)s->serial_number_text[i];

@@ -366,7 +366,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_INFO.manufacture_date")
     else:
-        t_info.manufacture_date = _v18
+        t_info.manufacture_date = _r.text_out(_v18, 9, rep, "mavlink.BATTERY_INFO.manufacture_date")
 
     # mavlink_info.yaml:41: copy serial_number -> serial_number_text
     _v19 = s.serial_number_text
@@ -375,7 +375,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_INFO.serial_number")
     else:
-        t_info.serial_number = _v19
+        t_info.serial_number = _r.text_out(_v19, 32, rep, "mavlink.BATTERY_INFO.serial_number")
 
     # mavlink_info.yaml:42: copy name -> model_name
     # Manufacturer then product name, joined by an underscore.
@@ -385,7 +385,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("mavlink.BATTERY_INFO.name")
     else:
-        t_info.name = _v20
+        t_info.name = _r.text_out(_v20, 50, rep, "mavlink.BATTERY_INFO.name")
 
     # what did not survive the conversion
     if rep_d is not None:

@@ -122,7 +122,7 @@ def backward(
         if rep_u is not None:
             rep_u.unknown("uorb.BatteryInfo.serial_number")
     else:
-        t_info.serial_number = _v2
+        t_info.serial_number = _r.text_out(_v2, 32, rep, "uorb.BatteryInfo.serial_number")
 
     # what did not survive the conversion
     if rep_d is not None:

@@ -265,6 +265,20 @@ def text_in(value: Any) -> str | None:
     return value or None
 
 
+def text_out(text: str, capacity: int | None, rep: LossReport | None, label: str) -> str:
+    """A text for a string field of ``capacity`` bytes (a MAVLink ``char[N]``): cut to what the field holds, as the
+    wire carries it, and reported clamped, as :func:`bytes_out` does for a byte array. A cut inside a character
+    keeps its bytes (the model's strings decode a field's bytes with ``surrogateescape``)."""
+    if capacity is None:
+        return text
+    data = text.encode("utf-8", "surrogateescape")
+    if len(data) <= capacity:
+        return text
+    if rep is not None:
+        rep.clamped(label, f"{len(data)} bytes, room for {capacity}")
+    return data[:capacity].decode("utf-8", "surrogateescape")
+
+
 def bytes_out(text: str, capacity: int | None, rep: LossReport | None, label: str) -> bytes:
     data = text.encode("utf-8")
     if capacity is not None and len(data) > capacity:

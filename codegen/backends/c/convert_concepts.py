@@ -307,10 +307,7 @@ class ConceptOps(CBase):
             self.emit(clear)
         self.emit(f"battgen_loss_add(rep_u, BATTGEN_LOSS_UNKNOWN, {label});", "} else {", "size_t i;")
         self.emit(f"size_t n = (size_t)s->{name}_len;")
-        if not isinstance(t, StringType):
-            self.emit(f"if (n > {cap}u) {{ battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, {label}); n = {cap}u; }}")
-        else:
-            self.emit(f"if (n > {cap}u) {{ n = {cap}u; }} /* Python keeps the whole text; C has room for {cap} */")
+        self.emit(f"if (n > {cap}u) {{ battgen_loss_add(rep, BATTGEN_LOSS_CLAMPED, {label}); n = {cap}u; }}")
         if not dynamic:
             self.emit(f"battgen_zero({target}, sizeof {target});")
         self.emit(f"for (i = 0; i < n; i++) {{ {target}[i] = {cast}s->{name}[i]; }}")

@@ -328,10 +328,7 @@ class ConceptOps(RustBase):
             self.emit(clear)
         self.emit(f"r.add_u(LossKind::Unknown, {label});", "} else {")
         self.emit(f"let mut n = s.{name}_len;")
-        if not isinstance(t, StringType):
-            self.emit(f"if n > {cap} {{ r.add(LossKind::Clamped, {label}); n = {cap}; }}")
-        else:
-            self.emit(f"n = n.min({cap}); // Python keeps the whole text; the field has room for {cap}")
+        self.emit(f"if n > {cap} {{ r.add(LossKind::Clamped, {label}); n = {cap}; }}")
         if not dynamic:
             self.emit(f"{target} = [0; {capacity(t)}];")
         self.emit(f"{target}[..n].copy_from_slice(&s.{name}[..n]);")

@@ -3856,7 +3856,10 @@ fn map_mavlink_info_backward(
             r.add_u(LossKind::Unknown, "mavlink.BATTERY_INFO.manufacture_date");
         } else {
             let mut n = s.manufacture_date_len;
-            n = n.min(9); // Python keeps the whole text; the field has room for 9
+            if n > 9 {
+                r.add(LossKind::Clamped, "mavlink.BATTERY_INFO.manufacture_date");
+                n = 9;
+            }
             t_info.manufacture_date = [0; 9];
             t_info.manufacture_date[..n].copy_from_slice(&s.manufacture_date[..n]);
         }
@@ -3868,7 +3871,10 @@ fn map_mavlink_info_backward(
             r.add_u(LossKind::Unknown, "mavlink.BATTERY_INFO.serial_number");
         } else {
             let mut n = s.serial_number_text_len;
-            n = n.min(32); // Python keeps the whole text; the field has room for 32
+            if n > 32 {
+                r.add(LossKind::Clamped, "mavlink.BATTERY_INFO.serial_number");
+                n = 32;
+            }
             t_info.serial_number = [0; 32];
             t_info.serial_number[..n].copy_from_slice(&s.serial_number_text[..n]);
         }
@@ -3880,7 +3886,10 @@ fn map_mavlink_info_backward(
             r.add_u(LossKind::Unknown, "mavlink.BATTERY_INFO.name");
         } else {
             let mut n = s.model_name_len;
-            n = n.min(50); // Python keeps the whole text; the field has room for 50
+            if n > 50 {
+                r.add(LossKind::Clamped, "mavlink.BATTERY_INFO.name");
+                n = 50;
+            }
             t_info.name = [0; 50];
             t_info.name[..n].copy_from_slice(&s.model_name[..n]);
         }
@@ -6594,7 +6603,10 @@ fn map_uorb_info_backward(
             r.add_u(LossKind::Unknown, "uorb.BatteryInfo.serial_number");
         } else {
             let mut n = s.serial_number_text_len;
-            n = n.min(32); // Python keeps the whole text; the field has room for 32
+            if n > 32 {
+                r.add(LossKind::Clamped, "uorb.BatteryInfo.serial_number");
+                n = 32;
+            }
             t_info.serial_number = [0; 32];
             t_info.serial_number[..n].copy_from_slice(&s.serial_number_text[..n]);
         }

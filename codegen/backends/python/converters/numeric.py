@@ -96,11 +96,9 @@ class NumericEmitters(RuleContext):
         self.emit_call("rep_u.unknown", [label], 2)
         self.emit("else:")
         if kind == "text":
-            if isinstance(f.type, StringType):
-                self.emit(f"    {target} = _v")
-            else:
-                cap = f.type.capacity if isinstance(f.type, ArrayType) else None
-                self.emit_assign(target, call("_r.bytes_out", ["_v", py_literal(cap), "rep", label]), 1)
+            cap = f.type.capacity if isinstance(f.type, ArrayType | StringType) else None
+            out = "_r.text_out" if isinstance(f.type, StringType) else "_r.bytes_out"
+            self.emit_assign(target, call(out, ["_v", py_literal(cap), "rep", label]), 1)
             return
         value = f"_v - {py_literal(add)}" if add else "_v"
         self.emit_assign(target, self.store(f, value, label, marks=op.unknown), 1)
