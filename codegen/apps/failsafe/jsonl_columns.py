@@ -60,7 +60,7 @@ def _template(line: bytes) -> tuple[list[str], list[tuple[int, int]]] | None:
     """The first line's values in text order (their names) and spans, if it has the plain shape."""
     try:
         obj = json.loads(line)
-    except ValueError:
+    except (ValueError, RecursionError):  # not JSON, or nested past the parser's depth: the per-sample reader says so
         return None
     if not isinstance(obj, dict) or not {"t", "armed", "battery"} <= obj.keys() or not obj.keys() <= set(TOP):
         return None
