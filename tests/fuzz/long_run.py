@@ -25,6 +25,7 @@ import resource
 import signal
 import sys
 import time
+from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
 
@@ -79,6 +80,7 @@ def fuzz_inputs(target: str, count: int, seed: int = 0, save: Path = CRASHERS) -
     corpus = make_seeds()
     rng = random.Random(f"{target}:{seed}")
     found: list[str] = []
+    kinds: Counter[str] = Counter()  # failures by exception, saved or not
     slowest = 0.0
     for done in range(count):
         if done and done % 10_000 == 0:
@@ -92,6 +94,7 @@ def fuzz_inputs(target: str, count: int, seed: int = 0, save: Path = CRASHERS) -
             if isinstance(exc, KeyboardInterrupt):
                 raise
             digest = hashlib.sha1(data).hexdigest()[:12]
+            kinds[type(exc).__name__] += 1
             if len(found) < MAX_SAVED:
                 folder = save / target
                 folder.mkdir(parents=True, exist_ok=True)
@@ -103,6 +106,8 @@ def fuzz_inputs(target: str, count: int, seed: int = 0, save: Path = CRASHERS) -
         finally:
             signal.alarm(0)
         slowest = max(slowest, time.monotonic() - started)
+    if kinds:
+        print(f"    {target}: failures by exception: {dict(kinds)}", flush=True)
     return count, found, slowest
 
 
