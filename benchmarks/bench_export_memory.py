@@ -81,13 +81,15 @@ def peak(args: list[str]) -> tuple[int, float, float]:
     return int(code), int(kib) / 1024, time.perf_counter() - start
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict[str, list[float]]:
+    """The peaks (MB) by kind, short then long."""
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--short", type=int, default=100_000)
     parser.add_argument("--long", type=int, default=1_000_000)
     parser.add_argument("--can-long", type=int, default=10_000_000, help="the issue's budget: 10M frames")
     parser.add_argument("--kinds", default="tlog,jsonl,can", help="comma-separated: tlog, jsonl, can")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    results: dict[str, list[float]] = {}
     makers = {
         "tlog": (tlog, ".tlog", args.long),
         "jsonl": (jsonl, ".jsonl", args.long),
@@ -101,7 +103,7 @@ def main() -> None:
             peaks = []
             for n in (args.short, long):
                 path = make(Path(folder) / f"{kind}-{n}{suffix}", n)
-                argv = [
+                command = [
                     sys.executable,
                     "-m",
                     "codegen",
@@ -112,14 +114,16 @@ def main() -> None:
                     "-q",
                 ]
                 if kind == "jsonl":
-                    argv += ["--message", "uorb.BatteryStatus"]
-                code, mb, seconds = peak(argv)
+                    command += ["--message", "uorb.BatteryStatus"]
+                code, mb, seconds = peak(command)
                 peaks.append(mb)
                 print(f"{kind:6s} {n:10d} {mb:9.1f} {seconds:8.1f}  {code}")
                 path.unlink()
             print(f"{kind:6s} growth from {args.short} to {long}: {peaks[1] - peaks[0]:+.1f} MB")
             verdict = "within" if peaks[1] < BUDGET_MB else "OVER"
             print(f"{kind:6s} peak at {long} records: {peaks[1]:.1f} MB, {verdict} the {BUDGET_MB} MB budget")
+            results[kind] = peaks
+    return results
 
 
 if __name__ == "__main__":
