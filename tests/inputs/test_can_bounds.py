@@ -309,3 +309,15 @@ def test_a_trc_start_time_beyond_any_date_is_one_located_error(tmp_path: Path, s
         list(read_capture(capture, "far.trc"))
     outcome = run_battgen("can", str(capture), seconds=120)
     assert outcome.code in (1, 2) and "Traceback" not in outcome.stderr, outcome.stderr[-2000:]
+
+
+@pytest.mark.parametrize("method", [0, 2])
+def test_an_object_of_size_0_inside_a_blf_container_is_refused_not_read_forever(tmp_path: Path, method: int) -> None:
+    """python-can moves on by an inner object's stated size: 0 kept it on the same object forever (found by the
+    long fuzz run on mutated BLF files; rebuilt here from the format)."""
+    inner = struct.pack("<4sHHLL", b"LOBJ", 16, 3, 0, 86) + bytes(16)
+    payload = inner if method == 0 else zlib.compress(inner)
+    stuck = tmp_path / "stuck.blf"
+    stuck.write_bytes(_blf([_container(payload, len(inner), method=method)]))
+    with pytest.raises(InputError, match="an object inside it states a size of 0 bytes"):
+        list(read_capture(stuck, "stuck.blf"))

@@ -149,6 +149,7 @@ class BoundedBlf:
         self.name = name
         self._chunks = self._objects()
         self._buffer = bytearray()
+        self._inner_tail = b""
         self.objects = 0
 
     def read(self, size: int = -1) -> bytes:
@@ -212,6 +213,7 @@ class BoundedBlf:
             if inflated is None:
                 yield base + body + padding  # a method python-can warns about and skips
                 continue
+            self._check_inner(inflated, where)
             new_size = _OBJECT_HEAD.size + _CONTAINER_HEAD.size + len(inflated)
             yield (
                 _OBJECT_HEAD.pack(b"LOBJ", head_size, version, new_size, kind)
@@ -219,6 +221,18 @@ class BoundedBlf:
                 + inflated
                 + bytes(new_size % 4)
             )
+
+    def _check_inner(self, data: bytes, where: str) -> None:
+        """No object inside a container states a size of 0: python-can's reader moves on by an object's size,
+        so it would read that one forever (found by the long fuzz run). An object's header may start in one
+        container and end in the next, as python-can joins them: the last bytes of the one before are kept."""
+        joined = self._inner_tail + data
+        at = joined.find(b"LOBJ")
+        while at >= 0:
+            if joined[at + 8 : at + 12] == bytes(4):
+                raise InputError(self.name, 0, f"BLF {where}: an object inside it states a size of 0 bytes")
+            at = joined.find(b"LOBJ", at + 1)
+        self._inner_tail = joined[-(_OBJECT_HEAD.size - 1) :]
 
     def _inflate(self, body: bytes, where: str) -> bytes | None:
         if len(body) < _CONTAINER_HEAD.size:
