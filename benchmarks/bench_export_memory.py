@@ -6,8 +6,8 @@ whose peak resident size is read from the kernel (``ru_maxrss`` of that process 
 the peaks and their growth from the short to the long input; the issue's budget is 400 MB at a million tlog
 frames or JSON Lines records and ten million CAN frames.
 
-    python benchmarks/bench_export_memory.py                 # 100k and 1M records of each kind
-    python benchmarks/bench_export_memory.py --can-long 10000000
+    python benchmarks/bench_export_memory.py                 # 100k and 1M tlog/JSONL records, 10M CAN frames
+    python benchmarks/bench_export_memory.py --can-long 1000000 --kinds can   # a quicker CAN run
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
+BUDGET_MB = 400  # issue 32: export's peak at a million tlog frames or JSONL records, ten million CAN frames
 _PEAK = """
 import resource, subprocess, sys
 done = subprocess.run(sys.argv[1:], capture_output=True)
@@ -80,16 +81,18 @@ def peak(args: list[str]) -> tuple[int, float, float]:
     return int(code), int(kib) / 1024, time.perf_counter() - start
 
 
-def main(argv: list[str] | None = None) -> None:
+def main(argv: list[str] | None = None) -> dict[str, list[float]]:
+    """The peaks (MB) by kind, short then long."""
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--short", type=int, default=100_000)
     parser.add_argument("--long", type=int, default=1_000_000)
-    parser.add_argument("--can-long", type=int, default=1_000_000)
+    parser.add_argument("--can-long", type=int, default=10_000_000, help="the issue's budget: 10M frames")
     parser.add_argument("--kinds", default="tlog,jsonl,can", help="comma-separated: tlog, jsonl, can")
     parser.add_argument("--quick", action="store_true", help="tiny sizes, one round (a smoke run)")
     args = parser.parse_args(argv)
     if args.quick:
         args.short, args.long, args.can_long, args.kinds = 200, 400, 400, "jsonl"
+    results: dict[str, list[float]] = {}
     makers = {
         "tlog": (tlog, ".tlog", args.long),
         "jsonl": (jsonl, ".jsonl", args.long),
@@ -103,7 +106,7 @@ def main(argv: list[str] | None = None) -> None:
             peaks = []
             for n in (args.short, long):
                 path = make(Path(folder) / f"{kind}-{n}{suffix}", n)
-                argv = [
+                command = [
                     sys.executable,
                     "-m",
                     "codegen",
@@ -114,12 +117,16 @@ def main(argv: list[str] | None = None) -> None:
                     "-q",
                 ]
                 if kind == "jsonl":
-                    argv += ["--message", "uorb.BatteryStatus"]
-                code, mb, seconds = peak(argv)
+                    command += ["--message", "uorb.BatteryStatus"]
+                code, mb, seconds = peak(command)
                 peaks.append(mb)
                 print(f"{kind:6s} {n:10d} {mb:9.1f} {seconds:8.1f}  {code}")
                 path.unlink()
             print(f"{kind:6s} growth from {args.short} to {long}: {peaks[1] - peaks[0]:+.1f} MB")
+            verdict = "within" if peaks[1] < BUDGET_MB else "OVER"
+            print(f"{kind:6s} peak at {long} records: {peaks[1]:.1f} MB, {verdict} the {BUDGET_MB} MB budget")
+            results[kind] = peaks
+    return results
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 the wire.
 
 Reads CAN captures (candump ``.log``, ``.asc``, ``.blf``, ``.trc``, python-can ``.csv`` with ``--input-format can``,
-each also ``.gz``; ArduPilot DataFlash ``.bin`` logs with CANF/CAFD records) or a live python-can bus
+each also ``.gz`` or ``.xz``; ArduPilot DataFlash ``.bin`` logs with CANF/CAFD records) or a live python-can bus
 (``socketcan:can0``, ``slcan:/dev/ttyACM0``, ``virtual:NAME``; until Ctrl-C or ``--duration``), reassembles every
 DroneCAN transfer and prints, per capture: each node's data types with counts and rates, then the transport
 problems (toggle errors, CRC mismatches and the signature they point to, missing start or end frames, transfer-id

@@ -1,7 +1,7 @@
 """``battgen export LOG... -o DIR``: battery records of many logs into one Parquet dataset.
 
 Inputs: PX4 ULog (.ulg), MAVLink telemetry logs (.tlog), ArduPilot DataFlash logs (.bin: BAT
-readings), CAN captures (candump .log, .asc, .blf, .trc, also .gz: DroneCAN BatteryInfo with
+readings), CAN captures (candump .log, .asc, .blf, .trc, also .gz or .xz: DroneCAN BatteryInfo with
 BatteryInfoAux, and CUAV CBAT, per node) and JSON Lines (.jsonl/.ndjson) of any
 bundled battery message (``--message``, else told from the first record's keys); a folder stands
 for the logs under it. Every record becomes a row of one table in SI units, unknown values null,
@@ -31,7 +31,6 @@ is refused (exit 2), never replaced by defaults.
 from __future__ import annotations
 
 import argparse
-import gzip
 import re
 import sys
 from collections.abc import Callable
@@ -99,20 +98,22 @@ def _inputs(names: list[str]) -> list[str]:
 
 
 def _exportable(path: Path) -> bool:
-    """A file of a folder to export: by its extension; a ``.log`` (``.log.gz``) only when it reads as a
-    candump capture, ``(seconds) interface id#data`` (a folder of logs holds other text logs too)."""
+    """A file of a folder to export: by its extension; a ``.log`` (``.log.gz``, ``.log.xz``) only when it reads
+    as a candump capture, ``(seconds) interface id#data`` (a folder of logs holds other text logs too)."""
+    from ..inputs.can.bounded import opened  # imported here: the CLI's start stays light
+    from ..inputs.kinds import COMPRESSED_SUFFIXES
+
     suffixes = [x.lower() for x in path.suffixes[-2:]]
     if not path.is_file():
         return False
-    if suffixes[-1:] == [".gz"]:
+    if suffixes[-1:] and suffixes[-1] in COMPRESSED_SUFFIXES:
         suffixes = suffixes[:-1]
     if suffixes[-1:] != [".log"]:
         return path.suffix.lower() in _SUFFIXES or bool(suffixes and suffixes[-1] in _SUFFIXES)
     try:
-        opener = gzip.open if path.suffix.lower() == ".gz" else open
-        with opener(path, "rb") as f:
+        with opened(path) as f:
             head = f.read(64)
-    except OSError:
+    except (OSError, EOFError, ValueError):  # a damaged stream (zlib.error, LZMAError are not OSErrors)
         return True  # let the export report it
     return bool(re.match(rb"\(\d+(\.\d+)?\) \S+ [0-9A-Fa-f]+#", head))
 

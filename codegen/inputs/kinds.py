@@ -8,8 +8,8 @@ The kinds, one vocabulary for every command and message, and what tells each (co
 - ``tlog``: MAVLink telemetry log (a µs stamp before each frame); a plausible big-endian stamp, then a MAVLink
   magic, else ``.tlog``.
 - ``mavlink``: a raw MAVLink byte stream; ``.mav``.
-- ``can``: a CAN capture (candump log or screen output, Vector ASC/BLF, PEAK TRC, gzip of them); ``LOGG`` (BLF),
-  candump/ASC/TRC lines, else ``.log``, ``.asc``, ``.blf``, ``.trc`` (also inside ``.gz``).
+- ``can``: a CAN capture (candump log or screen output, Vector ASC/BLF, PEAK TRC, gzip or xz of them); ``LOGG`` (BLF),
+  candump/ASC/TRC lines, else ``.log``, ``.asc``, ``.blf``, ``.trc`` (also inside ``.gz`` or ``.xz``).
 - ``dtb``: a devicetree blob; the FDT magic ``D0 0D FE ED``, else ``.dtb``. ``dts``: ``/dts-v1/``, else ``.dts``,
   ``.dtsi``.
 - ``param`` (``.param``, ``.parm``, QGroundControl ``.params``), ``json``, ``jsonl``, ``yaml``: by the name.
@@ -67,6 +67,8 @@ SUFFIXES: dict[str, frozenset[str]] = {
     "dataflash": frozenset({".bin"}),
 }
 KNOWN_SUFFIXES = frozenset().union(*SUFFIXES.values())
+# a CAN capture may come compressed (bus.log.gz, bus.blf.xz): these are looked through to the capture's own suffix
+COMPRESSED_SUFFIXES = frozenset({".gz", ".xz"})
 
 ULOG_MAGIC = b"ULog\x01\x12\x35"
 DATAFLASH_MAGIC = b"\xa3\x95\x80"  # a message header and type 128: the FMT record describing FMT
@@ -82,17 +84,17 @@ _ASC = re.compile(rb"\s*(date|base\s+(hex|dec)|;\s*\$?FILEVERSION|;\s*Start time
 
 
 def capture_suffix(path: Path) -> str:
-    """The suffix of a file name, looking through a ``.gz`` (``bus.asc.gz`` -> ``.asc``)."""
+    """The suffix of a file name, looking through a ``.gz`` or ``.xz`` (``bus.asc.gz`` -> ``.asc``)."""
     suffixes = [s.lower() for s in path.suffixes]
-    if suffixes and suffixes[-1] == ".gz":
+    if suffixes and suffixes[-1] in COMPRESSED_SUFFIXES:
         suffixes.pop()
     return suffixes[-1] if suffixes else ""
 
 
 def kind_of_name(path: Path) -> str | None:
-    """The kind a file's name says, if any (a ``.gz`` is looked through for captures)."""
+    """The kind a file's name says, if any (a ``.gz`` or ``.xz`` is looked through for captures)."""
     suffix = path.suffix.lower()
-    if suffix == ".gz":
+    if suffix in COMPRESSED_SUFFIXES:
         return "can" if capture_suffix(path) in SUFFIXES["can"] else None
     for kind, suffixes in SUFFIXES.items():
         if suffix in suffixes:

@@ -22,9 +22,10 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import BattgenError, LocatedError, cannot_read
+from ..errors import BattgenError, LocatedError
 from ..text.brief import brief
 from ..text.escape import shown
+from ..text.files import read_whole
 
 Value = int | float
 
@@ -123,10 +124,7 @@ def repeats(entries: Iterable[ParamEntry]) -> list[Repeat]:
 def load(path: Path, display: str | None = None) -> list[ParamEntry]:
     """Read a parameter file of either layout (told from the content)."""
     shown = display or path.as_posix()
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise ParameterFileError(shown, 0, cannot_read(exc)) from None
+    data = read_whole(path, shown, ParameterFileError, "a parameter file")
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -6,6 +6,10 @@ from pathlib import Path
 
 from ..errors import LocatedError, SchemaError, cannot_read
 
+# bytes of a whole-file input (a parameter file, a .dts, a .dtb, a schema): the largest real one is a few MB
+# (ArduPilot's apm.pdef.xml, ~3 MB); a bigger file is refused before it is read, not held in memory
+MAX_WHOLE_FILE = 64 * 1024 * 1024
+
 
 def display_path(path: Path, root: Path | None) -> str:
     """The path recorded in IR locations: relative to the schema root when under it (so output
@@ -18,12 +22,23 @@ def display_path(path: Path, root: Path | None) -> str:
     return path.as_posix()
 
 
-def read_text(path: Path, display: str, error: type[LocatedError] = SchemaError) -> str:
-    """Read an input file as UTF-8, turning I/O and decoding failures into ``error`` (file and line)."""
+def read_whole(path: Path, display: str, error: type[LocatedError], what: str) -> bytes:
+    """An input file read whole, at most :data:`MAX_WHOLE_FILE` bytes of it: a larger one (or an endless one,
+    ``/dev/zero``) is ``error`` at line 0 saying it expected ``what``, and costs no more than the limit."""
     try:
-        data = path.read_bytes()
+        with path.open("rb") as f:
+            data = f.read(MAX_WHOLE_FILE + 1)
     except OSError as exc:
         raise error(display, 0, cannot_read(exc)) from None
+    if len(data) > MAX_WHOLE_FILE:
+        raise error(display, 0, f"expected {what} of at most {MAX_WHOLE_FILE} bytes, found a larger file")
+    return data
+
+
+def read_text(path: Path, display: str, error: type[LocatedError] = SchemaError, what: str = "a text file") -> str:
+    """Read an input file as UTF-8 (:func:`read_whole`), turning I/O and decoding failures into ``error`` (file
+    and line)."""
+    data = read_whole(path, display, error, what)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:

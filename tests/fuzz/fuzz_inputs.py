@@ -5,6 +5,7 @@ built from the messages' own field names (so inputs reach from_dict and the vali
 from __future__ import annotations
 
 import json
+import random
 
 import yaml
 from hypothesis import strategies as st
@@ -137,3 +138,29 @@ def inputs(kind: str, seeds: list[bytes]) -> st.SearchStrategy[bytes]:
     if kind in ("json", "jsonl", "yaml"):
         options.append(document(kind))
     return st.one_of(*options)
+
+
+def mutate(rng: random.Random, seeds: list[bytes]) -> bytes:
+    """What :func:`mutated` draws, from a seeded generator instead of hypothesis: the long run's mutator (no
+    shrinking, a hundred times the inputs a second; a failing input is shrunk afterwards by hand or by the
+    hypothesis fuzzers)."""
+    if rng.random() < 0.1:
+        return rng.randbytes(rng.randrange(512))
+    data = bytearray(rng.choice(seeds))
+    for _ in range(rng.randint(1, 6)):
+        op = rng.randrange(6)
+        pos = rng.randrange(len(data) + 1)
+        if op == 0 and data:
+            data[min(pos, len(data) - 1)] = rng.randrange(256)
+        elif op == 1:
+            data[pos:pos] = rng.randbytes(rng.randint(1, 16))
+        elif op == 2:
+            del data[pos : pos + rng.randint(1, 32)]
+        elif op == 3:
+            end = min(len(data), pos + rng.randint(1, 64))
+            data[pos:pos] = data[pos:end] * rng.randint(1, 8)
+        elif op == 4:
+            del data[pos:]
+        else:
+            data[pos:pos] = rng.choice(TOKENS)
+    return bytes(data)

@@ -1,7 +1,8 @@
 """Fuzzing the data layer every log command reads through (``read_view``: ULog, DataFlash, tlog, CAN captures in
-candump, ASC and BLF, JSON Lines), on mutated real files of ``../shared/corpus`` and the seed corpus: a log either
-reads or raises a located BattgenError naming it, with a short message -- never another exception, a hang or a
-memory blow-up (the BLF and text bounds of codegen/inputs/can/bounded.py included).
+candump, ASC, BLF and TRC, also gzip- and xz-compressed, JSON Lines), on mutated real files of
+``../shared/corpus`` and the seed corpus: a log either reads or raises a located BattgenError naming it, with a
+short message -- never another exception, a hang or a memory blow-up (the BLF, text and decompression bounds of
+codegen/inputs/can/bounded.py included).
 
 A failing input becomes a regression: rebuilt from the format as a test of its own where it is a mutation of an
 upstream file (the corpus stays in ``../shared``), else saved under ``tests/fuzz/crashers/view-<kind>/`` and
@@ -12,6 +13,7 @@ replayed on every run here.
 from __future__ import annotations
 
 import functools
+import lzma
 import tempfile
 from pathlib import Path
 
@@ -42,13 +44,28 @@ KINDS: dict[str, tuple[str, list[Path]]] = {
             shared("corpus", "realworld3b", "can", "pythoncan_test_CanFdMessage.blf"),
         ],
     ),
+    "trc": (
+        ".trc",
+        [
+            shared("corpus", "realworld3b", "can", "pythoncan_test_CanMessage_V1_1.trc"),
+            shared("corpus", "realworld3b", "can", "pythoncan_test_CanMessage_V2_1.trc"),
+        ],
+    ),
+    # compressed streams, mutated as stored (damaged, cut, lying streams)...
+    "asc-gz": (".asc.gz", [shared("corpus", "realworld3b", "can", "pythoncan_test_CanMessage.asc.gz")]),
+    "candump-xz": (".log.xz", [shared("corpus", "realworld3b", "can", "px4-issue2568_uavcan_v0.log")]),
+    # ... and captures mutated, then compressed (what the readers behind the inflation see)
+    "blf-in-xz": (".blf.xz", [shared("corpus", "realworld3b", "can", "pythoncan_test_CanMessage.blf")]),
     "jsonl": (".jsonl", [Path(__file__).resolve().parents[1] / "data" / "instances" / "uorb_records.jsonl"]),
 }
+SEEDS_PACKED = {"candump-xz"}  # the seeds are xz-compressed, then mutated
+INPUTS_PACKED = {"blf-in-xz"}  # the mutated bytes are xz-compressed before they are read
 
 
 @functools.cache
 def _seeds(kind: str) -> list[bytes]:
-    return [require(p).read_bytes() for p in KINDS[kind][1]]
+    seeds = [require(p).read_bytes() for p in KINDS[kind][1]]
+    return [lzma.compress(s, preset=1) for s in seeds] if kind in SEEDS_PACKED else seeds
 
 
 def view(kind: str, data: bytes) -> None:
@@ -56,7 +73,7 @@ def view(kind: str, data: bytes) -> None:
     suffix = KINDS[kind][0]
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / f"input{suffix}"
-        path.write_bytes(data)
+        path.write_bytes(lzma.compress(data, preset=0) if kind in INPUTS_PACKED else data)
         try:
             for chunk in read_view(
                 path, path.name, catalog=bundled_catalog(), message="uorb.BatteryStatus" if kind == "jsonl" else None

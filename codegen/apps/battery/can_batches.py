@@ -1,4 +1,4 @@
-"""CAN bus captures (candump .log, Vector .asc/.blf, PEAK .trc, each also .gz) for the export: the
+"""CAN bus captures (candump .log, Vector .asc/.blf, PEAK .trc, each also .gz or .xz) for the export: the
 battery nodes' DroneCAN messages, one batch per node and message.
 
 Read through the capture readers of :mod:`codegen.inputs.can` (frames reassembled into transfers,

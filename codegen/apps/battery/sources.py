@@ -92,6 +92,8 @@ def ulog_batches(path: Path, name: str, catalog: Catalog, source: Buffer | None,
         raise BattgenError("the generated uorb.BatteryStatus has no ULog support: run 'battgen generate'")
     with UlogColumns(path, name, model, source) as log:
         start = log.start_us
+        if not 0 <= start < 1 << 63:  # the header's uint64: beyond int64 no time column can hold it
+            raise InputError(name, 0, f"a start time of {start} µs in the header: expected at most 2^63 - 1")
         offset = log.utc_offset_us()
         armed = log.armed()
         context = ulog_context(log, armed, offset)

@@ -1,7 +1,7 @@
 """CAN frames from where users have them: capture files, ArduPilot DataFlash logs, live buses.
 
 Capture files are read with python-can's log readers: candump ``.log``, Vector ``.asc`` and ``.blf``, PEAK ``.trc``
-(each also gzip-compressed), and python-can's own ``.csv`` when the format is given. ArduPilot DataFlash logs
+(each also gzip- or xz-compressed), and python-can's own ``.csv`` when the format is given. ArduPilot DataFlash logs
 (``.bin``) carry the frames of a logged bus as CANF (classic) and CAFD (CAN FD) records, read with pymavlink's
 DataFlash reader. A live bus is any python-can interface, named ``interface:channel`` (``socketcan:can0``,
 ``slcan:/dev/ttyACM0``, ``virtual:bus0``). python-can is an optional dependency (``pip install 'battgen[can]'``);
@@ -15,6 +15,7 @@ failure on a damaged file is an :class:`InputError` naming the file and the fram
 from __future__ import annotations
 
 import importlib
+import lzma
 import struct
 import time
 import zlib
@@ -24,7 +25,7 @@ from typing import Any, cast
 
 from ..dataflash import open_log
 from ..records import InputError
-from .bounded import bounded_reader
+from .bounded import bounded_reader, inner_suffix
 from .candump_screen import read_screen, screen_stamp
 from .reassembly import Frame
 
@@ -57,9 +58,11 @@ def _blf_parse_error() -> type[Exception]:
     return cast(type[Exception], BLFParseError)
 
 
-# what python-can's readers raise on a damaged capture (its BLF reader: BLFParseError, zlib.error, struct.error)
+# what python-can's readers raise on a damaged capture (its BLF reader: BLFParseError, zlib.error, struct.error;
+# its TRC reader: OverflowError on a start time beyond what a date or a C int holds)
 _READER_ERRORS = (
     ValueError,
+    ArithmeticError,
     KeyError,
     IndexError,
     TypeError,
@@ -67,6 +70,7 @@ _READER_ERRORS = (
     EOFError,
     AttributeError,
     zlib.error,
+    lzma.LZMAError,
     struct.error,
     _blf_parse_error(),
 )
@@ -160,7 +164,7 @@ def read_capture(path: Path, name: str) -> Iterator[Frame]:
     reader = _log_reader(path, name)
     try:
         yield from _frames_of(
-            iter(reader), name, "the CAN capture", one_per_line=_ONE_FRAME_A_LINE.get(path.suffix.lower())
+            iter(reader), name, "the CAN capture", one_per_line=_ONE_FRAME_A_LINE.get(inner_suffix(path))
         )
     finally:
         stop = getattr(reader, "stop", None)

@@ -33,6 +33,9 @@ def _quoted(name: str) -> str:
     return repr(name) if len(name) <= 60 else repr(name[:57]) + "..."
 
 
+_MAX_DIGITS = 256  # digits of one literal (a 64-bit cell needs 20 in decimal, 16 in hex)
+
+
 class Parser:
     def __init__(self, path: Path, display: str, root: Path | None = None) -> None:
         self.s = Scanner(path, display, root)
@@ -328,6 +331,8 @@ class Parser:
         digits = re.match(r"0[xX][0-9a-fA-F]+|[0-9]+", text)
         assert digits is not None
         d = digits.group(0)
+        if len(d) > _MAX_DIGITS:  # a cell holds 64 bits; Python refuses to convert 4,300 decimal digits
+            raise self.s.error(f"a number of {len(d)} digits: expected at most {_MAX_DIGITS}", at)
         if d[:2].lower() == "0x":
             return int(d[2:], 16)
         if len(d) > 1 and d[0] == "0":

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...errors import cannot_read
-from ...text.files import display_path
+from ...text.files import display_path, read_whole
 from .dtb import Blob, parse_dtb
 from .model import DevicetreeError, DtNode
 from .parse import Parser
@@ -22,11 +21,7 @@ def read_dts(path: Path, *, root: Path | None = None) -> list[DtNode]:
 
 def read_dtb_blob(path: Path, *, root: Path | None = None) -> Blob:
     display = display_path(path, root)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise DevicetreeError(display, 0, cannot_read(exc)) from None
-    return parse_dtb(data, display)
+    return parse_dtb(read_whole(path, display, DevicetreeError, "a devicetree blob"), display)
 
 
 def read_dtb(path: Path, *, root: Path | None = None) -> list[DtNode]:

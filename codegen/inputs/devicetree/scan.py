@@ -261,7 +261,7 @@ class Scanner:
 
 def _read(path: Path, display: str) -> str:
     try:
-        return read_text(path, display)
+        return read_text(path, display, what="a devicetree source")
     except SchemaError as exc:
         raise DevicetreeError(exc.file, exc.line, exc.message) from None
 
