@@ -18,7 +18,7 @@ from pathlib import Path
 
 from codegen.apps.battery.catalog import bundled_catalog
 from codegen.apps.battery.dataflash_batches import dataflash_batches
-from codegen.inputs.dataflash import BATTERY_TYPES
+from codegen.inputs.dataflash.log import BATTERY_TYPES
 
 CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus"
 

@@ -33,8 +33,8 @@ import pandas as pd
 from pyulog import ULog
 
 from codegen.apps.export.engine import ExportOptions, export_logs, export_one, finish
-from codegen.apps.fleet_query import connect
-from codegen.inputs.ulog_index import compiled
+from codegen.apps.export.query import connect
+from codegen.inputs.ulog.index import compiled
 from generated import _ulog
 from generated.uorb import BatteryInfo, BatteryStatus
 

@@ -23,7 +23,7 @@ TOPIC = "battery_status"
 
 def repeated_log(source: Path, out: Path, records: int) -> int:
     """``source`` with copies of its battery_status data records appended until it holds ``records``."""
-    from codegen.inputs.ulog_columns import UlogColumns
+    from codegen.inputs.ulog.columns import UlogColumns
     from generated.uorb import BatteryStatus
 
     data = source.read_bytes()

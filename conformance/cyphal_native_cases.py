@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from test_cyphal_codec import _bundled, plain, values
 
-from codegen.apps.package import bundled_schemas
+from codegen.apps.schemas.package import bundled_schemas
 from codegen.frontends import cyphal
 from codegen.frontends.cyphal.build import type_name
 from codegen.frontends.loader import load

@@ -25,10 +25,10 @@ from shared_data import SHARED, missing
 
 from codegen.apps.battery.figures import FlightFigures, flight_figures
 from codegen.apps.failsafe.logs import log_samples
-from codegen.apps.messages import BATTERY_MESSAGES
+from codegen.apps.schemas.messages import BATTERY_MESSAGES
 from codegen.cli.main import main
 from codegen.errors import BattgenError
-from codegen.inputs.kinds import detect
+from codegen.inputs.files.kinds import detect
 
 duckdb = pytest.importorskip("duckdb")
 pyulog = pytest.importorskip("pyulog")

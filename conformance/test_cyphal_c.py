@@ -22,7 +22,7 @@ from c_cases import PRELUDE, _print, value_init
 from cyphal_native_cases import TypeCases, all_cases, definition_cases, dump, has_nan
 from rust_cases import Unrepresentable
 
-from codegen.apps.package import project_root
+from codegen.apps.schemas.package import project_root
 from codegen.backends.c.render import render_library
 from codegen.backends.c.types import ident, type_name
 from codegen.ir import ArrayType, CompositeType, FieldType, Message, Schema

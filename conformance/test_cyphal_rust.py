@@ -21,7 +21,7 @@ import pytest
 from cyphal_native_cases import TypeCases, all_cases, definition_cases, dump, has_nan
 from test_cyphal_c import compare
 
-from codegen.apps.package import project_root
+from codegen.apps.schemas.package import project_root
 from codegen.backends.rust.cyphal_codec import rust_path
 from codegen.backends.rust.naming import field_ident
 from codegen.backends.rust.render import render_crate

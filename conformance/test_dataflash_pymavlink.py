@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 from shared_data import SHARED
 
-from codegen.inputs.dataflash import NUMBERED_TYPES, battery_records, open_log
-from codegen.inputs.dataflash_text import HEAD_BYTES, is_text_dataflash
-from codegen.inputs.dataflash_units import field_scales
+from codegen.inputs.dataflash.log import NUMBERED_TYPES, battery_records, open_log
+from codegen.inputs.dataflash.text import HEAD_BYTES, is_text_dataflash
+from codegen.inputs.dataflash.units import field_scales
 
 CORPUS = SHARED / "corpus"
 

@@ -22,7 +22,7 @@ from typing import Any
 import pytest
 from shared_data import UPSTREAM
 
-from codegen.apps.validate import Finding, check_file, make_checker
+from codegen.apps.gate.validate import Finding, check_file, make_checker
 from codegen.inputs.devicetree import find_compatible, read_dts
 
 pytest.importorskip("dtschema")

@@ -10,11 +10,11 @@ import pytest
 from pymavlink import mavparm
 from shared_data import UPSTREAM
 
-from codegen.apps.batt_parameters import check_parameter_file
 from codegen.apps.failsafe.vehicles import detect_vehicle
-from codegen.apps.package import bundled_schemas
-from codegen.apps.validate import check_file, make_checker
-from codegen.inputs import parameter_files
+from codegen.apps.gate.validate import check_file, make_checker
+from codegen.apps.parameters.check import check_parameter_file
+from codegen.apps.schemas.package import bundled_schemas
+from codegen.inputs.parameters import files as parameter_files
 
 CORPUS = UPSTREAM / "ardupilot_frame_params"
 FILES = {

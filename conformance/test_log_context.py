@@ -25,7 +25,7 @@ from shared_data import SHARED, missing
 from codegen.apps.battery.context import LogContext
 from codegen.apps.battery.tlog_batches import parameter_name
 from codegen.apps.battery.view import read_view
-from codegen.inputs.kinds import detect
+from codegen.inputs.files.kinds import detect
 
 pyulog = pytest.importorskip("pyulog")
 

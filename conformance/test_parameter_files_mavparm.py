@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 from pymavlink import mavparm
 
-from codegen.inputs import parameter_files
+from codegen.inputs.parameters import files as parameter_files
 
 FILES = {
     "mission_planner.param": "BATT_CAPACITY,3300\nBATT_LOW_VOLT,10.5\nBATT_CRT_VOLT,10\nBATT_FS_LOW_ACT,2\n",

@@ -17,7 +17,7 @@ import pytest
 from shared_data import SHARED
 
 from codegen.apps.battery.view import read_view
-from codegen.inputs.kinds import detect
+from codegen.inputs.files.kinds import detect
 
 
 def _tlogs() -> list[Path]:

@@ -19,7 +19,7 @@ from typing import Any
 
 from rust_cases import FIELD_RULES, Unrepresentable, random_records, vector_records
 
-from codegen.apps.package import bundled_schemas
+from codegen.apps.schemas.package import bundled_schemas
 from codegen.backends.c.types import ident, scalar, type_name
 from codegen.frontends.loader import load
 from codegen.ir import ArrayType, CompositeType, FieldType, Message, PrimitiveKind, PrimitiveType, Schema, StringType

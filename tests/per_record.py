@@ -14,7 +14,7 @@ import numpy as np
 
 from codegen.apps.battery.catalog import Catalog, SourceMapping
 from codegen.apps.battery.columns import ConceptColumn, empty_columns
-from codegen.apps.convert import converters
+from codegen.apps.conversion.convert import converters
 from codegen.inputs.model import PlainData
 
 

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import generated.convert as converters
-from codegen.apps.vectors import SIDES, VectorWriter
+from codegen.apps.conversion.vectors import SIDES, VectorWriter
 from codegen.backends.rust.model import type_path
 from codegen.backends.rust.naming import field_ident, snake
 from codegen.backends.rust.types import scalar

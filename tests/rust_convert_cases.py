@@ -17,7 +17,7 @@ from c_cases import _is_char_array, dump
 from rust_cases import Unrepresentable, _from_json, random_records, struct_literal
 
 import generated.convert as converters
-from codegen.apps.vectors import SIDES, VectorWriter
+from codegen.apps.conversion.vectors import SIDES, VectorWriter
 from codegen.backends.rust.converters import RustConverter
 from codegen.backends.rust.model import type_path
 from codegen.backends.rust.naming import field_ident, snake

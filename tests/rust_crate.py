@@ -15,7 +15,7 @@ import pytest
 import rust_failsafe_cases
 from rust_cases import Replay, collect, generated_classes, render_replay
 
-from codegen.apps.package import bundled_schemas, project_root
+from codegen.apps.schemas.package import bundled_schemas, project_root
 from codegen.frontends.loader import load
 
 GENERATED = project_root() / "generated" / "rust"

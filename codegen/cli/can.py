@@ -23,9 +23,9 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from ..apps.can_capture import CaptureReport, scan
-from ..apps.can_types import cyphal_types, shipped_tree, standard_types
-from ..apps.package import bundled_package
+from ..apps.can.capture import CaptureReport, scan
+from ..apps.can.known_types import cyphal_types, shipped_tree, standard_types
+from ..apps.schemas.package import bundled_package
 from ..errors import BattgenError, LocatedError, missing_file
 from ..inputs.can.captures import read_bus
 from ..inputs.can.cyphal_ports import cyphal_classes, subject_table

@@ -29,8 +29,8 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import IO, Any, Literal, cast
 
-from ..apps.convert import FORMATS, LOG_FORMATS, Conversion, Converted, input_format, output_format
-from ..apps.senders import SENDERS
+from ..apps.conversion.convert import FORMATS, LOG_FORMATS, Conversion, Converted, input_format, output_format
+from ..apps.conversion.senders import SENDERS
 from ..errors import BattgenError, missing_file
 from ..inputs.model import MessageClass
 from ..inputs.records import Notice

@@ -33,7 +33,7 @@ def check_subjects(pairs: list[str], cls: MessageClass) -> None:
 def check_bundled_subjects(pairs: list[str]) -> None:
     """As :func:`check_subjects`, for a command that reads with the bundled package (``battgen export``)."""
     if pairs:
-        from ..apps.package import bundled_package
+        from ..apps.schemas.package import bundled_package
         from ..inputs.can.cyphal_ports import cyphal_classes, subject_table
 
         subject_table(pairs, cyphal_classes(bundled_package().__name__))

@@ -12,8 +12,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..apps.docs import write_docs
-from ..apps.package import bundled_schemas
+from ..apps.schemas.docs import write_docs
+from ..apps.schemas.package import bundled_schemas
 from ..backends.markdown import render_docs
 from ..errors import BattgenError
 from ..frontends.loader import load

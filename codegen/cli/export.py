@@ -101,7 +101,7 @@ def _exportable(path: Path) -> bool:
     """A file of a folder to export: by its extension; a ``.log`` (``.log.gz``, ``.log.xz``) only when it reads
     as a candump capture, ``(seconds) interface id#data`` (a folder of logs holds other text logs too)."""
     from ..inputs.can.bounded import opened  # imported here: the CLI's start stays light
-    from ..inputs.kinds import COMPRESSED_SUFFIXES
+    from ..inputs.files.kinds import COMPRESSED_SUFFIXES
 
     suffixes = [x.lower() for x in path.suffixes[-2:]]
     if not path.is_file():

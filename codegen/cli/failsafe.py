@@ -66,8 +66,8 @@ from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
 from ..errors import BattgenError, missing_file
-from ..inputs import parameter_files
-from ..inputs.kinds import FLIGHT_LOG_KINDS, detect
+from ..inputs.files.kinds import FLIGHT_LOG_KINDS, detect
+from ..inputs.parameters import files as parameter_files
 from ..text.escape import line
 from .cyphal_options import add_cyphal_subject, check_bundled_subjects
 

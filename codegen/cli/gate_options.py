@@ -1,5 +1,6 @@
 """The CI gate's options, one definition for ``validate`` and ``report``: ``--select``, ``--ignore`` and
-``--profile``, read with ``[tool.battgen]`` of the nearest pyproject.toml (:func:`codegen.apps.gate.settings`)."""
+``--profile``, read with ``[tool.battgen]`` of the nearest pyproject.toml
+(:func:`codegen.apps.gate.selection.settings`)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from ..apps.gate import Settings, profile_names, settings
+from ..apps.gate.selection import Settings, profile_names, settings
 
 
 def add_gate_options(p: Any) -> None:

@@ -40,7 +40,7 @@ COMMANDS: tuple[tuple[str, str], ...] = (
 
 
 def _load(paths: Sequence[str], args: argparse.Namespace) -> Schema:
-    from ..apps.package import bundled_schemas, load_schemas
+    from ..apps.schemas.package import bundled_schemas, load_schemas
 
     include_paths = [Path(p) for p in args.include_path or ()]
     if paths or include_paths:
@@ -104,7 +104,7 @@ def _report_library(out: Path, check: bool, written: list[str], removed: list[st
 
 def cmd_generate(args: argparse.Namespace) -> int:
     # the code generator is imported by this command only
-    from ..apps.package import project_root
+    from ..apps.schemas.package import project_root
     from ..backends.python.name_clashes import refuse_clashes
     from ..backends.python.writer import generate
 

@@ -21,10 +21,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..apps.batt_parameters import check_parameter_file, check_proposals, propose_from_devicetree, render
 from ..apps.failsafe.checks import CELL_RANGES
 from ..apps.failsafe.stream import batt_parameter_count, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES
+from ..apps.parameters.check import check_parameter_file, check_proposals, propose_from_devicetree, render
 from ..errors import BattgenError, place
 from ..text.escape import line
 

@@ -94,7 +94,7 @@ def table_text(columns: list[str], rows: list[tuple[Any, ...]]) -> str:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        from ..apps import fleet_query
+        from ..apps.export import query as fleet_query
     except ImportError as exc:
         print(
             f"battgen: query needs the fleet extra ({exc.name} is missing): pip install 'battgen[fleet]'",

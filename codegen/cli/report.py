@@ -29,10 +29,10 @@ from pathlib import Path
 from typing import Any
 
 from ..apps.failsafe.vehicles import VEHICLES
-from ..apps.gate import unknown_name
-from ..apps.package import bundled_schemas
+from ..apps.gate.selection import unknown_name
 from ..apps.report.as_json import report_json
 from ..apps.report.build import collect, html, pngs
+from ..apps.schemas.package import bundled_schemas
 from ..errors import BattgenError, missing_file
 from ..text.escape import line
 from .cyphal_options import add_cyphal_subject, check_bundled_subjects

@@ -13,8 +13,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..apps.messages import resolve_message
-from ..apps.package import bundled_schemas
+from ..apps.schemas.messages import resolve_message
+from ..apps.schemas.package import bundled_schemas
 from ..backends.json_schema import export_all, message_json_schema
 from ..errors import BattgenError
 from ..frontends.loader import load

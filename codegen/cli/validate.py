@@ -30,7 +30,7 @@ its ``notices``), ``--format github`` GitHub Actions annotations (``::error file
 
 A CI gate: ``--select`` / ``--ignore`` take selectors (``range/max_error``, ``range``, ``max_error``,
 ``cells-beyond-count-zero``, wildcards allowed), and ``--profile px4`` waives PX4's documented
-deviations from its own .msg (each with its evidence, in codegen/apps/profiles/px4.yaml); the
+deviations from its own .msg (each with its evidence, in codegen/apps/gate/profiles/px4.yaml); the
 same settings may live under ``[tool.battgen]`` (``select``, ``ignore``, ``profile``) in the
 nearest pyproject.toml. What is left out is counted in the summary (SARIF: suppressed results).
 A file without records of the message is exit 1 (``--allow-empty`` accepts it).
@@ -47,14 +47,14 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ..apps import validate as engine
 from ..apps.failsafe.vehicles import VEHICLES
-from ..apps.gate import KIND_FIRMWARE, Gate, Settings, check_selectors, describe, for_firmware, names_of
-from ..apps.package import bundled_package, bundled_schemas
-from ..apps.validate import Checker, Event, FileReport, Finding, exit_code, is_empty, json_document, make_checker
-from ..apps.validate_formats import Group, Grouper, github_line, github_notice, sarif_document
+from ..apps.gate import validate as engine
+from ..apps.gate.formats import Group, Grouper, github_line, github_notice, sarif_document
+from ..apps.gate.selection import KIND_FIRMWARE, Gate, Settings, check_selectors, describe, for_firmware, names_of
+from ..apps.gate.validate import Checker, Event, FileReport, Finding, exit_code, is_empty, json_document, make_checker
+from ..apps.schemas.package import bundled_package, bundled_schemas
 from ..errors import BattgenError
-from ..inputs.kinds import KINDS, file_kind
+from ..inputs.files.kinds import KINDS, file_kind
 from ..inputs.records import Notice, Unreadable
 from ..ir import Message
 from ..text.escape import line

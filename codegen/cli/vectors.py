@@ -14,7 +14,7 @@ import json
 import sys
 from typing import Any
 
-from ..apps.vectors import vectors_document
+from ..apps.conversion.vectors import vectors_document
 from ..text.escape import line
 from .convert import open_output
 

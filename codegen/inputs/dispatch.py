@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ..ir import Message, SourceFormat
 from .documents import read_json, read_jsonl, read_yaml
-from .kinds import KIND_FORMATS, KIND_HOLDS, file_kind
+from .files.kinds import KIND_FORMATS, KIND_HOLDS, file_kind
 from .model import MavlinkClass, MessageClass
 from .records import InputError, Item
 
@@ -63,11 +63,11 @@ def read_records(
 
         return read_devicetree(path, name, message, binary=kind == "dtb")
     if model is not None and kind == "param":
-        from .parameter_records import read_parameter_records
+        from .parameters.records import read_parameter_records
 
         return read_parameter_records(path, name, model)
     if model is not None and kind == "ulog":
-        from .ulog import ulog_items
+        from .ulog.records import ulog_items
 
         return ulog_items(path, name, model)
     if model is not None and kind in ("tlog", "mavlink"):

@@ -27,8 +27,8 @@ from codegen.apps.battery.column_checks import (
 )
 from codegen.apps.battery.columns import NDArray
 from codegen.apps.battery.view import read_view
+from codegen.apps.gate.validate import make_checker
 from codegen.apps.report.series import _record_input, read_input
-from codegen.apps.validate import make_checker
 from codegen.inputs.records import Record
 
 SCHEMAS = ROOT / "schemas"

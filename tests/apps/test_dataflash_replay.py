@@ -14,7 +14,7 @@ from codegen.apps.battery.dataflash_batches import dataflash_batches
 from codegen.apps.failsafe.legacy_parameters import with_current_names
 from codegen.apps.failsafe.logs import log_samples, own_parameters
 from codegen.cli.main import main
-from codegen.inputs.dataflash import battery_records, open_log
+from codegen.inputs.dataflash.log import battery_records, open_log
 
 LOG = SHARED / "corpus" / "realworld3" / "dataflash" / "dronekit_log171.bin"
 
@@ -113,7 +113,7 @@ def test_failsafe_reads_the_log_once(
 ) -> None:
     # the log's own parameters come with the battery view's read (its context), not from a second pass over PARM
     from codegen.apps.battery.view import read_view
-    from codegen.inputs import dataflash
+    from codegen.inputs.dataflash import log as dataflash
 
     opened: list[Path] = []
     real = dataflash._open

@@ -1,4 +1,4 @@
-"""Every problem of a devicetree node in one report (codegen.apps.dt_problems through battgen validate).
+"""Every problem of a devicetree node in one report (codegen.apps.gate.devicetree through battgen validate).
 
 The same cases are compared with dt-validate itself in conformance/test_dt_node_problems_dtschema.py;
 these run without dtc or dtschema and pin the wording, lines and exit code."""

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from codegen.apps.fleet_query import run_query
+from codegen.apps.export.query import run_query
 from codegen.cli.main import main
 
 can = pytest.importorskip("can")

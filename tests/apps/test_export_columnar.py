@@ -23,11 +23,11 @@ from codegen.apps.battery.columnar import NotColumnar, convert_columns
 from codegen.apps.battery.readers import read_batches
 from codegen.apps.battery.sources import instances_to_columns
 from codegen.apps.export.table import concept_array
-from codegen.apps.package import bundled_package, model_class
+from codegen.apps.schemas.package import bundled_package, model_class
 from codegen.inputs.model import UorbClass
 from codegen.inputs.records import Record
-from codegen.inputs.ulog import ulog_items
-from codegen.inputs.ulog_columns import UlogColumns
+from codegen.inputs.ulog.columns import UlogColumns
+from codegen.inputs.ulog.records import ulog_items
 from codegen.ir import ArrayType, PrimitiveKind, PrimitiveType
 
 # every real ULog of ../shared (real_logs(): a collection error under CI when there are none)

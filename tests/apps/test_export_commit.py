@@ -19,7 +19,7 @@ from fleet_samples import jsonl
 from codegen.apps.export.durable import LOCK_FILE, writers_lock
 from codegen.apps.export.engine import ExportOptions, export_logs, finish
 from codegen.apps.export.manifest import committed
-from codegen.apps.fleet_query import run_query
+from codegen.apps.export.query import run_query
 from codegen.cli.main import main
 from codegen.errors import BattgenError
 

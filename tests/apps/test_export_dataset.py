@@ -18,7 +18,7 @@ from fleet_samples import DOCUMENTED, LOGS, jsonl, needs_logs, tlog
 
 from codegen.apps.export.content import content_id
 from codegen.apps.export.engine import ExportOptions, export_logs, finish
-from codegen.apps.fleet_query import run_query
+from codegen.apps.export.query import run_query
 from codegen.errors import BattgenError
 
 
@@ -170,7 +170,7 @@ def test_dataflash_bat_records(tmp_path: Path) -> None:
     got = run_query(
         out, "SELECT message, battery, t, armed, pack_voltage, current, discharged FROM battery ORDER BY battery, t"
     ).rows
-    assert [g[:4] for g in got] == [  # disarmed before its first ARM record (inputs/dataflash_arming.py)
+    assert [g[:4] for g in got] == [  # disarmed before its first ARM record (inputs/dataflash/arming.py)
         ("dataflash.BAT", 0, 1.0, False),
         ("dataflash.BAT", 0, 2.0, True),
         ("dataflash.BAT", 1, 2.0, True),

@@ -15,7 +15,7 @@ import pyarrow.parquet as pq
 import pytest
 from fleet_samples import LOGS, jsonl, needs_logs
 
-from codegen.apps.fleet_query import run_query
+from codegen.apps.export.query import run_query
 from codegen.cli.main import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cli"))

@@ -13,7 +13,7 @@ import pytest
 from codegen.apps.export import engine
 from codegen.apps.export.engine import ExportOptions, export_logs
 from codegen.apps.export.manifest import LOGS, committed
-from codegen.apps.fleet_query import run_query
+from codegen.apps.export.query import run_query
 from codegen.cli.main import main
 
 

@@ -13,8 +13,8 @@ import pyarrow.dataset as pads
 import pytest
 from fleet_samples import jsonl, tlog
 
+from codegen.apps.export.query import run_query
 from codegen.apps.export.views import views_sql
-from codegen.apps.fleet_query import run_query
 from codegen.cli.main import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cli"))

@@ -5,7 +5,7 @@ what validate refuses").
 
 The cases where they disagree today are listed in DISAGREE and marked as strict expected failures: convert's
 strict policy checks only the fields it maps and does not apply the schema's NaN, range, enum and bitmask rules
-(codegen/apps/convert.py). When it does, a listed case passes, the strict xfail fails, and the entry goes.
+(codegen/apps/conversion/convert.py). When it does, a listed case passes, the strict xfail fails, and the entry goes.
 """
 
 from __future__ import annotations

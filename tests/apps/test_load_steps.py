@@ -1,4 +1,4 @@
-"""One load-step definition of internal resistance (codegen.apps.load_steps): ``battgen report``'s
+"""One load-step definition of internal resistance (codegen.apps.battery.load_steps): ``battgen report``'s
 figures and the fleet view ``flights`` give the same resistance on the same flight, both the pack
 model's; the SQL the view is built from equals the Python definition on arbitrary series."""
 
@@ -13,12 +13,12 @@ from flight_logs import RESISTANCE, write_flight
 from hypothesis import given
 from hypothesis import strategies as st
 
+from codegen.apps.battery.load_steps import STEP_MAX_DT_S, internal_resistance, resistance_sql
 from codegen.apps.export.engine import ExportOptions, export_logs, finish
-from codegen.apps.fleet_query import run_query
-from codegen.apps.load_steps import STEP_MAX_DT_S, internal_resistance, resistance_sql
-from codegen.apps.package import bundled_schemas
+from codegen.apps.export.query import run_query
 from codegen.apps.report.figures import compute
 from codegen.apps.report.series import read_input
+from codegen.apps.schemas.package import bundled_schemas
 
 
 def test_report_and_flights_view_agree(tmp_path: Path) -> None:

@@ -27,7 +27,7 @@ from codegen.apps.failsafe.px4_levels import (
 )
 from codegen.apps.failsafe.px4_log import read_px4_log
 from codegen.apps.failsafe.px4_replay import replay_px4
-from codegen.apps.package import bundled_package, package_module
+from codegen.apps.schemas.package import bundled_package, package_module
 
 L, C, E, N = Px4Level.LOW, Px4Level.CRITICAL, Px4Level.EMERGENCY, Px4Level.NONE
 

@@ -16,10 +16,10 @@ import pytest
 from flight_logs import CELLS, RESISTANCE, write_capture_flight, write_flight
 
 from codegen.apps.battery.figures import trapezoid
-from codegen.apps.package import bundled_schemas
 from codegen.apps.report.downsample import POINT_BUDGET, decimate, planned_length
 from codegen.apps.report.figures import compute
 from codegen.apps.report.series import read_input
+from codegen.apps.schemas.package import bundled_schemas
 from codegen.cli.main import main
 
 pytest.importorskip("plotly")

@@ -16,13 +16,13 @@ import pytest
 from shared_data import SHARED, real_logs, require
 
 from codegen.apps.battery.context import LogContext
-from codegen.apps.package import bundled_schemas
 from codegen.apps.report.build import collect, html
 from codegen.apps.report.figures import NO_CELLS, compute, shown
 from codegen.apps.report.fleet import fleet_view
 from codegen.apps.report.log_facts import BATTERY_PARAMETER, log_facts
 from codegen.apps.report.plots import figure
 from codegen.apps.report.series import BatterySeries
+from codegen.apps.schemas.package import bundled_schemas
 
 pyulog = pytest.importorskip("pyulog")
 pytest.importorskip("plotly")

@@ -3,7 +3,7 @@
 The fact pinned here: NXP's RDDRONE-BMS772 firmware (NXP rddrone-bms772 repository, ``src/uavcan.c``) defines
 ``CELSIUS_TO_KELVIN`` as 272.15 and sends ``temperature_min_max[i].kelvin`` as its degrees Celsius plus that
 constant, so a reader using UDRAL's 273.15 gets every temperature 1 K low. The source cannot be fetched in a test:
-the constant is stated here and in :mod:`codegen.apps.senders`, and the conversion is checked against it.
+the constant is stated here and in :mod:`codegen.apps.conversion.senders`, and the conversion is checked against it.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from codegen.apps import senders
+from codegen.apps.conversion import senders as senders
 from codegen.cli.main import main
 
 NXP_CELSIUS_TO_KELVIN = 272.15  # NXP rddrone-bms772, src/uavcan.c: #define CELSIUS_TO_KELVIN 272.15

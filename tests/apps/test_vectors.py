@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 from pymavlink.dialects.v20 import common as mavlink2
 
-from codegen.apps.vectors import vectors_document
+from codegen.apps.conversion.vectors import vectors_document
 from codegen.cli.main import main
 from codegen.frontends.loader import load
 from codegen.ir import EnumKind

@@ -23,8 +23,8 @@ from c_cases import PRELUDE, _dump_c, _nested, dump, struct_init
 from rust_cases import Unrepresentable, _from_json, random_records
 
 import generated.convert as converters
-from codegen.apps.package import bundled_schemas, project_root
-from codegen.apps.vectors import SIDES, VectorWriter
+from codegen.apps.conversion.vectors import SIDES, VectorWriter
+from codegen.apps.schemas.package import bundled_schemas, project_root
 from codegen.backends.c.converters import CConverter, c_converters
 from codegen.backends.c.types import type_name
 from codegen.frontends.loader import load

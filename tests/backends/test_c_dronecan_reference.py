@@ -15,7 +15,7 @@ import pytest
 from c_cases import struct_init
 from rust_cases import Unrepresentable, random_records
 
-from codegen.apps.package import bundled_schemas, project_root
+from codegen.apps.schemas.package import bundled_schemas, project_root
 from codegen.backends.c.types import type_name
 from codegen.frontends.loader import load
 from codegen.ir import ArrayType, CompositeType, Message, Schema

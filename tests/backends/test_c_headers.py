@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from codegen.apps.package import bundled_schemas, project_root
+from codegen.apps.schemas.package import bundled_schemas, project_root
 from codegen.backends.c import render_library
 from codegen.frontends.loader import load
 

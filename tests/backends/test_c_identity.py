@@ -8,7 +8,7 @@ import re
 
 import pytest
 
-from codegen.apps.package import bundled_schemas, project_root
+from codegen.apps.schemas.package import bundled_schemas, project_root
 from codegen.backends.c.types import type_name
 from codegen.frontends.loader import load
 from codegen.ir import SourceFormat

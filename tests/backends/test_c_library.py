@@ -26,7 +26,7 @@ import pytest
 from c_cases import Replay, add_fuzz, collect, expected_lines, render_harness
 from rust_cases import generated_classes
 
-from codegen.apps.package import bundled_schemas, project_root
+from codegen.apps.schemas.package import bundled_schemas, project_root
 from codegen.frontends.loader import load
 
 GENERATED = project_root() / "generated" / "c"

@@ -18,8 +18,8 @@ from pathlib import Path
 import pytest
 from rust_convert_cases import RANDOM, Case, cases, render
 
-from codegen.apps.package import bundled_schemas, project_root
-from codegen.apps.vectors import SIDES
+from codegen.apps.conversion.vectors import SIDES
+from codegen.apps.schemas.package import bundled_schemas, project_root
 from codegen.backends.c.converters import c_converters
 from codegen.backends.rust.converters import RustConverter, rust_converters
 from codegen.frontends.loader import load

@@ -22,7 +22,7 @@ from rust_cases import Replay, render_replay, replay_test_name
 from rust_crate import GENERATED, Crate, cargo, shared_crate
 from shared_data import UPSTREAM, require
 
-from codegen.apps.package import bundled_schemas
+from codegen.apps.schemas.package import bundled_schemas
 from codegen.backends.rust import render_crate
 from codegen.backends.rust.render import rust_messages
 from codegen.backends.rust.rules import rust_rules

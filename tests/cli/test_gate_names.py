@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 from shared_data import REAL_LOGS, missing, real_logs
 
-from codegen.apps.gate import GENERIC_RULES, load_profile, names_of, profile_names, unknown_selector
-from codegen.apps.package import bundled_schemas
-from codegen.apps.validate import make_checker
+from codegen.apps.gate.selection import GENERIC_RULES, load_profile, names_of, profile_names, unknown_selector
+from codegen.apps.gate.validate import make_checker
+from codegen.apps.schemas.package import bundled_schemas
 from codegen.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -139,7 +139,7 @@ def test_a_px4_logs_default_report_and_validation_have_no_finding_px4_explains(
 def test_one_did_you_mean_for_every_command() -> None:
     """The gate's hints and the other commands' come from one matcher (codegen.errors.close_names): case is ignored
     and a dotted name's last part is compared, wherever the name was typed; each keeps its own sentence."""
-    from codegen.apps.gate import closest, unknown_name
+    from codegen.apps.gate.selection import closest, unknown_name
     from codegen.errors import close_names, did_you_mean
 
     known = ["copter", "plane", "rover", "uorb.BatteryStatus"]

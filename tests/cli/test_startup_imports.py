@@ -92,7 +92,7 @@ def test_convert_of_json_lines_imports_no_log_reader_nor_generator(tmp_path: Pat
     assert code == 0 and len(out.read_text(encoding="utf-8").splitlines()) == 1
     # python-can, the log and devicetree readers and the code generator belong to other inputs and commands
     assert _heavy(modules, ("jsonschema", "pandas", "pyarrow", "plotly", "numpy", "pydsdl", "can", "jinja2")) == []
-    readers = ("codegen.inputs.can", "codegen.inputs.devicetree", "codegen.inputs.ulog", "codegen.inputs.tlog")
+    readers = ("codegen.inputs.can", "codegen.inputs.devicetree", "codegen.inputs.ulog.records", "codegen.inputs.tlog")
     assert sorted(m for m in modules if m.startswith(readers)) == []
     assert "codegen.backends.python.registry" not in modules
 

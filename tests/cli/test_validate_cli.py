@@ -18,8 +18,8 @@ import pytest
 import yaml
 from conftest import ROOT
 
-from codegen.apps.messages import resolve_message
-from codegen.apps.validate import Checker, exit_code, make_checker
+from codegen.apps.gate.validate import Checker, exit_code, make_checker
+from codegen.apps.schemas.messages import resolve_message
 from codegen.cli.main import build_parser, main
 from codegen.cli.validate import check_file
 from codegen.frontends.loader import load

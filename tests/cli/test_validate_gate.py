@@ -11,7 +11,7 @@ import jsonschema
 import pytest
 from shared_data import REAL_LOGS, missing
 
-from codegen.apps.gate import finding_code, load_profile, matches, profile_names
+from codegen.apps.gate.selection import finding_code, load_profile, matches, profile_names
 from codegen.cli.main import main
 from codegen.frontends.loader import load
 

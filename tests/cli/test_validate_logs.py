@@ -13,7 +13,7 @@ import pytest
 from conftest import ROOT
 from shared_data import REAL_LOGS, missing
 
-from codegen.apps.validate import make_checker
+from codegen.apps.gate.validate import make_checker
 from codegen.cli.main import main
 from codegen.cli.validate import check_file
 from codegen.inputs.dispatch import read_records

@@ -126,7 +126,7 @@ def test_message_is_required_where_no_default_exists(capsys: pytest.CaptureFixtu
 
 def test_a_log_defaults_to_its_battery_message(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     # a ULog holds battery_status, whatever older versions of the message the schemas also hold: the message the
-    # report and the export read it as (one table, codegen.apps.messages.BATTERY_MESSAGES)
+    # report and the export read it as (one table, codegen.apps.schemas.messages.BATTERY_MESSAGES)
     log = tmp_path / "x.ulg"
     log.write_bytes(b"")
     assert main(["validate", str(log)]) == 2

@@ -22,7 +22,7 @@ import pytest
 from conftest import ROOT
 
 from codegen.apps.battery.catalog import build_catalog, bundled_catalog
-from codegen.apps.package import bundled_schemas
+from codegen.apps.schemas.package import bundled_schemas
 from codegen.errors import SchemaError
 from codegen.frontends import mappings
 from codegen.frontends.loader import load

@@ -17,7 +17,7 @@ from pathlib import Path
 from targets import MASKED, MAX_MESSAGE, SEEDS, run_main
 
 from codegen.apps.export.manifest import committed
-from codegen.apps.fleet_query import run_query
+from codegen.apps.export.query import run_query
 
 LOG = SEEDS / "flight.tlog"
 

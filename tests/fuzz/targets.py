@@ -23,8 +23,8 @@ from pathlib import Path
 from typing import Any
 from unittest import mock
 
-import codegen.apps.validate as validate_app
-from codegen.apps.validate import Checker, make_checker
+import codegen.apps.gate.validate as validate_app
+from codegen.apps.gate.validate import Checker, make_checker
 from codegen.cli.main import main
 from codegen.errors import BattgenError, LocatedError
 from codegen.frontends.loader import load

@@ -11,7 +11,8 @@ from budget import fuzz_settings
 from hypothesis import given
 from hypothesis import strategies as st
 
-from codegen.inputs import dataflash, parameter_files
+from codegen.inputs.dataflash import log as dataflash
+from codegen.inputs.parameters import files as parameter_files
 from codegen.inputs.records import InputError
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "inputs"))

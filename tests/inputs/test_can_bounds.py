@@ -15,14 +15,14 @@ from pathlib import Path
 import can
 import pytest
 
-from codegen.apps.can_capture import scan
-from codegen.apps.package import bundled_package
+from codegen.apps.can.capture import scan
+from codegen.apps.schemas.package import bundled_package
 from codegen.cli.main import main
 from codegen.inputs.can.bounded import MAX_CONTAINER, MAX_LINE, MAX_XZ_MEMORY, bounded_reader
 from codegen.inputs.can.captures import read_capture
 from codegen.inputs.can.reassembly import Frame
 from codegen.inputs.can.records import registry
-from codegen.inputs.kinds import kind_of_name
+from codegen.inputs.files.kinds import kind_of_name
 from codegen.inputs.records import InputError
 from tests.fuzz.measure import run_battgen
 from tests.shared_data import require, shared

@@ -18,7 +18,7 @@ import pytest
 from test_can_cyphal import CYCLES, NODES, PARAMETERS, SOURCE, STATUS, SUBJECTS, _capture, _frames, _source, _status
 from test_can_cyphal import dsdl as dsdl  # the module's fixture: nunavut's classes of the bundled types
 
-from codegen.apps.fleet_query import run_query
+from codegen.apps.export.query import run_query
 from codegen.cli.main import main
 
 pytest.importorskip("pycyphal")

@@ -18,7 +18,7 @@ from test_can_cyphal import dsdl as dsdl  # the module's fixture: nunavut's clas
 from test_can_cyphal_apps import _parameters, _read_back, _source
 
 from codegen.apps.export.cyphal_raw import number_paths
-from codegen.apps.package import load_schemas
+from codegen.apps.schemas.package import load_schemas
 from codegen.cli.main import main
 
 pytest.importorskip("pycyphal")

@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 from can_logs import write_capture
 
-from codegen.apps.can_types import shipped_tree, standard_types
+from codegen.apps.can.known_types import shipped_tree, standard_types
 from codegen.cli.main import main
 
 can = pytest.importorskip("can")

@@ -1,4 +1,4 @@
-"""The DataFlash (.bin) reader (codegen.inputs.dataflash) on logs written by an independent writer
+"""The DataFlash (.bin) reader (codegen.inputs.dataflash.log) on logs written by an independent writer
 (tests/inputs/dataflash_writer.py, from the format's description), read through pymavlink."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from dataflash_writer import DataflashWriter, battery_log
 
-from codegen.inputs import dataflash
+from codegen.inputs.dataflash import log as dataflash
 from codegen.inputs.records import InputError
 
 PARAMS = {"BATT_LOW_VOLT": 10.5, "BATT_FS_LOW_ACT": 2, "BATT2_CRT_VOLT": 9.9}

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from codegen.inputs.dataflash import _fd_captured
+from codegen.inputs.dataflash.log import _fd_captured
 
 
 def _damaged(tmp_path: Path) -> Path:

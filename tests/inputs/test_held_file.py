@@ -19,7 +19,7 @@ import pytest
 from codegen.apps.battery import readers
 from codegen.apps.battery.catalog import bundled_catalog
 from codegen.apps.export.engine import ExportOptions, export_logs
-from codegen.inputs.held_file import FileChanged, held
+from codegen.inputs.files.held import FileChanged, held
 from tests.shared_data import REAL_LOGS, require
 
 _TRUNCATE = "import os, sys; os.truncate(sys.argv[1], 64)"

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from codegen.apps.batt_proposal import propose, voltage_at
 from codegen.apps.failsafe.checks import check_file, check_settings
+from codegen.apps.parameters.proposal import propose, voltage_at
 from codegen.errors import BattgenError
-from codegen.inputs import parameter_files
-from codegen.inputs.parameter_files import ParameterFileError
+from codegen.inputs.parameters import files as parameter_files
+from codegen.inputs.parameters.files import ParameterFileError
 
 QGC = """# Onboard parameters for Vehicle 1
 #

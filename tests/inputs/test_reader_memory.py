@@ -33,7 +33,7 @@ import pytest
 from codegen.cli.main import main
 from codegen.errors import LocatedError
 from codegen.inputs.devicetree.reading import read_nodes
-from codegen.inputs.parameter_files import load
+from codegen.inputs.parameters.files import load
 from codegen.text.files import MAX_WHOLE_FILE
 from tests.shared_data import require, shared
 

@@ -9,7 +9,7 @@ import ast
 import re
 from pathlib import Path
 
-from codegen.inputs import ulog_index
+from codegen.inputs.ulog import index as ulog_index
 from generated import _ulog
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -72,7 +72,7 @@ def test_the_check_finds_what_it_looks_for() -> None:
 def test_the_compiled_walk_and_the_runtime_agree_on_what_a_corrupt_header_is() -> None:
     """The C walk hard-codes the bound the runtime names (it stops before a header the runtime
     would call corrupt, so the runtime decides): the two must not drift apart."""
-    source = (ROOT / "codegen" / "inputs" / "_ulog_scan.c").read_text(encoding="utf-8")
+    source = (ROOT / "codegen" / "inputs" / "ulog" / "_scan.c").read_text(encoding="utf-8")
     bound = re.search(r"#define MAX_UNKNOWN_SIZE (\d+)", source)
     assert bound is not None and int(bound.group(1)) == _ulog.MAX_UNKNOWN_SIZE
     assert _ulog.Log.KNOWN_TYPES == _ulog.KNOWN_TYPES == frozenset(b"ABCDFILMOPQRS")

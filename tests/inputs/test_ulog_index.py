@@ -1,4 +1,4 @@
-"""The C-speed record index (codegen/inputs/ulog_index.py) against the generated walker it stands in
+"""The C-speed record index (codegen/inputs/ulog/index.py) against the generated walker it stands in
 for: the same offsets for every topic instance and the same log state afterwards (subscriptions,
 info, parameters, logged text, counts, warnings in order), on the shared real logs, on logs the
 generated writer makes, and on those logs damaged every way hypothesis finds."""
@@ -15,7 +15,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shared_data import real_logs
 
-from codegen.inputs import ulog_columns, ulog_index
+from codegen.inputs.ulog import columns as ulog_columns
+from codegen.inputs.ulog import index as ulog_index
 from generated import _ulog
 from generated._ulog_parse import WALK_STATE
 from generated.uorb import BatteryInfo, BatteryStatus

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from codegen.inputs import ulog_index
+from codegen.inputs.ulog import index as ulog_index
 
 HOSTILE = Path(__file__).with_name("ulog_scan_hostile.py")
 
@@ -21,7 +21,7 @@ HOSTILE = Path(__file__).with_name("ulog_scan_hostile.py")
 def test_hostile_arguments_are_refused_not_crashed_on() -> None:
     if not ulog_index.compiled():
         if os.environ.get("CI") == "true":
-            pytest.fail("the C extension codegen/inputs/_ulog_scan.c was not built (CI has gcc)")
+            pytest.fail("the C extension codegen/inputs/ulog/_scan.c was not built (CI has gcc)")
         pytest.skip("the C extension is not built")
     run = subprocess.run([sys.executable, str(HOSTILE)], capture_output=True, text=True, timeout=300)
     last = run.stdout.strip().splitlines()[-1:] or [""]

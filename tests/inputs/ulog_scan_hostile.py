@@ -1,4 +1,4 @@
-"""The compiled ULog walk and gather (codegen/inputs/_ulog_scan.c) called with hostile arguments.
+"""The compiled ULog walk and gather (codegen/inputs/ulog/_scan.c) called with hostile arguments.
 
 Run as a child process by tests/inputs/test_ulog_scan_bounds.py, so that a crash (a segfault) is
 a failed test instead of a dead test run. Every call's outcome is compared with a model of the
@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from codegen.inputs._ulog_scan import gather, scan
+from codegen.inputs.ulog._scan import gather, scan
 
 REFUSED = (ValueError, TypeError, OverflowError, BufferError)
 BIG = [2**31 - 1, 2**31, 2**32, 2**62, 2**63 - 1]

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ...errors import BattgenError
 from ...ir import CONCEPTS_ENDPOINT, Concept, Direction, Endpoint, Message, Rule, Schema
-from ..package import bundled_schemas, load_schemas
+from ..schemas.package import bundled_schemas, load_schemas
 
 # codegen.frontends.mappings.MAPPED_FORMATS and codegen.frontends.loader.MAPPINGS_DIR, written here as importing
 # either module imports the frontends, which a fresh cache spares (tests/apps/test_ir_cache.py checks they agree)
@@ -131,7 +131,7 @@ def bundled_catalog(schema_dir: Path | None = None) -> Catalog:
     messages come from, and the mappings): every command starts here, and the Cyphal types (pydsdl),
     the parameter metadata and the validator rules are no part of a battery reading. A folder
     given is read whole, so every error in it is still reported. The bundled folder's IR comes from the cache
-    (:func:`~codegen.apps.package.load_schemas`): no frontend is imported when it is fresh."""
+    (:func:`~codegen.apps.schemas.package.load_schemas`): no frontend is imported when it is fresh."""
     if schema_dir is None:
         return build_catalog(load_schemas(bundled_schemas(), only=(*_MAPPED_FORMATS, _MAPPINGS_DIR)))
     from ...frontends.loader import load

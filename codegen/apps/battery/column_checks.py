@@ -6,7 +6,7 @@ picks the rows that some check of the generated ``validate()`` can flag (:func:`
 are built as the generated class (from the row's values) and run through :meth:`Checker.check`, so rule ids,
 messages and their order are the oracle's own. A row no check can flag gives no finding and costs no Python.
 
-A finding is placed as the per-record reader places it (:func:`codegen.inputs.ulog.ulog_items`: topic,
+A finding is placed as the per-record reader places it (:func:`codegen.inputs.ulog.records.ulog_items`: topic,
 multi_id, timestamp_us, offset and the record's index in file order). A ULog batch does not carry its records'
 offsets, so they come from the log's index (the C walk, no decoding); the format notices from the per-record
 reader's definitions. Where the batch lacks what a kind needs (a tlog's frame number, sysid/compid/seq and offset;
@@ -28,16 +28,16 @@ import numpy as np
 from ...backends.python import naming
 from ...inputs.model import GeneratedMessage, MessageClass, UorbClass
 from ...inputs.records import Notice, Record, Unreadable
-from ...inputs.ulog import LogRecord, UlogReader
-from ...inputs.ulog_columns import record_dtype
-from ...inputs.ulog_index import record_offsets
+from ...inputs.ulog.columns import record_dtype
+from ...inputs.ulog.index import record_offsets
+from ...inputs.ulog.records import LogRecord, UlogReader
 from ...ir import ArrayType, Field, Message, PrimitiveKind, PrimitiveType
 from .columns import NDArray, length_key
 from .view import Chunk
 
 
 class Checker(Protocol):
-    """The per-record validator (:class:`codegen.apps.validate.Checker`; not imported: the validator's app
+    """The per-record validator (:class:`codegen.apps.gate.validate.Checker`; not imported: the validator's app
     imports the battery view)."""
 
     cls: MessageClass
@@ -47,7 +47,7 @@ class Checker(Protocol):
     def check(self, record: Record) -> Sequence[Finding]: ...
 
 
-Finding = Any  # a :class:`codegen.apps.validate.Finding`, as the checker makes it
+Finding = Any  # a :class:`codegen.apps.gate.validate.Finding`, as the checker makes it
 
 _D_HEAD = 5  # a ULog data record's payload starts this far after the record (uint16 size, 'D', uint16 msg_id)
 
@@ -408,7 +408,8 @@ def _placed(rows: list[_Rows], chunks: list[Chunk], skip: frozenset[str]) -> tup
 def _record(
     name: str, topic: str, multi_id: int, offset: int, stamp: Any, index: int, instance: Any, skip: frozenset[str]
 ) -> Record:
-    """A row as the per-record reader yields it (:func:`codegen.inputs.ulog.ulog_items`): its place in the log."""
+    """A row as the per-record reader yields it (:func:`codegen.inputs.ulog.records.ulog_items`): its place in the
+    log."""
     rec = LogRecord(topic, multi_id, offset, int(stamp) if stamp >= 0 else None, instance, skip, {}, ())
     return Record(index, 0, None, name, where=rec.where(), instance=instance, skip=skip, location=rec.location())
 

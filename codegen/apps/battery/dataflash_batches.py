@@ -1,13 +1,13 @@
 """ArduPilot DataFlash logs (.bin) for the export: the battery monitor readings (``BAT``, older
-``BAT2``/``CURR``/``CURR2``) of :mod:`codegen.inputs.dataflash`, one batch per instance.
+``BAT2``/``CURR``/``CURR2``) of :mod:`codegen.inputs.dataflash.log`, one batch per instance.
 
 DataFlash has no message schema in the IR (its layout is in each log's own FMT records), so there is
 no mapping file to apply: the four values the reader gives -- ``Volt`` V, ``Curr`` A, ``CurrTot``
 mAh, ``RemPct`` % -- become concepts here, with the factors taken from the IR's unit registry.
 A value the log lacks is unknown; units come from the log (FMTU) or ArduPilot's logging code
-(:mod:`codegen.inputs.dataflash_units`). ``t`` is seconds since the log's first record, whose
+(:mod:`codegen.inputs.dataflash.units`). ``t`` is seconds since the log's first record, whose
 ``TimeUS`` (µs since boot) is ``Batch.origin_us``; ``armed`` follows
-:mod:`codegen.inputs.dataflash_arming` (``ARM`` / ``EV`` records from the state ``LOG_DISARMED``
+:mod:`codegen.inputs.dataflash.arming` (``ARM`` / ``EV`` records from the state ``LOG_DISARMED``
 implies at the first record); ``time`` (UTC) from the first ``GPS`` record with a week
 (``GWk``/``GMS`` against its ``TimeUS``, as pymavlink's DataFlash reader sets its clock), where
 the log has one.
@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ...inputs.dataflash import (
+from ...inputs.dataflash.arming import armed_at_start
+from ...inputs.dataflash.log import (
     FAILSAFE_SUBSYSTEMS,
     ArmingRecord,
     BatteryRecord,
@@ -31,7 +32,6 @@ from ...inputs.dataflash import (
     reason_name,
     timed_flight_records,
 )
-from ...inputs.dataflash_arming import armed_at_start
 from ...ir.units import unit
 from .catalog import Catalog
 from .columns import ConceptColumn, NDArray, empty_columns

@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from ...inputs.held_file import Buffer, held, whole
+from ...inputs.files.held import Buffer, held, whole
 from .can_batches import can_batches
 from .catalog import Catalog
 from .dataflash_batches import dataflash_batches

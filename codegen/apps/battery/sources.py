@@ -20,15 +20,15 @@ import numpy as np
 
 from ...backends.python import naming
 from ...errors import BattgenError
-from ...inputs.dataflash import shortest_float32
+from ...inputs.dataflash.log import shortest_float32
 from ...inputs.documents import read_jsonl
-from ...inputs.held_file import Buffer
-from ...inputs.kinds import LOG_KINDS, detect
+from ...inputs.files.held import Buffer
+from ...inputs.files.kinds import LOG_KINDS, detect
 from ...inputs.model import MessageClass, UorbClass
 from ...inputs.records import InputError, Record, Unreadable
-from ...inputs.ulog_columns import UlogColumns
+from ...inputs.ulog.columns import UlogColumns
 from ...ir import ArrayType, Field, Message, PrimitiveKind, PrimitiveType, Schema, StringType
-from ..package import bundled_package, model_class
+from ..schemas.package import bundled_package, model_class
 from .catalog import RECORD_ENDPOINTS, Catalog
 from .columns import ConceptColumn, NDArray, length_key
 from .context import (
@@ -66,7 +66,7 @@ class Batch:
 
 
 def log_kind(path: Path) -> str:
-    """The kind of a log or capture (:func:`codegen.inputs.kinds.detect`: content, then name); an InputError for
+    """The kind of a log or capture (:func:`codegen.inputs.files.kinds.detect`: content, then name); an InputError for
     a file of another kind."""
     kind = detect(path)
     if kind not in LOG_KINDS:

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import BattgenError
-from ...inputs.dataflash import shortest_float32
+from ...inputs.dataflash.log import shortest_float32
 from ...inputs.model import MavlinkClass
 from ...inputs.tlog import FrameRecord, StreamStats, read_messages
 from .catalog import Catalog

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...inputs.held_file import Buffer
+from ...inputs.files.held import Buffer
 from .catalog import Catalog, bundled_catalog
 from .columnar import convert_columns
 from .columns import ConceptColumn, NDArray

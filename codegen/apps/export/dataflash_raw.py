@@ -9,7 +9,7 @@ from typing import Any
 
 import pyarrow as pa
 
-from ...inputs.dataflash import open_log
+from ...inputs.dataflash.log import open_log
 
 RAW_TYPES = ("BAT", "BATT", "BAT2", "CURR", "CURR2", "BCL", "BCL2")  # the readings and the cell voltages
 

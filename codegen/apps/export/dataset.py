@@ -6,7 +6,7 @@ Layout under the output folder::
     raw/<message>/log=<id>/part-<version>.parquet  --raw: every field as decoded, sentinels kept
     failsafe/log=<id>/events-<version>.parquet     --failsafe: the replay's events (and replays-<version>)
     logs/<id>.json                                 the log's marker: what was exported, the files of its version
-    views.sql                                      the DuckDB views (see codegen.apps.fleet_query)
+    views.sql                                      the DuckDB views (see codegen.apps.export.query)
     dataset.json                                   {"partition": "log" or "day", "content_id": "xxh128" or "sha256"}
     .battgen-export.lock                           the writers' lock (one export at a time)
 

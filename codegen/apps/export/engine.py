@@ -21,12 +21,12 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from ...errors import BattgenError, OutputError, cannot_read
-from ...inputs.held_file import held
+from ...inputs.files.held import held
 from ..battery.catalog import bundled_catalog
 from ..battery.sources import Batch, log_kind
 from ..battery.view import read_view
 from ..failsafe.logs import SampleTable
-from ..package import bundled_package
+from ..schemas.package import bundled_package
 from .content import content_id, map_file, prefix_id
 from .cyphal_raw import CYPHAL_PREFIX, cyphal_raw_tables
 from .dataflash_raw import dataflash_raw_tables

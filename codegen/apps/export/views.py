@@ -1,14 +1,14 @@
 """The fleet views: plain SQL over the ``battery`` table of an exported dataset, for DuckDB.
 
 Written into the dataset as ``views.sql`` so any DuckDB can use them (``cd DIR; duckdb -init
-views.sql``); ``battgen query`` (:mod:`codegen.apps.fleet_query`) runs them before the user's SQL.
+views.sql``); ``battgen query`` (:mod:`codegen.apps.export.query`) runs them before the user's SQL.
 ``flights``: one row per flight (a log and a battery instance). ``packs``: one row per pack, by
 serial number where the pack reports one, else by vehicle and battery instance. A flight's records, times,
 voltages, current, armed time, charge and energy used are the figures of :mod:`codegen.apps.battery.figures`, the
 definition ``battgen report`` shows too.
 
 Internal resistance is estimated at load steps as ``battgen report`` does (one definition, in
-:mod:`codegen.apps.load_steps`): consecutive records of a battery at most 2 s apart whose current
+:mod:`codegen.apps.battery.load_steps`): consecutive records of a battery at most 2 s apart whose current
 changes by at least 20 % of the flight's peak (and 1 A) give R = -dV/dI; a flight's value is the
 median of its positive estimates.
 
@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..battery.figures import WINDOW_SQL, flight_sql
-from ..load_steps import resistance_sql
+from ..battery.load_steps import resistance_sql
 from .dataset import BATTERY, table_glob
 from .durable import write_atomic
 from .failsafe_columns import EVENTS_SCHEMA, REPLAYS_SCHEMA

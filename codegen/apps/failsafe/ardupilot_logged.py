@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...inputs.dataflash import open_log
+from ...inputs.dataflash.log import open_log
 from ..battery.columns import NDArray
 from .evaluator import Event
 from .logs import SampleTable

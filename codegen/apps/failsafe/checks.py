@@ -27,7 +27,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from ...inputs import parameter_files
+from ...inputs.parameters import files as parameter_files
 from .settings import instances, prefix
 from .vehicles import DEFAULT_VEHICLE, VEHICLES, Vehicle
 

@@ -1,7 +1,7 @@
 """Whose battery failsafe ``battgen failsafe`` replays a stream through: PX4's or ArduPilot's.
 
 Given (``--firmware``) it is that; else the given parameters name it (ArduPilot's ``BATT*_`` groups, PX4's ``BAT_*``
-thresholds and ``COM_*`` battery actions); else the log says (:mod:`codegen.inputs.kinds`: a ULog is PX4's own
+thresholds and ``COM_*`` battery actions); else the log says (:mod:`codegen.inputs.files.kinds`: a ULog is PX4's own
 format; a DataFlash log, a tlog and JSON Lines samples go through ArduPilot's, whose replay reads them).
 """
 
@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-from ...inputs.kinds import detect
+from ...inputs.files.kinds import detect
 from .stream import batt_parameter_count
 
 FIRMWARES = ("px4", "ardupilot")

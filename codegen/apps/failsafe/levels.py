@@ -2,7 +2,7 @@
 
 uORB ``battery_status.warning`` and MAVLink ``BATTERY_STATUS.charge_state`` carry the level; their
 values come from the generated enums of the bundled schemas (so they follow the message
-definitions), found through :mod:`codegen.apps.package`.
+definitions), found through :mod:`codegen.apps.schemas.package`.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import enum
 from collections.abc import Mapping
 from typing import Any
 
-from ..package import bundled_package, package_module
+from ..schemas.package import bundled_package, package_module
 
 
 class Level(enum.IntEnum):

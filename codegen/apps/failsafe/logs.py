@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...inputs import dataflash
+from ...inputs.dataflash import log as dataflash
 from ..battery.columns import NDArray
 from ..battery.context import LogContext
 from ..battery.view import Chunk, read_view

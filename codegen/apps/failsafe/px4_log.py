@@ -6,7 +6,7 @@ updates' time, state of charge (``battery_status.remaining``, the estimate the f
 from), ``connected``, ``time_remaining_s`` and the warning the firmware logged.
 
 What commander did comes from topics the battery view does not read, through the same ULog reader
-(:class:`codegen.inputs.ulog_columns.UlogColumns`): ``failsafe_flags.battery_warning`` and
+(:class:`codegen.inputs.ulog.columns.UlogColumns`): ``failsafe_flags.battery_warning`` and
 ``.battery_low_remaining_time`` (v1.14+; older logs do not record them), ``vehicle_status.nav_state`` (the mode a
 failsafe action puts the vehicle in) and ``rtl_time_estimate`` (``safe_time_estimate`` where ``valid``: what the
 remaining-flight-time failsafe compares the batteries' ``time_remaining_s`` with).
@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ...inputs.model import UorbClass
-from ...inputs.ulog_columns import UlogColumns
+from ...inputs.ulog.columns import UlogColumns
 from ..battery.catalog import bundled_catalog
 from ..battery.columns import NDArray
 from ..battery.context import LogContext

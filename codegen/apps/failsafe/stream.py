@@ -32,15 +32,15 @@ from typing import Any, cast
 
 from ...errors import BattgenError, LocatedError
 from ...frontends.loader import load
-from ...inputs import parameter_files
 from ...inputs.documents import read_jsonl
 from ...inputs.model import GeneratedMessage, MessageClass, package_name
+from ...inputs.parameters import files as parameter_files
 from ...inputs.records import Record, Unreadable
 from ...ir import Schema
 from ..battery.sources import FloatFields, float_fields, stored_data
-from ..convert import ConvertModule
-from ..messages import resolve_message
-from ..package import bundled_schemas, model_class, model_package
+from ..conversion.convert import ConvertModule
+from ..schemas.messages import resolve_message
+from ..schemas.package import bundled_schemas, model_class, model_package
 from .columnar import replay_columns
 from .evaluator import BatteryFailsafe, Event
 from .jsonl_columns import read_sample_columns

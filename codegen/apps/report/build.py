@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..failsafe.stream import read_parameter_values
-from ..gate import Settings
+from ..gate.selection import Settings
 from .fleet import fleet_view
 from .gating import apply_gate
 from .log_facts import LogFacts, log_facts

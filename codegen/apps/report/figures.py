@@ -4,7 +4,7 @@ The flight's own figures -- records, its first and last time, armed time, minimu
 current, charge and energy used -- are :mod:`codegen.apps.battery.figures`, the one definition the fleet views
 share: charge and energy from the battery's own counter where it keeps one, else the trapezoid integral of the
 current and of V·I. The
-internal resistance is estimated from load steps (:mod:`codegen.apps.load_steps`, the definition the fleet views
+internal resistance is estimated from load steps (:mod:`codegen.apps.battery.load_steps`, the definition the fleet views
 share): consecutive samples at most 2 s apart whose current changes by at least 20 % of the flight's peak current
 (and 1 A) give R = -ΔV/ΔI; the median of those steps is reported. The voltage sag per amp is the least-squares
 slope of the voltage's sample-to-sample changes against the current's, over the whole flight: it uses every
@@ -22,7 +22,7 @@ import numpy as np
 
 from ..battery.columns import NDArray
 from ..battery.figures import FlightFigures
-from ..load_steps import neighbour_changes, step_resistances
+from ..battery.load_steps import neighbour_changes, step_resistances
 from .series import BatterySeries
 
 

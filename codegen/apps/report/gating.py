@@ -1,15 +1,15 @@
 """The CI gate in a report: the findings ``validate`` would report of an input, by the same settings.
 
 ``--select``, ``--ignore``, ``--profile`` and ``[tool.battgen]`` are read as ``validate`` reads them
-(:func:`codegen.apps.gate.settings`); an unknown name is refused the same way
-(:func:`~codegen.apps.gate.check_selectors`, against the input's checked message), and without a profile asked
-for, the log's firmware chooses one (:func:`~codegen.apps.gate.for_firmware`, from the log's own context). What
-is left out is counted per reason and said on the page, never dropped silently.
+(:func:`codegen.apps.gate.selection.settings`); an unknown name is refused the same way
+(:func:`~codegen.apps.gate.selection.check_selectors`, against the input's checked message), and without a profile
+asked for, the log's firmware chooses one (:func:`~codegen.apps.gate.selection.for_firmware`, from the log's own
+context). What is left out is counted per reason and said on the page, never dropped silently.
 """
 
 from __future__ import annotations
 
-from ..gate import Gate, Settings, check_selectors, for_firmware
+from ..gate.selection import Gate, Settings, check_selectors, for_firmware
 from .series import InputSeries
 
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..battery.columns import NDArray
 from ..battery.context import LogContext, LogText
-from ..package import bundled_package, package_module
+from ..schemas.package import bundled_package, package_module
 
 # the parameters about the battery a person looks for: PX4's BAT*_ and COM_*BAT*, ArduPilot's BATT*_ and older FS_BATT_*
 BATTERY_PARAMETER = re.compile(r"^(BAT\d*_|BATT\d?_|COM_[A-Z_]*BAT|FS_BATT_)")

@@ -24,7 +24,7 @@ from ...errors import BattgenError
 from ...text.escape import line
 from ..battery.column_checks import FindingGroup
 from ..battery.context import LogText
-from ..gate import describe
+from ..gate.selection import describe
 from .downsample import POINT_BUDGET
 from .figures import compute
 from .fleet import FleetView

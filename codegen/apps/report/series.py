@@ -26,7 +26,7 @@ import numpy as np
 from ...errors import BattgenError
 from ...frontends.loader import RULES_DIR
 from ...inputs.dispatch import read_records
-from ...inputs.kinds import FLIGHT_LOG_KINDS, file_kind
+from ...inputs.files.kinds import FLIGHT_LOG_KINDS, file_kind
 from ...inputs.model import package_name
 from ...inputs.records import Notice, Record, Unreadable
 from ..battery.can_batches import UDRAL
@@ -36,12 +36,12 @@ from ..battery.columns import ConceptColumn, NDArray
 from ..battery.context import LogContext
 from ..battery.figures import FlightFigures, flight_figures
 from ..battery.view import Chunk, read_view
-from ..convert import Conversion
+from ..conversion.convert import Conversion
 from ..failsafe.logs import SampleTable
-from ..gate import Names, Settings, names_of
-from ..messages import BATTERY_MESSAGES
-from ..package import bundled_schemas
-from ..validate import Checker, Finding, make_checker
+from ..gate.selection import Names, Settings, names_of
+from ..gate.validate import Checker, Finding, make_checker
+from ..schemas.messages import BATTERY_MESSAGES
+from ..schemas.package import bundled_schemas
 
 KELVIN = 273.15
 COULOMB_PER_MAH = 3.6

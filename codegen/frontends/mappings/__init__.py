@@ -32,7 +32,7 @@ __all__ = ["MAPPED_FORMATS", "all_mappings", "concepts", "endpoints", "mappings_
 # messages): a catalog of the mappings needs these folders and no other
 MAPPED_FORMATS = ("uorb", "dronecan", "devicetree", "mavlink", "cyphal")
 
-# the mapping files shipped with battgen (the checkout's schemas/mappings/, as codegen.apps.package
+# the mapping files shipped with battgen (the checkout's schemas/mappings/, as codegen.apps.schemas.package
 # finds it): they take the compiled check (.fast_check), every other file jsonschema itself
 _BUNDLED_DIR = Path(__file__).resolve().parents[3] / "schemas" / "mappings"
 

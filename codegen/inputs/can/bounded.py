@@ -31,7 +31,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any, cast
 
-from ..kinds import COMPRESSED_SUFFIXES
+from ..files.kinds import COMPRESSED_SUFFIXES
 from ..records import InputError
 
 MAX_LINE = 1 << 16  # bytes of one line of a text capture (candump's longest, an FD frame, is under 200)

@@ -23,7 +23,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, cast
 
-from ..dataflash import open_log
+from ..dataflash.log import open_log
 from ..records import InputError
 from .bounded import bounded_reader, inner_suffix
 from .candump_screen import read_screen, screen_stamp

@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import cast
 
-from ..kinds import detect
+from ..files.kinds import detect
 from ..model import CyphalClass, DronecanClass, GeneratedMessage, MessageClass, package_name
 from ..records import InputError, Item, Notice, Record, Unreadable
 from .captures import read_capture, read_dataflash_frames

@@ -1,0 +1,1 @@
+"""What a CAN capture or live bus holds (``battgen can``): nodes, types, rates, transport problems."""

@@ -1,0 +1,2 @@
+"""Records of one format into another (``battgen convert``) and the conformance vectors of a converter (``battgen
+vectors``)."""
