@@ -348,14 +348,14 @@ def text(path: str, value: object, spec: Text) -> Violation | None:
                 f"{who} is {size} bytes of UTF-8, more than its {spec.capacity}",
             )
     if spec.const is not None and value != spec.const:
-        return Violation(path, "enum", value, spec.const, f"{who} = {value!r} must be {spec.const!r}")
+        return Violation(path, "enum", value, spec.const, f"{who} = {brief(value)} must be {spec.const!r}")
     if spec.choices and value not in spec.choices:
         return Violation(
             path,
             "enum",
             value,
             spec.choices,
-            f"{who} = {value!r} is not one of " + ", ".join(repr(c) for c in spec.choices),
+            f"{who} = {brief(value)} is not one of " + ", ".join(repr(c) for c in spec.choices),  # a value: briefly
         )
     return None
 
