@@ -182,7 +182,9 @@ def open_log(path: Path, display: str | None = None) -> DataflashLog:
 def _open(path: Path, display: str, notes: list[str], text: bool = False) -> Any:
     from pymavlink import DFReader
 
-    with _captured(notes):
+    # building the reader runs pymavlink's C indexer, which writes to the process's own descriptors: captured here,
+    # once per open, not around every message read (a temporary file and four dups per message)
+    with _captured(notes, native=True):
         try:
             if text:
                 return open_text_reader(path)
@@ -194,14 +196,18 @@ def _open(path: Path, display: str, notes: list[str], text: bool = False) -> Any
 
 
 @contextlib.contextmanager
-def _captured(notes: list[str]) -> Iterator[None]:
-    """pymavlink's prints (skipped bytes, unknown formats) as notes instead of output: Python's prints, and what its
-    C indexer writes to the process's own stderr/stdout (``Invalid length in FMT message at 0``), which no Python
-    redirection sees; that text would reach a terminal or CI log unescaped, between battgen's own lines."""
+def _captured(notes: list[str], *, native: bool = False) -> Iterator[None]:
+    """pymavlink's prints (skipped bytes, unknown formats) as notes instead of output: Python's prints, and with
+    ``native`` what its C indexer writes to the process's own stderr/stdout (``Invalid length in FMT message at 0``),
+    which no Python redirection sees; that text would reach a terminal or CI log unescaped, between battgen's lines."""
     out, err = io.StringIO(), io.StringIO()
-    with _fd_captured() as native, contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+    with (
+        _fd_captured() if native else contextlib.nullcontext(lambda: "") as written,
+        contextlib.redirect_stdout(out),
+        contextlib.redirect_stderr(err),
+    ):
         yield
-    for text in (out.getvalue(), err.getvalue(), native()):
+    for text in (out.getvalue(), err.getvalue(), written()):
         notes.extend(line for line in text.splitlines() if line.strip())
 
 
