@@ -294,3 +294,62 @@ def test_a_dataset_from_before_versions_reads_and_reexports(tmp_path: Path, flig
     )
     assert {s: v[0] for s, v in state(out).items()} == {s: v[0] for s, v in want.items()}
     assert not legacy & all_files(out) and leftovers(out) == set()  # the old names went with the swap
+
+
+# -- markers that cannot be trusted ------------------------------------------------------------------------------
+
+
+def _marker_path(out: Path, source: str) -> Path:
+    (path,) = [p for p in (out / "logs").glob("*.json") if json.loads(p.read_text())["source"] == source]
+    return path
+
+
+def test_a_marker_naming_files_outside_its_tables_deletes_nothing_there(
+    tmp_path: Path, flights: tuple[list[Path], Path]
+) -> None:
+    """A marker is what the next run deletes: one naming a file outside the dataset's tables (a hand edit, a crafted
+    dataset) counts as no marker, so the re-export replaces it and the named file stays."""
+    logs, _ = flights
+    out = tmp_path / "ds"
+    assert main(["export", "-q", "-o", str(out), str(logs[0])]) == 0
+    victim = tmp_path / "victim.parquet"
+    victim.write_bytes(b"keep me")
+    path = _marker_path(out, "flight.tlog")
+    data = json.loads(path.read_text())
+    data["files"]["battery"].append("../victim.parquet")
+    path.write_text(json.dumps(data))
+    assert main(["export", "-q", "-o", str(out), str(logs[0])]) == 0  # exported again: the marker is no marker
+    assert victim.read_bytes() == b"keep me"
+    assert set(state(out)) == {"flight.tlog"}
+    assert "../victim.parquet" not in path.read_text()
+
+
+def test_a_marker_naming_a_missing_file_is_exported_again(tmp_path: Path, flights: tuple[list[Path], Path]) -> None:
+    """Found by the commit fuzzer: a marker whose file name was damaged made the run say "already in the dataset"
+    while the views read a file that is not there."""
+    logs, _ = flights
+    out = tmp_path / "ds"
+    assert main(["export", "-q", "-o", str(out), str(logs[0])]) == 0
+    path = _marker_path(out, "flight.tlog")
+    data = json.loads(path.read_text())
+    data["files"]["battery"] = [name.replace(".parquet", "-x.parquet") for name in data["files"]["battery"]]
+    path.write_text(json.dumps(data))
+    assert main(["export", "-q", "-o", str(out), str(logs[0])]) == 0
+    assert set(state(out)) == {"flight.tlog"}  # the query reads every named file: none is missing
+
+
+def test_a_marker_replacing_another_sources_log_hides_nothing(tmp_path: Path, flights: tuple[list[Path], Path]) -> None:
+    """``replaces`` hides an earlier export of the same, grown, source: a marker naming another source's log
+    (damaged or crafted) must not hide that flight, nor have the next run delete it."""
+    logs, _ = flights
+    out = tmp_path / "ds"
+    assert main(["export", "-q", "-o", str(out), *map(str, logs)]) == 0
+    before = state(out)
+    bin_log = json.loads(_marker_path(out, "flight.bin").read_text())["log"]
+    path = _marker_path(out, "flight.tlog")
+    data = json.loads(path.read_text())
+    data["replaces"] = bin_log
+    path.write_text(json.dumps(data))
+    assert state(out) == before
+    assert main(["export", "-q", "-o", str(out), *map(str, logs)]) == 0
+    assert state(out) == before

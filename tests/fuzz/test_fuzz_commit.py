@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from budget import fuzz_settings
+import pytest
+from budget import crashers, fuzz_settings
 from commit_target import commit, seeds
 from fuzz_inputs import mutated
 from hypothesis import given
@@ -28,3 +29,10 @@ def test_the_long_run_tries_every_reader_target(tmp_path: Path) -> None:
     for target in READERS:
         tried, found, _ = fuzz_inputs(target, 3 if target != "commit" else 1, seed=1, save=tmp_path)
         assert tried >= 1 and found == [], (target, found)
+
+
+@pytest.mark.parametrize("path", crashers("commit"), ids=lambda p: p.name)
+def test_commit_crashers_replay(path: Path) -> None:
+    """Metadata the long run once found mishandled: a marker naming a missing or misnamed file, files under a
+    damaged key, a dataset.json nested past the parser or with a key misspelt."""
+    commit(path.read_bytes())

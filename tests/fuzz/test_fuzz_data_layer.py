@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 from budget import crashers, fuzz_settings
+from dataflash_seeds import thinned
 from fuzz_inputs import mutated
 from hypothesis import given
 from hypothesis import strategies as st
@@ -34,7 +35,14 @@ MAX_MESSAGE = 4000
 KINDS: dict[str, tuple[str, list[Path]]] = {
     "ulog": (".ulg", [SEEDS / "flight.ulg"]),
     "tlog": (".tlog", [SEEDS / "flight.tlog", shared("corpus", "realworld3b", "tlog", "dronekit-python_test.tlog")]),
-    "dataflash": (".bin", [shared("corpus", "realworld3b", "dataflash", "amc_backend_log_80k.bin")]),
+    # thinned (dataflash_seeds.py): every format, the first records of each type the layer reads
+    "dataflash": (
+        ".bin",
+        [
+            shared("corpus", "realworld3b", "dataflash", name)
+            for name in ("amc_backend_log_80k.bin", "wlichon_00000001.BIN", "dronekit_log171.bin")
+        ],
+    ),
     "candump": (".log", [shared("corpus", "realworld3b", "can", "px4-issue2568_uavcan_v0.log")]),
     "asc": (".asc", [shared("corpus", "realworld3b", "can", "pythoncan_logfile.asc")]),
     "blf": (
@@ -64,6 +72,8 @@ INPUTS_PACKED = {"blf-in-xz"}  # the mutated bytes are xz-compressed before they
 
 @functools.cache
 def _seeds(kind: str) -> list[bytes]:
+    if kind == "dataflash":
+        return [thinned(require(p)) for p in KINDS[kind][1]]
     seeds = [require(p).read_bytes() for p in KINDS[kind][1]]
     return [lzma.compress(s, preset=1) for s in seeds] if kind in SEEDS_PACKED else seeds
 

@@ -69,10 +69,11 @@ def _settings(out: Path) -> dict[str, Any]:
         raise BattgenError(f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
     try:
         data = json.loads(text)
-    except ValueError:
+    except (ValueError, RecursionError):  # a crafted file nested beyond the parser
         data = None
     if (
         not isinstance(data, dict)
+        or not set(data) <= {"partition", "content_id"}
         or data.get("partition") not in PARTITIONS
         or data.get("content_id", CONTENT_IDS[0]) not in CONTENT_IDS
     ):
@@ -102,7 +103,13 @@ def content_scheme(out: Path) -> str:
     found = _settings(out).get("content_id")
     if found in CONTENT_IDS:
         return str(found)
-    return "sha256" if _has_logs(out) else CONTENT_IDS[0]
+    if not _has_logs(out):
+        return CONTENT_IDS[0]
+    for path in sorted((out / LOGS).glob("*.json")):  # markers record it too (those written since they do)
+        recorded = (read_marker(out, path.stem) or {}).get("content_id")
+        if recorded in CONTENT_IDS:
+            return str(recorded)
+    return "sha256"
 
 
 def _has_logs(out: Path) -> bool:

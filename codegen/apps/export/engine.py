@@ -216,6 +216,9 @@ def _export(
         manifest["failsafe"] = options.failsafe.key
     where = partition_of(options.partition, log, utc_day(first_us))
     manifest["partition"] = where
+    manifest["content_id"] = options.content_id or content_scheme(
+        options.out
+    )  # the dataset's record again, should dataset.json lose its key
     if grown is not None:
         manifest["replaces"] = grown  # the commit that shows this log hides the one it continues
     writer.commit(manifest, extra, where)

@@ -14,6 +14,7 @@ time (``part-0.parquet``, ``events.parquet``, ``replays.parquet``) in the log's 
 from __future__ import annotations
 
 import json
+import re
 import shutil
 from collections.abc import Mapping
 from pathlib import Path
@@ -35,13 +36,67 @@ def marker(out: Path, log: str) -> Path:
 
 
 def read_marker(out: Path, log: str) -> dict[str, Any] | None:
-    """What the marker of an exported log records (None: not exported, or a marker unreadable -- a
-    re-export replaces it)."""
+    """What the marker of an exported log records (None: not exported, or a marker unreadable or damaged --
+    a re-export replaces it)."""
     try:
         data = json.loads(marker(out, log).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
-    return data if isinstance(data, dict) else None
+    if not isinstance(data, dict) or damage(out, log, data) is not None:
+        return None
+    return data
+
+
+_PARTITION = re.compile(
+    r"(day=(\d{4}-\d{2}-\d{2}|__HIVE_DEFAULT_PARTITION__)/)?log=([0-9A-Za-z_-]+)"
+)  # .dataset.partition_of
+
+
+def damage(out: Path, log: str, data: Mapping[str, Any]) -> str | None:
+    """Why a marker cannot be trusted, or None. A marker is what the next run deletes and what readers read: one
+    that names another log, a partition of another shape, or a file outside the dataset's tables or missing (a
+    hand edit, a disk error) would make a run delete what is not its own or the views read a file that is not
+    there, so it counts as no marker: the log is exported again when it is given again."""
+    if data.get("log") != log:
+        return f"names log {str(data.get('log'))[:40]!r}, not {log!r}"
+    where = data.get("partition")
+    if where is not None:
+        shape = _PARTITION.fullmatch(where) if isinstance(where, str) else None
+        if shape is None or shape.group(3) != log:
+            return f"expected a partition log={log} or day=YYYY-MM-DD/log={log}, got {str(where)[:60]!r}"
+    if "replaces" in data and not (
+        isinstance(data["replaces"], str) and _PARTITION.fullmatch(f"log={data['replaces']}")
+    ):
+        return "expected the id of the log it replaces"
+    files = data.get("files")
+    if files is None and "version" not in data:
+        return None  # a marker of before versions: its files have fixed names (:func:`marker_files`)
+    if (
+        not isinstance(files, dict)
+        or not set(files) <= set(FILE_KEYS)
+        or not all(isinstance(v, list) for v in files.values())
+        or not files.get(BATTERY)
+    ):
+        return (
+            f"expected its version's files as lists of paths by table ({', '.join(FILE_KEYS)}), a battery table first"
+        )
+    for names in files.values():
+        for rel in names:
+            if not (isinstance(rel, str) and _inside_tables(rel)):
+                return f"expected a table file of the dataset, got {str(rel)[:80]!r}"
+            if not (out / rel).is_file():
+                return f"names a file that is missing: {rel[:80]}"
+    return None
+
+
+def _inside_tables(rel: str) -> bool:
+    parts = rel.split("/")
+    return (
+        len(parts) >= 3
+        and parts[0] in TABLE_FOLDERS
+        and all(p not in ("", ".", "..") and "\\" not in p for p in parts)
+        and rel.endswith(".parquet")
+    )
 
 
 def _markers(out: Path) -> list[dict[str, Any]]:
@@ -70,7 +125,12 @@ def marker_files(out: Path, manifest: Mapping[str, Any]) -> dict[str, list[str]]
 
 def _current(markers: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """The markers of logs no other marker replaces (a log exported again once it grew: :func:`retire`)."""
-    replaced = {str(m["replaces"]) for m in markers if m.get("replaces")}
+    source = {str(m.get("log")): m.get("source") for m in markers}
+    # a log replaces only an earlier export of the same source (it grew): a marker naming another's log, damaged
+    # or crafted, must not hide (and have the next run delete) a flight that is not its own
+    replaced = {
+        str(m["replaces"]) for m in markers if m.get("replaces") and source.get(str(m["replaces"])) == m.get("source")
+    }
     return [m for m in markers if str(m.get("log")) not in replaced]
 
 

@@ -136,7 +136,8 @@ class DataflashLog:
                     scales[name] = _scales(name, getattr(msg, "fmt", None))
                 offset = max(0, int(reader.offset) - length)
                 stamp = getattr(msg, "_timestamp", None)
-                clock = round(stamp * 1e6) if isinstance(stamp, float | int) and math.isfinite(stamp) else None
+                good = isinstance(stamp, float | int) and math.isfinite(stamp) and 0 <= stamp * 1e6 < MAX_TIME_US
+                clock = round(stamp * 1e6) if good else None
                 yield DataflashMessage(name, index, offset, _time_us(values), values, scales[name], clock)
                 index += 1
         finally:
@@ -238,11 +239,17 @@ def _fd_captured() -> Iterator[Callable[[], str]]:
             captured = sink.read(65536).decode("utf-8", "replace")
 
 
+# beyond this a record's time is damage, not a time (2^62 us: 146,000 years since boot), and the clock columns,
+# microseconds in int64 plus a UTC offset, could not hold it
+MAX_TIME_US = 1 << 62
+
+
 def _time_us(values: Mapping[str, Any]) -> int | None:
     for name, scale in (("TimeUS", 1), ("TimeMS", 1000)):
         value = values.get(name)
         if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
-            return int(value) * scale
+            us = int(value) * scale
+            return us if 0 <= us < MAX_TIME_US else None
     return None
 
 
