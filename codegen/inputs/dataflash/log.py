@@ -136,8 +136,9 @@ class DataflashLog:
                     scales[name] = _scales(name, getattr(msg, "fmt", None))
                 offset = max(0, int(reader.offset) - length)
                 stamp = getattr(msg, "_timestamp", None)
-                good = isinstance(stamp, float | int) and math.isfinite(stamp) and 0 <= stamp * 1e6 < MAX_TIME_US
-                clock = round(stamp * 1e6) if good else None
+                clock = None
+                if isinstance(stamp, float | int) and math.isfinite(stamp) and 0 <= stamp * 1e6 < MAX_TIME_US:
+                    clock = round(stamp * 1e6)
                 yield DataflashMessage(name, index, offset, _time_us(values), values, scales[name], clock)
                 index += 1
         finally:
