@@ -344,6 +344,6 @@ def test_fleet_cell_columns_say_what_the_battery_figures_say() -> None:
     cell, imbalance = view.header.index("min cell [V]"), view.header.index("max imbalance [mV]")
     assert item.batteries and all(s.cells_split_evenly for s in item.batteries)
     for row, s in zip(view.rows, item.batteries, strict=True):
-        figures = dict(compute(s).rows(per_cell=not s.cells_split_evenly))
+        figures = dict(compute(s).rows(per_cell=s.has_cell_data))
         assert figures["max cell imbalance"] == NO_CELLS
         assert row[cell] == row[imbalance] == "—"

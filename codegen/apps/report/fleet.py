@@ -84,7 +84,7 @@ def fleet_view(inputs: Sequence[InputSeries]) -> FleetView:
         firmware = item.context.firmware if item.context is not None else None
         for s in item.batteries:
             f = compute(s)
-            per_cell = not s.cells_split_evenly
+            per_cell = s.has_cell_data
             rows.append(_row(PurePath(item.source).name, dates[flight], firmware, s.label, s.serial, f, per_cell))
             if s.serial:
                 x: int | str = (dates[flight] or "") if dated else flight + 1

@@ -90,7 +90,7 @@ def _section(
         "plot_id": plot_id,
         "label": s.label,
         "serial": s.serial,
-        "figures": compute(s, thresholds).rows(per_cell=not s.cells_split_evenly),
+        "figures": compute(s, thresholds).rows(per_cell=s.has_cell_data),
         "cells_note": cells_note,
         "events": [{"t": e.t, "level": e.level, "text": e.text, "css": _CSS.get(e.level, "")} for e in events],
         "warnings": [{"t": w.t, "level": w.level, "css": _CSS.get(w.level.upper(), "")} for w in warnings],

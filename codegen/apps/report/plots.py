@@ -49,7 +49,7 @@ def _rows(s: BatterySeries) -> list[tuple[str, str, list[tuple[str, NDArray]]]]:
         ("state of charge", "%", [("state of charge", s.state_of_charge)]),
         ("temperature", "°C", [("temperature", s.temperature)]),
     ]
-    if not s.cells_split_evenly:
+    if s.has_cell_data:
         rows += [
             ("cells", "V", [(f"cell {k + 1}", s.cell(k)) for k in range(s.cell_count)]),
             ("cell imbalance", "mV", [("max - min", s.imbalance * 1000)]),
@@ -147,19 +147,7 @@ def figure(
     for m in markers:
         colour = LEVEL_COLOURS.get(m.level, "#555")
         layout["shapes"].append(_across(m.t, {"color": colour, "width": 2}, f"failsafe {m.level}"))
-        layout["annotations"].append(
-            {
-                "xref": "x",
-                "x": m.t,
-                "yref": "paper",
-                "y": 1.0,
-                "text": m.level,
-                "showarrow": False,
-                "yanchor": "bottom",
-                "hovertext": m.text,
-                "font": {"color": colour, "size": 11},
-            }
-        )
+        layout["annotations"].append(_label(m.t, 1.0, m.level, colour, 11, yanchor="bottom", hovertext=m.text))
     for key in list(layout):
         if key.startswith("xaxis") and layout[key].get("matches") is None:
             layout[key].pop("matches", None)
@@ -217,6 +205,12 @@ def _across(t: float, line: dict[str, Any], name: str) -> dict[str, Any]:
     }
 
 
+def _label(t: float, y: float, text: str, colour: str, size: int, **placed: Any) -> dict[str, Any]:
+    """A marker's name at ``t`` s, ``y`` of the plot's height; ``placed``: plotly's anchors, shifts, hover text."""
+    where = {"xref": "x", "x": t, "yref": "paper", "y": y, "text": text, "showarrow": False}
+    return where | placed | {"font": {"color": colour, "size": size}}
+
+
 def _band(x0: float, x1: float, y0: float, y1: float, fill: str, name: str, **style: Any) -> dict[str, Any]:
     """A rectangle from ``x0`` to ``x1`` s, ``y0`` to ``y1`` of the plot's height."""
     box = {"type": "rect", "xref": "x", "x0": x0, "x1": x1, "yref": "paper", "y0": y0, "y1": y1}
@@ -239,19 +233,8 @@ def _warnings(layout: dict[str, Any], changes: Sequence[WarningChange]) -> None:
         if w.level in seen or w.level == "none":  # back to none: the line says it
             continue
         seen.add(w.level)
-        layout["annotations"].append(
-            {
-                "xref": "x",
-                "x": w.t,
-                "yref": "paper",
-                "y": 0,
-                "text": f"log: {w.level}",
-                "showarrow": False,
-                "yanchor": "top",
-                "yshift": -12 * (len(seen) - 1),  # first low, critical, emergency: often seconds apart
-                "font": {"color": colour, "size": 10},
-            }
-        )
+        shift = -12 * (len(seen) - 1)  # first low, critical, emergency: often seconds apart
+        layout["annotations"].append(_label(w.t, 0, f"log: {w.level}", colour, 10, yanchor="top", yshift=shift))
 
 
 def _modes(layout: dict[str, Any], modes: Sequence[tuple[float, str]], end: float) -> None:
@@ -270,19 +253,8 @@ def _modes(layout: dict[str, Any], modes: Sequence[tuple[float, str]], end: floa
         )
         if same or (stop - start) / span < 0.02:  # no label on a sliver: it would overprint the next
             continue
-        layout["annotations"].append(
-            {
-                "xref": "x",
-                "x": start,
-                "yref": "paper",
-                "y": 1.0175,
-                "text": base,
-                "showarrow": False,
-                "xanchor": "left",
-                "hovertext": f"{name} from {start:.1f} s",
-                "font": {"size": 9, "color": "#37474f"},
-            }
-        )
+        hover = f"{name} from {start:.1f} s"
+        layout["annotations"].append(_label(start, 1.0175, base, "#37474f", 9, xanchor="left", hovertext=hover))
     if modes:
         layout["margin"]["t"] = max(layout["margin"]["t"], 60)
 
@@ -293,19 +265,7 @@ def _events(layout: dict[str, Any], events: Sequence[tuple[float, str]]) -> None
     for t, what in events:
         style = {"color": EVENT_COLOUR, "width": 1, "dash": "longdash"}
         layout["shapes"].append(_across(t, style, f"log event {what}"))
-        layout["annotations"].append(
-            {
-                "xref": "x",
-                "x": t,
-                "yref": "paper",
-                "y": 1.0,
-                "text": "ev",
-                "showarrow": False,
-                "yanchor": "top",
-                "hovertext": what,
-                "font": {"color": EVENT_COLOUR, "size": 9},
-            }
-        )
+        layout["annotations"].append(_label(t, 1.0, "ev", EVENT_COLOUR, 9, yanchor="top", hovertext=what))
 
 
 def _failsafes(layout: dict[str, Any], failsafes: Sequence[tuple[float, str]]) -> None:
@@ -314,16 +274,5 @@ def _failsafes(layout: dict[str, Any], failsafes: Sequence[tuple[float, str]]) -
         style = {"color": FAILSAFE_COLOUR, "width": 2, "dash": "dashdot"}
         layout["shapes"].append(_across(t, style, f"log failsafe {what}"))
         layout["annotations"].append(
-            {
-                "xref": "x",
-                "x": t,
-                "yref": "paper",
-                "y": 0.5,
-                "text": "log failsafe",
-                "textangle": -90,
-                "showarrow": False,
-                "xanchor": "right",
-                "hovertext": what,
-                "font": {"color": FAILSAFE_COLOUR, "size": 10},
-            }
+            _label(t, 0.5, "log failsafe", FAILSAFE_COLOUR, 10, textangle=-90, xanchor="right", hovertext=what)
         )

@@ -125,6 +125,11 @@ class BatterySeries:
     def cell(self, k: int) -> NDArray:
         return np.asarray(self.cells[:, k], np.float64)
 
+    @property
+    def has_cell_data(self) -> bool:
+        """Whether the cells are measured: the one rule the page's figures and plots and the fleet table follow."""
+        return not self.cells_split_evenly
+
     @functools.cached_property
     def cells_split_evenly(self) -> bool:
         """Whether the cells are no measurement: every sample's known cells equal to each other and the pack voltage
