@@ -237,3 +237,21 @@ def test_strict_leaves_out_what_a_log_lacks_as_validate_does(tmp_path: Path) -> 
     assert checked == 0 and "max_error" in notes  # named among the fields not checked
     assert converted in (0, 1) and "--policy strict" not in err, err
     assert out.read_text(encoding="utf-8").count("\n") == 13
+
+
+@pytest.mark.parametrize(("consumed", "fires"), [(2**31 - 1, True), (2**31, False), (950, True)])
+def test_the_failsafe_acts_on_no_charge_validate_refuses(tmp_path: Path, consumed: int, fires: bool) -> None:
+    """A MAVLink current_consumed of 2^31 does not fit its int32 (validate's error): no drawn charge, no LOW; the
+    int32 limit itself is a value the field holds and acts as any other."""
+    params = tmp_path / "m.param"
+    params.write_text("BATT_MONITOR 4\nBATT_CAPACITY 1000\nBATT_LOW_MAH 100\nBATT_FS_LOW_ACT 2\n", encoding="utf-8")
+    data = {"voltages": [16000] + [65535] * 9, "current_battery": 200}
+    samples = [
+        {"t": t, "armed": True, "message": "mavlink.BATTERY_STATUS", "data": {**data, "current_consumed": c}}
+        for t, c in [(1, 100), (2, 100), *((t, consumed) for t in range(3, 10))]
+    ]
+    stream = tmp_path / "s.jsonl"
+    stream.write_text("".join(json.dumps(s) + "\n" for s in samples), encoding="utf-8")
+    code, out, err = run_main(["failsafe", "--vehicle", "copter", "--params", str(params), str(stream)])
+    assert code == 0, err
+    assert ("LOW" in out) is fires, out

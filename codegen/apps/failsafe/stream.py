@@ -59,22 +59,30 @@ ROLES: dict[str, dict[str, str]] = {
     },
     "dronecan.uavcan.equipment.power.BatteryInfo": {"voltage": "voltage", "current": "current"},
 }
-# which field gives which quantity of the reading, per message: a value validate refuses there is no reading
-_READS: dict[str, dict[str, str]] = {
-    name: {
-        field: {"voltage": "voltage_v", "cells": "voltage_v", "cells_ext": "voltage_v", "current": "current_a"}.get(
-            role, "consumed_mah"
-        )
-        for role, field in roles.items()
-    }
-    for name, roles in ROLES.items()
+# which field gives which quantity of a reading, per message: a value validate refuses there is no reading
+_UORB_READS = {
+    "voltage_v": "voltage_v",
+    "current_a": "current_a",
+    "discharged_mah": "consumed_mah",
+    "remaining": "remaining_mah",
+    "capacity": "remaining_mah",
 }
-_READS["uorb.BatteryStatus"] |= {"remaining": "remaining_mah", "capacity": "remaining_mah"}
-_READS["uorb.BatteryStatusV0"] |= {"remaining": "remaining_mah", "capacity": "remaining_mah"}
-_READS["mavlink.BATTERY_STATUS"] |= {"battery_remaining": "remaining_mah"}
-_READS["dronecan.uavcan.equipment.power.BatteryInfo"] |= {
-    "state_of_charge_pct": "remaining_mah",
-    "full_charge_capacity_wh": "remaining_mah",
+_READS: dict[str, dict[str, str]] = {
+    "uorb.BatteryStatus": _UORB_READS,
+    "uorb.BatteryStatusV0": _UORB_READS,
+    "mavlink.BATTERY_STATUS": {
+        "voltages": "voltage_v",
+        "voltages_ext": "voltage_v",
+        "current_battery": "current_a",
+        "current_consumed": "consumed_mah",
+        "battery_remaining": "remaining_mah",
+    },
+    "dronecan.uavcan.equipment.power.BatteryInfo": {
+        "voltage": "voltage_v",
+        "current": "current_a",
+        "state_of_charge_pct": "remaining_mah",
+        "full_charge_capacity_wh": "remaining_mah",
+    },
 }
 _OPTIONAL = {"distance_to_home_m": float, "travelled_m": float, "home_set": bool, "position_fix": bool}
 
@@ -103,8 +111,9 @@ ENDPOINTS: dict[str, str] = {
 
 
 class _Converters(Protocol):
-    """What the failsafe takes of a generated package's ``convert`` module (not the conversion app: it judges
-    records by validate's gate, which reads the failsafe's parameter checks)."""
+    """What the failsafe takes of a generated package's ``convert`` module. Not the conversion app's protocol:
+    importing it would close a cycle (strict conversion judges records by validate's gate, and validate imports
+    the failsafe's parameter checks)."""
 
     def converter(self, source: str, target: str) -> Callable[..., object]: ...
 

@@ -64,15 +64,16 @@ def errors(
     gate: Waivers | None = None,
 ) -> list[Violation]:
     """The violations validate reports as errors of a record: not warnings, not left out (``rules``, or what
-    gives them: asked for only when the record lacks a field), not waived by ``gate``."""
+    gives them: asked for only when a cross-field rule broke in a record lacking a field), not waived by
+    ``gate``."""
     out = []
     for v in violations:
         if v.severity == "warning":
             continue
         if skip:
-            if callable(rules):
+            if callable(rules) and str(v.rule).startswith(CROSS):  # only a cross-field rule asks what it reads
                 rules = rules()
-            if left_out(v, skip, rules or {}):
+            if left_out(v, skip, {} if callable(rules) or rules is None else rules):
                 continue
         if gate is not None and gate.why_not(str(v.rule), str(v.path)) is not None:
             continue
