@@ -10,7 +10,11 @@ BatteryInfo -- for NaN, +-inf, +-0, the smallest denormal, each type's limits an
   no reading, nor is the field's sentinel as the field stores it (a float32 voltage of 5e-324 is 0.0, uORB's
   unknown); any other value is read as the field stores it.
 
-Where they may differ, and why, is in :data:`EXPLAINED` (empty: none differ today).
+Where they may differ, and why, is in :data:`EXPLAINED` (empty: none differ today). Not compared here: a binary
+log replayed through the battery view (``failsafe`` on a .ulg/.tlog). Its values are as the fields store them
+(none beyond its type, so none of the type-bound cases arise), NaN is unknown there as here, but a value within
+the type that validate refuses by range (a logged ``remaining`` of 2.0, a tlog ``battery_remaining`` of 101) is
+still read by the view's column mappings.
 """
 
 from __future__ import annotations
