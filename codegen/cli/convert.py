@@ -14,10 +14,12 @@ one warning on stderr, and fields the log lacks keep their defaults), MAVLink te
 with bad CRCs and garbage skipped and summed up in one warning. ``--from``/``--to`` take a side
 name or a message name (``uorb.BatteryStatus``, ``mavlink.BATTERY_STATUS``).
 
-No real record is refused: a value the target cannot hold (a NaN cell among known ones in
-MAVLink's integer cells) is written as the target's "unknown" with an ``unrepresentable``
-loss entry; each such kind is one line on stderr naming file, record and field, with a count,
-and the exit code is 1. An input without records is exit 1 too (``--allow-empty`` accepts it).
+``--policy strict`` refuses (exit 2) a record ``battgen validate`` finds an error in, as validate judges the
+input (a log's firmware profile, the fields a log lacks left out); no record validate accepts is refused: a
+value the target cannot hold (a NaN cell among known ones in MAVLink's integer cells) is written as the
+target's "unknown" with an ``unrepresentable`` loss entry; each such kind is one line on stderr naming file,
+record and field, with a count, and the exit code is 1. An input without records is exit 1 too
+(``--allow-empty`` accepts it).
 """
 
 from __future__ import annotations

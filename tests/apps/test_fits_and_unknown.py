@@ -31,12 +31,14 @@ def _clamped(result: dict[str, Any]) -> dict[str, str]:
     return {e["field"].rsplit(".", 1)[-1]: e.get("detail", "") for e in result["loss"] if e["kind"] == "clamped"}
 
 
+# a uORB record validate accepts (max_error: PX4's range is 1..100, its default 0 is refused)
+VALID_UORB = {"timestamp": 1, "voltage_v": 12.0, "max_error": 1}
+
+
 @pytest.mark.parametrize(
     ("value", "field", "expected"),
     [
         ({"temperature": 400.0}, "temperature", 32766),  # INT16_MAX is MAVLink's unknown temperature
-        ({"remaining": -5.0}, "battery_remaining", 0),  # -1 is its unknown; the rule allows 0..100
-        ({"remaining": 2.0}, "battery_remaining", 100),
         ({"current_a": 3e36}, "current_battery", 32767),  # a float32 current no int16 holds
         ({"current_a": -3e36}, "current_battery", -32768),
     ],
@@ -44,27 +46,46 @@ def _clamped(result: dict[str, Any]) -> dict[str, str]:
 def test_uorb_to_mavlink_clamps_into_what_the_target_allows(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, value: dict[str, float], field: str, expected: int
 ) -> None:
-    record = {"timestamp": 1, "voltage_v": 12.0, **value}
+    record = {**VALID_UORB, **value}
     code, (result,), _ = _convert(capsys, tmp_path, "uorb.BatteryStatus", "mavlink.BATTERY_STATUS", record)
     assert code == 0
     assert result["record"][field] == expected
     assert field in _clamped(result)
 
 
+@pytest.mark.parametrize(
+    ("target", "field"),
+    [
+        ("mavlink.BATTERY_STATUS", "battery_remaining"),
+        ("dronecan.uavcan.equipment.power.BatteryInfo", "state_of_charge_pct"),
+    ],
+)
+@pytest.mark.parametrize(("charge", "expected"), [(2.0, 100), (-0.05, 0)])
+def test_a_charge_beyond_full_or_empty_clamps_into_range_not_onto_the_unknown(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, target: str, field: str, charge: float, expected: int
+) -> None:
+    """From the shared state (a uORB ``remaining`` of 2.0 is validate's error, so strict refuses it): MAVLink's
+    unknown is -1 and DroneCAN's 127, the ranges 0..100."""
+    record = {"pack_voltage": 12.0, "state_of_charge": charge}
+    code, (result,), _ = _convert(capsys, tmp_path, "concepts", target, record)
+    assert code == 0
+    held = result["record"].get("info", result["record"])
+    assert held[field] == expected
+    assert field in _clamped(result)
+
+
 def test_a_charge_above_full_is_100_percent_in_dronecan_not_its_unknown(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
-    record = {"timestamp": 1, "voltage_v": 12.0, "remaining": 2.0}
-    code, (result,), _ = _convert(
-        capsys, tmp_path, "uorb.BatteryStatus", "dronecan.uavcan.equipment.power.BatteryInfo", record
-    )
+    record = {"pack_voltage": 12.0, "state_of_charge": 2.0}
+    code, (result,), _ = _convert(capsys, tmp_path, "concepts", "dronecan.uavcan.equipment.power.BatteryInfo", record)
     assert code == 0
     assert result["record"]["info"]["state_of_charge_pct"] == 100  # 127 would read as unknown
     assert "state_of_charge_pct" in _clamped(result)
 
 
 def test_clamped_mavlink_output_passes_the_validator(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
-    record = {"timestamp": 1, "voltage_v": 12.0, "temperature": 400.0, "remaining": -5.0, "current_a": 3e36}
+    record = {**VALID_UORB, "temperature": 400.0, "current_a": 3e36}
     _, (result,), _ = _convert(capsys, tmp_path, "uorb.BatteryStatus", "mavlink.BATTERY_STATUS", record)
     converted = tmp_path / "out.jsonl"
     converted.write_text(json.dumps(result["record"]) + "\n", encoding="utf-8")
@@ -80,6 +101,9 @@ def test_clamped_mavlink_output_passes_the_validator(capsys: pytest.CaptureFixtu
             "current_battery = 70000 cA does not fit int16 (-32768..32767)",
         ),
         ("uorb.BatteryStatus", {"voltage_v": 12.0, "current_a": math.inf}, "current_a = inf is not a finite number"),
+        ("uorb.BatteryStatus", {**VALID_UORB, "remaining": 2.0}, "remaining = 2 is above the maximum 1"),
+        ("uorb.BatteryStatus", {**VALID_UORB, "voltage_v": math.nan}, "voltage_v is NaN, which is not allowed here"),
+        ("mavlink.BATTERY_STATUS", {"battery_remaining": 101}, "battery_remaining = 101"),
     ],
 )
 def test_strict_refuses_what_validate_refuses(

@@ -52,7 +52,7 @@ def test_yaml_in_and_out_with_a_multi_message_side(tmp_path: Path, capsys: pytes
     data = yaml.safe_load(out)
     assert data["cell_count"] == 3 and data["voltage_cell_v"][:3] == [pytest.approx(3.7)] * 3
     back = tmp_path / "uorb.json"
-    back.write_text(json.dumps({"voltage_v": 11.1, "id": 2}))
+    back.write_text(json.dumps({"voltage_v": 11.1, "id": 2, "max_error": 1}))  # a record validate accepts
     code, out, err = run(capsys, "convert", "--from", "uorb", "--to", "dronecan", "--out-format", "yaml", str(back))
     assert code == 0, err
     data = yaml.safe_load(out)

@@ -253,6 +253,9 @@ def test_raw_mavlink_stream_through_the_stream_parser(capsys: pytest.CaptureFixt
     assert report["violations"][0]["location"]["frame"] == 4
     (tmp_path / "capture.mav").write_bytes(data)
     code, lines, err = run(capsys, "convert", "--from", "mavlink", "--to", "uorb", str(tmp_path / "capture.mav"))
+    assert code == 2 and "cannot convert (--policy strict)" in err  # strict refuses the record validate refuses
+    mav = str(tmp_path / "capture.mav")
+    code, lines, err = run(capsys, "convert", "--from", "mavlink", "--to", "uorb", "--policy", "px4", mav)
     assert code == 0 and len(lines) == records and "1 BATTERY_STATUS frames with a bad CRC" in err
 
 

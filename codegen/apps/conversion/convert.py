@@ -34,6 +34,7 @@ from ...inputs.records import InputError, Item, Notice, Record, Unreadable
 from ...ir.numbers import to_json_data
 from ..schemas.package import bundled_schemas, load_schemas, named_package, package_module
 from .senders import find_sender
+from .strict import StrictCheck
 
 FORMATS = ("json", "jsonl", "yaml", "hex", "raw")
 BINARY_FORMATS = ("hex", "raw")
@@ -245,22 +246,6 @@ def _carried(result: object, report: object, field: str) -> float | None:
     return None
 
 
-TYPE_BOUNDS = "type-bounds"  # the generated validators' rule: a value its field's type cannot hold
-
-
-def _refuse_unfit(objs: Sequence[object], item: Record) -> None:
-    """A source value its field's type cannot hold (a MAVLink ``current_battery`` of 70000: no int16) is the
-    validator's error, and strict converts nothing of such a record: no encoder would write it either."""
-    for obj in objs:
-        check = getattr(obj, "validate", None)
-        for violation in check() if callable(check) else ():
-            if getattr(violation, "rule", None) == TYPE_BOUNDS:
-                message = getattr(violation, "message", str(violation))
-                raise fail(
-                    item.file, item.line, f"record {item.index + 1}: cannot convert (--policy strict): {message}"
-                )
-
-
 class Conversion:
     """One converter of a generated package, checked: the pair exists, has the policy."""
 
@@ -297,6 +282,7 @@ class Conversion:
                 f"{self.source_name} -> {self.target_name} has no {policy} policy (PX4 has no such code path)"
             )
         self.policy = policy
+        self.bundled = package is None  # the bundled package: the bundled schemas' IR describes its classes
         self.func = self.module.CONVERTERS[key]
         self.inputs_taken: tuple[str, ...] = self.module.INPUTS.get(key, ())
         self.source = Endpoint(self.source_name, self.module.ENDPOINTS[self.source_name])
@@ -326,6 +312,8 @@ class Conversion:
         # an input named <field>_before is state the converter carries from record to record (PX4's
         # discharged-charge integral): unless given, each record gets the previous result's <field>
         carried = [name for name in self.inputs_taken if name.endswith(CARRIED) and name not in extra]
+        # strict refuses a record validate finds an error in, judged as validate judges this kind of input
+        strict = StrictCheck(fmt, bundled=self.bundled) if self.policy == "strict" else None
         for item in self._items(source, where, fmt):
             if isinstance(item, Notice):
                 yield item
@@ -333,13 +321,13 @@ class Conversion:
             if isinstance(item, Unreadable):
                 raise fail(where, item.line, _reworded(item.message, item.reason, fmt))
             objs = self.source.build(item)
-            if self.policy == "strict":  # strict refuses what validate refuses of the values' types
-                _refuse_unfit(objs, item)
             # always kept: what the target could not hold is told even without --report (the fields dropped
             # or left unknown, alike for every record, only with it)
             report = self.module.LossReport(full=loss is not None)
             if self.sender is not None:
                 objs = self.sender.correct(objs, [a for a, _ in self.source.items], report)
+            if strict is not None:  # after a sender's correction: what it meant is what is converted
+                strict.refuse(objs, item)
             try:
                 result = self.func(*objs, policy=self.policy, report=report, **extra)
             except self.module.ConversionError as exc:
@@ -501,7 +489,13 @@ def _source(item: Record, where: str) -> dict[str, object]:
 def _located(record: Record, where: str) -> Record:
     """A log record whose errors name the input and the record: ``file (topic multi_id 0, ...)``."""
     return Record(
-        record.index, 0, None, f"{where} ({record.where})", instance=record.instance, location=record.location
+        record.index,
+        0,
+        None,
+        f"{where} ({record.where})",
+        instance=record.instance,
+        location=record.location,
+        skip=record.skip,  # the fields the log lacks: strict judges them as validate does, not at all
     )
 
 

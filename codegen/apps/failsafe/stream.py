@@ -28,7 +28,7 @@ import re
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from types import ModuleType
-from typing import Any, cast
+from typing import Any, Protocol, cast
 
 from ...errors import BattgenError, LocatedError
 from ...frontends.loader import load
@@ -38,7 +38,7 @@ from ...inputs.parameters import files as parameter_files
 from ...inputs.records import Record, Unreadable
 from ...ir import Schema
 from ..battery.sources import FloatFields, float_fields, stored_data
-from ..conversion.convert import ConvertModule
+from ..schemas.fits import errors
 from ..schemas.messages import resolve_message
 from ..schemas.package import bundled_schemas, model_class, model_package
 from .columnar import replay_columns
@@ -58,6 +58,31 @@ ROLES: dict[str, dict[str, str]] = {
         "consumed": "current_consumed",
     },
     "dronecan.uavcan.equipment.power.BatteryInfo": {"voltage": "voltage", "current": "current"},
+}
+# which field gives which quantity of a reading, per message: a value validate refuses there is no reading
+_UORB_READS = {
+    "voltage_v": "voltage_v",
+    "current_a": "current_a",
+    "discharged_mah": "consumed_mah",
+    "remaining": "remaining_mah",
+    "capacity": "remaining_mah",
+}
+_READS: dict[str, dict[str, str]] = {
+    "uorb.BatteryStatus": _UORB_READS,
+    "uorb.BatteryStatusV0": _UORB_READS,
+    "mavlink.BATTERY_STATUS": {
+        "voltages": "voltage_v",
+        "voltages_ext": "voltage_v",
+        "current_battery": "current_a",
+        "current_consumed": "consumed_mah",
+        "battery_remaining": "remaining_mah",
+    },
+    "dronecan.uavcan.equipment.power.BatteryInfo": {
+        "voltage": "voltage_v",
+        "current": "current_a",
+        "state_of_charge_pct": "remaining_mah",
+        "full_charge_capacity_wh": "remaining_mah",
+    },
 }
 _OPTIONAL = {"distance_to_home_m": float, "travelled_m": float, "home_set": bool, "position_fix": bool}
 
@@ -85,13 +110,21 @@ ENDPOINTS: dict[str, str] = {
 }
 
 
-def _converters(model: GeneratedMessage) -> ConvertModule | None:
+class _Converters(Protocol):
+    """What the failsafe takes of a generated package's ``convert`` module. Not the conversion app's protocol:
+    importing it would close a cycle (strict conversion judges records by validate's gate, and validate imports
+    the failsafe's parameter checks)."""
+
+    def converter(self, source: str, target: str) -> Callable[..., object]: ...
+
+
+def _converters(model: GeneratedMessage) -> _Converters | None:
     """The converters of the generated package ``model``'s class belongs to, if it has them."""
     try:
         module: ModuleType = importlib.import_module(package_name(cast(MessageClass, type(model))) + ".convert")
     except ImportError:
         return None
-    return cast(ConvertModule, module)
+    return cast(_Converters, module)
 
 
 def battery_state(qualified_name: str, model: GeneratedMessage) -> BatteryReading:
@@ -237,10 +270,26 @@ class Reader:
         try:
             # as the fields store them: a float32 voltage of 5e-324 is 0.0, the unknown, as the export reads it
             model = cls.from_dict(stored_data(floats, data))
-            battery = battery_state(qualified, model)
+            battery = known_only(qualified, model, battery_state(qualified, model))
         except (ValueError, BattgenError) as exc:
             raise fail(f"expected {qualified} data: {exc}") from None
         return Sample(line, float(t), armed, battery, qualified, data, extra, instance or _instance_of(qualified, data))
+
+
+def known_only(qualified_name: str, model: GeneratedMessage, reading: BatteryReading) -> BatteryReading:
+    """The reading without the quantities whose field holds a value validate refuses (:mod:`..schemas.fits`: one
+    meaning of "fits"): a voltage beyond float32, a MAVLink current beyond int16, a NaN where the schema's unknown
+    is another value is no measurement, and the failsafe reads it as unknown, as it reads the field's sentinel
+    (never as a level to fire on)."""
+    reads = _READS.get(qualified_name)
+    check = getattr(model, "validate", None)
+    if reads is None or not callable(check):
+        return reading
+    found = check()
+    if not found:
+        return reading
+    unknown = {reads[f] for v in errors(found) if (f := str(v.path).split("[", 1)[0].split(".", 1)[0]) in reads}
+    return dataclasses.replace(reading, **dict.fromkeys(unknown)) if unknown else reading
 
 
 def open_reader(schema_dir: Path | None, default_message: str | None = None) -> Reader:

@@ -212,6 +212,12 @@ def for_firmware(chosen: Settings, autopilot: str | None, firmware: str | None =
     return dataclasses.replace(chosen, profile=load_profile(autopilot), profile_from=why)
 
 
+def firmware_gate(message: str, kind: str | None) -> Gate:
+    """Validate's gate for a file of this kind when nothing is asked for: the bundled profile of the firmware
+    that writes such files (a ULog: PX4's), else none (``convert --policy strict`` judges records by it)."""
+    return Gate(for_firmware(Settings(), KIND_FIRMWARE.get(kind) if kind is not None else None), message)
+
+
 @dataclass(frozen=True)
 class Names:
     """What a selector may name for one message: its rules (cross-field ones by their full and short names) and

@@ -22,12 +22,11 @@ from ...inputs.files.kinds import KIND_FORMATS, file_kind
 from ...inputs.model import GeneratedMessage, MessageClass, Violation
 from ...inputs.records import Notice, Record, Unreadable
 from ...ir import Message, Schema, SourceFormat
-from ...ir.expr import referenced_fields
 from ...ir.numbers import to_json_data
-from ...ir.rules import bound_rules
 from ...text.brief import brief, clip, reportable
 from ..failsafe.checks import NONNEGATIVE, check_settings
 from ..failsafe.vehicles import detect_vehicle
+from ..schemas.fits import left_out, rule_fields
 from ..schemas.messages import BATTERY_MESSAGES, DATAFLASH_NOTE, resolve_message
 from ..schemas.package import data_error, load_schemas, model_class, model_package
 from .selection import Gate
@@ -108,22 +107,6 @@ def extra_check(message: Message) -> ExtraCheck | None:
     if message.format is SourceFormat.PDEF and set(NONNEGATIVE) <= names:
         return failsafe_check
     return None
-
-
-def rule_fields(schema: Schema, message: Message) -> dict[str, frozenset[str]]:
-    """Cross-field rule id -> the fields it reads (is_known() arguments included)."""
-    out: dict[str, frozenset[str]] = {}
-    for bound in bound_rules(schema, message):
-        exprs = [bound.where, bound.check, bound.path, *(e for _, e in bound.bindings)]
-        exprs += [p for p in bound.message if not isinstance(p, str)]
-        names = {n for e in exprs for n in referenced_fields(e, skip_is_known=False)}
-        out[bound.rule.id] = frozenset(names)
-    return out
-
-
-def _covers(skip: frozenset[str], path: str) -> bool:
-    """True when ``path`` (``a``, ``a[3]``, ``a.b``) lies in a skipped field."""
-    return any(path == s or path.startswith((s + ".", s + "[")) for s in skip)
 
 
 class Checker:
@@ -220,10 +203,7 @@ class Checker:
         return sorted(findings, key=lambda f: dt_problems.order_key(self.message, data, f.path, f.rule))
 
     def _skipped(self, v: Violation, skip: frozenset[str]) -> bool:
-        rule = str(v.rule)
-        if rule.startswith("cross-field:") and self.rules.get(rule[len("cross-field:") :], frozenset()) & skip:
-            return True
-        return _covers(skip, str(v.path))
+        return left_out(v, skip, self.rules)  # as convert --policy strict leaves it out (.fits)
 
     def _type_finding(self, record: Record, exc: BaseException) -> Finding:
         # the generated DataError names the field path, what was expected and the value found
