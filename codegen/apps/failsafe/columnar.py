@@ -29,17 +29,20 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import BattgenError
-from ..battery.columns import NDArray
 from .evaluator import DISTANCE, SEED_CRITICAL, BatteryFailsafe, Event
 from .levels import Level
-from .logs import SampleTable
 from .monitor import FLT_EPSILON, MAH_PER_AMP_MS, MAX_INTEGRATION_MS, ResistanceEstimator, Trigger
 from .reading import Sample
 from .settings import MAX_INSTANCES, MONITOR_VOLTAGE_ONLY, VOLTSRC_RESTING, BatterySettings
+
+if TYPE_CHECKING:  # the flight logs' readers and the IR: a JSON Lines stream's replay needs neither
+    from ..battery.columns import NDArray
+    from .logs import SampleTable
 
 
 @dataclass
@@ -94,12 +97,15 @@ def replay_columns(
         return None
     batteries: list[_Battery] = []
     enabled = np.zeros(len(t), bool)
-    for inst in np.unique(instance).tolist():
+    for inst in _instances(instance):
         rows = np.flatnonzero(instance == inst)
         mon = failsafe.monitor(int(inst))
         if mon.settings.enabled:
             enabled[rows] = True
-            batteries.append(_columns(mon.settings, rows, now[rows], volts[rows], amps[rows], mah[rows]))
+            if len(rows) == len(t):  # one battery: its columns are the stream's, not copies of them
+                batteries.append(_columns(mon.settings, rows, now, volts, amps, mah))
+            else:
+                batteries.append(_columns(mon.settings, rows, now[rows], volts[rows], amps[rows], mah[rows]))
     timer = SEED_CRITICAL not in failsafe.variants
     checked = enabled & armed_b
     out: list[tuple[Event, Sample]] = []
@@ -125,6 +131,14 @@ def replay_columns(
             end = row + 1 + int(later[0]) if len(later) else len(t)
             checked[row + 1 : end] = False
     return out
+
+
+def _instances(instance: NDArray) -> list[int]:
+    """The batteries present, in order (of integers counted: ``np.unique`` would import ``numpy.ma``, a tenth of a
+    JSON Lines replay's start-up)."""
+    if instance.dtype.kind in "iu":
+        return np.flatnonzero(np.bincount(instance, minlength=MAX_INSTANCES + 1)).tolist()
+    return [int(i) for i in np.unique(instance).tolist()]
 
 
 def _columns(s: BatterySettings, rows: NDArray, now: NDArray, volts: NDArray, amps: NDArray, mah: NDArray) -> _Battery:
@@ -155,13 +169,13 @@ def _columns(s: BatterySettings, rows: NDArray, now: NDArray, volts: NDArray, am
 def _consumed(now: NDArray, current: NDArray, mah: NDArray) -> NDArray:
     """BatteryMonitor.read's consumed charge at each sample."""
     known = ~np.isnan(mah)
+    if known.all():  # the log's own charge throughout: nothing is integrated
+        return np.where(known, mah, 0.0)
     dt = np.diff(now, prepend=now[:1])
     step = ~known & ~np.isnan(current) & (dt > 0) & (dt < MAX_INTEGRATION_MS)
     step[:1] = False  # the first reading has no interval
     add = np.where(step, current * dt.astype(np.float64) * MAH_PER_AMP_MS, -0.0)
     out = np.where(known, mah, 0.0)
-    if known.all():
-        return out
     # each run of samples without the log's own charge goes on from the value before it
     edges = np.flatnonzero(np.diff(np.concatenate(([False], ~known, [False])).astype(np.int8)))
     for start, stop in zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True):
@@ -191,11 +205,15 @@ def _resting(now: NDArray, voltage: NDArray, current: NDArray, measures: NDArray
 def _timer(condition: NDArray, now: NDArray, timeout_ms: int) -> NDArray:
     """Where a condition held for more than the timeout: runs over the checked samples, started at a run's first."""
     n = len(condition)
-    if timeout_ms <= 0 or not n:
-        return np.zeros(n, bool)
-    first = condition & ~np.concatenate(([False], condition[:-1]))
-    start = np.maximum.accumulate(np.where(first, np.arange(n), 0))
-    return condition & ~first & (now - now[start] > timeout_ms)
+    out = np.zeros(n, bool)
+    at = np.flatnonzero(condition)  # worked out where the condition holds only: most samples are healthy
+    if timeout_ms <= 0 or not len(at):
+        return out
+    first = np.empty(len(at), bool)
+    first[0], first[1:] = True, np.diff(at) != 1
+    start = at[np.maximum.accumulate(np.where(first, np.arange(len(at)), 0))]
+    out[at] = ~first & (now[at] - now[start] > timeout_ms)
+    return out
 
 
 def _next_event(b: _Battery, checked: NDArray, level: Level, timer: bool) -> tuple[int, Trigger] | None:

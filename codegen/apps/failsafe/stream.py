@@ -28,24 +28,21 @@ import re
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from types import ModuleType
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 from ...errors import BattgenError, LocatedError
-from ...frontends.loader import load
-from ...inputs.documents import read_jsonl
-from ...inputs.model import GeneratedMessage, MessageClass, package_name
 from ...inputs.parameters import files as parameter_files
-from ...inputs.records import Record, Unreadable
-from ...ir import Schema
-from ..battery.sources import FloatFields, float_fields, stored_data
-from ..conversion.convert import ConvertModule
-from ..schemas.messages import resolve_message
-from ..schemas.package import bundled_schemas, model_class, model_package
-from .columnar import replay_columns
 from .evaluator import BatteryFailsafe, Event
-from .jsonl_columns import read_sample_columns
 from .reading import BatteryReading, reading_of
 from .reading import Sample as Sample  # where the CLI, the report and the logs' replay import it from
+
+# A plain stream of SI samples needs none of the schemas' machinery (the IR, the frontends, the generated models,
+# the converters: a third of a second of imports): it is imported where a message first asks for it.
+if TYPE_CHECKING:
+    from ...inputs.model import GeneratedMessage, MessageClass
+    from ...ir import Schema
+    from ..battery.sources import FloatFields
+    from ..conversion.convert import ConvertModule
 
 # which field carries what, per message (units come from the IR metadata)
 ROLES: dict[str, dict[str, str]] = {
@@ -87,11 +84,13 @@ ENDPOINTS: dict[str, str] = {
 
 def _converters(model: GeneratedMessage) -> ConvertModule | None:
     """The converters of the generated package ``model``'s class belongs to, if it has them."""
+    from ...inputs.model import package_name
+
     try:
-        module: ModuleType = importlib.import_module(package_name(cast(MessageClass, type(model))) + ".convert")
+        module: ModuleType = importlib.import_module(package_name(cast("MessageClass", type(model))) + ".convert")
     except ImportError:
         return None
-    return cast(ConvertModule, module)
+    return cast("ConvertModule", module)
 
 
 def battery_state(qualified_name: str, model: GeneratedMessage) -> BatteryReading:
@@ -173,6 +172,10 @@ class Reader:
     def model(self, name: str, file: str, line: int) -> tuple[str, MessageClass, FloatFields]:
         """A message name's qualified name, generated class and float fields (resolved once per name)."""
         if name not in self._classes:
+            from ..battery.sources import float_fields
+            from ..schemas.messages import resolve_message
+            from ..schemas.package import model_class
+
             try:
                 msg = resolve_message(self.schema, name)
             except BattgenError as exc:
@@ -181,6 +184,9 @@ class Reader:
         return self._classes[name]
 
     def read(self, path: Path) -> Iterator[Sample]:
+        from ...inputs.documents import read_jsonl
+        from ...inputs.records import Record, Unreadable
+
         file = path.as_posix()
         for item in read_jsonl(path, file, comments=True):  # InputError when the file cannot be opened
             if isinstance(item, Unreadable):
@@ -234,6 +240,8 @@ class Reader:
         if not isinstance(data, dict):
             raise fail(f'expected "data": an object of {name} fields')
         qualified, cls, floats = self.model(name, file, line)
+        from ..battery.sources import stored_data
+
         try:
             # as the fields store them: a float32 voltage of 5e-324 is 0.0, the unknown, as the export reads it
             model = cls.from_dict(stored_data(floats, data))
@@ -248,10 +256,16 @@ def open_reader(schema_dir: Path | None, default_message: str | None = None) -> 
     if schema_dir is None:  # the bundled schemas load: only a stream of messages needs them (samples in SI do not)
 
         def bundled() -> tuple[Schema, ModuleType]:
+            from ...frontends.loader import load
+            from ..schemas.package import bundled_schemas, model_package
+
             schema = load([bundled_schemas()])
             return schema, model_package(schema, bundled_schemas())
 
         return Reader(None, None, default_message, bundled)
+    from ...frontends.loader import load
+    from ..schemas.package import model_package
+
     schema = load([schema_dir])
     return Reader(schema, model_package(schema, schema_dir), default_message)
 
@@ -315,6 +329,9 @@ class Replay:
 
     def _columnar(self, path: Path) -> list[tuple[Event, Sample]] | None:
         """The events of a plain-shaped stream replayed over its columns; None to read it sample by sample."""
+        from .columnar import replay_columns  # numpy, for a plain stream's columns
+        from .jsonl_columns import read_sample_columns
+
         columns = read_sample_columns(path)
         if columns is None:
             return None
