@@ -90,22 +90,28 @@ def replay_columns(
     sample by sample, with the evaluator's errors): the distance variant, a used evaluator, a time that is not
     finite or goes back, a battery outside 1..16."""
     exact = DISTANCE not in failsafe.variants and not failsafe.monitors and not failsafe.events
-    if not exact or not np.isfinite(t).all() or ((instance < 1) | (instance > MAX_INSTANCES)).any():
+    if not exact or not np.isfinite(t).all():
         return None
-    now = np.rint(t * 1000.0).astype(np.int64)
+    if len(instance) and (instance.min() < 1 or instance.max() > MAX_INSTANCES):
+        return None
+    now_ms = t * 1000.0
+    now = np.rint(now_ms, out=now_ms).astype(np.int64)
     if len(now) and (np.diff(now) < 0).any():
         return None
+    n = len(t)
     batteries: list[_Battery] = []
-    enabled = np.zeros(len(t), bool)
-    for inst in _instances(instance):
-        rows = np.flatnonzero(instance == inst)
+    enabled = np.zeros(n, bool)
+    for inst, count in _instances(instance):
         mon = failsafe.monitor(int(inst))
-        if mon.settings.enabled:
+        if not mon.settings.enabled:
+            continue
+        if count == n:  # one battery: its columns are the stream's, not copies of them
+            enabled[:] = True
+            batteries.append(_columns(mon.settings, np.arange(n), now, volts, amps, mah))
+        else:
+            rows = np.flatnonzero(instance == inst)
             enabled[rows] = True
-            if len(rows) == len(t):  # one battery: its columns are the stream's, not copies of them
-                batteries.append(_columns(mon.settings, rows, now, volts, amps, mah))
-            else:
-                batteries.append(_columns(mon.settings, rows, now[rows], volts[rows], amps[rows], mah[rows]))
+            batteries.append(_columns(mon.settings, rows, now[rows], volts[rows], amps[rows], mah[rows]))
     timer = SEED_CRITICAL not in failsafe.variants
     checked = enabled & armed_b
     out: list[tuple[Event, Sample]] = []
@@ -115,7 +121,7 @@ def replay_columns(
             mon = failsafe.monitors[b.settings.instance]
             if mon.failsafe is Level.CRITICAL:
                 continue
-            hit = _next_event(b, checked[b.rows], mon.failsafe, timer)
+            hit = _next_event(b, checked if len(b.rows) == n else checked[b.rows], mon.failsafe, timer)
             if hit is not None and (found is None or b.rows[hit[0]] < found[0]):
                 found = (int(b.rows[hit[0]]), b, hit[1])
         if found is None:
@@ -133,12 +139,15 @@ def replay_columns(
     return out
 
 
-def _instances(instance: NDArray) -> list[int]:
-    """The batteries present, in order (of integers counted: ``np.unique`` would import ``numpy.ma``, a tenth of a
-    JSON Lines replay's start-up)."""
+def _instances(instance: NDArray) -> list[tuple[float, int]]:
+    """The batteries present, in order, and their samples (of integers counted: ``np.unique`` would import
+    ``numpy.ma``, a tenth of a JSON Lines replay's start-up)."""
     if instance.dtype.kind in "iu":
-        return np.flatnonzero(np.bincount(instance, minlength=MAX_INSTANCES + 1)).tolist()
-    return [int(i) for i in np.unique(instance).tolist()]
+        counts = np.bincount(instance, minlength=MAX_INSTANCES + 1)
+        present = np.flatnonzero(counts)
+        return list(zip(present.tolist(), counts[present].tolist(), strict=True))
+    values, counts = np.unique(instance, return_counts=True)
+    return list(zip(values.tolist(), counts.tolist(), strict=True))
 
 
 def _columns(s: BatterySettings, rows: NDArray, now: NDArray, volts: NDArray, amps: NDArray, mah: NDArray) -> _Battery:

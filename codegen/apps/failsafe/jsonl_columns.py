@@ -21,6 +21,7 @@ sample by sample, with its errors, as before.
 from __future__ import annotations
 
 import json
+import math
 import mmap
 import re
 from collections.abc import Callable
@@ -230,20 +231,24 @@ def _read_compiled(path: Path) -> SampleColumns | None:
     lines = _scan(data, literals, slots, columns, armed, starts)
     if lines <= 0:
         return None
+    # min and max tell NaN (they propagate it) and inf without a temporary column; fmin / fmax skip the nulls
     table = columns[:, :lines]
-    t, instance = table[0], table[1] if "instance" in names else np.ones(lines)
+    t = table[0]
+    if not (math.isfinite(t.min()) and math.isfinite(t.max())):
+        return None  # the per-sample reader's error
+    instance = np.ones(lines, np.int64)
+    if "instance" in names:
+        if not (1 <= table[1].min() and table[1].max() <= 16):  # NaN fails both
+            return None  # the per-sample reader's error
+        instance = table[1].astype(np.int64)
     voltage, current, consumed = (
         table[2 + i] if f"battery.{k}" in names else np.full(lines, np.nan) for i, k in enumerate(BATTERY)
     )
-    if not np.isfinite(t).all() or not np.isfinite(instance).all() or ((instance < 1) | (instance > 16)).any():
-        return None  # the per-sample reader's error
     for col in (voltage, current, consumed):
-        if np.isinf(col).any():
+        if np.fmax.reduce(col) == np.inf or np.fmin.reduce(col) == -np.inf:
             return None  # a number beyond a float: the per-sample reader's business
-    int_instance = instance.astype(np.int64)
-    return SampleColumns(
-        t, int_instance, voltage, current, consumed, armed[:lines] == 1, data, starts=starts[: lines + 1]
-    )
+    flags = armed[:lines].view(np.bool_)  # the walk writes 0 or 1
+    return SampleColumns(t, instance, voltage, current, consumed, flags, data, starts=starts[: lines + 1])
 
 
 _U64 = np.uint64
