@@ -115,6 +115,14 @@ def test_both_readings_take_a_final_line_without_its_newline() -> None:
         compiled, numpy = _both(text)
         assert compiled is not None and numpy is not None
         n = len(compiled.t)
+        with tempfile.TemporaryDirectory() as tmp:  # the memory map a replay holding the file reads through
+            path = Path(tmp) / "s.jsonl"
+            path.write_text(text, encoding="utf-8")
+            mapped = read_sample_columns(path, mapped=True)
+            assert mapped is not None and not isinstance(mapped.data, bytes)
+            assert [mapped.line(k) for k in range(n)] == [compiled.line(k) for k in range(n)]
+            assert mapped.voltage.tolist() == compiled.voltage.tolist()
+            mapped.data.close()
         assert n == text.count('{"t"') and [compiled.line(k) for k in range(n)] == [numpy.line(k) for k in range(n)]
 
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 import json
 import math
 import mmap
+import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -108,14 +109,16 @@ def _template(line: bytes) -> tuple[list[str], list[tuple[int, int]]] | None:
 _SLOTS = {"t": 0, "instance": 1, "battery.voltage_v": 2, "battery.current_a": 3, "battery.consumed_mah": 4, "armed": 5}
 
 
-def read_sample_columns(path: Path, compiled: bool = True) -> SampleColumns | None:
+def read_sample_columns(path: Path, compiled: bool = True, mapped: bool = False) -> SampleColumns | None:
     """The stream's samples as columns, or None where it is not one plain shape throughout (``compiled``: through
-    the C walk where it is built)."""
+    the C walk where it is built; ``mapped``: over a memory map of the file rather than its bytes read, for a caller
+    that holds it still while the columns are used, :func:`codegen.inputs.files.held.held`: a map of a file that
+    another program truncates meanwhile kills the process with SIGBUS)."""
     try:
         if path.stat().st_size > MAX_BYTES:
             return None  # read line by line instead: memory stays flat
         if _scan is not None and compiled:
-            return _read_compiled(path)
+            return _read_compiled(path, mapped)
         data = path.read_bytes()
     except OSError:
         return None
@@ -207,13 +210,15 @@ def read_sample_columns(path: Path, compiled: bool = True) -> SampleColumns | No
     return SampleColumns(t, instance.astype(np.int64), voltage, current, consumed, armed, data)
 
 
-def _read_compiled(path: Path) -> SampleColumns | None:
-    """The C walk over the mapped file (OSError where it cannot be mapped)."""
+def _read_compiled(path: Path, mapped: bool) -> SampleColumns | None:
+    """The C walk over the file, mapped or read (OSError where it cannot be)."""
     assert _scan is not None
+    data: bytes | mmap.mmap
     with path.open("rb") as f:
-        if not path.stat().st_size:
+        if not os.fstat(f.fileno()).st_size:
             return None
-        data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)  # the events' lines are read from it later
+        # the events' lines are read from it later
+        data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) if mapped else f.read()
     end = data.find(b"\n")
     first = data[: end if end >= 0 else len(data)]
     found = _template(first)

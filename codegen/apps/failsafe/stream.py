@@ -24,6 +24,7 @@ import dataclasses
 import importlib
 import json
 import math
+import mmap
 import re
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
@@ -329,19 +330,27 @@ class Replay:
 
     def _columnar(self, path: Path) -> list[tuple[Event, Sample]] | None:
         """The events of a plain-shaped stream replayed over its columns; None to read it sample by sample."""
+        from ...inputs.files.held import held
         from .columnar import replay_columns  # numpy, for a plain stream's columns
         from .jsonl_columns import read_sample_columns
 
-        columns = read_sample_columns(path)
-        if columns is None:
-            return None
         file = path.as_posix()
+        # held still (writers wait) while it is read through a map and its events' lines are read from that map
+        with held(path, file) as hold:
+            columns = read_sample_columns(path, mapped=hold.leased)
+            if columns is None:
+                return None
 
-        def sample_at(k: int) -> Sample:
-            return self.reader.sample(json.loads(columns.line(k)), file, k + 1)
+            def sample_at(k: int) -> Sample:
+                return self.reader.sample(json.loads(columns.line(k)), file, k + 1)
 
-        c = columns
-        events = replay_columns(self.failsafe, c.t, c.instance, c.voltage, c.current, c.consumed, c.armed, sample_at)
+            c = columns
+            try:
+                events = replay_columns(self.failsafe, c.t, c.instance, c.voltage, c.current, c.consumed, c.armed,
+                                        sample_at)  # fmt: skip
+            finally:
+                if isinstance(c.data, mmap.mmap):
+                    c.data.close()  # nothing reads it past the hold
         if events is not None:
             self.samples = len(c.t)
         return events
