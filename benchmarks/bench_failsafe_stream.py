@@ -76,8 +76,8 @@ with open(sys.argv[1]) as f:
 """
 BEFORE = (
     "import sys\n"
-    "import codegen.apps.failsafe.stream as stream\n"
-    "stream.read_sample_columns = lambda path: None\n"
+    "import codegen.apps.failsafe.jsonl_columns as columns\n"
+    "columns.read_sample_columns = lambda *args, **kwargs: None\n"
     "from codegen.cli.main import main\n"
     "sys.exit(main(sys.argv[1:]))\n"
 )

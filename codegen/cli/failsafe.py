@@ -50,26 +50,26 @@ import json
 import sys
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ..apps.failsafe.ardupilot_logged import check_log
-from ..apps.failsafe.columnar import replay_table
 from ..apps.failsafe.distance import DistanceRule
 from ..apps.failsafe.evaluator import VARIANTS, Event, make_failsafe
 from ..apps.failsafe.firmware import FIRMWARES, choose_firmware
 from ..apps.failsafe.legacy_parameters import renamed, with_current_names
 from ..apps.failsafe.levels import apply_level
-from ..apps.failsafe.logs import NO_ARMING_NOTE, SampleTable, log_samples, own_parameters
-from ..apps.failsafe.px4_log import NoBatteryRecords, read_px4_log
-from ..apps.failsafe.px4_replay import Px4Event, replay_px4
 from ..apps.failsafe.settings import battery_settings
 from ..apps.failsafe.stream import Replay, Sample, batt_parameter_count, open_reader, read_parameter_values
 from ..apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
 from ..errors import BattgenError, missing_file
-from ..inputs.files.kinds import FLIGHT_LOG_KINDS, detect
 from ..inputs.parameters import files as parameter_files
 from ..text.escape import line
 from .cyphal_options import add_cyphal_subject, check_bundled_subjects
+
+# The flight logs' readers (numpy, pymavlink, python-can, the IR) are imported when the input is a log: a JSON
+# Lines stream of samples is replayed without them, and its start-up is most of what a short stream costs.
+if TYPE_CHECKING:
+    from ..apps.failsafe.logs import SampleTable
+    from ..apps.failsafe.px4_replay import Px4Event
 
 EXIT_OK, EXIT_EMPTY, EXIT_UNREADABLE, EXIT_DIFFERS = 0, 1, 2, 3
 
@@ -123,11 +123,17 @@ def run(args: argparse.Namespace) -> int:
     try:
         # a flight log or capture is read through the battery view; JSON and JSON Lines are sample streams
         table: SampleTable | None = None
-        if detect(stream) in FLIGHT_LOG_KINDS:
+        if _is_flight_log(stream):
+            from ..apps.failsafe.logs import log_samples
+
             table = log_samples(stream, args.stream, args.cyphal_subject)
         if table is not None and table.empty:  # said before the parameters a log without batteries may also lack
             return _no_readings(args)
-        own = own_parameters(table) if table is not None and not args.params else None
+        own = None
+        if table is not None and not args.params:
+            from ..apps.failsafe.logs import own_parameters
+
+            own = own_parameters(table)
         raw: Mapping[str, float] = {}
         if args.params:
             raw = read_parameter_values(Path(args.params))
@@ -175,10 +181,14 @@ def run(args: argparse.Namespace) -> int:
         reader = open_reader(Path(args.schemas) if args.schemas else None, args.message)
         replay = Replay(fs, reader)
         if table is not None and not table.has_arming:
+            from ..apps.failsafe.logs import NO_ARMING_NOTE
+
             print(line(f"battgen: {args.stream}: {NO_ARMING_NOTE}"), file=sys.stderr)
         events: Iterable[tuple[Event, Sample]]
         read = 0
         if table is not None:  # a log: replayed over its columns (the same events as sample by sample)
+            from ..apps.failsafe.columnar import replay_table
+
             events, counts = replay_table(fs, table, args.stream)
             read = sum(counts.values())
         else:
@@ -188,7 +198,11 @@ def run(args: argparse.Namespace) -> int:
         read = replay.samples if table is None else read
         if read == 0:  # a readable input without battery readings: exit 1 like every command (README)
             return _no_readings(args)
-        checks = check_log(stream, args.stream, table, fs.events) if table is not None else []
+        checks = []
+        if table is not None:
+            from ..apps.failsafe.ardupilot_logged import check_log
+
+            checks = check_log(stream, args.stream, table, fs.events)
         for check in checks:
             print(line(f"battgen: check {check.what}: {check.verdict()}"), file=sys.stderr)
     except (BattgenError, ValueError) as exc:
@@ -198,7 +212,18 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_DIFFERS if args.strict and any(c.problems for c in checks) else EXIT_OK
 
 
+def _is_flight_log(stream: Path) -> bool:
+    """Whether the input is a flight log or capture (else a stream of samples), told by content, then extension."""
+    from ..inputs.files.kinds import FLIGHT_LOG_KINDS, detect  # brings the IR's formats: asked once per run
+
+    return detect(stream) in FLIGHT_LOG_KINDS
+
+
 def _run_px4(args: argparse.Namespace, stream: Path, how: str, given: dict[str, float]) -> int:
+    from ..apps.failsafe.px4_log import NoBatteryRecords, read_px4_log
+    from ..apps.failsafe.px4_replay import replay_px4
+    from ..inputs.files.kinds import detect
+
     try:
         if detect(stream) != "ulog":
             raise BattgenError(

@@ -14,7 +14,8 @@ from pathlib import Path
 
 from ..ir import Message, SourceFormat
 from .documents import read_json, read_jsonl, read_yaml
-from .files.kinds import KIND_FORMATS, KIND_HOLDS, file_kind
+from .files.kind_formats import KIND_FORMATS
+from .files.kinds import KIND_HOLDS, file_kind
 from .model import MavlinkClass, MessageClass
 from .records import InputError, Item
 

@@ -12,7 +12,7 @@ import pytest
 
 from codegen.apps.failsafe.checks import check_settings
 from codegen.apps.failsafe.evaluator import BatteryFailsafe, BatteryReading, Event, Level, make_failsafe
-from codegen.apps.failsafe.levels import apply_level
+from codegen.apps.failsafe.levels import MAVLINK_CHARGE_STATE, UORB_WARNING, apply_level
 from codegen.apps.failsafe.monitor import ResistanceEstimator
 from codegen.apps.failsafe.settings import BatterySettings, battery_settings, prefix, split_name
 from codegen.apps.failsafe.vehicles import VEHICLES, Situation, detect_vehicle
@@ -342,6 +342,14 @@ def test_levels_map_onto_uorb_warning_and_mavlink_charge_state() -> None:
     assert crit.mavlink_charge_state == mavlink.MavBatteryChargeState.CRITICAL
     assert low.uorb_warning < crit.uorb_warning
     assert apply_level("mavlink.BATTERY_STATUS", {}, Level.NONE) == {"charge_state": mavlink.MavBatteryChargeState.OK}
+
+
+def test_the_levels_written_out_are_the_generated_enums() -> None:
+    """levels.py writes the enums' values out (importing the generated messages costs a replay's start-up)."""
+    mavlink, uorb = importlib.import_module("generated.mavlink"), importlib.import_module("generated.uorb")
+    warning, state = uorb.BatteryStatusWarning, mavlink.MavBatteryChargeState
+    assert UORB_WARNING == {level: int(warning[level.name]) for level in Level}
+    assert MAVLINK_CHARGE_STATE == {Level.NONE: state.OK, Level.LOW: state.LOW, Level.CRITICAL: state.CRITICAL}
 
 
 def test_time_must_not_go_back() -> None:

@@ -8,11 +8,11 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from ...inputs.files.held import Buffer, held, whole
-from .can_batches import can_batches
 from .catalog import Catalog
-from .dataflash_batches import dataflash_batches
 from .sources import Batch, jsonl_batches, log_kind, model_of, ulog_batches
-from .tlog_batches import tlog_batches
+
+# each log kind's reader is imported when a log of that kind is read: a ULog's replay does not pay for python-can
+# (which the CAN captures' reader imports up front), pymavlink or the DataFlash reader
 
 
 def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
@@ -43,10 +43,16 @@ def read_log(
                 source = whole(path, name)
             yield from ulog_batches(path, name, catalog, source, all_fields)
         elif kind == "tlog":
+            from .tlog_batches import tlog_batches
+
             yield from tlog_batches(path, name, catalog)
         elif kind == "dataflash":
+            from .dataflash_batches import dataflash_batches
+
             yield from dataflash_batches(path, name, catalog)
         elif kind == "can":
+            from .can_batches import can_batches
+
             yield from can_batches(path, name, catalog, model_of, subjects)
         else:
             yield from jsonl_batches(path, name, catalog, message)

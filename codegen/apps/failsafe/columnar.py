@@ -29,17 +29,20 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import BattgenError
-from ..battery.columns import NDArray
 from .evaluator import DISTANCE, SEED_CRITICAL, BatteryFailsafe, Event
 from .levels import Level
-from .logs import SampleTable
 from .monitor import FLT_EPSILON, MAH_PER_AMP_MS, MAX_INTEGRATION_MS, ResistanceEstimator, Trigger
 from .reading import Sample
 from .settings import MAX_INSTANCES, MONITOR_VOLTAGE_ONLY, VOLTSRC_RESTING, BatterySettings
+
+if TYPE_CHECKING:  # the flight logs' readers and the IR: a JSON Lines stream's replay needs neither
+    from ..battery.columns import NDArray
+    from .logs import SampleTable
 
 
 @dataclass
@@ -87,17 +90,26 @@ def replay_columns(
     sample by sample, with the evaluator's errors): the distance variant, a used evaluator, a time that is not
     finite or goes back, a battery outside 1..16."""
     exact = DISTANCE not in failsafe.variants and not failsafe.monitors and not failsafe.events
-    if not exact or not np.isfinite(t).all() or ((instance < 1) | (instance > MAX_INSTANCES)).any():
+    if not exact or not np.isfinite(t).all():
         return None
-    now = np.rint(t * 1000.0).astype(np.int64)
+    if len(instance) and (instance.min() < 1 or instance.max() > MAX_INSTANCES):
+        return None
+    now_ms = t * 1000.0
+    now = np.rint(now_ms, out=now_ms).astype(np.int64)
     if len(now) and (np.diff(now) < 0).any():
         return None
+    n = len(t)
     batteries: list[_Battery] = []
-    enabled = np.zeros(len(t), bool)
-    for inst in np.unique(instance).tolist():
-        rows = np.flatnonzero(instance == inst)
+    enabled = np.zeros(n, bool)
+    for inst, count in _instances(instance):
         mon = failsafe.monitor(int(inst))
-        if mon.settings.enabled:
+        if not mon.settings.enabled:
+            continue
+        if count == n:  # one battery: its columns are the stream's, not copies of them
+            enabled[:] = True
+            batteries.append(_columns(mon.settings, np.arange(n), now, volts, amps, mah))
+        else:
+            rows = np.flatnonzero(instance == inst)
             enabled[rows] = True
             batteries.append(_columns(mon.settings, rows, now[rows], volts[rows], amps[rows], mah[rows]))
     timer = SEED_CRITICAL not in failsafe.variants
@@ -109,7 +121,7 @@ def replay_columns(
             mon = failsafe.monitors[b.settings.instance]
             if mon.failsafe is Level.CRITICAL:
                 continue
-            hit = _next_event(b, checked[b.rows], mon.failsafe, timer)
+            hit = _next_event(b, checked if len(b.rows) == n else checked[b.rows], mon.failsafe, timer)
             if hit is not None and (found is None or b.rows[hit[0]] < found[0]):
                 found = (int(b.rows[hit[0]]), b, hit[1])
         if found is None:
@@ -125,6 +137,17 @@ def replay_columns(
             end = row + 1 + int(later[0]) if len(later) else len(t)
             checked[row + 1 : end] = False
     return out
+
+
+def _instances(instance: NDArray) -> list[tuple[float, int]]:
+    """The batteries present, in order, and their samples (of integers counted: ``np.unique`` would import
+    ``numpy.ma``, a tenth of a JSON Lines replay's start-up)."""
+    if instance.dtype.kind in "iu":
+        counts = np.bincount(instance, minlength=MAX_INSTANCES + 1)
+        present = np.flatnonzero(counts)
+        return list(zip(present.tolist(), counts[present].tolist(), strict=True))
+    values, counts = np.unique(instance, return_counts=True)
+    return list(zip(values.tolist(), counts.tolist(), strict=True))
 
 
 def _columns(s: BatterySettings, rows: NDArray, now: NDArray, volts: NDArray, amps: NDArray, mah: NDArray) -> _Battery:
@@ -155,13 +178,13 @@ def _columns(s: BatterySettings, rows: NDArray, now: NDArray, volts: NDArray, am
 def _consumed(now: NDArray, current: NDArray, mah: NDArray) -> NDArray:
     """BatteryMonitor.read's consumed charge at each sample."""
     known = ~np.isnan(mah)
+    if known.all():  # the log's own charge throughout: nothing is integrated
+        return np.where(known, mah, 0.0)
     dt = np.diff(now, prepend=now[:1])
     step = ~known & ~np.isnan(current) & (dt > 0) & (dt < MAX_INTEGRATION_MS)
     step[:1] = False  # the first reading has no interval
     add = np.where(step, current * dt.astype(np.float64) * MAH_PER_AMP_MS, -0.0)
     out = np.where(known, mah, 0.0)
-    if known.all():
-        return out
     # each run of samples without the log's own charge goes on from the value before it
     edges = np.flatnonzero(np.diff(np.concatenate(([False], ~known, [False])).astype(np.int8)))
     for start, stop in zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True):
@@ -191,11 +214,15 @@ def _resting(now: NDArray, voltage: NDArray, current: NDArray, measures: NDArray
 def _timer(condition: NDArray, now: NDArray, timeout_ms: int) -> NDArray:
     """Where a condition held for more than the timeout: runs over the checked samples, started at a run's first."""
     n = len(condition)
-    if timeout_ms <= 0 or not n:
-        return np.zeros(n, bool)
-    first = condition & ~np.concatenate(([False], condition[:-1]))
-    start = np.maximum.accumulate(np.where(first, np.arange(n), 0))
-    return condition & ~first & (now - now[start] > timeout_ms)
+    out = np.zeros(n, bool)
+    at = np.flatnonzero(condition)  # worked out where the condition holds only: most samples are healthy
+    if timeout_ms <= 0 or not len(at):
+        return out
+    first = np.empty(len(at), bool)
+    first[0], first[1:] = True, np.diff(at) != 1
+    start = at[np.maximum.accumulate(np.where(first, np.arange(len(at)), 0))]
+    out[at] = ~first & (now[at] - now[start] > timeout_ms)
+    return out
 
 
 def _next_event(b: _Battery, checked: NDArray, level: Level, timer: bool) -> tuple[int, Trigger] | None:

@@ -10,7 +10,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-from ...inputs.files.kinds import detect
 from .stream import batt_parameter_count
 
 FIRMWARES = ("px4", "ardupilot")
@@ -35,6 +34,8 @@ def choose_firmware(
             return "ardupilot", f"{where} holds ArduPilot's BATT*_ parameters"
         if px4_parameter_count(parameters):
             return "px4", f"{where} holds PX4's BAT_/COM_ parameters"
+    from ...inputs.files.kinds import detect  # the IR's formats come along: only a stream without parameters asks
+
     if detect(stream) == "ulog":
         return "px4", "the log is a PX4 ULog"
     return "ardupilot", "the log's"

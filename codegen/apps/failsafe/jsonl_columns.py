@@ -8,6 +8,10 @@ number (or ``null``) between them, checked over numpy arrays, and the numbers ar
 (``np.fromstring``, correctly rounded as ``float()`` is). Replacing every marker by its literal gives the file back,
 so a file that passes is the template filled with numbers: exactly what ``json.loads`` would have read.
 
+Where the C walk is built (``_jsonl_scan.c``, at install when a compiler is there) the file is mapped, not read,
+and walked once: the same literals must be there byte for byte on every line and a JSON number between them, read
+as ``float()`` reads it (the numpy reading below is what runs without it, and what the C one is tested against).
+
 Only the plain shape is taken: ``t``, ``armed``, optionally ``instance``, and ``battery`` holding ``voltage_v``,
 ``current_a`` and/or ``consumed_mah``. Anything else (messages, the distance fields, blank or comment lines, a
 line of another shape, a value the per-sample reader would refuse) gives None: the caller reads the stream
@@ -17,13 +21,25 @@ sample by sample, with its errors, as before.
 from __future__ import annotations
 
 import json
+import math
+import mmap
+import os
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..battery.columns import NDArray
+if TYPE_CHECKING:  # the columns module brings the IR along: only its type is needed here
+    from ..battery.columns import NDArray
+
+_scan: Callable[[Any, tuple[bytes, ...], bytes, Any, Any, Any], int] | None
+try:
+    from ._jsonl_scan import scan as _scan
+except ImportError:  # no compiler at install: the numpy reading
+    _scan = None
 
 TOP = ("t", "armed", "instance", "battery")
 BATTERY = ("voltage_v", "current_a", "consumed_mah")
@@ -44,11 +60,14 @@ class SampleColumns:
     current: NDArray
     consumed: NDArray
     armed: NDArray  # bool
-    data: bytes
+    data: bytes | mmap.mmap  # the file's bytes, or its memory map (which a file removed meanwhile keeps)
     _ends: NDArray | None = None
+    starts: NDArray | None = None  # each line's first byte, then the last one's end + 1 (the C walk finds them)
 
     def line(self, k: int) -> bytes:
         """The text of sample ``k``'s line."""
+        if self.starts is not None:
+            return self.data[int(self.starts[k]) : int(self.starts[k + 1]) - 1]
         if self._ends is None:
             self._ends = np.flatnonzero(np.frombuffer(self.data, np.uint8) == 10)
         ends = self._ends
@@ -87,11 +106,19 @@ def _template(line: bytes) -> tuple[list[str], list[tuple[int, int]]] | None:
     return names, spans
 
 
-def read_sample_columns(path: Path) -> SampleColumns | None:
-    """The stream's samples as columns, or None where it is not one plain shape throughout."""
+_SLOTS = {"t": 0, "instance": 1, "battery.voltage_v": 2, "battery.current_a": 3, "battery.consumed_mah": 4, "armed": 5}
+
+
+def read_sample_columns(path: Path, compiled: bool = True, mapped: bool = False) -> SampleColumns | None:
+    """The stream's samples as columns, or None where it is not one plain shape throughout (``compiled``: through
+    the C walk where it is built; ``mapped``: over a memory map of the file rather than its bytes read, for a caller
+    that holds it still while the columns are used, :func:`codegen.inputs.files.held.held`: a map of a file that
+    another program truncates meanwhile kills the process with SIGBUS)."""
     try:
         if path.stat().st_size > MAX_BYTES:
             return None  # read line by line instead: memory stays flat
+        if _scan is not None and compiled:
+            return _read_compiled(path, mapped)
         data = path.read_bytes()
     except OSError:
         return None
@@ -181,6 +208,52 @@ def read_sample_columns(path: Path) -> SampleColumns | None:
         if np.isinf(col).any():
             return None  # a number beyond a float: the per-sample reader's business
     return SampleColumns(t, instance.astype(np.int64), voltage, current, consumed, armed, data)
+
+
+def _read_compiled(path: Path, mapped: bool) -> SampleColumns | None:
+    """The C walk over the file, mapped or read (OSError where it cannot be)."""
+    assert _scan is not None
+    data: bytes | mmap.mmap
+    with path.open("rb") as f:
+        if not os.fstat(f.fileno()).st_size:
+            return None
+        # the events' lines are read from it later
+        data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) if mapped else f.read()
+    end = data.find(b"\n")
+    first = data[: end if end >= 0 else len(data)]
+    found = _template(first)
+    if found is None or len(first.translate(None, _CONTROL)) != len(first):
+        return None  # no control byte in the literals (a tab, a carriage return): the numpy reading's rule
+    names, spans = found
+    cuts = [0, *[x for s in spans for x in s], len(first)]
+    literals = tuple(first[cuts[2 * j] : cuts[2 * j + 1]] for j in range(len(spans) + 1))
+    slots = bytes(_SLOTS[name] for name in names)
+    shortest = sum(map(len, literals)) + len(slots)  # a line's fewest bytes: one a value
+    capacity = len(data) // shortest + 1
+    columns = np.empty((5, capacity))
+    armed = np.empty(capacity, np.uint8)
+    starts = np.empty(capacity + 1, np.int64)
+    lines = _scan(data, literals, slots, columns, armed, starts)
+    if lines <= 0:
+        return None
+    # min and max tell NaN (they propagate it) and inf without a temporary column; fmin / fmax skip the nulls
+    table = columns[:, :lines]
+    t = table[0]
+    if not (math.isfinite(t.min()) and math.isfinite(t.max())):
+        return None  # the per-sample reader's error
+    instance = np.ones(lines, np.int64)
+    if "instance" in names:
+        if not (1 <= table[1].min() and table[1].max() <= 16):  # NaN fails both
+            return None  # the per-sample reader's error
+        instance = table[1].astype(np.int64)
+    voltage, current, consumed = (
+        table[2 + i] if f"battery.{k}" in names else np.full(lines, np.nan) for i, k in enumerate(BATTERY)
+    )
+    for col in (voltage, current, consumed):
+        if np.fmax.reduce(col) == np.inf or np.fmin.reduce(col) == -np.inf:
+            return None  # a number beyond a float: the per-sample reader's business
+    flags = armed[:lines].view(np.bool_)  # the walk writes 0 or 1
+    return SampleColumns(t, instance, voltage, current, consumed, flags, data, starts=starts[: lines + 1])
 
 
 _U64 = np.uint64

@@ -1,8 +1,8 @@
 """The failsafe's levels, and how a level shows in the battery messages.
 
 uORB ``battery_status.warning`` and MAVLink ``BATTERY_STATUS.charge_state`` carry the level; their
-values come from the generated enums of the bundled schemas (so they follow the message
-definitions), found through :mod:`codegen.apps.schemas.package`.
+values are the generated enums' of the bundled schemas, written out (a test holds them equal, so they follow the
+message definitions).
 """
 
 from __future__ import annotations
@@ -11,8 +11,6 @@ import enum
 from collections.abc import Mapping
 from typing import Any
 
-from ..schemas.package import bundled_package, package_module
-
 
 class Level(enum.IntEnum):
     NONE = 0
@@ -20,21 +18,22 @@ class Level(enum.IntEnum):
     CRITICAL = 2
 
 
-def _enum(module: str, name: str) -> Any:
-    """A generated enum of the bundled package (``uorb.BatteryStatusWarning``)."""
-    return getattr(package_module(bundled_package(), module), name)
+# The levels as the generated enums of the bundled schemas give them (uorb.BatteryStatusWarning,
+# mavlink.MavBatteryChargeState), written out: importing the generated messages for two numbers cost a JSON Lines
+# replay a fifth of its time. tests/apps/test_failsafe.py holds them equal to the generated enums, so a change of the
+# message definitions fails there (as the Rust support's copy, codegen/backends/rust/support/failsafe.rs, would).
+UORB_WARNING = {Level.NONE: 0, Level.LOW: 1, Level.CRITICAL: 2}  # BatteryStatusWarning NONE, LOW, CRITICAL
+MAVLINK_CHARGE_STATE = {Level.NONE: 1, Level.LOW: 2, Level.CRITICAL: 3}  # MavBatteryChargeState OK, LOW, CRITICAL
 
 
 def uorb_warning(level: Level) -> int:
     """The level as uORB battery_status.warning (generated enum BatteryStatusWarning)."""
-    W = _enum("uorb", "BatteryStatusWarning")
-    return int({Level.NONE: W.NONE, Level.LOW: W.LOW, Level.CRITICAL: W.CRITICAL}[level])
+    return UORB_WARNING[level]
 
 
 def mavlink_charge_state(level: Level) -> int:
     """The level as MAVLink BATTERY_STATUS.charge_state (generated enum MavBatteryChargeState)."""
-    C = _enum("mavlink", "MavBatteryChargeState")
-    return int({Level.NONE: C.OK, Level.LOW: C.LOW, Level.CRITICAL: C.CRITICAL}[level])
+    return MAVLINK_CHARGE_STATE[level]
 
 
 def apply_level(qualified_name: str, data: Mapping[str, Any], level: Level) -> dict[str, Any]:

@@ -104,16 +104,20 @@ def battery_warnings(
     for more than 2 s, counted from its first update, which a log cannot show and is taken as at boot, or its last
     unconnected one). ``latched``: the releases that only let it rise."""
     levels = determine_warning(remaining, thresholds)
-    out = np.zeros(len(levels), np.int8)
-    warning = int(Px4Level.NONE)
-    unconnected_since = 0.0  # a log starts after boot: the library's first update is taken as at boot
-    for k, (t, ok, level) in enumerate(zip(boot_s.tolist(), connected.tolist(), levels.tolist(), strict=True)):
-        if not ok:
-            unconnected_since = t
-        if ok and t > unconnected_since + INITIALIZE_S:
-            warning = max(warning, level) if latched else level
-        out[k] = warning
-    return out
+    n = len(levels)
+    if not n:
+        return np.zeros(0, np.int8)
+    t = np.asarray(boot_s, np.float64)  # as the Python floats of a per-update loop: the sum below in float64
+    ok = np.asarray(connected, bool)
+    at = np.arange(n)
+    # the last unconnected update so far (the first update, taken as at boot, where there is none)
+    last_off = np.maximum.accumulate(np.where(ok, -1, at))
+    since = np.where(last_off >= 0, t[np.maximum(last_off, 0)], 0.0)
+    update = ok & (t > since + INITIALIZE_S)
+    if latched:  # only rises: the highest level of the updates so far (NONE = 0 before any)
+        return np.asarray(np.maximum.accumulate(np.where(update, levels, 0)), np.int8)
+    last = np.maximum.accumulate(np.where(update, at, -1))  # the level of the last update, NONE before any
+    return np.asarray(np.where(last >= 0, levels[np.maximum(last, 0)], 0), np.int8)
 
 
 def commander_warning(per_battery: list[tuple[NDArray, NDArray, NDArray]], t: NDArray, armed: NDArray) -> NDArray:
@@ -126,9 +130,10 @@ def commander_warning(per_battery: list[tuple[NDArray, NDArray, NDArray]], t: ND
         seen = idx >= 0
         latest = np.where(seen & connected[np.maximum(idx, 0)], warnings[np.maximum(idx, 0)], 0)
         worst = np.maximum(worst, latest.astype(np.int8))
-    out = np.zeros(len(t), np.int8)
-    flag = 0
-    for k, (w, a) in enumerate(zip(worst.tolist(), armed.tolist(), strict=True)):
-        flag = max(flag, w) if a else w
-        out[k] = flag
-    return out
+    # while armed it only rises: a running maximum that starts again at every disarmed sample (where it is the
+    # worst warning itself), from NONE before the first one; the group number lifts each group above the last
+    armed_b = np.asarray(armed, bool)
+    group = np.cumsum(~armed_b)
+    value = np.where(group == 0, np.maximum(worst, 0), worst).astype(np.int64) + 128  # 0..255
+    lifted = group.astype(np.int64) * 256 + value
+    return np.asarray(np.maximum.accumulate(lifted) - group * 256 - 128, np.int8) if len(t) else np.zeros(0, np.int8)

@@ -151,30 +151,39 @@ def _events(
     release: tuple[int, int, int] | None,
 ) -> list[Px4Event]:
     out: list[Px4Event] = []
-    previous, was_armed, at_arming = 0, False, Px4Level.NONE
-    for tk, ak, fk in zip(t.tolist(), armed.tolist(), flag.tolist(), strict=True):
-        level = Px4Level(fk)
-        if ak and not was_armed:
-            at_arming = level  # Failsafe::updateArmingState
-        if ak and level > Px4Level.NONE and (level > previous or not was_armed):
-            code = acting_parameter(settings.low_bat_act, level, at_arming, release)
-            action = battery_action(code, level)
-            battery, value, row = _worst(log, per_battery, tk, level)
-            out.append(
-                Px4Event(
-                    tk,
-                    battery,
-                    level,
-                    value,
-                    thresholds.threshold(level),
-                    code,
-                    action,
-                    settings.delay_s if action in (Action.RTL, Action.LAND) else 0.0,
-                    TEXTS[level],
-                    f"battery_status record {row} of battery {battery}",
-                )
+    n = len(t)
+    if not n:
+        return out
+    # over the columns: an event where the warning rises while armed, or is above NONE as the vehicle arms; the
+    # warning as of the arming (Failsafe::updateArmingState) is the one at the start of the armed run
+    armed_b = np.asarray(armed, bool)
+    was_armed = np.concatenate(([False], armed_b[:-1]))
+    rises = np.empty(n, bool)
+    rises[0] = flag[0] > 0
+    rises[1:] = flag[1:] > flag[:-1]
+    at = np.arange(n)
+    arming = np.maximum.accumulate(np.where(armed_b & ~was_armed, at, 0))
+    fires = np.flatnonzero(armed_b & (flag > 0) & (rises | ~was_armed))
+    levels, armings = flag[fires].tolist(), flag[arming[fires]].tolist()
+    for tk, fk, ak in zip(t[fires].tolist(), levels, armings, strict=True):
+        level, at_arming = Px4Level(fk), Px4Level(ak)
+        code = acting_parameter(settings.low_bat_act, level, at_arming, release)
+        action = battery_action(code, level)
+        battery, value, row = _worst(log, per_battery, tk, level)
+        out.append(
+            Px4Event(
+                tk,
+                battery,
+                level,
+                value,
+                thresholds.threshold(level),
+                code,
+                action,
+                settings.delay_s if action in (Action.RTL, Action.LAND) else 0.0,
+                TEXTS[level],
+                f"battery_status record {row} of battery {battery}",
             )
-        previous, was_armed = fk, ak
+        )
     return out
 
 

@@ -24,28 +24,25 @@ import dataclasses
 import importlib
 import json
 import math
+import mmap
 import re
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from types import ModuleType
-from typing import Any, Protocol, cast
+from typing import TYPE_CHECKING, Any, Protocol, cast
 
 from ...errors import BattgenError, LocatedError
-from ...frontends.loader import load
-from ...inputs.documents import read_jsonl
-from ...inputs.model import GeneratedMessage, MessageClass, package_name
 from ...inputs.parameters import files as parameter_files
-from ...inputs.records import Record, Unreadable
-from ...ir import Schema
-from ..battery.sources import FloatFields, float_fields, stored_data
-from ..schemas.fits import errors
-from ..schemas.messages import resolve_message
-from ..schemas.package import bundled_schemas, model_class, model_package
-from .columnar import replay_columns
 from .evaluator import BatteryFailsafe, Event
-from .jsonl_columns import read_sample_columns
 from .reading import BatteryReading, reading_of
 from .reading import Sample as Sample  # where the CLI, the report and the logs' replay import it from
+
+# A plain stream of SI samples needs none of the schemas' machinery (the IR, the frontends, the generated models,
+# the converters: a third of a second of imports): it is imported where a message first asks for it.
+if TYPE_CHECKING:
+    from ...inputs.model import GeneratedMessage, MessageClass
+    from ...ir import Schema
+    from ..battery.sources import FloatFields
 
 # which field carries what, per message (units come from the IR metadata)
 ROLES: dict[str, dict[str, str]] = {
@@ -120,11 +117,13 @@ class _Converters(Protocol):
 
 def _converters(model: GeneratedMessage) -> _Converters | None:
     """The converters of the generated package ``model``'s class belongs to, if it has them."""
+    from ...inputs.model import package_name
+
     try:
-        module: ModuleType = importlib.import_module(package_name(cast(MessageClass, type(model))) + ".convert")
+        module: ModuleType = importlib.import_module(package_name(cast("MessageClass", type(model))) + ".convert")
     except ImportError:
         return None
-    return cast(_Converters, module)
+    return cast("_Converters", module)
 
 
 def battery_state(qualified_name: str, model: GeneratedMessage) -> BatteryReading:
@@ -206,6 +205,10 @@ class Reader:
     def model(self, name: str, file: str, line: int) -> tuple[str, MessageClass, FloatFields]:
         """A message name's qualified name, generated class and float fields (resolved once per name)."""
         if name not in self._classes:
+            from ..battery.sources import float_fields
+            from ..schemas.messages import resolve_message
+            from ..schemas.package import model_class
+
             try:
                 msg = resolve_message(self.schema, name)
             except BattgenError as exc:
@@ -214,6 +217,9 @@ class Reader:
         return self._classes[name]
 
     def read(self, path: Path) -> Iterator[Sample]:
+        from ...inputs.documents import read_jsonl
+        from ...inputs.records import Record, Unreadable
+
         file = path.as_posix()
         for item in read_jsonl(path, file, comments=True):  # InputError when the file cannot be opened
             if isinstance(item, Unreadable):
@@ -267,6 +273,8 @@ class Reader:
         if not isinstance(data, dict):
             raise fail(f'expected "data": an object of {name} fields')
         qualified, cls, floats = self.model(name, file, line)
+        from ..battery.sources import stored_data
+
         try:
             # as the fields store them: a float32 voltage of 5e-324 is 0.0, the unknown, as the export reads it
             model = cls.from_dict(stored_data(floats, data))
@@ -285,6 +293,8 @@ def known_only(qualified_name: str, model: GeneratedMessage, reading: BatteryRea
     check = getattr(model, "validate", None)
     if reads is None or not callable(check):
         return reading
+    from ..schemas.fits import errors  # only a stream of messages validates
+
     found = check()
     if not found:
         return reading
@@ -297,10 +307,16 @@ def open_reader(schema_dir: Path | None, default_message: str | None = None) -> 
     if schema_dir is None:  # the bundled schemas load: only a stream of messages needs them (samples in SI do not)
 
         def bundled() -> tuple[Schema, ModuleType]:
+            from ...frontends.loader import load
+            from ..schemas.package import bundled_schemas, model_package
+
             schema = load([bundled_schemas()])
             return schema, model_package(schema, bundled_schemas())
 
         return Reader(None, None, default_message, bundled)
+    from ...frontends.loader import load
+    from ..schemas.package import model_package
+
     schema = load([schema_dir])
     return Reader(schema, model_package(schema, schema_dir), default_message)
 
@@ -364,16 +380,27 @@ class Replay:
 
     def _columnar(self, path: Path) -> list[tuple[Event, Sample]] | None:
         """The events of a plain-shaped stream replayed over its columns; None to read it sample by sample."""
-        columns = read_sample_columns(path)
-        if columns is None:
-            return None
+        from ...inputs.files.held import held
+        from .columnar import replay_columns  # numpy, for a plain stream's columns
+        from .jsonl_columns import read_sample_columns
+
         file = path.as_posix()
+        # held still (writers wait) while it is read through a map and its events' lines are read from that map
+        with held(path, file) as hold:
+            columns = read_sample_columns(path, mapped=hold.leased)
+            if columns is None:
+                return None
 
-        def sample_at(k: int) -> Sample:
-            return self.reader.sample(json.loads(columns.line(k)), file, k + 1)
+            def sample_at(k: int) -> Sample:
+                return self.reader.sample(json.loads(columns.line(k)), file, k + 1)
 
-        c = columns
-        events = replay_columns(self.failsafe, c.t, c.instance, c.voltage, c.current, c.consumed, c.armed, sample_at)
+            c = columns
+            try:
+                events = replay_columns(self.failsafe, c.t, c.instance, c.voltage, c.current, c.consumed, c.armed,
+                                        sample_at)  # fmt: skip
+            finally:
+                if isinstance(c.data, mmap.mmap):
+                    c.data.close()  # nothing reads it past the hold
         if events is not None:
             self.samples = len(c.t)
         return events

@@ -18,7 +18,8 @@ from typing import Any
 
 from ...errors import BattgenError, LocatedError
 from ...inputs.dispatch import read_records
-from ...inputs.files.kinds import KIND_FORMATS, file_kind
+from ...inputs.files.kind_formats import KIND_FORMATS
+from ...inputs.files.kinds import file_kind
 from ...inputs.model import GeneratedMessage, MessageClass, Violation
 from ...inputs.records import Notice, Record, Unreadable
 from ...ir import Message, Schema, SourceFormat

@@ -25,7 +25,6 @@ import re
 import struct
 from pathlib import Path
 
-from ...ir import SourceFormat
 from ..records import InputError
 
 KINDS = ("json", "jsonl", "yaml", "dts", "dtb", "param", "ulog", "tlog", "mavlink", "can", "dataflash")
@@ -33,16 +32,8 @@ KINDS = ("json", "jsonl", "yaml", "dts", "dtb", "param", "ulog", "tlog", "mavlin
 # view (codegen.apps.battery); a JSON Lines file of battery records is read by it too, as plain data
 FLIGHT_LOG_KINDS = ("ulog", "tlog", "dataflash", "can")
 LOG_KINDS = (*FLIGHT_LOG_KINDS, "jsonl")
-# the source format a file kind holds (the text kinds hold any), and how a message of another is refused
-KIND_FORMATS: dict[str, SourceFormat] = {
-    "dts": SourceFormat.DEVICETREE,
-    "dtb": SourceFormat.DEVICETREE,
-    "param": SourceFormat.PDEF,
-    "ulog": SourceFormat.UORB,
-    "tlog": SourceFormat.MAVLINK,
-    "mavlink": SourceFormat.MAVLINK,
-    "can": SourceFormat.DRONECAN,
-}
+# how a message of another source format than the kind holds is refused (the formats themselves:
+# kind_formats.py, apart, so that telling a file's kind does not import the IR)
 KIND_HOLDS = {
     "dts": "a devicetree file holds devicetree nodes",
     "dtb": "a devicetree file holds devicetree nodes",
