@@ -149,27 +149,6 @@ def tlog_messages(data: Buffer, models: Mapping[int, MavlinkClass], stats: Strea
     end = len(data)
     pos = 0
     while pos < end:
-        if stats.first_stamp is not None:  # (until then each good frame's stamp is offered to stats.seen)
-            # the common case, a run of whole good frames of known messages, in the runtime's fast walk
-            frames, offsets, others, stop = rt.scan_frames(data, pos, min(end, pos + _RUN), gap=_STAMP, wanted=models)
-            if stop > pos:
-                stats.other_frames += others
-                for frame, offset in zip(frames, offsets, strict=True):
-                    got = frame.msgid
-                    try:
-                        obj = decoders[got](frame.payload)
-                    except ValueError as exc:  # DecodeError: a payload longer than the message
-                        stats.decode_errors += 1
-                        stats.problems.append(str(exc))
-                        continue
-                    stats.records += 1
-                    number = numbers[got]
-                    numbers[got] = number + 1
-                    stamp = int.from_bytes(data[offset : offset + _STAMP], "big")
-                    yield _tuple_new(FrameRecord, (number, offset, stamp, frame, obj))
-                pos = stop
-                continue
-        # one entry that is not such a frame (or the first frame): judged here, then the fast walk resumes
         start = pos + _STAMP
         if start >= end:
             stats.truncated_bytes += end - pos
@@ -183,6 +162,27 @@ def tlog_messages(data: Buffer, models: Mapping[int, MavlinkClass], stats: Strea
                 pos = _resync(data, pos, end, stats)  # a stray magic byte claiming more than is left
                 continue
             total, got = head
+            if got in rt.REGISTRY and stats.first_stamp is not None:  # (until then every stamp goes to seen())
+                # a known message's frame: the runtime's fast walk checks it and the run of good frames of
+                # known messages after it; what stops the run (damage, another message) is judged below
+                run, offsets, others, stop = rt.scan_frames(data, pos, min(end, pos + _RUN), gap=_STAMP, wanted=models)
+                if stop > pos:
+                    stats.other_frames += others
+                    for frame, offset in zip(run, offsets, strict=True):
+                        got = frame.msgid
+                        try:
+                            obj = decoders[got](frame.payload)
+                        except ValueError as exc:  # DecodeError: a payload longer than the message
+                            stats.decode_errors += 1
+                            stats.problems.append(str(exc))
+                            continue
+                        stats.records += 1
+                        number = numbers[got]
+                        numbers[got] = number + 1
+                        stamp = int.from_bytes(data[offset : offset + _STAMP], "big")
+                        yield _tuple_new(FrameRecord, (number, offset, stamp, frame, obj))
+                    pos = stop
+                    continue
             after = start + total
             plausible = after == end or (after + _STAMP < end and _is_magic(data[after + _STAMP]))
             if got in rt.REGISTRY:  # its CRC_EXTRA is known: only a frame with a good CRC counts
