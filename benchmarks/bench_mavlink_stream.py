@@ -6,7 +6,8 @@ HEARTBEAT and the rest BATTERY_STATUS with changing values. Ours: :func:`codegen
 ``validate``, ``convert`` and the battery view read a .tlog with: CRC-checked frames decoded to generated
 instances). The peer: ``parse_buffer`` over the frames as a user feeds them (the 8-byte stamps cut off), keeping
 the BATTERY_STATUS messages. Both in this process, the sides taking turns over ``--rounds`` rounds; CPU seconds min
-and median; the decoded voltages, currents and consumed charges compared value for value.
+and median; the decoded voltages, currents and consumed charges of the timed runs compared value for value, and
+once more, untimed, every field of every record with its frame's system, component and sequence number.
 
 Usage: python benchmarks/bench_mavlink_stream.py [--frames N] [--rounds N] [--quick]
 """
@@ -66,6 +67,43 @@ def peer(bare: bytes) -> list[tuple[Any, ...]]:
     ]
 
 
+def every_value_ours(data: bytes) -> list[tuple[Any, ...]]:
+    """Every field of every BATTERY_STATUS record and its frame's header, as read by battgen (untimed)."""
+    import dataclasses
+
+    from codegen.inputs.tlog import StreamStats, read_frames
+    from generated.mavlink import BatteryStatus
+
+    names = [f.name for f in dataclasses.fields(BatteryStatus)]
+    out = []
+    for r in read_frames(io.BytesIO(data), "stream", BatteryStatus, StreamStats(), timestamps=True):
+        values = (getattr(r.instance, n) for n in names)
+        out.append(
+            (r.frame.sysid, r.frame.compid, r.frame.seq, *(tuple(v) if isinstance(v, list) else v for v in values))
+        )
+    return out
+
+
+def every_value_peer(bare: bytes) -> list[tuple[Any, ...]]:
+    """The same from pymavlink's messages, field by field under battgen's names (untimed)."""
+    import dataclasses
+
+    from generated.mavlink import BatteryStatus
+
+    names = [f.name for f in dataclasses.fields(BatteryStatus)]
+    mav = pm.MAVLink(None)
+    mav.robust_parsing = True
+    out = []
+    for m in mav.parse_buffer(bare) or []:
+        if m.get_type() == "BATTERY_STATUS":
+            head = m.get_header()
+            values = (getattr(m, n) for n in names)
+            out.append(
+                (head.srcSystem, head.srcComponent, head.seq, *(tuple(v) if isinstance(v, list) else v for v in values))
+            )
+    return out
+
+
 def run(frames: int = 200_000, rounds: int = 5) -> dict[str, float]:
     data, bare_frames = stream(frames)
     bare = b"".join(bare_frames)
@@ -79,6 +117,8 @@ def run(frames: int = 200_000, rounds: int = 5) -> dict[str, float]:
     )
     if outputs["battgen tlog reader"] != outputs["pymavlink parse_buffer"] or not outputs["battgen tlog reader"]:
         raise RuntimeError("the decoded BATTERY_STATUS values differ")
+    if every_value_ours(data) != every_value_peer(bare):
+        raise RuntimeError("the BATTERY_STATUS fields or frame headers differ")
     n = len(outputs["battgen tlog reader"])
     print(f"MAVLink stream, {frames:,} frames ({n:,} BATTERY_STATUS), {rounds} interleaved rounds, in-process")
     for name, timing in times.items():

@@ -17,8 +17,11 @@ from __future__ import annotations
 import dataclasses
 import functools
 import importlib
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
-from typing import Any, Protocol, cast, runtime_checkable
+from collections.abc import Callable, Container, Iterable, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Protocol, cast, runtime_checkable
+
+if TYPE_CHECKING:
+    import mmap
 
 
 class Violation(Protocol):
@@ -263,6 +266,9 @@ class MavlinkRuntime(Protocol):
     REGISTRY: dict[int, tuple[int, str, int, str]]  # msgid -> (CRC_EXTRA, class name, max length, name)
 
     def parse_frame(self, data: bytes) -> Frame: ...
+    def scan_frames(
+        self, data: bytes | mmap.mmap, pos: int, end: int, *, gap: int = 0, wanted: Container[int] | None = None
+    ) -> tuple[list[Frame], list[int], int, int]: ...
     def StreamParser(self) -> StreamParser: ...  # the class, called to make one
 
 

@@ -21,10 +21,15 @@ class EncodeError(ValueError):
 
 
 def fill(data: BytesLike, size: int, name: str) -> bytes:
-    """A payload zero-filled to ``size`` bytes (MAVLink 2 drops trailing zeros on send)."""
-    if len(data) > size:
+    """A payload zero-filled to ``size`` bytes (MAVLink 2 drops trailing zeros on send: most frames of a
+    stream take this path, so the zeros come from a table)."""
+    missing = size - len(data)
+    if missing < 0:
         raise DecodeError(f"{name}: payload of {len(data)} bytes exceeds the maximum length {size}")
-    return bytes(data) + bytes(size - len(data))
+    return bytes(data) + _ZEROS[missing]
+
+
+_ZEROS = [bytes(i) for i in range(256)]  # a MAVLink payload is at most 255 bytes
 
 
 def text(raw: bytes) -> str:
