@@ -367,6 +367,7 @@ class Conversion:
         taken = [name for name in self.inputs_taken if name.endswith(CARRIED) and name not in extra]
         carried = [(name, name.removesuffix(CARRIED)) for name in taken]
         carriers: dict[type, bool] = {}
+        given = any_extra = any(value is not None for value in extra.values())
         # looked up once: this loop runs per record, and its own work is a good part of a JSON Lines run
         build, build_data, func, policy = self.source.build, self.source.build_data, self.func, self.policy
         new_report, full, sender, strict = self.module.LossReport, loss is not None, self.sender, policy == "strict"
@@ -400,7 +401,10 @@ class Conversion:
             if sender is not None:
                 objs = sender.correct(objs, [a for a, _ in self.source.items], report)
             try:
-                result = func(*objs, policy=policy, report=report, **extra)
+                if any_extra:
+                    result = func(*objs, policy=policy, report=report, **extra)
+                else:  # every input at its default, None: not passed (a call's keywords cost)
+                    result = func(*objs, policy=policy, report=report)
             except conversion_error as exc:
                 raise fail(file, line, f"record {index + 1}: cannot convert: {exc}") from None
             except (ValueError, TypeError, AttributeError) as exc:
@@ -416,9 +420,11 @@ class Conversion:
                 if holds or report.carried:
                     for name, field in carried:
                         extra[name] = _carried(result, report, field)
+                    any_extra = True
                 else:  # nothing to carry: what _carried finds (None), without looking
                     for name, _ in carried:
                         extra[name] = None
+                    any_extra = given
             lost_before = len(report)
             lost = None if loss is None else report.summary() if loss == "summary" else report.to_dict()
             unheld = tuple(report.details("unrepresentable")) if lost_before else ()
