@@ -251,7 +251,13 @@ def cli_vs_script(n: int, rounds: int) -> dict[str, float]:
     wall_ratio = statistics.median(wall["script loop"]) / statistics.median(wall["battgen convert"])
     print(f"  battgen convert is {ratio:.2f}x the script in CPU, {wall_ratio:.2f}x in wall (target >= 1x)")
     print(f"  outputs: {n} records, equal value for value")
-    return {"cli convert battgen_s": statistics.median(cpu["battgen convert"]), "cli convert x_vs_script": ratio}
+    # "cli x_vs_loop" is the figure benchmarks/run_all.py reads for its table; the older name kept beside it
+    return {
+        "cli convert battgen_s": statistics.median(cpu["battgen convert"]),
+        "cli x_vs_loop": ratio,
+        "cli convert x_vs_script": ratio,
+        "cli x_vs_loop wall": wall_ratio,
+    }
 
 
 def main(argv: list[str] | None = None) -> dict[str, float]:

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import IO, Any, Literal, cast
 
 from ..apps.conversion.convert import FORMATS, LOG_FORMATS, Conversion, Converted, input_format, output_format
+from ..apps.conversion.jsonlines import encode_record
 from ..apps.conversion.senders import SENDERS
 from ..errors import BattgenError, missing_file
 from ..inputs.model import MessageClass
@@ -121,7 +122,8 @@ def run(args: argparse.Namespace) -> int:
             out_fmt = output_format(fmt, args.out_format)
             source = sys.stdin.buffer if path == "-" else Path(path)
             where = "<stdin>" if path == "-" else path
-            events = conversion.run(source, where, fmt, binary=out_fmt in ("hex", "raw"), loss=loss, inputs=extra)
+            binary, lines = out_fmt in ("hex", "raw"), out_fmt == "jsonl"
+            events = conversion.run(source, where, fmt, binary=binary, loss=loss, inputs=extra, lines=lines)
             before = tally.records
             _write(tally.count(events, where), where, fmt, out_fmt, out_stream, streaming=path == "-")
             if tally.records == before:
@@ -225,7 +227,8 @@ def _write(
             if event.source is not None:  # the file, the record, and a log record's topic instance
                 record["source"] = dict(event.source)
         if out_fmt == "jsonl":
-            out.write(json.dumps(record, allow_nan=False).encode() + b"\n")
+            # json.dumps(record, allow_nan=False)'s bytes: made with the record, else here
+            out.write(event.text if event.text is not None else encode_record(record))
             if streaming:
                 out.flush()
         else:

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import IO, Any, Literal, Protocol, cast
 
 from ...errors import BattgenError, cannot_read, did_you_mean
-from ...inputs.documents import read_json, read_jsonl, read_yaml
+from ...inputs.documents import jsonl_rows, read_json, read_yaml
 from ...inputs.files.kinds import content_kind, kind_of_name
 from ...inputs.model import (
     DecodingClass,
@@ -33,6 +33,7 @@ from ...inputs.payloads import read_hex, read_raw
 from ...inputs.records import InputError, Item, Notice, Record, Unreadable
 from ...ir.numbers import to_json_data
 from ..schemas.package import bundled_schemas, load_schemas, named_package, package_module
+from .jsonlines import loads, orjson_line
 from .senders import find_sender
 from .strict import StrictCheck
 
@@ -46,11 +47,15 @@ _EXTENSIONS |= {".dts": "dts", ".dtsi": "dts", ".dtb": "dtb"}
 
 # (alias, class) of each message of a side, the first required; the concept state is a side too
 Side = tuple[tuple[str, PlainClass], ...]
+Row = tuple[int, int, object]  # a JSON Lines record as read: (index, line, value); its Record made only if needed
 
 
 class LossReport(Protocol):
     """The generated converters' record of what a conversion lost."""
 
+    carried: dict[str, float]  # what the converter keeps for the next record
+
+    def __len__(self) -> int: ...
     def to_dict(self) -> list[dict[str, str]]: ...
     def summary(self) -> str: ...
     def details(self, kind: str) -> list[tuple[str, str]]: ...
@@ -119,7 +124,7 @@ def side_name(module: ConvertModule, name: str) -> str:
     return name  # unknown: reported with the known pairs
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)  # not frozen: a frozen dataclass's __init__ costs twice as much, and one is made per record
 class Converted:
     """One record converted: the target's plain data, or its payloads (binary output)."""
 
@@ -130,6 +135,7 @@ class Converted:
     source: Mapping[str, object] | None = None  # where the record came from: file, record, line or log location
     # (field, detail) of each value the target could not hold, written as its "unknown" instead
     unrepresentable: tuple[tuple[str, str], ...] = ()
+    text: bytes | None = None  # the plain data's JSON Lines bytes, when asked for and made at once (orjson)
 
 
 class Endpoint:
@@ -140,18 +146,33 @@ class Endpoint:
         self.items = items
         # the classes with a binary codec, looked up once (not per record)
         self.codecs = [cls if isinstance(cls, DecodingClass) else None for _, cls in items]
+        self.aliases = frozenset(a for a, _ in items)
 
     def build(self, rec: Record) -> list[PlainData | None]:
         if rec.instance is not None:  # decoded already (a log record; a CAN node's other messages beside it)
             rest = list(rec.companions[: len(self.items) - 1])
             return [rec.instance, *rest, *([None] * (len(self.items) - 1 - len(rest)))]
-        data = rec.data
+        return self.build_data(rec.data, rec.file, rec.line)
+
+    def build_data(self, data: object, file: str, line: int) -> list[PlainData | None]:
+        """The side's objects from a record's plain data (or its payloads); errors name ``file:line``."""
+        # the usual record, a bare object of the first message (no alias keys), built without the general walk
+        if data.__class__ is dict and (
+            len(cast(dict[str, Any], data)) > len(self.aliases)
+            or not self.aliases.issuperset(cast(dict[str, Any], data))
+        ):
+            try:
+                return [self.items[0][1].from_dict(cast(dict[str, Any], data)), *([None] * (len(self.items) - 1))]
+            except BattgenError:
+                raise
+            except (ValueError, TypeError, KeyError) as exc:  # as below
+                raise fail(file, line, f"invalid {self.name} record: {exc}") from None
         aliases = [a for a, _ in self.items]
         try:
             if isinstance(data, list) and data and all(isinstance(x, bytes) for x in data):
-                return self._decode(data, rec)
+                return self._decode(data, file, line)
             if not isinstance(data, dict):
-                raise fail(rec.file, rec.line, f"expected a {self.name} record (an object), got {type(data).__name__}")
+                raise fail(file, line, f"expected a {self.name} record (an object), got {type(data).__name__}")
             parts = (
                 [data.get(a) for a in aliases]
                 if len(aliases) > 1 and set(data) <= set(aliases)
@@ -161,28 +182,39 @@ class Endpoint:
             for (alias, cls), part in zip(self.items, parts, strict=True):
                 if part is None:
                     if alias == aliases[0]:
-                        raise fail(rec.file, rec.line, f"expected the {alias} message of {self.name}")
+                        raise fail(file, line, f"expected the {alias} message of {self.name}")
                     out.append(None)
                 elif not isinstance(part, dict):
-                    raise fail(rec.file, rec.line, f"expected {alias} to be an object")
+                    raise fail(file, line, f"expected {alias} to be an object")
                 else:
                     out.append(cls.from_dict(part))
             return out
         except BattgenError:
             raise
         except (ValueError, TypeError, KeyError) as exc:  # DataError / ConversionError are ValueErrors
-            raise fail(rec.file, rec.line, f"invalid {self.name} record: {exc}") from None
+            raise fail(file, line, f"invalid {self.name} record: {exc}") from None
 
-    def _decode(self, payloads: list[bytes], rec: Record) -> list[PlainData | None]:
+    def _decode(self, payloads: list[bytes], file: str, line: int) -> list[PlainData | None]:
         out: list[PlainData | None] = []
         for i, ((alias, _), cls) in enumerate(zip(self.items, self.codecs, strict=True)):
             if i >= len(payloads):
                 out.append(None)
                 continue
             if cls is None:
-                raise fail(rec.file, rec.line, f"{self.name} {alias} has no binary codec yet")
+                raise fail(file, line, f"{self.name} {alias} has no binary codec yet")
             out.append(cls.decode(payloads[i]))
         return out
+
+    def to_line(self, objs: object) -> tuple[object, bytes] | None:
+        """The plain data and its JSON Lines bytes (:func:`.jsonlines.orjson_line`) of a one-message side, when
+        orjson writes them as json does: then they are strict JSON data as they are, with no walk of
+        :func:`_json_data`. None for anything else."""
+        if len(self.items) != 1:
+            return None
+        obj: Any = objs[0] if isinstance(objs, tuple) else objs
+        data = obj.to_dict()
+        text = orjson_line(data)
+        return None if text is None else (data, text)
 
     def to_plain(self, objs: object) -> object:
         seq = cast(tuple[PlainData | None, ...], objs if isinstance(objs, tuple) else (objs,))
@@ -206,12 +238,14 @@ class Endpoint:
 
 
 _SCALARS = frozenset({int, str, bool, type(None)})
+_NUMBERS = frozenset({int, bool, float})
 
 
 def _json_data(data: dict[str, object]) -> object:
     """A message's ``to_dict()`` as strict JSON data: the dict itself when it holds only what JSON writes as it
     is (the usual record: finite numbers, text, flat lists of them), else :func:`to_json_data`'s copy (NaN and
-    the infinities spelled, bytes and enum members made plain, nested messages walked)."""
+    the infinities spelled, bytes and enum members made plain, nested messages walked). The types are taken
+    a list at a time (``set(map(type, ...))``, at C speed), each value looked at only when a list holds a float."""
     value: Any
     for value in data.values():
         kind = value.__class__
@@ -219,12 +253,13 @@ def _json_data(data: dict[str, object]) -> object:
             if value - value != 0.0:  # NaN or an infinity
                 return to_json_data(data)
         elif kind is list:
-            for item in value:
-                if item.__class__ is float:
-                    if item - item != 0.0:
-                        return to_json_data(data)
-                elif item.__class__ not in _SCALARS:
+            kinds = set(map(type, value))
+            if float in kinds:
+                # a sum of finite floats is finite unless it overflows (then the copy is made, and is the same)
+                if not kinds <= _NUMBERS or (total := sum(value)) - total != 0.0:
                     return to_json_data(data)
+            elif not kinds <= _SCALARS:
+                return to_json_data(data)
         elif kind not in _SCALARS:
             return to_json_data(data)
     return data
@@ -236,12 +271,14 @@ CARRIED = "_before"  # the suffix of a converter input fed from the previous rec
 def _carried(result: object, report: object, field: str) -> float | None:
     """The value of ``field`` a converter carries to the next record: what its report says it keeps (a
     firmware's float total), else the field of its result (one object or a tuple of them); None if absent."""
-    kept = getattr(report, "carried", {}).get(field)
-    if isinstance(kept, float):
-        return kept
+    kept = getattr(report, "carried", None)
+    if kept:  # (empty for most records: looked into only when something is kept)
+        value = kept.get(field)
+        if isinstance(value, float):
+            return value
     for obj in result if isinstance(result, tuple) else (result,):
         value = getattr(obj, field, None)
-        if isinstance(value, int | float) and not isinstance(value, bool):
+        if value is not None and isinstance(value, int | float) and not isinstance(value, bool):
             return float(value)
     return None
 
@@ -304,52 +341,94 @@ class Conversion:
         binary: bool = False,
         loss: Literal["entries", "summary"] | None = None,
         inputs: Mapping[str, float] | None = None,
+        lines: bool = False,
     ) -> Iterator[Converted | Notice]:
         """Convert every record of one input (``where`` names it) read as ``fmt``. ``binary``:
         hand out the target's payloads instead of its plain data; ``loss``: ``"entries"`` or
-        ``"summary"`` of each record's loss report."""
+        ``"summary"`` of each record's loss report; ``lines``: with the plain data, its JSON Lines
+        bytes where they are made at once (``Converted.text``)."""
         extra: dict[str, float | None] = dict(inputs or {})
         # an input named <field>_before is state the converter carries from record to record (PX4's
         # discharged-charge integral): unless given, each record gets the previous result's <field>
-        carried = [name for name in self.inputs_taken if name.endswith(CARRIED) and name not in extra]
+        taken = [name for name in self.inputs_taken if name.endswith(CARRIED) and name not in extra]
+        carried = [(name, name.removesuffix(CARRIED)) for name in taken]
+        carriers: dict[type, bool] = {}
+        given = any_extra = any(value is not None for value in extra.values())
+        # looked up once: this loop runs per record, and its own work is a good part of a JSON Lines run
+        build, build_data, func, policy = self.source.build, self.source.build_data, self.func, self.policy
+        new_report, full, sender = self.module.LossReport, loss is not None, self.sender
         # strict refuses a record validate finds an error in, judged as validate judges this kind of input
-        strict = StrictCheck(fmt, bundled=self.bundled) if self.policy == "strict" else None
+        strict = StrictCheck(fmt, bundled=self.bundled) if policy == "strict" else None
+        conversion_error, to_plain, to_binary = self.module.ConversionError, self.target.to_plain, self.target.to_binary
+        to_line = self.target.to_line
+        report = new_report(full=full)
+        lost_before = 0  # entries the last record's report holds (none: it is used again)
         for item in self._items(source, where, fmt):
-            if isinstance(item, Notice):
+            record: Record | None
+            if item.__class__ is tuple:  # a JSON Lines record: (index, line, value), its Record made if needed
+                index, line, data = item
+                file, record = where, None
+                objs = build_data(data, file, line)
+            elif isinstance(item, Notice):
                 yield item
                 continue
-            if isinstance(item, Unreadable):
+            elif isinstance(item, Unreadable):
                 raise fail(where, item.line, _reworded(item.message, item.reason, fmt))
-            objs = self.source.build(item)
-            # always kept: what the target could not hold is told even without --report (the fields dropped
-            # or left unknown, alike for every record, only with it)
-            report = self.module.LossReport(full=loss is not None)
-            if self.sender is not None:
-                objs = self.sender.correct(objs, [a for a, _ in self.source.items], report)
-            if strict is not None:  # after a sender's correction: what it meant is what is converted
-                strict.refuse(objs, item)
-            try:
-                result = self.func(*objs, policy=self.policy, report=report, **extra)
-            except self.module.ConversionError as exc:
-                raise fail(item.file, item.line, f"record {item.index + 1}: cannot convert: {exc}") from None
-            except (ValueError, TypeError, AttributeError) as exc:
-                text = f"record {item.index + 1}: cannot convert (a value the input lacks or does not fit): {exc}"
-                raise fail(item.file, item.line, text) from None
-            _keep_capture_time(result, item)
-            for name in carried:
-                extra[name] = _carried(result, report, name.removesuffix(CARRIED))
-            lost = None if loss is None else report.summary() if loss == "summary" else report.to_dict()
-            unheld = tuple(report.details("unrepresentable"))
-            # where the record came from: read only beside a loss (the report, a value the target cannot hold)
-            at = _source(item, where) if unheld or lost is not None else None
-            if binary:
-                payloads = self.target.to_binary(result, item.file, item.line)
-                yield Converted(item.line, payloads=payloads, loss=lost, source=at, unrepresentable=unheld)
             else:
-                plain = self.target.to_plain(result)
-                yield Converted(item.line, plain=plain, loss=lost, source=at, unrepresentable=unheld)
+                record = cast(Record, item)
+                index, line, file = record.index, record.line, record.file
+                objs = build(record)
+            # always kept: what the target could not hold is told even without --report (the fields dropped
+            # or left unknown, alike for every record, only with it); a report the last record left empty is
+            # used again rather than a new one made for every record
+            if lost_before or report.carried:
+                report = new_report(full=full)
+            if sender is not None:
+                objs = sender.correct(objs, [a for a, _ in self.source.items], report)
+            if strict is not None:  # after a sender's correction: what it meant is what is converted
+                record = record or Record(index, line, data, file)
+                strict.refuse(objs, record)
+            try:
+                if any_extra:
+                    result = func(*objs, policy=policy, report=report, **extra)
+                else:  # every input at its default, None: not passed (a call's keywords cost)
+                    result = func(*objs, policy=policy, report=report)
+            except conversion_error as exc:
+                raise fail(file, line, f"record {index + 1}: cannot convert: {exc}") from None
+            except (ValueError, TypeError, AttributeError) as exc:
+                text = f"record {index + 1}: cannot convert (a value the input lacks or does not fit): {exc}"
+                raise fail(file, line, text) from None
+            if record is not None and record.location is not None:
+                _keep_capture_time(result, record)
+            if carried:
+                holds = carriers.get(result.__class__)
+                if holds is None:  # whether this result type has any of the carried fields (asked once a type)
+                    holds = isinstance(result, tuple) or any(hasattr(result, f) for _, f in carried)
+                    carriers[result.__class__] = holds
+                if holds or report.carried:
+                    for name, field in carried:
+                        extra[name] = _carried(result, report, field)
+                    any_extra = True
+                else:  # nothing to carry: what _carried finds (None), without looking
+                    for name, _ in carried:
+                        extra[name] = None
+                    any_extra = given
+            lost_before = len(report)
+            lost = None if loss is None else report.summary() if loss == "summary" else report.to_dict()
+            unheld = tuple(report.details("unrepresentable")) if lost_before else ()
+            # where the record came from: read only beside a loss (the report, a value the target cannot hold)
+            at = None
+            if unheld or lost is not None:
+                at = _source(record or Record(index, line, data, file), where)
+            if binary:
+                payloads = to_binary(result, file, line)
+                yield Converted(line, payloads=payloads, loss=lost, source=at, unrepresentable=unheld)
+            elif lines and lost is None and (made := to_line(result)) is not None:
+                yield Converted(line, plain=made[0], source=at, unrepresentable=unheld, text=made[1])
+            else:
+                yield Converted(line, plain=to_plain(result), loss=lost, source=at, unrepresentable=unheld)
 
-    def _items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item]:
+    def _items(self, source: Path | IO[bytes], where: str, fmt: str) -> Iterator[Item | Row]:
         if fmt in LOG_FORMATS:
             yield from self._log_items(source, where, fmt)
             return
@@ -427,14 +506,14 @@ class Conversion:
             yield Notice(where, stats.summary(message_name(cls)), "stream")
 
 
-def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item]:
+def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item | Row]:
     try:
         if fmt == "raw":
             yield from read_raw(stream, where)
         elif fmt == "hex":
             yield from read_hex(stream, where)
         elif fmt == "jsonl":
-            yield from read_jsonl(stream, where)
+            yield from jsonl_rows(stream, where, loads=loads)
         elif fmt == "json":
             yield from read_json(stream, where)
         else:

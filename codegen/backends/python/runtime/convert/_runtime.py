@@ -232,6 +232,15 @@ def c_wrap(value: int, bits: int, signed: bool) -> int:
 def c_float_to_int(x: float, bits: int, signed: bool, rep: LossReport | None = None, label: str = "") -> int:
     """A C float-to-integer assignment as a Cortex-M FPU performs it (VCVT): truncate toward
     zero, saturate to 32 bits (NaN gives 0), then keep the field's low ``bits``."""
+    # the usual value first: finite and inside the 32-bit range, so truncated as it is (one int(), no NaN test)
+    if (-2147483648.0 < x < 2147483648.0) if signed else (0.0 < x < 4294967296.0):
+        n = int(x)
+        out = n & ((1 << bits) - 1)
+        if signed and out >= 1 << (bits - 1):
+            out -= 1 << bits
+        if rep is not None and out != n:
+            rep.clamped(label, f"{x!r} does not fit {'int' if signed else 'uint'}{bits}")
+        return out
     if math.isnan(x):
         n = 0
     elif signed:
