@@ -89,41 +89,58 @@ def read_jsonl(source: Source, name: str, *, comments: bool = False) -> Iterator
     """One record per non-blank line (with ``comments``, lines starting with ``#`` are skipped
     too); a malformed line is an Unreadable item and reading goes on."""
     with _text_stream(source, name) as stream:
-        index = 0
-        lineno = 0
-        while True:
-            try:
-                line = stream.readline(MAX_LINE + 1)
-                if len(line) > MAX_LINE and not line.endswith("\n"):
-                    lineno += 1
-                    length = len(line) + _skip_line(stream)
-                    yield Unreadable(name, lineno, _too_long(length))
-                    continue
-            except UnicodeDecodeError:
-                yield Unreadable(name, lineno + 1, "expected UTF-8 text")
-                return
-            if not line:
-                return
-            lineno += 1
-            if lineno == 1 and line.startswith(_BOM):
-                line = line[1:]
-            text = line.strip()
-            if not text or (comments and text.startswith("#")):
+        yield from jsonl_text_items(stream, name, comments=comments)
+
+
+def jsonl_text_items(
+    stream: IO[str], name: str, *, comments: bool = False, lineno: int = 0, index: int = 0
+) -> Iterator[Item]:
+    """:func:`read_jsonl` on an open text stream whose first ``lineno`` lines (holding ``index``
+    records) were read already (:mod:`.jsonl_blocks` hands over to it mid-file)."""
+    while True:
+        try:
+            line = stream.readline(MAX_LINE + 1)
+            if len(line) > MAX_LINE and not line.endswith("\n"):
+                lineno += 1
+                length = len(line) + _skip_line(stream)
+                yield Unreadable(name, lineno, _too_long(length))
                 continue
-            try:
-                data = json.loads(line)
-            except json.JSONDecodeError as exc:
-                message = f"expected one JSON value per line: {exc.msg} (column {exc.colno})"
-                yield Unreadable(name, lineno, message, exc.msg, exc.colno)
-                continue
-            except RecursionError:
-                yield Unreadable(name, lineno, TOO_DEEP)
-                continue
-            except ValueError:  # an integer of more digits than Python converts
-                yield Unreadable(name, lineno, _long_number(line))
-                continue
-            yield Record(index, lineno, data, name)
-            index += 1
+        except UnicodeDecodeError:
+            yield Unreadable(name, lineno + 1, "expected UTF-8 text")
+            return
+        if not line:
+            return
+        lineno += 1
+        value = jsonl_value(line, name, lineno, comments=comments)
+        if value is BLANK:
+            continue
+        if isinstance(value, Unreadable):
+            yield value
+            continue
+        yield Record(index, lineno, value, name)
+        index += 1
+
+
+BLANK = object()  # jsonl_value's answer for a blank (or comment) line
+
+
+def jsonl_value(line: str, name: str, lineno: int, *, comments: bool = False) -> object:
+    """The value of one JSON Lines line (its end of line kept: an error's column counts it),
+    :data:`BLANK` for a line holding none, or the Unreadable saying why it cannot be read."""
+    if lineno == 1 and line.startswith(_BOM):
+        line = line[1:]
+    text = line.strip()
+    if not text or (comments and text.startswith("#")):
+        return BLANK
+    try:
+        return json.loads(line)
+    except json.JSONDecodeError as exc:
+        message = f"expected one JSON value per line: {exc.msg} (column {exc.colno})"
+        return Unreadable(name, lineno, message, exc.msg, exc.colno)
+    except RecursionError:
+        return Unreadable(name, lineno, TOO_DEEP)
+    except ValueError:  # an integer of more digits than Python converts
+        return Unreadable(name, lineno, _long_number(line))
 
 
 # ------------------------------------------------------------------------------------------------
