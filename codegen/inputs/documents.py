@@ -19,14 +19,16 @@ import json
 import re
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from functools import cache
 from pathlib import Path
-from typing import IO
-
-import yaml
+from typing import IO, TYPE_CHECKING, Any
 
 from ..errors import cannot_read
 from ..text.files import read_text
 from .records import TOO_DEEP, InputError, Item, Record, Unreadable, join_path, nearest_line
+
+if TYPE_CHECKING:
+    import yaml  # imported where YAML is read: a run reading JSON does without PyYAML
 
 Source = Path | IO[bytes]
 
@@ -281,31 +283,37 @@ def _scan_json(text: str, pos: int, path: str, out: dict[str, int], index: _Line
 # YAML: a stream of documents, each a record or a list of records; composed one document at a time
 
 
-class _LineLoader(yaml.SafeLoader):
-    """SafeLoader that also hands back the composed node, so each value's line is known."""
+@cache
+def _line_loader() -> Any:
+    """SafeLoader that also hands back the composed node, so each value's line is known (a class made
+    on first use, with PyYAML imported then)."""
+    import yaml
 
-    def next_document(self) -> tuple[object, yaml.Node] | None:
-        if not self.check_node():
-            return None
-        node = self.get_node()
-        if node is None:
-            return None
-        return self.construct_document(node), node
+    class LineLoader(yaml.SafeLoader):
+        def next_document(self) -> tuple[object, yaml.Node] | None:
+            if not self.check_node():
+                return None
+            node = self.get_node()
+            if node is None:
+                return None
+            return self.construct_document(node), node
 
-    def construct_long_int(self, node: yaml.ScalarNode) -> object:
-        """PyYAML's int, but an integer of more digits than Python converts is an error at its line."""
-        try:
-            return self.construct_yaml_int(node)
-        except ValueError:
-            digits = sum(c.isdigit() for c in str(node.value))
-            problem = f"an integer of {digits} digits is more than a battery field holds (4,300 cannot be read)"
-            raise yaml.constructor.ConstructorError(None, None, problem, node.start_mark) from None
+        def construct_long_int(self, node: yaml.ScalarNode) -> object:
+            """PyYAML's int, but an integer of more digits than Python converts is an error at its line."""
+            try:
+                return self.construct_yaml_int(node)
+            except ValueError:
+                digits = sum(c.isdigit() for c in str(node.value))
+                problem = f"an integer of {digits} digits is more than a battery field holds (4,300 cannot be read)"
+                raise yaml.constructor.ConstructorError(None, None, problem, node.start_mark) from None
 
-
-_LineLoader.add_constructor("tag:yaml.org,2002:int", _LineLoader.construct_long_int)
+    LineLoader.add_constructor("tag:yaml.org,2002:int", LineLoader.construct_long_int)
+    return LineLoader
 
 
 def _node_lines(node: yaml.Node, path: str, out: dict[str, int], seen: set[int]) -> None:
+    import yaml
+
     out.setdefault(path, node.start_mark.line + 1)
     if id(node) in seen:
         return  # an alias: its lines are those of the anchored node, walked once (no alias bombs)
@@ -336,6 +344,8 @@ def _yaml_locator(node: yaml.Node) -> Callable[[str], int | None]:
 
 
 def _yaml_error(name: str, exc: Exception) -> InputError:
+    import yaml
+
     if isinstance(exc, yaml.MarkedYAMLError):
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else 0
@@ -350,9 +360,11 @@ def _yaml_error(name: str, exc: Exception) -> InputError:
 def read_yaml(source: Source, name: str) -> Iterator[Item]:
     """One record per document, or per item of a document that is a list; empty documents are
     skipped. A malformed document raises InputError when reading reaches it."""
+    import yaml
+
     with _text_stream(source, name) as stream:
         try:
-            loader = _LineLoader(stream)
+            loader = _line_loader()(stream)
         except (yaml.YAMLError, UnicodeDecodeError) as exc:
             raise _yaml_error(name, exc) from None
         try:

@@ -20,7 +20,6 @@ from __future__ import annotations
 import io
 from collections.abc import Iterator
 from pathlib import Path
-from typing import IO
 
 import orjson
 
@@ -123,7 +122,7 @@ def _text_from(path: Path, name: str, offset: int, lineno: int) -> Iterator[Part
         raise InputError(name, 0, cannot_read(exc)) from None
     with raw:
         raw.seek(offset)
-        stream: IO[str] = io.TextIOWrapper(raw, encoding="utf-8", newline="")
+        stream = io.TextIOWrapper(raw, encoding="utf-8", newline="")
         try:
             for item in jsonl_text_items(stream, name, lineno=lineno):
                 if isinstance(item, Record):
