@@ -3,7 +3,8 @@
 
 What it hands out is what :func:`.documents.read_jsonl` reads from the same file, line for line: the
 same values (the standard library's ``json`` is the meaning), the same line numbers and the same
-Unreadable lines. orjson parses a line when it can, and it can only for plain JSON, where it gives
+Unreadable lines. In a file longer than a block (shorter ones are read by ``json`` alone, sooner than
+orjson is imported) orjson parses a line when it can, and it can only for plain JSON, where it gives
 the value ``json`` gives; every other line -- blank, a byte order mark, a syntax error, ``NaN``, a
 lone surrogate, a number beyond a double -- is read by ``json`` through :func:`.documents.jsonl_value`,
 as :func:`read_jsonl` reads it. The one value orjson reads differently is an integer beyond 64 bits
@@ -18,10 +19,9 @@ rest of the file.
 from __future__ import annotations
 
 import io
-from collections.abc import Iterator
+import json
+from collections.abc import Callable, Iterator
 from pathlib import Path
-
-import orjson
 
 from ..errors import cannot_read
 from .documents import BLANK, MAX_LINE, jsonl_text_items, jsonl_value
@@ -50,8 +50,13 @@ def jsonl_blocks(path: Path, name: str) -> Iterator[Part]:
     with stream:
         offset = lineno = 0
         carry = b""
+        loads: Callable[[bytes], object] | None = None  # orjson's, once the file is longer than a block
         while True:
             data = stream.read(BLOCK)
+            if loads is None and len(data) == BLOCK:
+                import orjson  # here: a file of a few records is read sooner by json than orjson is imported
+
+                loads = orjson.loads
             block = carry + data if carry else data
             if not block:
                 return
@@ -62,10 +67,10 @@ def jsonl_blocks(path: Path, name: str) -> Iterator[Part]:
             whole = block[:cut]
             if not cut or not _plain(whole):
                 break
-            long_runs = whole.translate(_DIGITS).find(_LONG_RUN) >= 0
+            long_runs = loads is not None and whole.translate(_DIGITS).find(_LONG_RUN) >= 0
             raws = whole.splitlines(keepends=True)
             for start in range(0, len(raws), BATCH):
-                parts, lineno = _lines(raws[start : start + BATCH], name, lineno, long_runs)
+                parts, lineno = _lines(raws[start : start + BATCH], name, lineno, long_runs, loads)
                 yield from parts
             offset += cut
             carry = block[cut:]
@@ -84,20 +89,21 @@ def _plain(block: bytes) -> bool:
     return len(block) < MAX_LINE - 2 or max(map(len, block.splitlines(keepends=True))) <= MAX_LINE - 2
 
 
-def _lines(raws: list[bytes], name: str, lineno: int, long_runs: bool) -> tuple[list[Part], int]:
+def _lines(
+    raws: list[bytes], name: str, lineno: int, long_runs: bool, loads: Callable[[bytes], object] | None
+) -> tuple[list[Part], int]:
     """Lines of a block (each with its end of line), the first being line ``lineno + 1``: lists of
     values, with each unreadable line an Unreadable between them; and the number of the last line.
-    ``long_runs``: the block holds a run of 19 digits somewhere."""
+    ``long_runs``: the block holds a run of 19 digits somewhere; ``loads``: orjson's (None: json for every line)."""
     out: list[Part] = []
     lines: list[Line] = []
-    loads = orjson.loads
     for raw in raws:
         lineno += 1
-        if not long_runs or raw.translate(_DIGITS).find(_LONG_RUN) < 0:
+        if loads is not None and (not long_runs or raw.translate(_DIGITS).find(_LONG_RUN) < 0):
             try:
                 lines.append((lineno, loads(raw)))
                 continue
-            except orjson.JSONDecodeError:
+            except json.JSONDecodeError:  # orjson's is one
                 pass
         value = jsonl_value(raw.decode("utf-8"), name, lineno)
         if value is BLANK:

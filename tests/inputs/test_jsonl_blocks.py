@@ -68,10 +68,13 @@ TEXTS = {
 }
 
 
+@pytest.mark.parametrize("long", [False, True], ids=["json alone", "orjson"])
 @pytest.mark.parametrize("text", TEXTS.values(), ids=list(TEXTS))
-def test_blocks_read_what_lines_read(tmp_path: Path, text: str) -> None:
+def test_blocks_read_what_lines_read(tmp_path: Path, text: str, long: bool) -> None:
+    """A file of one block is read by json alone; a longer one by orjson where it can, from its first line."""
     path = tmp_path / "f.jsonl"
-    path.write_text(text, encoding="utf-8", newline="")
+    tail = "\n" + LINE * (BLOCK // len(LINE) + 1) if long else ""  # a few lines more than a block
+    path.write_text(text + tail, encoding="utf-8", newline="")
     assert _blocks(path) == _lines(path)
 
 

@@ -27,7 +27,6 @@ from ...ir.expr import referenced_fields
 from ...ir.numbers import to_json_data
 from ...ir.rules import bound_rules
 from ...text.brief import brief, clip, reportable
-from ..failsafe.checks import NONNEGATIVE, check_settings
 from ..failsafe.vehicles import detect_vehicle
 from ..schemas.messages import BATTERY_MESSAGES, DATAFLASH_NOTE, resolve_message
 from ..schemas.package import data_error, load_schemas, model_class, model_package
@@ -92,6 +91,8 @@ def failsafe_check(
     from the record's context; battery 1's absent parameters at the model's defaults), with the
     action codes of the vehicle given, else detected from the set (as ``battgen params --check`` and
     ``battgen failsafe`` do). Findings the schema's own checks made are not repeated."""
+    from ..failsafe.checks import check_settings  # here: only a parameter set is checked so
+
     values: Mapping[str, object] = context if context is not None else instance.to_dict()
     flagged = {str(v.path) for v in violations}
     detection = detect_vehicle(values, vehicle)
@@ -105,10 +106,11 @@ def failsafe_check(
 
 def extra_check(message: Message) -> ExtraCheck | None:
     """The checks a message gets beyond its generated validate()."""
-    names = {f.name for f in message.fields}
-    if message.format is SourceFormat.PDEF and set(NONNEGATIVE) <= names:
-        return failsafe_check
-    return None
+    if message.format is not SourceFormat.PDEF:
+        return None
+    from ..failsafe.checks import NONNEGATIVE  # here: the failsafe's checks are imported for a parameter set alone
+
+    return failsafe_check if set(NONNEGATIVE) <= {f.name for f in message.fields} else None
 
 
 def rule_fields(schema: Schema, message: Message) -> dict[str, frozenset[str]]:
