@@ -22,6 +22,7 @@ import io
 import json
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import IO, Any
 
 from ..errors import cannot_read
 from .documents import BLANK, MAX_LINE, jsonl_text_items, jsonl_value
@@ -66,7 +67,8 @@ def jsonl_blocks(path: Path, name: str) -> Iterator[Part]:
                 continue
             whole = block[:cut]
             if not cut or not _plain(whole):
-                break
+                yield from _text_from(path, name, offset, lineno, stream, block)
+                return
             long_runs = loads is not None and whole.translate(_DIGITS).find(_LONG_RUN) >= 0
             raws = whole.splitlines(keepends=True)
             for start in range(0, len(raws), BATCH):
@@ -76,7 +78,6 @@ def jsonl_blocks(path: Path, name: str) -> Iterator[Part]:
             carry = block[cut:]
             if not data:
                 return
-    yield from _text_from(path, name, offset, lineno)
 
 
 def _plain(block: bytes) -> bool:
@@ -120,20 +121,48 @@ def _lines(
     return out, lineno
 
 
-def _text_from(path: Path, name: str, offset: int, lineno: int) -> Iterator[Part]:
-    """The rest of the file from ``offset`` (a line's start, line ``lineno + 1``) through the text reader."""
-    try:
-        raw = path.open("rb")
-    except OSError as exc:
-        raise InputError(name, 0, cannot_read(exc)) from None
-    with raw:
-        raw.seek(offset)
-        stream = io.TextIOWrapper(raw, encoding="utf-8", newline="")
+def _text_from(path: Path, name: str, offset: int, lineno: int, stream: IO[bytes], pending: bytes) -> Iterator[Part]:
+    """The rest of the file from ``offset`` (a line's start, line ``lineno + 1``) through the text reader: the file
+    opened again there (as the text reader opens it), or, when it cannot seek (a pipe), the bytes read from there
+    (``pending``) and then the rest of ``stream``."""
+    if stream.seekable():
         try:
-            for item in jsonl_text_items(stream, name, lineno=lineno):
+            raw = path.open("rb")
+        except OSError as exc:
+            raise InputError(name, 0, cannot_read(exc)) from None
+    else:
+        raw = io.BufferedReader(_Rest(pending, stream))
+    with raw:
+        if stream.seekable():
+            raw.seek(offset)
+        text = io.TextIOWrapper(raw, encoding="utf-8", newline="")
+        try:
+            for item in jsonl_text_items(text, name, lineno=lineno):
                 if isinstance(item, Record):
                     yield [(item.line, item.data)]
                 elif isinstance(item, Unreadable):
                     yield item
         finally:
-            stream.detach()  # the binary file is closed by its own with
+            text.detach()  # the binary file is closed by its own with
+
+
+class _Rest(io.RawIOBase):
+    """``head``, then what is left of ``stream``."""
+
+    def __init__(self, head: bytes, stream: IO[bytes]) -> None:
+        super().__init__()
+        self.head = memoryview(head)
+        self.stream = stream
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        if self.head:
+            n = min(len(buffer), len(self.head))
+            buffer[:n] = self.head[:n]
+            self.head = self.head[n:]
+            return n
+        data = self.stream.read(len(buffer))
+        buffer[: len(data)] = data
+        return len(data)

@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import json
+import os
+import threading
 from pathlib import Path
 
 import pytest
@@ -109,3 +111,26 @@ CRASHERS = sorted((Path(__file__).resolve().parent.parent / "fuzz" / "crashers" 
 @pytest.mark.parametrize("crasher", CRASHERS, ids=[p.name for p in CRASHERS])
 def test_blocks_read_what_lines_read_of_past_crashers(crasher: Path) -> None:
     assert _blocks(crasher) == _lines(crasher)
+
+
+def test_blocks_of_a_pipe_hand_over_to_the_text_reader_without_seeking(tmp_path: Path) -> None:
+    """A pipe (``battgen validate <(...)``) cannot be opened again at a line: the text reader is given the
+    bytes read already, then the rest."""
+    data = LINE.encode() * 3000 + b'"' + b"a" * (MAX_LINE + 5) + b'"\n' + LINE.encode() * 5
+    read, write = os.pipe()
+    writer = threading.Thread(target=_write_all, args=(write, data))
+    writer.start()
+    try:
+        piped = _blocks(Path(f"/dev/fd/{read}"))
+    finally:
+        writer.join()
+        os.close(read)
+    path = tmp_path / "f.jsonl"
+    path.write_bytes(data)
+    assert piped == _lines(path)
+    assert any(isinstance(item, Unreadable) and item.line == 3001 for item in piped)
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    with os.fdopen(fd, "wb") as out:
+        out.write(data)
