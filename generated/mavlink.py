@@ -1657,35 +1657,41 @@ class BatteryInfo:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfo:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 20:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15, v16, v17, v18, v19 = (
+                    _BATTERY_INFO_VALUES(data)
+                )
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "id"),
+                    v1 if v1.__class__ is int else _m.as_int(v1, "battery_function"),
+                    v2 if v2.__class__ is int else _m.as_int(v2, "type"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "state_of_health"),
+                    v4 if v4.__class__ is int else _m.as_int(v4, "cells_in_series"),
+                    v5 if v5.__class__ is int else _m.as_int(v5, "cycle_count"),
+                    v6 if v6.__class__ is int else _m.as_int(v6, "weight"),
+                    v7 if v7.__class__ is float else _m.as_float(v7, "discharge_minimum_voltage"),
+                    v8 if v8.__class__ is float else _m.as_float(v8, "charging_minimum_voltage"),
+                    v9 if v9.__class__ is float else _m.as_float(v9, "resting_minimum_voltage"),
+                    v10 if v10.__class__ is float else _m.as_float(v10, "charging_maximum_voltage"),
+                    v11 if v11.__class__ is float else _m.as_float(v11, "charging_maximum_current"),
+                    v12 if v12.__class__ is float else _m.as_float(v12, "nominal_voltage"),
+                    v13 if v13.__class__ is float else _m.as_float(v13, "discharge_maximum_current"),
+                    v14 if v14.__class__ is float else _m.as_float(v14, "discharge_maximum_burst_current"),
+                    v15 if v15.__class__ is float else _m.as_float(v15, "design_capacity"),
+                    v16 if v16.__class__ is float else _m.as_float(v16, "full_charge_capacity"),
+                    v17 if v17.__class__ is str else _m.as_str(v17, "manufacture_date"),
+                    v18 if v18.__class__ is str else _m.as_str(v18, "serial_number"),
+                    v19 if v19.__class__ is str else _m.as_str(v19, "name"),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATTERY_INFO_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATTERY_INFO_KEYS, (), "BatteryInfo")
-        elif len(data) == 20:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15, v16, v17, v18, v19 = (
-                _BATTERY_INFO_VALUES(data)
-            )
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "id"),
-                v1 if v1.__class__ is int else _m.as_int(v1, "battery_function"),
-                v2 if v2.__class__ is int else _m.as_int(v2, "type"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "state_of_health"),
-                v4 if v4.__class__ is int else _m.as_int(v4, "cells_in_series"),
-                v5 if v5.__class__ is int else _m.as_int(v5, "cycle_count"),
-                v6 if v6.__class__ is int else _m.as_int(v6, "weight"),
-                v7 if v7.__class__ is float else _m.as_float(v7, "discharge_minimum_voltage"),
-                v8 if v8.__class__ is float else _m.as_float(v8, "charging_minimum_voltage"),
-                v9 if v9.__class__ is float else _m.as_float(v9, "resting_minimum_voltage"),
-                v10 if v10.__class__ is float else _m.as_float(v10, "charging_maximum_voltage"),
-                v11 if v11.__class__ is float else _m.as_float(v11, "charging_maximum_current"),
-                v12 if v12.__class__ is float else _m.as_float(v12, "nominal_voltage"),
-                v13 if v13.__class__ is float else _m.as_float(v13, "discharge_maximum_current"),
-                v14 if v14.__class__ is float else _m.as_float(v14, "discharge_maximum_burst_current"),
-                v15 if v15.__class__ is float else _m.as_float(v15, "design_capacity"),
-                v16 if v16.__class__ is float else _m.as_float(v16, "full_charge_capacity"),
-                v17 if v17.__class__ is str else _m.as_str(v17, "manufacture_date"),
-                v18 if v18.__class__ is str else _m.as_str(v18, "serial_number"),
-                v19 if v19.__class__ is str else _m.as_str(v19, "name"),
-            )
         obj = cls()
         if "id" in data:
             x = data["id"]
@@ -2279,27 +2285,33 @@ class BatteryStatus:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 14:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13 = _BATTERY_STATUS_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "id"),
+                    v1 if v1.__class__ is int else _m.as_int(v1, "battery_function"),
+                    v2 if v2.__class__ is int else _m.as_int(v2, "type"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "temperature"),
+                    _m.as_typed_list(v4, "voltages", 10, True, int, _m.as_int),
+                    v5 if v5.__class__ is int else _m.as_int(v5, "current_battery"),
+                    v6 if v6.__class__ is int else _m.as_int(v6, "current_consumed"),
+                    v7 if v7.__class__ is int else _m.as_int(v7, "energy_consumed"),
+                    v8 if v8.__class__ is int else _m.as_int(v8, "battery_remaining"),
+                    v9 if v9.__class__ is int else _m.as_int(v9, "time_remaining"),
+                    v10 if v10.__class__ is int else _m.as_int(v10, "charge_state"),
+                    _m.as_typed_list(v11, "voltages_ext", 4, True, int, _m.as_int),
+                    v12 if v12.__class__ is int else _m.as_int(v12, "mode"),
+                    v13 if v13.__class__ is int else _m.as_int(v13, "fault_bitmask"),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATTERY_STATUS_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATTERY_STATUS_KEYS, (), "BatteryStatus")
-        elif len(data) == 14:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13 = _BATTERY_STATUS_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "id"),
-                v1 if v1.__class__ is int else _m.as_int(v1, "battery_function"),
-                v2 if v2.__class__ is int else _m.as_int(v2, "type"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "temperature"),
-                _m.as_typed_list(v4, "voltages", 10, True, int, _m.as_int),
-                v5 if v5.__class__ is int else _m.as_int(v5, "current_battery"),
-                v6 if v6.__class__ is int else _m.as_int(v6, "current_consumed"),
-                v7 if v7.__class__ is int else _m.as_int(v7, "energy_consumed"),
-                v8 if v8.__class__ is int else _m.as_int(v8, "battery_remaining"),
-                v9 if v9.__class__ is int else _m.as_int(v9, "time_remaining"),
-                v10 if v10.__class__ is int else _m.as_int(v10, "charge_state"),
-                _m.as_typed_list(v11, "voltages_ext", 4, True, int, _m.as_int),
-                v12 if v12.__class__ is int else _m.as_int(v12, "mode"),
-                v13 if v13.__class__ is int else _m.as_int(v13, "fault_bitmask"),
-            )
         obj = cls()
         if "id" in data:
             x = data["id"]
@@ -2756,21 +2768,27 @@ class BatteryStatusV2:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryStatusV2:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 8:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7 = _BATTERY_STATUS_V2_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "id"),
+                    v1 if v1.__class__ is int else _m.as_int(v1, "temperature"),
+                    v2 if v2.__class__ is float else _m.as_float(v2, "voltage"),
+                    v3 if v3.__class__ is float else _m.as_float(v3, "current"),
+                    v4 if v4.__class__ is float else _m.as_float(v4, "capacity_consumed"),
+                    v5 if v5.__class__ is float else _m.as_float(v5, "capacity_remaining"),
+                    v6 if v6.__class__ is float else _m.as_float(v6, "state_of_charge"),
+                    v7 if v7.__class__ is int else _m.as_int(v7, "status_flags"),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATTERY_STATUS_V2_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATTERY_STATUS_V2_KEYS, (), "BatteryStatusV2")
-        elif len(data) == 8:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7 = _BATTERY_STATUS_V2_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "id"),
-                v1 if v1.__class__ is int else _m.as_int(v1, "temperature"),
-                v2 if v2.__class__ is float else _m.as_float(v2, "voltage"),
-                v3 if v3.__class__ is float else _m.as_float(v3, "current"),
-                v4 if v4.__class__ is float else _m.as_float(v4, "capacity_consumed"),
-                v5 if v5.__class__ is float else _m.as_float(v5, "capacity_remaining"),
-                v6 if v6.__class__ is float else _m.as_float(v6, "state_of_charge"),
-                v7 if v7.__class__ is int else _m.as_int(v7, "status_flags"),
-            )
         obj = cls()
         if "id" in data:
             x = data["id"]
@@ -3030,19 +3048,25 @@ class Heartbeat:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Heartbeat:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 6:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5 = _HEARTBEAT_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "type"),
+                    v1 if v1.__class__ is int else _m.as_int(v1, "autopilot"),
+                    v2 if v2.__class__ is int else _m.as_int(v2, "base_mode"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "custom_mode"),
+                    v4 if v4.__class__ is int else _m.as_int(v4, "system_status"),
+                    v5 if v5.__class__ is int else _m.as_int(v5, "mavlink_version"),
+                )
         if data.__class__ is not dict or not data.keys() <= _HEARTBEAT_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _HEARTBEAT_KEYS, (), "Heartbeat")
-        elif len(data) == 6:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5 = _HEARTBEAT_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "type"),
-                v1 if v1.__class__ is int else _m.as_int(v1, "autopilot"),
-                v2 if v2.__class__ is int else _m.as_int(v2, "base_mode"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "custom_mode"),
-                v4 if v4.__class__ is int else _m.as_int(v4, "system_status"),
-                v5 if v5.__class__ is int else _m.as_int(v5, "mavlink_version"),
-            )
         obj = cls()
         if "type" in data:
             x = data["type"]
@@ -3301,18 +3325,24 @@ class ParamValue:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> ParamValue:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 5:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4 = _PARAM_VALUE_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is str else _m.as_str(v0, "param_id"),
+                    v1 if v1.__class__ is float else _m.as_float(v1, "param_value"),
+                    v2 if v2.__class__ is int else _m.as_int(v2, "param_type"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "param_count"),
+                    v4 if v4.__class__ is int else _m.as_int(v4, "param_index"),
+                )
         if data.__class__ is not dict or not data.keys() <= _PARAM_VALUE_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _PARAM_VALUE_KEYS, (), "ParamValue")
-        elif len(data) == 5:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4 = _PARAM_VALUE_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is str else _m.as_str(v0, "param_id"),
-                v1 if v1.__class__ is float else _m.as_float(v1, "param_value"),
-                v2 if v2.__class__ is int else _m.as_int(v2, "param_type"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "param_count"),
-                v4 if v4.__class__ is int else _m.as_int(v4, "param_index"),
-            )
         obj = cls()
         if "param_id" in data:
             x = data["param_id"]
@@ -3513,17 +3543,23 @@ class Statustext:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Statustext:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 4:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3 = _STATUSTEXT_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "severity"),
+                    v1 if v1.__class__ is str else _m.as_str(v1, "text"),
+                    v2 if v2.__class__ is int else _m.as_int(v2, "id"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "chunk_seq"),
+                )
         if data.__class__ is not dict or not data.keys() <= _STATUSTEXT_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _STATUSTEXT_KEYS, (), "Statustext")
-        elif len(data) == 4:  # every field named: fetched in one call
-            v0, v1, v2, v3 = _STATUSTEXT_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "severity"),
-                v1 if v1.__class__ is str else _m.as_str(v1, "text"),
-                v2 if v2.__class__ is int else _m.as_int(v2, "id"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "chunk_seq"),
-            )
         obj = cls()
         if "severity" in data:
             x = data["severity"]
@@ -3875,29 +3911,35 @@ class SysStatus:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> SysStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 16:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15 = _SYS_STATUS_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "onboard_control_sensors_present"),
+                    v1 if v1.__class__ is int else _m.as_int(v1, "onboard_control_sensors_enabled"),
+                    v2 if v2.__class__ is int else _m.as_int(v2, "onboard_control_sensors_health"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "load"),
+                    v4 if v4.__class__ is int else _m.as_int(v4, "voltage_battery"),
+                    v5 if v5.__class__ is int else _m.as_int(v5, "current_battery"),
+                    v6 if v6.__class__ is int else _m.as_int(v6, "battery_remaining"),
+                    v7 if v7.__class__ is int else _m.as_int(v7, "drop_rate_comm"),
+                    v8 if v8.__class__ is int else _m.as_int(v8, "errors_comm"),
+                    v9 if v9.__class__ is int else _m.as_int(v9, "errors_count1"),
+                    v10 if v10.__class__ is int else _m.as_int(v10, "errors_count2"),
+                    v11 if v11.__class__ is int else _m.as_int(v11, "errors_count3"),
+                    v12 if v12.__class__ is int else _m.as_int(v12, "errors_count4"),
+                    v13 if v13.__class__ is int else _m.as_int(v13, "onboard_control_sensors_present_extended"),
+                    v14 if v14.__class__ is int else _m.as_int(v14, "onboard_control_sensors_enabled_extended"),
+                    v15 if v15.__class__ is int else _m.as_int(v15, "onboard_control_sensors_health_extended"),
+                )
         if data.__class__ is not dict or not data.keys() <= _SYS_STATUS_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _SYS_STATUS_KEYS, (), "SysStatus")
-        elif len(data) == 16:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15 = _SYS_STATUS_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "onboard_control_sensors_present"),
-                v1 if v1.__class__ is int else _m.as_int(v1, "onboard_control_sensors_enabled"),
-                v2 if v2.__class__ is int else _m.as_int(v2, "onboard_control_sensors_health"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "load"),
-                v4 if v4.__class__ is int else _m.as_int(v4, "voltage_battery"),
-                v5 if v5.__class__ is int else _m.as_int(v5, "current_battery"),
-                v6 if v6.__class__ is int else _m.as_int(v6, "battery_remaining"),
-                v7 if v7.__class__ is int else _m.as_int(v7, "drop_rate_comm"),
-                v8 if v8.__class__ is int else _m.as_int(v8, "errors_comm"),
-                v9 if v9.__class__ is int else _m.as_int(v9, "errors_count1"),
-                v10 if v10.__class__ is int else _m.as_int(v10, "errors_count2"),
-                v11 if v11.__class__ is int else _m.as_int(v11, "errors_count3"),
-                v12 if v12.__class__ is int else _m.as_int(v12, "errors_count4"),
-                v13 if v13.__class__ is int else _m.as_int(v13, "onboard_control_sensors_present_extended"),
-                v14 if v14.__class__ is int else _m.as_int(v14, "onboard_control_sensors_enabled_extended"),
-                v15 if v15.__class__ is int else _m.as_int(v15, "onboard_control_sensors_health_extended"),
-            )
         obj = cls()
         if "onboard_control_sensors_present" in data:
             x = data["onboard_control_sensors_present"]

@@ -266,24 +266,30 @@ class BattParams:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BattParams:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 11:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10 = _BATT_PARAMS_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "BATT_CAPACITY"),
+                    v1 if v1.__class__ is float else _m.as_float(v1, "BATT_LOW_VOLT"),
+                    v2 if v2.__class__ is int else _m.as_int(v2, "BATT_LOW_TIMER"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "BATT_FS_VOLTSRC"),
+                    v4 if v4.__class__ is float else _m.as_float(v4, "BATT_LOW_MAH"),
+                    v5 if v5.__class__ is float else _m.as_float(v5, "BATT_CRT_VOLT"),
+                    v6 if v6.__class__ is float else _m.as_float(v6, "BATT_CRT_MAH"),
+                    v7 if v7.__class__ is int else _m.as_int(v7, "BATT_FS_LOW_ACT"),
+                    v8 if v8.__class__ is int else _m.as_int(v8, "BATT_FS_CRT_ACT"),
+                    v9 if v9.__class__ is float else _m.as_float(v9, "BATT_ARM_VOLT"),
+                    v10 if v10.__class__ is int else _m.as_int(v10, "BATT_ARM_MAH"),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATT_PARAMS_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATT_PARAMS_KEYS, (), "BattParams")
-        elif len(data) == 11:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10 = _BATT_PARAMS_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "BATT_CAPACITY"),
-                v1 if v1.__class__ is float else _m.as_float(v1, "BATT_LOW_VOLT"),
-                v2 if v2.__class__ is int else _m.as_int(v2, "BATT_LOW_TIMER"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "BATT_FS_VOLTSRC"),
-                v4 if v4.__class__ is float else _m.as_float(v4, "BATT_LOW_MAH"),
-                v5 if v5.__class__ is float else _m.as_float(v5, "BATT_CRT_VOLT"),
-                v6 if v6.__class__ is float else _m.as_float(v6, "BATT_CRT_MAH"),
-                v7 if v7.__class__ is int else _m.as_int(v7, "BATT_FS_LOW_ACT"),
-                v8 if v8.__class__ is int else _m.as_int(v8, "BATT_FS_CRT_ACT"),
-                v9 if v9.__class__ is float else _m.as_float(v9, "BATT_ARM_VOLT"),
-                v10 if v10.__class__ is int else _m.as_int(v10, "BATT_ARM_MAH"),
-            )
         obj = cls()
         if "BATT_CAPACITY" in data:
             x = data["BATT_CAPACITY"]

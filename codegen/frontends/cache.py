@@ -19,7 +19,6 @@ import math
 import os
 import pickle
 import sys
-import tempfile
 from collections.abc import Collection
 from pathlib import Path
 
@@ -87,6 +86,8 @@ def _read(file: Path, key: str) -> Schema | None:
 
 
 def _write(file: Path, key: str, schema: Schema) -> None:
+    import tempfile  # here: a run that finds the IR stored writes nothing
+
     try:
         file.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=file.name, suffix=".tmp", dir=file.parent)

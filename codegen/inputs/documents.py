@@ -19,14 +19,16 @@ import json
 import re
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from functools import cache
 from pathlib import Path
-from typing import IO
-
-import yaml
+from typing import IO, TYPE_CHECKING, Any
 
 from ..errors import cannot_read
 from ..text.files import read_text
 from .records import TOO_DEEP, InputError, Item, Record, Unreadable, join_path, nearest_line
+
+if TYPE_CHECKING:
+    import yaml  # imported where YAML is read: a run reading JSON does without PyYAML
 
 Source = Path | IO[bytes]
 
@@ -88,8 +90,8 @@ def _too_long(length: int) -> str:
 def read_jsonl(source: Source, name: str, *, comments: bool = False) -> Iterator[Item]:
     """One record per non-blank line (with ``comments``, lines starting with ``#`` are skipped
     too); a malformed line is an Unreadable item and reading goes on."""
-    for row in jsonl_rows(source, name, comments=comments):
-        yield Record(row[0], row[1], row[2], name) if row.__class__ is tuple else row  # type: ignore[misc]
+    with _text_stream(source, name) as stream:
+        yield from jsonl_text_items(stream, name, comments=comments)
 
 
 def jsonl_rows(
@@ -99,41 +101,73 @@ def jsonl_rows(
     where it needs one (``battgen convert``: making a frozen Record costs about what reading its line does). ``loads``:
     ``json.loads``, or a faster reader of the same values that raises its errors (convert's)."""
     with _text_stream(source, name) as stream:
-        index = 0
-        lineno = 0
-        while True:
-            try:
-                line = stream.readline(MAX_LINE + 1)
-                if len(line) > MAX_LINE and not line.endswith("\n"):
-                    lineno += 1
-                    length = len(line) + _skip_line(stream)
-                    yield Unreadable(name, lineno, _too_long(length))
-                    continue
-            except UnicodeDecodeError:
-                yield Unreadable(name, lineno + 1, "expected UTF-8 text")
-                return
-            if not line:
-                return
-            lineno += 1
-            if lineno == 1 and line.startswith(_BOM):
-                line = line[1:]
-            text = line.strip()
-            if not text or (comments and text.startswith("#")):
+        yield from _jsonl_lines(stream, name, comments=comments, loads=loads)
+
+
+def jsonl_text_items(
+    stream: IO[str], name: str, *, comments: bool = False, lineno: int = 0, index: int = 0
+) -> Iterator[Item]:
+    """:func:`read_jsonl` on an open text stream whose first ``lineno`` lines (holding ``index``
+    records) were read already (:mod:`.jsonl_blocks` hands over to it mid-file)."""
+    for row in _jsonl_lines(stream, name, comments=comments, lineno=lineno, index=index):
+        yield Record(row[0], row[1], row[2], name) if isinstance(row, tuple) else row
+
+
+def _jsonl_lines(
+    stream: IO[str],
+    name: str,
+    *,
+    comments: bool,
+    lineno: int = 0,
+    index: int = 0,
+    loads: Callable[[str], object] = json.loads,
+) -> Iterator[tuple[int, int, object] | Unreadable]:
+    while True:
+        try:
+            line = stream.readline(MAX_LINE + 1)
+            if len(line) > MAX_LINE and not line.endswith("\n"):
+                lineno += 1
+                length = len(line) + _skip_line(stream)
+                yield Unreadable(name, lineno, _too_long(length))
                 continue
-            try:
-                data = loads(line)
-            except json.JSONDecodeError as exc:
-                message = f"expected one JSON value per line: {exc.msg} (column {exc.colno})"
-                yield Unreadable(name, lineno, message, exc.msg, exc.colno)
-                continue
-            except RecursionError:
-                yield Unreadable(name, lineno, TOO_DEEP)
-                continue
-            except ValueError:  # an integer of more digits than Python converts
-                yield Unreadable(name, lineno, _long_number(line))
-                continue
-            yield index, lineno, data
-            index += 1
+        except UnicodeDecodeError:
+            yield Unreadable(name, lineno + 1, "expected UTF-8 text")
+            return
+        if not line:
+            return
+        lineno += 1
+        value = jsonl_value(line, name, lineno, comments=comments, loads=loads)
+        if value is BLANK:
+            continue
+        if isinstance(value, Unreadable):
+            yield value
+            continue
+        yield index, lineno, value
+        index += 1
+
+
+BLANK = object()  # jsonl_value's answer for a blank (or comment) line
+
+
+def jsonl_value(
+    line: str, name: str, lineno: int, *, comments: bool = False, loads: Callable[[str], object] = json.loads
+) -> object:
+    """The value of one JSON Lines line (its end of line kept: an error's column counts it),
+    :data:`BLANK` for a line holding none, or the Unreadable saying why it cannot be read."""
+    if lineno == 1 and line.startswith(_BOM):
+        line = line[1:]
+    text = line.strip()
+    if not text or (comments and text.startswith("#")):
+        return BLANK
+    try:
+        return loads(line)
+    except json.JSONDecodeError as exc:
+        message = f"expected one JSON value per line: {exc.msg} (column {exc.colno})"
+        return Unreadable(name, lineno, message, exc.msg, exc.colno)
+    except RecursionError:
+        return Unreadable(name, lineno, TOO_DEEP)
+    except ValueError:  # an integer of more digits than Python converts
+        return Unreadable(name, lineno, _long_number(line))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -274,31 +308,37 @@ def _scan_json(text: str, pos: int, path: str, out: dict[str, int], index: _Line
 # YAML: a stream of documents, each a record or a list of records; composed one document at a time
 
 
-class _LineLoader(yaml.SafeLoader):
-    """SafeLoader that also hands back the composed node, so each value's line is known."""
+@cache
+def _line_loader() -> Any:
+    """SafeLoader that also hands back the composed node, so each value's line is known (a class made
+    on first use, with PyYAML imported then)."""
+    import yaml
 
-    def next_document(self) -> tuple[object, yaml.Node] | None:
-        if not self.check_node():
-            return None
-        node = self.get_node()
-        if node is None:
-            return None
-        return self.construct_document(node), node
+    class LineLoader(yaml.SafeLoader):
+        def next_document(self) -> tuple[object, yaml.Node] | None:
+            if not self.check_node():
+                return None
+            node = self.get_node()
+            if node is None:
+                return None
+            return self.construct_document(node), node
 
-    def construct_long_int(self, node: yaml.ScalarNode) -> object:
-        """PyYAML's int, but an integer of more digits than Python converts is an error at its line."""
-        try:
-            return self.construct_yaml_int(node)
-        except ValueError:
-            digits = sum(c.isdigit() for c in str(node.value))
-            problem = f"an integer of {digits} digits is more than a battery field holds (4,300 cannot be read)"
-            raise yaml.constructor.ConstructorError(None, None, problem, node.start_mark) from None
+        def construct_long_int(self, node: yaml.ScalarNode) -> object:
+            """PyYAML's int, but an integer of more digits than Python converts is an error at its line."""
+            try:
+                return self.construct_yaml_int(node)
+            except ValueError:
+                digits = sum(c.isdigit() for c in str(node.value))
+                problem = f"an integer of {digits} digits is more than a battery field holds (4,300 cannot be read)"
+                raise yaml.constructor.ConstructorError(None, None, problem, node.start_mark) from None
 
-
-_LineLoader.add_constructor("tag:yaml.org,2002:int", _LineLoader.construct_long_int)
+    LineLoader.add_constructor("tag:yaml.org,2002:int", LineLoader.construct_long_int)
+    return LineLoader
 
 
 def _node_lines(node: yaml.Node, path: str, out: dict[str, int], seen: set[int]) -> None:
+    import yaml
+
     out.setdefault(path, node.start_mark.line + 1)
     if id(node) in seen:
         return  # an alias: its lines are those of the anchored node, walked once (no alias bombs)
@@ -329,6 +369,8 @@ def _yaml_locator(node: yaml.Node) -> Callable[[str], int | None]:
 
 
 def _yaml_error(name: str, exc: Exception) -> InputError:
+    import yaml
+
     if isinstance(exc, yaml.MarkedYAMLError):
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else 0
@@ -343,9 +385,11 @@ def _yaml_error(name: str, exc: Exception) -> InputError:
 def read_yaml(source: Source, name: str) -> Iterator[Item]:
     """One record per document, or per item of a document that is a list; empty documents are
     skipped. A malformed document raises InputError when reading reaches it."""
+    import yaml
+
     with _text_stream(source, name) as stream:
         try:
-            loader = _LineLoader(stream)
+            loader = _line_loader()(stream)
         except (yaml.YAMLError, UnicodeDecodeError) as exc:
             raise _yaml_error(name, exc) from None
         try:

@@ -10,7 +10,6 @@ import dataclasses
 import enum
 import json
 from functools import cache
-from importlib import resources
 from typing import Any
 
 from .. import ir
@@ -69,6 +68,8 @@ IR_SCHEMA_ID = "https://battgen.dev/schemas/ir.schema.json"
 @cache
 def ir_json_schema() -> dict[str, Any]:
     """The JSON Schema (Draft 2020-12) of the IR's JSON form, shipped with the toolchain."""
+    from importlib import resources  # here: it brings tempfile, which reading data does without
+
     text = resources.files(__package__).joinpath("ir.schema.json").read_text(encoding="utf-8")
     result: dict[str, Any] = json.loads(text)
     return result

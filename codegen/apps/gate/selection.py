@@ -30,8 +30,6 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import yaml
-
 from ...errors import BattgenError, close_names
 from ...ir import Message
 
@@ -122,6 +120,8 @@ def load_profile(name: str) -> Profile:
     if not re.fullmatch(r"[a-z0-9_-]+", name) or not path.is_file():
         hint = closest(name, profile_names())
         raise BattgenError(f"unknown profile {name!r}{hint} (bundled profiles: {', '.join(profile_names())})")
+    import yaml  # here: a run without --profile reads no YAML
+
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
     waivers = tuple(
         Waiver(str(w["message"]), str(w["ignore"]), " ".join(str(w["reason"]).split()), tuple(w["evidence"]))

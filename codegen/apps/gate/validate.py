@@ -20,12 +20,12 @@ from ...errors import BattgenError, LocatedError
 from ...inputs.dispatch import read_records
 from ...inputs.files.kind_formats import KIND_FORMATS
 from ...inputs.files.kinds import file_kind
+from ...inputs.jsonl_blocks import jsonl_blocks
 from ...inputs.model import GeneratedMessage, MessageClass, Violation
 from ...inputs.records import Notice, Record, Unreadable
 from ...ir import Message, Schema, SourceFormat
 from ...ir.numbers import to_json_data
 from ...text.brief import brief, clip, reportable
-from ..failsafe.checks import NONNEGATIVE, check_settings
 from ..failsafe.vehicles import detect_vehicle
 from ..schemas.fits import left_out, rule_fields
 from ..schemas.messages import BATTERY_MESSAGES, DATAFLASH_NOTE, resolve_message
@@ -91,6 +91,8 @@ def failsafe_check(
     from the record's context; battery 1's absent parameters at the model's defaults), with the
     action codes of the vehicle given, else detected from the set (as ``battgen params --check`` and
     ``battgen failsafe`` do). Findings the schema's own checks made are not repeated."""
+    from ..failsafe.checks import check_settings  # here: only a parameter set is checked so
+
     values: Mapping[str, object] = context if context is not None else instance.to_dict()
     flagged = {str(v.path) for v in violations}
     detection = detect_vehicle(values, vehicle)
@@ -104,10 +106,11 @@ def failsafe_check(
 
 def extra_check(message: Message) -> ExtraCheck | None:
     """The checks a message gets beyond its generated validate()."""
-    names = {f.name for f in message.fields}
-    if message.format is SourceFormat.PDEF and set(NONNEGATIVE) <= names:
-        return failsafe_check
-    return None
+    if message.format is not SourceFormat.PDEF:
+        return None
+    from ..failsafe.checks import NONNEGATIVE  # here: the failsafe's checks are imported for a parameter set alone
+
+    return failsafe_check if set(NONNEGATIVE) <= {f.name for f in message.fields} else None
 
 
 class Checker:
@@ -129,6 +132,8 @@ class Checker:
         self.rules = rules or {}
         self.extra = extra
         self.vehicle = vehicle  # the ArduPilot vehicle a parameter set is for (None: detect it)
+        # a record is judged by from_dict and validate() alone: no checks beyond them, no devicetree node's reading
+        self.plain = extra is None and message.devicetree is None
 
     def check(self, record: Record) -> list[Finding]:
         instance = record.instance
@@ -268,31 +273,40 @@ def check_file(
         if on_event is not None:
             on_event(event)
 
+    def judge(record: Record) -> None:
+        report.records += 1
+        for finding in checker.check(record):
+            reason = gate.why_not(finding.rule, finding.path) if gate is not None else None
+            if reason is not None:
+                finding = dataclasses.replace(finding, waived=reason)
+                report.waived += 1
+            elif finding.severity == "warning":
+                report.warnings += 1
+            else:
+                report.errors += 1
+            if keep_findings:
+                report.findings.append(finding)
+            tell(finding)
+
+    def note(item: Notice | Unreadable) -> None:
+        if isinstance(item, Notice):
+            report.notices.append(item)
+            if item.severity == "error":  # damage a reader found (a CAN transfer's bad CRC): a finding too
+                report.errors += 1
+        else:
+            report.unreadable.append(item)
+        tell(item)
+
     try:
-        for item in read_records(path, message, report.file, model=checker.cls, kind=kind, subjects=subjects):
-            if isinstance(item, Notice):
-                report.notices.append(item)
-                if item.severity == "error":  # damage a reader found (a CAN transfer's bad CRC): a finding too
-                    report.errors += 1
-                tell(item)
-                continue
-            if isinstance(item, Unreadable):
-                report.unreadable.append(item)
-                tell(item)
-                continue
-            report.records += 1
-            for finding in checker.check(item):
-                reason = gate.why_not(finding.rule, finding.path) if gate is not None else None
-                if reason is not None:
-                    finding = dataclasses.replace(finding, waived=reason)
-                    report.waived += 1
-                elif finding.severity == "warning":
-                    report.warnings += 1
+        kind = kind or file_kind(path)
+        if kind == "jsonl" and checker.plain:
+            _check_json_lines(path, report, checker.cls, judge, note)
+        else:
+            for item in read_records(path, message, report.file, model=checker.cls, kind=kind, subjects=subjects):
+                if isinstance(item, Record):
+                    judge(item)
                 else:
-                    report.errors += 1
-                if keep_findings:
-                    report.findings.append(finding)
-                tell(finding)
+                    note(item)
     except LocatedError as exc:  # input, parameter-file and devicetree errors name file and line
         problem = Unreadable(exc.file, exc.line, exc.message)
     except BattgenError as exc:
@@ -304,6 +318,32 @@ def check_file(
     report.unreadable.append(problem)
     tell(problem)
     return report
+
+
+def _check_json_lines(
+    path: Path,
+    report: FileReport,
+    cls: MessageClass,
+    judge: Callable[[Record], None],
+    note: Callable[[Unreadable], None],
+) -> None:
+    """A JSON Lines file of plain records, a block of lines at a time: a line that ``from_dict`` and
+    ``validate()`` pass is counted, and only a line with findings becomes a Record and is checked
+    again by :meth:`Checker.check`, which words them (what a file of valid records costs is the
+    parse and the generated code, nothing per line beyond them)."""
+    from_dict = cls.from_dict
+    for part in jsonl_blocks(path, report.file):
+        if isinstance(part, Unreadable):
+            note(part)
+            continue
+        for line, data in part:
+            try:
+                if not from_dict(data).validate():  # data not a mapping: from_dict raises, and the check below words it
+                    report.records += 1
+                    continue
+            except Exception:  # a record from_dict rejects: Checker.check words why
+                pass
+            judge(Record(report.records, line, data, report.file))
 
 
 def is_empty(report: FileReport) -> bool:

@@ -15,9 +15,7 @@ import hashlib
 import importlib
 import importlib.util
 import os
-import shutil
 import sys
-import tempfile
 from collections.abc import Collection, Iterable
 from pathlib import Path
 from types import ModuleType
@@ -106,6 +104,9 @@ def _committed_package(folder: Path) -> ModuleType:
 def _temporary_package(schema: Schema, key: str) -> ModuleType:
     digest = hashlib.sha256(key.encode()).hexdigest()[:12]
     name = f"_battgen_models_{digest}"
+    import shutil  # here: the bundled schemas, what most runs read, need neither
+    import tempfile
+
     tmp = Path(tempfile.mkdtemp(prefix="battgen-models-"))
     atexit.register(shutil.rmtree, tmp, True)
     from ...backends.python.writer import generate  # the code generator, for a folder other than the bundled one

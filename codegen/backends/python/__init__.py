@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from collections import defaultdict
 from functools import cache
-from importlib import resources
 from typing import TYPE_CHECKING
 
 from ...ir import DronecanKind, Message, Schema, SourceFormat
@@ -40,6 +39,8 @@ def _indent_block(text: str, width: int) -> str:
 
 @cache
 def environment() -> jinja2.Environment:
+    from importlib import resources  # here, as jinja2: it brings tempfile, which reading data does without
+
     import jinja2
 
     loader = jinja2.DictLoader(

@@ -8,9 +8,7 @@ configuration found on disk out, so the output depends on the IR and the ruff ve
 
 from __future__ import annotations
 
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 from ...errors import BattgenError
@@ -31,6 +29,9 @@ def ruff_format(files: dict[str, str]) -> dict[str, str]:
     sources = {rel: text for rel, text in files.items() if rel.endswith(".py")}
     if not sources:
         return dict(files)
+    import subprocess  # here, not at the top: a data command imports this module for its names alone
+    import tempfile
+
     with tempfile.TemporaryDirectory(prefix="battgen-ruff-") as tmp:
         root = Path(tmp)
         for rel, text in sources.items():

@@ -57,7 +57,8 @@ class ClassView:
     whole_getter: str = ""  # module-level operator.itemgetter of every field's name, in field order
     whole_keys: str = ""  # the itemgetter's arguments
     whole_count: int = 0  # how many
-    whole_from_dict: str = ""  # statements reading such a record (unindented), returning the instance
+    whole_fetch: str = ""  # the getter's call, assigning every value to its local
+    whole_from_dict: str = ""  # the statement building the instance from those locals (unindented)
 
 
 def enum_views(enums: tuple[EnumDef, ...], owner: str) -> list[EnumView]:
@@ -171,11 +172,11 @@ def _whole_record(ctx: ModuleContext, cls: str, keys: list[str], readers: list[s
     values into locals ``v0``.. (no per-field membership test, no default set and then overwritten), each
     taken as it is when of the attribute's type, and the class is called with them in field order."""
     targets = ", ".join(f"v{i}" for i in range(len(readers)))
-    body = f"{targets} = {{getter}}(data)\nreturn cls(\n" + "".join(f"    {r},\n" for r in readers) + ")"
     getter = ctx.constant(cls, "VALUES")
     return {
         "whole_getter": getter,
         "whole_keys": ", ".join(py_literal(k) for k in keys),
         "whole_count": len(keys),
-        "whole_from_dict": body.replace("{getter}", getter),
+        "whole_fetch": f"{targets} = {getter}(data)",
+        "whole_from_dict": "return cls(\n" + "".join(f"    {r},\n" for r in readers) + ")",
     }

@@ -375,15 +375,21 @@ class BatteryCells:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryCells:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 2:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1 = _BATTERY_CELLS_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    _m.as_typed_list(v0, "voltages", 24, False, float, _m.as_float),
+                    v1 if v1.__class__ is int else _m.as_int(v1, "index"),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATTERY_CELLS_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATTERY_CELLS_KEYS, (), "BatteryCells")
-        elif len(data) == 2:  # every field named: fetched in one call
-            v0, v1 = _BATTERY_CELLS_VALUES(data)
-            return cls(
-                _m.as_typed_list(v0, "voltages", 24, False, float, _m.as_float),
-                v1 if v1.__class__ is int else _m.as_int(v1, "index"),
-            )
         obj = cls()
         if "voltages" in data:
             x = data["voltages"]
@@ -629,22 +635,28 @@ class BatteryContinuous:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryContinuous:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 9:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7, v8 = _BATTERY_CONTINUOUS_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is float else _m.as_float(v0, "temperature_cells"),
+                    v1 if v1.__class__ is float else _m.as_float(v1, "temperature_pcb"),
+                    v2 if v2.__class__ is float else _m.as_float(v2, "temperature_other"),
+                    v3 if v3.__class__ is float else _m.as_float(v3, "current"),
+                    v4 if v4.__class__ is float else _m.as_float(v4, "voltage"),
+                    v5 if v5.__class__ is float else _m.as_float(v5, "state_of_charge"),
+                    v6 if v6.__class__ is int else _m.as_int(v6, "slot_id"),
+                    v7 if v7.__class__ is float else _m.as_float(v7, "capacity_consumed"),
+                    v8 if v8.__class__ is int else _m.as_int(v8, "status_flags"),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATTERY_CONTINUOUS_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATTERY_CONTINUOUS_KEYS, (), "BatteryContinuous")
-        elif len(data) == 9:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7, v8 = _BATTERY_CONTINUOUS_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is float else _m.as_float(v0, "temperature_cells"),
-                v1 if v1.__class__ is float else _m.as_float(v1, "temperature_pcb"),
-                v2 if v2.__class__ is float else _m.as_float(v2, "temperature_other"),
-                v3 if v3.__class__ is float else _m.as_float(v3, "current"),
-                v4 if v4.__class__ is float else _m.as_float(v4, "voltage"),
-                v5 if v5.__class__ is float else _m.as_float(v5, "state_of_charge"),
-                v6 if v6.__class__ is int else _m.as_int(v6, "slot_id"),
-                v7 if v7.__class__ is float else _m.as_float(v7, "capacity_consumed"),
-                v8 if v8.__class__ is int else _m.as_int(v8, "status_flags"),
-            )
         obj = cls()
         if "temperature_cells" in data:
             x = data["temperature_cells"]
@@ -955,21 +967,27 @@ class BatteryInfoAux:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfoAux:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 8:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7 = _BATTERY_INFO_AUX_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    _m.as_object(v0, "timestamp", _timestamp_class()),
+                    _m.as_typed_list(v1, "voltage_cell", 255, False, float, _m.as_float),
+                    v2 if v2.__class__ is int else _m.as_int(v2, "cycle_count"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "over_discharge_count"),
+                    v4 if v4.__class__ is float else _m.as_float(v4, "max_current"),
+                    v5 if v5.__class__ is float else _m.as_float(v5, "nominal_voltage"),
+                    v6 if v6.__class__ is bool else _m.as_bool(v6, "is_powering_off"),
+                    v7 if v7.__class__ is int else _m.as_int(v7, "battery_id"),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATTERY_INFO_AUX_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATTERY_INFO_AUX_KEYS, (), "BatteryInfoAux")
-        elif len(data) == 8:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7 = _BATTERY_INFO_AUX_VALUES(data)
-            return cls(
-                _m.as_object(v0, "timestamp", _timestamp_class()),
-                _m.as_typed_list(v1, "voltage_cell", 255, False, float, _m.as_float),
-                v2 if v2.__class__ is int else _m.as_int(v2, "cycle_count"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "over_discharge_count"),
-                v4 if v4.__class__ is float else _m.as_float(v4, "max_current"),
-                v5 if v5.__class__ is float else _m.as_float(v5, "nominal_voltage"),
-                v6 if v6.__class__ is bool else _m.as_bool(v6, "is_powering_off"),
-                v7 if v7.__class__ is int else _m.as_int(v7, "battery_id"),
-            )
         obj = cls()
         if "timestamp" in data:
             x = data["timestamp"]
@@ -1413,28 +1431,34 @@ class BatteryPeriodic:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryPeriodic:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 15:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14 = _BATTERY_PERIODIC_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    _m.as_bytes(v0, "name", 50, False),
+                    _m.as_bytes(v1, "serial_number", 32, False),
+                    _m.as_bytes(v2, "manufacture_date", 9, False),
+                    v3 if v3.__class__ is float else _m.as_float(v3, "design_capacity"),
+                    v4 if v4.__class__ is int else _m.as_int(v4, "cells_in_series"),
+                    v5 if v5.__class__ is float else _m.as_float(v5, "nominal_voltage"),
+                    v6 if v6.__class__ is float else _m.as_float(v6, "discharge_minimum_voltage"),
+                    v7 if v7.__class__ is float else _m.as_float(v7, "charging_minimum_voltage"),
+                    v8 if v8.__class__ is float else _m.as_float(v8, "charging_maximum_voltage"),
+                    v9 if v9.__class__ is float else _m.as_float(v9, "charging_maximum_current"),
+                    v10 if v10.__class__ is float else _m.as_float(v10, "discharge_maximum_current"),
+                    v11 if v11.__class__ is float else _m.as_float(v11, "discharge_maximum_burst_current"),
+                    v12 if v12.__class__ is float else _m.as_float(v12, "full_charge_capacity"),
+                    v13 if v13.__class__ is int else _m.as_int(v13, "cycle_count"),
+                    v14 if v14.__class__ is int else _m.as_int(v14, "state_of_health"),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATTERY_PERIODIC_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATTERY_PERIODIC_KEYS, (), "BatteryPeriodic")
-        elif len(data) == 15:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14 = _BATTERY_PERIODIC_VALUES(data)
-            return cls(
-                _m.as_bytes(v0, "name", 50, False),
-                _m.as_bytes(v1, "serial_number", 32, False),
-                _m.as_bytes(v2, "manufacture_date", 9, False),
-                v3 if v3.__class__ is float else _m.as_float(v3, "design_capacity"),
-                v4 if v4.__class__ is int else _m.as_int(v4, "cells_in_series"),
-                v5 if v5.__class__ is float else _m.as_float(v5, "nominal_voltage"),
-                v6 if v6.__class__ is float else _m.as_float(v6, "discharge_minimum_voltage"),
-                v7 if v7.__class__ is float else _m.as_float(v7, "charging_minimum_voltage"),
-                v8 if v8.__class__ is float else _m.as_float(v8, "charging_maximum_voltage"),
-                v9 if v9.__class__ is float else _m.as_float(v9, "charging_maximum_current"),
-                v10 if v10.__class__ is float else _m.as_float(v10, "discharge_maximum_current"),
-                v11 if v11.__class__ is float else _m.as_float(v11, "discharge_maximum_burst_current"),
-                v12 if v12.__class__ is float else _m.as_float(v12, "full_charge_capacity"),
-                v13 if v13.__class__ is int else _m.as_int(v13, "cycle_count"),
-                v14 if v14.__class__ is int else _m.as_int(v14, "state_of_health"),
-            )
         obj = cls()
         if "name" in data:
             x = data["name"]
@@ -1829,19 +1853,25 @@ class BatteryTag:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryTag:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 6:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5 = _BATTERY_TAG_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "serial_number"),
+                    v1 if v1.__class__ is int else _m.as_int(v1, "num_cycles"),
+                    v2 if v2.__class__ is float else _m.as_float(v2, "armed_hours"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "battery_capacity_mAh"),
+                    v4 if v4.__class__ is int else _m.as_int(v4, "first_use_mins"),
+                    v5 if v5.__class__ is int else _m.as_int(v5, "last_arm_time_mins"),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATTERY_TAG_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATTERY_TAG_KEYS, (), "BatteryTag")
-        elif len(data) == 6:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5 = _BATTERY_TAG_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "serial_number"),
-                v1 if v1.__class__ is int else _m.as_int(v1, "num_cycles"),
-                v2 if v2.__class__ is float else _m.as_float(v2, "armed_hours"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "battery_capacity_mAh"),
-                v4 if v4.__class__ is int else _m.as_int(v4, "first_use_mins"),
-                v5 if v5.__class__ is int else _m.as_int(v5, "last_arm_time_mins"),
-            )
         obj = cls()
         if "serial_number" in data:
             x = data["serial_number"]

@@ -361,64 +361,70 @@ class CBAT:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> CBAT:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 25:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                (
+                    v0,
+                    v1,
+                    v2,
+                    v3,
+                    v4,
+                    v5,
+                    v6,
+                    v7,
+                    v8,
+                    v9,
+                    v10,
+                    v11,
+                    v12,
+                    v13,
+                    v14,
+                    v15,
+                    v16,
+                    v17,
+                    v18,
+                    v19,
+                    v20,
+                    v21,
+                    v22,
+                    v23,
+                    v24,
+                ) = _CBAT_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is float else _m.as_float(v0, "temperature"),
+                    v1 if v1.__class__ is float else _m.as_float(v1, "voltage"),
+                    _m.as_typed_list(v2, "voltage_cell", 15, False, float, _m.as_float),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "cell_count"),
+                    v4 if v4.__class__ is float else _m.as_float(v4, "current"),
+                    v5 if v5.__class__ is float else _m.as_float(v5, "average_current"),
+                    v6 if v6.__class__ is float else _m.as_float(v6, "average_power"),
+                    v7 if v7.__class__ is float else _m.as_float(v7, "available_energy"),
+                    v8 if v8.__class__ is float else _m.as_float(v8, "remaining_capacity"),
+                    v9 if v9.__class__ is float else _m.as_float(v9, "full_charge_capacity"),
+                    v10 if v10.__class__ is float else _m.as_float(v10, "design_capacity"),
+                    v11 if v11.__class__ is int else _m.as_int(v11, "average_time_to_empty"),
+                    v12 if v12.__class__ is int else _m.as_int(v12, "average_time_to_full"),
+                    v13 if v13.__class__ is int else _m.as_int(v13, "state_of_health"),
+                    v14 if v14.__class__ is int else _m.as_int(v14, "state_of_charge"),
+                    v15 if v15.__class__ is int else _m.as_int(v15, "max_error"),
+                    v16 if v16.__class__ is int else _m.as_int(v16, "serial_number"),
+                    v17 if v17.__class__ is int else _m.as_int(v17, "manufacture_date"),
+                    v18 if v18.__class__ is int else _m.as_int(v18, "cycle_count"),
+                    v19 if v19.__class__ is int else _m.as_int(v19, "over_discharge_count"),
+                    v20 if v20.__class__ is float else _m.as_float(v20, "passed_charge"),
+                    v21 if v21.__class__ is float else _m.as_float(v21, "nominal_voltage"),
+                    v22 if v22.__class__ is bool else _m.as_bool(v22, "is_powering_off"),
+                    v23 if v23.__class__ is int else _m.as_int(v23, "interface_error"),
+                    v24 if v24.__class__ is int else _m.as_int(v24, "status_flags"),
+                )
         if data.__class__ is not dict or not data.keys() <= _CBAT_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _CBAT_KEYS, (), "CBAT")
-        elif len(data) == 25:  # every field named: fetched in one call
-            (
-                v0,
-                v1,
-                v2,
-                v3,
-                v4,
-                v5,
-                v6,
-                v7,
-                v8,
-                v9,
-                v10,
-                v11,
-                v12,
-                v13,
-                v14,
-                v15,
-                v16,
-                v17,
-                v18,
-                v19,
-                v20,
-                v21,
-                v22,
-                v23,
-                v24,
-            ) = _CBAT_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is float else _m.as_float(v0, "temperature"),
-                v1 if v1.__class__ is float else _m.as_float(v1, "voltage"),
-                _m.as_typed_list(v2, "voltage_cell", 15, False, float, _m.as_float),
-                v3 if v3.__class__ is int else _m.as_int(v3, "cell_count"),
-                v4 if v4.__class__ is float else _m.as_float(v4, "current"),
-                v5 if v5.__class__ is float else _m.as_float(v5, "average_current"),
-                v6 if v6.__class__ is float else _m.as_float(v6, "average_power"),
-                v7 if v7.__class__ is float else _m.as_float(v7, "available_energy"),
-                v8 if v8.__class__ is float else _m.as_float(v8, "remaining_capacity"),
-                v9 if v9.__class__ is float else _m.as_float(v9, "full_charge_capacity"),
-                v10 if v10.__class__ is float else _m.as_float(v10, "design_capacity"),
-                v11 if v11.__class__ is int else _m.as_int(v11, "average_time_to_empty"),
-                v12 if v12.__class__ is int else _m.as_int(v12, "average_time_to_full"),
-                v13 if v13.__class__ is int else _m.as_int(v13, "state_of_health"),
-                v14 if v14.__class__ is int else _m.as_int(v14, "state_of_charge"),
-                v15 if v15.__class__ is int else _m.as_int(v15, "max_error"),
-                v16 if v16.__class__ is int else _m.as_int(v16, "serial_number"),
-                v17 if v17.__class__ is int else _m.as_int(v17, "manufacture_date"),
-                v18 if v18.__class__ is int else _m.as_int(v18, "cycle_count"),
-                v19 if v19.__class__ is int else _m.as_int(v19, "over_discharge_count"),
-                v20 if v20.__class__ is float else _m.as_float(v20, "passed_charge"),
-                v21 if v21.__class__ is float else _m.as_float(v21, "nominal_voltage"),
-                v22 if v22.__class__ is bool else _m.as_bool(v22, "is_powering_off"),
-                v23 if v23.__class__ is int else _m.as_int(v23, "interface_error"),
-                v24 if v24.__class__ is int else _m.as_int(v24, "status_flags"),
-            )
         obj = cls()
         if "temperature" in data:
             x = data["temperature"]

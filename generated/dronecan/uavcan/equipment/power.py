@@ -460,27 +460,33 @@ class BatteryInfo:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> BatteryInfo:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 14:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13 = _BATTERY_INFO_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is float else _m.as_float(v0, "temperature"),
+                    v1 if v1.__class__ is float else _m.as_float(v1, "voltage"),
+                    v2 if v2.__class__ is float else _m.as_float(v2, "current"),
+                    v3 if v3.__class__ is float else _m.as_float(v3, "average_power_10sec"),
+                    v4 if v4.__class__ is float else _m.as_float(v4, "remaining_capacity_wh"),
+                    v5 if v5.__class__ is float else _m.as_float(v5, "full_charge_capacity_wh"),
+                    v6 if v6.__class__ is float else _m.as_float(v6, "hours_to_full_charge"),
+                    v7 if v7.__class__ is int else _m.as_int(v7, "status_flags"),
+                    v8 if v8.__class__ is int else _m.as_int(v8, "state_of_health_pct"),
+                    v9 if v9.__class__ is int else _m.as_int(v9, "state_of_charge_pct"),
+                    v10 if v10.__class__ is int else _m.as_int(v10, "state_of_charge_pct_stdev"),
+                    v11 if v11.__class__ is int else _m.as_int(v11, "battery_id"),
+                    v12 if v12.__class__ is int else _m.as_int(v12, "model_instance_id"),
+                    _m.as_bytes(v13, "model_name", 31, False),
+                )
         if data.__class__ is not dict or not data.keys() <= _BATTERY_INFO_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _BATTERY_INFO_KEYS, (), "BatteryInfo")
-        elif len(data) == 14:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13 = _BATTERY_INFO_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is float else _m.as_float(v0, "temperature"),
-                v1 if v1.__class__ is float else _m.as_float(v1, "voltage"),
-                v2 if v2.__class__ is float else _m.as_float(v2, "current"),
-                v3 if v3.__class__ is float else _m.as_float(v3, "average_power_10sec"),
-                v4 if v4.__class__ is float else _m.as_float(v4, "remaining_capacity_wh"),
-                v5 if v5.__class__ is float else _m.as_float(v5, "full_charge_capacity_wh"),
-                v6 if v6.__class__ is float else _m.as_float(v6, "hours_to_full_charge"),
-                v7 if v7.__class__ is int else _m.as_int(v7, "status_flags"),
-                v8 if v8.__class__ is int else _m.as_int(v8, "state_of_health_pct"),
-                v9 if v9.__class__ is int else _m.as_int(v9, "state_of_charge_pct"),
-                v10 if v10.__class__ is int else _m.as_int(v10, "state_of_charge_pct_stdev"),
-                v11 if v11.__class__ is int else _m.as_int(v11, "battery_id"),
-                v12 if v12.__class__ is int else _m.as_int(v12, "model_instance_id"),
-                _m.as_bytes(v13, "model_name", 31, False),
-            )
         obj = cls()
         if "temperature" in data:
             x = data["temperature"]
@@ -857,17 +863,23 @@ class CircuitStatus:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> CircuitStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 4:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3 = _CIRCUIT_STATUS_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "circuit_id"),
+                    v1 if v1.__class__ is float else _m.as_float(v1, "voltage"),
+                    v2 if v2.__class__ is float else _m.as_float(v2, "current"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "error_flags"),
+                )
         if data.__class__ is not dict or not data.keys() <= _CIRCUIT_STATUS_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _CIRCUIT_STATUS_KEYS, (), "CircuitStatus")
-        elif len(data) == 4:  # every field named: fetched in one call
-            v0, v1, v2, v3 = _CIRCUIT_STATUS_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "circuit_id"),
-                v1 if v1.__class__ is float else _m.as_float(v1, "voltage"),
-                v2 if v2.__class__ is float else _m.as_float(v2, "current"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "error_flags"),
-            )
         obj = cls()
         if "circuit_id" in data:
             x = data["circuit_id"]
@@ -1068,18 +1080,24 @@ class PrimaryPowerSupplyStatus:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> PrimaryPowerSupplyStatus:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 5:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4 = _PRIMARY_POWER_SUPPLY_STATUS_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is float else _m.as_float(v0, "hours_to_empty_at_10sec_avg_power"),
+                    v1 if v1.__class__ is float else _m.as_float(v1, "hours_to_empty_at_10sec_avg_power_variance"),
+                    v2 if v2.__class__ is bool else _m.as_bool(v2, "external_power_available"),
+                    v3 if v3.__class__ is int else _m.as_int(v3, "remaining_energy_pct"),
+                    v4 if v4.__class__ is int else _m.as_int(v4, "remaining_energy_pct_stdev"),
+                )
         if data.__class__ is not dict or not data.keys() <= _PRIMARY_POWER_SUPPLY_STATUS_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _PRIMARY_POWER_SUPPLY_STATUS_KEYS, (), "PrimaryPowerSupplyStatus")
-        elif len(data) == 5:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4 = _PRIMARY_POWER_SUPPLY_STATUS_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is float else _m.as_float(v0, "hours_to_empty_at_10sec_avg_power"),
-                v1 if v1.__class__ is float else _m.as_float(v1, "hours_to_empty_at_10sec_avg_power_variance"),
-                v2 if v2.__class__ is bool else _m.as_bool(v2, "external_power_available"),
-                v3 if v3.__class__ is int else _m.as_int(v3, "remaining_energy_pct"),
-                v4 if v4.__class__ is int else _m.as_int(v4, "remaining_energy_pct_stdev"),
-            )
         obj = cls()
         if "hours_to_empty_at_10sec_avg_power" in data:
             x = data["hours_to_empty_at_10sec_avg_power"]

@@ -145,15 +145,21 @@ class PowerTs_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> PowerTs_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 2:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1 = _POWER_TS_0_1_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    _m.as_object(v0, "timestamp", _synchronized_timestamp_1_0_class()),
+                    _m.as_object(v1, "value", _power_0_1_class()),
+                )
         if data.__class__ is not dict or not data.keys() <= _POWER_TS_0_1_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _POWER_TS_0_1_KEYS, (), "PowerTs_0_1")
-        elif len(data) == 2:  # every field named: fetched in one call
-            v0, v1 = _POWER_TS_0_1_VALUES(data)
-            return cls(
-                _m.as_object(v0, "timestamp", _synchronized_timestamp_1_0_class()),
-                _m.as_object(v1, "value", _power_0_1_class()),
-            )
         obj = cls()
         if "timestamp" in data:
             x = data["timestamp"]
@@ -271,15 +277,21 @@ class Power_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Power_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 2:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1 = _POWER_0_1_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    _m.as_object(v0, "current", _scalar_1_0_class()),
+                    _m.as_object(v1, "voltage", _scalar_1_0_class_2()),
+                )
         if data.__class__ is not dict or not data.keys() <= _POWER_0_1_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _POWER_0_1_KEYS, (), "Power_0_1")
-        elif len(data) == 2:  # every field named: fetched in one call
-            v0, v1 = _POWER_0_1_VALUES(data)
-            return cls(
-                _m.as_object(v0, "current", _scalar_1_0_class()),
-                _m.as_object(v1, "voltage", _scalar_1_0_class_2()),
-            )
         obj = cls()
         if "current" in data:
             x = data["current"]
@@ -395,15 +407,21 @@ class SourceTs_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> SourceTs_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 2:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1 = _SOURCE_TS_0_1_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    _m.as_object(v0, "timestamp", _synchronized_timestamp_1_0_class()),
+                    _m.as_object(v1, "value", _source_0_1_class()),
+                )
         if data.__class__ is not dict or not data.keys() <= _SOURCE_TS_0_1_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _SOURCE_TS_0_1_KEYS, (), "SourceTs_0_1")
-        elif len(data) == 2:  # every field named: fetched in one call
-            v0, v1 = _SOURCE_TS_0_1_VALUES(data)
-            return cls(
-                _m.as_object(v0, "timestamp", _synchronized_timestamp_1_0_class()),
-                _m.as_object(v1, "value", _source_0_1_class()),
-            )
         obj = cls()
         if "timestamp" in data:
             x = data["timestamp"]
@@ -526,16 +544,22 @@ class Source_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Source_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 3:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2 = _SOURCE_0_1_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    _m.as_object(v0, "power", _power_0_1_class()),
+                    _m.as_object(v1, "energy", _scalar_1_0_class_3()),
+                    _m.as_object(v2, "full_energy", _scalar_1_0_class_3()),
+                )
         if data.__class__ is not dict or not data.keys() <= _SOURCE_0_1_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _SOURCE_0_1_KEYS, (), "Source_0_1")
-        elif len(data) == 3:  # every field named: fetched in one call
-            v0, v1, v2 = _SOURCE_0_1_VALUES(data)
-            return cls(
-                _m.as_object(v0, "power", _power_0_1_class()),
-                _m.as_object(v1, "energy", _scalar_1_0_class_3()),
-                _m.as_object(v2, "full_energy", _scalar_1_0_class_3()),
-            )
         obj = cls()
         if "power" in data:
             x = data["power"]

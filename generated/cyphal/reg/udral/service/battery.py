@@ -545,36 +545,42 @@ class Parameters_0_3:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Parameters_0_3:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 17:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15, v16 = _PARAMETERS_0_3_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    v0 if v0.__class__ is int else _m.as_int(v0, "unique_id"),
+                    _m.as_object(v1, "mass", _scalar_1_0_class()),
+                    _m.as_object(v2, "design_capacity", _scalar_1_0_class_2()),
+                    _m.as_list(
+                        v3,
+                        "design_cell_voltage_min_max",
+                        2,
+                        True,
+                        lambda item, p: _m.as_object(item, p, _scalar_1_0_class_3()),
+                    ),
+                    _m.as_object(v4, "discharge_current", _scalar_1_0_class_4()),
+                    _m.as_object(v5, "discharge_current_burst", _scalar_1_0_class_4()),
+                    _m.as_object(v6, "charge_current", _scalar_1_0_class_4()),
+                    _m.as_object(v7, "charge_current_fast", _scalar_1_0_class_4()),
+                    _m.as_object(v8, "charge_termination_threshold", _scalar_1_0_class_4()),
+                    _m.as_object(v9, "charge_voltage", _scalar_1_0_class_3()),
+                    v10 if v10.__class__ is int else _m.as_int(v10, "cycle_count"),
+                    v11 if v11.__class__ is int else _m.as_int(v11, "series_cell_count"),
+                    v12 if v12.__class__ is int else _m.as_int(v12, "state_of_health_pct"),
+                    _m.as_object(v13, "technology", _technology_0_1_class()),
+                    _m.as_object(v14, "nominal_voltage", _scalar_1_0_class_3()),
+                    v15 if v15.__class__ is int else _m.as_int(v15, "unix_manufacture_time"),
+                    _m.as_bytes(v16, "name", 64, False),
+                )
         if data.__class__ is not dict or not data.keys() <= _PARAMETERS_0_3_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _PARAMETERS_0_3_KEYS, (), "Parameters_0_3")
-        elif len(data) == 17:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4, v5, v6, v7, v8, v9, v10, v11, v12, v13, v14, v15, v16 = _PARAMETERS_0_3_VALUES(data)
-            return cls(
-                v0 if v0.__class__ is int else _m.as_int(v0, "unique_id"),
-                _m.as_object(v1, "mass", _scalar_1_0_class()),
-                _m.as_object(v2, "design_capacity", _scalar_1_0_class_2()),
-                _m.as_list(
-                    v3,
-                    "design_cell_voltage_min_max",
-                    2,
-                    True,
-                    lambda item, p: _m.as_object(item, p, _scalar_1_0_class_3()),
-                ),
-                _m.as_object(v4, "discharge_current", _scalar_1_0_class_4()),
-                _m.as_object(v5, "discharge_current_burst", _scalar_1_0_class_4()),
-                _m.as_object(v6, "charge_current", _scalar_1_0_class_4()),
-                _m.as_object(v7, "charge_current_fast", _scalar_1_0_class_4()),
-                _m.as_object(v8, "charge_termination_threshold", _scalar_1_0_class_4()),
-                _m.as_object(v9, "charge_voltage", _scalar_1_0_class_3()),
-                v10 if v10.__class__ is int else _m.as_int(v10, "cycle_count"),
-                v11 if v11.__class__ is int else _m.as_int(v11, "series_cell_count"),
-                v12 if v12.__class__ is int else _m.as_int(v12, "state_of_health_pct"),
-                _m.as_object(v13, "technology", _technology_0_1_class()),
-                _m.as_object(v14, "nominal_voltage", _scalar_1_0_class_3()),
-                v15 if v15.__class__ is int else _m.as_int(v15, "unix_manufacture_time"),
-                _m.as_bytes(v16, "name", 64, False),
-            )
         obj = cls()
         if "unique_id" in data:
             x = data["unique_id"]
@@ -912,20 +918,26 @@ class Status_0_2:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Status_0_2:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 5:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1, v2, v3, v4 = _STATUS_0_2_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    _m.as_object(v0, "heartbeat", _heartbeat_0_1_class()),
+                    _m.as_list(
+                        v1, "temperature_min_max", 2, True, lambda item, p: _m.as_object(item, p, _scalar_1_0_class_5())
+                    ),
+                    _m.as_object(v2, "available_charge", _scalar_1_0_class_2()),
+                    _m.as_object(v3, "error", _error_0_1_class()),
+                    _m.as_typed_list(v4, "cell_voltages", 255, False, float, _m.as_float),
+                )
         if data.__class__ is not dict or not data.keys() <= _STATUS_0_2_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _STATUS_0_2_KEYS, (), "Status_0_2")
-        elif len(data) == 5:  # every field named: fetched in one call
-            v0, v1, v2, v3, v4 = _STATUS_0_2_VALUES(data)
-            return cls(
-                _m.as_object(v0, "heartbeat", _heartbeat_0_1_class()),
-                _m.as_list(
-                    v1, "temperature_min_max", 2, True, lambda item, p: _m.as_object(item, p, _scalar_1_0_class_5())
-                ),
-                _m.as_object(v2, "available_charge", _scalar_1_0_class_2()),
-                _m.as_object(v3, "error", _error_0_1_class()),
-                _m.as_typed_list(v4, "cell_voltages", 255, False, float, _m.as_float),
-            )
         obj = cls()
         if "heartbeat" in data:
             x = data["heartbeat"]

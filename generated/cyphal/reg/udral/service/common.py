@@ -102,15 +102,21 @@ class Heartbeat_0_1:
     @classmethod
     def from_dict(cls, data: _Mapping[str, _Any]) -> Heartbeat_0_1:
         """Build from plain data; absent fields keep their defaults, unknown ones raise DataError."""
+        if data.__class__ is dict and len(data) == 2:
+            # as many keys as fields: when every field is named, every value is fetched in one call (and no
+            # key can be another's); else the getter misses one, and the careful check below names the stranger
+            try:
+                v0, v1 = _HEARTBEAT_0_1_VALUES(data)
+            except KeyError:
+                pass
+            else:
+                return cls(
+                    _m.as_object(v0, "readiness", _readiness_0_1_class()),
+                    _m.as_object(v1, "health", _health_1_0_class()),
+                )
         if data.__class__ is not dict or not data.keys() <= _HEARTBEAT_0_1_KEYS:
             # not a plain dict, or a key that is no field's: the careful check (it raises DataError)
             data = _m.check_keys(data, _HEARTBEAT_0_1_KEYS, (), "Heartbeat_0_1")
-        elif len(data) == 2:  # every field named: fetched in one call
-            v0, v1 = _HEARTBEAT_0_1_VALUES(data)
-            return cls(
-                _m.as_object(v0, "readiness", _readiness_0_1_class()),
-                _m.as_object(v1, "health", _health_1_0_class()),
-            )
         obj = cls()
         if "readiness" in data:
             x = data["readiness"]
