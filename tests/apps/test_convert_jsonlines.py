@@ -10,7 +10,8 @@ from typing import Any
 
 import pytest
 
-from codegen.apps.conversion.jsonlines import encode_record, loads
+from codegen.apps.conversion.jsonlines import encode_record
+from codegen.inputs.jsonl_blocks import loads_line as loads
 
 LINES = [
     '{"voltage": 15.046, "current": 17.35, "remaining_capacity_wh": "NaN", "battery_id": 2}\n',

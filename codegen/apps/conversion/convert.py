@@ -19,6 +19,7 @@ from typing import IO, Any, Literal, Protocol, cast
 from ...errors import BattgenError, cannot_read, did_you_mean
 from ...inputs.documents import jsonl_rows, read_json, read_yaml
 from ...inputs.files.kinds import content_kind, kind_of_name
+from ...inputs.jsonl_blocks import loads_line
 from ...inputs.model import (
     DecodingClass,
     DronecanClass,
@@ -33,7 +34,7 @@ from ...inputs.payloads import read_hex, read_raw
 from ...inputs.records import InputError, Item, Notice, Record, Unreadable
 from ...ir.numbers import to_json_data
 from ..schemas.package import bundled_schemas, load_schemas, named_package, package_module
-from .jsonlines import loads, orjson_line
+from .jsonlines import orjson_line
 from .senders import find_sender
 from .strict import StrictCheck
 
@@ -513,7 +514,7 @@ def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item | Ro
         elif fmt == "hex":
             yield from read_hex(stream, where)
         elif fmt == "jsonl":
-            yield from jsonl_rows(stream, where, loads=loads)
+            yield from jsonl_rows(stream, where, loads=loads_line)
         elif fmt == "json":
             yield from read_json(stream, where)
         else:

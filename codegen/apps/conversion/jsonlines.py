@@ -1,16 +1,12 @@
-"""JSON Lines for ``battgen convert`` at the speed of the data: records read and written with orjson where its
-answer is the standard library's, the standard library everywhere else.
+"""JSON Lines for ``battgen convert`` at the speed of the data: records written with orjson where its bytes are
+the standard library's, the standard library everywhere else.
 
-Reading: :func:`loads` is ``json.loads`` for :func:`...inputs.documents.read_jsonl` (which keeps the lines,
-indexes and errors): an ordinary line is read by ``orjson.loads`` (4x faster), a line orjson cannot read (bare
-``NaN``, a lone surrogate, a syntax error) by ``json.loads``, which reads it or raises its own error; so is a
-line where orjson found a float of 9.2e18 or more, since orjson reads an integer beyond 64 bits as a float where
-json keeps it exact.
+Reading is :func:`...inputs.jsonl_blocks.loads_line`, the one rule of when orjson reads a line as json does.
 
 Writing: :func:`encode_record` returns the bytes ``json.dumps(record, allow_nan=False)`` writes, by
 ``orjson.dumps`` (10x faster) where its bytes can be told to be json's but for the separators (its docstring).
 
-Without orjson installed both fall back to the standard library whole.
+Without orjson installed writing falls back to the standard library whole.
 """
 
 from __future__ import annotations
@@ -23,41 +19,6 @@ try:
     import orjson
 except ImportError:  # pragma: no cover - a dependency; the standard library alone still gives the same bytes
     orjson = None  # type: ignore[assignment]
-
-# orjson reads an integer beyond 64 bits as a float, json keeps it exact: a float this large in what orjson read
-# may have been one (the int64 bound; orjson keeps integers up to uint64's as integers)
-_INT64 = 9.2e18
-
-
-def _exact(value: dict[Any, Any] | list[Any]) -> bool:
-    """Whether ``value`` (orjson's) holds no float that may have been written as a big integer."""
-    for item in value.values() if isinstance(value, dict) else value:
-        kind = item.__class__
-        if kind is float:
-            if not -_INT64 < item < _INT64:
-                return False
-        elif (kind is dict or kind is list) and not _exact(item):
-            return False
-    return True
-
-
-def loads(line: str) -> object:
-    """One JSON Lines record's value, as ``json.loads`` reads it, and its errors when it has none (module
-    docstring)."""
-    if orjson is not None:
-        try:
-            data = orjson.loads(line)
-        except orjson.JSONDecodeError:
-            pass  # json reads it (NaN) or words the error
-        else:
-            kind = data.__class__
-            if kind is dict or kind is list:
-                if _exact(data):
-                    return data
-            elif kind is not float or -_INT64 < data < _INT64:
-                return data
-    return json.loads(line)
-
 
 # ------------------------------------------------------------------------------------------------
 # writing
