@@ -8,11 +8,8 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from ...inputs.files.held import Buffer, held, whole
-from .can_batches import can_batches
 from .catalog import Catalog
-from .dataflash_batches import dataflash_batches
 from .sources import Batch, jsonl_batches, log_kind, model_of, ulog_batches
-from .tlog_batches import tlog_batches
 
 
 def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
@@ -42,11 +39,19 @@ def read_log(
             if source is None and not hold.leased:  # unheld, a map could end in SIGBUS: read it whole
                 source = whole(path, name)
             yield from ulog_batches(path, name, catalog, source, all_fields)
+        # each kind's reader is imported when a log of that kind is read: a fresh process exporting a ULog
+        # does not load python-can (0.15-0.3 s) or pymavlink's readers
         elif kind == "tlog":
+            from .tlog_batches import tlog_batches
+
             yield from tlog_batches(path, name, catalog)
         elif kind == "dataflash":
+            from .dataflash_batches import dataflash_batches
+
             yield from dataflash_batches(path, name, catalog)
         elif kind == "can":
+            from .can_batches import can_batches
+
             yield from can_batches(path, name, catalog, model_of, subjects)
         else:
             yield from jsonl_batches(path, name, catalog, message)
