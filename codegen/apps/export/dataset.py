@@ -44,9 +44,9 @@ from ...errors import BattgenError, OutputError
 from ...ir import ArrayType, CompositeType, Field, Message, PrimitiveKind, PrimitiveType, Schema, StringType
 from ..battery.columns import length_key
 from ..battery.sources import Batch
+from . import arrow
 from .durable import TMP_PREFIX, fsync_dir, fsync_file, write_atomic
 from .manifest import BATTERY, LOGS, RAW, marker, marker_files, read_marker
-from . import arrow
 from .table import floats, repeated
 
 __all__ = ["BATTERY", "LOGS", "RAW", "marker"]  # the layout's names, defined with the markers
