@@ -134,6 +134,13 @@ def _progress(total: int, quiet: bool) -> tuple[Callable[[Any], None] | None, Ca
     return step, bar.close
 
 
+def _failsafe_options(args: argparse.Namespace) -> Any:
+    """``--failsafe``'s replay options (the replay is imported by the runs that ask for it)."""
+    from ..apps.export.failsafe_tables import failsafe_options
+
+    return failsafe_options(args.failsafe, args.vehicle, args.firmware)
+
+
 def _tell(text: str) -> None:
     print(line(f"battgen: {text}"), file=sys.stderr)
 
@@ -141,7 +148,6 @@ def _tell(text: str) -> None:
 def run(args: argparse.Namespace) -> int:
     try:
         from ..apps.export import engine
-        from ..apps.export.failsafe_tables import failsafe_options
     except ImportError as exc:
         print(
             f"battgen: export needs the fleet extra ({exc.name} is missing): pip install 'battgen[fleet]'",
@@ -170,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
         print(line(f"battgen: --cyphal-subject: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE
     try:
-        replay = None if args.failsafe is None else failsafe_options(args.failsafe, args.vehicle, args.firmware)
+        replay = None if args.failsafe is None else _failsafe_options(args)
     except BattgenError as exc:
         print(line(f"battgen: --failsafe: {exc}"), file=sys.stderr)
         return EXIT_UNREADABLE

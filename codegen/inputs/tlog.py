@@ -147,8 +147,10 @@ def tlog_messages(data: Buffer, models: Mapping[int, MavlinkClass], stats: Strea
     numbers = dict.fromkeys(models, 0)
     decoders = {msgid: model.decode for msgid, model in models.items()}
     end = len(data)
-    pos = 0
+    pos = released = 0
     while pos < end:
+        if pos - released >= _RELEASE:
+            released = _release(data, released, pos)
         start = pos + _STAMP
         if start >= end:
             stats.truncated_bytes += end - pos
@@ -216,6 +218,20 @@ def tlog_messages(data: Buffer, models: Mapping[int, MavlinkClass], stats: Strea
                 pos = after
                 continue
         pos = _resync(data, pos, end, stats)
+
+
+_RELEASE = 8 << 20  # bytes of a mapped tlog walked past before their pages are let go
+
+
+def _release(data: Buffer, lo: int, hi: int) -> int:
+    """Let this process's pages of ``data[lo:hi]`` go (the walk never looks back, and a decoded frame holds a
+    copy of its bytes): a map's pages count in the resident size once read, so a whole tlog walked would be,
+    each walk, the file's size on top of the export's memory; the kernel reads them again should anything touch
+    them. Returns the new start of what is kept (``lo`` stays page-aligned)."""
+    hi -= hi % mmap.PAGESIZE
+    if isinstance(data, mmap.mmap) and hasattr(mmap, "MADV_DONTNEED") and hi > lo:
+        data.madvise(mmap.MADV_DONTNEED, lo, hi - lo)
+    return max(lo, hi)
 
 
 def _first_verified(data: Buffer, rt: MavlinkRuntime, lo: int, hi: int) -> int:

@@ -11,9 +11,6 @@ from ...inputs.files.held import Buffer, held, whole
 from .catalog import Catalog
 from .sources import Batch, jsonl_batches, log_kind, model_of, ulog_batches
 
-# each log kind's reader is imported when a log of that kind is read: a ULog's replay does not pay for python-can
-# (which the CAN captures' reader imports up front), pymavlink or the DataFlash reader
-
 
 def read_batches(path: Path, name: str, catalog: Catalog, message: str | None = None) -> list[Batch]:
     """Every battery batch of one log, every field of ULog records (see :func:`read_log`)."""
@@ -42,6 +39,8 @@ def read_log(
             if source is None and not hold.leased:  # unheld, a map could end in SIGBUS: read it whole
                 source = whole(path, name)
             yield from ulog_batches(path, name, catalog, source, all_fields)
+        # each kind's reader is imported when a log of that kind is read: a fresh process exporting a ULog
+        # does not load python-can (0.15-0.3 s) or pymavlink's readers
         elif kind == "tlog":
             from .tlog_batches import tlog_batches
 

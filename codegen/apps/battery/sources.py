@@ -21,7 +21,6 @@ import numpy as np
 from ...backends.python import naming
 from ...errors import BattgenError
 from ...inputs.dataflash.log import shortest_float32
-from ...inputs.documents import read_jsonl
 from ...inputs.files.held import Buffer
 from ...inputs.files.kinds import LOG_KINDS, detect
 from ...inputs.model import MessageClass, UorbClass
@@ -274,6 +273,8 @@ def jsonl_batches(path: Path, name: str, catalog: Catalog, message: str | None) 
     """A JSON Lines file's records in batches of :data:`JSONL_CHUNK`. A record whose number does not fit its
     field's type (a uORB ``id`` of 2^32 + 1, a float32 of 1e300) is left out with a note naming it: cast, it would
     wrap into another battery's number (or be infinity)."""
+    from ...inputs.documents import read_jsonl  # with YAML's reader: imported by the runs that read JSON Lines
+
     qualified: str | None = message
     records: list[Record] = []
     first_stamp: float | None = None

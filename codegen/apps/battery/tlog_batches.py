@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import re
 import struct
+from array import array
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,15 +53,40 @@ AUTOPILOT_INVALID = 8  # MAV_AUTOPILOT_INVALID
 COMP_GIMBAL = 154  # MAV_COMP_ID_GIMBAL
 
 
+UNKNOWN_STAMP = 1 << 63  # a stamp past int64 is a damaged one, unknown (as is none): every such stamp is kept as this
+
+
+@dataclass
+class _Beats:
+    """A system's vehicle heartbeats in file order, a column each: a tlog holds one a second for as long as it
+    runs, and as tuples of Python ints they were some 200 bytes each (20 MB at 100k), here 41."""
+
+    at: array[int] = field(default_factory=lambda: array("q"))  # the entry's offset in the file
+    armed: array[int] = field(default_factory=lambda: array("b"))  # base_mode & MAV_MODE_FLAG_SAFETY_ARMED, 0/1
+    mav_type: array[int] = field(default_factory=lambda: array("q"))
+    stamp: array[int] = field(default_factory=lambda: array("Q"))  # the tlog stamp, or UNKNOWN_STAMP
+    base_mode: array[int] = field(default_factory=lambda: array("q"))
+    custom_mode: array[int] = field(default_factory=lambda: array("q"))
+
+    def add(self, offset: int, stamp: int | None, mav_type: int, base_mode: int, custom_mode: int) -> None:
+        self.at.append(offset)
+        self.armed.append(1 if base_mode & SAFETY_ARMED else 0)
+        self.mav_type.append(mav_type)
+        self.stamp.append(UNKNOWN_STAMP if stamp is None or stamp >= UNKNOWN_STAMP else stamp)
+        self.base_mode.append(base_mode)
+        self.custom_mode.append(custom_mode)
+
+    def __len__(self) -> int:
+        return len(self.at)
+
+
 @dataclass
 class _System:
-    """What one system id sent: its battery frames and its vehicle heartbeats (offset, armed, type)."""
+    """What one system id sent: its battery frames and its vehicle heartbeats."""
 
     batteries: dict[int, list[FrameRecord]] = field(default_factory=dict)
     sys_status: list[FrameRecord] = field(default_factory=list)
-    beats: list[tuple[int, bool, int]] = field(default_factory=list)
-    beat_stamps: list[int | None] = field(default_factory=list)  # each heartbeat's tlog stamp
-    beat_modes: list[tuple[int, int]] = field(default_factory=list)  # each heartbeat's (base_mode, custom_mode)
+    beats: _Beats = field(default_factory=_Beats)
     autopilot: int | None = None  # MAV_AUTOPILOT of the last vehicle heartbeat
     parameters: dict[str, tuple[float, int]] = field(default_factory=dict)  # PARAM_VALUE: (value, MAV_PARAM_TYPE)
     texts: list[tuple[int | None, int, str, int]] = field(
@@ -163,10 +189,8 @@ def _survey(records: Iterable[FrameRecord], ids: _Ids, *, keep: bool) -> dict[in
             hb = rec.instance
             mav_type, autopilot = int(getattr(hb, "type")), int(getattr(hb, "autopilot"))  # noqa: B009
             if is_vehicle_heartbeat(rec.frame.compid, mav_type, autopilot):
-                armed = bool(int(getattr(hb, "base_mode")) & SAFETY_ARMED)  # noqa: B009
-                system.beats.append((rec.offset or 0, armed, mav_type))
-                system.beat_stamps.append(rec.timestamp)
-                system.beat_modes.append((int(getattr(hb, "base_mode")), int(getattr(hb, "custom_mode"))))  # noqa: B009
+                base_mode, custom_mode = int(getattr(hb, "base_mode")), int(getattr(hb, "custom_mode"))  # noqa: B009
+                system.beats.add(rec.offset or 0, rec.timestamp, mav_type, base_mode, custom_mode)
                 system.autopilot = autopilot
     return systems
 
@@ -207,21 +231,22 @@ def _batch(
         vehicle=f"mavlink:{sysid}",
     )
     batch.origin_us, batch.utc_offset_us = origin, 0
-    if system.beats:
-        beat_at = np.array([b[0] for b in system.beats], np.int64)
-        beat_armed = np.array([b[1] for b in system.beats], np.float64)
+    if len(system.beats):
+        beat_at = np.frombuffer(system.beats.at, np.int64)
+        beat_armed = np.frombuffer(system.beats.armed, np.int8).astype(np.float64)
         at = np.array([f.offset or 0 for f in frames], np.int64)
         idx = np.searchsorted(beat_at, at, side="right") - 1  # the latest heartbeat before the record in the file
         batch.armed = np.where(idx >= 0, beat_armed[np.maximum(idx, 0)], np.nan)
-        batch.vehicle_type = system.beats[-1][2]
+        batch.vehicle_type = system.beats.mav_type[-1]
     return batch
 
 
 def _context(system: _System, sysid: int, origin: int) -> LogContext:
     """One system's context (:mod:`.context`): its id, MAV_TYPE, firmware family and arming changes."""
-    if not system.beats:
+    beats = system.beats
+    if not len(beats):
         return LogContext("tlog", origin, 0, f"mavlink:{sysid}", parameters=_parameters(system, None))
-    known = [(s, b[1]) for s, b in zip(system.beat_stamps, system.beats, strict=True) if s is not None and s < 1 << 63]
+    known = [(s, a) for s, a in zip(beats.stamp, beats.armed, strict=True) if s < UNKNOWN_STAMP]
     t = np.array([(s - origin) / 1e6 for s, _ in known], np.float64)
     armed = np.array([a for _, a in known], np.float64)
     autopilot = MAV_AUTOPILOT_FIRMWARE.get(system.autopilot) if system.autopilot is not None else None
@@ -231,7 +256,7 @@ def _context(system: _System, sysid: int, origin: int) -> LogContext:
         origin,
         0,
         f"mavlink:{sysid}",
-        system.beats[-1][2],
+        beats.mav_type[-1],
         autopilot,
         parameters=_parameters(system, autopilot),
         arming=arming_changes(t, armed),
@@ -276,8 +301,9 @@ def _modes(system: _System, origin: int) -> tuple[tuple[float, str], ...]:
 
     out: list[tuple[float, str]] = []
     last: str | None = None
-    for stamp, (_, _, mav_type), (base, custom) in zip(
-        system.beat_stamps, system.beats, system.beat_modes, strict=True
+    beats = system.beats
+    for stamp, mav_type, base, custom in zip(
+        beats.stamp, beats.mav_type, beats.base_mode, beats.custom_mode, strict=True
     ):
         t = _seconds(stamp, origin)
         if t is None:

@@ -44,6 +44,7 @@ from ...errors import BattgenError, OutputError
 from ...ir import ArrayType, CompositeType, Field, Message, PrimitiveKind, PrimitiveType, Schema, StringType
 from ..battery.columns import length_key
 from ..battery.sources import Batch
+from . import arrow
 from .durable import TMP_PREFIX, fsync_dir, fsync_file, write_atomic
 from .manifest import BATTERY, LOGS, RAW, marker, marker_files, read_marker
 from .table import floats, repeated
@@ -209,7 +210,7 @@ def raw_table(message: Message, batch: Batch, log: str, schema: Schema | None = 
     message is in, naming the fields inside its composite ones."""
     arrays = [
         repeated(log, batch.n),
-        pa.array(np.asarray(batch.instance, np.int32), type=pa.int32()),
+        arrow.array(np.asarray(batch.instance, np.int32), pa.int32()),
         floats(batch.t),
     ]
     fields = [pa.field("log", pa.string()), pa.field("instance", pa.int32()), pa.field("t", pa.float64())]
@@ -223,18 +224,18 @@ def raw_table(message: Message, batch: Batch, log: str, schema: Schema | None = 
                 lengths = np.asarray(batch.columns[length_key(name)], np.int64)
                 keep = np.arange(values.shape[1])[None, :] < lengths[:, None]
                 offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int32)
-                flat = pa.array(values[keep], type=typ.value_type)
-                arr = pa.ListArray.from_arrays(pa.array(offsets, pa.int32()), flat).cast(typ)
+                flat = _numbers(values[keep], typ.value_type)
+                arr = pa.ListArray.from_arrays(arrow.array(offsets, pa.int32()), flat).cast(typ)
             else:
-                flat = pa.array(values.reshape(-1), type=typ.value_type)
+                flat = _numbers(values.reshape(-1), typ.value_type)
                 width = values.shape[1] if values.ndim == 2 else 0
                 arr = pa.FixedSizeListArray.from_arrays(flat, width).cast(typ)
         elif pa.types.is_string(typ):
-            arr = pa.array(
-                [v.split(b"\0", 1)[0].decode("utf-8", "replace") if isinstance(v, bytes) else v for v in values], typ
+            arr = arrow.strings(
+                [v.split(b"\0", 1)[0].decode("utf-8", "replace") if isinstance(v, bytes) else v for v in values]
             )
         else:
-            arr = pa.array(values, type=typ, from_pandas=False)
+            arr = _numbers(values, typ)
         meta = {"unit": f.unit.symbol} if f.unit is not None else {}
         if f.invalid is not None:
             meta["invalid"] = f.invalid.text
@@ -243,6 +244,13 @@ def raw_table(message: Message, batch: Batch, log: str, schema: Schema | None = 
     return pa.Table.from_arrays(
         arrays, schema=pa.schema(fields, metadata={"battgen": json.dumps({"message": message.qualified_name})})
     )
+
+
+def _numbers(values: Any, typ: Any) -> Any:
+    """A column of numbers as Arrow (from its numpy buffer: ``pa.array`` would import pandas, see :mod:`.arrow`)."""
+    if values.dtype == object:  # not one numpy type: what pa.array makes of Python numbers
+        return pa.array(values, type=typ, from_pandas=False)
+    return arrow.array(values, typ)
 
 
 # The columns whose row-group statistics (min, max, nulls) are written: those a query over many logs

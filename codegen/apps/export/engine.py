@@ -15,21 +15,16 @@ import mmap
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import pyarrow as pa
-import pyarrow.compute as pc
+import numpy as np
 
 from ...errors import BattgenError, OutputError, cannot_read
 from ...inputs.files.held import held
 from ..battery.catalog import bundled_catalog
 from ..battery.sources import Batch, log_kind
 from ..battery.view import read_view
-from ..failsafe.logs import SampleTable
-from ..schemas.package import bundled_package
 from .content import content_id, map_file, prefix_id
-from .cyphal_raw import CYPHAL_PREFIX, cyphal_raw_tables
-from .dataflash_raw import dataflash_raw_tables
 from .dataset import (
     LogWriter,
     claim_layout,
@@ -40,11 +35,13 @@ from .dataset import (
     raw_table,
 )
 from .durable import writers_lock
-from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, FailsafeOptions, replay_tables
-from .manifest import exported_sources, retire, sweep
+from .manifest import EVENTS_FILE, FAILSAFE, REPLAYS_FILE, exported_sources, retire, sweep
 from .table import battery_schema, battery_table
 from .views import write_views
-from .workers import run_pooled
+
+if TYPE_CHECKING:  # what only some runs need is imported where they need it: a fresh process pays for its run only
+    from ..failsafe.logs import SampleTable
+    from .failsafe_tables import FailsafeOptions
 
 
 @dataclass(frozen=True)
@@ -148,7 +145,7 @@ def _export(
     notes: list[str] = []
     warnings: list[str] = []
     messages: set[str] = set()
-    replay = SampleTable()  # what the failsafe replay needs of each chunk (not its columns)
+    replay = None if options.failsafe is None else _sample_table()  # what the replay needs of each chunk
     clock: Batch | None = None  # a batch of the log, for the replay's time of day
     first_us: int | None = None  # the log's first time of day (UTC µs), which names its day partition (--partition day)
     try:
@@ -165,25 +162,29 @@ def _export(
             table = battery_table(catalog, schema, columns, batch, log, file.name)
             writer.add(table)
             # a Cyphal capture's types are written by cyphal_raw_tables below, each subject's every transfer
-            cyphal = kind == "can" and batch.message.startswith(CYPHAL_PREFIX)
-            if options.raw and batch.message in catalog.sources and not cyphal:
+            if options.raw and batch.message in catalog.sources and not (kind == "can" and _cyphal(batch.message)):
                 writer.add_raw(
                     batch.message, raw_table(catalog.schema.message(batch.message), batch, log, catalog.schema)
                 )
             messages.add(batch.message)
             notes.extend(n for n in batch.notes if n not in notes)
             warnings.extend(batch.warnings)
-            if options.partition == "day" and table.num_rows:  # only a day partition needs it
-                first = pc.min(table["time"].cast(pa.int64())).as_py()
+            if options.partition == "day":  # only a day partition needs it
+                first = _first_time(batch)
                 if first is not None:
                     first_us = first if first_us is None else min(first_us, first)
-            if options.failsafe is not None:
+            if replay is not None:
                 replay.add(chunk)
                 clock = clock or (batch if batch.n else None)
         if options.raw and kind == "dataflash":
+            from .dataflash_raw import dataflash_raw_tables
+
             for message, raw in dataflash_raw_tables(file, name, log):
                 writer.add_raw(message, raw)
         if options.raw and kind == "can" and options.cyphal_subjects:  # every subject's type, not only SourceTs
+            from ..schemas.package import bundled_package
+            from .cyphal_raw import cyphal_raw_tables
+
             package = bundled_package().__name__
             for message, raw in cyphal_raw_tables(file, name, log, options.cyphal_subjects, catalog.schema, package):
                 writer.add_raw(message, raw)
@@ -194,6 +195,9 @@ def _export(
         notes.append("no battery records")
     extra: list[tuple[str, dict[str, Any]]] = []
     if options.failsafe is not None:
+        from .failsafe_tables import replay_tables
+
+        assert replay is not None
         try:
             replayed = replay_tables(file, name, kind, log, options.failsafe, replay, clock)
         except BattgenError as exc:
@@ -233,6 +237,27 @@ def _export(
         notes=tuple(notes + warnings),
         warnings=tuple(warnings),
     )
+
+
+def _sample_table() -> SampleTable:
+    from ..failsafe.logs import SampleTable
+
+    return SampleTable()
+
+
+def _cyphal(message: str) -> bool:
+    """Whether a CAN capture's batch is of a Cyphal type (written by :func:`.cyphal_raw.cyphal_raw_tables`)."""
+    from .cyphal_raw import CYPHAL_PREFIX
+
+    return message.startswith(CYPHAL_PREFIX)
+
+
+def _first_time(batch: Batch) -> int | None:
+    """The batch's earliest time of day (µs since the epoch), where it has one."""
+    if batch.time_us is None or not batch.n:
+        return None
+    times = batch.time_us if batch.time_known is None else batch.time_us[batch.time_known]
+    return int(np.min(times)) if len(times) else None
 
 
 def utc_day(us: int | None) -> str | None:
@@ -281,6 +306,8 @@ def _run(paths: list[str], options: ExportOptions, jobs: int) -> Iterator[LogRes
         for p in paths:
             yield export_one(p, options)
         return
+    from .workers import run_pooled
+
     yield from run_pooled(functools.partial(export_one, options=options), paths, jobs, _died)
 
 

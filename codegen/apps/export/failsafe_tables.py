@@ -34,9 +34,6 @@ from ..failsafe.vehicles import VEHICLES
 from .failsafe_columns import EVENT_COLUMNS, REPLAYS_SCHEMA, events_table
 from .px4_failsafe_tables import px4_tables
 
-FAILSAFE = "failsafe"
-EVENTS_FILE = "events.parquet"
-REPLAYS_FILE = "replays.parquet"
 OWN_PARAMETERS = "log"  # --failsafe log: each ArduPilot log's own parameters (DataFlash PARM, tlog PARAM_VALUE)
 
 

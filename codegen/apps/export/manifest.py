@@ -21,11 +21,15 @@ from pathlib import Path
 from typing import Any
 
 from .durable import TMP_PREFIX
-from .failsafe_tables import EVENTS_FILE, FAILSAFE, REPLAYS_FILE
 
 BATTERY = "battery"
 RAW = "raw"
 LOGS = "logs"
+# the failsafe replay's table folder and files (:mod:`.failsafe_tables`), named here so that reading a dataset's
+# layout does not import the replay (and, through it, the failsafe's parameter checks and schema loader)
+FAILSAFE = "failsafe"
+EVENTS_FILE = "events.parquet"
+REPLAYS_FILE = "replays.parquet"
 TABLE_FOLDERS = (BATTERY, RAW, FAILSAFE)
 # the keys of a marker's "files": the battery table, the raw tables, the failsafe replay's two tables
 FILE_KEYS = (BATTERY, RAW, "events", "replays")

@@ -21,6 +21,7 @@ from ..battery.catalog import Catalog
 from ..battery.columns import ConceptColumn, NDArray
 from ..battery.sources import Batch
 from ..battery.view import battery_of
+from . import arrow
 
 # Text that repeats (the log, its file, a choice among a few) is dictionary-encoded in Arrow: Parquet
 # stores it so anyway, and building it so is a fraction of the cost. Engines read it as text.
@@ -99,14 +100,14 @@ def concept_array(col: ConceptColumn) -> Any:
     if kind == "number":
         return floats(col.values, invalid)
     if kind in ("integer", "bool"):
-        return pa.array(col.values, type=_ARROW_TYPES[kind], mask=invalid)
+        return arrow.array(col.values, _ARROW_TYPES[kind], invalid)
     if kind == "text":
-        return pa.array(col.values, type=pa.string(), mask=invalid)
+        return arrow.strings(col.values, invalid)
     choices = _words(tuple(col.concept.choices))
     if kind == "choice":
-        return pa.DictionaryArray.from_arrays(pa.array(col.values.astype(np.int32), mask=invalid), choices)
+        return pa.DictionaryArray.from_arrays(arrow.array(col.values.astype(np.int32), pa.int32(), invalid), choices)
     if kind == "flags":
-        return _flag_lists(col.values, valid, choices, invalid)
+        return _flag_lists(col.values, valid, tuple(col.concept.choices), invalid)
     assert col.lengths is not None
     lengths = np.where(valid, col.lengths, 0)
     width = int(lengths[0]) if len(lengths) else 0
@@ -119,40 +120,39 @@ def concept_array(col: ConceptColumn) -> Any:
 
 def floats(values: NDArray, invalid: NDArray | None = None) -> Any:
     """float64 values as Arrow, NaN (and where ``invalid``) null: with none of either (the usual),
-    the array as it is, no copy; else through a mask. (pyarrow's own NaN scan, ``from_pandas``, took
-    4x the mask's time and 15x numpy's ``isnan``.)"""
+    the array as it is, no copy; else with a validity bitmap. (pyarrow's own NaN scan, ``from_pandas``,
+    took 4x the mask's time and 15x numpy's ``isnan``.)"""
     null = np.isnan(values)
     if invalid is not None:
         null |= invalid
-    if not null.any():
-        return pa.array(values, type=pa.float64())
-    return pa.array(values, type=pa.float64(), mask=null)
+    return arrow.array(values, pa.float64(), null)
 
 
-def _flag_lists(bits: NDArray, valid: NDArray, choices: Any, invalid: NDArray | None) -> Any:
+def _flag_lists(bits: NDArray, valid: NDArray, choices: tuple[str, ...], invalid: NDArray | None) -> Any:
     """Bit sets as lists of their choices' names; rows without a bit set (the usual) cost nothing."""
     rows = np.flatnonzero(np.where(valid, bits, 0))
     counts = np.zeros(len(bits), np.int32)
-    names = np.zeros(0, np.int32)
+    names: list[str] = []
     if len(rows):
         set_bits = ((bits[rows, None] >> np.arange(len(choices))) & 1).astype(bool)
         counts[rows] = set_bits.sum(axis=1)
-        names = np.asarray(np.nonzero(set_bits)[1], np.int32)
-    return _lists(counts, pa.DictionaryArray.from_arrays(pa.array(names), choices).cast(pa.string()), invalid)
+        names = [choices[i] for i in np.nonzero(set_bits)[1].tolist()]
+    return _lists(counts, arrow.strings(names), invalid)
 
 
 def _lists(lengths: NDArray, items: Any, invalid: NDArray | None) -> Any:
     """A list array of ``items`` split into rows of ``lengths``; null rows where ``invalid``."""
     offsets = np.zeros(len(lengths) + 1, np.int32)
     np.cumsum(lengths, out=offsets[1:])
-    return pa.ListArray.from_arrays(pa.array(offsets), items, mask=None if invalid is None else pa.array(invalid))
+    mask = None if invalid is None else arrow.array(invalid, pa.bool_())
+    return pa.ListArray.from_arrays(arrow.array(offsets, pa.int32()), items, mask=mask)
 
 
 @functools.lru_cache(maxsize=1024)
 def _words(words: tuple[str, ...]) -> Any:
     """One Arrow array per set of words, so every chunk of a log's table has the same dictionary
     object for a label or choice column."""
-    return pa.array(list(words), type=pa.string())
+    return arrow.strings(words)
 
 
 # The caches below hold arrays of a chunk's length: every chunk of a log but its last has the same,
@@ -170,7 +170,7 @@ def nulls(n: int, typ: Any) -> Any:
 
 @functools.lru_cache(maxsize=4)
 def _zeros(n: int) -> Any:
-    return pa.array(np.zeros(n, np.int32))
+    return arrow.array(np.zeros(n, np.int32), pa.int32())
 
 
 def label(text: str, n: int) -> Any:
@@ -181,7 +181,7 @@ def label(text: str, n: int) -> Any:
 @functools.lru_cache(maxsize=4)
 def repeated(text: str, n: int) -> Any:
     """``text`` ``n`` times as plain text (the log id, which is its Hive partition key too)."""
-    return pa.repeat(pa.scalar(text, pa.string()), n)
+    return arrow.repeat(text, n)
 
 
 def battery_table(
@@ -198,17 +198,15 @@ def battery_table(
         if batch.vehicle is None
         else label(batch.vehicle, n)
         if isinstance(batch.vehicle, str)
-        else pa.array(batch.vehicle, type=pa.string()).dictionary_encode(),
-        pa.array(battery, type=pa.int32()),
+        else arrow.strings(batch.vehicle).dictionary_encode(),
+        arrow.array(battery, pa.int32()),
         floats(batch.t),
         nulls(n, timestamp)
         if batch.time_us is None
-        else pa.array(
-            batch.time_us, type=pa.int64(), mask=None if batch.time_known is None else ~batch.time_known
-        ).cast(timestamp),
+        else arrow.array(batch.time_us, timestamp, None if batch.time_known is None else ~batch.time_known),
         nulls(n, pa.bool_())
         if batch.armed is None
-        else pa.array(batch.armed == 1.0, type=pa.bool_(), mask=np.isnan(batch.armed)),
+        else arrow.array(batch.armed == 1.0, pa.bool_(), np.isnan(batch.armed)),
         label(batch.message, n),
     ]
     arrays.extend(concept_array(columns[c.name]) for c in catalog.concepts)

@@ -236,7 +236,8 @@ class _Bindings:
         if not self.events:
             return table[ids]
         events = np.array(sorted(self.events), np.int64).reshape(-1, 3)
-        if len(np.unique(events[:, 0])) == len(events):  # one change per msg_id (the usual): by table
+        # one change per msg_id (the usual): by table (a set of a few ids: np.unique's first call imports numpy.ma)
+        if len(set(events[:, 0].tolist())) == len(events):
             since = np.full(size, np.iinfo(np.int64).max, np.int64)
             after = table.copy()
             since[events[:, 0]], after[events[:, 0]] = events[:, 1], events[:, 2]
