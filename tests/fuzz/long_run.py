@@ -52,7 +52,7 @@ PER_INPUT_SECONDS = 30  # far beyond any input's need: longer is a hang
 MEMORY_CAP = 3 << 30
 
 
-class Hang(Exception):
+class Hang(BaseException):  # a reader catching Exception must not swallow the alarm (it hid a hang)
     pass
 
 
@@ -153,7 +153,7 @@ def fuzz(target: str, seconds: float) -> tuple[int, list[str]]:
         )
         try:
             test()
-        except Exception as exc:
+        except (Exception, Hang) as exc:  # Hang: a BaseException, so that no reader swallows it
             data = failing[-1]  # the last failing call is hypothesis's shrunk example
             folder = CRASHERS / target
             folder.mkdir(parents=True, exist_ok=True)

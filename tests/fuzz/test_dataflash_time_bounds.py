@@ -1,14 +1,21 @@
-"""A DataFlash record whose time cannot be a time (beyond 2^62 us) is read as a record without one, never cast
-into the int64 clock columns, where numpy would wrap it to a garbage time with only a RuntimeWarning (found by the
-long fuzz run: tests/fuzz/crashers/view-dataflash/time-beyond-int64.bin)."""
+"""DataFlash inputs the long fuzz run found mishandled. A record whose time cannot be a time (beyond 2^62 us) is
+read as a record without one, never cast into the int64 clock columns, where numpy would wrap it to a garbage time
+with only a RuntimeWarning (tests/fuzz/crashers/view-dataflash/time-beyond-int64.bin). A format of length 0 is
+refused (format-of-length-0.bin)."""
 
 from __future__ import annotations
 
+import tempfile
 import warnings
+from pathlib import Path
 
+import pytest
 from budget import CRASHERS
 from test_fuzz_data_layer import view
 
+from codegen.apps.battery.catalog import bundled_catalog
+from codegen.apps.battery.view import read_view
+from codegen.errors import BattgenError
 from codegen.inputs.dataflash.log import MAX_TIME_US, _time_us
 
 
@@ -26,3 +33,14 @@ def test_the_crasher_reads_without_a_wrapped_time() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         view("dataflash", data)
+
+
+def test_a_format_of_length_zero_is_refused_not_walked_for_ever() -> None:
+    """pymavlink steps back over such a record's header and parses it again, for ever (a hang the long fuzz run's
+    alarm found, which the reader's catch-all had hidden): the reader refuses the log, naming the record."""
+    data = (CRASHERS / "view-dataflash" / "format-of-length-0.bin").read_bytes()
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "flight.bin"
+        path.write_bytes(data)
+        with pytest.raises(BattgenError, match=r"flight\.bin: .*offset \d+ of a format with no length"):
+            list(read_view(path, path.name, catalog=bundled_catalog()))

@@ -181,8 +181,26 @@ def open_log(path: Path, display: str | None = None) -> DataflashLog:
     )
 
 
-def _open(path: Path, display: str, notes: list[str], text: bool = False) -> Any:
+def _binary_reader(path: Path) -> Any:
+    """pymavlink's binary reader, refusing a record that does not move it on. A format record may declare a length
+    of 0: pymavlink then steps back over the header it just read and parses the same record again, for ever (found
+    by the long fuzz run; tests/fuzz/crashers/view-dataflash/format-of-length-0.bin). Every other length moves it."""
     from pymavlink import DFReader
+
+    class Guarded(DFReader.DFReader_binary):  # type: ignore[misc]
+        def _parse_next(self) -> Any:
+            before = self.offset
+            msg = super()._parse_next()
+            if msg is not None and self.offset <= before:
+                raise ValueError(
+                    f"a record at offset {before} of a format with no length (the reader would not move on)"
+                )
+            return msg
+
+    return Guarded(str(path), zero_time_base=True)
+
+
+def _open(path: Path, display: str, notes: list[str], text: bool = False) -> Any:
 
     # building the reader runs pymavlink's C indexer, which writes to the process's own descriptors: captured here,
     # once per open, not around every message read (a temporary file and four dups per message)
@@ -190,7 +208,7 @@ def _open(path: Path, display: str, notes: list[str], text: bool = False) -> Any
         try:
             if text:
                 return open_text_reader(path)
-            return DFReader.DFReader_binary(str(path), zero_time_base=True)
+            return _binary_reader(path)
         except (OSError, ValueError) as exc:
             raise InputError(display, 0, f"cannot read DataFlash log: {exc}") from None
         except Exception as exc:  # a corrupt FMT record: pymavlink raises a bare Exception
