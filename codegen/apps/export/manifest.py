@@ -88,7 +88,11 @@ def damage(out: Path, log: str, data: Mapping[str, Any]) -> str | None:
         for rel in names:
             if not (isinstance(rel, str) and _inside_tables(rel)):
                 return f"expected a table file of the dataset, got {str(rel)[:80]!r}"
-            if not (out / rel).is_file():
+            try:
+                present = (out / rel).is_file()
+            except OSError:  # a name the file system refuses (too long): no file of ours
+                present = False
+            if not present:
                 return f"names a file that is missing: {rel[:80]}"
     return None
 
@@ -98,7 +102,7 @@ def _inside_tables(rel: str) -> bool:
     return (
         len(parts) >= 3
         and parts[0] in TABLE_FOLDERS
-        and all(p not in ("", ".", "..") and "\\" not in p for p in parts)
+        and all(p not in ("", ".", "..") and "\\" not in p and len(p) <= 255 for p in parts)
         and rel.endswith(".parquet")
     )
 
