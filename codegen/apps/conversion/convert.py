@@ -19,7 +19,7 @@ from typing import IO, Any, Literal, Protocol, cast
 from ...errors import BattgenError, cannot_read, did_you_mean
 from ...inputs.documents import jsonl_rows, read_json, read_yaml
 from ...inputs.files.kinds import content_kind, kind_of_name
-from ...inputs.jsonl_blocks import loads_line
+from ...inputs.jsonl_blocks import jsonl_blocks, loads_line
 from ...inputs.model import (
     DecodingClass,
     DronecanClass,
@@ -34,7 +34,7 @@ from ...inputs.payloads import read_hex, read_raw
 from ...inputs.records import InputError, Item, Notice, Record, Unreadable
 from ...ir.numbers import to_json_data
 from ..schemas.package import bundled_schemas, load_schemas, named_package, package_module
-from .jsonlines import orjson_line
+from .jsonlines import integral, integral_line, orjson_line
 from .senders import find_sender
 from .strict import StrictCheck
 
@@ -214,7 +214,7 @@ class Endpoint:
             return None
         obj: Any = objs[0] if isinstance(objs, tuple) else objs
         data = obj.to_dict()
-        text = orjson_line(data)
+        text = integral_line(data) if integral(obj.__class__) else orjson_line(data)
         return None if text is None else (data, text)
 
     def to_plain(self, objs: object) -> object:
@@ -436,6 +436,9 @@ class Conversion:
         if not isinstance(source, Path):
             yield from _stream_items(source, where, fmt)
             return
+        if fmt == "jsonl":  # a file: a block of lines a step, as validate reads it (a stream: a line a step)
+            yield from _block_rows(source, where)
+            return
         try:
             stream = source.open("rb")
         except OSError as exc:
@@ -505,6 +508,18 @@ class Conversion:
                 yield _located(item, where)
         if stats.damaged:  # the summary without the last problem: a converted log is not a report
             yield Notice(where, stats.summary(message_name(cls)), "stream")
+
+
+def _block_rows(path: Path, where: str) -> Iterator[Item | Row]:
+    """A JSON Lines file's records as rows, :func:`...inputs.jsonl_blocks.jsonl_blocks`' values with their index."""
+    index = 0
+    for part in jsonl_blocks(path, where):
+        if isinstance(part, Unreadable):
+            yield part
+            continue
+        for line, value in part:
+            yield index, line, value
+            index += 1
 
 
 def _stream_items(stream: IO[bytes], where: str, fmt: str) -> Iterator[Item | Row]:

@@ -11,6 +11,7 @@ Without orjson installed writing falls back to the standard library whole.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 from typing import Any, cast
@@ -39,6 +40,33 @@ def _es_in_keys(keys: tuple[object, ...]) -> int:
         if len(_key_es) < 256:
             _key_es[keys] = found
     return found
+
+
+_INTEGRAL = frozenset({"int", "list[int]", "bool", "list[bool]"})
+_integral: dict[type, bool] = {}
+
+
+def integral(cls: type) -> bool:
+    """Whether every field of a generated message class holds integers or booleans (its dataclass fields are typed
+    ``int``, ``bool`` or lists of them, as MAVLink's are): orjson then writes json's very digits, and its line needs
+    no check but the separators (:func:`integral_line`)."""
+    found = _integral.get(cls)
+    if found is None:
+        found = dataclasses.is_dataclass(cls) and all(f.type in _INTEGRAL for f in dataclasses.fields(cls))
+        _integral[cls] = found
+    return found
+
+
+def integral_line(record: dict[str, Any]) -> bytes | None:
+    """``json.dumps(record, allow_nan=False)``'s bytes and a newline for the plain data of an :func:`integral` class
+    (keys that are field names, so no separator inside one), or None (orjson refuses an integer beyond 64 bits)."""
+    if orjson is None:
+        return None
+    try:
+        out = orjson.dumps(record, option=orjson.OPT_APPEND_NEWLINE)
+    except TypeError:
+        return None
+    return out.replace(b",", b", ").replace(b":", b": ")
 
 
 def orjson_line(record: dict[Any, Any]) -> bytes | None:
