@@ -605,7 +605,9 @@ class GpsClock:
 def _gps_clock(msg: DataflashMessage) -> GpsClock | None:
     """The clock of a GPS record that has a week (pymavlink's DFReader takes the first with ``GWk`` > 0)."""
     week, ms = _number(msg.fields, "GWk"), _number(msg.fields, "GMS")
-    if msg.time_us is None or week is None or ms is None or week <= 0:
+    # a week of uint16 and a time within the week, as ArduPilot logs them (GWk H, GMS I): anything else is damage,
+    # and would push the UTC clock beyond the int64 microseconds the clock columns hold
+    if msg.time_us is None or week is None or ms is None or not 0 < week <= 0xFFFF or not 0 <= ms < 604_800_000:
         return None
     return GpsClock(msg.time_us, (GPS_EPOCH_S + int(week) * 604_800 - GPS_LEAP_S) * 1_000_000 + int(ms) * 1000)
 
