@@ -353,3 +353,25 @@ def test_a_marker_replacing_another_sources_log_hides_nothing(tmp_path: Path, fl
     assert state(out) == before
     assert main(["export", "-q", "-o", str(out), *map(str, logs)]) == 0
     assert state(out) == before
+
+
+def test_a_log_id_of_digits_only_stays_text_in_the_views(tmp_path: Path, flights: tuple[list[Path], Path]) -> None:
+    """A content id is hex: one in 20,000 is digits only, and DuckDB's hive partitioning would read ``log=<id>`` as
+    a BIGINT, which then clashed with the file's own ``log`` text (a CI run's CAN export failed so). The views type
+    the partition's ``log`` as text."""
+    logs, _ = flights
+    out = tmp_path / "ds"
+    assert main(["export", "-q", "-o", str(out), str(logs[0])]) == 0
+    path = _marker_path(out, "flight.tlog")
+    data = json.loads(path.read_text())
+    old, new = data["log"], "1234567890123456"
+    for table in ("battery", "raw", "failsafe"):
+        for folder in sorted((out / table).rglob(f"log={old}")):
+            folder.rename(folder.with_name(f"log={new}"))
+    text = path.read_text().replace(old, new)
+    path.unlink()
+    (out / "logs" / f"{new}.json").write_text(text)
+    finish(out)
+    rows = run_query(out, "SELECT DISTINCT typeof(log), log FROM battery").rows
+    assert rows == [("VARCHAR", new)]
+    assert run_query(out, "SELECT count(*) FROM flights").rows[0][0] >= 1

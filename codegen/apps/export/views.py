@@ -33,8 +33,10 @@ from .manifest import committed
 _STEP = resistance_sql("dt", "pack_voltage", "prev_voltage", "current", "prev_current", "peak_abs_current")
 VIEWS_FILE = "views.sql"
 
+# a log id is hex, and one of digits only would be read as a number by hive partitioning: typed as text
 _BATTERY_VIEW = """CREATE OR REPLACE VIEW battery AS
-SELECT * FROM read_parquet({files}, hive_partitioning = true, union_by_name = true);
+SELECT * FROM read_parquet({files}, hive_partitioning = true, hive_types = {{'log': VARCHAR}},
+    union_by_name = true);
 """
 
 _FLIGHT_VIEWS = f"""-- One row per flight (a log and a battery instance). SI units: V, A, C, J, K, s, Ohm.
@@ -118,7 +120,8 @@ def _table_view(name: str, files: list[str], schema: Any) -> str:
     (DuckDB refuses an empty list)."""
     if files:
         return f"""CREATE OR REPLACE VIEW {name} AS
-SELECT * FROM read_parquet({_list(files)}, hive_partitioning = true, union_by_name = true);
+SELECT * FROM read_parquet({_list(files)}, hive_partitioning = true, hive_types = {{'log': VARCHAR}},
+    union_by_name = true);
 """
     columns = ", ".join(f"CAST(NULL AS {_DUCKDB_TYPES.get(str(f.type), 'TIMESTAMPTZ')}) AS {f.name}" for f in schema)
     return f"CREATE OR REPLACE VIEW {name} AS SELECT {columns} WHERE false;\n"
