@@ -24,6 +24,7 @@ memory stays flat; every loop ends at the end of the file.
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import math
 import os
@@ -137,8 +138,8 @@ class DataflashLog:
                 offset = max(0, int(reader.offset) - length)
                 stamp = getattr(msg, "_timestamp", None)
                 clock = None
-                if isinstance(stamp, float | int) and math.isfinite(stamp) and 0 <= stamp * 1e6 < MAX_TIME_US:
-                    clock = round(stamp * 1e6)
+                if isinstance(stamp, float | int) and math.isfinite(stamp):
+                    clock = _bounded_us(round(stamp * 1e6))
                 yield DataflashMessage(name, index, offset, _time_us(values), values, scales[name], clock)
                 index += 1
         finally:
@@ -182,9 +183,16 @@ def open_log(path: Path, display: str | None = None) -> DataflashLog:
 
 
 def _binary_reader(path: Path) -> Any:
-    """pymavlink's binary reader, refusing a record that does not move it on. A format record may declare a length
-    of 0: pymavlink then steps back over the header it just read and parses the same record again, for ever (found
-    by the long fuzz run; tests/fuzz/crashers/view-dataflash/format-of-length-0.bin). Every other length moves it."""
+    """pymavlink's binary reader, refusing a record that does not move it on (:func:`_guarded_reader`)."""
+    return _guarded_reader()(str(path), zero_time_base=True)
+
+
+@functools.cache
+def _guarded_reader() -> Any:
+    """pymavlink's binary reader class, made once, refusing a record that does not move it on. A format record may
+    declare a length of 0: pymavlink then steps back over the header it just read and parses the same record again,
+    for ever (found by the long fuzz run; tests/fuzz/crashers/view-dataflash/format-of-length-0.bin). Every other
+    length moves it."""
     from pymavlink import DFReader
 
     class Guarded(DFReader.DFReader_binary):  # type: ignore[misc]
@@ -197,11 +205,10 @@ def _binary_reader(path: Path) -> Any:
                 )
             return msg
 
-    return Guarded(str(path), zero_time_base=True)
+    return Guarded
 
 
 def _open(path: Path, display: str, notes: list[str], text: bool = False) -> Any:
-
     # building the reader runs pymavlink's C indexer, which writes to the process's own descriptors: captured here,
     # once per open, not around every message read (a temporary file and four dups per message)
     with _captured(notes, native=True):
@@ -267,9 +274,13 @@ def _time_us(values: Mapping[str, Any]) -> int | None:
     for name, scale in (("TimeUS", 1), ("TimeMS", 1000)):
         value = values.get(name)
         if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
-            us = int(value) * scale
-            return us if 0 <= us < MAX_TIME_US else None
+            return _bounded_us(int(value) * scale)
     return None
+
+
+def _bounded_us(us: int) -> int | None:
+    """A time in microseconds, or None where it is no time (negative, or beyond MAX_TIME_US)."""
+    return us if 0 <= us < MAX_TIME_US else None
 
 
 def shortest_float32(value: float) -> float:
